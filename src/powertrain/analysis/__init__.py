@@ -1,0 +1,1 @@
+"""Post-processing: FFT order analysis and comparisons."""

@@ -1,0 +1,35 @@
+r"""Fourier coefficients of sampled periodic signals.
+
+For samples :math:`s_k = s(k T/N)`, :math:`k = 0..N-1` over an integer number of periods,
+the complex amplitude of harmonic :math:`j` (so that :math:`s(t) \approx \mathrm{Re}\,
+\sum_j \hat S_j e^{i j \Omega t}`) is :math:`\hat S_j = \frac{2}{N}\sum_k s_k e^{-2\pi i jk/N}`
+for :math:`j \ge 1` and :math:`\hat S_0 = \frac1N\sum_k s_k`. The RMS value of harmonic j
+is :math:`|\hat S_j|/\sqrt2`.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+
+def harmonic_amplitudes(samples, axis=0):
+    """Complex amplitudes of all harmonics of a signal sampled over one window.
+
+    Parameters
+    ----------
+    samples : ndarray
+        Equally spaced samples covering the window exactly once (do not repeat the end
+        point), along ``axis``.
+
+    Returns
+    -------
+    ndarray of complex
+        Harmonic j of the window's fundamental at index j (0 = mean).
+    """
+    samples = np.asarray(samples, dtype=float)
+    N = samples.shape[axis]
+    spec = np.fft.rfft(samples, axis=axis) / N
+    idx = [slice(None)] * spec.ndim
+    idx[axis] = slice(1, None)
+    spec[tuple(idx)] *= 2.0
+    return spec

@@ -1,0 +1,43 @@
+"""Errors raised for bad user input.
+
+Every loader raises :class:`InputError` naming the file and the key (and, for tables,
+line and column), so that the command line can print one line and exit non-zero.
+"""
+
+from __future__ import annotations
+
+
+class InputError(ValueError):
+    """Bad input file or value.
+
+    Parameters
+    ----------
+    message : str
+        What is wrong, in one line.
+    file : str, optional
+        File in which the problem was found.
+    key : str, optional
+        Key (dotted path), column or parameter name.
+    line : int, optional
+        Line number (1-based) for tabular files.
+    """
+
+    def __init__(self, message: str, file: str | None = None, key: str | None = None,
+                 line: int | None = None):
+        self.message = message
+        self.file = None if file is None else str(file)
+        self.key = key
+        self.line = line
+        super().__init__(self.one_line())
+
+    def one_line(self) -> str:
+        where = []
+        if self.file:
+            where.append(self.file)
+        if self.line is not None:
+            where.append(f"line {self.line}")
+        if self.key:
+            where.append(f"key '{self.key}'")
+        prefix = ": ".join([", ".join(where)]) if where else ""
+        text = f"{prefix}: {self.message}" if prefix else self.message
+        return " ".join(text.split())

@@ -1,0 +1,1 @@
+"""Readers and writers: the only place where datasheet units meet the SI interior."""

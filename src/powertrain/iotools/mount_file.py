@@ -1,0 +1,93 @@
+"""Mount files: ``mounts/*.toml`` in datasheet units (c in N/mm, d in N·s/mm, m in kg).
+
+Layout::
+
+    [mount]
+    name = "Hydraulic engine mount, X direction"
+    model = "triple-parallel"          # a preset of powertrain.models.mount.TOPOLOGIES
+    source = "Kovarik 2016, Fig. 37"   # optional
+    notes = "..."                      # optional
+
+    [units]                            # every quantity declares its unit
+    c = "N/mm"
+    d = "N*s/mm"
+    m = "kg"
+
+    [parameters]
+    c1 = 0.0
+    d1 = 0.0
+    ...
+
+Values are converted to SI once, here. Missing or negative parameters, NaN, unknown units
+or models and unknown keys raise :class:`powertrain.errors.InputError` naming file and key.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from powertrain.errors import InputError
+from powertrain.iotools.atomic import atomic_write
+from powertrain.iotools.tomlfile import get, number, read_toml
+from powertrain.models.mount import TOPOLOGIES, MountModel
+from powertrain.units import from_si, to_si
+
+#: The unit each parameter family is written in by :func:`write_mount`.
+DATASHEET_UNITS = {"c": "N/mm", "d": "N*s/mm", "m": "kg"}
+_DIMENSION = {"c": "stiffness", "d": "damping", "m": "mass"}
+
+
+def read_mount(path) -> MountModel:
+    """Load a mount file into a :class:`~powertrain.models.mount.MountModel` (SI)."""
+    path = str(path)
+    doc = read_toml(path)
+    mount = get(doc, "mount", path, types=dict)
+    model = get(mount, "model", path, "mount", types=str)
+    if model not in TOPOLOGIES:
+        raise InputError(f"unknown model {model!r} (known: {', '.join(TOPOLOGIES)})",
+                         file=path, key="mount.model")
+    topo = TOPOLOGIES[model]
+    units = get(doc, "units", path, types=dict)
+    params_raw = get(doc, "parameters", path, types=dict)
+    unknown = sorted(set(params_raw) - set(topo.parameters))
+    if unknown:
+        raise InputError(f"unknown parameter for model {model!r} "
+                         f"(expected {', '.join(topo.parameters)})",
+                         file=path, key=f"parameters.{unknown[0]}")
+    params = {}
+    for p in topo.parameters:
+        family = p[0]
+        unit = get(units, family, path, "units", types=str)
+        raw = get(params_raw, p, path, "parameters")
+        value = number(raw, path, f"parameters.{p}", nonneg=True)
+        params[p] = float(to_si(value, unit, _DIMENSION[family], file=path,
+                                key=f"units.{family}"))
+    return MountModel(topo, params, name=str(mount.get("name", Path(path).stem)),
+                      source=str(mount.get("source", "")), notes=str(mount.get("notes", "")))
+
+
+def format_mount(model: MountModel, *, comment: str = "") -> str:
+    """The TOML text of a mount file in datasheet units."""
+    def q(s):
+        return '"' + str(s).replace("\\", "\\\\").replace('"', '\\"') + '"'
+    lines = []
+    for line in comment.splitlines():
+        lines.append(f"# {line}".rstrip())
+    lines += ["[mount]", f"name = {q(model.name or model.topology.description)}",
+              f"model = {q(model.topology.name)}"]
+    if model.source:
+        lines.append(f"source = {q(model.source)}")
+    if model.notes:
+        lines.append(f"notes = {q(model.notes)}")
+    lines += ["", "[units]"] + [f'{k} = "{u}"' for k, u in DATASHEET_UNITS.items()]
+    lines += ["", "[parameters]"]
+    for p in model.topology.parameters:
+        lines.append(f"{p} = {from_si(model.params[p], DATASHEET_UNITS[p[0]]):.8g}")
+    return "\n".join(lines) + "\n"
+
+
+def write_mount(model: MountModel, path, *, comment: str = "") -> None:
+    """Write a mount file atomically (temporary file, then rename)."""
+    text = format_mount(model, comment=comment)
+    with atomic_write(path) as fh:
+        fh.write(text)

@@ -1,0 +1,90 @@
+"""Reading TOML data files with errors that name the file and the key."""
+
+from __future__ import annotations
+
+import math
+import sys
+
+from powertrain.errors import InputError
+from powertrain.units import to_si
+
+if sys.version_info >= (3, 11):
+    import tomllib
+else:  # pragma: no cover
+    import tomli as tomllib
+
+
+def read_toml(path) -> dict:
+    """Parse a TOML file; unreadable or malformed files raise :class:`InputError`."""
+    try:
+        with open(path, "rb") as fh:
+            return tomllib.load(fh)
+    except FileNotFoundError:
+        raise InputError("file not found", file=path) from None
+    except IsADirectoryError:
+        raise InputError("is a directory, expected a file", file=path) from None
+    except PermissionError:
+        raise InputError("file not readable (permission denied)", file=path) from None
+    except tomllib.TOMLDecodeError as exc:
+        raise InputError(f"not valid TOML: {exc}", file=path) from None
+    except UnicodeDecodeError:
+        raise InputError("not a text (UTF-8) TOML file", file=path) from None
+
+
+def get(table: dict, key: str, path, prefix: str = "", *, default=..., types=None):
+    """``table[key]`` or an :class:`InputError` naming ``prefix.key`` when missing/mistyped."""
+    full = f"{prefix}.{key}" if prefix else key
+    if key not in table:
+        if default is ...:
+            raise InputError("missing key", file=path, key=full)
+        return default
+    value = table[key]
+    if types is not None and not isinstance(value, types):
+        raise InputError(f"expected {_type_name(types)}, got {type(value).__name__}",
+                         file=path, key=full)
+    return value
+
+
+def _type_name(types):
+    if isinstance(types, tuple):
+        return " or ".join(t.__name__ for t in types)
+    return types.__name__
+
+
+def number(value, path, key, *, nonneg=False, positive=False) -> float:
+    """Validate a finite real number (bool rejected)."""
+    if isinstance(value, bool) or not isinstance(value, (int, float)):
+        raise InputError(f"expected a number, got {value!r}", file=path, key=key)
+    value = float(value)
+    if not math.isfinite(value):
+        raise InputError(f"not a finite number ({value})", file=path, key=key)
+    if positive and value <= 0:
+        raise InputError(f"must be positive, got {value}", file=path, key=key)
+    if nonneg and value < 0:
+        raise InputError(f"must not be negative, got {value}", file=path, key=key)
+    return value
+
+
+def quantity(table: dict, key: str, dimension: str, path, prefix: str = "", *,
+             default=..., nonneg=False, positive=False):
+    """Read ``key = {value = ..., unit = "..."}`` (or ``[value, "unit"]``) and convert to SI.
+
+    Every physical quantity in engine files declares its unit this way.
+    """
+    full = f"{prefix}.{key}" if prefix else key
+    raw = get(table, key, path, prefix, default=default)
+    if raw is default and default is not ...:
+        return default
+    if isinstance(raw, dict):
+        if "value" not in raw:
+            raise InputError("missing key", file=path, key=f"{full}.value")
+        if "unit" not in raw:
+            raise InputError("missing unit", file=path, key=f"{full}.unit")
+        value, unit = raw["value"], raw["unit"]
+    else:
+        raise InputError("expected {value = ..., unit = \"...\"}", file=path, key=full)
+    if isinstance(value, list):
+        vals = [number(v, path, f"{full}.value", nonneg=nonneg, positive=positive) for v in value]
+        return [to_si(v, unit, dimension, file=path, key=f"{full}.unit") for v in vals]
+    value = number(value, path, f"{full}.value", nonneg=nonneg, positive=positive)
+    return to_si(value, unit, dimension, file=path, key=f"{full}.unit")

@@ -1,0 +1,200 @@
+r"""Lumped mount networks: point masses joined by Kelvin–Voigt elements.
+
+Every lumped mount model of Kovarik (2016), Table 2, is a small linear network. Its nodes are
+the engine-side node (index 0), ``n`` internal point masses (indices ``1..n``) and the ground
+node (index ``GROUND = -1``, the chassis side). Each element ``e`` joins two nodes with a spring
+``c_e`` [N/m] and a viscous damper ``d_e`` [N·s/m] in parallel (Kelvin–Voigt).
+
+With harmonic motion :math:`x = \hat X e^{i\omega t}` (eq. 10–12) each element has the complex
+stiffness :math:`k_e = c_e + i\omega d_e` and the network the dynamic stiffness matrix
+
+.. math:: \mathbf D(\omega) = \mathbf K + i\omega\mathbf C - \omega^2\mathbf M .
+
+Prescribing the engine-side displacement :math:`\hat X_1` with the base grounded, the internal
+masses follow from :math:`\mathbf D_{ii}\hat{\mathbf X}_i = -\mathbf D_{i1}\hat X_1`, and
+
+* the cross-point dynamic stiffness is the force transmitted to ground per unit engine-side
+  displacement, :math:`K_{CP} = F_T/\hat X_1 = \sum_{e\,\in\,\text{ground}} k_e\,\hat X_{e}/\hat X_1`
+  (eq. 1, 24 and 39 in general form);
+* the input-point dynamic stiffness is the force needed at the engine-side node,
+  :math:`K_{IP} = \mathbf D_{11} + \mathbf D_{1i}\hat{\mathbf X}_i/\hat X_1` (eq. 2, 3), plus
+  :math:`-\omega^2 m_e` when an engine mass rides on the node.
+
+For the triple mass oscillator in parallel connection this is exactly eq. 29–39.
+
+References
+----------
+.. [1] B. Kovarik, *Modeling of the Nonlinear Frequency Dependent Engine Mount Dynamic
+   Stiffness*, Master's thesis, University of Zagreb, 2016.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+#: Index of the ground (chassis) node in ``elem_nodes``.
+GROUND = -1
+#: Index of the engine-side node.
+ENGINE = 0
+
+
+def network_matrices(masses, elem_nodes, c, d, *, include_ground=False):
+    r"""Mass, damping and stiffness matrices of a mount network.
+
+    Parameters
+    ----------
+    masses : array_like, shape (n,)
+        Internal point masses [kg] (zero allowed: a massless node).
+    elem_nodes : array_like of int, shape (n_el, 2)
+        Node pairs of the elements; 0 = engine side, 1..n = internal, -1 = ground.
+    c : array_like, shape (n_el,)
+        Element stiffnesses [N/m].
+    d : array_like, shape (n_el,)
+        Element damping coefficients [N·s/m].
+    include_ground : bool
+        If False (default) the ground is fixed and the matrices have size ``n + 1``
+        (engine-side node first). If True the ground node is kept as the last degree of
+        freedom (size ``n + 2``), for assembly on a compliant body.
+
+    Returns
+    -------
+    M, C, K : ndarray, shape (n + 1, n + 1) or (n + 2, n + 2)
+        The engine-side node carries no mass of its own [kg, N·s/m, N/m].
+    """
+    masses = np.asarray(masses, dtype=float)
+    elem_nodes = np.asarray(elem_nodes, dtype=int).reshape(-1, 2)
+    c = np.asarray(c, dtype=float)
+    d = np.asarray(d, dtype=float)
+    n = masses.size
+    size = n + 2 if include_ground else n + 1
+    M = np.zeros((size, size))
+    M[1:n + 1, 1:n + 1] = np.diag(masses)
+    C = np.zeros((size, size))
+    K = np.zeros((size, size))
+    for (a, b), ce, de in zip(elem_nodes, c, d):
+        ia = (n + 1 if include_ground else None) if a == GROUND else a
+        ib = (n + 1 if include_ground else None) if b == GROUND else b
+        for mat, val in ((K, ce), (C, de)):
+            if ia is not None:
+                mat[ia, ia] += val
+            if ib is not None:
+                mat[ib, ib] += val
+            if ia is not None and ib is not None:
+                mat[ia, ib] -= val
+                mat[ib, ia] -= val
+    return M, C, K
+
+
+def ground_force_rows(n_internal, elem_nodes, c, d):
+    r"""Rows giving the force transmitted to ground from the network state.
+
+    :math:`F_T = \mathbf k_g \cdot \mathbf x + \mathbf d_g \cdot \dot{\mathbf x}` with the
+    state ordered as in :func:`network_matrices` (ground fixed). Eq. 24 in general form.
+
+    Returns
+    -------
+    kg, dg : ndarray, shape (n_internal + 1,)
+        [N/m] and [N·s/m].
+    """
+    elem_nodes = np.asarray(elem_nodes, dtype=int).reshape(-1, 2)
+    kg = np.zeros(n_internal + 1)
+    dg = np.zeros(n_internal + 1)
+    for (a, b), ce, de in zip(elem_nodes, np.asarray(c, float), np.asarray(d, float)):
+        if (a == GROUND) == (b == GROUND):
+            continue
+        other = b if a == GROUND else a
+        kg[other] += ce
+        dg[other] += de
+    return kg, dg
+
+
+def _internal_solution(omega, masses, elem_nodes, c, d):
+    """Dynamic stiffness matrices and internal displacements per unit engine-side motion."""
+    omega = np.atleast_1d(np.asarray(omega, dtype=float))
+    M, C, K = network_matrices(masses, elem_nodes, c, d)
+    w = omega[:, None, None]
+    D = K[None] + 1j * w * C[None] - w**2 * M[None]
+    n = M.shape[0] - 1
+    if n == 0:
+        return omega, D, np.ones((omega.size, 1), dtype=complex)
+    rhs = -D[:, 1:, 0:1]
+    Xi = np.linalg.solve(D[:, 1:, 1:], rhs)[..., 0]
+    X = np.concatenate([np.ones((omega.size, 1), dtype=complex), Xi], axis=1)
+    return omega, D, X
+
+
+def cross_point_stiffness(omega, masses, elem_nodes, c, d):
+    r"""Cross-point dynamic stiffness :math:`K_{CP}(\omega) = F_T/\hat X_1` [N/m].
+
+    Base grounded, engine-side displacement prescribed; internal masses condensed
+    (Kovarik 2016, eq. 1 and the general form of eq. 39).
+
+    Parameters
+    ----------
+    omega : float or array_like
+        Angular frequency [rad/s].
+    masses, elem_nodes, c, d
+        Network, see :func:`network_matrices`.
+
+    Returns
+    -------
+    ndarray of complex, shape (n_freq,)
+    """
+    omega, _, X = _internal_solution(omega, masses, elem_nodes, c, d)
+    kg, dg = ground_force_rows(X.shape[1] - 1, elem_nodes, c, d)
+    return X @ kg + 1j * omega * (X @ dg)
+
+
+def input_point_stiffness(omega, masses, elem_nodes, c, d, engine_mass=0.0):
+    r"""Input-point dynamic stiffness :math:`K_{IP}(\omega) = F_1/\hat X_1` [N/m].
+
+    The force needed at the engine-side node per unit displacement, with the base grounded
+    (Kovarik 2016, eq. 2–3). With ``engine_mass`` :math:`m_e` [kg] the inertia term
+    :math:`-\omega^2 m_e` is included, so that :math:`\hat X_1 = F/K_{IP}` for a force
+    :math:`F` on the engine mass.
+    """
+    omega, D, X = _internal_solution(omega, masses, elem_nodes, c, d)
+    return np.einsum("fj,fj->f", D[:, 0, :], X) - omega**2 * engine_mass
+
+
+def internal_displacements(omega, masses, elem_nodes, c, d):
+    """Complex displacement of every network node per unit engine-side displacement.
+
+    Returns
+    -------
+    ndarray of complex, shape (n_freq, n_internal + 1)
+        Column 0 is the engine-side node (identically 1).
+    """
+    return _internal_solution(omega, masses, elem_nodes, c, d)[2]
+
+
+def forced_engine_mass_response(omega, masses, elem_nodes, c, d, engine_mass, force):
+    r"""Engine mass on the mount under a harmonic force: the thesis's verification set-up.
+
+    A force :math:`F e^{i\omega t}` acts on a mass :math:`m_e` carried by the mount
+    (Kovarik 2016, sec. 3.2, Appendix A). The engine mass moves under the input-point
+    stiffness, the ground sees the cross-point one:
+
+    .. math:: \hat X_1 = \frac{F}{K_{IP}(\omega) - \omega^2 m_e}, \qquad
+              F_T = K_{CP}(\omega)\,\hat X_1 .
+
+    Parameters
+    ----------
+    omega : array_like
+        Angular frequency [rad/s].
+    engine_mass : float
+        [kg]
+    force : float
+        Force amplitude [N].
+
+    Returns
+    -------
+    x1 : ndarray of complex
+        Engine-mass displacement amplitude [m].
+    ft : ndarray of complex
+        Force transmitted to ground [N].
+    """
+    kip = input_point_stiffness(omega, masses, elem_nodes, c, d, engine_mass)
+    kcp = cross_point_stiffness(omega, masses, elem_nodes, c, d)
+    x1 = force / kip
+    return x1, kcp * x1

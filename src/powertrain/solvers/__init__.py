@@ -1,0 +1,1 @@
+"""Solvers: public wrappers around the kernels, and the frequency-domain solvers."""

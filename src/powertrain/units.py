@@ -1,0 +1,117 @@
+"""The one table of units accepted in data files, and conversion to SI.
+
+Data files may use the datasheet units of the field (N/mm, N·s/mm, kg, bar, mm, rpm, deg);
+every quantity declares its unit and the loaders convert it once, here. Inside the package
+everything is SI: m, kg, s, N, Pa, rad.
+"""
+
+from __future__ import annotations
+
+import math
+
+from powertrain.errors import InputError
+
+#: unit string -> (dimension, factor to SI). Aliases spell the same unit differently.
+UNITS: dict[str, tuple[str, float]] = {
+    # stiffness
+    "N/m": ("stiffness", 1.0),
+    "N/mm": ("stiffness", 1e3),
+    "kN/mm": ("stiffness", 1e6),
+    # damping
+    "N*s/m": ("damping", 1.0),
+    "Ns/m": ("damping", 1.0),
+    "N·s/m": ("damping", 1.0),
+    "N*s/mm": ("damping", 1e3),
+    "Ns/mm": ("damping", 1e3),
+    "N·s/mm": ("damping", 1e3),
+    # mass
+    "kg": ("mass", 1.0),
+    "g": ("mass", 1e-3),
+    "t": ("mass", 1e3),
+    # length
+    "m": ("length", 1.0),
+    "mm": ("length", 1e-3),
+    "cm": ("length", 1e-2),
+    # volume
+    "m^3": ("volume", 1.0),
+    "cm^3": ("volume", 1e-6),
+    "L": ("volume", 1e-3),
+    # pressure
+    "Pa": ("pressure", 1.0),
+    "kPa": ("pressure", 1e3),
+    "MPa": ("pressure", 1e6),
+    "bar": ("pressure", 1e5),
+    # angle
+    "rad": ("angle", 1.0),
+    "deg": ("angle", math.pi / 180.0),
+    # rotational speed
+    "rad/s": ("angular_speed", 1.0),
+    "rpm": ("angular_speed", 2.0 * math.pi / 60.0),
+    # moment of inertia
+    "kg*m^2": ("inertia", 1.0),
+    "kg*mm^2": ("inertia", 1e-6),
+    # mass times radius (unbalance)
+    "kg*m": ("unbalance", 1.0),
+    "kg*mm": ("unbalance", 1e-3),
+    "g*mm": ("unbalance", 1e-6),
+    # torque / moment
+    "N*m": ("torque", 1.0),
+    "Nm": ("torque", 1.0),
+    # force
+    "N": ("force", 1.0),
+    "kN": ("force", 1e3),
+    # frequency
+    "Hz": ("frequency", 1.0),
+    # time
+    "s": ("time", 1.0),
+    "ms": ("time", 1e-3),
+    # energy per mass (fuel heating value)
+    "J/kg": ("specific_energy", 1.0),
+    "MJ/kg": ("specific_energy", 1e6),
+    # temperature (absolute only)
+    "K": ("temperature", 1.0),
+    # dimensionless
+    "1": ("dimensionless", 1.0),
+    "-": ("dimensionless", 1.0),
+    "%": ("dimensionless", 1e-2),
+}
+
+
+def to_si(value, unit: str, dimension: str, *, file=None, key=None):
+    """Convert ``value`` given in ``unit`` to SI, checking the unit measures ``dimension``.
+
+    Parameters
+    ----------
+    value : float or array_like
+        Value(s) in the declared unit.
+    unit : str
+        Unit string, one of :data:`UNITS`.
+    dimension : str
+        Expected dimension (e.g. ``"stiffness"``).
+    file, key : str, optional
+        Where the value came from, for the error message.
+
+    Returns
+    -------
+    float or ndarray
+        Value(s) in SI.
+
+    Raises
+    ------
+    InputError
+        Unknown unit or unit of the wrong dimension.
+    """
+    if not isinstance(unit, str) or unit not in UNITS:
+        known = ", ".join(u for u, (dim, _) in UNITS.items() if dim == dimension)
+        raise InputError(f"unknown unit {unit!r} (expected one of: {known})", file=file, key=key)
+    dim, factor = UNITS[unit]
+    if dim != dimension:
+        raise InputError(f"unit {unit!r} measures {dim}, expected {dimension}", file=file, key=key)
+    return value * factor
+
+
+def from_si(value, unit: str):
+    """Convert an SI value to ``unit`` (for writing datasheet-unit files and tables)."""
+    if unit not in UNITS:
+        raise InputError(f"unknown unit {unit!r}")
+    return value / UNITS[unit][1]
