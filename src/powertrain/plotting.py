@@ -46,3 +46,43 @@ def plot_stiffness(curves, path=None, measured=None, ax=None):
         fig.tight_layout()
         save_figure(fig, path)
     return ax
+
+
+def plot_runup(results, path=None, quantities=("synthesis", "order_2", "order_4"),
+               signal="velocity"):
+    """Grid of RMS curves: rows = mount × direction, columns = ``quantities``.
+
+    Parameters
+    ----------
+    results : list of (label, RunupResult)
+    """
+    plt = _pyplot()
+    first = results[0][1]
+    rows = first.channels
+    fig, axes = plt.subplots(len(rows), len(quantities), figsize=(4 * len(quantities),
+                             1.9 * len(rows)), sharex=True, squeeze=False)
+    scale = {"velocity": (1e3, "mm/s"), "displacement": (1e6, "µm"),
+             "acceleration": (1.0, "m/s²"), "mount_force": (1.0, "N")}[signal]
+    for r, (mount, direction) in enumerate(rows):
+        for q, quantity in enumerate(quantities):
+            ax = axes[r, q]
+            for label, res in results:
+                if (mount, direction) not in res.channels:
+                    continue
+                ax.semilogy(res.rpm, res.curve(mount, direction, quantity, signal) * scale[0],
+                            "o-", ms=3, lw=1.2, label=label)
+            title = "synthesis (orders ≤ 8)" if quantity == "synthesis" else \
+                quantity.replace("order_", "order ")
+            ax.set_title(f"{mount} {direction.upper()} — {title}", fontsize=8)
+            ax.grid(True, which="both", alpha=0.3)
+            ax.tick_params(labelsize=7)
+            if q == 0:
+                ax.set_ylabel(f"RMS {signal} [{scale[1]}]", fontsize=7)
+    for ax in axes[-1]:
+        ax.set_xlabel("engine speed [rpm]", fontsize=8)
+    if len(results) > 1:
+        axes[0, 0].legend(fontsize=7)
+    fig.tight_layout()
+    if path:
+        save_figure(fig, path)
+    return fig

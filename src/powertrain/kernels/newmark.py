@@ -23,7 +23,7 @@ import numpy as np
 from numba import njit
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def newmark_kernel(G, H, Fs, h, x0, v0, a0, X, V, A):
     """Integrate ``Fs.shape[0] - 1`` steps; write states into X, V, A (rows = time steps).
 

@@ -123,6 +123,18 @@ def _internal_solution(omega, masses, elem_nodes, c, d):
     return omega, D, X
 
 
+def condensed_network(omega, masses, elem_nodes, c, d):
+    """Node displacements per unit engine-side motion and input-point stiffness, in one solve.
+
+    Returns
+    -------
+    X : ndarray complex (n_freq, n_internal + 1)
+    k_ip : ndarray complex (n_freq,)  [N/m], no engine mass
+    """
+    omega, D, X = _internal_solution(omega, masses, elem_nodes, c, d)
+    return X, np.einsum("fj,fj->f", D[:, 0, :], X)
+
+
 def cross_point_stiffness(omega, masses, elem_nodes, c, d):
     r"""Cross-point dynamic stiffness :math:`K_{CP}(\omega) = F_T/\hat X_1` [N/m].
 
@@ -198,3 +210,101 @@ def forced_engine_mass_response(omega, masses, elem_nodes, c, d, engine_mass, fo
     kcp = cross_point_stiffness(omega, masses, elem_nodes, c, d)
     x1 = force / kip
     return x1, kcp * x1
+
+
+def incidence_matrix(n_internal, elem_nodes):
+    r"""Element incidence over the extended node set (engine side, internal masses, ground).
+
+    Row ``e`` has ``+1`` at node ``a`` and ``-1`` at node ``b`` of element ``e``; the nodes are
+    ordered engine side (0), internal masses (``1..n``), ground (``n + 1``). The extended
+    dynamic stiffness matrix is then
+    :math:`\mathbf D = \mathbf B^T \operatorname{diag}(c + i\omega d)\,\mathbf B -
+    \omega^2 \operatorname{diag}(0, \mathbf m, 0)`.
+
+    Parameters
+    ----------
+    n_internal : int
+        Number of internal nodes ``n``.
+    elem_nodes : array_like of int, shape (n_el, 2)
+        Node pairs, see :func:`network_matrices`.
+
+    Returns
+    -------
+    ndarray, shape (n_el, n_internal + 2)
+    """
+    elem_nodes = np.asarray(elem_nodes, dtype=int).reshape(-1, 2)
+    B = np.zeros((elem_nodes.shape[0], n_internal + 2))
+    for e, (a, b) in enumerate(elem_nodes):
+        B[e, n_internal + 1 if a == GROUND else a] += 1.0
+        B[e, n_internal + 1 if b == GROUND else b] -= 1.0
+    return B
+
+
+def cross_point_stiffness_gradient(omega, masses, elem_nodes, c, d):
+    r"""Cross-point stiffness and its derivatives with respect to every c, d and m.
+
+    Two static condensations share one factorisation per frequency: the internal motion
+    :math:`\hat{\mathbf X}` for a unit engine-side displacement with the ground held (the
+    state behind :func:`cross_point_stiffness`), and the internal motion :math:`\hat{\mathbf Y}`
+    for a unit ground displacement with the engine side held. Extending both over all nodes
+    (:math:`X_E = 1, X_G = 0`; :math:`Y_E = 0, Y_G = 1`), the symmetric network gives
+
+    .. math::
+        K_{CP} = -\hat{\mathbf Y}^T \mathbf D(\omega)\,\hat{\mathbf X}, \qquad
+        \frac{\partial K_{CP}}{\partial p} = -\hat{\mathbf Y}^T
+        \frac{\partial \mathbf D}{\partial p}\hat{\mathbf X}
+
+    (the second because :math:`\mathbf D\hat{\mathbf X}` and
+    :math:`\mathbf D\hat{\mathbf Y}` vanish at the internal nodes), so with the element
+    elongations :math:`u_e = X_a - X_b`, :math:`v_e = Y_a - Y_b`
+
+    .. math::
+        \frac{\partial K_{CP}}{\partial c_e} = -u_e v_e, \quad
+        \frac{\partial K_{CP}}{\partial d_e} = -i\omega\,u_e v_e, \quad
+        \frac{\partial K_{CP}}{\partial m_j} = \omega^2 X_j Y_j ,
+
+    and :math:`K_{CP}` is homogeneous of degree one in the parameters,
+    :math:`K_{CP} = \sum_p p\,\partial K_{CP}/\partial p`. This is the analytic Jacobian
+    used for parameter identification (Kovarik 2016, sec. 2.2, eq. 19).
+
+    Parameters
+    ----------
+    omega : float or array_like
+        Angular frequency [rad/s].
+    masses, elem_nodes, c, d
+        Network, see :func:`network_matrices`: masses [kg], c [N/m], d [N·s/m].
+
+    Returns
+    -------
+    kcp : ndarray of complex, shape (n_freq,)
+        Cross-point dynamic stiffness [N/m].
+    dk_dm : ndarray of complex, shape (n_freq, n_internal)
+        [N/(m·kg)]
+    dk_dc : ndarray of complex, shape (n_freq, n_el)
+        [1]
+    dk_dd : ndarray of complex, shape (n_freq, n_el)
+        [1/s]
+    """
+    omega = np.atleast_1d(np.asarray(omega, dtype=float))
+    masses = np.asarray(masses, dtype=float)
+    c = np.asarray(c, dtype=float)
+    d = np.asarray(d, dtype=float)
+    n = masses.size
+    B = incidence_matrix(n, elem_nodes)
+    k = c[None, :] + 1j * omega[:, None] * d[None, :]                 # (f, e)
+    D = np.einsum("ea,fe,eb->fab", B, k, B)
+    D[:, 1:n + 1, 1:n + 1] -= (omega[:, None]**2 * masses[None, :])[:, :, None] \
+        * np.eye(n)[None]
+    nf = omega.size
+    XY = np.zeros((nf, n + 2, 2), dtype=complex)
+    XY[:, 0, 0] = 1.0
+    XY[:, n + 1, 1] = 1.0
+    if n:
+        rhs = -D[:, 1:n + 1][:, :, [0, n + 1]]
+        XY[:, 1:n + 1, :] = np.linalg.solve(D[:, 1:n + 1, 1:n + 1], rhs)
+    uv = np.einsum("ea,fas->fes", B, XY)
+    dk_dc = -uv[..., 0] * uv[..., 1]
+    dk_dd = 1j * omega[:, None] * dk_dc
+    dk_dm = omega[:, None]**2 * XY[:, 1:n + 1, 0] * XY[:, 1:n + 1, 1]
+    kcp = dk_dc @ c + dk_dd @ d + dk_dm @ masses
+    return kcp, dk_dm, dk_dc, dk_dd

@@ -1,0 +1,197 @@
+"""Run-up results: order spectra of the nine mount channels against speed.
+
+HDF5 layout (all arrays SI, units in each dataset's ``unit`` attribute)::
+
+    /                      attrs: format="powertrain-runup", format_version, powertrain_version,
+                                  created (UTC ISO 8601), solver settings (JSON), engine name,
+                                  engine_snapshot (the engine file text), mount_snapshots (JSON
+                                  {path: text}), synthetic (bool), description
+    /rpm                   (n_rpm,)                       rpm
+    /orders                (n_orders,)                    1 (orders 0.5 ... 8)
+    /channels/mount        (9,) str                       left/right/gearbox
+    /channels/direction    (9,) str                       x/y/z (engine axes)
+    /velocity/amplitude    (n_rpm, 9, n_orders) complex   m/s   (peak complex amplitude)
+    /velocity/order_rms    (n_rpm, 9, n_orders)           m/s
+    /velocity/synthesis_rms (n_rpm, 9)                    m/s   (RMS sum, orders <= 8)
+    /displacement/...      same, m
+    /acceleration/...      same, m/s^2
+    /mount_force/...       same, N (force transmitted to ground, engine axes)
+    /mount_force/mean      (n_rpm, 9)                     N (static preload part, no gravity)
+    /diagnostics/periodicity        (n_rpm,)              1 (cycle-to-cycle, Newmark)
+    /diagnostics/rigid_body_modes_hz (6,)                 Hz
+    /diagnostics/solver_seconds     ()                    s
+
+Long-format CSV (also the measured-data format): columns
+``mount,direction,quantity,rpm,velocity_rms_mm_per_s`` with ``quantity`` = ``order_0.5``,
+``order_1``, ... ``order_8`` or ``synthesis``.
+"""
+
+from __future__ import annotations
+
+import json
+from dataclasses import dataclass, field
+from datetime import datetime, timezone
+
+import numpy as np
+
+from powertrain.analysis.orders import order_label, order_rms, synthesis_rms
+
+QUANTITIES = {
+    "displacement": "m",
+    "velocity": "m/s",
+    "acceleration": "m/s^2",
+    "mount_force": "N",
+}
+CSV_HEADER = "mount,direction,quantity,rpm,velocity_rms_mm_per_s"
+
+
+@dataclass
+class RunupResult:
+    """Order spectra of a run-up (complex peak amplitudes, SI).
+
+    Arrays ``displacement``, ``velocity``, ``acceleration``, ``mount_force`` have shape
+    (n_rpm, n_channels, n_orders); ``channels`` lists (mount, direction) in engine axes.
+    """
+
+    rpm: np.ndarray
+    orders: np.ndarray
+    channels: list
+    displacement: np.ndarray
+    velocity: np.ndarray
+    acceleration: np.ndarray
+    mount_force: np.ndarray
+    mean_mount_force: np.ndarray
+    periodicity: np.ndarray
+    settings: dict = field(default_factory=dict)
+    solver_seconds: float = 0.0
+    rigid_body_modes_hz: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    meta: dict = field(default_factory=dict)
+
+    # ----------------------------------------------------------------- accessors
+    def order_rms(self, quantity="velocity") -> np.ndarray:
+        """RMS value per rpm, channel and order [SI]."""
+        return order_rms(getattr(self, quantity))
+
+    def synthesis_rms(self, quantity="velocity") -> np.ndarray:
+        """RMS sum over orders 0.5..8 per rpm and channel [SI]."""
+        return synthesis_rms(getattr(self, quantity), axis=-1)
+
+    def order_index(self, order: float) -> int:
+        idx = np.flatnonzero(np.isclose(self.orders, order))
+        if idx.size == 0:
+            raise KeyError(f"order {order} not in result")
+        return int(idx[0])
+
+    def channel_index(self, mount: str, direction: str) -> int:
+        return self.channels.index((mount, direction))
+
+    def curve(self, mount, direction, quantity="synthesis", signal="velocity") -> np.ndarray:
+        """RMS curve against rpm: ``quantity`` = ``synthesis`` or ``order_2`` etc. [SI]."""
+        c = self.channel_index(mount, direction)
+        if quantity == "synthesis":
+            return self.synthesis_rms(signal)[:, c]
+        order = float(quantity.split("_", 1)[1])
+        return self.order_rms(signal)[:, c, self.order_index(order)]
+
+    # ----------------------------------------------------------------- writers
+    def csv_text(self) -> str:
+        """Long-format CSV text of the velocity RMS values [mm/s]."""
+        lines = [CSV_HEADER]
+        rms = self.order_rms("velocity") * 1e3
+        syn = self.synthesis_rms("velocity") * 1e3
+        for c, (mount, direction) in enumerate(self.channels):
+            for k, order in enumerate(self.orders):
+                q = order_label(order)
+                for i, r in enumerate(self.rpm):
+                    lines.append(f"{mount},{direction},{q},{r:g},{rms[i, c, k]:.8g}")
+            for i, r in enumerate(self.rpm):
+                lines.append(f"{mount},{direction},synthesis,{r:g},{syn[i, c]:.8g}")
+        return "\n".join(lines) + "\n"
+
+    def to_csv(self, path) -> None:
+        from powertrain.iotools.atomic import atomic_write
+        text = self.csv_text()
+        with atomic_write(path) as fh:
+            fh.write(text)
+
+    def to_hdf5(self, path, *, engine_snapshot: str = "", mount_snapshots: dict | None = None,
+                synthetic: bool = False, description: str = "") -> None:
+        """Write the documented HDF5 layout atomically."""
+        import h5py
+
+        from powertrain import __version__
+        from powertrain.iotools.atomic import atomic_path
+        with atomic_path(path) as tmp:
+            with h5py.File(tmp, "w") as h5:
+                a = h5.attrs
+                a["format"] = "powertrain-runup"
+                a["format_version"] = 1
+                a["powertrain_version"] = __version__
+                a["created"] = datetime.now(timezone.utc).isoformat(timespec="seconds")
+                a["settings"] = json.dumps(self.settings)
+                a["meta"] = json.dumps(self.meta)
+                a["engine_snapshot"] = engine_snapshot
+                a["mount_snapshots"] = json.dumps(mount_snapshots or {})
+                a["synthetic"] = bool(synthetic)
+                a["description"] = description
+                ds = h5.create_dataset("rpm", data=self.rpm)
+                ds.attrs["unit"] = "rpm"
+                ds = h5.create_dataset("orders", data=self.orders)
+                ds.attrs["unit"] = "1"
+                g = h5.create_group("channels")
+                g.create_dataset("mount", data=np.array([m for m, _ in self.channels], dtype="S"))
+                g.create_dataset("direction",
+                                 data=np.array([d for _, d in self.channels], dtype="S"))
+                g.attrs["axes"] = "engine coordinate system (Kovarik 2016, sec. 4.1)"
+                for name, unit in QUANTITIES.items():
+                    g = h5.create_group(name)
+                    arr = getattr(self, name)
+                    for key, data in (("amplitude", arr), ("order_rms", order_rms(arr)),
+                                      ("synthesis_rms", synthesis_rms(arr, axis=-1))):
+                        ds = g.create_dataset(key, data=data)
+                        ds.attrs["unit"] = unit
+                ds = h5["mount_force"].create_dataset("mean", data=self.mean_mount_force)
+                ds.attrs["unit"] = "N"
+                g = h5.create_group("diagnostics")
+                g.create_dataset("periodicity", data=self.periodicity).attrs["unit"] = "1"
+                g.create_dataset("rigid_body_modes_hz",
+                                 data=self.rigid_body_modes_hz).attrs["unit"] = "Hz"
+                g.create_dataset("solver_seconds", data=self.solver_seconds).attrs["unit"] = "s"
+
+    @classmethod
+    def from_hdf5(cls, path) -> "RunupResult":
+        import h5py
+
+        from powertrain.errors import InputError
+        try:
+            h5 = h5py.File(path, "r")
+        except (OSError, FileNotFoundError) as exc:
+            raise InputError(f"cannot open HDF5 file ({exc})", file=path) from None
+        with h5:
+            if h5.attrs.get("format") != "powertrain-runup":
+                raise InputError("not a powertrain run-up result", file=path, key="format")
+            channels = list(zip([m.decode() for m in h5["channels/mount"][()]],
+                                [d.decode() for d in h5["channels/direction"][()]]))
+            return cls(rpm=h5["rpm"][()], orders=h5["orders"][()], channels=channels,
+                       displacement=h5["displacement/amplitude"][()],
+                       velocity=h5["velocity/amplitude"][()],
+                       acceleration=h5["acceleration/amplitude"][()],
+                       mount_force=h5["mount_force/amplitude"][()],
+                       mean_mount_force=h5["mount_force/mean"][()],
+                       periodicity=h5["diagnostics/periodicity"][()],
+                       settings=json.loads(h5.attrs["settings"]),
+                       solver_seconds=float(h5["diagnostics/solver_seconds"][()]),
+                       rigid_body_modes_hz=h5["diagnostics/rigid_body_modes_hz"][()],
+                       meta=json.loads(h5.attrs["meta"]))
+
+    # ----------------------------------------------------------------- plots
+    def plot(self, path=None, quantities=("synthesis", "order_2", "order_4"),
+             signal="velocity", others=None):
+        """The thesis's figure set (Figs 45–71): one row per mount and direction, columns
+        synthesis, 2nd and 4th order RMS velocity [mm/s] against rpm.
+
+        ``others``: optional list of (label, RunupResult) overlaid for comparison.
+        """
+        from powertrain.plotting import plot_runup
+        return plot_runup([("simulation", self)] + list(others or []), path, quantities,
+                          signal)
