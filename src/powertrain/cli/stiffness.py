@@ -8,7 +8,7 @@ from powertrain.cli import main
 
 
 @main.command()
-@click.argument("mount_file", type=click.Path(dir_okay=False))
+@click.argument("mount_file")  # checked by read_mount: one-line errors, exit 1
 @click.option("--freq", default="1:400:1", show_default=True,
               help="Frequencies [Hz]: list 5,10,20 and/or range start:stop:step.")
 @click.option("--method", type=click.Choice(["frequency", "time"]), default="frequency",

@@ -41,13 +41,16 @@ def read_mount(path) -> MountModel:
     """Load a mount file into a :class:`~powertrain.models.mount.MountModel` (SI)."""
     path = str(path)
     doc = read_toml(path)
+    _no_unknown_keys(doc, {"mount", "units", "parameters"}, path, "")
     mount = get(doc, "mount", path, types=dict)
+    _no_unknown_keys(mount, {"name", "model", "source", "notes"}, path, "mount")
     model = get(mount, "model", path, "mount", types=str)
     if model not in TOPOLOGIES:
         raise InputError(f"unknown model {model!r} (known: {', '.join(TOPOLOGIES)})",
                          file=path, key="mount.model")
     topo = TOPOLOGIES[model]
     units = get(doc, "units", path, types=dict)
+    _no_unknown_keys(units, set(DATASHEET_UNITS), path, "units")
     params_raw = get(doc, "parameters", path, types=dict)
     unknown = sorted(set(params_raw) - set(topo.parameters))
     if unknown:
@@ -64,6 +67,15 @@ def read_mount(path) -> MountModel:
                                 key=f"units.{family}"))
     return MountModel(topo, params, name=str(mount.get("name", Path(path).stem)),
                       source=str(mount.get("source", "")), notes=str(mount.get("notes", "")))
+
+
+def _no_unknown_keys(table: dict, known: set, path: str, prefix: str) -> None:
+    """Raise :class:`InputError` naming the first key of ``table`` not in ``known``."""
+    unknown = sorted(set(table) - known)
+    if unknown:
+        key = f"{prefix}.{unknown[0]}" if prefix else unknown[0]
+        raise InputError(f"unknown key (expected {', '.join(sorted(known))})",
+                         file=path, key=key)
 
 
 def format_mount(model: MountModel, *, comment: str = "") -> str:

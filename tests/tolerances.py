@@ -1,0 +1,42 @@
+"""Named tolerances of the numerical tests, each stating its criterion and why.
+
+Imported by the tests and by ``scripts/verify_thesis_tables.py``, so that the published
+verification and the test suite apply the same numbers.
+"""
+
+#: Tables 3 and 4 (x1 [mm], F_T [N]): |ours - printed MSC Nastran| <= 1 unit of the last
+#: printed digit, real and imaginary part separately. Solving the Appendix A deck exactly
+#: reproduces the Nastran columns (worst about 0.6 unit: x1 imag at 5 Hz -0.67506 vs printed
+#: -0.6750; F_T imag at 30 Hz -6.146 vs -6.2), so anything beyond rounding is a bug.
+TABLE34_MAX_DEV_LAST_DIGIT = 1.0
+
+#: Table 5 (K_CP [N/mm]): |K_ours - K_Nastran| / |K_Nastran| <= 0.5 % (complex). The printed
+#: Nastran K_CP is not consistent with the thesis's own Tables 3-4 (F_T/x1 of the exact
+#: solution differs by up to 2.1 N/mm in the imaginary part at 40 Hz, 0.4 % of |K|), and the
+#: thesis's four columns disagree among themselves by up to 0.6 % (Analytical vs Nastran at
+#: 40 Hz): 0.5 % is the size of the thesis's own tool-to-tool spread.
+TABLE5_MAX_REL_DEV = 5e-3
+
+#: Time method (Newmark, 1024 steps per period, + FFT) vs frequency method, relative to the
+#: frequency-method value: < 1e-3. The discrete steady state of the trapezoidal rule is the
+#: exact response at the warped frequency (2/h) tan(wh/2) = w (1 + (wh)^2/12 + ...), i.e.
+#: a relative frequency error of (2 pi/1024)^2/12 = 3.1e-6, amplified near resonances by the
+#: quality factor; 1e-3 leaves that margin and is still 100x below Table 5's tolerance.
+TIME_VS_FREQUENCY_REL = 1e-3
+
+#: Closed-form checks of the network solver (matrix solve vs hand-derived formula): both
+#: are exact, so only floating-point round-off separates them (condition numbers ~1e6).
+CLOSED_FORM_REL = 1e-9
+
+#: Newmark average acceleration against an exact solution: the method has no amplitude
+#: error and a relative frequency (period) error of (w h)^2/12 per mode, so a free vibration
+#: of amplitude A accumulates a phase error w t (w h)^2/12 and, to leading order,
+#: |x_num - x_exact| <= A (w h)^2/12 max_t[exp(-zeta w t) w t]; a forced steady state is the
+#: exact one at the warped frequency, error |X| (w h)^2/12 w |d ln H/dw|. The tests allow
+#: these leading-order bounds times NEWMARK_BOUND_SAFETY (higher-order terms); the observed
+#: errors are 0.5 of the allowance, i.e. the leading-order estimate itself.
+NEWMARK_BOUND_SAFETY = 2.0
+
+#: Periodic steady state of the Newmark recurrence: the state after one period equals the
+#: initial state to round-off (it solves (I - Phi) z0 = g exactly), relative to max |state|.
+PERIODIC_STATE_REL = 1e-9
