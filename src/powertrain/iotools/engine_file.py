@@ -1,0 +1,398 @@
+"""Engine files: ``engines/*.toml``, every quantity written ``key = {value = ..., unit = "..."}``.
+
+Layout (see ``engines/default.toml`` for a complete, commented example)::
+
+    [engine]            name, source, notes
+    [crank_train]       cylinders, bore, stroke, rod_length, pin_offset, compression_ratio,
+                        cylinder_positions, cylinder_axis, rotation ("+X" or "-X"),
+                        crank_pin_angles, firing_order, reciprocating_mass, rotating_mass,
+                        counterweight_fraction, crankcase_pressure
+    [body]              mass, cg, inertia (3x3 nested list, tensor entries)
+    [mounts.left], [mounts.right], [mounts.gearbox]
+                        position, local_x, local_z, files = {x = ..., y = ..., z = ...}
+                        (mount-file paths relative to the engine file)
+    [balancer]          enabled, speed_ratio, [[balancer.shafts]] name, mass_radius,
+                        position, phase, sense (+1 with the crank, -1 against)
+    [combustion]        model = "single-zone" (parameters below) or "measured"
+                        (traces = "file.csv", see powertrain.iotools.pressure_csv)
+    [combustion.full_load]  speed, torque, fmep (lists of equal length)
+
+All values are converted to SI here, once, through :mod:`powertrain.units`. Missing keys,
+unknown keys or units, negative masses, NaN, a non-positive-definite inertia tensor,
+unreadable engine or mount files raise :class:`powertrain.errors.InputError` naming the file
+and the key.
+"""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import numpy as np
+
+from powertrain.errors import InputError
+from powertrain.iotools.mount_file import read_mount
+from powertrain.iotools.tomlfile import get, number, quantity, read_toml
+from powertrain.models import engine as em
+from powertrain.units import to_si
+
+
+def _find_default_engine() -> Path:
+    """``engines/default.toml`` of the source tree this package was installed from.
+
+    The package lives in ``<repo>/src/powertrain`` (editable install); walk up from this file
+    to the first folder holding ``engines/default.toml`` next to ``pyproject.toml``.
+    """
+    here = Path(__file__).resolve()
+    for parent in here.parents:
+        candidate = parent / "engines" / "default.toml"
+        if candidate.is_file() and (parent / "pyproject.toml").is_file():
+            return candidate
+    return here.parents[3] / "engines" / "default.toml"
+
+
+#: The shipped default engine, ``<repo>/engines/default.toml``.
+DEFAULT_ENGINE_PATH: Path = _find_default_engine()
+
+MOUNT_NAMES = ("left", "right", "gearbox")
+DIRECTIONS = ("x", "y", "z")
+
+_ALLOWED = {
+    "": {"engine", "crank_train", "body", "mounts", "balancer", "combustion"},
+    "engine": {"name", "source", "notes"},
+    "crank_train": {"cylinders", "bore", "stroke", "rod_length", "pin_offset",
+                    "compression_ratio", "cylinder_positions", "cylinder_axis", "rotation",
+                    "crank_pin_angles", "firing_order", "reciprocating_mass", "rotating_mass",
+                    "counterweight_fraction", "crankcase_pressure"},
+    "body": {"mass", "cg", "inertia"},
+    "mount": {"position", "local_x", "local_z", "files"},
+    "balancer": {"enabled", "speed_ratio", "shafts"},
+    "shaft": {"name", "mass_radius", "position", "phase", "sense"},
+    "single-zone": {"model", "imep_factors", "ambient_pressure", "start", "duration",
+                    "wiebe_a", "wiebe_m", "polytropic_compression", "polytropic_expansion",
+                    "exhaust_valve_opening", "blowdown_end", "valve_overlap",
+                    "exhaust_pressure_ratio", "intake_pressure_min", "intake_pressure_max",
+                    "indicated_efficiency", "volumetric_efficiency", "air_fuel_ratio",
+                    "heating_value", "intake_temperature", "full_load"},
+    "measured": {"model", "traces"},
+    "full_load": {"speed", "torque", "fmep"},
+}
+
+
+def _check_keys(table, allowed, path, prefix):
+    unknown = sorted(set(table) - set(allowed))
+    if unknown:
+        key = f"{prefix}.{unknown[0]}" if prefix else unknown[0]
+        raise InputError(f"unknown key (expected one of: {', '.join(sorted(allowed))})",
+                         file=path, key=key)
+
+
+def _table(doc, key, path, prefix=""):
+    return get(doc, key, path, prefix, types=dict)
+
+
+def _raw_quantity(table, key, path, prefix):
+    full = f"{prefix}.{key}" if prefix else key
+    raw = get(table, key, path, prefix)
+    if not isinstance(raw, dict):
+        raise InputError('expected {value = ..., unit = "..."}', file=path, key=full)
+    for k in ("value", "unit"):
+        if k not in raw:
+            raise InputError("missing key", file=path, key=f"{full}.{k}")
+    extra = sorted(set(raw) - {"value", "unit"})
+    if extra:
+        raise InputError("unknown key (expected value, unit)", file=path, key=f"{full}.{extra[0]}")
+    return raw["value"], raw["unit"], full
+
+
+def _array(table, key, dimension, path, prefix, shape, *, nonneg=False, positive=False):
+    """A list (or nested list) quantity of the given shape, in SI."""
+    value, unit, full = _raw_quantity(table, key, path, prefix)
+
+    def flat(v):
+        if isinstance(v, list):
+            return [x for item in v for x in flat(item)]
+        return [v]
+
+    def nested_shape(v):
+        if isinstance(v, list):
+            shapes = {nested_shape(x) for x in v}
+            if len(shapes) != 1:
+                return None
+            inner = shapes.pop() if v else ()
+            return None if inner is None else (len(v),) + inner
+        return ()
+
+    got = nested_shape(value)
+    want_len = shape if isinstance(shape, tuple) else None
+    if got is None or got == () or (want_len is not None and got != want_len):
+        raise InputError(f"expected a list of shape {shape}, got {value!r}"[:200],
+                         file=path, key=f"{full}.value")
+    vals = [number(v, path, f"{full}.value", nonneg=nonneg, positive=positive)
+            for v in flat(value)]
+    return np.asarray(to_si(np.array(vals, dtype=float), unit, dimension, file=path,
+                            key=f"{full}.unit"), dtype=float).reshape(got)
+
+
+def _vec3(table, key, dimension, path, prefix):
+    return _array(table, key, dimension, path, prefix, (3,))
+
+
+def _unit_vector(table, key, path, prefix):
+    v = _vec3(table, key, "dimensionless", path, prefix)
+    n = float(np.linalg.norm(v))
+    if n < 1e-12:
+        raise InputError("direction vector must not be zero", file=path,
+                         key=f"{prefix}.{key}")
+    return v / n
+
+
+def _q(table, key, dimension, path, prefix, **kw):
+    return float(quantity(table, key, dimension, path, prefix, **kw))
+
+
+def read_engine(path=DEFAULT_ENGINE_PATH) -> em.Engine:
+    """Load an engine file into an :class:`~powertrain.models.engine.Engine` (SI).
+
+    Parameters
+    ----------
+    path : str or Path
+        Engine TOML file; mount files and pressure traces are resolved relative to it.
+
+    Raises
+    ------
+    InputError
+        Naming the file and key of the first problem found.
+    """
+    path = str(path)
+    doc = read_toml(path)
+    _check_keys(doc, _ALLOWED[""], path, "")
+    meta = _table(doc, "engine", path)
+    _check_keys(meta, _ALLOWED["engine"], path, "engine")
+    name = get(meta, "name", path, "engine", types=str)
+    crank = _read_crank(_table(doc, "crank_train", path), path)
+    body = _read_body(_table(doc, "body", path), path)
+    mounts = _read_mounts(_table(doc, "mounts", path), path)
+    balancer = _read_balancer(_table(doc, "balancer", path), path)
+    combustion = _read_combustion(_table(doc, "combustion", path), path, crank)
+    return em.Engine(name=name, crank=crank, body=body, mounts=mounts, balancer=balancer,
+                     combustion=combustion, file=path)
+
+
+def _read_crank(t, path) -> em.CrankTrain:
+    p = "crank_train"
+    _check_keys(t, _ALLOWED[p], path, p)
+    n = get(t, "cylinders", path, p, types=int)
+    if isinstance(n, bool) or n < 1:
+        raise InputError(f"must be a positive integer, got {n!r}", file=path,
+                         key=f"{p}.cylinders")
+    bore = _q(t, "bore", "length", path, p, positive=True)
+    stroke = _q(t, "stroke", "length", path, p, positive=True)
+    rod = _q(t, "rod_length", "length", path, p, positive=True)
+    offset = _q(t, "pin_offset", "length", path, p)
+    if rod <= 0.5 * stroke + abs(offset):
+        raise InputError("connecting rod must be longer than the crank radius plus the pin "
+                         "offset", file=path, key=f"{p}.rod_length")
+    eps = _q(t, "compression_ratio", "dimensionless", path, p, positive=True)
+    if eps <= 1.0:
+        raise InputError(f"must exceed 1, got {eps}", file=path, key=f"{p}.compression_ratio")
+    xs = _array(t, "cylinder_positions", "length", path, p, (n,))
+    axis = _unit_vector(t, "cylinder_axis", path, p)
+    if abs(axis[0]) > 1e-9:
+        raise InputError("cylinder axis must be perpendicular to the crank axis (engine X)",
+                         file=path, key=f"{p}.cylinder_axis")
+    rot = get(t, "rotation", path, p, types=str)
+    if rot not in ("+X", "-X"):
+        raise InputError(f"expected \"+X\" or \"-X\", got {rot!r}", file=path,
+                         key=f"{p}.rotation")
+    pins = _array(t, "crank_pin_angles", "angle", path, p, (n,))
+    order_raw = get(t, "firing_order", path, p, types=list)
+    key_fo = f"{p}.firing_order"
+    if (sorted(order_raw) != list(range(1, n + 1))
+            or any(isinstance(c, bool) or not isinstance(c, int) for c in order_raw)):
+        raise InputError(f"must list the cylinders 1..{n} once each, got {order_raw!r}",
+                         file=path, key=key_fo)
+    k1 = order_raw.index(1)
+    order = tuple(order_raw[k1:] + order_raw[:k1])
+    firing = _firing_angles(pins, order, path, key_fo)
+    m_rec = _q(t, "reciprocating_mass", "mass", path, p, nonneg=True)
+    m_rot = _q(t, "rotating_mass", "mass", path, p, nonneg=True)
+    cw = _q(t, "counterweight_fraction", "dimensionless", path, p, nonneg=True)
+    pcc = _q(t, "crankcase_pressure", "pressure", path, p, nonneg=True)
+    return em.CrankTrain(bore=bore, stroke=stroke, rod_length=rod, pin_offset=offset,
+                         compression_ratio=eps, cylinder_x=xs, cylinder_axis=axis,
+                         rotation_sign=1 if rot == "+X" else -1, crank_pin_angles=pins,
+                         firing_order=order, firing_angles=firing, reciprocating_mass=m_rec,
+                         rotating_mass=m_rot, counterweight_fraction=cw,
+                         crankcase_pressure=pcc)
+
+
+def _firing_angles(pins, order, path, key):
+    """Cylinder-1 crank angle of each cylinder's firing TDC on [0, 4π).
+
+    Walk the firing order from cylinder 1 (fired at 0): each next cylinder fires at the first
+    of its TDC angles (``pin + 2πk``) after the previous firing.
+    """
+    two_pi = 2.0 * np.pi
+    pins = np.mod(pins - pins[0], two_pi)
+    firing = np.zeros(len(pins))
+    last = 0.0
+    for cyl in order[1:]:
+        a = pins[cyl - 1]
+        while a <= last + 1e-9:
+            a += two_pi
+        firing[cyl - 1] = a
+        last = a
+    if last >= 2 * two_pi - 1e-9:
+        raise InputError("firing order and crank-pin angles do not fit into one 720° cycle",
+                         file=path, key=key)
+    return firing + 0.0
+
+
+def _read_body(t, path) -> em.RigidBody:
+    p = "body"
+    _check_keys(t, _ALLOWED[p], path, p)
+    mass = _q(t, "mass", "mass", path, p, positive=True)
+    cg = _vec3(t, "cg", "length", path, p)
+    inertia = _array(t, "inertia", "inertia", path, p, (3, 3))
+    key = f"{p}.inertia"
+    if not np.allclose(inertia, inertia.T, rtol=1e-9, atol=1e-12 * np.abs(inertia).max()):
+        raise InputError("inertia tensor must be symmetric", file=path, key=key)
+    eig = np.linalg.eigvalsh(inertia)
+    if eig.min() <= 0:
+        raise InputError(f"inertia tensor must be positive definite (eigenvalues "
+                         f"{', '.join(f'{v:.4g}' for v in eig)} kg*m^2)", file=path, key=key)
+    if eig[0] + eig[1] < eig[2] * (1 - 1e-9):
+        raise InputError("principal moments violate the triangle inequality "
+                         "(not a physical body)", file=path, key=key)
+    return em.RigidBody(mass=mass, cg=cg, inertia=inertia)
+
+
+def _read_mounts(t, path) -> list:
+    base = Path(path).parent
+    _check_keys(t, MOUNT_NAMES, path, "mounts")
+    mounts = []
+    for name in MOUNT_NAMES:
+        p = f"mounts.{name}"
+        m = get(t, name, path, "mounts", types=dict)
+        _check_keys(m, _ALLOWED["mount"], path, p)
+        pos = _vec3(m, "position", "length", path, p)
+        lx = _unit_vector(m, "local_x", path, p)
+        lz = _unit_vector(m, "local_z", path, p)
+        if abs(float(lx @ lz)) > 1e-6:
+            raise InputError("local_x and local_z must be perpendicular", file=path,
+                             key=f"{p}.local_z")
+        ly = np.cross(lz, lx)
+        rotation = np.column_stack([lx, ly, lz])
+        files = get(m, "files", path, p, types=dict)
+        _check_keys(files, DIRECTIONS, path, f"{p}.files")
+        directions, paths = {}, {}
+        for d in DIRECTIONS:
+            rel = get(files, d, path, f"{p}.files", types=str)
+            full = base / rel
+            if not full.is_file():
+                raise InputError(f"mount file not found: {full}", file=path,
+                                 key=f"{p}.files.{d}")
+            directions[d] = read_mount(full)
+            paths[d] = str(full)
+        mounts.append(em.MountSpec(name=name, position=pos, rotation=rotation,
+                                   directions=directions, files=paths))
+    return mounts
+
+
+def _read_balancer(t, path) -> em.Balancer:
+    p = "balancer"
+    _check_keys(t, _ALLOWED[p], path, p)
+    enabled = get(t, "enabled", path, p, types=bool)
+    ratio = _q(t, "speed_ratio", "dimensionless", path, p, positive=True)
+    shafts_raw = get(t, "shafts", path, p, types=list)
+    shafts = []
+    for k, s in enumerate(shafts_raw):
+        sp = f"{p}.shafts[{k}]"
+        if not isinstance(s, dict):
+            raise InputError("expected a table", file=path, key=sp)
+        _check_keys(s, _ALLOWED["shaft"], path, sp)
+        sense = get(s, "sense", path, sp, types=int)
+        if sense not in (1, -1) or isinstance(sense, bool):
+            raise InputError(f"expected +1 or -1, got {sense!r}", file=path, key=f"{sp}.sense")
+        shafts.append(em.BalancerShaft(
+            name=str(get(s, "name", path, sp, types=str)),
+            mass_radius=_q(s, "mass_radius", "unbalance", path, sp, nonneg=True),
+            position=_vec3(s, "position", "length", path, sp),
+            phase=_q(s, "phase", "angle", path, sp), sense=sense))
+    return em.Balancer(enabled=enabled, ratio=ratio, shafts=tuple(shafts))
+
+
+def _read_combustion(t, path, crank):
+    p = "combustion"
+    model = get(t, "model", path, p, types=str)
+    if model == "measured":
+        _check_keys(t, _ALLOWED["measured"], path, p)
+        rel = get(t, "traces", path, p, types=str)
+        from powertrain.iotools.pressure_csv import read_pressure_traces
+        full = Path(path).parent / rel
+        if not full.is_file():
+            raise InputError(f"pressure-trace file not found: {full}", file=path,
+                             key=f"{p}.traces")
+        return read_pressure_traces(full, crank.n_cylinders)
+    if model != "single-zone":
+        raise InputError(f"unknown model {model!r} (known: single-zone, measured)",
+                         file=path, key=f"{p}.model")
+    _check_keys(t, _ALLOWED["single-zone"], path, p)
+    n = crank.n_cylinders
+    factors = _array(t, "imep_factors", "dimensionless", path, p, (n,), nonneg=True)
+    fl = _table(t, "full_load", path, p)
+    fp = f"{p}.full_load"
+    _check_keys(fl, _ALLOWED["full_load"], path, fp)
+    speed = np.asarray(quantity(fl, "speed", "angular_speed", path, fp, positive=True), float)
+    if speed.ndim != 1 or speed.size < 2 or np.any(np.diff(speed) <= 0):
+        raise InputError("expected at least two strictly increasing speeds", file=path,
+                         key=f"{fp}.speed")
+    torque = np.asarray(quantity(fl, "torque", "torque", path, fp, nonneg=True), float)
+    fmep = np.asarray(quantity(fl, "fmep", "pressure", path, fp, nonneg=True), float)
+    for key, arr in (("torque", torque), ("fmep", fmep)):
+        if arr.shape != speed.shape:
+            raise InputError(f"expected {speed.size} values (one per speed)", file=path,
+                             key=f"{fp}.{key}")
+
+    def q(key, dim, **kw):
+        return _q(t, key, dim, path, p, **kw)
+
+    deg = math.pi / 180
+    c = em.SingleZoneCombustion(
+        full_load=em.FullLoadCurve(speed=speed, torque=torque, fmep=fmep),
+        imep_factors=factors,
+        ambient_pressure=q("ambient_pressure", "pressure", positive=True),
+        start=q("start", "angle"), duration=q("duration", "angle", positive=True),
+        wiebe_a=q("wiebe_a", "dimensionless", positive=True),
+        wiebe_m=q("wiebe_m", "dimensionless", nonneg=True),
+        n_compression=q("polytropic_compression", "dimensionless", positive=True),
+        n_expansion=q("polytropic_expansion", "dimensionless", positive=True),
+        exhaust_valve_opening=q("exhaust_valve_opening", "angle"),
+        blowdown_end=q("blowdown_end", "angle"),
+        valve_overlap=q("valve_overlap", "angle", positive=True),
+        exhaust_pressure_ratio=q("exhaust_pressure_ratio", "dimensionless", positive=True),
+        intake_pressure_min=q("intake_pressure_min", "pressure", positive=True),
+        intake_pressure_max=q("intake_pressure_max", "pressure", positive=True),
+        indicated_efficiency=q("indicated_efficiency", "dimensionless", positive=True),
+        volumetric_efficiency=q("volumetric_efficiency", "dimensionless", positive=True),
+        air_fuel_ratio=q("air_fuel_ratio", "dimensionless", positive=True),
+        heating_value=q("heating_value", "specific_energy", positive=True),
+        intake_temperature=q("intake_temperature", "temperature", positive=True))
+    for key, ok, why in (
+            ("polytropic_compression", c.n_compression > 1, "must exceed 1"),
+            ("polytropic_expansion", c.n_expansion > 1, "must exceed 1"),
+            ("start", -180 * deg < c.start < 90 * deg, "must lie between -180 and 90 deg"),
+            ("exhaust_valve_opening", c.start + c.duration <= c.exhaust_valve_opening,
+             "must not precede the end of combustion (start + duration)"),
+            ("blowdown_end", c.exhaust_valve_opening < c.blowdown_end
+             <= 2 * math.pi - c.valve_overlap, "must lie between exhaust valve opening and "
+             "the start of the valve overlap"),
+            ("valve_overlap", c.valve_overlap < math.pi / 2, "must be below 90 deg"),
+            ("intake_pressure_max", c.intake_pressure_max >= c.intake_pressure_min,
+             "must not be below intake_pressure_min"),
+            ("indicated_efficiency", c.indicated_efficiency < 1, "must be below 1"),
+    ):
+        if not ok:
+            raise InputError(why, file=path, key=f"{p}.{key}")
+    return c

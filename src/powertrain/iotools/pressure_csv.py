@@ -1,0 +1,150 @@
+"""Measured cylinder-pressure traces: a small CSV format with declared units.
+
+Format::
+
+    # any number of comment lines starting with '#'
+    speed [rpm],cylinder,crank_angle [deg],pressure [bar]
+    2000,1,-180.0,1.013
+    2000,1,-179.5,1.013
+    ...
+
+* one header line naming the four columns in this order; ``speed``, ``crank_angle`` and
+  ``pressure`` declare their unit in brackets (any unit of :mod:`powertrain.units` of the
+  right dimension: rpm or rad/s; deg or rad; bar, kPa, MPa or Pa);
+* ``cylinder`` is the cylinder number 1..n;
+* ``crank_angle`` is that cylinder's own crank angle from its firing top dead centre; each
+  (speed, cylinder) trace covers one 720° cycle once, strictly increasing, with no gap
+  larger than :data:`MAX_GAP_DEG` (including the wrap-around), e.g. -360..359.5 or 0..719;
+* ``pressure`` is absolute;
+* every speed lists every cylinder.
+
+Traces are resampled onto a common grid of cycle angles on [-π, 3π) by periodic linear
+interpolation. Errors name the file, line and column.
+"""
+
+from __future__ import annotations
+
+import csv
+import math
+import re
+
+import numpy as np
+
+from powertrain.errors import InputError
+from powertrain.units import to_si
+
+#: Largest allowed gap between crank angles of one trace [deg].
+MAX_GAP_DEG = 10.0
+#: Points per cycle of the common grid.
+GRID_POINTS = 2880
+
+_COLUMNS = (("speed", "angular_speed"), ("cylinder", None), ("crank_angle", "angle"),
+            ("pressure", "pressure"))
+_HEADER = re.compile(r"^\s*([a-z_]+)\s*(?:\[\s*([^\]]+?)\s*\])?\s*$")
+
+
+def read_pressure_traces(path, n_cylinders: int):
+    """Read a pressure-trace CSV into a :class:`~powertrain.models.engine.MeasuredPressure`.
+
+    Parameters
+    ----------
+    path : str or Path
+    n_cylinders : int
+        Number of cylinders the engine has.
+    """
+    from powertrain.models.engine import MeasuredPressure
+    path = str(path)
+    try:
+        with open(path, newline="", encoding="utf-8") as fh:
+            lines = [(i + 1, line) for i, line in enumerate(fh)]
+    except OSError as exc:
+        raise InputError(f"cannot read file ({exc.strerror})", file=path) from None
+    except UnicodeDecodeError:
+        raise InputError("not a UTF-8 text file", file=path) from None
+    body = [(n, s) for n, s in lines if s.strip() and not s.lstrip().startswith("#")]
+    if not body:
+        raise InputError("no header line", file=path)
+    hline, header = body[0]
+    names = next(csv.reader([header]))
+    if len(names) != 4:
+        raise InputError("expected 4 columns: speed [unit], cylinder, crank_angle [unit], "
+                         "pressure [unit]", file=path, line=hline)
+    units = []
+    for (want, dim), cell in zip(_COLUMNS, names):
+        m = _HEADER.match(cell)
+        if not m or m.group(1) != want:
+            raise InputError(f"expected column {want!r}, got {cell.strip()!r}", file=path,
+                             line=hline, key=want)
+        if dim is not None and not m.group(2):
+            raise InputError("column must declare its unit in brackets, e.g. "
+                             f"'{want} [..]'", file=path, line=hline, key=want)
+        units.append(m.group(2))
+    rows = []
+    for n, s in body[1:]:
+        cells = next(csv.reader([s]))
+        if len(cells) != 4:
+            raise InputError(f"expected 4 values, got {len(cells)}", file=path, line=n)
+        vals = []
+        for (name, _), c in zip(_COLUMNS, cells):
+            try:
+                v = float(c)
+            except ValueError:
+                raise InputError(f"not a number: {c.strip()!r}", file=path, line=n,
+                                 key=name) from None
+            if not math.isfinite(v):
+                raise InputError("not a finite number", file=path, line=n, key=name)
+            vals.append(v)
+        if vals[1] != int(vals[1]) or not 1 <= vals[1] <= n_cylinders:
+            raise InputError(f"cylinder must be 1..{n_cylinders}", file=path, line=n,
+                             key="cylinder")
+        if vals[3] < 0:
+            raise InputError("absolute pressure must not be negative", file=path, line=n,
+                             key="pressure")
+        rows.append((n, *vals))
+    if not rows:
+        raise InputError("no data rows", file=path)
+    data = np.array([r[1:] for r in rows], dtype=float)
+    line_no = np.array([r[0] for r in rows])
+    speed = to_si(data[:, 0], units[0], "angular_speed", file=path, key="speed")
+    angle = to_si(data[:, 2], units[2], "angle", file=path, key="crank_angle")
+    pressure = to_si(data[:, 3], units[3], "pressure", file=path, key="pressure")
+    if np.any(speed <= 0):
+        raise InputError("speeds must be positive", file=path, key="speed",
+                         line=int(line_no[np.argmax(speed <= 0)]))
+    speeds = np.unique(speed)
+    grid = -np.pi + 4 * np.pi * np.arange(GRID_POINTS) / GRID_POINTS
+    out = np.empty((speeds.size, n_cylinders, GRID_POINTS))
+    max_gap = math.radians(MAX_GAP_DEG)
+    for i, w in enumerate(speeds):
+        for c in range(1, n_cylinders + 1):
+            sel = (speed == w) & (data[:, 1] == c)
+            if not np.any(sel):
+                raise InputError(f"no trace for cylinder {c} at {w * 60 / (2 * np.pi):.6g} rpm",
+                                 file=path, key="cylinder")
+            a, pr, ln = angle[sel], pressure[sel], line_no[sel]
+            bad = np.nonzero(np.diff(a) <= 0)[0]
+            if bad.size:
+                raise InputError("crank angles must increase within a trace", file=path,
+                                 line=int(ln[bad[0] + 1]), key="crank_angle")
+            if a[-1] - a[0] >= 4 * np.pi - 1e-9:
+                raise InputError("trace covers more than one 720° cycle", file=path,
+                                 line=int(ln[-1]), key="crank_angle")
+            gaps = np.append(np.diff(a), a[0] + 4 * np.pi - a[-1])
+            if gaps.max() > max_gap + 1e-12:
+                raise InputError(f"trace has a gap over {MAX_GAP_DEG:g}° (cylinder {c}, "
+                                 f"{w * 60 / (2 * np.pi):.6g} rpm)", file=path,
+                                 line=int(ln[0]), key="crank_angle")
+            out[i, c - 1] = np.interp(grid, a, pr, period=4 * np.pi)
+    return MeasuredPressure(file=path, speed=speeds, pressure=out, theta=grid)
+
+
+def format_pressure_traces(speeds_rpm, theta, pressure) -> str:
+    """CSV text of traces: ``pressure[i_speed, i_cyl, k]`` [Pa] at angles ``theta`` [rad]
+    (written in rpm, deg, bar)."""
+    lines = ["# cylinder pressure traces (powertrain.iotools.pressure_csv)",
+             "speed [rpm],cylinder,crank_angle [deg],pressure [bar]"]
+    for i, n in enumerate(speeds_rpm):
+        for c in range(pressure.shape[1]):
+            for a, p in zip(theta, pressure[i, c]):
+                lines.append(f"{n:.6g},{c + 1},{math.degrees(a):.6g},{p / 1e5:.8g}")
+    return "\n".join(lines) + "\n"

@@ -1,0 +1,655 @@
+r"""The engine model: crank train, rigid powertrain body, mounts, balancer shafts, combustion.
+
+Thin objects over :mod:`powertrain.physics.slider_crank`, :mod:`~powertrain.physics.combustion`
+and :mod:`~powertrain.physics.balancer`. Everything is SI, in engine axes (Kovarik 2016,
+sec. 4.1): origin at the centre of the 3rd main bearing, X along the crank axis (opposite to
+the vehicle's ISO 8855 X, i.e. rearwards for the longitudinal engine), Y opposite to the
+vehicle's Y (to the right), Z up.
+
+Load on the powertrain (:meth:`Engine.generalized_load`)
+--------------------------------------------------------
+The powertrain is one rigid body that contains the moving parts; the load returned is what
+the moving parts, the gas and the crankshaft's output torque exert on it. For each cylinder,
+at its own position along X and at constant crank speed:
+
+* the gas force on the cylinder head, :math:`+F_g\,\mathbf u`, on the cylinder axis;
+* the piston side thrust :math:`-N\,\mathbf s` at the piston pin and the couple
+  :math:`e F_g\,(\mathbf s\times\mathbf u)` of the pin offset;
+* the main-bearing reaction :math:`F_r(\sin\beta\,\mathbf s - \cos\beta\,\mathbf u)` on the
+  crank axis (the crank torque :math:`T` leaves through the crankshaft to the driveline);
+* the residual rotating-mass force
+  :math:`(1-k_{cw})\,m_{rot}\,r\omega^2(\cos\theta_i\,\mathbf u + \sin\theta_i\,\mathbf s)` on
+  the crank axis: the rotating masses are *included*, and the crank counterweights
+  balance the fraction :math:`k_{cw}` of each throw's own rotating mass in its own plane
+  (default 1);
+
+plus the balancer-shaft forces at the shaft positions. Their sum per cylinder is the shaking
+force :math:`-m a\,\mathbf u` plus the torque reaction :math:`-T` about the axis of rotation
+(see :mod:`powertrain.physics.slider_crank`), so the net load is the shaking force plus the
+torque reaction, including its mean (the drive-torque reaction). Moments are taken about the
+powertrain's centre of gravity.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from powertrain.physics import balancer as bal
+from powertrain.physics import combustion as comb
+from powertrain.physics import slider_crank as sc
+
+RPM = 2.0 * np.pi / 60.0
+
+
+@dataclass(frozen=True, eq=False)
+class RigidBody:
+    """Mass properties of the powertrain (engine + gearbox) as one rigid body.
+
+    Attributes
+    ----------
+    mass : float
+        [kg]
+    cg : ndarray, shape (3,)
+        Centre of gravity in engine axes [m].
+    inertia : ndarray, shape (3, 3)
+        Inertia tensor about the CG in engine axes [kg·m²]; off-diagonal entries are the
+        tensor entries :math:`I_{xy} = -\\int xy\\,dm`.
+    """
+
+    mass: float
+    cg: np.ndarray
+    inertia: np.ndarray
+
+    def mass_matrix(self) -> np.ndarray:
+        """6×6 mass matrix for ``[x, y, z, rx, ry, rz]`` at the CG [kg, kg·m²]."""
+        m = np.zeros((6, 6))
+        m[:3, :3] = self.mass * np.eye(3)
+        m[3:, 3:] = self.inertia
+        return m
+
+
+@dataclass(frozen=True, eq=False)
+class MountSpec:
+    """One mount of the powertrain.
+
+    Attributes
+    ----------
+    name : str
+        ``left``, ``right`` or ``gearbox``.
+    position : ndarray, shape (3,)
+        Engine-side mount point (measurement point) in engine axes [m].
+    rotation : ndarray, shape (3, 3)
+        Columns are the mount's local x, y, z axes expressed in engine axes.
+    directions : dict of str to MountModel
+        ``{"x": ..., "y": ..., "z": ...}``: the mount model along each local axis.
+    files : dict of str to str
+        Mount file of each direction.
+    """
+
+    name: str
+    position: np.ndarray
+    rotation: np.ndarray
+    directions: dict
+    files: dict = field(default_factory=dict)
+
+    def static_stiffness_matrix(self) -> np.ndarray:
+        """3×3 static stiffness in engine axes [N/m]: :math:`R\\,\\mathrm{diag}(k_x,k_y,k_z)R^T`."""
+        k = np.diag([self.directions[d].static_stiffness() for d in "xyz"])
+        return self.rotation @ k @ self.rotation.T
+
+
+@dataclass(frozen=True, eq=False)
+class CrankTrain:
+    """Geometry and masses of the crank train (SI).
+
+    Attributes
+    ----------
+    bore, stroke, rod_length, pin_offset : float
+        [m]; the crank radius is ``stroke / 2``.
+    compression_ratio : float
+        Geometric compression ratio [-].
+    cylinder_x : ndarray
+        Position of each cylinder along the crank axis (engine X) [m], cylinder 1 first.
+    cylinder_axis : ndarray, shape (3,)
+        Unit vector :math:`\\mathbf u` of the cylinder axis (crank axis to head), engine axes.
+    rotation_sign : int
+        +1: the crank turns positively about +X, −1: about −X.
+    crank_pin_angles : ndarray
+        Cylinder-1 crank angle at which each cylinder is at a top dead centre [rad].
+    firing_order : tuple of int
+        Cylinder numbers (1-based), starting with 1.
+    firing_angles : ndarray
+        Cylinder-1 crank angle of each cylinder's firing TDC on ``[0, 4π)`` [rad].
+    reciprocating_mass, rotating_mass : float
+        Per cylinder [kg].
+    counterweight_fraction : float
+        Share of each throw's rotating mass balanced by its counterweights [-].
+    crankcase_pressure : float
+        Pressure under the piston [Pa].
+    """
+
+    bore: float
+    stroke: float
+    rod_length: float
+    pin_offset: float
+    compression_ratio: float
+    cylinder_x: np.ndarray
+    cylinder_axis: np.ndarray
+    rotation_sign: int
+    crank_pin_angles: np.ndarray
+    firing_order: tuple
+    firing_angles: np.ndarray
+    reciprocating_mass: float
+    rotating_mass: float
+    counterweight_fraction: float
+    crankcase_pressure: float
+
+    @property
+    def n_cylinders(self) -> int:
+        return len(self.cylinder_x)
+
+    @property
+    def crank_radius(self) -> float:
+        """[m]"""
+        return 0.5 * self.stroke
+
+    @property
+    def piston_area(self) -> float:
+        """[m²]"""
+        return np.pi * self.bore**2 / 4.0
+
+    @property
+    def swept_volume(self) -> float:
+        """Swept volume of one cylinder from the exact kinematics [m³]."""
+        return float(sc.swept_volume(self.bore, self.crank_radius, self.rod_length,
+                                     self.pin_offset))
+
+    @property
+    def displacement(self) -> float:
+        """Engine displacement [m³]."""
+        return self.n_cylinders * self.swept_volume
+
+    @property
+    def lateral_axis(self) -> np.ndarray:
+        """Unit vector :math:`\\mathbf s = \\sigma\\,\\mathbf e_x\\times\\mathbf u`."""
+        return self.rotation_sign * np.cross([1.0, 0.0, 0.0], self.cylinder_axis)
+
+    def volume(self, theta):
+        """Cylinder volume [m³] and dV/dθ [m³/rad] at crank angle ``theta`` [rad]."""
+        return sc.cylinder_volume(theta, self.bore, self.crank_radius, self.rod_length,
+                                  self.pin_offset, self.compression_ratio)
+
+
+@dataclass(frozen=True, eq=False)
+class BalancerShaft:
+    """One balancer shaft.
+
+    Attributes
+    ----------
+    name : str
+    mass_radius : float
+        Unbalance [kg·m].
+    position : ndarray, shape (3,)
+        A point of the shaft axis at the unbalance's plane, engine axes [m].
+    phase : float
+        Angle of the unbalance at cylinder-1 TDC from :math:`\\mathbf u` towards
+        :math:`\\mathbf s` [rad].
+    sense : int
+        +1 turns with the crank, −1 against it.
+    """
+
+    name: str
+    mass_radius: float
+    position: np.ndarray
+    phase: float
+    sense: int
+
+
+@dataclass(frozen=True, eq=False)
+class Balancer:
+    """Balancer shafts turning at ``ratio`` × crank speed; ``enabled`` switches them."""
+
+    enabled: bool
+    ratio: float
+    shafts: tuple
+
+
+@dataclass(frozen=True, eq=False)
+class FullLoadCurve:
+    """Full-load brake torque and friction mean effective pressure against speed.
+
+    Attributes
+    ----------
+    speed : ndarray
+        Engine speed [rad/s], increasing.
+    torque : ndarray
+        Full-load brake torque [N·m].
+    fmep : ndarray
+        Friction mean effective pressure [Pa].
+    """
+
+    speed: np.ndarray
+    torque: np.ndarray
+    fmep: np.ndarray
+
+    def imep(self, omega: float, displacement: float, load: float = 1.0) -> float:
+        r"""Net IMEP [Pa] at ``omega`` [rad/s] for ``load`` × full-load torque.
+
+        .. math:: \mathrm{IMEP} = \frac{4\pi\,T_b}{V_D} + \mathrm{FMEP}
+        """
+        tb = load * np.interp(omega, self.speed, self.torque)
+        return float(4.0 * np.pi * tb / displacement + np.interp(omega, self.speed, self.fmep))
+
+
+@dataclass(frozen=True, eq=False)
+class SingleZoneCombustion:
+    """Parameters of the single-zone pressure model (SI; see :mod:`powertrain.physics.combustion`)."""
+
+    full_load: FullLoadCurve
+    imep_factors: np.ndarray
+    ambient_pressure: float
+    start: float
+    duration: float
+    wiebe_a: float
+    wiebe_m: float
+    n_compression: float
+    n_expansion: float
+    exhaust_valve_opening: float
+    blowdown_end: float
+    valve_overlap: float
+    exhaust_pressure_ratio: float
+    intake_pressure_min: float
+    intake_pressure_max: float
+    indicated_efficiency: float
+    volumetric_efficiency: float
+    air_fuel_ratio: float
+    heating_value: float
+    intake_temperature: float
+    grid_points: int = 5760
+    model: str = "single-zone"
+
+    def cycle_pressures(self, crank: CrankTrain, omega: float, load: float = 1.0):
+        """Pressure of every cylinder on the cycle grid.
+
+        Returns
+        -------
+        theta : ndarray, shape (N,)
+            Grid of cylinder cycle angles on ``[-π, 3π)`` [rad].
+        pressure : ndarray, shape (n_cyl, N)
+            Absolute pressure [Pa].
+        info : dict
+            ``imep_target`` [Pa] per cylinder, ``heat`` [J] per cylinder, ``p_intake``,
+            ``p_exhaust`` [Pa].
+        """
+        n = self.grid_points
+        theta = -np.pi + 4.0 * np.pi * np.arange(n) / n
+        V, dV = crank.volume(theta)
+        vd = crank.swept_volume
+        imep = self.full_load.imep(omega, crank.displacement, load)
+        p_in = comb.boost_pressure(
+            imep, vd, V[0], indicated_efficiency=self.indicated_efficiency,
+            air_fuel_ratio=self.air_fuel_ratio, heating_value=self.heating_value,
+            intake_temperature=self.intake_temperature,
+            volumetric_efficiency=self.volumetric_efficiency)
+        p_in = float(np.clip(p_in, self.intake_pressure_min, self.intake_pressure_max))
+        p_ex = max(self.ambient_pressure, self.exhaust_pressure_ratio * p_in)
+        p0, p1 = comb.pressure_parts(theta, V, p_in, p_ex, self.n_compression, self.n_expansion,
+                                     self.start, self.duration, self.wiebe_a, self.wiebe_m,
+                                     self.exhaust_valve_opening, self.blowdown_end,
+                                     self.valve_overlap)
+        dtheta = 4.0 * np.pi / n
+        targets = imep * np.asarray(self.imep_factors, dtype=float)
+        heats = np.array([comb.calibrate_heat(p0, p1, dV, dtheta, vd, t) for t in targets])
+        pressure = p0[None, :] + heats[:, None] * p1[None, :]
+        return theta, pressure, {"imep_target": targets, "heat": heats, "p_intake": p_in,
+                                 "p_exhaust": p_ex}
+
+    def speed_range(self):
+        """(min, max) speed of the full-load curve [rad/s]."""
+        return float(self.full_load.speed[0]), float(self.full_load.speed[-1])
+
+
+@dataclass(frozen=True, eq=False)
+class MeasuredPressure:
+    """Measured cylinder-pressure traces (see :mod:`powertrain.iotools.pressure_csv`).
+
+    Attributes
+    ----------
+    file : str
+    speed : ndarray
+        Measured speeds [rad/s], increasing.
+    pressure : ndarray, shape (n_speed, n_cyl, N)
+        Absolute pressure [Pa] on the common grid ``theta``.
+    theta : ndarray, shape (N,)
+        Cylinder cycle angles on ``[-π, 3π)`` [rad].
+    """
+
+    file: str
+    speed: np.ndarray
+    pressure: np.ndarray
+    theta: np.ndarray
+    model: str = "measured"
+
+    def cycle_pressures(self, crank: CrankTrain, omega: float, load: float = 1.0):
+        """Pressure of every cylinder on the grid, linearly interpolated in speed.
+
+        ``load`` must be 1 (traces are what they are).
+        """
+        from powertrain.errors import InputError
+        if load != 1.0:
+            raise InputError("measured pressure traces cannot be scaled to another load",
+                             file=self.file, key="load")
+        lo, hi = self.speed_range()
+        if not lo - 1e-9 <= omega <= hi + 1e-9:
+            raise InputError(f"speed {omega / RPM:.6g} rpm outside the measured traces "
+                             f"({lo / RPM:.6g}..{hi / RPM:.6g} rpm)", file=self.file,
+                             key="speed")
+        if len(self.speed) == 1:
+            p = self.pressure[0]
+        else:
+            j = int(np.clip(np.searchsorted(self.speed, omega) - 1, 0, len(self.speed) - 2))
+            w = (omega - self.speed[j]) / (self.speed[j + 1] - self.speed[j])
+            p = (1 - w) * self.pressure[j] + w * self.pressure[j + 1]
+        dtheta = self.theta[1] - self.theta[0]
+        _, dV = crank.volume(self.theta)
+        imep = np.array([comb.indicated_work(pc, dV, dtheta) for pc in p]) / crank.swept_volume
+        return self.theta, p, {"imep_target": imep, "heat": np.full(len(p), np.nan),
+                               "p_intake": float("nan"), "p_exhaust": float("nan")}
+
+    def speed_range(self):
+        return float(self.speed[0]), float(self.speed[-1])
+
+
+@dataclass(frozen=True, eq=False)
+class Excitation:
+    """What drives the block at one speed, sampled at given cylinder-1 crank angles.
+
+    Attributes
+    ----------
+    rpm : float
+        Engine speed [rpm].
+    crank_angle : ndarray, shape (n,)
+        Cylinder-1 crank angle [rad].
+    pressure, gas_force, inertia_force, torque, torque_gas, torque_inertia : ndarray, (n, n_cyl)
+        Per cylinder: absolute pressure [Pa], gas force on the piston [N], reciprocating
+        inertia force along the cylinder axis [N], crank torque and its gas and inertia
+        parts [N·m].
+    load : ndarray, shape (n, 6)
+        ``[Fx, Fy, Fz, Mx, My, Mz]`` on the powertrain about its CG, engine axes [N, N·m].
+    imep : ndarray, shape (n_cyl,)
+        Net IMEP of each cylinder [Pa].
+    info : dict
+        Model details (intake pressure, heat released ...).
+    """
+
+    rpm: float
+    crank_angle: np.ndarray
+    pressure: np.ndarray
+    gas_force: np.ndarray
+    inertia_force: np.ndarray
+    torque: np.ndarray
+    torque_gas: np.ndarray
+    torque_inertia: np.ndarray
+    load: np.ndarray
+    imep: np.ndarray
+    info: dict
+
+    def order_spectrum(self, max_order: float = 8.0):
+        """Orders and complex amplitudes of the load over one engine cycle.
+
+        Requires the crank angles to be an equally spaced sampling of ``[0, 4π)``.
+
+        Returns
+        -------
+        orders : ndarray
+            0, 0.5, 1, ... ``max_order`` (per crank revolution).
+        amplitudes : ndarray of complex, shape (n_orders, 6)
+            Complex amplitude of each load component [N, N·m] (order 0: the mean).
+        """
+        from powertrain.analysis.fourier import harmonic_amplitudes
+        spec = harmonic_amplitudes(self.load, axis=0)
+        n_h = int(round(2 * max_order)) + 1
+        return np.arange(n_h) / 2.0, spec[:n_h]
+
+    def plot(self, path=None):
+        """Summary figure (see :func:`powertrain.plotting.plot_excitation`)."""
+        from powertrain.plotting import plot_excitation
+        return plot_excitation(self, path)
+
+
+@dataclass(frozen=True, eq=False)
+class Engine:
+    """An engine-gearbox powertrain on its mounts, with its excitation.
+
+    Attributes
+    ----------
+    name : str
+    crank : CrankTrain
+    body : RigidBody
+    mounts : list of MountSpec
+    balancer : Balancer
+    combustion : SingleZoneCombustion or MeasuredPressure
+    file : str
+        Engine file it was read from ("" if built in code).
+    """
+
+    name: str
+    crank: CrankTrain
+    body: RigidBody
+    mounts: list
+    balancer: Balancer
+    combustion: object
+    file: str = ""
+    _cache: dict = field(default_factory=dict, repr=False, compare=False)
+
+    # ------------------------------------------------------------------ copies
+    def replace(self, **changes) -> "Engine":
+        """A copy with fields replaced (``dataclasses.replace``; the pressure cache is reset)."""
+        changes.setdefault("_cache", {})
+        return dataclasses.replace(self, **changes)
+
+    def with_balancers(self, enabled: bool = True, mass_radius: float | None = None) -> "Engine":
+        """A copy with the balancer shafts switched on or off (and optionally every shaft's
+        unbalance set to ``mass_radius`` [kg·m])."""
+        shafts = self.balancer.shafts
+        if mass_radius is not None:
+            shafts = tuple(dataclasses.replace(s, mass_radius=float(mass_radius)) for s in shafts)
+        return self.replace(balancer=dataclasses.replace(self.balancer, enabled=bool(enabled),
+                                                         shafts=shafts))
+
+    def with_imep_factors(self, factors) -> "Engine":
+        """A copy with per-cylinder IMEP factors (single-zone model only)."""
+        factors = np.asarray(factors, dtype=float)
+        if factors.shape != (self.crank.n_cylinders,):
+            raise ValueError(f"expected {self.crank.n_cylinders} factors")
+        return self.replace(combustion=dataclasses.replace(self.combustion,
+                                                           imep_factors=factors))
+
+    @property
+    def mount_names(self) -> list:
+        return [m.name for m in self.mounts]
+
+    def mount(self, name: str) -> MountSpec:
+        """The mount called ``name``."""
+        for m in self.mounts:
+            if m.name == name:
+                return m
+        raise KeyError(name)
+
+    # ------------------------------------------------------------------ pressure
+    def speed_range_rpm(self):
+        """Speeds [rpm] for which the combustion model is defined."""
+        lo, hi = self.combustion.speed_range()
+        return lo / RPM, hi / RPM
+
+    def _check_speed(self, rpm):
+        from powertrain.errors import InputError
+        rpm = float(rpm)
+        lo, hi = self.speed_range_rpm()
+        if not np.isfinite(rpm) or not lo - 1e-6 <= rpm <= hi + 1e-6:
+            key = ("combustion.full_load.speed" if self.combustion.model == "single-zone"
+                   else "combustion.traces")
+            raise InputError(f"engine speed {rpm:g} rpm outside the model's range "
+                             f"{lo:g}..{hi:g} rpm", file=self.file or None, key=key)
+        return rpm
+
+    def cycle_pressures(self, rpm: float, load: float = 1.0):
+        """Grid, pressures and model info of every cylinder (cached per speed and load)."""
+        rpm = self._check_speed(rpm)
+        key = (rpm, float(load))
+        if key not in self._cache:
+            if len(self._cache) > 64:
+                self._cache.clear()
+            self._cache[key] = self.combustion.cycle_pressures(self.crank, rpm * RPM, load)
+        return self._cache[key]
+
+    def cylinder_pressure(self, rpm: float, crank_angle_rad, load: float = 1.0) -> np.ndarray:
+        """Absolute pressure [Pa] of every cylinder, shape ``(n, n_cyl)``, at cylinder-1
+        crank angles ``crank_angle_rad`` [rad] (periodic over 4π)."""
+        theta_g, p, _ = self.cycle_pressures(rpm, load)
+        local = self.local_angles(crank_angle_rad)
+        out = np.empty(local.shape)
+        period = 4.0 * np.pi
+        for i in range(self.crank.n_cylinders):
+            out[:, i] = np.interp(local[:, i], theta_g, p[i], period=period)
+        return out
+
+    def local_angles(self, crank_angle_rad) -> np.ndarray:
+        """Each cylinder's cycle angle on ``[-π, 3π)`` [rad], shape ``(n, n_cyl)``."""
+        th = np.atleast_1d(np.asarray(crank_angle_rad, dtype=float))
+        local = th[:, None] - self.crank.firing_angles[None, :]
+        return np.mod(local + np.pi, 4.0 * np.pi) - np.pi
+
+    # ------------------------------------------------------------------ loads
+    def excitation(self, rpm: float, crank_angle_rad=None, load: float = 1.0,
+                   n_points: int = 1440) -> Excitation:
+        """Pressures, per-cylinder forces and torques and the total load at one speed.
+
+        Parameters
+        ----------
+        rpm : float
+            Engine speed [rpm] (constant).
+        crank_angle_rad : array_like, optional
+            Cylinder-1 crank angles [rad]; default ``n_points`` equally spaced on
+            ``[0, 4π)``.
+        load : float
+            Fraction of the full-load torque [-] (single-zone model).
+        """
+        if crank_angle_rad is None:
+            crank_angle_rad = 4.0 * np.pi * np.arange(n_points) / n_points
+        return self._evaluate(rpm, crank_angle_rad, load, detail=True)
+
+    def _evaluate(self, rpm, crank_angle_rad, load, detail):
+        th = np.atleast_1d(np.asarray(crank_angle_rad, dtype=float))
+        ct = self.crank
+        omega = self._check_speed(rpm) * RPM
+        p = self.cylinder_pressure(rpm, th, load)
+        fg = (p - ct.crankcase_pressure) * ct.piston_area
+        u = ct.cylinder_axis
+        s = ct.lateral_axis
+        su = np.cross(s, u)
+        r, l, e = ct.crank_radius, ct.rod_length, ct.pin_offset
+        cg = self.body.cg
+        force = np.zeros((th.size, 3))
+        moment = np.zeros((th.size, 3))
+        n_cyl = ct.n_cylinders
+        out = {k: np.empty((th.size, n_cyl)) for k in
+               ("inertia", "torque", "torque_gas", "torque_inertia")}
+
+        def add(f, point):
+            nonlocal force, moment
+            force = force + f
+            moment = moment + np.cross(point - cg, f)
+
+        for i in range(n_cyl):
+            theta_i = th - ct.crank_pin_angles[i]
+            k = sc.crank_forces(theta_i, omega, fg[:, i], r, l, e, ct.reciprocating_mass)
+            for name in out:
+                out[name][:, i] = k[name]
+            origin = np.array([ct.cylinder_x[i], 0.0, 0.0])
+            pin = origin + e * s + k["y"][:, None] * u
+            head = origin + k["y"][:, None] * u
+            add(fg[:, i, None] * u, head)                                   # gas on head
+            add(-k["side"][:, None] * s, pin)                               # side thrust
+            moment = moment + (e * fg[:, i])[:, None] * su                 # pin-offset couple
+            bearing = k["rod"][:, None] * (np.sin(k["beta"])[:, None] * s
+                                           - np.cos(k["beta"])[:, None] * u)
+            add(bearing, origin)                                            # main bearing
+            f_rot = (1.0 - ct.counterweight_fraction) * ct.rotating_mass * r * omega**2
+            if f_rot != 0.0:
+                add(f_rot * (np.cos(theta_i)[:, None] * u + np.sin(theta_i)[:, None] * s),
+                    origin)
+        if self.balancer.enabled:
+            for sh in self.balancer.shafts:
+                f_u, f_s = bal.shaft_force(th, omega, sh.mass_radius, sh.phase, sh.sense,
+                                           self.balancer.ratio)
+                add(f_u[:, None] * u + f_s[:, None] * s, sh.position)
+        if not detail:
+            return np.hstack([force, moment])
+        theta_g, p_g, info = self.cycle_pressures(rpm, load)
+        _, dV = ct.volume(theta_g)
+        dtheta = theta_g[1] - theta_g[0]
+        imep = np.array([comb.indicated_work(pc, dV, dtheta) for pc in p_g]) / ct.swept_volume
+        return Excitation(rpm=float(rpm), crank_angle=th, pressure=p, gas_force=fg,
+                          inertia_force=out["inertia"], torque=out["torque"],
+                          torque_gas=out["torque_gas"], torque_inertia=out["torque_inertia"],
+                          load=np.hstack([force, moment]), imep=imep, info=dict(info))
+
+    def generalized_load(self, rpm: float, crank_angle_rad, load: float = 1.0) -> np.ndarray:
+        """``[Fx, Fy, Fz, Mx, My, Mz]`` on the powertrain about its CG, engine axes.
+
+        Parameters
+        ----------
+        rpm : float
+            Engine speed [rpm].
+        crank_angle_rad : array_like, shape (n,)
+            Cylinder-1 crank angle [rad]; the load is periodic over 4π.
+        load : float
+            Fraction of full-load torque [-] (default full load).
+
+        Returns
+        -------
+        ndarray, shape (n, 6)
+            [N, N, N, N·m, N·m, N·m].
+        """
+        return self._evaluate(rpm, crank_angle_rad, load, detail=False)
+
+    def load_interpolant(self, rpm: float, n_points: int = 2880, load: float = 1.0):
+        """A fast callable ``f(crank_angle_rad) -> (n, 6)`` for one speed.
+
+        The load is sampled once on ``n_points`` equally spaced angles of ``[0, 4π)`` and
+        interpolated linearly and periodically (for time-stepping solvers that need the
+        load one angle at a time; 0.25° spacing by default).
+        """
+        grid = 4.0 * np.pi * np.arange(n_points) / n_points
+        table = self.generalized_load(rpm, grid, load)
+
+        def f(crank_angle_rad):
+            th = np.atleast_1d(np.asarray(crank_angle_rad, dtype=float))
+            return np.column_stack([np.interp(th, grid, table[:, j], period=4.0 * np.pi)
+                                    for j in range(6)])
+        return f
+
+    def static_stiffness_matrix(self) -> np.ndarray:
+        """6×6 stiffness of the mounts at the CG from each direction's static stiffness.
+
+        :math:`K = \\sum_m B_m^T K_m B_m` with :math:`B_m = [I, -\\widetilde{(p_m - c)}]`,
+        the mount-point displacement for small rotations [N/m, N, N·m/rad].
+        """
+        K = np.zeros((6, 6))
+        for m in self.mounts:
+            d = m.position - self.body.cg
+            skew = np.array([[0, -d[2], d[1]], [d[2], 0, -d[0]], [-d[1], d[0], 0]])
+            B = np.hstack([np.eye(3), -skew])
+            K += B.T @ m.static_stiffness_matrix() @ B
+        return K
+
+    def rigid_body_modes(self):
+        """Natural frequencies [Hz] and mode shapes of the powertrain on the static mount
+        stiffness (undamped, rigid chassis): :math:`K\\phi = \\omega^2 M\\phi`."""
+        from scipy.linalg import eigh
+        w2, vec = eigh(self.static_stiffness_matrix(), self.body.mass_matrix())
+        return np.sqrt(np.clip(w2, 0.0, None)) / (2 * np.pi), vec

@@ -1,0 +1,234 @@
+r"""Exact slider-crank kinematics and the forces of one cylinder on the engine block.
+
+Plane of one cylinder
+---------------------
+The crank rotates at constant angular speed :math:`\omega` [rad/s]. In the plane of the
+cylinder, :math:`u` is the cylinder axis (pointing from the crank axis to the head) and
+:math:`s` the lateral direction into which the crank pin moves just after top dead centre.
+The crank angle :math:`\theta` [rad] is measured from the cylinder axis in the sense of
+rotation. The piston pin moves on the line :math:`s = e` (piston-pin offset :math:`e` [m],
+positive towards :math:`+s`, the major thrust side of a conventionally rotating engine).
+
+With crank radius :math:`r` [m], connecting-rod length :math:`l` [m] and the rod angle
+:math:`\beta` (no series expansion anywhere):
+
+.. math::
+
+    \sin\beta = \frac{r\sin\theta - e}{l}, \qquad
+    y = r\cos\theta + l\cos\beta,
+
+    \frac{dy}{d\theta} = -\frac{r\sin(\theta+\beta)}{\cos\beta}, \qquad
+    \frac{d^2y}{d\theta^2} = -r\cos\theta - l\cos\beta\,\beta'^2 - l\sin\beta\,\beta'',
+
+    \beta' = \frac{r\cos\theta}{l\cos\beta}, \qquad
+    \beta'' = \frac{l\sin\beta\,\beta'^2 - r\sin\theta}{l\cos\beta},
+
+and the piston acceleration is :math:`a = \omega^2\, d^2y/d\theta^2` [m/s²] along :math:`u`
+(Heywood 1988, sec. 2.2; Taylor 1985, vol. 2, ch. 8 for the forces). For :math:`e = 0` its
+Fourier series is :math:`a = -r\omega^2(\cos\theta + A_2\cos 2\theta - A_4\cos 4\theta
++ \dots)` with :math:`A_2 = \lambda + \lambda^3/4 + 15\lambda^5/128 + \dots`,
+:math:`\lambda = r/l` (see :func:`second_order_coefficient`).
+
+Forces (the connecting rod's mass is split into a reciprocating part lumped at the piston pin
+and a rotating part at the crank pin; its moment-of-inertia correction is neglected)
+------------------------------------------------------------------------------------
+With gas force :math:`F_g = (p - p_{cc})A` [N] on the piston crown (towards the crank) and
+reciprocating mass :math:`m` [kg], the piston's equilibrium gives the rod force (compression
+positive) and the wall force on the piston
+
+.. math::
+
+    F_r = \frac{F_g + m a}{\cos\beta}, \qquad N = F_r \sin\beta ,
+
+and the crank torque in the sense of rotation
+
+.. math::
+
+    T = F_r\, r \sin(\theta + \beta) = -(F_g + m a)\,\frac{dy}{d\theta}.
+
+Forces on the block (the crank is assumed to turn at constant speed, the torque :math:`T`
+leaves through the crankshaft): gas on the head :math:`+F_g\,u` on the cylinder axis,
+piston side thrust :math:`-N\,s` at the piston pin together with the couple
+:math:`e F_g` (in the :math:`s\times u` sense) that the pin offset puts into the wall
+contact, and the main-bearing reaction :math:`F_r(\sin\beta\,s - \cos\beta\,u)` on the crank
+axis. Their sum is the shaking force :math:`-m a\,u` on the pin line plus the torque
+reaction :math:`-T` about the axis of rotation; :func:`block_forces` returns them separately
+so that each can be placed at its own point.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+
+def rod_angle(theta, r, l, e=0.0):
+    r"""Connecting-rod angle :math:`\beta` [rad], :math:`\sin\beta = (r\sin\theta - e)/l`.
+
+    Parameters
+    ----------
+    theta : array_like
+        Crank angle from the cylinder axis [rad].
+    r : float
+        Crank radius (half the stroke) [m].
+    l : float
+        Connecting-rod length, centre to centre [m].
+    e : float, optional
+        Piston-pin offset [m].
+
+    Returns
+    -------
+    ndarray
+        Rod angle [rad].
+    """
+    theta = np.asarray(theta, dtype=float)
+    return np.arcsin((r * np.sin(theta) - e) / l)
+
+
+def piston_kinematics(theta, r, l, e=0.0):
+    r"""Exact piston position and its first two derivatives with respect to crank angle.
+
+    Parameters
+    ----------
+    theta : array_like
+        Crank angle from the cylinder axis [rad].
+    r : float
+        Crank radius [m].
+    l : float
+        Connecting-rod length [m].
+    e : float, optional
+        Piston-pin offset [m].
+
+    Returns
+    -------
+    y : ndarray
+        Piston-pin distance from the crank axis along the cylinder axis [m].
+    dy : ndarray
+        :math:`dy/d\theta` [m/rad].
+    d2y : ndarray
+        :math:`d^2y/d\theta^2` [m/rad²]; the acceleration at constant speed is
+        :math:`\omega^2\,d^2y/d\theta^2` [m/s²].
+    beta : ndarray
+        Rod angle [rad].
+    """
+    theta = np.asarray(theta, dtype=float)
+    beta = rod_angle(theta, r, l, e)
+    cb, sb = np.cos(beta), np.sin(beta)
+    y = r * np.cos(theta) + l * cb
+    b1 = r * np.cos(theta) / (l * cb)
+    b2 = (l * sb * b1**2 - r * np.sin(theta)) / (l * cb)
+    dy = -r * np.sin(theta + beta) / cb
+    d2y = -r * np.cos(theta) - l * cb * b1**2 - l * sb * b2
+    return y, dy, d2y, beta
+
+
+def stroke_limits(r, l, e=0.0):
+    r"""Piston-pin positions at top and bottom dead centre [m] and their crank angles [rad].
+
+    .. math:: y_{TDC} = \sqrt{(l+r)^2 - e^2}, \quad y_{BDC} = \sqrt{(l-r)^2 - e^2},
+              \quad \sin\theta_{TDC} = \frac{e}{l+r}, \quad
+              \sin(\theta_{BDC}-\pi) = -\frac{e}{l-r}
+
+    Returns
+    -------
+    y_tdc, y_bdc, theta_tdc, theta_bdc : float
+    """
+    y_tdc = float(np.sqrt((l + r) ** 2 - e**2))
+    y_bdc = float(np.sqrt((l - r) ** 2 - e**2))
+    theta_tdc = float(np.arcsin(e / (l + r)))
+    theta_bdc = float(np.pi + np.arcsin(e / (l - r)))
+    return y_tdc, y_bdc, theta_tdc, theta_bdc
+
+
+def cylinder_volume(theta, bore, r, l, e, compression_ratio):
+    r"""Cylinder volume [m³] from the exact kinematics.
+
+    .. math:: V = V_c + A\,(y_{TDC} - y), \qquad V_c = \frac{V_d}{\varepsilon - 1},
+              \qquad V_d = A\,(y_{TDC} - y_{BDC}), \qquad A = \pi B^2/4
+
+    Parameters
+    ----------
+    theta : array_like
+        Crank angle from the cylinder axis [rad].
+    bore : float
+        Bore [m].
+    r, l, e : float
+        Crank radius, rod length, piston-pin offset [m].
+    compression_ratio : float
+        Geometric compression ratio :math:`\varepsilon` [-].
+
+    Returns
+    -------
+    V : ndarray
+        Volume [m³].
+    dV : ndarray
+        :math:`dV/d\theta` [m³/rad].
+    """
+    area = np.pi * bore**2 / 4.0
+    y_tdc, y_bdc, _, _ = stroke_limits(r, l, e)
+    vd = area * (y_tdc - y_bdc)
+    vc = vd / (compression_ratio - 1.0)
+    y, dy, _, _ = piston_kinematics(theta, r, l, e)
+    return vc + area * (y_tdc - y), -area * dy
+
+
+def swept_volume(bore, r, l, e=0.0):
+    """Swept volume of one cylinder [m³] from the exact dead-centre positions."""
+    y_tdc, y_bdc, _, _ = stroke_limits(r, l, e)
+    return np.pi * bore**2 / 4.0 * (y_tdc - y_bdc)
+
+
+def crank_forces(theta, omega, gas_force, r, l, e, m_rec):
+    r"""Rod force, side thrust and crank torque of one cylinder (exact kinematics).
+
+    Parameters
+    ----------
+    theta : array_like
+        Crank angle of this cylinder from its cylinder axis [rad].
+    omega : float
+        Crank angular speed [rad/s] (constant).
+    gas_force : array_like
+        :math:`F_g = (p - p_{cc})A` on the piston crown, towards the crank [N].
+    r, l, e : float
+        Crank radius, rod length, piston-pin offset [m].
+    m_rec : float
+        Reciprocating mass (piston group plus the rod's small-end share) [kg].
+
+    Returns
+    -------
+    dict of ndarray
+        ``y`` [m], ``dy`` [m/rad], ``acc`` piston acceleration along :math:`u` [m/s²],
+        ``beta`` [rad], ``rod`` rod force :math:`F_r` (compression > 0) [N], ``side`` wall
+        force on the piston :math:`N` along :math:`s` [N], ``inertia`` reciprocating inertia
+        force :math:`-m a` along :math:`u` [N], ``torque`` crank torque :math:`T` [N·m],
+        ``torque_gas`` and ``torque_inertia`` its gas and inertia parts [N·m].
+    """
+    y, dy, d2y, beta = piston_kinematics(theta, r, l, e)
+    acc = omega**2 * d2y
+    fg = np.asarray(gas_force, dtype=float)
+    rod = (fg + m_rec * acc) / np.cos(beta)
+    return {
+        "y": y, "dy": dy, "acc": acc, "beta": beta, "rod": rod,
+        "side": rod * np.sin(beta), "inertia": -m_rec * acc,
+        "torque": -(fg + m_rec * acc) * dy,
+        "torque_gas": -fg * dy, "torque_inertia": -m_rec * acc * dy,
+    }
+
+
+def second_order_coefficient(lam, terms=3):
+    r"""Coefficient :math:`A_2` of :math:`\cos 2\theta` in :math:`-a/(r\omega^2)` for
+    :math:`e = 0`.
+
+    .. math:: A_2 = \lambda + \tfrac14\lambda^3 + \tfrac{15}{128}\lambda^5 + \dots
+
+    (binomial expansion of :math:`\sqrt{1-\lambda^2\sin^2\theta}`; Taylor 1985, vol. 2,
+    ch. 8). The first omitted term is of order :math:`\lambda^7` (about 35/512 λ⁷).
+
+    Parameters
+    ----------
+    lam : float
+        Crank-radius to rod-length ratio :math:`\lambda = r/l` [-].
+    terms : int
+        Number of terms of the series kept (1 to 3).
+    """
+    coeffs = [1.0, 1.0 / 4.0, 15.0 / 128.0]
+    return float(sum(c * lam ** (2 * k + 1) for k, c in enumerate(coeffs[:terms])))
