@@ -86,3 +86,66 @@ def plot_runup(results, path=None, quantities=("synthesis", "order_2", "order_4"
     if path:
         save_figure(fig, path)
     return fig
+
+
+def plot_excitation(exc, path=None):
+    """Summary figure of an :class:`~powertrain.models.engine.Excitation` over one cycle.
+
+    Four panels against the crank angle of cylinder 1 [deg]: cylinder pressures [bar];
+    per-cylinder crank torque [N·m]; total forces [N] and moments [N·m] on the powertrain
+    about its CG (engine axes); and the order spectrum (0.5..8) of the load components.
+
+    Parameters
+    ----------
+    exc : Excitation
+    path : str, optional
+        PNG file to write.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
+    import numpy as np
+    plt = _pyplot()
+    deg = np.degrees(exc.crank_angle)
+    fig, axes = plt.subplots(2, 2, figsize=(11, 7.5))
+    ax = axes[0, 0]
+    for i in range(exc.pressure.shape[1]):
+        ax.plot(deg, exc.pressure[:, i] / 1e5, label=f"cylinder {i + 1}")
+    ax.set_ylabel("cylinder pressure [bar]")
+    ax.legend(fontsize=8)
+    ax = axes[0, 1]
+    for i in range(exc.torque.shape[1]):
+        ax.plot(deg, exc.torque[:, i], lw=0.8, label=f"cylinder {i + 1}")
+    ax.plot(deg, exc.torque.sum(axis=1), "k", lw=1.2, label="sum")
+    ax.set_ylabel("crank torque [N·m]")
+    ax.legend(fontsize=8)
+    ax = axes[1, 0]
+    for j, name in enumerate(["Fx [N]", "Fy [N]", "Fz [N]"]):
+        ax.plot(deg, exc.load[:, j], label=name)
+    for j, name in enumerate(["Mx [N·m]", "My [N·m]", "Mz [N·m]"]):
+        ax.plot(deg, exc.load[:, 3 + j], "--", label=name)
+    ax.set_ylabel("load on the powertrain about its CG")
+    ax.legend(fontsize=8, ncol=2)
+    for a in (axes[0, 0], axes[0, 1], axes[1, 0]):
+        a.set_xlabel("crank angle of cylinder 1 [deg]")
+        a.set_xlim(0, 720)
+        a.set_xticks(np.arange(0, 721, 90))
+        a.grid(True, alpha=0.3)
+    ax = axes[1, 1]
+    orders, amp = exc.order_spectrum(8.0)
+    names = ["Fx [N]", "Fy [N]", "Fz [N]", "Mx [N·m]", "My [N·m]", "Mz [N·m]"]
+    width = 0.5 / 7
+    for j, name in enumerate(names):
+        ax.bar(orders[1:] + (j - 2.5) * width, np.abs(amp[1:, j]), width=width, label=name)
+    ax.set_xlabel("engine order")
+    ax.set_ylabel("amplitude [N or N·m]")
+    ax.set_xticks(np.arange(0.5, 8.01, 0.5))
+    ax.tick_params(axis="x", labelsize=7)
+    ax.grid(True, axis="y", alpha=0.3)
+    ax.legend(fontsize=7, ncol=2)
+    fig.suptitle(f"Excitation at {exc.rpm:g} rpm")
+    fig.tight_layout()
+    if path:
+        save_figure(fig, path)
+    return fig
