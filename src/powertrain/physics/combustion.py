@@ -6,7 +6,7 @@ Cycle angle
 the firing top dead centre, on the window :math:`-\pi \le \theta < 3\pi` (compression from
 bottom dead centre, firing TDC at 0, expansion, exhaust from :math:`\pi`, gas-exchange TDC at
 :math:`2\pi`, intake to :math:`3\pi \equiv -\pi`). With a piston-pin offset the kinematic TDC
-lies :math:`\arcsin(e/(l+r))` (about 0.15°) after :math:`\theta = 0`; the volume is always
+lies at :math:`\arcsin(e/(l+r))` (about −0.15° for the default engine); the volume is always
 taken from the exact kinematics.
 
 Model (Heywood 1988, sec. 9.2 and 14.4; Wiebe 1970)

@@ -7,7 +7,9 @@ cylinder, :math:`u` is the cylinder axis (pointing from the crank axis to the he
 :math:`s` the lateral direction into which the crank pin moves just after top dead centre.
 The crank angle :math:`\theta` [rad] is measured from the cylinder axis in the sense of
 rotation. The piston pin moves on the line :math:`s = e` (piston-pin offset :math:`e` [m],
-positive towards :math:`+s`, the major thrust side of a conventionally rotating engine).
+positive towards :math:`+s`. In the power stroke the rod pushes the piston towards
+:math:`-s`, so :math:`-s` is the major thrust side and the usual offset towards it is
+:math:`e < 0`).
 
 With crank radius :math:`r` [m], connecting-rod length :math:`l` [m] and the rod angle
 :math:`\beta` (no series expansion anywhere):
