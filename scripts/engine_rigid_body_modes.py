@@ -12,8 +12,6 @@ from __future__ import annotations
 
 import sys
 
-import numpy as np
-
 from powertrain.iotools.engine_file import DEFAULT_ENGINE_PATH, read_engine
 
 

@@ -45,8 +45,6 @@ def excitation(rpm, engine_file, load, no_balancers, step, csv_path, plot):
     """
     import math
 
-    import numpy as np
-
     from powertrain.errors import InputError
     from powertrain.iotools.engine_file import DEFAULT_ENGINE_PATH, read_engine
 
