@@ -52,15 +52,23 @@ from powertrain.models.mount import DEFAULT_TOPOLOGY, TOPOLOGIES, MountModel, To
 from powertrain.physics.mount_network import incidence_matrix
 
 #: Number of random starting points screened by default.
-DEFAULT_STARTS = 32
-#: Number of screened starts run to convergence by default.
-DEFAULT_POLISH = 6
+DEFAULT_STARTS = 24
+#: Number of screened starts run further by default.
+DEFAULT_POLISH = 4
 #: Seed of the starting points by default (the fit is deterministic for given data).
 DEFAULT_SEED = 0
 #: Levenberg–Marquardt function evaluations per start in the screening phase.
 SCREEN_NFEV = 100
-#: Maximum function evaluations of a polishing run.
-POLISH_NFEV = 3000
+#: Perturbations ("hops") of the incumbent by default.
+DEFAULT_HOPS = 16
+#: Fraction of the log-parameters replaced in a hop.
+HOP_FRACTION = 0.3
+#: Further function evaluations of a promising hop.
+HOP_NFEV = 300
+#: Function evaluations of each polishing run.
+POLISH_NFEV = 500
+#: Further function evaluations allowed to the best polished start.
+FINAL_NFEV = 2000
 
 _DISPLACEMENT = 1e-3  # eq. 18-19: 1 mm displacement [m]
 
@@ -277,6 +285,10 @@ class FitResult:
         Convergence flag of each polishing run.
     polish_rel_rms : tuple of float
         :math:`\\varepsilon` reached by each polishing run (spread = multi-modality).
+    n_hops : int
+        Perturbations of the incumbent tried.
+    hops_accepted : int
+        Perturbations that improved the fit.
     time_s : float
         Wall-clock time of the fit [s].
     nfev : int
@@ -293,6 +305,8 @@ class FitResult:
     success: bool
     polish_success: tuple
     polish_rel_rms: tuple
+    n_hops: int
+    hops_accepted: int
     time_s: float
     nfev: int
 
@@ -306,8 +320,10 @@ class FitResult:
         return (f"model {self.model.topology.name}: f_obj = {self.objective_n:.4g} N "
                 f"(eq. 19, |k_t - k_m| in N/mm x 1 mm over {self.frequency_hz.size} "
                 f"frequencies), relative RMS error = {100 * self.rel_rms:.3g} %\n"
-                f"{self.n_starts} starts screened, {self.n_polished} polished "
-                f"({sum(self.polish_success)} converged), {self.nfev} evaluations, "
+                f"{self.n_starts} starts screened, {self.n_polished} polished, "
+                f"{self.hops_accepted} of {self.n_hops} hops accepted, "
+                f"{'converged' if self.success else 'evaluation limit reached'}, "
+                f"{self.nfev} evaluations, "
                 f"{self.time_s:.2f} s")
 
     def plot(self, ax=None, path=None):
@@ -323,7 +339,7 @@ class FitResult:
 
 def fit_mount(frequency_hz, kcp_measured, model: str | Topology = DEFAULT_TOPOLOGY, *,
               starts: int = DEFAULT_STARTS, seed=DEFAULT_SEED, polish: int = DEFAULT_POLISH,
-              name: str = "", source: str = "") -> FitResult:
+              hops: int = DEFAULT_HOPS, name: str = "", source: str = "") -> FitResult:
     """Identify the parameters of a lumped mount model from a measured K*(f) (sec. 2.2).
 
     Minimises :math:`f_{obj}` (Kovarik 2016, eq. 19) over non-negative parameters; see the
@@ -342,7 +358,10 @@ def fit_mount(frequency_hz, kcp_measured, model: str | Topology = DEFAULT_TOPOLO
     seed : int or None
         Seed of the starting points.
     polish : int
-        Best screened starts run to convergence (>= 1).
+        Best screened starts run further (>= 1).
+    hops : int
+        Perturbations of the incumbent (>= 0): a random ~30 % of its log-parameters are
+        replaced by fresh starting values and the result kept when better.
     name, source : str
         Metadata for the returned model.
 
@@ -375,26 +394,43 @@ def fit_mount(frequency_hz, kcp_measured, model: str | Topology = DEFAULT_TOPOLO
         raise ValueError(f"{n_par} parameters need at least {(n_par + 1) // 2} frequencies")
     if not np.any(np.abs(km) > 0):
         raise ValueError("measured stiffness is zero everywhere")
-    if int(starts) < 1 or int(polish) < 1:
-        raise ValueError("starts and polish must be >= 1")
-    starts, polish = int(starts), min(int(polish), int(starts))
+    if int(starts) < 1 or int(polish) < 1 or int(hops) < 0:
+        raise ValueError("starts and polish must be >= 1, hops >= 0")
+    starts, polish, hops = int(starts), min(int(polish), int(starts)), int(hops)
 
     prob = _Problem(topology, f, km)
+    rng = np.random.default_rng(seed)
+    fresh = starting_points(topology, f, km, starts + hops, rng)
     screened = []
     with np.errstate(all="ignore"):
-        for q0 in starting_points(topology, f, km, starts, seed):
+        for q0 in fresh[:starts]:
             q, err, _ = prob.solve(prob.rescale(q0), SCREEN_NFEV, 1e-6)
             screened.append((err, q))
         screened.sort(key=lambda t: t[0])
         polished = [prob.solve(q, POLISH_NFEV, 1e-10) for _, q in screened[:polish]]
-    best = min(range(len(polished)), key=lambda i: polished[i][1])
-    q_best = np.clip(polished[best][0], prob.lo, prob.hi)
+        q_best, err_best, ok_best = min(polished, key=lambda t: t[1])
+        accepted = 0
+        for q_new in fresh[starts:]:
+            # hop: replace a random ~30 % of the parameters by fresh start values
+            mask = rng.random(q_best.size) < HOP_FRACTION
+            if not mask.any():
+                mask[rng.integers(q_best.size)] = True
+            q, err, _ = prob.solve(prob.rescale(np.where(mask, q_new, q_best)),
+                                   SCREEN_NFEV, 1e-6)
+            if err < 1.5 * err_best:
+                q, err, ok = prob.solve(q, HOP_NFEV, 1e-10)
+                if err < err_best:
+                    q_best, err_best, ok_best = q, err, ok
+                    accepted += 1
+        if not ok_best:
+            q_best, err_best, ok_best = prob.solve(q_best, FINAL_NFEV, 1e-10)
+    q_best = np.clip(q_best, prob.lo, prob.hi)
     fitted = MountModel.from_values(topology, np.exp(q_best), name=name, source=source)
     kfit = fitted.cross_point_stiffness(f)
     return FitResult(model=fitted, frequency_hz=f, kcp_measured=km,
                      objective_n=objective_n(kfit, km), rel_rms=relative_rms_error(kfit, km),
                      n_starts=starts, n_polished=len(polished),
-                     success=polished[best][2],
-                     polish_success=tuple(p[2] for p in polished),
+                     success=ok_best, polish_success=tuple(p[2] for p in polished),
                      polish_rel_rms=tuple(p[1] for p in polished),
+                     n_hops=hops, hops_accepted=accepted,
                      time_s=time.perf_counter() - t0, nfev=prob.nfev)

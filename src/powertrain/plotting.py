@@ -88,6 +88,115 @@ def plot_runup(results, path=None, quantities=("synthesis", "order_2", "order_4"
     return fig
 
 
+def plot_comparison(comparison, path=None, quantities=("synthesis", "order_2", "order_4")):
+    """Measured and simulated RMS velocity against speed, level gap shaded.
+
+    The thesis's layout (Kovarik 2016, Figs 45-71): one row per mount and direction, one
+    column per quantity (synthesis, 2nd and 4th order), log-scaled velocity [mm/s]. The
+    measured curve is a thin black line, the simulation markers at its speeds joined by
+    straight lines (on the log axis these are exactly the log-level interpolation used for the
+    gaps); the gap at the compared speeds is shaded red where the simulation is higher, green
+    where it is lower. Points excluded at the noise floor are grey crosses, the exclusion
+    limit a dotted line. Channel titles give the RMS gap and bias [dB].
+
+    Parameters
+    ----------
+    comparison : ComparisonResult
+    path : str or Path, optional
+        PNG file written atomically.
+    quantities : sequence of str
+        Columns.
+    """
+    import numpy as np
+
+    from matplotlib.lines import Line2D
+    from matplotlib.ticker import NullFormatter
+
+    from powertrain.analysis.compare import NOISE_FLOOR_MARGIN
+    plt = _pyplot()
+    sim = comparison.simulated
+    rows = list(sim.channels)
+    rows += [c for c in comparison.measured.channels if c not in rows]
+    fig, axes = plt.subplots(len(rows), len(quantities),
+                             figsize=(4.3 * len(quantities), 1.75 * len(rows) + 0.8),
+                             sharex=True, squeeze=False)
+    mm = 1e3
+    limit = NOISE_FLOOR_MARGIN * comparison.noise_floor * mm
+    compared = {(c.mount, c.direction, c.quantity): c for c in comparison.channels}
+    for r, (mount, direction) in enumerate(rows):
+        for q, quantity in enumerate(quantities):
+            ax = axes[r, q]
+            key = (mount, direction, quantity)
+            title = "synthesis (orders ≤ 8)" if quantity == "synthesis" else \
+                quantity.replace("order_", "order ")
+            c = compared.get(key)
+            if key in comparison.measured.curves:
+                rm, vm = comparison.measured.curves[key]
+                ax.plot(rm, vm * mm, "-", color="k", lw=0.9, label="measured")
+            if key in sim.curves:
+                rs, vs = sim.curves[key]
+                pos = vs > 0
+                ax.plot(rs[pos], vs[pos] * mm, "o-", color="C0", ms=3, lw=1.2,
+                        label="simulated")
+            if c is not None:
+                s = np.where(c.scored, c.simulated, np.nan) * mm
+                m = np.where(c.scored, c.measured, np.nan) * mm
+                ax.fill_between(c.rpm, m, s, where=c.scored & (s >= m), interpolate=True,
+                                color="C3", alpha=0.3, lw=0, label="sim > measured")
+                ax.fill_between(c.rpm, m, s, where=c.scored & (s < m), interpolate=True,
+                                color="C2", alpha=0.35, lw=0, label="sim < measured")
+                if c.at_floor.any():
+                    ax.plot(c.rpm[c.at_floor], np.maximum(c.measured[c.at_floor] * mm,
+                                                          limit * 0.5),
+                            "x", color="0.55", ms=3, label="excluded (noise floor)")
+                title += (f"   ΔL rms {c.stats['rms_db']:.1f} dB, "
+                          f"bias {c.stats['bias_db']:+.1f} dB")
+            else:
+                ax.text(0.5, 0.5, "not compared", transform=ax.transAxes, ha="center",
+                        va="center", fontsize=8, color="0.4")
+            ax.set_yscale("log")
+            vals = [v for k in (key,) for src_ in (comparison.measured.curves, sim.curves)
+                    if k in src_ for v in src_[k][1] * mm if v > 0]
+            if vals:
+                # at least one decade, so that a labelled power of ten is always visible
+                lo, hi = min(vals) / 1.6, max(vals) * 1.6
+                if hi / lo < 10:
+                    mid = np.sqrt(lo * hi)
+                    lo, hi = mid / np.sqrt(10), mid * np.sqrt(10)
+                lo = max(lo, limit / 2) if limit > 0 and limit < hi / 10 else lo
+                ax.set_ylim(lo, hi)
+                if limit > 0 and lo < limit < hi:
+                    ax.axhline(limit, color="0.5", ls=":", lw=0.8)
+            ax.yaxis.set_minor_formatter(NullFormatter())
+            ax.set_title(f"{mount} {direction.upper()} — {title}", fontsize=7.5)
+            ax.grid(True, which="both", alpha=0.25)
+            ax.tick_params(labelsize=7)
+            if q == 0:
+                ax.set_ylabel("RMS velocity [mm/s]", fontsize=7)
+    for ax in axes[-1]:
+        ax.set_xlabel("engine speed [rpm]", fontsize=8)
+    handles, labels = {}, []
+    for ax in axes.ravel():
+        for h, lab in zip(*ax.get_legend_handles_labels()):
+            if lab not in handles:
+                handles[lab] = h
+                labels.append(lab)
+    labels.append(f"noise-floor limit ({limit:g} mm/s)")
+    handles[labels[-1]] = Line2D([], [], color="0.5", ls=":", lw=0.8)
+    from pathlib import Path
+    src = Path(comparison.measured.source).name
+    tag = "SYNTHETIC measurement" if comparison.measured.synthetic else "measurement"
+    fig.suptitle(f"{tag}: {src}   overall RMS gap {comparison.overall_rms_db:.2f} dB "
+                 "(gap = 20 log10(sim/measured))", fontsize=9)
+    fig.legend([handles[lab] for lab in labels], labels, loc="upper center", ncol=len(labels),
+               fontsize=8, bbox_to_anchor=(0.5, 1 - 0.35 / fig.get_figheight()),
+               frameon=False)
+    fig.tight_layout(rect=(0, 0, 1, 1 - 0.7 / fig.get_figheight()))
+    if path:
+        save_figure(fig, path)
+    return fig
+
+
 def plot_excitation(exc, path=None):
     """Summary figure of an :class:`~powertrain.models.engine.Excitation` over one cycle.
 
@@ -149,3 +258,51 @@ def plot_excitation(exc, path=None):
     if path:
         save_figure(fig, path)
     return fig
+
+
+def plot_mount_fit(frequency_hz, kcp_measured, kcp_fitted, *, label="fit", title=None,
+                   ax=None, path=None):
+    """Measured (dots) and fitted (lines) real and imaginary K*(f) [N/mm].
+
+    The presentation of Kovarik (2016), Figs. 15–29 and 37–42.
+
+    Parameters
+    ----------
+    frequency_hz : ndarray
+        [Hz]
+    kcp_measured, kcp_fitted : ndarray of complex
+        Cross-point dynamic stiffness [N/m].
+    label : str
+        Legend label of the fitted curves.
+    title : str, optional
+    ax : matplotlib Axes, optional
+        Draw into it; otherwise a new figure is made (and saved when ``path`` is given).
+    path : str, optional
+        PNG file, written atomically.
+
+    Returns
+    -------
+    matplotlib Axes
+    """
+    import numpy as np
+    plt = _pyplot()
+    fig = None
+    if ax is None:
+        fig, ax = plt.subplots(figsize=(8, 4.5))
+    f = np.asarray(frequency_hz)
+    km = np.asarray(kcp_measured) / 1e3
+    kf = np.asarray(kcp_fitted) / 1e3
+    ax.plot(f, km.real, "k.", ms=3, label="measured, real")
+    ax.plot(f, km.imag, ".", color="0.5", ms=3, label="measured, imaginary")
+    line, = ax.plot(f, kf.real, "-", label=f"{label}, real")
+    ax.plot(f, kf.imag, "--", color=line.get_color(), label=f"{label}, imaginary")
+    ax.set_xlabel("frequency [Hz]")
+    ax.set_ylabel("cross-point dynamic stiffness [N/mm]")
+    if title:
+        ax.set_title(title, fontsize=9)
+    ax.grid(True, alpha=0.3)
+    ax.legend(fontsize=8)
+    if fig is not None and path:
+        fig.tight_layout()
+        save_figure(fig, path)
+    return ax
