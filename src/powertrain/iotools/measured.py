@@ -1,0 +1,314 @@
+r"""Measured run-up order curves: long-format CSV or the run-up HDF5 layout.
+
+CSV (the format :meth:`powertrain.results.RunupResult.to_csv` writes)::
+
+    # lines starting with '#' are comments (kept, e.g. a SYNTHETIC label); blank lines skipped
+    mount,direction,quantity,rpm,velocity_rms_mm_per_s
+    left,x,order_2,1000,0.512
+    left,x,synthesis,1000,0.801
+    ...
+
+* ``mount``: a mount name of the model (``left``, ``right``, ``gearbox`` for the default
+  engine); ``direction``: ``x``, ``y`` or ``z`` (engine axes; upper case accepted);
+  ``quantity``: ``synthesis`` or ``order_<n>`` (``order_2``, ``order_0.5``...); ``rpm`` > 0.
+* exactly one level column, whose name states quantity, statistic and unit (table
+  :data:`LEVEL_COLUMNS`): ``velocity_rms_mm_per_s``, ``velocity_rms_m_per_s``,
+  ``velocity_peak_mm_per_s`` or ``velocity_peak_m_per_s``. Peak values are converted to RMS
+  by :math:`1/\sqrt2`, exact for a single sinusoidal order; a ``synthesis`` row in a peak file
+  is read as the root-sum-square of the order peaks (the usual order-analyser convention),
+  for which the same factor is exact too.
+* rows may come in any order; speeds need not be the same for every channel.
+
+Levels are returned in SI (m/s RMS). Any problem -- unreadable file, a header without a
+recognised level column, an unknown column, mount, direction or quantity, a non-numeric,
+negative or NaN value, a duplicate row -- raises :class:`~powertrain.errors.InputError`
+naming file, line and column.
+
+HDF5 files in the layout of :mod:`powertrain.results` (``powertrain runup --out``) are read
+with :meth:`RunupResult.from_hdf5`; every channel's synthesis and order RMS velocities become
+curves.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from powertrain.analysis.orders import order_label
+from powertrain.errors import InputError
+
+#: Recognised level columns: name -> (factor to m/s, statistic).
+LEVEL_COLUMNS = {
+    "velocity_rms_mm_per_s": (1e-3, "rms"),
+    "velocity_rms_m_per_s": (1.0, "rms"),
+    "velocity_peak_mm_per_s": (1e-3, "peak"),
+    "velocity_peak_m_per_s": (1.0, "peak"),
+}
+KEY_COLUMNS = ("mount", "direction", "quantity", "rpm")
+DIRECTIONS = ("x", "y", "z")
+_HDF5_SIGNATURE = b"\x89HDF\r\n\x1a\n"
+
+
+def quantity_sort_key(quantity: str):
+    """Sort key: ``synthesis`` first, then orders ascending."""
+    if quantity == "synthesis":
+        return (0, 0.0)
+    return (1, float(quantity.split("_", 1)[1]))
+
+
+def normalise_quantity(text: str) -> str:
+    """``synthesis`` or ``order_<n>`` with n > 0 written without trailing zeros.
+
+    Raises
+    ------
+    ValueError
+        If ``text`` is neither.
+    """
+    text = text.strip()
+    if text == "synthesis":
+        return text
+    if text.startswith("order_"):
+        try:
+            order = float(text[6:])
+        except ValueError:
+            order = float("nan")
+        if math.isfinite(order) and order > 0:
+            return order_label(order)
+    raise ValueError(f"unknown quantity {text!r} (expected 'synthesis' or 'order_<n>', "
+                     "e.g. order_2)")
+
+
+@dataclass
+class MeasuredRunup:
+    """Order curves of a run-up: RMS velocity against speed per channel and quantity.
+
+    Attributes
+    ----------
+    curves : dict
+        ``(mount, direction, quantity) -> (rpm [rpm], level [m/s RMS])``, each a 1-D array,
+        speeds strictly increasing.
+    source : str
+        File read.
+    notes : list of str
+        Conversions applied (e.g. peak to RMS).
+    comments : list of str
+        Comment lines of the file (without the leading ``#``).
+    """
+
+    curves: dict
+    source: str = ""
+    notes: list = field(default_factory=list)
+    comments: list = field(default_factory=list)
+
+    @property
+    def channels(self) -> list:
+        """(mount, direction) pairs present, in order of first appearance."""
+        seen = []
+        for m, d, _ in self.curves:
+            if (m, d) not in seen:
+                seen.append((m, d))
+        return seen
+
+    @property
+    def quantities(self) -> list:
+        """Quantities present, ``synthesis`` first, then orders ascending."""
+        return sorted({q for _, _, q in self.curves}, key=quantity_sort_key)
+
+    @property
+    def synthetic(self) -> bool:
+        """True if a comment line says the data are synthetic."""
+        return any("synthetic" in c.lower() for c in self.comments)
+
+    def curve(self, mount: str, direction: str, quantity: str):
+        """``(rpm [rpm], level [m/s RMS])`` of one channel and quantity (KeyError if absent)."""
+        return self.curves[(mount, direction, quantity)]
+
+    def rpm_range(self):
+        """Lowest and highest speed of all curves [rpm]."""
+        lo = min(float(r[0]) for r, _ in self.curves.values())
+        hi = max(float(r[-1]) for r, _ in self.curves.values())
+        return lo, hi
+
+    @classmethod
+    def from_result(cls, result, source: str = "") -> "MeasuredRunup":
+        """RMS velocity curves (synthesis and every order) of a
+        :class:`~powertrain.results.RunupResult`."""
+        rpm = np.asarray(result.rpm, float)
+        order_idx = np.argsort(rpm)
+        rms = result.order_rms("velocity")[order_idx]
+        syn = result.synthesis_rms("velocity")[order_idx]
+        rpm = rpm[order_idx]
+        curves = {}
+        for c, (m, d) in enumerate(result.channels):
+            curves[(m, d, "synthesis")] = (rpm.copy(), syn[:, c].copy())
+            for k, order in enumerate(result.orders):
+                curves[(m, d, order_label(order))] = (rpm.copy(), rms[:, c, k].copy())
+        return cls(curves, source=str(source))
+
+
+def read_measured(path, mounts=None) -> MeasuredRunup:
+    """Read measured (or simulated) run-up order curves from CSV or HDF5.
+
+    Parameters
+    ----------
+    path : str or Path
+        Long-format CSV (see module docstring) or run-up HDF5 file.
+    mounts : sequence of str, optional
+        Mount names allowed (those of the model compared with); None accepts any name.
+
+    Returns
+    -------
+    MeasuredRunup
+        Levels in m/s RMS.
+
+    Raises
+    ------
+    InputError
+        One line naming file, line and column.
+    """
+    path = str(path)
+    try:
+        with open(path, "rb") as fh:
+            head = fh.read(8)
+    except OSError as exc:
+        raise InputError(f"cannot read file ({exc.strerror or exc})", file=path) from None
+    if head == _HDF5_SIGNATURE:
+        return _read_hdf5(path, mounts)
+    return _read_csv(path, mounts)
+
+
+def _read_hdf5(path, mounts):
+    from powertrain.results import RunupResult
+    try:
+        result = RunupResult.from_hdf5(path)
+    except KeyError as exc:
+        raise InputError(f"not in the run-up HDF5 layout (missing {exc})", file=path) from None
+    if mounts is not None:
+        for m, _ in result.channels:
+            if m not in mounts:
+                raise InputError(f"unknown mount {m!r} (known: {', '.join(mounts)})",
+                                 file=path, key="channels/mount")
+    for _, d in result.channels:
+        if d not in DIRECTIONS:
+            raise InputError(f"unknown direction {d!r} (expected x, y, z)", file=path,
+                             key="channels/direction")
+    rpm = np.asarray(result.rpm, float)
+    if not np.all(np.isfinite(rpm)) or np.any(rpm <= 0):
+        raise InputError("speeds must be finite and > 0", file=path, key="rpm")
+    if np.unique(rpm).size != rpm.size:
+        raise InputError("duplicate speed", file=path, key="rpm")
+    if not np.all(np.isfinite(result.velocity)):
+        raise InputError("NaN or infinite velocity", file=path, key="velocity/amplitude")
+    return MeasuredRunup.from_result(result, source=path)
+
+
+def _read_csv(path, mounts):
+    try:
+        with open(path, encoding="utf-8") as fh:
+            lines = fh.read().splitlines()
+    except (OSError, UnicodeDecodeError) as exc:
+        raise InputError(f"cannot read file as UTF-8 text ({exc})", file=path) from None
+    comments = []
+    header = None
+    rows = {}          # key -> {rpm: (level, line)}
+    order = []
+    factor = statistic = None
+    level_col = None
+    for lineno, raw in enumerate(lines, start=1):
+        text = raw.strip()
+        if not text:
+            continue
+        if text.startswith("#"):
+            comments.append(text[1:].strip())
+            continue
+        fields = [f.strip() for f in text.split(",")]
+        if header is None:
+            header = fields
+            known = set(KEY_COLUMNS) | set(LEVEL_COLUMNS)
+            for name in header:
+                if name not in known:
+                    raise InputError(
+                        f"unknown column {name!r} (expected {', '.join(KEY_COLUMNS)} and one "
+                        f"level column: {', '.join(LEVEL_COLUMNS)})",
+                        file=path, line=lineno, key=name or "(empty)")
+                if header.count(name) > 1:
+                    raise InputError(f"column {name!r} appears twice", file=path,
+                                     line=lineno, key=name)
+            for name in KEY_COLUMNS:
+                if name not in header:
+                    raise InputError(f"header lacks column {name!r}", file=path, line=lineno,
+                                     key=name)
+            levels = [n for n in header if n in LEVEL_COLUMNS]
+            if len(levels) != 1:
+                raise InputError(
+                    "header needs exactly one level column with its unit "
+                    f"({', '.join(LEVEL_COLUMNS)}); found "
+                    f"{', '.join(levels) if levels else 'none'}",
+                    file=path, line=lineno, key="header")
+            level_col = levels[0]
+            factor, statistic = LEVEL_COLUMNS[level_col]
+            col = {n: i for i, n in enumerate(header)}
+            continue
+        if len(fields) != len(header):
+            raise InputError(f"{len(fields)} fields, header has {len(header)}", file=path,
+                             line=lineno, key=header[min(len(fields), len(header)) - 1])
+        mount = fields[col["mount"]]
+        if not mount or (mounts is not None and mount not in mounts):
+            known_txt = f" (known: {', '.join(mounts)})" if mounts is not None else ""
+            raise InputError(f"unknown mount {mount!r}{known_txt}", file=path, line=lineno,
+                             key="mount")
+        direction = fields[col["direction"]].lower()
+        if direction not in DIRECTIONS:
+            raise InputError(f"unknown direction {fields[col['direction']]!r} "
+                             "(expected x, y or z)", file=path, line=lineno, key="direction")
+        try:
+            quantity = normalise_quantity(fields[col["quantity"]])
+        except ValueError as exc:
+            raise InputError(str(exc), file=path, line=lineno, key="quantity") from None
+        rpm = _number(fields[col["rpm"]], path, lineno, "rpm")
+        if rpm <= 0:
+            raise InputError(f"speed must be > 0, got {rpm:g}", file=path, line=lineno,
+                             key="rpm")
+        level = _number(fields[col[level_col]], path, lineno, level_col)
+        if level < 0:
+            raise InputError(f"negative level {level:g}", file=path, line=lineno,
+                             key=level_col)
+        key = (mount, direction, quantity)
+        if key not in rows:
+            rows[key] = {}
+            order.append(key)
+        if rpm in rows[key]:
+            raise InputError(f"duplicate row: {mount},{direction},{quantity} at {rpm:g} rpm "
+                             f"already on line {rows[key][rpm][1]}", file=path, line=lineno,
+                             key="rpm")
+        rows[key][rpm] = (level, lineno)
+    if header is None:
+        raise InputError("no header line (expected "
+                         "mount,direction,quantity,rpm,velocity_rms_mm_per_s)", file=path)
+    if not rows:
+        raise InputError("no data rows", file=path)
+    scale = factor / (math.sqrt(2.0) if statistic == "peak" else 1.0)
+    curves = {}
+    for key in order:
+        speeds = np.array(sorted(rows[key]))
+        curves[key] = (speeds, np.array([rows[key][r][0] for r in speeds]) * scale)
+    notes = []
+    if statistic == "peak":
+        notes.append(f"levels read from peak column {level_col!r} and converted to RMS by "
+                     "1/sqrt(2) (exact for a sinusoidal order; synthesis read as the "
+                     "root-sum-square of the order peaks)")
+    return MeasuredRunup(curves, source=path, notes=notes, comments=comments)
+
+
+def _number(text, path, line, column):
+    try:
+        value = float(text)
+    except ValueError:
+        raise InputError(f"not a number: {text!r}", file=path, line=line,
+                         key=column) from None
+    if not math.isfinite(value):
+        raise InputError(f"{text!r} is not a finite number", file=path, line=line,
+                         key=column)
+    return value
