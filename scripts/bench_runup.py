@@ -101,7 +101,7 @@ def ivp_run(system, load, h, x0, v0, n_cycle, method, rtol):
         return dz
 
     sol = solve_ivp(rhs, (0, t_grid[-1]), np.concatenate([x0, v0]), method=method,
-                    t_eval=t_grid, rtol=rtol, atol=rtol * 1e-6, jac=A)
+                    t_eval=t_grid, rtol=rtol, atol=rtol * 1e-6, jac=lambda t, z: A)
     if not sol.success:
         raise RuntimeError(sol.message)
     return sol.y[n:].T, sol.nfev
