@@ -145,3 +145,43 @@ def test_results_roundtrip_hdf5_and_csv(tmp_path, runups):
     c = newm.channel_index(first[0], first[1])
     assert float(first[4]) == pytest.approx(
         newm.order_rms()[0, c, newm.order_index(float(first[2][6:]))] * 1e3, rel=1e-7)
+
+
+def _cli(args, cwd):
+    import subprocess
+    import sys
+    return subprocess.run([sys.executable, "-m", "powertrain.cli", *args], cwd=cwd,
+                          capture_output=True, text=True)
+
+
+def test_cli_runup_writes_hdf5_csv_and_plot(tmp_path):
+    r = _cli(["runup", "--from", "1000", "--to", "2000", "--step", "500", "--out", "r.h5",
+              "--csv", "r.csv", "--plot", "r.png", "--quiet"], tmp_path)
+    assert r.returncode == 0, r.stderr
+    back = RunupResult.from_hdf5(tmp_path / "r.h5")
+    np.testing.assert_array_equal(back.rpm, [1000.0, 1500.0, 2000.0])
+    assert (tmp_path / "r.csv").read_text().startswith(
+        "mount,direction,quantity,rpm,velocity_rms_mm_per_s\n")
+    assert (tmp_path / "r.png").stat().st_size > 10_000
+
+
+@pytest.mark.parametrize("edit,key", [
+    (lambda s: s.replace("[body]", "[bodyx]", 1), "body"),
+    (lambda s: s.replace('unit = "kg"', 'unit = "furlong"', 1), "unit"),
+])
+def test_cli_runup_bad_engine_file_one_line_no_output(tmp_path, edit, key):
+    src = DEFAULT_ENGINE_PATH.read_text() if hasattr(DEFAULT_ENGINE_PATH, "read_text") else \
+        open(DEFAULT_ENGINE_PATH).read()
+    bad = tmp_path / "bad.toml"
+    bad.write_text(edit(src))
+    # mount files are referenced relative to the engine file: keep them reachable
+    import shutil
+    from pathlib import Path
+    shutil.copytree(Path(DEFAULT_ENGINE_PATH).parent.parent / "mounts", tmp_path.parent / "mounts",
+                    dirs_exist_ok=True)
+    r = _cli(["runup", "--engine", str(bad), "--out", "r.h5", "--csv", "r.csv", "--quiet"],
+             tmp_path)
+    assert r.returncode == 1
+    lines = r.stderr.strip().splitlines()
+    assert len(lines) == 1 and "bad.toml" in lines[0] and key in lines[0], r.stderr
+    assert not (tmp_path / "r.h5").exists() and not (tmp_path / "r.csv").exists()
