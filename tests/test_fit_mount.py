@@ -43,6 +43,10 @@ RECOVERY_REL_RMS_SMALL = 1e-5
 #: The robustness criterion of scripts/fit_robustness.py: relative RMS error against the
 #: noisy data <= 2 % with 1 % complex noise (the noise alone gives ~1 %).
 ROBUST_REL_RMS = 0.02
+#: ... and the fit follows the curve, not the noise: a 15-parameter least-squares fit to 800
+#: noisy residuals leaves about sqrt(15/800) x 1 % = 0.14 % of the noise-free curve's RMS;
+#: local minima that miss the 200 Hz resonance of the hydraulic Y mount are at >= 1.5 %.
+ROBUST_TRUE_CURVE_REL_RMS = 0.0075
 #: SLS parameters recovered to 1e-4 relative from exact data (identifiable model).
 SLS_PARAMETER_REL = 1e-4
 
@@ -163,7 +167,7 @@ def test_mini_robustness_hydraulic_y(seed):
     res = fit_mount(F, km, "triple-parallel")
     assert res.rel_rms <= ROBUST_REL_RMS, res.summary()
     # and it is a fit of the curve, not of the noise: close to the noise-free curve too
-    assert relative_rms_error(res.kcp_fitted, k) <= ROBUST_REL_RMS
+    assert relative_rms_error(res.kcp_fitted, k) <= ROBUST_TRUE_CURVE_REL_RMS
 
 
 def test_fit_input_validation():

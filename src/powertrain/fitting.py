@@ -68,7 +68,7 @@ HOP_NFEV = 300
 #: Function evaluations of each polishing run.
 POLISH_NFEV = 500
 #: Further function evaluations allowed to the best polished start.
-FINAL_NFEV = 2000
+FINAL_NFEV = 1000
 
 _DISPLACEMENT = 1e-3  # eq. 18-19: 1 mm displacement [m]
 
