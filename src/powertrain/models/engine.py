@@ -65,10 +65,8 @@ class RigidBody:
 
     def mass_matrix(self) -> np.ndarray:
         """6×6 mass matrix for ``[x, y, z, rx, ry, rz]`` at the CG [kg, kg·m²]."""
-        m = np.zeros((6, 6))
-        m[:3, :3] = self.mass * np.eye(3)
-        m[3:, 3:] = self.inertia
-        return m
+        from powertrain.physics.rigid_body import rigid_body_mass_matrix
+        return rigid_body_mass_matrix(self.mass, self.inertia)
 
 
 @dataclass(frozen=True, eq=False)
@@ -94,11 +92,6 @@ class MountSpec:
     rotation: np.ndarray
     directions: dict
     files: dict = field(default_factory=dict)
-
-    def static_stiffness_matrix(self) -> np.ndarray:
-        """3×3 static stiffness in engine axes [N/m]: :math:`R\\,\\mathrm{diag}(k_x,k_y,k_z)R^T`."""
-        k = np.diag([self.directions[d].static_stiffness() for d in "xyz"])
-        return self.rotation @ k @ self.rotation.T
 
 
 @dataclass(frozen=True, eq=False)
@@ -633,23 +626,10 @@ class Engine:
                                     for j in range(6)])
         return f
 
-    def static_stiffness_matrix(self) -> np.ndarray:
-        """6×6 stiffness of the mounts at the CG from each direction's static stiffness.
-
-        :math:`K = \\sum_m B_m^T K_m B_m` with :math:`B_m = [I, -\\widetilde{(p_m - c)}]`,
-        the mount-point displacement for small rotations [N/m, N, N·m/rad].
-        """
-        K = np.zeros((6, 6))
-        for m in self.mounts:
-            d = m.position - self.body.cg
-            skew = np.array([[0, -d[2], d[1]], [d[2], 0, -d[0]], [-d[1], d[0], 0]])
-            B = np.hstack([np.eye(3), -skew])
-            K += B.T @ m.static_stiffness_matrix() @ B
-        return K
-
     def rigid_body_modes(self):
-        """Natural frequencies [Hz] and mode shapes of the powertrain on the static mount
-        stiffness (undamped, rigid chassis): :math:`K\\phi = \\omega^2 M\\phi`."""
-        from scipy.linalg import eigh
-        w2, vec = eigh(self.static_stiffness_matrix(), self.body.mass_matrix())
-        return np.sqrt(np.clip(w2, 0.0, None)) / (2 * np.pi), vec
+        """Natural frequencies [Hz] and mode shapes of the powertrain on its mounts' static
+        stiffness (undamped, rigid chassis); see
+        :meth:`powertrain.assembly.AssembledSystem.rigid_body_modes`."""
+        from powertrain.assembly import assemble
+        b = self.body
+        return assemble(b.mass, b.cg, b.inertia, self.mounts).rigid_body_modes()
