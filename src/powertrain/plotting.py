@@ -306,3 +306,98 @@ def plot_mount_fit(frequency_hz, kcp_measured, kcp_fitted, *, label="fit", title
         fig.tight_layout()
         save_figure(fig, path)
     return ax
+
+
+def plot_whatif(whatif, path=None):
+    """Baseline, variants and measurement overlaid: RMS velocity [mm/s] (or the signal of
+    ``whatif.signal``) against speed.
+
+    One row per mount and direction, one column per quantity of ``whatif.quantities``
+    (synthesis, 2nd and 4th order by default); the baseline black, each variant in colour
+    with its mean change [dB] in the legend of the first row, the measurement (when given)
+    as grey dots.
+
+    Parameters
+    ----------
+    whatif : powertrain.whatif.WhatIfResult
+    path : str, optional
+        PNG written atomically.
+    """
+    import numpy as np
+    plt = _pyplot()
+    base = whatif.baseline
+    signal = getattr(whatif, "signal", "velocity")
+    scale, unit = {"velocity": (1e3, "mm/s"), "mount_force": (1.0, "N"),
+                   "displacement": (1e6, "µm"), "acceleration": (1.0, "m/s²")}[signal]
+    rows = base.channels
+    quantities = whatif.quantities
+    fig, axes = plt.subplots(len(rows), len(quantities),
+                             figsize=(4 * len(quantities), 1.9 * len(rows)),
+                             sharex=True, squeeze=False)
+    for r, (mount, direction) in enumerate(rows):
+        for q, quantity in enumerate(quantities):
+            ax = axes[r, q]
+            if whatif.measured is not None and signal == "velocity":
+                try:
+                    rpm_m, lev_m = whatif.measured.curve(mount, direction, quantity)
+                    ax.semilogy(rpm_m, lev_m * 1e3, ".", color="0.55", ms=3,
+                                label="measured")
+                except KeyError:
+                    pass
+            ax.semilogy(base.rpm, base.curve(mount, direction, quantity, signal) * scale, "k-", lw=1.6,
+                        label="baseline")
+            for v in whatif.variants:
+                d = whatif.delta_db(v.name, mount, direction, quantity)
+                mean = float(np.nanmean(d)) if np.isfinite(d).any() else float("nan")
+                ax.semilogy(v.result.rpm, v.result.curve(mount, direction, quantity, signal) * scale,
+                            "o-", ms=2.5, lw=1.1, label=f"{v.name} ({mean:+.2f} dB)")
+            title = "synthesis (orders ≤ 8)" if quantity == "synthesis" else \
+                quantity.replace("order_", "order ")
+            ax.set_title(f"{mount} {direction.upper()} — {title}", fontsize=8)
+            ax.grid(True, which="both", alpha=0.3)
+            ax.tick_params(labelsize=7)
+            ax.legend(fontsize=5.5, loc="best")
+            if q == 0:
+                ax.set_ylabel(f"RMS {signal.replace('_', ' ')} [{unit}]", fontsize=7)
+    for ax in axes[-1]:
+        ax.set_xlabel("engine speed [rpm]", fontsize=8)
+    fig.suptitle("what-if: baseline vs variants (legend: mean change over the speed steps)",
+                 fontsize=9)
+    fig.tight_layout()
+    if path:
+        save_figure(fig, path)
+    return fig
+
+
+def plot_retune(target_fit, path=None):
+    """Baseline, requested and fitted K_CP of a retune target: |K| [N/mm] and phase [deg].
+
+    Parameters
+    ----------
+    target_fit : powertrain.retune.TargetFit
+    path : str, optional
+        PNG written atomically.
+    """
+    import numpy as np
+    plt = _pyplot()
+    tf = target_fit
+    f = tf.frequency_hz[1:]
+    fig, (ax1, ax2) = plt.subplots(2, 1, figsize=(7, 6), sharex=True)
+    for k, style, label in ((tf.kcp_baseline, "k-", "baseline"),
+                            (tf.kcp_target, "C1--", "requested"),
+                            (tf.kcp_fitted, "C0-", f"fitted {tf.model.topology.name}")):
+        ax1.loglog(f, np.abs(k[1:]) / 1e3, style, lw=1.3, label=label)
+        ax2.semilogx(f, np.degrees(np.angle(k[1:])), style, lw=1.3, label=label)
+    for ax in (ax1, ax2):
+        ax.axvspan(tf.target.f_lo, tf.target.f_hi, color="0.9", zorder=0)
+        ax.grid(True, which="both", alpha=0.3)
+    ax1.set_ylabel("|K_CP| [N/mm]")
+    ax2.set_ylabel("loss angle [deg]")
+    ax2.set_xlabel("frequency [Hz]")
+    ax1.legend(fontsize=8)
+    ax1.set_title(f"{tf.target.spec}: max error in band {100 * tf.max_band_error:.1f} %, "
+                  f"mean change {100 * tf.mean_band_change:+.1f} %", fontsize=9)
+    fig.tight_layout()
+    if path:
+        save_figure(fig, path)
+    return fig

@@ -1,0 +1,152 @@
+"""``powertrain whatif``: baseline vs variants of the mount system, change in dB."""
+
+from __future__ import annotations
+
+import click
+
+from powertrain.cli import main
+
+
+@main.command()
+@click.option("--engine", "engine_file", type=click.Path(dir_okay=False),
+              help="Engine file (default: the shipped engines/default.toml).")
+@click.option("--from", "rpm_from", type=float, default=1000.0, show_default=True,
+              help="First speed step [rpm].")
+@click.option("--to", "rpm_to", type=float, default=6000.0, show_default=True,
+              help="Last speed step [rpm].")
+@click.option("--step", "rpm_step", type=float, default=500.0, show_default=True,
+              help="Speed step [rpm].")
+@click.option("--solver", type=click.Choice(["harmonic", "newmark"]), default="harmonic",
+              show_default=True,
+              help="harmonic: exact steady state of the linear model, fast; newmark: time "
+                   "integration as in `runup`.")
+@click.option("--scale", multiple=True, metavar="MOUNT.DIR.KIND=FACTOR",
+              help="Scale springs (stiffness), dampers (damping) or c, d and m together "
+                   "(dynamic: K_CP(f) x FACTOR); MOUNT/DIR may be *. Repeatable.")
+@click.option("--set", "set_", multiple=True, metavar="MOUNT.DIR.PARAM=VALUE",
+              help="Set one parameter in its datasheet unit (c N/mm, d N*s/mm, m kg) or an "
+                   "explicit unit (150N/mm). Repeatable.")
+@click.option("--swap", multiple=True, metavar="MOUNT.DIR=FILE.toml",
+              help="Replace one direction's model by a mount file. Repeatable.")
+@click.option("--move", multiple=True, metavar="MOUNT=DX,DY,DZ",
+              help="Shift a mount point [mm, engine axes]. Repeatable.")
+@click.option("--rotate", multiple=True, metavar="MOUNT=AX,AY,AZ",
+              help="Rotate a mount's axes about engine X, then Y, then Z [deg]. Repeatable.")
+@click.option("--variants", "variants_file", type=click.Path(dir_okay=False),
+              help="TOML file of named variants ([[variant]] name = ..., scale = [...], ...).")
+@click.option("--target", multiple=True, metavar="MOUNT.DIR:CHANGE:BAND[:WIDTH]",
+              help="Retune to a K_CP change over a band, e.g. left.z:+20%:100-300Hz "
+                   "(blend 0.5 octave outside, or :1oct); each target is its own variant.")
+@click.option("--target-out", type=click.Path(dir_okay=False),
+              help="Write the fitted mount file of the (single) target.")
+@click.option("--target-plot", type=click.Path(dir_okay=False),
+              help="PNG of baseline, requested and fitted K_CP of the (single) target.")
+@click.option("--measured", "measured_file", type=click.Path(dir_okay=False),
+              help="Measured run-up (CSV or HDF5, as for `compare`) to overlay.")
+@click.option("--plot", type=click.Path(dir_okay=False),
+              help="PNG overlay of baseline, variants (and measurement).")
+@click.option("--json", "json_file", type=click.Path(dir_okay=False),
+              help="Write the changes as JSON.")
+@click.option("--signal", type=click.Choice(["velocity", "mount_force"]), default="velocity",
+              show_default=True,
+              help="Compared signal: mount-point velocity or force transmitted to ground.")
+@click.option("--workers", type=int, default=None,
+              help="Processes for the variants (default: all local cores; 1 = serial).")
+@click.option("--quiet", is_flag=True, help="No progress bar and no table.")
+def whatif(engine_file, rpm_from, rpm_to, rpm_step, solver, scale, set_, swap, move, rotate,
+           variants_file, target, target_out, target_plot, measured_file, plot, json_file,
+           signal, workers, quiet):
+    """What-if: run the baseline and variants of the mount system, print the change in dB.
+
+    The command-line operations (--scale/--set/--swap/--move/--rotate) form one variant,
+    "command line"; each --target is a variant of its own; --variants adds the variants of
+    a file. For each channel (mount x engine X/Y/Z) and quantity (synthesis, 2nd, 4th order)
+    the change 20 log10(v_variant/v_baseline) is averaged over the speed steps (mean) and
+    its largest magnitude reported (max|d|).
+
+    \b
+    Examples:
+      powertrain whatif --scale left.z.stiffness=1.2
+      powertrain whatif --scale "*.*.dynamic=0.9" --set right.y.c2=150 --json out.json
+      powertrain whatif --move gearbox=0,0,10 --rotate left=0,0,5 --plot whatif.png
+      powertrain whatif --target left.z:+20%:100-300Hz --target-out left-z-retuned.toml
+      powertrain whatif --variants variants.toml --measured measured.csv --plot w.png
+    """
+    from powertrain.errors import InputError
+    from powertrain.iotools.engine_file import DEFAULT_ENGINE_PATH, read_engine
+    from powertrain.runup import default_rpm
+    from powertrain.variants import (Origin, Variant, check_operations, parse_operations,
+                                     parse_target, read_variants)
+
+    if not (rpm_from > 0 and rpm_to >= rpm_from and rpm_step > 0):
+        raise InputError("need 0 < --from <= --to and --step > 0", key="--from/--to/--step")
+    if workers is not None and workers < 1:
+        raise InputError("must be >= 1", key="--workers")
+    engine = read_engine(engine_file or DEFAULT_ENGINE_PATH)
+    lo, hi = engine.speed_range_rpm()
+    rpm = default_rpm(rpm_from, rpm_to, rpm_step)
+    if rpm[0] < lo - 1e-6 or rpm[-1] > hi + 1e-6:
+        raise InputError(f"speeds outside the engine model's range {lo:g}..{hi:g} rpm",
+                         key="--from/--to")
+
+    variants = []
+    ops = parse_operations({"scale": scale, "set": set_, "swap": swap, "move": move,
+                            "rotate": rotate})
+    if ops:
+        variants.append(Variant("command line", ops))
+    for text in target:
+        op = parse_target(text, Origin("--target"))
+        variants.append(Variant(f"target {text}", (op,)))
+    if variants_file:
+        variants += read_variants(variants_file)
+    if not variants:
+        raise InputError("no variant given (use --scale, --set, --swap, --move, --rotate, "
+                         "--target or --variants)", key="--variants")
+    names = [v.name for v in variants]
+    dup = sorted({n for n in names if names.count(n) > 1})
+    if dup:
+        raise InputError(f"duplicate variant name {dup[0]!r}", file=variants_file,
+                         key="variant.name")
+    for v in variants:
+        check_operations(engine, v.operations)
+    n_targets = sum(len(v.targets) for v in variants)
+    for opt, value in (("--target-out", target_out), ("--target-plot", target_plot)):
+        if value and n_targets != 1:
+            raise InputError(f"needs exactly one target, {n_targets} given", key=opt)
+    measured = None
+    if measured_file:
+        from powertrain.iotools.measured import read_measured
+        measured = read_measured(measured_file, mounts=engine.mount_names)
+
+    from powertrain.whatif import run_whatif
+    result = run_whatif(engine, variants, rpm, solver=solver, workers=workers,
+                        measured=measured, signal=signal, progress=not quiet)
+
+    written = []
+    if target_out:
+        from powertrain.iotools.mount_file import write_mount
+        tf = result.target_fits[0]
+        write_mount(tf.model, target_out, comment=f"powertrain whatif: {tf.summary()}")
+        written.append(target_out)
+    if target_plot:
+        result.target_fits[0].plot(target_plot)
+        written.append(target_plot)
+    if json_file:
+        result.to_json(json_file)
+        written.append(json_file)
+    if plot:
+        result.plot(plot)
+        written.append(plot)
+    if quiet:
+        return
+    modes = ", ".join(f"{f:.2f}" for f in result.baseline.rigid_body_modes_hz)
+    click.echo(f"baseline: {engine.name} ({engine.file}), solver {solver}, "
+               f"{rpm[0]:g}-{rpm[-1]:g} rpm step {rpm_step:g}")
+    click.echo(f"baseline rigid-body modes [Hz]: {modes}")
+    for tf in result.target_fits:
+        click.echo(tf.summary())
+    click.echo(f"change of RMS {signal.replace('_', ' ')} vs baseline, 20 log10(v/v0) [dB]: "
+               "mean over speeds / max |d|")
+    click.echo(result.table())
+    if written:
+        click.echo(f"wrote {', '.join(written)}")

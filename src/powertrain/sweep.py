@@ -1,0 +1,138 @@
+"""The sweep engine: run many run-up variants on any executor.
+
+A :class:`SweepTask` is a small picklable description -- baseline engine, the variant's
+operations (:mod:`powertrain.variants`, targets already resolved), speeds, solver -- and
+:func:`run_task` turns it into a :class:`~powertrain.results.RunupResult` in whatever process
+runs it (it applies the operations there, so only the description travels).
+:func:`run_sweep` hands the tasks to an *executor*: anything with the
+:class:`concurrent.futures.Executor` method ``submit(fn, *args) -> future`` whose futures have
+``result()``. Only ``submit`` and ``result`` are used (not ``map``, whose return type differs
+between libraries), results come back in task order.
+
+* default: :class:`concurrent.futures.ProcessPoolExecutor` on the local cores
+  (``workers`` processes, default ``os.cpu_count()``), created and shut down here;
+* ``workers=1`` (or a single task): :class:`SerialExecutor`, in this process;
+* a distributed engine: pass its client, e.g. Dask::
+
+      from distributed import Client
+      client = Client("tcp://scheduler:8786")    # or Client() for a local cluster
+      results = run_sweep(tasks, executor=client)
+
+  ``distributed.Client.submit(fn, *args)`` returns a future with ``.result()``, which is all
+  :func:`run_sweep` needs; the workers must have ``powertrain`` installed. An executor passed
+  in is not shut down. Nothing in the model knows which executor runs it.
+
+BLAS inside :func:`powertrain.runup.run_runup` is limited to one thread, so one process per
+core does not oversubscribe.
+"""
+
+from __future__ import annotations
+
+import os
+from concurrent.futures import Future
+from dataclasses import dataclass, field
+
+import numpy as np
+
+
+@dataclass(frozen=True)
+class SweepTask:
+    """One run-up of one variant.
+
+    Attributes
+    ----------
+    name : str
+        Variant name (``baseline`` for no operation).
+    engine : Engine
+        Baseline engine.
+    operations : tuple
+        Operations of :mod:`powertrain.variants` applied in order (no unresolved targets).
+    rpm : ndarray
+        Speed steps [rpm].
+    solver : {"harmonic", "newmark"}
+    options : dict
+        Further keyword arguments of :func:`powertrain.runup.run_runup`
+        (``angle_step_deg``...).
+    """
+
+    name: str
+    engine: object
+    operations: tuple = ()
+    rpm: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    solver: str = "harmonic"
+    options: dict = field(default_factory=dict)
+
+
+def run_task(task: SweepTask):
+    """Apply the task's operations to its engine and run the run-up.
+
+    Returns
+    -------
+    RunupResult
+        ``meta["variant"]`` holds the task name.
+    """
+    from powertrain.runup import run_runup
+    from powertrain.variants import apply_operations
+    engine = apply_operations(task.engine, task.operations)
+    result = run_runup(engine, task.rpm, solver=task.solver, **task.options)
+    result.meta["variant"] = task.name
+    return result
+
+
+class SerialExecutor:
+    """Runs each submitted call at once in this process (the ``workers=1`` executor)."""
+
+    def submit(self, fn, *args, **kwargs) -> Future:
+        fut: Future = Future()
+        try:
+            fut.set_result(fn(*args, **kwargs))
+        except BaseException as exc:  # delivered by result(), as a pool would
+            fut.set_exception(exc)
+        return fut
+
+
+def default_workers() -> int:
+    """Local cores (``os.cpu_count()``, at least 1)."""
+    return max(1, os.cpu_count() or 1)
+
+
+def run_sweep(tasks, executor=None, *, workers: int | None = None, progress: bool = False):
+    """Run the tasks, return their results in task order.
+
+    Parameters
+    ----------
+    tasks : sequence of SweepTask
+    executor : object with ``submit``, optional
+        Default: a process pool of ``workers`` processes (serial when ``workers == 1`` or
+        one task), shut down on return. Any given executor (a Dask ``distributed.Client``,
+        a ``ThreadPoolExecutor``...) is used as is and left running.
+    workers : int, optional
+        Processes of the default pool (default :func:`default_workers`).
+    progress : bool
+        Progress bar over the tasks.
+
+    Returns
+    -------
+    list of RunupResult
+    """
+    tasks = list(tasks)
+    if workers is not None and workers < 1:
+        raise ValueError("workers must be >= 1")
+    own = None
+    if executor is None:
+        n = min(workers or default_workers(), len(tasks))
+        if n <= 1:
+            executor = SerialExecutor()
+        else:
+            from concurrent.futures import ProcessPoolExecutor
+            executor = own = ProcessPoolExecutor(max_workers=n)
+    try:
+        futures = [executor.submit(run_task, t) for t in tasks]
+        iterator = futures
+        if progress:
+            from tqdm import tqdm
+            iterator = tqdm(futures, desc="variants", unit="run-up", leave=False)
+        return [f.result() for f in iterator]
+    finally:
+        if own is not None:
+            own.shutdown(cancel_futures=True)

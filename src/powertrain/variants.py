@@ -1,0 +1,609 @@
+r"""Variants of the mount system: parse spec strings into operations, apply them to an Engine.
+
+Three layers, all pure (nothing is mutated; every ``apply`` returns a new
+:class:`~powertrain.models.engine.Engine`):
+
+1. **parse** -- :func:`parse_scale`, :func:`parse_set`, :func:`parse_swap`, :func:`parse_move`,
+   :func:`parse_rotate`, :func:`parse_target` turn one spec string (command-line option or
+   variants-file entry) into an operation object; syntax errors raise
+   :class:`~powertrain.errors.InputError` naming the option (or file, line and key);
+2. **operations** -- frozen, picklable dataclasses (:class:`Scale`, :class:`SetParameter`,
+   :class:`Swap`, :class:`Move`, :class:`Rotate`, :class:`Target`) holding SI values and
+   the spec they came from;
+3. **apply** -- :func:`apply_operations` applies a sequence in order; unknown mount,
+   direction or parameter names raise :class:`InputError` naming where the spec came from.
+
+Spec syntax (``MOUNT`` a mount name of the engine or ``*``; ``DIR`` a local direction of the
+mount, ``x``, ``y``, ``z`` or ``*``; the default engine's mounts are ``left``, ``right``,
+``gearbox`` with local axes parallel to the engine axes):
+
+=========================================  ==================================================
+``--scale MOUNT.DIR.KIND=FACTOR``          ``KIND``: ``stiffness`` (every spring c_i of the
+                                           network times FACTOR), ``damping`` (every damper
+                                           d_i), ``dynamic`` (every c_i, d_i and m_i: the
+                                           whole K_CP(ω) times FACTOR, exactly); FACTOR > 0
+``--set MOUNT.DIR.PARAM=VALUE[UNIT]``      one network parameter in its datasheet unit
+                                           (c in N/mm, d in N·s/mm, m in kg, the table
+                                           :data:`powertrain.iotools.mount_file.DATASHEET_UNITS`)
+                                           or in an explicit unit of :mod:`powertrain.units`
+                                           (``150N/mm``, ``1.5e5 N/m``); VALUE >= 0
+``--swap MOUNT.DIR=FILE.toml``             replace one direction's model by a mount file
+``--move MOUNT=DX,DY,DZ``                  shift the mount point [mm], engine axes
+``--rotate MOUNT=AX,AY,AZ``                rotate the mount's local axes about the engine
+                                           axes through the mount point [deg]: first AX
+                                           about X, then AY about Y, then AZ about Z (fixed
+                                           axes), :math:`R' = R_z R_y R_x R`
+``--target MOUNT.DIR:CHANGE:BAND[:WIDTH]`` retune to a desired K_CP change, see
+                                           :mod:`powertrain.retune`
+=========================================  ==================================================
+
+What "scale stiffness" means for a lumped network
+-------------------------------------------------
+A mount direction is a network of springs :math:`c_i`, dampers :math:`d_i` and internal
+masses :math:`m_i`. ``stiffness`` scales every :math:`c_i` by :math:`s`: the static
+stiffness :math:`K_{CP}(0)` (a function of the springs only, homogeneous of degree one in
+them) is scaled by exactly :math:`s`, and so is every rigid-body mode frequency's square
+when all mounts are scaled; at higher frequency :math:`K_{CP}(\omega)` is *not* simply
+scaled: the internal resonances move by :math:`\sqrt s` (masses unchanged) and the dampers
+weigh less (:math:`s>1`) or more. ``dynamic`` scales :math:`c_i, d_i, m_i` together:
+the dynamic stiffness matrix :math:`-\omega^2 M + i\omega C + K` of the network is scaled
+by :math:`s`, the internal motion per unit engine-side motion is unchanged, so
+:math:`K_{CP}(\omega)` is :math:`s` times the baseline at every frequency
+(:meth:`~powertrain.models.mount.MountModel.scaled_dynamic_stiffness`) -- the variant a
+supplier delivers with "20 % stiffer, same characteristic".
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+import re
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from powertrain.errors import InputError
+
+#: Scale kinds and what each scales.
+SCALE_KINDS = {"stiffness": "every spring c_i", "damping": "every damper d_i",
+               "dynamic": "every c_i, d_i and m_i (K_CP(omega) times the factor)"}
+WILDCARD = "*"
+_NAME = r"[A-Za-z_][A-Za-z0-9_\-]*"
+
+
+@dataclass(frozen=True)
+class Origin:
+    """Where a spec came from, for error messages.
+
+    Attributes
+    ----------
+    key : str
+        Command-line option (``--scale``) or variants-file key (``variant[2].scale``).
+    file : str or None
+        Variants file.
+    line : int or None
+        1-based line in ``file``.
+    """
+
+    key: str
+    file: str | None = None
+    line: int | None = None
+
+    def error(self, message: str) -> InputError:
+        """An :class:`InputError` located here."""
+        return InputError(message, file=self.file, key=self.key, line=self.line)
+
+
+@dataclass(frozen=True)
+class Scale:
+    """Scale springs, dampers or the whole network of matching mount directions.
+
+    Attributes
+    ----------
+    mount, direction : str
+        Names or ``*``.
+    kind : {"stiffness", "damping", "dynamic"}
+    factor : float
+        > 0 [1].
+    """
+
+    mount: str
+    direction: str
+    kind: str
+    factor: float
+    spec: str = ""
+    origin: Origin = Origin("--scale")
+
+    def apply(self, engine):
+        def change(model):
+            if self.kind == "stiffness":
+                return model.scaled(stiffness=self.factor)
+            if self.kind == "damping":
+                return model.scaled(damping=self.factor)
+            return model.scaled_dynamic_stiffness(self.factor)
+        return _map_directions(engine, self.mount, self.direction, change, self.origin)
+
+
+@dataclass(frozen=True)
+class SetParameter:
+    """Set one parameter of matching mount directions.
+
+    Attributes
+    ----------
+    mount, direction : str
+        Names or ``*``.
+    parameter : str
+        ``c2``, ``d4``, ``m1``...
+    value : float
+        SI value: [N/m], [N·s/m] or [kg].
+    """
+
+    mount: str
+    direction: str
+    parameter: str
+    value: float
+    spec: str = ""
+    origin: Origin = Origin("--set")
+
+    def apply(self, engine):
+        def change(model):
+            if self.parameter not in model.topology.parameters:
+                raise self.origin.error(
+                    f"{self.spec!r}: model {model.topology.name!r} has no parameter "
+                    f"{self.parameter!r} (expected {', '.join(model.topology.parameters)})")
+            return model.with_params(**{self.parameter: self.value})
+        return _map_directions(engine, self.mount, self.direction, change, self.origin)
+
+
+@dataclass(frozen=True)
+class Swap:
+    """Replace one mount direction's model.
+
+    Attributes
+    ----------
+    mount, direction : str
+    model : MountModel
+        The new model (SI).
+    path : str
+        Mount file it was read from (or a description).
+    """
+
+    mount: str
+    direction: str
+    model: object
+    path: str = ""
+    spec: str = ""
+    origin: Origin = Origin("--swap")
+
+    def apply(self, engine):
+        new = _map_directions(engine, self.mount, self.direction, lambda m: self.model,
+                              self.origin)
+        mounts = [dataclasses.replace(m, files={**m.files, self.direction: self.path})
+                  if m.name == self.mount else m for m in new.mounts]
+        return new.replace(mounts=mounts)
+
+
+@dataclass(frozen=True)
+class Move:
+    """Shift matching mount points.
+
+    Attributes
+    ----------
+    mount : str
+        Name or ``*``.
+    offset : tuple of float
+        (dx, dy, dz) in engine axes [m].
+    """
+
+    mount: str
+    offset: tuple
+    spec: str = ""
+    origin: Origin = Origin("--move")
+
+    def apply(self, engine):
+        d = np.asarray(self.offset, float)
+        return _map_mounts(engine, self.mount, lambda m: dataclasses.replace(
+            m, position=np.asarray(m.position, float) + d), self.origin)
+
+
+@dataclass(frozen=True)
+class Rotate:
+    """Rotate matching mounts' local axes about the engine axes through the mount point.
+
+    Attributes
+    ----------
+    mount : str
+        Name or ``*``.
+    angles : tuple of float
+        (ax, ay, az) [rad]: first ax about engine X, then ay about Y, then az about Z.
+    """
+
+    mount: str
+    angles: tuple
+    spec: str = ""
+    origin: Origin = Origin("--rotate")
+
+    def matrix(self) -> np.ndarray:
+        """:math:`R_z(a_z) R_y(a_y) R_x(a_x)` (fixed engine axes)."""
+        return rotation_matrix(*self.angles)
+
+    def apply(self, engine):
+        R = self.matrix()
+        return _map_mounts(engine, self.mount, lambda m: dataclasses.replace(
+            m, rotation=R @ np.asarray(m.rotation, float)), self.origin)
+
+
+@dataclass(frozen=True)
+class Target:
+    """A desired change of a mount direction's K_CP over a band (resolved by fitting, see
+    :func:`powertrain.retune.retune`; cannot be applied directly).
+
+    Attributes
+    ----------
+    mount, direction : str
+    factor : float
+        Desired K_CP ratio inside the band (1.2 for ``+20%``) [1], > 0.
+    f_lo, f_hi : float
+        Band [Hz], 0 < f_lo < f_hi.
+    blend_octaves : float
+        Width of the smooth transition outside the band [octaves] (default 0.5).
+    """
+
+    mount: str
+    direction: str
+    factor: float
+    f_lo: float
+    f_hi: float
+    blend_octaves: float = 0.5
+    spec: str = ""
+    origin: Origin = Origin("--target")
+
+    def apply(self, engine):
+        raise TypeError("a Target must be resolved by powertrain.retune.resolve_targets first")
+
+    def check(self, engine) -> None:
+        """Raise :class:`InputError` if the mount or direction is unknown."""
+        _map_directions(engine, self.mount, self.direction, lambda m: m, self.origin)
+
+
+@dataclass(frozen=True)
+class Variant:
+    """A named sequence of operations applied in order to the baseline engine."""
+
+    name: str
+    operations: tuple = ()
+    origin: Origin | None = None
+
+    @property
+    def specs(self) -> list:
+        return [op.spec for op in self.operations]
+
+    @property
+    def targets(self) -> list:
+        return [op for op in self.operations if isinstance(op, Target)]
+
+
+# --------------------------------------------------------------------------- geometry
+def rotation_matrix(ax: float, ay: float, az: float) -> np.ndarray:
+    """:math:`R_z(a_z) R_y(a_y) R_x(a_x)`: rotations about the fixed X, Y, Z axes [rad]."""
+    cx, sx, cy, sy, cz, sz = (math.cos(ax), math.sin(ax), math.cos(ay), math.sin(ay),
+                              math.cos(az), math.sin(az))
+    rx = np.array([[1, 0, 0], [0, cx, -sx], [0, sx, cx]])
+    ry = np.array([[cy, 0, sy], [0, 1, 0], [-sy, 0, cy]])
+    rz = np.array([[cz, -sz, 0], [sz, cz, 0], [0, 0, 1]])
+    return rz @ ry @ rx
+
+
+# --------------------------------------------------------------------------- apply
+def _map_mounts(engine, mount, change, origin):
+    names = engine.mount_names
+    if mount != WILDCARD and mount not in names:
+        raise origin.error(f"unknown mount {mount!r} (expected {', '.join(names)} or *)")
+    mounts = [change(m) if mount in (WILDCARD, m.name) else m for m in engine.mounts]
+    return engine.replace(mounts=mounts)
+
+
+def _map_directions(engine, mount, direction, change, origin):
+    def per_mount(m):
+        dirs = list(m.directions)
+        if direction != WILDCARD and direction not in dirs:
+            raise origin.error(f"unknown direction {direction!r} of mount {m.name!r} "
+                               f"(expected {', '.join(dirs)} or *)")
+        new = {d: change(model) if direction in (WILDCARD, d) else model
+               for d, model in m.directions.items()}
+        return dataclasses.replace(m, directions=new)
+    return _map_mounts(engine, mount, per_mount, origin)
+
+
+def apply_operations(engine, operations):
+    """Apply operations in order; returns a new Engine (``engine`` is not changed).
+
+    Parameters
+    ----------
+    engine : Engine
+    operations : sequence of operation objects (not :class:`Target`; resolve those first)
+
+    Raises
+    ------
+    InputError
+        Unknown mount, direction or parameter, named with the spec's origin.
+    """
+    for op in operations:
+        engine = op.apply(engine)
+    return engine
+
+
+def check_operations(engine, operations) -> None:
+    """Validate names of every operation against ``engine`` (targets included)."""
+    for op in operations:
+        if isinstance(op, Target):
+            op.check(engine)
+        else:
+            engine = op.apply(engine)
+
+
+# --------------------------------------------------------------------------- parse
+def _split(text: str, origin: Origin, form: str):
+    if not isinstance(text, str) or text.count("=") != 1:
+        raise origin.error(f"cannot read {text!r} (expected {form})")
+    left, right = (s.strip() for s in text.split("="))
+    if not left or not right:
+        raise origin.error(f"cannot read {text!r} (expected {form})")
+    return left, right
+
+
+def _path_parts(left, n, text, origin, form, wildcard=True):
+    parts = left.split(".")
+    pattern = re.compile(rf"^(\*|{_NAME})$" if wildcard else rf"^{_NAME}$")
+    if len(parts) != n or not all(pattern.match(p) for p in parts):
+        raise origin.error(f"cannot read {text!r} (expected {form})")
+    return parts
+
+
+def _direction(d, text, origin):
+    if d not in ("x", "y", "z", WILDCARD):
+        raise origin.error(f"{text!r}: unknown direction {d!r} (expected x, y, z or *)")
+    return d
+
+
+def _float(s, text, origin, what="a number"):
+    try:
+        v = float(s)
+    except ValueError:
+        raise origin.error(f"{text!r}: {s!r} is not {what}") from None
+    if not math.isfinite(v):
+        raise origin.error(f"{text!r}: {s!r} is not finite")
+    return v
+
+
+def _vector3(s, text, origin):
+    parts = s.split(",")
+    if len(parts) != 3:
+        raise origin.error(f"{text!r}: expected three comma-separated numbers")
+    return tuple(_float(p.strip(), text, origin) for p in parts)
+
+
+def parse_scale(text: str, origin: Origin = Origin("--scale")) -> Scale:
+    """``MOUNT.DIR.KIND=FACTOR`` -> :class:`Scale` (KIND stiffness|damping|dynamic)."""
+    form = "MOUNT.DIR.KIND=FACTOR, e.g. left.z.stiffness=1.2"
+    left, right = _split(text, origin, form)
+    mount, direction, kind = _path_parts(left, 3, text, origin, form)
+    _direction(direction, text, origin)
+    if kind not in SCALE_KINDS:
+        raise origin.error(f"{text!r}: unknown kind {kind!r} (expected "
+                           f"{', '.join(SCALE_KINDS)})")
+    factor = _float(right, text, origin, "a factor")
+    if factor <= 0:
+        raise origin.error(f"{text!r}: factor must be positive, got {factor:g}")
+    return Scale(mount, direction, kind, factor, spec=text, origin=origin)
+
+
+def parse_set(text: str, origin: Origin = Origin("--set")) -> SetParameter:
+    """``MOUNT.DIR.PARAM=VALUE[UNIT]`` -> :class:`SetParameter` (SI value).
+
+    Without a unit the parameter family's datasheet unit applies (c: N/mm, d: N·s/mm, m: kg).
+    """
+    from powertrain.iotools.mount_file import DATASHEET_UNITS
+    from powertrain.units import UNITS, to_si
+    form = "MOUNT.DIR.PARAM=VALUE, e.g. right.y.c2=150 (N/mm)"
+    left, right = _split(text, origin, form)
+    mount, direction, param = _path_parts(left, 3, text, origin, form)
+    _direction(direction, text, origin)
+    if not re.match(r"^[cdm][0-9]+$", param):
+        raise origin.error(f"{text!r}: unknown parameter {param!r} (expected c<n>, d<n> "
+                           "or m<n>)")
+    m = re.match(r"^([-+0-9.eE]+)\s*(.*)$", right)
+    if not m:
+        raise origin.error(f"{text!r}: {right!r} is not a number")
+    value = _float(m.group(1), text, origin)
+    unit = m.group(2).strip() or DATASHEET_UNITS[param[0]]
+    if value < 0:
+        raise origin.error(f"{text!r}: value must not be negative, got {value:g}")
+    dimension = {"c": "stiffness", "d": "damping", "m": "mass"}[param[0]]
+    if unit not in UNITS:
+        raise origin.error(f"{text!r}: unknown unit {unit!r}")
+    try:
+        si = float(to_si(value, unit, dimension))
+    except InputError as exc:
+        raise origin.error(f"{text!r}: {exc.message}") from None
+    return SetParameter(mount, direction, param, si, spec=text, origin=origin)
+
+
+def parse_swap(text: str, origin: Origin = Origin("--swap"), base: Path | None = None) -> Swap:
+    """``MOUNT.DIR=FILE.toml`` -> :class:`Swap` (the mount file is read now).
+
+    ``base``: folder relative paths are taken from (variants file folder; default cwd).
+    """
+    from powertrain.iotools.mount_file import read_mount
+    form = "MOUNT.DIR=FILE.toml, e.g. left.z=mounts/hydraulic-engine-mount-z.toml"
+    left, right = _split(text, origin, form)
+    mount, direction = _path_parts(left, 2, text, origin, form, wildcard=False)
+    _direction(direction, text, origin)
+    path = Path(right)
+    if base is not None and not path.is_absolute():
+        path = Path(base) / path
+    if not path.is_file():
+        raise origin.error(f"{text!r}: mount file not found: {path}")
+    return Swap(mount, direction, read_mount(path), path=str(path), spec=text, origin=origin)
+
+
+def parse_move(text: str, origin: Origin = Origin("--move")) -> Move:
+    """``MOUNT=DX,DY,DZ`` [mm, engine axes] -> :class:`Move` (SI offset)."""
+    form = "MOUNT=DX,DY,DZ in mm, e.g. gearbox=0,0,10"
+    left, right = _split(text, origin, form)
+    (mount,) = _path_parts(left, 1, text, origin, form)
+    d = _vector3(right, text, origin)
+    return Move(mount, tuple(1e-3 * v for v in d), spec=text, origin=origin)
+
+
+def parse_rotate(text: str, origin: Origin = Origin("--rotate")) -> Rotate:
+    """``MOUNT=AX,AY,AZ`` [deg about engine X, Y, Z] -> :class:`Rotate` (SI angles)."""
+    form = "MOUNT=AX,AY,AZ in degrees, e.g. left=0,0,5"
+    left, right = _split(text, origin, form)
+    (mount,) = _path_parts(left, 1, text, origin, form)
+    a = _vector3(right, text, origin)
+    return Rotate(mount, tuple(math.radians(v) for v in a), spec=text, origin=origin)
+
+
+def parse_target(text: str, origin: Origin = Origin("--target")) -> Target:
+    """``MOUNT.DIR:CHANGE:BAND[:WIDTH]`` -> :class:`Target`.
+
+    CHANGE: ``+20%``, ``-15%`` or a factor ``*1.2``; BAND: ``100-300Hz`` (``Hz`` optional);
+    WIDTH: transition outside the band, ``0.5oct`` (default half an octave).
+    """
+    form = "MOUNT.DIR:CHANGE:BAND, e.g. left.z:+20%:100-300Hz"
+    parts = [p.strip() for p in text.split(":")] if isinstance(text, str) else []
+    if len(parts) not in (3, 4):
+        raise origin.error(f"cannot read {text!r} (expected {form})")
+    mount, direction = _path_parts(parts[0], 2, text, origin, form, wildcard=False)
+    _direction(direction, text, origin)
+    change = parts[1].replace(" ", "")
+    m_pct = re.match(r"^([+-][0-9.eE+-]+)%$", change)
+    m_fac = re.match(r"^[*x]([0-9.eE+-]+)$", change)
+    if m_pct:
+        factor = 1.0 + _float(m_pct.group(1), text, origin) / 100.0
+    elif m_fac:
+        factor = _float(m_fac.group(1), text, origin)
+    else:
+        raise origin.error(f"{text!r}: cannot read change {parts[1]!r} (expected +20%, -15% "
+                           "or *1.2)")
+    if factor <= 0:
+        raise origin.error(f"{text!r}: the change must leave a positive stiffness "
+                           f"(factor {factor:g})")
+    m_band = re.match(r"^([0-9.eE+]+)\s*-\s*([0-9.eE+]+)\s*(Hz)?$", parts[2])
+    if not m_band:
+        raise origin.error(f"{text!r}: cannot read band {parts[2]!r} (expected e.g. 100-300Hz)")
+    f_lo = _float(m_band.group(1), text, origin)
+    f_hi = _float(m_band.group(2), text, origin)
+    if not 0 < f_lo < f_hi:
+        raise origin.error(f"{text!r}: band must satisfy 0 < low < high [Hz]")
+    width = 0.5
+    if len(parts) == 4:
+        m_w = re.match(r"^([0-9.eE+]+)\s*oct$", parts[3])
+        if not m_w:
+            raise origin.error(f"{text!r}: cannot read width {parts[3]!r} (expected e.g. "
+                               "0.5oct)")
+        width = _float(m_w.group(1), text, origin)
+        if width <= 0:
+            raise origin.error(f"{text!r}: width must be positive")
+    return Target(mount, direction, factor, f_lo, f_hi, width, spec=text, origin=origin)
+
+
+#: Operation keyword (CLI option without ``--``, variants-file key) -> parser.
+PARSERS = {"scale": parse_scale, "set": parse_set, "swap": parse_swap, "move": parse_move,
+           "rotate": parse_rotate, "target": parse_target}
+
+
+def parse_operations(specs: dict, *, base: Path | None = None) -> tuple:
+    """Operations from ``{"scale": [...], "set": [...], ...}`` of command-line strings, in
+    the order scale, set, swap, move, rotate, target (each list in its given order)."""
+    ops = []
+    for kind, parser in PARSERS.items():
+        for text in specs.get(kind, ()) or ():
+            origin = Origin(f"--{kind}")
+            if kind == "swap":
+                ops.append(parser(text, origin, base=base))
+            else:
+                ops.append(parser(text, origin))
+    return tuple(ops)
+
+
+# --------------------------------------------------------------------------- variants file
+VARIANTS_FILE_KEYS = ("name",) + tuple(PARSERS)
+
+
+def read_variants(path) -> list:
+    """Read a variants file (TOML): a list of :class:`Variant`.
+
+    Layout::
+
+        [[variant]]
+        name = "left z +20 % stiffness"
+        scale = ["left.z.stiffness=1.2"]      # optional lists of specs, same syntax
+        set = ["right.y.c2=150"]              # as the command-line options; applied in
+        swap = ["left.z=my-mount.toml"]       # the order scale, set, swap, move,
+        move = ["gearbox=0,0,10"]             # rotate, target; swap paths relative to
+        rotate = ["left=0,0,5"]               # the variants file
+        target = ["left.z:+20%:100-300Hz"]
+
+    Errors name the file, the line and the key (``variant[2].scale``).
+    """
+    from powertrain.iotools.tomlfile import read_toml
+    path = str(path)
+    doc = read_toml(path)
+    lines = Path(path).read_text(encoding="utf-8").splitlines()
+    headers = [i for i, ln in enumerate(lines) if re.match(r"^\s*\[\[\s*variant\s*\]\]", ln)]
+
+    def locate(k, needle):
+        """1-based line of ``needle`` within the k-th [[variant]] block (or its header)."""
+        if k >= len(headers):
+            return None
+        end = headers[k + 1] if k + 1 < len(headers) else len(lines)
+        for i in range(headers[k], end):
+            if needle and needle in lines[i]:
+                return i + 1
+        return headers[k] + 1
+
+    unknown = sorted(set(doc) - {"variant"})
+    if unknown:
+        raise InputError("unknown key (expected [[variant]] tables)", file=path, key=unknown[0])
+    tables = doc.get("variant")
+    if not isinstance(tables, list) or not tables or not all(isinstance(t, dict)
+                                                             for t in tables):
+        raise InputError("expected one or more [[variant]] tables", file=path, key="variant")
+    variants, names = [], set()
+    for k, t in enumerate(tables):
+        key0 = f"variant[{k + 1}]"
+        bad = sorted(set(t) - set(VARIANTS_FILE_KEYS))
+        if bad:
+            raise InputError(f"unknown key (expected {', '.join(VARIANTS_FILE_KEYS)})",
+                             file=path, line=locate(k, bad[0]), key=f"{key0}.{bad[0]}")
+        name = t.get("name")
+        if not isinstance(name, str) or not name.strip():
+            raise InputError("missing or empty name", file=path, line=locate(k, "name"),
+                             key=f"{key0}.name")
+        if name in names or name == "baseline":
+            raise InputError(f"duplicate or reserved variant name {name!r}", file=path,
+                             line=locate(k, "name"), key=f"{key0}.name")
+        names.add(name)
+        ops = []
+        for kind, parser in PARSERS.items():
+            specs = t.get(kind, [])
+            if isinstance(specs, str):
+                specs = [specs]
+            if not isinstance(specs, list) or not all(isinstance(s, str) for s in specs):
+                raise InputError("expected a list of strings", file=path,
+                                 line=locate(k, kind), key=f"{key0}.{kind}")
+            for text in specs:
+                origin = Origin(f"{key0}.{kind}", file=path, line=locate(k, text))
+                if kind == "swap":
+                    ops.append(parser(text, origin, base=Path(path).parent))
+                else:
+                    ops.append(parser(text, origin))
+        if not ops:
+            raise InputError("variant has no operation", file=path, line=locate(k, ""),
+                             key=key0)
+        variants.append(Variant(name, tuple(ops), Origin(key0, file=path,
+                                                         line=locate(k, ""))))
+    return variants

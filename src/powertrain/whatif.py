@@ -1,0 +1,287 @@
+r"""What-if: run the baseline and variants of the mount system, report the change in dB.
+
+:func:`run_whatif` resolves retune targets (:mod:`powertrain.retune`), builds one
+:class:`~powertrain.sweep.SweepTask` per variant plus the baseline, runs them with
+:func:`powertrain.sweep.run_sweep` and returns a :class:`WhatIfResult`.
+
+Change of a variant against the baseline, per channel (mount × engine X/Y/Z) and quantity
+(``synthesis``, ``order_2``, ``order_4`` by default), at each speed step:
+
+.. math:: \Delta(n) = 20\log_{10}\frac{v_{var}(n)}{v_{base}(n)}\ \mathrm{dB}
+
+with :math:`v` the RMS velocity of the mount point (or, with ``signal="mount_force"``, the
+RMS force the mount transmits to ground). Reported: ``mean_delta_db`` (the arithmetic mean of
+:math:`\Delta` over the speed steps, "rpm-averaged"), ``max_abs_delta_db`` (the largest
+:math:`|\Delta|`) and the speed where it occurs. Speed steps where both levels are below
+:data:`FLOOR_REL` of the baseline curve's maximum (a cancelled order) are left out.
+"""
+
+from __future__ import annotations
+
+import json
+from dataclasses import dataclass, field
+
+import numpy as np
+
+#: Quantities reported by default.
+QUANTITIES = ("synthesis", "order_2", "order_4")
+#: Levels below this fraction of the baseline curve's maximum are not compared (both sides).
+FLOOR_REL = 1e-9
+
+
+@dataclass
+class VariantRun:
+    """One variant: name, the operations' specs and its run-up."""
+
+    name: str
+    specs: list
+    result: object
+
+
+def delta_db(base, variant, floor_rel=FLOOR_REL) -> np.ndarray:
+    """:math:`20\\log_{10}(v/v_0)` [dB]; NaN where both are below the floor.
+
+    Parameters
+    ----------
+    base, variant : array_like
+        Levels (any consistent unit), same shape.
+    floor_rel : float
+        Floor relative to ``max(base)``.
+    """
+    b = np.asarray(base, float)
+    v = np.asarray(variant, float)
+    floor = floor_rel * (np.max(b) if b.size else 0.0)
+    tiny = np.finfo(float).tiny
+    out = 20 * np.log10(np.maximum(v, tiny) / np.maximum(b, tiny))
+    out[(b <= floor) & (v <= floor)] = np.nan
+    return out
+
+
+@dataclass
+class WhatIfResult:
+    """Baseline and variant run-ups with their changes in dB.
+
+    Attributes
+    ----------
+    baseline : RunupResult
+    variants : list of VariantRun
+    description : dict
+        Baseline description (engine, file, solver, speeds, mounts...).
+    quantities : tuple of str
+    measured : MeasuredRunup or None
+        Overlaid measurement.
+    target_fits : list of TargetFit
+    signal : str
+        Compared signal: ``velocity`` (default; the measured quantity), ``mount_force``
+        (force transmitted to ground), ``displacement`` or ``acceleration``.
+    """
+
+    baseline: object
+    variants: list
+    description: dict = field(default_factory=dict)
+    quantities: tuple = QUANTITIES
+    measured: object = None
+    target_fits: list = field(default_factory=list)
+    signal: str = "velocity"
+
+    # ------------------------------------------------------------------ numbers
+    def variant(self, name: str) -> VariantRun:
+        for v in self.variants:
+            if v.name == name:
+                return v
+        raise KeyError(name)
+
+    def delta_db(self, name: str, mount: str, direction: str, quantity: str = "synthesis"):
+        """Change of a variant against the baseline per speed step [dB]."""
+        res = self.variant(name).result
+        return delta_db(self.baseline.curve(mount, direction, quantity, self.signal),
+                        res.curve(mount, direction, quantity, self.signal))
+
+    def channel_changes(self, name: str) -> list:
+        """Per channel and quantity: ``mount``, ``direction``, ``quantity``,
+        ``mean_delta_db``, ``max_abs_delta_db``, ``rpm_at_max_abs``, ``delta_db`` (list)
+        and, with a measurement, ``mean_gap_to_measured_db``."""
+        res = self.variant(name).result
+        rpm = np.asarray(self.baseline.rpm, float)
+        out = []
+        for mount, direction in self.baseline.channels:
+            for q in self.quantities:
+                d = self.delta_db(name, mount, direction, q)
+                ok = np.isfinite(d)
+                row = {"mount": mount, "direction": direction, "quantity": q,
+                       "mean_delta_db": float(np.mean(d[ok])) if ok.any() else None,
+                       "max_abs_delta_db": float(np.max(np.abs(d[ok]))) if ok.any() else None,
+                       "rpm_at_max_abs": float(rpm[ok][np.argmax(np.abs(d[ok]))])
+                       if ok.any() else None,
+                       "delta_db": [None if not np.isfinite(x) else float(x) for x in d]}
+                if self.measured is not None and self.signal == "velocity":
+                    row["mean_gap_to_measured_db"] = _gap_to_measured(
+                        res, self.measured, mount, direction, q)
+                out.append(row)
+        return out
+
+    def baseline_gaps(self) -> list:
+        """Mean gap baseline vs measurement per channel and quantity [dB] (empty without
+        a measurement)."""
+        if self.measured is None or self.signal != "velocity":
+            return []
+        return [{"mount": m, "direction": d, "quantity": q,
+                 "mean_gap_to_measured_db": _gap_to_measured(self.baseline, self.measured,
+                                                             m, d, q)}
+                for m, d in self.baseline.channels for q in self.quantities]
+
+    # ------------------------------------------------------------------ output
+    def to_dict(self) -> dict:
+        from powertrain import __version__
+        base = dict(self.description)
+        base.setdefault("rpm", [float(r) for r in self.baseline.rpm])
+        base["rigid_body_modes_hz"] = [float(f) for f in self.baseline.rigid_body_modes_hz]
+        if self.measured is not None:
+            base["measured"] = {"file": self.measured.source,
+                                "synthetic": bool(self.measured.synthetic),
+                                "channels": self.baseline_gaps()}
+        return {"format": "powertrain-whatif", "format_version": 1,
+                "powertrain_version": __version__,
+                "signal": self.signal,
+                "definition": f"delta_db = 20 log10(v_variant / v_baseline), v = RMS "
+                              f"{self.signal}; "
+                              "mean_delta_db = mean over the speed steps; max_abs_delta_db = "
+                              "largest |delta_db|",
+                "quantities": list(self.quantities),
+                "baseline": base,
+                "targets": [tf.to_dict() for tf in self.target_fits],
+                "variants": [{"name": v.name, "operations": list(v.specs),
+                              "rigid_body_modes_hz": [float(f) for f in
+                                                      v.result.rigid_body_modes_hz],
+                              "channels": self.channel_changes(v.name)}
+                             for v in self.variants]}
+
+    def to_json(self, path=None) -> str:
+        """JSON text of :meth:`to_dict`; written atomically to ``path`` if given."""
+        text = json.dumps(self.to_dict(), indent=2) + "\n"
+        if path is not None:
+            from powertrain.iotools.atomic import atomic_write
+            with atomic_write(path) as fh:
+                fh.write(text)
+        return text
+
+    def table(self) -> str:
+        """Text table per variant: rows = channels, columns = mean / max |Δ| [dB] per quantity."""
+        blocks = []
+        for v in self.variants:
+            rows = {}
+            for r in self.channel_changes(v.name):
+                key = f"{r['mount']}.{r['direction']}"
+                cell = ("-" if r["mean_delta_db"] is None else
+                        f"{r['mean_delta_db']:+.2f} / {r['max_abs_delta_db']:.2f}")
+                rows.setdefault(key, [key]).append(cell)
+            header = ["channel"] + [f"{q} mean/max|d| [dB]" for q in self.quantities]
+            modes = ", ".join(f"{f:.2f}" for f in v.result.rigid_body_modes_hz)
+            blocks.append(f"variant {v.name!r} ({'; '.join(v.specs)}) vs baseline\n"
+                          f"rigid-body modes [Hz]: {modes}\n"
+                          + _format_table(header, list(rows.values())))
+        return "\n\n".join(blocks)
+
+    def plot(self, path=None):
+        """Overlay of baseline, variants and measurement (see
+        :func:`powertrain.plotting.plot_whatif`)."""
+        from powertrain.plotting import plot_whatif
+        return plot_whatif(self, path)
+
+
+def _format_table(header, rows) -> str:
+    """Fixed-width text table of strings, first column left-aligned."""
+    widths = [max(len(h), *(len(r[i]) for r in rows)) if rows else len(h)
+              for i, h in enumerate(header)]
+
+    def line(cells):
+        return "  ".join(c.ljust(w) if i == 0 else c.rjust(w)
+                         for i, (c, w) in enumerate(zip(cells, widths)))
+    return "\n".join([line(header), line(["-" * w for w in widths])]
+                     + [line(r) for r in rows])
+
+
+def _gap_to_measured(result, measured, mount, direction, quantity):
+    """Mean of 20 log10(sim/measured) [dB] at the measured speeds inside the simulated range
+    (simulation interpolated linearly in log level); None if not available."""
+    try:
+        rpm_m, lev_m = measured.curve(mount, direction, quantity)
+    except KeyError:
+        return None
+    rpm_s = np.asarray(result.rpm, float)
+    sim = result.curve(mount, direction, quantity)
+    order = np.argsort(rpm_s)
+    rpm_s, sim = rpm_s[order], sim[order]
+    inside = (rpm_m >= rpm_s[0]) & (rpm_m <= rpm_s[-1]) & (lev_m > 0)
+    if not inside.any() or np.any(sim <= 0):
+        return None
+    s = np.exp(np.interp(rpm_m[inside], rpm_s, np.log(sim)))
+    return float(np.mean(20 * np.log10(s / lev_m[inside])))
+
+
+def describe_engine(engine, solver: str, rpm) -> dict:
+    """Baseline description for the JSON output."""
+    return {"name": "baseline", "engine": engine.name, "engine_file": engine.file,
+            "solver": solver, "rpm": [float(r) for r in rpm],
+            "balancers_enabled": bool(engine.balancer.enabled),
+            "mounts": {m.name: {"position_mm": [1e3 * float(x) for x in m.position],
+                                "files": dict(m.files),
+                                "models": {d: mdl.topology.name
+                                           for d, mdl in m.directions.items()}}
+                       for m in engine.mounts}}
+
+
+def run_whatif(engine, variants, rpm=None, *, solver: str = "harmonic", executor=None,
+               workers: int | None = None, measured=None, quantities=QUANTITIES,
+               signal: str = "velocity", progress: bool = False, fit_kwargs: dict | None = None,
+               runup_options: dict | None = None) -> WhatIfResult:
+    """Run the baseline and every variant; return their changes.
+
+    Parameters
+    ----------
+    engine : Engine
+        Baseline.
+    variants : sequence of Variant
+        Names unique and not ``baseline``; targets are resolved here (fits run in this
+        process, before the sweep).
+    rpm : array_like, optional
+        Speed steps [rpm] (default 1000..6000 step 500).
+    solver : {"harmonic", "newmark"}
+        Default harmonic: exact for the linear model and fast.
+    executor, workers
+        See :func:`powertrain.sweep.run_sweep`.
+    measured : MeasuredRunup, optional
+        Overlaid in the plot; gaps reported.
+    quantities : tuple of str
+    signal : str
+        ``velocity`` (default), ``mount_force``, ``displacement`` or ``acceleration``.
+    fit_kwargs : dict, optional
+        Passed to :func:`powertrain.fitting.fit_mount` for targets.
+    runup_options : dict, optional
+        Further keyword arguments of :func:`powertrain.runup.run_runup`.
+    """
+    from powertrain.retune import resolve_targets
+    from powertrain.runup import default_rpm
+    from powertrain.sweep import SweepTask, run_sweep
+    from powertrain.variants import check_operations
+    rpm = default_rpm() if rpm is None else np.atleast_1d(np.asarray(rpm, float))
+    names = [v.name for v in variants]
+    if len(set(names)) != len(names) or "baseline" in names:
+        raise ValueError("variant names must be unique and not 'baseline'")
+    resolved, fits = [], []
+    for v in variants:
+        check_operations(engine, v.operations)
+    for v in variants:
+        rv, f = resolve_targets(engine, v, **(fit_kwargs or {}))
+        resolved.append(rv)
+        fits += f
+    base_engine = engine.replace()          # fresh pressure cache: a small pickle
+    opts = dict(runup_options or {})
+    tasks = [SweepTask("baseline", base_engine, (), rpm, solver, opts)]
+    tasks += [SweepTask(v.name, base_engine, v.operations, rpm, solver, opts) for v in resolved]
+    results = run_sweep(tasks, executor, workers=workers, progress=progress)
+    runs = [VariantRun(v.name, v.specs, r) for v, r in zip(resolved, results[1:])]
+    return WhatIfResult(baseline=results[0], variants=runs,
+                        description=describe_engine(engine, solver, rpm),
+                        quantities=tuple(quantities), measured=measured, target_fits=fits,
+                        signal=signal)
