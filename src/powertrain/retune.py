@@ -30,8 +30,8 @@ follows from the gain (Bode's gain-phase relation),
 so the requested curve is :math:`K_t(f) = K_0(f)\,g(f)\,e^{i\varphi(f)}`. (Multiplying real and
 imaginary part by :math:`g` alone -- keeping the loss angle -- is not realisable by a
 network: on the default ``left.z`` mount with ``+20%:100-300Hz`` the best triple-parallel
-fit to it misses by 9.5 % in the band and reaches only +14.7 % on average; with the Bode
-phase it fits to 4 % and +19.7 %.)
+fit to it misses by 9.6 % in the band and reaches only +14.7 % on average; with the Bode
+phase it fits to 3.6 % and +19.8 %.)
 
 Fit
 ---
