@@ -401,3 +401,130 @@ def plot_retune(target_fit, path=None):
     if path:
         save_figure(fig, path)
     return fig
+
+
+# ---------------------------------------------------------------------------- diagnosis
+def plot_gap_map(diagnosis, path=None):
+    """Gap map of a :class:`powertrain.diagnosis.DiagnosisResult`: one panel per quantity,
+    channels against speed, colour = gap 20 log10(sim/measured) [dB] (±6 dB scale), the
+    ±3 dB regions outlined."""
+    import numpy as np
+    plt = _pyplot()
+    d = diagnosis.data
+    nq = len(d.quantities)
+    ncol = min(3, nq)
+    nrow = int(np.ceil(nq / ncol))
+    fig, axes = plt.subplots(nrow, ncol, figsize=(4.6 * ncol, 2.6 * nrow + 0.6), squeeze=False,
+                             sharex=True, sharey=True)
+    im = None
+    for k, q in enumerate(d.quantities):
+        ax = axes.flat[k]
+        g = diagnosis.gap[:, :, k].T
+        im = ax.pcolormesh(d.rpm, np.arange(len(d.channels)), np.ma.masked_invalid(g),
+                           cmap="RdBu_r", vmin=-6, vmax=6, shading="nearest")
+        if np.isfinite(g).any() and np.nanmax(np.abs(g)) > 3:
+            ax.contour(d.rpm, np.arange(len(d.channels)), np.nan_to_num(np.abs(g)), [3.0],
+                       colors="k", linewidths=0.6)
+        ax.set_title(q, fontsize=9)
+        ax.set_yticks(range(len(d.channels)))
+        ax.set_yticklabels([f"{m} {a}" for m, a in d.channels], fontsize=7)
+    for ax in axes.flat[nq:]:
+        ax.set_visible(False)
+    for ax in axes[-1]:
+        ax.set_xlabel("speed [rpm]")
+    if im is not None:
+        fig.colorbar(im, ax=axes.ravel().tolist(), label="gap sim/measured [dB]", shrink=0.8)
+    fig.suptitle(f"gap map (baseline): {diagnosis.verdict_text[:110]}", fontsize=8)
+    if path:
+        save_figure(fig, path)
+    return fig
+
+
+def plot_gap_frequency(diagnosis, path=None):
+    """Order gaps re-plotted against frequency f = order·rpm/60 [Hz] per channel (left; a
+    structural cause lines up across orders at one frequency) and against speed per order
+    (right; an excitation cause lines up at one order), with the fitted smooth parts."""
+    import numpy as np
+    plt = _pyplot()
+    d = diagnosis.data
+    p = diagnosis.parts
+    fig, (a1, a2) = plt.subplots(1, 2, figsize=(12, 4.5))
+    qs = np.flatnonzero(d.order_mask)
+    for j, k in enumerate(qs):
+        o = (d.harmonic[k] + 1) / 2.0
+        f = o * d.rpm / 60.0
+        g = diagnosis.gap[:, :, k]
+        for c in range(len(d.channels)):
+            a1.plot(f, g[:, c], ".", ms=1.5, color=f"C{j % 10}",
+                    label=d.quantities[k] if c == 0 else None)
+        n_ok = np.isfinite(g).sum(axis=1)
+        mean = np.where(n_ok > 0, np.nansum(g, axis=1) / np.maximum(n_ok, 1), np.nan)
+        a2.plot(d.rpm, mean, "-", color=f"C{j % 10}", lw=1,
+                label=f"{d.quantities[k]} (mean over channels)")
+    sc = p["structure_curves"]
+    for c, row in enumerate(sc["by_channel"]):
+        a1.plot(sc["frequency_hz"], np.array(row) + p["channel_const_db"][c], "k-", lw=0.6,
+                alpha=0.6, label="fitted dH_channel(f) + g_channel" if c == 0 else None)
+    ec = p["excitation_curves"]
+    for k, row in zip(qs, ec["by_quantity"]):
+        a2.plot(ec["rpm"], row, "--", color="k", lw=0.6, alpha=0.6)
+    a1.set_xscale("log")
+    a1.set_xlabel("frequency = order x rpm / 60 [Hz]")
+    a2.set_xlabel("speed [rpm]")
+    for ax in (a1, a2):
+        ax.set_ylabel("gap [dB]")
+        ax.axhline(0, color="0.5", lw=0.5)
+        ax.grid(True, alpha=0.3)
+        ax.legend(fontsize=7, markerscale=4)
+    s = p["share_alone"]
+    fig.suptitle(f"structure {s['structure']:.0%}, excitation {s['excitation']:.0%}, channel "
+                 f"constant {s['const']:.0%} of the gap's sum of squares (each alone)",
+                 fontsize=9)
+    fig.tight_layout()
+    if path:
+        save_figure(fig, path)
+    return fig
+
+
+def plot_diagnosis_overlay(diagnosis, path=None, n_panels=6):
+    """Measured vs baseline vs baseline + chosen effect for the channel-quantities with the
+    largest baseline gaps; held-out speeds marked."""
+    import numpy as np
+    plt = _pyplot()
+    d = diagnosis.data
+    g = diagnosis.gap
+    score = []
+    for c in range(len(d.channels)):
+        for k in np.flatnonzero(d.order_mask):
+            v = g[:, c, k]
+            if np.isfinite(v).sum() > 2:
+                score.append((float(np.sqrt(np.nanmean(v ** 2))), c, k))
+    score.sort(reverse=True)
+    score = score[:n_panels]
+    ncol = 3
+    nrow = max(1, int(np.ceil(len(score) / ncol)))
+    fig, axes = plt.subplots(nrow, ncol, figsize=(13, 3.2 * nrow), squeeze=False)
+    held = np.isin(d.rpm, diagnosis.split["heldout_rpm"])
+    for ax, (_, c, k) in zip(axes.flat, score):
+        m = d.level[:, c, k] * 1e3
+        sim0 = m * 10 ** (g[:, c, k] / 20)
+        ax.semilogy(d.rpm, m, "k.", ms=2, label="measured")
+        ax.semilogy(d.rpm[held], m[held], "o", mfc="none", mec="0.6", ms=3,
+                    label="held-out speeds")
+        ax.semilogy(d.rpm, sim0, "C3-", lw=1, label="baseline")
+        if diagnosis.gap_after is not None:
+            ax.semilogy(d.rpm, m * 10 ** (diagnosis.gap_after[:, c, k] / 20), "C0-", lw=1,
+                        label=f"+ {diagnosis.chosen.label}")
+        mnt, dr = d.channels[c]
+        ax.set_title(f"{mnt} {dr} {d.quantities[k]}", fontsize=9)
+        ax.set_xlabel("speed [rpm]")
+        ax.set_ylabel("velocity RMS [mm/s]")
+        ax.grid(True, which="both", alpha=0.3)
+    for ax in axes.flat[len(score):]:
+        ax.set_visible(False)
+    axes.flat[0].legend(fontsize=7)
+    fig.suptitle(f"before / after / measured: {diagnosis.verdict_text[:120]}", fontsize=8)
+    fig.tight_layout()
+    if path:
+        save_figure(fig, path)
+    return fig

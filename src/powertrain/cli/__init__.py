@@ -39,7 +39,7 @@ def main():
 
 def _register():
     from powertrain.cli import stiffness  # noqa: F401
-    for name in ("fit_mount", "runup", "excitation", "compare", "whatif"):
+    for name in ("fit_mount", "runup", "excitation", "compare", "diagnose", "whatif"):
         try:
             __import__(f"powertrain.cli.{name}")
         except ModuleNotFoundError as exc:  # command not built yet

@@ -1,0 +1,407 @@
+r"""Unmodelled effects as model extensions: a small library of candidates for the sim-to-real gap.
+
+Each effect is a physical extension of the baseline model with a few bounded parameters whose
+defaults reduce it to the baseline. The registry :data:`EFFECTS` gives for each its name,
+parameter names, bounds, defaults and units; every effect can be used
+
+* on an :class:`~powertrain.models.engine.Engine` (``Engine -> Engine``, for ``runup``,
+  ``compare`` and ``whatif``) where the effect is a change of the engine model:
+  :func:`with_base_compliance_all`, :func:`with_mount_stiffness`,
+  :func:`with_balancer_error`, :func:`with_cylinder_imbalance`;
+* on the response (:func:`simulate`) where it is not a change of the linear model:
+  ``amplitude_stiffness`` (an amplitude-dependent mount, solved by equivalent linearisation
+  iterated to consistency) and ``sensor_gain`` (a measurement effect);
+* on the fast cached path :func:`predict` (one :class:`~powertrain.solvers.fast_harmonic.
+  HarmonicModel`, many parameter sets), which the diagnosis uses.
+
+Library (parameter bounds in :data:`EFFECTS`):
+
+================== =========== ===================================================================
+name               kind        physics
+================== =========== ===================================================================
+base_compliance    structure   every mount stands on a local chassis base: mass m_b on a spring
+                               c_b (damping ratio ζ_b = 5 %) instead of the rigid ground
+mount_stiffness    structure   each mount's dynamic stiffness times a factor k_i (temperature,
+                               preload, part-to-part spread), all directions and frequencies
+amplitude_stiffness structure  mount stiffness depends on the engine-side amplitude a (data at
+                               a_ref = 0.1 mm): g(a) = 1 + κ[1/(1 + a/a_c) − 1/(1 + a_ref/a_c)]
+balancer_error     excitation  balancer shafts' unbalance times g and timing lag δ
+cylinder_imbalance excitation  cylinder i delivers (1 + ε_i) times the nominal IMEP
+sensor_gain        sensor      each channel's sensor reads 10^(G_c/20) times the true level
+================== =========== ===================================================================
+
+Equivalent linearisation (``amplitude_stiffness``): at each speed every network's dynamic
+stiffness (springs, dampers and masses alike) is scaled by :math:`g(a_n)`, where
+:math:`a_n = \sqrt{\sum_h |\hat x_{E,n,h}|^2}` is the engine-side peak displacement
+(:math:`\sqrt2` × RMS sum of the orders) of network n; the solve is repeated with the updated
+factors until they change by less than 1e-6 (fixed-point iteration with under-relaxation
+0.7; at most 60 iterations). Its time-domain check (Newmark, stiffness updated once per engine
+cycle from the RMS of the previous cycle) is :func:`time_domain_amplitude_check`.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from powertrain.solvers.fast_harmonic import N_HARMONICS, HarmonicModel
+
+#: Reference amplitude of the mount data (dynamic stiffness measured at 0.1 mm) [m].
+A_REF = 1.0e-4
+#: Damping ratio of the local base of ``base_compliance`` [1].
+BASE_ZETA = 0.05
+
+
+@dataclass(frozen=True)
+class Parameter:
+    """One bounded parameter of an effect.
+
+    Attributes
+    ----------
+    name, unit, description : str
+    lower, upper, default : float
+        Bounds and the value that reduces the effect to the baseline (SI).
+    log : bool
+        Fitted in log space (positive, scale-like parameters).
+    """
+
+    name: str
+    unit: str
+    lower: float
+    upper: float
+    default: float
+    log: bool = False
+    description: str = ""
+
+
+@dataclass(frozen=True)
+class Effect:
+    """A candidate unmodelled effect.
+
+    Attributes
+    ----------
+    name : str
+    kind : {"structure", "excitation", "sensor"}
+    parameters : tuple of Parameter
+    description : str
+    apply : callable or None
+        ``apply(engine, **params) -> Engine`` where the effect is an engine-model change.
+    """
+
+    name: str
+    kind: str
+    parameters: tuple
+    description: str
+    apply: object = None
+    start_grid: tuple = field(default=())
+
+    @property
+    def parameter_names(self) -> list:
+        return [p.name for p in self.parameters]
+
+    def defaults(self) -> dict:
+        return {p.name: p.default for p in self.parameters}
+
+    def bounds(self):
+        return (np.array([p.lower for p in self.parameters]),
+                np.array([p.upper for p in self.parameters]))
+
+    def to_dict(self) -> dict:
+        return {"name": self.name, "kind": self.kind, "description": self.description,
+                "parameters": [dataclasses.asdict(p) for p in self.parameters]}
+
+
+# ----------------------------------------------------------------------- Engine -> Engine
+def _map_networks(engine, fn):
+    mounts = []
+    for mi, m in enumerate(engine.mounts):
+        mounts.append(dataclasses.replace(
+            m, directions={ax: fn(mi, m, ax, mod) for ax, mod in m.directions.items()}))
+    return engine.replace(mounts=mounts)
+
+
+def with_base_compliance_all(engine, c_base=np.inf, m_base=10.0, zeta=BASE_ZETA):
+    r"""Every mount network on a local compliant base (all mounts alike).
+
+    Base of mass ``m_base`` [kg] on a spring ``c_base`` [N/m] with the damper
+    :math:`d_b = 2\zeta\sqrt{c_b m_b}` [N·s/m]
+    (:func:`powertrain.models.extensions.with_base_compliance`). ``c_base = inf`` (default)
+    is the rigid ground: the engine is returned unchanged.
+    """
+    from powertrain.models.extensions import with_base_compliance
+    if not np.isfinite(c_base):
+        return engine
+    d_base = 2 * zeta * np.sqrt(c_base * m_base)
+    return _map_networks(engine, lambda mi, m, ax, mod: with_base_compliance(
+        mod, m_base, c_base, d_base))
+
+
+def with_mount_stiffness(engine, k1=1.0, k2=1.0, k3=1.0):
+    """Mount i's dynamic stiffness times ``k<i>`` [1] (i = 1, 2, 3 in engine-file order;
+    default engine: left, right, gearbox): every spring, damper and mass of its networks
+    scaled, so K_CP(ω) scales exactly (:meth:`MountModel.scaled_dynamic_stiffness`)."""
+    k = (k1, k2, k3)
+    return _map_networks(engine, lambda mi, m, ax, mod: mod.scaled_dynamic_stiffness(k[mi])
+                         if mi < 3 else mod)
+
+
+def with_balancer_error(engine, gain=1.0, lag=0.0):
+    r"""Balancer shafts' unbalance times ``gain`` [1] and the drive lagging by ``lag`` [rad]
+    of shaft angle: :math:`\alpha = \sigma(\rho\theta - \delta) + \phi`, a pure delay of the
+    balancer force (its complex order amplitude times :math:`g e^{-i\delta}`)."""
+    shafts = tuple(dataclasses.replace(s, mass_radius=s.mass_radius * gain,
+                                       phase=s.phase - s.sense * lag)
+                   for s in engine.balancer.shafts)
+    return engine.replace(balancer=dataclasses.replace(engine.balancer, shafts=shafts))
+
+
+def with_cylinder_imbalance(engine, e1=0.0, e2=0.0, e3=0.0, e4=0.0):
+    """Cylinder i's IMEP times (1 + e<i>) [1] (single-zone combustion only)."""
+    base = np.asarray(engine.combustion.imep_factors, float)
+    eps = np.array([e1, e2, e3, e4][:base.size])
+    return engine.with_imep_factors(base * (1.0 + eps))
+
+
+def amplitude_factor(a, kappa, a_c):
+    r"""Stiffness factor of ``amplitude_stiffness``:
+    :math:`g(a) = 1 + \kappa\,[1/(1 + a/a_c) - 1/(1 + a_{ref}/a_c)]`, g(a_ref) = 1.
+
+    Parameters
+    ----------
+    a : array_like
+        Engine-side peak displacement [m].
+    kappa : float
+        Stiffening from large to vanishing amplitude [1] (0 = none).
+    a_c : float
+        Characteristic amplitude [m].
+    """
+    a = np.asarray(a, float)
+    return 1.0 + kappa * (1.0 / (1.0 + a / a_c) - 1.0 / (1.0 + A_REF / a_c))
+
+
+# ----------------------------------------------------------------------- registry
+EFFECTS: dict = {e.name: e for e in [
+    Effect("base_compliance", "structure",
+           (Parameter("c_base", "N/m", 1.0e5, 2.0e7, 2.0e7, True,
+                      "base (chassis) stiffness under each mount; upper bound ~ rigid"),
+            Parameter("m_base", "kg", 1.0, 60.0, 10.0, True,
+                      "base (chassis) mass at each mount")),
+           "local compliant chassis base under every mount (rigid ground at c_base -> inf)",
+           with_base_compliance_all,
+           start_grid=((1.5e5, 4e5, 1e6, 3e6), (2.0, 6.0, 15.0, 40.0))),
+    Effect("mount_stiffness", "structure",
+           tuple(Parameter(f"k{i}", "1", 0.3, 3.0, 1.0, True,
+                           f"dynamic-stiffness factor of mount {i} (file order)")
+                 for i in (1, 2, 3)),
+           "per-mount dynamic-stiffness offset (temperature, preload, spread)",
+           with_mount_stiffness),
+    Effect("amplitude_stiffness", "structure",
+           (Parameter("kappa", "1", 0.0, 3.0, 0.0, False,
+                      "stiffening from large to vanishing amplitude"),
+            Parameter("a_c", "m", 1.0e-6, 1.0e-3, 2.0e-5, True, "characteristic amplitude")),
+           "amplitude-dependent mount stiffness, equivalent linearisation iterated to "
+           "consistency (mount data at 0.1 mm)", None,
+           start_grid=((0.3, 1.0, 2.0), (3e-6, 2e-5, 1.5e-4))),
+    Effect("balancer_error", "excitation",
+           (Parameter("gain", "1", 0.0, 2.0, 1.0, False, "balancer unbalance factor"),
+            Parameter("lag", "rad", -0.7, 0.7, 0.0, False, "balancer timing lag")),
+           "balancer shafts' unbalance and timing error", with_balancer_error),
+    Effect("cylinder_imbalance", "excitation",
+           tuple(Parameter(f"e{i}", "1", -0.25, 0.25, 0.0, False,
+                           f"relative IMEP deviation of cylinder {i}") for i in (1, 2, 3, 4)),
+           "cylinder-to-cylinder IMEP differences (half and first orders); linearised load",
+           with_cylinder_imbalance),
+    Effect("sensor_gain", "sensor",
+           tuple(Parameter(f"g{c}", "dB", -8.0, 8.0, 0.0, False,
+                           f"gain error of channel {c} (mount-major x, y, z)")
+                 for c in range(1, 10)),
+           "per-channel sensor gain (calibration) error", None),
+]}
+
+
+# ----------------------------------------------------------------------- fast path
+@dataclass
+class Prediction:
+    """Complex channel velocities of a scenario on a :class:`HarmonicModel`.
+
+    Attributes
+    ----------
+    velocity : ndarray (n_r, n_ch, 16) complex
+        Peak amplitudes of orders 0.5..8 [m/s].
+    iterations : int
+        Fixed-point iterations of the equivalent linearisation (0 if none).
+    factors : ndarray (n_r, n_net) or None
+        Amplitude factors g(a_n) at convergence.
+    """
+
+    velocity: np.ndarray
+    iterations: int = 0
+    factors: np.ndarray | None = None
+
+
+def _kip(hm, abc, scenario, g=None):
+    a, b, c = abc
+    s = np.ones(a.shape[-1])
+    if "mount_stiffness" in scenario:
+        p = scenario["mount_stiffness"]
+        k = np.array([p.get("k1", 1.0), p.get("k2", 1.0), p.get("k3", 1.0)])
+        for n, (mi, _, _) in enumerate(hm.networks):
+            if mi < 3:
+                s[n] = k[mi]
+    s = s[None, None, :] if g is None else s[None, None, :] * g[:, None, :]
+    a, b, c = a * s, b * s, c * s
+    if "base_compliance" in scenario:
+        p = scenario["base_compliance"]
+        cb, mb = p["c_base"], p["m_base"]
+        w = hm.omega[..., None]
+        zb = cb + 1j * w * 2 * BASE_ZETA * np.sqrt(cb * mb) - w ** 2 * mb
+        return a - b ** 2 / (c + zb)
+    return a
+
+
+def _load(hm, scenario):
+    load = hm.load
+    if "balancer_error" in scenario:
+        p = scenario["balancer_error"]
+        shafts = hm.shaft_loads().sum(axis=0)
+        on = 1.0 if hm.engine.balancer.enabled else 0.0
+        load = load + (p["gain"] * np.exp(-1j * p["lag"]) - on) * shafts
+    if "cylinder_imbalance" in scenario:
+        p = scenario["cylinder_imbalance"]
+        d = hm.imep_derivatives()
+        eps = np.array([p.get(f"e{i + 1}", 0.0) for i in range(d.shape[0])])
+        load = load + np.tensordot(eps, d, axes=1)
+    return load
+
+
+def predict(hm: HarmonicModel, scenario: dict, *, abc=None, tol=1e-6,
+            max_iter=60) -> Prediction:
+    """Channel velocities with the effects of ``scenario`` on the cached model.
+
+    Parameters
+    ----------
+    hm : HarmonicModel
+    scenario : dict
+        ``{effect name: {parameter: value}}`` (SI); missing parameters take their defaults.
+    abc : tuple, optional
+        Two-port stiffnesses to start from (default: the engine's networks).
+
+    Returns
+    -------
+    Prediction
+    """
+    sc = {}
+    for name, p in scenario.items():
+        if name not in EFFECTS:
+            raise KeyError(f"unknown effect {name!r}")
+        sc[name] = {**EFFECTS[name].defaults(), **p}
+    abc = hm.two_ports() if abc is None else abc
+    load = _load(hm, sc)
+    iterations, g = 0, None
+    if "amplitude_stiffness" in sc and sc["amplitude_stiffness"]["kappa"] != 0.0:
+        p = sc["amplitude_stiffness"]
+        g = np.ones((hm.rpm.size, len(hm.networks)))
+        for iterations in range(1, max_iter + 1):
+            q = hm.solve(_kip(hm, abc, sc, g), load)
+            g_new = amplitude_factor(hm.network_amplitude(q), p["kappa"], p["a_c"])
+            change = np.max(np.abs(g_new - g))
+            g = g + 0.7 * (g_new - g)
+            if change < tol:
+                break
+    q = hm.solve(_kip(hm, abc, sc, g), load)
+    v = hm.velocity(q)
+    if "sensor_gain" in sc:
+        p = sc["sensor_gain"]
+        gains = np.array([p.get(f"g{c + 1}", 0.0) for c in range(v.shape[1])])
+        v = v * 10.0 ** (gains / 20.0)[None, :, None]
+    return Prediction(v, iterations, g)
+
+
+def simulate(engine, rpm, scenario: dict):
+    """Run-up velocities (harmonic steady state) of ``engine`` with the effects of
+    ``scenario`` applied; a :class:`~powertrain.results.RunupResult` holding the velocity
+    only (displacement = velocity/(iω), acceleration = iω·velocity, no mount forces)."""
+    from powertrain.analysis.orders import ORDERS
+    from powertrain.results import RunupResult
+    hm = HarmonicModel(engine, rpm)
+    pred = predict(hm, scenario)
+    w = hm.omega[:, 1:N_HARMONICS][:, None, :]
+    v = pred.velocity
+    return RunupResult(rpm=hm.rpm, orders=ORDERS.copy(), channels=list(hm.channels),
+                       displacement=v / (1j * w), velocity=v, acceleration=1j * w * v,
+                       mount_force=np.zeros_like(v), mean_mount_force=np.zeros(v.shape[:2]),
+                       periodicity=np.zeros(hm.rpm.size),
+                       settings={"solver": "harmonic (effects)", "effects": scenario},
+                       meta={"engine": getattr(engine, "name", "")})
+
+
+# ----------------------------------------------------------------------- time-domain check
+def time_domain_amplitude_check(engine, rpm, kappa, a_c, *, cycles=40, angle_step_deg=1.0):
+    r"""Amplitude-dependent mounts in the time domain, for checking the linearisation.
+
+    The assembled 33-DOF model is integrated by Newmark (average acceleration) cycle by
+    cycle; at the start of each engine cycle every network's springs, dampers and masses are
+    rescaled by :math:`g(a_n)` (under-relaxed by 0.7 like the frequency-domain iteration) with :math:`a_n = \sqrt2\,\mathrm{RMS}` of its engine-side
+    displacement over the previous cycle (the mean removed) — a quasi-static amplitude
+    memory, the time-domain counterpart of the equivalent linearisation. After ``cycles``
+    cycles the last cycle is order-analysed.
+
+    Returns
+    -------
+    velocity : ndarray (n_ch, 16) complex
+        Order amplitudes of the last cycle [m/s].
+    factors : ndarray (n_net,)
+        Stiffness factors used in the last cycle.
+    periodicity : float
+        Max change of the channel velocities between the last two cycles, relative.
+    """
+    from powertrain.analysis.orders import order_spectrum
+    from powertrain.assembly import assemble
+    from powertrain.solvers.newmark import newmark
+    n_cycle = int(round(720.0 / angle_step_deg))
+    omega = rpm * 2 * np.pi / 60.0
+    h = np.deg2rad(angle_step_deg) / omega
+    theta = np.arange(n_cycle) * (4 * np.pi / n_cycle)
+    load = np.asarray(engine.generalized_load(rpm, theta), float)
+    b = engine.body
+    g = np.ones(3 * len(engine.mounts))
+    state = None
+    prev_v = None
+    for _ in range(cycles):
+        k = iter(g)
+        eng_g = _map_networks(engine, lambda mi, m, ax, mod: mod.scaled_dynamic_stiffness(
+            float(next(k))))
+        system = assemble(b.mass, b.cg, b.inertia, eng_g.mounts)
+        F = np.zeros((n_cycle + 1, system.n_dof))
+        F[:, :6] = np.concatenate([load, load[:1]])
+        if state is None:
+            from powertrain.solvers.harmonic import harmonic_response
+            from powertrain.analysis.fourier import harmonic_amplitudes
+            fh = harmonic_amplitudes(load, axis=0)[: n_cycle // 2]
+            om = 0.5 * omega * np.arange(fh.shape[0])
+            qh = harmonic_response(system, fh, om)
+            state = (qh.real.sum(0), (1j * om[:, None] * qh).real.sum(0),
+                     (-(om ** 2)[:, None] * qh).real.sum(0))
+        X, V, A = newmark(system.M, system.C, system.K, F, h, *state)
+        state = (X[-1], V[-1], A[-1])
+        xe = X[:-1, :6] @ _rows(engine).T                     # (n_cycle, n_net)
+        a = np.sqrt(2.0) * np.std(xe, axis=0)
+        last_v = V[:-1] @ system.channel_matrix.T
+        g_used = g
+        g = g + 0.7 * (amplitude_factor(a, kappa, a_c) - g)
+        per = float("nan")
+        if prev_v is not None:
+            per = np.max(np.abs(last_v - prev_v)) / np.max(np.abs(last_v))
+        prev_v = last_v
+    return order_spectrum(last_v, 2).T, g_used, per
+
+
+def _rows(engine):
+    from powertrain.physics.rigid_body import direction_row
+    from powertrain.assembly import DIRECTIONS
+    cg = np.asarray(engine.body.cg, float)
+    return np.array([direction_row(np.asarray(m.position, float) - cg,
+                                   np.asarray(m.rotation, float)[:, i])
+                     for m in engine.mounts for i, _ in enumerate(DIRECTIONS)])

@@ -1,0 +1,251 @@
+r"""Cached frequency-domain model for many cheap re-solves (diagnosis, truth generation).
+
+The harmonic solver (:mod:`powertrain.solvers.harmonic`) condenses every mount network to its
+input-point stiffness and solves a 6×6 system per order. When only the mounts, the chassis
+under them or the sensors change, the load harmonics per speed stay the same; when the
+balancer or the cylinders change, only a few harmonics change, linearly in the unbalance or
+(to first order) in the cylinder IMEP. :class:`HarmonicModel` caches:
+
+* the load harmonics :math:`\hat{\mathbf f}_{r,h}` (speed r, harmonic h = 0..16, i.e.
+  orders 0…8 in steps of 0.5) [N, N·m];
+* each network's *two-port* dynamic stiffness between its engine-side node E and its ground
+  node B with the internal masses condensed,
+
+  .. math:: \begin{pmatrix} F_E \\ F_B \end{pmatrix} =
+            \begin{pmatrix} a & b \\ b & c \end{pmatrix}
+            \begin{pmatrix} x_E \\ x_B \end{pmatrix},
+            \qquad a = K_{IP},\; b = -K_{CP}\ \text{(rigid ground)},
+
+  so that a base of mass :math:`m_b`, stiffness :math:`c_b` and damping :math:`d_b` under the
+  network (:func:`powertrain.models.extensions.with_base_compliance`) gives, exactly,
+
+  .. math:: K_{IP}' = a - \frac{b^2}{c + c_b + i\omega d_b - \omega^2 m_b},
+
+  and a network whose springs, dampers and masses are all scaled by :math:`s` has
+  :math:`(a, b, c)` scaled by :math:`s`.
+
+:meth:`HarmonicModel.solve` then solves, for all speeds and harmonics at once,
+
+.. math:: \Big(-\omega_h^2\mathbf M_{rb} + \sum_n K_{IP,n}(\omega_h)\,
+          \mathbf r_n\mathbf r_n^T\Big)\hat{\mathbf q}_{r,h} = \hat{\mathbf f}_{r,h},
+
+and the channel velocities are :math:`\hat{\mathbf v} = i\omega_h\mathbf C\hat{\mathbf q}`
+(the same numbers as :func:`powertrain.runup.run_runup` with ``solver="harmonic"``, see
+tests/test_diagnose.py).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from powertrain.analysis.fourier import harmonic_amplitudes
+from powertrain.assembly import DIRECTIONS
+from powertrain.physics import balancer as bal
+from powertrain.physics.mount_network import network_matrices
+from powertrain.physics.rigid_body import (direction_row, point_motion_matrix,
+                                           rigid_body_mass_matrix)
+
+#: Harmonics of the engine cycle solved: h = 1..16 are orders 0.5..8.
+N_HARMONICS = 17
+#: Samples per engine cycle for the load harmonics (1° like the run-up default).
+N_ANGLE = 720
+
+
+def two_port(omega, masses, elem_nodes, c, d):
+    r"""Two-port dynamic stiffness ``(a, b, c)`` of a network between E and its ground node.
+
+    Parameters
+    ----------
+    omega : ndarray
+        Angular frequencies [rad/s], any shape.
+    masses, elem_nodes, c, d
+        Network (see :func:`powertrain.physics.mount_network.network_matrices`).
+
+    Returns
+    -------
+    a, b, c : ndarray complex, shape of ``omega`` [N/m]
+        :math:`a = K_{IP}` (ground fixed), :math:`b` the coupling, :math:`c` the
+        ground-side stiffness with E fixed.
+    """
+    w = np.asarray(omega, float)
+    M, C, K = network_matrices(masses, elem_nodes, c, d, include_ground=True)
+    ww = w.reshape(-1)[:, None, None]
+    D = K[None] + 1j * ww * C[None] - ww ** 2 * M[None]
+    n = M.shape[0] - 2
+    bnd = [0, n + 1]
+    Dbb = D[:, bnd][:, :, bnd]
+    if n:
+        Dbi = D[:, bnd, 1:n + 1]
+        Dib = D[:, 1:n + 1][:, :, bnd]
+        S = Dbb - Dbi @ np.linalg.solve(D[:, 1:n + 1, 1:n + 1], Dib)
+    else:
+        S = Dbb
+    shape = w.shape
+    return S[:, 0, 0].reshape(shape), S[:, 0, 1].reshape(shape), S[:, 1, 1].reshape(shape)
+
+
+def shaft_load(engine, shaft, rpm, theta):
+    r"""Generalized load of one balancer shaft [N, N·m], shape ``(n, 6)``, about the CG.
+
+    The shaft's centrifugal force (:func:`powertrain.physics.balancer.shaft_force`) at its
+    position; independent of whether the engine's balancer is enabled.
+    """
+    ct = engine.crank
+    omega = rpm * 2 * np.pi / 60.0
+    f_u, f_s = bal.shaft_force(theta, omega, shaft.mass_radius, shaft.phase, shaft.sense,
+                               engine.balancer.ratio)
+    F = f_u[:, None] * ct.cylinder_axis + f_s[:, None] * ct.lateral_axis
+    Mo = np.cross(np.asarray(shaft.position, float) - engine.body.cg, F)
+    return np.hstack([F, Mo])
+
+
+class HarmonicModel:
+    """Frequency-domain model of an engine at fixed speeds, with cached load harmonics.
+
+    Parameters
+    ----------
+    engine : Engine
+    rpm : array_like
+        Speeds [rpm] (inside the engine's range).
+    n_angle : int
+        Samples per engine cycle for the load harmonics.
+
+    Attributes
+    ----------
+    omega : ndarray (n_r, 17)
+        Angular frequency of harmonic h at each speed, :math:`h\\Omega/2` [rad/s].
+    rows : ndarray (n_net, 6)
+        Network direction rows :math:`\\mathbf r_n`.
+    channel_matrix : ndarray (n_ch, 6)
+        Rigid-body coordinates to mount-point motion in engine X/Y/Z.
+    networks : list of (mount index, axis name, MountModel)
+    """
+
+    def __init__(self, engine, rpm, n_angle=N_ANGLE):
+        self.engine = engine
+        self.rpm = np.atleast_1d(np.asarray(rpm, float))
+        self.n_angle = int(n_angle)
+        self.theta = 4 * np.pi * np.arange(self.n_angle) / self.n_angle
+        Omega = self.rpm * 2 * np.pi / 60.0
+        self.omega = 0.5 * Omega[:, None] * np.arange(N_HARMONICS)[None, :]
+        b = engine.body
+        self.M = rigid_body_mass_matrix(b.mass, b.inertia)
+        cg = np.asarray(b.cg, float)
+        rows, nets, cm = [], [], []
+        for mi, m in enumerate(engine.mounts):
+            r = np.asarray(m.position, float) - cg
+            R = np.asarray(m.rotation, float)
+            for ai, axis in enumerate(DIRECTIONS):
+                rows.append(direction_row(r, R[:, ai]))
+                nets.append((mi, axis, m.directions[axis]))
+            cm.append(point_motion_matrix(r))
+        self.rows = np.array(rows)
+        self.networks = nets
+        self.channel_matrix = np.vstack(cm)
+        self.channels = [(m.name, a) for m in engine.mounts for a in DIRECTIONS]
+        self.mount_names = [m.name for m in engine.mounts]
+        self._load = None
+        self._abc = None
+        self._extra = {}
+
+    # ------------------------------------------------------------------ cached parts
+    def load_of(self, engine) -> np.ndarray:
+        """Load harmonics of ``engine`` at the model's speeds, (n_r, 17, 6) complex."""
+        out = np.empty((self.rpm.size, N_HARMONICS, 6), complex)
+        for i, r in enumerate(self.rpm):
+            load = np.asarray(engine.generalized_load(float(r), self.theta), float)
+            out[i] = harmonic_amplitudes(load, axis=0)[:N_HARMONICS]
+        return out
+
+    @property
+    def load(self) -> np.ndarray:
+        """Load harmonics of the nominal engine, (n_r, 17, 6) complex [N, N·m]."""
+        if self._load is None:
+            self._load = self.load_of(self.engine)
+        return self._load
+
+    def shaft_loads(self) -> np.ndarray:
+        """Per balancer shaft load harmonics (n_shafts, n_r, 17, 6), nominal unbalance."""
+        if "shafts" not in self._extra:
+            sh = self.engine.balancer.shafts
+            out = np.zeros((len(sh), self.rpm.size, N_HARMONICS, 6), complex)
+            for k, s in enumerate(sh):
+                for i, r in enumerate(self.rpm):
+                    out[k, i] = harmonic_amplitudes(shaft_load(self.engine, s, r, self.theta),
+                                                    axis=0)[:N_HARMONICS]
+            self._extra["shafts"] = out
+        return self._extra["shafts"]
+
+    def imep_derivatives(self, step=0.05) -> np.ndarray:
+        r"""Load-harmonic derivatives per cylinder IMEP factor, (n_cyl, n_r, 17, 6).
+
+        Central differences :math:`(\mathbf f(1+\delta) - \mathbf f(1-\delta))/(2\delta)`
+        (``step`` :math:`\delta`) about all factors 1.
+        """
+        if "imep" not in self._extra:
+            n = self.engine.crank.n_cylinders
+            base = np.asarray(self.engine.combustion.imep_factors, float)
+            out = np.zeros((n, self.rpm.size, N_HARMONICS, 6), complex)
+            for k in range(n):
+                up, dn = base.copy(), base.copy()
+                up[k] += step
+                dn[k] -= step
+                out[k] = (self.load_of(self.engine.with_imep_factors(up))
+                          - self.load_of(self.engine.with_imep_factors(dn))) / (2 * step)
+            self._extra["imep"] = out
+        return self._extra["imep"]
+
+    def two_ports(self, models=None):
+        """``(a, b, c)`` of every network at every speed and harmonic, each (n_r, 17, n_net).
+
+        ``models`` (list of MountModel, one per network) defaults to the engine's own
+        networks (cached).
+        """
+        if models is None and self._abc is not None:
+            return self._abc
+        mods = [n[2] for n in self.networks] if models is None else models
+        abc = [np.empty(self.omega.shape + (len(mods),), complex) for _ in range(3)]
+        for k, mod in enumerate(mods):
+            res = two_port(self.omega, *mod.network())
+            for j in range(3):
+                abc[j][..., k] = res[j]
+        if models is None:
+            self._abc = tuple(abc)
+        return tuple(abc)
+
+    # ------------------------------------------------------------------ solves
+    def solve(self, kip, load=None, harmonics=slice(1, N_HARMONICS)) -> np.ndarray:
+        r"""Rigid-body amplitudes :math:`\hat{\mathbf q}` (n_r, n_h, 6) for the given input-point
+        stiffnesses ``kip`` (n_r, 17, n_net) [N/m] and load (default nominal)."""
+        load = self.load if load is None else load
+        w = self.omega[:, harmonics]
+        K = kip[:, harmonics]
+        D = (-(w ** 2))[..., None, None] * self.M + np.einsum(
+            "rhn,ni,nj->rhij", K, self.rows, self.rows)
+        return np.linalg.solve(D, load[:, harmonics][..., None])[..., 0]
+
+    def velocity(self, q, harmonics=slice(1, N_HARMONICS)) -> np.ndarray:
+        """Complex peak channel velocities (n_r, n_ch, n_h) [m/s] from :meth:`solve`'s q."""
+        w = self.omega[:, harmonics]
+        return np.einsum("ci,rhi->rch", self.channel_matrix, q) * (1j * w)[:, None, :]
+
+    def network_amplitude(self, q) -> np.ndarray:
+        r"""Engine-side peak displacement of each network :math:`a_n =
+        \sqrt{\sum_h |\mathbf r_n\cdot\hat{\mathbf q}_h|^2}` [m] (= √2 × RMS sum), (n_r, n_net)."""
+        x = np.einsum("ni,rhi->rhn", self.rows, q)
+        return np.sqrt(np.sum(np.abs(x) ** 2, axis=1))
+
+    def nominal_kip(self) -> np.ndarray:
+        return self.two_ports()[0]
+
+    def subset(self, index) -> "HarmonicModel":
+        """The model at the speeds ``rpm[index]``, sharing the cached parts computed so far."""
+        index = np.asarray(index)
+        new = object.__new__(HarmonicModel)
+        new.__dict__.update(self.__dict__)
+        new.rpm = self.rpm[index]
+        new.omega = self.omega[index]
+        new._load = None if self._load is None else self._load[index]
+        new._abc = None if self._abc is None else tuple(x[index] for x in self._abc)
+        new._extra = {k: v[:, index] for k, v in self._extra.items()}
+        return new
