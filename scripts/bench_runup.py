@@ -3,7 +3,11 @@
 
 Runs, on the default engine (or ``--engine``):
 
-* our Newmark stepper (Numba kernel, warm JIT), the whole run-up;
+* our Newmark stepper (Numba kernel, warm JIT), the whole run-up, as ``powertrain runup``
+  runs it: the average-acceleration recurrence diagonalised once per model
+  (:class:`powertrain.solvers.newmark.ModalNewmark`; identical to the physical-coordinate
+  kernel to round-off, tests/test_runup.py) — the dense physical-coordinate kernel's time is
+  printed too;
 * a plain NumPy Newmark loop (the same recurrence, one Python iteration per step);
 * ``scipy.integrate.solve_ivp`` with each stiff method (Radau, BDF, LSODA) on the first-order
   form of the same assembled model, from the same initial state, over the same six cycles,
@@ -142,6 +146,13 @@ def main(argv=None):
         wall = time.perf_counter() - t0
     err_nm = np.max(np.abs(res.synthesis_rms() / ref_syn - 1))
     newmark_s = best / rpms.size
+    dense = min(run_runup(engine, rpms, system=system, angle_step_deg=args.angle_step,
+                          stepper="dense").solver_seconds for _ in range(3))
+    err_dense = np.max(np.abs(run_runup(engine, rpms, system=system, stepper="dense")
+                              .synthesis_rms() / ref_syn - 1))
+    print(f"dense physical-coordinate Newmark kernel: run-up solver time {dense:.4f} s "
+          f"({dense / rpms.size:.5f} s per speed), max synthesis deviation vs harmonic "
+          f"{100 * err_dense:.3f} %")
     print(f"Newmark (Numba): run-up of {rpms.size} speeds, solver time {best:.4f} s warm "
           f"(best of {args.repeat}; wall incl. load sampling {wall:.3f} s), cold first run in a "
           f"fresh process {cold_total:.2f} s (solver {cold_solver:.2f} s); "

@@ -62,3 +62,43 @@ def newmark_kernel(G, H, Fs, h, x0, v0, a0, X, V, A):
         for j in range(n):
             X[k, j] = xt[j] + hh * A[k, j]
             V[k, j] = vt[j] + hv * A[k, j]
+
+
+@njit(cache=True, nogil=True)
+def modal_trapezoid_kernel(lam_d, gain, G, n_steps, eta0, keep_from, out):
+    r"""Newmark average acceleration in the modal coordinates of the first-order system.
+
+    With :math:`\dot{\mathbf z} = \mathbf A\mathbf z + \mathbf b(t)` and
+    :math:`\mathbf A = \boldsymbol\Psi\boldsymbol\Lambda\boldsymbol\Psi^{-1}`, the average
+    acceleration rule is the trapezoidal rule, so each mode obeys
+
+    .. math:: \eta_{k} = \lambda_d\,\eta_{k-1} + \gamma\,(g_{k-1} + g_k),\qquad
+              \lambda_d = \frac{1 + h\lambda/2}{1 - h\lambda/2},\quad
+              \gamma = \frac{h/2}{1 - h\lambda/2}.
+
+    Parameters
+    ----------
+    lam_d, gain : ndarray complex (m,)
+    G : ndarray complex (N, m)
+        Modal loads :math:`\boldsymbol\Psi^{-1}\mathbf b(t_k)` over one load period of N
+        steps; step k uses row ``k % N``.
+    n_steps : int
+    eta0 : ndarray complex (m,)
+    keep_from : int
+        First time index written to ``out``.
+    out : ndarray complex (n_steps + 1 - keep_from, m)
+    """
+    m = eta0.shape[0]
+    N = G.shape[0]
+    eta = eta0.copy()
+    if keep_from == 0:
+        for j in range(m):
+            out[0, j] = eta[j]
+    for k in range(1, n_steps + 1):
+        kp = (k - 1) % N
+        kc = k % N
+        for j in range(m):
+            eta[j] = lam_d[j] * eta[j] + gain[j] * (G[kp, j] + G[kc, j])
+        if k >= keep_from:
+            for j in range(m):
+                out[k - keep_from, j] = eta[j]

@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from powertrain.kernels.newmark import newmark_kernel
+from powertrain.kernels.newmark import modal_trapezoid_kernel, newmark_kernel
 
 
 def _prepare(M, C, K, h):
@@ -105,3 +105,124 @@ def periodic_state(M, C, K, F_period, h):
         Phi[:, col] = np.concatenate([X[-1], V[-1], A[-1]])
     z0 = np.linalg.lstsq(np.eye(3 * n) - Phi, g, rcond=None)[0]
     return z0[:n], z0[n:2 * n], z0[2 * n:]
+
+
+class ModalNewmark:
+    r"""Newmark average acceleration for a linear time-invariant model, in modal coordinates.
+
+    Average acceleration (β = 1/4, γ = 1/2) is the trapezoidal rule applied to the
+    first-order form :math:`\dot{\mathbf z} = \mathbf A\mathbf z + \mathbf b`,
+    :math:`\mathbf z = (\mathbf x, \dot{\mathbf x})`,
+    :math:`\mathbf A = \begin{bmatrix}0 & I\\ -M^{-1}K & -M^{-1}C\end{bmatrix}`, so its
+    propagator :math:`(I - \tfrac h2 A)^{-1}(I + \tfrac h2 A)` shares the eigenvectors of
+    :math:`\mathbf A`. One eigendecomposition per model (independent of the step) turns every
+    step into a diagonal complex recurrence (:func:`~powertrain.kernels.newmark.modal_trapezoid_kernel`)
+    that reproduces :func:`newmark` to round-off (tests/test_runup.py checks it) at a fraction
+    of the cost. Needs a regular mass matrix; use :func:`newmark` otherwise, and for nonlinear
+    elements.
+
+    Parameters
+    ----------
+    M, C, K : ndarray (n, n)
+    load_dofs : int
+        The load acts on the first ``load_dofs`` coordinates (6: the rigid body).
+    """
+
+    def __init__(self, M, C, K, load_dofs=None):
+        M = np.asarray(M, float)
+        n = M.shape[0]
+        Minv = np.linalg.inv(M)
+        A = np.zeros((2 * n, 2 * n))
+        A[:n, n:] = np.eye(n)
+        A[n:, :n] = -Minv @ K
+        A[n:, n:] = -Minv @ np.asarray(C, float)
+        lam, Psi = np.linalg.eig(A)
+        self.n = n
+        self.lam = lam
+        self.Psi = Psi
+        self.Psi_inv = np.linalg.inv(Psi)
+        nl = n if load_dofs is None else int(load_dofs)
+        self.load_dofs = nl
+        self.M, self.C, self.K, self.Minv = M, np.asarray(C, float), np.asarray(K, float), Minv
+        err = np.linalg.norm(Psi @ np.diag(lam) @ self.Psi_inv - A) / np.linalg.norm(A)
+        if not err < 1e-8:
+            raise np.linalg.LinAlgError(f"state matrix not safely diagonalisable ({err:.1e})")
+        #: modal load per unit generalized load: Psi^-1 [0; M^-1 B]
+        self.load_map = self.Psi_inv[:, n:] @ Minv[:, :nl]
+        # For real loads and states the modal coordinates of a conjugate pair of modes are
+        # conjugate: step one of each pair and count it twice in z = Re(sum Psi eta).
+        scale = np.abs(lam).max()
+        real_mode = np.abs(lam.imag) <= 1e-12 * scale
+        keep = real_mode | (lam.imag > 0)
+        if not np.isclose(2 * np.count_nonzero(lam.imag > 0) + np.count_nonzero(real_mode),
+                          lam.size):
+            raise np.linalg.LinAlgError("eigenvalues not in conjugate pairs")
+        weight = np.where(real_mode[keep], 1.0, 2.0)
+        self.lam_r = lam[keep]
+        self.Psi_r = Psi[:, keep] * weight[None, :]
+        self.Psi_inv_r = self.Psi_inv[keep]
+        self.load_map_r = self.load_map[keep]
+
+    def run(self, F, h, x0, v0, keep_from=0):
+        """Integrate with the load ``F`` (n_steps + 1, load_dofs) [N] from (x0, v0).
+
+        Returns
+        -------
+        X, V, A : ndarray (n_steps + 1 - keep_from, n)
+            States from time index ``keep_from`` on (A from the equation of motion).
+        """
+        F = np.asarray(F, float)
+        lam_d = (1 + 0.5 * h * self.lam) / (1 - 0.5 * h * self.lam)
+        gain = (0.5 * h) / (1 - 0.5 * h * self.lam)
+        G = np.ascontiguousarray(F @ self.load_map.T)
+        eta0 = self.Psi_inv @ np.concatenate([x0, v0]).astype(complex)
+        out = np.empty((F.shape[0] - keep_from, self.lam.size), dtype=complex)
+        modal_trapezoid_kernel(lam_d, gain, G, F.shape[0] - 1, eta0, int(keep_from), out)
+        Z = (out @ self.Psi.T).real
+        X, V = Z[:, :self.n], Z[:, self.n:]
+        f_full = np.zeros((F.shape[0] - keep_from, self.n))
+        f_full[:, :self.load_dofs] = F[keep_from:]
+        A = (f_full - V @ self.C.T - X @ self.K.T) @ self.Minv.T
+        return X, V, A
+
+    def output_map(self, Wx, Wv, Wa=None):
+        """Modal map of outputs ``y = Wx x + Wv v (+ Wa a)`` (rows = outputs).
+
+        Returns ``(W_modal, W_load)``: ``y = Re(eta @ W_modal.T) + F @ W_load.T``, the second
+        term being the direct load part of the acceleration, a = M^-1 (f - C v - K x).
+        ``W_modal`` is returned as the pair (Re W^T, Im W^T) used by :meth:`run_outputs`.
+        """
+        n = self.n
+        Wm = np.asarray(Wx, float) @ self.Psi_r[:n] + np.asarray(Wv, float) @ self.Psi_r[n:]
+        W_load = np.zeros((Wm.shape[0], self.load_dofs))
+        if Wa is not None:
+            Wa = np.asarray(Wa, float)
+            Wm = Wm + Wa @ (self.Psi_r[n:] * self.lam_r[None, :])
+            W_load = Wa @ self.Minv[:, :self.load_dofs]
+        return (np.ascontiguousarray(Wm.real.T), np.ascontiguousarray(Wm.imag.T)), W_load
+
+    def harmonic_state(self, load_harmonics, omegas):
+        """Steady state (x, v) at t = 0 of the harmonic load sum, in modal coordinates:
+        eta_j = (Psi^-1 b_j) / (i w_j - lambda), z(0) = Re sum_j Psi eta_j."""
+        g = np.asarray(load_harmonics, complex) @ self.load_map.T          # (n_h, m)
+        eta = g / (1j * np.asarray(omegas, float)[:, None] - self.lam[None, :])
+        z0 = (self.Psi @ eta.sum(axis=0)).real
+        return z0[:self.n], z0[self.n:]
+
+    def run_outputs(self, F_cycle, cycles, h, x0, v0, keep_from, W_modal, W_load):
+        """Integrate ``cycles`` repetitions of the one-cycle load ``F_cycle`` (N, load_dofs)
+        and return only the outputs ``y`` (rows from time index ``keep_from``)."""
+        F_cycle = np.asarray(F_cycle, float)
+        N = F_cycle.shape[0]
+        lam_d = (1 + 0.5 * h * self.lam_r) / (1 - 0.5 * h * self.lam_r)
+        gain = (0.5 * h) / (1 - 0.5 * h * self.lam_r)
+        G = np.ascontiguousarray(F_cycle @ self.load_map_r.T)
+        eta0 = self.Psi_inv_r @ np.concatenate([x0, v0]).astype(complex)
+        out = np.empty((cycles * N + 1 - keep_from, self.lam_r.size), dtype=complex)
+        modal_trapezoid_kernel(lam_d, gain, G, cycles * N, eta0, int(keep_from), out)
+        # Re(eta W^T) as two real products
+        Y = out.real @ W_modal[0] - out.imag @ W_modal[1]
+        if np.any(W_load):
+            idx = (np.arange(keep_from, cycles * N + 1)) % N
+            Y += F_cycle[idx] @ W_load.T
+        return Y
