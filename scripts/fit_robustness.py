@@ -88,8 +88,13 @@ def main(argv=None):
     if unknown or args.seeds < 1:
         ap.error(f"unknown set(s) {unknown}" if unknown else "--seeds must be >= 1")
 
-    from powertrain.fitting import (DEFAULT_POLISH, DEFAULT_SEED, DEFAULT_STARTS, fit_mount,
-                                    relative_rms_error)
+    from powertrain.fitting import (
+        DEFAULT_POLISH,
+        DEFAULT_SEED,
+        DEFAULT_STARTS,
+        fit_mount,
+        relative_rms_error,
+    )
 
     # compile the kernel once, outside the timings
     f0, k0, _ = synthesise(load_set(names[0]), 0)

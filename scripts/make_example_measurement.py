@@ -89,7 +89,7 @@ def local_displacement_amplitude(engine, result):
     """(n_rpm, mount, axis) -> engine-side peak displacement amplitude along the mount's
     local axis: sqrt(2) x RMS sum over orders [m]."""
     out = {}
-    for mi, m in enumerate(engine.mounts):
+    for m in engine.mounts:
         idx = [result.channel_index(m.name, a) for a in "xyz"]
         d = result.displacement[:, idx, :]                      # (n_rpm, 3, n_orders)
         local = np.einsum("ji,rjo->rio", np.asarray(m.rotation, float), d)   # R^T d

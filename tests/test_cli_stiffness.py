@@ -14,9 +14,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 from click.testing import CliRunner
+from tolerances import TIME_VS_FREQUENCY_REL
 
 from powertrain.cli import main
-from tolerances import TIME_VS_FREQUENCY_REL
 
 MOUNTS = Path(__file__).resolve().parents[1] / "mounts"
 BASE = MOUNTS / "hydraulic-engine-mount-x.toml"

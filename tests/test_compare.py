@@ -210,7 +210,7 @@ def test_peak_column_is_converted_to_rms(tmp_path, sim_csv):
     b = read_measured(write_long_csv(tmp_path / "peak.csv", peak,
                                      header="mount,direction,quantity,rpm,"
                                             "velocity_peak_mm_per_s"))
-    for key, (r, v) in a.curves.items():
+    for key, (_r, v) in a.curves.items():
         np.testing.assert_allclose(b.curves[key][1], v, rtol=1e-12)
     assert b.notes and "sqrt(2)" in b.notes[0] and not a.notes
     c = read_measured(write_long_csv(tmp_path / "si.csv",
@@ -218,7 +218,7 @@ def test_peak_column_is_converted_to_rms(tmp_path, sim_csv):
                                       for m, d, q, r, v in rows],
                                      header="mount,direction,quantity,rpm,"
                                             "velocity_rms_m_per_s"))
-    for key, (r, v) in a.curves.items():
+    for key, (_r, v) in a.curves.items():
         np.testing.assert_allclose(c.curves[key][1], v, rtol=1e-12)
 
 

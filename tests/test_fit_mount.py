@@ -97,7 +97,7 @@ def test_gradient_kernel_numpy_and_finite_differences_agree(name):
             plus[j] += h
             minus[j] -= h
 
-            def k_of(v):
+            def k_of(v, base=base):
                 args = {"m": masses, "c": c, "d": d}
                 key = "m" if base is masses else "c" if base is c else "d"
                 args[key] = v

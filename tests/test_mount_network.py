@@ -11,12 +11,16 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from tolerances import (
+    CLOSED_FORM_REL,
+    NEWMARK_BOUND_SAFETY,
+    PERIODIC_STATE_REL,
+    TIME_VS_FREQUENCY_REL,
+)
 
 from powertrain.models.mount import TOPOLOGIES, MountModel
 from powertrain.solvers.mount_time_domain import time_cross_point_stiffness
 from powertrain.solvers.newmark import newmark, periodic_state
-from tolerances import (CLOSED_FORM_REL, NEWMARK_BOUND_SAFETY, PERIODIC_STATE_REL,
-                        TIME_VS_FREQUENCY_REL)
 
 FREQS_HZ = np.array([0.5, 3.0, 17.0, 60.0, 150.0, 400.0])
 

@@ -24,8 +24,16 @@ from powertrain.errors import InputError
 from powertrain.iotools.engine_file import read_engine
 from powertrain.retune import band_weight, retune
 from powertrain.sweep import SerialExecutor, SweepTask, run_sweep
-from powertrain.variants import (Variant, apply_operations, parse_move, parse_rotate,
-                                 parse_scale, parse_set, parse_target, read_variants)
+from powertrain.variants import (
+    Variant,
+    apply_operations,
+    parse_move,
+    parse_rotate,
+    parse_scale,
+    parse_set,
+    parse_target,
+    read_variants,
+)
 from powertrain.whatif import run_whatif
 
 RPM = np.array([1500.0, 3000.0, 4500.0])

@@ -20,8 +20,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from powertrain.physics.mount_network import ground_force_rows
-from powertrain.physics.rigid_body import (direction_row, point_motion_matrix,
-                                           rigid_body_mass_matrix)
+from powertrain.physics.rigid_body import direction_row, point_motion_matrix, rigid_body_mass_matrix
 
 DIRECTIONS = ("x", "y", "z")
 

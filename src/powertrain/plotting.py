@@ -108,7 +108,6 @@ def plot_comparison(comparison, path=None, quantities=("synthesis", "order_2", "
         Columns.
     """
     import numpy as np
-
     from matplotlib.lines import Line2D
     from matplotlib.ticker import NullFormatter
 
@@ -466,7 +465,7 @@ def plot_gap_frequency(diagnosis, path=None):
         a1.plot(sc["frequency_hz"], np.array(row) + p["channel_const_db"][c], "k-", lw=0.6,
                 alpha=0.6, label="fitted dH_channel(f) + g_channel" if c == 0 else None)
     ec = p["excitation_curves"]
-    for k, row in zip(qs, ec["by_quantity"]):
+    for row in ec["by_quantity"]:
         a2.plot(ec["rpm"], row, "--", color="k", lw=0.6, alpha=0.6)
     a1.set_xscale("log")
     a1.set_xlabel("frequency = order x rpm / 60 [Hz]")

@@ -159,7 +159,7 @@ class RunupResult:
                 g.create_dataset("solver_seconds", data=self.solver_seconds).attrs["unit"] = "s"
 
     @classmethod
-    def from_hdf5(cls, path) -> "RunupResult":
+    def from_hdf5(cls, path) -> RunupResult:
         import h5py
 
         from powertrain.errors import InputError

@@ -76,8 +76,10 @@ def stiffness_table(model, frequency_hz, method="frequency", engine_mass=None, f
         x1, ft = model.forced_engine_mass_response(f, engine_mass, force)
         return StiffnessTable(f, model.cross_point_stiffness(f), method, x1, ft)
     if method == "time":
-        from powertrain.solvers.mount_time_domain import (time_cross_point_stiffness,
-                                                          time_forced_response)
+        from powertrain.solvers.mount_time_domain import (
+            time_cross_point_stiffness,
+            time_forced_response,
+        )
         if engine_mass is None:
             r = time_cross_point_stiffness(model, f, **kw)
             return StiffnessTable(f, r.kcp, method, meta={"periodicity": r.periodicity})

@@ -44,7 +44,8 @@ def fit_mount(measured, model, out, plot, starts, seed, fmin, fmax):
     from pathlib import Path
 
     from powertrain.errors import InputError
-    from powertrain.fitting import DEFAULT_SEED, DEFAULT_STARTS, fit_mount as fit
+    from powertrain.fitting import DEFAULT_SEED, DEFAULT_STARTS
+    from powertrain.fitting import fit_mount as fit
     from powertrain.iotools.mount_file import write_mount
     from powertrain.iotools.stiffness_csv import FREQUENCY, read_stiffness_csv
     from powertrain.units import from_si

@@ -33,10 +33,10 @@ def stiffness(mount_file, freq, method, fmt, plot, engine_mass, force):
       powertrain stiffness mounts/thesis-appendix-a.toml --freq 5,10,12,15,17,20,25,30,40 \\
           --engine-mass 100 --force 100 --method time --format csv
     """
+    from powertrain.analysis.stiffness_table import stiffness_table
+    from powertrain.cli.common import parse_frequencies
     from powertrain.errors import InputError
     from powertrain.iotools.mount_file import read_mount
-    from powertrain.cli.common import parse_frequencies
-    from powertrain.analysis.stiffness_table import stiffness_table
 
     if (engine_mass is None) != (force is None):
         raise InputError("--engine-mass and --force go together", key="--engine-mass")

@@ -75,8 +75,14 @@ def whatif(engine_file, rpm_from, rpm_to, rpm_step, solver, scale, set_, swap, m
     from powertrain.errors import InputError
     from powertrain.iotools.engine_file import DEFAULT_ENGINE_PATH, read_engine
     from powertrain.runup import default_rpm
-    from powertrain.variants import (Origin, Variant, check_operations, parse_operations,
-                                     parse_target, read_variants)
+    from powertrain.variants import (
+        Origin,
+        Variant,
+        check_operations,
+        parse_operations,
+        parse_target,
+        read_variants,
+    )
 
     if not (rpm_from > 0 and rpm_to >= rpm_from and rpm_step > 0):
         raise InputError("need 0 < --from <= --to and --step > 0", key="--from/--to/--step")

@@ -132,7 +132,7 @@ class MeasuredRunup:
         return lo, hi
 
     @classmethod
-    def from_result(cls, result, source: str = "") -> "MeasuredRunup":
+    def from_result(cls, result, source: str = "") -> MeasuredRunup:
         """RMS velocity curves (synthesis and every order) of a
         :class:`~powertrain.results.RunupResult`."""
         rpm = np.asarray(result.rpm, float)

@@ -51,7 +51,7 @@ class MeasuredStiffness:
     kcp: np.ndarray
     source: str = ""
 
-    def select(self, fmin=None, fmax=None) -> "MeasuredStiffness":
+    def select(self, fmin=None, fmax=None) -> MeasuredStiffness:
         """The points with ``fmin <= f <= fmax`` [Hz] (either bound optional)."""
         keep = np.ones(self.frequency_hz.size, bool)
         if fmin is not None:

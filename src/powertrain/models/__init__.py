@@ -1,4 +1,4 @@
 """Thin model objects over the physics functions: mounts, engine, powertrain."""
-from powertrain.models.mount import MountModel, Topology, TOPOLOGIES, DEFAULT_TOPOLOGY
+from powertrain.models.mount import DEFAULT_TOPOLOGY, TOPOLOGIES, MountModel, Topology
 
 __all__ = ["MountModel", "Topology", "TOPOLOGIES", "DEFAULT_TOPOLOGY"]

@@ -439,12 +439,12 @@ class Engine:
     _cache: dict = field(default_factory=dict, repr=False, compare=False)
 
     # ------------------------------------------------------------------ copies
-    def replace(self, **changes) -> "Engine":
+    def replace(self, **changes) -> Engine:
         """A copy with fields replaced (``dataclasses.replace``; the pressure cache is reset)."""
         changes.setdefault("_cache", {})
         return dataclasses.replace(self, **changes)
 
-    def with_balancers(self, enabled: bool = True, mass_radius: float | None = None) -> "Engine":
+    def with_balancers(self, enabled: bool = True, mass_radius: float | None = None) -> Engine:
         """A copy with the balancer shafts switched on or off (and optionally every shaft's
         unbalance set to ``mass_radius`` [kg·m])."""
         shafts = self.balancer.shafts
@@ -453,7 +453,7 @@ class Engine:
         return self.replace(balancer=dataclasses.replace(self.balancer, enabled=bool(enabled),
                                                          shafts=shafts))
 
-    def with_imep_factors(self, factors) -> "Engine":
+    def with_imep_factors(self, factors) -> Engine:
         """A copy with per-cylinder IMEP factors (single-zone model only)."""
         factors = np.asarray(factors, dtype=float)
         if factors.shape != (self.crank.n_cylinders,):

@@ -164,7 +164,7 @@ class MountModel:
             raise ValueError(f"missing parameters {missing} for {self.topology.name}")
 
     @classmethod
-    def from_values(cls, topology: str | Topology, values, **meta) -> "MountModel":
+    def from_values(cls, topology: str | Topology, values, **meta) -> MountModel:
         """Build from a sequence of SI values in the topology's parameter order."""
         topo = TOPOLOGIES[topology] if isinstance(topology, str) else topology
         values = np.asarray(values, dtype=float)
@@ -207,11 +207,11 @@ class MountModel:
         """Cross-point stiffness at zero frequency [N/m]."""
         return float(self.cross_point_stiffness(0.0)[0].real)
 
-    def with_params(self, **changes) -> "MountModel":
+    def with_params(self, **changes) -> MountModel:
         """A copy with some parameters replaced (SI)."""
         return replace(self, params={**self.params, **changes})
 
-    def scaled(self, stiffness: float = 1.0, damping: float = 1.0) -> "MountModel":
+    def scaled(self, stiffness: float = 1.0, damping: float = 1.0) -> MountModel:
         """A copy with every spring scaled by ``stiffness`` and every damper by ``damping``.
 
         Scaling all springs (and masses unchanged) scales K_CP's real part only at low
@@ -222,7 +222,7 @@ class MountModel:
                for p, v in self.params.items()}
         return replace(self, params=new)
 
-    def scaled_dynamic_stiffness(self, factor: float) -> "MountModel":
+    def scaled_dynamic_stiffness(self, factor: float) -> MountModel:
         """A copy whose K_CP(ω) is exactly ``factor`` times this one at every frequency.
 
         Every c, d and m scaled by the same factor: D(ω) scales by it, the internal motion
