@@ -20,6 +20,10 @@ from powertrain.cli import main
               show_default=True,
               help="newmark: time integration, 6 cycles, last 2 processed; harmonic: "
                    "frequency-domain steady state order by order.")
+@click.option("--stepper", type=click.Choice(["auto", "modal", "dense"]), default="auto",
+              show_default=True,
+              help="Newmark implementation: modal (diagonalised recurrence), dense "
+                   "(physical coordinates); auto = modal when the mass matrix is regular.")
 @click.option("--angle-step", type=float, default=1.0, show_default=True,
               help="Crank-angle increment of the Newmark stepper [deg].")
 @click.option("--out", type=click.Path(dir_okay=False), default="runup.h5", show_default=True,
@@ -31,8 +35,8 @@ from powertrain.cli import main
               help="Thesis figure set (Figs 45-71) as PNG.")
 @click.option("--no-balancers", is_flag=True, help="Switch the balancer shafts off.")
 @click.option("--quiet", is_flag=True, help="No progress bar and no table.")
-def runup(rpm_from, rpm_to, rpm_step, engine_file, solver, angle_step, out, csv_file, plot,
-          no_balancers, quiet):
+def runup(rpm_from, rpm_to, rpm_step, engine_file, solver, stepper, angle_step, out, csv_file,
+          plot, no_balancers, quiet):
     """Run-up: steady-state mount-point velocities at each speed, order analysed.
 
     Prints the rigid-body modes and the synthesis (RMS sum of orders 0.5..8) velocity of the
@@ -58,7 +62,7 @@ def runup(rpm_from, rpm_to, rpm_step, engine_file, solver, angle_step, out, csv_
     rpm = default_rpm(rpm_from, rpm_to, rpm_step)
     try:
         result = run_runup(engine, rpm, solver=solver, angle_step_deg=angle_step,
-                           progress=not quiet)
+                           progress=not quiet, stepper=stepper)
     except ValueError as exc:
         raise InputError(str(exc), key="--angle-step") from None
     snapshot = open(engine_path, encoding="utf-8").read()
