@@ -48,6 +48,8 @@ class PeriodicityWarning(UserWarning):
 
 
 def default_rpm(start=1000.0, stop=6000.0, step=500.0) -> np.ndarray:
+    """Speed steps ``start, start + step, ... <= stop`` [rpm] (default: the thesis's 1000 to
+    6000 rpm in 500 rpm steps, sec. 4.4)."""
     n = int(np.floor((stop - start) / step + 1e-9)) + 1
     return start + step * np.arange(n)
 

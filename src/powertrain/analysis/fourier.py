@@ -20,6 +20,8 @@ def harmonic_amplitudes(samples, axis=0):
     samples : ndarray
         Equally spaced samples covering the window exactly once (do not repeat the end
         point), along ``axis``.
+    axis : int
+        Time axis of ``samples``.
 
     Returns
     -------

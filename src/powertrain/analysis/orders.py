@@ -34,6 +34,8 @@ def order_spectrum(samples, revolutions, orders=ORDERS, axis=0):
         Window length in crank revolutions (4 for two four-stroke cycles).
     orders : array_like
         Orders wanted; each times ``revolutions`` must be an integer.
+    axis : int
+        Time axis of ``samples``.
 
     Returns
     -------

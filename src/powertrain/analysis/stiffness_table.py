@@ -67,6 +67,9 @@ def stiffness_table(model, frequency_hz, method="frequency", engine_mass=None, f
         [kg]
     force : float, optional
         [N]
+    steps_per_period : int, optional
+        Newmark steps per excitation period for the time method (default
+        :data:`powertrain.solvers.mount_time_domain.STEPS_PER_PERIOD`).
     """
     f = np.asarray(frequency_hz, float)
     kw = {} if steps_per_period is None else {"steps_per_period": steps_per_period}

@@ -67,5 +67,11 @@ def matching_mass_radius(m_rec, r, a2, n_cylinders=4, n_shafts=2, ratio=2.0):
         Second-order coefficient :math:`A_2` of the piston acceleration [-]
         (≈ λ at leading order; see
         :func:`powertrain.physics.slider_crank.second_order_coefficient`).
+    n_cylinders : int
+        Number of cylinders of the inline engine [-].
+    n_shafts : int
+        Number of balancer shafts sharing the force [-].
+    ratio : float
+        Shaft speed over crank speed ρ [-] (2 for second-order balancing).
     """
     return n_cylinders * m_rec * r * a2 / (n_shafts * ratio**2)

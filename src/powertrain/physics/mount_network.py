@@ -194,6 +194,8 @@ def forced_engine_mass_response(omega, masses, elem_nodes, c, d, engine_mass, fo
     ----------
     omega : array_like
         Angular frequency [rad/s].
+    masses, elem_nodes, c, d
+        Network, see :func:`network_matrices`.
     engine_mass : float
         [kg]
     force : float

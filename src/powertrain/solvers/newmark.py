@@ -73,6 +73,8 @@ def periodic_state(M, C, K, F_period, h):
 
     Parameters
     ----------
+    M, C, K : ndarray (n, n)
+        [kg], [N·s/m], [N/m].
     F_period : ndarray (N + 1, n)
         Load over exactly one period, ``F_period[N] == F_period[0]``.
     h : float
