@@ -293,3 +293,27 @@ def test_cli_unreadable_file(tmp_path, kind):
     lines = res.stderr.splitlines()
     assert len(lines) == 1 and str(path) in lines[0], res.stderr
     assert not out.exists()
+
+
+def test_max_mass_bounds_internal_masses_and_still_fits():
+    """K_CP alone leaves the internal masses free (the thesis sets carry up to 200 kg); a
+    physical bound must be honoured and, for the hydraulic Y set (true masses 0.67, 0.71,
+    3.96 kg), still reach the noise-free curve."""
+    truth = read_mount(MOUNTS / "hydraulic-engine-mount-y.toml")
+    f = np.arange(1.0, 201.0)
+    k = truth.cross_point_stiffness(f)
+    res = fit_mount(f, k, "triple-parallel", max_mass=5.0)
+    masses = [res.model.params[p] for p in ("m1", "m2", "m3")]
+    assert max(masses) <= 5.0 * (1 + 1e-9)
+    assert res.rel_rms < 0.005
+    with pytest.raises(ValueError):
+        fit_mount(f, k, "triple-parallel", max_mass=-1.0)
+
+
+def test_cli_rejects_non_positive_max_mass(tmp_path):
+    csv = tmp_path / "k.csv"
+    csv.write_text("frequency_hz,k_real_n_per_mm,k_imag_n_per_mm\n" +
+                   "".join(f"{f},{100 + f},{f / 10}\n" for f in range(1, 30)))
+    out = tmp_path / "fit.toml"
+    r = CliRunner().invoke(main, ["fit-mount", str(csv), "--out", str(out), "--max-mass", "0"])
+    assert r.exit_code == 1 and "--max-mass" in r.output and not out.exists()

@@ -109,14 +109,16 @@ def relative_rms_error(kcp_model, kcp_measured) -> float:
     return float(np.sqrt(np.sum(np.abs(diff) ** 2) / np.sum(np.abs(km) ** 2)))
 
 
-def parameter_box(topology: Topology, frequency_hz, kcp_measured):
+def parameter_box(topology: Topology, frequency_hz, kcp_measured, max_mass=None):
     r"""Wide box of plausible log-parameters, scaled to the data.
 
     With :math:`K_s` the RMS of :math:`|K_m|` [N/m] and :math:`\omega_{lo}, \omega_{hi}` the
     lowest non-zero and the highest angular frequency [rad/s]: springs
     :math:`K_s\,[10^{-8}, 10^{4}]`, dampers :math:`[10^{-8} K_s/\omega_{hi}, 10^{3}
     K_s/\omega_{lo}]`, masses :math:`[10^{-8} K_s/\omega_{hi}^2, 10^{3} K_s/\omega_{lo}^2]`.
-    The lower ends stand for "absent" (a zero in a thesis parameter list).
+    The lower ends stand for "absent" (a zero in a thesis parameter list). ``max_mass``
+    [kg], when given, caps every internal mass: K_CP alone does not identify the internal
+    masses (the engine, which feels K_IP, does), so a physically known bound helps.
 
     Returns
     -------
@@ -133,8 +135,9 @@ def parameter_box(topology: Topology, frequency_hz, kcp_measured):
             lo.append(ks / whi * 1e-8)
             hi.append(ks / wlo * 1e3)
         else:
-            lo.append(ks / whi**2 * 1e-8)
-            hi.append(ks / wlo**2 * 1e3)
+            m_hi = ks / wlo**2 * 1e3 if max_mass is None else float(max_mass)
+            lo.append(min(ks / whi**2 * 1e-8, m_hi * 1e-6))
+            hi.append(m_hi)
     return np.log(lo), np.log(hi)
 
 
@@ -147,7 +150,8 @@ def _scales(frequency_hz, kcp_measured):
     return ks, wlo, whi
 
 
-def starting_points(topology: Topology, frequency_hz, kcp_measured, n: int, seed=DEFAULT_SEED):
+def starting_points(topology: Topology, frequency_hz, kcp_measured, n: int, seed=DEFAULT_SEED,
+                    max_mass=None):
     r"""``n`` random starting log-parameter vectors (seeded), scaled to the data.
 
     Springs :math:`K_s 10^{U(-2, 1)}`; dampers :math:`K_s/\omega_c \cdot 10^{U(-2, 0)}`;
@@ -160,7 +164,7 @@ def starting_points(topology: Topology, frequency_hz, kcp_measured, n: int, seed
     """
     rng = np.random.default_rng(seed)
     ks, wlo, whi = _scales(frequency_hz, kcp_measured)
-    lo, hi = parameter_box(topology, frequency_hz, kcp_measured)
+    lo, hi = parameter_box(topology, frequency_hz, kcp_measured, max_mass)
     out = np.empty((n, len(topology.parameters)))
     for i in range(n):
         for j, p in enumerate(topology.parameters):
@@ -178,12 +182,12 @@ def starting_points(topology: Topology, frequency_hz, kcp_measured, n: int, seed
 class _Problem:
     """Normalised complex residual and its Jacobian in log-parameters, with a soft wall."""
 
-    def __init__(self, topology: Topology, frequency_hz, kcp_measured):
+    def __init__(self, topology: Topology, frequency_hz, kcp_measured, max_mass=None):
         self.topology = topology
         self.omega = 2 * np.pi * np.asarray(frequency_hz, float)
         self.km = np.asarray(kcp_measured, complex)
         self.norm = float(np.sqrt(np.sum(np.abs(self.km) ** 2)))
-        self.lo, self.hi = parameter_box(topology, frequency_hz, kcp_measured)
+        self.lo, self.hi = parameter_box(topology, frequency_hz, kcp_measured, max_mass)
         names = topology.parameters
         n_el, n = len(topology.elements), topology.n_internal
         self.B = incidence_matrix(n, topology.elem_nodes)
@@ -339,7 +343,8 @@ class FitResult:
 
 def fit_mount(frequency_hz, kcp_measured, model: str | Topology = DEFAULT_TOPOLOGY, *,
               starts: int = DEFAULT_STARTS, seed=DEFAULT_SEED, polish: int = DEFAULT_POLISH,
-              hops: int = DEFAULT_HOPS, name: str = "", source: str = "") -> FitResult:
+              hops: int = DEFAULT_HOPS, name: str = "", source: str = "",
+              max_mass: float | None = None) -> FitResult:
     """Identify the parameters of a lumped mount model from a measured K*(f) (sec. 2.2).
 
     Minimises :math:`f_{obj}` (Kovarik 2016, eq. 19) over non-negative parameters; see the
@@ -364,6 +369,10 @@ def fit_mount(frequency_hz, kcp_measured, model: str | Topology = DEFAULT_TOPOLO
         replaced by fresh starting values and the result kept when better.
     name, source : str
         Metadata for the returned model.
+    max_mass : float, optional
+        Upper bound of every internal mass [kg] (default: the data-scaled box of
+        :func:`parameter_box`). K_CP does not identify the internal masses, but the engine
+        feels them through K_IP: bound them when their physical size is known.
 
     Returns
     -------
@@ -398,9 +407,11 @@ def fit_mount(frequency_hz, kcp_measured, model: str | Topology = DEFAULT_TOPOLO
         raise ValueError("starts and polish must be >= 1, hops >= 0")
     starts, polish, hops = int(starts), min(int(polish), int(starts)), int(hops)
 
-    prob = _Problem(topology, f, km)
+    if max_mass is not None and not max_mass > 0:
+        raise ValueError("max_mass must be positive")
+    prob = _Problem(topology, f, km, max_mass)
     rng = np.random.default_rng(seed)
-    fresh = starting_points(topology, f, km, starts + hops, rng)
+    fresh = starting_points(topology, f, km, starts + hops, rng, max_mass)
     screened = []
     with np.errstate(all="ignore"):
         for q0 in fresh[:starts]:

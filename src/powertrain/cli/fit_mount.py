@@ -25,7 +25,10 @@ _MODELS = tuple(TOPOLOGIES)
               help="Seed of the starting points [default: powertrain.fitting.DEFAULT_SEED].")
 @click.option("--fmin", type=float, help="Fit only frequencies >= FMIN [Hz].")
 @click.option("--fmax", type=float, help="Fit only frequencies <= FMAX [Hz].")
-def fit_mount(measured, model, out, plot, starts, seed, fmin, fmax):
+@click.option("--max-mass", type=float,
+              help="Upper bound of every internal mass [kg]. K_CP alone does not identify the "
+                   "internal masses, but the engine feels them (input-point stiffness).")
+def fit_mount(measured, model, out, plot, starts, seed, fmin, fmax, max_mass):
     """Fit a lumped mount model to the measured dynamic stiffness in MEASURED (CSV).
 
     MEASURED has a header line and the columns frequency_hz plus either k_real_n_per_mm,
@@ -55,6 +58,8 @@ def fit_mount(measured, model, out, plot, starts, seed, fmin, fmax):
                          file=measured, key="--model")
     starts = DEFAULT_STARTS if starts is None else starts
     seed = DEFAULT_SEED if seed is None else seed
+    if max_mass is not None and not max_mass > 0:
+        raise InputError(f"must be positive, got {max_mass}", key="--max-mass")
     if starts < 1:
         raise InputError(f"must be >= 1, got {starts}", key="--starts")
     if fmin is not None and fmax is not None and not fmin < fmax:
@@ -69,7 +74,7 @@ def fit_mount(measured, model, out, plot, starts, seed, fmin, fmax):
     if not (abs(data.kcp) > 0).any():
         raise InputError("stiffness is zero everywhere", file=measured, key=FREQUENCY)
 
-    result = fit(data.frequency_hz, data.kcp, model, starts=starts, seed=seed,
+    result = fit(data.frequency_hz, data.kcp, model, starts=starts, seed=seed, max_mass=max_mass,
                  name=f"{topo.description} fitted to {Path(measured).name}",
                  source=f"powertrain fit-mount {Path(measured).name} --model {model}")
     f = data.frequency_hz
