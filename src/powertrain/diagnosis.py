@@ -44,7 +44,8 @@ curves (second differences along speed, robust):
   improvement is significant: the per-speed improvements :math:`d_r` have
   :math:`\bar d/(s_d/\sqrt{n_r}) >` :data:`T_MIN` and :math:`\bar d > 0`;
 * a pair is preferred to its better member only if it is supported against that member
-  in the same way;
+  in the same way and explains at least :data:`PAIR_GAIN_MIN` of the held-out excess that
+  member leaves;
 * the best supported candidate is the **answer** when it explains at least
   :data:`EXPLAINED_MIN` of the held-out excess gap over noise,
   :math:`(E_0 - E_c)/(E_0 - \hat\sigma^2)`;
@@ -85,6 +86,8 @@ T_MIN = 4.0
 BIC_MARGIN = 10.0
 #: Fraction of the held-out excess gap the answer must explain.
 EXPLAINED_MIN = 0.6
+#: A pair must also explain this fraction of what its better member leaves over noise.
+PAIR_GAIN_MIN = 0.5
 #: Excess gap over noise below which the model counts as agreeing [dB RMS].
 EXCESS_MIN_DB = 0.5
 #: Training speeds used for fitting (evenly chosen among the training blocks).
@@ -469,17 +472,16 @@ def fit_candidate(problem: _Problem, effects, starts=None) -> FitOutcome:
     cands = [np.clip(x0, inner_lo, inner_hi)]
     for s in starts or []:
         cands.append(np.clip(s, inner_lo, inner_hi))
-    # coarse grid of start points for effects that declare one
+    # coarse grid of start points for effects that declare one (the cylinder IMEP factors
+    # need one: at e = 0 the half orders vanish and the gradient of their level with them)
     if len(effects) == 1 and EFFECTS[effects[0]].start_grid:
         grid = EFFECTS[effects[0]].start_grid
         mesh = np.meshgrid(*grid, indexing="ij")
-        pts = np.stack([m.ravel() for m in mesh], axis=1)
-        pts = np.where(logs[None, :], np.log(pts), pts)
+        pts = np.stack([m.ravel() for m in mesh], axis=1).astype(float)
+        pts[:, logs] = np.log(pts[:, logs])
         costs = [np.sum(problem.vector(_scenario(names, logs, p)) ** 2) for p in pts]
         for i in np.argsort(costs)[:2]:
             cands.append(np.clip(pts[i], inner_lo, inner_hi))
-    if effects == ("balancer_error",):
-        cands += [np.array([0.6, 0.0]), np.array([1.0, 0.35]), np.array([1.0, -0.35])]
     best, nfev = None, 0
 
     def fun(x):
@@ -648,7 +650,8 @@ class DiagnosisResult:
             "split": self.split,
             "confounding_check": self.band_check,
             "decision_rule": {"T_MIN": T_MIN, "BIC_MARGIN": BIC_MARGIN,
-                              "EXPLAINED_MIN": EXPLAINED_MIN, "EXCESS_MIN_DB": EXCESS_MIN_DB},
+                              "EXPLAINED_MIN": EXPLAINED_MIN, "EXCESS_MIN_DB": EXCESS_MIN_DB,
+                              "PAIR_GAIN_MIN": PAIR_GAIN_MIN},
             "effects_library": [e.to_dict() for e in EFFECTS.values()],
             "seconds": self.seconds, "notes": self.notes,
         }
@@ -867,7 +870,9 @@ def _diagnose(measured, engine, noise_floor, effects, pairs, band_check):
             members = [by_label[e] for e in o.effects]
             best_m = min(members, key=lambda m: m.heldout_mse)
             t, dbic = _compare(best_m, o)
-            if not (t > T_MIN and dbic > BIC_MARGIN):
+            left = best_m.heldout_mse - (sigma ** 2 if np.isfinite(sigma) else 0.0)
+            gain = (best_m.heldout_mse - o.heldout_mse) / left if left > 0 else 0.0
+            if not (t > T_MIN and dbic > BIC_MARGIN and gain >= PAIR_GAIN_MIN):
                 o.status = f"not better than {best_m.label} alone"
     outcomes.sort(key=lambda o: o.heldout_mse)
     supported = [o for o in outcomes if o.status == "supported"]

@@ -185,7 +185,8 @@ def amplitude_factor(a, kappa, a_c):
 EFFECTS: dict = {e.name: e for e in [
     Effect("base_compliance", "structure",
            (Parameter("c_base", "N/m", 1.0e5, 2.0e7, 2.0e7, True,
-                      "base (chassis) stiffness under each mount; upper bound ~ rigid"),
+                      "base (chassis) stiffness under each mount; the upper bound (the "
+                      "default) is the rigid ground"),
             Parameter("m_base", "kg", 1.0, 60.0, 10.0, True,
                       "base (chassis) mass at each mount")),
            "local compliant chassis base under every mount (rigid ground at c_base -> inf)",
@@ -196,7 +197,7 @@ EFFECTS: dict = {e.name: e for e in [
                            f"dynamic-stiffness factor of mount {i} (file order)")
                  for i in (1, 2, 3)),
            "per-mount dynamic-stiffness offset (temperature, preload, spread)",
-           with_mount_stiffness),
+           with_mount_stiffness, start_grid=((0.5, 1.0, 2.0),) * 3),
     Effect("amplitude_stiffness", "structure",
            (Parameter("kappa", "1", 0.0, 3.0, 0.0, False,
                       "stiffening from large to vanishing amplitude"),
@@ -207,12 +208,13 @@ EFFECTS: dict = {e.name: e for e in [
     Effect("balancer_error", "excitation",
            (Parameter("gain", "1", 0.0, 2.0, 1.0, False, "balancer unbalance factor"),
             Parameter("lag", "rad", -0.7, 0.7, 0.0, False, "balancer timing lag")),
-           "balancer shafts' unbalance and timing error", with_balancer_error),
+           "balancer shafts' unbalance and timing error", with_balancer_error,
+           start_grid=((0.6, 1.0, 1.4), (-0.35, 0.0, 0.35))),
     Effect("cylinder_imbalance", "excitation",
            tuple(Parameter(f"e{i}", "1", -0.25, 0.25, 0.0, False,
                            f"relative IMEP deviation of cylinder {i}") for i in (1, 2, 3, 4)),
            "cylinder-to-cylinder IMEP differences (half and first orders); linearised load",
-           with_cylinder_imbalance),
+           with_cylinder_imbalance, start_grid=((-0.06, 0.06),) * 4),
     Effect("sensor_gain", "sensor",
            tuple(Parameter(f"g{c}", "dB", -8.0, 8.0, 0.0, False,
                            f"gain error of channel {c} (mount-major x, y, z)")
@@ -255,6 +257,8 @@ def _kip(hm, abc, scenario, g=None):
     if "base_compliance" in scenario:
         p = scenario["base_compliance"]
         cb, mb = p["c_base"], p["m_base"]
+        if cb >= EFFECTS["base_compliance"].parameters[0].upper:
+            return a                         # upper bound = rigid ground (the default)
         w = hm.omega[..., None]
         zb = cb + 1j * w * 2 * BASE_ZETA * np.sqrt(cb * mb) - w ** 2 * mb
         return a - b ** 2 / (c + zb)
