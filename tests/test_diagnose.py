@@ -22,7 +22,6 @@ from powertrain.effects import EFFECTS, predict, time_domain_amplitude_check
 from powertrain.errors import InputError
 from powertrain.iotools.engine_file import DEFAULT_ENGINE_PATH, read_engine
 from powertrain.iotools.measured import MeasuredRunup
-from powertrain.models.extensions import with_base_compliance
 from powertrain.runup import run_runup
 from powertrain.solvers.fast_harmonic import HarmonicModel
 from powertrain.synth import make_case

@@ -734,8 +734,7 @@ class DiagnosisResult:
         from pathlib import Path
 
         from powertrain.iotools.atomic import atomic_write
-        from powertrain.plotting import (plot_diagnosis_overlay, plot_gap_frequency,
-                                         plot_gap_map)
+        from powertrain.plotting import plot_diagnosis_overlay, plot_gap_frequency, plot_gap_map
         out = Path(directory)
         out.mkdir(parents=True, exist_ok=True)
         files = []

@@ -307,7 +307,7 @@ def predict(hm: HarmonicModel, scenario: dict, *, abc=None, tol=1e-6,
     if "amplitude_stiffness" in sc and sc["amplitude_stiffness"]["kappa"] != 0.0:
         p = sc["amplitude_stiffness"]
         g = np.ones((hm.rpm.size, len(hm.networks)))
-        for iterations in range(1, max_iter + 1):
+        for iterations in range(1, max_iter + 1):  # noqa: B007 (count returned)
             q = hm.solve(_kip(hm, abc, sc, g), load)
             g_new = amplitude_factor(hm.network_amplitude(q), p["kappa"], p["a_c"])
             change = np.max(np.abs(g_new - g))
@@ -347,7 +347,8 @@ def time_domain_amplitude_check(engine, rpm, kappa, a_c, *, cycles=40, angle_ste
 
     The assembled 33-DOF model is integrated by Newmark (average acceleration) cycle by
     cycle; at the start of each engine cycle every network's springs, dampers and masses are
-    rescaled by :math:`g(a_n)` (under-relaxed by 0.7 like the frequency-domain iteration) with :math:`a_n = \sqrt2\,\mathrm{RMS}` of its engine-side
+    rescaled by :math:`g(a_n)` (under-relaxed by 0.7 like the frequency-domain iteration)
+    with :math:`a_n = \sqrt2\,\mathrm{RMS}` of its engine-side
     displacement over the previous cycle (the mean removed) — a quasi-static amplitude
     memory, the time-domain counterpart of the equivalent linearisation. After ``cycles``
     cycles the last cycle is order-analysed.
@@ -376,13 +377,13 @@ def time_domain_amplitude_check(engine, rpm, kappa, a_c, *, cycles=40, angle_ste
     for _ in range(cycles):
         k = iter(g)
         eng_g = _map_networks(engine, lambda mi, m, ax, mod: mod.scaled_dynamic_stiffness(
-            float(next(k))))
+            float(next(k))))  # noqa: B023 (called at once)
         system = assemble(b.mass, b.cg, b.inertia, eng_g.mounts)
         F = np.zeros((n_cycle + 1, system.n_dof))
         F[:, :6] = np.concatenate([load, load[:1]])
         if state is None:
-            from powertrain.solvers.harmonic import harmonic_response
             from powertrain.analysis.fourier import harmonic_amplitudes
+            from powertrain.solvers.harmonic import harmonic_response
             fh = harmonic_amplitudes(load, axis=0)[: n_cycle // 2]
             om = 0.5 * omega * np.arange(fh.shape[0])
             qh = harmonic_response(system, fh, om)
@@ -403,8 +404,8 @@ def time_domain_amplitude_check(engine, rpm, kappa, a_c, *, cycles=40, angle_ste
 
 
 def _rows(engine):
-    from powertrain.physics.rigid_body import direction_row
     from powertrain.assembly import DIRECTIONS
+    from powertrain.physics.rigid_body import direction_row
     cg = np.asarray(engine.body.cg, float)
     return np.array([direction_row(np.asarray(m.position, float) - cg,
                                    np.asarray(m.rotation, float)[:, i])

@@ -42,8 +42,7 @@ from powertrain.analysis.fourier import harmonic_amplitudes
 from powertrain.assembly import DIRECTIONS
 from powertrain.physics import balancer as bal
 from powertrain.physics.mount_network import network_matrices
-from powertrain.physics.rigid_body import (direction_row, point_motion_matrix,
-                                           rigid_body_mass_matrix)
+from powertrain.physics.rigid_body import direction_row, point_motion_matrix, rigid_body_mass_matrix
 
 #: Harmonics of the engine cycle solved: h = 1..16 are orders 0.5..8.
 N_HARMONICS = 17
@@ -238,7 +237,7 @@ class HarmonicModel:
     def nominal_kip(self) -> np.ndarray:
         return self.two_ports()[0]
 
-    def subset(self, index) -> "HarmonicModel":
+    def subset(self, index) -> HarmonicModel:
         """The model at the speeds ``rpm[index]``, sharing the cached parts computed so far."""
         index = np.asarray(index)
         new = object.__new__(HarmonicModel)
