@@ -32,19 +32,26 @@ def main():
 
     \b
     Examples:
+      powertrain runup --from 1000 --to 6000 --step 500 --csv runup.csv --plot runup.png
       powertrain stiffness mounts/hydraulic-engine-mount-z.toml --freq 1:400:1 --plot k.png
       powertrain fit-mount measured.csv --model triple-parallel --out fitted.toml
+      powertrain compare examples/measured-runup.csv --plot compare.png --json compare.json
+      powertrain whatif --scale left.z.stiffness=1.2 --json whatif.json
+      powertrain diagnose examples/measured-runup.csv --report diagnosis/
     """
 
 
 def _register():
-    from powertrain.cli import stiffness  # noqa: F401
-    for name in ("fit_mount", "runup", "excitation", "compare", "diagnose", "whatif"):
-        try:
-            __import__(f"powertrain.cli.{name}")
-        except ModuleNotFoundError as exc:  # command not built yet
-            if exc.name != f"powertrain.cli.{name}":
-                raise
+    """Import the command modules: each adds its command to :func:`main`."""
+    from powertrain.cli import (  # noqa: F401
+        compare,
+        diagnose,
+        excitation,
+        fit_mount,
+        runup,
+        stiffness,
+        whatif,
+    )
 
 
 _register()
