@@ -38,6 +38,7 @@ import numpy as np
 
 from powertrain.analysis.orders import order_label
 from powertrain.errors import InputError
+from powertrain.iotools.textfile import parse_number, read_text
 
 #: Recognised level columns: name -> (factor to m/s, statistic).
 LEVEL_COLUMNS = {
@@ -205,11 +206,7 @@ def _read_hdf5(path, mounts):
 
 
 def _read_csv(path, mounts):
-    try:
-        with open(path, encoding="utf-8") as fh:
-            lines = fh.read().splitlines()
-    except (OSError, UnicodeDecodeError) as exc:
-        raise InputError(f"cannot read file as UTF-8 text ({exc})", file=path) from None
+    lines = read_text(path, "CSV").splitlines()
     comments = []
     header = None
     rows = {}          # key -> {rpm: (level, line)}
@@ -267,11 +264,11 @@ def _read_csv(path, mounts):
             quantity = normalise_quantity(fields[col["quantity"]])
         except ValueError as exc:
             raise InputError(str(exc), file=path, line=lineno, key="quantity") from None
-        rpm = _number(fields[col["rpm"]], path, lineno, "rpm")
+        rpm = parse_number(fields[col["rpm"]], path, lineno, "rpm")
         if rpm <= 0:
             raise InputError(f"speed must be > 0, got {rpm:g}", file=path, line=lineno,
                              key="rpm")
-        level = _number(fields[col[level_col]], path, lineno, level_col)
+        level = parse_number(fields[col[level_col]], path, lineno, level_col)
         if level < 0:
             raise InputError(f"negative level {level:g}", file=path, line=lineno,
                              key=level_col)
@@ -300,15 +297,3 @@ def _read_csv(path, mounts):
                      "1/sqrt(2) (exact for a sinusoidal order; synthesis read as the "
                      "root-sum-square of the order peaks)")
     return MeasuredRunup(curves, source=path, notes=notes, comments=comments)
-
-
-def _number(text, path, line, column):
-    try:
-        value = float(text)
-    except ValueError:
-        raise InputError(f"not a number: {text!r}", file=path, line=line,
-                         key=column) from None
-    if not math.isfinite(value):
-        raise InputError(f"{text!r} is not a finite number", file=path, line=line,
-                         key=column)
-    return value

@@ -31,6 +31,7 @@ import re
 import numpy as np
 
 from powertrain.errors import InputError
+from powertrain.iotools.textfile import parse_number, read_text
 from powertrain.units import to_si
 
 #: Largest allowed gap between crank angles of one trace [deg].
@@ -54,13 +55,7 @@ def read_pressure_traces(path, n_cylinders: int):
     """
     from powertrain.models.engine import MeasuredPressure
     path = str(path)
-    try:
-        with open(path, newline="", encoding="utf-8") as fh:
-            lines = [(i + 1, line) for i, line in enumerate(fh)]
-    except OSError as exc:
-        raise InputError(f"cannot read file ({exc.strerror})", file=path) from None
-    except UnicodeDecodeError:
-        raise InputError("not a UTF-8 text file", file=path) from None
+    lines = list(enumerate(read_text(path, "CSV").splitlines(), start=1))
     body = [(n, s) for n, s in lines if s.strip() and not s.lstrip().startswith("#")]
     if not body:
         raise InputError("no header line", file=path)
@@ -86,14 +81,7 @@ def read_pressure_traces(path, n_cylinders: int):
             raise InputError(f"expected 4 values, got {len(cells)}", file=path, line=n)
         vals = []
         for (name, _), c in zip(_COLUMNS, cells):
-            try:
-                v = float(c)
-            except ValueError:
-                raise InputError(f"not a number: {c.strip()!r}", file=path, line=n,
-                                 key=name) from None
-            if not math.isfinite(v):
-                raise InputError("not a finite number", file=path, line=n, key=name)
-            vals.append(v)
+            vals.append(parse_number(c, path, n, name))
         if vals[1] != int(vals[1]) or not 1 <= vals[1] <= n_cylinders:
             raise InputError(f"cylinder must be 1..{n_cylinders}", file=path, line=n,
                              key="cylinder")

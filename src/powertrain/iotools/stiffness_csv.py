@@ -20,12 +20,12 @@ output of ``powertrain stiffness --format csv`` is a valid input. Every problem 
 from __future__ import annotations
 
 import csv
-import math
 from dataclasses import dataclass
 
 import numpy as np
 
 from powertrain.errors import InputError
+from powertrain.iotools.textfile import parse_number, read_text
 from powertrain.units import to_si
 
 FREQUENCY = "frequency_hz"
@@ -62,19 +62,7 @@ class MeasuredStiffness:
 
 
 def _open_rows(path):
-    try:
-        with open(path, newline="", encoding="utf-8") as fh:
-            text = fh.read()
-    except FileNotFoundError:
-        raise InputError("file not found", file=path) from None
-    except IsADirectoryError:
-        raise InputError("is a directory, expected a file", file=path) from None
-    except PermissionError:
-        raise InputError("file not readable (permission denied)", file=path) from None
-    except UnicodeDecodeError:
-        raise InputError("not a text (UTF-8) CSV file", file=path) from None
-    except OSError as exc:
-        raise InputError(f"cannot read file ({exc.strerror})", file=path) from None
+    text = read_text(path, "CSV")
     rows = []
     for lineno, fields in zip(range(1, 10**9), csv.reader(text.splitlines())):
         if not fields or all(not f.strip() for f in fields) or fields[0].lstrip().startswith("#"):
@@ -134,17 +122,7 @@ def read_stiffness_csv(path) -> MeasuredStiffness:
                              file=path, key=FREQUENCY, line=lineno)
         for name in cols:
             raw = fields[index[name]]
-            try:
-                value = float(raw)
-            except ValueError:
-                raise InputError(f"not a number: {raw!r}", file=path, key=name,
-                                 line=lineno) from None
-            if not math.isfinite(value):
-                raise InputError(f"not a finite number ({raw})", file=path, key=name,
-                                 line=lineno)
-            if value < 0 and name in (FREQUENCY, ABS):
-                raise InputError(f"must not be negative, got {raw}", file=path, key=name,
-                                 line=lineno)
+            value = parse_number(raw, path, lineno, name, nonneg=name in (FREQUENCY, ABS))
             if data[FREQUENCY] and name == FREQUENCY and value <= data[FREQUENCY][-1]:
                 raise InputError(f"frequencies must be strictly increasing ({raw} after "
                                  f"{data[FREQUENCY][-1]:g})", file=path, key=name,

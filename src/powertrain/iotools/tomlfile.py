@@ -6,6 +6,7 @@ import math
 import sys
 
 from powertrain.errors import InputError
+from powertrain.iotools.textfile import read_text
 from powertrain.units import to_si
 
 if sys.version_info >= (3, 11):
@@ -16,19 +17,11 @@ else:  # pragma: no cover
 
 def read_toml(path) -> dict:
     """Parse a TOML file; unreadable or malformed files raise :class:`InputError`."""
+    text = read_text(path, "TOML")
     try:
-        with open(path, "rb") as fh:
-            return tomllib.load(fh)
-    except FileNotFoundError:
-        raise InputError("file not found", file=path) from None
-    except IsADirectoryError:
-        raise InputError("is a directory, expected a file", file=path) from None
-    except PermissionError:
-        raise InputError("file not readable (permission denied)", file=path) from None
+        return tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
         raise InputError(f"not valid TOML: {exc}", file=path) from None
-    except UnicodeDecodeError:
-        raise InputError("not a text (UTF-8) TOML file", file=path) from None
 
 
 def get(table: dict, key: str, path, prefix: str = "", *, default=..., types=None):
