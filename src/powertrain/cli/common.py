@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import math
 
+import click
 import numpy as np
 
 from powertrain.errors import InputError
@@ -49,3 +50,26 @@ def format_table(header: list[str], rows: list[list], floatfmt: str = "{:.4g}") 
              "  ".join("-" * w for w in widths)]
     lines += ["  ".join(c.rjust(w) for c, w in zip(r, widths)) for r in cells]
     return "\n".join(lines)
+
+
+def speed_options(func):
+    """The ``--from/--to/--step`` speed-step options [rpm] shared by the run-up commands."""
+    for option in reversed([
+        click.option("--from", "rpm_from", type=float, default=1000.0, show_default=True,
+                     help="First speed step [rpm]."),
+        click.option("--to", "rpm_to", type=float, default=6000.0, show_default=True,
+                     help="Last speed step [rpm]."),
+        click.option("--step", "rpm_step", type=float, default=500.0, show_default=True,
+                     help="Speed step [rpm]."),
+    ]):
+        func = option(func)
+    return func
+
+
+def speed_steps(rpm_from: float, rpm_to: float, rpm_step: float) -> np.ndarray:
+    """Validated speed steps [rpm] from the ``--from/--to/--step`` options."""
+    from powertrain.runup import default_rpm
+    if not (math.isfinite(rpm_from + rpm_to + rpm_step) and rpm_from > 0
+            and rpm_to >= rpm_from and rpm_step > 0):
+        raise InputError("need 0 < --from <= --to and --step > 0", key="--from/--to/--step")
+    return default_rpm(rpm_from, rpm_to, rpm_step)

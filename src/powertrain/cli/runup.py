@@ -5,15 +5,11 @@ from __future__ import annotations
 import click
 
 from powertrain.cli import main
+from powertrain.cli.common import speed_options, speed_steps
 
 
 @main.command()
-@click.option("--from", "rpm_from", type=float, default=1000.0, show_default=True,
-              help="First speed step [rpm].")
-@click.option("--to", "rpm_to", type=float, default=6000.0, show_default=True,
-              help="Last speed step [rpm].")
-@click.option("--step", "rpm_step", type=float, default=500.0, show_default=True,
-              help="Speed step [rpm].")
+@speed_options
 @click.option("--engine", "engine_file", type=click.Path(dir_okay=False),
               help="Engine file (default: the shipped engines/default.toml).")
 @click.option("--solver", type=click.Choice(["newmark", "harmonic"]), default="newmark",
@@ -51,15 +47,13 @@ def runup(rpm_from, rpm_to, rpm_step, engine_file, solver, stepper, angle_step, 
 
     from powertrain.errors import InputError
     from powertrain.iotools.engine_file import DEFAULT_ENGINE_PATH, read_engine
-    from powertrain.runup import default_rpm, run_runup
+    from powertrain.runup import run_runup
 
-    if not (rpm_from > 0 and rpm_to >= rpm_from and rpm_step > 0):
-        raise InputError("need 0 < --from <= --to and --step > 0", key="--from/--to/--step")
+    rpm = speed_steps(rpm_from, rpm_to, rpm_step)
     engine_path = engine_file or DEFAULT_ENGINE_PATH
     engine = read_engine(engine_path)
     if no_balancers:
         engine = engine.with_balancers(enabled=False)
-    rpm = default_rpm(rpm_from, rpm_to, rpm_step)
     try:
         result = run_runup(engine, rpm, solver=solver, angle_step_deg=angle_step,
                            progress=not quiet, stepper=stepper)

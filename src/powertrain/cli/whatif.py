@@ -5,17 +5,13 @@ from __future__ import annotations
 import click
 
 from powertrain.cli import main
+from powertrain.cli.common import speed_options, speed_steps
 
 
 @main.command()
 @click.option("--engine", "engine_file", type=click.Path(dir_okay=False),
               help="Engine file (default: the shipped engines/default.toml).")
-@click.option("--from", "rpm_from", type=float, default=1000.0, show_default=True,
-              help="First speed step [rpm].")
-@click.option("--to", "rpm_to", type=float, default=6000.0, show_default=True,
-              help="Last speed step [rpm].")
-@click.option("--step", "rpm_step", type=float, default=500.0, show_default=True,
-              help="Speed step [rpm].")
+@speed_options
 @click.option("--solver", type=click.Choice(["harmonic", "newmark"]), default="harmonic",
               show_default=True,
               help="harmonic: exact steady state of the linear model, fast; newmark: time "
@@ -74,7 +70,6 @@ def whatif(engine_file, rpm_from, rpm_to, rpm_step, solver, scale, set_, swap, m
     """
     from powertrain.errors import InputError
     from powertrain.iotools.engine_file import DEFAULT_ENGINE_PATH, read_engine
-    from powertrain.runup import default_rpm
     from powertrain.variants import (
         Origin,
         Variant,
@@ -84,13 +79,11 @@ def whatif(engine_file, rpm_from, rpm_to, rpm_step, solver, scale, set_, swap, m
         read_variants,
     )
 
-    if not (rpm_from > 0 and rpm_to >= rpm_from and rpm_step > 0):
-        raise InputError("need 0 < --from <= --to and --step > 0", key="--from/--to/--step")
+    rpm = speed_steps(rpm_from, rpm_to, rpm_step)
     if workers is not None and workers < 1:
         raise InputError("must be >= 1", key="--workers")
     engine = read_engine(engine_file or DEFAULT_ENGINE_PATH)
     lo, hi = engine.speed_range_rpm()
-    rpm = default_rpm(rpm_from, rpm_to, rpm_step)
     if rpm[0] < lo - 1e-6 or rpm[-1] > hi + 1e-6:
         raise InputError(f"speeds outside the engine model's range {lo:g}..{hi:g} rpm",
                          key="--from/--to")
