@@ -46,12 +46,27 @@ curves (second differences along speed, robust):
 * a pair is preferred to its better member only if it is supported against that member
   in the same way and explains at least :data:`PAIR_GAIN_MIN` of the held-out excess that
   member leaves;
-* the best supported candidate is the **answer** when it explains at least
-  :data:`EXPLAINED_MIN` of the held-out excess gap over noise,
-  :math:`(E_0 - E_c)/(E_0 - \hat\sigma^2)`;
+* the **answer** is the best (lowest held-out gap) supported candidate, among the first
+  :data:`N_CHECKED` supported ones, that passes all of
+
+  - *size*: it explains at least :data:`EXPLAINED_MIN` of the held-out excess gap over
+    noise, :math:`(E_0 - E_c)/(E_0 - \hat\sigma^2)`;
+  - *residual consistent with noise*: its held-out residual, averaged per channel and order
+    over groups of about 4 adjacent held-out speeds (:func:`structured_residual`; noise
+    averages out, structure does not), keeps a structured RMS beyond noise of at most
+    :math:`\max(` :data:`STRUCT_ABS_DB`, :data:`STRUCT_REL` × the baseline's :math:`)`;
+  - *held-out cells* (:func:`heldout_cells_check`): refitted without some (channel, order)
+    cells, it must predict them at the held-out speeds — explain at least
+    :data:`XV_EXPLAINED_MIN` of their excess with t > :data:`T_MIN` (skipped when their
+    excess is below :data:`EXCESS_MIN_DB`). Physical effects withhold channels (three
+    folds, one channel of every mount triad each: the rigid body carries the effect to a
+    channel it was not fitted on); candidates with per-channel sensor gains withhold orders
+    (orders ≤ 2 vs > 2, both ways: a gain is the same on every order of its channel, a
+    frequency-tied gap is not). Nine free gains thus cannot absorb a structural gap;
 * otherwise: **"no effect"** when the excess RMS gap :math:`\sqrt{\max(E_0 - \hat\sigma^2,
   0)}` is below :data:`EXCESS_MIN_DB` (the model agrees within noise), else
-  **"unexplained"** (a supported but insufficient candidate is named as partial).
+  **"unexplained"** (a supported candidate that failed a check is named as partial, with
+  the rule it failed).
 
 Parameter uncertainties are the 1σ of the Gauss–Newton covariance
 :math:`\hat s^2 (J^TJ)^{-1}` (residual correlation along speed ignored: optimistic). A
@@ -97,6 +112,21 @@ N_TEST_RPM = 36
 #: Blocks of the speed split and those held out (0-based).
 N_BLOCKS = 12
 HELDOUT_BLOCKS = (1, 4, 7, 10)
+#: Residual structure: the answer's held-out residual, averaged over short runs of adjacent
+#: held-out speeds per channel and order (noise averages out, structure does not), may keep
+#: at most this structured RMS beyond noise [dB] ...
+STRUCT_ABS_DB = 0.6
+#: ... or this fraction of the baseline's structured held-out gap, whichever is larger.
+STRUCT_REL = 0.35
+#: Held-out cells: the answer refitted without some (channel, order) cells must explain at
+#: least this fraction of the held-out excess on the withheld cells (at the held-out speeds).
+XV_EXPLAINED_MIN = 0.5
+#: Channel folds for physical effects (each holds out one channel of every mount triad).
+CHANNEL_FOLDS = ((0, 4, 8), (1, 5, 6), (2, 3, 7))
+#: Orders up to this one form the "low" fold of the order split (sensor gains) [order].
+ORDER_SPLIT = 2.0
+#: Supported candidates (best first) put through the structure and held-out-cell checks.
+N_CHECKED = 3
 #: Smallest data set that can be split: speeds in total.
 MIN_RPM = 12
 DEFAULT_NOISE_FLOOR = 1.0e-6
@@ -403,6 +433,9 @@ class FitOutcome:
     bic_gain: float = float("nan")
     explained: float = float("nan")
     status: str = ""
+    struct_db: float = float("nan")
+    chi2_ratio: float = float("nan")
+    cells_check: dict | None = None
 
     @property
     def label(self) -> str:
@@ -412,7 +445,8 @@ class FitOutcome:
 class _Problem:
     """Residual functions on the training and held-out speeds."""
 
-    def __init__(self, hm_train, hm_test, data, train_idx, test_idx):
+    def __init__(self, hm_train, hm_test, data, train_idx, test_idx, train_cells=None,
+                 test_cells=None):
         self.hm = {"train": hm_train, "test": hm_test}
         self.data = data
         self.idx = {"train": train_idx, "test": test_idx}
@@ -422,11 +456,17 @@ class _Problem:
                            [q for q, o in zip(data.quantities, om) if o],
                            data.harmonic[om], data.level[:, :, om], data.floor)
         self.valid = {k: np.isfinite(v) for k, v in self.meas.items()}
+        # optional (channel, order) cells used for fitting / scoring (held-out channels or
+        # orders): bool (n_ch, n_orders)
+        for part, cells in (("train", train_cells), ("test", test_cells)):
+            if cells is not None:
+                self.valid[part] = self.valid[part] & np.asarray(cells, bool)[None]
 
     def gaps(self, scenario, part="train"):
         pred = predict(self.hm[part], scenario)
         sim = model_levels(pred.velocity, self.sub)
-        return residuals_db(sim, self.meas[part], self.data.floor)
+        g = residuals_db(sim, self.meas[part], self.data.floor)
+        return np.where(self.valid[part], g, np.nan)
 
     def vector(self, scenario, part="train"):
         g = self.gaps(scenario, part)
@@ -462,7 +502,7 @@ def _applicable(engine, effect):
     return True
 
 
-def fit_candidate(problem: _Problem, effects, starts=None) -> FitOutcome:
+def fit_candidate(problem: _Problem, effects, starts=None, grid=True) -> FitOutcome:
     """Fit one effect or a combination on the training speeds, score on the held-out ones."""
     from scipy.optimize import least_squares
     t0 = time.perf_counter()
@@ -474,7 +514,7 @@ def fit_candidate(problem: _Problem, effects, starts=None) -> FitOutcome:
         cands.append(np.clip(s, inner_lo, inner_hi))
     # coarse grid of start points for effects that declare one (the cylinder IMEP factors
     # need one: at e = 0 the half orders vanish and the gradient of their level with them)
-    if len(effects) == 1 and EFFECTS[effects[0]].start_grid:
+    if grid and len(effects) == 1 and EFFECTS[effects[0]].start_grid:
         grid = EFFECTS[effects[0]].start_grid
         mesh = np.meshgrid(*grid, indexing="ij")
         pts = np.stack([m.ravel() for m in mesh], axis=1).astype(float)
@@ -530,6 +570,7 @@ def _score(problem, effects, sc, params, sigma, rss, n, p, nfev, seconds, x=None
     out = FitOutcome(tuple(effects), params, sigma, rss, n, p, bic, mse, math.sqrt(mse),
                      per_rpm, ch, nfev, seconds)
     out.x = x
+    out.heldout_gaps = g
     return out
 
 
@@ -543,6 +584,124 @@ def _compare(base: FitOutcome, cand: FitOutcome):
     t = float(np.mean(d)) / (sd / math.sqrt(d.size)) if sd > 0 else (
         float("inf") if np.mean(d) > 0 else 0.0)
     return t, base.bic - cand.bic
+
+
+def _speed_groups(test_idx, size=4):
+    """Runs of adjacent held-out speeds, cut into groups of about ``size`` speeds."""
+    runs, start = [], 0
+    for i in range(1, test_idx.size + 1):
+        if i == test_idx.size or test_idx[i] != test_idx[i - 1] + 1:
+            runs.append(np.arange(start, i))
+            start = i
+    groups = []
+    for r in runs:
+        k = max(1, int(round(r.size / size)))
+        groups += [g for g in np.array_split(r, k) if g.size >= 2]
+    return groups
+
+
+def structured_residual(g, censored, groups, sigma, cells=None):
+    r"""Structured part of held-out residuals [dB RMS beyond noise] and its χ² ratio.
+
+    For every group of adjacent held-out speeds and every (channel, order) the mean
+    residual :math:`\bar g` of the :math:`n` uncensored points is formed; pure noise of
+    scatter :math:`\sigma` gives :math:`E[\bar g^2] = \sigma^2/n`. Returned:
+    :math:`\sqrt{\max(0,\ \overline{\bar g^2 - \sigma^2/n})}` and the ratio
+    :math:`\overline{n\bar g^2/\sigma^2}` (≈ 1 for noise).
+
+    Parameters
+    ----------
+    g : ndarray (n_test, n_ch, n_o)
+        Held-out residuals [dB] (NaN where not scored).
+    censored : ndarray bool, same shape
+    groups : list of index arrays into the first axis
+    sigma : float
+        Noise [dB, 1σ].
+    cells : ndarray bool (n_ch, n_o), optional
+        Cells included (default all).
+    """
+    ok = np.isfinite(g) & ~censored
+    if cells is not None:
+        ok &= np.asarray(cells, bool)[None]
+    z, chi = [], []
+    s2 = sigma ** 2 if np.isfinite(sigma) and sigma > 0 else 0.0
+    for grp in groups:
+        n = ok[grp].sum(axis=0)
+        sm = np.where(ok[grp], g[grp], 0.0).sum(axis=0)
+        use = n >= 2
+        m = sm[use] / n[use]
+        z.append(m ** 2 - s2 / n[use])
+        if s2 > 0:
+            chi.append(n[use] * m ** 2 / s2)
+    if not z:
+        return float("nan"), float("nan")
+    z = np.concatenate(z)
+    chi_r = float(np.mean(np.concatenate(chi))) if chi else float("nan")
+    return float(math.sqrt(max(float(np.mean(z)), 0.0))), chi_r
+
+
+def _cells_mse(o: FitOutcome, cells):
+    g = o.heldout_gaps
+    ok = np.isfinite(g) & np.asarray(cells, bool)[None]
+    per = np.array([np.mean(g[i][ok[i]] ** 2) if ok[i].any() else np.nan
+                    for i in range(g.shape[0])])
+    return float(np.mean(g[ok] ** 2)) if ok.any() else float("nan"), per
+
+
+def heldout_cells_check(problem, o: FitOutcome, baseline: FitOutcome, sigma):
+    """Refit ``o``'s effects without some (channel, order) cells and score the withheld
+    cells at the held-out speeds (cross-validation over cells as well as speeds).
+
+    Physical effects (no ``sensor_gain``) withhold channels (:data:`CHANNEL_FOLDS`): a
+    physical effect predicts a channel it was not fitted on through the rigid-body
+    kinematics, a channel gain cannot. Candidates with ``sensor_gain`` withhold orders
+    (orders up to :data:`ORDER_SPLIT` vs the others, both ways): a true gain is the same on
+    every order of its channel, a frequency-dependent gap is not.
+
+    Returns
+    -------
+    dict
+        ``kind``, ``explained`` (fraction of the withheld cells' held-out excess over noise
+        removed), ``t`` (per-speed significance), ``baseline_excess_db`` and ``seconds``.
+    """
+    t0 = time.perf_counter()
+    n_ch, n_o = problem.valid["test"].shape[1:]
+    if "sensor_gain" in o.effects:
+        kind = "orders"
+        order = (problem.sub.harmonic + 1) / 2.0
+        low = np.broadcast_to(order <= ORDER_SPLIT + 1e-9, (n_ch, n_o))
+        folds = [low, ~low]
+    else:
+        kind = "channels"
+        folds = []
+        for f in CHANNEL_FOLDS:
+            m = np.zeros((n_ch, n_o), bool)
+            m[[c for c in f if c < n_ch]] = True
+            folds.append(m)
+    g_all = np.full(problem.valid["test"].shape, np.nan)
+    for held in folds:
+        if not held.any() or held.all():
+            continue
+        prob = _Problem(problem.hm["train"], problem.hm["test"], problem.data,
+                        problem.idx["train"], problem.idx["test"], train_cells=~held,
+                        test_cells=held)
+        fo = fit_candidate(prob, o.effects, starts=[o.x], grid=False)
+        g_all = np.where(np.isfinite(fo.heldout_gaps), fo.heldout_gaps, g_all)
+    ok = np.isfinite(g_all)
+    per_c = np.array([np.mean(g_all[i][ok[i]] ** 2) if ok[i].any() else np.nan
+                      for i in range(g_all.shape[0])])
+    cells = ok.any(axis=0)
+    e0, per_0 = _cells_mse(baseline, cells)
+    ec = float(np.mean(g_all[ok] ** 2)) if ok.any() else float("nan")
+    s2 = sigma ** 2 if np.isfinite(sigma) else 0.0
+    excess = max(e0 - s2, 0.0)
+    d = per_0 - per_c
+    d = d[np.isfinite(d)]
+    sd = float(np.std(d, ddof=1)) if d.size > 1 else 0.0
+    t = float(np.mean(d)) / (sd / math.sqrt(d.size)) if sd > 0 else 0.0
+    return {"kind": kind, "explained": (e0 - ec) / excess if excess > 0 else float("nan"),
+            "t": t, "baseline_excess_db": math.sqrt(excess), "heldout_rms_db": math.sqrt(ec),
+            "seconds": time.perf_counter() - t0}
 
 
 def _band_check(problem_factory, effect, data, train_idx, n_bands=4):
@@ -633,6 +792,9 @@ class DiagnosisResult:
                 "heldout_channel_rms_db_after": o.heldout_channel_rms,
                 "train_bic_gain": o.bic_gain, "heldout_t": o.t_stat,
                 "explained_fraction_of_excess": o.explained, "verdict": o.status,
+                "heldout_structured_residual_db": o.struct_db,
+                "heldout_block_chi2_ratio": o.chi2_ratio,
+                "heldout_cells_check": o.cells_check,
                 "nfev": o.nfev, "seconds": o.seconds}
 
     def to_dict(self) -> dict:
@@ -651,7 +813,10 @@ class DiagnosisResult:
             "confounding_check": self.band_check,
             "decision_rule": {"T_MIN": T_MIN, "BIC_MARGIN": BIC_MARGIN,
                               "EXPLAINED_MIN": EXPLAINED_MIN, "EXCESS_MIN_DB": EXCESS_MIN_DB,
-                              "PAIR_GAIN_MIN": PAIR_GAIN_MIN},
+                              "PAIR_GAIN_MIN": PAIR_GAIN_MIN, "STRUCT_ABS_DB": STRUCT_ABS_DB,
+                              "STRUCT_REL": STRUCT_REL, "XV_EXPLAINED_MIN": XV_EXPLAINED_MIN,
+                              "CHANNEL_FOLDS": CHANNEL_FOLDS, "ORDER_SPLIT": ORDER_SPLIT},
+            "baseline_heldout_structured_db": b.struct_db,
             "effects_library": [e.to_dict() for e in EFFECTS.values()],
             "seconds": self.seconds, "notes": self.notes,
         }
@@ -696,11 +861,13 @@ class DiagnosisResult:
             lines.append(f"    ... {len(self.regions) - 12} more in the JSON")
         lines += ["", "2. WHICH (fitted on the training speeds, scored on the held-out ones)",
                   f"  {'candidate':<40} {'p':>2} {'held-out dB':>11} {'t':>6} {'dBIC':>8} "
-                  f"{'expl.':>6}  status"]
-        lines.append(f"  {'(baseline)':<40} {0:>2} {b.heldout_rms_db:>11.2f}")
+                  f"{'expl.':>6} {'struct dB':>9}  status"]
+        lines.append(f"  {'(baseline)':<40} {0:>2} {b.heldout_rms_db:>11.2f} {'':>6} {'':>8} "
+                     f"{'':>6} {b.struct_db:>9.2f}")
         for o in self.outcomes:
             lines.append(f"  {o.label:<40} {o.n_params:>2} {o.heldout_rms_db:>11.2f} "
-                         f"{o.t_stat:>6.1f} {o.bic_gain:>8.1f} {o.explained:>6.0%}  {o.status}")
+                         f"{o.t_stat:>6.1f} {o.bic_gain:>8.1f} {o.explained:>6.0%} "
+                         f"{o.struct_db:>9.2f}  {o.status}")
         if self.chosen is not None:
             lines.append("  parameters (1 sigma, Gauss-Newton, optimistic):")
             for e, ps in self.chosen.params.items():
@@ -874,25 +1041,51 @@ def _diagnose(measured, engine, noise_floor, effects, pairs, band_check):
             if not (t > T_MIN and dbic > BIC_MARGIN and gain >= PAIR_GAIN_MIN):
                 o.status = f"not better than {best_m.label} alone"
     outcomes.sort(key=lambda o: o.heldout_mse)
+    # residual structure on the held-out speeds (all outcomes; cheap)
+    groups = _speed_groups(test_idx)
+    cens_t = ~(problem.meas["test"] >= CENSOR_MARGIN * data.floor)
+    baseline.struct_db, baseline.chi2_ratio = structured_residual(
+        baseline.heldout_gaps, cens_t, groups, sigma)
+    for o in outcomes:
+        o.struct_db, o.chi2_ratio = structured_residual(o.heldout_gaps, cens_t, groups, sigma)
+    struct_max = max(STRUCT_ABS_DB, STRUCT_REL * baseline.struct_db)
     supported = [o for o in outcomes if o.status == "supported"]
     chosen = None
     excess_db = math.sqrt(excess0)
-    if supported:
+    big = [o for o in supported if np.isfinite(o.explained) and o.explained >= EXPLAINED_MIN]
+    for o in big[:N_CHECKED]:
+        if not o.struct_db <= struct_max:
+            o.status = (f"residual structured ({o.struct_db:.2f} dB > {struct_max:.2f} dB "
+                        f"beyond noise)")
+            continue
+        o.cells_check = heldout_cells_check(problem, o, baseline, sigma)
+        xv = o.cells_check
+        if xv["baseline_excess_db"] >= EXCESS_MIN_DB and not (
+                xv["explained"] >= XV_EXPLAINED_MIN and xv["t"] > T_MIN):
+            o.status = (f"fails held-out {xv['kind']} (explains {xv['explained']:.0%}, "
+                        f"t {xv['t']:.1f})")
+            continue
+        chosen = o
+        break
+    if chosen is not None:
+        best = chosen
+        best.status = "chosen"
+        verdict = best.label
+        verdict_text = (f"{best.label}: explains {best.explained:.0%} of the held-out "
+                        f"excess gap over noise; held-out RMS gap {e0 ** 0.5:.2f} -> "
+                        f"{best.heldout_rms_db:.2f} dB; structured residual "
+                        f"{best.struct_db:.2f} dB (baseline {baseline.struct_db:.2f} dB); "
+                        f"withheld {best.cells_check['kind']}: explains "
+                        f"{best.cells_check['explained']:.0%}")
+    elif supported:
         best = supported[0]
-        if np.isfinite(best.explained) and best.explained >= EXPLAINED_MIN:
-            chosen = best
-            best.status = "chosen"
-            verdict = best.label
-            verdict_text = (f"{best.label}: explains {best.explained:.0%} of the held-out "
-                            f"excess gap over noise; held-out RMS gap {e0 ** 0.5:.2f} -> "
-                            f"{best.heldout_rms_db:.2f} dB")
-        else:
+        if best.status == "supported":
             best.status = "partial"
-            verdict = "unexplained"
-            verdict_text = (f"unexplained: the best candidate, {best.label}, explains only "
-                            f"{best.explained:.0%} of the held-out excess gap "
-                            f"({excess_db:.2f} dB RMS over noise); "
-                            + _where_text(regions, parts))
+        verdict = "unexplained"
+        verdict_text = (f"unexplained: the best candidate, {best.label}, explains "
+                        f"{best.explained:.0%} of the held-out excess gap "
+                        f"({excess_db:.2f} dB RMS over noise) but fails the decision rule "
+                        f"({best.status}); " + _where_text(regions, parts))
     elif excess_db < EXCESS_MIN_DB:
         verdict = "no effect"
         verdict_text = (f"no effect: the held-out gap ({e0 ** 0.5:.2f} dB RMS) is within "

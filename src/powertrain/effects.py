@@ -25,7 +25,8 @@ mount_stiffness    structure   each mount's dynamic stiffness times a factor k_i
                                preload, part-to-part spread), all directions and frequencies
 amplitude_stiffness structure  mount stiffness depends on the engine-side amplitude a (data at
                                a_ref = 0.1 mm): g(a) = 1 + κ[1/(1 + a/a_c) − 1/(1 + a_ref/a_c)]
-balancer_error     excitation  balancer shafts' unbalance times g and timing lag δ
+balancer_error     excitation  balancer shafts' unbalance times g (shaft-to-shaft difference
+                               a), timing lag δ
 cylinder_imbalance excitation  cylinder i delivers (1 + ε_i) times the nominal IMEP
 sensor_gain        sensor      each channel's sensor reads 10^(G_c/20) times the true level
 ================== =========== ===================================================================
@@ -147,13 +148,23 @@ def with_mount_stiffness(engine, k1=1.0, k2=1.0, k3=1.0):
                          if mi < 3 else mod)
 
 
-def with_balancer_error(engine, gain=1.0, lag=0.0):
-    r"""Balancer shafts' unbalance times ``gain`` [1] and the drive lagging by ``lag`` [rad]
+def _shaft_factors(n, gain, asym):
+    """Unbalance factor of each shaft: ``gain (1 ± asym/2)``, + for the first half of the
+    shafts (file order), − for the others (two shafts: first +, second −)."""
+    sign = np.where(np.arange(n) < n / 2.0, 1.0, -1.0) if n > 1 else np.zeros(n)
+    return gain * (1.0 + 0.5 * asym * sign)
+
+
+def with_balancer_error(engine, gain=1.0, lag=0.0, asym=0.0):
+    r"""Balancer shafts' unbalance times ``gain`` [1], shaft-to-shaft unbalance difference
+    ``asym`` [1] (first shaft × (1 + asym/2), second × (1 − asym/2): the forces of the
+    counter-rotating pair no longer cancel sideways), and the drive lagging by ``lag`` [rad]
     of shaft angle: :math:`\alpha = \sigma(\rho\theta - \delta) + \phi`, a pure delay of the
     balancer force (its complex order amplitude times :math:`g e^{-i\delta}`)."""
-    shafts = tuple(dataclasses.replace(s, mass_radius=s.mass_radius * gain,
+    f = _shaft_factors(len(engine.balancer.shafts), gain, asym)
+    shafts = tuple(dataclasses.replace(s, mass_radius=s.mass_radius * fk,
                                        phase=s.phase - s.sense * lag)
-                   for s in engine.balancer.shafts)
+                   for s, fk in zip(engine.balancer.shafts, f))
     return engine.replace(balancer=dataclasses.replace(engine.balancer, shafts=shafts))
 
 
@@ -207,9 +218,12 @@ EFFECTS: dict = {e.name: e for e in [
            start_grid=((0.3, 1.0, 2.0), (3e-6, 2e-5, 1.5e-4))),
     Effect("balancer_error", "excitation",
            (Parameter("gain", "1", 0.0, 2.0, 1.0, False, "balancer unbalance factor"),
-            Parameter("lag", "rad", -0.7, 0.7, 0.0, False, "balancer timing lag")),
-           "balancer shafts' unbalance and timing error", with_balancer_error,
-           start_grid=((0.6, 1.0, 1.4), (-0.35, 0.0, 0.35))),
+            Parameter("lag", "rad", -0.7, 0.7, 0.0, False, "balancer timing lag"),
+            Parameter("asym", "1", -0.8, 0.8, 0.0, False,
+                      "unbalance difference between the shafts (first - second, relative)")),
+           "balancer shafts' unbalance, shaft-to-shaft difference and timing error",
+           with_balancer_error,
+           start_grid=((0.6, 1.0, 1.4), (-0.35, 0.0, 0.35), (-0.3, 0.3))),
     Effect("cylinder_imbalance", "excitation",
            tuple(Parameter(f"e{i}", "1", -0.25, 0.25, 0.0, False,
                            f"relative IMEP deviation of cylinder {i}") for i in (1, 2, 3, 4)),
@@ -269,9 +283,10 @@ def _load(hm, scenario):
     load = hm.load
     if "balancer_error" in scenario:
         p = scenario["balancer_error"]
-        shafts = hm.shaft_loads().sum(axis=0)
+        sh = hm.shaft_loads()
         on = 1.0 if hm.engine.balancer.enabled else 0.0
-        load = load + (p["gain"] * np.exp(-1j * p["lag"]) - on) * shafts
+        f = _shaft_factors(sh.shape[0], p["gain"], p["asym"])
+        load = load + np.tensordot(f * np.exp(-1j * p["lag"]) - on, sh, axes=1)
     if "cylinder_imbalance" in scenario:
         p = scenario["cylinder_imbalance"]
         d = hm.imep_derivatives()

@@ -44,6 +44,11 @@ above the rigid-body modes, so for them the local criterion is what counts). Noi
 noise floor :data:`FLOOR` added in power with exponential power (complex Gaussian noise);
 the synthesis is the RMS sum of all 16 noisy orders. Orders :data:`WRITTEN_ORDERS` and the
 synthesis of the nine channels are kept.
+
+Detectability: :attr:`SynthCase.heldout_effect_db` is the hidden effect's noise-free gap
+RMS on the diagnosis' held-out speeds; :func:`is_detectable` calls a case detectable when
+it reaches :data:`DETECT_DB` or :data:`DETECT_NOISE` × the noise. Below that no diagnosis can
+name the effect, and the blind test expects "no effect" (no claim) there.
 """
 
 from __future__ import annotations
@@ -77,6 +82,35 @@ WRITTEN_ORDERS = (0.5, 1.0, 1.5, 2.0, 2.5, 3.0, 4.0, 6.0)
 MIN_EFFECT_DB = 0.5
 #: ... or this largest noise-free gap [dB].
 MIN_EFFECT_MAX_DB = 4.0
+#: A hidden effect is *detectable* when its noise-free gap RMS on the held-out speeds of the
+#: diagnosis' split reaches this [dB] ...
+DETECT_DB = 1.5
+#: ... or this multiple of the case's measurement noise (1 sigma) [1].
+DETECT_NOISE = 2.0
+
+
+def is_detectable(gap_rms_db, noise_db) -> bool:
+    """Detectability rule: noise-free held-out gap RMS ≥ :data:`DETECT_DB` or ≥
+    :data:`DETECT_NOISE` × the noise (1σ, dB)."""
+    return bool(gap_rms_db >= DETECT_DB or gap_rms_db >= DETECT_NOISE * noise_db)
+
+
+def heldout_gap_db(rpm, reference_velocity, true_velocity) -> float:
+    """Noise-free gap RMS [dB] between two velocity sets (n_r, 9, 16) on the held-out speeds of
+    :func:`powertrain.diagnosis.split_rpm` (a function of the speed grid only), written
+    orders, :data:`FLOOR` added in power, points where both are below 3 × floor left out."""
+    from powertrain.diagnosis import split_rpm
+    held = split_rpm(np.asarray(rpm, float))[1]
+    idx = [int(round(2 * o)) - 1 for o in WRITTEN_ORDERS]
+
+    def lev(v):
+        return np.sqrt((np.abs(v[held][..., idx]) / np.sqrt(2)) ** 2 + FLOOR ** 2)
+
+    a, b = lev(reference_velocity), lev(true_velocity)
+    keep = np.maximum(a, b) >= 3 * FLOOR
+    if not keep.any():
+        return 0.0
+    return float(np.sqrt(np.mean((20 * np.log10(a / b))[keep] ** 2)))
 
 
 @dataclass
@@ -93,6 +127,9 @@ class SynthCase:
         Noise-free truth [m/s].
     effect_rms_db : float
         Noise-free gap between truth and baseline [dB RMS, written orders].
+    heldout_effect_db : float
+        The same on the diagnosis' held-out speeds only (:func:`heldout_gap_db`); decides
+        :attr:`detectable`.
     """
 
     measured: object
@@ -103,6 +140,26 @@ class SynthCase:
     effect_rms_db: float = 0.0
     seed: int = 0
     meta: dict = field(default_factory=dict)
+    heldout_effect_db: float = 0.0
+    member_effect_db: dict = field(default_factory=dict)
+
+    @property
+    def detectable_library_effects(self) -> set:
+        """Library matches of the hidden effects that are detectable *alone* (each one's
+        noise-free held-out gap, :attr:`member_effect_db`); for a single effect the same as
+        :attr:`library_effects` when :attr:`detectable`."""
+        if not self.detectable:
+            return set()
+        if len(self.truth) == 1:
+            return self.library_effects
+        return {TRUTH_EFFECTS[t] for t, _ in self.truth
+                if is_detectable(self.member_effect_db.get(t, 0.0), self.noise_db)}
+
+    @property
+    def detectable(self) -> bool:
+        """Whether the hidden effect can be identified at all (:func:`is_detectable`);
+        False for effect-free cases."""
+        return bool(self.truth) and is_detectable(self.heldout_effect_db, self.noise_db)
 
     @property
     def library_effects(self) -> set:
@@ -309,7 +366,8 @@ def _written_levels(v):
     return rms, idx
 
 
-def make_case(engine, truth_names, seed, *, rpm=None, hm=None, noise_db=None) -> SynthCase:
+def make_case(engine, truth_names, seed, *, rpm=None, hm=None, noise_db=None,
+              params=None) -> SynthCase:
     """One synthetic measurement with the named truth effects (random parameters).
 
     Parameters
@@ -323,6 +381,11 @@ def make_case(engine, truth_names, seed, *, rpm=None, hm=None, noise_db=None) ->
         Speeds [rpm] (default 1000..6000 step 50).
     hm : HarmonicModel, optional
         Cached model of ``engine`` at ``rpm`` (reused across cases).
+    noise_db : float, optional
+        Measurement scatter [dB, 1σ] (default uniform 0.5–1.0).
+    params : dict, optional
+        ``{truth name: parameters}`` fixing some truth effects' parameters instead of
+        drawing them (tests); missing keys of a given effect are drawn.
     """
     from powertrain.analysis.orders import order_label
     from powertrain.iotools.measured import MeasuredRunup
@@ -334,7 +397,8 @@ def make_case(engine, truth_names, seed, *, rpm=None, hm=None, noise_db=None) ->
     truth, v, eff_db = [], base, 0.0
     if truth_names:
         for _ in range(40):
-            truth = [(n, draw_truth(n, rng, len(hm.networks))) for n in truth_names]
+            truth = [(n, {**draw_truth(n, rng, len(hm.networks)), **(params or {}).get(n, {})})
+                     for n in truth_names]
             v = truth_velocity(engine, hm, truth)
             rms1, _ = _written_levels(v)
             a = np.sqrt(rms1[..., idx] ** 2 + FLOOR ** 2)
@@ -356,4 +420,12 @@ def make_case(engine, truth_names, seed, *, rpm=None, hm=None, noise_db=None) ->
         curves[(m, d, "synthesis")] = (rpm.copy(), syn[:, c].copy())
     mr = MeasuredRunup(curves, source=f"synthetic case seed {seed}",
                        comments=["SYNTHETIC"])
-    return SynthCase(mr, truth, sigma, rpm, v, eff_db, seed)
+    held_db = heldout_gap_db(rpm, base, v) if truth else 0.0
+    members = {}
+    if len(truth) > 1:
+        for t in truth:
+            members[t[0]] = heldout_gap_db(rpm, base, truth_velocity(engine, hm, [t]))
+    elif truth:
+        members[truth[0][0]] = held_db
+    return SynthCase(mr, truth, sigma, rpm, v, eff_db, seed, heldout_effect_db=held_db,
+                     member_effect_db=members)
