@@ -20,8 +20,8 @@ truth effect           library match       truth model (candidate model)
                                            equivalent linearisation (candidate: rational law
                                            on the whole dynamic stiffness, one for all)
 ``balancer_shafts``    balancer_error      per-shaft unbalance 0.75–1.25 and common drive lag
-                                           ±0.35 rad plus per-shaft ±0.05 rad (candidate: one
-                                           gain, one lag)
+                                           ±0.35 rad plus per-shaft ±0.05 rad (candidate: gain,
+                                           shaft asymmetry, one common lag)
 ``cylinder_combustion`` cylinder_imbalance per-cylinder IMEP ±12 % *and* start of combustion
                                            ±2°, exact pressure model (candidate: IMEP factors,
                                            load linearised)
