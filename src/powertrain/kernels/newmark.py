@@ -65,7 +65,7 @@ def newmark_kernel(G, H, Fs, h, x0, v0, a0, X, V, A):
 
 
 @njit(cache=True, nogil=True)
-def modal_trapezoid_kernel(lam_d, gain, G, n_steps, eta0, keep_from, out):
+def modal_trapezoid_kernel(lam_d, gain, G, n_steps, eta0, keep_from, out_re, out_im):
     r"""Newmark average acceleration in the modal coordinates of the first-order system.
 
     With :math:`\dot{\mathbf z} = \mathbf A\mathbf z + \mathbf b(t)` and
@@ -85,15 +85,18 @@ def modal_trapezoid_kernel(lam_d, gain, G, n_steps, eta0, keep_from, out):
     n_steps : int
     eta0 : ndarray complex (m,)
     keep_from : int
-        First time index written to ``out``.
-    out : ndarray complex (n_steps + 1 - keep_from, m)
+        First time index written to the outputs.
+    out_re, out_im : ndarray float (n_steps + 1 - keep_from, m)
+        Real and imaginary parts of the modal coordinates (separate contiguous arrays, so
+        that the output mapping is two plain BLAS products).
     """
     m = eta0.shape[0]
     N = G.shape[0]
     eta = eta0.copy()
     if keep_from == 0:
         for j in range(m):
-            out[0, j] = eta[j]
+            out_re[0, j] = eta[j].real
+            out_im[0, j] = eta[j].imag
     for k in range(1, n_steps + 1):
         kp = (k - 1) % N
         kc = k % N
@@ -101,4 +104,5 @@ def modal_trapezoid_kernel(lam_d, gain, G, n_steps, eta0, keep_from, out):
             eta[j] = lam_d[j] * eta[j] + gain[j] * (G[kp, j] + G[kc, j])
         if k >= keep_from:
             for j in range(m):
-                out[k - keep_from, j] = eta[j]
+                out_re[k - keep_from, j] = eta[j].real
+                out_im[k - keep_from, j] = eta[j].imag
