@@ -2,6 +2,10 @@
 
 from __future__ import annotations
 
+#: Display factor and unit of each run-up signal (SI -> plot unit).
+SIGNAL_UNITS = {"velocity": (1e3, "mm/s"), "displacement": (1e6, "µm"),
+                "acceleration": (1.0, "m/s²"), "mount_force": (1.0, "N")}
+
 
 def _pyplot():
     import matplotlib
@@ -61,8 +65,7 @@ def plot_runup(results, path=None, quantities=("synthesis", "order_2", "order_4"
     rows = first.channels
     fig, axes = plt.subplots(len(rows), len(quantities), figsize=(4 * len(quantities),
                              1.9 * len(rows)), sharex=True, squeeze=False)
-    scale = {"velocity": (1e3, "mm/s"), "displacement": (1e6, "µm"),
-             "acceleration": (1.0, "m/s²"), "mount_force": (1.0, "N")}[signal]
+    scale = SIGNAL_UNITS[signal]
     for r, (mount, direction) in enumerate(rows):
         for q, quantity in enumerate(quantities):
             ax = axes[r, q]
@@ -327,8 +330,7 @@ def plot_whatif(whatif, path=None):
     plt = _pyplot()
     base = whatif.baseline
     signal = getattr(whatif, "signal", "velocity")
-    scale, unit = {"velocity": (1e3, "mm/s"), "mount_force": (1.0, "N"),
-                   "displacement": (1e6, "µm"), "acceleration": (1.0, "m/s²")}[signal]
+    scale, unit = SIGNAL_UNITS[signal]
     rows = base.channels
     quantities = whatif.quantities
     fig, axes = plt.subplots(len(rows), len(quantities),
