@@ -60,9 +60,10 @@ curves (second differences along speed, robust):
     :data:`XV_EXPLAINED_MIN` of their excess with t > :data:`T_MIN` (skipped when their
     excess is below :data:`EXCESS_MIN_DB`). Physical effects withhold channels (three
     folds, one channel of every mount triad each: the rigid body carries the effect to a
-    channel it was not fitted on); candidates with per-channel sensor gains withhold orders
-    (orders ≤ 2 vs > 2, both ways: a gain is the same on every order of its channel, a
-    frequency-tied gap is not). Nine free gains thus cannot absorb a structural gap;
+    channel it was not fitted on); candidates with sensor errors withhold orders
+    (orders ≤ 2 vs > 2, both ways: a gain or a triad rotation is the same on every order of
+    its channels, a frequency-tied gap is not). Free gains thus cannot absorb a structural
+    gap;
 * otherwise: **"no effect"** when the excess RMS gap :math:`\sqrt{\max(E_0 - \hat\sigma^2,
   0)}` is below :data:`EXCESS_MIN_DB` (the model agrees within noise), else
   **"unexplained"** (a supported candidate that failed a check is named as partial, with
@@ -652,9 +653,9 @@ def heldout_cells_check(problem, o: FitOutcome, baseline: FitOutcome, sigma):
     """Refit ``o``'s effects without some (channel, order) cells and score the withheld
     cells at the held-out speeds (cross-validation over cells as well as speeds).
 
-    Physical effects (no ``sensor_gain``) withhold channels (:data:`CHANNEL_FOLDS`): a
+    Physical effects (no ``sensor_error``) withhold channels (:data:`CHANNEL_FOLDS`): a
     physical effect predicts a channel it was not fitted on through the rigid-body
-    kinematics, a channel gain cannot. Candidates with ``sensor_gain`` withhold orders
+    kinematics, a channel gain cannot. Candidates with ``sensor_error`` withhold orders
     (orders up to :data:`ORDER_SPLIT` vs the others, both ways): a true gain is the same on
     every order of its channel, a frequency-dependent gap is not.
 
@@ -666,7 +667,7 @@ def heldout_cells_check(problem, o: FitOutcome, baseline: FitOutcome, sigma):
     """
     t0 = time.perf_counter()
     n_ch, n_o = problem.valid["test"].shape[1:]
-    if "sensor_gain" in o.effects:
+    if "sensor_error" in o.effects:
         kind = "orders"
         order = (problem.sub.harmonic + 1) / 2.0
         low = np.broadcast_to(order <= ORDER_SPLIT + 1e-9, (n_ch, n_o))

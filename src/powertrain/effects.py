@@ -10,7 +10,7 @@ parameter names, bounds, defaults and units; every effect can be used
   :func:`with_balancer_error`, :func:`with_cylinder_imbalance`;
 * on the response (:func:`simulate`) where it is not a change of the linear model:
   ``amplitude_stiffness`` (an amplitude-dependent mount, solved by equivalent linearisation
-  iterated to consistency) and ``sensor_gain`` (a measurement effect);
+  iterated to consistency) and ``sensor_error`` (a measurement effect);
 * on the fast cached path :func:`predict` (one :class:`~powertrain.solvers.fast_harmonic.
   HarmonicModel`, many parameter sets), which the diagnosis uses.
 
@@ -21,18 +21,24 @@ name               kind        physics
 ================== =========== ===================================================================
 base_compliance    structure   every mount stands on a local chassis base: mass m_b on a spring
                                c_b (damping ratio ζ_b = 5 %) instead of the rigid ground
-mount_stiffness    structure   each mount's dynamic stiffness times a factor k_i (temperature,
-                               preload, part-to-part spread), all directions and frequencies
-amplitude_stiffness structure  mount stiffness depends on the engine-side amplitude a (data at
-                               a_ref = 0.1 mm): g(a) = 1 + κ[1/(1 + a/a_c) − 1/(1 + a_ref/a_c)]
+mount_stiffness    structure   each mount's elastomer times a factor k_i (temperature, preload,
+                               part-to-part spread): its springs and dampers × k_i (constant
+                               loss factor), its masses (fluid and rubber inertia) unchanged
+amplitude_stiffness structure  the elastomer's stiffness depends on the engine-side amplitude a
+                               (data at a_ref = 0.1 mm): springs and dampers × g(a),
+                               g(a) = 1 + κ[1/(1 + a/a_c) − 1/(1 + a_ref/a_c)], masses kept
 balancer_error     excitation  balancer shafts' unbalance times g (shaft-to-shaft difference
                                a), timing lag δ
 cylinder_imbalance excitation  cylinder i delivers (1 + ε_i) times the nominal IMEP
-sensor_gain        sensor      each channel's sensor reads 10^(G_c/20) times the true level
+sensor_error       sensor      each channel's sensor reads 10^(G_c/20) times the true level
+                               (calibration), and each mount's triad is rotated by a small
+                               rotation vector φ_m (mounting orientation): the triad reads
+                               diag(10^(G/20)) R(φ_m) v, R by Rodrigues' formula
 ================== =========== ===================================================================
 
-Equivalent linearisation (``amplitude_stiffness``): at each speed every network's dynamic
-stiffness (springs, dampers and masses alike) is scaled by :math:`g(a_n)`, where
+Equivalent linearisation (``amplitude_stiffness``): at each speed every network's springs
+and dampers (its elastomer; the masses are kept, as in ``mount_stiffness``, whose factor
+multiplies) are scaled by :math:`g(a_n)`, where
 :math:`a_n = \sqrt{\sum_h |\hat x_{E,n,h}|^2}` is the engine-side peak displacement
 (:math:`\sqrt2` × RMS sum of the orders) of network n; the solve is repeated with the updated
 factors until they change by less than 1e-6 (fixed-point iteration with under-relaxation
@@ -140,11 +146,21 @@ def with_base_compliance_all(engine, c_base=np.inf, m_base=10.0, zeta=BASE_ZETA)
 
 
 def with_mount_stiffness(engine, k1=1.0, k2=1.0, k3=1.0):
-    """Mount i's dynamic stiffness times ``k<i>`` [1] (i = 1, 2, 3 in engine-file order;
-    default engine: left, right, gearbox): every spring, damper and mass of its networks
-    scaled, so K_CP(ω) scales exactly (:meth:`MountModel.scaled_dynamic_stiffness`)."""
+    r"""Mount i's elastomer stiffened by ``k<i>`` [1] (i = 1, 2, 3 in engine-file order;
+    default engine: left, right, gearbox), all three directions alike.
+
+    Temperature, preload and part-to-part spread change the rubber's modulus, and with a
+    frequency-independent loss factor its damping in proportion; the fluid column of a
+    hydromount and the lumped rubber masses keep their inertia. Every spring and damper of
+    the mount's networks is therefore scaled by :math:`k_i` and every mass kept
+    (:meth:`MountModel.scaled`): the network's dynamic stiffness becomes
+    :math:`k_i(\mathbf K + i\omega\mathbf C) - \omega^2\mathbf M`, so its resonances
+    (the hydromount's notch and peak) move by about :math:`\sqrt{k_i}` — unlike a plain
+    factor on :math:`K_{CP}(\omega)`, which would keep them fixed and, above the engine's
+    rigid-body modes, barely change the engine-side velocities.
+    """
     k = (k1, k2, k3)
-    return _map_networks(engine, lambda mi, m, ax, mod: mod.scaled_dynamic_stiffness(k[mi])
+    return _map_networks(engine, lambda mi, m, ax, mod: mod.scaled(k[mi], k[mi])
                          if mi < 3 else mod)
 
 
@@ -205,9 +221,11 @@ EFFECTS: dict = {e.name: e for e in [
            start_grid=((1.5e5, 4e5, 1e6, 3e6), (2.0, 6.0, 15.0, 40.0))),
     Effect("mount_stiffness", "structure",
            tuple(Parameter(f"k{i}", "1", 0.3, 3.0, 1.0, True,
-                           f"dynamic-stiffness factor of mount {i} (file order)")
+                           f"elastomer (spring and damper) factor of mount {i} (file "
+                           f"order); its masses unchanged")
                  for i in (1, 2, 3)),
-           "per-mount dynamic-stiffness offset (temperature, preload, spread)",
+           "per-mount elastomer stiffness offset (temperature, preload, spread): springs "
+           "and dampers scaled, fluid and rubber inertia kept",
            with_mount_stiffness, start_grid=((0.5, 1.0, 2.0),) * 3),
     Effect("amplitude_stiffness", "structure",
            (Parameter("kappa", "1", 0.0, 3.0, 0.0, False,
@@ -229,11 +247,16 @@ EFFECTS: dict = {e.name: e for e in [
                            f"relative IMEP deviation of cylinder {i}") for i in (1, 2, 3, 4)),
            "cylinder-to-cylinder IMEP differences (half and first orders); linearised load",
            with_cylinder_imbalance, start_grid=((-0.06, 0.06),) * 4),
-    Effect("sensor_gain", "sensor",
+    Effect("sensor_error", "sensor",
            tuple(Parameter(f"g{c}", "dB", -8.0, 8.0, 0.0, False,
                            f"gain error of channel {c} (mount-major x, y, z)")
-                 for c in range(1, 10)),
-           "per-channel sensor gain (calibration) error", None),
+                 for c in range(1, 10))
+           + tuple(Parameter(f"r{m}{ax}", "rad", -0.15, 0.15, 0.0, False,
+                             f"orientation error of the triad at mount {m}: rotation about "
+                             f"engine {ax.upper()}")
+                   for m in (1, 2, 3) for ax in "xyz"),
+           "per-channel sensor gain (calibration) and per-triad orientation (mounting) "
+           "errors", None),
 ]}
 
 
@@ -257,17 +280,18 @@ class Prediction:
     factors: np.ndarray | None = None
 
 
-def _kip(hm, abc, scenario, g=None):
+def _elastomer_factors(hm, scenario):
+    """Per-network elastomer factor of ``mount_stiffness`` (None when absent or all 1)."""
+    if "mount_stiffness" not in scenario:
+        return None
+    p = scenario["mount_stiffness"]
+    k = np.array([p.get("k1", 1.0), p.get("k2", 1.0), p.get("k3", 1.0)])
+    s = np.array([k[mi] if mi < 3 else 1.0 for mi, _, _ in hm.networks])
+    return None if np.all(s == 1.0) else s
+
+
+def _kip(hm, abc, scenario):
     a, b, c = abc
-    s = np.ones(a.shape[-1])
-    if "mount_stiffness" in scenario:
-        p = scenario["mount_stiffness"]
-        k = np.array([p.get("k1", 1.0), p.get("k2", 1.0), p.get("k3", 1.0)])
-        for n, (mi, _, _) in enumerate(hm.networks):
-            if mi < 3:
-                s[n] = k[mi]
-    s = s[None, None, :] if g is None else s[None, None, :] * g[:, None, :]
-    a, b, c = a * s, b * s, c * s
     if "base_compliance" in scenario:
         p = scenario["base_compliance"]
         cb, mb = p["c_base"], p["m_base"]
@@ -295,8 +319,7 @@ def _load(hm, scenario):
     return load
 
 
-def predict(hm: HarmonicModel, scenario: dict, *, abc=None, tol=1e-6,
-            max_iter=60) -> Prediction:
+def predict(hm: HarmonicModel, scenario: dict, *, tol=1e-6, max_iter=60) -> Prediction:
     """Channel velocities with the effects of ``scenario`` on the cached model.
 
     Parameters
@@ -304,8 +327,8 @@ def predict(hm: HarmonicModel, scenario: dict, *, abc=None, tol=1e-6,
     hm : HarmonicModel
     scenario : dict
         ``{effect name: {parameter: value}}`` (SI); missing parameters take their defaults.
-    abc : tuple, optional
-        Two-port stiffnesses to start from (default: the engine's networks).
+    tol, max_iter
+        Convergence of the amplitude factors (``amplitude_stiffness``).
 
     Returns
     -------
@@ -316,26 +339,79 @@ def predict(hm: HarmonicModel, scenario: dict, *, abc=None, tol=1e-6,
         if name not in EFFECTS:
             raise KeyError(f"unknown effect {name!r}")
         sc[name] = {**EFFECTS[name].defaults(), **p}
-    abc = hm.two_ports() if abc is None else abc
+    if set(sc) <= {"sensor_error"}:         # the model itself unchanged: cached solve
+        v = hm.baseline_velocity()
+        if sc:
+            p = sc["sensor_error"]
+            gains = np.array([p[f"g{c + 1}"] for c in range(v.shape[1])])
+            rot = np.array([[p[f"r{m + 1}{ax}"] for ax in "xyz"]
+                            for m in range(v.shape[1] // 3)])
+            v = sensor_reading(v, gains, rot)
+        return Prediction(v)
+    s_el = _elastomer_factors(hm, sc)
+    if s_el is None:
+        abc = hm.two_ports()                 # cached
+    else:                                    # exact: the rescaled networks' two-ports
+        abc = hm.two_ports_scaled(s_el[None, None, :])
     load = _load(hm, sc)
     iterations, g = 0, None
     if "amplitude_stiffness" in sc and sc["amplitude_stiffness"]["kappa"] != 0.0:
         p = sc["amplitude_stiffness"]
+        s0 = np.ones(len(hm.networks)) if s_el is None else s_el
         g = np.ones((hm.rpm.size, len(hm.networks)))
         for iterations in range(1, max_iter + 1):  # noqa: B007 (count returned)
-            q = hm.solve(_kip(hm, abc, sc, g), load)
+            abc = hm.two_ports_scaled((s0[None, :] * g)[:, None, :])
+            q = hm.solve(_kip(hm, abc, sc), load)
             g_new = amplitude_factor(hm.network_amplitude(q), p["kappa"], p["a_c"])
             change = np.max(np.abs(g_new - g))
             g = g + 0.7 * (g_new - g)
             if change < tol:
                 break
-    q = hm.solve(_kip(hm, abc, sc, g), load)
+        abc = hm.two_ports_scaled((s0[None, :] * g)[:, None, :])
+    q = hm.solve(_kip(hm, abc, sc), load)
     v = hm.velocity(q)
-    if "sensor_gain" in sc:
-        p = sc["sensor_gain"]
-        gains = np.array([p.get(f"g{c + 1}", 0.0) for c in range(v.shape[1])])
-        v = v * 10.0 ** (gains / 20.0)[None, :, None]
+    if "sensor_error" in sc:
+        p = sc["sensor_error"]
+        gains = np.array([p[f"g{c + 1}"] for c in range(v.shape[1])])
+        rot = np.array([[p[f"r{m + 1}{ax}"] for ax in "xyz"] for m in range(v.shape[1] // 3)])
+        v = sensor_reading(v, gains, rot)
     return Prediction(v, iterations, g)
+
+
+def rotation_matrix(phi):
+    r"""Rotation matrix of the rotation vector ``phi`` [rad] (Rodrigues):
+    :math:`\mathbf R = \mathbf I + \frac{\sin\theta}{\theta}[\boldsymbol\varphi]_\times +
+    \frac{1 - \cos\theta}{\theta^2}[\boldsymbol\varphi]_\times^2`, θ = |φ|."""
+    phi = np.asarray(phi, float)
+    th = float(np.linalg.norm(phi))
+    K = np.array([[0.0, -phi[2], phi[1]], [phi[2], 0.0, -phi[0]], [-phi[1], phi[0], 0.0]])
+    if th < 1e-12:
+        return np.eye(3) + K
+    return np.eye(3) + np.sin(th) / th * K + (1 - np.cos(th)) / th ** 2 * (K @ K)
+
+
+def sensor_reading(velocity, gain_db, rotation):
+    r"""What mis-calibrated, mis-oriented triads read from the true channel velocities.
+
+    Channel c of triad m reads :math:`10^{G_c/20}\,[\mathbf R(\boldsymbol\varphi_m)
+    \mathbf v_m]_c`: the triad's axes are rotated by :math:`\boldsymbol\varphi_m` from
+    the engine axes, then each axis has its own gain.
+
+    Parameters
+    ----------
+    velocity : ndarray (n_r, 3 n_m, n_h) complex
+        True mount-point velocities, triads mount-major x, y, z.
+    gain_db : ndarray (3 n_m,)
+        Channel gain errors [dB].
+    rotation : ndarray (n_m, 3)
+        Rotation vector of each triad [rad].
+    """
+    v = np.asarray(velocity)
+    out = np.empty_like(v)
+    for m in range(v.shape[1] // 3):
+        sl = slice(3 * m, 3 * m + 3)
+        out[:, sl] = np.einsum("ij,rjh->rih", rotation_matrix(rotation[m]), v[:, sl])
+    return out * 10.0 ** (np.asarray(gain_db, float) / 20.0)[None, :, None]
 
 
 def simulate(engine, rpm, scenario: dict):
@@ -361,8 +437,8 @@ def time_domain_amplitude_check(engine, rpm, kappa, a_c, *, cycles=40, angle_ste
     r"""Amplitude-dependent mounts in the time domain, for checking the linearisation.
 
     The assembled 33-DOF model is integrated by Newmark (average acceleration) cycle by
-    cycle; at the start of each engine cycle every network's springs, dampers and masses are
-    rescaled by :math:`g(a_n)` (under-relaxed by 0.7 like the frequency-domain iteration)
+    cycle; at the start of each engine cycle every network's springs and dampers are
+    rescaled by :math:`g(a_n)` (masses kept) (under-relaxed by 0.7 like the frequency-domain iteration)
     with :math:`a_n = \sqrt2\,\mathrm{RMS}` of its engine-side
     displacement over the previous cycle (the mean removed) — a quasi-static amplitude
     memory, the time-domain counterpart of the equivalent linearisation. After ``cycles``
@@ -391,8 +467,8 @@ def time_domain_amplitude_check(engine, rpm, kappa, a_c, *, cycles=40, angle_ste
     prev_v = None
     for _ in range(cycles):
         k = iter(g)
-        eng_g = _map_networks(engine, lambda mi, m, ax, mod: mod.scaled_dynamic_stiffness(
-            float(next(k))))  # noqa: B023 (called at once)
+        eng_g = _map_networks(engine, lambda mi, m, ax, mod: mod.scaled(
+            *(2 * (float(next(k)),))))  # noqa: B023 (called at once)
         system = assemble(b.mass, b.cg, b.inertia, eng_g.mounts)
         F = np.zeros((n_cycle + 1, system.n_dof))
         F[:, :6] = np.concatenate([load, load[:1]])

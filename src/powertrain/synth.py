@@ -14,7 +14,8 @@ truth effect           library match       truth model (candidate model)
                                            base mass/spring per network, all alike)
 ``mount_temperature``  mount_stiffness     per mount *and direction* spring factors s·e^{N(0,
                                            0.05)}, dampers s^0.7, masses unchanged (candidate:
-                                           one exact dynamic-stiffness factor per mount)
+                                           one elastomer factor per mount, springs and
+                                           dampers alike)
 ``amplitude_power``    amplitude_stiffness springs only times (a/a_ref)^(−β), β per mount type
                                            (hydraulic, elastomeric) 0.08–0.25, a ≥ 1 µm;
                                            equivalent linearisation (candidate: rational law
@@ -25,8 +26,10 @@ truth effect           library match       truth model (candidate model)
 ``cylinder_combustion`` cylinder_imbalance per-cylinder IMEP ±12 % *and* start of combustion
                                            ±2°, exact pressure model (candidate: IMEP factors,
                                            load linearised)
-``sensor_triads``      sensor_gain         per-channel gain ±5 dB and 1–3 % cross-axis
-                                           sensitivity within each triad (candidate: gain only)
+``sensor_triads``      sensor_error        per-channel gain ±5 dB and 1–3 % cross-axis
+                                           sensitivity within each triad, a random 3×3
+                                           matrix (candidate: gains and a rotation of
+                                           each triad)
 ``powertrain_bending`` (none: outside)     engine–gearbox bending mode 50–140 Hz amplifying the
                                            gearbox mount point, factor 1 + κω²/(ω_b² − ω² +
                                            2iζω_bω), κ 0.15–0.5
@@ -68,7 +71,7 @@ TRUTH_EFFECTS = {
     "amplitude_power": "amplitude_stiffness",
     "balancer_shafts": "balancer_error",
     "cylinder_combustion": "cylinder_imbalance",
-    "sensor_triads": "sensor_gain",
+    "sensor_triads": "sensor_error",
     "powertrain_bending": None,
     "torsional_driveline": None,
 }

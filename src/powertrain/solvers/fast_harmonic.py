@@ -146,6 +146,8 @@ class HarmonicModel:
         self._load = None
         self._abc = None
         self._extra = {}
+        self._v0 = None
+        self._net_arrays = None
 
     # ------------------------------------------------------------------ cached parts
     def load_of(self, engine) -> np.ndarray:
@@ -212,6 +214,41 @@ class HarmonicModel:
             self._abc = tuple(abc)
         return tuple(abc)
 
+    def two_ports_scaled(self, scale):
+        r"""``(a, b, c)`` of every network with its elastomer scaled, each (n_r, 17, n_net).
+
+        Every spring and damper of network n at speed r and harmonic h times
+        ``scale[r, h, n]`` (any shape that broadcasts to (n_r, 17, n_net)), its masses
+        kept — :math:`s(\mathbf K + i\omega\mathbf C) - \omega^2\mathbf M` condensed
+        by the compiled :func:`powertrain.kernels.two_port.two_port_kernel`. With
+        ``scale = 1`` the same as :meth:`two_ports` to round-off.
+        """
+        from powertrain.kernels.two_port import two_port_kernel
+        n_net = len(self.networks)
+        sc = np.broadcast_to(np.asarray(scale, float), self.omega.shape + (n_net,))
+        if self._net_arrays is None:
+            arrs = []
+            for _, _, mod in self.networks:
+                m, en, c, d = mod.network()
+                arrs.append((np.ascontiguousarray(m, float),
+                             np.ascontiguousarray(np.asarray(en, np.int64).reshape(-1, 2)),
+                             np.ascontiguousarray(c, float), np.ascontiguousarray(d, float)))
+            self._net_arrays = arrs
+        w = np.ascontiguousarray(self.omega.reshape(-1))
+        out = [np.empty((w.size, n_net), complex) for _ in range(3)]
+        col = [np.empty(w.size, complex) for _ in range(3)]
+        for k, arrs in enumerate(self._net_arrays):
+            two_port_kernel(w, np.ascontiguousarray(sc[..., k].reshape(-1)), *arrs, *col)
+            for j in range(3):
+                out[j][:, k] = col[j]
+        return tuple(x.reshape(self.omega.shape + (n_net,)) for x in out)
+
+    def baseline_velocity(self) -> np.ndarray:
+        """Channel velocities of the unchanged model (n_r, n_ch, 16), cached."""
+        if getattr(self, "_v0", None) is None:
+            self._v0 = self.velocity(self.solve(self.two_ports()[0]))
+        return self._v0
+
     # ------------------------------------------------------------------ solves
     def solve(self, kip, load=None, harmonics=slice(1, N_HARMONICS)) -> np.ndarray:
         r"""Rigid-body amplitudes :math:`\hat{\mathbf q}` (n_r, n_h, 6) for the given input-point
@@ -247,4 +284,5 @@ class HarmonicModel:
         new._load = None if self._load is None else self._load[index]
         new._abc = None if self._abc is None else tuple(x[index] for x in self._abc)
         new._extra = {k: v[:, index] for k, v in self._extra.items()}
+        new._v0 = None if getattr(self, "_v0", None) is None else self._v0[index]
         return new
