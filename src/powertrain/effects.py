@@ -342,11 +342,7 @@ def predict(hm: HarmonicModel, scenario: dict, *, tol=1e-6, max_iter=60) -> Pred
     if set(sc) <= {"sensor_error"}:         # the model itself unchanged: cached solve
         v = hm.baseline_velocity()
         if sc:
-            p = sc["sensor_error"]
-            gains = np.array([p[f"g{c + 1}"] for c in range(v.shape[1])])
-            rot = np.array([[p[f"r{m + 1}{ax}"] for ax in "xyz"]
-                            for m in range(v.shape[1] // 3)])
-            v = sensor_reading(v, gains, rot)
+            v = apply_sensor_error(v, sc["sensor_error"])
         return Prediction(v)
     s_el = _elastomer_factors(hm, sc)
     if s_el is None:
@@ -371,11 +367,18 @@ def predict(hm: HarmonicModel, scenario: dict, *, tol=1e-6, max_iter=60) -> Pred
     q = hm.solve(_kip(hm, abc, sc), load)
     v = hm.velocity(q)
     if "sensor_error" in sc:
-        p = sc["sensor_error"]
-        gains = np.array([p[f"g{c + 1}"] for c in range(v.shape[1])])
-        rot = np.array([[p[f"r{m + 1}{ax}"] for ax in "xyz"] for m in range(v.shape[1] // 3)])
-        v = sensor_reading(v, gains, rot)
+        v = apply_sensor_error(v, sc["sensor_error"])
     return Prediction(v, iterations, g)
+
+
+def apply_sensor_error(velocity, params: dict):
+    """:func:`sensor_reading` with the ``sensor_error`` parameters ``g<c>`` [dB] and
+    ``r<m><axis>`` [rad] (missing ones 0)."""
+    n_ch = velocity.shape[1]
+    gains = np.array([params.get(f"g{c + 1}", 0.0) for c in range(n_ch)])
+    rot = np.array([[params.get(f"r{m + 1}{ax}", 0.0) for ax in "xyz"]
+                    for m in range(n_ch // 3)])
+    return sensor_reading(velocity, gains, rot)
 
 
 def rotation_matrix(phi):
@@ -430,6 +433,111 @@ def simulate(engine, rpm, scenario: dict):
                        periodicity=np.zeros(hm.rpm.size),
                        settings={"solver": "harmonic (effects)", "effects": scenario},
                        meta={"engine": getattr(engine, "name", "")})
+
+
+# ----------------------------------------------------------------------- the normal model
+#: Effects that are not a change of the linear engine model (applied to the response).
+RESPONSE_EFFECTS = ("amplitude_stiffness", "sensor_error")
+
+
+def check_scenario(scenario: dict) -> dict:
+    """Validate ``{effect: {parameter: value}}``: known names, values inside the bounds.
+
+    Returns the scenario with every parameter filled in (defaults); raises ``KeyError``
+    (unknown effect or parameter) or ``ValueError`` (value outside its bounds, not finite)
+    with a one-line message.
+    """
+    out = {}
+    for name, params in scenario.items():
+        if name not in EFFECTS:
+            raise KeyError(f"unknown effect {name!r} (expected {', '.join(EFFECTS)})")
+        eff = EFFECTS[name]
+        spec = {p.name: p for p in eff.parameters}
+        for k, v in params.items():
+            if k not in spec:
+                raise KeyError(f"effect {name!r} has no parameter {k!r} (expected "
+                               f"{', '.join(spec)})")
+            p = spec[k]
+            if not (np.isfinite(v) and p.lower <= v <= p.upper):
+                raise ValueError(f"{name}.{k} = {v:g} {p.unit} outside its bounds "
+                                 f"{p.lower:g}..{p.upper:g} {p.unit}")
+        out[name] = {**eff.defaults(), **params}
+    return out
+
+
+def runup_with_effects(engine, rpm, scenario: dict, **options):
+    r"""Run-up of ``engine`` with the effects of ``scenario``, through the normal run-up.
+
+    Every effect goes through :func:`powertrain.runup.run_runup` (either solver, all
+    outputs: displacement, velocity, acceleration, mount forces):
+
+    * engine-model effects (``base_compliance``, ``mount_stiffness``, ``balancer_error``,
+      ``cylinder_imbalance``) change the engine (``Effect.apply``), applied in that order;
+    * ``amplitude_stiffness``: the factors :math:`g(a_n)` of the equivalent linearisation
+      are converged at each speed on the frequency-domain model
+      (:func:`predict`); then each speed step runs with every network's springs and dampers
+      scaled by its factor at that speed. ``meta["amplitude_factors"]`` holds them
+      (n_r, n_net); the rigid-body modes reported are those at the reference amplitude;
+    * ``sensor_error``: the channels' displacement, velocity and acceleration are read
+      through :func:`sensor_reading` (the transmitted forces are not sensor readings and
+      stay as they are).
+
+    Parameters
+    ----------
+    engine : Engine
+    rpm : array_like
+        Speed steps [rpm].
+    scenario : dict
+        ``{effect: {parameter: value}}`` (SI, :data:`EFFECTS` units).
+    **options
+        Keyword arguments of :func:`~powertrain.runup.run_runup` (``solver``...).
+
+    Returns
+    -------
+    RunupResult
+        ``settings["effects"]`` records the scenario.
+    """
+    from powertrain.runup import run_runup
+    sc = check_scenario(scenario)
+    rpm = np.atleast_1d(np.asarray(rpm, float))
+    for name in ("base_compliance", "mount_stiffness", "balancer_error", "cylinder_imbalance"):
+        if name in sc:
+            engine = EFFECTS[name].apply(engine, **sc[name])
+    amp = sc.get("amplitude_stiffness")
+    if amp is not None and amp["kappa"] != 0.0:
+        hm = HarmonicModel(engine, rpm)
+        g = predict(hm, {"amplitude_stiffness": amp}).factors
+        parts = []
+        for i, r in enumerate(rpm):
+            k = iter(g[i])
+            eng_i = _map_networks(engine, lambda mi, m, ax, mod: mod.scaled(
+                *(2 * (float(next(k)),))))  # noqa: B023 (called at once)
+            parts.append(run_runup(eng_i, [r], **options))
+        result = _concatenate(parts)
+        result.rigid_body_modes_hz = run_runup(engine, rpm[:1], solver="harmonic"
+                                               ).rigid_body_modes_hz
+        result.meta["amplitude_factors"] = g.tolist()
+    else:
+        result = run_runup(engine, rpm, **options)
+    if "sensor_error" in sc:
+        for attr in ("displacement", "velocity", "acceleration"):
+            setattr(result, attr, apply_sensor_error(getattr(result, attr),
+                                                     sc["sensor_error"]))
+    result.settings["effects"] = sc
+    return result
+
+
+def _concatenate(parts):
+    """One RunupResult from single-speed results (same channels and orders)."""
+    first = parts[0]
+    out = dataclasses.replace(first)
+    for attr in ("rpm", "displacement", "velocity", "acceleration", "mount_force",
+                 "mean_mount_force", "periodicity"):
+        setattr(out, attr, np.concatenate([getattr(p, attr) for p in parts], axis=0))
+    out.solver_seconds = float(sum(p.solver_seconds for p in parts))
+    out.settings = dict(first.settings)
+    out.meta = dict(first.meta)
+    return out
 
 
 # ----------------------------------------------------------------------- time-domain check

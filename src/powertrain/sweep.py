@@ -64,7 +64,9 @@ class SweepTask:
 
 
 def run_task(task: SweepTask):
-    """Apply the task's operations to its engine and run the run-up.
+    """Apply the task's operations to its engine and run the run-up (response-level
+    effects, :func:`powertrain.variants.response_scenario`, through
+    :func:`powertrain.effects.runup_with_effects`).
 
     Returns
     -------
@@ -72,9 +74,15 @@ def run_task(task: SweepTask):
         ``meta["variant"]`` holds the task name.
     """
     from powertrain.runup import run_runup
-    from powertrain.variants import apply_operations
+    from powertrain.variants import apply_operations, response_scenario
     engine = apply_operations(task.engine, task.operations)
-    result = run_runup(engine, task.rpm, solver=task.solver, **task.options)
+    response = response_scenario(task.operations)
+    if response:        # amplitude-dependent mounts, sensor errors: see effects module
+        from powertrain.effects import runup_with_effects
+        result = runup_with_effects(engine, task.rpm, response, solver=task.solver,
+                                    **task.options)
+    else:
+        result = run_runup(engine, task.rpm, solver=task.solver, **task.options)
     result.meta["variant"] = task.name
     return result
 

@@ -35,6 +35,14 @@ mount, ``x``, ``y``, ``z`` or ``*``; the default engine's mounts are ``left``, `
                                            axes), :math:`R' = R_z R_y R_x R`
 ``--target MOUNT.DIR:CHANGE:BAND[:WIDTH]`` retune to a desired K_CP change, see
                                            :mod:`powertrain.retune`
+``--effect NAME[:PARAM=VALUE[UNIT],...]``  add an unmodelled effect of
+                                           :data:`powertrain.effects.EFFECTS` (e.g.
+                                           ``mount_stiffness:k1=1.5``,
+                                           ``base_compliance:c_base=400N/mm,m_base=8kg``);
+                                           VALUE in the parameter's unit (N/m, kg, rad,
+                                           dB, 1) or an explicit one of the same
+                                           dimension; inside the effect's bounds; run by
+                                           :func:`powertrain.effects.runup_with_effects`
 =========================================  ==================================================
 
 What "scale stiffness" means for a lumped network
@@ -265,6 +273,48 @@ class Target:
     def check(self, engine) -> None:
         """Raise :class:`InputError` if the mount or direction is unknown."""
         _map_directions(engine, self.mount, self.direction, lambda m: m, self.origin)
+
+
+@dataclass(frozen=True)
+class AddEffect:
+    """An unmodelled effect of :data:`powertrain.effects.EFFECTS` with its parameters.
+
+    Engine-model effects are applied by :meth:`apply`; the response-level ones
+    (``amplitude_stiffness``, ``sensor_error``) leave the engine unchanged here and are
+    applied to the run-up by :func:`powertrain.sweep.run_task` through
+    :func:`powertrain.effects.runup_with_effects`.
+
+    Attributes
+    ----------
+    effect : str
+    params : tuple of (name, SI value)
+    """
+
+    effect: str
+    params: tuple = ()
+    spec: str = ""
+    origin: Origin = Origin("--effect")
+
+    @property
+    def scenario(self) -> dict:
+        return {self.effect: dict(self.params)}
+
+    def apply(self, engine):
+        from powertrain.effects import EFFECTS, RESPONSE_EFFECTS
+        if self.effect in RESPONSE_EFFECTS:
+            return engine
+        eff = EFFECTS[self.effect]
+        return eff.apply(engine, **{**eff.defaults(), **dict(self.params)})
+
+
+def response_scenario(operations) -> dict:
+    """The response-level effects of a variant's operations, merged in order."""
+    from powertrain.effects import RESPONSE_EFFECTS
+    sc: dict = {}
+    for op in operations:
+        if isinstance(op, AddEffect) and op.effect in RESPONSE_EFFECTS:
+            sc.setdefault(op.effect, {}).update(dict(op.params))
+    return sc
 
 
 @dataclass(frozen=True)
@@ -510,9 +560,54 @@ def parse_target(text: str, origin: Origin = Origin("--target")) -> Target:
     return Target(mount, direction, factor, f_lo, f_hi, width, spec=text, origin=origin)
 
 
+def parse_effect(text: str, origin: Origin = Origin("--effect")) -> AddEffect:
+    """``NAME[:PARAM=VALUE[UNIT][,PARAM=VALUE...]]`` -> :class:`AddEffect` (SI values).
+
+    Without a unit a value is in the parameter's own unit (:data:`powertrain.effects.
+    EFFECTS`: N/m, kg, m, rad, dB or 1); an explicit unit must have the same dimension
+    (``c_base=400N/mm``, ``lag=5deg``). Unknown effect or parameter, a value outside the
+    effect's bounds: an error naming the option.
+    """
+    from powertrain.effects import EFFECTS
+    from powertrain.units import UNITS
+    form = "NAME[:PARAM=VALUE,...], e.g. mount_stiffness:k1=1.5"
+    name, _, rest = text.partition(":")
+    name = name.strip()
+    if name not in EFFECTS:
+        raise origin.error(f"{text!r}: unknown effect {name!r} (expected "
+                           f"{', '.join(EFFECTS)})")
+    spec = {p.name: p for p in EFFECTS[name].parameters}
+    params = []
+    for item in [x.strip() for x in rest.split(",")] if rest.strip() else []:
+        key, eq, value = item.partition("=")
+        key = key.strip()
+        if not eq:
+            raise origin.error(f"{text!r}: expected PARAM=VALUE in {item!r} ({form})")
+        if key not in spec:
+            raise origin.error(f"{text!r}: effect {name!r} has no parameter {key!r} "
+                               f"(expected {', '.join(spec)})")
+        p = spec[key]
+        m = re.match(r"^([-+0-9.eE]+)\s*(.*)$", value.strip())
+        if not m:
+            raise origin.error(f"{text!r}: {value.strip()!r} is not a number")
+        v = _float(m.group(1), text, origin)
+        unit = m.group(2).strip() or p.unit
+        if unit != p.unit:
+            if unit not in UNITS or p.unit not in UNITS or UNITS[unit][0] != UNITS[p.unit][0]:
+                raise origin.error(f"{text!r}: unit {unit!r} of {key} is unknown or not a "
+                                   f"unit of {p.unit}")
+            v = v * UNITS[unit][1] / UNITS[p.unit][1]
+        if not (p.lower <= v <= p.upper):
+            u = "" if p.unit == "1" else f" {p.unit}"
+            raise origin.error(f"{text!r}: {key} = {v:g}{u} outside the effect's bounds "
+                               f"{p.lower:g}..{p.upper:g}{u}")
+        params.append((key, float(v)))
+    return AddEffect(name, tuple(params), spec=text, origin=origin)
+
+
 #: Operation keyword (CLI option without ``--``, variants-file key) -> parser.
 PARSERS = {"scale": parse_scale, "set": parse_set, "swap": parse_swap, "move": parse_move,
-           "rotate": parse_rotate, "target": parse_target}
+           "rotate": parse_rotate, "target": parse_target, "effect": parse_effect}
 
 
 def parse_operations(specs: dict, *, base: Path | None = None) -> tuple:
@@ -546,6 +641,7 @@ def read_variants(path) -> list:
         move = ["gearbox=0,0,10"]             # rotate, target; swap paths relative to
         rotate = ["left=0,0,5"]               # the variants file
         target = ["left.z:+20%:100-300Hz"]
+        effect = ["mount_stiffness:k3=0.7"]   # unmodelled effects (powertrain.effects)
 
     Errors name the file, the line and the key (``variant[2].scale``).
     """

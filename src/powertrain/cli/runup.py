@@ -30,9 +30,12 @@ from powertrain.cli.common import speed_options, speed_steps
 @click.option("--plot", type=click.Path(dir_okay=False),
               help="Thesis figure set (Figs 45-71) as PNG.")
 @click.option("--no-balancers", is_flag=True, help="Switch the balancer shafts off.")
+@click.option("--effect", multiple=True, metavar="NAME[:PARAM=VALUE,...]",
+              help="Add an unmodelled effect of the diagnosis library (as in `whatif`), e.g. "
+                   "base_compliance:c_base=400N/mm,m_base=8kg. Repeatable.")
 @click.option("--quiet", is_flag=True, help="No progress bar and no table.")
 def runup(rpm_from, rpm_to, rpm_step, engine_file, solver, stepper, angle_step, out, csv_file,
-          plot, no_balancers, quiet):
+          plot, no_balancers, effect, quiet):
     """Run-up: steady-state mount-point velocities at each speed, order analysed.
 
     Prints the rigid-body modes and the synthesis (RMS sum of orders 0.5..8) velocity of the
@@ -42,6 +45,7 @@ def runup(rpm_from, rpm_to, rpm_step, engine_file, solver, stepper, angle_step, 
     Examples:
       powertrain runup --from 1000 --to 6000 --step 500
       powertrain runup --solver harmonic --csv runup.csv --plot runup.png
+      powertrain runup --effect amplitude_stiffness:kappa=1,a_c=0.02mm
     """
     import numpy as np
 
@@ -54,12 +58,24 @@ def runup(rpm_from, rpm_to, rpm_step, engine_file, solver, stepper, angle_step, 
     engine = read_engine(engine_path)
     if no_balancers:
         engine = engine.with_balancers(enabled=False)
+    scenario = {}
+    if effect:
+        from powertrain.variants import parse_effect
+        for text in effect:
+            op = parse_effect(text)
+            scenario.setdefault(op.effect, {}).update(dict(op.params))
     try:
-        result = run_runup(engine, rpm, solver=solver, angle_step_deg=angle_step,
-                           progress=not quiet, stepper=stepper)
+        if scenario:
+            from powertrain.effects import runup_with_effects
+            result = runup_with_effects(engine, rpm, scenario, solver=solver,
+                                        angle_step_deg=angle_step, stepper=stepper)
+        else:
+            result = run_runup(engine, rpm, solver=solver, angle_step_deg=angle_step,
+                               progress=not quiet, stepper=stepper)
     except ValueError as exc:
         raise InputError(str(exc), key="--angle-step") from None
-    snapshot = open(engine_path, encoding="utf-8").read()
+    from pathlib import Path
+    snapshot = Path(engine_path).read_text(encoding="utf-8")
     mounts = {f"{m.name}.{a}": {"model": mdl.topology.name, "params_si": mdl.params,
                                  "source": mdl.source}
               for m in engine.mounts for a, mdl in m.directions.items()}
@@ -76,6 +92,10 @@ def runup(rpm_from, rpm_to, rpm_step, engine_file, solver, stepper, angle_step, 
     modes = ", ".join(f"{f:.1f}" for f in result.rigid_body_modes_hz)
     click.echo(f"engine: {engine.name} ({engine_path})")
     click.echo(f"rigid-body modes [Hz]: {modes}")
+    if scenario:
+        click.echo("effects: " + "; ".join(
+            f"{name}(" + ", ".join(f"{k}={v:g}" for k, v in p.items()) + ")"
+            for name, p in result.settings["effects"].items()))
     syn = result.synthesis_rms("velocity") * 1e3
     header = ["rpm"] + [f"{m}.{d}" for m, d in result.channels]
     rows = [[f"{r:g}"] + [float(v) for v in syn[i]] for i, r in enumerate(result.rpm)]

@@ -28,6 +28,10 @@ from powertrain.cli.common import speed_options, speed_steps
               help="Shift a mount point [mm, engine axes]. Repeatable.")
 @click.option("--rotate", multiple=True, metavar="MOUNT=AX,AY,AZ",
               help="Rotate a mount's axes about engine X, then Y, then Z [deg]. Repeatable.")
+@click.option("--effect", multiple=True, metavar="NAME[:PARAM=VALUE,...]",
+              help="Add an unmodelled effect of the diagnosis library, e.g. "
+                   "mount_stiffness:k1=1.5 or base_compliance:c_base=400N/mm,m_base=8kg "
+                   "(see `powertrain diagnose`). Repeatable.")
 @click.option("--variants", "variants_file", type=click.Path(dir_okay=False),
               help="TOML file of named variants ([[variant]] name = ..., scale = [...], ...).")
 @click.option("--target", multiple=True, metavar="MOUNT.DIR:CHANGE:BAND[:WIDTH]",
@@ -50,11 +54,12 @@ from powertrain.cli.common import speed_options, speed_steps
               help="Processes for the variants (default: all local cores; 1 = serial).")
 @click.option("--quiet", is_flag=True, help="No progress bar and no table.")
 def whatif(engine_file, rpm_from, rpm_to, rpm_step, solver, scale, set_, swap, move, rotate,
-           variants_file, target, target_out, target_plot, measured_file, plot, json_file,
+           effect, variants_file, target, target_out, target_plot, measured_file, plot, json_file,
            signal, workers, quiet):
     """What-if: run the baseline and variants of the mount system, print the change in dB.
 
-    The command-line operations (--scale/--set/--swap/--move/--rotate) form one variant,
+    The command-line operations (--scale/--set/--swap/--move/--rotate/--effect) form one
+    variant,
     "command line"; each --target is a variant of its own; --variants adds the variants of
     a file. For each channel (mount x engine X/Y/Z) and quantity (synthesis, 2nd, 4th order)
     the change 20 log10(v_variant/v_baseline) is averaged over the speed steps (mean) and
@@ -67,6 +72,7 @@ def whatif(engine_file, rpm_from, rpm_to, rpm_step, solver, scale, set_, swap, m
       powertrain whatif --move gearbox=0,0,10 --rotate left=0,0,5 --plot whatif.png
       powertrain whatif --target left.z:+20%:100-300Hz --target-out left-z-retuned.toml
       powertrain whatif --variants variants.toml --measured measured.csv --plot w.png
+      powertrain whatif --effect mount_stiffness:k1=1.5,k2=1.5 --effect sensor_error:g3=2
     """
     from powertrain.errors import InputError
     from powertrain.iotools.engine_file import DEFAULT_ENGINE_PATH, read_engine
@@ -90,7 +96,7 @@ def whatif(engine_file, rpm_from, rpm_to, rpm_step, solver, scale, set_, swap, m
 
     variants = []
     ops = parse_operations({"scale": scale, "set": set_, "swap": swap, "move": move,
-                            "rotate": rotate})
+                            "rotate": rotate, "effect": effect})
     if ops:
         variants.append(Variant("command line", ops))
     for text in target:
@@ -100,7 +106,7 @@ def whatif(engine_file, rpm_from, rpm_to, rpm_step, solver, scale, set_, swap, m
         variants += read_variants(variants_file)
     if not variants:
         raise InputError("no variant given (use --scale, --set, --swap, --move, --rotate, "
-                         "--target or --variants)", key="--variants")
+                         "--effect, --target or --variants)", key="--variants")
     names = [v.name for v in variants]
     dup = sorted({n for n in names if names.count(n) > 1})
     if dup:
