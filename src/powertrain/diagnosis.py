@@ -36,8 +36,10 @@ of :data:`powertrain.effects.EFFECTS`, and the pairs of the three best, is fitte
 :data:`N_FIT_RPM` evenly chosen) training speeds by bounded least squares in dB
 (``scipy.optimize.least_squares``, multi-start on a coarse grid) and scored on the held-out
 speeds. Decision rule, with :math:`E_0, E_c` the held-out mean squared gaps (dB²) of the
-baseline and the candidate and :math:`\hat\sigma` the noise estimated from the measured
-curves (second differences along speed, robust):
+baseline and the candidate, :math:`\hat\sigma` the noise estimated from the measured
+curves (second differences along speed, robust) and :math:`E_n = \hat\sigma^2 u` the held-out
+mean squared gap a perfect model would leave, :math:`u` the fraction of scored held-out
+points that are not censored (:func:`noise_mse`; a censored point leaves no noise):
 
 * a candidate is **supported** when it lowers the training BIC,
   :math:`n\ln(\mathrm{RSS}/n) + p\ln n`, by more than :data:`BIC_MARGIN`, and the held-out
@@ -50,7 +52,7 @@ curves (second differences along speed, robust):
   :data:`N_CHECKED` supported ones, that passes all of
 
   - *size*: it explains at least :data:`EXPLAINED_MIN` of the held-out excess gap over
-    noise, :math:`(E_0 - E_c)/(E_0 - \hat\sigma^2)`;
+    noise, :math:`(E_0 - E_c)/(E_0 - E_n)`;
   - *residual consistent with noise*: its held-out residual, averaged per channel and order
     over groups of about 4 adjacent held-out speeds (:func:`structured_residual`; noise
     averages out, structure does not), keeps a structured RMS beyond noise of at most
@@ -64,7 +66,7 @@ curves (second differences along speed, robust):
     (orders ≤ 2 vs > 2, both ways: a gain or a triad rotation is the same on every order of
     its channels, a frequency-tied gap is not). Free gains thus cannot absorb a structural
     gap;
-* otherwise: **"no effect"** when the excess RMS gap :math:`\sqrt{\max(E_0 - \hat\sigma^2,
+* otherwise: **"no effect"** when the excess RMS gap :math:`\sqrt{\max(E_0 - E_n,
   0)}` is below :data:`EXCESS_MIN_DB` (the model agrees within noise), else
   **"unexplained"** (a supported candidate that failed a check is named as partial, with
   the rule it failed).
@@ -661,6 +663,30 @@ def _cells_mse(o: FitOutcome, cells):
     return float(np.mean(g[ok] ** 2)) if ok.any() else float("nan"), per
 
 
+def noise_mse(problem, sigma, cells=None) -> float:
+    r"""Expected held-out mean squared gap of a perfect model [dB²]: :math:`\hat\sigma^2`
+    times the fraction of scored held-out points that are not censored (a censored point's
+    residual, :math:`\max(0, 20\log_{10}(s'/3f))`, is 0 for a model below the censoring
+    level, whatever the noise).
+
+    Parameters
+    ----------
+    problem : _Problem
+    sigma : float
+        Noise [dB, 1σ] (NaN: 0 returned).
+    cells : ndarray bool (n_ch, n_o), optional
+        Restrict to these (channel, order) cells.
+    """
+    if not (np.isfinite(sigma) and sigma > 0):
+        return 0.0
+    valid = problem.valid["test"]
+    if cells is not None:
+        valid = valid & np.asarray(cells, bool)[None]
+    unc = valid & (problem.meas["test"] >= CENSOR_MARGIN * problem.data.floor)
+    n = int(valid.sum())
+    return float(sigma ** 2 * unc.sum() / n) if n else 0.0
+
+
 def heldout_cells_check(problem, o: FitOutcome, baseline: FitOutcome, sigma):
     """Refit ``o``'s effects without some (channel, order) cells and score the withheld
     cells at the held-out speeds (cross-validation over cells as well as speeds).
@@ -706,8 +732,7 @@ def heldout_cells_check(problem, o: FitOutcome, baseline: FitOutcome, sigma):
     cells = ok.any(axis=0)
     e0, per_0 = _cells_mse(baseline, cells)
     ec = float(np.mean(g_all[ok] ** 2)) if ok.any() else float("nan")
-    s2 = sigma ** 2 if np.isfinite(sigma) else 0.0
-    excess = max(e0 - s2, 0.0)
+    excess = max(e0 - noise_mse(problem, sigma, cells), 0.0)
     d = per_0 - per_c
     d = d[np.isfinite(d)]
     sd = float(np.std(d, ddof=1)) if d.size > 1 else 0.0
@@ -756,6 +781,8 @@ class DiagnosisResult:
     seconds: float
     synthetic: bool = False
     notes: list = field(default_factory=list)
+    #: E_n: held-out mean squared gap a perfect model would leave [dB²] (:func:`noise_mse`).
+    noise_mse_heldout: float = 0.0
 
     # ------------------------------------------------------------------ dicts
     def where(self) -> dict:
@@ -812,7 +839,7 @@ class DiagnosisResult:
 
     def to_dict(self) -> dict:
         b = self.baseline
-        excess = math.sqrt(max(b.heldout_mse - self.noise_db ** 2, 0.0))
+        excess = math.sqrt(max(b.heldout_mse - self.noise_mse_heldout, 0.0))
         return {
             "source": self.source, "synthetic": self.synthetic, "engine": self.engine_name,
             "where": self.where(),
@@ -822,6 +849,7 @@ class DiagnosisResult:
             "heldout_rms_db_before": b.heldout_rms_db,
             "heldout_rms_db_after": (self.chosen or b).heldout_rms_db,
             "heldout_excess_rms_db_before": excess,
+            "heldout_noise_mse_db2": self.noise_mse_heldout,
             "split": self.split,
             "confounding_check": self.band_check,
             "decision_rule": {"T_MIN": T_MIN, "BIC_MARGIN": BIC_MARGIN,
@@ -1036,7 +1064,8 @@ def _diagnose(measured, engine, noise_floor, effects, pairs, band_check):
             fo.t_stat, fo.bic_gain = _compare(baseline, fo)
             outcomes.append(fo)
     e0 = baseline.heldout_mse
-    excess0 = max(e0 - (sigma ** 2 if np.isfinite(sigma) else 0.0), 0.0)
+    s2_heldout = noise_mse(problem, sigma)
+    excess0 = max(e0 - s2_heldout, 0.0)
     for o in outcomes:
         o.explained = (e0 - o.heldout_mse) / excess0 if excess0 > 0 else float("nan")
         supported = (o.bic_gain > BIC_MARGIN and o.t_stat > T_MIN
@@ -1049,7 +1078,7 @@ def _diagnose(measured, engine, noise_floor, effects, pairs, band_check):
             members = [by_label[e] for e in o.effects]
             best_m = min(members, key=lambda m: m.heldout_mse)
             t, dbic = _compare(best_m, o)
-            left = best_m.heldout_mse - (sigma ** 2 if np.isfinite(sigma) else 0.0)
+            left = best_m.heldout_mse - s2_heldout
             gain = (best_m.heldout_mse - o.heldout_mse) / left if left > 0 else 0.0
             if not (t > T_MIN and dbic > BIC_MARGIN and gain >= PAIR_GAIN_MIN):
                 o.status = f"not better than {best_m.label} alone"
@@ -1132,7 +1161,8 @@ def _diagnose(measured, engine, noise_floor, effects, pairs, band_check):
     return DiagnosisResult(data, src, getattr(engine, "name", ""), gap_map, gap_after, parts,
                            rigid, regions, sigma, split, baseline, outcomes, chosen, verdict,
                            verdict_text, bands, time.perf_counter() - t0,
-                           synthetic=bool(getattr(measured, "synthetic", False)))
+                           synthetic=bool(getattr(measured, "synthetic", False)),
+                           noise_mse_heldout=s2_heldout)
 
 
 def _where_text(regions, parts):

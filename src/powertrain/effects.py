@@ -8,9 +8,11 @@ parameter names, bounds, defaults and units; every effect can be used
   ``compare`` and ``whatif``) where the effect is a change of the engine model:
   :func:`with_base_compliance_all`, :func:`with_mount_stiffness`,
   :func:`with_balancer_error`, :func:`with_cylinder_imbalance`;
-* on the response (:func:`simulate`) where it is not a change of the linear model:
-  ``amplitude_stiffness`` (an amplitude-dependent mount, solved by equivalent linearisation
-  iterated to consistency) and ``sensor_error`` (a measurement effect);
+* on the ordinary run-up, every effect (:func:`runup_with_effects`, behind
+  ``powertrain runup --effect`` and ``powertrain whatif --effect``), including the two that
+  are not a change of the linear model: ``amplitude_stiffness`` (an amplitude-dependent
+  mount, equivalent linearisation iterated to consistency) and ``sensor_error`` (a
+  measurement effect); :func:`simulate` is its harmonic-only shortcut;
 * on the fast cached path :func:`predict` (one :class:`~powertrain.solvers.fast_harmonic.
   HarmonicModel`, many parameter sets), which the diagnosis uses.
 
