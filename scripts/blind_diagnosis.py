@@ -28,8 +28,9 @@ unexplained_ok=...``):
 * false_claims: fraction of the effect-free cases *plus the undetectable cases* (in- or
   out-of-library) with a false claim: on an effect-free case any chosen effect set; on an
   undetectable case a chosen set that names an effect outside the library matches of the
-  hidden effects ("no effect" and "unexplained" are never claims; naming a hidden effect
-  that the rule calls undetectable is right, not false, and is counted separately);
+  hidden effects ("no effect", "unexplained" and "ambiguous" are never claims; naming a
+  hidden effect that the rule calls undetectable is right, not false, and is counted
+  separately);
 * unexplained_ok: fraction of *detectable* out-of-library cases answered "unexplained".
 
 The line before it, ``raw: top1=... shrink_median=... false_claims=... unexplained_ok=...``,
@@ -183,7 +184,7 @@ def main(argv=None):
         return "+".join(r["truth_set"])
 
     def answer_label(r):
-        if r["verdict"] in ("no effect", "unexplained"):
+        if r["verdict"] in ("no effect", "unexplained", "ambiguous"):
             return r["verdict"]
         return "+".join(r["chosen_set"])
     conf = Counter((truth_label(r), answer_label(r)) for r in rows)

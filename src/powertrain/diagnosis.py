@@ -783,6 +783,8 @@ class DiagnosisResult:
     notes: list = field(default_factory=list)
     #: E_n: held-out mean squared gap a perfect model would leave [dB²] (:func:`noise_mse`).
     noise_mse_heldout: float = 0.0
+    #: Labels of candidates that pass the decision rule but cannot be told apart.
+    ambiguous: list = field(default_factory=list)
 
     # ------------------------------------------------------------------ dicts
     def where(self) -> dict:
@@ -850,6 +852,7 @@ class DiagnosisResult:
             "heldout_rms_db_after": (self.chosen or b).heldout_rms_db,
             "heldout_excess_rms_db_before": excess,
             "heldout_noise_mse_db2": self.noise_mse_heldout,
+            "ambiguous_between": self.ambiguous,
             "split": self.split,
             "confounding_check": self.band_check,
             "decision_rule": {"T_MIN": T_MIN, "BIC_MARGIN": BIC_MARGIN,
@@ -1109,7 +1112,35 @@ def _diagnose(measured, engine, noise_floor, effects, pairs, band_check):
             continue
         chosen = o
         break
+    # confounding: an admissible rival from another effect family that the held-out data
+    # cannot tell apart from the answer makes the answer ambiguous, not a claim
+    rivals = []
     if chosen is not None:
+        mine = set(chosen.effects)
+        for o in outcomes:
+            theirs = set(o.effects)
+            if (o is chosen or o.status != "supported" or theirs <= mine or mine <= theirs
+                    or not (np.isfinite(o.explained) and o.explained >= EXPLAINED_MIN)
+                    or not o.struct_db <= struct_max):
+                continue
+            t_rival = _compare(o, chosen)[0]
+            if not t_rival > T_MIN:
+                rivals.append((o, t_rival))
+    ambiguous = []
+    if rivals:
+        ambiguous = [chosen.label] + [o.label for o, _ in rivals]
+        chosen.status = "indistinguishable from " + ", ".join(o.label for o, _ in rivals)
+        for o, t_rival in rivals:
+            o.status = f"indistinguishable from {chosen.label} (t {t_rival:.1f})"
+        verdict = "ambiguous"
+        verdict_text = (
+            "ambiguous: " + " or ".join(f"{o.label} (explains {o.explained:.0%})"
+                                        for o in [chosen] + [r for r, _ in rivals])
+            + f"; each passes the decision rule but the held-out speeds do not tell them "
+              f"apart (t {max(t for _, t in rivals):.1f} <= {T_MIN:g}); data at other "
+              f"amplitudes, loads or channels are needed to decide")
+        chosen = None
+    elif chosen is not None:
         best = chosen
         best.status = "chosen"
         verdict = best.label
@@ -1162,7 +1193,7 @@ def _diagnose(measured, engine, noise_floor, effects, pairs, band_check):
                            rigid, regions, sigma, split, baseline, outcomes, chosen, verdict,
                            verdict_text, bands, time.perf_counter() - t0,
                            synthetic=bool(getattr(measured, "synthetic", False)),
-                           noise_mse_heldout=s2_heldout)
+                           noise_mse_heldout=s2_heldout, ambiguous=ambiguous)
 
 
 def _where_text(regions, parts):

@@ -41,6 +41,9 @@ def two_port_kernel(omega, scale, masses, elem_nodes, c, d, out_a, out_b, out_c)
         Node pairs; 0 = engine side, 1..n internal, −1 = ground.
     c, d : ndarray (n_el,) float
         Element stiffness [N/m] and damping [N·s/m].
+    out_a, out_b, out_c : ndarray (n_w,) complex
+        Filled with :math:`a = K_{IP}`, the coupling :math:`b` and the ground-side
+        :math:`c` [N/m].
     """
     n = masses.size
     size = n + 2
