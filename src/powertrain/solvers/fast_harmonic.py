@@ -148,7 +148,6 @@ class HarmonicModel:
         self._extra = {}
         self._v0 = None
         self._net_arrays = None
-        self._rr = None
 
     # ------------------------------------------------------------------ cached parts
     def load_of(self, engine) -> np.ndarray:
@@ -257,21 +256,19 @@ class HarmonicModel:
         load = self.load if load is None else load
         w = self.omega[:, harmonics]
         K = kip[:, harmonics]
-        if self._rr is None:                         # r_n r_n^T, flattened (n_net, 36)
-            self._rr = np.einsum("ni,nj->nij", self.rows, self.rows).reshape(
-                len(self.rows), 36).astype(complex)
-        D = (-(w ** 2))[..., None, None] * self.M + (K @ self._rr).reshape(K.shape[:2] + (6, 6))
+        D = (-(w ** 2))[..., None, None] * self.M + np.einsum(
+            "rhn,ni,nj->rhij", K, self.rows, self.rows)
         return np.linalg.solve(D, load[:, harmonics][..., None])[..., 0]
 
     def velocity(self, q, harmonics=slice(1, N_HARMONICS)) -> np.ndarray:
         """Complex peak channel velocities (n_r, n_ch, n_h) [m/s] from :meth:`solve`'s q."""
         w = self.omega[:, harmonics]
-        return np.swapaxes(q @ self.channel_matrix.T, 1, 2) * (1j * w)[:, None, :]
+        return np.einsum("ci,rhi->rch", self.channel_matrix, q) * (1j * w)[:, None, :]
 
     def network_amplitude(self, q) -> np.ndarray:
         r"""Engine-side peak displacement of each network :math:`a_n =
         \sqrt{\sum_h |\mathbf r_n\cdot\hat{\mathbf q}_h|^2}` [m] (= √2 × RMS sum), (n_r, n_net)."""
-        x = q @ self.rows.T                                      # (n_r, n_h, n_net)
+        x = np.einsum("ni,rhi->rhn", self.rows, q)
         return np.sqrt(np.sum(np.abs(x) ** 2, axis=1))
 
     def nominal_kip(self) -> np.ndarray:
