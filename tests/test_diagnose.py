@@ -247,8 +247,8 @@ def test_elastomer_factor_moves_hydromount_resonance_not_plain_scaling(engine):
 
 def test_sensor_error_rotates_then_scales_each_triad(engine):
     """Closed form: a triad turned 90° about engine Z reads the X velocity on its Y axis;
-    the gain applies per axis after the rotation. The cached sensor-only path equals the
-    general path."""
+    the gain applies per axis after the rotation. A sensor error alone gives the same as with
+    a neutral physical effect beside it (the sensor is applied after the physics)."""
     from powertrain.effects import sensor_reading
     v = np.zeros((1, 9, 2), complex)
     v[0, 3, :] = [1.0 + 2.0j, 3.0]                    # mount 2, x

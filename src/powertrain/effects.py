@@ -166,6 +166,13 @@ def with_mount_stiffness(engine, k1=1.0, k2=1.0, k3=1.0):
                          if mi < 3 else mod)
 
 
+def with_network_elastomer(engine, factors):
+    """Every network's springs and dampers times its own factor (network order: mount-major
+    x, y, z, as :attr:`HarmonicModel.networks`), masses kept (:meth:`MountModel.scaled`)."""
+    f = iter(np.asarray(factors, float).ravel())
+    return _map_networks(engine, lambda mi, m, ax, mod: mod.scaled(*(2 * (float(next(f)),))))
+
+
 def _shaft_factors(n, gain, asym):
     """Unbalance factor of each shaft: ``gain (1 ± asym/2)``, + for the first half of the
     shafts (file order), − for the others (two shafts: first +, second −)."""
@@ -341,11 +348,6 @@ def predict(hm: HarmonicModel, scenario: dict, *, tol=1e-6, max_iter=60) -> Pred
         if name not in EFFECTS:
             raise KeyError(f"unknown effect {name!r}")
         sc[name] = {**EFFECTS[name].defaults(), **p}
-    if set(sc) <= {"sensor_error"}:         # the model itself unchanged: cached solve
-        v = hm.baseline_velocity()
-        if sc:
-            v = apply_sensor_error(v, sc["sensor_error"])
-        return Prediction(v)
     s_el = _elastomer_factors(hm, sc)
     if s_el is None:
         abc = hm.two_ports()                 # cached
@@ -461,8 +463,9 @@ def check_scenario(scenario: dict) -> dict:
                                f"{', '.join(spec)})")
             p = spec[k]
             if not (np.isfinite(v) and p.lower <= v <= p.upper):
-                raise ValueError(f"{name}.{k} = {v:g} {p.unit} outside its bounds "
-                                 f"{p.lower:g}..{p.upper:g} {p.unit}")
+                u = "" if p.unit == "1" else f" {p.unit}"
+                raise ValueError(f"{name}.{k} = {v:g}{u} outside the effect's bounds "
+                                 f"{p.lower:g}..{p.upper:g}{u}")
         out[name] = {**eff.defaults(), **params}
     return out
 
@@ -511,10 +514,7 @@ def runup_with_effects(engine, rpm, scenario: dict, **options):
         g = predict(hm, {"amplitude_stiffness": amp}).factors
         parts = []
         for i, r in enumerate(rpm):
-            k = iter(g[i])
-            eng_i = _map_networks(engine, lambda mi, m, ax, mod: mod.scaled(
-                *(2 * (float(next(k)),))))  # noqa: B023 (called at once)
-            parts.append(run_runup(eng_i, [r], **options))
+            parts.append(run_runup(with_network_elastomer(engine, g[i]), [r], **options))
         result = _concatenate(parts)
         result.rigid_body_modes_hz = run_runup(engine, rpm[:1], solver="harmonic"
                                                ).rigid_body_modes_hz
@@ -576,9 +576,7 @@ def time_domain_amplitude_check(engine, rpm, kappa, a_c, *, cycles=40, angle_ste
     state = None
     prev_v = None
     for _ in range(cycles):
-        k = iter(g)
-        eng_g = _map_networks(engine, lambda mi, m, ax, mod: mod.scaled(
-            *(2 * (float(next(k)),))))  # noqa: B023 (called at once)
+        eng_g = with_network_elastomer(engine, g)
         system = assemble(b.mass, b.cg, b.inertia, eng_g.mounts)
         F = np.zeros((n_cycle + 1, system.n_dof))
         F[:, :6] = np.concatenate([load, load[:1]])

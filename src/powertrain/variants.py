@@ -307,14 +307,20 @@ class AddEffect:
         return eff.apply(engine, **{**eff.defaults(), **dict(self.params)})
 
 
+def effect_scenario(operations, names=None) -> dict:
+    """``{effect: {parameter: value}}`` of the :class:`AddEffect` operations, merged in order
+    (only the effects in ``names``, if given)."""
+    sc: dict = {}
+    for op in operations:
+        if isinstance(op, AddEffect) and (names is None or op.effect in names):
+            sc.setdefault(op.effect, {}).update(dict(op.params))
+    return sc
+
+
 def response_scenario(operations) -> dict:
     """The response-level effects of a variant's operations, merged in order."""
     from powertrain.effects import RESPONSE_EFFECTS
-    sc: dict = {}
-    for op in operations:
-        if isinstance(op, AddEffect) and op.effect in RESPONSE_EFFECTS:
-            sc.setdefault(op.effect, {}).update(dict(op.params))
-    return sc
+    return effect_scenario(operations, RESPONSE_EFFECTS)
 
 
 @dataclass(frozen=True)
@@ -568,7 +574,7 @@ def parse_effect(text: str, origin: Origin = Origin("--effect")) -> AddEffect:
     (``c_base=400N/mm``, ``lag=5deg``). Unknown effect or parameter, a value outside the
     effect's bounds: an error naming the option.
     """
-    from powertrain.effects import EFFECTS
+    from powertrain.effects import EFFECTS, check_scenario
     from powertrain.units import UNITS
     form = "NAME[:PARAM=VALUE,...], e.g. mount_stiffness:k1=1.5"
     name, _, rest = text.partition(":")
@@ -597,11 +603,11 @@ def parse_effect(text: str, origin: Origin = Origin("--effect")) -> AddEffect:
                 raise origin.error(f"{text!r}: unit {unit!r} of {key} is unknown or not a "
                                    f"unit of {p.unit}")
             v = v * UNITS[unit][1] / UNITS[p.unit][1]
-        if not (p.lower <= v <= p.upper):
-            u = "" if p.unit == "1" else f" {p.unit}"
-            raise origin.error(f"{text!r}: {key} = {v:g}{u} outside the effect's bounds "
-                               f"{p.lower:g}..{p.upper:g}{u}")
         params.append((key, float(v)))
+    try:
+        check_scenario({name: dict(params)})         # bounds, finiteness: one rule
+    except ValueError as exc:
+        raise origin.error(f"{text!r}: {exc}") from None
     return AddEffect(name, tuple(params), spec=text, origin=origin)
 
 

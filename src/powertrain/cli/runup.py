@@ -58,12 +58,8 @@ def runup(rpm_from, rpm_to, rpm_step, engine_file, solver, stepper, angle_step, 
     engine = read_engine(engine_path)
     if no_balancers:
         engine = engine.with_balancers(enabled=False)
-    scenario = {}
-    if effect:
-        from powertrain.variants import parse_effect
-        for text in effect:
-            op = parse_effect(text)
-            scenario.setdefault(op.effect, {}).update(dict(op.params))
+    from powertrain.variants import effect_scenario, parse_operations
+    scenario = effect_scenario(parse_operations({"effect": effect}))
     try:
         if scenario:
             from powertrain.effects import runup_with_effects

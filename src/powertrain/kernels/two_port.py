@@ -48,12 +48,12 @@ def two_port_kernel(omega, scale, masses, elem_nodes, c, d, out_a, out_b, out_c)
     n = masses.size
     size = n + 2
     D = np.empty((size, size), np.complex128)
-    done = np.zeros(size, np.bool_)
+    gone = np.zeros(size, np.bool_)          # eliminated internal nodes
     for w in range(omega.size):
         om = omega[w]
         s = scale[w]
         for i in range(size):
-            done[i] = False
+            gone[i] = False
             for j in range(size):
                 D[i, j] = 0.0
         for k in range(n):
@@ -70,23 +70,21 @@ def two_port_kernel(omega, scale, masses, elem_nodes, c, d, out_a, out_b, out_c)
             D[ib, ib] += z
             D[ia, ib] -= z
             D[ib, ia] -= z
-        done[0] = True                      # boundary nodes stay
-        done[n + 1] = True
-        for _ in range(n):
+        for _ in range(n):                  # boundary nodes 0 and n + 1 are never eliminated
             k = -1
             best = -1.0
             for i in range(1, n + 1):
-                if not done[i] and abs(D[i, i]) > best:
+                if not gone[i] and abs(D[i, i]) > best:
                     best = abs(D[i, i])
                     k = i
-            done[k] = True
+            gone[k] = True
             p = D[k, k]
             for i in range(size):
-                if i != k and (not done[i] or i == 0 or i == n + 1):
+                if not gone[i]:
                     f = D[i, k] / p
                     if f != 0.0:
                         for j in range(size):
-                            if j != k and (not done[j] or j == 0 or j == n + 1):
+                            if not gone[j]:
                                 D[i, j] -= f * D[k, j]
         out_a[w] = D[0, 0]
         out_b[w] = D[0, n + 1]

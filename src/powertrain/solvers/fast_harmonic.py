@@ -146,7 +146,6 @@ class HarmonicModel:
         self._load = None
         self._abc = None
         self._extra = {}
-        self._v0 = None
         self._net_arrays = None
 
     # ------------------------------------------------------------------ cached parts
@@ -243,12 +242,6 @@ class HarmonicModel:
                 out[j][:, k] = col[j]
         return tuple(x.reshape(self.omega.shape + (n_net,)) for x in out)
 
-    def baseline_velocity(self) -> np.ndarray:
-        """Channel velocities of the unchanged model (n_r, n_ch, 16), cached."""
-        if getattr(self, "_v0", None) is None:
-            self._v0 = self.velocity(self.solve(self.two_ports()[0]))
-        return self._v0
-
     # ------------------------------------------------------------------ solves
     def solve(self, kip, load=None, harmonics=slice(1, N_HARMONICS)) -> np.ndarray:
         r"""Rigid-body amplitudes :math:`\hat{\mathbf q}` (n_r, n_h, 6) for the given input-point
@@ -284,5 +277,4 @@ class HarmonicModel:
         new._load = None if self._load is None else self._load[index]
         new._abc = None if self._abc is None else tuple(x[index] for x in self._abc)
         new._extra = {k: v[:, index] for k, v in self._extra.items()}
-        new._v0 = None if getattr(self, "_v0", None) is None else self._v0[index]
         return new
