@@ -75,6 +75,16 @@ def run_case(task):
             "t_gen": t_gen, "t_diag": t_diag}
 
 
+def _print_truth(tasks):
+    from powertrain.validation.cases import make_case
+    print(f"{'#':>3} {'hidden':<40} {'eng':<6} {'gap dB':>6} {'p95':>5} {'sig':>4} det  expected")
+    for i, names, eng, seed in tasks:
+        c = make_case(i, names, eng, seed)
+        det = "-" if c.category == "none" else "yes" if c.detectable else "no"
+        print(f"{i:>3} {'+'.join(names) or 'none':<40} {eng:<6} {c.stats[0]:>6.2f} "
+              f"{c.stats[1]:>5.1f} {c.sigma_db:>4.2f} {det:>3}  {'+'.join(c.expected_set)}")
+
+
 def _run_all(tasks, jobs, scheduler):
     try:
         from powertrain.parallel import run_map
@@ -139,6 +149,8 @@ def main(argv=None):
     ap.add_argument("--scheduler", default=None,
                     help="'local' (dask LocalCluster), tcp://HOST:PORT, 'processes', 'serial'")
     ap.add_argument("--dump", help="write the per-case rows to this JSON file")
+    ap.add_argument("--generate-only", action="store_true",
+                    help="make the cases and print their truth, without diagnosing them")
     args = ap.parse_args(argv)
     from powertrain.validation.cases import DETECT_LOCAL_DB, DETECT_RMS_DB, case_plan
     from powertrain.validation.scoring import TARGETS, meets_targets, score, score_line
@@ -146,6 +158,9 @@ def main(argv=None):
     print(f"seed {seed}{'' if args.seed is not None else ' (drawn from os.urandom)'}")
     tasks = [(i, names, eng, s) for i, (names, eng, s) in
              enumerate(case_plan(args.cases, seed))]
+    if args.generate_only:
+        _print_truth(tasks)
+        return
     t0 = time.perf_counter()
     rows = _run_all(tasks, args.jobs, args.scheduler)
     wall = time.perf_counter() - t0
