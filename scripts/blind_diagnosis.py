@@ -50,9 +50,9 @@ def run_case(task):
     t0 = time.perf_counter()
     case = make_case(i, names, eng, seed)
     t_gen = time.perf_counter() - t0
-    t0 = time.perf_counter()
+    t0, c0 = time.perf_counter(), time.process_time()
     d = diagnose(case.measured, engines()[eng], noise_floor=FLOOR).to_dict()
-    t_diag = time.perf_counter() - t0
+    t_diag, c_diag = time.perf_counter() - t0, time.process_time() - c0
     chosen = d.get("chosen") or {}
     where = d["where"]
     rpm = np.asarray(where["rpm"], float)
@@ -72,7 +72,7 @@ def run_case(task):
             "parameters": chosen.get("parameters") if chosen else None,
             "ambiguous": d.get("ambiguous_between", []), "shrink": shrink,
             "measured_shrink": 1 - after / before if before else 0.0,
-            "t_gen": t_gen, "t_diag": t_diag}
+            "t_gen": t_gen, "t_diag": t_diag, "cpu_diag": c_diag}
 
 
 def _print_truth(tasks):
@@ -86,17 +86,27 @@ def _print_truth(tasks):
 
 
 def _run_all(tasks, jobs, scheduler):
+    """Rows of all tasks in order; one line per finished case on stderr."""
+    import sys
+    from contextlib import contextmanager
     try:
-        from powertrain.parallel import run_map
+        from powertrain.parallel import executor
     except ImportError:                     # before powertrain.parallel exists
-        run_map = None
-    if run_map is not None:
-        return run_map(run_case, tasks, scheduler, workers=jobs, progress="blind cases")
-    if jobs > 1:
         from concurrent.futures import ProcessPoolExecutor
-        with ProcessPoolExecutor(jobs) as ex:
-            return list(ex.map(run_case, tasks))
-    return [run_case(t) for t in tasks]
+
+        @contextmanager
+        def executor(scheduler=None, *, workers=None, n_jobs=None):
+            with ProcessPoolExecutor(workers) as ex:
+                yield ex
+    rows = []
+    with executor(scheduler, workers=jobs, n_jobs=len(tasks)) as ex:
+        futures = [ex.submit(run_case, t) for t in tasks]
+        for f in futures:
+            r = f.result()
+            print(f"case {r['i']}: {'+'.join(r['names']) or 'none'} -> {_answer(r)} "
+                  f"({r['t_diag']:.1f} s)", file=sys.stderr, flush=True)
+            rows.append(r)
+    return rows
 
 
 def _answer(r):
@@ -179,10 +189,12 @@ def main(argv=None):
     if missing:
         print(f"  ({missing} claims without a reported gap after: shrink left out)")
     td = np.array([r["t_diag"] for r in rows])
+    tc = np.array([r["cpu_diag"] for r in rows])
     tg = np.array([r["t_gen"] for r in rows])
     print(f"diagnosis time per case: median {np.median(td):.1f} s, longest {td.max():.1f} s "
-          f"(case {int(np.argmax(td))}); truth generation median {np.median(tg):.2f} s; "
-          f"wall {wall:.0f} s ({args.jobs} jobs, scheduler {args.scheduler or 'auto'})")
+          f"(case {int(np.argmax(td))}); CPU time median {np.median(tc):.1f} s, longest "
+          f"{tc.max():.1f} s; truth generation median {np.median(tg):.2f} s; wall "
+          f"{wall:.0f} s ({args.jobs} jobs, scheduler {args.scheduler or 'auto'})")
     if args.dump:
         with open(args.dump, "w") as fh:
             json.dump(rows, fh, indent=1)
