@@ -35,7 +35,7 @@ def compare(measured, sim_file, engine_file, plot, json_file, noise_floor, solve
     For each mount, direction and quantity (synthesis, 2nd, 4th and any other measured
     order): the level gap 20 log10(sim/measured) [dB] at the measured speeds (simulation
     interpolated linearly in rpm and log level, never extrapolated) with its RMS, mean and
-    maximum; FRAC over speed; CSAC and CSF across the nine channels at each speed; an
+    maximum; FRAC over speed; CSAC and CSF across the channels at each speed; an
     FRFSM-like score (Gaussian kernel, sigma 6 dB). Worst channel first.
 
     MEASURED: long-format CSV (mount,direction,quantity,rpm,velocity_rms_mm_per_s; also
