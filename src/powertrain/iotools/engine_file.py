@@ -37,7 +37,6 @@ from powertrain.iotools.tomlfile import get, number, quantity, read_toml
 from powertrain.models import engine as em
 from powertrain.units import to_si
 
-
 #: The shipped default engine (package data, see :mod:`powertrain.data`).
 DEFAULT_ENGINE_PATH: Path = default_engine_path()
 
