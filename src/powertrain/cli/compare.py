@@ -21,7 +21,7 @@ from powertrain.cli import main
               help="JSON with every gap and metric, what was compared and what is missing.")
 @click.option("--noise-floor", type=float, default=0.001, show_default=True,
               help="RMS noise floor of the measured order curves [mm/s]; measured points "
-                   "below 2x this (within 6 dB) are excluded and counted.")
+                   "below 3x this (within 9.5 dB) are excluded and counted.")
 @click.option("--solver", type=click.Choice(["newmark", "harmonic"]), default="newmark",
               show_default=True, help="Solver when the simulation is run here.")
 @click.option("--step", "rpm_step", type=float, default=500.0, show_default=True,
