@@ -84,6 +84,10 @@ def compare(measured, sim_file, engine_file, plot, json_file, noise_floor, solve
         if stop < start:
             raise InputError(f"measured speeds {lo:g}..{hi:g} rpm outside the engine's range "
                              f"{e_lo:g}..{e_hi:g} rpm", file=measured, key="rpm")
+        from powertrain.cli.common import MAX_SPEEDS
+        if (stop - start) / rpm_step + 1 > MAX_SPEEDS:
+            raise InputError(f"{(stop - start) / rpm_step + 1:.3g} speed steps over the "
+                             f"measured range; at most {MAX_SPEEDS}", key="--step")
         rpm = default_rpm(start, stop, rpm_step)
         result = run_runup(engine, rpm, solver=solver, progress=not quiet)
         simulated = MeasuredRunup.from_result(
