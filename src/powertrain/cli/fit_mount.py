@@ -60,8 +60,14 @@ def fit_mount(measured, model, out, plot, starts, seed, fmin, fmax, max_mass):
     seed = DEFAULT_SEED if seed is None else seed
     if max_mass is not None and not max_mass > 0:
         raise InputError(f"must be positive, got {max_mass}", key="--max-mass")
-    if starts < 1:
-        raise InputError(f"must be >= 1, got {starts}", key="--starts")
+    if not 1 <= starts <= 10_000:
+        raise InputError(f"must be 1..10000, got {starts}", key="--starts")
+    if not 0 <= seed < 2 ** 63:
+        raise InputError(f"must be an integer 0..2^63-1, got {seed}", key="--seed")
+    import math
+    for name, value in (("--fmin", fmin), ("--fmax", fmax), ("--max-mass", max_mass)):
+        if value is not None and not math.isfinite(value):
+            raise InputError(f"must be a finite number, got {value}", key=name)
     if fmin is not None and fmax is not None and not fmin < fmax:
         raise InputError(f"--fmin {fmin:g} must be below --fmax {fmax:g}", key="--fmin")
     data = read_stiffness_csv(measured).select(fmin, fmax)

@@ -134,7 +134,11 @@ def _unit_vector(table, key, path, prefix):
 
 
 def _q(table, key, dimension, path, prefix, **kw):
-    return float(quantity(table, key, dimension, path, prefix, **kw))
+    value = quantity(table, key, dimension, path, prefix, **kw)
+    if isinstance(value, list):
+        raise InputError("expected one number, got a list", file=path,
+                         key=f"{prefix}.{key}.value" if prefix else f"{key}.value")
+    return float(value)
 
 
 def read_engine(path=DEFAULT_ENGINE_PATH) -> em.Engine:
@@ -161,8 +165,11 @@ def read_engine(path=DEFAULT_ENGINE_PATH) -> em.Engine:
     mounts = _read_mounts(_table(doc, "mounts", path), path)
     balancer = _read_balancer(_table(doc, "balancer", path), path)
     combustion = _read_combustion(_table(doc, "combustion", path), path, crank)
-    return em.Engine(name=name, crank=crank, body=body, mounts=mounts, balancer=balancer,
-                     combustion=combustion, file=path)
+    engine = em.Engine(name=name, crank=crank, body=body, mounts=mounts, balancer=balancer,
+                        combustion=combustion, file=path)
+    from powertrain.iotools.engine_checks import check_engine
+    check_engine(engine, path)
+    return engine
 
 
 def _read_crank(t, path) -> em.CrankTrain:
@@ -194,8 +201,8 @@ def _read_crank(t, path) -> em.CrankTrain:
     pins = _array(t, "crank_pin_angles", "angle", path, p, (n,))
     order_raw = get(t, "firing_order", path, p, types=list)
     key_fo = f"{p}.firing_order"
-    if (sorted(order_raw) != list(range(1, n + 1))
-            or any(isinstance(c, bool) or not isinstance(c, int) for c in order_raw)):
+    if (any(isinstance(c, bool) or not isinstance(c, int) for c in order_raw)
+            or sorted(order_raw) != list(range(1, n + 1))):
         raise InputError(f"must list the cylinders 1..{n} once each, got {order_raw!r}",
                          file=path, key=key_fo)
     k1 = order_raw.index(1)
