@@ -9,7 +9,6 @@ import numpy as np
 
 from powertrain.errors import InputError
 
-
 #: Most frequencies one option may ask for, and the highest frequency [Hz] (a mount model
 #: fitted below 1 kHz says nothing at 100 kHz; the limits keep a typo from hanging the run).
 MAX_FREQUENCIES = 100_000

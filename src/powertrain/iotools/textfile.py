@@ -6,7 +6,6 @@ import math
 
 from powertrain.errors import InputError
 
-
 #: Largest input file read [bytes]; larger files are refused before reading.
 MAX_FILE_BYTES = 512 * 2 ** 20
 
