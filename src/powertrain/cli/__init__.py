@@ -54,6 +54,7 @@ def main():
       powertrain compare examples/measured-runup.csv --plot compare.png --json compare.json
       powertrain whatif --scale left.z.stiffness=1.2 --json whatif.json
       powertrain diagnose examples/measured-runup.csv --report diagnosis/
+      powertrain modes --engine engines/default-torque-rod.toml --json modes.json
     """
 
 
@@ -64,6 +65,7 @@ def _register():
         diagnose,
         excitation,
         fit_mount,
+        modes,
         runup,
         stiffness,
         whatif,

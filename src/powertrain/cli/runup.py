@@ -40,7 +40,7 @@ def runup(rpm_from, rpm_to, rpm_step, engine_file, solver, stepper, angle_step, 
     """Run-up: steady-state mount-point velocities at each speed, order analysed.
 
     Prints the rigid-body modes and the synthesis (RMS sum of orders 0.5..8) velocity of the
-    nine channels (mount × engine X/Y/Z) per speed; writes HDF5, CSV and PNG only on request
+    channels (every mount × engine X/Y/Z) per speed; writes HDF5, CSV and PNG only on request
     (--out, --csv, --plot) and names the files written.
 
     \b
