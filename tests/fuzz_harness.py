@@ -80,6 +80,8 @@ class Worker:
         if self.proc is not None:
             self.proc.kill()
             self.proc.wait()
+            self.proc.stdin.close()
+            self.proc.stdout.close()
             self.proc = None
 
     def run(self, args: list[str], cwd: Path) -> dict:
@@ -603,3 +605,123 @@ KINDS = {"engine": case_engine, "mount": case_mount, "pressure_csv": case_pressu
          "stiffness_csv": case_stiffness, "measured_csv": case_measured_csv,
          "measured_hdf5": case_measured_hdf5, "variants": case_variants,
          "options": case_options}
+
+
+# --------------------------------------------------------------------------- issue 10's list
+def _engine_text_sub(pattern: str, repl: str) -> bytes:
+    text, n = re.subn(pattern, repl, _SEEDS["engine"].decode(), flags=re.M)
+    assert n, pattern
+    return text.encode()
+
+
+def _engine_case(text: bytes, what: str) -> Case:
+    return Case({"engines/e.toml": text, **mount_files()},
+                ["runup", "--engine", "engines/e.toml", *QUICK_RUNUP, "--out", "o.h5"],
+                ["o.h5"], "e.toml", what)
+
+
+def _all_mounts_at(pos: str) -> bytes:
+    return _engine_text_sub(r"^position = \{value = \[[-0-9., ]+\], unit = \"mm\"\}(?=.*\n"
+                            r"(?:.*\n)?(local_x|orientation))",
+                            f'position = {{value = [{pos}], unit = "mm"}}')
+
+
+def _zero_mount_files() -> dict:
+    zero = b'[mount]\nname = "zero"\nmodel = "kelvin-voigt"\n[units]\nc = "N/mm"\n' \
+           b'd = "N*s/mm"\nm = "kg"\n[parameters]\nc1 = 0\nd1 = 0\n'
+    return {name: zero for name in mount_files()}
+
+
+def _mutate_h5_fixed(action: str) -> bytes:
+    """A run-up HDF5 with one named defect (deterministic)."""
+    values = iter([action])
+
+    def draw(strategy):
+        if values is not None:
+            try:
+                return next(values)
+            except StopIteration:
+                pass
+        return {"settings": "{", "velocity_shape": (3,), "rpm_zero": np.nan}.get(
+            action, 0)
+    data, _ = mutate_hdf5(draw, _SEEDS["sim.h5"], "m.h5")
+    return data
+
+
+def _flip(data: bytes, positions) -> bytes:
+    b = bytearray(data)
+    for p in positions:
+        b[p % len(b)] ^= 0xFF
+    return bytes(b)
+
+
+def issue_cases() -> dict:
+    """Every failure issue 10 lists (that runs in seconds), as a named case."""
+    e = _engine_case
+    cases = {
+        "engine: list where a number belongs": e(_engine_text_sub(
+            r"^bore = .*$", 'bore = {value = [82.5, 1.0], unit = "mm"}'), "bore list"),
+        "engine: firing order mixing strings and ints": e(_engine_text_sub(
+            r"^firing_order = .*$", 'firing_order = [1, "3", 4, 2]'), "firing order"),
+        "engine: huge counterweight_fraction": e(_engine_text_sub(
+            r"^counterweight_fraction = .*$",
+            'counterweight_fraction = {value = 1e300, unit = "1"}'), "counterweight"),
+        "engine: bore huge": e(_engine_text_sub(
+            r"^bore = .*$", 'bore = {value = 1e300, unit = "mm"}'), "bore huge"),
+        "engine: imep_factors 1e-300": e(_engine_text_sub(
+            r"^imep_factors = .*$", 'imep_factors = {value = [1e-300, 1, 1, 1], unit = "1"}'),
+            "imep"),
+        "engine: mounts all at the CG": e(_all_mounts_at("200.0, 10.0, 70.0"), "mounts at CG"),
+        "engine: all-zero mounts": Case({"engines/e.toml": _SEEDS["engine"],
+                                         **_zero_mount_files()},
+                                        ["runup", "--engine", "engines/e.toml", *QUICK_RUNUP,
+                                         "--out", "o.h5"], ["o.h5"], "e.toml", "zero mounts"),
+        "engine file is a FIFO": Case({"engines/e.toml": "fifo", **mount_files()},
+                                      ["runup", "--engine", "engines/e.toml", *QUICK_RUNUP,
+                                       "--out", "o.h5"], ["o.h5"], "e.toml", "FIFO"),
+        "measured CSV is a FIFO": Case({"m.csv": "fifo"}, ["compare", "m.csv", "--quiet",
+                                                           "--json", "c.json"],
+                                       ["c.json"], "m.csv", "FIFO"),
+        "CSV cell over 128 kB": Case({"k.csv": _SEEDS["k.csv"].replace(
+            b"\n1,", b"\n1" + b"0" * 140_000 + b",", 1)},
+                                     ["fit-mount", "k.csv", "--starts", "2", "--out", "f.toml"],
+                                     ["f.toml"], "k.csv", "big cell"),
+        "fit-mount on 1e300 N/mm data": Case(
+            {"k.csv": re.sub(rb"\n(\d+),[^,]+,[^,]+,", rb"\n\1,1e300,1e300,", _SEEDS["k.csv"])},
+            ["fit-mount", "k.csv", "--starts", "2", "--out", "f.toml"], ["f.toml"], "k.csv",
+            "1e300 N/mm"),
+        "fit-mount --seed -1": Case({"k.csv": _SEEDS["k.csv"]},
+                                    ["fit-mount", "k.csv", "--starts", "2", "--out", "f.toml",
+                                     "--seed", "-1"], ["f.toml"], "--seed", "seed"),
+        "--angle-step 0": Case({}, ["runup", "--from", "1000", "--to", "2000", "--angle-step",
+                                    "0", "--out", "o.h5"], ["o.h5"], "--angle-step", ""),
+        "runup --to 9000 names --to": Case({}, ["runup", "--to", "9000", "--quiet", "--out",
+                                                "o.h5"], ["o.h5"], "--to", ""),
+        "--from 1000 --to 1e12": Case({}, ["runup", "--from", "1000", "--to", "1e12", "--out",
+                                           "o.h5"], ["o.h5"], "--step", ""),
+        "--freq 0:1e12:1": Case({**mount_files()}, ["stiffness",
+                                                   "mounts/hydraulic-engine-mount-z.toml",
+                                                   "--freq", "0:1e12:1"], [], "--freq", ""),
+        "stiffness --freq 1e300": Case({**mount_files()}, ["stiffness",
+                                                          "mounts/hydraulic-engine-mount-z.toml",
+                                                          "--freq", "1e300"], [], "--freq", ""),
+        "compare --step 0.01": Case({"m.csv": _SEEDS["measured.csv"]},
+                                    ["compare", "m.csv", "--step", "0.01", "--quiet", "--json",
+                                     "c.json"], ["c.json"], "--step", ""),
+        "plot path under a regular file": Case({"file": b"x"},
+                                               ["runup", *QUICK_RUNUP, "--out", "o.h5",
+                                                "--plot", "file/p.png"], ["o.h5"], "--plot", ""),
+    }
+    for action, what in (("settings", "non-JSON settings"), ("mount_int", "integer mount names"),
+                         ("velocity_shape", "wrong-shaped velocity"),
+                         ("softlink_loop", "soft-link loop"), ("empty_rpm", "empty rpm array")):
+        cases[f"HDF5: {what}"] = Case(
+            {"m.h5": _mutate_h5_fixed(action), "sim.csv": _SEEDS["sim.csv"]},
+            ["compare", "m.h5", "--sim", "sim.csv", "--quiet", "--json", "c.json"], ["c.json"],
+            "m.h5", what)
+    for k, pos in enumerate((100, 3000, 20000, 60000)):
+        cases[f"HDF5: flipped bytes #{k + 1}"] = Case(
+            {"m.h5": _flip(_SEEDS["sim.h5"], range(pos, pos + 64)), "sim.csv": _SEEDS["sim.csv"]},
+            ["compare", "m.h5", "--sim", "sim.csv", "--quiet", "--json", "c.json"], ["c.json"],
+            "m.h5", "flipped")
+    return cases

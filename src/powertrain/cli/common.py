@@ -143,3 +143,23 @@ def write_json(path, text: str, provenance: dict, key: str = "--json") -> None:
                          file=path, key=key) from None
     with atomic_write(path) as fh:
         fh.write(out)
+
+
+def checked_runup(engine, engine_path, run, *args, **kwargs):
+    """``run(engine, *args, **kwargs)`` (a run-up), with a model that cannot be solved or a
+    result that is not finite reported as bad input naming the engine file (the last guard:
+    the checks at load catch the known causes first)."""
+    try:
+        with np.errstate(all="ignore"):
+            result = run(engine, *args, **kwargs)
+    except InputError:
+        raise
+    except (ValueError, ArithmeticError, np.linalg.LinAlgError) as exc:
+        raise InputError(f"the model cannot be solved ({type(exc).__name__}: "
+                         f"{str(exc)[:120]})", file=engine_path, key="engine") from None
+    for name in ("displacement", "velocity", "acceleration", "mount_force", "mean_mount_force"):
+        if not np.all(np.isfinite(getattr(result, name))):
+            raise InputError(f"the simulated {name.replace('_', ' ')} is not finite (NaN or "
+                             "inf): the engine's values are out of any physical range",
+                             file=engine_path, key="engine")
+    return result

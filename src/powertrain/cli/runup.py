@@ -50,7 +50,7 @@ def runup(rpm_from, rpm_to, rpm_step, engine_file, solver, stepper, angle_step, 
       powertrain runup --solver harmonic --csv runup.csv --plot runup.png
       powertrain runup --effect amplitude_stiffness:kappa=1,a_c=0.02mm
     """
-    from powertrain.cli.common import check_outputs, runup_settings
+    from powertrain.cli.common import check_outputs, checked_runup, runup_settings
     from powertrain.iotools.engine_file import DEFAULT_ENGINE_PATH, read_engine
     from powertrain.runup import run_runup
 
@@ -67,11 +67,12 @@ def runup(rpm_from, rpm_to, rpm_step, engine_file, solver, stepper, angle_step, 
     runup_settings(engine, rpm, angle_step)
     if scenario:
         from powertrain.effects import runup_with_effects
-        result = runup_with_effects(engine, rpm, scenario, solver=solver,
-                                    angle_step_deg=angle_step, stepper=stepper)
+        result = checked_runup(engine, engine_path, runup_with_effects, rpm, scenario,
+                               solver=solver, angle_step_deg=angle_step, stepper=stepper)
     else:
-        result = run_runup(engine, rpm, solver=solver, angle_step_deg=angle_step,
-                           progress=not quiet, stepper=stepper)
+        result = checked_runup(engine, engine_path, run_runup, rpm, solver=solver,
+                               angle_step_deg=angle_step, progress=not quiet,
+                               stepper=stepper)
     written = []
     if out:
         from powertrain.provenance import provenance

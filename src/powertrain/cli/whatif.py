@@ -118,6 +118,7 @@ def whatif(engine_file, rpm_from, rpm_to, rpm_step, solver, scale, set_, swap, m
                          key="variant.name")
     for v in variants:
         check_operations(engine, v.operations)
+        _check_variant_support(engine, v)
     n_targets = sum(len(v.targets) for v in variants)
     for opt, value in (("--target-out", target_out), ("--target-plot", target_plot)):
         if value and n_targets != 1:
@@ -161,3 +162,19 @@ def whatif(engine_file, rpm_from, rpm_to, rpm_step, solver, scale, set_, swap, m
     click.echo(result.table())
     if written:
         click.echo(f"wrote {', '.join(written)}")
+
+
+def _check_variant_support(engine, variant) -> None:
+    """Each mount operation must leave mounts that carry the body (finite, plausible
+    rigid-body modes); the error names the option or variants-file key at fault."""
+    from powertrain.errors import InputError
+    from powertrain.iotools.engine_checks import check_support
+    from powertrain.variants import Target
+    for op in variant.operations:
+        if isinstance(op, Target) or not hasattr(op, "apply"):
+            continue
+        engine = op.apply(engine)
+        try:
+            check_support(engine, None)
+        except InputError as exc:
+            raise op.origin.error(f"variant {variant.name!r}: {exc.message}") from None

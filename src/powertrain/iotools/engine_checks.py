@@ -8,7 +8,8 @@ overflow, NaN in the results):
 
 * the mounts must carry the body: its rigid-body modes on the mounts' static stiffness must
   be finite and at least :data:`MIN_MODE_HZ` (below it the static sag under the body's own
-  weight, ``g / (2 pi f)^2``, exceeds a quarter of a metre);
+  weight, ``g / (2 pi f)^2``, exceeds a quarter of a metre), and at most
+  :data:`MAX_MODE_HZ`;
 * the crank train's excitation (gas and inertia forces, balancers) must be finite and below
   :data:`MAX_FORCE_N` at both ends of the engine's speed range.
 """
@@ -23,6 +24,9 @@ from powertrain.errors import InputError
 
 #: Lowest acceptable rigid-body mode [Hz]: 1 Hz is a static sag of g / (2 pi)^2 = 0.25 m.
 MIN_MODE_HZ = 1.0
+#: Highest acceptable rigid-body mode [Hz]: engine mounts put them at 5-30 Hz; 10 kHz means
+#: the stiffness is off by orders of magnitude (a unit error).
+MAX_MODE_HZ = 1e4
 #: Largest acceptable excitation force [N] (a 2 L engine at full load: ~1e4 N).
 MAX_FORCE_N = 1e9
 #: Crank-angle samples of the excitation check per cycle.
@@ -52,7 +56,11 @@ def check_support(engine, path) -> None:
         raise InputError("the mounts do not hold the body: its static stiffness matrix is "
                          "singular or not finite (mounts all at one point, or all zero?)",
                          file=path, key="mounts")
-    low = float(np.min(modes))
+    low, high = float(np.min(modes)), float(np.max(modes))
+    if high > MAX_MODE_HZ:
+        raise InputError(f"the mounts are implausibly stiff: a rigid-body mode at {high:.3g} Hz "
+                         f"(more than {MAX_MODE_HZ:g} Hz; unit error?)", file=path,
+                         key="mounts")
     if low < 1e-3:
         raise InputError("the mounts cannot carry the body: a rigid-body mode at 0 Hz (no "
                          "static stiffness in some direction)", file=path, key="mounts")
