@@ -100,6 +100,8 @@ def speed_steps(rpm_from: float, rpm_to: float, rpm_step: float) -> np.ndarray:
 MAX_SPEEDS = 2000
 #: Finest crank-angle step [deg] of the Newmark stepper (720 / 0.05 = 14 400 steps a cycle).
 MIN_ANGLE_STEP_DEG = 0.05
+#: Coarsest crank-angle step [deg]: 72 steps a cycle still resolve order 8 without aliasing.
+MAX_ANGLE_STEP_DEG = 10.0
 
 
 def check_outputs(**targets) -> None:
@@ -121,11 +123,11 @@ def runup_settings(engine, rpm: np.ndarray, angle_step: float) -> None:
         raise InputError(f"{rpm[-1]:g} rpm is above the engine's range {lo:g}..{hi:g} rpm",
                          key="--to")
     n_cycle = 720.0 / angle_step if math.isfinite(angle_step) and angle_step > 0 else 0.0
-    if not (angle_step >= MIN_ANGLE_STEP_DEG and abs(n_cycle - round(n_cycle)) < 1e-9
-            and round(n_cycle) % 2 == 0):
+    if not (MIN_ANGLE_STEP_DEG <= angle_step <= MAX_ANGLE_STEP_DEG
+            and abs(n_cycle - round(n_cycle)) < 1e-9 and round(n_cycle) % 2 == 0):
         raise InputError(f"{angle_step:g} deg: must divide 720 deg into an even number of "
-                         f"steps and be >= {MIN_ANGLE_STEP_DEG:g} deg (e.g. 0.5, 1, 2)",
-                         key="--angle-step")
+                         f"steps, {MIN_ANGLE_STEP_DEG:g}..{MAX_ANGLE_STEP_DEG:g} deg "
+                         "(e.g. 0.5, 1, 2)", key="--angle-step")
 
 
 def write_json(path, text: str, provenance: dict, key: str = "--json") -> None:

@@ -28,7 +28,8 @@ _MODELS = tuple(TOPOLOGIES)
 @click.option("--max-mass", type=float,
               help="Upper bound of every internal mass [kg]. K_CP alone does not identify the "
                    "internal masses, but the engine feels them (input-point stiffness).")
-def fit_mount(measured, model, out, plot, starts, seed, fmin, fmax, max_mass):
+@click.option("--quiet", is_flag=True, help="No progress indicator on stderr.")
+def fit_mount(measured, model, out, plot, starts, seed, fmin, fmax, max_mass, quiet):
     """Fit a lumped mount model to the measured dynamic stiffness in MEASURED (CSV).
 
     MEASURED has a header line and the columns frequency_hz plus either k_real_n_per_mm,
@@ -80,9 +81,13 @@ def fit_mount(measured, model, out, plot, starts, seed, fmin, fmax, max_mass):
     if not (abs(data.kcp) > 0).any():
         raise InputError("stiffness is zero everywhere", file=measured, key=FREQUENCY)
 
-    result = fit(data.frequency_hz, data.kcp, model, starts=starts, seed=seed, max_mass=max_mass,
-                 name=f"{topo.description} fitted to {Path(measured).name}",
-                 source=f"powertrain fit-mount {Path(measured).name} --model {model}")
+    from powertrain.cli.common import check_outputs
+    from powertrain.progress import activity
+    check_outputs(out=out, plot=plot)
+    with activity(f"fit-mount ({model}, {starts} starts)", enabled=not quiet):
+        result = fit(data.frequency_hz, data.kcp, model, starts=starts, seed=seed,
+                     max_mass=max_mass, name=f"{topo.description} fitted to {Path(measured).name}",
+                     source=f"powertrain fit-mount {Path(measured).name} --model {model}")
     f = data.frequency_hz
     comment = (f"Fitted by powertrain fit-mount (Kovarik 2016 sec. 2.2, eq. 19) to "
                f"{Path(measured).name}: {f.size} frequencies, {f[0]:g}-{f[-1]:g} Hz.\n"
