@@ -270,6 +270,8 @@ def rigid_body_modes(system, inertia, *, static=False, crank_axis=(1.0, 0.0, 0.0
         Static stiffness, undamped (else: dynamic stiffness at each mode's own frequency).
     crank_axis : array_like (3,)
         Unit vector of the crank axis in engine axes (engine X).
+    engine_name : str, optional
+        Recorded in the result (reports, plots).
     """
     M6 = system.M[:6, :6]
     w2, vec = sla.eigh(system.static_stiffness_6(), M6)
