@@ -75,9 +75,11 @@ def fit_mount(measured, model, out, plot, starts, seed, fmin, fmax, max_mass, qu
     topo = TOPOLOGIES[model]
     need = (len(topo.parameters) + 1) // 2
     if data.frequency_hz.size < need:
-        raise InputError(f"{data.frequency_hz.size} frequencies in range, the "
+        limits = "/".join(n for n, v in (("--fmin", fmin), ("--fmax", fmax)) if v is not None)
+        raise InputError(f"{data.frequency_hz.size} frequencies in range"
+                         + (f" of {limits}" if limits else "") + f", the "
                          f"{len(topo.parameters)} parameters of {model} need at least {need}",
-                         file=measured, key=FREQUENCY)
+                         file=measured, key=limits or FREQUENCY)
     if not (abs(data.kcp) > 0).any():
         raise InputError("stiffness is zero everywhere", file=measured, key=FREQUENCY)
 

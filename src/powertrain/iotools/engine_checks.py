@@ -59,16 +59,36 @@ def check_support(engine, path) -> None:
     low, high = float(np.min(modes)), float(np.max(modes))
     if high > MAX_MODE_HZ:
         raise InputError(f"the mounts are implausibly stiff: a rigid-body mode at {high:.3g} Hz "
-                         f"(more than {MAX_MODE_HZ:g} Hz; unit error?)", file=path,
-                         key="mounts")
+                         f"(more than {MAX_MODE_HZ:g} Hz; unit error?); stiffest: "
+                         f"{extreme_mount(engine.mounts, max)}", file=path, key="mounts")
     if low < 1e-3:
         raise InputError("the mounts cannot carry the body: a rigid-body mode at 0 Hz (no "
-                         "static stiffness in some direction)", file=path, key="mounts")
+                         f"static stiffness in some direction); softest: "
+                         f"{extreme_mount(engine.mounts, min)}", file=path, key="mounts")
     if low < MIN_MODE_HZ:
         sag = _G / (2 * math.pi * max(low, 1e-9)) ** 2
         raise InputError(f"the mounts cannot carry the body: lowest rigid-body mode "
                          f"{low:.3g} Hz, a static sag of about {sag:.3g} m under its weight "
-                         f"(need >= {MIN_MODE_HZ:g} Hz)", file=path, key="mounts")
+                         f"(need >= {MIN_MODE_HZ:g} Hz); softest: "
+                         f"{extreme_mount(engine.mounts, min)}", file=path, key="mounts")
+
+
+def extreme_mount(mounts, pick=min) -> str:
+    """``mount.direction (file, static stiffness)`` of the softest (``pick=min``) or stiffest
+    (``pick=max``) mount direction, to point at the file to look at."""
+    entries = []
+    for m in mounts:
+        for d, mdl in m.directions.items():
+            try:
+                k = float(mdl.static_stiffness())
+            except (ValueError, ArithmeticError, np.linalg.LinAlgError):
+                k = math.nan
+            entries.append((k if math.isfinite(k) else -1.0, m.name, d, m.files.get(d, "")))
+    if not entries:
+        return "no mount"
+    k, name, d, file = pick(entries)
+    where = f", {file}" if file else ""
+    return f"{name}.{d} ({k / 1e3:.3g} N/mm static{where})"
 
 
 def check_excitation(engine, path) -> None:

@@ -203,8 +203,10 @@ def _check_static_support(body, mounts, path):
     except np.linalg.LinAlgError:
         kr = np.zeros(1)
     if kr.min() <= 1e-9 * max(kr.max(), 1e-300):
+        from powertrain.iotools.engine_checks import extreme_mount
         raise InputError("the mounts' static stiffness does not hold the body in every "
-                         "direction (a rigid-body mode at 0 Hz)", file=path, key="mounts")
+                         "direction (a rigid-body mode at 0 Hz); softest: "
+                         f"{extreme_mount(mounts)}", file=path, key="mounts")
 
 
 def _read_crank(t, path) -> em.CrankTrain:
