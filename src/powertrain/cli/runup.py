@@ -67,8 +67,10 @@ def runup(rpm_from, rpm_to, rpm_step, engine_file, solver, stepper, angle_step, 
     runup_settings(engine, rpm, angle_step)
     if scenario:
         from powertrain.effects import runup_with_effects
-        result = checked_runup(engine, engine_path, runup_with_effects, rpm, scenario,
-                               solver=solver, angle_step_deg=angle_step, stepper=stepper)
+        from powertrain.progress import activity
+        with activity(f"run-up with effects ({solver})", enabled=not quiet):
+            result = checked_runup(engine, engine_path, runup_with_effects, rpm, scenario,
+                                   solver=solver, angle_step_deg=angle_step, stepper=stepper)
     else:
         result = checked_runup(engine, engine_path, run_runup, rpm, solver=solver,
                                angle_step_deg=angle_step, progress=not quiet,
