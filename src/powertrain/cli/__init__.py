@@ -13,8 +13,19 @@ import click
 from powertrain import __version__
 
 
+#: ``ctx.meta`` key of the command-line arguments as given (for the provenance line).
+ARGV_KEY = "powertrain.argv"
+
+
 class _Group(click.Group):
-    """Turns :class:`powertrain.errors.InputError` into one line on stderr and exit code 1."""
+    """Turns :class:`powertrain.errors.InputError` into one line on stderr and exit code 1;
+    keeps the arguments as given for :func:`powertrain.cli.common.cli_provenance`."""
+
+    def make_context(self, info_name, args, parent=None, **extra):
+        argv = list(args)
+        ctx = super().make_context(info_name, args, parent=parent, **extra)
+        ctx.meta[ARGV_KEY] = argv
+        return ctx
 
     def invoke(self, ctx):
         from powertrain.errors import InputError
