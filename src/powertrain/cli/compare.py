@@ -93,9 +93,9 @@ def compare(measured, sim_file, engine_file, plot, json_file, noise_floor, solve
         raise InputError("nothing to compare: no channel and quantity has a point above the "
                          "noise floor inside the simulated speed range", file=measured)
     if plot:
-        from powertrain.cli.common import cli_provenance, write_plot
-        prov = cli_provenance(f"{engine.name} ({engine_file}), {solver}" if engine is not None
-                              else f"simulation from {sim_file}")
+        from powertrain.cli.common import cli_provenance, engine_description, write_plot
+        prov = cli_provenance(engine_description(engine, engine_file) + f", {solver} solver"
+                              if engine is not None else f"simulation from {sim_file}")
         write_plot(lambda p: comp.plot(path=p, provenance=prov), plot)
     if json_file:
         comp.to_json(json_file)

@@ -54,8 +54,18 @@ def plot_comparison(comparison, path=None, quantities=None, *, ax=None, channel=
     fig, panels, own, axes = grid(ax, rows, quantities, channel, quantity, panel_height=1.85)
     limit = NOISE_FLOOR_MARGIN * comparison.noise_floor * 1e3
     compared = {(c.mount, c.direction, c.quantity): c for c in comparison.channels}
+    missing = {(m["mount"], m["direction"], m["quantity"]): m["reason"]
+               for m in comparison.missing}
     for key, a in panels.items():
-        _panel(a, key, comparison, compared.get(key), limit)
+        c = compared.get(key)
+        if c is None or not c.scored.any():
+            mount, direction, q = key
+            a.set_title(f"{mount} {direction.upper()} — {quantity_label(q)}", fontsize=8.5)
+            no_data(a, "not compared: " + missing.get(key, "every measured point at the "
+                                                          "noise floor"))
+            a.tick_params(labelsize=7)
+            continue
+        _panel(a, key, comparison, c, limit)
     label_grid(fig, axes, "RMS velocity [mm/s]")
     if own:
         extra = [(Line2D([], [], color="0.5", ls=":", lw=0.8),
@@ -69,7 +79,8 @@ def plot_comparison(comparison, path=None, quantities=None, *, ax=None, channel=
 
 
 def _panel(ax, key, comparison, c, limit):
-    """One channel-quantity: curves, shaded gap, excluded points, title with the gap."""
+    """One compared channel-quantity: curves, shaded gap, excluded points, title with the
+    gap."""
     mm = 1e3
     mount, direction, q = key
     values = []
@@ -84,7 +95,7 @@ def _panel(ax, key, comparison, c, limit):
         ax.plot(rs[ok], vs[ok] * mm, "o-", color="C0", ms=2.5, lw=1.1, label="simulated")
         values.append(vs[ok] * mm)
     title = f"{mount} {direction.upper()} — {quantity_label(q)}"
-    if c is not None and c.scored.any():
+    if c.scored.any():
         s = np.where(c.scored, c.simulated, np.nan) * mm
         m = np.where(c.scored, c.measured, np.nan) * mm
         ax.fill_between(c.rpm, m, s, where=c.scored & (s >= m), interpolate=True,
@@ -92,22 +103,13 @@ def _panel(ax, key, comparison, c, limit):
         ax.fill_between(c.rpm, m, s, where=c.scored & (s < m), interpolate=True,
                         color="C2", alpha=0.35, lw=0, label="sim < measured")
         title += f"\nΔL rms {c.stats['rms_db']:.1f} dB, bias {c.stats['bias_db']:+.1f} dB"
-    if c is not None and c.at_floor.any():
+    if c.at_floor.any():
         ax.plot(c.rpm[c.at_floor], np.maximum(c.measured[c.at_floor] * mm, limit * 0.5), "x",
                 color="0.55", ms=3, label="excluded (noise floor)")
     values = np.concatenate(values) if values else np.array([])
-    drawn = style_panel(ax, title, values)
-    if drawn and limit > 0:
+    if style_panel(ax, title, values) and limit > 0:
         lo, hi = ax.get_ylim()
         if limit / 2 < hi and lo < limit:
             ax.set_ylim(max(lo, limit / 2), hi)
         if lo < limit < hi:
             ax.axhline(limit, color="0.5", ls=":", lw=0.8)
-    if c is None or not c.scored.any():
-        reason = ("every measured point at the noise floor" if c is not None
-                  and c.at_floor.any() else "not compared (no data)")
-        if not drawn:
-            no_data(ax, reason)
-        else:
-            ax.text(0.5, 0.92, reason, transform=ax.transAxes, ha="center", va="top",
-                    fontsize=7, color="0.35")

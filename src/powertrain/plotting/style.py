@@ -136,8 +136,8 @@ def quantity_label(quantity: str) -> str:
 
 def no_data(ax, text="no data above the noise floor"):
     """Label an empty panel in its centre (and drop its y tick labels)."""
-    ax.text(0.5, 0.5, text, transform=ax.transAxes, ha="center", va="center",
-            fontsize=LABEL_SIZE, color="0.4", wrap=True)
+    ax.text(0.5, 0.5, "\n".join(textwrap.wrap(text, 42)), transform=ax.transAxes,
+            ha="center", va="center", fontsize=LABEL_SIZE, color="0.4")
     ax.tick_params(axis="y", labelleft=False)
 
 
