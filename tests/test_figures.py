@@ -37,7 +37,8 @@ def saved(monkeypatch):
         dpi = kwargs.get("dpi") or self.dpi
         found[Path(str(fname)).name] = (_problems(drawn, self, dpi),
                                         [t.get_text() for t, _ in drawn
-                                         if t.get_text().startswith("powertrain ")])
+                                         if t.get_text().startswith("powertrain ")],
+                                        sum(a.get_legend() is not None for a in self.axes))
 
     monkeypatch.setattr(Figure, "savefig", savefig)
     return found
@@ -56,12 +57,15 @@ def run(tmp_path, monkeypatch, *args):
     return res
 
 
-def _assert_clean(saved, names, command):
+def _assert_clean(saved, names, command, panel_legends=True):
     for name in names:
         # an atomic write saves a temporary ".NAME.<random>.tmp" first
         keys = [k for k in saved if k == name or k.startswith(f".{name}.")]
         assert keys, f"{name} not written by `powertrain {command}`"
-        problems, foot = saved[keys[-1]]
+        problems, foot, n_axes_legends = saved[keys[-1]]
+        if not panel_legends:
+            assert n_axes_legends == 0, f"{name}: {n_axes_legends} panel legends, want one " \
+                                        "legend for the figure"
         assert not problems, f"{name}:\n" + "\n".join(problems[:10])
         assert foot and f"$ powertrain {command}" in foot[0].replace("\n", " "), \
             f"{name}: no provenance line naming the command ({foot})"
@@ -71,11 +75,11 @@ def _assert_clean(saved, names, command):
 def test_runup_and_compare_figures(tmp_path, monkeypatch, saved):
     run(tmp_path, monkeypatch, "runup", "--solver", "harmonic", "--from", "1000", "--to",
         "6000", "--step", "1000", "--out", "r.h5", "--plot", "runup.png", "--quiet")
-    _assert_clean(saved, ["runup.png"], "runup")
+    _assert_clean(saved, ["runup.png"], "runup", panel_legends=False)
     # a raised noise floor leaves panels partly and wholly below it (labelled, not blank)
     run(tmp_path, monkeypatch, "compare", MEASURED, "--sim", "r.h5", "--noise-floor", "0.01",
         "--plot", "compare.png", "--quiet")
-    _assert_clean(saved, ["compare.png"], "compare")
+    _assert_clean(saved, ["compare.png"], "compare", panel_legends=False)
 
 
 def test_whatif_figures(tmp_path, monkeypatch, saved):
@@ -85,13 +89,15 @@ def test_whatif_figures(tmp_path, monkeypatch, saved):
     run(tmp_path, monkeypatch, "whatif", "--target", "left.z:+20%:100-300Hz", "--from",
         "1000", "--to", "2000", "--step", "1000", "--workers", "1", "--quiet",
         "--target-plot", "target.png")
-    _assert_clean(saved, ["whatif.png", "target.png"], "whatif")
+    _assert_clean(saved, ["whatif.png"], "whatif", panel_legends=False)
+    _assert_clean(saved, ["target.png"], "whatif")
 
 
 def test_diagnose_report_figures(tmp_path, monkeypatch, saved):
     run(tmp_path, monkeypatch, "diagnose", MEASURED, "--effects", "mount_stiffness",
         "--no-pairs", "--noise-floor", "0.005", "--report", "diag")
-    _assert_clean(saved, ["gap_map.png", "gap_vs_frequency.png", "overlay.png"], "diagnose")
+    _assert_clean(saved, ["gap_map.png", "gap_vs_frequency.png", "overlay.png"], "diagnose",
+                  panel_legends=False)
 
 
 @pytest.mark.parametrize("form,axis", [("magnitude-phase", "log"), ("real-imag", "linear"),
@@ -123,6 +129,45 @@ def test_the_checker_finds_overlap_and_overflow():
     plt.close(fig)
     assert any("overlap" in p and "on the title" in p for p in problems)
     assert any("outside" in p and "right edge" in p for p in problems)
+
+
+# --------------------------------------------------------------------------- style helpers
+@pytest.mark.parametrize("lo,hi", [(1, 400), (0.003, 0.2), (0.6, 0.9), (1e-5, 1e3), (30, 600),
+                                   (0.95, 1.02), (2.1, 2.9)])
+def test_log_ticks_are_plain_numbers(lo, hi):
+    from powertrain.plotting.style import _log_ticks, _plain
+    ticks = _log_ticks(lo, hi, 8)
+    labels = [_plain(t) for t in ticks]
+    assert 2 <= len(ticks) <= 8, labels
+    assert all(lo <= t <= hi for t in ticks)
+    assert not any("×" in lab or "^" in lab for lab in labels)
+    if hi / lo < 1e4:
+        assert not any("e" in lab for lab in labels), labels
+    if (lo, hi) == (1, 400):
+        assert labels == ["1", "2", "5", "10", "20", "50", "100", "200"]
+
+
+@pytest.mark.parametrize("data,extend", [([-10, 2], "min"), ([-2, 8], "max"),
+                                         ([-9, 9], "both"), ([-5, 5], "neither")])
+def test_colorbar_extends_where_clipped(data, extend):
+    import matplotlib.pyplot as plt
+    import numpy as np
+
+    from powertrain.plotting.style import colorbar
+    fig, ax = plt.subplots(layout="constrained")
+    im = ax.pcolormesh(np.array([data]), vmin=-6, vmax=6)
+    assert colorbar(fig, im, ax, data, -6, 6, "gap [dB]").extend == extend
+    plt.close(fig)
+
+
+def test_provenance_line():
+    from powertrain import __version__
+    from powertrain.provenance import Provenance
+    p = Provenance.now("powertrain runup --plot r.png", "EA888 (default.toml), balancers off")
+    line = p.line()
+    assert line.startswith(f"powertrain {__version__}")
+    assert "UTC" in line and "balancers off" in line and "$ powertrain runup" in line
+    assert p.to_dict()["command"] == "powertrain runup --plot r.png"
 
 
 # --------------------------------------------------------------------------- library API

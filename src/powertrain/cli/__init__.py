@@ -12,7 +12,6 @@ import click
 
 from powertrain import __version__
 
-
 #: ``ctx.meta`` key of the command-line arguments as given (for the provenance line).
 ARGV_KEY = "powertrain.argv"
 
