@@ -118,6 +118,12 @@ def test_excitation_figure(tmp_path, monkeypatch, saved):
     _assert_clean(saved, ["exc.png"], "excitation")
 
 
+@pytest.mark.parametrize("args", [[], ["--static"]])
+def test_modes_figure(tmp_path, monkeypatch, saved, args):
+    run(tmp_path, monkeypatch, "modes", *args, "--plot", "modes.png")
+    _assert_clean(saved, ["modes.png"], "modes")
+
+
 # --------------------------------------------------------------------------- checker
 def test_the_checker_finds_overlap_and_overflow():
     import matplotlib.pyplot as plt
