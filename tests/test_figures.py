@@ -174,6 +174,9 @@ def test_provenance_line():
     assert line.startswith(f"powertrain {__version__}")
     assert "UTC" in line and "balancers off" in line and "$ powertrain runup" in line
     assert p.to_dict()["command"] == "powertrain runup --plot r.png"
+    from powertrain.provenance import provenance
+    q = Provenance.from_record(provenance())   # the HDF5/JSON record, short form
+    assert q.version == __version__ and q.date.endswith("Z") and q.command.startswith("powertrain")
 
 
 # --------------------------------------------------------------------------- library API

@@ -128,6 +128,19 @@ class Provenance:
         return cls(command=command, engine=engine, version=__version__,
                    date=stamp.strftime("%Y-%m-%dT%H:%M:%SZ"))
 
+    @classmethod
+    def from_record(cls, record: dict) -> Provenance:
+        """The short form of a provenance record of :func:`provenance` (HDF5/JSON)."""
+        engine = record.get("engine_name", "")
+        if record.get("engine_file"):
+            engine += f" ({record['engine_file']})"
+        mods = list(record.get("modifications", [])) + list(record.get("effects", {}) or {})
+        if mods:
+            engine += ", " + ", ".join(str(m) for m in mods)
+        return cls(command=record.get("command_line", ""), engine=engine.strip(),
+                   version=record.get("powertrain_version", ""),
+                   date=str(record.get("created", "")).replace("+00:00", "Z"))
+
     def with_engine(self, engine: str) -> Provenance:
         """Copy with ``engine`` set."""
         return dataclasses.replace(self, engine=engine)

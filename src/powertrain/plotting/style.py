@@ -111,10 +111,14 @@ def add_provenance(fig, provenance):
     Parameters
     ----------
     fig : Figure
-    provenance : powertrain.provenance.Provenance or None
-        None: only the program version is shown.
+    provenance : powertrain.provenance.Provenance, dict or None
+        A :class:`~powertrain.provenance.Provenance`, or a record of
+        :func:`powertrain.provenance.provenance`; None: only the program version is shown.
     """
     from powertrain import __version__
+    if isinstance(provenance, dict):   # a record of powertrain.provenance.provenance()
+        from powertrain.provenance import Provenance
+        provenance = Provenance.from_record(provenance)
     text = provenance.line() if provenance is not None else f"powertrain {__version__}"
     width, height = fig.get_figwidth(), fig.get_figheight()
     text = wrap(text, width * 0.98, FOOT_SIZE)
