@@ -938,12 +938,15 @@ class DiagnosisResult:
         return "\n".join(lines)
 
     # ------------------------------------------------------------------ figures
-    def plot(self, path=None):
-        """Gap map figure (see :func:`powertrain.plotting.plot_gap_map`)."""
+    def plot(self, ax=None, *, path=None, quantity=None, provenance=None):
+        """Gap map figure; returns it (see :func:`powertrain.plotting.plot_gap_map`)."""
         from powertrain.plotting import plot_gap_map
-        return plot_gap_map(self, path)
+        from powertrain.plotting.style import target_and_path
+        ax, path = target_and_path(ax, path)
+        return plot_gap_map(self, path, ax=ax, quantity=quantity,
+                            provenance=provenance or getattr(self, "provenance", None))
 
-    def report(self, directory) -> list:
+    def report(self, directory, provenance=None) -> list:
         """Write ``summary.txt``, ``diagnosis.json`` and the figures into ``directory``."""
         from pathlib import Path
 
@@ -957,10 +960,12 @@ class DiagnosisResult:
         files.append(out / "summary.txt")
         self.to_json(out / "diagnosis.json")
         files.append(out / "diagnosis.json")
+        from powertrain.plotting.style import close_figure
+        provenance = provenance or getattr(self, "provenance", None)
         for name, fn in (("gap_map.png", plot_gap_map), ("gap_vs_frequency.png",
                                                            plot_gap_frequency),
                          ("overlay.png", plot_diagnosis_overlay)):
-            fn(self, out / name)
+            close_figure(fn(self, out / name, provenance=provenance))
             files.append(out / name)
         return files
 

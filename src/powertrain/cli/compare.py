@@ -106,7 +106,10 @@ def compare(measured, sim_file, engine_file, plot, json_file, noise_floor, solve
                          f"noise floor ({noise_floor:g} mm/s) inside the simulated speed range",
                          file=measured, key="--noise-floor")
     if plot:
-        comp.plot(plot)
+        from powertrain.cli.common import cli_provenance, engine_description, write_plot
+        prov = cli_provenance(engine_description(engine, engine_file) + f", {solver} solver"
+                              if engine is not None else f"simulation from {sim_file}")
+        write_plot(lambda p: comp.plot(path=p, provenance=prov), plot)
     if json_file:
         from powertrain.provenance import provenance
         write_json(json_file, comp.to_json(),

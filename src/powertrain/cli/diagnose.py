@@ -77,7 +77,10 @@ def diagnose(measured, engine_file, report_dir, json_file, noise_floor, effects,
                    provenance(engine, engine_file=engine_file or DEFAULT_ENGINE_PATH))
         click.echo(f"wrote {json_file}")
     if report_dir:
-        files = res.report(report_dir)
+        from powertrain.cli.common import cli_provenance, engine_description, use_agg
+        use_agg()
+        files = res.report(report_dir, provenance=cli_provenance(
+            engine_description(engine, engine.file)))
         click.echo(f"wrote {len(files)} files to {report_dir}")
 
 

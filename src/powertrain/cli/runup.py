@@ -93,7 +93,10 @@ def runup(rpm_from, rpm_to, rpm_step, engine_file, solver, stepper, angle_step, 
         result.to_csv(csv_file)
         written.append(csv_file)
     if plot:
-        result.plot(plot)
+        from powertrain.cli.common import cli_provenance, engine_description, write_plot
+        fig_prov = cli_provenance(engine_description(engine, engine_path, no_balancers=no_balancers,
+                                                 effects=effect))
+        write_plot(lambda p: result.plot(path=p, provenance=fig_prov), plot)
         written.append(plot)
     if quiet:
         return
