@@ -117,6 +117,23 @@ class Effect:
         return (np.array([p.lower for p in self.parameters]),
                 np.array([p.upper for p in self.parameters]))
 
+    def applicable(self, engine) -> bool:
+        """Whether the effect can act on ``engine``."""
+        if self.name == "cylinder_imbalance":
+            return getattr(engine.combustion, "model", "") == "single-zone"
+        if self.name == "balancer_error":
+            return len(engine.balancer.shafts) > 0
+        if self.name == "mount_stiffness":
+            return len(engine.mounts) <= 3
+        return True
+
+    def warm(self, hm):
+        """Fill the parts of the cached model ``hm`` this effect needs."""
+        if self.name == "balancer_error":
+            hm.shaft_loads()
+        if self.name == "cylinder_imbalance":
+            hm.imep_derivatives()
+
     def to_dict(self) -> dict:
         return {"name": self.name, "kind": self.kind, "description": self.description,
                 "parameters": [dataclasses.asdict(p) for p in self.parameters]}
