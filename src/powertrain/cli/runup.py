@@ -62,7 +62,7 @@ def runup(rpm_from, rpm_to, rpm_step, engine_file, solver, stepper, angle_step, 
     scenario = effect_scenario(parse_operations({"effect": effect}))
     try:
         if scenario:
-            from powertrain.effects import runup_with_effects
+            from powertrain.effect_runup import runup_with_effects
             result = runup_with_effects(engine, rpm, scenario, solver=solver,
                                         angle_step_deg=angle_step, stepper=stepper)
         else:

@@ -25,6 +25,7 @@ import numpy as np
 
 from powertrain.analysis.noise_floor import above_floor
 from powertrain.diagnosis.fit import FitOutcome, Problem, fit_candidate
+from powertrain.effects import EFFECTS
 
 #: Orders up to this one form the "low" fold of the order split (sensor gains) [order].
 ORDER_SPLIT = 2.0
@@ -102,7 +103,7 @@ def noise_mse(problem: Problem, sigma, cells=None) -> float:
 
 def _folds(problem: Problem, effects):
     n_ch, n_o = problem.valid["test"].shape[1:]
-    if "sensor_error" in effects:
+    if any(EFFECTS[e].response_only for e in effects):
         order = (problem.sub.harmonic + 1) / 2.0
         low = np.broadcast_to(order <= ORDER_SPLIT + 1e-9, (n_ch, n_o))
         return "orders", [low, ~low]

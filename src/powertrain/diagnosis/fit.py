@@ -22,7 +22,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from powertrain.diagnosis.data import GapData, model_levels, residuals_db
-from powertrain.effects import EFFECTS, apply_sensor_error, predict
+from powertrain.effects import EFFECTS, predict
 
 #: Residual evaluations per fit (all starts, grid and Jacobian columns included); a fit that
 #: reaches it stops with the best point so far and reports ``budget_hit``.
@@ -57,6 +57,7 @@ class FitOutcome:
     x: np.ndarray | None = None
     heldout_gaps: np.ndarray | None = field(default=None, repr=False)
     status_code: object = None
+    units: dict = field(default_factory=dict)
 
     @property
     def label(self) -> str:
@@ -73,6 +74,7 @@ class Problem:
     def __init__(self, hm_train, hm_test, data: GapData, train_idx, test_idx, train_cells=None,
                  test_cells=None):
         self.hm = {"train": hm_train, "test": hm_test}
+        self.engine = hm_train.engine
         self.data = data
         self.idx = {"train": train_idx, "test": test_idx}
         om = data.order_mask
@@ -92,7 +94,7 @@ class Problem:
     def gaps(self, scenario, part="train"):
         # the physical part of the scenario is solved once per distinct value: a sensor
         # error only re-reads the same velocities (cheap finite-difference columns)
-        phys = {k: v for k, v in scenario.items() if k != "sensor_error"}
+        phys = {k: v for k, v in scenario.items() if not EFFECTS[k].response_only}
         key = repr(sorted((k, sorted(v.items())) for k, v in phys.items()))
         last = self._last.get(part)
         if last is not None and last[0] == key:
@@ -100,8 +102,9 @@ class Problem:
         else:
             vel = predict(self.hm[part], phys).velocity
             self._last[part] = (key, vel)
-        if "sensor_error" in scenario:
-            vel = apply_sensor_error(vel, scenario["sensor_error"])
+        for k, v in scenario.items():
+            if EFFECTS[k].response_only:
+                vel = EFFECTS[k].reading(vel, v)
         sim = model_levels(vel, self.sub)
         g = residuals_db(sim, self.meas[part], self.data.floor)
         return np.where(self.valid[part], g, np.nan)
@@ -121,17 +124,20 @@ class Packing:
     log: np.ndarray
     x0: np.ndarray
 
+    units: dict = None
+
     @classmethod
-    def of(cls, effects):
-        names, lo, hi, logs, x0 = [], [], [], [], []
+    def of(cls, effects, engine=None):
+        names, lo, hi, logs, x0, units = [], [], [], [], [], {}
         for e in effects:
-            for p in EFFECTS[e].parameters:
+            for p in EFFECTS[e].parameters(engine):
+                units[(e, p.name)] = p.unit
                 names.append((e, p.name))
                 lo.append(math.log(p.lower) if p.log else p.lower)
                 hi.append(math.log(p.upper) if p.log else p.upper)
                 logs.append(p.log)
                 x0.append(math.log(p.default) if p.log else p.default)
-        return cls(names, np.array(lo), np.array(hi), np.array(logs, bool), np.array(x0))
+        return cls(names, np.array(lo), np.array(hi), np.array(logs, bool), np.array(x0), units)
 
     def scenario(self, x):
         sc = {}
@@ -178,8 +184,9 @@ def _starts(problem, pack, effects, starts, grid, fun):
     cands = [np.clip(pack.x0, lo, hi)] + [np.clip(s, lo, hi) for s in starts or []]
     # coarse grid of start points for effects that declare one (the cylinder IMEP factors
     # need one: at e = 0 the half orders vanish and the gradient of their level with them)
-    if grid and len(effects) == 1 and EFFECTS[effects[0]].start_grid:
-        mesh = np.meshgrid(*EFFECTS[effects[0]].start_grid, indexing="ij")
+    sg = EFFECTS[effects[0]].start_grid(problem.engine) if len(effects) == 1 else ()
+    if grid and sg:
+        mesh = np.meshgrid(*sg, indexing="ij")
         pts = np.stack([m.ravel() for m in mesh], axis=1).astype(float)
         pts[:, pack.log] = np.log(pts[:, pack.log])
         costs = [np.sum(fun(p) ** 2) for p in pts]
@@ -223,7 +230,7 @@ def fit_candidate(problem: Problem, effects, starts=None, grid=True,
                   budget=EVAL_BUDGET) -> FitOutcome:
     """Fit one effect or a combination on the training speeds, score on the held-out ones."""
     t0 = time.perf_counter()
-    pack = Packing.of(effects)
+    pack = Packing.of(effects, problem.engine)
     fun = _Counted(problem, pack, budget)
     cands = _starts(problem, pack, effects, starts, grid, fun)
     best, nfev, hit = _least_squares(fun, pack, cands)
@@ -243,6 +250,7 @@ def fit_candidate(problem: Problem, effects, starts=None, grid=True,
     out = score(problem, effects, pack.scenario(x), params, sigma, rss, n, p, nfev,
                 time.perf_counter() - t0, x)
     out.budget_hit = hit
+    out.units = {e: {pn: pack.units[(e, pn)] for pn in ps} for e, ps in params.items()}
     return out
 
 

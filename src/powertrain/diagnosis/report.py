@@ -5,7 +5,6 @@ from __future__ import annotations
 import numpy as np
 
 from powertrain.diagnosis.where import REGION_DB, attribution_text
-from powertrain.effects import EFFECTS
 
 
 def _header(r) -> list:
@@ -53,8 +52,8 @@ def _which(r) -> list:
     if r.chosen is not None:
         lines.append("  parameters (1 sigma, Gauss-Newton, optimistic):")
         for e, ps in r.chosen.params.items():
-            spec = {p.name: p for p in EFFECTS[e].parameters}
-            txt = ", ".join(f"{k} = {v:.4g} +- {r.chosen.sigma[e][k]:.2g} {spec[k].unit}"
+            unit = r.chosen.units.get(e, {})
+            txt = ", ".join(f"{k} = {v:.4g} +- {r.chosen.sigma[e][k]:.2g} {unit.get(k, '')}"
                             for k, v in ps.items())
             lines.append(f"    {e}: {txt}")
     for eq in r.equivalents:
