@@ -19,7 +19,7 @@ With positive magnitudes FRAC is rarely far below 1 (two flat curves give 1 even
 10× higher), so read it with the dB gap, never alone.
 
 CSAC and CSF (cross-signature assurance and scale factors), at each speed, summed over the
-channels :math:`j` (the nine mount × direction channels) [3]_:
+channels :math:`j` (every mount × direction channel) [3]_:
 
 .. math:: \mathrm{CSAC}(n) = \frac{\left(\sum_j s_{nj} m_{nj}\right)^2}
                                   {\sum_j s_{nj}^2\,\sum_j m_{nj}^2},\qquad

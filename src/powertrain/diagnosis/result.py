@@ -80,6 +80,9 @@ class DiagnosisResult:
             "quantities": list(d.quantities),
             "gap_db": [[[None if not np.isfinite(x) else round(float(x), 3) for x in row]
                         for row in mat] for mat in self.gap],
+            "gap_db_after": None if self.gap_after is None else
+            [[[None if not np.isfinite(x) else round(float(x), 3) for x in row]
+              for row in mat] for mat in self.gap_after],
             "per_channel": self._per_channel(),
             "regions_beyond_3db": self.regions,
             "decomposition": {
