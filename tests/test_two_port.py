@@ -11,8 +11,7 @@ import numpy as np
 import pytest
 
 from powertrain.iotools.engine_file import DEFAULT_ENGINE_PATH, read_engine
-from powertrain.physics.mount_network import GROUND, cross_point_stiffness, \
-    input_point_stiffness, two_port
+from powertrain.physics.mount_network import GROUND, cross_point_stiffness, input_point_stiffness, two_port
 
 EXACT = 1e-9
 
