@@ -157,3 +157,13 @@ def test_rule_is_frozen_and_documented():
     doc = DecisionRule.__doc__
     for f in dataclasses.fields(DecisionRule):
         assert f"    {f.name} :" in doc, f.name
+
+
+def test_supported_candidate_within_noise_is_no_effect_not_unexplained():
+    """A model equal to the measurement up to round-off: candidates fit the round-off
+    'significantly' (huge BIC gains on tiny residuals) but there is nothing to explain."""
+    base_mse, noise = 4.0e-4, 1.5e-4
+    a = cand("a", 3.0e-4, 500.0, spread=1e-5)          # explains 40 %: partial
+    ev = evidence(a, base_mse=base_mse, noise=noise)
+    v = decide(ev)
+    assert v.kind is VerdictKind.NO_EFFECT and "would change it by" in v.text

@@ -214,10 +214,13 @@ def _diagnose(measured, engine, noise_floor, effects, pairs, do_bands, rule, sch
                 return Problem(s.sub(idx), s.problem.hm["test"], s.data, idx, s.test_idx)
             bands = band_check(factory, chosen.effects[0], s.data,
                                s.train_all[::max(1, s.train_all.size // 48)])
+    eq = cand.equivalents(s, chosen, rule)
+    text = verdict.text if not eq else verdict.text + (
+        "; the data cannot tell it from " + "; ".join(x["text"] for x in eq))
     return DiagnosisResult(
         s.data, s.src, getattr(engine, "name", ""), gap_map, gap_after, parts, rigid, found,
-        sigma, s.split_dict(), baseline, outcomes, chosen, verdict.label, verdict.text, bands,
+        sigma, s.split_dict(), baseline, outcomes, chosen, verdict.label, text, bands,
         time.perf_counter() - t0, synthetic=bool(getattr(measured, "synthetic", False)),
         noise_mse_heldout=e_n, ambiguous=verdict.ambiguous, rule=rule,
-        verdict_kind=verdict.kind, equivalents=cand.equivalents(s, chosen, verdict),
+        verdict_kind=verdict.kind, equivalents=eq,
         budget_hits=[o.label for o in outcomes if o.budget_hit])

@@ -18,8 +18,9 @@ would leave (noise):
 * an admissible rival of another effect family that the held-out speeds cannot tell apart
   from the answer (t ≤ ``t_min``) makes the verdict **ambiguous**;
 * otherwise **no effect** when the excess RMS gap :math:`\sqrt{\max(E_0 - E_n, 0)}` is
-  below ``excess_min_db``, else **unexplained** (the best supported candidate named as
-  partial, with the rule it failed).
+  below ``excess_min_db`` (even if a candidate fits what is left "significantly": a model
+  that agrees to round-off leaves round-off for candidates to fit), else **unexplained**
+  (the best supported candidate named as partial, with the rule it failed).
 
 :func:`decide` never fits anything. When it reaches a candidate whose held-out cells check
 is not in the evidence yet, it returns a verdict with ``needs_cells_check`` set; the driver
@@ -293,6 +294,16 @@ def _no_answer(ev, rule, ass, order, ranked):
     excess_db = math.sqrt(max(e0 - ev.noise_mse, 0.0))
     supported = [c for c in ranked if ass[c.label].status is not Status.NOT_SUPPORTED
                  and ass[c.label].status is not Status.NOT_BETTER_THAN_MEMBER]
+    if excess_db < rule.excess_min_db:
+        # within noise: nothing to explain, whatever a candidate fits (a model that agrees
+        # to round-off still has candidates that fit the round-off "significantly")
+        extra = (f"; the best supported candidate, {supported[0].label}, would change it by "
+                 f"{abs(e0 ** 0.5 - supported[0].heldout_mse ** 0.5):.2f} dB only"
+                 if supported else " and no candidate improves it significantly")
+        text = (f"no effect: the held-out gap ({e0 ** 0.5:.2f} dB RMS) is within noise "
+                f"({ev.sigma_db:.2f} dB; excess {excess_db:.2f} dB < {rule.excess_min_db:g} "
+                f"dB){extra}")
+        return Verdict(VerdictKind.NO_EFFECT, "no effect", text, ass, order)
     if supported:
         best = ass[supported[0].label]
         if best.status is Status.SUPPORTED:
@@ -301,11 +312,6 @@ def _no_answer(ev, rule, ass, order, ranked):
                 f"{best.explained:.0%} of the held-out excess gap ({excess_db:.2f} dB RMS "
                 f"over noise) but fails the decision rule ({best.text}); " + ev.where_text)
         return Verdict(VerdictKind.UNEXPLAINED, "unexplained", text, ass, order)
-    if excess_db < rule.excess_min_db:
-        text = (f"no effect: the held-out gap ({e0 ** 0.5:.2f} dB RMS) is within noise "
-                f"({ev.sigma_db:.2f} dB; excess {excess_db:.2f} dB < {rule.excess_min_db:g} "
-                f"dB) and no candidate improves it significantly")
-        return Verdict(VerdictKind.NO_EFFECT, "no effect", text, ass, order)
     text = (f"unexplained: no candidate improves the held-out gap significantly; excess "
             f"over noise {excess_db:.2f} dB RMS; " + ev.where_text)
     return Verdict(VerdictKind.UNEXPLAINED, "unexplained", text, ass, order)

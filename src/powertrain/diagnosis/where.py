@@ -6,7 +6,7 @@ decomposition of all order gaps (not the synthesis) into smooth parts,
 .. math:: \Delta L_{c,o}(n) \approx g_c + \Delta H_c\!\big(f = o\,n/60\big)
           + \Delta F_o(n),
 
-fitted by penalised least squares (piecewise-linear bases: ΔH on 16 knots in log f, ΔF on
+fitted by penalised least squares (piecewise-linear bases: ΔH on 32 knots in log f, ΔF on
 8 knots in rpm, second-difference smoothing and a small ridge): :math:`g_c` a constant per
 channel (sensor gain), :math:`\Delta H_c` tied to a fixed *frequency* (transfer path,
 structure), :math:`\Delta F_o` tied to a fixed *order and speed* (excitation).
@@ -30,7 +30,7 @@ from powertrain.diagnosis.data import GapData
 #: Gap beyond which a region is listed [dB].
 REGION_DB = 3.0
 #: Knots of the structure (frequency) and excitation (speed) bases.
-N_FREQ_KNOTS = 16
+N_FREQ_KNOTS = 32
 N_RPM_KNOTS = 8
 #: Second-difference smoothing and ridge weights of the decomposition.
 LAM_SMOOTH, LAM_RIDGE = 3.0, 0.3
@@ -133,7 +133,7 @@ def decompose_gap(gap, data: GapData, mask):
         out[k][mask] = v
     out["residual"] = np.full(gap.shape, np.nan)
     out["residual"][mask] = y - fit
-    share, alone = {}, {}
+    share, alone, alone_fit = {}, {}, {}
     for k, v in parts.items():
         den = float(np.sum(v ** 2)) or 1.0       # best scale of the joint fit's part alone
         s = float(np.dot(v, y)) / den
@@ -141,6 +141,8 @@ def decompose_gap(gap, data: GapData, mask):
         cols = np.arange(X.shape[1])[blocks[k]]
         b_k = _solve(X, P, y, cols)
         alone[k] = max(0.0, 1.0 - float(np.sum((y - X @ b_k) ** 2)) / ss)
+        alone_fit[k] = np.full(gap.shape, np.nan)
+        alone_fit[k][mask] = X @ b_k
     out.update(share_alone=share, r2_alone=alone, r2_full=1.0 - float(np.sum((y - fit) ** 2)) / ss,
                residual_rms_db=float(np.sqrt(np.mean((y - fit) ** 2))))
     out["structure_curves"] = {"frequency_hz": fk.tolist(),
@@ -148,31 +150,33 @@ def decompose_gap(gap, data: GapData, mask):
     out["excitation_curves"] = {"rpm": rk.tolist(),
                                 "by_quantity": beta[blocks["excitation"]].reshape(n_q, -1).tolist()}
     out["channel_const_db"] = beta[blocks["const"]].tolist()
-    out["attribution"] = attribute(out, data, gap.shape[2])
+    out["attribution"] = attribute(out, alone_fit, data, gap.shape[2], fk,
+                                   beta_alone=_solve(X, P, y, np.arange(X.shape[1])[
+                                       blocks["structure"]])[blocks["structure"]])
     return out
 
 
-def attribute(parts, data: GapData, n_q):
-    """Kind of the gap (the part with the largest R² alone) and where it lives: the orders
-    (excitation), the frequency band (structure) or the channels (sensor)."""
+def attribute(parts, alone_fit, data: GapData, n_q, fk, beta_alone):
+    """Kind of the gap (the part with the largest R² alone) and where it lives, read from
+    that part's own fit: the orders (excitation), the frequency band (structure) or the
+    channels (sensor) carrying at least :data:`NAME_FRACTION` of its largest RMS."""
     alone = parts["r2_alone"]
     kind = max(("structure", "excitation", "const"), key=lambda k: alone[k])
     out = {"kind": kind, "label": KIND_LABEL[kind], "r2_alone": alone[kind]}
+    fit = alone_fit[kind]
     if kind == "excitation":
-        rms = np.array([np.sqrt(np.nanmean(parts["excitation"][:, :, k] ** 2))
-                        if np.isfinite(parts["excitation"][:, :, k]).any() else 0.0
-                        for k in range(n_q)])
+        rms = np.array([np.sqrt(np.nanmean(fit[:, :, k] ** 2))
+                        if np.isfinite(fit[:, :, k]).any() else 0.0 for k in range(n_q)])
         top = np.flatnonzero(rms >= NAME_FRACTION * rms.max()) if rms.max() > 0 else []
         out["orders"] = [float((data.harmonic[k] + 1) / 2.0) for k in top]
     elif kind == "structure":
-        curves = np.abs(np.array(parts["structure_curves"]["by_channel"]))
-        f = np.array(parts["structure_curves"]["frequency_hz"])
-        level = np.sqrt(np.mean(curves ** 2, axis=0))
+        level = np.sqrt(np.mean(np.abs(beta_alone.reshape(-1, fk.size)) ** 2, axis=0))
         hot = np.flatnonzero(level >= NAME_FRACTION * level.max()) if level.max() > 0 else [0]
-        out["band_hz"] = [float(f[hot[0]]), float(f[hot[-1]])]
+        out["band_hz"] = [float(fk[hot[0]]), float(fk[hot[-1]])]
     else:
-        g = np.abs(np.array(parts["channel_const_db"]))
-        top = np.flatnonzero(g >= NAME_FRACTION * g.max()) if g.max() > 0 else []
+        rms = np.array([np.sqrt(np.nanmean(fit[:, c] ** 2)) if np.isfinite(fit[:, c]).any()
+                        else 0.0 for c in range(fit.shape[1])])
+        top = np.flatnonzero(rms >= NAME_FRACTION * rms.max()) if rms.max() > 0 else []
         out["channels"] = [list(data.channels[c]) for c in top]
     return out
 

@@ -117,6 +117,13 @@ class Effect:
         """What the sensors read from the channel velocities (n_r, n_ch, n_h)."""
         return velocity
 
+    # ------------------------------------------------------------------ identifiability
+    def alternatives(self, params, engine=None) -> list:
+        """Other parameter sets that may explain the same magnitudes, as
+        ``[(description, params), ...]`` (the diagnosis keeps those the data cannot tell
+        apart from ``params``); none by default."""
+        return []
+
 
 def map_networks(engine, fn):
     """The engine with every mount network replaced by ``fn(mount index, mount, axis, model)``."""

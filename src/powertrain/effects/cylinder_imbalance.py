@@ -55,9 +55,13 @@ class ScaledCombustion:
         return self.base.speed_range()
 
     def cycle_pressures(self, crank, omega, load=1.0):
+        from powertrain.physics.combustion import indicated_work
         theta, p, info = self.base.cycle_pressures(crank, omega, load)
         pm = motored_pressure(theta, p, crank)
-        return theta, pm + np.asarray(self.factors, float)[:, None] * (p - pm), info
+        p_new = pm + np.asarray(self.factors, float)[:, None] * (p - pm)
+        _, dV = crank.volume(theta)
+        imep = np.array([indicated_work(pc, dV, theta[1] - theta[0]) for pc in p_new])
+        return theta, p_new, dict(info, imep_target=imep / crank.swept_volume)
 
 
 def with_cylinder_imbalance(engine, **e):
@@ -104,6 +108,24 @@ class CylinderImbalance(Effect):
                 out[k] = (hm.load_of(up) - hm.load_of(dn)) / (2 * STEP)
             hm._extra["cylinder_imbalance"] = out
         return hm._extra["cylinder_imbalance"]
+
+    def alternatives(self, params, engine=None):
+        """The same cylinder-to-cylinder pattern with another reference: the strongest
+        cylinder nominal (the others weak), the weakest nominal (the others strong), the mean
+        nominal. Orders 0.5, 1, 1.5 see only the deviations from the mean, so these differ
+        mainly in the firing orders' level, often below the noise."""
+        n = len(params)
+        f = 1.0 + np.array([params.get(f"e{i + 1}", 0.0) for i in range(n)])
+        out = []
+        for label, ref in (("strongest cylinder nominal, the others weak", f.max()),
+                           ("weakest cylinder nominal, the others strong", f.min()),
+                           ("mean nominal", f.mean())):
+            g = np.clip(f / ref - 1.0, -0.25, 0.25)
+            if np.max(np.abs(g - (f - 1.0))) > 1e-3:
+                out.append((f"{label}: " + ", ".join(f"e{i + 1}={x:+.3f}"
+                                                     for i, x in enumerate(g)),
+                            {f"e{i + 1}": float(x) for i, x in enumerate(g)}))
+        return out
 
     def load_delta(self, hm, p):
         d = self.warm(hm)

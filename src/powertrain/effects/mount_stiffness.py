@@ -44,6 +44,20 @@ class MountStiffness(Effect):
     def apply(self, engine, **params):
         return with_mount_stiffness(engine, **params)
 
+    def alternatives(self, params, engine=None):
+        """The factors of two mounts swapped (mirror-image mounts can give the same
+        magnitudes), for every pair whose factors differ."""
+        names = mount_labels(engine)
+        k = [params.get(f"k{i + 1}", 1.0) for i in range(len(names))]
+        out = []
+        for i in range(len(k)):
+            for j in range(i + 1, len(k)):
+                if abs(np.log(k[i] / k[j])) > 0.02:
+                    alt = dict(params, **{f"k{i + 1}": k[j], f"k{j + 1}": k[i]})
+                    out.append((f"{names[i]} and {names[j]} swapped: k{i + 1}={k[j]:.3g}, "
+                                f"k{j + 1}={k[i]:.3g}", alt))
+        return out
+
     def elastomer_scale(self, hm, p):
         s = np.array([p.get(f"k{mi + 1}", 1.0) for mi, _, _ in hm.networks])
         return None if np.all(s == 1.0) else s
