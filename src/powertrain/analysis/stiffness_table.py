@@ -45,7 +45,7 @@ class StiffnessTable:
         return "\n".join(lines) + "\n"
 
     def to_text(self) -> str:
-        from powertrain.cli.common import format_table
+        from powertrain.analysis.text_table import format_table
         cols = self.columns()
         header = list(cols)
         rows = [[float(cols[c][i]) for c in cols] for i in range(self.frequency_hz.size)]

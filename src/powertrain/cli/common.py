@@ -7,6 +7,7 @@ import math
 import click
 import numpy as np
 
+from powertrain.analysis.text_table import format_table  # noqa: F401 (re-export)
 from powertrain.errors import InputError
 
 #: Most frequencies one option may ask for, and the highest frequency [Hz] (a mount model
@@ -53,18 +54,6 @@ def parse_frequencies(text: str, option: str = "--freq") -> np.ndarray:
     if np.any(np.diff(arr) <= 0):
         raise InputError("frequencies must be strictly increasing", key=option)
     return arr
-
-
-def format_table(header: list[str], rows: list[list], floatfmt: str = "{:.4g}") -> str:
-    """Fixed-width text table."""
-    cells = [[floatfmt.format(v) if isinstance(v, float) else str(v) for v in row]
-             for row in rows]
-    widths = [max(len(h), *(len(r[i]) for r in cells)) if cells else len(h)
-              for i, h in enumerate(header)]
-    lines = ["  ".join(h.rjust(w) for h, w in zip(header, widths)),
-             "  ".join("-" * w for w in widths)]
-    lines += ["  ".join(c.rjust(w) for c, w in zip(r, widths)) for r in cells]
-    return "\n".join(lines)
 
 
 def speed_options(func):

@@ -66,7 +66,7 @@ def runup(rpm_from, rpm_to, rpm_step, engine_file, solver, stepper, angle_step, 
     scenario = effect_scenario(parse_operations({"effect": effect}))
     runup_settings(engine, rpm, angle_step)
     if scenario:
-        from powertrain.effects import runup_with_effects
+        from powertrain.effect_runup import runup_with_effects
         from powertrain.progress import activity
         with activity(f"run-up with effects ({solver})", enabled=not quiet):
             result = checked_runup(engine, engine_path, runup_with_effects, rpm, scenario,
