@@ -38,6 +38,7 @@ def main():
       powertrain compare examples/measured-runup.csv --plot compare.png --json compare.json
       powertrain whatif --scale left.z.stiffness=1.2 --json whatif.json
       powertrain diagnose examples/measured-runup.csv --report diagnosis/
+      powertrain track run.csv --csv tracked.csv --plot orders.png
     """
 
 
@@ -50,6 +51,7 @@ def _register():
         fit_mount,
         runup,
         stiffness,
+        track,
         whatif,
     )
 
