@@ -35,8 +35,9 @@ import math
 
 import numpy as np
 
-#: Default -3 dB half-bandwidth of the filter [Hz]: holds an order within 0.5 dB through a
-#: crossing with an equally strong... see tests; at run-up rates up to ~500 rpm/s.
+#: Default -3 dB half-bandwidth of the filter [Hz]: holds an order within 0.5 dB while a
+#: fixed tone of half its amplitude crosses it at 500 rpm/s (order 2; tests and
+#: scripts/verify_order_tracking.py); widen it for envelopes that change faster.
 DEFAULT_BANDWIDTH_HZ = 0.5
 #: Decimate when the sampling rate exceeds this multiple of the highest tracked frequency.
 DECIMATE_ABOVE = 10.0
