@@ -91,7 +91,7 @@ def track_recording(rec, orders=None, *, rpm_step=50.0, method="cot", use="auto"
         raise InputError(f"order {orders.max():g} at {rpm.max():g} rpm is {f_top:.0f} Hz, "
                          f"above {MAX_FREQUENCY_FRACTION:g} x the sampling rate {fs:g} Hz",
                          file=rec.source, key="--orders")
-    X = np.vstack([c.values for c in chans])
+    X = rec.channel_matrix(chans)
     if method == "cot":
         amp = np.empty((rpm.size, X.shape[0], orders.size), complex)
         steps = range(0, rpm.size, CHUNK)

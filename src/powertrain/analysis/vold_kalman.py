@@ -35,6 +35,8 @@ import math
 
 import numpy as np
 
+from powertrain.analysis.order_tracking import first_passing
+
 #: Default -3 dB half-bandwidth of the filter [Hz]: holds an order within 0.5 dB while a
 #: fixed tone of half its amplitude crosses it at 500 rpm/s (order 2; tests and
 #: scripts/verify_order_tracking.py); widen it for envelopes that change faster.
@@ -98,7 +100,7 @@ def vkf_amplitudes(X, profile, orders, rpm_centre, *, bandwidth_hz=DEFAULT_BANDW
     if D >= 2:
         X = resample_poly(X, 1, D, axis=-1, window=("kaiser", 8.0))
         t, angle, rpm = t[::D][:X.shape[1]], angle[::D][:X.shape[1]], rpm[::D][:X.shape[1]]
-    times = _first_passing(t, rpm, rpm_centre)
+    times = first_passing(t, rpm, rpm_centre)
     cb = _factor(t.size, weight_from_bandwidth(bandwidth_hz, (t[-1] - t[0]) / (t.size - 1)))
     out = np.empty((len(rpm_centre), X.shape[0], len(orders)), complex)
     iterator = range(len(orders))
@@ -113,16 +115,4 @@ def vkf_amplitudes(X, profile, orders, rpm_centre, *, bandwidth_hz=DEFAULT_BANDW
         for ch in range(X.shape[0]):
             out[:, ch, k] = 2.0 * (np.interp(times, t, env[:, ch].real)
                                    + 1j * np.interp(times, t, env[:, ch].imag))
-    return out
-
-
-def _first_passing(t, rpm, targets):
-    """First time the speed passes each target speed [s]."""
-    out = np.empty(len(targets))
-    for i, r in enumerate(targets):
-        d = rpm - r
-        c = np.flatnonzero((d[:-1] <= 0) != (d[1:] <= 0))
-        c = int(c[0]) if c.size else int(np.argmin(np.abs(d)))
-        f = d[c] / (d[c] - d[c + 1]) if c + 1 < d.size and d[c] != d[c + 1] else 0.0
-        out[i] = t[c] + f * (t[min(c + 1, t.size - 1)] - t[c])
     return out

@@ -136,8 +136,8 @@ def simulate_sweep(engine, rpm_from, rpm_to, rate_rpm_per_s, sample_rate=8192.0,
     first = (-(-(2 * L) // m) * m - L) // m                         # first output index
     t_out = (first + np.arange(y.shape[0])) / sample_rate
     rpm_out = rpm_from + rate_rpm_per_s * t_out
-    chans = [RawChannel(f"{mnt}.{d}", mnt, "active", d, "acceleration",
-                        np.ascontiguousarray(y[:, c]), "m/s^2")
+    block = np.ascontiguousarray(y.T)
+    chans = [RawChannel(f"{mnt}.{d}", mnt, "active", d, "acceleration", block[c], "m/s^2")
              for c, (mnt, d) in enumerate(system.channels)]
     note = (f"SYNTHETIC: simulated continuous run-up {rpm_from:g}->{rpm_to:g} rpm at "
             f"{rate_rpm_per_s:g} rpm/s ({getattr(engine, 'name', '')}; Newmark average "
