@@ -83,6 +83,12 @@ def track_recording(rec, orders=None, *, rpm_step=50.0, method="cot", use="auto"
     i0, i1 = profile.valid
     n_min = float(np.min(profile.rpm[i0:i1 + 1]))
     margin = cot.KERNEL_ZERO_CROSSINGS / (cot.ANTI_ALIAS_FRACTION * S * n_min / 60.0)
+    if method == "vkf":
+        from powertrain.analysis.vold_kalman import DEFAULT_BANDWIDTH_HZ, EDGE_TIME_CONSTANTS
+        bandwidth_hz = float(DEFAULT_BANDWIDTH_HZ if bandwidth_hz is None else bandwidth_hz)
+        if not bandwidth_hz > 0:
+            raise InputError("must be > 0 [Hz]", key="--bandwidth")
+        margin = max(margin, EDGE_TIME_CONSTANTS / bandwidth_hz)
     rpm, centre = cot.speed_grid(profile, rpm_step, B, margin_s=margin, file=rec.source,
                                  key=profile.source)
     fs = rec.sample_rate
@@ -106,12 +112,10 @@ def track_recording(rec, orders=None, *, rpm_step=50.0, method="cot", use="auto"
                     "window": "hann", "kernel": f"Kaiser-windowed sinc, "
                     f"{cot.KERNEL_ZERO_CROSSINGS} zero crossings, beta {cot.KERNEL_BETA:g}"}
     else:
-        from powertrain.analysis.vold_kalman import DEFAULT_BANDWIDTH_HZ, vkf_amplitudes
-        bw = float(bandwidth_hz or DEFAULT_BANDWIDTH_HZ)
-        if not bw > 0:
-            raise InputError("must be > 0 [Hz]", key="--bandwidth")
-        amp = vkf_amplitudes(X, profile, orders, rpm, bandwidth_hz=bw, progress=progress)
-        settings = {"bandwidth_hz": bw, "structural_equation": "two-pole"}
+        from powertrain.analysis.vold_kalman import vkf_amplitudes
+        amp = vkf_amplitudes(X, profile, orders, rpm, bandwidth_hz=bandwidth_hz,
+                             progress=progress)
+        settings = {"bandwidth_hz": bandwidth_hz, "structural_equation": "two-pole"}
     settings.update({"rpm_step": float(rpm_step), "speed_source": profile.source,
                      "speed_notes": profile.notes, "sample_rate_hz": fs})
     tracked = [TrackedChannel(c.name, c.mount, c.side, c.direction, c.quantity) for c in chans]

@@ -41,6 +41,10 @@ from powertrain.analysis.order_tracking import first_passing
 #: fixed tone of half its amplitude crosses it at 500 rpm/s (order 2; tests and
 #: scripts/verify_order_tracking.py); widen it for envelopes that change faster.
 DEFAULT_BANDWIDTH_HZ = 0.5
+#: Speeds closer to the record ends than this many 1/bandwidth seconds are not reported:
+#: the smoother's end transient (time constant about 1/(2 pi f_b / sqrt 2)) has decayed
+#: below 0.01 dB there.
+EDGE_TIME_CONSTANTS = 1.5
 #: Decimate when the sampling rate exceeds this multiple of the highest tracked frequency.
 DECIMATE_ABOVE = 10.0
 DECIMATED_RATE_FACTOR = 5.0
