@@ -77,7 +77,7 @@ def main(argv=None):
     ap.add_argument("--rate", type=float, default=25.0, help="slow sweep rate [rpm/s]")
     ap.add_argument("--from", dest="rpm_from", type=float, default=1000.0)
     ap.add_argument("--to", dest="rpm_to", type=float, default=6000.0)
-    ap.add_argument("--fast", default="100,400", help="faster rates to plot [rpm/s]")
+    ap.add_argument("--fast", default="200,1000", help="faster rates to plot [rpm/s]")
     ap.add_argument("--plot", default="docs/sweep-rates.png")
     ap.add_argument("--plot-stiffness", type=float, default=20.0,
                     help="mount stiffness factor of the plotted variant")
