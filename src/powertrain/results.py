@@ -1,4 +1,4 @@
-"""Run-up results: order spectra of the nine mount channels against speed.
+"""Run-up results: order spectra of the mount channels (three per mount) against speed.
 
 HDF5 layout (all arrays SI, units in each dataset's ``unit`` attribute)::
 
@@ -8,15 +8,15 @@ HDF5 layout (all arrays SI, units in each dataset's ``unit`` attribute)::
                                   {path: text}), synthetic (bool), description
     /rpm                   (n_rpm,)                       rpm
     /orders                (n_orders,)                    1 (orders 0.5 ... 8)
-    /channels/mount        (9,) str                       left/right/gearbox
-    /channels/direction    (9,) str                       x/y/z (engine axes)
-    /velocity/amplitude    (n_rpm, 9, n_orders) complex   m/s   (peak complex amplitude)
-    /velocity/order_rms    (n_rpm, 9, n_orders)           m/s
-    /velocity/synthesis_rms (n_rpm, 9)                    m/s   (RMS sum, orders <= 8)
+    /channels/mount        (n_ch,) str                    mount names (left/right/gearbox ...)
+    /channels/direction    (n_ch,) str                    x/y/z (engine axes)
+    /velocity/amplitude    (n_rpm, n_ch, n_orders) complex   m/s   (peak complex amplitude)
+    /velocity/order_rms    (n_rpm, n_ch, n_orders)           m/s
+    /velocity/synthesis_rms (n_rpm, n_ch)                  m/s   (RMS sum, orders <= 8)
     /displacement/...      same, m
     /acceleration/...      same, m/s^2
     /mount_force/...       same, N (force transmitted to ground, engine axes)
-    /mount_force/mean      (n_rpm, 9)                     N (static preload part, no gravity)
+    /mount_force/mean      (n_rpm, n_ch)                   N (static preload part, no gravity)
     /diagnostics/periodicity        (n_rpm,)              1 (cycle-to-cycle, Newmark)
     /diagnostics/rigid_body_modes_hz (6,)                 Hz
     /diagnostics/solver_seconds     ()                    s
@@ -115,8 +115,14 @@ class RunupResult:
             fh.write(text)
 
     def to_hdf5(self, path, *, engine_snapshot: str = "", mount_snapshots: dict | None = None,
-                synthetic: bool = False, description: str = "") -> None:
-        """Write the documented HDF5 layout atomically."""
+                synthetic: bool = False, description: str = "",
+                provenance: dict | None = None) -> None:
+        """Write the documented HDF5 layout atomically.
+
+        ``engine_snapshot`` is the engine file as read; ``provenance``
+        (:func:`powertrain.provenance.provenance`) records the engine as it ran (e.g. the
+        balancers off), the effects applied, the command line, the version and the time.
+        """
         import h5py
 
         from powertrain import __version__
@@ -134,6 +140,11 @@ class RunupResult:
                 a["mount_snapshots"] = json.dumps(mount_snapshots or {})
                 a["synthetic"] = bool(synthetic)
                 a["description"] = description
+                if provenance:
+                    a["provenance"] = json.dumps(provenance, allow_nan=False)
+                    a["command_line"] = provenance.get("command_line", "")
+                    a["engine_as_run"] = json.dumps(provenance.get("engine_as_run", {}),
+                                                    allow_nan=False)
                 ds = h5.create_dataset("rpm", data=self.rpm)
                 ds.attrs["unit"] = "rpm"
                 ds = h5.create_dataset("orders", data=self.orders)

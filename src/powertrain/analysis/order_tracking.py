@@ -168,6 +168,8 @@ def cot_amplitudes(X, profile, orders, rpm_centre, angle_centre, block_revs=None
         From :func:`speed_grid`.
     block_revs : int, optional
         Block length [rev] (default :func:`block_revolutions`).
+    progress : bool, optional
+        Show a progress bar on stderr (quiet off a terminal).
 
     Returns
     -------

@@ -79,6 +79,8 @@ def speed_from_rpm(time, rpm, *, smooth_s=0.1, file=None, key="rpm") -> SpeedPro
         Measured speed [rpm].
     smooth_s : float
         Smoothing window [s].
+    file, key : str, optional
+        File and channel named in error messages.
     """
     from scipy.signal import savgol_filter
     time = np.asarray(time, float)

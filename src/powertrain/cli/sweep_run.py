@@ -20,6 +20,8 @@ def run_sweep(engine, rpm_from, rpm_to, rate, sample_rate, raw_file, out, csv_fi
     if effect:
         raise InputError("effects are not simulated in a sweep (use stepped run-ups)",
                          key="--effect")
+    from powertrain.cli.common import check_outputs
+    check_outputs(raw=raw_file)
     rec = simulate_sweep(engine, rpm_from, rpm_to, rate, sample_rate, progress=not quiet)
     tracked = track_recording(rec, rpm_step=TRACK_RPM_STEP, progress=not quiet).as_velocity()
     if raw_file:

@@ -63,6 +63,8 @@ def track(raw, map_file, rpm_column, tacho_column, pulses_per_rev, orders_spec, 
     if pulses_per_rev is not None and pulses_per_rev < 1:
         raise InputError("must be >= 1", key="--pulses-per-rev")
     orders = parse_orders(orders_spec)
+    from powertrain.cli.common import check_outputs
+    check_outputs(csv=csv_file, out=out, plot=plot, map=map_png)
     cmap = None
     if map_file:
         from powertrain.iotools.channel_map import read_channel_map

@@ -76,7 +76,7 @@ class MountSpec:
     Attributes
     ----------
     name : str
-        ``left``, ``right`` or ``gearbox``.
+        Any name (e.g. ``left``, ``right``, ``gearbox``, ``torque_rod``).
     position : ndarray, shape (3,)
         Engine-side mount point (measurement point) in engine axes [m].
     rotation : ndarray, shape (3, 3)
@@ -420,11 +420,14 @@ class Engine:
     Attributes
     ----------
     name : str
-    crank : CrankTrain
+    crank : CrankTrain or None
+        None: the engine file has no ``[crank_train]`` (no excitation; ``modes`` only).
     body : RigidBody
     mounts : list of MountSpec
+        Any number (>= 3) of mounts, in file order.
     balancer : Balancer
-    combustion : SingleZoneCombustion or MeasuredPressure
+    combustion : SingleZoneCombustion or MeasuredPressure or None
+        None: the engine file has no ``[combustion]`` (no excitation).
     file : str
         Engine file it was read from ("" if built in code).
     """
@@ -473,8 +476,23 @@ class Engine:
         raise KeyError(name)
 
     # ------------------------------------------------------------------ pressure
+    @property
+    def has_excitation(self) -> bool:
+        """True when the engine has a crank train and a combustion model."""
+        return self.crank is not None and self.combustion is not None
+
+    def require_excitation(self):
+        """Raise :class:`~powertrain.errors.InputError` naming the missing section when the
+        engine file describes no excitation."""
+        from powertrain.errors import InputError
+        for section, value in (("crank_train", self.crank), ("combustion", self.combustion)):
+            if value is None:
+                raise InputError(f"missing section [{section}]: this command needs the "
+                                 "engine's excitation", file=self.file or None, key=section)
+
     def speed_range_rpm(self):
         """Speeds [rpm] for which the combustion model is defined."""
+        self.require_excitation()
         lo, hi = self.combustion.speed_range()
         return lo / RPM, hi / RPM
 
