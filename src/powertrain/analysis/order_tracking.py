@@ -122,7 +122,8 @@ def speed_grid(profile, rpm_step, block_revs, *, margin_s=0.0, file=None, key="r
     rpm, centre = list(grid[keep]), thc[keep]
     if not rpm:
         raise InputError(f"speed never passes a multiple of {rpm_step:g} rpm with "
-                         f"{block_revs} revolutions of data either side (speed "
+                         f"{block_revs / 2:g} revolutions (+ {margin_s:.3g} s) of data either "
+                         "side (speed "
                          f"{n.min():.0f}..{n.max():.0f} rpm over {t[-1] - t[0]:.3g} s)",
                          file=file, key=key)
     return np.array(rpm, float), np.array(centre, float)
