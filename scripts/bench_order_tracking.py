@@ -4,10 +4,10 @@ Ours: :func:`powertrain.tracking.track_recording` (speed from the rpm channel, c
 order tracking with the fused anti-alias/angle-resampling Numba kernel, exact-order Hann
 spectra per block; Numba threads on all cores).
 Peer: a plain scipy implementation of the same analysis -- 8th-order Butterworth anti-alias
-(``sosfiltfilt``) at 1.6x the highest tracked frequency (passband droop < 0.01 dB), angle from the integrated rpm,
-cubic-spline resampling of the whole record to a uniform angle grid (``CubicSpline``), then
-per grid speed a Hann-windowed ``rfft`` of the block and the bins of the orders
-(single-threaded, as scipy runs it).
+(``sosfiltfilt``) at 1.6x the highest tracked frequency (passband droop < 0.01 dB), angle
+from the integrated rpm, cubic-spline resampling of the whole record to a uniform angle grid
+(``CubicSpline``), then per grid speed a Hann-windowed ``rfft`` of the block and the bins of
+the orders (single-threaded, as scipy runs it).
 
 Both track orders 0.5..8 every 50 rpm on the same synthetic signal (orders with known
 amplitudes plus broadband noise; SYNTHETIC) and their worst error against the known

@@ -122,7 +122,7 @@ def check_as_velocity(path):
     _, acc = track(path, "--quantity", "acceleration", "--as", "velocity")
     _, vel = track(path, "--quantity", "velocity")
     worst = 0.0
-    for (m, d, q), (r1, v1) in curves_of(acc).items():
+    for (_, d, q), (_, v1) in curves_of(acc).items():
         r2, v2 = curves_of(vel)[("right", d, q)]
         worst = max(worst, float(np.max(np.abs(db(v1, v2)))))
     return worst

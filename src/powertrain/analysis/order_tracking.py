@@ -155,8 +155,7 @@ def first_passing(t, rpm, targets, *others):
     return out[0] if not others else tuple(out)
 
 
-def cot_amplitudes(X, profile, orders, rpm_centre, angle_centre, block_revs=None, *,
-                   progress=False):
+def cot_amplitudes(X, profile, orders, rpm_centre, angle_centre, block_revs=None):
     """Complex order amplitudes per grid speed by computed order tracking.
 
     Parameters

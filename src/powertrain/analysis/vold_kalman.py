@@ -88,6 +88,8 @@ def vkf_amplitudes(X, profile, orders, rpm_centre, *, bandwidth_hz=DEFAULT_BANDW
         Grid speeds [rpm]; each is read at the first instant the speed passes it.
     bandwidth_hz : float
         -3 dB half-bandwidth [Hz].
+    progress : bool
+        tqdm bar over the orders (hidden when stderr is not a terminal).
 
     Returns
     -------
@@ -110,7 +112,7 @@ def vkf_amplitudes(X, profile, orders, rpm_centre, *, bandwidth_hz=DEFAULT_BANDW
     iterator = range(len(orders))
     if progress:
         from tqdm import tqdm
-        iterator = tqdm(iterator, desc="Vold-Kalman", unit="order", leave=False)
+        iterator = tqdm(iterator, desc="Vold-Kalman", unit="order", leave=False, disable=None)
     for k in iterator:
         c = np.exp(-1j * orders[k] * angle)
         rhs = (X * c[None, :]).T                                   # (n, n_ch)

@@ -36,11 +36,10 @@ def read_mdf_signals(path, channel_map=None) -> FileSignals:
     if problem is not None:
         raise InputError(f"not a readable MDF file ({problem})", file=path)
     time, signals = None, []
-    masters = {mdf.masters_db.get(g) for g in range(len(mdf.groups))}
     try:
         for g, group in enumerate(mdf.groups):
-            for c, ch in enumerate(group.channels):
-                if c in masters and mdf.masters_db.get(g) == c:
+            for c in range(len(group.channels)):
+                if mdf.masters_db.get(g) == c:          # the group's time channel
                     continue
                 sig = mdf.get(group=g, index=c)
                 t = np.asarray(sig.timestamps, float)

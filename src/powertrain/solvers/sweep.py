@@ -84,8 +84,8 @@ def simulate_sweep(engine, rpm_from, rpm_to, rate_rpm_per_s, sample_rate=8192.0,
     from scipy.signal import firwin, upfirdn
 
     from powertrain.assembly import assemble
-    from powertrain.solvers.newmark import ModalNewmark
     from powertrain.kernels.newmark import modal_trapezoid_kernel
+    from powertrain.solvers.newmark import ModalNewmark
     _check(engine, rpm_from, rpm_to, rate_rpm_per_s, sample_rate)
     if system is None:
         b = engine.body
@@ -125,7 +125,6 @@ def simulate_sweep(engine, rpm_from, rpm_to, rate_rpm_per_s, sample_rate=8192.0,
         eta = out_re[-1] + 1j * out_im[-1]
         acc = out_re @ w_re - out_im @ w_im + F @ w_load.T          # (k, n_ch)
         buf = np.concatenate([tail, acc[:-1]])                      # global start s - len(tail)
-        start = s - tail.shape[0]
         dec = upfirdn(fir, buf, 1, m, axis=0)
         i_lo = -(-(2 * L) // m)
         i_hi = (buf.shape[0] - 1) // m
