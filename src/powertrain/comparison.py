@@ -281,7 +281,8 @@ def compare_runup(simulated, measured: MeasuredRunup, *, noise_floor=DEFAULT_NOI
     ComparisonResult
     """
     if not isinstance(simulated, MeasuredRunup):
-        simulated = MeasuredRunup.from_result(simulated, source="simulation")
+        simulated = MeasuredRunup.from_result(simulated, source="simulation",
+                                              signal=measured.signal)
     if not (np.isfinite(noise_floor) and noise_floor >= 0):
         raise ValueError("noise floor must be finite and >= 0")
     channel_order = list(simulated.channels)
