@@ -9,7 +9,6 @@ measurements from :mod:`powertrain.synth` whose truth the diagnosis never sees.
 
 from __future__ import annotations
 
-import dataclasses
 import json
 
 import numpy as np
@@ -18,7 +17,7 @@ from click.testing import CliRunner
 
 from powertrain.cli import main
 from powertrain.diagnosis import diagnose
-from powertrain.effects import EFFECTS, predict, time_domain_amplitude_check
+from powertrain.effects import EFFECTS, Effect, predict, time_domain_amplitude_check
 from powertrain.errors import InputError
 from powertrain.iotools.engine_file import DEFAULT_ENGINE_PATH, read_engine
 from powertrain.iotools.measured import MeasuredRunup
@@ -62,7 +61,7 @@ def test_defaults_reduce_every_effect_to_the_baseline(engine):
     for name, eff in EFFECTS.items():
         v = predict(hm, {name: eff.defaults()}).velocity
         assert np.max(np.abs(v - v0)) <= EXACT * np.max(np.abs(v0)), name
-        if eff.apply is not None:
+        if eff.engine_change:
             eng = eff.apply(engine, **eff.defaults())
             if name != "base_compliance":       # its default is the rigid ground
                 vr = run_runup(eng, [2000.0], solver="harmonic").velocity[0]
@@ -133,9 +132,9 @@ def test_too_few_speeds_is_refused(engine):
 def test_registry_is_documented():
     for e in EFFECTS.values():
         assert e.kind in ("structure", "excitation", "sensor")
-        for p in e.parameters:
+        for p in e.parameters():
             assert p.lower <= p.default <= p.upper and p.unit and p.description
-    assert dataclasses.is_dataclass(next(iter(EFFECTS.values())))
+    assert all(isinstance(e, Effect) for e in EFFECTS.values())
 
 
 # --------------------------------------------------------------------------- decision rules
