@@ -15,6 +15,7 @@ outcome is classified:
 
 from __future__ import annotations
 
+import copy
 import json
 import math
 import os
@@ -281,7 +282,8 @@ WEIRD_VALUES = WEIRD_NUMBERS + ["", "abc", "1", "nan", True, [], [1, 2], [1, "a"
 
 
 def weird_value():
-    return st.one_of(st.sampled_from(WEIRD_VALUES),
+    """A weird TOML value (a fresh copy: mutations must not change the shared constants)."""
+    return st.one_of(st.sampled_from(WEIRD_VALUES).map(copy.deepcopy),
                      st.floats(allow_nan=True, allow_infinity=True),
                      st.integers(-2 ** 63, 2 ** 63 - 1),
                      st.text(max_size=6))
