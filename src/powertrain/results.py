@@ -217,16 +217,22 @@ class RunupResult:
                    meta=_h5_json(h5, "meta", path))
 
     # ----------------------------------------------------------------- plots
-    def plot(self, path=None, quantities=("synthesis", "order_2", "order_4"),
-             signal="velocity", others=None):
-        """The thesis's figure set (Figs 45–71): one row per mount and direction, columns
-        synthesis, 2nd and 4th order RMS velocity [mm/s] against rpm.
+    def plot(self, ax=None, *, path=None, quantities=("synthesis", "order_2", "order_4"),
+             signal="velocity", others=None, channel=None, quantity=None, provenance=None):
+        """The thesis's figure set (Figs 45–71): one row per mount and direction, one column
+        per quantity (every one of ``quantities`` is drawn), RMS ``signal`` against rpm.
 
-        ``others``: optional list of (label, RunupResult) overlaid for comparison.
+        ``ax``: None (new figure), a Figure/SubFigure (the grid) or an Axes (the one panel
+        ``channel``/``quantity``); ``others``: optional list of (label, RunupResult)
+        overlaid; ``provenance``: foot line (default: ``self.provenance`` if set). Returns the
+        figure; see :func:`powertrain.plotting.plot_runup`.
         """
         from powertrain.plotting import plot_runup
+        from powertrain.plotting.style import target_and_path
+        ax, path = target_and_path(ax, path)
         return plot_runup([("simulation", self)] + list(others or []), path, quantities,
-                          signal)
+                          signal, ax=ax, channel=channel, quantity=quantity,
+                          provenance=provenance or getattr(self, "provenance", None))
 
 
 def _h5_array(h5, key, path, kinds, ndim, shape=None):

@@ -7,6 +7,7 @@ import math
 import click
 import numpy as np
 
+from powertrain.analysis.text_table import format_table  # noqa: F401 (re-export)
 from powertrain.errors import InputError
 
 #: Most frequencies one option may ask for, and the highest frequency [Hz] (a mount model
@@ -53,18 +54,6 @@ def parse_frequencies(text: str, option: str = "--freq") -> np.ndarray:
     if np.any(np.diff(arr) <= 0):
         raise InputError("frequencies must be strictly increasing", key=option)
     return arr
-
-
-def format_table(header: list[str], rows: list[list], floatfmt: str = "{:.4g}") -> str:
-    """Fixed-width text table."""
-    cells = [[floatfmt.format(v) if isinstance(v, float) else str(v) for v in row]
-             for row in rows]
-    widths = [max(len(h), *(len(r[i]) for r in cells)) if cells else len(h)
-              for i, h in enumerate(header)]
-    lines = ["  ".join(h.rjust(w) for h, w in zip(header, widths)),
-             "  ".join("-" * w for w in widths)]
-    lines += ["  ".join(c.rjust(w) for c, w in zip(r, widths)) for r in cells]
-    return "\n".join(lines)
 
 
 def speed_options(func):
@@ -165,3 +154,53 @@ def checked_runup(engine, engine_path, run, *args, **kwargs):
                              "inf): the engine's values are out of any physical range",
                              file=engine_path, key="engine")
     return result
+
+
+# ------------------------------------------------------------------ figures
+def use_agg() -> None:
+    """Select matplotlib's file-only Agg backend: the CLI draws no windows. Only the CLI
+    does this; the library never switches the backend."""
+    import matplotlib
+    matplotlib.use("Agg")
+
+
+def cli_provenance(engine: str = ""):
+    """:class:`~powertrain.provenance.Provenance` of this command: the command line as given,
+    ``engine`` (what ran), version and time."""
+    from powertrain.provenance import Provenance, command_line
+    return Provenance.now(command=command_line(), engine=engine)
+
+
+def engine_description(engine, path, *, no_balancers=False, effects=()) -> str:
+    """``name (file)`` plus what the command line changed (balancers off, effects)."""
+    import os
+    rel = os.path.relpath(str(path))
+    shown = rel if not rel.startswith("..") else os.path.basename(str(path))
+    text = f"{engine.name} ({shown})"
+    if no_balancers:
+        text += ", balancers off"
+    if effects:
+        text += ", effects " + " ".join(effects)
+    return text
+
+
+def write_plot(draw, path) -> None:
+    """Draw a figure with ``draw(path)`` (a result's ``plot``) under the Agg backend, then
+    release it."""
+    use_agg()
+    from powertrain.plotting.style import close_figure
+    close_figure(draw(path))
+
+
+def plot_form_options(func):
+    """``--form`` and ``--freq-axis`` of the dynamic-stiffness plots."""
+    for option in reversed([
+        click.option("--form", type=click.Choice(["magnitude-phase", "real-imag"]),
+                     default="magnitude-phase", show_default=True,
+                     help="Plot form: |K*| and loss angle (datasheets, ISO 10846) or real "
+                          "and imaginary part (the thesis)."),
+        click.option("--freq-axis", type=click.Choice(["log", "linear"]), default="log",
+                     show_default=True, help="Frequency axis of the plot."),
+    ]):
+        func = option(func)
+    return func

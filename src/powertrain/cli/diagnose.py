@@ -67,6 +67,9 @@ def diagnose(measured, engine_file, report_dir, json_file, noise_floor, effects,
         check_writable(Path(report_dir) / "summary.txt", key="--report")
     engine = read_engine(engine_file or str(DEFAULT_ENGINE_PATH))
     meas = read_measured(measured, mounts=engine.mount_names)
+    if meas.signal != "velocity":
+        raise InputError("diagnose needs velocity, acceleration or displacement order curves "
+                         f"(this file holds {meas.signal})", file=measured)
     with activity("diagnose (fitting the effect library)", enabled=not quiet):
         res = run(meas, engine, noise_floor=noise_floor * 1e-3, effects=names,
                   pairs=not no_pairs)
@@ -77,7 +80,10 @@ def diagnose(measured, engine_file, report_dir, json_file, noise_floor, effects,
                    provenance(engine, engine_file=engine_file or DEFAULT_ENGINE_PATH))
         click.echo(f"wrote {json_file}")
     if report_dir:
-        files = res.report(report_dir)
+        from powertrain.cli.common import cli_provenance, engine_description, use_agg
+        use_agg()
+        files = res.report(report_dir, provenance=cli_provenance(
+            engine_description(engine, engine.file)))
         click.echo(f"wrote {len(files)} files to {report_dir}")
 
 

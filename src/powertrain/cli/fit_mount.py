@@ -5,6 +5,7 @@ from __future__ import annotations
 import click
 
 from powertrain.cli import main
+from powertrain.cli.common import plot_form_options
 from powertrain.models.mount import TOPOLOGIES
 
 _MODELS = tuple(TOPOLOGIES)
@@ -19,6 +20,7 @@ _MODELS = tuple(TOPOLOGIES)
               help="Fitted mount file to write (TOML, datasheet units).")
 @click.option("--plot", type=click.Path(dir_okay=False),
               help="Write a measured-vs-fitted K*(f) plot (PNG).")
+@plot_form_options
 @click.option("--starts", type=int, default=None,
               help="Random starting points screened [default: powertrain.fitting.DEFAULT_STARTS].")
 @click.option("--seed", type=int, default=None,
@@ -29,7 +31,7 @@ _MODELS = tuple(TOPOLOGIES)
               help="Upper bound of every internal mass [kg]. K_CP alone does not identify the "
                    "internal masses, but the engine feels them (input-point stiffness).")
 @click.option("--quiet", is_flag=True, help="No progress indicator on stderr.")
-def fit_mount(measured, model, out, plot, starts, seed, fmin, fmax, max_mass, quiet):
+def fit_mount(measured, model, out, plot, form, freq_axis, starts, seed, fmin, fmax, max_mass, quiet):
     """Fit a lumped mount model to the measured dynamic stiffness in MEASURED (CSV).
 
     MEASURED has a header line and the columns frequency_hz plus either k_real_n_per_mm,
@@ -97,7 +99,10 @@ def fit_mount(measured, model, out, plot, starts, seed, fmin, fmax, max_mass, qu
                f"{100 * result.rel_rms:.4g} %, starts = {starts}, seed = {seed}.")
     write_mount(result.model, out, comment=comment)
     if plot:
-        result.plot(path=plot)
+        from powertrain.cli.common import cli_provenance, write_plot
+        prov = cli_provenance()
+        write_plot(lambda p: result.plot(path=p, form=form, freq_axis=freq_axis,
+                                         provenance=prov), plot)
 
     units = {"c": "N/mm", "d": "N*s/mm", "m": "kg"}
     click.echo(result.summary())

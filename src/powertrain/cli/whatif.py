@@ -138,8 +138,10 @@ def whatif(engine_file, rpm_from, rpm_to, rpm_step, solver, scale, set_, swap, m
         tf = result.target_fits[0]
         write_mount(tf.model, target_out, comment=f"powertrain whatif: {tf.summary()}")
         written.append(target_out)
+    from powertrain.cli.common import cli_provenance, engine_description, write_plot
+    prov = cli_provenance(engine_description(engine, engine.file))
     if target_plot:
-        result.target_fits[0].plot(target_plot)
+        write_plot(lambda p: result.target_fits[0].plot(path=p, provenance=prov), target_plot)
         written.append(target_plot)
     if json_file:
         from powertrain.provenance import provenance
@@ -147,7 +149,7 @@ def whatif(engine_file, rpm_from, rpm_to, rpm_step, solver, scale, set_, swap, m
                    provenance(engine, engine_file=engine_file or DEFAULT_ENGINE_PATH))
         written.append(json_file)
     if plot:
-        result.plot(plot)
+        write_plot(lambda p: result.plot(path=p, provenance=prov), plot)
         written.append(plot)
     if quiet:
         return
