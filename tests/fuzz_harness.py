@@ -230,6 +230,12 @@ def seeds(worker: Worker, folder: Path) -> dict:
     assert res["code"] == 0, res
     _SEEDS["sim.h5"] = (folder / "sim.h5").read_bytes()
     _SEEDS["sim.csv"] = (folder / "sim.csv").read_bytes()
+    from powertrain import signals
+    from powertrain.iotools.raw_csv import write_raw_csv
+    write_raw_csv(folder / "raw.csv", signals.analytic_sweep(fs=2048.0, duration=2.0,
+                                                             rpm0=1500.0, rpm1=3000.0),
+                  comment="SYNTHETIC: analytic sweep (fuzz seed)")
+    _SEEDS["raw.csv"] = (folder / "raw.csv").read_bytes()
     res = worker.run(["stiffness", str(ROOT / "mounts" / "hydraulic-engine-mount-z.toml"),
                       "--freq", "1:200:10", "--format", "csv"], folder)
     _SEEDS["k.csv"] = res["stdout"].encode()
@@ -602,11 +608,18 @@ def case_options(draw) -> Case:
                         "f.toml", opt, value], ["f.toml"], opt, f"option {opt}")
 
 
+def case_raw_csv(draw) -> Case:
+    files = {"raw.csv": mutate_csv(draw, _SEEDS["raw.csv"])}
+    return Case(files, ["track", "raw.csv", "--quantity", "acceleration", "--orders", "1,2,4",
+                        "--quiet", "--csv", "t.csv"], ["t.csv"], "raw.csv",
+                "raw time-data CSV (track)")
+
+
 #: Input kind -> case builder.
 KINDS = {"engine": case_engine, "mount": case_mount, "pressure_csv": case_pressure,
          "stiffness_csv": case_stiffness, "measured_csv": case_measured_csv,
          "measured_hdf5": case_measured_hdf5, "variants": case_variants,
-         "options": case_options}
+         "options": case_options, "raw_csv": case_raw_csv}
 
 
 # --------------------------------------------------------------------------- issue 10's list
