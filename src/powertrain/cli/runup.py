@@ -29,13 +29,18 @@ from powertrain.cli.common import speed_options, speed_steps
                    "velocity_rms_mm_per_s).")
 @click.option("--plot", type=click.Path(dir_okay=False),
               help="Thesis figure set (Figs 45-71) as PNG.")
+@click.option("--path-plot", type=click.Path(dir_okay=False),
+              help="Path contributions at the body points of a modal or measured chassis "
+                   "(PNG), at --path-order.")
+@click.option("--path-order", type=float, default=2.0, show_default=True,
+              help="Engine order of the path-contribution plot.")
 @click.option("--no-balancers", is_flag=True, help="Switch the balancer shafts off.")
 @click.option("--effect", multiple=True, metavar="NAME[:PARAM=VALUE,...]",
               help="Add an unmodelled effect of the diagnosis library (as in `whatif`), e.g. "
                    "base_compliance:c_base=400N/mm,m_base=8kg. Repeatable.")
 @click.option("--quiet", is_flag=True, help="No progress bar and no table.")
 def runup(rpm_from, rpm_to, rpm_step, engine_file, solver, stepper, angle_step, out, csv_file,
-          plot, no_balancers, effect, quiet):
+          plot, path_plot, path_order, no_balancers, effect, quiet):
     """Run-up: steady-state mount-point velocities at each speed, order analysed.
 
     Prints the rigid-body modes and the synthesis (RMS sum of orders 0.5..8) velocity of the
@@ -46,6 +51,7 @@ def runup(rpm_from, rpm_to, rpm_step, engine_file, solver, stepper, angle_step, 
       powertrain runup --from 1000 --to 6000 --step 500
       powertrain runup --solver harmonic --csv runup.csv --plot runup.png
       powertrain runup --effect amplitude_stiffness:kappa=1,a_c=0.02mm
+      powertrain runup --engine engines/default-modal-body.toml --path-plot paths.png
     """
     import numpy as np
 
@@ -56,6 +62,15 @@ def runup(rpm_from, rpm_to, rpm_step, engine_file, solver, stepper, angle_step, 
     rpm = speed_steps(rpm_from, rpm_to, rpm_step)
     engine_path = engine_file or DEFAULT_ENGINE_PATH
     engine = read_engine(engine_path)
+    engine.require_excitation()
+    if path_plot:
+        from powertrain.analysis.orders import ORDERS
+        if not getattr(engine.chassis, "points", ()):
+            raise InputError("needs body points ([chassis.points.NAME] with a modal or frf "
+                             "chassis)", file=engine.file, key="--path-plot")
+        if not np.any(np.isclose(ORDERS, path_order)):
+            raise InputError(f"order {path_order:g} not analysed (0.5 to 8 in steps of 0.5)",
+                             key="--path-order")
     if no_balancers:
         engine = engine.with_balancers(enabled=False)
     from powertrain.variants import effect_scenario, parse_operations
@@ -82,6 +97,8 @@ def runup(rpm_from, rpm_to, rpm_step, engine_file, solver, stepper, angle_step, 
         result.to_csv(csv_file)
     if plot:
         result.plot(plot)
+    if path_plot:
+        result.plot_paths(path_plot, path_order)
     if quiet:
         return
     from powertrain.cli.common import format_table
@@ -100,4 +117,5 @@ def runup(rpm_from, rpm_to, rpm_step, engine_file, solver, stepper, angle_step, 
     if solver == "newmark":
         click.echo(f"periodicity of processed windows: max {100 * np.max(result.periodicity):.2g} %")
     click.echo(f"solver time: {result.solver_seconds:.3f} s; wrote {out}"
-               + (f", {csv_file}" if csv_file else "") + (f", {plot}" if plot else ""))
+               + (f", {csv_file}" if csv_file else "") + (f", {plot}" if plot else "")
+               + (f", {path_plot}" if path_plot else ""))
