@@ -12,7 +12,8 @@ Rules:
   level (:func:`~powertrain.analysis.compare.interpolate_log`); measured points outside the
   simulated speed range are not compared (never extrapolated) and are counted.
 * Measured points at or near the noise floor (below ``NOISE_FLOOR_MARGIN`` × floor, i.e.
-  within 6 dB of it) are excluded and counted, never scored as gaps.
+  within 9.5 dB of it; :mod:`powertrain.analysis.noise_floor`) are excluded and counted,
+  never scored as gaps.
 * Channels or quantities present on one side only are listed as missing, never scored as a
   zero level; so are channels with no scoreable point.
 * CSAC and CSF need at least :data:`MIN_CHANNELS_CSAC` channels at a speed (counted otherwise).

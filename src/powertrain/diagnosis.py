@@ -810,6 +810,9 @@ class DiagnosisResult:
             "quantities": list(d.quantities),
             "gap_db": [[[None if not np.isfinite(x) else round(float(x), 3) for x in row]
                         for row in mat] for mat in self.gap],
+            "gap_db_after": None if self.gap_after is None else
+            [[[None if not np.isfinite(x) else round(float(x), 3) for x in row]
+              for row in mat] for mat in self.gap_after],
             "per_channel": chans,
             "regions_beyond_3db": self.regions,
             "decomposition": {

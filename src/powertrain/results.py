@@ -184,8 +184,14 @@ class RunupResult:
             fh.write(text)
 
     def to_hdf5(self, path, *, engine_snapshot: str = "", mount_snapshots: dict | None = None,
-                synthetic: bool = False, description: str = "") -> None:
-        """Write the documented HDF5 layout atomically."""
+                synthetic: bool = False, description: str = "",
+                provenance: dict | None = None) -> None:
+        """Write the documented HDF5 layout atomically.
+
+        ``engine_snapshot`` is the engine file as read; ``provenance``
+        (:func:`powertrain.provenance.provenance`) records the engine as it ran (e.g. the
+        balancers off), the effects applied, the command line, the version and the time.
+        """
         import h5py
 
         from powertrain import __version__
@@ -203,6 +209,11 @@ class RunupResult:
                 a["mount_snapshots"] = json.dumps(mount_snapshots or {})
                 a["synthetic"] = bool(synthetic)
                 a["description"] = description
+                if provenance:
+                    a["provenance"] = json.dumps(provenance, allow_nan=False)
+                    a["command_line"] = provenance.get("command_line", "")
+                    a["engine_as_run"] = json.dumps(provenance.get("engine_as_run", {}),
+                                                    allow_nan=False)
                 ds = h5.create_dataset("rpm", data=self.rpm)
                 ds.attrs["unit"] = "rpm"
                 ds = h5.create_dataset("orders", data=self.orders)

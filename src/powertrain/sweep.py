@@ -136,11 +136,9 @@ def run_sweep(tasks, executor=None, *, workers: int | None = None, progress: boo
             executor = own = ProcessPoolExecutor(max_workers=n)
     try:
         futures = [executor.submit(run_task, t) for t in tasks]
-        iterator = futures
-        if progress:
-            from tqdm import tqdm
-            iterator = tqdm(futures, desc="variants", unit="run-up", leave=False)
-        return [f.result() for f in iterator]
+        from powertrain.progress import progress_bar
+        bar = progress_bar(futures, enabled=progress, desc="variants", unit="run-up")
+        return [f.result() for f in bar]
     finally:
         if own is not None:
             own.shutdown(cancel_futures=True)

@@ -14,15 +14,31 @@ from powertrain import __version__
 
 
 class _Group(click.Group):
-    """Turns :class:`powertrain.errors.InputError` into one line on stderr and exit code 1."""
+    """Turns :class:`powertrain.errors.InputError` into one line on stderr and exit code 1.
+
+    A command that fails removes the output files it had already written (no leftovers).
+    """
+
+    def main(self, args=None, *posargs, **kwargs):
+        from powertrain import provenance
+        provenance.COMMAND_LINE[:] = ["powertrain",
+                                      *(sys.argv[1:] if args is None else list(args))]
+        return super().main(args, *posargs, **kwargs)
 
     def invoke(self, ctx):
         from powertrain.errors import InputError
+        from powertrain.iotools.atomic import discard_written, start_tracking
+        start_tracking()
         try:
             return super().invoke(ctx)
         except InputError as exc:
+            discard_written()
             click.echo(f"error: {exc.one_line()}", err=True)
             sys.exit(1)
+        except BaseException as exc:
+            if getattr(exc, "exit_code", getattr(exc, "code", 1)):  # not a clean exit
+                discard_written()
+            raise
 
 
 @click.group(cls=_Group, context_settings={"help_option_names": ["-h", "--help"]})

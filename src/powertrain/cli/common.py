@@ -69,7 +69,62 @@ def speed_options(func):
 def speed_steps(rpm_from: float, rpm_to: float, rpm_step: float) -> np.ndarray:
     """Validated speed steps [rpm] from the ``--from/--to/--step`` options."""
     from powertrain.runup import default_rpm
-    if not (math.isfinite(rpm_from + rpm_to + rpm_step) and rpm_from > 0
-            and rpm_to >= rpm_from and rpm_step > 0):
-        raise InputError("need 0 < --from <= --to and --step > 0", key="--from/--to/--step")
+    for value, key in ((rpm_from, "--from"), (rpm_to, "--to"), (rpm_step, "--step")):
+        if not (math.isfinite(value) and value > 0):
+            raise InputError(f"must be a finite speed > 0 [rpm], got {value:g}", key=key)
+    if rpm_to < rpm_from:
+        raise InputError(f"{rpm_to:g} rpm is below --from {rpm_from:g} rpm", key="--to")
+    n = math.floor((rpm_to - rpm_from) / rpm_step + 1e-9) + 1
+    if n > MAX_SPEEDS:
+        raise InputError(f"{n:.3g} speed steps from --from/--to/--step; at most {MAX_SPEEDS}",
+                         key="--step")
     return default_rpm(rpm_from, rpm_to, rpm_step)
+
+
+#: Largest speed grid a run-up command accepts (about 0.1 s per speed step).
+MAX_SPEEDS = 2000
+#: Finest crank-angle step [deg] of the Newmark stepper (720 / 0.05 = 14 400 steps a cycle).
+MIN_ANGLE_STEP_DEG = 0.05
+
+
+def check_outputs(**targets) -> None:
+    """Refuse, before any work, output paths that cannot be written (``--name=path``)."""
+    from powertrain.iotools.atomic import check_writable
+    for name, path in targets.items():
+        if path:
+            check_writable(path, key=f"--{name.replace('_', '-')}")
+
+
+def runup_settings(engine, rpm: np.ndarray, angle_step: float) -> None:
+    """Check a run-up's speeds against the engine's range and the crank-angle step, naming
+    the option at fault."""
+    lo, hi = engine.speed_range_rpm()
+    if rpm[0] < lo - 1e-6:
+        raise InputError(f"{rpm[0]:g} rpm is below the engine's range {lo:g}..{hi:g} rpm",
+                         key="--from")
+    if rpm[-1] > hi + 1e-6:
+        raise InputError(f"{rpm[-1]:g} rpm is above the engine's range {lo:g}..{hi:g} rpm",
+                         key="--to")
+    n_cycle = 720.0 / angle_step if math.isfinite(angle_step) and angle_step > 0 else 0.0
+    if not (angle_step >= MIN_ANGLE_STEP_DEG and abs(n_cycle - round(n_cycle)) < 1e-9
+            and round(n_cycle) % 2 == 0):
+        raise InputError(f"{angle_step:g} deg: must divide 720 deg into an even number of "
+                         f"steps and be >= {MIN_ANGLE_STEP_DEG:g} deg (e.g. 0.5, 1, 2)",
+                         key="--angle-step")
+
+
+def write_json(path, text: str, provenance: dict, key: str = "--json") -> None:
+    """Write a result's JSON ``text`` with a ``provenance`` key added, atomically; a result
+    with a non-finite number is refused (no NaN in an output file)."""
+    import json
+
+    from powertrain.iotools.atomic import atomic_write
+    doc = json.loads(text)
+    doc["provenance"] = provenance
+    try:
+        out = json.dumps(doc, indent=1, allow_nan=False) + "\n"
+    except ValueError:
+        raise InputError("the result holds a non-finite number (NaN or inf); not written",
+                         file=path, key=key) from None
+    with atomic_write(path) as fh:
+        fh.write(out)

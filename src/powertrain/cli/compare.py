@@ -21,7 +21,7 @@ from powertrain.cli import main
               help="JSON with every gap and metric, what was compared and what is missing.")
 @click.option("--noise-floor", type=float, default=0.001, show_default=True,
               help="RMS noise floor of the measured order curves [mm/s]; measured points "
-                   "below 2x this (within 6 dB) are excluded and counted.")
+                   "below 3x this (within 9.5 dB) are excluded and counted.")
 @click.option("--solver", type=click.Choice(["newmark", "harmonic"]), default="newmark",
               show_default=True, help="Solver when the simulation is run here.")
 @click.option("--step", "rpm_step", type=float, default=500.0, show_default=True,
@@ -60,6 +60,8 @@ def compare(measured, sim_file, engine_file, plot, json_file, noise_floor, solve
         raise InputError("must be a finite number >= 0 [mm/s]", key="--noise-floor")
     if not (math.isfinite(rpm_step) and rpm_step > 0):
         raise InputError("must be > 0 [rpm]", key="--step")
+    from powertrain.cli.common import check_outputs, write_json
+    check_outputs(plot=plot, json=json_file)
     engine = None
     if sim_file:
         simulated = read_measured(sim_file)
@@ -95,7 +97,10 @@ def compare(measured, sim_file, engine_file, plot, json_file, noise_floor, solve
     if plot:
         comp.plot(plot)
     if json_file:
-        comp.to_json(json_file)
+        from powertrain.provenance import provenance
+        write_json(json_file, comp.to_json(),
+                   provenance(engine, engine_file=engine_file) if engine is not None
+                   else dict(provenance(), simulation_file=str(sim_file)))
     elapsed = time.perf_counter() - t0
     d = comp.to_dict()
     c = d["compared"]

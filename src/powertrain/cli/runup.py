@@ -22,10 +22,11 @@ from powertrain.cli.common import speed_options, speed_steps
                    "(physical coordinates); auto = modal when the mass matrix is regular.")
 @click.option("--angle-step", type=float, default=1.0, show_default=True,
               help="Crank-angle increment of the Newmark stepper [deg].")
-@click.option("--out", type=click.Path(dir_okay=False), default="runup.h5", show_default=True,
-              help="HDF5 result file.")
+@click.option("--out", type=click.Path(dir_okay=False),
+              help="Write the HDF5 result file (e.g. runup.h5); nothing is written unless "
+                   "--out, --csv or --plot is given.")
 @click.option("--csv", "csv_file", type=click.Path(dir_okay=False),
-              help="Also write the long-format CSV (mount,direction,quantity,rpm,"
+              help="Write the long-format CSV (mount,direction,quantity,rpm,"
                    "velocity_rms_mm_per_s).")
 @click.option("--plot", type=click.Path(dir_okay=False),
               help="Thesis figure set (Figs 45-71) as PNG.")
@@ -44,63 +45,91 @@ def runup(rpm_from, rpm_to, rpm_step, engine_file, solver, stepper, angle_step, 
     """Run-up: steady-state mount-point velocities at each speed, order analysed.
 
     Prints the rigid-body modes and the synthesis (RMS sum of orders 0.5..8) velocity of the
-    channels (every mount × engine X/Y/Z) per speed; writes HDF5 (and CSV/PNG on request).
+    channels (every mount × engine X/Y/Z) per speed; writes HDF5, CSV and PNG only on request
+    (--out, --csv, --plot) and names the files written.
 
     \b
     Examples:
       powertrain runup --from 1000 --to 6000 --step 500
+      powertrain runup --out runup.h5 --no-balancers
       powertrain runup --solver harmonic --csv runup.csv --plot runup.png
       powertrain runup --effect amplitude_stiffness:kappa=1,a_c=0.02mm
       powertrain runup --engine engines/default-modal-body.toml --path-plot paths.png
     """
-    import numpy as np
-
-    from powertrain.errors import InputError
+    from powertrain.cli.common import check_outputs, runup_settings
     from powertrain.iotools.engine_file import DEFAULT_ENGINE_PATH, read_engine
     from powertrain.runup import run_runup
 
     rpm = speed_steps(rpm_from, rpm_to, rpm_step)
+    check_outputs(out=out, csv=csv_file, plot=plot, path_plot=path_plot)
     engine_path = engine_file or DEFAULT_ENGINE_PATH
     engine = read_engine(engine_path)
     engine.require_excitation()
     if path_plot:
-        from powertrain.analysis.orders import ORDERS
-        if not getattr(engine.chassis, "points", ()):
-            raise InputError("needs body points ([chassis.points.NAME] with a modal or frf "
-                             "chassis)", file=engine.file, key="--path-plot")
-        if not np.any(np.isclose(ORDERS, path_order)):
-            raise InputError(f"order {path_order:g} not analysed (0.5 to 8 in steps of 0.5)",
-                             key="--path-order")
+        _check_path_plot(engine, path_order)
+    modifications = []
     if no_balancers:
         engine = engine.with_balancers(enabled=False)
+        modifications.append("balancer shafts switched off (--no-balancers)")
     from powertrain.variants import effect_scenario, parse_operations
     scenario = effect_scenario(parse_operations({"effect": effect}))
-    try:
-        if scenario:
-            from powertrain.effects import runup_with_effects
-            result = runup_with_effects(engine, rpm, scenario, solver=solver,
-                                        angle_step_deg=angle_step, stepper=stepper)
-        else:
-            result = run_runup(engine, rpm, solver=solver, angle_step_deg=angle_step,
-                               progress=not quiet, stepper=stepper)
-    except ValueError as exc:
-        raise InputError(str(exc), key="--angle-step") from None
-    from pathlib import Path
-    snapshot = Path(engine_path).read_text(encoding="utf-8")
-    mounts = {f"{m.name}.{a}": {"model": mdl.topology.name, "params_si": mdl.params,
-                                 "source": mdl.source}
-              for m in engine.mounts for a, mdl in m.directions.items()}
-    import json
-    result.to_hdf5(out, engine_snapshot=snapshot, mount_snapshots={"mounts": json.dumps(mounts)},
-                   description=f"run-up {rpm_from:g}-{rpm_to:g} rpm, {engine.name}")
+    runup_settings(engine, rpm, angle_step)
+    if scenario:
+        from powertrain.effects import runup_with_effects
+        result = runup_with_effects(engine, rpm, scenario, solver=solver,
+                                    angle_step_deg=angle_step, stepper=stepper)
+    else:
+        result = run_runup(engine, rpm, solver=solver, angle_step_deg=angle_step,
+                           progress=not quiet, stepper=stepper)
+    written = []
+    if out:
+        from powertrain.provenance import provenance
+        prov = provenance(engine, engine_file=engine_path, modifications=modifications,
+                          effects=scenario)
+        import json
+        from pathlib import Path
+        mounts = {f"{m.name}.{a}": {"model": mdl.topology.name, "params_si": mdl.params,
+                                     "source": mdl.source}
+                  for m in engine.mounts for a, mdl in m.directions.items()}
+        result.to_hdf5(out, engine_snapshot=Path(engine_path).read_text(encoding="utf-8"),
+                       mount_snapshots={"mounts": json.dumps(mounts)}, provenance=prov,
+                       description=f"run-up {rpm_from:g}-{rpm_to:g} rpm, {engine.name}")
+        written.append(out)
     if csv_file:
         result.to_csv(csv_file)
+        written.append(csv_file)
     if plot:
         result.plot(plot)
+        written.append(plot)
     if path_plot:
         result.plot_paths(path_plot, path_order)
+        written.append(path_plot)
     if quiet:
         return
+    _print_table(result, engine, engine_path, solver, scenario)
+    click.echo(f"solver time: {result.solver_seconds:.3f} s; "
+               + (f"wrote {', '.join(map(str, written))}" if written else
+                  "no file written (ask with --out, --csv or --plot)"))
+
+
+def _check_path_plot(engine, path_order):
+    """--path-plot needs body points; --path-order must be an analysed order."""
+    import numpy as np
+
+    from powertrain.analysis.orders import ORDERS
+    from powertrain.errors import InputError
+    if not getattr(engine.chassis, "points", ()):
+        raise InputError("needs body points ([chassis.points.NAME] with a modal or frf "
+                         "chassis)", file=engine.file, key="--path-plot")
+    if not np.any(np.isclose(ORDERS, path_order)):
+        raise InputError(f"order {path_order:g} not analysed (0.5 to 8 in steps of 0.5)",
+                         key="--path-order")
+
+
+def _print_table(result, engine, engine_path, solver, scenario):
+    """Rigid-body modes and the synthesis velocity table."""
+    import numpy as np
+
     from powertrain.cli.common import format_table
     modes = ", ".join(f"{f:.1f}" for f in result.rigid_body_modes_hz)
     click.echo(f"engine: {engine.name} ({engine_path})")
@@ -116,6 +145,3 @@ def runup(rpm_from, rpm_to, rpm_step, engine_file, solver, stepper, angle_step, 
     click.echo(format_table(header, rows, "{:.3f}"))
     if solver == "newmark":
         click.echo(f"periodicity of processed windows: max {100 * np.max(result.periodicity):.2g} %")
-    click.echo(f"solver time: {result.solver_seconds:.3f} s; wrote {out}"
-               + (f", {csv_file}" if csv_file else "") + (f", {plot}" if plot else "")
-               + (f", {path_plot}" if path_plot else ""))

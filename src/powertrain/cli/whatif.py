@@ -5,7 +5,13 @@ from __future__ import annotations
 import click
 
 from powertrain.cli import main
-from powertrain.cli.common import speed_options, speed_steps
+from powertrain.cli.common import (
+    check_outputs,
+    runup_settings,
+    speed_options,
+    speed_steps,
+    write_json,
+)
 
 
 @main.command()
@@ -94,11 +100,9 @@ def whatif(engine_file, rpm_from, rpm_to, rpm_step, solver, scale, set_, swap, m
     rpm = speed_steps(rpm_from, rpm_to, rpm_step)
     if workers is not None and workers < 1:
         raise InputError("must be >= 1", key="--workers")
+    check_outputs(target_out=target_out, target_plot=target_plot, plot=plot, json=json_file)
     engine = read_engine(engine_file or DEFAULT_ENGINE_PATH)
-    lo, hi = engine.speed_range_rpm()
-    if rpm[0] < lo - 1e-6 or rpm[-1] > hi + 1e-6:
-        raise InputError(f"speeds outside the engine model's range {lo:g}..{hi:g} rpm",
-                         key="--from/--to")
+    runup_settings(engine, rpm, 1.0)
 
     variants = []
     ops = parse_operations({"scale": scale, "set": set_, "swap": swap, "move": move,
@@ -146,7 +150,9 @@ def whatif(engine_file, rpm_from, rpm_to, rpm_step, solver, scale, set_, swap, m
         result.target_fits[0].plot(target_plot)
         written.append(target_plot)
     if json_file:
-        result.to_json(json_file)
+        from powertrain.provenance import provenance
+        write_json(json_file, result.to_json(),
+                   provenance(engine, engine_file=engine_file or DEFAULT_ENGINE_PATH))
         written.append(json_file)
     if plot:
         result.plot(plot)

@@ -39,6 +39,7 @@ from pathlib import Path
 
 import numpy as np
 
+from powertrain.data import default_engine_path
 from powertrain.errors import InputError
 from powertrain.iotools.mount_file import read_mount
 from powertrain.iotools.tomlfile import get, number, quantity, read_toml
@@ -46,23 +47,8 @@ from powertrain.models import engine as em
 from powertrain.models.mount import MountModel
 from powertrain.units import to_si
 
-
-def _find_default_engine() -> Path:
-    """``engines/default.toml`` of the source tree this package was installed from.
-
-    The package lives in ``<repo>/src/powertrain`` (editable install); walk up from this file
-    to the first folder holding ``engines/default.toml`` next to ``pyproject.toml``.
-    """
-    here = Path(__file__).resolve()
-    for parent in here.parents:
-        candidate = parent / "engines" / "default.toml"
-        if candidate.is_file() and (parent / "pyproject.toml").is_file():
-            return candidate
-    return here.parents[3] / "engines" / "default.toml"
-
-
-#: The shipped default engine, ``<repo>/engines/default.toml``.
-DEFAULT_ENGINE_PATH: Path = _find_default_engine()
+#: The shipped default engine (package data, see :mod:`powertrain.data`).
+DEFAULT_ENGINE_PATH: Path = default_engine_path()
 
 #: Mount names of the default engine (any names are accepted; at least three mounts).
 DEFAULT_MOUNT_NAMES = ("left", "right", "gearbox")
