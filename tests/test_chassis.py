@@ -226,3 +226,63 @@ def test_whatif_objective_on_the_body_side(tmp_path):
     bad = CliRunner().invoke(main, ["whatif", "--engine", str(MODAL), "--scale",
                                     "left.z.stiffness=0.8", "--objective", "seat.z:order_2:1-2"])
     assert bad.exit_code == 1 and "--objective" in bad.output
+
+
+def test_uff58_receptances_read_like_csv(tmp_path, engine):
+    """Oracle: the same receptances written as UFF 58 (pyuff, another file path) couple to
+    the same result as the modal body (ASCII UFF keeps ~6 significant digits: 1e-4)."""
+    import pyuff
+    rpm = np.array([2500.0])
+    f = np.unique(np.outer(rpm / 60.0, np.arange(1, 17) / 2.0).ravel())
+    f = np.concatenate([[0.5 * f[0]], f, [2 * f[-1]]])
+    ch = engine.chassis
+    sets = []
+    for r in engine.mount_names + list(ch.points):
+        for e in engine.mount_names:
+            H = np.array([ch.modal_receptance(2 * np.pi * fi, [r], [e]) for fi in f])
+            for a in range(3):
+                for b in range(3):
+                    sets.append(pyuff.prepare_58(
+                        binary=0, func_type=4, rsp_ent_name=r, rsp_node=1, rsp_dir=a + 1,
+                        ref_ent_name=e, ref_node=1, ref_dir=b + 1, data=H[:, a, b], x=f,
+                        id1="receptance", ord_data_type=6, abscissa_spacing=0,
+                        abscissa_spec_data_type=18, ordinate_spec_data_type=8,
+                        orddenom_spec_data_type=13, z_axis_spec_data_type=0, ver_num=0,
+                        load_case_id=0, z_axis_value=0.0))
+    pyuff.UFF(str(tmp_path / "body.uff")).write_sets(sets, mode="overwrite")
+    text = MODAL.read_text()
+    text = text[:text.index("\n[chassis]\n") + 1] + (
+        '[chassis]\nmodel = "frf"\nfrf = "body.uff"\n\n[chassis.points.seat_rail]\n')
+    text = text.replace('"../mounts/', f'"{ENGINES.parent / "mounts"}/')
+    (tmp_path / "frf.toml").write_text(text)
+    a = run_runup(engine, rpm, solver="harmonic")
+    b = run_runup(read_engine(tmp_path / "frf.toml"), rpm, solver="harmonic")
+    k = a.order_index(2.0)
+    np.testing.assert_allclose(b.velocity[..., k], a.velocity[..., k], rtol=1e-4,
+                               atol=1e-6 * np.abs(a.velocity[..., k]).max())
+
+
+@pytest.mark.parametrize("edit,key", [
+    (lambda lines: lines[:2] + lines[3:], "response"),                  # a pair loses a row
+    (lambda lines: [ln for ln in lines if "left.x,right.y" not in ln
+                    and "right.y,left.x" not in ln], "response"),       # a pair is missing
+    (lambda lines: lines[:2] + [lines[2].replace("left.x", "boot.x", 1)] + lines[3:],
+     "response"),
+    (lambda lines: lines[:2] + [lines[2].replace(",", ",nan,", 1).replace(",nan,", ",", 0)]
+     + lines[3:], None),
+], ids=["grid", "missing pair", "unknown point", "bad cell"])
+def test_bad_receptance_file(tmp_path, engine, edit, key):
+    """Oracle: the brief — bad FRF files give one error naming file (and column)."""
+    _frf_csv(engine, np.array([2000.0]), tmp_path / "body.csv")
+    lines = (tmp_path / "body.csv").read_text().splitlines()
+    (tmp_path / "body.csv").write_text("\n".join(edit(lines)) + "\n")
+    text = MODAL.read_text()
+    text = text[:text.index("\n[chassis]\n") + 1] + (
+        '[chassis]\nmodel = "frf"\nfrf = "body.csv"\n\n[chassis.points.seat_rail]\n')
+    text = text.replace('"../mounts/', f'"{ENGINES.parent / "mounts"}/')
+    (tmp_path / "frf.toml").write_text(text)
+    with pytest.raises(InputError) as info:
+        read_engine(tmp_path / "frf.toml")
+    assert info.value.file == str(tmp_path / "body.csv")
+    if key:
+        assert info.value.key in (key, "frequency_hz"), info.value.one_line()

@@ -12,9 +12,10 @@ pair of attachment-point directions (reciprocity fills H_ab from H_ba) and, for 
 point, its response to every attachment-point direction; every pair on the same frequency
 grid (strictly increasing, covering the run-up's order frequencies).
 
-UFF 58 (read with pyuff): one function per pair, receptance (function type 1 or 4 with
-ordinate displacement/force) in m/N; nodes named ``NAME`` through the record's
-``rsp_entity_name``/``ref_entity_name``, directions 1/2/3 = x/y/z (negative = reversed).
+UFF 58 (read with pyuff): one frequency response function (function type 4) per pair,
+receptance (ordinate displacement over force) in m/N; the point is named by the record's
+response/reference entity name (``rsp_ent_name``/``ref_ent_name`` = NAME), directions 1/2/3 =
+x/y/z in engine axes (negative = reversed).
 """
 
 from __future__ import annotations
@@ -103,10 +104,16 @@ def _read_uff(path, names):
         if s.get("type") != 58:
             continue
         key = f"dataset {k + 1}"
-        r = _channel(f"{s.get('rsp_entity_name', '')}.{'xyz'[abs(int(s['rsp_dir'])) - 1]}",
-                     names, path, None, f"{key} rsp_entity_name")
-        e = _channel(f"{s.get('ref_entity_name', '')}.{'xyz'[abs(int(s['ref_dir'])) - 1]}",
-                     names, path, None, f"{key} ref_entity_name")
+        if int(s.get("func_type", 4)) not in (0, 4):
+            raise InputError(f"function type {s.get('func_type')} is not a frequency response "
+                             "function (4)", file=path, key=f"{key} func_type")
+        if int(s.get("ordinate_spec_data_type", 8)) in (11, 12):
+            raise InputError("expected receptance (displacement/force), got mobility or "
+                             "accelerance", file=path, key=f"{key} ordinate_spec_data_type")
+        r = _channel(f"{s.get('rsp_ent_name', '')}.{'xyz'[abs(int(s['rsp_dir'])) - 1]}",
+                     names, path, None, f"{key} rsp_ent_name")
+        e = _channel(f"{s.get('ref_ent_name', '')}.{'xyz'[abs(int(s['ref_dir'])) - 1]}",
+                     names, path, None, f"{key} ref_ent_name")
         sign = np.sign(int(s["rsp_dir"])) * np.sign(int(s["ref_dir"]))
         f = np.asarray(s["x"], float)
         h = sign * np.asarray(s["data"], complex)
