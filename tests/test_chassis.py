@@ -286,3 +286,21 @@ def test_bad_receptance_file(tmp_path, engine, edit, key):
     assert info.value.file == str(tmp_path / "body.csv")
     if key:
         assert info.value.key in (key, "frequency_hz"), info.value.one_line()
+
+
+def test_paths_of_a_rotated_mount_sum_to_the_point_response():
+    """Oracle: superposition, with a mount whose local axes are turned (the torque rod,
+    Euler angles): contributions along local axes still add up to the point velocity."""
+    from powertrain.models.chassis import BodyMode, Chassis
+    e = read_engine(ENGINES / "default-torque-rod.toml")
+    rng = np.random.default_rng(5)
+    names = e.mount_names + ["seat_rail"]
+    body = Chassis(model="modal", points=("seat_rail",), modes=tuple(
+        BodyMode(f, 0.03, 20.0, {n: rng.normal(size=3) for n in names})
+        for f in (30.0, 55.0, 90.0)))
+    res = run_runup(e.replace(chassis=body), [2000.0, 3000.0], solver="harmonic")
+    for d in "xyz":
+        pc = res.path_contributions("seat_rail", d, 2.0)
+        total = res.velocity[:, res.channel_index("seat_rail", d), res.order_index(2.0)]
+        np.testing.assert_allclose(pc.sum(axis=1), total, rtol=1e-9)
+    assert len(res.paths) == 12 and ("torque_rod", "x") in res.paths

@@ -311,10 +311,9 @@ def path_contributions(system, rpm, force) -> np.ndarray:
     out = np.zeros((len(rpm), 3 * len(ch.points), n_a, ORDERS.size), complex)
     from scipy.linalg import block_diag
     E = block_diag(*system.mount_axes)          # column p: local axis of path p, at its mount
-    for i, n_rpm in enumerate(rpm):
-        for k, order in enumerate(ORDERS):
-            w = order * n_rpm * 2 * np.pi / 60.0
-            G = ch.receptance_at(w, list(ch.points), mounts)           # (3 n_p, 3 n_m)
-            f_local = E.T @ force[i, :n_a, k]
-            out[i, :, :, k] = 1j * w * (G @ E) * f_local[None, :]
+    w = np.outer(np.asarray(rpm, float) * 2 * np.pi / 60.0, ORDERS)      # (n_rpm, n_orders)
+    G = ch.receptances(w, list(ch.points), mounts).reshape(w.shape + (3 * len(ch.points), n_a))
+    GE = G @ E                                                     # (n_rpm, n_o, 3 n_p, n_a)
+    f_local = np.einsum("ap,ika->ikp", E, np.moveaxis(force[:, :n_a, :], 1, 2))   # e_p . f
+    out[:] = np.moveaxis(1j * w[..., None, None] * GE * f_local[:, :, None, :], 1, 3)
     return out

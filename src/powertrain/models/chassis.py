@@ -124,6 +124,21 @@ class Chassis:
                       for m in self.modes])
         return (P / d[None, :]) @ Q.T
 
+    def receptances(self, omegas, responses, excitations) -> np.ndarray:
+        """Receptance matrices (n_omega, 3 n_resp, 3 n_exc) [m/N] at every ``omegas``
+        [rad/s] (vectorised for the modal body)."""
+        omegas = np.asarray(omegas, float).ravel()
+        if self.model != "modal":
+            return np.array([self.receptance_at(w, responses, excitations) for w in omegas])
+        P = np.vstack([self.shape_matrix(r) for r in responses])        # (3 nr, k)
+        Q = np.vstack([self.shape_matrix(e) for e in excitations])      # (3 ne, k)
+        wk = np.array([m.omega for m in self.modes])
+        mk = np.array([m.modal_mass for m in self.modes])
+        zk = np.array([m.damping_ratio for m in self.modes])
+        w = omegas[:, None]
+        d = mk * (wk**2 - w**2 + 2j * zk * wk * w)                       # (n_w, k)
+        return np.einsum("ik,wk,jk->wij", P, 1.0 / d, Q)
+
     def receptance_at(self, omega, responses, excitations) -> np.ndarray:
         """Receptance matrix [m/N] of the body (modal or measured) at ``omega`` [rad/s]."""
         if self.model == "modal":
