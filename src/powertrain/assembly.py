@@ -23,6 +23,20 @@ from powertrain.physics.mount_network import ground_force_rows
 from powertrain.physics.rigid_body import direction_row, point_motion_matrix, rigid_body_mass_matrix
 
 DIRECTIONS = ("x", "y", "z")
+#: Suffix of the body-side (passive) channel of a mount: ``left/passive``.
+PASSIVE = "/passive"
+
+
+def passive_name(mount: str) -> str:
+    """Channel name of the body side of ``mount``."""
+    return f"{mount}{PASSIVE}"
+
+
+def split_side(name: str):
+    """``("left", "passive")`` for ``left/passive``, ``(name, "active")`` otherwise."""
+    if name.endswith(PASSIVE):
+        return name[:-len(PASSIVE)], "passive"
+    return name, "active"
 
 
 @dataclass
@@ -77,7 +91,6 @@ class AssembledSystem:
     def add_body_side(self, chassis, mount_names, body0):
         """Append the body-side channels of every mount (``NAME/passive``) and of the body
         points of interest; their force rows are the mount's transmitted force (points: 0)."""
-        from powertrain.models.chassis import passive_name
         self.chassis = chassis
         self.body_start = body0
         self.mount_names = list(mount_names)

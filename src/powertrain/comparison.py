@@ -245,13 +245,19 @@ class ComparisonResult:
                          f"{s['frfsm']:.3f}", int(c.at_floor.sum()), int(c.outside.sum())])
         return _format_table(header, rows)
 
-    def plot(self, path=None, quantities=EXPECTED_QUANTITIES):
-        """Measured vs simulated curves, gap shaded (thesis layout, Figs 45-71).
+    def plot(self, ax=None, *, path=None, quantities=None, channel=None, quantity=None,
+             provenance=None):
+        """Measured vs simulated curves, gap shaded (thesis layout, Figs 45-71); every
+        measured quantity is drawn unless ``quantities`` says otherwise. Returns the figure.
 
         See :func:`powertrain.plotting.plot_comparison`.
         """
         from powertrain.plotting import plot_comparison
-        return plot_comparison(self, path, quantities)
+        from powertrain.plotting.style import target_and_path
+        ax, path = target_and_path(ax, path)
+        return plot_comparison(self, path, quantities, ax=ax, channel=channel,
+                               quantity=quantity,
+                               provenance=provenance or getattr(self, "provenance", None))
 
 
 def compare_runup(simulated, measured: MeasuredRunup, *, noise_floor=DEFAULT_NOISE_FLOOR,
@@ -275,7 +281,8 @@ def compare_runup(simulated, measured: MeasuredRunup, *, noise_floor=DEFAULT_NOI
     ComparisonResult
     """
     if not isinstance(simulated, MeasuredRunup):
-        simulated = MeasuredRunup.from_result(simulated, source="simulation")
+        simulated = MeasuredRunup.from_result(simulated, source="simulation",
+                                              signal=measured.signal)
     if not (np.isfinite(noise_floor) and noise_floor >= 0):
         raise ValueError("noise floor must be finite and >= 0")
     channel_order = list(simulated.channels)

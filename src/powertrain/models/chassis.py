@@ -22,21 +22,9 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from powertrain.assembly import PASSIVE, passive_name, split_side  # noqa: F401 (re-export)
+
 MODELS = ("rigid", "modal", "frf")
-#: Suffix of the body-side (passive) channel of a mount: ``left/passive``.
-PASSIVE = "/passive"
-
-
-def passive_name(mount: str) -> str:
-    """Channel name of the body side of ``mount``."""
-    return f"{mount}{PASSIVE}"
-
-
-def split_side(name: str):
-    """``("left", "passive")`` for ``left/passive``, ``(name, "active")`` otherwise."""
-    if name.endswith(PASSIVE):
-        return name[:-len(PASSIVE)], "passive"
-    return name, "active"
 
 
 @dataclass(frozen=True, eq=False)
