@@ -23,6 +23,7 @@ from __future__ import annotations
 
 import json
 from dataclasses import dataclass, field
+from typing import ClassVar
 
 import numpy as np
 
@@ -141,6 +142,17 @@ class ComparisonResult:
     sim_rpm : ndarray
         Simulated speeds [rpm].
     """
+
+    #: Quantities every comparison reports (plots draw them even when none was measured).
+    EXPECTED_QUANTITIES: ClassVar[tuple] = EXPECTED_QUANTITIES
+
+    def requested_quantities(self) -> list:
+        """Every quantity requested: the default three and all measured or compared ones,
+        in the measured-file order (synthesis first, then orders ascending)."""
+        qs = set(EXPECTED_QUANTITIES) | set(self.measured.quantities)
+        qs |= {c.quantity for c in self.channels}
+        return sorted(qs, key=quantity_sort_key)
+
 
     channels: list
     per_rpm: list

@@ -12,11 +12,7 @@ from powertrain.plotting.style import figure_legend, finish, no_data, quantity_l
 
 def comparison_quantities(comparison) -> list:
     """Every quantity requested: the default three and all measured or compared ones."""
-    from powertrain.comparison import EXPECTED_QUANTITIES
-    from powertrain.iotools.measured import quantity_sort_key
-    qs = set(EXPECTED_QUANTITIES) | set(comparison.measured.quantities)
-    qs |= {c.quantity for c in comparison.channels}
-    return sorted(qs, key=quantity_sort_key)
+    return comparison.requested_quantities()
 
 
 def plot_comparison(comparison, path=None, quantities=None, *, ax=None, channel=None,

@@ -24,12 +24,11 @@ GAP_OUTLINE_DB = 3.0
 
 
 def _censored(diagnosis):
-    """Measured points below the censoring limit (``CENSOR_MARGIN`` × noise floor)."""
-    import powertrain.diagnosis as dg
+    """Measured points at the noise floor (the one rule, :mod:`powertrain.analysis.noise_floor`)
+    and the rule's margin."""
+    from powertrain.analysis.noise_floor import NOISE_FLOOR_MARGIN, at_floor
     d = diagnosis.data
-    margin = getattr(dg, "CENSOR_MARGIN", 3.0)
-    with np.errstate(invalid="ignore"):
-        return np.isfinite(d.level) & (d.level < margin * d.floor), margin
+    return np.isfinite(d.level) & at_floor(d.level, d.floor), NOISE_FLOOR_MARGIN
 
 
 def plot_gap_map(diagnosis, path=None, *, ax=None, quantity=None, provenance=None):
