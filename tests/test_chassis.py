@@ -198,8 +198,10 @@ def test_cli_runup_modal_body_and_modes(tmp_path):
     runner = CliRunner()
     res = runner.invoke(main, ["runup", "--engine", str(MODAL), "--from", "2000", "--to",
                                "3000", "--step", "1000", "--quiet", "--out",
-                               str(tmp_path / "r.h5"), "--plot", str(tmp_path / "r.png")])
+                               str(tmp_path / "r.h5"), "--plot", str(tmp_path / "r.png"),
+                               "--path-plot", str(tmp_path / "p.png")])
     assert res.exit_code == 0, res.output
+    assert (tmp_path / "r.png").stat().st_size > 0 and (tmp_path / "p.png").stat().st_size > 0
     res = runner.invoke(main, ["modes", "--engine", str(MODAL)])
     assert res.exit_code == 0, res.output
     assert "(chassis)" in res.output

@@ -113,14 +113,16 @@ def runup(rpm_from, rpm_to, rpm_step, engine_file, solver, stepper, angle_step, 
     if csv_file:
         result.to_csv(csv_file)
         written.append(csv_file)
-    if plot:
+    if plot or path_plot:
         from powertrain.cli.common import cli_provenance, engine_description, write_plot
         fig_prov = cli_provenance(engine_description(engine, engine_path, no_balancers=no_balancers,
                                                  effects=effect))
+    if plot:
         write_plot(lambda p: result.plot(path=p, provenance=fig_prov), plot)
         written.append(plot)
     if path_plot:
-        result.plot_paths(path_plot, path_order)
+        write_plot(lambda p: result.plot_paths(path=p, order=path_order, provenance=fig_prov),
+                   path_plot)
         written.append(path_plot)
     if quiet:
         return
