@@ -124,6 +124,18 @@ def test_modes_figure(tmp_path, monkeypatch, saved, args):
     _assert_clean(saved, ["modes.png"], "modes")
 
 
+def test_track_figures(tmp_path, monkeypatch, saved):
+    from powertrain import signals
+    from powertrain.iotools.raw_csv import write_raw_csv
+    write_raw_csv(tmp_path / "sweep.csv",
+                  signals.analytic_sweep(duration=4.0, rpm0=1500.0, rpm1=4500.0),
+                  comment="SYNTHETIC: analytic sweep")
+    run(tmp_path, monkeypatch, "track", "sweep.csv", "--quantity", "acceleration",
+        "--orders", "0.5:8:0.5", "--quiet", "--plot", "orders.png", "--map", "maps.png")
+    _assert_clean(saved, ["orders.png"], "track", panel_legends=False)
+    _assert_clean(saved, ["maps.png"], "track")
+
+
 # --------------------------------------------------------------------------- checker
 def test_the_checker_finds_overlap_and_overflow():
     import matplotlib.pyplot as plt
