@@ -82,6 +82,12 @@ def test_runup_and_compare_figures(tmp_path, monkeypatch, saved):
     _assert_clean(saved, ["compare.png"], "compare", panel_legends=False)
 
 
+def test_runup_sweep_figure(tmp_path, monkeypatch, saved):
+    run(tmp_path, monkeypatch, "runup", "--from", "2000", "--to", "3000", "--sweep", "500",
+        "--sample-rate", "4096", "--plot", "sweep.png", "--quiet")
+    _assert_clean(saved, ["sweep.png"], "runup", panel_legends=False)
+
+
 def test_whatif_figures(tmp_path, monkeypatch, saved):
     run(tmp_path, monkeypatch, "whatif", "--variants", VARIANTS, "--measured", MEASURED,
         "--from", "1000", "--to", "3000", "--step", "1000", "--workers", "1", "--quiet",
