@@ -115,8 +115,8 @@ def test_assurance_criteria_closed_form():
     assert cm.frfsm_score(np.zeros(4)) == 1.0
 
 
-def test_noise_floor_mask_is_within_6_db_of_the_floor():
-    v = np.array([0.0, 0.5, 1.0, 1.99, 2.0, 5.0])
+def test_noise_floor_mask_is_within_9_5_db_of_the_floor():
+    v = np.array([0.0, 0.5, 1.0, 2.99, 3.0, 5.0])
     assert cm.noise_floor_mask(v, 1.0).tolist() == [True, True, True, True, False, False]
 
 

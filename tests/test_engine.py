@@ -258,7 +258,7 @@ BAD_FILES = [
     ("missing mount file", "../mounts/elastomeric-gearbox-mount-y.toml",
      "../mounts/no-such-mount.toml", "mounts.gearbox.files.y"),
     ("unknown key", "cylinders = 4", "cylinders = 4\nbore_mm = 82.5", "crank_train.bore_mm"),
-    ("wrong mount name", "[mounts.gearbox]", "[mounts.rear]", "mounts.rear"),
+    ("bad mount name", "[mounts.gearbox]", '[mounts."rear.tail"]', "mounts.rear.tail"),
     ("bad firing order", "firing_order = [1, 3, 4, 2]", "firing_order = [1, 3, 3, 2]",
      "crank_train.firing_order"),
     ("wrong dimension", 'stroke = {value = 84.2, unit = "mm"}',

@@ -1,16 +1,16 @@
-r"""Assembly of the powertrain model: a 6-DOF rigid body on nine mount networks.
+r"""Assembly of the powertrain model: a 6-DOF rigid body on its mounts' networks (three per mount).
 
 Each mount has a position (its engine-side point, which is also the measurement point) and a
 rotation whose columns are the mount's local x, y, z axes in engine axes. In each local
 direction a lumped network (e.g. the triple mass oscillator) joins the engine-side point to
 the rigid ground. The engine-side node of the network moves with the body along that
 direction, :math:`x_E = \mathbf e\cdot(\mathbf u + \boldsymbol\theta\times\mathbf r)`, and its
-internal masses are extra degrees of freedom (27 for nine triple mass oscillators). With the
-map :math:`\mathbf L` from global coordinates to network nodes, every network adds
+internal masses are extra degrees of freedom (27 for the default engine's nine triple mass
+oscillators). With the map :math:`\mathbf L` from global coordinates to network nodes, every network adds
 :math:`\mathbf L^T\mathbf K_n\mathbf L` (and likewise C, M) to the global matrices.
 
-Outputs are linear maps of the state: the velocity of each mount point in engine X/Y/Z (nine
-channels) and the force each mount transmits to ground, in engine axes.
+Outputs are linear maps of the state: the velocity of each mount point in engine X/Y/Z (three
+channels per mount) and the force each mount transmits to ground, in engine axes.
 """
 
 from __future__ import annotations
@@ -34,10 +34,10 @@ class AssembledSystem:
     M, C, K : ndarray (n, n)
         Global matrices; the first six coordinates are the rigid body (SI).
     channels : list of (mount, direction)
-        The nine output channels (engine axes).
-    channel_matrix : ndarray (9, n)
+        Output channels, three per mount (engine axes).
+    channel_matrix : ndarray (3 n_mounts, n)
         Maps q (or q', q'') to the motion of the mount points in engine X/Y/Z.
-    force_matrix_k, force_matrix_d : ndarray (9, n)
+    force_matrix_k, force_matrix_d : ndarray (3 n_mounts, n)
         Force transmitted by each mount to ground in engine axes:
         F = force_matrix_k @ q + force_matrix_d @ q'.
     dof_labels : list of str
@@ -69,18 +69,20 @@ class AssembledSystem:
         """Static solution K q = B f for a constant 6-vector load [N, N·m]."""
         return np.linalg.solve(self.K, self.load_matrix() @ np.asarray(load6, float))
 
+    def static_stiffness_6(self) -> np.ndarray:
+        """6×6 static stiffness of the body on its mounts, internal nodes condensed
+        statically [N/m, N, N·m/rad]."""
+        K = self.K
+        if self.n_dof == 6:
+            return K[:6, :6].copy()
+        Kbb, Kbi, Kii = K[:6, :6], K[:6, 6:], K[6:, 6:]
+        return Kbb - Kbi @ np.linalg.solve(Kii, Kbi.T)
+
     def rigid_body_modes(self):
         """Natural frequencies [Hz] and mode shapes of the 6-DOF body on the mounts'
         static (0 Hz) cross-point stiffness, internal masses condensed statically."""
         import scipy.linalg as sla
-        K = self.K
-        n = self.n_dof
-        if n > 6:
-            Kbb, Kbi, Kii = K[:6, :6], K[:6, 6:], K[6:, 6:]
-            Kr = Kbb - Kbi @ np.linalg.solve(Kii, Kbi.T)
-        else:
-            Kr = K
-        w2, vec = sla.eigh(Kr, self.M[:6, :6])
+        w2, vec = sla.eigh(self.static_stiffness_6(), self.M[:6, :6])
         return np.sqrt(np.clip(w2, 0, None)) / (2 * np.pi), vec
 
 

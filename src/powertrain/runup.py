@@ -23,6 +23,7 @@ import numpy as np
 from powertrain.analysis.fourier import harmonic_amplitudes
 from powertrain.analysis.orders import ORDERS, order_spectrum
 from powertrain.assembly import assemble
+from powertrain.progress import progress_bar
 from powertrain.results import RunupResult
 from powertrain.solvers.harmonic import harmonic_response
 from powertrain.solvers.newmark import ModalNewmark, newmark
@@ -133,9 +134,7 @@ def _run_runup(engine, rpm=None, *, solver="newmark", angle_step_deg=ANGLE_STEP_
     force = np.zeros(shape, complex)
     mean_force = np.zeros((rpm.size, n_ch))
     periodicity = np.zeros(rpm.size)
-    if progress:
-        from tqdm import tqdm
-        bar = {"desc": f"run-up ({solver})", "unit": "speed", "leave": False}
+    bar = {"desc": f"run-up ({solver})", "unit": "speed", "enabled": bool(progress)}
     loads = [_cycle_load(engine, n_rpm, n_cycle) for n_rpm in rpm]
     timings = np.zeros(rpm.size)
     modal = None
@@ -231,10 +230,10 @@ def _run_runup(engine, rpm=None, *, solver="newmark", angle_step_deg=ANGLE_STEP_
         from concurrent.futures import ThreadPoolExecutor
         with ThreadPoolExecutor(max_workers=workers) as pool:
             futures = [pool.submit(solve_speed, i) for i in range(rpm.size)]
-            for fut in (tqdm(futures, **bar) if progress else futures):
+            for fut in progress_bar(futures, **bar):
                 fut.result()
     else:
-        for i in (tqdm(range(rpm.size), **bar) if progress else range(rpm.size)):
+        for i in progress_bar(range(rpm.size), **bar):
             solve_speed(i)
     wall = time.perf_counter() - wall0
     # solver time: summed per-speed solver times (serial); wall-clock if run concurrently

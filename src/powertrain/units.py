@@ -47,6 +47,7 @@ UNITS: dict[str, tuple[str, float]] = {
     # rotational speed
     "rad/s": ("angular_speed", 1.0),
     "rpm": ("angular_speed", 2.0 * math.pi / 60.0),
+    "1/min": ("angular_speed", 2.0 * math.pi / 60.0),
     # moment of inertia
     "kg*m^2": ("inertia", 1.0),
     "kg*mm^2": ("inertia", 1e-6),
@@ -57,6 +58,18 @@ UNITS: dict[str, tuple[str, float]] = {
     # torque / moment
     "N*m": ("torque", 1.0),
     "Nm": ("torque", 1.0),
+    # velocity, acceleration (vibration transducers)
+    "m/s": ("velocity", 1.0),
+    "mm/s": ("velocity", 1e-3),
+    "m/s^2": ("acceleration", 1.0),
+    "m/s2": ("acceleration", 1.0),
+    "mm/s^2": ("acceleration", 1e-3),
+    # displacement also accepts micrometres
+    "um": ("length", 1e-6),
+    "µm": ("length", 1e-6),
+    # electric potential (tacho pulse trains)
+    "V": ("voltage", 1.0),
+    "mV": ("voltage", 1e-3),
     # force
     "N": ("force", 1.0),
     "kN": ("force", 1e3),
@@ -75,6 +88,26 @@ UNITS: dict[str, tuple[str, float]] = {
     "-": ("dimensionless", 1.0),
     "%": ("dimensionless", 1e-2),
 }
+
+#: Standard gravity [m/s^2] (CGPM 1901), the ``g`` of accelerometer data.
+STANDARD_GRAVITY = 9.80665
+
+#: Symbols whose meaning depends on the dimension expected: ``g`` is a gram where a mass is
+#: expected and standard gravity where an acceleration is expected.
+UNITS_BY_DIMENSION: dict[tuple[str, str], float] = {
+    ("g", "acceleration"): STANDARD_GRAVITY,
+}
+
+
+def dimension_of(unit: str, candidates=None):
+    """Dimension of ``unit``, preferring one of ``candidates`` for ambiguous symbols (``g``).
+
+    Returns None for an unknown unit.
+    """
+    for cand in candidates or ():
+        if (unit, cand) in UNITS_BY_DIMENSION or UNITS.get(unit, ("",))[0] == cand:
+            return cand
+    return UNITS[unit][0] if unit in UNITS else None
 
 
 def to_si(value, unit: str, dimension: str, *, file=None, key=None):
@@ -101,8 +134,11 @@ def to_si(value, unit: str, dimension: str, *, file=None, key=None):
     InputError
         Unknown unit or unit of the wrong dimension.
     """
+    if isinstance(unit, str) and (unit, dimension) in UNITS_BY_DIMENSION:
+        return value * UNITS_BY_DIMENSION[(unit, dimension)]
     if not isinstance(unit, str) or unit not in UNITS:
-        known = ", ".join(u for u, (dim, _) in UNITS.items() if dim == dimension)
+        known = ", ".join([u for u, (dim, _) in UNITS.items() if dim == dimension]
+                          + [u for u, dim in UNITS_BY_DIMENSION if dim == dimension])
         raise InputError(f"unknown unit {unit!r} (expected one of: {known})", file=file, key=key)
     dim, factor = UNITS[unit]
     if dim != dimension:
@@ -110,8 +146,10 @@ def to_si(value, unit: str, dimension: str, *, file=None, key=None):
     return value * factor
 
 
-def from_si(value, unit: str):
+def from_si(value, unit: str, dimension: str | None = None):
     """Convert an SI value to ``unit`` (for writing datasheet-unit files and tables)."""
+    if (unit, dimension) in UNITS_BY_DIMENSION:
+        return value / UNITS_BY_DIMENSION[(unit, dimension)]
     if unit not in UNITS:
         raise InputError(f"unknown unit {unit!r}")
     return value / UNITS[unit][1]

@@ -19,7 +19,7 @@ With positive magnitudes FRAC is rarely far below 1 (two flat curves give 1 even
 10× higher), so read it with the dB gap, never alone.
 
 CSAC and CSF (cross-signature assurance and scale factors), at each speed, summed over the
-channels :math:`j` (the nine mount × direction channels) [3]_:
+channels :math:`j` (every mount × direction channel) [3]_:
 
 .. math:: \mathrm{CSAC}(n) = \frac{\left(\sum_j s_{nj} m_{nj}\right)^2}
                                   {\sum_j s_{nj}^2\,\sum_j m_{nj}^2},\qquad
@@ -58,12 +58,10 @@ from __future__ import annotations
 
 import numpy as np
 
+from powertrain.analysis.noise_floor import NOISE_FLOOR_MARGIN  # the one noise-floor rule
+
 #: Standard deviation of the Gaussian kernel of :func:`frfsm_score` [dB].
 FRFSM_SIGMA_DB = 6.0
-#: A measured point counts as "at or near the noise floor" below this factor times the
-#: floor: 6 dB above it, uncorrelated noise as large as the floor inflates an RMS reading by
-#: 20 log10(sqrt(1 + 1/4)) = 0.97 dB, about the measurement's own scatter.
-NOISE_FLOOR_MARGIN = 2.0
 
 
 def interpolate_log(rpm, level, rpm_new):
@@ -264,8 +262,8 @@ def noise_floor_mask(measured, noise_floor, margin=NOISE_FLOOR_MARGIN):
     r"""True where a measured level is at or near the noise floor (not to be scored).
 
     A level counts as near the floor when
-    :math:`v_\mathrm{meas} < \text{margin}\cdot v_\mathrm{floor}` (default margin 2, i.e.
-    within 6 dB of the floor).
+    :math:`v_\mathrm{meas} < \text{margin}\cdot v_\mathrm{floor}` (default: the one rule of
+    :mod:`powertrain.analysis.noise_floor`, margin 3, i.e. within 9.5 dB of the floor).
 
     Parameters
     ----------

@@ -14,15 +14,31 @@ from powertrain import __version__
 
 
 class _Group(click.Group):
-    """Turns :class:`powertrain.errors.InputError` into one line on stderr and exit code 1."""
+    """Turns :class:`powertrain.errors.InputError` into one line on stderr and exit code 1.
+
+    A command that fails removes the output files it had already written (no leftovers).
+    """
+
+    def main(self, args=None, *posargs, **kwargs):
+        from powertrain import provenance
+        provenance.COMMAND_LINE[:] = ["powertrain",
+                                      *(sys.argv[1:] if args is None else list(args))]
+        return super().main(args, *posargs, **kwargs)
 
     def invoke(self, ctx):
         from powertrain.errors import InputError
+        from powertrain.iotools.atomic import discard_written, start_tracking
+        start_tracking()
         try:
             return super().invoke(ctx)
         except InputError as exc:
+            discard_written()
             click.echo(f"error: {exc.one_line()}", err=True)
             sys.exit(1)
+        except BaseException as exc:
+            if getattr(exc, "exit_code", getattr(exc, "code", 1)):  # not a clean exit
+                discard_written()
+            raise
 
 
 @click.group(cls=_Group, context_settings={"help_option_names": ["-h", "--help"]})
@@ -38,6 +54,8 @@ def main():
       powertrain compare examples/measured-runup.csv --plot compare.png --json compare.json
       powertrain whatif --scale left.z.stiffness=1.2 --json whatif.json
       powertrain diagnose examples/measured-runup.csv --report diagnosis/
+      powertrain modes --engine engines/default-torque-rod.toml --json modes.json
+      powertrain track run.csv --csv tracked.csv --plot orders.png
     """
 
 
@@ -48,8 +66,10 @@ def _register():
         diagnose,
         excitation,
         fit_mount,
+        modes,
         runup,
         stiffness,
+        track,
         whatif,
     )
 

@@ -24,7 +24,9 @@ from powertrain.cli import main
 @click.option("--effects", "effects", default="",
               help="Comma-separated candidates (default: all of the library).")
 @click.option("--no-pairs", is_flag=True, help="Do not try pairs of effects.")
-def diagnose(measured, engine_file, report_dir, json_file, noise_floor, effects, no_pairs):
+@click.option("--quiet", is_flag=True, help="No progress indicator on stderr.")
+def diagnose(measured, engine_file, report_dir, json_file, noise_floor, effects, no_pairs,
+             quiet):
     """Diagnose the gap between the simulated and a measured run-up.
 
     1. Where: the gap map per channel, quantity and speed, the regions beyond +-3 dB and
@@ -42,6 +44,7 @@ def diagnose(measured, engine_file, report_dir, json_file, noise_floor, effects,
       powertrain diagnose case.csv --report out/diag --json out/diag.json
     """
     import math
+    from pathlib import Path
 
     from powertrain.diagnosis import diagnose as run
     from powertrain.effects import EFFECTS
@@ -56,16 +59,31 @@ def diagnose(measured, engine_file, report_dir, json_file, noise_floor, effects,
         if e not in EFFECTS:
             raise InputError(f"unknown effect {e!r} (known: {', '.join(EFFECTS)})",
                              key="--effects")
+    from powertrain.cli.common import check_outputs, write_json
+    from powertrain.progress import activity
+    check_outputs(json=json_file)
+    if report_dir:
+        from powertrain.iotools.atomic import check_writable
+        check_writable(Path(report_dir) / "summary.txt", key="--report")
     engine = read_engine(engine_file or str(DEFAULT_ENGINE_PATH))
     meas = read_measured(measured, mounts=engine.mount_names)
-    res = run(meas, engine, noise_floor=noise_floor * 1e-3, effects=names,
-              pairs=not no_pairs)
+    if meas.signal != "velocity":
+        raise InputError("diagnose needs velocity, acceleration or displacement order curves "
+                         f"(this file holds {meas.signal})", file=measured)
+    with activity("diagnose (fitting the effect library)", enabled=not quiet):
+        res = run(meas, engine, noise_floor=noise_floor * 1e-3, effects=names,
+                  pairs=not no_pairs)
     click.echo(res.summary())
     if json_file:
-        res.to_json(json_file)
+        from powertrain.provenance import provenance
+        write_json(json_file, res.to_json(),
+                   provenance(engine, engine_file=engine_file or DEFAULT_ENGINE_PATH))
         click.echo(f"wrote {json_file}")
     if report_dir:
-        files = res.report(report_dir)
+        from powertrain.cli.common import cli_provenance, engine_description, use_agg
+        use_agg()
+        files = res.report(report_dir, provenance=cli_provenance(
+            engine_description(engine, engine.file)))
         click.echo(f"wrote {len(files)} files to {report_dir}")
 
 
@@ -82,7 +100,8 @@ def diagnose(measured, engine_file, report_dir, json_file, noise_floor, effects,
                    "diagnosis).")
 @click.option("--engine", "engine_file", type=click.Path(dir_okay=False),
               help="Baseline engine file (default: engines/default.toml).")
-def synth(effect_names, seed, out, truth_file, engine_file):
+@click.option("--quiet", is_flag=True, help="No progress indicator on stderr.")
+def synth(effect_names, seed, out, truth_file, engine_file, quiet):
     """Make a SYNTHETIC measured run-up with hidden effects and noise (truth generator).
 
     \b
@@ -106,7 +125,13 @@ def synth(effect_names, seed, out, truth_file, engine_file):
             raise InputError(f"unknown truth effect {e!r} (known: {', '.join(TRUTH_EFFECTS)})",
                              key="--effect")
     engine = read_engine(engine_file or str(DEFAULT_ENGINE_PATH))
-    case = make_case(engine, names, seed)
+    from powertrain.cli.common import check_outputs
+    from powertrain.progress import activity
+    if not 0 <= seed < 2 ** 63:
+        raise InputError(f"must be an integer 0..2^63-1, got {seed}", key="--seed")
+    check_outputs(out=out, truth=truth_file)
+    with activity("synth (simulating the hidden truth)", enabled=not quiet):
+        case = make_case(engine, names, seed)
     with atomic_write(out) as fh:
         fh.write(case.csv_text())
     if truth_file:

@@ -22,10 +22,11 @@ from powertrain.cli.common import speed_options, speed_steps
                    "(physical coordinates); auto = modal when the mass matrix is regular.")
 @click.option("--angle-step", type=float, default=1.0, show_default=True,
               help="Crank-angle increment of the Newmark stepper [deg].")
-@click.option("--out", type=click.Path(dir_okay=False), default="runup.h5", show_default=True,
-              help="HDF5 result file.")
+@click.option("--out", type=click.Path(dir_okay=False),
+              help="Write the HDF5 result file (e.g. runup.h5); nothing is written unless "
+                   "--out, --csv or --plot is given.")
 @click.option("--csv", "csv_file", type=click.Path(dir_okay=False),
-              help="Also write the long-format CSV (mount,direction,quantity,rpm,"
+              help="Write the long-format CSV (mount,direction,quantity,rpm,"
                    "velocity_rms_mm_per_s).")
 @click.option("--plot", type=click.Path(dir_okay=False),
               help="Thesis figure set (Figs 45-71) as PNG.")
@@ -33,57 +34,94 @@ from powertrain.cli.common import speed_options, speed_steps
 @click.option("--effect", multiple=True, metavar="NAME[:PARAM=VALUE,...]",
               help="Add an unmodelled effect of the diagnosis library (as in `whatif`), e.g. "
                    "base_compliance:c_base=400N/mm,m_base=8kg. Repeatable.")
+@click.option("--sweep", type=float, metavar="RPM_PER_S",
+              help="Continuous run-up at this rate [rpm/s] (time integration of one speed "
+                   "ramp) instead of steady states; tracked like measured data.")
+@click.option("--raw", "raw_file", type=click.Path(dir_okay=False),
+              help="With --sweep: write the raw mount-point accelerations (raw HDF5 layout).")
+@click.option("--sample-rate", type=float, default=8192.0, show_default=True,
+              help="With --sweep: sampling rate of the raw data [Hz].")
 @click.option("--quiet", is_flag=True, help="No progress bar and no table.")
 def runup(rpm_from, rpm_to, rpm_step, engine_file, solver, stepper, angle_step, out, csv_file,
-          plot, no_balancers, effect, quiet):
+          plot, no_balancers, effect, sweep, raw_file, sample_rate, quiet):
     """Run-up: steady-state mount-point velocities at each speed, order analysed.
 
     Prints the rigid-body modes and the synthesis (RMS sum of orders 0.5..8) velocity of the
-    nine channels (mount × engine X/Y/Z) per speed; writes HDF5 (and CSV/PNG on request).
+    channels (every mount × engine X/Y/Z) per speed; writes HDF5, CSV and PNG only on request
+    (--out, --csv, --plot) and names the files written.
 
     \b
     Examples:
       powertrain runup --from 1000 --to 6000 --step 500
+      powertrain runup --out runup.h5 --no-balancers
       powertrain runup --solver harmonic --csv runup.csv --plot runup.png
       powertrain runup --effect amplitude_stiffness:kappa=1,a_c=0.02mm
+      powertrain runup --from 2000 --to 3000 --sweep 200 --raw sweep.h5 --csv sweep.csv
     """
-    import numpy as np
-
-    from powertrain.errors import InputError
+    from powertrain.cli.common import check_outputs, checked_runup, runup_settings
     from powertrain.iotools.engine_file import DEFAULT_ENGINE_PATH, read_engine
     from powertrain.runup import run_runup
 
     rpm = speed_steps(rpm_from, rpm_to, rpm_step)
+    check_outputs(out=out, csv=csv_file, plot=plot)
     engine_path = engine_file or DEFAULT_ENGINE_PATH
     engine = read_engine(engine_path)
+    modifications = []
     if no_balancers:
         engine = engine.with_balancers(enabled=False)
+        modifications.append("balancer shafts switched off (--no-balancers)")
+    if sweep is not None or raw_file:
+        from powertrain.cli.sweep_run import run_sweep
+        return run_sweep(engine, rpm_from, rpm_to, sweep, sample_rate, raw_file, out, csv_file,
+                         plot, effect, quiet)
     from powertrain.variants import effect_scenario, parse_operations
     scenario = effect_scenario(parse_operations({"effect": effect}))
-    try:
-        if scenario:
-            from powertrain.effects import runup_with_effects
-            result = runup_with_effects(engine, rpm, scenario, solver=solver,
-                                        angle_step_deg=angle_step, stepper=stepper)
-        else:
-            result = run_runup(engine, rpm, solver=solver, angle_step_deg=angle_step,
-                               progress=not quiet, stepper=stepper)
-    except ValueError as exc:
-        raise InputError(str(exc), key="--angle-step") from None
-    from pathlib import Path
-    snapshot = Path(engine_path).read_text(encoding="utf-8")
-    mounts = {f"{m.name}.{a}": {"model": mdl.topology.name, "params_si": mdl.params,
-                                 "source": mdl.source}
-              for m in engine.mounts for a, mdl in m.directions.items()}
-    import json
-    result.to_hdf5(out, engine_snapshot=snapshot, mount_snapshots={"mounts": json.dumps(mounts)},
-                   description=f"run-up {rpm_from:g}-{rpm_to:g} rpm, {engine.name}")
+    runup_settings(engine, rpm, angle_step)
+    if scenario:
+        from powertrain.effect_runup import runup_with_effects
+        from powertrain.progress import activity
+        with activity(f"run-up with effects ({solver})", enabled=not quiet):
+            result = checked_runup(engine, engine_path, runup_with_effects, rpm, scenario,
+                                   solver=solver, angle_step_deg=angle_step, stepper=stepper)
+    else:
+        result = checked_runup(engine, engine_path, run_runup, rpm, solver=solver,
+                               angle_step_deg=angle_step, progress=not quiet,
+                               stepper=stepper)
+    written = []
+    if out:
+        from powertrain.provenance import provenance
+        prov = provenance(engine, engine_file=engine_path, modifications=modifications,
+                          effects=scenario)
+        import json
+        from pathlib import Path
+        mounts = {f"{m.name}.{a}": {"model": mdl.topology.name, "params_si": mdl.params,
+                                     "source": mdl.source}
+                  for m in engine.mounts for a, mdl in m.directions.items()}
+        result.to_hdf5(out, engine_snapshot=Path(engine_path).read_text(encoding="utf-8"),
+                       mount_snapshots={"mounts": json.dumps(mounts)}, provenance=prov,
+                       description=f"run-up {rpm_from:g}-{rpm_to:g} rpm, {engine.name}")
+        written.append(out)
     if csv_file:
         result.to_csv(csv_file)
+        written.append(csv_file)
     if plot:
-        result.plot(plot)
+        from powertrain.cli.common import cli_provenance, engine_description, write_plot
+        fig_prov = cli_provenance(engine_description(engine, engine_path, no_balancers=no_balancers,
+                                                 effects=effect))
+        write_plot(lambda p: result.plot(path=p, provenance=fig_prov), plot)
+        written.append(plot)
     if quiet:
         return
+    _print_table(result, engine, engine_path, solver, scenario)
+    click.echo(f"solver time: {result.solver_seconds:.3f} s; "
+               + (f"wrote {', '.join(map(str, written))}" if written else
+                  "no file written (ask with --out, --csv or --plot)"))
+
+
+def _print_table(result, engine, engine_path, solver, scenario):
+    """Rigid-body modes and the synthesis velocity table."""
+    import numpy as np
+
     from powertrain.cli.common import format_table
     modes = ", ".join(f"{f:.1f}" for f in result.rigid_body_modes_hz)
     click.echo(f"engine: {engine.name} ({engine_path})")
@@ -99,5 +137,3 @@ def runup(rpm_from, rpm_to, rpm_step, engine_file, solver, stepper, angle_step, 
     click.echo(format_table(header, rows, "{:.3f}"))
     if solver == "newmark":
         click.echo(f"periodicity of processed windows: max {100 * np.max(result.periodicity):.2g} %")
-    click.echo(f"solver time: {result.solver_seconds:.3f} s; wrote {out}"
-               + (f", {csv_file}" if csv_file else "") + (f", {plot}" if plot else ""))

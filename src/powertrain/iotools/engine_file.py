@@ -8,14 +8,22 @@ Layout (see ``engines/default.toml`` for a complete, commented example)::
                         crank_pin_angles, firing_order, reciprocating_mass, rotating_mass,
                         counterweight_fraction, crankcase_pressure
     [body]              mass, cg, inertia (3x3 nested list, tensor entries)
-    [mounts.left], [mounts.right], [mounts.gearbox]
-                        position, local_x, local_z, files = {x = ..., y = ..., z = ...}
-                        (mount-file paths relative to the engine file)
+    [mounts.NAME]       any number (>= 3) of named mounts, each with
+                        position; orientation as local_x + local_z, or
+                        orientation = {value = [a, b, c], unit = "deg"} (R = Rz(c) Ry(b) Rx(a));
+                        either files = {x = ..., y = ..., z = ...} (mount-file paths relative
+                        to the engine file) or an inline spring-damper per local direction,
+                        stiffness = {value = [kx, ky, kz], unit = "N/mm"} and optional
+                        damping = {value = [cx, cy, cz], unit = "N*s/mm"}
     [balancer]          enabled, speed_ratio, [[balancer.shafts]] name, mass_radius,
                         position, phase, sense (+1 with the crank, -1 against)
     [combustion]        model = "single-zone" (parameters below) or "measured"
                         (traces = "file.csv", see powertrain.iotools.pressure_csv)
     [combustion.full_load]  speed, torque, fmep (lists of equal length)
+
+Only ``[engine]``, ``[body]`` and ``[mounts.*]`` are required: without ``[crank_train]`` and
+``[combustion]`` the engine has no excitation (enough for ``modes``); commands that need one
+name the missing section. Without ``[balancer]`` the engine has no balancer shafts.
 
 All values are converted to SI here, once, through :mod:`powertrain.units`. Missing keys,
 unknown keys or units, negative masses, NaN, a non-positive-definite inertia tensor,
@@ -26,35 +34,25 @@ and the key.
 from __future__ import annotations
 
 import math
+import re
 from pathlib import Path
 
 import numpy as np
 
+from powertrain.data import default_engine_path
 from powertrain.errors import InputError
 from powertrain.iotools.mount_file import read_mount
 from powertrain.iotools.tomlfile import get, number, quantity, read_toml
 from powertrain.models import engine as em
+from powertrain.models.mount import MountModel
 from powertrain.units import to_si
 
+#: The shipped default engine (package data, see :mod:`powertrain.data`).
+DEFAULT_ENGINE_PATH: Path = default_engine_path()
 
-def _find_default_engine() -> Path:
-    """``engines/default.toml`` of the source tree this package was installed from.
-
-    The package lives in ``<repo>/src/powertrain`` (editable install); walk up from this file
-    to the first folder holding ``engines/default.toml`` next to ``pyproject.toml``.
-    """
-    here = Path(__file__).resolve()
-    for parent in here.parents:
-        candidate = parent / "engines" / "default.toml"
-        if candidate.is_file() and (parent / "pyproject.toml").is_file():
-            return candidate
-    return here.parents[3] / "engines" / "default.toml"
-
-
-#: The shipped default engine, ``<repo>/engines/default.toml``.
-DEFAULT_ENGINE_PATH: Path = _find_default_engine()
-
-MOUNT_NAMES = ("left", "right", "gearbox")
+#: Mount names of the default engine (any names are accepted; at least three mounts).
+DEFAULT_MOUNT_NAMES = ("left", "right", "gearbox")
+MIN_MOUNTS = 3
 DIRECTIONS = ("x", "y", "z")
 
 _ALLOWED = {
@@ -65,7 +63,8 @@ _ALLOWED = {
                     "crank_pin_angles", "firing_order", "reciprocating_mass", "rotating_mass",
                     "counterweight_fraction", "crankcase_pressure"},
     "body": {"mass", "cg", "inertia"},
-    "mount": {"position", "local_x", "local_z", "files"},
+    "mount": {"position", "local_x", "local_z", "orientation", "files", "stiffness",
+              "damping"},
     "balancer": {"enabled", "speed_ratio", "shafts"},
     "shaft": {"name", "mass_radius", "position", "phase", "sense"},
     "single-zone": {"model", "imep_factors", "ambient_pressure", "start", "duration",
@@ -148,7 +147,11 @@ def _unit_vector(table, key, path, prefix):
 
 
 def _q(table, key, dimension, path, prefix, **kw):
-    return float(quantity(table, key, dimension, path, prefix, **kw))
+    value = quantity(table, key, dimension, path, prefix, **kw)
+    if isinstance(value, list):
+        raise InputError("expected one number, got a list", file=path,
+                         key=f"{prefix}.{key}.value" if prefix else f"{key}.value")
+    return float(value)
 
 
 def read_engine(path=DEFAULT_ENGINE_PATH) -> em.Engine:
@@ -170,13 +173,40 @@ def read_engine(path=DEFAULT_ENGINE_PATH) -> em.Engine:
     meta = _table(doc, "engine", path)
     _check_keys(meta, _ALLOWED["engine"], path, "engine")
     name = get(meta, "name", path, "engine", types=str)
-    crank = _read_crank(_table(doc, "crank_train", path), path)
     body = _read_body(_table(doc, "body", path), path)
     mounts = _read_mounts(_table(doc, "mounts", path), path)
-    balancer = _read_balancer(_table(doc, "balancer", path), path)
-    combustion = _read_combustion(_table(doc, "combustion", path), path, crank)
-    return em.Engine(name=name, crank=crank, body=body, mounts=mounts, balancer=balancer,
-                     combustion=combustion, file=path)
+    crank = combustion = None
+    if "crank_train" in doc:
+        crank = _read_crank(_table(doc, "crank_train", path), path)
+    if "combustion" in doc:
+        if crank is None:
+            raise InputError("[combustion] needs a [crank_train] section", file=path,
+                             key="crank_train")
+        combustion = _read_combustion(_table(doc, "combustion", path), path, crank)
+    balancer = em.Balancer(enabled=False, ratio=2.0, shafts=())
+    if "balancer" in doc:
+        balancer = _read_balancer(_table(doc, "balancer", path), path)
+    _check_static_support(body, mounts, path)
+    engine = em.Engine(name=name, crank=crank, body=body, mounts=mounts, balancer=balancer,
+                       combustion=combustion, file=path)
+    from powertrain.iotools.engine_checks import check_engine
+    check_engine(engine, path)
+    return engine
+
+
+def _check_static_support(body, mounts, path):
+    """The mounts' static stiffness must hold the body in all six directions."""
+    from powertrain.assembly import assemble
+    system = assemble(body.mass, body.cg, body.inertia, mounts)
+    try:
+        kr = np.linalg.eigvalsh(system.static_stiffness_6())
+    except np.linalg.LinAlgError:
+        kr = np.zeros(1)
+    if kr.min() <= 1e-9 * max(kr.max(), 1e-300):
+        from powertrain.iotools.engine_checks import extreme_mount
+        raise InputError("the mounts' static stiffness does not hold the body in every "
+                         "direction (a rigid-body mode at 0 Hz); softest: "
+                         f"{extreme_mount(mounts)}", file=path, key="mounts")
 
 
 def _read_crank(t, path) -> em.CrankTrain:
@@ -208,8 +238,8 @@ def _read_crank(t, path) -> em.CrankTrain:
     pins = _array(t, "crank_pin_angles", "angle", path, p, (n,))
     order_raw = get(t, "firing_order", path, p, types=list)
     key_fo = f"{p}.firing_order"
-    if (sorted(order_raw) != list(range(1, n + 1))
-            or any(isinstance(c, bool) or not isinstance(c, int) for c in order_raw)):
+    if (any(isinstance(c, bool) or not isinstance(c, int) for c in order_raw)
+            or sorted(order_raw) != list(range(1, n + 1))):
         raise InputError(f"must list the cylinders 1..{n} once each, got {order_raw!r}",
                          file=path, key=key_fo)
     k1 = order_raw.index(1)
@@ -268,22 +298,68 @@ def _read_body(t, path) -> em.RigidBody:
     return em.RigidBody(mass=mass, cg=cg, inertia=inertia)
 
 
+_NAME_RE = re.compile(r"^[A-Za-z_][A-Za-z0-9_-]*$")
+
+
 def _read_mounts(t, path) -> list:
-    base = Path(path).parent
-    _check_keys(t, MOUNT_NAMES, path, "mounts")
+    """Every ``[mounts.NAME]`` table, in file order (at least :data:`MIN_MOUNTS`)."""
+    if len(t) < MIN_MOUNTS:
+        raise InputError(f"need at least {MIN_MOUNTS} mounts, got {len(t)}", file=path,
+                         key="mounts")
     mounts = []
-    for name in MOUNT_NAMES:
+    for name in t:
+        if not _NAME_RE.match(name):
+            raise InputError("mount names are letters, digits, '_' or '-' and start with a "
+                             "letter", file=path, key=f"mounts.{name}")
         p = f"mounts.{name}"
         m = get(t, name, path, "mounts", types=dict)
         _check_keys(m, _ALLOWED["mount"], path, p)
         pos = _vec3(m, "position", "length", path, p)
-        lx = _unit_vector(m, "local_x", path, p)
-        lz = _unit_vector(m, "local_z", path, p)
-        if abs(float(lx @ lz)) > 1e-6:
-            raise InputError("local_x and local_z must be perpendicular", file=path,
-                             key=f"{p}.local_z")
-        ly = np.cross(lz, lx)
-        rotation = np.column_stack([lx, ly, lz])
+        rotation = _read_orientation(m, path, p)
+        directions, paths = _read_mount_directions(m, path, p)
+        mounts.append(em.MountSpec(name=name, position=pos, rotation=rotation,
+                                   directions=directions, files=paths))
+    return mounts
+
+
+def euler_rotation(a, b, c) -> np.ndarray:
+    """Local→engine rotation R = Rz(c)·Ry(b)·Rx(a) [angles in rad]: rotations about engine X
+    by ``a``, then engine Y by ``b``, then engine Z by ``c`` (columns = local axes)."""
+    ca, sa, cb, sb, cc, sc = (math.cos(a), math.sin(a), math.cos(b), math.sin(b),
+                              math.cos(c), math.sin(c))
+    rx = np.array([[1.0, 0.0, 0.0], [0.0, ca, -sa], [0.0, sa, ca]])
+    ry = np.array([[cb, 0.0, sb], [0.0, 1.0, 0.0], [-sb, 0.0, cb]])
+    rz = np.array([[cc, -sc, 0.0], [sc, cc, 0.0], [0.0, 0.0, 1.0]])
+    return rz @ ry @ rx
+
+
+def _read_orientation(m, path, p) -> np.ndarray:
+    has_vectors = "local_x" in m or "local_z" in m
+    if "orientation" in m:
+        if has_vectors:
+            raise InputError("give either orientation or local_x/local_z, not both",
+                             file=path, key=f"{p}.orientation")
+        angles = _vec3(m, "orientation", "angle", path, p)
+        return euler_rotation(*angles)
+    if not has_vectors:
+        raise InputError("missing key (give orientation or local_x and local_z)", file=path,
+                         key=f"{p}.orientation")
+    lx = _unit_vector(m, "local_x", path, p)
+    lz = _unit_vector(m, "local_z", path, p)
+    if abs(float(lx @ lz)) > 1e-6:
+        raise InputError("local_x and local_z must be perpendicular", file=path,
+                         key=f"{p}.local_z")
+    return np.column_stack([lx, np.cross(lz, lx), lz])
+
+
+def _read_mount_directions(m, path, p):
+    """Mount model per local direction: network files, or an inline spring-damper."""
+    if "files" in m:
+        for key in ("stiffness", "damping"):
+            if key in m:
+                raise InputError("give either files or an inline stiffness/damping, not both",
+                                 file=path, key=f"{p}.{key}")
+        base = Path(path).parent
         files = get(m, "files", path, p, types=dict)
         _check_keys(files, DIRECTIONS, path, f"{p}.files")
         directions, paths = {}, {}
@@ -295,9 +371,18 @@ def _read_mounts(t, path) -> list:
                                  key=f"{p}.files.{d}")
             directions[d] = read_mount(full)
             paths[d] = str(full)
-        mounts.append(em.MountSpec(name=name, position=pos, rotation=rotation,
-                                   directions=directions, files=paths))
-    return mounts
+        return directions, paths
+    if "stiffness" not in m:
+        raise InputError("missing key (give files or an inline stiffness)", file=path,
+                         key=f"{p}.stiffness")
+    k = _array(m, "stiffness", "stiffness", path, p, (3,), nonneg=True)
+    c = (_array(m, "damping", "damping", path, p, (3,), nonneg=True) if "damping" in m
+         else np.zeros(3))
+    directions = {d: MountModel.from_values("kelvin-voigt", [k[i], c[i]],
+                                            name=f"inline spring-damper {d}",
+                                            source=f"{path}: {p}")
+                  for i, d in enumerate(DIRECTIONS)}
+    return directions, {}
 
 
 def _read_balancer(t, path) -> em.Balancer:

@@ -76,7 +76,7 @@ class MountSpec:
     Attributes
     ----------
     name : str
-        ``left``, ``right`` or ``gearbox``.
+        Any name (e.g. ``left``, ``right``, ``gearbox``, ``torque_rod``).
     position : ndarray, shape (3,)
         Engine-side mount point (measurement point) in engine axes [m].
     rotation : ndarray, shape (3, 3)
@@ -407,10 +407,13 @@ class Excitation:
         n_h = int(round(2 * max_order)) + 1
         return np.arange(n_h) / 2.0, spec[:n_h]
 
-    def plot(self, path=None):
-        """Summary figure (see :func:`powertrain.plotting.plot_excitation`)."""
+    def plot(self, ax=None, *, path=None, provenance=None):
+        """Summary figure; returns it (see :func:`powertrain.plotting.plot_excitation`)."""
         from powertrain.plotting import plot_excitation
-        return plot_excitation(self, path)
+        from powertrain.plotting.style import target_and_path
+        ax, path = target_and_path(ax, path)
+        return plot_excitation(self, path, ax=ax,
+                               provenance=provenance or getattr(self, "provenance", None))
 
 
 @dataclass(frozen=True, eq=False)
@@ -420,11 +423,14 @@ class Engine:
     Attributes
     ----------
     name : str
-    crank : CrankTrain
+    crank : CrankTrain or None
+        None: the engine file has no ``[crank_train]`` (no excitation; ``modes`` only).
     body : RigidBody
     mounts : list of MountSpec
+        Any number (>= 3) of mounts, in file order.
     balancer : Balancer
-    combustion : SingleZoneCombustion or MeasuredPressure
+    combustion : SingleZoneCombustion or MeasuredPressure or None
+        None: the engine file has no ``[combustion]`` (no excitation).
     file : str
         Engine file it was read from ("" if built in code).
     """
@@ -473,8 +479,23 @@ class Engine:
         raise KeyError(name)
 
     # ------------------------------------------------------------------ pressure
+    @property
+    def has_excitation(self) -> bool:
+        """True when the engine has a crank train and a combustion model."""
+        return self.crank is not None and self.combustion is not None
+
+    def require_excitation(self):
+        """Raise :class:`~powertrain.errors.InputError` naming the missing section when the
+        engine file describes no excitation."""
+        from powertrain.errors import InputError
+        for section, value in (("crank_train", self.crank), ("combustion", self.combustion)):
+            if value is None:
+                raise InputError(f"missing section [{section}]: this command needs the "
+                                 "engine's excitation", file=self.file or None, key=section)
+
     def speed_range_rpm(self):
         """Speeds [rpm] for which the combustion model is defined."""
+        self.require_excitation()
         lo, hi = self.combustion.speed_range()
         return lo / RPM, hi / RPM
 

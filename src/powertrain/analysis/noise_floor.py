@@ -1,0 +1,39 @@
+r"""The one noise-floor rule: which measured levels are too close to the floor to be scored.
+
+A measured RMS level :math:`m` is *at the floor* (censored: it only says the true level is
+below :math:`\kappa f`) when :math:`m < \kappa f`, with :math:`f` the RMS noise floor and
+:math:`\kappa` = :data:`NOISE_FLOOR_MARGIN` = 3 (9.5 dB). Rationale: complex Gaussian noise
+of RMS :math:`f` alone exceeds :math:`\kappa f` with probability :math:`e^{-\kappa^2}` =
+1.2e-4, and a signal at :math:`\kappa f` is inflated by the floor (added in power) by
+:math:`10\log_{10}(1 + 1/\kappa^2)` = 0.46 dB, below the measurements' own scatter. Used by
+``powertrain compare`` (points excluded and counted) and ``powertrain diagnose`` (points
+censored).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+#: Multiple of the RMS noise floor below which a measured level is censored [1] (9.5 dB:
+#: noise alone exceeds it with probability e^-9 = 1.2e-4).
+NOISE_FLOOR_MARGIN = 3.0
+
+
+def censoring_level(noise_floor):
+    """Level below which a measured point is at the floor [unit of ``noise_floor``]."""
+    return NOISE_FLOOR_MARGIN * noise_floor
+
+
+def at_floor(measured, noise_floor):
+    """True where a measured level is at or below the censoring level, or not positive
+    (NaN stays False: absent points are not 'at the floor')."""
+    m = np.asarray(measured, float)
+    with np.errstate(invalid="ignore"):
+        return (m < censoring_level(noise_floor)) | (m <= 0)
+
+
+def above_floor(measured, noise_floor):
+    """True where a measured level is finite and scoreable (not at the floor)."""
+    m = np.asarray(measured, float)
+    with np.errstate(invalid="ignore"):
+        return np.isfinite(m) & (m >= censoring_level(noise_floor)) & (m > 0)

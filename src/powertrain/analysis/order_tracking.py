@@ -1,0 +1,200 @@
+r"""Computed order tracking (COT) of run-up time data.
+
+For each speed of the output grid (every ``rpm_step`` rpm the shaft passes through) one
+block of ``B`` revolutions centred on the instant the speed passes it is analysed:
+
+1. **angle-domain resampling with anti-alias filter**: ``S`` samples per revolution
+   (a power of two, at least :data:`SAMPLES_PER_ORDER` times the highest order), each the
+   low-pass interpolation of the time samples at its instant (the crank-angle curve of
+   :mod:`powertrain.analysis.speed` inverted), with the low-pass at
+   :data:`ANTI_ALIAS_FRACTION` of the local angular Nyquist frequency
+   :math:`S\,n/120` [Hz] (Kaiser-windowed sinc, :mod:`powertrain.kernels.order_tracking`):
+   content that the angle sampling would alias is removed first, the tracked orders stay
+   in the flat passband;
+2. **order spectrum of the block** at exactly the orders asked for (integer, fractional or
+   non-integer such as :math:`\sqrt2`), Hann window over the block:
+
+   .. math:: \hat S_o = \frac{2}{\sum_j w_j}\sum_j w_j\,x(\theta_j)\,e^{-i o \theta_j},
+             \qquad \mathrm{RMS}_o = |\hat S_o|/\sqrt2;
+
+   evaluating the window's transform at the order itself (not at the nearest FFT bin)
+   leaves no picket-fence error, and the block length (:func:`block_revolutions`, at least
+   4 bins between neighbouring orders) keeps the Hann side lobes of one order below
+   -50 dB at the next;
+3. the synthesis is the RMS sum over the orders tracked (:mod:`powertrain.analysis.orders`).
+
+Vold–Kalman filtering (:mod:`powertrain.analysis.vold_kalman`) is the second method.
+"""
+
+from __future__ import annotations
+
+import functools
+import math
+
+import numpy as np
+
+from powertrain.errors import InputError
+
+#: Angle samples per revolution: at least this many per unit of the highest order.
+SAMPLES_PER_ORDER = 6
+#: Anti-alias cut-off as a fraction of the angular Nyquist frequency S/2 [orders]. Only
+#: content that folds onto the tracked orders (<= S/6) matters, i.e. content above
+#: 5S/6; the kernel's transition band (about S/2 +- 0.3 S/2) ends below that, while the
+#: tracked orders stay in the flat passband.
+ANTI_ALIAS_FRACTION = 1.0
+#: Zero crossings per side and Kaiser beta of the resampling kernel: with 8 and 7 the
+#: tracked RMS of a 16-order sweep buried under 5x stronger orders 8.25..200 is within
+#: 0.004 dB (16 and 8: 0.0005 dB at twice the cost); tests/test_order_tracking.py.
+KERNEL_ZERO_CROSSINGS = 8
+KERNEL_BETA = 7.0
+#: Block length bounds [revolutions].
+MIN_BLOCK_REVS = 8
+MAX_BLOCK_REVS = 64
+
+
+def parse_orders(text: str, option: str = "--orders") -> np.ndarray:
+    """``0.5:8:0.5`` (start:stop:step, inclusive), a list ``1,0.5,1.41421356``, or a mix."""
+    values = []
+    for part in str(text).split(","):
+        part = part.strip()
+        if not part:
+            continue
+        try:
+            if ":" in part:
+                a, b, c = (float(x) for x in part.split(":"))
+                if not (c > 0 and b >= a):
+                    raise ValueError
+                n = int(math.floor((b - a) / c + 1e-9)) + 1
+                values.extend(a + c * np.arange(n))
+            else:
+                values.append(float(part))
+        except ValueError:
+            raise InputError(f"cannot read orders {part!r} (use 0.5:8:0.5 or 1,2,4)",
+                             key=option) from None
+    arr = np.unique(np.round(np.array(values, float), 12))
+    if arr.size == 0 or not np.all(np.isfinite(arr)) or np.any(arr <= 0):
+        raise InputError("orders must be finite and > 0", key=option)
+    return arr
+
+
+def block_revolutions(orders) -> int:
+    """Block length [rev]: at least 4 Hann bins between neighbouring orders (and from 0)."""
+    o = np.sort(np.asarray(orders, float))
+    spacing = min(o[0], np.min(np.diff(o)) if o.size > 1 else o[0])
+    return int(min(MAX_BLOCK_REVS, max(MIN_BLOCK_REVS, math.ceil(4.0 / spacing - 1e-9))))
+
+
+def samples_per_rev(orders) -> int:
+    """Angle samples per revolution: power of two >= SAMPLES_PER_ORDER * highest order."""
+    need = max(16.0, SAMPLES_PER_ORDER * float(np.max(orders)))
+    return int(2 ** math.ceil(math.log2(need)))
+
+
+@functools.lru_cache(maxsize=4)
+def kernel_table(K, beta, n_tab=16385):
+    """Kaiser-windowed sinc with K zero crossings per side, on v = -1 ... 1."""
+    v = np.linspace(-1.0, 1.0, n_tab)
+    table = np.sinc(K * v) * np.kaiser(n_tab, beta)
+    table.flags.writeable = False
+    return table
+
+
+def speed_grid(profile, rpm_step, block_revs, *, margin_s=0.0, file=None, key="rpm"):
+    """Grid speeds [rpm] the shaft passes with a whole block inside the measured range.
+
+    Returns
+    -------
+    rpm : ndarray (k,)
+        Grid speeds (multiples of ``rpm_step``).
+    centre : ndarray (k,)
+        Crank angle at which the speed passes each [rad].
+    """
+    i0, i1 = profile.valid
+    t, n, th = profile.time[i0:i1 + 1], profile.rpm[i0:i1 + 1], profile.angle[i0:i1 + 1]
+    if not (math.isfinite(rpm_step) and rpm_step > 0):
+        raise InputError("must be > 0 [rpm]", key="--rpm-step")
+    lo_ok = np.interp(th[0] + np.pi * block_revs, th, t) + margin_s
+    hi_ok = np.interp(th[-1] - np.pi * block_revs, th, t) - margin_s
+    grid = rpm_step * np.arange(math.ceil(n.min() / rpm_step), math.floor(n.max() / rpm_step)
+                                + 1)
+    tc, thc = first_passing(t, n, grid, th)
+    keep = (tc >= lo_ok) & (tc <= hi_ok)
+    rpm, centre = list(grid[keep]), thc[keep]
+    if not rpm:
+        raise InputError(f"speed never passes a multiple of {rpm_step:g} rpm with "
+                         f"{block_revs / 2:g} revolutions (+ {margin_s:.3g} s) of data either "
+                         "side (speed "
+                         f"{n.min():.0f}..{n.max():.0f} rpm over {t[-1] - t[0]:.3g} s)",
+                         file=file, key=key)
+    return np.array(rpm, float), np.array(centre, float)
+
+
+def first_passing(t, rpm, targets, *others):
+    """Time (and the values of ``others`` interpolated there) at which the speed first
+    reaches each target [s]; NaN where it never does.
+
+    From below (``rpm[0] < target``) the first sample at or above the target is found by
+    bisection in the running maximum, from above in the running minimum.
+    """
+    t = np.asarray(t, float)
+    rpm = np.asarray(rpm, float)
+    targets = np.asarray(targets, float)
+    up = np.searchsorted(np.maximum.accumulate(rpm), targets, side="left")
+    down = np.searchsorted(-np.minimum.accumulate(rpm), -targets, side="left")
+    idx = np.where(rpm[0] < targets, up, down)
+    found = idx < rpm.size
+    i1 = np.clip(idx, 1, rpm.size - 1)
+    i0 = i1 - 1
+    d0, d1 = rpm[i0] - targets, rpm[i1] - targets
+    f = np.where(d0 != d1, d0 / np.where(d0 != d1, d0 - d1, 1.0), 0.0)
+    f = np.where(idx == 0, 0.0, np.clip(f, 0.0, 1.0))
+    out = [np.where(found, t[i0] + f * (t[i1] - t[i0]), np.nan)]
+    for arr in others:
+        arr = np.asarray(arr, float)
+        out.append(np.where(found, arr[i0] + f * (arr[i1] - arr[i0]), np.nan))
+    return out[0] if not others else tuple(out)
+
+
+def cot_amplitudes(X, profile, orders, rpm_centre, angle_centre, block_revs=None):
+    """Complex order amplitudes per grid speed by computed order tracking.
+
+    Parameters
+    ----------
+    X : ndarray (n_ch, n)
+        Channels [SI], uniformly sampled at ``profile.time``.
+    profile : SpeedProfile
+    orders : ndarray (n_o,)
+    rpm_centre, angle_centre : ndarray (k,)
+        From :func:`speed_grid`.
+    block_revs : int, optional
+        Block length [rev] (default :func:`block_revolutions`).
+    progress : bool, optional
+        Show a progress bar on stderr (quiet off a terminal).
+
+    Returns
+    -------
+    ndarray complex (k, n_ch, n_o)
+        Peak complex amplitudes [SI], phase relative to crank angle 0.
+    """
+    from powertrain.kernels.order_tracking import sinc_resample_kernel
+    X = np.ascontiguousarray(X, float)
+    orders = np.asarray(orders, float)
+    B = block_revs or block_revolutions(orders)
+    S = samples_per_rev(orders)
+    N = B * S
+    fs = (profile.time.size - 1) / (profile.time[-1] - profile.time[0])
+    j = np.arange(N)
+    theta = angle_centre[:, None] + (j[None, :] - N / 2) * (2 * np.pi / S)   # (k, N)
+    idx = np.arange(profile.time.size, dtype=float)
+    pos = np.interp(theta.ravel(), profile.angle, idx)
+    rpm_at = np.interp(pos, idx, profile.rpm)
+    cutoff = np.minimum(1.0, ANTI_ALIAS_FRACTION * S * rpm_at / 60.0 / fs)
+    out = np.empty((X.shape[0], pos.size))
+    sinc_resample_kernel(X, pos, cutoff, kernel_table(KERNEL_ZERO_CROSSINGS, KERNEL_BETA),
+                         float(KERNEL_ZERO_CROSSINGS), out)
+    w = 0.5 - 0.5 * np.cos(2 * np.pi * j / N)
+    E = (w[:, None] * np.exp(-1j * np.outer((j - N / 2) * (2 * np.pi / S), orders)))
+    E *= 2.0 / w.sum()
+    spec = out.reshape(X.shape[0], len(rpm_centre), N) @ E              # (n_ch, k, n_o)
+    spec *= np.exp(-1j * np.outer(angle_centre, orders))[None]
+    return np.transpose(spec, (1, 0, 2))

@@ -1,0 +1,43 @@
+"""``powertrain modes``: the rigid-body modes of the powertrain on its mounts."""
+
+from __future__ import annotations
+
+import click
+
+from powertrain.cli import main
+
+
+@main.command()
+@click.option("--engine", "engine_file", type=click.Path(dir_okay=False),
+              help="Engine file (default: the shipped engines/default.toml); only [engine], "
+                   "[body] and [mounts.*] are needed.")
+@click.option("--static", is_flag=True,
+              help="Static (0 Hz) mount stiffness, undamped (default: each mode with the "
+                   "networks' dynamic stiffness at its own frequency, damped).")
+@click.option("--json", "json_file", type=click.Path(dir_okay=False),
+              help="Write the modes as JSON.")
+@click.option("--plot", type=click.Path(dir_okay=False),
+              help="Write the kinetic-energy distribution per mode (PNG).")
+def modes(engine_file, static, json_file, plot):
+    """Six rigid-body modes: frequency, damping ratio, dominant coordinate, kinetic-energy
+    distribution [%] over x, y, z, rx, ry, rz about the CG in engine axes, and the angle of
+    each mode's rotation axis to the torque-roll axis.
+
+    \b
+    Examples:
+      powertrain modes
+      powertrain modes --engine engines/default-torque-rod.toml --json modes.json
+      powertrain modes --static --plot modes.png
+    """
+    from powertrain.iotools.engine_file import DEFAULT_ENGINE_PATH, read_engine
+    from powertrain.solvers.modes import engine_modes
+
+    engine = read_engine(engine_file or DEFAULT_ENGINE_PATH)
+    result = engine_modes(engine, static=static)
+    if json_file:
+        result.write_json(json_file)
+    if plot:
+        from powertrain.cli.common import cli_provenance, engine_description, write_plot
+        prov = cli_provenance(engine_description(engine, engine.file))
+        write_plot(lambda p: result.plot(path=p, provenance=prov), plot)
+    click.echo(result.to_text())

@@ -1,0 +1,180 @@
+"""Raw run-up time data: one entry point for every format, one channel-mapping step.
+
+:func:`read_raw` recognises the format from the file's first bytes (HDF5 signature, the MDF
+identification block, a UFF ``-1`` delimiter line, otherwise a wide CSV), lets the format's
+reader list its signals ``(name, values, unit)`` and turns them into a
+:class:`~powertrain.models.recording.RawRecording` here, once: channel names through the
+name convention or a channel map (:mod:`powertrain.iotools.channel_map`), units to SI
+through :mod:`powertrain.units`.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from powertrain.errors import InputError
+from powertrain.iotools.channel_map import (
+    ChannelMap,
+    parse_channel_name,
+    quantity_of_unit,
+    split_unit,
+)
+from powertrain.models.recording import QUANTITIES, RawChannel, RawRecording
+from powertrain.units import to_si
+
+_HDF5 = b"\x89HDF\r\n\x1a\n"
+_MDF = b"MDF     "
+
+
+@dataclass
+class FileSignals:
+    """What a format reader found: a time base and named signals (values in file units)."""
+
+    time: np.ndarray | None
+    signals: list                      # [(name, values, unit)]
+    source: str
+    time_name: str = "time"
+    comments: list = field(default_factory=list)
+    times: dict = field(default_factory=dict)   # name -> own time base (MDF, UFF), optional
+
+
+def detect_format(path) -> str:
+    """``hdf5``, ``mdf``, ``uff`` or ``csv`` from the first bytes of the file."""
+    try:
+        with open(path, "rb") as fh:
+            head = fh.read(512)
+    except FileNotFoundError:
+        raise InputError("file not found", file=path) from None
+    except OSError as exc:
+        raise InputError(f"cannot read file ({exc.strerror or exc})", file=path) from None
+    if head.startswith(_HDF5):
+        return "hdf5"
+    if head.startswith(_MDF):
+        return "mdf"
+    first = head.lstrip(b" \r\n\t").split(b"\n", 1)[0].strip()
+    if first == b"-1":
+        return "uff"
+    return "csv"
+
+
+def read_raw(path, channel_map: ChannelMap | None = None, *, rpm: str | None = None,
+             tacho: str | None = None) -> RawRecording:
+    """Read a raw run-up recording in any supported format.
+
+    Parameters
+    ----------
+    path : str or Path
+        Wide CSV, raw HDF5, UFF (dataset 58) or MDF4 file.
+    channel_map : ChannelMap, optional
+        File channel name -> mount, side, direction, quantity (default: the name convention).
+    rpm, tacho : str, optional
+        Name of the speed [rpm] or tacho channel (default: the map's, else a channel named
+        ``rpm`` / ``tacho``).
+
+    Returns
+    -------
+    RawRecording
+        Validated, SI.
+    """
+    path = str(path)
+    fmt = detect_format(path)
+    if fmt == "hdf5":
+        from powertrain.iotools.raw_hdf5 import read_hdf5_signals as reader
+    elif fmt == "mdf":
+        from powertrain.iotools.raw_mdf import read_mdf_signals as reader
+    elif fmt == "uff":
+        from powertrain.iotools.raw_uff import read_uff_signals as reader
+    else:
+        from powertrain.iotools.raw_csv import read_csv_signals as reader
+    found = reader(path, channel_map)
+    return assemble(found, channel_map, rpm=rpm, tacho=tacho)
+
+
+def _find(signals, wanted):
+    """Index of the signal named ``wanted`` (full name or name without the unit bracket)."""
+    for i, (name, _, _) in enumerate(signals):
+        if name == wanted or split_unit(name)[0] == wanted:
+            return i
+    return None
+
+
+def _pick_speed(found: FileSignals, cmap, rpm, tacho):
+    signals = list(found.signals)
+    rpm_name = rpm or (cmap.rpm if cmap else None)
+    tacho_name = tacho or (cmap.tacho if cmap else None)
+    out = {}
+    for kind, wanted, default in (("rpm", rpm_name, "rpm"), ("tacho", tacho_name, "tacho")):
+        i = _find(signals, wanted or default)
+        if i is None:
+            if wanted:
+                raise InputError(f"no channel named {wanted!r} for the {kind}",
+                                 file=found.source, key=wanted)
+            continue
+        name, values, unit = signals.pop(i)
+        values = np.asarray(values, float)
+        if kind == "rpm":
+            unit = unit or "rpm"
+            values = to_si(values, unit, "angular_speed", file=found.source, key=name) \
+                * 60.0 / (2.0 * np.pi)
+        elif unit:
+            values = to_si(values, unit, "voltage", file=found.source, key=name)
+        out[kind] = values
+    return out, signals
+
+
+def assemble(found: FileSignals, cmap: ChannelMap | None = None, *, rpm=None,
+             tacho=None) -> RawRecording:
+    """Map the signals of a file to mount channels in SI (see :func:`read_raw`)."""
+    src = found.source
+    speed, signals = _pick_speed(found, cmap, rpm, tacho)
+    channels, ignored = [], []
+    used = set()
+    for name, values, file_unit in signals:
+        if cmap is not None and cmap.channels:
+            spec = cmap.channels.get(name) or cmap.channels.get(split_unit(name)[0])
+            if spec is None:
+                spec = parse_channel_name(name)
+                if spec is None:
+                    ignored.append(name)
+                    continue
+            used.add(name)
+            used.add(split_unit(name)[0])
+        else:
+            spec = parse_channel_name(name)
+            if spec is None:
+                raise InputError("channel name maps to no mount (name it MOUNT.DIRECTION "
+                                 "[UNIT], e.g. 'left.z [m/s^2]', or give a --channels map)",
+                                 file=src, key=name)
+        unit = spec.unit or file_unit or split_unit(name)[1]
+        if not unit:
+            raise InputError("channel declares no unit (add it in brackets or as 'unit' in "
+                             "the channel map)", file=src, key=name)
+        quantity = quantity_of_unit(unit, file=src, key=name)
+        if spec.quantity is not None and spec.quantity != quantity:
+            raise InputError(f"unit {unit!r} measures {quantity}, but the channel map says "
+                             f"{spec.quantity}", file=src, key=name)
+        dimension = "length" if quantity == "displacement" else quantity
+        si = to_si(np.asarray(values, float), unit, dimension, file=src, key=name)
+        channels.append(RawChannel(name, spec.mount, spec.side, spec.direction, quantity,
+                                   si, unit))
+    if cmap is not None:
+        for name in cmap.channels:
+            if name not in used:
+                raise InputError("channel of the channel map not found in the file",
+                                 file=cmap.source or src, key=f"channels.{name}")
+    if channels and len({c.values.size for c in channels}) == 1:
+        for ch, row in zip(channels, RawRecording.rows([c.values for c in channels])):
+            ch.values = row
+    comments = list(found.comments)
+    if ignored:
+        comments.append("channels not in the channel map, ignored: " + ", ".join(ignored))
+    rec = RawRecording(found.time, channels, speed.get("rpm"), speed.get("tacho"), src,
+                       comments)
+    return rec.validate(found.time_name)
+
+
+def si_unit(quantity: str) -> str:
+    """SI unit string of a measured quantity."""
+    return QUANTITIES[quantity]

@@ -1,0 +1,123 @@
+"""Raw run-up time data in HDF5.
+
+Layout written by :func:`write_raw_hdf5` (``powertrain runup --sweep --raw``)::
+
+    /                 attrs: format="powertrain-raw", format_version=1, powertrain_version,
+                             created, description, synthetic (bool), comments (JSON list)
+    /time             (n,)  attrs unit="s"
+    /rpm              (n,)  attrs unit="rpm"         (optional)
+    /tacho            (n,)  attrs unit="V"           (optional)
+    /channels/<name>  (n,)  attrs unit (the values' unit, e.g. "m/s^2" or "g"), mount, side,
+                            direction, quantity; <name> = MOUNT.DIRECTION or
+                            MOUNT.SIDE.DIRECTION
+
+Any other HDF5 file is read with a channel map: its keys are dataset paths (``time``,
+``rpm`` and ``tacho`` name the datasets holding those; a dataset's ``unit`` attribute is
+used unless the map gives one).
+"""
+
+from __future__ import annotations
+
+import json
+from datetime import datetime, timezone
+
+import numpy as np
+
+from powertrain.errors import InputError
+from powertrain.iotools.raw import FileSignals
+
+FORMAT = "powertrain-raw"
+
+
+def _unit(ds):
+    u = ds.attrs.get("unit", "")
+    return u.decode() if isinstance(u, bytes) else str(u)
+
+
+def read_hdf5_signals(path, channel_map=None) -> FileSignals:
+    """Signals of a raw HDF5 file (see module docstring)."""
+    import h5py
+    try:
+        h5 = h5py.File(path, "r")
+    except OSError as exc:
+        raise InputError(f"cannot open HDF5 file ({exc})", file=path) from None
+    with h5:
+        fmt = h5.attrs.get("format", "")
+        fmt = fmt.decode() if isinstance(fmt, bytes) else str(fmt)
+        if fmt == "powertrain-runup":
+            raise InputError("this is a run-up result (order curves), not raw time data; "
+                             "give it to 'compare' or 'diagnose'", file=path, key="format")
+        if fmt == FORMAT:
+            return _read_own(h5, path)
+        if channel_map is None:
+            raise InputError(f"not a '{FORMAT}' HDF5 file; give a --channels map naming its "
+                             "datasets", file=path, key="format")
+        return _read_mapped(h5, path, channel_map)
+
+
+def _dataset(h5, name, path):
+    if name not in h5 or not hasattr(h5[name], "shape"):
+        raise InputError("dataset not found", file=path, key=name)
+    data = h5[name][()]
+    if np.ndim(data) != 1 or not np.issubdtype(np.asarray(data).dtype, np.number):
+        raise InputError("expected a 1-D numeric dataset", file=path, key=name)
+    return np.asarray(data, float)
+
+
+def _read_own(h5, path):
+    time = _dataset(h5, "time", path)
+    unit = _unit(h5["time"]) or "s"
+    from powertrain.units import to_si
+    time = to_si(time, unit, "time", file=path, key="time")
+    signals = []
+    for name in ("rpm", "tacho"):
+        if name in h5:
+            signals.append((name, _dataset(h5, name, path), _unit(h5[name])))
+    if "channels" not in h5:
+        raise InputError("no /channels group", file=path, key="channels")
+    for name, ds in h5["channels"].items():
+        signals.append((name, _dataset(h5, f"channels/{name}", path), _unit(ds)))
+    comments = json.loads(h5.attrs.get("comments", "[]"))
+    if h5.attrs.get("synthetic", False) and not any("synthetic" in c.lower() for c in comments):
+        comments.append("SYNTHETIC")
+    return FileSignals(time, signals, str(path), "time", comments)
+
+
+def _read_mapped(h5, path, cmap):
+    tname = cmap.time or "time"
+    time = _dataset(h5, tname, path)
+    signals = []
+    for name in [cmap.rpm, cmap.tacho, *cmap.channels]:
+        if name:
+            signals.append((name, _dataset(h5, name, path), _unit(h5[name])))
+    return FileSignals(time, signals, str(path), tname)
+
+
+def write_raw_hdf5(path, recording, *, description: str = "", synthetic: bool = False) -> None:
+    """Write a :class:`RawRecording` in the layout above (values in each channel's unit)."""
+    import h5py
+
+    from powertrain import __version__
+    from powertrain.iotools.atomic import atomic_path
+    from powertrain.units import from_si
+    with atomic_path(path) as tmp:
+        with h5py.File(tmp, "w") as h5:
+            a = h5.attrs
+            a["format"] = FORMAT
+            a["format_version"] = 1
+            a["powertrain_version"] = __version__
+            a["created"] = datetime.now(timezone.utc).isoformat(timespec="seconds")
+            a["description"] = description
+            a["synthetic"] = bool(synthetic or recording.synthetic)
+            a["comments"] = json.dumps(list(recording.comments))
+            h5.create_dataset("time", data=recording.time).attrs["unit"] = "s"
+            if recording.rpm is not None:
+                h5.create_dataset("rpm", data=recording.rpm).attrs["unit"] = "rpm"
+            if recording.tacho is not None:
+                h5.create_dataset("tacho", data=recording.tacho).attrs["unit"] = "V"
+            g = h5.create_group("channels", track_order=True)
+            for ch in recording.channels:
+                dim = "length" if ch.quantity == "displacement" else ch.quantity
+                ds = g.create_dataset(ch.label, data=from_si(ch.values, ch.unit, dim))
+                for k in ("unit", "mount", "side", "direction", "quantity"):
+                    ds.attrs[k] = getattr(ch, k)

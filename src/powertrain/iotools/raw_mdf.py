@@ -1,0 +1,96 @@
+"""Raw run-up time data in ASAM MDF4 (read and written by asammdf).
+
+Every channel of the file except the masters is a signal (name and unit as stored); all are
+brought onto the time base of the first vibration channel (they must share it: a test-lab
+export of one group does). Names follow the ``MOUNT.DIRECTION`` convention or a channel map.
+"""
+
+from __future__ import annotations
+
+import gc
+import sys
+import warnings
+
+import numpy as np
+
+from powertrain.errors import InputError
+from powertrain.iotools.raw import FileSignals
+
+
+def read_mdf_signals(path, channel_map=None) -> FileSignals:
+    """Signals of an MDF file."""
+    from asammdf import MDF
+    with open(path, "rb") as fh:
+        head = fh.read(72)
+    if len(head) < 72 or head[64:68] not in (b"##HD", b"HD\x00\x00") and head[64:66] != b"HD":
+        raise InputError("not a readable MDF file (no header block after the identification "
+                         "block)", file=path)
+    problem = None
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        try:
+            mdf = MDF(str(path))
+        except Exception as exc:   # asammdf raises many types on malformed files
+            problem = str(exc).splitlines()[0][:80] if str(exc) else type(exc).__name__
+        _quiet_collect()           # a half-built MDF object complains when finalised
+    if problem is not None:
+        raise InputError(f"not a readable MDF file ({problem})", file=path)
+    time, signals = None, []
+    try:
+        for g, group in enumerate(mdf.groups):
+            for c in range(len(group.channels)):
+                if mdf.masters_db.get(g) == c:          # the group's time channel
+                    continue
+                sig = mdf.get(group=g, index=c)
+                t = np.asarray(sig.timestamps, float)
+                if time is None:
+                    time = t
+                elif t.shape != time.shape or not np.allclose(t, time, rtol=0,
+                                                              atol=1e-9 * max(time[-1], 1.0)):
+                    raise InputError("time base differs from the first channel's", file=path,
+                                     key=sig.name)
+                samples = np.asarray(sig.samples)
+                if not np.issubdtype(samples.dtype, np.number):
+                    raise InputError("not a numeric channel", file=path, key=sig.name)
+                signals.append((sig.name, samples.astype(float), (sig.unit or "").strip()))
+    finally:
+        mdf.close()
+    if time is None:
+        raise InputError("no channel in the MDF file", file=path)
+    return FileSignals(time, signals, str(path), "master time")
+
+
+def _quiet_collect():
+    """Collect garbage with finalizer errors of half-built asammdf objects silenced."""
+    hook = sys.unraisablehook
+    sys.unraisablehook = lambda unraisable: None
+    try:
+        gc.collect()
+    finally:
+        sys.unraisablehook = hook
+
+
+def write_raw_mdf(path, recording) -> None:
+    """Write a :class:`RawRecording` as MDF 4.10, one group, one channel per signal."""
+    from asammdf import MDF, Signal
+
+    from powertrain.iotools.atomic import atomic_path
+    from powertrain.units import from_si
+    t = np.asarray(recording.time, float)
+    sigs = []
+    if recording.rpm is not None:
+        sigs.append(Signal(recording.rpm, t, name="rpm", unit="rpm"))
+    if recording.tacho is not None:
+        sigs.append(Signal(recording.tacho, t, name="tacho", unit="V"))
+    for ch in recording.channels:
+        dim = "length" if ch.quantity == "displacement" else ch.quantity
+        sigs.append(Signal(np.asarray(from_si(ch.values, ch.unit, dim), float), t,
+                           name=ch.label, unit=ch.unit))
+    mdf = MDF(version="4.10")
+    mdf.append(sigs, comment=recording.source or "powertrain")
+    with atomic_path(path) as tmp:
+        out = mdf.save(str(tmp), overwrite=True)
+        import os
+        if str(out) != str(tmp):
+            os.replace(out, tmp)
+    mdf.close()

@@ -1,0 +1,144 @@
+"""One place to choose where independent jobs run: serially, in local processes, or on a
+dask.distributed cluster.
+
+``executor(scheduler)`` returns a context manager yielding an object with the
+``concurrent.futures`` interface (``submit`` → future with ``.result()``, ``map``):
+
+================================ ==========================================================
+``scheduler``                    runs on
+================================ ==========================================================
+``None`` or ``"auto"``           whatever starts fastest locally: serial for one job or one
+                                 core, else a process pool (``workers`` processes)
+``"serial"``                     this process, one job after the other
+``"processes"``                  a local process pool
+``"local"``                      a dask.distributed ``LocalCluster`` on this machine's cores
+                                 (one single-threaded worker process per core)
+``"tcp://HOST:PORT"``            an existing dask.distributed scheduler (start it with
+                                 ``dask scheduler`` and workers with ``dask worker HOST:PORT``)
+================================ ==========================================================
+
+Results do not depend on the choice: every job is a pure function of its arguments, and
+:func:`run_map` returns them in submission order (tests/test_parallel.py).
+"""
+
+from __future__ import annotations
+
+import os
+import sys
+from concurrent.futures import Future, ProcessPoolExecutor
+from contextlib import contextmanager
+
+from powertrain.errors import InputError
+
+
+class SerialExecutor:
+    """``concurrent.futures``-like executor running every job at submission."""
+
+    def submit(self, fn, *args, **kwargs) -> Future:
+        fut = Future()
+        try:
+            fut.set_result(fn(*args, **kwargs))
+        except BaseException as exc:  # noqa: BLE001 (handed to the caller via the future)
+            fut.set_exception(exc)
+        return fut
+
+    def map(self, fn, *iterables):
+        return [fn(*a) for a in zip(*iterables)]
+
+    def shutdown(self, wait=True):
+        return None
+
+
+def cpu_count() -> int:
+    """Cores this process may use."""
+    try:
+        return len(os.sched_getaffinity(0))
+    except AttributeError:              # pragma: no cover (not Linux)
+        return os.cpu_count() or 1
+
+
+def check_scheduler(scheduler) -> str:
+    """Normalised scheduler name; ``InputError`` (key ``--scheduler``) if not understood."""
+    s = "auto" if scheduler in (None, "") else str(scheduler).strip()
+    if s in ("auto", "serial", "processes", "local") or s.startswith("tcp://"):
+        if s.startswith("tcp://") and ":" not in s[len("tcp://"):]:
+            raise InputError(f"{s!r}: expected tcp://HOST:PORT", key="--scheduler")
+        return s
+    raise InputError(f"{s!r}: expected 'local', 'serial', 'processes' or tcp://HOST:PORT",
+                     key="--scheduler")
+
+
+@contextmanager
+def executor(scheduler=None, *, workers=None, n_jobs=None):
+    """Executor for ``scheduler`` (see the module table), shut down on exit.
+
+    Parameters
+    ----------
+    scheduler : str or None
+        ``None``/``"auto"``, ``"serial"``, ``"processes"``, ``"local"`` or ``"tcp://HOST:PORT"``.
+    workers : int, optional
+        Local processes (default: the usable cores).
+    n_jobs : int, optional
+        Number of jobs about to be submitted (``auto`` runs one job serially).
+    """
+    s = check_scheduler(scheduler)
+    n = workers or cpu_count()
+    if s == "auto":
+        s = "serial" if (n <= 1 or (n_jobs is not None and n_jobs <= 1)) else "processes"
+    if s == "serial":
+        yield SerialExecutor()
+    elif s == "processes":
+        with ProcessPoolExecutor(max_workers=n) as ex:
+            yield ex
+    else:
+        with _dask_client(s, n) as client:
+            yield client
+
+
+@contextmanager
+def _dask_client(address, n):
+    try:
+        from distributed import Client, LocalCluster
+    except ImportError as exc:          # pragma: no cover (declared dependency)
+        raise InputError("dask.distributed is not installed (pip install 'dask[distributed]')",
+                         key="--scheduler") from exc
+    if address == "local":
+        with LocalCluster(n_workers=n, threads_per_worker=1, processes=True,
+                          dashboard_address=None) as cluster, Client(cluster) as client:
+            yield client
+        return
+    try:
+        client = Client(address, timeout="10s")
+    except OSError as exc:
+        raise InputError(f"cannot reach the dask scheduler at {address} ({exc})",
+                         key="--scheduler") from exc
+    try:
+        yield client
+    finally:
+        client.close()
+
+
+def run_map(fn, items, scheduler=None, *, workers=None, progress=None):
+    """``[fn(x) for x in items]`` on ``scheduler``, results in the order of ``items``.
+
+    ``progress``: a description for a tqdm bar on stderr (shown only on a terminal).
+    """
+    items = list(items)
+    with executor(scheduler, workers=workers, n_jobs=len(items)) as ex:
+        futures = [ex.submit(fn, x) for x in items]
+        bar = progress_bar(len(futures), progress) if progress else None
+        out = []
+        for f in futures:
+            out.append(f.result())
+            if bar is not None:
+                bar.update(1)
+        if bar is not None:
+            bar.close()
+    return out
+
+
+def progress_bar(total, desc, quiet=False):
+    """tqdm bar on stderr; disabled when ``quiet`` or stderr is not a terminal."""
+    from tqdm import tqdm
+    return tqdm(total=total, desc=desc, file=sys.stderr, leave=False,
+                disable=quiet or not sys.stderr.isatty())

@@ -1,0 +1,319 @@
+r"""Rigid-body modes of the powertrain on its mounts: frequencies, damping, energy, torque roll.
+
+Two methods:
+
+* ``static`` — the six undamped modes of the body on the mounts' static (0 Hz) cross-point
+  stiffness, the networks' internal nodes condensed statically:
+  :math:`\mathbf K_{6}\boldsymbol\varphi = \omega^2\mathbf M_{6}\boldsymbol\varphi`.
+* ``dynamic`` (default) — each mode with the mount networks' dynamic stiffness at its own
+  (complex) frequency. The networks' internal degrees of freedom are condensed exactly at the
+  complex eigenvalue :math:`s`: every network adds :math:`K_{IP}(s)\,\mathbf r\mathbf r^T`
+  with :math:`K_{IP}(s) = D_{EE} - \mathbf D_{Ei}\mathbf D_{ii}^{-1}\mathbf D_{iE}`,
+  :math:`\mathbf D(s) = \mathbf K + s\mathbf C + s^2\mathbf M` of the network. The nonlinear
+  eigenproblem :math:`\big(s^2\mathbf M_6 + \sum K_{IP}(s)\mathbf r\mathbf r^T\big)\boldsymbol
+  \varphi = 0` is solved per mode by a secant iteration on :math:`s` starting from the static
+  mode (the branch is followed by the modal assurance criterion); every root is an eigenvalue
+  of the full state-space model with the internal degrees of freedom, which is checked.
+  Natural frequency :math:`|s|/2\pi`, damping ratio :math:`-\mathrm{Re}\,s/|s|`, damped
+  frequency :math:`\mathrm{Im}\,s/2\pi`.
+
+Kinetic-energy distribution of mode :math:`\boldsymbol\varphi` over the coordinates
+``x, y, z, rx, ry, rz`` (CG translations and rotations about axes through the CG parallel to
+the engine axes): :math:`E_j = \mathrm{Re}\big(\bar\varphi_j(\mathbf M\boldsymbol\varphi)_j\big)
+/ \mathrm{Re}\big(\boldsymbol\varphi^H\mathbf M\boldsymbol\varphi\big)`, in percent (sums to
+100; small negative entries come from products of inertia).
+
+Torque-roll axis: the axis about which the free body turns under a torque about the crank axis
+(engine X), :math:`\mathbf d = \mathbf I^{-1}\mathbf e_x/|\mathbf I^{-1}\mathbf e_x|` through
+the CG (Jeong & Singh, J. Sound Vib. 234(1), 2000, sec. 2). Each mode's rotation axis is the
+direction of its rotational part; the angle between the two axes is reported in 0..90°.
+"""
+
+from __future__ import annotations
+
+import json
+from dataclasses import dataclass, field
+
+import numpy as np
+import scipy.linalg as sla
+
+from powertrain.physics.mount_network import network_matrices
+
+COORDINATES = ("x", "y", "z", "rx", "ry", "rz")
+#: Relative change of s at which the secant iteration stops.
+TOLERANCE = 1e-12
+MAX_ITERATIONS = 60
+
+
+@dataclass
+class Mode:
+    """One rigid-body (or chassis) mode.
+
+    Attributes
+    ----------
+    frequency_hz : float
+        Natural frequency |s|/2π [Hz].
+    damping_ratio : float
+        −Re s/|s| [-] (0 for the static method).
+    damped_frequency_hz : float
+        Im s/2π [Hz].
+    shape : ndarray complex (6,)
+        ``[x, y, z, rx, ry, rz]`` at the CG [m, rad], largest-energy entry real positive,
+        unit modal mass.
+    ked_percent : ndarray (6,)
+        Kinetic-energy distribution [%].
+    angle_to_torque_roll_axis_deg : float
+        Angle between the mode's rotation axis and the torque-roll axis [deg].
+    kind : str
+        ``rigid-body`` or ``chassis``.
+    """
+
+    frequency_hz: float
+    damping_ratio: float
+    damped_frequency_hz: float
+    shape: np.ndarray
+    ked_percent: np.ndarray
+    angle_to_torque_roll_axis_deg: float
+    kind: str = "rigid-body"
+    iterations: int = 0
+
+    @property
+    def dominant(self) -> str:
+        return COORDINATES[int(np.argmax(self.ked_percent))]
+
+    def to_dict(self) -> dict:
+        shape = self.shape.real
+        return {"frequency_hz": float(self.frequency_hz),
+                "damping_ratio": float(self.damping_ratio),
+                "dominant": self.dominant,
+                "ked_percent": {c: float(v) for c, v in zip(COORDINATES, self.ked_percent)},
+                "damped_frequency_hz": float(self.damped_frequency_hz),
+                "angle_to_torque_roll_axis_deg": float(self.angle_to_torque_roll_axis_deg),
+                "shape": {c: float(v) for c, v in zip(COORDINATES, shape)},
+                "kind": self.kind}
+
+
+@dataclass
+class ModesResult:
+    """Modes sorted by frequency, the torque-roll axis and the method used."""
+
+    modes: list
+    torque_roll_axis: dict
+    method: str
+    engine: str = ""
+    meta: dict = field(default_factory=dict)
+
+    @property
+    def frequencies_hz(self) -> np.ndarray:
+        return np.array([m.frequency_hz for m in self.modes])
+
+    def to_dict(self) -> dict:
+        return {"modes": [m.to_dict() for m in self.modes],
+                "torque_roll_axis": self.torque_roll_axis, "method": self.method,
+                "engine": self.engine, **self.meta}
+
+    def write_json(self, path) -> None:
+        from powertrain.iotools.atomic import atomic_write
+        with atomic_write(path) as fh:
+            json.dump(self.to_dict(), fh, indent=2)
+            fh.write("\n")
+
+    def to_text(self) -> str:
+        head = (f"{'mode':>4}  {'f [Hz]':>7}  {'zeta':>6}  {'dominant':>8}  "
+                + "  ".join(f"{c:>6}" for c in COORDINATES) + "  TRA angle")
+        lines = [f"{self.engine}: rigid-body modes ({self.method})", head, "-" * len(head)]
+        for i, m in enumerate(self.modes, 1):
+            tag = "" if m.kind == "rigid-body" else f"  ({m.kind})"
+            lines.append(f"{i:4d}  {m.frequency_hz:7.3f}  {m.damping_ratio:6.3f}  "
+                         f"{m.dominant:>8}  "
+                         + "  ".join(f"{v:6.1f}" for v in m.ked_percent)
+                         + f"  {m.angle_to_torque_roll_axis_deg:6.1f} deg{tag}")
+        t = self.torque_roll_axis
+        d = ", ".join(f"{v:.4f}" for v in t["direction"])
+        lines.append(f"torque-roll axis through the CG, direction [{d}] (engine axes), "
+                     f"{t['angle_to_crank_axis_deg']:.2f} deg from the crank axis")
+        return "\n".join(lines)
+
+    def plot(self, ax=None, *, path=None, provenance=None):
+        """Stacked kinetic-energy distribution per mode (PNG when ``path`` is given);
+        returns the figure."""
+        from powertrain.plotting.style import target_and_path
+        from powertrain.plotting_body import plot_modes
+        ax, path = target_and_path(ax, path)
+        return plot_modes(self, path, ax=ax,
+                          provenance=provenance or getattr(self, "provenance", None))
+
+
+# ---------------------------------------------------------------------------- physics
+def torque_roll_axis(inertia, crank_axis=(1.0, 0.0, 0.0)) -> np.ndarray:
+    """Unit direction of the torque-roll axis, :math:`\\mathbf I^{-1}\\mathbf e` normalised."""
+    d = np.linalg.solve(np.asarray(inertia, float), np.asarray(crank_axis, float))
+    d = d / np.linalg.norm(d)
+    return d if d @ np.asarray(crank_axis, float) >= 0 else -d
+
+
+def kinetic_energy_percent(M6, phi) -> np.ndarray:
+    """:math:`100\\,\\mathrm{Re}(\\bar\\varphi_j(\\mathbf M\\varphi)_j)/\\mathrm{Re}(\\varphi^H
+    \\mathbf M\\varphi)` per coordinate [%]."""
+    phi = np.asarray(phi, complex)
+    e = (np.conj(phi) * (M6 @ phi)).real
+    return 100.0 * e / e.sum()
+
+
+def _axis_angle_deg(a, b) -> float:
+    na, nb = np.linalg.norm(a), np.linalg.norm(b)
+    if na == 0 or nb == 0:
+        return float("nan")
+    return float(np.degrees(np.arccos(np.clip(abs(a @ b) / (na * nb), 0.0, 1.0))))
+
+
+def _normalise(M6, phi):
+    """Unit modal mass, phase so that the largest-energy entry is real positive."""
+    phi = np.asarray(phi, complex)
+    j = int(np.argmax((np.conj(phi) * (M6 @ phi)).real))
+    phi = phi * np.exp(-1j * np.angle(phi[j]))
+    return phi / np.sqrt((np.conj(phi) @ M6 @ phi).real)
+
+
+def _condensed_stiffness(system, s):
+    """6×6 :math:`\\sum_n K_{IP,n}(s)\\,\\mathbf r_n\\mathbf r_n^T` at complex ``s``."""
+    K6 = np.zeros((6, 6), complex)
+    for row, _start, _ni, model in system.networks:
+        M, C, K = network_matrices(*model.network())
+        D = K + s * C + s * s * M
+        kip = D[0, 0]
+        if D.shape[0] > 1:
+            kip = kip - D[0, 1:] @ np.linalg.solve(D[1:, 1:], D[1:, 0])
+        K6 += kip * np.outer(row, row)
+    return K6
+
+
+def _mac(a, b, M6) -> float:
+    num = abs(np.conj(a) @ M6 @ b) ** 2
+    return float(num / ((np.conj(a) @ M6 @ a).real * (np.conj(b) @ M6 @ b).real))
+
+
+def _follow(system, M6, s0, phi0):
+    """Secant iteration on s for the branch through (s0, phi0)."""
+    def step(s, phi_ref):
+        mu, vec = sla.eig(_condensed_stiffness(system, s), M6)
+        k = int(np.argmax([_mac(vec[:, j], phi_ref, M6) for j in range(6)]))
+        return 1j * np.sqrt(mu[k]), vec[:, k]
+
+    s_prev, phi = s0, phi0
+    f_prev, phi = step(s_prev, phi)
+    s = f_prev
+    g_prev = f_prev - s_prev
+    for it in range(1, MAX_ITERATIONS + 1):
+        f, phi_new = step(s, phi)
+        g = f - s
+        if abs(g) <= TOLERANCE * abs(s):
+            return f, phi_new, it
+        phi = phi_new
+        denom = g - g_prev
+        s_next = f if denom == 0 else s - g * (s - s_prev) / denom
+        s_prev, g_prev, s = s, g, s_next
+    return s, phi, MAX_ITERATIONS
+
+
+def _null_vector(system, M6, s):
+    """Body shape of a root s: null vector of s²M₆ + ΣK_IP(s) r rᵀ."""
+    _, _, vh = np.linalg.svd(s * s * M6 + _condensed_stiffness(system, s))
+    return np.conj(vh[-1])
+
+
+def _dynamic_roots(system, M6, omegas, vec):
+    """Roots followed from each static mode, made unique against the exact eigenvalues.
+
+    Each static mode is followed by :func:`_follow`. The full state-space eigenvalues near
+    the rigid-body band are the candidates; static modes are assigned to distinct candidates
+    (nearest root and shape, :func:`scipy.optimize.linear_sum_assignment`), so two branches
+    can never land on the same eigenvalue.
+    """
+    from scipy.optimize import linear_sum_assignment
+    followed = [_follow(system, M6, 1j * w, vec[:, i].astype(complex))
+                for i, w in enumerate(omegas)]
+    lam = _state_space_eigenvalues(system)
+    top = 3.0 * max(omegas.max(), 1e-9)
+    cand = lam[(lam.imag > 0) & (np.abs(lam) < top)]
+    if cand.size < 6:
+        return followed
+    shapes = [_null_vector(system, M6, c) for c in cand]
+    cost = np.array([[abs(s - c) / abs(s) + 1.0 - _mac(phi, shapes[j], M6)
+                      for j, c in enumerate(cand)] for s, phi, _ in followed])
+    rows, cols = linear_sum_assignment(cost)
+    out = []
+    for i, j in zip(rows, cols):
+        s, phi, its = followed[i]
+        if abs(s - cand[j]) > 1e-6 * abs(s):           # branch lost: take the exact root
+            s, phi = cand[j], shapes[j]
+        out.append((s, phi, its))
+    return out
+
+
+def _state_space_eigenvalues(system) -> np.ndarray:
+    """Finite eigenvalues of the full model (internal degrees of freedom included)."""
+    n = system.n_dof
+    A = np.block([[np.zeros((n, n)), np.eye(n)], [-system.K, -system.C]])
+    B = np.block([[np.eye(n), np.zeros((n, n))], [np.zeros((n, n)), system.M]])
+    lam = sla.eig(A, B, right=False)
+    return lam[np.isfinite(lam)]
+
+
+def rigid_body_modes(system, inertia, *, static=False, crank_axis=(1.0, 0.0, 0.0),
+                     engine_name="") -> ModesResult:
+    """The six rigid-body modes of an assembled powertrain (rigid chassis).
+
+    Parameters
+    ----------
+    system : AssembledSystem
+        The body on its mounts (:func:`powertrain.assembly.assemble`).
+    inertia : array_like (3, 3)
+        Inertia tensor about the CG [kg·m²] (for the torque-roll axis).
+    static : bool
+        Static stiffness, undamped (else: dynamic stiffness at each mode's own frequency).
+    crank_axis : array_like (3,)
+        Unit vector of the crank axis in engine axes (engine X).
+    engine_name : str, optional
+        Recorded in the result (reports, plots).
+    """
+    M6 = system.M[:6, :6]
+    w2, vec = sla.eigh(system.static_stiffness_6(), M6)
+    tra = torque_roll_axis(inertia, crank_axis)
+    omegas = np.sqrt(np.clip(w2, 0.0, None))
+    roots = [(1j * w, vec[:, i].astype(complex), 0) for i, w in enumerate(omegas)]
+    if not static:
+        roots = _dynamic_roots(system, M6, omegas, vec)
+    modes = []
+    for s, phi, its in roots:
+        phi = _normalise(M6, phi)
+        ked = kinetic_energy_percent(M6, phi)
+        rot = phi[3:].real
+        modes.append(Mode(frequency_hz=abs(s) / (2 * np.pi),
+                          damping_ratio=0.0 if static else float(-s.real / abs(s)),
+                          damped_frequency_hz=float(s.imag / (2 * np.pi)), shape=phi,
+                          ked_percent=ked, angle_to_torque_roll_axis_deg=_axis_angle_deg(
+                              rot, tra), iterations=its))
+    modes.sort(key=lambda m: m.frequency_hz)
+    crank = np.asarray(crank_axis, float)
+    tra_info = {"direction": [float(v) for v in tra],
+                "angle_to_crank_axis_deg": _axis_angle_deg(tra, crank),
+                "angles_to_mode_rotation_axes_deg": [m.angle_to_torque_roll_axis_deg
+                                                     for m in modes],
+                "through": "centre of gravity"}
+    method = ("static: static stiffness, undamped" if static else
+              "dynamic: network dynamic stiffness at each mode's complex frequency "
+              "(internal degrees of freedom condensed exactly, secant iteration)")
+    return ModesResult(modes=modes, torque_roll_axis=tra_info, method=method,
+                       engine=engine_name)
+
+
+def engine_modes(engine, *, static=False) -> ModesResult:
+    """:func:`rigid_body_modes` of an :class:`~powertrain.models.engine.Engine`."""
+    from powertrain.assembly import assemble
+    b = engine.body
+    system = assemble(b.mass, b.cg, b.inertia, engine.mounts)
+    result = rigid_body_modes(system, b.inertia, static=static, engine_name=engine.name)
+    result.meta["cg_m"] = [float(v) for v in b.cg]
+    result.meta["mounts"] = engine.mount_names
+    return result

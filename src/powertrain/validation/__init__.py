@@ -1,0 +1,15 @@
+"""Validation of the diagnosis on data it was not made from.
+
+* :mod:`powertrain.validation.truth` — the *truth simulator*: its own assembly of the
+  powertrain (mount networks with their ground nodes, optional chassis bases and a
+  powertrain bending mode) run in the time domain by Newmark integration, with
+  higher-fidelity effect models written independently of the diagnosis' candidates;
+* :mod:`powertrain.validation.cases` — the truth effects (how their parameters are drawn),
+  the case plan of the blind benchmark, measurement scatter and the noise floor, and the
+  detectability of each case decided from the noise-free truth;
+* :mod:`powertrain.validation.scoring` — the benchmark's scores from verdict rows, with
+  Wilson score intervals.
+
+The diagnosis is never imported here: the benchmark script hands the measured run-up to
+:func:`powertrain.diagnosis.diagnose` and reads its answer through ``to_dict()``.
+"""

@@ -1,0 +1,209 @@
+r"""Cases of the blind benchmark: plan, engines, measurement scatter and noise, detectability.
+
+**Plan** (:func:`case_plan`), repeated every 25 cases: 14 single in-library effects
+(``mount_temperature`` and ``weak_cylinder`` three times, the four other in-library kinds
+twice, engines alternating), 3 pairs of different in-library kinds (random, random engine),
+4 effect-free (two per engine), 4 out-of-library (``sensor_bracket`` and
+``powertrain_bending`` twice each, alternating engines). The order within a lap is fixed and
+mixed, so a short run still covers most kinds.
+
+**Engines**: the default single-zone engine, or the same engine with **measured pressure
+traces** (:func:`traces_engine`: its own single-zone traces tabulated every 250 rpm) — the
+diagnosis gets the engine the case was made on, without the hidden effect.
+
+**Measurement** (:func:`measure`): 100-rpm grid 1000–6000 rpm; each order's complex amplitude
+[RMS] times :math:`10^{\epsilon/20}`, :math:`\epsilon\sim N(0,\sigma)` (log-normal scatter, σ
+uniform 0.5–1.0 dB per case), plus complex Gaussian noise of RMS :data:`FLOOR`; the written
+orders :data:`WRITTEN_ORDERS` and the synthesis (RMS sum of all 16 noisy orders).
+
+**Detectability** (:func:`gap_stats`, from the noise-free truth against the noise-free
+baseline, both on the truth path; never shown to the diagnosis): over the written order
+points of all speeds (floor added in power; points where both are below 3 × floor left out)
+the gap RMS reaches :data:`DETECT_RMS_DB` or the 95th percentile of ``|gap|`` reaches
+:data:`DETECT_LOCAL_DB`. For a pair each member is also classified alone; the *expected*
+answer is the library matches of the members detectable alone (all members if none is).
+"""
+
+from __future__ import annotations
+
+import functools
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from powertrain.validation import truth as tr
+from powertrain.validation.kinds import IN_LIBRARY, KINDS
+
+#: RMS noise floor of every order [m/s] (also handed to the diagnosis).
+FLOOR = 1.0e-6
+#: Orders written to the measured file.
+WRITTEN_ORDERS = (0.5, 1.0, 1.5, 2.0, 2.5, 3.0, 4.0, 6.0)
+#: Speed grid of the measurement [rpm].
+RPM = np.arange(1000.0, 6000.1, 100.0)
+#: A case is detectable when its noise-free gap RMS reaches this [dB] (twice the 0.5 dB by
+#: which a model may miss and still count as agreeing) ...
+DETECT_RMS_DB = 1.0
+#: ... or 5 % of its points are off by at least this [dB] (3 × the largest scatter, 1σ).
+DETECT_LOCAL_DB = 3.0
+#: Scatter range [dB, 1σ].
+SIGMA_DB = (0.5, 1.0)
+
+_LAP = [("mount_temperature", "sz"), ("weak_cylinder", "traces"), ("none", "sz"),
+        ("balancer_shafts", "sz"), ("sensor_bracket", "sz"), ("sensor_triads", "traces"),
+        ("chassis_base", "sz"), ("pair", None), ("amplitude_elastomer", "traces"),
+        ("weak_cylinder", "sz"), ("none", "traces"), ("powertrain_bending", "traces"),
+        ("mount_temperature", "traces"), ("balancer_shafts", "traces"), ("pair", None),
+        ("sensor_triads", "sz"), ("chassis_base", "traces"), ("none", "sz"),
+        ("amplitude_elastomer", "sz"), ("sensor_bracket", "traces"), ("pair", None),
+        ("powertrain_bending", "sz"), ("none", "traces"), ("weak_cylinder", "traces"),
+        ("mount_temperature", "sz")]
+
+
+def case_plan(n_cases, seed):
+    """``[(names, engine kind, case seed)]`` for ``n_cases`` cases of benchmark ``seed``.
+
+    Names are truth kinds (empty: effect-free); engine kind ``"sz"`` (single-zone) or
+    ``"traces"``; the case seed is derived from (``seed``, index).
+    """
+    out = []
+    for i in range(n_cases):
+        case_seed = int(np.random.SeedSequence([seed, i]).generate_state(1)[0])
+        rng = np.random.default_rng(case_seed)
+        name, eng = _LAP[i % len(_LAP)]
+        if name == "pair":
+            names = sorted(rng.choice(IN_LIBRARY, 2, replace=False).tolist())
+            eng = "sz" if rng.random() < 0.5 else "traces"
+        else:
+            names = [] if name == "none" else [name]
+        out.append((names, eng, case_seed))
+    return out
+
+
+@functools.cache
+def engines():
+    """``{"sz": default engine, "traces": the same with measured pressure traces}``."""
+    from powertrain.iotools.engine_file import DEFAULT_ENGINE_PATH, read_engine
+    e = read_engine(DEFAULT_ENGINE_PATH)
+    return {"sz": e, "traces": traces_engine(e)}
+
+
+def traces_engine(engine, step_rpm=250.0):
+    """``engine`` with its single-zone pressures tabulated every ``step_rpm`` as measured
+    traces (:class:`~powertrain.models.engine.MeasuredPressure`)."""
+    from powertrain.models.engine import RPM as RAD_PER_RPM
+    from powertrain.models.engine import MeasuredPressure
+    lo, hi = engine.speed_range_rpm()
+    speeds = np.arange(lo, hi + 1e-9, step_rpm)
+    p = []
+    for n in speeds:
+        theta, pc, _ = engine.combustion.cycle_pressures(engine.crank, n * RAD_PER_RPM)
+        p.append(pc)
+    comb = MeasuredPressure("synthetic traces (single-zone model of the default engine)",
+                            speeds * RAD_PER_RPM, np.array(p), theta)
+    return engine.replace(combustion=comb, name=engine.name + " [measured traces]")
+
+
+@functools.cache
+def baseline_velocity(engine_kind):
+    """Noise-free baseline on the truth path (n_r, 9, 16) [m/s peak]."""
+    e = engines()[engine_kind]
+    return tr.simulate_truth(tr.TruthSpec(e, list(e.mounts)), RPM)
+
+
+def truth_velocity(engine, truth):
+    """Noise-free truth of ``[(kind name, params)]`` on ``engine``."""
+    parts = {"engine": engine, "mounts": list(engine.mounts), "chassis": None,
+             "bending": None, "amplitude_beta": None, "sensor": []}
+    for name, params in truth:
+        KINDS[name].apply(params, parts)
+    return tr.simulate_truth(tr.TruthSpec(**parts), RPM)
+
+
+def written_levels(velocity, floor=FLOOR):
+    """RMS levels of the written orders with the floor added in power (n_r, n_ch, n_w)."""
+    idx = [int(round(2 * o)) - 1 for o in WRITTEN_ORDERS]
+    return np.sqrt((np.abs(velocity[..., idx]) / np.sqrt(2)) ** 2 + floor ** 2)
+
+
+def gap_stats(reference, velocity):
+    """(RMS, 95th percentile of |gap|) [dB] of ``velocity`` against ``reference``."""
+    a, b = written_levels(reference), written_levels(velocity)
+    keep = np.maximum(a, b) >= 3 * FLOOR
+    g = np.abs(20 * np.log10(b / a))[keep]
+    if g.size == 0:
+        return 0.0, 0.0
+    return float(np.sqrt(np.mean(g ** 2))), float(np.percentile(g, 95))
+
+
+def is_detectable(stats) -> bool:
+    """Detectability rule on :func:`gap_stats` (module docstring)."""
+    return bool(stats[0] >= DETECT_RMS_DB or stats[1] >= DETECT_LOCAL_DB)
+
+
+def measure(velocity, sigma_db, rng, source="", channels=None):
+    """Noisy measured run-up (:class:`~powertrain.iotools.measured.MeasuredRunup`)."""
+    from powertrain.analysis.orders import order_label
+    from powertrain.iotools.measured import MeasuredRunup
+    amp = velocity / np.sqrt(2) * 10 ** (rng.normal(0, sigma_db, velocity.shape) / 20)
+    noise = FLOOR * (rng.normal(size=amp.shape) + 1j * rng.normal(size=amp.shape)) / np.sqrt(2)
+    lev = np.abs(amp + noise)
+    syn = np.sqrt(np.sum(lev ** 2, axis=-1))
+    curves = {}
+    for c, (m, d) in enumerate(channels):
+        for o in WRITTEN_ORDERS:
+            curves[(m, d, order_label(o))] = (RPM.copy(), lev[:, c, int(round(2 * o)) - 1].copy())
+        curves[(m, d, "synthesis")] = (RPM.copy(), syn[:, c].copy())
+    return MeasuredRunup(curves, source=source, comments=["SYNTHETIC: blind benchmark truth"])
+
+
+@dataclass
+class Case:
+    """One benchmark case: what the diagnosis sees and what only the scorer knows."""
+
+    index: int
+    names: list
+    engine_kind: str
+    seed: int
+    measured: object
+    sigma_db: float
+    truth: list
+    clean: np.ndarray
+    stats: tuple
+    member_stats: dict = field(default_factory=dict)
+
+    @property
+    def category(self) -> str:
+        """``"none"``, ``"in"`` (every hidden effect in the library) or ``"out"``."""
+        if not self.names:
+            return "none"
+        return "in" if all(KINDS[n].library for n in self.names) else "out"
+
+    @property
+    def detectable(self) -> bool:
+        return bool(self.names) and is_detectable(self.stats)
+
+    @property
+    def truth_set(self) -> list:
+        return sorted({KINDS[n].library or "outside" for n in self.names})
+
+    @property
+    def expected_set(self) -> list:
+        alone = [n for n in self.names if is_detectable(self.member_stats.get(n, self.stats))]
+        return sorted({KINDS[n].library or "outside" for n in (alone or self.names)})
+
+
+def make_case(index, names, engine_kind, seed) -> Case:
+    """Draw, simulate and measure one case."""
+    rng = np.random.default_rng(seed)
+    engine = engines()[engine_kind]
+    truth = [(n, KINDS[n].draw(rng, engine)) for n in names]
+    base = baseline_velocity(engine_kind)
+    clean = truth_velocity(engine, truth) if truth else base
+    sigma = float(rng.uniform(*SIGMA_DB))
+    channels = [(mt.name, a) for mt in engine.mounts for a in "xyz"]
+    measured = measure(clean, sigma, rng, f"blind case {index} (seed {seed})", channels)
+    members = {}
+    if len(truth) > 1:
+        members = {t[0]: gap_stats(base, truth_velocity(engine, [t])) for t in truth}
+    return Case(index, list(names), engine_kind, seed, measured, sigma, truth, clean,
+                gap_stats(base, clean), members)

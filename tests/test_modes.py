@@ -1,0 +1,194 @@
+"""``powertrain modes`` (issue 13, item 2) against a closed form and an independent derivation.
+
+Tolerances: frequencies 1e-6 relative and kinetic-energy shares 0.01 percentage points (the
+issue's); both computations are exact linear algebra, so they agree to round-off.
+"""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import numpy as np
+import pytest
+import scipy.linalg as sla
+from click.testing import CliRunner
+from scipy.spatial.transform import Rotation
+
+from powertrain.assembly import assemble
+from powertrain.cli import main
+from powertrain.iotools.engine_file import DEFAULT_ENGINE_PATH, read_engine
+from powertrain.solvers.modes import COORDINATES, engine_modes
+
+DATA = Path(__file__).parent / "data"
+REFERENCE = DATA / "modes-reference-engine.toml"
+FREQ_REL = 1e-6
+KED_PP = 0.01
+
+SYMMETRIC = """
+[engine]
+name = "symmetric four-mount layout"
+
+[body]
+mass = {{value = {m}, unit = "kg"}}
+cg = {{value = [0.0, 0.0, 0.0], unit = "mm"}}
+inertia = {{value = [[{ixx}, 0.0, 0.0], [0.0, {iyy}, 0.0], [0.0, 0.0, {izz}]], unit = "kg*m^2"}}
+"""
+MOUNT = """
+[mounts.{name}]
+position = {{value = [{x}, {y}, 0.0], unit = "mm"}}
+orientation = {{value = [0.0, 0.0, 90.0], unit = "deg"}}
+stiffness = {{value = [{ky}, {kx}, {kz}], unit = "N/mm"}}
+damping = {{value = [{cy}, {cx}, {cz}], unit = "N*s/mm"}}
+"""
+
+
+def _symmetric(tmp_path):
+    """Four equal mounts at (±a, ±b) in the CG plane, diagonal inertia: decoupled modes.
+
+    Each mount is turned by 90° about Z with its x and y stiffness swapped, so in engine axes
+    it acts with kx, ky, kz (exercises the Euler orientation).
+    """
+    p = dict(m=150.0, ixx=6.0, iyy=14.0, izz=12.0)
+    k = dict(kx=110.0, ky=90.0, kz=200.0, cx=0.15, cy=0.12, cz=0.3)
+    a, b = 0.35, 0.25
+    text = SYMMETRIC.format(**p)
+    for i, (sx, sy) in enumerate([(1, 1), (1, -1), (-1, 1), (-1, -1)]):
+        text += MOUNT.format(name=f"m{i}", x=1e3 * sx * a, y=1e3 * sy * b, **k)
+    path = tmp_path / "symmetric.toml"
+    path.write_text(text)
+    kx, ky, kz = (1e3 * k[n] for n in ("kx", "ky", "kz"))
+    cx, cy, cz = (1e3 * k[n] for n in ("cx", "cy", "cz"))
+    # closed form: stiffness, damping and inertia of each decoupled coordinate
+    closed = {"x": (4 * kx, 4 * cx, p["m"]), "y": (4 * ky, 4 * cy, p["m"]),
+              "z": (4 * kz, 4 * cz, p["m"]), "rx": (4 * kz * b**2, 4 * cz * b**2, p["ixx"]),
+              "ry": (4 * kz * a**2, 4 * cz * a**2, p["iyy"]),
+              "rz": (4 * (kx * b**2 + ky * a**2), 4 * (cx * b**2 + cy * a**2), p["izz"])}
+    return path, closed
+
+
+@pytest.mark.parametrize("static", [True, False], ids=["static", "dynamic"])
+def test_symmetric_layout_matches_closed_form(tmp_path, static):
+    """Oracle: closed form. Each decoupled coordinate is a single-DOF oscillator:
+    f = sqrt(k/J)/2π, ζ = c/(2 sqrt(kJ)) (dynamic; 0 static), 100 % energy in it, and with a
+    diagonal inertia the torque-roll axis is the crank axis (the roll mode's axis: 0°)."""
+    path, closed = _symmetric(tmp_path)
+    res = engine_modes(read_engine(path), static=static)
+    assert [m.kind for m in res.modes] == ["rigid-body"] * 6
+    for m in res.modes:
+        k, c, J = closed[m.dominant]
+        assert m.frequency_hz == pytest.approx(np.sqrt(k / J) / (2 * np.pi), rel=FREQ_REL)
+        zeta = 0.0 if static else c / (2 * np.sqrt(k * J))
+        assert m.damping_ratio == pytest.approx(zeta, rel=1e-9, abs=1e-12)
+        assert m.ked_percent.max() == pytest.approx(100.0, abs=KED_PP)
+    assert sorted(m.dominant for m in res.modes) == sorted(COORDINATES)
+    np.testing.assert_allclose(res.torque_roll_axis["direction"], [1, 0, 0], atol=1e-12)
+    roll = next(m for m in res.modes if m.dominant == "rx")
+    assert roll.angle_to_torque_roll_axis_deg == pytest.approx(0.0, abs=1e-6)
+
+
+def _independent_reference(path):
+    """Six-DOF modes of a rigid body on linear springs, derived and coded apart from the
+    package (Lagrange's equations; e.g. Harris' Shock and Vibration Handbook, ch. 3
+    'Vibration of a resiliently supported rigid body').
+
+    Reads the file with tomllib, builds each mount's rotation with scipy's extrinsic 'xyz'
+    Euler convention (= Rz·Ry·Rx), writes the elastic energy
+    V(q) = ½ Σ_mounts Σ_local k_d (e_d·(u + θ×r))² and takes its Hessian by polarisation,
+    K_ij = V(e_i + e_j) − V(e_i) − V(e_j) (exact for a quadratic form); the kinetic energy
+    gives M = diag(m, m, m, I_CG). Modes from scipy.linalg.eigh; energy shares
+    φ_j(Mφ)_j/φᵀMφ.
+    """
+    import tomllib
+    doc = tomllib.loads(path.read_text())
+    b = doc["body"]
+    mass = b["mass"]["value"]
+    cg = np.array(b["cg"]["value"]) / 1e3
+    inertia = np.array(b["inertia"]["value"])
+    springs = []
+    for m in doc["mounts"].values():
+        R = Rotation.from_euler("xyz", m["orientation"]["value"], degrees=True).as_matrix()
+        r = np.array(m["position"]["value"]) / 1e3 - cg
+        for d in range(3):
+            springs.append((m["stiffness"]["value"][d] * 1e3, R[:, d], r))
+
+    def energy(q):
+        u, th = q[:3], q[3:]
+        return 0.5 * sum(k * (e @ (u + np.cross(th, r))) ** 2 for k, e, r in springs)
+
+    eye = np.eye(6)
+    K = np.array([[energy(eye[i] + eye[j]) - energy(eye[i]) - energy(eye[j])
+                   for j in range(6)] for i in range(6)])
+    M = np.zeros((6, 6))
+    M[:3, :3] = mass * np.eye(3)
+    M[3:, 3:] = inertia
+    w2, phi = sla.eigh(K, M)
+    ked = 100 * phi * (M @ phi) / np.einsum("ij,ij->j", phi, M @ phi)
+    return np.sqrt(w2) / (2 * np.pi), ked.T
+
+
+def test_static_modes_reproduce_independent_six_dof_reference(tmp_path):
+    """Oracle: the independent derivation above, for an engine file with Euler-angle
+    orientations, inline springs, an offset CG and products of inertia; through the CLI's
+    JSON (frequencies 1e-6 relative, energy 0.01 percentage points)."""
+    out = tmp_path / "modes.json"
+    res = CliRunner().invoke(main, ["modes", "--engine", str(REFERENCE), "--static",
+                                    "--json", str(out)])
+    assert res.exit_code == 0, res.output
+    data = json.loads(out.read_text())
+    f_ref, ked_ref = _independent_reference(REFERENCE)
+    f = [m["frequency_hz"] for m in data["modes"]]
+    np.testing.assert_allclose(f, f_ref, rtol=FREQ_REL)
+    ked = np.array([[m["ked_percent"][c] for c in COORDINATES] for m in data["modes"]])
+    np.testing.assert_allclose(ked, ked_ref, atol=KED_PP)
+    assert all(m["damping_ratio"] == 0.0 for m in data["modes"])
+    assert data["method"].startswith("static")
+
+
+def test_json_keys_and_order(tmp_path):
+    """Oracle: the issue's JSON layout, modes sorted by frequency."""
+    out = tmp_path / "m.json"
+    res = CliRunner().invoke(main, ["modes", "--json", str(out), "--plot",
+                                    str(tmp_path / "m.png")])
+    assert res.exit_code == 0, res.output
+    data = json.loads(out.read_text())
+    assert {"modes", "torque_roll_axis", "method"} <= set(data)
+    assert len(data["modes"]) == 6
+    for m in data["modes"]:
+        assert {"frequency_hz", "damping_ratio", "dominant", "ked_percent"} <= set(m)
+        assert set(m["ked_percent"]) == set(COORDINATES)
+        assert sum(m["ked_percent"].values()) == pytest.approx(100.0, abs=1e-9)
+        assert m["dominant"] == max(m["ked_percent"], key=m["ked_percent"].get)
+    f = [m["frequency_hz"] for m in data["modes"]]
+    assert f == sorted(f)
+    assert (tmp_path / "m.png").stat().st_size > 0
+
+
+@pytest.mark.parametrize("path", [DEFAULT_ENGINE_PATH,
+                                  Path(DEFAULT_ENGINE_PATH).parent / "default-torque-rod.toml",
+                                  REFERENCE], ids=["default", "torque-rod", "reference"])
+def test_dynamic_modes_are_eigenvalues_of_the_full_model(path):
+    """Oracle: a second solver. Every damped mode's complex frequency s is an eigenvalue of
+    the full state-space model M q'' + C q' + K q = 0 with the networks' internal degrees of
+    freedom (scipy.linalg.eig), and the six modes are distinct."""
+    e = read_engine(path)
+    system = assemble(e.body.mass, e.body.cg, e.body.inertia, e.mounts)
+    n = system.n_dof
+    A = np.block([[np.zeros((n, n)), np.eye(n)], [-system.K, -system.C]])
+    B = np.block([[np.eye(n), np.zeros((n, n))], [np.zeros((n, n)), system.M]])
+    lam = sla.eig(A, B, right=False)
+    lam = lam[np.isfinite(lam)]
+    res = engine_modes(e)
+    s = [2 * np.pi * m.frequency_hz * (-m.damping_ratio + 1j * np.sqrt(1 - m.damping_ratio**2))
+         for m in res.modes]
+    for si in s:
+        assert np.min(np.abs(lam - si)) / abs(si) < 1e-8
+    assert min(abs(a - b) for i, a in enumerate(s) for b in s[i + 1:]) > 1e-6 * abs(s[0])
+    assert [m.frequency_hz for m in res.modes] == sorted(m.frequency_hz for m in res.modes)
+
+
+def test_modes_of_an_engine_file_without_excitation():
+    """Oracle: the issue — an engine file with only [engine], [body], [mounts.*] runs modes."""
+    res = CliRunner().invoke(main, ["modes", "--engine", str(REFERENCE)])
+    assert res.exit_code == 0, res.output
+    assert "torque-roll axis" in res.output

@@ -1,0 +1,196 @@
+"""Output files (issue 10, item 4): mode from the umask, atomic, only what is asked, provenance,
+the right key in every error, no leftovers after a failed run."""
+
+from __future__ import annotations
+
+import json
+import os
+import stat
+import subprocess
+import sys
+
+import h5py
+import pytest
+from click.testing import CliRunner
+
+from powertrain.cli import main
+from powertrain.iotools.atomic import atomic_write, discard_written, start_tracking
+
+QUICK = ["--from", "1000", "--to", "2000", "--step", "500"]
+
+
+def _cli(args, cwd, umask=0o022):
+    """Run the CLI in a subprocess under ``umask`` (stderr not a terminal: no progress bar)."""
+    code = f"import os, sys; os.umask({umask}); from powertrain.cli import main; main()"
+    return subprocess.run([sys.executable, "-c", code, *args], cwd=cwd, capture_output=True,
+                          text=True, timeout=300)
+
+
+def _mode(path):
+    return stat.S_IMODE(os.stat(path).st_mode)
+
+
+@pytest.mark.parametrize("umask,expected", [(0o022, 0o644), (0o077, 0o600), (0o002, 0o664)])
+def test_atomic_write_gets_the_umask_mode(tmp_path, umask, expected):
+    old = os.umask(umask)
+    try:
+        with atomic_write(tmp_path / "a.txt") as fh:
+            fh.write("x")
+    finally:
+        os.umask(old)
+    assert _mode(tmp_path / "a.txt") == expected
+    assert [p.name for p in tmp_path.iterdir()] == ["a.txt"]      # no temporary file left
+
+
+def test_failed_block_leaves_nothing(tmp_path):
+    with pytest.raises(RuntimeError):
+        with atomic_write(tmp_path / "a.txt") as fh:
+            fh.write("half")
+            raise RuntimeError
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_discard_written_removes_this_commands_outputs(tmp_path):
+    start_tracking()
+    with atomic_write(tmp_path / "a.txt") as fh:
+        fh.write("x")
+    assert [p.name for p in discard_written()] == ["a.txt"]
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_runup_outputs_0644_with_provenance_and_balancers_off(tmp_path):
+    r = _cli(["runup", *QUICK, "--no-balancers", "--out", "r.h5", "--csv", "r.csv",
+              "--plot", "r.png"], tmp_path)
+    assert r.returncode == 0, r.stderr
+    assert "wrote r.h5, r.csv, r.png" in r.stdout
+    for name in ("r.h5", "r.csv", "r.png"):
+        assert _mode(tmp_path / name) == 0o644, name
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["r.csv", "r.h5", "r.png"]
+    with h5py.File(tmp_path / "r.h5", "r") as h5:
+        prov = json.loads(h5.attrs["provenance"])
+        as_run = json.loads(h5.attrs["engine_as_run"])
+        assert h5.attrs["command_line"].startswith("powertrain runup --from 1000")
+    assert as_run["balancer"]["enabled"] is False
+    assert "--no-balancers" in prov["command_line"]
+    assert prov["modifications"] == ["balancer shafts switched off (--no-balancers)"]
+    assert prov["powertrain_version"] and prov["created"].endswith("+00:00")
+    assert {m["name"] for m in as_run["mounts"]} == {"left", "right", "gearbox"}
+
+
+def test_runup_effect_recorded(tmp_path):
+    r = _cli(["runup", *QUICK, "--solver", "harmonic", "--quiet", "--out", "r.h5",
+              "--effect", "base_compliance:c_base=400N/mm,m_base=8kg"], tmp_path)
+    assert r.returncode == 0, r.stderr
+    with h5py.File(tmp_path / "r.h5", "r") as h5:
+        prov = json.loads(h5.attrs["provenance"])
+    assert prov["effects"]["base_compliance"]["c_base"] == pytest.approx(400e3)
+
+
+def test_runup_writes_only_what_is_asked(tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    r = CliRunner().invoke(main, ["runup", *QUICK, "--solver", "harmonic"],
+                           catch_exceptions=False)
+    assert r.exit_code == 0
+    assert "no file written" in r.output
+    assert list(tmp_path.iterdir()) == []
+    r = _cli(["runup", *QUICK, "--solver", "harmonic", "--csv", "only.csv"], tmp_path)
+    assert r.returncode == 0 and "wrote only.csv" in r.stdout
+    assert [p.name for p in tmp_path.iterdir()] == ["only.csv"]
+
+
+@pytest.mark.parametrize("args,key", [
+    (["--to", "9000"], "--to"),
+    (["--from", "200", "--to", "2000"], "--from"),
+    (["--from", "2000", "--to", "1000"], "--to"),
+    (["--step", "0"], "--step"),
+    (["--from", "1000", "--to", "1e12", "--step", "1"], "--step"),
+    (["--angle-step", "0"], "--angle-step"),
+    (["--angle-step", "7"], "--angle-step"),
+    (["--angle-step", "nan"], "--angle-step"),
+])
+def test_runup_errors_name_the_right_option(tmp_path, args, key):
+    r = CliRunner().invoke(main, ["runup", "--out", str(tmp_path / "r.h5"), *args])
+    assert r.exit_code == 1
+    lines = r.output.strip().splitlines()
+    assert len(lines) == 1 and f"key '{key}'" in lines[0], r.output
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_unwritable_output_refused_before_work(tmp_path):
+    (tmp_path / "file").write_text("")
+    r = _cli(["runup", *QUICK, "--out", "r.h5", "--plot", "file/p.png"], tmp_path)
+    assert r.returncode == 1
+    assert r.stderr.count("\n") == 1 and "--plot" in r.stderr, r.stderr
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["file"]
+
+
+def test_failure_after_writing_removes_the_earlier_outputs(tmp_path, monkeypatch):
+    """A run that fails on its last output leaves none of its outputs behind."""
+    from powertrain.errors import InputError
+    from powertrain.results import RunupResult
+
+    def broken(self, path=None, **kw):
+        raise InputError("cannot draw", file=path, key="--plot")
+    monkeypatch.setattr(RunupResult, "plot", broken)
+    r = CliRunner().invoke(main, ["runup", *QUICK, "--solver", "harmonic",
+                                  "--out", str(tmp_path / "r.h5"),
+                                  "--csv", str(tmp_path / "r.csv"),
+                                  "--plot", str(tmp_path / "r.png")])
+    assert r.exit_code == 1, r.output
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_progress_bar_quiet_when_not_a_terminal(tmp_path):
+    r = _cli(["runup", *QUICK, "--solver", "harmonic"], tmp_path)
+    assert r.returncode == 0 and r.stderr == ""
+
+
+def test_progress_bar_shown_on_a_terminal():
+    """On a TTY the bar appears; disabled (``--quiet``) it does not."""
+    import io
+
+    from powertrain.progress import progress_bar
+
+    class FakeTTY(io.StringIO):
+        def isatty(self):
+            return True
+    buf = FakeTTY()
+    old, sys.stderr = sys.stderr, buf
+    try:
+        list(progress_bar(range(3), desc="x"))
+        shown = buf.getvalue()
+        buf.seek(0)
+        buf.truncate()
+        list(progress_bar(range(3), desc="x", enabled=False))
+        hidden = buf.getvalue()
+    finally:
+        sys.stderr = old
+    assert "x" in shown and "0/3" in shown and hidden == ""
+
+
+def test_activity_bar_ticks_on_a_terminal_only():
+    import io
+    import time
+
+    from powertrain.progress import activity
+
+    class FakeTTY(io.StringIO):
+        def isatty(self):
+            return True
+    buf = FakeTTY()
+    old, sys.stderr = sys.stderr, buf
+    try:
+        with activity("work", interval=0.05):
+            time.sleep(0.2)
+        shown = buf.getvalue()
+    finally:
+        sys.stderr = old
+    assert "work" in shown and "elapsed" in shown
+    plain = io.StringIO()
+    old, sys.stderr = sys.stderr, plain
+    try:
+        with activity("work", interval=0.05):
+            time.sleep(0.1)
+    finally:
+        sys.stderr = old
+    assert plain.getvalue() == ""

@@ -1,0 +1,79 @@
+"""The installed package: built as a wheel, installed in a fresh venv, run from an empty folder.
+
+Issue 10, item 1: engines/, mounts/ and examples/ are package data found with
+:mod:`importlib.resources`, so ``powertrain runup`` works outside the checkout. The fresh venv
+sees the current environment's third-party packages through a ``.pth`` line (no download, and
+no editable install of this checkout), and the wheel is installed with ``--no-deps``.
+"""
+
+from __future__ import annotations
+
+import os
+import site
+import subprocess
+import sys
+import sysconfig
+import venv
+from pathlib import Path
+
+import pytest
+
+from powertrain.data import FOLDERS, default_engine_path, shipped_files
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def test_shipped_files_are_the_checkout_folders():
+    """In the checkout, package data and the top-level folders are the same files (no copy)."""
+    assert default_engine_path().resolve() == (ROOT / "engines" / "default.toml").resolve()
+    for folder in FOLDERS:
+        shipped = {p.name for p in shipped_files(folder)}
+        top = {p.name for p in (ROOT / folder).iterdir() if p.is_file()}
+        assert shipped == top, folder
+
+
+def _third_party_paths() -> list[str]:
+    """Site folders of the running environment, minus anything that holds this checkout."""
+    paths = site.getsitepackages() + [sysconfig.get_paths()["purelib"]]
+    return sorted({p for p in paths if Path(p).is_dir() and not (Path(p) / "powertrain").is_dir()})
+
+
+def _clean_env(venv_dir: Path) -> dict:
+    env = {k: v for k, v in os.environ.items()
+           if k not in ("PYTHONPATH", "PYTHONHOME", "VIRTUAL_ENV")}
+    env["PATH"] = f"{venv_dir / 'bin'}{os.pathsep}{env.get('PATH', '')}"
+    env["NUMBA_CACHE_DIR"] = str(venv_dir / "numba-cache")
+    return env
+
+
+@pytest.mark.slow
+def test_wheel_runs_runup_from_an_empty_folder(tmp_path):
+    wheels = tmp_path / "wheels"
+    build = subprocess.run([sys.executable, "-m", "pip", "wheel", str(ROOT), "--no-deps",
+                            "-q", "-w", str(wheels)], capture_output=True, text=True)
+    assert build.returncode == 0, build.stderr[-2000:]
+    wheel = next(wheels.glob("powertrain-*.whl"))
+
+    venv_dir = tmp_path / "venv"
+    venv.EnvBuilder(with_pip=False).create(venv_dir)
+    vpython = venv_dir / "bin" / "python"
+    vsite = subprocess.run([str(vpython), "-c", "import sysconfig; print(sysconfig.get_paths()['purelib'])"],
+                           capture_output=True, text=True, check=True).stdout.strip()
+    (Path(vsite) / "third_party.pth").write_text("\n".join(_third_party_paths()) + "\n")
+    env = _clean_env(venv_dir)
+    inst = subprocess.run([str(vpython), "-m", "pip", "install", "--no-deps", "-q", str(wheel)],
+                          capture_output=True, text=True, env=env)
+    assert inst.returncode == 0, inst.stderr[-2000:]
+
+    empty = tmp_path / "empty"
+    empty.mkdir()
+    where = subprocess.run([str(vpython), "-c", "import powertrain; print(powertrain.__file__)"],
+                           capture_output=True, text=True, env=env, cwd=empty, check=True)
+    assert Path(where.stdout.strip()).resolve().is_relative_to(venv_dir.resolve())
+    run = subprocess.run([str(venv_dir / "bin" / "powertrain"), "runup", "--from", "1000",
+                          "--to", "2000", "--step", "500", "--csv", "r.csv"],
+                         capture_output=True, text=True, env=env, cwd=empty, timeout=600)
+    assert run.returncode == 0, run.stderr[-2000:]
+    lines = (empty / "r.csv").read_text().splitlines()
+    assert lines[0].startswith("mount,direction,quantity,rpm")
+    assert {ln.split(",")[3] for ln in lines[1:]} == {"1000", "1500", "2000"}
