@@ -4,7 +4,8 @@ shown in README and docs/ runs in a test, so no figure or flag can go stale agai
 The rules a docs author must know are in docs/extending.md, "Writing docs"; in short:
 
 * ```bash blocks are executed, every other fence (```text for output, ```toml, ```python)
-  is not; ```sh, ```shell, ```console and ```zsh are refused so that no command escapes.
+  is not; ```sh, ```shell, ```console and ```zsh are refused so that no command escapes;
+  ```python blocks must compile.
 * Each doc file runs in its own empty temporary folder in which the repository's
   ``examples/``, ``engines/``, ``mounts/`` and ``scripts/`` are reachable by those names
   (symbolic links); its commands run in order, so a later block may read what an earlier
@@ -32,6 +33,7 @@ import shlex
 import signal
 import subprocess
 import sys
+import textwrap
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -339,6 +341,17 @@ def test_relative_links_resolve(doc):
               if not re.match(r"[a-z]+:", target) and not target.startswith("#")
               and not (path.parent / target.split("#")[0]).exists()]
     assert not broken, f"{doc}: broken links {broken}"
+
+
+PYTHON_BLOCK = re.compile(r"^\s*```python\n(.*?)^\s*```", re.S | re.M)
+
+
+@pytest.mark.parametrize("doc", list(ALL_COMMANDS))
+def test_python_examples_compile(doc):
+    """```python blocks are not run (they may be fragments), but they must be valid Python."""
+    text = (ROOT / doc).read_text(encoding="utf-8")
+    for block in PYTHON_BLOCK.findall(text):
+        compile(textwrap.dedent(block), doc, "exec")
 
 
 def test_every_doc_page_with_commands_is_collected():
