@@ -74,7 +74,7 @@ class Problem:
     def __init__(self, hm_train, hm_test, data: GapData, train_idx, test_idx, train_cells=None,
                  test_cells=None):
         self.hm = {"train": hm_train, "test": hm_test}
-        self.engine = hm_train.engine
+        self.engine = hm_train.engine       # for the effects' parameters (layout only)
         self.data = data
         self.idx = {"train": train_idx, "test": test_idx}
         om = data.order_mask
@@ -85,6 +85,13 @@ class Problem:
         for part, cells in (("train", train_cells), ("test", test_cells)):
             if cells is not None:
                 self.valid[part] = self.valid[part] & np.asarray(cells, bool)[None]
+
+    def __getstate__(self):
+        # sent to other processes (parallel fits): the engine without its pressure cache
+        state = dict(self.__dict__)
+        if hasattr(self.engine, "replace"):
+            state["engine"] = self.engine.replace()
+        return state
 
     def restricted(self, train_cells=None, test_cells=None) -> Problem:
         """The same problem with (channel, order) cells withheld from fitting / scoring."""
