@@ -217,7 +217,8 @@ def _diagnose(measured, engine, noise_floor, effects, pairs, do_bands, rule, sch
                                s.train_all[::max(1, s.train_all.size // 48)])
     eq = cand.equivalents(s, chosen, rule)
     text = verdict.text if not eq else verdict.text + (
-        "; the data cannot tell it from " + "; ".join(x["text"] for x in eq))
+        f"; the order magnitudes cannot tell it from {len(eq)} equivalent explanation(s): "
+        + "; ".join(x["text"] for x in eq[:3]) + ("; ..." if len(eq) > 3 else ""))
     return DiagnosisResult(
         s.data, s.src, getattr(engine, "name", ""), gap_map, gap_after, parts, rigid, found,
         sigma, s.split_dict(), baseline, outcomes, chosen, verdict.label, text, bands,
