@@ -28,6 +28,7 @@ Vold–Kalman filtering (:mod:`powertrain.analysis.vold_kalman`) is the second m
 
 from __future__ import annotations
 
+import functools
 import math
 
 import numpy as np
@@ -89,10 +90,13 @@ def samples_per_rev(orders) -> int:
     return int(2 ** math.ceil(math.log2(need)))
 
 
+@functools.lru_cache(maxsize=4)
 def kernel_table(K, beta, n_tab=16385):
     """Kaiser-windowed sinc with K zero crossings per side, on v = -1 ... 1."""
     v = np.linspace(-1.0, 1.0, n_tab)
-    return np.sinc(K * v) * np.kaiser(n_tab, beta)
+    table = np.sinc(K * v) * np.kaiser(n_tab, beta)
+    table.flags.writeable = False
+    return table
 
 
 def speed_grid(profile, rpm_step, block_revs, *, margin_s=0.0, file=None, key="rpm"):
@@ -113,27 +117,45 @@ def speed_grid(profile, rpm_step, block_revs, *, margin_s=0.0, file=None, key="r
     hi_ok = np.interp(th[-1] - np.pi * block_revs, th, t) - margin_s
     grid = rpm_step * np.arange(math.ceil(n.min() / rpm_step), math.floor(n.max() / rpm_step)
                                 + 1)
-    rpm, centre = [], []
-    for r in grid:
-        d = n - r
-        cross = np.flatnonzero((d[:-1] <= 0) != (d[1:] <= 0))
-        for c in cross:
-            f = d[c] / (d[c] - d[c + 1]) if d[c] != d[c + 1] else 0.0
-            tc = t[c] + f * (t[c + 1] - t[c])
-            if lo_ok <= tc <= hi_ok:
-                rpm.append(r)
-                centre.append(th[c] + f * (th[c + 1] - th[c]))
-                break
+    tc, thc = first_passing(t, n, grid, th)
+    keep = (tc >= lo_ok) & (tc <= hi_ok)
+    rpm, centre = list(grid[keep]), thc[keep]
     if not rpm:
         raise InputError(f"speed never passes a multiple of {rpm_step:g} rpm with "
-                         f"{block_revs} revolutions of data either side (speed "
+                         f"{block_revs / 2:g} revolutions (+ {margin_s:.3g} s) of data either "
+                         "side (speed "
                          f"{n.min():.0f}..{n.max():.0f} rpm over {t[-1] - t[0]:.3g} s)",
                          file=file, key=key)
     return np.array(rpm, float), np.array(centre, float)
 
 
-def cot_amplitudes(X, profile, orders, rpm_centre, angle_centre, block_revs=None, *,
-                   progress=False):
+def first_passing(t, rpm, targets, *others):
+    """Time (and the values of ``others`` interpolated there) at which the speed first
+    reaches each target [s]; NaN where it never does.
+
+    From below (``rpm[0] < target``) the first sample at or above the target is found by
+    bisection in the running maximum, from above in the running minimum.
+    """
+    t = np.asarray(t, float)
+    rpm = np.asarray(rpm, float)
+    targets = np.asarray(targets, float)
+    up = np.searchsorted(np.maximum.accumulate(rpm), targets, side="left")
+    down = np.searchsorted(-np.minimum.accumulate(rpm), -targets, side="left")
+    idx = np.where(rpm[0] < targets, up, down)
+    found = idx < rpm.size
+    i1 = np.clip(idx, 1, rpm.size - 1)
+    i0 = i1 - 1
+    d0, d1 = rpm[i0] - targets, rpm[i1] - targets
+    f = np.where(d0 != d1, d0 / np.where(d0 != d1, d0 - d1, 1.0), 0.0)
+    f = np.where(idx == 0, 0.0, np.clip(f, 0.0, 1.0))
+    out = [np.where(found, t[i0] + f * (t[i1] - t[i0]), np.nan)]
+    for arr in others:
+        arr = np.asarray(arr, float)
+        out.append(np.where(found, arr[i0] + f * (arr[i1] - arr[i0]), np.nan))
+    return out[0] if not others else tuple(out)
+
+
+def cot_amplitudes(X, profile, orders, rpm_centre, angle_centre, block_revs=None):
     """Complex order amplitudes per grid speed by computed order tracking.
 
     Parameters
@@ -146,6 +168,8 @@ def cot_amplitudes(X, profile, orders, rpm_centre, angle_centre, block_revs=None
         From :func:`speed_grid`.
     block_revs : int, optional
         Block length [rev] (default :func:`block_revolutions`).
+    progress : bool, optional
+        Show a progress bar on stderr (quiet off a terminal).
 
     Returns
     -------

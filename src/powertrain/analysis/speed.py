@@ -79,12 +79,28 @@ def speed_from_rpm(time, rpm, *, smooth_s=0.1, file=None, key="rpm") -> SpeedPro
         Measured speed [rpm].
     smooth_s : float
         Smoothing window [s].
+    file, key : str, optional
+        File and channel named in error messages.
     """
     from scipy.signal import savgol_filter
     time = np.asarray(time, float)
     rpm = np.asarray(rpm, float)
     window = _savgol_window(time, smooth_s)
-    smooth = savgol_filter(rpm, window, 3, mode="interp") if window > 4 else rpm
+    # long windows: Savitzky-Golay on means of k samples, interpolated back (linear inside,
+    # the end slopes extrapolated outside the first and last block centres)
+    k = max(1, window // 64)
+    n_blocks = rpm.size // k
+    if k > 1 and n_blocks >= 16:
+        means = rpm[:n_blocks * k].reshape(n_blocks, k).mean(axis=1)
+        t_means = time[:n_blocks * k].reshape(n_blocks, k).mean(axis=1)
+        sm = savgol_filter(means, _savgol_window(t_means, smooth_s), 3, mode="interp")
+        smooth = np.interp(time, t_means, sm)
+        lo, hi = time < t_means[0], time > t_means[-1]
+        smooth[lo] = sm[0] + (sm[1] - sm[0]) / (t_means[1] - t_means[0]) * (time[lo] - t_means[0])
+        smooth[hi] = sm[-1] + (sm[-1] - sm[-2]) / (t_means[-1] - t_means[-2]) * (
+            time[hi] - t_means[-1])
+    else:
+        smooth = savgol_filter(rpm, window, 3, mode="interp") if window > 4 else rpm
     if np.any(smooth <= 0):
         raise InputError("speed must stay > 0 (a stopped or reversing shaft cannot be "
                          "order tracked)", file=file, key=key)

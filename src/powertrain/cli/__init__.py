@@ -55,6 +55,7 @@ def main():
       powertrain whatif --scale left.z.stiffness=1.2 --json whatif.json
       powertrain diagnose examples/measured-runup.csv --report diagnosis/
       powertrain modes --engine engines/default-torque-rod.toml --json modes.json
+      powertrain track run.csv --csv tracked.csv --plot orders.png
     """
 
 
@@ -68,6 +69,7 @@ def _register():
         modes,
         runup,
         stiffness,
+        track,
         whatif,
     )
 

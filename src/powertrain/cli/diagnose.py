@@ -74,6 +74,9 @@ def diagnose(measured, engine_file, report_dir, json_file, noise_floor, effects,
         check_writable(Path(report_dir) / "summary.txt", key="--report")
     engine = read_engine(engine_file or str(DEFAULT_ENGINE_PATH))
     meas = read_measured(measured, mounts=engine.mount_names)
+    if meas.signal != "velocity":
+        raise InputError("diagnose needs velocity, acceleration or displacement order curves "
+                         f"(this file holds {meas.signal})", file=measured)
     with activity("diagnose (fitting the effect library)", enabled=not quiet):
         res = run(meas, engine, noise_floor=noise_floor * 1e-3, effects=names,
                   pairs=not no_pairs, scheduler=scheduler, progress=False)
@@ -84,7 +87,10 @@ def diagnose(measured, engine_file, report_dir, json_file, noise_floor, effects,
                    provenance(engine, engine_file=engine_file or DEFAULT_ENGINE_PATH))
         click.echo(f"wrote {json_file}")
     if report_dir:
-        files = res.report(report_dir)
+        from powertrain.cli.common import cli_provenance, engine_description, use_agg
+        use_agg()
+        files = res.report(report_dir, provenance=cli_provenance(
+            engine_description(engine, engine.file)))
         click.echo(f"wrote {len(files)} files to {report_dir}")
 
 
@@ -101,7 +107,8 @@ def diagnose(measured, engine_file, report_dir, json_file, noise_floor, effects,
                    "diagnosis).")
 @click.option("--engine", "engine_file", type=click.Path(dir_okay=False),
               help="Baseline engine file (default: engines/default.toml).")
-def synth(effect_names, seed, out, truth_file, engine_file):
+@click.option("--quiet", is_flag=True, help="No progress indicator on stderr.")
+def synth(effect_names, seed, out, truth_file, engine_file, quiet):
     """Make a SYNTHETIC measured run-up with hidden effects and noise (truth generator).
 
     \b
@@ -125,7 +132,13 @@ def synth(effect_names, seed, out, truth_file, engine_file):
             raise InputError(f"unknown truth effect {e!r} (known: {', '.join(TRUTH_EFFECTS)})",
                              key="--effect")
     engine = read_engine(engine_file or str(DEFAULT_ENGINE_PATH))
-    case = make_case(engine, names, seed)
+    from powertrain.cli.common import check_outputs
+    from powertrain.progress import activity
+    if not 0 <= seed < 2 ** 63:
+        raise InputError(f"must be an integer 0..2^63-1, got {seed}", key="--seed")
+    check_outputs(out=out, truth=truth_file)
+    with activity("synth (simulating the hidden truth)", enabled=not quiet):
+        case = make_case(engine, names, seed)
     with atomic_write(out) as fh:
         fh.write(case.csv_text())
     if truth_file:

@@ -34,9 +34,16 @@ from powertrain.cli.common import speed_options, speed_steps
 @click.option("--effect", multiple=True, metavar="NAME[:PARAM=VALUE,...]",
               help="Add an unmodelled effect of the diagnosis library (as in `whatif`), e.g. "
                    "base_compliance:c_base=400N/mm,m_base=8kg. Repeatable.")
+@click.option("--sweep", type=float, metavar="RPM_PER_S",
+              help="Continuous run-up at this rate [rpm/s] (time integration of one speed "
+                   "ramp) instead of steady states; tracked like measured data.")
+@click.option("--raw", "raw_file", type=click.Path(dir_okay=False),
+              help="With --sweep: write the raw mount-point accelerations (raw HDF5 layout).")
+@click.option("--sample-rate", type=float, default=8192.0, show_default=True,
+              help="With --sweep: sampling rate of the raw data [Hz].")
 @click.option("--quiet", is_flag=True, help="No progress bar and no table.")
 def runup(rpm_from, rpm_to, rpm_step, engine_file, solver, stepper, angle_step, out, csv_file,
-          plot, no_balancers, effect, quiet):
+          plot, no_balancers, effect, sweep, raw_file, sample_rate, quiet):
     """Run-up: steady-state mount-point velocities at each speed, order analysed.
 
     Prints the rigid-body modes and the synthesis (RMS sum of orders 0.5..8) velocity of the
@@ -49,8 +56,9 @@ def runup(rpm_from, rpm_to, rpm_step, engine_file, solver, stepper, angle_step, 
       powertrain runup --out runup.h5 --no-balancers
       powertrain runup --solver harmonic --csv runup.csv --plot runup.png
       powertrain runup --effect amplitude_stiffness:kappa=1,a_c=0.02mm
+      powertrain runup --from 2000 --to 3000 --sweep 200 --raw sweep.h5 --csv sweep.csv
     """
-    from powertrain.cli.common import check_outputs, runup_settings
+    from powertrain.cli.common import check_outputs, checked_runup, runup_settings
     from powertrain.iotools.engine_file import DEFAULT_ENGINE_PATH, read_engine
     from powertrain.runup import run_runup
 
@@ -62,16 +70,23 @@ def runup(rpm_from, rpm_to, rpm_step, engine_file, solver, stepper, angle_step, 
     if no_balancers:
         engine = engine.with_balancers(enabled=False)
         modifications.append("balancer shafts switched off (--no-balancers)")
+    if sweep is not None or raw_file:
+        from powertrain.cli.sweep_run import run_sweep
+        return run_sweep(engine, rpm_from, rpm_to, sweep, sample_rate, raw_file, out, csv_file,
+                         plot, effect, quiet)
     from powertrain.variants import effect_scenario, parse_operations
     scenario = effect_scenario(parse_operations({"effect": effect}))
     runup_settings(engine, rpm, angle_step)
     if scenario:
         from powertrain.effect_runup import runup_with_effects
-        result = runup_with_effects(engine, rpm, scenario, solver=solver,
-                                    angle_step_deg=angle_step, stepper=stepper)
+        from powertrain.progress import activity
+        with activity(f"run-up with effects ({solver})", enabled=not quiet):
+            result = checked_runup(engine, engine_path, runup_with_effects, rpm, scenario,
+                                   solver=solver, angle_step_deg=angle_step, stepper=stepper)
     else:
-        result = run_runup(engine, rpm, solver=solver, angle_step_deg=angle_step,
-                           progress=not quiet, stepper=stepper)
+        result = checked_runup(engine, engine_path, run_runup, rpm, solver=solver,
+                               angle_step_deg=angle_step, progress=not quiet,
+                               stepper=stepper)
     written = []
     if out:
         from powertrain.provenance import provenance
@@ -90,7 +105,10 @@ def runup(rpm_from, rpm_to, rpm_step, engine_file, solver, stepper, angle_step, 
         result.to_csv(csv_file)
         written.append(csv_file)
     if plot:
-        result.plot(plot)
+        from powertrain.cli.common import cli_provenance, engine_description, write_plot
+        fig_prov = cli_provenance(engine_description(engine, engine_path, no_balancers=no_balancers,
+                                                 effects=effect))
+        write_plot(lambda p: result.plot(path=p, provenance=fig_prov), plot)
         written.append(plot)
     if quiet:
         return

@@ -84,7 +84,7 @@ def summary(r) -> str:
     return "\n".join(lines)
 
 
-def write_report(r, directory) -> list:
+def write_report(r, directory, provenance=None) -> list:
     """Write ``summary.txt``, ``diagnosis.json`` and the figures into ``directory``."""
     from pathlib import Path
 
@@ -96,8 +96,10 @@ def write_report(r, directory) -> list:
         fh.write(r.summary() + "\n")
     r.to_json(out / "diagnosis.json")
     files = [out / "summary.txt", out / "diagnosis.json"]
+    from powertrain.plotting.style import close_figure
+    provenance = provenance or getattr(r, "provenance", None)
     for name, fn in (("gap_map.png", plot_gap_map), ("gap_vs_frequency.png", plot_gap_frequency),
                      ("overlay.png", plot_diagnosis_overlay)):
-        fn(r, out / name)
+        close_figure(fn(r, out / name, provenance=provenance))
         files.append(out / name)
     return files

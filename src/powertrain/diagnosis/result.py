@@ -158,15 +158,18 @@ class DiagnosisResult:
         from powertrain.diagnosis.report import summary
         return summary(self)
 
-    def plot(self, path=None):
-        """Gap map figure (see :func:`powertrain.plotting.plot_gap_map`)."""
+    def plot(self, ax=None, *, path=None, quantity=None, provenance=None):
+        """Gap map figure; returns it (see :func:`powertrain.plotting.plot_gap_map`)."""
         from powertrain.plotting import plot_gap_map
-        return plot_gap_map(self, path)
+        from powertrain.plotting.style import target_and_path
+        ax, path = target_and_path(ax, path)
+        return plot_gap_map(self, path, ax=ax, quantity=quantity,
+                            provenance=provenance or getattr(self, "provenance", None))
 
-    def report(self, directory) -> list:
+    def report(self, directory, provenance=None) -> list:
         """Write ``summary.txt``, ``diagnosis.json`` and the figures into ``directory``."""
         from powertrain.diagnosis.report import write_report
-        return write_report(self, directory)
+        return write_report(self, directory, provenance=provenance)
 
 
 def _jsonable(x):

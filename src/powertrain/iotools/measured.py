@@ -13,7 +13,13 @@ CSV (the format :meth:`powertrain.results.RunupResult.to_csv` writes)::
   ``quantity``: ``synthesis`` or ``order_<n>`` (``order_2``, ``order_0.5``...); ``rpm`` > 0.
 * exactly one level column, whose name states quantity, statistic and unit (table
   :data:`LEVEL_COLUMNS`): ``velocity_rms_mm_per_s``, ``velocity_rms_m_per_s``,
-  ``velocity_peak_mm_per_s`` or ``velocity_peak_m_per_s``. Peak values are converted to RMS
+  ``velocity_peak_mm_per_s`` or ``velocity_peak_m_per_s``; or, as ``powertrain track``
+  writes them, ``acceleration_rms_m_per_s2``, ``displacement_rms_mm`` or ``force_rms_n``.
+  Acceleration and displacement orders are converted to velocity order by order,
+  :math:`v_o = a_o/\omega_o` and :math:`v_o = \omega_o x_o` with
+  :math:`\omega_o = 2\pi\,o\,n/60`, and the synthesis is recomputed as the RMS sum of the
+  converted orders (a synthesis row cannot be converted by itself); force curves are
+  compared with the simulated mount forces (``signal = "mount_force"``). Peak values are converted to RMS
   by :math:`1/\sqrt2`, exact for a single sinusoidal order; a ``synthesis`` row in a peak file
   is read as the root-sum-square of the order peaks (the usual order-analyser convention),
   for which the same factor is exact too.
@@ -38,18 +44,33 @@ import numpy as np
 
 from powertrain.analysis.orders import order_label
 from powertrain.errors import InputError
-from powertrain.iotools.textfile import parse_number, read_text
+from powertrain.iotools.textfile import check_regular_file, parse_number, read_text
 
-#: Recognised level columns: name -> (factor to m/s, statistic).
+#: Recognised level columns: name -> (factor to SI, statistic).
 LEVEL_COLUMNS = {
     "velocity_rms_mm_per_s": (1e-3, "rms"),
     "velocity_rms_m_per_s": (1.0, "rms"),
     "velocity_peak_mm_per_s": (1e-3, "peak"),
     "velocity_peak_m_per_s": (1.0, "peak"),
+    "acceleration_rms_m_per_s2": (1.0, "rms"),
+    "displacement_rms_mm": (1e-3, "rms"),
+    "force_rms_n": (1.0, "rms"),
 }
 KEY_COLUMNS = ("mount", "direction", "quantity", "rpm")
 DIRECTIONS = ("x", "y", "z")
 _HDF5_SIGNATURE = b"\x89HDF\r\n\x1a\n"
+
+
+#: Highest plausible order level [m/s RMS]: above 1 km/s it is a unit or export error.
+MAX_LEVEL_M_PER_S = 1e3
+#: Highest plausible engine speed [rpm].
+MAX_RPM = 1e5
+
+
+def _check_level(level_si: float, path, line, key) -> None:
+    if level_si > MAX_LEVEL_M_PER_S:
+        raise InputError(f"level {level_si:.3g} m/s above the plausible {MAX_LEVEL_M_PER_S:g} "
+                         "m/s (unit error?)", file=path, line=line, key=key)
 
 
 def quantity_sort_key(quantity: str):
@@ -96,12 +117,16 @@ class MeasuredRunup:
         Conversions applied (e.g. peak to RMS).
     comments : list of str
         Comment lines of the file (without the leading ``#``).
+    signal : str
+        ``velocity`` (levels in m/s, also for converted acceleration and displacement
+        curves) or ``mount_force`` (force curves, levels in N).
     """
 
     curves: dict
     source: str = ""
     notes: list = field(default_factory=list)
     comments: list = field(default_factory=list)
+    signal: str = "velocity"
 
     @property
     def channels(self) -> list:
@@ -133,20 +158,20 @@ class MeasuredRunup:
         return lo, hi
 
     @classmethod
-    def from_result(cls, result, source: str = "") -> MeasuredRunup:
-        """RMS velocity curves (synthesis and every order) of a
-        :class:`~powertrain.results.RunupResult`."""
+    def from_result(cls, result, source: str = "", signal: str = "velocity") -> MeasuredRunup:
+        """RMS curves (synthesis and every order) of a
+        :class:`~powertrain.results.RunupResult`: velocity, or ``mount_force``."""
         rpm = np.asarray(result.rpm, float)
         order_idx = np.argsort(rpm)
-        rms = result.order_rms("velocity")[order_idx]
-        syn = result.synthesis_rms("velocity")[order_idx]
+        rms = result.order_rms(signal)[order_idx]
+        syn = result.synthesis_rms(signal)[order_idx]
         rpm = rpm[order_idx]
         curves = {}
         for c, (m, d) in enumerate(result.channels):
             curves[(m, d, "synthesis")] = (rpm.copy(), syn[:, c].copy())
             for k, order in enumerate(result.orders):
                 curves[(m, d, order_label(order))] = (rpm.copy(), rms[:, c, k].copy())
-        return cls(curves, source=str(source))
+        return cls(curves, source=str(source), signal=signal)
 
 
 def read_measured(path, mounts=None) -> MeasuredRunup:
@@ -170,6 +195,7 @@ def read_measured(path, mounts=None) -> MeasuredRunup:
         One line naming file, line and column.
     """
     path = str(path)
+    check_regular_file(path)
     try:
         with open(path, "rb") as fh:
             head = fh.read(8)
@@ -200,8 +226,12 @@ def _read_hdf5(path, mounts):
         raise InputError("speeds must be finite and > 0", file=path, key="rpm")
     if np.unique(rpm).size != rpm.size:
         raise InputError("duplicate speed", file=path, key="rpm")
+    if np.any(rpm > MAX_RPM):
+        raise InputError(f"speed above {MAX_RPM:g} rpm", file=path, key="rpm")
     if not np.all(np.isfinite(result.velocity)):
         raise InputError("NaN or infinite velocity", file=path, key="velocity/amplitude")
+    worst = float(np.max(np.abs(result.velocity), initial=0.0))
+    _check_level(worst, path, None, "velocity/amplitude")
     return MeasuredRunup.from_result(result, source=path)
 
 
@@ -265,13 +295,15 @@ def _read_csv(path, mounts):
         except ValueError as exc:
             raise InputError(str(exc), file=path, line=lineno, key="quantity") from None
         rpm = parse_number(fields[col["rpm"]], path, lineno, "rpm")
-        if rpm <= 0:
-            raise InputError(f"speed must be > 0, got {rpm:g}", file=path, line=lineno,
-                             key="rpm")
+        if not 0 < rpm <= MAX_RPM:
+            raise InputError(f"speed must be > 0 and <= {MAX_RPM:g} rpm, got {rpm:g}",
+                             file=path, line=lineno, key="rpm")
         level = parse_number(fields[col[level_col]], path, lineno, level_col)
         if level < 0:
             raise InputError(f"negative level {level:g}", file=path, line=lineno,
                              key=level_col)
+        _check_level(level * factor / (math.sqrt(2.0) if statistic == "peak" else 1.0), path,
+                     lineno, level_col)
         key = (mount, direction, quantity)
         if key not in rows:
             rows[key] = {}
@@ -292,8 +324,52 @@ def _read_csv(path, mounts):
         speeds = np.array(sorted(rows[key]))
         curves[key] = (speeds, np.array([rows[key][r][0] for r in speeds]) * scale)
     notes = []
+    signal = "velocity"
+    kind = level_col.split("_", 1)[0]
+    if kind in ("acceleration", "displacement"):
+        curves = to_velocity(curves, kind, notes)
+    elif kind == "force":
+        signal = "mount_force"
+        notes.append("force curves: compared with the simulated mount forces [N]")
     if statistic == "peak":
         notes.append(f"levels read from peak column {level_col!r} and converted to RMS by "
                      "1/sqrt(2) (exact for a sinusoidal order; synthesis read as the "
                      "root-sum-square of the order peaks)")
-    return MeasuredRunup(curves, source=path, notes=notes, comments=comments)
+    return MeasuredRunup(curves, source=path, notes=notes, comments=comments, signal=signal)
+
+
+def to_velocity(curves, kind, notes):
+    r"""Convert acceleration or displacement order curves to velocity, order by order.
+
+    :math:`v_o = a_o/\omega_o` or :math:`v_o = \omega_o x_o`, :math:`\omega_o = 2\pi o n/60`;
+    each channel's synthesis is recomputed as the RMS sum of its converted orders at the
+    speeds where every order of the channel is present (elsewhere it is dropped).
+    """
+    out, dropped = {}, []
+    channels = {(m, d) for m, d, _ in curves}
+    for m, d in sorted(channels):
+        orders = {q: v for (mm, dd, q), v in curves.items()
+                  if (mm, dd) == (m, d) and q != "synthesis"}
+        for q, (rpm, level) in orders.items():
+            w = 2 * math.pi * float(q.split("_", 1)[1]) * rpm / 60.0
+            out[(m, d, q)] = (rpm, level / w if kind == "acceleration" else level * w)
+        if (m, d, "synthesis") in curves:
+            common = None
+            for rpm, _ in orders.values():
+                common = set(rpm.tolist()) if common is None else common & set(rpm.tolist())
+            if not common:
+                dropped.append(f"{m}.{d}")
+                continue
+            speeds = np.array(sorted(common))
+            total = np.zeros(speeds.size)
+            for q in orders:
+                rpm, level = out[(m, d, q)]
+                total += np.interp(speeds, rpm, level) ** 2
+            out[(m, d, "synthesis")] = (speeds, np.sqrt(total))
+    notes.append(f"{kind} order curves converted to velocity order by order (divided by "
+                 "omega_o)" if kind == "acceleration" else
+                 f"{kind} order curves converted to velocity order by order (times omega_o)")
+    notes.append("synthesis recomputed as the RMS sum of the converted orders")
+    if dropped:
+        notes.append("synthesis dropped (no order curves to convert): " + ", ".join(dropped))
+    return out

@@ -164,6 +164,9 @@ def assemble(found: FileSignals, cmap: ChannelMap | None = None, *, rpm=None,
             if name not in used:
                 raise InputError("channel of the channel map not found in the file",
                                  file=cmap.source or src, key=f"channels.{name}")
+    if channels and len({c.values.size for c in channels}) == 1:
+        for ch, row in zip(channels, RawRecording.rows([c.values for c in channels])):
+            ch.values = row
     comments = list(found.comments)
     if ignored:
         comments.append("channels not in the channel map, ignored: " + ", ".join(ignored))

@@ -115,7 +115,7 @@ def write_raw_hdf5(path, recording, *, description: str = "", synthetic: bool = 
                 h5.create_dataset("rpm", data=recording.rpm).attrs["unit"] = "rpm"
             if recording.tacho is not None:
                 h5.create_dataset("tacho", data=recording.tacho).attrs["unit"] = "V"
-            g = h5.create_group("channels")
+            g = h5.create_group("channels", track_order=True)
             for ch in recording.channels:
                 dim = "length" if ch.quantity == "displacement" else ch.quantity
                 ds = g.create_dataset(ch.label, data=from_si(ch.values, ch.unit, dim))

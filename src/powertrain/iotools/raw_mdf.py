@@ -7,6 +7,8 @@ export of one group does). Names follow the ``MOUNT.DIRECTION`` convention or a 
 
 from __future__ import annotations
 
+import gc
+import sys
 import warnings
 
 import numpy as np
@@ -18,19 +20,26 @@ from powertrain.iotools.raw import FileSignals
 def read_mdf_signals(path, channel_map=None) -> FileSignals:
     """Signals of an MDF file."""
     from asammdf import MDF
-    try:
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore")
+    with open(path, "rb") as fh:
+        head = fh.read(72)
+    if len(head) < 72 or head[64:68] not in (b"##HD", b"HD\x00\x00") and head[64:66] != b"HD":
+        raise InputError("not a readable MDF file (no header block after the identification "
+                         "block)", file=path)
+    problem = None
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        try:
             mdf = MDF(str(path))
-    except Exception as exc:   # asammdf raises many types on malformed files
-        raise InputError(f"not a readable MDF file ({str(exc).splitlines()[0][:80]})",
-                         file=path) from None
+        except Exception as exc:   # asammdf raises many types on malformed files
+            problem = str(exc).splitlines()[0][:80] if str(exc) else type(exc).__name__
+        _quiet_collect()           # a half-built MDF object complains when finalised
+    if problem is not None:
+        raise InputError(f"not a readable MDF file ({problem})", file=path)
     time, signals = None, []
-    masters = {mdf.masters_db.get(g) for g in range(len(mdf.groups))}
     try:
         for g, group in enumerate(mdf.groups):
-            for c, ch in enumerate(group.channels):
-                if c in masters and mdf.masters_db.get(g) == c:
+            for c in range(len(group.channels)):
+                if mdf.masters_db.get(g) == c:          # the group's time channel
                     continue
                 sig = mdf.get(group=g, index=c)
                 t = np.asarray(sig.timestamps, float)
@@ -49,6 +58,16 @@ def read_mdf_signals(path, channel_map=None) -> FileSignals:
     if time is None:
         raise InputError("no channel in the MDF file", file=path)
     return FileSignals(time, signals, str(path), "master time")
+
+
+def _quiet_collect():
+    """Collect garbage with finalizer errors of half-built asammdf objects silenced."""
+    hook = sys.unraisablehook
+    sys.unraisablehook = lambda unraisable: None
+    try:
+        gc.collect()
+    finally:
+        sys.unraisablehook = hook
 
 
 def write_raw_mdf(path, recording) -> None:

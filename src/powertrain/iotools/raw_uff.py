@@ -9,6 +9,7 @@ tacho channels unless the map (or ``--rpm/--tacho``) says otherwise.
 
 from __future__ import annotations
 
+import gc
 import warnings
 
 import numpy as np
@@ -24,13 +25,16 @@ SPECIFIC_DATA_TYPE = {"displacement": 8, "force": 13, "velocity": 11, "accelerat
 def read_uff_signals(path, channel_map=None) -> FileSignals:
     """Signals of the datasets 58 of a UFF file."""
     import pyuff
-    try:
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore")
+    problem = None
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")     # pyuff leaves its file handles to the GC
+        try:
             sets = pyuff.UFF(str(path)).read_sets()
-    except Exception as exc:   # pyuff raises bare Exceptions on malformed files
-        raise InputError(f"not a readable universal file ({str(exc).splitlines()[0][:80]})",
-                         file=path) from None
+        except Exception as exc:   # pyuff raises bare Exceptions on malformed files
+            problem = str(exc).splitlines()[0][:80] if str(exc) else type(exc).__name__
+        gc.collect()
+    if problem is not None:
+        raise InputError(f"not a readable universal file ({problem})", file=path)
     if isinstance(sets, dict):
         sets = [sets]
     sets = [s for s in sets if s.get("type") == 58]
@@ -80,4 +84,7 @@ def write_raw_uff(path, recording) -> None:
             orddenom_spec_data_type=0, z_axis_spec_data_type=0))
     with atomic_path(path) as tmp:
         os.unlink(tmp)               # pyuff appends to an existing file
-        pyuff.UFF(str(tmp)).write_sets(sets, mode="add", force_double=True)
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")     # pyuff leaves its file handles to the GC
+            pyuff.UFF(str(tmp)).write_sets(sets, mode="add", force_double=True)
+            gc.collect()

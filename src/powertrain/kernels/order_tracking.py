@@ -20,7 +20,6 @@ import math
 import numpy as np
 from numba import njit, prange
 
-
 #: Output samples per parallel work item.
 CHUNK = 256
 

@@ -97,6 +97,29 @@ class RawRecording:
     def synthetic(self) -> bool:
         return any("synthetic" in c.lower() for c in self.comments)
 
+    def channel_matrix(self, channels=None) -> np.ndarray:
+        """Samples of ``channels`` (default all) as one (n_ch, n) array [SI].
+
+        When the channels are the rows, in order, of one array (as the readers build them)
+        that array is returned without copying.
+        """
+        vals = [c.values for c in (self.channels if channels is None else channels)]
+        base = vals[0].base
+        if (isinstance(base, np.ndarray) and base.ndim == 2 and base.shape[0] == len(vals)
+                and base.flags.c_contiguous
+                and all(v.base is base and v.__array_interface__["data"][0]
+                        == base[i].__array_interface__["data"][0] for i, v in enumerate(vals))):
+            return base
+        return np.vstack(vals)
+
+    @staticmethod
+    def rows(values_list) -> list:
+        """The arrays of ``values_list`` copied into one (n_ch, n) block; its rows."""
+        block = np.empty((len(values_list), np.size(values_list[0])))
+        for i, v in enumerate(values_list):
+            block[i] = v
+        return list(block)
+
     def validate(self, time_key="time") -> RawRecording:
         """Check shapes, finiteness and uniform increasing time; return self.
 

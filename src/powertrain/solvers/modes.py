@@ -134,10 +134,14 @@ class ModesResult:
                      f"{t['angle_to_crank_axis_deg']:.2f} deg from the crank axis")
         return "\n".join(lines)
 
-    def plot(self, path=None):
-        """Stacked kinetic-energy distribution per mode (PNG when ``path`` is given)."""
+    def plot(self, ax=None, *, path=None, provenance=None):
+        """Stacked kinetic-energy distribution per mode (PNG when ``path`` is given);
+        returns the figure."""
+        from powertrain.plotting.style import target_and_path
         from powertrain.plotting_body import plot_modes
-        return plot_modes(self, path)
+        ax, path = target_and_path(ax, path)
+        return plot_modes(self, path, ax=ax,
+                          provenance=provenance or getattr(self, "provenance", None))
 
 
 # ---------------------------------------------------------------------------- physics
@@ -270,6 +274,8 @@ def rigid_body_modes(system, inertia, *, static=False, crank_axis=(1.0, 0.0, 0.0
         Static stiffness, undamped (else: dynamic stiffness at each mode's own frequency).
     crank_axis : array_like (3,)
         Unit vector of the crank axis in engine axes (engine X).
+    engine_name : str, optional
+        Recorded in the result (reports, plots).
     """
     M6 = system.M[:6, :6]
     w2, vec = sla.eigh(system.static_stiffness_6(), M6)

@@ -1,0 +1,88 @@
+r"""Synthetic run-up time data with known order content (test oracles; labelled SYNTHETIC).
+
+A linear sweep :math:`n(t) = n_0 + (n_1 - n_0)\,t/T` has the crank angle
+:math:`\theta(t) = \tfrac{2\pi}{60}\left(n_0 t + \tfrac{n_1 - n_0}{2T}t^2\right)` in closed
+form, so a sum of orders :math:`\sum_o A_o\cos(o\theta + \varphi_o)` is exact at every
+sample; its derivative :math:`-\sum_o A_o\,o\,\omega(t)\sin(o\theta + \varphi_o)` is the
+matching acceleration. None of this passes through the tracker's speed estimate.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from powertrain.models.recording import RawChannel, RawRecording
+
+
+def linear_sweep(fs, duration, rpm0, rpm1, *, endpoint=False):
+    """Time [s], speed [rpm] and crank angle [rad] of a linear sweep."""
+    n = int(round(fs * duration)) + (1 if endpoint else 0)
+    t = np.arange(n) / fs
+    rpm = rpm0 + (rpm1 - rpm0) * t / duration
+    theta = (2 * np.pi / 60.0) * (rpm0 * t + 0.5 * (rpm1 - rpm0) / duration * t * t)
+    return t, rpm, theta
+
+
+def order_sum(theta, orders, amplitudes, phases=None):
+    """:math:`\\sum_o A_o \\cos(o\\theta + \\varphi_o)`."""
+    phases = np.zeros(len(orders)) if phases is None else phases
+    return sum(a * np.cos(o * theta + p) for o, a, p in zip(orders, amplitudes, phases))
+
+
+def order_sum_derivative(theta, rpm, orders, amplitudes, phases=None):
+    """Time derivative of :func:`order_sum` along the sweep."""
+    phases = np.zeros(len(orders)) if phases is None else phases
+    omega = rpm * (2 * np.pi / 60.0)
+    return sum(-a * o * omega * np.sin(o * theta + p)
+               for o, a, p in zip(orders, amplitudes, phases))
+
+
+def tacho(theta, pulses_per_rev, *, high=5.0, duty=0.5):
+    """Rectangular tacho pulse train, ``pulses_per_rev`` pulses per revolution [V]."""
+    phase = np.mod(theta * pulses_per_rev / (2 * np.pi), 1.0)
+    return np.where(phase < duty, high, 0.0)
+
+
+#: Published order-tracking example of a commercial signal-processing toolbox: 600 Hz,
+#: 5 s, 600 -> 2400 rpm, orders 1, 1/2, sqrt(2), 2 with amplitudes 1, 1/2, sqrt(2), 2.
+TOOLBOX_ORDERS = np.array([1.0, 0.5, np.sqrt(2.0), 2.0])
+TOOLBOX_AMPLITUDES = np.array([1.0, 0.5, np.sqrt(2.0), 2.0])
+
+
+def toolbox_example() -> RawRecording:
+    """The toolbox example as a one-channel recording (acceleration, m/s^2) with rpm."""
+    t, rpm, theta = linear_sweep(600.0, 5.0, 600.0, 2400.0, endpoint=True)
+    x = order_sum(theta, TOOLBOX_ORDERS, TOOLBOX_AMPLITUDES)
+    return RawRecording(t, [RawChannel("left.z", "left", "active", "z", "acceleration", x,
+                                       "m/s^2")], rpm, None, "toolbox example",
+                        ["SYNTHETIC: order-tracking example of a signal-processing toolbox "
+                         "(600 Hz, 5 s, 600->2400 rpm, orders 1, 1/2, sqrt2, 2)"])
+
+
+#: Analytic sweep: orders 0.5..8 step 0.5, amplitudes and phases.
+ANALYTIC_ORDERS = np.arange(1, 17) * 0.5
+ANALYTIC_VELOCITY = 1e-3 * (1.0 + 0.25 * np.arange(16))          # [m/s] peak
+ANALYTIC_PHASES = 0.4 * np.arange(16)
+
+
+def analytic_sweep(fs=8192.0, duration=20.0, rpm0=1000.0, rpm1=6000.0,
+                   pulses_per_rev=4) -> RawRecording:
+    """Velocity channel ``right.z`` [mm/s] with known orders, the matching acceleration
+    ``left.z`` [g], the rpm and a tacho."""
+    t, rpm, theta = linear_sweep(fs, duration, rpm0, rpm1)
+    v = order_sum(theta, ANALYTIC_ORDERS, ANALYTIC_VELOCITY, ANALYTIC_PHASES)
+    a = order_sum_derivative(theta, rpm, ANALYTIC_ORDERS, ANALYTIC_VELOCITY, ANALYTIC_PHASES)
+    chans = [RawChannel("left.z", "left", "active", "z", "acceleration", a, "g"),
+             RawChannel("right.z", "right", "active", "z", "velocity", v, "mm/s")]
+    return RawRecording(t, chans, rpm, tacho(theta, pulses_per_rev), "analytic sweep",
+                        [f"SYNTHETIC: analytic linear sweep {rpm0:g}->{rpm1:g} rpm in "
+                         f"{duration:g} s, orders 0.5..8"])
+
+
+def crossing(fs=4096.0, duration=10.0, tone_hz=100.0, tone_amplitude=0.5) -> RawRecording:
+    """Order 2 (amplitude 1) crossing a fixed-frequency tone during 1000 -> 6000 rpm."""
+    t, rpm, theta = linear_sweep(fs, duration, 1000.0, 6000.0)
+    x = np.cos(2 * theta) + tone_amplitude * np.cos(2 * np.pi * tone_hz * t)
+    return RawRecording(t, [RawChannel("left.z", "left", "active", "z", "acceleration", x,
+                                       "m/s^2")], rpm, None, "crossing",
+                        [f"SYNTHETIC: order 2 crossing a {tone_hz:g} Hz tone"])

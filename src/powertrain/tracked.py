@@ -1,0 +1,210 @@
+r"""Order-tracked run-up: complex order amplitudes per speed and channel, and their files.
+
+Long-format CSV (read by ``compare`` and ``diagnose``; :mod:`powertrain.iotools.measured`)::
+
+    # tracked by powertrain track (cot) from run.h5 [SYNTHETIC: ...]
+    mount,direction,quantity,rpm,acceleration_rms_m_per_s2
+    left,z,order_2,1050,0.0123
+    left,z,synthesis,1050,0.0150
+
+The level column states the channels' quantity and unit (:data:`LEVEL_COLUMNS`); a
+``side`` column (``active``/``passive``) follows ``mount`` when any channel is passive.
+``synthesis`` is the RMS sum over the orders tracked.
+
+HDF5 (``--out``)::
+
+    /                attrs format="powertrain-tracked", format_version=1, source, method,
+                           settings (JSON), comments (JSON), created, powertrain_version
+    /rpm             (k,)              rpm
+    /orders          (n_o,)            1
+    /channels/{name,mount,side,direction,quantity,unit}   (n_ch,) str (unit = SI unit)
+    /amplitude       (k, n_ch, n_o) complex   SI peak amplitude, phase re crank angle 0
+    /order_rms       (k, n_ch, n_o)           SI RMS
+    /synthesis_rms   (k, n_ch)                SI RMS
+"""
+
+from __future__ import annotations
+
+import json
+from dataclasses import dataclass, field, replace
+from datetime import datetime, timezone
+
+import numpy as np
+
+from powertrain.analysis.orders import order_label
+from powertrain.errors import InputError
+from powertrain.models.recording import QUANTITIES
+
+#: quantity -> (level column, factor from SI to the column's unit).
+LEVEL_COLUMNS = {
+    "acceleration": ("acceleration_rms_m_per_s2", 1.0),
+    "velocity": ("velocity_rms_mm_per_s", 1e3),
+    "displacement": ("displacement_rms_mm", 1e3),
+    "force": ("force_rms_n", 1.0),
+}
+
+
+@dataclass
+class TrackedChannel:
+    """Identity of a tracked channel (no samples)."""
+
+    name: str
+    mount: str
+    side: str
+    direction: str
+    quantity: str
+
+
+@dataclass
+class TrackedOrders:
+    """Complex order amplitudes of a tracked run-up.
+
+    Attributes
+    ----------
+    rpm : ndarray (k,)
+        Speeds [rpm].
+    orders : ndarray (n_o,)
+    channels : list of TrackedChannel
+    amplitude : ndarray complex (k, n_ch, n_o)
+        Peak complex amplitude [SI of each channel's quantity].
+    method : str
+        ``cot`` or ``vkf``.
+    source : str
+    settings : dict
+    comments : list of str
+    """
+
+    rpm: np.ndarray
+    orders: np.ndarray
+    channels: list
+    amplitude: np.ndarray
+    method: str = "cot"
+    source: str = ""
+    settings: dict = field(default_factory=dict)
+    comments: list = field(default_factory=list)
+
+    def order_rms(self) -> np.ndarray:
+        """RMS per speed, channel and order [SI]."""
+        return np.abs(self.amplitude) / np.sqrt(2.0)
+
+    def synthesis_rms(self) -> np.ndarray:
+        """RMS sum over the tracked orders per speed and channel [SI]."""
+        return np.sqrt(np.sum(self.order_rms() ** 2, axis=-1))
+
+    @property
+    def quantity(self) -> str:
+        """The one quantity of all channels (InputError if mixed)."""
+        qs = sorted({c.quantity for c in self.channels})
+        if len(qs) != 1:
+            raise InputError(f"channels measure {', '.join(qs)}: one level column per CSV; "
+                             "select one with --quantity (or convert with --as velocity)",
+                             file=self.source, key="quantity")
+        return qs[0]
+
+    def as_velocity(self) -> TrackedOrders:
+        r"""Convert every channel to velocity, order by order: :math:`\hat v = \hat a/(i\omega_o)`
+        and :math:`\hat v = i\omega_o \hat x`, :math:`\omega_o = 2\pi o n/60`."""
+        w = 2 * np.pi * self.orders[None, :] * self.rpm[:, None] / 60.0      # (k, n_o)
+        amp = self.amplitude.copy()
+        chans = []
+        for c, ch in enumerate(self.channels):
+            if ch.quantity == "acceleration":
+                amp[:, c, :] /= 1j * w
+            elif ch.quantity == "displacement":
+                amp[:, c, :] *= 1j * w
+            elif ch.quantity == "force":
+                raise InputError("a force cannot be converted to velocity", file=self.source,
+                                 key=ch.name)
+            chans.append(replace(ch, quantity="velocity"))
+        return replace(self, channels=chans, amplitude=amp,
+                       settings={**self.settings, "converted_to": "velocity"})
+
+    # ------------------------------------------------------------------ writers
+    def csv_text(self) -> str:
+        """Long-format CSV text (module docstring)."""
+        col, factor = LEVEL_COLUMNS[self.quantity]
+        with_side = any(c.side != "active" for c in self.channels)
+        tag = " [SYNTHETIC]" if any("synthetic" in c.lower() for c in self.comments) else ""
+        lines = [f"# tracked by powertrain track ({self.method}) from {self.source}{tag}"]
+        lines += [f"# {c}" for c in self.comments]
+        lines.append(",".join(["mount"] + (["side"] if with_side else [])
+                              + ["direction", "quantity", "rpm", col]))
+        rms = self.order_rms() * factor
+        syn = self.synthesis_rms() * factor
+        for c, ch in enumerate(self.channels):
+            key = [ch.mount] + ([ch.side] if with_side else []) + [ch.direction]
+            for k, order in enumerate(self.orders):
+                q = order_label(order)
+                lines += [",".join(key + [q, f"{r:g}", f"{rms[i, c, k]:.8g}"])
+                          for i, r in enumerate(self.rpm)]
+            lines += [",".join(key + ["synthesis", f"{r:g}", f"{syn[i, c]:.8g}"])
+                      for i, r in enumerate(self.rpm)]
+        return "\n".join(lines) + "\n"
+
+    def to_csv(self, path) -> None:
+        from powertrain.iotools.atomic import atomic_write
+        text = self.csv_text()
+        with atomic_write(path) as fh:
+            fh.write(text)
+
+    def to_hdf5(self, path) -> None:
+        """Write the HDF5 layout of the module docstring atomically."""
+        import h5py
+
+        from powertrain import __version__
+        from powertrain.iotools.atomic import atomic_path
+        with atomic_path(path) as tmp:
+            with h5py.File(tmp, "w") as h5:
+                a = h5.attrs
+                a["format"] = "powertrain-tracked"
+                a["format_version"] = 1
+                a["powertrain_version"] = __version__
+                a["created"] = datetime.now(timezone.utc).isoformat(timespec="seconds")
+                a["source"] = self.source
+                a["method"] = self.method
+                a["settings"] = json.dumps(self.settings)
+                a["comments"] = json.dumps(self.comments)
+                h5.create_dataset("rpm", data=self.rpm).attrs["unit"] = "rpm"
+                h5.create_dataset("orders", data=self.orders).attrs["unit"] = "1"
+                g = h5.create_group("channels")
+                for key in ("name", "mount", "side", "direction", "quantity"):
+                    g.create_dataset(key, data=np.array([getattr(c, key) for c in self.channels],
+                                                        dtype="S"))
+                g.create_dataset("unit", data=np.array([QUANTITIES[c.quantity]
+                                                        for c in self.channels], dtype="S"))
+                h5.create_dataset("amplitude", data=self.amplitude)
+                h5.create_dataset("order_rms", data=self.order_rms())
+                h5.create_dataset("synthesis_rms", data=self.synthesis_rms())
+
+    @classmethod
+    def from_hdf5(cls, path) -> TrackedOrders:
+        import h5py
+        with h5py.File(path, "r") as h5:
+            if h5.attrs.get("format") != "powertrain-tracked":
+                raise InputError("not a powertrain tracked-orders file", file=path,
+                                 key="format")
+            g = h5["channels"]
+            cols = {k: [v.decode() for v in g[k][()]]
+                    for k in ("name", "mount", "side", "direction", "quantity")}
+            chans = [TrackedChannel(*row) for row in zip(*cols.values())]
+            return cls(h5["rpm"][()], h5["orders"][()], chans, h5["amplitude"][()],
+                       str(h5.attrs["method"]), str(h5.attrs["source"]),
+                       json.loads(h5.attrs["settings"]), json.loads(h5.attrs["comments"]))
+
+    def curve(self, label: str, quantity: str = "synthesis") -> np.ndarray:
+        """RMS curve [SI] of the channel ``mount[.side].direction`` (synthesis or order_<n>)."""
+        c = [_label(ch) for ch in self.channels].index(label)
+        if quantity == "synthesis":
+            return self.synthesis_rms()[:, c]
+        o = float(quantity.split("_", 1)[1])
+        return self.order_rms()[:, c, int(np.argmin(np.abs(self.orders - o)))]
+
+    def plot(self, path=None, quantities=None):
+        """Order curves (RMS against rpm), one panel per channel."""
+        from powertrain.plotting_orders import plot_tracked
+        return plot_tracked(self, path, quantities)
+
+
+def _label(ch) -> str:
+    return f"{ch.mount}.{ch.direction}" if ch.side == "active" else \
+        f"{ch.mount}.{ch.side}.{ch.direction}"

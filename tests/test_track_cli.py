@@ -1,0 +1,106 @@
+"""``powertrain track`` end to end: outputs, formats, bad input (issue 12, items 1-4)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from click.testing import CliRunner
+
+from powertrain import signals
+from powertrain.cli import main
+from powertrain.iotools.raw_csv import write_raw_csv
+from powertrain.iotools.raw_hdf5 import write_raw_hdf5
+from powertrain.models.recording import RawChannel, RawRecording
+from powertrain.tracked import TrackedOrders
+
+
+def run(*args):
+    return CliRunner().invoke(main, ["track", *map(str, args)])
+
+
+@pytest.fixture(scope="module")
+def analytic(tmp_path_factory):
+    folder = tmp_path_factory.mktemp("raw")
+    path = folder / "sweep.csv"
+    write_raw_csv(path, signals.analytic_sweep(duration=6.0, rpm0=1500.0, rpm1=4500.0),
+                  comment="SYNTHETIC: analytic sweep")
+    return path
+
+
+def test_track_writes_csv_hdf5_and_plots(tmp_path, analytic):
+    out = {k: tmp_path / f"o.{k}" for k in ("csv", "h5", "png", "map.png")}
+    r = run(analytic, "--quantity", "acceleration", "--orders", "0.5:8:0.5", "--csv",
+            out["csv"], "--out", out["h5"], "--plot", out["png"], "--map", out["map.png"])
+    assert r.exit_code == 0, r.output
+    assert "tracked RMS" in r.output and "[SYNTHETIC]" in r.output
+    lines = out["csv"].read_text().splitlines()
+    assert lines[0].startswith("# tracked by powertrain track (cot)")
+    header = [ln for ln in lines if not ln.startswith("#")][0]
+    assert header == "mount,direction,quantity,rpm,acceleration_rms_m_per_s2"
+    tr = TrackedOrders.from_hdf5(out["h5"])
+    assert tr.orders.size == 16 and tr.amplitude.shape[1] == 1
+    assert out["png"].stat().st_size > 10_000 and out["map.png"].stat().st_size > 10_000
+
+
+def test_as_velocity_and_side_column(tmp_path):
+    t, rpm, th = signals.linear_sweep(4096.0, 6.0, 1500.0, 4500.0)
+    rec = RawRecording(t, [
+        RawChannel("a", "left", "active", "z", "acceleration", np.cos(2 * th), "m/s^2"),
+        RawChannel("b", "left", "passive", "z", "acceleration", np.cos(4 * th), "g")], rpm)
+    write_raw_hdf5(tmp_path / "r.h5", rec)
+    r = run(tmp_path / "r.h5", "--orders", "2,4", "--as", "velocity", "--csv", tmp_path / "v.csv",
+            "--quiet")
+    assert r.exit_code == 0, r.output
+    text = (tmp_path / "v.csv").read_text().splitlines()
+    assert "mount,side,direction,quantity,rpm,velocity_rms_mm_per_s" in text
+    assert any(ln.startswith("left,passive,z,order_4,") for ln in text)
+
+
+def test_mixed_quantities_need_a_choice(tmp_path, analytic):
+    r = run(analytic, "--csv", tmp_path / "x.csv", "--quiet")
+    assert r.exit_code == 1 and "--quantity" in r.output
+    assert not (tmp_path / "x.csv").exists()
+
+
+def _bad_files(folder):
+    t, rpm, th = signals.linear_sweep(2048.0, 4.0, 1500.0, 3000.0)
+    cases = {}
+    p = folder / "tacho-flat.csv"
+    write_raw_csv(p, RawRecording(t, [RawChannel("a", "left", "active", "z", "acceleration",
+                                                 np.cos(th), "m/s^2")], None, np.ones(t.size)))
+    cases["tacho with no edges"] = (p, ["--tacho", "tacho", "--pulses-per-rev", "1"],
+                                    "tacho", "no edges")
+    p = folder / "short.csv"
+    write_raw_csv(p, RawRecording(t[:400], [RawChannel("a", "left", "active", "z", "velocity",
+                                                       np.cos(th[:400]), "mm/s")], rpm[:400]))
+    cases["speed never in range"] = (p, [], "rpm", "never passes")
+    p = folder / "nomount.csv"
+    p.write_text("time [s],rpm [1/min],sensor7 [g]\n" + "\n".join(
+        f"{k / 1000},{1500},{0.1}" for k in range(100)) + "\n")
+    cases["channel maps to no mount"] = (p, [], "sensor7", "no mount")
+    p = folder / "kind.csv"
+    p.write_text("time [s],rpm [1/min],left.z [kPa]\n" + "\n".join(
+        f"{k / 1000},{1500},{0.1}" for k in range(100)) + "\n")
+    cases["unit of the wrong kind"] = (p, [], "left.z", "kPa")
+    p = folder / "backwards.csv"
+    p.write_text("time [s],rpm [1/min],left.z [g]\n" + "\n".join(
+        f"{(k % 50) / 1000},{1500},{0.1}" for k in range(100)) + "\n")
+    cases["time not increasing"] = (p, [], "time", "not increasing")
+    p = folder / "runup.h5"
+    from powertrain.iotools.engine_file import DEFAULT_ENGINE_PATH, read_engine
+    from powertrain.runup import run_runup
+    run_runup(read_engine(DEFAULT_ENGINE_PATH), [2000.0, 2500.0], solver="harmonic").to_hdf5(p)
+    cases["file of another format"] = (p, [], "format", "run-up result")
+    return cases
+
+
+def test_bad_input_one_line_exit_1_no_output(tmp_path):
+    for name, (path, extra, key, words) in _bad_files(tmp_path).items():
+        out = tmp_path / f"{path.stem}-out.csv"
+        r = run(path, *extra, "--csv", out, "--quiet")
+        lines = [ln for ln in r.output.splitlines() if ln.strip()]
+        assert r.exit_code == 1, (name, r.output)
+        assert len(lines) == 1, (name, r.output)
+        assert str(path.name) in lines[0] and key in lines[0] and words in lines[0], \
+            (name, lines[0])
+        assert not out.exists(), name
