@@ -163,8 +163,8 @@ def test_four_mount_engine_gets_its_own_parameters_and_folds():
     """The torque-rod engine (4 mounts): a stiffness factor per mount, 12 channel gains,
     4 triad rotations, channel folds holding out one channel of every triad; the fast path
     of a factor on the fourth mount equals the engine-level change."""
-    from powertrain.diagnosis.checks import channel_folds
     from powertrain.data import shipped_path
+    from powertrain.diagnosis.checks import channel_folds
     eng = read_engine(shipped_path("engines", "default-torque-rod.toml"))
     n = len(eng.mounts)
     assert n == 4
