@@ -62,10 +62,14 @@ from powertrain.cli.common import (
                    "ranks the variants by the mean change over the band [rpm].")
 @click.option("--workers", type=int, default=None,
               help="Processes for the variants (default: all local cores; 1 = serial).")
+@click.option("--scheduler", default=None, metavar="local|tcp://HOST:PORT",
+              help="Run the variants on dask.distributed: 'local' (a LocalCluster on this "
+                   "machine's cores) or an existing scheduler's address; also 'processes' "
+                   "or 'serial'. Default: a local process pool (--workers). Same results.")
 @click.option("--quiet", is_flag=True, help="No progress bar and no table.")
 def whatif(engine_file, rpm_from, rpm_to, rpm_step, solver, scale, set_, swap, move, rotate,
            effect, variants_file, target, target_out, target_plot, measured_file, plot, json_file,
-           signal, objective, workers, quiet):
+           signal, objective, workers, scheduler, quiet):
     """What-if: run the baseline and variants of the mount system, print the change in dB.
 
     The command-line operations (--scale/--set/--swap/--move/--rotate/--effect) form one
@@ -136,8 +140,16 @@ def whatif(engine_file, rpm_from, rpm_to, rpm_step, solver, scale, set_, swap, m
 
     goal = _objective(objective, engine.assemble().channels, rpm) if objective else None
     from powertrain.whatif import run_whatif
-    result = run_whatif(engine, variants, rpm, solver=solver, workers=workers,
-                        measured=measured, signal=signal, progress=not quiet)
+    if scheduler:
+        from powertrain.parallel import check_scheduler, executor
+        with executor(check_scheduler(scheduler), workers=workers,
+                      n_jobs=len(variants) + 1) as ex:
+            result = run_whatif(engine, variants, rpm, solver=solver, executor=ex,
+                                workers=workers, measured=measured, signal=signal,
+                                progress=not quiet)
+    else:
+        result = run_whatif(engine, variants, rpm, solver=solver, workers=workers,
+                            measured=measured, signal=signal, progress=not quiet)
     if goal is not None:
         result.objective = goal
 
