@@ -16,6 +16,7 @@ from tolerances import (
     COT_SMEAR_DB,
     TACHO_VS_RPM_DB,
     TRACKED_ORDER_DB,
+    TRACKED_PHASE_RAD,
     VKF_CROSSING_DB,
 )
 
@@ -64,7 +65,7 @@ def test_analytic_sweep_amplitudes(amps, phases):
     err = db(tr.order_rms()[:, 0, :], np.array(amps)[None, :] / np.sqrt(2))
     assert np.max(np.abs(err)) <= TRACKED_ORDER_DB
     phase = np.angle(tr.amplitude[:, 0, :] * np.exp(-1j * np.array(phases))[None, :])
-    assert np.max(np.abs(phase)) < 1e-3
+    assert np.max(np.abs(phase)) <= TRACKED_PHASE_RAD
 
 
 def test_toolbox_example():
