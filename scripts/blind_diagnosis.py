@@ -50,9 +50,9 @@ def run_case(task):
     t0 = time.perf_counter()
     case = make_case(i, names, eng, seed)
     t_gen = time.perf_counter() - t0
-    t0 = time.perf_counter()
+    t0, c0 = time.perf_counter(), time.process_time()
     d = diagnose(case.measured, engines()[eng], noise_floor=FLOOR).to_dict()
-    t_diag = time.perf_counter() - t0
+    t_diag, c_diag = time.perf_counter() - t0, time.process_time() - c0
     chosen = d.get("chosen") or {}
     where = d["where"]
     rpm = np.asarray(where["rpm"], float)
@@ -72,21 +72,41 @@ def run_case(task):
             "parameters": chosen.get("parameters") if chosen else None,
             "ambiguous": d.get("ambiguous_between", []), "shrink": shrink,
             "measured_shrink": 1 - after / before if before else 0.0,
-            "t_gen": t_gen, "t_diag": t_diag}
+            "t_gen": t_gen, "t_diag": t_diag, "cpu_diag": c_diag}
+
+
+def _print_truth(tasks):
+    from powertrain.validation.cases import make_case
+    print(f"{'#':>3} {'hidden':<40} {'eng':<6} {'gap dB':>6} {'p95':>5} {'sig':>4} det  expected")
+    for i, names, eng, seed in tasks:
+        c = make_case(i, names, eng, seed)
+        det = "-" if c.category == "none" else "yes" if c.detectable else "no"
+        print(f"{i:>3} {'+'.join(names) or 'none':<40} {eng:<6} {c.stats[0]:>6.2f} "
+              f"{c.stats[1]:>5.1f} {c.sigma_db:>4.2f} {det:>3}  {'+'.join(c.expected_set)}")
 
 
 def _run_all(tasks, jobs, scheduler):
+    """Rows of all tasks in order; one line per finished case on stderr."""
+    import sys
+    from contextlib import contextmanager
     try:
-        from powertrain.parallel import run_map
+        from powertrain.parallel import executor
     except ImportError:                     # before powertrain.parallel exists
-        run_map = None
-    if run_map is not None:
-        return run_map(run_case, tasks, scheduler, workers=jobs, progress="blind cases")
-    if jobs > 1:
         from concurrent.futures import ProcessPoolExecutor
-        with ProcessPoolExecutor(jobs) as ex:
-            return list(ex.map(run_case, tasks))
-    return [run_case(t) for t in tasks]
+
+        @contextmanager
+        def executor(scheduler=None, *, workers=None, n_jobs=None):
+            with ProcessPoolExecutor(workers) as ex:
+                yield ex
+    rows = []
+    with executor(scheduler, workers=jobs, n_jobs=len(tasks)) as ex:
+        futures = [ex.submit(run_case, t) for t in tasks]
+        for f in futures:
+            r = f.result()
+            print(f"case {r['i']}: {'+'.join(r['names']) or 'none'} -> {_answer(r)} "
+                  f"({r['t_diag']:.1f} s)", file=sys.stderr, flush=True)
+            rows.append(r)
+    return rows
 
 
 def _answer(r):
@@ -139,6 +159,8 @@ def main(argv=None):
     ap.add_argument("--scheduler", default=None,
                     help="'local' (dask LocalCluster), tcp://HOST:PORT, 'processes', 'serial'")
     ap.add_argument("--dump", help="write the per-case rows to this JSON file")
+    ap.add_argument("--generate-only", action="store_true",
+                    help="make the cases and print their truth, without diagnosing them")
     args = ap.parse_args(argv)
     from powertrain.validation.cases import DETECT_LOCAL_DB, DETECT_RMS_DB, case_plan
     from powertrain.validation.scoring import TARGETS, meets_targets, score, score_line
@@ -146,6 +168,9 @@ def main(argv=None):
     print(f"seed {seed}{'' if args.seed is not None else ' (drawn from os.urandom)'}")
     tasks = [(i, names, eng, s) for i, (names, eng, s) in
              enumerate(case_plan(args.cases, seed))]
+    if args.generate_only:
+        _print_truth(tasks)
+        return
     t0 = time.perf_counter()
     rows = _run_all(tasks, args.jobs, args.scheduler)
     wall = time.perf_counter() - t0
@@ -164,10 +189,12 @@ def main(argv=None):
     if missing:
         print(f"  ({missing} claims without a reported gap after: shrink left out)")
     td = np.array([r["t_diag"] for r in rows])
+    tc = np.array([r["cpu_diag"] for r in rows])
     tg = np.array([r["t_gen"] for r in rows])
     print(f"diagnosis time per case: median {np.median(td):.1f} s, longest {td.max():.1f} s "
-          f"(case {int(np.argmax(td))}); truth generation median {np.median(tg):.2f} s; "
-          f"wall {wall:.0f} s ({args.jobs} jobs, scheduler {args.scheduler or 'auto'})")
+          f"(case {int(np.argmax(td))}); CPU time median {np.median(tc):.1f} s, longest "
+          f"{tc.max():.1f} s; truth generation median {np.median(tg):.2f} s; wall "
+          f"{wall:.0f} s ({args.jobs} jobs, scheduler {args.scheduler or 'auto'})")
     if args.dump:
         with open(args.dump, "w") as fh:
             json.dump(rows, fh, indent=1)

@@ -9,7 +9,6 @@ measurements from :mod:`powertrain.synth` whose truth the diagnosis never sees.
 
 from __future__ import annotations
 
-import dataclasses
 import json
 
 import numpy as np
@@ -18,7 +17,7 @@ from click.testing import CliRunner
 
 from powertrain.cli import main
 from powertrain.diagnosis import diagnose
-from powertrain.effects import EFFECTS, predict, time_domain_amplitude_check
+from powertrain.effects import EFFECTS, Effect, predict, time_domain_amplitude_check
 from powertrain.errors import InputError
 from powertrain.iotools.engine_file import DEFAULT_ENGINE_PATH, read_engine
 from powertrain.iotools.measured import MeasuredRunup
@@ -62,7 +61,7 @@ def test_defaults_reduce_every_effect_to_the_baseline(engine):
     for name, eff in EFFECTS.items():
         v = predict(hm, {name: eff.defaults()}).velocity
         assert np.max(np.abs(v - v0)) <= EXACT * np.max(np.abs(v0)), name
-        if eff.apply is not None:
+        if eff.engine_change:
             eng = eff.apply(engine, **eff.defaults())
             if name != "base_compliance":       # its default is the rigid ground
                 vr = run_runup(eng, [2000.0], solver="harmonic").velocity[0]
@@ -93,30 +92,6 @@ def test_equivalent_linearisation_agrees_with_time_domain(engine):
     for k in (3, 7):                              # orders 2 and 4
         ratio = np.abs(v_td[:, k]) / np.abs(pred.velocity[0, :, k])
         assert np.max(np.abs(ratio - 1)) < LINEARISATION_REL
-
-
-def test_effect_free_case_claims_nothing(engine):
-    case = make_case(engine, [], seed=11, rpm=np.arange(1000.0, 6000.1, 100.0))
-    res = diagnose(case.measured, engine)
-    assert res.chosen is None
-    assert res.verdict == "no effect"
-
-
-def test_hidden_balancer_error_is_found_and_shrinks_the_gap(engine):
-    case = make_case(engine, ["balancer_shafts"], seed=5, rpm=np.arange(1000.0, 6000.1, 100.0))
-    res = diagnose(case.measured, engine, pairs=False, band_check=False)
-    assert res.outcomes[0].effects == ("balancer_error",)
-    assert res.chosen is not None and res.chosen.effects == ("balancer_error",)
-    assert res.chosen.heldout_rms_db < 0.5 * res.baseline.heldout_rms_db
-    # a physical effect refitted without a third of the channels predicts them through the
-    # rigid-body kinematics (the held-out-channels check it had to pass)
-    xv = res.chosen.cells_check
-    assert xv["kind"] == "channels" and xv["explained"] > 0.8
-    d = json.loads(res.to_json())
-    for key in ("effect", "parameters", "heldout_rms_db_before", "heldout_rms_db_after",
-                "verdict"):
-        assert key in d["ranking"][0]
-    assert "regions_beyond_3db" in d["where"]
 
 
 def test_synth_and_diagnose_commands(tmp_path):
@@ -157,9 +132,9 @@ def test_too_few_speeds_is_refused(engine):
 def test_registry_is_documented():
     for e in EFFECTS.values():
         assert e.kind in ("structure", "excitation", "sensor")
-        for p in e.parameters:
+        for p in e.parameters():
             assert p.lower <= p.default <= p.upper and p.unit and p.description
-    assert dataclasses.is_dataclass(next(iter(EFFECTS.values())))
+    assert all(isinstance(e, Effect) for e in EFFECTS.values())
 
 
 # --------------------------------------------------------------------------- decision rules
@@ -264,14 +239,3 @@ def test_sensor_error_rotates_then_scales_each_triad(engine):
     fast = predict(hm, {"sensor_error": p}).velocity
     general = predict(hm, {"sensor_error": p, "balancer_error": {}}).velocity
     assert np.max(np.abs(fast - general)) <= EXACT * np.max(np.abs(general))
-
-
-def test_confounded_effects_are_reported_as_ambiguous_not_claimed(engine):
-    """A weak amplitude dependence (0.7 dB at 0.8 dB noise) is explained equally well by a
-    per-mount stiffness offset (the confounding the issue warns of): both pass the rule, the
-    held-out speeds cannot tell them apart, so nothing is claimed and both are named."""
-    case = make_case(engine, ["amplitude_power"], 4028)
-    res = diagnose(case.measured, engine)
-    assert res.verdict == "ambiguous" and res.chosen is None
-    assert {"mount_stiffness", "amplitude_stiffness"} <= set(res.ambiguous)
-    assert json.loads(res.to_json())["ambiguous_between"] == res.ambiguous

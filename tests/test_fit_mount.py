@@ -184,8 +184,10 @@ def test_fit_input_validation():
 def test_result_plot(tmp_path):
     true = model_from_datasheet("sls", c1=150.0, c2=80.0, d2=0.4)
     res = fit_mount(F, true.cross_point_stiffness(F), "sls", starts=2, hops=0)
-    ax = res.plot()
-    assert len(ax.get_lines()) == 4
+    fig = res.plot(form="real-imag")
+    assert len(fig.axes[0].get_lines()) == 4
+    fig = res.plot()   # |K*| and loss angle: two panels, measured + fit in each
+    assert [len(a.get_lines()) for a in fig.axes] == [2, 2]
     res.plot(path=tmp_path / "fit.png")
     assert (tmp_path / "fit.png").stat().st_size > 0
 

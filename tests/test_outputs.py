@@ -166,3 +166,31 @@ def test_progress_bar_shown_on_a_terminal():
     finally:
         sys.stderr = old
     assert "x" in shown and "0/3" in shown and hidden == ""
+
+
+def test_activity_bar_ticks_on_a_terminal_only():
+    import io
+    import time
+
+    from powertrain.progress import activity
+
+    class FakeTTY(io.StringIO):
+        def isatty(self):
+            return True
+    buf = FakeTTY()
+    old, sys.stderr = sys.stderr, buf
+    try:
+        with activity("work", interval=0.05):
+            time.sleep(0.2)
+        shown = buf.getvalue()
+    finally:
+        sys.stderr = old
+    assert "work" in shown and "elapsed" in shown
+    plain = io.StringIO()
+    old, sys.stderr = sys.stderr, plain
+    try:
+        with activity("work", interval=0.05):
+            time.sleep(0.1)
+    finally:
+        sys.stderr = old
+    assert plain.getvalue() == ""

@@ -23,6 +23,7 @@ from __future__ import annotations
 
 import json
 from dataclasses import dataclass, field
+from typing import ClassVar
 
 import numpy as np
 
@@ -142,6 +143,17 @@ class ComparisonResult:
         Simulated speeds [rpm].
     """
 
+    #: Quantities every comparison reports (plots draw them even when none was measured).
+    EXPECTED_QUANTITIES: ClassVar[tuple] = EXPECTED_QUANTITIES
+
+    def requested_quantities(self) -> list:
+        """Every quantity requested: the default three and all measured or compared ones,
+        in the measured-file order (synthesis first, then orders ascending)."""
+        qs = set(EXPECTED_QUANTITIES) | set(self.measured.quantities)
+        qs |= {c.quantity for c in self.channels}
+        return sorted(qs, key=quantity_sort_key)
+
+
     channels: list
     per_rpm: list
     missing: list
@@ -245,13 +257,19 @@ class ComparisonResult:
                          f"{s['frfsm']:.3f}", int(c.at_floor.sum()), int(c.outside.sum())])
         return _format_table(header, rows)
 
-    def plot(self, path=None, quantities=EXPECTED_QUANTITIES):
-        """Measured vs simulated curves, gap shaded (thesis layout, Figs 45-71).
+    def plot(self, ax=None, *, path=None, quantities=None, channel=None, quantity=None,
+             provenance=None):
+        """Measured vs simulated curves, gap shaded (thesis layout, Figs 45-71); every
+        measured quantity is drawn unless ``quantities`` says otherwise. Returns the figure.
 
         See :func:`powertrain.plotting.plot_comparison`.
         """
         from powertrain.plotting import plot_comparison
-        return plot_comparison(self, path, quantities)
+        from powertrain.plotting.style import target_and_path
+        ax, path = target_and_path(ax, path)
+        return plot_comparison(self, path, quantities, ax=ax, channel=channel,
+                               quantity=quantity,
+                               provenance=provenance or getattr(self, "provenance", None))
 
 
 def compare_runup(simulated, measured: MeasuredRunup, *, noise_floor=DEFAULT_NOISE_FLOOR,

@@ -330,15 +330,19 @@ class FitResult:
                 f"{self.nfev} evaluations, "
                 f"{self.time_s:.2f} s")
 
-    def plot(self, ax=None, path=None):
-        """Measured and fitted real and imaginary K*(f) [N/mm] (see
+    def plot(self, ax=None, path=None, *, form="magnitude-phase", freq_axis="log",
+             provenance=None):
+        """Measured and fitted K*(f) [N/mm]: |K*| and loss angle (datasheets, ISO 10846) or
+        real and imaginary part (``form="real-imag"``, the thesis), over ``log`` or
+        ``linear`` frequency; returns the figure (see
         :func:`powertrain.plotting.plot_mount_fit`)."""
         from powertrain.plotting import plot_mount_fit
         return plot_mount_fit(self.frequency_hz, self.kcp_measured, self.kcp_fitted,
                               label=f"{self.model.topology.name} fit",
                               title=f"f_obj = {self.objective_n:.4g} N, "
                                     f"rel. RMS error = {100 * self.rel_rms:.3g} %",
-                              ax=ax, path=path)
+                              ax=ax, path=path, form=form, freq_axis=freq_axis,
+                              provenance=provenance)
 
 
 def fit_mount(frequency_hz, kcp_measured, model: str | Topology = DEFAULT_TOPOLOGY, *,

@@ -7,20 +7,19 @@ from __future__ import annotations
 
 import numpy as np
 
-from powertrain.plotting import _pyplot, save_figure
+from powertrain.plotting.style import finish, subplots
 
 _COLOURS = {"x": "tab:blue", "y": "tab:orange", "z": "tab:green", "rx": "tab:red",
             "ry": "tab:purple", "rz": "tab:brown"}
 
 
-def plot_modes(result, path=None, ax=None):
+def plot_modes(result, path=None, ax=None, provenance=None):
     """Kinetic-energy distribution of each mode as stacked bars, labelled with frequency,
-    damping ratio and the angle of its rotation axis to the torque-roll axis."""
+    damping ratio and the angle of its rotation axis to the torque-roll axis; returns the
+    figure (``ax``: None, an Axes, Figure or SubFigure)."""
     from powertrain.solvers.modes import COORDINATES
-    plt = _pyplot()
-    fig = None
-    if ax is None:
-        fig, ax = plt.subplots(figsize=(9, 4.8))
+    fig, axes, own = subplots(ax, figsize=(9, 5.2))
+    ax = axes[0, 0]
     n = len(result.modes)
     x = np.arange(n)
     bottom = np.zeros(n)
@@ -35,10 +34,10 @@ def plot_modes(result, path=None, ax=None):
                         for m in result.modes], fontsize=8)
     ax.set_ylabel("kinetic energy [%]")
     ax.set_ylim(0, 100)
-    ax.legend(ncol=6, fontsize=8, loc="upper center", bbox_to_anchor=(0.5, -0.28))
+    if own:
+        fig.legend(*ax.get_legend_handles_labels(), ncol=6, fontsize=8,
+                   loc="outside upper center", frameon=False)
+    else:
+        ax.legend(ncol=6, fontsize=8, loc="upper center")
     ax.set_title(f"{result.engine} — {result.method.split(':')[0]} modes", fontsize=9)
-    if fig is not None:
-        fig.tight_layout()
-        if path:
-            save_figure(fig, path)
-    return ax
+    return finish(fig, own, path, provenance)

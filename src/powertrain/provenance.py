@@ -10,11 +10,19 @@ Written into every HDF5 (attribute ``provenance``) and JSON (key ``provenance``)
   and parameters;
 * ``modifications``: what the command changed on the engine as read, and ``effects``: the
   unmodelled effects applied (name and SI parameters).
+
+For figures, a :class:`Provenance` value holds the short form (command, engine, version,
+date) printed as one line at the foot of every figure
+(:func:`powertrain.plotting.style.add_provenance`); the CLI fills it
+(:func:`powertrain.cli.common.cli_provenance`), library users make one with
+:meth:`Provenance.now`, and result objects may carry one in a ``provenance`` attribute,
+which their ``plot`` methods use when none is passed.
 """
 
 from __future__ import annotations
 
 import dataclasses
+import datetime as _dt
 import math
 import shlex
 import sys
@@ -86,3 +94,70 @@ def provenance(engine=None, *, engine_file=None, modifications=(), effects=None)
         doc["effects"] = jsonable(effects or {})
         doc["engine_as_run"] = engine_as_run(engine)
     return doc
+
+
+@dataclasses.dataclass(frozen=True)
+class Provenance:
+    """Program, command, engine and date of one result.
+
+    Attributes
+    ----------
+    command : str
+        The command line as typed (``powertrain runup --from 1000 ...``), or a description of
+        the library call; empty when unknown.
+    engine : str
+        The engine that ran: name and file, and what was changed on the command line
+        (e.g. ``"EA888-like (engines/default.toml), balancers off"``); empty when the result
+        has no engine (a mount stiffness).
+    version : str
+        ``powertrain`` version.
+    date : str
+        UTC date and time, ISO 8601 to the second (``2026-11-23T18:30:00Z``).
+    """
+
+    command: str = ""
+    engine: str = ""
+    version: str = ""
+    date: str = ""
+
+    @classmethod
+    def now(cls, command: str = "", engine: str = "") -> Provenance:
+        """A provenance stamped with the current UTC time and this version."""
+        from powertrain import __version__
+        stamp = _dt.datetime.now(_dt.timezone.utc).replace(microsecond=0)
+        return cls(command=command, engine=engine, version=__version__,
+                   date=stamp.strftime("%Y-%m-%dT%H:%M:%SZ"))
+
+    @classmethod
+    def from_record(cls, record: dict) -> Provenance:
+        """The short form of a provenance record of :func:`provenance` (HDF5/JSON)."""
+        engine = record.get("engine_name", "")
+        if record.get("engine_file"):
+            engine += f" ({record['engine_file']})"
+        mods = list(record.get("modifications", [])) + list(record.get("effects", {}) or {})
+        if mods:
+            engine += ", " + ", ".join(str(m) for m in mods)
+        return cls(command=record.get("command_line", ""), engine=engine.strip(),
+                   version=record.get("powertrain_version", ""),
+                   date=str(record.get("created", "")).replace("+00:00", "Z"))
+
+    def with_engine(self, engine: str) -> Provenance:
+        """Copy with ``engine`` set."""
+        return dataclasses.replace(self, engine=engine)
+
+    def line(self) -> str:
+        """One line for a figure foot: ``powertrain 0.1.0 · 2026-11-23 18:30 UTC · engine:
+        ... · $ command``."""
+        from powertrain import __version__
+        parts = [f"powertrain {self.version or __version__}"]
+        if self.date:
+            parts.append(self.date.replace("T", " ").replace("Z", " UTC"))
+        if self.engine:
+            parts.append(f"engine: {self.engine}")
+        if self.command:
+            parts.append(f"$ {self.command}")
+        return "  ·  ".join(parts)
+
+    def to_dict(self) -> dict:
+        """Plain dict (for JSON and HDF5 attributes)."""
+        return dataclasses.asdict(self)

@@ -171,38 +171,122 @@ class RunupResult:
 
     @classmethod
     def from_hdf5(cls, path) -> RunupResult:
+        """Read a run-up HDF5 file; every dataset's type and shape is checked (errors name
+        the file and the dataset or attribute)."""
         import h5py
 
         from powertrain.errors import InputError
+        from powertrain.iotools.textfile import check_regular_file
+        check_regular_file(path)
         try:
             h5 = h5py.File(path, "r")
         except (OSError, FileNotFoundError) as exc:
             raise InputError(f"cannot open HDF5 file ({exc})", file=path) from None
-        with h5:
-            if h5.attrs.get("format") != "powertrain-runup":
-                raise InputError("not a powertrain run-up result", file=path, key="format")
-            channels = list(zip([m.decode() for m in h5["channels/mount"][()]],
-                                [d.decode() for d in h5["channels/direction"][()]]))
-            return cls(rpm=h5["rpm"][()], orders=h5["orders"][()], channels=channels,
-                       displacement=h5["displacement/amplitude"][()],
-                       velocity=h5["velocity/amplitude"][()],
-                       acceleration=h5["acceleration/amplitude"][()],
-                       mount_force=h5["mount_force/amplitude"][()],
-                       mean_mount_force=h5["mount_force/mean"][()],
-                       periodicity=h5["diagnostics/periodicity"][()],
-                       settings=json.loads(h5.attrs["settings"]),
-                       solver_seconds=float(h5["diagnostics/solver_seconds"][()]),
-                       rigid_body_modes_hz=h5["diagnostics/rigid_body_modes_hz"][()],
-                       meta=json.loads(h5.attrs["meta"]))
+        try:
+            with h5:
+                return cls._from_open_hdf5(h5, path)
+        except InputError:
+            raise
+        except (OSError, RuntimeError, KeyError, ValueError, TypeError) as exc:
+            raise InputError(f"damaged or not in the run-up layout ({type(exc).__name__}: "
+                             f"{str(exc)[:120]})", file=path) from None
+
+    @classmethod
+    def _from_open_hdf5(cls, h5, path) -> RunupResult:
+        from powertrain.errors import InputError
+        if h5.attrs.get("format") != "powertrain-runup":
+            raise InputError("not a powertrain run-up result", file=path, key="format")
+        rpm = _h5_array(h5, "rpm", path, "f", 1)
+        orders = _h5_array(h5, "orders", path, "f", 1)
+        mounts = _h5_names(h5, "channels/mount", path)
+        directions = _h5_names(h5, "channels/direction", path)
+        if len(mounts) != len(directions):
+            raise InputError(f"{len(mounts)} mounts but {len(directions)} directions",
+                             file=path, key="channels/direction")
+        n = (rpm.size, len(mounts), orders.size)
+        amp = {q: _h5_array(h5, f"{q}/amplitude", path, "fc", 3, n)
+               for q in ("displacement", "velocity", "acceleration", "mount_force")}
+        return cls(rpm=rpm, orders=orders, channels=list(zip(mounts, directions)), **amp,
+                   mean_mount_force=_h5_array(h5, "mount_force/mean", path, "f", 2, n[:2]),
+                   periodicity=_h5_array(h5, "diagnostics/periodicity", path, "f", 1, n[:1]),
+                   settings=_h5_json(h5, "settings", path),
+                   solver_seconds=float(_h5_array(h5, "diagnostics/solver_seconds", path,
+                                                  "f", 0)),
+                   rigid_body_modes_hz=_h5_array(h5, "diagnostics/rigid_body_modes_hz", path,
+                                                 "f", 1),
+                   meta=_h5_json(h5, "meta", path))
 
     # ----------------------------------------------------------------- plots
-    def plot(self, path=None, quantities=("synthesis", "order_2", "order_4"),
-             signal="velocity", others=None):
-        """The thesis's figure set (Figs 45–71): one row per mount and direction, columns
-        synthesis, 2nd and 4th order RMS velocity [mm/s] against rpm.
+    def plot(self, ax=None, *, path=None, quantities=("synthesis", "order_2", "order_4"),
+             signal="velocity", others=None, channel=None, quantity=None, provenance=None):
+        """The thesis's figure set (Figs 45–71): one row per mount and direction, one column
+        per quantity (every one of ``quantities`` is drawn), RMS ``signal`` against rpm.
 
-        ``others``: optional list of (label, RunupResult) overlaid for comparison.
+        ``ax``: None (new figure), a Figure/SubFigure (the grid) or an Axes (the one panel
+        ``channel``/``quantity``); ``others``: optional list of (label, RunupResult)
+        overlaid; ``provenance``: foot line (default: ``self.provenance`` if set). Returns the
+        figure; see :func:`powertrain.plotting.plot_runup`.
         """
         from powertrain.plotting import plot_runup
+        from powertrain.plotting.style import target_and_path
+        ax, path = target_and_path(ax, path)
         return plot_runup([("simulation", self)] + list(others or []), path, quantities,
-                          signal)
+                          signal, ax=ax, channel=channel, quantity=quantity,
+                          provenance=provenance or getattr(self, "provenance", None))
+
+
+def _h5_array(h5, key, path, kinds, ndim, shape=None):
+    """Dataset ``key`` as an array of dtype kind in ``kinds`` ("f": real, "c": complex),
+    ``ndim`` dimensions and, if given, ``shape``."""
+    import h5py
+
+    from powertrain.errors import InputError
+    obj = h5.get(key)
+    if not isinstance(obj, h5py.Dataset):
+        raise InputError("missing dataset", file=path, key=key)
+    kind = obj.dtype.kind
+    if not (kind in kinds or (kind in "iu" and "f" in kinds)):
+        raise InputError(f"expected numbers, got dtype {obj.dtype}", file=path, key=key)
+    if obj.ndim != ndim or (shape is not None and obj.shape != tuple(shape)):
+        want = shape if shape is not None else f"{ndim} dimensions"
+        raise InputError(f"shape {obj.shape}, expected {want}", file=path, key=key)
+    data = obj[()]
+    return np.asarray(data, dtype=complex if kind == "c" else float)
+
+
+def _h5_names(h5, key, path) -> list[str]:
+    """1-D dataset of strings (bytes or str)."""
+    import h5py
+
+    from powertrain.errors import InputError
+    obj = h5.get(key)
+    if not isinstance(obj, h5py.Dataset) or obj.ndim != 1 or obj.dtype.kind not in "SOU":
+        raise InputError("expected a 1-D dataset of names", file=path, key=key)
+    names = []
+    for v in obj[()]:
+        if isinstance(v, bytes):
+            try:
+                v = v.decode("utf-8")
+            except UnicodeDecodeError:
+                raise InputError("names must be UTF-8", file=path, key=key) from None
+        if not isinstance(v, str):
+            raise InputError("expected names (strings)", file=path, key=key)
+        names.append(v)
+    return names
+
+
+def _h5_json(h5, attr, path) -> dict:
+    """Attribute ``attr`` holding a JSON object."""
+    from powertrain.errors import InputError
+    raw = h5.attrs.get(attr)
+    if raw is None:
+        raise InputError("missing attribute", file=path, key=attr)
+    if isinstance(raw, bytes):
+        raw = raw.decode("utf-8", errors="replace")
+    try:
+        value = json.loads(str(raw))
+    except ValueError:
+        raise InputError("attribute is not JSON", file=path, key=attr) from None
+    if not isinstance(value, dict):
+        raise InputError("expected a JSON object", file=path, key=attr)
+    return value

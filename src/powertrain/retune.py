@@ -244,10 +244,15 @@ class TargetFit:
                 f"{100 * self.max_band_error:.2f} %, mean |K_CP| change "
                 f"{100 * self.mean_band_change:+.2f} % (requested {100 * (t.factor - 1):+.2f} %)")
 
-    def plot(self, path=None):
-        """Baseline, requested and fitted K_CP (see :func:`powertrain.plotting.plot_retune`)."""
+    def plot(self, ax=None, *, path=None, form="magnitude-phase", freq_axis="log",
+             provenance=None):
+        """Baseline, requested and fitted K_CP; returns the figure (see
+        :func:`powertrain.plotting.plot_retune`)."""
         from powertrain.plotting import plot_retune
-        return plot_retune(self, path)
+        from powertrain.plotting.style import target_and_path
+        ax, path = target_and_path(ax, path)
+        return plot_retune(self, path, ax=ax, form=form, freq_axis=freq_axis,
+                           provenance=provenance)
 
 
 def _rel_rms(k, kt) -> float:

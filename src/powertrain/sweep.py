@@ -66,7 +66,7 @@ class SweepTask:
 def run_task(task: SweepTask):
     """Apply the task's operations to its engine and run the run-up (response-level
     effects, :func:`powertrain.variants.response_scenario`, through
-    :func:`powertrain.effects.runup_with_effects`).
+    :func:`powertrain.effect_runup.runup_with_effects`).
 
     Returns
     -------
@@ -78,7 +78,7 @@ def run_task(task: SweepTask):
     engine = apply_operations(task.engine, task.operations)
     response = response_scenario(task.operations)
     if response:        # amplitude-dependent mounts, sensor errors: see effects module
-        from powertrain.effects import runup_with_effects
+        from powertrain.effect_runup import runup_with_effects
         result = runup_with_effects(engine, task.rpm, response, solver=task.solver,
                                     **task.options)
     else:

@@ -62,7 +62,6 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from powertrain.effects import A_REF
-from powertrain.physics.mount_network import network_matrices
 from powertrain.solvers.fast_harmonic import N_HARMONICS, HarmonicModel
 
 TRUTH_EFFECTS = {
@@ -188,20 +187,11 @@ class SynthCase:
 
 # ---------------------------------------------------------------------------- truth models
 def _two_port_springs(omega, model, s):
-    """Two-port (a, b, c) with the network's springs times s (n_r,) per speed."""
-    M, C, K = network_matrices(*model.network(), include_ground=True)
-    w = omega[..., None, None]
-    D = s[:, None, None, None] * K + 1j * w * C - w ** 2 * M
-    n = M.shape[0] - 2
-    bnd = [0, n + 1]
-    Dbb = D[..., bnd, :][..., :, bnd]
-    if n:
-        Dbi = D[..., bnd, 1:n + 1]
-        Dib = D[..., 1:n + 1, :][..., :, bnd]
-        S = Dbb - Dbi @ np.linalg.solve(D[..., 1:n + 1, 1:n + 1], Dib)
-    else:
-        S = Dbb
-    return S[..., 0, 0], S[..., 0, 1], S[..., 1, 1]
+    """Two-port (a, b, c) with the network's springs times s (n_r,) per speed (dampers and
+    masses kept): the one condensation, :func:`powertrain.physics.mount_network.two_port`."""
+    from powertrain.physics.mount_network import two_port
+    return two_port(omega, *model.network(), spring_scale=np.asarray(s, float)[:, None],
+                    damper_scale=1.0)
 
 
 def _solve_body(hm, abc, load, body):

@@ -42,7 +42,7 @@ mount, ``x``, ``y``, ``z`` or ``*``; the default engine's mounts are ``left``, `
                                            VALUE in the parameter's unit (N/m, kg, rad,
                                            dB, 1) or an explicit one of the same
                                            dimension; inside the effect's bounds; run by
-                                           :func:`powertrain.effects.runup_with_effects`
+                                           :func:`powertrain.effect_runup.runup_with_effects`
 =========================================  ==================================================
 
 What "scale stiffness" means for a lumped network
@@ -282,7 +282,7 @@ class AddEffect:
     Engine-model effects are applied by :meth:`apply`; the response-level ones
     (``amplitude_stiffness``, ``sensor_error``) leave the engine unchanged here and are
     applied to the run-up by :func:`powertrain.sweep.run_task` through
-    :func:`powertrain.effects.runup_with_effects`.
+    :func:`powertrain.effect_runup.runup_with_effects`.
 
     Attributes
     ----------
@@ -304,7 +304,7 @@ class AddEffect:
         if self.effect in RESPONSE_EFFECTS:
             return engine
         eff = EFFECTS[self.effect]
-        return eff.apply(engine, **{**eff.defaults(), **dict(self.params)})
+        return eff.apply(engine, **{**eff.defaults(engine), **dict(self.params)})
 
 
 def effect_scenario(operations, names=None) -> dict:
@@ -566,8 +566,11 @@ def parse_target(text: str, origin: Origin = Origin("--target")) -> Target:
     return Target(mount, direction, factor, f_lo, f_hi, width, spec=text, origin=origin)
 
 
-def parse_effect(text: str, origin: Origin = Origin("--effect")) -> AddEffect:
+def parse_effect(text: str, origin: Origin = Origin("--effect"), engine=None) -> AddEffect:
     """``NAME[:PARAM=VALUE[UNIT][,PARAM=VALUE...]]`` -> :class:`AddEffect` (SI values).
+
+    Parameters are those the effect generates for ``engine`` (default: the default layout,
+    three mounts, four cylinders).
 
     Without a unit a value is in the parameter's own unit (:data:`powertrain.effects.
     EFFECTS`: N/m, kg, m, rad, dB or 1); an explicit unit must have the same dimension
@@ -582,7 +585,7 @@ def parse_effect(text: str, origin: Origin = Origin("--effect")) -> AddEffect:
     if name not in EFFECTS:
         raise origin.error(f"{text!r}: unknown effect {name!r} (expected "
                            f"{', '.join(EFFECTS)})")
-    spec = {p.name: p for p in EFFECTS[name].parameters}
+    spec = {p.name: p for p in EFFECTS[name].parameters(engine)}
     params = []
     for item in [x.strip() for x in rest.split(",")] if rest.strip() else []:
         key, eq, value = item.partition("=")
@@ -605,7 +608,7 @@ def parse_effect(text: str, origin: Origin = Origin("--effect")) -> AddEffect:
             v = v * UNITS[unit][1] / UNITS[p.unit][1]
         params.append((key, float(v)))
     try:
-        check_scenario({name: dict(params)})         # bounds, finiteness: one rule
+        check_scenario({name: dict(params)}, engine)  # bounds, finiteness: one rule
     except ValueError as exc:
         raise origin.error(f"{text!r}: {exc}") from None
     return AddEffect(name, tuple(params), spec=text, origin=origin)

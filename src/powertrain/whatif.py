@@ -182,11 +182,14 @@ class WhatIfResult:
                           + _format_table(header, list(rows.values())))
         return "\n\n".join(blocks)
 
-    def plot(self, path=None):
-        """Overlay of baseline, variants and measurement (see
+    def plot(self, ax=None, *, path=None, channel=None, quantity=None, provenance=None):
+        """Overlay of baseline, variants and measurement; returns the figure (see
         :func:`powertrain.plotting.plot_whatif`)."""
         from powertrain.plotting import plot_whatif
-        return plot_whatif(self, path)
+        from powertrain.plotting.style import target_and_path
+        ax, path = target_and_path(ax, path)
+        return plot_whatif(self, path, ax=ax, channel=channel, quantity=quantity,
+                           provenance=provenance or getattr(self, "provenance", None))
 
 
 def _format_table(header, rows) -> str:

@@ -45,11 +45,21 @@ class StiffnessTable:
         return "\n".join(lines) + "\n"
 
     def to_text(self) -> str:
-        from powertrain.cli.common import format_table
+        from powertrain.analysis.text_table import format_table
         cols = self.columns()
         header = list(cols)
         rows = [[float(cols[c][i]) for c in cols] for i in range(self.frequency_hz.size)]
         return f"# method: {self.method}\n" + format_table(header, rows) + "\n"
+
+    def plot(self, ax=None, *, path=None, label=None, form="magnitude-phase", freq_axis="log",
+             measured=None, provenance=None):
+        """K*(f) as |K*| and loss angle (datasheets, ISO 10846; default) or real and imaginary
+        part (``form="real-imag"``, the thesis), over ``log`` or ``linear`` frequency;
+        returns the figure (see :func:`powertrain.plotting.plot_stiffness`)."""
+        from powertrain.plotting import plot_stiffness
+        return plot_stiffness([(label or self.meta.get("name", "model"), self)], path,
+                              measured=measured, ax=ax, form=form, freq_axis=freq_axis,
+                              provenance=provenance or getattr(self, "provenance", None))
 
 
 def stiffness_table(model, frequency_hz, method="frequency", engine_mass=None, force=None,

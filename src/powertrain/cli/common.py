@@ -7,7 +7,13 @@ import math
 import click
 import numpy as np
 
+from powertrain.analysis.text_table import format_table  # noqa: F401 (re-export)
 from powertrain.errors import InputError
+
+#: Most frequencies one option may ask for, and the highest frequency [Hz] (a mount model
+#: fitted below 1 kHz says nothing at 100 kHz; the limits keep a typo from hanging the run).
+MAX_FREQUENCIES = 100_000
+MAX_FREQUENCY_HZ = 1e5
 
 
 def parse_frequencies(text: str, option: str = "--freq") -> np.ndarray:
@@ -23,33 +29,31 @@ def parse_frequencies(text: str, option: str = "--freq") -> np.ndarray:
                 if len(fields) != 3 or fields[2] <= 0 or fields[1] < fields[0]:
                     raise ValueError
                 start, stop, step = fields
-                n = int(math.floor((stop - start) / step + 1e-9)) + 1
+                if not all(math.isfinite(x) for x in fields):
+                    raise ValueError
+                n = math.floor((stop - start) / step + 1e-9) + 1
+                if n + len(values) > MAX_FREQUENCIES:
+                    raise InputError(f"{part!r} asks for {n:.3g} frequencies; at most "
+                                     f"{MAX_FREQUENCIES}", key=option)
                 values.extend(start + step * np.arange(n))
             else:
                 values.append(float(part))
+        except InputError:
+            raise
         except ValueError:
             raise InputError(f"cannot read frequency {part!r} (use 5,10,20 or 1:400:1)",
                              key=option) from None
     arr = np.array(values, dtype=float)
     if arr.size == 0:
         raise InputError("no frequency given", key=option)
-    if not np.all(np.isfinite(arr)) or np.any(arr < 0):
-        raise InputError("frequencies must be finite and >= 0", key=option)
+    if not np.all(np.isfinite(arr)) or np.any(arr < 0) or np.any(arr > MAX_FREQUENCY_HZ):
+        raise InputError(f"frequencies must be finite, >= 0 and <= {MAX_FREQUENCY_HZ:g} Hz",
+                         key=option)
+    if arr.size > MAX_FREQUENCIES:
+        raise InputError(f"{arr.size} frequencies; at most {MAX_FREQUENCIES}", key=option)
     if np.any(np.diff(arr) <= 0):
         raise InputError("frequencies must be strictly increasing", key=option)
     return arr
-
-
-def format_table(header: list[str], rows: list[list], floatfmt: str = "{:.4g}") -> str:
-    """Fixed-width text table."""
-    cells = [[floatfmt.format(v) if isinstance(v, float) else str(v) for v in row]
-             for row in rows]
-    widths = [max(len(h), *(len(r[i]) for r in cells)) if cells else len(h)
-              for i, h in enumerate(header)]
-    lines = ["  ".join(h.rjust(w) for h, w in zip(header, widths)),
-             "  ".join("-" * w for w in widths)]
-    lines += ["  ".join(c.rjust(w) for c, w in zip(r, widths)) for r in cells]
-    return "\n".join(lines)
 
 
 def speed_options(func):
@@ -85,6 +89,8 @@ def speed_steps(rpm_from: float, rpm_to: float, rpm_step: float) -> np.ndarray:
 MAX_SPEEDS = 2000
 #: Finest crank-angle step [deg] of the Newmark stepper (720 / 0.05 = 14 400 steps a cycle).
 MIN_ANGLE_STEP_DEG = 0.05
+#: Coarsest crank-angle step [deg]: 72 steps a cycle still resolve order 8 without aliasing.
+MAX_ANGLE_STEP_DEG = 10.0
 
 
 def check_outputs(**targets) -> None:
@@ -106,11 +112,11 @@ def runup_settings(engine, rpm: np.ndarray, angle_step: float) -> None:
         raise InputError(f"{rpm[-1]:g} rpm is above the engine's range {lo:g}..{hi:g} rpm",
                          key="--to")
     n_cycle = 720.0 / angle_step if math.isfinite(angle_step) and angle_step > 0 else 0.0
-    if not (angle_step >= MIN_ANGLE_STEP_DEG and abs(n_cycle - round(n_cycle)) < 1e-9
-            and round(n_cycle) % 2 == 0):
+    if not (MIN_ANGLE_STEP_DEG <= angle_step <= MAX_ANGLE_STEP_DEG
+            and abs(n_cycle - round(n_cycle)) < 1e-9 and round(n_cycle) % 2 == 0):
         raise InputError(f"{angle_step:g} deg: must divide 720 deg into an even number of "
-                         f"steps and be >= {MIN_ANGLE_STEP_DEG:g} deg (e.g. 0.5, 1, 2)",
-                         key="--angle-step")
+                         f"steps, {MIN_ANGLE_STEP_DEG:g}..{MAX_ANGLE_STEP_DEG:g} deg "
+                         "(e.g. 0.5, 1, 2)", key="--angle-step")
 
 
 def write_json(path, text: str, provenance: dict, key: str = "--json") -> None:
@@ -128,3 +134,73 @@ def write_json(path, text: str, provenance: dict, key: str = "--json") -> None:
                          file=path, key=key) from None
     with atomic_write(path) as fh:
         fh.write(out)
+
+
+def checked_runup(engine, engine_path, run, *args, **kwargs):
+    """``run(engine, *args, **kwargs)`` (a run-up), with a model that cannot be solved or a
+    result that is not finite reported as bad input naming the engine file (the last guard:
+    the checks at load catch the known causes first)."""
+    try:
+        with np.errstate(all="ignore"):
+            result = run(engine, *args, **kwargs)
+    except InputError:
+        raise
+    except (ValueError, ArithmeticError, np.linalg.LinAlgError) as exc:
+        raise InputError(f"the model cannot be solved ({type(exc).__name__}: "
+                         f"{str(exc)[:120]})", file=engine_path, key="engine") from None
+    for name in ("displacement", "velocity", "acceleration", "mount_force", "mean_mount_force"):
+        if not np.all(np.isfinite(getattr(result, name))):
+            raise InputError(f"the simulated {name.replace('_', ' ')} is not finite (NaN or "
+                             "inf): the engine's values are out of any physical range",
+                             file=engine_path, key="engine")
+    return result
+
+
+# ------------------------------------------------------------------ figures
+def use_agg() -> None:
+    """Select matplotlib's file-only Agg backend: the CLI draws no windows. Only the CLI
+    does this; the library never switches the backend."""
+    import matplotlib
+    matplotlib.use("Agg")
+
+
+def cli_provenance(engine: str = ""):
+    """:class:`~powertrain.provenance.Provenance` of this command: the command line as given,
+    ``engine`` (what ran), version and time."""
+    from powertrain.provenance import Provenance, command_line
+    return Provenance.now(command=command_line(), engine=engine)
+
+
+def engine_description(engine, path, *, no_balancers=False, effects=()) -> str:
+    """``name (file)`` plus what the command line changed (balancers off, effects)."""
+    import os
+    rel = os.path.relpath(str(path))
+    shown = rel if not rel.startswith("..") else os.path.basename(str(path))
+    text = f"{engine.name} ({shown})"
+    if no_balancers:
+        text += ", balancers off"
+    if effects:
+        text += ", effects " + " ".join(effects)
+    return text
+
+
+def write_plot(draw, path) -> None:
+    """Draw a figure with ``draw(path)`` (a result's ``plot``) under the Agg backend, then
+    release it."""
+    use_agg()
+    from powertrain.plotting.style import close_figure
+    close_figure(draw(path))
+
+
+def plot_form_options(func):
+    """``--form`` and ``--freq-axis`` of the dynamic-stiffness plots."""
+    for option in reversed([
+        click.option("--form", type=click.Choice(["magnitude-phase", "real-imag"]),
+                     default="magnitude-phase", show_default=True,
+                     help="Plot form: |K*| and loss angle (datasheets, ISO 10846) or real "
+                          "and imaginary part (the thesis)."),
+        click.option("--freq-axis", type=click.Choice(["log", "linear"]), default="log",
+                     show_default=True, help="Frequency axis of the plot."),
+    ]):
+        func = option(func)
+    return func

@@ -87,11 +87,21 @@ def compare(measured, sim_file, engine_file, plot, json_file, noise_floor, solve
                     math.ceil(e_lo / rpm_step - 1e-9) * rpm_step)
         stop = min(math.ceil(hi / rpm_step - 1e-9) * rpm_step,
                    math.floor(e_hi / rpm_step + 1e-9) * rpm_step)
-        if stop < start:
+        if hi < e_lo or lo > e_hi:
             raise InputError(f"measured speeds {lo:g}..{hi:g} rpm outside the engine's range "
                              f"{e_lo:g}..{e_hi:g} rpm", file=measured, key="rpm")
+        if stop < start or start <= 0:
+            raise InputError(f"{rpm_step:g} rpm leaves no speed step inside both the measured "
+                             f"({lo:g}..{hi:g}) and the engine's ({e_lo:g}..{e_hi:g}) range",
+                             key="--step")
+        from powertrain.cli.common import MAX_SPEEDS
+        if (stop - start) / rpm_step + 1 > MAX_SPEEDS:
+            raise InputError(f"{(stop - start) / rpm_step + 1:.3g} speed steps over the "
+                             f"measured range; at most {MAX_SPEEDS}", key="--step")
         rpm = default_rpm(start, stop, rpm_step)
-        result = run_runup(engine, rpm, solver=solver, progress=not quiet)
+        from powertrain.cli.common import checked_runup
+        result = checked_runup(engine, engine_file, run_runup, rpm, solver=solver,
+                               progress=not quiet)
         simulated = MeasuredRunup.from_result(
             result, source=f"{engine_file} ({solver}, {rpm[0]:g}..{rpm[-1]:g} rpm step "
                            f"{rpm_step:g})", signal=meas.signal)
@@ -99,9 +109,13 @@ def compare(measured, sim_file, engine_file, plot, json_file, noise_floor, solve
     comp = compare_runup(simulated, meas, noise_floor=noise_floor * 1e-3)
     if not comp.channels:
         raise InputError("nothing to compare: no channel and quantity has a point above the "
-                         "noise floor inside the simulated speed range", file=measured)
+                         f"noise floor ({noise_floor:g} mm/s) inside the simulated speed range",
+                         file=measured, key="--noise-floor")
     if plot:
-        comp.plot(plot)
+        from powertrain.cli.common import cli_provenance, engine_description, write_plot
+        prov = cli_provenance(engine_description(engine, engine_file) + f", {solver} solver"
+                              if engine is not None else f"simulation from {sim_file}")
+        write_plot(lambda p: comp.plot(path=p, provenance=prov), plot)
     if json_file:
         from powertrain.provenance import provenance
         write_json(json_file, comp.to_json(),

@@ -80,7 +80,10 @@ def diagnose(measured, engine_file, report_dir, json_file, noise_floor, effects,
                    provenance(engine, engine_file=engine_file or DEFAULT_ENGINE_PATH))
         click.echo(f"wrote {json_file}")
     if report_dir:
-        files = res.report(report_dir)
+        from powertrain.cli.common import cli_provenance, engine_description, use_agg
+        use_agg()
+        files = res.report(report_dir, provenance=cli_provenance(
+            engine_description(engine, engine.file)))
         click.echo(f"wrote {len(files)} files to {report_dir}")
 
 
@@ -97,7 +100,8 @@ def diagnose(measured, engine_file, report_dir, json_file, noise_floor, effects,
                    "diagnosis).")
 @click.option("--engine", "engine_file", type=click.Path(dir_okay=False),
               help="Baseline engine file (default: engines/default.toml).")
-def synth(effect_names, seed, out, truth_file, engine_file):
+@click.option("--quiet", is_flag=True, help="No progress indicator on stderr.")
+def synth(effect_names, seed, out, truth_file, engine_file, quiet):
     """Make a SYNTHETIC measured run-up with hidden effects and noise (truth generator).
 
     \b
@@ -121,7 +125,13 @@ def synth(effect_names, seed, out, truth_file, engine_file):
             raise InputError(f"unknown truth effect {e!r} (known: {', '.join(TRUTH_EFFECTS)})",
                              key="--effect")
     engine = read_engine(engine_file or str(DEFAULT_ENGINE_PATH))
-    case = make_case(engine, names, seed)
+    from powertrain.cli.common import check_outputs
+    from powertrain.progress import activity
+    if not 0 <= seed < 2 ** 63:
+        raise InputError(f"must be an integer 0..2^63-1, got {seed}", key="--seed")
+    check_outputs(out=out, truth=truth_file)
+    with activity("synth (simulating the hidden truth)", enabled=not quiet):
+        case = make_case(engine, names, seed)
     with atomic_write(out) as fh:
         fh.write(case.csv_text())
     if truth_file:

@@ -69,7 +69,10 @@ def excitation(rpm, engine_file, load, no_balancers, step, csv_path, plot):
     if csv_path:
         _write_csv(exc, csv_path)
     if plot:
-        exc.plot(plot)
+        from powertrain.cli.common import cli_provenance, engine_description, write_plot
+        prov = cli_provenance(engine_description(engine, engine.file,
+                                                 no_balancers=no_balancers))
+        write_plot(lambda p: exc.plot(path=p, provenance=prov), plot)
     click.echo(summary(engine, exc))
 
 

@@ -5,6 +5,7 @@ from __future__ import annotations
 import click
 
 from powertrain.cli import main
+from powertrain.cli.common import plot_form_options
 from powertrain.models.mount import TOPOLOGIES
 
 _MODELS = tuple(TOPOLOGIES)
@@ -19,6 +20,7 @@ _MODELS = tuple(TOPOLOGIES)
               help="Fitted mount file to write (TOML, datasheet units).")
 @click.option("--plot", type=click.Path(dir_okay=False),
               help="Write a measured-vs-fitted K*(f) plot (PNG).")
+@plot_form_options
 @click.option("--starts", type=int, default=None,
               help="Random starting points screened [default: powertrain.fitting.DEFAULT_STARTS].")
 @click.option("--seed", type=int, default=None,
@@ -28,7 +30,8 @@ _MODELS = tuple(TOPOLOGIES)
 @click.option("--max-mass", type=float,
               help="Upper bound of every internal mass [kg]. K_CP alone does not identify the "
                    "internal masses, but the engine feels them (input-point stiffness).")
-def fit_mount(measured, model, out, plot, starts, seed, fmin, fmax, max_mass):
+@click.option("--quiet", is_flag=True, help="No progress indicator on stderr.")
+def fit_mount(measured, model, out, plot, form, freq_axis, starts, seed, fmin, fmax, max_mass, quiet):
     """Fit a lumped mount model to the measured dynamic stiffness in MEASURED (CSV).
 
     MEASURED has a header line and the columns frequency_hz plus either k_real_n_per_mm,
@@ -60,23 +63,35 @@ def fit_mount(measured, model, out, plot, starts, seed, fmin, fmax, max_mass):
     seed = DEFAULT_SEED if seed is None else seed
     if max_mass is not None and not max_mass > 0:
         raise InputError(f"must be positive, got {max_mass}", key="--max-mass")
-    if starts < 1:
-        raise InputError(f"must be >= 1, got {starts}", key="--starts")
+    if not 1 <= starts <= 10_000:
+        raise InputError(f"must be 1..10000, got {starts}", key="--starts")
+    if not 0 <= seed < 2 ** 63:
+        raise InputError(f"must be an integer 0..2^63-1, got {seed}", key="--seed")
+    import math
+    for name, value in (("--fmin", fmin), ("--fmax", fmax), ("--max-mass", max_mass)):
+        if value is not None and not math.isfinite(value):
+            raise InputError(f"must be a finite number, got {value}", key=name)
     if fmin is not None and fmax is not None and not fmin < fmax:
         raise InputError(f"--fmin {fmin:g} must be below --fmax {fmax:g}", key="--fmin")
     data = read_stiffness_csv(measured).select(fmin, fmax)
     topo = TOPOLOGIES[model]
     need = (len(topo.parameters) + 1) // 2
     if data.frequency_hz.size < need:
-        raise InputError(f"{data.frequency_hz.size} frequencies in range, the "
+        limits = "/".join(n for n, v in (("--fmin", fmin), ("--fmax", fmax)) if v is not None)
+        raise InputError(f"{data.frequency_hz.size} frequencies in range"
+                         + (f" of {limits}" if limits else "") + f", the "
                          f"{len(topo.parameters)} parameters of {model} need at least {need}",
-                         file=measured, key=FREQUENCY)
+                         file=measured, key=limits or FREQUENCY)
     if not (abs(data.kcp) > 0).any():
         raise InputError("stiffness is zero everywhere", file=measured, key=FREQUENCY)
 
-    result = fit(data.frequency_hz, data.kcp, model, starts=starts, seed=seed, max_mass=max_mass,
-                 name=f"{topo.description} fitted to {Path(measured).name}",
-                 source=f"powertrain fit-mount {Path(measured).name} --model {model}")
+    from powertrain.cli.common import check_outputs
+    from powertrain.progress import activity
+    check_outputs(out=out, plot=plot)
+    with activity(f"fit-mount ({model}, {starts} starts)", enabled=not quiet):
+        result = fit(data.frequency_hz, data.kcp, model, starts=starts, seed=seed,
+                     max_mass=max_mass, name=f"{topo.description} fitted to {Path(measured).name}",
+                     source=f"powertrain fit-mount {Path(measured).name} --model {model}")
     f = data.frequency_hz
     comment = (f"Fitted by powertrain fit-mount (Kovarik 2016 sec. 2.2, eq. 19) to "
                f"{Path(measured).name}: {f.size} frequencies, {f[0]:g}-{f[-1]:g} Hz.\n"
@@ -84,7 +99,10 @@ def fit_mount(measured, model, out, plot, starts, seed, fmin, fmax, max_mass):
                f"{100 * result.rel_rms:.4g} %, starts = {starts}, seed = {seed}.")
     write_mount(result.model, out, comment=comment)
     if plot:
-        result.plot(path=plot)
+        from powertrain.cli.common import cli_provenance, write_plot
+        prov = cli_provenance()
+        write_plot(lambda p: result.plot(path=p, form=form, freq_axis=freq_axis,
+                                         provenance=prov), plot)
 
     units = {"c": "N/mm", "d": "N*s/mm", "m": "kg"}
     click.echo(result.summary())

@@ -37,5 +37,7 @@ def modes(engine_file, static, json_file, plot):
     if json_file:
         result.write_json(json_file)
     if plot:
-        result.plot(plot)
+        from powertrain.cli.common import cli_provenance, engine_description, write_plot
+        prov = cli_provenance(engine_description(engine, engine.file))
+        write_plot(lambda p: result.plot(path=p, provenance=prov), plot)
     click.echo(result.to_text())

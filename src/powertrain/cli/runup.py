@@ -58,7 +58,7 @@ def runup(rpm_from, rpm_to, rpm_step, engine_file, solver, stepper, angle_step, 
       powertrain runup --effect amplitude_stiffness:kappa=1,a_c=0.02mm
       powertrain runup --from 2000 --to 3000 --sweep 200 --raw sweep.h5 --csv sweep.csv
     """
-    from powertrain.cli.common import check_outputs, runup_settings
+    from powertrain.cli.common import check_outputs, checked_runup, runup_settings
     from powertrain.iotools.engine_file import DEFAULT_ENGINE_PATH, read_engine
     from powertrain.runup import run_runup
 
@@ -78,12 +78,15 @@ def runup(rpm_from, rpm_to, rpm_step, engine_file, solver, stepper, angle_step, 
     scenario = effect_scenario(parse_operations({"effect": effect}))
     runup_settings(engine, rpm, angle_step)
     if scenario:
-        from powertrain.effects import runup_with_effects
-        result = runup_with_effects(engine, rpm, scenario, solver=solver,
-                                    angle_step_deg=angle_step, stepper=stepper)
+        from powertrain.effect_runup import runup_with_effects
+        from powertrain.progress import activity
+        with activity(f"run-up with effects ({solver})", enabled=not quiet):
+            result = checked_runup(engine, engine_path, runup_with_effects, rpm, scenario,
+                                   solver=solver, angle_step_deg=angle_step, stepper=stepper)
     else:
-        result = run_runup(engine, rpm, solver=solver, angle_step_deg=angle_step,
-                           progress=not quiet, stepper=stepper)
+        result = checked_runup(engine, engine_path, run_runup, rpm, solver=solver,
+                               angle_step_deg=angle_step, progress=not quiet,
+                               stepper=stepper)
     written = []
     if out:
         from powertrain.provenance import provenance
@@ -102,7 +105,10 @@ def runup(rpm_from, rpm_to, rpm_step, engine_file, solver, stepper, angle_step, 
         result.to_csv(csv_file)
         written.append(csv_file)
     if plot:
-        result.plot(plot)
+        from powertrain.cli.common import cli_provenance, engine_description, write_plot
+        fig_prov = cli_provenance(engine_description(engine, engine_path, no_balancers=no_balancers,
+                                                 effects=effect))
+        write_plot(lambda p: result.plot(path=p, provenance=fig_prov), plot)
         written.append(plot)
     if quiet:
         return

@@ -5,6 +5,7 @@ from __future__ import annotations
 import click
 
 from powertrain.cli import main
+from powertrain.cli.common import plot_form_options
 
 
 @main.command()
@@ -17,9 +18,10 @@ from powertrain.cli import main
 @click.option("--format", "fmt", type=click.Choice(["table", "csv"]), default="table",
               show_default=True)
 @click.option("--plot", type=click.Path(dir_okay=False), help="Write a K*(f) plot (PNG).")
+@plot_form_options
 @click.option("--engine-mass", type=float, help="Engine mass on the mount [kg] (verification set-up).")
 @click.option("--force", type=float, help="Harmonic force amplitude on the engine mass [N].")
-def stiffness(mount_file, freq, method, fmt, plot, engine_mass, force):
+def stiffness(mount_file, freq, method, fmt, plot, form, freq_axis, engine_mass, force):
     """Cross-point dynamic stiffness K*(f) of MOUNT_FILE: real, imaginary, magnitude, loss angle.
 
     With --engine-mass and --force it reproduces the thesis's verification set-up (a harmonic
@@ -30,6 +32,8 @@ def stiffness(mount_file, freq, method, fmt, plot, engine_mass, force):
     \b
     Examples:
       powertrain stiffness mounts/hydraulic-engine-mount-z.toml --freq 1:400:1 --plot k.png
+      powertrain stiffness mounts/hydraulic-engine-mount-z.toml --plot k.png \\
+          --form real-imag --freq-axis linear
       powertrain stiffness mounts/thesis-appendix-a.toml --freq 5,10,12,15,17,20,25,30,40 \\
           --engine-mass 100 --force 100 --method time --format csv
     """
@@ -48,6 +52,8 @@ def stiffness(mount_file, freq, method, fmt, plot, engine_mass, force):
     model = read_mount(mount_file)
     table = stiffness_table(model, freqs, method=method, engine_mass=engine_mass, force=force)
     if plot:
-        from powertrain.plotting import plot_stiffness
-        plot_stiffness([(model.name or mount_file, table)], plot)
+        from powertrain.cli.common import cli_provenance, write_plot
+        prov = cli_provenance()
+        write_plot(lambda p: table.plot(path=p, label=model.name or mount_file, form=form,
+                                        freq_axis=freq_axis, provenance=prov), plot)
     click.echo(table.to_csv() if fmt == "csv" else table.to_text(), nl=False)

@@ -118,6 +118,7 @@ def whatif(engine_file, rpm_from, rpm_to, rpm_step, solver, scale, set_, swap, m
                          key="variant.name")
     for v in variants:
         check_operations(engine, v.operations)
+        _check_variant_support(engine, v)
     n_targets = sum(len(v.targets) for v in variants)
     for opt, value in (("--target-out", target_out), ("--target-plot", target_plot)):
         if value and n_targets != 1:
@@ -137,8 +138,10 @@ def whatif(engine_file, rpm_from, rpm_to, rpm_step, solver, scale, set_, swap, m
         tf = result.target_fits[0]
         write_mount(tf.model, target_out, comment=f"powertrain whatif: {tf.summary()}")
         written.append(target_out)
+    from powertrain.cli.common import cli_provenance, engine_description, write_plot
+    prov = cli_provenance(engine_description(engine, engine.file))
     if target_plot:
-        result.target_fits[0].plot(target_plot)
+        write_plot(lambda p: result.target_fits[0].plot(path=p, provenance=prov), target_plot)
         written.append(target_plot)
     if json_file:
         from powertrain.provenance import provenance
@@ -146,7 +149,7 @@ def whatif(engine_file, rpm_from, rpm_to, rpm_step, solver, scale, set_, swap, m
                    provenance(engine, engine_file=engine_file or DEFAULT_ENGINE_PATH))
         written.append(json_file)
     if plot:
-        result.plot(plot)
+        write_plot(lambda p: result.plot(path=p, provenance=prov), plot)
         written.append(plot)
     if quiet:
         return
@@ -161,3 +164,19 @@ def whatif(engine_file, rpm_from, rpm_to, rpm_step, solver, scale, set_, swap, m
     click.echo(result.table())
     if written:
         click.echo(f"wrote {', '.join(written)}")
+
+
+def _check_variant_support(engine, variant) -> None:
+    """Each mount operation must leave mounts that carry the body (finite, plausible
+    rigid-body modes); the error names the option or variants-file key at fault."""
+    from powertrain.errors import InputError
+    from powertrain.iotools.engine_checks import check_support
+    from powertrain.variants import Target
+    for op in variant.operations:
+        if isinstance(op, Target) or not hasattr(op, "apply"):
+            continue
+        engine = op.apply(engine)
+        try:
+            check_support(engine, None)
+        except InputError as exc:
+            raise op.origin.error(f"variant {variant.name!r}: {exc.message}") from None

@@ -147,7 +147,11 @@ def _unit_vector(table, key, path, prefix):
 
 
 def _q(table, key, dimension, path, prefix, **kw):
-    return float(quantity(table, key, dimension, path, prefix, **kw))
+    value = quantity(table, key, dimension, path, prefix, **kw)
+    if isinstance(value, list):
+        raise InputError("expected one number, got a list", file=path,
+                         key=f"{prefix}.{key}.value" if prefix else f"{key}.value")
+    return float(value)
 
 
 def read_engine(path=DEFAULT_ENGINE_PATH) -> em.Engine:
@@ -183,8 +187,11 @@ def read_engine(path=DEFAULT_ENGINE_PATH) -> em.Engine:
     if "balancer" in doc:
         balancer = _read_balancer(_table(doc, "balancer", path), path)
     _check_static_support(body, mounts, path)
-    return em.Engine(name=name, crank=crank, body=body, mounts=mounts, balancer=balancer,
-                     combustion=combustion, file=path)
+    engine = em.Engine(name=name, crank=crank, body=body, mounts=mounts, balancer=balancer,
+                       combustion=combustion, file=path)
+    from powertrain.iotools.engine_checks import check_engine
+    check_engine(engine, path)
+    return engine
 
 
 def _check_static_support(body, mounts, path):
@@ -196,8 +203,10 @@ def _check_static_support(body, mounts, path):
     except np.linalg.LinAlgError:
         kr = np.zeros(1)
     if kr.min() <= 1e-9 * max(kr.max(), 1e-300):
+        from powertrain.iotools.engine_checks import extreme_mount
         raise InputError("the mounts' static stiffness does not hold the body in every "
-                         "direction (a rigid-body mode at 0 Hz)", file=path, key="mounts")
+                         "direction (a rigid-body mode at 0 Hz); softest: "
+                         f"{extreme_mount(mounts)}", file=path, key="mounts")
 
 
 def _read_crank(t, path) -> em.CrankTrain:
@@ -229,8 +238,8 @@ def _read_crank(t, path) -> em.CrankTrain:
     pins = _array(t, "crank_pin_angles", "angle", path, p, (n,))
     order_raw = get(t, "firing_order", path, p, types=list)
     key_fo = f"{p}.firing_order"
-    if (sorted(order_raw) != list(range(1, n + 1))
-            or any(isinstance(c, bool) or not isinstance(c, int) for c in order_raw)):
+    if (any(isinstance(c, bool) or not isinstance(c, int) for c in order_raw)
+            or sorted(order_raw) != list(range(1, n + 1))):
         raise InputError(f"must list the cylinders 1..{n} once each, got {order_raw!r}",
                          file=path, key=key_fo)
     k1 = order_raw.index(1)

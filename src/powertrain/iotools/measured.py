@@ -44,7 +44,7 @@ import numpy as np
 
 from powertrain.analysis.orders import order_label
 from powertrain.errors import InputError
-from powertrain.iotools.textfile import parse_number, read_text
+from powertrain.iotools.textfile import check_regular_file, parse_number, read_text
 
 #: Recognised level columns: name -> (factor to SI, statistic).
 LEVEL_COLUMNS = {
@@ -59,6 +59,18 @@ LEVEL_COLUMNS = {
 KEY_COLUMNS = ("mount", "direction", "quantity", "rpm")
 DIRECTIONS = ("x", "y", "z")
 _HDF5_SIGNATURE = b"\x89HDF\r\n\x1a\n"
+
+
+#: Highest plausible order level [m/s RMS]: above 1 km/s it is a unit or export error.
+MAX_LEVEL_M_PER_S = 1e3
+#: Highest plausible engine speed [rpm].
+MAX_RPM = 1e5
+
+
+def _check_level(level_si: float, path, line, key) -> None:
+    if level_si > MAX_LEVEL_M_PER_S:
+        raise InputError(f"level {level_si:.3g} m/s above the plausible {MAX_LEVEL_M_PER_S:g} "
+                         "m/s (unit error?)", file=path, line=line, key=key)
 
 
 def quantity_sort_key(quantity: str):
@@ -183,6 +195,7 @@ def read_measured(path, mounts=None) -> MeasuredRunup:
         One line naming file, line and column.
     """
     path = str(path)
+    check_regular_file(path)
     try:
         with open(path, "rb") as fh:
             head = fh.read(8)
@@ -213,8 +226,12 @@ def _read_hdf5(path, mounts):
         raise InputError("speeds must be finite and > 0", file=path, key="rpm")
     if np.unique(rpm).size != rpm.size:
         raise InputError("duplicate speed", file=path, key="rpm")
+    if np.any(rpm > MAX_RPM):
+        raise InputError(f"speed above {MAX_RPM:g} rpm", file=path, key="rpm")
     if not np.all(np.isfinite(result.velocity)):
         raise InputError("NaN or infinite velocity", file=path, key="velocity/amplitude")
+    worst = float(np.max(np.abs(result.velocity), initial=0.0))
+    _check_level(worst, path, None, "velocity/amplitude")
     return MeasuredRunup.from_result(result, source=path)
 
 
@@ -278,13 +295,15 @@ def _read_csv(path, mounts):
         except ValueError as exc:
             raise InputError(str(exc), file=path, line=lineno, key="quantity") from None
         rpm = parse_number(fields[col["rpm"]], path, lineno, "rpm")
-        if rpm <= 0:
-            raise InputError(f"speed must be > 0, got {rpm:g}", file=path, line=lineno,
-                             key="rpm")
+        if not 0 < rpm <= MAX_RPM:
+            raise InputError(f"speed must be > 0 and <= {MAX_RPM:g} rpm, got {rpm:g}",
+                             file=path, line=lineno, key="rpm")
         level = parse_number(fields[col[level_col]], path, lineno, level_col)
         if level < 0:
             raise InputError(f"negative level {level:g}", file=path, line=lineno,
                              key=level_col)
+        _check_level(level * factor / (math.sqrt(2.0) if statistic == "peak" else 1.0), path,
+                     lineno, level_col)
         key = (mount, direction, quantity)
         if key not in rows:
             rows[key] = {}

@@ -36,6 +36,8 @@ from powertrain.units import to_si
 
 #: Largest allowed gap between crank angles of one trace [deg].
 MAX_GAP_DEG = 10.0
+#: Highest plausible cylinder pressure [Pa] (1000 bar; peak firing pressures are ~200 bar).
+MAX_PRESSURE_PA = 1e8
 #: Points per cycle of the common grid.
 GRID_POINTS = 2880
 
@@ -96,9 +98,15 @@ def read_pressure_traces(path, n_cylinders: int):
     speed = to_si(data[:, 0], units[0], "angular_speed", file=path, key="speed")
     angle = to_si(data[:, 2], units[2], "angle", file=path, key="crank_angle")
     pressure = to_si(data[:, 3], units[3], "pressure", file=path, key="pressure")
-    if np.any(speed <= 0):
-        raise InputError("speeds must be positive", file=path, key="speed",
-                         line=int(line_no[np.argmax(speed <= 0)]))
+    rpm = speed * 60 / (2 * np.pi)
+    bad_speed = (rpm < 1.0) | (rpm > 1e5)
+    if np.any(bad_speed):
+        raise InputError("speeds must be 1..1e5 rpm", file=path, key="speed",
+                         line=int(line_no[np.argmax(bad_speed)]))
+    if np.any(pressure > MAX_PRESSURE_PA):
+        raise InputError(f"pressure above the plausible {MAX_PRESSURE_PA / 1e5:g} bar",
+                         file=path, key="pressure",
+                         line=int(line_no[np.argmax(pressure > MAX_PRESSURE_PA)]))
     speeds = np.unique(speed)
     grid = -np.pi + 4 * np.pi * np.arange(GRID_POINTS) / GRID_POINTS
     out = np.empty((speeds.size, n_cylinders, GRID_POINTS))

@@ -61,10 +61,19 @@ class MeasuredStiffness:
         return MeasuredStiffness(self.frequency_hz[keep], self.kcp[keep], self.source)
 
 
+#: Plausible magnitudes: frequency [Hz], stiffness [N/mm] (a steel bar is ~1e6 N/mm), phase
+#: [deg]; beyond them a value is a unit or export error.
+LIMITS = {FREQUENCY: 1e5, REAL: 1e9, IMAG: 1e9, ABS: 1e9, PHASE: 360.0}
+
+
 def _open_rows(path):
     text = read_text(path, "CSV")
     rows = []
-    for lineno, fields in zip(range(1, 10**9), csv.reader(text.splitlines())):
+    try:
+        parsed = list(csv.reader(text.splitlines()))
+    except csv.Error as exc:
+        raise InputError(f"not a CSV table ({exc})", file=path) from None
+    for lineno, fields in zip(range(1, 10**9), parsed):
         if not fields or all(not f.strip() for f in fields) or fields[0].lstrip().startswith("#"):
             continue
         rows.append((lineno, [f.strip() for f in fields]))
@@ -127,6 +136,10 @@ def read_stiffness_csv(path) -> MeasuredStiffness:
                 raise InputError(f"frequencies must be strictly increasing ({raw} after "
                                  f"{data[FREQUENCY][-1]:g})", file=path, key=name,
                                  line=lineno)
+            limit = LIMITS.get(name)
+            if limit is not None and abs(value) > limit:
+                raise InputError(f"|{raw}| above the plausible {limit:g}", file=path,
+                                 key=name, line=lineno)
             data[name].append(value)
     if not data[FREQUENCY]:
         raise InputError("no data rows", file=path, key=FREQUENCY)

@@ -6,6 +6,29 @@ import math
 
 from powertrain.errors import InputError
 
+#: Largest input file read [bytes]; larger files are refused before reading.
+MAX_FILE_BYTES = 512 * 2 ** 20
+
+
+def check_regular_file(path) -> None:
+    """Refuse, without opening it, anything but an existing regular file of at most
+    :data:`MAX_FILE_BYTES` (a FIFO or device would block or never end)."""
+    import os
+    import stat
+    try:
+        st = os.stat(path)
+    except FileNotFoundError:
+        raise InputError("file not found", file=path) from None
+    except OSError as exc:
+        raise InputError(f"cannot read file ({exc.strerror or exc})", file=path) from None
+    if stat.S_ISDIR(st.st_mode):
+        raise InputError("is a directory, expected a file", file=path)
+    if not stat.S_ISREG(st.st_mode):
+        raise InputError("not a regular file (FIFO, socket or device)", file=path)
+    if st.st_size > MAX_FILE_BYTES:
+        raise InputError(f"file of {st.st_size / 2 ** 20:.0f} MiB, more than the "
+                         f"{MAX_FILE_BYTES // 2 ** 20} MiB accepted", file=path)
+
 
 def read_text(path, kind: str = "text") -> str:
     """Whole content of a UTF-8 text file.
@@ -21,9 +44,10 @@ def read_text(path, kind: str = "text") -> str:
     InputError
         Missing, unreadable, a directory, or not UTF-8 — one line naming the file.
     """
+    check_regular_file(path)
     try:
         with open(path, encoding="utf-8", newline="") as fh:
-            return fh.read()
+            text = fh.read()
     except FileNotFoundError:
         raise InputError("file not found", file=path) from None
     except IsADirectoryError:
@@ -34,6 +58,23 @@ def read_text(path, kind: str = "text") -> str:
         raise InputError(f"not a UTF-8 {kind} file", file=path) from None
     except OSError as exc:
         raise InputError(f"cannot read file ({exc.strerror or exc})", file=path) from None
+    if kind == "CSV":
+        _check_line_lengths(text, path)
+    return text
+
+
+#: Longest line of a CSV file [characters] (the csv module's cell limit is 128 kB).
+MAX_CSV_LINE = 65536
+
+
+def _check_line_lengths(text: str, path) -> None:
+    if "\x00" in text:
+        line = text.count("\n", 0, text.index("\x00")) + 1
+        raise InputError("NUL character: not a text CSV file", file=path, line=line)
+    for lineno, line in enumerate(text.splitlines(), start=1):
+        if len(line) > MAX_CSV_LINE:
+            raise InputError(f"line of {len(line)} characters, more than the "
+                             f"{MAX_CSV_LINE} accepted", file=path, line=lineno)
 
 
 def parse_number(text, path, line, column, *, nonneg: bool = False) -> float:

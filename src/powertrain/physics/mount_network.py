@@ -135,6 +135,50 @@ def condensed_network(omega, masses, elem_nodes, c, d):
     return X, np.einsum("fj,fj->f", D[:, 0, :], X)
 
 
+def two_port(omega, masses, elem_nodes, c, d, spring_scale=1.0, damper_scale=None):
+    r"""Two-port dynamic stiffness ``(a, b, c)`` between the engine-side node and the ground
+    node, internal masses condensed — the one condensation
+    (:func:`powertrain.kernels.two_port.two_port_kernel`, pivot checked).
+
+    .. math:: \begin{pmatrix} F_E \\ F_B \end{pmatrix} =
+              \begin{pmatrix} a & b \\ b & c \end{pmatrix}
+              \begin{pmatrix} x_E \\ x_B \end{pmatrix},
+              \qquad a = K_{IP},\; b = -K_{CP}\ \text{(ground fixed)}.
+
+    Parameters
+    ----------
+    omega : array_like
+        Angular frequencies [rad/s], any shape.
+    masses, elem_nodes, c, d
+        Network, see :func:`network_matrices`.
+    spring_scale, damper_scale : float or array_like
+        Factors on every spring and damper (broadcast to ``omega``; dampers default to the
+        springs' factor), masses kept.
+
+    Returns
+    -------
+    a, b, c : ndarray complex, shape of ``omega`` [N/m]
+
+    Raises
+    ------
+    FloatingPointError
+        The network is singular at some frequency (a pivot below the kernel's tolerance).
+    """
+    from powertrain.kernels.two_port import two_port_kernel
+    w = np.asarray(omega, float)
+    s = np.broadcast_to(np.asarray(spring_scale, float), w.shape)
+    t = s if damper_scale is None else np.broadcast_to(np.asarray(damper_scale, float), w.shape)
+    flat = [np.ascontiguousarray(x.reshape(-1)) for x in (w, s, t)]
+    out = [np.empty(flat[0].size, complex) for _ in range(3)]
+    status = two_port_kernel(*flat, np.ascontiguousarray(masses, float),
+                             np.ascontiguousarray(np.asarray(elem_nodes, np.int64).reshape(-1, 2)),
+                             np.ascontiguousarray(c, float), np.ascontiguousarray(d, float), *out)
+    if status:
+        raise FloatingPointError("mount network singular at some frequency (two-port pivot "
+                                 "below tolerance)")
+    return tuple(x.reshape(w.shape) for x in out)
+
+
 def cross_point_stiffness(omega, masses, elem_nodes, c, d):
     r"""Cross-point dynamic stiffness :math:`K_{CP}(\omega) = F_T/\hat X_1` [N/m].
 

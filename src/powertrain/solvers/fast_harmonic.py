@@ -41,46 +41,13 @@ import numpy as np
 from powertrain.analysis.fourier import harmonic_amplitudes
 from powertrain.assembly import DIRECTIONS
 from powertrain.physics import balancer as bal
-from powertrain.physics.mount_network import network_matrices
+from powertrain.physics.mount_network import two_port
 from powertrain.physics.rigid_body import direction_row, point_motion_matrix, rigid_body_mass_matrix
 
 #: Harmonics of the engine cycle solved: h = 1..16 are orders 0.5..8.
 N_HARMONICS = 17
 #: Samples per engine cycle for the load harmonics (1° like the run-up default).
 N_ANGLE = 720
-
-
-def two_port(omega, masses, elem_nodes, c, d):
-    r"""Two-port dynamic stiffness ``(a, b, c)`` of a network between E and its ground node.
-
-    Parameters
-    ----------
-    omega : ndarray
-        Angular frequencies [rad/s], any shape.
-    masses, elem_nodes, c, d
-        Network (see :func:`powertrain.physics.mount_network.network_matrices`).
-
-    Returns
-    -------
-    a, b, c : ndarray complex, shape of ``omega`` [N/m]
-        :math:`a = K_{IP}` (ground fixed), :math:`b` the coupling, :math:`c` the
-        ground-side stiffness with E fixed.
-    """
-    w = np.asarray(omega, float)
-    M, C, K = network_matrices(masses, elem_nodes, c, d, include_ground=True)
-    ww = w.reshape(-1)[:, None, None]
-    D = K[None] + 1j * ww * C[None] - ww ** 2 * M[None]
-    n = M.shape[0] - 2
-    bnd = [0, n + 1]
-    Dbb = D[:, bnd][:, :, bnd]
-    if n:
-        Dbi = D[:, bnd, 1:n + 1]
-        Dib = D[:, 1:n + 1][:, :, bnd]
-        S = Dbb - Dbi @ np.linalg.solve(D[:, 1:n + 1, 1:n + 1], Dib)
-    else:
-        S = Dbb
-    shape = w.shape
-    return S[:, 0, 0].reshape(shape), S[:, 0, 1].reshape(shape), S[:, 1, 1].reshape(shape)
 
 
 def shaft_load(engine, shaft, rpm, theta):
@@ -146,7 +113,6 @@ class HarmonicModel:
         self._load = None
         self._abc = None
         self._extra = {}
-        self._net_arrays = None
 
     # ------------------------------------------------------------------ cached parts
     def load_of(self, engine) -> np.ndarray:
@@ -219,28 +185,18 @@ class HarmonicModel:
         Every spring and damper of network n at speed r and harmonic h times
         ``scale[r, h, n]`` (any shape that broadcasts to (n_r, 17, n_net)), its masses
         kept — :math:`s(\mathbf K + i\omega\mathbf C) - \omega^2\mathbf M` condensed
-        by the compiled :func:`powertrain.kernels.two_port.two_port_kernel`. With
-        ``scale = 1`` the same as :meth:`two_ports` to round-off.
+        by the one two-port condensation
+        (:func:`powertrain.physics.mount_network.two_port`). With ``scale = 1`` the same
+        as :meth:`two_ports`.
         """
-        from powertrain.kernels.two_port import two_port_kernel
         n_net = len(self.networks)
         sc = np.broadcast_to(np.asarray(scale, float), self.omega.shape + (n_net,))
-        if self._net_arrays is None:
-            arrs = []
-            for _, _, mod in self.networks:
-                m, en, c, d = mod.network()
-                arrs.append((np.ascontiguousarray(m, float),
-                             np.ascontiguousarray(np.asarray(en, np.int64).reshape(-1, 2)),
-                             np.ascontiguousarray(c, float), np.ascontiguousarray(d, float)))
-            self._net_arrays = arrs
-        w = np.ascontiguousarray(self.omega.reshape(-1))
-        out = [np.empty((w.size, n_net), complex) for _ in range(3)]
-        col = [np.empty(w.size, complex) for _ in range(3)]
-        for k, arrs in enumerate(self._net_arrays):
-            two_port_kernel(w, np.ascontiguousarray(sc[..., k].reshape(-1)), *arrs, *col)
+        abc = [np.empty(self.omega.shape + (n_net,), complex) for _ in range(3)]
+        for k, (_, _, mod) in enumerate(self.networks):
+            res = two_port(self.omega, *mod.network(), spring_scale=sc[..., k])
             for j in range(3):
-                out[j][:, k] = col[j]
-        return tuple(x.reshape(self.omega.shape + (n_net,)) for x in out)
+                abc[j][..., k] = res[j]
+        return tuple(abc)
 
     # ------------------------------------------------------------------ solves
     def solve(self, kip, load=None, harmonics=slice(1, N_HARMONICS)) -> np.ndarray:

@@ -134,10 +134,14 @@ class ModesResult:
                      f"{t['angle_to_crank_axis_deg']:.2f} deg from the crank axis")
         return "\n".join(lines)
 
-    def plot(self, path=None):
-        """Stacked kinetic-energy distribution per mode (PNG when ``path`` is given)."""
+    def plot(self, ax=None, *, path=None, provenance=None):
+        """Stacked kinetic-energy distribution per mode (PNG when ``path`` is given);
+        returns the figure."""
+        from powertrain.plotting.style import target_and_path
         from powertrain.plotting_body import plot_modes
-        return plot_modes(self, path)
+        ax, path = target_and_path(ax, path)
+        return plot_modes(self, path, ax=ax,
+                          provenance=provenance or getattr(self, "provenance", None))
 
 
 # ---------------------------------------------------------------------------- physics

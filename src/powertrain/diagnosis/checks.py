@@ -1,0 +1,170 @@
+r"""Evidence beyond the held-out speeds: residual structure, held-out (channel, order) cells,
+the noise a perfect model would leave, and the speed-band confounding check.
+
+* :func:`structured_residual`: the held-out residual averaged per channel and order over
+  groups of about 4 adjacent held-out speeds (noise averages out, structure does not);
+* :func:`heldout_cells_check`: the candidate refitted without some (channel, order) cells
+  must predict them at the held-out speeds. Physical effects withhold channels (folds
+  generated from the mounts, :func:`channel_folds`: one channel of every mount triad each —
+  the rigid body carries the effect to a channel it was not fitted on); candidates with
+  sensor errors withhold orders (orders ≤ :data:`ORDER_SPLIT` vs the others, both ways: a
+  gain or a triad rotation is the same on every order of its channels, a frequency-tied gap
+  is not). Free gains thus cannot absorb a structural gap;
+* :func:`noise_mse`: :math:`E_n = \hat\sigma^2 u`, the held-out mean squared gap a perfect
+  model would leave, :math:`u` the fraction of scored held-out points that are not censored;
+* :func:`band_check`: the chosen effect refitted on four speed bands: a parameter believed
+  constant that trends with speed points to a different effect.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+
+import numpy as np
+
+from powertrain.analysis.noise_floor import above_floor
+from powertrain.diagnosis.fit import FitOutcome, Problem, fit_candidate
+from powertrain.effects import EFFECTS
+
+#: Orders up to this one form the "low" fold of the order split (sensor gains) [order].
+ORDER_SPLIT = 2.0
+
+
+def channel_folds(n_mounts: int) -> tuple:
+    """Channel folds: fold j withholds channel (j + m) mod 3 of mount m's triad, for every
+    mount (three mounts: (0, 4, 8), (1, 5, 6), (2, 3, 7))."""
+    return tuple(tuple(3 * m + (j + m) % 3 for m in range(n_mounts)) for j in range(3))
+
+
+def structured_residual(g, censored, groups, sigma, cells=None):
+    r"""Structured part of held-out residuals [dB RMS beyond noise] and its χ² ratio.
+
+    For every group of adjacent held-out speeds and every (channel, order) the mean
+    residual :math:`\bar g` of the :math:`n` uncensored points is formed; pure noise of
+    scatter :math:`\sigma` gives :math:`E[\bar g^2] = \sigma^2/n`. Returned:
+    :math:`\sqrt{\max(0,\ \overline{\bar g^2 - \sigma^2/n})}` and the ratio
+    :math:`\overline{n\bar g^2/\sigma^2}` (≈ 1 for noise).
+
+    Parameters
+    ----------
+    g : ndarray (n_test, n_ch, n_o)
+        Held-out residuals [dB] (NaN where not scored).
+    censored : ndarray bool, same shape
+    groups : list of index arrays into the first axis
+    sigma : float
+        Noise [dB, 1σ].
+    cells : ndarray bool (n_ch, n_o), optional
+        Cells included (default all).
+    """
+    ok = np.isfinite(g) & ~censored
+    if cells is not None:
+        ok &= np.asarray(cells, bool)[None]
+    z, chi = [], []
+    s2 = sigma ** 2 if np.isfinite(sigma) and sigma > 0 else 0.0
+    for grp in groups:
+        n = ok[grp].sum(axis=0)
+        sm = np.where(ok[grp], g[grp], 0.0).sum(axis=0)
+        use = n >= 2
+        m = sm[use] / n[use]
+        z.append(m ** 2 - s2 / n[use])
+        if s2 > 0:
+            chi.append(n[use] * m ** 2 / s2)
+    if not z:
+        return float("nan"), float("nan")
+    z = np.concatenate(z)
+    chi_r = float(np.mean(np.concatenate(chi))) if chi else float("nan")
+    return float(math.sqrt(max(float(np.mean(z)), 0.0))), chi_r
+
+
+def cells_mse(o: FitOutcome, cells):
+    """Held-out mean squared gap of ``o`` on the (channel, order) ``cells``; and per speed."""
+    g = o.heldout_gaps
+    ok = np.isfinite(g) & np.asarray(cells, bool)[None]
+    per = np.array([np.mean(g[i][ok[i]] ** 2) if ok[i].any() else np.nan
+                    for i in range(g.shape[0])])
+    return float(np.mean(g[ok] ** 2)) if ok.any() else float("nan"), per
+
+
+def noise_mse(problem: Problem, sigma, cells=None) -> float:
+    r"""Expected held-out mean squared gap of a perfect model [dB²]: :math:`\hat\sigma^2`
+    times the fraction of scored held-out points that are not censored (a censored point's
+    residual, :math:`\max(0, 20\log_{10}(s'/\kappa f))`, is 0 for a model below the
+    censoring level, whatever the noise)."""
+    if not (np.isfinite(sigma) and sigma > 0):
+        return 0.0
+    valid = problem.valid["test"]
+    if cells is not None:
+        valid = valid & np.asarray(cells, bool)[None]
+    unc = valid & above_floor(problem.meas["test"], problem.data.floor)
+    n = int(valid.sum())
+    return float(sigma ** 2 * unc.sum() / n) if n else 0.0
+
+
+def _folds(problem: Problem, effects):
+    n_ch, n_o = problem.valid["test"].shape[1:]
+    if any(EFFECTS[e].response_only for e in effects):
+        order = (problem.sub.harmonic + 1) / 2.0
+        low = np.broadcast_to(order <= ORDER_SPLIT + 1e-9, (n_ch, n_o))
+        return "orders", [low, ~low]
+    folds = []
+    for f in channel_folds(n_ch // 3):
+        m = np.zeros((n_ch, n_o), bool)
+        m[[c for c in f if c < n_ch]] = True
+        folds.append(m)
+    return "channels", folds
+
+
+def per_speed_t(d):
+    """t statistic of the mean of per-speed improvements ``d`` (NaN entries dropped)."""
+    d = d[np.isfinite(d)]
+    sd = float(np.std(d, ddof=1)) if d.size > 1 else 0.0
+    return float(np.mean(d)) / (sd / math.sqrt(d.size)) if sd > 0 else 0.0
+
+
+def heldout_cells_check(problem: Problem, o: FitOutcome, baseline: FitOutcome, sigma,
+                        budget=None):
+    """Refit ``o``'s effects without some (channel, order) cells and score the withheld
+    cells at the held-out speeds (cross-validation over cells as well as speeds).
+
+    Returns
+    -------
+    dict
+        ``kind``, ``explained`` (fraction of the withheld cells' held-out excess over noise
+        removed), ``t`` (per-speed significance), ``baseline_excess_db``,
+        ``heldout_rms_db`` and ``seconds``.
+    """
+    t0 = time.perf_counter()
+    kind, folds = _folds(problem, o.effects)
+    g_all = np.full(problem.valid["test"].shape, np.nan)
+    kw = {} if budget is None else {"budget": budget}
+    for held in folds:
+        if not held.any() or held.all():
+            continue
+        fo = fit_candidate(problem.restricted(~held, held), o.effects, starts=[o.x],
+                           grid=False, **kw)
+        g_all = np.where(np.isfinite(fo.heldout_gaps), fo.heldout_gaps, g_all)
+    ok = np.isfinite(g_all)
+    per_c = np.array([np.mean(g_all[i][ok[i]] ** 2) if ok[i].any() else np.nan
+                      for i in range(g_all.shape[0])])
+    cells = ok.any(axis=0)
+    e0, per_0 = cells_mse(baseline, cells)
+    ec = float(np.mean(g_all[ok] ** 2)) if ok.any() else float("nan")
+    excess = max(e0 - noise_mse(problem, sigma, cells), 0.0)
+    return {"kind": kind, "explained": (e0 - ec) / excess if excess > 0 else float("nan"),
+            "t": per_speed_t(per_0 - per_c), "baseline_excess_db": math.sqrt(excess),
+            "heldout_rms_db": math.sqrt(ec), "seconds": time.perf_counter() - t0}
+
+
+def band_check(problem_factory, effect, data, train_idx, n_bands=4):
+    """Refit one effect on speed bands of the training data: parameter trend with speed."""
+    out = []
+    edges = np.linspace(0, train_idx.size, n_bands + 1).astype(int)
+    for b in range(n_bands):
+        idx = train_idx[edges[b]:edges[b + 1]]
+        if idx.size < 3:
+            continue
+        fo = fit_candidate(problem_factory(idx), (effect,))
+        out.append({"rpm_from": float(data.rpm[idx[0]]), "rpm_to": float(data.rpm[idx[-1]]),
+                    "parameters": fo.params[effect], "sigma": fo.sigma[effect]})
+    return out

@@ -1,0 +1,226 @@
+"""The diagnosis driver: data → where → candidates → fit → decide → result.
+
+:func:`diagnose` runs the steps of the modules of this package in order; every decision
+is taken by the pure :func:`powertrain.diagnosis.rule.decide`.
+"""
+
+from __future__ import annotations
+
+import time
+from itertools import combinations
+
+import numpy as np
+
+from powertrain.diagnosis import candidates as cand
+from powertrain.diagnosis.checks import band_check, heldout_cells_check, noise_mse, structured_residual
+from powertrain.diagnosis.data import (
+    DEFAULT_NOISE_FLOOR,
+    HELDOUT_BLOCKS,
+    MIN_RPM,
+    N_BLOCKS,
+    N_FIT_RPM,
+    N_TEST_RPM,
+    even,
+    gap_data,
+    model_levels,
+    noise_sigma_db,
+    residuals_db,
+    speed_groups,
+    split_rpm,
+)
+from powertrain.diagnosis.fit import EVAL_BUDGET, Problem, baseline_outcome, fit_candidate
+from powertrain.diagnosis.result import DiagnosisResult
+from powertrain.diagnosis.rule import CandidateEvidence, DecisionRule, Evidence, VerdictKind, decide
+from powertrain.diagnosis.where import decompose_gap, regions, rigid_span_gap, where_text
+from powertrain.effects import predict
+from powertrain.errors import InputError
+from powertrain.solvers.fast_harmonic import HarmonicModel
+
+
+def diagnose(measured, engine, *, noise_floor=DEFAULT_NOISE_FLOOR, effects=None,
+             pairs=True, band_check=True, rule=None, scheduler="serial", progress=True,
+             budget=EVAL_BUDGET) -> DiagnosisResult:
+    """Diagnose the gap between ``engine``'s simulated run-up and ``measured``.
+
+    Parameters
+    ----------
+    measured : MeasuredRunup
+        Measured order curves [m/s RMS].
+    engine : Engine
+        Baseline model.
+    noise_floor : float
+        RMS noise floor of the measured order curves [m/s].
+    effects : sequence of str, optional
+        Candidates (default: all of the effect registry that apply to ``engine``).
+    pairs : bool
+        Also fit the pairs of the three best single candidates.
+    band_check : bool
+        Refit the chosen effect on speed bands (confounding check).
+    rule : DecisionRule, optional
+        Decision constants (default :class:`DecisionRule`).
+    scheduler : str
+        Where the candidate fits run (:func:`powertrain.parallel.executor`): ``serial``
+        (default), ``processes``, ``local`` (dask LocalCluster) or ``tcp://HOST:PORT``.
+        The result is the same on every scheduler.
+    progress : bool
+        Progress bar on stderr (only on a terminal).
+    budget : int
+        Residual evaluations per fit (:data:`powertrain.diagnosis.fit.EVAL_BUDGET`).
+
+    Returns
+    -------
+    DiagnosisResult
+
+    Raises
+    ------
+    InputError
+        Too few speeds to split, or nothing comparable.
+    """
+    from threadpoolctl import threadpool_limits
+    with threadpool_limits(limits=1, user_api="blas"):
+        return _diagnose(measured, engine, noise_floor, effects, pairs, band_check,
+                         rule or DecisionRule(), scheduler, progress, budget)
+
+
+class _Setup:
+    """Data, split, cached models and the fitting problem of one diagnosis."""
+
+    def __init__(self, measured, engine, noise_floor, effects):
+        self.src = getattr(measured, "source", "")
+        self.data = data = gap_data(measured, engine, noise_floor)
+        _check_data(data, self.src)
+        self.train_all, self.test_all = split_rpm(data.rpm)
+        self.train_idx = even(self.train_all, N_FIT_RPM)
+        self.test_idx = even(self.test_all, N_TEST_RPM)
+        self.effects = cand.applicable(engine, effects)
+        self.hm = HarmonicModel(engine, data.rpm)
+        self.hm.two_ports()
+        need = np.union1d(self.train_all, self.test_idx)
+        self.hm_need = self.hm.subset(need)
+        cand.warm_caches(self.hm_need, self.effects)
+        self.pos = {int(r): i for i, r in enumerate(need)}
+        self.problem = Problem(self.sub(self.train_idx), self.sub(self.test_idx), data,
+                               self.train_idx, self.test_idx)
+
+    def sub(self, idx):
+        return self.hm_need.subset([self.pos[int(i)] for i in idx])
+
+    def split_dict(self):
+        d = self.data
+        return {"description": f"{N_BLOCKS} contiguous speed blocks, blocks "
+                               f"{', '.join(str(b + 1) for b in HELDOUT_BLOCKS)} held out: "
+                               f"{self.test_all.size} held-out speeds ({self.test_idx.size} "
+                               f"scored), {self.train_all.size} training speeds "
+                               f"({self.train_idx.size} fitted); all channels and measured "
+                               f"orders; synthesis not fitted",
+                "train_rpm": d.rpm[self.train_idx].tolist(),
+                "heldout_rpm": d.rpm[self.test_idx].tolist()}
+
+
+def _check_data(data, src):
+    if data.rpm.size < MIN_RPM:
+        raise InputError(f"only {data.rpm.size} measured speeds inside the engine's range: "
+                         f"too few to split into training and held-out speeds (need at least "
+                         f"{MIN_RPM})", file=src or None, key="rpm")
+    om = data.order_mask
+    if not om.any() or data.usable[:, :, om].sum() < 20:
+        raise InputError("fewer than 20 measured order points above the noise floor's "
+                         "censoring level (3x the floor): nothing to diagnose", file=src or None)
+
+
+def _where(s: _Setup):
+    data = s.data
+    vel0 = predict(s.hm, {}).velocity
+    gap = residuals_db(model_levels(vel0, data), data.level, data.floor)
+    gap_map = np.where(data.censored, np.nan, gap)
+    mask = np.isfinite(gap_map) & data.order_mask[None, None, :]
+    parts = decompose_gap(gap_map, data, mask)
+    return gap_map, parts, rigid_span_gap(vel0, data, s.hm.channel_matrix), \
+        regions(gap_map, data, parts)
+
+
+def _fit_job(job):
+    problem, effects, starts, budget = job
+    from threadpoolctl import threadpool_limits
+    with threadpool_limits(limits=1, user_api="blas"):
+        return fit_candidate(problem, effects, starts=starts, budget=budget)
+
+
+def _fit_all(s: _Setup, pairs, scheduler, progress, budget):
+    """Singles, then the pairs of the three best singles; in the order of submission."""
+    from powertrain.parallel import run_map
+    desc = "diagnose: candidate fits" if progress else None
+    jobs = [(s.problem, (e,), None, budget) for e in s.effects]
+    singles = run_map(_fit_job, jobs, scheduler, progress=desc)
+    outcomes = list(singles)
+    if pairs:
+        best3 = sorted(singles, key=lambda o: o.heldout_mse)[:3]
+        jobs = [(s.problem, (a.effects[0], b.effects[0]), [np.concatenate([a.x, b.x])], budget)
+                for a, b in combinations(best3, 2)]
+        outcomes += run_map(_fit_job, jobs, scheduler, progress=desc and "diagnose: pairs")
+    return outcomes
+
+
+def _evidence(o, struct=None):
+    return CandidateEvidence(o.label, o.effects, o.heldout_mse, o.heldout_per_rpm, o.bic,
+                             o.struct_db if struct is None else struct, o.cells_check)
+
+
+def _decide(s, baseline, outcomes, sigma, rule, where_phrase, budget):
+    """Decide; run held-out cells checks as the rule asks for them."""
+    e_n = noise_mse(s.problem, sigma)
+    by_label = {o.label: o for o in outcomes}
+    while True:
+        ev = Evidence(_evidence(baseline), [_evidence(o) for o in outcomes], e_n, sigma,
+                      where_phrase)
+        verdict = decide(ev, rule)
+        if verdict.kind is not VerdictKind.PENDING:
+            return verdict, e_n
+        o = by_label[verdict.needs_cells_check]
+        o.cells_check = heldout_cells_check(s.problem, o, baseline, sigma, budget=budget)
+
+
+def _structure(s, baseline, outcomes, sigma):
+    groups = speed_groups(s.test_idx)
+    cens_t = ~s.data.usable[s.test_idx][:, :, s.data.order_mask]
+    for o in [baseline] + outcomes:
+        o.struct_db, o.chi2_ratio = structured_residual(o.heldout_gaps, cens_t, groups, sigma)
+
+
+def _diagnose(measured, engine, noise_floor, effects, pairs, do_bands, rule, scheduler,
+              progress, budget):
+    t0 = time.perf_counter()
+    s = _Setup(measured, engine, noise_floor, effects)
+    gap_map, parts, rigid, found = _where(s)
+    sigma = noise_sigma_db(s.data)
+    baseline = baseline_outcome(s.problem)
+    outcomes = _fit_all(s, pairs, scheduler, progress, budget)
+    _structure(s, baseline, outcomes, sigma)
+    verdict, e_n = _decide(s, baseline, outcomes, sigma, rule, where_text(found, parts), budget)
+    for o in outcomes:
+        a = verdict.assessments[o.label]
+        o.t_stat, o.bic_gain, o.explained = a.t_stat, a.bic_gain, a.explained
+        o.status, o.status_code = a.text, a.status
+    outcomes.sort(key=lambda o: o.heldout_mse)
+    chosen = next((o for o in outcomes if o.label == verdict.chosen), None)
+    gap_after, bands = None, []
+    if chosen is not None:
+        sc = {e: chosen.params[e] for e in chosen.effects}
+        g1 = residuals_db(model_levels(predict(s.hm, sc).velocity, s.data), s.data.level,
+                          s.data.floor)
+        gap_after = np.where(s.data.censored, np.nan, g1)
+        if do_bands and len(chosen.effects) == 1:
+            def factory(idx):
+                return Problem(s.sub(idx), s.problem.hm["test"], s.data, idx, s.test_idx)
+            bands = band_check(factory, chosen.effects[0], s.data,
+                               s.train_all[::max(1, s.train_all.size // 48)])
+    eq = cand.equivalents(s, chosen, rule)
+    text = verdict.text if not eq else verdict.text + (
+        "; the data cannot tell it from " + "; ".join(x["text"] for x in eq))
+    return DiagnosisResult(
+        s.data, s.src, getattr(engine, "name", ""), gap_map, gap_after, parts, rigid, found,
+        sigma, s.split_dict(), baseline, outcomes, chosen, verdict.label, text, bands,
+        time.perf_counter() - t0, synthetic=bool(getattr(measured, "synthetic", False)),
+        noise_mse_heldout=e_n, ambiguous=verdict.ambiguous, rule=rule,
+        verdict_kind=verdict.kind, equivalents=eq,
+        budget_hits=[o.label for o in outcomes if o.budget_hit])

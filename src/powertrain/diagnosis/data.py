@@ -1,0 +1,184 @@
+r"""Step 0 of the diagnosis: measured data on a speed grid, the noise floor, the speed split.
+
+The simulation is the harmonic steady state at every measured speed inside the engine's
+range. The measured noise floor :math:`f` (RMS per order) is added to the model in power,
+:math:`s' = \sqrt{s^2 + f^2}` (for the synthesis :math:`\sqrt{s^2 + 16 f^2}`). A measured
+point below the censoring level :math:`\kappa f` of the one noise-floor rule
+(:mod:`powertrain.analysis.noise_floor`, :math:`\kappa = 3`) is *censored*: it only says the
+level is below :math:`\kappa f`, so its residual is
+:math:`\max(0, 20\log_{10}(s'/\kappa f))` — a model predicting an order where none was
+measured is penalised, noise is never scored as a gap.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from powertrain.analysis.noise_floor import above_floor, at_floor, censoring_level
+
+#: Default RMS noise floor of the measured order curves [m/s].
+DEFAULT_NOISE_FLOOR = 1.0e-6
+#: Training speeds used for fitting (evenly chosen among the training blocks).
+N_FIT_RPM = 24
+#: Held-out speeds scored (evenly chosen among the held-out blocks).
+N_TEST_RPM = 36
+#: Blocks of the speed split and those held out (0-based).
+N_BLOCKS = 12
+HELDOUT_BLOCKS = (1, 4, 7, 10)
+#: Smallest data set that can be split: speeds in total.
+MIN_RPM = 12
+
+
+@dataclass
+class GapData:
+    """Measured levels on a speed grid, arranged for fast comparison.
+
+    Attributes
+    ----------
+    rpm : ndarray (n_r,)
+    channels : list of (mount, direction)
+    quantities : list of str
+        Orders (``order_2``...) then ``synthesis`` if measured.
+    harmonic : ndarray (n_q,) int
+        Index into the 16 orders 0.5..8 (−1 for the synthesis).
+    level : ndarray (n_r, n_ch, n_q)
+        Measured RMS velocity [m/s]; NaN where absent.
+    floor : float
+        Noise floor [m/s RMS].
+    """
+
+    rpm: np.ndarray
+    channels: list
+    quantities: list
+    harmonic: np.ndarray
+    level: np.ndarray
+    floor: float
+
+    @property
+    def order_mask(self):
+        return self.harmonic >= 0
+
+    @property
+    def censored(self):
+        """Measured points at the floor (bool, like ``level``; absent points False)."""
+        return at_floor(self.level, self.floor) & np.isfinite(self.level)
+
+    @property
+    def usable(self):
+        """Measured points above the floor (bool, like ``level``)."""
+        return above_floor(self.level, self.floor)
+
+    def orders_only(self) -> GapData:
+        """The same data without the synthesis."""
+        om = self.order_mask
+        return GapData(self.rpm, self.channels, [q for q, o in zip(self.quantities, om) if o],
+                       self.harmonic[om], self.level[:, :, om], self.floor)
+
+
+def _half_order_quantities(measured):
+    from powertrain.iotools.measured import quantity_sort_key
+    quantities = []
+    for q in sorted({q for _, _, q in measured.curves}, key=quantity_sort_key):
+        if q == "synthesis":
+            continue
+        o = float(q.split("_", 1)[1])
+        if abs(2 * o - round(2 * o)) < 1e-9 and 0.5 <= o <= 8.0:
+            quantities.append(q)
+    if any(q == "synthesis" for _, _, q in measured.curves):
+        quantities.append("synthesis")
+    return quantities
+
+
+def gap_data(measured, engine, noise_floor=DEFAULT_NOISE_FLOOR) -> GapData:
+    """Arrange a :class:`MeasuredRunup` on the union of its speeds inside the engine range."""
+    lo, hi = engine.speed_range_rpm()
+    rpm = np.unique(np.concatenate([r for r, _ in measured.curves.values()]))
+    rpm = rpm[(rpm >= lo - 1e-9) & (rpm <= hi + 1e-9)]
+    channels = [(m.name, a) for m in engine.mounts for a in ("x", "y", "z")]
+    quantities = _half_order_quantities(measured)
+    harmonic = np.array([-1 if q == "synthesis" else int(round(2 * float(q[6:]))) - 1
+                         for q in quantities])
+    level = np.full((rpm.size, len(channels), len(quantities)), np.nan)
+    for (m, d, q), (r, v) in measured.curves.items():
+        if (m, d) not in channels or q not in quantities:
+            continue
+        c, k = channels.index((m, d)), quantities.index(q)
+        idx = np.searchsorted(rpm, r)
+        ok = (idx < rpm.size) & (rpm[np.minimum(idx, rpm.size - 1)] == r)
+        level[idx[ok], c, k] = v[ok]
+    return GapData(rpm, channels, quantities, harmonic, level, float(noise_floor))
+
+
+def model_levels(velocity, data: GapData):
+    """Model RMS levels (n_r, n_ch, n_q) with the noise floor added in power [m/s]."""
+    rms = np.abs(velocity) / np.sqrt(2.0)                      # (n_r, n_ch, 16)
+    out = np.empty(velocity.shape[:2] + (data.harmonic.size,))
+    f2 = data.floor ** 2
+    for k, h in enumerate(data.harmonic):
+        if h < 0:
+            out[..., k] = np.sqrt(np.sum(rms ** 2, axis=-1) + 16 * f2)
+        else:
+            out[..., k] = np.sqrt(rms[..., h] ** 2 + f2)
+    return out
+
+
+def residuals_db(sim, meas, floor):
+    """Gap [dB] with censoring at the noise-floor rule's level; NaN where nothing was
+    measured."""
+    cl = censoring_level(floor)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        gap = 20 * np.log10(sim / meas)
+        cens = meas < cl
+        gap = np.where(cens, np.maximum(0.0, 20 * np.log10(sim / cl)), gap)
+    return np.where(np.isfinite(meas), gap, np.nan)
+
+
+def noise_sigma_db(data: GapData) -> float:
+    r"""Measurement scatter [dB, 1σ] from the measured order curves: second differences of
+    the dB level along speed, :math:`\hat\sigma = 1.4826\,\mathrm{MAD}/\sqrt6` (exact for
+    independent scatter on a locally linear curve).
+
+    On a grid coarser than the curves' features the second differences also carry the
+    curvature; the estimate is then an upper bound (the diagnosis stays conservative)."""
+    lv = data.level[:, :, data.order_mask]
+    ok = above_floor(lv, data.floor)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        L = np.where(ok, 20 * np.log10(lv), np.nan)
+    d2 = L[2:] - 2 * L[1:-1] + L[:-2]
+    d2 = d2[np.isfinite(d2)]
+    if d2.size < 10:
+        return float("nan")
+    return float(1.4826 * np.median(np.abs(d2 - np.median(d2))) / math.sqrt(6.0))
+
+
+def split_rpm(rpm):
+    """Training and held-out speed indices (12 contiguous blocks, blocks 2, 5, 8, 11 held
+    out)."""
+    n = rpm.size
+    block = np.minimum((np.arange(n) * N_BLOCKS) // n, N_BLOCKS - 1)
+    test = np.isin(block, HELDOUT_BLOCKS)
+    return np.flatnonzero(~test), np.flatnonzero(test)
+
+
+def even(idx, n_max):
+    """At most ``n_max`` of ``idx``, evenly spread."""
+    if idx.size <= n_max:
+        return idx
+    return idx[np.unique(np.round(np.linspace(0, idx.size - 1, n_max)).astype(int))]
+
+
+def speed_groups(test_idx, size=4):
+    """Runs of adjacent held-out speeds, cut into groups of about ``size`` speeds."""
+    runs, start = [], 0
+    for i in range(1, test_idx.size + 1):
+        if i == test_idx.size or test_idx[i] != test_idx[i - 1] + 1:
+            runs.append(np.arange(start, i))
+            start = i
+    groups = []
+    for r in runs:
+        k = max(1, int(round(r.size / size)))
+        groups += [g for g in np.array_split(r, k) if g.size >= 2]
+    return groups

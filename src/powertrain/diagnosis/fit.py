@@ -1,0 +1,277 @@
+r"""Step 3 of the diagnosis: fit candidate effects on the training speeds, score them on the
+held-out ones.
+
+Each candidate (one effect of the registry, or a pair) is fitted on the training speeds by
+bounded least squares in dB (``scipy.optimize.least_squares``, trust region reflective,
+multi-start: the defaults, given starts and, for single effects that declare one, the two
+best points of a coarse grid) and scored on the held-out speeds. Every fit has an
+evaluation budget (:data:`EVAL_BUDGET` residual evaluations, Jacobian columns included):
+when it is hit the best point so far is kept and the outcome says so (``budget_hit``).
+
+Parameter uncertainties are the 1σ of the Gauss–Newton covariance
+:math:`\hat s^2 (J^TJ)^{-1}` (residual correlation along speed ignored: optimistic).
+"""
+
+from __future__ import annotations
+
+import math
+import time
+import warnings
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from powertrain.diagnosis.data import GapData, model_levels, residuals_db
+from powertrain.effects import EFFECTS, predict
+
+#: Residual evaluations per fit (all starts, grid and Jacobian columns included); a fit that
+#: reaches it stops with the best point so far and reports ``budget_hit``.
+EVAL_BUDGET = 2500
+
+
+@dataclass
+class FitOutcome:
+    """A fitted candidate (one effect or a pair)."""
+
+    effects: tuple
+    params: dict
+    sigma: dict
+    rss_train: float
+    n_train: int
+    n_params: int
+    bic: float
+    heldout_mse: float
+    heldout_rms_db: float
+    heldout_per_rpm: np.ndarray
+    heldout_channel_rms: list
+    nfev: int
+    seconds: float
+    t_stat: float = float("nan")
+    bic_gain: float = float("nan")
+    explained: float = float("nan")
+    status: str = ""
+    struct_db: float = float("nan")
+    chi2_ratio: float = float("nan")
+    cells_check: dict | None = None
+    budget_hit: bool = False
+    x: np.ndarray | None = None
+    heldout_gaps: np.ndarray | None = field(default=None, repr=False)
+    status_code: object = None
+    units: dict = field(default_factory=dict)
+
+    @property
+    def label(self) -> str:
+        return "+".join(self.effects)
+
+
+class Problem:
+    """Residual functions on the training and held-out speeds.
+
+    ``train_cells`` / ``test_cells`` (bool (n_ch, n_orders)) restrict the (channel, order)
+    cells fitted / scored (held-out channels or orders).
+    """
+
+    def __init__(self, hm_train, hm_test, data: GapData, train_idx, test_idx, train_cells=None,
+                 test_cells=None):
+        self.hm = {"train": hm_train, "test": hm_test}
+        self.engine = hm_train.engine
+        self.data = data
+        self.idx = {"train": train_idx, "test": test_idx}
+        om = data.order_mask
+        self.meas = {k: data.level[v][:, :, om] for k, v in self.idx.items()}
+        self.sub = data.orders_only()
+        self.valid = {k: np.isfinite(v) for k, v in self.meas.items()}
+        self._last = {}
+        for part, cells in (("train", train_cells), ("test", test_cells)):
+            if cells is not None:
+                self.valid[part] = self.valid[part] & np.asarray(cells, bool)[None]
+
+    def restricted(self, train_cells=None, test_cells=None) -> Problem:
+        """The same problem with (channel, order) cells withheld from fitting / scoring."""
+        return Problem(self.hm["train"], self.hm["test"], self.data, self.idx["train"],
+                       self.idx["test"], train_cells, test_cells)
+
+    def gaps(self, scenario, part="train"):
+        # the physical part of the scenario is solved once per distinct value: a sensor
+        # error only re-reads the same velocities (cheap finite-difference columns)
+        phys = {k: v for k, v in scenario.items() if not EFFECTS[k].response_only}
+        key = repr(sorted((k, sorted(v.items())) for k, v in phys.items()))
+        last = self._last.get(part)
+        if last is not None and last[0] == key:
+            vel = last[1]
+        else:
+            vel = predict(self.hm[part], phys).velocity
+            self._last[part] = (key, vel)
+        for k, v in scenario.items():
+            if EFFECTS[k].response_only:
+                vel = EFFECTS[k].reading(vel, v)
+        sim = model_levels(vel, self.sub)
+        g = residuals_db(sim, self.meas[part], self.data.floor)
+        return np.where(self.valid[part], g, np.nan)
+
+    def vector(self, scenario, part="train"):
+        g = self.gaps(scenario, part)
+        return g[self.valid[part]]
+
+
+@dataclass
+class Packing:
+    """Parameters of a candidate as one vector (log space for scale-like parameters)."""
+
+    names: list
+    lower: np.ndarray
+    upper: np.ndarray
+    log: np.ndarray
+    x0: np.ndarray
+
+    units: dict = None
+
+    @classmethod
+    def of(cls, effects, engine=None):
+        names, lo, hi, logs, x0, units = [], [], [], [], [], {}
+        for e in effects:
+            for p in EFFECTS[e].parameters(engine):
+                units[(e, p.name)] = p.unit
+                names.append((e, p.name))
+                lo.append(math.log(p.lower) if p.log else p.lower)
+                hi.append(math.log(p.upper) if p.log else p.upper)
+                logs.append(p.log)
+                x0.append(math.log(p.default) if p.log else p.default)
+        return cls(names, np.array(lo), np.array(hi), np.array(logs, bool), np.array(x0), units)
+
+    def scenario(self, x):
+        sc = {}
+        for (e, p), lg, v in zip(self.names, self.log, x):
+            sc.setdefault(e, {})[p] = float(math.exp(v) if lg else v)
+        return sc
+
+    def values(self, x, sd):
+        """``params``, ``sigma`` dicts (SI) from the vector and its 1σ."""
+        params, sigma = {}, {}
+        for (e, pn), lg, v, s in zip(self.names, self.log, x, sd):
+            val = math.exp(v) if lg else v
+            params.setdefault(e, {})[pn] = float(val)
+            sigma.setdefault(e, {})[pn] = float(val * s if lg else s)
+        return params, sigma
+
+
+class _Budget(Exception):
+    """Raised inside the residual function when the fit's evaluation budget is spent."""
+
+
+class _Counted:
+    """Residual function with an evaluation count, a budget and the best point seen."""
+
+    def __init__(self, problem, pack, budget):
+        self.problem, self.pack, self.budget = problem, pack, budget
+        self.n = 0
+        self.best = (np.inf, None, None)
+
+    def __call__(self, x):
+        if self.n >= self.budget:
+            raise _Budget
+        self.n += 1
+        r = self.problem.vector(self.pack.scenario(x))
+        c = 0.5 * float(np.sum(r ** 2))
+        if c < self.best[0]:
+            self.best = (c, np.array(x, float), r)
+        return r
+
+
+def _starts(problem, pack, effects, starts, grid, fun):
+    span = pack.upper - pack.lower
+    lo, hi = pack.lower + 1e-9 * span, pack.upper - 1e-9 * span
+    cands = [np.clip(pack.x0, lo, hi)] + [np.clip(s, lo, hi) for s in starts or []]
+    # coarse grid of start points for effects that declare one (the cylinder IMEP factors
+    # need one: at e = 0 the half orders vanish and the gradient of their level with them)
+    sg = EFFECTS[effects[0]].start_grid(problem.engine) if len(effects) == 1 else ()
+    if grid and sg:
+        mesh = np.meshgrid(*sg, indexing="ij")
+        pts = np.stack([m.ravel() for m in mesh], axis=1).astype(float)
+        pts[:, pack.log] = np.log(pts[:, pack.log])
+        costs = [np.sum(fun(p) ** 2) for p in pts]
+        cands += [np.clip(pts[i], lo, hi) for i in np.argsort(costs)[:2]]
+    return cands
+
+
+def _least_squares(fun, pack, cands):
+    """Best trust-region fit over the start points; (result-like, nfev, budget hit)."""
+    from scipy.optimize import least_squares
+    span = pack.upper - pack.lower
+    best, nfev = None, 0
+    for x_start in cands:
+        try:
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore")
+                res = least_squares(fun, x_start, bounds=(pack.lower, pack.upper),
+                                    x_scale=np.maximum(span / 8, 1e-3), method="trf",
+                                    max_nfev=60 * len(x_start), diff_step=1e-4)
+        except _Budget:
+            return None, nfev, True
+        nfev += res.nfev
+        if best is None or res.cost < best.cost:
+            best = res
+    return best, nfev, False
+
+
+def _jacobian(fun, x, pack):
+    """Forward-difference Jacobian at ``x`` (used when the budget stopped the fit)."""
+    r0 = fun.problem.vector(pack.scenario(x))
+    J = np.empty((r0.size, x.size))
+    for j in range(x.size):
+        h = 1e-4 * max(1.0, abs(x[j]))
+        xj = x.copy()
+        xj[j] = min(x[j] + h, pack.upper[j]) if x[j] + h <= pack.upper[j] else x[j] - h
+        J[:, j] = (fun.problem.vector(pack.scenario(xj)) - r0) / (xj[j] - x[j])
+    return r0, J
+
+
+def fit_candidate(problem: Problem, effects, starts=None, grid=True,
+                  budget=EVAL_BUDGET) -> FitOutcome:
+    """Fit one effect or a combination on the training speeds, score on the held-out ones."""
+    t0 = time.perf_counter()
+    pack = Packing.of(effects, problem.engine)
+    fun = _Counted(problem, pack, budget)
+    cands = _starts(problem, pack, effects, starts, grid, fun)
+    best, nfev, hit = _least_squares(fun, pack, cands)
+    if best is None:                       # budget spent: the best point evaluated so far
+        x = fun.best[1] if fun.best[1] is not None else cands[0]
+        r, J = _jacobian(fun, x, pack)
+        nfev = fun.n
+    else:
+        x, r, J = best.x, best.fun, best.jac
+    n, p = r.size, len(pack.names)
+    rss = float(np.sum(r ** 2))
+    try:                                   # Gauss-Newton covariance in fitted coordinates
+        sd = np.sqrt(np.clip(np.diag(rss / max(n - p, 1) * np.linalg.pinv(J.T @ J)), 0, None))
+    except np.linalg.LinAlgError:
+        sd = np.full(p, np.nan)
+    params, sigma = pack.values(x, sd)
+    out = score(problem, effects, pack.scenario(x), params, sigma, rss, n, p, nfev,
+                time.perf_counter() - t0, x)
+    out.budget_hit = hit
+    out.units = {e: {pn: pack.units[(e, pn)] for pn in ps} for e, ps in params.items()}
+    return out
+
+
+def score(problem, effects, sc, params, sigma, rss, n, p, nfev, seconds, x=None) -> FitOutcome:
+    """Held-out scores of a scenario: mean squared gap per speed, overall, per channel."""
+    g = problem.gaps(sc, "test")
+    valid = np.isfinite(g)
+    per_rpm = np.array([np.mean(g[i][valid[i]] ** 2) if valid[i].any() else np.nan
+                        for i in range(g.shape[0])])
+    mse = float(np.mean(g[valid] ** 2))
+    ch = []
+    for c in range(g.shape[1]):
+        v = g[:, c][valid[:, c]]
+        ch.append(float(np.sqrt(np.mean(v ** 2))) if v.size else float("nan"))
+    bic = n * math.log(max(rss, 1e-300) / n) + p * math.log(n)
+    return FitOutcome(tuple(effects), params, sigma, rss, n, p, bic, mse, math.sqrt(mse),
+                      per_rpm, ch, nfev, seconds, x=x, heldout_gaps=g)
+
+
+def baseline_outcome(problem: Problem) -> FitOutcome:
+    """The baseline model (no effect) scored like a candidate."""
+    r0 = problem.vector({})
+    return score(problem, (), {}, {}, {}, float(np.sum(r0 ** 2)),
+                 int(problem.valid["train"].sum()), 0, 1, 0.0)

@@ -1,0 +1,105 @@
+"""Step 5 of the diagnosis, in words and figures: ``summary.txt`` and the report folder."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from powertrain.diagnosis.where import REGION_DB, attribution_text
+
+
+def _header(r) -> list:
+    d, p = r.data, r.parts
+    lines = [f"measured: {r.source}{' [SYNTHETIC]' if r.synthetic else ''}",
+             f"engine: {r.engine_name}",
+             f"data: {d.rpm.size} speeds {d.rpm[0]:g}..{d.rpm[-1]:g} rpm, "
+             f"{len(d.channels)} channels, quantities {', '.join(d.quantities)}; "
+             f"noise estimate {r.noise_db:.2f} dB (1 sigma)",
+             f"split: {r.split['description']}", "",
+             "1. WHERE",
+             f"  decomposition of the order gaps (share of sum of squares, each part "
+             f"alone): structure/frequency {p['share_alone']['structure']:.0%}, "
+             f"excitation/order {p['share_alone']['excitation']:.0%}, "
+             f"channel constant {p['share_alone']['const']:.0%}; all together "
+             f"{p['r2_full']:.0%}, residual {p['residual_rms_db']:.2f} dB RMS",
+             f"  attribution (each part fitted alone): {attribution_text(p['attribution'])}"]
+    rg = r.rigid_gap[np.isfinite(r.rigid_gap)]
+    if rg.size:
+        lines.append(f"  outside the rigid-body span: median {np.median(rg):.2f} dB RMS "
+                     f"over channels (90 % {np.percentile(rg, 90):.2f} dB)")
+    lines.append(f"  regions beyond +-{REGION_DB:g} dB: {len(r.regions)}")
+    for g in r.regions[:12]:
+        fq = f" ({g['frequency_hz_at_max']:.0f} Hz)" if g["frequency_hz_at_max"] else ""
+        lines.append(f"    {g['mount']:>7} {g['direction']} {g['quantity']:<10} "
+                     f"{g['rpm_from']:>6g}-{g['rpm_to']:<6g} rpm  max {g['gap_at_max_db']:+.1f} "
+                     f"dB{fq}  {g['kind']}")
+    if len(r.regions) > 12:
+        lines.append(f"    ... {len(r.regions) - 12} more in the JSON")
+    return lines
+
+
+def _which(r) -> list:
+    b = r.baseline
+    lines = ["", "2. WHICH (fitted on the training speeds, scored on the held-out ones)",
+             f"  {'candidate':<40} {'p':>2} {'held-out dB':>11} {'t':>6} {'dBIC':>8} "
+             f"{'expl.':>6} {'struct dB':>9}  status",
+             f"  {'(baseline)':<40} {0:>2} {b.heldout_rms_db:>11.2f} {'':>6} {'':>8} "
+             f"{'':>6} {b.struct_db:>9.2f}"]
+    for o in r.outcomes:
+        flag = " [evaluation budget hit]" if o.budget_hit else ""
+        lines.append(f"  {o.label:<40} {o.n_params:>2} {o.heldout_rms_db:>11.2f} "
+                     f"{o.t_stat:>6.1f} {o.bic_gain:>8.1f} {o.explained:>6.0%} "
+                     f"{o.struct_db:>9.2f}  {o.status}{flag}")
+    if r.chosen is not None:
+        lines.append("  parameters (1 sigma, Gauss-Newton, optimistic):")
+        for e, ps in r.chosen.params.items():
+            unit = r.chosen.units.get(e, {})
+            txt = ", ".join(f"{k} = {v:.4g} +- {r.chosen.sigma[e][k]:.2g} {unit.get(k, '')}"
+                            for k, v in ps.items())
+            lines.append(f"    {e}: {txt}")
+    for eq in r.equivalents:
+        lines.append(f"  equivalent explanation: {eq['text']}")
+    if r.band_check:
+        lines.append("  confounding check (refit on speed bands):")
+        for bnd in r.band_check:
+            txt = ", ".join(f"{k}={v:.3g}" for k, v in bnd["parameters"].items())
+            lines.append(f"    {bnd['rpm_from']:g}-{bnd['rpm_to']:g} rpm: {txt}")
+    return lines
+
+
+def summary(r) -> str:
+    """The plain-text report: where, which, how far, verdict."""
+    b, d = r.baseline, r.data
+    lines = _header(r) + _which(r)
+    lines += ["", "3. HOW FAR (held-out speeds)"]
+    after = r.chosen or b
+    lines.append(f"  {'mount':>7} {'dir':>3} {'before dB':>9} {'after dB':>8}")
+    for c, (m, di) in enumerate(d.channels):
+        lines.append(f"  {m:>7} {di:>3} {b.heldout_channel_rms[c]:>9.2f} "
+                     f"{after.heldout_channel_rms[c]:>8.2f}")
+    lines.append(f"  overall {b.heldout_rms_db:.2f} -> {after.heldout_rms_db:.2f} dB RMS")
+    if r.budget_hits:
+        lines.append(f"  evaluation budget hit by: {', '.join(r.budget_hits)} (best point "
+                     f"so far kept)")
+    lines += ["", f"VERDICT: {r.verdict_text}", f"({r.seconds:.1f} s)"]
+    return "\n".join(lines)
+
+
+def write_report(r, directory, provenance=None) -> list:
+    """Write ``summary.txt``, ``diagnosis.json`` and the figures into ``directory``."""
+    from pathlib import Path
+
+    from powertrain.iotools.atomic import atomic_write
+    from powertrain.plotting import plot_diagnosis_overlay, plot_gap_frequency, plot_gap_map
+    out = Path(directory)
+    out.mkdir(parents=True, exist_ok=True)
+    with atomic_write(out / "summary.txt") as fh:
+        fh.write(r.summary() + "\n")
+    r.to_json(out / "diagnosis.json")
+    files = [out / "summary.txt", out / "diagnosis.json"]
+    from powertrain.plotting.style import close_figure
+    provenance = provenance or getattr(r, "provenance", None)
+    for name, fn in (("gap_map.png", plot_gap_map), ("gap_vs_frequency.png", plot_gap_frequency),
+                     ("overlay.png", plot_diagnosis_overlay)):
+        close_figure(fn(r, out / name, provenance=provenance))
+        files.append(out / name)
+    return files

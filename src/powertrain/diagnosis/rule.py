@@ -1,0 +1,317 @@
+r"""Step 4 of the diagnosis: the decision rule, a pure function of the evidence.
+
+:func:`decide` (evidence, rule) → :class:`Verdict`. With :math:`E_0, E_c` the held-out mean
+squared gaps (dB²) of the baseline and a candidate and :math:`E_n` the one a perfect model
+would leave (noise):
+
+* a candidate is **supported** when it lowers the training BIC by more than ``bic_margin``
+  and its held-out improvement is significant: the per-speed improvements :math:`d_r` have
+  :math:`\bar d/(s_d/\sqrt{n_r}) >` ``t_min`` and :math:`\bar d > 0`;
+* a pair is preferred to its better member only if it is supported against that member in
+  the same way and explains at least ``pair_gain_min`` of the excess that member leaves;
+* the **answer** is the best (lowest held-out gap) supported candidate, among the first
+  ``n_checked`` that explain at least ``explained_min`` of :math:`E_0 - E_n`, whose
+  held-out residual keeps a structured RMS beyond noise of at most
+  :math:`\max(` ``struct_abs_db``, ``struct_rel`` × the baseline's) and that predicts
+  withheld (channel, order) cells (explains ≥ ``xv_explained_min`` of their excess with
+  t > ``t_min``; skipped when their excess is below ``excess_min_db``);
+* an admissible rival of another effect family that the held-out speeds cannot tell apart
+  from the answer (t ≤ ``t_min``) makes the verdict **ambiguous**;
+* otherwise **no effect** when the excess RMS gap :math:`\sqrt{\max(E_0 - E_n, 0)}` is
+  below ``excess_min_db`` (even if a candidate fits what is left "significantly": a model
+  that agrees to round-off leaves round-off for candidates to fit), else **unexplained**
+  (the best supported candidate named as partial, with the rule it failed).
+
+:func:`decide` never fits anything. When it reaches a candidate whose held-out cells check
+is not in the evidence yet, it returns a verdict with ``needs_cells_check`` set; the driver
+computes that check and decides again (:func:`powertrain.diagnosis.core.diagnose`).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from dataclasses import dataclass, field
+from enum import Enum
+
+import numpy as np
+
+
+@dataclass(frozen=True)
+class DecisionRule:
+    """Constants of the decision rule (each with its rationale; tests/test_decision_rule.py
+    checks a case on each side of every threshold).
+
+    Attributes
+    ----------
+    t_min : float
+        Held-out significance: 4 standard errors of the per-speed improvement; a chance
+        improvement that large has p ≈ 3e-5 per candidate, < 1e-3 over ~25 candidates.
+    bic_margin : float
+        Training BIC gain: 10 is "very strong" evidence (Kass & Raftery 1995; likelihood
+        ratio e^5 ≈ 150 after the parameter penalty).
+    explained_min : float
+        Fraction of the held-out excess over noise the answer must explain: more than half
+        plus a margin, so that the answer is the gap's main cause, not a side effect.
+    pair_gain_min : float
+        Fraction of what the better member leaves that a pair must remove: a second effect
+        must earn its parameters on at least half the rest, else it fits residue.
+    excess_min_db : float
+        Excess RMS gap over noise below which the model agrees [dB]: 0.5 dB is a test lab's
+        run-to-run repeatability of order levels.
+    struct_abs_db : float
+        Structured held-out residual beyond noise the answer may keep [dB]: about the lab's
+        repeatability, below which structure cannot be told from run-to-run variation.
+    struct_rel : float
+        ... or this fraction of the baseline's structured gap: the answer must remove about
+        two thirds of the structure, not just the noise-like part.
+    xv_explained_min : float
+        Fraction of the withheld cells' excess the refitted answer must predict: a physical
+        effect transfers to cells it was not fitted on, free parameters do not.
+    n_checked : int
+        Supported candidates (best first) put through the structure and held-out-cell
+        checks: the fourth best explains clearly less and each check costs 2–3 refits.
+    """
+
+    t_min: float = 4.0
+    bic_margin: float = 10.0
+    explained_min: float = 0.6
+    pair_gain_min: float = 0.5
+    excess_min_db: float = 0.5
+    struct_abs_db: float = 0.6
+    struct_rel: float = 0.35
+    xv_explained_min: float = 0.5
+    n_checked: int = 3
+
+    def to_dict(self) -> dict:
+        """Upper-case keys (the diagnosis JSON's ``decision_rule``)."""
+        return {k.upper(): v for k, v in dataclasses.asdict(self).items()}
+
+
+class Status(Enum):
+    """Status of a candidate after the decision."""
+
+    SUPPORTED = "supported"
+    NOT_SUPPORTED = "not supported"
+    NOT_BETTER_THAN_MEMBER = "not better than its better member"
+    STRUCTURED_RESIDUAL = "residual structured"
+    FAILS_HELDOUT_CELLS = "fails held-out cells"
+    INDISTINGUISHABLE = "indistinguishable"
+    PARTIAL = "partial"
+    CHOSEN = "chosen"
+
+
+class VerdictKind(Enum):
+    """Kind of answer."""
+
+    EFFECT = "effect"
+    NO_EFFECT = "no effect"
+    UNEXPLAINED = "unexplained"
+    AMBIGUOUS = "ambiguous"
+    PENDING = "pending"          # a held-out cells check is needed first
+
+
+@dataclass
+class CandidateEvidence:
+    """What the fits measured for one candidate (or the baseline, no effects)."""
+
+    label: str
+    effects: tuple
+    heldout_mse: float
+    heldout_per_rpm: np.ndarray
+    bic: float
+    struct_db: float = float("nan")
+    cells: dict | None = None
+
+
+@dataclass
+class Evidence:
+    """All the decision needs: baseline, candidates, noise, the 'where' phrase."""
+
+    baseline: CandidateEvidence
+    candidates: list
+    noise_mse: float
+    sigma_db: float
+    where_text: str = ""
+
+
+@dataclass
+class Assessment:
+    """A candidate's numbers and status after the decision."""
+
+    t_stat: float
+    bic_gain: float
+    explained: float
+    status: Status
+    text: str
+
+
+@dataclass
+class Verdict:
+    """The answer: kind, the JSON ``verdict`` label, text, per-candidate assessments (in
+    held-out order), the chosen label and the labels that cannot be told apart."""
+
+    kind: VerdictKind
+    label: str
+    text: str
+    assessments: dict = field(default_factory=dict)
+    order: list = field(default_factory=list)
+    chosen: str | None = None
+    ambiguous: list = field(default_factory=list)
+    needs_cells_check: str | None = None
+
+
+def improvement_t(base: CandidateEvidence, cand: CandidateEvidence):
+    """t statistic of the held-out improvement per speed of ``cand`` over ``base``."""
+    d = base.heldout_per_rpm - cand.heldout_per_rpm
+    d = d[np.isfinite(d)]
+    if d.size < 2:
+        return float("nan")
+    sd = float(np.std(d, ddof=1))
+    if sd > 0:
+        return float(np.mean(d)) / (sd / math.sqrt(d.size))
+    return float("inf") if np.mean(d) > 0 else 0.0
+
+
+def _assess(ev: Evidence, rule: DecisionRule) -> dict:
+    e0 = ev.baseline.heldout_mse
+    excess0 = max(e0 - ev.noise_mse, 0.0)
+    out = {}
+    for c in ev.candidates:
+        t, dbic = improvement_t(ev.baseline, c), ev.baseline.bic - c.bic
+        ok = dbic > rule.bic_margin and t > rule.t_min and c.heldout_mse < e0
+        st = Status.SUPPORTED if ok else Status.NOT_SUPPORTED
+        out[c.label] = Assessment(t, dbic, (e0 - c.heldout_mse) / excess0 if excess0 > 0
+                                  else float("nan"), st, st.value)
+    by_label = {c.label: c for c in ev.candidates}
+    for c in ev.candidates:
+        if len(c.effects) != 2 or out[c.label].status is not Status.SUPPORTED:
+            continue
+        best_m = min((by_label[e] for e in c.effects), key=lambda m: m.heldout_mse)
+        t, dbic = improvement_t(best_m, c), best_m.bic - c.bic
+        left = best_m.heldout_mse - ev.noise_mse
+        gain = (best_m.heldout_mse - c.heldout_mse) / left if left > 0 else 0.0
+        if not (t > rule.t_min and dbic > rule.bic_margin and gain >= rule.pair_gain_min):
+            out[c.label].status = Status.NOT_BETTER_THAN_MEMBER
+            out[c.label].text = f"not better than {best_m.label} alone"
+    return out
+
+
+def _struct_max(ev, rule):
+    return max(rule.struct_abs_db, rule.struct_rel * ev.baseline.struct_db)
+
+
+def _big(a, rule):
+    return np.isfinite(a.explained) and a.explained >= rule.explained_min
+
+
+def _choose(ev, rule, ranked, ass):
+    """First of the big supported candidates that passes structure and cells; or a label
+    whose cells check is missing (pending)."""
+    smax = _struct_max(ev, rule)
+    big = [c for c in ranked if ass[c.label].status is Status.SUPPORTED
+           and _big(ass[c.label], rule)]
+    for c in big[:rule.n_checked]:
+        a = ass[c.label]
+        if not c.struct_db <= smax:
+            a.status = Status.STRUCTURED_RESIDUAL
+            a.text = f"residual structured ({c.struct_db:.2f} dB > {smax:.2f} dB beyond noise)"
+            continue
+        if c.cells is None:
+            return None, c.label
+        xv = c.cells
+        if xv["baseline_excess_db"] >= rule.excess_min_db and not (
+                xv["explained"] >= rule.xv_explained_min and xv["t"] > rule.t_min):
+            a.status = Status.FAILS_HELDOUT_CELLS
+            a.text = (f"fails held-out {xv['kind']} (explains {xv['explained']:.0%}, "
+                      f"t {xv['t']:.1f})")
+            continue
+        return c, None
+    return None, None
+
+
+def _rivals(ev, rule, ranked, ass, chosen):
+    """Admissible candidates of another family the held-out speeds cannot tell apart."""
+    mine, smax, out = set(chosen.effects), _struct_max(ev, rule), []
+    for c in ranked:
+        theirs, a = set(c.effects), ass[c.label]
+        if (c is chosen or a.status is not Status.SUPPORTED or theirs <= mine
+                or mine <= theirs or not _big(a, rule) or not c.struct_db <= smax):
+            continue
+        t_rival = improvement_t(c, chosen)
+        if not t_rival > rule.t_min:
+            out.append((c, t_rival))
+    return out
+
+
+def decide(evidence: Evidence, rule: DecisionRule = DecisionRule()) -> Verdict:
+    """The verdict for ``evidence`` under ``rule`` (pure: no fitting, no side effects)."""
+    ev = evidence
+    ass = _assess(ev, rule)
+    ranked = sorted(ev.candidates, key=lambda c: c.heldout_mse)
+    order = [c.label for c in ranked]
+    chosen, pending = _choose(ev, rule, ranked, ass)
+    if pending is not None:
+        return Verdict(VerdictKind.PENDING, "pending", "", ass, order,
+                       needs_cells_check=pending)
+    rivals = _rivals(ev, rule, ranked, ass, chosen) if chosen is not None else []
+    if rivals:
+        return _ambiguous(ev, rule, ass, order, chosen, rivals)
+    if chosen is not None:
+        return _chosen(ev, ass, order, chosen)
+    return _no_answer(ev, rule, ass, order, ranked)
+
+
+def _ambiguous(ev, rule, ass, order, chosen, rivals):
+    a = ass[chosen.label]
+    a.text = "indistinguishable from " + ", ".join(c.label for c, _ in rivals)
+    a.status = Status.INDISTINGUISHABLE
+    for c, t in rivals:
+        ass[c.label].status = Status.INDISTINGUISHABLE
+        ass[c.label].text = f"indistinguishable from {chosen.label} (t {t:.1f})"
+    text = ("ambiguous: " + " or ".join(f"{c.label} (explains {ass[c.label].explained:.0%})"
+                                       for c in [chosen] + [r for r, _ in rivals])
+            + f"; each passes the decision rule but the held-out speeds do not tell them "
+              f"apart (t {max(t for _, t in rivals):.1f} <= {rule.t_min:g}); data at other "
+              f"amplitudes, loads or channels are needed to decide")
+    return Verdict(VerdictKind.AMBIGUOUS, "ambiguous", text, ass, order,
+                   ambiguous=[chosen.label] + [c.label for c, _ in rivals])
+
+
+def _chosen(ev, ass, order, c):
+    a = ass[c.label]
+    a.status, a.text = Status.CHOSEN, Status.CHOSEN.value
+    text = (f"{c.label}: explains {a.explained:.0%} of the held-out excess gap over noise; "
+            f"held-out RMS gap {ev.baseline.heldout_mse ** 0.5:.2f} -> "
+            f"{c.heldout_mse ** 0.5:.2f} dB; structured residual {c.struct_db:.2f} dB "
+            f"(baseline {ev.baseline.struct_db:.2f} dB); withheld {c.cells['kind']}: "
+            f"explains {c.cells['explained']:.0%}")
+    return Verdict(VerdictKind.EFFECT, c.label, text, ass, order, chosen=c.label)
+
+
+def _no_answer(ev, rule, ass, order, ranked):
+    e0 = ev.baseline.heldout_mse
+    excess_db = math.sqrt(max(e0 - ev.noise_mse, 0.0))
+    supported = [c for c in ranked if ass[c.label].status is not Status.NOT_SUPPORTED
+                 and ass[c.label].status is not Status.NOT_BETTER_THAN_MEMBER]
+    if excess_db < rule.excess_min_db:
+        # within noise: nothing to explain, whatever a candidate fits (a model that agrees
+        # to round-off still has candidates that fit the round-off "significantly")
+        extra = (f"; the best supported candidate, {supported[0].label}, would change it by "
+                 f"{abs(e0 ** 0.5 - supported[0].heldout_mse ** 0.5):.2f} dB only"
+                 if supported else " and no candidate improves it significantly")
+        text = (f"no effect: the held-out gap ({e0 ** 0.5:.2f} dB RMS) is within noise "
+                f"({ev.sigma_db:.2f} dB; excess {excess_db:.2f} dB < {rule.excess_min_db:g} "
+                f"dB){extra}")
+        return Verdict(VerdictKind.NO_EFFECT, "no effect", text, ass, order)
+    if supported:
+        best = ass[supported[0].label]
+        if best.status is Status.SUPPORTED:
+            best.status, best.text = Status.PARTIAL, Status.PARTIAL.value
+        text = (f"unexplained: the best candidate, {supported[0].label}, explains "
+                f"{best.explained:.0%} of the held-out excess gap ({excess_db:.2f} dB RMS "
+                f"over noise) but fails the decision rule ({best.text}); " + ev.where_text)
+        return Verdict(VerdictKind.UNEXPLAINED, "unexplained", text, ass, order)
+    text = (f"unexplained: no candidate improves the held-out gap significantly; excess "
+            f"over noise {excess_db:.2f} dB RMS; " + ev.where_text)
+    return Verdict(VerdictKind.UNEXPLAINED, "unexplained", text, ass, order)

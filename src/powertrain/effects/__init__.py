@@ -1,0 +1,45 @@
+r"""Unmodelled effects as model extensions: the candidates for the sim-to-real gap.
+
+One class per effect (:mod:`.base` defines the interface), one registry
+(:data:`EFFECTS`, :mod:`.registry`) read by ``powertrain runup/whatif --effect``,
+``powertrain synth``, the what-if variants and the diagnosis. Parameters are generated
+from the engine: one stiffness factor per mount, one gain per channel and one rotation per
+triad, one combustion deviation per cylinder, per-shaft balancer unbalance and timing.
+
+================== =========== ===================================================================
+name               kind        physics
+================== =========== ===================================================================
+base_compliance    structure   every mount stands on a local chassis base: mass m_b on a spring
+                               c_b (damping ratio ζ_b = 5 %) instead of the rigid ground
+mount_stiffness    structure   each mount's elastomer times a factor k_i: springs and dampers
+                               × k_i, masses (fluid and rubber inertia) unchanged
+amplitude_stiffness structure  springs and dampers × g(a) of the engine-side amplitude a,
+                               g(a) = 1 + κ[1/(1 + a/a_c) − 1/(1 + a_ref/a_c)] (a_ref = 0.1 mm)
+balancer_error     excitation  balancer shafts' unbalance g(1 ± a/2) and timing δ ± s/2 per shaft
+cylinder_imbalance excitation  cylinder i's combustion (IMEP, or the combustion part of its
+                               measured trace) times (1 + ε_i)
+sensor_error       sensor      channel gains 10^(G_c/20) and triad rotations φ_m:
+                               diag(10^(G/20)) R(φ_m) v
+================== =========== ===================================================================
+
+Every effect can be used on an :class:`~powertrain.models.engine.Engine`
+(``EFFECTS[name].apply(engine, **params)``, where it is an engine-model change), on the
+fast cached path :func:`predict` (the diagnosis), and through the ordinary run-up
+(:func:`powertrain.effect_runup.runup_with_effects`).
+"""
+
+from powertrain.effects.amplitude_stiffness import A_REF, amplitude_factor, time_domain_amplitude_check
+from powertrain.effects.balancer_error import with_balancer_error
+from powertrain.effects.base import Effect, Parameter, map_networks, with_network_elastomer
+from powertrain.effects.base_compliance import BASE_ZETA, with_base_compliance_all
+from powertrain.effects.cylinder_imbalance import with_cylinder_imbalance
+from powertrain.effects.mount_stiffness import with_mount_stiffness
+from powertrain.effects.predict import Prediction, predict
+from powertrain.effects.registry import EFFECT_CLASSES, EFFECTS, RESPONSE_EFFECTS, check_scenario
+from powertrain.effects.sensor_error import apply_sensor_error, rotation_matrix, sensor_reading
+
+__all__ = ["A_REF", "BASE_ZETA", "EFFECTS", "EFFECT_CLASSES", "RESPONSE_EFFECTS", "Effect",
+           "Parameter", "Prediction", "amplitude_factor", "apply_sensor_error",
+           "check_scenario", "map_networks", "predict", "rotation_matrix", "sensor_reading",
+           "time_domain_amplitude_check", "with_balancer_error", "with_base_compliance_all",
+           "with_cylinder_imbalance", "with_mount_stiffness", "with_network_elastomer"]

@@ -1,0 +1,141 @@
+"""The effect interface: one class per unmodelled effect, parameters generated from the engine.
+
+An effect has a ``name``, a ``kind`` (structure, excitation, sensor), a ``description``,
+``parameters(engine)`` (bounded, with units; generated from the engine's mounts, cylinders,
+balancer shafts and channels), ``applicable(engine)`` and ``apply(engine, params)`` (the
+changed engine model, where the effect is one). For the fast cached path
+(:func:`powertrain.effects.predict`) an effect contributes through hooks, each a no-op by
+default: an elastomer scale per network, an input-point stiffness change from the
+networks' two-ports, a load change, amplitude-dependent network factors, a change of the
+sensor reading. To add an effect: one new module with a subclass and its tests, and one
+line in :mod:`powertrain.effects.registry` (docs/extending.md).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from dataclasses import dataclass
+
+import numpy as np
+
+
+@dataclass(frozen=True)
+class Parameter:
+    """One bounded parameter of an effect.
+
+    Attributes
+    ----------
+    name, unit, description : str
+    lower, upper, default : float
+        Bounds and the value that reduces the effect to the baseline (SI).
+    log : bool
+        Fitted in log space (positive, scale-like parameters).
+    """
+
+    name: str
+    unit: str
+    lower: float
+    upper: float
+    default: float
+    log: bool = False
+    description: str = ""
+
+
+def mount_labels(engine) -> list:
+    """Names of the engine's mounts in file order (three generic ones without an engine)."""
+    if engine is None:
+        return ["mount 1", "mount 2", "mount 3"]
+    return [m.name for m in engine.mounts]
+
+
+class Effect:
+    """A candidate unmodelled effect (subclass per effect; see the module docstring)."""
+
+    name = ""
+    kind = ""
+    description = ""
+    #: False for effects that are not a change of the linear engine model (``apply`` absent).
+    engine_change = True
+    #: True when the effect only changes what the sensors read (the physics is untouched).
+    response_only = False
+
+    # ------------------------------------------------------------------ description
+    def parameters(self, engine=None) -> tuple:
+        """Parameters for ``engine`` (default layout without one)."""
+        raise NotImplementedError
+
+    def start_grid(self, engine=None) -> tuple:
+        """Coarse grid of start values per parameter (empty: start at the defaults)."""
+        return ()
+
+    def applicable(self, engine) -> bool:
+        """Whether the effect can act on ``engine``."""
+        return True
+
+    def defaults(self, engine=None) -> dict:
+        return {p.name: p.default for p in self.parameters(engine)}
+
+    @property
+    def parameter_names(self) -> list:
+        return [p.name for p in self.parameters()]
+
+    def bounds(self, engine=None):
+        ps = self.parameters(engine)
+        return np.array([p.lower for p in ps]), np.array([p.upper for p in ps])
+
+    def to_dict(self, engine=None) -> dict:
+        return {"name": self.name, "kind": self.kind, "description": self.description,
+                "parameters": [dataclasses.asdict(p) for p in self.parameters(engine)]}
+
+    # ------------------------------------------------------------------ engine model
+    def apply(self, engine, **params):
+        """The engine with the effect (``engine_change`` effects)."""
+        raise NotImplementedError(f"{self.name} is not a change of the engine model")
+
+    # ------------------------------------------------------------------ fast-path hooks
+    def warm(self, hm):
+        """Fill the parts of the cached model ``hm`` this effect needs."""
+
+    def elastomer_scale(self, hm, p):
+        """Factor on every network's springs and dampers, (n_net,), or None."""
+        return None
+
+    def kip(self, hm, abc, p, kip):
+        """Input-point stiffness (n_r, 17, n_net) given the networks' two-ports."""
+        return kip
+
+    def load_delta(self, hm, p):
+        """Change of the load harmonics (n_r, 17, 6), or None."""
+        return None
+
+    def amplitude_factors(self, amplitude, p):
+        """Elastomer factors at the networks' amplitudes (n_r, n_net), or None if the
+        effect does not depend on amplitude (or is switched off)."""
+        return None
+
+    def reading(self, velocity, p):
+        """What the sensors read from the channel velocities (n_r, n_ch, n_h)."""
+        return velocity
+
+    # ------------------------------------------------------------------ identifiability
+    def alternatives(self, params, engine=None) -> list:
+        """Other parameter sets that may explain the same magnitudes, as
+        ``[(description, params), ...]`` (the diagnosis keeps those the data cannot tell
+        apart from ``params``); none by default."""
+        return []
+
+
+def map_networks(engine, fn):
+    """The engine with every mount network replaced by ``fn(mount index, mount, axis, model)``."""
+    mounts = []
+    for mi, m in enumerate(engine.mounts):
+        mounts.append(dataclasses.replace(
+            m, directions={ax: fn(mi, m, ax, mod) for ax, mod in m.directions.items()}))
+    return engine.replace(mounts=mounts)
+
+
+def with_network_elastomer(engine, factors):
+    """Every network's springs and dampers times its own factor (network order: mount-major
+    x, y, z, as :attr:`HarmonicModel.networks`), masses kept (:meth:`MountModel.scaled`)."""
+    f = iter(np.asarray(factors, float).ravel())
+    return map_networks(engine, lambda mi, m, ax, mod: mod.scaled(*(2 * (float(next(f)),))))

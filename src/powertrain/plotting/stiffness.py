@@ -1,0 +1,181 @@
+"""Dynamic-stiffness figures K*(f): mount models, measured-vs-fitted, retune targets.
+
+Two forms: ``real-imag`` — real and imaginary part [N/mm] in one panel (the thesis's form,
+Kovarik 2016 Figs 15–29); ``magnitude-phase`` — |K*| [N/mm] above the loss angle [deg] (the
+datasheet form, ISO 10846). Frequency axis ``log`` (plain-number ticks) or ``linear``.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from powertrain.plotting.style import (
+    LABEL_SIZE,
+    LEGEND_SIZE,
+    TICK_SIZE,
+    TITLE_SIZE,
+    finish,
+    log_axis,
+    subplots,
+)
+
+FORMS = ("magnitude-phase", "real-imag")
+FREQ_AXES = ("log", "linear")
+#: Defaults: the datasheet form (ISO 10846) over log frequency.
+DEFAULT_FORM, DEFAULT_FREQ_AXIS = "magnitude-phase", "log"
+
+
+def stiffness_axes(ax, form, figsize=(7.5, 5.2)):
+    """Figure and axes of a stiffness plot: one Axes for ``real-imag``, two (|K*|, loss
+    angle) for ``magnitude-phase``; ``ax`` as for :func:`powertrain.plotting.style.subplots`,
+    or a pair of Axes for ``magnitude-phase``."""
+    if form not in FORMS:
+        raise ValueError(f"form must be one of {FORMS}, got {form!r}")
+    if form == "magnitude-phase" and isinstance(ax, (list, tuple)) and len(ax) == 2:
+        return ax[0].figure, list(ax), False
+    if form == "real-imag":
+        fig, axes, own = subplots(ax, 1, 1, figsize=(figsize[0], figsize[1] * 0.8))
+        return fig, [axes[0, 0]], own
+    fig, axes, own = subplots(ax, 2, 1, figsize=figsize, sharex=True,
+                              gridspec_kw={"height_ratios": [3, 2]})
+    return fig, list(axes[:, 0]), own
+
+
+def draw_stiffness(axes, f, kcp, form, *, label, style="-", color=None, marker=None,
+                   freq_axis=DEFAULT_FREQ_AXIS):
+    """Draw one K*(f) [N/m] curve into ``axes`` (from :func:`stiffness_axes`); measured data
+    as markers (``marker``), models as lines (real solid, imaginary dashed)."""
+    f = np.asarray(f, dtype=float)
+    k = np.asarray(kcp) / 1e3
+    if freq_axis == "log":
+        ok = f > 0
+        f, k = f[ok], k[ok]
+    if marker:
+        kw, kw_imag = {"ls": "none", "marker": marker, "ms": 3}, {"ls": "none",
+                                                                 "marker": marker, "ms": 3}
+    else:
+        kw, kw_imag = {"ls": style, "lw": 1.3}, {"ls": "--", "lw": 1.3}
+    if form == "real-imag":
+        line, = axes[0].plot(f, k.real, color=color, label=f"{label}, real", **kw)
+        axes[0].plot(f, k.imag, color="0.55" if marker else line.get_color(),
+                     label=f"{label}, imaginary", **kw_imag)
+        return line
+    line, = axes[0].plot(f, np.abs(k), color=color, label=label, **kw)
+    axes[1].plot(f, np.degrees(np.angle(k)), color=line.get_color(), label=label, **kw)
+    return line
+
+
+def style_stiffness(axes, form, freq_axis, band=None):
+    """Labels, grid, frequency axis (log with plain numbers, or linear), optional shaded
+    band (f_lo, f_hi) [Hz]."""
+    if freq_axis not in FREQ_AXES:
+        raise ValueError(f"freq_axis must be one of {FREQ_AXES}, got {freq_axis!r}")
+    if form == "real-imag":
+        axes[0].set_ylabel("dynamic stiffness K* [N/mm]", fontsize=LABEL_SIZE)
+    else:
+        axes[0].set_ylabel("|K*| [N/mm]", fontsize=LABEL_SIZE)
+        axes[1].set_ylabel("loss angle [deg]", fontsize=LABEL_SIZE)
+    axes[-1].set_xlabel("frequency [Hz]", fontsize=LABEL_SIZE)
+    for a in axes:
+        if freq_axis == "log":
+            log_axis(a, "x", max_ticks=10)
+        if band is not None:
+            a.axvspan(*band, color="0.9", zorder=0)
+        a.grid(True, which="major", alpha=0.35)
+        a.grid(True, which="minor", alpha=0.12)
+        a.tick_params(which="both", labelsize=TICK_SIZE)
+    if form == "magnitude-phase":
+        axes[0].tick_params(labelbottom=False)
+    axes[0].legend(fontsize=LEGEND_SIZE, loc="best")
+
+
+def plot_stiffness(curves, path=None, measured=None, ax=None, *, form=DEFAULT_FORM,
+                   freq_axis=DEFAULT_FREQ_AXIS, title=None, provenance=None):
+    """Cross-point dynamic stiffness K*(f) of one or more mount models (and a measurement).
+
+    Parameters
+    ----------
+    curves : list of (label, StiffnessTable) or (label, frequency_hz, kcp [N/m])
+    path : str, optional
+        PNG written atomically.
+    measured : (frequency_hz, kcp [N/m]) or None
+        Drawn as dots.
+    ax : None, Axes, Figure, SubFigure, or (Axes, Axes) for ``magnitude-phase``
+    form : {"magnitude-phase", "real-imag"}
+        |K*| and loss angle (datasheets, ISO 10846) or real and imaginary part (thesis).
+    freq_axis : {"log", "linear"}
+    title : str, optional
+    provenance : Provenance, optional
+        Foot line of a new figure.
+
+    Returns
+    -------
+    matplotlib Figure (or SubFigure)
+    """
+    fig, axes, own = stiffness_axes(ax, form)
+    if measured is not None:
+        draw_stiffness(axes, measured[0], measured[1], form, label="measured", color="k",
+                       marker=".", freq_axis=freq_axis)
+    for k, item in enumerate(curves):
+        label, f, kcp = (item[0], item[1].frequency_hz, item[1].kcp) if len(item) == 2 \
+            else item
+        draw_stiffness(axes, f, kcp, form, label=label, color=f"C{k % 10}",
+                       freq_axis=freq_axis)
+    style_stiffness(axes, form, freq_axis)
+    if title:
+        axes[0].set_title(title, fontsize=TITLE_SIZE)
+    return finish(fig, own, path, provenance)
+
+
+def plot_mount_fit(frequency_hz, kcp_measured, kcp_fitted, *, label="fit", title=None,
+                   ax=None, path=None, form=DEFAULT_FORM, freq_axis=DEFAULT_FREQ_AXIS,
+                   provenance=None):
+    """Measured (dots) and fitted (lines) K*(f) of a mount fit, in either form (see
+    :func:`plot_stiffness`; the thesis shows real and imaginary parts, Kovarik 2016,
+    Figs. 15–29 and 37–42).
+
+    Parameters
+    ----------
+    frequency_hz : ndarray
+        [Hz]
+    kcp_measured, kcp_fitted : ndarray of complex
+        Cross-point dynamic stiffness [N/m].
+    label : str
+        Legend label of the fitted curves.
+    title : str, optional
+    ax, path, form, freq_axis, provenance
+        As for :func:`plot_stiffness`.
+
+    Returns
+    -------
+    matplotlib Figure (or SubFigure)
+    """
+    return plot_stiffness([(label, frequency_hz, kcp_fitted)], path,
+                          measured=(frequency_hz, kcp_measured), ax=ax, form=form,
+                          freq_axis=freq_axis, title=title, provenance=provenance)
+
+
+def plot_retune(target_fit, path=None, *, ax=None, form=DEFAULT_FORM,
+                freq_axis=DEFAULT_FREQ_AXIS, provenance=None):
+    """Baseline, requested and fitted K_CP of a retune target, the band shaded.
+
+    Parameters
+    ----------
+    target_fit : powertrain.retune.TargetFit
+    path : str, optional
+        PNG written atomically.
+    ax, form, freq_axis, provenance
+        As for :func:`plot_stiffness`.
+    """
+    tf = target_fit
+    fig, axes, own = stiffness_axes(ax, form)
+    for k, style, label, color in ((tf.kcp_baseline, "-", "baseline", "k"),
+                                   (tf.kcp_target, "--", "requested", "C1"),
+                                   (tf.kcp_fitted, "-", f"fitted {tf.model.topology.name}",
+                                    "C0")):
+        draw_stiffness(axes, tf.frequency_hz, k, form, label=label, style=style, color=color,
+                       freq_axis=freq_axis)
+    style_stiffness(axes, form, freq_axis, band=(tf.target.f_lo, tf.target.f_hi))
+    axes[0].set_title(f"{tf.target.spec}: max error in band {100 * tf.max_band_error:.1f} %, "
+                      f"mean change {100 * tf.mean_band_change:+.1f} %", fontsize=TITLE_SIZE)
+    return finish(fig, own, path, provenance)

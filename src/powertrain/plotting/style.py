@@ -1,0 +1,281 @@
+"""Shared figure helpers: figure set-up, provenance line, plain-number log axes, colour bars
+with ``extend``, one legend per figure, empty-panel labels, atomic saving.
+
+Every figure of the package is made with these, so they look alike and pass the text-overlap
+test (``tests/test_figures.py``). matplotlib is imported lazily; nothing here switches the
+backend (the CLI picks Agg, :func:`powertrain.cli.common.use_agg`).
+"""
+
+from __future__ import annotations
+
+import math
+import textwrap
+
+import numpy as np
+
+#: Display factor and unit of each run-up signal (SI -> plot unit).
+SIGNAL_UNITS = {"velocity": (1e3, "mm/s"), "displacement": (1e6, "µm"),
+                "acceleration": (1.0, "m/s²"), "mount_force": (1.0, "N")}
+
+#: Resolution of saved PNGs [dots per inch].
+DPI = 120
+#: Font sizes [pt]: panel titles, axis labels, tick labels, legends, provenance line.
+TITLE_SIZE, LABEL_SIZE, TICK_SIZE, LEGEND_SIZE, FOOT_SIZE = 8.5, 8, 7, 7.5, 6
+#: Average glyph width as a fraction of the font size (DejaVu Sans), for text-width estimates.
+_GLYPH = 0.6
+
+
+# ------------------------------------------------------------------ figure and axes
+def subplots(target, nrows=1, ncols=1, figsize=(8.0, 4.5), **kwargs):
+    """Figure and a 2-D array of axes for a plot function's ``ax`` argument.
+
+    Parameters
+    ----------
+    target : None, matplotlib Axes, Figure or SubFigure
+        None: a new pyplot figure with constrained layout (the current backend; never
+        switched). Figure or SubFigure: the panels are made in it. Axes: used as is, allowed
+        only for a single panel.
+    nrows, ncols : int
+    figsize : (float, float)
+        Size of a new figure [in].
+    kwargs
+        Passed to ``subplots`` (sharex, sharey, gridspec_kw ...).
+
+    Returns
+    -------
+    fig : Figure or SubFigure
+    axes : ndarray of Axes, shape (nrows, ncols)
+    own : bool
+        True when the figure was made here (then the caller adds title, legend, provenance).
+    """
+    from matplotlib.axes import Axes
+    from matplotlib.figure import FigureBase
+    if target is None:
+        import matplotlib.pyplot as plt
+        fig = plt.figure(figsize=figsize, layout="constrained")
+        return fig, fig.subplots(nrows, ncols, squeeze=False, **kwargs), True
+    if isinstance(target, FigureBase):
+        return target, target.subplots(nrows, ncols, squeeze=False, **kwargs), False
+    if isinstance(target, Axes):
+        if nrows * ncols != 1:
+            raise TypeError(f"this figure has {nrows * ncols} panels: pass a Figure or "
+                            "SubFigure (e.g. fig.subfigures()), not one Axes")
+        return target.figure, np.array([[target]]), False
+    raise TypeError(f"ax must be a matplotlib Axes, Figure or SubFigure, not "
+                    f"{type(target).__name__}")
+
+
+def is_axes(target) -> bool:
+    """True for a single matplotlib Axes (then grid plots draw one chosen panel)."""
+    if target is None:
+        return False
+    from matplotlib.axes import Axes
+    return isinstance(target, Axes)
+
+
+def root_size(fig):
+    """(width, height) [in] of the top-level figure holding ``fig``."""
+    root = fig.figure if hasattr(fig, "figure") and fig.figure is not None else fig
+    while getattr(root, "figure", None) is not None and root.figure is not root:
+        root = root.figure
+    return root.get_figwidth(), root.get_figheight()
+
+
+def finish(fig, own, path=None, provenance=None, title=None):
+    """Title, provenance line and saving of a figure made by a plot function."""
+    if title:
+        text = wrap(title, root_size(fig)[0] * 0.95, 9)
+        if fig.legends:   # the legend above the panels carries the title (no collision)
+            fig.legends[0].set_title(text, prop={"size": 9})
+        else:
+            fig.suptitle(text, fontsize=9)
+    if own:
+        add_provenance(fig, provenance)
+    if path:
+        save_figure(fig, path)
+    return fig
+
+
+# ------------------------------------------------------------------ text
+def wrap(text, width_in, fontsize) -> str:
+    """Wrap ``text`` to lines that fit ``width_in`` inches at ``fontsize`` points."""
+    chars = max(20, int(width_in * 72 / (fontsize * _GLYPH) * 0.95))
+    return "\n".join(textwrap.wrap(text, chars, break_long_words=True,
+                                   break_on_hyphens=False)) or text
+
+
+def add_provenance(fig, provenance):
+    """Write the provenance line (wrapped) at the foot of a top-level figure, in a strip
+    reserved from the constrained layout so that it never overlaps the axes.
+
+    Parameters
+    ----------
+    fig : Figure
+    provenance : powertrain.provenance.Provenance, dict or None
+        A :class:`~powertrain.provenance.Provenance`, or a record of
+        :func:`powertrain.provenance.provenance`; None: only the program version is shown.
+    """
+    from powertrain import __version__
+    if isinstance(provenance, dict):   # a record of powertrain.provenance.provenance()
+        from powertrain.provenance import Provenance
+        provenance = Provenance.from_record(provenance)
+    text = provenance.line() if provenance is not None else f"powertrain {__version__}"
+    width, height = fig.get_figwidth(), fig.get_figheight()
+    text = wrap(text, width * 0.98, FOOT_SIZE)
+    n_lines = text.count("\n") + 1
+    strip = (n_lines * FOOT_SIZE * 1.25 + 4) / 72 / height
+    engine = fig.get_layout_engine()
+    if engine is not None and hasattr(engine, "set") and "rect" in engine.get():
+        engine.set(rect=(0, strip, 1, 1 - strip))
+    fig.text(0.008, 1.5 / 72 / height, text, fontsize=FOOT_SIZE, color="0.35",
+             ha="left", va="bottom", linespacing=1.1)
+
+
+def quantity_label(quantity: str) -> str:
+    """``synthesis`` -> ``synthesis (orders ≤ 8)``, ``order_2`` -> ``order 2``."""
+    if quantity == "synthesis":
+        return "synthesis (orders ≤ 8)"
+    return quantity.replace("order_", "order ")
+
+
+def no_data(ax, text="no data above the noise floor"):
+    """Label an empty panel in its centre (and drop its y tick labels)."""
+    ax.text(0.5, 0.5, "\n".join(textwrap.wrap(text, 42)), transform=ax.transAxes,
+            ha="center", va="center", fontsize=LABEL_SIZE, color="0.4")
+    ax.tick_params(axis="y", labelleft=False)
+
+
+# ------------------------------------------------------------------ log axes
+def _plain(value, _pos=None) -> str:
+    """Tick label of a log axis as a plain number: 10, 20, 50, 0.05 (never 2×10¹)."""
+    if value <= 0 or not math.isfinite(value):
+        return ""
+    text = f"{value:.6g}"
+    return text.replace("e+0", "e").replace("e-0", "e-")
+
+
+def _log_ticks(vmin, vmax, max_ticks):
+    """Ticks of a log axis inside [vmin, vmax]: 1-2-5 per decade, thinned to 1-3 or 1 (or
+    every n-th decade) when more than ``max_ticks``, refined to 1..9 when fewer than two."""
+    if vmin > vmax:
+        vmin, vmax = vmax, vmin
+    if not (vmax > 0 and math.isfinite(vmax)):
+        return np.array([])
+    vmin = vmin if vmin > 0 else vmax * 1e-6
+    lo, hi = math.floor(math.log10(vmin)), math.ceil(math.log10(vmax))
+
+    def inside(subs, every=1):
+        t = [s * 10.0 ** e for e in range(lo, hi + 1) if (e - lo) % every == 0 for s in subs]
+        return [v for v in t if vmin * (1 - 1e-9) <= v <= vmax * (1 + 1e-9)]
+
+    candidates = [inside(s) for s in ((1, 2, 5), (1, 3), (1,))]
+    candidates += [inside((1,), n) for n in range(2, 12)]
+    for ticks in candidates:
+        if len(ticks) <= max_ticks:
+            break
+    if len(ticks) >= 2:
+        return np.array(ticks)
+    fine = inside(range(1, 10))
+    if 2 <= len(fine) <= max_ticks:
+        return np.array(fine)
+    from matplotlib.ticker import MaxNLocator
+    lin = MaxNLocator(nbins=3, steps=[1, 2, 2.5, 5, 10]).tick_values(vmin, vmax)
+    return np.array([v for v in lin if vmin <= v <= vmax and v > 0])
+
+
+def log_axis(ax, axis="x", max_ticks=8, minor=True):
+    """Make ``ax``'s x or y axis logarithmic with plain-number tick labels (10, 20, 50, 100 …)
+    and unlabelled minor ticks.
+
+    Parameters
+    ----------
+    ax : matplotlib Axes
+    axis : {"x", "y"}
+    max_ticks : int
+        Most labelled ticks; the 1-2-5 sequence is thinned beyond it.
+    minor : bool
+        Unlabelled minor ticks at 2..9 × 10^n (off in large grids: they cost drawing time).
+    """
+    from matplotlib.ticker import FuncFormatter, Locator, LogLocator, NullFormatter
+
+    class PlainLogLocator(Locator):
+        def __call__(self):
+            return self.tick_values(*self.axis.get_view_interval())
+
+        def tick_values(self, vmin, vmax):
+            return _log_ticks(vmin, vmax, max_ticks)
+
+    target = ax.xaxis if axis == "x" else ax.yaxis
+    (ax.set_xscale if axis == "x" else ax.set_yscale)("log")
+    target.set_major_locator(PlainLogLocator())
+    target.set_major_formatter(FuncFormatter(_plain))
+    if minor:
+        target.set_minor_locator(LogLocator(subs=np.arange(2, 10), numticks=100))
+    else:
+        from matplotlib.ticker import NullLocator
+        target.set_minor_locator(NullLocator())
+    target.set_minor_formatter(NullFormatter())
+
+
+# ------------------------------------------------------------------ colour bar, legend
+def colorbar(fig, mappable, axes, data, vmin, vmax, label):
+    """Colour bar with ``extend`` arrows on the sides where ``data`` is clipped by the
+    ``[vmin, vmax]`` scale."""
+    finite = np.asarray(data, dtype=float)
+    finite = finite[np.isfinite(finite)]
+    below = finite.size and finite.min() < vmin
+    above = finite.size and finite.max() > vmax
+    extend = {(1, 1): "both", (1, 0): "min", (0, 1): "max"}.get((int(bool(below)),
+                                                                    int(bool(above))), "neither")
+    cb = fig.colorbar(mappable, ax=axes, extend=extend, shrink=0.9, aspect=30)
+    cb.set_label(label, fontsize=LABEL_SIZE)
+    cb.ax.tick_params(labelsize=TICK_SIZE)
+    return cb
+
+
+def figure_legend(fig, axes, extra=(), fontsize=LEGEND_SIZE):
+    """One legend for the whole figure, above the panels: the distinct labels of all
+    ``axes`` (first occurrence wins) plus ``extra`` (handle, label) pairs; as many columns
+    as fit the figure width."""
+    handles, labels = [], []
+    for ax in np.ravel(axes):
+        for h, lab in zip(*ax.get_legend_handles_labels()):
+            if lab not in labels and not lab.startswith("_"):
+                handles.append(h)
+                labels.append(lab)
+    for h, lab in extra:
+        handles.append(h)
+        labels.append(lab)
+    if not labels:
+        return None
+    width = root_size(fig)[0] * 0.96 * 72
+    entry = max(len(lab) for lab in labels) * fontsize * _GLYPH + 3.2 * fontsize
+    ncol = max(1, min(len(labels), int(width // entry)))
+    return fig.legend(handles, labels, loc="outside upper center", ncol=ncol,
+                      fontsize=fontsize, frameon=False, markerscale=1.5)
+
+
+# ------------------------------------------------------------------ output
+def save_figure(fig, path):
+    """Save a figure as PNG atomically (no half-written file on failure)."""
+    from powertrain.iotools.atomic import atomic_path
+    root = fig
+    while getattr(root, "figure", None) is not None and root.figure is not root:
+        root = root.figure
+    with atomic_path(path) as tmp:
+        root.savefig(tmp, dpi=DPI, format="png")
+
+
+def target_and_path(ax, path):
+    """Accept the old call ``result.plot("file.png")``: a str or path given as ``ax`` is the
+    output file."""
+    import os
+    if isinstance(ax, (str, os.PathLike)):
+        return None, ax
+    return ax, path
+
+
+def close_figure(fig):
+    """Release a pyplot figure (after saving it, when nobody will show it)."""
+    import matplotlib.pyplot as plt
+    plt.close(fig)

@@ -1,0 +1,169 @@
+"""The pure decision rule: every constant of DecisionRule has a case on each side of its
+threshold (the same evidence, the threshold just below / just above the statistic)."""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+
+import numpy as np
+import pytest
+
+from powertrain.diagnosis.rule import (
+    CandidateEvidence,
+    DecisionRule,
+    Evidence,
+    Status,
+    VerdictKind,
+    decide,
+    improvement_t,
+)
+
+N = 30
+WIGGLE = np.sin(np.arange(N) * 1.7)
+CELLS_OK = {"kind": "channels", "explained": 0.9, "t": 12.0, "baseline_excess_db": 1.5}
+
+
+def cand(label, mse, bic, struct=0.2, cells=CELLS_OK, spread=0.3):
+    effects = tuple(label.split("+"))
+    return CandidateEvidence(label, effects, mse, mse + spread * WIGGLE, bic, struct,
+                             dict(cells) if cells else None)
+
+
+def evidence(*cands, base_mse=4.0, base_struct=0.5, noise=0.5):
+    base = CandidateEvidence("", (), base_mse, np.full(N, base_mse), 1000.0, base_struct)
+    return Evidence(base, list(cands), noise, math.sqrt(noise), "where")
+
+
+def just(rule_value, above):
+    """A threshold just above (or below) a statistic."""
+    return rule_value * (1.01 if above else 0.99)
+
+
+def test_clean_case_chooses_the_candidate():
+    v = decide(evidence(cand("a", 1.0, 900.0)))
+    assert v.kind is VerdictKind.EFFECT and v.label == "a" == v.chosen
+    assert v.assessments["a"].status is Status.CHOSEN
+
+
+def test_missing_cells_check_is_requested_not_guessed():
+    v = decide(evidence(cand("a", 1.0, 900.0, cells=None)))
+    assert v.kind is VerdictKind.PENDING and v.needs_cells_check == "a"
+
+
+@pytest.mark.parametrize("above", [False, True])
+def test_t_min(above):
+    ev = evidence(cand("a", 1.0, 900.0, spread=1.0))
+    t = improvement_t(ev.baseline, ev.candidates[0])
+    ev.candidates[0].cells["t"] = 1e6
+    v = decide(ev, DecisionRule(t_min=just(t, above)))
+    assert (v.chosen == "a") is (not above)
+
+
+@pytest.mark.parametrize("above", [False, True])
+def test_bic_margin(above):
+    v = decide(evidence(cand("a", 1.0, 900.0)), DecisionRule(bic_margin=just(100.0, above)))
+    assert (v.chosen == "a") is (not above)
+    assert v.assessments["a"].status is (Status.NOT_SUPPORTED if above else Status.CHOSEN)
+
+
+@pytest.mark.parametrize("above", [False, True])
+def test_explained_min(above):
+    explained = (4.0 - 1.0) / (4.0 - 0.5)
+    v = decide(evidence(cand("a", 1.0, 900.0)), DecisionRule(explained_min=just(explained, above)))
+    assert (v.chosen == "a") is (not above)
+    if above:
+        assert v.kind is VerdictKind.UNEXPLAINED and v.assessments["a"].status is Status.PARTIAL
+
+
+@pytest.mark.parametrize("above", [False, True])
+def test_pair_gain_min(above):
+    a, b = cand("a", 1.5, 950.0), cand("b", 3.0, 980.0)
+    ab = cand("a+b", 0.8, 800.0)
+    gain = (1.5 - 0.8) / (1.5 - 0.5)
+    v = decide(evidence(a, b, ab), DecisionRule(pair_gain_min=just(gain, above)))
+    assert v.chosen == ("a" if above else "a+b")
+    if above:
+        assert v.assessments["a+b"].status is Status.NOT_BETTER_THAN_MEMBER
+
+
+@pytest.mark.parametrize("above", [False, True])
+def test_excess_min_db_no_effect_vs_unexplained(above):
+    excess = math.sqrt(4.0 - 0.5)
+    v = decide(evidence(cand("a", 3.9, 999.0)), DecisionRule(excess_min_db=just(excess, above)))
+    assert v.kind is (VerdictKind.NO_EFFECT if above else VerdictKind.UNEXPLAINED)
+
+
+@pytest.mark.parametrize("above", [False, True])
+def test_excess_min_db_skips_cells_check_on_small_excess(above):
+    cells = {**CELLS_OK, "explained": 0.1, "baseline_excess_db": 0.4}
+    v = decide(evidence(cand("a", 1.0, 900.0, cells=cells)),
+               DecisionRule(excess_min_db=just(0.4, above)))
+    assert (v.chosen == "a") is above
+    if not above:
+        assert v.assessments["a"].status is Status.FAILS_HELDOUT_CELLS
+
+
+@pytest.mark.parametrize("above", [False, True])
+def test_struct_abs_db(above):
+    v = decide(evidence(cand("a", 1.0, 900.0, struct=0.4), base_struct=0.5),
+               DecisionRule(struct_abs_db=just(0.4, above)))
+    assert (v.chosen == "a") is above
+    if not above:
+        assert v.assessments["a"].status is Status.STRUCTURED_RESIDUAL
+
+
+@pytest.mark.parametrize("above", [False, True])
+def test_struct_rel(above):
+    v = decide(evidence(cand("a", 1.0, 900.0, struct=0.7), base_struct=2.0),
+               DecisionRule(struct_abs_db=0.1, struct_rel=just(0.35, above)))
+    assert (v.chosen == "a") is above
+
+
+@pytest.mark.parametrize("above", [False, True])
+def test_xv_explained_min(above):
+    v = decide(evidence(cand("a", 1.0, 900.0)), DecisionRule(xv_explained_min=just(0.9, above)))
+    assert (v.chosen == "a") is (not above)
+
+
+@pytest.mark.parametrize("n_checked", [1, 2])
+def test_n_checked(n_checked):
+    first = cand("a", 1.0, 900.0, struct=5.0)          # fails the structure check
+    second = cand("b", 1.2, 905.0, spread=0.0)
+    v = decide(evidence(first, second), DecisionRule(n_checked=n_checked))
+    assert v.chosen == (None if n_checked == 1 else "b")
+
+
+def test_rivals_of_another_family_make_it_ambiguous():
+    b = cand("b", 1.01, 901.0)
+    b.heldout_per_rpm = 1.01 + 0.3 * np.cos(np.arange(N) * 0.9)
+    v = decide(evidence(cand("a", 1.0, 900.0), b))
+    assert v.kind is VerdictKind.AMBIGUOUS and set(v.ambiguous) == {"a", "b"}
+
+
+def test_decide_is_pure():
+    ev = evidence(cand("a", 1.0, 900.0))
+    before = dataclasses.asdict(ev)
+    decide(ev)
+    decide(ev)
+    after = dataclasses.asdict(ev)
+    assert repr(before) == repr(after)
+
+
+def test_rule_is_frozen_and_documented():
+    rule = DecisionRule()
+    with pytest.raises(dataclasses.FrozenInstanceError):
+        rule.t_min = 1.0
+    doc = DecisionRule.__doc__
+    for f in dataclasses.fields(DecisionRule):
+        assert f"    {f.name} :" in doc, f.name
+
+
+def test_supported_candidate_within_noise_is_no_effect_not_unexplained():
+    """A model equal to the measurement up to round-off: candidates fit the round-off
+    'significantly' (huge BIC gains on tiny residuals) but there is nothing to explain."""
+    base_mse, noise = 4.0e-4, 1.5e-4
+    a = cand("a", 3.0e-4, 500.0, spread=1e-5)          # explains 40 %: partial
+    ev = evidence(a, base_mse=base_mse, noise=noise)
+    v = decide(ev)
+    assert v.kind is VerdictKind.NO_EFFECT and "would change it by" in v.text

@@ -1,0 +1,336 @@
+"""Every shell command shown in README.md and docs/**/*.md runs (issue 10: "every command
+shown in README and docs/ runs in a test, so no figure or flag can go stale again").
+
+The rules a docs author must know are in docs/extending.md, "Writing docs"; in short:
+
+* ```bash blocks are executed, every other fence (```text for output, ```toml, ```python)
+  is not; ```sh, ```shell, ```console and ```zsh are refused so that no command escapes.
+* Each doc file runs in its own empty temporary folder in which the repository's
+  ``examples/``, ``engines/``, ``mounts/`` and ``scripts/`` are reachable by those names
+  (symbolic links); its commands run in order, so a later block may read what an earlier
+  one wrote. ``powertrain`` and ``python`` are the interpreter under test.
+* One command is one line (backslash continuations joined); comment lines are dropped.
+* In a ``&&`` chain, install steps (``python3 -m venv``, ``. .venv/bin/activate``,
+  ``source .venv/bin/activate``, ``pip install``) and the test-suite command
+  (``python -m pytest``) are not run: the environment under test is installed already and
+  CI runs the suite itself (running it here would recurse). The rest of the chain runs.
+  Each skipped part is reported as a skipped test naming file, line and rule.
+* A command must exit 0 within ``TIMEOUT_S`` (a command whose trailing comment says
+  ``# exits 1`` must exit 1 with exactly one line on stderr), and every file it names as an
+  output (``--out``, ``--csv``, ``--plot``, ``--json``, ``--truth``, ``--report``,
+  ``--target-out``, ``--target-plot``, ``> FILE``) must exist afterwards, outside the
+  repository (docs commands never write into the source tree).
+
+Failures name the doc file and line.
+"""
+
+from __future__ import annotations
+
+import os
+import re
+import shlex
+import signal
+import subprocess
+import sys
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import pytest
+
+import powertrain
+
+ROOT = Path(__file__).resolve().parents[1]
+#: Folders of the repository reachable by their relative names from a doc command.
+LINKED = ("examples", "engines", "mounts", "scripts")
+#: A command shown in the docs should take <= ~20 s; this is the hard stop (a loaded 2-core
+#: CI machine runs several times slower than the figures quoted in the docs).
+TIMEOUT_S = 120.0
+#: Fences whose content is executed, and shell fences that are refused (use ```bash).
+RUN_FENCE = "bash"
+REFUSED_FENCES = ("sh", "shell", "console", "zsh")
+#: Options whose value is a file (or folder) the command writes.
+OUTPUT_OPTIONS = ("--out", "--csv", "--plot", "--json", "--truth", "--report", "--target-out",
+                  "--target-plot")
+#: Parts of a ``&&`` chain that are not run (install steps and the test suite itself).
+SKIP_RULES = (
+    (re.compile(r"^python3? -m venv\b"), "install step (virtual environment)"),
+    (re.compile(r"^(\.|source) \S*activate$"), "install step (virtual environment)"),
+    (re.compile(r"^(python3? -m )?pip install\b"), "install step (pip install)"),
+    (re.compile(r"^python3? -m pytest\b"), "the test suite itself (CI runs it; would recurse)"),
+)
+EXPECT_EXIT_1 = re.compile(r"#\s*exits? 1\b")
+
+
+@dataclass
+class Command:
+    """One command of a doc file: the text to run and the parts skipped by rule."""
+
+    doc: str                  # path relative to the repository
+    line: int                 # 1-based line of the command's first line
+    text: str                 # what runs ("" when every part was skipped)
+    skipped: list = field(default_factory=list)   # [(part, reason)]
+    expect_exit: int = 0
+
+    @property
+    def where(self) -> str:
+        return f"{self.doc}:{self.line}"
+
+
+def doc_files() -> list:
+    """README.md and every Markdown file under docs/, in a fixed order."""
+    return [ROOT / "README.md"] + sorted((ROOT / "docs").rglob("*.md"))
+
+
+def _split_outside_quotes(text: str, sep: str) -> list:
+    """Split ``text`` at ``sep`` where it stands outside single and double quotes."""
+    parts, quote, start, i = [], None, 0, 0
+    while i < len(text):
+        ch = text[i]
+        if quote:
+            quote = None if ch == quote else quote
+        elif ch in "'\"":
+            quote = ch
+        elif text.startswith(sep, i):
+            parts.append(text[start:i])
+            start = i + len(sep)
+            i += len(sep)
+            continue
+        i += 1
+    parts.append(text[start:])
+    return parts
+
+
+def strip_comment(text: str) -> tuple:
+    """(command, comment): a ``#`` after whitespace outside quotes starts a comment."""
+    quote = None
+    for i, ch in enumerate(text):
+        if quote:
+            quote = None if ch == quote else quote
+        elif ch in "'\"":
+            quote = ch
+        elif ch == "#" and (i == 0 or text[i - 1].isspace()):
+            return text[:i].rstrip(), text[i:]
+    return text.rstrip(), ""
+
+
+def skip_reason(part: str):
+    """The rule that skips one part of a ``&&`` chain, or None if it runs."""
+    for pattern, reason in SKIP_RULES:
+        if pattern.search(part.strip()):
+            return reason
+    return None
+
+
+def bash_blocks(path: Path, root: Path = ROOT) -> list:
+    """[(first line number, [lines])] of the ```bash blocks of a Markdown file."""
+    blocks, current, start, fence = [], None, 0, None
+    for number, raw in enumerate(path.read_text(encoding="utf-8").splitlines(), 1):
+        stripped = raw.strip()
+        if stripped.startswith("```"):
+            if fence is None:
+                fence = stripped[3:].strip().split()[0] if stripped[3:].strip() else ""
+                if fence in REFUSED_FENCES:
+                    raise AssertionError(f"{path.relative_to(root)}:{number}: ```{fence} block; "
+                                         "shell commands go in ```bash (docs/extending.md)")
+                current, start = ([] if fence == RUN_FENCE else None), number + 1
+            else:
+                if current is not None:
+                    blocks.append((start, current))
+                fence, current = None, None
+        elif current is not None:
+            current.append(raw)
+    return blocks
+
+
+def commands_of(path: Path, root: Path = ROOT) -> list:
+    """The commands of every ```bash block of ``path``, continuations joined."""
+    doc = str(path.relative_to(root))
+    out = []
+    for start, lines in bash_blocks(path, root):
+        pending, first = "", None
+        for offset, raw in enumerate(lines):
+            text = raw.strip()
+            if not pending and (not text or text.startswith("#")):
+                continue
+            first = start + offset if not pending else first
+            if text.endswith("\\"):
+                pending += text[:-1].rstrip() + " "
+                continue
+            out.append(_command(doc, first, pending + text))
+            pending = ""
+        assert not pending, f"{doc}:{first}: block ends inside a continued line"
+    return out
+
+
+def _command(doc: str, line: int, text: str) -> Command:
+    body, comment = strip_comment(text)
+    run, skipped = [], []
+    for part in _split_outside_quotes(body, "&&"):
+        reason = skip_reason(part)
+        (skipped.append((part.strip(), reason)) if reason else run.append(part.strip()))
+    return Command(doc, line, " && ".join(run), skipped,
+                   1 if EXPECT_EXIT_1.search(comment) else 0)
+
+
+def output_paths(command: str) -> list:
+    """Files and folders a command names as its outputs (options and ``>`` redirection)."""
+    paths = []
+    for part in _split_outside_quotes(command, "&&"):
+        for segment in _split_outside_quotes(part, "|"):
+            try:
+                tokens = shlex.split(segment)
+            except ValueError:
+                continue
+            for i, tok in enumerate(tokens):
+                name, eq, value = tok.partition("=")
+                if name in OUTPUT_OPTIONS and eq:
+                    paths.append(value)
+                elif tok in OUTPUT_OPTIONS + (">", ">>") and i + 1 < len(tokens):
+                    paths.append(tokens[i + 1])
+                elif tok.startswith(">") and tok.lstrip(">"):
+                    paths.append(tok.lstrip(">"))
+    return [p for p in paths if not p.startswith("/dev/")]
+
+
+ALL_COMMANDS = {str(p.relative_to(ROOT)): commands_of(p) for p in doc_files()}
+RUN_FILES = [doc for doc, cmds in ALL_COMMANDS.items() if any(c.text for c in cmds)]
+SKIPPED_PARTS = [(c, part, reason) for cmds in ALL_COMMANDS.values() for c in cmds
+                 for part, reason in c.skipped]
+
+
+@pytest.fixture(scope="module")
+def shim_bin(tmp_path_factory) -> Path:
+    """A folder with ``python``, ``python3`` and ``powertrain`` of the interpreter under test."""
+    bin_dir = tmp_path_factory.mktemp("docs-bin")
+    exe = shlex.quote(sys.executable)
+    for name, target in (("python", exe), ("python3", exe),
+                         ("powertrain", f"{exe} -m powertrain.cli")):
+        script = bin_dir / name
+        script.write_text(f'#!/bin/sh\nexec {target} "$@"\n')
+        script.chmod(0o755)
+    return bin_dir
+
+
+def doc_environment(bin_dir: Path) -> dict:
+    env = dict(os.environ)
+    src = str(Path(powertrain.__file__).resolve().parents[1])
+    env["PYTHONPATH"] = os.pathsep.join([src] + [p for p in [env.get("PYTHONPATH")] if p])
+    env["PATH"] = os.pathsep.join([str(bin_dir), env.get("PATH", "")])
+    env["MPLBACKEND"] = "Agg"
+    return env
+
+
+def run_command(cmd: Command, cwd: Path, env: dict) -> tuple:
+    """(exit code, stdout, stderr, seconds); the whole process group is killed on timeout."""
+    t0 = time.perf_counter()
+    proc = subprocess.Popen(["bash", "-c", "set -o pipefail\n" + cmd.text], cwd=cwd, env=env,
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                            start_new_session=True)
+    try:
+        out, err = proc.communicate(timeout=TIMEOUT_S)
+    except subprocess.TimeoutExpired:
+        os.killpg(proc.pid, signal.SIGKILL)
+        proc.communicate()
+        pytest.fail(f"{cmd.where}: `{cmd.text}` did not finish within {TIMEOUT_S:.0f} s "
+                    "(docs commands must be quick: show the quick form, quote the full one "
+                    "in a ```text block)")
+    return proc.returncode, out, err, time.perf_counter() - t0
+
+
+def check_outputs(cmd: Command, cwd: Path) -> None:
+    for name in output_paths(cmd.text):
+        path = cwd / name
+        assert path.exists(), f"{cmd.where}: `{cmd.text}` did not write {name}"
+        resolved = path.resolve()
+        assert ROOT not in resolved.parents, \
+            f"{cmd.where}: `{cmd.text}` writes {name} into the repository ({resolved})"
+
+
+# ----------------------------------------------------------------------------- the parser
+def test_parser_joins_continuations_drops_comments_and_applies_the_skip_rule(tmp_path):
+    doc = tmp_path / "page.md"
+    doc.write_text("text\n```bash\n# a comment\npowertrain stiffness m.toml \\\n"
+                   "    --freq 5,10 --format csv > k.csv   # trailing\n\n"
+                   "python3 -m venv .venv && . .venv/bin/activate && pip install -e . && "
+                   "powertrain runup --csv r.csv\n"
+                   "powertrain runup --angle-step 0  # exits 1\n```\n"
+                   "```text\npowertrain not-run\n```\n")
+    cmds = commands_of(doc, root=tmp_path)
+    assert [c.line for c in cmds] == [4, 7, 8]
+    assert cmds[0].text == "powertrain stiffness m.toml --freq 5,10 --format csv > k.csv"
+    assert output_paths(cmds[0].text) == ["k.csv"]
+    assert cmds[1].text == "powertrain runup --csv r.csv"
+    assert [reason for _, reason in cmds[1].skipped] == [
+        "install step (virtual environment)", "install step (virtual environment)",
+        "install step (pip install)"]
+    assert cmds[2].expect_exit == 1 and cmds[0].expect_exit == 0
+    assert skip_reason('python -m pytest -q') and not skip_reason("python scripts/x.py")
+    assert output_paths("powertrain diagnose c.csv --report=out/d --json out/d.json") == [
+        "out/d", "out/d.json"]
+
+
+def test_shell_fences_other_than_bash_are_refused(tmp_path):
+    doc = tmp_path / "page.md"
+    doc.write_text("```sh\nls\n```\n")
+    with pytest.raises(AssertionError, match="page.md:1"):
+        bash_blocks(doc, root=tmp_path)
+
+
+def test_readme_shows_the_two_commands_and_ci_runs_the_second():
+    """The README's first block is the front door: install + main job, install + tests;
+    .ci/run runs the same test command."""
+    first = bash_blocks(ROOT / "README.md")[0][1]
+    lines = [s.strip() for s in first if s.strip() and not s.strip().startswith("#")]
+    assert len(lines) == 2, lines
+    main_job, tests = lines
+    assert "pip install -e ." in main_job and "powertrain runup" in main_job
+    assert tests.endswith("python -m pytest -q") and 'pip install -e ".[test]"' in tests
+    assert tests in (ROOT / ".ci" / "run").read_text()
+
+
+LINK = re.compile(r"\]\(([^)\s]+)\)")
+
+
+@pytest.mark.parametrize("doc", list(ALL_COMMANDS))
+def test_relative_links_resolve(doc):
+    """Every relative link of a doc page points to an existing file (anchors not checked)."""
+    path = ROOT / doc
+    text = re.sub(r"```.*?```", "", path.read_text(encoding="utf-8"), flags=re.S)
+    broken = [target for target in LINK.findall(text)
+              if not re.match(r"[a-z]+:", target) and not target.startswith("#")
+              and not (path.parent / target.split("#")[0]).exists()]
+    assert not broken, f"{doc}: broken links {broken}"
+
+
+def test_every_doc_page_with_commands_is_collected():
+    assert "README.md" in RUN_FILES
+    assert len(RUN_FILES) >= 5, RUN_FILES
+
+
+# ----------------------------------------------------------------------------- the runs
+@pytest.mark.parametrize(("cmd", "part", "reason"), SKIPPED_PARTS,
+                         ids=[f"{c.where}:{p.split()[0]}" for c, p, _ in SKIPPED_PARTS])
+def test_skipped_by_rule(cmd, part, reason):
+    """Reported, never silent: the part of a chain the rule does not run."""
+    pytest.skip(f"{cmd.where}: `{part}` not run: {reason} "
+                "(rule: docs/extending.md, 'Writing docs')")
+
+
+@pytest.mark.parametrize("doc", RUN_FILES)
+def test_doc_commands_run(doc, tmp_path, shim_bin):
+    for name in LINKED:
+        (tmp_path / name).symlink_to(ROOT / name, target_is_directory=True)
+    env = doc_environment(shim_bin)
+    for cmd in ALL_COMMANDS[doc]:
+        if not cmd.text:
+            continue
+        code, out, err, _ = run_command(cmd, tmp_path, env)
+        tail = "\n".join((out + err).strip().splitlines()[-15:])
+        assert code == cmd.expect_exit, \
+            f"{cmd.where}: `{cmd.text}` exited {code} (expected {cmd.expect_exit}):\n{tail}"
+        if cmd.expect_exit:
+            lines = err.strip().splitlines()
+            assert len(lines) == 1, f"{cmd.where}: expected one line on stderr, got:\n{err}"
+        else:
+            check_outputs(cmd, tmp_path)

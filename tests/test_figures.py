@@ -1,0 +1,214 @@
+"""Every figure the command line writes: no overlapping text, no text outside the figure, a
+provenance line; and the library's ``plot(ax=None)`` contract.
+
+Each CLI command runs in-process with quick settings. ``Figure.savefig`` is wrapped so that
+the very draw that writes the PNG records every text drawn (titles, axis and tick labels,
+legends, colour-bar labels, the provenance line) with its renderer bounding box; the check
+and its tolerance (1 px at the saved resolution) are in ``tests/figure_text.py``.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import matplotlib
+import pytest
+from click.testing import CliRunner
+from figure_text import TOLERANCE_PX, check_boxes, recording_texts, text_problems
+
+from powertrain.cli import main
+
+ROOT = Path(__file__).resolve().parents[1]
+MEASURED = str(ROOT / "examples" / "measured-runup.csv")
+VARIANTS = str(ROOT / "examples" / "whatif-variants.toml")
+MOUNT = str(ROOT / "mounts" / "hydraulic-engine-mount-z.toml")
+
+
+@pytest.fixture
+def saved(monkeypatch):
+    """{png name: (text problems, provenance lines)} of every figure saved meanwhile."""
+    from matplotlib.figure import Figure
+    found = {}
+    original = Figure.savefig
+
+    def savefig(self, fname, *args, **kwargs):
+        with recording_texts() as drawn:
+            original(self, fname, *args, **kwargs)
+        dpi = kwargs.get("dpi") or self.dpi
+        found[Path(str(fname)).name] = (_problems(drawn, self, dpi),
+                                        [t.get_text() for t, _ in drawn
+                                         if t.get_text().startswith("powertrain ")],
+                                        sum(a.get_legend() is not None for a in self.axes))
+
+    monkeypatch.setattr(Figure, "savefig", savefig)
+    return found
+
+
+def _problems(drawn, fig, dpi):
+    """As :func:`figure_text.text_problems`, from the texts recorded while saving."""
+    w, h = fig.get_figwidth() * dpi, fig.get_figheight() * dpi
+    return check_boxes(drawn, w, h, TOLERANCE_PX)
+
+
+def run(tmp_path, monkeypatch, *args):
+    monkeypatch.chdir(tmp_path)
+    res = CliRunner().invoke(main, [str(a) for a in args], catch_exceptions=False)
+    assert res.exit_code == 0, res.output
+    return res
+
+
+def _assert_clean(saved, names, command, panel_legends=True):
+    for name in names:
+        # an atomic write saves a temporary ".NAME.<random>.tmp" first
+        keys = [k for k in saved if k == name or k.startswith(f".{name}.")]
+        assert keys, f"{name} not written by `powertrain {command}`"
+        problems, foot, n_axes_legends = saved[keys[-1]]
+        if not panel_legends:
+            assert n_axes_legends == 0, f"{name}: {n_axes_legends} panel legends, want one " \
+                                        "legend for the figure"
+        assert not problems, f"{name}:\n" + "\n".join(problems[:10])
+        assert foot and f"$ powertrain {command}" in foot[0].replace("\n", " "), \
+            f"{name}: no provenance line naming the command ({foot})"
+        assert foot[0].startswith(f"powertrain {__import__('powertrain').__version__}")
+
+
+def test_runup_and_compare_figures(tmp_path, monkeypatch, saved):
+    run(tmp_path, monkeypatch, "runup", "--solver", "harmonic", "--from", "1000", "--to",
+        "6000", "--step", "1000", "--out", "r.h5", "--plot", "runup.png", "--quiet")
+    _assert_clean(saved, ["runup.png"], "runup", panel_legends=False)
+    # a raised noise floor leaves panels partly and wholly below it (labelled, not blank)
+    run(tmp_path, monkeypatch, "compare", MEASURED, "--sim", "r.h5", "--noise-floor", "0.01",
+        "--plot", "compare.png", "--quiet")
+    _assert_clean(saved, ["compare.png"], "compare", panel_legends=False)
+
+
+def test_whatif_figures(tmp_path, monkeypatch, saved):
+    run(tmp_path, monkeypatch, "whatif", "--variants", VARIANTS, "--measured", MEASURED,
+        "--from", "1000", "--to", "3000", "--step", "1000", "--workers", "1", "--quiet",
+        "--plot", "whatif.png")
+    run(tmp_path, monkeypatch, "whatif", "--target", "left.z:+20%:100-300Hz", "--from",
+        "1000", "--to", "2000", "--step", "1000", "--workers", "1", "--quiet",
+        "--target-plot", "target.png")
+    _assert_clean(saved, ["whatif.png"], "whatif", panel_legends=False)
+    _assert_clean(saved, ["target.png"], "whatif")
+
+
+def test_diagnose_report_figures(tmp_path, monkeypatch, saved):
+    run(tmp_path, monkeypatch, "diagnose", MEASURED, "--effects", "mount_stiffness",
+        "--no-pairs", "--noise-floor", "0.005", "--report", "diag")
+    _assert_clean(saved, ["gap_map.png", "gap_vs_frequency.png", "overlay.png"], "diagnose",
+                  panel_legends=False)
+
+
+@pytest.mark.parametrize("form,axis", [("magnitude-phase", "log"), ("real-imag", "linear"),
+                                       ("real-imag", "log"), ("magnitude-phase", "linear")])
+def test_stiffness_and_fit_figures(tmp_path, monkeypatch, saved, form, axis):
+    res = run(tmp_path, monkeypatch, "stiffness", MOUNT, "--freq", "1:300:1", "--format",
+              "csv", "--plot", "k.png", "--form", form, "--freq-axis", axis)
+    (tmp_path / "k.csv").write_text(res.output)
+    run(tmp_path, monkeypatch, "fit-mount", "k.csv", "--model", "sls", "--starts", "2",
+        "--out", "fit.toml", "--plot", "fit.png", "--form", form, "--freq-axis", axis)
+    _assert_clean(saved, ["k.png"], "stiffness")
+    _assert_clean(saved, ["fit.png"], "fit-mount")
+
+
+def test_excitation_figure(tmp_path, monkeypatch, saved):
+    run(tmp_path, monkeypatch, "excitation", "--rpm", "3000", "--step", "2", "--plot",
+        "exc.png")
+    _assert_clean(saved, ["exc.png"], "excitation")
+
+
+@pytest.mark.parametrize("args", [[], ["--static"]])
+def test_modes_figure(tmp_path, monkeypatch, saved, args):
+    run(tmp_path, monkeypatch, "modes", *args, "--plot", "modes.png")
+    _assert_clean(saved, ["modes.png"], "modes")
+
+
+# --------------------------------------------------------------------------- checker
+def test_the_checker_finds_overlap_and_overflow():
+    import matplotlib.pyplot as plt
+    fig, ax = plt.subplots(figsize=(3, 2))
+    ax.set_title("a title")
+    ax.text(0.5, 1.02, "on the title", transform=ax.transAxes, ha="center")
+    fig.text(0.9, 0.5, "runs off the right edge")
+    problems = text_problems(fig)
+    plt.close(fig)
+    assert any("overlap" in p and "on the title" in p for p in problems)
+    assert any("outside" in p and "right edge" in p for p in problems)
+
+
+# --------------------------------------------------------------------------- style helpers
+@pytest.mark.parametrize("lo,hi", [(1, 400), (0.003, 0.2), (0.6, 0.9), (1e-5, 1e3), (30, 600),
+                                   (0.95, 1.02), (2.1, 2.9)])
+def test_log_ticks_are_plain_numbers(lo, hi):
+    from powertrain.plotting.style import _log_ticks, _plain
+    ticks = _log_ticks(lo, hi, 8)
+    labels = [_plain(t) for t in ticks]
+    assert 2 <= len(ticks) <= 8, labels
+    assert all(lo <= t <= hi for t in ticks)
+    assert not any("×" in lab or "^" in lab for lab in labels)
+    if hi / lo < 1e4:
+        assert not any("e" in lab for lab in labels), labels
+    if (lo, hi) == (1, 400):
+        assert labels == ["1", "2", "5", "10", "20", "50", "100", "200"]
+
+
+@pytest.mark.parametrize("data,extend", [([-10, 2], "min"), ([-2, 8], "max"),
+                                         ([-9, 9], "both"), ([-5, 5], "neither")])
+def test_colorbar_extends_where_clipped(data, extend):
+    import matplotlib.pyplot as plt
+    import numpy as np
+
+    from powertrain.plotting.style import colorbar
+    fig, ax = plt.subplots(layout="constrained")
+    im = ax.pcolormesh(np.array([data]), vmin=-6, vmax=6)
+    assert colorbar(fig, im, ax, data, -6, 6, "gap [dB]").extend == extend
+    plt.close(fig)
+
+
+def test_provenance_line():
+    from powertrain import __version__
+    from powertrain.provenance import Provenance
+    p = Provenance.now("powertrain runup --plot r.png", "EA888 (default.toml), balancers off")
+    line = p.line()
+    assert line.startswith(f"powertrain {__version__}")
+    assert "UTC" in line and "balancers off" in line and "$ powertrain runup" in line
+    assert p.to_dict()["command"] == "powertrain runup --plot r.png"
+    from powertrain.provenance import provenance
+    q = Provenance.from_record(provenance())   # the HDF5/JSON record, short form
+    assert q.version == __version__ and q.date.endswith("Z") and q.command.startswith("powertrain")
+
+
+# --------------------------------------------------------------------------- library API
+@pytest.fixture
+def no_backend_switch(monkeypatch):
+    def refuse(*args, **kwargs):
+        raise AssertionError("a plot function switched the matplotlib backend")
+    monkeypatch.setattr(matplotlib, "use", refuse)
+
+
+def test_plot_into_user_axes_and_subfigures(no_backend_switch):
+    import matplotlib.pyplot as plt
+    import numpy as np
+
+    from powertrain.analysis.stiffness_table import stiffness_table
+    from powertrain.iotools.engine_file import DEFAULT_ENGINE_PATH, read_engine
+    from powertrain.iotools.mount_file import read_mount
+    from powertrain.runup import run_runup
+
+    table = stiffness_table(read_mount(MOUNT), np.arange(1.0, 100.0))
+    fig, (a1, a2) = plt.subplots(1, 2)
+    assert table.plot(a1, form="real-imag") is fig
+    assert len(a1.get_lines()) == 2
+    result = run_runup(read_engine(DEFAULT_ENGINE_PATH), np.array([1000.0, 2000.0]),
+                       solver="harmonic", progress=False)
+    assert result.plot(a2, channel=("left", "z"), quantity="order_2") is fig
+    assert a2.get_title().startswith("left Z")
+    with pytest.raises(TypeError, match="Figure or SubFigure"):
+        table.plot(a1)    # |K*| and loss angle need two panels
+    plt.close(fig)
+    fig = plt.figure(layout="constrained")
+    left, right = fig.subfigures(1, 2)
+    assert result.plot(left) is left and len(left.axes) == 27
+    assert table.plot(right) is right and len(right.axes) == 2
+    plt.close(fig)
