@@ -7,7 +7,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from powertrain.plotting.style import figure_legend, finish, subplots
+from powertrain.plotting.style import figure_legend, finish, no_data, subplots
 
 #: Rigid-body coordinates, as in :data:`powertrain.solvers.modes.COORDINATES`.
 COORDINATES = ("x", "y", "z", "rx", "ry", "rz")
@@ -58,7 +58,7 @@ def plot_runup_both_sides(result, path=None, quantities=("synthesis", "order_2",
     from powertrain.assembly import passive_name
     from powertrain.plotting import SIGNAL_UNITS
     from powertrain.plotting.runup import style_panel
-    from powertrain.plotting.style import no_data, quantity_label
+    from powertrain.plotting.style import quantity_label
     rows = [(m, d, True) for m in result.mounts for d in "xyz"]
     rows += [(p, d, False) for p in result.points for d in "xyz"]
     fig, axes, own = subplots(ax, len(rows), len(quantities),
@@ -69,7 +69,8 @@ def plot_runup_both_sides(result, path=None, quantities=("synthesis", "order_2",
             a = axes[r, q]
             y = _positive(result.curve(name, d, quantity, signal) * factor)
             values = [y.compressed()]
-            a.plot(result.rpm, y, "o-", ms=3, lw=1.2, color="tab:blue",
+            a.plot(result.rpm, y, "o-", ms=3, lw=1.2,
+                   color="tab:blue" if is_mount else "tab:green",
                    label="engine side" if is_mount else "body point")
             if is_mount:
                 yb = _positive(result.curve(passive_name(name), d, quantity, signal) * factor)
@@ -101,6 +102,10 @@ def plot_path_contributions(result, path=None, order=2.0, n_paths=6, ax=None,
         mag = np.abs(total)
         unit = np.where(mag > 0, np.conj(total) / np.where(mag > 0, mag, 1.0), 0.0)
         inphase = (pc * unit[:, None]).real
+        if not mag.max(initial=0.0) > 1e-9:        # [mm/s]: no response in this direction
+            a.set_title(f"{p} {d.upper()} — order {order:g}", fontsize=8)
+            no_data(a, "no response in this direction (zero at every speed)")
+            continue
         top = np.argsort(np.abs(inphase).max(axis=0))[::-1][:n_paths]
         for j in top:   # one colour per path in every panel: one legend for the figure
             a.plot(result.rpm, inphase[:, j], "o-", ms=3, lw=1.1, color=f"C{j % 10}",
