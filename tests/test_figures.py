@@ -82,6 +82,14 @@ def test_runup_and_compare_figures(tmp_path, monkeypatch, saved):
     _assert_clean(saved, ["compare.png"], "compare", panel_legends=False)
 
 
+def test_runup_body_figures(tmp_path, monkeypatch, saved):
+    engine = str(ROOT / "engines" / "default-modal-body.toml")
+    run(tmp_path, monkeypatch, "runup", "--engine", engine, "--solver", "harmonic", "--from",
+        "1000", "--to", "3000", "--step", "1000", "--plot", "body.png", "--path-plot",
+        "paths.png", "--quiet")
+    _assert_clean(saved, ["body.png", "paths.png"], "runup", panel_legends=False)
+
+
 def test_runup_sweep_figure(tmp_path, monkeypatch, saved):
     run(tmp_path, monkeypatch, "runup", "--from", "2000", "--to", "3000", "--sweep", "500",
         "--sample-rate", "4096", "--plot", "sweep.png", "--quiet")

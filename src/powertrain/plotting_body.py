@@ -7,7 +7,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from powertrain.plotting.style import finish, subplots
+from powertrain.plotting.style import figure_legend, finish, no_data, subplots
 
 #: Rigid-body coordinates, as in :data:`powertrain.solvers.modes.COORDINATES`.
 COORDINATES = ("x", "y", "z", "rx", "ry", "rz")
@@ -57,7 +57,8 @@ def plot_runup_both_sides(result, path=None, quantities=("synthesis", "order_2",
     (``ax``: None, a Figure or SubFigure)."""
     from powertrain.assembly import passive_name
     from powertrain.plotting import SIGNAL_UNITS
-    from powertrain.plotting.style import no_data, quantity_label
+    from powertrain.plotting.runup import style_panel
+    from powertrain.plotting.style import quantity_label
     rows = [(m, d, True) for m in result.mounts for d in "xyz"]
     rows += [(p, d, False) for p in result.points for d in "xyz"]
     fig, axes, own = subplots(ax, len(rows), len(quantities),
@@ -67,32 +68,23 @@ def plot_runup_both_sides(result, path=None, quantities=("synthesis", "order_2",
         for q, quantity in enumerate(quantities):
             a = axes[r, q]
             y = _positive(result.curve(name, d, quantity, signal) * factor)
-            drawn = not np.all(np.ma.getmaskarray(y))
-            if drawn:
-                a.semilogy(result.rpm, y, "o-", ms=3, lw=1.2, color="tab:blue",
-                           label="engine side" if is_mount else "body point")
+            values = [y.compressed()]
+            a.plot(result.rpm, y, "o-", ms=3, lw=1.2,
+                   color="tab:blue" if is_mount else "tab:green",
+                   label="engine side" if is_mount else "body point")
             if is_mount:
                 yb = _positive(result.curve(passive_name(name), d, quantity, signal) * factor)
-                if not np.all(np.ma.getmaskarray(yb)):
-                    a.semilogy(result.rpm, yb, "s--", ms=3, lw=1.2, color="tab:red",
-                               label="body side")
-                    drawn = True
-            if not drawn:
-                no_data(a, "zero")
-            a.set_title(f"{name} {d.upper()} — {quantity_label(quantity)}", fontsize=8)
-            a.grid(True, which="major", alpha=0.3)
-            a.tick_params(which="both", labelsize=6)
+                a.plot(result.rpm, yb, "s--", ms=3, lw=1.2, color="tab:red", label="body side")
+                values.append(yb.compressed())
+            if not style_panel(a, f"{name} {d.upper()} — {quantity_label(quantity)}",
+                               np.concatenate(values)):
+                no_data(a, "zero at every speed")
             if q == 0:
                 a.set_ylabel(f"RMS {signal.replace('_', ' ')} [{unit}]", fontsize=7)
     for a in axes[-1]:
         a.set_xlabel("engine speed [rpm]", fontsize=8)
-    handles = {}
-    for a in axes.ravel():
-        for h, lab in zip(*a.get_legend_handles_labels()):
-            handles.setdefault(lab, h)
-    if handles:
-        fig.legend(list(handles.values()), list(handles), ncol=3, fontsize=7,
-                   loc="outside upper center", frameon=False)
+    if own:
+        figure_legend(fig, axes)
     return finish(fig, own, path, provenance)
 
 
@@ -110,9 +102,14 @@ def plot_path_contributions(result, path=None, order=2.0, n_paths=6, ax=None,
         mag = np.abs(total)
         unit = np.where(mag > 0, np.conj(total) / np.where(mag > 0, mag, 1.0), 0.0)
         inphase = (pc * unit[:, None]).real
+        if not mag.max(initial=0.0) > 1e-9:        # [mm/s]: no response in this direction
+            a.set_title(f"{p} {d.upper()} — order {order:g}", fontsize=8)
+            no_data(a, "no response in this direction (zero at every speed)")
+            continue
         top = np.argsort(np.abs(inphase).max(axis=0))[::-1][:n_paths]
-        for j in top:
-            a.plot(result.rpm, inphase[:, j], "o-", ms=3, lw=1.1, label=labels[j])
+        for j in top:   # one colour per path in every panel: one legend for the figure
+            a.plot(result.rpm, inphase[:, j], "o-", ms=3, lw=1.1, color=f"C{j % 10}",
+                   label=labels[j])
         a.plot(result.rpm, mag, "k-", lw=2, label="total |v|")
         a.axhline(0.0, color="0.5", lw=0.6)
         a.set_title(f"{p} {d.upper()} — order {order:g}: path contributions in phase "
@@ -120,6 +117,7 @@ def plot_path_contributions(result, path=None, order=2.0, n_paths=6, ax=None,
         a.set_ylabel("velocity [mm/s]", fontsize=7)
         a.grid(True, alpha=0.3)
         a.tick_params(labelsize=6)
-        a.legend(fontsize=6, ncol=4)
     axes[-1, 0].set_xlabel("engine speed [rpm]", fontsize=8)
+    if own:
+        figure_legend(fig, axes)
     return finish(fig, own, path, provenance)
