@@ -112,7 +112,7 @@ class DiagnosisResult:
                 "heldout_structured_residual_db": o.struct_db,
                 "heldout_block_chi2_ratio": o.chi2_ratio,
                 "heldout_cells_check": o.cells_check,
-                "nfev": o.nfev, "budget_hit": o.budget_hit, "seconds": o.seconds}
+                "nfev": o.nfev, "n_eval": o.n_eval, "budget_hit": o.budget_hit, "seconds": o.seconds}
 
     def _decision_rule_dict(self):
         return {**self.rule.to_dict(),
