@@ -64,6 +64,7 @@ def main() -> int:
     try:
         fh.seeds(worker, tmp / "seeds")
         for name, case in fh.issue_cases().items():
+            case.description = name
             outcome, detail = fh.run_case(worker, case, tmp / "case")
             record("issue-10", case, outcome, detail)
         for kind in kinds:

@@ -15,6 +15,7 @@ outcome is classified:
 
 from __future__ import annotations
 
+import copy
 import json
 import math
 import os
@@ -229,6 +230,12 @@ def seeds(worker: Worker, folder: Path) -> dict:
     assert res["code"] == 0, res
     _SEEDS["sim.h5"] = (folder / "sim.h5").read_bytes()
     _SEEDS["sim.csv"] = (folder / "sim.csv").read_bytes()
+    from powertrain import signals
+    from powertrain.iotools.raw_csv import write_raw_csv
+    write_raw_csv(folder / "raw.csv", signals.analytic_sweep(fs=2048.0, duration=2.0,
+                                                             rpm0=1500.0, rpm1=3000.0),
+                  comment="SYNTHETIC: analytic sweep (fuzz seed)")
+    _SEEDS["raw.csv"] = (folder / "raw.csv").read_bytes()
     res = worker.run(["stiffness", str(ROOT / "mounts" / "hydraulic-engine-mount-z.toml"),
                       "--freq", "1:200:10", "--format", "csv"], folder)
     _SEEDS["k.csv"] = res["stdout"].encode()
@@ -281,7 +288,8 @@ WEIRD_VALUES = WEIRD_NUMBERS + ["", "abc", "1", "nan", True, [], [1, 2], [1, "a"
 
 
 def weird_value():
-    return st.one_of(st.sampled_from(WEIRD_VALUES),
+    """A weird TOML value (a fresh copy: mutations must not change the shared constants)."""
+    return st.one_of(st.sampled_from(WEIRD_VALUES).map(copy.deepcopy),
                      st.floats(allow_nan=True, allow_infinity=True),
                      st.integers(-2 ** 63, 2 ** 63 - 1),
                      st.text(max_size=6))
@@ -600,11 +608,18 @@ def case_options(draw) -> Case:
                         "f.toml", opt, value], ["f.toml"], opt, f"option {opt}")
 
 
+def case_raw_csv(draw) -> Case:
+    files = {"raw.csv": mutate_csv(draw, _SEEDS["raw.csv"])}
+    return Case(files, ["track", "raw.csv", "--quantity", "acceleration", "--orders", "1,2,4",
+                        "--quiet", "--csv", "t.csv"], ["t.csv"], "raw.csv",
+                "raw time-data CSV (track)")
+
+
 #: Input kind -> case builder.
 KINDS = {"engine": case_engine, "mount": case_mount, "pressure_csv": case_pressure,
          "stiffness_csv": case_stiffness, "measured_csv": case_measured_csv,
          "measured_hdf5": case_measured_hdf5, "variants": case_variants,
-         "options": case_options}
+         "options": case_options, "raw_csv": case_raw_csv}
 
 
 # --------------------------------------------------------------------------- issue 10's list

@@ -167,3 +167,25 @@ def test_supported_candidate_within_noise_is_no_effect_not_unexplained():
     ev = evidence(a, base_mse=base_mse, noise=noise)
     v = decide(ev)
     assert v.kind is VerdictKind.NO_EFFECT and "would change it by" in v.text
+
+
+def test_evaluation_budget_stops_a_fit_and_says_so():
+    """A fit that reaches its evaluation budget keeps its best point and is flagged."""
+    from powertrain.diagnosis.data import GapData, split_rpm
+    from powertrain.diagnosis.fit import Problem, fit_candidate
+    from powertrain.effects import predict
+    from powertrain.iotools.engine_file import DEFAULT_ENGINE_PATH, read_engine
+    from powertrain.solvers.fast_harmonic import HarmonicModel
+    eng = read_engine(DEFAULT_ENGINE_PATH)
+    rpm = np.arange(1000.0, 6000.1, 250.0)
+    hm = HarmonicModel(eng, rpm)
+    v = predict(hm, {"balancer_error": {"gain": 0.6, "lag": 0.2}}).velocity
+    lev = np.abs(v[:, :, [1, 3]]) / np.sqrt(2)
+    data = GapData(rpm, [(m, d) for m in eng.mount_names for d in "xyz"],
+                   ["order_1", "order_2"], np.array([1, 3]), lev, 1e-9)
+    tr, te = split_rpm(rpm)
+    prob = Problem(hm.subset(tr), hm.subset(te), data, tr, te)
+    small = fit_candidate(prob, ("balancer_error",), budget=8)
+    full = fit_candidate(prob, ("balancer_error",))
+    assert small.budget_hit and small.n_eval <= 8 and not full.budget_hit
+    assert full.heldout_mse < small.heldout_mse

@@ -157,3 +157,27 @@ def test_mount_parameters_follow_the_engine(engine):
     assert names == [f"k{i + 1}" for i in range(n)]
     g = [p.name for p in EFFECTS["sensor_error"].parameters(engine) if p.name.startswith("g")]
     assert len(g) == 3 * n
+
+
+def test_four_mount_engine_gets_its_own_parameters_and_folds():
+    """The torque-rod engine (4 mounts): a stiffness factor per mount, 12 channel gains,
+    4 triad rotations, channel folds holding out one channel of every triad; the fast path
+    of a factor on the fourth mount equals the engine-level change."""
+    from powertrain.data import shipped_path
+    from powertrain.diagnosis.checks import channel_folds
+    eng = read_engine(shipped_path("engines", "default-torque-rod.toml"))
+    n = len(eng.mounts)
+    assert n == 4
+    assert [p.name for p in EFFECTS["mount_stiffness"].parameters(eng)] == ["k1", "k2", "k3",
+                                                                             "k4"]
+    ps = EFFECTS["sensor_error"].parameters(eng)
+    assert sum(p.name.startswith("g") for p in ps) == 12 and sum(
+        p.name.startswith("r") for p in ps) == 12
+    folds = channel_folds(n)
+    assert sorted(c for f in folds for c in f) == list(range(12))
+    assert all(len({c // 3 for c in f}) == n for f in folds)
+    hm = HarmonicModel(eng, [2500.0])
+    v = predict(hm, {"mount_stiffness": {"k4": 1.7}}).velocity
+    ref = run_runup(EFFECTS["mount_stiffness"].apply(eng, k4=1.7), [2500.0],
+                    solver="harmonic").velocity
+    assert np.max(np.abs(v - ref)) <= EXACT * np.max(np.abs(ref))

@@ -4,7 +4,8 @@ shown in README and docs/ runs in a test, so no figure or flag can go stale agai
 The rules a docs author must know are in docs/extending.md, "Writing docs"; in short:
 
 * ```bash blocks are executed, every other fence (```text for output, ```toml, ```python)
-  is not; ```sh, ```shell, ```console and ```zsh are refused so that no command escapes.
+  is not; ```sh, ```shell, ```console and ```zsh are refused so that no command escapes;
+  ```python blocks must compile.
 * Each doc file runs in its own empty temporary folder in which the repository's
   ``examples/``, ``engines/``, ``mounts/`` and ``scripts/`` are reachable by those names
   (symbolic links); its commands run in order, so a later block may read what an earlier
@@ -32,7 +33,8 @@ import shlex
 import signal
 import subprocess
 import sys
-import time
+import textwrap
+from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -49,6 +51,8 @@ TIMEOUT_S = 120.0
 #: Fences whose content is executed, and shell fences that are refused (use ```bash).
 RUN_FENCE = "bash"
 REFUSED_FENCES = ("sh", "shell", "console", "zsh")
+#: Doc files run side by side (each command is a separate process; CI has two cores).
+WORKERS = 2
 #: Options whose value is a file (or folder) the command writes.
 OUTPUT_OPTIONS = ("--out", "--csv", "--plot", "--json", "--truth", "--report", "--target-out",
                   "--target-plot")
@@ -221,9 +225,9 @@ def doc_environment(bin_dir: Path) -> dict:
     return env
 
 
-def run_command(cmd: Command, cwd: Path, env: dict) -> tuple:
-    """(exit code, stdout, stderr, seconds); the whole process group is killed on timeout."""
-    t0 = time.perf_counter()
+def run_command(cmd: Command, cwd: Path, env: dict):
+    """Run one command; the failure message (None if it passed). The whole process group is
+    killed on timeout."""
     proc = subprocess.Popen(["bash", "-c", "set -o pipefail\n" + cmd.text], cwd=cwd, env=env,
                             stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
                             start_new_session=True)
@@ -232,19 +236,39 @@ def run_command(cmd: Command, cwd: Path, env: dict) -> tuple:
     except subprocess.TimeoutExpired:
         os.killpg(proc.pid, signal.SIGKILL)
         proc.communicate()
-        pytest.fail(f"{cmd.where}: `{cmd.text}` did not finish within {TIMEOUT_S:.0f} s "
-                    "(docs commands must be quick: show the quick form, quote the full one "
-                    "in a ```text block)")
-    return proc.returncode, out, err, time.perf_counter() - t0
+        return (f"{cmd.where}: `{cmd.text}` did not finish within {TIMEOUT_S:.0f} s (docs "
+                "commands must be quick: show the quick form, quote the full one in a "
+                "```text block)")
+    if proc.returncode != cmd.expect_exit:
+        tail = "\n".join((out + err).strip().splitlines()[-15:])
+        return (f"{cmd.where}: `{cmd.text}` exited {proc.returncode} (expected "
+                f"{cmd.expect_exit}):\n{tail}")
+    if cmd.expect_exit and len(err.strip().splitlines()) != 1:
+        return f"{cmd.where}: `{cmd.text}`: expected one line on stderr, got:\n{err}"
+    return None if cmd.expect_exit else check_outputs(cmd, cwd)
 
 
-def check_outputs(cmd: Command, cwd: Path) -> None:
+def check_outputs(cmd: Command, cwd: Path):
+    """Failure message if a named output is missing or lies in the repository, else None."""
     for name in output_paths(cmd.text):
         path = cwd / name
-        assert path.exists(), f"{cmd.where}: `{cmd.text}` did not write {name}"
-        resolved = path.resolve()
-        assert ROOT not in resolved.parents, \
-            f"{cmd.where}: `{cmd.text}` writes {name} into the repository ({resolved})"
+        if not path.exists():
+            return f"{cmd.where}: `{cmd.text}` did not write {name}"
+        if ROOT in path.resolve().parents:
+            return (f"{cmd.where}: `{cmd.text}` writes {name} into the repository "
+                    f"({path.resolve()})")
+    return None
+
+
+def run_doc(doc: str, folder: Path, env: dict):
+    """Run a doc file's commands in order in ``folder``; the first failure (None if none)."""
+    for name in LINKED:
+        (folder / name).symlink_to(ROOT / name, target_is_directory=True)
+    for cmd in ALL_COMMANDS[doc]:
+        failure = run_command(cmd, folder, env) if cmd.text else None
+        if failure:
+            return failure
+    return None
 
 
 # ----------------------------------------------------------------------------- the parser
@@ -289,6 +313,22 @@ def test_readme_shows_the_two_commands_and_ci_runs_the_second():
     assert tests in (ROOT / ".ci" / "run").read_text()
 
 
+def test_failures_name_the_doc_file_and_line(tmp_path):
+    env = dict(os.environ)
+    assert run_command(Command("a.md", 3, "true"), tmp_path, env) is None
+    assert run_command(Command("a.md", 3, "false"), tmp_path, env).startswith(
+        "a.md:3: `false` exited 1")
+    assert "did not write out.csv" in run_command(
+        Command("a.md", 4, "true --csv out.csv"), tmp_path, env)
+    assert run_command(Command("a.md", 5, "echo bad >&2; exit 1", expect_exit=1),
+                       tmp_path, env) is None
+    assert "one line on stderr" in run_command(
+        Command("a.md", 6, "printf 'a\\nb\\n' >&2; exit 1", expect_exit=1), tmp_path, env)
+    (tmp_path / "examples").symlink_to(ROOT / "examples", target_is_directory=True)
+    assert "into the repository" in run_command(
+        Command("a.md", 7, "true --out examples/whatif-variants.toml"), tmp_path, env)
+
+
 LINK = re.compile(r"\]\(([^)\s]+)\)")
 
 
@@ -301,6 +341,17 @@ def test_relative_links_resolve(doc):
               if not re.match(r"[a-z]+:", target) and not target.startswith("#")
               and not (path.parent / target.split("#")[0]).exists()]
     assert not broken, f"{doc}: broken links {broken}"
+
+
+PYTHON_BLOCK = re.compile(r"^\s*```python\n(.*?)^\s*```", re.S | re.M)
+
+
+@pytest.mark.parametrize("doc", list(ALL_COMMANDS))
+def test_python_examples_compile(doc):
+    """```python blocks are not run (they may be fragments), but they must be valid Python."""
+    text = (ROOT / doc).read_text(encoding="utf-8")
+    for block in PYTHON_BLOCK.findall(text):
+        compile(textwrap.dedent(block), doc, "exec")
 
 
 def test_every_doc_page_with_commands_is_collected():
@@ -317,20 +368,19 @@ def test_skipped_by_rule(cmd, part, reason):
                 "(rule: docs/extending.md, 'Writing docs')")
 
 
-@pytest.mark.parametrize("doc", RUN_FILES)
-def test_doc_commands_run(doc, tmp_path, shim_bin):
-    for name in LINKED:
-        (tmp_path / name).symlink_to(ROOT / name, target_is_directory=True)
+@pytest.fixture(scope="module")
+def doc_runs(request, shim_bin, tmp_path_factory) -> dict:
+    """Run the selected doc files, WORKERS at a time (each in its own folder, its commands in
+    order); {doc: future of its first failure or None}."""
+    selected = [item.callspec.params["doc"] for item in request.session.items
+                if getattr(item, "originalname", "") == "test_doc_commands_run"]
     env = doc_environment(shim_bin)
-    for cmd in ALL_COMMANDS[doc]:
-        if not cmd.text:
-            continue
-        code, out, err, _ = run_command(cmd, tmp_path, env)
-        tail = "\n".join((out + err).strip().splitlines()[-15:])
-        assert code == cmd.expect_exit, \
-            f"{cmd.where}: `{cmd.text}` exited {code} (expected {cmd.expect_exit}):\n{tail}"
-        if cmd.expect_exit:
-            lines = err.strip().splitlines()
-            assert len(lines) == 1, f"{cmd.where}: expected one line on stderr, got:\n{err}"
-        else:
-            check_outputs(cmd, tmp_path)
+    with ThreadPoolExecutor(max_workers=WORKERS) as pool:
+        return {doc: pool.submit(run_doc, doc, tmp_path_factory.mktemp("doc"), env)
+                for doc in selected}
+
+
+@pytest.mark.parametrize("doc", RUN_FILES)
+def test_doc_commands_run(doc, doc_runs):
+    failure = doc_runs[doc].result()
+    assert failure is None, failure

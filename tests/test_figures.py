@@ -82,6 +82,20 @@ def test_runup_and_compare_figures(tmp_path, monkeypatch, saved):
     _assert_clean(saved, ["compare.png"], "compare", panel_legends=False)
 
 
+def test_runup_body_figures(tmp_path, monkeypatch, saved):
+    engine = str(ROOT / "engines" / "default-modal-body.toml")
+    run(tmp_path, monkeypatch, "runup", "--engine", engine, "--solver", "harmonic", "--from",
+        "1000", "--to", "3000", "--step", "1000", "--plot", "body.png", "--path-plot",
+        "paths.png", "--quiet")
+    _assert_clean(saved, ["body.png", "paths.png"], "runup", panel_legends=False)
+
+
+def test_runup_sweep_figure(tmp_path, monkeypatch, saved):
+    run(tmp_path, monkeypatch, "runup", "--from", "2000", "--to", "3000", "--sweep", "500",
+        "--sample-rate", "4096", "--plot", "sweep.png", "--quiet")
+    _assert_clean(saved, ["sweep.png"], "runup", panel_legends=False)
+
+
 def test_whatif_figures(tmp_path, monkeypatch, saved):
     run(tmp_path, monkeypatch, "whatif", "--variants", VARIANTS, "--measured", MEASURED,
         "--from", "1000", "--to", "3000", "--step", "1000", "--workers", "1", "--quiet",
@@ -122,6 +136,18 @@ def test_excitation_figure(tmp_path, monkeypatch, saved):
 def test_modes_figure(tmp_path, monkeypatch, saved, args):
     run(tmp_path, monkeypatch, "modes", *args, "--plot", "modes.png")
     _assert_clean(saved, ["modes.png"], "modes")
+
+
+def test_track_figures(tmp_path, monkeypatch, saved):
+    from powertrain import signals
+    from powertrain.iotools.raw_csv import write_raw_csv
+    write_raw_csv(tmp_path / "sweep.csv",
+                  signals.analytic_sweep(duration=4.0, rpm0=1500.0, rpm1=4500.0),
+                  comment="SYNTHETIC: analytic sweep")
+    run(tmp_path, monkeypatch, "track", "sweep.csv", "--quantity", "acceleration",
+        "--orders", "0.5:8:0.5", "--quiet", "--plot", "orders.png", "--map", "maps.png")
+    _assert_clean(saved, ["orders.png"], "track", panel_legends=False)
+    _assert_clean(saved, ["maps.png"], "track")
 
 
 # --------------------------------------------------------------------------- checker

@@ -1,8 +1,9 @@
 """Bad input, all of it (issue 10, item 6): property-based campaign over every input kind.
 
 Hypothesis mutates valid seeds of every input kind -- engine TOML, mount TOML, pressure CSV,
-stiffness CSV, measured CSV and HDF5, what-if variants TOML and option specs (``--freq``,
-``--effect``, ``--scale``, ``--set``, ``--move``, ``--rotate``, ``--target``, speeds, seeds)
+stiffness CSV, measured CSV and HDF5, what-if variants TOML, raw time-data CSV (``track``)
+and option specs (``--freq``, ``--effect``, ``--scale``, ``--set``, ``--move``,
+``--rotate``, ``--target``, speeds, seeds)
 -- and runs the command that reads it (``tests/fuzz_harness.py``). Every run must end in a
 clean one-line error naming the file or option (exit 1, no output file) or in a finite
 result; never a traceback, a hang, NaN/inf in an output, or a leftover file.

@@ -179,3 +179,19 @@ def test_torque_rod_runs_runup_and_whatif(tmp_path):
                                "torque_rod.z.stiffness=1.2", "--json", str(tmp_path / "w.json")])
     assert res.exit_code == 0, res.output
     assert "torque_rod.z" in res.output
+
+
+def test_stiffness_of_an_engine_files_mount():
+    """Oracle: an inline spring-damper's K* = k + iωc in N/mm (the torque rod's x)."""
+    res = CliRunner().invoke(main, ["stiffness", "--engine", str(TORQUE_ROD), "--mount",
+                                    "torque_rod.x", "--freq", "100", "--format", "csv"])
+    assert res.exit_code == 0, res.output
+    row = [r for r in res.output.splitlines() if r and not r.startswith(("#", "freq"))][0]
+    f, k_re, k_im = (float(v) for v in row.split(",")[:3])
+    with open(TORQUE_ROD, "rb") as fh:
+        rod = tomllib.load(fh)["mounts"]["torque_rod"]
+    assert k_re == pytest.approx(rod["stiffness"]["value"][0], rel=1e-9)
+    assert k_im == pytest.approx(2 * np.pi * 100 * rod["damping"]["value"][0], rel=1e-6)
+    for args in (["--engine", str(TORQUE_ROD), "--mount", "rod.x"], []):
+        bad = CliRunner().invoke(main, ["stiffness", *args])
+        assert bad.exit_code == 1 and len(bad.output.strip().splitlines()) == 1

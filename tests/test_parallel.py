@@ -34,3 +34,34 @@ def test_serial_executor_hands_exceptions_to_the_future():
         fut = ex.submit(int, "x")
     with pytest.raises(ValueError):
         fut.result()
+
+
+def test_diagnosis_candidate_fits_on_a_local_dask_cluster_equal_serial():
+    """The candidate fits of one diagnosis on a dask LocalCluster give the serial answer,
+    number for number (each fit is a pure function of its problem)."""
+    pytest.importorskip("distributed")
+    import numpy as np
+
+    from powertrain.analysis.orders import order_label
+    from powertrain.diagnosis import diagnose
+    from powertrain.effects import predict
+    from powertrain.iotools.engine_file import DEFAULT_ENGINE_PATH, read_engine
+    from powertrain.iotools.measured import MeasuredRunup
+    from powertrain.solvers.fast_harmonic import HarmonicModel
+    eng = read_engine(DEFAULT_ENGINE_PATH)
+    rpm = np.arange(1000.0, 6000.1, 100.0)
+    v = predict(HarmonicModel(eng, rpm), {"balancer_error": {"gain": 0.7}}).velocity
+    rng = np.random.default_rng()
+    lev = np.abs(v) / np.sqrt(2) * 10 ** (rng.normal(0, 0.5, v.shape) / 20)
+    curves = {(m, d, order_label(o)): (rpm, lev[:, 3 * i + j, int(2 * o) - 1])
+              for i, m in enumerate(eng.mount_names) for j, d in enumerate("xyz")
+              for o in (0.5, 1.0, 2.0, 4.0)}
+    meas = MeasuredRunup(curves, source="SYNTHETIC (test)")
+    kw = dict(noise_floor=1e-7, effects=["balancer_error", "mount_stiffness"],
+              band_check=False, progress=False)
+    a = diagnose(meas, eng, scheduler="serial", **kw).to_dict()
+    b = diagnose(meas, eng, scheduler="local", **kw).to_dict()
+    assert a["verdict"] == b["verdict"]
+    for x, y in zip(a["ranking"], b["ranking"]):
+        assert x["effect"] == y["effect"] and x["parameters"] == y["parameters"]
+        assert x["heldout_rms_db_after"] == y["heldout_rms_db_after"]

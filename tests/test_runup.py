@@ -136,15 +136,19 @@ def test_results_roundtrip_hdf5_and_csv(tmp_path, runups):
     assert back.channels == newm.channels
     assert back.settings["solver"] == "newmark"
     text = newm.csv_text().splitlines()
-    assert text[0] == "mount,direction,quantity,rpm,velocity_rms_mm_per_s"
+    assert text[0] == ("mount,direction,quantity,rpm,side,velocity_rms_mm_per_s,"
+                       "acceleration_rms_m_per_s2,force_rms_n")
     n_rows = len(newm.channels) * newm.rpm.size * (ORDERS.size + 1)
     assert len(text) == 1 + n_rows
     quantities = {line.split(",")[2] for line in text[1:]}
     assert quantities == {order_label(o) for o in ORDERS} | {"synthesis"}
     first = text[1].split(",")
     c = newm.channel_index(first[0], first[1])
-    assert float(first[4]) == pytest.approx(
-        newm.order_rms()[0, c, newm.order_index(float(first[2][6:]))] * 1e3, rel=1e-7)
+    k = newm.order_index(float(first[2][6:]))
+    assert first[4] == "active"
+    assert float(first[5]) == pytest.approx(newm.order_rms()[0, c, k] * 1e3, rel=1e-7)
+    assert float(first[6]) == pytest.approx(newm.order_rms("acceleration")[0, c, k], rel=1e-7)
+    assert float(first[7]) == pytest.approx(newm.order_rms("mount_force")[0, c, k], rel=1e-7)
 
 
 def _cli(args, cwd):
@@ -161,7 +165,7 @@ def test_cli_runup_writes_hdf5_csv_and_plot(tmp_path):
     back = RunupResult.from_hdf5(tmp_path / "r.h5")
     np.testing.assert_array_equal(back.rpm, [1000.0, 1500.0, 2000.0])
     assert (tmp_path / "r.csv").read_text().startswith(
-        "mount,direction,quantity,rpm,velocity_rms_mm_per_s\n")
+        "mount,direction,quantity,rpm,side,velocity_rms_mm_per_s,")
     assert (tmp_path / "r.png").stat().st_size > 10_000
 
 

@@ -23,6 +23,20 @@ from powertrain.physics.mount_network import ground_force_rows
 from powertrain.physics.rigid_body import direction_row, point_motion_matrix, rigid_body_mass_matrix
 
 DIRECTIONS = ("x", "y", "z")
+#: Suffix of the body-side (passive) channel of a mount: ``left/passive``.
+PASSIVE = "/passive"
+
+
+def passive_name(mount: str) -> str:
+    """Channel name of the body side of ``mount``."""
+    return f"{mount}{PASSIVE}"
+
+
+def split_side(name: str):
+    """``("left", "passive")`` for ``left/passive``, ``(name, "active")`` otherwise."""
+    if name.endswith(PASSIVE):
+        return name[:-len(PASSIVE)], "passive"
+    return name, "active"
 
 
 @dataclass
@@ -54,6 +68,54 @@ class AssembledSystem:
     #: per network: (row (6,) mapping q_rb to the engine-side node, first internal dof,
     #: number of internal dofs, MountModel)
     networks: list = field(default_factory=list)
+    #: the body under the mounts (None or rigid: fixed base)
+    chassis: object = None
+    #: first coordinate of the body modes (modal chassis; n_dof otherwise)
+    body_start: int = 0
+    #: names of the mounts, in order (their engine-side channels come first)
+    mount_names: list = field(default_factory=list)
+    #: rotation (3, 3) of every mount (columns = local axes in engine axes)
+    mount_axes: list = field(default_factory=list)
+
+    def __post_init__(self):
+        if not self.body_start:
+            self.body_start = self.M.shape[0]
+        if not self.mount_names:
+            self.mount_names = list(dict.fromkeys(m for m, _ in self.channels))
+
+    @property
+    def n_mount_channels(self) -> int:
+        """Engine-side channels (the first rows of the output matrices)."""
+        return 3 * len(self.mount_names)
+
+    def add_body_side(self, chassis, mount_names, body0):
+        """Append the body-side channels of every mount (``NAME/passive``) and of the body
+        points of interest; their force rows are the mount's transmitted force (points: 0)."""
+        self.chassis = chassis
+        self.body_start = body0
+        self.mount_names = list(mount_names)
+        n = self.n_dof
+        rows, frows_k, frows_d, names = [], [], [], []
+        for mi, name in enumerate(mount_names):
+            names += [(passive_name(name), a) for a in DIRECTIONS]
+            rows.append(self._body_rows(chassis, name, n))
+            frows_k.append(self.force_matrix_k[3 * mi:3 * mi + 3])
+            frows_d.append(self.force_matrix_d[3 * mi:3 * mi + 3])
+        for p in chassis.points:
+            names += [(p, a) for a in DIRECTIONS]
+            rows.append(self._body_rows(chassis, p, n))
+            frows_k.append(np.zeros((3, n)))
+            frows_d.append(np.zeros((3, n)))
+        self.channels = self.channels + names
+        self.channel_matrix = np.vstack([self.channel_matrix] + rows)
+        self.force_matrix_k = np.vstack([self.force_matrix_k] + frows_k)
+        self.force_matrix_d = np.vstack([self.force_matrix_d] + frows_d)
+
+    def _body_rows(self, chassis, name, n):
+        rows = np.zeros((3, n))
+        if chassis.model == "modal":
+            rows[:, self.body_start:] = chassis.shape_matrix(name)
+        return rows
 
     @property
     def n_dof(self) -> int:
@@ -86,8 +148,8 @@ class AssembledSystem:
         return np.sqrt(np.clip(w2, 0, None)) / (2 * np.pi), vec
 
 
-def assemble(mass, cg, inertia, mounts) -> AssembledSystem:
-    """Assemble the rigid body and its mounts.
+def assemble(mass, cg, inertia, mounts, chassis=None) -> AssembledSystem:
+    """Assemble the rigid body, its mounts and (optionally) a modal body under them.
 
     Parameters
     ----------
@@ -100,9 +162,17 @@ def assemble(mass, cg, inertia, mounts) -> AssembledSystem:
     mounts : sequence
         Objects with ``name``, ``position`` (3,) [m, engine axes], ``rotation`` (3, 3)
         (columns = local x, y, z in engine axes) and ``directions`` {"x"|"y"|"z": MountModel}.
+    chassis : Chassis, optional
+        ``modal``: the body modes become the last coordinates; each network's base node moves
+        with the body at its mount's attachment point. ``frf`` is coupled in the harmonic
+        solver only (:mod:`powertrain.solvers.harmonic`); ``rigid`` or None: fixed base.
+
+    Outputs: the channels of every mount's engine-side point; with a non-rigid chassis also
+    its body side (``NAME/passive``) and the body points of interest.
     """
     cg = np.asarray(cg, float)
-    blocks = []   # (row 1x6, M_net, C_net, K_net, kg, dg, mount index, local axis)
+    modal = chassis is not None and chassis.model == "modal"
+    blocks = []
     n_int_total = 0
     labels = ["u_x", "u_y", "u_z", "theta_x", "theta_y", "theta_z"]
     for mi, mount in enumerate(mounts):
@@ -110,14 +180,15 @@ def assemble(mass, cg, inertia, mounts) -> AssembledSystem:
         R = np.asarray(mount.rotation, float)
         for ai, axis in enumerate(DIRECTIONS):
             model = mount.directions[axis]
-            e = R[:, ai]
-            Mn, Cn, Kn = model.matrices()
+            Mn, Cn, Kn = model.matrices(include_ground=modal)
             masses, elem_nodes, c, d = model.network()
             kg, dg = ground_force_rows(masses.size, elem_nodes, c, d)
-            blocks.append((direction_row(r, e), Mn, Cn, Kn, kg, dg, mi, ai))
+            blocks.append((direction_row(r, R[:, ai]), Mn, Cn, Kn, kg, dg, mi, ai))
             labels += [f"{mount.name}.{axis}.m{j + 1}" for j in range(masses.size)]
             n_int_total += masses.size
-    n = 6 + n_int_total
+    n_body = len(chassis.modes) if modal else 0
+    body0 = 6 + n_int_total
+    n = body0 + n_body
     M = np.zeros((n, n))
     C = np.zeros((n, n))
     K = np.zeros((n, n))
@@ -125,24 +196,39 @@ def assemble(mass, cg, inertia, mounts) -> AssembledSystem:
     n_m = len(mounts)
     Fk = np.zeros((3 * n_m, n))
     Fd = np.zeros((3 * n_m, n))
+    shapes = {m.name: chassis.shape_matrix(m.name) for m in mounts} if modal else {}
     start = 6
     networks = []
     for row, Mn, Cn, Kn, kg, dg, mi, ai in blocks:
-        ni = Mn.shape[0] - 1
-        L = np.zeros((ni + 1, n))
+        ni = kg.size - 1
+        e = np.asarray(mounts[mi].rotation, float)[:, ai]
+        L = np.zeros((Mn.shape[0], n))
         L[0, :6] = row
-        L[1:, start:start + ni] = np.eye(ni)
+        L[1:ni + 1, start:start + ni] = np.eye(ni)
+        if modal:
+            L[ni + 1, body0:] = e @ shapes[mounts[mi].name]       # base node on the body
         M += L.T @ Mn @ L
         C += L.T @ Cn @ L
         K += L.T @ Kn @ L
-        # force on ground along the local axis, expressed in engine axes
-        e = np.asarray(mounts[mi].rotation, float)[:, ai]
-        Fk[3 * mi:3 * mi + 3] += np.outer(e, kg @ L)
-        Fd[3 * mi:3 * mi + 3] += np.outer(e, dg @ L)
+        # force on the base along the local axis, expressed in engine axes
+        fk = kg @ L[:ni + 1] - (kg.sum() * L[ni + 1] if modal else 0.0)
+        fd = dg @ L[:ni + 1] - (dg.sum() * L[ni + 1] if modal else 0.0)
+        Fk[3 * mi:3 * mi + 3] += np.outer(e, fk)
+        Fd[3 * mi:3 * mi + 3] += np.outer(e, fd)
         networks.append((row, start, ni, mounts[mi].directions[DIRECTIONS[ai]]))
         start += ni
+    for k, mode in enumerate(chassis.modes if modal else ()):
+        j = body0 + k
+        M[j, j] += mode.modal_mass
+        C[j, j] += 2.0 * mode.damping_ratio * mode.omega * mode.modal_mass
+        K[j, j] += mode.omega ** 2 * mode.modal_mass
+        labels.append(f"body_mode_{k + 1}")
     channels = [(m.name, a) for m in mounts for a in DIRECTIONS]
     Cm = np.zeros((3 * n_m, n))
     for mi, mount in enumerate(mounts):
         Cm[3 * mi:3 * mi + 3, :6] = point_motion_matrix(np.asarray(mount.position, float) - cg)
-    return AssembledSystem(M, C, K, channels, Cm, Fk, Fd, labels, networks)
+    system = AssembledSystem(M, C, K, channels, Cm, Fk, Fd, labels, networks)
+    system.mount_axes = [np.asarray(m.rotation, float) for m in mounts]
+    if chassis is not None and not chassis.is_rigid:
+        system.add_body_side(chassis, [m.name for m in mounts], body0)
+    return system

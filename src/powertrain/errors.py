@@ -6,6 +6,9 @@ line and column), so that the command line can print one line and exit non-zero.
 
 from __future__ import annotations
 
+#: Longest error line: a value quoted from a damaged file is cut, the file and key stay.
+MAX_LINE = 400
+
 
 class InputError(ValueError):
     """Bad input file or value.
@@ -40,4 +43,5 @@ class InputError(ValueError):
             where.append(f"key '{self.key}'")
         prefix = ": ".join([", ".join(where)]) if where else ""
         text = f"{prefix}: {self.message}" if prefix else self.message
-        return " ".join(text.split())
+        text = " ".join(text.split())
+        return text if len(text) <= MAX_LINE else text[:MAX_LINE - 3] + "..."

@@ -24,7 +24,6 @@ Results do not depend on the choice: every job is a pure function of its argumen
 from __future__ import annotations
 
 import os
-import sys
 from concurrent.futures import Future, ProcessPoolExecutor
 from contextlib import contextmanager
 
@@ -138,7 +137,7 @@ def run_map(fn, items, scheduler=None, *, workers=None, progress=None):
 
 
 def progress_bar(total, desc, quiet=False):
-    """tqdm bar on stderr; disabled when ``quiet`` or stderr is not a terminal."""
-    from tqdm import tqdm
-    return tqdm(total=total, desc=desc, file=sys.stderr, leave=False,
-                disable=quiet or not sys.stderr.isatty())
+    """tqdm bar on stderr (:func:`powertrain.progress.progress_bar`); disabled when
+    ``quiet`` or stderr is not a terminal."""
+    from powertrain.progress import progress_bar as bar
+    return bar(None, enabled=not quiet, total=total, desc=desc)

@@ -21,9 +21,21 @@ HDF5 layout (all arrays SI, units in each dataset's ``unit`` attribute)::
     /diagnostics/rigid_body_modes_hz (6,)                 Hz
     /diagnostics/solver_seconds     ()                    s
 
+    /channels/side         (n_ch,) str                    active (engine side) / passive (body)
+    /channels/location     (n_ch,) str                    mount or body-point name
+    /path_contribution/velocity (n_rpm, 3 n_points, 3 n_mounts, n_orders) complex  m/s
+                           (with body points: velocity at each body-point channel carried
+                           by each path mount × local direction; /points, /paths name them)
+
+Channels: every mount's engine side (``left``), with a modal or measured chassis also its
+body side (``left/passive``) and the body points of interest (``seat_rail``).
+
 Long-format CSV (also the measured-data format): columns
-``mount,direction,quantity,rpm,velocity_rms_mm_per_s`` with ``quantity`` = ``order_0.5``,
-``order_1``, ... ``order_8`` or ``synthesis``.
+``mount,direction,quantity,rpm,side,velocity_rms_mm_per_s,acceleration_rms_m_per_s2,
+force_rms_n`` with ``quantity`` = ``order_0.5``, ``order_1``, ... ``order_8`` or
+``synthesis``, ``side`` = ``active`` or ``passive``; ``force_rms_n`` is the force the mount
+transmits to the body (empty for body points). Files with only the first four columns and
+``velocity_rms_mm_per_s`` stay valid input.
 """
 
 from __future__ import annotations
@@ -42,7 +54,9 @@ QUANTITIES = {
     "acceleration": "m/s^2",
     "mount_force": "N",
 }
-CSV_HEADER = "mount,direction,quantity,rpm,velocity_rms_mm_per_s"
+#: Columns written by :meth:`RunupResult.csv_text` (files with only the first five stay valid).
+CSV_HEADER = ("mount,direction,quantity,rpm,side,velocity_rms_mm_per_s,"
+              "acceleration_rms_m_per_s2,force_rms_n")
 
 
 @dataclass
@@ -66,6 +80,51 @@ class RunupResult:
     solver_seconds: float = 0.0
     rigid_body_modes_hz: np.ndarray = field(default_factory=lambda: np.zeros(0))
     meta: dict = field(default_factory=dict)
+    #: complex velocity at every body-point channel per mount path (mount × local
+    #: direction), shape (n_rpm, 3 n_points, 3 n_mounts, n_orders) [m/s]; None without
+    #: body points (see :func:`powertrain.runup.path_contributions`)
+    path_contribution: np.ndarray | None = None
+
+    # ----------------------------------------------------------------- both sides
+    @property
+    def mounts(self) -> list:
+        """Mount names (engine-side channels), in order."""
+        from powertrain.models.chassis import split_side
+        names = [m for m, _ in self.channels if split_side(m)[1] == "active"]
+        points = set(self.points)
+        return [m for m in dict.fromkeys(names) if m not in points]
+
+    @property
+    def points(self) -> list:
+        """Body points of interest (modal or measured chassis)."""
+        return list(self.meta.get("points", []))
+
+    def side(self, name) -> str:
+        """``active`` (engine side of a mount), ``passive`` (body side or body point)."""
+        from powertrain.models.chassis import split_side
+        return "passive" if name in self.points else split_side(name)[1]
+
+    def isolation_db(self, mount, direction, quantity="synthesis") -> np.ndarray:
+        """Isolation of a mount: 20 log10(engine-side / body-side RMS velocity) [dB]
+        per speed (needs a non-rigid chassis)."""
+        from powertrain.models.chassis import passive_name
+        a = self.curve(mount, direction, quantity)
+        b = self.curve(passive_name(mount), direction, quantity)
+        tiny = np.finfo(float).tiny
+        return 20 * np.log10(np.maximum(a, tiny) / np.maximum(b, tiny))
+
+    @property
+    def paths(self) -> list:
+        """(mount, local direction) of every transfer path, in path-contribution order."""
+        return [(m, d) for m in self.mounts for d in ("x", "y", "z")]
+
+    def path_contributions(self, point, direction, order) -> np.ndarray:
+        """Complex velocity at body point ``point`` along engine ``direction`` carried by each
+        path, for ``order``: shape (n_rpm, n_paths) [m/s]; sums to the point's velocity."""
+        if self.path_contribution is None:
+            raise KeyError("no path contributions (no body points in the chassis)")
+        row = self.points.index(point) * 3 + "xyz".index(direction)
+        return self.path_contribution[:, row, :, self.order_index(order)]
 
     # ----------------------------------------------------------------- accessors
     def order_rms(self, quantity="velocity") -> np.ndarray:
@@ -95,17 +154,27 @@ class RunupResult:
 
     # ----------------------------------------------------------------- writers
     def csv_text(self) -> str:
-        """Long-format CSV text of the velocity RMS values [mm/s]."""
+        """Long-format CSV text: RMS velocity [mm/s], acceleration [m/s²] and the force the
+        mount transmits to the body [N] per channel, side, order and speed (body points
+        have no force: empty cell)."""
+        from powertrain.models.chassis import split_side
         lines = [CSV_HEADER]
-        rms = self.order_rms("velocity") * 1e3
-        syn = self.synthesis_rms("velocity") * 1e3
-        for c, (mount, direction) in enumerate(self.channels):
-            for k, order in enumerate(self.orders):
-                q = order_label(order)
+        values = [(self.order_rms("velocity") * 1e3, self.synthesis_rms("velocity") * 1e3),
+                  (self.order_rms("acceleration"), self.synthesis_rms("acceleration")),
+                  (self.order_rms("mount_force"), self.synthesis_rms("mount_force"))]
+        points = set(self.points)
+        labels = [order_label(o) for o in self.orders] + ["synthesis"]
+        for c, (name, direction) in enumerate(self.channels):
+            base, side = split_side(name)
+            if name in points:
+                side = "passive"
+            for k, q in enumerate(labels):
                 for i, r in enumerate(self.rpm):
-                    lines.append(f"{mount},{direction},{q},{r:g},{rms[i, c, k]:.8g}")
-            for i, r in enumerate(self.rpm):
-                lines.append(f"{mount},{direction},synthesis,{r:g},{syn[i, c]:.8g}")
+                    cells = [(rms[i, c, k] if k < len(self.orders) else syn[i, c])
+                             for rms, syn in values]
+                    force = "" if name in points else f"{cells[2]:.8g}"
+                    lines.append(f"{base},{direction},{q},{r:g},{side},{cells[0]:.8g},"
+                                 f"{cells[1]:.8g},{force}")
         return "\n".join(lines) + "\n"
 
     def to_csv(self, path) -> None:
@@ -168,6 +237,25 @@ class RunupResult:
                 g.create_dataset("rigid_body_modes_hz",
                                  data=self.rigid_body_modes_hz).attrs["unit"] = "Hz"
                 g.create_dataset("solver_seconds", data=self.solver_seconds).attrs["unit"] = "s"
+                self._write_sides(h5)
+
+    def _write_sides(self, h5):
+        """/channels/side and /channels/location; /path_contribution with body points."""
+        from powertrain.models.chassis import split_side
+        g = h5["channels"]
+        g.create_dataset("side", data=np.array([self.side(m) for m, _ in self.channels],
+                                               dtype="S"))
+        g.create_dataset("location", data=np.array([split_side(m)[0] for m, _ in
+                                                    self.channels], dtype="S"))
+        if self.path_contribution is not None:
+            pg = h5.create_group("path_contribution")
+            ds = pg.create_dataset("velocity", data=self.path_contribution)
+            ds.attrs["unit"] = "m/s"
+            ds.attrs["axes"] = "rpm, point channel, path (mount x local direction), order"
+            pg.create_dataset("points", data=np.array(
+                [f"{p}.{d}" for p in self.points for d in "xyz"], dtype="S"))
+            pg.create_dataset("paths", data=np.array([f"{m}.{d}" for m, d in self.paths],
+                                                     dtype="S"))
 
     @classmethod
     def from_hdf5(cls, path) -> RunupResult:
@@ -214,9 +302,20 @@ class RunupResult:
                                                   "f", 0)),
                    rigid_body_modes_hz=_h5_array(h5, "diagnostics/rigid_body_modes_hz", path,
                                                  "f", 1),
-                   meta=_h5_json(h5, "meta", path))
+                   meta=_h5_json(h5, "meta", path),
+                   path_contribution=_h5_paths(h5, path, n))
 
     # ----------------------------------------------------------------- plots
+    def plot_paths(self, ax=None, *, path=None, order=2.0, provenance=None):
+        """Path contributions at the body points (see
+        :func:`powertrain.plotting_body.plot_path_contributions`)."""
+        from powertrain.plotting.style import target_and_path
+        from powertrain.plotting_body import plot_path_contributions
+        ax, path = target_and_path(ax, path)
+        return plot_path_contributions(self, path, order, ax=ax,
+                                       provenance=provenance or getattr(self, "provenance",
+                                                                        None))
+
     def plot(self, ax=None, *, path=None, quantities=("synthesis", "order_2", "order_4"),
              signal="velocity", others=None, channel=None, quantity=None, provenance=None):
         """The thesis's figure set (Figs 45–71): one row per mount and direction, one column
@@ -225,11 +324,19 @@ class RunupResult:
         ``ax``: None (new figure), a Figure/SubFigure (the grid) or an Axes (the one panel
         ``channel``/``quantity``); ``others``: optional list of (label, RunupResult)
         overlaid; ``provenance``: foot line (default: ``self.provenance`` if set). Returns the
-        figure; see :func:`powertrain.plotting.plot_runup`.
+        figure; see :func:`powertrain.plotting.plot_runup`. With a body model (body-side
+        channels), no ``others`` and no single panel: both sides of each mount in one panel,
+        and the body points (:func:`powertrain.plotting_body.plot_runup_both_sides`).
         """
         from powertrain.plotting import plot_runup
-        from powertrain.plotting.style import target_and_path
+        from powertrain.plotting.style import is_axes, target_and_path
         ax, path = target_and_path(ax, path)
+        if (not others and not is_axes(ax)
+                and any(self.side(m) == "passive" for m, _ in self.channels)):
+            from powertrain.plotting_body import plot_runup_both_sides
+            return plot_runup_both_sides(self, path, quantities, signal, ax=ax,
+                                         provenance=provenance or getattr(self, "provenance",
+                                                                          None))
         return plot_runup([("simulation", self)] + list(others or []), path, quantities,
                           signal, ax=ax, channel=channel, quantity=quantity,
                           provenance=provenance or getattr(self, "provenance", None))
@@ -252,6 +359,19 @@ def _h5_array(h5, key, path, kinds, ndim, shape=None):
         raise InputError(f"shape {obj.shape}, expected {want}", file=path, key=key)
     data = obj[()]
     return np.asarray(data, dtype=complex if kind == "c" else float)
+
+
+def _h5_paths(h5, path, n):
+    """/path_contribution/velocity (n_rpm, 3 n_points, 3 n_mounts, n_orders) or None."""
+    from powertrain.errors import InputError
+    if "path_contribution" not in h5:
+        return None
+    key = "path_contribution/velocity"
+    data = _h5_array(h5, key, path, "c", 4)
+    if data.shape[0] != n[0] or data.shape[3] != n[2] or data.shape[1] % 3 or data.shape[2] % 3:
+        raise InputError(f"shape {data.shape} does not fit the speeds and orders", file=path,
+                         key=key)
+    return data
 
 
 def _h5_names(h5, key, path) -> list[str]:

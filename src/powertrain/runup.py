@@ -125,7 +125,14 @@ def _run_runup(engine, rpm=None, *, solver="newmark", angle_step_deg=ANGLE_STEP_
         raise ValueError("need cycles >= processed_cycles >= 1")
     if system is None:
         b = engine.body
-        system = assemble(b.mass, b.cg, b.inertia, engine.mounts)
+        system = assemble(b.mass, b.cg, b.inertia, engine.mounts,
+                          getattr(engine, "chassis", None))
+    chassis = getattr(system, "chassis", None)
+    if solver == "newmark" and chassis is not None and chassis.model == "frf":
+        from powertrain.errors import InputError
+        raise InputError("a measured-receptance chassis (model = \"frf\") is coupled in the "
+                         "frequency domain only: use the harmonic solver",
+                         file=chassis.file or None, key="chassis.model")
     n_ch = len(system.channels)
     shape = (rpm.size, n_ch, ORDERS.size)
     disp = np.zeros(shape, complex)
@@ -174,6 +181,9 @@ def _run_runup(engine, rpm=None, *, solver="newmark", angle_step_deg=ANGLE_STEP_
             d_c, v_c, a_c, f_c = (Y[:-1, k * n_ch:(k + 1) * n_ch] for k in range(4))
             _post(i, d_c, v_c, a_c, f_c, None)
             return
+        if chassis is not None and chassis.model == "frf":
+            _frf_orders(i, fh, omegas)
+            return
         qh = harmonic_response(system, fh, omegas)
         if solver == "harmonic":
             j = np.round(ORDERS * 2).astype(int)
@@ -201,6 +211,23 @@ def _run_runup(engine, rpm=None, *, solver="newmark", angle_step_deg=ANGLE_STEP_
         win = slice(start, start + processed_cycles * n_cycle)
         d_c, v_c, a_c, f_c = _outputs(system, X[win], V[win], A[win])
         _post(i, d_c, v_c, a_c, f_c, (X, V, A, start))
+
+    def _frf_orders(i, fh, omegas):
+        """Harmonic solve with a measured-receptance body (admittance coupling)."""
+        from powertrain.solvers.admittance import frf_response
+        j = np.round(ORDERS * 2).astype(int)
+        q, body, fb = frf_response(system, fh[j], omegas[j])
+        n_a = system.n_mount_channels
+        x = np.hstack([q @ system.channel_matrix[:n_a].T, body])          # (n_orders, n_ch)
+        w = omegas[j][:, None]
+        disp[i] = x.T
+        vel[i] = (1j * w * x).T
+        acc[i] = (-(w ** 2) * x).T
+        f = np.hstack([fb, fb, np.zeros((len(j), x.shape[1] - 2 * n_a))])
+        force[i] = f.T
+        _, _, f0 = frf_response(system, fh[:1], omegas[:1])
+        mean_force[i] = np.hstack([f0[0].real, f0[0].real,
+                                   np.zeros(x.shape[1] - 2 * n_a)])
 
     def _post(i, d_c, v_c, a_c, f_c, states):
         """Order analysis and periodicity of the processed window (Newmark)."""
@@ -253,9 +280,40 @@ def _run_runup(engine, rpm=None, *, solver="newmark", angle_step_deg=ANGLE_STEP_
                 f"(orders <= {INITIAL_STATE_MAX_ORDER:g})"
                 if solver == "newmark" else ""}
     modes_hz, _ = system.rigid_body_modes()
+    paths = None
+    if chassis is not None and not chassis.is_rigid and chassis.points:
+        paths = path_contributions(system, rpm, force)
     return RunupResult(rpm=rpm, orders=ORDERS.copy(), channels=list(system.channels),
                        displacement=disp, velocity=vel, acceleration=acc, mount_force=force,
                        mean_mount_force=mean_force, periodicity=periodicity,
                        settings=settings, solver_seconds=solver_seconds,
-                       rigid_body_modes_hz=modes_hz,
-                       meta={"engine": getattr(engine, "name", "")})
+                       rigid_body_modes_hz=modes_hz, path_contribution=paths,
+                       meta={"engine": getattr(engine, "name", ""),
+                             "chassis": "rigid" if chassis is None else chassis.model,
+                             "points": list(chassis.points) if chassis is not None else []})
+
+
+def path_contributions(system, rpm, force) -> np.ndarray:
+    r"""Velocity at every body-point channel carried by each mount path (mount × local
+    direction), complex, per speed and order [m/s]:
+    :math:`\hat v_{P,(m,d)} = i\omega\,\mathbf G_{Pm}(\omega)\,\mathbf e_d\,
+    (\mathbf e_d\cdot\hat{\mathbf f}_m)`, :math:`\hat{\mathbf f}_m` the force mount m puts on
+    the body (engine axes) and :math:`\mathbf G_{Pm}` the body's receptance. The paths of a
+    point sum to its velocity (the body is loaded through the mounts only).
+
+    Returns
+    -------
+    ndarray complex (n_rpm, 3 n_points, 3 n_mounts, n_orders)
+    """
+    ch = system.chassis
+    mounts = system.mount_names
+    n_a = system.n_mount_channels
+    out = np.zeros((len(rpm), 3 * len(ch.points), n_a, ORDERS.size), complex)
+    from scipy.linalg import block_diag
+    E = block_diag(*system.mount_axes)          # column p: local axis of path p, at its mount
+    w = np.outer(np.asarray(rpm, float) * 2 * np.pi / 60.0, ORDERS)      # (n_rpm, n_orders)
+    G = ch.receptances(w, list(ch.points), mounts).reshape(w.shape + (3 * len(ch.points), n_a))
+    GE = G @ E                                                     # (n_rpm, n_o, 3 n_p, n_a)
+    f_local = np.einsum("ap,ika->ikp", E, np.moveaxis(force[:, :n_a, :], 1, 2))   # e_p . f
+    out[:] = np.moveaxis(1j * w[..., None, None] * GE * f_local[:, :, None, :], 1, 3)
+    return out

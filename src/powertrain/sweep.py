@@ -29,10 +29,11 @@ core does not oversubscribe.
 from __future__ import annotations
 
 import os
-from concurrent.futures import Future
 from dataclasses import dataclass, field
 
 import numpy as np
+
+from powertrain.parallel import SerialExecutor  # noqa: F401 (one serial executor)
 
 
 @dataclass(frozen=True)
@@ -85,18 +86,6 @@ def run_task(task: SweepTask):
         result = run_runup(engine, task.rpm, solver=task.solver, **task.options)
     result.meta["variant"] = task.name
     return result
-
-
-class SerialExecutor:
-    """Runs each submitted call at once in this process (the ``workers=1`` executor)."""
-
-    def submit(self, fn, *args, **kwargs) -> Future:
-        fut: Future = Future()
-        try:
-            fut.set_result(fn(*args, **kwargs))
-        except BaseException as exc:  # delivered by result(), as a pool would
-            fut.set_exception(exc)
-        return fut
 
 
 def default_workers() -> int:

@@ -199,10 +199,13 @@ class TrackedOrders:
         o = float(quantity.split("_", 1)[1])
         return self.order_rms()[:, c, int(np.argmin(np.abs(self.orders - o)))]
 
-    def plot(self, path=None, quantities=None):
-        """Order curves (RMS against rpm), one panel per channel."""
+    def plot(self, ax=None, *, path=None, quantities=None, provenance=None):
+        """Order curves (RMS against rpm), one panel per channel; returns the figure."""
+        from powertrain.plotting.style import target_and_path
         from powertrain.plotting_orders import plot_tracked
-        return plot_tracked(self, path, quantities)
+        ax, path = target_and_path(ax, path)
+        return plot_tracked(self, path, quantities, ax=ax,
+                            provenance=provenance or getattr(self, "provenance", None))
 
 
 def _label(ch) -> str:

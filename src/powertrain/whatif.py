@@ -83,6 +83,41 @@ class WhatIfResult:
     measured: object = None
     target_fits: list = field(default_factory=list)
     signal: str = "velocity"
+    #: optional response to minimise: (channel, direction, quantity, rpm_lo, rpm_hi)
+    objective: tuple | None = None
+
+    def objective_changes(self) -> list:
+        """Variants ranked by the mean change of the objective response over its speed band
+        [dB], best (most negative) first: ``name``, ``mean_delta_db``,
+        ``baseline_rms_si`` and ``variant_rms_si`` (mean levels over the band, SI)."""
+        if self.objective is None:
+            return []
+        name, d, q, lo, hi = self.objective
+        rpm = np.asarray(self.baseline.rpm, float)
+        band = (rpm >= lo - 1e-9) & (rpm <= hi + 1e-9)
+        base = self.baseline.curve(name, d, q, self.signal)
+        out = []
+        for v in self.variants:
+            var = v.result.curve(name, d, q, self.signal)
+            dd = delta_db(base, var)[band]
+            ok = np.isfinite(dd)
+            out.append({"name": v.name,
+                        "mean_delta_db": float(np.mean(dd[ok])) if ok.any() else None,
+                        "baseline_rms_si": float(np.mean(base[band])),
+                        "variant_rms_si": float(np.mean(var[band]))})
+        return sorted(out, key=lambda r: np.inf if r["mean_delta_db"] is None
+                      else r["mean_delta_db"])
+
+    def objective_text(self) -> str:
+        if self.objective is None:
+            return ""
+        name, d, q, lo, hi = self.objective
+        lines = [f"objective: minimise {name}.{d} {q} RMS {self.signal.replace('_', ' ')} at "
+                 f"{lo:g}-{hi:g} rpm (mean change over the band, best first)"]
+        for r in self.objective_changes():
+            val = "-" if r["mean_delta_db"] is None else f"{r['mean_delta_db']:+.2f} dB"
+            lines.append(f"  {val:>10}  {r['name']}")
+        return "\n".join(lines)
 
     # ------------------------------------------------------------------ numbers
     def variant(self, name: str) -> VariantRun:
@@ -150,6 +185,10 @@ class WhatIfResult:
                 "quantities": list(self.quantities),
                 "baseline": base,
                 "targets": [tf.to_dict() for tf in self.target_fits],
+                "objective": None if self.objective is None else {
+                    "channel": self.objective[0], "direction": self.objective[1],
+                    "quantity": self.objective[2], "rpm": list(self.objective[3:]),
+                    "ranking": self.objective_changes()},
                 "variants": [{"name": v.name, "operations": list(v.specs),
                               "rigid_body_modes_hz": [float(f) for f in
                                                       v.result.rigid_body_modes_hz],

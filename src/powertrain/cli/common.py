@@ -174,7 +174,10 @@ def cli_provenance(engine: str = ""):
 def engine_description(engine, path, *, no_balancers=False, effects=()) -> str:
     """``name (file)`` plus what the command line changed (balancers off, effects)."""
     import os
-    rel = os.path.relpath(str(path))
+    try:
+        rel = os.path.relpath(str(path))
+    except ValueError:          # another drive (Windows)
+        rel = ".."
     shown = rel if not rel.startswith("..") else os.path.basename(str(path))
     text = f"{engine.name} ({shown})"
     if no_balancers:

@@ -25,8 +25,13 @@ from powertrain.cli import main
               help="Comma-separated candidates (default: all of the library).")
 @click.option("--no-pairs", is_flag=True, help="Do not try pairs of effects.")
 @click.option("--quiet", is_flag=True, help="No progress indicator on stderr.")
+@click.option("--scheduler", default=None, metavar="local|tcp://HOST:PORT",
+              help="Run the candidate fits on dask.distributed: 'local' (a LocalCluster on "
+                   "this machine's cores) or an existing scheduler's address; also "
+                   "'processes' or 'serial'. Default: serial (starts fastest). Same result "
+                   "on every scheduler.")
 def diagnose(measured, engine_file, report_dir, json_file, noise_floor, effects, no_pairs,
-             quiet):
+             quiet, scheduler):
     """Diagnose the gap between the simulated and a measured run-up.
 
     1. Where: the gap map per channel, quantity and speed, the regions beyond +-3 dB and
@@ -60,7 +65,9 @@ def diagnose(measured, engine_file, report_dir, json_file, noise_floor, effects,
             raise InputError(f"unknown effect {e!r} (known: {', '.join(EFFECTS)})",
                              key="--effects")
     from powertrain.cli.common import check_outputs, write_json
+    from powertrain.parallel import check_scheduler
     from powertrain.progress import activity
+    scheduler = check_scheduler(scheduler or "serial")
     check_outputs(json=json_file)
     if report_dir:
         from powertrain.iotools.atomic import check_writable
@@ -72,7 +79,7 @@ def diagnose(measured, engine_file, report_dir, json_file, noise_floor, effects,
                          f"(this file holds {meas.signal})", file=measured)
     with activity("diagnose (fitting the effect library)", enabled=not quiet):
         res = run(meas, engine, noise_floor=noise_floor * 1e-3, effects=names,
-                  pairs=not no_pairs)
+                  pairs=not no_pairs, scheduler=scheduler, progress=False)
     click.echo(res.summary())
     if json_file:
         from powertrain.provenance import provenance

@@ -30,6 +30,11 @@ from powertrain.cli.common import speed_options, speed_steps
                    "velocity_rms_mm_per_s).")
 @click.option("--plot", type=click.Path(dir_okay=False),
               help="Thesis figure set (Figs 45-71) as PNG.")
+@click.option("--path-plot", type=click.Path(dir_okay=False),
+              help="Path contributions at the body points of a modal or measured chassis "
+                   "(PNG), at --path-order.")
+@click.option("--path-order", type=float, default=2.0, show_default=True,
+              help="Engine order of the path-contribution plot.")
 @click.option("--no-balancers", is_flag=True, help="Switch the balancer shafts off.")
 @click.option("--effect", multiple=True, metavar="NAME[:PARAM=VALUE,...]",
               help="Add an unmodelled effect of the diagnosis library (as in `whatif`), e.g. "
@@ -43,7 +48,7 @@ from powertrain.cli.common import speed_options, speed_steps
               help="With --sweep: sampling rate of the raw data [Hz].")
 @click.option("--quiet", is_flag=True, help="No progress bar and no table.")
 def runup(rpm_from, rpm_to, rpm_step, engine_file, solver, stepper, angle_step, out, csv_file,
-          plot, no_balancers, effect, sweep, raw_file, sample_rate, quiet):
+          plot, path_plot, path_order, no_balancers, effect, sweep, raw_file, sample_rate, quiet):
     """Run-up: steady-state mount-point velocities at each speed, order analysed.
 
     Prints the rigid-body modes and the synthesis (RMS sum of orders 0.5..8) velocity of the
@@ -56,6 +61,7 @@ def runup(rpm_from, rpm_to, rpm_step, engine_file, solver, stepper, angle_step, 
       powertrain runup --out runup.h5 --no-balancers
       powertrain runup --solver harmonic --csv runup.csv --plot runup.png
       powertrain runup --effect amplitude_stiffness:kappa=1,a_c=0.02mm
+      powertrain runup --engine engines/default-modal-body.toml --path-plot paths.png
       powertrain runup --from 2000 --to 3000 --sweep 200 --raw sweep.h5 --csv sweep.csv
     """
     from powertrain.cli.common import check_outputs, checked_runup, runup_settings
@@ -63,9 +69,12 @@ def runup(rpm_from, rpm_to, rpm_step, engine_file, solver, stepper, angle_step, 
     from powertrain.runup import run_runup
 
     rpm = speed_steps(rpm_from, rpm_to, rpm_step)
-    check_outputs(out=out, csv=csv_file, plot=plot)
+    check_outputs(out=out, csv=csv_file, plot=plot, path_plot=path_plot)
     engine_path = engine_file or DEFAULT_ENGINE_PATH
     engine = read_engine(engine_path)
+    engine.require_excitation()
+    if path_plot:
+        _check_path_plot(engine, path_order)
     modifications = []
     if no_balancers:
         engine = engine.with_balancers(enabled=False)
@@ -104,18 +113,37 @@ def runup(rpm_from, rpm_to, rpm_step, engine_file, solver, stepper, angle_step, 
     if csv_file:
         result.to_csv(csv_file)
         written.append(csv_file)
-    if plot:
+    if plot or path_plot:
         from powertrain.cli.common import cli_provenance, engine_description, write_plot
         fig_prov = cli_provenance(engine_description(engine, engine_path, no_balancers=no_balancers,
                                                  effects=effect))
+    if plot:
         write_plot(lambda p: result.plot(path=p, provenance=fig_prov), plot)
         written.append(plot)
+    if path_plot:
+        write_plot(lambda p: result.plot_paths(path=p, order=path_order, provenance=fig_prov),
+                   path_plot)
+        written.append(path_plot)
     if quiet:
         return
     _print_table(result, engine, engine_path, solver, scenario)
     click.echo(f"solver time: {result.solver_seconds:.3f} s; "
                + (f"wrote {', '.join(map(str, written))}" if written else
                   "no file written (ask with --out, --csv or --plot)"))
+
+
+def _check_path_plot(engine, path_order):
+    """--path-plot needs body points; --path-order must be an analysed order."""
+    import numpy as np
+
+    from powertrain.analysis.orders import ORDERS
+    from powertrain.errors import InputError
+    if not getattr(engine.chassis, "points", ()):
+        raise InputError("needs body points ([chassis.points.NAME] with a modal or frf "
+                         "chassis)", file=engine.file, key="--path-plot")
+    if not np.any(np.isclose(ORDERS, path_order)):
+        raise InputError(f"order {path_order:g} not analysed (0.5 to 8 in steps of 0.5)",
+                         key="--path-order")
 
 
 def _print_table(result, engine, engine_path, solver, scenario):

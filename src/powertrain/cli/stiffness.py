@@ -9,7 +9,12 @@ from powertrain.cli.common import plot_form_options
 
 
 @main.command()
-@click.argument("mount_file")  # checked by read_mount: one-line errors, exit 1
+@click.argument("mount_file", required=False)  # checked by read_mount: one-line errors, exit 1
+@click.option("--engine", "engine_file", type=click.Path(dir_okay=False),
+              help="Take the mount model from an engine file instead (with --mount).")
+@click.option("--mount", "mount_dir", metavar="MOUNT.DIR",
+              help="Mount and local direction of --engine, e.g. torque_rod.x (network file or "
+                   "inline spring-damper).")
 @click.option("--freq", default="1:400:1", show_default=True,
               help="Frequencies [Hz]: list 5,10,20 and/or range start:stop:step.")
 @click.option("--method", type=click.Choice(["frequency", "time"]), default="frequency",
@@ -21,7 +26,8 @@ from powertrain.cli.common import plot_form_options
 @plot_form_options
 @click.option("--engine-mass", type=float, help="Engine mass on the mount [kg] (verification set-up).")
 @click.option("--force", type=float, help="Harmonic force amplitude on the engine mass [N].")
-def stiffness(mount_file, freq, method, fmt, plot, form, freq_axis, engine_mass, force):
+def stiffness(mount_file, engine_file, mount_dir, freq, method, fmt, plot, form, freq_axis,
+              engine_mass, force):
     """Cross-point dynamic stiffness K*(f) of MOUNT_FILE: real, imaginary, magnitude, loss angle.
 
     With --engine-mass and --force it reproduces the thesis's verification set-up (a harmonic
@@ -36,11 +42,11 @@ def stiffness(mount_file, freq, method, fmt, plot, form, freq_axis, engine_mass,
           --form real-imag --freq-axis linear
       powertrain stiffness mounts/thesis-appendix-a.toml --freq 5,10,12,15,17,20,25,30,40 \\
           --engine-mass 100 --force 100 --method time --format csv
+      powertrain stiffness --engine engines/default-torque-rod.toml --mount torque_rod.x
     """
     from powertrain.analysis.stiffness_table import stiffness_table
     from powertrain.cli.common import parse_frequencies
     from powertrain.errors import InputError
-    from powertrain.iotools.mount_file import read_mount
 
     if (engine_mass is None) != (force is None):
         raise InputError("--engine-mass and --force go together", key="--engine-mass")
@@ -49,11 +55,33 @@ def stiffness(mount_file, freq, method, fmt, plot, form, freq_axis, engine_mass,
     freqs = parse_frequencies(freq)
     if method == "time" and freqs[0] <= 0:
         raise InputError("the time method needs frequencies > 0 Hz", key="--freq")
-    model = read_mount(mount_file)
+    model, label = _model(mount_file, engine_file, mount_dir)
     table = stiffness_table(model, freqs, method=method, engine_mass=engine_mass, force=force)
     if plot:
         from powertrain.cli.common import cli_provenance, write_plot
         prov = cli_provenance()
-        write_plot(lambda p: table.plot(path=p, label=model.name or mount_file, form=form,
+        write_plot(lambda p: table.plot(path=p, label=model.name or label, form=form,
                                         freq_axis=freq_axis, provenance=prov), plot)
     click.echo(table.to_csv() if fmt == "csv" else table.to_text(), nl=False)
+
+
+def _model(mount_file, engine_file, mount_dir):
+    """The mount model of MOUNT_FILE, or of --mount in --engine (an engine file without
+    excitation sections is enough)."""
+    from powertrain.errors import InputError
+    from powertrain.iotools.mount_file import read_mount
+    if (mount_file is None) == (engine_file is None):
+        raise InputError("give either MOUNT_FILE or --engine with --mount", key="MOUNT_FILE")
+    if mount_file is not None:
+        if mount_dir:
+            raise InputError("--mount goes with --engine", key="--mount")
+        return read_mount(mount_file), mount_file
+    from powertrain.iotools.engine_file import read_engine
+    engine = read_engine(engine_file)
+    parts = (mount_dir or "").split(".")
+    names = engine.mount_names
+    if len(parts) != 2 or parts[0] not in names or parts[1] not in ("x", "y", "z"):
+        raise InputError(f"expected MOUNT.DIR with MOUNT one of {', '.join(names)} and DIR "
+                         f"x/y/z, got {mount_dir!r}", key="--mount")
+    model = engine.mount(parts[0]).directions[parts[1]]
+    return model, f"{parts[0]} {parts[1]} ({engine_file})"

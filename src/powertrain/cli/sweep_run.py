@@ -31,7 +31,10 @@ def run_sweep(engine, rpm_from, rpm_to, rate, sample_rate, raw_file, out, csv_fi
     if out:
         tracked.to_hdf5(out)
     if plot:
-        tracked.plot(plot)
+        from powertrain.cli.common import cli_provenance, engine_description, write_plot
+        prov = cli_provenance(engine_description(engine, engine.file)
+                              + f", sweep {rate:g} rpm/s")
+        write_plot(lambda p: tracked.plot(path=p, provenance=prov), plot)
     if quiet:
         return
     from powertrain.cli.common import format_table

@@ -83,11 +83,14 @@ def track(raw, map_file, rpm_column, tacho_column, pulses_per_rev, orders_spec, 
         tracked.to_csv(csv_file)
     if out:
         tracked.to_hdf5(out)
+    if plot or map_png:
+        from powertrain.cli.common import cli_provenance, write_plot
+        prov = cli_provenance(f"none (raw time data {raw})")
     if plot:
-        tracked.plot(plot)
+        write_plot(lambda p: tracked.plot(path=p, provenance=prov), plot)
     if map_png:
         from powertrain.plotting_orders import plot_maps
-        plot_maps(**maps, path=map_png)
+        write_plot(lambda p: plot_maps(**maps, path=p, provenance=prov), map_png)
     if not quiet:
         _report(rec, tracked, [p for p in (csv_file, out, plot, map_png) if p])
 

@@ -56,12 +56,20 @@ from powertrain.cli.common import (
 @click.option("--signal", type=click.Choice(["velocity", "mount_force"]), default="velocity",
               show_default=True,
               help="Compared signal: mount-point velocity or force transmitted to ground.")
+@click.option("--objective", metavar="CHANNEL.DIR:QUANTITY:FROM-TO",
+              help="Response to minimise, e.g. seat_rail.z:order_2:1500-3000 (a body point), "
+                   "left/passive.z:synthesis:1000-6000 (body side of a mount) or left.z:...; "
+                   "ranks the variants by the mean change over the band [rpm].")
 @click.option("--workers", type=int, default=None,
               help="Processes for the variants (default: all local cores; 1 = serial).")
+@click.option("--scheduler", default=None, metavar="local|tcp://HOST:PORT",
+              help="Run the variants on dask.distributed: 'local' (a LocalCluster on this "
+                   "machine's cores) or an existing scheduler's address; also 'processes' "
+                   "or 'serial'. Default: a local process pool (--workers). Same results.")
 @click.option("--quiet", is_flag=True, help="No progress bar and no table.")
 def whatif(engine_file, rpm_from, rpm_to, rpm_step, solver, scale, set_, swap, move, rotate,
            effect, variants_file, target, target_out, target_plot, measured_file, plot, json_file,
-           signal, workers, quiet):
+           signal, objective, workers, scheduler, quiet):
     """What-if: run the baseline and variants of the mount system, print the change in dB.
 
     The command-line operations (--scale/--set/--swap/--move/--rotate/--effect) form one
@@ -79,6 +87,8 @@ def whatif(engine_file, rpm_from, rpm_to, rpm_step, solver, scale, set_, swap, m
       powertrain whatif --target left.z:+20%:100-300Hz --target-out left-z-retuned.toml
       powertrain whatif --variants variants.toml --measured measured.csv --plot w.png
       powertrain whatif --effect mount_stiffness:k1=1.5,k2=1.5 --effect sensor_error:g3=2
+      powertrain whatif --engine engines/default-modal-body.toml --scale left.z.stiffness=0.8 \\
+          --objective seat_rail.z:order_2:1500-3000
     """
     from powertrain.errors import InputError
     from powertrain.iotools.engine_file import DEFAULT_ENGINE_PATH, read_engine
@@ -128,9 +138,20 @@ def whatif(engine_file, rpm_from, rpm_to, rpm_step, solver, scale, set_, swap, m
         from powertrain.iotools.measured import read_measured
         measured = read_measured(measured_file, mounts=engine.mount_names)
 
+    goal = _objective(objective, engine.assemble().channels, rpm) if objective else None
     from powertrain.whatif import run_whatif
-    result = run_whatif(engine, variants, rpm, solver=solver, workers=workers,
-                        measured=measured, signal=signal, progress=not quiet)
+    if scheduler:
+        from powertrain.parallel import check_scheduler, executor
+        with executor(check_scheduler(scheduler), workers=workers,
+                      n_jobs=len(variants) + 1) as ex:
+            result = run_whatif(engine, variants, rpm, solver=solver, executor=ex,
+                                workers=workers, measured=measured, signal=signal,
+                                progress=not quiet)
+    else:
+        result = run_whatif(engine, variants, rpm, solver=solver, workers=workers,
+                            measured=measured, signal=signal, progress=not quiet)
+    if goal is not None:
+        result.objective = goal
 
     written = []
     if target_out:
@@ -162,8 +183,39 @@ def whatif(engine_file, rpm_from, rpm_to, rpm_step, solver, scale, set_, swap, m
     click.echo(f"change of RMS {signal.replace('_', ' ')} vs baseline, 20 log10(v/v0) [dB]: "
                "mean over speeds / max |d|")
     click.echo(result.table())
+    if result.objective is not None:
+        click.echo(result.objective_text())
     if written:
         click.echo(f"wrote {', '.join(written)}")
+
+
+def _objective(text, channels, rpm):
+    """Parse ``CHANNEL.DIR:QUANTITY:FROM-TO`` against the model's channels."""
+    import numpy as np
+
+    from powertrain.analysis.orders import ORDERS
+    from powertrain.errors import InputError
+    from powertrain.iotools.measured import normalise_quantity
+    form = "CHANNEL.DIR:QUANTITY:FROM-TO, e.g. seat_rail.z:order_2:1500-3000"
+    parts = [p.strip() for p in text.split(":")]
+    if len(parts) != 3 or "." not in parts[0] or "-" not in parts[2]:
+        raise InputError(f"expected {form}, got {text!r}", key="--objective")
+    name, d = parts[0].rsplit(".", 1)
+    d = d.lower()
+    if (name, d) not in channels:
+        known = sorted({m for m, _ in channels})
+        raise InputError(f"unknown channel {parts[0]!r} (channels: {', '.join(known)}; "
+                         "directions x, y, z)", key="--objective")
+    try:
+        q = normalise_quantity(parts[1])
+        if q != "synthesis" and not np.any(np.isclose(ORDERS, float(q.split("_", 1)[1]))):
+            raise ValueError(q)
+        lo, hi = (float(x) for x in parts[2].lower().removesuffix("rpm").split("-"))
+    except (ValueError, KeyError):
+        raise InputError(f"expected {form}, got {text!r}", key="--objective") from None
+    if not (lo <= hi) or not any(lo - 1e-9 <= r <= hi + 1e-9 for r in rpm):
+        raise InputError(f"no speed step in {lo:g}-{hi:g} rpm", key="--objective")
+    return (name, d, q, lo, hi)
 
 
 def _check_variant_support(engine, variant) -> None:

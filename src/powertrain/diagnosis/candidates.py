@@ -29,37 +29,48 @@ def warm_caches(hm, effects):
         EFFECTS[e].warm(hm)
 
 
-def equivalents(setup, chosen, rule) -> list:
+def _refit(setup, e, params, budget):
+    """The chosen effect refitted from an alternative start (a few evaluations)."""
+    from powertrain.diagnosis.fit import Packing, fit_candidate
+    pack = Packing.of((e,), setup.problem.engine)
+    x = np.array([math.log(params[pn]) if lg else params[pn]
+                  for (_, pn), lg in zip(pack.names, pack.log)])
+    return fit_candidate(setup.problem, (e,), starts=[x], grid=False, budget=budget)
+
+
+def _same(a, b, tol=0.01):
+    return all(abs(a[k] - b[k]) <= tol * max(1.0, abs(b[k])) for k in b)
+
+
+def equivalents(setup, chosen, rule, budget=400) -> list:
     r"""Parameter sets that explain the data as well as the chosen answer, within the noise.
 
-    For each alternative the chosen effect offers (``Effect.alternatives``: another
-    reference cylinder, swapped mirror-image mounts...) the held-out gap is evaluated; it is
-    *equivalent* when the held-out speeds do not prefer the answer significantly (per-speed
-    t ≤ ``rule.t_min``, as between rival candidates) and its training BIC is not worse by
-    more than ``rule.bic_margin``. The answer is then one of several; the report lists
-    them instead of picking one silently. (Order magnitudes only: measured phases, which
-    would separate some of them, are not read.)
+    The chosen effect is refitted from each alternative start it offers
+    (``Effect.alternatives``: another cylinder weak or strong, another reference cylinder,
+    swapped mirror-image mounts...). A refit that lands elsewhere is *equivalent* when the
+    held-out speeds do not prefer the answer significantly (per-speed t ≤ ``rule.t_min``, as
+    between rival candidates) and its training BIC is not worse by more than
+    ``rule.bic_margin``; the report lists them instead of picking one silently. (Order
+    magnitudes only: measured phases, which would separate some of them, are not read.)
     """
     if chosen is None or len(chosen.effects) != 1:
         return []
     e = chosen.effects[0]
-    p = setup.problem
     mine = CandidateEvidence(chosen.label, chosen.effects, chosen.heldout_mse,
                              chosen.heldout_per_rpm, chosen.bic)
-    out = []
-    for text, params in EFFECTS[e].alternatives(chosen.params[e], p.engine):
-        sc = {e: params}
-        g = p.gaps(sc, "test")
-        ok = np.isfinite(g)
-        per = np.array([np.mean(g[i][ok[i]] ** 2) if ok[i].any() else np.nan
-                        for i in range(g.shape[0])])
-        r = p.vector(sc)
-        n, k = r.size, chosen.n_params
-        bic = n * math.log(max(float(np.sum(r ** 2)), 1e-300) / n) + k * math.log(n)
-        alt = CandidateEvidence(e, (e,), float(np.mean(g[ok] ** 2)), per, bic)
+    out, seen = [], [chosen.params[e]]
+    for text, params in EFFECTS[e].alternatives(chosen.params[e], setup.problem.engine):
+        fo = _refit(setup, e, {**chosen.params[e], **params}, budget)
+        p = fo.params[e]
+        if any(_same(p, q) for q in seen):
+            continue
+        seen.append(p)
+        alt = CandidateEvidence(e, (e,), fo.heldout_mse, fo.heldout_per_rpm, fo.bic)
         t = improvement_t(alt, mine)
-        if t <= rule.t_min and bic - chosen.bic <= rule.bic_margin:
-            out.append({"effect": e, "parameters": params, "text": f"{e}: {text}",
-                        "heldout_rms_db": math.sqrt(alt.heldout_mse),
-                        "t_answer_vs_this": t, "train_bic_loss": bic - chosen.bic})
+        if t <= rule.t_min and fo.bic - chosen.bic <= rule.bic_margin:
+            desc = ", ".join(f"{k}={v:.3g}" for k, v in p.items())
+            out.append({"effect": e, "parameters": p, "start": text,
+                        "text": f"{e} ({desc}; refitted from '{text}')",
+                        "heldout_rms_db": fo.heldout_rms_db, "t_answer_vs_this": t,
+                        "train_bic_loss": fo.bic - chosen.bic})
     return out

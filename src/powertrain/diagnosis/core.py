@@ -38,7 +38,7 @@ from powertrain.solvers.fast_harmonic import HarmonicModel
 
 
 def diagnose(measured, engine, *, noise_floor=DEFAULT_NOISE_FLOOR, effects=None,
-             pairs=True, band_check=True, rule=None, scheduler="serial", progress=True,
+             pairs=True, band_check=True, rule=None, scheduler=None, progress=True,
              budget=EVAL_BUDGET) -> DiagnosisResult:
     """Diagnose the gap between ``engine``'s simulated run-up and ``measured``.
 
@@ -60,7 +60,8 @@ def diagnose(measured, engine, *, noise_floor=DEFAULT_NOISE_FLOOR, effects=None,
         Decision constants (default :class:`DecisionRule`).
     scheduler : str
         Where the candidate fits run (:func:`powertrain.parallel.executor`): ``serial``
-        (default), ``processes``, ``local`` (dask LocalCluster) or ``tcp://HOST:PORT``.
+        (default, also for None: it starts fastest), ``processes``, ``local`` (dask
+        LocalCluster) or ``tcp://HOST:PORT``.
         The result is the same on every scheduler.
     progress : bool
         Progress bar on stderr (only on a terminal).
@@ -79,7 +80,7 @@ def diagnose(measured, engine, *, noise_floor=DEFAULT_NOISE_FLOOR, effects=None,
     from threadpoolctl import threadpool_limits
     with threadpool_limits(limits=1, user_api="blas"):
         return _diagnose(measured, engine, noise_floor, effects, pairs, band_check,
-                         rule or DecisionRule(), scheduler, progress, budget)
+                         rule or DecisionRule(), scheduler or "serial", progress, budget)
 
 
 class _Setup:
@@ -216,7 +217,8 @@ def _diagnose(measured, engine, noise_floor, effects, pairs, do_bands, rule, sch
                                s.train_all[::max(1, s.train_all.size // 48)])
     eq = cand.equivalents(s, chosen, rule)
     text = verdict.text if not eq else verdict.text + (
-        "; the data cannot tell it from " + "; ".join(x["text"] for x in eq))
+        f"; the order magnitudes cannot tell it from {len(eq)} equivalent explanation(s): "
+        + "; ".join(x["text"] for x in eq[:3]) + ("; ..." if len(eq) > 3 else ""))
     return DiagnosisResult(
         s.data, s.src, getattr(engine, "name", ""), gap_map, gap_after, parts, rigid, found,
         sigma, s.split_dict(), baseline, outcomes, chosen, verdict.label, text, bands,

@@ -24,7 +24,8 @@ import numpy as np
 from powertrain.diagnosis.data import GapData, model_levels, residuals_db
 from powertrain.effects import EFFECTS, predict
 
-#: Residual evaluations per fit (all starts, grid and Jacobian columns included); a fit that
+#: Residual evaluations per fit (all starts, grid and Jacobian columns included; weighted by
+#: the effects' ``eval_cost``, an iterated amplitude-dependent solve counting 10); a fit that
 #: reaches it stops with the best point so far and reports ``budget_hit``.
 EVAL_BUDGET = 2500
 
@@ -58,6 +59,8 @@ class FitOutcome:
     heldout_gaps: np.ndarray | None = field(default=None, repr=False)
     status_code: object = None
     units: dict = field(default_factory=dict)
+    #: Residual evaluations spent, weighted by cost (the budget's unit).
+    n_eval: float = 0.0
 
     @property
     def label(self) -> str:
@@ -74,7 +77,7 @@ class Problem:
     def __init__(self, hm_train, hm_test, data: GapData, train_idx, test_idx, train_cells=None,
                  test_cells=None):
         self.hm = {"train": hm_train, "test": hm_test}
-        self.engine = hm_train.engine
+        self.engine = hm_train.engine       # for the effects' parameters (layout only)
         self.data = data
         self.idx = {"train": train_idx, "test": test_idx}
         om = data.order_mask
@@ -85,6 +88,13 @@ class Problem:
         for part, cells in (("train", train_cells), ("test", test_cells)):
             if cells is not None:
                 self.valid[part] = self.valid[part] & np.asarray(cells, bool)[None]
+
+    def __getstate__(self):
+        # sent to other processes (parallel fits): the engine without its pressure cache
+        state = dict(self.__dict__)
+        if hasattr(self.engine, "replace"):
+            state["engine"] = self.engine.replace()
+        return state
 
     def restricted(self, train_cells=None, test_cells=None) -> Problem:
         """The same problem with (channel, order) cells withheld from fitting / scoring."""
@@ -162,15 +172,15 @@ class _Budget(Exception):
 class _Counted:
     """Residual function with an evaluation count, a budget and the best point seen."""
 
-    def __init__(self, problem, pack, budget):
-        self.problem, self.pack, self.budget = problem, pack, budget
-        self.n = 0
+    def __init__(self, problem, pack, budget, cost=1.0):
+        self.problem, self.pack, self.budget, self.cost = problem, pack, budget, cost
+        self.n = 0.0
         self.best = (np.inf, None, None)
 
     def __call__(self, x):
         if self.n >= self.budget:
             raise _Budget
-        self.n += 1
+        self.n += self.cost
         r = self.problem.vector(self.pack.scenario(x))
         c = 0.5 * float(np.sum(r ** 2))
         if c < self.best[0]:
@@ -231,13 +241,16 @@ def fit_candidate(problem: Problem, effects, starts=None, grid=True,
     """Fit one effect or a combination on the training speeds, score on the held-out ones."""
     t0 = time.perf_counter()
     pack = Packing.of(effects, problem.engine)
-    fun = _Counted(problem, pack, budget)
-    cands = _starts(problem, pack, effects, starts, grid, fun)
-    best, nfev, hit = _least_squares(fun, pack, cands)
+    fun = _Counted(problem, pack, budget, max(EFFECTS[e].eval_cost for e in effects))
+    try:
+        cands = _starts(problem, pack, effects, starts, grid, fun)
+        best, nfev, hit = _least_squares(fun, pack, cands)
+    except _Budget:                        # spent on the start grid already
+        cands, best, nfev, hit = [pack.x0], None, 0, True
     if best is None:                       # budget spent: the best point evaluated so far
         x = fun.best[1] if fun.best[1] is not None else cands[0]
         r, J = _jacobian(fun, x, pack)
-        nfev = fun.n
+        nfev = int(fun.n)
     else:
         x, r, J = best.x, best.fun, best.jac
     n, p = r.size, len(pack.names)
@@ -250,6 +263,7 @@ def fit_candidate(problem: Problem, effects, starts=None, grid=True,
     out = score(problem, effects, pack.scenario(x), params, sigma, rss, n, p, nfev,
                 time.perf_counter() - t0, x)
     out.budget_hit = hit
+    out.n_eval = fun.n
     out.units = {e: {pn: pack.units[(e, pn)] for pn in ps} for e, ps in params.items()}
     return out
 

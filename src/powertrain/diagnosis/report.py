@@ -46,8 +46,9 @@ def _which(r) -> list:
              f"{'':>6} {b.struct_db:>9.2f}"]
     for o in r.outcomes:
         flag = " [evaluation budget hit]" if o.budget_hit else ""
+        expl = f"{o.explained:>6.0%}" if np.isfinite(o.explained) else f"{'-':>6}"
         lines.append(f"  {o.label:<40} {o.n_params:>2} {o.heldout_rms_db:>11.2f} "
-                     f"{o.t_stat:>6.1f} {o.bic_gain:>8.1f} {o.explained:>6.0%} "
+                     f"{o.t_stat:>6.1f} {o.bic_gain:>8.1f} {expl} "
                      f"{o.struct_db:>9.2f}  {o.status}{flag}")
     if r.chosen is not None:
         lines.append("  parameters (1 sigma, Gauss-Newton, optimistic):")

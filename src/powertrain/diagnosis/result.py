@@ -112,7 +112,7 @@ class DiagnosisResult:
                 "heldout_structured_residual_db": o.struct_db,
                 "heldout_block_chi2_ratio": o.chi2_ratio,
                 "heldout_cells_check": o.cells_check,
-                "nfev": o.nfev, "budget_hit": o.budget_hit, "seconds": o.seconds}
+                "nfev": o.nfev, "n_eval": o.n_eval, "budget_hit": o.budget_hit, "seconds": o.seconds}
 
     def _decision_rule_dict(self):
         return {**self.rule.to_dict(),
@@ -145,7 +145,8 @@ class DiagnosisResult:
         }
 
     def to_json(self, path=None) -> str:
-        text = json.dumps(self.to_dict(), indent=1, allow_nan=False, default=_jsonable)
+        text = json.dumps(_finite_or_null(self.to_dict()), indent=1, allow_nan=False,
+                          default=_jsonable)
         if path is not None:
             from powertrain.iotools.atomic import atomic_write
             with atomic_write(path) as fh:
@@ -170,6 +171,20 @@ class DiagnosisResult:
         """Write ``summary.txt``, ``diagnosis.json`` and the figures into ``directory``."""
         from powertrain.diagnosis.report import write_report
         return write_report(self, directory, provenance=provenance)
+
+
+def _finite_or_null(x):
+    """``x`` with every non-finite float (a quantity that is undefined here, e.g. the explained
+    fraction when the baseline leaves no excess over noise) replaced by ``None`` (JSON null)."""
+    if isinstance(x, dict):
+        return {k: _finite_or_null(v) for k, v in x.items()}
+    if isinstance(x, (list, tuple)):
+        return [_finite_or_null(v) for v in x]
+    if isinstance(x, np.ndarray):
+        return _finite_or_null(x.tolist())
+    if isinstance(x, (float, np.floating)) and not math.isfinite(float(x)):
+        return None
+    return x
 
 
 def _jsonable(x):

@@ -117,6 +117,13 @@ class CylinderImbalance(Effect):
         n = len(params)
         f = 1.0 + np.array([params.get(f"e{i + 1}", 0.0) for i in range(n)])
         out = []
+        dev = float(np.max(np.abs(f / np.median(f) - 1.0)))
+        for j in range(n):                   # one cylinder weak / strong (magnitudes only)
+            for sign, word in ((-1.0, "weak"), (1.0, "strong")):
+                g = np.zeros(n)
+                g[j] = sign * dev
+                out.append((f"cylinder {j + 1} {word}", {f"e{i + 1}": float(x)
+                                                        for i, x in enumerate(g)}))
         for label, ref in (("strongest cylinder nominal, the others weak", f.max()),
                            ("weakest cylinder nominal, the others strong", f.min()),
                            ("mean nominal", f.mean())):

@@ -56,7 +56,10 @@ MIN_MOUNTS = 3
 DIRECTIONS = ("x", "y", "z")
 
 _ALLOWED = {
-    "": {"engine", "crank_train", "body", "mounts", "balancer", "combustion"},
+    "": {"engine", "crank_train", "body", "mounts", "balancer", "combustion", "chassis"},
+    "chassis": {"model", "modes", "points", "frf"},
+    "chassis_mode": {"frequency", "damping_ratio", "modal_mass", "shape"},
+    "chassis_point": {"description"},
     "engine": {"name", "source", "notes"},
     "crank_train": {"cylinders", "bore", "stroke", "rod_length", "pin_offset",
                     "compression_ratio", "cylinder_positions", "cylinder_axis", "rotation",
@@ -187,11 +190,74 @@ def read_engine(path=DEFAULT_ENGINE_PATH) -> em.Engine:
     if "balancer" in doc:
         balancer = _read_balancer(_table(doc, "balancer", path), path)
     _check_static_support(body, mounts, path)
+    chassis = None
+    if "chassis" in doc:
+        chassis = _read_chassis(_table(doc, "chassis", path), path, [m.name for m in mounts])
     engine = em.Engine(name=name, crank=crank, body=body, mounts=mounts, balancer=balancer,
-                       combustion=combustion, file=path)
+                       combustion=combustion, file=path, chassis=chassis)
     from powertrain.iotools.engine_checks import check_engine
     check_engine(engine, path)
     return engine
+
+
+def _read_chassis(t, path, mount_names):
+    """``[chassis]``: model rigid | modal | frf, body modes, body points of interest."""
+    from powertrain.models.chassis import MODELS, BodyMode, Chassis
+    p = "chassis"
+    _check_keys(t, _ALLOWED[p], path, p)
+    model = get(t, "model", path, p, types=str)
+    if model not in MODELS:
+        raise InputError(f"unknown model {model!r} (known: {', '.join(MODELS)})", file=path,
+                         key=f"{p}.model")
+    points_raw = get(t, "points", path, p, default={}, types=dict)
+    for name, pt in points_raw.items():
+        key = f"{p}.points.{name}"
+        if not _NAME_RE.match(name) or name in mount_names:
+            raise InputError("body point names are letters, digits, '_' or '-' and differ "
+                             "from the mount names", file=path, key=key)
+        if not isinstance(pt, dict):
+            raise InputError("expected a table", file=path, key=key)
+        _check_keys(pt, _ALLOWED["chassis_point"], path, key)
+    points = tuple(points_raw)
+    for k, other in (("modes", "modal"), ("frf", "frf")):
+        if k in t and model != other:
+            raise InputError(f"only with model = \"{other}\"", file=path, key=f"{p}.{k}")
+    modes, receptance = (), None
+    if model == "modal":
+        raw = get(t, "modes", path, p, types=list)
+        if not raw:
+            raise InputError("need at least one body mode", file=path, key=f"{p}.modes")
+        modes = tuple(_read_body_mode(m, path, f"{p}.modes[{k}]", mount_names, points)
+                      for k, m in enumerate(raw))
+    elif model == "frf":
+        from powertrain.iotools.receptance import read_receptance
+        rel = get(t, "frf", path, p, types=str)
+        full = Path(path).parent / rel
+        if not full.is_file():
+            raise InputError(f"receptance file not found: {full}", file=path, key=f"{p}.frf")
+        receptance = read_receptance(full, mount_names, points)
+    return Chassis(model=model, modes=modes, points=points, receptance=receptance, file=path)
+
+
+def _read_body_mode(m, path, p, mount_names, points):
+    from powertrain.models.chassis import BodyMode
+    if not isinstance(m, dict):
+        raise InputError("expected a table", file=path, key=p)
+    _check_keys(m, _ALLOWED["chassis_mode"], path, p)
+    f = _q(m, "frequency", "frequency", path, p, positive=True)
+    zeta = _q(m, "damping_ratio", "dimensionless", path, p, nonneg=True)
+    mass = _q(m, "modal_mass", "mass", path, p, positive=True)
+    shape_raw = get(m, "shape", path, p, types=dict)
+    sp = f"{p}.shape"
+    _check_keys(shape_raw, list(mount_names) + list(points), path, sp)
+    shapes = {}
+    for name in list(mount_names) + list(points):
+        v = get(shape_raw, name, path, sp, types=list)
+        if len(v) != 3:
+            raise InputError(f"expected [sx, sy, sz], got {v!r}"[:200], file=path,
+                             key=f"{sp}.{name}")
+        shapes[name] = np.array([number(x, path, f"{sp}.{name}") for x in v])
+    return BodyMode(frequency=f, damping_ratio=zeta, modal_mass=mass, shapes=shapes)
 
 
 def _check_static_support(body, mounts, path):

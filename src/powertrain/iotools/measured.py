@@ -8,6 +8,17 @@ CSV (the format :meth:`powertrain.results.RunupResult.to_csv` writes)::
     left,x,synthesis,1000,0.801
     ...
 
+or, with both sides of the mounts (what ``powertrain runup --csv`` writes)::
+
+    mount,direction,quantity,rpm,side,velocity_rms_mm_per_s,acceleration_rms_m_per_s2,force_rms_n
+    left,z,order_2,1000,active,0.512,0.0064,41.2
+    left,z,order_2,1000,passive,0.020,0.00025,41.2
+    seat_rail,z,order_2,1000,passive,0.004,0.00005,
+
+``side`` = ``active`` (engine side, the default without the column) or ``passive`` (body
+side of the mount; a name that is not a mount is a body point of interest). Passive rows of
+mount ``left`` become channel ``left/passive``.
+
 * ``mount``: a mount name of the model (``left``, ``right``, ``gearbox`` for the default
   engine); ``direction``: ``x``, ``y`` or ``z`` (engine axes; upper case accepted);
   ``quantity``: ``synthesis`` or ``order_<n>`` (``order_2``, ``order_0.5``...); ``rpm`` > 0.
@@ -57,6 +68,11 @@ LEVEL_COLUMNS = {
     "force_rms_n": (1.0, "rms"),
 }
 KEY_COLUMNS = ("mount", "direction", "quantity", "rpm")
+#: Optional columns: the side of the mount (``active`` = engine side, default; ``passive`` =
+#: body side, or a body point of interest named in ``mount``) and further value columns
+#: (read and checked; the comparison uses the velocity level column).
+OPTIONAL_COLUMNS = ("side", "acceleration_rms_m_per_s2", "force_rms_n")
+SIDES = ("active", "passive")
 DIRECTIONS = ("x", "y", "z")
 _HDF5_SIGNATURE = b"\x89HDF\r\n\x1a\n"
 
@@ -174,7 +190,7 @@ class MeasuredRunup:
         return cls(curves, source=str(source), signal=signal)
 
 
-def read_measured(path, mounts=None) -> MeasuredRunup:
+def read_measured(path, mounts=None, points=None) -> MeasuredRunup:
     """Read measured (or simulated) run-up order curves from CSV or HDF5.
 
     Parameters
@@ -183,6 +199,8 @@ def read_measured(path, mounts=None) -> MeasuredRunup:
         Long-format CSV (see module docstring) or run-up HDF5 file.
     mounts : sequence of str, optional
         Mount names allowed (those of the model compared with); None accepts any name.
+    points : sequence of str, optional
+        Body points of interest allowed on ``passive`` rows; None accepts any name.
 
     Returns
     -------
@@ -203,7 +221,7 @@ def read_measured(path, mounts=None) -> MeasuredRunup:
         raise InputError(f"cannot read file ({exc.strerror or exc})", file=path) from None
     if head == _HDF5_SIGNATURE:
         return _read_hdf5(path, mounts)
-    return _read_csv(path, mounts)
+    return _read_csv(path, mounts, points)
 
 
 def _read_hdf5(path, mounts):
@@ -213,8 +231,10 @@ def _read_hdf5(path, mounts):
     except KeyError as exc:
         raise InputError(f"not in the run-up HDF5 layout (missing {exc})", file=path) from None
     if mounts is not None:
+        from powertrain.models.chassis import split_side
         for m, _ in result.channels:
-            if m not in mounts:
+            base, side = split_side(m)
+            if base not in mounts and side == "active" and not _is_point(result, m):
                 raise InputError(f"unknown mount {m!r} (known: {', '.join(mounts)})",
                                  file=path, key="channels/mount")
     for _, d in result.channels:
@@ -235,7 +255,12 @@ def _read_hdf5(path, mounts):
     return MeasuredRunup.from_result(result, source=path)
 
 
-def _read_csv(path, mounts):
+def _is_point(result, name) -> bool:
+    """True if ``name`` is a body point of interest of a result (meta ``points``)."""
+    return name in result.meta.get("points", [])
+
+
+def _read_csv(path, mounts, points=None):
     lines = read_text(path, "CSV").splitlines()
     comments = []
     header = None
@@ -253,7 +278,7 @@ def _read_csv(path, mounts):
         fields = [f.strip() for f in text.split(",")]
         if header is None:
             header = fields
-            known = set(KEY_COLUMNS) | set(LEVEL_COLUMNS)
+            known = set(KEY_COLUMNS) | set(LEVEL_COLUMNS) | set(OPTIONAL_COLUMNS)
             for name in header:
                 if name not in known:
                     raise InputError(
@@ -268,6 +293,10 @@ def _read_csv(path, mounts):
                     raise InputError(f"header lacks column {name!r}", file=path, line=lineno,
                                      key=name)
             levels = [n for n in header if n in LEVEL_COLUMNS]
+            velocity_levels = [n for n in levels if n.startswith("velocity_")]
+            if len(levels) > 1 and len(velocity_levels) == 1:
+                # both-sides run-up CSV: velocity is the level, the rest are extra values
+                levels = velocity_levels
             if len(levels) != 1:
                 raise InputError(
                     "header needs exactly one level column with its unit "
@@ -282,7 +311,18 @@ def _read_csv(path, mounts):
             raise InputError(f"{len(fields)} fields, header has {len(header)}", file=path,
                              line=lineno, key=header[min(len(fields), len(header)) - 1])
         mount = fields[col["mount"]]
-        if not mount or (mounts is not None and mount not in mounts):
+        side = fields[col["side"]].lower() if "side" in col else "active"
+        if side not in SIDES:
+            raise InputError(f"unknown side {fields[col['side']]!r} (expected active or "
+                             "passive)", file=path, line=lineno, key="side")
+        for extra in OPTIONAL_COLUMNS[1:]:
+            if extra in col and extra != level_col and fields[col[extra]]:
+                parse_number(fields[col[extra]], path, lineno, extra, nonneg=True)
+        if side == "passive" and mount and (mounts is None or mount in mounts):
+            mount = f"{mount}/passive"                    # body side of that mount
+        elif side == "passive" and mount and (points is None or mount in points):
+            pass                                          # a body point of interest
+        elif not mount or (mounts is not None and mount not in mounts):
             known_txt = f" (known: {', '.join(mounts)})" if mounts is not None else ""
             raise InputError(f"unknown mount {mount!r}{known_txt}", file=path, line=lineno,
                              key="mount")

@@ -35,6 +35,9 @@ from powertrain.units import from_si, to_si
 #: The unit each parameter family is written in by :func:`write_mount`.
 DATASHEET_UNITS = {"c": "N/mm", "d": "N*s/mm", "m": "kg"}
 _DIMENSION = {"c": "stiffness", "d": "damping", "m": "mass"}
+#: Plausible upper bounds in SI (1e9 N/mm, 1e6 N*s/mm, 10 t): a steel bar is ~1e6 N/mm, so
+#: anything beyond is a unit error and would only ruin the conditioning of the assembly.
+MAX_SI = {"c": 1e12, "d": 1e9, "m": 1e4}
 
 
 def read_mount(path) -> MountModel:
@@ -65,6 +68,10 @@ def read_mount(path) -> MountModel:
         value = number(raw, path, f"parameters.{p}", nonneg=True)
         params[p] = float(to_si(value, unit, _DIMENSION[family], file=path,
                                 key=f"units.{family}"))
+        if params[p] > MAX_SI[family]:
+            raise InputError(f"{value:g} {unit} above the plausible "
+                             f"{from_si(MAX_SI[family], unit):g} {unit} (unit error?)",
+                             file=path, key=f"parameters.{p}")
     return MountModel(topo, params, name=str(mount.get("name", Path(path).stem)),
                       source=str(mount.get("source", "")), notes=str(mount.get("notes", "")))
 

@@ -433,6 +433,8 @@ class Engine:
         None: the engine file has no ``[combustion]`` (no excitation).
     file : str
         Engine file it was read from ("" if built in code).
+    chassis : Chassis or None
+        The body under the mounts (:mod:`powertrain.models.chassis`); None = rigid.
     """
 
     name: str
@@ -442,6 +444,7 @@ class Engine:
     balancer: Balancer
     combustion: object
     file: str = ""
+    chassis: object = None
     _cache: dict = field(default_factory=dict, repr=False, compare=False)
 
     # ------------------------------------------------------------------ copies
@@ -646,6 +649,13 @@ class Engine:
             return np.column_stack([np.interp(th, grid, table[:, j], period=4.0 * np.pi)
                                     for j in range(6)])
         return f
+
+    def assemble(self):
+        """The assembled linear model: body, mounts and chassis
+        (:func:`powertrain.assembly.assemble`)."""
+        from powertrain.assembly import assemble
+        b = self.body
+        return assemble(b.mass, b.cg, b.inertia, self.mounts, self.chassis)
 
     def rigid_body_modes(self):
         """Natural frequencies [Hz] and mode shapes of the powertrain on its mounts' static

@@ -14,6 +14,10 @@ import numpy as np
 
 from powertrain.errors import InputError
 
+#: Largest sample magnitude accepted (in the channel's unit): far above any recorded
+#: vibration, far below where squares and spectra overflow.
+MAX_SAMPLE = 1e15
+
 #: Measured quantity -> SI unit and the dimension name of :mod:`powertrain.units`.
 QUANTITIES = {
     "acceleration": "m/s^2",
@@ -179,3 +183,6 @@ class RawRecording:
             raise InputError(f"{ch.values.size} samples, time has {n}", **where)
         if not np.all(np.isfinite(ch.values)):
             raise InputError("NaN or infinite sample", **where)
+        if np.max(np.abs(ch.values), initial=0.0) > MAX_SAMPLE:
+            raise InputError(f"sample magnitude above {MAX_SAMPLE:g}: not a vibration "
+                             "signal (export or unit error)", **where)

@@ -87,6 +87,7 @@ def finish(fig, own, path=None, provenance=None, title=None):
         text = wrap(title, root_size(fig)[0] * 0.95, 9)
         if fig.legends:   # the legend above the panels carries the title (no collision)
             fig.legends[0].set_title(text, prop={"size": 9})
+            fig.legends[0].get_title().set_multialignment("center")
         else:
             fig.suptitle(text, fontsize=9)
     if own:

@@ -220,6 +220,14 @@ class HarmonicModel:
         x = np.einsum("ni,rhi->rhn", self.rows, q)
         return np.sqrt(np.sum(np.abs(x) ** 2, axis=1))
 
+    def __getstate__(self):
+        # sent to other processes (parallel fits): without the engine's pressure cache,
+        # which the cached load harmonics make unnecessary
+        state = dict(self.__dict__)
+        if hasattr(self.engine, "replace"):
+            state["engine"] = self.engine.replace()
+        return state
+
     def nominal_kip(self) -> np.ndarray:
         return self.two_ports()[0]
 

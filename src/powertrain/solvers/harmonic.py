@@ -45,7 +45,8 @@ def harmonic_response(system, load_harmonics, omegas):
     ndarray (n_h, n_dof) complex
     """
     omegas = np.asarray(omegas, float)
-    if not system.networks:
+    if not system.networks or system.body_start < system.n_dof:
+        # no networks, or a modal body under them: solve the assembled matrices
         return harmonic_response_full(system, load_harmonics, omegas)
     w = omegas[:, None, None]
     # the body's own mass; every spring and damper acting on it comes from the networks

@@ -76,6 +76,7 @@ class Mode:
     angle_to_torque_roll_axis_deg: float
     kind: str = "rigid-body"
     iterations: int = 0
+    body_energy_percent: float = 0.0
 
     @property
     def dominant(self) -> str:
@@ -90,7 +91,8 @@ class Mode:
                 "damped_frequency_hz": float(self.damped_frequency_hz),
                 "angle_to_torque_roll_axis_deg": float(self.angle_to_torque_roll_axis_deg),
                 "shape": {c: float(v) for c, v in zip(COORDINATES, shape)},
-                "kind": self.kind}
+                "kind": self.kind,
+                "body_energy_percent": float(self.body_energy_percent)}
 
 
 @dataclass
@@ -175,17 +177,25 @@ def _normalise(M6, phi):
     return phi / np.sqrt((np.conj(phi) @ M6 @ phi).real)
 
 
+def _retained(system) -> np.ndarray:
+    """Indices of the kept coordinates: the rigid body and the body modes (modal chassis);
+    the networks' internal coordinates are condensed."""
+    return np.r_[np.arange(6), np.arange(system.body_start, system.n_dof)].astype(int)
+
+
 def _condensed_stiffness(system, s):
-    """6×6 :math:`\\sum_n K_{IP,n}(s)\\,\\mathbf r_n\\mathbf r_n^T` at complex ``s``."""
-    K6 = np.zeros((6, 6), complex)
-    for row, _start, _ni, model in system.networks:
-        M, C, K = network_matrices(*model.network())
-        D = K + s * C + s * s * M
-        kip = D[0, 0]
-        if D.shape[0] > 1:
-            kip = kip - D[0, 1:] @ np.linalg.solve(D[1:, 1:], D[1:, 0])
-        K6 += kip * np.outer(row, row)
-    return K6
+    r""":math:`\mathbf D_R(s) - s^2\mathbf M_R` with the internal coordinates condensed
+    exactly at complex ``s`` (for the rigid chassis: :math:`\sum_n K_{IP,n}(s)\mathbf r_n
+    \mathbf r_n^T`)."""
+    keep = _retained(system)
+    internal = np.setdiff1d(np.arange(system.n_dof), keep)
+    D = system.K + s * system.C + s * s * system.M
+    Dr = D[np.ix_(keep, keep)] - s * s * system.M[np.ix_(keep, keep)]
+    if internal.size:
+        Dri = D[np.ix_(keep, internal)]
+        Dr = Dr - Dri @ np.linalg.solve(D[np.ix_(internal, internal)],
+                                        D[np.ix_(internal, keep)])
+    return Dr
 
 
 def _mac(a, b, M6) -> float:
@@ -197,7 +207,7 @@ def _follow(system, M6, s0, phi0):
     """Secant iteration on s for the branch through (s0, phi0)."""
     def step(s, phi_ref):
         mu, vec = sla.eig(_condensed_stiffness(system, s), M6)
-        k = int(np.argmax([_mac(vec[:, j], phi_ref, M6) for j in range(6)]))
+        k = int(np.argmax([_mac(vec[:, j], phi_ref, M6) for j in range(mu.size)]))
         return 1j * np.sqrt(mu[k]), vec[:, k]
 
     s_prev, phi = s0, phi0
@@ -217,7 +227,7 @@ def _follow(system, M6, s0, phi0):
 
 
 def _null_vector(system, M6, s):
-    """Body shape of a root s: null vector of s²M₆ + ΣK_IP(s) r rᵀ."""
+    """Shape of a root s: null vector of s²M_R + K_R(s) (condensed)."""
     _, _, vh = np.linalg.svd(s * s * M6 + _condensed_stiffness(system, s))
     return np.conj(vh[-1])
 
@@ -236,7 +246,7 @@ def _dynamic_roots(system, M6, omegas, vec):
     lam = _state_space_eigenvalues(system)
     top = 3.0 * max(omegas.max(), 1e-9)
     cand = lam[(lam.imag > 0) & (np.abs(lam) < top)]
-    if cand.size < 6:
+    if cand.size < len(followed):
         return followed
     shapes = [_null_vector(system, M6, c) for c in cand]
     cost = np.array([[abs(s - c) / abs(s) + 1.0 - _mac(phi, shapes[j], M6)
@@ -251,6 +261,17 @@ def _dynamic_roots(system, M6, omegas, vec):
     return out
 
 
+def _static_condensed(system, keep) -> np.ndarray:
+    """Static stiffness on the kept coordinates, internal coordinates condensed."""
+    internal = np.setdiff1d(np.arange(system.n_dof), keep)
+    K = system.K
+    Kr = K[np.ix_(keep, keep)]
+    if internal.size:
+        Kr = Kr - K[np.ix_(keep, internal)] @ np.linalg.solve(K[np.ix_(internal, internal)],
+                                                             K[np.ix_(internal, keep)])
+    return 0.5 * (Kr + Kr.T)
+
+
 def _state_space_eigenvalues(system) -> np.ndarray:
     """Finite eigenvalues of the full model (internal degrees of freedom included)."""
     n = system.n_dof
@@ -262,7 +283,11 @@ def _state_space_eigenvalues(system) -> np.ndarray:
 
 def rigid_body_modes(system, inertia, *, static=False, crank_axis=(1.0, 0.0, 0.0),
                      engine_name="") -> ModesResult:
-    """The six rigid-body modes of an assembled powertrain (rigid chassis).
+    """The six rigid-body modes of an assembled powertrain, plus the body modes of a modal
+    chassis (coupled through the mounts).
+
+    Kinetic-energy shares are over the powertrain's six coordinates; a mode whose kinetic
+    energy lies mostly in the body modes is of kind ``chassis``.
 
     Parameters
     ----------
@@ -277,23 +302,29 @@ def rigid_body_modes(system, inertia, *, static=False, crank_axis=(1.0, 0.0, 0.0
     engine_name : str, optional
         Recorded in the result (reports, plots).
     """
-    M6 = system.M[:6, :6]
-    w2, vec = sla.eigh(system.static_stiffness_6(), M6)
+    keep = _retained(system)
+    MR = system.M[np.ix_(keep, keep)]
+    w2, vec = sla.eigh(_static_condensed(system, keep), MR)
     tra = torque_roll_axis(inertia, crank_axis)
     omegas = np.sqrt(np.clip(w2, 0.0, None))
     roots = [(1j * w, vec[:, i].astype(complex), 0) for i, w in enumerate(omegas)]
     if not static:
-        roots = _dynamic_roots(system, M6, omegas, vec)
+        roots = _dynamic_roots(system, MR, omegas, vec)
+    M6 = MR[:6, :6]
     modes = []
     for s, phi, its in roots:
-        phi = _normalise(M6, phi)
-        ked = kinetic_energy_percent(M6, phi)
-        rot = phi[3:].real
+        phi = _normalise(MR, phi)
+        e = (np.conj(phi) * (MR @ phi)).real
+        body_share = 100.0 * e[6:].sum() / e.sum()
+        ked = kinetic_energy_percent(M6, phi[:6])
+        rot = phi[3:6].real
         modes.append(Mode(frequency_hz=abs(s) / (2 * np.pi),
                           damping_ratio=0.0 if static else float(-s.real / abs(s)),
-                          damped_frequency_hz=float(s.imag / (2 * np.pi)), shape=phi,
+                          damped_frequency_hz=float(s.imag / (2 * np.pi)), shape=phi[:6],
                           ked_percent=ked, angle_to_torque_roll_axis_deg=_axis_angle_deg(
-                              rot, tra), iterations=its))
+                              rot, tra), iterations=its,
+                          kind="rigid-body" if body_share < 50.0 else "chassis",
+                          body_energy_percent=float(body_share)))
     modes.sort(key=lambda m: m.frequency_hz)
     crank = np.asarray(crank_axis, float)
     tra_info = {"direction": [float(v) for v in tra],
@@ -312,7 +343,8 @@ def engine_modes(engine, *, static=False) -> ModesResult:
     """:func:`rigid_body_modes` of an :class:`~powertrain.models.engine.Engine`."""
     from powertrain.assembly import assemble
     b = engine.body
-    system = assemble(b.mass, b.cg, b.inertia, engine.mounts)
+    chassis = engine.chassis if getattr(engine.chassis, "model", "") == "modal" else None
+    system = assemble(b.mass, b.cg, b.inertia, engine.mounts, chassis)
     result = rigid_body_modes(system, b.inertia, static=static, engine_name=engine.name)
     result.meta["cg_m"] = [float(v) for v in b.cg]
     result.meta["mounts"] = engine.mount_names

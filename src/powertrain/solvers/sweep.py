@@ -81,8 +81,6 @@ def simulate_sweep(engine, rpm_from, rpm_to, rate_rpm_per_s, sample_rate=8192.0,
     RawRecording
         Nine acceleration channels [m/s^2] (engine side) and the speed [rpm].
     """
-    from scipy.signal import firwin, upfirdn
-
     from powertrain.assembly import assemble
     from powertrain.kernels.newmark import modal_trapezoid_kernel
     from powertrain.solvers.newmark import ModalNewmark
@@ -96,43 +94,32 @@ def simulate_sweep(engine, rpm_from, rpm_to, rate_rpm_per_s, sample_rate=8192.0,
     n_steps = int(math.floor(duration / h))
     speeds, table, n_theta = _load_table(engine, rpm_from, rpm_to)
     modal = ModalNewmark(system.M, system.C, system.K, load_dofs=6)
-    n_ch = len(system.channels)
     Z = np.zeros_like(system.channel_matrix)
     (w_re, w_im), w_load = modal.output_map(Z, Z, system.channel_matrix)
     lam_d = (1 + 0.5 * h * modal.lam_r) / (1 - 0.5 * h * modal.lam_r)
     gain = (0.5 * h) / (1 - 0.5 * h * modal.lam_r)
     eta = _initial_state(engine, modal, rpm_from)
-    L = FIR_HALF * m
-    fir = firwin(2 * L + 1, 1.0 / m, window=("kaiser", 8.0))
-    tail = np.zeros((0, n_ch))
-    outputs = []
+    decimator = _Decimator(m, len(system.channels))
     chunk = CHUNK_OUT * m                   # a multiple of m keeps the decimation aligned
     starts = range(0, n_steps, chunk)
     if progress:
         from tqdm import tqdm
         starts = tqdm(starts, desc="sweep", unit="chunk", leave=False, disable=None)
+    outputs = []
     for s in starts:
-        e = min(s + chunk, n_steps)
-        k = np.arange(s, e + 1)
-        t = k * h
+        t = np.arange(s, min(s + chunk, n_steps) + 1) * h
         rpm = rpm_from + rate_rpm_per_s * t
         theta = (2 * np.pi / 60.0) * (rpm_from * t + 0.5 * rate_rpm_per_s * t * t)
         F = _load_at(speeds, table, n_theta, rpm, theta)
         G = np.ascontiguousarray(F @ modal.load_map_r.T)
-        out_re = np.empty((k.size, lam_d.size))
+        out_re = np.empty((t.size, lam_d.size))
         out_im = np.empty_like(out_re)
-        modal_trapezoid_kernel(lam_d, gain, G, k.size - 1, eta, 0, out_re, out_im)
+        modal_trapezoid_kernel(lam_d, gain, G, t.size - 1, eta, 0, out_re, out_im)
         eta = out_re[-1] + 1j * out_im[-1]
         acc = out_re @ w_re - out_im @ w_im + F @ w_load.T          # (k, n_ch)
-        buf = np.concatenate([tail, acc[:-1]])                      # global start s - len(tail)
-        dec = upfirdn(fir, buf, 1, m, axis=0)
-        i_lo = -(-(2 * L) // m)
-        i_hi = (buf.shape[0] - 1) // m
-        if i_hi >= i_lo:
-            outputs.append(dec[i_lo:i_hi + 1])
-        tail = buf[-2 * L:] if buf.shape[0] >= 2 * L else buf
+        outputs.append(decimator.push(acc[:-1]))                    # last row starts the next
     y = np.concatenate(outputs)
-    first = (-(-(2 * L) // m) * m - L) // m                         # first output index
+    first = decimator.first_output_index
     t_out = (first + np.arange(y.shape[0])) / sample_rate
     rpm_out = rpm_from + rate_rpm_per_s * t_out
     block = np.ascontiguousarray(y.T)
@@ -143,6 +130,37 @@ def simulate_sweep(engine, rpm_from, rpm_to, rate_rpm_per_s, sample_rate=8192.0,
             f"acceleration, modal, {m * sample_rate:g} Hz internal, decimated to "
             f"{sample_rate:g} Hz)")
     return RawRecording(t_out, chans, rpm_out, None, "simulated sweep", [note]).validate()
+
+
+class _Decimator:
+    """Zero-phase polyphase decimation by ``m`` of a signal arriving in chunks.
+
+    The FIR (2 L + 1 taps, L = FIR_HALF m, Kaiser beta 8, cut-off at the output Nyquist) is
+    centred, so output j is the filtered input at index j m; outputs whose support is not yet
+    complete wait for the next chunk (the last 2 L input rows are kept). Chunk lengths must
+    be multiples of m.
+    """
+
+    def __init__(self, m, n_ch):
+        from scipy.signal import firwin
+        self.m = m
+        self.L = FIR_HALF * m
+        self.fir = firwin(2 * self.L + 1, 1.0 / m, window=("kaiser", 8.0))
+        self.tail = np.zeros((0, n_ch))
+
+    @property
+    def first_output_index(self) -> int:
+        """Output sample index of the first row returned (time = index / output rate)."""
+        return (-(-(2 * self.L) // self.m) * self.m - self.L) // self.m
+
+    def push(self, rows):
+        from scipy.signal import upfirdn
+        buf = np.concatenate([self.tail, rows])
+        dec = upfirdn(self.fir, buf, 1, self.m, axis=0)
+        i_lo = -(-(2 * self.L) // self.m)
+        i_hi = (buf.shape[0] - 1) // self.m
+        self.tail = buf[-2 * self.L:] if buf.shape[0] >= 2 * self.L else buf
+        return dec[i_lo:i_hi + 1] if i_hi >= i_lo else dec[:0]
 
 
 def _check(engine, rpm_from, rpm_to, rate, sample_rate):

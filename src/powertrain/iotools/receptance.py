@@ -1,0 +1,142 @@
+r"""Measured body receptances for ``[chassis] model = "frf"``: CSV or UFF 58.
+
+CSV (comments with ``#``)::
+
+    frequency_hz,response,excitation,receptance_real_m_per_n,receptance_imag_m_per_n
+    10,left.z,left.z,-1.2e-7,-3.0e-9
+    ...
+
+``response`` and ``excitation`` are ``NAME.DIR``: NAME a mount (its body-side attachment
+point) or a body point of interest, DIR ``x``, ``y`` or ``z`` in engine axes. Needed: every
+pair of attachment-point directions (reciprocity fills H_ab from H_ba) and, for each body
+point, its response to every attachment-point direction; every pair on the same frequency
+grid (strictly increasing, covering the run-up's order frequencies).
+
+UFF 58 (read with pyuff): one frequency response function (function type 4) per pair,
+receptance (ordinate displacement over force) in m/N; the point is named by the record's
+response/reference entity name (``rsp_ent_name``/``ref_ent_name`` = NAME), directions 1/2/3 =
+x/y/z in engine axes (negative = reversed).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from powertrain.errors import InputError
+from powertrain.iotools.textfile import parse_number, read_text
+from powertrain.models.chassis import MeasuredReceptance
+
+COLUMNS = ("frequency_hz", "response", "excitation", "receptance_real_m_per_n",
+           "receptance_imag_m_per_n")
+
+
+def _channel(text, names, path, line, column):
+    parts = text.strip().split(".")
+    if len(parts) != 2 or parts[0] not in names or parts[1].lower() not in ("x", "y", "z"):
+        raise InputError(f"expected NAME.DIR with NAME one of {', '.join(names)} and DIR "
+                         f"x/y/z, got {text.strip()!r}", file=path, line=line, key=column)
+    return parts[0], parts[1].lower()
+
+
+def read_receptance(path, mounts, points) -> MeasuredReceptance:
+    """Read a receptance file (``.uff``/``.unv`` as UFF 58, else CSV) and check coverage."""
+    path = str(path)
+    names = list(mounts) + list(points)
+    if path.lower().endswith((".uff", ".unv")):
+        freq, values = _read_uff(path, names)
+    else:
+        freq, values = _read_csv(path, names)
+    _check_coverage(values, mounts, points, path)
+    return MeasuredReceptance(frequency_hz=freq, values=values, file=path)
+
+
+def _read_csv(path, names):
+    rows = [(i + 1, ln) for i, ln in enumerate(read_text(path, "CSV").splitlines())
+            if ln.strip() and not ln.lstrip().startswith("#")]
+    if not rows:
+        raise InputError("empty receptance file", file=path)
+    header = [h.strip() for h in rows[0][1].split(",")]
+    if tuple(header) != COLUMNS:
+        raise InputError(f"expected the columns {','.join(COLUMNS)}", file=path,
+                         line=rows[0][0], key="header")
+    data = {}
+    for line, text in rows[1:]:
+        cells = text.split(",")
+        if len(cells) != len(COLUMNS):
+            raise InputError(f"expected {len(COLUMNS)} cells", file=path, line=line)
+        f = parse_number(cells[0], path, line, COLUMNS[0], nonneg=True)
+        r = _channel(cells[1], names, path, line, COLUMNS[1])
+        e = _channel(cells[2], names, path, line, COLUMNS[2])
+        h = complex(parse_number(cells[3], path, line, COLUMNS[3]),
+                    parse_number(cells[4], path, line, COLUMNS[4]))
+        data.setdefault(r + e, []).append((f, h, line))
+    return _to_grid(data, path)
+
+
+def _to_grid(data, path):
+    grid, values = None, {}
+    for key, rows in data.items():
+        f = np.array([r[0] for r in rows])
+        if np.any(np.diff(f) <= 0):
+            raise InputError(f"frequencies of {key[0]}.{key[1]} / {key[2]}.{key[3]} must be "
+                             "strictly increasing", file=path, line=rows[0][2],
+                             key="frequency_hz")
+        if grid is None:
+            grid = f
+        elif f.shape != grid.shape or not np.allclose(f, grid, rtol=1e-9):
+            raise InputError("every pair needs the same frequency grid", file=path,
+                             line=rows[0][2], key="frequency_hz")
+        values[key] = np.array([r[1] for r in rows], complex)
+    if grid is None or grid.size < 2:
+        raise InputError("need at least two frequencies", file=path, key="frequency_hz")
+    return grid, values
+
+
+def _read_uff(path, names):
+    try:
+        import pyuff
+        sets = pyuff.UFF(path).read_sets()
+    except Exception as exc:  # pyuff raises bare Exceptions on malformed files
+        raise InputError(f"not a readable UFF file ({exc})"[:200], file=path) from None
+    sets = [sets] if isinstance(sets, dict) else sets
+    data = {}
+    for k, s in enumerate(sets):
+        if s.get("type") != 58:
+            continue
+        key = f"dataset {k + 1}"
+        if int(s.get("func_type", 4)) not in (0, 4):
+            raise InputError(f"function type {s.get('func_type')} is not a frequency response "
+                             "function (4)", file=path, key=f"{key} func_type")
+        if int(s.get("ordinate_spec_data_type", 8)) in (11, 12):
+            raise InputError("expected receptance (displacement/force), got mobility or "
+                             "accelerance", file=path, key=f"{key} ordinate_spec_data_type")
+        r = _channel(f"{s.get('rsp_ent_name', '')}.{'xyz'[abs(int(s['rsp_dir'])) - 1]}",
+                     names, path, None, f"{key} rsp_ent_name")
+        e = _channel(f"{s.get('ref_ent_name', '')}.{'xyz'[abs(int(s['ref_dir'])) - 1]}",
+                     names, path, None, f"{key} ref_ent_name")
+        sign = np.sign(int(s["rsp_dir"])) * np.sign(int(s["ref_dir"]))
+        f = np.asarray(s["x"], float)
+        h = sign * np.asarray(s["data"], complex)
+        data[r + e] = [(fi, hi, None) for fi, hi in zip(f, h)]
+    if not data:
+        raise InputError("no UFF 58 function records", file=path)
+    return _to_grid(data, path)
+
+
+def _check_coverage(values, mounts, points, path):
+    def have(a, ad, b, bd):
+        return (a, ad, b, bd) in values or (b, bd, a, ad) in values
+    for a in mounts:
+        for b in mounts:
+            for ad in "xyz":
+                for bd in "xyz":
+                    if not have(a, ad, b, bd):
+                        raise InputError(f"missing receptance {a}.{ad} / {b}.{bd}",
+                                         file=path, key="response")
+    for p in points:
+        for b in mounts:
+            for pd in "xyz":
+                for bd in "xyz":
+                    if (p, pd, b, bd) not in values:
+                        raise InputError(f"missing receptance {p}.{pd} / {b}.{bd}",
+                                         file=path, key="response")
