@@ -4,11 +4,11 @@ engine files without excitation."""
 from __future__ import annotations
 
 import math
-import tomllib
 from pathlib import Path
 
 import numpy as np
 import pytest
+import tomllib
 from click.testing import CliRunner
 
 from powertrain.assembly import assemble

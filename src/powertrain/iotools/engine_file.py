@@ -202,7 +202,7 @@ def read_engine(path=DEFAULT_ENGINE_PATH) -> em.Engine:
 
 def _read_chassis(t, path, mount_names):
     """``[chassis]``: model rigid | modal | frf, body modes, body points of interest."""
-    from powertrain.models.chassis import MODELS, BodyMode, Chassis
+    from powertrain.models.chassis import MODELS, Chassis
     p = "chassis"
     _check_keys(t, _ALLOWED[p], path, p)
     model = get(t, "model", path, p, types=str)

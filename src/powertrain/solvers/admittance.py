@@ -86,7 +86,7 @@ def frf_response(system, load_harmonics, omegas):
         q, xa = sol[:6], sol[6:]
         fb = -(D[6:, :6] @ q + D[6:, 6:] @ xa)
         out_q[h, :6] = q
-        for row, start, ni, e, a, T, X in ports:
+        for row, start, ni, e, a, _t, X in ports:
             if ni:
                 out_q[h, start:start + ni] = X @ np.array([row @ q, e @ xa[a.start - 6:a.stop - 6]])
         out_b[h, :n_a] = xa

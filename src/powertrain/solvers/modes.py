@@ -37,8 +37,6 @@ from dataclasses import dataclass, field
 import numpy as np
 import scipy.linalg as sla
 
-from powertrain.physics.mount_network import network_matrices
-
 COORDINATES = ("x", "y", "z", "rx", "ry", "rz")
 #: Relative change of s at which the secant iteration stops.
 TOLERANCE = 1e-12
