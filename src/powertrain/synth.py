@@ -318,8 +318,10 @@ def truth_velocity(engine, hm: HarmonicModel, truth) -> np.ndarray:
 
 
 def draw_truth(name, rng, n_net=9):
-    """Random parameters of a truth effect."""
+    """Random parameters of a truth effect (``n_net`` mount networks, three per mount: one per
+    local direction; the engine has as many measured channels)."""
     u = rng.uniform
+    n_m = n_net // 3
     if name == "body_modes":
         K = 3
         shapes = rng.normal(size=(n_net, K))
@@ -327,8 +329,8 @@ def draw_truth(name, rng, n_net=9):
         return {"freq": np.sort(u(20, 80, K)), "zeta": u(0.03, 0.08, K),
                 "mass": np.exp(u(np.log(1.5), np.log(10), K)), "shapes": shapes}
     if name == "mount_temperature":
-        s_m = np.exp(rng.choice([-1, 1], 3) * u(np.log(1.3), np.log(2.2), 3))
-        sp = np.repeat(s_m, 3) * np.exp(rng.normal(0, 0.05, 9))
+        s_m = np.exp(rng.choice([-1, 1], n_m) * u(np.log(1.3), np.log(2.2), n_m))
+        sp = np.repeat(s_m, 3) * np.exp(rng.normal(0, 0.05, 3 * n_m))
         return {"mount_factor": s_m, "spring": sp, "damper": sp ** 0.7}
     if name == "amplitude_power":
         return {"beta": u(0.08, 0.25, 2)}
@@ -338,9 +340,9 @@ def draw_truth(name, rng, n_net=9):
     if name == "cylinder_combustion":
         return {"imep_dev": u(-0.12, 0.12, 4), "start_shift_deg": u(-2, 2, 4)}
     if name == "sensor_triads":
-        g = np.clip(rng.normal(0, 2.5, 9), -5, 5)
-        T = np.zeros((9, 9))
-        for m in range(3):
+        g = np.clip(rng.normal(0, 2.5, 3 * n_m), -5, 5)
+        T = np.zeros((3 * n_m, 3 * n_m))
+        for m in range(n_m):
             blk = u(0.01, 0.03, (3, 3)) * rng.choice([-1, 1], (3, 3))
             np.fill_diagonal(blk, 1.0)
             T[3 * m:3 * m + 3, 3 * m:3 * m + 3] = blk
