@@ -182,7 +182,7 @@ def _run_runup(engine, rpm=None, *, solver="newmark", angle_step_deg=ANGLE_STEP_
             _post(i, d_c, v_c, a_c, f_c, None)
             return
         if chassis is not None and chassis.model == "frf":
-            _frf_orders(i, fh, omegas)
+            disp[i], vel[i], acc[i], force[i], mean_force[i] = frf_orders(system, fh, omegas)
             return
         qh = harmonic_response(system, fh, omegas)
         if solver == "harmonic":
@@ -211,23 +211,6 @@ def _run_runup(engine, rpm=None, *, solver="newmark", angle_step_deg=ANGLE_STEP_
         win = slice(start, start + processed_cycles * n_cycle)
         d_c, v_c, a_c, f_c = _outputs(system, X[win], V[win], A[win])
         _post(i, d_c, v_c, a_c, f_c, (X, V, A, start))
-
-    def _frf_orders(i, fh, omegas):
-        """Harmonic solve with a measured-receptance body (admittance coupling)."""
-        from powertrain.solvers.admittance import frf_response
-        j = np.round(ORDERS * 2).astype(int)
-        q, body, fb = frf_response(system, fh[j], omegas[j])
-        n_a = system.n_mount_channels
-        x = np.hstack([q @ system.channel_matrix[:n_a].T, body])          # (n_orders, n_ch)
-        w = omegas[j][:, None]
-        disp[i] = x.T
-        vel[i] = (1j * w * x).T
-        acc[i] = (-(w ** 2) * x).T
-        f = np.hstack([fb, fb, np.zeros((len(j), x.shape[1] - 2 * n_a))])
-        force[i] = f.T
-        _, _, f0 = frf_response(system, fh[:1], omegas[:1])
-        mean_force[i] = np.hstack([f0[0].real, f0[0].real,
-                                   np.zeros(x.shape[1] - 2 * n_a)])
 
     def _post(i, d_c, v_c, a_c, f_c, states):
         """Order analysis and periodicity of the processed window (Newmark)."""
@@ -291,6 +274,24 @@ def _run_runup(engine, rpm=None, *, solver="newmark", angle_step_deg=ANGLE_STEP_
                        meta={"engine": getattr(engine, "name", ""),
                              "chassis": "rigid" if chassis is None else chassis.model,
                              "points": list(chassis.points) if chassis is not None else []})
+
+
+def frf_orders(system, fh, omegas):
+    """One speed's order amplitudes with a measured-receptance body (admittance coupling,
+    :func:`powertrain.solvers.admittance.frf_response`): displacement, velocity,
+    acceleration, transmitted force, each (n_ch, n_orders) complex, and the mean force (n_ch,).
+    """
+    from powertrain.solvers.admittance import frf_response
+    j = np.round(ORDERS * 2).astype(int)
+    q, body, fb = frf_response(system, fh[j], omegas[j])
+    n_a = system.n_mount_channels
+    x = np.hstack([q @ system.channel_matrix[:n_a].T, body])          # (n_orders, n_ch)
+    w = omegas[j][:, None]
+    n_rest = x.shape[1] - 2 * n_a
+    force = np.hstack([fb, fb, np.zeros((len(j), n_rest))])
+    _, _, f0 = frf_response(system, fh[:1], omegas[:1])
+    mean_force = np.hstack([f0[0].real, f0[0].real, np.zeros(n_rest)])
+    return x.T, (1j * w * x).T, (-(w ** 2) * x).T, force.T, mean_force
 
 
 def path_contributions(system, rpm, force) -> np.ndarray:
