@@ -37,6 +37,16 @@ MAX_LISTED = 64
 COMMAND_LINE: list[str] = []
 
 
+def stamp_hdf5(attrs, file_format: str) -> None:
+    """The header every HDF5 file of the project carries: ``format``, ``format_version`` (1),
+    ``powertrain_version`` and ``created`` (UTC, ISO 8601) on the root attributes."""
+    from powertrain import __version__
+    attrs["format"] = file_format
+    attrs["format_version"] = 1
+    attrs["powertrain_version"] = __version__
+    attrs["created"] = datetime.now(timezone.utc).isoformat(timespec="seconds")
+
+
 def command_line() -> str:
     """The command as typed: the CLI's record, else ``sys.argv``."""
     argv = COMMAND_LINE or ["powertrain", *sys.argv[1:]]

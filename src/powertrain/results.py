@@ -42,7 +42,6 @@ from __future__ import annotations
 
 import json
 from dataclasses import dataclass, field
-from datetime import datetime, timezone
 
 import numpy as np
 
@@ -194,15 +193,12 @@ class RunupResult:
         """
         import h5py
 
-        from powertrain import __version__
         from powertrain.iotools.atomic import atomic_path
+        from powertrain.provenance import stamp_hdf5
         with atomic_path(path) as tmp:
             with h5py.File(tmp, "w") as h5:
                 a = h5.attrs
-                a["format"] = "powertrain-runup"
-                a["format_version"] = 1
-                a["powertrain_version"] = __version__
-                a["created"] = datetime.now(timezone.utc).isoformat(timespec="seconds")
+                stamp_hdf5(a, "powertrain-runup")
                 a["settings"] = json.dumps(self.settings)
                 a["meta"] = json.dumps(self.meta)
                 a["engine_snapshot"] = engine_snapshot

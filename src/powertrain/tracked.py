@@ -27,7 +27,6 @@ from __future__ import annotations
 
 import json
 from dataclasses import dataclass, field, replace
-from datetime import datetime, timezone
 
 import numpy as np
 
@@ -151,15 +150,12 @@ class TrackedOrders:
         """Write the HDF5 layout of the module docstring atomically."""
         import h5py
 
-        from powertrain import __version__
         from powertrain.iotools.atomic import atomic_path
+        from powertrain.provenance import stamp_hdf5
         with atomic_path(path) as tmp:
             with h5py.File(tmp, "w") as h5:
                 a = h5.attrs
-                a["format"] = "powertrain-tracked"
-                a["format_version"] = 1
-                a["powertrain_version"] = __version__
-                a["created"] = datetime.now(timezone.utc).isoformat(timespec="seconds")
+                stamp_hdf5(a, "powertrain-tracked")
                 a["source"] = self.source
                 a["method"] = self.method
                 a["settings"] = json.dumps(self.settings)

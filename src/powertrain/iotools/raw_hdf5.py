@@ -19,7 +19,6 @@ used unless the map gives one).
 from __future__ import annotations
 
 import json
-from datetime import datetime, timezone
 
 import numpy as np
 
@@ -97,16 +96,13 @@ def write_raw_hdf5(path, recording, *, description: str = "", synthetic: bool = 
     """Write a :class:`RawRecording` in the layout above (values in each channel's unit)."""
     import h5py
 
-    from powertrain import __version__
     from powertrain.iotools.atomic import atomic_path
+    from powertrain.provenance import stamp_hdf5
     from powertrain.units import from_si
     with atomic_path(path) as tmp:
         with h5py.File(tmp, "w") as h5:
             a = h5.attrs
-            a["format"] = FORMAT
-            a["format_version"] = 1
-            a["powertrain_version"] = __version__
-            a["created"] = datetime.now(timezone.utc).isoformat(timespec="seconds")
+            stamp_hdf5(a, FORMAT)
             a["description"] = description
             a["synthetic"] = bool(synthetic or recording.synthetic)
             a["comments"] = json.dumps(list(recording.comments))
