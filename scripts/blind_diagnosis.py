@@ -15,8 +15,13 @@ never shown to the diagnosis) are printed with 95 % Wilson intervals; the line b
 last has the raw scores, the last line ``top1=... shrink_median=... false_claims=...
 unexplained_ok=...``.
 
+With ``--plan passive`` the cases measure both sides of every mount on the modal-body
+engine (:mod:`powertrain.validation.passive`: body modes changed, one mount's stiffness
+changed, effect-free) and a line ``passive: chassis_and_mount_top1=...`` (issue 13's target)
+is printed before the raw scores.
+
 Usage: ``python scripts/blind_diagnosis.py --cases 50 [--seed S] [--jobs 2]
-[--scheduler local|tcp://HOST:PORT] [--dump rows.json]``. Without ``--seed`` the seed is
+[--scheduler local|tcp://HOST:PORT] [--dump rows.json] [--plan default|passive]``. Without ``--seed`` the seed is
 drawn from ``os.urandom`` and printed.
 """
 
@@ -41,17 +46,27 @@ def _levels(case, m, d, q, rpm, which):
     return np.abs(case.clean[idx, c, h]) / np.sqrt(2)
 
 
+def _make(i, names, eng, seed):
+    """(case, engine handed to the diagnosis): passive-side engine kinds (``body_*``) from
+    :mod:`powertrain.validation.passive`, the others from :mod:`powertrain.validation.cases`."""
+    if eng.startswith("body_"):
+        from powertrain.validation.passive import make_passive_case, passive_engines
+        return make_passive_case(i, names, eng, seed), passive_engines()[eng]
+    from powertrain.validation.cases import engines, make_case
+    return make_case(i, names, eng, seed), engines()[eng]
+
+
 def run_case(task):
     """Make one case, diagnose it, return its row (plain JSON types)."""
     from powertrain.diagnosis import diagnose
-    from powertrain.validation.cases import FLOOR, engines, make_case
+    from powertrain.validation.cases import FLOOR
     from powertrain.validation.scoring import noise_free_shrink
     i, names, eng, seed = task
     t0 = time.perf_counter()
-    case = make_case(i, names, eng, seed)
+    case, engine = _make(i, names, eng, seed)
     t_gen = time.perf_counter() - t0
     t0, c0 = time.perf_counter(), time.process_time()
-    d = diagnose(case.measured, engines()[eng], noise_floor=FLOOR).to_dict()
+    d = diagnose(case.measured, engine, noise_floor=FLOOR).to_dict()
     t_diag, c_diag = time.perf_counter() - t0, time.process_time() - c0
     chosen = d.get("chosen") or {}
     where = d["where"]
@@ -76,10 +91,9 @@ def run_case(task):
 
 
 def _print_truth(tasks):
-    from powertrain.validation.cases import make_case
     print(f"{'#':>3} {'hidden':<40} {'eng':<6} {'gap dB':>6} {'p95':>5} {'sig':>4} det  expected")
     for i, names, eng, seed in tasks:
-        c = make_case(i, names, eng, seed)
+        c = _make(i, names, eng, seed)[0]
         det = "-" if c.category == "none" else "yes" if c.detectable else "no"
         print(f"{i:>3} {'+'.join(names) or 'none':<40} {eng:<6} {c.stats[0]:>6.2f} "
               f"{c.stats[1]:>5.1f} {c.sigma_db:>4.2f} {det:>3}  {'+'.join(c.expected_set)}")
@@ -161,13 +175,25 @@ def main(argv=None):
     ap.add_argument("--dump", help="write the per-case rows to this JSON file")
     ap.add_argument("--generate-only", action="store_true",
                     help="make the cases and print their truth, without diagnosing them")
+    ap.add_argument("--plan", choices=("default", "passive"), default="default",
+                    help="'passive': cases with both sides of every mount measured on the "
+                         "modal-body engine (powertrain.validation.passive)")
     args = ap.parse_args(argv)
     from powertrain.validation.cases import DETECT_LOCAL_DB, DETECT_RMS_DB, case_plan
-    from powertrain.validation.scoring import TARGETS, meets_targets, score, score_line
+    from powertrain.validation.passive import passive_plan
+    from powertrain.validation.scoring import (
+        TARGETS,
+        meets_targets,
+        passive_line,
+        score,
+        score_line,
+    )
     seed = args.seed if args.seed is not None else int.from_bytes(os.urandom(4), "little")
-    print(f"seed {seed}{'' if args.seed is not None else ' (drawn from os.urandom)'}")
+    print(f"seed {seed}{'' if args.seed is not None else ' (drawn from os.urandom)'}"
+          + (" (passive-side plan)" if args.plan == "passive" else ""))
+    plan = passive_plan if args.plan == "passive" else case_plan
     tasks = [(i, names, eng, s) for i, (names, eng, s) in
-             enumerate(case_plan(args.cases, seed))]
+             enumerate(plan(args.cases, seed))]
     if args.generate_only:
         _print_truth(tasks)
         return
@@ -198,6 +224,8 @@ def main(argv=None):
     if args.dump:
         with open(args.dump, "w") as fh:
             json.dump(rows, fh, indent=1)
+    if args.plan == "passive":
+        print(passive_line(rows))
     print("raw: " + score_line(sc["raw"]))
     print(score_line(sc))
 

@@ -285,7 +285,7 @@ def truth_velocity(engine, hm: HarmonicModel, truth) -> np.ndarray:
     def solve(abc):
         if "body_modes" in names:
             return _solve_body(hm, abc, load, names["body_modes"])
-        return hm.solve(abc[0], load)
+        return hm.solve(abc[0], load, abc=abc)
 
     s = np.ones((n_r, len(models)))
     if "amplitude_power" in names:

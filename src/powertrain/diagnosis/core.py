@@ -31,6 +31,7 @@ from powertrain.diagnosis.data import (
 from powertrain.diagnosis.fit import EVAL_BUDGET, Problem, baseline_outcome, fit_candidate
 from powertrain.diagnosis.result import DiagnosisResult
 from powertrain.diagnosis.rule import CandidateEvidence, DecisionRule, Evidence, VerdictKind, decide
+from powertrain.diagnosis.sides import side_attribution
 from powertrain.diagnosis.where import decompose_gap, regions, rigid_span_gap, where_text
 from powertrain.effects import predict
 from powertrain.errors import InputError
@@ -95,6 +96,8 @@ class _Setup:
         self.test_idx = even(self.test_all, N_TEST_RPM)
         self.effects = cand.applicable(engine, effects)
         self.hm = HarmonicModel(engine, data.rpm)
+        if data.channels != self.hm.channels:       # body-side channels measured (or not)
+            self.hm.use_channels(data.channels)
         self.hm.two_ports()
         need = np.union1d(self.train_all, self.test_idx)
         self.hm_need = self.hm.subset(need)
@@ -136,7 +139,9 @@ def _where(s: _Setup):
     gap_map = np.where(data.censored, np.nan, gap)
     mask = np.isfinite(gap_map) & data.order_mask[None, None, :]
     parts = decompose_gap(gap_map, data, mask)
-    return gap_map, parts, rigid_span_gap(vel0, data, s.hm.channel_matrix), \
+    parts["sides"] = side_attribution(gap_map, data)
+    na = data.n_active
+    return gap_map, parts, rigid_span_gap(vel0[:, :na], data.active_only(), s.hm.channel_matrix), \
         regions(gap_map, data, parts)
 
 

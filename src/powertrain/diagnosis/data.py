@@ -71,11 +71,38 @@ class GapData:
         """Measured points above the floor (bool, like ``level``)."""
         return above_floor(self.level, self.floor)
 
+    #: Engine-side channels (the first ones; body-side channels and body points follow);
+    #: None: all.
+    n_engine_side: int | None = None
+
+    @property
+    def n_active(self) -> int:
+        """Number of engine-side channels."""
+        return len(self.channels) if self.n_engine_side is None else self.n_engine_side
+
+    def active_only(self) -> GapData:
+        """The same data on the engine-side channels only."""
+        n = self.n_active
+        return GapData(self.rpm, self.channels[:n], self.quantities, self.harmonic,
+                       self.level[:, :n], self.floor)
+
     def orders_only(self) -> GapData:
         """The same data without the synthesis."""
         om = self.order_mask
         return GapData(self.rpm, self.channels, [q for q, o in zip(self.quantities, om) if o],
-                       self.harmonic[om], self.level[:, :, om], self.floor)
+                       self.harmonic[om], self.level[:, :, om], self.floor, self.n_engine_side)
+
+
+def model_channels(engine) -> list:
+    """Channels the fast model predicts for ``engine``: every mount's engine side, and with
+    a modal body (:mod:`powertrain.solvers.body_coupling`) every mount's body side
+    (``NAME/passive``) and the body points of interest."""
+    from powertrain.solvers.body_coupling import ModalBody, body_channels
+    active = [(m.name, a) for m in engine.mounts for a in ("x", "y", "z")]
+    body = ModalBody.of(engine)
+    if body is None:
+        return active
+    return active + body_channels([m.name for m in engine.mounts], body)
 
 
 def _half_order_quantities(measured):
@@ -98,6 +125,8 @@ def gap_data(measured, engine, noise_floor=DEFAULT_NOISE_FLOOR) -> GapData:
     rpm = np.unique(np.concatenate([r for r, _ in measured.curves.values()]))
     rpm = rpm[(rpm >= lo - 1e-9) & (rpm <= hi + 1e-9)]
     channels = [(m.name, a) for m in engine.mounts for a in ("x", "y", "z")]
+    measured_channels = {(m, d) for m, d, _ in measured.curves}
+    channels += [c for c in model_channels(engine)[len(channels):] if c in measured_channels]
     quantities = _half_order_quantities(measured)
     harmonic = np.array([-1 if q == "synthesis" else int(round(2 * float(q[6:]))) - 1
                          for q in quantities])
@@ -109,7 +138,8 @@ def gap_data(measured, engine, noise_floor=DEFAULT_NOISE_FLOOR) -> GapData:
         idx = np.searchsorted(rpm, r)
         ok = (idx < rpm.size) & (rpm[np.minimum(idx, rpm.size - 1)] == r)
         level[idx[ok], c, k] = v[ok]
-    return GapData(rpm, channels, quantities, harmonic, level, float(noise_floor))
+    return GapData(rpm, channels, quantities, harmonic, level, float(noise_floor),
+                   3 * len(engine.mounts))
 
 
 def model_levels(velocity, data: GapData):

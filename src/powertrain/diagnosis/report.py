@@ -22,6 +22,9 @@ def _header(r) -> list:
              f"channel constant {p['share_alone']['const']:.0%}; all together "
              f"{p['r2_full']:.0%}, residual {p['residual_rms_db']:.2f} dB RMS",
              f"  attribution (each part fitted alone): {attribution_text(p['attribution'])}"]
+    if p.get("sides"):
+        from powertrain.diagnosis.sides import side_text
+        lines.append(f"  sides: {side_text(p['sides'])}")
     rg = r.rigid_gap[np.isfinite(r.rigid_gap)]
     if rg.size:
         lines.append(f"  outside the rigid-body span: median {np.median(rg):.2f} dB RMS "

@@ -93,6 +93,7 @@ class DiagnosisResult:
                 "structure_curves": p["structure_curves"],
                 "excitation_curves": p["excitation_curves"],
                 "attribution": p["attribution"]},
+            "sides": p.get("sides"),
             "outside_rigid_span_rms_db": {
                 "median": float(np.median(rg)) if rg.size else None,
                 "p90": float(np.percentile(rg, 90)) if rg.size else None},

@@ -265,6 +265,9 @@ def _region_kind(parts, sl, c, k):
 def where_text(found, parts):
     """The 'where' phrase of an unexplained verdict."""
     txt = attribution_text(parts["attribution"])
+    if parts.get("sides"):
+        from powertrain.diagnosis.sides import side_text
+        txt += "; " + side_text(parts["sides"])
     if found:
         r = found[0]
         txt += (f"; worst at {r['mount']} {r['direction']} {r['quantity']} "

@@ -116,6 +116,11 @@ class Effect:
         effect does not depend on amplitude (or is switched off)."""
         return None
 
+    def body_change(self, hm, p, body):
+        """The modal body under the mounts (:class:`~powertrain.solvers.body_coupling.ModalBody`)
+        with the effect; only called when the engine has one."""
+        return body
+
     def reading(self, velocity, p):
         """What the sensors read from the channel velocities (n_r, n_ch, n_h)."""
         return velocity

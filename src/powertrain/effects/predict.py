@@ -53,6 +53,16 @@ def _kip(hm, sc, abc):
     return kip
 
 
+def _body(hm, sc):
+    """The modal body under the mounts with the effects' changes (None: no body)."""
+    body = getattr(hm, "body", None)
+    if body is None:
+        return None
+    for eff, p in sc.values():
+        body = eff.body_change(hm, p, body)
+    return body
+
+
 def _amplitude_effect(hm, sc):
     """The amplitude-dependent effect of the scenario (switched on), or None."""
     for eff, p in sc.values():
@@ -67,7 +77,7 @@ def _iterate(hm, sc, s0, load, amp, tol, max_iter):
     iterations = 0
     for iterations in range(1, max_iter + 1):  # noqa: B007 (count returned)
         abc = hm.two_ports_scaled((s0[None, :] * g)[:, None, :])
-        q = hm.solve(_kip(hm, sc, abc), load)
+        q = hm.solve(_kip(hm, sc, abc), load, abc=abc, body=_body(hm, sc))
         g_new = eff.amplitude_factors(hm.network_amplitude(q), p)
         change = np.max(np.abs(g_new - g))
         g = g + 0.7 * (g_new - g)
@@ -104,7 +114,7 @@ def predict(hm: HarmonicModel, scenario: dict, *, tol=1e-6, max_iter=60) -> Pred
     if amp is not None:
         s0 = np.ones(len(hm.networks)) if s_el is None else s_el
         abc, iterations, g = _iterate(hm, sc, s0, load, amp, tol, max_iter)
-    v = hm.velocity(hm.solve(_kip(hm, sc, abc), load))
+    v = hm.velocity(hm.solve(_kip(hm, sc, abc), load, abc=abc, body=_body(hm, sc)))
     for eff, p in sc.values():
         v = eff.reading(v, p)
     return Prediction(v, iterations, g)

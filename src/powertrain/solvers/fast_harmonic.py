@@ -43,6 +43,7 @@ from powertrain.assembly import DIRECTIONS
 from powertrain.physics import balancer as bal
 from powertrain.physics.mount_network import two_port
 from powertrain.physics.rigid_body import direction_row, point_motion_matrix, rigid_body_mass_matrix
+from powertrain.solvers.body_coupling import ModalBody, body_channels, coupled_solve
 
 #: Harmonics of the engine cycle solved: h = 1..16 are orders 0.5..8.
 N_HARMONICS = 17
@@ -113,6 +114,29 @@ class HarmonicModel:
         self._load = None
         self._abc = None
         self._extra = {}
+        self._body_setup(engine)
+
+    def _body_setup(self, engine):
+        """A modal body under the mounts (:mod:`powertrain.solvers.body_coupling`): its
+        passive-side and body-point channels follow the engine-side ones."""
+        self.body = ModalBody.of(engine)
+        #: indices of the channels :meth:`velocity` returns (None: all of ``channels``)
+        self.output = None
+        self.active_channels = list(self.channels)
+        if self.body is None:
+            return
+        axes = [np.asarray(m.rotation, float) for m in engine.mounts]
+        self.body_shapes = self.body.network_shapes(self.networks, axes)
+        self.channels = self.channels + body_channels(self.mount_names, self.body)
+        n_a, K = self.channel_matrix.shape[0], self.body.n_modes
+        full = np.zeros((len(self.channels), 6 + K))
+        full[:n_a, :6] = self.channel_matrix
+        full[n_a:, 6:] = self.body.output_rows()
+        self.output_matrix = full
+
+    def use_channels(self, channels):
+        """Let :meth:`velocity` return ``channels`` only (names as :attr:`channels`)."""
+        self.output = np.array([self.channels.index(tuple(c)) for c in channels], int)
 
     # ------------------------------------------------------------------ cached parts
     def load_of(self, engine) -> np.ndarray:
@@ -199,12 +223,23 @@ class HarmonicModel:
         return tuple(abc)
 
     # ------------------------------------------------------------------ solves
-    def solve(self, kip, load=None, harmonics=slice(1, N_HARMONICS)) -> np.ndarray:
+    def solve(self, kip, load=None, harmonics=slice(1, N_HARMONICS), abc=None,
+              body=None) -> np.ndarray:
         r"""Rigid-body amplitudes :math:`\hat{\mathbf q}` (n_r, n_h, 6) for the given input-point
-        stiffnesses ``kip`` (n_r, 17, n_net) [N/m] and load (default nominal)."""
+        stiffnesses ``kip`` (n_r, 17, n_net) [N/m] and load (default nominal).
+
+        With a modal body (:attr:`body`) the amplitudes are (n_r, n_h, 6 + K), the body
+        modes last, coupled through the networks' two-ports ``abc`` (default nominal) to the
+        body ``body`` (default :attr:`body`) by
+        :func:`powertrain.solvers.body_coupling.coupled_solve`."""
         load = self.load if load is None else load
         w = self.omega[:, harmonics]
         K = kip[:, harmonics]
+        if self.body is not None:
+            abc = self.two_ports() if abc is None else abc
+            return coupled_solve(self.M, w, self.rows, self.body_shapes,
+                                 tuple(x[:, harmonics] for x in abc), K,
+                                 self.body if body is None else body, load[:, harmonics])
         D = (-(w ** 2))[..., None, None] * self.M + np.einsum(
             "rhn,ni,nj->rhij", K, self.rows, self.rows)
         return np.linalg.solve(D, load[:, harmonics][..., None])[..., 0]
@@ -212,12 +247,15 @@ class HarmonicModel:
     def velocity(self, q, harmonics=slice(1, N_HARMONICS)) -> np.ndarray:
         """Complex peak channel velocities (n_r, n_ch, n_h) [m/s] from :meth:`solve`'s q."""
         w = self.omega[:, harmonics]
-        return np.einsum("ci,rhi->rch", self.channel_matrix, q) * (1j * w)[:, None, :]
+        C = self.channel_matrix if self.body is None else self.output_matrix
+        if self.output is not None:
+            C = C[self.output]
+        return np.einsum("ci,rhi->rch", C, q) * (1j * w)[:, None, :]
 
     def network_amplitude(self, q) -> np.ndarray:
         r"""Engine-side peak displacement of each network :math:`a_n =
         \sqrt{\sum_h |\mathbf r_n\cdot\hat{\mathbf q}_h|^2}` [m] (= √2 × RMS sum), (n_r, n_net)."""
-        x = np.einsum("ni,rhi->rhn", self.rows, q)
+        x = np.einsum("ni,rhi->rhn", self.rows, q[..., :6])
         return np.sqrt(np.sum(np.abs(x) ** 2, axis=1))
 
     def __getstate__(self):

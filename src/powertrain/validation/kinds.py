@@ -24,6 +24,10 @@ truth effect            library match        drawn parameters
 ``sensor_bracket``      (outside)            one or two channels of a triad on a bracket
                                              resonating at 120–350 Hz, ζ 3–7 %
 ``powertrain_bending``  (outside)            gearbox-part bending mode 80–180 Hz, ζ 2–5 %
+``body_modes``          chassis_modes        passive-side plan only: the modal body's modes
+                                             (one or two shifted 12–25 % in frequency, their
+                                             mass and damping changed, all ± a few %,
+                                             shapes ± 0.03)
 ======================= ==================== ==============================================
 
 Cases, measurement noise and detectability: :mod:`powertrain.validation.cases`.
@@ -185,3 +189,35 @@ KINDS = {k.name: k for k in [
 ]}
 IN_LIBRARY = [k for k, v in KINDS.items() if v.library]
 OUT_OF_LIBRARY = [k for k, v in KINDS.items() if not v.library]
+
+
+# ----------------------------------------------------------------------- passive-side cases
+def _draw_body_modes(rng, engine):
+    """The vehicle body differs from the engine file's modal body: every mode ± 2 % in
+    frequency, ± 5 % in modal mass, ± 10 % in damping, shapes ± 0.03; one or two modes
+    0.75-0.88x or 1.12-1.3x in frequency with modal mass x e^N(0, 0.3) and damping
+    x e^U(-0.7, 0.7)."""
+    modes = engine.chassis.modes
+    n_k = len(modes)
+    f = np.array([m.frequency for m in modes]) * np.exp(rng.normal(0, 0.02, n_k))
+    mu = np.array([m.modal_mass for m in modes]) * np.exp(rng.normal(0, 0.05, n_k))
+    z = np.array([m.damping_ratio for m in modes]) * np.exp(rng.normal(0, 0.1, n_k))
+    changed = rng.choice(n_k, int(rng.integers(1, 3)), replace=False)
+    for k in changed:
+        f[k] *= rng.uniform(0.75, 0.88) if rng.random() < 0.5 else rng.uniform(1.12, 1.3)
+        mu[k] *= np.exp(rng.normal(0, 0.3))
+        z[k] *= np.exp(rng.uniform(-0.7, 0.7))
+    shapes = np.array([[m.shapes[mt.name] for mt in engine.mounts] for m in modes], float)
+    shapes = shapes + rng.normal(0, 0.03, shapes.shape)
+    return {"body": tr.BodyModes(f, mu, z, shapes), "changed": [int(k) for k in changed]}
+
+
+def _apply_body_modes(p, parts):
+    parts["body"] = p["body"]
+
+
+#: Truth kinds of the passive-side plan only (:mod:`powertrain.validation.passive`); kept out
+#: of :data:`IN_LIBRARY`, so the default plan's draws are unchanged.
+PASSIVE_KINDS = {"body_modes": TruthKind("body_modes", "chassis_modes", _draw_body_modes,
+                                         _apply_body_modes)}
+KINDS.update(PASSIVE_KINDS)

@@ -122,6 +122,30 @@ def score(rows) -> dict:
                     "unexplained_ok": _rate(out, is_unexplained)}}
 
 
+#: Issue 13's target on the passive-side plan: body-mode (chassis) and single-mount stiffness
+#: offsets named in at least this fraction of the detectable cases.
+PASSIVE_TARGET = 0.9
+#: Truth kinds that target counts (library matches ``chassis_modes``, ``mount_stiffness``).
+PASSIVE_KINDS = ("body_modes", "mount_temperature")
+
+
+def passive_rate(rows) -> Rate:
+    """Of the detectable single-effect cases whose hidden effect is a body-mode or a
+    one-mount stiffness offset, those whose claim is the expected effect (top-1)."""
+    sel = [r for r in rows if r["detectable"] and len(r["names"]) == 1
+           and r["names"][0] in PASSIVE_KINDS]
+    return _rate(sel, top1_hit)
+
+
+def passive_line(rows) -> str:
+    """``passive: chassis_and_mount_top1=0.93 (14/15, Wilson 0.70-0.99) target >= 0.9: met``."""
+    r = passive_rate(rows)
+    lo, hi = r.interval
+    ok = r.n > 0 and r.value >= PASSIVE_TARGET
+    return (f"passive: chassis_and_mount_top1={r.value:.2f} ({r.k}/{r.n}, Wilson "
+            f"{lo:.2f}-{hi:.2f}) target >= {PASSIVE_TARGET:g}: {'met' if ok else 'NOT met'}")
+
+
 def _value(x):
     return x.value if isinstance(x, Rate) else x
 

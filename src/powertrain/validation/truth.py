@@ -25,6 +25,10 @@ the effects' own parametrisations. The truth is made differently:
     measured-trace engines alike;
   - chassis: a base mass under every mount with its own three springs, all bases on one or
     two global chassis modes (random shapes);
+  - body modes (:class:`BodyModes`): the mount bases directly on a vehicle body's modes,
+    each mode's frequency, modal mass, damping and shape its own; with ``passive`` the
+    body side of every mount is output too (base node or attachment-point motion), as a
+    test lab measures both sides;
   - sensors: per-channel gain, triad rotation and cross-axis sensitivity (a 3×3 matrix per
     triad); a sensor bracket's resonance (base-excitation transmissibility);
   - powertrain bending: a flexible degree of freedom of the gearbox part, inertially coupled
@@ -81,6 +85,25 @@ class ChassisBase:
 
 
 @dataclass(frozen=True)
+class BodyModes:
+    """A vehicle body whose modes the mount bases sit on directly (no base mass between).
+
+    Attributes
+    ----------
+    mode_hz, modal_mass, zeta : ndarray (n_modes,)
+        [Hz], [kg], [-].
+    shapes : ndarray (n_modes, n_mounts, 3)
+        Body motion at each mount's attachment point per unit modal coordinate, engine
+        axes [-].
+    """
+
+    mode_hz: np.ndarray
+    modal_mass: np.ndarray
+    zeta: np.ndarray
+    shapes: np.ndarray
+
+
+@dataclass(frozen=True)
 class BendingMode:
     """Engine-gearbox bending: the gearbox part (mass ``mass`` at ``point``) moves by
     ``shape_point`` η relative to the rigid body; mount points move by ``shape_mounts`` η.
@@ -122,6 +145,10 @@ class TruthSpec:
     bending: BendingMode | None = None
     amplitude_beta: np.ndarray | None = None
     sensor: list = field(default_factory=list)
+    #: a modal body under the mounts (bases directly on its modes)
+    body: BodyModes | None = None
+    #: also output every mount's body side (channels ``NAME/passive``, after the engine side)
+    passive: bool = False
 
 
 # ----------------------------------------------------------------------- assembly
@@ -137,21 +164,28 @@ def _rigid_mass(body):
     return M
 
 
-def _layout(mounts, chassis, bending):
-    """Index of the first bending, network, base and chassis-mode coordinates."""
+def _layout(mounts, chassis, bending, body=None):
+    """Index of the first bending, network, base and chassis-mode (or body-mode)
+    coordinates."""
     n_int = sum(mt.directions[a].network()[0].size for mt in mounts for a in "xyz")
     i_bend = 6
     i_net = i_bend + (1 if bending is not None else 0)
     i_base = i_net + n_int
     i_mode = i_base + (3 * len(mounts) if chassis is not None else 0)
     n = i_mode + (len(chassis.mode_hz) if chassis is not None else 0)
+    n += len(body.mode_hz) if body is not None else 0
     return i_bend, i_net, i_base, i_mode, n
 
 
-def assemble_truth(body, mounts, chassis=None, bending=None) -> AssembledSystem:
+def assemble_truth(body, mounts, chassis=None, bending=None, modes=None,
+                   passive=False) -> AssembledSystem:
     """Linear model of the rigid powertrain on its mount networks, with optional chassis
-    bases and bending mode (see the module docstring). Force outputs are left zero."""
-    i_bend, i_net, i_base, i_mode, n = _layout(mounts, chassis, bending)
+    bases, body modes ``modes`` (:class:`BodyModes`; not with ``chassis``) and bending mode
+    (see the module docstring). ``passive``: the body side of every mount as further
+    channels (``NAME/passive``). Force outputs are left zero."""
+    if chassis is not None and modes is not None:
+        raise ValueError("chassis bases and body modes are exclusive")
+    i_bend, i_net, i_base, i_mode, n = _layout(mounts, chassis, bending, modes)
     M, C, K = (np.zeros((n, n)) for _ in range(3))
     M[:6, :6] = _rigid_mass(body)
     cg = np.asarray(body.cg, float)
@@ -170,11 +204,15 @@ def assemble_truth(body, mounts, chassis=None, bending=None) -> AssembledSystem:
             L[1:ni + 1, start:start + ni] = np.eye(ni)
             if chassis is not None:
                 L[ni + 1, i_base + 3 * m:i_base + 3 * m + 3] = e
+            elif modes is not None:
+                L[ni + 1, i_mode:] = modes.shapes[:, m, :] @ e
             for G, g in ((M, Mn), (C, Cn), (K, Kn)):
                 G += L.T @ g @ L
             start += ni
     if chassis is not None:
         _add_chassis(M, C, K, chassis, i_base, i_mode, len(mounts))
+    if modes is not None:
+        _add_body_modes(M, C, K, modes, i_mode)
     if bending is not None:
         _add_bending(M, C, K, bending, cg, i_bend)
     channels = [(mt.name, a) for mt in mounts for a in "xyz"]
@@ -185,6 +223,8 @@ def assemble_truth(body, mounts, chassis=None, bending=None) -> AssembledSystem:
             Cm[3 * m + a, :6] = _point_row(r, np.eye(3)[a])
             if bending is not None:
                 Cm[3 * m + a, i_bend] = bending.shape_mounts[m][a]
+    if passive:
+        channels, Cm = _passive_outputs(channels, Cm, mounts, chassis, modes, i_base, i_mode)
     Z = np.zeros_like(Cm)
     return AssembledSystem(M, C, K, channels, Cm, Z, Z.copy())
 
@@ -209,6 +249,30 @@ def _add_chassis(M, C, K, ch: ChassisBase, i_base, i_mode, n_mounts):
             C += c * np.outer(row, row)
 
 
+def _add_body_modes(M, C, K, modes: BodyModes, i_mode):
+    for k, (f, mu, z) in enumerate(zip(modes.mode_hz, modes.modal_mass, modes.zeta)):
+        w = 2 * np.pi * f
+        j = i_mode + k
+        M[j, j] += mu
+        K[j, j] += mu * w ** 2
+        C[j, j] += 2 * z * mu * w
+
+
+def _passive_outputs(channels, Cm, mounts, chassis, modes, i_base, i_mode):
+    """Channels and output rows with the body side of every mount appended: the base node
+    (chassis bases), the body's motion at the attachment point (body modes), or zero
+    (rigid ground)."""
+    rows = np.zeros((3 * len(mounts), Cm.shape[1]))
+    for m in range(len(mounts)):
+        for a in range(3):
+            if chassis is not None:
+                rows[3 * m + a, i_base + 3 * m + a] = 1.0
+            elif modes is not None:
+                rows[3 * m + a, i_mode:] = modes.shapes[:, m, a]
+    names = [(f"{mt.name}/passive", a) for mt in mounts for a in "xyz"]
+    return channels + names, np.vstack([Cm, rows])
+
+
 def _add_bending(M, C, K, b: BendingMode, cg, i):
     r = np.asarray(b.point, float) - cg
     P = np.array([_point_row(r, np.eye(3)[a]) for a in range(3)])     # (3, 6)
@@ -229,7 +293,8 @@ def simulate_truth(spec: TruthSpec, rpm):
     rpm = np.asarray(rpm, float)
     body = spec.engine.body
     if spec.amplitude_beta is None:
-        sys_ = assemble_truth(body, spec.mounts, spec.chassis, spec.bending)
+        sys_ = assemble_truth(body, spec.mounts, spec.chassis, spec.bending, spec.body,
+                              spec.passive)
         res = run_runup(spec.engine, rpm, system=sys_, **NEWMARK)
         vel = res.velocity
     else:
@@ -244,7 +309,8 @@ def _amplitude_runup(spec: TruthSpec, rpm):
     """Equivalent linearisation of the amplitude power law, one assembly per speed."""
     from powertrain.runup import run_runup
     body = spec.engine.body
-    sys0 = assemble_truth(body, spec.mounts, spec.chassis, spec.bending)
+    sys0 = assemble_truth(body, spec.mounts, spec.chassis, spec.bending, spec.body,
+                          spec.passive)
     res = run_runup(spec.engine, rpm, system=sys0, **NEWMARK)
     disp, vel = res.displacement, res.velocity
     factors = None
@@ -253,7 +319,8 @@ def _amplitude_runup(spec: TruthSpec, rpm):
         factors = new if factors is None else np.sqrt(factors * new)   # damped update
         for i, n_rpm in enumerate(rpm):
             mounts = [_scaled_mount(mt, factors[i, m]) for m, mt in enumerate(spec.mounts)]
-            s = assemble_truth(body, mounts, spec.chassis, spec.bending)
+            s = assemble_truth(body, mounts, spec.chassis, spec.bending, spec.body,
+                               spec.passive)
             r = run_runup(spec.engine, [n_rpm], system=s, **NEWMARK)
             disp[i], vel[i] = r.displacement[0], r.velocity[0]
     return vel

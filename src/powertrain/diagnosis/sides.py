@@ -1,0 +1,120 @@
+r"""Part of step 1 (where): does the gap live in the body, or in the mounts / the excitation?
+
+Used when the measured file carries body-side (passive) channels the model predicts (a
+modal body under the mounts). With the gap :math:`\Delta L` [dB] (+ = simulation higher)
+on the engine side (a) and the body side (p) of each mount, order and speed:
+
+* the **isolation change** of a mount, :math:`\Delta I = \Delta L_a - \Delta L_p`, the
+  model's isolation (engine-side minus body-side level) minus the measured one; a changed
+  excitation moves both sides alike (:math:`\Delta I \approx 0`);
+* the gap lives **in the body** when the body side carries it: passive-side gap RMS at
+  least :data:`BODY_RATIO` × the engine side's and at least :data:`BODY_MIN_DB`, and the
+  passive gap is found at :data:`MIN_SHARED_MOUNTS` or more mount bases — a shared body
+  resonance (its band: the frequencies where the passive gap is largest);
+* **in the mounts** when the isolation changed (:math:`\Delta I` RMS ≥ :data:`ISO_MIN_DB`)
+  with the engine side off too;
+* otherwise **engine side / excitation**: both sides off alike, isolation kept.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from powertrain.assembly import split_side
+
+#: The passive side must carry at least this multiple of the engine side's gap RMS [1]
+#: (a body change barely moves the engine side: issue 13 measured 0.06-0.3 dB there).
+BODY_RATIO = 2.0
+#: ... and at least this much [dB] (twice the 0.5 dB by which a model may miss).
+BODY_MIN_DB = 1.0
+#: A mount base counts as off when its passive gap RMS reaches this [dB].
+MOUNT_OFF_DB = 1.0
+#: Mount bases that must be off for a shared (body) resonance [1].
+MIN_SHARED_MOUNTS = 2
+#: Isolation change RMS that points at the mounts [dB].
+ISO_MIN_DB = 1.0
+
+
+def _rms(x) -> float:
+    x = np.asarray(x, float)
+    x = x[np.isfinite(x)]
+    return float(np.sqrt(np.mean(x ** 2))) if x.size else float("nan")
+
+
+def _pairs(channels):
+    """(engine-side index, body-side index, mount) of every mount direction measured on
+    both sides."""
+    index = {c: i for i, c in enumerate(channels)}
+    out = []
+    for i, (m, d) in enumerate(channels):
+        base, side = split_side(m)
+        if side == "passive" and (base, d) in index:
+            out.append((index[(base, d)], i, base))
+    return out
+
+
+def _band(gap, data, cols):
+    """Frequency band [Hz] where the passive gap is largest (points within 6 dB of the
+    largest |gap| on these channels)."""
+    order = (data.harmonic + 1) / 2.0
+    f = data.rpm[:, None, None] * order[None, None, :] / 60.0
+    g = np.abs(gap[:, cols][:, :, data.order_mask])
+    f = np.broadcast_to(f, gap.shape)[:, cols][:, :, data.order_mask]
+    ok = np.isfinite(g)
+    if not ok.any():
+        return None
+    hot = ok & (g >= np.max(g[ok]) - 6.0)
+    return [float(np.min(f[hot])), float(np.max(f[hot]))]
+
+
+def side_attribution(gap, data) -> dict | None:
+    """Which side carries the order gap (module docstring); None without body-side pairs.
+
+    Parameters
+    ----------
+    gap : ndarray (n_r, n_ch, n_q)
+        Gap map [dB], NaN where censored or not measured.
+    data : GapData
+    """
+    pairs = _pairs(data.channels)
+    if not pairs:
+        return None
+    om = data.order_mask
+    a_idx = [a for a, _, _ in pairs]
+    p_idx = [p for _, p, _ in pairs]
+    ga, gp = gap[:, a_idx][:, :, om], gap[:, p_idx][:, :, om]
+    rms_a, rms_p, rms_iso = _rms(ga), _rms(gp), _rms(ga - gp)
+    per_mount = {}
+    for (_, p, base) in pairs:
+        per_mount.setdefault(base, []).append(p)
+    off = [m for m, cols in per_mount.items() if _rms(gap[:, cols][:, :, om]) >= MOUNT_OFF_DB]
+    if (np.isfinite(rms_p) and rms_p >= BODY_MIN_DB
+            and rms_p >= BODY_RATIO * (rms_a if np.isfinite(rms_a) else 0.0)
+            and len(off) >= MIN_SHARED_MOUNTS):
+        where = "body"
+    elif np.isfinite(rms_iso) and rms_iso >= ISO_MIN_DB and rms_a >= MOUNT_OFF_DB / 2:
+        where = "mounts"
+    else:
+        where = "engine side or excitation"
+    cols = [p for m in off for p in per_mount[m]]
+    return {"location": where, "engine_side_rms_db": rms_a, "body_side_rms_db": rms_p,
+            "isolation_change_rms_db": rms_iso, "mounts_off_body_side": off,
+            "band_hz": _band(gap, data, cols) if (where == "body" and cols) else None}
+
+
+def side_text(s) -> str:
+    """One phrase for the where step ('' without body-side channels)."""
+    if not s:
+        return ""
+    nums = (f"body side {s['body_side_rms_db']:.1f} dB RMS vs engine side "
+            f"{s['engine_side_rms_db']:.1f} dB, isolation changed by "
+            f"{s['isolation_change_rms_db']:.1f} dB RMS")
+    if s["location"] == "body":
+        band = s.get("band_hz")
+        at = f" near {band[0]:.0f}-{band[1]:.0f} Hz" if band else ""
+        return (f"the gap lives in the body: a resonance shared by the bases of "
+                f"{', '.join(s['mounts_off_body_side'])}{at} ({nums})")
+    if s["location"] == "mounts":
+        return f"the gap changes the mounts' isolation: it lives in the mounts ({nums})"
+    return (f"both sides of the mounts are off alike: the gap lives on the engine side or in "
+            f"the excitation, not in the body ({nums})")

@@ -1,0 +1,105 @@
+r"""``chassis_modes``: the body modes shared by the mount bases are not where the model has them.
+
+For an engine with a modal body (``[chassis] model = "modal"``, :mod:`powertrain.models.chassis`)
+each body mode k gets its natural frequency ``f<k>`` [Hz], modal mass ``m<k>`` [kg] and
+damping ratio ``z<k>`` [1] fitted; its shape at the mount attachment points (and body points)
+is kept from the engine file. The fast path couples the rigid powertrain to the changed
+modes through the mount two-ports (:mod:`powertrain.solvers.body_coupling`), so the effect
+moves the body-side (passive) channels most and the engine side a little.
+
+**Why shapes are not fitted.** The measured data are order *magnitudes* at the body side of
+three or four mounts: a mode's shape at the attachment points and its modal mass enter the
+receptance only as :math:`\psi\psi^T/m_k`, so a common scale of the shape is the modal mass
+itself, and free shapes would add 3 × (number of mounts) parameters per mode with only
+magnitudes (signs lost) to fix them — poorly identified and far over the evaluation budget.
+Frequency, modal mass and damping of the file's modes are what a body-in-white test or a
+trimmed-body FE update changes, are identifiable from where and how high the shared
+resonance appears on the passive side, and keep the fit to three parameters per mode.
+A body mode entirely missing from the file is outside this candidate (the diagnosis then
+answers "unexplained" with the gap attributed to the body side, :mod:`powertrain.diagnosis.sides`).
+
+Applicable to engines with a modal body only (on a rigid chassis the model predicts no
+body-side motion to compare with).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from powertrain.effects.base import Effect, Parameter
+
+#: Frequency bounds relative to the file's value [1].
+FREQ_RANGE = (0.6, 1.6)
+#: Modal-mass bounds relative to the file's value [1].
+MASS_RANGE = (0.25, 4.0)
+#: Damping-ratio bounds [1].
+ZETA_RANGE = (0.005, 0.25)
+#: Frequency factors of the start grid (each mode) [1].
+GRID_FREQ = (0.85, 1.15)
+
+
+def _modes(engine):
+    ch = getattr(engine, "chassis", None)
+    if ch is None or ch.model != "modal":
+        return ()
+    return tuple(ch.modes)
+
+
+class ChassisModes(Effect):
+    name = "chassis_modes"
+    kind = "structure"
+    description = ("body modes shared by the mount bases: frequency, modal mass and damping "
+                   "of each of the engine file's body modes (shapes kept)")
+
+    def parameters(self, engine=None):
+        modes = _modes(engine)
+        if not modes:      # generic layout without a modal body (not applicable there)
+            return (Parameter("f1", "Hz", 5.0, 200.0, 30.0, True, "body mode 1 frequency"),
+                    Parameter("m1", "kg", 1.0, 500.0, 40.0, True, "body mode 1 modal mass"),
+                    Parameter("z1", "1", *ZETA_RANGE, 0.03, True, "body mode 1 damping ratio"))
+        out = []
+        for k, m in enumerate(modes):
+            z0 = float(np.clip(m.damping_ratio, *ZETA_RANGE))
+            out += [Parameter(f"f{k + 1}", "Hz", FREQ_RANGE[0] * m.frequency,
+                              FREQ_RANGE[1] * m.frequency, m.frequency, True,
+                              f"natural frequency of body mode {k + 1} (file: "
+                              f"{m.frequency:g} Hz)"),
+                    Parameter(f"m{k + 1}", "kg", MASS_RANGE[0] * m.modal_mass,
+                              MASS_RANGE[1] * m.modal_mass, m.modal_mass, True,
+                              f"modal mass of body mode {k + 1} (file: {m.modal_mass:g} kg)"),
+                    Parameter(f"z{k + 1}", "1", *ZETA_RANGE, z0, True,
+                              f"damping ratio of body mode {k + 1} (file: "
+                              f"{m.damping_ratio:g})")]
+        return tuple(out)
+
+    def applicable(self, engine) -> bool:
+        return bool(_modes(engine))
+
+    def start_grid(self, engine=None):
+        """Each mode's frequency at 0.85 and 1.15 × the file's (masses, damping at the
+        file's values): 2^K start points, the two best kept."""
+        modes = _modes(engine)
+        if not modes or len(modes) > 5:
+            return ()
+        out = []
+        for m in modes:
+            out += [tuple(g * m.frequency for g in GRID_FREQ), (m.modal_mass,),
+                    (float(np.clip(m.damping_ratio, *ZETA_RANGE)),)]
+        return tuple(out)
+
+    def apply(self, engine, **params):
+        import dataclasses
+        modes = []
+        for k, m in enumerate(engine.chassis.modes):
+            modes.append(dataclasses.replace(
+                m, frequency=float(params.get(f"f{k + 1}", m.frequency)),
+                modal_mass=float(params.get(f"m{k + 1}", m.modal_mass)),
+                damping_ratio=float(params.get(f"z{k + 1}", m.damping_ratio))))
+        return engine.replace(chassis=dataclasses.replace(engine.chassis, modes=tuple(modes)))
+
+    def body_change(self, hm, p, body):
+        K = body.n_modes
+        f = [p.get(f"f{k + 1}", body.frequency_hz[k]) for k in range(K)]
+        m = [p.get(f"m{k + 1}", body.modal_mass[k]) for k in range(K)]
+        z = [p.get(f"z{k + 1}", body.damping_ratio[k]) for k in range(K)]
+        return body.with_modes(f, m, z)

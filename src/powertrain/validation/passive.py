@@ -1,0 +1,97 @@
+r"""Passive-side cases of the blind benchmark: both sides of every mount measured.
+
+A test lab measures the engine side *and* the body side of each mount. These cases are run
+on the default engine with the modal body of ``engines/default-modal-body.toml`` (four
+**illustrative** body modes; also with measured pressure traces), and the truth is made on
+the truth path (:mod:`powertrain.validation.truth`: own assembly with the mount bases on the
+body's modes, Newmark run-up) with the body side of every mount as further channels
+(``NAME/passive``), measured with the same scatter and noise floor as the engine side
+(:func:`powertrain.validation.cases.measure`).
+
+**Plan** (:func:`passive_plan`), repeated every 10 cases: ``body_modes`` four times (the
+body's modes differ from the file's, :data:`powertrain.validation.kinds.PASSIVE_KINDS`),
+``mount_temperature`` four times (one mount 0.5–0.8× or 1.25–2× as stiff), two effect-free;
+engines alternating. The diagnosis gets the modal-body engine (nominal body) and the
+measured file with both sides.
+"""
+
+from __future__ import annotations
+
+import functools
+
+import numpy as np
+
+from powertrain.validation import truth as tr
+from powertrain.validation.cases import RPM, SIGMA_DB, Case, gap_stats, measure, traces_engine
+from powertrain.validation.kinds import KINDS
+
+#: Engine kinds of the passive-side cases.
+ENGINE_KINDS = ("body_sz", "body_traces")
+_LAP = [("body_modes", "body_sz"), ("mount_temperature", "body_traces"), ("none", "body_sz"),
+        ("body_modes", "body_traces"), ("mount_temperature", "body_sz"),
+        ("body_modes", "body_sz"), ("mount_temperature", "body_traces"),
+        ("none", "body_traces"), ("body_modes", "body_traces"), ("mount_temperature", "body_sz")]
+
+
+def passive_plan(n_cases, seed):
+    """``[(names, engine kind, case seed)]`` of the passive-side plan (module docstring)."""
+    out = []
+    for i in range(n_cases):
+        case_seed = int(np.random.SeedSequence([seed, 13, i]).generate_state(1)[0])
+        name, eng = _LAP[i % len(_LAP)]
+        out.append(([] if name == "none" else [name], eng, case_seed))
+    return out
+
+
+@functools.cache
+def passive_engines():
+    """``{"body_sz": the modal-body engine, "body_traces": the same with measured
+    traces}``."""
+    from powertrain.iotools.engine_file import DEFAULT_ENGINE_PATH, read_engine
+    e = read_engine(DEFAULT_ENGINE_PATH.parent / "default-modal-body.toml")
+    return {"body_sz": e, "body_traces": traces_engine(e)}
+
+
+def nominal_body(engine) -> tr.BodyModes:
+    """The engine file's modal body as the truth path's :class:`~.truth.BodyModes`."""
+    modes = engine.chassis.modes
+    shapes = np.array([[m.shapes[mt.name] for mt in engine.mounts] for m in modes], float)
+    return tr.BodyModes(np.array([m.frequency for m in modes], float),
+                        np.array([m.modal_mass for m in modes], float),
+                        np.array([m.damping_ratio for m in modes], float), shapes)
+
+
+def channels(engine) -> list:
+    """Engine-side channels, then the body side of every mount."""
+    act = [(mt.name, a) for mt in engine.mounts for a in "xyz"]
+    return act + [(f"{mt.name}/passive", a) for mt in engine.mounts for a in "xyz"]
+
+
+def truth_velocity(engine, truth):
+    """Noise-free truth (engine and body side) of ``[(kind name, params)]`` on ``engine``."""
+    parts = {"engine": engine, "mounts": list(engine.mounts), "chassis": None,
+             "bending": None, "amplitude_beta": None, "sensor": [],
+             "body": nominal_body(engine), "passive": True}
+    for name, params in truth:
+        KINDS[name].apply(params, parts)
+    return tr.simulate_truth(tr.TruthSpec(**parts), RPM)
+
+
+@functools.cache
+def baseline_velocity(engine_kind):
+    """Noise-free baseline on the truth path, both sides (n_r, 18, 16) [m/s peak]."""
+    return truth_velocity(passive_engines()[engine_kind], [])
+
+
+def make_passive_case(index, names, engine_kind, seed) -> Case:
+    """Draw, simulate and measure one passive-side case."""
+    rng = np.random.default_rng(seed)
+    engine = passive_engines()[engine_kind]
+    truth = [(n, KINDS[n].draw(rng, engine)) for n in names]
+    base = baseline_velocity(engine_kind)
+    clean = truth_velocity(engine, truth) if truth else base
+    sigma = float(rng.uniform(*SIGMA_DB))
+    measured = measure(clean, sigma, rng, f"blind passive case {index} (seed {seed})",
+                       channels(engine))
+    return Case(index, list(names), engine_kind, seed, measured, sigma, truth, clean,
+                gap_stats(base, clean), {})
