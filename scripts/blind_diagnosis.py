@@ -86,6 +86,7 @@ def run_case(task):
             "claimed": sorted(chosen.get("effects", [])) if chosen else [],
             "parameters": chosen.get("parameters") if chosen else None,
             "ambiguous": d.get("ambiguous_between", []), "shrink": shrink,
+            "where_side": (where.get("sides") or {}).get("location"),
             "measured_shrink": 1 - after / before if before else 0.0,
             "t_gen": t_gen, "t_diag": t_diag, "cpu_diag": c_diag}
 
@@ -185,6 +186,7 @@ def main(argv=None):
         TARGETS,
         meets_targets,
         passive_line,
+        passive_where_line,
         score,
         score_line,
     )
@@ -225,6 +227,7 @@ def main(argv=None):
         with open(args.dump, "w") as fh:
             json.dump(rows, fh, indent=1)
     if args.plan == "passive":
+        print(passive_where_line(rows))
         print(passive_line(rows))
     print("raw: " + score_line(sc["raw"]))
     print(score_line(sc))

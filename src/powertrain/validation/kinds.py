@@ -27,7 +27,7 @@ truth effect            library match        drawn parameters
 ``body_modes``          chassis_modes        passive-side plan only: the modal body's modes
                                              (one or two shifted 12–25 % in frequency, their
                                              mass and damping changed, all ± a few %,
-                                             shapes ± 0.03)
+                                             shape components ± 5 %)
 ======================= ==================== ==============================================
 
 Cases, measurement noise and detectability: :mod:`powertrain.validation.cases`.
@@ -194,7 +194,7 @@ OUT_OF_LIBRARY = [k for k, v in KINDS.items() if not v.library]
 # ----------------------------------------------------------------------- passive-side cases
 def _draw_body_modes(rng, engine):
     """The vehicle body differs from the engine file's modal body: every mode ± 2 % in
-    frequency, ± 5 % in modal mass, ± 10 % in damping, shapes ± 0.03; one or two modes
+    frequency, ± 5 % in modal mass, ± 10 % in damping, shape components ± 5 %; one or two modes
     0.75-0.88x or 1.12-1.3x in frequency with modal mass x e^N(0, 0.3) and damping
     x e^U(-0.7, 0.7)."""
     modes = engine.chassis.modes
@@ -208,7 +208,7 @@ def _draw_body_modes(rng, engine):
         mu[k] *= np.exp(rng.normal(0, 0.3))
         z[k] *= np.exp(rng.uniform(-0.7, 0.7))
     shapes = np.array([[m.shapes[mt.name] for mt in engine.mounts] for m in modes], float)
-    shapes = shapes + rng.normal(0, 0.03, shapes.shape)
+    shapes = shapes * np.exp(rng.normal(0, 0.05, shapes.shape))
     return {"body": tr.BodyModes(f, mu, z, shapes), "changed": [int(k) for k in changed]}
 
 

@@ -146,6 +146,21 @@ def passive_line(rows) -> str:
             f"{lo:.2f}-{hi:.2f}) target >= {PASSIVE_TARGET:g}: {'met' if ok else 'NOT met'}")
 
 
+#: What the "where" step should say per passive-side truth kind.
+PASSIVE_WHERE = {"body_modes": "body", "mount_temperature": "mounts"}
+
+
+def passive_where_line(rows) -> str:
+    """``passive where: body_modes -> body 9/10, mount_temperature -> mounts 4/6`` over the
+    detectable single-effect cases (the diagnosis' ``where.sides.location``)."""
+    parts = []
+    for kind, loc in PASSIVE_WHERE.items():
+        sel = [r for r in rows if r["detectable"] and r["names"] == [kind]]
+        k = sum(r.get("where_side") == loc for r in sel)
+        parts.append(f"{kind} -> {loc} {Rate(k, len(sel))}")
+    return "passive where: " + ", ".join(parts)
+
+
 def _value(x):
     return x.value if isinstance(x, Rate) else x
 
