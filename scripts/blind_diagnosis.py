@@ -21,8 +21,8 @@ changed, effect-free) and a line ``passive: chassis_and_mount_top1=...`` (issue 
 is printed before the raw scores.
 
 Usage: ``python scripts/blind_diagnosis.py --cases 50 [--seed S] [--jobs 2]
-[--scheduler local|tcp://HOST:PORT] [--dump rows.json] [--plan default|passive]``. Without ``--seed`` the seed is
-drawn from ``os.urandom`` and printed.
+[--scheduler local|tcp://HOST:PORT] [--dump rows.json] [--plan default|passive]``.
+Without ``--seed`` the seed is drawn from ``os.urandom`` and printed.
 """
 
 from __future__ import annotations

@@ -1,0 +1,115 @@
+"""Diagnosis with both sides of the mounts measured (issue 13, item 5): body-side channels
+in the data, the "where" step's side attribution, the own two-sided run-up.
+
+Oracles: hand-made gap maps with a known location (body, mounts, engine side), the
+channel lists an engine-side-only file had before, and the model's own run-up (answers
+"no effect" on a fresh scatter draw).
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from powertrain.diagnosis import diagnose, gap_data
+from powertrain.diagnosis.sides import (
+    BODY_MIN_DB,
+    ISO_MIN_DB,
+    side_attribution,
+    side_text,
+)
+from powertrain.effects import predict
+from powertrain.iotools.engine_file import DEFAULT_ENGINE_PATH, read_engine
+from powertrain.iotools.measured import MeasuredRunup
+from powertrain.solvers.fast_harmonic import HarmonicModel
+from powertrain.validation.cases import FLOOR, RPM, measure
+from powertrain.validation.passive import channels as both_sides
+
+MODAL = Path(DEFAULT_ENGINE_PATH).parent / "default-modal-body.toml"
+
+
+@pytest.fixture(scope="module")
+def engine():
+    return read_engine(MODAL)
+
+
+@pytest.fixture(scope="module")
+def own(engine):
+    """The model's own both-sides run-up on the benchmark grid, measured with 0.5 dB scatter
+    (fresh draw) and the noise floor."""
+    hm = HarmonicModel(engine, RPM)
+    hm.use_channels(both_sides(engine))
+    v = predict(hm, {}).velocity
+    return measure(v, 0.5, np.random.default_rng(), "own two-sided run-up", both_sides(engine))
+
+
+def _engine_side_only(m):
+    return MeasuredRunup({k: v for k, v in m.curves.items() if "/" not in k[0]},
+                         source="engine side only")
+
+
+def test_gap_data_reads_body_side_channels_the_model_predicts(engine, own):
+    d = gap_data(own, engine, FLOOR)
+    assert d.channels == both_sides(engine) and d.n_active == 9
+    assert np.isfinite(d.level[:, 9:]).any()
+    assert d.active_only().channels == both_sides(engine)[:9]
+    # a rigid-chassis model predicts no body side: those channels are left out, as before
+    rigid = gap_data(own, read_engine(DEFAULT_ENGINE_PATH), FLOOR)
+    assert rigid.channels == both_sides(engine)[:9]
+
+
+def test_engine_side_only_file_is_read_as_before(engine, own):
+    old = _engine_side_only(own)
+    a = gap_data(old, engine, FLOOR)
+    b = gap_data(old, read_engine(DEFAULT_ENGINE_PATH), FLOOR)
+    assert a.channels == b.channels and len(a.channels) == 9
+    np.testing.assert_array_equal(a.level, b.level)
+
+
+def _data_and_gap(active_db, passive_db, n_off=3):
+    """Gap map on 9 engine-side and 9 body-side channels: constant per side; the body side
+    off at the first ``n_off`` mounts only."""
+    from powertrain.diagnosis.data import GapData
+    rpm = np.arange(1000.0, 3001.0, 100.0)
+    ch = [(m, a) for m in ("left", "right", "gearbox") for a in "xyz"]
+    ch = ch + [(f"{m}/passive", a) for m, a in ch]
+    lev = np.ones((rpm.size, 18, 2)) * 1e-3
+    d = GapData(rpm, ch, ["order_1", "order_2"], np.array([1, 3]), lev, 1e-6, 9)
+    gap = np.zeros_like(lev)
+    gap[:, :9] = active_db
+    gap[:, 9:9 + 3 * n_off] = passive_db
+    return d, gap
+
+
+@pytest.mark.parametrize("active, passive, n_off, where", [
+    (0.2, 3.0, 3, "body"),                         # body side carries it, at every base
+    (0.2, 3.0, 1, "engine side or excitation"),    # one base only: not a shared body mode
+    (0.2, 0.8 * BODY_MIN_DB, 3, "engine side or excitation"),   # below BODY_MIN_DB
+    (1.0, 1.0, 3, "engine side or excitation"),    # both sides alike: isolation kept
+    (1.0, 1.0 - 1.2 * ISO_MIN_DB, 3, "mounts"),    # isolation changed, engine side off
+    (1.0, 1.0 - 0.8 * ISO_MIN_DB, 3, "engine side or excitation"),
+])
+def test_side_attribution_both_sides_of_each_threshold(active, passive, n_off, where):
+    d, gap = _data_and_gap(active, passive, n_off)
+    s = side_attribution(gap, d)
+    assert s["location"] == where, s
+    assert side_text(s)
+
+
+def test_no_body_side_channels_no_side_attribution():
+    d, gap = _data_and_gap(1.0, 1.0)
+    from powertrain.diagnosis.data import GapData
+    d9 = GapData(d.rpm, d.channels[:9], d.quantities, d.harmonic, d.level[:, :9], d.floor)
+    assert side_attribution(gap[:, :9], d9) is None and side_text(None) == ""
+
+
+def test_own_two_sided_runup_is_no_effect(engine, own):
+    r = diagnose(own, engine, noise_floor=FLOOR, progress=False, pairs=False,
+                 band_check=False)
+    d = r.to_dict()
+    assert d["verdict"] == "no effect", d["verdict_text"]
+    assert [list(c) for c in both_sides(engine)] == d["where"]["channels"]
+    assert d["where"]["sides"]["location"] == "engine side or excitation"
+    assert "chassis_modes" in [o["effect"] for o in d["ranking"]]
