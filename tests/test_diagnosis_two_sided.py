@@ -85,7 +85,7 @@ def _data_and_gap(active_db, passive_db, n_off=3):
 
 @pytest.mark.parametrize("active, passive, n_off, where", [
     (0.2, 3.0, 3, "body"),                         # body side carries it, at every base
-    (0.2, 3.0, 1, "engine side or excitation"),    # one base only: not a shared body mode
+    (0.2, 3.0, 1, "body"),                         # one base only: local, not shared
     (0.2, 0.8 * BODY_MIN_DB, 3, "engine side or excitation"),   # below BODY_MIN_DB
     (1.0, 1.0, 3, "engine side or excitation"),    # both sides alike: isolation kept
     (1.0, 1.0 - 1.2 * ISO_MIN_DB, 3, "mounts"),    # isolation changed, engine side off
@@ -95,7 +95,9 @@ def test_side_attribution_both_sides_of_each_threshold(active, passive, n_off, w
     d, gap = _data_and_gap(active, passive, n_off)
     s = side_attribution(gap, d)
     assert s["location"] == where, s
-    assert side_text(s)
+    if where == "body":
+        assert s["shared"] == (n_off >= 2)
+    assert ("shared by the bases" in side_text(s)) == (where == "body" and n_off >= 2)
 
 
 def test_no_body_side_channels_no_side_attribution():
@@ -107,7 +109,7 @@ def test_no_body_side_channels_no_side_attribution():
 
 def test_own_two_sided_runup_is_no_effect(engine, own):
     r = diagnose(own, engine, noise_floor=FLOOR, progress=False, pairs=False,
-                 band_check=False)
+                 band_check=False, effects=["chassis_modes", "mount_stiffness"])
     d = r.to_dict()
     assert d["verdict"] == "no effect", d["verdict_text"]
     assert [list(c) for c in both_sides(engine)] == d["where"]["channels"]

@@ -619,15 +619,18 @@ PARSERS = {"scale": parse_scale, "set": parse_set, "swap": parse_swap, "move": p
            "rotate": parse_rotate, "target": parse_target, "effect": parse_effect}
 
 
-def parse_operations(specs: dict, *, base: Path | None = None) -> tuple:
+def parse_operations(specs: dict, *, base: Path | None = None, engine=None) -> tuple:
     """Operations from ``{"scale": [...], "set": [...], ...}`` of command-line strings, in
-    the order scale, set, swap, move, rotate, target (each list in its given order)."""
+    the order scale, set, swap, move, rotate, target (each list in its given order);
+    effects' parameters are those generated for ``engine`` (default layout without one)."""
     ops = []
     for kind, parser in PARSERS.items():
         for text in specs.get(kind, ()) or ():
             origin = Origin(f"--{kind}")
             if kind == "swap":
                 ops.append(parser(text, origin, base=base))
+            elif kind == "effect" and engine is not None:
+                ops.append(parser(text, origin, engine=engine))
             else:
                 ops.append(parser(text, origin))
     return tuple(ops)

@@ -84,7 +84,7 @@ def runup(rpm_from, rpm_to, rpm_step, engine_file, solver, stepper, angle_step, 
         return run_sweep(engine, rpm_from, rpm_to, sweep, sample_rate, raw_file, out, csv_file,
                          plot, effect, quiet)
     from powertrain.variants import effect_scenario, parse_operations
-    scenario = effect_scenario(parse_operations({"effect": effect}))
+    scenario = effect_scenario(parse_operations({"effect": effect}, engine=engine))
     runup_settings(engine, rpm, angle_step)
     if scenario:
         from powertrain.effect_runup import runup_with_effects
