@@ -93,11 +93,21 @@ def _data_and_gap(active_db, passive_db, n_off=3):
 ])
 def test_side_attribution_both_sides_of_each_threshold(active, passive, n_off, where):
     d, gap = _data_and_gap(active, passive, n_off)
-    s = side_attribution(gap, d)
+    s = side_attribution(gap, d, sigma_db=0.0)
     assert s["location"] == where, s
     if where == "body":
         assert s["shared"] == (n_off >= 2)
     assert ("shared by the bases" in side_text(s)) == (where == "body" and n_off >= 2)
+
+
+def test_side_attribution_discounts_the_scatter():
+    """Independent scatter σ on both sides is no isolation change: a gap map of pure noise
+    (σ = 1 dB, fresh draw) is not put in the mounts or the body."""
+    d, _ = _data_and_gap(0.0, 0.0)
+    gap = np.random.default_rng().normal(0.0, 1.0, d.level.shape)
+    s = side_attribution(gap, d, sigma_db=1.0)
+    assert s["location"] == "engine side or excitation", s
+    assert side_attribution(gap, d, sigma_db=0.0)["location"] == "mounts"
 
 
 def test_no_body_side_channels_no_side_attribution():

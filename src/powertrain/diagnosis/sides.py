@@ -1,7 +1,10 @@
 r"""Part of step 1 (where): does the gap live in the body, or in the mounts / the excitation?
 
 Used when the measured file carries body-side (passive) channels the model predicts (a
-modal body under the mounts). With the gap :math:`\Delta L` [dB] (+ = simulation higher)
+modal body under the mounts). Every RMS below is the *excess over the measurement
+scatter* σ̂ (:func:`powertrain.diagnosis.data.noise_sigma_db`):
+:math:`\sqrt{\max(0, \mathrm{rms}^2 - \sigmâ^2)}` for a gap,
+:math:`\sqrt{\max(0, \mathrm{rms}^2 - 2\sigmâ^2)}` for a difference of two gaps. With the gap :math:`\Delta L` [dB] (+ = simulation higher)
 on the engine side (a) and the body side (p) of each mount, order and speed:
 
 * the **isolation change** of a mount, :math:`\Delta I = \Delta L_a - \Delta L_p`, the
@@ -37,10 +40,13 @@ MIN_SHARED_MOUNTS = 2
 ISO_MIN_DB = 1.0
 
 
-def _rms(x) -> float:
+def _rms(x, noise_var=0.0) -> float:
+    """RMS excess over the noise variance ``noise_var`` [dB²] of the finite values."""
     x = np.asarray(x, float)
     x = x[np.isfinite(x)]
-    return float(np.sqrt(np.mean(x ** 2))) if x.size else float("nan")
+    if not x.size:
+        return float("nan")
+    return float(np.sqrt(max(float(np.mean(x ** 2)) - noise_var, 0.0)))
 
 
 def _pairs(channels):
@@ -69,7 +75,7 @@ def _band(gap, data, cols):
     return [float(np.min(f[hot])), float(np.max(f[hot]))]
 
 
-def side_attribution(gap, data) -> dict | None:
+def side_attribution(gap, data, sigma_db=None) -> dict | None:
     """Which side carries the order gap (module docstring); None without body-side pairs.
 
     Parameters
@@ -77,19 +83,26 @@ def side_attribution(gap, data) -> dict | None:
     gap : ndarray (n_r, n_ch, n_q)
         Gap map [dB], NaN where censored or not measured.
     data : GapData
+    sigma_db : float, optional
+        Measurement scatter [dB, 1σ] (default: estimated from ``data``).
     """
     pairs = _pairs(data.channels)
     if not pairs:
         return None
+    if sigma_db is None:
+        from powertrain.diagnosis.data import noise_sigma_db
+        sigma_db = noise_sigma_db(data)
+    v = float(sigma_db) ** 2 if np.isfinite(sigma_db) else 0.0
     om = data.order_mask
     a_idx = [a for a, _, _ in pairs]
     p_idx = [p for _, p, _ in pairs]
     ga, gp = gap[:, a_idx][:, :, om], gap[:, p_idx][:, :, om]
-    rms_a, rms_p, rms_iso = _rms(ga), _rms(gp), _rms(ga - gp)
+    rms_a, rms_p, rms_iso = _rms(ga, v), _rms(gp, v), _rms(ga - gp, 2 * v)
     per_mount = {}
     for (_, p, base) in pairs:
         per_mount.setdefault(base, []).append(p)
-    off = [m for m, cols in per_mount.items() if _rms(gap[:, cols][:, :, om]) >= MOUNT_OFF_DB]
+    off = [m for m, cols in per_mount.items()
+           if _rms(gap[:, cols][:, :, om], v) >= MOUNT_OFF_DB]
     if (np.isfinite(rms_p) and rms_p >= BODY_MIN_DB
             and rms_p >= BODY_RATIO * (rms_a if np.isfinite(rms_a) else 0.0)):
         where = "body"
@@ -100,7 +113,7 @@ def side_attribution(gap, data) -> dict | None:
     cols = [p for m in off for p in per_mount[m]]
     return {"location": where, "engine_side_rms_db": rms_a, "body_side_rms_db": rms_p,
             "isolation_change_rms_db": rms_iso, "mounts_off_body_side": off,
-            "shared": len(off) >= MIN_SHARED_MOUNTS,
+            "shared": len(off) >= MIN_SHARED_MOUNTS, "noise_sigma_db": float(sigma_db),
             "band_hz": _band(gap, data, cols) if (where == "body" and cols) else None}
 
 
@@ -108,7 +121,7 @@ def side_text(s) -> str:
     """One phrase for the where step ('' without body-side channels)."""
     if not s:
         return ""
-    nums = (f"body side {s['body_side_rms_db']:.1f} dB RMS vs engine side "
+    nums = (f"excess over noise: body side {s['body_side_rms_db']:.1f} dB RMS vs engine side "
             f"{s['engine_side_rms_db']:.1f} dB, isolation changed by "
             f"{s['isolation_change_rms_db']:.1f} dB RMS")
     if s["location"] == "body":
