@@ -61,18 +61,28 @@ def _pairs(channels):
     return out
 
 
-def _band(gap, data, cols):
-    """Frequency band [Hz] where the passive gap is largest (points within 6 dB of the
-    largest |gap| on these channels)."""
+def _band(gap, data, cols, n_bins=24):
+    """Frequency band [Hz] of the passive gap: mean squared gap in log-spaced frequency
+    bins (f = order × rpm / 60), the run of bins around the largest with at least half its
+    value."""
     order = (data.harmonic + 1) / 2.0
-    f = data.rpm[:, None, None] * order[None, None, :] / 60.0
-    g = np.abs(gap[:, cols][:, :, data.order_mask])
-    f = np.broadcast_to(f, gap.shape)[:, cols][:, :, data.order_mask]
+    f = np.broadcast_to(data.rpm[:, None, None] * order[None, None, :] / 60.0, gap.shape)
+    g = gap[:, cols][:, :, data.order_mask]
+    f = f[:, cols][:, :, data.order_mask]
     ok = np.isfinite(g)
     if not ok.any():
         return None
-    hot = ok & (g >= np.max(g[ok]) - 6.0)
-    return [float(np.min(f[hot])), float(np.max(f[hot]))]
+    g, f = g[ok], f[ok]
+    edges = np.geomspace(f.min(), f.max() * 1.0001, n_bins + 1)
+    k = np.clip(np.searchsorted(edges, f, side="right") - 1, 0, n_bins - 1)
+    ms = np.array([np.mean(g[k == j] ** 2) if np.any(k == j) else 0.0 for j in range(n_bins)])
+    top = int(np.argmax(ms))
+    lo, hi = top, top
+    while lo > 0 and ms[lo - 1] >= 0.5 * ms[top]:
+        lo -= 1
+    while hi < n_bins - 1 and ms[hi + 1] >= 0.5 * ms[top]:
+        hi += 1
+    return [float(edges[lo]), float(edges[hi + 1])]
 
 
 def side_attribution(gap, data, sigma_db=None) -> dict | None:
