@@ -16,7 +16,7 @@ on the engine side (a) and the body side (p) of each mount, order and speed:
   :data:`MIN_SHARED_MOUNTS` or more mount bases (its band: the frequencies where the
   passive gap is largest), local to one base otherwise;
 * **in the mounts** when the isolation changed (:math:`\Delta I` RMS ≥ :data:`ISO_MIN_DB`)
-  with the engine side off too;
+  with the engine side off too (≥ :data:`ENGINE_OFF_DB`);
 * otherwise **engine side / excitation**: both sides off alike, isolation kept.
 """
 
@@ -26,9 +26,12 @@ import numpy as np
 
 from powertrain.assembly import split_side
 
-#: The passive side must carry at least this multiple of the engine side's gap RMS [1]
-#: (a body change barely moves the engine side: issue 13 measured 0.06-0.3 dB there).
-BODY_RATIO = 2.0
+#: The passive side must carry at least this multiple of the engine side's excess RMS [1]:
+#: a body change reaches the engine side only through the bases' motion (issue 13 measured
+#: 0.06-0.3 dB there for several dB on the body side), a mount change moves the engine side
+#: directly and the body side follows the changed force (body/engine ratio 2.5-8 in the
+#: development draws of the blind benchmark's passive plan, 15 to unbounded for body modes).
+BODY_RATIO = 10.0
 #: ... and at least this much [dB] (twice the 0.5 dB by which a model may miss).
 BODY_MIN_DB = 1.0
 #: A mount base counts as off when its passive gap RMS reaches this [dB] (a test lab's
@@ -36,8 +39,11 @@ BODY_MIN_DB = 1.0
 MOUNT_OFF_DB = 0.5
 #: Mount bases that must be off for a shared (body) resonance [1].
 MIN_SHARED_MOUNTS = 2
-#: Isolation change RMS that points at the mounts [dB].
+#: Isolation change RMS that points at the mounts [dB] ...
 ISO_MIN_DB = 1.0
+#: ... with the engine side off by at least this much [dB] (issue 13's largest engine-side
+#: effect of a body change).
+ENGINE_OFF_DB = 0.3
 
 
 def _rms(x, noise_var=0.0) -> float:
@@ -116,7 +122,7 @@ def side_attribution(gap, data, sigma_db=None) -> dict | None:
     if (np.isfinite(rms_p) and rms_p >= BODY_MIN_DB
             and rms_p >= BODY_RATIO * (rms_a if np.isfinite(rms_a) else 0.0)):
         where = "body"
-    elif np.isfinite(rms_iso) and rms_iso >= ISO_MIN_DB and rms_a >= MOUNT_OFF_DB:
+    elif np.isfinite(rms_iso) and rms_iso >= ISO_MIN_DB and rms_a >= ENGINE_OFF_DB:
         where = "mounts"
     else:
         where = "engine side or excitation"
