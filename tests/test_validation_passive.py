@@ -1,0 +1,105 @@
+"""Passive-side cases of the blind benchmark (issue 13, item 5): truth path with a modal body
+and both sides of every mount, the passive plan, and its scores.
+
+Oracles: the fast model with the same body (a different path: frequency domain, two-port
+condensation; the truth is Newmark on its own assembly), the default plan's draws (must not
+change), the physics of a body change (body side moves, engine side barely), and
+hand-counted rows for the scores.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from powertrain.effects import predict
+from powertrain.solvers.fast_harmonic import HarmonicModel
+from powertrain.validation.cases import RPM, case_plan, gap_stats
+from powertrain.validation.kinds import IN_LIBRARY, KINDS, PASSIVE_KINDS
+from powertrain.validation.passive import (
+    baseline_velocity,
+    channels,
+    make_passive_case,
+    passive_engines,
+    passive_plan,
+    truth_velocity,
+)
+from powertrain.validation.scoring import passive_line, passive_rate, passive_where_line
+
+#: Newmark (1 deg steps, own assembly) vs the fast harmonic model with the body: relative to
+#: each channel's largest amplitude (issue 13: 0.5 %).
+NEWMARK_REL = 5e-3
+
+
+@pytest.fixture(scope="module")
+def engine():
+    return passive_engines()["body_sz"]
+
+
+def test_truth_baseline_with_body_equals_the_fast_model(engine):
+    """Both sides of every mount on the truth path (Newmark, bases on the body modes) against
+    the fast model's (6 + K) coupled solve."""
+    b = baseline_velocity("body_sz")
+    assert b.shape == (RPM.size, 18, 16)
+    hm = HarmonicModel(engine, RPM)
+    hm.use_channels(channels(engine))
+    v = predict(hm, {}).velocity
+    scale = np.abs(b).max(axis=(0, 2), keepdims=True)
+    moving = scale[0, :, 0] > 0
+    rel = np.abs(v - b)[:, moving] / scale[:, moving]
+    assert rel.max() < NEWMARK_REL
+    assert not moving[channels(engine).index(("gearbox/passive", "x"))]   # shape 0 there
+
+
+def test_body_change_moves_the_body_side_not_the_engine_side(engine):
+    rng = np.random.default_rng()
+    p = KINDS["body_modes"].draw(rng, engine)
+    v = truth_velocity(engine, [("body_modes", p)])
+    b = baseline_velocity("body_sz")
+    active, passive = gap_stats(b[:, :9], v[:, :9]), gap_stats(b[:, 9:], v[:, 9:])
+    assert passive[0] > 3 * active[0] and active[0] < 0.5
+
+
+def test_default_plan_is_unchanged_by_the_passive_kinds():
+    assert "body_modes" not in IN_LIBRARY and set(PASSIVE_KINDS) <= set(KINDS)
+    names = {n for names, _, _ in case_plan(50, 7) for n in names}
+    assert "body_modes" not in names
+
+
+def test_passive_plan_counts_and_reproducible():
+    plan = passive_plan(20, 5)
+    assert plan == passive_plan(20, 5) and plan != passive_plan(20, 6)
+    kinds = [tuple(n) for n, _, _ in plan]
+    assert kinds.count(("body_modes",)) == 8 and kinds.count(("mount_temperature",)) == 8
+    assert kinds.count(()) == 4
+    assert {e for _, e, _ in plan} == {"body_sz", "body_traces"}
+
+
+def test_passive_case_measures_both_sides():
+    names, eng, seed = passive_plan(1, int.from_bytes(np.random.bytes(4), "little"))[0]
+    c = make_passive_case(0, names, eng, seed)
+    assert c.measured.channels == channels(passive_engines()[eng])
+    assert c.category == "in" and c.truth_set == ["chassis_modes"]
+
+
+def _row(names, det, claimed, side=None):
+    lib = {"body_modes": "chassis_modes", "mount_temperature": "mount_stiffness"}
+    ts = sorted(lib[n] for n in names)
+    return {"names": names, "detectable": det, "truth_set": ts, "expected_set": ts,
+            "claimed": claimed, "category": "in" if names else "none", "where_side": side}
+
+
+def test_passive_scores_by_hand():
+    rows = [_row(["body_modes"], True, ["chassis_modes"], "body"),
+            _row(["body_modes"], True, [], "body"),
+            _row(["body_modes"], False, [], "engine side or excitation"),   # not counted
+            _row(["mount_temperature"], True, ["mount_stiffness"], "mounts"),
+            _row(["mount_temperature"], True, ["chassis_modes"], "body"),
+            _row([], False, [])]
+    r = passive_rate(rows)
+    assert (r.k, r.n) == (2, 4)
+    line = passive_line(rows)
+    assert line.startswith("passive: chassis_and_mount_top1=0.50 (2/4, Wilson 0.15-0.85)")
+    assert line.endswith("NOT met")
+    assert "body_modes -> body 1.00 (2/2" in passive_where_line(rows)
+    assert "mount_temperature -> mounts 0.50 (1/2" in passive_where_line(rows)
