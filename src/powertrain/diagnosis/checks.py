@@ -7,9 +7,15 @@ the noise a perfect model would leave, and the speed-band confounding check.
   must predict them at the held-out speeds. Physical effects withhold channels (folds
   generated from the mounts, :func:`channel_folds`: one channel of every mount triad each —
   the rigid body carries the effect to a channel it was not fitted on); candidates with
-  sensor errors withhold orders (orders ≤ :data:`ORDER_SPLIT` vs the others, both ways: a
-  gain or a triad rotation is the same on every order of its channels, a frequency-tied gap
-  is not). Free gains thus cannot absorb a structural gap;
+  sensor errors withhold orders per channel (:func:`order_folds`: each channel's
+  *informative* orders, those with measured points above the noise floor, dealt into
+  :data:`ORDER_FOLDS` folds in a staggered pattern, so every refit still sees some orders of
+  every channel: a gain or a triad rotation is the same on every order of its channels, a
+  frequency-tied gap is not). Free gains thus cannot absorb a structural gap. The folds
+  are dealt over informative orders because orders that are all at the floor (the half
+  orders of a balanced four-cylinder engine) identify nothing, and staggered because
+  withholding an order from every channel at once leaves channels that are weak in the
+  remaining orders with unidentified gains, which a refit then moves at will;
 * :func:`noise_mse`: :math:`E_n = \hat\sigma^2 u`, the held-out mean squared gap a perfect
   model would leave, :math:`u` the fraction of scored held-out points that are not censored;
 * :func:`band_check`: the chosen effect refitted on four speed bands: a parameter believed
@@ -27,8 +33,13 @@ from powertrain.analysis.noise_floor import above_floor
 from powertrain.diagnosis.fit import FitOutcome, Problem, fit_candidate
 from powertrain.effects import EFFECTS
 
-#: Orders up to this one form the "low" fold of the order split (sensor gains) [order].
+#: Fallback order split when fewer than two orders are informative: orders up to this one
+#: form the "low" fold [order].
 ORDER_SPLIT = 2.0
+#: Folds of the (channel, informative order) cells for response-only candidates.
+ORDER_FOLDS = 3
+#: Measured training points above the floor that make an order informative.
+MIN_ORDER_POINTS = 10
 
 
 def channel_folds(n_mounts: int) -> tuple:
@@ -101,12 +112,33 @@ def noise_mse(problem: Problem, sigma, cells=None) -> float:
     return float(sigma ** 2 * unc.sum() / n) if n else 0.0
 
 
+def order_folds(problem: Problem) -> list:
+    """Withheld-cell masks (n_ch, n_o) over the informative orders (at least
+    :data:`MIN_ORDER_POINTS` training points above the floor): cell (channel c, i-th
+    informative order) is withheld in fold (c + i) mod :data:`ORDER_FOLDS`, so every
+    channel keeps some of its orders to fit its gain on and every order some of its
+    channels; with fewer than two informative orders, orders ≤ :data:`ORDER_SPLIT` vs the
+    others."""
+    n_ch, n_o = problem.valid["test"].shape[1:]
+    usable = above_floor(problem.meas["train"], problem.data.floor) & problem.valid["train"]
+    informative = np.flatnonzero(usable.sum(axis=(0, 1)) >= MIN_ORDER_POINTS)
+    if informative.size < 2:
+        order = (problem.sub.harmonic + 1) / 2.0
+        low = np.broadcast_to(order <= ORDER_SPLIT + 1e-9, (n_ch, n_o))
+        return [low, ~low]
+    fold_of = (np.arange(n_ch)[:, None] + np.arange(informative.size)[None, :]) % ORDER_FOLDS
+    folds = []
+    for j in range(ORDER_FOLDS):
+        m = np.zeros((n_ch, n_o), bool)
+        m[:, informative] = fold_of == j
+        folds.append(m)
+    return folds
+
+
 def _folds(problem: Problem, effects):
     n_ch, n_o = problem.valid["test"].shape[1:]
     if any(EFFECTS[e].response_only for e in effects):
-        order = (problem.sub.harmonic + 1) / 2.0
-        low = np.broadcast_to(order <= ORDER_SPLIT + 1e-9, (n_ch, n_o))
-        return "orders", [low, ~low]
+        return "orders", order_folds(problem)
     folds = []
     for f in channel_folds(n_ch // 3):
         m = np.zeros((n_ch, n_o), bool)

@@ -8,6 +8,11 @@ best points of a coarse grid) and scored on the held-out speeds. Every fit has a
 evaluation budget (:data:`EVAL_BUDGET` residual evaluations, Jacobian columns included):
 when it is hit the best point so far is kept and the outcome says so (``budget_hit``).
 
+Parameters with a prior (``Parameter.prior_sd``) add the residual
+:math:`\hat\sigma\,(x - x_0)/s_p` per parameter (:math:`\hat\sigma` the measured scatter in
+dB): a maximum a posteriori fit, so that directions the magnitudes do not identify stay at
+the prior's centre; the BIC and the held-out scores use the data residuals only.
+
 Parameter uncertainties are the 1σ of the Gauss–Newton covariance
 :math:`\hat s^2 (J^TJ)^{-1}` (residual correlation along speed ignored: optimistic).
 """
@@ -21,13 +26,18 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from powertrain.diagnosis.data import GapData, model_levels, residuals_db
+from powertrain.analysis.noise_floor import above_floor
+from powertrain.diagnosis.data import GapData, model_levels, noise_sigma_db, residuals_db
 from powertrain.effects import EFFECTS, predict
 
 #: Residual evaluations per fit (all starts, grid and Jacobian columns included; weighted by
 #: the effects' ``eval_cost``, an iterated amplitude-dependent solve counting 10); a fit that
 #: reaches it stops with the best point so far and reports ``budget_hit``.
 EVAL_BUDGET = 2500
+#: Starts of a block refined after screening (block-wise multi-start).
+BLOCK_REFINED = 2
+#: Share of a fit's evaluation budget the block-wise multi-start may use.
+BLOCK_SHARE = 0.4
 
 
 @dataclass
@@ -84,6 +94,9 @@ class Problem:
         self.meas = {k: data.level[v][:, :, om] for k, v in self.idx.items()}
         self.sub = data.orders_only()
         self.valid = {k: np.isfinite(v) for k, v in self.meas.items()}
+        sig = noise_sigma_db(data)
+        #: measured scatter [dB, 1σ] (weight of the parameter priors; 1 dB if unknown)
+        self.sigma_db = sig if np.isfinite(sig) and sig > 0 else 1.0
         self._last = {}
         for part, cells in (("train", train_cells), ("test", test_cells)):
             if cells is not None:
@@ -135,19 +148,26 @@ class Packing:
     x0: np.ndarray
 
     units: dict = None
+    prior_sd: np.ndarray = None
+
+    @property
+    def n_prior(self) -> int:
+        return 0 if self.prior_sd is None else int(np.isfinite(self.prior_sd).sum())
 
     @classmethod
     def of(cls, effects, engine=None):
-        names, lo, hi, logs, x0, units = [], [], [], [], [], {}
+        names, lo, hi, logs, x0, units, prior = [], [], [], [], [], {}, []
         for e in effects:
             for p in EFFECTS[e].parameters(engine):
+                prior.append(np.nan if p.prior_sd is None else p.prior_sd)
                 units[(e, p.name)] = p.unit
                 names.append((e, p.name))
                 lo.append(math.log(p.lower) if p.log else p.lower)
                 hi.append(math.log(p.upper) if p.log else p.upper)
                 logs.append(p.log)
                 x0.append(math.log(p.default) if p.log else p.default)
-        return cls(names, np.array(lo), np.array(hi), np.array(logs, bool), np.array(x0), units)
+        return cls(names, np.array(lo), np.array(hi), np.array(logs, bool), np.array(x0), units,
+                   np.array(prior, float))
 
     def scenario(self, x):
         sc = {}
@@ -176,12 +196,26 @@ class _Counted:
         self.problem, self.pack, self.budget, self.cost = problem, pack, budget, cost
         self.n = 0.0
         self.best = (np.inf, None, None)
+        self.has_prior = pack.n_prior > 0
+        if self.has_prior:
+            self.prior_on = np.isfinite(pack.prior_sd)
+            self.prior_w = problem.sigma_db / pack.prior_sd[self.prior_on]
 
-    def __call__(self, x):
+    def prior(self, x):
+        """Prior residuals (empty without priors)."""
+        if not self.has_prior:
+            return np.empty(0)
+        return self.prior_w * (np.asarray(x) - self.pack.x0)[self.prior_on]
+
+    def charge(self, cost=None):
+        """Count one evaluation (raises when the budget is spent)."""
         if self.n >= self.budget:
             raise _Budget
-        self.n += self.cost
-        r = self.problem.vector(self.pack.scenario(x))
+        self.n += self.cost if cost is None else cost
+
+    def __call__(self, x):
+        self.charge()
+        r = np.concatenate([self.problem.vector(self.pack.scenario(x)), self.prior(x)])
         c = 0.5 * float(np.sum(r ** 2))
         if c < self.best[0]:
             self.best = (c, np.array(x, float), r)
@@ -201,7 +235,76 @@ def _starts(problem, pack, effects, starts, grid, fun):
         pts[:, pack.log] = np.log(pts[:, pack.log])
         costs = [np.sum(fun(p) ** 2) for p in pts]
         cands += [np.clip(pts[i], lo, hi) for i in np.argsort(costs)[:2]]
+    if grid and len(effects) == 1:
+        xb = _block_start(fun, pack, effects[0])
+        if xb is not None:
+            cands.append(np.clip(xb, lo, hi))
     return cands
+
+
+def _block_start(fun, pack, effect):
+    """Block-wise multi-start (``Effect.separable_groups``): for each block (parameters that
+    act on their own channels only) every start is screened with the gains set to the mean
+    gap of their channels (:func:`_projected`), the best :data:`BLOCK_REFINED` are refined
+    on the block's channels alone, and the blocks' optima are joined into one start for the
+    joint fit. None when the effect declares no blocks. The screening and refits are
+    charged to the fit's budget and stop at :data:`BLOCK_SHARE` of it."""
+    groups = EFFECTS[effect].separable_groups(fun.problem.engine)
+    if not groups:
+        return None
+    x = pack.x0.copy()
+    n_ch, n_o = fun.problem.valid["train"].shape[1:]
+    for names, chans, starts in groups:
+        idx = np.array([pack.names.index((effect, n)) for n in names])
+        cells = np.zeros((n_ch, n_o), bool)
+        cells[chans] = True
+        sub = fun.problem.restricted(train_cells=cells)
+        screened = sorted((_projected(fun, sub, pack, effect, x, idx, st, chans)
+                           for st in starts), key=lambda t: t[0])
+        best = screened[0]
+        for cost, xs in screened[:BLOCK_REFINED]:
+            if fun.n >= BLOCK_SHARE * fun.budget:
+                break
+            res = _refine_block(fun, sub, pack, x, idx, xs)
+            if res.cost * 2 < best[0]:
+                best = (2 * res.cost, res.x)
+        x[idx] = best[1]
+    return x
+
+
+def _projected(fun, sub, pack, effect, x, idx, start, chans):
+    """(cost, block vector) of a start with each channel's gain set to minus its mean gap
+    over the points above the floor (the least-squares gain, censoring aside)."""
+    names = [pack.names[i][1] for i in idx]
+    xs = np.array([start.get(n, pack.x0[i]) for n, i in zip(names, idx)])
+    xx = x.copy()
+    xx[idx] = xs
+    fun.charge()
+    g = sub.gaps(pack.scenario(xx))
+    up = above_floor(sub.meas["train"], sub.data.floor) & np.isfinite(g)
+    for c in chans:
+        gi = names.index(f"g{c + 1}") if f"g{c + 1}" in names else None
+        if gi is not None and up[:, c].any():
+            shift = float(np.mean(g[:, c][up[:, c]]))
+            xs[gi] = np.clip(xs[gi] - shift, pack.lower[idx[gi]], pack.upper[idx[gi]])
+            g[:, c] = np.where(up[:, c], g[:, c] - shift, g[:, c])
+    xx[idx] = xs
+    r = np.concatenate([g[sub.valid["train"]], fun.prior(xx)])
+    return float(np.sum(r ** 2)), xs
+
+
+def _refine_block(fun, sub, pack, x, idx, xs):
+    from scipy.optimize import least_squares
+
+    def f(v):
+        fun.charge()
+        xx = x.copy()
+        xx[idx] = v
+        return np.concatenate([sub.vector(pack.scenario(xx)), fun.prior(xx)])
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        return least_squares(f, xs, bounds=(pack.lower[idx], pack.upper[idx]), method="trf",
+                             max_nfev=10 * idx.size, diff_step=1e-4)
 
 
 def _least_squares(fun, pack, cands):
@@ -226,13 +329,15 @@ def _least_squares(fun, pack, cands):
 
 def _jacobian(fun, x, pack):
     """Forward-difference Jacobian at ``x`` (used when the budget stopped the fit)."""
-    r0 = fun.problem.vector(pack.scenario(x))
+    def full(x):
+        return np.concatenate([fun.problem.vector(pack.scenario(x)), fun.prior(x)])
+    r0 = full(x)
     J = np.empty((r0.size, x.size))
     for j in range(x.size):
         h = 1e-4 * max(1.0, abs(x[j]))
         xj = x.copy()
         xj[j] = min(x[j] + h, pack.upper[j]) if x[j] + h <= pack.upper[j] else x[j] - h
-        J[:, j] = (fun.problem.vector(pack.scenario(xj)) - r0) / (xj[j] - x[j])
+        J[:, j] = (full(xj) - r0) / (xj[j] - x[j])
     return r0, J
 
 
@@ -253,10 +358,13 @@ def fit_candidate(problem: Problem, effects, starts=None, grid=True,
         nfev = int(fun.n)
     else:
         x, r, J = best.x, best.fun, best.jac
-    n, p = r.size, len(pack.names)
-    rss = float(np.sum(r ** 2))
+    n, p = r.size - pack.n_prior, len(pack.names)
+    rss = float(np.sum(r[:n] ** 2))
     try:                                   # Gauss-Newton covariance in fitted coordinates
-        sd = np.sqrt(np.clip(np.diag(rss / max(n - p, 1) * np.linalg.pinv(J.T @ J)), 0, None))
+        s2 = rss / max(n - p, 1)
+        if pack.n_prior:                   # prior rows were weighted with the scatter
+            s2 = max(s2, problem.sigma_db ** 2)
+        sd = np.sqrt(np.clip(np.diag(s2 * np.linalg.pinv(J.T @ J)), 0, None))
     except np.linalg.LinAlgError:
         sd = np.full(p, np.nan)
     params, sigma = pack.values(x, sd)

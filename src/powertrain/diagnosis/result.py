@@ -13,7 +13,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from powertrain.analysis.noise_floor import NOISE_FLOOR_MARGIN
-from powertrain.diagnosis.checks import ORDER_SPLIT, channel_folds
+from powertrain.diagnosis.checks import ORDER_FOLDS, ORDER_SPLIT, channel_folds
 from powertrain.diagnosis.data import GapData
 from powertrain.diagnosis.fit import FitOutcome
 from powertrain.diagnosis.rule import DecisionRule, VerdictKind
@@ -118,7 +118,7 @@ class DiagnosisResult:
     def _decision_rule_dict(self):
         return {**self.rule.to_dict(),
                 "CHANNEL_FOLDS": channel_folds(len(self.data.channels) // 3),
-                "ORDER_SPLIT": ORDER_SPLIT}
+                "ORDER_SPLIT": ORDER_SPLIT, "ORDER_FOLDS": ORDER_FOLDS}
 
     def to_dict(self) -> dict:
         b = self.baseline

@@ -30,6 +30,12 @@ class Parameter:
         Bounds and the value that reduces the effect to the baseline (SI).
     log : bool
         Fitted in log space (positive, scale-like parameters).
+    prior_sd : float or None
+        Standard deviation of a Gaussian prior about ``default`` (in the fitted coordinate;
+        None: flat between the bounds). For parameters that magnitudes alone identify poorly
+        (a triad's rotation and cross-axis terms), the prior keeps the unidentified
+        directions at the datasheet's typical value instead of wherever the noise pushes
+        them (maximum a posteriori fit, :mod:`powertrain.diagnosis.fit`).
     """
 
     name: str
@@ -39,6 +45,7 @@ class Parameter:
     default: float
     log: bool = False
     description: str = ""
+    prior_sd: float | None = None
 
 
 def mount_labels(engine) -> list:
@@ -70,6 +77,13 @@ class Effect:
     def start_grid(self, engine=None) -> tuple:
         """Coarse grid of start values per parameter (empty: start at the defaults)."""
         return ()
+
+    def separable_groups(self, engine=None) -> list:
+        """Blocks of parameters that act on disjoint channels, for a block-wise multi-start
+        before the joint fit: ``[(parameter names, channel indices, [start dicts]), ...]``
+        (empty: none). Only meaningful for effects whose channels do not interact (sensor
+        readings)."""
+        return []
 
     def applicable(self, engine) -> bool:
         """Whether the effect can act on ``engine``."""

@@ -1,9 +1,14 @@
-r"""``sensor_error``: each channel's sensor reads a gain error, each triad a small rotation.
+r"""``sensor_error``: each channel's sensor reads a gain error, each triad a small rotation
+and cross-axis sensitivity.
 
-Channel c of triad m reads :math:`10^{G_c/20}\,[\mathbf R(\boldsymbol\varphi_m)
-\mathbf v_m]_c`: the triad's axes are rotated by :math:`\boldsymbol\varphi_m` (Rodrigues)
-from the engine axes, then each axis has its own gain. One gain ``g<c>`` per channel and a
-rotation ``r<m><axis>`` per mount triad, generated from the engine's mounts.
+Channel c of triad m reads :math:`10^{G_c/20}\,[(\mathbf R(\boldsymbol\varphi_m) +
+\mathbf S_m)\mathbf v_m]_c`: the triad's axes are rotated by :math:`\boldsymbol\varphi_m`
+(Rodrigues) from the engine axes, :math:`\mathbf S_m` is a symmetric matrix with zero
+diagonal (transverse sensitivity: an accelerometer axis also feels the other two axes, a
+few percent by datasheet, typically ≤ 5 %), then each axis has its own gain. Rotation
+(antisymmetric) and cross-axis (symmetric) together make any small off-diagonal triad
+matrix. One gain ``g<c>`` per channel, a rotation ``r<m><axis>`` and three cross-axis terms
+``s<m>xy``, ``s<m>xz``, ``s<m>yz`` per mount triad, generated from the engine's mounts.
 """
 
 from __future__ import annotations
@@ -11,6 +16,20 @@ from __future__ import annotations
 import numpy as np
 
 from powertrain.effects.base import Effect, Parameter, mount_labels
+
+#: Pairs of triad axes with a cross-axis sensitivity parameter.
+CROSS_AXES = ("xy", "xz", "yz")
+#: Bound of a cross-axis sensitivity [1]: accelerometer datasheets give ≤ 5 % transverse
+#: sensitivity; 8 % leaves room for the mounting.
+CROSS_AXIS_MAX = 0.08
+#: Prior standard deviations (maximum a posteriori fit): a triad glued by hand is within a
+#: few degrees [rad]; transverse sensitivity is typically 1–3 % [1].
+ROTATION_PRIOR = 0.1
+#: Rotation of the block-wise multi-start's extra starts [rad] (about 6°).
+ROTATION_START = 0.1
+_START_DIRECTIONS = [np.eye(3)[i] * sg for i in range(3) for sg in (1, -1)] + [
+    np.array([a, b, c]) / np.sqrt(3) for a in (1, -1) for b in (1, -1) for c in (1, -1)]
+CROSS_AXIS_PRIOR = 0.02
 
 
 def rotation_matrix(phi):
@@ -25,7 +44,7 @@ def rotation_matrix(phi):
     return np.eye(3) + np.sin(th) / th * K + (1 - np.cos(th)) / th ** 2 * (K @ K)
 
 
-def sensor_reading(velocity, gain_db, rotation):
+def sensor_reading(velocity, gain_db, rotation, cross_axis=None):
     """What mis-calibrated, mis-oriented triads read from the true channel velocities.
 
     Parameters
@@ -36,23 +55,31 @@ def sensor_reading(velocity, gain_db, rotation):
         Channel gain errors [dB].
     rotation : ndarray (n_m, 3)
         Rotation vector of each triad [rad].
+    cross_axis : ndarray (n_m, 3), optional
+        Cross-axis sensitivities (xy, xz, yz) of each triad [1] (default none).
     """
     v = np.asarray(velocity)
     out = np.empty_like(v)
     for m in range(v.shape[1] // 3):
         sl = slice(3 * m, 3 * m + 3)
-        out[:, sl] = np.einsum("ij,rjh->rih", rotation_matrix(rotation[m]), v[:, sl])
+        T = rotation_matrix(rotation[m])
+        if cross_axis is not None:
+            sxy, sxz, syz = cross_axis[m]
+            T = T + np.array([[0.0, sxy, sxz], [sxy, 0.0, syz], [sxz, syz, 0.0]])
+        out[:, sl] = np.einsum("ij,rjh->rih", T, v[:, sl])
     return out * 10.0 ** (np.asarray(gain_db, float) / 20.0)[None, :, None]
 
 
 def apply_sensor_error(velocity, params: dict):
-    """:func:`sensor_reading` with the parameters ``g<c>`` [dB] and ``r<m><axis>`` [rad]
-    (missing ones 0)."""
+    """:func:`sensor_reading` with the parameters ``g<c>`` [dB], ``r<m><axis>`` [rad] and
+    ``s<m><axes>`` [1] (missing ones 0)."""
     n_ch = velocity.shape[1]
     gains = np.array([params.get(f"g{c + 1}", 0.0) for c in range(n_ch)])
     rot = np.array([[params.get(f"r{m + 1}{ax}", 0.0) for ax in "xyz"]
                     for m in range(n_ch // 3)])
-    return sensor_reading(velocity, gains, rot)
+    cross = np.array([[params.get(f"s{m + 1}{ax}", 0.0) for ax in CROSS_AXES]
+                      for m in range(n_ch // 3)])
+    return sensor_reading(velocity, gains, rot, cross)
 
 
 class SensorError(Effect):
@@ -71,9 +98,28 @@ class SensorError(Effect):
                       for m, name in enumerate(mounts) for a, ax in enumerate("xyz"))
         rots = tuple(Parameter(f"r{m + 1}{ax}", "rad", -0.15, 0.15, 0.0, False,
                                f"orientation error of the triad at mount {m + 1} ({name}): "
-                               f"rotation about engine {ax.upper()}")
+                               f"rotation about engine {ax.upper()}", ROTATION_PRIOR)
                      for m, name in enumerate(mounts) for ax in "xyz")
-        return gains + rots
+        cross = tuple(Parameter(f"s{m + 1}{ax}", "1", -CROSS_AXIS_MAX, CROSS_AXIS_MAX, 0.0,
+                                False, f"cross-axis sensitivity {ax[0]}-{ax[1]} of the triad "
+                                       f"at mount {m + 1} ({name})", CROSS_AXIS_PRIOR)
+                      for m, name in enumerate(mounts) for ax in CROSS_AXES)
+        return gains + rots + cross
+
+    def separable_groups(self, engine=None):
+        """One block per triad (its 3 gains, rotation and cross-axis terms act on its 3
+        channels only), started at no rotation and at :data:`ROTATION_START` about each
+        of the 6 axis and 8 diagonal directions (until one fits within the scatter): a gain
+        error and a rotation that leaks a strong axis into a weak one look
+        alike locally, so a start at zero rotation alone can settle on a large false gain."""
+        out = []
+        for m, _ in enumerate(mount_labels(engine)):
+            names = ([f"g{3 * m + a + 1}" for a in range(3)]
+                     + [f"r{m + 1}{ax}" for ax in "xyz"] + [f"s{m + 1}{ax}" for ax in CROSS_AXES])
+            starts = [{}] + [dict(zip([f"r{m + 1}{ax}" for ax in "xyz"], ROTATION_START * d))
+                             for d in _START_DIRECTIONS]
+            out.append((names, [3 * m, 3 * m + 1, 3 * m + 2], starts))
+        return out
 
     def reading(self, velocity, p):
         return apply_sensor_error(velocity, p)
