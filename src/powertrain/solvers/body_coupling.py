@@ -109,15 +109,25 @@ def body_channels(mount_names, body: ModalBody) -> list:
             + [(p, a) for p in body.points for a in DIRECTIONS])
 
 
-def coupled_solve(M, omega, rows, shapes, abc, kip, body: ModalBody, load):
+def network_products(rows, shapes):
+    r"""Outer products per network, flattened for one matrix product each:
+    :math:`\mathbf r_n\mathbf r_n^T` (n_net, 36), :math:`\mathbf r_n\mathbf s_n^T`
+    (n_net, 6K), :math:`\mathbf s_n\mathbf s_n^T` (n_net, K²)."""
+    n = rows.shape[0]
+    return (np.einsum("ni,nj->nij", rows, rows).reshape(n, -1),
+            np.einsum("ni,nk->nik", rows, shapes).reshape(n, -1),
+            np.einsum("nk,nl->nkl", shapes, shapes).reshape(n, -1))
+
+
+def coupled_solve(M, omega, products, abc, kip, body: ModalBody, load):
     r"""Solve the (6 + K) system of the module docstring for all speeds and harmonics.
 
     Parameters
     ----------
     M : ndarray (6, 6)
     omega : ndarray (n_r, n_h) [rad/s]
-    rows : ndarray (n_net, 6)
-    shapes : ndarray (n_net, K)
+    products : tuple
+        :func:`network_products` of the network rows and
         :meth:`ModalBody.network_shapes`.
     abc : tuple of ndarray (n_r, n_h, n_net)
         The networks' two-ports (only ``b`` and ``c`` are read).
@@ -132,13 +142,14 @@ def coupled_solve(M, omega, rows, shapes, abc, kip, body: ModalBody, load):
     """
     _, b, c = abc
     K = body.n_modes
-    D = np.zeros(omega.shape + (6 + K, 6 + K), complex)
-    D[..., :6, :6] = (-(omega ** 2))[..., None, None] * M + np.einsum(
-        "rhn,ni,nj->rhij", kip, rows, rows)
-    cross = np.einsum("rhn,ni,nk->rhik", b, rows, shapes)
+    rr, rs, ss = products
+    sh = omega.shape
+    D = np.zeros(sh + (6 + K, 6 + K), complex)
+    D[..., :6, :6] = (-(omega ** 2))[..., None, None] * M + (kip @ rr).reshape(sh + (6, 6))
+    cross = (b @ rs).reshape(sh + (6, K))
     D[..., :6, 6:] = cross
     D[..., 6:, :6] = np.swapaxes(cross, -1, -2)
-    D[..., 6:, 6:] = np.einsum("rhn,nk,nl->rhkl", c, shapes, shapes)
+    D[..., 6:, 6:] = (c @ ss).reshape(sh + (K, K))
     idx = np.arange(6, 6 + K)
     D[..., idx, idx] += body.impedance(omega)
     rhs = np.zeros(omega.shape + (6 + K,), complex)
