@@ -3,9 +3,10 @@ r"""Part of step 1 (where): does the gap live in the body, or in the mounts / th
 Used when the measured file carries body-side (passive) channels the model predicts (a
 modal body under the mounts). Every RMS below is the *excess over the measurement
 scatter* σ̂ (:func:`powertrain.diagnosis.data.noise_sigma_db`):
-:math:`\sqrt{\max(0, \mathrm{rms}^2 - \sigmâ^2)}` for a gap,
-:math:`\sqrt{\max(0, \mathrm{rms}^2 - 2\sigmâ^2)}` for a difference of two gaps. With the gap :math:`\Delta L` [dB] (+ = simulation higher)
-on the engine side (a) and the body side (p) of each mount, order and speed:
+:math:`\sqrt{\max(0, \mathrm{rms}^2 - \hat\sigma^2)}` for a gap,
+:math:`\sqrt{\max(0, \mathrm{rms}^2 - 2\hat\sigma^2)}` for a difference of two gaps.
+With the gap :math:`\Delta L` [dB] (+ = simulation higher) on the engine side (a) and the
+body side (p) of each mount, order and speed:
 
 * the **isolation change** of a mount, :math:`\Delta I = \Delta L_a - \Delta L_p`, the
   model's isolation (engine-side minus body-side level) minus the measured one; a changed
