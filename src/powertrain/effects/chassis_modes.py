@@ -89,6 +89,11 @@ class ChassisModes(Effect):
 
     def apply(self, engine, **params):
         import dataclasses
+        if not _modes(engine):
+            if params and params != self.defaults(None):
+                raise ValueError("chassis_modes needs an engine with a modal body "
+                                 "([chassis] model = \"modal\")")
+            return engine             # nothing to change: the defaults are the baseline
         modes = []
         for k, m in enumerate(engine.chassis.modes):
             modes.append(dataclasses.replace(
