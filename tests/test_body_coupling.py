@@ -110,3 +110,13 @@ def test_chassis_modes_effect_parameters(engine):
     hm = HarmonicModel(engine, RPM[:2])
     np.testing.assert_array_equal(predict(hm, {"chassis_modes": {}}).velocity,
                                   predict(hm, {}).velocity)
+
+
+def test_chassis_modes_on_a_rigid_chassis_is_one_line(tmp_path):
+    from click.testing import CliRunner
+
+    from powertrain.cli import main
+    res = CliRunner().invoke(main, ["whatif", "--effect", "chassis_modes:f1=40", "--from",
+                                    "1000", "--to", "2000", "--step", "500"])
+    assert res.exit_code == 1 and "needs an engine with a modal body" in res.output
+    assert "Traceback" not in res.output

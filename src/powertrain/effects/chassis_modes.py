@@ -91,8 +91,9 @@ class ChassisModes(Effect):
         import dataclasses
         if not _modes(engine):
             if params and params != self.defaults(None):
-                raise ValueError("chassis_modes needs an engine with a modal body "
-                                 "([chassis] model = \"modal\")")
+                from powertrain.errors import InputError
+                raise InputError("effect chassis_modes needs an engine with a modal body "
+                                 "([chassis] model = \"modal\")", key="chassis_modes")
             return engine             # nothing to change: the defaults are the baseline
         modes = []
         for k, m in enumerate(engine.chassis.modes):
