@@ -86,6 +86,7 @@ def _data_and_gap(active_db, passive_db, n_off=3):
 @pytest.mark.parametrize("active, passive, n_off, where", [
     (0.2, 3.0, 3, "body"),                         # body side carries it, at every base
     (0.5, 3.0, 3, "mounts"),                       # engine side off too: ratio 6 < 10
+    (0.2, 1.5, 3, "body"),                         # ratio 7.5, but engine side < 0.3 dB
     (0.1, 3.0, 1, "body"),                         # one base only: local, not shared
     (0.2, 0.8 * BODY_MIN_DB, 3, "engine side or excitation"),   # below BODY_MIN_DB
     (1.0, 1.0, 3, "engine side or excitation"),    # both sides alike: isolation kept

@@ -12,7 +12,8 @@ body side (p) of each mount, order and speed:
   model's isolation (engine-side minus body-side level) minus the measured one; a changed
   excitation moves both sides alike (:math:`\Delta I \approx 0`);
 * the gap lives **in the body** when the body side carries it: passive-side gap RMS at
-  least :data:`BODY_RATIO` × the engine side's and at least :data:`BODY_MIN_DB`; it is a
+  least :data:`BODY_MIN_DB` and either :data:`BODY_RATIO` × the engine side's, or the
+  isolation changed while the engine side stays below :data:`ENGINE_OFF_DB`; it is a
   *shared* body resonance when the passive gap reaches :data:`MOUNT_OFF_DB` at
   :data:`MIN_SHARED_MOUNTS` or more mount bases (its band: the frequencies where the
   passive gap is largest), local to one base otherwise;
@@ -120,10 +121,12 @@ def side_attribution(gap, data, sigma_db=None) -> dict | None:
         per_mount.setdefault(base, []).append(p)
     off = [m for m, cols in per_mount.items()
            if _rms(gap[:, cols][:, :, om], v) >= MOUNT_OFF_DB]
-    if (np.isfinite(rms_p) and rms_p >= BODY_MIN_DB
-            and rms_p >= BODY_RATIO * (rms_a if np.isfinite(rms_a) else 0.0)):
+    a = rms_a if np.isfinite(rms_a) else 0.0
+    body_side = bool(np.isfinite(rms_p) and rms_p >= BODY_MIN_DB)
+    iso = bool(np.isfinite(rms_iso) and rms_iso >= ISO_MIN_DB)
+    if body_side and (rms_p >= BODY_RATIO * a or (iso and a < ENGINE_OFF_DB)):
         where = "body"
-    elif np.isfinite(rms_iso) and rms_iso >= ISO_MIN_DB and rms_a >= ENGINE_OFF_DB:
+    elif iso and a >= ENGINE_OFF_DB:
         where = "mounts"
     else:
         where = "engine side or excitation"
