@@ -127,3 +127,18 @@ def test_own_two_sided_runup_is_no_effect(engine, own):
     assert [list(c) for c in both_sides(engine)] == d["where"]["channels"]
     assert d["where"]["sides"]["location"] == "engine side or excitation"
     assert "chassis_modes" in [o["effect"] for o in d["ranking"]]
+
+
+def test_synth_on_a_modal_body_writes_both_sides(tmp_path):
+    from click.testing import CliRunner
+
+    from powertrain.cli import main
+    from powertrain.iotools.measured import read_measured
+    out = tmp_path / "s.csv"
+    res = CliRunner().invoke(main, ["synth", "--engine", str(MODAL), "--effect", "none",
+                                    "--out", str(out)])
+    assert res.exit_code == 0, res.output
+    assert out.read_text().splitlines()[1].endswith(",side,velocity_rms_mm_per_s")
+    m = read_measured(out, mounts=["left", "right", "gearbox"], points=["seat_rail"])
+    assert ("left/passive", "z") in m.channels and ("seat_rail", "y") in m.channels
+    assert ("left", "z") in m.channels

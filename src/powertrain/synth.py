@@ -176,12 +176,22 @@ class SynthCase:
         return "in"
 
     def csv_text(self) -> str:
+        """The measured CSV; with a body under the mounts (channels ``NAME/passive`` and
+        body points) with the ``side`` column."""
+        from powertrain.assembly import split_side
+        names = {m for m, _, _ in self.measured.curves}
+        bases = {split_side(m)[0] for m in names if split_side(m)[1] == "passive"}
         lines = [f"# SYNTHETIC measured run-up (powertrain synth, seed {self.seed}); the hidden "
                  "effect is not stated here",
+                 "mount,direction,quantity,rpm,side,velocity_rms_mm_per_s" if bases else
                  "mount,direction,quantity,rpm,velocity_rms_mm_per_s"]
         for (m, d, q), (r, v) in self.measured.curves.items():
+            base, side = split_side(m)
+            if bases and side == "active" and base not in bases:
+                side = "passive"                     # a body point of interest
+            col = f",{side}" if bases else ""
             for ri, vi in zip(r, v):
-                lines.append(f"{m},{d},{q},{ri:g},{vi * 1e3:.6g}")
+                lines.append(f"{base},{d},{q},{ri:g}{col},{vi * 1e3:.6g}")
         return "\n".join(lines) + "\n"
 
 
