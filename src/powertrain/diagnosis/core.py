@@ -147,30 +147,39 @@ def _fit_job(job):
         return fit_candidate(problem, effects, starts=starts, budget=budget)
 
 
-def _fit_all(s: _Setup, pairs, scheduler, progress, budget, e_n, rule):
-    """Singles, then pairs (:func:`pair_candidates`); in the order of submission."""
+def _fit_all(s: _Setup, pairs, scheduler, progress, budget, e_n, rule, baseline, sigma):
+    """Singles, then pairs (:func:`pair_candidates`); in the order of submission, each with
+    its structured residual."""
     from powertrain.parallel import run_map
     desc = "diagnose: candidate fits" if progress else None
     jobs = [(s.problem, (e,), None, budget) for e in s.effects]
     singles = run_map(_fit_job, jobs, scheduler, progress=desc)
+    _structure(s, baseline, singles, sigma)
     outcomes = list(singles)
     if pairs:
         by = {o.effects[0]: o for o in singles}
         jobs = [(s.problem, (a, b), [np.concatenate([by[a].x, by[b].x])], budget)
                 for a, b in pair_candidates(singles, e_n, rule)]
-        outcomes += run_map(_fit_job, jobs, scheduler, progress=desc and "diagnose: pairs")
+        found = run_map(_fit_job, jobs, scheduler, progress=desc and "diagnose: pairs")
+        _structure(s, baseline, found, sigma)
+        outcomes += found
     return outcomes
 
 
 def pair_candidates(singles, e_n, rule) -> list:
     """Pairs worth fitting: none when the best single leaves a held-out excess RMS gap over
-    noise below ``rule.excess_min_db`` (nothing left that a second effect could be shown to
-    explain); else the best single with each other effect (forward selection: the second
-    effect is whatever explains most of the rest) and the second with the third best."""
+    noise below ``rule.excess_min_db`` and a structured residual within
+    ``rule.struct_abs_db`` (nothing left that a second effect could be shown to explain);
+    else the best single with each other effect (forward selection: the second effect is
+    whatever explains most of the rest) and the second with the third best."""
     ranked = sorted(singles, key=lambda o: o.heldout_mse)
-    if not ranked or math.sqrt(max(ranked[0].heldout_mse - e_n, 0.0)) < rule.excess_min_db:
+    if not ranked:
         return []
-    best = ranked[0].effects[0]
+    top = ranked[0]
+    if (math.sqrt(max(top.heldout_mse - e_n, 0.0)) < rule.excess_min_db
+            and top.struct_db <= rule.struct_abs_db):
+        return []
+    best = top.effects[0]
     out = [(best, o.effects[0]) for o in ranked[1:]]
     if len(ranked) >= 3:
         out.append((ranked[1].effects[0], ranked[2].effects[0]))
@@ -210,8 +219,9 @@ def _diagnose(measured, engine, noise_floor, effects, pairs, do_bands, rule, sch
     gap_map, parts, rigid, found = _where(s)
     sigma = noise_sigma_db(s.data)
     baseline = baseline_outcome(s.problem)
-    outcomes = _fit_all(s, pairs, scheduler, progress, budget, noise_mse(s.problem, sigma), rule)
-    _structure(s, baseline, outcomes, sigma)
+    _structure(s, baseline, [], sigma)
+    outcomes = _fit_all(s, pairs, scheduler, progress, budget, noise_mse(s.problem, sigma), rule,
+                        baseline, sigma)
     verdict, e_n = _decide(s, baseline, outcomes, sigma, rule, where_text(found, parts), budget)
     for o in outcomes:
         a = verdict.assessments[o.label]
