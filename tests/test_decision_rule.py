@@ -54,7 +54,7 @@ def test_missing_cells_check_is_requested_not_guessed():
 @pytest.mark.parametrize("above", [False, True])
 def test_t_min(above):
     ev = evidence(cand("a", 1.0, 900.0, spread=1.0))
-    t = improvement_t(ev.baseline, ev.candidates[0])
+    t = improvement_t(ev.baseline, ev.candidates[0], ev.noise_mse)
     ev.candidates[0].cells["t"] = 1e6
     v = decide(ev, DecisionRule(t_min=just(t, above)))
     assert (v.chosen == "a") is (not above)
@@ -189,3 +189,16 @@ def test_evaluation_budget_stops_a_fit_and_says_so():
     full = fit_candidate(prob, ("balancer_error",))
     assert small.budget_hit and small.n_eval <= 8 and not full.budget_hit
     assert full.heldout_mse < small.heldout_mse
+
+
+def test_improvement_t_is_a_relative_improvement():
+    """Per-speed log ratios: an improvement by the same factor at every speed has no scatter
+    (unbounded t) however much the gap varies along the run-up, while a difference of the
+    gaps would scatter with the gap; adding the noise's E_n keeps it finite and large."""
+    gap = np.linspace(1.0, 40.0, N)                       # gap grows towards a resonance
+    base = CandidateEvidence("", (), float(gap.mean()), gap, 0.0)
+    half = CandidateEvidence("a", ("a",), float(gap.mean() / 2), gap / 2, 0.0)
+    assert improvement_t(base, half) > 1e6
+    d = gap - gap / 2
+    assert np.mean(d) / (np.std(d, ddof=1) / np.sqrt(N)) < 10   # the difference's t
+    assert 10 < improvement_t(base, half, noise_mse=1.0) < 1e6

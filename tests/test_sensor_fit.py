@@ -11,10 +11,10 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from powertrain.analysis.orders import order_label
 from powertrain.diagnosis.checks import ORDER_FOLDS, order_folds
 from powertrain.diagnosis.core import _Setup
 from powertrain.diagnosis.fit import fit_candidate
-from powertrain.analysis.orders import order_label
 from powertrain.effects import EFFECTS, predict, sensor_reading
 from powertrain.iotools.engine_file import DEFAULT_ENGINE_PATH, read_engine
 from powertrain.iotools.measured import MeasuredRunup

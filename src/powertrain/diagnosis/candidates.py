@@ -42,7 +42,7 @@ def _same(a, b, tol=0.01):
     return all(abs(a[k] - b[k]) <= tol * max(1.0, abs(b[k])) for k in b)
 
 
-def equivalents(setup, chosen, rule, budget=400) -> list:
+def equivalents(setup, chosen, rule, budget=400, noise_mse=0.0) -> list:
     r"""Parameter sets that explain the data as well as the chosen answer, within the noise.
 
     The chosen effect is refitted from each alternative start it offers
@@ -66,7 +66,7 @@ def equivalents(setup, chosen, rule, budget=400) -> list:
             continue
         seen.append(p)
         alt = CandidateEvidence(e, (e,), fo.heldout_mse, fo.heldout_per_rpm, fo.bic)
-        t = improvement_t(alt, mine)
+        t = improvement_t(alt, mine, noise_mse)
         if t <= rule.t_min and fo.bic - chosen.bic <= rule.bic_margin:
             desc = ", ".join(f"{k}={v:.3g}" for k, v in p.items())
             out.append({"effect": e, "parameters": p, "start": text,

@@ -147,8 +147,13 @@ def _folds(problem: Problem, effects):
     return "channels", folds
 
 
-def per_speed_t(d):
-    """t statistic of the mean of per-speed improvements ``d`` (NaN entries dropped)."""
+def per_speed_t(per_0, per_c, noise_mse=0.0):
+    """t statistic of the per-speed log-ratio improvements of ``per_c`` over ``per_0``
+    (mean squared gaps per speed, noise added; NaN entries dropped), as
+    :func:`powertrain.diagnosis.rule.improvement_t`."""
+    en = max(float(noise_mse), 1e-12)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        d = np.log((per_0 + en) / (per_c + en))
     d = d[np.isfinite(d)]
     sd = float(np.std(d, ddof=1)) if d.size > 1 else 0.0
     return float(np.mean(d)) / (sd / math.sqrt(d.size)) if sd > 0 else 0.0
@@ -182,9 +187,10 @@ def heldout_cells_check(problem: Problem, o: FitOutcome, baseline: FitOutcome, s
     cells = ok.any(axis=0)
     e0, per_0 = cells_mse(baseline, cells)
     ec = float(np.mean(g_all[ok] ** 2)) if ok.any() else float("nan")
-    excess = max(e0 - noise_mse(problem, sigma, cells), 0.0)
+    e_n = noise_mse(problem, sigma, cells)
+    excess = max(e0 - e_n, 0.0)
     return {"kind": kind, "explained": (e0 - ec) / excess if excess > 0 else float("nan"),
-            "t": per_speed_t(per_0 - per_c), "baseline_excess_db": math.sqrt(excess),
+            "t": per_speed_t(per_0, per_c, e_n), "baseline_excess_db": math.sqrt(excess),
             "heldout_rms_db": math.sqrt(ec), "seconds": time.perf_counter() - t0}
 
 

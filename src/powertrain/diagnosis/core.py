@@ -6,8 +6,8 @@ is taken by the pure :func:`powertrain.diagnosis.rule.decide`.
 
 from __future__ import annotations
 
+import math
 import time
-from itertools import combinations
 
 import numpy as np
 
@@ -152,19 +152,43 @@ def _fit_job(job):
         return fit_candidate(problem, effects, starts=starts, budget=budget)
 
 
-def _fit_all(s: _Setup, pairs, scheduler, progress, budget):
-    """Singles, then the pairs of the three best singles; in the order of submission."""
+def _fit_all(s: _Setup, pairs, scheduler, progress, budget, e_n, rule, baseline, sigma):
+    """Singles, then pairs (:func:`pair_candidates`); in the order of submission, each with
+    its structured residual."""
     from powertrain.parallel import run_map
     desc = "diagnose: candidate fits" if progress else None
     jobs = [(s.problem, (e,), None, budget) for e in s.effects]
     singles = run_map(_fit_job, jobs, scheduler, progress=desc)
+    _structure(s, baseline, singles, sigma)
     outcomes = list(singles)
     if pairs:
-        best3 = sorted(singles, key=lambda o: o.heldout_mse)[:3]
-        jobs = [(s.problem, (a.effects[0], b.effects[0]), [np.concatenate([a.x, b.x])], budget)
-                for a, b in combinations(best3, 2)]
-        outcomes += run_map(_fit_job, jobs, scheduler, progress=desc and "diagnose: pairs")
+        by = {o.effects[0]: o for o in singles}
+        jobs = [(s.problem, (a, b), [np.concatenate([by[a].x, by[b].x])], budget)
+                for a, b in pair_candidates(singles, e_n, rule)]
+        found = run_map(_fit_job, jobs, scheduler, progress=desc and "diagnose: pairs")
+        _structure(s, baseline, found, sigma)
+        outcomes += found
     return outcomes
+
+
+def pair_candidates(singles, e_n, rule) -> list:
+    """Pairs worth fitting: none when the best single leaves a held-out excess RMS gap over
+    noise below ``rule.excess_min_db`` and a structured residual within
+    ``rule.struct_abs_db`` (nothing left that a second effect could be shown to explain);
+    else the best single with each other effect (forward selection: the second effect is
+    whatever explains most of the rest) and the second with the third best."""
+    ranked = sorted(singles, key=lambda o: o.heldout_mse)
+    if not ranked:
+        return []
+    top = ranked[0]
+    if (math.sqrt(max(top.heldout_mse - e_n, 0.0)) < rule.excess_min_db
+            and top.struct_db <= rule.struct_abs_db):
+        return []
+    best = top.effects[0]
+    out = [(best, o.effects[0]) for o in ranked[1:]]
+    if len(ranked) >= 3:
+        out.append((ranked[1].effects[0], ranked[2].effects[0]))
+    return out
 
 
 def _evidence(o, struct=None):
@@ -200,8 +224,9 @@ def _diagnose(measured, engine, noise_floor, effects, pairs, do_bands, rule, sch
     gap_map, parts, rigid, found = _where(s)
     sigma = noise_sigma_db(s.data)
     baseline = baseline_outcome(s.problem)
-    outcomes = _fit_all(s, pairs, scheduler, progress, budget)
-    _structure(s, baseline, outcomes, sigma)
+    _structure(s, baseline, [], sigma)
+    outcomes = _fit_all(s, pairs, scheduler, progress, budget, noise_mse(s.problem, sigma), rule,
+                        baseline, sigma)
     verdict, e_n = _decide(s, baseline, outcomes, sigma, rule, where_text(found, parts), budget)
     for o in outcomes:
         a = verdict.assessments[o.label]
@@ -220,7 +245,7 @@ def _diagnose(measured, engine, noise_floor, effects, pairs, do_bands, rule, sch
                 return Problem(s.sub(idx), s.problem.hm["test"], s.data, idx, s.test_idx)
             bands = band_check(factory, chosen.effects[0], s.data,
                                s.train_all[::max(1, s.train_all.size // 48)])
-    eq = cand.equivalents(s, chosen, rule)
+    eq = cand.equivalents(s, chosen, rule, noise_mse=e_n)
     text = verdict.text if not eq else verdict.text + (
         f"; the order magnitudes cannot tell it from {len(eq)} equivalent explanation(s): "
         + "; ".join(x["text"] for x in eq[:3]) + ("; ..." if len(eq) > 3 else ""))

@@ -26,18 +26,16 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from powertrain.analysis.noise_floor import above_floor
 from powertrain.diagnosis.data import GapData, model_levels, noise_sigma_db, residuals_db
+from powertrain.diagnosis.starts import start_points
 from powertrain.effects import EFFECTS, predict
 
-#: Residual evaluations per fit (all starts, grid and Jacobian columns included; weighted by
-#: the effects' ``eval_cost``, an iterated amplitude-dependent solve counting 10); a fit that
-#: reaches it stops with the best point so far and reports ``budget_hit``.
+#: Evaluation budget per fit, in solves of the cached model (all starts, grid and Jacobian
+#: columns included; an evaluation costs the solves it made, at least 1: a sensor reading
+#: of cached velocities counts 1, an amplitude-dependent evaluation its fixed-point
+#: iterations); a fit that reaches it stops with the best point so far and reports
+#: ``budget_hit``.
 EVAL_BUDGET = 2500
-#: Starts of a block refined after screening (block-wise multi-start).
-BLOCK_REFINED = 2
-#: Share of a fit's evaluation budget the block-wise multi-start may use.
-BLOCK_SHARE = 0.4
 
 
 @dataclass
@@ -98,6 +96,7 @@ class Problem:
         #: measured scatter [dB, 1σ] (weight of the parameter priors; 1 dB if unknown)
         self.sigma_db = sig if np.isfinite(sig) and sig > 0 else 1.0
         self._last = {}
+        self.reset_warm()
         for part, cells in (("train", train_cells), ("test", test_cells)):
             if cells is not None:
                 self.valid[part] = self.valid[part] & np.asarray(cells, bool)[None]
@@ -108,6 +107,12 @@ class Problem:
         if hasattr(self.engine, "replace"):
             state["engine"] = self.engine.replace()
         return state
+
+    def reset_warm(self):
+        """Forget the amplitude fixed point's warm start and the solve count (at the start
+        of every fit, so that a fit's result does not depend on what ran before it)."""
+        self._warm = {}
+        self.solves = 0
 
     def restricted(self, train_cells=None, test_cells=None) -> Problem:
         """The same problem with (channel, order) cells withheld from fitting / scoring."""
@@ -123,7 +128,11 @@ class Problem:
         if last is not None and last[0] == key:
             vel = last[1]
         else:
-            vel = predict(self.hm[part], phys).velocity
+            pred = predict(self.hm[part], phys, warm_factors=self._warm.get(part))
+            vel = pred.velocity
+            if pred.factors is not None:
+                self._warm[part] = pred.factors
+            self.solves += max(1, pred.iterations)
             self._last[part] = (key, vel)
         for k, v in scenario.items():
             if EFFECTS[k].response_only:
@@ -192,8 +201,8 @@ class _Budget(Exception):
 class _Counted:
     """Residual function with an evaluation count, a budget and the best point seen."""
 
-    def __init__(self, problem, pack, budget, cost=1.0):
-        self.problem, self.pack, self.budget, self.cost = problem, pack, budget, cost
+    def __init__(self, problem, pack, budget):
+        self.problem, self.pack, self.budget = problem, pack, budget
         self.n = 0.0
         self.best = (np.inf, None, None)
         self.has_prior = pack.n_prior > 0
@@ -207,104 +216,22 @@ class _Counted:
             return np.empty(0)
         return self.prior_w * (np.asarray(x) - self.pack.x0)[self.prior_on]
 
-    def charge(self, cost=None):
-        """Count one evaluation (raises when the budget is spent)."""
+    def evaluate(self, problem, x):
+        """Residuals of ``problem`` at ``x`` with the prior's, charged to the budget (raises
+        when it is spent)."""
         if self.n >= self.budget:
             raise _Budget
-        self.n += self.cost if cost is None else cost
+        before = problem.solves
+        r = np.concatenate([problem.vector(self.pack.scenario(x)), self.prior(x)])
+        self.n += max(1, problem.solves - before)
+        return r
 
     def __call__(self, x):
-        self.charge()
-        r = np.concatenate([self.problem.vector(self.pack.scenario(x)), self.prior(x)])
+        r = self.evaluate(self.problem, x)
         c = 0.5 * float(np.sum(r ** 2))
         if c < self.best[0]:
             self.best = (c, np.array(x, float), r)
         return r
-
-
-def _starts(problem, pack, effects, starts, grid, fun):
-    span = pack.upper - pack.lower
-    lo, hi = pack.lower + 1e-9 * span, pack.upper - 1e-9 * span
-    cands = [np.clip(pack.x0, lo, hi)] + [np.clip(s, lo, hi) for s in starts or []]
-    # coarse grid of start points for effects that declare one (the cylinder IMEP factors
-    # need one: at e = 0 the half orders vanish and the gradient of their level with them)
-    sg = EFFECTS[effects[0]].start_grid(problem.engine) if len(effects) == 1 else ()
-    if grid and sg:
-        mesh = np.meshgrid(*sg, indexing="ij")
-        pts = np.stack([m.ravel() for m in mesh], axis=1).astype(float)
-        pts[:, pack.log] = np.log(pts[:, pack.log])
-        costs = [np.sum(fun(p) ** 2) for p in pts]
-        cands += [np.clip(pts[i], lo, hi) for i in np.argsort(costs)[:2]]
-    if grid and len(effects) == 1:
-        xb = _block_start(fun, pack, effects[0])
-        if xb is not None:
-            cands.append(np.clip(xb, lo, hi))
-    return cands
-
-
-def _block_start(fun, pack, effect):
-    """Block-wise multi-start (``Effect.separable_groups``): for each block (parameters that
-    act on their own channels only) every start is screened with the gains set to the mean
-    gap of their channels (:func:`_projected`), the best :data:`BLOCK_REFINED` are refined
-    on the block's channels alone, and the blocks' optima are joined into one start for the
-    joint fit. None when the effect declares no blocks. The screening and refits are
-    charged to the fit's budget and stop at :data:`BLOCK_SHARE` of it."""
-    groups = EFFECTS[effect].separable_groups(fun.problem.engine)
-    if not groups:
-        return None
-    x = pack.x0.copy()
-    n_ch, n_o = fun.problem.valid["train"].shape[1:]
-    for names, chans, starts in groups:
-        idx = np.array([pack.names.index((effect, n)) for n in names])
-        cells = np.zeros((n_ch, n_o), bool)
-        cells[chans] = True
-        sub = fun.problem.restricted(train_cells=cells)
-        screened = sorted((_projected(fun, sub, pack, effect, x, idx, st, chans)
-                           for st in starts), key=lambda t: t[0])
-        best = screened[0]
-        for cost, xs in screened[:BLOCK_REFINED]:
-            if fun.n >= BLOCK_SHARE * fun.budget:
-                break
-            res = _refine_block(fun, sub, pack, x, idx, xs)
-            if res.cost * 2 < best[0]:
-                best = (2 * res.cost, res.x)
-        x[idx] = best[1]
-    return x
-
-
-def _projected(fun, sub, pack, effect, x, idx, start, chans):
-    """(cost, block vector) of a start with each channel's gain set to minus its mean gap
-    over the points above the floor (the least-squares gain, censoring aside)."""
-    names = [pack.names[i][1] for i in idx]
-    xs = np.array([start.get(n, pack.x0[i]) for n, i in zip(names, idx)])
-    xx = x.copy()
-    xx[idx] = xs
-    fun.charge()
-    g = sub.gaps(pack.scenario(xx))
-    up = above_floor(sub.meas["train"], sub.data.floor) & np.isfinite(g)
-    for c in chans:
-        gi = names.index(f"g{c + 1}") if f"g{c + 1}" in names else None
-        if gi is not None and up[:, c].any():
-            shift = float(np.mean(g[:, c][up[:, c]]))
-            xs[gi] = np.clip(xs[gi] - shift, pack.lower[idx[gi]], pack.upper[idx[gi]])
-            g[:, c] = np.where(up[:, c], g[:, c] - shift, g[:, c])
-    xx[idx] = xs
-    r = np.concatenate([g[sub.valid["train"]], fun.prior(xx)])
-    return float(np.sum(r ** 2)), xs
-
-
-def _refine_block(fun, sub, pack, x, idx, xs):
-    from scipy.optimize import least_squares
-
-    def f(v):
-        fun.charge()
-        xx = x.copy()
-        xx[idx] = v
-        return np.concatenate([sub.vector(pack.scenario(xx)), fun.prior(xx)])
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")
-        return least_squares(f, xs, bounds=(pack.lower[idx], pack.upper[idx]), method="trf",
-                             max_nfev=10 * idx.size, diff_step=1e-4)
 
 
 def _least_squares(fun, pack, cands):
@@ -345,10 +272,12 @@ def fit_candidate(problem: Problem, effects, starts=None, grid=True,
                   budget=EVAL_BUDGET) -> FitOutcome:
     """Fit one effect or a combination on the training speeds, score on the held-out ones."""
     t0 = time.perf_counter()
+    problem.reset_warm()
+    problem._last = {}
     pack = Packing.of(effects, problem.engine)
-    fun = _Counted(problem, pack, budget, max(EFFECTS[e].eval_cost for e in effects))
+    fun = _Counted(problem, pack, budget)
     try:
-        cands = _starts(problem, pack, effects, starts, grid, fun)
+        cands = start_points(problem, pack, effects, starts, grid, fun)
         best, nfev, hit = _least_squares(fun, pack, cands)
     except _Budget:                        # spent on the start grid already
         cands, best, nfev, hit = [pack.x0], None, 0, True

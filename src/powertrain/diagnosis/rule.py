@@ -5,7 +5,8 @@ squared gaps (dB²) of the baseline and a candidate and :math:`E_n` the one a pe
 would leave (noise):
 
 * a candidate is **supported** when it lowers the training BIC by more than ``bic_margin``
-  and its held-out improvement is significant: the per-speed improvements :math:`d_r` have
+  and its held-out improvement is significant: the per-speed improvements :math:`d_r`
+  (log ratios of the mean squared gaps plus noise, :func:`improvement_t`) have
   :math:`\bar d/(s_d/\sqrt{n_r}) >` ``t_min`` and :math:`\bar d > 0`;
 * a pair is preferred to its better member only if it is supported against that member in
   the same way and explains at least ``pair_gain_min`` of the excess that member leaves;
@@ -161,9 +162,21 @@ class Verdict:
     needs_cells_check: str | None = None
 
 
-def improvement_t(base: CandidateEvidence, cand: CandidateEvidence):
-    """t statistic of the held-out improvement per speed of ``cand`` over ``base``."""
-    d = base.heldout_per_rpm - cand.heldout_per_rpm
+def improvement_t(base: CandidateEvidence, cand: CandidateEvidence, noise_mse=0.0):
+    r"""t statistic of the held-out improvement per speed of ``cand`` over ``base``.
+
+    The per-speed improvement is the log ratio
+    :math:`d_r = \ln\frac{E_{0,r} + E_n}{E_{c,r} + E_n}` of the mean squared gaps with the
+    noise's :math:`E_n` added: a relative improvement, about equally large at the speeds
+    where the gap is large (near a resonance) and where it is moderate, so that its scatter
+    over speeds measures chance rather than how the gap varies along the run-up (a
+    difference :math:`E_{0,r} - E_{c,r}` is dominated by the few speeds near a resonance
+    and its t stays small however certain the improvement); speeds within noise count as
+    no change. t = :math:`\bar d/(s_d/\sqrt{n_r})`.
+    """
+    en = max(float(noise_mse), 1e-12)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        d = np.log((base.heldout_per_rpm + en) / (cand.heldout_per_rpm + en))
     d = d[np.isfinite(d)]
     if d.size < 2:
         return float("nan")
@@ -178,7 +191,7 @@ def _assess(ev: Evidence, rule: DecisionRule) -> dict:
     excess0 = max(e0 - ev.noise_mse, 0.0)
     out = {}
     for c in ev.candidates:
-        t, dbic = improvement_t(ev.baseline, c), ev.baseline.bic - c.bic
+        t, dbic = improvement_t(ev.baseline, c, ev.noise_mse), ev.baseline.bic - c.bic
         ok = dbic > rule.bic_margin and t > rule.t_min and c.heldout_mse < e0
         st = Status.SUPPORTED if ok else Status.NOT_SUPPORTED
         out[c.label] = Assessment(t, dbic, (e0 - c.heldout_mse) / excess0 if excess0 > 0
@@ -188,7 +201,7 @@ def _assess(ev: Evidence, rule: DecisionRule) -> dict:
         if len(c.effects) != 2 or out[c.label].status is not Status.SUPPORTED:
             continue
         best_m = min((by_label[e] for e in c.effects), key=lambda m: m.heldout_mse)
-        t, dbic = improvement_t(best_m, c), best_m.bic - c.bic
+        t, dbic = improvement_t(best_m, c, ev.noise_mse), best_m.bic - c.bic
         left = best_m.heldout_mse - ev.noise_mse
         gain = (best_m.heldout_mse - c.heldout_mse) / left if left > 0 else 0.0
         if not (t > rule.t_min and dbic > rule.bic_margin and gain >= rule.pair_gain_min):
@@ -238,7 +251,7 @@ def _rivals(ev, rule, ranked, ass, chosen):
         if (c is chosen or a.status is not Status.SUPPORTED or theirs <= mine
                 or mine <= theirs or not _big(a, rule) or not c.struct_db <= smax):
             continue
-        t_rival = improvement_t(c, chosen)
+        t_rival = improvement_t(c, chosen, ev.noise_mse)
         if not t_rival > rule.t_min:
             out.append((c, t_rival))
     return out

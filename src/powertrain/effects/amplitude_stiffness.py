@@ -30,8 +30,6 @@ class AmplitudeStiffness(Effect):
     description = ("amplitude-dependent mount stiffness, equivalent linearisation iterated to "
                    "consistency (mount data at 0.1 mm)")
     engine_change = False
-    #: an evaluation iterates the linearisation (typically 5–20 re-condensed solves)
-    eval_cost = 10.0
 
     def parameters(self, engine=None):
         return (Parameter("kappa", "1", 0.0, 3.0, 0.0, False,

@@ -65,9 +65,6 @@ class Effect:
     engine_change = True
     #: True when the effect only changes what the sensors read (the physics is untouched).
     response_only = False
-    #: Cost of one evaluation on the fast path relative to a plain solve (the diagnosis'
-    #: evaluation budget counts in these units).
-    eval_cost = 1.0
 
     # ------------------------------------------------------------------ description
     def parameters(self, engine=None) -> tuple:

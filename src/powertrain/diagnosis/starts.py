@@ -1,0 +1,108 @@
+"""Start points of the candidate fits (:mod:`powertrain.diagnosis.fit`): the defaults, given
+starts, the effects' coarse start grids, and a block-wise multi-start for effects whose
+parameters act on disjoint channels (``Effect.separable_groups``: a sensor triad's gains,
+rotation and cross-axis terms).
+
+Every evaluation made here is charged to the fit's budget through ``fun`` (the fit's
+counted residual function).
+"""
+
+from __future__ import annotations
+
+import warnings
+
+import numpy as np
+
+from powertrain.analysis.noise_floor import above_floor
+from powertrain.effects import EFFECTS
+
+#: Starts of a block refined after screening (block-wise multi-start).
+BLOCK_REFINED = 2
+#: Share of a fit's evaluation budget the block-wise multi-start may use.
+BLOCK_SHARE = 0.4
+
+
+def start_points(problem, pack, effects, starts, grid, fun):
+    """Start vectors of a fit: the defaults, the given ``starts``, the two best points of
+    the effect's coarse start grid and the block-wise multi-start's optimum."""
+    span = pack.upper - pack.lower
+    lo, hi = pack.lower + 1e-9 * span, pack.upper - 1e-9 * span
+    cands = [np.clip(pack.x0, lo, hi)] + [np.clip(s, lo, hi) for s in starts or []]
+    # coarse grid of start points for effects that declare one (the cylinder IMEP factors
+    # need one: at e = 0 the half orders vanish and the gradient of their level with them)
+    sg = EFFECTS[effects[0]].start_grid(problem.engine) if len(effects) == 1 else ()
+    if grid and sg:
+        mesh = np.meshgrid(*sg, indexing="ij")
+        pts = np.stack([m.ravel() for m in mesh], axis=1).astype(float)
+        pts[:, pack.log] = np.log(pts[:, pack.log])
+        costs = [np.sum(fun(p) ** 2) for p in pts]
+        cands += [np.clip(pts[i], lo, hi) for i in np.argsort(costs)[:2]]
+    if grid and len(effects) == 1:
+        xb = _block_start(fun, pack, effects[0])
+        if xb is not None:
+            cands.append(np.clip(xb, lo, hi))
+    return cands
+
+
+def _block_start(fun, pack, effect):
+    """Block-wise multi-start (``Effect.separable_groups``): for each block (parameters that
+    act on their own channels only) every start is screened with the gains set to the mean
+    gap of their channels (:func:`_projected`), the best :data:`BLOCK_REFINED` are refined
+    on the block's channels alone, and the blocks' optima are joined into one start for the
+    joint fit. None when the effect declares no blocks. The screening and refits are
+    charged to the fit's budget and stop at :data:`BLOCK_SHARE` of it."""
+    groups = EFFECTS[effect].separable_groups(fun.problem.engine)
+    if not groups:
+        return None
+    x = pack.x0.copy()
+    n_ch, n_o = fun.problem.valid["train"].shape[1:]
+    for names, chans, starts in groups:
+        idx = np.array([pack.names.index((effect, n)) for n in names])
+        cells = np.zeros((n_ch, n_o), bool)
+        cells[chans] = True
+        sub = fun.problem.restricted(train_cells=cells)
+        screened = sorted((_projected(fun, sub, pack, effect, x, idx, st, chans)
+                           for st in starts), key=lambda t: t[0])
+        best = screened[0]
+        for _cost, xs in screened[:BLOCK_REFINED]:
+            if fun.n >= BLOCK_SHARE * fun.budget:
+                break
+            res = _refine_block(fun, sub, pack, x, idx, xs)
+            if res.cost * 2 < best[0]:
+                best = (2 * res.cost, res.x)
+        x[idx] = best[1]
+    return x
+
+
+def _projected(fun, sub, pack, effect, x, idx, start, chans):
+    """(cost, block vector) of a start with each channel's gain set to minus its mean gap
+    over the points above the floor (the least-squares gain, censoring aside)."""
+    names = [pack.names[i][1] for i in idx]
+    xs = np.array([start.get(n, pack.x0[i]) for n, i in zip(names, idx)])
+    xx = x.copy()
+    xx[idx] = xs
+    fun.evaluate(sub, xx)
+    g = sub.gaps(pack.scenario(xx))
+    up = above_floor(sub.meas["train"], sub.data.floor) & np.isfinite(g)
+    for c in chans:
+        gi = names.index(f"g{c + 1}") if f"g{c + 1}" in names else None
+        if gi is not None and up[:, c].any():
+            shift = float(np.mean(g[:, c][up[:, c]]))
+            xs[gi] = np.clip(xs[gi] - shift, pack.lower[idx[gi]], pack.upper[idx[gi]])
+            g[:, c] = np.where(up[:, c], g[:, c] - shift, g[:, c])
+    xx[idx] = xs
+    r = np.concatenate([g[sub.valid["train"]], fun.prior(xx)])
+    return float(np.sum(r ** 2)), xs
+
+
+def _refine_block(fun, sub, pack, x, idx, xs):
+    from scipy.optimize import least_squares
+
+    def f(v):
+        xx = x.copy()
+        xx[idx] = v
+        return fun.evaluate(sub, xx)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        return least_squares(f, xs, bounds=(pack.lower[idx], pack.upper[idx]), method="trf",
+                             max_nfev=10 * idx.size, diff_step=1e-4)
