@@ -126,6 +126,16 @@ def test_xv_explained_min(above):
     assert (v.chosen == "a") is (not above)
 
 
+@pytest.mark.parametrize("above", [False, True])
+def test_xv_t_min(above):
+    ev = evidence(cand("a", 1.0, 900.0))
+    ev.candidates[0].cells["t"] = 3.5
+    v = decide(ev, DecisionRule(xv_t_min=just(3.5, above)))
+    assert (v.chosen == "a") is (not above)
+    if above:
+        assert v.assessments["a"].status is Status.FAILS_HELDOUT_CELLS
+
+
 @pytest.mark.parametrize("n_checked", [1, 2])
 def test_n_checked(n_checked):
     first = cand("a", 1.0, 900.0, struct=5.0)          # fails the structure check

@@ -8,9 +8,9 @@ the noise a perfect model would leave, and the speed-band confounding check.
   generated from the mounts, :func:`channel_folds`: one channel of every mount triad each —
   the rigid body carries the effect to a channel it was not fitted on); candidates with
   sensor errors withhold orders per channel (:func:`order_folds`: each channel's
-  *informative* orders, those with measured points above the noise floor, dealt into
-  :data:`ORDER_FOLDS` folds in a staggered pattern, so every refit still sees some orders of
-  every channel: a gain or a triad rotation is the same on every order of its channels, a
+  *informative* orders, those with measured points of that channel above the noise floor,
+  dealt into :data:`ORDER_FOLDS` folds in a staggered pattern, so every refit still sees an
+  informative order of every channel: a gain or a triad rotation is the same on every order of its channels, a
   frequency-tied gap is not). Free gains thus cannot absorb a structural gap. The folds
   are dealt over informative orders because orders that are all at the floor (the half
   orders of a balanced four-cylinder engine) identify nothing, and staggered because
@@ -113,25 +113,26 @@ def noise_mse(problem: Problem, sigma, cells=None) -> float:
 
 
 def order_folds(problem: Problem) -> list:
-    """Withheld-cell masks (n_ch, n_o) over the informative orders (at least
-    :data:`MIN_ORDER_POINTS` training points above the floor): cell (channel c, i-th
-    informative order) is withheld in fold (c + i) mod :data:`ORDER_FOLDS`, so every
-    channel keeps some of its orders to fit its gain on and every order some of its
-    channels; with fewer than two informative orders, orders ≤ :data:`ORDER_SPLIT` vs the
-    others."""
-    n_ch, n_o = problem.valid["test"].shape[1:]
+    """Withheld-cell masks (n_ch, n_o) over each channel's informative orders (at least
+    :data:`MIN_ORDER_POINTS` training points of that channel above the floor): the i-th
+    informative order of channel c is withheld in fold (c + i) mod :data:`ORDER_FOLDS`, so
+    every order keeps some of its channels; a channel with a single informative order never
+    has it withheld (its gain would have nothing left to be fitted on). With fewer than two
+    informative orders overall, orders ≤ :data:`ORDER_SPLIT` vs the others."""
+    n_ch, n_o = problem.valid["train"].shape[1:]
     usable = above_floor(problem.meas["train"], problem.data.floor) & problem.valid["train"]
-    informative = np.flatnonzero(usable.sum(axis=(0, 1)) >= MIN_ORDER_POINTS)
-    if informative.size < 2:
+    informative = usable.sum(axis=0) >= MIN_ORDER_POINTS              # (n_ch, n_o)
+    if informative.any(axis=0).sum() < 2:
         order = (problem.sub.harmonic + 1) / 2.0
         low = np.broadcast_to(order <= ORDER_SPLIT + 1e-9, (n_ch, n_o))
         return [low, ~low]
-    fold_of = (np.arange(n_ch)[:, None] + np.arange(informative.size)[None, :]) % ORDER_FOLDS
-    folds = []
-    for j in range(ORDER_FOLDS):
-        m = np.zeros((n_ch, n_o), bool)
-        m[:, informative] = fold_of == j
-        folds.append(m)
+    folds = [np.zeros((n_ch, n_o), bool) for _ in range(ORDER_FOLDS)]
+    for c in range(n_ch):
+        orders = np.flatnonzero(informative[c])
+        if orders.size < 2:
+            continue
+        for i, k in enumerate(orders):
+            folds[(c + i) % ORDER_FOLDS][c, k] = True
     return folds
 
 
