@@ -22,6 +22,8 @@ def read_toml(path) -> dict:
         return tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
         raise InputError(f"not valid TOML: {exc}", file=path) from None
+    except ValueError as exc:        # e.g. an integer too long to convert (> 4300 digits)
+        raise InputError(f"not valid TOML: {exc}", file=path) from None
 
 
 def get(table: dict, key: str, path, prefix: str = "", *, default=..., types=None):
