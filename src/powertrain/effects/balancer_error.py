@@ -59,7 +59,8 @@ class BalancerError(Effect):
                           "timing difference between the shafts (first - second lag)"))
 
     def start_grid(self, engine=None):
-        return ((0.6, 1.0, 1.4), (-0.35, 0.0, 0.35), (-0.3, 0.0, 0.3), (-0.3, 0.0, 0.3))
+        return ((0.6, 1.0, 1.4), (-0.35, -0.15, 0.0, 0.15, 0.35), (-0.3, 0.0, 0.3),
+                (-0.3, -0.15, 0.0, 0.15, 0.3))
 
     def applicable(self, engine):
         return len(engine.balancer.shafts) > 0

@@ -1,4 +1,5 @@
-"""The triad model of ``sensor_error`` and how the diagnosis fits and checks it.
+"""Start points of the diagnosis' fits (:mod:`powertrain.diagnosis.starts`), the triad model of
+``sensor_error`` and how the diagnosis checks it.
 
 A triad rotated by a few degrees about an oblique axis leaks a strong axis into a weak one;
 from zero rotation, a large false gain on the weak channel is a local optimum. The block-wise
@@ -39,12 +40,12 @@ def test_cross_axis_terms_make_a_symmetric_off_diagonal(engine):
     assert np.allclose(same, v)
 
 
-def _setup(engine, params, seed=7, scatter_db=0.3):
-    """Measured order curves of the cached model with ``params`` read by the sensors, with
+def _setup(engine, params, seed=7, scatter_db=0.3, effect="sensor_error"):
+    """Measured order curves of the cached model with ``effect`` at ``params``, with
     log-normal scatter (synthetic)."""
     rpm = np.arange(1000.0, 6000.1, 100.0)
     hm = HarmonicModel(engine, rpm)
-    vel = predict(hm, {"sensor_error": params}).velocity
+    vel = predict(hm, {effect: params}).velocity
     rng = np.random.default_rng(seed)
     lev = np.abs(vel) / np.sqrt(2) * 10 ** (rng.normal(0, scatter_db, vel.shape) / 20)
     lev = np.sqrt(lev ** 2 + 1e-12)
@@ -52,7 +53,7 @@ def _setup(engine, params, seed=7, scatter_db=0.3):
     for c, (m, d) in enumerate(hm.channels):
         for o in (0.5, 1.0, 1.5, 2.0, 3.0, 4.0, 6.0):
             curves[(m, d, order_label(o))] = (rpm, lev[:, c, int(round(2 * o)) - 1])
-    return _Setup(MeasuredRunup(curves, source="synthetic"), engine, 1e-6, ["sensor_error"])
+    return _Setup(MeasuredRunup(curves, source="synthetic"), engine, 1e-6, [effect])
 
 
 def test_block_multistart_finds_an_oblique_triad_rotation(engine):
@@ -82,3 +83,13 @@ def test_order_folds_keep_orders_of_every_channel(engine):
     # orders at the floor everywhere (the half orders here) are never withheld
     usable = np.isfinite(s.problem.meas["train"]) & (s.problem.meas["train"] > 3e-6)
     assert not (held.astype(bool) & ~usable.any(axis=0)[None, :]).any()
+
+
+def test_balancer_one_shaft_late_is_found_with_its_sign(engine):
+    """One shaft ~10 deg late (lag 0.085, skew 0.17 rad): the mirror timing (skew < 0) is a
+    local optimum that a coarse start grid without intermediate timings settled on."""
+    truth = {"gain": 1.0, "lag": 0.085, "asym": -0.05, "skew": 0.17}
+    s = _setup(engine, truth, effect="balancer_error")
+    p = fit_candidate(s.problem, ("balancer_error",)).params["balancer_error"]
+    assert p["skew"] == pytest.approx(0.17, abs=0.03)
+    assert p["lag"] == pytest.approx(0.085, abs=0.03)
