@@ -135,7 +135,7 @@ def test_bad_mount_file(tmp_path, name, content, key):
     assert sorted(q.name for q in tmp_path.iterdir()) == ([p.name] if p.exists() else [])
 
 
-@pytest.mark.parametrize("freq", ["10,5", "5,5", "1:0:1", "abc", "5,-1", ""])
+@pytest.mark.parametrize("freq", ["10,5", "5,5", "1:0:1", "abc", "5,-1", "", "0.01:1e12:1e-300,-0.0"])
 def test_bad_frequencies(tmp_path, freq):
     out = tmp_path / "plot.png"
     res = run(BASE, "--freq", freq, "--plot", out)

@@ -31,10 +31,11 @@ def parse_frequencies(text: str, option: str = "--freq") -> np.ndarray:
                 start, stop, step = fields
                 if not all(math.isfinite(x) for x in fields):
                     raise ValueError
-                n = math.floor((stop - start) / step + 1e-9) + 1
-                if n + len(values) > MAX_FREQUENCIES:
-                    raise InputError(f"{part!r} asks for {n:.3g} frequencies; at most "
+                ratio = (stop - start) / step
+                if not math.isfinite(ratio) or ratio + 1 + len(values) > MAX_FREQUENCIES:
+                    raise InputError(f"{part!r} asks for {ratio + 1:.3g} frequencies; at most "
                                      f"{MAX_FREQUENCIES}", key=option)
+                n = math.floor(ratio + 1e-9) + 1
                 values.extend(start + step * np.arange(n))
             else:
                 values.append(float(part))
