@@ -194,16 +194,25 @@ class Case:
 
 def make_case(index, names, engine_kind, seed) -> Case:
     """Draw, simulate and measure one case."""
-    rng = np.random.default_rng(seed)
     engine = engines()[engine_kind]
+    return draw_case(index, names, engine_kind, seed, engine, baseline_velocity(engine_kind),
+                     truth_velocity, [(mt.name, a) for mt in engine.mounts for a in "xyz"],
+                     "blind case")
+
+
+def draw_case(index, names, engine_kind, seed, engine, base, simulate, channels,
+              label) -> Case:
+    """Draw the hidden effects ``names`` on ``engine``, simulate them
+    (``simulate(engine, truth)``, noise-free, ``base`` without them) and measure
+    ``channels`` (source ``"{label} {index} (seed {seed})"``); pairs also get each member's
+    gap alone."""
+    rng = np.random.default_rng(seed)
     truth = [(n, KINDS[n].draw(rng, engine)) for n in names]
-    base = baseline_velocity(engine_kind)
-    clean = truth_velocity(engine, truth) if truth else base
+    clean = simulate(engine, truth) if truth else base
     sigma = float(rng.uniform(*SIGMA_DB))
-    channels = [(mt.name, a) for mt in engine.mounts for a in "xyz"]
-    measured = measure(clean, sigma, rng, f"blind case {index} (seed {seed})", channels)
+    measured = measure(clean, sigma, rng, f"{label} {index} (seed {seed})", channels)
     members = {}
     if len(truth) > 1:
-        members = {t[0]: gap_stats(base, truth_velocity(engine, [t])) for t in truth}
+        members = {t[0]: gap_stats(base, simulate(engine, [t])) for t in truth}
     return Case(index, list(names), engine_kind, seed, measured, sigma, truth, clean,
                 gap_stats(base, clean), members)

@@ -22,7 +22,7 @@ import functools
 import numpy as np
 
 from powertrain.validation import truth as tr
-from powertrain.validation.cases import RPM, SIGMA_DB, Case, gap_stats, measure, traces_engine
+from powertrain.validation.cases import RPM, Case, draw_case, traces_engine
 from powertrain.validation.kinds import KINDS
 
 #: Engine kinds of the passive-side cases.
@@ -85,13 +85,6 @@ def baseline_velocity(engine_kind):
 
 def make_passive_case(index, names, engine_kind, seed) -> Case:
     """Draw, simulate and measure one passive-side case."""
-    rng = np.random.default_rng(seed)
     engine = passive_engines()[engine_kind]
-    truth = [(n, KINDS[n].draw(rng, engine)) for n in names]
-    base = baseline_velocity(engine_kind)
-    clean = truth_velocity(engine, truth) if truth else base
-    sigma = float(rng.uniform(*SIGMA_DB))
-    measured = measure(clean, sigma, rng, f"blind passive case {index} (seed {seed})",
-                       channels(engine))
-    return Case(index, list(names), engine_kind, seed, measured, sigma, truth, clean,
-                gap_stats(base, clean), {})
+    return draw_case(index, names, engine_kind, seed, engine, baseline_velocity(engine_kind),
+                     truth_velocity, channels(engine), "blind passive case")
