@@ -95,7 +95,6 @@ class Problem:
         sig = noise_sigma_db(data)
         #: measured scatter [dB, 1σ] (weight of the parameter priors; 1 dB if unknown)
         self.sigma_db = sig if np.isfinite(sig) and sig > 0 else 1.0
-        self._last = {}
         self.reset_warm()
         for part, cells in (("train", train_cells), ("test", test_cells)):
             if cells is not None:
@@ -109,8 +108,10 @@ class Problem:
         return state
 
     def reset_warm(self):
-        """Forget the amplitude fixed point's warm start and the solve count (at the start
-        of every fit, so that a fit's result does not depend on what ran before it)."""
+        """Forget the cached velocities, the amplitude fixed point's warm start and the solve
+        count (at the start of every fit, so that a fit's result does not depend on what ran
+        before it)."""
+        self._last = {}
         self._warm = {}
         self.solves = 0
 
@@ -273,7 +274,6 @@ def fit_candidate(problem: Problem, effects, starts=None, grid=True,
     """Fit one effect or a combination on the training speeds, score on the held-out ones."""
     t0 = time.perf_counter()
     problem.reset_warm()
-    problem._last = {}
     pack = Packing.of(effects, problem.engine)
     fun = _Counted(problem, pack, budget)
     try:
