@@ -18,6 +18,9 @@ the noise a perfect model would leave, and the speed-band confounding check.
   remaining orders with unidentified gains, which a refit then moves at will;
 * :func:`noise_mse`: :math:`E_n = \hat\sigma^2 u`, the held-out mean squared gap a perfect
   model would leave, :math:`u` the fraction of scored held-out points that are not censored;
+* :func:`crossfit`: the candidate refitted with each other third of the speed blocks held
+  out, so that every speed is scored once by a fit that did not see it (for candidates
+  whose held-out t on one third of the speeds is short of the rule's);
 * :func:`band_check`: the chosen effect refitted on four speed bands: a parameter believed
   constant that trends with speed points to a different effect.
 """
@@ -30,7 +33,8 @@ import time
 import numpy as np
 
 from powertrain.analysis.noise_floor import above_floor
-from powertrain.diagnosis.fit import FitOutcome, Problem, fit_candidate
+from powertrain.diagnosis.fit import FitOutcome, Problem, baseline_outcome, fit_candidate
+from powertrain.diagnosis.rule import log_ratio_t
 from powertrain.effects import EFFECTS
 
 #: Fallback order split when fewer than two orders are informative: orders up to this one
@@ -148,34 +152,40 @@ def _folds(problem: Problem, effects):
     return "channels", folds
 
 
-def per_speed_t(per_0, per_c, noise_mse=0.0):
-    """t statistic of the per-speed log-ratio improvements of ``per_c`` over ``per_0``
-    (mean squared gaps per speed, noise added; NaN entries dropped), as
-    :func:`powertrain.diagnosis.rule.improvement_t`."""
-    en = max(float(noise_mse), 1e-12)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        d = np.log((per_0 + en) / (per_c + en))
-    d = d[np.isfinite(d)]
-    sd = float(np.std(d, ddof=1)) if d.size > 1 else 0.0
-    return float(np.mean(d)) / (sd / math.sqrt(d.size)) if sd > 0 else 0.0
-
-
 def heldout_cells_check(problem: Problem, o: FitOutcome, baseline: FitOutcome, sigma,
-                        budget=None):
+                        budget=None, fold_problems=()):
     """Refit ``o``'s effects without some (channel, order) cells and score the withheld
-    cells at the held-out speeds (cross-validation over cells as well as speeds).
+    cells at the held-out speeds (cross-validation over cells as well as speeds). With
+    ``fold_problems`` (a candidate judged on cross-fitted speeds, :func:`crossfit`) the
+    withheld cells are scored at the held-out speeds of every speed fold.
 
     Returns
     -------
     dict
         ``kind``, ``explained`` (fraction of the withheld cells' held-out excess over noise
         removed), ``t`` (per-speed significance), ``baseline_excess_db``,
-        ``heldout_rms_db`` and ``seconds``.
+        ``heldout_rms_db``, ``speed_folds`` and ``seconds``.
     """
     t0 = time.perf_counter()
     kind, folds = _folds(problem, o.effects)
-    g_all = np.full(problem.valid["test"].shape, np.nan)
     kw = {} if budget is None else {"budget": budget}
+    parts = [_cells_fold(problem, o, baseline, folds, sigma, kw)]
+    parts += [_cells_fold(p, o, baseline_outcome(p), folds, sigma, kw) for p in fold_problems]
+    n = sum(q["n"] for q in parts)
+    e0, ec, e_n = (sum(q[k] * q["n"] for q in parts) / n if n else float("nan")
+                   for k in ("e0", "ec", "e_n"))
+    per_0, per_c = (np.concatenate([q[k] for q in parts]) for k in ("per_0", "per_c"))
+    excess = max(e0 - e_n, 0.0)
+    return {"kind": kind, "explained": (e0 - ec) / excess if excess > 0 else float("nan"),
+            "t": log_ratio_t(per_0, per_c, e_n), "baseline_excess_db": math.sqrt(excess),
+            "heldout_rms_db": math.sqrt(ec), "speed_folds": len(parts),
+            "seconds": time.perf_counter() - t0}
+
+
+def _cells_fold(problem, o, baseline, folds, sigma, kw) -> dict:
+    """One speed fold of :func:`heldout_cells_check`: the withheld cells' mean squared gaps
+    (baseline, refits, noise), per speed and over all scored points."""
+    g_all = np.full(problem.valid["test"].shape, np.nan)
     for held in folds:
         if not held.any() or held.all():
             continue
@@ -188,11 +198,28 @@ def heldout_cells_check(problem: Problem, o: FitOutcome, baseline: FitOutcome, s
     cells = ok.any(axis=0)
     e0, per_0 = cells_mse(baseline, cells)
     ec = float(np.mean(g_all[ok] ** 2)) if ok.any() else float("nan")
-    e_n = noise_mse(problem, sigma, cells)
-    excess = max(e0 - e_n, 0.0)
-    return {"kind": kind, "explained": (e0 - ec) / excess if excess > 0 else float("nan"),
-            "t": per_speed_t(per_0, per_c, e_n), "baseline_excess_db": math.sqrt(excess),
-            "heldout_rms_db": math.sqrt(ec), "seconds": time.perf_counter() - t0}
+    return {"per_0": per_0, "per_c": per_c, "e0": e0, "ec": ec, "n": int(ok.sum()),
+            "e_n": noise_mse(problem, sigma, cells)}
+
+
+def crossfit(fold_problems, o: FitOutcome, budget=None) -> np.ndarray:
+    """Mean squared gap per speed of ``o``'s effects over all speed folds: ``o``'s own
+    held-out scores (fold 0), then refits on each other fold's training speeds (started
+    from ``o``'s optimum) scored on the speeds that fold leaves out.
+    ``fold_problems`` are the :class:`Problem` of folds 1, 2, ...; the baseline's vector
+    over the same speeds is :func:`crossfit_baseline`."""
+    kw = {} if budget is None else {"budget": budget}
+    parts = [o.heldout_per_rpm]
+    for p in fold_problems:
+        parts.append(fit_candidate(p, o.effects, starts=[o.x], grid=False, **kw)
+                     .heldout_per_rpm)
+    return np.concatenate(parts)
+
+
+def crossfit_baseline(fold_problems, baseline: FitOutcome) -> np.ndarray:
+    """The baseline's mean squared gap per speed over the speeds :func:`crossfit` scores."""
+    return np.concatenate([baseline.heldout_per_rpm]
+                          + [baseline_outcome(p).heldout_per_rpm for p in fold_problems])
 
 
 def band_check(problem_factory, effect, data, train_idx, n_bands=4):

@@ -12,13 +12,21 @@ import time
 import numpy as np
 
 from powertrain.diagnosis import candidates as cand
-from powertrain.diagnosis.checks import band_check, heldout_cells_check, noise_mse, structured_residual
+from powertrain.diagnosis.checks import (
+    band_check,
+    crossfit,
+    crossfit_baseline,
+    heldout_cells_check,
+    noise_mse,
+    structured_residual,
+)
 from powertrain.diagnosis.data import (
     DEFAULT_NOISE_FLOOR,
     HELDOUT_BLOCKS,
     MIN_RPM,
     N_BLOCKS,
     N_FIT_RPM,
+    N_FOLDS,
     N_TEST_RPM,
     even,
     gap_data,
@@ -109,6 +117,22 @@ class _Setup:
     def sub(self, idx):
         return self.hm_need.subset([self.pos[int(i)] for i in idx])
 
+    def fold_problems(self) -> list:
+        """The fitting problems of speed folds 1, 2 (:func:`split_rpm`; fold 0 is
+        ``problem``), built on first use."""
+        if getattr(self, "_folds", None) is None:
+            self._folds = []
+            for k in range(1, N_FOLDS):
+                tr, te = split_rpm(self.data.rpm, fold=k)
+                tr, te = even(tr, N_FIT_RPM), even(te, N_TEST_RPM)
+                hm = self.hm.subset(np.union1d(tr, te))
+                cand.warm_caches(hm, self.effects)
+                pos = {int(r): i for i, r in enumerate(np.union1d(tr, te))}
+                self._folds.append(Problem(hm.subset([pos[int(i)] for i in tr]),
+                                           hm.subset([pos[int(i)] for i in te]),
+                                           self.data, tr, te))
+        return self._folds
+
     def split_dict(self):
         d = self.data
         return {"description": f"{N_BLOCKS} contiguous speed blocks, blocks "
@@ -193,7 +217,8 @@ def pair_candidates(singles, e_n, rule) -> list:
 
 def _evidence(o, struct=None):
     return CandidateEvidence(o.label, o.effects, o.heldout_mse, o.heldout_per_rpm, o.bic,
-                             o.struct_db if struct is None else struct, o.cells_check)
+                             o.struct_db if struct is None else struct, o.cells_check,
+                             o.crossfit)
 
 
 def _decide(s, baseline, outcomes, sigma, rule, where_phrase, budget):
@@ -206,8 +231,17 @@ def _decide(s, baseline, outcomes, sigma, rule, where_phrase, budget):
         verdict = decide(ev, rule)
         if verdict.kind is not VerdictKind.PENDING:
             return verdict, e_n
+        if verdict.needs_crossfit:
+            folds = s.fold_problems()
+            if baseline.crossfit is None:
+                baseline.crossfit = crossfit_baseline(folds, baseline)
+            for label in verdict.needs_crossfit:
+                by_label[label].crossfit = crossfit(folds, by_label[label], budget=budget)
+            continue
         o = by_label[verdict.needs_cells_check]
-        o.cells_check = heldout_cells_check(s.problem, o, baseline, sigma, budget=budget)
+        o.cells_check = heldout_cells_check(
+            s.problem, o, baseline, sigma, budget=budget,
+            fold_problems=s.fold_problems() if o.crossfit is not None else ())
 
 
 def _structure(s, baseline, outcomes, sigma):
@@ -231,6 +265,7 @@ def _diagnose(measured, engine, noise_floor, effects, pairs, do_bands, rule, sch
     for o in outcomes:
         a = verdict.assessments[o.label]
         o.t_stat, o.bic_gain, o.explained = a.t_stat, a.bic_gain, a.explained
+        o.t_crossfit = a.t_crossfit
         o.status, o.status_code = a.text, a.status
     outcomes.sort(key=lambda o: o.heldout_mse)
     chosen = next((o for o in outcomes if o.label == verdict.chosen), None)

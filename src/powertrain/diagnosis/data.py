@@ -28,6 +28,8 @@ N_TEST_RPM = 36
 #: Blocks of the speed split and those held out (0-based).
 N_BLOCKS = 12
 HELDOUT_BLOCKS = (1, 4, 7, 10)
+#: Speed folds of the cross-fit (every block held out once).
+N_FOLDS = 3
 #: Smallest data set that can be split: speeds in total.
 MIN_RPM = 12
 
@@ -184,12 +186,13 @@ def noise_sigma_db(data: GapData) -> float:
     return float(1.4826 * np.median(np.abs(d2 - np.median(d2))) / math.sqrt(6.0))
 
 
-def split_rpm(rpm):
+def split_rpm(rpm, fold=0):
     """Training and held-out speed indices (12 contiguous blocks, blocks 2, 5, 8, 11 held
-    out)."""
+    out); ``fold`` k = 1, 2 holds out the blocks k places further on (cross-fitting: the
+    three folds hold out every block once)."""
     n = rpm.size
     block = np.minimum((np.arange(n) * N_BLOCKS) // n, N_BLOCKS - 1)
-    test = np.isin(block, HELDOUT_BLOCKS)
+    test = np.isin(block, [(b + fold) % N_BLOCKS for b in HELDOUT_BLOCKS])
     return np.flatnonzero(~test), np.flatnonzero(test)
 
 

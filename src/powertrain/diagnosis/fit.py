@@ -62,6 +62,9 @@ class FitOutcome:
     struct_db: float = float("nan")
     chi2_ratio: float = float("nan")
     cells_check: dict | None = None
+    #: mean squared gap per speed over all speed folds (:func:`checks.crossfit`), if run
+    crossfit: np.ndarray | None = field(default=None, repr=False)
+    t_crossfit: float = float("nan")
     budget_hit: bool = False
     x: np.ndarray | None = None
     heldout_gaps: np.ndarray | None = field(default=None, repr=False)

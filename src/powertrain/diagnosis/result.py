@@ -108,6 +108,7 @@ class DiagnosisResult:
                 "heldout_channel_rms_db_before": self.baseline.heldout_channel_rms,
                 "heldout_channel_rms_db_after": o.heldout_channel_rms,
                 "train_bic_gain": o.bic_gain, "heldout_t": o.t_stat,
+                "crossfit_t": o.t_crossfit,
                 "explained_fraction_of_excess": o.explained, "verdict": o.status,
                 "status": None if o.status_code is None else o.status_code.name.lower(),
                 "heldout_structured_residual_db": o.struct_db,

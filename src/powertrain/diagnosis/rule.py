@@ -77,6 +77,13 @@ class DecisionRule:
     n_checked : int
         Supported candidates (best first) put through the structure and held-out-cell
         checks: the fourth best explains clearly less and each check costs 2–3 refits.
+    t_screen : float
+        Held-out t above which a candidate that passes BIC and explains at least
+        ``explained_min`` but misses ``t_min`` is cross-fitted (refitted with the other two
+        thirds of the speeds held out, so every speed is scored once) and judged on all
+        speeds against the same ``t_min``: a gap that sits at a few resonance crossings
+        leaves one third of the speeds too few informative ones; three times the speeds
+        raise t by about √3, so below 2 (2√3 ≈ 3.5 < 4) cross-fitting cannot succeed.
     """
 
     t_min: float = 4.0
@@ -89,6 +96,8 @@ class DecisionRule:
     xv_explained_min: float = 0.5
     xv_t_min: float = 3.0
     n_checked: int = 3
+
+    t_screen: float = 2.0
 
     def to_dict(self) -> dict:
         """Upper-case keys (the diagnosis JSON's ``decision_rule``)."""
@@ -129,6 +138,9 @@ class CandidateEvidence:
     bic: float
     struct_db: float = float("nan")
     cells: dict | None = None
+    #: mean squared gap per speed over all three speed folds (each fold's refit scored on
+    #: the speeds it left out; the baseline's over the same speeds); None until cross-fitted
+    crossfit: np.ndarray | None = None
 
 
 @dataclass
@@ -151,6 +163,8 @@ class Assessment:
     explained: float
     status: Status
     text: str
+    t_crossfit: float = float("nan")
+    needs_crossfit: bool = False
 
 
 @dataclass
@@ -166,6 +180,7 @@ class Verdict:
     chosen: str | None = None
     ambiguous: list = field(default_factory=list)
     needs_cells_check: str | None = None
+    needs_crossfit: list = field(default_factory=list)
 
 
 def improvement_t(base: CandidateEvidence, cand: CandidateEvidence, noise_mse=0.0):
@@ -180,9 +195,23 @@ def improvement_t(base: CandidateEvidence, cand: CandidateEvidence, noise_mse=0.
     and its t stays small however certain the improvement); speeds within noise count as
     no change. t = :math:`\bar d/(s_d/\sqrt{n_r})`.
     """
+    return log_ratio_t(base.heldout_per_rpm, cand.heldout_per_rpm, noise_mse)
+
+
+def crossfit_t(base: CandidateEvidence, cand: CandidateEvidence, noise_mse=0.0):
+    """:func:`improvement_t` over every speed when both carry cross-fitted per-speed gaps
+    (``crossfit``), else over the held-out speeds."""
+    if base.crossfit is None or cand.crossfit is None:
+        return improvement_t(base, cand, noise_mse)
+    return log_ratio_t(base.crossfit, cand.crossfit, noise_mse)
+
+
+def log_ratio_t(per_0, per_c, noise_mse=0.0):
+    """t of the per-speed log ratios ln((per_0 + E_n)/(per_c + E_n)) (NaN entries dropped);
+    the statistic of :func:`improvement_t`."""
     en = max(float(noise_mse), 1e-12)
     with np.errstate(divide="ignore", invalid="ignore"):
-        d = np.log((base.heldout_per_rpm + en) / (cand.heldout_per_rpm + en))
+        d = np.log((np.asarray(per_0, float) + en) / (np.asarray(per_c, float) + en))
     d = d[np.isfinite(d)]
     if d.size < 2:
         return float("nan")
@@ -197,23 +226,33 @@ def _assess(ev: Evidence, rule: DecisionRule) -> dict:
     excess0 = max(e0 - ev.noise_mse, 0.0)
     out = {}
     for c in ev.candidates:
-        t, dbic = improvement_t(ev.baseline, c, ev.noise_mse), ev.baseline.bic - c.bic
-        ok = dbic > rule.bic_margin and t > rule.t_min and c.heldout_mse < e0
-        st = Status.SUPPORTED if ok else Status.NOT_SUPPORTED
-        out[c.label] = Assessment(t, dbic, (e0 - c.heldout_mse) / excess0 if excess0 > 0
-                                  else float("nan"), st, st.value)
+        out[c.label] = _support(ev, rule, c, e0, excess0)
     by_label = {c.label: c for c in ev.candidates}
     for c in ev.candidates:
         if len(c.effects) != 2 or out[c.label].status is not Status.SUPPORTED:
             continue
         best_m = min((by_label[e] for e in c.effects), key=lambda m: m.heldout_mse)
-        t, dbic = improvement_t(best_m, c, ev.noise_mse), best_m.bic - c.bic
+        t, dbic = crossfit_t(best_m, c, ev.noise_mse), best_m.bic - c.bic
         left = best_m.heldout_mse - ev.noise_mse
         gain = (best_m.heldout_mse - c.heldout_mse) / left if left > 0 else 0.0
         if not (t > rule.t_min and dbic > rule.bic_margin and gain >= rule.pair_gain_min):
             out[c.label].status = Status.NOT_BETTER_THAN_MEMBER
             out[c.label].text = f"not better than {best_m.label} alone"
     return out
+
+
+def _support(ev, rule, c, e0, excess0) -> Assessment:
+    """Support of one candidate against the baseline; cross-fitted when held-out t falls
+    between ``t_screen`` and ``t_min`` for a candidate that is otherwise admissible."""
+    t, dbic = improvement_t(ev.baseline, c, ev.noise_mse), ev.baseline.bic - c.bic
+    explained = (e0 - c.heldout_mse) / excess0 if excess0 > 0 else float("nan")
+    base_ok = dbic > rule.bic_margin and c.heldout_mse < e0
+    tx = crossfit_t(ev.baseline, c, ev.noise_mse) if c.crossfit is not None else float("nan")
+    ok = base_ok and (t > rule.t_min or tx > rule.t_min)
+    st = Status.SUPPORTED if ok else Status.NOT_SUPPORTED
+    need = (base_ok and c.crossfit is None and rule.t_screen < t <= rule.t_min
+            and np.isfinite(explained) and explained >= rule.explained_min)
+    return Assessment(t, dbic, explained, st, st.value, t_crossfit=tx, needs_crossfit=need)
 
 
 def _struct_max(ev, rule):
@@ -257,7 +296,7 @@ def _rivals(ev, rule, ranked, ass, chosen):
         if (c is chosen or a.status is not Status.SUPPORTED or theirs <= mine
                 or mine <= theirs or not _big(a, rule) or not c.struct_db <= smax):
             continue
-        t_rival = improvement_t(c, chosen, ev.noise_mse)
+        t_rival = crossfit_t(c, chosen, ev.noise_mse)
         if not t_rival > rule.t_min:
             out.append((c, t_rival))
     return out
@@ -269,6 +308,9 @@ def decide(evidence: Evidence, rule: DecisionRule = DecisionRule()) -> Verdict:
     ass = _assess(ev, rule)
     ranked = sorted(ev.candidates, key=lambda c: c.heldout_mse)
     order = [c.label for c in ranked]
+    cross = [c.label for c in ranked if ass[c.label].needs_crossfit]
+    if cross:
+        return Verdict(VerdictKind.PENDING, "pending", "", ass, order, needs_crossfit=cross)
     chosen, pending = _choose(ev, rule, ranked, ass)
     if pending is not None:
         return Verdict(VerdictKind.PENDING, "pending", "", ass, order,

@@ -34,6 +34,10 @@ FREQ_RANGE = (0.6, 1.6)
 MASS_RANGE = (0.25, 4.0)
 #: Damping-ratio bounds [1].
 ZETA_RANGE = (0.005, 0.25)
+#: Prior standard deviation of ln(damping ratio) about the file's value [1]: a body's modal
+#: damping is known from its modal test within about a factor of two (e^0.7); without it a
+#: near-zero damping places a sharp resonance between two measured speeds and fits noise.
+DAMPING_PRIOR = 0.7
 #: Frequency factors of the start grid (each mode) [1].
 GRID_FREQ = (0.85, 1.15)
 
@@ -69,7 +73,7 @@ class ChassisModes(Effect):
                               f"modal mass of body mode {k + 1} (file: {m.modal_mass:g} kg)"),
                     Parameter(f"z{k + 1}", "1", *ZETA_RANGE, z0, True,
                               f"damping ratio of body mode {k + 1} (file: "
-                              f"{m.damping_ratio:g})")]
+                              f"{m.damping_ratio:g})", DAMPING_PRIOR)]
         return tuple(out)
 
     def applicable(self, engine) -> bool:
