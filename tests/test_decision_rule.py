@@ -212,3 +212,91 @@ def test_improvement_t_is_a_relative_improvement():
     d = gap - gap / 2
     assert np.mean(d) / (np.std(d, ddof=1) / np.sqrt(N)) < 10   # the difference's t
     assert 10 < improvement_t(base, half, noise_mse=1.0) < 1e6
+
+
+def _sparse(n, base, hit, every=5):
+    """Per-speed gaps: ``base`` everywhere, ``hit`` at every ``every``-th speed (a gap that
+    sits at a few resonance crossings)."""
+    g = np.full(n, base)
+    g[::every] = hit
+    return g
+
+
+def _crossfit_case(n_held=17, n_all=51):
+    """A candidate that removes a gap sitting at a few speeds: few informative held-out
+    speeds (t between t_screen and t_min), three times as many over all speed folds."""
+    base = CandidateEvidence("", (), 4.0, _sparse(n_held, 0.6, 12.0), 1000.0, 0.5)
+    c = CandidateEvidence("a", ("a",), 0.7, _sparse(n_held, 0.55, 1.0) * (1 + 0.2 * WIGGLE[:n_held]),
+                          900.0, 0.2, dict(CELLS_OK))
+    base_x, c_x = _sparse(n_all, 0.6, 12.0), _sparse(n_all, 0.55, 1.0) * (1 + 0.2 * np.sin(np.arange(n_all) * 1.7))
+    return Evidence(base, [c], 0.5, math.sqrt(0.5), "where"), base_x, c_x
+
+
+@pytest.mark.parametrize("above", [False, True])
+def test_t_screen(above):
+    """Held-out t between t_screen and t_min: cross-fitting is requested (pending), not
+    guessed; below t_screen the candidate is simply not supported."""
+    ev, _, _ = _crossfit_case()
+    t = improvement_t(ev.baseline, ev.candidates[0], ev.noise_mse)
+    assert 2.0 < t < 4.0
+    v = decide(ev, DecisionRule(t_screen=just(t, above)))
+    if above:
+        assert v.kind is VerdictKind.UNEXPLAINED and not v.needs_crossfit
+    else:
+        assert v.kind is VerdictKind.PENDING and v.needs_crossfit == ["a"]
+
+
+@pytest.mark.parametrize("above", [False, True])
+def test_crossfit_t_is_judged_against_t_min(above):
+    """Once cross-fitted, the candidate is supported when its t over every speed exceeds
+    t_min (the same threshold), and the verdict no longer waits for it."""
+    from powertrain.diagnosis.rule import crossfit_t
+    ev, bx, cx = _crossfit_case()
+    ev.baseline.crossfit, ev.candidates[0].crossfit = bx, cx
+    tx = crossfit_t(ev.baseline, ev.candidates[0], ev.noise_mse)
+    t = improvement_t(ev.baseline, ev.candidates[0], ev.noise_mse)
+    assert tx > 4.0 > t
+    v = decide(ev, DecisionRule(t_min=just(tx, above)))
+    assert v.kind is not VerdictKind.PENDING
+    assert (v.chosen == "a") is (not above)
+    assert v.assessments["a"].t_crossfit == pytest.approx(tx)
+
+
+def test_crossfit_folds_score_every_speed_once():
+    """The three speed folds hold out every speed exactly once; fold 0 is the split the
+    fits use."""
+    from powertrain.diagnosis.data import N_FOLDS, split_rpm
+    rpm = np.arange(800.0, 6001.0, 100.0)
+    held = np.concatenate([split_rpm(rpm, k)[1] for k in range(N_FOLDS)])
+    assert np.array_equal(np.sort(held), np.arange(rpm.size))
+    for k in range(N_FOLDS):
+        tr, te = split_rpm(rpm, k)
+        assert np.intersect1d(tr, te).size == 0 and tr.size + te.size == rpm.size
+    assert np.array_equal(split_rpm(rpm)[1], split_rpm(rpm, 0)[1])
+
+
+def test_crossfit_scores_each_fold_with_a_refit_that_did_not_see_it():
+    """checks.crossfit: fold 0 is the candidate's own held-out score, folds 1, 2 refits on
+    their training speeds; on the model's own (noise-free) response with the effect every
+    speed is predicted, and the baseline over the same speeds is not."""
+    from powertrain.diagnosis.checks import crossfit, crossfit_baseline
+    from powertrain.diagnosis.data import N_FOLDS, GapData, split_rpm
+    from powertrain.diagnosis.fit import Problem, baseline_outcome, fit_candidate
+    from powertrain.effects import predict
+    from powertrain.iotools.engine_file import DEFAULT_ENGINE_PATH, read_engine
+    from powertrain.solvers.fast_harmonic import HarmonicModel
+    eng = read_engine(DEFAULT_ENGINE_PATH)
+    rpm = np.arange(1000.0, 6000.1, 200.0)
+    hm = HarmonicModel(eng, rpm)
+    v = predict(hm, {"balancer_error": {"gain": 1.4, "lag": 0.2}}).velocity
+    lev = np.abs(v[:, :, [1, 3]]) / np.sqrt(2)
+    data = GapData(rpm, [(m, d) for m in eng.mount_names for d in "xyz"],
+                   ["order_1", "order_2"], np.array([1, 3]), lev, 1e-9)
+    probs = [Problem(hm.subset(tr), hm.subset(te), data, tr, te)
+             for tr, te in (split_rpm(rpm, k) for k in range(N_FOLDS))]
+    o = fit_candidate(probs[0], ("balancer_error",))
+    per = crossfit(probs[1:], o)
+    base = crossfit_baseline(probs[1:], baseline_outcome(probs[0]))
+    assert per.size == base.size == rpm.size
+    assert np.array_equal(per[:o.heldout_per_rpm.size], o.heldout_per_rpm)
+    assert np.nanmax(per) < 1e-6 < np.nanmin(base)
