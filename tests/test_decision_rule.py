@@ -228,7 +228,8 @@ def _crossfit_case(n_held=17, n_all=51):
     base = CandidateEvidence("", (), 4.0, _sparse(n_held, 0.6, 12.0), 1000.0, 0.5)
     c = CandidateEvidence("a", ("a",), 0.7, _sparse(n_held, 0.55, 1.0) * (1 + 0.2 * WIGGLE[:n_held]),
                           900.0, 0.2, dict(CELLS_OK))
-    base_x, c_x = _sparse(n_all, 0.6, 12.0), _sparse(n_all, 0.55, 1.0) * (1 + 0.2 * np.sin(np.arange(n_all) * 1.7))
+    wiggle = 1 + 0.2 * np.sin(np.arange(n_all) * 1.7)
+    base_x, c_x = _sparse(n_all, 0.6, 12.0), _sparse(n_all, 0.55, 1.0) * wiggle
     return Evidence(base, [c], 0.5, math.sqrt(0.5), "where"), base_x, c_x
 
 
