@@ -106,6 +106,12 @@ def test_chassis_modes_effect_parameters(engine):
     assert ps["f1"].unit == "Hz" and ps["m1"].unit == "kg" and ps["z1"].unit == "1"
     assert ps["f1"].lower < ps["f1"].default == 28.0 < ps["f1"].upper
     assert ps["m4"].default == 8.0
+    # only the damping ratios carry a prior (log, about the file's value)
+    from powertrain.effects.chassis_modes import DAMPING_PRIOR
+    assert {n for n, p in ps.items() if p.prior_sd is not None} == {
+        f"z{k + 1}" for k in range(len(engine.chassis.modes))}
+    assert all(ps[f"z{k + 1}"].prior_sd == DAMPING_PRIOR and ps[f"z{k + 1}"].log
+               for k in range(len(engine.chassis.modes)))
     # defaults are the file's body: the baseline, exactly
     hm = HarmonicModel(engine, RPM[:2])
     np.testing.assert_array_equal(predict(hm, {"chassis_modes": {}}).velocity,
