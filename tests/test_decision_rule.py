@@ -301,3 +301,38 @@ def test_crossfit_scores_each_fold_with_a_refit_that_did_not_see_it():
     assert per.size == base.size == rpm.size
     assert np.array_equal(per[:o.heldout_per_rpm.size], o.heldout_per_rpm)
     assert np.nanmax(per) < 1e-6 < np.nanmin(base)
+
+
+def _pair_case():
+    """A pair whose gain over its better member sits at a few held-out speeds: held-out t
+    between t_screen and t_min."""
+    n = N
+    a = CandidateEvidence("a", ("a",), 1.5, _sparse(n, 1.0, 4.0), 950.0, 0.2, dict(CELLS_OK))
+    ab = CandidateEvidence("a+b", ("a", "b"), 0.8, _sparse(n, 0.95, 1.1)
+                           * (1 + 0.2 * WIGGLE), 800.0, 0.2, dict(CELLS_OK))
+    b = cand("b", 3.0, 980.0)
+    return evidence(a, b, ab), a, ab
+
+
+def test_pair_against_member_is_cross_fitted_in_the_band():
+    ev, a, ab = _pair_case()
+    t = improvement_t(a, ab, ev.noise_mse)
+    assert 2.0 < t < 4.0
+    v = decide(ev)
+    assert v.kind is VerdictKind.PENDING and v.needs_crossfit == ["a+b", "a"]
+    assert decide(ev, DecisionRule(t_screen=just(t, True))).chosen == "a"
+
+
+@pytest.mark.parametrize("above", [False, True])
+def test_pair_cross_fitted_against_member_uses_t_min(above):
+    from powertrain.diagnosis.rule import crossfit_t
+    ev, a, ab = _pair_case()
+    n3 = 3 * N
+    wig = 1 + 0.2 * np.sin(np.arange(n3) * 1.7)
+    ev.baseline.crossfit = np.full(n3, 4.0)
+    a.crossfit, ab.crossfit = _sparse(n3, 1.0, 4.0), _sparse(n3, 0.95, 1.1) * wig
+    tx = crossfit_t(a, ab, ev.noise_mse)
+    assert tx > 4.0
+    v = decide(ev, DecisionRule(t_min=just(tx, above)))
+    assert v.kind is not VerdictKind.PENDING
+    assert v.chosen == ("a" if above else "a+b")

@@ -68,8 +68,9 @@ def test_effect_free_runs_make_no_false_claims():
 
 @pytest.mark.xfail(reason="issue 11 open: the detectable top-1 target (0.9) is met on one of "
                    "three 50-case seeds with the final code (0.91, 0.86, 0.81; pooled 55/64, "
-                   "Wilson 0.75-0.93, docs/validation/diagnosis.md); the misses are amplitude-dependent elastomers "
-                   "(not drawn here) and rare sensor/balancer cases, so this test of four "
+                   "Wilson 0.75-0.93, docs/validation/diagnosis.md); the misses are "
+                   "amplitude-dependent elastomers (not drawn here) and rare sensor/balancer "
+                   "cases, so this test of four "
                    "balancer/cylinder/sensor/mount cases usually passes (XPASS) but is not yet "
                    "a guarantee (then: remove this mark)", strict=False)
 def test_detectable_in_library_effects_are_named():

@@ -9,7 +9,8 @@ would leave (noise):
   (log ratios of the mean squared gaps plus noise, :func:`improvement_t`) have
   :math:`\bar d/(s_d/\sqrt{n_r}) >` ``t_min`` and :math:`\bar d > 0`;
 * a pair is preferred to its better member only if it is supported against that member in
-  the same way and explains at least ``pair_gain_min`` of the excess that member leaves;
+  the same way (cross-fitting both when that t lies between ``t_screen`` and ``t_min``) and
+  explains at least ``pair_gain_min`` of the excess that member leaves;
 * the **answer** is the best (lowest held-out gap) supported candidate, among the first
   ``n_checked`` that explain at least ``explained_min`` of :math:`E_0 - E_n`, whose
   held-out residual keeps a structured RMS beyond noise of at most
@@ -165,6 +166,8 @@ class Assessment:
     text: str
     t_crossfit: float = float("nan")
     needs_crossfit: bool = False
+    #: labels to cross-fit before this candidate can be judged (itself, a pair's member)
+    crossfit_labels: tuple = ()
 
 
 @dataclass
@@ -238,6 +241,11 @@ def _assess(ev: Evidence, rule: DecisionRule) -> dict:
         if not (t > rule.t_min and dbic > rule.bic_margin and gain >= rule.pair_gain_min):
             out[c.label].status = Status.NOT_BETTER_THAN_MEMBER
             out[c.label].text = f"not better than {best_m.label} alone"
+            if (t > rule.t_screen and dbic > rule.bic_margin and gain >= rule.pair_gain_min
+                    and (c.crossfit is None or best_m.crossfit is None)):
+                out[c.label].needs_crossfit = True       # judge pair vs member on all speeds
+                out[c.label].crossfit_labels = tuple(x.label for x in (c, best_m)
+                                                     if x.crossfit is None)
     return out
 
 
@@ -252,7 +260,8 @@ def _support(ev, rule, c, e0, excess0) -> Assessment:
     st = Status.SUPPORTED if ok else Status.NOT_SUPPORTED
     need = (base_ok and c.crossfit is None and rule.t_screen < t <= rule.t_min
             and np.isfinite(explained) and explained >= rule.explained_min)
-    return Assessment(t, dbic, explained, st, st.value, t_crossfit=tx, needs_crossfit=need)
+    return Assessment(t, dbic, explained, st, st.value, t_crossfit=tx, needs_crossfit=need,
+                      crossfit_labels=(c.label,) if need else ())
 
 
 def _struct_max(ev, rule):
@@ -308,7 +317,8 @@ def decide(evidence: Evidence, rule: DecisionRule = DecisionRule()) -> Verdict:
     ass = _assess(ev, rule)
     ranked = sorted(ev.candidates, key=lambda c: c.heldout_mse)
     order = [c.label for c in ranked]
-    cross = [c.label for c in ranked if ass[c.label].needs_crossfit]
+    cross = list(dict.fromkeys(lab for c in ranked if ass[c.label].needs_crossfit
+                               for lab in ass[c.label].crossfit_labels))
     if cross:
         return Verdict(VerdictKind.PENDING, "pending", "", ass, order, needs_crossfit=cross)
     chosen, pending = _choose(ev, rule, ranked, ass)
