@@ -239,9 +239,11 @@ def _decide(s, baseline, outcomes, sigma, rule, where_phrase, budget):
                 by_label[label].crossfit = crossfit(folds, by_label[label], budget=budget)
             continue
         o = by_label[verdict.needs_cells_check]
+        # over all speed folds when its support itself needed them (held-out t short)
+        all_folds = not verdict.assessments[o.label].t_stat > rule.t_min
         o.cells_check = heldout_cells_check(
             s.problem, o, baseline, sigma, budget=budget,
-            fold_problems=s.fold_problems() if o.crossfit is not None else ())
+            fold_problems=s.fold_problems() if all_folds else ())
 
 
 def _structure(s, baseline, outcomes, sigma):
