@@ -165,7 +165,6 @@ class Assessment:
     status: Status
     text: str
     t_crossfit: float = float("nan")
-    needs_crossfit: bool = False
     #: labels to cross-fit before this candidate can be judged (itself, a pair's member)
     crossfit_labels: tuple = ()
 
@@ -243,7 +242,7 @@ def _assess(ev: Evidence, rule: DecisionRule) -> dict:
             out[c.label].text = f"not better than {best_m.label} alone"
             if (t > rule.t_screen and dbic > rule.bic_margin and gain >= rule.pair_gain_min
                     and (c.crossfit is None or best_m.crossfit is None)):
-                out[c.label].needs_crossfit = True       # judge pair vs member on all speeds
+                # judge pair vs member on all speeds
                 out[c.label].crossfit_labels = tuple(x.label for x in (c, best_m)
                                                      if x.crossfit is None)
     return out
@@ -260,7 +259,7 @@ def _support(ev, rule, c, e0, excess0) -> Assessment:
     st = Status.SUPPORTED if ok else Status.NOT_SUPPORTED
     need = (base_ok and c.crossfit is None and rule.t_screen < t <= rule.t_min
             and np.isfinite(explained) and explained >= rule.explained_min)
-    return Assessment(t, dbic, explained, st, st.value, t_crossfit=tx, needs_crossfit=need,
+    return Assessment(t, dbic, explained, st, st.value, t_crossfit=tx,
                       crossfit_labels=(c.label,) if need else ())
 
 
@@ -317,8 +316,7 @@ def decide(evidence: Evidence, rule: DecisionRule = DecisionRule()) -> Verdict:
     ass = _assess(ev, rule)
     ranked = sorted(ev.candidates, key=lambda c: c.heldout_mse)
     order = [c.label for c in ranked]
-    cross = list(dict.fromkeys(lab for c in ranked if ass[c.label].needs_crossfit
-                               for lab in ass[c.label].crossfit_labels))
+    cross = list(dict.fromkeys(lab for c in ranked for lab in ass[c.label].crossfit_labels))
     if cross:
         return Verdict(VerdictKind.PENDING, "pending", "", ass, order, needs_crossfit=cross)
     chosen, pending = _choose(ev, rule, ranked, ass)
