@@ -179,20 +179,26 @@ def test_supported_candidate_within_noise_is_no_effect_not_unexplained():
     assert v.kind is VerdictKind.NO_EFFECT and "would change it by" in v.text
 
 
-def test_evaluation_budget_stops_a_fit_and_says_so():
-    """A fit that reaches its evaluation budget keeps its best point and is flagged."""
-    from powertrain.diagnosis.data import GapData, split_rpm
-    from powertrain.diagnosis.fit import Problem, fit_candidate
+def _balancer_data(rpm, params):
+    """The model's own noise-free orders 1 and 2 with a balancer error: (model, data)."""
+    from powertrain.diagnosis.data import GapData
     from powertrain.effects import predict
     from powertrain.iotools.engine_file import DEFAULT_ENGINE_PATH, read_engine
     from powertrain.solvers.fast_harmonic import HarmonicModel
     eng = read_engine(DEFAULT_ENGINE_PATH)
-    rpm = np.arange(1000.0, 6000.1, 250.0)
     hm = HarmonicModel(eng, rpm)
-    v = predict(hm, {"balancer_error": {"gain": 0.6, "lag": 0.2}}).velocity
+    v = predict(hm, {"balancer_error": params}).velocity
     lev = np.abs(v[:, :, [1, 3]]) / np.sqrt(2)
-    data = GapData(rpm, [(m, d) for m in eng.mount_names for d in "xyz"],
-                   ["order_1", "order_2"], np.array([1, 3]), lev, 1e-9)
+    return hm, GapData(rpm, [(m, d) for m in eng.mount_names for d in "xyz"],
+                       ["order_1", "order_2"], np.array([1, 3]), lev, 1e-9)
+
+
+def test_evaluation_budget_stops_a_fit_and_says_so():
+    """A fit that reaches its evaluation budget keeps its best point and is flagged."""
+    from powertrain.diagnosis.data import split_rpm
+    from powertrain.diagnosis.fit import Problem, fit_candidate
+    rpm = np.arange(1000.0, 6000.1, 250.0)
+    hm, data = _balancer_data(rpm, {"gain": 0.6, "lag": 0.2})
     tr, te = split_rpm(rpm)
     prob = Problem(hm.subset(tr), hm.subset(te), data, tr, te)
     small = fit_candidate(prob, ("balancer_error",), budget=8)
@@ -281,23 +287,16 @@ def test_crossfit_scores_each_fold_with_a_refit_that_did_not_see_it():
     their training speeds; on the model's own (noise-free) response with the effect every
     speed is predicted, and the baseline over the same speeds is not."""
     from powertrain.diagnosis.checks import crossfit, crossfit_baseline
-    from powertrain.diagnosis.data import N_FOLDS, GapData, split_rpm
+    from powertrain.diagnosis.data import N_FOLDS, split_rpm
     from powertrain.diagnosis.fit import Problem, baseline_outcome, fit_candidate
-    from powertrain.effects import predict
-    from powertrain.iotools.engine_file import DEFAULT_ENGINE_PATH, read_engine
-    from powertrain.solvers.fast_harmonic import HarmonicModel
-    eng = read_engine(DEFAULT_ENGINE_PATH)
     rpm = np.arange(1000.0, 6000.1, 200.0)
-    hm = HarmonicModel(eng, rpm)
-    v = predict(hm, {"balancer_error": {"gain": 1.4, "lag": 0.2}}).velocity
-    lev = np.abs(v[:, :, [1, 3]]) / np.sqrt(2)
-    data = GapData(rpm, [(m, d) for m in eng.mount_names for d in "xyz"],
-                   ["order_1", "order_2"], np.array([1, 3]), lev, 1e-9)
+    hm, data = _balancer_data(rpm, {"gain": 1.4, "lag": 0.2})
     probs = [Problem(hm.subset(tr), hm.subset(te), data, tr, te)
              for tr, te in (split_rpm(rpm, k) for k in range(N_FOLDS))]
     o = fit_candidate(probs[0], ("balancer_error",))
-    per = crossfit(probs[1:], o)
-    base = crossfit_baseline(probs[1:], baseline_outcome(probs[0]))
+    folds = [(p, baseline_outcome(p)) for p in probs[1:]]
+    per = crossfit(folds, o)
+    base = crossfit_baseline(folds, baseline_outcome(probs[0]))
     assert per.size == base.size == rpm.size
     assert np.array_equal(per[:o.heldout_per_rpm.size], o.heldout_per_rpm)
     assert np.nanmax(per) < 1e-6 < np.nanmin(base)

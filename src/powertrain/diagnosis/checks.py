@@ -33,7 +33,7 @@ import time
 import numpy as np
 
 from powertrain.analysis.noise_floor import above_floor
-from powertrain.diagnosis.fit import FitOutcome, Problem, baseline_outcome, fit_candidate
+from powertrain.diagnosis.fit import FitOutcome, Problem, fit_candidate
 from powertrain.diagnosis.rule import log_ratio_t
 from powertrain.effects import EFFECTS
 
@@ -153,11 +153,12 @@ def _folds(problem: Problem, effects):
 
 
 def heldout_cells_check(problem: Problem, o: FitOutcome, baseline: FitOutcome, sigma,
-                        budget=None, fold_problems=()):
+                        budget=None, folds=()):
     """Refit ``o``'s effects without some (channel, order) cells and score the withheld
     cells at the held-out speeds (cross-validation over cells as well as speeds). With
-    ``fold_problems`` (a candidate judged on cross-fitted speeds, :func:`crossfit`) the
-    withheld cells are scored at the held-out speeds of every speed fold.
+    ``folds`` (``[(Problem, its baseline FitOutcome)]`` of the other speed folds: a
+    candidate judged on cross-fitted speeds, :func:`crossfit`) the withheld cells are scored
+    at the held-out speeds of every speed fold.
 
     Returns
     -------
@@ -167,10 +168,9 @@ def heldout_cells_check(problem: Problem, o: FitOutcome, baseline: FitOutcome, s
         ``heldout_rms_db``, ``speed_folds`` and ``seconds``.
     """
     t0 = time.perf_counter()
-    kind, folds = _folds(problem, o.effects)
+    kind, cells = _folds(problem, o.effects)
     kw = {} if budget is None else {"budget": budget}
-    parts = [_cells_fold(problem, o, baseline, folds, sigma, kw)]
-    parts += [_cells_fold(p, o, baseline_outcome(p), folds, sigma, kw) for p in fold_problems]
+    parts = [_cells_fold(p, o, b, cells, sigma, kw) for p, b in [(problem, baseline), *folds]]
     n = sum(q["n"] for q in parts)
     e0, ec, e_n = (sum(q[k] * q["n"] for q in parts) / n if n else float("nan")
                    for k in ("e0", "ec", "e_n"))
@@ -182,11 +182,11 @@ def heldout_cells_check(problem: Problem, o: FitOutcome, baseline: FitOutcome, s
             "seconds": time.perf_counter() - t0}
 
 
-def _cells_fold(problem, o, baseline, folds, sigma, kw) -> dict:
+def _cells_fold(problem, o, baseline, cell_folds, sigma, kw) -> dict:
     """One speed fold of :func:`heldout_cells_check`: the withheld cells' mean squared gaps
     (baseline, refits, noise), per speed and over all scored points."""
     g_all = np.full(problem.valid["test"].shape, np.nan)
-    for held in folds:
+    for held in cell_folds:
         if not held.any() or held.all():
             continue
         fo = fit_candidate(problem.restricted(~held, held), o.effects, starts=[o.x],
@@ -202,24 +202,23 @@ def _cells_fold(problem, o, baseline, folds, sigma, kw) -> dict:
             "e_n": noise_mse(problem, sigma, cells)}
 
 
-def crossfit(fold_problems, o: FitOutcome, budget=None) -> np.ndarray:
+def crossfit(folds, o: FitOutcome, budget=None) -> np.ndarray:
     """Mean squared gap per speed of ``o``'s effects over all speed folds: ``o``'s own
     held-out scores (fold 0), then refits on each other fold's training speeds (started
-    from ``o``'s optimum) scored on the speeds that fold leaves out.
-    ``fold_problems`` are the :class:`Problem` of folds 1, 2, ...; the baseline's vector
-    over the same speeds is :func:`crossfit_baseline`."""
+    from ``o``'s optimum) scored on the speeds that fold leaves out. ``folds`` are
+    ``[(Problem, its baseline FitOutcome)]`` of folds 1, 2, ...; the baseline's vector over
+    the same speeds is :func:`crossfit_baseline`."""
     kw = {} if budget is None else {"budget": budget}
     parts = [o.heldout_per_rpm]
-    for p in fold_problems:
+    for p, _ in folds:
         parts.append(fit_candidate(p, o.effects, starts=[o.x], grid=False, **kw)
                      .heldout_per_rpm)
     return np.concatenate(parts)
 
 
-def crossfit_baseline(fold_problems, baseline: FitOutcome) -> np.ndarray:
+def crossfit_baseline(folds, baseline: FitOutcome) -> np.ndarray:
     """The baseline's mean squared gap per speed over the speeds :func:`crossfit` scores."""
-    return np.concatenate([baseline.heldout_per_rpm]
-                          + [baseline_outcome(p).heldout_per_rpm for p in fold_problems])
+    return np.concatenate([baseline.heldout_per_rpm] + [b.heldout_per_rpm for _, b in folds])
 
 
 def band_check(problem_factory, effect, data, train_idx, n_bands=4):

@@ -118,8 +118,8 @@ class _Setup:
         return self.hm_need.subset([self.pos[int(i)] for i in idx])
 
     def fold_problems(self) -> list:
-        """The fitting problems of speed folds 1, 2 (:func:`split_rpm`; fold 0 is
-        ``problem``), built on first use."""
+        """``[(Problem, baseline outcome)]`` of speed folds 1, 2 (:func:`split_rpm`; fold 0
+        is ``problem``), built on first use."""
         if getattr(self, "_folds", None) is None:
             self._folds = []
             for k in range(1, N_FOLDS):
@@ -128,9 +128,9 @@ class _Setup:
                 hm = self.hm.subset(np.union1d(tr, te))
                 cand.warm_caches(hm, self.effects)
                 pos = {int(r): i for i, r in enumerate(np.union1d(tr, te))}
-                self._folds.append(Problem(hm.subset([pos[int(i)] for i in tr]),
-                                           hm.subset([pos[int(i)] for i in te]),
-                                           self.data, tr, te))
+                p = Problem(hm.subset([pos[int(i)] for i in tr]),
+                            hm.subset([pos[int(i)] for i in te]), self.data, tr, te)
+                self._folds.append((p, baseline_outcome(p)))
         return self._folds
 
     def split_dict(self):
@@ -243,7 +243,7 @@ def _decide(s, baseline, outcomes, sigma, rule, where_phrase, budget):
         all_folds = not verdict.assessments[o.label].t_stat > rule.t_min
         o.cells_check = heldout_cells_check(
             s.problem, o, baseline, sigma, budget=budget,
-            fold_problems=s.fold_problems() if all_folds else ())
+            folds=s.fold_problems() if all_folds else ())
 
 
 def _structure(s, baseline, outcomes, sigma):
