@@ -1,17 +1,19 @@
 """The one two-port condensation (kernels/two_port.py via physics.mount_network.two_port)
 against independent dense solves of the same networks, and its pivot check.
 
-Oracle: :func:`input_point_stiffness` and :func:`cross_point_stiffness` (LAPACK solve of
-the internal block, a different code path): a = K_IP, b = −K_CP; c = K_IP of the network
-turned round (engine side and ground swapped). Same linear algebra, so round-off only."""
+Oracle: tests/network_oracle.py (LAPACK solve of the assembled nodal matrix, a different code
+path) for the two-port, the internal motion and complex Laplace variables; and the network
+turned round (engine side and ground swapped): its a is our c. Same linear algebra, so
+round-off only."""
 
 from __future__ import annotations
 
 import numpy as np
 import pytest
+from network_oracle import dense_two_port
 
 from powertrain.iotools.engine_file import DEFAULT_ENGINE_PATH, read_engine
-from powertrain.physics.mount_network import GROUND, cross_point_stiffness, input_point_stiffness, two_port
+from powertrain.physics.mount_network import GROUND, laplace_two_port, two_port
 
 EXACT = 1e-9
 
@@ -32,11 +34,21 @@ def _reversed(elem_nodes):
 def test_two_port_equals_independent_solves(k):
     masses, en, c, d = _networks()[k]
     w = np.geomspace(5.0, 2000.0, 40)
-    a, b, cc = two_port(w, masses, en, c, d)
-    kip = input_point_stiffness(w, masses, en, c, d)
-    kcp = cross_point_stiffness(w, masses, en, c, d)
-    kip_rev = input_point_stiffness(w, masses, _reversed(en), c, d)
-    for x, ref in ((a, kip), (-b, kcp), (cc, kip_rev)):
+    a, b, cc, X = two_port(w, masses, en, c, d, internal=True)
+    T, X_ref = dense_two_port(1j * w, masses, en, c, d)
+    a_rev = two_port(w, masses, _reversed(en), c, d)[0]
+    for x, ref in ((a, T[:, 0, 0]), (b, T[:, 0, 1]), (cc, T[:, 1, 1]), (cc, a_rev),
+                   (X, X_ref)):
+        assert np.max(np.abs(x - ref)) <= EXACT * np.max(np.abs(ref))
+
+
+@pytest.mark.parametrize("k", [0, 4, 8])
+def test_two_port_at_complex_and_zero_laplace_variable(k):
+    masses, en, c, d = _networks()[k]
+    s = np.array([0.0, -3.0 + 40.0j, -20.0 + 300.0j])
+    a, b, cc, X = laplace_two_port(s, masses, en, c, d, internal=True)
+    T, X_ref = dense_two_port(s, masses, en, c, d)
+    for x, ref in ((a, T[:, 0, 0]), (b, T[:, 0, 1]), (cc, T[:, 1, 1]), (X, X_ref)):
         assert np.max(np.abs(x - ref)) <= EXACT * np.max(np.abs(ref))
 
 

@@ -19,6 +19,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from powertrain.physics.condensation import NetworkPorts, condense
 from powertrain.physics.mount_network import ground_force_rows
 from powertrain.physics.rigid_body import direction_row, point_motion_matrix, rigid_body_mass_matrix
 
@@ -76,6 +77,8 @@ class AssembledSystem:
     mount_names: list = field(default_factory=list)
     #: rotation (3, 3) of every mount (columns = local axes in engine axes)
     mount_axes: list = field(default_factory=list)
+    #: the networks on the retained coordinates (None: nothing to condense)
+    network_ports: NetworkPorts | None = None
 
     def __post_init__(self):
         if not self.body_start:
@@ -127,18 +130,24 @@ class AssembledSystem:
         B[:6, :6] = np.eye(6)
         return B
 
-    def static_displacement(self, load6) -> np.ndarray:
-        """Static solution K q = B f for a constant 6-vector load [N, N·m]."""
-        return np.linalg.solve(self.K, self.load_matrix() @ np.asarray(load6, float))
+    def ports(self) -> NetworkPorts:
+        """The networks on the retained coordinates (:mod:`powertrain.physics.condensation`);
+        a model assembled without them keeps every coordinate."""
+        if self.network_ports is not None:
+            return self.network_ports
+        n = self.n_dof
+        return NetworkPorts(np.arange(n), (self.M, self.C, self.K), np.zeros((0, n)),
+                            np.zeros((0, n)), [], [])
+
+    @property
+    def retained(self) -> np.ndarray:
+        """Coordinates kept by the condensation: the rigid body and the body modes."""
+        return self.ports().retained
 
     def static_stiffness_6(self) -> np.ndarray:
-        """6×6 static stiffness of the body on its mounts, internal nodes condensed
+        """6×6 static stiffness of the body on its mounts, every other coordinate condensed
         statically [N/m, N, N·m/rad]."""
-        K = self.K
-        if self.n_dof == 6:
-            return K[:6, :6].copy()
-        Kbb, Kbi, Kii = K[:6, :6], K[:6, 6:], K[6:, 6:]
-        return Kbb - Kbi @ np.linalg.solve(Kii, Kbi.T)
+        return condense(self, np.arange(6), 0.0).real
 
     def rigid_body_modes(self):
         """Natural frequencies [Hz] and mode shapes of the 6-DOF body on the mounts'
@@ -229,6 +238,33 @@ def assemble(mass, cg, inertia, mounts, chassis=None) -> AssembledSystem:
         Cm[3 * mi:3 * mi + 3, :6] = point_motion_matrix(np.asarray(mount.position, float) - cg)
     system = AssembledSystem(M, C, K, channels, Cm, Fk, Fd, labels, networks)
     system.mount_axes = [np.asarray(m.rotation, float) for m in mounts]
+    system.network_ports = _ports(system, body0, mounts, blocks, shapes,
+                                  chassis.modes if modal else ())
     if chassis is not None and not chassis.is_rigid:
         system.add_body_side(chassis, [m.name for m in mounts], body0)
     return system
+
+
+def _ports(system, body0, mounts, blocks, shapes, body_modes) -> NetworkPorts:
+    """The networks on the retained coordinates (rigid body, then the body modes), and the
+    frame they stand in: the rigid-body mass and the body modes' oscillators."""
+    n = system.n_dof
+    retained = np.r_[np.arange(6), np.arange(body0, n)].astype(int)
+    frame = tuple(np.zeros((retained.size, retained.size)) for _ in range(3))
+    frame[0][:6, :6] = system.M[:6, :6]
+    for k, mode in enumerate(body_modes):
+        j = 6 + k
+        frame[0][j, j] = mode.modal_mass
+        frame[1][j, j] = 2.0 * mode.damping_ratio * mode.omega * mode.modal_mass
+        frame[2][j, j] = mode.omega ** 2 * mode.modal_mass
+    n_net = len(blocks)
+    engine_rows = np.zeros((n_net, retained.size))
+    base_rows = np.zeros((n_net, retained.size))
+    for k, (row, *_, mi, ai) in enumerate(blocks):
+        engine_rows[k, :6] = row
+        if shapes:
+            base_rows[k, 6:] = np.asarray(mounts[mi].rotation, float)[:, ai] @ shapes[
+                mounts[mi].name]
+    return NetworkPorts(retained, frame, engine_rows, base_rows,
+                        [(start, ni) for _, start, ni, _ in system.networks],
+                        [model for *_, model in system.networks])

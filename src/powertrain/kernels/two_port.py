@@ -4,10 +4,11 @@ The one implementation of the mount two-port condensation (wrapped by
 :func:`powertrain.physics.mount_network.two_port`, used by the cached harmonic model and the
 truth generator). For one lumped network (internal point masses joined by Kelvin–Voigt
 elements to its engine-side node E, its ground node B and each other) and a list of
-frequencies :math:`\omega_w` with a spring factor :math:`s_w` and a damper factor
-:math:`t_w` each, the kernel forms the nodal dynamic stiffness
+values of the Laplace variable :math:`\lambda_w` (:math:`i\omega_w` for a harmonic
+motion, complex for a damped mode, 0 for the static case) with a spring factor :math:`s_w` and
+a damper factor :math:`t_w` each, the kernel forms the nodal dynamic stiffness
 
-.. math:: \mathbf D_w = s_w\mathbf K + i\omega_w t_w\mathbf C - \omega_w^2\mathbf M
+.. math:: \mathbf D_w = s_w\mathbf K + \lambda_w t_w\mathbf C + \lambda_w^2\mathbf M
 
 (springs and dampers scaled, the masses kept: :meth:`MountModel.scaled`) and condenses the
 internal nodes by Gaussian elimination (symmetric pivoting on the largest remaining
@@ -19,9 +20,11 @@ network is singular at that frequency, the outputs are NaN and the status is 1),
           \begin{pmatrix} a & b \\ b & c \end{pmatrix}
           \begin{pmatrix} x_E \\ x_B \end{pmatrix}
 
-(:math:`a = K_{IP}` with the ground fixed, :math:`b = -K_{CP}`; checked against the
-independent solves of :func:`~powertrain.physics.mount_network.input_point_stiffness` and
-:func:`~powertrain.physics.mount_network.cross_point_stiffness` in tests/test_two_port.py).
+(:math:`a = K_{IP}` with the ground fixed, :math:`b = -K_{CP}`), and, on request, the
+internal motion per unit :math:`x_E` (ground held) and per unit :math:`x_B` (engine side
+held) by back substitution. The same elimination (:func:`condense_nodes`) gives the
+cross-point stiffness derivatives of :mod:`.mount_stiffness`. Checked against a plain NumPy
+solve of the assembled network in tests/test_two_port.py.
 """
 
 from __future__ import annotations
@@ -33,15 +36,69 @@ from numba import njit
 PIVOT_RTOL = 1e-13
 
 
-@njit(cache=True)
-def two_port_kernel(omega, spring_scale, damper_scale, masses, elem_nodes, c, d, out_a, out_b,
-                    out_c):
+@njit(cache=True, nogil=True)
+def condense_nodes(D, n, order, X):
+    """Eliminate the internal nodes 1..n of the nodal matrix ``D`` (n + 2, n + 2) in place.
+
+    Symmetric pivoting on the largest remaining diagonal; afterwards ``D[0, 0]``,
+    ``D[0, n + 1]``, ``D[n + 1, n + 1]`` are the two-port and, when ``X`` has n + 2 rows,
+    ``X[:, 0]`` / ``X[:, 1]`` the nodal motion per unit engine-side / ground-node motion.
+    ``order`` (n,) int is work space. Returns False when a pivot is below
+    :data:`PIVOT_RTOL` times the largest entry (singular network).
+    """
+    size = n + 2
+    big = 0.0
+    for i in range(size):
+        for j in range(size):
+            if abs(D[i, j]) > big:
+                big = abs(D[i, j])
+    gone = np.zeros(size, np.bool_)
+    for step in range(n):             # boundary nodes 0 and n + 1 are never eliminated
+        k = -1
+        best = -1.0
+        for i in range(1, n + 1):
+            if not gone[i] and abs(D[i, i]) > best:
+                best = abs(D[i, i])
+                k = i
+        if best <= PIVOT_RTOL * big:
+            return False
+        gone[k] = True
+        order[step] = k
+        p = D[k, k]
+        for i in range(size):
+            if not gone[i]:
+                f = D[i, k] / p
+                if f != 0.0:
+                    for j in range(size):
+                        if not gone[j]:
+                            D[i, j] -= f * D[k, j]
+    if X.shape[0] == size:
+        for col in range(2):
+            for i in range(size):
+                X[i, col] = 0.0
+            X[0 if col == 0 else n + 1, col] = 1.0
+            # row k keeps its entries of the nodes still present when k was eliminated
+            for step in range(n - 1, -1, -1):
+                k = order[step]
+                acc = D[k, 0] * X[0, col] + D[k, n + 1] * X[n + 1, col]
+                for later in range(step + 1, n):
+                    j = order[later]
+                    acc += D[k, j] * X[j, col]
+                X[k, col] = -acc / D[k, k]
+    return True
+
+
+@njit(cache=True, nogil=True)
+def two_port_kernel(lam, spring_scale, damper_scale, masses, elem_nodes, c, d, out_a, out_b,
+                    out_c, out_x):
     """Fill ``out_a``, ``out_b``, ``out_c`` (n_w,) complex with the two-port of one network.
 
     Parameters
     ----------
-    omega, spring_scale, damper_scale : ndarray (n_w,) float
-        Angular frequency [rad/s], spring and damper factors [1] of each entry.
+    lam : ndarray (n_w,) complex
+        Laplace variable of each entry (:math:`i\\omega` for a harmonic) [1/s].
+    spring_scale, damper_scale : ndarray (n_w,) float
+        Spring and damper factors [1] of each entry.
     masses : ndarray (n,) float
         Internal masses [kg] (zero allowed).
     elem_nodes : ndarray (n_el, 2) int
@@ -51,68 +108,24 @@ def two_port_kernel(omega, spring_scale, damper_scale, masses, elem_nodes, c, d,
     out_a, out_b, out_c : ndarray (n_w,) complex
         Filled with :math:`a = K_{IP}`, the coupling :math:`b` and the ground-side
         :math:`c` [N/m].
+    out_x : ndarray (n_w, n, 2) complex or (0, n, 2)
+        Filled (when it has n_w rows) with the internal motion per unit engine-side and per
+        unit ground-node motion.
 
     Returns
     -------
     int
-        0, or 1 if a pivot was below :data:`PIVOT_RTOL` at some frequency (NaN there).
+        0, or 1 if a pivot was below :data:`PIVOT_RTOL` at some entry (NaN there).
     """
     status = 0
     n = masses.size
     size = n + 2
     D = np.empty((size, size), np.complex128)
-    gone = np.zeros(size, np.bool_)          # eliminated internal nodes
-    for w in range(omega.size):
-        om = omega[w]
-        s = spring_scale[w]
-        t = damper_scale[w]
-        for i in range(size):
-            gone[i] = False
-            for j in range(size):
-                D[i, j] = 0.0
-        for k in range(n):
-            D[k + 1, k + 1] = -om * om * masses[k]
-        for e in range(c.size):
-            ia = elem_nodes[e, 0]
-            ib = elem_nodes[e, 1]
-            if ia < 0:
-                ia = n + 1
-            if ib < 0:
-                ib = n + 1
-            if s == t:
-                z = s * (c[e] + 1j * om * d[e])
-            else:
-                z = s * c[e] + 1j * om * t * d[e]
-            D[ia, ia] += z
-            D[ib, ib] += z
-            D[ia, ib] -= z
-            D[ib, ia] -= z
-        big = 0.0
-        for i in range(size):
-            for j in range(size):
-                if abs(D[i, j]) > big:
-                    big = abs(D[i, j])
-        singular = False
-        for _ in range(n):                  # boundary nodes 0 and n + 1 are never eliminated
-            k = -1
-            best = -1.0
-            for i in range(1, n + 1):
-                if not gone[i] and abs(D[i, i]) > best:
-                    best = abs(D[i, i])
-                    k = i
-            if best <= PIVOT_RTOL * big:
-                singular = True
-                break
-            gone[k] = True
-            p = D[k, k]
-            for i in range(size):
-                if not gone[i]:
-                    f = D[i, k] / p
-                    if f != 0.0:
-                        for j in range(size):
-                            if not gone[j]:
-                                D[i, j] -= f * D[k, j]
-        if singular:
+    order = np.empty(n, np.int64)
+    X = np.empty((size if out_x.shape[0] else 0, 2), np.complex128)
+    for w in range(lam.size):
+        nodal_matrix(lam[w], spring_scale[w], damper_scale[w], masses, elem_nodes, c, d, D)
+        if not condense_nodes(D, n, order, X):
             status = 1
             out_a[w] = np.nan
             out_b[w] = np.nan
@@ -121,4 +134,36 @@ def two_port_kernel(omega, spring_scale, damper_scale, masses, elem_nodes, c, d,
         out_a[w] = D[0, 0]
         out_b[w] = D[0, n + 1]
         out_c[w] = D[n + 1, n + 1]
+        if out_x.shape[0]:
+            for i in range(n):
+                out_x[w, i, 0] = X[i + 1, 0]
+                out_x[w, i, 1] = X[i + 1, 1]
     return status
+
+
+@njit(cache=True, nogil=True)
+def nodal_matrix(lam, s, t, masses, elem_nodes, c, d, D):
+    """Fill ``D`` (n + 2, n + 2) with :math:`s\\mathbf K + \\lambda t\\mathbf C +
+    \\lambda^2\\mathbf M` over the nodes engine side (0), internal (1..n), ground (n + 1)."""
+    n = masses.size
+    size = n + 2
+    for i in range(size):
+        for j in range(size):
+            D[i, j] = 0.0
+    for k in range(n):
+        D[k + 1, k + 1] = lam * lam * masses[k]
+    for e in range(c.size):
+        ia = elem_nodes[e, 0]
+        ib = elem_nodes[e, 1]
+        if ia < 0:
+            ia = n + 1
+        if ib < 0:
+            ib = n + 1
+        if s == t:
+            z = s * (c[e] + lam * d[e])
+        else:
+            z = s * c[e] + lam * t * d[e]
+        D[ia, ia] += z
+        D[ib, ib] += z
+        D[ia, ib] -= z
+        D[ib, ia] -= z

@@ -108,75 +108,70 @@ def ground_force_rows(n_internal, elem_nodes, c, d):
     return kg, dg
 
 
-def _internal_solution(omega, masses, elem_nodes, c, d):
-    """Dynamic stiffness matrices and internal displacements per unit engine-side motion."""
-    omega = np.atleast_1d(np.asarray(omega, dtype=float))
-    M, C, K = network_matrices(masses, elem_nodes, c, d)
-    w = omega[:, None, None]
-    D = K[None] + 1j * w * C[None] - w**2 * M[None]
-    n = M.shape[0] - 1
-    if n == 0:
-        return omega, D, np.ones((omega.size, 1), dtype=complex)
-    rhs = -D[:, 1:, 0:1]
-    Xi = np.linalg.solve(D[:, 1:, 1:], rhs)[..., 0]
-    X = np.concatenate([np.ones((omega.size, 1), dtype=complex), Xi], axis=1)
-    return omega, D, X
-
-
-def condensed_network(omega, masses, elem_nodes, c, d):
-    """Node displacements per unit engine-side motion and input-point stiffness, in one solve.
-
-    Returns
-    -------
-    X : ndarray complex (n_freq, n_internal + 1)
-    k_ip : ndarray complex (n_freq,)  [N/m], no engine mass
-    """
-    omega, D, X = _internal_solution(omega, masses, elem_nodes, c, d)
-    return X, np.einsum("fj,fj->f", D[:, 0, :], X)
-
-
-def two_port(omega, masses, elem_nodes, c, d, spring_scale=1.0, damper_scale=None):
+def two_port(omega, masses, elem_nodes, c, d, spring_scale=1.0, damper_scale=None, *,
+             internal=False):
     r"""Two-port dynamic stiffness ``(a, b, c)`` between the engine-side node and the ground
-    node, internal masses condensed — the one condensation
-    (:func:`powertrain.kernels.two_port.two_port_kernel`, pivot checked).
+    node at angular frequencies ``omega`` [rad/s]: :func:`laplace_two_port` at
+    :math:`s = i\omega`.
 
     .. math:: \begin{pmatrix} F_E \\ F_B \end{pmatrix} =
               \begin{pmatrix} a & b \\ b & c \end{pmatrix}
               \begin{pmatrix} x_E \\ x_B \end{pmatrix},
               \qquad a = K_{IP},\; b = -K_{CP}\ \text{(ground fixed)}.
+    """
+    return laplace_two_port(1j * np.asarray(omega, float), masses, elem_nodes, c, d,
+                            spring_scale, damper_scale, internal=internal)
+
+
+def laplace_two_port(s, masses, elem_nodes, c, d, spring_scale=1.0, damper_scale=None, *,
+                     internal=False):
+    r"""The one mount two-port condensation
+    (:func:`powertrain.kernels.two_port.two_port_kernel`, pivot checked): the network's
+    :math:`\mathbf D(s) = \mathbf K + s\mathbf C + s^2\mathbf M` with its internal nodes
+    eliminated, grounded (``a``) and ungrounded (``a, b, c``).
 
     Parameters
     ----------
-    omega : array_like
-        Angular frequencies [rad/s], any shape.
+    s : array_like complex
+        Laplace variable [1/s], any shape (:math:`i\omega` harmonic, 0 static, complex for a
+        damped mode).
     masses, elem_nodes, c, d
         Network, see :func:`network_matrices`.
     spring_scale, damper_scale : float or array_like
-        Factors on every spring and damper (broadcast to ``omega``; dampers default to the
+        Factors on every spring and damper (broadcast to ``s``; dampers default to the
         springs' factor), masses kept.
+    internal : bool
+        Also return the internal nodes' motion per unit engine-side motion (ground held) and
+        per unit ground-node motion (engine side held), shape ``s.shape + (n_internal, 2)``.
 
     Returns
     -------
-    a, b, c : ndarray complex, shape of ``omega`` [N/m]
+    a, b, c : ndarray complex, shape of ``s`` [N/m]
+        (and ``X`` when ``internal``).
 
     Raises
     ------
     FloatingPointError
-        The network is singular at some frequency (a pivot below the kernel's tolerance).
+        The network is singular at some ``s`` (a pivot below the kernel's tolerance).
     """
     from powertrain.kernels.two_port import two_port_kernel
-    w = np.asarray(omega, float)
-    s = np.broadcast_to(np.asarray(spring_scale, float), w.shape)
-    t = s if damper_scale is None else np.broadcast_to(np.asarray(damper_scale, float), w.shape)
-    flat = [np.ascontiguousarray(x.reshape(-1)) for x in (w, s, t)]
+    lam = np.asarray(s, complex)
+    sc = np.broadcast_to(np.asarray(spring_scale, float), lam.shape)
+    t = sc if damper_scale is None else np.broadcast_to(np.asarray(damper_scale, float),
+                                                        lam.shape)
+    flat = [np.ascontiguousarray(x.reshape(-1)) for x in (lam, sc, t)]
+    masses = np.ascontiguousarray(masses, float).reshape(-1)
     out = [np.empty(flat[0].size, complex) for _ in range(3)]
-    status = two_port_kernel(*flat, np.ascontiguousarray(masses, float),
+    x = np.empty((flat[0].size if internal else 0, masses.size, 2), complex)
+    status = two_port_kernel(*flat, masses,
                              np.ascontiguousarray(np.asarray(elem_nodes, np.int64).reshape(-1, 2)),
-                             np.ascontiguousarray(c, float), np.ascontiguousarray(d, float), *out)
+                             np.ascontiguousarray(c, float), np.ascontiguousarray(d, float),
+                             *out, x)
     if status:
         raise FloatingPointError("mount network singular at some frequency (two-port pivot "
                                  "below tolerance)")
-    return tuple(x.reshape(w.shape) for x in out)
+    res = tuple(v.reshape(lam.shape) for v in out)
+    return res + (x.reshape(lam.shape + x.shape[1:]),) if internal else res
 
 
 def cross_point_stiffness(omega, masses, elem_nodes, c, d):
@@ -196,9 +191,8 @@ def cross_point_stiffness(omega, masses, elem_nodes, c, d):
     -------
     ndarray of complex, shape (n_freq,)
     """
-    omega, _, X = _internal_solution(omega, masses, elem_nodes, c, d)
-    kg, dg = ground_force_rows(X.shape[1] - 1, elem_nodes, c, d)
-    return X @ kg + 1j * omega * (X @ dg)
+    omega = np.atleast_1d(np.asarray(omega, dtype=float))
+    return -two_port(omega, masses, elem_nodes, c, d)[1]
 
 
 def input_point_stiffness(omega, masses, elem_nodes, c, d, engine_mass=0.0):
@@ -209,19 +203,8 @@ def input_point_stiffness(omega, masses, elem_nodes, c, d, engine_mass=0.0):
     :math:`-\omega^2 m_e` is included, so that :math:`\hat X_1 = F/K_{IP}` for a force
     :math:`F` on the engine mass.
     """
-    omega, D, X = _internal_solution(omega, masses, elem_nodes, c, d)
-    return np.einsum("fj,fj->f", D[:, 0, :], X) - omega**2 * engine_mass
-
-
-def internal_displacements(omega, masses, elem_nodes, c, d):
-    """Complex displacement of every network node per unit engine-side displacement.
-
-    Returns
-    -------
-    ndarray of complex, shape (n_freq, n_internal + 1)
-        Column 0 is the engine-side node (identically 1).
-    """
-    return _internal_solution(omega, masses, elem_nodes, c, d)[2]
+    omega = np.atleast_1d(np.asarray(omega, dtype=float))
+    return two_port(omega, masses, elem_nodes, c, d)[0] - omega**2 * engine_mass
 
 
 def forced_engine_mass_response(omega, masses, elem_nodes, c, d, engine_mass, force):
@@ -286,7 +269,7 @@ def incidence_matrix(n_internal, elem_nodes):
     return B
 
 
-def cross_point_stiffness_gradient(omega, masses, elem_nodes, c, d, *, method="kernel"):
+def cross_point_stiffness_gradient(omega, masses, elem_nodes, c, d):
     r"""Cross-point stiffness and its derivatives with respect to every c, d and m.
 
     Two static condensations share one factorisation per frequency: the internal motion
@@ -319,10 +302,6 @@ def cross_point_stiffness_gradient(omega, masses, elem_nodes, c, d, *, method="k
         Angular frequency [rad/s].
     masses, elem_nodes, c, d
         Network, see :func:`network_matrices`: masses [kg], c [N/m], d [N·s/m].
-    method : {"kernel", "numpy"}
-        ``kernel`` (default): the compiled per-frequency solve of
-        :mod:`powertrain.kernels.mount_stiffness`; ``numpy``: batched LAPACK solves. The two
-        agree to rounding (tested); the kernel is much faster for small networks.
 
     Returns
     -------
@@ -341,31 +320,11 @@ def cross_point_stiffness_gradient(omega, masses, elem_nodes, c, d, *, method="k
     d = np.asarray(d, dtype=float)
     n = masses.size
     B = incidence_matrix(n, elem_nodes)
-    if method == "kernel":
-        from powertrain.kernels.mount_stiffness import kcp_gradient_kernel
-        nf, n_el = omega.size, c.size
-        kcp = np.empty(nf, dtype=complex)
-        dk_dm = np.empty((nf, n), dtype=complex)
-        dk_dc = np.empty((nf, n_el), dtype=complex)
-        dk_dd = np.empty((nf, n_el), dtype=complex)
-        kcp_gradient_kernel(omega, B, masses, c, d, kcp, dk_dm, dk_dc, dk_dd)
-        return kcp, dk_dm, dk_dc, dk_dd
-    if method != "numpy":
-        raise ValueError(f"unknown method {method!r}")
-    k = c[None, :] + 1j * omega[:, None] * d[None, :]                 # (f, e)
-    D = np.einsum("ea,fe,eb->fab", B, k, B)
-    D[:, 1:n + 1, 1:n + 1] -= (omega[:, None]**2 * masses[None, :])[:, :, None] \
-        * np.eye(n)[None]
-    nf = omega.size
-    XY = np.zeros((nf, n + 2, 2), dtype=complex)
-    XY[:, 0, 0] = 1.0
-    XY[:, n + 1, 1] = 1.0
-    if n:
-        rhs = -D[:, 1:n + 1][:, :, [0, n + 1]]
-        XY[:, 1:n + 1, :] = np.linalg.solve(D[:, 1:n + 1, 1:n + 1], rhs)
-    uv = np.einsum("ea,fas->fes", B, XY)
-    dk_dc = -uv[..., 0] * uv[..., 1]
-    dk_dd = 1j * omega[:, None] * dk_dc
-    dk_dm = omega[:, None]**2 * XY[:, 1:n + 1, 0] * XY[:, 1:n + 1, 1]
-    kcp = dk_dc @ c + dk_dd @ d + dk_dm @ masses
+    from powertrain.kernels.mount_stiffness import kcp_gradient_kernel
+    nf, n_el = omega.size, c.size
+    kcp = np.empty(nf, dtype=complex)
+    dk_dm = np.empty((nf, n), dtype=complex)
+    dk_dc = np.empty((nf, n_el), dtype=complex)
+    dk_dd = np.empty((nf, n_el), dtype=complex)
+    kcp_gradient_kernel(omega, B, masses, c, d, kcp, dk_dm, dk_dc, dk_dd)   # NaN if singular
     return kcp, dk_dm, dk_dc, dk_dd

@@ -37,6 +37,8 @@ from dataclasses import dataclass, field
 import numpy as np
 import scipy.linalg as sla
 
+from powertrain.physics.condensation import condense
+
 COORDINATES = ("x", "y", "z", "rx", "ry", "rz")
 #: Relative change of s at which the secant iteration stops.
 TOLERANCE = 1e-12
@@ -175,25 +177,12 @@ def _normalise(M6, phi):
     return phi / np.sqrt((np.conj(phi) @ M6 @ phi).real)
 
 
-def _retained(system) -> np.ndarray:
-    """Indices of the kept coordinates: the rigid body and the body modes (modal chassis);
-    the networks' internal coordinates are condensed."""
-    return np.r_[np.arange(6), np.arange(system.body_start, system.n_dof)].astype(int)
-
-
 def _condensed_stiffness(system, s):
-    r""":math:`\mathbf D_R(s) - s^2\mathbf M_R` with the internal coordinates condensed
-    exactly at complex ``s`` (for the rigid chassis: :math:`\sum_n K_{IP,n}(s)\mathbf r_n
-    \mathbf r_n^T`)."""
-    keep = _retained(system)
-    internal = np.setdiff1d(np.arange(system.n_dof), keep)
-    D = system.K + s * system.C + s * s * system.M
-    Dr = D[np.ix_(keep, keep)] - s * s * system.M[np.ix_(keep, keep)]
-    if internal.size:
-        Dri = D[np.ix_(keep, internal)]
-        Dr = Dr - Dri @ np.linalg.solve(D[np.ix_(internal, internal)],
-                                        D[np.ix_(internal, keep)])
-    return Dr
+    r""":math:`\mathbf D_R(s) - s^2\mathbf M_R` on the retained coordinates (rigid body, body
+    modes), the networks condensed exactly at complex ``s``
+    (:func:`powertrain.physics.condensation.condense`)."""
+    keep = system.retained
+    return condense(system, keep, s) - s * s * system.M[np.ix_(keep, keep)]
 
 
 def _mac(a, b, M6) -> float:
@@ -230,6 +219,19 @@ def _null_vector(system, M6, s):
     return np.conj(vh[-1])
 
 
+def _body_roots(system, M6, cand):
+    """The candidate roots with their shapes, without the networks' own internal roots (where
+    a network's internal block is singular and the condensation has a pole)."""
+    kept, shapes = [], []
+    for c in cand:
+        try:
+            shapes.append(_null_vector(system, M6, c))
+        except FloatingPointError:
+            continue
+        kept.append(c)
+    return np.array(kept, complex), shapes
+
+
 def _dynamic_roots(system, M6, omegas, vec):
     """Roots followed from each static mode, made unique against the exact eigenvalues.
 
@@ -243,10 +245,9 @@ def _dynamic_roots(system, M6, omegas, vec):
                 for i, w in enumerate(omegas)]
     lam = _state_space_eigenvalues(system)
     top = 3.0 * max(omegas.max(), 1e-9)
-    cand = lam[(lam.imag > 0) & (np.abs(lam) < top)]
+    cand, shapes = _body_roots(system, M6, lam[(lam.imag > 0) & (np.abs(lam) < top)])
     if cand.size < len(followed):
         return followed
-    shapes = [_null_vector(system, M6, c) for c in cand]
     cost = np.array([[abs(s - c) / abs(s) + 1.0 - _mac(phi, shapes[j], M6)
                       for j, c in enumerate(cand)] for s, phi, _ in followed])
     rows, cols = linear_sum_assignment(cost)
@@ -260,13 +261,8 @@ def _dynamic_roots(system, M6, omegas, vec):
 
 
 def _static_condensed(system, keep) -> np.ndarray:
-    """Static stiffness on the kept coordinates, internal coordinates condensed."""
-    internal = np.setdiff1d(np.arange(system.n_dof), keep)
-    K = system.K
-    Kr = K[np.ix_(keep, keep)]
-    if internal.size:
-        Kr = Kr - K[np.ix_(keep, internal)] @ np.linalg.solve(K[np.ix_(internal, internal)],
-                                                             K[np.ix_(internal, keep)])
+    """Static stiffness on the kept coordinates, the others condensed."""
+    Kr = condense(system, keep, 0.0).real
     return 0.5 * (Kr + Kr.T)
 
 
@@ -300,7 +296,7 @@ def rigid_body_modes(system, inertia, *, static=False, crank_axis=(1.0, 0.0, 0.0
     engine_name : str, optional
         Recorded in the result (reports, plots).
     """
-    keep = _retained(system)
+    keep = system.retained
     MR = system.M[np.ix_(keep, keep)]
     w2, vec = sla.eigh(_static_condensed(system, keep), MR)
     tra = torque_roll_axis(inertia, crank_axis)

@@ -1,0 +1,166 @@
+r"""The one condensation of the assembled model: its mount networks' internal coordinates
+eliminated through their two-ports, at any Laplace variable :math:`s`.
+
+The retained coordinates R are the rigid body and, under a modal chassis, the body modes.
+Their frame (the rigid-body mass, the body modes' oscillators) has
+:math:`\mathbf D_0(s) = \mathbf K_0 + s\mathbf C_0 + s^2\mathbf M_0`; network n joins its
+engine-side node (motion :math:`\mathbf p_{E,n}\cdot\mathbf q_R`) to its base node (motion
+:math:`\mathbf p_{B,n}\cdot\mathbf q_R`, zero on a rigid ground) and, its internal masses
+eliminated (:func:`powertrain.physics.mount_network.laplace_two_port`), acts through the
+two-port :math:`\mathbf T_n = [[a_n, b_n]; [b_n, c_n]]`:
+
+.. math:: \mathbf D_R(s) = \mathbf D_0(s) + \sum_n \mathbf P_n^T\mathbf T_n(s)\mathbf P_n,
+          \qquad \mathbf P_n = [\mathbf p_{E,n}; \mathbf p_{B,n}],
+
+exact: the Schur complement of :math:`\mathbf K + s\mathbf C + s^2\mathbf M` on R
+(tests/test_two_port.py against a dense solve). :func:`condense` keeps any subset of R (the
+rest of R condensed densely, e.g. the body modes for the 6×6 static stiffness); the static
+stiffness (:math:`s = 0`), the modes (complex :math:`s`), the harmonic steady state
+(:math:`s = i\omega`, :func:`harmonic_solve`) and the cached diagnosis model (its own
+two-port values, :func:`frame_and_ports`) all go through :func:`condensed_matrix`.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from powertrain.physics.mount_network import laplace_two_port
+
+
+@dataclass(frozen=True)
+class NetworkPorts:
+    """How the networks sit on the retained coordinates R.
+
+    Attributes
+    ----------
+    retained : ndarray int (n_R,)
+        Indices of R in the full coordinates.
+    frame : tuple of ndarray (n_R, n_R)
+        :math:`\\mathbf M_0, \\mathbf C_0, \\mathbf K_0` of R without the networks.
+    engine_rows, base_rows : ndarray (n_net, n_R)
+        :math:`\\mathbf p_E`, :math:`\\mathbf p_B` per network (base rows zero: ground).
+    internal : list of (start, n_internal)
+        Each network's internal coordinates in the full numbering.
+    models : list
+        Each network's model (``network()`` gives masses, nodes, c, d).
+    """
+
+    retained: np.ndarray
+    frame: tuple
+    engine_rows: np.ndarray
+    base_rows: np.ndarray
+    internal: list
+    models: list
+
+    @property
+    def grounded(self) -> bool:
+        return not np.any(self.base_rows)
+
+
+def two_ports(ports: NetworkPorts, s, internal=False):
+    """``(a, b, c)`` each ``s.shape + (n_net,)`` of every network at ``s`` (and the list of
+    internal motions per network when ``internal``)."""
+    s = np.asarray(s, complex)
+    abc = [np.empty(s.shape + (len(ports.models),), complex) for _ in range(3)]
+    shapes = []
+    for k, model in enumerate(ports.models):
+        res = laplace_two_port(s, *model.network(), internal=internal)
+        for j in range(3):
+            abc[j][..., k] = res[j]
+        if internal:
+            shapes.append(res[3])
+    return (tuple(abc), shapes) if internal else tuple(abc)
+
+
+def condensed_matrix(frame, engine_rows, base_rows, abc, s):
+    r""":math:`\mathbf D_R(s)` of the module docstring, shape ``s.shape + (n_R, n_R)``, for
+    given two-port values ``abc`` (each ``s.shape + (n_net,)``); ``base_rows`` None: every
+    base grounded (``b``, ``c`` unused)."""
+    s = np.asarray(s, complex)
+    M0, C0, K0 = frame
+    n = M0.shape[0]
+    a, b, c = abc
+    E = engine_rows
+    D = (s ** 2)[..., None, None] * M0 + s[..., None, None] * C0 + K0
+    D = D + (a.reshape(-1, E.shape[0]) @ np.einsum("ni,nj->nij", E, E).reshape(-1, n * n)
+             ).reshape(s.shape + (n, n))
+    if base_rows is not None:
+        B = base_rows
+        cross = (b.reshape(-1, E.shape[0]) @ np.einsum("ni,nj->nij", E, B).reshape(-1, n * n)
+                 ).reshape(s.shape + (n, n))
+        D = D + cross + np.swapaxes(cross, -1, -2) + (
+            c.reshape(-1, E.shape[0]) @ np.einsum("ni,nj->nij", B, B).reshape(-1, n * n)
+        ).reshape(s.shape + (n, n))
+    return D
+
+
+def condense(system, keep, s):
+    r"""Dynamic stiffness :math:`\mathbf K + s\mathbf C + s^2\mathbf M` of ``system`` on the
+    coordinates ``keep`` with all others eliminated exactly.
+
+    Parameters
+    ----------
+    system : AssembledSystem
+    keep : array_like int
+        Kept coordinates; a subset of the retained ones (rigid body, body modes).
+    s : complex or array_like
+        Laplace variable [1/s].
+
+    Returns
+    -------
+    ndarray complex, ``shape(s) + (n_keep, n_keep)``
+    """
+    ports = system.ports()
+    s = np.asarray(s, complex)
+    D = _retained_matrix(ports, two_ports(ports, s), s)
+    pos = {int(j): i for i, j in enumerate(ports.retained)}
+    if any(int(j) not in pos for j in keep):
+        raise ValueError("condense keeps only retained coordinates (rigid body, body modes)")
+    k = np.array([pos[int(j)] for j in keep], int)
+    rest = np.setdiff1d(np.arange(ports.retained.size), k)
+    Dk = D[..., k[:, None], k[None, :]]
+    if rest.size:
+        Dkr = D[..., k[:, None], rest[None, :]]
+        Dk = Dk - Dkr @ np.linalg.solve(D[..., rest[:, None], rest[None, :]],
+                                        D[..., rest[:, None], k[None, :]])
+    return Dk
+
+
+def _retained_matrix(ports, abc, s):
+    return condensed_matrix(ports.frame, ports.engine_rows,
+                            None if ports.grounded else ports.base_rows, abc, s)
+
+
+def harmonic_solve(system, load_harmonics, omegas):
+    r"""Steady-state amplitudes of every coordinate under a load on the rigid body:
+    :math:`\mathbf D_R(i\omega)\hat{\mathbf q}_R = \hat{\mathbf f}`, then each network's
+    internal motion from its engine-side and base motion.
+
+    Parameters
+    ----------
+    system : AssembledSystem
+    load_harmonics : ndarray (n_h, 6) complex
+        Amplitudes of the 6-vector load [N, N·m].
+    omegas : ndarray (n_h,)
+        Angular frequency of each harmonic [rad/s].
+
+    Returns
+    -------
+    ndarray (n_h, n_dof) complex
+    """
+    ports = system.ports()
+    s = 1j * np.asarray(omegas, float)
+    abc, shapes = two_ports(ports, s, internal=True)
+    D = _retained_matrix(ports, abc, s)
+    rhs = np.zeros(s.shape + (ports.retained.size,), complex)
+    rhs[:, :6] = load_harmonics
+    q_r = np.linalg.solve(D, rhs[..., None])[..., 0]
+    out = np.zeros((s.size, system.n_dof), complex)
+    out[:, ports.retained] = q_r
+    x_e = q_r @ ports.engine_rows.T
+    x_b = q_r @ ports.base_rows.T
+    for k, ((start, ni), X) in enumerate(zip(ports.internal, shapes)):
+        out[:, start:start + ni] = X[..., 0] * x_e[:, k, None] + X[..., 1] * x_b[:, k, None]
+    return out
