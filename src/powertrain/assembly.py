@@ -121,16 +121,6 @@ class AssembledSystem:
     def n_dof(self) -> int:
         return self.M.shape[0]
 
-    def load_matrix(self) -> np.ndarray:
-        """B (n×6): the generalized load acts on the rigid-body coordinates only."""
-        B = np.zeros((self.n_dof, 6))
-        B[:6, :6] = np.eye(6)
-        return B
-
-    def static_displacement(self, load6) -> np.ndarray:
-        """Static solution K q = B f for a constant 6-vector load [N, N·m]."""
-        return np.linalg.solve(self.K, self.load_matrix() @ np.asarray(load6, float))
-
     def static_stiffness_6(self) -> np.ndarray:
         """6×6 static stiffness of the body on its mounts, internal nodes condensed
         statically [N/m, N, N·m/rad]."""

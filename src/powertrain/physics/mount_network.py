@@ -213,17 +213,6 @@ def input_point_stiffness(omega, masses, elem_nodes, c, d, engine_mass=0.0):
     return np.einsum("fj,fj->f", D[:, 0, :], X) - omega**2 * engine_mass
 
 
-def internal_displacements(omega, masses, elem_nodes, c, d):
-    """Complex displacement of every network node per unit engine-side displacement.
-
-    Returns
-    -------
-    ndarray of complex, shape (n_freq, n_internal + 1)
-        Column 0 is the engine-side node (identically 1).
-    """
-    return _internal_solution(omega, masses, elem_nodes, c, d)[2]
-
-
 def forced_engine_mass_response(omega, masses, elem_nodes, c, d, engine_mass, force):
     r"""Engine mass on the mount under a harmonic force: the thesis's verification set-up.
 

@@ -74,12 +74,3 @@ def harmonic_response_full(system, load_harmonics, omegas):
     rhs = np.zeros((omegas.size, system.n_dof, 1), dtype=complex)
     rhs[:, :6, 0] = load_harmonics
     return np.linalg.solve(D, rhs)[..., 0]
-
-
-def synthesize(q_harmonics, omegas, t):
-    """Time signals from harmonic amplitudes: returns q, q', q'' at times ``t`` (n_t, n_dof)."""
-    ph = np.exp(1j * np.outer(t, omegas))          # (n_t, n_h)
-    q = (ph @ q_harmonics).real
-    v = (ph @ (1j * omegas[:, None] * q_harmonics)).real
-    a = (ph @ (-(omegas ** 2)[:, None] * q_harmonics)).real
-    return q, v, a
