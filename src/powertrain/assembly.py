@@ -124,12 +124,6 @@ class AssembledSystem:
     def n_dof(self) -> int:
         return self.M.shape[0]
 
-    def load_matrix(self) -> np.ndarray:
-        """B (n×6): the generalized load acts on the rigid-body coordinates only."""
-        B = np.zeros((self.n_dof, 6))
-        B[:6, :6] = np.eye(6)
-        return B
-
     def ports(self) -> NetworkPorts:
         """The networks on the retained coordinates (:mod:`powertrain.physics.condensation`);
         a model assembled without them keeps every coordinate."""

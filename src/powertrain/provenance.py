@@ -151,10 +151,6 @@ class Provenance:
                    version=record.get("powertrain_version", ""),
                    date=str(record.get("created", "")).replace("+00:00", "Z"))
 
-    def with_engine(self, engine: str) -> Provenance:
-        """Copy with ``engine`` set."""
-        return dataclasses.replace(self, engine=engine)
-
     def line(self) -> str:
         """One line for a figure foot: ``powertrain 0.1.0 · 2026-11-23 18:30 UTC · engine:
         ... · $ command``."""

@@ -146,18 +146,6 @@ class SynthCase:
     member_effect_db: dict = field(default_factory=dict)
 
     @property
-    def detectable_library_effects(self) -> set:
-        """Library matches of the hidden effects that are detectable *alone* (each one's
-        noise-free held-out gap, :attr:`member_effect_db`); for a single effect the same as
-        :attr:`library_effects` when :attr:`detectable`."""
-        if not self.detectable:
-            return set()
-        if len(self.truth) == 1:
-            return self.library_effects
-        return {TRUTH_EFFECTS[t] for t, _ in self.truth
-                if is_detectable(self.member_effect_db.get(t, 0.0), self.noise_db)}
-
-    @property
     def detectable(self) -> bool:
         """Whether the hidden effect can be identified at all (:func:`is_detectable`);
         False for effect-free cases."""

@@ -89,10 +89,6 @@ class Effect:
     def defaults(self, engine=None) -> dict:
         return {p.name: p.default for p in self.parameters(engine)}
 
-    @property
-    def parameter_names(self) -> list:
-        return [p.name for p in self.parameters()]
-
     def bounds(self, engine=None):
         ps = self.parameters(engine)
         return np.array([p.lower for p in ps]), np.array([p.upper for p in ps])

@@ -21,7 +21,7 @@ from powertrain.iotools.channel_map import (
     quantity_of_unit,
     split_unit,
 )
-from powertrain.models.recording import QUANTITIES, RawChannel, RawRecording
+from powertrain.models.recording import RawChannel, RawRecording
 from powertrain.units import to_si
 
 _HDF5 = b"\x89HDF\r\n\x1a\n"
@@ -173,8 +173,3 @@ def assemble(found: FileSignals, cmap: ChannelMap | None = None, *, rpm=None,
     rec = RawRecording(found.time, channels, speed.get("rpm"), speed.get("tacho"), src,
                        comments)
     return rec.validate(found.time_name)
-
-
-def si_unit(quantity: str) -> str:
-    """SI unit string of a measured quantity."""
-    return QUANTITIES[quantity]

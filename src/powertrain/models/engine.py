@@ -63,12 +63,6 @@ class RigidBody:
     cg: np.ndarray
     inertia: np.ndarray
 
-    def mass_matrix(self) -> np.ndarray:
-        """6×6 mass matrix for ``[x, y, z, rx, ry, rz]`` at the CG [kg, kg·m²]."""
-        from powertrain.physics.rigid_body import rigid_body_mass_matrix
-        return rigid_body_mass_matrix(self.mass, self.inertia)
-
-
 @dataclass(frozen=True, eq=False)
 class MountSpec:
     """One mount of the powertrain.
@@ -633,22 +627,6 @@ class Engine:
             [N, N, N, N·m, N·m, N·m].
         """
         return self._evaluate(rpm, crank_angle_rad, load, detail=False)
-
-    def load_interpolant(self, rpm: float, n_points: int = 2880, load: float = 1.0):
-        """A fast callable ``f(crank_angle_rad) -> (n, 6)`` for one speed.
-
-        The load is sampled once on ``n_points`` equally spaced angles of ``[0, 4π)`` and
-        interpolated linearly and periodically (for time-stepping solvers that need the
-        load one angle at a time; 0.25° spacing by default).
-        """
-        grid = 4.0 * np.pi * np.arange(n_points) / n_points
-        table = self.generalized_load(rpm, grid, load)
-
-        def f(crank_angle_rad):
-            th = np.atleast_1d(np.asarray(crank_angle_rad, dtype=float))
-            return np.column_stack([np.interp(th, grid, table[:, j], period=4.0 * np.pi)
-                                    for j in range(6)])
-        return f
 
     def assemble(self):
         """The assembled linear model: body, mounts and chassis

@@ -14,15 +14,6 @@ from powertrain.plotting.runup import plot_runup, plot_whatif
 from powertrain.plotting.stiffness import plot_mount_fit, plot_retune, plot_stiffness
 from powertrain.plotting.style import SIGNAL_UNITS, save_figure
 
-
-def _pyplot():
-    """matplotlib.pyplot, imported lazily; the backend is NOT switched (the CLI picks Agg).
-    Kept for figure modules written before :mod:`powertrain.plotting.style`; new code uses
-    :func:`powertrain.plotting.style.subplots`."""
-    import matplotlib.pyplot as plt
-    return plt
-
-
 __all__ = ["SIGNAL_UNITS", "plot_comparison", "plot_diagnosis_overlay", "plot_excitation",
            "plot_gap_frequency", "plot_gap_map", "plot_mount_fit", "plot_retune", "plot_runup",
            "plot_stiffness", "plot_whatif", "save_figure"]

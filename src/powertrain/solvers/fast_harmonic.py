@@ -172,25 +172,6 @@ class HarmonicModel:
             self._extra["shafts"] = out
         return self._extra["shafts"]
 
-    def imep_derivatives(self, step=0.05) -> np.ndarray:
-        r"""Load-harmonic derivatives per cylinder IMEP factor, (n_cyl, n_r, 17, 6).
-
-        Central differences :math:`(\mathbf f(1+\delta) - \mathbf f(1-\delta))/(2\delta)`
-        (``step`` :math:`\delta`) about all factors 1.
-        """
-        if "imep" not in self._extra:
-            n = self.engine.crank.n_cylinders
-            base = np.asarray(self.engine.combustion.imep_factors, float)
-            out = np.zeros((n, self.rpm.size, N_HARMONICS, 6), complex)
-            for k in range(n):
-                up, dn = base.copy(), base.copy()
-                up[k] += step
-                dn[k] -= step
-                out[k] = (self.load_of(self.engine.with_imep_factors(up))
-                          - self.load_of(self.engine.with_imep_factors(dn))) / (2 * step)
-            self._extra["imep"] = out
-        return self._extra["imep"]
-
     def two_ports(self, models=None):
         """``(a, b, c)`` of every network at every speed and harmonic, each (n_r, 17, n_net).
 
@@ -271,9 +252,6 @@ class HarmonicModel:
         if hasattr(self.engine, "replace"):
             state["engine"] = self.engine.replace()
         return state
-
-    def nominal_kip(self) -> np.ndarray:
-        return self.two_ports()[0]
 
     def subset(self, index) -> HarmonicModel:
         """The model at the speeds ``rpm[index]``, sharing the cached parts computed so far."""

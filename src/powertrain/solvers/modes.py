@@ -105,10 +105,6 @@ class ModesResult:
     engine: str = ""
     meta: dict = field(default_factory=dict)
 
-    @property
-    def frequencies_hz(self) -> np.ndarray:
-        return np.array([m.frequency_hz for m in self.modes])
-
     def to_dict(self) -> dict:
         return {"modes": [m.to_dict() for m in self.modes],
                 "torque_roll_axis": self.torque_roll_axis, "method": self.method,
