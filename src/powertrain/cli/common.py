@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import contextlib
 import math
 
 import click
@@ -208,3 +209,23 @@ def plot_form_options(func):
     ]):
         func = option(func)
     return func
+
+
+@contextlib.contextmanager
+def terminate_as_exit():
+    """Turn SIGTERM (``kill PID``) into ``SystemExit(143)`` while a command runs, so that its
+    staged outputs and temporary files are removed as on any other failure (main thread
+    only; other signals keep their handlers)."""
+    import signal
+    import threading
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+
+    def stop(signum, frame):
+        raise SystemExit(128 + signum)
+    old = signal.signal(signal.SIGTERM, stop)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGTERM, old)
