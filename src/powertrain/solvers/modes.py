@@ -338,12 +338,40 @@ def rigid_body_modes(system, inertia, *, static=False, crank_axis=(1.0, 0.0, 0.0
 
 
 def engine_modes(engine, *, static=False) -> ModesResult:
-    """:func:`rigid_body_modes` of an :class:`~powertrain.models.engine.Engine`."""
+    """:func:`rigid_body_modes` of an :class:`~powertrain.models.engine.Engine`.
+
+    Raises
+    ------
+    InputError
+        Naming the engine file, when the model cannot be solved or a mode is not finite
+        (values at the edge of the float range, a body mode that couples to nothing).
+    """
     from powertrain.assembly import assemble
+    from powertrain.errors import InputError
     b = engine.body
     chassis = engine.chassis if getattr(engine.chassis, "model", "") == "modal" else None
-    system = assemble(b.mass, b.cg, b.inertia, engine.mounts, chassis)
-    result = rigid_body_modes(system, b.inertia, static=static, engine_name=engine.name)
+    try:
+        with np.errstate(all="ignore"):
+            system = assemble(b.mass, b.cg, b.inertia, engine.mounts, chassis)
+            result = rigid_body_modes(system, b.inertia, static=static,
+                                      engine_name=engine.name)
+    except (ValueError, ArithmeticError, np.linalg.LinAlgError) as exc:
+        raise InputError(f"the modes cannot be computed ({type(exc).__name__}: "
+                         f"{str(exc)[:100]}): mount, body or chassis values out of any "
+                         "physical range", file=engine.file, key="mounts") from None
+    for i, mode in enumerate(result.modes, 1):
+        if not _finite(mode):
+            key = "chassis.modes" if mode.kind == "chassis" else "mounts"
+            raise InputError(f"mode {i} ({mode.kind}) is not finite (NaN or inf): values out "
+                             "of any physical range, or a body mode whose shape is zero at "
+                             "every mount", file=engine.file, key=key)
     result.meta["cg_m"] = [float(v) for v in b.cg]
     result.meta["mounts"] = engine.mount_names
     return result
+
+
+def _finite(mode: Mode) -> bool:
+    numbers = [mode.frequency_hz, mode.damping_ratio, mode.damped_frequency_hz,
+               mode.angle_to_torque_roll_axis_deg, mode.body_energy_percent]
+    return bool(np.all(np.isfinite(numbers)) and np.all(np.isfinite(mode.shape))
+                and np.all(np.isfinite(mode.ked_percent)))
