@@ -87,7 +87,8 @@ class Mode:
                 "dominant": self.dominant,
                 "ked_percent": {c: float(v) for c, v in zip(COORDINATES, self.ked_percent)},
                 "damped_frequency_hz": float(self.damped_frequency_hz),
-                "angle_to_torque_roll_axis_deg": float(self.angle_to_torque_roll_axis_deg),
+                "angle_to_torque_roll_axis_deg": _number_or_null(
+                    self.angle_to_torque_roll_axis_deg),
                 "shape": {c: float(v) for c, v in zip(COORDINATES, shape)},
                 "kind": self.kind,
                 "body_energy_percent": float(self.body_energy_percent)}
@@ -158,6 +159,12 @@ def kinetic_energy_percent(M6, phi) -> np.ndarray:
     phi = np.asarray(phi, complex)
     e = (np.conj(phi) * (M6 @ phi)).real
     return 100.0 * e / e.sum()
+
+
+def _number_or_null(value):
+    """``value`` as a float, or None (JSON null) where it is undefined (NaN: the rotation
+    axis of a mode without rotation)."""
+    return float(value) if np.isfinite(value) else None
 
 
 def _axis_angle_deg(a, b) -> float:
@@ -327,8 +334,8 @@ def rigid_body_modes(system, inertia, *, static=False, crank_axis=(1.0, 0.0, 0.0
     crank = np.asarray(crank_axis, float)
     tra_info = {"direction": [float(v) for v in tra],
                 "angle_to_crank_axis_deg": _axis_angle_deg(tra, crank),
-                "angles_to_mode_rotation_axes_deg": [m.angle_to_torque_roll_axis_deg
-                                                     for m in modes],
+                "angles_to_mode_rotation_axes_deg": [
+                    _number_or_null(m.angle_to_torque_roll_axis_deg) for m in modes],
                 "through": "centre of gravity"}
     method = ("static: static stiffness, undamped" if static else
               "dynamic: network dynamic stiffness at each mode's complex frequency "
@@ -372,6 +379,6 @@ def engine_modes(engine, *, static=False) -> ModesResult:
 
 def _finite(mode: Mode) -> bool:
     numbers = [mode.frequency_hz, mode.damping_ratio, mode.damped_frequency_hz,
-               mode.angle_to_torque_roll_axis_deg, mode.body_energy_percent]
+               mode.body_energy_percent]          # the axis angle may be undefined (NaN)
     return bool(np.all(np.isfinite(numbers)) and np.all(np.isfinite(mode.shape))
                 and np.all(np.isfinite(mode.ked_percent)))
