@@ -41,7 +41,7 @@ def read_uff_signals(path, channel_map=None) -> FileSignals:
         raise InputError(f"not a readable universal file ({problem})", file=path)
     if isinstance(sets, dict):
         sets = [sets]
-    _check_complete(path, len(sets))
+    check_complete(path, len(sets))
     sets = [s for s in sets if s.get("type") == 58]
     if not sets:
         raise InputError("no dataset 58 (function at nodal DOF) in the universal file",
@@ -73,7 +73,7 @@ _COUNT = re.compile(r"powertrain dataset (\d+) of (\d+)")
 _DATASET_START = re.compile(rb"(?:^|\n)[ ]*-1[ ]*\r?\n[ ]*(\d+)b?[ \r\n]")
 
 
-def _check_complete(path, n_read: int) -> None:
+def check_complete(path, n_read: int) -> None:
     """Refuse a truncated file: it must end with the ``-1`` delimiter, and every dataset that
     starts in it must have been read (pyuff silently drops an incomplete last one)."""
     with open(path, "rb") as fh:
