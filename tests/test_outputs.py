@@ -14,7 +14,7 @@ import pytest
 from click.testing import CliRunner
 
 from powertrain.cli import main
-from powertrain.iotools.atomic import atomic_write, discard_written, start_tracking
+from powertrain.iotools.atomic import OutputTransaction, atomic_write, sweep_stale_temps
 
 QUICK = ["--from", "1000", "--to", "2000", "--step", "500"]
 
@@ -50,12 +50,52 @@ def test_failed_block_leaves_nothing(tmp_path):
     assert list(tmp_path.iterdir()) == []
 
 
-def test_discard_written_removes_this_commands_outputs(tmp_path):
-    start_tracking()
-    with atomic_write(tmp_path / "a.txt") as fh:
-        fh.write("x")
-    assert [p.name for p in discard_written()] == ["a.txt"]
-    assert list(tmp_path.iterdir()) == []
+def test_transaction_commits_all_outputs_together(tmp_path):
+    (tmp_path / "a.txt").write_text("old")
+    with OutputTransaction():
+        with atomic_write(tmp_path / "a.txt") as fh:
+            fh.write("new")
+        with atomic_write(tmp_path / "sub" / "b.txt") as fh:
+            fh.write("b")
+        assert (tmp_path / "a.txt").read_text() == "old"       # staged, not yet replaced
+    assert (tmp_path / "a.txt").read_text() == "new"
+    assert (tmp_path / "sub" / "b.txt").read_text() == "b"
+    assert sorted(p.name for p in tmp_path.rglob("*")) == ["a.txt", "b.txt", "sub"]
+
+
+def test_failed_transaction_keeps_earlier_files_and_removes_its_own(tmp_path):
+    (tmp_path / "a.txt").write_text("old")
+    with pytest.raises(RuntimeError):
+        with OutputTransaction():
+            with atomic_write(tmp_path / "a.txt") as fh:
+                fh.write("new")
+            with atomic_write(tmp_path / "sub" / "deeper" / "b.txt") as fh:
+                fh.write("b")
+            raise RuntimeError
+    assert (tmp_path / "a.txt").read_text() == "old"
+    assert [p.name for p in tmp_path.iterdir()] == ["a.txt"]      # no temp, no new folder
+
+
+def test_stale_temporary_files_of_dead_processes_are_swept(tmp_path):
+    dead = subprocess.run([sys.executable, "-c", "import os; print(os.getpid())"],
+                          capture_output=True, text=True).stdout.strip()
+    stale = tmp_path / f".x.csv.pt{dead}-abc123.tmp"
+    mine = tmp_path / f".y.csv.pt{os.getpid()}-abc123.tmp"
+    other = tmp_path / ".z.csv.abc.tmp"                          # not ours: kept
+    for p in (stale, mine, other):
+        p.write_text("half")
+    assert sweep_stale_temps(tmp_path) == [stale]
+    assert sorted(p.name for p in tmp_path.iterdir()) == sorted([mine.name, other.name])
+
+
+def test_modes_failing_on_its_plot_keeps_the_old_json(tmp_path):
+    """Issue 18: a failing command never deletes a file it did not create."""
+    (tmp_path / "m.json").write_text("old\n")
+    (tmp_path / "afile").write_text("")
+    r = _cli(["modes", "--json", "m.json", "--plot", "afile/p.png"], tmp_path)
+    assert r.returncode == 1 and r.stderr.count("\n") == 1, r.stderr
+    assert (tmp_path / "m.json").read_text() == "old\n"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["afile", "m.json"]
 
 
 def test_runup_outputs_0644_with_provenance_and_balancers_off(tmp_path):

@@ -50,6 +50,14 @@ KERNEL_BETA = 7.0
 #: Block length bounds [revolutions].
 MIN_BLOCK_REVS = 8
 MAX_BLOCK_REVS = 64
+#: Most speeds of a tracked speed grid (1 rpm steps over 20 000 rpm).
+MAX_GRID_SPEEDS = 20_000
+
+
+#: Most orders one ``--orders`` may ask for, and the highest order (order 200 of 6000 rpm is
+#: 20 kHz; the limits keep a typo from asking for terabytes).
+MAX_ORDERS = 2000
+MAX_ORDER = 200.0
 
 
 def parse_orders(text: str, option: str = "--orders") -> np.ndarray:
@@ -62,18 +70,26 @@ def parse_orders(text: str, option: str = "--orders") -> np.ndarray:
         try:
             if ":" in part:
                 a, b, c = (float(x) for x in part.split(":"))
-                if not (c > 0 and b >= a):
+                if not (math.isfinite(a + b + c) and c > 0 and b >= a):
                     raise ValueError
-                n = int(math.floor((b - a) / c + 1e-9)) + 1
-                values.extend(a + c * np.arange(n))
+                n = (b - a) / c + 1
+                if not n <= MAX_ORDERS - len(values):
+                    raise InputError(f"{part!r} asks for {n:.3g} orders; at most "
+                                     f"{MAX_ORDERS}", key=option)
+                values.extend(a + c * np.arange(int(math.floor(n - 1 + 1e-9)) + 1))
             else:
                 values.append(float(part))
+        except InputError:
+            raise
         except ValueError:
             raise InputError(f"cannot read orders {part!r} (use 0.5:8:0.5 or 1,2,4)",
                              key=option) from None
     arr = np.unique(np.round(np.array(values, float), 12))
     if arr.size == 0 or not np.all(np.isfinite(arr)) or np.any(arr <= 0):
         raise InputError("orders must be finite and > 0", key=option)
+    if arr.size > MAX_ORDERS or arr[-1] > MAX_ORDER:
+        raise InputError(f"{arr.size} orders up to {arr[-1]:g}; at most {MAX_ORDERS} orders "
+                         f"up to order {MAX_ORDER:g}", key=option)
     return arr
 
 
@@ -113,6 +129,10 @@ def speed_grid(profile, rpm_step, block_revs, *, margin_s=0.0, file=None, key="r
     t, n, th = profile.time[i0:i1 + 1], profile.rpm[i0:i1 + 1], profile.angle[i0:i1 + 1]
     if not (math.isfinite(rpm_step) and rpm_step > 0):
         raise InputError("must be > 0 [rpm]", key="--rpm-step")
+    n_grid = (n.max() - n.min()) / rpm_step
+    if not n_grid <= MAX_GRID_SPEEDS:
+        raise InputError(f"{n_grid:.3g} grid speeds over {n.min():.0f}..{n.max():.0f} rpm; "
+                         f"at most {MAX_GRID_SPEEDS} (choose a larger step)", key="--rpm-step")
     lo_ok = np.interp(th[0] + np.pi * block_revs, th, t) + margin_s
     hi_ok = np.interp(th[-1] - np.pi * block_revs, th, t) - margin_s
     grid = rpm_step * np.arange(math.ceil(n.min() / rpm_step), math.floor(n.max() / rpm_step)

@@ -33,6 +33,10 @@ TRIGGER_LOW = 0.4
 #: interval is a spike.
 MISSING_TOOTH_TOLERANCE = 0.3
 SPIKE_RATIO = 0.3
+#: Fewest tacho edges a speed profile is fitted to (a cubic spline with end conditions),
+#: and the most pulses per revolution accepted.
+MIN_TACHO_EDGES = 8
+MAX_PULSES_PER_REV = 100_000
 
 
 @dataclass
@@ -126,9 +130,9 @@ def tacho_edges(time, tacho, *, file=None, key="tacho"):
     state = marker[idx]
     state[marker[idx] < 0] = 0
     rise = np.flatnonzero((state[1:] == 1) & (state[:-1] == 0)) + 1
-    if rise.size < 3:
-        raise InputError(f"tacho has no edges ({rise.size} rising edges found)", file=file,
-                         key=key)
+    if rise.size < MIN_TACHO_EDGES:
+        raise InputError(f"tacho has too few edges ({rise.size} rising edges found, at least "
+                         f"{MIN_TACHO_EDGES} needed)", file=file, key=key)
     # the sample at index `rise` is the first above `up`; interpolate the crossing of `up`
     i1 = rise
     i0 = np.maximum(rise - 1, 0)
@@ -177,10 +181,15 @@ def speed_from_tacho(time, tacho, pulses_per_rev, *, smooth_s=0.1, file=None,
     """Speed profile from a tacho pulse train (see module docstring)."""
     from scipy.interpolate import make_lsq_spline
     time = np.asarray(time, float)
-    if not (pulses_per_rev >= 1 and float(pulses_per_rev).is_integer()):
-        raise InputError("must be a whole number >= 1", key="--pulses-per-rev")
+    if not (1 <= pulses_per_rev <= MAX_PULSES_PER_REV
+            and float(pulses_per_rev).is_integer()):
+        raise InputError(f"must be a whole number 1..{MAX_PULSES_PER_REV}",
+                         key="--pulses-per-rev")
     edges = tacho_edges(time, tacho, file=file, key=key)
     t_e, counts, notes = count_teeth(edges, file=file, key=key)
+    if t_e.size < MIN_TACHO_EDGES:
+        raise InputError(f"{t_e.size} usable tacho edges; at least {MIN_TACHO_EDGES} needed "
+                         "for a speed profile", file=file, key=key)
     theta_e = counts * (2.0 * np.pi / pulses_per_rev)
     n_int = int(max(0, min((t_e[-1] - t_e[0]) / smooth_s, (t_e.size - 4) / 4)))
     inner = np.linspace(t_e[0], t_e[-1], n_int + 2)[1:-1]

@@ -16,7 +16,9 @@ from powertrain import __version__
 class _Group(click.Group):
     """Turns :class:`powertrain.errors.InputError` into one line on stderr and exit code 1.
 
-    A command that fails removes the output files it had already written (no leftovers).
+    Every command runs inside one :class:`~powertrain.iotools.atomic.OutputTransaction`:
+    its output files are staged and replace the targets together only when the command
+    succeeds; a failed command changes no file (docs/reference/outputs.md).
     """
 
     def main(self, args=None, *posargs, **kwargs):
@@ -26,19 +28,15 @@ class _Group(click.Group):
         return super().main(args, *posargs, **kwargs)
 
     def invoke(self, ctx):
+        from powertrain.cli.common import terminate_as_exit
         from powertrain.errors import InputError
-        from powertrain.iotools.atomic import discard_written, start_tracking
-        start_tracking()
+        from powertrain.iotools.atomic import OutputTransaction
         try:
-            return super().invoke(ctx)
+            with terminate_as_exit(), OutputTransaction():
+                return super().invoke(ctx)
         except InputError as exc:
-            discard_written()
             click.echo(f"error: {exc.one_line()}", err=True)
             sys.exit(1)
-        except BaseException as exc:
-            if getattr(exc, "exit_code", getattr(exc, "code", 1)):  # not a clean exit
-                discard_written()
-            raise
 
 
 @click.group(cls=_Group, context_settings={"help_option_names": ["-h", "--help"]})

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import contextlib
 import math
 
 import click
@@ -137,23 +138,35 @@ def write_json(path, text: str, provenance: dict, key: str = "--json") -> None:
         fh.write(out)
 
 
-def checked_runup(engine, engine_path, run, *args, **kwargs):
-    """``run(engine, *args, **kwargs)`` (a run-up), with a model that cannot be solved or a
-    result that is not finite reported as bad input naming the engine file (the last guard:
-    the checks at load catch the known causes first)."""
+def solved(solve, file, key):
+    """``solve()``, with a model that cannot be solved (singular, overflow) reported as bad
+    input naming ``file`` and ``key`` (the last guard: the checks at load catch the known
+    causes first)."""
     try:
         with np.errstate(all="ignore"):
-            result = run(engine, *args, **kwargs)
+            return solve()
     except InputError:
         raise
     except (ValueError, ArithmeticError, np.linalg.LinAlgError) as exc:
         raise InputError(f"the model cannot be solved ({type(exc).__name__}: "
-                         f"{str(exc)[:120]})", file=engine_path, key="engine") from None
-    for name in ("displacement", "velocity", "acceleration", "mount_force", "mean_mount_force"):
-        if not np.all(np.isfinite(getattr(result, name))):
-            raise InputError(f"the simulated {name.replace('_', ' ')} is not finite (NaN or "
-                             "inf): the engine's values are out of any physical range",
-                             file=engine_path, key="engine")
+                         f"{str(exc)[:120]})", file=file, key=key) from None
+
+
+def require_finite(values: dict, file, key) -> None:
+    """Refuse results holding NaN or inf (``values``: name -> array), naming the input."""
+    for name, value in values.items():
+        if value is not None and not np.all(np.isfinite(value)):
+            raise InputError(f"the computed {name} is not finite (NaN or "
+                             "inf): values out of any physical range", file=file, key=key)
+
+
+def checked_runup(engine, engine_path, run, *args, **kwargs):
+    """``run(engine, *args, **kwargs)`` (a run-up) through :func:`solved`, its result
+    checked finite (errors name the engine file)."""
+    result = solved(lambda: run(engine, *args, **kwargs), engine_path, "engine")
+    require_finite({name.replace("_", " "): getattr(result, name) for name in (
+        "displacement", "velocity", "acceleration", "mount_force", "mean_mount_force")},
+        engine_path, "engine")
     return result
 
 
@@ -208,3 +221,23 @@ def plot_form_options(func):
     ]):
         func = option(func)
     return func
+
+
+@contextlib.contextmanager
+def terminate_as_exit():
+    """Turn SIGTERM (``kill PID``) into ``SystemExit(143)`` while a command runs, so that its
+    staged outputs and temporary files are removed as on any other failure (main thread
+    only; other signals keep their handlers)."""
+    import signal
+    import threading
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+
+    def stop(signum, frame):
+        raise SystemExit(128 + signum)
+    old = signal.signal(signal.SIGTERM, stop)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGTERM, old)

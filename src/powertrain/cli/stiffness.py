@@ -50,13 +50,20 @@ def stiffness(mount_file, engine_file, mount_dir, freq, method, fmt, plot, form,
 
     if (engine_mass is None) != (force is None):
         raise InputError("--engine-mass and --force go together", key="--engine-mass")
-    if engine_mass is not None and not engine_mass > 0:
-        raise InputError(f"must be positive, got {engine_mass}", key="--engine-mass")
+    if engine_mass is not None and not 0 < engine_mass < float("inf"):
+        raise InputError(f"must be positive and finite, got {engine_mass}", key="--engine-mass")
+    if force is not None and not abs(force) < float("inf"):
+        raise InputError(f"must be a finite force [N], got {force}", key="--force")
     freqs = parse_frequencies(freq)
     if method == "time" and freqs[0] <= 0:
         raise InputError("the time method needs frequencies > 0 Hz", key="--freq")
     model, label = _model(mount_file, engine_file, mount_dir)
-    table = stiffness_table(model, freqs, method=method, engine_mass=engine_mass, force=force)
+    from powertrain.cli.common import require_finite, solved
+    source = mount_file or engine_file
+    key = "parameters" if mount_file else f"--mount {mount_dir}"
+    table = solved(lambda: stiffness_table(model, freqs, method=method,
+                                           engine_mass=engine_mass, force=force), source, key)
+    require_finite(table.columns(), source, key)
     if plot:
         from powertrain.cli.common import cli_provenance, write_plot
         prov = cli_provenance()

@@ -60,8 +60,9 @@ def track(raw, map_file, rpm_column, tacho_column, pulses_per_rev, orders_spec, 
         raise click.UsageError("give --rpm or --tacho, not both")
     if tacho_column and pulses_per_rev is None:
         raise InputError("--tacho needs --pulses-per-rev N", key="--pulses-per-rev")
-    if pulses_per_rev is not None and pulses_per_rev < 1:
-        raise InputError("must be >= 1", key="--pulses-per-rev")
+    from powertrain.analysis.speed import MAX_PULSES_PER_REV
+    if pulses_per_rev is not None and not 1 <= pulses_per_rev <= MAX_PULSES_PER_REV:
+        raise InputError(f"must be 1..{MAX_PULSES_PER_REV}", key="--pulses-per-rev")
     orders = parse_orders(orders_spec)
     from powertrain.cli.common import check_outputs
     check_outputs(csv=csv_file, out=out, plot=plot, map=map_png)

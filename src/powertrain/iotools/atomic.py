@@ -1,23 +1,39 @@
-"""Atomic file output: write to a temporary file beside the target, then rename.
+"""Safe file output: every file is written to a temporary file beside its target and renamed
+onto the target only when complete; a command's outputs are committed together.
 
-A failure half-way leaves no half-written output behind, and the finished file gets the mode
-an ordinary ``open(path, "w")`` would give (``0666 & ~umask``: 0644 under umask 022), not the
-private 0600 of the temporary file. Every file renamed into place is remembered in
-:data:`WRITTEN` so that a command that fails after writing some of its outputs can remove them
-(:func:`discard_written`): a failed run leaves no output file.
+* :func:`atomic_path` / :func:`atomic_write` write one file. Outside a transaction the
+  temporary file replaces the target as soon as its block succeeds.
+* :class:`OutputTransaction` (``with OutputTransaction(): ...``, used by the CLI for every
+  command) *stages* every file written inside it: nothing in the user's folders is replaced
+  until the block ends without error; then all staged files are renamed onto their targets
+  together, under an exclusive lock of each target folder, so two concurrent runs writing
+  the same paths leave the complete set of one of them. A failure anywhere (also a failure
+  after some outputs were written) removes the staged files and the folders the run created:
+  a failed command never deletes or truncates a file it did not create.
+* Temporary files are named ``.NAME.pt<PID>-<random>.tmp``. Every exit path through Python
+  removes them; a process killed outright (SIGKILL, power loss) cannot, so every later write
+  into the same folder first removes the temporary files of processes that no longer run.
+* The finished file gets the mode an ordinary ``open(path, "w")`` would give
+  (``0666 & ~umask``: 0644 under umask 022), not the private 0600 of the temporary file.
 """
 
 from __future__ import annotations
 
 import contextlib
+import errno
 import os
+import re
 import tempfile
 from pathlib import Path
 
 from powertrain.errors import InputError
 
-#: Files written by :func:`atomic_path` since the last :func:`start_tracking`.
-WRITTEN: list[Path] = []
+#: Longest file name [bytes] we write: the file system's limit (255 on Linux and macOS)
+#: minus room for the temporary name's prefix and suffix.
+MAX_NAME_BYTES = 255 - 40
+_TEMP = re.compile(r"^\..+\.pt(\d+)-[A-Za-z0-9_]+\.tmp$")
+#: The transaction in progress (innermost), or None.
+_ACTIVE: list = []
 
 
 def current_umask() -> int:
@@ -34,64 +50,198 @@ def current_umask() -> int:
     return mask
 
 
-def start_tracking() -> None:
-    """Forget earlier outputs: a new command starts."""
-    WRITTEN.clear()
+def _pid_alive(pid: int) -> bool:
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except (PermissionError, OverflowError, OSError):
+        return True                         # someone else's process (or unknowable): keep
+    return True
 
 
-def discard_written() -> list[Path]:
-    """Remove every output written since :func:`start_tracking` (after a failed command)."""
+def sweep_stale_temps(folder) -> list[Path]:
+    """Remove ``folder``'s temporary files left by killed powertrain processes."""
     removed = []
-    while WRITTEN:
-        path = WRITTEN.pop()
-        with contextlib.suppress(OSError):
-            path.unlink()
-            removed.append(path)
+    with contextlib.suppress(OSError):
+        for entry in os.scandir(folder):
+            m = _TEMP.match(entry.name)
+            if m and int(m.group(1)) != os.getpid() and not _pid_alive(int(m.group(1))):
+                with contextlib.suppress(OSError):
+                    os.unlink(entry.path)
+                    removed.append(Path(entry.path))
     return removed
 
 
 def check_writable(target, key: str | None = None) -> Path:
-    """Fail early, before any work, if ``target`` cannot be written (folder or path clash)."""
+    """Fail early, before any work, if ``target`` cannot be written (folder or path clash,
+    a name too long for the file system)."""
     target = Path(target)
-    if target.is_dir():
-        raise InputError("is a folder, not a file", file=target, key=key)
-    parent = target.parent
-    for folder in [parent, *parent.parents]:
-        if folder.exists():
-            if not folder.is_dir():
-                raise InputError(f"cannot write: {folder} is not a folder", file=target, key=key)
-            if not os.access(folder, os.W_OK | os.X_OK) and folder == parent:
-                raise InputError("cannot write: folder not writable", file=target, key=key)
-            break
+    if len(target.name.encode("utf-8", "surrogateescape")) > MAX_NAME_BYTES or \
+            any(len(p.encode("utf-8", "surrogateescape")) > 255 for p in target.parts):
+        raise InputError(f"file name too long (at most {MAX_NAME_BYTES} bytes)", file=target,
+                         key=key)
+    try:
+        if target.is_dir():
+            raise InputError("is a folder, not a file", file=target, key=key)
+        parent = target.parent
+        for folder in [parent, *parent.parents]:
+            if folder.exists():
+                if not folder.is_dir():
+                    raise InputError(f"cannot write: {folder} is not a folder", file=target,
+                                     key=key)
+                if not os.access(folder, os.W_OK | os.X_OK) and folder == parent:
+                    raise InputError("cannot write: folder not writable", file=target,
+                                     key=key)
+                break
+    except OSError as exc:
+        raise InputError(f"cannot write ({exc.strerror or exc})", file=target, key=key) \
+            from None
     return target
+
+
+def _make_parent(target: Path, created: list) -> None:
+    """Create the target's missing folders, remembering them (deepest last)."""
+    missing = [p for p in [target.parent, *target.parent.parents] if not p.exists()]
+    for folder in reversed(missing):
+        try:
+            folder.mkdir()
+        except FileExistsError:
+            continue
+        created.append(folder)
+
+
+def _cannot_write(target, exc) -> InputError:
+    return InputError(f"cannot write ({exc.strerror or exc})", file=target)
+
+
+def _replace(tmp, target) -> None:
+    os.chmod(tmp, 0o666 & ~current_umask())
+    try:
+        os.replace(tmp, target)
+    except OSError as exc:
+        raise _cannot_write(target, exc) from None
+
+
+class OutputTransaction:
+    """Stage every file written inside the ``with`` block; commit all of them when the
+    block succeeds, remove them (and the folders created for them) when it fails."""
+
+    def __init__(self):
+        self.staged: dict = {}              # target -> temporary file
+        self.created: list = []             # folders created for the outputs
+        self.committed: list = []
+
+    def __enter__(self):
+        _ACTIVE.append(self)
+        return self
+
+    def __exit__(self, exc_type, exc, tb):
+        _ACTIVE.remove(self)
+        if exc_type is None or not _failed(exc):
+            self.commit()
+        else:
+            self.abort()
+        return False
+
+    def stage(self, target: Path, tmp: Path) -> None:
+        """Keep ``tmp`` until the commit (a second write of one target replaces the first)."""
+        old = self.staged.pop(target, None)
+        if old is not None:
+            with contextlib.suppress(OSError):
+                os.unlink(old)
+        self.staged[target] = tmp
+
+    def commit(self) -> list[Path]:
+        """Rename every staged file onto its target, each target folder locked meanwhile."""
+        folders = sorted({str(t.parent.resolve()) for t in self.staged})
+        with contextlib.ExitStack() as locks:
+            for folder in folders:
+                locks.enter_context(_folder_lock(folder))
+            try:
+                for target, tmp in list(self.staged.items()):
+                    _replace(tmp, target)
+                    del self.staged[target]
+                    self.committed.append(target)
+            finally:
+                self.abort()
+        return self.committed
+
+    def abort(self) -> None:
+        """Remove the staged files and the (now empty) folders created for them."""
+        for tmp in self.staged.values():
+            with contextlib.suppress(OSError):
+                os.unlink(tmp)
+        self.staged.clear()
+        for folder in reversed(self.created):
+            with contextlib.suppress(OSError):
+                folder.rmdir()
+        self.created.clear()
+
+
+def _failed(exc) -> bool:
+    """An exception other than a clean exit (``SystemExit(0)``, click's ``Exit(0)``)."""
+    if isinstance(exc, SystemExit):
+        return exc.code not in (None, 0)
+    return getattr(exc, "exit_code", 1) != 0
+
+
+@contextlib.contextmanager
+def _folder_lock(folder):
+    """Exclusive ``flock`` of a folder (POSIX); no lock where the OS has none."""
+    try:
+        import fcntl
+    except ImportError:                  # pragma: no cover (Windows)
+        yield
+        return
+    try:
+        fd = os.open(folder, os.O_RDONLY)
+    except OSError:
+        yield
+        return
+    try:
+        with contextlib.suppress(OSError):
+            fcntl.flock(fd, fcntl.LOCK_EX)
+        yield
+    finally:
+        os.close(fd)                     # closing releases the lock
 
 
 @contextlib.contextmanager
 def atomic_path(target):
-    """Yield a temporary path in the target's folder; rename it onto ``target`` on success."""
+    """Yield a temporary path in the target's folder; on success it replaces ``target``
+    (at once, or at the commit of the :class:`OutputTransaction` in progress)."""
     target = Path(target)
+    txn = _ACTIVE[-1] if _ACTIVE else None
+    created = txn.created if txn is not None else []
     try:
-        target.parent.mkdir(parents=True, exist_ok=True)
-        fd, tmp = tempfile.mkstemp(prefix=f".{target.name}.", suffix=".tmp", dir=target.parent)
+        _make_parent(target, created)
+        sweep_stale_temps(target.parent)
+        fd, tmp = tempfile.mkstemp(prefix=f".{target.name}.pt{os.getpid()}-", suffix=".tmp",
+                                   dir=target.parent)
     except OSError as exc:
-        raise InputError(f"cannot write ({exc.strerror or exc})", file=target) from None
+        if exc.errno == errno.ENAMETOOLONG:
+            raise InputError("file name too long", file=target) from None
+        raise _cannot_write(target, exc) from None
     os.close(fd)
+    tmp = Path(tmp)
+    keep = False
     try:
-        yield Path(tmp)
-        os.chmod(tmp, 0o666 & ~current_umask())
-        try:
-            os.replace(tmp, target)
-        except OSError as exc:
-            raise InputError(f"cannot write ({exc.strerror or exc})", file=target) from None
-        WRITTEN.append(target)
+        yield tmp
+        if txn is None:
+            _replace(tmp, target)
+        else:
+            txn.stage(target, tmp)
+            keep = True
     finally:
-        if os.path.exists(tmp):
-            os.unlink(tmp)
+        if not keep and tmp.exists():
+            tmp.unlink()
 
 
 @contextlib.contextmanager
 def atomic_write(target, mode="w", **kwargs):
-    """Open a temporary file for writing; it replaces ``target`` only if the block succeeds."""
+    """Open a temporary file for writing; it replaces ``target`` only if the block succeeds
+    (see :func:`atomic_path`)."""
     with atomic_path(target) as tmp:
         with open(tmp, mode, **kwargs) as fh:
             yield fh

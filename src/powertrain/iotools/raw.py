@@ -78,7 +78,9 @@ def read_raw(path, channel_map: ChannelMap | None = None, *, rpm: str | None = N
     RawRecording
         Validated, SI.
     """
+    from powertrain.iotools.textfile import check_regular_file
     path = str(path)
+    check_regular_file(path)
     fmt = detect_format(path)
     if fmt == "hdf5":
         from powertrain.iotools.raw_hdf5 import read_hdf5_signals as reader

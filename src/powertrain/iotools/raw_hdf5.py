@@ -28,6 +28,11 @@ from powertrain.iotools.raw import FileSignals
 FORMAT = "powertrain-raw"
 
 
+#: Most values one raw HDF5 file may declare over the datasets read (a declared shape is
+#: checked before reading: a chunked dataset of 2**40 unwritten values is a few bytes).
+MAX_VALUES = 2 ** 27
+
+
 def _unit(ds):
     u = ds.attrs.get("unit", "")
     return u.decode() if isinstance(u, bytes) else str(u)
@@ -41,54 +46,96 @@ def read_hdf5_signals(path, channel_map=None) -> FileSignals:
     except OSError as exc:
         raise InputError(f"cannot open HDF5 file ({exc})", file=path) from None
     with h5:
-        fmt = h5.attrs.get("format", "")
-        fmt = fmt.decode() if isinstance(fmt, bytes) else str(fmt)
-        if fmt == "powertrain-runup":
-            raise InputError("this is a run-up result (order curves), not raw time data; "
-                             "give it to 'compare' or 'diagnose'", file=path, key="format")
-        if fmt == FORMAT:
-            return _read_own(h5, path)
-        if channel_map is None:
-            raise InputError(f"not a '{FORMAT}' HDF5 file; give a --channels map naming its "
-                             "datasets", file=path, key="format")
-        return _read_mapped(h5, path, channel_map)
+        try:
+            return _read(h5, path, channel_map)
+        except (KeyError, OSError, RuntimeError, TypeError) as exc:
+            # h5py's errors for broken links and unreadable objects
+            raise InputError(f"unreadable HDF5 object ({str(exc)[:80]})", file=path) from None
 
 
-def _dataset(h5, name, path):
-    if name not in h5 or not hasattr(h5[name], "shape"):
-        raise InputError("dataset not found", file=path, key=name)
-    data = h5[name][()]
-    if np.ndim(data) != 1 or not np.issubdtype(np.asarray(data).dtype, np.number):
+def _read(h5, path, channel_map):
+    fmt = _text_attr(h5, "format", path)
+    if fmt == "powertrain-runup":
+        raise InputError("this is a run-up result (order curves), not raw time data; "
+                         "give it to 'compare' or 'diagnose'", file=path, key="format")
+    if fmt == FORMAT:
+        return _read_own(h5, path)
+    if channel_map is None:
+        raise InputError(f"not a '{FORMAT}' HDF5 file; give a --channels map naming its "
+                         "datasets", file=path, key="format")
+    return _read_mapped(h5, path, channel_map)
+
+
+def _text_attr(h5, name, path, default=""):
+    value = h5.attrs.get(name, default)
+    value = value.decode(errors="replace") if isinstance(value, bytes) else value
+    if not isinstance(value, str):
+        raise InputError("expected a text attribute", file=path, key=f"/@{name}")
+    return value
+
+
+class _Budget:
+    """Values left to read from one file (:data:`MAX_VALUES` in all)."""
+
+    def __init__(self):
+        self.left = MAX_VALUES
+
+
+def _dataset(h5, name, path, budget):
+    obj = h5.get(name)
+    if obj is None or not hasattr(obj, "shape") or not hasattr(obj, "dtype"):
+        raise InputError("dataset not found (or a group, or a broken link)", file=path,
+                         key=name)
+    if len(obj.shape or ()) != 1 or obj.dtype.kind not in "iuf":
         raise InputError("expected a 1-D numeric dataset", file=path, key=name)
-    return np.asarray(data, float)
+    if obj.shape[0] > budget.left:
+        raise InputError(f"declares {obj.shape[0]:.3g} values; at most {MAX_VALUES} in a "
+                         "file", file=path, key=name)
+    budget.left -= obj.shape[0]
+    return np.asarray(obj[()], float)
+
+
+def _comments(h5, path):
+    text = _text_attr(h5, "comments", path, "[]")
+    try:
+        comments = json.loads(text)
+    except ValueError:
+        raise InputError("not a JSON list of strings", file=path, key="/@comments") from None
+    if not isinstance(comments, list) or not all(isinstance(c, str) for c in comments):
+        raise InputError("not a JSON list of strings", file=path, key="/@comments")
+    return comments
 
 
 def _read_own(h5, path):
-    time = _dataset(h5, "time", path)
+    budget = _Budget()
+    time = _dataset(h5, "time", path, budget)
     unit = _unit(h5["time"]) or "s"
     from powertrain.units import to_si
     time = to_si(time, unit, "time", file=path, key="time")
     signals = []
     for name in ("rpm", "tacho"):
         if name in h5:
-            signals.append((name, _dataset(h5, name, path), _unit(h5[name])))
-    if "channels" not in h5:
+            signals.append((name, _dataset(h5, name, path, budget), _unit(h5[name])))
+    group = h5.get("channels")
+    if group is None or not hasattr(group, "items") or hasattr(group, "shape"):
         raise InputError("no /channels group", file=path, key="channels")
-    for name, ds in h5["channels"].items():
-        signals.append((name, _dataset(h5, f"channels/{name}", path), _unit(ds)))
-    comments = json.loads(h5.attrs.get("comments", "[]"))
+    for name in group:
+        key = f"channels/{name}"
+        signals.append((name, _dataset(h5, key, path, budget), _unit(h5[key])))
+    comments = _comments(h5, path)
     if h5.attrs.get("synthetic", False) and not any("synthetic" in c.lower() for c in comments):
         comments.append("SYNTHETIC")
     return FileSignals(time, signals, str(path), "time", comments)
 
 
 def _read_mapped(h5, path, cmap):
+    budget = _Budget()
     tname = cmap.time or "time"
-    time = _dataset(h5, tname, path)
+    time = _dataset(h5, tname, path, budget)
     signals = []
     for name in [cmap.rpm, cmap.tacho, *cmap.channels]:
         if name:
-            signals.append((name, _dataset(h5, name, path), _unit(h5[name])))
+            signals.append((name, _dataset(h5, name, path, budget), _unit(h5[name])))
     return FileSignals(time, signals, str(path), tname)
 
 

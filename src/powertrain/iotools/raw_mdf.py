@@ -43,6 +43,10 @@ def read_mdf_signals(path, channel_map=None) -> FileSignals:
                     continue
                 sig = mdf.get(group=g, index=c)
                 t = np.asarray(sig.timestamps, float)
+                if t.size < 2 or np.size(sig.samples) != t.size:
+                    raise InputError(f"channel has {np.size(sig.samples)} samples at "
+                                     f"{t.size} times; a signal needs at least 2",
+                                     file=path, key=sig.name)
                 if time is None:
                     time = t
                 elif t.shape != time.shape or not np.allclose(t, time, rtol=0,

@@ -2,7 +2,10 @@
 
 Each dataset 58 holds one channel: its name is ID line 1 (``id1``), its unit the ordinate
 units label, its time base the even abscissa (``abscissa_min``, ``abscissa_inc``) or the
-abscissa values. All channels must share one time base. Names follow the
+abscissa values. All channels must share one time base. A truncated file is refused: it must
+end with the ``-1`` delimiter, every dataset started must be complete, and the datasets this
+module writes are numbered (ID line 4 ``powertrain dataset K of N``) so that a file cut at a
+dataset boundary is found too. Names follow the
 ``MOUNT.DIRECTION`` convention or a channel map; ``rpm`` and ``tacho`` name the speed and
 tacho channels unless the map (or ``--rpm/--tacho``) says otherwise.
 """
@@ -10,6 +13,7 @@ tacho channels unless the map (or ``--rpm/--tacho``) says otherwise.
 from __future__ import annotations
 
 import gc
+import re
 import warnings
 
 import numpy as np
@@ -37,16 +41,21 @@ def read_uff_signals(path, channel_map=None) -> FileSignals:
         raise InputError(f"not a readable universal file ({problem})", file=path)
     if isinstance(sets, dict):
         sets = [sets]
+    check_complete(path, len(sets))
     sets = [s for s in sets if s.get("type") == 58]
     if not sets:
         raise InputError("no dataset 58 (function at nodal DOF) in the universal file",
                          file=path)
+    _check_count(path, sets)
     time = None
     signals = []
     for k, s in enumerate(sets):
         name = str(s.get("id1", "")).strip() or f"dataset {k + 1}"
         x = np.asarray(s["x"], float)
         data = np.asarray(s["data"])
+        if x.size < 2 or data.shape != x.shape:
+            raise InputError(f"{data.size} values at {x.size} abscissa points; a signal "
+                             "needs at least 2", file=path, key=name)
         if np.iscomplexobj(data):
             raise InputError("complex data: expected a real time history", file=path, key=name)
         if time is None:
@@ -56,6 +65,39 @@ def read_uff_signals(path, channel_map=None) -> FileSignals:
         unit = str(s.get("ordinate_axis_units_lab", "")).strip()
         signals.append((name, data.astype(float), unit))
     return FileSignals(time, signals, str(path), "abscissa")
+
+
+#: Start of a dataset: the ``-1`` delimiter line, then the dataset number (``58`` or
+#: ``58b`` for binary).
+_COUNT = re.compile(r"powertrain dataset (\d+) of (\d+)")
+_DATASET_START = re.compile(rb"(?:^|\n)[ ]*-1[ ]*\r?\n[ ]*(\d+)b?[ \r\n]")
+
+
+def check_complete(path, n_read: int) -> None:
+    """Refuse a truncated file: it must end with the ``-1`` delimiter, and every dataset that
+    starts in it must have been read (pyuff silently drops an incomplete last one)."""
+    with open(path, "rb") as fh:
+        data = fh.read()
+    if not data.rstrip().endswith(b"-1") or not data.rstrip()[:-2].endswith((b"\n", b" ")):
+        raise InputError("file does not end with the '-1' delimiter line: truncated?",
+                         file=path)
+    started = len(_DATASET_START.findall(data))
+    if started > n_read:
+        raise InputError(f"{started} datasets start in the file but only {n_read} could be "
+                         "read: truncated or damaged", file=path)
+
+
+def _check_count(path, sets) -> None:
+    """Files written here number their datasets (ID line 4, ``powertrain dataset K of N``);
+    a file cut at a dataset boundary then misses some of 1..N."""
+    marks = [_COUNT.fullmatch(str(s.get("id4", "")).strip()) for s in sets]
+    totals = {int(m.group(2)) for m in marks if m}
+    if not totals:
+        return
+    seen = sorted(int(m.group(1)) for m in marks if m)
+    if len(totals) > 1 or seen != list(range(1, max(totals) + 1)):
+        raise InputError(f"{len(sets)} datasets, but the file's datasets are numbered "
+                         f"{seen[:3]}... of {max(totals)}: truncated or damaged", file=path)
 
 
 def write_raw_uff(path, recording) -> None:
@@ -77,7 +119,8 @@ def write_raw_uff(path, recording) -> None:
     sets = []
     for node, (name, values, unit, kind) in enumerate(rows, start=1):
         sets.append(pyuff.prepare_58(
-            binary=1, id1=name, id2=recording.source or "powertrain", func_type=1,
+            binary=1, id1=name, id2=recording.source or "powertrain",
+            id4=f"powertrain dataset {node} of {len(rows)}", func_type=1,
             rsp_node=node, rsp_dir=0, ref_node=0, ref_dir=0, data=np.asarray(values, float),
             x=recording.time, abscissa_spec_data_type=17, abscissa_axis_units_lab="s",
             ordinate_spec_data_type=SPECIFIC_DATA_TYPE[kind], ordinate_axis_units_lab=unit,

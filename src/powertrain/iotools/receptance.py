@@ -93,34 +93,64 @@ def _to_grid(data, path):
 
 
 def _read_uff(path, names):
+    from powertrain.iotools.raw_uff import check_complete
+    from powertrain.iotools.textfile import check_regular_file
+    check_regular_file(path)
     try:
         import pyuff
         sets = pyuff.UFF(path).read_sets()
     except Exception as exc:  # pyuff raises bare Exceptions on malformed files
         raise InputError(f"not a readable UFF file ({exc})"[:200], file=path) from None
     sets = [sets] if isinstance(sets, dict) else sets
+    check_complete(path, len(sets))
     data = {}
     for k, s in enumerate(sets):
         if s.get("type") != 58:
             continue
         key = f"dataset {k + 1}"
-        if int(s.get("func_type", 4)) not in (0, 4):
-            raise InputError(f"function type {s.get('func_type')} is not a frequency response "
-                             "function (4)", file=path, key=f"{key} func_type")
-        if int(s.get("ordinate_spec_data_type", 8)) in (11, 12):
-            raise InputError("expected receptance (displacement/force), got mobility or "
-                             "accelerance", file=path, key=f"{key} ordinate_spec_data_type")
-        r = _channel(f"{s.get('rsp_ent_name', '')}.{'xyz'[abs(int(s['rsp_dir'])) - 1]}",
-                     names, path, None, f"{key} rsp_ent_name")
-        e = _channel(f"{s.get('ref_ent_name', '')}.{'xyz'[abs(int(s['ref_dir'])) - 1]}",
-                     names, path, None, f"{key} ref_ent_name")
-        sign = np.sign(int(s["rsp_dir"])) * np.sign(int(s["ref_dir"]))
-        f = np.asarray(s["x"], float)
-        h = sign * np.asarray(s["data"], complex)
+        try:
+            r, e, f, h = _uff_record(s, names, path, key)
+        except (KeyError, ValueError, TypeError, OverflowError) as exc:
+            if isinstance(exc, InputError):
+                raise
+            raise InputError(f"malformed record ({type(exc).__name__}: {str(exc)[:60]})",
+                             file=path, key=key) from None
         data[r + e] = [(fi, hi, None) for fi, hi in zip(f, h)]
     if not data:
         raise InputError("no UFF 58 function records", file=path)
     return _to_grid(data, path)
+
+
+def _uff_direction(s, field, path, key) -> int:
+    d = int(s[field])
+    if not 1 <= abs(d) <= 3:
+        raise InputError(f"direction {d}: expected 1, 2 or 3 (x, y, z; negative = reversed)",
+                         file=path, key=f"{key} {field}")
+    return d
+
+
+def _uff_record(s, names, path, key):
+    """(response, excitation, frequencies, receptance) of one UFF 58 record."""
+    if int(s.get("func_type", 4)) not in (0, 4):
+        raise InputError(f"function type {s.get('func_type')} is not a frequency response "
+                         "function (4)", file=path, key=f"{key} func_type")
+    if int(s.get("ordinate_spec_data_type", 8)) in (11, 12):
+        raise InputError("expected receptance (displacement/force), got mobility or "
+                         "accelerance", file=path, key=f"{key} ordinate_spec_data_type")
+    rsp = _uff_direction(s, "rsp_dir", path, key)
+    ref = _uff_direction(s, "ref_dir", path, key)
+    r = _channel(f"{s.get('rsp_ent_name', '')}.{'xyz'[abs(rsp) - 1]}", names, path, None,
+                 f"{key} rsp_ent_name")
+    e = _channel(f"{s.get('ref_ent_name', '')}.{'xyz'[abs(ref) - 1]}", names, path, None,
+                 f"{key} ref_ent_name")
+    f = np.asarray(s["x"], float)
+    h = np.sign(rsp) * np.sign(ref) * np.asarray(s["data"], complex)
+    if f.ndim != 1 or f.shape != h.shape:
+        raise InputError(f"{h.size} values at {f.size} frequencies", file=path, key=key)
+    if not (np.all(np.isfinite(f)) and np.all(f >= 0) and np.all(np.isfinite(h))):
+        raise InputError("frequencies and receptances must be finite (frequencies >= 0)",
+                         file=path, key=key)
+    return r, e, f, h
 
 
 def _check_coverage(values, mounts, points, path):

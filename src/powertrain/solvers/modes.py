@@ -89,7 +89,8 @@ class Mode:
                 "dominant": self.dominant,
                 "ked_percent": {c: float(v) for c, v in zip(COORDINATES, self.ked_percent)},
                 "damped_frequency_hz": float(self.damped_frequency_hz),
-                "angle_to_torque_roll_axis_deg": float(self.angle_to_torque_roll_axis_deg),
+                "angle_to_torque_roll_axis_deg": _number_or_null(
+                    self.angle_to_torque_roll_axis_deg),
                 "shape": {c: float(v) for c, v in zip(COORDINATES, shape)},
                 "kind": self.kind,
                 "body_energy_percent": float(self.body_energy_percent)}
@@ -156,6 +157,12 @@ def kinetic_energy_percent(M6, phi) -> np.ndarray:
     phi = np.asarray(phi, complex)
     e = (np.conj(phi) * (M6 @ phi)).real
     return 100.0 * e / e.sum()
+
+
+def _number_or_null(value):
+    """``value`` as a float, or None (JSON null) where it is undefined (NaN: the rotation
+    axis of a mode without rotation)."""
+    return float(value) if np.isfinite(value) else None
 
 
 def _axis_angle_deg(a, b) -> float:
@@ -319,8 +326,8 @@ def rigid_body_modes(system, inertia, *, static=False, crank_axis=(1.0, 0.0, 0.0
     crank = np.asarray(crank_axis, float)
     tra_info = {"direction": [float(v) for v in tra],
                 "angle_to_crank_axis_deg": _axis_angle_deg(tra, crank),
-                "angles_to_mode_rotation_axes_deg": [m.angle_to_torque_roll_axis_deg
-                                                     for m in modes],
+                "angles_to_mode_rotation_axes_deg": [
+                    _number_or_null(m.angle_to_torque_roll_axis_deg) for m in modes],
                 "through": "centre of gravity"}
     method = ("static: static stiffness, undamped" if static else
               "dynamic: network dynamic stiffness at each mode's complex frequency "
@@ -330,12 +337,40 @@ def rigid_body_modes(system, inertia, *, static=False, crank_axis=(1.0, 0.0, 0.0
 
 
 def engine_modes(engine, *, static=False) -> ModesResult:
-    """:func:`rigid_body_modes` of an :class:`~powertrain.models.engine.Engine`."""
+    """:func:`rigid_body_modes` of an :class:`~powertrain.models.engine.Engine`.
+
+    Raises
+    ------
+    InputError
+        Naming the engine file, when the model cannot be solved or a mode is not finite
+        (values at the edge of the float range, a body mode that couples to nothing).
+    """
     from powertrain.assembly import assemble
+    from powertrain.errors import InputError
     b = engine.body
     chassis = engine.chassis if getattr(engine.chassis, "model", "") == "modal" else None
-    system = assemble(b.mass, b.cg, b.inertia, engine.mounts, chassis)
-    result = rigid_body_modes(system, b.inertia, static=static, engine_name=engine.name)
+    try:
+        with np.errstate(all="ignore"):
+            system = assemble(b.mass, b.cg, b.inertia, engine.mounts, chassis)
+            result = rigid_body_modes(system, b.inertia, static=static,
+                                      engine_name=engine.name)
+    except (ValueError, ArithmeticError, np.linalg.LinAlgError) as exc:
+        raise InputError(f"the modes cannot be computed ({type(exc).__name__}: "
+                         f"{str(exc)[:100]}): mount, body or chassis values out of any "
+                         "physical range", file=engine.file, key="mounts") from None
+    for i, mode in enumerate(result.modes, 1):
+        if not _finite(mode):
+            key = "chassis.modes" if mode.kind == "chassis" else "mounts"
+            raise InputError(f"mode {i} ({mode.kind}) is not finite (NaN or inf): values out "
+                             "of any physical range, or a body mode whose shape is zero at "
+                             "every mount", file=engine.file, key=key)
     result.meta["cg_m"] = [float(v) for v in b.cg]
     result.meta["mounts"] = engine.mount_names
     return result
+
+
+def _finite(mode: Mode) -> bool:
+    numbers = [mode.frequency_hz, mode.damping_ratio, mode.damped_frequency_hz,
+               mode.body_energy_percent]          # the axis angle may be undefined (NaN)
+    return bool(np.all(np.isfinite(numbers)) and np.all(np.isfinite(mode.shape))
+                and np.all(np.isfinite(mode.ked_percent)))
