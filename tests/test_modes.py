@@ -192,3 +192,40 @@ def test_modes_of_an_engine_file_without_excitation():
     res = CliRunner().invoke(main, ["modes", "--engine", str(REFERENCE)])
     assert res.exit_code == 0, res.output
     assert "torque-roll axis" in res.output
+
+
+def test_text_says_which_modes_and_pairs_them_with_the_static_ones():
+    """Issue 18: `runup` prints the undamped static-stiffness modes, `modes` the damped ones
+    at dynamic stiffness; each output says which, both sort by frequency, and `modes` pairs
+    each damped mode with the static mode of the most similar shape (MAC)."""
+    static = engine_modes(read_engine(DEFAULT_ENGINE_PATH), static=True)
+    damped = engine_modes(read_engine(DEFAULT_ENGINE_PATH))
+    assert "undamped" in static.to_text().splitlines()[0]
+    assert "static (0 Hz) stiffness" in static.to_text().splitlines()[0]
+    assert "damped, each with the mounts' dynamic stiffness" in damped.to_text()
+    # one-to-one pairing with the static modes, by shape
+    f_static = sorted(m.frequency_hz for m in static.modes)
+    paired = sorted(m.static_frequency_hz for m in damped.modes)
+    np.testing.assert_allclose(paired, f_static, rtol=1e-12)
+    assert all(0.0 < m.static_mac <= 1.0 + 1e-12 for m in damped.modes)
+    assert all(m.static_mac == pytest.approx(1.0) for m in static.modes)
+    # runup prints the static modes, labelled as such, with the same dominant coordinates
+    res = CliRunner().invoke(main, ["runup", "--solver", "harmonic", "--to", "1000"])
+    assert res.exit_code == 0, res.output
+    line = next(ln for ln in res.output.splitlines() if ln.startswith("rigid-body modes"))
+    assert "undamped" in line and "static stiffness" in line and "powertrain modes" in line
+    expected = ", ".join(f"{m.frequency_hz:.1f} ({m.dominant})" for m in static.modes)
+    assert expected in line
+
+
+def test_negative_energy_shares_are_explained():
+    """The static default modes carry a -0.2 % share (products of inertia); the table says
+    the shares are signed and that each row adds up to 100 %, and prints no '-0.0'."""
+    res = engine_modes(read_engine(DEFAULT_ENGINE_PATH), static=True)
+    lowest = min(float(np.min(m.ked_percent)) for m in res.modes)
+    assert lowest < -0.05
+    text = res.to_text()
+    assert f"energy shares are signed (lowest {lowest:.1f} %)" in text
+    assert "adds up to 100 %" in text and " -0.0 " not in text
+    for m in res.modes:
+        assert m.ked_percent.sum() == pytest.approx(100.0, abs=1e-9)

@@ -8,12 +8,18 @@ score).
 
 Rules:
 
-* The simulation is interpolated to the measured speeds linearly in rpm and linearly in log
-  level (:func:`~powertrain.analysis.compare.interpolate_log`); measured points outside the
+* The simulation is taken at the measured speeds: exactly where it was simulated there
+  (``powertrain compare`` simulates at the measured speeds by default), otherwise
+  interpolated linearly in rpm and linearly in log level
+  (:func:`~powertrain.analysis.compare.interpolate_log`); measured points outside the
   simulated speed range are not compared (never extrapolated) and are counted.
 * Measured points at or near the noise floor (below ``NOISE_FLOOR_MARGIN`` × floor, i.e.
   within 9.5 dB of it; :mod:`powertrain.analysis.noise_floor`) are excluded and counted,
   never scored as gaps.
+* Points where the simulation is below the noise floor itself while the measurement is above
+  the exclusion limit are "measured, not modelled": the model predicts nothing measurable
+  there (e.g. tracker leakage into an order the model does not excite). They are listed
+  apart (:attr:`ComparisonResult.not_modelled`) and never enter a dB gap.
 * Channels or quantities present on one side only are listed as missing, never scored as a
   zero level; so are channels with no scoreable point.
 * CSAC and CSF need at least :data:`MIN_CHANNELS_CSAC` channels at a speed (counted otherwise).
@@ -28,6 +34,7 @@ from typing import ClassVar
 import numpy as np
 
 from powertrain.analysis import compare as cm
+from powertrain.analysis.noise_floor import at_floor, below_floor, censoring_level
 from powertrain.iotools.measured import MeasuredRunup, quantity_sort_key
 
 #: Quantities always expected (the thesis's comparison, sec. 4.4); any other measured order is
@@ -43,9 +50,10 @@ RPM_TOL = 1e-6
 DEFINITIONS = {
     "gap_db": "20*log10(v_sim/v_meas) at each compared measured speed; positive = "
               "simulation higher",
-    "interpolation": "simulation interpolated to the measured speeds linearly in rpm and "
-                     "linearly in log level; no extrapolation (points outside the simulated "
-                     "speed range are not compared)",
+    "interpolation": "simulation taken at the measured speeds: exact where simulated there "
+                     "(simulated_at_measured_speeds), otherwise interpolated linearly in rpm "
+                     "and linearly in log level; no extrapolation (points outside the "
+                     "simulated speed range are not compared)",
     "rms_db": "sqrt(mean(gap_db^2)) over the compared speeds of the channel",
     "bias_db": "mean(gap_db) over the compared speeds of the channel",
     "max_abs_db": "max |gap_db| over the compared speeds, at rpm_at_max_abs_db",
@@ -63,10 +71,16 @@ DEFINITIONS = {
              "frfsm_sigma_db; our simplified score following the idea of the FRF similarity "
              "metric of Lee, Ahn & Kim (JSV 436, 2018): likelihood of the level error under "
              "a normal distribution, normalised to 0..1",
-    "noise_floor": "measured points below noise_floor_margin * noise_floor are excluded and "
-                   "counted (n_excluded_noise_floor), never scored",
+    "noise_floor": "measured points below noise_floor_margin * noise_floor "
+                   "(noise_floor_exclusion_m_per_s) are excluded and counted "
+                   "(n_excluded_noise_floor), never scored",
+    "measured_not_modelled": "simulation below noise_floor while the measurement is not "
+                             "excluded: the model predicts nothing measurable there; counted "
+                             "(n_measured_not_modelled), listed in measured_not_modelled, "
+                             "never scored; n_simulation_zero counts those where the "
+                             "simulation is exactly zero",
     "overall_rms_db": "sqrt(mean(gap_db^2)) pooled over every compared point of every "
-                      "channel and quantity",
+                      "channel and quantity (not the measured-not-modelled points)",
 }
 
 
@@ -87,6 +101,8 @@ class ChannelComparison:
     outside: np.ndarray            # bool: outside the simulated speed range
     at_floor: np.ndarray           # bool: at or near the noise floor (inside the range)
     sim_zero: np.ndarray           # bool: simulation exactly zero (cannot be scored in dB)
+    not_modelled: np.ndarray       # bool: simulation below the floor, measurement above
+    interpolated: np.ndarray       # bool: inside the range but not at a simulated speed
     scored: np.ndarray             # bool
     gap_db: np.ndarray             # at the scored speeds
     stats: dict = field(default_factory=dict)
@@ -101,6 +117,7 @@ class ChannelComparison:
             "n_excluded_noise_floor": int(self.at_floor.sum()),
             "n_outside_simulated_range": int(self.outside.sum()),
             "n_simulation_zero": int(self.sim_zero.sum()),
+            "n_measured_not_modelled": int(self.not_modelled.sum()),
             "rpm_compared": [_num(x) for x in r],
             "measured_m_per_s": [_num(x) for x in self.measured[self.scored]],
             "simulated_m_per_s": [_num(x) for x in self.simulated[self.scored]],
@@ -141,6 +158,9 @@ class ComparisonResult:
         RMS noise floor of the measurement [m/s].
     sim_rpm : ndarray
         Simulated speeds [rpm].
+    not_modelled : list of dict
+        Measured-not-modelled points per channel and quantity: ``{"mount", "direction",
+        "quantity", "rpm", "measured_m_per_s", "simulated_m_per_s"}``.
     """
 
     #: Quantities every comparison reports (plots draw them even when none was measured).
@@ -163,6 +183,17 @@ class ComparisonResult:
     sim_rpm: np.ndarray
     sigma_db: float = cm.FRFSM_SIGMA_DB
     info: dict = field(default_factory=dict)
+    not_modelled: list = field(default_factory=list)
+
+    @property
+    def n_not_modelled(self) -> int:
+        """Measured-not-modelled points over every channel and quantity."""
+        return sum(len(e["rpm"]) for e in self.not_modelled)
+
+    @property
+    def n_interpolated(self) -> int:
+        """Compared points whose simulated level was interpolated between simulated speeds."""
+        return int(sum((c.interpolated & c.scored).sum() for c in self.channels))
 
     @property
     def overall_rms_db(self) -> float:
@@ -209,6 +240,8 @@ class ComparisonResult:
             "notes": list(self.measured.notes) + list(self.info.get("notes", [])),
             "noise_floor_m_per_s": self.noise_floor,
             "noise_floor_margin": cm.NOISE_FLOOR_MARGIN,
+            "noise_floor_exclusion_m_per_s": censoring_level(self.noise_floor),
+            "simulated_at_measured_speeds": self.n_interpolated == 0,
             "frfsm_sigma_db": self.sigma_db,
             "min_channels_csac": MIN_CHANNELS_CSAC,
             "overall_rms_db": _num(self.overall_rms_db),
@@ -223,8 +256,11 @@ class ComparisonResult:
                 "n_points_outside_simulated_range": int(sum(c.outside.sum()
                                                             for c in self.channels)),
                 "n_points_simulation_zero": int(sum(c.sim_zero.sum() for c in self.channels)),
+                "n_points_measured_not_modelled": self.n_not_modelled,
+                "n_points_interpolated": self.n_interpolated,
             },
             "missing": list(self.missing),
+            "measured_not_modelled": list(self.not_modelled),
             "per_quantity": self.per_quantity(),
             "channels": [c.to_dict() for c in self.channels],
             "per_rpm": list(self.per_rpm),
@@ -302,38 +338,56 @@ def compare_runup(simulated, measured: MeasuredRunup, *, noise_floor=DEFAULT_NOI
     quantities = sorted(set(EXPECTED_QUANTITIES) | set(measured.quantities),
                         key=quantity_sort_key)
     sim_rpm = np.unique(np.concatenate([r for r, _ in simulated.curves.values()]))
-    channels, missing = [], []
+    channels, missing, not_modelled = [], [], []
     for mount, direction in channel_order:
         for q in quantities:
-            key = (mount, direction, q)
             where = {"mount": mount, "direction": direction, "quantity": q}
-            if key not in measured.curves:
-                missing.append({**where, "reason": "not in the measured data"})
+            key = (mount, direction, q)
+            if key not in measured.curves or key not in simulated.curves:
+                side = "measured data" if key not in measured.curves else "simulation"
+                missing.append({**where, "reason": f"not in the {side}"})
                 continue
-            if key not in simulated.curves:
-                missing.append({**where, "reason": "not in the simulation"})
-                continue
-            rpm_m, lev_m = measured.curves[key]
-            rpm_s, lev_s = simulated.curves[key]
-            sim, inside = cm.interpolate_log(rpm_s, lev_s, rpm_m)
-            floor = inside & cm.noise_floor_mask(lev_m, noise_floor)
-            zero = inside & ~floor & ~(sim > 0)
-            scored = inside & ~floor & ~zero
-            if not scored.any():
+            c = _compare_channel(where, measured.curves[key], simulated.curves[key],
+                                 noise_floor, sigma_db)
+            if c.not_modelled.any():
+                not_modelled.append({**where, **_points(c, c.not_modelled)})
+            if c.scored.any():
+                channels.append(c)
+            elif not c.not_modelled.any():
                 missing.append({**where, "reason":
-                                f"no comparable point ({int((~inside).sum())} outside the "
-                                f"simulated range, {int(floor.sum())} at the noise floor, "
-                                f"{int(zero.sum())} simulated as zero)"})
-                continue
-            gap = cm.level_gap_db(sim[scored], lev_m[scored])
-            stats = cm.gap_statistics(rpm_m[scored], gap)
-            stats["frac"] = cm.frac(sim[scored], lev_m[scored])
-            stats["frfsm"] = cm.frfsm_score(gap, sigma_db)
-            channels.append(ChannelComparison(mount, direction, q, rpm_m, lev_m, sim,
-                                              ~inside, floor, zero, scored, gap, stats))
+                                f"no comparable point ({int(c.outside.sum())} outside the "
+                                f"simulated range, {int(c.at_floor.sum())} at the noise "
+                                "floor)"})
     per_rpm = _per_rpm(channels)
     return ComparisonResult(channels, per_rpm, missing, measured, simulated,
-                            float(noise_floor), sim_rpm, sigma_db)
+                            float(noise_floor), sim_rpm, sigma_db, not_modelled=not_modelled)
+
+
+def _compare_channel(where, measured_curve, simulated_curve, noise_floor, sigma_db):
+    """Classify and score the measured points of one channel and quantity."""
+    rpm_m, lev_m = measured_curve
+    rpm_s, lev_s = simulated_curve
+    sim, inside = cm.interpolate_log(rpm_s, lev_s, rpm_m)
+    floor = inside & at_floor(lev_m, noise_floor)
+    unmodelled = inside & ~floor & below_floor(sim, noise_floor)
+    zero = unmodelled & ~(sim > 0)
+    scored = inside & ~floor & ~unmodelled
+    at_node = np.isin(np.round(rpm_m / RPM_TOL), np.round(np.asarray(rpm_s) / RPM_TOL))
+    gap = cm.level_gap_db(sim[scored], lev_m[scored])
+    stats = cm.gap_statistics(rpm_m[scored], gap)
+    if scored.any():
+        stats["frac"] = cm.frac(sim[scored], lev_m[scored])
+        stats["frfsm"] = cm.frfsm_score(gap, sigma_db)
+    return ChannelComparison(where["mount"], where["direction"], where["quantity"], rpm_m,
+                             lev_m, sim, ~inside, floor, zero, unmodelled, inside & ~at_node,
+                             scored, gap, stats)
+
+
+def _points(c: ChannelComparison, mask) -> dict:
+    """Speeds and both levels of the points of ``c`` selected by ``mask`` (JSON-ready)."""
+    return {"rpm": [_num(x) for x in c.rpm[mask]],
+            "measured_m_per_s": [_num(x) for x in c.measured[mask]],
+            "simulated_m_per_s": [_num(x) for x in c.simulated[mask]]}
 
 
 def _per_rpm(channels) -> list:

@@ -58,7 +58,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from powertrain.analysis.noise_floor import NOISE_FLOOR_MARGIN  # the one noise-floor rule
+from powertrain.analysis.noise_floor import NOISE_FLOOR_MARGIN  # noqa: F401 (re-export)
 
 #: Standard deviation of the Gaussian kernel of :func:`frfsm_score` [dB].
 FRFSM_SIGMA_DB = 6.0
@@ -256,28 +256,3 @@ def frfsm_score(gap_db, sigma_db=FRFSM_SIGMA_DB):
     if g.size == 0:
         return float("nan")
     return float(np.mean(np.exp(-g ** 2 / (2.0 * sigma_db ** 2))))
-
-
-def noise_floor_mask(measured, noise_floor, margin=NOISE_FLOOR_MARGIN):
-    r"""True where a measured level is at or near the noise floor (not to be scored).
-
-    A level counts as near the floor when
-    :math:`v_\mathrm{meas} < \text{margin}\cdot v_\mathrm{floor}` (default: the one rule of
-    :mod:`powertrain.analysis.noise_floor`, margin 3, i.e. within 9.5 dB of the floor).
-
-    Parameters
-    ----------
-    measured : array_like
-        Measured RMS levels [unit of ``noise_floor``].
-    noise_floor : float
-        RMS noise floor of the measurement [same unit]; 0 disables the test (zero levels
-        still count as at the floor).
-    margin : float
-        Factor above the floor below which a point is excluded [1].
-
-    Returns
-    -------
-    ndarray of bool
-    """
-    m = np.asarray(measured, float)
-    return (m < margin * noise_floor) | (m <= 0)

@@ -8,6 +8,10 @@ of RMS :math:`f` alone exceeds :math:`\kappa f` with probability :math:`e^{-\kap
 :math:`10\log_{10}(1 + 1/\kappa^2)` = 0.46 dB, below the measurements' own scatter. Used by
 ``powertrain compare`` (points excluded and counted) and ``powertrain diagnose`` (points
 censored).
+
+A *model* level below the floor itself (:func:`below_floor`) predicts nothing the
+measurement could see; where the measurement is above the censoring level there, the point is
+"measured, not modelled" (``powertrain compare`` reports it apart from the level gaps).
 """
 
 from __future__ import annotations
@@ -17,6 +21,8 @@ import numpy as np
 #: Multiple of the RMS noise floor below which a measured level is censored [1] (9.5 dB:
 #: noise alone exceeds it with probability e^-9 = 1.2e-4).
 NOISE_FLOOR_MARGIN = 3.0
+#: The margin in decibels, 20 log10(NOISE_FLOOR_MARGIN) [dB].
+NOISE_FLOOR_MARGIN_DB = float(20.0 * np.log10(NOISE_FLOOR_MARGIN))
 
 
 def censoring_level(noise_floor):
@@ -37,3 +43,11 @@ def above_floor(measured, noise_floor):
     m = np.asarray(measured, float)
     with np.errstate(invalid="ignore"):
         return np.isfinite(m) & (m >= censoring_level(noise_floor)) & (m > 0)
+
+
+def below_floor(level, noise_floor):
+    """True where a (simulated) level is below the noise floor itself, or not positive
+    (NaN stays False): a level the measurement could not see at all."""
+    v = np.asarray(level, float)
+    with np.errstate(invalid="ignore"):
+        return (v < noise_floor) | (v <= 0)

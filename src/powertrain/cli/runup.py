@@ -26,7 +26,7 @@ from powertrain.cli.common import speed_options, speed_steps
               help="Write the HDF5 result file (e.g. runup.h5); nothing is written unless "
                    "--out, --csv or --plot is given.")
 @click.option("--csv", "csv_file", type=click.Path(dir_okay=False),
-              help="Write the long-format CSV (mount,direction,quantity,rpm,"
+              help="Write the long-format CSV (columns mount, direction, quantity, rpm, "
                    "velocity_rms_mm_per_s).")
 @click.option("--plot", type=click.Path(dir_okay=False),
               help="Thesis figure set (Figs 45-71) as PNG.")
@@ -51,7 +51,9 @@ def runup(rpm_from, rpm_to, rpm_step, engine_file, solver, stepper, angle_step, 
           plot, path_plot, path_order, no_balancers, effect, sweep, raw_file, sample_rate, quiet):
     """Run-up: steady-state mount-point velocities at each speed, order analysed.
 
-    Prints the rigid-body modes and the synthesis (RMS sum of orders 0.5..8) velocity of the
+    Prints the rigid-body modes (undamped, at the mounts' static stiffness; 'powertrain modes'
+    gives the damped ones at dynamic stiffness) and the synthesis (RMS sum of orders 0.5..8)
+    velocity of the
     channels (every mount × engine X/Y/Z) per speed; writes HDF5, CSV and PNG only on request
     (--out, --csv, --plot) and names the files written.
 
@@ -146,14 +148,36 @@ def _check_path_plot(engine, path_order):
                          key="--path-order")
 
 
+def _labelled_modes(engine, frequencies_hz) -> str:
+    """``5.9 (y), 6.7 (z), ...``: each static-stiffness mode with its dominant coordinate
+    (largest kinetic-energy share), from the same eigenproblem as the run-up's
+    (:meth:`~powertrain.assembly.AssembledSystem.rigid_body_modes`), matched by frequency."""
+    import numpy as np
+
+    from powertrain.assembly import assemble
+    from powertrain.solvers.modes import COORDINATES, kinetic_energy_percent
+    b = engine.body
+    system = assemble(b.mass, b.cg, b.inertia, engine.mounts, getattr(engine, "chassis", None))
+    f_sys, shapes = system.rigid_body_modes()
+    out = []
+    for f in frequencies_hz:
+        k = int(np.argmin(np.abs(f_sys - f)))
+        dom = COORDINATES[int(np.argmax(kinetic_energy_percent(system.M[:6, :6],
+                                                               shapes[:, k])))]
+        out.append(f"{f:.1f} ({dom})" if abs(f_sys[k] - f) <= 1e-6 * max(f, 1.0)
+                   else f"{f:.1f}")
+    return ", ".join(out)
+
+
 def _print_table(result, engine, engine_path, solver, scenario):
     """Rigid-body modes and the synthesis velocity table."""
     import numpy as np
 
     from powertrain.cli.common import format_table
-    modes = ", ".join(f"{f:.1f}" for f in result.rigid_body_modes_hz)
     click.echo(f"engine: {engine.name} ({engine_path})")
-    click.echo(f"rigid-body modes [Hz]: {modes}")
+    click.echo("rigid-body modes, undamped, mounts at their static stiffness [Hz]: "
+               f"{_labelled_modes(engine, result.rigid_body_modes_hz)} (damped, at the "
+               "mounts' dynamic stiffness: 'powertrain modes')")
     if scenario:
         click.echo("effects: " + "; ".join(
             f"{name}(" + ", ".join(f"{k}={v:g}" for k, v in p.items()) + ")"

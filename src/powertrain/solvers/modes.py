@@ -21,7 +21,10 @@ Kinetic-energy distribution of mode :math:`\boldsymbol\varphi` over the coordina
 ``x, y, z, rx, ry, rz`` (CG translations and rotations about axes through the CG parallel to
 the engine axes): :math:`E_j = \mathrm{Re}\big(\bar\varphi_j(\mathbf M\boldsymbol\varphi)_j\big)
 / \mathrm{Re}\big(\boldsymbol\varphi^H\mathbf M\boldsymbol\varphi\big)`, in percent (sums to
-100; small negative entries come from products of inertia).
+100). The shares are signed: the products of inertia couple rx, ry and rz in
+:math:`\mathbf M`, and a damped mode's shape is complex, so a coordinate moving against the
+energy flow of its coupled partner has a slightly negative share (a few tenths of a percent);
+the text output says so whenever one is printed.
 
 Torque-roll axis: the axis about which the free body turns under a torque about the crank axis
 (engine X), :math:`\mathbf d = \mathbf I^{-1}\mathbf e_x/|\mathbf I^{-1}\mathbf e_x|` through
@@ -66,6 +69,12 @@ class Mode:
         Angle between the mode's rotation axis and the torque-roll axis [deg].
     kind : str
         ``rigid-body`` or ``chassis``.
+    static_frequency_hz : float
+        Frequency of the undamped static-stiffness mode of the most similar shape (paired
+        one to one by the modal assurance criterion; the frequency itself for the static
+        method) [Hz].
+    static_mac : float
+        Modal assurance criterion between this mode's shape and that static mode's [-].
     """
 
     frequency_hz: float
@@ -77,6 +86,8 @@ class Mode:
     kind: str = "rigid-body"
     iterations: int = 0
     body_energy_percent: float = 0.0
+    static_frequency_hz: float = float("nan")
+    static_mac: float = float("nan")
 
     @property
     def dominant(self) -> str:
@@ -93,7 +104,9 @@ class Mode:
                     self.angle_to_torque_roll_axis_deg),
                 "shape": {c: float(v) for c, v in zip(COORDINATES, shape)},
                 "kind": self.kind,
-                "body_energy_percent": float(self.body_energy_percent)}
+                "body_energy_percent": float(self.body_energy_percent),
+                "static_frequency_hz": float(self.static_frequency_hz),
+                "static_mac": float(self.static_mac)}
 
 
 @dataclass
@@ -117,20 +130,46 @@ class ModesResult:
             json.dump(self.to_dict(), fh, indent=2)
             fh.write("\n")
 
+    def is_static(self) -> bool:
+        """True for the undamped static-stiffness modes (``--static``)."""
+        return self.method.startswith("static")
+
+    def title(self) -> str:
+        """What these modes are, in one line."""
+        if self.is_static():
+            return (f"{self.engine}: rigid-body modes, undamped, mounts at their static "
+                    "(0 Hz) stiffness (the modes 'powertrain runup' prints)")
+        return (f"{self.engine}: rigid-body modes, damped, each with the mounts' dynamic "
+                "stiffness at its own frequency\n'static f': the undamped static-stiffness "
+                "mode ('powertrain runup', --static) of the most similar shape, paired one to "
+                "one; MAC: their shape correlation")
+
     def to_text(self) -> str:
-        head = (f"{'mode':>4}  {'f [Hz]':>7}  {'zeta':>6}  {'dominant':>8}  "
+        """Table of the modes, sorted by frequency, with a note on signed energy shares."""
+        static = self.is_static()
+        head = (f"{'mode':>4}  {'f [Hz]':>7}  {'zeta':>6}"
+                + ("" if static else f"  {'static f':>8}  {'MAC':>4}") + f"  {'dominant':>8}  "
                 + "  ".join(f"{c:>6}" for c in COORDINATES) + "  TRA angle")
-        lines = [f"{self.engine}: rigid-body modes ({self.method})", head, "-" * len(head)]
+        lines = [self.title(), head, "-" * len(head)]
         for i, m in enumerate(self.modes, 1):
             tag = "" if m.kind == "rigid-body" else f"  ({m.kind})"
-            lines.append(f"{i:4d}  {m.frequency_hz:7.3f}  {m.damping_ratio:6.3f}  "
-                         f"{m.dominant:>8}  "
-                         + "  ".join(f"{v:6.1f}" for v in m.ked_percent)
+            lines.append(f"{i:4d}  {m.frequency_hz:7.3f}  {m.damping_ratio:6.3f}"
+                         + ("" if static else f"  {m.static_frequency_hz:8.3f}  "
+                                               f"{m.static_mac:4.2f}")
+                         + f"  {m.dominant:>8}  "
+                         + "  ".join(f"{round(v, 1) or 0.0:6.1f}" for v in m.ked_percent)
                          + f"  {m.angle_to_torque_roll_axis_deg:6.1f} deg{tag}")
         t = self.torque_roll_axis
         d = ", ".join(f"{v:.4f}" for v in t["direction"])
         lines.append(f"torque-roll axis through the CG, direction [{d}] (engine axes), "
                      f"{t['angle_to_crank_axis_deg']:.2f} deg from the crank axis")
+        lowest = min(float(np.min(m.ked_percent)) for m in self.modes)
+        if round(lowest, 1) < 0:
+            lines.append(f"energy shares are signed (lowest {lowest:.1f} %): the products of "
+                         "inertia couple rx, ry, rz" + ("" if static else " and damped shapes "
+                                                        "are complex")
+                         + ", so a coordinate can hold a slightly negative share; each row "
+                         "adds up to 100 %")
         return "\n".join(lines)
 
     def plot(self, ax=None, *, path=None, provenance=None):
@@ -263,6 +302,17 @@ def _dynamic_roots(system, M6, omegas, vec):
     return out
 
 
+def _pair_with_static(M, shapes, static_shapes) -> list:
+    """``(index of the static mode, MAC)`` for each shape: the one-to-one pairing of largest
+    total MAC (:func:`scipy.optimize.linear_sum_assignment`)."""
+    from scipy.optimize import linear_sum_assignment
+    mac = np.array([[_mac(phi, static_shapes[:, j].astype(complex), M)
+                     for j in range(static_shapes.shape[1])] for phi in shapes])
+    rows, cols = linear_sum_assignment(-mac)
+    pair = dict(zip(rows, cols))
+    return [(int(pair[i]), float(mac[i, pair[i]])) for i in range(len(shapes))]
+
+
 def _static_condensed(system, keep) -> np.ndarray:
     """Static stiffness on the kept coordinates, the others condensed."""
     Kr = condense(system, keep, 0.0).real
@@ -309,7 +359,8 @@ def rigid_body_modes(system, inertia, *, static=False, crank_axis=(1.0, 0.0, 0.0
         roots = _dynamic_roots(system, MR, omegas, vec)
     M6 = MR[:6, :6]
     modes = []
-    for s, phi, its in roots:
+    pairs = _pair_with_static(MR, [phi for _, phi, _ in roots], vec)
+    for (s, phi, its), (k, mac) in zip(roots, pairs):
         phi = _normalise(MR, phi)
         e = (np.conj(phi) * (MR @ phi)).real
         body_share = 100.0 * e[6:].sum() / e.sum()
@@ -321,7 +372,9 @@ def rigid_body_modes(system, inertia, *, static=False, crank_axis=(1.0, 0.0, 0.0
                           ked_percent=ked, angle_to_torque_roll_axis_deg=_axis_angle_deg(
                               rot, tra), iterations=its,
                           kind="rigid-body" if body_share < 50.0 else "chassis",
-                          body_energy_percent=float(body_share)))
+                          body_energy_percent=float(body_share),
+                          static_frequency_hz=float(omegas[k] / (2 * np.pi)),
+                          static_mac=mac))
     modes.sort(key=lambda m: m.frequency_hz)
     crank = np.asarray(crank_axis, float)
     tra_info = {"direction": [float(v) for v in tra],

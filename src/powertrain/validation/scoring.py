@@ -36,6 +36,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from powertrain.analysis.noise_floor import censoring_level
+
 #: Targets of the benchmark (issue 11): top-1 and shrink at least, false claims at most,
 #: unexplained at least.
 TARGETS = {"top1": 0.9, "shrink_median": 0.7, "false_claims": 0.05, "unexplained_ok": 0.8}
@@ -221,7 +223,7 @@ def noise_free_shrink(where, heldout_rpm, truth_levels, measured_levels, floor):
             meas = measured_levels(m, d, q)
             s0 = meas * 10 ** (g0[:, c, k] / 20)
             s1 = meas * 10 ** (g1[:, c, k] / 20)
-            ok = held & np.isfinite(s0) & np.isfinite(s1) & (np.maximum(s0, t) >= 3 * floor)
+            ok = held & np.isfinite(s0) & np.isfinite(s1) & (np.maximum(s0, t) >= censoring_level(floor))
             b.append(20 * np.log10(s0[ok] / t[ok]))
             a.append(20 * np.log10(s1[ok] / t[ok]))
     b, a = np.concatenate(b), np.concatenate(a)
