@@ -17,7 +17,9 @@ import venv
 from pathlib import Path
 
 import pytest
+from click.testing import CliRunner
 
+from powertrain.cli import main
 from powertrain.data import FOLDERS, default_engine_path, shipped_files
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -30,6 +32,38 @@ def test_shipped_files_are_the_checkout_folders():
         shipped = {p.name for p in shipped_files(folder)}
         top = {p.name for p in (ROOT / folder).iterdir() if p.is_file()}
         assert shipped == top, folder
+
+
+def _examples(folder) -> object:
+    return CliRunner().invoke(main, ["examples", str(folder)])
+
+
+def test_examples_copies_every_shipped_file_and_leaves_identical_ones(tmp_path):
+    first = _examples(tmp_path / "tour")
+    assert first.exit_code == 0, first.output
+    n = sum(len(shipped_files(folder)) for folder in FOLDERS)
+    assert f"copied {n} files" in first.output
+    for folder in FOLDERS:
+        for src in shipped_files(folder):
+            assert (tmp_path / "tour" / folder / src.name).read_bytes() == src.read_bytes()
+    again = _examples(tmp_path / "tour")
+    assert again.exit_code == 0 and "copied 0 files" in again.output, again.output
+
+
+def test_examples_never_overwrites_and_copies_nothing_on_a_clash(tmp_path):
+    (tmp_path / "examples").mkdir()
+    mine = tmp_path / "examples" / "measured-runup.csv"
+    mine.write_text("my own measurement\n")
+    result = _examples(tmp_path)
+    assert result.exit_code == 1
+    assert result.output.strip().splitlines() == [
+        f"error: {mine}, key 'FOLDER': exists and differs from the shipped file; powertrain "
+        "examples never overwrites (move it or choose another folder); nothing copied"]
+    assert mine.read_text() == "my own measurement\n"
+    assert sorted(p.name for p in tmp_path.rglob("*")) == ["examples", "measured-runup.csv"]
+    (tmp_path / "file").write_text("x")
+    assert _examples(tmp_path / "file").exit_code == 1
+    assert (tmp_path / "file").read_text() == "x"
 
 
 def _third_party_paths() -> list[str]:
