@@ -7,9 +7,11 @@ The rules a docs author must know are in docs/extending.md, "Writing docs"; in s
   is not; ```sh, ```shell, ```console and ```zsh are refused so that no command escapes;
   ```python blocks must compile.
 * Each doc file runs in its own empty temporary folder in which the repository's
-  ``examples/``, ``engines/``, ``mounts/`` and ``scripts/`` are reachable by those names
-  (symbolic links); its commands run in order, so a later block may read what an earlier
-  one wrote. ``powertrain`` and ``python`` are the interpreter under test.
+  ``scripts/`` is reachable by that name (a symbolic link). A page that runs
+  ``powertrain examples DIR`` makes its own copy of the shipped files, as a user after a wheel
+  install does; on any other page ``examples/``, ``engines/`` and ``mounts/`` are linked too.
+  Its commands run in order, so a later block may read what an earlier one wrote.
+  ``powertrain`` and ``python`` are the interpreter under test.
 * One command is one line (backslash continuations joined); comment lines are dropped.
 * In a ``&&`` chain, install steps (``python3 -m venv``, ``. .venv/bin/activate``,
   ``source .venv/bin/activate``, ``pip install``) and the test-suite command
@@ -21,12 +23,21 @@ The rules a docs author must know are in docs/extending.md, "Writing docs"; in s
   output (``--out``, ``--csv``, ``--plot``, ``--json``, ``--truth``, ``--report``,
   ``--target-out``, ``--target-plot``, ``> FILE``) must exist afterwards, outside the
   repository (docs commands never write into the source tree).
+* A ```text block is a *shown output* when the fence before it is a ```bash block, only
+  prose (no heading) stands between, and its first line does not start with ``$ `` (a
+  ``$ COMMAND`` block is a transcript of a full run that is not repeated here). A shown
+  output must match what the bash block's commands printed (their stdout, or else their
+  stderr, in order): its lines are an excerpt of consecutive printed lines; a line that is
+  just ``...`` stands for any number of printed lines, and ``...`` inside a line for any
+  text; whitespace runs are equal whatever their length; every number within
+  ``NUMBER_REL_TOL`` relative or one unit of its last shown digit, whichever is larger.
 
 Failures name the doc file and line.
 """
 
 from __future__ import annotations
 
+import difflib
 import os
 import re
 import shlex
@@ -43,8 +54,16 @@ import pytest
 import powertrain
 
 ROOT = Path(__file__).resolve().parents[1]
-#: Folders of the repository reachable by their relative names from a doc command.
-LINKED = ("examples", "engines", "mounts", "scripts")
+#: Folders of the repository reachable by their relative names from every doc command.
+LINKED = ("scripts",)
+#: Linked too, unless the page copies the shipped files itself with ``powertrain examples``.
+SHIPPED = ("examples", "engines", "mounts")
+COPIES_SHIPPED = re.compile(r"(^|&&\s*)powertrain examples\b")
+#: A number in a shown output matches the printed one within this relative tolerance or one
+#: unit of its last shown digit, whichever is larger.
+NUMBER_REL_TOL = 0.01
+ELISION = "..."
+TRANSCRIPT = "$ "
 #: A command shown in the docs should take <= ~20 s; this is the hard stop (a loaded 2-core
 #: CI machine runs several times slower than the figures quoted in the docs).
 TIMEOUT_S = 120.0
@@ -75,6 +94,7 @@ class Command:
     text: str                 # what runs ("" when every part was skipped)
     skipped: list = field(default_factory=list)   # [(part, reason)]
     expect_exit: int = 0
+    block: int = 0            # first line of its ```bash block
 
     @property
     def where(self) -> str:
@@ -126,25 +146,60 @@ def skip_reason(part: str):
     return None
 
 
-def bash_blocks(path: Path, root: Path = ROOT) -> list:
-    """[(first line number, [lines])] of the ```bash blocks of a Markdown file."""
-    blocks, current, start, fence = [], None, 0, None
+@dataclass
+class Fence:
+    """One fenced block of a Markdown file."""
+
+    kind: str                 # the fence's language ("" if none)
+    start: int                # 1-based line of its first content line
+    lines: list
+    after_heading: bool       # a heading stands between the previous fence and this one
+
+
+def fenced_blocks(path: Path, root: Path = ROOT) -> list:
+    """Every fenced block of a Markdown file, in order (refused shell fences raise)."""
+    blocks, current, heading = [], None, False
     for number, raw in enumerate(path.read_text(encoding="utf-8").splitlines(), 1):
         stripped = raw.strip()
         if stripped.startswith("```"):
-            if fence is None:
-                fence = stripped[3:].strip().split()[0] if stripped[3:].strip() else ""
-                if fence in REFUSED_FENCES:
-                    raise AssertionError(f"{path.relative_to(root)}:{number}: ```{fence} block; "
+            if current is None:
+                kind = stripped[3:].strip().split()[0] if stripped[3:].strip() else ""
+                if kind in REFUSED_FENCES:
+                    raise AssertionError(f"{path.relative_to(root)}:{number}: ```{kind} block; "
                                          "shell commands go in ```bash (docs/extending.md)")
-                current, start = ([] if fence == RUN_FENCE else None), number + 1
+                current = Fence(kind, number + 1, [], heading)
             else:
-                if current is not None:
-                    blocks.append((start, current))
-                fence, current = None, None
+                blocks.append(current)
+                current, heading = None, False
         elif current is not None:
-            current.append(raw)
+            current.lines.append(raw)
+        elif stripped.startswith("#"):
+            heading = True
     return blocks
+
+
+def bash_blocks(path: Path, root: Path = ROOT) -> list:
+    """[(first line number, [lines])] of the ```bash blocks of a Markdown file."""
+    return [(b.start, b.lines) for b in fenced_blocks(path, root) if b.kind == RUN_FENCE]
+
+
+@dataclass
+class Shown:
+    """A ```text block showing what the ```bash block before it printed."""
+
+    doc: str
+    line: int                 # first line of the shown text
+    block: int                # first line of the bash block
+    lines: list
+
+
+def shown_outputs(path: Path, root: Path = ROOT) -> list:
+    """The shown outputs of a Markdown file (rule in the module docstring)."""
+    doc, blocks = str(path.relative_to(root)), fenced_blocks(path, root)
+    return [Shown(doc, here.start, before.start, here.lines)
+            for before, here in zip(blocks, blocks[1:])
+            if before.kind == RUN_FENCE and here.kind == "text" and not here.after_heading
+            and here.lines and not here.lines[0].startswith(TRANSCRIPT)]
 
 
 def commands_of(path: Path, root: Path = ROOT) -> list:
@@ -161,20 +216,20 @@ def commands_of(path: Path, root: Path = ROOT) -> list:
             if text.endswith("\\"):
                 pending += text[:-1].rstrip() + " "
                 continue
-            out.append(_command(doc, first, pending + text))
+            out.append(_command(doc, first, pending + text, start))
             pending = ""
         assert not pending, f"{doc}:{first}: block ends inside a continued line"
     return out
 
 
-def _command(doc: str, line: int, text: str) -> Command:
+def _command(doc: str, line: int, text: str, block: int = 0) -> Command:
     body, comment = strip_comment(text)
     run, skipped = [], []
     for part in _split_outside_quotes(body, "&&"):
         reason = skip_reason(part)
         (skipped.append((part.strip(), reason)) if reason else run.append(part.strip()))
     return Command(doc, line, " && ".join(run), skipped,
-                   1 if EXPECT_EXIT_1.search(comment) else 0)
+                   1 if EXPECT_EXIT_1.search(comment) else 0, block)
 
 
 def output_paths(command: str) -> list:
@@ -198,6 +253,7 @@ def output_paths(command: str) -> list:
 
 
 ALL_COMMANDS = {str(p.relative_to(ROOT)): commands_of(p) for p in doc_files()}
+SHOWN = {str(p.relative_to(ROOT)): shown_outputs(p) for p in doc_files()}
 RUN_FILES = [doc for doc, cmds in ALL_COMMANDS.items() if any(c.text for c in cmds)]
 SKIPPED_PARTS = [(c, part, reason) for cmds in ALL_COMMANDS.values() for c in cmds
                  for part, reason in c.skipped]
@@ -225,9 +281,9 @@ def doc_environment(bin_dir: Path) -> dict:
     return env
 
 
-def run_command(cmd: Command, cwd: Path, env: dict):
+def run_command(cmd: Command, cwd: Path, env: dict, printed: list | None = None):
     """Run one command; the failure message (None if it passed). The whole process group is
-    killed on timeout."""
+    killed on timeout. ``printed`` (if given) receives ``(stdout, stderr)``."""
     proc = subprocess.Popen(["bash", "-c", "set -o pipefail\n" + cmd.text], cwd=cwd, env=env,
                             stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
                             start_new_session=True)
@@ -239,6 +295,8 @@ def run_command(cmd: Command, cwd: Path, env: dict):
         return (f"{cmd.where}: `{cmd.text}` did not finish within {TIMEOUT_S:.0f} s (docs "
                 "commands must be quick: show the quick form, quote the full one in a "
                 "```text block)")
+    if printed is not None:
+        printed.append((out, err))
     if proc.returncode != cmd.expect_exit:
         tail = "\n".join((out + err).strip().splitlines()[-15:])
         return (f"{cmd.where}: `{cmd.text}` exited {proc.returncode} (expected "
@@ -260,15 +318,98 @@ def check_outputs(cmd: Command, cwd: Path):
     return None
 
 
+NUMBER = r"[-+]?(?:\d+(?:\.\d*)?|\.\d+)(?:[eE][-+]?\d+)?"
+
+
+def line_pattern(shown: str) -> tuple:
+    """(regex, [shown numbers]) of one shown line: ``...`` any text, whitespace runs
+    ``\\s+``, numbers captured."""
+    regex, numbers = [], []
+    for k, literal in enumerate(shown.strip().split(ELISION)):
+        if k:
+            regex.append(".*?")
+        for token in re.findall(rf"(?<![\w.]){NUMBER}|\s+|\w+|.", literal):
+            if re.fullmatch(NUMBER, token):
+                regex.append(rf"(?<![\w.])({NUMBER})")
+                numbers.append(token)
+            else:
+                regex.append(r"\s+" if token.isspace() else re.escape(token))
+    return "".join(regex), numbers
+
+
+def numbers_agree(shown: str, printed: str) -> bool:
+    """Within NUMBER_REL_TOL relative or one unit of the last shown digit."""
+    mantissa = re.split("[eE]", shown)[0]
+    digits = len(mantissa.split(".")[1]) if "." in mantissa else 0
+    exponent = int(re.split("[eE]", shown)[1]) if re.search("[eE]", shown) else 0
+    unit = 10.0 ** (exponent - digits)
+    tol = max(NUMBER_REL_TOL * abs(float(shown)), unit * (1 + 1e-9))
+    return abs(float(printed) - float(shown)) <= tol
+
+
+def line_matches(shown: str, printed: str) -> bool:
+    regex, numbers = line_pattern(shown)
+    found = re.fullmatch(regex, printed.strip())
+    return bool(found) and all(numbers_agree(a, b) for a, b in zip(numbers, found.groups()))
+
+
+def match_shown(shown: list, printed: list):
+    """None if the shown lines are an excerpt of the printed ones (``...`` lines skip any
+    number of lines), else the first shown line that has no match where it should."""
+    segments, current = [], []
+    for line in shown:
+        if line.strip() == ELISION:
+            segments.append(current)
+            current = []
+        else:
+            current.append(line)
+    segments.append(current)
+    cursor = 0
+    for segment in (s for s in segments if s):
+        for at in range(cursor, len(printed) - len(segment) + 1):
+            if all(line_matches(a, b) for a, b in zip(segment, printed[at:])):
+                cursor = at + len(segment)
+                break
+        else:
+            return _first_unmatched(segment, printed[cursor:])
+    return None
+
+
+def _first_unmatched(segment: list, printed: list) -> str:
+    """The first line of ``segment`` that matches no printed line, with the nearest one."""
+    lonely = [a for a in segment if not any(line_matches(a, b) for b in printed)]
+    if not lonely:
+        return f"lines from `{segment[0].strip()}` on are not consecutive printed lines"
+    near = difflib.get_close_matches(lonely[0].strip(), [b.strip() for b in printed], 1, 0)
+    return f"shown `{lonely[0].strip()}`; nearest printed `{near[0] if near else '(nothing)'}`"
+
+
+def check_shown(shown: Shown, printed: list):
+    """Failure message if a shown output matches neither the stdout nor the stderr."""
+    streams = ["".join(out for out, _ in printed), "".join(err for _, err in printed)]
+    misses = [match_shown(shown.lines, stream.splitlines()) for stream in streams]
+    if all(misses):
+        return (f"{shown.doc}:{shown.line}: the ```text block does not show what the commands "
+                f"of {shown.doc}:{shown.block} printed: {misses[0]} (rule: docs/extending.md, "
+                "'Writing docs')")
+    return None
+
+
 def run_doc(doc: str, folder: Path, env: dict):
-    """Run a doc file's commands in order in ``folder``; the first failure (None if none)."""
-    for name in LINKED:
+    """Run a doc file's commands in order in ``folder`` and compare its shown outputs; the
+    first failing command, or every shown output that does not match (None if all pass)."""
+    commands = ALL_COMMANDS[doc]
+    copies = any(COPIES_SHIPPED.search(c.text) for c in commands)
+    for name in LINKED + (() if copies else SHIPPED):
         (folder / name).symlink_to(ROOT / name, target_is_directory=True)
-    for cmd in ALL_COMMANDS[doc]:
-        failure = run_command(cmd, folder, env) if cmd.text else None
+    printed = {}
+    for cmd in commands:
+        failure = (run_command(cmd, folder, env, printed.setdefault(cmd.block, []))
+                   if cmd.text else None)
         if failure:
             return failure
-    return None
+    misses = [check_shown(shown, printed.get(shown.block, [])) for shown in SHOWN[doc]]
+    return "\n".join(m for m in misses if m) or None
 
 
 # ----------------------------------------------------------------------------- the parser

@@ -17,7 +17,9 @@ import venv
 from pathlib import Path
 
 import pytest
+from click.testing import CliRunner
 
+from powertrain.cli import main
 from powertrain.data import FOLDERS, default_engine_path, shipped_files
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -30,6 +32,38 @@ def test_shipped_files_are_the_checkout_folders():
         shipped = {p.name for p in shipped_files(folder)}
         top = {p.name for p in (ROOT / folder).iterdir() if p.is_file()}
         assert shipped == top, folder
+
+
+def _examples(folder) -> object:
+    return CliRunner().invoke(main, ["examples", str(folder)])
+
+
+def test_examples_copies_every_shipped_file_and_leaves_identical_ones(tmp_path):
+    first = _examples(tmp_path / "tour")
+    assert first.exit_code == 0, first.output
+    n = sum(len(shipped_files(folder)) for folder in FOLDERS)
+    assert f"copied {n} files" in first.output
+    for folder in FOLDERS:
+        for src in shipped_files(folder):
+            assert (tmp_path / "tour" / folder / src.name).read_bytes() == src.read_bytes()
+    again = _examples(tmp_path / "tour")
+    assert again.exit_code == 0 and "copied 0 files" in again.output, again.output
+
+
+def test_examples_never_overwrites_and_copies_nothing_on_a_clash(tmp_path):
+    (tmp_path / "examples").mkdir()
+    mine = tmp_path / "examples" / "measured-runup.csv"
+    mine.write_text("my own measurement\n")
+    result = _examples(tmp_path)
+    assert result.exit_code == 1
+    assert result.output.strip().splitlines() == [
+        f"error: {mine}, key 'FOLDER': exists and differs from the shipped file; powertrain "
+        "examples never overwrites (move it or choose another folder); nothing copied"]
+    assert mine.read_text() == "my own measurement\n"
+    assert sorted(p.name for p in tmp_path.rglob("*")) == ["examples", "measured-runup.csv"]
+    (tmp_path / "file").write_text("x")
+    assert _examples(tmp_path / "file").exit_code == 1
+    assert (tmp_path / "file").read_text() == "x"
 
 
 def _third_party_paths() -> list[str]:
@@ -46,14 +80,21 @@ def _clean_env(venv_dir: Path) -> dict:
     return env
 
 
-@pytest.mark.slow
-def test_wheel_runs_runup_from_an_empty_folder(tmp_path):
+def readme_tour(folder: Path) -> Path:
+    """The README's "A five-minute tour" section, as a Markdown file of its own in ``folder``."""
+    text = (ROOT / "README.md").read_text(encoding="utf-8")
+    tour = folder / "tour.md"
+    tour.write_text(text.split("## A five-minute tour", 1)[1].split("\n## ", 1)[0])
+    return tour
+
+
+def _install_wheel(tmp_path: Path) -> tuple:
+    """Build the wheel, install it into a fresh venv; (venv folder, its environment)."""
     wheels = tmp_path / "wheels"
     build = subprocess.run([sys.executable, "-m", "pip", "wheel", str(ROOT), "--no-deps",
                             "-q", "-w", str(wheels)], capture_output=True, text=True)
     assert build.returncode == 0, build.stderr[-2000:]
     wheel = next(wheels.glob("powertrain-*.whl"))
-
     venv_dir = tmp_path / "venv"
     venv.EnvBuilder(with_pip=False).create(venv_dir)
     vpython = venv_dir / "bin" / "python"
@@ -64,16 +105,32 @@ def test_wheel_runs_runup_from_an_empty_folder(tmp_path):
     inst = subprocess.run([str(vpython), "-m", "pip", "install", "--no-deps", "-q", str(wheel)],
                           capture_output=True, text=True, env=env)
     assert inst.returncode == 0, inst.stderr[-2000:]
+    return venv_dir, env
 
+
+@pytest.mark.slow
+def test_wheel_runs_the_readme_tour_unchanged_in_an_empty_folder(tmp_path):
+    """Issue 18: README's five-minute tour, every command as shown, in an empty folder after a
+    wheel install; each named output exists and each shown output matches (the docs test's
+    rules, tests/test_docs_commands.py)."""
+    from test_docs_commands import check_shown, commands_of, run_command, shown_outputs
+    venv_dir, env = _install_wheel(tmp_path)
+    env["MPLBACKEND"] = "Agg"
     empty = tmp_path / "empty"
     empty.mkdir()
-    where = subprocess.run([str(vpython), "-c", "import powertrain; print(powertrain.__file__)"],
+    where = subprocess.run(["python", "-c", "import powertrain; print(powertrain.__file__)"],
                            capture_output=True, text=True, env=env, cwd=empty, check=True)
     assert Path(where.stdout.strip()).resolve().is_relative_to(venv_dir.resolve())
-    run = subprocess.run([str(venv_dir / "bin" / "powertrain"), "runup", "--from", "1000",
-                          "--to", "2000", "--step", "500", "--csv", "r.csv"],
-                         capture_output=True, text=True, env=env, cwd=empty, timeout=600)
-    assert run.returncode == 0, run.stderr[-2000:]
-    lines = (empty / "r.csv").read_text().splitlines()
+    tour = readme_tour(tmp_path)
+    commands = commands_of(tour, root=tmp_path)
+    assert len(commands) >= 8 and commands[0].text == "powertrain examples ."
+    printed = {}
+    for cmd in commands:
+        failure = run_command(cmd, empty, env, printed.setdefault(cmd.block, []))
+        assert failure is None, failure
+    for shown in shown_outputs(tour, root=tmp_path):
+        failure = check_shown(shown, printed[shown.block])
+        assert failure is None, failure
+    lines = (empty / "runup.csv").read_text().splitlines()
     assert lines[0].startswith("mount,direction,quantity,rpm")
-    assert {ln.split(",")[3] for ln in lines[1:]} == {"1000", "1500", "2000"}
+    assert {ln.split(",")[3] for ln in lines[1:]} == {str(r) for r in range(1000, 6001, 500)}

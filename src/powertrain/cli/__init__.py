@@ -46,6 +46,7 @@ def main():
 
     \b
     Examples:
+      powertrain examples .      # copies the shipped engines/, mounts/, examples/ here
       powertrain runup --from 1000 --to 6000 --step 500 --csv runup.csv --plot runup.png
       powertrain stiffness mounts/hydraulic-engine-mount-z.toml --freq 1:400:1 --plot k.png
       powertrain fit-mount measured.csv --model triple-parallel --out fitted.toml
@@ -62,6 +63,7 @@ def _register():
     from powertrain.cli import (  # noqa: F401
         compare,
         diagnose,
+        examples,
         excitation,
         fit_mount,
         modes,

@@ -1,0 +1,59 @@
+"""``powertrain examples``: copy the shipped engines, mounts and examples into a folder."""
+
+from __future__ import annotations
+
+import filecmp
+import shutil
+from pathlib import Path
+
+import click
+
+from powertrain.cli import main
+
+
+@main.command()
+@click.argument("folder", type=click.Path(file_okay=True, dir_okay=True))
+def examples(folder):
+    """Copy the shipped files into FOLDER/engines, FOLDER/mounts and FOLDER/examples.
+
+    The guide's commands name these files (``examples/measured-runup.csv``,
+    ``engines/default-modal-body.toml``, ``mounts/hydraulic-engine-mount-z.toml``); after a
+    wheel install they are inside the package, and this command puts a copy where the
+    commands find them. An existing file is never overwritten: a file identical to the shipped
+    one is left as it is, a different one stops the command before anything is copied.
+
+    \b
+    Examples:
+      powertrain examples .
+      powertrain examples ~/powertrain-tour && cd ~/powertrain-tour
+    """
+    from powertrain.data import FOLDERS, shipped_files
+    from powertrain.errors import InputError
+    from powertrain.iotools.atomic import atomic_path
+
+    root = Path(folder)
+    if root.exists() and not root.is_dir():
+        raise InputError("exists and is not a folder; nothing copied", file=root, key="FOLDER")
+    pairs = [(src, root / name / src.name) for name in FOLDERS for src in shipped_files(name)]
+    for src, dest in pairs:
+        _check_free(src, dest, InputError)
+    copied = [dest for src, dest in pairs if not dest.exists()]
+    for src, dest in pairs:
+        if dest in copied:
+            with atomic_path(dest) as tmp:
+                shutil.copyfile(src, tmp)
+    kept = len(pairs) - len(copied)
+    click.echo(f"copied {len(copied)} files into {root}/{{{','.join(FOLDERS)}}}"
+               + (f"; {kept} identical files were there already" if kept else ""))
+
+
+def _check_free(src: Path, dest: Path, error) -> None:
+    """Refuse a destination that exists and is not a copy of the shipped file ``src``."""
+    if dest.parent.exists() and not dest.parent.is_dir():
+        raise error("exists and is not a folder; nothing copied", file=dest.parent, key="FOLDER")
+    if dest.exists() and not dest.is_file():
+        raise error("exists and is not a file; nothing copied", file=dest, key="FOLDER")
+    if dest.exists() and not filecmp.cmp(src, dest, shallow=False):
+        raise error("exists and differs from the shipped file; powertrain examples never "
+                    "overwrites (move it or choose another folder); nothing copied",
+                    file=dest, key="FOLDER")
