@@ -130,7 +130,8 @@ def check_as_velocity(path):
 
 def check_crossing(path):
     _, cot = track(path, "--orders", "2", "--rpm-step", "25")
-    _, vkf = track(path, "--orders", "2", "--rpm-step", "25", "--method", "vkf")
+    _, vkf = track(path, "--orders", "2", "--rpm-step", "25", "--method", "vkf",
+                   "--bandwidth", "0.5")
     e_cot = float(np.max(np.abs(db(curves_of(cot)[("left", "z", "order_2")][1] * np.sqrt(2), 1))))
     e_vkf = float(np.max(np.abs(db(curves_of(vkf)[("left", "z", "order_2")][1] * np.sqrt(2), 1))))
     return e_vkf, e_cot

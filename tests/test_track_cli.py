@@ -5,6 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 from click.testing import CliRunner
+from tolerances import TRACKED_ORDER_DB
 
 from powertrain import signals
 from powertrain.cli import main
@@ -104,3 +105,77 @@ def test_bad_input_one_line_exit_1_no_output(tmp_path):
         assert str(path.name) in lines[0] and key in lines[0] and words in lines[0], \
             (name, lines[0])
         assert not out.exists(), name
+
+
+def _order2_level(csv_path, rpm_step=100.0):
+    rows = [ln.split(",") for ln in csv_path.read_text().splitlines()
+            if ",order_2," in ln and not ln.startswith("#")]
+    return np.array([float(r[-1]) for r in rows])
+
+
+def test_lab_units_m_s2_and_u_min(tmp_path):
+    t, rpm, th = signals.linear_sweep(2048.0, 4.0, 1500.0, 3000.0)
+    path = tmp_path / "lab.csv"
+    body = np.column_stack([t, rpm, 1000.0 * np.cos(2 * th)])        # mm/s² amplitude 1 m/s²
+    np.savetxt(path, body, delimiter=",", fmt="%.9g", comments="",
+               header="time [s],rpm [U/min],left.z [mm/s²]", encoding="utf-8")
+    r = run(path, "--orders", "2", "--csv", tmp_path / "o.csv", "--quiet")
+    assert r.exit_code == 0, r.output
+    level = _order2_level(tmp_path / "o.csv")
+    assert level.size > 5
+    assert np.max(np.abs(20 * np.log10(level * np.sqrt(2)))) <= TRACKED_ORDER_DB
+
+
+def _can_speed_mdf(path, *, vibration_bases_differ=False):
+    """Vibration at 4096 Hz in one MDF4 group, engine speed at 100 Hz (CAN) in its own,
+    starting 3 ms later and ending 0.5 s earlier than the vibration record."""
+    from asammdf import MDF, Signal
+    t, rpm, th = signals.linear_sweep(4096.0, 6.0, 1500.0, 4500.0)
+    t_can = np.arange(0.003, 5.5, 0.01)
+    rpm_can = np.interp(t_can, t, rpm)
+    vib = [Signal(np.cos(2 * th), t, name="left.z", unit="m/s²")]
+    if vibration_bases_differ:
+        vib.append(Signal(np.cos(2 * th[::2]), t[::2], name="right.z", unit="m/s^2"))
+    mdf = MDF(version="4.10")
+    mdf.append(vib[:1])
+    mdf.append([Signal(rpm_can, t_can, name="EngSpeed", unit="1/min")])
+    if vibration_bases_differ:
+        mdf.append(vib[1:])
+    mdf.save(str(path), overwrite=True)
+    mdf.close()
+
+
+def test_speed_channel_on_its_own_time_base_mdf4(tmp_path):
+    _can_speed_mdf(tmp_path / "can.mf4")
+    r = run(tmp_path / "can.mf4", "--rpm", "EngSpeed", "--orders", "2", "--csv",
+            tmp_path / "o.csv")
+    assert r.exit_code == 0, r.output
+    level = _order2_level(tmp_path / "o.csv")
+    assert level.size > 20
+    assert np.max(np.abs(20 * np.log10(level * np.sqrt(2)))) <= TRACKED_ORDER_DB
+    text = (tmp_path / "o.csv").read_text()
+    assert "EngSpeed resampled (linear) from its own time base (100 Hz)" in text
+    assert "outside the EngSpeed record" in text                   # said, not silent
+    _can_speed_mdf(tmp_path / "bad.mf4", vibration_bases_differ=True)
+    r = run(tmp_path / "bad.mf4", "--rpm", "EngSpeed", "--csv", tmp_path / "b.csv", "--quiet")
+    assert r.exit_code == 1 and "right.z" in r.output and "time base" in r.output
+    assert len(r.output.strip().splitlines()) == 1 and not (tmp_path / "b.csv").exists()
+
+
+def test_speed_channel_on_its_own_time_base_hdf5(tmp_path):
+    import h5py
+    t, rpm, th = signals.linear_sweep(4096.0, 6.0, 1500.0, 4500.0)
+    rec = RawRecording(t, [RawChannel("a", "left", "active", "z", "acceleration",
+                                      np.cos(2 * th), "m/s^2")], None)
+    write_raw_hdf5(tmp_path / "r.h5", rec)
+    t_can = np.arange(0.0, 6.0, 0.01)
+    with h5py.File(tmp_path / "r.h5", "a") as h5:
+        h5.create_dataset("rpm_time", data=t_can * 1e3).attrs["unit"] = "ms"
+        ds = h5.create_dataset("rpm", data=np.interp(t_can, t, rpm))
+        ds.attrs["unit"] = "rpm"
+        ds.attrs["time"] = "rpm_time"
+    r = run(tmp_path / "r.h5", "--orders", "2", "--csv", tmp_path / "o.csv", "--quiet")
+    assert r.exit_code == 0, r.output
+    level = _order2_level(tmp_path / "o.csv")
+    assert level.size > 20
+    assert np.max(np.abs(20 * np.log10(level * np.sqrt(2)))) <= TRACKED_ORDER_DB

@@ -61,7 +61,9 @@ def track_recording(rec, orders=None, *, rpm_step=50.0, method="cot", use="auto"
     quantity : str, optional
         Track only channels of this quantity.
     bandwidth_hz : float, optional
-        Vold–Kalman -3 dB half-bandwidth [Hz].
+        Vold–Kalman -3 dB half-bandwidth [Hz] (default: per order and speed from the sweep
+        rate, the record length and the order spacing,
+        :func:`~powertrain.analysis.vold_kalman.default_bandwidth`).
     block_revs : int, optional
         COT block length [rev].
     progress : bool
@@ -78,49 +80,85 @@ def track_recording(rec, orders=None, *, rpm_step=50.0, method="cot", use="auto"
     if not chans:
         raise InputError(f"no {quantity} channel", file=rec.source, key="--quantity")
     profile = speed_profile(rec, use=use, pulses_per_rev=pulses_per_rev)
+    if method == "cot":
+        amp, rpm, settings = _track_cot(rec, chans, profile, orders, rpm_step, block_revs,
+                                        progress)
+    else:
+        amp, rpm, settings = _track_vkf(rec, chans, profile, orders, rpm_step, bandwidth_hz,
+                                        progress)
+    i0, i1 = profile.valid
+    settings.update({"rpm_step": float(rpm_step), "speed_source": profile.source,
+                     "speed_notes": profile.notes, "sample_rate_hz": rec.sample_rate,
+                     "measured_rpm": [float(np.min(profile.rpm[i0:i1 + 1])),
+                                      float(np.max(profile.rpm[i0:i1 + 1]))]})
+    tracked = [TrackedChannel(c.name, c.mount, c.side, c.direction, c.quantity) for c in chans]
+    return TrackedOrders(rpm, orders, tracked, amp, method, rec.source, settings,
+                         list(rec.comments))
+
+
+def _check_rate(rec, orders, rpm):
+    f_top = orders.max() * rpm.max() / 60.0
+    fs = rec.sample_rate
+    if f_top > MAX_FREQUENCY_FRACTION * fs:
+        raise InputError(f"order {orders.max():g} at {rpm.max():g} rpm is {f_top:.0f} Hz, "
+                         f"above {MAX_FREQUENCY_FRACTION:g} x the sampling rate {fs:g} Hz",
+                         file=rec.source, key="--orders")
+
+
+def _track_cot(rec, chans, profile, orders, rpm_step, block_revs, progress):
+    """Computed order tracking over the speed grid: (amplitudes, rpm, settings)."""
     B = int(block_revs or cot.block_revolutions(orders))
     S = cot.samples_per_rev(orders)
     i0, i1 = profile.valid
     n_min = float(np.min(profile.rpm[i0:i1 + 1]))
     margin = cot.KERNEL_ZERO_CROSSINGS / (cot.ANTI_ALIAS_FRACTION * S * n_min / 60.0)
-    if method == "vkf":
-        from powertrain.analysis.vold_kalman import DEFAULT_BANDWIDTH_HZ, EDGE_TIME_CONSTANTS
-        bandwidth_hz = float(DEFAULT_BANDWIDTH_HZ if bandwidth_hz is None else bandwidth_hz)
-        if not bandwidth_hz > 0:
-            raise InputError("must be > 0 [Hz]", key="--bandwidth")
-        margin = max(margin, EDGE_TIME_CONSTANTS / bandwidth_hz)
     rpm, centre = cot.speed_grid(profile, rpm_step, B, margin_s=margin, file=rec.source,
                                  key=profile.source)
-    fs = rec.sample_rate
-    f_top = orders.max() * rpm.max() / 60.0
-    if f_top > MAX_FREQUENCY_FRACTION * fs:
-        raise InputError(f"order {orders.max():g} at {rpm.max():g} rpm is {f_top:.0f} Hz, "
-                         f"above {MAX_FREQUENCY_FRACTION:g} x the sampling rate {fs:g} Hz",
-                         file=rec.source, key="--orders")
+    _check_rate(rec, orders, rpm)
     X = rec.channel_matrix(chans)
-    if method == "cot":
-        amp = np.empty((rpm.size, X.shape[0], orders.size), complex)
-        steps = range(0, rpm.size, CHUNK)
-        if progress:
-            from tqdm import tqdm
-            steps = tqdm(steps, desc="order tracking", unit="block", leave=False,
-                         disable=None, total=len(steps))
-        for s in steps:
-            amp[s:s + CHUNK] = cot.cot_amplitudes(X, profile, orders, rpm[s:s + CHUNK],
-                                                  centre[s:s + CHUNK], B)
-        settings = {"block_revolutions": B, "samples_per_revolution": S,
-                    "window": "hann", "kernel": f"Kaiser-windowed sinc, "
-                    f"{cot.KERNEL_ZERO_CROSSINGS} zero crossings, beta {cot.KERNEL_BETA:g}"}
+    amp = np.empty((rpm.size, X.shape[0], orders.size), complex)
+    steps = range(0, rpm.size, CHUNK)
+    if progress:
+        from tqdm import tqdm
+        steps = tqdm(steps, desc="order tracking", unit="block", leave=False,
+                     disable=None, total=len(steps))
+    for s in steps:
+        amp[s:s + CHUNK] = cot.cot_amplitudes(X, profile, orders, rpm[s:s + CHUNK],
+                                              centre[s:s + CHUNK], B)
+    return amp, rpm, {"block_revolutions": B, "samples_per_revolution": S, "window": "hann",
+                      "kernel": f"Kaiser-windowed sinc, {cot.KERNEL_ZERO_CROSSINGS} zero "
+                      f"crossings, beta {cot.KERNEL_BETA:g}"}
+
+
+def _track_vkf(rec, chans, profile, orders, rpm_step, bandwidth_hz, progress):
+    """Vold–Kalman filtering over the speed grid: (amplitudes, rpm, settings).
+
+    Speeds within EDGE_TIME_CONSTANTS / bandwidth of the record's ends are not reported; the
+    time dropped at each end is returned in the settings (``ends_dropped_s``).
+    """
+    from powertrain.analysis import vold_kalman as vk
+    if bandwidth_hz is None:
+        width = vk.default_bandwidth(profile, orders)
+        rule = (f"per order and speed: {vk.SWEEP_FACTOR:g} x sqrt(order sweep rate), at "
+                f"least {vk.EDGE_TIME_CONSTANTS:g} / ({vk.EDGE_FRACTION:g} x record length), "
+                f"at most order spacing / {vk.SPACING_RATIO:g}")
     else:
-        from powertrain.analysis.vold_kalman import vkf_amplitudes
-        amp = vkf_amplitudes(X, profile, orders, rpm, bandwidth_hz=bandwidth_hz,
-                             progress=progress)
-        settings = {"bandwidth_hz": bandwidth_hz, "structural_equation": "two-pole"}
-    settings.update({"rpm_step": float(rpm_step), "speed_source": profile.source,
-                     "speed_notes": profile.notes, "sample_rate_hz": fs})
-    tracked = [TrackedChannel(c.name, c.mount, c.side, c.direction, c.quantity) for c in chans]
-    return TrackedOrders(rpm, orders, tracked, amp, method, rec.source, settings,
-                         list(rec.comments))
+        if not (np.isfinite(bandwidth_hz) and bandwidth_hz > 0):
+            raise InputError("must be > 0 [Hz]", key="--bandwidth")
+        width = np.full((orders.size, profile.time.size), float(bandwidth_hz))
+        rule = "given (--bandwidth)"
+    i0, i1 = profile.valid
+    ends = [vk.EDGE_TIME_CONSTANTS / float(np.min(width[:, i])) for i in (i0, i1)]
+    rpm, _ = cot.speed_grid(profile, rpm_step, 0, margin_s=ends, file=rec.source,
+                            key=profile.source)
+    _check_rate(rec, orders, rpm)
+    amp = vk.vkf_amplitudes(rec.channel_matrix(chans), profile, orders, rpm,
+                            bandwidth_hz=width, progress=progress)
+    inside = width[:, i0:i1 + 1]
+    return amp, rpm, {"bandwidth_hz": float(np.max(inside)),
+                      "bandwidth_hz_range": [float(np.min(inside)), float(np.max(inside))],
+                      "bandwidth_rule": rule, "ends_dropped_s": ends,
+                      "structural_equation": "two-pole"}
 
 
 def order_map(rec, profile, channel=0, *, rpm_step=50.0, max_order=None, resolution=None):

@@ -48,6 +48,7 @@ UNITS: dict[str, tuple[str, float]] = {
     "rad/s": ("angular_speed", 1.0),
     "rpm": ("angular_speed", 2.0 * math.pi / 60.0),
     "1/min": ("angular_speed", 2.0 * math.pi / 60.0),
+    "U/min": ("angular_speed", 2.0 * math.pi / 60.0),        # Umdrehungen pro Minute
     # moment of inertia
     "kg*m^2": ("inertia", 1.0),
     "kg*mm^2": ("inertia", 1e-6),
@@ -63,7 +64,10 @@ UNITS: dict[str, tuple[str, float]] = {
     "mm/s": ("velocity", 1e-3),
     "m/s^2": ("acceleration", 1.0),
     "m/s2": ("acceleration", 1.0),
+    "m/s²": ("acceleration", 1.0),
     "mm/s^2": ("acceleration", 1e-3),
+    "mm/s2": ("acceleration", 1e-3),
+    "mm/s²": ("acceleration", 1e-3),
     # displacement also accepts micrometres
     "um": ("length", 1e-6),
     "µm": ("length", 1e-6),

@@ -118,6 +118,8 @@ def kernel_table(K, beta, n_tab=16385):
 def speed_grid(profile, rpm_step, block_revs, *, margin_s=0.0, file=None, key="rpm"):
     """Grid speeds [rpm] the shaft passes with a whole block inside the measured range.
 
+    ``margin_s`` [s] is kept free beyond the block at both ends, or ``(start, end)``.
+
     Returns
     -------
     rpm : ndarray (k,)
@@ -133,8 +135,9 @@ def speed_grid(profile, rpm_step, block_revs, *, margin_s=0.0, file=None, key="r
     if not n_grid <= MAX_GRID_SPEEDS:
         raise InputError(f"{n_grid:.3g} grid speeds over {n.min():.0f}..{n.max():.0f} rpm; "
                          f"at most {MAX_GRID_SPEEDS} (choose a larger step)", key="--rpm-step")
-    lo_ok = np.interp(th[0] + np.pi * block_revs, th, t) + margin_s
-    hi_ok = np.interp(th[-1] - np.pi * block_revs, th, t) - margin_s
+    m0, m1 = np.broadcast_to(np.asarray(margin_s, float), (2,))
+    lo_ok = np.interp(th[0] + np.pi * block_revs, th, t) + m0
+    hi_ok = np.interp(th[-1] - np.pi * block_revs, th, t) - m1
     grid = rpm_step * np.arange(math.ceil(n.min() / rpm_step), math.floor(n.max() / rpm_step)
                                 + 1)
     tc, thc = first_passing(t, n, grid, th)
@@ -142,7 +145,7 @@ def speed_grid(profile, rpm_step, block_revs, *, margin_s=0.0, file=None, key="r
     rpm, centre = list(grid[keep]), thc[keep]
     if not rpm:
         raise InputError(f"speed never passes a multiple of {rpm_step:g} rpm with "
-                         f"{block_revs / 2:g} revolutions (+ {margin_s:.3g} s) of data either "
+                         f"{block_revs / 2:g} revolutions (+ {max(m0, m1):.3g} s) of data either "
                          "side (speed "
                          f"{n.min():.0f}..{n.max():.0f} rpm over {t[-1] - t[0]:.3g} s)",
                          file=file, key=key)

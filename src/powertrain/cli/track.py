@@ -24,7 +24,9 @@ from powertrain.cli import main
               help="cot: computed order tracking (angle resampling, block spectra); vkf: "
                    "Vold-Kalman order filter (crossing orders, fast sweeps).")
 @click.option("--bandwidth", type=float,
-              help="Vold-Kalman -3 dB half-bandwidth [Hz] (default 0.5).")
+              help="Vold-Kalman -3 dB half-bandwidth [Hz] (default: per order and speed, "
+                   "1.5 x sqrt(order sweep rate [Hz/s]), at most a quarter of the order "
+                   "spacing; 0.5 rejects a crossing fixed tone but flattens fast resonances).")
 @click.option("--quantity", type=click.Choice(["acceleration", "velocity", "displacement",
                                                 "force"]),
               help="Track only channels of this quantity.")
@@ -127,7 +129,15 @@ def _report(rec, tracked, written):
     s = tracked.settings
     click.echo(f"speed: {s['speed_source']}; tracked ({tracked.method}) at "
                f"{tracked.rpm.size} speeds {tracked.rpm[0]:g}..{tracked.rpm[-1]:g} rpm "
-               f"(step {s['rpm_step']:g})")
+               f"(step {s['rpm_step']:g}) of the measured {s['measured_rpm'][0]:.0f}.."
+               f"{s['measured_rpm'][1]:.0f} rpm")
+    if "ends_dropped_s" in s:
+        lo, hi = s["bandwidth_hz_range"]
+        start, end = s["ends_dropped_s"]
+        span = rec.time[-1] - rec.time[0]
+        click.echo(f"Vold-Kalman bandwidth {lo:.3g}..{hi:.3g} Hz ({s['bandwidth_rule']}); "
+                   f"not reported: the first {start:.3g} s and the last {end:.3g} s "
+                   f"({100 * (start + end) / span:.1f} % of the record, filter end transient)")
     rows = []
     rms = tracked.order_rms()
     syn = tracked.synthesis_rms()

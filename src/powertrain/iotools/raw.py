@@ -37,7 +37,7 @@ class FileSignals:
     source: str
     time_name: str = "time"
     comments: list = field(default_factory=list)
-    times: dict = field(default_factory=dict)   # name -> own time base (MDF, UFF), optional
+    times: dict = field(default_factory=dict)   # name -> own time base [s] where not `time`
 
 
 def detect_format(path) -> str:
@@ -115,15 +115,68 @@ def _pick_speed(found: FileSignals, cmap, rpm, tacho):
                                  file=found.source, key=wanted)
             continue
         name, values, unit = signals.pop(i)
-        values = np.asarray(values, float)
+        values = np.asarray(values, float).ravel()
         if kind == "rpm":
             unit = unit or "rpm"
             values = to_si(values, unit, "angular_speed", file=found.source, key=name) \
                 * 60.0 / (2.0 * np.pi)
         elif unit:
             values = to_si(values, unit, "voltage", file=found.source, key=name)
-        out[kind] = values
+        out[kind] = (name, values)
     return out, signals
+
+
+def _same_time(a, b) -> bool:
+    return a.shape == b.shape and np.allclose(a, b, rtol=0, atol=1e-9 * max(abs(b[-1]), 1.0))
+
+
+def _vibration_time(found: FileSignals, signals):
+    """The one time base of the vibration channels (only a speed channel may have its own)."""
+    if not signals:
+        return found.time
+    first = signals[0][0]
+    time = found.times.get(first, found.time)
+    for name, _, _ in signals[1:]:
+        if not _same_time(np.asarray(found.times.get(name, found.time)), np.asarray(time)):
+            raise InputError(f"time base differs from channel {first!r}'s (only the speed or "
+                             "tacho channel may have its own; it is resampled)",
+                             file=found.source, key=name)
+    return time
+
+
+def _onto_time(found: FileSignals, speed, time):
+    """Speed/tacho channels on their own time base, linearly interpolated onto ``time``.
+
+    Returns ``(speed values, time, keep)``: where the speed's record is shorter, the
+    vibration samples outside it are dropped (``keep`` selects those kept) and a comment
+    says so.
+    """
+    time = np.asarray(time, float)
+    keep = slice(None)
+    out = {}
+    for kind, (name, values) in speed.items():
+        own = found.times.get(name)
+        if own is None or _same_time(np.asarray(own, float), time):
+            out[kind] = values
+            continue
+        own = np.asarray(own, float).ravel()
+        if own.shape != values.shape or own.size < 2 or np.any(np.diff(own) <= 0):
+            raise InputError("the channel's own time base must increase and have one value "
+                             "per sample", file=found.source, key=name)
+        inside = (time >= own[0]) & (time <= own[-1])
+        if not inside.any():
+            raise InputError("the channel's time base does not overlap the vibration "
+                             "channels'", file=found.source, key=name)
+        lo, hi = np.flatnonzero(inside)[[0, -1]]
+        if lo > 0 or hi < time.size - 1:
+            keep = slice(max(lo, keep.start or 0), min(hi + 1, keep.stop or time.size))
+            found.comments.append(f"vibration samples outside the {name} record "
+                                  f"({own[0]:g}..{own[-1]:g} s) dropped")
+        rate = (own.size - 1) / (own[-1] - own[0])
+        found.comments.append(f"{name} resampled (linear) from its own time base "
+                              f"({rate:.4g} Hz) onto the vibration channels'")
+        out[kind] = np.interp(time, own, values)
+    return {k: v[keep] for k, v in out.items()}, time[keep], keep
 
 
 def assemble(found: FileSignals, cmap: ChannelMap | None = None, *, rpm=None,
@@ -131,6 +184,7 @@ def assemble(found: FileSignals, cmap: ChannelMap | None = None, *, rpm=None,
     """Map the signals of a file to mount channels in SI (see :func:`read_raw`)."""
     src = found.source
     speed, signals = _pick_speed(found, cmap, rpm, tacho)
+    speed, time, keep = _onto_time(found, speed, _vibration_time(found, signals))
     channels, ignored = [], []
     used = set()
     for name, values, file_unit in signals:
@@ -158,7 +212,7 @@ def assemble(found: FileSignals, cmap: ChannelMap | None = None, *, rpm=None,
             raise InputError(f"unit {unit!r} measures {quantity}, but the channel map says "
                              f"{spec.quantity}", file=src, key=name)
         dimension = "length" if quantity == "displacement" else quantity
-        si = to_si(np.asarray(values, float), unit, dimension, file=src, key=name)
+        si = to_si(np.asarray(values, float)[keep], unit, dimension, file=src, key=name)
         channels.append(RawChannel(name, spec.mount, spec.side, spec.direction, quantity,
                                    si, unit))
     if cmap is not None:
@@ -172,6 +226,5 @@ def assemble(found: FileSignals, cmap: ChannelMap | None = None, *, rpm=None,
     comments = list(found.comments)
     if ignored:
         comments.append("channels not in the channel map, ignored: " + ", ".join(ignored))
-    rec = RawRecording(found.time, channels, speed.get("rpm"), speed.get("tacho"), src,
-                       comments)
+    rec = RawRecording(time, channels, speed.get("rpm"), speed.get("tacho"), src, comments)
     return rec.validate(found.time_name)

@@ -14,6 +14,11 @@ Layout written by :func:`write_raw_hdf5` (``powertrain runup --sweep --raw``)::
 Any other HDF5 file is read with a channel map: its keys are dataset paths (``time``,
 ``rpm`` and ``tacho`` name the datasets holding those; a dataset's ``unit`` attribute is
 used unless the map gives one).
+
+In both layouts the speed (or tacho) dataset may have its own time base, e.g. CAN engine
+speed at 100 Hz: its attribute ``time`` names the dataset of its sample times (with a
+``unit`` attribute, default s), and it is resampled onto ``/time``
+(:func:`powertrain.iotools.raw.assemble`).
 """
 
 from __future__ import annotations
@@ -112,10 +117,11 @@ def _read_own(h5, path):
     unit = _unit(h5["time"]) or "s"
     from powertrain.units import to_si
     time = to_si(time, unit, "time", file=path, key="time")
-    signals = []
+    signals, times = [], {}
     for name in ("rpm", "tacho"):
         if name in h5:
             signals.append((name, _dataset(h5, name, path, budget), _unit(h5[name])))
+            _own_time(h5, name, path, times, budget)
     group = h5.get("channels")
     if group is None or not hasattr(group, "items") or hasattr(group, "shape"):
         raise InputError("no /channels group", file=path, key="channels")
@@ -125,18 +131,32 @@ def _read_own(h5, path):
     comments = _comments(h5, path)
     if h5.attrs.get("synthetic", False) and not any("synthetic" in c.lower() for c in comments):
         comments.append("SYNTHETIC")
-    return FileSignals(time, signals, str(path), "time", comments)
+    return FileSignals(time, signals, str(path), "time", comments, times)
+
+
+def _own_time(h5, name, path, times, budget):
+    """Record the own time base [s] of dataset ``name`` if its ``time`` attribute names one."""
+    ref = h5[name].attrs.get("time")
+    if ref is None:
+        return
+    ref = ref.decode() if isinstance(ref, bytes) else str(ref)
+    from powertrain.units import to_si
+    times[name] = to_si(_dataset(h5, ref, path, budget), _unit(h5[ref]) or "s", "time", file=path,
+                        key=ref)
 
 
 def _read_mapped(h5, path, cmap):
     budget = _Budget()
     tname = cmap.time or "time"
     time = _dataset(h5, tname, path, budget)
-    signals = []
+    signals, times = [], {}
     for name in [cmap.rpm, cmap.tacho, *cmap.channels]:
         if name:
             signals.append((name, _dataset(h5, name, path, budget), _unit(h5[name])))
-    return FileSignals(time, signals, str(path), tname)
+    for name in (cmap.rpm, cmap.tacho):
+        if name:
+            _own_time(h5, name, path, times, budget)
+    return FileSignals(time, signals, str(path), tname, times=times)
 
 
 def write_raw_hdf5(path, recording, *, description: str = "", synthetic: bool = False) -> None:

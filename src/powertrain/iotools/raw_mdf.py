@@ -1,8 +1,10 @@
 """Raw run-up time data in ASAM MDF4 (read and written by asammdf).
 
-Every channel of the file except the masters is a signal (name and unit as stored); all are
-brought onto the time base of the first vibration channel (they must share it: a test-lab
-export of one group does). Names follow the ``MOUNT.DIRECTION`` convention or a channel map.
+Every channel of the file except the masters is a signal (name and unit as stored). The
+vibration channels must share one time base (a test-lab export of one group does); the
+speed or tacho channel may have its own, e.g. CAN engine speed at 100 Hz in its own group,
+and is resampled onto the vibration channels' (:func:`powertrain.iotools.raw.assemble`).
+Names follow the ``MOUNT.DIRECTION`` convention or a channel map.
 """
 
 from __future__ import annotations
@@ -35,7 +37,7 @@ def read_mdf_signals(path, channel_map=None) -> FileSignals:
         _quiet_collect()           # a half-built MDF object complains when finalised
     if problem is not None:
         raise InputError(f"not a readable MDF file ({problem})", file=path)
-    time, signals = None, []
+    time, signals, times = None, [], {}
     try:
         for g, group in enumerate(mdf.groups):
             for c in range(len(group.channels)):
@@ -51,8 +53,7 @@ def read_mdf_signals(path, channel_map=None) -> FileSignals:
                     time = t
                 elif t.shape != time.shape or not np.allclose(t, time, rtol=0,
                                                               atol=1e-9 * max(time[-1], 1.0)):
-                    raise InputError("time base differs from the first channel's", file=path,
-                                     key=sig.name)
+                    times[sig.name] = t                 # checked once the speed is known
                 samples = np.asarray(sig.samples)
                 if not np.issubdtype(samples.dtype, np.number):
                     raise InputError("not a numeric channel", file=path, key=sig.name)
@@ -61,7 +62,7 @@ def read_mdf_signals(path, channel_map=None) -> FileSignals:
         mdf.close()
     if time is None:
         raise InputError("no channel in the MDF file", file=path)
-    return FileSignals(time, signals, str(path), "master time")
+    return FileSignals(time, signals, str(path), "master time", times=times)
 
 
 def _quiet_collect():
