@@ -116,8 +116,7 @@ class AssembledSystem:
 
     def _body_rows(self, chassis, name, n):
         rows = np.zeros((3, n))
-        if chassis.model == "modal":
-            rows[:, self.body_start:] = chassis.shape_matrix(name)
+        rows[:, self.body_start:] = chassis.body_rows(name)
         return rows
 
     @property
@@ -180,7 +179,8 @@ def assemble(mass, cg, inertia, mounts, chassis=None) -> AssembledSystem:
     its body side (``NAME/passive``) and the body points of interest.
     """
     cg = np.asarray(cg, float)
-    modal = chassis is not None and chassis.model == "modal"
+    body_modes = chassis.body_modes if chassis is not None else ()
+    modal = bool(body_modes)
     blocks = []
     n_int_total = 0
     labels = ["u_x", "u_y", "u_z", "theta_x", "theta_y", "theta_z"]
@@ -195,7 +195,7 @@ def assemble(mass, cg, inertia, mounts, chassis=None) -> AssembledSystem:
             blocks.append((direction_row(r, R[:, ai]), Mn, Cn, Kn, kg, dg, mi, ai))
             labels += [f"{mount.name}.{axis}.m{j + 1}" for j in range(masses.size)]
             n_int_total += masses.size
-    n_body = len(chassis.modes) if modal else 0
+    n_body = len(body_modes)
     body0 = 6 + n_int_total
     n = body0 + n_body
     M = np.zeros((n, n))
@@ -205,7 +205,7 @@ def assemble(mass, cg, inertia, mounts, chassis=None) -> AssembledSystem:
     n_m = len(mounts)
     Fk = np.zeros((3 * n_m, n))
     Fd = np.zeros((3 * n_m, n))
-    shapes = {m.name: chassis.shape_matrix(m.name) for m in mounts} if modal else {}
+    shapes = {m.name: chassis.body_rows(m.name) for m in mounts} if modal else {}
     start = 6
     networks = []
     for row, Mn, Cn, Kn, kg, dg, mi, ai in blocks:
@@ -226,7 +226,7 @@ def assemble(mass, cg, inertia, mounts, chassis=None) -> AssembledSystem:
         Fd[3 * mi:3 * mi + 3] += np.outer(e, fd)
         networks.append((row, start, ni, mounts[mi].directions[DIRECTIONS[ai]]))
         start += ni
-    for k, mode in enumerate(chassis.modes if modal else ()):
+    for k, mode in enumerate(body_modes):
         j = body0 + k
         M[j, j] += mode.modal_mass
         C[j, j] += 2.0 * mode.damping_ratio * mode.omega * mode.modal_mass
@@ -238,8 +238,7 @@ def assemble(mass, cg, inertia, mounts, chassis=None) -> AssembledSystem:
         Cm[3 * mi:3 * mi + 3, :6] = point_motion_matrix(np.asarray(mount.position, float) - cg)
     system = AssembledSystem(M, C, K, channels, Cm, Fk, Fd, labels, networks)
     system.mount_axes = [np.asarray(m.rotation, float) for m in mounts]
-    system.network_ports = _ports(system, body0, mounts, blocks, shapes,
-                                  chassis.modes if modal else ())
+    system.network_ports = _ports(system, body0, mounts, blocks, shapes, body_modes)
     if chassis is not None and not chassis.is_rigid:
         system.add_body_side(chassis, [m.name for m in mounts], body0)
     return system

@@ -62,7 +62,7 @@ class ModalBody:
         """The modal body of ``engine`` (None for a rigid, absent or measured-receptance
         chassis: the fast path predicts body-side motion only for a modal body)."""
         ch = getattr(engine, "chassis", None)
-        if ch is None or ch.model != "modal" or not ch.modes:
+        if ch is None or not ch.body_modes:
             return None
         ms = np.array([ch.shape_matrix(m.name) for m in engine.mounts], float)
         ps = np.array([ch.shape_matrix(p) for p in ch.points], float).reshape(

@@ -337,7 +337,7 @@ def engine_modes(engine, *, static=False) -> ModesResult:
     """:func:`rigid_body_modes` of an :class:`~powertrain.models.engine.Engine`."""
     from powertrain.assembly import assemble
     b = engine.body
-    chassis = engine.chassis if getattr(engine.chassis, "model", "") == "modal" else None
+    chassis = engine.chassis if getattr(engine.chassis, "body_modes", ()) else None
     system = assemble(b.mass, b.cg, b.inertia, engine.mounts, chassis)
     result = rigid_body_modes(system, b.inertia, static=static, engine_name=engine.name)
     result.meta["cg_m"] = [float(v) for v in b.cg]
