@@ -181,3 +181,41 @@ def test_four_mount_engine_gets_its_own_parameters_and_folds():
     ref = run_runup(EFFECTS["mount_stiffness"].apply(eng, k4=1.7), [2500.0],
                     solver="harmonic").velocity
     assert np.max(np.abs(v - ref)) <= EXACT * np.max(np.abs(ref))
+
+
+#: Linear effects: the fast path and the run-up of the changed engine are the same model.
+#: Cylinder imbalance enters the fast path to first order in the IMEP deviation.
+FIRST_ORDER = {"cylinder_imbalance": 2e-3}
+
+
+def _moved_parameters(effect, engine):
+    """Every parameter a tenth of the way from its default towards its upper bound (the
+    lower one for a default at the upper bound; geometric for log parameters)."""
+    out = {}
+    for p in effect.parameters(engine):
+        bound = p.lower if p.default >= p.upper else p.upper
+        if p.log and p.default > 0:
+            out[p.name] = p.default * (bound / p.default) ** 0.1
+        else:
+            out[p.name] = p.default + 0.1 * (bound - p.default)
+    return out
+
+
+@pytest.mark.parametrize("name", [n for n, e in EFFECTS.items() if e.engine_change])
+@pytest.mark.parametrize("engine_file", ["default.toml", "default-modal-body.toml"])
+def test_runup_application_and_diagnosis_prediction_agree(name, engine_file):
+    """One physics per effect: ``apply()`` (what the run-up and `whatif --effect` run) and
+    the fast-path hooks behind ``predict()`` give the same velocities, for every effect that
+    changes the engine model."""
+    eng = read_engine(DEFAULT_ENGINE_PATH.parent / engine_file)
+    effect = EFFECTS[name]
+    if not effect.applicable(eng):
+        pytest.skip(f"{name} does not act on {engine_file}")
+    params = _moved_parameters(effect, eng)
+    rpm = [1500.0, 4000.0]
+    fast = predict(HarmonicModel(eng, rpm), {name: params}).velocity
+    base = predict(HarmonicModel(eng, rpm), {}).velocity
+    ref = run_runup(effect.apply(eng, **params), rpm, solver="harmonic").velocity
+    assert np.max(np.abs(ref - base)) > 1e-4 * np.max(np.abs(ref)), \
+        "the moved parameters change nothing"
+    assert np.max(np.abs(fast - ref)) <= FIRST_ORDER.get(name, EXACT) * np.max(np.abs(ref))

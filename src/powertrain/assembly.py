@@ -116,8 +116,7 @@ class AssembledSystem:
 
     def _body_rows(self, chassis, name, n):
         rows = np.zeros((3, n))
-        if chassis.model == "modal":
-            rows[:, self.body_start:] = chassis.shape_matrix(name)
+        rows[:, self.body_start:] = chassis.body_rows(name)
         return rows
 
     @property
@@ -174,91 +173,91 @@ def assemble(mass, cg, inertia, mounts, chassis=None) -> AssembledSystem:
     its body side (``NAME/passive``) and the body points of interest.
     """
     cg = np.asarray(cg, float)
-    modal = chassis is not None and chassis.model == "modal"
-    blocks = []
-    n_int_total = 0
-    labels = ["u_x", "u_y", "u_z", "theta_x", "theta_y", "theta_z"]
-    for mi, mount in enumerate(mounts):
-        r = np.asarray(mount.position, float) - cg
-        R = np.asarray(mount.rotation, float)
-        for ai, axis in enumerate(DIRECTIONS):
-            model = mount.directions[axis]
-            Mn, Cn, Kn = model.matrices(include_ground=modal)
-            masses, elem_nodes, c, d = model.network()
-            kg, dg = ground_force_rows(masses.size, elem_nodes, c, d)
-            blocks.append((direction_row(r, R[:, ai]), Mn, Cn, Kn, kg, dg, mi, ai))
-            labels += [f"{mount.name}.{axis}.m{j + 1}" for j in range(masses.size)]
-            n_int_total += masses.size
-    n_body = len(chassis.modes) if modal else 0
-    body0 = 6 + n_int_total
-    n = body0 + n_body
-    M = np.zeros((n, n))
-    C = np.zeros((n, n))
-    K = np.zeros((n, n))
-    M[:6, :6] = rigid_body_mass_matrix(mass, inertia)
+    body_modes = chassis.body_modes if chassis is not None else ()
+    modal = bool(body_modes)
+    blocks, labels = _network_blocks(mounts, cg, modal)
+    body0 = 6 + sum(kg.size - 1 for _, _, _, _, kg, _, _, _ in blocks)
+    n = body0 + len(body_modes)
+    retained = np.r_[np.arange(6), np.arange(body0, n)].astype(int)
+    frame = _frame(mass, inertia, body_modes)
+    M, C, K = (np.zeros((n, n)) for _ in range(3))
+    labels += [f"body_mode_{k + 1}" for k in range(len(body_modes))]
     n_m = len(mounts)
-    Fk = np.zeros((3 * n_m, n))
-    Fd = np.zeros((3 * n_m, n))
-    shapes = {m.name: chassis.shape_matrix(m.name) for m in mounts} if modal else {}
-    start = 6
-    networks = []
-    for row, Mn, Cn, Kn, kg, dg, mi, ai in blocks:
-        ni = kg.size - 1
-        e = np.asarray(mounts[mi].rotation, float)[:, ai]
-        L = np.zeros((Mn.shape[0], n))
-        L[0, :6] = row
-        L[1:ni + 1, start:start + ni] = np.eye(ni)
-        if modal:
-            L[ni + 1, body0:] = e @ shapes[mounts[mi].name]       # base node on the body
-        M += L.T @ Mn @ L
-        C += L.T @ Cn @ L
-        K += L.T @ Kn @ L
-        # force on the base along the local axis, expressed in engine axes
-        fk = kg @ L[:ni + 1] - (kg.sum() * L[ni + 1] if modal else 0.0)
-        fd = dg @ L[:ni + 1] - (dg.sum() * L[ni + 1] if modal else 0.0)
-        Fk[3 * mi:3 * mi + 3] += np.outer(e, fk)
-        Fd[3 * mi:3 * mi + 3] += np.outer(e, fd)
-        networks.append((row, start, ni, mounts[mi].directions[DIRECTIONS[ai]]))
-        start += ni
-    for k, mode in enumerate(chassis.modes if modal else ()):
-        j = body0 + k
-        M[j, j] += mode.modal_mass
-        C[j, j] += 2.0 * mode.damping_ratio * mode.omega * mode.modal_mass
-        K[j, j] += mode.omega ** 2 * mode.modal_mass
-        labels.append(f"body_mode_{k + 1}")
+    Fk, Fd = np.zeros((3 * n_m, n)), np.zeros((3 * n_m, n))
+    shapes = {m.name: chassis.body_rows(m.name) for m in mounts} if modal else {}
+    networks, base_rows = _add_networks((M, C, K, Fk, Fd), blocks, mounts, shapes, body0)
+    for X, X0 in zip((M, C, K), frame):
+        X[np.ix_(retained, retained)] += X0
     channels = [(m.name, a) for m in mounts for a in DIRECTIONS]
     Cm = np.zeros((3 * n_m, n))
     for mi, mount in enumerate(mounts):
         Cm[3 * mi:3 * mi + 3, :6] = point_motion_matrix(np.asarray(mount.position, float) - cg)
     system = AssembledSystem(M, C, K, channels, Cm, Fk, Fd, labels, networks)
     system.mount_axes = [np.asarray(m.rotation, float) for m in mounts]
-    system.network_ports = _ports(system, body0, mounts, blocks, shapes,
-                                  chassis.modes if modal else ())
+    system.network_ports = NetworkPorts(
+        retained, frame, np.array([np.r_[b[0], np.zeros(len(body_modes))] for b in blocks]
+                                  ).reshape(-1, retained.size),
+        np.array(base_rows)[:, retained].reshape(-1, retained.size),
+        [(st, ni) for _, st, ni, _ in networks], [mod for *_, mod in networks])
     if chassis is not None and not chassis.is_rigid:
         system.add_body_side(chassis, [m.name for m in mounts], body0)
     return system
 
 
-def _ports(system, body0, mounts, blocks, shapes, body_modes) -> NetworkPorts:
-    """The networks on the retained coordinates (rigid body, then the body modes), and the
-    frame they stand in: the rigid-body mass and the body modes' oscillators."""
-    n = system.n_dof
-    retained = np.r_[np.arange(6), np.arange(body0, n)].astype(int)
-    frame = tuple(np.zeros((retained.size, retained.size)) for _ in range(3))
-    frame[0][:6, :6] = system.M[:6, :6]
+def _add_networks(matrices, blocks, mounts, shapes, body0):
+    """Add every network to the global M, C, K and its transmitted force to the force rows
+    ``Fk``, ``Fd`` (in place); returns the network list and each network's base row (the
+    body motion under its base node; zero on the ground)."""
+    M, C, K, Fk, Fd = matrices
+    n = M.shape[0]
+    start, networks, base_rows = 6, [], []
+    for row, Mn, Cn, Kn, kg, dg, mi, ai in blocks:
+        ni = kg.size - 1
+        e = np.asarray(mounts[mi].rotation, float)[:, ai]
+        L = np.zeros((Mn.shape[0], n))
+        L[0, :6] = row
+        L[1:ni + 1, start:start + ni] = np.eye(ni)
+        if shapes:
+            L[ni + 1, body0:] = e @ shapes[mounts[mi].name]       # base node on the body
+        for X, Xn in ((M, Mn), (C, Cn), (K, Kn)):
+            X += L.T @ Xn @ L
+        # force on the base along the local axis, expressed in engine axes
+        base = L[ni + 1] if shapes else np.zeros(n)
+        Fk[3 * mi:3 * mi + 3] += np.outer(e, kg @ L[:ni + 1] - kg.sum() * base)
+        Fd[3 * mi:3 * mi + 3] += np.outer(e, dg @ L[:ni + 1] - dg.sum() * base)
+        networks.append((row, start, ni, mounts[mi].directions[DIRECTIONS[ai]]))
+        base_rows.append(base)
+        start += ni
+    return networks, base_rows
+
+
+def _network_blocks(mounts, cg, with_ground):
+    """Per network: (engine-side row, its M, C, K, ground-force rows kg, dg, mount index,
+    axis index), and the labels of the coordinates (rigid body, then internal nodes)."""
+    blocks = []
+    labels = ["u_x", "u_y", "u_z", "theta_x", "theta_y", "theta_z"]
+    for mi, mount in enumerate(mounts):
+        r = np.asarray(mount.position, float) - cg
+        R = np.asarray(mount.rotation, float)
+        for ai, axis in enumerate(DIRECTIONS):
+            model = mount.directions[axis]
+            Mn, Cn, Kn = model.matrices(include_ground=with_ground)
+            masses, elem_nodes, c, d = model.network()
+            kg, dg = ground_force_rows(masses.size, elem_nodes, c, d)
+            blocks.append((direction_row(r, R[:, ai]), Mn, Cn, Kn, kg, dg, mi, ai))
+            labels += [f"{mount.name}.{axis}.m{j + 1}" for j in range(masses.size)]
+    return blocks, labels
+
+
+def _frame(mass, inertia, body_modes):
+    """M, C, K of the retained coordinates without the networks: the rigid-body mass and
+    each body mode's single-DOF oscillator."""
+    n = 6 + len(body_modes)
+    M0, C0, K0 = (np.zeros((n, n)) for _ in range(3))
+    M0[:6, :6] = rigid_body_mass_matrix(mass, inertia)
     for k, mode in enumerate(body_modes):
         j = 6 + k
-        frame[0][j, j] = mode.modal_mass
-        frame[1][j, j] = 2.0 * mode.damping_ratio * mode.omega * mode.modal_mass
-        frame[2][j, j] = mode.omega ** 2 * mode.modal_mass
-    n_net = len(blocks)
-    engine_rows = np.zeros((n_net, retained.size))
-    base_rows = np.zeros((n_net, retained.size))
-    for k, (row, *_, mi, ai) in enumerate(blocks):
-        engine_rows[k, :6] = row
-        if shapes:
-            base_rows[k, 6:] = np.asarray(mounts[mi].rotation, float)[:, ai] @ shapes[
-                mounts[mi].name]
-    return NetworkPorts(retained, frame, engine_rows, base_rows,
-                        [(start, ni) for _, start, ni, _ in system.networks],
-                        [model for *_, model in system.networks])
+        M0[j, j] = mode.modal_mass
+        C0[j, j] = 2.0 * mode.damping_ratio * mode.omega * mode.modal_mass
+        K0[j, j] = mode.omega ** 2 * mode.modal_mass
+    return M0, C0, K0

@@ -58,10 +58,12 @@ from __future__ import annotations
 
 import dataclasses
 from dataclasses import dataclass, field
+from types import SimpleNamespace
 
 import numpy as np
 
 from powertrain.effects import A_REF
+from powertrain.solvers.body_coupling import coupled_solve
 from powertrain.solvers.fast_harmonic import N_HARMONICS, HarmonicModel
 
 TRUTH_EFFECTS = {
@@ -194,24 +196,11 @@ def _two_port_springs(omega, model, s):
 
 def _solve_body(hm, abc, load, body):
     """Rigid body + flexible chassis body (modal) under all networks; q (n_r, 16, 6)."""
-    a, b, c = (x[:, 1:] for x in abc)
-    w = hm.omega[:, 1:]
-    Phi = body["shapes"]                                    # (n_net, K)
-    wk = 2 * np.pi * body["freq"]
-    mk = body["mass"]
-    zk = body["zeta"]
-    K = Phi.shape[1]
-    R = hm.rows
-    D = np.zeros(w.shape + (6 + K, 6 + K), complex)
-    D[..., :6, :6] = (-(w ** 2))[..., None, None] * hm.M + np.einsum("rhn,ni,nj->rhij", a, R, R)
-    D[..., :6, 6:] = np.einsum("rhn,ni,nk->rhik", b, R, Phi)
-    D[..., 6:, :6] = np.einsum("rhn,nk,ni->rhki", b, Phi, R)
-    modal = mk * (wk ** 2 - w[..., None] ** 2 + 2j * zk * wk * w[..., None])
-    D[..., 6:, 6:] = np.einsum("rhn,nk,nl->rhkl", c, Phi, Phi)
-    D[..., np.arange(6, 6 + K), np.arange(6, 6 + K)] += modal
-    rhs = np.zeros(w.shape + (6 + K,), complex)
-    rhs[..., :6] = load[:, 1:]
-    return np.linalg.solve(D, rhs[..., None])[..., 0][..., :6]
+    modes = SimpleNamespace(frequency_hz=body["freq"], modal_mass=body["mass"],
+                            damping_ratio=body["zeta"])
+    return coupled_solve(hm.M, hm.omega[:, 1:], hm.rows, body["shapes"],
+                         tuple(x[:, 1:] for x in abc), abc[0][:, 1:], modes,
+                         load[:, 1:])[..., :6]
 
 
 class _PerCylinderCombustion:

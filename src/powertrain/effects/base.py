@@ -5,10 +5,10 @@ An effect has a ``name``, a ``kind`` (structure, excitation, sensor), a ``descri
 balancer shafts and channels), ``applicable(engine)`` and ``apply(engine, params)`` (the
 changed engine model, where the effect is one). For the fast cached path
 (:func:`powertrain.effects.predict`) an effect contributes through hooks, each a no-op by
-default: an elastomer scale per network, an input-point stiffness change from the
-networks' two-ports, a load change, amplitude-dependent network factors, a change of the
-sensor reading. To add an effect: one new module with a subclass and its tests, and one
-line in :mod:`powertrain.effects.registry` (docs/extending.md).
+default: an elastomer scale per network, a change of the networks' two-ports, a load
+change, amplitude-dependent network factors, a change of the sensor reading. To add an
+effect: one new module with a subclass and its tests, and one line in
+:mod:`powertrain.effects.registry` (docs/extending.md).
 """
 
 from __future__ import annotations
@@ -110,9 +110,9 @@ class Effect:
         """Factor on every network's springs and dampers, (n_net,), or None."""
         return None
 
-    def kip(self, hm, abc, p, kip):
-        """Input-point stiffness (n_r, 17, n_net) given the networks' two-ports."""
-        return kip
+    def two_port(self, hm, abc, p):
+        """The networks' two-ports ``(a, b, c)``, each (n_r, 17, n_net), with the effect."""
+        return abc
 
     def load_delta(self, hm, p):
         """Change of the load harmonics (n_r, 17, 6), or None."""

@@ -1,8 +1,13 @@
 r"""``base_compliance``: every mount stands on a local chassis base.
 
-Mass :math:`m_b` on a spring :math:`c_b` with damping ratio ζ_b = 5 % instead of the rigid
-ground. On the cached path the network's two-port gives it exactly,
-:math:`K_{IP}' = a - b^2/(c + c_b + i\omega d_b - \omega^2 m_b)`.
+Mass :math:`m_b` on a spring :math:`c_b` with damping ratio ζ_b = 5 % between the network
+and the ground (or the body). On the cached path the base node is condensed from the
+network's two-port exactly: with :math:`k_b = c_b + i\omega d_b` and
+:math:`z = c + k_b - \omega^2 m_b`,
+
+.. math:: a' = a - b^2/z,\quad b' = b\,k_b/z,\quad c' = k_b - k_b^2/z
+
+(:math:`a'` the input-point stiffness on a rigid ground; :math:`b', c'` couple a modal body).
 """
 
 from __future__ import annotations
@@ -51,11 +56,12 @@ class BaseCompliance(Effect):
     def apply(self, engine, c_base=np.inf, m_base=10.0):
         return with_base_compliance_all(engine, c_base, m_base)
 
-    def kip(self, hm, abc, p, kip):
+    def two_port(self, hm, abc, p):
         cb, mb = p["c_base"], p["m_base"]
         if cb >= C_RIGID:
-            return kip                       # upper bound = rigid ground (the default)
+            return abc                       # upper bound = rigid ground (the default)
         a, b, c = abc
         w = hm.omega[..., None]
-        zb = cb + 1j * w * 2 * BASE_ZETA * np.sqrt(cb * mb) - w ** 2 * mb
-        return kip - b ** 2 / (c + zb)
+        kb = cb + 1j * w * 2 * BASE_ZETA * np.sqrt(cb * mb)
+        z = c + kb - w ** 2 * mb
+        return a - b ** 2 / z, b * kb / z, kb - kb ** 2 / z

@@ -44,9 +44,7 @@ GRID_FREQ = (0.85, 1.15)
 
 def _modes(engine):
     ch = getattr(engine, "chassis", None)
-    if ch is None or ch.model != "modal":
-        return ()
-    return tuple(ch.modes)
+    return () if ch is None else ch.body_modes
 
 
 class ChassisModes(Effect):

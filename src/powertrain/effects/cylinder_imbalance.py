@@ -51,6 +51,10 @@ class ScaledCombustion:
     def model(self):
         return self.base.model
 
+    @property
+    def speed_key(self):
+        return getattr(self.base, "speed_key", "combustion.traces")
+
     def speed_range(self):
         return self.base.speed_range()
 
@@ -68,9 +72,9 @@ def with_cylinder_imbalance(engine, **e):
     """Cylinder i's combustion times (1 + e<i>) [1] (``e1=...``; missing ones 0)."""
     n = engine.crank.n_cylinders
     eps = np.array([float(e.get(f"e{i + 1}", 0.0)) for i in range(n)])
-    if getattr(engine.combustion, "model", "") == "single-zone":
-        base = np.asarray(engine.combustion.imep_factors, float)
-        return engine.with_imep_factors(base * (1.0 + eps))
+    scale = getattr(engine.combustion, "with_cylinder_factors", None)
+    if scale is not None:                  # a model of its own cylinders' combustion
+        return engine.replace(combustion=scale(1.0 + eps))
     return engine.replace(combustion=ScaledCombustion(engine.combustion, 1.0 + eps))
 
 

@@ -3,9 +3,11 @@ r"""The fast cached path: channel velocities of a scenario on one
 
 Each effect of the scenario contributes through its hooks (:class:`Effect`): elastomer
 scales change the networks' two-ports (condensed by the one kernel,
-:func:`powertrain.kernels.two_port.two_port_kernel`), input-point changes act on the
-two-ports, load changes add, amplitude-dependent factors are iterated to consistency
-(under-relaxation 0.7, at most 60 iterations, tolerance 1e-6), sensor readings come last.
+:func:`powertrain.kernels.two_port.two_port_kernel`), the effects' two-port changes follow,
+load changes add, amplitude-dependent factors are iterated to consistency (under-relaxation
+0.7, at most 60 iterations, tolerance 1e-6), sensor readings come last. Every effect that
+changes the engine model predicts what its ``apply()`` runs, to round-off
+(tests/test_diagnosis_physics.py).
 """
 
 from __future__ import annotations
@@ -46,11 +48,11 @@ def _filled(hm, scenario):
     return sc
 
 
-def _kip(hm, sc, abc):
-    kip = abc[0]
+def _two_ports(sc, hm, abc):
+    """The networks' two-ports with every effect's change."""
     for eff, p in sc.values():
-        kip = eff.kip(hm, abc, p, kip)
-    return kip
+        abc = eff.two_port(hm, abc, p)
+    return abc
 
 
 def _body(hm, sc):
@@ -79,7 +81,8 @@ def _iterate(hm, sc, s0, load, amp, tol, max_iter, g0=None):
     iterations = 0
     for iterations in range(1, max_iter + 1):  # noqa: B007 (count returned)
         abc = hm.two_ports_scaled((s0[None, :] * g)[:, None, :])
-        q = hm.solve(_kip(hm, sc, abc), load, abc=abc, body=_body(hm, sc))
+        eff_abc = _two_ports(sc, hm, abc)
+        q = hm.solve(eff_abc[0], load, abc=eff_abc, body=_body(hm, sc))
         g_new = eff.amplitude_factors(hm.network_amplitude(q), p)
         change = np.max(np.abs(g_new - g))
         g = g + 0.7 * (g_new - g)
@@ -121,7 +124,8 @@ def predict(hm: HarmonicModel, scenario: dict, *, tol=1e-6, max_iter=60,
     if amp is not None:
         s0 = np.ones(len(hm.networks)) if s_el is None else s_el
         abc, iterations, g = _iterate(hm, sc, s0, load, amp, tol, max_iter, warm_factors)
-    v = hm.velocity(hm.solve(_kip(hm, sc, abc), load, abc=abc, body=_body(hm, sc)))
+    abc = _two_ports(sc, hm, abc)
+    v = hm.velocity(hm.solve(abc[0], load, abc=abc, body=_body(hm, sc)))
     for eff, p in sc.values():
         v = eff.reading(v, p)
     return Prediction(v, iterations, g)

@@ -24,8 +24,6 @@ import numpy as np
 
 from powertrain.assembly import PASSIVE, passive_name, split_side  # noqa: F401 (re-export)
 
-MODELS = ("rigid", "modal", "frf")
-
 
 @dataclass(frozen=True, eq=False)
 class BodyMode:
@@ -74,12 +72,14 @@ class MeasuredReceptance:
 
 @dataclass(frozen=True, eq=False)
 class Chassis:
-    """The body under the mounts.
+    """The body under the mounts; ``Chassis(model=...)`` makes the class of that model
+    (:class:`RigidChassis`, :class:`ModalChassis`, :class:`MeasuredChassis`), which owns the
+    body's assembly rows, its coupling to the mounts and its receptances.
 
     Attributes
     ----------
     model : str
-        ``rigid``, ``modal`` or ``frf``.
+        ``rigid``, ``modal`` or ``frf`` (the file's name of the class).
     modes : tuple of BodyMode
         ``modal`` only.
     points : tuple of str
@@ -95,29 +95,68 @@ class Chassis:
     file: str = ""
     notes: dict = field(default_factory=dict)
 
+    #: the mounts' body side does not move
+    is_rigid = False
+    #: coupled to the powertrain by its receptances in the frequency domain only
+    coupled_by_admittance = False
+
+    def __new__(cls, model="rigid", *args, **kwargs):
+        if cls is Chassis:
+            if model not in CHASSIS_CLASSES:
+                raise ValueError(f"unknown chassis model {model!r}")
+            cls = CHASSIS_CLASSES[model]
+        return object.__new__(cls)
+
     @property
-    def is_rigid(self) -> bool:
-        return self.model == "rigid"
+    def body_modes(self) -> tuple:
+        """Body modes that become coordinates of the assembled model (none by default)."""
+        return ()
 
     def shape_matrix(self, name) -> np.ndarray:
         """(3, n_modes): the shape of every mode at attachment point or body point ``name``."""
         return np.array([m.shapes[name] for m in self.modes], float).reshape(-1, 3).T
 
-    def modal_receptance(self, omega, responses, excitations) -> np.ndarray:
-        """Modal receptance matrix (3 n_resp, 3 n_exc) [m/N] at ``omega`` [rad/s]."""
-        P = np.vstack([self.shape_matrix(r) for r in responses])        # (3 nr, k)
-        Q = np.vstack([self.shape_matrix(e) for e in excitations])      # (3 ne, k)
-        d = np.array([m.modal_mass * (m.omega**2 - omega**2
-                                      + 2j * m.damping_ratio * m.omega * omega)
-                      for m in self.modes])
-        return (P / d[None, :]) @ Q.T
+    def body_rows(self, name) -> np.ndarray:
+        """Rows (3, n_body_modes) from the body coordinates to the motion at ``name``."""
+        return np.zeros((3, len(self.body_modes)))
+
+    def require_time_domain(self) -> None:
+        """Raise InputError when the body cannot be integrated in time."""
 
     def receptances(self, omegas, responses, excitations) -> np.ndarray:
         """Receptance matrices (n_omega, 3 n_resp, 3 n_exc) [m/N] at every ``omegas``
-        [rad/s] (vectorised for the modal body)."""
+        [rad/s]."""
         omegas = np.asarray(omegas, float).ravel()
-        if self.model != "modal":
-            return np.array([self.receptance_at(w, responses, excitations) for w in omegas])
+        return np.array([self.receptance_at(w, responses, excitations) for w in omegas])
+
+    def receptance_at(self, omega, responses, excitations) -> np.ndarray:
+        """Receptance matrix [m/N] of the body at ``omega`` [rad/s] (rigid: zero)."""
+        return np.zeros((3 * len(responses), 3 * len(excitations)), complex)
+
+
+class RigidChassis(Chassis):
+    """The mounts stand on the rigid ground (the thesis's set-up)."""
+
+    is_rigid = True
+
+
+class ModalChassis(Chassis):
+    """Body modes shared by the mount attachment points; they become coordinates of the
+    assembled model."""
+
+    @property
+    def body_modes(self) -> tuple:
+        return tuple(self.modes)
+
+    def body_rows(self, name) -> np.ndarray:
+        return self.shape_matrix(name)
+
+    def modal_receptance(self, omega, responses, excitations) -> np.ndarray:
+        """Modal receptance matrix (3 n_resp, 3 n_exc) [m/N] at ``omega`` [rad/s]."""
+        return self.receptances([omega], responses, excitations)[0]
+
+    def receptances(self, omegas, responses, excitations) -> np.ndarray:
+        omegas = np.asarray(omegas, float).ravel()
         P = np.vstack([self.shape_matrix(r) for r in responses])        # (3 nr, k)
         Q = np.vstack([self.shape_matrix(e) for e in excitations])      # (3 ne, k)
         wk = np.array([m.omega for m in self.modes])
@@ -128,9 +167,25 @@ class Chassis:
         return np.einsum("ik,wk,jk->wij", P, 1.0 / d, Q)
 
     def receptance_at(self, omega, responses, excitations) -> np.ndarray:
-        """Receptance matrix [m/N] of the body (modal or measured) at ``omega`` [rad/s]."""
-        if self.model == "modal":
-            return self.modal_receptance(omega, responses, excitations)
-        if self.model == "frf":
-            return self.receptance.at(omega, responses, excitations)
-        return np.zeros((3 * len(responses), 3 * len(excitations)), complex)
+        return self.modal_receptance(omega, responses, excitations)
+
+
+class MeasuredChassis(Chassis):
+    """Measured receptances between the attachment points (and to the body points), coupled
+    by admittance in the frequency domain."""
+
+    coupled_by_admittance = True
+
+    def require_time_domain(self) -> None:
+        from powertrain.errors import InputError
+        raise InputError("a measured-receptance chassis (model = \"frf\") is coupled in the "
+                         "frequency domain only: use the harmonic solver",
+                         file=self.file or None, key="chassis.model")
+
+    def receptance_at(self, omega, responses, excitations) -> np.ndarray:
+        return self.receptance.at(omega, responses, excitations)
+
+
+#: The chassis class of each ``[chassis] model`` name.
+CHASSIS_CLASSES = {"rigid": RigidChassis, "modal": ModalChassis, "frf": MeasuredChassis}
+MODELS = tuple(CHASSIS_CLASSES)

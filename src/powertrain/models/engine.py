@@ -257,6 +257,13 @@ class SingleZoneCombustion:
     intake_temperature: float
     grid_points: int = 5760
     model: str = "single-zone"
+    #: engine-file key of the speed range (named in an out-of-range error)
+    speed_key = "combustion.full_load.speed"
+
+    def with_cylinder_factors(self, factors) -> SingleZoneCombustion:
+        """Cylinder i's combustion times ``factors[i]``: its IMEP target."""
+        return dataclasses.replace(self, imep_factors=np.asarray(self.imep_factors, float)
+                                   * np.asarray(factors, float))
 
     def cycle_pressures(self, crank: CrankTrain, omega: float, load: float = 1.0):
         """Pressure of every cylinder on the cycle grid.
@@ -319,6 +326,7 @@ class MeasuredPressure:
     pressure: np.ndarray
     theta: np.ndarray
     model: str = "measured"
+    speed_key = "combustion.traces"
 
     def cycle_pressures(self, crank: CrankTrain, omega: float, load: float = 1.0):
         """Pressure of every cylinder on the grid, linearly interpolated in speed.
@@ -501,8 +509,7 @@ class Engine:
         rpm = float(rpm)
         lo, hi = self.speed_range_rpm()
         if not np.isfinite(rpm) or not lo - 1e-6 <= rpm <= hi + 1e-6:
-            key = ("combustion.full_load.speed" if self.combustion.model == "single-zone"
-                   else "combustion.traces")
+            key = getattr(self.combustion, "speed_key", "combustion.traces")
             raise InputError(f"engine speed {rpm:g} rpm outside the model's range "
                              f"{lo:g}..{hi:g} rpm", file=self.file or None, key=key)
         return rpm

@@ -23,22 +23,25 @@ from __future__ import annotations
 
 import numpy as np
 
-from powertrain.physics.mount_network import network_matrices
+from powertrain.physics.condensation import condensed_matrix, two_ports
 
 DIRECTIONS = ("x", "y", "z")
 
 
-def _two_port(model, omega):
-    """(2×2 two-port [E, G], internal response per unit x_E and per unit x_G)."""
-    M, C, K = network_matrices(*model.network(), include_ground=True)
-    D = K + 1j * omega * C - omega**2 * M
-    n = D.shape[0]
-    ends = [0, n - 1]
-    inner = list(range(1, n - 1))
-    if not inner:
-        return D[np.ix_(ends, ends)], np.zeros((0, 2), complex)
-    X = -np.linalg.solve(D[np.ix_(inner, inner)], D[np.ix_(inner, ends)])   # (ni, 2)
-    return D[np.ix_(ends, ends)] + D[np.ix_(ends, inner)] @ X, X
+def _attachment_ports(system):
+    """Frame and port rows on the coordinates [q (6), x_A (3 per mount)]: each network's
+    engine side on q, its base on its mount's attachment point along the local axis."""
+    n_a = system.n_mount_channels
+    n = 6 + n_a
+    frame = (np.zeros((n, n)), np.zeros((n, n)), np.zeros((n, n)))
+    frame[0][:6, :6] = system.M[:6, :6]
+    E = np.zeros((len(system.networks), n))
+    B = np.zeros((len(system.networks), n))
+    for k, (row, *_rest) in enumerate(system.networks):
+        m, d = divmod(k, 3)
+        E[k, :6] = row
+        B[k, 6 + 3 * m:9 + 3 * m] = system.mount_axes[m][:, d]
+    return frame, E, B
 
 
 def frf_response(system, load_harmonics, omegas):
@@ -55,42 +58,26 @@ def frf_response(system, load_harmonics, omegas):
     """
     chassis = system.chassis
     mounts = system.mount_names
-    nm = len(mounts)
-    n_a = 3 * nm
-    out_q = np.zeros((len(omegas), system.n_dof), complex)
-    out_b = np.zeros((len(omegas), n_a + 3 * len(chassis.points)), complex)
-    out_f = np.zeros((len(omegas), n_a), complex)
-    nets = [(k, row, start, ni, model) for k, (row, start, ni, model)
-            in enumerate(system.networks)]
-    for h, (w, f6) in enumerate(zip(omegas, np.asarray(load_harmonics, complex))):
-        D = np.zeros((6 + n_a, 6 + n_a), complex)
-        D[:6, :6] = -(w**2) * system.M[:6, :6]
-        ports = []
-        for k, row, start, ni, model in nets:
-            m, d = divmod(k, 3)
-            e = system.mount_axes[m][:, d]
-            T, X = _two_port(model, w)
-            a = slice(6 + 3 * m, 9 + 3 * m)
-            D[:6, :6] += T[0, 0] * np.outer(row, row)
-            D[:6, a] += T[0, 1] * np.outer(row, e)
-            D[a, :6] += T[1, 0] * np.outer(e, row)
-            D[a, a] += T[1, 1] * np.outer(e, e)
-            ports.append((row, start, ni, e, a, T, X))
-        G = chassis.receptance_at(w, mounts, mounts)
-        A = D.copy()
-        A[6:] = G @ D[6:]
-        A[6:, 6:] += np.eye(n_a)
-        rhs = np.zeros(6 + n_a, complex)
-        rhs[:6] = f6
-        sol = np.linalg.solve(A, rhs)
-        q, xa = sol[:6], sol[6:]
-        fb = -(D[6:, :6] @ q + D[6:, 6:] @ xa)
-        out_q[h, :6] = q
-        for row, start, ni, e, a, _t, X in ports:
-            if ni:
-                out_q[h, start:start + ni] = X @ np.array([row @ q, e @ xa[a.start - 6:a.stop - 6]])
-        out_b[h, :n_a] = xa
-        if chassis.points:
-            out_b[h, n_a:] = chassis.receptance_at(w, list(chassis.points), mounts) @ fb
-        out_f[h] = fb
-    return out_q, out_b, out_f
+    n_a = system.n_mount_channels
+    omegas = np.asarray(omegas, float)
+    s = 1j * omegas
+    frame, E, B = _attachment_ports(system)
+    abc, shapes = two_ports(system.ports(), s, internal=True)
+    D = condensed_matrix(frame, E, B, abc, s)                  # (n_h, 6 + n_a, 6 + n_a)
+    G = chassis.receptances(omegas, mounts, mounts)
+    A = D.copy()
+    A[:, 6:] = G @ D[:, 6:]
+    A[:, 6:, 6:] += np.eye(n_a)
+    rhs = np.zeros((omegas.size, 6 + n_a), complex)
+    rhs[:, :6] = load_harmonics
+    sol = np.linalg.solve(A, rhs[..., None])[..., 0]
+    fb = -np.einsum("hij,hj->hi", D[:, 6:], sol)
+    out_q = np.zeros((omegas.size, system.n_dof), complex)
+    out_q[:, :6] = sol[:, :6]
+    x_e, x_b = sol @ E.T, sol @ B.T
+    for k, (_row, start, ni, _model) in enumerate(system.networks):
+        X = shapes[k]
+        out_q[:, start:start + ni] = X[..., 0] * x_e[:, k, None] + X[..., 1] * x_b[:, k, None]
+    body = np.hstack([sol[:, 6:], np.einsum("hij,hj->hi", chassis.receptances(
+        omegas, list(chassis.points), mounts), fb)]) if chassis.points else sol[:, 6:]
+    return out_q, body, fb

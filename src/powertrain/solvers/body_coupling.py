@@ -8,7 +8,8 @@ axis :math:`\mathbf e_n`: :math:`x_{B,n} = \mathbf s_n\cdot\boldsymbol\eta`,
 (3 × K) the shapes of the K body modes at mount m (:class:`~powertrain.models.chassis.Chassis`,
 ``model = "modal"``). Each network is the one two-port condensation
 (:func:`powertrain.physics.mount_network.two_port`, :math:`F_E = a x_E + b x_B`,
-:math:`F_B = b x_E + c x_B`), each body mode
+:math:`F_B = b x_E + c x_B`), assembled by the one condensation
+(:func:`powertrain.physics.condensation.condensed_matrix`); each body mode
 :math:`Z_k(\omega) = m_k(\omega_k^2 - \omega^2 + 2i\zeta_k\omega_k\omega)`; per speed and
 harmonic the (6 + K) complex system
 
@@ -31,6 +32,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from powertrain.assembly import DIRECTIONS, passive_name
+from powertrain.physics.condensation import condensed_matrix
 
 
 @dataclass(frozen=True)
@@ -60,7 +62,7 @@ class ModalBody:
         """The modal body of ``engine`` (None for a rigid, absent or measured-receptance
         chassis: the fast path predicts body-side motion only for a modal body)."""
         ch = getattr(engine, "chassis", None)
-        if ch is None or ch.model != "modal" or not ch.modes:
+        if ch is None or not ch.body_modes:
             return None
         ms = np.array([ch.shape_matrix(m.name) for m in engine.mounts], float)
         ps = np.array([ch.shape_matrix(p) for p in ch.points], float).reshape(
@@ -109,49 +111,51 @@ def body_channels(mount_names, body: ModalBody) -> list:
             + [(p, a) for p in body.points for a in DIRECTIONS])
 
 
-def network_products(rows, shapes):
-    r"""Outer products per network, flattened for one matrix product each:
-    :math:`\mathbf r_n\mathbf r_n^T` (n_net, 36), :math:`\mathbf r_n\mathbf s_n^T`
-    (n_net, 6K), :math:`\mathbf s_n\mathbf s_n^T` (n_net, K²)."""
-    n = rows.shape[0]
-    return (np.einsum("ni,nj->nij", rows, rows).reshape(n, -1),
-            np.einsum("ni,nk->nik", rows, shapes).reshape(n, -1),
-            np.einsum("nk,nl->nkl", shapes, shapes).reshape(n, -1))
+def modal_frame(M, frequency_hz, modal_mass, damping_ratio):
+    r"""Frame of the rigid powertrain (mass ``M`` (6, 6)) and K body modes as single-DOF
+    oscillators: :math:`(\mathbf M_0, \mathbf C_0, \mathbf K_0)`, each (6 + K, 6 + K), so
+    that :math:`\mathbf K_0 + i\omega\mathbf C_0 - \omega^2\mathbf M_0` holds
+    :math:`Z_k(\omega)` on the body modes."""
+    wk = 2 * np.pi * np.asarray(frequency_hz, float)
+    mk = np.asarray(modal_mass, float)
+    n = 6 + wk.size
+    M0, C0, K0 = (np.zeros((n, n)) for _ in range(3))
+    M0[:6, :6] = M
+    idx = np.arange(6, n)
+    M0[idx, idx] = mk
+    C0[idx, idx] = 2.0 * np.asarray(damping_ratio, float) * wk * mk
+    K0[idx, idx] = wk ** 2 * mk
+    return M0, C0, K0
 
 
-def coupled_solve(M, omega, products, abc, kip, body: ModalBody, load):
-    r"""Solve the (6 + K) system of the module docstring for all speeds and harmonics.
+def coupled_solve(M, omega, rows, shapes, abc, kip, body, load):
+    r"""Solve the (6 + K) system of the module docstring for all speeds and harmonics through
+    the one condensation (:func:`powertrain.physics.condensation.condensed_matrix`).
 
     Parameters
     ----------
     M : ndarray (6, 6)
     omega : ndarray (n_r, n_h) [rad/s]
-    products : tuple
-        :func:`network_products` of the network rows and
-        :meth:`ModalBody.network_shapes`.
+    rows, shapes : ndarray (n_net, 6), (n_net, K)
+        Network rows :math:`\mathbf r_n` and body shapes :math:`\mathbf s_n`
+        (:meth:`ModalBody.network_shapes`).
     abc : tuple of ndarray (n_r, n_h, n_net)
         The networks' two-ports (only ``b`` and ``c`` are read).
     kip : ndarray (n_r, n_h, n_net)
         Engine-side term ``a`` (with the effects' input-point changes).
     body : ModalBody
+        Or anything with ``frequency_hz``, ``modal_mass``, ``damping_ratio``.
     load : ndarray (n_r, n_h, 6)
 
     Returns
     -------
     ndarray (n_r, n_h, 6 + K) complex: :math:`\hat{\mathbf q}` then :math:`\hat{\boldsymbol\eta}`.
     """
-    _, b, c = abc
-    K = body.n_modes
-    rr, rs, ss = products
-    sh = omega.shape
-    D = np.zeros(sh + (6 + K, 6 + K), complex)
-    D[..., :6, :6] = (-(omega ** 2))[..., None, None] * M + (kip @ rr).reshape(sh + (6, 6))
-    cross = (b @ rs).reshape(sh + (6, K))
-    D[..., :6, 6:] = cross
-    D[..., 6:, :6] = np.swapaxes(cross, -1, -2)
-    D[..., 6:, 6:] = (c @ ss).reshape(sh + (K, K))
-    idx = np.arange(6, 6 + K)
-    D[..., idx, idx] += body.impedance(omega)
+    K = shapes.shape[1]
+    E = np.hstack([rows, np.zeros((rows.shape[0], K))])
+    B = np.hstack([np.zeros_like(rows), shapes])
+    frame = modal_frame(M, body.frequency_hz, body.modal_mass, body.damping_ratio)
+    D = condensed_matrix(frame, E, B, (kip, abc[1], abc[2]), 1j * np.asarray(omega, float))
     rhs = np.zeros(omega.shape + (6 + K,), complex)
     rhs[..., :6] = load
     return np.linalg.solve(D, rhs[..., None])[..., 0]

@@ -41,13 +41,13 @@ import numpy as np
 from powertrain.analysis.fourier import harmonic_amplitudes
 from powertrain.assembly import DIRECTIONS
 from powertrain.physics import balancer as bal
+from powertrain.physics.condensation import condensed_matrix
 from powertrain.physics.mount_network import two_port
 from powertrain.physics.rigid_body import direction_row, point_motion_matrix, rigid_body_mass_matrix
 from powertrain.solvers.body_coupling import (
     ModalBody,
     body_channels,
     coupled_solve,
-    network_products,
 )
 
 #: Harmonics of the engine cycle solved: h = 1..16 are orders 0.5..8.
@@ -132,7 +132,6 @@ class HarmonicModel:
             return
         axes = [np.asarray(m.rotation, float) for m in engine.mounts]
         self.body_shapes = self.body.network_shapes(self.networks, axes)
-        self.body_products = network_products(self.rows, self.body_shapes)
         self.channels = self.channels + body_channels(self.mount_names, self.body)
         n_a, K = self.channel_matrix.shape[0], self.body.n_modes
         full = np.zeros((len(self.channels), 6 + K))
@@ -224,11 +223,11 @@ class HarmonicModel:
         K = kip[:, harmonics]
         if self.body is not None:
             abc = self.two_ports() if abc is None else abc
-            return coupled_solve(self.M, w, self.body_products,
+            return coupled_solve(self.M, w, self.rows, self.body_shapes,
                                  tuple(x[:, harmonics] for x in abc), K,
                                  self.body if body is None else body, load[:, harmonics])
-        D = (-(w ** 2))[..., None, None] * self.M + np.einsum(
-            "rhn,ni,nj->rhij", K, self.rows, self.rows)
+        frame = (self.M, np.zeros((6, 6)), np.zeros((6, 6)))
+        D = condensed_matrix(frame, self.rows, None, (K, None, None), 1j * w)
         return np.linalg.solve(D, load[:, harmonics][..., None])[..., 0]
 
     def velocity(self, q, harmonics=slice(1, N_HARMONICS)) -> np.ndarray:

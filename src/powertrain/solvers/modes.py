@@ -401,7 +401,7 @@ def engine_modes(engine, *, static=False) -> ModesResult:
     from powertrain.assembly import assemble
     from powertrain.errors import InputError
     b = engine.body
-    chassis = engine.chassis if getattr(engine.chassis, "model", "") == "modal" else None
+    chassis = engine.chassis if getattr(engine.chassis, "body_modes", ()) else None
     try:
         with np.errstate(all="ignore"):
             system = assemble(b.mass, b.cg, b.inertia, engine.mounts, chassis)

@@ -1,0 +1,267 @@
+r"""The run-up's per-speed solvers behind one protocol, chosen once per run.
+
+A :class:`Stepper` turns one speed's load over an engine cycle into the order amplitudes of
+every channel (:class:`SpeedOrders`). Four implement it:
+
+* :class:`HarmonicStepper` — the frequency-domain steady state order by order through the one
+  condensation (:func:`powertrain.solvers.harmonic.harmonic_response`);
+* :class:`AdmittanceStepper` — the same with a measured-receptance body, coupled by
+  admittance (:func:`powertrain.solvers.admittance.frf_response`);
+* :class:`ModalNewmarkStepper` — Newmark average acceleration, the recurrence diagonalised
+  once per model (:class:`powertrain.solvers.newmark.ModalNewmark`);
+* :class:`DenseNewmarkStepper` — the same recurrence in physical coordinates (Numba kernel).
+
+:func:`choose_stepper` picks one from the solver and stepper names and the chassis (which
+says whether it can be integrated in time). A time stepper sees the assembled model only
+through ``system.M``, ``C``, ``K`` and its output rows; the mount elements enter there.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass
+
+import numpy as np
+
+from powertrain.analysis.fourier import harmonic_amplitudes
+from powertrain.analysis.orders import ORDERS, order_spectrum
+from powertrain.solvers.harmonic import harmonic_response
+from powertrain.solvers.newmark import ModalNewmark, newmark
+
+#: Highest order in the frequency-domain initial-state estimate of the Newmark run (the
+#: stepper itself sees the full sampled load): load harmonics above order 40 are < 2e-5 of
+#: the 2nd order for the default engine, and their response is smaller still.
+INITIAL_STATE_MAX_ORDER = 40.0
+
+
+@dataclass(frozen=True)
+class Cycles:
+    """Time grid of a run-up: samples per engine cycle, cycles simulated and processed."""
+
+    n_cycle: int
+    angle_step_deg: float
+    cycles: int
+    processed_cycles: int
+
+    @property
+    def start(self) -> int:
+        """First sample of the processed window."""
+        return (self.cycles - self.processed_cycles) * self.n_cycle
+
+
+@dataclass
+class SpeedOrders:
+    """One speed's result: complex order amplitudes (n_ch, n_orders) of displacement,
+    velocity, acceleration and transmitted force, the mean force (n_ch,), the cycle-to-cycle
+    periodicity of the processed window (0 in the frequency domain) and the solver time [s]."""
+
+    displacement: np.ndarray
+    velocity: np.ndarray
+    acceleration: np.ndarray
+    force: np.ndarray
+    mean_force: np.ndarray
+    periodicity: float = 0.0
+    seconds: float = 0.0
+
+
+class Stepper:
+    """Protocol: ``solve(load, omega)`` -> :class:`SpeedOrders`; ``settings()`` for the
+    result file; ``setup_seconds`` spent once per model."""
+
+    solver = ""
+    setup_seconds = 0.0
+
+    def __init__(self, system, grid: Cycles):
+        self.system = system
+        self.grid = grid
+
+    def harmonics(self, load, omega, max_order=None):
+        """Load harmonics of the cycle (index j is order j/2) and their frequencies."""
+        n_h = self.grid.n_cycle // 2
+        if max_order is not None:
+            n_h = min(n_h, int(2 * max_order) + 1)
+        fh = harmonic_amplitudes(load, axis=0)[:n_h]
+        return fh, 0.5 * omega * np.arange(fh.shape[0])
+
+    def settings(self) -> dict:
+        return {"solver": self.solver, "angle_step_deg": self.grid.angle_step_deg,
+                "cycles": 0, "processed_cycles": 0,
+                "integrator": "harmonic steady state per order", "initial_state": ""}
+
+
+class HarmonicStepper(Stepper):
+    """Frequency-domain steady state per order (rigid or modal body)."""
+
+    solver = "harmonic"
+
+    def solve(self, load, omega) -> SpeedOrders:
+        t0 = time.perf_counter()
+        fh, omegas = self.harmonics(load, omega)
+        qh = harmonic_response(self.system, fh, omegas)
+        j = np.round(ORDERS * 2).astype(int)
+        w = omegas[j][:, None]
+        q_o = qh[j]                                       # (n_orders, n)
+        s = self.system
+        x = (q_o @ s.channel_matrix.T).T
+        force = ((q_o @ s.force_matrix_k.T) + 1j * w * (q_o @ s.force_matrix_d.T)).T
+        return SpeedOrders(x, 1j * w.T * x, -(w.T ** 2) * x, force,
+                           s.force_matrix_k @ qh[0].real, 0.0, time.perf_counter() - t0)
+
+
+class AdmittanceStepper(Stepper):
+    """Frequency-domain steady state per order with a measured-receptance body."""
+
+    solver = "harmonic"
+
+    def solve(self, load, omega) -> SpeedOrders:
+        from powertrain.solvers.admittance import frf_response
+        t0 = time.perf_counter()
+        fh, omegas = self.harmonics(load, omega)
+        s = self.system
+        j = np.round(ORDERS * 2).astype(int)
+        q, body, fb = frf_response(s, fh[np.r_[j, 0]], omegas[np.r_[j, 0]])
+        n_a = s.n_mount_channels
+        x = np.hstack([q[:-1] @ s.channel_matrix[:n_a].T, body[:-1]])      # (n_orders, n_ch)
+        w = omegas[j][:, None]
+        n_rest = x.shape[1] - 2 * n_a
+        force = np.hstack([fb[:-1], fb[:-1], np.zeros((len(j), n_rest))])
+        f0 = fb[-1].real
+        return SpeedOrders(x.T, (1j * w * x).T, (-(w ** 2) * x).T, force.T,
+                           np.hstack([f0, f0, np.zeros(n_rest)]), 0.0,
+                           time.perf_counter() - t0)
+
+
+class _NewmarkStepper(Stepper):
+    """Shared part of the two Newmark steppers: the processed window's order analysis."""
+
+    solver = "newmark"
+    implementation = ""
+
+    def settings(self) -> dict:
+        g = self.grid
+        return {"solver": self.solver, "angle_step_deg": g.angle_step_deg,
+                "cycles": g.cycles, "processed_cycles": g.processed_cycles,
+                "integrator": "Newmark average acceleration (beta=1/4, gamma=1/2), "
+                + self.implementation,
+                "initial_state": "static preload + frequency-domain steady state at t=0 "
+                f"(orders <= {INITIAL_STATE_MAX_ORDER:g})"}
+
+    def window_orders(self, d_c, v_c, a_c, f_c, v_prev, seconds) -> SpeedOrders:
+        """Orders of the processed window's channel signals and its periodicity against
+        the cycle before its last (``v_prev``)."""
+        revs = 2 * self.grid.processed_cycles
+        last = v_c[-self.grid.n_cycle:]
+        scale = np.max(np.abs(last)) or 1.0
+        return SpeedOrders(order_spectrum(d_c, revs).T, order_spectrum(v_c, revs).T,
+                           order_spectrum(a_c, revs).T, order_spectrum(f_c, revs).T,
+                           f_c.mean(axis=0), float(np.max(np.abs(last - v_prev)) / scale),
+                           seconds)
+
+
+class ModalNewmarkStepper(_NewmarkStepper):
+    """Newmark recurrence diagonalised once per model; needs a regular mass matrix and at
+    least two processed cycles."""
+
+    implementation = "modal (diagonalised recurrence)"
+
+    def __init__(self, system, grid: Cycles):
+        super().__init__(system, grid)
+        if grid.processed_cycles < 2:
+            raise ValueError("the modal stepper needs processed_cycles >= 2; use "
+                             "stepper='dense'")
+        t0 = time.perf_counter()
+        self.modal = ModalNewmark(system.M, system.C, system.K, load_dofs=6)
+        Cm, Z = system.channel_matrix, np.zeros_like(system.channel_matrix)
+        self.maps = self.modal.output_map(np.vstack([Cm, Z, Z, system.force_matrix_k]),
+                                          np.vstack([Z, Cm, Z, system.force_matrix_d]),
+                                          np.vstack([Z, Z, Cm, Z]))
+        self.setup_seconds = time.perf_counter() - t0
+
+    def solve(self, load, omega) -> SpeedOrders:
+        t0 = time.perf_counter()
+        g = self.grid
+        fh, omegas = self.harmonics(load, omega, INITIAL_STATE_MAX_ORDER)
+        x0, v0 = self.modal.harmonic_state(fh, omegas)
+        Y = self.modal.run_outputs(load, g.cycles, np.deg2rad(g.angle_step_deg) / omega,
+                                   x0, v0, g.start, *self.maps)
+        seconds = time.perf_counter() - t0
+        n_ch = len(self.system.channels)
+        d_c, v_c, a_c, f_c = (Y[:-1, k * n_ch:(k + 1) * n_ch] for k in range(4))
+        return self.window_orders(d_c, v_c, a_c, f_c, v_c[:g.n_cycle], seconds)
+
+
+class DenseNewmarkStepper(_NewmarkStepper):
+    """Newmark recurrence in physical coordinates (any mass matrix)."""
+
+    implementation = "dense"
+
+    def solve(self, load, omega) -> SpeedOrders:
+        t0 = time.perf_counter()
+        g, s = self.grid, self.system
+        fh, omegas = self.harmonics(load, omega, INITIAL_STATE_MAX_ORDER)
+        qh = harmonic_response(s, fh, omegas)
+        # periodic steady-state estimate at t = 0: static preload + harmonic solution
+        x0 = qh.real.sum(axis=0)
+        v0 = (1j * omegas[:, None] * qh).real.sum(axis=0)
+        a0 = (-(omegas ** 2)[:, None] * qh).real.sum(axis=0)
+        F = np.zeros((g.cycles * g.n_cycle + 1, s.n_dof))
+        F[:, :6] = np.concatenate([np.tile(load, (g.cycles, 1)), load[:1]])
+        X, V, A = newmark(s.M, s.C, s.K, F, np.deg2rad(g.angle_step_deg) / omega, x0, v0, a0)
+        seconds = time.perf_counter() - t0
+        n = g.n_cycle
+        win = slice(g.start, g.start + g.processed_cycles * n)
+        d_c, v_c, a_c, f_c = self._outputs(X[win], V[win], A[win])
+        v_prev = v_c[:n] if g.processed_cycles >= 2 else \
+            self._outputs(X[g.start - n:g.start], V[g.start - n:g.start],
+                          A[g.start - n:g.start])[1]
+        return self.window_orders(d_c, v_c, a_c, f_c, v_prev, seconds)
+
+    def _outputs(self, q, v, a):
+        s = self.system
+        Cm = s.channel_matrix
+        return (q @ Cm.T, v @ Cm.T, a @ Cm.T,
+                q @ s.force_matrix_k.T + v @ s.force_matrix_d.T)
+
+
+def _auto_newmark(system, grid):
+    if grid.processed_cycles < 2:
+        return DenseNewmarkStepper(system, grid)
+    try:
+        return ModalNewmarkStepper(system, grid)
+    except np.linalg.LinAlgError:
+        return DenseNewmarkStepper(system, grid)
+
+
+#: Newmark implementations by their ``--stepper`` name.
+NEWMARK_STEPPERS = {"auto": _auto_newmark, "modal": ModalNewmarkStepper,
+                    "dense": DenseNewmarkStepper}
+
+
+def _newmark(system, grid, stepper):
+    chassis = system.chassis
+    if chassis is not None:
+        chassis.require_time_domain()
+    if stepper not in NEWMARK_STEPPERS:
+        raise ValueError(f"unknown stepper {stepper!r}")
+    return NEWMARK_STEPPERS[stepper](system, grid)
+
+
+def _harmonic(system, grid, stepper):
+    if stepper not in NEWMARK_STEPPERS:
+        raise ValueError(f"unknown stepper {stepper!r}")
+    chassis = system.chassis
+    if chassis is not None and chassis.coupled_by_admittance:
+        return AdmittanceStepper(system, grid)
+    return HarmonicStepper(system, grid)
+
+
+#: Solvers by their ``--solver`` name.
+SOLVERS = {"newmark": _newmark, "harmonic": _harmonic}
+
+
+def choose_stepper(system, solver, stepper, grid: Cycles) -> Stepper:
+    """The stepper of a run-up: ``solver`` (``newmark`` or ``harmonic``), the Newmark
+    implementation ``stepper`` (``auto``, ``modal``, ``dense``) and the chassis decide."""
+    if solver not in SOLVERS:
+        raise ValueError(f"unknown solver {solver!r}")
+    return SOLVERS[solver](system, grid, stepper)
