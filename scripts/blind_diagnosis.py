@@ -82,7 +82,7 @@ def run_case(task):
             "category": case.category, "detectable": case.detectable,
             "truth_set": case.truth_set, "expected_set": case.expected_set,
             "gap_rms_db": case.stats[0], "gap_p95_db": case.stats[1],
-            "sigma_db": case.sigma_db, "verdict": d["verdict"],
+            "sigma_db": case.noise_db, "verdict": d["verdict"],
             "claimed": sorted(chosen.get("effects", [])) if chosen else [],
             "parameters": chosen.get("parameters") if chosen else None,
             "ambiguous": d.get("ambiguous_between", []), "shrink": shrink,
@@ -97,7 +97,7 @@ def _print_truth(tasks):
         c = _make(i, names, eng, seed)[0]
         det = "-" if c.category == "none" else "yes" if c.detectable else "no"
         print(f"{i:>3} {'+'.join(names) or 'none':<40} {eng:<6} {c.stats[0]:>6.2f} "
-              f"{c.stats[1]:>5.1f} {c.sigma_db:>4.2f} {det:>3}  {'+'.join(c.expected_set)}")
+              f"{c.stats[1]:>5.1f} {c.noise_db:>4.2f} {det:>3}  {'+'.join(c.expected_set)}")
 
 
 def _run_all(tasks, jobs, scheduler):

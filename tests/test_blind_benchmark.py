@@ -25,6 +25,7 @@ def _rows(path):
     return [{k: v for k, v in r.items() if k not in TIMES} for r in json.loads(path.read_text())]
 
 
+@pytest.mark.slow
 def test_local_cluster_benchmark_equals_serial(tmp_path, capsys):
     pytest.importorskip("distributed")
     seed = str(int.from_bytes(os.urandom(4), "little"))

@@ -12,7 +12,6 @@ import dataclasses
 from pathlib import Path
 
 import numpy as np
-import pytest
 
 from powertrain.effects import EFFECTS, predict
 from powertrain.iotools.engine_file import DEFAULT_ENGINE_PATH, read_engine
@@ -21,16 +20,12 @@ from powertrain.runup import run_runup
 from powertrain.solvers.fast_harmonic import HarmonicModel
 
 MODAL = Path(DEFAULT_ENGINE_PATH).parent / "default-modal-body.toml"
+ENGINE_FILE = MODAL          # the module's ``engine`` (tests/conftest.py)
 RPM = [1100.0, 1900.0, 2600.0, 3700.0, 5200.0]
 #: Same linear model, two exact frequency-domain paths: round-off [relative to the largest].
 ROUND_OFF = 1e-9
 #: Issue 13: Newmark vs harmonic body-side curves.
 NEWMARK_REL = 5e-3
-
-
-@pytest.fixture(scope="module")
-def engine():
-    return read_engine(MODAL)
 
 
 def _rel(a, b):

@@ -18,15 +18,11 @@ from powertrain.runup import run_runup
 
 ENGINES = Path(DEFAULT_ENGINE_PATH).parent
 MODAL = ENGINES / "default-modal-body.toml"
+ENGINE_FILE = MODAL          # the module's ``engine`` (tests/conftest.py)
 #: Issue 13: body-side curves, Newmark vs harmonic (the run-up's own Newmark tolerance).
 NEWMARK_VS_HARMONIC = 5e-3
 BODY_CHANNELS = [("left/passive", "z"), ("right/passive", "z"), ("gearbox/passive", "z"),
                  ("left/passive", "y"), ("seat_rail", "z"), ("seat_rail", "y")]
-
-
-@pytest.fixture(scope="module")
-def engine():
-    return read_engine(MODAL)
 
 
 @pytest.fixture(scope="module")

@@ -28,11 +28,7 @@ from powertrain.validation.cases import FLOOR, RPM, measure
 from powertrain.validation.passive import channels as both_sides
 
 MODAL = Path(DEFAULT_ENGINE_PATH).parent / "default-modal-body.toml"
-
-
-@pytest.fixture(scope="module")
-def engine():
-    return read_engine(MODAL)
+ENGINE_FILE = MODAL          # the module's ``engine`` (tests/conftest.py)
 
 
 @pytest.fixture(scope="module")

@@ -521,6 +521,7 @@ def doc_runs(request, shim_bin, tmp_path_factory) -> dict:
                 for doc in selected}
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("doc", RUN_FILES)
 def test_doc_commands_run(doc, doc_runs):
     failure = doc_runs[doc].result()

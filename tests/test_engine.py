@@ -40,11 +40,6 @@ ZERO_ORDER_REL = 1e-9
 MEAN_TORQUE_REL = 1e-3
 
 
-@pytest.fixture(scope="module")
-def engine():
-    return read_engine(DEFAULT_ENGINE_PATH)
-
-
 def no_offset(eng):
     return eng.replace(crank=dataclasses.replace(eng.crank, pin_offset=0.0))
 

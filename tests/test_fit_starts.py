@@ -17,14 +17,8 @@ from powertrain.diagnosis.checks import ORDER_FOLDS, order_folds
 from powertrain.diagnosis.core import _Setup
 from powertrain.diagnosis.fit import fit_candidate
 from powertrain.effects import EFFECTS, predict, sensor_reading
-from powertrain.iotools.engine_file import DEFAULT_ENGINE_PATH, read_engine
 from powertrain.iotools.measured import MeasuredRunup
 from powertrain.solvers.fast_harmonic import HarmonicModel
-
-
-@pytest.fixture(scope="module")
-def engine():
-    return read_engine(DEFAULT_ENGINE_PATH)
 
 
 def test_cross_axis_terms_make_a_symmetric_off_diagonal(engine):

@@ -17,6 +17,7 @@ def test_local_schedulers_match_serial(scheduler):
     assert run_map(_square, range(7), scheduler, workers=2) == [x * x for x in range(7)]
 
 
+@pytest.mark.slow
 def test_dask_local_cluster_matches_serial():
     pytest.importorskip("distributed")
     assert run_map(_square, range(5), "local", workers=1) == [x * x for x in range(5)]
@@ -36,6 +37,7 @@ def test_serial_executor_hands_exceptions_to_the_future():
         fut.result()
 
 
+@pytest.mark.slow
 def test_diagnosis_candidate_fits_on_a_local_dask_cluster_equal_serial():
     """The candidate fits of one diagnosis on a dask LocalCluster give the serial answer,
     number for number (each fit is a pure function of its problem)."""

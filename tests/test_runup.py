@@ -7,8 +7,7 @@ import pytest
 from network_oracle import dense_harmonic_response
 
 from powertrain.analysis.orders import ORDERS, order_label, order_spectrum, synthesis_rms
-from powertrain.assembly import assemble
-from powertrain.iotools.engine_file import DEFAULT_ENGINE_PATH, read_engine
+from powertrain.iotools.engine_file import DEFAULT_ENGINE_PATH
 from powertrain.physics.rigid_body import point_motion_matrix
 from powertrain.results import RunupResult
 from powertrain.runup import run_runup
@@ -20,17 +19,6 @@ NEWMARK_VS_HARMONIC = 5e-3
 PERIODICITY = 1e-3
 #: Issue 3: results move less than 0.1 % when the crank-angle step is halved.
 STEP_HALVING = 1e-3
-
-
-@pytest.fixture(scope="module")
-def engine():
-    return read_engine(DEFAULT_ENGINE_PATH)
-
-
-@pytest.fixture(scope="module")
-def system(engine):
-    b = engine.body
-    return assemble(b.mass, b.cg, b.inertia, engine.mounts)
 
 
 @pytest.fixture(scope="module")

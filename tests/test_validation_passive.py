@@ -10,7 +10,7 @@ hand-counted rows for the scores.
 from __future__ import annotations
 
 import numpy as np
-import pytest
+from conftest import MODAL
 
 from powertrain.effects import predict
 from powertrain.solvers.fast_harmonic import HarmonicModel
@@ -26,14 +26,11 @@ from powertrain.validation.passive import (
 )
 from powertrain.validation.scoring import passive_line, passive_rate, passive_where_line
 
+ENGINE_FILE = MODAL          # the module's ``engine`` (tests/conftest.py)
+
 #: Newmark (1 deg steps, own assembly) vs the fast harmonic model with the body: relative to
 #: each channel's largest amplitude (issue 13: 0.5 %).
 NEWMARK_REL = 5e-3
-
-
-@pytest.fixture(scope="module")
-def engine():
-    return passive_engines()["body_sz"]
 
 
 def test_truth_baseline_with_body_equals_the_fast_model(engine):

@@ -32,11 +32,6 @@ NEWMARK_REL = 5e-4
 SAME_DB = 0.02
 
 
-@pytest.fixture(scope="module")
-def engine():
-    return engines()["sz"]
-
-
 def test_truth_baseline_equals_the_model_on_the_other_path(engine):
     rpm = RPM[::10]
     h = run_runup(engine, rpm, solver="harmonic").velocity

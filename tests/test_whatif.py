@@ -21,7 +21,6 @@ from click.testing import CliRunner
 from powertrain.assembly import assemble
 from powertrain.cli import main
 from powertrain.errors import InputError
-from powertrain.iotools.engine_file import read_engine
 from powertrain.retune import band_weight, retune
 from powertrain.sweep import SerialExecutor, SweepTask, run_sweep
 from powertrain.variants import (
@@ -48,11 +47,6 @@ EXACT = 1e-9
 #: within 2 % of its target (see powertrain.retune).
 RETUNE_BAND_REL = 0.10
 RETUNE_MEAN_PTS = 0.05
-
-
-@pytest.fixture(scope="module")
-def engine():
-    return read_engine()
 
 
 def body_system(eng):

@@ -123,7 +123,7 @@ def synth(effect_names, seed, out, truth_file, engine_file, quiet):
     from powertrain.errors import InputError
     from powertrain.iotools.atomic import atomic_write
     from powertrain.iotools.engine_file import DEFAULT_ENGINE_PATH, read_engine
-    from powertrain.synth import TRUTH_EFFECTS, make_case
+    from powertrain.validation.synth import TRUTH_EFFECTS, make_case
 
     names = [] if effect_names.strip() == "none" else [
         e.strip() for e in effect_names.split(",") if e.strip()]

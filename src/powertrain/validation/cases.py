@@ -1,4 +1,4 @@
-r"""Cases of the blind benchmark: plan, engines, measurement scatter and noise, detectability.
+r"""Cases of the truth generators: plan, engines, case maker, scatter and noise, detectability.
 
 **Plan** (:func:`case_plan`), repeated every 25 cases: 14 single in-library effects
 (``mount_temperature`` and ``weak_cylinder`` three times, the four other in-library kinds
@@ -11,14 +11,20 @@ mixed, so a short run still covers most kinds.
 traces** (:func:`traces_engine`: its own single-zone traces tabulated every 250 rpm) — the
 diagnosis gets the engine the case was made on, without the hidden effect.
 
-**Measurement** (:func:`measure`): 100-rpm grid 1000–6000 rpm; each order's complex amplitude
-[RMS] times :math:`10^{\epsilon/20}`, :math:`\epsilon\sim N(0,\sigma)` (log-normal scatter, σ
-uniform 0.5–1.0 dB per case), plus complex Gaussian noise of RMS :data:`FLOOR`; the written
-orders :data:`WRITTEN_ORDERS` and the synthesis (RMS sum of all 16 noisy orders).
+**Case maker** (:func:`draw_case`, also for ``powertrain synth``,
+:mod:`powertrain.validation.synth`): draw the hidden effects, simulate the noise-free truth,
+measure it, and record its noise-free gap against the baseline.
+
+**Measurement** (:func:`measure`): 100-rpm grid 1000–6000 rpm (``synth``: 50 rpm); each
+order's complex amplitude [RMS] times :math:`10^{\epsilon/20}`,
+:math:`\epsilon\sim N(0,\sigma)` (log-normal scatter, σ uniform 0.5–1.0 dB per case),
+plus complex Gaussian noise of RMS :data:`FLOOR`; the written orders :data:`WRITTEN_ORDERS`
+and the synthesis (RMS sum of all 16 noisy orders).
 
 **Detectability** (:func:`gap_stats`, from the noise-free truth against the noise-free
 baseline, both on the truth path; never shown to the diagnosis): over the written order
-points of all speeds (floor added in power; points where both are below 3 × floor left out)
+points of all speeds (:func:`gaps_db`: floor added in power; points where both are at the
+floor, :func:`powertrain.analysis.noise_floor.censoring_level`, left out)
 the gap RMS reaches :data:`DETECT_RMS_DB` or the 95th percentile of ``|gap|`` reaches
 :data:`DETECT_LOCAL_DB`. For a pair each member is also classified alone; the *expected*
 answer is the library matches of the members detectable alone (all members if none is).
@@ -31,6 +37,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from powertrain.analysis.noise_floor import censoring_level
 from powertrain.validation import truth as tr
 from powertrain.validation.kinds import IN_LIBRARY, KINDS
 
@@ -125,11 +132,19 @@ def written_levels(velocity, floor=FLOOR):
     return np.sqrt((np.abs(velocity[..., idx]) / np.sqrt(2)) ** 2 + floor ** 2)
 
 
-def gap_stats(reference, velocity):
-    """(RMS, 95th percentile of |gap|) [dB] of ``velocity`` against ``reference``."""
+def gaps_db(reference, velocity) -> np.ndarray:
+    """``|gap|`` [dB] of ``velocity`` against ``reference`` at the written order points that
+    are not both at the floor (the one noise-floor rule,
+    :func:`powertrain.analysis.noise_floor.censoring_level`), flattened."""
     a, b = written_levels(reference), written_levels(velocity)
-    keep = np.maximum(a, b) >= 3 * FLOOR
-    g = np.abs(20 * np.log10(b / a))[keep]
+    keep = np.maximum(a, b) >= censoring_level(FLOOR)
+    return np.abs(20 * np.log10(b / a))[keep]
+
+
+def gap_stats(reference, velocity):
+    """(RMS, 95th percentile of |gap|) [dB] of ``velocity`` against ``reference``
+    (:func:`gaps_db`)."""
+    g = gaps_db(reference, velocity)
     if g.size == 0:
         return 0.0, 0.0
     return float(np.sqrt(np.mean(g ** 2))), float(np.percentile(g, 95))
@@ -140,8 +155,9 @@ def is_detectable(stats) -> bool:
     return bool(stats[0] >= DETECT_RMS_DB or stats[1] >= DETECT_LOCAL_DB)
 
 
-def measure(velocity, sigma_db, rng, source="", channels=None):
-    """Noisy measured run-up (:class:`~powertrain.iotools.measured.MeasuredRunup`)."""
+def measure(velocity, sigma_db, rng, source="", channels=None, rpm=RPM):
+    """Noisy measured run-up (:class:`~powertrain.iotools.measured.MeasuredRunup`) of the
+    noise-free ``velocity`` (n_r, n_ch, 16) at the speeds ``rpm``."""
     from powertrain.analysis.orders import order_label
     from powertrain.iotools.measured import MeasuredRunup
     amp = velocity / np.sqrt(2) * 10 ** (rng.normal(0, sigma_db, velocity.shape) / 20)
@@ -151,45 +167,76 @@ def measure(velocity, sigma_db, rng, source="", channels=None):
     curves = {}
     for c, (m, d) in enumerate(channels):
         for o in WRITTEN_ORDERS:
-            curves[(m, d, order_label(o))] = (RPM.copy(), lev[:, c, int(round(2 * o)) - 1].copy())
-        curves[(m, d, "synthesis")] = (RPM.copy(), syn[:, c].copy())
-    return MeasuredRunup(curves, source=source, comments=["SYNTHETIC: blind benchmark truth"])
+            curves[(m, d, order_label(o))] = (rpm.copy(), lev[:, c, int(round(2 * o)) - 1].copy())
+        curves[(m, d, "synthesis")] = (rpm.copy(), syn[:, c].copy())
+    return MeasuredRunup(curves, source=source, comments=[f"SYNTHETIC: {source}"])
 
 
 @dataclass
 class Case:
-    """One benchmark case: what the diagnosis sees and what only the scorer knows."""
+    """One case: what the diagnosis sees and what only the scorer knows.
+
+    ``noise_db`` is the measurement scatter [dB, 1σ]; ``stats`` the noise-free gap
+    (:func:`gap_stats`) of the truth ``clean`` against the baseline, ``member_stats`` that of
+    each member of a pair alone; ``kinds`` the truth kinds the names refer to
+    (:data:`~powertrain.validation.kinds.KINDS`, or those of ``powertrain synth``).
+    """
 
     index: int
     names: list
     engine_kind: str
     seed: int
     measured: object
-    sigma_db: float
+    noise_db: float
     truth: list
     clean: np.ndarray
     stats: tuple
     member_stats: dict = field(default_factory=dict)
+    kinds: dict = field(default_factory=lambda: KINDS)
 
     @property
     def category(self) -> str:
         """``"none"``, ``"in"`` (every hidden effect in the library) or ``"out"``."""
         if not self.names:
             return "none"
-        return "in" if all(KINDS[n].library for n in self.names) else "out"
+        return "in" if all(self.kinds[n].library for n in self.names) else "out"
 
     @property
     def detectable(self) -> bool:
         return bool(self.names) and is_detectable(self.stats)
 
     @property
+    def effect_rms_db(self) -> float:
+        """Noise-free gap RMS of the truth against the baseline [dB]."""
+        return self.stats[0]
+
+    @property
     def truth_set(self) -> list:
-        return sorted({KINDS[n].library or "outside" for n in self.names})
+        return sorted({self.kinds[n].library or "outside" for n in self.names})
 
     @property
     def expected_set(self) -> list:
         alone = [n for n in self.names if is_detectable(self.member_stats.get(n, self.stats))]
-        return sorted({KINDS[n].library or "outside" for n in (alone or self.names)})
+        return sorted({self.kinds[n].library or "outside" for n in (alone or self.names)})
+
+    def csv_text(self) -> str:
+        """The measured CSV (long format); with a body under the mounts (channels
+        ``NAME/passive`` and body points) with the ``side`` column."""
+        from powertrain.assembly import split_side
+        names = {m for m, _, _ in self.measured.curves}
+        bases = {split_side(m)[0] for m in names if split_side(m)[1] == "passive"}
+        lines = [f"# SYNTHETIC measured run-up (powertrain synth, seed {self.seed}); the hidden "
+                 "effect is not stated here",
+                 "mount,direction,quantity,rpm,side,velocity_rms_mm_per_s" if bases else
+                 "mount,direction,quantity,rpm,velocity_rms_mm_per_s"]
+        for (m, d, q), (r, v) in self.measured.curves.items():
+            base, side = split_side(m)
+            if bases and side == "active" and base not in bases:
+                side = "passive"                     # a body point of interest
+            col = f",{side}" if bases else ""
+            for ri, vi in zip(r, v):
+                lines.append(f"{base},{d},{q},{ri:g}{col},{vi * 1e3:.6g}")
+        return "\n".join(lines) + "\n"
 
 
 def make_case(index, names, engine_kind, seed) -> Case:
@@ -200,19 +247,30 @@ def make_case(index, names, engine_kind, seed) -> Case:
                      "blind case")
 
 
-def draw_case(index, names, engine_kind, seed, engine, base, simulate, channels,
-              label) -> Case:
-    """Draw the hidden effects ``names`` on ``engine``, simulate them
-    (``simulate(engine, truth)``, noise-free, ``base`` without them) and measure
-    ``channels`` (source ``"{label} {index} (seed {seed})"``); pairs also get each member's
-    gap alone."""
+def draw_case(index, names, engine_kind, seed, engine, base, simulate, channels, label, *,
+              kinds=KINDS, rpm=RPM, noise_db=None, params=None, redraws=1,
+              worth=None) -> Case:
+    """The one case maker: draw the hidden effects ``names`` (:class:`TruthKind` of
+    ``kinds``) on ``engine``, simulate them (``simulate(engine, truth)``, noise-free,
+    ``base`` without them) and measure ``channels`` at ``rpm`` (source
+    ``"{label} {index} (seed {seed})"``); pairs also get each member's gap alone.
+
+    ``params`` (``{name: parameters}``) fixes parameters instead of drawing them; the draw
+    is repeated up to ``redraws`` times until ``worth(base, clean)`` holds; ``noise_db``
+    fixes the scatter (default uniform :data:`SIGMA_DB`).
+    """
     rng = np.random.default_rng(seed)
-    truth = [(n, KINDS[n].draw(rng, engine)) for n in names]
-    clean = simulate(engine, truth) if truth else base
-    sigma = float(rng.uniform(*SIGMA_DB))
-    measured = measure(clean, sigma, rng, f"{label} {index} (seed {seed})", channels)
+    truth, clean = [], base
+    for _ in range(redraws if names else 0):
+        truth = [(n, {**kinds[n].draw(rng, engine), **(params or {}).get(n, {})})
+                 for n in names]
+        clean = simulate(engine, truth)
+        if worth is None or worth(base, clean):
+            break
+    sigma = float(rng.uniform(*SIGMA_DB)) if noise_db is None else float(noise_db)
+    measured = measure(clean, sigma, rng, f"{label} {index} (seed {seed})", channels, rpm)
     members = {}
     if len(truth) > 1:
         members = {t[0]: gap_stats(base, simulate(engine, [t])) for t in truth}
     return Case(index, list(names), engine_kind, seed, measured, sigma, truth, clean,
-                gap_stats(base, clean), members)
+                gap_stats(base, clean), members, kinds)

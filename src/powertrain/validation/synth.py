@@ -1,9 +1,15 @@
-r"""Truth generator: synthetic "measured" run-ups with hidden effects, for blind tests.
+r"""The quick truth generator of ``powertrain synth``: the harmonic model with effects of its own.
 
 A case is the default (or any) engine plus zero, one or two hidden *truth* effects with
-random parameters, then measurement noise, on a dense speed grid. The truth effects are of
-higher fidelity than, and parametrised differently from, the diagnosis candidates of
-:mod:`powertrain.effects`, so a blind test is not circular:
+random parameters, measured like every case of :mod:`powertrain.validation.cases` (one case
+maker, :func:`~powertrain.validation.cases.draw_case`: one measurement model, one noise floor
+:data:`~powertrain.validation.cases.FLOOR`, one detectability rule
+:func:`~powertrain.validation.cases.is_detectable`), on a 50-rpm grid. Unlike the blind
+benchmark's truth (:mod:`powertrain.validation.truth`, Newmark on its own assembly) the
+noise-free truth here is the frequency-domain harmonic model
+(:class:`~powertrain.solvers.fast_harmonic.HarmonicModel`) with truth effects of higher
+fidelity than, and parametrised differently from, the diagnosis candidates of
+:mod:`powertrain.effects`:
 
 =====================  ==================  =====================================================
 truth effect           library match       truth model (candidate model)
@@ -38,26 +44,18 @@ truth effect           library match       truth model (candidate model)
                                            1 + κω²/(ω_t² − ω² + 2iζω_tω)
 =====================  ==================  =====================================================
 
-Effects are redrawn (up to 40 times) until their noise-free gap is at least
-:data:`MIN_EFFECT_DB` RMS over the written order points or reaches :data:`MIN_EFFECT_MAX_DB`
-somewhere: smaller effects are not worth diagnosing at 0.5–1 dB measurement noise (chassis
-modes rarely reach 0.5 dB RMS on the engine-side velocities, which are mass-controlled
-above the rigid-body modes, so for them the local criterion is what counts). Noise: each order level times
-:math:`10^{\epsilon/20}`, :math:`\epsilon\sim N(0,\sigma)`, σ uniform in 0.5–1.0 dB, then a
-noise floor :data:`FLOOR` added in power with exponential power (complex Gaussian noise);
-the synthesis is the RMS sum of all 16 noisy orders. Orders :data:`WRITTEN_ORDERS` and the
-synthesis of the nine channels are kept.
-
-Detectability: :attr:`SynthCase.heldout_effect_db` is the hidden effect's noise-free gap
-RMS on the diagnosis' held-out speeds; :func:`is_detectable` calls a case detectable when
-it reaches :data:`DETECT_DB` or :data:`DETECT_NOISE` × the noise. Below that no diagnosis can
-name the effect, and the blind test expects "no effect" (no claim) there.
+Effects are redrawn (up to :data:`REDRAWS` times) until their noise-free gap
+(:func:`~powertrain.validation.cases.gaps_db`) is at least :data:`MIN_EFFECT_DB` RMS or reaches
+:data:`MIN_EFFECT_MAX_DB` somewhere: smaller effects are not worth diagnosing at 0.5–1 dB
+measurement noise (chassis modes rarely reach 0.5 dB RMS on the engine-side velocities,
+which are mass-controlled above the rigid-body modes, so for them the local criterion is
+what counts). The diagnosis is never imported here.
 """
 
 from __future__ import annotations
 
 import dataclasses
-from dataclasses import dataclass, field
+import functools
 from types import SimpleNamespace
 
 import numpy as np
@@ -65,6 +63,8 @@ import numpy as np
 from powertrain.effects import A_REF
 from powertrain.solvers.body_coupling import coupled_solve
 from powertrain.solvers.fast_harmonic import N_HARMONICS, HarmonicModel
+from powertrain.validation.cases import draw_case, gaps_db
+from powertrain.validation.kinds import TruthKind
 
 TRUTH_EFFECTS = {
     "body_modes": "base_compliance",
@@ -76,113 +76,14 @@ TRUTH_EFFECTS = {
     "powertrain_bending": None,
     "torsional_driveline": None,
 }
-IN_LIBRARY = [k for k, v in TRUTH_EFFECTS.items() if v]
-OUT_OF_LIBRARY = [k for k, v in TRUTH_EFFECTS.items() if not v]
-#: RMS noise floor per order [m/s].
-FLOOR = 1.0e-6
-#: Orders written (0.5, 1, 1.5 carry cylinder differences; 2, 4, 6 the mass forces).
-WRITTEN_ORDERS = (0.5, 1.0, 1.5, 2.0, 2.5, 3.0, 4.0, 6.0)
+#: Speed grid of a synth case [rpm].
+RPM = np.arange(1000.0, 6000.1, 50.0)
 #: Smallest noise-free gap of a hidden effect [dB RMS over the written order points].
 MIN_EFFECT_DB = 0.5
 #: ... or this largest noise-free gap [dB].
 MIN_EFFECT_MAX_DB = 4.0
-#: A hidden effect is *detectable* when its noise-free gap RMS on the held-out speeds of the
-#: diagnosis' split reaches this [dB] ...
-DETECT_DB = 1.5
-#: ... or this multiple of the case's measurement noise (1 sigma) [1].
-DETECT_NOISE = 2.0
-
-
-def is_detectable(gap_rms_db, noise_db) -> bool:
-    """Detectability rule: noise-free held-out gap RMS ≥ :data:`DETECT_DB` or ≥
-    :data:`DETECT_NOISE` × the noise (1σ, dB)."""
-    return bool(gap_rms_db >= DETECT_DB or gap_rms_db >= DETECT_NOISE * noise_db)
-
-
-def heldout_gap_db(rpm, reference_velocity, true_velocity) -> float:
-    """Noise-free gap RMS [dB] between two velocity sets (n_r, 9, 16) on the held-out speeds of
-    :func:`powertrain.diagnosis.split_rpm` (a function of the speed grid only), written
-    orders, :data:`FLOOR` added in power, points where both are below 3 × floor left out."""
-    from powertrain.diagnosis import split_rpm
-    held = split_rpm(np.asarray(rpm, float))[1]
-    idx = [int(round(2 * o)) - 1 for o in WRITTEN_ORDERS]
-
-    def lev(v):
-        return np.sqrt((np.abs(v[held][..., idx]) / np.sqrt(2)) ** 2 + FLOOR ** 2)
-
-    a, b = lev(reference_velocity), lev(true_velocity)
-    keep = np.maximum(a, b) >= 3 * FLOOR
-    if not keep.any():
-        return 0.0
-    return float(np.sqrt(np.mean((20 * np.log10(a / b))[keep] ** 2)))
-
-
-@dataclass
-class SynthCase:
-    """A synthetic measurement and its hidden truth.
-
-    Attributes
-    ----------
-    measured : MeasuredRunup
-    truth : list of (truth effect name, parameters dict)
-    noise_db : float
-    rpm : ndarray
-    clean_velocity : ndarray (n_r, 9, 16) complex
-        Noise-free truth [m/s].
-    effect_rms_db : float
-        Noise-free gap between truth and baseline [dB RMS, written orders].
-    heldout_effect_db : float
-        The same on the diagnosis' held-out speeds only (:func:`heldout_gap_db`); decides
-        :attr:`detectable`.
-    """
-
-    measured: object
-    truth: list
-    noise_db: float
-    rpm: np.ndarray
-    clean_velocity: np.ndarray
-    effect_rms_db: float = 0.0
-    seed: int = 0
-    meta: dict = field(default_factory=dict)
-    heldout_effect_db: float = 0.0
-    member_effect_db: dict = field(default_factory=dict)
-
-    @property
-    def detectable(self) -> bool:
-        """Whether the hidden effect can be identified at all (:func:`is_detectable`);
-        False for effect-free cases."""
-        return bool(self.truth) and is_detectable(self.heldout_effect_db, self.noise_db)
-
-    @property
-    def library_effects(self) -> set:
-        return {TRUTH_EFFECTS[t] for t, _ in self.truth}
-
-    @property
-    def kind(self) -> str:
-        if not self.truth:
-            return "none"
-        if any(TRUTH_EFFECTS[t] is None for t, _ in self.truth):
-            return "out"
-        return "in"
-
-    def csv_text(self) -> str:
-        """The measured CSV; with a body under the mounts (channels ``NAME/passive`` and
-        body points) with the ``side`` column."""
-        from powertrain.assembly import split_side
-        names = {m for m, _, _ in self.measured.curves}
-        bases = {split_side(m)[0] for m in names if split_side(m)[1] == "passive"}
-        lines = [f"# SYNTHETIC measured run-up (powertrain synth, seed {self.seed}); the hidden "
-                 "effect is not stated here",
-                 "mount,direction,quantity,rpm,side,velocity_rms_mm_per_s" if bases else
-                 "mount,direction,quantity,rpm,velocity_rms_mm_per_s"]
-        for (m, d, q), (r, v) in self.measured.curves.items():
-            base, side = split_side(m)
-            if bases and side == "active" and base not in bases:
-                side = "passive"                     # a body point of interest
-            col = f",{side}" if bases else ""
-            for ri, vi in zip(r, v):
-                lines.append(f"{base},{d},{q},{ri:g}{col},{vi * 1e3:.6g}")
-        return "\n".join(lines) + "\n"
+#: Draws of a hidden effect before the last one is kept whatever its size.
+REDRAWS = 40
 
 
 # ---------------------------------------------------------------------------- truth models
@@ -342,15 +243,27 @@ def draw_truth(name, rng, n_net=9):
     raise KeyError(name)
 
 
-def _written_levels(v):
-    rms = np.abs(v) / np.sqrt(2.0)
-    idx = [int(round(2 * o)) - 1 for o in WRITTEN_ORDERS]
-    return rms, idx
+def _draw(name, rng, engine):
+    return draw_truth(name, rng, 3 * len(engine.mounts))
 
 
-def make_case(engine, truth_names, seed, *, rpm=None, hm=None, noise_db=None,
-              params=None) -> SynthCase:
-    """One synthetic measurement with the named truth effects (random parameters).
+#: The truth kinds of ``powertrain synth`` (drawn by :func:`draw_truth`; their models act
+#: together in :func:`truth_velocity`, so they have no ``apply`` of their own).
+SYNTH_KINDS = {n: TruthKind(n, lib, functools.partial(_draw, n), None)
+               for n, lib in TRUTH_EFFECTS.items()}
+
+
+def worth_diagnosing(base, velocity) -> bool:
+    """Redraw rule: the noise-free gap reaches :data:`MIN_EFFECT_DB` RMS or
+    :data:`MIN_EFFECT_MAX_DB` somewhere."""
+    g = gaps_db(base, velocity)
+    return bool(g.size) and bool(np.sqrt(np.mean(g ** 2)) >= MIN_EFFECT_DB
+                                 or np.max(g) >= MIN_EFFECT_MAX_DB)
+
+
+def make_case(engine, truth_names, seed, *, rpm=None, hm=None, noise_db=None, params=None):
+    """One synthetic measurement (:class:`~powertrain.validation.cases.Case`) with the named
+    truth effects (random parameters).
 
     Parameters
     ----------
@@ -360,7 +273,7 @@ def make_case(engine, truth_names, seed, *, rpm=None, hm=None, noise_db=None,
         Names from :data:`TRUTH_EFFECTS` (empty: effect-free).
     seed : int
     rpm : array_like, optional
-        Speeds [rpm] (default 1000..6000 step 50).
+        Speeds [rpm] (default :data:`RPM`).
     hm : HarmonicModel, optional
         Cached model of ``engine`` at ``rpm`` (reused across cases).
     noise_db : float, optional
@@ -369,45 +282,14 @@ def make_case(engine, truth_names, seed, *, rpm=None, hm=None, noise_db=None,
         ``{truth name: parameters}`` fixing some truth effects' parameters instead of
         drawing them (tests); missing keys of a given effect are drawn.
     """
-    from powertrain.analysis.orders import order_label
-    from powertrain.iotools.measured import MeasuredRunup
-    rng = np.random.default_rng(seed)
-    rpm = np.arange(1000.0, 6000.1, 50.0) if rpm is None else np.asarray(rpm, float)
+    rpm = RPM if rpm is None else np.asarray(rpm, float)
     hm = HarmonicModel(engine, rpm) if hm is None else hm
     base = hm.velocity(hm.solve(hm.two_ports()[0]))
-    rms0, idx = _written_levels(base)
-    truth, v, eff_db = [], base, 0.0
-    if truth_names:
-        for _ in range(40):
-            truth = [(n, {**draw_truth(n, rng, len(hm.networks)), **(params or {}).get(n, {})})
-                     for n in truth_names]
-            v = truth_velocity(engine, hm, truth)
-            rms1, _ = _written_levels(v)
-            a = np.sqrt(rms1[..., idx] ** 2 + FLOOR ** 2)
-            b = np.sqrt(rms0[..., idx] ** 2 + FLOOR ** 2)
-            keep = np.maximum(a, b) >= 2 * FLOOR
-            dd = (20 * np.log10(a / b))[keep]
-            eff_db = float(np.sqrt(np.mean(dd ** 2)))
-            if eff_db >= MIN_EFFECT_DB or np.max(np.abs(dd)) >= MIN_EFFECT_MAX_DB:
-                break
-    sigma = float(rng.uniform(0.5, 1.0)) if noise_db is None else float(noise_db)
-    rms = np.abs(v) / np.sqrt(2.0)
-    gain = 10 ** (rng.normal(0, sigma, rms.shape) / 20)
-    meas = np.sqrt((gain * rms) ** 2 + FLOOR ** 2 * rng.exponential(1.0, rms.shape))
-    syn = np.sqrt(np.sum(meas ** 2, axis=-1))
-    curves = {}
-    for c, (m, d) in enumerate(hm.channels):
-        for o, h in zip(WRITTEN_ORDERS, idx):
-            curves[(m, d, order_label(o))] = (rpm.copy(), meas[:, c, h].copy())
-        curves[(m, d, "synthesis")] = (rpm.copy(), syn[:, c].copy())
-    mr = MeasuredRunup(curves, source=f"synthetic case seed {seed}",
-                       comments=["SYNTHETIC"])
-    held_db = heldout_gap_db(rpm, base, v) if truth else 0.0
-    members = {}
-    if len(truth) > 1:
-        for t in truth:
-            members[t[0]] = heldout_gap_db(rpm, base, truth_velocity(engine, hm, [t]))
-    elif truth:
-        members[truth[0][0]] = held_db
-    return SynthCase(mr, truth, sigma, rpm, v, eff_db, seed, heldout_effect_db=held_db,
-                     member_effect_db=members)
+    return draw_case(0, list(truth_names), "", seed, engine, base,
+                     functools.partial(_simulate, hm), hm.channels, "synthetic case",
+                     kinds=SYNTH_KINDS, rpm=rpm, noise_db=noise_db, params=params,
+                     redraws=REDRAWS, worth=worth_diagnosing)
+
+
+def _simulate(hm, engine, truth):
+    return truth_velocity(engine, hm, truth)

@@ -1,0 +1,49 @@
+"""Shared test set-up: the data paths, the engines (each file read once per session) and the
+assembled rigid system.
+
+``engine`` is the engine of the test module: the file named by the module's
+``ENGINE_FILE`` (e.g. ``ENGINE_FILE = MODAL``) or the shipped default engine. Engines are
+immutable, so one object per file serves every module.
+"""
+
+from __future__ import annotations
+
+import functools
+from pathlib import Path
+
+import pytest
+
+from powertrain.iotools.engine_file import DEFAULT_ENGINE_PATH, read_engine
+
+ROOT = Path(__file__).resolve().parents[1]
+ENGINES = ROOT / "engines"
+MOUNTS = ROOT / "mounts"
+EXAMPLES = ROOT / "examples"
+DEFAULT_ENGINE = Path(DEFAULT_ENGINE_PATH)
+MODAL = DEFAULT_ENGINE.parent / "default-modal-body.toml"
+TORQUE_ROD = DEFAULT_ENGINE.parent / "default-torque-rod.toml"
+
+
+@functools.cache
+def shared_engine(path=DEFAULT_ENGINE):
+    """The engine of ``path``, read once per session."""
+    return read_engine(Path(path))
+
+
+@pytest.fixture(scope="module")
+def engine(request):
+    """The module's ``ENGINE_FILE`` engine, or the default engine."""
+    return shared_engine(getattr(request.module, "ENGINE_FILE", DEFAULT_ENGINE))
+
+
+@pytest.fixture(scope="session")
+def default_engine():
+    return shared_engine(DEFAULT_ENGINE)
+
+
+@pytest.fixture(scope="module")
+def system(engine):
+    """The module engine's body on its mounts, rigid chassis (:func:`powertrain.assembly.assemble`)."""
+    from powertrain.assembly import assemble
+    b = engine.body
+    return assemble(b.mass, b.cg, b.inertia, engine.mounts)

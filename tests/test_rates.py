@@ -1,0 +1,55 @@
+"""The sizing helper of the rate tests (tests/rates.py), checked by exact binomial sums
+written out here independently of the helper."""
+
+from __future__ import annotations
+
+from math import comb
+
+import pytest
+import rates
+
+from powertrain.validation.scoring import TARGETS
+
+
+def binomial_cdf(k, n, p):
+    """P(X <= k), X ~ Binomial(n, p)."""
+    return sum(comb(n, j) * p ** j * (1 - p) ** (n - j) for j in range(0, k + 1))
+
+
+@pytest.mark.parametrize("target,higher", [(TARGETS["top1"], True),
+                                            (TARGETS["unexplained_ok"], True),
+                                            (TARGETS["false_claims"], False)])
+def test_size_catches_a_rate_worse_by_a_tenth_with_power_0_8(target, higher):
+    n, k_pass = rates.size(target, higher)
+    if higher:
+        power = binomial_cdf(k_pass - 1, n, target - 0.1)          # P(k < k_pass)
+        at_target = binomial_cdf(k_pass - 1, n, target)
+    else:
+        power = 1 - binomial_cdf(k_pass, n, target + 0.1)          # P(k > k_pass)
+        at_target = 1 - binomial_cdf(k_pass, n, target)
+    assert power >= rates.POWER
+    # a test at the target itself rarely fails (one-sided 95 % Wilson bound; discreteness
+    # and the Wilson approximation leave it near, not at, 5 %)
+    assert at_target <= 0.11
+    # and n is the smallest: one case fewer has less power
+    n1 = n - 1
+    assert rates.fail_probability(n1, target, target - 0.1 if higher else target + 0.1,
+                                  higher) < rates.POWER
+
+
+def test_threshold_is_the_wilson_rule_edge():
+    n, k = rates.size(0.9)
+    assert rates.passes(k, n, 0.9) and not rates.passes(k - 1, n, 0.9)
+    n, k = rates.size(0.05, higher_is_better=False)
+    assert rates.passes(k, n, 0.05, False) and not rates.passes(k + 1, n, 0.05, False)
+
+
+@pytest.mark.parametrize("n", [2, 3, 4])
+def test_the_old_sizes_have_no_power(n):
+    """The old CI sizes (2-4 draws, 95 % two-sided Wilson interval) catch a rate 0.1 below
+    the top-1 or unexplained target with probability below 0.8: the reason for the sizing."""
+    for target in (TARGETS["top1"], TARGETS["unexplained_ok"]):
+        k_pass = rates.threshold(n, target, z=1.96)
+        fail = binomial_cdf(k_pass - 1, n, target - 0.1) if k_pass > 0 else 0.0
+        assert fail == pytest.approx(rates.fail_probability(n, target, target - 0.1, z=1.96))
+        assert fail < rates.POWER
