@@ -148,14 +148,13 @@ def _check_path_plot(engine, path_order):
 
 
 def _csv_comments(scenario, prov) -> list:
-    """``#`` lines of the run-up CSV: a SYNTHETIC label when effects were added (the file is
-    then a stand-in for a measurement, as `synth` writes), and the provenance."""
-    out = []
-    if scenario:
-        out.append(f"SYNTHETIC: simulated run-up with added effects {_effects_text(scenario)}"
-                   "; not measured")
-    out.append(f"provenance: {prov.line()}")
-    return out
+    """``#`` lines of the run-up CSV with added effects (a stand-in for a measurement, as
+    `synth` writes): the SYNTHETIC label and the provenance. A plain run-up CSV starts with
+    its header, as before."""
+    if not scenario:
+        return []
+    return [f"SYNTHETIC: simulated run-up with added effects {_effects_text(scenario)}; not "
+            "measured", f"provenance: {prov.line()}"]
 
 
 def _effects_text(scenario) -> str:
