@@ -73,6 +73,9 @@ def test_stiffness_plot_prints_a_summary_and_the_path(tmp_path):
     assert png.stat().st_size > 0
     res, _ = invoke("stiffness", MOUNT, "--plot", png, "--format", "table")
     assert len(res.output.splitlines()) > 400           # asked for: every row
+    res, _ = invoke("stiffness", MOUNT, "--plot", png, "--format", "csv")
+    assert res.stdout.startswith("frequency_hz,") and "wrote" not in res.stdout
+    assert res.stderr.strip() == f"wrote {png}"         # CSV on stdout stays clean
 
 
 def test_fit_mount_names_the_plot_it_wrote(tmp_path):
