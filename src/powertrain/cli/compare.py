@@ -200,7 +200,6 @@ def _summary(comp, elapsed) -> str:
 
 def _print_report(comp, meas, simulated, noise_floor) -> None:
     """Sources, rules, the per-channel table, per-quantity lines and what was not compared."""
-    from powertrain.analysis.noise_floor import censoring_level
     tag = " [SYNTHETIC]" if meas.synthetic else ""
     click.echo(f"measured: {meas.source}{tag}")
     click.echo(f"simulated: {simulated.source}")
@@ -210,7 +209,7 @@ def _print_report(comp, meas, simulated, noise_floor) -> None:
            f"simulation interpolated linearly in rpm and log level at {comp.n_interpolated} "
            "of them, never extrapolated")
     click.echo(f"gap = 20 log10(sim/measured) [dB] at the measured speeds; {how}; noise floor "
-               f"{noise_floor:g} mm/s (measured points below {censoring_level(noise_floor):g} "
+               f"{noise_floor:g} mm/s (measured points below {comp.exclusion_limit * 1e3:g} "
                "mm/s excluded)")
     click.echo("")
     click.echo("per channel, worst first:")
