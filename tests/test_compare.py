@@ -455,3 +455,14 @@ def test_raw_time_data_points_to_track(tmp_path, raw):
     lines = [ln for ln in res.output.splitlines() if ln.strip()]
     assert len(lines) == 1 and "raw time data" in lines[0] and "powertrain track" in lines[0]
     assert not (tmp_path / "c.json").exists()
+
+
+def test_not_compared_list_is_grouped_per_mount_and_reason():
+    from powertrain.cli.compare import _missing_lines
+    missing = [{"mount": "right", "direction": d, "quantity": q, "reason": "not in the "
+                "measured data"} for d in "xyz" for q in ("order_4", "synthesis", "order_2")]
+    missing.append({"mount": "left", "direction": "z", "quantity": "order_1.5",
+                    "reason": "no comparable point"})
+    assert _missing_lines(missing) == [
+        "right x, y, z: synthesis, order_2, order_4: not in the measured data",
+        "left z: order_1.5: no comparable point"]

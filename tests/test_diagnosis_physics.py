@@ -13,7 +13,7 @@ from powertrain.diagnosis import diagnose
 from powertrain.diagnosis.data import gap_data
 from powertrain.diagnosis.where import decompose_gap
 from powertrain.effects import EFFECTS, predict
-from powertrain.iotools.engine_file import read_engine
+from powertrain.iotools.engine_file import DEFAULT_ENGINE_PATH, read_engine
 from powertrain.iotools.measured import read_measured
 from powertrain.runup import run_runup
 from powertrain.solvers.fast_harmonic import HarmonicModel

@@ -119,7 +119,7 @@ def test_diagnose_report_figures(tmp_path, monkeypatch, saved):
 def test_stiffness_and_fit_figures(tmp_path, monkeypatch, saved, form, axis):
     res = run(tmp_path, monkeypatch, "stiffness", MOUNT, "--freq", "1:300:1", "--format",
               "csv", "--plot", "k.png", "--form", form, "--freq-axis", axis)
-    (tmp_path / "k.csv").write_text(res.output)
+    (tmp_path / "k.csv").write_text(res.stdout)   # the "wrote k.png" note goes to stderr
     run(tmp_path, monkeypatch, "fit-mount", "k.csv", "--model", "sls", "--starts", "2",
         "--out", "fit.toml", "--plot", "fit.png", "--form", form, "--freq-axis", axis)
     _assert_clean(saved, ["k.png"], "stiffness")

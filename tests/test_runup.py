@@ -7,7 +7,8 @@ import pytest
 from network_oracle import dense_harmonic_response
 
 from powertrain.analysis.orders import ORDERS, order_label, order_spectrum, synthesis_rms
-from powertrain.iotools.engine_file import DEFAULT_ENGINE_PATH
+from powertrain.assembly import assemble
+from powertrain.iotools.engine_file import DEFAULT_ENGINE_PATH, read_engine
 from powertrain.physics.rigid_body import point_motion_matrix
 from powertrain.results import RunupResult
 from powertrain.runup import run_runup

@@ -186,6 +186,12 @@ class ComparisonResult:
     not_modelled: list = field(default_factory=list)
 
     @property
+    def exclusion_limit(self) -> float:
+        """Measured levels below this are excluded [m/s]: the one noise-floor rule,
+        :func:`~powertrain.analysis.noise_floor.censoring_level` of the floor."""
+        return censoring_level(self.noise_floor)
+
+    @property
     def n_not_modelled(self) -> int:
         """Measured-not-modelled points over every channel and quantity."""
         return sum(len(e["rpm"]) for e in self.not_modelled)
@@ -240,7 +246,7 @@ class ComparisonResult:
             "notes": list(self.measured.notes) + list(self.info.get("notes", [])),
             "noise_floor_m_per_s": self.noise_floor,
             "noise_floor_margin": cm.NOISE_FLOOR_MARGIN,
-            "noise_floor_exclusion_m_per_s": censoring_level(self.noise_floor),
+            "noise_floor_exclusion_m_per_s": self.exclusion_limit,
             "simulated_at_measured_speeds": self.n_interpolated == 0,
             "frfsm_sigma_db": self.sigma_db,
             "min_channels_csac": MIN_CHANNELS_CSAC,

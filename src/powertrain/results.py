@@ -152,12 +152,13 @@ class RunupResult:
         return self.order_rms(signal)[:, c, self.order_index(order)]
 
     # ----------------------------------------------------------------- writers
-    def csv_text(self) -> str:
+    def csv_text(self, comments=()) -> str:
         """Long-format CSV text: RMS velocity [mm/s], acceleration [m/s²] and the force the
         mount transmits to the body [N] per channel, side, order and speed (body points
-        have no force: empty cell)."""
+        have no force: empty cell). ``comments`` become ``#`` lines above the header (a
+        SYNTHETIC label, the provenance)."""
         from powertrain.models.chassis import split_side
-        lines = [CSV_HEADER]
+        lines = [f"# {' '.join(str(c).split())}" for c in comments] + [CSV_HEADER]
         values = [(self.order_rms("velocity") * 1e3, self.synthesis_rms("velocity") * 1e3),
                   (self.order_rms("acceleration"), self.synthesis_rms("acceleration")),
                   (self.order_rms("mount_force"), self.synthesis_rms("mount_force"))]
@@ -176,9 +177,10 @@ class RunupResult:
                                  f"{cells[1]:.8g},{force}")
         return "\n".join(lines) + "\n"
 
-    def to_csv(self, path) -> None:
+    def to_csv(self, path, comments=()) -> None:
+        """Write :meth:`csv_text` atomically."""
         from powertrain.iotools.atomic import atomic_write
-        text = self.csv_text()
+        text = self.csv_text(comments)
         with atomic_write(path) as fh:
             fh.write(text)
 

@@ -200,7 +200,6 @@ def _summary(comp, elapsed) -> str:
 
 def _print_report(comp, meas, simulated, noise_floor) -> None:
     """Sources, rules, the per-channel table, per-quantity lines and what was not compared."""
-    from powertrain.analysis.noise_floor import censoring_level
     tag = " [SYNTHETIC]" if meas.synthetic else ""
     click.echo(f"measured: {meas.source}{tag}")
     click.echo(f"simulated: {simulated.source}")
@@ -210,7 +209,7 @@ def _print_report(comp, meas, simulated, noise_floor) -> None:
            f"simulation interpolated linearly in rpm and log level at {comp.n_interpolated} "
            "of them, never extrapolated")
     click.echo(f"gap = 20 log10(sim/measured) [dB] at the measured speeds; {how}; noise floor "
-               f"{noise_floor:g} mm/s (measured points below {censoring_level(noise_floor):g} "
+               f"{noise_floor:g} mm/s (measured points below {comp.exclusion_limit * 1e3:g} "
                "mm/s excluded)")
     click.echo("")
     click.echo("per channel, worst first:")
@@ -230,9 +229,24 @@ def _print_report(comp, meas, simulated, noise_floor) -> None:
     if comp.missing:
         click.echo("")
         click.echo("not compared:")
-        for m in comp.missing:
-            click.echo(f"  {m['mount']} {m['direction']} {m['quantity']}: {m['reason']}")
+        for line in _missing_lines(comp.missing):
+            click.echo(f"  {line}")
     click.echo("")
+
+
+def _missing_lines(missing) -> list:
+    """``MOUNT DIRS: QUANTITIES: reason``, one line per mount and reason: the directions with
+    the same quantities and reason share a line (every entry stays in the JSON)."""
+    from powertrain.iotools.measured import quantity_sort_key
+    groups = {}                                     # (mount, reason, direction) -> quantities
+    for m in missing:
+        groups.setdefault((m["mount"], m["reason"], m["direction"]), []).append(m["quantity"])
+    merged = {}                                     # (mount, reason, quantities) -> directions
+    for (mount, reason, direction), qs in groups.items():
+        key = (mount, reason, tuple(sorted(qs, key=quantity_sort_key)))
+        merged.setdefault(key, []).append(direction)
+    return [f"{mount} {', '.join(sorted(dirs))}: {', '.join(qs)}: {reason}"
+            for (mount, reason, qs), dirs in merged.items()]
 
 
 def _print_not_modelled(comp, noise_floor) -> None:

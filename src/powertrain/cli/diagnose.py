@@ -8,6 +8,32 @@ import click
 from powertrain.cli import main
 
 
+class _ListedOption(click.Option):
+    """An option whose help ends with names read from a registry when the help is shown
+    (``names`` returns them), so the registry is not imported at every start-up."""
+
+    def __init__(self, *args, names, **kwargs):
+        super().__init__(*args, **kwargs)
+        self._names = names
+        self._base_help = self.help
+
+    def get_help_record(self, ctx):
+        self.help = f"{self._base_help} {self._names()}"
+        return super().get_help_record(ctx)
+
+
+def _library_names() -> str:
+    from powertrain.effects import EFFECTS
+    return f"Known: {', '.join(EFFECTS)}."
+
+
+def _truth_names() -> str:
+    from powertrain.validation.synth import TRUTH_ALIASES, TRUTH_EFFECTS
+    old = ", ".join(f"{a} (= {n})" for a, n in TRUTH_ALIASES.items())
+    return (f"Known: {', '.join(TRUTH_EFFECTS)}; or 'none'. Former names still accepted: "
+            f"{old}.")
+
+
 @main.command()
 @click.argument("measured", type=click.Path(dir_okay=False))
 @click.option("--engine", "engine_file", type=click.Path(dir_okay=False),
@@ -21,7 +47,7 @@ from powertrain.cli import main
 @click.option("--noise-floor", type=float, default=0.001, show_default=True,
               help="RMS noise floor of the measured order curves [mm/s]; measured points "
                    "below 3x this are treated as 'below 3x floor' (censored).")
-@click.option("--effects", "effects", default="",
+@click.option("--effects", "effects", default="", cls=_ListedOption, names=_library_names,
               help="Comma-separated candidates (default: all of the library).")
 @click.option("--no-pairs", is_flag=True, help="Do not try pairs of effects.")
 @click.option("--quiet", is_flag=True, help="No progress indicator on stderr.")
@@ -45,7 +71,7 @@ def diagnose(measured, engine_file, report_dir, json_file, noise_floor, effects,
 
     \b
     Examples:
-      powertrain synth --effect balancer_shafts --seed 3 --out case.csv
+      powertrain synth --effect balancer_error --seed 3 --out case.csv
       powertrain diagnose case.csv --report out/diag --json out/diag.json
     """
     import math
@@ -96,9 +122,8 @@ def diagnose(measured, engine_file, report_dir, json_file, noise_floor, effects,
 
 @main.command()
 @click.option("--effect", "effect_names", default="none", show_default=True,
-              help="Hidden truth effect(s), comma-separated, from: body_modes, "
-                   "mount_temperature, amplitude_power, balancer_shafts, cylinder_combustion, "
-                   "sensor_triads, powertrain_bending, torsional_driveline; or 'none'.")
+              cls=_ListedOption, names=_truth_names,
+              help="Hidden truth effect(s), comma-separated.")
 @click.option("--seed", type=int, default=0, show_default=True)
 @click.option("--out", required=True, type=click.Path(dir_okay=False),
               help="CSV written (long format; the hidden effect is not written).")
@@ -123,10 +148,10 @@ def synth(effect_names, seed, out, truth_file, engine_file, quiet):
     from powertrain.errors import InputError
     from powertrain.iotools.atomic import atomic_write
     from powertrain.iotools.engine_file import DEFAULT_ENGINE_PATH, read_engine
-    from powertrain.validation.synth import TRUTH_EFFECTS, make_case
+    from powertrain.validation.synth import TRUTH_EFFECTS, make_case, truth_effect_name
 
     names = [] if effect_names.strip() == "none" else [
-        e.strip() for e in effect_names.split(",") if e.strip()]
+        truth_effect_name(e.strip()) for e in effect_names.split(",") if e.strip()]
     for e in names:
         if e not in TRUTH_EFFECTS:
             raise InputError(f"unknown truth effect {e!r} (known: {', '.join(TRUTH_EFFECTS)})",

@@ -6,6 +6,7 @@ import click
 
 from powertrain.cli import main
 from powertrain.cli.common import plot_form_options
+from powertrain.fitting import DEFAULT_SEED, DEFAULT_STARTS
 from powertrain.models.mount import TOPOLOGIES
 
 _MODELS = tuple(TOPOLOGIES)
@@ -19,12 +20,12 @@ _MODELS = tuple(TOPOLOGIES)
 @click.option("--out", required=True, type=click.Path(dir_okay=False),
               help="Fitted mount file to write (TOML, datasheet units).")
 @click.option("--plot", type=click.Path(dir_okay=False),
-              help="Write a measured-vs-fitted K*(f) plot (PNG).")
+              help="Write a measured-vs-fitted K*(f) plot (PNG); the path is printed.")
 @plot_form_options
-@click.option("--starts", type=int, default=None,
-              help="Random starting points screened [default: powertrain.fitting.DEFAULT_STARTS].")
-@click.option("--seed", type=int, default=None,
-              help="Seed of the starting points [default: powertrain.fitting.DEFAULT_SEED].")
+@click.option("--starts", type=int, default=DEFAULT_STARTS, show_default=True,
+              help="Random starting points screened.")
+@click.option("--seed", type=int, default=DEFAULT_SEED, show_default=True,
+              help="Seed of the starting points.")
 @click.option("--fmin", type=float, help="Fit only frequencies >= FMIN [Hz].")
 @click.option("--fmax", type=float, help="Fit only frequencies <= FMAX [Hz].")
 @click.option("--max-mass", type=float,
@@ -50,7 +51,6 @@ def fit_mount(measured, model, out, plot, form, freq_axis, starts, seed, fmin, f
     from pathlib import Path
 
     from powertrain.errors import InputError
-    from powertrain.fitting import DEFAULT_SEED, DEFAULT_STARTS
     from powertrain.fitting import fit_mount as fit
     from powertrain.iotools.mount_file import write_mount
     from powertrain.iotools.stiffness_csv import FREQUENCY, read_stiffness_csv
@@ -59,8 +59,6 @@ def fit_mount(measured, model, out, plot, form, freq_axis, starts, seed, fmin, f
     if model not in TOPOLOGIES:
         raise InputError(f"unknown model {model!r} (known: {', '.join(TOPOLOGIES)})",
                          file=measured, key="--model")
-    starts = DEFAULT_STARTS if starts is None else starts
-    seed = DEFAULT_SEED if seed is None else seed
     if max_mass is not None and not max_mass > 0:
         raise InputError(f"must be positive, got {max_mass}", key="--max-mass")
     if not 1 <= starts <= 10_000:
@@ -111,4 +109,4 @@ def fit_mount(measured, model, out, plot, form, freq_axis, starts, seed, fmin, f
     click.echo("parameters:")
     for p in topo.parameters:
         click.echo(f"  {p:>3s} = {from_si(result.model.params[p], units[p[0]]):.6g} {units[p[0]]}")
-    click.echo(f"wrote {out}")
+    click.echo("wrote " + ", ".join(p for p in (out, plot) if p))

@@ -112,13 +112,12 @@ def runup(rpm_from, rpm_to, rpm_step, engine_file, solver, stepper, angle_step, 
                        mount_snapshots={"mounts": json.dumps(mounts)}, provenance=prov,
                        description=f"run-up {rpm_from:g}-{rpm_to:g} rpm, {engine.name}")
         written.append(out)
-    if csv_file:
-        result.to_csv(csv_file)
-        written.append(csv_file)
-    if plot or path_plot:
-        from powertrain.cli.common import cli_provenance, engine_description, write_plot
-        fig_prov = cli_provenance(engine_description(engine, engine_path, no_balancers=no_balancers,
+    from powertrain.cli.common import cli_provenance, engine_description, write_plot
+    fig_prov = cli_provenance(engine_description(engine, engine_path, no_balancers=no_balancers,
                                                  effects=effect))
+    if csv_file:
+        result.to_csv(csv_file, _csv_comments(scenario, fig_prov))
+        written.append(csv_file)
     if plot:
         write_plot(lambda p: result.plot(path=p, provenance=fig_prov), plot)
         written.append(plot)
@@ -146,6 +145,22 @@ def _check_path_plot(engine, path_order):
     if not np.any(np.isclose(ORDERS, path_order)):
         raise InputError(f"order {path_order:g} not analysed (0.5 to 8 in steps of 0.5)",
                          key="--path-order")
+
+
+def _csv_comments(scenario, prov) -> list:
+    """``#`` lines of the run-up CSV with added effects (a stand-in for a measurement, as
+    `synth` writes): the SYNTHETIC label and the provenance. A plain run-up CSV starts with
+    its header, as before."""
+    if not scenario:
+        return []
+    return [f"SYNTHETIC: simulated run-up with added effects {_effects_text(scenario)}; not "
+            "measured", f"provenance: {prov.line()}"]
+
+
+def _effects_text(scenario) -> str:
+    """``name(param=value, ...); ...`` of the effects added [SI]."""
+    return "; ".join(f"{name}(" + ", ".join(f"{k}={v:g}" for k, v in p.items()) + ")"
+                     for name, p in scenario.items())
 
 
 def _labelled_modes(engine, frequencies_hz) -> str:
@@ -179,9 +194,7 @@ def _print_table(result, engine, engine_path, solver, scenario):
                f"{_labelled_modes(engine, result.rigid_body_modes_hz)} (damped, at the "
                "mounts' dynamic stiffness: 'powertrain modes')")
     if scenario:
-        click.echo("effects: " + "; ".join(
-            f"{name}(" + ", ".join(f"{k}={v:g}" for k, v in p.items()) + ")"
-            for name, p in result.settings["effects"].items()))
+        click.echo("effects: " + _effects_text(result.settings["effects"]))
     syn = result.synthesis_rms("velocity") * 1e3
     header = ["rpm"] + [f"{m}.{d}" for m, d in result.channels]
     rows = [[f"{r:g}"] + [float(v) for v in syn[i]] for i, r in enumerate(result.rpm)]

@@ -21,8 +21,12 @@ from powertrain.cli.common import plot_form_options
               show_default=True,
               help="frequency: condensed network (eq. 39); time: Newmark integration + FFT.")
 @click.option("--format", "fmt", type=click.Choice(["table", "csv"]), default="table",
-              show_default=True)
-@click.option("--plot", type=click.Path(dir_okay=False), help="Write a K*(f) plot (PNG).")
+              show_default=True,
+              help="Printed output: the table of every frequency, or CSV (with --plot and "
+                   "no --format: a short summary instead).")
+@click.option("--plot", type=click.Path(dir_okay=False),
+              help="Write a K*(f) plot (PNG); prints a summary (|K*| range, loss-angle peak) "
+                   "and the path instead of the full table unless --format is given.")
 @plot_form_options
 @click.option("--engine-mass", type=float, help="Engine mass on the mount [kg] (verification set-up).")
 @click.option("--force", type=float, help="Harmonic force amplitude on the engine mass [N].")
@@ -69,7 +73,26 @@ def stiffness(mount_file, engine_file, mount_dir, freq, method, fmt, plot, form,
         prov = cli_provenance()
         write_plot(lambda p: table.plot(path=p, label=model.name or label, form=form,
                                         freq_axis=freq_axis, provenance=prov), plot)
-    click.echo(table.to_csv() if fmt == "csv" else table.to_text(), nl=False)
+    explicit = click.get_current_context().get_parameter_source("fmt").name != "DEFAULT"
+    if plot and not explicit:
+        click.echo(_summary(table))
+    else:
+        click.echo(table.to_csv() if fmt == "csv" else table.to_text(), nl=False)
+    if plot:   # on stderr when stdout carries CSV (often redirected to a file)
+        click.echo(f"wrote {plot}", err=explicit and fmt == "csv")
+
+
+def _summary(table) -> str:
+    """What a plot reader checks first: |K*| range and the loss-angle peak, in N/mm, deg."""
+    import numpy as np
+    cols = table.columns()
+    f, k, phi = cols["frequency_hz"], cols["k_abs_n_per_mm"], cols["loss_angle_deg"]
+    lo, hi, top = int(np.argmin(k)), int(np.argmax(k)), int(np.argmax(phi))
+    return (f"# method: {table.method}; {f.size} frequencies {f[0]:g}..{f[-1]:g} Hz "
+            "(every value: --format table or csv)\n"
+            f"|K*| {k[0]:.4g} N/mm at {f[0]:g} Hz; min {k[lo]:.4g} N/mm at {f[lo]:g} Hz, "
+            f"max {k[hi]:.4g} N/mm at {f[hi]:g} Hz\n"
+            f"loss angle max {phi[top]:.3g} deg at {f[top]:g} Hz")
 
 
 def _model(mount_file, engine_file, mount_dir):

@@ -26,7 +26,7 @@ truth effect           library match       truth model (candidate model)
                                            (hydraulic, elastomeric) 0.08–0.25, a ≥ 1 µm;
                                            equivalent linearisation (candidate: rational law
                                            on the whole dynamic stiffness, one for all)
-``balancer_shafts``    balancer_error      per-shaft unbalance 0.75–1.25 and common drive lag
+``balancer_error``     balancer_error      per-shaft unbalance 0.75–1.25 and common drive lag
                                            ±0.35 rad plus per-shaft ±0.05 rad (candidate: gain,
                                            shaft asymmetry, one common lag)
 ``cylinder_combustion`` cylinder_imbalance per-cylinder IMEP ±12 % *and* start of combustion
@@ -70,12 +70,15 @@ TRUTH_EFFECTS = {
     "body_modes": "base_compliance",
     "mount_temperature": "mount_stiffness",
     "amplitude_power": "amplitude_stiffness",
-    "balancer_shafts": "balancer_error",
+    "balancer_error": "balancer_error",
     "cylinder_combustion": "cylinder_imbalance",
     "sensor_triads": "sensor_error",
     "powertrain_bending": None,
     "torsional_driveline": None,
 }
+#: Former names still accepted (scripts written before the names were made one with the
+#: diagnosis library's): old name -> truth effect.
+TRUTH_ALIASES = {"balancer_shafts": "balancer_error"}
 #: Speed grid of a synth case [rpm].
 RPM = np.arange(1000.0, 6000.1, 50.0)
 #: Smallest noise-free gap of a hidden effect [dB RMS over the written order points].
@@ -138,8 +141,8 @@ def truth_velocity(engine, hm: HarmonicModel, truth) -> np.ndarray:
             engine.combustion, np.asarray(engine.combustion.imep_factors) * (1 + np.array(
                 p["imep_dev"])), np.deg2rad(p["start_shift_deg"])))
         load = hm.load_of(eng)
-    if "balancer_shafts" in names:
-        p = names["balancer_shafts"]
+    if "balancer_error" in names:
+        p = names["balancer_error"]
         sh = hm.shaft_loads()
         on = 1.0 if engine.balancer.enabled else 0.0
         for k in range(sh.shape[0]):
@@ -205,6 +208,11 @@ def truth_velocity(engine, hm: HarmonicModel, truth) -> np.ndarray:
     return v
 
 
+def truth_effect_name(name: str) -> str:
+    """The truth effect's name, former names (:data:`TRUTH_ALIASES`) resolved."""
+    return TRUTH_ALIASES.get(name, name)
+
+
 def draw_truth(name, rng, n_net=9):
     """Random parameters of a truth effect (``n_net`` mount networks, three per mount: one per
     local direction; the engine has as many measured channels)."""
@@ -222,7 +230,7 @@ def draw_truth(name, rng, n_net=9):
         return {"mount_factor": s_m, "spring": sp, "damper": sp ** 0.7}
     if name == "amplitude_power":
         return {"beta": u(0.08, 0.25, 2)}
-    if name == "balancer_shafts":
+    if name == "balancer_error":
         return {"gain": u(0.75, 1.25, 2), "lag": u(-0.35, 0.35),
                 "lag_shaft": u(-0.05, 0.05, 2)}
     if name == "cylinder_combustion":
@@ -270,7 +278,7 @@ def make_case(engine, truth_names, seed, *, rpm=None, hm=None, noise_db=None, pa
     engine : Engine
         Baseline model.
     truth_names : sequence of str
-        Names from :data:`TRUTH_EFFECTS` (empty: effect-free).
+        Names from :data:`TRUTH_EFFECTS` or :data:`TRUTH_ALIASES` (empty: effect-free).
     seed : int
     rpm : array_like, optional
         Speeds [rpm] (default :data:`RPM`).
@@ -282,6 +290,8 @@ def make_case(engine, truth_names, seed, *, rpm=None, hm=None, noise_db=None, pa
         ``{truth name: parameters}`` fixing some truth effects' parameters instead of
         drawing them (tests); missing keys of a given effect are drawn.
     """
+    truth_names = [truth_effect_name(n) for n in truth_names]
+    params = {truth_effect_name(k): v for k, v in (params or {}).items()} or None
     rpm = RPM if rpm is None else np.asarray(rpm, float)
     hm = HarmonicModel(engine, rpm) if hm is None else hm
     base = hm.velocity(hm.solve(hm.two_ports()[0]))
