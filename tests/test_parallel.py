@@ -5,7 +5,7 @@ from __future__ import annotations
 import pytest
 
 from powertrain.errors import InputError
-from powertrain.parallel import check_scheduler, executor, run_map
+from powertrain.parallel import check_scheduler, executor, probe_scheduler, run_map
 
 
 def _square(x):
@@ -23,11 +23,70 @@ def test_dask_local_cluster_matches_serial():
     assert run_map(_square, range(5), "local", workers=1) == [x * x for x in range(5)]
 
 
-@pytest.mark.parametrize("bad", ["tcp://nohost", "cluster", "udp://a:1"])
+@pytest.mark.parametrize("bad", ["tcp://nohost", "cluster", "udp://a:1", "tcp://host:notaport",
+                                 "tcp://:99", "tcp://h:0", "tcp://h:65536", "tcp://a b:1"])
 def test_bad_scheduler_is_one_line_input_error(bad):
     with pytest.raises(InputError) as e:
         check_scheduler(bad)
     assert "--scheduler" in str(e.value) and "\n" not in str(e.value)
+
+
+def _server(behaviour):
+    """A TCP server on a free local port: ``silent`` accepts and never answers, ``http``
+    answers like a web server, ``closed`` nothing listens. Returns (address, stop)."""
+    import socket
+    import threading
+    sock = socket.socket()
+    sock.bind(("127.0.0.1", 0))
+    port = sock.getsockname()[1]
+    if behaviour == "closed":
+        sock.close()
+        return f"tcp://127.0.0.1:{port}", lambda: None
+    sock.listen(4)
+    held = []
+
+    def serve():
+        try:
+            while True:
+                conn, _ = sock.accept()
+                held.append(conn)
+                if behaviour == "http":
+                    conn.sendall(b"HTTP/1.0 400 Bad request\r\nContent-Length: 0\r\n\r\n")
+        except OSError:
+            pass
+    threading.Thread(target=serve, daemon=True).start()
+
+    def stop():
+        sock.close()
+        for c in held:
+            c.close()
+    return f"tcp://127.0.0.1:{port}", stop
+
+
+@pytest.mark.parametrize("behaviour,words", [("silent", "no dask scheduler answered"),
+                                             ("http", "not a dask scheduler"),
+                                             ("closed", "cannot reach")])
+def test_address_where_no_scheduler_answers_is_refused_in_time(behaviour, words):
+    """Issue 18: an HTTP server (3 EiB allocation) or a silent one (hang) behind the
+    address: a one-line error within the timeout."""
+    import time
+    address, stop = _server(behaviour)
+    t0 = time.perf_counter()
+    try:
+        with pytest.raises(InputError) as e:
+            check_scheduler(address, reach=True) if behaviour != "silent" else \
+                probe_scheduler(address, timeout=0.5)
+    finally:
+        stop()
+    assert words in str(e.value) and "--scheduler" in str(e.value)
+    assert time.perf_counter() - t0 < 5.0
+
+
+def test_a_real_scheduler_passes_the_probe():
+    distributed = pytest.importorskip("distributed")
+    with distributed.LocalCluster(n_workers=0, dashboard_address=None, processes=False,
+                                  protocol="tcp://") as cluster:
+        probe_scheduler(cluster.scheduler_address)
 
 
 def test_serial_executor_hands_exceptions_to_the_future():

@@ -56,15 +56,65 @@ def cpu_count() -> int:
         return os.cpu_count() or 1
 
 
-def check_scheduler(scheduler) -> str:
-    """Normalised scheduler name; ``InputError`` (key ``--scheduler``) if not understood."""
+def check_scheduler(scheduler, *, reach: bool = False) -> str:
+    """Normalised scheduler name; ``InputError`` (key ``--scheduler``) if not understood
+    (``tcp://HOST:PORT`` needs a host and a port 1..65535). ``reach``: also check, before
+    any work, that a dask scheduler answers there (:func:`probe_scheduler`)."""
     s = "auto" if scheduler in (None, "") else str(scheduler).strip()
-    if s in ("auto", "serial", "processes", "local") or s.startswith("tcp://"):
-        if s.startswith("tcp://") and ":" not in s[len("tcp://"):]:
-            raise InputError(f"{s!r}: expected tcp://HOST:PORT", key="--scheduler")
+    if s in ("auto", "serial", "processes", "local"):
+        return s
+    if s.startswith("tcp://"):
+        scheduler_host_port(s)
+        if reach:
+            probe_scheduler(s)
         return s
     raise InputError(f"{s!r}: expected 'local', 'serial', 'processes' or tcp://HOST:PORT",
                      key="--scheduler")
+
+
+def scheduler_host_port(address: str) -> tuple[str, int]:
+    """(host, port) of ``tcp://HOST:PORT`` (``[IPv6]:PORT`` too)."""
+    host, sep, port = address[len("tcp://"):].rpartition(":")
+    host = host[1:-1] if host.startswith("[") and host.endswith("]") else host
+    if not (sep and host and port.isdigit() and 1 <= int(port) <= 65535
+            and len(host) <= 253 and not any(c in host for c in "/@ ")):
+        raise InputError(f"{address!r}: expected tcp://HOST:PORT with a port 1..65535",
+                         key="--scheduler")
+    return host, int(port)
+
+
+#: Seconds to wait for a dask scheduler to connect and greet.
+CONNECT_TIMEOUT_S = 10.0
+
+
+def probe_scheduler(address: str, timeout: float = CONNECT_TIMEOUT_S) -> None:
+    """Refuse an address where no dask scheduler answers: nothing listens, something else
+    listens (an HTTP server waits for a request, sends nothing), or it never answers.
+
+    A dask scheduler greets every new connection first: a frame header (total length, then
+    the number of frames, both unsigned 64-bit little-endian) and its handshake."""
+    import socket
+    import struct
+    host, port = scheduler_host_port(address)
+    try:
+        with socket.create_connection((host, port), timeout=timeout) as sock:
+            sock.settimeout(timeout)
+            head = b""
+            while len(head) < 16:
+                chunk = sock.recv(16 - len(head))
+                if not chunk:
+                    break
+                head += chunk
+    except TimeoutError:
+        raise InputError(f"no dask scheduler answered at {address} within {timeout:g} s",
+                         key="--scheduler") from None
+    except OSError as exc:
+        raise InputError(f"cannot reach the dask scheduler at {address} "
+                         f"({exc.strerror or exc})", key="--scheduler") from None
+    total, frames = struct.unpack("<QQ", head) if len(head) == 16 else (0, 0)
+    if not (16 < total < 2 ** 26 and 1 <= frames <= 64):
+        raise InputError(f"what answers at {address} is not a dask scheduler",
+                         key="--scheduler")
 
 
 @contextmanager
@@ -106,8 +156,9 @@ def _dask_client(address, n):
                           dashboard_address=None) as cluster, Client(cluster) as client:
             yield client
         return
+    probe_scheduler(address)
     try:
-        client = Client(address, timeout="10s")
+        client = Client(address, timeout=f"{CONNECT_TIMEOUT_S:g}s")
     except OSError as exc:
         raise InputError(f"cannot reach the dask scheduler at {address} ({exc})",
                          key="--scheduler") from exc

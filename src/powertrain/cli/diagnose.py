@@ -93,7 +93,7 @@ def diagnose(measured, engine_file, report_dir, json_file, noise_floor, effects,
     from powertrain.cli.common import check_outputs, write_json
     from powertrain.parallel import check_scheduler
     from powertrain.progress import activity
-    scheduler = check_scheduler(scheduler or "serial")
+    scheduler = check_scheduler(scheduler or "serial", reach=True)
     check_outputs(json=json_file)
     if report_dir:
         from powertrain.iotools.atomic import check_writable

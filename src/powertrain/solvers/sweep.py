@@ -32,6 +32,13 @@ STEPS_PER_DEGREE = 1.0
 CHUNK_OUT = 8192
 #: Half-length of the decimation FIR in output samples.
 FIR_HALF = 10
+#: Bounds of a sweep, checked before any work: output samples (time data for the tracker;
+#: 2**22 is 512 s at 8192 Hz) and internal integration steps (2**24: about three minutes).
+MIN_SWEEP_SAMPLES = 1024
+MAX_SWEEP_SAMPLES = 2 ** 22
+MAX_SWEEP_STEPS = 2 ** 24
+#: Highest output sampling rate [Hz].
+MAX_SAMPLE_RATE = 2 ** 20
 
 
 def _load_table(engine, rpm_from, rpm_to):
@@ -85,13 +92,11 @@ def simulate_sweep(engine, rpm_from, rpm_to, rate_rpm_per_s, sample_rate=8192.0,
     from powertrain.kernels.newmark import modal_trapezoid_kernel
     from powertrain.solvers.newmark import ModalNewmark
     _check(engine, rpm_from, rpm_to, rate_rpm_per_s, sample_rate)
+    m, n_steps = sweep_steps(rpm_from, rpm_to, rate_rpm_per_s, sample_rate)
+    h = 1.0 / (m * sample_rate)
     if system is None:
         b = engine.body
         system = assemble(b.mass, b.cg, b.inertia, engine.mounts)
-    m = max(1, math.ceil(6.0 * rpm_to * STEPS_PER_DEGREE / sample_rate))
-    h = 1.0 / (m * sample_rate)
-    duration = (rpm_to - rpm_from) / rate_rpm_per_s
-    n_steps = int(math.floor(duration / h))
     speeds, table, n_theta = _load_table(engine, rpm_from, rpm_to)
     modal = ModalNewmark(system.M, system.C, system.K, load_dofs=6)
     Z = np.zeros_like(system.channel_matrix)
@@ -138,14 +143,16 @@ class _Decimator:
     The FIR (2 L + 1 taps, L = FIR_HALF m, Kaiser beta 8, cut-off at the output Nyquist) is
     centred, so output j is the filtered input at index j m; outputs whose support is not yet
     complete wait for the next chunk (the last 2 L input rows are kept). Chunk lengths must
-    be multiples of m.
+    be multiples of m. With m = 1 (output rate >= the internal rate) the filter is the
+    identity.
     """
 
     def __init__(self, m, n_ch):
         from scipy.signal import firwin
         self.m = m
-        self.L = FIR_HALF * m
-        self.fir = firwin(2 * self.L + 1, 1.0 / m, window=("kaiser", 8.0))
+        self.L = FIR_HALF * m if m > 1 else 0          # m = 1: nothing to decimate
+        self.fir = firwin(2 * self.L + 1, 1.0 / m, window=("kaiser", 8.0)) if m > 1 \
+            else np.ones(1)
         self.tail = np.zeros((0, n_ch))
 
     @property
@@ -159,7 +166,7 @@ class _Decimator:
         dec = upfirdn(self.fir, buf, 1, self.m, axis=0)
         i_lo = -(-(2 * self.L) // self.m)
         i_hi = (buf.shape[0] - 1) // self.m
-        self.tail = buf[-2 * self.L:] if buf.shape[0] >= 2 * self.L else buf
+        self.tail = buf[max(0, buf.shape[0] - 2 * self.L):]
         return dec[i_lo:i_hi + 1] if i_hi >= i_lo else dec[:0]
 
 
@@ -168,12 +175,31 @@ def _check(engine, rpm_from, rpm_to, rate, sample_rate):
         raise InputError("a sweep needs 0 < --from < --to", key="--from/--to")
     if not (math.isfinite(rate) and rate > 0):
         raise InputError("must be > 0 [rpm/s]", key="--sweep")
-    if not (math.isfinite(sample_rate) and sample_rate >= 256):
-        raise InputError("must be >= 256 [Hz]", key="--sample-rate")
+    if not (256 <= sample_rate <= MAX_SAMPLE_RATE):
+        raise InputError(f"must be 256..{MAX_SAMPLE_RATE:g} [Hz]", key="--sample-rate")
     lo, hi = engine.speed_range_rpm()
     if rpm_from < lo - 1e-6 or rpm_to > hi + 1e-6:
         raise InputError(f"sweep {rpm_from:g}..{rpm_to:g} rpm outside the engine's range "
                          f"{lo:g}..{hi:g} rpm", key="--from/--to")
+
+
+def sweep_steps(rpm_from, rpm_to, rate, sample_rate) -> tuple[int, int]:
+    """(internal steps per output sample, internal steps) of a sweep, bounded before any
+    work: at least :data:`MIN_SWEEP_SAMPLES` output samples, at most
+    :data:`MAX_SWEEP_SAMPLES` output samples and :data:`MAX_SWEEP_STEPS` internal steps."""
+    m = max(1, math.ceil(6.0 * rpm_to * STEPS_PER_DEGREE / sample_rate))
+    duration = (rpm_to - rpm_from) / rate
+    n_out = duration * sample_rate
+    if not n_out >= MIN_SWEEP_SAMPLES:
+        raise InputError(f"a {duration:.3g} s sweep gives {n_out:.3g} samples at "
+                         f"{sample_rate:g} Hz; at least {MIN_SWEEP_SAMPLES} needed (a slower "
+                         "sweep)", key="--sweep")
+    if not (n_out <= MAX_SWEEP_SAMPLES and n_out * m <= MAX_SWEEP_STEPS):
+        raise InputError(f"a {duration:.3g} s sweep: {n_out:.3g} samples at {sample_rate:g} "
+                         f"Hz and {n_out * m:.3g} integration steps; at most "
+                         f"{MAX_SWEEP_SAMPLES} and {MAX_SWEEP_STEPS} (a faster sweep, a "
+                         "narrower speed range or a lower --sample-rate)", key="--sweep")
+    return m, int(math.floor(n_out * m))
 
 
 def _initial_state(engine, modal, rpm):
