@@ -16,8 +16,11 @@ Both track orders 0.5..8 every 50 rpm on the same synthetic signal (orders with 
 amplitudes plus broadband noise; SYNTHETIC) and their worst error against the known
 amplitudes is printed, so the two do the same work to a comparable accuracy.
 
+Ours runs twice: with Numba's threads on all cores, and with one thread (the peer is
+single-threaded, so that pair compares the same work on the same resources).
+
 Usage: python scripts/bench_order_tracking.py [--duration 60] [--channels 16]
-Prints throughput (samples/s) of each and, last, the ratio.
+Prints throughput (samples/s) of each and, last, the ratios.
 """
 
 from __future__ import annotations
@@ -87,7 +90,21 @@ def plain_scipy(rec, orders, rpm_step):
     return grid, out
 
 
+def timed(func, *args, **kwargs):
+    """(result, wall seconds, CPU seconds summed over threads) of one call."""
+    t0, c0 = time.perf_counter(), time.process_time()
+    result = func(*args, **kwargs)
+    return result, time.perf_counter() - t0, time.process_time() - c0
+
+
+def report(label, wall, cpu, n_samples, speeds, error):
+    print(f"{label}: wall {wall:.2f} s = {n_samples / wall / 1e6:.1f} M samples/s; CPU "
+          f"{cpu:.2f} s = {n_samples / cpu / 1e6:.0f} M samples per CPU-second; {speeds} "
+          f"speeds, worst error {error:.3f} dB")
+
+
 def main(argv=None):
+    import numba
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--duration", type=float, default=60.0)
     ap.add_argument("--channels", type=int, default=16)
@@ -96,30 +113,27 @@ def main(argv=None):
     n_samples = rec.time.size * len(rec.channels)
     small, _ = make_recording(2.0, 2)
     track_recording(small, ORDERS, rpm_step=500.0)                 # JIT warm-up (cached)
-    t0, c0 = time.perf_counter(), time.process_time()
-    ours = track_recording(rec, ORDERS, rpm_step=RPM_STEP)
-    t_ours, c_ours = time.perf_counter() - t0, time.process_time() - c0
-    t0, c0 = time.perf_counter(), time.process_time()
-    grid, peer = plain_scipy(rec, ORDERS, RPM_STEP)
-    t_peer, c_peer = time.perf_counter() - t0, time.process_time() - c0
+    ours, t_ours, c_ours = timed(track_recording, rec, ORDERS, rpm_step=RPM_STEP)
+    threads = numba.get_num_threads()
+    numba.set_num_threads(1)
+    _, t_one, c_one = timed(track_recording, rec, ORDERS, rpm_step=RPM_STEP)
+    numba.set_num_threads(threads)
+    (grid, peer), t_peer, c_peer = timed(plain_scipy, rec, ORDERS, RPM_STEP)
     ref = amps / np.sqrt(2.0)
     e_ours = np.max(np.abs(20 * np.log10(ours.order_rms() / ref)))
     e_peer = np.max(np.abs(20 * np.log10(peer / ref)))
     print(f"run-up {RPM0:g}->{RPM1:g} rpm, {args.duration:g} s, {len(rec.channels)} channels "
           f"at {FS:g} Hz = {n_samples / 1e6:.1f} M samples; orders 0.5..8, every "
           f"{RPM_STEP:g} rpm; {os.cpu_count()} cores (shared machine: other jobs running)")
-    load = os.getloadavg()[0]
-    print(f"load average {load:.1f} on {os.cpu_count()} cores: wall-clock figures are "
-          "inflated by other jobs when it exceeds the core count; CPU time is summed over "
-          "threads")
-    print(f"ours (powertrain, COT, Numba): wall {t_ours:.2f} s = {n_samples / t_ours / 1e6:.1f} "
-          f"M samples/s; CPU {c_ours:.2f} s = {n_samples / c_ours / 1e6:.0f} M samples per "
-          f"CPU-second; {ours.rpm.size} speeds, worst error "
-          f"{e_ours:.3f} dB (noise incl.)")
-    print(f"plain scipy (sosfiltfilt + CubicSpline + rfft per block): wall {t_peer:.2f} s = "
-          f"{n_samples / t_peer / 1e6:.1f} M samples/s; CPU {c_peer:.2f} s = "
-          f"{n_samples / c_peer / 1e6:.0f} M samples per CPU-second; {grid.size} "
-          f"speeds, worst error {e_peer:.3f} dB")
+    print(f"load average {os.getloadavg()[0]:.1f} on {os.cpu_count()} cores: wall-clock "
+          "figures are inflated by other jobs when it exceeds the core count; CPU time is "
+          "summed over threads")
+    report(f"ours (powertrain, COT, Numba, {threads} threads)", t_ours, c_ours, n_samples,
+           ours.rpm.size, e_ours)
+    report("ours (1 Numba thread)", t_one, c_one, n_samples, ours.rpm.size, e_ours)
+    report("plain scipy, analysed blocks only (sosfiltfilt + CubicSpline + rfft per block)",
+           t_peer, c_peer, n_samples, grid.size, e_peer)
+    print(f"single-thread ratio (plain scipy / ours with 1 thread, wall): {t_peer / t_one:.1f}x")
     print(f"CPU-time ratio (plain scipy / ours): {c_peer / c_ours:.1f}x")
     print(f"ratio (plain scipy wall time / ours): {t_peer / t_ours:.1f}x")
 

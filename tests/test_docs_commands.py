@@ -470,6 +470,51 @@ def test_failures_name_the_doc_file_and_line(tmp_path):
         Command("a.md", 7, "true --out examples/whatif-variants.toml"), tmp_path, env)
 
 
+def test_shown_outputs_are_text_blocks_right_after_a_bash_block(tmp_path):
+    doc = tmp_path / "page.md"
+    doc.write_text("```bash\necho a\n```\nprose\n```text\na\n```\n"
+                   "```text\nnot after bash\n```\n```bash\necho b\n```\n# Heading\n"
+                   "```text\nafter a heading\n```\n```bash\necho c\n```\n"
+                   "```text\n$ long-command\nits output\n```\n")
+    shown = shown_outputs(doc, root=tmp_path)
+    assert [(s.line, s.block, s.lines) for s in shown] == [(6, 2, ["a"])]
+    assert [c.block for c in commands_of(doc, root=tmp_path)] == [2, 12, 19]
+
+
+@pytest.mark.parametrize(("shown", "printed", "ok"), [
+    ("overall RMS gap 0.81 dB over 3624 points", "overall RMS gap 0.81 dB over 3624 points", True),
+    ("gap 0.81 dB", "gap 0.82 dB", True),              # one unit of the last shown digit
+    ("gap 0.81 dB", "gap 0.83 dB", False),
+    ("explains 91% ... 3.80 -> 1.24 dB; ...", "explains 100% of it; 3.80 -> 0.45 dB; x", False),
+    ("explains 100% ... 3.80 -> 0.45 dB; ...", "explains 100% of it; 3.80 -> 0.45 dB; x", True),
+    ("t 10.7", "t 40.0", False),
+    ("3624 points", "3650 points", True),              # 1 % relative
+    ("3624 points", "3700 points", False),
+    ("a  +0.00 / 0.74", "a -0.00 /  0.74", True),       # whitespace runs, signed zero
+    ("ratio 1.6e-05", "ratio 1.7e-05", True),
+    ("ratio 1.6e-05", "ratio 1.9e-05", False),
+    ("solver time: ... s; wrote r.h5", "solver time: 0.011 s; wrote r.h5", True),
+    ("order_2 1000-6000 rpm", "order_2 1000-6000 rpm", True),
+    ("order_2 1000-6000 rpm", "order_4 1000-6000 rpm", False),
+    ("0 missing", "0 missing; 15.97 s", False),        # a line is matched whole
+])
+def test_a_shown_line_matches_a_printed_line(shown, printed, ok):
+    assert line_matches(shown, printed) is ok
+
+
+def test_shown_lines_are_an_excerpt_with_elision_lines():
+    printed = ["head", "a 1", "b 2", "c 3", "d 4", "tail"]
+    assert match_shown(["a 1", "b 2"], printed) is None
+    assert match_shown(["a 1", "...", "d 4"], printed) is None
+    assert match_shown(["...", "tail"], printed) is None
+    assert "not consecutive" in match_shown(["a 1", "c 3"], printed)
+    assert "nearest printed `d 4`" in match_shown(["a 1", "...", "d 9"], printed)
+    assert match_shown(["d 4", "...", "a 1"], printed) is not None       # order kept
+    stderr_only = Shown("a.md", 5, 1, ["error: x.csv: bad"])
+    assert check_shown(stderr_only, [("", "error: x.csv: bad\n")]) is None
+    assert check_shown(stderr_only, [("error: y.csv: bad\n", "")]).startswith("a.md:5: ")
+
+
 LINK = re.compile(r"\]\(([^)\s]+)\)")
 
 
