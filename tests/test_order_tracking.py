@@ -225,3 +225,49 @@ def test_noisy_quantised_rpm_channel():
     common, i1, i2 = np.intersect1d(clean.rpm, noisy.rpm, return_indices=True)
     assert common.size > 20
     assert np.max(np.abs(db(noisy.order_rms()[i2], clean.order_rms()[i1]))) <= TACHO_VS_RPM_DB
+
+
+def test_overall_level_is_the_band_limited_rms():
+    """Only tracked orders: overall = synthesis; a 1000 Hz tone of known amplitude adds its
+    mean square inside the band and nothing when the band ends below it."""
+    rec = signals.analytic_sweep(duration=8.0, rpm0=1500.0, rpm1=4500.0)
+    tone = 2e-3                                                       # [m/s] peak
+    vel = rec.channels[1]
+    tr = track_recording(rec, rpm_step=100.0, quantity="velocity", overall={})
+    assert np.max(np.abs(db(tr.overall[:, 0], tr.synthesis_rms()[:, 0]))) <= TRACKED_ORDER_DB
+    vel.values = vel.values + tone * np.cos(2 * np.pi * 1000.0 * rec.time)
+    wide = track_recording(rec, rpm_step=100.0, quantity="velocity", overall={})
+    expected = np.sqrt(wide.synthesis_rms()[:, 0] ** 2 + tone ** 2 / 2)
+    assert np.max(np.abs(db(wide.overall[:, 0], expected))) <= TRACKED_ORDER_DB
+    below = track_recording(rec, rpm_step=100.0, quantity="velocity",
+                            overall={"band": (5.0, 900.0)})
+    assert np.max(np.abs(db(below.overall[:, 0], below.synthesis_rms()[:, 0]))) \
+        <= TRACKED_ORDER_DB
+    assert below.settings["overall_band_hz"] == [5.0, 900.0]
+
+
+def test_overall_as_velocity_from_acceleration():
+    rec = signals.analytic_sweep(duration=8.0, rpm0=1500.0, rpm1=4500.0)
+    acc = track_recording(rec, rpm_step=100.0, quantity="acceleration",
+                          overall={"velocity": True}).as_velocity()
+    vel = track_recording(rec, rpm_step=100.0, quantity="velocity", overall={})
+    assert np.max(np.abs(db(acc.overall, vel.overall))) <= AS_VELOCITY_DB
+    plain = track_recording(rec, rpm_step=100.0, quantity="acceleration", overall={})
+    with pytest.raises(InputError, match="overall"):
+        plain.as_velocity()
+
+
+def test_order_spectrum_at_one_speed():
+    from powertrain.tracking import order_spectrum, speed_profile
+    rec = signals.analytic_sweep(duration=8.0, rpm0=1500.0, rpm1=4500.0)
+    spec = order_spectrum(rec, speed_profile(rec), 3000.0, 10.0, quantity="velocity")
+    rms = spec.order_rms()[0, 0]
+    on = np.isin(np.round(spec.orders * 16), np.round(signals.ANALYTIC_ORDERS * 16))
+    assert on.sum() == 16 and spec.orders[-1] == 10.0
+    assert np.max(np.abs(db(rms[on], signals.ANALYTIC_VELOCITY / np.sqrt(2)))) \
+        <= TRACKED_ORDER_DB
+    far = np.min(np.abs(spec.orders[:, None] - signals.ANALYTIC_ORDERS[None, :]), axis=1) \
+        >= 2 / 16                                                  # two lines from any order
+    assert np.max(rms[far]) < 0.01 * np.min(rms[on])
+    with pytest.raises(InputError, match="does not pass"):
+        order_spectrum(rec, speed_profile(rec), 6000.0, 10.0)
