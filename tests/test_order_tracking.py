@@ -136,29 +136,11 @@ def test_vkf_holds_order_through_tone_crossing_where_cot_smears():
     assert e_vkf <= VKF_CROSSING_DB
 
 
-def swept_resonance(fs, duration, rpm0, rpm1, order, fn, zeta):
-    """Single-DOF resonance (static gain 1) driven by ``cos(order * crank angle)`` along a
-    linear sweep, started in its steady state; exact for the piecewise-linear input on the
-    sample grid (scipy ``lsim``). Returns the recording and the envelope of the complex
-    response (cos and sin drives) at every sample: the fine-grid reference."""
-    from scipy.signal import StateSpace, lsim
-    t, rpm, th = signals.linear_sweep(fs, duration, rpm0, rpm1)
-    wn = 2 * np.pi * fn
-    system = StateSpace([[0, 1], [-wn ** 2, -2 * zeta * wn]], [[0], [wn ** 2]], [[1, 0]], [[0]])
-    w0 = 2 * np.pi * order * rpm0 / 60
-    h0 = 1 / (1 - (w0 / wn) ** 2 + 2j * zeta * w0 / wn)
-    z = [lsim(system, drive(order * th), t, X0=[part(h0), part(1j * w0 * h0)])[1]
-         for drive, part in ((np.cos, np.real), (np.sin, np.imag))]
-    rec = RawRecording(t, [RawChannel("x", "left", "active", "z", "displacement", z[0], "m")],
-                       rpm, source="swept resonance").validate()
-    return rec, np.abs(z[0] + 1j * z[1])
-
-
 def test_vkf_default_bandwidth_holds_a_swept_resonance():
     """The issue's case: order 2 sweeps through a 100 Hz resonance (zeta 0.02) at 500 rpm/s
     in a 10 s record; the default orders 0.5..8 are tracked."""
     fn, zeta = 100.0, 0.02
-    rec, envelope = swept_resonance(8192.0, 10.0, 1000.0, 6000.0, 2.0, fn, zeta)
+    rec, envelope = signals.swept_resonance(8192.0, 10.0, 1000.0, 6000.0, 2.0, fn, zeta)
     vkf = track_recording(rec, rpm_step=10.0, method="vkf")
     k = list(vkf.orders).index(2.0)
     level = np.abs(vkf.amplitude[:, 0, k])
