@@ -136,29 +136,11 @@ def test_vkf_holds_order_through_tone_crossing_where_cot_smears():
     assert e_vkf <= VKF_CROSSING_DB
 
 
-def swept_resonance(fs, duration, rpm0, rpm1, order, fn, zeta):
-    """Single-DOF resonance (static gain 1) driven by ``cos(order * crank angle)`` along a
-    linear sweep, started in its steady state; exact for the piecewise-linear input on the
-    sample grid (scipy ``lsim``). Returns the recording and the envelope of the complex
-    response (cos and sin drives) at every sample: the fine-grid reference."""
-    from scipy.signal import StateSpace, lsim
-    t, rpm, th = signals.linear_sweep(fs, duration, rpm0, rpm1)
-    wn = 2 * np.pi * fn
-    system = StateSpace([[0, 1], [-wn ** 2, -2 * zeta * wn]], [[0], [wn ** 2]], [[1, 0]], [[0]])
-    w0 = 2 * np.pi * order * rpm0 / 60
-    h0 = 1 / (1 - (w0 / wn) ** 2 + 2j * zeta * w0 / wn)
-    z = [lsim(system, drive(order * th), t, X0=[part(h0), part(1j * w0 * h0)])[1]
-         for drive, part in ((np.cos, np.real), (np.sin, np.imag))]
-    rec = RawRecording(t, [RawChannel("x", "left", "active", "z", "displacement", z[0], "m")],
-                       rpm, source="swept resonance").validate()
-    return rec, np.abs(z[0] + 1j * z[1])
-
-
 def test_vkf_default_bandwidth_holds_a_swept_resonance():
     """The issue's case: order 2 sweeps through a 100 Hz resonance (zeta 0.02) at 500 rpm/s
     in a 10 s record; the default orders 0.5..8 are tracked."""
     fn, zeta = 100.0, 0.02
-    rec, envelope = swept_resonance(8192.0, 10.0, 1000.0, 6000.0, 2.0, fn, zeta)
+    rec, envelope = signals.swept_resonance(8192.0, 10.0, 1000.0, 6000.0, 2.0, fn, zeta)
     vkf = track_recording(rec, rpm_step=10.0, method="vkf")
     k = list(vkf.orders).index(2.0)
     level = np.abs(vkf.amplitude[:, 0, k])
@@ -225,3 +207,49 @@ def test_noisy_quantised_rpm_channel():
     common, i1, i2 = np.intersect1d(clean.rpm, noisy.rpm, return_indices=True)
     assert common.size > 20
     assert np.max(np.abs(db(noisy.order_rms()[i2], clean.order_rms()[i1]))) <= TACHO_VS_RPM_DB
+
+
+def test_overall_level_is_the_band_limited_rms():
+    """Only tracked orders: overall = synthesis; a 1000 Hz tone of known amplitude adds its
+    mean square inside the band and nothing when the band ends below it."""
+    rec = signals.analytic_sweep(duration=8.0, rpm0=1500.0, rpm1=4500.0)
+    tone = 2e-3                                                       # [m/s] peak
+    vel = rec.channels[1]
+    tr = track_recording(rec, rpm_step=100.0, quantity="velocity", overall={})
+    assert np.max(np.abs(db(tr.overall[:, 0], tr.synthesis_rms()[:, 0]))) <= TRACKED_ORDER_DB
+    vel.values = vel.values + tone * np.cos(2 * np.pi * 1000.0 * rec.time)
+    wide = track_recording(rec, rpm_step=100.0, quantity="velocity", overall={})
+    expected = np.sqrt(wide.synthesis_rms()[:, 0] ** 2 + tone ** 2 / 2)
+    assert np.max(np.abs(db(wide.overall[:, 0], expected))) <= TRACKED_ORDER_DB
+    below = track_recording(rec, rpm_step=100.0, quantity="velocity",
+                            overall={"band": (5.0, 900.0)})
+    assert np.max(np.abs(db(below.overall[:, 0], below.synthesis_rms()[:, 0]))) \
+        <= TRACKED_ORDER_DB
+    assert below.settings["overall_band_hz"] == [5.0, 900.0]
+
+
+def test_overall_as_velocity_from_acceleration():
+    rec = signals.analytic_sweep(duration=8.0, rpm0=1500.0, rpm1=4500.0)
+    acc = track_recording(rec, rpm_step=100.0, quantity="acceleration",
+                          overall={"velocity": True}).as_velocity()
+    vel = track_recording(rec, rpm_step=100.0, quantity="velocity", overall={})
+    assert np.max(np.abs(db(acc.overall, vel.overall))) <= AS_VELOCITY_DB
+    plain = track_recording(rec, rpm_step=100.0, quantity="acceleration", overall={})
+    with pytest.raises(InputError, match="overall"):
+        plain.as_velocity()
+
+
+def test_order_spectrum_at_one_speed():
+    from powertrain.tracking import order_spectrum, speed_profile
+    rec = signals.analytic_sweep(duration=8.0, rpm0=1500.0, rpm1=4500.0)
+    spec = order_spectrum(rec, speed_profile(rec), 3000.0, 10.0, quantity="velocity")
+    rms = spec.order_rms()[0, 0]
+    on = np.isin(np.round(spec.orders * 16), np.round(signals.ANALYTIC_ORDERS * 16))
+    assert on.sum() == 16 and spec.orders[-1] == 10.0
+    assert np.max(np.abs(db(rms[on], signals.ANALYTIC_VELOCITY / np.sqrt(2)))) \
+        <= TRACKED_ORDER_DB
+    far = np.min(np.abs(spec.orders[:, None] - signals.ANALYTIC_ORDERS[None, :]), axis=1) \
+        >= 2 / 16                                                  # two lines from any order
+    assert np.max(rms[far]) < 0.01 * np.min(rms[on])
+    with pytest.raises(InputError, match="does not pass"):
+        order_spectrum(rec, speed_profile(rec), 6000.0, 10.0)

@@ -179,3 +179,41 @@ def test_speed_channel_on_its_own_time_base_hdf5(tmp_path):
     level = _order2_level(tmp_path / "o.csv")
     assert level.size > 20
     assert np.max(np.abs(20 * np.log10(level * np.sqrt(2)))) <= TRACKED_ORDER_DB
+
+
+def test_overall_and_order_spectrum_options(tmp_path, analytic):
+    out = {k: tmp_path / k for k in ("t.csv", "s.csv", "t.h5")}
+    r = run(analytic, "--quantity", "velocity", "--orders", "1,2,4", "--overall",
+            "--spectrum-at", "3000", "--spectrum-at", "3500", "--spectrum-out", out["s.csv"],
+            "--csv", out["t.csv"], "--out", out["t.h5"])
+    assert r.exit_code == 0, r.output
+    assert " overall " in r.output
+    rows = [ln.split(",") for ln in out["t.csv"].read_text().splitlines()
+            if not ln.startswith("#")]
+    assert rows[0] == ["mount", "direction", "quantity", "rpm", "velocity_rms_mm_per_s"]
+    kinds = {row[2] for row in rows[1:]}
+    assert kinds == {"order_1", "order_2", "order_4", "synthesis", "overall"}
+    assert TrackedOrders.from_hdf5(out["t.h5"]).overall.shape[1] == 1
+    spec = [ln.split(",") for ln in out["s.csv"].read_text().splitlines()
+            if not ln.startswith("#")]
+    assert spec[0] == ["mount", "direction", "rpm", "order", "velocity_rms_mm_per_s"]
+    assert {row[2] for row in spec[1:]} == {"3000", "3500"}
+    at2 = [float(row[4]) for row in spec[1:] if row[2] == "3000" and row[3] == "2"]
+    expected = signals.ANALYTIC_VELOCITY[3] * 1e3 / np.sqrt(2)             # order 2 [mm/s]
+    assert abs(20 * np.log10(at2[0] / expected)) <= TRACKED_ORDER_DB
+    c = CliRunner().invoke(main, ["compare", str(out["t.csv"]), "--step", "500", "--quiet"])
+    assert c.exit_code == 0, c.output                                    # overall rows skipped
+
+
+@pytest.mark.parametrize("extra, key", [
+    (["--spectrum-at", "3000"], "--spectrum-out"),
+    (["--spectrum-at", "9000", "--spectrum-out", "s.csv"], "--spectrum-at"),
+    (["--overall-band", "900:5"], "--overall-band"),
+    (["--overall-band", "a:b"], "--overall-band"),
+])
+def test_overall_and_spectrum_bad_options(tmp_path, analytic, extra, key):
+    extra = [str(tmp_path / e) if e.endswith(".csv") else e for e in extra]
+    r = run(analytic, "--csv", tmp_path / "t.csv", "--quantity", "velocity", "--quiet", *extra)
+    assert r.exit_code == 1 and key in r.output, r.output
+    assert len(r.output.strip().splitlines()) == 1
+    assert not (tmp_path / "t.csv").exists() and not (tmp_path / "s.csv").exists()

@@ -86,3 +86,24 @@ def crossing(fs=4096.0, duration=10.0, tone_hz=100.0, tone_amplitude=0.5) -> Raw
     return RawRecording(t, [RawChannel("left.z", "left", "active", "z", "acceleration", x,
                                        "m/s^2")], rpm, None, "crossing",
                         [f"SYNTHETIC: order 2 crossing a {tone_hz:g} Hz tone"])
+
+
+def swept_resonance(fs, duration, rpm0, rpm1, order, fn, zeta):
+    """Single-DOF resonance (static gain 1) driven by ``cos(order * crank angle)`` along a
+    linear sweep, started in its steady state; exact for the piecewise-linear input on the
+    sample grid (scipy ``lsim``). Returns the recording and the envelope of the complex
+    response (cos and sin drives) at every sample: the fine-grid reference."""
+    from scipy.signal import StateSpace, lsim
+    t, rpm, th = linear_sweep(fs, duration, rpm0, rpm1)
+    wn = 2 * np.pi * fn
+    system = StateSpace([[0, 1], [-wn ** 2, -2 * zeta * wn]], [[0], [wn ** 2]], [[1, 0]], [[0]])
+    w0 = 2 * np.pi * order * rpm0 / 60
+    h0 = 1 / (1 - (w0 / wn) ** 2 + 2j * zeta * w0 / wn)
+    z = [lsim(system, drive(order * th), t, X0=[part(h0), part(1j * w0 * h0)])[1]
+         for drive, part in ((np.cos, np.real), (np.sin, np.imag))]
+    rec = RawRecording(t, [RawChannel("x", "left", "active", "z", "displacement", z[0], "m")],
+                       rpm, source="swept resonance",
+                       comments=[f"SYNTHETIC: order {order:g} through a {fn:g} Hz resonance "
+                                 f"(damping {zeta:g}), {rpm0:g}->{rpm1:g} rpm in "
+                                 f"{duration:g} s"]).validate()
+    return rec, np.abs(z[0] + 1j * z[1])

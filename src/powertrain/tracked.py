@@ -6,10 +6,18 @@ Long-format CSV (read by ``compare`` and ``diagnose``; :mod:`powertrain.iotools.
     mount,direction,quantity,rpm,acceleration_rms_m_per_s2
     left,z,order_2,1050,0.0123
     left,z,synthesis,1050,0.0150
+    left,z,overall,1050,0.0163
 
 The level column states the channels' quantity and unit (:data:`LEVEL_COLUMNS`); a
 ``side`` column (``active``/``passive``) follows ``mount`` when any channel is passive.
-``synthesis`` is the RMS sum over the orders tracked.
+``synthesis`` is the RMS sum over the orders tracked; ``overall`` rows (``track --overall``)
+the RMS of the raw signal in a band (:mod:`powertrain.analysis.overall`).
+
+Order spectrum CSV (``track --spectrum-at RPM --spectrum-out F``, :meth:`TrackedOrders.
+spectrum_csv_text`): one row per channel, speed and order of the fine order grid::
+
+    mount,direction,rpm,order,acceleration_rms_m_per_s2
+    left,z,3000,0.0625,1.2e-05
 
 HDF5 (``--out``)::
 
@@ -21,6 +29,7 @@ HDF5 (``--out``)::
     /amplitude       (k, n_ch, n_o) complex   SI peak amplitude, phase re crank angle 0
     /order_rms       (k, n_ch, n_o)           SI RMS
     /synthesis_rms   (k, n_ch)                SI RMS
+/overall_rms     (k, n_ch)                SI RMS (only with --overall)
 """
 
 from __future__ import annotations
@@ -71,6 +80,9 @@ class TrackedOrders:
     source : str
     settings : dict
     comments : list of str
+    overall : ndarray (k, n_ch) or None
+        Overall RMS of the raw signal per speed [SI], in the band of
+        ``settings["overall_band_hz"]``.
     """
 
     rpm: np.ndarray
@@ -81,6 +93,7 @@ class TrackedOrders:
     source: str = ""
     settings: dict = field(default_factory=dict)
     comments: list = field(default_factory=list)
+    overall: np.ndarray | None = None
 
     def order_rms(self) -> np.ndarray:
         """RMS per speed, channel and order [SI]."""
@@ -103,6 +116,10 @@ class TrackedOrders:
     def as_velocity(self) -> TrackedOrders:
         r"""Convert every channel to velocity, order by order: :math:`\hat v = \hat a/(i\omega_o)`
         and :math:`\hat v = i\omega_o \hat x`, :math:`\omega_o = 2\pi o n/60`."""
+        if self.overall is not None and self.settings.get("overall_quantity") != "velocity":
+            raise InputError("the overall level cannot be converted after tracking (track "
+                             "with the overall level computed as velocity)",
+                             file=self.source, key="overall")
         w = 2 * np.pi * self.orders[None, :] * self.rpm[:, None] / 60.0      # (k, n_o)
         amp = self.amplitude.copy()
         chans = []
@@ -138,6 +155,29 @@ class TrackedOrders:
                           for i, r in enumerate(self.rpm)]
             lines += [",".join(key + ["synthesis", f"{r:g}", f"{syn[i, c]:.8g}"])
                       for i, r in enumerate(self.rpm)]
+            if self.overall is not None:
+                lines += [",".join(key + ["overall", f"{r:g}",
+                                          f"{self.overall[i, c] * factor:.8g}"])
+                          for i, r in enumerate(self.rpm)]
+        return "\n".join(lines) + "\n"
+
+    def spectrum_csv_text(self) -> str:
+        """Order spectrum CSV text (module docstring): RMS against order per speed."""
+        col, factor = LEVEL_COLUMNS[self.quantity]
+        with_side = any(c.side != "active" for c in self.channels)
+        tag = " [SYNTHETIC]" if any("synthetic" in c.lower() for c in self.comments) else ""
+        s = self.settings
+        lines = [f"# order spectrum by powertrain track from {self.source}{tag}: COT block "
+                 f"of {s['block_revolutions']} revolutions, Hann window, orders in steps of "
+                 f"{s['order_resolution']:g}"]
+        lines += [f"# {c}" for c in self.comments]
+        lines.append(",".join(["mount"] + (["side"] if with_side else [])
+                              + ["direction", "rpm", "order", col]))
+        rms = self.order_rms() * factor
+        for c, ch in enumerate(self.channels):
+            key = [ch.mount] + ([ch.side] if with_side else []) + [ch.direction]
+            lines += [",".join(key + [f"{r:g}", f"{o:g}", f"{rms[i, c, k]:.8g}"])
+                      for i, r in enumerate(self.rpm) for k, o in enumerate(self.orders)]
         return "\n".join(lines) + "\n"
 
     def to_csv(self, path) -> None:
@@ -171,6 +211,8 @@ class TrackedOrders:
                 h5.create_dataset("amplitude", data=self.amplitude)
                 h5.create_dataset("order_rms", data=self.order_rms())
                 h5.create_dataset("synthesis_rms", data=self.synthesis_rms())
+                if self.overall is not None:
+                    h5.create_dataset("overall_rms", data=self.overall)
 
     @classmethod
     def from_hdf5(cls, path) -> TrackedOrders:
@@ -183,9 +225,11 @@ class TrackedOrders:
             cols = {k: [v.decode() for v in g[k][()]]
                     for k in ("name", "mount", "side", "direction", "quantity")}
             chans = [TrackedChannel(*row) for row in zip(*cols.values())]
+            overall = h5["overall_rms"][()] if "overall_rms" in h5 else None
             return cls(h5["rpm"][()], h5["orders"][()], chans, h5["amplitude"][()],
                        str(h5.attrs["method"]), str(h5.attrs["source"]),
-                       json.loads(h5.attrs["settings"]), json.loads(h5.attrs["comments"]))
+                       json.loads(h5.attrs["settings"]), json.loads(h5.attrs["comments"]),
+                       overall)
 
     def curve(self, label: str, quantity: str = "synthesis") -> np.ndarray:
         """RMS curve [SI] of the channel ``mount[.side].direction`` (synthesis or order_<n>)."""

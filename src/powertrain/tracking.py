@@ -19,6 +19,11 @@ from powertrain.tracked import TrackedChannel, TrackedOrders
 MAX_FREQUENCY_FRACTION = 0.4
 #: Grid speeds per COT call (progress granularity).
 CHUNK = 16
+#: Order spectrum (``track --spectrum-at``): block length [rev], i.e. orders in steps of
+#: 1/16 (integer and half orders fall on a line: no scalloping loss).
+SPECTRUM_REVS = 16
+#: ... up to this multiple of the highest tracked order.
+SPECTRUM_EXTENT = 1.25
 
 
 def speed_profile(rec, *, use="auto", pulses_per_rev=None, smooth_s=0.1):
@@ -43,7 +48,7 @@ def speed_profile(rec, *, use="auto", pulses_per_rev=None, smooth_s=0.1):
 
 def track_recording(rec, orders=None, *, rpm_step=50.0, method="cot", use="auto",
                     pulses_per_rev=None, quantity=None, bandwidth_hz=None, block_revs=None,
-                    progress=False) -> TrackedOrders:
+                    overall=None, progress=False) -> TrackedOrders:
     """Order-track every channel of a recording.
 
     Parameters
@@ -66,6 +71,10 @@ def track_recording(rec, orders=None, *, rpm_step=50.0, method="cot", use="auto"
         :func:`~powertrain.analysis.vold_kalman.default_bandwidth`).
     block_revs : int, optional
         COT block length [rev].
+    overall : dict, optional
+        Also the overall level of the raw signal per speed
+        (:mod:`powertrain.analysis.overall`): ``band`` (lo, hi) [Hz] or None for
+        :func:`overall_band`, ``velocity`` True to give it as velocity.
     progress : bool
         tqdm bar on stderr (hidden when stderr is not a terminal).
 
@@ -92,8 +101,63 @@ def track_recording(rec, orders=None, *, rpm_step=50.0, method="cot", use="auto"
                      "measured_rpm": [float(np.min(profile.rpm[i0:i1 + 1])),
                                       float(np.max(profile.rpm[i0:i1 + 1]))]})
     tracked = [TrackedChannel(c.name, c.mount, c.side, c.direction, c.quantity) for c in chans]
-    return TrackedOrders(rpm, orders, tracked, amp, method, rec.source, settings,
-                         list(rec.comments))
+    result = TrackedOrders(rpm, orders, tracked, amp, method, rec.source, settings,
+                           list(rec.comments))
+    if overall is not None:
+        _add_overall(result, rec, chans, profile, overall.get("band"), overall.get("velocity"))
+    return result
+
+
+def overall_band(orders, rpm, sample_rate):
+    """Default band of the overall level [Hz]: from half the lowest order's frequency at the
+    lowest grid speed (above drift and DC) to MAX_FREQUENCY_FRACTION x the sampling rate
+    (the whole range the tracker accepts)."""
+    return 0.5 * float(np.min(orders)) * float(np.min(rpm)) / 60.0, \
+        MAX_FREQUENCY_FRACTION * sample_rate
+
+
+def _add_overall(result, rec, chans, profile, band, velocity):
+    """Overall level per speed and channel into ``result`` (SI RMS; velocity if asked)."""
+    from powertrain.analysis.overall import overall_rms
+    band = band or overall_band(result.orders, result.rpm, rec.sample_rate)
+    turn = {"acceleration": -1, "velocity": 0, "displacement": 1}
+    if velocity and any(c.quantity not in turn for c in chans):
+        raise InputError("a force cannot be converted to velocity", file=rec.source,
+                         key="--as")
+    derivative = [turn[c.quantity] for c in chans] if velocity else None
+    B = int(result.settings.get("block_revolutions") or cot.block_revolutions(result.orders))
+    result.overall = overall_rms(rec.channel_matrix(chans), profile, result.rpm, B, band,
+                                 derivative)
+    result.settings.update({"overall_band_hz": [float(band[0]), float(band[1])],
+                            "overall_revolutions": B,
+                            "overall_quantity": "velocity" if velocity else "channel"})
+
+
+def order_spectrum(rec, profile, rpm, top_order, *, quantity=None) -> TrackedOrders:
+    """Order spectrum of every channel at one speed: RMS at orders k/SPECTRUM_REVS up to
+    ``top_order`` (COT block of SPECTRUM_REVS revolutions, Hann), as a TrackedOrders with one
+    speed."""
+    if not (np.isfinite(rpm) and rpm > 0):
+        raise InputError("must be a speed > 0 [rpm]", key="--spectrum-at")
+    chans = [c for c in rec.channels if quantity is None or c.quantity == quantity]
+    B = SPECTRUM_REVS
+    top = min(float(top_order), MAX_FREQUENCY_FRACTION * rec.sample_rate * 60.0 / rpm)
+    fine = np.arange(1, int(np.floor(top * B + 1e-9)) + 1) / B
+    S = cot.samples_per_rev(fine)
+    i0, i1 = profile.valid
+    t, n, th = (a[i0:i1 + 1] for a in (profile.time, profile.rpm, profile.angle))
+    _, centre = cot.first_passing(t, n, [float(rpm)], th)
+    reach = np.pi * B + 2 * np.pi * cot.KERNEL_ZERO_CROSSINGS / S
+    if fine.size == 0 or not (th[0] + reach <= centre[0] <= th[-1] - reach):
+        raise InputError(f"speed does not pass {rpm:g} rpm with {B / 2:g} revolutions of data "
+                         f"either side (speed {n.min():.0f}..{n.max():.0f} rpm)",
+                         file=rec.source, key="--spectrum-at")
+    amp = cot.cot_amplitudes(rec.channel_matrix(chans), profile, fine, np.array([rpm]),
+                             centre, B)
+    tracked = [TrackedChannel(c.name, c.mount, c.side, c.direction, c.quantity) for c in chans]
+    return TrackedOrders(np.array([float(rpm)]), fine, tracked, amp, "cot", rec.source,
+                         {"block_revolutions": B, "window": "hann",
+                          "order_resolution": 1.0 / B}, list(rec.comments))
 
 
 def _check_rate(rec, orders, rpm):

@@ -27,7 +27,8 @@ half-bandwidth :math:`f_b`: :math:`r = \sqrt{\sqrt2 - 1}/(2\pi f_b\Delta t)^2`.
   is set to :math:`f_b = 1.5\sqrt{\dot f_o}` (:data:`SWEEP_FACTOR`): against the exact
   response of a single-DOF resonance swept through at 100 and 500 rpm/s (damping 0.005 to
   0.05, order 2 at 50 and 150 Hz) the peak is at most 0.21 dB below the fine-grid envelope
-  (0.5 Hz fixed: up to 8 dB; ``tests/test_order_tracking.py``);
+  (0.5 Hz fixed: up to 7 dB at 100 rpm/s; ``scripts/verify_vkf_bandwidth.py``,
+  ``tests/test_order_tracking.py``);
 * *record rule*: never narrower than :math:`1.5/(0.05\,T)` for a record of :math:`T`
   seconds, so that the end transient costs at most 5 % of the record at each end
   (:data:`EDGE_FRACTION`);

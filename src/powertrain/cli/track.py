@@ -38,9 +38,21 @@ from powertrain.cli import main
 @click.option("--plot", type=click.Path(dir_okay=False), help="PNG of the order curves.")
 @click.option("--map", "map_png", type=click.Path(dir_okay=False),
               help="PNG: rpm-order (Campbell) and rpm-frequency maps of the first channel.")
+@click.option("--overall", is_flag=True,
+              help="Also the overall level of the raw signal per speed (RMS in a band, over "
+                   "the block of each speed): 'overall' rows in --csv, /overall_rms in --out.")
+@click.option("--overall-band", metavar="LO:HI",
+              help="Band of --overall [Hz] (default: half the lowest order's frequency at the "
+                   "lowest speed to 0.4 x the sampling rate).")
+@click.option("--spectrum-at", "spectrum_at", type=float, multiple=True, metavar="RPM",
+              help="Order spectrum (RMS against order, steps of 1/16 order, up to 1.25 x the "
+                   "highest --orders) at this speed; repeatable. Needs --spectrum-out.")
+@click.option("--spectrum-out", type=click.Path(dir_okay=False),
+              help="CSV of the order spectra of --spectrum-at.")
 @click.option("--quiet", is_flag=True, help="No progress bar and no table.")
 def track(raw, map_file, rpm_column, tacho_column, pulses_per_rev, orders_spec, rpm_step,
-          method, bandwidth, quantity, as_quantity, csv_file, out, plot, map_png, quiet):
+          method, bandwidth, quantity, as_quantity, csv_file, out, plot, map_png, overall,
+          overall_band, spectrum_at, spectrum_out, quiet):
     """Order-track raw run-up time data: speed from an rpm or tacho channel, order RMS
     against rpm per channel.
 
@@ -52,6 +64,7 @@ def track(raw, map_file, rpm_column, tacho_column, pulses_per_rev, orders_spec, 
       powertrain track run.csv --csv tracked.csv --plot orders.png
       powertrain track run.mf4 --channels map.toml --tacho Tacho1 --pulses-per-rev 60
       powertrain track run.h5 --orders 1,2,4 --method vkf --as velocity --csv v.csv
+      powertrain track run.csv --overall --spectrum-at 3000 --spectrum-out s.csv --csv t.csv
     """
     from powertrain.analysis.order_tracking import parse_orders
     from powertrain.errors import InputError
@@ -66,8 +79,12 @@ def track(raw, map_file, rpm_column, tacho_column, pulses_per_rev, orders_spec, 
     if pulses_per_rev is not None and not 1 <= pulses_per_rev <= MAX_PULSES_PER_REV:
         raise InputError(f"must be 1..{MAX_PULSES_PER_REV}", key="--pulses-per-rev")
     orders = parse_orders(orders_spec)
+    overall_opts = _overall_options(overall, overall_band, as_quantity)
+    if bool(spectrum_at) != bool(spectrum_out):
+        raise InputError("--spectrum-at RPM and --spectrum-out FILE go together",
+                         key="--spectrum-out" if spectrum_at else "--spectrum-at")
     from powertrain.cli.common import check_outputs
-    check_outputs(csv=csv_file, out=out, plot=plot, map=map_png)
+    check_outputs(csv=csv_file, out=out, plot=plot, map=map_png, spectrum_out=spectrum_out)
     cmap = None
     if map_file:
         from powertrain.iotools.channel_map import read_channel_map
@@ -76,16 +93,26 @@ def track(raw, map_file, rpm_column, tacho_column, pulses_per_rev, orders_spec, 
     use = "tacho" if tacho_column else "rpm" if rpm_column else "auto"
     tracked = track_recording(rec, orders, rpm_step=rpm_step, method=method, use=use,
                               pulses_per_rev=pulses_per_rev, quantity=quantity,
-                              bandwidth_hz=bandwidth, progress=not quiet)
+                              bandwidth_hz=bandwidth, overall=overall_opts,
+                              progress=not quiet)
+    spectra = _spectra(rec, use, pulses_per_rev, spectrum_at, orders, quantity)
     if as_quantity == "velocity":
         tracked = tracked.as_velocity()
+        spectra = spectra and spectra.as_velocity()
     if csv_file:
         _ = tracked.quantity                      # mixed quantities: fail before writing
+    if spectra:
+        _ = spectra.quantity
     maps = _maps(rec, use, pulses_per_rev, rpm_step) if map_png else None
     if csv_file:
         tracked.to_csv(csv_file)
     if out:
         tracked.to_hdf5(out)
+    if spectra:
+        from powertrain.iotools.atomic import atomic_write
+        text = spectra.spectrum_csv_text()
+        with atomic_write(spectrum_out) as fh:
+            fh.write(text)
     if plot or map_png:
         from powertrain.cli.common import cli_provenance, write_plot
         prov = cli_provenance(f"none (raw time data {raw})")
@@ -95,7 +122,34 @@ def track(raw, map_file, rpm_column, tacho_column, pulses_per_rev, orders_spec, 
         from powertrain.plotting_orders import plot_maps
         write_plot(lambda p: plot_maps(**maps, path=p, provenance=prov), map_png)
     if not quiet:
-        _report(rec, tracked, [p for p in (csv_file, out, plot, map_png) if p])
+        _report(rec, tracked, [p for p in (csv_file, out, plot, map_png, spectrum_out) if p])
+
+
+def _overall_options(overall, overall_band, as_quantity):
+    """The ``overall`` argument of track_recording, or None."""
+    if not (overall or overall_band):
+        return None
+    from powertrain.analysis.overall import parse_band
+    band = parse_band(overall_band) if overall_band else None
+    return {"band": band, "velocity": as_quantity == "velocity"}
+
+
+def _spectra(rec, use, pulses_per_rev, speeds, orders, quantity):
+    """Order spectra at the speeds of --spectrum-at (one TrackedOrders), or None."""
+    if not speeds:
+        return None
+    import numpy as np
+
+    from powertrain.tracking import SPECTRUM_EXTENT, order_spectrum, speed_profile
+    profile = speed_profile(rec, use=use, pulses_per_rev=pulses_per_rev)
+    parts = [order_spectrum(rec, profile, rpm, SPECTRUM_EXTENT * float(np.max(orders)),
+                            quantity=quantity) for rpm in speeds]
+    size = min(p.orders.size for p in parts)        # the top order is capped by fs / rpm
+    first = parts[0]
+    amp = np.concatenate([p.amplitude[:, :, :size] for p in parts])
+    from dataclasses import replace
+    return replace(first, rpm=np.concatenate([p.rpm for p in parts]),
+                   orders=first.orders[:size], amplitude=amp)
 
 
 def _maps(rec, use, pulses_per_rev, rpm_step):
@@ -151,6 +205,10 @@ def _report(rec, tracked, written):
         v = syn[:, c] * f
         rows.append([label, ch.quantity, "synthesis", float(np.median(v)), float(v.min()),
                      float(v.max()), unit])
+        if tracked.overall is not None:
+            v = tracked.overall[:, c] * f
+            rows.append([label, ch.quantity, "overall", float(np.median(v)),
+                         float(v.min()), float(v.max()), unit])
     click.echo("tracked RMS over the speed grid:")
     click.echo(format_table(["channel", "quantity", "order", "median", "min", "max", "unit"],
                             rows, "{:.6g}"))

@@ -21,7 +21,9 @@ mount ``left`` become channel ``left/passive``.
 
 * ``mount``: a mount name of the model (``left``, ``right``, ``gearbox`` for the default
   engine); ``direction``: ``x``, ``y`` or ``z`` (engine axes; upper case accepted);
-  ``quantity``: ``synthesis`` or ``order_<n>`` (``order_2``, ``order_0.5``...); ``rpm`` > 0.
+  ``quantity``: ``synthesis`` or ``order_<n>`` (``order_2``, ``order_0.5``...); ``rpm`` > 0;
+  ``overall`` rows (the raw signal's overall level, ``track --overall``) are skipped: the
+  model has no overall level to compare with.
 * exactly one level column, whose name states quantity, statistic and unit (table
   :data:`LEVEL_COLUMNS`): ``velocity_rms_mm_per_s``, ``velocity_rms_m_per_s``,
   ``velocity_peak_mm_per_s`` or ``velocity_peak_m_per_s``; or, as ``powertrain track``
@@ -330,6 +332,8 @@ def _read_csv(path, mounts, points=None):
         if direction not in DIRECTIONS:
             raise InputError(f"unknown direction {fields[col['direction']]!r} "
                              "(expected x, y or z)", file=path, line=lineno, key="direction")
+        if fields[col["quantity"]].strip() == "overall":
+            continue                      # track --overall: the raw signal's, not modelled
         try:
             quantity = normalise_quantity(fields[col["quantity"]])
         except ValueError as exc:

@@ -160,7 +160,8 @@ def _onto_time(found: FileSignals, speed, time):
             out[kind] = values
             continue
         own = np.asarray(own, float).ravel()
-        if own.shape != values.shape or own.size < 2 or np.any(np.diff(own) <= 0):
+        if (own.shape != values.shape or own.size < 2 or not np.all(np.isfinite(own))
+                or np.any(np.diff(own) <= 0)):
             raise InputError("the channel's own time base must increase and have one value "
                              "per sample", file=found.source, key=name)
         inside = (time >= own[0]) & (time <= own[-1])
