@@ -20,6 +20,7 @@ from powertrain.plotting.style import (
     no_data,
     quantity_label,
     subplots,
+    wrap,
 )
 
 RPM_LABEL = "engine speed [rpm]"
@@ -174,7 +175,11 @@ def plot_whatif(whatif, path=None, *, ax=None, channel=None, quantity=None, prov
     largest = {k: _largest_change(whatif, k) for k in keys}
     shown = keys if view == "delta" or is_axes(ax) else \
         [k for k in keys if largest[k] >= VISIBLE_CHANGE_DB] or [max(keys, key=largest.get)]
-    fig, panels, own, axes = _panels(ax, shown, quantities, base.channels, channel, quantity)
+    signal = getattr(whatif, "signal", "velocity")
+    title = _whatif_title(view, keys, shown, signal)
+    fig, panels, own, axes = _panels(ax, shown, quantities, base.channels, channel, quantity,
+                                     title_lines=wrap(title, PRINT_WIDTH_IN * 0.95,
+                                                      9).count("\n") + 1)
     overall = {v.name: _mean_change(whatif, v.name, base.channels, quantities)
                for v in whatif.variants}
     draw = _delta_panel if view == "delta" else _levels_panel
@@ -182,17 +187,15 @@ def plot_whatif(whatif, path=None, *, ax=None, channel=None, quantity=None, prov
         draw(a, whatif, key, overall)
     if view == "delta":
         _share_delta_axis(panels.values())
-    signal = getattr(whatif, "signal", "velocity")
     ylabel = "Δ = 20 log10(v/v0) [dB]" if view == "delta" else \
         f"RMS {signal.replace('_', ' ')} [{SIGNAL_UNITS[signal][1]}]"
     label_grid(fig, axes, ylabel)
     if own:
         figure_legend(fig, axes)
-    title = _whatif_title(view, keys, shown, signal)
     return finish(fig, own, path, provenance, title=title if own else None)
 
 
-def _panels(ax, shown, quantities, channels, channel, quantity):
+def _panels(ax, shown, quantities, channels, channel, quantity, title_lines=2):
     """The full channel × quantity grid when every panel is shown, else the shown panels
     three to a row in reading order."""
     rows = list(channels)
@@ -200,8 +203,8 @@ def _panels(ax, shown, quantities, channels, channel, quantity):
         return grid(ax, rows, quantities, channel, quantity)
     ncol = min(3, len(shown))
     nrow = -(-len(shown) // ncol)
-    fig, axes, own = subplots(ax, nrow, ncol, figsize=(PRINT_WIDTH_IN, 1.45 * nrow + 1.9),
-                              sharex=True)
+    fig, axes, own = subplots(ax, nrow, ncol, sharex=True,
+                              figsize=(PRINT_WIDTH_IN, 1.45 * nrow + 1.6 + 0.17 * title_lines))
     for a in axes.flat[len(shown):]:
         a.set_visible(False)
     if len(shown) % ncol:   # x tick labels on the panels above the empty slots
@@ -265,7 +268,12 @@ def _whatif_title(view, keys, shown, signal) -> str:
     title = f"what-if: baseline vs variants{SYNTHESIS_NOTE}"
     hidden = [k for k in keys if k not in shown]
     if hidden:
-        names = ", ".join(f"{m} {d.upper()} {quantity_label(q)}" for m, d, q in hidden)
+        per_channel = {}
+        for m, d, q in hidden:
+            per_channel.setdefault(f"{m} {d.upper()}", []).append(quantity_label(q))
+        n_q = len({q for _, _, q in keys})
+        names = "; ".join(ch if len(qs) == n_q else f"{ch} {', '.join(qs)}"
+                          for ch, qs in per_channel.items())
         title += (f". Not drawn, every variant within ±{VISIBLE_CHANGE_DB:g} dB of the "
                   f"baseline at every speed (see the Δ dB figure): {names}")
     return title
