@@ -66,7 +66,7 @@ def _problems(drawn, fig, dpi):
 #: Colour maps allowed in figures: perceptually uniform (viridis) and the diverging RdBu_r
 #: (blue-red, readable with every common colour-vision deficiency); plus the one-grey map of
 #: censored cells.
-CVD_SAFE_MAPS = {"viridis", "RdBu_r", "from_list"}
+CVD_SAFE_MAPS = {"viridis", "RdBu_r", "censored grey"}
 
 
 def _colour_maps(fig):
