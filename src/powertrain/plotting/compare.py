@@ -33,9 +33,9 @@ def plot_comparison(comparison, path=None, quantities=None, *, ax=None, channel=
     The measured curve is a thin black line, the simulation markers at its speeds joined by
     straight lines (on the log axis these are exactly the log-level interpolation used for
     the gaps); the gap at the compared speeds is shaded orange where the simulation is
-    higher, sky blue where it is lower (colour-blind safe). Points excluded at the noise floor are grey crosses, the
-    exclusion limit a dotted line; a panel with no point above it says so. Panel titles give
-    the RMS gap and bias [dB].
+    higher, sky blue where it is lower (colour-blind safe). Points excluded at the noise
+    floor are grey crosses, the exclusion limit a dotted line; a panel with no point above
+    it says so. Under each panel title: the RMS gap and bias [dB].
 
     Parameters
     ----------

@@ -107,8 +107,8 @@ def _gap_panels(axes, diagnosis, qs, cens, valid):
             no_data(a, "every point below the censoring limit")
             continue
         grey = np.where(cens[:, rows, k].T, 0.0, np.nan)
-        a.pcolormesh(d.rpm, y, np.ma.masked_invalid(grey), cmap=ListedColormap(["0.7"], name="censored grey"),
-                     shading="nearest")
+        a.pcolormesh(d.rpm, y, np.ma.masked_invalid(grey), shading="nearest",
+                     cmap=ListedColormap(["0.7"], name="censored grey"))
         im = a.pcolormesh(d.rpm, y, np.ma.masked_where(~ok, g), cmap="RdBu_r",
                           vmin=-GAP_SCALE_DB, vmax=GAP_SCALE_DB, shading="nearest")
         runs = _runs_beyond(np.where(ok, np.abs(g), 0.0) > GAP_OUTLINE_DB, GAP_OUTLINE_RUN)
