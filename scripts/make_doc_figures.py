@@ -27,6 +27,11 @@ def _run(args, cwd):
     subprocess.run([str(a) for a in args], cwd=cwd, check=True)
 
 
+def _shown(path: Path) -> str:
+    """The path relative to the checkout (so the provenance line names no home folder)."""
+    return str(path.relative_to(ROOT)) if path.is_relative_to(ROOT) else str(path)
+
+
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--out", default=str(ROOT / "docs"), help="folder of the figures")
@@ -35,17 +40,15 @@ def main(argv=None) -> int:
     out = Path(args.out).resolve()
     cli = [sys.executable, "-m", "powertrain.cli"]
     written = [out / "compare-example.png"]
-    _run(cli + ["compare", ROOT / "examples" / "measured-runup.csv", "--plot", written[0],
+    _run(cli + ["compare", "examples/measured-runup.csv", "--plot", _shown(written[0]),
                 "--quiet"], ROOT)
     if not args.quick:
         written.append(out / "sweep-rates.png")
-        _run([sys.executable, ROOT / "scripts" / "sweep_vs_stepped.py", "--plot", written[1]],
-             ROOT)
+        _run([sys.executable, "scripts/sweep_vs_stepped.py", "--plot", _shown(written[1])], ROOT)
     from PIL import Image
     for path in written:
         with Image.open(path) as im:
-            print(f"wrote {path.relative_to(ROOT) if path.is_relative_to(ROOT) else path}: "
-                  f"{im.width} x {im.height} px")
+            print(f"wrote {_shown(path)}: {im.width} x {im.height} px")
     return 0
 
 
