@@ -1,5 +1,6 @@
-"""Text layout check of a rendered figure: no two text elements overlap, none leaves the
-figure.
+"""Checks of a rendered figure: no two text elements overlap, none leaves the figure, all
+text is at least 8 pt when printed at the report's page width, no legend covers data, and
+every coloured line or area is drawn from the colour-blind-safe palette.
 
 The figure is drawn once with matplotlib's Agg renderer while every :class:`~matplotlib.text.Text`
 draw call is recorded, so exactly the text that appears in the PNG is checked — titles, axis
@@ -74,3 +75,59 @@ def check_boxes(drawn, width, height, tol=TOLERANCE_PX) -> list[str]:
         problems.append(f"overlap {dx[i, j]:.0f}x{dy[i, j]:.0f} px: "
                         f"{drawn[i][0].get_text()!r} and {drawn[j][0].get_text()!r}")
     return problems
+
+
+def small_texts(drawn, fig_width_in) -> list[str]:
+    """Texts smaller than :data:`powertrain.plotting.style.MIN_PRINT_PT` when the figure is
+    printed at :data:`powertrain.plotting.style.PRINT_WIDTH_IN` (a wider figure is scaled
+    down to it; a narrower one is printed at its own size)."""
+    from powertrain.plotting.style import MIN_PRINT_PT, PRINT_WIDTH_IN
+    scale = min(1.0, PRINT_WIDTH_IN / fig_width_in)
+    return [f"{t.get_fontsize() * scale:.1f} pt at {PRINT_WIDTH_IN * 2.54:.0f} cm print "
+            f"width: {t.get_text()[:40]!r}" for t, _ in drawn
+            if t.get_fontsize() * scale < MIN_PRINT_PT - 1e-6]
+
+
+def legends_over_data(fig) -> list[str]:
+    """Legends (of an axes or the figure) whose box holds a data point of a line, in display
+    coordinates after drawing."""
+    problems = []
+    for ax in fig.axes:
+        lines = [ln for ln in ax.get_lines() if ln.get_visible() and len(ln.get_xdata())]
+        legends = [ax.get_legend()] + list(fig.legends)
+        for leg in [g for g in legends if g is not None and g.get_visible()]:
+            box = leg.get_window_extent()
+            for ln in lines:
+                xy = np.ma.filled(np.ma.asarray(ln.get_xydata(), float), np.nan)
+                xy = xy[np.isfinite(xy).all(axis=1)]
+                if not xy.size:
+                    continue
+                px = ln.get_transform().transform(xy)
+                inside = ax.bbox.contains          # points outside the axes are clipped
+                hit = [(x, y) for x, y in px if box.contains(x, y) and inside(x, y)]
+                if hit:
+                    problems.append(f"legend covers {len(hit)} point(s) of "
+                                    f"{ln.get_label()!r} in {ax.get_title()!r}")
+    return problems
+
+
+def off_palette_colours(fig) -> list[str]:
+    """Line, bar and shading colours that are neither grey/black nor in the Okabe-Ito
+    palette (colour maps of images and meshes are checked by name in the tests)."""
+    from matplotlib.collections import PolyCollection
+    from matplotlib.colors import to_hex, to_rgb
+    from matplotlib.patches import Rectangle
+
+    from powertrain.plotting.style import OKABE_ITO
+    allowed = {c.lower() for c in OKABE_ITO.values()}
+    found = set()
+    for ax in fig.axes:
+        colours = [ln.get_color() for ln in ax.get_lines()]
+        colours += [p.get_facecolor() for p in ax.patches if isinstance(p, Rectangle)]
+        colours += [c.get_facecolor()[0] for c in ax.collections
+                    if isinstance(c, PolyCollection) and len(c.get_facecolor())]
+        for c in colours:
+            r, g, b = to_rgb(c)
+            if not (abs(r - g) < 1e-6 and abs(g - b) < 1e-6) and to_hex(c) not in allowed:
+                found.add(f"{to_hex(c)} in {ax.get_title()!r}")
+    return sorted(found)

@@ -1,5 +1,7 @@
-"""Every figure the command line writes: no overlapping text, no text outside the figure, a
-provenance line; and the library's ``plot(ax=None)`` contract.
+"""Every figure the command line writes: no overlapping text, no text outside the figure, all
+text at least 8 pt at the 16 cm print width, no legend over data, only colour-blind-safe
+colours (Okabe-Ito palette, greys; colour maps viridis and RdBu_r), every requested quantity
+drawn, a provenance line; and the library's ``plot(ax=None)`` contract.
 
 Each CLI command runs in-process with quick settings. ``Figure.savefig`` is wrapped so that
 the very draw that writes the PNG records every text drawn (titles, axis and tick labels,
@@ -14,7 +16,15 @@ from pathlib import Path
 import matplotlib
 import pytest
 from click.testing import CliRunner
-from figure_text import TOLERANCE_PX, check_boxes, recording_texts, text_problems
+from figure_text import (
+    TOLERANCE_PX,
+    check_boxes,
+    legends_over_data,
+    off_palette_colours,
+    recording_texts,
+    small_texts,
+    text_problems,
+)
 
 from powertrain.cli import main
 
@@ -35,7 +45,10 @@ def saved(monkeypatch):
         with recording_texts() as drawn:
             original(self, fname, *args, **kwargs)
         dpi = kwargs.get("dpi") or self.dpi
-        found[Path(str(fname)).name] = (_problems(drawn, self, dpi),
+        found[Path(str(fname)).name] = (_problems(drawn, self, dpi) + small_texts(
+                                            drawn, self.get_figwidth())
+                                        + legends_over_data(self) + off_palette_colours(self)
+                                        + _colour_maps(self),
                                         [t.get_text() for t, _ in drawn
                                          if t.get_text().startswith("powertrain ")],
                                         sum(a.get_legend() is not None for a in self.axes))
@@ -48,6 +61,20 @@ def _problems(drawn, fig, dpi):
     """As :func:`figure_text.text_problems`, from the texts recorded while saving."""
     w, h = fig.get_figwidth() * dpi, fig.get_figheight() * dpi
     return check_boxes(drawn, w, h, TOLERANCE_PX)
+
+
+#: Colour maps allowed in figures: perceptually uniform (viridis) and the diverging RdBu_r
+#: (blue-red, readable with every common colour-vision deficiency); plus the one-grey map of
+#: censored cells.
+CVD_SAFE_MAPS = {"viridis", "RdBu_r", "censored grey"}
+
+
+def _colour_maps(fig):
+    return [f"colour map {m.get_cmap().name} in {ax.get_title()!r}" for ax in fig.axes
+            for m in ax.collections + ax.images
+            if hasattr(m, "get_array") and m.get_array() is not None
+            and type(m).__name__ in ("QuadMesh", "AxesImage")
+            and m.get_cmap().name not in CVD_SAFE_MAPS]
 
 
 def run(tmp_path, monkeypatch, *args):
@@ -237,4 +264,86 @@ def test_plot_into_user_axes_and_subfigures(no_backend_switch):
     left, right = fig.subfigures(1, 2)
     assert result.plot(left) is left and len(left.axes) == 27
     assert table.plot(right) is right and len(right.axes) == 2
+    plt.close(fig)
+
+
+# --------------------------------------------------------------------------- what is drawn
+def _drawn_labels(fig):
+    return {ln.get_label() for ax in fig.axes for ln in ax.get_lines()}
+
+
+@pytest.mark.parametrize("spec,expected", [
+    ("1.5,2,4", ["order 1.5", "order 2", "order 4"]),
+    ("0.5:8:0.5", [f"order {o / 2:g}" for o in range(1, 17)]),
+])
+def test_track_plot_draws_every_requested_order(spec, expected):
+    import matplotlib.pyplot as plt
+    import numpy as np
+
+    from powertrain import signals
+    from powertrain.analysis.order_tracking import parse_orders
+    from powertrain.tracking import track_recording
+    rec = signals.analytic_sweep(duration=3.0, rpm0=1500.0, rpm1=3500.0)
+    tracked = track_recording(rec, parse_orders(spec), rpm_step=100.0, progress=False)
+    fig = tracked.plot()
+    fig.canvas.draw()
+    assert set(expected + ["synthesis"]) <= _drawn_labels(fig)
+    for ax in fig.axes:          # at most the documented dynamic range, plain tick labels
+        lo, hi = ax.get_ylim()
+        assert 20 * np.log10(hi / lo) <= 60 + 20 * np.log10(1.4) + 1e-6
+        assert not any("e" in t.get_text() for t in ax.get_yticklabels())
+    plt.close(fig)
+
+
+def test_map_channel_and_reference_unit(tmp_path, monkeypatch, saved):
+    import matplotlib.pyplot as plt
+
+    from powertrain import signals
+    from powertrain.iotools.raw_csv import write_raw_csv
+    write_raw_csv(tmp_path / "sweep.csv",
+                  signals.analytic_sweep(duration=3.0, rpm0=1500.0, rpm1=3500.0),
+                  comment="SYNTHETIC: analytic sweep")
+    shown = []
+    monkeypatch.setattr(plt, "close", lambda fig=None: shown.append(fig))
+    run(tmp_path, monkeypatch, "track", "sweep.csv", "--orders", "2,4", "--quiet",
+        "--map", "maps.png", "--map-channel", "left.z", "--as", "velocity")
+    _assert_clean(saved, ["maps.png"], "track")
+    fig = shown[-1]
+    a1, a2 = fig.axes[:2]
+    assert a1.get_ylim() == a2.get_ylim()                     # one speed range
+    assert a1.get_xlim()[1] == pytest.approx(1.25 * 4)       # 25 % above the highest order
+    assert "left.z" in fig.legends[0].get_title().get_text() if fig.legends else \
+        "left.z" in fig._suptitle.get_text()
+    res = CliRunner().invoke(main, ["track", "sweep.csv", "--map", "m.png", "--map-channel",
+                                    "nope"])
+    assert res.exit_code == 1 and "--map-channel" in res.output
+    assert not (tmp_path / "m.png").exists()
+
+
+def test_whatif_levels_and_delta_views():
+    import matplotlib.pyplot as plt
+    import numpy as np
+
+    from powertrain.iotools.engine_file import DEFAULT_ENGINE_PATH, read_engine
+    from powertrain.plotting.runup import VISIBLE_CHANGE_DB
+    from powertrain.variants import Variant, parse_operations
+    from powertrain.whatif import run_whatif
+    engine = read_engine(DEFAULT_ENGINE_PATH)
+    variants = [Variant("gearbox x3", parse_operations({"scale": ["gearbox.*.stiffness=3"]}))]
+    result = run_whatif(engine, variants, np.array([1000.0, 2000.0, 3000.0]), workers=1,
+                        progress=False)
+    keys = [(m, d, q) for m, d in result.baseline.channels for q in result.quantities]
+    fig = result.plot()
+    titles = [a.get_title() for a in fig.axes if a.get_visible()]
+    text = fig.texts[0].get_text() if not fig.legends else fig.legends[0].get_title().get_text()
+    for m, d, q in keys:       # every quantity drawn, or named as unchanged
+        big = max(np.nanmax(np.abs(result.delta_db(v.name, m, d, q))) for v in result.variants)
+        drawn = any(t.startswith(f"{m} {d.upper()} · ") and q.replace("_", " ") in t
+                    for t in titles)
+        assert drawn == (big >= VISIBLE_CHANGE_DB) or (drawn and len(titles) == 1)
+        assert drawn or f"{m} {d.upper()}" in text.replace("\n", " ")
+    plt.close(fig)
+    fig = result.plot(view="delta")
+    assert len([a for a in fig.axes if a.get_visible()]) == len(keys)
+    assert any(v.name in lab for v in result.variants for lab in _drawn_labels(fig))
     plt.close(fig)

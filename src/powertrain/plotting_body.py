@@ -7,19 +7,32 @@ from __future__ import annotations
 
 import numpy as np
 
-from powertrain.plotting.style import figure_legend, finish, no_data, subplots
+from powertrain.plotting.runup import SYNTHESIS_NOTE
+from powertrain.plotting.style import (
+    LABEL_SIZE,
+    LEGEND_SIZE,
+    OKABE_ITO,
+    PRINT_WIDTH_IN,
+    TICK_SIZE,
+    TITLE_SIZE,
+    figure_legend,
+    finish,
+    no_data,
+    series_style,
+    subplots,
+)
 
 #: Rigid-body coordinates, as in :data:`powertrain.solvers.modes.COORDINATES`.
 COORDINATES = ("x", "y", "z", "rx", "ry", "rz")
-_COLOURS = {"x": "tab:blue", "y": "tab:orange", "z": "tab:green", "rx": "tab:red",
-            "ry": "tab:purple", "rz": "tab:brown"}
+_COLOURS = dict(zip(COORDINATES, (OKABE_ITO[c] for c in (
+    "blue", "orange", "bluish green", "vermillion", "reddish purple", "sky blue"))))
 
 
 def plot_modes(result, path=None, ax=None, provenance=None):
     """Kinetic-energy distribution of each mode as stacked bars, labelled with frequency,
     damping ratio and the angle of its rotation axis to the torque-roll axis; returns the
     figure (``ax``: None, an Axes, Figure or SubFigure)."""
-    fig, axes, own = subplots(ax, figsize=(9, 5.2))
+    fig, axes, own = subplots(ax, figsize=(PRINT_WIDTH_IN, 4.6))
     ax = axes[0, 0]
     n = len(result.modes)
     x = np.arange(n)
@@ -32,15 +45,16 @@ def plot_modes(result, path=None, ax=None, provenance=None):
     ax.set_xticklabels([f"{m.frequency_hz:.2f} Hz\nζ={m.damping_ratio:.3f}\n"
                         f"TRA {m.angle_to_torque_roll_axis_deg:.0f}°"
                         + ("" if m.kind == "rigid-body" else f"\n{m.kind}")
-                        for m in result.modes], fontsize=8)
-    ax.set_ylabel("kinetic energy [%]")
+                        for m in result.modes], fontsize=TICK_SIZE)
+    ax.tick_params(labelsize=TICK_SIZE)
+    ax.set_ylabel("kinetic energy [%]", fontsize=LABEL_SIZE)
     ax.set_ylim(0, 100)
     if own:
-        fig.legend(*ax.get_legend_handles_labels(), ncol=6, fontsize=8,
+        fig.legend(*ax.get_legend_handles_labels(), ncol=6, fontsize=LEGEND_SIZE,
                    loc="outside upper center", frameon=False)
     else:
-        ax.legend(ncol=6, fontsize=8, loc="upper center")
-    ax.set_title(f"{result.engine} — {result.method.split(':')[0]} modes", fontsize=9)
+        ax.legend(ncol=6, fontsize=LEGEND_SIZE, loc="upper center")
+    ax.set_title(f"{result.engine} — {result.method.split(':')[0]} modes", fontsize=TITLE_SIZE)
     return finish(fig, own, path, provenance)
 
 
@@ -53,71 +67,115 @@ def plot_runup_both_sides(result, path=None, quantities=("synthesis", "order_2",
                           signal="velocity", ax=None, provenance=None):
     """Run-up curves with a body model: one panel per mount and direction holding the
     engine side (solid) and the body side (dashed), then one per body-point direction;
-    columns = ``quantities``; log-scaled RMS [mm/s for velocity]. Returns the figure
-    (``ax``: None, a Figure or SubFigure)."""
+    columns = ``quantities``; log-scaled RMS [mm/s for velocity]. A body side that is zero
+    at every speed is said in its panel title; a body-point direction zero in every column
+    is not drawn but named in the figure title. Returns the figure (``ax``: None, a Figure
+    or SubFigure)."""
     from powertrain.assembly import passive_name
     from powertrain.plotting import SIGNAL_UNITS
-    from powertrain.plotting.runup import style_panel
-    from powertrain.plotting.style import quantity_label
-    rows = [(m, d, True) for m in result.mounts for d in "xyz"]
-    rows += [(p, d, False) for p in result.points for d in "xyz"]
-    fig, axes, own = subplots(ax, len(rows), len(quantities),
-                              figsize=(4 * len(quantities), 1.9 * len(rows)), sharex=True)
     factor, unit = SIGNAL_UNITS[signal][:2]
-    for r, (name, d, is_mount) in enumerate(rows):
+    rows = [(m, d, True) for m in result.mounts for d in "xyz"]
+    points = [(p, d, False) for p in result.points for d in "xyz"]
+    silent = [(p, d) for p, d, _ in points
+              if not any(np.any(result.curve(p, d, q, signal) > 0) for q in quantities)]
+    rows += [r for r in points if r[:2] not in silent]
+    fig, axes, own = subplots(ax, len(rows), len(quantities),
+                              figsize=(PRINT_WIDTH_IN, 1.3 * len(rows) + 1.9), sharex=True)
+    for r, row in enumerate(rows):
         for q, quantity in enumerate(quantities):
-            a = axes[r, q]
-            y = _positive(result.curve(name, d, quantity, signal) * factor)
-            values = [y.compressed()]
-            a.plot(result.rpm, y, "o-", ms=3, lw=1.2,
-                   color="tab:blue" if is_mount else "tab:green",
-                   label="engine side" if is_mount else "body point")
-            if is_mount:
-                yb = _positive(result.curve(passive_name(name), d, quantity, signal) * factor)
-                a.plot(result.rpm, yb, "s--", ms=3, lw=1.2, color="tab:red", label="body side")
-                values.append(yb.compressed())
-            if not style_panel(a, f"{name} {d.upper()} — {quantity_label(quantity)}",
-                               np.concatenate(values)):
-                no_data(a, "zero at every speed")
-            if q == 0:
-                a.set_ylabel(f"RMS {signal.replace('_', ' ')} [{unit}]", fontsize=7)
+            _both_sides_panel(axes[r, q], result, row, quantity, signal, factor)
     for a in axes[-1]:
-        a.set_xlabel("engine speed [rpm]", fontsize=8)
+        a.set_xlabel("engine speed [rpm]", fontsize=LABEL_SIZE)
+    fig.supylabel(f"RMS {signal.replace('_', ' ')} [{unit}]", fontsize=LABEL_SIZE + 0.5)
     if own:
         figure_legend(fig, axes)
-    return finish(fig, own, path, provenance)
+    title = "run-up with the body model: both sides of each mount, then the body points"
+    title += SYNTHESIS_NOTE
+    if any(not np.any(result.curve(passive_name(m), d, q, signal) > 0)
+           for m, d, _ in rows[:3 * len(result.mounts)] for q in quantities):
+        title += ". \"body side zero\": the body model does not move there at any speed"
+    if silent:
+        title += (". Zero at every speed (no mount path moves them), not drawn: "
+                  + ", ".join(f"{p} {d.upper()}" for p, d in silent))
+    return finish(fig, own, path, provenance, title=title if own else None)
+
+
+def _both_sides_panel(a, result, row, quantity, signal, factor):
+    from powertrain.assembly import passive_name
+    from powertrain.plotting.runup import panel_title, style_panel
+    name, d, is_mount = row
+    y = result.curve(name, d, quantity, signal) * factor
+    values = [y]
+    a.plot(result.rpm, _positive(y), "o-", ms=2, lw=1.1,
+           color=OKABE_ITO["blue"] if is_mount else OKABE_ITO["bluish green"],
+           label="engine side" if is_mount else "body point")
+    title = panel_title(name, d, quantity)
+    if is_mount:
+        yb = result.curve(passive_name(name), d, quantity, signal) * factor
+        if np.any(yb > 0):
+            a.plot(result.rpm, _positive(yb), "s--", ms=2, lw=1.1,
+                   color=OKABE_ITO["vermillion"], label="body side")
+            values.append(yb)
+        else:
+            title += "\nbody side zero"
+    if not style_panel(a, title, np.concatenate(values)):
+        no_data(a, "zero at every speed")
 
 
 def plot_path_contributions(result, path=None, order=2.0, n_paths=6, ax=None,
                             provenance=None):
     """Transfer-path view of every body-point direction at one order: the part of each
     path's velocity in phase with the total, Re(v_path·conj(v)/|v|) [mm/s] (these add up to
-    |v|), for the ``n_paths`` largest paths, and the total |v| (black). Returns the figure."""
-    rows = [(p, d) for p in result.points for d in "xyz"]
-    fig, axes, own = subplots(ax, len(rows), 1, figsize=(8, 2.6 * len(rows)), sharex=True)
+    |v|), for the ``n_paths`` largest paths, and the total |v| (black). Paths with the same
+    curve (a symmetric layout) share one line and one legend entry; a direction without
+    response is named in the title instead of drawn. Returns the figure."""
+    rows, silent = [], []
+    for p in result.points:
+        for d in "xyz":
+            pc = result.path_contributions(p, d, order) * 1e3          # (n_rpm, n_paths)
+            (rows if np.abs(pc.sum(axis=1)).max(initial=0.0) > 1e-9 else silent).append(
+                (p, d, pc))
+    if not rows:                 # nothing moves at all: one labelled empty panel
+        rows, silent = silent[:1], silent[1:]
+    fig, axes, own = subplots(ax, len(rows), 1, sharex=True,
+                              figsize=(PRINT_WIDTH_IN, 2.4 * len(rows) + 2.0))
     labels = [f"{m} {d}" for m, d in result.paths]
-    for a, (p, d) in zip(axes[:, 0], rows):
-        pc = result.path_contributions(p, d, order) * 1e3          # (n_rpm, n_paths)
-        total = pc.sum(axis=1)
-        mag = np.abs(total)
-        unit = np.where(mag > 0, np.conj(total) / np.where(mag > 0, mag, 1.0), 0.0)
-        inphase = (pc * unit[:, None]).real
-        if not mag.max(initial=0.0) > 1e-9:        # [mm/s]: no response in this direction
-            a.set_title(f"{p} {d.upper()} — order {order:g}", fontsize=8)
+    colours = {}
+    for a, (p, d, pc) in zip(axes[:, 0], rows):
+        if np.abs(pc).max(initial=0.0) > 1e-9:
+            _paths_panel(a, result.rpm, pc, labels, n_paths, colours)
+        else:
             no_data(a, "no response in this direction (zero at every speed)")
-            continue
-        top = np.argsort(np.abs(inphase).max(axis=0))[::-1][:n_paths]
-        for j in top:   # one colour per path in every panel: one legend for the figure
-            a.plot(result.rpm, inphase[:, j], "o-", ms=3, lw=1.1, color=f"C{j % 10}",
-                   label=labels[j])
-        a.plot(result.rpm, mag, "k-", lw=2, label="total |v|")
-        a.axhline(0.0, color="0.5", lw=0.6)
-        a.set_title(f"{p} {d.upper()} — order {order:g}: path contributions in phase "
-                    "with the total", fontsize=8)
-        a.set_ylabel("velocity [mm/s]", fontsize=7)
+        a.set_title(f"{p} {d.upper()}", fontsize=TITLE_SIZE)
+        a.set_ylabel("velocity [mm/s]", fontsize=LABEL_SIZE)
         a.grid(True, alpha=0.3)
-        a.tick_params(labelsize=6)
-    axes[-1, 0].set_xlabel("engine speed [rpm]", fontsize=8)
+        a.tick_params(labelsize=TICK_SIZE)
+    axes[-1, 0].set_xlabel("engine speed [rpm]", fontsize=LABEL_SIZE)
     if own:
         figure_legend(fig, axes)
-    return finish(fig, own, path, provenance)
+    title = (f"transfer paths at order {order:g}: each path's velocity in phase with the "
+             "total (they add up to |v|), the largest paths")
+    if silent:
+        title += ". No response at every speed, not drawn: " + ", ".join(
+            f"{p} {d.upper()}" for p, d, _ in silent)
+    return finish(fig, own, path, provenance, title=title if own else None)
+
+
+def _paths_panel(a, rpm, pc, labels, n_paths, colours):
+    """One body-point direction: the largest in-phase path parts (equal curves merged) and
+    the total; ``colours`` keeps one colour per legend label across panels."""
+    total = pc.sum(axis=1)
+    mag = np.abs(total)
+    unit = np.where(mag > 0, np.conj(total) / np.where(mag > 0, mag, 1.0), 0.0)
+    inphase = (pc * unit[:, None]).real
+    groups = []
+    for j in np.argsort(np.abs(inphase).max(axis=0))[::-1][:n_paths]:
+        same = [g for g in groups if np.allclose(inphase[:, g[0]], inphase[:, j],
+                                                 rtol=1e-6, atol=1e-9)]
+        (same[0].append(j) if same else groups.append([j]))
+    for g in groups:
+        label = " = ".join(labels[j] for j in g)
+        k = colours.setdefault(label, len(colours))
+        a.plot(rpm, inphase[:, g[0]], marker="o", ms=2.5, lw=1.1, label=label, **series_style(k))
+    a.plot(rpm, mag, "k-", lw=2, label="total |v|")
+    a.axhline(0.0, color="0.5", lw=0.6)

@@ -3,17 +3,23 @@ maps, slow vs fast sweep. matplotlib comes through :mod:`powertrain.plotting`.""
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import numpy as np
 
 from powertrain.plotting.style import (
     LABEL_SIZE,
+    LEGEND_SIZE,
+    PRINT_WIDTH_IN,
     TICK_SIZE,
     TITLE_SIZE,
     colorbar,
+    colour,
     figure_legend,
     finish,
     log_axis,
     no_data,
+    series_style,
     subplots,
 )
 
@@ -22,68 +28,106 @@ DISPLAY = {"acceleration": ("m/s²", 1.0), "velocity": ("mm/s", 1e3),
            "displacement": ("mm", 1e3), "force": ("N", 1.0)}
 
 
-def plot_tracked(tracked, path=None, quantities=None, *, ax=None, provenance=None):
-    """Order RMS against rpm, one panel per channel (synthesis and the orders asked); one
-    legend for the figure; returns the figure (``ax``: None, Figure or SubFigure, or an
-    Axes when there is one channel)."""
+#: Dynamic range of an order-curve panel [dB]: the axis reaches this far below the panel's
+#: largest level, so numerical noise far below (1e-5 of the signal) does not stretch it.
+DYNAMIC_RANGE_DB = 60.0
+#: Campbell and waterfall maps reach this far above the highest tracked order.
+MAP_MARGIN = 1.25
+
+
+def tracked_quantities(tracked) -> list:
+    """What ``track --plot`` draws: the synthesis and every tracked order."""
     from powertrain.analysis.orders import order_label
+    return ["synthesis"] + [order_label(o) for o in tracked.orders]
+
+
+def plot_tracked(tracked, path=None, quantities=None, *, ax=None, provenance=None):
+    """Order RMS against rpm, one panel per channel: the synthesis (black) and every order
+    asked (default: every tracked order, :func:`tracked_quantities`), each in its own colour
+    and line style; the y axis spans at most :data:`DYNAMIC_RANGE_DB` below the panel's
+    largest level, and orders wholly below it are named in the title. One legend for the
+    figure; returns the figure (``ax``: None, Figure or SubFigure, or an Axes when there is
+    one channel)."""
     from powertrain.plotting.runup import style_panel
-    quantities = list(quantities or ["synthesis"] + [order_label(o) for o in tracked.orders
-                                                     if o in (1.0, 2.0, 4.0)]
-                      or [order_label(tracked.orders[0])])
+    quantities = list(quantities or tracked_quantities(tracked))
     n = len(tracked.channels)
     cols = min(3, n)
     rows = -(-n // cols)
-    fig, axes, own = subplots(ax, rows, cols, figsize=(4.2 * cols + 0.4, 2.6 * rows + 1.3))
+    fig, axes, own = subplots(ax, rows, cols, figsize=(PRINT_WIDTH_IN, 2.0 * rows + 2.4))
+    hidden = {}
     for c, ch in enumerate(tracked.channels):
         a = axes[c // cols][c % cols]
-        unit, f = DISPLAY[ch.quantity]
         label = ch.mount + ("" if ch.side == "active" else f".{ch.side}") + f".{ch.direction}"
-        values = []
-        for k, q in enumerate(quantities):
-            v = tracked.curve(label, q) * f
-            ok = np.isfinite(v) & (v > 0)
-            a.plot(tracked.rpm[ok], v[ok], color=f"C{k % 10}", label=q.replace("_", " "))
-            values.append(v[ok])
-        if not style_panel(a, f"{label} ({ch.quantity})", np.concatenate(values)):
+        peaks = _draw_curves(a, tracked, label, quantities, DISPLAY[ch.quantity][1])
+        if not style_panel(a, f"{label} ({ch.quantity})", list(peaks.values()),
+                           DYNAMIC_RANGE_DB):
             no_data(a, "zero at every speed")
-        a.set_ylabel(f"RMS [{unit}]", fontsize=LABEL_SIZE)
+        bottom = a.get_ylim()[0]
+        for q, peak in peaks.items():
+            if peak < bottom:
+                hidden.setdefault(q, []).append(label)
+        a.set_ylabel(f"RMS [{DISPLAY[ch.quantity][0]}]", fontsize=LABEL_SIZE)
         a.set_xlabel("engine speed [rpm]", fontsize=LABEL_SIZE)
     for c in range(n, rows * cols):
         axes[c // cols][c % cols].set_visible(False)
     if own:
         figure_legend(fig, axes)
-    return finish(fig, own, path, provenance,
-                  title=f"order tracking ({tracked.method}) of {tracked.source}" if own
-                  else None)
+    title = f"order tracking ({tracked.method}) of {Path(str(tracked.source)).name}"
+    groups = {}
+    for q, where in hidden.items():
+        groups.setdefault("every panel" if len(where) == n else ", ".join(where), []).append(q)
+    for where, qs in groups.items():
+        names = ", ".join(q.replace("order_", "") for q in qs)
+        title += (f"; order{'s' * (len(qs) > 1)} {names} more than "
+                  f"{DYNAMIC_RANGE_DB:g} dB below the largest level, off the axis in {where}")
+    return finish(fig, own, path, provenance, title=title if own else None)
+
+
+def _draw_curves(a, tracked, label, quantities, factor) -> dict:
+    """Draw the requested curves of one channel; returns {quantity: largest level}."""
+    peaks = {}
+    for k, q in enumerate(quantities):
+        v = tracked.curve(label, q) * factor
+        ok = np.isfinite(v) & (v > 0)
+        style = {"color": "k", "lw": 1.8} if q == "synthesis" else \
+            {**series_style(k - ("synthesis" in quantities)), "lw": 1.1}
+        a.plot(tracked.rpm[ok], v[ok], label=q.replace("_", " "), **style)
+        peaks[q] = float(v[ok].max()) if ok.any() else 0.0
+    return peaks
 
 
 def plot_maps(rpm, orders, order_rms, times, freqs, rpm_t, psd, title="", path=None,
-              unit="m/s²", *, ax=None, provenance=None):
-    """Campbell (rpm-order) and rpm-frequency colour maps side by side, levels in dB re the
-    maximum on an 80 dB scale (colour-bar arrows where lower levels are clipped); returns
-    the figure (``ax``: None, Figure or SubFigure)."""
-    fig, axes, own = subplots(ax, 1, 2, figsize=(12, 5.0))
-    a1, a2 = axes[0]
+              unit="m/s²", *, factor=1.0, max_order=None, ax=None, provenance=None):
+    """Campbell (rpm-order) above rpm-frequency colour map, over the speed range where both
+    have data, levels in dB re the maximum on an 80 dB scale (colour-bar arrows where lower
+    levels are clipped); the order axis and the frequency axis end :data:`MAP_MARGIN` above
+    ``max_order`` (default: the highest order of the map). ``order_rms`` is SI, shown in
+    ``unit`` = SI × ``factor``. Returns the figure (``ax``: None, Figure or SubFigure)."""
+    fig, axes, own = subplots(ax, 2, 1, figsize=(PRINT_WIDTH_IN, 7.4), sharey=True)
+    a1, a2 = axes[:, 0]
+    top = MAP_MARGIN * float(max_order or np.max(orders))
     ref = max(np.max(order_rms), 1e-30)
     db1 = 20 * np.log10(np.maximum(order_rms, ref * 1e-5) / ref)
     m1 = a1.pcolormesh(orders, rpm, db1, shading="nearest", cmap="viridis", vmin=-80, vmax=0)
     a1.set_xlabel("order", fontsize=LABEL_SIZE)
-    a1.set_ylabel("engine speed [rpm]", fontsize=LABEL_SIZE)
+    a1.set_xlim(0, min(top, float(np.max(orders))))
     a1.set_title("rpm-order map (Campbell)", fontsize=TITLE_SIZE)
-    colorbar(fig, m1, a1, db1, -80, 0, f"order RMS [dB re {ref:.3g} {unit}]")
+    colorbar(fig, m1, a1, db1, -80, 0, f"order RMS [dB re {ref * factor:.3g} {unit}]")
     refp = max(np.max(psd), 1e-30)
     db2 = 10 * np.log10(np.maximum(psd, refp * 1e-8) / refp)
     m2 = a2.pcolormesh(freqs, rpm_t, db2, shading="nearest", cmap="viridis", vmin=-80, vmax=0)
     a2.set_xlabel("frequency [Hz]", fontsize=LABEL_SIZE)
-    a2.set_ylabel("engine speed [rpm]", fontsize=LABEL_SIZE)
     a2.set_title("rpm-frequency map (waterfall)", fontsize=TITLE_SIZE)
     colorbar(fig, m2, a2, db2, -80, 0, "PSD [dB re max]")
-    f_top = 1.25 * float(np.max(orders)) * float(np.max(rpm)) / 60.0   # highest order shown
-    if 0 < f_top < float(np.max(freqs)):
-        a2.set_xlim(float(np.min(freqs)), f_top)
+    f_top = top * float(np.max(rpm)) / 60.0
+    a2.set_xlim(float(np.min(freqs)), min(f_top, float(np.max(freqs))))
+    lo = max(float(np.min(rpm)), float(np.min(rpm_t)))    # where both maps have data
+    hi = min(float(np.max(rpm)), float(np.max(rpm_t)))
     for a in (a1, a2):
+        a.set_ylabel("engine speed [rpm]", fontsize=LABEL_SIZE)
+        a.set_ylim(lo, hi)
         a.tick_params(labelsize=TICK_SIZE)
+        a.yaxis.set_tick_params(labelleft=True)
     return finish(fig, own, path, provenance, title=title if own else None)
 
 
@@ -92,16 +136,18 @@ def plot_sweep_rates(curves, path=None, title="", *, ax=None, provenance=None):
 
     ``curves``: list of (label, rpm, level [m/s]) drawn in that order.
     """
-    fig, axes, own = subplots(ax, figsize=(7.5, 4.6))
+    fig, axes, own = subplots(ax, figsize=(PRINT_WIDTH_IN, 4.2))
     a = axes[0, 0]
-    for label, rpm, level in curves:
-        a.plot(rpm, np.asarray(level) * 1e3, label=label,
-               lw=2.2 if label.startswith("stepped") else 1.2,
-               ls="--" if label.startswith("stepped") else "-")
+    for k, (label, rpm, level) in enumerate(curves):
+        stepped = label.startswith("stepped")
+        a.plot(rpm, np.asarray(level) * 1e3, label=label, lw=2.2 if stepped else 1.2,
+               color="k" if stepped else colour(k), ls="--" if stepped else "-")
     log_axis(a, "y")
     a.set_xlabel("engine speed [rpm]", fontsize=LABEL_SIZE)
     a.set_ylabel("RMS velocity [mm/s]", fontsize=LABEL_SIZE)
     a.grid(True, which="major", alpha=0.35)
-    a.legend(fontsize=8)
-    a.set_title(title, fontsize=TITLE_SIZE)
-    return finish(fig, own, path, provenance)
+    if own:
+        figure_legend(fig, axes)
+    else:
+        a.legend(fontsize=LEGEND_SIZE)
+    return finish(fig, own, path, provenance, title=title if own else None)

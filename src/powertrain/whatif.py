@@ -221,14 +221,17 @@ class WhatIfResult:
                           + _format_table(header, list(rows.values())))
         return "\n\n".join(blocks)
 
-    def plot(self, ax=None, *, path=None, channel=None, quantity=None, provenance=None):
-        """Overlay of baseline, variants and measurement; returns the figure (see
+    def plot(self, ax=None, *, path=None, channel=None, quantity=None, provenance=None,
+             view="levels"):
+        """Baseline, variants and measurement (``view="levels"``) or each variant's change
+        Δ dB against the baseline (``view="delta"``); returns the figure (see
         :func:`powertrain.plotting.plot_whatif`)."""
         from powertrain.plotting import plot_whatif
         from powertrain.plotting.style import target_and_path
         ax, path = target_and_path(ax, path)
         return plot_whatif(self, path, ax=ax, channel=channel, quantity=quantity,
-                           provenance=provenance or getattr(self, "provenance", None))
+                           provenance=provenance or getattr(self, "provenance", None),
+                           view=view)
 
 
 def _format_table(header, rows) -> str:

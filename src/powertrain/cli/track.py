@@ -37,7 +37,10 @@ from powertrain.cli import main
 @click.option("--out", type=click.Path(dir_okay=False), help="HDF5 with complex amplitudes.")
 @click.option("--plot", type=click.Path(dir_okay=False), help="PNG of the order curves.")
 @click.option("--map", "map_png", type=click.Path(dir_okay=False),
-              help="PNG: rpm-order (Campbell) and rpm-frequency maps of the first channel.")
+              help="PNG: rpm-order (Campbell) and rpm-frequency maps of one channel.")
+@click.option("--map-channel", metavar="NAME",
+              help="Channel of --map: its name in the file or its MOUNT[.SIDE].DIRECTION "
+                   "label (default: the first channel).")
 @click.option("--overall", is_flag=True,
               help="Also the overall level of the raw signal per speed (RMS in a band, over "
                    "the block of each speed): 'overall' rows in --csv, /overall_rms in --out.")
@@ -51,8 +54,8 @@ from powertrain.cli import main
               help="CSV of the order spectra of --spectrum-at.")
 @click.option("--quiet", is_flag=True, help="No progress bar and no table.")
 def track(raw, map_file, rpm_column, tacho_column, pulses_per_rev, orders_spec, rpm_step,
-          method, bandwidth, quantity, as_quantity, csv_file, out, plot, map_png, overall,
-          overall_band, spectrum_at, spectrum_out, quiet):
+          method, bandwidth, quantity, as_quantity, csv_file, out, plot, map_png, map_channel,
+          overall, overall_band, spectrum_at, spectrum_out, quiet):
     """Order-track raw run-up time data: speed from an rpm or tacho channel, order RMS
     against rpm per channel.
 
@@ -103,7 +106,10 @@ def track(raw, map_file, rpm_column, tacho_column, pulses_per_rev, orders_spec, 
         _ = tracked.quantity                      # mixed quantities: fail before writing
     if spectra:
         _ = spectra.quantity
-    maps = _maps(rec, use, pulses_per_rev, rpm_step) if map_png else None
+    if map_channel and not map_png:
+        raise InputError("--map-channel needs --map FILE.png", key="--map-channel")
+    maps = _maps(rec, use, pulses_per_rev, rpm_step, _map_channel(rec, map_channel),
+                 max(orders)) if map_png else None
     if csv_file:
         tracked.to_csv(csv_file)
     if out:
@@ -152,24 +158,41 @@ def _spectra(rec, use, pulses_per_rev, speeds, orders, quantity):
                    orders=first.orders[:size], amplitude=amp)
 
 
-def _maps(rec, use, pulses_per_rev, rpm_step):
-    """Campbell and rpm-frequency maps of the first channel (arguments of plot_maps)."""
+def _map_channel(rec, name):
+    """Index of the --map-channel NAME (file name or MOUNT[.SIDE].DIRECTION label)."""
+    if not name:
+        return 0
+    for i, ch in enumerate(rec.channels):
+        if name in (ch.name, ch.label):
+            return i
+    from powertrain.errors import InputError
+    known = ", ".join(ch.label for ch in rec.channels)
+    raise InputError(f"no channel {name!r} in the file (channels: {known})",
+                     key="--map-channel")
+
+
+def _maps(rec, use, pulses_per_rev, rpm_step, channel, max_order):
+    """Campbell and rpm-frequency maps of one channel (arguments of plot_maps), both
+    reaching 25 % above the highest tracked order."""
     import numpy as np
     from scipy.signal import spectrogram
 
+    from powertrain.plotting_orders import DISPLAY, MAP_MARGIN
     from powertrain.tracking import order_map, speed_profile
     profile = speed_profile(rec, use=use, pulses_per_rev=pulses_per_rev)
-    rpm, fine, rms = order_map(rec, profile, 0, rpm_step=rpm_step)
+    rpm, fine, rms = order_map(rec, profile, channel, rpm_step=rpm_step,
+                               max_order=MAP_MARGIN * max_order)
     fs = rec.sample_rate
-    nper = int(2 ** np.ceil(np.log2(max(64, fs / 2.0))))          # ~2 Hz resolution
-    f, tt, p = spectrogram(rec.channels[0].values, fs, nperseg=min(nper, rec.time.size),
-                           noverlap=min(nper, rec.time.size) // 2)
+    nper = min(int(2 ** np.ceil(np.log2(max(64, fs / 2.0)))), rec.time.size)   # ~2 Hz
+    f, tt, p = spectrogram(rec.channels[channel].values, fs, nperseg=nper,
+                           noverlap=nper * 7 // 8)
     rpm_t = np.interp(tt + rec.time[0], rec.time, profile.rpm)
-    ch = rec.channels[0]
-    from powertrain.plotting_orders import DISPLAY
+    ch = rec.channels[channel]
+    from pathlib import Path
     return dict(rpm=rpm, orders=fine, order_rms=rms, times=tt, freqs=f, rpm_t=rpm_t, psd=p.T,
-                title=f"{ch.label} ({ch.quantity}) of {rec.source}",
-                unit=DISPLAY[ch.quantity][0])
+                title=f"{ch.label} ({ch.quantity}) of {Path(str(rec.source)).name}",
+                unit=DISPLAY[ch.quantity][0], factor=DISPLAY[ch.quantity][1],
+                max_order=max_order)
 
 
 def _report(rec, tracked, written):

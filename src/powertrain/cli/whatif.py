@@ -51,6 +51,8 @@ from powertrain.cli.common import (
               help="Measured run-up (CSV or HDF5, as for `compare`) to overlay.")
 @click.option("--plot", type=click.Path(dir_okay=False),
               help="PNG overlay of baseline, variants (and measurement).")
+@click.option("--delta-plot", type=click.Path(dir_okay=False),
+              help="PNG of each variant's change against the baseline, 20 log10(v/v0) [dB].")
 @click.option("--json", "json_file", type=click.Path(dir_okay=False),
               help="Write the changes as JSON.")
 @click.option("--signal", type=click.Choice(["velocity", "mount_force"]), default="velocity",
@@ -69,7 +71,7 @@ from powertrain.cli.common import (
 @click.option("--quiet", is_flag=True, help="No progress bar and no table.")
 def whatif(engine_file, rpm_from, rpm_to, rpm_step, solver, scale, set_, swap, move, rotate,
            effect, variants_file, target, target_out, target_plot, measured_file, plot, json_file,
-           signal, objective, workers, scheduler, quiet):
+           delta_plot, signal, objective, workers, scheduler, quiet):
     """What-if: run the baseline and variants of the mount system, print the change in dB.
 
     The command-line operations (--scale/--set/--swap/--move/--rotate/--effect) form one
@@ -104,7 +106,8 @@ def whatif(engine_file, rpm_from, rpm_to, rpm_step, solver, scale, set_, swap, m
     rpm = speed_steps(rpm_from, rpm_to, rpm_step)
     if workers is not None and workers < 1:
         raise InputError("must be >= 1", key="--workers")
-    check_outputs(target_out=target_out, target_plot=target_plot, plot=plot, json=json_file)
+    check_outputs(target_out=target_out, target_plot=target_plot, plot=plot, json=json_file,
+                  delta_plot=delta_plot)
     engine = read_engine(engine_file or DEFAULT_ENGINE_PATH)
     runup_settings(engine, rpm, 1.0)
 
@@ -172,6 +175,9 @@ def whatif(engine_file, rpm_from, rpm_to, rpm_step, solver, scale, set_, swap, m
     if plot:
         write_plot(lambda p: result.plot(path=p, provenance=prov), plot)
         written.append(plot)
+    if delta_plot:
+        write_plot(lambda p: result.plot(path=p, provenance=prov, view="delta"), delta_plot)
+        written.append(delta_plot)
     if quiet:
         return
     modes = ", ".join(f"{f:.2f}" for f in result.baseline.rigid_body_modes_hz)

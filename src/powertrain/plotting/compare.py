@@ -6,8 +6,17 @@ from pathlib import Path
 
 import numpy as np
 
-from powertrain.plotting.runup import grid, label_grid, style_panel
-from powertrain.plotting.style import figure_legend, finish, no_data, quantity_label
+from powertrain.plotting.runup import SYNTHESIS_NOTE, grid, label_grid, panel_title, style_panel
+from powertrain.plotting.style import (
+    GAP_ABOVE,
+    GAP_BELOW,
+    TICK_SIZE,
+    TITLE_SIZE,
+    colour,
+    figure_legend,
+    finish,
+    no_data,
+)
 
 
 def comparison_quantities(comparison) -> list:
@@ -23,10 +32,10 @@ def plot_comparison(comparison, path=None, quantities=None, *, ax=None, channel=
     column per quantity (synthesis and every measured order), log-scaled velocity [mm/s].
     The measured curve is a thin black line, the simulation markers at its speeds joined by
     straight lines (on the log axis these are exactly the log-level interpolation used for
-    the gaps); the gap at the compared speeds is shaded red where the simulation is higher,
-    green where it is lower. Points excluded at the noise floor are grey crosses, the
-    exclusion limit a dotted line; a panel with no point above it says so. Panel titles give
-    the RMS gap and bias [dB].
+    the gaps); the gap at the compared speeds is shaded orange where the simulation is
+    higher, sky blue where it is lower (colour-blind safe). Points excluded at the noise
+    floor are grey crosses, the exclusion limit a dotted line; a panel with no point above
+    it says so. Under each panel title: the RMS gap and bias [dB].
 
     Parameters
     ----------
@@ -47,7 +56,7 @@ def plot_comparison(comparison, path=None, quantities=None, *, ax=None, channel=
     rows = list(sim.channels)
     rows += [c for c in comparison.measured.channels if c not in rows]
     quantities = list(quantities or comparison_quantities(comparison))
-    fig, panels, own, axes = grid(ax, rows, quantities, channel, quantity, panel_height=1.85)
+    fig, panels, own, axes = grid(ax, rows, quantities, channel, quantity, panel_height=1.35)
     limit = NOISE_FLOOR_MARGIN * comparison.noise_floor * 1e3
     compared = {(c.mount, c.direction, c.quantity): c for c in comparison.channels}
     missing = {(m["mount"], m["direction"], m["quantity"]): m["reason"]
@@ -55,11 +64,10 @@ def plot_comparison(comparison, path=None, quantities=None, *, ax=None, channel=
     for key, a in panels.items():
         c = compared.get(key)
         if c is None or not c.scored.any():
-            mount, direction, q = key
-            a.set_title(f"{mount} {direction.upper()} — {quantity_label(q)}", fontsize=8.5)
+            a.set_title(panel_title(*key), fontsize=TITLE_SIZE)
             no_data(a, "not compared: " + missing.get(key, "every measured point at the "
                                                           "noise floor"))
-            a.tick_params(labelsize=7)
+            a.tick_params(labelsize=TICK_SIZE)
             continue
         _panel(a, key, comparison, c, limit)
     label_grid(fig, axes, "RMS velocity [mm/s]")
@@ -70,7 +78,8 @@ def plot_comparison(comparison, path=None, quantities=None, *, ax=None, channel=
     src = Path(comparison.measured.source).name
     tag = "SYNTHETIC measurement" if comparison.measured.synthetic else "measurement"
     title = (f"{tag} {src} vs simulation: overall RMS gap {comparison.overall_rms_db:.2f} dB "
-             "(gap = 20 log10(sim/measured))")
+             f"(gap = 20 log10(sim/measured); under each panel title its RMS and bias "
+             f"[dB]){SYNTHESIS_NOTE}")
     return finish(fig, own, path, provenance, title=title if own else None)
 
 
@@ -88,17 +97,17 @@ def _panel(ax, key, comparison, c, limit):
     if key in comparison.simulated.curves:
         rs, vs = comparison.simulated.curves[key]
         ok = vs > 0
-        ax.plot(rs[ok], vs[ok] * mm, "o-", color="C0", ms=2.5, lw=1.1, label="simulated")
+        ax.plot(rs[ok], vs[ok] * mm, "o-", color=colour(0), ms=2, lw=1.0, label="simulated")
         values.append(vs[ok] * mm)
-    title = f"{mount} {direction.upper()} — {quantity_label(q)}"
+    title = panel_title(mount, direction, q)
     if c.scored.any():
         s = np.where(c.scored, c.simulated, np.nan) * mm
         m = np.where(c.scored, c.measured, np.nan) * mm
         ax.fill_between(c.rpm, m, s, where=c.scored & (s >= m), interpolate=True,
-                        color="C3", alpha=0.3, lw=0, label="sim > measured")
+                        color=GAP_ABOVE, alpha=0.45, lw=0, label="sim > measured")
         ax.fill_between(c.rpm, m, s, where=c.scored & (s < m), interpolate=True,
-                        color="C2", alpha=0.35, lw=0, label="sim < measured")
-        title += f"\nΔL rms {c.stats['rms_db']:.1f} dB, bias {c.stats['bias_db']:+.1f} dB"
+                        color=GAP_BELOW, alpha=0.45, lw=0, label="sim < measured")
+        title += f"\n{c.stats['rms_db']:.1f} rms, {c.stats['bias_db']:+.1f} bias"
     if c.at_floor.any():
         ax.plot(c.rpm[c.at_floor], np.maximum(c.measured[c.at_floor] * mm, limit * 0.5), "x",
                 color="0.55", ms=3, label="excluded (noise floor)")

@@ -6,6 +6,9 @@ import numpy as np
 
 from powertrain.plotting.style import (
     LABEL_SIZE,
+    LEGEND_SIZE,
+    OKABE_ITO,
+    PRINT_WIDTH_IN,
     TICK_SIZE,
     TITLE_SIZE,
     colorbar,
@@ -14,13 +17,18 @@ from powertrain.plotting.style import (
     log_axis,
     no_data,
     quantity_label,
+    series_style,
     subplots,
+    wrap,
 )
 
 #: Colour scale of the gap map [dB]; cells beyond are clipped (the colour bar shows arrows).
 GAP_SCALE_DB = 6.0
-#: Gap outlined on the map [dB].
+#: Gap outlined on the map [dB] ...
 GAP_OUTLINE_DB = 3.0
+#: ... where it holds over at least this many neighbouring speeds (a lone noisy cell is not
+#: outlined).
+GAP_OUTLINE_RUN = 3
 
 
 def _censored(diagnosis):
@@ -32,11 +40,12 @@ def _censored(diagnosis):
 
 
 def plot_gap_map(diagnosis, path=None, *, ax=None, quantity=None, provenance=None):
-    """Gap map of a :class:`powertrain.diagnosis.DiagnosisResult`: one panel per quantity,
-    channels against speed, colour = gap 20 log10(sim/measured) [dB] on a ±6 dB scale
-    (arrows on the colour bar when cells lie beyond), ±3 dB contours; cells measured below
-    the censoring limit (3 × noise floor) grey; a quantity with no point above it is
-    labelled instead of drawn.
+    """Gap map of a :class:`powertrain.diagnosis.DiagnosisResult`: one panel per quantity
+    with a point above the censoring limit (3 × noise floor; the other quantities are named
+    in the title), channels against speed, colour = gap 20 log10(sim/measured) [dB] on a
+    ±6 dB scale (arrows on the colour bar when cells lie beyond); outlined: runs of at least
+    :data:`GAP_OUTLINE_RUN` neighbouring speeds beyond ±3 dB (single noisy cells are not);
+    cells measured below the censoring limit grey.
 
     Parameters
     ----------
@@ -47,58 +56,90 @@ def plot_gap_map(diagnosis, path=None, *, ax=None, quantity=None, provenance=Non
         An Axes gets the one panel ``quantity`` (default: the first).
     provenance : Provenance, optional
     """
-    from matplotlib.colors import ListedColormap
     d = diagnosis.data
     cens, margin = _censored(diagnosis)
-    qs = list(d.quantities)
+    valid = np.isfinite(diagnosis.gap) & ~cens
+    shown = [q for k, q in enumerate(d.quantities) if valid[:, :, k].any()]
+    empty = [q for q in d.quantities if q not in shown]
     if ax is not None and not hasattr(ax, "subplots"):
-        qs = [quantity or qs[0]]
+        qs = [quantity or (shown or list(d.quantities))[0]]
         fig, axes, own = subplots(ax)
     else:
-        ncol = {1: 1, 2: 2, 3: 3, 4: 2}.get(len(qs), 3)
-        nrow = int(np.ceil(len(qs) / ncol))
-        fig, axes, own = subplots(ax, nrow, ncol, figsize=(4.4 * ncol + 1.4, 2.7 * nrow + 1.3),
-                                  sharex=True, sharey=True)
-    y = np.arange(len(d.channels))
-    im = None
-    shown = []
-    for a, q in zip(axes.flat, qs):
-        k = d.quantities.index(q)
-        g = diagnosis.gap[:, :, k].T
-        valid = np.isfinite(g) & ~cens[:, :, k].T
-        a.set_title(quantity_label(q), fontsize=TITLE_SIZE)
-        a.set_yticks(y, [f"{m} {di.upper()}" for m, di in d.channels])
-        a.tick_params(labelsize=TICK_SIZE)
-        if not valid.any():
-            no_data(a, f"every measured point below {margin:g}× the noise floor")
-            continue
-        grey = np.where(cens[:, :, k].T, 0.0, np.nan)
-        a.pcolormesh(d.rpm, y, np.ma.masked_invalid(grey), cmap=ListedColormap(["0.7"]),
-                     shading="nearest")
-        im = a.pcolormesh(d.rpm, y, np.ma.masked_where(~valid, g), cmap="RdBu_r",
-                          vmin=-GAP_SCALE_DB, vmax=GAP_SCALE_DB, shading="nearest")
-        shown.append(np.where(valid, g, np.nan))
-        if np.nanmax(np.abs(np.where(valid, g, np.nan))) > GAP_OUTLINE_DB:
-            a.contour(d.rpm, y, np.where(valid, np.abs(g), 0.0), [GAP_OUTLINE_DB],
-                      colors="k", linewidths=0.6)
+        qs = shown or list(d.quantities)[:1]
+        ncol = 1 if len(qs) == 1 else 2
+        nrow = -(-len(qs) // ncol)
+        fig, axes, own = subplots(ax, nrow, ncol, sharex=True, sharey=True,
+                                  figsize=(PRINT_WIDTH_IN, 0.2 * _n_rows(valid) * nrow + 2.6))
+    im = _gap_panels(axes, diagnosis, qs, cens, valid)
     for a in axes.flat[len(qs):]:
         a.set_visible(False)
     for a in axes[-1]:
         a.set_xlabel("engine speed [rpm]", fontsize=LABEL_SIZE)
     if im is not None:
-        colorbar(fig, im, axes.ravel().tolist(), np.concatenate([s.ravel() for s in shown]),
-                 -GAP_SCALE_DB, GAP_SCALE_DB,
-                 f"gap 20 log10(sim/measured) [dB]; contour ±{GAP_OUTLINE_DB:g} dB; grey: "
-                 f"below {margin:g}× noise floor")
-    return finish(fig, own, path, provenance,
-                  title=f"gap map (baseline): {diagnosis.verdict_text}" if own else None)
+        colorbar(fig, im, axes.ravel().tolist(), diagnosis.gap[valid], -GAP_SCALE_DB,
+                 GAP_SCALE_DB, f"gap 20 log10(sim/measured) [dB]; grey: below {margin:g}× "
+                               "the noise floor")
+    title = f"gap map (baseline): {diagnosis.verdict_text}"
+    if empty:
+        title += (f". Every measured point below {margin:g}× the noise floor, not drawn: "
+                  + ", ".join(quantity_label(q) for q in empty))
+    title += (f". Outlined: ≥ {GAP_OUTLINE_RUN} neighbouring speeds beyond "
+              f"±{GAP_OUTLINE_DB:g} dB")
+    return finish(fig, own, path, provenance, title=title if own else None)
+
+
+def _gap_panels(axes, diagnosis, qs, cens, valid):
+    """Draw the gap panels; returns the last colour mesh (None when nothing was drawn)."""
+    from matplotlib.colors import ListedColormap
+    d = diagnosis.data
+    rows = np.flatnonzero(valid.any(axis=(0, 2))) if valid.any() else \
+        np.arange(len(d.channels))                       # channels with a point to show
+    y = np.arange(rows.size)
+    im = None
+    for a, q in zip(axes.flat, qs):
+        k = d.quantities.index(q)
+        g = diagnosis.gap[:, rows, k].T
+        ok = valid[:, rows, k].T
+        a.set_title(quantity_label(q), fontsize=TITLE_SIZE)
+        a.set_yticks(y, [f"{d.channels[c][0]} {d.channels[c][1].upper()}" for c in rows])
+        a.tick_params(labelsize=TICK_SIZE)
+        if not ok.any():
+            no_data(a, "every point below the censoring limit")
+            continue
+        grey = np.where(cens[:, rows, k].T, 0.0, np.nan)
+        a.pcolormesh(d.rpm, y, np.ma.masked_invalid(grey), shading="nearest",
+                     cmap=ListedColormap(["0.7"], name="censored grey"))
+        im = a.pcolormesh(d.rpm, y, np.ma.masked_where(~ok, g), cmap="RdBu_r",
+                          vmin=-GAP_SCALE_DB, vmax=GAP_SCALE_DB, shading="nearest")
+        runs = _runs_beyond(np.where(ok, np.abs(g), 0.0) > GAP_OUTLINE_DB, GAP_OUTLINE_RUN)
+        if runs.any():
+            a.contour(d.rpm, y, runs.astype(float), [0.5], colors="k", linewidths=0.8)
+    return im
+
+
+def _n_rows(valid) -> int:
+    """Channels drawn in the gap map: those with a point above the censoring limit."""
+    return max(1, int(valid.any(axis=(0, 2)).sum()))
+
+
+def _runs_beyond(mask, run):
+    """Cells of ``mask`` (channels × speeds) in runs of at least ``run`` along speed."""
+    out = np.zeros_like(mask)
+    for c, row in enumerate(mask):
+        edges = np.flatnonzero(np.diff(np.concatenate([[0], row.astype(int), [0]])))
+        for start, stop in zip(edges[::2], edges[1::2]):
+            if stop - start >= run:
+                out[c, start:stop] = True
+    return out
 
 
 def plot_gap_frequency(diagnosis, path=None, *, ax=None, provenance=None):
-    """Order gaps re-plotted against frequency f = order·rpm/60 [Hz] per channel (left; a
-    structural cause lines up across orders at one frequency) and, averaged over the
-    channels, against speed per order (right; an excitation cause lines up at one order),
-    with the fitted smooth parts.
+    """Order gaps re-plotted (a) against frequency f = order·rpm/60 [Hz], one colour per
+    channel with that channel's fitted structure part dH(f) + constant (a structural cause
+    lines up across orders at one frequency), and (b), averaged over the channels, against
+    speed, one colour per order with that order's fitted excitation part (dashed; an
+    excitation cause lines up at one order). Only orders with a gap above the noise floor
+    are drawn and listed; each panel's legend sits above it, off the data.
 
     Parameters
     ----------
@@ -107,45 +148,74 @@ def plot_gap_frequency(diagnosis, path=None, *, ax=None, provenance=None):
     ax : None, Figure or SubFigure
     provenance : Provenance, optional
     """
-    from matplotlib.lines import Line2D
     d = diagnosis.data
     p = diagnosis.parts
-    fig, axes, own = subplots(ax, 1, 2, figsize=(12, 5.0))
-    a1, a2 = axes[0]
-    for j, k in enumerate(np.flatnonzero(d.order_mask)):
-        colour = f"C{j % 10}"
-        f = (d.harmonic[k] + 1) / 2.0 * d.rpm / 60.0
-        g = diagnosis.gap[:, :, k]
-        for c in range(len(d.channels)):
-            a1.plot(f, g[:, c], ".", ms=1.8, color=colour,
-                    label=quantity_label(d.quantities[k]) if c == 0 else None)
-        n_ok = np.isfinite(g).sum(axis=1)
-        mean = np.where(n_ok > 0, np.nansum(g, axis=1) / np.maximum(n_ok, 1), np.nan)
-        a2.plot(d.rpm, mean, "-", color=colour, lw=1)
-    sc = p["structure_curves"]
-    for c, row in enumerate(sc["by_channel"]):
-        a1.plot(sc["frequency_hz"], np.array(row) + p["channel_const_db"][c], "k-", lw=0.6,
-                alpha=0.6)
-    ec = p["excitation_curves"]
-    for row in ec["by_quantity"]:
-        a2.plot(ec["rpm"], row, "--", color="k", lw=0.6, alpha=0.6)
+    fig, axes, own = subplots(ax, 2, 1, figsize=(PRINT_WIDTH_IN, 8.4))
+    a1, a2 = axes[:, 0]
+    with_data = [k for k in np.flatnonzero(d.order_mask)
+                 if np.isfinite(diagnosis.gap[:, :, k]).any()]
+    _gap_by_channel(a1, diagnosis, with_data)
+    _gap_by_order(a2, diagnosis, with_data)
     log_axis(a1, "x", max_ticks=9)
     a1.set_xlabel("frequency = order × rpm / 60 [Hz]", fontsize=LABEL_SIZE)
     a1.set_ylabel("gap per channel [dB]", fontsize=LABEL_SIZE)
     a2.set_xlabel("engine speed [rpm]", fontsize=LABEL_SIZE)
     a2.set_ylabel("gap, mean over channels [dB]", fontsize=LABEL_SIZE)
-    for a in (a1, a2):
+    titles = ("(a) gap of every order per channel against frequency; line: the channel's "
+              "fitted structure part dH(f) + constant",
+              "(b) gap per order, mean over the channels, against speed; dashed: the "
+              "order's fitted excitation part")
+    for a, title in zip((a1, a2), titles):
         a.axhline(0, color="0.5", lw=0.5)
         a.grid(True, alpha=0.3)
         a.tick_params(which="both", labelsize=TICK_SIZE)
-    if own:
-        figure_legend(fig, axes, [
-            (Line2D([], [], color="k", lw=0.6), "fitted structure part dH(f) + channel constant"),
-            (Line2D([], [], color="k", ls="--", lw=0.6), "fitted excitation part (per order)")])
+        _legend_above(a, title)
     s = p["share_alone"]
     title = (f"gap split: structure {s['structure']:.0%}, excitation {s['excitation']:.0%}, "
              f"channel constant {s['const']:.0%} of the gap's sum of squares (each alone)")
     return finish(fig, own, path, provenance, title=title if own else None)
+
+
+def _gap_by_channel(ax, diagnosis, orders):
+    d, p = diagnosis.data, diagnosis.parts
+    sc = p["structure_curves"]
+    for c, (mount, direction) in enumerate(d.channels):
+        if not np.isfinite(diagnosis.gap[:, c, orders]).any():
+            continue
+        style = series_style(c)
+        marker = "o^s"[(c // 6) % 3]
+        for k in orders:
+            f = (d.harmonic[k] + 1) / 2.0 * d.rpm / 60.0
+            ax.plot(f, diagnosis.gap[:, c, k], marker, ms=1.6, color=style["color"],
+                    alpha=0.6, ls="none")
+        ax.plot(sc["frequency_hz"], np.array(sc["by_channel"][c]) + p["channel_const_db"][c],
+                lw=1.2, marker=marker, ms=3, markevery=4,
+                label=f"{mount} {direction.upper()}", **style)
+
+
+def _gap_by_order(ax, diagnosis, orders):
+    d, p = diagnosis.data, diagnosis.parts
+    ec = p["excitation_curves"]
+    for j, k in enumerate(orders):
+        g = diagnosis.gap[:, :, k]
+        n_ok = np.isfinite(g).sum(axis=1)
+        mean = np.where(n_ok > 0, np.nansum(g, axis=1) / np.maximum(n_ok, 1), np.nan)
+        style = series_style(j)
+        ax.plot(d.rpm, mean, lw=1.0, color=style["color"], ls=style["ls"],
+                label=quantity_label(d.quantities[k]))
+        ax.plot(ec["rpm"], ec["by_quantity"][k], lw=2.0, ls=(0, (4, 2)), color=style["color"],
+                alpha=0.7)
+
+
+def _legend_above(ax, title):
+    """The panel's legend above it (outside the data), carrying the panel title."""
+    n = len(ax.get_legend_handles_labels()[1])
+    leg = ax.legend(loc="lower left", bbox_to_anchor=(0, 1.01, 1, 0), mode="expand",
+                    ncol=max(1, min(n, 5)), fontsize=LEGEND_SIZE, frameon=False,
+                    title=wrap(title, PRINT_WIDTH_IN * 0.9, TITLE_SIZE),
+                    title_fontsize=TITLE_SIZE, borderaxespad=0.2)
+    leg.get_title().set_multialignment("left")
+    leg._legend_box.align = "left"
 
 
 def plot_diagnosis_overlay(diagnosis, path=None, n_panels=6, *, ax=None, provenance=None):
@@ -171,9 +241,9 @@ def plot_diagnosis_overlay(diagnosis, path=None, n_panels=6, *, ax=None, provena
             if np.isfinite(v).sum() > 2:
                 score.append((float(np.sqrt(np.nanmean(v ** 2))), c, k))
     score = sorted(score, reverse=True)[:n_panels]
-    ncol = 3
+    ncol = 2
     nrow = max(1, int(np.ceil(len(score) / ncol)))
-    fig, axes, own = subplots(ax, nrow, ncol, figsize=(12.5, 3.2 * nrow + 1.4))
+    fig, axes, own = subplots(ax, nrow, ncol, figsize=(PRINT_WIDTH_IN, 2.3 * nrow + 2.0))
     held = np.isin(d.rpm, diagnosis.split["heldout_rpm"])
     for a, (rms, c, k) in zip(axes.flat, score):
         _overlay_panel(a, diagnosis, c, k, held, rms)
@@ -183,7 +253,7 @@ def plot_diagnosis_overlay(diagnosis, path=None, n_panels=6, *, ax=None, provena
         a.set_visible(False)
     for a in axes.flat[:len(score)]:
         a.set_xlabel("engine speed [rpm]", fontsize=LABEL_SIZE)
-    fig.supylabel("RMS velocity [mm/s]", fontsize=LABEL_SIZE + 1)
+    fig.supylabel("RMS velocity [mm/s]", fontsize=LABEL_SIZE + 0.5)
     if own:
         figure_legend(fig, axes)
     return finish(fig, own, path, provenance,
@@ -198,11 +268,13 @@ def _overlay_panel(ax, diagnosis, c, k, held, rms):
     sim0 = m * 10 ** (g[:, c, k] / 20)
     ax.plot(d.rpm, m, "k.", ms=2.5, label="measured")
     ax.plot(d.rpm[held], m[held], "o", mfc="none", mec="0.6", ms=4, label="held-out speeds")
-    ax.plot(d.rpm, sim0, "C3-", lw=1, label="baseline simulation")
+    ax.plot(d.rpm, sim0, "-", color=OKABE_ITO["vermillion"], lw=1,
+            label="baseline simulation")
     values = [m, sim0]
     if diagnosis.gap_after is not None and diagnosis.chosen is not None:
         after = m * 10 ** (diagnosis.gap_after[:, c, k] / 20)
-        ax.plot(d.rpm, after, "C0-", lw=1, label=f"baseline + {diagnosis.chosen.label}")
+        ax.plot(d.rpm, after, "-", color=OKABE_ITO["blue"], lw=1,
+                label=f"baseline + {diagnosis.chosen.label}")
         values.append(after)
     mnt, dr = d.channels[c]
     style_panel(ax, f"{mnt} {dr.upper()} — {quantity_label(d.quantities[k])}: "

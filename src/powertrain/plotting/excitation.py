@@ -7,21 +7,31 @@ import numpy as np
 
 from powertrain.plotting.style import (
     LABEL_SIZE,
-    LEGEND_SIZE,
+    OKABE_ITO,
+    PRINT_WIDTH_IN,
     TICK_SIZE,
+    TITLE_SIZE,
+    colour,
+    figure_legend,
     finish,
     subplots,
 )
 
 LOAD_NAMES = ["Fx [N]", "Fy [N]", "Fz [N]", "Mx [N·m]", "My [N·m]", "Mz [N·m]"]
+#: Legend label of the x, y and z component (one colour each in every load panel).
+COMPONENTS = ("x: Fx, Mx", "y: Fy, My", "z: Fz, Mz")
+#: Colours of the components, apart from the cylinders' (palette colours 0-3).
+_COMPONENT_COLOURS = (OKABE_ITO["reddish purple"], OKABE_ITO["sky blue"], "0.3")
 
 
 def plot_excitation(exc, path=None, *, ax=None, provenance=None):
     """Summary figure of an :class:`~powertrain.models.engine.Excitation` over one cycle.
 
-    Four panels against the crank angle of cylinder 1 [deg]: cylinder pressures [bar];
-    per-cylinder crank torque [N·m]; total forces [N] and moments [N·m] on the powertrain
-    about its CG (engine axes); and the order spectrum (0.5..8) of the load components.
+    Six panels: cylinder pressures [bar] and per-cylinder crank torque [N·m] against the
+    crank angle of cylinder 1 [deg] (one colour per cylinder in both); the total forces [N]
+    and moments [N·m] on the powertrain about its CG (engine axes), each on its own axis
+    (one colour per component x, y, z); and the order spectrum (0.5..8) of the forces and of
+    the moments. One legend above the panels, so none covers a curve.
 
     Parameters
     ----------
@@ -29,7 +39,7 @@ def plot_excitation(exc, path=None, *, ax=None, provenance=None):
     path : str, optional
         PNG file to write.
     ax : None, Figure or SubFigure
-        Where to draw the four panels.
+        Where to draw the six panels.
     provenance : Provenance, optional
         Foot line of a new figure.
 
@@ -38,48 +48,47 @@ def plot_excitation(exc, path=None, *, ax=None, provenance=None):
     matplotlib Figure (or SubFigure)
     """
     deg = np.degrees(exc.crank_angle)
-    fig, axes, own = subplots(ax, 2, 2, figsize=(11, 7.8))
-    a = axes[0, 0]
+    fig, axes, own = subplots(ax, 3, 2, figsize=(PRINT_WIDTH_IN, 8.6))
     for i in range(exc.pressure.shape[1]):
-        a.plot(deg, exc.pressure[:, i] / 1e5, label=f"cylinder {i + 1}")
-    a.set_ylabel("cylinder pressure [bar]", fontsize=LABEL_SIZE)
-    a.legend(fontsize=LEGEND_SIZE)
-    a = axes[0, 1]
-    for i in range(exc.torque.shape[1]):
-        a.plot(deg, exc.torque[:, i], lw=0.8, label=f"cylinder {i + 1}")
-    a.plot(deg, exc.torque.sum(axis=1), "k", lw=1.2, label="sum")
-    a.set_ylabel("crank torque [N·m]", fontsize=LABEL_SIZE)
-    a.legend(fontsize=LEGEND_SIZE, ncol=2)
-    a = axes[1, 0]
+        axes[0, 0].plot(deg, exc.pressure[:, i] / 1e5, color=colour(i), lw=1.1,
+                        label=f"cylinder {i + 1}")
+        axes[0, 1].plot(deg, exc.torque[:, i], color=colour(i), lw=0.8)
+    axes[0, 1].plot(deg, exc.torque.sum(axis=1), "k", lw=1.4, label="sum of the cylinders")
+    axes[0, 0].set_ylabel("cylinder pressure [bar]", fontsize=LABEL_SIZE)
+    axes[0, 1].set_ylabel("crank torque [N·m]", fontsize=LABEL_SIZE)
     for j in range(3):
-        a.plot(deg, exc.load[:, j], label=LOAD_NAMES[j])
-    for j in range(3, 6):
-        a.plot(deg, exc.load[:, j], "--", label=LOAD_NAMES[j])
-    a.set_ylabel("load on the powertrain about its CG", fontsize=LABEL_SIZE)
-    a.legend(fontsize=LEGEND_SIZE, ncol=2)
-    for a in (axes[0, 0], axes[0, 1], axes[1, 0]):
+        axes[1, 0].plot(deg, exc.load[:, j], color=_COMPONENT_COLOURS[j], lw=1.1,
+                        label=COMPONENTS[j])
+        axes[1, 1].plot(deg, exc.load[:, j + 3], color=_COMPONENT_COLOURS[j], lw=1.1)
+    axes[1, 0].set_ylabel("force on the powertrain [N]", fontsize=LABEL_SIZE)
+    axes[1, 1].set_ylabel("moment about the CG [N·m]", fontsize=LABEL_SIZE)
+    for a in axes[:2].flat:
         a.set_xlabel("crank angle of cylinder 1 [deg]", fontsize=LABEL_SIZE)
         a.set_xlim(0, 720)
-        a.set_xticks(np.arange(0, 721, 90))
+        a.set_xticks(np.arange(0, 721, 180))
         a.grid(True, alpha=0.3)
         a.tick_params(labelsize=TICK_SIZE)
-    _spectrum(axes[1, 1], exc)
+    _spectrum(axes[2], exc)
+    if own:
+        figure_legend(fig, axes)
     return finish(fig, own, path, provenance,
                   title=f"Excitation at {exc.rpm:g} rpm" if own else None)
 
 
-def _spectrum(ax, exc):
-    """Order amplitudes of the six load components as grouped bars."""
+def _spectrum(axes, exc):
+    """Order amplitudes of the forces (left) and moments (right) as grouped bars."""
     orders, amp = exc.order_spectrum(8.0)
-    width = 0.5 / 7
-    for j, name in enumerate(LOAD_NAMES):
-        a = np.abs(amp[1:, j])
-        ax.bar(orders[1:] + (j - 2.5) * width, np.where(a > 0, a, np.nan), width=width,
-               label=name)
-    ax.set_xlabel("engine order", fontsize=LABEL_SIZE)
-    ax.set_ylabel("amplitude [N or N·m]", fontsize=LABEL_SIZE)
-    ax.set_xticks(np.arange(1, 8.01, 1.0))
-    ax.set_xticks(np.arange(0.5, 8.01, 0.5), minor=True)
-    ax.tick_params(labelsize=TICK_SIZE)
-    ax.grid(True, axis="y", alpha=0.3)
-    ax.legend(fontsize=LEGEND_SIZE, ncol=2)
+    width = 0.12
+    for a, first, unit in ((axes[0], 0, "N"), (axes[1], 3, "N·m")):
+        for j in range(3):
+            v = np.abs(amp[1:, first + j])
+            a.bar(orders[1:] + (j - 1) * width, np.where(v > 0, v, np.nan), width=width,
+                  color=_COMPONENT_COLOURS[j])
+        a.set_title(f"order spectrum of the {'forces' if first == 0 else 'moments'}",
+                    fontsize=TITLE_SIZE)
+        a.set_xlabel("engine order", fontsize=LABEL_SIZE)
+        a.set_ylabel(f"amplitude [{unit}]", fontsize=LABEL_SIZE)
+        a.set_xticks(np.arange(1, 8.01, 1.0))
+        a.set_xticks(np.arange(0.5, 8.01, 0.5), minor=True)
+        a.tick_params(labelsize=TICK_SIZE)
+        a.grid(True, axis="y", alpha=0.3)

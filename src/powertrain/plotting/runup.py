@@ -8,9 +8,11 @@ import numpy as np
 
 from powertrain.plotting.style import (
     LABEL_SIZE,
+    PRINT_WIDTH_IN,
     SIGNAL_UNITS,
     TICK_SIZE,
     TITLE_SIZE,
+    colour,
     figure_legend,
     finish,
     is_axes,
@@ -18,12 +20,15 @@ from powertrain.plotting.style import (
     no_data,
     quantity_label,
     subplots,
+    wrap,
 )
 
 RPM_LABEL = "engine speed [rpm]"
+#: Said once in a figure's title instead of in every panel.
+SYNTHESIS_NOTE = " (synthesis = RMS sum of the orders ≤ 8)"
 
 
-def grid(ax, rows, quantities, channel=None, quantity=None, panel_height=1.9):
+def grid(ax, rows, quantities, channel=None, quantity=None, panel_height=1.3):
     """Panels of a channel × quantity figure.
 
     ``ax`` None, Figure or SubFigure: the full grid; an Axes: the one panel ``channel``
@@ -38,10 +43,15 @@ def grid(ax, rows, quantities, channel=None, quantity=None, panel_height=1.9):
         q = quantity or quantities[0]
         return ax.figure, {(*ch, q): ax}, False, np.array([[ax]])
     nr, nq = len(rows), len(quantities)
-    fig, axes, own = subplots(ax, nr, nq, figsize=(3.9 * nq + 0.5, panel_height * nr + 1.3),
+    fig, axes, own = subplots(ax, nr, nq, figsize=(PRINT_WIDTH_IN, panel_height * nr + 1.6),
                               sharex=True)
     panels = {(*rows[r], quantities[q]): axes[r, q] for r in range(nr) for q in range(nq)}
     return fig, panels, own, axes
+
+
+def panel_title(mount, direction, quantity) -> str:
+    """Short panel title of a grid: ``left Z · order 2``."""
+    return f"{mount} {direction.upper()} · {quantity_label(quantity)}"
 
 
 def label_grid(fig, axes, ylabel):
@@ -53,11 +63,13 @@ def label_grid(fig, axes, ylabel):
         return
     for ax in axes[-1]:
         ax.set_xlabel(RPM_LABEL, fontsize=LABEL_SIZE)
-    fig.supylabel(ylabel, fontsize=LABEL_SIZE + 1)
+    fig.supylabel(ylabel, fontsize=LABEL_SIZE + 0.5)
 
 
-def style_panel(ax, title, values):
-    """Title, log y axis with plain-number ticks and limits spanning at least a factor 4."""
+def style_panel(ax, title, values, dynamic_range_db=None):
+    """Title, log y axis with plain-number ticks and limits spanning at least a factor 4;
+    with ``dynamic_range_db`` the axis reaches at most that far below the largest value
+    (numerical noise far below does not stretch it). False when there is nothing to show."""
     ax.set_title(title, fontsize=TITLE_SIZE)
     ax.grid(True, which="major", alpha=0.35)
     ax.tick_params(which="both", labelsize=TICK_SIZE)
@@ -66,10 +78,12 @@ def style_panel(ax, title, values):
     if values.size == 0:
         return False
     lo, hi = values.min() / 1.4, values.max() * 1.4
+    if dynamic_range_db is not None:
+        lo = max(lo, values.max() * 10 ** (-dynamic_range_db / 20))
     if hi / lo < 4:
         mid = np.sqrt(lo * hi)
         lo, hi = mid / 2, mid * 2
-    log_axis(ax, "y", max_ticks=5, minor=False)
+    log_axis(ax, "y", max_ticks=4, minor=False)
     ax.set_ylim(lo, hi)
     return True
 
@@ -112,28 +126,37 @@ def plot_runup(results, path=None, quantities=("synthesis", "order_2", "order_4"
             if (mount, direction) not in res.channels:
                 continue
             r, v = _positive(res.rpm, res.curve(mount, direction, q, signal) * scale)
-            a.plot(r, v, "o-", ms=2.5, lw=1.2, label=label)
+            a.plot(r, v, "o-", ms=2, lw=1.1, label=label)
             values.append(v)
-        title = f"{mount} {direction.upper()} — {quantity_label(q)}"
+        title = panel_title(mount, direction, q)
         if not style_panel(a, title, np.concatenate(values) if values else []):
             no_data(a, "zero at every speed (not excited)")
     label_grid(fig, axes, f"RMS {signal.replace('_', ' ')} [{unit}]")
     if len(results) > 1 and own:
         figure_legend(fig, axes)
     return finish(fig, own, path, provenance,
-                  title=f"run-up: RMS {signal.replace('_', ' ')} at the mounts" if own else None)
+                  title=f"run-up: RMS {signal.replace('_', ' ')} at the mounts{SYNTHESIS_NOTE}"
+                  if own else None)
 
 
 # --------------------------------------------------------------------------- what-if
-def plot_whatif(whatif, path=None, *, ax=None, channel=None, quantity=None, provenance=None):
-    """Baseline, variants and measurement overlaid: RMS velocity [mm/s] (or the signal of
-    ``whatif.signal``) against speed.
+#: A what-if panel of absolute levels is drawn when some variant differs from the baseline
+#: by at least this much at some speed [dB]; smaller changes are invisible on a log axis
+#: spanning decades and are read from the Δ dB figure instead.
+VISIBLE_CHANGE_DB = 1.0
 
-    One row per mount and direction, one column per quantity of ``whatif.quantities``; the
-    baseline black, each variant in colour, the measurement (when given) as grey dots. One
-    legend for the figure: each variant with its mean change over all channels, quantities
-    and speeds; each panel title lists the variants' mean change in that panel (dB, in
-    legend order) when there are at most six variants.
+
+def plot_whatif(whatif, path=None, *, ax=None, channel=None, quantity=None, provenance=None,
+                view="levels"):
+    """A what-if study against speed: absolute levels (``view="levels"``) or the change of
+    each variant against the baseline, Δ = 20 log10(v/v0) [dB] (``view="delta"``).
+
+    ``levels``: baseline black, each variant in colour, the measurement (when given) as grey
+    dots, only for the channel-quantities where some variant changes the level by at least
+    :data:`VISIBLE_CHANGE_DB` somewhere (the others are listed under the title: their lines
+    would lie on top of each other). ``delta``: every channel-quantity, one panel each, on one
+    shared Δ axis, a line per variant. The legend gives each variant's mean change over all
+    channels, quantities and speeds.
 
     Parameters
     ----------
@@ -142,46 +165,126 @@ def plot_whatif(whatif, path=None, *, ax=None, channel=None, quantity=None, prov
         PNG written atomically.
     ax, channel, quantity, provenance
         As for :func:`plot_runup`.
+    view : {"levels", "delta"}
     """
+    if view not in ("levels", "delta"):
+        raise ValueError(f"view must be 'levels' or 'delta', got {view!r}")
     base = whatif.baseline
-    signal = getattr(whatif, "signal", "velocity")
-    scale, unit = SIGNAL_UNITS[signal]
     quantities = list(whatif.quantities)
-    fig, panels, own, axes = grid(ax, list(base.channels), quantities, channel, quantity,
-                                  panel_height=2.0)
+    keys = [(m, d, q) for m, d in base.channels for q in quantities]
+    largest = {k: _largest_change(whatif, k) for k in keys}
+    shown = keys if view == "delta" or is_axes(ax) else \
+        [k for k in keys if largest[k] >= VISIBLE_CHANGE_DB] or [max(keys, key=largest.get)]
+    signal = getattr(whatif, "signal", "velocity")
+    title = _whatif_title(view, keys, shown, signal)
+    fig, panels, own, axes = _panels(ax, shown, quantities, base.channels, channel, quantity,
+                                     title_lines=wrap(title, PRINT_WIDTH_IN * 0.95,
+                                                      9).count("\n") + 1)
     overall = {v.name: _mean_change(whatif, v.name, base.channels, quantities)
                for v in whatif.variants}
-    for (mount, direction, q), a in panels.items():
-        values = []
-        if whatif.measured is not None and signal == "velocity":
-            key = (mount, direction, q)
-            if key in whatif.measured.curves:
-                r, v = _positive(*whatif.measured.curves[key])
-                a.plot(r, v * 1e3, ".", color="0.55", ms=2.5, label="measured")
-                values.append(v * 1e3)
-        r, v = _positive(base.rpm, base.curve(mount, direction, q, signal) * scale)
-        a.plot(r, v, "k-", lw=1.6, label="baseline")
-        values.append(v)
-        means = []
-        for k, var in enumerate(whatif.variants):
-            r, v = _positive(var.result.rpm,
-                             var.result.curve(mount, direction, q, signal) * scale)
-            a.plot(r, v, "o-", ms=2, lw=1.0, color=f"C{k % 10}",
-                   label=f"{var.name} (mean {overall[var.name]:+.2f} dB)")
-            values.append(v)
-            means.append(_mean_change(whatif, var.name, [(mount, direction)], [q]))
-        title = f"{mount} {direction.upper()} — {quantity_label(q)}"
-        if 0 < len(means) <= 6:
-            title += "\nmean Δ [dB]: " + "  ".join(f"{m:+.2f}" for m in means)
-        if not style_panel(a, title, np.concatenate(values)):
-            no_data(a, "zero at every speed (not excited)")
-    label_grid(fig, axes, f"RMS {signal.replace('_', ' ')} [{unit}]")
+    draw = _delta_panel if view == "delta" else _levels_panel
+    for key, a in panels.items():
+        draw(a, whatif, key, overall)
+    if view == "delta":
+        _share_delta_axis(panels.values())
+    ylabel = "Δ = 20 log10(v/v0) [dB]" if view == "delta" else \
+        f"RMS {signal.replace('_', ' ')} [{SIGNAL_UNITS[signal][1]}]"
+    label_grid(fig, axes, ylabel)
     if own:
         figure_legend(fig, axes)
-    return finish(fig, own, path, provenance,
-                  title=("what-if: baseline vs variants; mean Δ = mean change 20 log10(v/v0) "
-                         "over the speed steps [dB], in the panel titles per variant in "
-                         "legend order") if own else None)
+    return finish(fig, own, path, provenance, title=title if own else None)
+
+
+def _panels(ax, shown, quantities, channels, channel, quantity, title_lines=2):
+    """The full channel × quantity grid when every panel is shown, else the shown panels
+    three to a row in reading order."""
+    rows = list(channels)
+    if is_axes(ax) or len(shown) == len(rows) * len(quantities):
+        return grid(ax, rows, quantities, channel, quantity)
+    ncol = min(3, len(shown))
+    nrow = -(-len(shown) // ncol)
+    fig, axes, own = subplots(ax, nrow, ncol, sharex=True,
+                              figsize=(PRINT_WIDTH_IN, 1.45 * nrow + 1.6 + 0.17 * title_lines))
+    for a in axes.flat[len(shown):]:
+        a.set_visible(False)
+    if len(shown) % ncol:   # x tick labels on the panels above the empty slots
+        for a in axes[-2, len(shown) % ncol:] if nrow > 1 else []:
+            a.xaxis.set_tick_params(labelbottom=True)
+            a.set_xlabel(RPM_LABEL, fontsize=LABEL_SIZE)
+    return fig, dict(zip(shown, axes.flat)), own, axes
+
+
+def _levels_panel(a, whatif, key, overall):
+    mount, direction, q = key
+    base = whatif.baseline
+    signal = getattr(whatif, "signal", "velocity")
+    scale = SIGNAL_UNITS[signal][0]
+    values = []
+    if whatif.measured is not None and signal == "velocity" and key in whatif.measured.curves:
+        r, v = _positive(*whatif.measured.curves[key])
+        a.plot(r, v * 1e3, ".", color="0.55", ms=2.5, label="measured")
+        values.append(v * 1e3)
+    r, v = _positive(base.rpm, base.curve(mount, direction, q, signal) * scale)
+    a.plot(r, v, "k-", lw=1.6, label="baseline")
+    values.append(v)
+    for k, var in enumerate(whatif.variants):
+        r, v = _positive(var.result.rpm, var.result.curve(mount, direction, q, signal) * scale)
+        a.plot(r, v, "o-", ms=2, lw=1.0, color=colour(k),
+               label=f"{var.name} (mean {overall[var.name]:+.2f} dB)")
+        values.append(v)
+    if not style_panel(a, panel_title(mount, direction, q), np.concatenate(values)):
+        no_data(a, "zero at every speed (not excited)")
+
+
+def _delta_panel(a, whatif, key, overall):
+    mount, direction, q = key
+    a.axhline(0.0, color="k", lw=1.0, label="baseline (0 dB)")
+    for k, var in enumerate(whatif.variants):
+        d = whatif.delta_db(var.name, mount, direction, q)
+        a.plot(var.result.rpm, d, "-", lw=1.1, color=colour(k),
+               label=f"{var.name} (mean {overall[var.name]:+.2f} dB)")
+    a.set_title(panel_title(mount, direction, q), fontsize=TITLE_SIZE)
+    a.grid(True, alpha=0.35)
+    a.tick_params(labelsize=TICK_SIZE)
+
+
+def _share_delta_axis(axes):
+    """One symmetric Δ range for every panel (at least ±1 dB), so panels compare."""
+    top = 1.0
+    for a in axes:
+        for line in a.get_lines():
+            y = np.asarray(line.get_ydata(), float)
+            if np.isfinite(y).any():
+                top = max(top, float(np.nanmax(np.abs(y))) * 1.1)
+    for a in axes:
+        a.set_ylim(-top, top)
+
+
+def _whatif_title(view, keys, shown, signal) -> str:
+    if view == "delta":
+        return ("what-if: change of each variant against the baseline, "
+                f"Δ = 20 log10(v/v0) of the RMS {signal.replace('_', ' ')} [dB]"
+                + SYNTHESIS_NOTE)
+    title = f"what-if: baseline vs variants{SYNTHESIS_NOTE}"
+    hidden = [k for k in keys if k not in shown]
+    if hidden:
+        per_channel = {}
+        for m, d, q in hidden:
+            per_channel.setdefault(f"{m} {d.upper()}", []).append(quantity_label(q))
+        n_q = len({q for _, _, q in keys})
+        names = "; ".join(ch if len(qs) == n_q else f"{ch} {', '.join(qs)}"
+                          for ch, qs in per_channel.items())
+        title += (f". Not drawn, every variant within ±{VISIBLE_CHANGE_DB:g} dB of the "
+                  f"baseline at every speed (see the Δ dB figure): {names}")
+    return title
+
+
+def _largest_change(whatif, key) -> float:
+    """Largest |Δ| [dB] of any variant at any speed on one channel-quantity (0 if none)."""
+    d = [np.abs(np.atleast_1d(whatif.delta_db(v.name, *key))) for v in whatif.variants]
+    d = np.concatenate(d) if d else np.array([])
+    d = d[np.isfinite(d)]
+    return float(d.max()) if d.size else 0.0
 
 
 def _mean_change(whatif, name, channels, quantities) -> float:

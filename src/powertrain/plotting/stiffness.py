@@ -12,8 +12,10 @@ import numpy as np
 from powertrain.plotting.style import (
     LABEL_SIZE,
     LEGEND_SIZE,
+    PRINT_WIDTH_IN,
     TICK_SIZE,
     TITLE_SIZE,
+    colour,
     finish,
     log_axis,
     subplots,
@@ -25,7 +27,7 @@ FREQ_AXES = ("log", "linear")
 DEFAULT_FORM, DEFAULT_FREQ_AXIS = "magnitude-phase", "log"
 
 
-def stiffness_axes(ax, form, figsize=(7.5, 5.2)):
+def stiffness_axes(ax, form, figsize=(PRINT_WIDTH_IN, 5.2)):
     """Figure and axes of a stiffness plot: one Axes for ``real-imag``, two (|K*|, loss
     angle) for ``magnitude-phase``; ``ax`` as for :func:`powertrain.plotting.style.subplots`,
     or a pair of Axes for ``magnitude-phase``."""
@@ -65,7 +67,7 @@ def draw_stiffness(axes, f, kcp, form, *, label, style="-", color=None, marker=N
     return line
 
 
-def style_stiffness(axes, form, freq_axis, band=None):
+def style_stiffness(axes, form, freq_axis, band=None, own=False):
     """Labels, grid, frequency axis (log with plain numbers, or linear), optional shaded
     band (f_lo, f_hi) [Hz]."""
     if freq_axis not in FREQ_AXES:
@@ -86,7 +88,11 @@ def style_stiffness(axes, form, freq_axis, band=None):
         a.tick_params(which="both", labelsize=TICK_SIZE)
     if form == "magnitude-phase":
         axes[0].tick_params(labelbottom=False)
-    axes[0].legend(fontsize=LEGEND_SIZE, loc="best")
+    if own:       # a figure of its own: the legend above the panels, off the curves
+        axes[0].figure.legend(*axes[0].get_legend_handles_labels(), loc="outside upper center",
+                   fontsize=LEGEND_SIZE, frameon=False, ncol=2)
+    else:
+        axes[0].legend(fontsize=LEGEND_SIZE, loc="best")
 
 
 def plot_stiffness(curves, path=None, measured=None, ax=None, *, form=DEFAULT_FORM,
@@ -119,9 +125,9 @@ def plot_stiffness(curves, path=None, measured=None, ax=None, *, form=DEFAULT_FO
     for k, item in enumerate(curves):
         label, f, kcp = (item[0], item[1].frequency_hz, item[1].kcp) if len(item) == 2 \
             else item
-        draw_stiffness(axes, f, kcp, form, label=label, color=f"C{k % 10}",
+        draw_stiffness(axes, f, kcp, form, label=label, color=colour(k),
                        freq_axis=freq_axis)
-    style_stiffness(axes, form, freq_axis)
+    style_stiffness(axes, form, freq_axis, own=own)
     if title:
         axes[0].set_title(title, fontsize=TITLE_SIZE)
     return finish(fig, own, path, provenance)
@@ -170,12 +176,12 @@ def plot_retune(target_fit, path=None, *, ax=None, form=DEFAULT_FORM,
     tf = target_fit
     fig, axes, own = stiffness_axes(ax, form)
     for k, style, label, color in ((tf.kcp_baseline, "-", "baseline", "k"),
-                                   (tf.kcp_target, "--", "requested", "C1"),
+                                   (tf.kcp_target, "--", "requested", colour(1)),
                                    (tf.kcp_fitted, "-", f"fitted {tf.model.topology.name}",
-                                    "C0")):
+                                    colour(0))):
         draw_stiffness(axes, tf.frequency_hz, k, form, label=label, style=style, color=color,
                        freq_axis=freq_axis)
-    style_stiffness(axes, form, freq_axis, band=(tf.target.f_lo, tf.target.f_hi))
+    style_stiffness(axes, form, freq_axis, band=(tf.target.f_lo, tf.target.f_hi), own=own)
     axes[0].set_title(f"{tf.target.spec}: max error in band {100 * tf.max_band_error:.1f} %, "
                       f"mean change {100 * tf.mean_band_change:+.1f} %", fontsize=TITLE_SIZE)
     return finish(fig, own, path, provenance)

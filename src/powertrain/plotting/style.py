@@ -17,16 +17,34 @@ import numpy as np
 SIGNAL_UNITS = {"velocity": (1e3, "mm/s"), "displacement": (1e6, "µm"),
                 "acceleration": (1.0, "m/s²"), "mount_force": (1.0, "N")}
 
-#: Resolution of saved PNGs [dots per inch].
-DPI = 120
+#: Intended print width of every figure [in]: the text width of an A4 report page, 16 cm.
+#: Figures are drawn at this width, so a font size in points is the printed size.
+PRINT_WIDTH_IN = 16 / 2.54
+#: Smallest printed text [pt] (titles, labels, ticks, legends, provenance line).
+MIN_PRINT_PT = 8.0
+#: Resolution of saved PNGs [dots per inch]: 300 dpi at 16 cm is about 1900 px wide.
+DPI = 300
 #: Font sizes [pt]: panel titles, axis labels, tick labels, legends, provenance line.
-TITLE_SIZE, LABEL_SIZE, TICK_SIZE, LEGEND_SIZE, FOOT_SIZE = 8.5, 8, 7, 7.5, 6
+TITLE_SIZE, LABEL_SIZE, TICK_SIZE, LEGEND_SIZE, FOOT_SIZE = 8.5, 8.5, 8, 8, 8
+
+#: Colour-blind-safe palette (Okabe & Ito 2008, "Color Universal Design"), without its black
+#: (reserved for baselines and totals) and its yellow (too light for lines on white). Lines
+#: beyond the seventh repeat the colours with another line style (:func:`series_style`).
+OKABE_ITO = {"blue": "#0072B2", "orange": "#E69F00", "bluish green": "#009E73",
+             "vermillion": "#D55E00", "reddish purple": "#CC79A7", "sky blue": "#56B4E9",
+             "yellow": "#F0E442", "black": "#000000"}
+PALETTE = tuple(OKABE_ITO[n] for n in ("blue", "orange", "bluish green", "vermillion",
+                                       "reddish purple", "sky blue"))
+#: Gap shading: simulation above the measurement, simulation below it (orange / sky blue:
+#: told apart with every colour-vision deficiency, unlike red / green).
+GAP_ABOVE, GAP_BELOW = OKABE_ITO["orange"], OKABE_ITO["sky blue"]
+_LINE_STYLES = ("-", "--", ":", "-.")
 #: Average glyph width as a fraction of the font size (DejaVu Sans), for text-width estimates.
 _GLYPH = 0.6
 
 
 # ------------------------------------------------------------------ figure and axes
-def subplots(target, nrows=1, ncols=1, figsize=(8.0, 4.5), **kwargs):
+def subplots(target, nrows=1, ncols=1, figsize=(PRINT_WIDTH_IN, 3.6), **kwargs):
     """Figure and a 2-D array of axes for a plot function's ``ax`` argument.
 
     Parameters
@@ -37,7 +55,8 @@ def subplots(target, nrows=1, ncols=1, figsize=(8.0, 4.5), **kwargs):
         only for a single panel.
     nrows, ncols : int
     figsize : (float, float)
-        Size of a new figure [in].
+        Size of a new figure [in]; its width is the print width :data:`PRINT_WIDTH_IN`
+        (fonts are then printed at their nominal size).
     kwargs
         Passed to ``subplots`` (sharex, sharey, gridspec_kw ...).
 
@@ -53,9 +72,10 @@ def subplots(target, nrows=1, ncols=1, figsize=(8.0, 4.5), **kwargs):
     if target is None:
         import matplotlib.pyplot as plt
         fig = plt.figure(figsize=figsize, layout="constrained")
-        return fig, fig.subplots(nrows, ncols, squeeze=False, **kwargs), True
+        return fig, _use_palette(fig.subplots(nrows, ncols, squeeze=False, **kwargs)), True
     if isinstance(target, FigureBase):
-        return target, target.subplots(nrows, ncols, squeeze=False, **kwargs), False
+        return target, _use_palette(target.subplots(nrows, ncols, squeeze=False, **kwargs)), \
+            False
     if isinstance(target, Axes):
         if nrows * ncols != 1:
             raise TypeError(f"this figure has {nrows * ncols} panels: pass a Figure or "
@@ -63,6 +83,23 @@ def subplots(target, nrows=1, ncols=1, figsize=(8.0, 4.5), **kwargs):
         return target.figure, np.array([[target]]), False
     raise TypeError(f"ax must be a matplotlib Axes, Figure or SubFigure, not "
                     f"{type(target).__name__}")
+
+
+def colour(k: int) -> str:
+    """The ``k``-th colour of :data:`PALETTE` (cyclic)."""
+    return PALETTE[k % len(PALETTE)]
+
+
+def series_style(k: int) -> dict:
+    """Colour and line style of the ``k``-th of many series: the palette's colours first
+    solid, then dashed, dotted, dash-dotted (24 distinct series)."""
+    return {"color": colour(k), "ls": _LINE_STYLES[(k // len(PALETTE)) % len(_LINE_STYLES)]}
+
+
+def _use_palette(axes):
+    for a in np.ravel(axes):
+        a.set_prop_cycle(color=list(PALETTE))
+    return axes
 
 
 def is_axes(target) -> bool:
@@ -133,9 +170,8 @@ def add_provenance(fig, provenance):
 
 
 def quantity_label(quantity: str) -> str:
-    """``synthesis`` -> ``synthesis (orders ≤ 8)``, ``order_2`` -> ``order 2``."""
-    if quantity == "synthesis":
-        return "synthesis (orders ≤ 8)"
+    """``order_2`` -> ``order 2``; ``synthesis`` (the RMS sum of the orders ≤ 8, said once
+    in the figure's title) stays."""
     return quantity.replace("order_", "order ")
 
 
@@ -148,11 +184,11 @@ def no_data(ax, text="no data above the noise floor"):
 
 # ------------------------------------------------------------------ log axes
 def _plain(value, _pos=None) -> str:
-    """Tick label of a log axis as a plain number: 10, 20, 50, 0.05 (never 2×10¹)."""
+    """Tick label of a log axis as a plain number: 10, 20, 50, 0.05, 0.00001 (never 2×10¹
+    or 1e-5)."""
     if value <= 0 or not math.isfinite(value):
         return ""
-    text = f"{value:.6g}"
-    return text.replace("e+0", "e").replace("e-0", "e-")
+    return np.format_float_positional(float(f"{value:.6g}"), trim="-")
 
 
 def _log_ticks(vmin, vmax, max_ticks):
