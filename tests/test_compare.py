@@ -306,7 +306,7 @@ def test_cli_with_sim_file_writes_json_and_plot(tmp_path, sim_csv):
     assert out_png.stat().st_size > 10_000
     table = res.output.split("per channel, worst first:")[1].splitlines()
     assert table[3].split()[:3] == ["left", "x", "order_2"]
-    assert "gearbox z synthesis: not in the measured data" in res.output
+    assert "gearbox z: synthesis, order_2, order_4: not in the measured data" in res.output
 
 
 def test_sim_and_engine_together_is_a_usage_error(tmp_path, sim_csv):

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import click
 
+from powertrain.analysis.noise_floor import NOISE_FLOOR_MARGIN
 from powertrain.cli import main
 
 
@@ -46,7 +47,8 @@ def _truth_names() -> str:
                    "parameters, heldout_rms_db_before/after, verdict), verdict.")
 @click.option("--noise-floor", type=float, default=0.001, show_default=True,
               help="RMS noise floor of the measured order curves [mm/s]; measured points "
-                   "below 3x this are treated as 'below 3x floor' (censored).")
+                   f"below {NOISE_FLOOR_MARGIN:g}x this are treated as 'below "
+                   f"{NOISE_FLOOR_MARGIN:g}x floor' (censored).")
 @click.option("--effects", "effects", default="", cls=_ListedOption, names=_library_names,
               help="Comma-separated candidates (default: all of the library).")
 @click.option("--no-pairs", is_flag=True, help="Do not try pairs of effects.")

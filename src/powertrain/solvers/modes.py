@@ -138,11 +138,11 @@ class ModesResult:
         """What these modes are, in one line."""
         if self.is_static():
             return (f"{self.engine}: rigid-body modes, undamped, mounts at their static "
-                    "(0 Hz) stiffness (the modes 'powertrain runup' prints)")
+                    "(0 Hz) stiffness (the kind 'powertrain runup' prints)")
         return (f"{self.engine}: rigid-body modes, damped, each with the mounts' dynamic "
                 "stiffness at its own frequency\n'static f': the undamped static-stiffness "
-                "mode ('powertrain runup', --static) of the most similar shape, paired one to "
-                "one; MAC: their shape correlation")
+                "mode (--static; the kind 'powertrain runup' prints) of the most similar "
+                "shape, paired one to one; MAC: their shape correlation")
 
     def to_text(self) -> str:
         """Table of the modes, sorted by frequency, with a note on signed energy shares."""
