@@ -66,3 +66,26 @@ def test_singular_network_is_refused_not_nan():
     with pytest.raises(FloatingPointError):
         two_port(np.array([10.0]), np.array([0.0]), [[0, GROUND]], np.array([1e5]),
                  np.array([10.0]))
+
+
+def test_condense_equals_dense_schur_complement():
+    """condense(system, keep, s) against a dense Schur complement of the assembled matrices:
+    the rigid engine and the modal body, harmonic, damped-mode and static s, keeping the
+    retained coordinates or only the rigid body; and a model assembled without networks."""
+    from network_oracle import dense_condense
+
+    from powertrain.assembly import AssembledSystem, assemble
+    from powertrain.physics.condensation import condense
+    for name in ("default.toml", "default-modal-body.toml"):
+        eng = read_engine(DEFAULT_ENGINE_PATH.parent / name)
+        b = eng.body
+        system = assemble(b.mass, b.cg, b.inertia, eng.mounts, eng.chassis)
+        for keep in (system.retained, np.arange(6)):
+            for s in (0.0, 2j * np.pi * 37.0, -4.0 + 2j * np.pi * 11.0):
+                got, ref = condense(system, keep, s), dense_condense(system, keep, s)
+                assert np.max(np.abs(got - ref)) <= EXACT * np.max(np.abs(ref))
+    bare = AssembledSystem(system.M, system.C, system.K, system.channels,
+                           system.channel_matrix, system.force_matrix_k, system.force_matrix_d)
+    keep = system.retained
+    got, ref = condense(bare, keep, 3j), dense_condense(bare, keep, 3j)
+    assert np.max(np.abs(got - ref)) <= EXACT * np.max(np.abs(ref))

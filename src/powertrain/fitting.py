@@ -212,7 +212,7 @@ class _Problem:
 
     def kcp(self, p):
         """K_CP [N/m] for SI parameters ``p`` (and fill the derivative buffers)."""
-        from powertrain.kernels.mount_stiffness import kcp_gradient_kernel
+        from powertrain.kernels.two_port import kcp_gradient_kernel
         kcp_gradient_kernel(self.omega, self.B, self.to_m @ p, self.to_c @ p, self.to_d @ p,
                             self._kcp, self._dm, self._dc, self._dd)
         return self._kcp

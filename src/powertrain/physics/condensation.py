@@ -84,6 +84,8 @@ def condensed_matrix(frame, engine_rows, base_rows, abc, s):
     a, b, c = abc
     E = engine_rows
     D = (s ** 2)[..., None, None] * M0 + s[..., None, None] * C0 + K0
+    if not E.shape[0]:
+        return D
     D = D + (a.reshape(-1, E.shape[0]) @ np.einsum("ni,nj->nij", E, E).reshape(-1, n * n)
              ).reshape(s.shape + (n, n))
     if base_rows is not None:

@@ -320,7 +320,7 @@ def cross_point_stiffness_gradient(omega, masses, elem_nodes, c, d):
     d = np.asarray(d, dtype=float)
     n = masses.size
     B = incidence_matrix(n, elem_nodes)
-    from powertrain.kernels.mount_stiffness import kcp_gradient_kernel
+    from powertrain.kernels.two_port import kcp_gradient_kernel
     nf, n_el = omega.size, c.size
     kcp = np.empty(nf, dtype=complex)
     dk_dm = np.empty((nf, n), dtype=complex)
