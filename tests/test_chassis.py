@@ -190,6 +190,7 @@ def test_bad_chassis_names_file_and_key(tmp_path, what, old, new, key):
     assert info.value.key == key, info.value.one_line()
 
 
+@pytest.mark.slow
 def test_cli_runup_modal_body_and_modes(tmp_path):
     runner = CliRunner()
     res = runner.invoke(main, ["runup", "--engine", str(MODAL), "--from", "2000", "--to",

@@ -375,6 +375,7 @@ def test_example_is_labelled_synthetic():
     assert r[0] == 1000.0 and r[-1] == 6000.0 and np.all(np.diff(r) == 50.0)
 
 
+@pytest.mark.slow
 def test_compare_on_the_shipped_example_end_to_end(tmp_path, capsys):
     """Runs the default engine (Newmark, at the measured speeds) against the example; prints the
     wall time (not a timed test: the budget is < 10 s with a warm JIT cache)."""

@@ -88,6 +88,7 @@ def test_equivalent_linearisation_agrees_with_time_domain(engine):
         assert np.max(np.abs(ratio - 1)) < LINEARISATION_REL
 
 
+@pytest.mark.slow
 def test_synth_and_diagnose_commands(tmp_path):
     runner = CliRunner()
     csv = tmp_path / "m.csv"
@@ -132,6 +133,7 @@ def test_registry_is_documented():
 
 
 # --------------------------------------------------------------------------- decision rules
+@pytest.mark.slow
 def test_out_of_library_channel_constant_gap_is_not_taken_for_a_sensor_error(engine):
     """A gearbox bending mode at 50 Hz: above it the gearbox points move (1 - kappa) times
     the rigid value, a gap nearly constant per channel (the decomposition gives the channel

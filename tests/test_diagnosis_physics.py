@@ -36,6 +36,7 @@ def _own_csv(engine, step, path):
     return read_measured(str(path), mounts=engine.mount_names)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("step", [50.0, 100.0])
 def test_own_runup_is_no_effect_on_any_grid(engine, step, tmp_path):
     meas = _own_csv(engine, step, tmp_path / "own.csv")
@@ -63,6 +64,7 @@ def _gap_parts(engine, scenario):
     return decompose_gap(np.where(mask, gap, np.nan), data, mask)["attribution"]
 
 
+@pytest.mark.slow
 def test_where_attributes_half_orders_to_excitation_and_names_them(engine):
     att = _gap_parts(engine, {"cylinder_imbalance": {"e2": -0.1}})
     assert att["kind"] == "excitation", att
@@ -85,7 +87,7 @@ def _synthetic_gap(fn, step=100.0):
     return decompose_gap(gap, data, np.ones(gap.shape, bool))["attribution"]
 
 
-@pytest.mark.parametrize("step", [50.0, 100.0])
+@pytest.mark.parametrize("step", [pytest.param(50.0, marks=pytest.mark.slow), 100.0])
 def test_where_attributes_a_frequency_fixed_gap_to_structure_with_its_band(step):
     """A resonance at 150 Hz seen by every order (a bracket, a body mode): structure, and
     the band named contains 150 Hz; same on a 50- and a 100-rpm grid."""
@@ -96,7 +98,7 @@ def test_where_attributes_a_frequency_fixed_gap_to_structure_with_its_band(step)
     assert att["band_hz"][0] <= 150.0 <= att["band_hz"][1]
 
 
-@pytest.mark.parametrize("step", [50.0, 100.0])
+@pytest.mark.parametrize("step", [pytest.param(50.0, marks=pytest.mark.slow), 100.0])
 def test_where_attributes_an_order_bound_gap_to_excitation_with_its_orders(step):
     def fn(f, o, n, c):
         return np.where(np.isin(o, (0.5, 1.5)), 8.0 + 0.001 * n, 0.0)
