@@ -1,7 +1,9 @@
 """The installed package: built as a wheel, installed in a fresh venv, run from an empty folder.
 
 Issue 10, item 1: engines/, mounts/ and examples/ are package data found with
-:mod:`importlib.resources`, so ``powertrain runup`` works outside the checkout. The fresh venv
+:mod:`importlib.resources`, so ``powertrain runup`` works outside the checkout. Issue 18:
+``powertrain examples DIR`` copies them into a folder, and the README's five-minute tour runs
+unchanged in an empty folder after a wheel install. The fresh venv
 sees the current environment's third-party packages through a ``.pth`` line (no download, and
 no editable install of this checkout), and the wheel is installed with ``--no-deps``.
 """

@@ -16,11 +16,15 @@ from powertrain.cli import main
 def examples(folder):
     """Copy the shipped files into FOLDER/engines, FOLDER/mounts and FOLDER/examples.
 
-    The guide's commands name these files (``examples/measured-runup.csv``,
-    ``engines/default-modal-body.toml``, ``mounts/hydraulic-engine-mount-z.toml``); after a
-    wheel install they are inside the package, and this command puts a copy where the
-    commands find them. An existing file is never overwritten: a file identical to the shipped
-    one is left as it is, a different one stops the command before anything is copied.
+    \b
+    The guides' commands name these files, e.g.
+      examples/measured-runup.csv
+      engines/default-modal-body.toml
+      mounts/hydraulic-engine-mount-z.toml
+    After a wheel install they are inside the package; this command puts a copy where the
+    commands find them. An existing file is never overwritten: a file identical to the
+    shipped one is left as it is, a different one stops the command before anything is
+    copied.
 
     \b
     Examples:
