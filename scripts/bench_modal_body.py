@@ -17,7 +17,7 @@ import numpy as np
 
 from powertrain.iotools.engine_file import DEFAULT_ENGINE_PATH, read_engine
 from powertrain.models.chassis import BodyMode, Chassis
-from powertrain.runup import run_runup
+from powertrain.workflows.runup import run_runup
 
 N_MODES = 20
 

@@ -1,6 +1,6 @@
 """Benchmark: order tracking of a 60 s, 16-channel, 25.6 kHz run-up (issue 12, item 8).
 
-Ours: :func:`powertrain.tracking.track_recording` (speed from the rpm channel, computed
+Ours: :func:`powertrain.workflows.tracking.track_recording` (speed from the rpm channel, computed
 order tracking with the fused anti-alias/angle-resampling Numba kernel, exact-order Hann
 spectra per block; Numba threads on all cores).
 Peer: a plain scipy implementation of the same analysis doing the same work -- like ours it
@@ -33,8 +33,8 @@ import numpy as np
 
 from powertrain.analysis.order_tracking import block_revolutions
 from powertrain.models.recording import RawChannel, RawRecording
-from powertrain.signals import linear_sweep, order_sum
-from powertrain.tracking import track_recording
+from powertrain.validation.signals import linear_sweep, order_sum
+from powertrain.workflows.tracking import track_recording
 
 FS = 25600.0
 ORDERS = np.arange(1, 17) * 0.5

@@ -38,8 +38,8 @@ from powertrain.analysis.fourier import harmonic_amplitudes
 from powertrain.analysis.orders import order_spectrum, synthesis_rms
 from powertrain.assembly import assemble
 from powertrain.iotools.engine_file import DEFAULT_ENGINE_PATH, read_engine
-from powertrain.runup import default_rpm, run_runup
 from powertrain.solvers.harmonic import harmonic_response
+from powertrain.workflows.runup import default_rpm, run_runup
 
 ACCURACY = 5e-3   # synthesis agreement with the harmonic solution, relative
 
@@ -131,7 +131,7 @@ def main(argv=None):
     # cold start: first call in a fresh process (JIT compile or cache load)
     code = ("import time; t=time.perf_counter();"
             "from powertrain.iotools.engine_file import read_engine;"
-            "from powertrain.runup import run_runup;"
+            "from powertrain.workflows.runup import run_runup;"
             f"r=run_runup(read_engine({args.engine!r}));"
             "print(time.perf_counter()-t, r.solver_seconds)")
     cold = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)

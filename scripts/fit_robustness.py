@@ -1,5 +1,5 @@
 #!/usr/bin/env python
-"""Robustness of mount parameter identification (``powertrain.fitting.fit_mount``).
+"""Robustness of mount parameter identification (``powertrain.workflows.fitting.fit_mount``).
 
 For each mount parameter set of Kovarik (2016), sec. 4.2 (``mounts/hydraulic-engine-mount-
 {x,y,z}.toml``, ``mounts/elastomeric-gearbox-mount-{x,y,z}.toml``, triple mass oscillator in
@@ -88,7 +88,7 @@ def main(argv=None):
     if unknown or args.seeds < 1:
         ap.error(f"unknown set(s) {unknown}" if unknown else "--seeds must be >= 1")
 
-    from powertrain.fitting import (
+    from powertrain.workflows.fitting import (
         DEFAULT_POLISH,
         DEFAULT_SEED,
         DEFAULT_STARTS,

@@ -41,10 +41,10 @@ from pathlib import Path
 import numpy as np
 
 from powertrain.analysis.orders import order_label
-from powertrain.iotools.atomic import atomic_write
 from powertrain.iotools.engine_file import DEFAULT_ENGINE_PATH, read_engine
 from powertrain.models.extensions import with_base_compliance
-from powertrain.runup import run_runup
+from powertrain.outputs import atomic_write
+from powertrain.workflows.runup import run_runup
 
 # ----------------------------------------------------------------------------- parameters
 SEED = 20160901

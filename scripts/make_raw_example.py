@@ -3,7 +3,7 @@
 ``examples/raw-runup-lab.csv`` (+ ``examples/raw-channels.toml``).
 
 Nothing here was measured. Both files hold the same 2 s linear sweep 1500 -> 2500 rpm of
-the default engine's continuous run-up simulation (:mod:`powertrain.solvers.sweep`,
+the default engine's continuous run-up simulation (:mod:`powertrain.solvers.speed_ramp`,
 2048 Hz), mount-point accelerations of the left mount and a tacho:
 
 * ``raw-runup.csv`` names its columns by the convention ``MOUNT.DIRECTION [UNIT]``
@@ -24,8 +24,8 @@ import numpy as np
 from powertrain.iotools.engine_file import DEFAULT_ENGINE_PATH, read_engine
 from powertrain.iotools.raw_csv import write_raw_csv
 from powertrain.models.recording import RawChannel, RawRecording
-from powertrain.signals import tacho
-from powertrain.solvers.sweep import simulate_sweep
+from powertrain.solvers.speed_ramp import simulate_sweep
+from powertrain.validation.signals import tacho
 
 RPM0, RPM1, RATE, FS = 1500.0, 2500.0, 500.0, 2048.0
 MAP = """# Channel map of examples/raw-runup-lab.csv (SYNTHETIC): file channel -> mount point

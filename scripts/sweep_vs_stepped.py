@@ -1,6 +1,6 @@
 """Continuous run-up (simulated sweep, tracked) against the stepped harmonic run-up.
 
-1. Simulates a linear sweep of the default engine (``powertrain.solvers.sweep``: Newmark in
+1. Simulates a linear sweep of the default engine (``powertrain.solvers.speed_ramp``: Newmark in
    time, speed-dependent load), tracks its mount-point accelerations like measured data
    (computed order tracking, 50 rpm grid, converted to velocity order by order) and
    compares orders 2, 4 and the synthesis of the nine channels with the stepped harmonic
@@ -26,9 +26,9 @@ import time
 import numpy as np
 
 from powertrain.iotools.engine_file import DEFAULT_ENGINE_PATH, read_engine
-from powertrain.runup import run_runup
-from powertrain.solvers.sweep import simulate_sweep
-from powertrain.tracking import track_recording
+from powertrain.solvers.speed_ramp import simulate_sweep
+from powertrain.workflows.runup import run_runup
+from powertrain.workflows.tracking import track_recording
 
 LIMIT_DB = 0.2
 QUANTITIES = ("order_2", "order_4", "synthesis")
@@ -94,7 +94,7 @@ def main(argv=None):
     for q in QUANTITIES:
         print(f"  {q:10s} |gap| to stepped harmonic: median {np.median(g[q]):.4f} dB, "
               f"95th percentile {np.percentile(g[q], 95):.4f} dB, max {g[q].max():.4f} dB")
-    from powertrain.variants import apply_operations, parse_operations
+    from powertrain.workflows.variants import apply_operations, parse_operations
     stiff = apply_operations(engine, parse_operations(
         {"scale": [f"*.*.stiffness={args.plot_stiffness:g}"]}))
     base, _, _ = tracked_sweep(stiff, args.plot_from, args.plot_to, args.rate)
@@ -116,7 +116,7 @@ def main(argv=None):
               f"{np.median(np.abs(20 * np.log10(y / ref))):.3f} dB")
         curves.append((f"sweep {rate:g} rpm/s", fast.rpm, y))
     if args.plot:
-        from powertrain.plotting_orders import plot_sweep_rates
+        from powertrain.plotting.orders import plot_sweep_rates
         plot_sweep_rates(curves, args.plot, title=f"{label} {q.replace('_', ' ')}, mount "
                          f"stiffness x{args.plot_stiffness:g}: stepped run-up vs continuous "
                          "sweeps (simulated, tracked)")

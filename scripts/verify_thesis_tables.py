@@ -13,7 +13,7 @@ the same set-up, ``mounts/thesis-appendix-a.toml`` (the Appendix A deck), with
 * the time method: Newmark average-acceleration integration from the periodic steady state,
   processed by FFT (as the thesis did in AVL Excite),
 
-through :func:`powertrain.analysis.stiffness_table.stiffness_table`, and prints both next to
+through :func:`powertrain.workflows.stiffness.stiffness_table`, and prints both next to
 the printed MSC Nastran column.
 
 Tolerances (named in ``tests/tolerances.py``, shared with ``tests/test_thesis_tables.py``):
@@ -56,8 +56,8 @@ from pathlib import Path
 
 import numpy as np
 
-from powertrain.analysis.stiffness_table import stiffness_table
 from powertrain.iotools.mount_file import read_mount
+from powertrain.workflows.stiffness import stiffness_table
 
 ROOT = Path(__file__).resolve().parents[1]
 MOUNT_FILE = ROOT / "mounts" / "thesis-appendix-a.toml"

@@ -16,8 +16,8 @@ import numpy as np
 from powertrain.effects import EFFECTS, predict
 from powertrain.iotools.engine_file import DEFAULT_ENGINE_PATH, read_engine
 from powertrain.models.chassis import Chassis
-from powertrain.runup import run_runup
 from powertrain.solvers.fast_harmonic import HarmonicModel
+from powertrain.workflows.runup import run_runup
 
 MODAL = Path(DEFAULT_ENGINE_PATH).parent / "default-modal-body.toml"
 ENGINE_FILE = MODAL          # the module's ``engine`` (tests/conftest.py)

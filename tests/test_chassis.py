@@ -13,8 +13,8 @@ from powertrain.cli import main
 from powertrain.errors import InputError
 from powertrain.iotools.engine_file import DEFAULT_ENGINE_PATH, read_engine
 from powertrain.iotools.measured import read_measured
-from powertrain.results import RunupResult
-from powertrain.runup import run_runup
+from powertrain.results.runup import RunupResult
+from powertrain.workflows.runup import run_runup
 
 ENGINES = Path(DEFAULT_ENGINE_PATH).parent
 MODAL = ENGINES / "default-modal-body.toml"

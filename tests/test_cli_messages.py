@@ -13,10 +13,10 @@ from click.testing import CliRunner
 
 from powertrain.cli import main
 from powertrain.effects import EFFECTS
-from powertrain.fitting import DEFAULT_SEED, DEFAULT_STARTS
 from powertrain.iotools.engine_file import DEFAULT_ENGINE_PATH, read_engine
 from powertrain.iotools.measured import read_measured
 from powertrain.validation.synth import TRUTH_ALIASES, TRUTH_EFFECTS, make_case
+from powertrain.workflows.fitting import DEFAULT_SEED, DEFAULT_STARTS
 
 MOUNT = Path(DEFAULT_ENGINE_PATH).parents[1] / "mounts" / "hydraulic-engine-mount-z.toml"
 QUICK = ["--from", "1000", "--to", "2000", "--step", "500", "--solver", "harmonic"]
@@ -29,7 +29,7 @@ def invoke(*args):
 
 def test_fit_mount_help_shows_default_values():
     _, text = invoke("fit-mount", "--help")
-    assert "powertrain.fitting" not in text
+    assert "powertrain.workflows.fitting" not in text
     assert f"[default: {DEFAULT_STARTS}]" in text and f"[default: {DEFAULT_SEED}]" in text
 
 

@@ -26,11 +26,11 @@ from powertrain.analysis.noise_floor import (
     censoring_level,
 )
 from powertrain.cli import main
-from powertrain.comparison import compare_runup
 from powertrain.errors import InputError
 from powertrain.iotools.measured import read_measured
 from powertrain.models.extensions import with_base_compliance
 from powertrain.models.mount import MountModel
+from powertrain.workflows.comparison import compare_runup
 
 ROOT = Path(__file__).resolve().parents[1]
 EXAMPLE = ROOT / "examples" / "measured-runup.csv"
@@ -275,7 +275,7 @@ def test_peak_column_is_converted_to_rms(tmp_path, sim_csv):
 
 def test_hdf5_measured_file_against_itself(tmp_path):
     from powertrain.iotools.engine_file import DEFAULT_ENGINE_PATH, read_engine
-    from powertrain.runup import run_runup
+    from powertrain.workflows.runup import run_runup
     res = run_runup(read_engine(DEFAULT_ENGINE_PATH), [1000.0, 2000.0, 3000.0],
                     solver="harmonic")
     h5 = tmp_path / "r.h5"

@@ -20,9 +20,9 @@ from powertrain.diagnosis import diagnose
 from powertrain.effects import EFFECTS, Effect, predict, time_domain_amplitude_check
 from powertrain.errors import InputError
 from powertrain.iotools.measured import MeasuredRunup
-from powertrain.runup import run_runup
 from powertrain.solvers.fast_harmonic import HarmonicModel
 from powertrain.validation.synth import make_case
+from powertrain.workflows.runup import run_runup
 
 #: Same linear model solved two ways: only round-off separates them.
 EXACT = 1e-9

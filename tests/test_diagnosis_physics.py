@@ -15,8 +15,8 @@ from powertrain.diagnosis.where import decompose_gap
 from powertrain.effects import EFFECTS, predict
 from powertrain.iotools.engine_file import DEFAULT_ENGINE_PATH, read_engine
 from powertrain.iotools.measured import read_measured
-from powertrain.runup import run_runup
 from powertrain.solvers.fast_harmonic import HarmonicModel
+from powertrain.workflows.runup import run_runup
 
 #: Same linear model, two code paths: round-off only.
 EXACT = 1e-9

@@ -13,7 +13,7 @@ import pytest
 
 import powertrain
 
-LAYERS = ("physics", "solvers", "analysis", "models", "kernels", "iotools")
+LAYERS = ("physics", "solvers", "analysis", "models", "kernels", "iotools", "results")
 
 
 def _modules():
@@ -22,7 +22,7 @@ def _modules():
         yield pkg
         for info in pkgutil.iter_modules(pkg.__path__):
             yield importlib.import_module(f"powertrain.{layer}.{info.name}")
-    for name in ("assembly", "runup", "results", "units", "errors"):
+    for name in ("assembly", "workflows.runup", "units", "errors", "outputs"):
         yield importlib.import_module(f"powertrain.{name}")
 
 

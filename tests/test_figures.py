@@ -167,8 +167,8 @@ def test_modes_figure(tmp_path, monkeypatch, saved, args):
 
 
 def test_track_figures(tmp_path, monkeypatch, saved):
-    from powertrain import signals
     from powertrain.iotools.raw_csv import write_raw_csv
+    from powertrain.validation import signals
     write_raw_csv(tmp_path / "sweep.csv",
                   signals.analytic_sweep(duration=4.0, rpm0=1500.0, rpm1=4500.0),
                   comment="SYNTHETIC: analytic sweep")
@@ -245,10 +245,10 @@ def test_plot_into_user_axes_and_subfigures(no_backend_switch):
     import matplotlib.pyplot as plt
     import numpy as np
 
-    from powertrain.analysis.stiffness_table import stiffness_table
     from powertrain.iotools.engine_file import DEFAULT_ENGINE_PATH, read_engine
     from powertrain.iotools.mount_file import read_mount
-    from powertrain.runup import run_runup
+    from powertrain.workflows.runup import run_runup
+    from powertrain.workflows.stiffness import stiffness_table
 
     table = stiffness_table(read_mount(MOUNT), np.arange(1.0, 100.0))
     fig, (a1, a2) = plt.subplots(1, 2)
@@ -281,9 +281,9 @@ def test_track_plot_draws_every_requested_order(spec, expected):
     import matplotlib.pyplot as plt
     import numpy as np
 
-    from powertrain import signals
     from powertrain.analysis.order_tracking import parse_orders
-    from powertrain.tracking import track_recording
+    from powertrain.validation import signals
+    from powertrain.workflows.tracking import track_recording
     rec = signals.analytic_sweep(duration=3.0, rpm0=1500.0, rpm1=3500.0)
     tracked = track_recording(rec, parse_orders(spec), rpm_step=100.0, progress=False)
     fig = tracked.plot()
@@ -299,8 +299,8 @@ def test_track_plot_draws_every_requested_order(spec, expected):
 def test_map_channel_and_reference_unit(tmp_path, monkeypatch, saved):
     import matplotlib.pyplot as plt
 
-    from powertrain import signals
     from powertrain.iotools.raw_csv import write_raw_csv
+    from powertrain.validation import signals
     write_raw_csv(tmp_path / "sweep.csv",
                   signals.analytic_sweep(duration=3.0, rpm0=1500.0, rpm1=3500.0),
                   comment="SYNTHETIC: analytic sweep")
@@ -327,8 +327,8 @@ def test_whatif_levels_and_delta_views():
 
     from powertrain.iotools.engine_file import DEFAULT_ENGINE_PATH, read_engine
     from powertrain.plotting.runup import VISIBLE_CHANGE_DB
-    from powertrain.variants import Variant, parse_operations
-    from powertrain.whatif import run_whatif
+    from powertrain.workflows.variants import Variant, parse_operations
+    from powertrain.workflows.whatif import run_whatif
     engine = read_engine(DEFAULT_ENGINE_PATH)
     variants = [Variant("gearbox x3", parse_operations({"scale": ["gearbox.*.stiffness=3"]}))]
     result = run_whatif(engine, variants, np.array([1000.0, 2000.0, 3000.0]), workers=1,

@@ -1,4 +1,4 @@
-"""Mount parameter identification (``powertrain.fitting``, ``powertrain fit-mount``).
+"""Mount parameter identification (``powertrain.workflows.fitting``, ``powertrain fit-mount``).
 
 Oracles:
 
@@ -23,10 +23,10 @@ from click.testing import CliRunner
 from network_oracle import numpy_kcp_gradient
 
 from powertrain.cli import main
-from powertrain.fitting import fit_mount, objective_n, relative_rms_error
 from powertrain.iotools.mount_file import read_mount
 from powertrain.models.mount import TOPOLOGIES, MountModel
 from powertrain.physics import mount_network as net
+from powertrain.workflows.fitting import fit_mount, objective_n, relative_rms_error
 
 MOUNTS = Path(__file__).resolve().parents[1] / "mounts"
 

@@ -33,9 +33,9 @@ def test_converted_per_order_and_synthesis_recomputed(tmp_path, column, factor):
 
 
 def test_force_curves_compare_with_mount_forces(tmp_path):
-    from powertrain.comparison import compare_runup
     from powertrain.iotools.engine_file import DEFAULT_ENGINE_PATH, read_engine
-    from powertrain.runup import run_runup
+    from powertrain.workflows.comparison import compare_runup
+    from powertrain.workflows.runup import run_runup
     rpm = np.array([2000.0, 2500.0, 3000.0])
     res = run_runup(read_engine(DEFAULT_ENGINE_PATH), rpm, solver="harmonic")
     rows = [f"{mnt},{d},{q},{r:g},{res.curve(mnt, d, q, 'mount_force')[i]:.10g}"

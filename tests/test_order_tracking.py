@@ -1,6 +1,6 @@
 """Order tracking against signals with known order content (issue 12, items 2, 3, 7).
 
-Oracles: closed-form linear sweeps (:mod:`powertrain.signals`), the published toolbox
+Oracles: closed-form linear sweeps (:mod:`powertrain.validation.signals`), the published toolbox
 example, and two methods / two speed sources that must agree. Amplitudes and phases of the
 analytic sweep are drawn by hypothesis, not pinned.
 """
@@ -22,12 +22,12 @@ from tolerances import (
     VKF_RESONANCE_DB,
 )
 
-from powertrain import signals
 from powertrain.analysis.order_tracking import block_revolutions, first_passing, parse_orders
 from powertrain.analysis.speed import count_teeth, speed_from_tacho, tacho_edges
 from powertrain.errors import InputError
 from powertrain.models.recording import RawChannel, RawRecording
-from powertrain.tracking import track_recording
+from powertrain.validation import signals
+from powertrain.workflows.tracking import track_recording
 
 
 def db(a, b):
@@ -240,7 +240,7 @@ def test_overall_as_velocity_from_acceleration():
 
 
 def test_order_spectrum_at_one_speed():
-    from powertrain.tracking import order_spectrum, speed_profile
+    from powertrain.workflows.tracking import order_spectrum, speed_profile
     rec = signals.analytic_sweep(duration=8.0, rpm0=1500.0, rpm1=4500.0)
     spec = order_spectrum(rec, speed_profile(rec), 3000.0, 10.0, quantity="velocity")
     rms = spec.order_rms()[0, 0]

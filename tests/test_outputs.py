@@ -14,7 +14,7 @@ import pytest
 from click.testing import CliRunner
 
 from powertrain.cli import main
-from powertrain.iotools.atomic import OutputTransaction, atomic_write, sweep_stale_temps
+from powertrain.outputs import OutputTransaction, atomic_write, sweep_stale_temps
 
 QUICK = ["--from", "1000", "--to", "2000", "--step", "500"]
 
@@ -167,7 +167,7 @@ def test_unwritable_output_refused_before_work(tmp_path):
 def test_failure_after_writing_removes_the_earlier_outputs(tmp_path, monkeypatch):
     """A run that fails on its last output leaves none of its outputs behind."""
     from powertrain.errors import InputError
-    from powertrain.results import RunupResult
+    from powertrain.results.runup import RunupResult
 
     def broken(self, path=None, **kw):
         raise InputError("cannot draw", file=path, key="--plot")

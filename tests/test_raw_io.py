@@ -5,7 +5,6 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from powertrain import signals
 from powertrain.errors import InputError
 from powertrain.iotools.channel_map import parse_channel_name, read_channel_map
 from powertrain.iotools.raw import detect_format, read_raw
@@ -15,6 +14,7 @@ from powertrain.iotools.raw_mdf import write_raw_mdf
 from powertrain.iotools.raw_uff import write_raw_uff
 from powertrain.models.recording import RawChannel, RawRecording
 from powertrain.units import STANDARD_GRAVITY, to_si
+from powertrain.validation import signals
 
 WRITERS = {"csv": write_raw_csv, "h5": write_raw_hdf5, "uff": write_raw_uff,
            "mf4": write_raw_mdf}
@@ -125,7 +125,7 @@ def test_bad_channel_map(tmp_path):
 
 
 def test_other_formats_are_rejected(tmp_path):
-    from powertrain.results import RunupResult  # noqa: F401  (layout owner)
+    from powertrain.results.runup import RunupResult  # noqa: F401  (layout owner)
     p = tmp_path / "fake.mf4"
     p.write_bytes(b"MDF     4.10    " + b"\0" * 100)
     with pytest.raises(InputError, match="MDF"):

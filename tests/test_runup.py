@@ -10,9 +10,9 @@ from powertrain.analysis.orders import ORDERS, order_label, order_spectrum, synt
 from powertrain.assembly import assemble
 from powertrain.iotools.engine_file import DEFAULT_ENGINE_PATH, read_engine
 from powertrain.physics.rigid_body import point_motion_matrix
-from powertrain.results import RunupResult
-from powertrain.runup import run_runup
+from powertrain.results.runup import RunupResult
 from powertrain.solvers.harmonic import harmonic_response
+from powertrain.workflows.runup import run_runup
 
 #: Issue 3 acceptance: Newmark vs harmonic on every 2nd, 4th and synthesis value.
 NEWMARK_VS_HARMONIC = 5e-3

@@ -18,7 +18,7 @@ from tolerances import SWEEP_VS_STEPPED_MEDIAN_DB
 from powertrain.cli import main
 from powertrain.iotools.engine_file import DEFAULT_ENGINE_PATH, read_engine
 from powertrain.iotools.raw import read_raw
-from powertrain.runup import run_runup
+from powertrain.workflows.runup import run_runup
 
 
 @pytest.fixture(scope="module")

@@ -17,8 +17,8 @@ import pytest
 from data import thesis_tables
 from tolerances import TABLE5_MAX_REL_DEV, TABLE34_MAX_DEV_LAST_DIGIT, TIME_VS_FREQUENCY_REL
 
-from powertrain.analysis.stiffness_table import stiffness_table
 from powertrain.iotools.mount_file import read_mount
+from powertrain.workflows.stiffness import stiffness_table
 
 MOUNT = Path(__file__).resolve().parents[1] / "mounts" / "thesis-appendix-a.toml"
 TABLES = thesis_tables.load()

@@ -7,12 +7,12 @@ import pytest
 from click.testing import CliRunner
 from tolerances import TRACKED_ORDER_DB
 
-from powertrain import signals
 from powertrain.cli import main
 from powertrain.iotools.raw_csv import write_raw_csv
 from powertrain.iotools.raw_hdf5 import write_raw_hdf5
 from powertrain.models.recording import RawChannel, RawRecording
-from powertrain.tracked import TrackedOrders
+from powertrain.results.tracked import TrackedOrders
+from powertrain.validation import signals
 
 
 def run(*args):
@@ -89,7 +89,7 @@ def _bad_files(folder):
     cases["time not increasing"] = (p, [], "time", "not increasing")
     p = folder / "runup.h5"
     from powertrain.iotools.engine_file import DEFAULT_ENGINE_PATH, read_engine
-    from powertrain.runup import run_runup
+    from powertrain.workflows.runup import run_runup
     run_runup(read_engine(DEFAULT_ENGINE_PATH), [2000.0, 2500.0], solver="harmonic").to_hdf5(p)
     cases["file of another format"] = (p, [], "format", "run-up result")
     return cases

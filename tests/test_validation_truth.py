@@ -11,7 +11,6 @@ import pytest
 
 from powertrain.effects import with_balancer_error
 from powertrain.physics.combustion import indicated_work
-from powertrain.runup import run_runup
 from powertrain.validation import truth as tr
 from powertrain.validation.cases import (
     RPM,
@@ -25,6 +24,7 @@ from powertrain.validation.cases import (
     truth_velocity,
 )
 from powertrain.validation.kinds import IN_LIBRARY, KINDS, PASSIVE_KINDS
+from powertrain.workflows.runup import run_runup
 
 #: Newmark (1 deg steps) vs exact harmonic steady state: relative to the largest amplitude.
 NEWMARK_REL = 5e-4

@@ -21,9 +21,9 @@ from click.testing import CliRunner
 from powertrain.assembly import assemble
 from powertrain.cli import main
 from powertrain.errors import InputError
-from powertrain.retune import band_weight, retune
-from powertrain.sweep import SerialExecutor, SweepTask, run_sweep
-from powertrain.variants import (
+from powertrain.workflows.retune import band_weight, retune
+from powertrain.workflows.sweeps import SerialExecutor, SweepTask, run_sweep
+from powertrain.workflows.variants import (
     Variant,
     apply_operations,
     parse_move,
@@ -33,7 +33,7 @@ from powertrain.variants import (
     parse_target,
     read_variants,
 )
-from powertrain.whatif import run_whatif
+from powertrain.workflows.whatif import run_whatif
 
 RPM = np.array([1500.0, 3000.0, 4500.0])
 #: Identity variant: no change beyond round-off [dB].
@@ -44,7 +44,7 @@ EXACT = 1e-9
 #: band, and the mean change within 5 percentage points of the requested +20 %. The
 #: requested curve (baseline x band gain with its Bode phase) is met to 6 % / +16.6 % on
 #: left.z, the gap being the price of keeping the input-point stiffness (what the body feels)
-#: within 2 % of its target (see powertrain.retune).
+#: within 2 % of its target (see powertrain.workflows.retune).
 RETUNE_BAND_REL = 0.10
 RETUNE_MEAN_PTS = 0.05
 
@@ -226,7 +226,7 @@ NEWMARK_REL = 5e-3
 def test_effects_through_the_normal_runup_match_the_fast_path(engine):
     """Every diagnosis effect runs through run_runup (Newmark here) and agrees with the
     cached frequency-domain path of the diagnosis (:func:`powertrain.effects.simulate`)."""
-    from powertrain.effect_runup import runup_with_effects, simulate
+    from powertrain.workflows.effect_runup import runup_with_effects, simulate
     scenarios = [{"base_compliance": {"c_base": 4e5, "m_base": 8.0}},
                  {"mount_stiffness": {"k1": 1.5, "k3": 0.7}},
                  {"amplitude_stiffness": {"kappa": 1.0, "a_c": 2e-5}},
@@ -243,7 +243,7 @@ def test_effects_through_the_normal_runup_match_the_fast_path(engine):
 
 
 def test_whatif_effect_option_units_and_variants_file(tmp_path, engine):
-    from powertrain.variants import parse_effect
+    from powertrain.workflows.variants import parse_effect
     op = parse_effect("base_compliance:c_base=400N/mm,m_base=8kg")
     assert dict(op.params) == {"c_base": pytest.approx(4e5), "m_base": 8.0}
     assert dict(parse_effect("balancer_error:lag=5deg").params)["lag"] == pytest.approx(

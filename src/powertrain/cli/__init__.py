@@ -16,7 +16,7 @@ from powertrain import __version__
 class _Group(click.Group):
     """Turns :class:`powertrain.errors.InputError` into one line on stderr and exit code 1.
 
-    Every command runs inside one :class:`~powertrain.iotools.atomic.OutputTransaction`:
+    Every command runs inside one :class:`~powertrain.outputs.OutputTransaction`:
     its output files are staged and replace the targets together only when the command
     succeeds; a failed command changes no file (docs/reference/outputs.md).
     """
@@ -30,7 +30,7 @@ class _Group(click.Group):
     def invoke(self, ctx):
         from powertrain.cli.common import terminate_as_exit
         from powertrain.errors import InputError
-        from powertrain.iotools.atomic import OutputTransaction
+        from powertrain.outputs import OutputTransaction
         try:
             with terminate_as_exit(), OutputTransaction():
                 return super().invoke(ctx)

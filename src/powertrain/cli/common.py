@@ -74,7 +74,7 @@ def speed_options(func):
 
 def speed_steps(rpm_from: float, rpm_to: float, rpm_step: float) -> np.ndarray:
     """Validated speed steps [rpm] from the ``--from/--to/--step`` options."""
-    from powertrain.runup import default_rpm
+    from powertrain.workflows.runup import default_rpm
     for value, key in ((rpm_from, "--from"), (rpm_to, "--to"), (rpm_step, "--step")):
         if not (math.isfinite(value) and value > 0):
             raise InputError(f"must be a finite speed > 0 [rpm], got {value:g}", key=key)
@@ -97,7 +97,7 @@ MAX_ANGLE_STEP_DEG = 10.0
 
 def check_outputs(**targets) -> None:
     """Refuse, before any work, output paths that cannot be written (``--name=path``)."""
-    from powertrain.iotools.atomic import check_writable
+    from powertrain.outputs import check_writable
     for name, path in targets.items():
         if path:
             check_writable(path, key=f"--{name.replace('_', '-')}")
@@ -126,7 +126,7 @@ def write_json(path, text: str, provenance: dict, key: str = "--json") -> None:
     with a non-finite number is refused (no NaN in an output file)."""
     import json
 
-    from powertrain.iotools.atomic import atomic_write
+    from powertrain.outputs import atomic_write
     doc = json.loads(text)
     doc["provenance"] = provenance
     try:

@@ -57,8 +57,8 @@ def compare(measured, sim_file, engine_file, plot, json_file, noise_floor, solve
     import math
     import time
 
-    from powertrain.comparison import compare_runup
     from powertrain.errors import InputError
+    from powertrain.workflows.comparison import compare_runup
 
     t0 = time.perf_counter()
     if sim_file and engine_file:
@@ -140,7 +140,7 @@ def _simulate(engine, engine_file, meas, measured, rpm_step, solver, quiet):
     """Run the engine at the measured speeds (or on a ``rpm_step`` grid over them)."""
     from powertrain.cli.common import checked_runup
     from powertrain.iotools.measured import MeasuredRunup
-    from powertrain.runup import run_runup
+    from powertrain.workflows.runup import run_runup
     rpm = _simulation_speeds(engine, meas, measured, rpm_step)
     grid = (f"{rpm[0]:g}..{rpm[-1]:g} rpm step {rpm_step:g}, interpolated" if rpm_step
             else f"at the {rpm.size} measured speeds {rpm[0]:g}..{rpm[-1]:g} rpm")
@@ -183,7 +183,7 @@ def _simulation_speeds(engine, meas, measured, rpm_step):
     if (stop - start) / rpm_step + 1 > MAX_SPEEDS:
         raise InputError(f"{(stop - start) / rpm_step + 1:.3g} speed steps over the "
                          f"measured range; at most {MAX_SPEEDS}", key="--step")
-    from powertrain.runup import default_rpm
+    from powertrain.workflows.runup import default_rpm
     return default_rpm(start, stop, rpm_step)
 
 

@@ -98,7 +98,7 @@ def diagnose(measured, engine_file, report_dir, json_file, noise_floor, effects,
     scheduler = check_scheduler(scheduler or "serial", reach=True)
     check_outputs(json=json_file)
     if report_dir:
-        from powertrain.iotools.atomic import check_writable
+        from powertrain.outputs import check_writable
         check_writable(Path(report_dir) / "summary.txt", key="--report")
     engine = read_engine(engine_file or str(DEFAULT_ENGINE_PATH))
     meas = read_measured(measured, mounts=engine.mount_names)
@@ -148,8 +148,8 @@ def synth(effect_names, seed, out, truth_file, engine_file, quiet):
     import numpy as np
 
     from powertrain.errors import InputError
-    from powertrain.iotools.atomic import atomic_write
     from powertrain.iotools.engine_file import DEFAULT_ENGINE_PATH, read_engine
+    from powertrain.outputs import atomic_write
     from powertrain.validation.synth import TRUTH_EFFECTS, make_case, truth_effect_name
 
     names = [] if effect_names.strip() == "none" else [

@@ -33,7 +33,7 @@ def examples(folder):
     """
     from powertrain.data import FOLDERS, shipped_files
     from powertrain.errors import InputError
-    from powertrain.iotools.atomic import atomic_path
+    from powertrain.outputs import atomic_path
 
     root = Path(folder)
     if root.exists() and not root.is_dir():

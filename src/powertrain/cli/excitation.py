@@ -79,7 +79,7 @@ def excitation(rpm, engine_file, load, no_balancers, step, csv_path, plot):
 def _write_csv(exc, path):
     import numpy as np
 
-    from powertrain.iotools.atomic import atomic_write
+    from powertrain.outputs import atomic_write
 
     n_cyl = exc.pressure.shape[1]
     header = list(LOAD_COLUMNS)

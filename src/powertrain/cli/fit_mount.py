@@ -6,8 +6,8 @@ import click
 
 from powertrain.cli import main
 from powertrain.cli.common import plot_form_options
-from powertrain.fitting import DEFAULT_SEED, DEFAULT_STARTS
 from powertrain.models.mount import TOPOLOGIES
+from powertrain.workflows.fitting import DEFAULT_SEED, DEFAULT_STARTS
 
 _MODELS = tuple(TOPOLOGIES)
 
@@ -51,10 +51,10 @@ def fit_mount(measured, model, out, plot, form, freq_axis, starts, seed, fmin, f
     from pathlib import Path
 
     from powertrain.errors import InputError
-    from powertrain.fitting import fit_mount as fit
     from powertrain.iotools.mount_file import write_mount
     from powertrain.iotools.stiffness_csv import FREQUENCY, read_stiffness_csv
     from powertrain.units import from_si
+    from powertrain.workflows.fitting import fit_mount as fit
 
     if model not in TOPOLOGIES:
         raise InputError(f"unknown model {model!r} (known: {', '.join(TOPOLOGIES)})",

@@ -68,7 +68,7 @@ def runup(rpm_from, rpm_to, rpm_step, engine_file, solver, stepper, angle_step, 
     """
     from powertrain.cli.common import check_outputs, checked_runup, runup_settings
     from powertrain.iotools.engine_file import DEFAULT_ENGINE_PATH, read_engine
-    from powertrain.runup import run_runup
+    from powertrain.workflows.runup import run_runup
 
     rpm = speed_steps(rpm_from, rpm_to, rpm_step)
     check_outputs(out=out, csv=csv_file, plot=plot, path_plot=path_plot)
@@ -85,12 +85,12 @@ def runup(rpm_from, rpm_to, rpm_step, engine_file, solver, stepper, angle_step, 
         from powertrain.cli.sweep_run import run_sweep
         return run_sweep(engine, rpm_from, rpm_to, sweep, sample_rate, raw_file, out, csv_file,
                          plot, effect, quiet)
-    from powertrain.variants import effect_scenario, parse_operations
+    from powertrain.workflows.variants import effect_scenario, parse_operations
     scenario = effect_scenario(parse_operations({"effect": effect}, engine=engine))
     runup_settings(engine, rpm, angle_step)
     if scenario:
-        from powertrain.effect_runup import runup_with_effects
         from powertrain.progress import activity
+        from powertrain.workflows.effect_runup import runup_with_effects
         with activity(f"run-up with effects ({solver})", enabled=not quiet):
             result = checked_runup(engine, engine_path, runup_with_effects, rpm, scenario,
                                    solver=solver, angle_step_deg=angle_step, stepper=stepper)

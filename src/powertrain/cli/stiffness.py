@@ -48,9 +48,9 @@ def stiffness(mount_file, engine_file, mount_dir, freq, method, fmt, plot, form,
           --engine-mass 100 --force 100 --method time --format csv
       powertrain stiffness --engine engines/default-torque-rod.toml --mount torque_rod.x
     """
-    from powertrain.analysis.stiffness_table import stiffness_table
     from powertrain.cli.common import parse_frequencies
     from powertrain.errors import InputError
+    from powertrain.workflows.stiffness import stiffness_table
 
     if (engine_mass is None) != (force is None):
         raise InputError("--engine-mass and --force go together", key="--engine-mass")

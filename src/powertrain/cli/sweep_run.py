@@ -13,8 +13,8 @@ def run_sweep(engine, rpm_from, rpm_to, rate, sample_rate, raw_file, out, csv_fi
     """Simulate the sweep, write the raw HDF5, track it (COT, orders 0.5..8, as velocity)."""
     from powertrain.errors import InputError
     from powertrain.iotools.raw_hdf5 import write_raw_hdf5
-    from powertrain.solvers.sweep import simulate_sweep
-    from powertrain.tracking import track_recording
+    from powertrain.solvers.speed_ramp import simulate_sweep
+    from powertrain.workflows.tracking import track_recording
     if rate is None:
         raise InputError("--raw needs --sweep RPM_PER_S", key="--sweep")
     if effect:

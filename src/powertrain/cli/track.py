@@ -72,7 +72,7 @@ def track(raw, map_file, rpm_column, tacho_column, pulses_per_rev, orders_spec, 
     from powertrain.analysis.order_tracking import parse_orders
     from powertrain.errors import InputError
     from powertrain.iotools.raw import read_raw
-    from powertrain.tracking import track_recording
+    from powertrain.workflows.tracking import track_recording
 
     if rpm_column and tacho_column:
         raise click.UsageError("give --rpm or --tacho, not both")
@@ -115,7 +115,7 @@ def track(raw, map_file, rpm_column, tacho_column, pulses_per_rev, orders_spec, 
     if out:
         tracked.to_hdf5(out)
     if spectra:
-        from powertrain.iotools.atomic import atomic_write
+        from powertrain.outputs import atomic_write
         text = spectra.spectrum_csv_text()
         with atomic_write(spectrum_out) as fh:
             fh.write(text)
@@ -125,7 +125,7 @@ def track(raw, map_file, rpm_column, tacho_column, pulses_per_rev, orders_spec, 
     if plot:
         write_plot(lambda p: tracked.plot(path=p, provenance=prov), plot)
     if map_png:
-        from powertrain.plotting_orders import plot_maps
+        from powertrain.plotting.orders import plot_maps
         write_plot(lambda p: plot_maps(**maps, path=p, provenance=prov), map_png)
     if not quiet:
         _report(rec, tracked, [p for p in (csv_file, out, plot, map_png, spectrum_out) if p])
@@ -146,7 +146,7 @@ def _spectra(rec, use, pulses_per_rev, speeds, orders, quantity):
         return None
     import numpy as np
 
-    from powertrain.tracking import SPECTRUM_EXTENT, order_spectrum, speed_profile
+    from powertrain.workflows.tracking import SPECTRUM_EXTENT, order_spectrum, speed_profile
     profile = speed_profile(rec, use=use, pulses_per_rev=pulses_per_rev)
     parts = [order_spectrum(rec, profile, rpm, SPECTRUM_EXTENT * float(np.max(orders)),
                             quantity=quantity) for rpm in speeds]
@@ -177,8 +177,8 @@ def _maps(rec, use, pulses_per_rev, rpm_step, channel, max_order):
     import numpy as np
     from scipy.signal import spectrogram
 
-    from powertrain.plotting_orders import DISPLAY, MAP_MARGIN
-    from powertrain.tracking import order_map, speed_profile
+    from powertrain.plotting.orders import DISPLAY, MAP_MARGIN
+    from powertrain.workflows.tracking import order_map, speed_profile
     profile = speed_profile(rec, use=use, pulses_per_rev=pulses_per_rev)
     rpm, fine, rms = order_map(rec, profile, channel, rpm_step=rpm_step,
                                max_order=MAP_MARGIN * max_order)
@@ -199,7 +199,7 @@ def _report(rec, tracked, written):
     import numpy as np
 
     from powertrain.cli.common import format_table
-    from powertrain.plotting_orders import DISPLAY
+    from powertrain.plotting.orders import DISPLAY
     tag = " [SYNTHETIC]" if rec.synthetic else ""
     click.echo(f"raw: {rec.source}{tag}: {len(rec.channels)} channel(s), "
                f"{rec.sample_rate:g} Hz, {rec.time[-1] - rec.time[0]:.3g} s")

@@ -94,7 +94,7 @@ def whatif(engine_file, rpm_from, rpm_to, rpm_step, solver, scale, set_, swap, m
     """
     from powertrain.errors import InputError
     from powertrain.iotools.engine_file import DEFAULT_ENGINE_PATH, read_engine
-    from powertrain.variants import (
+    from powertrain.workflows.variants import (
         Origin,
         Variant,
         check_operations,
@@ -142,7 +142,7 @@ def whatif(engine_file, rpm_from, rpm_to, rpm_step, solver, scale, set_, swap, m
         measured = read_measured(measured_file, mounts=engine.mount_names)
 
     goal = _objective(objective, engine.assemble().channels, rpm) if objective else None
-    from powertrain.whatif import run_whatif
+    from powertrain.workflows.whatif import run_whatif
     if scheduler:
         from powertrain.parallel import check_scheduler, executor
         with executor(check_scheduler(scheduler), workers=workers,
@@ -229,7 +229,7 @@ def _check_variant_support(engine, variant) -> None:
     rigid-body modes); the error names the option or variants-file key at fault."""
     from powertrain.errors import InputError
     from powertrain.iotools.engine_checks import check_support
-    from powertrain.variants import Target
+    from powertrain.workflows.variants import Target
     for op in variant.operations:
         if isinstance(op, Target) or not hasattr(op, "apply"):
             continue

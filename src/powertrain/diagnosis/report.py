@@ -92,7 +92,7 @@ def write_report(r, directory, provenance=None) -> list:
     """Write ``summary.txt``, ``diagnosis.json`` and the figures into ``directory``."""
     from pathlib import Path
 
-    from powertrain.iotools.atomic import atomic_write
+    from powertrain.outputs import atomic_write
     from powertrain.plotting import plot_diagnosis_overlay, plot_gap_frequency, plot_gap_map
     out = Path(directory)
     out.mkdir(parents=True, exist_ok=True)

@@ -150,7 +150,7 @@ class DiagnosisResult:
         text = json.dumps(_finite_or_null(self.to_dict()), indent=1, allow_nan=False,
                           default=_jsonable)
         if path is not None:
-            from powertrain.iotools.atomic import atomic_write
+            from powertrain.outputs import atomic_write
             with atomic_write(path) as fh:
                 fh.write(text)
         return text

@@ -1,6 +1,6 @@
 r"""Measured run-up order curves: long-format CSV or the run-up HDF5 layout.
 
-CSV (the format :meth:`powertrain.results.RunupResult.to_csv` writes)::
+CSV (the format :meth:`powertrain.results.runup.RunupResult.to_csv` writes)::
 
     # lines starting with '#' are comments (kept, e.g. a SYNTHETIC label); blank lines skipped
     mount,direction,quantity,rpm,velocity_rms_mm_per_s
@@ -43,7 +43,7 @@ recognised level column, an unknown column, mount, direction or quantity, a non-
 negative or NaN value, a duplicate row -- raises :class:`~powertrain.errors.InputError`
 naming file, line and column.
 
-HDF5 files in the layout of :mod:`powertrain.results` (``powertrain runup --out``) are read
+HDF5 files in the layout of :mod:`powertrain.results.runup` (``powertrain runup --out``) are read
 with :meth:`RunupResult.from_hdf5`; every channel's synthesis and order RMS velocities become
 curves.
 """
@@ -178,7 +178,7 @@ class MeasuredRunup:
     @classmethod
     def from_result(cls, result, source: str = "", signal: str = "velocity") -> MeasuredRunup:
         """RMS curves (synthesis and every order) of a
-        :class:`~powertrain.results.RunupResult`: velocity, or ``mount_force``."""
+        :class:`~powertrain.results.runup.RunupResult`: velocity, or ``mount_force``."""
         rpm = np.asarray(result.rpm, float)
         order_idx = np.argsort(rpm)
         rms = result.order_rms(signal)[order_idx]
@@ -227,7 +227,7 @@ def read_measured(path, mounts=None, points=None) -> MeasuredRunup:
 
 
 def _read_hdf5(path, mounts):
-    from powertrain.results import RunupResult
+    from powertrain.results.runup import RunupResult
     try:
         result = RunupResult.from_hdf5(path)
     except KeyError as exc:

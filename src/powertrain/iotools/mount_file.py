@@ -27,9 +27,9 @@ from __future__ import annotations
 from pathlib import Path
 
 from powertrain.errors import InputError
-from powertrain.iotools.atomic import atomic_write
 from powertrain.iotools.tomlfile import get, number, read_toml
 from powertrain.models.mount import TOPOLOGIES, MountModel
+from powertrain.outputs import atomic_write
 from powertrain.units import from_si, to_si
 
 #: The unit each parameter family is written in by :func:`write_mount`.

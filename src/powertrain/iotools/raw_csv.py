@@ -90,7 +90,7 @@ def _numbers(lines, start, n_cols, path):
 
 def write_raw_csv(path, recording, *, comment: str = "") -> None:
     """Write a :class:`RawRecording` as a wide CSV in its channels' file units."""
-    from powertrain.iotools.atomic import atomic_write
+    from powertrain.outputs import atomic_write
     from powertrain.units import from_si
     cols, names = [recording.time], ["time [s]"]
     if recording.rpm is not None:

@@ -163,7 +163,7 @@ def write_raw_hdf5(path, recording, *, description: str = "", synthetic: bool = 
     """Write a :class:`RawRecording` in the layout above (values in each channel's unit)."""
     import h5py
 
-    from powertrain.iotools.atomic import atomic_path
+    from powertrain.outputs import atomic_path
     from powertrain.provenance import stamp_hdf5
     from powertrain.units import from_si
     with atomic_path(path) as tmp:

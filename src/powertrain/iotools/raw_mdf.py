@@ -79,7 +79,7 @@ def write_raw_mdf(path, recording) -> None:
     """Write a :class:`RawRecording` as MDF 4.10, one group, one channel per signal."""
     from asammdf import MDF, Signal
 
-    from powertrain.iotools.atomic import atomic_path
+    from powertrain.outputs import atomic_path
     from powertrain.units import from_si
     t = np.asarray(recording.time, float)
     sigs = []

@@ -106,7 +106,7 @@ def write_raw_uff(path, recording) -> None:
 
     import pyuff
 
-    from powertrain.iotools.atomic import atomic_path
+    from powertrain.outputs import atomic_path
     from powertrain.units import from_si
     rows = []
     if recording.rpm is not None:

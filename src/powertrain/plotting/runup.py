@@ -160,7 +160,7 @@ def plot_whatif(whatif, path=None, *, ax=None, channel=None, quantity=None, prov
 
     Parameters
     ----------
-    whatif : powertrain.whatif.WhatIfResult
+    whatif : powertrain.workflows.whatif.WhatIfResult
     path : str, optional
         PNG written atomically.
     ax, channel, quantity, provenance

@@ -167,7 +167,7 @@ def plot_retune(target_fit, path=None, *, ax=None, form=DEFAULT_FORM,
 
     Parameters
     ----------
-    target_fit : powertrain.retune.TargetFit
+    target_fit : powertrain.workflows.retune.TargetFit
     path : str, optional
         PNG written atomically.
     ax, form, freq_axis, provenance

@@ -295,7 +295,7 @@ def figure_legend(fig, axes, extra=(), fontsize=LEGEND_SIZE):
 # ------------------------------------------------------------------ output
 def save_figure(fig, path):
     """Save a figure as PNG atomically (no half-written file on failure)."""
-    from powertrain.iotools.atomic import atomic_path
+    from powertrain.outputs import atomic_path
     root = fig
     while getattr(root, "figure", None) is not None and root.figure is not root:
         root = root.figure

@@ -30,7 +30,7 @@ balancer or the cylinders change, only a few harmonics change, linearly in the u
           \mathbf r_n\mathbf r_n^T\Big)\hat{\mathbf q}_{r,h} = \hat{\mathbf f}_{r,h},
 
 and the channel velocities are :math:`\hat{\mathbf v} = i\omega_h\mathbf C\hat{\mathbf q}`
-(the same numbers as :func:`powertrain.runup.run_runup` with ``solver="harmonic"``, see
+(the same numbers as :func:`powertrain.workflows.runup.run_runup` with ``solver="harmonic"``, see
 tests/test_diagnose.py).
 """
 

@@ -125,7 +125,7 @@ class ModesResult:
                 "engine": self.engine, **self.meta}
 
     def write_json(self, path) -> None:
-        from powertrain.iotools.atomic import atomic_write
+        from powertrain.outputs import atomic_write
         with atomic_write(path) as fh:
             json.dump(self.to_dict(), fh, indent=2)
             fh.write("\n")
@@ -175,8 +175,8 @@ class ModesResult:
     def plot(self, ax=None, *, path=None, provenance=None):
         """Stacked kinetic-energy distribution per mode (PNG when ``path`` is given);
         returns the figure."""
+        from powertrain.plotting.body import plot_modes
         from powertrain.plotting.style import target_and_path
-        from powertrain.plotting_body import plot_modes
         ax, path = target_and_path(ax, path)
         return plot_modes(self, path, ax=ax,
                           provenance=provenance or getattr(self, "provenance", None))

@@ -8,7 +8,7 @@ the effects' own parametrisations. The truth is made differently:
   keeps its ground node (:func:`~powertrain.physics.mount_network.network_matrices` with
   ``include_ground=True``), which is either fixed or tied to a *chassis base*; the
   powertrain may carry a *bending* degree of freedom;
-* **solver** — time integration: :func:`powertrain.runup.run_runup` with the Newmark
+* **solver** — time integration: :func:`powertrain.workflows.runup.run_runup` with the Newmark
   solver (average acceleration, 1° crank steps, 6 cycles, the last 2 order-analysed) on the
   system assembled here;
 * **effects** — physical models of their own (:class:`TruthSpec`), parametrised unlike the
@@ -289,7 +289,7 @@ def _add_bending(M, C, K, b: BendingMode, cg, i):
 def simulate_truth(spec: TruthSpec, rpm):
     """Noise-free truth: complex velocity amplitudes (n_r, n_ch, 16) [m/s, peak] of the
     measured channels, by Newmark run-up on the truth assembly."""
-    from powertrain.runup import run_runup
+    from powertrain.workflows.runup import run_runup
     rpm = np.asarray(rpm, float)
     body = spec.engine.body
     if spec.amplitude_beta is None:
@@ -307,7 +307,7 @@ def simulate_truth(spec: TruthSpec, rpm):
 
 def _amplitude_runup(spec: TruthSpec, rpm):
     """Equivalent linearisation of the amplitude power law, one assembly per speed."""
-    from powertrain.runup import run_runup
+    from powertrain.workflows.runup import run_runup
     body = spec.engine.body
     sys0 = assemble_truth(body, spec.mounts, spec.chassis, spec.bending, spec.body,
                           spec.passive)

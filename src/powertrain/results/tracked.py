@@ -181,7 +181,7 @@ class TrackedOrders:
         return "\n".join(lines) + "\n"
 
     def to_csv(self, path) -> None:
-        from powertrain.iotools.atomic import atomic_write
+        from powertrain.outputs import atomic_write
         text = self.csv_text()
         with atomic_write(path) as fh:
             fh.write(text)
@@ -190,7 +190,7 @@ class TrackedOrders:
         """Write the HDF5 layout of the module docstring atomically."""
         import h5py
 
-        from powertrain.iotools.atomic import atomic_path
+        from powertrain.outputs import atomic_path
         from powertrain.provenance import stamp_hdf5
         with atomic_path(path) as tmp:
             with h5py.File(tmp, "w") as h5:
@@ -241,8 +241,8 @@ class TrackedOrders:
 
     def plot(self, ax=None, *, path=None, quantities=None, provenance=None):
         """Order curves (RMS against rpm), one panel per channel; returns the figure."""
+        from powertrain.plotting.orders import plot_tracked
         from powertrain.plotting.style import target_and_path
-        from powertrain.plotting_orders import plot_tracked
         ax, path = target_and_path(ax, path)
         return plot_tracked(self, path, quantities, ax=ax,
                             provenance=provenance or getattr(self, "provenance", None))

@@ -1,8 +1,8 @@
 r"""What-if: run the baseline and variants of the mount system, report the change in dB.
 
-:func:`run_whatif` resolves retune targets (:mod:`powertrain.retune`), builds one
-:class:`~powertrain.sweep.SweepTask` per variant plus the baseline, runs them with
-:func:`powertrain.sweep.run_sweep` and returns a :class:`WhatIfResult`.
+:func:`run_whatif` resolves retune targets (:mod:`powertrain.workflows.retune`), builds one
+:class:`~powertrain.workflows.sweeps.SweepTask` per variant plus the baseline, runs them with
+:func:`powertrain.workflows.sweeps.run_sweep` and returns a :class:`WhatIfResult`.
 
 Change of a variant against the baseline, per channel (mount × engine X/Y/Z) and quantity
 (``synthesis``, ``order_2``, ``order_4`` by default), at each speed step:
@@ -199,7 +199,7 @@ class WhatIfResult:
         """JSON text of :meth:`to_dict`; written atomically to ``path`` if given."""
         text = json.dumps(self.to_dict(), indent=2) + "\n"
         if path is not None:
-            from powertrain.iotools.atomic import atomic_write
+            from powertrain.outputs import atomic_write
             with atomic_write(path) as fh:
                 fh.write(text)
         return text
@@ -294,21 +294,21 @@ def run_whatif(engine, variants, rpm=None, *, solver: str = "harmonic", executor
     solver : {"harmonic", "newmark"}
         Default harmonic: exact for the linear model and fast.
     executor, workers
-        See :func:`powertrain.sweep.run_sweep`.
+        See :func:`powertrain.workflows.sweeps.run_sweep`.
     measured : MeasuredRunup, optional
         Overlaid in the plot; gaps reported.
     quantities : tuple of str
     signal : str
         ``velocity`` (default), ``mount_force``, ``displacement`` or ``acceleration``.
     fit_kwargs : dict, optional
-        Passed to :func:`powertrain.fitting.fit_mount` for targets.
+        Passed to :func:`powertrain.workflows.fitting.fit_mount` for targets.
     runup_options : dict, optional
-        Further keyword arguments of :func:`powertrain.runup.run_runup`.
+        Further keyword arguments of :func:`powertrain.workflows.runup.run_runup`.
     """
-    from powertrain.retune import resolve_targets
-    from powertrain.runup import default_rpm
-    from powertrain.sweep import SweepTask, run_sweep
-    from powertrain.variants import check_operations
+    from powertrain.workflows.retune import resolve_targets
+    from powertrain.workflows.runup import default_rpm
+    from powertrain.workflows.sweeps import SweepTask, run_sweep
+    from powertrain.workflows.variants import check_operations
     rpm = default_rpm() if rpm is None else np.atleast_1d(np.asarray(rpm, float))
     names = [v.name for v in variants]
     if len(set(names)) != len(names) or "baseline" in names:

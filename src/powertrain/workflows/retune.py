@@ -2,9 +2,9 @@ r"""Retune a mount direction to a desired change of its dynamic stiffness over a
 
 The way an engineer asks a mount supplier for a variant: "20 % stiffer between 100 and
 300 Hz, otherwise as it is". ``--target left.z:+20%:100-300Hz`` (syntax:
-:func:`powertrain.variants.parse_target`) builds the requested curve from the baseline
+:func:`powertrain.workflows.variants.parse_target`) builds the requested curve from the baseline
 cross-point stiffness :math:`K_0(f)` of that mount direction, fits the same lumped model to
-it with :func:`powertrain.fitting.fit_mount`, and runs the fitted model as a variant.
+it with :func:`powertrain.workflows.fitting.fit_mount`, and runs the fitted model as a variant.
 
 Requested curve
 ---------------
@@ -42,7 +42,7 @@ inertia of the network's internal masses), a test rig measures the *cross-point*
 on the mount: K_IP 80 times the baseline's at 33 Hz, and the left mount's velocity drops by
 25 dB). The retune therefore has two stages:
 
-1. :func:`~powertrain.fitting.fit_mount` (multi-start, log-parameters, its default seeded
+1. :func:`~powertrain.workflows.fitting.fit_mount` (multi-start, log-parameters, its default seeded
    starts -- it takes no user starting point) of the baseline topology to :math:`K_t` alone;
 2. a joint least-squares refinement (:func:`scipy.optimize.least_squares`, log-parameters)
    of the relative errors of :math:`K_{CP}` against :math:`K_t` *and* of :math:`K_{IP}`
@@ -65,7 +65,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from powertrain.variants import Origin, Swap, Target, Variant
+from powertrain.workflows.variants import Origin, Swap, Target, Variant
 
 #: Log-spaced fit frequencies above 0 Hz.
 N_FREQUENCIES = 120
@@ -197,7 +197,7 @@ class TargetFit:
     start : str
         Start of the retained refinement: ``baseline`` or ``fit_mount``.
     fit_summary : str
-        :meth:`powertrain.fitting.FitResult.summary` of stage 1.
+        :meth:`powertrain.workflows.fitting.FitResult.summary` of stage 1.
     """
 
     target: Target
@@ -300,14 +300,14 @@ def retune(model, target: Target, **fit_kwargs) -> TargetFit:
         Baseline model of the mount direction (SI).
     target : Target
     **fit_kwargs
-        Passed to :func:`powertrain.fitting.fit_mount` (``starts``, ``seed``...).
+        Passed to :func:`powertrain.workflows.fitting.fit_mount` (``starts``, ``seed``...).
 
     Returns
     -------
     TargetFit
     """
-    from powertrain.fitting import fit_mount
     from powertrain.models.mount import MountModel
+    from powertrain.workflows.fitting import fit_mount
     f = fit_frequencies(target)
     k0 = model.cross_point_stiffness(f)
     kt = target_curve(model, target, f)

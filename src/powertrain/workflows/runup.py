@@ -27,7 +27,7 @@ import numpy as np
 from powertrain.analysis.orders import ORDERS
 from powertrain.assembly import assemble
 from powertrain.progress import progress_bar
-from powertrain.results import RunupResult
+from powertrain.results.runup import RunupResult
 from powertrain.solvers.steppers import Cycles, choose_stepper
 
 #: Default crank-angle increment [deg]; halving it moves the results < 0.1 % (see tests).

@@ -13,7 +13,7 @@ from powertrain.analysis import order_tracking as cot
 from powertrain.analysis.orders import ORDERS
 from powertrain.analysis.speed import speed_from_rpm, speed_from_tacho
 from powertrain.errors import InputError
-from powertrain.tracked import TrackedChannel, TrackedOrders
+from powertrain.results.tracked import TrackedChannel, TrackedOrders
 
 #: Highest tracked frequency allowed, as a fraction of the sampling rate (Nyquist 0.5).
 MAX_FREQUENCY_FRACTION = 0.4

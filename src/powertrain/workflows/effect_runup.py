@@ -22,9 +22,9 @@ from powertrain.solvers.fast_harmonic import N_HARMONICS, HarmonicModel
 
 def runup_with_effects(engine, rpm, scenario: dict, **options):
     """Run-up of ``engine`` with the effects of ``scenario`` (``{effect: {parameter:
-    value}}``, SI) through :func:`powertrain.runup.run_runup` (``**options``: its keyword
+    value}}``, SI) through :func:`powertrain.workflows.runup.run_runup` (``**options``: its keyword
     arguments); ``settings["effects"]`` records the scenario."""
-    from powertrain.runup import run_runup
+    from powertrain.workflows.runup import run_runup
     sc = check_scenario(scenario, engine)
     rpm = np.atleast_1d(np.asarray(rpm, float))
     for name, eff in EFFECTS.items():
@@ -65,10 +65,10 @@ def _concatenate(parts):
 
 def simulate(engine, rpm, scenario: dict):
     """Run-up velocities (harmonic steady state) of ``engine`` with the effects of
-    ``scenario``; a :class:`~powertrain.results.RunupResult` holding the velocity only
+    ``scenario``; a :class:`~powertrain.results.runup.RunupResult` holding the velocity only
     (displacement = velocity/(iω), acceleration = iω·velocity, no mount forces)."""
     from powertrain.analysis.orders import ORDERS
-    from powertrain.results import RunupResult
+    from powertrain.results.runup import RunupResult
     hm = HarmonicModel(engine, rpm)
     w = hm.omega[:, 1:N_HARMONICS][:, None, :]
     v = predict(hm, scenario).velocity

@@ -81,7 +81,7 @@ class RunupResult:
     meta: dict = field(default_factory=dict)
     #: complex velocity at every body-point channel per mount path (mount × local
     #: direction), shape (n_rpm, 3 n_points, 3 n_mounts, n_orders) [m/s]; None without
-    #: body points (see :func:`powertrain.runup.path_contributions`)
+    #: body points (see :func:`powertrain.workflows.runup.path_contributions`)
     path_contribution: np.ndarray | None = None
 
     # ----------------------------------------------------------------- both sides
@@ -179,7 +179,7 @@ class RunupResult:
 
     def to_csv(self, path, comments=()) -> None:
         """Write :meth:`csv_text` atomically."""
-        from powertrain.iotools.atomic import atomic_write
+        from powertrain.outputs import atomic_write
         text = self.csv_text(comments)
         with atomic_write(path) as fh:
             fh.write(text)
@@ -195,7 +195,7 @@ class RunupResult:
         """
         import h5py
 
-        from powertrain.iotools.atomic import atomic_path
+        from powertrain.outputs import atomic_path
         from powertrain.provenance import stamp_hdf5
         with atomic_path(path) as tmp:
             with h5py.File(tmp, "w") as h5:
@@ -306,9 +306,9 @@ class RunupResult:
     # ----------------------------------------------------------------- plots
     def plot_paths(self, ax=None, *, path=None, order=2.0, provenance=None):
         """Path contributions at the body points (see
-        :func:`powertrain.plotting_body.plot_path_contributions`)."""
+        :func:`powertrain.plotting.body.plot_path_contributions`)."""
+        from powertrain.plotting.body import plot_path_contributions
         from powertrain.plotting.style import target_and_path
-        from powertrain.plotting_body import plot_path_contributions
         ax, path = target_and_path(ax, path)
         return plot_path_contributions(self, path, order, ax=ax,
                                        provenance=provenance or getattr(self, "provenance",
@@ -324,14 +324,14 @@ class RunupResult:
         overlaid; ``provenance``: foot line (default: ``self.provenance`` if set). Returns the
         figure; see :func:`powertrain.plotting.plot_runup`. With a body model (body-side
         channels), no ``others`` and no single panel: both sides of each mount in one panel,
-        and the body points (:func:`powertrain.plotting_body.plot_runup_both_sides`).
+        and the body points (:func:`powertrain.plotting.body.plot_runup_both_sides`).
         """
         from powertrain.plotting import plot_runup
         from powertrain.plotting.style import is_axes, target_and_path
         ax, path = target_and_path(ax, path)
         if (not others and not is_axes(ax)
                 and any(self.side(m) == "passive" for m, _ in self.channels)):
-            from powertrain.plotting_body import plot_runup_both_sides
+            from powertrain.plotting.body import plot_runup_both_sides
             return plot_runup_both_sides(self, path, quantities, signal, ax=ax,
                                          provenance=provenance or getattr(self, "provenance",
                                                                           None))

@@ -34,7 +34,7 @@ mount, ``x``, ``y``, ``z`` or ``*``; the default engine's mounts are ``left``, `
                                            about X, then AY about Y, then AZ about Z (fixed
                                            axes), :math:`R' = R_z R_y R_x R`
 ``--target MOUNT.DIR:CHANGE:BAND[:WIDTH]`` retune to a desired K_CP change, see
-                                           :mod:`powertrain.retune`
+                                           :mod:`powertrain.workflows.retune`
 ``--effect NAME[:PARAM=VALUE[UNIT],...]``  add an unmodelled effect of
                                            :data:`powertrain.effects.EFFECTS` (e.g.
                                            ``mount_stiffness:k1=1.5``,
@@ -42,7 +42,7 @@ mount, ``x``, ``y``, ``z`` or ``*``; the default engine's mounts are ``left``, `
                                            VALUE in the parameter's unit (N/m, kg, rad,
                                            dB, 1) or an explicit one of the same
                                            dimension; inside the effect's bounds; run by
-                                           :func:`powertrain.effect_runup.runup_with_effects`
+                                           :func:`powertrain.workflows.effect_runup.runup_with_effects`
 =========================================  ==================================================
 
 What "scale stiffness" means for a lumped network
@@ -245,7 +245,7 @@ class Rotate:
 @dataclass(frozen=True)
 class Target:
     """A desired change of a mount direction's K_CP over a band (resolved by fitting, see
-    :func:`powertrain.retune.retune`; cannot be applied directly).
+    :func:`powertrain.workflows.retune.retune`; cannot be applied directly).
 
     Attributes
     ----------
@@ -268,7 +268,7 @@ class Target:
     origin: Origin = Origin("--target")
 
     def apply(self, engine):
-        raise TypeError("a Target must be resolved by powertrain.retune.resolve_targets first")
+        raise TypeError("a Target must be resolved by powertrain.workflows.retune.resolve_targets first")
 
     def check(self, engine) -> None:
         """Raise :class:`InputError` if the mount or direction is unknown."""
@@ -281,8 +281,8 @@ class AddEffect:
 
     Engine-model effects are applied by :meth:`apply`; the response-level ones
     (``amplitude_stiffness``, ``sensor_error``) leave the engine unchanged here and are
-    applied to the run-up by :func:`powertrain.sweep.run_task` through
-    :func:`powertrain.effect_runup.runup_with_effects`.
+    applied to the run-up by :func:`powertrain.workflows.sweeps.run_task` through
+    :func:`powertrain.workflows.effect_runup.runup_with_effects`.
 
     Attributes
     ----------

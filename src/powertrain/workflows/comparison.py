@@ -277,7 +277,7 @@ class ComparisonResult:
         """JSON text of :meth:`to_dict`; written atomically to ``path`` if given."""
         text = json.dumps(self.to_dict(), indent=1) + "\n"
         if path is not None:
-            from powertrain.iotools.atomic import atomic_write
+            from powertrain.outputs import atomic_write
             with atomic_write(path) as fh:
                 fh.write(text)
         return text

@@ -1,8 +1,8 @@
 """The sweep engine: run many run-up variants on any executor.
 
 A :class:`SweepTask` is a small picklable description -- baseline engine, the variant's
-operations (:mod:`powertrain.variants`, targets already resolved), speeds, solver -- and
-:func:`run_task` turns it into a :class:`~powertrain.results.RunupResult` in whatever process
+operations (:mod:`powertrain.workflows.variants`, targets already resolved), speeds, solver -- and
+:func:`run_task` turns it into a :class:`~powertrain.results.runup.RunupResult` in whatever process
 runs it (it applies the operations there, so only the description travels).
 :func:`run_sweep` hands the tasks to an *executor*: anything with the
 :class:`concurrent.futures.Executor` method ``submit(fn, *args) -> future`` whose futures have
@@ -22,7 +22,7 @@ between libraries), results come back in task order.
   :func:`run_sweep` needs; the workers must have ``powertrain`` installed. An executor passed
   in is not shut down. Nothing in the model knows which executor runs it.
 
-BLAS inside :func:`powertrain.runup.run_runup` is limited to one thread, so one process per
+BLAS inside :func:`powertrain.workflows.runup.run_runup` is limited to one thread, so one process per
 core does not oversubscribe.
 """
 
@@ -47,12 +47,12 @@ class SweepTask:
     engine : Engine
         Baseline engine.
     operations : tuple
-        Operations of :mod:`powertrain.variants` applied in order (no unresolved targets).
+        Operations of :mod:`powertrain.workflows.variants` applied in order (no unresolved targets).
     rpm : ndarray
         Speed steps [rpm].
     solver : {"harmonic", "newmark"}
     options : dict
-        Further keyword arguments of :func:`powertrain.runup.run_runup`
+        Further keyword arguments of :func:`powertrain.workflows.runup.run_runup`
         (``angle_step_deg``...).
     """
 
@@ -66,20 +66,20 @@ class SweepTask:
 
 def run_task(task: SweepTask):
     """Apply the task's operations to its engine and run the run-up (response-level
-    effects, :func:`powertrain.variants.response_scenario`, through
-    :func:`powertrain.effect_runup.runup_with_effects`).
+    effects, :func:`powertrain.workflows.variants.response_scenario`, through
+    :func:`powertrain.workflows.effect_runup.runup_with_effects`).
 
     Returns
     -------
     RunupResult
         ``meta["variant"]`` holds the task name.
     """
-    from powertrain.runup import run_runup
-    from powertrain.variants import apply_operations, response_scenario
+    from powertrain.workflows.runup import run_runup
+    from powertrain.workflows.variants import apply_operations, response_scenario
     engine = apply_operations(task.engine, task.operations)
     response = response_scenario(task.operations)
     if response:        # amplitude-dependent mounts, sensor errors: see effects module
-        from powertrain.effect_runup import runup_with_effects
+        from powertrain.workflows.effect_runup import runup_with_effects
         result = runup_with_effects(engine, task.rpm, response, solver=task.solver,
                                     **task.options)
     else:
