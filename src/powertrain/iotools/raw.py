@@ -41,7 +41,10 @@ class FileSignals:
 
 
 def detect_format(path) -> str:
-    """``hdf5``, ``mdf``, ``uff`` or ``csv`` from the first bytes of the file."""
+    """``hdf5``, ``mdf``, ``uff`` or ``csv`` from the first bytes of the file (a regular file:
+    a FIFO or device is refused before it is opened, so nothing blocks)."""
+    from powertrain.iotools.textfile import check_regular_file
+    check_regular_file(path)
     try:
         with open(path, "rb") as fh:
             head = fh.read(512)
