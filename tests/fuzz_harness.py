@@ -170,7 +170,7 @@ def classify(case: Case, res: dict, folder: Path) -> tuple[str, str]:
     temps = temporary_files(folder)
     if temps:
         return "leftover", ", ".join(temps)
-    present = [o for o in case.outputs if (folder / o).exists()]
+    present = [o for o in case.outputs if os.path.exists(folder / o)]
     if res["code"] != 0:
         created = [o for o in present if o not in case.files]
         if created:
@@ -972,7 +972,8 @@ def mdf_with(defect: str) -> bytes:
             "other_time_base": [Signal(np.zeros(10), np.arange(10.0), name="right.z",
                                        unit="g")],
             "nan_values": [Signal(np.full(t.size, np.nan), t, name="right.z", unit="g")],
-            "text_channel": [Signal(np.array([b"ab"] * t.size), t, name="right.z")],
+            "text_channel": [Signal(np.array([b"ab"] * t.size), t, name="right.z",
+                                    encoding="utf-8")],
             "no_channels": []}[defect]
     mdf = MDF(version="4.10")
     groups = [good, sigs] if defect != "no_channels" else []
