@@ -1065,7 +1065,8 @@ def case_track_options(draw) -> Case:
     else:
         value = draw(st.sampled_from(["a" * 300 + ".csv", "x/" * 200 + "t.csv",
                                       "raw.csv/t.csv"]))
-    args = ["track", "raw.csv", "--orders", "1,2,4", "--quiet", opt, value, *extra]
+    args = ["track", "raw.csv", "--orders", "1,2,4", "--quantity", "acceleration", "--quiet",
+            opt, value, *extra]
     outputs = [value] if opt == "--csv" else []
     return Case({"raw.csv": _SEEDS["raw.csv"]}, args, outputs, opt, f"track option {opt}")
 

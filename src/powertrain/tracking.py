@@ -84,10 +84,13 @@ def track_recording(rec, orders=None, *, rpm_step=50.0, method="cot", use="auto"
     n_min = float(np.min(profile.rpm[i0:i1 + 1]))
     margin = cot.KERNEL_ZERO_CROSSINGS / (cot.ANTI_ALIAS_FRACTION * S * n_min / 60.0)
     if method == "vkf":
-        from powertrain.analysis.vold_kalman import DEFAULT_BANDWIDTH_HZ, EDGE_TIME_CONSTANTS
+        from powertrain.analysis.vold_kalman import (
+            DEFAULT_BANDWIDTH_HZ,
+            EDGE_TIME_CONSTANTS,
+            check_bandwidth,
+        )
         bandwidth_hz = float(DEFAULT_BANDWIDTH_HZ if bandwidth_hz is None else bandwidth_hz)
-        if not bandwidth_hz > 0:
-            raise InputError("must be > 0 [Hz]", key="--bandwidth")
+        check_bandwidth(bandwidth_hz, rec.time[-1] - rec.time[0], rec.sample_rate)
         margin = max(margin, EDGE_TIME_CONSTANTS / bandwidth_hz)
     rpm, centre = cot.speed_grid(profile, rpm_step, B, margin_s=margin, file=rec.source,
                                  key=profile.source)
