@@ -100,12 +100,13 @@ def main() -> int:
 
 
 def _safety(args, tmp, counts, per_kind, failures):
-    """Concurrent runs to one path and SIGKILLs at random moments (0.5..6 s)."""
+    """Concurrent runs to one path and SIGKILLs at random moments (1.5..4.5 s: the run-up
+    killed writes its outputs about 2..4.5 s after its start)."""
     import random
     rng = random.Random(args.seed)
     trials = [("concurrent", lambda: fh.concurrent_runs(tmp / "safety", n=rng.choice([2, 3])))
               for _ in range(args.safety)]
-    trials += [("sigkill", lambda: fh.killed_run(tmp / "safety", rng.uniform(0.5, 6.0)))
+    trials += [("sigkill", lambda: fh.killed_run(tmp / "safety", rng.uniform(1.5, 4.5)))
                for _ in range(args.safety)]
     for name, trial in trials:
         outcome, detail = trial()
