@@ -1,16 +1,17 @@
-"""Long malformed-input campaign (issue 10, item 6): every input kind, many examples.
+"""Long malformed-input campaign (issues 10 and 18): every input kind, many examples.
 
 Runs the hypothesis strategies of ``tests/fuzz_harness.py`` (the same as the CI suite
-``tests/test_fuzz_inputs.py``, more examples) plus the failures issue 10 listed, classifies
-every run and prints the counts, last line::
+``tests/test_fuzz_inputs.py``, more examples), the failures issues 10 and 18 listed, and the
+data-safety trials (concurrent runs to one path, SIGKILL mid-write at random moments);
+classifies every run and prints the counts, last line::
 
-    tracebacks=0 hangs=0 nan_outputs=0 leftovers=0 clean_errors=N ok=M
+    tracebacks=0 hangs=0 nan_outputs=0 leftovers=0 lost_files=0 clean_errors=N ok=M
 
 Failing cases are copied to ``--keep`` (default ``fuzz-failures/``) with the command in
 ``ARGS`` so they can be replayed. Usage::
 
     python scripts/fuzz_inputs.py --examples 100          # ~100 per input kind
-    python scripts/fuzz_inputs.py --examples 5 --kinds engine,options
+    python scripts/fuzz_inputs.py --examples 5 --kinds engine,options --safety 2
 """
 
 from __future__ import annotations
@@ -37,6 +38,8 @@ def main() -> int:
                     help=f"comma-separated input kinds ({', '.join(fh.KINDS)})")
     ap.add_argument("--seed", type=int, default=None, help="hypothesis seed (default random)")
     ap.add_argument("--keep", default="fuzz-failures", help="folder for failing cases")
+    ap.add_argument("--safety", type=int, default=10,
+                    help="concurrent-run and SIGKILL trials (each)")
     args = ap.parse_args()
     kinds = [k.strip() for k in args.kinds.split(",") if k.strip()]
     unknown = [k for k in kinds if k not in fh.KINDS]
@@ -67,6 +70,13 @@ def main() -> int:
             case.description = name
             outcome, detail = fh.run_case(worker, case, tmp / "case")
             record("issue-10", case, outcome, detail)
+        for name, (case, expected) in fh.issue_18_cases().items():
+            case.description = name
+            outcome, detail = fh.run_case(worker, case, tmp / "case")
+            if outcome != expected and outcome not in fh.FAILURES:
+                outcome, detail = "unclear_error", f"expected {expected}: {detail}"
+            record("issue-18", case, outcome, detail)
+        _safety(args, tmp, counts, per_kind, failures)
         for kind in kinds:
             run = _campaign(kind, args, worker, tmp, record)
             run()
@@ -75,12 +85,36 @@ def main() -> int:
         worker.close()
         shutil.rmtree(tmp, ignore_errors=True)
     print(f"issue-10 named cases: {dict(per_kind['issue-10'])}")
+    print(f"issue-18 named cases: {dict(per_kind['issue-18'])}")
+    print(f"data safety (concurrent runs, SIGKILL): {dict(per_kind['safety'])}; "
+          f"{sum(n > 0 for n in fh.KILL_TEMPS)} of {len(fh.KILL_TEMPS)} kills left "
+          f"{sum(fh.KILL_TEMPS)} temporary files, all swept by the next run unless counted "
+          "as leftovers")
     print(f"runs: {sum(counts.values())} in {time.perf_counter() - t0:.0f} s; "
           f"unclear errors (exit 1 not naming the file/option): {counts['unclear_error']}")
     print(f"tracebacks={counts['traceback']} hangs={counts['hang']} "
           f"nan_outputs={counts['nan_output']} leftovers={counts['leftover']} "
-          f"clean_errors={counts['clean_error']} ok={counts['ok']}")
+          f"lost_files={counts['lost_file']} clean_errors={counts['clean_error']} "
+          f"ok={counts['ok']}")
     return 1 if failures else 0
+
+
+def _safety(args, tmp, counts, per_kind, failures):
+    """Concurrent runs to one path and SIGKILLs at random moments (1.5..4.5 s: the run-up
+    killed writes its outputs about 2..4.5 s after its start)."""
+    import random
+    rng = random.Random(args.seed)
+    trials = [("concurrent", lambda: fh.concurrent_runs(tmp / "safety", n=rng.choice([2, 3])))
+              for _ in range(args.safety)]
+    trials += [("sigkill", lambda: fh.killed_run(tmp / "safety", rng.uniform(1.5, 4.5)))
+               for _ in range(args.safety)]
+    for name, trial in trials:
+        outcome, detail = trial()
+        counts[outcome] += 1
+        per_kind["safety"][outcome] += 1
+        if outcome in fh.FAILURES:
+            failures.append(f"safety {name}: {outcome}: {detail[-200:]}")
+            print(f"  FAIL {failures[-1]}", flush=True)
 
 
 def _campaign(kind, args, worker, tmp, record):

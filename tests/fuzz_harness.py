@@ -10,7 +10,10 @@ outcome is classified:
 * ``clean_error``: exit 1 with one line on stderr, ``error: ...`` naming the mutated file
   (or the mutated option), no output file left; click's own usage errors (exit 2) count too;
 * ``traceback``, ``hang`` (timeout), ``nan_output``, ``leftover`` (a failed run left an output
-  file) and ``unclear_error`` (exit 1 but not one line naming the file or key): failures.
+  file, or any run a temporary ``.NAME.*.tmp`` file), ``lost_file`` (a file that was in the
+  folder before, an input or an earlier output, is gone or changed after a failed run, or
+  after a successful run that was not asked to write it) and ``unclear_error`` (exit 1 but
+  not one line naming the file or key): failures.
 """
 
 from __future__ import annotations
@@ -31,7 +34,7 @@ import numpy as np
 from hypothesis import strategies as st
 
 ROOT = Path(__file__).resolve().parents[1]
-FAILURES = ("traceback", "hang", "nan_output", "leftover", "unclear_error")
+FAILURES = ("traceback", "hang", "nan_output", "leftover", "lost_file", "unclear_error")
 #: Seconds a single command may take before it counts as a hang.
 TIMEOUT = 60.0
 #: Address-space limit of the worker [bytes].
@@ -108,7 +111,7 @@ class Case:
     files: dict
     args: list
     outputs: list
-    mutated: str                      # file name or option the error must name
+    mutated: str | tuple              # file name or option the error must name (or one of)
     description: str = ""
     setup: list = field(default_factory=list)   # callables(folder) run after writing files
 
@@ -130,7 +133,16 @@ def _nonfinite_in(path: Path) -> bool:
         with h5py.File(path, "r") as h5:
             h5.visititems(visit)
         return bool(bad)
-    return bool(_NONFINITE.search(path.read_text(encoding="utf-8", errors="replace")))
+    text = path.read_text(encoding="utf-8", errors="replace")
+    if path.suffix == ".json":                # numbers only: descriptions may say "-> inf"
+        def bad(constant):
+            raise ValueError(constant)
+        try:
+            json.loads(text, parse_constant=bad)
+        except ValueError:
+            return True
+        return False
+    return bool(_NONFINITE.search(text))
 
 
 def write_case(case: Case, folder: Path) -> None:
@@ -152,21 +164,47 @@ def classify(case: Case, res: dict, folder: Path) -> tuple[str, str]:
     if res["traceback"] or res["code"] not in (0, 1, 2):
         return "traceback", res["traceback"].strip().splitlines()[-1] if res["traceback"] \
             else f"exit {res['code']}"
-    present = [o for o in case.outputs if (folder / o).exists()]
+    lost = lost_files(case, folder, failed=res["code"] != 0)
+    if lost:
+        return "lost_file", ", ".join(lost)
+    temps = temporary_files(folder)
+    if temps:
+        return "leftover", ", ".join(temps)
+    present = [o for o in case.outputs if os.path.exists(folder / o)]
     if res["code"] != 0:
-        if present:
-            return "leftover", ", ".join(present)
+        created = [o for o in present if o not in case.files]
+        if created:
+            return "leftover", ", ".join(created)
         err = res["stderr"].strip()
         if res["code"] == 2 and "Error:" in err:
             return "clean_error", err.splitlines()[-1]
         lines = err.splitlines()
+        names = case.mutated if isinstance(case.mutated, tuple) else (case.mutated,)
         if len(lines) == 1 and lines[0].startswith("error:") and \
-                Path(case.mutated).name in lines[0]:
+                any(Path(name).name in lines[0] for name in names):
             return "clean_error", lines[0]
         return "unclear_error", err[-300:]
     if _NONFINITE.search(res["stdout"]) or any(_nonfinite_in(folder / o) for o in present):
         return "nan_output", res["stdout"][-300:]
     return "ok", ""
+
+
+def lost_files(case: Case, folder: Path, failed: bool) -> list:
+    """Files the case put in the folder that are gone or changed: after a failed run any of
+    them, after a successful one those that are not its outputs."""
+    lost = []
+    for name, content in case.files.items():
+        if content == "fifo" or (not failed and name in case.outputs):
+            continue
+        p = folder / name
+        if not p.is_file() or p.read_bytes() != content:
+            lost.append(name)
+    return lost
+
+
+def temporary_files(folder: Path) -> list:
+    """Temporary output files (``.NAME.*.tmp``) anywhere under ``folder``."""
+    return sorted(str(p.relative_to(folder)) for p in folder.rglob(".*.tmp"))
 
 
 def run_case(worker: Worker, case: Case, folder: Path) -> tuple[str, str]:
@@ -239,6 +277,7 @@ def seeds(worker: Worker, folder: Path) -> dict:
     res = worker.run(["stiffness", str(ROOT / "mounts" / "hydraulic-engine-mount-z.toml"),
                       "--freq", "1:200:10", "--format", "csv"], folder)
     _SEEDS["k.csv"] = res["stdout"].encode()
+    raw_format_seeds(folder)
     shutil.rmtree(folder, ignore_errors=True)
     return _SEEDS
 
@@ -740,3 +779,599 @@ def issue_cases() -> dict:
             ["compare", "m.h5", "--sim", "sim.csv", "--quiet", "--json", "c.json"], ["c.json"],
             "m.h5", "flipped")
     return cases
+
+
+# --------------------------------------------------------------------------- issue 18
+# Raw HDF5, UFF and MDF4 time data, channel maps, the FRF chassis, diagnose, track and sweep
+# options, scheduler addresses, and data safety (earlier files never lost).
+LAB_NAMES = {"rpm": "EngSpeed", "tacho": "Tacho1", "left.z": "ACC_L_Z", "right.z": "VEL_R_Z"}
+CHANNEL_MAP = (b'rpm = "EngSpeed"\ntacho = "Tacho1"\n\n[channels]\n'
+               b'"ACC_L_Z" = { mount = "left", direction = "z", quantity = "acceleration", '
+               b'unit = "g" }\n'
+               b'"VEL_R_Z" = { mount = "right", direction = "z", quantity = "velocity", '
+               b'unit = "mm/s" }\n')
+
+
+def raw_format_seeds(folder: Path) -> None:
+    """The raw seed as HDF5, UFF 58 and MDF4; a lab-named CSV with its channel map; a
+    modal-body engine with a measured receptance (FRF) body, CSV and UFF."""
+    from powertrain.iotools.raw import read_raw
+    from powertrain.iotools.raw_hdf5 import write_raw_hdf5
+    from powertrain.iotools.raw_mdf import write_raw_mdf
+    from powertrain.iotools.raw_uff import write_raw_uff
+    rec = read_raw(folder / "raw.csv")
+    for name, write in (("raw.h5", write_raw_hdf5), ("raw.uff", write_raw_uff),
+                        ("raw.mf4", write_raw_mdf)):
+        write(folder / name, rec)
+        _SEEDS[name] = (folder / name).read_bytes()
+    lines = _SEEDS["raw.csv"].decode().splitlines()
+    head = next(i for i, ln in enumerate(lines) if not ln.startswith("#"))
+    cols = lines[head].split(",")
+    for i, c in enumerate(cols):
+        bare = c.split(" [")[0]
+        if bare in LAB_NAMES:
+            cols[i] = LAB_NAMES[bare] + (" [1/min]" if bare == "rpm" else
+                                         " [V]" if bare == "tacho" else "")
+    lines[head] = ",".join(cols)
+    _SEEDS["lab.csv"] = ("\n".join(lines) + "\n").encode()
+    _SEEDS["map.toml"] = CHANNEL_MAP
+    _frf_seeds()
+
+
+FRF_RPM = 2000.0
+
+
+def _frf_seeds() -> None:
+    from powertrain.iotools.engine_file import read_engine
+    engine = read_engine(ROOT / "engines" / "default-modal-body.toml")
+    ch = engine.chassis
+    f = np.unique(np.outer([FRF_RPM / 60.0], np.arange(1, 17) / 2.0).ravel())
+    f = np.concatenate([[0.5 * f[0]], f, [2 * f[-1]]])
+    rows = ["frequency_hz,response,excitation,receptance_real_m_per_n,"
+            "receptance_imag_m_per_n"]
+    records = []
+    for r in engine.mount_names + list(ch.points):
+        for e in engine.mount_names:
+            H = np.array([ch.modal_receptance(2 * np.pi * fi, [r], [e]) for fi in f])
+            for a, rd in enumerate("xyz"):
+                for b, ed in enumerate("xyz"):
+                    rows += [f"{fi!r},{r}.{rd},{e}.{ed},{h.real!r},{h.imag!r}"
+                             for fi, h in zip(f.tolist(), H[:, a, b].tolist())]
+                    records.append(dict(rsp_ent_name=r, rsp_dir=a + 1, ref_ent_name=e,
+                                        ref_dir=b + 1, data=H[:, a, b], x=f))
+    _SEEDS["body.csv"] = ("\n".join(rows) + "\n").encode()
+    _SEEDS["frf_records"] = records
+    text = (ROOT / "engines" / "default-modal-body.toml").read_text()
+    text = text[:text.index("\n[chassis]\n") + 1]
+    for ext in ("csv", "uff"):
+        _SEEDS[f"frf-{ext}.toml"] = (text + f'[chassis]\nmodel = "frf"\nfrf = "../body.{ext}"'
+                                     '\n\n[chassis.points.seat_rail]\n').encode()
+
+
+def frf_uff(records) -> bytes:
+    """UFF 58 receptance records (ASCII) as bytes."""
+    import tempfile
+    import warnings
+
+    import pyuff
+    sets = [pyuff.prepare_58(binary=0, func_type=4, rsp_node=1, ref_node=1, id1="receptance",
+                             ord_data_type=6, abscissa_spacing=0, abscissa_spec_data_type=18,
+                             ordinate_spec_data_type=8, orddenom_spec_data_type=13,
+                             z_axis_spec_data_type=0, ver_num=0, load_case_id=0,
+                             z_axis_value=0.0, **r) for r in records]
+    with tempfile.TemporaryDirectory() as tmp, warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        p = Path(tmp) / "b.uff"
+        pyuff.UFF(str(p)).write_sets(sets, mode="overwrite")
+        return p.read_bytes()
+
+
+RAW_H5_MUTATIONS = ["comments_text", "comments_ints", "dangling_time", "dangling_channel",
+                    "channels_dataset", "huge_time", "huge_channel", "delete", "string_time",
+                    "two_d", "nan_value", "time_backwards", "unit", "format", "flip"]
+
+
+def mutate_raw_hdf5(draw, data: bytes) -> tuple[bytes, str]:
+    """A mutated copy of a raw HDF5 file (see RAW_H5_MUTATIONS)."""
+    import tempfile
+
+    import h5py
+    action = draw(st.sampled_from(RAW_H5_MUTATIONS))
+    if action == "flip":
+        return mutate_bytes(draw, data), action
+    with tempfile.TemporaryDirectory() as tmp:
+        p = Path(tmp) / "x.h5"
+        p.write_bytes(data)
+        with h5py.File(p, "r+") as h5:
+            chan = "channels/" + sorted(h5["channels"])[0]
+            _RAW_H5_EDITS[action](h5, chan, draw)
+        return p.read_bytes(), action
+
+
+def _replace(h5, name, value):
+    del h5[name]
+    h5[name] = value
+
+
+def _huge(h5, name):
+    del h5[name]
+    h5.create_dataset(name, shape=(2 ** 40,), chunks=(1024,), dtype="f8")
+
+
+def _edit_value(h5, name, index, value):
+    v = h5[name][()]
+    v[index] = value
+    h5[name][...] = v
+
+
+_RAW_H5_EDITS = {
+    "comments_text": lambda h5, c, d: h5.attrs.__setitem__("comments", d(st.sampled_from(
+        ["not json", "{", "", "null"]))),
+    "comments_ints": lambda h5, c, d: h5.attrs.__setitem__("comments", "[1, 2]"),
+    "dangling_time": lambda h5, c, d: _replace(h5, "time", __import__("h5py").SoftLink("/x")),
+    "dangling_channel": lambda h5, c, d: _replace(h5, c, __import__("h5py").SoftLink("/x")),
+    "channels_dataset": lambda h5, c, d: _replace(h5, "channels", np.ones(4)),
+    "huge_time": lambda h5, c, d: _huge(h5, "time"),
+    "huge_channel": lambda h5, c, d: _huge(h5, c),
+    "delete": lambda h5, c, d: h5.__delitem__(d(st.sampled_from(["time", "channels", "rpm",
+                                                                 "tacho", c]))),
+    "string_time": lambda h5, c, d: _replace(h5, "time", np.array([b"a", b"b"])),
+    "two_d": lambda h5, c, d: _replace(h5, c, np.ones((3, 4))),
+    "nan_value": lambda h5, c, d: _edit_value(h5, d(st.sampled_from(["time", "rpm", c])),
+                                              d(st.integers(0, 100)),
+                                              d(st.sampled_from([np.nan, np.inf, 1e300]))),
+    "time_backwards": lambda h5, c, d: _edit_value(h5, "time", 50, -1.0),
+    "unit": lambda h5, c, d: h5[d(st.sampled_from(["time", "rpm", c]))].attrs.__setitem__(
+        "unit", d(st.sampled_from(["furlong", "", "m/s^2", "1e300"]))),
+    "format": lambda h5, c, d: h5.attrs.__setitem__("format", "other"),
+}
+
+
+def _track(raw: str, *extra) -> list:
+    return ["track", raw, "--orders", "1,2,4", "--quantity", "acceleration", "--quiet",
+            "--csv", "t.csv", *extra]
+
+
+def case_raw_hdf5(draw) -> Case:
+    data, action = mutate_raw_hdf5(draw, _SEEDS["raw.h5"])
+    return Case({"raw.h5": data}, _track("raw.h5"), ["t.csv"], "raw.h5",
+                f"raw HDF5 ({action})")
+
+
+def _uff_cut_at_dataset(data: bytes, keep: int) -> bytes:
+    """The first ``keep`` datasets of a UFF file (a cut exactly at a dataset boundary)."""
+    starts = [m.start() for m in re.finditer(rb"(?:^|\n)[ ]*-1[ ]*\n[ ]*58", data)]
+    return data[:starts[keep] + 1] if keep < len(starts) else data
+
+
+def case_uff(draw) -> Case:
+    action = draw(st.sampled_from(["bytes", "bytes", "fraction", "boundary"]))
+    data = _SEEDS["raw.uff"]
+    if action == "bytes":
+        data = mutate_bytes(draw, data)
+    elif action == "fraction":
+        data = data[:int(len(data) * draw(st.sampled_from([0.1, 0.5, 0.9, 0.99, 0.999])))]
+    else:
+        data = _uff_cut_at_dataset(data, draw(st.integers(0, 3)))
+    return Case({"raw.uff": data}, _track("raw.uff"), ["t.csv"], "raw.uff",
+                f"raw UFF ({action})")
+
+
+MDF_DEFECTS = ["zero_length", "one_sample", "other_time_base", "nan_values", "text_channel",
+               "no_channels", "bytes"]
+
+
+def mdf_with(defect: str) -> bytes:
+    """An MDF4 file with one structural defect (built by asammdf)."""
+    import tempfile
+
+    from asammdf import MDF, Signal
+    t = np.arange(4096) / 2048.0
+    good = [Signal(np.sin(t * 200), t, name="left.z", unit="g"),
+            Signal(1500 + 500 * t, t, name="rpm", unit="rpm")]
+    sigs = {"zero_length": [Signal(np.zeros(0), np.zeros(0), name="left.z", unit="g")],
+            "one_sample": [Signal(np.zeros(1), np.zeros(1), name="left.z", unit="g")],
+            "other_time_base": [Signal(np.zeros(10), np.arange(10.0), name="right.z",
+                                       unit="g")],
+            "nan_values": [Signal(np.full(t.size, np.nan), t, name="right.z", unit="g")],
+            "text_channel": [Signal(np.array([b"ab"] * t.size), t, name="right.z",
+                                    encoding="utf-8")],
+            "no_channels": []}[defect]
+    mdf = MDF(version="4.10")
+    groups = [good, sigs] if defect != "no_channels" else []
+    for g in groups:
+        if g:
+            mdf.append(g)
+    with tempfile.TemporaryDirectory() as tmp:
+        out = mdf.save(str(Path(tmp) / "x.mf4"), overwrite=True)
+        mdf.close()
+        return Path(out).read_bytes()
+
+
+def case_mdf4(draw) -> Case:
+    defect = draw(st.sampled_from(MDF_DEFECTS))
+    data = mutate_bytes(draw, _SEEDS["raw.mf4"]) if defect == "bytes" else mdf_with(defect)
+    return Case({"raw.mf4": data}, _track("raw.mf4"), ["t.csv"], "raw.mf4",
+                f"raw MDF4 ({defect})")
+
+
+def case_channel_map(draw) -> Case:
+    files = {"lab.csv": _SEEDS["lab.csv"], "map.toml": mutate_toml(draw, _SEEDS["map.toml"])}
+    # a map that drops a unit or the speed channel is named through the data file's channel
+    return Case(files, _track("lab.csv", "--channels", "map.toml"), ["t.csv"],
+                ("map.toml", "lab.csv"), "channel map TOML")
+
+
+FRF_RUNUP = ["runup", "--engine", "engines/e.toml", "--from", "2000", "--to", "2000",
+             "--step", "500", "--solver", "harmonic", "--quiet", "--csv", "o.csv"]
+
+
+def case_frf_chassis(draw) -> Case:
+    """The FRF (measured receptance) chassis: a mutated receptance CSV or UFF record, or a
+    mutated [chassis] table."""
+    where = draw(st.sampled_from(["csv", "csv", "uff", "engine"]))
+    files = {**mount_files()}
+    if where == "csv":
+        files.update({"engines/e.toml": _SEEDS["frf-csv.toml"],
+                      "body.csv": mutate_csv(draw, _SEEDS["body.csv"])})
+        return Case(files, FRF_RUNUP, ["o.csv"], "body.csv", "FRF chassis (receptance CSV)")
+    if where == "uff":
+        records = copy.deepcopy(_SEEDS["frf_records"])
+        r = records[draw(st.integers(0, len(records) - 1))]
+        field_ = draw(st.sampled_from(["rsp_dir", "ref_dir", "rsp_ent_name", "data", "x"]))
+        if field_ in ("rsp_dir", "ref_dir"):
+            r[field_] = draw(st.sampled_from([0, 4, 5, -6, 6]))   # pyuff writes -6..6
+        elif field_ == "rsp_ent_name":
+            r[field_] = draw(st.sampled_from(["", "nope", "left.z"]))
+        else:
+            v = np.array(r[field_], dtype=complex if field_ == "data" else float)
+            v[draw(st.integers(0, v.size - 1))] = draw(st.sampled_from([np.nan, np.inf, -1.0]))
+            r[field_] = v
+        data = frf_uff(records)
+        if draw(st.booleans()):
+            data = data[:int(len(data) * 0.9)]
+        files.update({"engines/e.toml": _SEEDS["frf-uff.toml"], "body.uff": data})
+        return Case(files, FRF_RUNUP, ["o.csv"], "body.uff", f"FRF chassis (UFF {field_})")
+    files.update({"engines/e.toml": mutate_toml(draw, _SEEDS["frf-csv.toml"]),
+                  "body.csv": _SEEDS["body.csv"]})
+    return Case(files, FRF_RUNUP, ["o.csv"], "e.toml", "FRF chassis ([chassis] table)")
+
+
+DIAGNOSE = ["--effects", "sensor_error", "--no-pairs", "--quiet", "--json", "d.json"]
+
+
+def case_diagnose(draw) -> Case:
+    files = {"m.csv": mutate_csv(draw, _SEEDS["measured.csv"])}
+    return Case(files, ["diagnose", "m.csv", *DIAGNOSE], ["d.json"], "m.csv",
+                "diagnose (measured CSV)")
+
+
+def case_track_options(draw) -> Case:
+    opt = draw(st.sampled_from(["--rpm-step", "--orders", "--pulses-per-rev", "--bandwidth",
+                                "--csv"]))
+    extra = []
+    if opt == "--rpm-step":
+        value = draw(st.one_of(option_value(), st.sampled_from(["1e-9", "1e-300", "0.5"])))
+    elif opt == "--orders":
+        value = draw(st.one_of(st.sampled_from(["1:inf:1", "1:2:1e-12", "1e300", "0.5:8:0.5",
+                                                "1,1e6", "-1", "1:2", "0.001:0.002:0.001"]),
+                               freq_spec()))
+    elif opt == "--pulses-per-rev":
+        value = draw(st.sampled_from(["9" * 400, "0", "-1", "1", "4", "1e3", "100001"]))
+        extra = ["--tacho", "tacho"]
+    elif opt == "--bandwidth":
+        value = draw(option_value())
+        extra = ["--method", "vkf"]
+    else:
+        value = draw(st.sampled_from(["a" * 300 + ".csv", "x/" * 200 + "t.csv",
+                                      "raw.csv/t.csv"]))
+    args = ["track", "raw.csv", "--orders", "1,2,4", "--quantity", "acceleration", "--quiet",
+            opt, value, *extra]
+    outputs = [value] if opt == "--csv" else []
+    return Case({"raw.csv": _SEEDS["raw.csv"]}, args, outputs, opt, f"track option {opt}")
+
+
+def case_sweep_options(draw) -> Case:
+    rate = draw(st.one_of(st.sampled_from(["1e9", "1e-3", "1e-320", "0", "-5", "nan", "inf",
+                                           "50", "100", "400", "1000", "abc"]),
+                          st.floats(1e-3, 1e6).map(repr)))
+    fs = draw(st.sampled_from(["8192", "16000", "12600", "256", "255", "1e300", "nan",
+                               "4096"]))
+    args = ["runup", "--from", "2000", "--to", "2100", "--sweep", rate, "--sample-rate", fs,
+            "--quiet", "--csv", "s.csv"]
+    return Case({}, args, ["s.csv"], "--s", f"runup --sweep {rate} --sample-rate {fs}")
+
+
+def case_modes_engine(draw) -> Case:
+    """``modes`` on a mutated modal-body engine (finite extremes, zero shapes)."""
+    text = mutate_toml(draw, _read("engines/default-modal-body.toml"))
+    return Case({"engines/e.toml": text, **mount_files()},
+                ["modes", "--engine", "engines/e.toml", "--json", "m.json"], ["m.json"],
+                "e.toml", "modes (modal-body engine)")
+
+
+KINDS.update({"raw_hdf5": case_raw_hdf5, "uff": case_uff, "mdf4": case_mdf4,
+              "channel_map": case_channel_map, "frf_chassis": case_frf_chassis,
+              "diagnose": case_diagnose, "track_options": case_track_options,
+              "sweep_options": case_sweep_options, "modes": case_modes_engine})
+
+
+# --------------------------------------------------------------------------- issue 18's list
+class FakeServers:
+    """Local TCP servers for scheduler addresses: ``http`` answers like a web server once
+    it gets a request (sends nothing first), ``silent`` accepts and never answers."""
+
+    def __init__(self):
+        import socket
+        import threading
+        self.socks, self.conns, self.address = [], [], {}
+        for kind in ("http", "silent", "eager_http"):
+            sock = socket.socket()
+            sock.bind(("127.0.0.1", 0))
+            sock.listen(8)
+            self.socks.append(sock)
+            self.address[kind] = f"tcp://127.0.0.1:{sock.getsockname()[1]}"
+            threading.Thread(target=self._serve, args=(sock, kind), daemon=True).start()
+
+    def _serve(self, sock, kind):
+        try:
+            while True:
+                conn, _ = sock.accept()
+                self.conns.append(conn)
+                if kind == "eager_http":
+                    conn.sendall(b"HTTP/1.0 400 Bad request\r\nContent-Length: 0\r\n\r\n")
+        except OSError:
+            pass
+
+    def close(self):
+        for s in self.socks + self.conns:
+            s.close()
+
+
+_SERVERS: list = []
+
+
+def fake_servers() -> FakeServers:
+    if not _SERVERS:
+        _SERVERS.append(FakeServers())
+    return _SERVERS[0]
+
+
+def _raw_h5_with(action: str) -> bytes:
+    import tempfile
+
+    import h5py
+    with tempfile.TemporaryDirectory() as tmp:
+        p = Path(tmp) / "x.h5"
+        p.write_bytes(_SEEDS["raw.h5"])
+        with h5py.File(p, "r+") as h5:
+            chan = "channels/" + sorted(h5["channels"])[0]
+            _RAW_H5_EDITS[action](h5, chan, lambda strategy: "not json")
+        return p.read_bytes()
+
+
+def _tacho_with_edges(n: int) -> bytes:
+    """The raw seed CSV with a tacho of ``n`` pulses over the record."""
+    lines = _SEEDS["raw.csv"].decode().splitlines()
+    head = next(i for i, ln in enumerate(lines) if not ln.startswith("#"))
+    col = next(i for i, c in enumerate(lines[head].split(",")) if c.startswith("tacho"))
+    rows = lines[head + 1:]
+    period = len(rows) // n
+    for k, ln in enumerate(rows):
+        cells = ln.split(",")
+        cells[col] = "5" if k % period < period // 4 else "0"
+        rows[k] = ",".join(cells)
+    return ("\n".join(lines[:head + 1] + rows) + "\n").encode()
+
+
+def _modal_engine_sub(pattern: str, repl: str, count: int = 0) -> bytes:
+    text, n = re.subn(pattern, repl, _read("engines/default-modal-body.toml").decode(),
+                      count=count, flags=re.M)
+    assert n, pattern
+    return text.encode()
+
+
+def _measured_with_level(value: str) -> bytes:
+    lines = _SEEDS["measured.csv"].decode().splitlines()
+    i = next(i for i, ln in enumerate(lines) if ln and ln[0] not in "#m")
+    cells = lines[i].split(",")
+    cells[-1] = value
+    lines[i] = ",".join(cells)
+    return ("\n".join(lines) + "\n").encode()
+
+
+def issue_18_cases() -> dict:
+    """Every root cause issue 18 lists, as a named case: name -> (case, expected outcome)."""
+    mf = mount_files()
+    zero = _zero_mount_files()
+    name_z = "mounts/hydraulic-engine-mount-z.toml"
+    srv = fake_servers()
+    records = copy.deepcopy(_SEEDS["frf_records"])
+    records[3]["rsp_dir"] = 5
+    cases = {
+        "stiffness on an all-zero mount": Case(
+            {**zero, "mounts/thesis.toml": _zero_thesis_mount()},
+            ["stiffness", "mounts/thesis.toml", "--format", "csv"], [], "thesis.toml", ""),
+        "stiffness --force nan": Case({**mf}, ["stiffness", name_z, "--engine-mass", "100",
+                                               "--force", "nan", "--format", "csv"], [],
+                                      "--force", ""),
+        "diagnose on a 1e-300 level --json": Case(
+            {"m.csv": _measured_with_level("1e-300")}, ["diagnose", "m.csv", *DIAGNOSE],
+            ["d.json"], "m.csv", ""),
+        "track --rpm-step 1e-300": Case({"raw.csv": _SEEDS["raw.csv"]}, _track(
+            "raw.csv", "--rpm-step", "1e-300"), ["t.csv"], "--rpm-step", ""),
+        "track --rpm-step 1e-9": Case({"raw.csv": _SEEDS["raw.csv"]}, _track(
+            "raw.csv", "--rpm-step", "1e-9"), ["t.csv"], "--rpm-step", ""),
+        "track --orders 1:inf:1": Case({"raw.csv": _SEEDS["raw.csv"]}, [
+            "track", "raw.csv", "--orders", "1:inf:1", "--csv", "t.csv"], ["t.csv"],
+            "--orders", ""),
+        "track --orders 1:2:1e-12": Case({"raw.csv": _SEEDS["raw.csv"]}, [
+            "track", "raw.csv", "--orders", "1:2:1e-12", "--csv", "t.csv"], ["t.csv"],
+            "--orders", ""),
+        "track --pulses-per-rev with 400 digits": Case({"raw.csv": _SEEDS["raw.csv"]}, _track(
+            "raw.csv", "--tacho", "tacho", "--pulses-per-rev", "9" * 400), ["t.csv"],
+            "--pulses-per-rev", ""),
+        "track: a tacho with 3 edges": Case({"raw.csv": _tacho_with_edges(3)}, _track(
+            "raw.csv", "--tacho", "tacho", "--pulses-per-rev", "1"), ["t.csv"], "raw.csv", ""),
+        "track: a FIFO": Case({"raw.csv": "fifo"}, _track("raw.csv"), ["t.csv"], "raw.csv",
+                              ""),
+        "track: a 300-character output name": Case(
+            {"raw.csv": _SEEDS["raw.csv"]}, ["track", "raw.csv", "--csv", "a" * 300 + ".csv"],
+            [], "--csv", ""),
+        "raw HDF5: non-JSON comments": Case({"raw.h5": _raw_h5_with("comments_text")},
+                                            _track("raw.h5"), ["t.csv"], "raw.h5", ""),
+        "raw HDF5: dangling soft link": Case({"raw.h5": _raw_h5_with("dangling_time")},
+                                             _track("raw.h5"), ["t.csv"], "raw.h5", ""),
+        "raw HDF5: /channels as a dataset": Case({"raw.h5": _raw_h5_with("channels_dataset")},
+                                                 _track("raw.h5"), ["t.csv"], "raw.h5", ""),
+        "raw HDF5: 2**40-long chunked /time": Case({"raw.h5": _raw_h5_with("huge_time")},
+                                                   _track("raw.h5"), ["t.csv"], "raw.h5", ""),
+        "MDF4 with zero-length channels": Case({"raw.mf4": mdf_with("zero_length")},
+                                               _track("raw.mf4"), ["t.csv"], "raw.mf4", ""),
+        "UFF truncated at 90 %": Case({"raw.uff": _SEEDS["raw.uff"][
+            :int(0.9 * len(_SEEDS["raw.uff"]))]}, _track("raw.uff"), ["t.csv"], "raw.uff", ""),
+        "UFF cut after a whole dataset": Case({"raw.uff": _uff_cut_at_dataset(
+            _SEEDS["raw.uff"], 3)}, _track("raw.uff"), ["t.csv"], "raw.uff", ""),
+        "modes: 1e308 stiffness": Case(
+            {**mf, "engines/e.toml": _read("engines/default-torque-rod.toml").replace(
+                b"[150.0, 15.0, 15.0]", b"[1e308, 15.0, 15.0]")},
+            ["modes", "--engine", "engines/e.toml", "--json", "m.json"], ["m.json"], "e.toml",
+            ""),
+        "modes: modal mass 1e-300": Case(
+            {**mf, "engines/e.toml": _modal_engine_sub(
+                r"modal_mass = \{value = 40.0", "modal_mass = {value = 1e-300")},
+            ["modes", "--engine", "engines/e.toml", "--json", "m.json"], ["m.json"], "e.toml",
+            ""),
+        "modes: all body shapes zero": Case(
+            {**mf, "engines/e.toml": _modal_engine_sub(
+                r"^shape = .*$", "shape = {left = [0.0, 0.0, 0.0], right = [0.0, 0.0, 0.0], "
+                "gearbox = [0.0, 0.0, 0.0], seat_rail = [0.0, 0.0, 0.0]}")},
+            ["modes", "--engine", "engines/e.toml", "--json", "m.json"], ["m.json"], "e.toml",
+            ""),
+        "UFF receptance with rsp_dir = 5": Case(
+            {**mf, "engines/e.toml": _SEEDS["frf-uff.toml"], "body.uff": frf_uff(records)},
+            FRF_RUNUP, ["o.csv"], "body.uff", ""),
+        "runup --sweep 1e9": _sweep_case("1e9"),
+        "runup --sweep 1e-3": _sweep_case("1e-3"),
+        "runup --sweep 1e-320": _sweep_case("1e-320"),
+        "diagnose --scheduler tcp://host:notaport": _scheduler_case("tcp://host:notaport"),
+        "diagnose --scheduler at an HTTP server": _scheduler_case(srv.address["http"]),
+        "diagnose --scheduler at an answering HTTP server": _scheduler_case(
+            srv.address["eager_http"]),
+        "diagnose --scheduler at a silent server": _scheduler_case(srv.address["silent"]),
+        "modes fails on its plot: the old m.json stays": Case(
+            {"m.json": b"old\n", "afile": b""},
+            ["modes", "--json", "m.json", "--plot", "afile/p.png"], ["m.json"], "afile", ""),
+        "runup fails on its plot: the old o.csv and o.h5 stay": Case(
+            {"o.csv": b"old\n", "o.h5": b"old\n", "afile": b""},
+            ["runup", *QUICK_RUNUP, "--csv", "o.csv", "--out", "o.h5", "--plot", "afile/p.png"],
+            ["o.csv", "o.h5"], "afile", ""),
+    }
+    out = {name: (case, "clean_error") for name, case in cases.items()}
+    # a level of 1e-300 is a valid (censored) point: a finite diagnosis, no NaN
+    out["diagnose on a 1e-300 level --json"] = (out["diagnose on a 1e-300 level --json"][0],
+                                                "ok")
+    for args in (["--from", "1000", "--to", "1300", "--sweep", "100"],
+                 ["--from", "2000", "--to", "2500", "--sweep", "400", "--sample-rate",
+                  "16000"]):
+        out["runup " + " ".join(args) + " runs"] = (
+            Case({}, ["runup", *args, "--quiet", "--csv", "y.csv"], ["y.csv"], "", ""), "ok")
+    return out
+
+
+def _zero_thesis_mount() -> bytes:
+    text = _read("mounts/thesis-appendix-a.toml").decode()
+    head, sep, params = text.partition("[parameters]")
+    return (head + sep + re.sub(r"=\s*[-0-9.eE+]+", "= 0", params)).encode()
+
+
+def _sweep_case(rate: str) -> Case:
+    return Case({}, ["runup", "--from", "2000", "--to", "2500", "--sweep", rate, "--quiet",
+                     "--csv", "y.csv"], ["y.csv"], "--sweep", "")
+
+
+def _scheduler_case(address: str) -> Case:
+    return Case({"m.csv": _SEEDS["measured.csv"]},
+                ["diagnose", "m.csv", *DIAGNOSE, "--scheduler", address], ["d.json"],
+                "--scheduler", "")
+
+
+# --------------------------------------------------------------------------- data safety
+def _cli_process(args, cwd):
+    env = dict(os.environ)
+    env["PYTHONPATH"] = os.pathsep.join([str(ROOT / "src"), env.get("PYTHONPATH", "")])
+    return subprocess.Popen([sys.executable, "-m", "powertrain.cli", *args], cwd=cwd, env=env,
+                            stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
+
+
+def concurrent_runs(folder: Path, n: int = 2) -> tuple[str, str]:
+    """``n`` concurrent ``track`` runs writing the same two paths with different orders:
+    afterwards the CSV and the HDF5 must come from one run (``lost_file`` if mixed or
+    missing) and no temporary file may be left."""
+    import h5py
+    shutil.rmtree(folder, ignore_errors=True)
+    folder.mkdir(parents=True)
+    (folder / "raw.csv").write_bytes(_SEEDS["raw.csv"])
+    procs = [_cli_process(["track", "raw.csv", "--orders", str(k + 1), "--quantity",
+                           "acceleration", "--quiet", "--csv", "t.csv", "--out", "t.h5"],
+                          folder) for k in range(n)]
+    codes = [p.wait(timeout=TIMEOUT) for p in procs]
+    errs = [p.stderr.read() for p in procs]
+    for p in procs:
+        p.stderr.close()
+    try:
+        if any(codes) or not (folder / "t.csv").exists() or not (folder / "t.h5").exists():
+            return ("traceback" if any(c not in (0, 1) for c in codes) else "lost_file",
+                    f"exit codes {codes}: {errs}"[-300:])
+        temps = temporary_files(folder)
+        if temps:
+            return "leftover", ", ".join(temps)
+        csv_orders = {ln.split(",")[2] for ln in (folder / "t.csv").read_text().splitlines()
+                      if ln and not ln.startswith(("#", "mount"))} - {"synthesis"}
+        with h5py.File(folder / "t.h5", "r") as h5:
+            h5_orders = {f"order_{o:g}" for o in h5["orders"][()]}
+        if csv_orders != h5_orders:
+            return "lost_file", f"mixed outputs: CSV {csv_orders}, HDF5 {h5_orders}"
+        return "ok", ""
+    finally:
+        shutil.rmtree(folder, ignore_errors=True)
+
+
+#: Temporary files found right after each SIGKILL of :func:`killed_run` (the later run
+#: must sweep them).
+KILL_TEMPS: list = []
+
+
+def killed_run(folder: Path, delay: float) -> tuple[str, str]:
+    """SIGKILL a ``runup`` writing three outputs over older files after ``delay`` seconds,
+    then run a later command into the same folder: the older files must be intact or
+    completely replaced and no temporary file may remain after the later run."""
+    import signal
+    import time
+    shutil.rmtree(folder, ignore_errors=True)
+    folder.mkdir(parents=True)
+    old = {"o.csv": b"old\n", "o.h5": b"old\n", "o.png": b"old\n"}
+    for name, content in old.items():
+        (folder / name).write_bytes(content)
+    proc = _cli_process(["runup", "--from", "1000", "--to", "6000", "--step", "250",
+                         "--solver", "harmonic", "--quiet", "--csv", "o.csv", "--out", "o.h5",
+                         "--plot", "o.png"], folder)
+    time.sleep(delay)
+    proc.send_signal(signal.SIGKILL)
+    proc.wait()
+    proc.stderr.close()
+    try:
+        for name, content in old.items():
+            data = (folder / name).read_bytes() if (folder / name).exists() else None
+            if data is None or (data != content and data[:4] == content[:4]):
+                return "lost_file", f"{name} after SIGKILL at {delay:.2f} s"
+        KILL_TEMPS.append(len(temporary_files(folder)))
+        later = _cli_process(["modes", "--json", "m.json"], folder)
+        later.wait(timeout=TIMEOUT)
+        later.stderr.close()
+        temps = temporary_files(folder)
+        if temps:
+            return "leftover", f"after SIGKILL at {delay:.2f} s and a later run: {temps}"
+        return "ok", ""
+    finally:
+        shutil.rmtree(folder, ignore_errors=True)

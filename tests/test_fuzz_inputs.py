@@ -1,16 +1,19 @@
-"""Bad input, all of it (issue 10, item 6): property-based campaign over every input kind.
+"""Bad input, all of it (issues 10 and 18): property-based campaign over every input kind.
 
 Hypothesis mutates valid seeds of every input kind -- engine TOML, mount TOML, pressure CSV,
-stiffness CSV, measured CSV and HDF5, what-if variants TOML, raw time-data CSV (``track``)
-and option specs (``--freq``, ``--effect``, ``--scale``, ``--set``, ``--move``,
-``--rotate``, ``--target``, speeds, seeds)
+stiffness CSV, measured CSV and HDF5, what-if variants TOML, raw time data as CSV, HDF5, UFF
+58 and MDF4 (``track``), channel maps, the FRF (measured receptance) chassis, ``diagnose``,
+``modes`` on a modal-body engine, and option specs (``--freq``, ``--effect``, ``--scale``,
+``--set``, ``--move``, ``--rotate``, ``--target``, speeds, seeds, track options, sweeps)
 -- and runs the command that reads it (``tests/fuzz_harness.py``). Every run must end in a
 clean one-line error naming the file or option (exit 1, no output file) or in a finite
-result; never a traceback, a hang, NaN/inf in an output, or a leftover file.
+result; never a traceback, a hang, NaN/inf in an output, a leftover file, or a lost one
+(a file that was there before, changed or gone after a failed run).
 
-Examples per kind are bounded here (``FUZZ_EXAMPLES``, default 6) to keep CI short;
+Examples per kind are bounded here (``FUZZ_EXAMPLES``, default 4) to keep CI short;
 ``python scripts/fuzz_inputs.py`` runs the long campaign and prints the counts.
-Every failure issue 10 lists is also replayed by name (``test_issue_10_failures``).
+Every failure issues 10 and 18 list is also replayed by name, and data safety is checked
+once each: concurrent runs to one path, a SIGKILL mid-write.
 """
 
 from __future__ import annotations
@@ -22,7 +25,7 @@ import pytest
 from hypothesis import HealthCheck, Phase, given, settings
 from hypothesis import strategies as st
 
-EXAMPLES = int(os.environ.get("FUZZ_EXAMPLES", "6"))
+EXAMPLES = int(os.environ.get("FUZZ_EXAMPLES", "4"))
 
 
 @pytest.fixture(scope="module")
@@ -31,6 +34,32 @@ def worker(tmp_path_factory):
     fh.seeds(w, tmp_path_factory.mktemp("seeds"))
     yield w
     w.close()
+
+
+@pytest.fixture(scope="module")
+def issue_18(worker):
+    return fh.issue_18_cases()
+
+
+def test_issue_18_root_causes(worker, issue_18, tmp_path):
+    """Each root cause issue 18 lists gives a clean one-line error (or runs, for the short
+    sweeps), and no earlier file is lost."""
+    wrong = []
+    for name, (case, expected) in issue_18.items():
+        outcome, detail = fh.run_case(worker, case, tmp_path / "case")
+        if outcome != expected:
+            wrong.append(f"{name}: {outcome} ({detail[:200]})")
+    assert not wrong, "\n".join(wrong)
+
+
+def test_concurrent_runs_leave_one_complete_set(worker, tmp_path):
+    outcome, detail = fh.concurrent_runs(tmp_path / "c")
+    assert outcome == "ok", detail
+
+
+def test_sigkill_mid_write_leaves_no_temporary_file_after_the_next_run(worker, tmp_path):
+    outcome, detail = fh.killed_run(tmp_path / "k", delay=2.5)
+    assert outcome == "ok", detail
 
 
 @pytest.mark.parametrize("name", sorted(

@@ -134,3 +134,52 @@ def test_other_formats_are_rejected(tmp_path):
     p.write_text("    -1\n    58\ngarbage\n")
     with pytest.raises(InputError, match=str(p)):
         read_raw(p)
+
+
+def _uff_starts(data: bytes) -> list:
+    import re
+    return [m.start() for m in re.finditer(rb"(?:^|\n)[ ]*-1[ ]*\n[ ]*58", data)]
+
+
+@pytest.mark.parametrize("cut", ["mid-dataset", "between datasets"])
+def test_truncated_uff_is_refused(tmp_path, cut):
+    """Issue 18: a UFF cut at 90 % was read with its last channel silently dropped. A cut
+    inside a dataset misses the closing delimiter; a cut exactly between two datasets is
+    found by the numbering (ID line 4) of the datasets we write."""
+    path = tmp_path / "rec.uff"
+    write_raw_uff(path, recording())
+    data = path.read_bytes()
+    starts = _uff_starts(data)
+    path.write_bytes(data[:int(0.9 * len(data))] if cut == "mid-dataset"
+                     else data[:starts[-1] + 1])
+    with pytest.raises(InputError, match="truncated") as e:
+        read_raw(path)
+    assert e.value.file == str(path)
+
+
+@pytest.mark.parametrize("edit,key", [
+    (lambda h5: h5.attrs.__setitem__("comments", "not json"), "/@comments"),
+    (lambda h5: (h5.__delitem__("time"), h5.__setitem__("time", __import__("h5py").SoftLink(
+        "/nowhere"))), "time"),
+    (lambda h5: (h5.__delitem__("channels"), h5.__setitem__("channels", np.ones(3))),
+     "channels"),
+    (lambda h5: (h5.__delitem__("time"), h5.create_dataset("time", shape=(2 ** 40,),
+                                                           chunks=(1024,), dtype="f8")),
+     "time"),
+], ids=["comments not JSON", "dangling link", "channels a dataset", "2**40 declared"])
+def test_bad_raw_hdf5_names_file_and_key(tmp_path, edit, key):
+    import h5py
+    path = tmp_path / "rec.h5"
+    write_raw_hdf5(path, recording())
+    with h5py.File(path, "r+") as h5:
+        edit(h5)
+    with pytest.raises(InputError) as e:
+        read_raw(path)
+    assert (e.value.file, e.value.key) == (str(path), key)
+
+
+def test_fifo_is_refused_without_blocking(tmp_path):
+    import os
+    os.mkfifo(tmp_path / "run.csv")
+    with pytest.raises(InputError, match="not a regular file"):
+        read_raw(tmp_path / "run.csv")

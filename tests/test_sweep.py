@@ -81,3 +81,33 @@ def test_bad_sweep_options():
     assert r.exit_code == 1 and "--from" in r.output
     r = CliRunner().invoke(main, ["runup", "--raw", "x.h5", "--quiet"])
     assert r.exit_code == 1 and "--sweep" in r.output
+
+
+@pytest.mark.parametrize("rate", ["1e9", "1e-3", "1e-320"])
+def test_sweep_size_is_bounded_before_work(rate):
+    """Issue 18: too fast (no samples), too slow (runs on for days) or 1e-320 (overflow):
+    one line naming --sweep, at once."""
+    import time
+    t0 = time.perf_counter()
+    r = CliRunner().invoke(main, ["runup", "--from", "2000", "--to", "2500", "--sweep", rate,
+                                  "--quiet", "--csv", "never.csv"])
+    assert r.exit_code == 1 and "'--sweep'" in r.output and len(r.output.splitlines()) == 1
+    assert time.perf_counter() - t0 < 10.0
+
+
+def test_output_rate_at_the_internal_rate_needs_no_decimation():
+    """Issue 18: --sample-rate >= 6 x --to gave 'Invalid cutoff frequency'. Oracle: the same
+    integration grid (h = 1/16384 s) output undecimated at 16384 Hz and decimated to 8192 Hz
+    (zero-phase FIR, pass band up to ~3 kHz, far above the engine's orders here) agree at the
+    common instants."""
+    from powertrain.solvers.sweep import simulate_sweep
+    engine = read_engine(DEFAULT_ENGINE_PATH)
+    fine = simulate_sweep(engine, 2000.0, 2300.0, 300.0, sample_rate=16384.0)
+    coarse = simulate_sweep(engine, 2000.0, 2300.0, 300.0, sample_rate=8192.0)
+    k_fine = np.rint(fine.time * 16384).astype(int)
+    k_coarse = np.rint(coarse.time * 16384).astype(int)
+    common, i_f, i_c = np.intersect1d(k_fine, k_coarse, return_indices=True)
+    assert common.size > 0.9 * coarse.time.size
+    for a, b in zip(fine.channels, coarse.channels):
+        x, y = a.values[i_f], b.values[i_c]
+        assert np.sqrt(np.mean((x - y) ** 2)) < 1e-3 * np.sqrt(np.mean(y ** 2)), a.label

@@ -140,6 +140,10 @@ def speed_grid(profile, rpm_step, block_revs, *, margin_s=0.0, file=None, key="r
     hi_ok = np.interp(th[-1] - np.pi * block_revs, th, t) - m1
     grid = rpm_step * np.arange(math.ceil(n.min() / rpm_step), math.floor(n.max() / rpm_step)
                                 + 1)
+    if grid.size == 0:
+        raise InputError(f"no multiple of {rpm_step:g} rpm between the record's speeds "
+                         f"{n.min():.0f}..{n.max():.0f} rpm (a smaller step)", file=file,
+                         key="--rpm-step")
     tc, thc = first_passing(t, n, grid, th)
     keep = (tc >= lo_ok) & (tc <= hi_ok)
     rpm, centre = list(grid[keep]), thc[keep]

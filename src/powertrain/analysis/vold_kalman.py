@@ -76,6 +76,21 @@ DECIMATE_ABOVE = 10.0
 DECIMATED_RATE_FACTOR = 5.0
 
 
+def check_bandwidth(bandwidth_hz, duration_s, sample_rate):
+    """Refuse a bandwidth [Hz] that is not finite and > 0, above a quarter of the sampling
+    rate, or so narrow that the end transients (:data:`EDGE_TIME_CONSTANTS` / bandwidth at
+    each end) leave no data of the ``duration_s`` record."""
+    from powertrain.errors import InputError
+    if not 0 < bandwidth_hz <= 0.25 * sample_rate:
+        raise InputError(f"must be > 0 and <= {0.25 * sample_rate:g} Hz (a quarter of the "
+                         f"sampling rate), got {bandwidth_hz:g}", key="--bandwidth")
+    edge = EDGE_TIME_CONSTANTS / bandwidth_hz
+    if not 2 * edge < duration_s:
+        raise InputError(f"{bandwidth_hz:g} Hz needs {edge:.3g} s at each end of the record "
+                         f"for the filter's end transient; the record is {duration_s:.3g} s "
+                         "(a wider bandwidth)", key="--bandwidth")
+
+
 def weight_from_bandwidth(bandwidth_hz, dt):
     """Structural weight r for a -3 dB half-bandwidth [Hz] (scalar or per sample) at dt [s]."""
     x = 2 * np.pi * np.asarray(bandwidth_hz, float) * dt
