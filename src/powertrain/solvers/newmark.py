@@ -15,8 +15,7 @@ import threading
 
 import numpy as np
 
-from powertrain.kernels.newmark import (modal_trapezoid_kernel, newmark_kernel,
-                                        newmark_port_kernel)
+from powertrain.kernels.newmark import modal_trapezoid_kernel, newmark_kernel, newmark_port_kernel
 
 
 def _prepare(M, C, K, h):

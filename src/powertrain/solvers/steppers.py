@@ -251,7 +251,7 @@ class DenseNewmarkStepper(_NewmarkStepper):
             Z = None
         else:
             z0 = self.ports.describing_forces(amplitudes, qh @ self.ports.rows.T).real.sum(0)
-            X, V, A, Z = newmark_ports(s.M, s.C, s.K, F, h, self.ports, x0, v0, None, z0)
+            X, V, A, Z = newmark_ports(s.M, s.C, s.K, F, h, self.ports, x0, v0, a0, z0)
         seconds = time.perf_counter() - t0
         n = g.n_cycle
         win = slice(g.start, g.start + g.processed_cycles * n)
