@@ -12,10 +12,11 @@ of state (its memory, e.g. the friction element's reversal point), dispatched he
 * :func:`commit_state` updates the state once the step has converged.
 
 A new law adds its code, one branch in each of the two functions and its Python element type
-(:mod:`powertrain.physics.mount_elements`); the Newmark kernel
-(:func:`powertrain.kernels.newmark.newmark_port_kernel`) does not change.
+(:mod:`powertrain.physics.mount_elements`); the Newmark kernel with port laws
+(:func:`newmark_port_kernel`, here because kernels import no other kernel) does not change.
 """
 
+import numpy as np
 from numba import njit
 
 #: No force (a linear element has no port law; kept so that code 0 is harmless).
@@ -62,3 +63,115 @@ def port_force_loop(kinds, par, state, U, V, F):
         for e in range(kinds.shape[0]):
             F[t, e] = port_force(kinds[e], U[t, e], V[t, e], par[e], state[e])[0]
             commit_state(kinds[e], U[t, e], V[t, e], par[e], state[e])
+
+
+@njit(cache=True, nogil=True)
+def newmark_port_kernel(G, H, Fs, h, x0, v0, a0, W, P, Q, kinds, par, state, X, V, A, Z,
+                        tol, max_iter):
+    r"""Newmark average acceleration with port laws in parallel with the linear model:
+    :math:`\mathbf M\ddot{\mathbf x} + \mathbf C\dot{\mathbf x} + \mathbf K\mathbf x
+    + \mathbf P^T\mathbf z = \mathbf f`, :math:`z_e = f_e(\mathbf p_e\cdot\mathbf x,
+    \mathbf p_e\cdot\dot{\mathbf x})` (:mod:`powertrain.kernels.port_forces`).
+
+    The linear step gives :math:`\ddot{\mathbf x}_{lin}` as in
+    :func:`powertrain.kernels.newmark.newmark_kernel`; with
+    the port forces :math:`\ddot{\mathbf x} = \ddot{\mathbf x}_{lin} - \mathbf W\mathbf z`,
+    :math:`\mathbf W = \mathbf S^{-1}\mathbf P^T`, so the port motions are
+    :math:`\mathbf u = \mathbf u_{lin} - \tfrac{h^2}{4}\mathbf Q\mathbf z`,
+    :math:`\dot{\mathbf u} = \dot{\mathbf u}_{lin} - \tfrac h2\mathbf Q\mathbf z`,
+    :math:`\mathbf Q = \mathbf P\mathbf W`. Newton solves the m equations
+    :math:`z_e = f_e(u_e, \dot u_e)` per step (Jacobian
+    :math:`\mathbf I + \mathrm{diag}(\tfrac{h^2}{4}k_t + \tfrac h2 c_t)\mathbf Q`), from the
+    previous step's forces; the states are committed once it has converged.
+
+    Parameters
+    ----------
+    G, H, Fs, h, x0, v0, a0, X, V, A
+        As :func:`newmark_kernel`.
+    W : ndarray (n, m)
+        S^-1 P^T.
+    P : ndarray (m, n)
+        Port rows: relative displacement across each port law per unit coordinate.
+    Q : ndarray (m, m)
+        P S^-1 P^T.
+    kinds : ndarray int64 (m,)
+        Port-law codes.
+    par : ndarray (m, n_par)
+        Their parameters.
+    state : ndarray (m, n_state)
+        Their state, updated in place (the state after the last step).
+    Z : ndarray (n_steps + 1, m)
+        Output: port forces at every time point [N].
+    tol : float
+        Newton stops when every residual is below ``tol`` times (1 + the largest force).
+    max_iter : int
+
+    Returns
+    -------
+    int
+        Steps at which Newton did not converge (0 on success).
+    """
+    n = x0.shape[0]
+    m = kinds.shape[0]
+    ns = Fs.shape[0]
+    hh = 0.25 * h * h
+    hv = 0.5 * h
+    xt = np.empty(n)
+    vt = np.empty(n)
+    ul = np.empty(m)
+    vl = np.empty(m)
+    z = np.empty(m)
+    r = np.empty(m)
+    J = np.empty((m, m))
+    failed = 0
+    for j in range(n):
+        X[0, j] = x0[j]
+        V[0, j] = v0[j]
+        A[0, j] = a0[j]
+    for e in range(m):
+        z[e] = port_force(kinds[e], P[e] @ x0, P[e] @ v0, par[e], state[e])[0]
+        Z[0, e] = z[e]
+    for k in range(1, ns):
+        for j in range(n):
+            xt[j] = X[k - 1, j] + h * V[k - 1, j] + hh * A[k - 1, j]
+            vt[j] = V[k - 1, j] + hv * A[k - 1, j]
+        for i in range(n):
+            s = Fs[k, i]
+            for j in range(n):
+                s -= G[i, j] * vt[j] + H[i, j] * xt[j]
+            A[k, i] = s
+        for e in range(m):
+            ul[e] = 0.0
+            vl[e] = 0.0
+            for j in range(n):
+                ul[e] += P[e, j] * (xt[j] + hh * A[k, j])
+                vl[e] += P[e, j] * (vt[j] + hv * A[k, j])
+        converged = False
+        for _ in range(max_iter):
+            big = 1.0
+            worst = 0.0
+            for e in range(m):
+                qz = Q[e] @ z
+                f, kt, ct = port_force(kinds[e], ul[e] - hh * qz, vl[e] - hv * qz, par[e],
+                                       state[e])
+                r[e] = f - z[e]
+                big = max(big, abs(z[e]))
+                worst = max(worst, abs(r[e]))
+                for j in range(m):
+                    J[e, j] = (hh * kt + hv * ct) * Q[e, j]
+                J[e, e] += 1.0
+            if worst <= tol * big:
+                converged = True
+                break
+            z += np.linalg.solve(J, r)
+        if not converged:
+            failed += 1
+        for e in range(m):
+            qz = Q[e] @ z
+            commit_state(kinds[e], ul[e] - hh * qz, vl[e] - hv * qz, par[e], state[e])
+            Z[k, e] = z[e]
+        for j in range(n):
+            A[k, j] -= W[j] @ z
+            X[k, j] = xt[j] + hh * A[k, j]
+            V[k, j] = vt[j] + hv * A[k, j]
+    return failed

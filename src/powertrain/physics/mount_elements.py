@@ -14,7 +14,7 @@ between the engine-side node and the base node, acting on their relative displac
   nothing; a static force–deflection curve is a separate matter (issue 20's operating point);
 * the time domain: the port law's **kernel arrays** (kind code, parameters, initial state,
   :class:`PortForces`), integrated with the linear model by
-  :func:`powertrain.kernels.newmark.newmark_port_kernel` (Newton per step over plain arrays).
+  :func:`powertrain.kernels.port_forces.newmark_port_kernel` (Newton per step over plain arrays).
 
 A port law is an object with ``kind`` (its code in :mod:`powertrain.kernels.port_forces`),
 ``parameters()`` (float array), ``initial_state(u0, f0)`` (float array: the memory at the

@@ -15,7 +15,8 @@ import threading
 
 import numpy as np
 
-from powertrain.kernels.newmark import modal_trapezoid_kernel, newmark_kernel, newmark_port_kernel
+from powertrain.kernels.newmark import modal_trapezoid_kernel, newmark_kernel
+from powertrain.kernels.port_forces import newmark_port_kernel
 
 
 def _prepare(M, C, K, h):
@@ -87,7 +88,7 @@ PORT_MAX_ITER = 50
 def newmark_ports(M, C, K, F, h, ports, x0=None, v0=None, a0=None, z0=None):
     """:func:`newmark` with the port laws ``ports``
     (:class:`~powertrain.physics.mount_elements.PortForces`) in parallel with the linear
-    model: :func:`powertrain.kernels.newmark.newmark_port_kernel`, Newton per step. The
+    model: :func:`powertrain.kernels.port_forces.newmark_port_kernel`, Newton per step. The
     laws start from the state carrying the forces ``z0`` (m,) [N] (default: unloaded).
 
     Returns
