@@ -66,6 +66,41 @@ def port_force_loop(kinds, par, state, U, V, F):
 
 
 @njit(cache=True, nogil=True)
+def _dot(a, b):
+    """Dot product of two short vectors (a loop: no BLAS call per step)."""
+    s = 0.0
+    for i in range(a.shape[0]):
+        s += a[i] * b[i]
+    return s
+
+
+@njit(cache=True, nogil=True)
+def _solve_in_place(J, r):
+    """Solve ``J x = r`` (small, dense) by Gaussian elimination with partial pivoting;
+    ``x`` overwrites ``r``, ``J`` is destroyed (no allocation per call)."""
+    m = r.shape[0]
+    for c in range(m):
+        p = c
+        for i in range(c + 1, m):
+            if abs(J[i, c]) > abs(J[p, c]):
+                p = i
+        if p != c:
+            for j in range(c, m):
+                J[c, j], J[p, j] = J[p, j], J[c, j]
+            r[c], r[p] = r[p], r[c]
+        for i in range(c + 1, m):
+            f = J[i, c] / J[c, c]
+            for j in range(c, m):
+                J[i, j] -= f * J[c, j]
+            r[i] -= f * r[c]
+    for i in range(m - 1, -1, -1):
+        s = r[i]
+        for j in range(i + 1, m):
+            s -= J[i, j] * r[j]
+        r[i] = s / J[i, i]
+
+
+@njit(cache=True, nogil=True)
 def newmark_port_kernel(G, H, Fs, h, x0, v0, a0, W, P, Q, kinds, par, state, X, V, A, Z,
                         tol, max_iter):
     r"""Newmark average acceleration with port laws in parallel with the linear model:
@@ -129,7 +164,7 @@ def newmark_port_kernel(G, H, Fs, h, x0, v0, a0, W, P, Q, kinds, par, state, X, 
         V[0, j] = v0[j]
         A[0, j] = a0[j]
     for e in range(m):
-        z[e] = port_force(kinds[e], P[e] @ x0, P[e] @ v0, par[e], state[e])[0]
+        z[e] = port_force(kinds[e], _dot(P[e], x0), _dot(P[e], v0), par[e], state[e])[0]
         Z[0, e] = z[e]
     for k in range(1, ns):
         for j in range(n):
@@ -151,7 +186,7 @@ def newmark_port_kernel(G, H, Fs, h, x0, v0, a0, W, P, Q, kinds, par, state, X, 
             big = 1.0
             worst = 0.0
             for e in range(m):
-                qz = Q[e] @ z
+                qz = _dot(Q[e], z)
                 f, kt, ct = port_force(kinds[e], ul[e] - hh * qz, vl[e] - hv * qz, par[e],
                                        state[e])
                 r[e] = f - z[e]
@@ -163,15 +198,17 @@ def newmark_port_kernel(G, H, Fs, h, x0, v0, a0, W, P, Q, kinds, par, state, X, 
             if worst <= tol * big:
                 converged = True
                 break
-            z += np.linalg.solve(J, r)
+            _solve_in_place(J, r)
+            for e in range(m):
+                z[e] += r[e]
         if not converged:
             failed += 1
         for e in range(m):
-            qz = Q[e] @ z
+            qz = _dot(Q[e], z)
             commit_state(kinds[e], ul[e] - hh * qz, vl[e] - hv * qz, par[e], state[e])
             Z[k, e] = z[e]
         for j in range(n):
-            A[k, j] -= W[j] @ z
+            A[k, j] -= _dot(W[j], z)
             X[k, j] = xt[j] + hh * A[k, j]
             V[k, j] = vt[j] + hv * A[k, j]
     return failed

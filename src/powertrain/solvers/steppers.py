@@ -30,7 +30,7 @@ import numpy as np
 
 from powertrain.analysis.fourier import harmonic_amplitudes
 from powertrain.analysis.orders import ORDERS, order_spectrum
-from powertrain.solvers.equivalent_linear import amplitude_fixed_point
+from powertrain.solvers.equivalent_linear import AMPLITUDE_HARMONICS, amplitude_fixed_point
 from powertrain.solvers.harmonic import harmonic_response
 from powertrain.solvers.newmark import ModalNewmark, newmark, newmark_ports
 
@@ -97,11 +97,15 @@ class Stepper:
 
     def harmonic_state(self, fh, omegas, omega):
         """Harmonic response (n_h, n_dof) of the (equivalent-linear) model and the
-        nonlinear elements' amplitudes (None: linear model)."""
+        nonlinear elements' amplitudes (None: linear model). The fixed point iterates on
+        the harmonics that make the amplitudes only; one solve of all follows."""
         s = self.system
-        A, qh = self.equivalent_linear(lambda a: harmonic_response(s, fh, omegas, a),
-                                       lambda q: q @ self.ports.rows.T, omega)
-        return qh, A
+        if self.ports is None:
+            return harmonic_response(s, fh, omegas), None
+        k = AMPLITUDE_HARMONICS.stop
+        A = self.equivalent_linear(lambda a: harmonic_response(s, fh[:k], omegas[:k], a),
+                                   lambda q: q @ self.ports.rows.T, omega)[0]
+        return harmonic_response(s, fh, omegas, self.ports.network_amplitudes(A)), A
 
     def harmonics(self, load, omega, max_order=None):
         """Load harmonics of the cycle (index j is order j/2) and their frequencies."""
