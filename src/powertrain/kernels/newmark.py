@@ -106,4 +106,3 @@ def modal_trapezoid_kernel(lam_d, gain, G, n_steps, eta0, keep_from, out_re, out
             for j in range(m):
                 out_re[k - keep_from, j] = eta[j].real
                 out_im[k - keep_from, j] = eta[j].imag
-
