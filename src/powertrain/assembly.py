@@ -20,6 +20,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from powertrain.physics.condensation import NetworkPorts, condense
+from powertrain.physics.mount_elements import PortForces, port_forces
 from powertrain.physics.mount_network import ground_force_rows
 from powertrain.physics.rigid_body import direction_row, point_motion_matrix, rigid_body_mass_matrix
 
@@ -54,7 +55,8 @@ class AssembledSystem:
         Maps q (or q', q'') to the motion of the mount points in engine X/Y/Z.
     force_matrix_k, force_matrix_d : ndarray (3 n_mounts, n)
         Force transmitted by each mount to ground in engine axes:
-        F = force_matrix_k @ q + force_matrix_d @ q'.
+        F = force_matrix_k @ q + force_matrix_d @ q' (+ ``port_force_map`` @ the port
+        laws' forces, :meth:`port_forces`).
     dof_labels : list of str
     """
 
@@ -67,7 +69,7 @@ class AssembledSystem:
     force_matrix_d: np.ndarray
     dof_labels: list = field(default_factory=list)
     #: per network: (row (6,) mapping q_rb to the engine-side node, first internal dof,
-    #: number of internal dofs, MountModel)
+    #: number of internal dofs, MountElement)
     networks: list = field(default_factory=list)
     #: the body under the mounts (None or rigid: fixed base)
     chassis: object = None
@@ -79,6 +81,10 @@ class AssembledSystem:
     mount_axes: list = field(default_factory=list)
     #: the networks on the retained coordinates (None: nothing to condense)
     network_ports: NetworkPorts | None = None
+    #: per network: relative displacement engine side minus base per unit q, (n_net, n)
+    port_rows: np.ndarray | None = None
+    #: transmitted-force channels per unit force across each network, (n_ch, n_net)
+    port_force_map: np.ndarray | None = None
 
     def __post_init__(self):
         if not self.body_start:
@@ -113,6 +119,10 @@ class AssembledSystem:
         self.channel_matrix = np.vstack([self.channel_matrix] + rows)
         self.force_matrix_k = np.vstack([self.force_matrix_k] + frows_k)
         self.force_matrix_d = np.vstack([self.force_matrix_d] + frows_d)
+        if self.port_force_map is not None:
+            Pf = self.port_force_map
+            self.port_force_map = np.vstack([Pf, Pf, np.zeros((3 * len(chassis.points),
+                                                               Pf.shape[1]))])
 
     def _body_rows(self, chassis, name, n):
         rows = np.zeros((3, n))
@@ -122,6 +132,19 @@ class AssembledSystem:
     @property
     def n_dof(self) -> int:
         return self.M.shape[0]
+
+    @property
+    def network_names(self) -> list:
+        """``mount.direction`` of every network, in order."""
+        return [f"{m}.{a}" for m in self.mount_names for a in DIRECTIONS]
+
+    def port_forces(self) -> PortForces | None:
+        """The nonlinear elements' port laws as kernel arrays; None: the model is linear
+        (:mod:`powertrain.physics.mount_elements`)."""
+        if self.port_rows is None:
+            return None
+        return port_forces([el for *_, el in self.networks], self.port_rows,
+                           self.port_force_map, self.network_names)
 
     def ports(self) -> NetworkPorts:
         """The networks on the retained coordinates (:mod:`powertrain.physics.condensation`);
@@ -176,7 +199,7 @@ def assemble(mass, cg, inertia, mounts, chassis=None) -> AssembledSystem:
     body_modes = chassis.body_modes if chassis is not None else ()
     modal = bool(body_modes)
     blocks, labels = _network_blocks(mounts, cg, modal)
-    body0 = 6 + sum(kg.size - 1 for _, _, _, _, kg, _, _, _ in blocks)
+    body0 = 6 + sum(b[4].size - 1 for b in blocks)
     n = body0 + len(body_modes)
     retained = np.r_[np.arange(6), np.arange(body0, n)].astype(int)
     frame = _frame(mass, inertia, body_modes)
@@ -185,20 +208,22 @@ def assemble(mass, cg, inertia, mounts, chassis=None) -> AssembledSystem:
     n_m = len(mounts)
     Fk, Fd = np.zeros((3 * n_m, n)), np.zeros((3 * n_m, n))
     shapes = {m.name: chassis.body_rows(m.name) for m in mounts} if modal else {}
-    networks, base_rows = _add_networks((M, C, K, Fk, Fd), blocks, mounts, shapes, body0)
+    networks, base_rows, port_rows, port_map = _add_networks((M, C, K, Fk, Fd), blocks, mounts,
+                                                             shapes, body0)
     for X, X0 in zip((M, C, K), frame):
         X[np.ix_(retained, retained)] += X0
     channels = [(m.name, a) for m in mounts for a in DIRECTIONS]
     Cm = np.zeros((3 * n_m, n))
     for mi, mount in enumerate(mounts):
         Cm[3 * mi:3 * mi + 3, :6] = point_motion_matrix(np.asarray(mount.position, float) - cg)
-    system = AssembledSystem(M, C, K, channels, Cm, Fk, Fd, labels, networks)
+    system = AssembledSystem(M, C, K, channels, Cm, Fk, Fd, labels, networks,
+                             port_rows=port_rows, port_force_map=port_map)
     system.mount_axes = [np.asarray(m.rotation, float) for m in mounts]
     system.network_ports = NetworkPorts(
         retained, frame, np.array([np.r_[b[0], np.zeros(len(body_modes))] for b in blocks]
                                   ).reshape(-1, retained.size),
         np.array(base_rows)[:, retained].reshape(-1, retained.size),
-        [(st, ni) for _, st, ni, _ in networks], [mod for *_, mod in networks])
+        [(st, ni) for _, st, ni, _ in networks], [el for *_, el in networks])
     if chassis is not None and not chassis.is_rigid:
         system.add_body_side(chassis, [m.name for m in mounts], body0)
     return system
@@ -206,12 +231,14 @@ def assemble(mass, cg, inertia, mounts, chassis=None) -> AssembledSystem:
 
 def _add_networks(matrices, blocks, mounts, shapes, body0):
     """Add every network to the global M, C, K and its transmitted force to the force rows
-    ``Fk``, ``Fd`` (in place); returns the network list and each network's base row (the
-    body motion under its base node; zero on the ground)."""
+    ``Fk``, ``Fd`` (in place); returns the network list, each network's base row (the
+    body motion under its base node; zero on the ground), its port row (engine side minus
+    base) and its force-map column (the mount axis on the mount's force rows)."""
     M, C, K, Fk, Fd = matrices
     n = M.shape[0]
     start, networks, base_rows = 6, [], []
-    for row, Mn, Cn, Kn, kg, dg, mi, ai in blocks:
+    port_map = np.zeros((Fk.shape[0], len(blocks)))
+    for k, (row, Mn, Cn, Kn, kg, dg, mi, ai, element) in enumerate(blocks):
         ni = kg.size - 1
         e = np.asarray(mounts[mi].rotation, float)[:, ai]
         L = np.zeros((Mn.shape[0], n))
@@ -225,26 +252,30 @@ def _add_networks(matrices, blocks, mounts, shapes, body0):
         base = L[ni + 1] if shapes else np.zeros(n)
         Fk[3 * mi:3 * mi + 3] += np.outer(e, kg @ L[:ni + 1] - kg.sum() * base)
         Fd[3 * mi:3 * mi + 3] += np.outer(e, dg @ L[:ni + 1] - dg.sum() * base)
-        networks.append((row, start, ni, mounts[mi].directions[DIRECTIONS[ai]]))
+        port_map[3 * mi:3 * mi + 3, k] = e
+        networks.append((row, start, ni, element))
         base_rows.append(base)
         start += ni
-    return networks, base_rows
+    port_rows = np.zeros((len(blocks), n))
+    port_rows[:, :6] = [b[0] for b in blocks]
+    return networks, base_rows, port_rows - np.array(base_rows).reshape(-1, n), port_map
 
 
 def _network_blocks(mounts, cg, with_ground):
     """Per network: (engine-side row, its M, C, K, ground-force rows kg, dg, mount index,
-    axis index), and the labels of the coordinates (rigid body, then internal nodes)."""
+    axis index, element), and the labels of the coordinates (rigid body, then internal
+    nodes)."""
     blocks = []
     labels = ["u_x", "u_y", "u_z", "theta_x", "theta_y", "theta_z"]
     for mi, mount in enumerate(mounts):
         r = np.asarray(mount.position, float) - cg
         R = np.asarray(mount.rotation, float)
         for ai, axis in enumerate(DIRECTIONS):
-            model = mount.directions[axis]
-            Mn, Cn, Kn = model.matrices(include_ground=with_ground)
-            masses, elem_nodes, c, d = model.network()
+            element = mount.directions[axis].element()
+            Mn, Cn, Kn = element.matrices(include_ground=with_ground)
+            masses, elem_nodes, c, d = element.network()
             kg, dg = ground_force_rows(masses.size, elem_nodes, c, d)
-            blocks.append((direction_row(r, R[:, ai]), Mn, Cn, Kn, kg, dg, mi, ai))
+            blocks.append((direction_row(r, R[:, ai]), Mn, Cn, Kn, kg, dg, mi, ai, element))
             labels += [f"{mount.name}.{axis}.m{j + 1}" for j in range(masses.size)]
     return blocks, labels
 

@@ -40,6 +40,7 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from powertrain.physics import mount_network as net
+from powertrain.physics.mount_elements import MountElement
 
 
 @dataclass(frozen=True)
@@ -150,6 +151,9 @@ class MountModel:
         Parameter values in SI: c [N/m], d [N·s/m], m [kg].
     name, source, notes : str
         Metadata carried from the mount file.
+    port_law : object, optional
+        A nonlinear force in parallel with the network between its engine-side and base
+        nodes (:mod:`powertrain.physics.mount_elements`); None: the linear network.
     """
 
     topology: Topology
@@ -157,6 +161,7 @@ class MountModel:
     name: str = ""
     source: str = ""
     notes: str = ""
+    port_law: object = None
 
     def __post_init__(self):
         missing = [p for p in self.topology.parameters if p not in self.params]
@@ -182,6 +187,10 @@ class MountModel:
         c = np.array([self.params[e[2]] if e[2] else 0.0 for e in t.elements], dtype=float)
         d = np.array([self.params[e[3]] if e[3] else 0.0 for e in t.elements], dtype=float)
         return masses, t.elem_nodes, c, d
+
+    def element(self) -> MountElement:
+        """The element the assembled model holds for this direction."""
+        return MountElement(self, self.port_law)
 
     def cross_point_stiffness(self, frequency_hz) -> np.ndarray:
         """Cross-point dynamic stiffness K_CP [N/m] at ``frequency_hz`` [Hz] (eq. 39)."""

@@ -26,8 +26,6 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from powertrain.physics.mount_network import laplace_two_port
-
 
 @dataclass(frozen=True)
 class NetworkPorts:
@@ -43,8 +41,9 @@ class NetworkPorts:
         :math:`\\mathbf p_E`, :math:`\\mathbf p_B` per network (base rows zero: ground).
     internal : list of (start, n_internal)
         Each network's internal coordinates in the full numbering.
-    models : list
-        Each network's model (``network()`` gives masses, nodes, c, d).
+    elements : list
+        Each network's :class:`~powertrain.physics.mount_elements.MountElement` (its
+        ``two_port(s, amplitude, internal)``).
     """
 
     retained: np.ndarray
@@ -52,21 +51,24 @@ class NetworkPorts:
     engine_rows: np.ndarray
     base_rows: np.ndarray
     internal: list
-    models: list
+    elements: list
 
     @property
     def grounded(self) -> bool:
         return not np.any(self.base_rows)
 
 
-def two_ports(ports: NetworkPorts, s, internal=False):
+def two_ports(ports: NetworkPorts, s, internal=False, amplitudes=None):
     """``(a, b, c)`` each ``s.shape + (n_net,)`` of every network at ``s`` (and the list of
-    internal motions per network when ``internal``)."""
+    internal motions per network when ``internal``): each element's equivalent-linear
+    two-port at its relative-displacement amplitude (``amplitudes`` (n_net,) [m]; None:
+    zero, which a linear element ignores)."""
     s = np.asarray(s, complex)
-    abc = [np.empty(s.shape + (len(ports.models),), complex) for _ in range(3)]
+    abc = [np.empty(s.shape + (len(ports.elements),), complex) for _ in range(3)]
     shapes = []
-    for k, model in enumerate(ports.models):
-        res = laplace_two_port(s, *model.network(), internal=internal)
+    for k, element in enumerate(ports.elements):
+        res = element.two_port(s, 0.0 if amplitudes is None else amplitudes[k],
+                               internal=internal)
         for j in range(3):
             abc[j][..., k] = res[j]
         if internal:
@@ -135,7 +137,7 @@ def _retained_matrix(ports, abc, s):
                             None if ports.grounded else ports.base_rows, abc, s)
 
 
-def harmonic_solve(system, load_harmonics, omegas):
+def harmonic_solve(system, load_harmonics, omegas, amplitudes=None):
     r"""Steady-state amplitudes of every coordinate under a load on the rigid body:
     :math:`\mathbf D_R(i\omega)\hat{\mathbf q}_R = \hat{\mathbf f}`, then each network's
     internal motion from its engine-side and base motion.
@@ -147,6 +149,9 @@ def harmonic_solve(system, load_harmonics, omegas):
         Amplitudes of the 6-vector load [N, N·m].
     omegas : ndarray (n_h,)
         Angular frequency of each harmonic [rad/s].
+    amplitudes : ndarray (n_net,), optional
+        Relative-displacement amplitude of every network [m], for the equivalent-linear
+        two-port of a nonlinear element (:mod:`powertrain.physics.mount_elements`).
 
     Returns
     -------
@@ -154,7 +159,7 @@ def harmonic_solve(system, load_harmonics, omegas):
     """
     ports = system.ports()
     s = 1j * np.asarray(omegas, float)
-    abc, shapes = two_ports(ports, s, internal=True)
+    abc, shapes = two_ports(ports, s, internal=True, amplitudes=amplitudes)
     D = _retained_matrix(ports, abc, s)
     rhs = np.zeros(s.shape + (ports.retained.size,), complex)
     rhs[:, :6] = load_harmonics

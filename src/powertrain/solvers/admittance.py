@@ -44,8 +44,10 @@ def _attachment_ports(system):
     return frame, E, B
 
 
-def frf_response(system, load_harmonics, omegas):
-    """Harmonic response with a measured-receptance body.
+def frf_response(system, load_harmonics, omegas, amplitudes=None):
+    """Harmonic response with a measured-receptance body (nonlinear elements at their
+    equivalent-linear two-port at ``amplitudes`` (n_net,) [m], as
+    :func:`powertrain.physics.condensation.harmonic_solve`).
 
     Returns
     -------
@@ -62,7 +64,7 @@ def frf_response(system, load_harmonics, omegas):
     omegas = np.asarray(omegas, float)
     s = 1j * omegas
     frame, E, B = _attachment_ports(system)
-    abc, shapes = two_ports(system.ports(), s, internal=True)
+    abc, shapes = two_ports(system.ports(), s, internal=True, amplitudes=amplitudes)
     D = condensed_matrix(frame, E, B, abc, s)                  # (n_h, 6 + n_a, 6 + n_a)
     G = chassis.receptances(omegas, mounts, mounts)
     A = D.copy()
@@ -81,3 +83,12 @@ def frf_response(system, load_harmonics, omegas):
     body = np.hstack([sol[:, 6:], np.einsum("hij,hj->hi", chassis.receptances(
         omegas, list(chassis.points), mounts), fb)]) if chassis.points else sol[:, 6:]
     return out_q, body, fb
+
+
+def relative_motion(system, index, q, body):
+    """Relative displacement engine side minus body side across the networks ``index``
+    (n_h, len(index)) of an :func:`frf_response` solution ``q``, ``body``."""
+    axes = np.array([system.mount_axes[k // 3][:, k % 3] for k in index])
+    rows = np.array([system.networks[k][0] for k in index])
+    attach = np.stack([body[:, 3 * (k // 3):3 * (k // 3) + 3] for k in index], axis=1)
+    return q[:, :6] @ rows.T - np.einsum("hki,ki->hk", attach, axes)

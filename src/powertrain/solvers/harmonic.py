@@ -25,7 +25,7 @@ from __future__ import annotations
 from powertrain.physics.condensation import harmonic_solve
 
 
-def harmonic_response(system, load_harmonics, omegas):
+def harmonic_response(system, load_harmonics, omegas, amplitudes=None):
     """Complex amplitudes of q for each load harmonic (condensed solve).
 
     Parameters
@@ -35,9 +35,12 @@ def harmonic_response(system, load_harmonics, omegas):
         Amplitudes of the 6-vector load [N, N·m] (index 0 = mean).
     omegas : ndarray (n_h,)
         Angular frequency of each harmonic [rad/s].
+    amplitudes : ndarray (n_net,), optional
+        Relative-displacement amplitude of every network [m]: nonlinear elements act
+        through their equivalent-linear two-port there.
 
     Returns
     -------
     ndarray (n_h, n_dof) complex
     """
-    return harmonic_solve(system, load_harmonics, omegas)
+    return harmonic_solve(system, load_harmonics, omegas, amplitudes)

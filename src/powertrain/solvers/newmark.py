@@ -1,6 +1,8 @@
 r"""Public Newmark average-acceleration integrator and its periodic steady state.
 
-:func:`newmark` validates, allocates and calls :func:`powertrain.kernels.newmark.newmark_kernel`.
+:func:`newmark` validates, allocates and calls :func:`powertrain.kernels.newmark.newmark_kernel`;
+:func:`newmark_ports` the same with nonlinear port laws in parallel with the linear model
+(:mod:`powertrain.physics.mount_elements`), Newton per step inside the kernel.
 :func:`periodic_state` finds the exactly periodic steady state of the *discrete* Newmark
 recurrence under a periodic load (shooting: the one-period map :math:`z \mapsto \Phi z + g`
 is affine, so :math:`z_0 = (I-\Phi)^{-1} g`), so time-domain results need no transient to die
@@ -14,6 +16,7 @@ import threading
 import numpy as np
 
 from powertrain.kernels.newmark import modal_trapezoid_kernel, newmark_kernel
+from powertrain.kernels.port_forces import newmark_port_kernel
 
 
 def _prepare(M, C, K, h):
@@ -50,24 +53,72 @@ def newmark(M, C, K, F, h, x0=None, v0=None, a0=None):
     X, V, A : ndarray (n_steps + 1, n)
     """
     Sinv, G, H = _prepare(M, C, K, h)
-    F = np.asarray(F, dtype=float)
-    n = G.shape[0]
-    if F.ndim != 2 or F.shape[1] != n:
-        raise ValueError("F must have shape (n_steps + 1, n)")
-    x0 = np.zeros(n) if x0 is None else np.asarray(x0, float).copy()
-    v0 = np.zeros(n) if v0 is None else np.asarray(v0, float).copy()
-    if a0 is None:
-        try:
-            a0 = np.linalg.solve(M, F[0] - C @ v0 - K @ x0)
-        except np.linalg.LinAlgError:
-            a0 = np.zeros(n)
-    a0 = np.asarray(a0, float).copy()
-    Fs = np.ascontiguousarray(F @ Sinv.T)
+    Fs, x0, v0, a0 = _start(M, C, K, F, Sinv, x0, v0, a0)
     X = np.empty_like(Fs)
     V = np.empty_like(Fs)
     A = np.empty_like(Fs)
     newmark_kernel(G, H, Fs, float(h), x0, v0, a0, X, V, A)
     return X, V, A
+
+
+def _start(M, C, K, F, Sinv, x0, v0, a0, port_force=None):
+    """Pre-multiplied loads and the initial state (``a0`` consistent when omitted, with
+    the port forces ``port_force`` (n,) on the left-hand side)."""
+    F = np.asarray(F, dtype=float)
+    n = Sinv.shape[0]
+    if F.ndim != 2 or F.shape[1] != n:
+        raise ValueError("F must have shape (n_steps + 1, n)")
+    x0 = np.zeros(n) if x0 is None else np.asarray(x0, float).copy()
+    v0 = np.zeros(n) if v0 is None else np.asarray(v0, float).copy()
+    if a0 is None:
+        inner = 0.0 if port_force is None else port_force
+        try:
+            a0 = np.linalg.solve(M, F[0] - C @ v0 - K @ x0 - inner)
+        except np.linalg.LinAlgError:
+            a0 = np.zeros(n)
+    return np.ascontiguousarray(F @ Sinv.T), x0, v0, np.asarray(a0, float).copy()
+
+
+#: Newton tolerance of the port laws per step (relative to 1 + the largest port force [N])
+#: and its iteration limit; a piecewise-linear law converges in a few iterations.
+PORT_TOL = 1e-10
+PORT_MAX_ITER = 50
+
+
+def newmark_ports(M, C, K, F, h, ports, x0=None, v0=None, a0=None, z0=None):
+    """:func:`newmark` with the port laws ``ports``
+    (:class:`~powertrain.physics.mount_elements.PortForces`) in parallel with the linear
+    model: :func:`powertrain.kernels.port_forces.newmark_port_kernel`, Newton per step. The
+    laws start from the state carrying the forces ``z0`` (m,) [N] (default: unloaded).
+
+    Returns
+    -------
+    X, V, A : ndarray (n_steps + 1, n)
+    Z : ndarray (n_steps + 1, m)
+        Port forces [N] (positive: pushing the base along the port row).
+
+    Raises
+    ------
+    FloatingPointError
+        Newton did not converge at some step (the names of the port laws are given).
+    """
+    Sinv, G, H = _prepare(M, C, K, h)
+    P = np.ascontiguousarray(ports.rows, float)
+    x0 = np.zeros(P.shape[1]) if x0 is None else x0
+    v0 = np.zeros(P.shape[1]) if v0 is None else v0
+    state = ports.initial_state(x0, z0)
+    z0 = ports.forces(P @ x0, P @ v0, state)
+    Fs, x0, v0, a0 = _start(M, C, K, F, Sinv, x0, v0, a0, P.T @ z0)
+    W = np.ascontiguousarray(Sinv @ P.T)
+    X, V, A = (np.empty_like(Fs) for _ in range(3))
+    Z = np.empty((Fs.shape[0], P.shape[0]))
+    failed = newmark_port_kernel(G, H, Fs, float(h), x0, v0, a0, W, P,
+                                 np.ascontiguousarray(P @ W), ports.kinds, ports.parameters,
+                                 state, X, V, A, Z, PORT_TOL, PORT_MAX_ITER)
+    if failed:
+        raise FloatingPointError(f"port laws {', '.join(ports.names)}: Newton did not converge "
+                                 f"at {failed} of {Fs.shape[0] - 1} steps")
+    return X, V, A, Z
 
 
 def periodic_state(M, C, K, F_period, h):

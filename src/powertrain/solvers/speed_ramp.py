@@ -66,6 +66,14 @@ def _load_at(speeds, table, n_theta, rpm, theta):
     return a * (1 - fv) + b * fv
 
 
+def _require_linear(system):
+    """The sweep's modal recurrence holds no port law (nonlinear mount element)."""
+    ports = system.port_forces()
+    if ports is not None:
+        raise ValueError(f"the continuous sweep integrates linear mounts only "
+                         f"({', '.join(ports.names)} nonlinear)")
+
+
 def simulate_sweep(engine, rpm_from, rpm_to, rate_rpm_per_s, sample_rate=8192.0, *,
                    system=None, progress=False) -> RawRecording:
     """Simulate a continuous linear run-up; mount-point accelerations as raw time data.
@@ -97,6 +105,7 @@ def simulate_sweep(engine, rpm_from, rpm_to, rate_rpm_per_s, sample_rate=8192.0,
     if system is None:
         b = engine.body
         system = assemble(b.mass, b.cg, b.inertia, engine.mounts)
+    _require_linear(system)
     speeds, table, n_theta = _load_table(engine, rpm_from, rpm_to)
     modal = ModalNewmark(system.M, system.C, system.K, load_dofs=6)
     Z = np.zeros_like(system.channel_matrix)

@@ -12,8 +12,13 @@ every channel (:class:`SpeedOrders`). Four implement it:
 * :class:`DenseNewmarkStepper` — the same recurrence in physical coordinates (Numba kernel).
 
 :func:`choose_stepper` picks one from the solver and stepper names and the chassis (which
-says whether it can be integrated in time). A time stepper sees the assembled model only
-through ``system.M``, ``C``, ``K`` and its output rows; the mount elements enter there.
+says whether it can be integrated in time). A time stepper sees the assembled model through
+``system.M``, ``C``, ``K``, its output rows and, when some mount element is nonlinear, the
+elements' port laws (``system.port_forces()``, :mod:`powertrain.physics.mount_elements`):
+the dense Newmark stepper integrates them (Newton per step in the kernel), the modal one
+refuses them, and the frequency-domain steppers solve the equivalent-linear model at the
+elements' amplitudes (:mod:`powertrain.solvers.equivalent_linear`). No stepper asks which
+element it holds.
 """
 
 from __future__ import annotations
@@ -25,8 +30,9 @@ import numpy as np
 
 from powertrain.analysis.fourier import harmonic_amplitudes
 from powertrain.analysis.orders import ORDERS, order_spectrum
+from powertrain.solvers.equivalent_linear import AMPLITUDE_HARMONICS, amplitude_fixed_point
 from powertrain.solvers.harmonic import harmonic_response
-from powertrain.solvers.newmark import ModalNewmark, newmark
+from powertrain.solvers.newmark import ModalNewmark, newmark, newmark_ports
 
 #: Highest order in the frequency-domain initial-state estimate of the Newmark run (the
 #: stepper itself sees the full sampled load): load harmonics above order 40 are < 2e-5 of
@@ -74,6 +80,32 @@ class Stepper:
     def __init__(self, system, grid: Cycles):
         self.system = system
         self.grid = grid
+        self.ports = system.port_forces()
+        #: the last speed's equivalent-linear amplitudes (the next speed's first guess)
+        self.amplitudes = None
+
+    def equivalent_linear(self, solve, relative_motion, omega):
+        """``(amplitudes, solve(amplitudes))``: the nonlinear elements' equivalent-linear
+        fixed point (:func:`amplitude_fixed_point`), warm-started from the last speed;
+        a linear model is solved once (amplitudes None)."""
+        if self.ports is None:
+            return None, solve(None)
+        A, solution = amplitude_fixed_point(solve, relative_motion, self.ports,
+                                            omega * 30.0 / np.pi, self.amplitudes)
+        self.amplitudes = A
+        return A, solution
+
+    def harmonic_state(self, fh, omegas, omega):
+        """Harmonic response (n_h, n_dof) of the (equivalent-linear) model and the
+        nonlinear elements' amplitudes (None: linear model). The fixed point iterates on
+        the harmonics that make the amplitudes only; one solve of all follows."""
+        s = self.system
+        if self.ports is None:
+            return harmonic_response(s, fh, omegas), None
+        k = AMPLITUDE_HARMONICS.stop
+        A = self.equivalent_linear(lambda a: harmonic_response(s, fh[:k], omegas[:k], a),
+                                   lambda q: q @ self.ports.rows.T, omega)[0]
+        return harmonic_response(s, fh, omegas, self.ports.network_amplitudes(A)), A
 
     def harmonics(self, load, omega, max_order=None):
         """Load harmonics of the cycle (index j is order j/2) and their frequencies."""
@@ -97,15 +129,19 @@ class HarmonicStepper(Stepper):
     def solve(self, load, omega) -> SpeedOrders:
         t0 = time.perf_counter()
         fh, omegas = self.harmonics(load, omega)
-        qh = harmonic_response(self.system, fh, omegas)
+        qh, A = self.harmonic_state(fh, omegas, omega)
         j = np.round(ORDERS * 2).astype(int)
         w = omegas[j][:, None]
         q_o = qh[j]                                       # (n_orders, n)
         s = self.system
         x = (q_o @ s.channel_matrix.T).T
         force = ((q_o @ s.force_matrix_k.T) + 1j * w * (q_o @ s.force_matrix_d.T)).T
-        return SpeedOrders(x, 1j * w.T * x, -(w.T ** 2) * x, force,
-                           s.force_matrix_k @ qh[0].real, 0.0, time.perf_counter() - t0)
+        mean = s.force_matrix_k @ qh[0].real
+        if A is not None:
+            z = self.ports.describing_forces(A, qh @ self.ports.rows.T) @ self.ports.force_map.T
+            force, mean = force + z[j].T, mean + z[0].real
+        return SpeedOrders(x, 1j * w.T * x, -(w.T ** 2) * x, force, mean, 0.0,
+                           time.perf_counter() - t0)
 
 
 class AdmittanceStepper(Stepper):
@@ -114,12 +150,16 @@ class AdmittanceStepper(Stepper):
     solver = "harmonic"
 
     def solve(self, load, omega) -> SpeedOrders:
-        from powertrain.solvers.admittance import frf_response
+        from powertrain.solvers.admittance import frf_response, relative_motion
         t0 = time.perf_counter()
         fh, omegas = self.harmonics(load, omega)
         s = self.system
         j = np.round(ORDERS * 2).astype(int)
-        q, body, fb = frf_response(s, fh[np.r_[j, 0]], omegas[np.r_[j, 0]])
+        sel = np.r_[j, 0]                     # the orders (harmonics 1..16), then the mean
+        q, body, fb = self.equivalent_linear(
+            lambda a: frf_response(s, fh[sel], omegas[sel], a),
+            lambda r: relative_motion(s, self.ports.index, *r[:2])[np.r_[-1, :len(j)]],
+            omega)[1]
         n_a = s.n_mount_channels
         x = np.hstack([q[:-1] @ s.channel_matrix[:n_a].T, body[:-1]])      # (n_orders, n_ch)
         w = omegas[j][:, None]
@@ -169,6 +209,9 @@ class ModalNewmarkStepper(_NewmarkStepper):
         if grid.processed_cycles < 2:
             raise ValueError("the modal stepper needs processed_cycles >= 2; use "
                              "stepper='dense'")
+        if self.ports is not None:
+            raise ValueError(f"the modal stepper integrates linear models only "
+                             f"({', '.join(self.ports.names)} nonlinear); use stepper='dense'")
         t0 = time.perf_counter()
         self.modal = ModalNewmark(system.M, system.C, system.K, load_dofs=6)
         Cm, Z = system.channel_matrix, np.zeros_like(system.channel_matrix)
@@ -199,32 +242,42 @@ class DenseNewmarkStepper(_NewmarkStepper):
         t0 = time.perf_counter()
         g, s = self.grid, self.system
         fh, omegas = self.harmonics(load, omega, INITIAL_STATE_MAX_ORDER)
-        qh = harmonic_response(s, fh, omegas)
+        qh, amplitudes = self.harmonic_state(fh, omegas, omega)
         # periodic steady-state estimate at t = 0: static preload + harmonic solution
         x0 = qh.real.sum(axis=0)
         v0 = (1j * omegas[:, None] * qh).real.sum(axis=0)
         a0 = (-(omegas ** 2)[:, None] * qh).real.sum(axis=0)
         F = np.zeros((g.cycles * g.n_cycle + 1, s.n_dof))
         F[:, :6] = np.concatenate([np.tile(load, (g.cycles, 1)), load[:1]])
-        X, V, A = newmark(s.M, s.C, s.K, F, np.deg2rad(g.angle_step_deg) / omega, x0, v0, a0)
+        h = np.deg2rad(g.angle_step_deg) / omega
+        if self.ports is None:
+            X, V, A = newmark(s.M, s.C, s.K, F, h, x0, v0, a0)
+            Z = None
+        else:
+            z0 = self.ports.describing_forces(amplitudes, qh @ self.ports.rows.T).real.sum(0)
+            X, V, A, Z = newmark_ports(s.M, s.C, s.K, F, h, self.ports, x0, v0, a0, z0)
         seconds = time.perf_counter() - t0
         n = g.n_cycle
         win = slice(g.start, g.start + g.processed_cycles * n)
-        d_c, v_c, a_c, f_c = self._outputs(X[win], V[win], A[win])
+        d_c, v_c, a_c, f_c = self._outputs(X, V, A, Z, win)
         v_prev = v_c[:n] if g.processed_cycles >= 2 else \
-            self._outputs(X[g.start - n:g.start], V[g.start - n:g.start],
-                          A[g.start - n:g.start])[1]
+            self._outputs(X, V, A, Z, slice(g.start - n, g.start))[1]
         return self.window_orders(d_c, v_c, a_c, f_c, v_prev, seconds)
 
-    def _outputs(self, q, v, a):
+    def _outputs(self, X, V, A, Z, win):
+        """Channel displacement, velocity, acceleration and transmitted force over ``win``
+        (the port laws' forces ``Z`` added to the force)."""
         s = self.system
         Cm = s.channel_matrix
-        return (q @ Cm.T, v @ Cm.T, a @ Cm.T,
-                q @ s.force_matrix_k.T + v @ s.force_matrix_d.T)
+        q, v, a = X[win], V[win], A[win]
+        force = q @ s.force_matrix_k.T + v @ s.force_matrix_d.T
+        if Z is not None:
+            force += Z[win] @ self.ports.force_map.T
+        return q @ Cm.T, v @ Cm.T, a @ Cm.T, force
 
 
 def _auto_newmark(system, grid):
-    if grid.processed_cycles < 2:
+    if grid.processed_cycles < 2 or system.port_forces() is not None:
         return DenseNewmarkStepper(system, grid)
     try:
         return ModalNewmarkStepper(system, grid)

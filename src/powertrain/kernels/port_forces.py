@@ -1,0 +1,214 @@
+r"""Port laws: nonlinear forces across a mount network, evaluated from plain arrays.
+
+A port law acts in parallel with a mount network, between its engine-side node and its base
+node, on the relative displacement :math:`u = x_E - x_B` and velocity :math:`\dot u`. Numba
+cannot call Python objects fast, so every law is a kind code, a row of parameters and a row
+of state (its memory, e.g. the friction element's reversal point), dispatched here by code:
+
+* :func:`port_force` gives the trial force :math:`f` (on the base; :math:`-f` on the engine
+  side), the tangent stiffness :math:`\partial f/\partial u` and the tangent damping
+  :math:`\partial f/\partial\dot u` at :math:`(u, \dot u)` from the committed state, without
+  changing it (Newton iterates on it);
+* :func:`commit_state` updates the state once the step has converged.
+
+A new law adds its code, one branch in each of the two functions and its Python element type
+(:mod:`powertrain.physics.mount_elements`); the Newmark kernel with port laws
+(:func:`newmark_port_kernel`, here because kernels import no other kernel) does not change.
+"""
+
+import numpy as np
+from numba import njit
+
+#: No force (a linear element has no port law; kept so that code 0 is harmless).
+NONE = 0
+#: Jenkins element: spring ``k = par[0]`` in series with a Coulomb slider of slip force
+#: ``F_s = par[1]``; state ``z = state[0]``, the slider's position.
+JENKINS = 1
+
+
+@njit(cache=True, nogil=True)
+def port_force(kind, u, v, par, state):
+    """``(f, df/du, df/dv)`` of the port law ``kind`` at ``(u, v)`` from the committed
+    ``state`` (unchanged) [N, N/m, N·s/m]."""
+    if kind == JENKINS:
+        k = par[0]
+        fs = par[1]
+        f = k * (u - state[0])
+        if f > fs:
+            return fs, 0.0, 0.0
+        if f < -fs:
+            return -fs, 0.0, 0.0
+        return f, k, 0.0
+    return 0.0, 0.0, 0.0
+
+
+@njit(cache=True, nogil=True)
+def commit_state(kind, u, v, par, state):
+    """Update ``state`` in place after a converged step ending at ``(u, v)``."""
+    if kind == JENKINS:
+        k = par[0]
+        fs = par[1]
+        f = k * (u - state[0])
+        if f > fs:
+            state[0] = u - fs / k
+        elif f < -fs:
+            state[0] = u + fs / k
+
+
+@njit(cache=True, nogil=True)
+def port_force_loop(kinds, par, state, U, V, F):
+    """Forces ``F`` (n_t, m) of the port laws along prescribed motions ``U``, ``V``
+    (n_t, m), committing the state after every point (a displacement-driven test)."""
+    for t in range(U.shape[0]):
+        for e in range(kinds.shape[0]):
+            F[t, e] = port_force(kinds[e], U[t, e], V[t, e], par[e], state[e])[0]
+            commit_state(kinds[e], U[t, e], V[t, e], par[e], state[e])
+
+
+@njit(cache=True, nogil=True)
+def _dot(a, b):
+    """Dot product of two short vectors (a loop: no BLAS call per step)."""
+    s = 0.0
+    for i in range(a.shape[0]):
+        s += a[i] * b[i]
+    return s
+
+
+@njit(cache=True, nogil=True)
+def _solve_in_place(J, r):
+    """Solve ``J x = r`` (small, dense) by Gaussian elimination with partial pivoting;
+    ``x`` overwrites ``r``, ``J`` is destroyed (no allocation per call)."""
+    m = r.shape[0]
+    for c in range(m):
+        p = c
+        for i in range(c + 1, m):
+            if abs(J[i, c]) > abs(J[p, c]):
+                p = i
+        if p != c:
+            for j in range(c, m):
+                J[c, j], J[p, j] = J[p, j], J[c, j]
+            r[c], r[p] = r[p], r[c]
+        for i in range(c + 1, m):
+            f = J[i, c] / J[c, c]
+            for j in range(c, m):
+                J[i, j] -= f * J[c, j]
+            r[i] -= f * r[c]
+    for i in range(m - 1, -1, -1):
+        s = r[i]
+        for j in range(i + 1, m):
+            s -= J[i, j] * r[j]
+        r[i] = s / J[i, i]
+
+
+@njit(cache=True, nogil=True)
+def newmark_port_kernel(G, H, Fs, h, x0, v0, a0, W, P, Q, kinds, par, state, X, V, A, Z,
+                        tol, max_iter):
+    r"""Newmark average acceleration with port laws in parallel with the linear model:
+    :math:`\mathbf M\ddot{\mathbf x} + \mathbf C\dot{\mathbf x} + \mathbf K\mathbf x
+    + \mathbf P^T\mathbf z = \mathbf f`, :math:`z_e = f_e(\mathbf p_e\cdot\mathbf x,
+    \mathbf p_e\cdot\dot{\mathbf x})` (:mod:`powertrain.kernels.port_forces`).
+
+    The linear step gives :math:`\ddot{\mathbf x}_{lin}` as in
+    :func:`powertrain.kernels.newmark.newmark_kernel`; with
+    the port forces :math:`\ddot{\mathbf x} = \ddot{\mathbf x}_{lin} - \mathbf W\mathbf z`,
+    :math:`\mathbf W = \mathbf S^{-1}\mathbf P^T`, so the port motions are
+    :math:`\mathbf u = \mathbf u_{lin} - \tfrac{h^2}{4}\mathbf Q\mathbf z`,
+    :math:`\dot{\mathbf u} = \dot{\mathbf u}_{lin} - \tfrac h2\mathbf Q\mathbf z`,
+    :math:`\mathbf Q = \mathbf P\mathbf W`. Newton solves the m equations
+    :math:`z_e = f_e(u_e, \dot u_e)` per step (Jacobian
+    :math:`\mathbf I + \mathrm{diag}(\tfrac{h^2}{4}k_t + \tfrac h2 c_t)\mathbf Q`), from the
+    previous step's forces; the states are committed once it has converged.
+
+    Parameters
+    ----------
+    G, H, Fs, h, x0, v0, a0, X, V, A
+        As :func:`newmark_kernel`.
+    W : ndarray (n, m)
+        S^-1 P^T.
+    P : ndarray (m, n)
+        Port rows: relative displacement across each port law per unit coordinate.
+    Q : ndarray (m, m)
+        P S^-1 P^T.
+    kinds : ndarray int64 (m,)
+        Port-law codes.
+    par : ndarray (m, n_par)
+        Their parameters.
+    state : ndarray (m, n_state)
+        Their state, updated in place (the state after the last step).
+    Z : ndarray (n_steps + 1, m)
+        Output: port forces at every time point [N].
+    tol : float
+        Newton stops when every residual is below ``tol`` times (1 + the largest force).
+    max_iter : int
+
+    Returns
+    -------
+    int
+        Steps at which Newton did not converge (0 on success).
+    """
+    n = x0.shape[0]
+    m = kinds.shape[0]
+    ns = Fs.shape[0]
+    hh = 0.25 * h * h
+    hv = 0.5 * h
+    xt = np.empty(n)
+    vt = np.empty(n)
+    ul = np.empty(m)
+    vl = np.empty(m)
+    z = np.empty(m)
+    r = np.empty(m)
+    J = np.empty((m, m))
+    failed = 0
+    for j in range(n):
+        X[0, j] = x0[j]
+        V[0, j] = v0[j]
+        A[0, j] = a0[j]
+    for e in range(m):
+        z[e] = port_force(kinds[e], _dot(P[e], x0), _dot(P[e], v0), par[e], state[e])[0]
+        Z[0, e] = z[e]
+    for k in range(1, ns):
+        for j in range(n):
+            xt[j] = X[k - 1, j] + h * V[k - 1, j] + hh * A[k - 1, j]
+            vt[j] = V[k - 1, j] + hv * A[k - 1, j]
+        for i in range(n):
+            s = Fs[k, i]
+            for j in range(n):
+                s -= G[i, j] * vt[j] + H[i, j] * xt[j]
+            A[k, i] = s
+        for e in range(m):
+            ul[e] = 0.0
+            vl[e] = 0.0
+            for j in range(n):
+                ul[e] += P[e, j] * (xt[j] + hh * A[k, j])
+                vl[e] += P[e, j] * (vt[j] + hv * A[k, j])
+        converged = False
+        for _ in range(max_iter):
+            big = 1.0
+            worst = 0.0
+            for e in range(m):
+                qz = _dot(Q[e], z)
+                f, kt, ct = port_force(kinds[e], ul[e] - hh * qz, vl[e] - hv * qz, par[e],
+                                       state[e])
+                r[e] = f - z[e]
+                big = max(big, abs(z[e]))
+                worst = max(worst, abs(r[e]))
+                for j in range(m):
+                    J[e, j] = (hh * kt + hv * ct) * Q[e, j]
+                J[e, e] += 1.0
+            if worst <= tol * big:
+                converged = True
+                break
+            _solve_in_place(J, r)
+            for e in range(m):
+                z[e] += r[e]
+        if not converged:
+            failed += 1
+        for e in range(m):
+            qz = _dot(Q[e], z)
+            commit_state(kinds[e], ul[e] - hh * qz, vl[e] - hv * qz, par[e], state[e])
+            Z[k, e] = z[e]
+        for j in range(n):
+            A[k, j] -= _dot(W[j], z)
+            X[k, j] = xt[j] + hh * A[k, j]
+            V[k, j] = vt[j] + hv * A[k, j]
+    return failed

@@ -1,0 +1,201 @@
+r"""Mount elements: one mount direction as the assembled model and its solvers see it.
+
+A :class:`MountElement` is a linear network (:mod:`powertrain.physics.mount_network`; its M,
+C, K go into the assembled matrices) and, optionally, a *port law* in parallel with it
+between the engine-side node and the base node, acting on their relative displacement
+:math:`u = x_E - x_B`. The solvers ask an element two things:
+
+* the frequency domain: its **equivalent-linear two-port** at a relative-displacement
+  amplitude, :meth:`MountElement.two_port` — the network's two-port plus the port law's
+  describing function :math:`k_{eq}(A)` (a spring between the two nodes) at every
+  :math:`s \ne 0`; without a port law exactly the network's two-port. A port law carries
+  no mean force: it starts unloaded at the operating point (its ``initial_state`` at the
+  static deflection), so at :math:`s = 0` (the static preload, the mean of a run-up) it adds
+  nothing; a static force–deflection curve is a separate matter (issue 20's operating point);
+* the time domain: the port law's **kernel arrays** (kind code, parameters, initial state,
+  :class:`PortForces`), integrated with the linear model by
+  :func:`powertrain.kernels.port_forces.newmark_port_kernel` (Newton per step over plain arrays).
+
+A port law is an object with ``kind`` (its code in :mod:`powertrain.kernels.port_forces`),
+``parameters()`` (float array), ``initial_state(u0, f0)`` (float array: the memory at the
+start, where the relative displacement is ``u0`` and the force expected from the
+equivalent-linear solution ``f0``)
+and ``describing_stiffness(amplitude)`` (complex [N/m]). :class:`JenkinsFriction` is the one
+implemented here: simple, with a closed-form describing function, it proves the plug-in
+(tests/test_mount_elements.py).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from powertrain.kernels.port_forces import JENKINS, port_force
+from powertrain.physics.mount_network import laplace_two_port, network_matrices
+
+
+@dataclass(frozen=True)
+class JenkinsFriction:
+    r"""A spring :math:`k` in series with a Coulomb slider of slip force :math:`F_s`:
+    :math:`f = k(u - z)`, :math:`|f| \le F_s`, the slider position :math:`z` its memory.
+
+    Describing function (Caughey 1960) for :math:`u = A\sin\omega t`, with
+    :math:`\delta = F_s/(kA)`: :math:`k_{eq} = k` for :math:`\delta \ge 1`, otherwise
+
+    .. math:: k_{eq} = \frac{k}{\pi}\left(\varphi - \tfrac12\sin 2\varphi\right)
+              + i\,\frac{4k}{\pi}\,\delta(1 - \delta), \qquad \cos\varphi = 1 - 2\delta,
+
+    the imaginary part being the loop area :math:`4F_s(A - F_s/k)` over :math:`\pi A^2`.
+
+    Parameters
+    ----------
+    stiffness : float
+        k [N/m] (> 0).
+    slip_force : float
+        F_s [N] (>= 0).
+    """
+
+    stiffness: float
+    slip_force: float
+    kind = JENKINS
+
+    def parameters(self) -> np.ndarray:
+        return np.array([self.stiffness, self.slip_force], float)
+
+    def initial_state(self, u0: float, f0: float = 0.0) -> np.ndarray:
+        """Slider where the element carries ``f0`` (clipped to the slip force) at ``u0``."""
+        if self.stiffness <= 0:
+            return np.array([u0], float)
+        return np.array([u0 - np.clip(f0, -self.slip_force, self.slip_force) / self.stiffness])
+
+    def describing_stiffness(self, amplitude) -> np.ndarray:
+        """Equivalent complex stiffness [N/m] at the displacement amplitude [m]."""
+        amplitude = np.asarray(amplitude, float)
+        k = self.stiffness
+        with np.errstate(divide="ignore", invalid="ignore"):
+            delta = np.where(amplitude > 0, self.slip_force / (k * amplitude), np.inf)
+        d = np.minimum(delta, 1.0)
+        phi = np.arccos(1.0 - 2.0 * d)
+        slip = k / np.pi * (phi - 0.5 * np.sin(2 * phi)) + 4j * k / np.pi * d * (1 - d)
+        return np.where(delta >= 1.0, k + 0j, slip)
+
+
+@dataclass(frozen=True, eq=False)
+class MountElement:
+    """One mount direction: a linear network and an optional port law in parallel.
+
+    Parameters
+    ----------
+    model : object
+        The linear network: ``network()`` gives ``(masses, elem_nodes, c, d)``
+        (:class:`powertrain.models.mount.MountModel`).
+    port_law : object, optional
+        Nonlinear force between the engine-side and base nodes (module docstring).
+    """
+
+    model: object
+    port_law: object = None
+
+    @property
+    def nonlinear(self) -> bool:
+        return self.port_law is not None
+
+    def network(self):
+        """``(masses, elem_nodes, c, d)`` of the linear network."""
+        return self.model.network()
+
+    def matrices(self, include_ground=False):
+        """``(M, C, K)`` of the linear network (the port law is not in them)."""
+        return network_matrices(*self.network(), include_ground=include_ground)
+
+    def two_port(self, s, amplitude=0.0, internal=False):
+        """Equivalent-linear two-port ``(a, b, c)`` at the Laplace variable ``s`` and the
+        relative-displacement amplitude [m] (and the internal motions when ``internal``, see
+        :func:`powertrain.physics.mount_network.laplace_two_port`; a port law moves no
+        internal node)."""
+        res = laplace_two_port(s, *self.network(), internal=internal)
+        if self.port_law is None:
+            return res
+        k = np.where(np.asarray(s) == 0, 0.0, self.port_law.describing_stiffness(amplitude))
+        return (res[0] + k, res[1] - k, res[2] + k) + res[3:]
+
+
+@dataclass(frozen=True)
+class PortForces:
+    """The port laws of an assembled model as kernel arrays.
+
+    Attributes
+    ----------
+    rows : ndarray (m, n)
+        Relative displacement across each port law per unit coordinate (engine-side row
+        minus base row).
+    kinds : ndarray int64 (m,); parameters : ndarray (m, n_par)
+    laws : list
+        The port-law objects (for their initial state).
+    force_map : ndarray (n_ch, m)
+        Transmitted-force channels per unit port force (engine axes).
+    names : list of str
+        ``mount.direction`` of each port law.
+    index : ndarray int (m,)
+        Each port law's network (the element's place among the assembled networks).
+    n_networks : int
+        Networks in the model.
+    """
+
+    rows: np.ndarray
+    kinds: np.ndarray
+    parameters: np.ndarray
+    laws: list
+    force_map: np.ndarray
+    names: list = field(default_factory=list)
+    index: np.ndarray = field(default_factory=lambda: np.zeros(0, int))
+    n_networks: int = 0
+
+    def network_amplitudes(self, amplitudes) -> np.ndarray:
+        """Amplitudes of every network (n_networks,) [m]: the port laws' ``amplitudes``
+        (m,) at their networks, zero at the linear ones (which ignore it)."""
+        out = np.zeros(self.n_networks)
+        out[self.index] = amplitudes
+        return out
+
+    def describing_forces(self, amplitudes, relative) -> np.ndarray:
+        """Equivalent-linear port forces (n_h, m) [N] of the relative-motion harmonics
+        ``relative`` (n_h, m) at the ``amplitudes`` (m,)."""
+        k = np.array([law.describing_stiffness(a) for law, a in zip(self.laws, amplitudes)])
+        z = relative * k[None, :]
+        z[0] = 0.0                                    # the mean: unloaded (module docstring)
+        return z
+
+    def initial_state(self, x0, f0=None) -> np.ndarray:
+        """State rows (m, n_state) of every law at the initial coordinates ``x0``, expected
+        to carry the forces ``f0`` (m,) [N] (default: unloaded)."""
+        u0 = self.rows @ np.asarray(x0, float)
+        f0 = np.zeros(u0.size) if f0 is None else f0
+        states = [np.atleast_1d(law.initial_state(u, f)) for law, u, f in
+                  zip(self.laws, u0, f0)]
+        out = np.zeros((len(states), max(s.size for s in states)))
+        for e, st in enumerate(states):
+            out[e, :st.size] = st
+        return out
+
+    def forces(self, u, v, state) -> np.ndarray:
+        """Port forces (m,) [N] at the relative motions ``u``, ``v`` (m,) from ``state``."""
+        return np.array([port_force(k, ue, ve, p, st)[0] for k, ue, ve, p, st in
+                         zip(self.kinds, u, v, self.parameters, state)])
+
+
+def port_forces(elements, rows, force_map, names) -> PortForces | None:
+    """The port laws among ``elements`` (per network: its port row, force-map column and
+    name) as kernel arrays; None when every element is linear."""
+    idx = [k for k, el in enumerate(elements) if el.nonlinear]
+    if not idx:
+        return None
+    laws = [elements[k].port_law for k in idx]
+    pars = [np.atleast_1d(law.parameters()) for law in laws]
+    par = np.zeros((len(pars), max(p.size for p in pars)))
+    for e, p in enumerate(pars):
+        par[e, :p.size] = p
+    return PortForces(np.ascontiguousarray(rows[idx]), np.array([law.kind for law in laws],
+                      np.int64), par, laws, np.ascontiguousarray(force_map[:, idx]),
+                      [names[k] for k in idx], np.array(idx, int), len(elements))
