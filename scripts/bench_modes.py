@@ -1,7 +1,7 @@
 """Time of ``powertrain modes`` (warm) against a brute-force peer on the same model.
 
 Ours: the six damped rigid-body modes by secant iteration on the condensed 6×6 problem
-(:func:`powertrain.solvers.modes.engine_modes`, which also checks each root against the full
+(:func:`powertrain.workflows.modes.modes`, which also checks each root against the full
 model). Peer: every eigenvalue and eigenvector of the full state-space model with the
 networks' internal degrees of freedom (scipy.linalg.eig), which still leaves the rigid-body
 modes to be picked out. The issue's target is under one second warm.
@@ -21,7 +21,7 @@ import scipy.linalg as sla
 
 from powertrain.assembly import assemble
 from powertrain.iotools.engine_file import DEFAULT_ENGINE_PATH, read_engine
-from powertrain.solvers.modes import engine_modes
+from powertrain.workflows.modes import modes as engine_modes
 
 
 def best_of(fn, n=5):

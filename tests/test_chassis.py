@@ -13,7 +13,7 @@ from powertrain.cli import main
 from powertrain.errors import InputError
 from powertrain.iotools.engine_file import DEFAULT_ENGINE_PATH, read_engine
 from powertrain.iotools.measured import read_measured
-from powertrain.results.runup import RunupResult
+from powertrain.iotools.runup_hdf5 import read_runup_hdf5
 from powertrain.workflows.runup import run_runup
 
 ENGINES = Path(DEFAULT_ENGINE_PATH).parent
@@ -152,7 +152,7 @@ def test_csv_and_hdf5_carry_both_sides(tmp_path, runups):
     meas = read_measured(tmp_path / "r.csv", mounts=["left", "right", "gearbox"])
     rpm, lev = meas.curve("left/passive", "z", "order_2")
     np.testing.assert_allclose(lev, newm.curve("left/passive", "z", "order_2"), rtol=1e-7)
-    back = RunupResult.from_hdf5(tmp_path / "r.h5")
+    back = read_runup_hdf5(tmp_path / "r.h5")
     assert back.channels == newm.channels and back.points == ["seat_rail"]
     np.testing.assert_array_equal(back.path_contribution, newm.path_contribution)
     iso = newm.isolation_db("left", "z", "order_2")

@@ -18,7 +18,8 @@ from scipy.spatial.transform import Rotation
 from powertrain.assembly import assemble
 from powertrain.cli import main
 from powertrain.iotools.engine_file import DEFAULT_ENGINE_PATH, read_engine
-from powertrain.solvers.modes import COORDINATES, engine_modes
+from powertrain.solvers.modes import COORDINATES
+from powertrain.workflows.modes import modes as engine_modes
 
 DATA = Path(__file__).parent / "data"
 REFERENCE = DATA / "modes-reference-engine.toml"

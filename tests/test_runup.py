@@ -9,8 +9,8 @@ from network_oracle import dense_harmonic_response
 from powertrain.analysis.orders import ORDERS, order_label, order_spectrum, synthesis_rms
 from powertrain.assembly import assemble
 from powertrain.iotools.engine_file import DEFAULT_ENGINE_PATH, read_engine
+from powertrain.iotools.runup_hdf5 import read_runup_hdf5
 from powertrain.physics.rigid_body import point_motion_matrix
-from powertrain.results.runup import RunupResult
 from powertrain.solvers.harmonic import harmonic_response
 from powertrain.workflows.runup import run_runup
 
@@ -134,7 +134,7 @@ def test_results_roundtrip_hdf5_and_csv(tmp_path, runups):
     newm, _ = runups
     path = tmp_path / "r.h5"
     newm.to_hdf5(path, engine_snapshot="x = 1")
-    back = RunupResult.from_hdf5(path)
+    back = read_runup_hdf5(path)
     np.testing.assert_array_equal(back.velocity, newm.velocity)
     assert back.channels == newm.channels
     assert back.settings["solver"] == "newmark"
@@ -165,7 +165,7 @@ def test_cli_runup_writes_hdf5_csv_and_plot(tmp_path):
     r = _cli(["runup", "--from", "1000", "--to", "2000", "--step", "500", "--out", "r.h5",
               "--csv", "r.csv", "--plot", "r.png", "--quiet"], tmp_path)
     assert r.returncode == 0, r.stderr
-    back = RunupResult.from_hdf5(tmp_path / "r.h5")
+    back = read_runup_hdf5(tmp_path / "r.h5")
     np.testing.assert_array_equal(back.rpm, [1000.0, 1500.0, 2000.0])
     assert (tmp_path / "r.csv").read_text().startswith(
         "mount,direction,quantity,rpm,side,velocity_rms_mm_per_s,")

@@ -226,7 +226,8 @@ NEWMARK_REL = 5e-3
 def test_effects_through_the_normal_runup_match_the_fast_path(engine):
     """Every diagnosis effect runs through run_runup (Newmark here) and agrees with the
     cached frequency-domain path of the diagnosis (:func:`powertrain.effects.simulate`)."""
-    from powertrain.workflows.effect_runup import runup_with_effects, simulate
+    from powertrain.workflows.effect_runup import simulate
+    from powertrain.workflows.runup import runup_with_effects
     scenarios = [{"base_compliance": {"c_base": 4e5, "m_base": 8.0}},
                  {"mount_stiffness": {"k1": 1.5, "k3": 0.7}},
                  {"amplitude_stiffness": {"kappa": 1.0, "a_c": 2e-5}},

@@ -45,3 +45,27 @@ class InputError(ValueError):
         text = f"{prefix}: {self.message}" if prefix else self.message
         text = " ".join(text.split())
         return text if len(text) <= MAX_LINE else text[:MAX_LINE - 3] + "..."
+
+
+def solved(solve, file, key):
+    """``solve()``, with a model that cannot be solved (singular, overflow) reported as bad
+    input naming ``file`` and ``key`` (the last guard: the checks at load catch the known
+    causes first)."""
+    import numpy as np
+    try:
+        with np.errstate(all="ignore"):
+            return solve()
+    except InputError:
+        raise
+    except (ValueError, ArithmeticError, np.linalg.LinAlgError) as exc:
+        raise InputError(f"the model cannot be solved ({type(exc).__name__}: "
+                         f"{str(exc)[:120]})", file=file, key=key) from None
+
+
+def require_finite(values: dict, file, key) -> None:
+    """Refuse results holding NaN or inf (``values``: name -> array), naming the input."""
+    import numpy as np
+    for name, value in values.items():
+        if value is not None and not np.all(np.isfinite(value)):
+            raise InputError(f"the computed {name} is not finite (NaN or "
+                             "inf): values out of any physical range", file=file, key=key)

@@ -9,7 +9,7 @@ import click
 import numpy as np
 
 from powertrain.analysis.text_table import format_table  # noqa: F401 (re-export)
-from powertrain.errors import InputError
+from powertrain.errors import InputError, require_finite, solved  # noqa: F401 (re-export)
 
 #: Most frequencies one option may ask for, and the highest frequency [Hz] (a mount model
 #: fitted below 1 kHz says nothing at 100 kHz; the limits keep a typo from hanging the run).
@@ -89,10 +89,6 @@ def speed_steps(rpm_from: float, rpm_to: float, rpm_step: float) -> np.ndarray:
 
 #: Largest speed grid a run-up command accepts (about 0.1 s per speed step).
 MAX_SPEEDS = 2000
-#: Finest crank-angle step [deg] of the Newmark stepper (720 / 0.05 = 14 400 steps a cycle).
-MIN_ANGLE_STEP_DEG = 0.05
-#: Coarsest crank-angle step [deg]: 72 steps a cycle still resolve order 8 without aliasing.
-MAX_ANGLE_STEP_DEG = 10.0
 
 
 def check_outputs(**targets) -> None:
@@ -104,21 +100,15 @@ def check_outputs(**targets) -> None:
 
 
 def runup_settings(engine, rpm: np.ndarray, angle_step: float) -> None:
-    """Check a run-up's speeds against the engine's range and the crank-angle step, naming
-    the option at fault."""
-    lo, hi = engine.speed_range_rpm()
-    if rpm[0] < lo - 1e-6:
-        raise InputError(f"{rpm[0]:g} rpm is below the engine's range {lo:g}..{hi:g} rpm",
-                         key="--from")
-    if rpm[-1] > hi + 1e-6:
-        raise InputError(f"{rpm[-1]:g} rpm is above the engine's range {lo:g}..{hi:g} rpm",
-                         key="--to")
-    n_cycle = 720.0 / angle_step if math.isfinite(angle_step) and angle_step > 0 else 0.0
-    if not (MIN_ANGLE_STEP_DEG <= angle_step <= MAX_ANGLE_STEP_DEG
-            and abs(n_cycle - round(n_cycle)) < 1e-9 and round(n_cycle) % 2 == 0):
-        raise InputError(f"{angle_step:g} deg: must divide 720 deg into an even number of "
-                         f"steps, {MIN_ANGLE_STEP_DEG:g}..{MAX_ANGLE_STEP_DEG:g} deg "
-                         "(e.g. 0.5, 1, 2)", key="--angle-step")
+    """:func:`powertrain.workflows.runup.check_runup_settings` (speeds, crank-angle step)."""
+    from powertrain.workflows.runup import check_runup_settings
+    check_runup_settings(engine, rpm, angle_step)
+
+
+def checked_runup(engine, engine_path, run, *args, **kwargs):
+    """:func:`powertrain.workflows.runup.checked_runup` (a run-up, checked finite)."""
+    from powertrain.workflows.runup import checked_runup as checked
+    return checked(engine, engine_path, run, *args, **kwargs)
 
 
 def write_json(path, text: str, provenance: dict, key: str = "--json") -> None:
@@ -136,38 +126,6 @@ def write_json(path, text: str, provenance: dict, key: str = "--json") -> None:
                          file=path, key=key) from None
     with atomic_write(path) as fh:
         fh.write(out)
-
-
-def solved(solve, file, key):
-    """``solve()``, with a model that cannot be solved (singular, overflow) reported as bad
-    input naming ``file`` and ``key`` (the last guard: the checks at load catch the known
-    causes first)."""
-    try:
-        with np.errstate(all="ignore"):
-            return solve()
-    except InputError:
-        raise
-    except (ValueError, ArithmeticError, np.linalg.LinAlgError) as exc:
-        raise InputError(f"the model cannot be solved ({type(exc).__name__}: "
-                         f"{str(exc)[:120]})", file=file, key=key) from None
-
-
-def require_finite(values: dict, file, key) -> None:
-    """Refuse results holding NaN or inf (``values``: name -> array), naming the input."""
-    for name, value in values.items():
-        if value is not None and not np.all(np.isfinite(value)):
-            raise InputError(f"the computed {name} is not finite (NaN or "
-                             "inf): values out of any physical range", file=file, key=key)
-
-
-def checked_runup(engine, engine_path, run, *args, **kwargs):
-    """``run(engine, *args, **kwargs)`` (a run-up) through :func:`solved`, its result
-    checked finite (errors name the engine file)."""
-    result = solved(lambda: run(engine, *args, **kwargs), engine_path, "engine")
-    require_finite({name.replace("_", " "): getattr(result, name) for name in (
-        "displacement", "velocity", "acceleration", "mount_force", "mean_mount_force")},
-        engine_path, "engine")
-    return result
 
 
 # ------------------------------------------------------------------ figures

@@ -29,15 +29,15 @@ def modes(engine_file, static, json_file, plot):
       powertrain modes --engine engines/default-torque-rod.toml --json modes.json
       powertrain modes --static --plot modes.png
     """
-    from powertrain.iotools.engine_file import DEFAULT_ENGINE_PATH, read_engine
-    from powertrain.solvers.modes import engine_modes
+    from powertrain.cli.common import cli_provenance, engine_description, write_plot
+    from powertrain.iotools.engine_file import engine_or_default
+    from powertrain.workflows.modes import modes as solve_modes
 
-    engine = read_engine(engine_file or DEFAULT_ENGINE_PATH)
-    result = engine_modes(engine, static=static)
+    engine = engine_or_default(engine_file)
+    result = solve_modes(engine, static=static)
     if json_file:
         result.write_json(json_file)
     if plot:
-        from powertrain.cli.common import cli_provenance, engine_description, write_plot
         prov = cli_provenance(engine_description(engine, engine.file))
         write_plot(lambda p: result.plot(path=p, provenance=prov), plot)
     click.echo(result.to_text())

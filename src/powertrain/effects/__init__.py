@@ -27,7 +27,7 @@ sensor_error       sensor      channel gains 10^(G_c/20) and triad rotations φ_
 Every effect can be used on an :class:`~powertrain.models.engine.Engine`
 (``EFFECTS[name].apply(engine, **params)``, where it is an engine-model change), on the
 fast cached path :func:`predict` (the diagnosis), and through the ordinary run-up
-(:func:`powertrain.workflows.effect_runup.runup_with_effects`).
+(:func:`powertrain.workflows.runup.runup_with_effects`).
 """
 
 from powertrain.effects.amplitude_stiffness import A_REF, amplitude_factor, time_domain_amplitude_check

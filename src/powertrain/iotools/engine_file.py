@@ -34,6 +34,7 @@ and the key.
 from __future__ import annotations
 
 import math
+import os
 import re
 from pathlib import Path
 
@@ -155,6 +156,14 @@ def _q(table, key, dimension, path, prefix, **kw):
         raise InputError("expected one number, got a list", file=path,
                          key=f"{prefix}.{key}.value" if prefix else f"{key}.value")
     return float(value)
+
+
+def engine_or_default(engine=None) -> em.Engine:
+    """``engine`` as an :class:`~powertrain.models.engine.Engine`: one given stays as it is,
+    a path is read (:func:`read_engine`), None reads the shipped default engine."""
+    if engine is None or isinstance(engine, (str, os.PathLike)):
+        return read_engine(DEFAULT_ENGINE_PATH if engine is None else engine)
+    return engine
 
 
 def read_engine(path=DEFAULT_ENGINE_PATH) -> em.Engine:

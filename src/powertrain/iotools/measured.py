@@ -44,8 +44,8 @@ negative or NaN value, a duplicate row -- raises :class:`~powertrain.errors.Inpu
 naming file, line and column.
 
 HDF5 files in the layout of :mod:`powertrain.results.runup` (``powertrain runup --out``) are read
-with :meth:`RunupResult.from_hdf5`; every channel's synthesis and order RMS velocities become
-curves.
+with :func:`powertrain.iotools.runup_hdf5.read_runup_hdf5`; every channel's synthesis and order
+RMS velocities become curves.
 """
 
 from __future__ import annotations
@@ -227,9 +227,9 @@ def read_measured(path, mounts=None, points=None) -> MeasuredRunup:
 
 
 def _read_hdf5(path, mounts):
-    from powertrain.results.runup import RunupResult
+    from powertrain.iotools.runup_hdf5 import read_runup_hdf5
     try:
-        result = RunupResult.from_hdf5(path)
+        result = read_runup_hdf5(path)
     except KeyError as exc:
         raise InputError(f"not in the run-up HDF5 layout (missing {exc})", file=path) from None
     if mounts is not None:

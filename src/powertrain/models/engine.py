@@ -409,14 +409,6 @@ class Excitation:
         n_h = int(round(2 * max_order)) + 1
         return np.arange(n_h) / 2.0, spec[:n_h]
 
-    def plot(self, ax=None, *, path=None, provenance=None):
-        """Summary figure; returns it (see :func:`powertrain.plotting.plot_excitation`)."""
-        from powertrain.plotting import plot_excitation
-        from powertrain.plotting.style import target_and_path
-        ax, path = target_and_path(ax, path)
-        return plot_excitation(self, path, ax=ax,
-                               provenance=provenance or getattr(self, "provenance", None))
-
 
 @dataclass(frozen=True, eq=False)
 class Engine:

@@ -1,2 +1,2 @@
-"""Result objects: what a workflow returns (run-up, tracked orders), with their text, plots
-and file writers."""
+"""Result objects: what a workflow returns (run-up, continuous run-up, tracked orders, modes,
+excitation), with their text, plots and file writers."""

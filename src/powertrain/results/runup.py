@@ -83,6 +83,12 @@ class RunupResult:
     #: direction), shape (n_rpm, 3 n_points, 3 n_mounts, n_orders) [m/s]; None without
     #: body points (see :func:`powertrain.workflows.runup.path_contributions`)
     path_contribution: np.ndarray | None = None
+    #: the engine that ran (balancers as run, before effects), when
+    #: :func:`powertrain.workflows.runup.runup` made the result; its file and mounts go into
+    #: the HDF5 file
+    engine: object = field(default=None, repr=False, compare=False)
+    #: what was changed on the engine (``balancer shafts switched off``), for the provenance
+    modifications: list = field(default_factory=list)
 
     # ----------------------------------------------------------------- both sides
     @property
@@ -151,6 +157,46 @@ class RunupResult:
         order = float(quantity.split("_", 1)[1])
         return self.order_rms(signal)[:, c, self.order_index(order)]
 
+    # ----------------------------------------------------------------- text
+    def to_text(self) -> str:
+        """The engine, the rigid-body modes, the effects, the synthesis RMS velocity per speed
+        and channel [mm/s] and, for a time integration, the periodicity (what ``powertrain
+        runup`` prints)."""
+        from powertrain.analysis.text_table import format_table
+        name, file = self.meta.get("engine", ""), self.meta.get("engine_file", "")
+        lines = [f"engine: {name} ({file})" if file else f"engine: {name}",
+                 "rigid-body modes, undamped, mounts at their static stiffness [Hz]: "
+                 f"{self._labelled_modes()} (damped, at the mounts' dynamic stiffness: "
+                 "'powertrain modes')"]
+        if self.settings.get("effects"):
+            lines.append("effects: " + effects_text(self.settings["effects"]))
+        syn = self.synthesis_rms("velocity") * 1e3
+        header = ["rpm"] + [f"{m}.{d}" for m, d in self.channels]
+        rows = [[f"{r:g}"] + [float(v) for v in syn[i]] for i, r in enumerate(self.rpm)]
+        lines += ["synthesis RMS velocity (orders 0.5-8) [mm/s]:",
+                  format_table(header, rows, "{:.3f}")]
+        if self.settings.get("cycles"):
+            lines.append("periodicity of processed windows: max "
+                         f"{100 * np.max(self.periodicity):.2g} %")
+        return "\n".join(lines)
+
+    def _labelled_modes(self) -> str:
+        """``5.9 (y), 6.7 (z), ...``: each mode with its dominant coordinate, where known."""
+        coords = list(self.meta.get("rigid_body_mode_dominant", []))
+        coords += [""] * (len(self.rigid_body_modes_hz) - len(coords))
+        return ", ".join(f"{f:.1f} ({c})" if c else f"{f:.1f}"
+                         for f, c in zip(self.rigid_body_modes_hz, coords))
+
+    def synthetic_comments(self, provenance=None) -> list:
+        """``#`` lines of a CSV of a run-up with added effects (a stand-in for a measurement,
+        as ``synth`` writes): the SYNTHETIC label and the ``provenance`` line; none without
+        effects."""
+        effects = self.settings.get("effects")
+        if not effects:
+            return []
+        return [f"SYNTHETIC: simulated run-up with added effects {effects_text(effects)}; "
+                "not measured"] + ([f"provenance: {provenance.line()}"] if provenance else [])
+
     # ----------------------------------------------------------------- writers
     def csv_text(self, comments=()) -> str:
         """Long-format CSV text: RMS velocity [mm/s], acceleration [m/s²] and the force the
@@ -184,26 +230,30 @@ class RunupResult:
         with atomic_write(path) as fh:
             fh.write(text)
 
-    def to_hdf5(self, path, *, engine_snapshot: str = "", mount_snapshots: dict | None = None,
-                synthetic: bool = False, description: str = "",
-                provenance: dict | None = None) -> None:
+    def to_hdf5(self, path, *, engine_snapshot: str | None = None,
+                mount_snapshots: dict | None = None, synthetic: bool = False,
+                description: str | None = None, provenance: dict | None = None) -> None:
         """Write the documented HDF5 layout atomically.
 
-        ``engine_snapshot`` is the engine file as read; ``provenance``
-        (:func:`powertrain.provenance.provenance`) records the engine as it ran (e.g. the
-        balancers off), the effects applied, the command line, the version and the time.
+        ``engine_snapshot`` is the engine file as read, ``mount_snapshots`` the mount models
+        as run; ``provenance`` (:func:`powertrain.provenance.provenance`) records the engine
+        as it ran (e.g. the balancers off), the effects applied, the command line, the
+        version and the time. With :attr:`engine` set, all three (and the description)
+        default to that engine's.
         """
         import h5py
 
         from powertrain.outputs import atomic_path
         from powertrain.provenance import stamp_hdf5
+        snapshot, mount_snapshots, description, provenance = self._run_record(
+            engine_snapshot, mount_snapshots, description, provenance)
         with atomic_path(path) as tmp:
             with h5py.File(tmp, "w") as h5:
                 a = h5.attrs
                 stamp_hdf5(a, "powertrain-runup")
                 a["settings"] = json.dumps(self.settings)
                 a["meta"] = json.dumps(self.meta)
-                a["engine_snapshot"] = engine_snapshot
+                a["engine_snapshot"] = snapshot
                 a["mount_snapshots"] = json.dumps(mount_snapshots or {})
                 a["synthetic"] = bool(synthetic)
                 a["description"] = description
@@ -237,6 +287,29 @@ class RunupResult:
                 g.create_dataset("solver_seconds", data=self.solver_seconds).attrs["unit"] = "s"
                 self._write_sides(h5)
 
+    def _run_record(self, snapshot, mounts, description, provenance):
+        """Engine file text, mount snapshots, description and provenance of the HDF5 file:
+        as given, else from :attr:`engine`."""
+        e = self.engine
+        if e is None:
+            return snapshot or "", mounts, description or "", provenance
+        from pathlib import Path
+
+        from powertrain.provenance import provenance as record
+        if snapshot is None:
+            snapshot = Path(e.file).read_text(encoding="utf-8") if e.file else ""
+        if mounts is None:
+            mounts = {"mounts": json.dumps({
+                f"{m.name}.{a}": {"model": mdl.topology.name, "params_si": mdl.params,
+                                  "source": mdl.source}
+                for m in e.mounts for a, mdl in m.directions.items()})}
+        if description is None:
+            description = f"run-up {self.rpm[0]:g}-{self.rpm[-1]:g} rpm, {e.name}"
+        if provenance is None:
+            provenance = record(e, engine_file=e.file, modifications=self.modifications,
+                                effects=self.settings.get("effects"))
+        return snapshot, mounts, description, provenance
+
     def _write_sides(self, h5):
         """/channels/side and /channels/location; /path_contribution with body points."""
         from powertrain.models.chassis import split_side
@@ -254,54 +327,6 @@ class RunupResult:
                 [f"{p}.{d}" for p in self.points for d in "xyz"], dtype="S"))
             pg.create_dataset("paths", data=np.array([f"{m}.{d}" for m, d in self.paths],
                                                      dtype="S"))
-
-    @classmethod
-    def from_hdf5(cls, path) -> RunupResult:
-        """Read a run-up HDF5 file; every dataset's type and shape is checked (errors name
-        the file and the dataset or attribute)."""
-        import h5py
-
-        from powertrain.errors import InputError
-        from powertrain.iotools.textfile import check_regular_file
-        check_regular_file(path)
-        try:
-            h5 = h5py.File(path, "r")
-        except (OSError, FileNotFoundError) as exc:
-            raise InputError(f"cannot open HDF5 file ({exc})", file=path) from None
-        try:
-            with h5:
-                return cls._from_open_hdf5(h5, path)
-        except InputError:
-            raise
-        except (OSError, RuntimeError, KeyError, ValueError, TypeError) as exc:
-            raise InputError(f"damaged or not in the run-up layout ({type(exc).__name__}: "
-                             f"{str(exc)[:120]})", file=path) from None
-
-    @classmethod
-    def _from_open_hdf5(cls, h5, path) -> RunupResult:
-        from powertrain.errors import InputError
-        if h5.attrs.get("format") != "powertrain-runup":
-            raise InputError("not a powertrain run-up result", file=path, key="format")
-        rpm = _h5_array(h5, "rpm", path, "f", 1)
-        orders = _h5_array(h5, "orders", path, "f", 1)
-        mounts = _h5_names(h5, "channels/mount", path)
-        directions = _h5_names(h5, "channels/direction", path)
-        if len(mounts) != len(directions):
-            raise InputError(f"{len(mounts)} mounts but {len(directions)} directions",
-                             file=path, key="channels/direction")
-        n = (rpm.size, len(mounts), orders.size)
-        amp = {q: _h5_array(h5, f"{q}/amplitude", path, "fc", 3, n)
-               for q in ("displacement", "velocity", "acceleration", "mount_force")}
-        return cls(rpm=rpm, orders=orders, channels=list(zip(mounts, directions)), **amp,
-                   mean_mount_force=_h5_array(h5, "mount_force/mean", path, "f", 2, n[:2]),
-                   periodicity=_h5_array(h5, "diagnostics/periodicity", path, "f", 1, n[:1]),
-                   settings=_h5_json(h5, "settings", path),
-                   solver_seconds=float(_h5_array(h5, "diagnostics/solver_seconds", path,
-                                                  "f", 0)),
-                   rigid_body_modes_hz=_h5_array(h5, "diagnostics/rigid_body_modes_hz", path,
-                                                 "f", 1),
-                   meta=_h5_json(h5, "meta", path),
-                   path_contribution=_h5_paths(h5, path, n))
 
     # ----------------------------------------------------------------- plots
     def plot_paths(self, ax=None, *, path=None, order=2.0, provenance=None):
@@ -340,71 +365,57 @@ class RunupResult:
                           provenance=provenance or getattr(self, "provenance", None))
 
 
-def _h5_array(h5, key, path, kinds, ndim, shape=None):
-    """Dataset ``key`` as an array of dtype kind in ``kinds`` ("f": real, "c": complex),
-    ``ndim`` dimensions and, if given, ``shape``."""
-    import h5py
-
-    from powertrain.errors import InputError
-    obj = h5.get(key)
-    if not isinstance(obj, h5py.Dataset):
-        raise InputError("missing dataset", file=path, key=key)
-    kind = obj.dtype.kind
-    if not (kind in kinds or (kind in "iu" and "f" in kinds)):
-        raise InputError(f"expected numbers, got dtype {obj.dtype}", file=path, key=key)
-    if obj.ndim != ndim or (shape is not None and obj.shape != tuple(shape)):
-        want = shape if shape is not None else f"{ndim} dimensions"
-        raise InputError(f"shape {obj.shape}, expected {want}", file=path, key=key)
-    data = obj[()]
-    return np.asarray(data, dtype=complex if kind == "c" else float)
+def effects_text(scenario) -> str:
+    """``name(param=value, ...); ...`` of the effects added [SI]."""
+    return "; ".join(f"{name}(" + ", ".join(f"{k}={v:g}" for k, v in p.items()) + ")"
+                     for name, p in scenario.items())
 
 
-def _h5_paths(h5, path, n):
-    """/path_contribution/velocity (n_rpm, 3 n_points, 3 n_mounts, n_orders) or None."""
-    from powertrain.errors import InputError
-    if "path_contribution" not in h5:
-        return None
-    key = "path_contribution/velocity"
-    data = _h5_array(h5, key, path, "c", 4)
-    if data.shape[0] != n[0] or data.shape[3] != n[2] or data.shape[1] % 3 or data.shape[2] % 3:
-        raise InputError(f"shape {data.shape} does not fit the speeds and orders", file=path,
-                         key=key)
-    return data
+@dataclass
+class SweepRunup:
+    """A continuous run-up (one speed ramp, time-integrated): the raw recording, as a
+    measurement would give it, and its tracked order curves.
 
+    Attributes
+    ----------
+    recording : Recording
+        Mount-point accelerations against time, with speed (SYNTHETIC; the raw HDF5 layout
+        of :func:`powertrain.iotools.raw_hdf5.write_raw_hdf5`).
+    tracked : TrackedOrders
+        Order curves tracked from it as a measurement is (COT, orders 0.5..8, velocity).
+    rate_rpm_per_s : float
+        Speed ramp [rpm/s].
+    engine : Engine, optional
+        The engine that ran.
+    """
 
-def _h5_names(h5, key, path) -> list[str]:
-    """1-D dataset of strings (bytes or str)."""
-    import h5py
+    recording: object
+    tracked: object
+    rate_rpm_per_s: float
+    engine: object = field(default=None, repr=False, compare=False)
 
-    from powertrain.errors import InputError
-    obj = h5.get(key)
-    if not isinstance(obj, h5py.Dataset) or obj.ndim != 1 or obj.dtype.kind not in "SOU":
-        raise InputError("expected a 1-D dataset of names", file=path, key=key)
-    names = []
-    for v in obj[()]:
-        if isinstance(v, bytes):
-            try:
-                v = v.decode("utf-8")
-            except UnicodeDecodeError:
-                raise InputError("names must be UTF-8", file=path, key=key) from None
-        if not isinstance(v, str):
-            raise InputError("expected names (strings)", file=path, key=key)
-        names.append(v)
-    return names
+    def to_text(self) -> str:
+        """What was simulated and the tracked synthesis RMS velocity at about 12 speeds
+        [mm/s] (what ``powertrain runup --sweep`` prints)."""
+        from powertrain.analysis.text_table import format_table
+        tracked = self.tracked
+        syn = tracked.synthesis_rms() * 1e3
+        labels = [f"{c.mount}.{c.direction}" for c in tracked.channels]
+        step = max(1, len(tracked.rpm) // 12)
+        rows = [[f"{r:g}"] + [float(v) for v in syn[i]]
+                for i, r in list(enumerate(tracked.rpm))[::step]]
+        return "\n".join([self.recording.comments[0],
+                          "tracked synthesis RMS velocity (orders 0.5-8) [mm/s]:",
+                          format_table(["rpm"] + labels, rows, "{:.3f}")])
 
+    def plot(self, ax=None, *, path=None, provenance=None):
+        """The tracked order curves (see :meth:`TrackedOrders.plot`); returns the figure."""
+        return self.tracked.plot(ax, path=path, provenance=provenance)
 
-def _h5_json(h5, attr, path) -> dict:
-    """Attribute ``attr`` holding a JSON object."""
-    from powertrain.errors import InputError
-    raw = h5.attrs.get(attr)
-    if raw is None:
-        raise InputError("missing attribute", file=path, key=attr)
-    if isinstance(raw, bytes):
-        raw = raw.decode("utf-8", errors="replace")
-    try:
-        value = json.loads(str(raw))
-    except ValueError:
-        raise InputError("attribute is not JSON", file=path, key=attr) from None
-    if not isinstance(value, dict):
-        raise InputError("expected a JSON object", file=path, key=attr)
-    return value
+    def to_csv(self, path) -> None:
+        """The tracked curves as long-format CSV."""
+        self.tracked.to_csv(path)
+
+    def to_hdf5(self, path) -> None:
+        """The tracked curves as HDF5."""
+        self.tracked.to_hdf5(path)

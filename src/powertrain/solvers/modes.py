@@ -34,9 +34,6 @@ direction of its rotational part; the angle between the two axes is reported in 
 
 from __future__ import annotations
 
-import json
-from dataclasses import dataclass, field
-
 import numpy as np
 import scipy.linalg as sla
 
@@ -46,140 +43,6 @@ COORDINATES = ("x", "y", "z", "rx", "ry", "rz")
 #: Relative change of s at which the secant iteration stops.
 TOLERANCE = 1e-12
 MAX_ITERATIONS = 60
-
-
-@dataclass
-class Mode:
-    """One rigid-body (or chassis) mode.
-
-    Attributes
-    ----------
-    frequency_hz : float
-        Natural frequency |s|/2π [Hz].
-    damping_ratio : float
-        −Re s/|s| [-] (0 for the static method).
-    damped_frequency_hz : float
-        Im s/2π [Hz].
-    shape : ndarray complex (6,)
-        ``[x, y, z, rx, ry, rz]`` at the CG [m, rad], largest-energy entry real positive,
-        unit modal mass.
-    ked_percent : ndarray (6,)
-        Kinetic-energy distribution [%].
-    angle_to_torque_roll_axis_deg : float
-        Angle between the mode's rotation axis and the torque-roll axis [deg].
-    kind : str
-        ``rigid-body`` or ``chassis``.
-    static_frequency_hz : float
-        Frequency of the undamped static-stiffness mode of the most similar shape (paired
-        one to one by the modal assurance criterion; the frequency itself for the static
-        method) [Hz].
-    static_mac : float
-        Modal assurance criterion between this mode's shape and that static mode's [-].
-    """
-
-    frequency_hz: float
-    damping_ratio: float
-    damped_frequency_hz: float
-    shape: np.ndarray
-    ked_percent: np.ndarray
-    angle_to_torque_roll_axis_deg: float
-    kind: str = "rigid-body"
-    iterations: int = 0
-    body_energy_percent: float = 0.0
-    static_frequency_hz: float = float("nan")
-    static_mac: float = float("nan")
-
-    @property
-    def dominant(self) -> str:
-        return COORDINATES[int(np.argmax(self.ked_percent))]
-
-    def to_dict(self) -> dict:
-        shape = self.shape.real
-        return {"frequency_hz": float(self.frequency_hz),
-                "damping_ratio": float(self.damping_ratio),
-                "dominant": self.dominant,
-                "ked_percent": {c: float(v) for c, v in zip(COORDINATES, self.ked_percent)},
-                "damped_frequency_hz": float(self.damped_frequency_hz),
-                "angle_to_torque_roll_axis_deg": _number_or_null(
-                    self.angle_to_torque_roll_axis_deg),
-                "shape": {c: float(v) for c, v in zip(COORDINATES, shape)},
-                "kind": self.kind,
-                "body_energy_percent": float(self.body_energy_percent),
-                "static_frequency_hz": float(self.static_frequency_hz),
-                "static_mac": float(self.static_mac)}
-
-
-@dataclass
-class ModesResult:
-    """Modes sorted by frequency, the torque-roll axis and the method used."""
-
-    modes: list
-    torque_roll_axis: dict
-    method: str
-    engine: str = ""
-    meta: dict = field(default_factory=dict)
-
-    def to_dict(self) -> dict:
-        return {"modes": [m.to_dict() for m in self.modes],
-                "torque_roll_axis": self.torque_roll_axis, "method": self.method,
-                "engine": self.engine, **self.meta}
-
-    def write_json(self, path) -> None:
-        from powertrain.outputs import atomic_write
-        with atomic_write(path) as fh:
-            json.dump(self.to_dict(), fh, indent=2)
-            fh.write("\n")
-
-    def is_static(self) -> bool:
-        """True for the undamped static-stiffness modes (``--static``)."""
-        return self.method.startswith("static")
-
-    def title(self) -> str:
-        """What these modes are, in one line."""
-        if self.is_static():
-            return (f"{self.engine}: rigid-body modes, undamped, mounts at their static "
-                    "(0 Hz) stiffness (the kind 'powertrain runup' prints)")
-        return (f"{self.engine}: rigid-body modes, damped, each with the mounts' dynamic "
-                "stiffness at its own frequency\n'static f': the undamped static-stiffness "
-                "mode (--static; the kind 'powertrain runup' prints) of the most similar "
-                "shape, paired one to one; MAC: their shape correlation")
-
-    def to_text(self) -> str:
-        """Table of the modes, sorted by frequency, with a note on signed energy shares."""
-        static = self.is_static()
-        head = (f"{'mode':>4}  {'f [Hz]':>7}  {'zeta':>6}"
-                + ("" if static else f"  {'static f':>8}  {'MAC':>4}") + f"  {'dominant':>8}  "
-                + "  ".join(f"{c:>6}" for c in COORDINATES) + "  TRA angle")
-        lines = [self.title(), head, "-" * len(head)]
-        for i, m in enumerate(self.modes, 1):
-            tag = "" if m.kind == "rigid-body" else f"  ({m.kind})"
-            lines.append(f"{i:4d}  {m.frequency_hz:7.3f}  {m.damping_ratio:6.3f}"
-                         + ("" if static else f"  {m.static_frequency_hz:8.3f}  "
-                                               f"{m.static_mac:4.2f}")
-                         + f"  {m.dominant:>8}  "
-                         + "  ".join(f"{round(v, 1) or 0.0:6.1f}" for v in m.ked_percent)
-                         + f"  {m.angle_to_torque_roll_axis_deg:6.1f} deg{tag}")
-        t = self.torque_roll_axis
-        d = ", ".join(f"{v:.4f}" for v in t["direction"])
-        lines.append(f"torque-roll axis through the CG, direction [{d}] (engine axes), "
-                     f"{t['angle_to_crank_axis_deg']:.2f} deg from the crank axis")
-        lowest = min(float(np.min(m.ked_percent)) for m in self.modes)
-        if round(lowest, 1) < 0:
-            lines.append(f"energy shares are signed (lowest {lowest:.1f} %): the products of "
-                         "inertia couple rx, ry, rz" + ("" if static else " and damped shapes "
-                                                        "are complex")
-                         + ", so a coordinate can hold a slightly negative share; each row "
-                         "adds up to 100 %")
-        return "\n".join(lines)
-
-    def plot(self, ax=None, *, path=None, provenance=None):
-        """Stacked kinetic-energy distribution per mode (PNG when ``path`` is given);
-        returns the figure."""
-        from powertrain.plotting.body import plot_modes
-        from powertrain.plotting.style import target_and_path
-        ax, path = target_and_path(ax, path)
-        return plot_modes(self, path, ax=ax,
-                          provenance=provenance or getattr(self, "provenance", None))
 
 
 # ---------------------------------------------------------------------------- physics
@@ -198,7 +61,7 @@ def kinetic_energy_percent(M6, phi) -> np.ndarray:
     return 100.0 * e / e.sum()
 
 
-def _number_or_null(value):
+def number_or_null(value):
     """``value`` as a float, or None (JSON null) where it is undefined (NaN: the rotation
     axis of a mode without rotation)."""
     return float(value) if np.isfinite(value) else None
@@ -328,8 +191,7 @@ def _state_space_eigenvalues(system) -> np.ndarray:
     return lam[np.isfinite(lam)]
 
 
-def rigid_body_modes(system, inertia, *, static=False, crank_axis=(1.0, 0.0, 0.0),
-                     engine_name="") -> ModesResult:
+def rigid_body_modes(system, inertia, *, static=False, crank_axis=(1.0, 0.0, 0.0)) -> dict:
     """The six rigid-body modes of an assembled powertrain, plus the body modes of a modal
     chassis (coupled through the mounts).
 
@@ -346,8 +208,9 @@ def rigid_body_modes(system, inertia, *, static=False, crank_axis=(1.0, 0.0, 0.0
         Static stiffness, undamped (else: dynamic stiffness at each mode's own frequency).
     crank_axis : array_like (3,)
         Unit vector of the crank axis in engine axes (engine X).
-    engine_name : str, optional
-        Recorded in the result (reports, plots).
+
+    Returns ``{"modes": [fields of a powertrain.results.modes.Mode, by frequency],
+    "torque_roll_axis": {...}, "method": str}``.
     """
     keep = system.retained
     MR = system.M[np.ix_(keep, keep)]
@@ -366,64 +229,23 @@ def rigid_body_modes(system, inertia, *, static=False, crank_axis=(1.0, 0.0, 0.0
         body_share = 100.0 * e[6:].sum() / e.sum()
         ked = kinetic_energy_percent(M6, phi[:6])
         rot = phi[3:6].real
-        modes.append(Mode(frequency_hz=abs(s) / (2 * np.pi),
-                          damping_ratio=0.0 if static else float(-s.real / abs(s)),
-                          damped_frequency_hz=float(s.imag / (2 * np.pi)), shape=phi[:6],
-                          ked_percent=ked, angle_to_torque_roll_axis_deg=_axis_angle_deg(
-                              rot, tra), iterations=its,
-                          kind="rigid-body" if body_share < 50.0 else "chassis",
-                          body_energy_percent=float(body_share),
-                          static_frequency_hz=float(omegas[k] / (2 * np.pi)),
-                          static_mac=mac))
-    modes.sort(key=lambda m: m.frequency_hz)
+        modes.append({"frequency_hz": abs(s) / (2 * np.pi),
+                      "damping_ratio": 0.0 if static else float(-s.real / abs(s)),
+                      "damped_frequency_hz": float(s.imag / (2 * np.pi)), "shape": phi[:6],
+                      "ked_percent": ked, "iterations": its,
+                      "angle_to_torque_roll_axis_deg": _axis_angle_deg(rot, tra),
+                      "kind": "rigid-body" if body_share < 50.0 else "chassis",
+                      "body_energy_percent": float(body_share),
+                      "static_frequency_hz": float(omegas[k] / (2 * np.pi)),
+                      "static_mac": mac})
+    modes.sort(key=lambda m: m["frequency_hz"])
     crank = np.asarray(crank_axis, float)
     tra_info = {"direction": [float(v) for v in tra],
                 "angle_to_crank_axis_deg": _axis_angle_deg(tra, crank),
                 "angles_to_mode_rotation_axes_deg": [
-                    _number_or_null(m.angle_to_torque_roll_axis_deg) for m in modes],
+                    number_or_null(m["angle_to_torque_roll_axis_deg"]) for m in modes],
                 "through": "centre of gravity"}
     method = ("static: static stiffness, undamped" if static else
               "dynamic: network dynamic stiffness at each mode's complex frequency "
               "(internal degrees of freedom condensed exactly, secant iteration)")
-    return ModesResult(modes=modes, torque_roll_axis=tra_info, method=method,
-                       engine=engine_name)
-
-
-def engine_modes(engine, *, static=False) -> ModesResult:
-    """:func:`rigid_body_modes` of an :class:`~powertrain.models.engine.Engine`.
-
-    Raises
-    ------
-    InputError
-        Naming the engine file, when the model cannot be solved or a mode is not finite
-        (values at the edge of the float range, a body mode that couples to nothing).
-    """
-    from powertrain.assembly import assemble
-    from powertrain.errors import InputError
-    b = engine.body
-    chassis = engine.chassis if getattr(engine.chassis, "body_modes", ()) else None
-    try:
-        with np.errstate(all="ignore"):
-            system = assemble(b.mass, b.cg, b.inertia, engine.mounts, chassis)
-            result = rigid_body_modes(system, b.inertia, static=static,
-                                      engine_name=engine.name)
-    except (ValueError, ArithmeticError, np.linalg.LinAlgError) as exc:
-        raise InputError(f"the modes cannot be computed ({type(exc).__name__}: "
-                         f"{str(exc)[:100]}): mount, body or chassis values out of any "
-                         "physical range", file=engine.file, key="mounts") from None
-    for i, mode in enumerate(result.modes, 1):
-        if not _finite(mode):
-            key = "chassis.modes" if mode.kind == "chassis" else "mounts"
-            raise InputError(f"mode {i} ({mode.kind}) is not finite (NaN or inf): values out "
-                             "of any physical range, or a body mode whose shape is zero at "
-                             "every mount", file=engine.file, key=key)
-    result.meta["cg_m"] = [float(v) for v in b.cg]
-    result.meta["mounts"] = engine.mount_names
-    return result
-
-
-def _finite(mode: Mode) -> bool:
-    numbers = [mode.frequency_hz, mode.damping_ratio, mode.damped_frequency_hz,
-               mode.body_energy_percent]          # the axis angle may be undefined (NaN)
-    return bool(np.all(np.isfinite(numbers)) and np.all(np.isfinite(mode.shape))
-                and np.all(np.isfinite(mode.ked_percent)))
+    return {"modes": modes, "torque_roll_axis": tra_info, "method": method}

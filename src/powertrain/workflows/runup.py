@@ -1,4 +1,9 @@
-r"""The run-up orchestrator: engine -> assembled model -> solver -> order results.
+r"""The run-up: engine -> assembled model -> solver -> order results.
+
+:func:`runup` is the public entry (the ``powertrain runup`` command calls it): the engine
+checked, balancers and unmodelled effects applied, the settings checked, then a stepped run-up
+(:func:`run_runup`, :func:`runup_with_effects`) or a continuous one (``sweep``, tracked like a
+measurement).
 
 For each speed step the load over one engine cycle is sampled at a constant crank-angle
 increment. Two solvers give the periodic steady state of the same assembled linear model:
@@ -26,8 +31,9 @@ import numpy as np
 
 from powertrain.analysis.orders import ORDERS
 from powertrain.assembly import assemble
+from powertrain.errors import InputError, require_finite, solved
 from powertrain.progress import progress_bar
-from powertrain.results.runup import RunupResult
+from powertrain.results.runup import RunupResult, SweepRunup
 from powertrain.solvers.steppers import Cycles, choose_stepper
 
 #: Default crank-angle increment [deg]; halving it moves the results < 0.1 % (see tests).
@@ -40,6 +46,12 @@ PERIODICITY_LIMIT = 1e-3
 #: Speed steps run concurrently in threads (the Newmark kernel releases the GIL); serial by
 #: default: on a busy 2-core machine threads were measured slower.
 WORKERS = 1
+#: Finest crank-angle step [deg] of the Newmark stepper (720 / 0.05 = 14 400 steps a cycle).
+MIN_ANGLE_STEP_DEG = 0.05
+#: Coarsest crank-angle step [deg]: 72 steps a cycle still resolve order 8 without aliasing.
+MAX_ANGLE_STEP_DEG = 10.0
+#: Speed grid of the tracked curves of a continuous run-up [rpm] (the ``track`` default).
+TRACK_RPM_STEP = 50.0
 
 
 class PeriodicityWarning(UserWarning):
@@ -204,4 +216,210 @@ def path_contributions(system, rpm, force) -> np.ndarray:
     GE = G @ E                                                     # (n_rpm, n_o, 3 n_p, n_a)
     f_local = np.einsum("ap,ika->ikp", E, np.moveaxis(force[:, :n_a, :], 1, 2))   # e_p . f
     out[:] = np.moveaxis(1j * w[..., None, None] * GE * f_local[:, :, None, :], 1, 3)
+    return out
+
+
+# --------------------------------------------------------------------------- effects
+def runup_with_effects(engine, rpm, scenario: dict, **options):
+    """Run-up of ``engine`` with the effects of ``scenario`` (``{effect: {parameter:
+    value}}``, SI) through :func:`run_runup` (``**options``: its keyword arguments);
+    ``settings["effects"]`` records the scenario.
+
+    * engine-model effects change the engine (``Effect.apply``), in registry order;
+    * amplitude-dependent effects: the factors :math:`g(a_n)` of the equivalent linearisation
+      are converged at each speed on the frequency-domain model
+      (:func:`powertrain.effects.predict`); then each speed step runs with every network's
+      springs and dampers scaled by its factor at that speed (``meta["amplitude_factors"]``);
+    * sensor effects: the channels' displacement, velocity and acceleration are read through
+      the effect (the transmitted forces are not sensor readings and stay as they are).
+    """
+    from powertrain.effects import EFFECTS, check_scenario, predict, with_network_elastomer
+    from powertrain.solvers.fast_harmonic import HarmonicModel
+    sc = check_scenario(scenario, engine)
+    rpm = np.atleast_1d(np.asarray(rpm, float))
+    for name, eff in EFFECTS.items():
+        if name in sc and eff.engine_change:
+            engine = eff.apply(engine, **sc[name])
+    amp = {n: p for n, p in sc.items()
+           if EFFECTS[n].amplitude_factors(np.ones((1, 1)), p) is not None}
+    if amp:
+        g = predict(HarmonicModel(engine, rpm), amp).factors
+        parts = [run_runup(with_network_elastomer(engine, g[i]), [r], **options)
+                 for i, r in enumerate(rpm)]
+        result = _concatenate(parts)
+        result.rigid_body_modes_hz = run_runup(engine, rpm[:1], solver="harmonic"
+                                               ).rigid_body_modes_hz
+        result.meta["amplitude_factors"] = g.tolist()
+    else:
+        result = run_runup(engine, rpm, **options)
+    for name, p in sc.items():
+        if EFFECTS[name].response_only:
+            for attr in ("displacement", "velocity", "acceleration"):
+                setattr(result, attr, EFFECTS[name].reading(getattr(result, attr), p))
+    result.settings["effects"] = sc
+    return result
+
+
+def _concatenate(parts):
+    """One RunupResult from single-speed results (same channels and orders)."""
+    import dataclasses
+    first = parts[0]
+    out = dataclasses.replace(first)
+    for attr in ("rpm", "displacement", "velocity", "acceleration", "mount_force",
+                 "mean_mount_force", "periodicity"):
+        setattr(out, attr, np.concatenate([getattr(p, attr) for p in parts], axis=0))
+    out.solver_seconds = float(sum(p.solver_seconds for p in parts))
+    out.settings = dict(first.settings)
+    out.meta = dict(first.meta)
+    return out
+
+
+# --------------------------------------------------------------------------- public entry
+def runup(engine=None, rpm=None, *, solver="newmark", stepper="auto",
+          angle_step_deg=ANGLE_STEP_DEG, balancers=True, effects=(), sweep=None,
+          sample_rate=8192.0, progress=False):
+    """A run-up of ``engine`` as the ``powertrain runup`` command runs it.
+
+    Parameters
+    ----------
+    engine : Engine, str or Path, optional
+        The engine, or its file (default: the shipped ``engines/default.toml``).
+    rpm : array_like, optional
+        Speed steps [rpm] (default 1000..6000 step 500); with ``sweep``, the ramp runs from
+        the first to the last.
+    solver, stepper, angle_step_deg :
+        As in :func:`run_runup`.
+    balancers : bool
+        False switches the balancer shafts off.
+    effects : sequence of str or dict
+        Unmodelled effects, as the command's ``--effect`` strings
+        (``"base_compliance:c_base=400N/mm,m_base=8kg"``) or a scenario
+        ``{effect: {parameter: value}}`` [SI].
+    sweep : float, optional
+        Continuous run-up at this rate [rpm/s] (time integration of one speed ramp), tracked
+        like measured data (no effects).
+    sample_rate : float
+        With ``sweep``: sampling rate of the raw data [Hz].
+    progress : bool
+        Progress bar on stderr.
+
+    Returns
+    -------
+    RunupResult, or SweepRunup with ``sweep``
+        ``to_text()`` is what the command prints; ``plot(ax=None)``, ``to_csv``, ``to_hdf5``.
+
+    Raises
+    ------
+    InputError
+        Naming the engine file and key, or the option, of bad input.
+    """
+    from powertrain.iotools.engine_file import engine_or_default
+    engine = engine_or_default(engine)
+    engine.require_excitation()
+    modifications = []
+    if not balancers:
+        engine = engine.with_balancers(enabled=False)
+        modifications.append("balancer shafts switched off (--no-balancers)")
+    if sweep is not None:
+        return _sweep_runup(engine, rpm, sweep, sample_rate, effects, progress)
+    rpm = _speeds(rpm)
+    scenario = _scenario(effects, engine)
+    check_runup_settings(engine, rpm, angle_step_deg)
+    result = _stepped(engine, rpm, scenario, progress, solver=solver,
+                      angle_step_deg=angle_step_deg, stepper=stepper)
+    result.engine, result.modifications = engine, modifications
+    result.meta["engine_file"] = str(engine.file)
+    result.meta["rigid_body_mode_dominant"] = mode_coordinates(engine,
+                                                               result.rigid_body_modes_hz)
+    return result
+
+
+def _stepped(engine, rpm, scenario, progress, **options) -> RunupResult:
+    """The stepped run-up, with the effects of ``scenario`` if any, checked finite."""
+    if not scenario:
+        return checked_runup(engine, engine.file, run_runup, rpm, progress=progress,
+                             **options)
+    from powertrain.progress import activity
+    with activity(f"run-up with effects ({options['solver']})", enabled=progress):
+        return checked_runup(engine, engine.file, runup_with_effects, rpm, scenario,
+                             **options)
+
+
+def _scenario(effects, engine) -> dict:
+    """``{effect: {parameter: value}}`` of ``--effect`` strings (or a scenario as given)."""
+    if isinstance(effects, dict):
+        return effects
+    from powertrain.workflows.variants import effect_scenario, parse_operations
+    return effect_scenario(parse_operations({"effect": list(effects)}, engine=engine))
+
+
+def _sweep_runup(engine, rpm, rate, sample_rate, effects, progress) -> SweepRunup:
+    """Simulate the speed ramp and track it (COT, orders 0.5..8, as velocity)."""
+    from powertrain.solvers.speed_ramp import simulate_sweep
+    from powertrain.workflows.tracking import track_recording
+    if effects:
+        raise InputError("effects are not simulated in a sweep (use stepped run-ups)",
+                         key="--effect")
+    rpm = _speeds(rpm)
+    rec = simulate_sweep(engine, rpm[0], rpm[-1], rate, sample_rate, progress=progress)
+    tracked = track_recording(rec, rpm_step=TRACK_RPM_STEP, progress=progress).as_velocity()
+    return SweepRunup(recording=rec, tracked=tracked, rate_rpm_per_s=float(rate),
+                      engine=engine)
+
+
+def check_runup_settings(engine, rpm, angle_step: float) -> None:
+    """Check a run-up's speeds against the engine's range and the crank-angle step, naming
+    the option at fault."""
+    import math
+    lo, hi = engine.speed_range_rpm()
+    if rpm[0] < lo - 1e-6:
+        raise InputError(f"{rpm[0]:g} rpm is below the engine's range {lo:g}..{hi:g} rpm",
+                         key="--from")
+    if rpm[-1] > hi + 1e-6:
+        raise InputError(f"{rpm[-1]:g} rpm is above the engine's range {lo:g}..{hi:g} rpm",
+                         key="--to")
+    n_cycle = 720.0 / angle_step if math.isfinite(angle_step) and angle_step > 0 else 0.0
+    if not (MIN_ANGLE_STEP_DEG <= angle_step <= MAX_ANGLE_STEP_DEG
+            and abs(n_cycle - round(n_cycle)) < 1e-9 and round(n_cycle) % 2 == 0):
+        raise InputError(f"{angle_step:g} deg: must divide 720 deg into an even number of "
+                         f"steps, {MIN_ANGLE_STEP_DEG:g}..{MAX_ANGLE_STEP_DEG:g} deg "
+                         "(e.g. 0.5, 1, 2)", key="--angle-step")
+
+
+def check_path_plot(engine, order) -> None:
+    """A path-contribution plot needs body points, and ``order`` must be an analysed one."""
+    if not getattr(engine.chassis, "points", ()):
+        raise InputError("needs body points ([chassis.points.NAME] with a modal or frf "
+                         "chassis)", file=engine.file, key="--path-plot")
+    if not np.any(np.isclose(ORDERS, order)):
+        raise InputError(f"order {order:g} not analysed (0.5 to 8 in steps of 0.5)",
+                         key="--path-order")
+
+
+def checked_runup(engine, engine_path, run, *args, **kwargs):
+    """``run(engine, *args, **kwargs)`` (a run-up) through :func:`~powertrain.errors.solved`,
+    its result checked finite (errors name the engine file)."""
+    result = solved(lambda: run(engine, *args, **kwargs), engine_path, "engine")
+    require_finite({name.replace("_", " "): getattr(result, name) for name in (
+        "displacement", "velocity", "acceleration", "mount_force", "mean_mount_force")},
+        engine_path, "engine")
+    return result
+
+
+def mode_coordinates(engine, frequencies_hz) -> list:
+    """The dominant coordinate (largest kinetic-energy share) of each static-stiffness mode
+    of ``engine``, from the same eigenproblem as the run-up's
+    (:meth:`~powertrain.assembly.AssembledSystem.rigid_body_modes`), matched by frequency;
+    ``""`` where ``frequencies_hz`` holds a mode ``engine`` does not have (an effect moved
+    it)."""
+    from powertrain.solvers.modes import COORDINATES, kinetic_energy_percent
+    b = engine.body
+    system = assemble(b.mass, b.cg, b.inertia, engine.mounts, getattr(engine, "chassis", None))
+    f_sys, shapes = system.rigid_body_modes()
+    out = []
+    for f in frequencies_hz:
+        k = int(np.argmin(np.abs(f_sys - f)))
+        energy = kinetic_energy_percent(system.M[:6, :6], shapes[:, k])
+        out.append(COORDINATES[int(np.argmax(energy))]
+                   if abs(f_sys[k] - f) <= 1e-6 * max(f, 1.0) else "")
     return out

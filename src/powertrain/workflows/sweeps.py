@@ -67,19 +67,18 @@ class SweepTask:
 def run_task(task: SweepTask):
     """Apply the task's operations to its engine and run the run-up (response-level
     effects, :func:`powertrain.workflows.variants.response_scenario`, through
-    :func:`powertrain.workflows.effect_runup.runup_with_effects`).
+    :func:`powertrain.workflows.runup.runup_with_effects`).
 
     Returns
     -------
     RunupResult
         ``meta["variant"]`` holds the task name.
     """
-    from powertrain.workflows.runup import run_runup
+    from powertrain.workflows.runup import run_runup, runup_with_effects
     from powertrain.workflows.variants import apply_operations, response_scenario
     engine = apply_operations(task.engine, task.operations)
     response = response_scenario(task.operations)
     if response:        # amplitude-dependent mounts, sensor errors: see effects module
-        from powertrain.workflows.effect_runup import runup_with_effects
         result = runup_with_effects(engine, task.rpm, response, solver=task.solver,
                                     **task.options)
     else:

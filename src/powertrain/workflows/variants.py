@@ -42,7 +42,7 @@ mount, ``x``, ``y``, ``z`` or ``*``; the default engine's mounts are ``left``, `
                                            VALUE in the parameter's unit (N/m, kg, rad,
                                            dB, 1) or an explicit one of the same
                                            dimension; inside the effect's bounds; run by
-                                           :func:`powertrain.workflows.effect_runup.runup_with_effects`
+                                           :func:`powertrain.workflows.runup.runup_with_effects`
 =========================================  ==================================================
 
 What "scale stiffness" means for a lumped network
@@ -282,7 +282,7 @@ class AddEffect:
     Engine-model effects are applied by :meth:`apply`; the response-level ones
     (``amplitude_stiffness``, ``sensor_error``) leave the engine unchanged here and are
     applied to the run-up by :func:`powertrain.workflows.sweeps.run_task` through
-    :func:`powertrain.workflows.effect_runup.runup_with_effects`.
+    :func:`powertrain.workflows.runup.runup_with_effects`.
 
     Attributes
     ----------
