@@ -100,7 +100,7 @@ def test_output_rate_at_the_internal_rate_needs_no_decimation():
     integration grid (h = 1/16384 s) output undecimated at 16384 Hz and decimated to 8192 Hz
     (zero-phase FIR, pass band up to ~3 kHz, far above the engine's orders here) agree at the
     common instants."""
-    from powertrain.solvers.sweep import simulate_sweep
+    from powertrain.solvers.speed_ramp import simulate_sweep
     engine = read_engine(DEFAULT_ENGINE_PATH)
     fine = simulate_sweep(engine, 2000.0, 2300.0, 300.0, sample_rate=16384.0)
     coarse = simulate_sweep(engine, 2000.0, 2300.0, 300.0, sample_rate=8192.0)

@@ -207,8 +207,7 @@ def _track_vkf(rec, chans, profile, orders, rpm_step, bandwidth_hz, progress):
                 f"least {vk.EDGE_TIME_CONSTANTS:g} / ({vk.EDGE_FRACTION:g} x record length), "
                 f"at most order spacing / {vk.SPACING_RATIO:g}")
     else:
-        if not (np.isfinite(bandwidth_hz) and bandwidth_hz > 0):
-            raise InputError("must be > 0 [Hz]", key="--bandwidth")
+        vk.check_bandwidth(float(bandwidth_hz), rec.time[-1] - rec.time[0], rec.sample_rate)
         width = np.full((orders.size, profile.time.size), float(bandwidth_hz))
         rule = "given (--bandwidth)"
     i0, i1 = profile.valid
