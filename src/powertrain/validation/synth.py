@@ -351,20 +351,35 @@ class SynthCase:
 
     def plot(self, ax=None, *, path=None, mount=None, direction="z", provenance=None):
         """The measured order curves [mm/s RMS] of one channel (default: the first mount,
-        ``direction``) against speed, into ``ax`` or a new figure; returns the figure."""
-        from powertrain.plotting.style import finish, log_axis, subplots, target_and_path
+        ``direction``) against speed, with the generator's noise floor, into ``ax`` or a new
+        figure; returns the figure."""
+        from powertrain.plotting.style import (
+            figure_legend,
+            finish,
+            log_axis,
+            series_style,
+            subplots,
+            target_and_path,
+        )
+        from powertrain.validation.cases import FLOOR
         ax, path = target_and_path(ax, path)
         curves = self.measured.curves
         mount = mount or next(iter(curves))[0]
         fig, axes, own = subplots(ax)
         a = axes[0, 0]
-        for (m, d, q), (rpm, v) in curves.items():
-            if (m, d) == (mount, direction) and q != "synthesis":
-                a.plot(rpm, np.asarray(v) * 1e3, lw=1.0, label=q.replace("_", " "))
+        drawn = [(q, rpm, v) for (m, d, q), (rpm, v) in curves.items()
+                 if (m, d) == (mount, direction) and q != "synthesis"]
+        for k, (q, rpm, v) in enumerate(drawn):
+            a.plot(rpm, np.asarray(v) * 1e3, lw=1.0, label=q.replace("_", " "),
+                   **series_style(k))
+        a.axhline(FLOOR * 1e3, color="0.4", lw=0.8, ls=(0, (1, 2)), label="noise floor")
         log_axis(a, "y")
         a.set_xlabel("engine speed [rpm]")
         a.set_ylabel(f"{mount} {direction} velocity [mm/s RMS]")
-        a.legend(fontsize=7, ncol=4)
+        if own:
+            figure_legend(fig, axes)
+        else:
+            a.legend(fontsize=7, ncol=3)
         return finish(fig, own, path, provenance,
                       title=f"synthetic measured run-up (seed {self.seed}): {self.to_text()}")
 
