@@ -76,50 +76,56 @@ def diagnose(measured, engine_file, report_dir, json_file, noise_floor, effects,
       powertrain synth --effect balancer_error --seed 3 --out case.csv
       powertrain diagnose case.csv --report out/diag --json out/diag.json
     """
-    import math
-    from pathlib import Path
-
+    from powertrain.cli.common import check_outputs
     from powertrain.diagnosis import diagnose as run
-    from powertrain.effects import EFFECTS
-    from powertrain.errors import InputError
-    from powertrain.iotools.engine_file import DEFAULT_ENGINE_PATH, read_engine
-    from powertrain.iotools.measured import read_measured
-
-    if not (math.isfinite(noise_floor) and noise_floor >= 0):
-        raise InputError("must be a finite number >= 0 [mm/s]", key="--noise-floor")
-    names = [e.strip() for e in effects.split(",") if e.strip()] or None
-    for e in names or []:
-        if e not in EFFECTS:
-            raise InputError(f"unknown effect {e!r} (known: {', '.join(EFFECTS)})",
-                             key="--effects")
-    from powertrain.cli.common import check_outputs, write_json
     from powertrain.parallel import check_scheduler
     from powertrain.progress import activity
+
+    noise_floor = _noise_floor(noise_floor)
+    names = [e.strip() for e in effects.split(",") if e.strip()] or None
     scheduler = check_scheduler(scheduler or "serial", reach=True)
     check_outputs(json=json_file)
-    if report_dir:
-        from powertrain.outputs import check_writable
-        check_writable(Path(report_dir) / "summary.txt", key="--report")
-    engine = read_engine(engine_file or str(DEFAULT_ENGINE_PATH))
-    meas = read_measured(measured, mounts=engine.mount_names)
-    if meas.signal != "velocity":
-        raise InputError("diagnose needs velocity, acceleration or displacement order curves "
-                         f"(this file holds {meas.signal})", file=measured)
+    _check_report(report_dir)
     with activity("diagnose (fitting the effect library)", enabled=not quiet):
-        res = run(meas, engine, noise_floor=noise_floor * 1e-3, effects=names,
+        res = run(measured, engine_file, noise_floor=noise_floor, effects=names,
                   pairs=not no_pairs, scheduler=scheduler, progress=False)
-    click.echo(res.summary())
+    click.echo(res.to_text())
     if json_file:
-        from powertrain.provenance import provenance
-        write_json(json_file, res.to_json(),
-                   provenance(engine, engine_file=engine_file or DEFAULT_ENGINE_PATH))
-        click.echo(f"wrote {json_file}")
+        _write_json(res, json_file, engine_file)
     if report_dir:
         from powertrain.cli.common import cli_provenance, engine_description, use_agg
         use_agg()
         files = res.report(report_dir, provenance=cli_provenance(
-            engine_description(engine, engine.file)))
+            engine_description(res.engine, res.engine.file)))
         click.echo(f"wrote {len(files)} files to {report_dir}")
+
+
+def _noise_floor(value: float) -> float:
+    """``--noise-floor`` [mm/s] checked, in SI [m/s]."""
+    import math
+
+    from powertrain.errors import InputError
+    from powertrain.units import to_si
+    if not (math.isfinite(value) and value >= 0):
+        raise InputError("must be a finite number >= 0 [mm/s]", key="--noise-floor")
+    return to_si(value, "mm/s", "velocity")
+
+
+def _check_report(report_dir) -> None:
+    if report_dir:
+        from pathlib import Path
+
+        from powertrain.outputs import check_writable
+        check_writable(Path(report_dir) / "summary.txt", key="--report")
+
+
+def _write_json(res, json_file, engine_file) -> None:
+    from powertrain.cli.common import write_json
+    from powertrain.iotools.engine_file import DEFAULT_ENGINE_PATH
+    from powertrain.provenance import provenance
+    write_json(json_file, res.to_json(),
+               provenance(res.engine, engine_file=engine_file or DEFAULT_ENGINE_PATH))
+    click.echo(f"wrote {json_file}")
 
 
 @main.command()
@@ -143,39 +149,16 @@ def synth(effect_names, seed, out, truth_file, engine_file, quiet):
       powertrain synth --effect mount_temperature --seed 1 --out m.csv --truth t.json
       powertrain synth --effect none --out clean.csv
     """
-    import json
-
-    import numpy as np
-
-    from powertrain.errors import InputError
-    from powertrain.iotools.engine_file import DEFAULT_ENGINE_PATH, read_engine
-    from powertrain.outputs import atomic_write
-    from powertrain.validation.synth import TRUTH_EFFECTS, make_case, truth_effect_name
-
-    names = [] if effect_names.strip() == "none" else [
-        truth_effect_name(e.strip()) for e in effect_names.split(",") if e.strip()]
-    for e in names:
-        if e not in TRUTH_EFFECTS:
-            raise InputError(f"unknown truth effect {e!r} (known: {', '.join(TRUTH_EFFECTS)})",
-                             key="--effect")
-    engine = read_engine(engine_file or str(DEFAULT_ENGINE_PATH))
     from powertrain.cli.common import check_outputs
     from powertrain.progress import activity
-    if not 0 <= seed < 2 ** 63:
-        raise InputError(f"must be an integer 0..2^63-1, got {seed}", key="--seed")
+    from powertrain.validation.synth import synth as run
+
+    names = [] if effect_names.strip() == "none" else [
+        e.strip() for e in effect_names.split(",") if e.strip()]
     check_outputs(out=out, truth=truth_file)
     with activity("synth (simulating the hidden truth)", enabled=not quiet):
-        case = make_case(engine, names, seed)
-    with atomic_write(out) as fh:
-        fh.write(case.csv_text())
+        case = run(names, seed, engine=engine_file)
+    case.to_csv(out)
     if truth_file:
-        def conv(x):
-            return x.tolist() if isinstance(x, np.ndarray) else float(x)
-        doc = {"seed": seed, "noise_db": case.noise_db, "effect_rms_db": case.effect_rms_db,
-               "truth": [{"effect": n, "library_match": TRUTH_EFFECTS[n],
-                          "parameters": {k: conv(v) for k, v in p.items()}}
-                         for n, p in case.truth]}
-        with atomic_write(truth_file) as fh:
-            fh.write(json.dumps(doc, indent=1))
-    click.echo(f"wrote {out}: {len(names) or 'no'} hidden effect(s), noise "
-               f"{case.noise_db:.2f} dB, noise-free effect {case.effect_rms_db:.2f} dB RMS")
+        case.to_truth_json(truth_file)
+    click.echo(f"wrote {out}: {case.to_text()}")

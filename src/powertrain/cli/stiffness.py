@@ -48,70 +48,36 @@ def stiffness(mount_file, engine_file, mount_dir, freq, method, fmt, plot, form,
           --engine-mass 100 --force 100 --method time --format csv
       powertrain stiffness --engine engines/default-torque-rod.toml --mount torque_rod.x
     """
-    from powertrain.cli.common import parse_frequencies
-    from powertrain.errors import InputError
-    from powertrain.workflows.stiffness import stiffness_table
+    from powertrain.cli.common import parse_frequencies, require_finite, solved
+    from powertrain.workflows.stiffness import stiffness as run
 
-    if (engine_mass is None) != (force is None):
-        raise InputError("--engine-mass and --force go together", key="--engine-mass")
-    if engine_mass is not None and not 0 < engine_mass < float("inf"):
-        raise InputError(f"must be positive and finite, got {engine_mass}", key="--engine-mass")
-    if force is not None and not abs(force) < float("inf"):
-        raise InputError(f"must be a finite force [N], got {force}", key="--force")
     freqs = parse_frequencies(freq)
-    if method == "time" and freqs[0] <= 0:
-        raise InputError("the time method needs frequencies > 0 Hz", key="--freq")
-    model, label = _model(mount_file, engine_file, mount_dir)
-    from powertrain.cli.common import require_finite, solved
+    mount = _mount(mount_file, engine_file, mount_dir)
     source = mount_file or engine_file
     key = "parameters" if mount_file else f"--mount {mount_dir}"
-    table = solved(lambda: stiffness_table(model, freqs, method=method,
-                                           engine_mass=engine_mass, force=force), source, key)
-    require_finite(table.columns(), source, key)
+    result = solved(lambda: run(mount, engine=engine_file, freq=freqs, method=method,
+                                engine_mass=engine_mass, force=force), source, key)
+    require_finite(result.columns(), source, key)
     if plot:
         from powertrain.cli.common import cli_provenance, write_plot
         prov = cli_provenance()
-        write_plot(lambda p: table.plot(path=p, label=model.name or label, form=form,
-                                        freq_axis=freq_axis, provenance=prov), plot)
+        write_plot(lambda p: result.plot(path=p, form=form, freq_axis=freq_axis,
+                                         provenance=prov), plot)
     explicit = click.get_current_context().get_parameter_source("fmt").name != "DEFAULT"
     if plot and not explicit:
-        click.echo(_summary(table))
+        click.echo(result.summary())
     else:
-        click.echo(table.to_csv() if fmt == "csv" else table.to_text(), nl=False)
+        click.echo(result.to_csv() if fmt == "csv" else result.to_text(), nl=False)
     if plot:   # on stderr when stdout carries CSV (often redirected to a file)
         click.echo(f"wrote {plot}", err=explicit and fmt == "csv")
 
 
-def _summary(table) -> str:
-    """What a plot reader checks first: |K*| range and the loss-angle peak, in N/mm, deg."""
-    import numpy as np
-    cols = table.columns()
-    f, k, phi = cols["frequency_hz"], cols["k_abs_n_per_mm"], cols["loss_angle_deg"]
-    lo, hi, top = int(np.argmin(k)), int(np.argmax(k)), int(np.argmax(phi))
-    return (f"# method: {table.method}; {f.size} frequencies {f[0]:g}..{f[-1]:g} Hz "
-            "(every value: --format table or csv)\n"
-            f"|K*| {k[0]:.4g} N/mm at {f[0]:g} Hz; min {k[lo]:.4g} N/mm at {f[lo]:g} Hz, "
-            f"max {k[hi]:.4g} N/mm at {f[hi]:g} Hz\n"
-            f"loss angle max {phi[top]:.3g} deg at {f[top]:g} Hz")
-
-
-def _model(mount_file, engine_file, mount_dir):
-    """The mount model of MOUNT_FILE, or of --mount in --engine (an engine file without
-    excitation sections is enough)."""
+def _mount(mount_file, engine_file, mount_dir):
+    """The ``mount`` of :func:`powertrain.workflows.stiffness.stiffness`: MOUNT_FILE, or
+    --mount of --engine."""
     from powertrain.errors import InputError
-    from powertrain.iotools.mount_file import read_mount
     if (mount_file is None) == (engine_file is None):
         raise InputError("give either MOUNT_FILE or --engine with --mount", key="MOUNT_FILE")
-    if mount_file is not None:
-        if mount_dir:
-            raise InputError("--mount goes with --engine", key="--mount")
-        return read_mount(mount_file), mount_file
-    from powertrain.iotools.engine_file import read_engine
-    engine = read_engine(engine_file)
-    parts = (mount_dir or "").split(".")
-    names = engine.mount_names
-    if len(parts) != 2 or parts[0] not in names or parts[1] not in ("x", "y", "z"):
-        raise InputError(f"expected MOUNT.DIR with MOUNT one of {', '.join(names)} and DIR "
-                         f"x/y/z, got {mount_dir!r}", key="--mount")
-    model = engine.mount(parts[0]).directions[parts[1]]
-    return model, f"{parts[0]} {parts[1]} ({engine_file})"
+    if mount_file is not None and mount_dir:
+        raise InputError("--mount goes with --engine", key="--mount")
+    return mount_file if mount_file is not None else mount_dir

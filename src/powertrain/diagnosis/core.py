@@ -46,17 +46,18 @@ from powertrain.errors import InputError
 from powertrain.solvers.fast_harmonic import HarmonicModel
 
 
-def diagnose(measured, engine, *, noise_floor=DEFAULT_NOISE_FLOOR, effects=None,
+def diagnose(measured, engine=None, *, noise_floor=DEFAULT_NOISE_FLOOR, effects=None,
              pairs=True, band_check=True, rule=None, scheduler=None, progress=True,
              budget=EVAL_BUDGET) -> DiagnosisResult:
     """Diagnose the gap between ``engine``'s simulated run-up and ``measured``.
 
     Parameters
     ----------
-    measured : MeasuredRunup
-        Measured order curves [m/s RMS].
-    engine : Engine
-        Baseline model.
+    measured : MeasuredRunup, str or path
+        Measured order curves [m/s RMS], or the file to read them from (CSV or run-up
+        HDF5, :func:`powertrain.iotools.measured.read_measured`).
+    engine : Engine, str or path, optional
+        Baseline model, or its file (default: the shipped ``engines/default.toml``).
     noise_floor : float
         RMS noise floor of the measured order curves [m/s].
     effects : sequence of str, optional
@@ -84,12 +85,38 @@ def diagnose(measured, engine, *, noise_floor=DEFAULT_NOISE_FLOOR, effects=None,
     Raises
     ------
     InputError
-        Too few speeds to split, or nothing comparable.
+        An unknown effect, a file that cannot be read, order curves of another signal than
+        velocity, too few speeds to split, or nothing comparable.
     """
     from threadpoolctl import threadpool_limits
+    engine, measured = _inputs(measured, engine, effects)
     with threadpool_limits(limits=1, user_api="blas"):
-        return _diagnose(measured, engine, noise_floor, effects, pairs, band_check,
-                         rule or DecisionRule(), scheduler or "serial", progress, budget)
+        result = _diagnose(measured, engine, noise_floor, effects, pairs, band_check,
+                           rule or DecisionRule(), scheduler or "serial", progress, budget)
+    result.engine = engine
+    return result
+
+
+def _inputs(measured, engine, effects):
+    """``(engine, measured)`` read from their files when given as paths; the effect names
+    checked against the registry."""
+    import os
+
+    from powertrain.effects import EFFECTS
+    for e in effects or []:
+        if e not in EFFECTS:
+            raise InputError(f"unknown effect {e!r} (known: {', '.join(EFFECTS)})",
+                             key="--effects")
+    if engine is None or isinstance(engine, (str, os.PathLike)):
+        from powertrain.iotools.engine_file import DEFAULT_ENGINE_PATH, read_engine
+        engine = read_engine(str(engine or DEFAULT_ENGINE_PATH))
+    if isinstance(measured, (str, os.PathLike)):
+        from powertrain.iotools.measured import read_measured
+        measured = read_measured(measured, mounts=engine.mount_names)
+    if measured.signal != "velocity":
+        raise InputError("diagnose needs velocity, acceleration or displacement order curves "
+                         f"(this file holds {measured.signal})", file=measured.source or None)
+    return engine, measured
 
 
 class _Setup:

@@ -97,7 +97,7 @@ def write_report(r, directory, provenance=None) -> list:
     out = Path(directory)
     out.mkdir(parents=True, exist_ok=True)
     with atomic_write(out / "summary.txt") as fh:
-        fh.write(r.summary() + "\n")
+        fh.write(r.to_text() + "\n")
     r.to_json(out / "diagnosis.json")
     files = [out / "summary.txt", out / "diagnosis.json"]
     from powertrain.plotting.style import close_figure

@@ -22,7 +22,8 @@ from powertrain.effects import EFFECTS
 
 @dataclass
 class DiagnosisResult:
-    """Everything the diagnosis found; ``.to_json()``, ``.summary()``, ``.report(dir)``."""
+    """Everything the diagnosis found; ``.to_text()``, ``.to_json()``, ``.plot()``,
+    ``.report(dir)``."""
 
     data: GapData
     source: str
@@ -53,6 +54,8 @@ class DiagnosisResult:
     equivalents: list = field(default_factory=list)
     #: Fits stopped by their evaluation budget (labels).
     budget_hits: list = field(default_factory=list)
+    #: The baseline engine diagnosed (:class:`~powertrain.models.engine.Engine`).
+    engine: object = field(default=None, repr=False, compare=False)
 
     # ------------------------------------------------------------------ dicts
     def _per_channel(self):
@@ -156,8 +159,9 @@ class DiagnosisResult:
         return text
 
     # ------------------------------------------------------------------ text, figures
-    def summary(self) -> str:
-        """Plain-text report (:func:`powertrain.diagnosis.report.summary`)."""
+    def to_text(self) -> str:
+        """Plain-text report: where, which, how far, verdict (what ``powertrain diagnose``
+        prints and ``summary.txt`` holds; :func:`powertrain.diagnosis.report.summary`)."""
         from powertrain.diagnosis.report import summary
         return summary(self)
 

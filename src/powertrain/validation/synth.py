@@ -303,3 +303,126 @@ def make_case(engine, truth_names, seed, *, rpm=None, hm=None, noise_db=None, pa
 
 def _simulate(hm, engine, truth):
     return truth_velocity(engine, hm, truth)
+
+
+# ---------------------------------------------------------------------------- public API
+@dataclasses.dataclass
+class SynthCase:
+    """A synthetic measured run-up of :func:`synth` (``powertrain synth``): ``.to_text()``,
+    ``.to_csv(path)``, ``.to_truth_json(path)``, ``.plot()``.
+
+    ``case`` is the :class:`~powertrain.validation.cases.Case` (``case.measured`` the
+    :class:`~powertrain.iotools.measured.MeasuredRunup` a diagnosis reads).
+    """
+
+    case: object
+    seed: int
+
+    @property
+    def measured(self):
+        """The measured order curves (:class:`~powertrain.iotools.measured.MeasuredRunup`)."""
+        return self.case.measured
+
+    def to_text(self) -> str:
+        """Hidden effects, noise and the noise-free effect's size (one line)."""
+        c = self.case
+        return (f"{len(c.names) or 'no'} hidden effect(s), noise {c.noise_db:.2f} dB, "
+                f"noise-free effect {c.effect_rms_db:.2f} dB RMS")
+
+    def to_csv(self, path=None) -> str:
+        """The measured CSV (long format; the hidden effect is not written), written
+        atomically to ``path`` when given."""
+        return _written(self.case.csv_text(), path)
+
+    def truth(self) -> dict:
+        """The hidden effects and their parameters (keep them away from the diagnosis)."""
+        def plain(x):
+            return x.tolist() if isinstance(x, np.ndarray) else float(x)
+        c = self.case
+        return {"seed": self.seed, "noise_db": c.noise_db, "effect_rms_db": c.effect_rms_db,
+                "truth": [{"effect": n, "library_match": TRUTH_EFFECTS[n],
+                           "parameters": {k: plain(v) for k, v in p.items()}}
+                          for n, p in c.truth]}
+
+    def to_truth_json(self, path=None) -> str:
+        """:meth:`truth` as JSON, written atomically to ``path`` when given."""
+        import json
+        return _written(json.dumps(self.truth(), indent=1), path)
+
+    def plot(self, ax=None, *, path=None, mount=None, direction="z", provenance=None):
+        """The measured order curves [mm/s RMS] of one channel (default: the first mount,
+        ``direction``) against speed, with the generator's noise floor, into ``ax`` or a new
+        figure; returns the figure."""
+        from powertrain.plotting.style import (
+            figure_legend,
+            finish,
+            log_axis,
+            series_style,
+            subplots,
+            target_and_path,
+        )
+        from powertrain.validation.cases import FLOOR
+        ax, path = target_and_path(ax, path)
+        curves = self.measured.curves
+        mount = mount or next(iter(curves))[0]
+        fig, axes, own = subplots(ax)
+        a = axes[0, 0]
+        drawn = [(q, rpm, v) for (m, d, q), (rpm, v) in curves.items()
+                 if (m, d) == (mount, direction) and q != "synthesis"]
+        for k, (q, rpm, v) in enumerate(drawn):
+            a.plot(rpm, np.asarray(v) * 1e3, lw=1.0, label=q.replace("_", " "),
+                   **series_style(k))
+        a.axhline(FLOOR * 1e3, color="0.4", lw=0.8, ls=(0, (1, 2)), label="noise floor")
+        log_axis(a, "y")
+        a.set_xlabel("engine speed [rpm]")
+        a.set_ylabel(f"{mount} {direction} velocity [mm/s RMS]")
+        if own:
+            figure_legend(fig, axes)
+        else:
+            a.legend(fontsize=7, ncol=3)
+        return finish(fig, own, path, provenance,
+                      title=f"synthetic measured run-up (seed {self.seed}): {self.to_text()}")
+
+
+def _written(text: str, path) -> str:
+    if path is not None:
+        from powertrain.outputs import atomic_write
+        with atomic_write(path) as fh:
+            fh.write(text)
+    return text
+
+
+def synth(effects=(), seed=0, *, engine=None, rpm=None, noise_db=None) -> SynthCase:
+    """A synthetic measured run-up of ``engine`` with hidden ``effects`` and noise.
+
+    Parameters
+    ----------
+    effects : sequence of str
+        Truth effects (:data:`TRUTH_EFFECTS`, former names :data:`TRUTH_ALIASES`); empty:
+        effect-free.
+    seed : int
+        0..2^63-1.
+    engine : Engine, str or path, optional
+        Baseline engine or its file (default: the shipped ``engines/default.toml``).
+    rpm, noise_db
+        As for :func:`make_case`.
+
+    Raises
+    ------
+    InputError
+        An unknown effect (``--effect``) or seed (``--seed``).
+    """
+    import os
+
+    from powertrain.errors import InputError
+    names = [truth_effect_name(e) for e in effects]
+    for e in names:
+        if e not in TRUTH_EFFECTS:
+            raise InputError(f"unknown truth effect {e!r} (known: {', '.join(TRUTH_EFFECTS)})",
+                             key="--effect")
+    if engine is None or isinstance(engine, (str, os.PathLike)):
+        from powertrain.iotools.engine_file import DEFAULT_ENGINE_PATH, read_engine
+        engine = read_engine(str(engine or DEFAULT_ENGINE_PATH))
+    if not 0 <= seed < 2 ** 63:
+        raise InputError(f"must be an integer 0..2^63-1, got {seed}", key="--seed")
+    return SynthCase(make_case(engine, names, seed, rpm=rpm, noise_db=noise_db), seed)

@@ -43,13 +43,15 @@ References
 
 from __future__ import annotations
 
+import dataclasses
 import time
-from dataclasses import dataclass
 
 import numpy as np
 
+from powertrain.errors import InputError
 from powertrain.models.mount import DEFAULT_TOPOLOGY, TOPOLOGIES, MountModel, Topology
 from powertrain.physics.mount_network import incidence_matrix
+from powertrain.results.fit import FitResult
 
 #: Number of random starting points screened by default.
 DEFAULT_STARTS = 24
@@ -263,92 +265,10 @@ class _Problem:
         return r.x, self.rel_rms(r.x), bool(r.status > 0)
 
 
-@dataclass(frozen=True)
-class FitResult:
-    """Outcome of :func:`fit_mount`.
-
-    Attributes
-    ----------
-    model : MountModel
-        Fitted model (SI parameters).
-    frequency_hz : ndarray
-        Frequencies of the fitted data [Hz].
-    kcp_measured : ndarray of complex
-        Measured cross-point stiffness [N/m].
-    objective_n : float
-        Thesis objective :math:`f_{obj}` (eq. 19) of the fitted model [N].
-    rel_rms : float
-        Relative RMS error :math:`\\varepsilon` of the fitted model [1].
-    n_starts : int
-        Starting points screened.
-    n_polished : int
-        Screened starts run to convergence.
-    success : bool
-        The best polishing run met a convergence tolerance (not the evaluation limit).
-    polish_success : tuple of bool
-        Convergence flag of each polishing run.
-    polish_rel_rms : tuple of float
-        :math:`\\varepsilon` reached by each polishing run (spread = multi-modality).
-    n_hops : int
-        Perturbations of the incumbent tried.
-    hops_accepted : int
-        Perturbations that improved the fit.
-    time_s : float
-        Wall-clock time of the fit [s].
-    nfev : int
-        Model evaluations (K_CP and Jacobian together).
-    """
-
-    model: MountModel
-    frequency_hz: np.ndarray
-    kcp_measured: np.ndarray
-    objective_n: float
-    rel_rms: float
-    n_starts: int
-    n_polished: int
-    success: bool
-    polish_success: tuple
-    polish_rel_rms: tuple
-    n_hops: int
-    hops_accepted: int
-    time_s: float
-    nfev: int
-
-    @property
-    def kcp_fitted(self) -> np.ndarray:
-        """Cross-point stiffness of the fitted model at the data frequencies [N/m]."""
-        return self.model.cross_point_stiffness(self.frequency_hz)
-
-    def summary(self) -> str:
-        """A few lines: objective, error, effort."""
-        return (f"model {self.model.topology.name}: f_obj = {self.objective_n:.4g} N "
-                f"(eq. 19, |k_t - k_m| in N/mm x 1 mm over {self.frequency_hz.size} "
-                f"frequencies), relative RMS error = {100 * self.rel_rms:.3g} %\n"
-                f"{self.n_starts} starts screened, {self.n_polished} polished, "
-                f"{self.hops_accepted} of {self.n_hops} hops accepted, "
-                f"{'converged' if self.success else 'evaluation limit reached'}, "
-                f"{self.nfev} evaluations, "
-                f"{self.time_s:.2f} s")
-
-    def plot(self, ax=None, path=None, *, form="magnitude-phase", freq_axis="log",
-             provenance=None):
-        """Measured and fitted K*(f) [N/mm]: |K*| and loss angle (datasheets, ISO 10846) or
-        real and imaginary part (``form="real-imag"``, the thesis), over ``log`` or
-        ``linear`` frequency; returns the figure (see
-        :func:`powertrain.plotting.plot_mount_fit`)."""
-        from powertrain.plotting import plot_mount_fit
-        return plot_mount_fit(self.frequency_hz, self.kcp_measured, self.kcp_fitted,
-                              label=f"{self.model.topology.name} fit",
-                              title=f"f_obj = {self.objective_n:.4g} N, "
-                                    f"rel. RMS error = {100 * self.rel_rms:.3g} %",
-                              ax=ax, path=path, form=form, freq_axis=freq_axis,
-                              provenance=provenance)
-
-
-def fit_mount(frequency_hz, kcp_measured, model: str | Topology = DEFAULT_TOPOLOGY, *,
+def fit_mount(measured, kcp_measured=None, model: str | Topology = DEFAULT_TOPOLOGY, *,
               starts: int = DEFAULT_STARTS, seed=DEFAULT_SEED, polish: int = DEFAULT_POLISH,
               hops: int = DEFAULT_HOPS, name: str = "", source: str = "",
-              max_mass: float | None = None) -> FitResult:
+              max_mass: float | None = None, fmin=None, fmax=None) -> FitResult:
     """Identify the parameters of a lumped mount model from a measured K*(f) (sec. 2.2).
 
     Minimises :math:`f_{obj}` (Kovarik 2016, eq. 19) over non-negative parameters; see the
@@ -356,10 +276,11 @@ def fit_mount(frequency_hz, kcp_measured, model: str | Topology = DEFAULT_TOPOLO
 
     Parameters
     ----------
-    frequency_hz : array_like, shape (n,)
-        Strictly increasing, non-negative frequencies [Hz].
+    measured : array_like, shape (n,), or str or path
+        Strictly increasing, non-negative frequencies [Hz] (with ``kcp_measured``), or a
+        dynamic-stiffness CSV (``powertrain fit-mount``; :func:`fit_mount_file`).
     kcp_measured : array_like of complex, shape (n,)
-        Measured cross-point dynamic stiffness [N/m].
+        Measured cross-point dynamic stiffness [N/m] (None with a file).
     model : str or Topology
         A preset of :data:`powertrain.models.mount.TOPOLOGIES` (default triple-parallel).
     starts : int
@@ -377,6 +298,8 @@ def fit_mount(frequency_hz, kcp_measured, model: str | Topology = DEFAULT_TOPOLO
         Upper bound of every internal mass [kg] (default: the data-scaled box of
         :func:`parameter_box`). K_CP does not identify the internal masses, but the engine
         feels them through K_IP: bound them when their physical size is known.
+    fmin, fmax : float, optional
+        With a file: fit only the frequencies in ``fmin..fmax`` [Hz].
 
     Returns
     -------
@@ -385,15 +308,57 @@ def fit_mount(frequency_hz, kcp_measured, model: str | Topology = DEFAULT_TOPOLO
     Raises
     ------
     ValueError
-        Unknown model, mismatched or non-finite data, too few frequencies.
+        Unknown model, mismatched or non-finite data, too few frequencies
+        (:class:`~powertrain.errors.InputError` naming the file and option for a file).
     """
+    if kcp_measured is None:
+        return fit_mount_file(measured, model, starts=starts, seed=seed, max_mass=max_mass,
+                              fmin=fmin, fmax=fmax, polish=polish, hops=hops)
+    return _fit_arrays(measured, kcp_measured, _topology(model), starts=starts, seed=seed,
+                       polish=polish, hops=hops, name=name, source=source, max_mass=max_mass)
+
+
+def _fit_arrays(frequency_hz, kcp_measured, topology, *, starts, seed, polish, hops, name,
+                source, max_mass) -> FitResult:
     t0 = time.perf_counter()
-    if isinstance(model, str):
-        if model not in TOPOLOGIES:
-            raise ValueError(f"unknown model {model!r} (known: {', '.join(TOPOLOGIES)})")
-        topology = TOPOLOGIES[model]
-    else:
-        topology = model
+    f, km = _checked_data(frequency_hz, kcp_measured, topology)
+    if int(starts) < 1 or int(polish) < 1 or int(hops) < 0:
+        raise ValueError("starts and polish must be >= 1, hops >= 0")
+    starts, polish, hops = int(starts), min(int(polish), int(starts)), int(hops)
+    if max_mass is not None and not max_mass > 0:
+        raise ValueError("max_mass must be positive")
+    prob = _Problem(topology, f, km, max_mass)
+    rng = np.random.default_rng(seed)
+    fresh = starting_points(topology, f, km, starts + hops, rng, max_mass)
+    with np.errstate(all="ignore"):
+        polished = _screen_and_polish(prob, fresh[:starts], polish)
+        q_best, err_best, ok_best = min(polished, key=lambda t: t[1])
+        q_best, err_best, ok_best, accepted = _hop(prob, rng, fresh[starts:],
+                                                   (q_best, err_best, ok_best))
+        if not ok_best:
+            q_best, err_best, ok_best = prob.solve(q_best, FINAL_NFEV, 1e-10)
+    q_best = np.clip(q_best, prob.lo, prob.hi)
+    fitted = MountModel.from_values(topology, np.exp(q_best), name=name, source=source)
+    kfit = fitted.cross_point_stiffness(f)
+    return FitResult(model=fitted, frequency_hz=f, kcp_measured=km,
+                     objective_n=objective_n(kfit, km), rel_rms=relative_rms_error(kfit, km),
+                     n_starts=starts, n_polished=len(polished),
+                     success=ok_best, polish_success=tuple(p[2] for p in polished),
+                     polish_rel_rms=tuple(p[1] for p in polished),
+                     n_hops=hops, hops_accepted=accepted,
+                     time_s=time.perf_counter() - t0, nfev=prob.nfev, seed=seed)
+
+
+def _topology(model) -> Topology:
+    if not isinstance(model, str):
+        return model
+    if model not in TOPOLOGIES:
+        raise ValueError(f"unknown model {model!r} (known: {', '.join(TOPOLOGIES)})")
+    return TOPOLOGIES[model]
+
+
+def _checked_data(frequency_hz, kcp_measured, topology):
+    """Frequencies [Hz] and K_CP [N/m] as flat arrays, refused when they cannot be fitted."""
     f = np.asarray(frequency_hz, dtype=float).ravel()
     km = np.asarray(kcp_measured, dtype=complex).ravel()
     if f.size != km.size:
@@ -407,45 +372,84 @@ def fit_mount(frequency_hz, kcp_measured, model: str | Topology = DEFAULT_TOPOLO
         raise ValueError(f"{n_par} parameters need at least {(n_par + 1) // 2} frequencies")
     if not np.any(np.abs(km) > 0):
         raise ValueError("measured stiffness is zero everywhere")
-    if int(starts) < 1 or int(polish) < 1 or int(hops) < 0:
-        raise ValueError("starts and polish must be >= 1, hops >= 0")
-    starts, polish, hops = int(starts), min(int(polish), int(starts)), int(hops)
+    return f, km
 
-    if max_mass is not None and not max_mass > 0:
-        raise ValueError("max_mass must be positive")
-    prob = _Problem(topology, f, km, max_mass)
-    rng = np.random.default_rng(seed)
-    fresh = starting_points(topology, f, km, starts + hops, rng, max_mass)
+
+def _screen_and_polish(prob, starts, polish) -> list:
+    """Run every start a few iterations, then the best ``polish`` to convergence:
+    ``[(q, relative RMS error, converged)]``."""
     screened = []
-    with np.errstate(all="ignore"):
-        for q0 in fresh[:starts]:
-            q, err, _ = prob.solve(prob.rescale(q0), SCREEN_NFEV, 1e-6)
-            screened.append((err, q))
-        screened.sort(key=lambda t: t[0])
-        polished = [prob.solve(q, POLISH_NFEV, 1e-10) for _, q in screened[:polish]]
-        q_best, err_best, ok_best = min(polished, key=lambda t: t[1])
-        accepted = 0
-        for q_new in fresh[starts:]:
-            # hop: replace a random ~30 % of the parameters by fresh start values
-            mask = rng.random(q_best.size) < HOP_FRACTION
-            if not mask.any():
-                mask[rng.integers(q_best.size)] = True
-            q, err, _ = prob.solve(prob.rescale(np.where(mask, q_new, q_best)),
-                                   SCREEN_NFEV, 1e-6)
-            if err < 1.5 * err_best:
-                q, err, ok = prob.solve(q, HOP_NFEV, 1e-10)
-                if err < err_best:
-                    q_best, err_best, ok_best = q, err, ok
-                    accepted += 1
-        if not ok_best:
-            q_best, err_best, ok_best = prob.solve(q_best, FINAL_NFEV, 1e-10)
-    q_best = np.clip(q_best, prob.lo, prob.hi)
-    fitted = MountModel.from_values(topology, np.exp(q_best), name=name, source=source)
-    kfit = fitted.cross_point_stiffness(f)
-    return FitResult(model=fitted, frequency_hz=f, kcp_measured=km,
-                     objective_n=objective_n(kfit, km), rel_rms=relative_rms_error(kfit, km),
-                     n_starts=starts, n_polished=len(polished),
-                     success=ok_best, polish_success=tuple(p[2] for p in polished),
-                     polish_rel_rms=tuple(p[1] for p in polished),
-                     n_hops=hops, hops_accepted=accepted,
-                     time_s=time.perf_counter() - t0, nfev=prob.nfev)
+    for q0 in starts:
+        q, err, _ = prob.solve(prob.rescale(q0), SCREEN_NFEV, 1e-6)
+        screened.append((err, q))
+    screened.sort(key=lambda t: t[0])
+    return [prob.solve(q, POLISH_NFEV, 1e-10) for _, q in screened[:polish]]
+
+
+def _hop(prob, rng, fresh, best):
+    """Perturb the incumbent ``best = (q, err, ok)`` once per row of ``fresh`` (a random
+    ~30 % of its parameters replaced by the row's); returns the best and the hops accepted."""
+    q_best, err_best, ok_best = best
+    accepted = 0
+    for q_new in fresh:
+        mask = rng.random(q_best.size) < HOP_FRACTION
+        if not mask.any():
+            mask[rng.integers(q_best.size)] = True
+        q, err, _ = prob.solve(prob.rescale(np.where(mask, q_new, q_best)), SCREEN_NFEV, 1e-6)
+        if err < 1.5 * err_best:
+            q, err, ok = prob.solve(q, HOP_NFEV, 1e-10)
+            if err < err_best:
+                q_best, err_best, ok_best = q, err, ok
+                accepted += 1
+    return q_best, err_best, ok_best, accepted
+
+
+#: Most starting points :func:`fit_mount_file` accepts.
+MAX_STARTS = 10_000
+
+
+def fit_mount_file(measured, model: str = DEFAULT_TOPOLOGY, *, starts: int = DEFAULT_STARTS,
+                   seed=DEFAULT_SEED, max_mass=None, fmin=None, fmax=None,
+                   **options) -> FitResult:
+    """:func:`fit_mount` on the dynamic-stiffness CSV ``measured`` (``powertrain fit-mount``),
+    the points in ``fmin..fmax`` [Hz]; bad input raises :class:`InputError` naming the file
+    and the option. ``options``: ``polish``, ``hops`` of :func:`fit_mount`."""
+    from pathlib import Path
+
+    from powertrain.iotools.stiffness_csv import FREQUENCY, read_stiffness_csv
+    _check_options(measured, model, starts, seed, max_mass, fmin, fmax)
+    data = read_stiffness_csv(measured).select(fmin, fmax)
+    topo = TOPOLOGIES[model]
+    need = (len(topo.parameters) + 1) // 2
+    if data.frequency_hz.size < need:
+        limits = "/".join(n for n, v in (("--fmin", fmin), ("--fmax", fmax)) if v is not None)
+        raise InputError(f"{data.frequency_hz.size} frequencies in range"
+                         + (f" of {limits}" if limits else "") + f", the "
+                         f"{len(topo.parameters)} parameters of {model} need at least {need}",
+                         file=measured, key=limits or FREQUENCY)
+    if not (abs(data.kcp) > 0).any():
+        raise InputError("stiffness is zero everywhere", file=measured, key=FREQUENCY)
+    file = Path(measured).name
+    result = fit_mount(data.frequency_hz, data.kcp, model, starts=starts, seed=seed,
+                       max_mass=max_mass, name=f"{topo.description} fitted to {file}",
+                       source=f"powertrain fit-mount {file} --model {model}", **options)
+    return dataclasses.replace(result, data_name=file)
+
+
+def _check_options(measured, model, starts, seed, max_mass, fmin, fmax) -> None:
+    """Refuse options :func:`fit_mount_file` cannot use, naming the option."""
+    import math
+    if model not in TOPOLOGIES:
+        raise InputError(f"unknown model {model!r} (known: {', '.join(TOPOLOGIES)})",
+                         file=measured, key="--model")
+    if max_mass is not None and not max_mass > 0:
+        raise InputError(f"must be positive, got {max_mass}", key="--max-mass")
+    if not 1 <= starts <= MAX_STARTS:
+        raise InputError(f"must be 1..{MAX_STARTS}, got {starts}", key="--starts")
+    if seed is not None and not 0 <= seed < 2 ** 63:
+        raise InputError(f"must be an integer 0..2^63-1, got {seed}", key="--seed")
+    for name, value in (("--fmin", fmin), ("--fmax", fmax), ("--max-mass", max_mass)):
+        if value is not None and not math.isfinite(value):
+            raise InputError(f"must be a finite number, got {value}", key=name)
+    if fmin is not None and fmax is not None and not fmin < fmax:
+        raise InputError(f"--fmin {fmin:g} must be below --fmax {fmax:g}", key="--fmin")

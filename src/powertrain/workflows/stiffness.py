@@ -1,69 +1,88 @@
-"""Tables of dynamic stiffness in datasheet units, from either solution method."""
+"""Dynamic stiffness K*(f) of a mount model (a mount file, a model, or one mount direction of
+an engine), from either solution method: :func:`stiffness`."""
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+import os
 
 import numpy as np
 
+from powertrain.errors import InputError
+from powertrain.results.stiffness import StiffnessResult
 
-@dataclass
-class StiffnessTable:
-    """K*(f) of a mount model, plus x1 and F_T for the verification set-up.
+#: Frequencies of :func:`stiffness` by default (``powertrain stiffness --freq 1:400:1``) [Hz].
+DEFAULT_FREQUENCIES_HZ = np.arange(1.0, 401.0)
 
-    Attributes are SI; :meth:`columns` gives the datasheet-unit columns written out.
+
+def stiffness(mount, *, engine=None, freq=None, method="frequency", force=None,
+              engine_mass=None, steps_per_period=None) -> StiffnessResult:
+    """Cross-point dynamic stiffness K*(f) of a mount model (``powertrain stiffness``).
+
+    Parameters
+    ----------
+    mount : MountModel, str or path
+        The model, a mount file, or with ``engine`` one mount direction ``"MOUNT.DIR"``
+        (e.g. ``"torque_rod.x"``).
+    engine : Engine, str or path, optional
+        Engine (file) whose mount ``mount`` names.
+    freq : array_like, optional
+        Strictly increasing frequencies [Hz] (default :data:`DEFAULT_FREQUENCIES_HZ`).
+    method : {"frequency", "time"}
+        Condensed network (eq. 39) or Newmark integration processed by FFT.
+    force, engine_mass : float, optional
+        Together: the thesis's verification set-up (a harmonic force [N] on an engine mass
+        [kg] carried by the mount), adding the engine-mass displacement x1 and the
+        transmitted force F_T.
+    steps_per_period : int, optional
+        Newmark steps per excitation period for the time method.
+
+    Returns
+    -------
+    StiffnessResult
     """
+    _check_set_up(engine_mass, force)
+    f = DEFAULT_FREQUENCIES_HZ if freq is None else np.asarray(freq, float)
+    if method == "time" and f[0] <= 0:
+        raise InputError("the time method needs frequencies > 0 Hz", key="--freq")
+    model, label = mount_model(mount, engine)
+    result = stiffness_table(model, f, method, engine_mass, force, steps_per_period)
+    result.label = model.name or label
+    return result
 
-    frequency_hz: np.ndarray
-    kcp: np.ndarray                      #: cross-point stiffness [N/m]
-    method: str
-    x1: np.ndarray | None = None         #: engine-mass displacement [m]
-    ft: np.ndarray | None = None         #: transmitted force [N]
-    meta: dict = field(default_factory=dict)
 
-    def columns(self) -> dict[str, np.ndarray]:
-        k = self.kcp / 1e3
-        cols = {
-            "frequency_hz": self.frequency_hz,
-            "k_real_n_per_mm": k.real,
-            "k_imag_n_per_mm": k.imag,
-            "k_abs_n_per_mm": np.abs(k),
-            "loss_angle_deg": np.degrees(np.angle(k)),
-        }
-        if self.x1 is not None:
-            cols["x1_real_mm"] = (self.x1 * 1e3).real
-            cols["x1_imag_mm"] = (self.x1 * 1e3).imag
-            cols["ft_real_n"] = self.ft.real
-            cols["ft_imag_n"] = self.ft.imag
-        return cols
+def _check_set_up(engine_mass, force) -> None:
+    if (engine_mass is None) != (force is None):
+        raise InputError("--engine-mass and --force go together", key="--engine-mass")
+    if engine_mass is not None and not 0 < engine_mass < float("inf"):
+        raise InputError(f"must be positive and finite, got {engine_mass}", key="--engine-mass")
+    if force is not None and not abs(force) < float("inf"):
+        raise InputError(f"must be a finite force [N], got {force}", key="--force")
 
-    def to_csv(self) -> str:
-        cols = self.columns()
-        lines = [",".join(cols)]
-        for i in range(self.frequency_hz.size):
-            lines.append(",".join(f"{cols[c][i]:.10g}" for c in cols))
-        return "\n".join(lines) + "\n"
 
-    def to_text(self) -> str:
-        from powertrain.analysis.text_table import format_table
-        cols = self.columns()
-        header = list(cols)
-        rows = [[float(cols[c][i]) for c in cols] for i in range(self.frequency_hz.size)]
-        return f"# method: {self.method}\n" + format_table(header, rows) + "\n"
-
-    def plot(self, ax=None, *, path=None, label=None, form="magnitude-phase", freq_axis="log",
-             measured=None, provenance=None):
-        """K*(f) as |K*| and loss angle (datasheets, ISO 10846; default) or real and imaginary
-        part (``form="real-imag"``, the thesis), over ``log`` or ``linear`` frequency;
-        returns the figure (see :func:`powertrain.plotting.plot_stiffness`)."""
-        from powertrain.plotting import plot_stiffness
-        return plot_stiffness([(label or self.meta.get("name", "model"), self)], path,
-                              measured=measured, ax=ax, form=form, freq_axis=freq_axis,
-                              provenance=provenance or getattr(self, "provenance", None))
+def mount_model(mount, engine=None):
+    """``(model, label)`` of :func:`stiffness`'s ``mount`` (and ``engine``): a model as given,
+    a mount file read, or the direction ``"MOUNT.DIR"`` of the engine's mount (an engine file
+    without excitation sections is enough)."""
+    from powertrain.iotools.mount_file import read_mount
+    if engine is None:
+        if isinstance(mount, (str, os.PathLike)):
+            return read_mount(mount), str(mount)
+        return mount, "model"
+    if isinstance(engine, (str, os.PathLike)):
+        from powertrain.iotools.engine_file import read_engine
+        engine, where = read_engine(engine), str(engine)
+    else:
+        where = str(getattr(engine, "file", None) or engine.name)
+    parts = str(mount or "").split(".")
+    names = engine.mount_names
+    if len(parts) != 2 or parts[0] not in names or parts[1] not in ("x", "y", "z"):
+        raise InputError(f"expected MOUNT.DIR with MOUNT one of {', '.join(names)} and DIR "
+                         f"x/y/z, got {mount!r}", key="--mount")
+    return engine.mount(parts[0]).directions[parts[1]], f"{parts[0]} {parts[1]} ({where})"
 
 
 def stiffness_table(model, frequency_hz, method="frequency", engine_mass=None, force=None,
-                    steps_per_period=None) -> StiffnessTable:
+                    steps_per_period=None) -> StiffnessResult:
     """Compute K*(f) (and x1, F_T when ``engine_mass`` and ``force`` are given).
 
     Parameters
@@ -85,9 +104,9 @@ def stiffness_table(model, frequency_hz, method="frequency", engine_mass=None, f
     kw = {} if steps_per_period is None else {"steps_per_period": steps_per_period}
     if method == "frequency":
         if engine_mass is None:
-            return StiffnessTable(f, model.cross_point_stiffness(f), method)
+            return StiffnessResult(f, model.cross_point_stiffness(f), method)
         x1, ft = model.forced_engine_mass_response(f, engine_mass, force)
-        return StiffnessTable(f, model.cross_point_stiffness(f), method, x1, ft)
+        return StiffnessResult(f, model.cross_point_stiffness(f), method, x1, ft)
     if method == "time":
         from powertrain.solvers.mount_time_domain import (
             time_cross_point_stiffness,
@@ -95,7 +114,7 @@ def stiffness_table(model, frequency_hz, method="frequency", engine_mass=None, f
         )
         if engine_mass is None:
             r = time_cross_point_stiffness(model, f, **kw)
-            return StiffnessTable(f, r.kcp, method, meta={"periodicity": r.periodicity})
+            return StiffnessResult(f, r.kcp, method, meta={"periodicity": r.periodicity})
         r = time_forced_response(model, f, engine_mass, force, **kw)
-        return StiffnessTable(f, r.kcp, method, r.x1, r.ft, meta={"periodicity": r.periodicity})
+        return StiffnessResult(f, r.kcp, method, r.x1, r.ft, meta={"periodicity": r.periodicity})
     raise ValueError(f"unknown method {method!r}")

@@ -1,0 +1,124 @@
+"""Outcome of a mount parameter identification
+(:func:`powertrain.workflows.fitting.fit_mount`): the fitted model, its error and the effort."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from powertrain.models.mount import MountModel
+
+#: Datasheet unit of a mount parameter, by its first letter (spring, damper, mass).
+PARAMETER_UNITS = {"c": "N/mm", "d": "N*s/mm", "m": "kg"}
+
+
+@dataclass(frozen=True)
+class FitResult:
+    """Outcome of :func:`fit_mount`.
+
+    Attributes
+    ----------
+    model : MountModel
+        Fitted model (SI parameters).
+    frequency_hz : ndarray
+        Frequencies of the fitted data [Hz].
+    kcp_measured : ndarray of complex
+        Measured cross-point stiffness [N/m].
+    objective_n : float
+        Thesis objective :math:`f_{obj}` (eq. 19) of the fitted model [N].
+    rel_rms : float
+        Relative RMS error :math:`\\varepsilon` of the fitted model [1].
+    n_starts : int
+        Starting points screened.
+    n_polished : int
+        Screened starts run to convergence.
+    success : bool
+        The best polishing run met a convergence tolerance (not the evaluation limit).
+    polish_success : tuple of bool
+        Convergence flag of each polishing run.
+    polish_rel_rms : tuple of float
+        :math:`\\varepsilon` reached by each polishing run (spread = multi-modality).
+    n_hops : int
+        Perturbations of the incumbent tried.
+    hops_accepted : int
+        Perturbations that improved the fit.
+    time_s : float
+        Wall-clock time of the fit [s].
+    nfev : int
+        Model evaluations (K_CP and Jacobian together).
+    seed : int or None
+        Seed of the starting points.
+    data_name : str
+        Name of the file the data came from ("" for arrays).
+    """
+
+    model: MountModel
+    frequency_hz: np.ndarray
+    kcp_measured: np.ndarray
+    objective_n: float
+    rel_rms: float
+    n_starts: int
+    n_polished: int
+    success: bool
+    polish_success: tuple
+    polish_rel_rms: tuple
+    n_hops: int
+    hops_accepted: int
+    time_s: float
+    nfev: int
+    seed: object = None
+    data_name: str = ""
+
+    @property
+    def kcp_fitted(self) -> np.ndarray:
+        """Cross-point stiffness of the fitted model at the data frequencies [N/m]."""
+        return self.model.cross_point_stiffness(self.frequency_hz)
+
+    def summary(self) -> str:
+        """A few lines: objective, error, effort."""
+        return (f"model {self.model.topology.name}: f_obj = {self.objective_n:.4g} N "
+                f"(eq. 19, |k_t - k_m| in N/mm x 1 mm over {self.frequency_hz.size} "
+                f"frequencies), relative RMS error = {100 * self.rel_rms:.3g} %\n"
+                f"{self.n_starts} starts screened, {self.n_polished} polished, "
+                f"{self.hops_accepted} of {self.n_hops} hops accepted, "
+                f"{'converged' if self.success else 'evaluation limit reached'}, "
+                f"{self.nfev} evaluations, "
+                f"{self.time_s:.2f} s")
+
+    def to_text(self) -> str:
+        """:meth:`summary` and the fitted parameters in datasheet units (what
+        ``powertrain fit-mount`` prints)."""
+        from powertrain.units import from_si
+        lines = [self.summary(), "parameters:"]
+        for p in self.model.topology.parameters:
+            unit = PARAMETER_UNITS[p[0]]
+            lines.append(f"  {p:>3s} = {from_si(self.model.params[p], unit):.6g} {unit}")
+        return "\n".join(lines)
+
+    def file_comment(self) -> str:
+        """The comment of the fitted mount file: data, error, starts and seed."""
+        f = self.frequency_hz
+        return (f"Fitted by powertrain fit-mount (Kovarik 2016 sec. 2.2, eq. 19) to "
+                f"{self.data_name or 'the data'}: {f.size} frequencies, "
+                f"{f[0]:g}-{f[-1]:g} Hz.\n"
+                f"f_obj = {self.objective_n:.6g} N, relative RMS error = "
+                f"{100 * self.rel_rms:.4g} %, starts = {self.n_starts}, seed = {self.seed}.")
+
+    def plot(self, ax=None, path=None, *, form="magnitude-phase", freq_axis="log",
+             provenance=None):
+        """Measured and fitted K*(f) [N/mm]: |K*| and loss angle (datasheets, ISO 10846) or
+        real and imaginary part (``form="real-imag"``, the thesis), over ``log`` or
+        ``linear`` frequency; returns the figure (see
+        :func:`powertrain.plotting.plot_mount_fit`)."""
+        from powertrain.plotting import plot_mount_fit
+        from powertrain.plotting.style import target_and_path
+        ax, path = target_and_path(ax, path)
+        return plot_mount_fit(self.frequency_hz, self.kcp_measured, self.kcp_fitted,
+                              label=f"{self.model.topology.name} fit",
+                              title=f"f_obj = {self.objective_n:.4g} N, "
+                                    f"rel. RMS error = {100 * self.rel_rms:.3g} %",
+                              ax=ax, path=path, form=form, freq_axis=freq_axis,
+                              provenance=provenance)
+
+

@@ -1,0 +1,90 @@
+"""Dynamic stiffness K*(f) of a mount model in datasheet units, from either solution method
+(:func:`powertrain.workflows.stiffness.stiffness`)."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+
+@dataclass
+class StiffnessResult:
+    """K*(f) of a mount model, plus x1 and F_T for the verification set-up.
+
+    Attributes are SI; :meth:`columns` gives the datasheet-unit columns written out;
+    :meth:`to_text` the table, :meth:`summary` the short form printed with a plot,
+    :meth:`to_csv` the CSV, :meth:`plot` the figure.
+    """
+
+    frequency_hz: np.ndarray
+    kcp: np.ndarray                      #: cross-point stiffness [N/m]
+    method: str
+    x1: np.ndarray | None = None         #: engine-mass displacement [m]
+    ft: np.ndarray | None = None         #: transmitted force [N]
+    meta: dict = field(default_factory=dict)
+    #: Legend label of the plot (the model's name, else where it came from).
+    label: str = ""
+
+    def columns(self) -> dict[str, np.ndarray]:
+        k = self.kcp / 1e3
+        cols = {
+            "frequency_hz": self.frequency_hz,
+            "k_real_n_per_mm": k.real,
+            "k_imag_n_per_mm": k.imag,
+            "k_abs_n_per_mm": np.abs(k),
+            "loss_angle_deg": np.degrees(np.angle(k)),
+        }
+        if self.x1 is not None:
+            cols["x1_real_mm"] = (self.x1 * 1e3).real
+            cols["x1_imag_mm"] = (self.x1 * 1e3).imag
+            cols["ft_real_n"] = self.ft.real
+            cols["ft_imag_n"] = self.ft.imag
+        return cols
+
+    def to_csv(self, path=None) -> str:
+        """The CSV text (datasheet units); written atomically to ``path`` when given."""
+        cols = self.columns()
+        lines = [",".join(cols)]
+        for i in range(self.frequency_hz.size):
+            lines.append(",".join(f"{cols[c][i]:.10g}" for c in cols))
+        text = "\n".join(lines) + "\n"
+        if path is not None:
+            from powertrain.outputs import atomic_write
+            with atomic_write(path) as fh:
+                fh.write(text)
+        return text
+
+    def to_text(self) -> str:
+        """The table of every frequency (``powertrain stiffness``)."""
+        from powertrain.analysis.text_table import format_table
+        cols = self.columns()
+        header = list(cols)
+        rows = [[float(cols[c][i]) for c in cols] for i in range(self.frequency_hz.size)]
+        return f"# method: {self.method}\n" + format_table(header, rows) + "\n"
+
+    def summary(self) -> str:
+        """What a plot reader checks first: |K*| range and the loss-angle peak, in N/mm, deg
+        (``powertrain stiffness --plot`` without ``--format``)."""
+        cols = self.columns()
+        f, k, phi = cols["frequency_hz"], cols["k_abs_n_per_mm"], cols["loss_angle_deg"]
+        lo, hi, top = int(np.argmin(k)), int(np.argmax(k)), int(np.argmax(phi))
+        return (f"# method: {self.method}; {f.size} frequencies {f[0]:g}..{f[-1]:g} Hz "
+                "(every value: --format table or csv)\n"
+                f"|K*| {k[0]:.4g} N/mm at {f[0]:g} Hz; min {k[lo]:.4g} N/mm at {f[lo]:g} Hz, "
+                f"max {k[hi]:.4g} N/mm at {f[hi]:g} Hz\n"
+                f"loss angle max {phi[top]:.3g} deg at {f[top]:g} Hz")
+
+    def plot(self, ax=None, *, path=None, label=None, form="magnitude-phase", freq_axis="log",
+             measured=None, provenance=None):
+        """K*(f) as |K*| and loss angle (datasheets, ISO 10846; default) or real and imaginary
+        part (``form="real-imag"``, the thesis), over ``log`` or ``linear`` frequency, into
+        ``ax`` (an Axes, a pair of Axes, a Figure) or a new figure; returns the figure (see
+        :func:`powertrain.plotting.plot_stiffness`)."""
+        from powertrain.plotting import plot_stiffness
+        from powertrain.plotting.style import target_and_path
+        ax, path = target_and_path(ax, path)
+        name = label or self.label or self.meta.get("name", "model")
+        return plot_stiffness([(name, self)], path, measured=measured, ax=ax, form=form,
+                              freq_axis=freq_axis,
+                              provenance=provenance or getattr(self, "provenance", None))
