@@ -5,10 +5,58 @@ Data flows one way: files (:mod:`powertrain.iotools`) -> model objects
 :mod:`powertrain.physics`) -> results -> analysis -> plots and reports.
 Everything inside the package is SI; datasheet units are converted once, in the loaders,
 through the table in :mod:`powertrain.units`.
+
+The functions a study calls are importable from here (``import powertrain as pt``)::
+
+    engine = pt.read_engine()                       # the shipped default engine
+    run = pt.runup(engine, rpm=range(1000, 6001, 500))
+    print(run.to_text())
+    gap = pt.compare("measured.csv", engine=engine)
+
+Each returns a result object with ``to_text()`` (what the command line prints), ``plot()``
+and its file writers; docs/guide/python-api.md walks a whole study. They are imported on
+first use, so ``import powertrain`` stays light.
 """
+
+from __future__ import annotations
+
+import importlib
 
 __version__ = "0.1.0"
 
 from powertrain.errors import InputError  # noqa: E402
 
-__all__ = ["InputError", "__version__"]
+#: Public name -> (module, attribute); imported on first access (PEP 562).
+API = {
+    "read_engine": ("powertrain.iotools.engine_file", "read_engine"),
+    "read_mount": ("powertrain.iotools.mount_file", "read_mount"),
+    "read_measured": ("powertrain.iotools.measured", "read_measured"),
+    "read_raw": ("powertrain.iotools.raw", "read_raw"),
+    "runup": ("powertrain.workflows.runup", "runup"),
+    "modes": ("powertrain.workflows.modes", "modes"),
+    "excitation": ("powertrain.workflows.excitation", "excitation"),
+    "stiffness": ("powertrain.workflows.stiffness", "stiffness"),
+    "fit_mount": ("powertrain.workflows.fitting", "fit_mount"),
+    "compare": ("powertrain.workflows.comparison", "compare"),
+    "whatif": ("powertrain.workflows.whatif", "whatif"),
+    "track": ("powertrain.workflows.tracking", "track"),
+    "diagnose": ("powertrain.diagnosis", "diagnose"),
+    "synth": ("powertrain.validation.synth", "synth"),
+}
+
+__all__ = ["InputError", "__version__", *API]
+
+
+def __getattr__(name: str):
+    """The functions of :data:`API`, imported when first used."""
+    try:
+        module, attr = API[name]
+    except KeyError:
+        raise AttributeError(f"module 'powertrain' has no attribute {name!r}") from None
+    value = getattr(importlib.import_module(module), attr)
+    globals()[name] = value
+    return value
+
+
+def __dir__():
+    return sorted(set(globals()) | set(API))
