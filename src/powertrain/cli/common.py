@@ -11,6 +11,17 @@ import numpy as np
 from powertrain.analysis.text_table import format_table  # noqa: F401 (re-export)
 from powertrain.errors import InputError
 
+#: Names of :mod:`powertrain.workflows.runup` the commands import from here (loaded lazily:
+#: ``powertrain --help`` imports no solver).
+_RUNUP_NAMES = ("MAX_SPEEDS", "checked_runup", "require_finite", "solved")
+
+
+def __getattr__(name):
+    if name in _RUNUP_NAMES:
+        from powertrain.workflows import runup
+        return getattr(runup, name)
+    raise AttributeError(name)
+
 #: Most frequencies one option may ask for, and the highest frequency [Hz] (a mount model
 #: fitted below 1 kHz says nothing at 100 kHz; the limits keep a typo from hanging the run).
 MAX_FREQUENCIES = 100_000
@@ -74,7 +85,7 @@ def speed_options(func):
 
 def speed_steps(rpm_from: float, rpm_to: float, rpm_step: float) -> np.ndarray:
     """Validated speed steps [rpm] from the ``--from/--to/--step`` options."""
-    from powertrain.workflows.runup import default_rpm
+    from powertrain.workflows.runup import MAX_SPEEDS, default_rpm
     for value, key in ((rpm_from, "--from"), (rpm_to, "--to"), (rpm_step, "--step")):
         if not (math.isfinite(value) and value > 0):
             raise InputError(f"must be a finite speed > 0 [rpm], got {value:g}", key=key)
@@ -87,8 +98,6 @@ def speed_steps(rpm_from: float, rpm_to: float, rpm_step: float) -> np.ndarray:
     return default_rpm(rpm_from, rpm_to, rpm_step)
 
 
-#: Largest speed grid a run-up command accepts (about 0.1 s per speed step).
-MAX_SPEEDS = 2000
 #: Finest crank-angle step [deg] of the Newmark stepper (720 / 0.05 = 14 400 steps a cycle).
 MIN_ANGLE_STEP_DEG = 0.05
 #: Coarsest crank-angle step [deg]: 72 steps a cycle still resolve order 8 without aliasing.
@@ -136,38 +145,6 @@ def write_json(path, text: str, provenance: dict, key: str = "--json") -> None:
                          file=path, key=key) from None
     with atomic_write(path) as fh:
         fh.write(out)
-
-
-def solved(solve, file, key):
-    """``solve()``, with a model that cannot be solved (singular, overflow) reported as bad
-    input naming ``file`` and ``key`` (the last guard: the checks at load catch the known
-    causes first)."""
-    try:
-        with np.errstate(all="ignore"):
-            return solve()
-    except InputError:
-        raise
-    except (ValueError, ArithmeticError, np.linalg.LinAlgError) as exc:
-        raise InputError(f"the model cannot be solved ({type(exc).__name__}: "
-                         f"{str(exc)[:120]})", file=file, key=key) from None
-
-
-def require_finite(values: dict, file, key) -> None:
-    """Refuse results holding NaN or inf (``values``: name -> array), naming the input."""
-    for name, value in values.items():
-        if value is not None and not np.all(np.isfinite(value)):
-            raise InputError(f"the computed {name} is not finite (NaN or "
-                             "inf): values out of any physical range", file=file, key=key)
-
-
-def checked_runup(engine, engine_path, run, *args, **kwargs):
-    """``run(engine, *args, **kwargs)`` (a run-up) through :func:`solved`, its result
-    checked finite (errors name the engine file)."""
-    result = solved(lambda: run(engine, *args, **kwargs), engine_path, "engine")
-    require_finite({name.replace("_", " "): getattr(result, name) for name in (
-        "displacement", "velocity", "acceleration", "mount_force", "mean_mount_force")},
-        engine_path, "engine")
-    return result
 
 
 # ------------------------------------------------------------------ figures

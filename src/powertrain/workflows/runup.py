@@ -19,6 +19,7 @@ solve per speed, the periodicity check, the result.
 
 from __future__ import annotations
 
+import os
 import time
 import warnings
 
@@ -26,10 +27,13 @@ import numpy as np
 
 from powertrain.analysis.orders import ORDERS
 from powertrain.assembly import assemble
+from powertrain.errors import InputError
 from powertrain.progress import progress_bar
 from powertrain.results.runup import RunupResult
 from powertrain.solvers.steppers import Cycles, choose_stepper
 
+#: Largest speed grid a run-up command accepts (about 0.1 s per speed step).
+MAX_SPEEDS = 2000
 #: Default crank-angle increment [deg]; halving it moves the results < 0.1 % (see tests).
 ANGLE_STEP_DEG = 1.0
 #: Cycles simulated per speed step and cycles processed (thesis sec. 4.4).
@@ -205,3 +209,45 @@ def path_contributions(system, rpm, force) -> np.ndarray:
     f_local = np.einsum("ap,ika->ikp", E, np.moveaxis(force[:, :n_a, :], 1, 2))   # e_p . f
     out[:] = np.moveaxis(1j * w[..., None, None] * GE * f_local[:, :, None, :], 1, 3)
     return out
+
+
+def engine_and_file(engine=None):
+    """The engine to run and the file it came from: an Engine as it is (its ``file``), a
+    path read, None the shipped ``engines/default.toml``."""
+    from powertrain.iotools.engine_file import DEFAULT_ENGINE_PATH, read_engine
+    if engine is None or isinstance(engine, (str, os.PathLike)):
+        path = str(engine or DEFAULT_ENGINE_PATH)
+        return read_engine(path), path
+    return engine, engine.file
+
+
+def solved(solve, file, key):
+    """``solve()``, with a model that cannot be solved (singular, overflow) reported as bad
+    input naming ``file`` and ``key`` (the last guard: the checks at load catch the known
+    causes first)."""
+    try:
+        with np.errstate(all="ignore"):
+            return solve()
+    except InputError:
+        raise
+    except (ValueError, ArithmeticError, np.linalg.LinAlgError) as exc:
+        raise InputError(f"the model cannot be solved ({type(exc).__name__}: "
+                         f"{str(exc)[:120]})", file=file, key=key) from None
+
+
+def require_finite(values: dict, file, key) -> None:
+    """Refuse results holding NaN or inf (``values``: name -> array), naming the input."""
+    for name, value in values.items():
+        if value is not None and not np.all(np.isfinite(value)):
+            raise InputError(f"the computed {name} is not finite (NaN or "
+                             "inf): values out of any physical range", file=file, key=key)
+
+
+def checked_runup(engine, engine_path, run, *args, **kwargs):
+    """``run(engine, *args, **kwargs)`` (a run-up) through :func:`solved`, its result
+    checked finite (errors name the engine file)."""
+    result = solved(lambda: run(engine, *args, **kwargs), engine_path, "engine")
+    require_finite({name.replace("_", " "): getattr(result, name) for name in (
+        "displacement", "velocity", "acceleration", "mount_force", "mean_mount_force")},
+        engine_path, "engine")
+    return result
