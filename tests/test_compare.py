@@ -459,11 +459,11 @@ def test_raw_time_data_points_to_track(tmp_path, raw):
 
 
 def test_not_compared_list_is_grouped_per_mount_and_reason():
-    from powertrain.cli.compare import _missing_lines
+    from powertrain.results.comparison import missing_lines
     missing = [{"mount": "right", "direction": d, "quantity": q, "reason": "not in the "
                 "measured data"} for d in "xyz" for q in ("order_4", "synthesis", "order_2")]
     missing.append({"mount": "left", "direction": "z", "quantity": "order_1.5",
                     "reason": "no comparable point"})
-    assert _missing_lines(missing) == [
+    assert missing_lines(missing) == [
         "right x, y, z: synthesis, order_2, order_4: not in the measured data",
         "left z: order_1.5: no comparable point"]

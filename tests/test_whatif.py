@@ -72,8 +72,8 @@ def test_identity_variant_changes_nothing(engine):
 def test_variant_same_alone_and_in_process_pool_sweep(engine):
     ops = (parse_scale("left.z.stiffness=1.2"),)
     other = (parse_scale("gearbox.*.damping=0.8"),)
-    tasks = [SweepTask("a", engine.replace(), ops, RPM, "harmonic"),
-             SweepTask("b", engine.replace(), other, RPM, "harmonic")]
+    tasks = [SweepTask("a", apply_operations(engine, ops), RPM, "harmonic"),
+             SweepTask("b", apply_operations(engine, other), RPM, "harmonic")]
     alone = run_sweep(tasks[:1], SerialExecutor())[0]
     with ProcessPoolExecutor(max_workers=2) as pool:
         swept = run_sweep(tasks, pool)

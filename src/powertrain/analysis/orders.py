@@ -22,6 +22,13 @@ def order_label(order: float) -> str:
     return f"order_{order:g}"
 
 
+def quantity_sort_key(quantity: str):
+    """Sort key of a quantity label: ``synthesis`` first, then orders ascending."""
+    if quantity == "synthesis":
+        return (0, 0.0)
+    return (1, float(quantity.split("_", 1)[1]))
+
+
 def order_spectrum(samples, revolutions, orders=ORDERS, axis=0):
     """Complex amplitudes of the given orders.
 

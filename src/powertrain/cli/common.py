@@ -11,6 +11,17 @@ import numpy as np
 from powertrain.analysis.text_table import format_table  # noqa: F401 (re-export)
 from powertrain.errors import InputError, require_finite, solved  # noqa: F401 (re-export)
 
+#: Names of :mod:`powertrain.workflows.runup` the commands import from here (loaded lazily:
+#: ``powertrain --help`` imports no solver).
+_RUNUP_NAMES = ("MAX_SPEEDS", "checked_runup", "require_finite", "solved")
+
+
+def __getattr__(name):
+    if name in _RUNUP_NAMES:
+        from powertrain.workflows import runup
+        return getattr(runup, name)
+    raise AttributeError(name)
+
 #: Most frequencies one option may ask for, and the highest frequency [Hz] (a mount model
 #: fitted below 1 kHz says nothing at 100 kHz; the limits keep a typo from hanging the run).
 MAX_FREQUENCIES = 100_000
@@ -74,7 +85,7 @@ def speed_options(func):
 
 def speed_steps(rpm_from: float, rpm_to: float, rpm_step: float) -> np.ndarray:
     """Validated speed steps [rpm] from the ``--from/--to/--step`` options."""
-    from powertrain.workflows.runup import default_rpm
+    from powertrain.workflows.runup import MAX_SPEEDS, default_rpm
     for value, key in ((rpm_from, "--from"), (rpm_to, "--to"), (rpm_step, "--step")):
         if not (math.isfinite(value) and value > 0):
             raise InputError(f"must be a finite speed > 0 [rpm], got {value:g}", key=key)
@@ -87,8 +98,6 @@ def speed_steps(rpm_from: float, rpm_to: float, rpm_step: float) -> np.ndarray:
     return default_rpm(rpm_from, rpm_to, rpm_step)
 
 
-#: Largest speed grid a run-up command accepts (about 0.1 s per speed step).
-MAX_SPEEDS = 2000
 
 
 def check_outputs(**targets) -> None:

@@ -92,149 +92,49 @@ def whatif(engine_file, rpm_from, rpm_to, rpm_step, solver, scale, set_, swap, m
       powertrain whatif --engine engines/default-modal-body.toml --scale left.z.stiffness=0.8 \\
           --objective seat_rail.z:order_2:1500-3000
     """
-    from powertrain.errors import InputError
-    from powertrain.iotools.engine_file import DEFAULT_ENGINE_PATH, read_engine
-    from powertrain.workflows.variants import (
-        Origin,
-        Variant,
-        check_operations,
-        parse_operations,
-        parse_target,
-        read_variants,
-    )
-
-    rpm = speed_steps(rpm_from, rpm_to, rpm_step)
-    if workers is not None and workers < 1:
-        raise InputError("must be >= 1", key="--workers")
+    from powertrain.workflows.whatif import whatif as run_whatif
+    outputs = (target_out, target_plot, json_file, plot, delta_plot)
     check_outputs(target_out=target_out, target_plot=target_plot, plot=plot, json=json_file,
                   delta_plot=delta_plot)
+    engine, rpm = _baseline(engine_file, rpm_from, rpm_to, rpm_step)
+    result = run_whatif(engine, scale=scale, set=set_, swap=swap, move=move, rotate=rotate,
+                        effects=effect, targets=target, variants=variants_file, rpm=rpm,
+                        solver=solver, signal=signal, objective=objective,
+                        measured=measured_file, executor=scheduler, workers=workers,
+                        progress=not quiet)
+    result.rpm_step = rpm_step
+    fit = result.target_fit("--target-out" if target_out else "--target-plot") \
+        if target_out or target_plot else None
+    _write(result, fit, engine, engine_file, *outputs)
+    if not quiet:
+        click.echo(result.to_text(written=outputs))
+
+
+def _baseline(engine_file, rpm_from, rpm_to, rpm_step):
+    """The baseline engine and the speed steps, checked against its speed range."""
+    from powertrain.iotools.engine_file import DEFAULT_ENGINE_PATH, read_engine
+    rpm = speed_steps(rpm_from, rpm_to, rpm_step)
     engine = read_engine(engine_file or DEFAULT_ENGINE_PATH)
     runup_settings(engine, rpm, 1.0)
+    return engine, rpm
 
-    variants = []
-    ops = parse_operations({"scale": scale, "set": set_, "swap": swap, "move": move,
-                            "rotate": rotate, "effect": effect})
-    if ops:
-        variants.append(Variant("command line", ops))
-    for text in target:
-        op = parse_target(text, Origin("--target"))
-        variants.append(Variant(f"target {text}", (op,)))
-    if variants_file:
-        variants += read_variants(variants_file)
-    if not variants:
-        raise InputError("no variant given (use --scale, --set, --swap, --move, --rotate, "
-                         "--effect, --target or --variants)", key="--variants")
-    names = [v.name for v in variants]
-    dup = sorted({n for n in names if names.count(n) > 1})
-    if dup:
-        raise InputError(f"duplicate variant name {dup[0]!r}", file=variants_file,
-                         key="variant.name")
-    for v in variants:
-        check_operations(engine, v.operations)
-        _check_variant_support(engine, v)
-    n_targets = sum(len(v.targets) for v in variants)
-    for opt, value in (("--target-out", target_out), ("--target-plot", target_plot)):
-        if value and n_targets != 1:
-            raise InputError(f"needs exactly one target, {n_targets} given", key=opt)
-    measured = None
-    if measured_file:
-        from powertrain.iotools.measured import read_measured
-        measured = read_measured(measured_file, mounts=engine.mount_names)
 
-    goal = _objective(objective, engine.assemble().channels, rpm) if objective else None
-    from powertrain.workflows.whatif import run_whatif
-    if scheduler:
-        from powertrain.parallel import check_scheduler, executor
-        with executor(check_scheduler(scheduler), workers=workers,
-                      n_jobs=len(variants) + 1) as ex:
-            result = run_whatif(engine, variants, rpm, solver=solver, executor=ex,
-                                workers=workers, measured=measured, signal=signal,
-                                progress=not quiet)
-    else:
-        result = run_whatif(engine, variants, rpm, solver=solver, workers=workers,
-                            measured=measured, signal=signal, progress=not quiet)
-    if goal is not None:
-        result.objective = goal
-
-    written = []
+def _write(result, fit, engine, engine_file, target_out, target_plot, json_file, plot,
+           delta_plot) -> None:
+    """Write the files asked for, each atomically."""
+    from powertrain.cli.common import cli_provenance, engine_description, write_plot
+    from powertrain.iotools.engine_file import DEFAULT_ENGINE_PATH
+    from powertrain.provenance import provenance
+    prov = cli_provenance(engine_description(engine, engine.file))
     if target_out:
         from powertrain.iotools.mount_file import write_mount
-        tf = result.target_fits[0]
-        write_mount(tf.model, target_out, comment=f"powertrain whatif: {tf.summary()}")
-        written.append(target_out)
-    from powertrain.cli.common import cli_provenance, engine_description, write_plot
-    prov = cli_provenance(engine_description(engine, engine.file))
+        write_mount(fit.model, target_out, comment=f"powertrain whatif: {fit.summary()}")
     if target_plot:
-        write_plot(lambda p: result.target_fits[0].plot(path=p, provenance=prov), target_plot)
-        written.append(target_plot)
+        write_plot(lambda p: fit.plot(path=p, provenance=prov), target_plot)
     if json_file:
-        from powertrain.provenance import provenance
         write_json(json_file, result.to_json(),
                    provenance(engine, engine_file=engine_file or DEFAULT_ENGINE_PATH))
-        written.append(json_file)
     if plot:
         write_plot(lambda p: result.plot(path=p, provenance=prov), plot)
-        written.append(plot)
     if delta_plot:
         write_plot(lambda p: result.plot(path=p, provenance=prov, view="delta"), delta_plot)
-        written.append(delta_plot)
-    if quiet:
-        return
-    modes = ", ".join(f"{f:.2f}" for f in result.baseline.rigid_body_modes_hz)
-    click.echo(f"baseline: {engine.name} ({engine.file}), solver {solver}, "
-               f"{rpm[0]:g}-{rpm[-1]:g} rpm step {rpm_step:g}")
-    click.echo(f"baseline rigid-body modes [Hz]: {modes}")
-    for tf in result.target_fits:
-        click.echo(tf.summary())
-    click.echo(f"change of RMS {signal.replace('_', ' ')} vs baseline, 20 log10(v/v0) [dB]: "
-               "mean over speeds / max |d|")
-    click.echo(result.table())
-    if result.objective is not None:
-        click.echo(result.objective_text())
-    if written:
-        click.echo(f"wrote {', '.join(written)}")
-
-
-def _objective(text, channels, rpm):
-    """Parse ``CHANNEL.DIR:QUANTITY:FROM-TO`` against the model's channels."""
-    import numpy as np
-
-    from powertrain.analysis.orders import ORDERS
-    from powertrain.errors import InputError
-    from powertrain.iotools.measured import normalise_quantity
-    form = "CHANNEL.DIR:QUANTITY:FROM-TO, e.g. seat_rail.z:order_2:1500-3000"
-    parts = [p.strip() for p in text.split(":")]
-    if len(parts) != 3 or "." not in parts[0] or "-" not in parts[2]:
-        raise InputError(f"expected {form}, got {text!r}", key="--objective")
-    name, d = parts[0].rsplit(".", 1)
-    d = d.lower()
-    if (name, d) not in channels:
-        known = sorted({m for m, _ in channels})
-        raise InputError(f"unknown channel {parts[0]!r} (channels: {', '.join(known)}; "
-                         "directions x, y, z)", key="--objective")
-    try:
-        q = normalise_quantity(parts[1])
-        if q != "synthesis" and not np.any(np.isclose(ORDERS, float(q.split("_", 1)[1]))):
-            raise ValueError(q)
-        lo, hi = (float(x) for x in parts[2].lower().removesuffix("rpm").split("-"))
-    except (ValueError, KeyError):
-        raise InputError(f"expected {form}, got {text!r}", key="--objective") from None
-    if not (lo <= hi) or not any(lo - 1e-9 <= r <= hi + 1e-9 for r in rpm):
-        raise InputError(f"no speed step in {lo:g}-{hi:g} rpm", key="--objective")
-    return (name, d, q, lo, hi)
-
-
-def _check_variant_support(engine, variant) -> None:
-    """Each mount operation must leave mounts that carry the body (finite, plausible
-    rigid-body modes); the error names the option or variants-file key at fault."""
-    from powertrain.errors import InputError
-    from powertrain.iotools.engine_checks import check_support
-    from powertrain.workflows.variants import Target
-    for op in variant.operations:
-        if isinstance(op, Target) or not hasattr(op, "apply"):
-            continue
-        engine = op.apply(engine)
-        try:
-            check_support(engine, None)
-        except InputError as exc:
-            raise op.origin.error(f"variant {variant.name!r}: {exc.message}") from None

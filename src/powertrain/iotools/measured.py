@@ -55,7 +55,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from powertrain.analysis.orders import order_label
+from powertrain.analysis.orders import order_label, quantity_sort_key
 from powertrain.errors import InputError
 from powertrain.iotools.textfile import check_regular_file, parse_number, read_text
 
@@ -89,13 +89,6 @@ def _check_level(level_si: float, path, line, key) -> None:
     if level_si > MAX_LEVEL_M_PER_S:
         raise InputError(f"level {level_si:.3g} m/s above the plausible {MAX_LEVEL_M_PER_S:g} "
                          "m/s (unit error?)", file=path, line=line, key=key)
-
-
-def quantity_sort_key(quantity: str):
-    """Sort key: ``synthesis`` first, then orders ascending."""
-    if quantity == "synthesis":
-        return (0, 0.0)
-    return (1, float(quantity.split("_", 1)[1]))
 
 
 def normalise_quantity(text: str) -> str:

@@ -94,6 +94,12 @@ class TrackedOrders:
     settings: dict = field(default_factory=dict)
     comments: list = field(default_factory=list)
     overall: np.ndarray | None = None
+    #: the recording tracked: ``synthetic``, ``n_channels``, ``sample_rate_hz``, ``seconds``
+    recording: dict = field(default_factory=dict)
+    #: order spectra at single speeds (``track(spectrum_at=...)``), or None
+    spectra: TrackedOrders | None = None
+    #: Campbell and rpm-frequency maps of one channel (``track(maps=True)``), or None
+    maps: dict | None = None
 
     def order_rms(self) -> np.ndarray:
         """RMS per speed, channel and order [SI]."""
@@ -238,6 +244,61 @@ class TrackedOrders:
             return self.synthesis_rms()[:, c]
         o = float(quantity.split("_", 1)[1])
         return self.order_rms()[:, c, int(np.argmin(np.abs(self.orders - o)))]
+
+    def to_text(self, written=()) -> str:
+        """The report ``powertrain track`` prints: the recording, the speed grid, the
+        Vold-Kalman settings, the tracked RMS table; the files in ``written`` at its end."""
+        from powertrain.analysis.text_table import format_table
+        r, s = self.recording, self.settings
+        lines = [f"raw: {self.source}{' [SYNTHETIC]' if r.get('synthetic') else ''}: "
+                 f"{r.get('n_channels')} channel(s), {r.get('sample_rate_hz'):g} Hz, "
+                 f"{r.get('seconds'):.3g} s",
+                 f"speed: {s['speed_source']}; tracked ({self.method}) at {self.rpm.size} "
+                 f"speeds {self.rpm[0]:g}..{self.rpm[-1]:g} rpm (step {s['rpm_step']:g}) of "
+                 f"the measured {s['measured_rpm'][0]:.0f}..{s['measured_rpm'][1]:.0f} rpm"]
+        if "ends_dropped_s" in s:
+            (lo, hi), (start, end) = s["bandwidth_hz_range"], s["ends_dropped_s"]
+            lines.append(f"Vold-Kalman bandwidth {lo:.3g}..{hi:.3g} Hz ({s['bandwidth_rule']}); "
+                         f"not reported: the first {start:.3g} s and the last {end:.3g} s "
+                         f"({100 * (start + end) / r.get('seconds'):.1f} % of the record, "
+                         "filter end transient)")
+        lines += ["tracked RMS over the speed grid:",
+                  format_table(["channel", "quantity", "order", "median", "min", "max", "unit"],
+                               self._rms_rows(), "{:.6g}")]
+        written = [p for p in written if p]
+        if written:
+            lines.append("wrote " + ", ".join(written))
+        return "\n".join(lines)
+
+    def _rms_rows(self) -> list:
+        """Median, min and max over the speeds per channel and order, synthesis, overall."""
+        from powertrain.plotting.orders import DISPLAY
+        rows, rms, syn = [], self.order_rms(), self.synthesis_rms()
+        for c, ch in enumerate(self.channels):
+            unit, f = DISPLAY[ch.quantity]
+            label = ch.mount + ("" if ch.side == "active" else f".{ch.side}") + f".{ch.direction}"
+            curves = [(f"{o:.6g}", rms[:, c, k]) for k, o in enumerate(self.orders)]
+            curves.append(("synthesis", syn[:, c]))
+            if self.overall is not None:
+                curves.append(("overall", self.overall[:, c]))
+            rows += [[label, ch.quantity, name, float(np.median(v * f)), float((v * f).min()),
+                      float((v * f).max()), unit] for name, v in curves]
+        return rows
+
+    def write_spectra(self, path) -> None:
+        """Write the order spectra (:attr:`spectra`) as CSV, atomically."""
+        from powertrain.outputs import atomic_write
+        text = self.spectra.spectrum_csv_text()
+        with atomic_write(path) as fh:
+            fh.write(text)
+
+    def plot_maps(self, ax=None, *, path=None, provenance=None):
+        """The Campbell and rpm-frequency maps (:attr:`maps`); returns the figure (see
+        :func:`powertrain.plotting.orders.plot_maps`)."""
+        from powertrain.plotting.orders import plot_maps
+        from powertrain.plotting.style import target_and_path
+        ax, path = target_and_path(ax, path)
+        return plot_maps(**self.maps, path=path, ax=ax, provenance=provenance)
 
     def plot(self, ax=None, *, path=None, quantities=None, provenance=None):
         """Order curves (RMS against rpm), one panel per channel; returns the figure."""

@@ -27,291 +27,176 @@ Rules:
 
 from __future__ import annotations
 
-import json
-from dataclasses import dataclass, field
-from typing import ClassVar
+import math
+import time
+from pathlib import Path
 
 import numpy as np
 
 from powertrain.analysis import compare as cm
-from powertrain.analysis.noise_floor import at_floor, below_floor, censoring_level
-from powertrain.iotools.measured import MeasuredRunup, quantity_sort_key
+from powertrain.analysis.noise_floor import at_floor, below_floor
+from powertrain.analysis.orders import quantity_sort_key
+from powertrain.errors import InputError
+from powertrain.iotools.measured import MeasuredRunup
+from powertrain.results.comparison import (
+    EXPECTED_QUANTITIES,
+    MIN_CHANNELS_CSAC,
+    ChannelComparison,
+    ComparisonResult,
+    json_number,
+)
 
-#: Quantities always expected (the thesis's comparison, sec. 4.4); any other measured order is
-#: compared too.
-EXPECTED_QUANTITIES = ("synthesis", "order_2", "order_4")
 #: Default RMS noise floor of the measured order curves [m/s] (0.001 mm/s, see README).
 DEFAULT_NOISE_FLOOR = 1e-6
-#: CSAC and CSF are computed at a speed only if at least this many channels are compared there.
-MIN_CHANNELS_CSAC = 3
 #: Speeds closer than this are the same speed when pooling channels [rpm].
 RPM_TOL = 1e-6
 
-DEFINITIONS = {
-    "gap_db": "20*log10(v_sim/v_meas) at each compared measured speed; positive = "
-              "simulation higher",
-    "interpolation": "simulation taken at the measured speeds: exact where simulated there "
-                     "(simulated_at_measured_speeds), otherwise interpolated linearly in rpm "
-                     "and linearly in log level; no extrapolation (points outside the "
-                     "simulated speed range are not compared)",
-    "rms_db": "sqrt(mean(gap_db^2)) over the compared speeds of the channel",
-    "bias_db": "mean(gap_db) over the compared speeds of the channel",
-    "max_abs_db": "max |gap_db| over the compared speeds, at rpm_at_max_abs_db",
-    "frac": "(sum_n s_n m_n)^2 / (sum_n s_n^2 * sum_n m_n^2), summed over the compared speeds "
-            "n of one channel and quantity; RMS magnitudes (no phase in measured order "
-            "curves); 1 = same shape, blind to a common scale (Heylen et al. 1997; "
-            "Allemang 2003)",
-    "csac": "(sum_j s_j m_j)^2 / (sum_j s_j^2 * sum_j m_j^2), summed over the channels j "
-            "compared at one speed and quantity; RMS magnitudes; shape across the channels, "
-            "sensitive to mass/stiffness errors (Zang, Grafe & Imregun 2001)",
-    "csf": "2|sum_j s_j m_j| / (sum_j s_j^2 + sum_j m_j^2), summed over the channels j at "
-           "one speed and quantity; RMS magnitudes; also sensitive to level, i.e. damping "
-           "and level errors (Zang, Grafe & Imregun 2001)",
-    "frfsm": "mean over the compared speeds of exp(-gap_db^2 / (2 sigma^2)), sigma = "
-             "frfsm_sigma_db; our simplified score following the idea of the FRF similarity "
-             "metric of Lee, Ahn & Kim (JSV 436, 2018): likelihood of the level error under "
-             "a normal distribution, normalised to 0..1",
-    "noise_floor": "measured points below noise_floor_margin * noise_floor "
-                   "(noise_floor_exclusion_m_per_s) are excluded and counted "
-                   "(n_excluded_noise_floor), never scored",
-    "measured_not_modelled": "simulation below noise_floor while the measurement is not "
-                             "excluded: the model predicts nothing measurable there; counted "
-                             "(n_measured_not_modelled), listed in measured_not_modelled, "
-                             "never scored; n_simulation_zero counts those where the "
-                             "simulation is exactly zero",
-    "overall_rms_db": "sqrt(mean(gap_db^2)) pooled over every compared point of every "
-                      "channel and quantity (not the measured-not-modelled points)",
-}
 
+def compare(measured, *, engine=None, simulated=None, solver="newmark", step=None,
+            noise_floor=DEFAULT_NOISE_FLOOR, progress=False) -> ComparisonResult:
+    """Compare a simulated run-up with a measured one (``powertrain compare``).
 
-@dataclass
-class ChannelComparison:
-    """Comparison of one channel (mount, direction) and quantity.
-
-    Arrays cover all measured speeds of the channel; ``scored`` marks the compared ones.
-    Levels in m/s RMS, speeds in rpm, gaps in dB.
-    """
-
-    mount: str
-    direction: str
-    quantity: str
-    rpm: np.ndarray
-    measured: np.ndarray
-    simulated: np.ndarray          # interpolated, NaN outside the simulated range
-    outside: np.ndarray            # bool: outside the simulated speed range
-    at_floor: np.ndarray           # bool: at or near the noise floor (inside the range)
-    sim_zero: np.ndarray           # bool: simulation exactly zero (cannot be scored in dB)
-    not_modelled: np.ndarray       # bool: simulation below the floor, measurement above
-    interpolated: np.ndarray       # bool: inside the range but not at a simulated speed
-    scored: np.ndarray             # bool
-    gap_db: np.ndarray             # at the scored speeds
-    stats: dict = field(default_factory=dict)
-
-    def to_dict(self) -> dict:
-        r = self.rpm[self.scored]
-        d = {"mount": self.mount, "direction": self.direction, "quantity": self.quantity}
-        d.update({k: _num(v) for k, v in self.stats.items()})
-        d.update({
-            "n_measured": int(self.rpm.size),
-            "n_compared": int(self.scored.sum()),
-            "n_excluded_noise_floor": int(self.at_floor.sum()),
-            "n_outside_simulated_range": int(self.outside.sum()),
-            "n_simulation_zero": int(self.sim_zero.sum()),
-            "n_measured_not_modelled": int(self.not_modelled.sum()),
-            "rpm_compared": [_num(x) for x in r],
-            "measured_m_per_s": [_num(x) for x in self.measured[self.scored]],
-            "simulated_m_per_s": [_num(x) for x in self.simulated[self.scored]],
-            "gap_db": [_num(x) for x in self.gap_db],
-        })
-        return d
-
-
-def _format_table(header, rows) -> str:
-    cells = [[str(v) for v in row] for row in rows]
-    widths = [max([len(h)] + [len(r[i]) for r in cells]) for i, h in enumerate(header)]
-    lines = ["  ".join(h.rjust(w) for h, w in zip(header, widths)),
-             "  ".join("-" * w for w in widths)]
-    lines += ["  ".join(c.rjust(w) for c, w in zip(r, widths)) for r in cells]
-    return "\n".join(lines)
-
-
-def _num(x):
-    x = float(x)
-    return x if np.isfinite(x) else None
-
-
-@dataclass
-class ComparisonResult:
-    """Outcome of :func:`compare_runup`: per-channel gaps and metrics, per-speed CSAC/CSF.
-
-    Attributes
+    Parameters
     ----------
-    channels : list of ChannelComparison
-        Channels and quantities compared (at least one scored point each).
-    per_rpm : list of dict
-        ``{"quantity", "rpm", "n_channels", "csac", "csf"}`` per quantity and speed.
-    missing : list of dict
-        ``{"mount", "direction", "quantity", "reason"}``: not compared, and why.
-    measured, simulated : MeasuredRunup
-        The curves compared (SI).
+    measured : str, Path or MeasuredRunup
+        Measured order curves (long-format CSV or run-up HDF5; raw time data are refused
+        with a pointer to :func:`~powertrain.workflows.tracking.track`).
+    engine : Engine, str, Path or None
+        Engine simulated at the measured speeds (default: the shipped
+        ``engines/default.toml``); not with ``simulated``.
+    simulated : str, Path, MeasuredRunup or RunupResult, optional
+        A simulation to compare instead (no simulation is run).
+    solver : {"newmark", "harmonic"}
+        Solver of the simulation run here.
+    step : float, optional
+        Simulate on a grid of this step [rpm] over the measured range and interpolate it to
+        the measured speeds (default: simulate at every measured speed in the engine's range).
     noise_floor : float
-        RMS noise floor of the measurement [m/s].
-    sim_rpm : ndarray
-        Simulated speeds [rpm].
-    not_modelled : list of dict
-        Measured-not-modelled points per channel and quantity: ``{"mount", "direction",
-        "quantity", "rpm", "measured_m_per_s", "simulated_m_per_s"}``.
+        RMS noise floor of the measured curves [m/s] (:func:`compare_runup`).
+    progress : bool
+        Progress bar of the simulation.
+
+    Returns
+    -------
+    ComparisonResult
+        With ``run`` telling what ran; ``to_text()`` is the report of the command.
     """
+    t0 = time.perf_counter()
+    if simulated is not None and engine is not None:
+        raise ValueError("give simulated or engine, not both")
+    if step is not None and not (math.isfinite(step) and step > 0):
+        raise InputError("must be > 0 [rpm]", key="--step")
+    if simulated is not None:
+        sim, meas, run = _given_simulation(simulated, measured)
+    else:
+        from powertrain.workflows.runup import engine_and_file
+        engine, engine_file = engine_and_file(engine)
+        meas = _read_curves(measured, list(engine.mount_names))
+        sim = _simulate(engine, engine_file, meas, step, solver, progress)
+        run = {"engine": engine, "engine_file": engine_file, "solver": solver}
+    run["simulation_seconds"] = time.perf_counter() - t0
+    comp = compare_runup(sim, meas, noise_floor=noise_floor)
+    if not comp.channels and not comp.not_modelled:
+        raise InputError("nothing to compare: no channel and quantity has a point above the "
+                         f"noise floor ({noise_floor * 1e3:g} mm/s) inside the simulated speed "
+                         "range", file=meas.source if isinstance(measured, MeasuredRunup)
+                         else measured, key="--noise-floor")
+    comp.run = {**run, "seconds": time.perf_counter() - t0}
+    return comp
 
-    #: Quantities every comparison reports (plots draw them even when none was measured).
-    EXPECTED_QUANTITIES: ClassVar[tuple] = EXPECTED_QUANTITIES
 
-    def requested_quantities(self) -> list:
-        """Every quantity requested: the default three and all measured or compared ones,
-        in the measured-file order (synthesis first, then orders ascending)."""
-        qs = set(EXPECTED_QUANTITIES) | set(self.measured.quantities)
-        qs |= {c.quantity for c in self.channels}
-        return sorted(qs, key=quantity_sort_key)
+def _given_simulation(simulated, measured):
+    """The given simulation's curves, the measured ones and ``run`` (what was compared)."""
+    name = None
+    if isinstance(simulated, MeasuredRunup):
+        sim = simulated
+    elif hasattr(simulated, "velocity"):                       # a RunupResult
+        sim = MeasuredRunup.from_result(simulated, source="simulation")
+    else:
+        name = str(simulated)
+        sim = _read_curves(simulated)
+    meas = _read_curves(measured, sorted({m for m, _ in sim.channels}))
+    if meas.signal != sim.signal:
+        if not isinstance(simulated, (str, Path)):
+            sim = MeasuredRunup.from_result(simulated, source="simulation", signal=meas.signal)
+        else:
+            raise InputError(f"measured {meas.signal} curves need a simulation of the same "
+                             "quantity; run without --sim (the simulation is run here)",
+                             file=name)
+    return sim, meas, {"engine": None, "simulation_file": name or sim.source}
 
 
-    channels: list
-    per_rpm: list
-    missing: list
-    measured: MeasuredRunup
-    simulated: MeasuredRunup
-    noise_floor: float
-    sim_rpm: np.ndarray
-    sigma_db: float = cm.FRFSM_SIGMA_DB
-    info: dict = field(default_factory=dict)
-    not_modelled: list = field(default_factory=list)
+def _read_curves(path, mounts=None):
+    """Order curves of ``path`` (a MeasuredRunup is taken as it is); raw time data are
+    refused with a pointer to ``track``."""
+    from powertrain.iotools.measured import read_measured
+    from powertrain.iotools.raw import detect_format
+    if isinstance(path, MeasuredRunup):
+        return path
+    kind = detect_format(path)
+    if kind in ("mdf", "uff"):
+        raise InputError(f"raw time data ({kind.upper()}), not order curves: track it first "
+                         f"('powertrain track {path} --csv curves.csv'), then compare "
+                         "curves.csv", file=path)
+    try:
+        return read_measured(path, mounts=mounts)
+    except InputError as exc:
+        if _is_raw_csv(exc):
+            raise InputError("raw time data (a 'time' column), not order curves: track it "
+                             f"first ('powertrain track {path} --csv curves.csv'), then "
+                             "compare curves.csv", file=path, line=exc.line,
+                             key=exc.key) from None
+        raise
 
-    @property
-    def exclusion_limit(self) -> float:
-        """Measured levels below this are excluded [m/s]: the one noise-floor rule,
-        :func:`~powertrain.analysis.noise_floor.censoring_level` of the floor."""
-        return censoring_level(self.noise_floor)
 
-    @property
-    def n_not_modelled(self) -> int:
-        """Measured-not-modelled points over every channel and quantity."""
-        return sum(len(e["rpm"]) for e in self.not_modelled)
+def _is_raw_csv(exc) -> bool:
+    """True if the order-curve reader refused a wide raw CSV (its time column)."""
+    from powertrain.iotools.channel_map import split_unit
+    return bool(exc.key) and split_unit(str(exc.key))[0].strip().lower() == "time" \
+        and exc.message.startswith("unknown column")
 
-    @property
-    def n_interpolated(self) -> int:
-        """Compared points whose simulated level was interpolated between simulated speeds."""
-        return int(sum((c.interpolated & c.scored).sum() for c in self.channels))
 
-    @property
-    def overall_rms_db(self) -> float:
-        """RMS of every scored gap, pooled over channels and quantities [dB]."""
-        g = np.concatenate([c.gap_db for c in self.channels]) if self.channels else np.zeros(0)
-        return float(np.sqrt(np.mean(g ** 2))) if g.size else float("nan")
+def _simulate(engine, engine_file, meas, rpm_step, solver, progress):
+    """Run the engine at the measured speeds (or on a ``rpm_step`` grid over them)."""
+    from powertrain.workflows.runup import checked_runup, run_runup
+    rpm = simulation_speeds(engine, meas, rpm_step)
+    grid = (f"{rpm[0]:g}..{rpm[-1]:g} rpm step {rpm_step:g}, interpolated" if rpm_step
+            else f"at the {rpm.size} measured speeds {rpm[0]:g}..{rpm[-1]:g} rpm")
+    result = checked_runup(engine, engine_file, run_runup, rpm, solver=solver,
+                           progress=progress)
+    return MeasuredRunup.from_result(result, source=f"{engine_file} ({solver}, {grid})",
+                                     signal=meas.signal)
 
-    def channel(self, mount, direction, quantity) -> ChannelComparison:
-        """The comparison of one channel and quantity (KeyError if not compared)."""
-        for c in self.channels:
-            if (c.mount, c.direction, c.quantity) == (mount, direction, quantity):
-                return c
-        raise KeyError((mount, direction, quantity))
 
-    def per_quantity(self) -> list:
-        """Pooled gap RMS and CSAC/CSF summary per quantity."""
-        out = []
-        for q in sorted({c.quantity for c in self.channels}, key=quantity_sort_key):
-            g = np.concatenate([c.gap_db for c in self.channels if c.quantity == q])
-            rows = [r for r in self.per_rpm if r["quantity"] == q and r["csac"] is not None]
-            entry = {"quantity": q, "rms_db": _num(np.sqrt(np.mean(g ** 2))),
-                     "bias_db": _num(np.mean(g)), "n_compared": int(g.size),
-                     "n_rpm_with_csac": len(rows)}
-            if rows:
-                csac = np.array([r["csac"] for r in rows])
-                csf = np.array([r["csf"] for r in rows])
-                entry.update({"csac_mean": _num(csac.mean()), "csac_min": _num(csac.min()),
-                              "rpm_at_csac_min": rows[int(np.argmin(csac))]["rpm"],
-                              "csf_mean": _num(csf.mean()), "csf_min": _num(csf.min()),
-                              "rpm_at_csf_min": rows[int(np.argmin(csf))]["rpm"]})
-            out.append(entry)
-        return out
-
-    def to_dict(self) -> dict:
-        n_total = sum(c.rpm.size for c in self.channels)
-        return {
-            "format": "powertrain-compare",
-            "format_version": 1,
-            "measured": self.measured.source,
-            "measured_synthetic": self.measured.synthetic,
-            "measured_comments": list(self.measured.comments),
-            "simulated": self.simulated.source,
-            "simulated_rpm": [float(r) for r in self.sim_rpm],
-            "notes": list(self.measured.notes) + list(self.info.get("notes", [])),
-            "noise_floor_m_per_s": self.noise_floor,
-            "noise_floor_margin": cm.NOISE_FLOOR_MARGIN,
-            "noise_floor_exclusion_m_per_s": self.exclusion_limit,
-            "simulated_at_measured_speeds": self.n_interpolated == 0,
-            "frfsm_sigma_db": self.sigma_db,
-            "min_channels_csac": MIN_CHANNELS_CSAC,
-            "overall_rms_db": _num(self.overall_rms_db),
-            "compared": {
-                "n_channel_quantities": len(self.channels),
-                "quantities": sorted({c.quantity for c in self.channels},
-                                     key=quantity_sort_key),
-                "n_points_measured": int(n_total),
-                "n_points_compared": int(sum(c.scored.sum() for c in self.channels)),
-                "n_points_excluded_noise_floor": int(sum(c.at_floor.sum()
-                                                         for c in self.channels)),
-                "n_points_outside_simulated_range": int(sum(c.outside.sum()
-                                                            for c in self.channels)),
-                "n_points_simulation_zero": int(sum(c.sim_zero.sum() for c in self.channels)),
-                "n_points_measured_not_modelled": self.n_not_modelled,
-                "n_points_interpolated": self.n_interpolated,
-            },
-            "missing": list(self.missing),
-            "measured_not_modelled": list(self.not_modelled),
-            "per_quantity": self.per_quantity(),
-            "channels": [c.to_dict() for c in self.channels],
-            "per_rpm": list(self.per_rpm),
-            "definitions": dict(DEFINITIONS),
-        }
-
-    def to_json(self, path=None) -> str:
-        """JSON text of :meth:`to_dict`; written atomically to ``path`` if given."""
-        text = json.dumps(self.to_dict(), indent=1) + "\n"
-        if path is not None:
-            from powertrain.outputs import atomic_write
-            with atomic_write(path) as fh:
-                fh.write(text)
-        return text
-
-    def worst_first(self) -> list:
-        """Channels sorted by RMS gap, largest first."""
-        return sorted(self.channels, key=lambda c: -c.stats["rms_db"])
-
-    def table(self) -> str:
-        """Text table of the channels, worst (largest RMS gap) first."""
-        header = ["mount", "dir", "quantity", "n", "rms dB", "bias dB", "max|dB|", "@rpm",
-                  "FRAC", "FRFSM", "floor", "outside"]
-        rows = []
-        for c in self.worst_first():
-            s = c.stats
-            rows.append([c.mount, c.direction, c.quantity, int(c.scored.sum()),
-                         f"{s['rms_db']:.2f}", f"{s['bias_db']:+.2f}", f"{s['max_abs_db']:.2f}",
-                         f"{s['rpm_at_max_abs_db']:g}", f"{s['frac']:.3f}",
-                         f"{s['frfsm']:.3f}", int(c.at_floor.sum()), int(c.outside.sum())])
-        return _format_table(header, rows)
-
-    def plot(self, ax=None, *, path=None, quantities=None, channel=None, quantity=None,
-             provenance=None):
-        """Measured vs simulated curves, gap shaded (thesis layout, Figs 45-71); every
-        measured quantity is drawn unless ``quantities`` says otherwise. Returns the figure.
-
-        See :func:`powertrain.plotting.plot_comparison`.
-        """
-        from powertrain.plotting import plot_comparison
-        from powertrain.plotting.style import target_and_path
-        ax, path = target_and_path(ax, path)
-        return plot_comparison(self, path, quantities, ax=ax, channel=channel,
-                               quantity=quantity,
-                               provenance=provenance or getattr(self, "provenance", None))
+def simulation_speeds(engine, meas, rpm_step=None):
+    """Speeds to simulate [rpm]: every measured speed inside the engine's range, or a
+    ``rpm_step`` grid covering the intersection of the measured and the engine's range."""
+    from powertrain.workflows.runup import MAX_SPEEDS, default_rpm
+    lo, hi = meas.rpm_range()
+    e_lo, e_hi = engine.speed_range_rpm()
+    if hi < e_lo or lo > e_hi:
+        raise InputError(f"measured speeds {lo:g}..{hi:g} rpm outside the engine's range "
+                         f"{e_lo:g}..{e_hi:g} rpm", file=meas.source, key="rpm")
+    if rpm_step is None:
+        rpm = np.unique(np.concatenate([r for r, _ in meas.curves.values()]))
+        rpm = rpm[(rpm >= e_lo - 1e-6) & (rpm <= e_hi + 1e-6)]
+        if rpm.size > MAX_SPEEDS:
+            raise InputError(f"{rpm.size} distinct measured speeds; at most {MAX_SPEEDS} are "
+                             "simulated one by one: give --step to simulate a grid",
+                             file=meas.source, key="rpm")
+        return rpm
+    start = max(math.floor(lo / rpm_step + 1e-9) * rpm_step,
+                math.ceil(e_lo / rpm_step - 1e-9) * rpm_step)
+    stop = min(math.ceil(hi / rpm_step - 1e-9) * rpm_step,
+               math.floor(e_hi / rpm_step + 1e-9) * rpm_step)
+    if stop < start or start <= 0:
+        raise InputError(f"{rpm_step:g} rpm leaves no speed step inside both the measured "
+                         f"({lo:g}..{hi:g}) and the engine's ({e_lo:g}..{e_hi:g}) range",
+                         key="--step")
+    if (stop - start) / rpm_step + 1 > MAX_SPEEDS:
+        raise InputError(f"{(stop - start) / rpm_step + 1:.3g} speed steps over the "
+                         f"measured range; at most {MAX_SPEEDS}", key="--step")
+    return default_rpm(start, stop, rpm_step)
 
 
 def compare_runup(simulated, measured: MeasuredRunup, *, noise_floor=DEFAULT_NOISE_FLOOR,
@@ -391,9 +276,9 @@ def _compare_channel(where, measured_curve, simulated_curve, noise_floor, sigma_
 
 def _points(c: ChannelComparison, mask) -> dict:
     """Speeds and both levels of the points of ``c`` selected by ``mask`` (JSON-ready)."""
-    return {"rpm": [_num(x) for x in c.rpm[mask]],
-            "measured_m_per_s": [_num(x) for x in c.measured[mask]],
-            "simulated_m_per_s": [_num(x) for x in c.simulated[mask]]}
+    return {"rpm": [json_number(x) for x in c.rpm[mask]],
+            "measured_m_per_s": [json_number(x) for x in c.measured[mask]],
+            "simulated_m_per_s": [json_number(x) for x in c.simulated[mask]]}
 
 
 def _per_rpm(channels) -> list:
@@ -409,7 +294,7 @@ def _per_rpm(channels) -> list:
             entry = {"quantity": q, "rpm": round(r, 6), "n_channels": int(sm.shape[0]),
                      "csac": None, "csf": None}
             if sm.shape[0] >= MIN_CHANNELS_CSAC:
-                entry["csac"] = _num(cm.csac(sm[:, 0], sm[:, 1]))
-                entry["csf"] = _num(cm.csf(sm[:, 0], sm[:, 1]))
+                entry["csac"] = json_number(cm.csac(sm[:, 0], sm[:, 1]))
+                entry["csf"] = json_number(cm.csf(sm[:, 0], sm[:, 1]))
             out.append(entry)
     return out

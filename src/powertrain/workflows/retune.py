@@ -61,11 +61,11 @@ inside the band against the requested one.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 
 import numpy as np
 
-from powertrain.workflows.variants import Origin, Swap, Target, Variant
+from powertrain.workflows.variants import Origin, Swap, Target
 
 #: Log-spaced fit frequencies above 0 Hz.
 N_FREQUENCIES = 120
@@ -337,28 +337,16 @@ def retune(model, target: Target, **fit_kwargs) -> TargetFit:
                      start=start, fit_summary=fit.summary())
 
 
-def resolve_targets(engine, variant: Variant, **fit_kwargs):
-    """Replace every :class:`Target` of ``variant`` by a :class:`Swap` of the fitted model.
-
-    Operations are applied in order, so a target retunes the mount direction as the earlier
-    operations of the variant left it.
+def retuned_swap(engine, target: Target, **fit_kwargs):
+    """Retune the mount direction of ``target`` as ``engine`` has it: the :class:`Swap` that
+    puts the fitted model in, and the fit.
 
     Returns
     -------
-    variant : Variant
-        Same name, targets replaced.
-    fits : list of TargetFit
+    swap : Swap
+    fit : TargetFit
     """
-    ops, fits = [], []
-    current = engine
-    for op in variant.operations:
-        if isinstance(op, Target):
-            op.check(current)
-            base = current.mount(op.mount).directions[op.direction]
-            tf = retune(base, op, **fit_kwargs)
-            fits.append(tf)
-            op = Swap(op.mount, op.direction, tf.model, path=f"<fitted: {op.spec}>",
-                      spec=op.spec, origin=op.origin or Origin("--target"))
-        current = op.apply(current)
-        ops.append(op)
-    return replace(variant, operations=tuple(ops)), fits
+    target.check(engine)
+    tf = retune(engine.mount(target.mount).directions[target.direction], target, **fit_kwargs)
+    return Swap(target.mount, target.direction, tf.model, path=f"<fitted: {target.spec}>",
+                spec=target.spec, origin=target.origin or Origin("--target")), tf

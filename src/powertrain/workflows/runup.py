@@ -24,6 +24,7 @@ solve per speed, the periodicity check, the result.
 
 from __future__ import annotations
 
+import os
 import time
 import warnings
 
@@ -36,6 +37,8 @@ from powertrain.progress import progress_bar
 from powertrain.results.runup import RunupResult, SweepRunup
 from powertrain.solvers.steppers import Cycles, choose_stepper
 
+#: Largest speed grid a run-up command accepts (about 0.1 s per speed step).
+MAX_SPEEDS = 2000
 #: Default crank-angle increment [deg]; halving it moves the results < 0.1 % (see tests).
 ANGLE_STEP_DEG = 1.0
 #: Cycles simulated per speed step and cycles processed (thesis sec. 4.4).
@@ -423,3 +426,13 @@ def mode_coordinates(engine, frequencies_hz) -> list:
         out.append(COORDINATES[int(np.argmax(energy))]
                    if abs(f_sys[k] - f) <= 1e-6 * max(f, 1.0) else "")
     return out
+
+
+def engine_and_file(engine=None):
+    """The engine to run and the file it came from: an Engine as it is (its ``file``), a
+    path read, None the shipped ``engines/default.toml``."""
+    from powertrain.iotools.engine_file import DEFAULT_ENGINE_PATH, read_engine
+    if engine is None or isinstance(engine, (str, os.PathLike)):
+        path = str(engine or DEFAULT_ENGINE_PATH)
+        return read_engine(path), path
+    return engine, engine.file

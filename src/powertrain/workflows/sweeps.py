@@ -1,9 +1,8 @@
 """The sweep engine: run many run-up variants on any executor.
 
-A :class:`SweepTask` is a small picklable description -- baseline engine, the variant's
-operations (:mod:`powertrain.workflows.variants`, targets already resolved), speeds, solver -- and
-:func:`run_task` turns it into a :class:`~powertrain.results.runup.RunupResult` in whatever process
-runs it (it applies the operations there, so only the description travels).
+A :class:`SweepTask` is a small picklable description -- the variant's engine (its operations
+already applied), its response-level effects, speeds, solver -- and :func:`run_task` turns it
+into a :class:`~powertrain.results.runup.RunupResult` in whatever process runs it.
 :func:`run_sweep` hands the tasks to an *executor*: anything with the
 :class:`concurrent.futures.Executor` method ``submit(fn, *args) -> future`` whose futures have
 ``result()``. Only ``submit`` and ``result`` are used (not ``map``, whose return type differs
@@ -45,44 +44,42 @@ class SweepTask:
     name : str
         Variant name (``baseline`` for no operation).
     engine : Engine
-        Baseline engine.
-    operations : tuple
-        Operations of :mod:`powertrain.workflows.variants` applied in order (no unresolved targets).
+        The variant's engine (its operations applied,
+        :func:`powertrain.workflows.whatif.variant_engine`).
     rpm : ndarray
         Speed steps [rpm].
     solver : {"harmonic", "newmark"}
     options : dict
         Further keyword arguments of :func:`powertrain.workflows.runup.run_runup`
         (``angle_step_deg``...).
+    effects : dict
+        Response-level effects ``{effect: {parameter: value}}`` (amplitude-dependent mounts,
+        sensor errors) run by :func:`powertrain.workflows.effect_runup.runup_with_effects`.
     """
 
     name: str
     engine: object
-    operations: tuple = ()
     rpm: np.ndarray = field(default_factory=lambda: np.zeros(0))
     solver: str = "harmonic"
     options: dict = field(default_factory=dict)
+    effects: dict = field(default_factory=dict)
 
 
 def run_task(task: SweepTask):
-    """Apply the task's operations to its engine and run the run-up (response-level
-    effects, :func:`powertrain.workflows.variants.response_scenario`, through
-    :func:`powertrain.workflows.runup.runup_with_effects`).
+    """Run the task's run-up (with its response-level effects, if any).
 
     Returns
     -------
     RunupResult
         ``meta["variant"]`` holds the task name.
     """
-    from powertrain.workflows.runup import run_runup, runup_with_effects
-    from powertrain.workflows.variants import apply_operations, response_scenario
-    engine = apply_operations(task.engine, task.operations)
-    response = response_scenario(task.operations)
-    if response:        # amplitude-dependent mounts, sensor errors: see effects module
-        result = runup_with_effects(engine, task.rpm, response, solver=task.solver,
+    if task.effects:
+        from powertrain.workflows.runup import runup_with_effects
+        result = runup_with_effects(task.engine, task.rpm, task.effects, solver=task.solver,
                                     **task.options)
     else:
-        result = run_runup(engine, task.rpm, solver=task.solver, **task.options)
+        from powertrain.workflows.runup import run_runup
+        result = run_runup(task.engine, task.rpm, solver=task.solver, **task.options)
     result.meta["variant"] = task.name
     return result
 

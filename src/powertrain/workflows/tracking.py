@@ -7,6 +7,8 @@ analysis.
 
 from __future__ import annotations
 
+import os
+
 import numpy as np
 
 from powertrain.analysis import order_tracking as cot
@@ -44,6 +46,139 @@ def speed_profile(rec, *, use="auto", pulses_per_rev=None, smooth_s=0.1):
         raise InputError("a tacho needs --pulses-per-rev N", file=rec.source, key="tacho")
     return speed_from_tacho(rec.time, rec.tacho, pulses_per_rev, smooth_s=smooth_s,
                             file=rec.source)
+
+
+def track(raw, *, orders=None, rpm_step=50.0, method="cot", bandwidth=None, channel_map=None,
+          rpm_column=None, tacho_column=None, pulses_per_rev=None, quantity=None,
+          as_quantity=None, overall=False, overall_band=None, spectrum_at=(),
+          map_channel=None, maps=False, progress=False) -> TrackedOrders:
+    """Order-track raw run-up time data (``powertrain track``).
+
+    Parameters
+    ----------
+    raw : str, Path or RawRecording
+        Wide CSV, raw HDF5, UFF 58 or MDF4 file, or a recording read already.
+    orders : str or array_like, optional
+        ``start:stop:step`` and/or a list (``"1,2,4.5"``), or the orders (default 0.5..8).
+    rpm_step, method, bandwidth, quantity, progress
+        See :func:`track_recording` (``bandwidth`` [Hz]).
+    channel_map : str, Path or ChannelMap, optional
+        File channel name -> mount, side, direction, quantity.
+    rpm_column, tacho_column : str, optional
+        Speed channel [rpm] or tacho pulse channel (needs ``pulses_per_rev``).
+    as_quantity : {"velocity"}, optional
+        Convert order by order (the spectra and the overall level too).
+    overall : bool
+        Also the overall level per speed, in ``overall_band`` (``"LO:HI"`` or (lo, hi) [Hz]).
+    spectrum_at : sequence of float
+        Speeds [rpm] of order spectra (``result.spectra``, :func:`order_spectrum`).
+    map_channel : str, optional
+        Channel of the maps: its name in the file or its label (default the first).
+    maps : bool
+        Campbell and rpm-frequency maps of that channel (``result.maps``).
+
+    Returns
+    -------
+    TrackedOrders
+        With ``spectra`` and ``maps`` when asked; ``to_text()`` is the command's report.
+    """
+    from powertrain.analysis.speed import MAX_PULSES_PER_REV
+    if tacho_column and pulses_per_rev is None:
+        raise InputError("--tacho needs --pulses-per-rev N", key="--pulses-per-rev")
+    if pulses_per_rev is not None and not 1 <= pulses_per_rev <= MAX_PULSES_PER_REV:
+        raise InputError(f"must be 1..{MAX_PULSES_PER_REV}", key="--pulses-per-rev")
+    if map_channel and not maps:
+        raise InputError("--map-channel needs --map FILE.png", key="--map-channel")
+    if isinstance(orders, str):
+        orders = cot.parse_orders(orders)
+    overall_opts = _overall_options(overall, overall_band, as_quantity)
+    rec = _recording(raw, channel_map, rpm_column, tacho_column)
+    use = "tacho" if tacho_column else "rpm" if rpm_column else "auto"
+    tracked = track_recording(rec, orders, rpm_step=rpm_step, method=method, use=use,
+                              pulses_per_rev=pulses_per_rev, quantity=quantity,
+                              bandwidth_hz=bandwidth, overall=overall_opts, progress=progress)
+    spectra = _spectra(rec, use, pulses_per_rev, spectrum_at, tracked.orders, quantity)
+    if as_quantity == "velocity":
+        tracked = tracked.as_velocity()
+        spectra = spectra and spectra.as_velocity()
+    if spectra:
+        _ = spectra.quantity                      # mixed quantities: fail before any file
+    tracked.spectra = spectra
+    if maps:
+        tracked.maps = _maps(rec, use, pulses_per_rev, rpm_step, _map_channel(rec, map_channel),
+                             float(np.max(tracked.orders)))
+    return tracked
+
+
+def _recording(raw, channel_map, rpm_column, tacho_column):
+    """The recording of ``raw`` (read through ``channel_map`` if a path)."""
+    from powertrain.iotools.raw import read_raw
+    if not isinstance(raw, (str, os.PathLike)):
+        return raw
+    if isinstance(channel_map, (str, os.PathLike)):
+        from powertrain.iotools.channel_map import read_channel_map
+        channel_map = read_channel_map(channel_map)
+    return read_raw(raw, channel_map, rpm=rpm_column, tacho=tacho_column)
+
+
+def _overall_options(overall, overall_band, as_quantity):
+    """The ``overall`` argument of track_recording, or None."""
+    if not (overall or overall_band):
+        return None
+    from powertrain.analysis.overall import parse_band
+    band = parse_band(overall_band) if isinstance(overall_band, str) else overall_band
+    return {"band": band, "velocity": as_quantity == "velocity"}
+
+
+def _spectra(rec, use, pulses_per_rev, speeds, orders, quantity):
+    """Order spectra at ``speeds`` (one TrackedOrders), or None."""
+    if not len(speeds):
+        return None
+    from dataclasses import replace
+    profile = speed_profile(rec, use=use, pulses_per_rev=pulses_per_rev)
+    parts = [order_spectrum(rec, profile, rpm, SPECTRUM_EXTENT * float(np.max(orders)),
+                            quantity=quantity) for rpm in speeds]
+    size = min(p.orders.size for p in parts)        # the top order is capped by fs / rpm
+    first = parts[0]
+    amp = np.concatenate([p.amplitude[:, :, :size] for p in parts])
+    return replace(first, rpm=np.concatenate([p.rpm for p in parts]),
+                   orders=first.orders[:size], amplitude=amp)
+
+
+def _map_channel(rec, name):
+    """Index of the map channel ``name`` (file name or MOUNT[.SIDE].DIRECTION label)."""
+    if not name:
+        return 0
+    for i, ch in enumerate(rec.channels):
+        if name in (ch.name, ch.label):
+            return i
+    known = ", ".join(ch.label for ch in rec.channels)
+    raise InputError(f"no channel {name!r} in the file (channels: {known})",
+                     key="--map-channel")
+
+
+def _maps(rec, use, pulses_per_rev, rpm_step, channel, max_order):
+    """Campbell and rpm-frequency maps of one channel (arguments of
+    :func:`~powertrain.plotting.orders.plot_maps`), both reaching 25 % above the highest
+    tracked order."""
+    from pathlib import Path
+
+    from scipy.signal import spectrogram
+
+    from powertrain.plotting.orders import DISPLAY, MAP_MARGIN
+    profile = speed_profile(rec, use=use, pulses_per_rev=pulses_per_rev)
+    rpm, fine, rms = order_map(rec, profile, channel, rpm_step=rpm_step,
+                               max_order=MAP_MARGIN * max_order)
+    fs = rec.sample_rate
+    nper = min(int(2 ** np.ceil(np.log2(max(64, fs / 2.0)))), rec.time.size)   # ~2 Hz
+    f, tt, p = spectrogram(rec.channels[channel].values, fs, nperseg=nper,
+                           noverlap=nper * 7 // 8)
+    rpm_t = np.interp(tt + rec.time[0], rec.time, profile.rpm)
+    ch = rec.channels[channel]
+    return dict(rpm=rpm, orders=fine, order_rms=rms, times=tt, freqs=f, rpm_t=rpm_t, psd=p.T,
+                title=f"{ch.label} ({ch.quantity}) of {Path(str(rec.source)).name}",
+                unit=DISPLAY[ch.quantity][0], factor=DISPLAY[ch.quantity][1],
+                max_order=max_order)
 
 
 def track_recording(rec, orders=None, *, rpm_step=50.0, method="cot", use="auto",
@@ -102,10 +237,16 @@ def track_recording(rec, orders=None, *, rpm_step=50.0, method="cot", use="auto"
                                       float(np.max(profile.rpm[i0:i1 + 1]))]})
     tracked = [TrackedChannel(c.name, c.mount, c.side, c.direction, c.quantity) for c in chans]
     result = TrackedOrders(rpm, orders, tracked, amp, method, rec.source, settings,
-                           list(rec.comments))
+                           list(rec.comments), recording=_summary(rec))
     if overall is not None:
         _add_overall(result, rec, chans, profile, overall.get("band"), overall.get("velocity"))
     return result
+
+
+def _summary(rec) -> dict:
+    """What the report says of a recording."""
+    return {"synthetic": bool(rec.synthetic), "n_channels": len(rec.channels),
+            "sample_rate_hz": float(rec.sample_rate), "seconds": float(rec.time[-1] - rec.time[0])}
 
 
 def overall_band(orders, rpm, sample_rate):

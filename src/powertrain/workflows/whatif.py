@@ -1,267 +1,24 @@
 r"""What-if: run the baseline and variants of the mount system, report the change in dB.
 
-:func:`run_whatif` resolves retune targets (:mod:`powertrain.workflows.retune`), builds one
-:class:`~powertrain.workflows.sweeps.SweepTask` per variant plus the baseline, runs them with
-:func:`powertrain.workflows.sweeps.run_sweep` and returns a :class:`WhatIfResult`.
-
-Change of a variant against the baseline, per channel (mount × engine X/Y/Z) and quantity
-(``synthesis``, ``order_2``, ``order_4`` by default), at each speed step:
-
-.. math:: \Delta(n) = 20\log_{10}\frac{v_{var}(n)}{v_{base}(n)}\ \mathrm{dB}
-
-with :math:`v` the RMS velocity of the mount point (or, with ``signal="mount_force"``, the
-RMS force the mount transmits to ground). Reported: ``mean_delta_db`` (the arithmetic mean of
-:math:`\Delta` over the speed steps, "rpm-averaged"), ``max_abs_delta_db`` (the largest
-:math:`|\Delta|`) and the speed where it occurs. Speed steps where both levels are below
-:data:`FLOOR_REL` of the baseline curve's maximum (a cancelled order) are left out.
+:func:`whatif` takes the variants as the command line writes them (``scale``, ``set``,
+``swap``, ``move``, ``rotate``, ``effects``, ``targets``, a variants file), parses them
+(:mod:`powertrain.workflows.variants`) and hands them to :func:`run_whatif`, which applies
+each variant once (:func:`variant_engine`: operations in order, a retune target fitted
+against the engine the earlier operations left, :mod:`powertrain.workflows.retune`; every
+step checked to carry the body), builds one :class:`~powertrain.workflows.sweeps.SweepTask`
+per variant plus the baseline, runs them with :func:`powertrain.workflows.sweeps.run_sweep`
+and returns a :class:`~powertrain.results.whatif.WhatIfResult` (the change in dB is
+defined there).
 """
 
 from __future__ import annotations
 
-import json
-from dataclasses import dataclass, field
+import os
 
 import numpy as np
 
-#: Quantities reported by default.
-QUANTITIES = ("synthesis", "order_2", "order_4")
-#: Levels below this fraction of the baseline curve's maximum are not compared (both sides).
-FLOOR_REL = 1e-9
-
-
-@dataclass
-class VariantRun:
-    """One variant: name, the operations' specs and its run-up."""
-
-    name: str
-    specs: list
-    result: object
-
-
-def delta_db(base, variant, floor_rel=FLOOR_REL) -> np.ndarray:
-    """:math:`20\\log_{10}(v/v_0)` [dB]; NaN where both are below the floor.
-
-    Parameters
-    ----------
-    base, variant : array_like
-        Levels (any consistent unit), same shape.
-    floor_rel : float
-        Floor relative to ``max(base)``.
-    """
-    b = np.asarray(base, float)
-    v = np.asarray(variant, float)
-    floor = floor_rel * (np.max(b) if b.size else 0.0)
-    tiny = np.finfo(float).tiny
-    out = 20 * np.log10(np.maximum(v, tiny) / np.maximum(b, tiny))
-    out[(b <= floor) & (v <= floor)] = np.nan
-    return out
-
-
-@dataclass
-class WhatIfResult:
-    """Baseline and variant run-ups with their changes in dB.
-
-    Attributes
-    ----------
-    baseline : RunupResult
-    variants : list of VariantRun
-    description : dict
-        Baseline description (engine, file, solver, speeds, mounts...).
-    quantities : tuple of str
-    measured : MeasuredRunup or None
-        Overlaid measurement.
-    target_fits : list of TargetFit
-    signal : str
-        Compared signal: ``velocity`` (default; the measured quantity), ``mount_force``
-        (force transmitted to ground), ``displacement`` or ``acceleration``.
-    """
-
-    baseline: object
-    variants: list
-    description: dict = field(default_factory=dict)
-    quantities: tuple = QUANTITIES
-    measured: object = None
-    target_fits: list = field(default_factory=list)
-    signal: str = "velocity"
-    #: optional response to minimise: (channel, direction, quantity, rpm_lo, rpm_hi)
-    objective: tuple | None = None
-
-    def objective_changes(self) -> list:
-        """Variants ranked by the mean change of the objective response over its speed band
-        [dB], best (most negative) first: ``name``, ``mean_delta_db``,
-        ``baseline_rms_si`` and ``variant_rms_si`` (mean levels over the band, SI)."""
-        if self.objective is None:
-            return []
-        name, d, q, lo, hi = self.objective
-        rpm = np.asarray(self.baseline.rpm, float)
-        band = (rpm >= lo - 1e-9) & (rpm <= hi + 1e-9)
-        base = self.baseline.curve(name, d, q, self.signal)
-        out = []
-        for v in self.variants:
-            var = v.result.curve(name, d, q, self.signal)
-            dd = delta_db(base, var)[band]
-            ok = np.isfinite(dd)
-            out.append({"name": v.name,
-                        "mean_delta_db": float(np.mean(dd[ok])) if ok.any() else None,
-                        "baseline_rms_si": float(np.mean(base[band])),
-                        "variant_rms_si": float(np.mean(var[band]))})
-        return sorted(out, key=lambda r: np.inf if r["mean_delta_db"] is None
-                      else r["mean_delta_db"])
-
-    def objective_text(self) -> str:
-        if self.objective is None:
-            return ""
-        name, d, q, lo, hi = self.objective
-        lines = [f"objective: minimise {name}.{d} {q} RMS {self.signal.replace('_', ' ')} at "
-                 f"{lo:g}-{hi:g} rpm (mean change over the band, best first)"]
-        for r in self.objective_changes():
-            val = "-" if r["mean_delta_db"] is None else f"{r['mean_delta_db']:+.2f} dB"
-            lines.append(f"  {val:>10}  {r['name']}")
-        return "\n".join(lines)
-
-    # ------------------------------------------------------------------ numbers
-    def variant(self, name: str) -> VariantRun:
-        for v in self.variants:
-            if v.name == name:
-                return v
-        raise KeyError(name)
-
-    def delta_db(self, name: str, mount: str, direction: str, quantity: str = "synthesis"):
-        """Change of a variant against the baseline per speed step [dB]."""
-        res = self.variant(name).result
-        return delta_db(self.baseline.curve(mount, direction, quantity, self.signal),
-                        res.curve(mount, direction, quantity, self.signal))
-
-    def channel_changes(self, name: str) -> list:
-        """Per channel and quantity: ``mount``, ``direction``, ``quantity``,
-        ``mean_delta_db``, ``max_abs_delta_db``, ``rpm_at_max_abs``, ``delta_db`` (list)
-        and, with a measurement, ``mean_gap_to_measured_db``."""
-        res = self.variant(name).result
-        rpm = np.asarray(self.baseline.rpm, float)
-        out = []
-        for mount, direction in self.baseline.channels:
-            for q in self.quantities:
-                d = self.delta_db(name, mount, direction, q)
-                ok = np.isfinite(d)
-                row = {"mount": mount, "direction": direction, "quantity": q,
-                       "mean_delta_db": float(np.mean(d[ok])) if ok.any() else None,
-                       "max_abs_delta_db": float(np.max(np.abs(d[ok]))) if ok.any() else None,
-                       "rpm_at_max_abs": float(rpm[ok][np.argmax(np.abs(d[ok]))])
-                       if ok.any() else None,
-                       "delta_db": [None if not np.isfinite(x) else float(x) for x in d]}
-                if self.measured is not None and self.signal == "velocity":
-                    row["mean_gap_to_measured_db"] = _gap_to_measured(
-                        res, self.measured, mount, direction, q)
-                out.append(row)
-        return out
-
-    def baseline_gaps(self) -> list:
-        """Mean gap baseline vs measurement per channel and quantity [dB] (empty without
-        a measurement)."""
-        if self.measured is None or self.signal != "velocity":
-            return []
-        return [{"mount": m, "direction": d, "quantity": q,
-                 "mean_gap_to_measured_db": _gap_to_measured(self.baseline, self.measured,
-                                                             m, d, q)}
-                for m, d in self.baseline.channels for q in self.quantities]
-
-    # ------------------------------------------------------------------ output
-    def to_dict(self) -> dict:
-        from powertrain import __version__
-        base = dict(self.description)
-        base.setdefault("rpm", [float(r) for r in self.baseline.rpm])
-        base["rigid_body_modes_hz"] = [float(f) for f in self.baseline.rigid_body_modes_hz]
-        if self.measured is not None:
-            base["measured"] = {"file": self.measured.source,
-                                "synthetic": bool(self.measured.synthetic),
-                                "channels": self.baseline_gaps()}
-        return {"format": "powertrain-whatif", "format_version": 1,
-                "powertrain_version": __version__,
-                "signal": self.signal,
-                "definition": f"delta_db = 20 log10(v_variant / v_baseline), v = RMS "
-                              f"{self.signal}; "
-                              "mean_delta_db = mean over the speed steps; max_abs_delta_db = "
-                              "largest |delta_db|",
-                "quantities": list(self.quantities),
-                "baseline": base,
-                "targets": [tf.to_dict() for tf in self.target_fits],
-                "objective": None if self.objective is None else {
-                    "channel": self.objective[0], "direction": self.objective[1],
-                    "quantity": self.objective[2], "rpm": list(self.objective[3:]),
-                    "ranking": self.objective_changes()},
-                "variants": [{"name": v.name, "operations": list(v.specs),
-                              "rigid_body_modes_hz": [float(f) for f in
-                                                      v.result.rigid_body_modes_hz],
-                              "channels": self.channel_changes(v.name)}
-                             for v in self.variants]}
-
-    def to_json(self, path=None) -> str:
-        """JSON text of :meth:`to_dict`; written atomically to ``path`` if given."""
-        text = json.dumps(self.to_dict(), indent=2) + "\n"
-        if path is not None:
-            from powertrain.outputs import atomic_write
-            with atomic_write(path) as fh:
-                fh.write(text)
-        return text
-
-    def table(self) -> str:
-        """Text table per variant: rows = channels, columns = mean / max |Δ| [dB] per quantity."""
-        blocks = []
-        for v in self.variants:
-            rows = {}
-            for r in self.channel_changes(v.name):
-                key = f"{r['mount']}.{r['direction']}"
-                cell = ("-" if r["mean_delta_db"] is None else
-                        f"{r['mean_delta_db']:+.2f} / {r['max_abs_delta_db']:.2f}")
-                rows.setdefault(key, [key]).append(cell)
-            header = ["channel"] + [f"{q} mean/max|d| [dB]" for q in self.quantities]
-            modes = ", ".join(f"{f:.2f}" for f in v.result.rigid_body_modes_hz)
-            blocks.append(f"variant {v.name!r} ({'; '.join(v.specs)}) vs baseline\n"
-                          f"rigid-body modes [Hz]: {modes}\n"
-                          + _format_table(header, list(rows.values())))
-        return "\n\n".join(blocks)
-
-    def plot(self, ax=None, *, path=None, channel=None, quantity=None, provenance=None,
-             view="levels"):
-        """Baseline, variants and measurement (``view="levels"``) or each variant's change
-        Δ dB against the baseline (``view="delta"``); returns the figure (see
-        :func:`powertrain.plotting.plot_whatif`)."""
-        from powertrain.plotting import plot_whatif
-        from powertrain.plotting.style import target_and_path
-        ax, path = target_and_path(ax, path)
-        return plot_whatif(self, path, ax=ax, channel=channel, quantity=quantity,
-                           provenance=provenance or getattr(self, "provenance", None),
-                           view=view)
-
-
-def _format_table(header, rows) -> str:
-    """Fixed-width text table of strings, first column left-aligned."""
-    widths = [max(len(h), *(len(r[i]) for r in rows)) if rows else len(h)
-              for i, h in enumerate(header)]
-
-    def line(cells):
-        return "  ".join(c.ljust(w) if i == 0 else c.rjust(w)
-                         for i, (c, w) in enumerate(zip(cells, widths)))
-    return "\n".join([line(header), line(["-" * w for w in widths])]
-                     + [line(r) for r in rows])
-
-
-def _gap_to_measured(result, measured, mount, direction, quantity):
-    """Mean of 20 log10(sim/measured) [dB] at the measured speeds inside the simulated range
-    (simulation interpolated linearly in log level); None if not available."""
-    try:
-        rpm_m, lev_m = measured.curve(mount, direction, quantity)
-    except KeyError:
-        return None
-    rpm_s = np.asarray(result.rpm, float)
-    sim = result.curve(mount, direction, quantity)
-    order = np.argsort(rpm_s)
-    rpm_s, sim = rpm_s[order], sim[order]
-    inside = (rpm_m >= rpm_s[0]) & (rpm_m <= rpm_s[-1]) & (lev_m > 0)
-    if not inside.any() or np.any(sim <= 0):
-        return None
-    s = np.exp(np.interp(rpm_m[inside], rpm_s, np.log(sim)))
-    return float(np.mean(20 * np.log10(s / lev_m[inside])))
+from powertrain.errors import InputError
+from powertrain.results.whatif import QUANTITIES, VariantRun, WhatIfResult
 
 
 def describe_engine(engine, solver: str, rpm) -> dict:
@@ -274,6 +31,159 @@ def describe_engine(engine, solver: str, rpm) -> dict:
                                 "models": {d: mdl.topology.name
                                            for d, mdl in m.directions.items()}}
                        for m in engine.mounts}}
+
+
+def whatif(engine=None, *, scale=(), set=(), swap=(), move=(), rotate=(), effects=(),
+           targets=(), variants=None, rpm=None, solver="harmonic", signal="velocity",
+           objective=None, measured=None, executor=None, workers=None,
+           progress=False) -> WhatIfResult:
+    """What-if: the baseline and variants of the mount system, the change in dB
+    (``powertrain whatif``).
+
+    Parameters
+    ----------
+    engine : Engine, str, Path or None
+        Baseline (default: the shipped ``engines/default.toml``).
+    scale, set, swap, move, rotate, effects : sequence of str
+        Operations as the command line writes them (``left.z.stiffness=1.2``...,
+        :mod:`powertrain.workflows.variants`); together the variant ``command line``.
+    targets : sequence of str
+        Retune targets (``left.z:+20%:100-300Hz``), each a variant of its own.
+    variants : str or Path, optional
+        TOML file of named variants.
+    rpm : array_like, optional
+        Speed steps [rpm] (default 1000..6000 step 500).
+    solver : {"harmonic", "newmark"}
+    signal : {"velocity", "mount_force"}
+    objective : str, optional
+        ``CHANNEL.DIR:QUANTITY:FROM-TO`` to rank the variants by (:func:`parse_objective`).
+    measured : str, Path or MeasuredRunup, optional
+        Measurement overlaid and compared.
+    executor : object with ``submit``, or str, optional
+        An executor, or a scheduler (``local``, ``tcp://HOST:PORT``, ``processes``,
+        ``serial``; :func:`powertrain.parallel.executor`); default a local process pool.
+    workers : int, optional
+        Local processes.
+    progress : bool
+
+    Returns
+    -------
+    WhatIfResult
+    """
+    from powertrain.workflows.runup import default_rpm, engine_and_file
+    if workers is not None and workers < 1:
+        raise InputError("must be >= 1", key="--workers")
+    engine, _ = engine_and_file(engine)
+    rpm = default_rpm() if rpm is None else np.atleast_1d(np.asarray(rpm, float))
+    ops = {"scale": scale, "set": set, "swap": swap, "move": move, "rotate": rotate,
+           "effect": effects}
+    runs = command_variants(engine, ops, targets, variants)
+    goal = parse_objective(objective, engine.assemble().channels, rpm) if objective else None
+    if isinstance(measured, (str, os.PathLike)):
+        from powertrain.iotools.measured import read_measured
+        measured = read_measured(measured, mounts=engine.mount_names)
+    result = _run_on(executor, engine, runs, rpm, solver=solver, workers=workers,
+                     measured=measured, signal=signal, progress=progress)
+    result.objective = goal
+    return result
+
+
+def _run_on(executor, engine, variants, rpm, **kwargs) -> WhatIfResult:
+    """:func:`run_whatif` on ``executor``: an executor, None (a local pool) or a scheduler
+    name, opened here and shut down on return."""
+    if not isinstance(executor, str):
+        return run_whatif(engine, variants, rpm, executor=executor, **kwargs)
+    from powertrain.parallel import check_scheduler
+    from powertrain.parallel import executor as open_executor
+    with open_executor(check_scheduler(executor), workers=kwargs.get("workers"),
+                       n_jobs=len(variants) + 1) as ex:
+        return run_whatif(engine, variants, rpm, executor=ex, **kwargs)
+
+
+def command_variants(engine, ops: dict, targets=(), variants_file=None) -> list:
+    """The variants of a command line: its operations (``{"scale": [...], ...}``) as the
+    variant ``command line``, each target a variant, then those of ``variants_file``."""
+    from powertrain.workflows.variants import (
+        Origin,
+        Variant,
+        parse_operations,
+        parse_target,
+        read_variants,
+    )
+    out = []
+    parsed = parse_operations(ops, engine=engine)
+    if parsed:
+        out.append(Variant("command line", parsed))
+    out += [Variant(f"target {t}", (parse_target(t, Origin("--target")),)) for t in targets]
+    if variants_file:
+        out += read_variants(variants_file)
+    if not out:
+        raise InputError("no variant given (use --scale, --set, --swap, --move, --rotate, "
+                         "--effect, --target or --variants)", key="--variants")
+    names = [v.name for v in out]
+    dup = sorted({n for n in names if names.count(n) > 1})
+    if dup:
+        raise InputError(f"duplicate variant name {dup[0]!r}", file=variants_file,
+                         key="variant.name")
+    return out
+
+
+def parse_objective(text, channels, rpm):
+    """``CHANNEL.DIR:QUANTITY:FROM-TO`` checked against the model's ``channels`` and the
+    speed steps ``rpm``: ``(channel, direction, quantity, rpm_lo, rpm_hi)``."""
+    from powertrain.analysis.orders import ORDERS
+    from powertrain.iotools.measured import normalise_quantity
+    form = "CHANNEL.DIR:QUANTITY:FROM-TO, e.g. seat_rail.z:order_2:1500-3000"
+    parts = [p.strip() for p in text.split(":")]
+    if len(parts) != 3 or "." not in parts[0] or "-" not in parts[2]:
+        raise InputError(f"expected {form}, got {text!r}", key="--objective")
+    name, d = parts[0].rsplit(".", 1)
+    d = d.lower()
+    if (name, d) not in channels:
+        known = sorted({m for m, _ in channels})
+        raise InputError(f"unknown channel {parts[0]!r} (channels: {', '.join(known)}; "
+                         "directions x, y, z)", key="--objective")
+    try:
+        q = normalise_quantity(parts[1])
+        if q != "synthesis" and not np.any(np.isclose(ORDERS, float(q.split("_", 1)[1]))):
+            raise ValueError(q)
+        lo, hi = (float(x) for x in parts[2].lower().removesuffix("rpm").split("-"))
+    except (ValueError, KeyError):
+        raise InputError(f"expected {form}, got {text!r}", key="--objective") from None
+    if not (lo <= hi) or not any(lo - 1e-9 <= r <= hi + 1e-9 for r in rpm):
+        raise InputError(f"no speed step in {lo:g}-{hi:g} rpm", key="--objective")
+    return (name, d, q, lo, hi)
+
+
+def variant_engine(engine, variant, **fit_kwargs):
+    """The engine of ``variant``: its operations applied once, in order (a retune target is
+    fitted against the engine the earlier operations left,
+    :func:`~powertrain.workflows.retune.retuned_swap`); then the engine after each
+    operation must carry the body (an error names the option or variants-file key).
+
+    Returns
+    -------
+    engine : Engine
+    fits : list of TargetFit
+    """
+    from powertrain.iotools.engine_checks import check_support
+    from powertrain.workflows.retune import retuned_swap
+    from powertrain.workflows.variants import Target
+    stages, fits = [], []
+    for op in variant.operations:
+        retuned = isinstance(op, Target)
+        if retuned:
+            op, fit = retuned_swap(engine, op, **fit_kwargs)
+            fits.append(fit)
+        engine = op.apply(engine)
+        if not retuned:
+            stages.append((op, engine))
+    for op, stage in stages:
+        try:
+            check_support(stage, None)
+        except InputError as exc:
+            raise op.origin.error(f"variant {variant.name!r}: {exc.message}") from None
+    return engine, fits
 
 
 def run_whatif(engine, variants, rpm=None, *, solver: str = "harmonic", executor=None,
@@ -305,28 +215,25 @@ def run_whatif(engine, variants, rpm=None, *, solver: str = "harmonic", executor
     runup_options : dict, optional
         Further keyword arguments of :func:`powertrain.workflows.runup.run_runup`.
     """
-    from powertrain.workflows.retune import resolve_targets
     from powertrain.workflows.runup import default_rpm
     from powertrain.workflows.sweeps import SweepTask, run_sweep
-    from powertrain.workflows.variants import check_operations
+    from powertrain.workflows.variants import response_scenario
     rpm = default_rpm() if rpm is None else np.atleast_1d(np.asarray(rpm, float))
     names = [v.name for v in variants]
     if len(set(names)) != len(names) or "baseline" in names:
         raise ValueError("variant names must be unique and not 'baseline'")
-    resolved, fits = [], []
-    for v in variants:
-        check_operations(engine, v.operations)
-    for v in variants:
-        rv, f = resolve_targets(engine, v, **(fit_kwargs or {}))
-        resolved.append(rv)
-        fits += f
-    base_engine = engine.replace()          # fresh pressure cache: a small pickle
     opts = dict(runup_options or {})
-    tasks = [SweepTask("baseline", base_engine, (), rpm, solver, opts)]
-    tasks += [SweepTask(v.name, base_engine, v.operations, rpm, solver, opts) for v in resolved]
+    tasks = [SweepTask("baseline", engine.replace(), rpm, solver, opts)]   # fresh caches
+    fits = []
+    for v in variants:
+        varied, f = variant_engine(engine, v, **(fit_kwargs or {}))
+        fits += f
+        tasks.append(SweepTask(v.name, varied, rpm, solver, opts,
+                               response_scenario(v.operations)))
     results = run_sweep(tasks, executor, workers=workers, progress=progress)
-    runs = [VariantRun(v.name, v.specs, r) for v, r in zip(resolved, results[1:])]
+    runs = [VariantRun(v.name, v.specs, r) for v, r in zip(variants, results[1:])]
     return WhatIfResult(baseline=results[0], variants=runs,
                         description=describe_engine(engine, solver, rpm),
                         quantities=tuple(quantities), measured=measured, target_fits=fits,
-                        signal=signal)
+                        signal=signal, rpm_step=float(rpm[1] - rpm[0]) if rpm.size > 1
+                        else None)
