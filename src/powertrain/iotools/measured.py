@@ -55,6 +55,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from powertrain.analysis.channel import DIRECTIONS, SIDES, passive_name, split_side
 from powertrain.analysis.orders import order_label
 from powertrain.errors import InputError
 from powertrain.iotools.textfile import check_regular_file, parse_number, read_text
@@ -74,8 +75,6 @@ KEY_COLUMNS = ("mount", "direction", "quantity", "rpm")
 #: body side, or a body point of interest named in ``mount``) and further value columns
 #: (read and checked; the comparison uses the velocity level column).
 OPTIONAL_COLUMNS = ("side", "acceleration_rms_m_per_s2", "force_rms_n")
-SIDES = ("active", "passive")
-DIRECTIONS = ("x", "y", "z")
 _HDF5_SIGNATURE = b"\x89HDF\r\n\x1a\n"
 
 
@@ -233,7 +232,6 @@ def _read_hdf5(path, mounts):
     except KeyError as exc:
         raise InputError(f"not in the run-up HDF5 layout (missing {exc})", file=path) from None
     if mounts is not None:
-        from powertrain.models.chassis import split_side
         for m, _ in result.channels:
             base, side = split_side(m)
             if base not in mounts and side == "active" and not _is_point(result, m):
@@ -321,7 +319,7 @@ def _read_csv(path, mounts, points=None):
             if extra in col and extra != level_col and fields[col[extra]]:
                 parse_number(fields[col[extra]], path, lineno, extra, nonneg=True)
         if side == "passive" and mount and (mounts is None or mount in mounts):
-            mount = f"{mount}/passive"                    # body side of that mount
+            mount = passive_name(mount)                  # body side of that mount
         elif side == "passive" and mount and (points is None or mount in points):
             pass                                          # a body point of interest
         elif not mount or (mounts is not None and mount not in mounts):

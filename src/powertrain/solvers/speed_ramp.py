@@ -20,6 +20,7 @@ import math
 
 import numpy as np
 
+from powertrain.analysis.channel import Channel
 from powertrain.errors import InputError
 from powertrain.models.recording import RawChannel, RawRecording
 
@@ -128,7 +129,7 @@ def simulate_sweep(engine, rpm_from, rpm_to, rate_rpm_per_s, sample_rate=8192.0,
     t_out = (first + np.arange(y.shape[0])) / sample_rate
     rpm_out = rpm_from + rate_rpm_per_s * t_out
     block = np.ascontiguousarray(y.T)
-    chans = [RawChannel(f"{mnt}.{d}", mnt, "active", d, "acceleration", block[c], "m/s^2")
+    chans = [RawChannel(Channel(mnt, "active", d).label, mnt, "active", d, "acceleration", block[c], "m/s^2")
              for c, (mnt, d) in enumerate(system.channels)]
     note = (f"SYNTHETIC: simulated continuous run-up {rpm_from:g}->{rpm_to:g} rpm at "
             f"{rate_rpm_per_s:g} rpm/s ({getattr(engine, 'name', '')}; Newmark average "
