@@ -388,57 +388,16 @@ def fit_mount(frequency_hz, kcp_measured, model: str | Topology = DEFAULT_TOPOLO
         Unknown model, mismatched or non-finite data, too few frequencies.
     """
     t0 = time.perf_counter()
-    if isinstance(model, str):
-        if model not in TOPOLOGIES:
-            raise ValueError(f"unknown model {model!r} (known: {', '.join(TOPOLOGIES)})")
-        topology = TOPOLOGIES[model]
-    else:
-        topology = model
+    topology = _topology(model)
     f = np.asarray(frequency_hz, dtype=float).ravel()
     km = np.asarray(kcp_measured, dtype=complex).ravel()
-    if f.size != km.size:
-        raise ValueError("frequency_hz and kcp_measured differ in length")
-    if not (np.all(np.isfinite(f)) and np.all(np.isfinite(km))):
-        raise ValueError("data must be finite")
-    if np.any(f < 0) or np.any(np.diff(f) <= 0):
-        raise ValueError("frequencies must be non-negative and strictly increasing")
-    n_par = len(topology.parameters)
-    if 2 * f.size < n_par:
-        raise ValueError(f"{n_par} parameters need at least {(n_par + 1) // 2} frequencies")
-    if not np.any(np.abs(km) > 0):
-        raise ValueError("measured stiffness is zero everywhere")
-    if int(starts) < 1 or int(polish) < 1 or int(hops) < 0:
-        raise ValueError("starts and polish must be >= 1, hops >= 0")
+    _check_fit_input(f, km, len(topology.parameters), starts, polish, hops, max_mass)
     starts, polish, hops = int(starts), min(int(polish), int(starts)), int(hops)
-
-    if max_mass is not None and not max_mass > 0:
-        raise ValueError("max_mass must be positive")
     prob = _Problem(topology, f, km, max_mass)
     rng = np.random.default_rng(seed)
     fresh = starting_points(topology, f, km, starts + hops, rng, max_mass)
-    screened = []
     with np.errstate(all="ignore"):
-        for q0 in fresh[:starts]:
-            q, err, _ = prob.solve(prob.rescale(q0), SCREEN_NFEV, 1e-6)
-            screened.append((err, q))
-        screened.sort(key=lambda t: t[0])
-        polished = [prob.solve(q, POLISH_NFEV, 1e-10) for _, q in screened[:polish]]
-        q_best, err_best, ok_best = min(polished, key=lambda t: t[1])
-        accepted = 0
-        for q_new in fresh[starts:]:
-            # hop: replace a random ~30 % of the parameters by fresh start values
-            mask = rng.random(q_best.size) < HOP_FRACTION
-            if not mask.any():
-                mask[rng.integers(q_best.size)] = True
-            q, err, _ = prob.solve(prob.rescale(np.where(mask, q_new, q_best)),
-                                   SCREEN_NFEV, 1e-6)
-            if err < 1.5 * err_best:
-                q, err, ok = prob.solve(q, HOP_NFEV, 1e-10)
-                if err < err_best:
-                    q_best, err_best, ok_best = q, err, ok
-                    accepted += 1
-        if not ok_best:
-            q_best, err_best, ok_best = prob.solve(q_best, FINAL_NFEV, 1e-10)
+        q_best, ok_best, polished, accepted = _search(prob, fresh, starts, polish, rng)
     q_best = np.clip(q_best, prob.lo, prob.hi)
     fitted = MountModel.from_values(topology, np.exp(q_best), name=name, source=source)
     kfit = fitted.cross_point_stiffness(f)
@@ -449,3 +408,57 @@ def fit_mount(frequency_hz, kcp_measured, model: str | Topology = DEFAULT_TOPOLO
                      polish_rel_rms=tuple(p[1] for p in polished),
                      n_hops=hops, hops_accepted=accepted,
                      time_s=time.perf_counter() - t0, nfev=prob.nfev)
+
+
+def _topology(model) -> Topology:
+    if isinstance(model, str):
+        if model not in TOPOLOGIES:
+            raise ValueError(f"unknown model {model!r} (known: {', '.join(TOPOLOGIES)})")
+        return TOPOLOGIES[model]
+    return model
+
+
+def _check_fit_input(f, km, n_par, starts, polish, hops, max_mass) -> None:
+    """ValueError for data or settings :func:`fit_mount` cannot fit."""
+    if f.size != km.size:
+        raise ValueError("frequency_hz and kcp_measured differ in length")
+    if not (np.all(np.isfinite(f)) and np.all(np.isfinite(km))):
+        raise ValueError("data must be finite")
+    if np.any(f < 0) or np.any(np.diff(f) <= 0):
+        raise ValueError("frequencies must be non-negative and strictly increasing")
+    if 2 * f.size < n_par:
+        raise ValueError(f"{n_par} parameters need at least {(n_par + 1) // 2} frequencies")
+    if not np.any(np.abs(km) > 0):
+        raise ValueError("measured stiffness is zero everywhere")
+    if int(starts) < 1 or int(polish) < 1 or int(hops) < 0:
+        raise ValueError("starts and polish must be >= 1, hops >= 0")
+    if max_mass is not None and not max_mass > 0:
+        raise ValueError("max_mass must be positive")
+
+
+def _search(prob, fresh, starts, polish, rng):
+    """Screen the first ``starts`` points, polish the best ``polish``, then hop from the
+    incumbent with the rest; ``(q_best, ok_best, polished, hops accepted)``."""
+    screened = []
+    for q0 in fresh[:starts]:
+        q, err, _ = prob.solve(prob.rescale(q0), SCREEN_NFEV, 1e-6)
+        screened.append((err, q))
+    screened.sort(key=lambda t: t[0])
+    polished = [prob.solve(q, POLISH_NFEV, 1e-10) for _, q in screened[:polish]]
+    q_best, err_best, ok_best = min(polished, key=lambda t: t[1])
+    accepted = 0
+    for q_new in fresh[starts:]:
+        # hop: replace a random ~30 % of the parameters by fresh start values
+        mask = rng.random(q_best.size) < HOP_FRACTION
+        if not mask.any():
+            mask[rng.integers(q_best.size)] = True
+        q, err, _ = prob.solve(prob.rescale(np.where(mask, q_new, q_best)),
+                               SCREEN_NFEV, 1e-6)
+        if err < 1.5 * err_best:
+            q, err, ok = prob.solve(q, HOP_NFEV, 1e-10)
+            if err < err_best:
+                q_best, err_best, ok_best = q, err, ok
+                accepted += 1
+    if not ok_best:
+        q_best, err_best, ok_best = prob.solve(q_best, FINAL_NFEV, 1e-10)
+    return q_best, ok_best, polished, accepted
