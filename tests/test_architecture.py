@@ -139,3 +139,27 @@ def test_the_map_checker_sees_a_missing_and_a_stale_unit(tmp_path, monkeypatch):
     named = set(doc_module_map())
     assert "units.py" in tree_units() - named
     assert "no_such_unit.py" in named - tree_units()
+
+
+# ---------------------------------------------------------------- sizes (issue 19)
+def _code_metrics():
+    """``scripts/code_metrics.py`` measured on this checkout (one rule, printed and tested)."""
+    import importlib.util
+    path = PACKAGE.parents[1] / "scripts" / "code_metrics.py"
+    spec = importlib.util.spec_from_file_location("code_metrics", path)
+    mod = sys.modules.setdefault("code_metrics", importlib.util.module_from_spec(spec))
+    spec.loader.exec_module(mod)        # registered first: its dataclass looks itself up
+    return mod, mod.measure(PACKAGE)
+
+
+def test_no_module_over_the_size_limit_and_few_loose_modules():
+    cm, m = _code_metrics()
+    assert not m.long_modules, f"modules over {cm.MODULE_MAX} lines: {m.long_modules}"
+    assert len(m.loose_modules) <= cm.LOOSE_MAX, m.loose_modules
+
+
+def test_no_function_over_the_size_limit_outside_kernels_and_cli():
+    """The CLI's command functions have their own, tighter limit (code_metrics.py)."""
+    cm, m = _code_metrics()
+    long = [f for f in m.long_functions if not f[0].startswith("cli/")]
+    assert not long, f"functions over {cm.FUNCTION_MAX} lines: {long}"

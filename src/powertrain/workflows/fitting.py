@@ -184,7 +184,9 @@ class _Problem:
 
     def __init__(self, topology: Topology, frequency_hz, kcp_measured, max_mass=None):
         self.topology = topology
-        self.omega = 2 * np.pi * np.asarray(frequency_hz, float)
+        self.frequency_hz = np.asarray(frequency_hz, float)
+        self.max_mass = max_mass
+        self.omega = 2 * np.pi * self.frequency_hz
         self.km = np.asarray(kcp_measured, complex)
         self.norm = float(np.sqrt(np.sum(np.abs(self.km) ** 2)))
         self.lo, self.hi = parameter_box(topology, frequency_hz, kcp_measured, max_mass)
@@ -394,20 +396,17 @@ def fit_mount(frequency_hz, kcp_measured, model: str | Topology = DEFAULT_TOPOLO
     _check_fit_input(f, km, len(topology.parameters), starts, polish, hops, max_mass)
     starts, polish, hops = int(starts), min(int(polish), int(starts)), int(hops)
     prob = _Problem(topology, f, km, max_mass)
-    rng = np.random.default_rng(seed)
-    fresh = starting_points(topology, f, km, starts + hops, rng, max_mass)
     with np.errstate(all="ignore"):
-        q_best, ok_best, polished, accepted = _search(prob, fresh, starts, polish, rng)
+        q_best, ok_best, polished, accepted = _search(prob, starts, polish, hops, seed)
     q_best = np.clip(q_best, prob.lo, prob.hi)
     fitted = MountModel.from_values(topology, np.exp(q_best), name=name, source=source)
     kfit = fitted.cross_point_stiffness(f)
     return FitResult(model=fitted, frequency_hz=f, kcp_measured=km,
                      objective_n=objective_n(kfit, km), rel_rms=relative_rms_error(kfit, km),
-                     n_starts=starts, n_polished=len(polished),
-                     success=ok_best, polish_success=tuple(p[2] for p in polished),
-                     polish_rel_rms=tuple(p[1] for p in polished),
-                     n_hops=hops, hops_accepted=accepted,
-                     time_s=time.perf_counter() - t0, nfev=prob.nfev)
+                     n_starts=starts, n_polished=len(polished), success=ok_best,
+                     polish_success=tuple(p[2] for p in polished),
+                     polish_rel_rms=tuple(p[1] for p in polished), n_hops=hops,
+                     hops_accepted=accepted, time_s=time.perf_counter() - t0, nfev=prob.nfev)
 
 
 def _topology(model) -> Topology:
@@ -436,9 +435,12 @@ def _check_fit_input(f, km, n_par, starts, polish, hops, max_mass) -> None:
         raise ValueError("max_mass must be positive")
 
 
-def _search(prob, fresh, starts, polish, rng):
-    """Screen the first ``starts`` points, polish the best ``polish``, then hop from the
-    incumbent with the rest; ``(q_best, ok_best, polished, hops accepted)``."""
+def _search(prob, starts, polish, hops, seed):
+    """Screen ``starts`` random points, polish the best ``polish``, then hop ``hops`` times
+    from the incumbent; ``(q_best, ok_best, polished, hops accepted)``."""
+    rng = np.random.default_rng(seed)
+    fresh = starting_points(prob.topology, prob.frequency_hz, prob.km, starts + hops, rng,
+                            prob.max_mass)
     screened = []
     for q0 in fresh[:starts]:
         q, err, _ = prob.solve(prob.rescale(q0), SCREEN_NFEV, 1e-6)
