@@ -55,7 +55,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from powertrain.analysis.channel import DIRECTIONS, SIDES, passive_name, split_side
+from powertrain.analysis.channel import DIRECTIONS, SIDES, Channel, passive_name, split_side
 from powertrain.analysis.orders import order_label
 from powertrain.errors import InputError
 from powertrain.iotools.textfile import check_regular_file, parse_number, read_text
@@ -436,7 +436,7 @@ def to_velocity(curves, kind, notes):
             for rpm, _ in orders.values():
                 common = set(rpm.tolist()) if common is None else common & set(rpm.tolist())
             if not common:
-                dropped.append(f"{m}.{d}")
+                dropped.append(Channel.of_node(m, d).label)
                 continue
             speeds = np.array(sorted(common))
             total = np.zeros(speeds.size)
