@@ -1,4 +1,10 @@
-"""Import contract of the kernels subpackage (STYLE.md, "Kernels apart").
+"""The architecture as written: the kernels' import contract and docs/architecture.md.
+
+The module map of docs/architecture.md names every package and top-level module of
+``src/powertrain`` and nothing else, every module it names inside a package exists, and its
+list of layers is the import-linter ``layers`` contract in its order.
+
+Import contract of the kernels subpackage (STYLE.md, "Kernels apart"):
 
 ``src/powertrain/kernels`` holds Numba kernels over plain SI floats and arrays; it may import
 numpy, numba and math only -- no I/O, plotting, CLI, model objects or other powertrain
@@ -9,6 +15,7 @@ imported to check it.
 from __future__ import annotations
 
 import ast
+import sys
 from pathlib import Path
 
 import pytest
@@ -57,3 +64,102 @@ def test_the_checker_catches_forbidden_imports(tmp_path):
                  "from . import other\nimport matplotlib.pyplot\n")
     mods = {m for _, m in imported_modules(p)} - ALLOWED
     assert mods == {"powertrain", ".", "matplotlib"}
+
+
+# ---------------------------------------------------------------- docs/architecture.md
+DOC = Path(__file__).resolve().parents[1] / "docs" / "architecture.md"
+PACKAGE = KERNELS.parent
+
+
+def _text_block(section: str) -> list[str]:
+    """Lines of the first ```text block under the ``## section`` heading of the doc."""
+    text = DOC.read_text(encoding="utf-8")
+    head = text.index(f"\n## {section}\n")
+    start = text.index("```text\n", head) + len("```text\n")
+    return text[start:text.index("```", start)].splitlines()
+
+
+def doc_module_map() -> dict[str, set[str]]:
+    """Top-level unit (``cli/``, ``assembly.py``) -> modules named under it (``runup.py``)."""
+    units: dict[str, set[str]] = {}
+    current = None
+    for line in _text_block("Module map"):
+        if not line.strip():
+            continue
+        name = line.split()[0]
+        if not line.startswith(" "):
+            assert name.endswith(("/", ".py")), f"module map line {line!r}"
+            current = name
+            units[current] = set()
+        else:
+            assert current is not None and current.endswith("/"), f"module map line {line!r}"
+            units[current].add(name)
+    return units
+
+
+def tree_units() -> set[str]:
+    """Packages (``cli/``) and modules (``assembly.py``) at the top of src/powertrain."""
+    return ({p.name + "/" for p in PACKAGE.iterdir() if (p / "__init__.py").exists()}
+            | {p.name for p in PACKAGE.glob("*.py") if p.name != "__init__.py"})
+
+
+def test_module_map_names_every_top_level_unit_and_only_those():
+    named = set(doc_module_map())
+    assert not named - tree_units(), f"named in docs/architecture.md, not in the package: " \
+        f"{sorted(named - tree_units())}"
+    assert not tree_units() - named, f"in the package, missing from the module map of " \
+        f"docs/architecture.md: {sorted(tree_units() - named)}"
+
+
+def test_every_module_the_map_names_inside_a_package_exists():
+    missing = [f"{unit}{mod}" for unit, mods in doc_module_map().items() for mod in mods
+               if not (PACKAGE / unit / mod).is_file()]
+    assert not missing, f"docs/architecture.md names modules that do not exist: {missing}"
+
+
+def test_layers_of_the_doc_are_the_contract_in_its_order():
+    try:
+        import tomllib
+    except ModuleNotFoundError:                     # pragma: no cover (Python < 3.11)
+        import tomli as tomllib
+    conf = tomllib.loads((PACKAGE.parents[1] / "pyproject.toml").read_text(encoding="utf-8"))
+    layers = next(c for c in conf["tool"]["importlinter"]["contracts"]
+                  if c["id"] == "layers")["layers"]
+    contract = [" ".join(layer.replace("powertrain.", "").split()) for layer in layers]
+    doc = [line.split("  ")[0].strip() for line in _text_block("Layers") if line.strip()]
+    assert doc == contract
+
+
+def test_the_map_checker_sees_a_missing_and_a_stale_unit(tmp_path, monkeypatch):
+    """The comparison can fail: a unit dropped from the doc and one the package lacks."""
+    doc = DOC.read_text(encoding="utf-8").replace("\nunits.py ", "\nno_such_unit.py ")
+    fake = tmp_path / "architecture.md"
+    fake.write_text(doc, encoding="utf-8")
+    monkeypatch.setattr(sys.modules[__name__], "DOC", fake)
+    named = set(doc_module_map())
+    assert "units.py" in tree_units() - named
+    assert "no_such_unit.py" in named - tree_units()
+
+
+# ---------------------------------------------------------------- sizes (issue 19)
+def _code_metrics():
+    """``scripts/code_metrics.py`` measured on this checkout (one rule, printed and tested)."""
+    import importlib.util
+    path = PACKAGE.parents[1] / "scripts" / "code_metrics.py"
+    spec = importlib.util.spec_from_file_location("code_metrics", path)
+    mod = sys.modules.setdefault("code_metrics", importlib.util.module_from_spec(spec))
+    spec.loader.exec_module(mod)        # registered first: its dataclass looks itself up
+    return mod, mod.measure(PACKAGE)
+
+
+def test_no_module_over_the_size_limit_and_few_loose_modules():
+    cm, m = _code_metrics()
+    assert not m.long_modules, f"modules over {cm.MODULE_MAX} lines: {m.long_modules}"
+    assert len(m.loose_modules) <= cm.LOOSE_MAX, m.loose_modules
+
+
+def test_no_function_over_the_size_limit_outside_kernels_and_cli():
+    """The CLI's command functions have their own, tighter limit (code_metrics.py)."""
+    cm, m = _code_metrics()
+    long = [f for f in m.long_functions if not f[0].startswith("cli/")]
+    assert not long, f"functions over {cm.FUNCTION_MAX} lines: {long}"

@@ -19,26 +19,11 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from powertrain.analysis.channel import DIRECTIONS, PASSIVE, passive_name, split_side  # noqa: F401 (re-export)
 from powertrain.physics.condensation import NetworkPorts, condense
 from powertrain.physics.mount_elements import PortForces, port_forces
 from powertrain.physics.mount_network import ground_force_rows
 from powertrain.physics.rigid_body import direction_row, point_motion_matrix, rigid_body_mass_matrix
-
-DIRECTIONS = ("x", "y", "z")
-#: Suffix of the body-side (passive) channel of a mount: ``left/passive``.
-PASSIVE = "/passive"
-
-
-def passive_name(mount: str) -> str:
-    """Channel name of the body side of ``mount``."""
-    return f"{mount}{PASSIVE}"
-
-
-def split_side(name: str):
-    """``("left", "passive")`` for ``left/passive``, ``(name, "active")`` otherwise."""
-    if name.endswith(PASSIVE):
-        return name[:-len(PASSIVE)], "passive"
-    return name, "active"
 
 
 @dataclass

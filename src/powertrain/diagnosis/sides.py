@@ -26,7 +26,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from powertrain.assembly import split_side
+from powertrain.analysis.channel import split_side
 
 #: The passive side must carry at least this multiple of the engine side's excess RMS [1]:
 #: a body change reaches the engine side only through the bases' motion (issue 13 measured

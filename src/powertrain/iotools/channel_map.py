@@ -24,13 +24,12 @@ from __future__ import annotations
 import re
 from dataclasses import dataclass, field
 
+from powertrain.analysis.channel import DIRECTIONS, SIDES, Channel
 from powertrain.errors import InputError
 from powertrain.iotools.tomlfile import get, read_toml
-from powertrain.models.recording import DIRECTIONS, QUANTITIES, QUANTITY_OF_DIMENSION, SIDES
+from powertrain.models.recording import QUANTITIES, QUANTITY_OF_DIMENSION
 from powertrain.units import dimension_of
 
-_NAME = re.compile(r"^\s*([A-Za-z_][\w\-]*)\.(?:(active|passive)\.)?([xyzXYZ])\s*"
-                   r"(?:\[\s*([^\]]*?)\s*\])?\s*$")
 _UNIT_IN_NAME = re.compile(r"^\s*(.*?)\s*\[\s*([^\]]*?)\s*\]\s*$")
 ENTRY_KEYS = ("mount", "side", "direction", "quantity", "unit")
 
@@ -65,11 +64,12 @@ def split_unit(name: str):
 
 def parse_channel_name(name: str) -> ChannelSpec | None:
     """Spec from the ``MOUNT[.SIDE].DIRECTION [UNIT]`` convention, or None."""
-    m = _NAME.match(name)
-    if not m:
+    text, unit = split_unit(name)
+    try:
+        ch = Channel.parse(text)
+    except ValueError:
         return None
-    mount, side, direction, unit = m.groups()
-    return ChannelSpec(mount, side or "active", direction.lower(), None, unit or "")
+    return ChannelSpec(ch.mount, ch.side, ch.direction, None, unit)
 
 
 def quantity_of_unit(unit: str, file=None, key=None) -> str:

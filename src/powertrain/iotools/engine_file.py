@@ -42,11 +42,21 @@ import numpy as np
 
 from powertrain.data import default_engine_path
 from powertrain.errors import InputError
+from powertrain.iotools.combustion_section import read_combustion
 from powertrain.iotools.mount_file import read_mount
-from powertrain.iotools.tomlfile import get, number, quantity, read_toml
+from powertrain.iotools.tomlfile import (
+    array_quantity,
+    check_keys,
+    get,
+    number,
+    read_toml,
+    scalar_quantity,
+    subtable,
+    unit_vector,
+    vector3,
+)
 from powertrain.models import engine as em
 from powertrain.models.mount import MountModel
-from powertrain.units import to_si
 
 #: The shipped default engine (package data, see :mod:`powertrain.data`).
 DEFAULT_ENGINE_PATH: Path = default_engine_path()
@@ -71,91 +81,7 @@ _ALLOWED = {
               "damping"},
     "balancer": {"enabled", "speed_ratio", "shafts"},
     "shaft": {"name", "mass_radius", "position", "phase", "sense"},
-    "single-zone": {"model", "imep_factors", "ambient_pressure", "start", "duration",
-                    "wiebe_a", "wiebe_m", "polytropic_compression", "polytropic_expansion",
-                    "exhaust_valve_opening", "blowdown_end", "valve_overlap",
-                    "exhaust_pressure_ratio", "intake_pressure_min", "intake_pressure_max",
-                    "indicated_efficiency", "volumetric_efficiency", "air_fuel_ratio",
-                    "heating_value", "intake_temperature", "full_load"},
-    "measured": {"model", "traces"},
-    "full_load": {"speed", "torque", "fmep"},
 }
-
-
-def _check_keys(table, allowed, path, prefix):
-    unknown = sorted(set(table) - set(allowed))
-    if unknown:
-        key = f"{prefix}.{unknown[0]}" if prefix else unknown[0]
-        raise InputError(f"unknown key (expected one of: {', '.join(sorted(allowed))})",
-                         file=path, key=key)
-
-
-def _table(doc, key, path, prefix=""):
-    return get(doc, key, path, prefix, types=dict)
-
-
-def _raw_quantity(table, key, path, prefix):
-    full = f"{prefix}.{key}" if prefix else key
-    raw = get(table, key, path, prefix)
-    if not isinstance(raw, dict):
-        raise InputError('expected {value = ..., unit = "..."}', file=path, key=full)
-    for k in ("value", "unit"):
-        if k not in raw:
-            raise InputError("missing key", file=path, key=f"{full}.{k}")
-    extra = sorted(set(raw) - {"value", "unit"})
-    if extra:
-        raise InputError("unknown key (expected value, unit)", file=path, key=f"{full}.{extra[0]}")
-    return raw["value"], raw["unit"], full
-
-
-def _array(table, key, dimension, path, prefix, shape, *, nonneg=False, positive=False):
-    """A list (or nested list) quantity of the given shape, in SI."""
-    value, unit, full = _raw_quantity(table, key, path, prefix)
-
-    def flat(v):
-        if isinstance(v, list):
-            return [x for item in v for x in flat(item)]
-        return [v]
-
-    def nested_shape(v):
-        if isinstance(v, list):
-            shapes = {nested_shape(x) for x in v}
-            if len(shapes) != 1:
-                return None
-            inner = shapes.pop() if v else ()
-            return None if inner is None else (len(v),) + inner
-        return ()
-
-    got = nested_shape(value)
-    want_len = shape if isinstance(shape, tuple) else None
-    if got is None or got == () or (want_len is not None and got != want_len):
-        raise InputError(f"expected a list of shape {shape}, got {value!r}"[:200],
-                         file=path, key=f"{full}.value")
-    vals = [number(v, path, f"{full}.value", nonneg=nonneg, positive=positive)
-            for v in flat(value)]
-    return np.asarray(to_si(np.array(vals, dtype=float), unit, dimension, file=path,
-                            key=f"{full}.unit"), dtype=float).reshape(got)
-
-
-def _vec3(table, key, dimension, path, prefix):
-    return _array(table, key, dimension, path, prefix, (3,))
-
-
-def _unit_vector(table, key, path, prefix):
-    v = _vec3(table, key, "dimensionless", path, prefix)
-    n = float(np.linalg.norm(v))
-    if n < 1e-12:
-        raise InputError("direction vector must not be zero", file=path,
-                         key=f"{prefix}.{key}")
-    return v / n
-
-
-def _q(table, key, dimension, path, prefix, **kw):
-    value = quantity(table, key, dimension, path, prefix, **kw)
-    if isinstance(value, list):
-        raise InputError("expected one number, got a list", file=path,
-                         key=f"{prefix}.{key}.value" if prefix else f"{key}.value")
-    return float(value)
 
 
 def engine_or_default(engine=None) -> em.Engine:
@@ -181,27 +107,27 @@ def read_engine(path=DEFAULT_ENGINE_PATH) -> em.Engine:
     """
     path = str(path)
     doc = read_toml(path)
-    _check_keys(doc, _ALLOWED[""], path, "")
-    meta = _table(doc, "engine", path)
-    _check_keys(meta, _ALLOWED["engine"], path, "engine")
+    check_keys(doc, _ALLOWED[""], path, "")
+    meta = subtable(doc, "engine", path)
+    check_keys(meta, _ALLOWED["engine"], path, "engine")
     name = get(meta, "name", path, "engine", types=str)
-    body = _read_body(_table(doc, "body", path), path)
-    mounts = _read_mounts(_table(doc, "mounts", path), path)
+    body = _read_body(subtable(doc, "body", path), path)
+    mounts = _read_mounts(subtable(doc, "mounts", path), path)
     crank = combustion = None
     if "crank_train" in doc:
-        crank = _read_crank(_table(doc, "crank_train", path), path)
+        crank = _read_crank(subtable(doc, "crank_train", path), path)
     if "combustion" in doc:
         if crank is None:
             raise InputError("[combustion] needs a [crank_train] section", file=path,
                              key="crank_train")
-        combustion = _read_combustion(_table(doc, "combustion", path), path, crank)
+        combustion = read_combustion(subtable(doc, "combustion", path), path, crank)
     balancer = em.Balancer(enabled=False, ratio=2.0, shafts=())
     if "balancer" in doc:
-        balancer = _read_balancer(_table(doc, "balancer", path), path)
+        balancer = _read_balancer(subtable(doc, "balancer", path), path)
     _check_static_support(body, mounts, path)
     chassis = None
     if "chassis" in doc:
-        chassis = _read_chassis(_table(doc, "chassis", path), path, [m.name for m in mounts])
+        chassis = _read_chassis(subtable(doc, "chassis", path), path, [m.name for m in mounts])
     engine = em.Engine(name=name, crank=crank, body=body, mounts=mounts, balancer=balancer,
                        combustion=combustion, file=path, chassis=chassis)
     from powertrain.iotools.engine_checks import check_engine
@@ -213,7 +139,7 @@ def _read_chassis(t, path, mount_names):
     """``[chassis]``: model rigid | modal | frf, body modes, body points of interest."""
     from powertrain.models.chassis import MODELS, Chassis
     p = "chassis"
-    _check_keys(t, _ALLOWED[p], path, p)
+    check_keys(t, _ALLOWED[p], path, p)
     model = get(t, "model", path, p, types=str)
     if model not in MODELS:
         raise InputError(f"unknown model {model!r} (known: {', '.join(MODELS)})", file=path,
@@ -226,7 +152,7 @@ def _read_chassis(t, path, mount_names):
                              "from the mount names", file=path, key=key)
         if not isinstance(pt, dict):
             raise InputError("expected a table", file=path, key=key)
-        _check_keys(pt, _ALLOWED["chassis_point"], path, key)
+        check_keys(pt, _ALLOWED["chassis_point"], path, key)
     points = tuple(points_raw)
     for k, other in (("modes", "modal"), ("frf", "frf")):
         if k in t and model != other:
@@ -252,13 +178,13 @@ def _read_body_mode(m, path, p, mount_names, points):
     from powertrain.models.chassis import BodyMode
     if not isinstance(m, dict):
         raise InputError("expected a table", file=path, key=p)
-    _check_keys(m, _ALLOWED["chassis_mode"], path, p)
-    f = _q(m, "frequency", "frequency", path, p, positive=True)
-    zeta = _q(m, "damping_ratio", "dimensionless", path, p, nonneg=True)
-    mass = _q(m, "modal_mass", "mass", path, p, positive=True)
+    check_keys(m, _ALLOWED["chassis_mode"], path, p)
+    f = scalar_quantity(m, "frequency", "frequency", path, p, positive=True)
+    zeta = scalar_quantity(m, "damping_ratio", "dimensionless", path, p, nonneg=True)
+    mass = scalar_quantity(m, "modal_mass", "mass", path, p, positive=True)
     shape_raw = get(m, "shape", path, p, types=dict)
     sp = f"{p}.shape"
-    _check_keys(shape_raw, list(mount_names) + list(points), path, sp)
+    check_keys(shape_raw, list(mount_names) + list(points), path, sp)
     shapes = {}
     for name in list(mount_names) + list(points):
         v = get(shape_raw, name, path, sp, types=list)
@@ -286,23 +212,23 @@ def _check_static_support(body, mounts, path):
 
 def _read_crank(t, path) -> em.CrankTrain:
     p = "crank_train"
-    _check_keys(t, _ALLOWED[p], path, p)
+    check_keys(t, _ALLOWED[p], path, p)
     n = get(t, "cylinders", path, p, types=int)
     if isinstance(n, bool) or n < 1:
         raise InputError(f"must be a positive integer, got {n!r}", file=path,
                          key=f"{p}.cylinders")
-    bore = _q(t, "bore", "length", path, p, positive=True)
-    stroke = _q(t, "stroke", "length", path, p, positive=True)
-    rod = _q(t, "rod_length", "length", path, p, positive=True)
-    offset = _q(t, "pin_offset", "length", path, p)
+    bore = scalar_quantity(t, "bore", "length", path, p, positive=True)
+    stroke = scalar_quantity(t, "stroke", "length", path, p, positive=True)
+    rod = scalar_quantity(t, "rod_length", "length", path, p, positive=True)
+    offset = scalar_quantity(t, "pin_offset", "length", path, p)
     if rod <= 0.5 * stroke + abs(offset):
         raise InputError("connecting rod must be longer than the crank radius plus the pin "
                          "offset", file=path, key=f"{p}.rod_length")
-    eps = _q(t, "compression_ratio", "dimensionless", path, p, positive=True)
+    eps = scalar_quantity(t, "compression_ratio", "dimensionless", path, p, positive=True)
     if eps <= 1.0:
         raise InputError(f"must exceed 1, got {eps}", file=path, key=f"{p}.compression_ratio")
-    xs = _array(t, "cylinder_positions", "length", path, p, (n,))
-    axis = _unit_vector(t, "cylinder_axis", path, p)
+    xs = array_quantity(t, "cylinder_positions", "length", path, p, (n,))
+    axis = unit_vector(t, "cylinder_axis", path, p)
     if abs(axis[0]) > 1e-9:
         raise InputError("cylinder axis must be perpendicular to the crank axis (engine X)",
                          file=path, key=f"{p}.cylinder_axis")
@@ -310,7 +236,7 @@ def _read_crank(t, path) -> em.CrankTrain:
     if rot not in ("+X", "-X"):
         raise InputError(f"expected \"+X\" or \"-X\", got {rot!r}", file=path,
                          key=f"{p}.rotation")
-    pins = _array(t, "crank_pin_angles", "angle", path, p, (n,))
+    pins = array_quantity(t, "crank_pin_angles", "angle", path, p, (n,))
     order_raw = get(t, "firing_order", path, p, types=list)
     key_fo = f"{p}.firing_order"
     if (any(isinstance(c, bool) or not isinstance(c, int) for c in order_raw)
@@ -320,10 +246,10 @@ def _read_crank(t, path) -> em.CrankTrain:
     k1 = order_raw.index(1)
     order = tuple(order_raw[k1:] + order_raw[:k1])
     firing = _firing_angles(pins, order, path, key_fo)
-    m_rec = _q(t, "reciprocating_mass", "mass", path, p, nonneg=True)
-    m_rot = _q(t, "rotating_mass", "mass", path, p, nonneg=True)
-    cw = _q(t, "counterweight_fraction", "dimensionless", path, p, nonneg=True)
-    pcc = _q(t, "crankcase_pressure", "pressure", path, p, nonneg=True)
+    m_rec = scalar_quantity(t, "reciprocating_mass", "mass", path, p, nonneg=True)
+    m_rot = scalar_quantity(t, "rotating_mass", "mass", path, p, nonneg=True)
+    cw = scalar_quantity(t, "counterweight_fraction", "dimensionless", path, p, nonneg=True)
+    pcc = scalar_quantity(t, "crankcase_pressure", "pressure", path, p, nonneg=True)
     return em.CrankTrain(bore=bore, stroke=stroke, rod_length=rod, pin_offset=offset,
                          compression_ratio=eps, cylinder_x=xs, cylinder_axis=axis,
                          rotation_sign=1 if rot == "+X" else -1, crank_pin_angles=pins,
@@ -356,10 +282,10 @@ def _firing_angles(pins, order, path, key):
 
 def _read_body(t, path) -> em.RigidBody:
     p = "body"
-    _check_keys(t, _ALLOWED[p], path, p)
-    mass = _q(t, "mass", "mass", path, p, positive=True)
-    cg = _vec3(t, "cg", "length", path, p)
-    inertia = _array(t, "inertia", "inertia", path, p, (3, 3))
+    check_keys(t, _ALLOWED[p], path, p)
+    mass = scalar_quantity(t, "mass", "mass", path, p, positive=True)
+    cg = vector3(t, "cg", "length", path, p)
+    inertia = array_quantity(t, "inertia", "inertia", path, p, (3, 3))
     key = f"{p}.inertia"
     if not np.allclose(inertia, inertia.T, rtol=1e-9, atol=1e-12 * np.abs(inertia).max()):
         raise InputError("inertia tensor must be symmetric", file=path, key=key)
@@ -388,8 +314,8 @@ def _read_mounts(t, path) -> list:
                              "letter", file=path, key=f"mounts.{name}")
         p = f"mounts.{name}"
         m = get(t, name, path, "mounts", types=dict)
-        _check_keys(m, _ALLOWED["mount"], path, p)
-        pos = _vec3(m, "position", "length", path, p)
+        check_keys(m, _ALLOWED["mount"], path, p)
+        pos = vector3(m, "position", "length", path, p)
         rotation = _read_orientation(m, path, p)
         directions, paths = _read_mount_directions(m, path, p)
         mounts.append(em.MountSpec(name=name, position=pos, rotation=rotation,
@@ -414,13 +340,13 @@ def _read_orientation(m, path, p) -> np.ndarray:
         if has_vectors:
             raise InputError("give either orientation or local_x/local_z, not both",
                              file=path, key=f"{p}.orientation")
-        angles = _vec3(m, "orientation", "angle", path, p)
+        angles = vector3(m, "orientation", "angle", path, p)
         return euler_rotation(*angles)
     if not has_vectors:
         raise InputError("missing key (give orientation or local_x and local_z)", file=path,
                          key=f"{p}.orientation")
-    lx = _unit_vector(m, "local_x", path, p)
-    lz = _unit_vector(m, "local_z", path, p)
+    lx = unit_vector(m, "local_x", path, p)
+    lz = unit_vector(m, "local_z", path, p)
     if abs(float(lx @ lz)) > 1e-6:
         raise InputError("local_x and local_z must be perpendicular", file=path,
                          key=f"{p}.local_z")
@@ -436,7 +362,7 @@ def _read_mount_directions(m, path, p):
                                  file=path, key=f"{p}.{key}")
         base = Path(path).parent
         files = get(m, "files", path, p, types=dict)
-        _check_keys(files, DIRECTIONS, path, f"{p}.files")
+        check_keys(files, DIRECTIONS, path, f"{p}.files")
         directions, paths = {}, {}
         for d in DIRECTIONS:
             rel = get(files, d, path, f"{p}.files", types=str)
@@ -450,8 +376,8 @@ def _read_mount_directions(m, path, p):
     if "stiffness" not in m:
         raise InputError("missing key (give files or an inline stiffness)", file=path,
                          key=f"{p}.stiffness")
-    k = _array(m, "stiffness", "stiffness", path, p, (3,), nonneg=True)
-    c = (_array(m, "damping", "damping", path, p, (3,), nonneg=True) if "damping" in m
+    k = array_quantity(m, "stiffness", "stiffness", path, p, (3,), nonneg=True)
+    c = (array_quantity(m, "damping", "damping", path, p, (3,), nonneg=True) if "damping" in m
          else np.zeros(3))
     directions = {d: MountModel.from_values("kelvin-voigt", [k[i], c[i]],
                                             name=f"inline spring-damper {d}",
@@ -462,97 +388,22 @@ def _read_mount_directions(m, path, p):
 
 def _read_balancer(t, path) -> em.Balancer:
     p = "balancer"
-    _check_keys(t, _ALLOWED[p], path, p)
+    check_keys(t, _ALLOWED[p], path, p)
     enabled = get(t, "enabled", path, p, types=bool)
-    ratio = _q(t, "speed_ratio", "dimensionless", path, p, positive=True)
+    ratio = scalar_quantity(t, "speed_ratio", "dimensionless", path, p, positive=True)
     shafts_raw = get(t, "shafts", path, p, types=list)
     shafts = []
     for k, s in enumerate(shafts_raw):
         sp = f"{p}.shafts[{k}]"
         if not isinstance(s, dict):
             raise InputError("expected a table", file=path, key=sp)
-        _check_keys(s, _ALLOWED["shaft"], path, sp)
+        check_keys(s, _ALLOWED["shaft"], path, sp)
         sense = get(s, "sense", path, sp, types=int)
         if sense not in (1, -1) or isinstance(sense, bool):
             raise InputError(f"expected +1 or -1, got {sense!r}", file=path, key=f"{sp}.sense")
         shafts.append(em.BalancerShaft(
             name=str(get(s, "name", path, sp, types=str)),
-            mass_radius=_q(s, "mass_radius", "unbalance", path, sp, nonneg=True),
-            position=_vec3(s, "position", "length", path, sp),
-            phase=_q(s, "phase", "angle", path, sp), sense=sense))
+            mass_radius=scalar_quantity(s, "mass_radius", "unbalance", path, sp, nonneg=True),
+            position=vector3(s, "position", "length", path, sp),
+            phase=scalar_quantity(s, "phase", "angle", path, sp), sense=sense))
     return em.Balancer(enabled=enabled, ratio=ratio, shafts=tuple(shafts))
-
-
-def _read_combustion(t, path, crank):
-    p = "combustion"
-    model = get(t, "model", path, p, types=str)
-    if model == "measured":
-        _check_keys(t, _ALLOWED["measured"], path, p)
-        rel = get(t, "traces", path, p, types=str)
-        from powertrain.iotools.pressure_csv import read_pressure_traces
-        full = Path(path).parent / rel
-        if not full.is_file():
-            raise InputError(f"pressure-trace file not found: {full}", file=path,
-                             key=f"{p}.traces")
-        return read_pressure_traces(full, crank.n_cylinders)
-    if model != "single-zone":
-        raise InputError(f"unknown model {model!r} (known: single-zone, measured)",
-                         file=path, key=f"{p}.model")
-    _check_keys(t, _ALLOWED["single-zone"], path, p)
-    n = crank.n_cylinders
-    factors = _array(t, "imep_factors", "dimensionless", path, p, (n,), nonneg=True)
-    fl = _table(t, "full_load", path, p)
-    fp = f"{p}.full_load"
-    _check_keys(fl, _ALLOWED["full_load"], path, fp)
-    speed = np.asarray(quantity(fl, "speed", "angular_speed", path, fp, positive=True), float)
-    if speed.ndim != 1 or speed.size < 2 or np.any(np.diff(speed) <= 0):
-        raise InputError("expected at least two strictly increasing speeds", file=path,
-                         key=f"{fp}.speed")
-    torque = np.asarray(quantity(fl, "torque", "torque", path, fp, nonneg=True), float)
-    fmep = np.asarray(quantity(fl, "fmep", "pressure", path, fp, nonneg=True), float)
-    for key, arr in (("torque", torque), ("fmep", fmep)):
-        if arr.shape != speed.shape:
-            raise InputError(f"expected {speed.size} values (one per speed)", file=path,
-                             key=f"{fp}.{key}")
-
-    def q(key, dim, **kw):
-        return _q(t, key, dim, path, p, **kw)
-
-    deg = math.pi / 180
-    c = em.SingleZoneCombustion(
-        full_load=em.FullLoadCurve(speed=speed, torque=torque, fmep=fmep),
-        imep_factors=factors,
-        ambient_pressure=q("ambient_pressure", "pressure", positive=True),
-        start=q("start", "angle"), duration=q("duration", "angle", positive=True),
-        wiebe_a=q("wiebe_a", "dimensionless", positive=True),
-        wiebe_m=q("wiebe_m", "dimensionless", nonneg=True),
-        n_compression=q("polytropic_compression", "dimensionless", positive=True),
-        n_expansion=q("polytropic_expansion", "dimensionless", positive=True),
-        exhaust_valve_opening=q("exhaust_valve_opening", "angle"),
-        blowdown_end=q("blowdown_end", "angle"),
-        valve_overlap=q("valve_overlap", "angle", positive=True),
-        exhaust_pressure_ratio=q("exhaust_pressure_ratio", "dimensionless", positive=True),
-        intake_pressure_min=q("intake_pressure_min", "pressure", positive=True),
-        intake_pressure_max=q("intake_pressure_max", "pressure", positive=True),
-        indicated_efficiency=q("indicated_efficiency", "dimensionless", positive=True),
-        volumetric_efficiency=q("volumetric_efficiency", "dimensionless", positive=True),
-        air_fuel_ratio=q("air_fuel_ratio", "dimensionless", positive=True),
-        heating_value=q("heating_value", "specific_energy", positive=True),
-        intake_temperature=q("intake_temperature", "temperature", positive=True))
-    for key, ok, why in (
-            ("polytropic_compression", c.n_compression > 1, "must exceed 1"),
-            ("polytropic_expansion", c.n_expansion > 1, "must exceed 1"),
-            ("start", -180 * deg < c.start < 90 * deg, "must lie between -180 and 90 deg"),
-            ("exhaust_valve_opening", c.start + c.duration <= c.exhaust_valve_opening,
-             "must not precede the end of combustion (start + duration)"),
-            ("blowdown_end", c.exhaust_valve_opening < c.blowdown_end
-             <= 2 * math.pi - c.valve_overlap, "must lie between exhaust valve opening and "
-             "the start of the valve overlap"),
-            ("valve_overlap", c.valve_overlap < math.pi / 2, "must be below 90 deg"),
-            ("intake_pressure_max", c.intake_pressure_max >= c.intake_pressure_min,
-             "must not be below intake_pressure_min"),
-            ("indicated_efficiency", c.indicated_efficiency < 1, "must be below 1"),
-    ):
-        if not ok:
-            raise InputError(why, file=path, key=f"{p}.{key}")
-    return c

@@ -55,6 +55,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from powertrain.analysis.channel import DIRECTIONS, SIDES, Channel, passive_name, split_side
 from powertrain.analysis.orders import order_label, quantity_sort_key
 from powertrain.errors import InputError
 from powertrain.iotools.textfile import check_regular_file, parse_number, read_text
@@ -74,8 +75,6 @@ KEY_COLUMNS = ("mount", "direction", "quantity", "rpm")
 #: body side, or a body point of interest named in ``mount``) and further value columns
 #: (read and checked; the comparison uses the velocity level column).
 OPTIONAL_COLUMNS = ("side", "acceleration_rms_m_per_s2", "force_rms_n")
-SIDES = ("active", "passive")
-DIRECTIONS = ("x", "y", "z")
 _HDF5_SIGNATURE = b"\x89HDF\r\n\x1a\n"
 
 
@@ -226,7 +225,6 @@ def _read_hdf5(path, mounts):
     except KeyError as exc:
         raise InputError(f"not in the run-up HDF5 layout (missing {exc})", file=path) from None
     if mounts is not None:
-        from powertrain.models.chassis import split_side
         for m, _ in result.channels:
             base, side = split_side(m)
             if base not in mounts and side == "active" and not _is_point(result, m):
@@ -256,14 +254,9 @@ def _is_point(result, name) -> bool:
 
 
 def _read_csv(path, mounts, points=None):
-    lines = read_text(path, "CSV").splitlines()
-    comments = []
-    header = None
-    rows = {}          # key -> {rpm: (level, line)}
-    order = []
-    factor = statistic = None
-    level_col = None
-    for lineno, raw in enumerate(lines, start=1):
+    comments, header, layout = [], None, None
+    rows, order = {}, []          # key -> {rpm: (level, line)}; keys in file order
+    for lineno, raw in enumerate(read_text(path, "CSV").splitlines(), start=1):
         text = raw.strip()
         if not text:
             continue
@@ -272,103 +265,144 @@ def _read_csv(path, mounts, points=None):
             continue
         fields = [f.strip() for f in text.split(",")]
         if header is None:
-            header = fields
-            known = set(KEY_COLUMNS) | set(LEVEL_COLUMNS) | set(OPTIONAL_COLUMNS)
-            for name in header:
-                if name not in known:
-                    raise InputError(
-                        f"unknown column {name!r} (expected {', '.join(KEY_COLUMNS)} and one "
-                        f"level column: {', '.join(LEVEL_COLUMNS)})",
-                        file=path, line=lineno, key=name or "(empty)")
-                if header.count(name) > 1:
-                    raise InputError(f"column {name!r} appears twice", file=path,
-                                     line=lineno, key=name)
-            for name in KEY_COLUMNS:
-                if name not in header:
-                    raise InputError(f"header lacks column {name!r}", file=path, line=lineno,
-                                     key=name)
-            levels = [n for n in header if n in LEVEL_COLUMNS]
-            velocity_levels = [n for n in levels if n.startswith("velocity_")]
-            if len(levels) > 1 and len(velocity_levels) == 1:
-                # both-sides run-up CSV: velocity is the level, the rest are extra values
-                levels = velocity_levels
-            if len(levels) != 1:
-                raise InputError(
-                    "header needs exactly one level column with its unit "
-                    f"({', '.join(LEVEL_COLUMNS)}); found "
-                    f"{', '.join(levels) if levels else 'none'}",
-                    file=path, line=lineno, key="header")
-            level_col = levels[0]
-            factor, statistic = LEVEL_COLUMNS[level_col]
-            col = {n: i for i, n in enumerate(header)}
+            header, layout = fields, _csv_layout(fields, path, lineno)
             continue
         if len(fields) != len(header):
             raise InputError(f"{len(fields)} fields, header has {len(header)}", file=path,
                              line=lineno, key=header[min(len(fields), len(header)) - 1])
-        mount = fields[col["mount"]]
-        side = fields[col["side"]].lower() if "side" in col else "active"
-        if side not in SIDES:
-            raise InputError(f"unknown side {fields[col['side']]!r} (expected active or "
-                             "passive)", file=path, line=lineno, key="side")
-        for extra in OPTIONAL_COLUMNS[1:]:
-            if extra in col and extra != level_col and fields[col[extra]]:
-                parse_number(fields[col[extra]], path, lineno, extra, nonneg=True)
-        if side == "passive" and mount and (mounts is None or mount in mounts):
-            mount = f"{mount}/passive"                    # body side of that mount
-        elif side == "passive" and mount and (points is None or mount in points):
-            pass                                          # a body point of interest
-        elif not mount or (mounts is not None and mount not in mounts):
-            known_txt = f" (known: {', '.join(mounts)})" if mounts is not None else ""
-            raise InputError(f"unknown mount {mount!r}{known_txt}", file=path, line=lineno,
-                             key="mount")
-        direction = fields[col["direction"]].lower()
-        if direction not in DIRECTIONS:
-            raise InputError(f"unknown direction {fields[col['direction']]!r} "
-                             "(expected x, y or z)", file=path, line=lineno, key="direction")
-        if fields[col["quantity"]].strip() == "overall":
-            continue                      # track --overall: the raw signal's, not modelled
-        try:
-            quantity = normalise_quantity(fields[col["quantity"]])
-        except ValueError as exc:
-            raise InputError(str(exc), file=path, line=lineno, key="quantity") from None
-        rpm = parse_number(fields[col["rpm"]], path, lineno, "rpm")
-        if not 0 < rpm <= MAX_RPM:
-            raise InputError(f"speed must be > 0 and <= {MAX_RPM:g} rpm, got {rpm:g}",
-                             file=path, line=lineno, key="rpm")
-        level = parse_number(fields[col[level_col]], path, lineno, level_col)
-        if level < 0:
-            raise InputError(f"negative level {level:g}", file=path, line=lineno,
-                             key=level_col)
-        _check_level(level * factor / (math.sqrt(2.0) if statistic == "peak" else 1.0), path,
-                     lineno, level_col)
-        key = (mount, direction, quantity)
-        if key not in rows:
-            rows[key] = {}
-            order.append(key)
-        if rpm in rows[key]:
-            raise InputError(f"duplicate row: {mount},{direction},{quantity} at {rpm:g} rpm "
-                             f"already on line {rows[key][rpm][1]}", file=path, line=lineno,
-                             key="rpm")
-        rows[key][rpm] = (level, lineno)
+        row = _csv_row(fields, layout, path, lineno, mounts, points)
+        if row is not None:
+            _add_row(rows, order, row, path, lineno)
     if header is None:
         raise InputError("no header line (expected "
                          "mount,direction,quantity,rpm,velocity_rms_mm_per_s)", file=path)
     if not rows:
         raise InputError("no data rows", file=path)
-    scale = factor / (math.sqrt(2.0) if statistic == "peak" else 1.0)
+    return _measured_runup(rows, order, layout, path, comments)
+
+
+@dataclass(frozen=True)
+class _Layout:
+    """Header of a measured CSV: column index by name and the level column read."""
+
+    col: dict
+    level_col: str
+
+    @property
+    def scale(self) -> float:
+        """Factor from the level column to SI RMS."""
+        factor, statistic = LEVEL_COLUMNS[self.level_col]
+        return factor / (math.sqrt(2.0) if statistic == "peak" else 1.0)
+
+
+def _csv_layout(header, path, lineno) -> _Layout:
+    known = set(KEY_COLUMNS) | set(LEVEL_COLUMNS) | set(OPTIONAL_COLUMNS)
+    for name in header:
+        if name not in known:
+            raise InputError(
+                f"unknown column {name!r} (expected {', '.join(KEY_COLUMNS)} and one "
+                f"level column: {', '.join(LEVEL_COLUMNS)})",
+                file=path, line=lineno, key=name or "(empty)")
+        if header.count(name) > 1:
+            raise InputError(f"column {name!r} appears twice", file=path,
+                             line=lineno, key=name)
+    for name in KEY_COLUMNS:
+        if name not in header:
+            raise InputError(f"header lacks column {name!r}", file=path, line=lineno,
+                             key=name)
+    levels = [n for n in header if n in LEVEL_COLUMNS]
+    velocity_levels = [n for n in levels if n.startswith("velocity_")]
+    if len(levels) > 1 and len(velocity_levels) == 1:
+        # both-sides run-up CSV: velocity is the level, the rest are extra values
+        levels = velocity_levels
+    if len(levels) != 1:
+        raise InputError(
+            "header needs exactly one level column with its unit "
+            f"({', '.join(LEVEL_COLUMNS)}); found "
+            f"{', '.join(levels) if levels else 'none'}",
+            file=path, line=lineno, key="header")
+    return _Layout({n: i for i, n in enumerate(header)}, levels[0])
+
+
+def _csv_row(fields, layout, path, lineno, mounts, points):
+    """``(node, direction, quantity, rpm, level)`` of a data row (level in the column's
+    unit), or None for a row not modelled (quantity ``overall``)."""
+    col, level_col = layout.col, layout.level_col
+    side = fields[col["side"]].lower() if "side" in col else "active"
+    if side not in SIDES:
+        raise InputError(f"unknown side {fields[col['side']]!r} (expected active or "
+                         "passive)", file=path, line=lineno, key="side")
+    for extra in OPTIONAL_COLUMNS[1:]:
+        if extra in col and extra != level_col and fields[col[extra]]:
+            parse_number(fields[col[extra]], path, lineno, extra, nonneg=True)
+    node = _csv_node(fields[col["mount"]], side, path, lineno, mounts, points)
+    direction = fields[col["direction"]].lower()
+    if direction not in DIRECTIONS:
+        raise InputError(f"unknown direction {fields[col['direction']]!r} "
+                         "(expected x, y or z)", file=path, line=lineno, key="direction")
+    if fields[col["quantity"]].strip() == "overall":
+        return None                       # track --overall: the raw signal's, not modelled
+    try:
+        quantity = normalise_quantity(fields[col["quantity"]])
+    except ValueError as exc:
+        raise InputError(str(exc), file=path, line=lineno, key="quantity") from None
+    rpm = parse_number(fields[col["rpm"]], path, lineno, "rpm")
+    if not 0 < rpm <= MAX_RPM:
+        raise InputError(f"speed must be > 0 and <= {MAX_RPM:g} rpm, got {rpm:g}",
+                         file=path, line=lineno, key="rpm")
+    level = parse_number(fields[col[level_col]], path, lineno, level_col)
+    if level < 0:
+        raise InputError(f"negative level {level:g}", file=path, line=lineno,
+                         key=level_col)
+    factor, statistic = LEVEL_COLUMNS[level_col]
+    _check_level(level * factor / (math.sqrt(2.0) if statistic == "peak" else 1.0), path,
+                 lineno, level_col)
+    return node, direction, quantity, rpm, level
+
+
+def _csv_node(mount, side, path, lineno, mounts, points) -> str:
+    """Node of a row's ``mount`` and ``side``: ``left``, ``left/passive`` (body side of a
+    mount) or a body point of interest."""
+    if side == "passive" and mount and (mounts is None or mount in mounts):
+        return passive_name(mount)                    # body side of that mount
+    if side == "passive" and mount and (points is None or mount in points):
+        return mount                                  # a body point of interest
+    if not mount or (mounts is not None and mount not in mounts):
+        known_txt = f" (known: {', '.join(mounts)})" if mounts is not None else ""
+        raise InputError(f"unknown mount {mount!r}{known_txt}", file=path, line=lineno,
+                         key="mount")
+    return mount
+
+
+def _add_row(rows, order, row, path, lineno) -> None:
+    node, direction, quantity, rpm, level = row
+    key = (node, direction, quantity)
+    if key not in rows:
+        rows[key] = {}
+        order.append(key)
+    if rpm in rows[key]:
+        raise InputError(f"duplicate row: {node},{direction},{quantity} at {rpm:g} rpm "
+                         f"already on line {rows[key][rpm][1]}", file=path, line=lineno,
+                         key="rpm")
+    rows[key][rpm] = (level, lineno)
+
+
+def _measured_runup(rows, order, layout, path, comments) -> MeasuredRunup:
+    """The curves of the rows in SI, converted to velocity (or kept as forces)."""
     curves = {}
     for key in order:
         speeds = np.array(sorted(rows[key]))
-        curves[key] = (speeds, np.array([rows[key][r][0] for r in speeds]) * scale)
+        curves[key] = (speeds, np.array([rows[key][r][0] for r in speeds]) * layout.scale)
     notes = []
     signal = "velocity"
+    level_col = layout.level_col
     kind = level_col.split("_", 1)[0]
     if kind in ("acceleration", "displacement"):
         curves = to_velocity(curves, kind, notes)
     elif kind == "force":
         signal = "mount_force"
         notes.append("force curves: compared with the simulated mount forces [N]")
-    if statistic == "peak":
+    if LEVEL_COLUMNS[level_col][1] == "peak":
         notes.append(f"levels read from peak column {level_col!r} and converted to RMS by "
                      "1/sqrt(2) (exact for a sinusoidal order; synthesis read as the "
                      "root-sum-square of the order peaks)")
@@ -395,7 +429,7 @@ def to_velocity(curves, kind, notes):
             for rpm, _ in orders.values():
                 common = set(rpm.tolist()) if common is None else common & set(rpm.tolist())
             if not common:
-                dropped.append(f"{m}.{d}")
+                dropped.append(Channel.of_node(m, d).label)
                 continue
             speeds = np.array(sorted(common))
             total = np.zeros(speeds.size)

@@ -105,6 +105,22 @@ def read_stiffness_csv(path) -> MeasuredStiffness:
     if not rows:
         raise InputError("empty file, expected a header line", file=path, key=FREQUENCY)
     header_line, header = rows[0]
+    pair, polar = _columns(header, header_line, path)
+    data = _values(rows[1:], header, [FREQUENCY, *pair], path)
+    f = np.array(data[FREQUENCY])
+    a = np.array(data[pair[0]])
+    b = np.array(data[pair[1]])
+    if polar:
+        mag = to_si(a, "N/mm", "stiffness")
+        kcp = mag * np.exp(1j * to_si(b, "deg", "angle"))
+    else:
+        kcp = to_si(a, "N/mm", "stiffness") + 1j * to_si(b, "N/mm", "stiffness")
+    return MeasuredStiffness(f, kcp, path)
+
+
+def _columns(header, header_line, path):
+    """``(pair, polar)``: the two stiffness columns of the header and whether they are
+    magnitude and phase."""
     seen = set()
     for name in header:
         if name in seen:
@@ -122,10 +138,14 @@ def read_stiffness_csv(path) -> MeasuredStiffness:
     for name in pair:
         if name not in header:
             raise InputError("missing column", file=path, key=name, line=header_line)
-    cols = [FREQUENCY, *pair]
+    return pair, polar
+
+
+def _values(rows, header, cols, path) -> dict:
+    """Column name -> list of numbers (file units) of the data ``rows``, checked."""
     index = {name: header.index(name) for name in cols}
     data = {name: [] for name in cols}
-    for lineno, fields in rows[1:]:
+    for lineno, fields in rows:
         if len(fields) != len(header):
             raise InputError(f"expected {len(header)} fields, got {len(fields)}",
                              file=path, key=FREQUENCY, line=lineno)
@@ -143,12 +163,4 @@ def read_stiffness_csv(path) -> MeasuredStiffness:
             data[name].append(value)
     if not data[FREQUENCY]:
         raise InputError("no data rows", file=path, key=FREQUENCY)
-    f = np.array(data[FREQUENCY])
-    a = np.array(data[pair[0]])
-    b = np.array(data[pair[1]])
-    if polar:
-        mag = to_si(a, "N/mm", "stiffness")
-        kcp = mag * np.exp(1j * to_si(b, "deg", "angle"))
-    else:
-        kcp = to_si(a, "N/mm", "stiffness") + 1j * to_si(b, "N/mm", "stiffness")
-    return MeasuredStiffness(f, kcp, path)
+    return data

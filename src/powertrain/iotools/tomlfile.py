@@ -5,6 +5,8 @@ from __future__ import annotations
 import math
 import sys
 
+import numpy as np
+
 from powertrain.errors import InputError
 from powertrain.iotools.textfile import read_text
 from powertrain.units import to_si
@@ -83,3 +85,84 @@ def quantity(table: dict, key: str, dimension: str, path, prefix: str = "", *,
         return [to_si(v, unit, dimension, file=path, key=f"{full}.unit") for v in vals]
     value = number(value, path, f"{full}.value", nonneg=nonneg, positive=positive)
     return to_si(value, unit, dimension, file=path, key=f"{full}.unit")
+
+
+def check_keys(table, allowed, path, prefix):
+    """InputError naming the first key of ``table`` not in ``allowed``."""
+    unknown = sorted(set(table) - set(allowed))
+    if unknown:
+        key = f"{prefix}.{unknown[0]}" if prefix else unknown[0]
+        raise InputError(f"unknown key (expected one of: {', '.join(sorted(allowed))})",
+                         file=path, key=key)
+
+
+def subtable(doc, key, path, prefix=""):
+    """The table ``doc[key]`` (InputError naming ``prefix.key`` if missing or not a table)."""
+    return get(doc, key, path, prefix, types=dict)
+
+
+def _raw_quantity(table, key, path, prefix):
+    full = f"{prefix}.{key}" if prefix else key
+    raw = get(table, key, path, prefix)
+    if not isinstance(raw, dict):
+        raise InputError('expected {value = ..., unit = "..."}', file=path, key=full)
+    for k in ("value", "unit"):
+        if k not in raw:
+            raise InputError("missing key", file=path, key=f"{full}.{k}")
+    extra = sorted(set(raw) - {"value", "unit"})
+    if extra:
+        raise InputError("unknown key (expected value, unit)", file=path, key=f"{full}.{extra[0]}")
+    return raw["value"], raw["unit"], full
+
+
+def array_quantity(table, key, dimension, path, prefix, shape, *, nonneg=False, positive=False):
+    """A list (or nested list) quantity of the given shape, in SI."""
+    value, unit, full = _raw_quantity(table, key, path, prefix)
+
+    def flat(v):
+        if isinstance(v, list):
+            return [x for item in v for x in flat(item)]
+        return [v]
+
+    def nested_shape(v):
+        if isinstance(v, list):
+            shapes = {nested_shape(x) for x in v}
+            if len(shapes) != 1:
+                return None
+            inner = shapes.pop() if v else ()
+            return None if inner is None else (len(v),) + inner
+        return ()
+
+    got = nested_shape(value)
+    want_len = shape if isinstance(shape, tuple) else None
+    if got is None or got == () or (want_len is not None and got != want_len):
+        raise InputError(f"expected a list of shape {shape}, got {value!r}"[:200],
+                         file=path, key=f"{full}.value")
+    vals = [number(v, path, f"{full}.value", nonneg=nonneg, positive=positive)
+            for v in flat(value)]
+    return np.asarray(to_si(np.array(vals, dtype=float), unit, dimension, file=path,
+                            key=f"{full}.unit"), dtype=float).reshape(got)
+
+
+def vector3(table, key, dimension, path, prefix):
+    """A 3-vector quantity in SI."""
+    return array_quantity(table, key, dimension, path, prefix, (3,))
+
+
+def unit_vector(table, key, path, prefix):
+    """A non-zero dimensionless 3-vector, normalised."""
+    v = vector3(table, key, "dimensionless", path, prefix)
+    n = float(np.linalg.norm(v))
+    if n < 1e-12:
+        raise InputError("direction vector must not be zero", file=path,
+                         key=f"{prefix}.{key}")
+    return v / n
+
+
+def scalar_quantity(table, key, dimension, path, prefix, **kw):
+    """One number quantity in SI (a list is an error)."""
+    value = quantity(table, key, dimension, path, prefix, **kw)
+    if isinstance(value, list):
+        raise InputError("expected one number, got a list", file=path,
+                         key=f"{prefix}.{key}.value" if prefix else f"{key}.value")
+    return float(value)

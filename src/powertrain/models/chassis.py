@@ -22,7 +22,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from powertrain.assembly import PASSIVE, passive_name, split_side  # noqa: F401 (re-export)
+from powertrain.analysis.channel import PASSIVE, passive_name, split_side  # noqa: F401 (re-export)
 
 
 @dataclass(frozen=True, eq=False)

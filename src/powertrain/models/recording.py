@@ -12,6 +12,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from powertrain.analysis.channel import DIRECTIONS, SIDES, Channel  # noqa: F401 (re-export)
 from powertrain.errors import InputError
 
 #: Largest sample magnitude accepted (in the channel's unit): far above any recorded
@@ -28,8 +29,6 @@ QUANTITIES = {
 #: Dimension of :mod:`powertrain.units` -> quantity (``length`` is a displacement).
 QUANTITY_OF_DIMENSION = {"acceleration": "acceleration", "velocity": "velocity",
                          "length": "displacement", "force": "force"}
-SIDES = ("active", "passive")
-DIRECTIONS = ("x", "y", "z")
 #: Relative tolerance on the sampling interval: a recording must be uniformly sampled.
 UNIFORM_TOLERANCE = 1e-3
 
@@ -60,10 +59,14 @@ class RawChannel:
     unit: str = ""
 
     @property
+    def channel(self) -> Channel:
+        """Where the channel was measured."""
+        return Channel(self.mount, self.side, self.direction)
+
+    @property
     def label(self) -> str:
         """``mount.direction`` (active side) or ``mount.passive.direction``."""
-        mid = "" if self.side == "active" else f".{self.side}"
-        return f"{self.mount}{mid}.{self.direction}"
+        return self.channel.label
 
 
 @dataclass

@@ -71,7 +71,7 @@ def plot_runup_both_sides(result, path=None, quantities=("synthesis", "order_2",
     at every speed is said in its panel title; a body-point direction zero in every column
     is not drawn but named in the figure title. Returns the figure (``ax``: None, a Figure
     or SubFigure)."""
-    from powertrain.assembly import passive_name
+    from powertrain.analysis.channel import passive_name
     from powertrain.plotting import SIGNAL_UNITS
     factor, unit = SIGNAL_UNITS[signal][:2]
     rows = [(m, d, True) for m in result.mounts for d in "xyz"]
@@ -101,7 +101,7 @@ def plot_runup_both_sides(result, path=None, quantities=("synthesis", "order_2",
 
 
 def _both_sides_panel(a, result, row, quantity, signal, factor):
-    from powertrain.assembly import passive_name
+    from powertrain.analysis.channel import passive_name
     from powertrain.plotting.runup import panel_title, style_panel
     name, d, is_mount = row
     y = result.curve(name, d, quantity, signal) * factor

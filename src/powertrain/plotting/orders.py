@@ -57,7 +57,7 @@ def plot_tracked(tracked, path=None, quantities=None, *, ax=None, provenance=Non
     hidden = {}
     for c, ch in enumerate(tracked.channels):
         a = axes[c // cols][c % cols]
-        label = ch.mount + ("" if ch.side == "active" else f".{ch.side}") + f".{ch.direction}"
+        label = ch.label
         peaks = _draw_curves(a, tracked, label, quantities, DISPLAY[ch.quantity][1])
         if not style_panel(a, f"{label} ({ch.quantity})", list(peaks.values()),
                            DYNAMIC_RANGE_DB):

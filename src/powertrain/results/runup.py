@@ -94,7 +94,7 @@ class RunupResult:
     @property
     def mounts(self) -> list:
         """Mount names (engine-side channels), in order."""
-        from powertrain.models.chassis import split_side
+        from powertrain.analysis.channel import split_side
         names = [m for m, _ in self.channels if split_side(m)[1] == "active"]
         points = set(self.points)
         return [m for m in dict.fromkeys(names) if m not in points]
@@ -106,13 +106,13 @@ class RunupResult:
 
     def side(self, name) -> str:
         """``active`` (engine side of a mount), ``passive`` (body side or body point)."""
-        from powertrain.models.chassis import split_side
+        from powertrain.analysis.channel import split_side
         return "passive" if name in self.points else split_side(name)[1]
 
     def isolation_db(self, mount, direction, quantity="synthesis") -> np.ndarray:
         """Isolation of a mount: 20 log10(engine-side / body-side RMS velocity) [dB]
         per speed (needs a non-rigid chassis)."""
-        from powertrain.models.chassis import passive_name
+        from powertrain.analysis.channel import passive_name
         a = self.curve(mount, direction, quantity)
         b = self.curve(passive_name(mount), direction, quantity)
         tiny = np.finfo(float).tiny
@@ -203,7 +203,7 @@ class RunupResult:
         mount transmits to the body [N] per channel, side, order and speed (body points
         have no force: empty cell). ``comments`` become ``#`` lines above the header (a
         SYNTHETIC label, the provenance)."""
-        from powertrain.models.chassis import split_side
+        from powertrain.analysis.channel import split_side
         lines = [f"# {' '.join(str(c).split())}" for c in comments] + [CSV_HEADER]
         values = [(self.order_rms("velocity") * 1e3, self.synthesis_rms("velocity") * 1e3),
                   (self.order_rms("acceleration"), self.synthesis_rms("acceleration")),
@@ -312,7 +312,7 @@ class RunupResult:
 
     def _write_sides(self, h5):
         """/channels/side and /channels/location; /path_contribution with body points."""
-        from powertrain.models.chassis import split_side
+        from powertrain.analysis.channel import split_side
         g = h5["channels"]
         g.create_dataset("side", data=np.array([self.side(m) for m, _ in self.channels],
                                                dtype="S"))

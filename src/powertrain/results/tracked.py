@@ -39,6 +39,7 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
+from powertrain.analysis.channel import Channel
 from powertrain.analysis.orders import order_label
 from powertrain.errors import InputError
 from powertrain.models.recording import QUANTITIES
@@ -61,6 +62,16 @@ class TrackedChannel:
     side: str
     direction: str
     quantity: str
+
+    @property
+    def channel(self) -> Channel:
+        """Where the channel was measured."""
+        return Channel(self.mount, self.side, self.direction)
+
+    @property
+    def label(self) -> str:
+        """``mount.direction`` (active side) or ``mount.passive.direction``."""
+        return self.channel.label
 
 
 @dataclass
@@ -239,7 +250,7 @@ class TrackedOrders:
 
     def curve(self, label: str, quantity: str = "synthesis") -> np.ndarray:
         """RMS curve [SI] of the channel ``mount[.side].direction`` (synthesis or order_<n>)."""
-        c = [_label(ch) for ch in self.channels].index(label)
+        c = [ch.label for ch in self.channels].index(label)
         if quantity == "synthesis":
             return self.synthesis_rms()[:, c]
         o = float(quantity.split("_", 1)[1])
@@ -308,7 +319,3 @@ class TrackedOrders:
         return plot_tracked(self, path, quantities, ax=ax,
                             provenance=provenance or getattr(self, "provenance", None))
 
-
-def _label(ch) -> str:
-    return f"{ch.mount}.{ch.direction}" if ch.side == "active" else \
-        f"{ch.mount}.{ch.side}.{ch.direction}"

@@ -31,7 +31,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from powertrain.assembly import DIRECTIONS, passive_name
+from powertrain.analysis.channel import DIRECTIONS, passive_name
 from powertrain.physics.condensation import condensed_matrix
 
 

@@ -20,6 +20,7 @@ import math
 
 import numpy as np
 
+from powertrain.analysis.channel import Channel
 from powertrain.errors import InputError
 from powertrain.models.recording import RawChannel, RawRecording
 
@@ -97,7 +98,6 @@ def simulate_sweep(engine, rpm_from, rpm_to, rate_rpm_per_s, sample_rate=8192.0,
         Nine acceleration channels [m/s^2] (engine side) and the speed [rpm].
     """
     from powertrain.assembly import assemble
-    from powertrain.kernels.newmark import modal_trapezoid_kernel
     from powertrain.solvers.newmark import ModalNewmark
     _check(engine, rpm_from, rpm_to, rate_rpm_per_s, sample_rate)
     m, n_steps = sweep_steps(rpm_from, rpm_to, rate_rpm_per_s, sample_rate)
@@ -106,15 +106,35 @@ def simulate_sweep(engine, rpm_from, rpm_to, rate_rpm_per_s, sample_rate=8192.0,
         b = engine.body
         system = assemble(b.mass, b.cg, b.inertia, engine.mounts)
     _require_linear(system)
-    speeds, table, n_theta = _load_table(engine, rpm_from, rpm_to)
+    load = _load_table(engine, rpm_from, rpm_to)
     modal = ModalNewmark(system.M, system.C, system.K, load_dofs=6)
+    decimator = _Decimator(m, len(system.channels))
+    ramp = (rpm_from, rate_rpm_per_s, h, n_steps)
+    y = _integrate(modal, system, load, ramp, _initial_state(engine, modal, rpm_from),
+                   decimator, progress)
+    t_out = (decimator.first_output_index + np.arange(y.shape[0])) / sample_rate
+    rpm_out = rpm_from + rate_rpm_per_s * t_out
+    block = np.ascontiguousarray(y.T)
+    chans = [RawChannel(Channel(mnt, "active", d).label, mnt, "active", d, "acceleration",
+                        block[c], "m/s^2") for c, (mnt, d) in enumerate(system.channels)]
+    note = (f"SYNTHETIC: simulated continuous run-up {rpm_from:g}->{rpm_to:g} rpm at "
+            f"{rate_rpm_per_s:g} rpm/s ({getattr(engine, 'name', '')}; Newmark average "
+            f"acceleration, modal, {m * sample_rate:g} Hz internal, decimated to "
+            f"{sample_rate:g} Hz)")
+    return RawRecording(t_out, chans, rpm_out, None, "simulated sweep", [note]).validate()
+
+
+def _integrate(modal, system, load, ramp, eta, decimator, progress):
+    """Decimated channel accelerations (n_out, n_ch) of the ramp ``(rpm_from, rate [rpm/s],
+    step h [s], steps)`` from the modal state ``eta``, chunk by chunk (trapezoid kernel)."""
+    from powertrain.kernels.newmark import modal_trapezoid_kernel
+    rpm_from, rate_rpm_per_s, h, n_steps = ramp
+    speeds, table, n_theta = load
     Z = np.zeros_like(system.channel_matrix)
     (w_re, w_im), w_load = modal.output_map(Z, Z, system.channel_matrix)
     lam_d = (1 + 0.5 * h * modal.lam_r) / (1 - 0.5 * h * modal.lam_r)
     gain = (0.5 * h) / (1 - 0.5 * h * modal.lam_r)
-    eta = _initial_state(engine, modal, rpm_from)
-    decimator = _Decimator(m, len(system.channels))
-    chunk = CHUNK_OUT * m                   # a multiple of m keeps the decimation aligned
+    chunk = CHUNK_OUT * decimator.m         # a multiple of m keeps the decimation aligned
     starts = range(0, n_steps, chunk)
     if progress:
         from tqdm import tqdm
@@ -132,18 +152,7 @@ def simulate_sweep(engine, rpm_from, rpm_to, rate_rpm_per_s, sample_rate=8192.0,
         eta = out_re[-1] + 1j * out_im[-1]
         acc = out_re @ w_re - out_im @ w_im + F @ w_load.T          # (k, n_ch)
         outputs.append(decimator.push(acc[:-1]))                    # last row starts the next
-    y = np.concatenate(outputs)
-    first = decimator.first_output_index
-    t_out = (first + np.arange(y.shape[0])) / sample_rate
-    rpm_out = rpm_from + rate_rpm_per_s * t_out
-    block = np.ascontiguousarray(y.T)
-    chans = [RawChannel(f"{mnt}.{d}", mnt, "active", d, "acceleration", block[c], "m/s^2")
-             for c, (mnt, d) in enumerate(system.channels)]
-    note = (f"SYNTHETIC: simulated continuous run-up {rpm_from:g}->{rpm_to:g} rpm at "
-            f"{rate_rpm_per_s:g} rpm/s ({getattr(engine, 'name', '')}; Newmark average "
-            f"acceleration, modal, {m * sample_rate:g} Hz internal, decimated to "
-            f"{sample_rate:g} Hz)")
-    return RawRecording(t_out, chans, rpm_out, None, "simulated sweep", [note]).validate()
+    return np.concatenate(outputs)
 
 
 class _Decimator:

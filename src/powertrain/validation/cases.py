@@ -222,7 +222,7 @@ class Case:
     def csv_text(self) -> str:
         """The measured CSV (long format); with a body under the mounts (channels
         ``NAME/passive`` and body points) with the ``side`` column."""
-        from powertrain.assembly import split_side
+        from powertrain.analysis.channel import split_side
         names = {m for m, _, _ in self.measured.curves}
         bases = {split_side(m)[0] for m in names if split_side(m)[1] == "passive"}
         lines = [f"# SYNTHETIC measured run-up (powertrain synth, seed {self.seed}); the hidden "

@@ -21,6 +21,7 @@ import functools
 
 import numpy as np
 
+from powertrain.analysis.channel import passive_name
 from powertrain.validation import truth as tr
 from powertrain.validation.cases import RPM, Case, draw_case, traces_engine
 from powertrain.validation.kinds import KINDS
@@ -64,7 +65,7 @@ def nominal_body(engine) -> tr.BodyModes:
 def channels(engine) -> list:
     """Engine-side channels, then the body side of every mount."""
     act = [(mt.name, a) for mt in engine.mounts for a in "xyz"]
-    return act + [(f"{mt.name}/passive", a) for mt in engine.mounts for a in "xyz"]
+    return act + [(passive_name(mt.name), a) for mt in engine.mounts for a in "xyz"]
 
 
 def truth_velocity(engine, truth):

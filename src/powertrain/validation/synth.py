@@ -132,9 +132,43 @@ class _PerCylinderCombustion:
 
 def truth_velocity(engine, hm: HarmonicModel, truth) -> np.ndarray:
     """Noise-free channel velocities (n_r, 9, 16) of ``engine`` with the truth effects."""
-    nets = [n[2] for n in hm.networks]
-    load = hm.load
     names = dict(truth)
+    load = _truth_load(engine, hm, names)
+    models = _truth_networks(hm, names)
+
+    def abc_for(s):                         # s (n_r, n_net) spring factors
+        out = [np.empty(hm.omega.shape + (len(models),), complex) for _ in range(3)]
+        for k, m in enumerate(models):
+            res = _two_port_springs(hm.omega, m, s[:, k])
+            for j in range(3):
+                out[j][..., k] = res[j]
+        return out
+
+    def solve(abc):
+        if "body_modes" in names:
+            return _solve_body(hm, abc, load, names["body_modes"])
+        return hm.solve(abc[0], load, abc=abc)
+
+    s = np.ones((hm.rpm.size, len(models)))
+    if "amplitude_power" in names:
+        p = names["amplitude_power"]
+        last = len(hm.mount_names) - 1          # engine mounts hydraulic, last elastomeric
+        beta = np.array([p["beta"][0] if hm.networks[k][0] < last else p["beta"][1]
+                         for k in range(len(models))])
+        for _ in range(60):
+            q = solve(abc_for(s))
+            a = np.maximum(hm.network_amplitude(q), 1e-6)
+            s_new = (a / A_REF) ** (-beta[None, :])
+            change = np.max(np.abs(s_new - s))
+            s = s + 0.7 * (s_new - s)
+            if change < 1e-6:
+                break
+    return _truth_readings(hm, hm.velocity(solve(abc_for(s))), names)
+
+
+def _truth_load(engine, hm, names):
+    """Load harmonics with the load-side truth effects (combustion, balancer, driveline)."""
+    load = hm.load
     if "cylinder_combustion" in names:
         p = names["cylinder_combustion"]
         eng = engine.replace(combustion=_PerCylinderCombustion(
@@ -154,46 +188,25 @@ def truth_velocity(engine, hm: HarmonicModel, truth) -> np.ndarray:
         fac = 1 + p["kappa"] * w ** 2 / (wt ** 2 - w ** 2 + 2j * p["zeta"] * wt * w)
         load = load.copy()
         load[..., 3] = load[..., 3] * fac
+    return load
+
+
+def _truth_networks(hm, names) -> list:
+    """The mount networks with the ``mount_temperature`` truth's spring and damper factors."""
+    nets = [n[2] for n in hm.networks]
     spring = np.ones(len(nets))
     damp = np.ones(len(nets))
     if "mount_temperature" in names:
         p = names["mount_temperature"]
         spring = np.asarray(p["spring"], float)
         damp = np.asarray(p["damper"], float)
-    models = [m.with_params(**{k: v * (sf if k[0] == "c" else df if k[0] == "d" else 1.0)
-                               for k, v in m.params.items()})
-              for m, sf, df in zip(nets, spring, damp)]
-    n_r = hm.rpm.size
+    return [m.with_params(**{k: v * (sf if k[0] == "c" else df if k[0] == "d" else 1.0)
+                             for k, v in m.params.items()})
+            for m, sf, df in zip(nets, spring, damp)]
 
-    def abc_for(s):                         # s (n_r, n_net) spring factors
-        out = [np.empty(hm.omega.shape + (len(models),), complex) for _ in range(3)]
-        for k, m in enumerate(models):
-            res = _two_port_springs(hm.omega, m, s[:, k])
-            for j in range(3):
-                out[j][..., k] = res[j]
-        return out
 
-    def solve(abc):
-        if "body_modes" in names:
-            return _solve_body(hm, abc, load, names["body_modes"])
-        return hm.solve(abc[0], load, abc=abc)
-
-    s = np.ones((n_r, len(models)))
-    if "amplitude_power" in names:
-        p = names["amplitude_power"]
-        last = len(hm.mount_names) - 1          # engine mounts hydraulic, last elastomeric
-        beta = np.array([p["beta"][0] if hm.networks[k][0] < last else p["beta"][1]
-                         for k in range(len(models))])
-        for _ in range(60):
-            q = solve(abc_for(s))
-            a = np.maximum(hm.network_amplitude(q), 1e-6)
-            s_new = (a / A_REF) ** (-beta[None, :])
-            change = np.max(np.abs(s_new - s))
-            s = s + 0.7 * (s_new - s)
-            if change < 1e-6:
-                break
-    q = solve(abc_for(s))
-    v = hm.velocity(q)
+def _truth_readings(hm, v, names):
+    """Channel velocities as read: the powertrain's bending and the sensor triads' truths."""
     if "powertrain_bending" in names:
         p = names["powertrain_bending"]
         w, wb = hm.omega[:, 1:N_HARMONICS], 2 * np.pi * p["freq"]

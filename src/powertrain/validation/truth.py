@@ -42,6 +42,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from powertrain.analysis.channel import passive_name
 from powertrain.assembly import AssembledSystem
 from powertrain.physics.combustion import indicated_work
 
@@ -269,7 +270,7 @@ def _passive_outputs(channels, Cm, mounts, chassis, modes, i_base, i_mode):
                 rows[3 * m + a, i_base + 3 * m + a] = 1.0
             elif modes is not None:
                 rows[3 * m + a, i_mode:] = modes.shapes[:, m, a]
-    names = [(f"{mt.name}/passive", a) for mt in mounts for a in "xyz"]
+    names = [(passive_name(mt.name), a) for mt in mounts for a in "xyz"]
     return channels + names, np.vstack([Cm, rows])
 
 

@@ -54,7 +54,7 @@ class SweepTask:
         (``angle_step_deg``...).
     effects : dict
         Response-level effects ``{effect: {parameter: value}}`` (amplitude-dependent mounts,
-        sensor errors) run by :func:`powertrain.workflows.effect_runup.runup_with_effects`.
+        sensor errors) run by :func:`powertrain.workflows.runup.runup_with_effects`.
     """
 
     name: str

@@ -7,9 +7,9 @@ Three layers, all pure (nothing is mutated; every ``apply`` returns a new
    :func:`parse_rotate`, :func:`parse_target` turn one spec string (command-line option or
    variants-file entry) into an operation object; syntax errors raise
    :class:`~powertrain.errors.InputError` naming the option (or file, line and key);
-2. **operations** -- frozen, picklable dataclasses (:class:`Scale`, :class:`SetParameter`,
-   :class:`Swap`, :class:`Move`, :class:`Rotate`, :class:`Target`) holding SI values and
-   the spec they came from;
+2. **operations** (:mod:`powertrain.workflows.operations`) -- frozen, picklable
+   dataclasses (:class:`Scale`, :class:`SetParameter`, :class:`Swap`, :class:`Move`,
+   :class:`Rotate`, :class:`Target`) holding SI values and the spec they came from;
 3. **apply** -- :func:`apply_operations` applies a sequence in order; unknown mount,
    direction or parameter names raise :class:`InputError` naming where the spec came from.
 
@@ -63,340 +63,33 @@ supplier delivers with "20 % stiffer, same characteristic".
 
 from __future__ import annotations
 
-import dataclasses
 import math
 import re
-from dataclasses import dataclass
 from pathlib import Path
 
-import numpy as np
-
 from powertrain.errors import InputError
+from powertrain.workflows.operations import (  # noqa: F401 (re-export: the operations' home)
+    WILDCARD,
+    AddEffect,
+    Move,
+    Origin,
+    Rotate,
+    Scale,
+    SetParameter,
+    Swap,
+    Target,
+    Variant,
+    apply_operations,
+    check_operations,
+    effect_scenario,
+    response_scenario,
+    rotation_matrix,
+)
 
 #: Scale kinds and what each scales.
 SCALE_KINDS = {"stiffness": "every spring c_i", "damping": "every damper d_i",
                "dynamic": "every c_i, d_i and m_i (K_CP(omega) times the factor)"}
-WILDCARD = "*"
 _NAME = r"[A-Za-z_][A-Za-z0-9_\-]*"
-
-
-@dataclass(frozen=True)
-class Origin:
-    """Where a spec came from, for error messages.
-
-    Attributes
-    ----------
-    key : str
-        Command-line option (``--scale``) or variants-file key (``variant[2].scale``).
-    file : str or None
-        Variants file.
-    line : int or None
-        1-based line in ``file``.
-    """
-
-    key: str
-    file: str | None = None
-    line: int | None = None
-
-    def error(self, message: str) -> InputError:
-        """An :class:`InputError` located here."""
-        return InputError(message, file=self.file, key=self.key, line=self.line)
-
-
-@dataclass(frozen=True)
-class Scale:
-    """Scale springs, dampers or the whole network of matching mount directions.
-
-    Attributes
-    ----------
-    mount, direction : str
-        Names or ``*``.
-    kind : {"stiffness", "damping", "dynamic"}
-    factor : float
-        > 0 [1].
-    """
-
-    mount: str
-    direction: str
-    kind: str
-    factor: float
-    spec: str = ""
-    origin: Origin = Origin("--scale")
-
-    def apply(self, engine):
-        def change(model):
-            if self.kind == "stiffness":
-                return model.scaled(stiffness=self.factor)
-            if self.kind == "damping":
-                return model.scaled(damping=self.factor)
-            return model.scaled_dynamic_stiffness(self.factor)
-        return _map_directions(engine, self.mount, self.direction, change, self.origin)
-
-
-@dataclass(frozen=True)
-class SetParameter:
-    """Set one parameter of matching mount directions.
-
-    Attributes
-    ----------
-    mount, direction : str
-        Names or ``*``.
-    parameter : str
-        ``c2``, ``d4``, ``m1``...
-    value : float
-        SI value: [N/m], [N·s/m] or [kg].
-    """
-
-    mount: str
-    direction: str
-    parameter: str
-    value: float
-    spec: str = ""
-    origin: Origin = Origin("--set")
-
-    def apply(self, engine):
-        def change(model):
-            if self.parameter not in model.topology.parameters:
-                raise self.origin.error(
-                    f"{self.spec!r}: model {model.topology.name!r} has no parameter "
-                    f"{self.parameter!r} (expected {', '.join(model.topology.parameters)})")
-            return model.with_params(**{self.parameter: self.value})
-        return _map_directions(engine, self.mount, self.direction, change, self.origin)
-
-
-@dataclass(frozen=True)
-class Swap:
-    """Replace one mount direction's model.
-
-    Attributes
-    ----------
-    mount, direction : str
-    model : MountModel
-        The new model (SI).
-    path : str
-        Mount file it was read from (or a description).
-    """
-
-    mount: str
-    direction: str
-    model: object
-    path: str = ""
-    spec: str = ""
-    origin: Origin = Origin("--swap")
-
-    def apply(self, engine):
-        new = _map_directions(engine, self.mount, self.direction, lambda m: self.model,
-                              self.origin)
-        mounts = [dataclasses.replace(m, files={**m.files, self.direction: self.path})
-                  if m.name == self.mount else m for m in new.mounts]
-        return new.replace(mounts=mounts)
-
-
-@dataclass(frozen=True)
-class Move:
-    """Shift matching mount points.
-
-    Attributes
-    ----------
-    mount : str
-        Name or ``*``.
-    offset : tuple of float
-        (dx, dy, dz) in engine axes [m].
-    """
-
-    mount: str
-    offset: tuple
-    spec: str = ""
-    origin: Origin = Origin("--move")
-
-    def apply(self, engine):
-        d = np.asarray(self.offset, float)
-        return _map_mounts(engine, self.mount, lambda m: dataclasses.replace(
-            m, position=np.asarray(m.position, float) + d), self.origin)
-
-
-@dataclass(frozen=True)
-class Rotate:
-    """Rotate matching mounts' local axes about the engine axes through the mount point.
-
-    Attributes
-    ----------
-    mount : str
-        Name or ``*``.
-    angles : tuple of float
-        (ax, ay, az) [rad]: first ax about engine X, then ay about Y, then az about Z.
-    """
-
-    mount: str
-    angles: tuple
-    spec: str = ""
-    origin: Origin = Origin("--rotate")
-
-    def matrix(self) -> np.ndarray:
-        """:math:`R_z(a_z) R_y(a_y) R_x(a_x)` (fixed engine axes)."""
-        return rotation_matrix(*self.angles)
-
-    def apply(self, engine):
-        R = self.matrix()
-        return _map_mounts(engine, self.mount, lambda m: dataclasses.replace(
-            m, rotation=R @ np.asarray(m.rotation, float)), self.origin)
-
-
-@dataclass(frozen=True)
-class Target:
-    """A desired change of a mount direction's K_CP over a band (resolved by fitting, see
-    :func:`powertrain.workflows.retune.retune`; cannot be applied directly).
-
-    Attributes
-    ----------
-    mount, direction : str
-    factor : float
-        Desired K_CP ratio inside the band (1.2 for ``+20%``) [1], > 0.
-    f_lo, f_hi : float
-        Band [Hz], 0 < f_lo < f_hi.
-    blend_octaves : float
-        Width of the smooth transition outside the band [octaves] (default 0.5).
-    """
-
-    mount: str
-    direction: str
-    factor: float
-    f_lo: float
-    f_hi: float
-    blend_octaves: float = 0.5
-    spec: str = ""
-    origin: Origin = Origin("--target")
-
-    def apply(self, engine):
-        raise TypeError("a Target must be resolved by powertrain.workflows.retune.resolve_targets first")
-
-    def check(self, engine) -> None:
-        """Raise :class:`InputError` if the mount or direction is unknown."""
-        _map_directions(engine, self.mount, self.direction, lambda m: m, self.origin)
-
-
-@dataclass(frozen=True)
-class AddEffect:
-    """An unmodelled effect of :data:`powertrain.effects.EFFECTS` with its parameters.
-
-    Engine-model effects are applied by :meth:`apply`; the response-level ones
-    (``amplitude_stiffness``, ``sensor_error``) leave the engine unchanged here and are
-    applied to the run-up by :func:`powertrain.workflows.sweeps.run_task` through
-    :func:`powertrain.workflows.runup.runup_with_effects`.
-
-    Attributes
-    ----------
-    effect : str
-    params : tuple of (name, SI value)
-    """
-
-    effect: str
-    params: tuple = ()
-    spec: str = ""
-    origin: Origin = Origin("--effect")
-
-    @property
-    def scenario(self) -> dict:
-        return {self.effect: dict(self.params)}
-
-    def apply(self, engine):
-        from powertrain.effects import EFFECTS, RESPONSE_EFFECTS
-        if self.effect in RESPONSE_EFFECTS:
-            return engine
-        eff = EFFECTS[self.effect]
-        return eff.apply(engine, **{**eff.defaults(engine), **dict(self.params)})
-
-
-def effect_scenario(operations, names=None) -> dict:
-    """``{effect: {parameter: value}}`` of the :class:`AddEffect` operations, merged in order
-    (only the effects in ``names``, if given)."""
-    sc: dict = {}
-    for op in operations:
-        if isinstance(op, AddEffect) and (names is None or op.effect in names):
-            sc.setdefault(op.effect, {}).update(dict(op.params))
-    return sc
-
-
-def response_scenario(operations) -> dict:
-    """The response-level effects of a variant's operations, merged in order."""
-    from powertrain.effects import RESPONSE_EFFECTS
-    return effect_scenario(operations, RESPONSE_EFFECTS)
-
-
-@dataclass(frozen=True)
-class Variant:
-    """A named sequence of operations applied in order to the baseline engine."""
-
-    name: str
-    operations: tuple = ()
-    origin: Origin | None = None
-
-    @property
-    def specs(self) -> list:
-        return [op.spec for op in self.operations]
-
-    @property
-    def targets(self) -> list:
-        return [op for op in self.operations if isinstance(op, Target)]
-
-
-# --------------------------------------------------------------------------- geometry
-def rotation_matrix(ax: float, ay: float, az: float) -> np.ndarray:
-    """:math:`R_z(a_z) R_y(a_y) R_x(a_x)`: rotations about the fixed X, Y, Z axes [rad]."""
-    cx, sx, cy, sy, cz, sz = (math.cos(ax), math.sin(ax), math.cos(ay), math.sin(ay),
-                              math.cos(az), math.sin(az))
-    rx = np.array([[1, 0, 0], [0, cx, -sx], [0, sx, cx]])
-    ry = np.array([[cy, 0, sy], [0, 1, 0], [-sy, 0, cy]])
-    rz = np.array([[cz, -sz, 0], [sz, cz, 0], [0, 0, 1]])
-    return rz @ ry @ rx
-
-
-# --------------------------------------------------------------------------- apply
-def _map_mounts(engine, mount, change, origin):
-    names = engine.mount_names
-    if mount != WILDCARD and mount not in names:
-        raise origin.error(f"unknown mount {mount!r} (expected {', '.join(names)} or *)")
-    mounts = [change(m) if mount in (WILDCARD, m.name) else m for m in engine.mounts]
-    return engine.replace(mounts=mounts)
-
-
-def _map_directions(engine, mount, direction, change, origin):
-    def per_mount(m):
-        dirs = list(m.directions)
-        if direction != WILDCARD and direction not in dirs:
-            raise origin.error(f"unknown direction {direction!r} of mount {m.name!r} "
-                               f"(expected {', '.join(dirs)} or *)")
-        new = {d: change(model) if direction in (WILDCARD, d) else model
-               for d, model in m.directions.items()}
-        return dataclasses.replace(m, directions=new)
-    return _map_mounts(engine, mount, per_mount, origin)
-
-
-def apply_operations(engine, operations):
-    """Apply operations in order; returns a new Engine (``engine`` is not changed).
-
-    Parameters
-    ----------
-    engine : Engine
-    operations : sequence of operation objects (not :class:`Target`; resolve those first)
-
-    Raises
-    ------
-    InputError
-        Unknown mount, direction or parameter, named with the spec's origin.
-    """
-    for op in operations:
-        engine = op.apply(engine)
-    return engine
-
-
-def check_operations(engine, operations) -> None:
-    """Validate names of every operation against ``engine`` (targets included)."""
-    for op in operations:
-        if isinstance(op, Target):
-            op.check(engine)
-        else:
-            engine = op.apply(engine)
 
 
 # --------------------------------------------------------------------------- parse
@@ -659,20 +352,17 @@ def read_variants(path) -> list:
     """
     from powertrain.iotools.tomlfile import read_toml
     path = str(path)
-    doc = read_toml(path)
-    lines = Path(path).read_text(encoding="utf-8").splitlines()
-    headers = [i for i, ln in enumerate(lines) if re.match(r"^\s*\[\[\s*variant\s*\]\]", ln)]
+    tables = _variant_tables(read_toml(path), path)
+    locate = _block_locator(path)
+    variants, names = [], set()
+    for k, t in enumerate(tables):
+        variants.append(_read_variant(k, t, path, locate, names))
+        names.add(variants[-1].name)
+    return variants
 
-    def locate(k, needle):
-        """1-based line of ``needle`` within the k-th [[variant]] block (or its header)."""
-        if k >= len(headers):
-            return None
-        end = headers[k + 1] if k + 1 < len(headers) else len(lines)
-        for i in range(headers[k], end):
-            if needle and needle in lines[i]:
-                return i + 1
-        return headers[k] + 1
 
+def _variant_tables(doc: dict, path: str) -> list:
+    """The ``[[variant]]`` tables of a variants file (nothing else allowed at the top)."""
     unknown = sorted(set(doc) - {"variant"})
     if unknown:
         raise InputError("unknown key (expected [[variant]] tables)", file=path, key=unknown[0])
@@ -680,38 +370,54 @@ def read_variants(path) -> list:
     if not isinstance(tables, list) or not tables or not all(isinstance(t, dict)
                                                              for t in tables):
         raise InputError("expected one or more [[variant]] tables", file=path, key="variant")
-    variants, names = [], set()
-    for k, t in enumerate(tables):
-        key0 = f"variant[{k + 1}]"
-        bad = sorted(set(t) - set(VARIANTS_FILE_KEYS))
-        if bad:
-            raise InputError(f"unknown key (expected {', '.join(VARIANTS_FILE_KEYS)})",
-                             file=path, line=locate(k, bad[0]), key=f"{key0}.{bad[0]}")
-        name = t.get("name")
-        if not isinstance(name, str) or not name.strip():
-            raise InputError("missing or empty name", file=path, line=locate(k, "name"),
-                             key=f"{key0}.name")
-        if name in names or name == "baseline":
-            raise InputError(f"duplicate or reserved variant name {name!r}", file=path,
-                             line=locate(k, "name"), key=f"{key0}.name")
-        names.add(name)
-        ops = []
-        for kind, parser in PARSERS.items():
-            specs = t.get(kind, [])
-            if isinstance(specs, str):
-                specs = [specs]
-            if not isinstance(specs, list) or not all(isinstance(s, str) for s in specs):
-                raise InputError("expected a list of strings", file=path,
-                                 line=locate(k, kind), key=f"{key0}.{kind}")
-            for text in specs:
-                origin = Origin(f"{key0}.{kind}", file=path, line=locate(k, text))
-                if kind == "swap":
-                    ops.append(parser(text, origin, base=Path(path).parent))
-                else:
-                    ops.append(parser(text, origin))
-        if not ops:
-            raise InputError("variant has no operation", file=path, line=locate(k, ""),
-                             key=key0)
-        variants.append(Variant(name, tuple(ops), Origin(key0, file=path,
-                                                         line=locate(k, ""))))
-    return variants
+    return tables
+
+
+def _block_locator(path: str):
+    """``locate(k, needle)``: 1-based line of ``needle`` within the k-th [[variant]] block
+    (or of its header; None past the last block)."""
+    lines = Path(path).read_text(encoding="utf-8").splitlines()
+    headers = [i for i, ln in enumerate(lines) if re.match(r"^\s*\[\[\s*variant\s*\]\]", ln)]
+
+    def locate(k, needle):
+        if k >= len(headers):
+            return None
+        end = headers[k + 1] if k + 1 < len(headers) else len(lines)
+        for i in range(headers[k], end):
+            if needle and needle in lines[i]:
+                return i + 1
+        return headers[k] + 1
+    return locate
+
+
+def _read_variant(k: int, t: dict, path: str, locate, names: set) -> Variant:
+    """The k-th (0-based) ``[[variant]]`` table; ``names``: the names taken before it."""
+    key0 = f"variant[{k + 1}]"
+    bad = sorted(set(t) - set(VARIANTS_FILE_KEYS))
+    if bad:
+        raise InputError(f"unknown key (expected {', '.join(VARIANTS_FILE_KEYS)})",
+                         file=path, line=locate(k, bad[0]), key=f"{key0}.{bad[0]}")
+    name = t.get("name")
+    if not isinstance(name, str) or not name.strip():
+        raise InputError("missing or empty name", file=path, line=locate(k, "name"),
+                         key=f"{key0}.name")
+    if name in names or name == "baseline":
+        raise InputError(f"duplicate or reserved variant name {name!r}", file=path,
+                         line=locate(k, "name"), key=f"{key0}.name")
+    ops = []
+    for kind, parser in PARSERS.items():
+        specs = t.get(kind, [])
+        if isinstance(specs, str):
+            specs = [specs]
+        if not isinstance(specs, list) or not all(isinstance(s, str) for s in specs):
+            raise InputError("expected a list of strings", file=path,
+                             line=locate(k, kind), key=f"{key0}.{kind}")
+        for text in specs:
+            origin = Origin(f"{key0}.{kind}", file=path, line=locate(k, text))
+            if kind == "swap":
+                ops.append(parser(text, origin, base=Path(path).parent))
+            else:
+                ops.append(parser(text, origin))
+    if not ops:
+        raise InputError("variant has no operation", file=path, line=locate(k, ""), key=key0)
+    return Variant(name, tuple(ops), Origin(key0, file=path, line=locate(k, "")))

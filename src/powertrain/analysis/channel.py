@@ -1,0 +1,88 @@
+"""Where a vibration channel sits: mount (or body point), side and direction.
+
+One value type, one spelling. The label of a channel is ``MOUNT.DIRECTION`` on the engine
+(active) side and ``MOUNT.passive.DIRECTION`` on the body (passive) side, e.g. ``left.z``,
+``left.passive.z``; it names the channels of raw recordings, tracked orders and their files.
+
+Results of a run-up key their curves by a *node* and a direction: the node of a mount's
+engine side is the mount's name (``left``), of its body side ``left/passive`` (the name
+files written by the run-up carry in their ``channels`` and wide CSV columns), a body point
+of interest its own name (``seat_rail``). :meth:`Channel.parse` reads every spelling users'
+files and options contain (``left.z``, ``left.active.z``, ``left.passive.z``,
+``left/passive.z``); :meth:`Channel.of_node` and :attr:`Channel.node` translate to and from
+the node of a result.
+"""
+
+from __future__ import annotations
+
+import re
+from dataclasses import dataclass
+
+SIDES = ("active", "passive")
+DIRECTIONS = ("x", "y", "z")
+#: Suffix of the node of a mount's body side: ``left/passive``.
+PASSIVE = "/passive"
+
+_TEXT = re.compile(r"^\s*([A-Za-z_][\w\-]*)(?:/(passive)|\.(active|passive))?\.([xyzXYZ])\s*$")
+
+
+def passive_name(mount: str) -> str:
+    """Node of the body side of ``mount`` (``left`` -> ``left/passive``)."""
+    return f"{mount}{PASSIVE}"
+
+
+def split_side(name: str):
+    """``("left", "passive")`` for the node ``left/passive``, ``(name, "active")`` otherwise."""
+    if name.endswith(PASSIVE):
+        return name[:-len(PASSIVE)], "passive"
+    return name, "active"
+
+
+@dataclass(frozen=True)
+class Channel:
+    """A measurement direction at a mount side or body point.
+
+    Attributes
+    ----------
+    mount : str
+        Mount (or body point) name.
+    side : str
+        ``active`` (engine side) or ``passive`` (body side).
+    direction : str
+        ``x``, ``y`` or ``z`` (engine axes).
+    """
+
+    mount: str
+    side: str
+    direction: str
+
+    @classmethod
+    def parse(cls, text: str) -> Channel:
+        """Channel of ``left.z``, ``left.active.z``, ``left.passive.z`` or
+        ``left/passive.z``; ValueError for anything else."""
+        m = _TEXT.match(text) if isinstance(text, str) else None
+        if not m:
+            raise ValueError(f"cannot read channel {text!r} (expected MOUNT.DIRECTION or "
+                             "MOUNT.passive.DIRECTION, e.g. left.z, left.passive.z)")
+        mount, slash, side, direction = m.groups()
+        return cls(mount, slash or side or "active", direction.lower())
+
+    @classmethod
+    def of_node(cls, node: str, direction: str) -> Channel:
+        """Channel of a result's ``(node, direction)`` pair (``("left/passive", "z")``)."""
+        mount, side = split_side(node)
+        return cls(mount, side, direction)
+
+    @property
+    def label(self) -> str:
+        """``mount.direction`` (active side) or ``mount.passive.direction``."""
+        mid = "" if self.side == "active" else f".{self.side}"
+        return f"{self.mount}{mid}.{self.direction}"
+
+    @property
+    def node(self) -> str:
+        """Node of a run-up result: ``left``, ``left/passive`` or a body point's name."""
+        return passive_name(self.mount) if self.side == "passive" else self.mount
+
+    def __str__(self) -> str:
+        return self.label
