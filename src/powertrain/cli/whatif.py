@@ -60,7 +60,8 @@ from powertrain.cli.common import (
               help="Compared signal: mount-point velocity or force transmitted to ground.")
 @click.option("--objective", metavar="CHANNEL.DIR:QUANTITY:FROM-TO",
               help="Response to minimise, e.g. seat_rail.z:order_2:1500-3000 (a body point), "
-                   "left/passive.z:synthesis:1000-6000 (body side of a mount) or left.z:...; "
+                   "left.passive.z:synthesis:1000-6000 (body side of a mount; left/passive.z "
+                   "is read too) or left.z:...; "
                    "ranks the variants by the mean change over the band [rpm].")
 @click.option("--workers", type=int, default=None,
               help="Processes for the variants (default: all local cores; 1 = serial).")

@@ -45,6 +45,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from powertrain.analysis.channel import Channel
 from powertrain.analysis.orders import order_label, order_rms, synthesis_rms
 
 QUANTITIES = {
@@ -171,7 +172,7 @@ class RunupResult:
         if self.settings.get("effects"):
             lines.append("effects: " + effects_text(self.settings["effects"]))
         syn = self.synthesis_rms("velocity") * 1e3
-        header = ["rpm"] + [f"{m}.{d}" for m, d in self.channels]
+        header = ["rpm"] + [Channel.of_node(m, d).label for m, d in self.channels]
         rows = [[f"{r:g}"] + [float(v) for v in syn[i]] for i, r in enumerate(self.rpm)]
         lines += ["synthesis RMS velocity (orders 0.5-8) [mm/s]:",
                   format_table(header, rows, "{:.3f}")]

@@ -20,6 +20,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from powertrain.analysis.channel import Channel
+
 #: Quantities reported by default.
 QUANTITIES = ("synthesis", "order_2", "order_4")
 #: Levels below this fraction of the baseline curve's maximum are not compared (both sides).
@@ -141,7 +143,7 @@ class WhatIfResult:
         if self.objective is None:
             return ""
         name, d, q, lo, hi = self.objective
-        lines = [f"objective: minimise {name}.{d} {q} RMS {self.signal.replace('_', ' ')} at "
+        lines = [f"objective: minimise {Channel.of_node(name, d).label} {q} RMS {self.signal.replace('_', ' ')} at "
                  f"{lo:g}-{hi:g} rpm (mean change over the band, best first)"]
         for r in self.objective_changes():
             val = "-" if r["mean_delta_db"] is None else f"{r['mean_delta_db']:+.2f} dB"

@@ -17,6 +17,7 @@ import os
 
 import numpy as np
 
+from powertrain.analysis.channel import Channel
 from powertrain.errors import InputError
 from powertrain.results.whatif import QUANTITIES, VariantRun, WhatIfResult
 
@@ -139,6 +140,8 @@ def parse_objective(text, channels, rpm):
         raise InputError(f"expected {form}, got {text!r}", key="--objective")
     name, d = parts[0].rsplit(".", 1)
     d = d.lower()
+    if (name, d) not in channels:          # left.passive.z spells the node left/passive too
+        name = _node_of(parts[0], name)
     if (name, d) not in channels:
         known = sorted({m for m, _ in channels})
         raise InputError(f"unknown channel {parts[0]!r} (channels: {', '.join(known)}; "
@@ -153,6 +156,15 @@ def parse_objective(text, channels, rpm):
     if not (lo <= hi) or not any(lo - 1e-9 <= r <= hi + 1e-9 for r in rpm):
         raise InputError(f"no speed step in {lo:g}-{hi:g} rpm", key="--objective")
     return (name, d, q, lo, hi)
+
+
+def _node_of(text, name):
+    """The result node of channel ``text`` (``left.passive.z`` -> ``left/passive``), else
+    ``name`` unchanged."""
+    try:
+        return Channel.parse(text).node
+    except ValueError:
+        return name
 
 
 def variant_engine(engine, variant, **fit_kwargs):
