@@ -143,7 +143,8 @@ class WhatIfResult:
         if self.objective is None:
             return ""
         name, d, q, lo, hi = self.objective
-        lines = [f"objective: minimise {Channel.of_node(name, d).label} {q} RMS {self.signal.replace('_', ' ')} at "
+        label = Channel.of_node(name, d).label
+        lines = [f"objective: minimise {label} {q} RMS {self.signal.replace('_', ' ')} at "
                  f"{lo:g}-{hi:g} rpm (mean change over the band, best first)"]
         for r in self.objective_changes():
             val = "-" if r["mean_delta_db"] is None else f"{r['mean_delta_db']:+.2f} dB"
