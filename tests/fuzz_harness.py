@@ -1164,6 +1164,15 @@ def _tacho_with_edges(n: int) -> bytes:
     return ("\n".join(lines[:head + 1] + rows) + "\n").encode()
 
 
+def _mdf_damaged_record_length() -> bytes:
+    """The seed MDF4 with its channel group's invalidation-bytes count (offset 100 of the
+    CG block, MDF 4.1) set to 3.4 GB per record: found by the long campaign (MemoryError)."""
+    b = bytearray(_SEEDS["raw.mf4"])
+    i = b.index(b"##CG") + 100
+    b[i:i + 4] = (0xCDC5D000).to_bytes(4, "little")
+    return bytes(b)
+
+
 def _modal_engine_sub(pattern: str, repl: str, count: int = 0) -> bytes:
     text, n = re.subn(pattern, repl, _read("engines/default-modal-body.toml").decode(),
                       count=count, flags=re.M)
@@ -1228,6 +1237,9 @@ def issue_18_cases() -> dict:
                                                    _track("raw.h5"), ["t.csv"], "raw.h5", ""),
         "MDF4 with zero-length channels": Case({"raw.mf4": mdf_with("zero_length")},
                                                _track("raw.mf4"), ["t.csv"], "raw.mf4", ""),
+        "MDF4 with a damaged record length": Case(
+            {"raw.mf4": _mdf_damaged_record_length()}, _track("raw.mf4"), ["t.csv"],
+            "raw.mf4", ""),
         "UFF truncated at 90 %": Case({"raw.uff": _SEEDS["raw.uff"][
             :int(0.9 * len(_SEEDS["raw.uff"]))]}, _track("raw.uff"), ["t.csv"], "raw.uff", ""),
         "UFF cut after a whole dataset": Case({"raw.uff": _uff_cut_at_dataset(
