@@ -1164,6 +1164,22 @@ def _tacho_with_edges(n: int) -> bytes:
     return ("\n".join(lines[:head + 1] + rows) + "\n").encode()
 
 
+def _mdf_damaged_record_length() -> bytes:
+    """The seed MDF4 with its channel group's invalidation-bytes count (offset 100 of the
+    CG block, MDF 4.1) set to 3.4 GB per record: found by the long campaign (MemoryError)."""
+    b = bytearray(_SEEDS["raw.mf4"])
+    i = b.index(b"##CG") + 100
+    b[i:i + 4] = (0xCDC5D000).to_bytes(4, "little")
+    return bytes(b)
+
+
+def _measured_truncated() -> bytes:
+    """The seed measurement cut inside the gearbox x channel: gearbox channels have no
+    held-out speeds (printed NaN dB, found by the long campaign)."""
+    data = _SEEDS["measured.csv"]
+    return data[:data.index(b"gearbox,x,synthesis,2600")]
+
+
 def _modal_engine_sub(pattern: str, repl: str, count: int = 0) -> bytes:
     text, n = re.subn(pattern, repl, _read("engines/default-modal-body.toml").decode(),
                       count=count, flags=re.M)
@@ -1198,6 +1214,9 @@ def issue_18_cases() -> dict:
         "diagnose on a 1e-300 level --json": Case(
             {"m.csv": _measured_with_level("1e-300")}, ["diagnose", "m.csv", *DIAGNOSE],
             ["d.json"], "m.csv", ""),
+        "diagnose on a measurement cut short": Case(
+            {"m.csv": _measured_truncated()}, ["diagnose", "m.csv", *DIAGNOSE], ["d.json"],
+            "m.csv", ""),
         "track --rpm-step 1e-300": Case({"raw.csv": _SEEDS["raw.csv"]}, _track(
             "raw.csv", "--rpm-step", "1e-300"), ["t.csv"], "--rpm-step", ""),
         "track --rpm-step 1e-9": Case({"raw.csv": _SEEDS["raw.csv"]}, _track(
@@ -1228,6 +1247,9 @@ def issue_18_cases() -> dict:
                                                    _track("raw.h5"), ["t.csv"], "raw.h5", ""),
         "MDF4 with zero-length channels": Case({"raw.mf4": mdf_with("zero_length")},
                                                _track("raw.mf4"), ["t.csv"], "raw.mf4", ""),
+        "MDF4 with a damaged record length": Case(
+            {"raw.mf4": _mdf_damaged_record_length()}, _track("raw.mf4"), ["t.csv"],
+            "raw.mf4", ""),
         "UFF truncated at 90 %": Case({"raw.uff": _SEEDS["raw.uff"][
             :int(0.9 * len(_SEEDS["raw.uff"]))]}, _track("raw.uff"), ["t.csv"], "raw.uff", ""),
         "UFF cut after a whole dataset": Case({"raw.uff": _uff_cut_at_dataset(
@@ -1268,9 +1290,10 @@ def issue_18_cases() -> dict:
             ["o.csv", "o.h5"], "afile", ""),
     }
     out = {name: (case, "clean_error") for name, case in cases.items()}
-    # a level of 1e-300 is a valid (censored) point: a finite diagnosis, no NaN
-    out["diagnose on a 1e-300 level --json"] = (out["diagnose on a 1e-300 level --json"][0],
-                                                "ok")
+    # a level of 1e-300 is a valid (censored) point, a short measurement a valid one too:
+    # a finite diagnosis, no NaN
+    for name in ("diagnose on a 1e-300 level --json", "diagnose on a measurement cut short"):
+        out[name] = (out[name][0], "ok")
     for args in (["--from", "1000", "--to", "1300", "--sweep", "100"],
                  ["--from", "2000", "--to", "2500", "--sweep", "400", "--sample-rate",
                   "16000"]):

@@ -70,6 +70,12 @@ def _which(r) -> list:
     return lines
 
 
+def _db(value) -> str:
+    """A channel's held-out RMS [dB], or "-" where it has no held-out point (a channel
+    measured on part of the speeds only)."""
+    return f"{value:.2f}" if np.isfinite(value) else "-"
+
+
 def summary(r) -> str:
     """The plain-text report: where, which, how far, verdict."""
     b, d = r.baseline, r.data
@@ -78,8 +84,8 @@ def summary(r) -> str:
     after = r.chosen or b
     lines.append(f"  {'mount':>7} {'dir':>3} {'before dB':>9} {'after dB':>8}")
     for c, (m, di) in enumerate(d.channels):
-        lines.append(f"  {m:>7} {di:>3} {b.heldout_channel_rms[c]:>9.2f} "
-                     f"{after.heldout_channel_rms[c]:>8.2f}")
+        lines.append(f"  {m:>7} {di:>3} {_db(b.heldout_channel_rms[c]):>9} "
+                     f"{_db(after.heldout_channel_rms[c]):>8}")
     lines.append(f"  overall {b.heldout_rms_db:.2f} -> {after.heldout_rms_db:.2f} dB RMS")
     if r.budget_hits:
         lines.append(f"  evaluation budget hit by: {', '.join(r.budget_hits)} (best point "

@@ -39,11 +39,12 @@ def read_mdf_signals(path, channel_map=None) -> FileSignals:
         raise InputError(f"not a readable MDF file ({problem})", file=path)
     time, signals, times = None, [], {}
     try:
+        _check_declared_size(mdf, path)
         for g, group in enumerate(mdf.groups):
             for c in range(len(group.channels)):
                 if mdf.masters_db.get(g) == c:          # the group's time channel
                     continue
-                sig = mdf.get(group=g, index=c)
+                sig = _channel(mdf, g, c, path)
                 t = np.asarray(sig.timestamps, float)
                 if t.size < 2 or np.size(sig.samples) != t.size:
                     raise InputError(f"channel has {np.size(sig.samples)} samples at "
@@ -63,6 +64,33 @@ def read_mdf_signals(path, channel_map=None) -> FileSignals:
     if time is None:
         raise InputError("no channel in the MDF file", file=path)
     return FileSignals(time, signals, str(path), "master time", times=times)
+
+
+#: Most bytes of samples the groups of one MDF file may declare (checked before reading: a
+#: damaged record length can declare gigabytes).
+MAX_SAMPLE_BYTES = 2 ** 30
+
+
+def _check_declared_size(mdf, path) -> None:
+    total = 0
+    for g, group in enumerate(mdf.groups):
+        cg = group.channel_group
+        record = int(getattr(cg, "samples_byte_nr", 0)) + \
+            int(getattr(cg, "invalidation_bytes_nr", 0))
+        total += int(getattr(cg, "cycles_nr", 0)) * record
+        if total > MAX_SAMPLE_BYTES:
+            raise InputError(f"channel group {g + 1} declares {total:.3g} bytes of samples; "
+                             f"at most {MAX_SAMPLE_BYTES} in a file (damaged?)", file=path)
+
+
+def _channel(mdf, g, c, path):
+    """Channel ``c`` of group ``g``; a damaged block is an error naming the channel."""
+    try:
+        return mdf.get(group=g, index=c)
+    except Exception as exc:       # asammdf raises many types on damaged blocks
+        name = mdf.groups[g].channels[c].name
+        raise InputError(f"cannot read the channel's samples ({type(exc).__name__}: "
+                         f"{str(exc)[:60]}): damaged file?", file=path, key=name) from None
 
 
 def _quiet_collect():
