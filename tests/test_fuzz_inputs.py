@@ -13,7 +13,8 @@ result; never a traceback, a hang, NaN/inf in an output, a leftover file, or a l
 Examples per kind are bounded here (``FUZZ_EXAMPLES``, default 4) to keep CI short;
 ``python scripts/fuzz_inputs.py`` runs the long campaign and prints the counts.
 Every failure issues 10 and 18 list is also replayed by name, and data safety is checked
-once each: concurrent runs to one path, a SIGKILL mid-write.
+once each: concurrent runs to one path, a SIGKILL mid-write (these three in the slow lane:
+about 40 s together).
 """
 
 from __future__ import annotations
@@ -41,6 +42,7 @@ def issue_18(worker):
     return fh.issue_18_cases()
 
 
+@pytest.mark.slow
 def test_issue_18_root_causes(worker, issue_18, tmp_path):
     """Each root cause issue 18 lists gives a clean one-line error (or runs, for the short
     sweeps), and no earlier file is lost."""
@@ -52,11 +54,13 @@ def test_issue_18_root_causes(worker, issue_18, tmp_path):
     assert not wrong, "\n".join(wrong)
 
 
+@pytest.mark.slow
 def test_concurrent_runs_leave_one_complete_set(worker, tmp_path):
     outcome, detail = fh.concurrent_runs(tmp_path / "c")
     assert outcome == "ok", detail
 
 
+@pytest.mark.slow
 def test_sigkill_mid_write_leaves_no_temporary_file_after_the_next_run(worker, tmp_path):
     outcome, detail = fh.killed_run(tmp_path / "k", delay=2.5)
     assert outcome == "ok", detail

@@ -205,7 +205,8 @@ def sweep_steps(rpm_from, rpm_to, rate, sample_rate) -> tuple[int, int]:
     """(internal steps per output sample, internal steps) of a sweep, bounded before any
     work: at least :data:`MIN_SWEEP_SAMPLES` output samples, at most
     :data:`MAX_SWEEP_SAMPLES` output samples and :data:`MAX_SWEEP_STEPS` internal steps."""
-    m = max(1, math.ceil(6.0 * rpm_to * STEPS_PER_DEGREE / sample_rate))
+    rpm_from, rpm_to, rate = float(rpm_from), float(rpm_to), float(rate)   # no NumPy scalars:
+    m = max(1, math.ceil(6.0 * rpm_to * STEPS_PER_DEGREE / sample_rate))  # inf, not a warning
     duration = (rpm_to - rpm_from) / rate
     n_out = duration * sample_rate
     if not n_out >= MIN_SWEEP_SAMPLES:
