@@ -12,6 +12,7 @@ from powertrain.cli.common import (
     speed_steps,
     write_json,
 )
+from powertrain.results.runup import RIGID_BODY_MODES_LABEL
 
 
 @main.command()
@@ -183,7 +184,7 @@ def whatif(engine_file, rpm_from, rpm_to, rpm_step, solver, scale, set_, swap, m
     modes = ", ".join(f"{f:.2f}" for f in result.baseline.rigid_body_modes_hz)
     click.echo(f"baseline: {engine.name} ({engine.file}), solver {solver}, "
                f"{rpm[0]:g}-{rpm[-1]:g} rpm step {rpm_step:g}")
-    click.echo(f"baseline rigid-body modes [Hz]: {modes}")
+    click.echo(f"baseline {RIGID_BODY_MODES_LABEL}: {modes}")
     for tf in result.target_fits:
         click.echo(tf.summary())
     click.echo(f"change of RMS {signal.replace('_', ' ')} vs baseline, 20 log10(v/v0) [dB]: "

@@ -23,6 +23,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from powertrain.results.runup import RIGID_BODY_MODES_LABEL
+
 #: Quantities reported by default.
 QUANTITIES = ("synthesis", "order_2", "order_4")
 #: Levels below this fraction of the baseline curve's maximum are not compared (both sides).
@@ -217,7 +219,7 @@ class WhatIfResult:
             header = ["channel"] + [f"{q} mean/max|d| [dB]" for q in self.quantities]
             modes = ", ".join(f"{f:.2f}" for f in v.result.rigid_body_modes_hz)
             blocks.append(f"variant {v.name!r} ({'; '.join(v.specs)}) vs baseline\n"
-                          f"rigid-body modes [Hz]: {modes}\n"
+                          f"{RIGID_BODY_MODES_LABEL}: {modes}\n"
                           + _format_table(header, list(rows.values())))
         return "\n\n".join(blocks)
 
