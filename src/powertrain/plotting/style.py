@@ -20,6 +20,9 @@ SIGNAL_UNITS = {"velocity": (1e3, "mm/s"), "displacement": (1e6, "µm"),
 #: Intended print width of every figure [in]: the text width of an A4 report page, 16 cm.
 #: Figures are drawn at this width, so a font size in points is the printed size.
 PRINT_WIDTH_IN = 16 / 2.54
+#: Tallest figure [in]: the text height of an A4 page (29.7 cm less 2.5 cm margins, 24.7 cm)
+#: less room for a three-line caption, 22 cm. Grids with many rows are compacted to fit it.
+MAX_HEIGHT_IN = 22 / 2.54
 #: Smallest printed text [pt] (titles, labels, ticks, legends, provenance line).
 MIN_PRINT_PT = 8.0
 #: Resolution of saved PNGs [dots per inch]: 300 dpi at 16 cm is about 1900 px wide.
@@ -129,9 +132,31 @@ def finish(fig, own, path=None, provenance=None, title=None):
             fig.suptitle(text, fontsize=9)
     if own:
         add_provenance(fig, provenance)
+        keep_inside(fig)
     if path:
         save_figure(fig, path)
     return fig
+
+
+def keep_inside(fig, tries=3):
+    """Shrink the constrained-layout area of a top-level figure by as much as any text
+    (a tick label or a panel title wider than its panel in the last column) overhangs the
+    figure's edges: constrained layout keeps such overhangs inside the figure only when its
+    area is the whole figure, not with the provenance strip or a ``supylabel``."""
+    engine = fig.get_layout_engine()
+    if engine is None or "rect" not in engine.get():
+        return
+    for _ in range(tries):
+        fig.canvas.draw()       # the layout is computed at drawing time
+        width, height = fig.get_figwidth(), fig.get_figheight()
+        box = fig.get_tightbbox(fig.canvas.get_renderer())   # [in]
+        over = np.array([-box.x0, -box.y0, box.x1 - width, box.y1 - height])
+        over = np.maximum(over, 0) + np.where(over > 0, 1 / 72, 0)   # 1 pt clear of the edge
+        if not over.any():
+            return
+        x0, y0, w, h = engine.get()["rect"]
+        engine.set(rect=(x0 + over[0] / width, y0 + over[1] / height,
+                         w - (over[0] + over[2]) / width, h - (over[1] + over[3]) / height))
 
 
 # ------------------------------------------------------------------ text
@@ -175,9 +200,10 @@ def quantity_label(quantity: str) -> str:
     return quantity.replace("order_", "order ")
 
 
-def no_data(ax, text="no data above the noise floor"):
-    """Label an empty panel in its centre (and drop its y tick labels)."""
-    ax.text(0.5, 0.5, "\n".join(textwrap.wrap(text, 42)), transform=ax.transAxes,
+def no_data(ax, text="no data above the noise floor", width=42):
+    """Label an empty panel in its centre, wrapped to lines of ``width`` characters (and drop
+    its y tick labels)."""
+    ax.text(0.5, 0.5, "\n".join(textwrap.wrap(text, width)), transform=ax.transAxes,
             ha="center", va="center", fontsize=LABEL_SIZE, color="0.4")
     ax.tick_params(axis="y", labelleft=False)
 
