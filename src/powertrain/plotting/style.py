@@ -217,9 +217,10 @@ def _plain(value, _pos=None) -> str:
     return np.format_float_positional(float(f"{value:.6g}"), trim="-")
 
 
-def _log_ticks(vmin, vmax, max_ticks):
+def _log_ticks(vmin, vmax, max_ticks, min_gap=0.0):
     """Ticks of a log axis inside [vmin, vmax]: 1-2-5 per decade, thinned to 1-3 or 1 (or
-    every n-th decade) when more than ``max_ticks``, refined to 1..9 when fewer than two."""
+    every n-th decade) when more than ``max_ticks`` or when two would be closer than
+    ``min_gap`` decades, refined to 1..9 when fewer than two."""
     if vmin > vmax:
         vmin, vmax = vmax, vmin
     if not (vmax > 0 and math.isfinite(vmax)):
@@ -234,16 +235,27 @@ def _log_ticks(vmin, vmax, max_ticks):
     candidates = [inside(s) for s in ((1, 2, 5), (1, 3), (1,))]
     candidates += [inside((1,), n) for n in range(2, 12)]
     for ticks in candidates:
-        if len(ticks) <= max_ticks:
+        gaps = np.diff(np.log10(ticks)) if len(ticks) > 1 else [np.inf]
+        if len(ticks) <= max_ticks and min(gaps) >= min_gap:
             break
     if len(ticks) >= 2:
         return np.array(ticks)
-    fine = inside(range(1, 10))
+    fine = _spaced(inside(range(1, 10)), min_gap)
     if 2 <= len(fine) <= max_ticks:
         return np.array(fine)
     from matplotlib.ticker import MaxNLocator
     lin = MaxNLocator(nbins=3, steps=[1, 2, 2.5, 5, 10]).tick_values(vmin, vmax)
-    return np.array([v for v in lin if vmin <= v <= vmax and v > 0])
+    return np.array(_spaced([v for v in lin if vmin <= v <= vmax and v > 0], min_gap))
+
+
+def _spaced(ticks, min_gap):
+    """The ascending ``ticks`` thinned so that neighbours are at least ``min_gap`` decades
+    apart (the first kept)."""
+    kept = []
+    for t in ticks:
+        if not kept or math.log10(t / kept[-1]) >= min_gap:
+            kept.append(t)
+    return kept
 
 
 def log_axis(ax, axis="x", max_ticks=8, minor=True):
@@ -266,7 +278,17 @@ def log_axis(ax, axis="x", max_ticks=8, minor=True):
             return self.tick_values(*self.axis.get_view_interval())
 
         def tick_values(self, vmin, vmax):
-            return _log_ticks(vmin, vmax, max_ticks)
+            return _log_ticks(vmin, vmax, max_ticks, self._min_gap(vmin, vmax))
+
+        def _min_gap(self, vmin, vmax):
+            """Decades between two stacked y tick labels (1.4 label heights) on this axes'
+            drawn height; 0 on an x axis (its labels sit side by side)."""
+            if axis != "y" or not (vmin > 0 and vmax > 0):
+                return 0.0
+            a = self.axis.axes
+            height_pt = a.bbox.height * 72 / a.figure.dpi
+            span = abs(math.log10(vmax / vmin))
+            return 1.4 * TICK_SIZE * span / height_pt if height_pt > 0 else 0.0
 
     target = ax.xaxis if axis == "x" else ax.yaxis
     (ax.set_xscale if axis == "x" else ax.set_yscale)("log")
