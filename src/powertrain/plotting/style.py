@@ -240,9 +240,10 @@ def _log_ticks(vmin, vmax, max_ticks, min_gap=0.0):
             break
     if len(ticks) >= 2:
         return np.array(ticks)
-    fine = _spaced(inside(range(1, 10)), min_gap)
-    if 2 <= len(fine) <= max_ticks:
-        return np.array(fine)
+    for subs in ((1, 2, 5), range(1, 10)):   # thinned 1-2-5, then refined to 1..9
+        fine = _spaced(inside(subs), min_gap)
+        if 2 <= len(fine) <= max_ticks:
+            return np.array(fine)
     from matplotlib.ticker import MaxNLocator
     lin = MaxNLocator(nbins=3, steps=[1, 2, 2.5, 5, 10]).tick_values(vmin, vmax)
     return np.array(_spaced([v for v in lin if vmin <= v <= vmax and v > 0], min_gap))
@@ -281,14 +282,15 @@ def log_axis(ax, axis="x", max_ticks=8, minor=True):
             return _log_ticks(vmin, vmax, max_ticks, self._min_gap(vmin, vmax))
 
         def _min_gap(self, vmin, vmax):
-            """Decades between two stacked y tick labels (1.4 label heights) on this axes'
-            drawn height; 0 on an x axis (its labels sit side by side)."""
+            """Decades between two stacked y tick labels (1.25 font sizes: the label's
+            height and a gap) on this axes' drawn height; 0 on an x axis (its labels sit
+            side by side)."""
             if axis != "y" or not (vmin > 0 and vmax > 0):
                 return 0.0
             a = self.axis.axes
             height_pt = a.bbox.height * 72 / a.figure.dpi
             span = abs(math.log10(vmax / vmin))
-            return 1.4 * TICK_SIZE * span / height_pt if height_pt > 0 else 0.0
+            return 1.25 * TICK_SIZE * span / height_pt if height_pt > 0 else 0.0
 
     target = ax.xaxis if axis == "x" else ax.yaxis
     (ax.set_xscale if axis == "x" else ax.set_yscale)("log")
