@@ -55,14 +55,25 @@ def text_problems(fig, tol=TOLERANCE_PX) -> list[str]:
     return check_boxes(drawn_texts(fig), fig.bbox.width, fig.bbox.height, tol)
 
 
+def texts_outside(drawn, width, height, tol=TOLERANCE_PX) -> list[str]:
+    """Recorded (Text, Bbox [px]) whose window extent is not inside the ``width`` x
+    ``height`` px figure (clipped in the PNG: a tick label, title or axis label of the last
+    column running past the right edge)."""
+    return [f"outside the figure: {text.get_text()!r} at ({bb.x0:.0f}, {bb.y0:.0f})-"
+            f"({bb.x1:.0f}, {bb.y1:.0f}) px, figure {width:.0f}x{height:.0f} px"
+            for text, bb in drawn
+            if bb.x0 < -tol or bb.y0 < -tol or bb.x1 > width + tol or bb.y1 > height + tol]
+
+
+def outside_problems(fig) -> list[str]:
+    """:func:`texts_outside` of ``fig`` drawn at its own dpi."""
+    return texts_outside(drawn_texts(fig), fig.bbox.width, fig.bbox.height)
+
+
 def check_boxes(drawn, width, height, tol=TOLERANCE_PX) -> list[str]:
-    """Problems among recorded (Text, Bbox [px]) in a ``width`` x ``height`` px figure."""
-    problems = []
-    for text, bb in drawn:
-        if bb.x0 < -tol or bb.y0 < -tol or bb.x1 > width + tol or bb.y1 > height + tol:
-            problems.append(f"outside the figure: {text.get_text()!r} at "
-                            f"({bb.x0:.0f}, {bb.y0:.0f})-({bb.x1:.0f}, {bb.y1:.0f}) px, "
-                            f"figure {width:.0f}x{height:.0f} px")
+    """Problems among recorded (Text, Bbox [px]) in a ``width`` x ``height`` px figure:
+    :func:`texts_outside`, then every overlapping pair."""
+    problems = texts_outside(drawn, width, height, tol)
     if len(drawn) < 2:
         return problems
     box = np.array([[b.x0, b.y0, b.x1, b.y1] for _, b in drawn])

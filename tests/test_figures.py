@@ -21,6 +21,7 @@ from figure_text import (
     check_boxes,
     legends_over_data,
     off_palette_colours,
+    outside_problems,
     recording_texts,
     small_texts,
     text_problems,
@@ -109,6 +110,67 @@ def test_runup_and_compare_figures(tmp_path, monkeypatch, saved):
     _assert_clean(saved, ["compare.png"], "compare", panel_legends=False)
 
 
+def test_compare_figure_at_the_measured_speeds_fits_a_page(tmp_path, monkeypatch, saved):
+    """The README's figure (simulated at the 50-rpm measured speeds): nothing clipped at the
+    edges (the last column's titles and "6000" once were), and no taller than an A4 page."""
+    import matplotlib.pyplot as plt
+
+    from powertrain.plotting.style import MAX_HEIGHT_IN, PRINT_WIDTH_IN
+    shown = []
+    monkeypatch.setattr(plt, "close", lambda fig=None: shown.append(fig))
+    run(tmp_path, monkeypatch, "compare", MEASURED, "--plot", "compare.png", "--quiet")
+    _assert_clean(saved, ["compare.png"], "compare", panel_legends=False)
+    fig = shown[-1]
+    assert fig.get_figwidth() == pytest.approx(PRINT_WIDTH_IN)
+    assert fig.get_figheight() <= MAX_HEIGHT_IN + 1e-9 < 24.7 / 2.54
+    assert len([a for a in fig.axes if a.get_visible()]) == 9 * 4
+
+
+def _without_orders(measured, cut):
+    """A 'simulation': the measurement itself, with left Z order 4 at 1e-12 m/s above
+    ``cut`` rpm and right X order 6 zero everywhere (the model misses them)."""
+    import copy
+
+    import numpy as np
+    sim = copy.deepcopy(measured)
+    r, v = sim.curves[("left", "z", "order_4")]
+    sim.curves[("left", "z", "order_4")] = (r, np.where(r > cut, 1e-12, v))
+    r, v = sim.curves[("right", "x", "order_6")]
+    sim.curves[("right", "x", "order_6")] = (r, np.zeros_like(v))
+    return sim
+
+
+def test_compare_figure_marks_measured_not_modelled_points():
+    import matplotlib.pyplot as plt
+    import numpy as np
+
+    from powertrain.iotools.measured import read_measured
+    from powertrain.plotting.style import MAX_HEIGHT_IN, OKABE_ITO
+    from powertrain.workflows.comparison import compare_runup
+    meas = read_measured(MEASURED)
+    comp = compare_runup(_without_orders(meas, 4000.0), meas)
+    per_key = {(e["mount"], e["direction"], e["quantity"]): len(e["rpm"])
+               for e in comp.not_modelled}
+    assert set(per_key) == {("left", "z", "order_4"), ("right", "x", "order_6")}
+    fig = comp.plot()
+    fig.canvas.draw()
+    marked = [ln for a in fig.axes for ln in a.get_lines()
+              if ln.get_label() == "measured, not modelled"]
+    assert sorted(len(ln.get_xdata()) for ln in marked) == sorted(per_key.values())
+    assert {ln.get_color() for ln in marked} == {OKABE_ITO["reddish purple"]}
+    legend = [t.get_text() for t in fig.legends[0].get_texts()]
+    assert "measured, not modelled" in legend
+    assert f"noise-floor limit ({comp.exclusion_limit * 1e3:g} mm/s)" in legend
+    title = fig.legends[0].get_title().get_text().replace("\n", " ")
+    assert f"{comp.n_not_modelled} points measured, not modelled" in title
+    # the panel with nothing scored shows its measured curve and marks, not "not compared"
+    assert not any("not compared" in t.get_text() for a in fig.axes for t in a.texts)
+    assert all(np.isfinite(ln.get_ydata()).all() for ln in marked)
+    assert fig.get_figheight() <= MAX_HEIGHT_IN + 1e-9
+    assert not outside_problems(fig), outside_problems(fig)
+    plt.close(fig)
+
+
 def test_runup_body_figures(tmp_path, monkeypatch, saved):
     engine = str(ROOT / "engines" / "default-modal-body.toml")
     run(tmp_path, monkeypatch, "runup", "--engine", engine, "--solver", "harmonic", "--from",
@@ -185,10 +247,12 @@ def test_the_checker_finds_overlap_and_overflow():
     ax.set_title("a title")
     ax.text(0.5, 1.02, "on the title", transform=ax.transAxes, ha="center")
     fig.text(0.9, 0.5, "runs off the right edge")
-    problems = text_problems(fig)
+    problems, outside = text_problems(fig), outside_problems(fig)
     plt.close(fig)
     assert any("overlap" in p and "on the title" in p for p in problems)
     assert any("outside" in p and "right edge" in p for p in problems)
+    assert any("right edge" in p for p in outside)
+    assert not any("overlap" in p or "on the title" in p for p in outside)
 
 
 # --------------------------------------------------------------------------- style helpers
@@ -288,6 +352,7 @@ def test_track_plot_draws_every_requested_order(spec, expected):
     tracked = track_recording(rec, parse_orders(spec), rpm_step=100.0, progress=False)
     fig = tracked.plot()
     fig.canvas.draw()
+    assert not outside_problems(fig), outside_problems(fig)
     assert set(expected + ["synthesis"]) <= _drawn_labels(fig)
     for ax in fig.axes:          # at most the documented dynamic range, plain tick labels
         lo, hi = ax.get_ylim()
@@ -335,6 +400,7 @@ def test_whatif_levels_and_delta_views():
                         progress=False)
     keys = [(m, d, q) for m, d in result.baseline.channels for q in result.quantities]
     fig = result.plot()
+    assert not outside_problems(fig), outside_problems(fig)
     titles = [a.get_title() for a in fig.axes if a.get_visible()]
     text = fig.texts[0].get_text() if not fig.legends else fig.legends[0].get_title().get_text()
     for m, d, q in keys:       # every quantity drawn, or named as unchanged
@@ -345,6 +411,7 @@ def test_whatif_levels_and_delta_views():
         assert drawn or f"{m} {d.upper()}" in text.replace("\n", " ")
     plt.close(fig)
     fig = result.plot(view="delta")
+    assert not outside_problems(fig), outside_problems(fig)
     assert len([a for a in fig.axes if a.get_visible()]) == len(keys)
     assert any(v.name in lab for v in result.variants for lab in _drawn_labels(fig))
     plt.close(fig)

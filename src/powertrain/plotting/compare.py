@@ -10,13 +10,41 @@ from powertrain.plotting.runup import SYNTHESIS_NOTE, grid, label_grid, panel_ti
 from powertrain.plotting.style import (
     GAP_ABOVE,
     GAP_BELOW,
+    LABEL_SIZE,
+    MAX_HEIGHT_IN,
+    OKABE_ITO,
     TICK_SIZE,
     TITLE_SIZE,
     colour,
     figure_legend,
     finish,
+    is_axes,
     no_data,
+    quantity_label,
 )
+
+#: Display factor of the levels: m/s -> mm/s.
+MM = 1e3
+#: Height of one panel row [in]: at most the roomy one, at least what keeps three log ticks
+#: apart at 8 pt; in between, as much as fits :data:`MAX_HEIGHT_IN`.
+ROW_HEIGHT_IN = (0.62, 1.35)
+#: Figure height outside the panel rows [in]: title, legend, x label, provenance line (as
+#: :func:`powertrain.plotting.runup.grid` adds).
+FRAME_HEIGHT_IN = 1.6
+#: Most labelled ticks on a panel's level axis: 1-2-5 per decade would collide at 8 pt on a
+#: compact row; the 1-3 or decade ticks do not.
+MAX_LEVEL_TICKS = 3
+#: Simulated speeds are marked when there are at most this many (a coarse grid, joined by
+#: the lines of the log-level interpolation); a simulation at the measured speeds is a line.
+MAX_MARKED_SPEEDS = 30
+#: Marker of a measured-not-modelled point.
+NOT_MODELLED_STYLE = {"marker": "^", "ls": "none", "ms": 2.5, "mew": 0,
+                      "color": OKABE_ITO["reddish purple"]}
+#: Text of an empty panel per reason it was not compared (the reasons of
+#: :attr:`ComparisonResult.missing`), short enough for a compact panel.
+EMPTY_TEXT = {"not in the measured data": "not measured",
+              "not in the simulation": "not simulated",
+              "no comparable point": "every point below the limit"}
 
 
 def comparison_quantities(comparison) -> list:
@@ -24,18 +52,29 @@ def comparison_quantities(comparison) -> list:
     return comparison.requested_quantities()
 
 
+def row_height(n_rows: int) -> float:
+    """Panel row height [in] that fits ``n_rows`` rows in :data:`MAX_HEIGHT_IN` (within
+    :data:`ROW_HEIGHT_IN`)."""
+    lo, hi = ROW_HEIGHT_IN
+    return float(np.clip((MAX_HEIGHT_IN - FRAME_HEIGHT_IN) / max(n_rows, 1), lo, hi))
+
+
 def plot_comparison(comparison, path=None, quantities=None, *, ax=None, channel=None,
                     quantity=None, provenance=None):
     """Measured and simulated RMS velocity against speed, level gap shaded.
 
-    The thesis's layout (Kovarik 2016, Figs 45-71): one row per mount and direction, one
-    column per quantity (synthesis and every measured order), log-scaled velocity [mm/s].
-    The measured curve is a thin black line, the simulation markers at its speeds joined by
-    straight lines (on the log axis these are exactly the log-level interpolation used for
-    the gaps); the gap at the compared speeds is shaded orange where the simulation is
-    higher, sky blue where it is lower (colour-blind safe). Points excluded at the noise
-    floor are grey crosses, the exclusion limit a dotted line; a panel with no point above
-    it says so. Under each panel title: the RMS gap and bias [dB].
+    The thesis's layout (Kovarik 2016, Figs 45-71): one row per mount and direction (named
+    on the left), one column per quantity (synthesis and every measured order, named on
+    top), log-scaled velocity [mm/s]; the rows are made as tall as fit one A4 page
+    (:func:`row_height`). The measured curve is a thin black line over the blue simulation
+    (marked at its speeds when at most :data:`MAX_MARKED_SPEEDS`, joined by straight lines:
+    on the log axis exactly the log-level interpolation used for the gaps); the gap at the
+    compared speeds is shaded orange where the simulation is higher, sky blue where it is
+    lower (colour-blind safe). Points excluded at the noise floor are grey crosses, the
+    exclusion limit (:attr:`ComparisonResult.exclusion_limit`) a dotted line;
+    measured-not-modelled points (simulation below the floor, measurement above the limit;
+    in no gap) reddish-purple triangles. A panel with nothing compared says so. Panel
+    titles: the RMS gap and bias [dB].
 
     Parameters
     ----------
@@ -49,72 +88,106 @@ def plot_comparison(comparison, path=None, quantities=None, *, ax=None, channel=
     provenance : Provenance, optional
         Foot line of a new figure.
     """
-    from matplotlib.lines import Line2D
-
-    from powertrain.analysis.compare import NOISE_FLOOR_MARGIN
-    sim = comparison.simulated
-    rows = list(sim.channels)
+    rows = list(comparison.simulated.channels)
     rows += [c for c in comparison.measured.channels if c not in rows]
     quantities = list(quantities or comparison_quantities(comparison))
-    fig, panels, own, axes = grid(ax, rows, quantities, channel, quantity, panel_height=1.35)
-    limit = NOISE_FLOOR_MARGIN * comparison.noise_floor * 1e3
+    fig, panels, own, axes = grid(ax, rows, quantities, channel, quantity,
+                                  panel_height=row_height(len(rows)))
+    limit = comparison.exclusion_limit * MM
     compared = {(c.mount, c.direction, c.quantity): c for c in comparison.channels}
+    unmodelled = {(e["mount"], e["direction"], e["quantity"]): e
+                  for e in comparison.not_modelled}
     missing = {(m["mount"], m["direction"], m["quantity"]): m["reason"]
                for m in comparison.missing}
+    margin_titles = not is_axes(ax)
     for key, a in panels.items():
-        c = compared.get(key)
-        if c is None or not c.scored.any():
-            a.set_title(panel_title(*key), fontsize=TITLE_SIZE)
-            no_data(a, "not compared: " + missing.get(key, "every measured point at the "
-                                                          "noise floor"))
-            a.tick_params(labelsize=TICK_SIZE)
-            continue
-        _panel(a, key, comparison, c, limit)
+        head = _head(key, rows[0], margin_titles)
+        if key in compared or key in unmodelled:
+            _panel(a, key, comparison, compared.get(key), unmodelled.get(key), limit, head)
+        else:
+            _empty_panel(a, head, missing.get(key, "no comparable point"))
+    if margin_titles:
+        from matplotlib.ticker import MaxNLocator
+        axes[0, 0].xaxis.set_major_locator(MaxNLocator(nbins=3, steps=[1, 2, 5, 10]))
+        for r, (mount, direction) in enumerate(rows):
+            axes[r, 0].set_ylabel(f"{mount} {direction.upper()}", fontsize=LABEL_SIZE)
     label_grid(fig, axes, "RMS velocity [mm/s]")
     if own:
-        extra = [(Line2D([], [], color="0.5", ls=":", lw=0.8),
-                  f"noise-floor limit ({limit:g} mm/s)")] if limit > 0 else []
-        figure_legend(fig, axes, extra)
+        _legend(fig, axes, limit)
+    return finish(fig, own, path, provenance, title=_title(comparison) if own else None)
+
+
+def _head(key, top_channel, margin_titles) -> str:
+    """First title line of a panel: the full ``left Z · order 2`` for a single panel; in a
+    grid the quantity on the top row (the channel is the row's y label), else nothing."""
+    if not margin_titles:
+        return panel_title(*key)
+    return quantity_label(key[2]) if tuple(key[:2]) == tuple(top_channel) else ""
+
+
+def _empty_panel(a, head, reason):
+    a.set_title(head, fontsize=TITLE_SIZE)
+    short = next((t for r, t in EMPTY_TEXT.items() if reason.startswith(r)), reason)
+    no_data(a, "not compared: " + short, width=16)
+    a.tick_params(labelsize=TICK_SIZE)
+
+
+def _legend(fig, axes, limit):
+    from matplotlib.lines import Line2D
+    extra = [(Line2D([], [], color="0.5", ls=":", lw=0.8),
+              f"noise-floor limit ({limit:g} mm/s)")] if limit > 0 else []
+    figure_legend(fig, axes, extra)
+
+
+def _title(comparison) -> str:
     src = Path(comparison.measured.source).name
     tag = "SYNTHETIC measurement" if comparison.measured.synthetic else "measurement"
-    title = (f"{tag} {src} vs simulation: overall RMS gap {comparison.overall_rms_db:.2f} dB "
-             f"(gap = 20 log10(sim/measured); under each panel title its RMS and bias "
-             f"[dB]){SYNTHESIS_NOTE}")
-    return finish(fig, own, path, provenance, title=title if own else None)
+    n = comparison.n_not_modelled
+    unmodelled = (f"; {n} points measured, not modelled (simulation below the "
+                  f"{comparison.noise_floor * MM:g} mm/s floor; in no gap)") if n else ""
+    return (f"{tag} {src} vs simulation: overall RMS gap {comparison.overall_rms_db:.2f} dB"
+            f"{unmodelled} (gap = 20 log10(sim/measured); over each panel its RMS and bias "
+            f"[dB]){SYNTHESIS_NOTE}")
 
 
-def _panel(ax, key, comparison, c, limit):
-    """One compared channel-quantity: curves, shaded gap, excluded points, title with the
-    gap."""
-    mm = 1e3
-    mount, direction, q = key
-    values = []
-    if key in comparison.measured.curves:
-        rm, vm = comparison.measured.curves[key]
-        ok = vm > 0
-        ax.plot(rm[ok], vm[ok] * mm, "-", color="k", lw=0.9, label="measured")
-        values.append(vm[ok] * mm)
-    if key in comparison.simulated.curves:
-        rs, vs = comparison.simulated.curves[key]
-        ok = vs > 0
-        ax.plot(rs[ok], vs[ok] * mm, "o-", color=colour(0), ms=2, lw=1.0, label="simulated")
-        values.append(vs[ok] * mm)
-    title = panel_title(mount, direction, q)
-    if c.scored.any():
-        s = np.where(c.scored, c.simulated, np.nan) * mm
-        m = np.where(c.scored, c.measured, np.nan) * mm
+def _panel(ax, key, comparison, c, unmodelled, limit, head):
+    """One channel-quantity: curves, shaded gap, excluded and measured-not-modelled points,
+    title with the gap."""
+    sparse = len(comparison.sim_rpm) <= MAX_MARKED_SPEEDS
+    values = [_curve(ax, comparison.measured.curves, key, "-", color="k", lw=0.7,
+                     label="measured", zorder=3),
+              _curve(ax, comparison.simulated.curves, key, "o-" if sparse else "-",
+                     color=colour(0), ms=2, lw=1.2, label="simulated")]
+    title = head
+    if c is not None and c.scored.any():
+        s = np.where(c.scored, c.simulated, np.nan) * MM
+        m = np.where(c.scored, c.measured, np.nan) * MM
         ax.fill_between(c.rpm, m, s, where=c.scored & (s >= m), interpolate=True,
                         color=GAP_ABOVE, alpha=0.45, lw=0, label="sim > measured")
         ax.fill_between(c.rpm, m, s, where=c.scored & (s < m), interpolate=True,
                         color=GAP_BELOW, alpha=0.45, lw=0, label="sim < measured")
-        title += f"\n{c.stats['rms_db']:.1f} rms, {c.stats['bias_db']:+.1f} bias"
-    if c.at_floor.any():
-        ax.plot(c.rpm[c.at_floor], np.maximum(c.measured[c.at_floor] * mm, limit * 0.5), "x",
+        title += ("\n" if title else "") + \
+            f"{c.stats['rms_db']:.1f} rms, {c.stats['bias_db']:+.1f} bias"
+    if c is not None and c.at_floor.any():
+        ax.plot(c.rpm[c.at_floor], np.maximum(c.measured[c.at_floor] * MM, limit * 0.5), "x",
                 color="0.55", ms=3, label="excluded (noise floor)")
-    values = np.concatenate(values) if values else np.array([])
-    if style_panel(ax, title, values) and limit > 0:
+    if unmodelled is not None:
+        ax.plot(unmodelled["rpm"], np.asarray(unmodelled["measured_m_per_s"], float) * MM,
+                label="measured, not modelled", **NOT_MODELLED_STYLE)
+    values = np.concatenate(values)
+    if style_panel(ax, title, values, max_ticks=MAX_LEVEL_TICKS) and limit > 0:
         lo, hi = ax.get_ylim()
         if limit / 2 < hi and lo < limit:
             ax.set_ylim(max(lo, limit / 2), hi)
         if lo < limit < hi:
             ax.axhline(limit, color="0.5", ls=":", lw=0.8)
+
+
+def _curve(ax, curves, key, fmt, **style):
+    """Draw the positive part of one curve [mm/s]; its drawn levels (empty if absent)."""
+    if key not in curves:
+        return np.array([])
+    rpm, level = curves[key]
+    ok = level > 0
+    ax.plot(rpm[ok], level[ok] * MM, fmt, **style)
+    return level[ok] * MM

@@ -66,10 +66,11 @@ def label_grid(fig, axes, ylabel):
     fig.supylabel(ylabel, fontsize=LABEL_SIZE + 0.5)
 
 
-def style_panel(ax, title, values, dynamic_range_db=None):
-    """Title, log y axis with plain-number ticks and limits spanning at least a factor 4;
-    with ``dynamic_range_db`` the axis reaches at most that far below the largest value
-    (numerical noise far below does not stretch it). False when there is nothing to show."""
+def style_panel(ax, title, values, dynamic_range_db=None, max_ticks=4):
+    """Title, log y axis with at most ``max_ticks`` plain-number ticks and limits spanning at
+    least a factor 4; with ``dynamic_range_db`` the axis reaches at most that far below the
+    largest value (numerical noise far below does not stretch it). False when there is
+    nothing to show."""
     ax.set_title(title, fontsize=TITLE_SIZE)
     ax.grid(True, which="major", alpha=0.35)
     ax.tick_params(which="both", labelsize=TICK_SIZE)
@@ -83,7 +84,7 @@ def style_panel(ax, title, values, dynamic_range_db=None):
     if hi / lo < 4:
         mid = np.sqrt(lo * hi)
         lo, hi = mid / 2, mid * 2
-    log_axis(ax, "y", max_ticks=4, minor=False)
+    log_axis(ax, "y", max_ticks=max_ticks, minor=False)
     ax.set_ylim(lo, hi)
     return True
 

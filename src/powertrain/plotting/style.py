@@ -20,6 +20,9 @@ SIGNAL_UNITS = {"velocity": (1e3, "mm/s"), "displacement": (1e6, "µm"),
 #: Intended print width of every figure [in]: the text width of an A4 report page, 16 cm.
 #: Figures are drawn at this width, so a font size in points is the printed size.
 PRINT_WIDTH_IN = 16 / 2.54
+#: Tallest figure [in]: the text height of an A4 page (29.7 cm less 2.5 cm margins, 24.7 cm)
+#: less room for a three-line caption, 22 cm. Grids with many rows are compacted to fit it.
+MAX_HEIGHT_IN = 22 / 2.54
 #: Smallest printed text [pt] (titles, labels, ticks, legends, provenance line).
 MIN_PRINT_PT = 8.0
 #: Resolution of saved PNGs [dots per inch]: 300 dpi at 16 cm is about 1900 px wide.
@@ -129,9 +132,31 @@ def finish(fig, own, path=None, provenance=None, title=None):
             fig.suptitle(text, fontsize=9)
     if own:
         add_provenance(fig, provenance)
+        keep_inside(fig)
     if path:
         save_figure(fig, path)
     return fig
+
+
+def keep_inside(fig, tries=3):
+    """Shrink the constrained-layout area of a top-level figure by as much as any text
+    (a tick label or a panel title wider than its panel in the last column) overhangs the
+    figure's edges: constrained layout keeps such overhangs inside the figure only when its
+    area is the whole figure, not with the provenance strip or a ``supylabel``."""
+    engine = fig.get_layout_engine()
+    if engine is None or "rect" not in engine.get():
+        return
+    for _ in range(tries):
+        fig.canvas.draw()       # the layout is computed at drawing time
+        width, height = fig.get_figwidth(), fig.get_figheight()
+        box = fig.get_tightbbox(fig.canvas.get_renderer())   # [in]
+        over = np.array([-box.x0, -box.y0, box.x1 - width, box.y1 - height])
+        over = np.maximum(over, 0) + np.where(over > 0, 1 / 72, 0)   # 1 pt clear of the edge
+        if not over.any():
+            return
+        x0, y0, w, h = engine.get()["rect"]
+        engine.set(rect=(x0 + over[0] / width, y0 + over[1] / height,
+                         w - (over[0] + over[2]) / width, h - (over[1] + over[3]) / height))
 
 
 # ------------------------------------------------------------------ text
@@ -175,9 +200,10 @@ def quantity_label(quantity: str) -> str:
     return quantity.replace("order_", "order ")
 
 
-def no_data(ax, text="no data above the noise floor"):
-    """Label an empty panel in its centre (and drop its y tick labels)."""
-    ax.text(0.5, 0.5, "\n".join(textwrap.wrap(text, 42)), transform=ax.transAxes,
+def no_data(ax, text="no data above the noise floor", width=42):
+    """Label an empty panel in its centre, wrapped to lines of ``width`` characters (and drop
+    its y tick labels)."""
+    ax.text(0.5, 0.5, "\n".join(textwrap.wrap(text, width)), transform=ax.transAxes,
             ha="center", va="center", fontsize=LABEL_SIZE, color="0.4")
     ax.tick_params(axis="y", labelleft=False)
 
@@ -191,9 +217,10 @@ def _plain(value, _pos=None) -> str:
     return np.format_float_positional(float(f"{value:.6g}"), trim="-")
 
 
-def _log_ticks(vmin, vmax, max_ticks):
+def _log_ticks(vmin, vmax, max_ticks, min_gap=0.0):
     """Ticks of a log axis inside [vmin, vmax]: 1-2-5 per decade, thinned to 1-3 or 1 (or
-    every n-th decade) when more than ``max_ticks``, refined to 1..9 when fewer than two."""
+    every n-th decade) when more than ``max_ticks`` or when two would be closer than
+    ``min_gap`` decades, refined to 1..9 when fewer than two."""
     if vmin > vmax:
         vmin, vmax = vmax, vmin
     if not (vmax > 0 and math.isfinite(vmax)):
@@ -208,16 +235,28 @@ def _log_ticks(vmin, vmax, max_ticks):
     candidates = [inside(s) for s in ((1, 2, 5), (1, 3), (1,))]
     candidates += [inside((1,), n) for n in range(2, 12)]
     for ticks in candidates:
-        if len(ticks) <= max_ticks:
+        gaps = np.diff(np.log10(ticks)) if len(ticks) > 1 else [np.inf]
+        if len(ticks) <= max_ticks and min(gaps) >= min_gap:
             break
     if len(ticks) >= 2:
         return np.array(ticks)
-    fine = inside(range(1, 10))
-    if 2 <= len(fine) <= max_ticks:
-        return np.array(fine)
+    for subs in ((1, 2, 5), range(1, 10)):   # thinned 1-2-5, then refined to 1..9
+        fine = _spaced(inside(subs), min_gap)
+        if 2 <= len(fine) <= max_ticks:
+            return np.array(fine)
     from matplotlib.ticker import MaxNLocator
     lin = MaxNLocator(nbins=3, steps=[1, 2, 2.5, 5, 10]).tick_values(vmin, vmax)
-    return np.array([v for v in lin if vmin <= v <= vmax and v > 0])
+    return np.array(_spaced([v for v in lin if vmin <= v <= vmax and v > 0], min_gap))
+
+
+def _spaced(ticks, min_gap):
+    """The ascending ``ticks`` thinned so that neighbours are at least ``min_gap`` decades
+    apart (the first kept)."""
+    kept = []
+    for t in ticks:
+        if not kept or math.log10(t / kept[-1]) >= min_gap:
+            kept.append(t)
+    return kept
 
 
 def log_axis(ax, axis="x", max_ticks=8, minor=True):
@@ -240,7 +279,18 @@ def log_axis(ax, axis="x", max_ticks=8, minor=True):
             return self.tick_values(*self.axis.get_view_interval())
 
         def tick_values(self, vmin, vmax):
-            return _log_ticks(vmin, vmax, max_ticks)
+            return _log_ticks(vmin, vmax, max_ticks, self._min_gap(vmin, vmax))
+
+        def _min_gap(self, vmin, vmax):
+            """Decades between two stacked y tick labels (1.25 font sizes: the label's
+            height and a gap) on this axes' drawn height; 0 on an x axis (its labels sit
+            side by side)."""
+            if axis != "y" or not (vmin > 0 and vmax > 0):
+                return 0.0
+            a = self.axis.axes
+            height_pt = a.bbox.height * 72 / a.figure.dpi
+            span = abs(math.log10(vmax / vmin))
+            return 1.25 * TICK_SIZE * span / height_pt if height_pt > 0 else 0.0
 
     target = ax.xaxis if axis == "x" else ax.yaxis
     (ax.set_xscale if axis == "x" else ax.set_yscale)("log")

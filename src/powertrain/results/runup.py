@@ -54,6 +54,8 @@ QUANTITIES = {
     "acceleration": "m/s^2",
     "mount_force": "N",
 }
+#: What the run-up's rigid-body mode frequencies are (printed by ``runup`` and ``whatif``).
+RIGID_BODY_MODES_LABEL = "rigid-body modes, undamped, mounts at their static stiffness [Hz]"
 #: Columns written by :meth:`RunupResult.csv_text` (files with only the first five stay valid).
 CSV_HEADER = ("mount,direction,quantity,rpm,side,velocity_rms_mm_per_s,"
               "acceleration_rms_m_per_s2,force_rms_n")
@@ -166,9 +168,8 @@ class RunupResult:
         from powertrain.analysis.text_table import format_table
         name, file = self.meta.get("engine", ""), self.meta.get("engine_file", "")
         lines = [f"engine: {name} ({file})" if file else f"engine: {name}",
-                 "rigid-body modes, undamped, mounts at their static stiffness [Hz]: "
-                 f"{self._labelled_modes()} (damped, at the mounts' dynamic stiffness: "
-                 "'powertrain modes')"]
+                 f"{RIGID_BODY_MODES_LABEL}: {self._labelled_modes()} (damped, at the "
+                 "mounts' dynamic stiffness: 'powertrain modes')"]
         if self.settings.get("effects"):
             lines.append("effects: " + effects_text(self.settings["effects"]))
         syn = self.synthesis_rms("velocity") * 1e3
