@@ -67,3 +67,53 @@ def test_ignored_imports_only_shrink():
     """The layers contract may list known upward imports only while they are being removed;
     the list must not grow."""
     assert len(_contracts()["layers"].get("ignore_imports", [])) <= 5
+
+
+def _cycles(graph) -> list[list[str]]:
+    """Strongly connected groups of more than one module in the direct-import graph."""
+    index, low, stack, on, found = {}, {}, [], set(), []
+
+    def visit(v):
+        index[v] = low[v] = len(index)
+        stack.append(v)
+        on.add(v)
+        for w in graph.find_modules_directly_imported_by(v):
+            if w not in index:
+                visit(w)
+                low[v] = min(low[v], low[w])
+            elif w in on:
+                low[v] = min(low[v], index[w])
+        if low[v] == index[v]:
+            group = []
+            while True:
+                w = stack.pop()
+                on.discard(w)
+                group.append(w)
+                if w == v:
+                    break
+            if len(group) > 1:
+                found.append(sorted(group))
+
+    for module in sorted(graph.modules):
+        if module not in index:
+            visit(module)
+    return found
+
+
+def test_no_import_cycle_between_modules():
+    """Issue 19: no cycle anywhere in the package (e.g. the raw readers and their entry point,
+    the command group and its commands)."""
+    grimp = pytest.importorskip("grimp")
+    sys.setrecursionlimit(max(sys.getrecursionlimit(), 10_000))
+    assert _cycles(grimp.build_graph("powertrain")) == []
+
+
+def test_the_cycle_finder_finds_a_cycle():
+    class Graph:
+        modules = {"a", "b", "c"}
+
+        @staticmethod
+        def find_modules_directly_imported_by(m):
+            return {"a": {"b"}, "b": {"a"}, "c": set()}[m]
+
+    assert _cycles(Graph()) == [["a", "b"]]

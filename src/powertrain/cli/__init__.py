@@ -6,56 +6,9 @@ Exit codes: 0 success, 1 bad input (one line on stderr naming file and key), 2 u
 
 from __future__ import annotations
 
-import sys
+from powertrain.cli.group import main
 
-import click
-
-from powertrain import __version__
-
-
-class _Group(click.Group):
-    """Turns :class:`powertrain.errors.InputError` into one line on stderr and exit code 1.
-
-    Every command runs inside one :class:`~powertrain.outputs.OutputTransaction`:
-    its output files are staged and replace the targets together only when the command
-    succeeds; a failed command changes no file (docs/reference/outputs.md).
-    """
-
-    def main(self, args=None, *posargs, **kwargs):
-        from powertrain import provenance
-        provenance.COMMAND_LINE[:] = ["powertrain",
-                                      *(sys.argv[1:] if args is None else list(args))]
-        return super().main(args, *posargs, **kwargs)
-
-    def invoke(self, ctx):
-        from powertrain.cli.common import terminate_as_exit
-        from powertrain.errors import InputError
-        from powertrain.outputs import OutputTransaction
-        try:
-            with terminate_as_exit(), OutputTransaction():
-                return super().invoke(ctx)
-        except InputError as exc:
-            click.echo(f"error: {exc.one_line()}", err=True)
-            sys.exit(1)
-
-
-@click.group(cls=_Group, context_settings={"help_option_names": ["-h", "--help"]})
-@click.version_option(__version__, prog_name="powertrain")
-def main():
-    """powertrain: powertrain mount vibration (NVH) simulator.
-
-    \b
-    Examples:
-      powertrain examples .      # copies the shipped engines/, mounts/, examples/ here
-      powertrain runup --from 1000 --to 6000 --step 500 --csv runup.csv --plot runup.png
-      powertrain stiffness mounts/hydraulic-engine-mount-z.toml --freq 1:400:1 --plot k.png
-      powertrain fit-mount measured.csv --model triple-parallel --out fitted.toml
-      powertrain compare examples/measured-runup.csv --plot compare.png --json compare.json
-      powertrain whatif --scale left.z.stiffness=1.2 --json whatif.json
-      powertrain diagnose examples/measured-runup.csv --report diagnosis/
-      powertrain modes --engine engines/default-torque-rod.toml --json modes.json
-      powertrain track run.csv --csv tracked.csv --plot orders.png
-    """
+__all__ = ["main"]
 
 
 def _register():

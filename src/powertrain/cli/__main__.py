@@ -1,4 +1,4 @@
 """``python -m powertrain.cli``: same as the ``powertrain`` console script."""
-from powertrain.cli import main
+from powertrain.cli.group import main
 
 main()

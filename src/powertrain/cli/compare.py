@@ -5,7 +5,7 @@ from __future__ import annotations
 import click
 
 from powertrain.analysis.noise_floor import NOISE_FLOOR_MARGIN, NOISE_FLOOR_MARGIN_DB
-from powertrain.cli import main
+from powertrain.cli.group import main
 
 
 @main.command()

@@ -6,7 +6,7 @@ from __future__ import annotations
 import click
 
 from powertrain.analysis.noise_floor import NOISE_FLOOR_MARGIN
-from powertrain.cli import main
+from powertrain.cli.group import main
 
 
 class _ListedOption(click.Option):

@@ -8,7 +8,7 @@ from pathlib import Path
 
 import click
 
-from powertrain.cli import main
+from powertrain.cli.group import main
 
 
 @main.command()

@@ -4,8 +4,8 @@ from __future__ import annotations
 
 import click
 
-from powertrain.cli import main
 from powertrain.cli.common import cli_provenance, engine_description, write_plot
+from powertrain.cli.group import main
 
 
 @main.command()

@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import click
 
-from powertrain.cli import main
 from powertrain.cli.common import (
     check_outputs,
     cli_provenance,
@@ -13,6 +12,7 @@ from powertrain.cli.common import (
     speed_steps,
     write_plot,
 )
+from powertrain.cli.group import main
 
 
 @main.command()

@@ -4,8 +4,8 @@ from __future__ import annotations
 
 import click
 
-from powertrain.cli import main
 from powertrain.cli.common import plot_form_options
+from powertrain.cli.group import main
 
 
 @main.command()

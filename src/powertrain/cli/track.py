@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import click
 
-from powertrain.cli import main
+from powertrain.cli.group import main
 
 
 @main.command()

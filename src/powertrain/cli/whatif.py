@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import click
 
-from powertrain.cli import main
 from powertrain.cli.common import (
     check_outputs,
     runup_settings,
@@ -12,6 +11,7 @@ from powertrain.cli.common import (
     speed_steps,
     write_json,
 )
+from powertrain.cli.group import main
 
 
 @main.command()

@@ -10,8 +10,6 @@ through :mod:`powertrain.units`.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
-
 import numpy as np
 
 from powertrain.errors import InputError
@@ -21,23 +19,12 @@ from powertrain.iotools.channel_map import (
     quantity_of_unit,
     split_unit,
 )
+from powertrain.iotools.raw_signals import FileSignals
 from powertrain.models.recording import RawChannel, RawRecording
 from powertrain.units import to_si
 
 _HDF5 = b"\x89HDF\r\n\x1a\n"
 _MDF = b"MDF     "
-
-
-@dataclass
-class FileSignals:
-    """What a format reader found: a time base and named signals (values in file units)."""
-
-    time: np.ndarray | None
-    signals: list                      # [(name, values, unit)]
-    source: str
-    time_name: str = "time"
-    comments: list = field(default_factory=list)
-    times: dict = field(default_factory=dict)   # name -> own time base [s] where not `time`
 
 
 def detect_format(path) -> str:

@@ -21,7 +21,7 @@ import numpy as np
 
 from powertrain.errors import InputError
 from powertrain.iotools.channel_map import split_unit
-from powertrain.iotools.raw import FileSignals
+from powertrain.iotools.raw_signals import FileSignals
 from powertrain.iotools.textfile import read_text
 from powertrain.units import to_si
 

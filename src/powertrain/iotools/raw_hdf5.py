@@ -28,7 +28,7 @@ import json
 import numpy as np
 
 from powertrain.errors import InputError
-from powertrain.iotools.raw import FileSignals
+from powertrain.iotools.raw_signals import FileSignals
 
 FORMAT = "powertrain-raw"
 

@@ -16,7 +16,7 @@ import warnings
 import numpy as np
 
 from powertrain.errors import InputError
-from powertrain.iotools.raw import FileSignals
+from powertrain.iotools.raw_signals import FileSignals
 
 
 def read_mdf_signals(path, channel_map=None) -> FileSignals:

@@ -19,7 +19,7 @@ import warnings
 import numpy as np
 
 from powertrain.errors import InputError
-from powertrain.iotools.raw import FileSignals
+from powertrain.iotools.raw_signals import FileSignals
 
 #: UFF specific data types (record 8/9 field 1) of the ordinate, by our quantity.
 SPECIFIC_DATA_TYPE = {"displacement": 8, "force": 13, "velocity": 11, "acceleration": 12,
