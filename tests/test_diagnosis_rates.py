@@ -6,7 +6,9 @@ core, :func:`powertrain.parallel.run_map`) and applies the Wilson rule of
 ``tests/rates.py``: it fails when the data show, at one-sided 95 % confidence, that the
 issue's target is missed. The number of cases is sized by :func:`rates.size` so that a true
 rate 0.1 worse than the target fails with probability >= 0.8 (top-1 and passive-side
-0.9: 61 cases; unexplained 0.8: 105; false claims 0.05: 36), hence their ``slow`` marker. The
+0.9: 61 cases; unexplained 0.8: 105; false claims 0.05: 36), hence their ``slow`` and
+``rates`` markers: about 20 min on 2 cores, so they run on request (``python -m pytest -m
+rates``), not in the default run or CI. The
 seeds are in the failure message; rerun one with
 :func:`powertrain.validation.cases.make_case`. The 50-case rates of the benchmark are printed
 by ``scripts/blind_diagnosis.py``.
@@ -84,6 +86,7 @@ def _detectable_row(task):
 
 
 @pytest.mark.slow
+@pytest.mark.rates
 def test_effect_free_runs_make_no_false_claims():
     n, k_pass = rates.size(TARGETS["false_claims"], higher_is_better=False)
     seed = fresh_seed()
@@ -93,6 +96,7 @@ def test_effect_free_runs_make_no_false_claims():
 
 
 @pytest.mark.slow
+@pytest.mark.rates
 def test_detectable_in_library_effects_are_named():
     n, k_pass = rates.size(TARGETS["top1"])
     seed = fresh_seed()
@@ -102,6 +106,7 @@ def test_detectable_in_library_effects_are_named():
 
 
 @pytest.mark.slow
+@pytest.mark.rates
 def test_detectable_out_of_library_effects_are_unexplained():
     n, k_pass = rates.size(TARGETS["unexplained_ok"])
     seed = fresh_seed()
@@ -135,6 +140,7 @@ def _passive_row(task):
 
 
 @pytest.mark.slow
+@pytest.mark.rates
 def test_passive_side_body_and_mount_changes_are_named():
     """Issue 13's target (>= 0.9 of detectable body-mode and one-mount stiffness cases named,
     both sides of every mount measured) is not excluded by fresh draws."""
