@@ -37,3 +37,16 @@ def test_raw_file_names_read_through_channel():
     spec = parse_channel_name("left/passive.z [g]")
     assert (spec.mount, spec.side, spec.direction, spec.unit) == ("left", "passive", "z", "g")
     assert parse_channel_name("Time") is None
+
+
+@pytest.mark.parametrize("name", ["nan", "NaN", "inf", "Infinity", "1left", "", "a b", "a.b"])
+def test_mount_names_that_a_csv_reader_takes_for_numbers_or_that_break_the_spelling_are_refused(
+        name):
+    from powertrain.analysis.channel import is_mount_name
+    assert not is_mount_name(name)
+
+
+@pytest.mark.parametrize("name", ["left", "gearbox", "torque_rod", "m-2", "_x", "nanny"])
+def test_ordinary_mount_names_are_accepted(name):
+    from powertrain.analysis.channel import is_mount_name
+    assert is_mount_name(name)

@@ -100,6 +100,7 @@ def _assert_clean(saved, names, command, panel_legends=True):
         assert foot[0].startswith(f"powertrain {__import__('powertrain').__version__}")
 
 
+@pytest.mark.slow          # ~7-11 s: keeps the fast lane under 3 min
 def test_runup_and_compare_figures(tmp_path, monkeypatch, saved):
     run(tmp_path, monkeypatch, "runup", "--solver", "harmonic", "--from", "1000", "--to",
         "6000", "--step", "1000", "--out", "r.h5", "--plot", "runup.png", "--quiet")
@@ -171,6 +172,7 @@ def test_compare_figure_marks_measured_not_modelled_points():
     plt.close(fig)
 
 
+@pytest.mark.slow          # ~7-11 s: keeps the fast lane under 3 min
 def test_runup_body_figures(tmp_path, monkeypatch, saved):
     engine = str(ROOT / "engines" / "default-modal-body.toml")
     run(tmp_path, monkeypatch, "runup", "--engine", engine, "--solver", "harmonic", "--from",

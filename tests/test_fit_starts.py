@@ -79,6 +79,7 @@ def test_order_folds_keep_orders_of_every_channel(engine):
     assert not (held.astype(bool) & ~usable.any(axis=0)[None, :]).any()
 
 
+@pytest.mark.slow          # ~7-11 s: keeps the fast lane under 3 min
 def test_balancer_one_shaft_late_is_found_with_its_sign(engine):
     """One shaft ~10 deg late (lag 0.085, skew 0.17 rad): the mirror timing (skew < 0) is a
     local optimum that a coarse start grid without intermediate timings settled on."""

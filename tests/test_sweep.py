@@ -52,6 +52,7 @@ def test_raw_file_is_raw_hdf5_labelled_synthetic(sweep_files):
     assert rec.synthetic and rec.rpm[0] >= 2000.0
 
 
+@pytest.mark.slow          # ~7-11 s: keeps the fast lane under 3 min
 def test_compare_and_diagnose_accept_tracked_acceleration(sweep_files, tmp_path):
     raw, _, folder = sweep_files
     acc = tmp_path / "acc.csv"

@@ -26,6 +26,16 @@ PASSIVE = "/passive"
 _TEXT = re.compile(r"^\s*([A-Za-z_][\w\-]*)(?:/(passive)|\.(active|passive))?\.([xyzXYZ])\s*$")
 
 
+_MOUNT = re.compile(r"^[A-Za-z_][\w\-]*$")
+
+
+def is_mount_name(name: str) -> bool:
+    """A mount name the channel spelling can carry: a letter or ``_`` first, then letters,
+    digits, ``_`` or ``-``, and not a word a CSV reader takes for a number (``nan``, ``inf``,
+    ``infinity``)."""
+    return bool(_MOUNT.match(name)) and name.lower() not in ("nan", "inf", "infinity")
+
+
 def passive_name(mount: str) -> str:
     """Node of the body side of ``mount`` (``left`` -> ``left/passive``)."""
     return f"{mount}{PASSIVE}"

@@ -24,7 +24,7 @@ from __future__ import annotations
 import re
 from dataclasses import dataclass, field
 
-from powertrain.analysis.channel import DIRECTIONS, SIDES, Channel
+from powertrain.analysis.channel import DIRECTIONS, SIDES, Channel, is_mount_name
 from powertrain.errors import InputError
 from powertrain.iotools.tomlfile import get, read_toml
 from powertrain.models.recording import QUANTITIES, QUANTITY_OF_DIMENSION
@@ -113,6 +113,9 @@ def read_channel_map(path) -> ChannelMap:
         unit = get(entry, "unit", path, prefix, default="", types=str)
         if not mount.strip():
             raise InputError("empty mount name", file=path, key=f"{prefix}.mount")
+        if not is_mount_name(mount.strip()):
+            raise InputError(f"mount name {mount.strip()!r}: a letter or _ first, then letters, "
+                             "digits, _ or -; not nan or inf", file=path, key=f"{prefix}.mount")
         if side not in SIDES:
             raise InputError(f"unknown side {side!r} (expected active or passive)",
                              file=path, key=f"{prefix}.side")

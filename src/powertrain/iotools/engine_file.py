@@ -40,6 +40,7 @@ from pathlib import Path
 
 import numpy as np
 
+from powertrain.analysis.channel import is_mount_name
 from powertrain.data import default_engine_path
 from powertrain.errors import InputError
 from powertrain.iotools.combustion_section import read_combustion
@@ -309,9 +310,9 @@ def _read_mounts(t, path) -> list:
                          key="mounts")
     mounts = []
     for name in t:
-        if not _NAME_RE.match(name):
+        if not is_mount_name(name):
             raise InputError("mount names are letters, digits, '_' or '-' and start with a "
-                             "letter", file=path, key=f"mounts.{name}")
+                             "letter; not nan or inf", file=path, key=f"mounts.{name}")
         p = f"mounts.{name}"
         m = get(t, name, path, "mounts", types=dict)
         check_keys(m, _ALLOWED["mount"], path, p)
