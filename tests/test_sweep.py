@@ -112,3 +112,12 @@ def test_output_rate_at_the_internal_rate_needs_no_decimation():
     for a, b in zip(fine.channels, coarse.channels):
         x, y = a.values[i_f], b.values[i_c]
         assert np.sqrt(np.mean((x - y) ** 2)) < 1e-3 * np.sqrt(np.mean(y ** 2)), a.label
+
+
+def test_a_sweep_too_short_to_track_names_the_sweep_rate():
+    """A 0.1 s ramp (2000-2100 rpm at 1000 rpm/s) simulates but cannot be order-tracked:
+    one line naming --sweep, not the simulated recording's rpm channel (fuzz campaign)."""
+    r = CliRunner().invoke(main, ["runup", "--from", "2000", "--to", "2100", "--sweep", "1000",
+                                  "--sample-rate", "16000", "--quiet", "--csv", "never.csv"])
+    assert r.exit_code == 1 and "'--sweep'" in r.output and "cannot be order-tracked" in r.output
+    assert len(r.output.splitlines()) == 1

@@ -365,7 +365,12 @@ def _sweep_runup(engine, rpm, rate, sample_rate, effects, progress) -> SweepRunu
                          key="--effect")
     rpm = _speeds(rpm)
     rec = simulate_sweep(engine, rpm[0], rpm[-1], rate, sample_rate, progress=progress)
-    tracked = track_recording(rec, rpm_step=TRACK_RPM_STEP, progress=progress).as_velocity()
+    try:
+        tracked = track_recording(rec, rpm_step=TRACK_RPM_STEP, progress=progress).as_velocity()
+    except InputError as exc:        # the simulated ramp is too short or fast to be tracked
+        raise InputError(f"the {rec.time[-1] - rec.time[0]:.3g} s sweep cannot be order-"
+                         f"tracked ({exc.message}); a slower sweep or a wider speed range",
+                         key="--sweep") from None
     return SweepRunup(recording=rec, tracked=tracked, rate_rpm_per_s=float(rate),
                       engine=engine)
 
@@ -403,9 +408,11 @@ def checked_runup(engine, engine_path, run, *args, **kwargs):
     """``run(engine, *args, **kwargs)`` (a run-up) through :func:`~powertrain.errors.solved`,
     its result checked finite (errors name the engine file)."""
     result = solved(lambda: run(engine, *args, **kwargs), engine_path, "engine")
-    require_finite({name.replace("_", " "): getattr(result, name) for name in (
-        "displacement", "velocity", "acceleration", "mount_force", "mean_mount_force")},
-        engine_path, "engine")
+    values = {name.replace("_", " "): getattr(result, name) for name in (
+        "displacement", "velocity", "acceleration", "mount_force", "mean_mount_force")}
+    with np.errstate(over="ignore"):   # finite amplitudes whose squares overflow: absurd levels
+        values["synthesis velocity"] = result.synthesis_rms("velocity")
+    require_finite(values, engine_path, "engine")
     return result
 
 
