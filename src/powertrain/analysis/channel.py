@@ -96,3 +96,18 @@ class Channel:
 
     def __str__(self) -> str:
         return self.label
+
+
+class ChannelFields:
+    """Mixin of a record with ``mount``, ``side`` and ``direction`` fields (a raw channel, a
+    tracked channel): its :class:`Channel` and the one spelling of its label."""
+
+    @property
+    def channel(self) -> Channel:
+        """Where the channel was measured."""
+        return Channel(self.mount, self.side, self.direction)
+
+    @property
+    def label(self) -> str:
+        """``mount.direction`` (active side) or ``mount.passive.direction``."""
+        return self.channel.label

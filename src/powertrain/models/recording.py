@@ -12,7 +12,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from powertrain.analysis.channel import DIRECTIONS, SIDES, Channel  # noqa: F401 (re-export)
+from powertrain.analysis.channel import DIRECTIONS, SIDES, Channel, ChannelFields  # noqa: F401 (re-export)
 from powertrain.errors import InputError
 
 #: Largest sample magnitude accepted (in the channel's unit): far above any recorded
@@ -34,7 +34,7 @@ UNIFORM_TOLERANCE = 1e-3
 
 
 @dataclass
-class RawChannel:
+class RawChannel(ChannelFields):
     """One transducer channel.
 
     Attributes
@@ -57,16 +57,6 @@ class RawChannel:
     quantity: str
     values: np.ndarray
     unit: str = ""
-
-    @property
-    def channel(self) -> Channel:
-        """Where the channel was measured."""
-        return Channel(self.mount, self.side, self.direction)
-
-    @property
-    def label(self) -> str:
-        """``mount.direction`` (active side) or ``mount.passive.direction``."""
-        return self.channel.label
 
 
 @dataclass

@@ -39,7 +39,7 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from powertrain.analysis.channel import Channel
+from powertrain.analysis.channel import ChannelFields
 from powertrain.analysis.orders import order_label
 from powertrain.errors import InputError
 from powertrain.models.recording import QUANTITIES
@@ -54,7 +54,7 @@ LEVEL_COLUMNS = {
 
 
 @dataclass
-class TrackedChannel:
+class TrackedChannel(ChannelFields):
     """Identity of a tracked channel (no samples)."""
 
     name: str
@@ -62,16 +62,6 @@ class TrackedChannel:
     side: str
     direction: str
     quantity: str
-
-    @property
-    def channel(self) -> Channel:
-        """Where the channel was measured."""
-        return Channel(self.mount, self.side, self.direction)
-
-    @property
-    def label(self) -> str:
-        """``mount.direction`` (active side) or ``mount.passive.direction``."""
-        return self.channel.label
 
 
 @dataclass
