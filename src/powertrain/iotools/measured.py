@@ -130,6 +130,11 @@ class MeasuredRunup:
     signal : str
         ``velocity`` (levels in m/s, also for converted acceleration and displacement
         curves) or ``mount_force`` (force curves, levels in N).
+    phases : dict
+        ``(mount, direction, quantity) -> phase [deg]`` aligned with that curve's speeds,
+        NaN where undefined; only curves with a ``phase_deg`` column. The order-k component
+        is √2·RMS·cos(kθ + φ), θ the crank angle
+        from cylinder-1 firing TDC.
     """
 
     curves: dict
@@ -137,6 +142,7 @@ class MeasuredRunup:
     notes: list = field(default_factory=list)
     comments: list = field(default_factory=list)
     signal: str = "velocity"
+    phases: dict = field(default_factory=dict)
 
     @property
     def channels(self) -> list:

@@ -24,6 +24,44 @@ NONE = 0
 #: Jenkins element: spring ``k = par[0]`` in series with a Coulomb slider of slip force
 #: ``F_s = par[1]``; state ``z = state[0]``, the slider's position.
 JENKINS = 1
+#: Berg's friction element: ``F_max = par[0]``, ``x2 = par[1]``; state ``[x_s, F_s,
+#: direction, u_last, F_last]``: the last reversal point, the direction of motion since it
+#: (+1, -1; 0 before any motion) and the last committed point (a reversal, when the next
+#: step turns back). Formula: :mod:`powertrain.physics.mount_laws`.
+BERG = 2
+
+
+@njit(cache=True, nogil=True)
+def _berg_branch(u, par, state):
+    """``(direction, x_s, F_s)`` of the branch the point ``u`` lies on: the committed one
+    while the motion keeps its direction, else a new one from the last committed point."""
+    du = u - state[3]
+    d = 1.0 if du > 0 else (-1.0 if du < 0 else state[2])
+    if d == state[2]:
+        return d, state[0], state[1]
+    return d, state[3], state[4]
+
+
+@njit(cache=True, nogil=True)
+def _berg(u, par, state):
+    """Berg's force and tangent stiffness at ``u`` from the committed ``state``."""
+    fm = par[0]
+    x2 = par[1]
+    if fm <= 0.0:
+        return 0.0, 0.0
+    d, xs, fs = _berg_branch(u, par, state)
+    if d == 0.0:
+        return state[4], fm / x2
+    y = u - xs
+    if d > 0:
+        a = x2 * (1.0 - fs / fm)
+        if y < 0.0:
+            y = 0.0
+        return fs + y / (a + y) * (fm - fs), a * (fm - fs) / ((a + y) * (a + y))
+    b = x2 * (1.0 + fs / fm)
+    if y > 0.0:
+        y = 0.0
+    return fs + y / (b - y) * (fm + fs), b * (fm + fs) / ((b - y) * (b - y))
 
 
 @njit(cache=True, nogil=True)
@@ -39,6 +77,9 @@ def port_force(kind, u, v, par, state):
         if f < -fs:
             return -fs, 0.0, 0.0
         return f, k, 0.0
+    if kind == BERG:
+        f, kt = _berg(u, par, state)
+        return f, kt, 0.0
     return 0.0, 0.0, 0.0
 
 
@@ -53,6 +94,14 @@ def commit_state(kind, u, v, par, state):
             state[0] = u - fs / k
         elif f < -fs:
             state[0] = u + fs / k
+    elif kind == BERG:
+        f = _berg(u, par, state)[0]
+        d, xs, fsr = _berg_branch(u, par, state)
+        state[0] = xs
+        state[1] = fsr
+        state[2] = d
+        state[3] = u
+        state[4] = f
 
 
 @njit(cache=True, nogil=True)

@@ -153,7 +153,14 @@ class MountModel:
         Metadata carried from the mount file.
     port_law : object, optional
         A nonlinear force in parallel with the network between its engine-side and base
-        nodes (:mod:`powertrain.physics.mount_elements`); None: the linear network.
+        nodes (:mod:`powertrain.physics.mount_elements`), e.g. the ``[friction]`` section's
+        :class:`~powertrain.physics.mount_laws.BergFriction`; None: the linear network.
+    amplitude_law : object, optional
+        The ``[amplitude]`` section (:class:`~powertrain.physics.mount_laws.PowerLaw` or
+        ``TableLaw``); None: amplitude independent.
+    static_curve : StaticCurve, optional
+        The ``[static]`` section (:class:`~powertrain.physics.mount_laws.StaticCurve`);
+        None: the network's static stiffness acts at any deflection.
     """
 
     topology: Topology
@@ -162,6 +169,8 @@ class MountModel:
     source: str = ""
     notes: str = ""
     port_law: object = None
+    amplitude_law: object = None
+    static_curve: object = None
 
     def __post_init__(self):
         missing = [p for p in self.topology.parameters if p not in self.params]
@@ -190,7 +199,13 @@ class MountModel:
 
     def element(self) -> MountElement:
         """The element the assembled model holds for this direction."""
-        return MountElement(self, self.port_law)
+        return MountElement(self, self.port_law, self.amplitude_law)
+
+    @property
+    def linear(self) -> bool:
+        """True without amplitude law, friction and static curve."""
+        return self.port_law is None and self.amplitude_law is None and \
+            self.static_curve is None
 
     def cross_point_stiffness(self, frequency_hz) -> np.ndarray:
         """Cross-point dynamic stiffness K_CP [N/m] at ``frequency_hz`` [Hz] (eq. 39)."""

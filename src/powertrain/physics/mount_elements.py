@@ -31,7 +31,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from powertrain.kernels.port_forces import JENKINS, port_force
+from powertrain.kernels.port_forces import JENKINS, NONE, port_force
 from powertrain.physics.mount_network import laplace_two_port, network_matrices
 
 
@@ -83,7 +83,8 @@ class JenkinsFriction:
 
 @dataclass(frozen=True, eq=False)
 class MountElement:
-    """One mount direction: a linear network and an optional port law in parallel.
+    """One mount direction: a linear network, scaled by its amplitude law and its static
+    factor, and an optional port law in parallel.
 
     Parameters
     ----------
@@ -91,30 +92,58 @@ class MountElement:
         The linear network: ``network()`` gives ``(masses, elem_nodes, c, d)``
         (:class:`powertrain.models.mount.MountModel`).
     port_law : object, optional
-        Nonlinear force between the engine-side and base nodes (module docstring).
+        Nonlinear force between the engine-side and base nodes (module docstring), e.g.
+        :class:`powertrain.physics.mount_laws.BergFriction`.
+    amplitude_law : object, optional
+        ``scales(A) -> (stiffness factor, damping factor)`` on every spring and damper of
+        the network at the relative-displacement amplitude A [m]
+        (:class:`~powertrain.physics.mount_laws.PowerLaw`, ``TableLaw``); masses unscaled.
+    static_factor : float
+        Factor on every spring and damper from the static curve at the operating point
+        (tangent stiffness there over that at the reference deflection); 1 without one.
     """
 
     model: object
     port_law: object = None
+    amplitude_law: object = None
+    static_factor: float = 1.0
 
     @property
     def nonlinear(self) -> bool:
-        return self.port_law is not None
+        """True when the element depends on its amplitude (port law or amplitude law)."""
+        law = self.amplitude_law
+        return self.port_law is not None or (law is not None and not law.constant)
 
-    def network(self):
-        """``(masses, elem_nodes, c, d)`` of the linear network."""
-        return self.model.network()
+    def scales(self, amplitude=0.0):
+        """``(stiffness factor, damping factor)`` of the network at the amplitude [m]."""
+        if self.amplitude_law is None:
+            return self.static_factor, self.static_factor
+        ks, ds = self.amplitude_law.scales(amplitude)
+        return self.static_factor * float(ks), self.static_factor * float(ds)
 
-    def matrices(self, include_ground=False):
-        """``(M, C, K)`` of the linear network (the port law is not in them)."""
-        return network_matrices(*self.network(), include_ground=include_ground)
+    def at_operating_point(self, static_factor: float) -> MountElement:
+        """A copy with the static curve's factor at an operating point."""
+        return MountElement(self.model, self.port_law, self.amplitude_law, float(static_factor))
+
+    def network(self, amplitude=0.0):
+        """``(masses, elem_nodes, c, d)`` of the linear network at the amplitude [m]."""
+        masses, nodes, c, d = self.model.network()
+        ks, ds = self.scales(amplitude)
+        if ks == 1.0 and ds == 1.0:
+            return masses, nodes, c, d
+        return masses, nodes, c * ks, d * ds
+
+    def matrices(self, include_ground=False, amplitude=0.0):
+        """``(M, C, K)`` of the linear network at the amplitude (the port law is not in
+        them)."""
+        return network_matrices(*self.network(amplitude), include_ground=include_ground)
 
     def two_port(self, s, amplitude=0.0, internal=False):
         """Equivalent-linear two-port ``(a, b, c)`` at the Laplace variable ``s`` and the
         relative-displacement amplitude [m] (and the internal motions when ``internal``, see
         :func:`powertrain.physics.mount_network.laplace_two_port`; a port law moves no
         internal node)."""
-        res = laplace_two_port(s, *self.network(), internal=internal)
+        res = laplace_two_port(s, *self.network(amplitude), internal=internal)
         if self.port_law is None:
             return res
         k = np.where(np.asarray(s) == 0, 0.0, self.port_law.describing_stiffness(amplitude))
@@ -162,7 +191,8 @@ class PortForces:
     def describing_forces(self, amplitudes, relative) -> np.ndarray:
         """Equivalent-linear port forces (n_h, m) [N] of the relative-motion harmonics
         ``relative`` (n_h, m) at the ``amplitudes`` (m,)."""
-        k = np.array([law.describing_stiffness(a) for law, a in zip(self.laws, amplitudes)])
+        k = np.array([0j if law is None else law.describing_stiffness(a)
+                      for law, a in zip(self.laws, amplitudes)])
         z = relative * k[None, :]
         z[0] = 0.0                                    # the mean: unloaded (module docstring)
         return z
@@ -172,8 +202,8 @@ class PortForces:
         to carry the forces ``f0`` (m,) [N] (default: unloaded)."""
         u0 = self.rows @ np.asarray(x0, float)
         f0 = np.zeros(u0.size) if f0 is None else f0
-        states = [np.atleast_1d(law.initial_state(u, f)) for law, u, f in
-                  zip(self.laws, u0, f0)]
+        states = [np.zeros(1) if law is None else np.atleast_1d(law.initial_state(u, f))
+                  for law, u, f in zip(self.laws, u0, f0)]
         out = np.zeros((len(states), max(s.size for s in states)))
         for e, st in enumerate(states):
             out[e, :st.size] = st
@@ -192,10 +222,11 @@ def port_forces(elements, rows, force_map, names) -> PortForces | None:
     if not idx:
         return None
     laws = [elements[k].port_law for k in idx]
-    pars = [np.atleast_1d(law.parameters()) for law in laws]
+    pars = [np.zeros(1) if law is None else np.atleast_1d(law.parameters()) for law in laws]
     par = np.zeros((len(pars), max(p.size for p in pars)))
     for e, p in enumerate(pars):
         par[e, :p.size] = p
-    return PortForces(np.ascontiguousarray(rows[idx]), np.array([law.kind for law in laws],
-                      np.int64), par, laws, np.ascontiguousarray(force_map[:, idx]),
-                      [names[k] for k in idx], np.array(idx, int), len(elements))
+    kinds = np.array([NONE if law is None else law.kind for law in laws], np.int64)
+    return PortForces(np.ascontiguousarray(rows[idx]), kinds, par, laws,
+                      np.ascontiguousarray(force_map[:, idx]), [names[k] for k in idx],
+                      np.array(idx, int), len(elements))

@@ -1,0 +1,230 @@
+r"""Amplitude, preload and friction laws of a mount direction (SI).
+
+The thesis (Kovarik 2016, sec. 6) names amplitude dependence as its model's main limitation
+and recommends a stiffness chosen from frequency and displacement amplitude, with a static
+force–deflection curve for the static nonlinearity. Three laws carry that physics here; a
+mount file's ``[amplitude]``, ``[friction]`` and ``[static]`` sections become them
+(:mod:`powertrain.iotools.mount_file`), and :class:`~powertrain.physics.mount_elements.MountElement`
+applies them:
+
+* :class:`PowerLaw`, :class:`TableLaw` — the **equivalent-linear amplitude law** of the
+  elastomer: every spring and damper of the network times a factor of the amplitude
+  :math:`A` of the relative displacement across the mount (masses never scaled);
+* :class:`BergFriction` — **Berg's friction element** (Berg 1998, *A non-linear rubber spring
+  model for rail vehicle dynamics analysis*, Vehicle System Dynamics 30), in parallel with the
+  whole network: from the last reversal point :math:`(x_s, F_s)`, with
+  :math:`\alpha = F_s/F_{max}` and :math:`y = x - x_s`,
+
+  .. math:: F = F_s + \frac{y}{x_2(1-\alpha) + y}(F_{max} - F_s)\ (y \ge 0),\qquad
+            F = F_s + \frac{y}{x_2(1+\alpha) - y}(F_{max} + F_s)\ (y \le 0),
+
+  so that from the unloaded state :math:`F = F_{max}/2` at :math:`y = x_2`;
+* :class:`StaticCurve` — the datasheet's **static force–deflection curve**: the monotone
+  cubic through its points (scipy's ``PchipInterpolator``), straight beyond them with the
+  end-point slope; the network's springs and dampers scale with its tangent stiffness at the
+  operating point over that at ``reference_deflection``.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from powertrain.kernels.port_forces import BERG
+
+#: Gauss–Legendre nodes per loop branch of Berg's describing function: the branch is smooth
+#: (a rational function of sin θ), so 48 nodes give the first harmonic to round-off.
+_GAUSS_NODES = 48
+
+
+@dataclass(frozen=True)
+class PowerLaw:
+    r"""Factor :math:`\mathrm{clip}((A_{ref}/A)^{n}, lo, hi)` on every spring and damper.
+
+    Parameters
+    ----------
+    reference : float
+        :math:`A_{ref}` [m]: the amplitude the network was measured and fitted at (> 0).
+    exponent : float
+        :math:`n` (0: amplitude independent).
+    limits : tuple of float
+        ``(lo, hi)``, 0 < lo <= 1 <= hi.
+    """
+
+    reference: float
+    exponent: float
+    limits: tuple = (0.2, 5.0)
+
+    @property
+    def constant(self) -> bool:
+        """True when the factor is 1 at every amplitude."""
+        return self.exponent == 0.0
+
+    def factor(self, amplitude) -> np.ndarray:
+        """The factor at the amplitude(s) [m] (A = 0 counts as the smallest positive)."""
+        a = np.maximum(np.asarray(amplitude, float), np.finfo(float).tiny)
+        with np.errstate(over="ignore"):
+            raw = (self.reference / a) ** self.exponent
+        return np.clip(raw, *self.limits)
+
+    def scales(self, amplitude):
+        """``(stiffness factor, damping factor)`` at the amplitude [m]."""
+        f = self.factor(amplitude)
+        return f, f
+
+
+@dataclass(frozen=True)
+class TableLaw:
+    """Factors tabulated against amplitude, interpolated in log amplitude, flat outside.
+
+    Parameters
+    ----------
+    amplitudes : tuple of float
+        Strictly increasing, > 0 [m].
+    stiffness_scale, damping_scale : tuple of float
+        Factors (> 0) at those amplitudes; ``damping_scale`` defaults to ``stiffness_scale``.
+    """
+
+    amplitudes: tuple
+    stiffness_scale: tuple
+    damping_scale: tuple | None = None
+
+    @property
+    def constant(self) -> bool:
+        d = self.stiffness_scale if self.damping_scale is None else self.damping_scale
+        return all(v == 1.0 for v in self.stiffness_scale) and all(v == 1.0 for v in d)
+
+    def scales(self, amplitude):
+        """``(stiffness factor, damping factor)`` at the amplitude(s) [m]."""
+        la = np.log(np.maximum(np.asarray(amplitude, float), self.amplitudes[0]))
+        xp = np.log(np.asarray(self.amplitudes, float))
+        ks = np.interp(la, xp, self.stiffness_scale)
+        d = self.stiffness_scale if self.damping_scale is None else self.damping_scale
+        return ks, np.interp(la, xp, d)
+
+
+@dataclass(frozen=True)
+class StaticCurve:
+    """A static force–deflection curve: deflection [m] -> force [N] (both increasing).
+
+    Parameters
+    ----------
+    deflection, force : tuple of float
+        The datasheet points, deflection strictly increasing, force strictly increasing.
+    reference_deflection : float
+        Where the dynamic data were measured [m].
+    """
+
+    deflection: tuple
+    force: tuple
+    reference_deflection: float = 0.0
+
+    def _pchip(self):
+        from scipy.interpolate import PchipInterpolator
+        return PchipInterpolator(np.asarray(self.deflection, float),
+                                 np.asarray(self.force, float), extrapolate=False)
+
+    def _ends(self, p):
+        x = np.asarray(self.deflection, float)
+        d = p.derivative()
+        return x[0], x[-1], float(p(x[0])), float(p(x[-1])), float(d(x[0])), float(d(x[-1]))
+
+    def force_at(self, x) -> np.ndarray:
+        """Force [N] at the deflection(s) ``x`` [m]."""
+        p = self._pchip()
+        x0, x1, f0, f1, k0, k1 = self._ends(p)
+        x = np.asarray(x, float)
+        inside = np.nan_to_num(p(np.clip(x, x0, x1)))
+        return np.where(x < x0, f0 + k0 * (x - x0), np.where(x > x1, f1 + k1 * (x - x1), inside))
+
+    def tangent_at(self, x) -> np.ndarray:
+        """Tangent stiffness dF/dx [N/m] at the deflection(s) ``x`` [m]."""
+        p = self._pchip()
+        x0, x1, _, _, k0, k1 = self._ends(p)
+        x = np.asarray(x, float)
+        inside = np.nan_to_num(p.derivative()(np.clip(x, x0, x1)))
+        return np.where(x < x0, k0, np.where(x > x1, k1, inside))
+
+    def factor(self, x) -> np.ndarray:
+        """Tangent stiffness at ``x`` over that at ``reference_deflection``."""
+        return self.tangent_at(x) / self.tangent_at(self.reference_deflection)
+
+
+@dataclass(frozen=True)
+class BergFriction:
+    """Berg's friction element (module docstring); a port law of
+    :mod:`powertrain.physics.mount_elements`.
+
+    Parameters
+    ----------
+    max_force : float
+        :math:`F_{max}` [N] (>= 0; 0: no friction).
+    half_displacement : float
+        :math:`x_2` [m] (> 0): displacement from the unloaded state at which half of
+        ``max_force`` is reached.
+    """
+
+    max_force: float
+    half_displacement: float
+    kind = BERG
+
+    def parameters(self) -> np.ndarray:
+        return np.array([self.max_force, self.half_displacement], float)
+
+    def initial_state(self, u0: float, f0: float = 0.0) -> np.ndarray:
+        """Unloaded at ``u0`` when ``f0`` is 0; otherwise on the virgin curve carrying ``f0``
+        (clipped inside ±max_force): state ``[x_s, F_s, direction, u_last, F_last]``."""
+        fm = self.max_force
+        f = float(np.clip(f0, -0.999 * fm, 0.999 * fm)) if fm > 0 else 0.0
+        if f == 0.0:
+            return np.array([u0, 0.0, 0.0, u0, 0.0])
+        # virgin branch from (x_s, 0): f = y/(x2 + y) fm (y > 0), f = y/(x2 - y) fm (y < 0)
+        x2 = self.half_displacement
+        y = f * x2 / (fm - abs(f))
+        return np.array([u0 - y, 0.0, np.sign(f), u0, f])
+
+    @property
+    def initial_stiffness(self) -> float:
+        """Tangent stiffness at a reversal point [N/m]: F_max / x2."""
+        return self.max_force / self.half_displacement
+
+    def loop_amplitude_force(self, amplitude) -> np.ndarray:
+        r"""Force at the tips :math:`\pm A` of the symmetric steady loop [N]: the root of
+        :math:`(x_2/F_{max})F_r^2 + (x_2 + A)F_r - A F_{max} = 0`."""
+        A = np.asarray(amplitude, float)
+        fm, x2 = self.max_force, self.half_displacement
+        if fm <= 0:
+            return np.zeros_like(A)
+        b = x2 + A
+        return 2 * A * fm / (b + np.sqrt(b * b + 4 * x2 * A))
+
+    def describing_stiffness(self, amplitude) -> np.ndarray:
+        r"""Equivalent complex stiffness [N/m] at the displacement amplitude [m]: the first
+        harmonic of the steady loop under :math:`u = A\sin\theta`,
+        :math:`k_{eq} = \frac{2}{\pi A}\int_{-\pi/2}^{\pi/2} F_\uparrow(\theta)
+        (\sin\theta + i\cos\theta)\,d\theta` (the descending branch mirrors the ascending
+        one); its imaginary part is the loop area over :math:`\pi A^2`."""
+        A = np.atleast_1d(np.asarray(amplitude, float))
+        out = np.full(A.shape, self.initial_stiffness + 0j if self.max_force > 0 else 0j)
+        big = A > 1e-12 * self.half_displacement
+        if self.max_force <= 0 or not big.any():
+            return out.reshape(np.shape(amplitude))
+        a = A[big][:, None]
+        t, w = np.polynomial.legendre.leggauss(_GAUSS_NODES)
+        theta = 0.5 * np.pi * t[None, :]
+        fr = self.loop_amplitude_force(a)
+        fm, x2 = self.max_force, self.half_displacement
+        y = a * (np.sin(theta) + 1.0)                       # from the reversal at -A
+        fs = -fr
+        f = fs + y / (x2 * (1 - fs / fm) + y) * (fm - fs)
+        wq = 0.5 * np.pi * w[None, :]
+        re = 2 / (np.pi * a[:, 0]) * np.sum(wq * f * np.sin(theta), axis=1)
+        im = 2 / (np.pi * a[:, 0]) * np.sum(wq * f * np.cos(theta), axis=1)
+        out[big] = re + 1j * im
+        return out.reshape(np.shape(amplitude))
+
+    def energy_per_cycle(self, amplitude) -> np.ndarray:
+        """Energy dissipated per cycle of the steady loop at the amplitude [J]."""
+        A = np.asarray(amplitude, float)
+        return np.pi * A ** 2 * np.imag(self.describing_stiffness(A))
