@@ -63,7 +63,8 @@ def read_raw(path, channel_map: ChannelMap | None = None, *, rpm: str | None = N
         Name of the speed [rpm] or tacho channel (default: the map's, else a channel named
         ``rpm`` / ``tacho``).
     cycle_reference : str, optional
-        Name of a once-per-cycle pulse channel [V] (cam or injection signal).
+        Name of a once-per-cycle pulse channel [V] (cam or injection signal; default a
+        channel named ``cycle``).
 
     Returns
     -------
@@ -100,8 +101,8 @@ def _pick_speed(found: FileSignals, cmap, rpm, tacho, cycle_reference=None):
     tacho_name = tacho or (cmap.tacho if cmap else None)
     out = {}
     for kind, wanted, default in (("rpm", rpm_name, "rpm"), ("tacho", tacho_name, "tacho"),
-                                  ("cycle_reference", cycle_reference, None)):
-        i = _find(signals, wanted or default) if wanted or default else None
+                                  ("cycle_reference", cycle_reference, "cycle")):
+        i = _find(signals, wanted or default)
         if i is None:
             if wanted:
                 raise InputError(f"no channel named {wanted!r} for the "

@@ -8,9 +8,9 @@ Layout (comment lines start with ``#``; a ``SYNTHETIC`` comment is kept as a lab
     ...
 
 * ``time [s]`` (or ``[ms]``) first or anywhere; uniformly sampled, strictly increasing;
-* optional ``rpm [1/min]`` (speed) and ``tacho [V]`` (pulse train); a once-per-cycle pulse
-  channel (cam or injection signal, ``track --cycle-reference NAME``; written as
-  ``cycle [V]``);
+* optional ``rpm [1/min]`` (speed), ``tacho [V]`` (pulse train) and ``cycle [V]`` (a
+  once-per-cycle pulse, cam or injection signal; another name with ``track
+  --cycle-reference NAME``);
 * every other column a channel ``MOUNT.DIRECTION [UNIT]`` or ``MOUNT.SIDE.DIRECTION [UNIT]``
   (or any name listed in a channel map).
 """
