@@ -204,3 +204,46 @@ def test_measured_csv_phase_column(tmp_path):
         read_measured(write(tmp_path, head + "left,z,synthesis,1000,0.1,10\n"))
     with pytest.raises(InputError, match="phase_deg"):
         read_measured(write(tmp_path, head + "left,z,order_2,1000,0.1,abc\n"))
+
+
+def _shifted_csv(result, path, shift_deg, keep_phase=True):
+    """The run-up CSV of ``result`` with every phase moved by ``shift_deg`` (or dropped)."""
+    lines = result.csv_text().splitlines()
+    out = [lines[0] if keep_phase else lines[0].rsplit(",", 1)[0]]
+    for line in lines[1:]:
+        head, phase = line.rsplit(",", 1)
+        if keep_phase:
+            head += "," + (f"{float(phase) + shift_deg:.6g}" if phase else "")
+        out.append(head)
+    path.write_text("\n".join(out) + "\n")
+    return path
+
+
+def test_compare_reports_phase_and_complex_gap(tmp_path, default_engine):
+    """Measured = simulated with every phase 10 degrees later: the phase gap is -10 degrees
+    at every point and the complex gap 0 dB, -10 degrees; the level gaps stay 0."""
+    from powertrain.workflows.comparison import compare
+    from powertrain.workflows.runup import run_runup
+    result = run_runup(default_engine, [1500.0, 2500.0, 3500.0], solver="harmonic")
+    (tmp_path / "a").mkdir()
+    (tmp_path / "b").mkdir()
+    comp = compare(_shifted_csv(result, tmp_path / "a" / "m.csv", 10.0), simulated=result)
+    c = comp.channel("left", "z", "order_2")
+    assert np.allclose(c.phase_gap_deg, -10.0, atol=1e-3)
+    assert c.stats["complex_gap_db"] == pytest.approx(0.0, abs=1e-4)
+    assert c.stats["complex_gap_deg"] == pytest.approx(-10.0, abs=1e-3)
+    assert c.stats["n_phase_compared"] == 3
+    entry = next(d for d in comp.to_dict()["channels"]
+                 if (d["mount"], d["direction"], d["quantity"]) == ("left", "z", "order_2"))
+    assert entry["phase_gap_deg"][0] == pytest.approx(-10.0, abs=1e-3)
+    plain = compare(_shifted_csv(result, tmp_path / "b" / "m.csv", 0.0, keep_phase=False),
+                    simulated=result)
+    assert plain.channel("left", "z", "order_2").phase_gap_deg is None
+    assert all("phase_gap_deg" not in d for d in plain.to_dict()["channels"])
+
+    def body(cmp, folder):                     # the report without the timing line
+        return cmp.to_text().rsplit("\n\n", 1)[0].replace(str(tmp_path / folder), "")
+
+    phase_block = "\n" + "\n".join(comp._phase_lines())
+    assert phase_block.count("complex gap") == 1
+    assert body(comp, "a").replace(phase_block, "") == body(plain, "b")
