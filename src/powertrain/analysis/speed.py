@@ -15,7 +15,12 @@ From a **tacho** (``pulses_per_rev`` pulses per revolution):
    counts ``k`` pulses; intervals under 30 % of the median (spikes) are dropped;
 4. the angle at the edges, :math:`2\pi\,\mathrm{count}/N`, is fitted by a least-squares
    cubic spline with knots ``smooth_s`` apart (a linear sweep's quadratic angle is
-   reproduced exactly; edge jitter is averaged), which gives angle and speed at every sample.
+   reproduced exactly; edge jitter is averaged), which gives angle and speed at every sample;
+5. the **reference pulse** (:attr:`SpeedProfile.reference`), from which the crank angle of
+   the order phases is counted (:mod:`powertrain.analysis.phase`): every pulse of a
+   once-per-revolution tacho, or the first pulse after the missing-tooth gap of a wheel
+   with ``N > 1`` teeth (the gap recurring once per revolution). An rpm channel, or an
+   ``N``-tooth wheel without a gap, has no reference: its angle origin is arbitrary.
 """
 
 from __future__ import annotations
@@ -56,6 +61,9 @@ class SpeedProfile:
     source : str
         ``rpm channel`` or ``tacho (N pulses/rev)``.
     notes : list of str
+    reference : float or None
+        Angle [rad] (on :attr:`angle`'s scale) of a once-per-revolution reference pulse,
+        known modulo 2π; None when the speed source has none (module docstring, step 5).
     """
 
     time: np.ndarray
@@ -64,6 +72,7 @@ class SpeedProfile:
     valid: tuple
     source: str
     notes: list = field(default_factory=list)
+    reference: float | None = None
 
 
 def _savgol_window(time, smooth_s):
@@ -114,13 +123,14 @@ def speed_from_rpm(time, rpm, *, smooth_s=0.1, file=None, key="rpm") -> SpeedPro
                         [f"rpm smoothed over {window} samples (Savitzky-Golay, cubic)"])
 
 
-def tacho_edges(time, tacho, *, file=None, key="tacho"):
-    """Times of the rising edges of a tacho signal [s] (Schmitt trigger, interpolated)."""
+def tacho_edges(time, tacho, *, file=None, key="tacho", what="tacho"):
+    """Times of the rising edges of a pulse train [s] (Schmitt trigger, interpolated);
+    ``what`` names the signal in error messages."""
     x = np.asarray(tacho, float)
     lo, hi = np.percentile(x, [2.0, 98.0])
     swing = hi - lo
     if not swing > 1e-12 * max(abs(hi), abs(lo), 1.0):
-        raise InputError("tacho has no edges (constant signal)", file=file, key=key)
+        raise InputError(f"{what} has no edges (constant signal)", file=file, key=key)
     up = lo + TRIGGER_HIGH * swing
     down = lo + TRIGGER_LOW * swing
     # state: 1 above `up`, 0 below `down`, else the last state (forward fill)
@@ -131,7 +141,7 @@ def tacho_edges(time, tacho, *, file=None, key="tacho"):
     state[marker[idx] < 0] = 0
     rise = np.flatnonzero((state[1:] == 1) & (state[:-1] == 0)) + 1
     if rise.size < MIN_TACHO_EDGES:
-        raise InputError(f"tacho has too few edges ({rise.size} rising edges found, at least "
+        raise InputError(f"{what} has too few edges ({rise.size} rising edges found, at least "
                          f"{MIN_TACHO_EDGES} needed)", file=file, key=key)
     # the sample at index `rise` is the first above `up`; interpolate the crossing of `up`
     i1 = rise
@@ -176,6 +186,21 @@ def count_teeth(edge_times, *, file=None, key="tacho"):
     return t, counts, notes
 
 
+def reference_count(counts, pulses_per_rev):
+    """Pulse count (on the scale of :func:`count_teeth`) of the reference pulse, or None.
+
+    One pulse per revolution: every pulse (0). More: the first pulse after a gap, if every
+    gap falls on the same tooth of the revolution (a missing-tooth wheel); else None.
+    """
+    if pulses_per_rev == 1:
+        return 0.0
+    after_gap = counts[1:][np.diff(counts) > 1]
+    if after_gap.size == 0:
+        return None
+    teeth = np.mod(after_gap, pulses_per_rev)
+    return float(teeth[0]) if np.all(teeth == teeth[0]) else None
+
+
 def speed_from_tacho(time, tacho, pulses_per_rev, *, smooth_s=0.1, file=None,
                      key="tacho") -> SpeedProfile:
     """Speed profile from a tacho pulse train (see module docstring)."""
@@ -206,5 +231,6 @@ def speed_from_tacho(time, tacho, pulses_per_rev, *, smooth_s=0.1, file=None,
     rpm = omega * (60.0 / (2.0 * np.pi))
     notes = [f"{t_e.size} tacho edges, {pulses_per_rev:g} pulses/rev; angle fitted by a "
              f"cubic spline with {n_int} interior knots"] + notes
+    ref = reference_count(counts, pulses_per_rev)
     return SpeedProfile(time, rpm, angle, valid, f"tacho ({pulses_per_rev:g} pulses/rev)",
-                        notes)
+                        notes, None if ref is None else ref * 2.0 * np.pi / pulses_per_rev)

@@ -52,10 +52,18 @@ from powertrain.cli.group import main
                    "highest --orders) at this speed; repeatable. Needs --spectrum-out.")
 @click.option("--spectrum-out", type=click.Path(dir_okay=False),
               help="CSV of the order spectra of --spectrum-at.")
+@click.option("--tdc-offset", type=float, metavar="DEG",
+              help="Measure the order phases: crank angle of cylinder-1 firing TDC after the "
+                   "tacho's reference pulse [deg] (0..360; 0..720 with --cycle-reference). "
+                   "Needs a tacho with one pulse per revolution or a missing-tooth gap.")
+@click.option("--cycle-reference", metavar="COLUMN",
+              help="Once-per-cycle pulse channel (cam or injection): fixes the 720° cycle, "
+                   "so half orders get a phase too; the offset then counts from the first "
+                   "tacho reference pulse after its edge.")
 @click.option("--quiet", is_flag=True, help="No progress bar and no table.")
 def track(raw, map_file, rpm_column, tacho_column, pulses_per_rev, orders_spec, rpm_step,
           method, bandwidth, quantity, as_quantity, csv_file, out, plot, map_png, map_channel,
-          overall, overall_band, spectrum_at, spectrum_out, quiet):
+          overall, overall_band, spectrum_at, spectrum_out, tdc_offset, cycle_reference, quiet):
     """Order-track raw run-up time data: speed from an rpm or tacho channel, order RMS
     against rpm per channel.
 
@@ -68,6 +76,7 @@ def track(raw, map_file, rpm_column, tacho_column, pulses_per_rev, orders_spec, 
       powertrain track run.mf4 --channels map.toml --tacho Tacho1 --pulses-per-rev 60
       powertrain track run.h5 --orders 1,2,4 --method vkf --as velocity --csv v.csv
       powertrain track run.csv --overall --spectrum-at 3000 --spectrum-out s.csv --csv t.csv
+      powertrain track run.csv --pulses-per-rev 1 --tdc-offset 42 --cycle-reference cam
     """
     from powertrain.cli.common import check_outputs
     from powertrain.errors import InputError
@@ -83,16 +92,22 @@ def track(raw, map_file, rpm_column, tacho_column, pulses_per_rev, orders_spec, 
                         tacho_column=tacho_column, pulses_per_rev=pulses_per_rev,
                         quantity=quantity, as_quantity=as_quantity, overall=overall,
                         overall_band=overall_band, spectrum_at=spectrum_at,
-                        map_channel=map_channel, maps=bool(map_png), progress=not quiet)
+                        map_channel=map_channel, maps=bool(map_png), tdc_offset=tdc_offset,
+                        cycle_reference=cycle_reference, progress=not quiet)
+    _write(tracked, csv_file, out, spectrum_out)
+    _figures(tracked, raw, plot, map_png)
+    if not quiet:
+        click.echo(tracked.to_text((csv_file, out, plot, map_png, spectrum_out)))
+
+
+def _write(tracked, csv_file, out, spectrum_out) -> None:
+    """The order curves (CSV, HDF5) and the order spectra, if asked for."""
     if csv_file:
         tracked.to_csv(csv_file)
     if out:
         tracked.to_hdf5(out)
     if spectrum_out:
         tracked.write_spectra(spectrum_out)
-    _figures(tracked, raw, plot, map_png)
-    if not quiet:
-        click.echo(tracked.to_text((csv_file, out, plot, map_png, spectrum_out)))
 
 
 def _figures(tracked, raw, plot, map_png) -> None:

@@ -36,6 +36,12 @@ mount ``left`` become channel ``left/passive``.
   by :math:`1/\sqrt2`, exact for a single sinusoidal order; a ``synthesis`` row in a peak file
   is read as the root-sum-square of the order peaks (the usual order-analyser convention),
   for which the same factor is exact too.
+* ``phase_deg`` (optional): the order's phase [deg] re cylinder-1 firing TDC
+  (:mod:`powertrain.analysis.phase`: order component √2·RMS·cos(kθ + φ)) of the level
+  column read (in a run-up CSV the velocity's); empty where undefined, always empty on
+  ``synthesis`` rows. Converted with the levels (acceleration to velocity: φ − 90°,
+  displacement: φ + 90°) and wrapped to (-180°, 180°]; read into
+  :attr:`MeasuredRunup.phases`.
 * rows may come in any order; speeds need not be the same for every channel.
 
 Levels are returned in SI (m/s RMS). Any problem -- unreadable file, a header without a
@@ -57,6 +63,7 @@ import numpy as np
 
 from powertrain.analysis.channel import DIRECTIONS, SIDES, Channel, passive_name, split_side
 from powertrain.analysis.orders import order_label, quantity_sort_key
+from powertrain.analysis.phase import wrap_deg
 from powertrain.errors import InputError
 from powertrain.iotools.textfile import check_regular_file, parse_number, read_text
 
@@ -74,7 +81,7 @@ KEY_COLUMNS = ("mount", "direction", "quantity", "rpm")
 #: Optional columns: the side of the mount (``active`` = engine side, default; ``passive`` =
 #: body side, or a body point of interest named in ``mount``) and further value columns
 #: (read and checked; the comparison uses the velocity level column).
-OPTIONAL_COLUMNS = ("side", "acceleration_rms_m_per_s2", "force_rms_n")
+OPTIONAL_COLUMNS = ("side", "acceleration_rms_m_per_s2", "force_rms_n", "phase_deg")
 _HDF5_SIGNATURE = b"\x89HDF\r\n\x1a\n"
 
 
@@ -132,9 +139,10 @@ class MeasuredRunup:
         curves) or ``mount_force`` (force curves, levels in N).
     phases : dict
         ``(mount, direction, quantity) -> phase [deg]`` aligned with that curve's speeds,
-        NaN where undefined; only curves with a ``phase_deg`` column. The order-k component
-        is √2·RMS·cos(kθ + φ), θ the crank angle
-        from cylinder-1 firing TDC.
+        NaN where undefined; only order curves with at least one phase given (a
+        ``phase_deg`` column, or a simulated result). The order-k component is
+        √2·RMS·cos(kθ + φ), θ the crank angle from cylinder-1 firing TDC
+        (:mod:`powertrain.analysis.phase`).
     """
 
     curves: dict
@@ -176,18 +184,24 @@ class MeasuredRunup:
     @classmethod
     def from_result(cls, result, source: str = "", signal: str = "velocity") -> MeasuredRunup:
         """RMS curves (synthesis and every order) of a
-        :class:`~powertrain.results.runup.RunupResult`: velocity, or ``mount_force``."""
+        :class:`~powertrain.results.runup.RunupResult`: velocity, or ``mount_force``; the
+        phases of its complex amplitudes (the simulation's crank angle is counted from
+        cylinder-1 firing TDC)."""
+        from powertrain.analysis.phase import phase_deg
         rpm = np.asarray(result.rpm, float)
         order_idx = np.argsort(rpm)
         rms = result.order_rms(signal)[order_idx]
         syn = result.synthesis_rms(signal)[order_idx]
+        phase = phase_deg(getattr(result, signal)[order_idx])
         rpm = rpm[order_idx]
-        curves = {}
+        curves, phases = {}, {}
         for c, (m, d) in enumerate(result.channels):
             curves[(m, d, "synthesis")] = (rpm.copy(), syn[:, c].copy())
             for k, order in enumerate(result.orders):
                 curves[(m, d, order_label(order))] = (rpm.copy(), rms[:, c, k].copy())
-        return cls(curves, source=str(source), signal=signal)
+                if np.any(np.isfinite(phase[:, c, k])):
+                    phases[(m, d, order_label(order))] = phase[:, c, k].copy()
+        return cls(curves, source=str(source), signal=signal, phases=phases)
 
 
 def read_measured(path, mounts=None, points=None) -> MeasuredRunup:
@@ -331,14 +345,15 @@ def _csv_layout(header, path, lineno) -> _Layout:
 
 
 def _csv_row(fields, layout, path, lineno, mounts, points):
-    """``(node, direction, quantity, rpm, level)`` of a data row (level in the column's
-    unit), or None for a row not modelled (quantity ``overall``)."""
+    """``(node, direction, quantity, rpm, level, phase)`` of a data row (level in the
+    column's unit, phase [deg] or NaN), or None for a row not modelled (quantity
+    ``overall``)."""
     col, level_col = layout.col, layout.level_col
     side = fields[col["side"]].lower() if "side" in col else "active"
     if side not in SIDES:
         raise InputError(f"unknown side {fields[col['side']]!r} (expected active or "
                          "passive)", file=path, line=lineno, key="side")
-    for extra in OPTIONAL_COLUMNS[1:]:
+    for extra in ("acceleration_rms_m_per_s2", "force_rms_n"):
         if extra in col and extra != level_col and fields[col[extra]]:
             parse_number(fields[col[extra]], path, lineno, extra, nonneg=True)
     node = _csv_node(fields[col["mount"]], side, path, lineno, mounts, points)
@@ -360,10 +375,20 @@ def _csv_row(fields, layout, path, lineno, mounts, points):
     if level < 0:
         raise InputError(f"negative level {level:g}", file=path, line=lineno,
                          key=level_col)
-    factor, statistic = LEVEL_COLUMNS[level_col]
-    _check_level(level * factor / (math.sqrt(2.0) if statistic == "peak" else 1.0), path,
-                 lineno, level_col)
-    return node, direction, quantity, rpm, level
+    _check_level(level * layout.scale, path, lineno, level_col)
+    return node, direction, quantity, rpm, level, _row_phase(fields, col, quantity, path,
+                                                             lineno)
+
+
+def _row_phase(fields, col, quantity, path, lineno) -> float:
+    """The ``phase_deg`` cell of a row [deg], wrapped; NaN where absent or empty."""
+    text = fields[col["phase_deg"]] if "phase_deg" in col else ""
+    if not text:
+        return math.nan
+    if quantity == "synthesis":
+        raise InputError("a synthesis row has no phase (a sum of orders): leave it empty",
+                         file=path, line=lineno, key="phase_deg")
+    return float(wrap_deg(parse_number(text, path, lineno, "phase_deg")))
 
 
 def _csv_node(mount, side, path, lineno, mounts, points) -> str:
@@ -381,7 +406,7 @@ def _csv_node(mount, side, path, lineno, mounts, points) -> str:
 
 
 def _add_row(rows, order, row, path, lineno) -> None:
-    node, direction, quantity, rpm, level = row
+    node, direction, quantity, rpm, level, phase = row
     key = (node, direction, quantity)
     if key not in rows:
         rows[key] = {}
@@ -390,21 +415,26 @@ def _add_row(rows, order, row, path, lineno) -> None:
         raise InputError(f"duplicate row: {node},{direction},{quantity} at {rpm:g} rpm "
                          f"already on line {rows[key][rpm][1]}", file=path, line=lineno,
                          key="rpm")
-    rows[key][rpm] = (level, lineno)
+    rows[key][rpm] = (level, lineno, phase)
 
 
 def _measured_runup(rows, order, layout, path, comments) -> MeasuredRunup:
     """The curves of the rows in SI, converted to velocity (or kept as forces)."""
-    curves = {}
+    curves, phases = {}, {}
     for key in order:
         speeds = np.array(sorted(rows[key]))
         curves[key] = (speeds, np.array([rows[key][r][0] for r in speeds]) * layout.scale)
+        phase = np.array([rows[key][r][2] for r in speeds])
+        if np.any(np.isfinite(phase)):
+            phases[key] = phase
     notes = []
     signal = "velocity"
     level_col = layout.level_col
     kind = level_col.split("_", 1)[0]
     if kind in ("acceleration", "displacement"):
         curves = to_velocity(curves, kind, notes)
+        turn = -90.0 if kind == "acceleration" else 90.0      # v = a/(i w), v = i w x
+        phases = {key: wrap_deg(p + turn) for key, p in phases.items()}
     elif kind == "force":
         signal = "mount_force"
         notes.append("force curves: compared with the simulated mount forces [N]")
@@ -412,7 +442,8 @@ def _measured_runup(rows, order, layout, path, comments) -> MeasuredRunup:
         notes.append(f"levels read from peak column {level_col!r} and converted to RMS by "
                      "1/sqrt(2) (exact for a sinusoidal order; synthesis read as the "
                      "root-sum-square of the order peaks)")
-    return MeasuredRunup(curves, source=path, notes=notes, comments=comments, signal=signal)
+    return MeasuredRunup(curves, source=path, notes=notes, comments=comments, signal=signal,
+                         phases=phases)
 
 
 def to_velocity(curves, kind, notes):

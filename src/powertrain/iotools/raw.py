@@ -50,7 +50,7 @@ def detect_format(path) -> str:
 
 
 def read_raw(path, channel_map: ChannelMap | None = None, *, rpm: str | None = None,
-             tacho: str | None = None) -> RawRecording:
+             tacho: str | None = None, cycle_reference: str | None = None) -> RawRecording:
     """Read a raw run-up recording in any supported format.
 
     Parameters
@@ -62,6 +62,9 @@ def read_raw(path, channel_map: ChannelMap | None = None, *, rpm: str | None = N
     rpm, tacho : str, optional
         Name of the speed [rpm] or tacho channel (default: the map's, else a channel named
         ``rpm`` / ``tacho``).
+    cycle_reference : str, optional
+        Name of a once-per-cycle pulse channel [V] (cam or injection signal; default a
+        channel named ``cycle``).
 
     Returns
     -------
@@ -81,7 +84,7 @@ def read_raw(path, channel_map: ChannelMap | None = None, *, rpm: str | None = N
     else:
         from powertrain.iotools.raw_csv import read_csv_signals as reader
     found = reader(path, channel_map)
-    return assemble(found, channel_map, rpm=rpm, tacho=tacho)
+    return assemble(found, channel_map, rpm=rpm, tacho=tacho, cycle_reference=cycle_reference)
 
 
 def _find(signals, wanted):
@@ -92,17 +95,18 @@ def _find(signals, wanted):
     return None
 
 
-def _pick_speed(found: FileSignals, cmap, rpm, tacho):
+def _pick_speed(found: FileSignals, cmap, rpm, tacho, cycle_reference=None):
     signals = list(found.signals)
     rpm_name = rpm or (cmap.rpm if cmap else None)
     tacho_name = tacho or (cmap.tacho if cmap else None)
     out = {}
-    for kind, wanted, default in (("rpm", rpm_name, "rpm"), ("tacho", tacho_name, "tacho")):
+    for kind, wanted, default in (("rpm", rpm_name, "rpm"), ("tacho", tacho_name, "tacho"),
+                                  ("cycle_reference", cycle_reference, "cycle")):
         i = _find(signals, wanted or default)
         if i is None:
             if wanted:
-                raise InputError(f"no channel named {wanted!r} for the {kind}",
-                                 file=found.source, key=wanted)
+                raise InputError(f"no channel named {wanted!r} for the "
+                                 f"{kind.replace('_', ' ')}", file=found.source, key=wanted)
             continue
         name, values, unit = signals.pop(i)
         values = np.asarray(values, float).ravel()
@@ -171,10 +175,10 @@ def _onto_time(found: FileSignals, speed, time):
 
 
 def assemble(found: FileSignals, cmap: ChannelMap | None = None, *, rpm=None,
-             tacho=None) -> RawRecording:
+             tacho=None, cycle_reference=None) -> RawRecording:
     """Map the signals of a file to mount channels in SI (see :func:`read_raw`)."""
     src = found.source
-    speed, signals = _pick_speed(found, cmap, rpm, tacho)
+    speed, signals = _pick_speed(found, cmap, rpm, tacho, cycle_reference)
     speed, time, keep = _onto_time(found, speed, _vibration_time(found, signals))
     channels, ignored = [], []
     used = set()
@@ -217,5 +221,6 @@ def assemble(found: FileSignals, cmap: ChannelMap | None = None, *, rpm=None,
     comments = list(found.comments)
     if ignored:
         comments.append("channels not in the channel map, ignored: " + ", ".join(ignored))
-    rec = RawRecording(time, channels, speed.get("rpm"), speed.get("tacho"), src, comments)
+    rec = RawRecording(time, channels, speed.get("rpm"), speed.get("tacho"), src, comments,
+                       speed.get("cycle_reference"))
     return rec.validate(found.time_name)

@@ -8,7 +8,9 @@ Layout (comment lines start with ``#``; a ``SYNTHETIC`` comment is kept as a lab
     ...
 
 * ``time [s]`` (or ``[ms]``) first or anywhere; uniformly sampled, strictly increasing;
-* optional ``rpm [1/min]`` (speed) and ``tacho [V]`` (pulse train);
+* optional ``rpm [1/min]`` (speed), ``tacho [V]`` (pulse train) and ``cycle [V]`` (a
+  once-per-cycle pulse, cam or injection signal; another name with ``track
+  --cycle-reference NAME``);
 * every other column a channel ``MOUNT.DIRECTION [UNIT]`` or ``MOUNT.SIDE.DIRECTION [UNIT]``
   (or any name listed in a channel map).
 """
@@ -99,6 +101,9 @@ def write_raw_csv(path, recording, *, comment: str = "") -> None:
     if recording.tacho is not None:
         cols.append(recording.tacho)
         names.append("tacho [V]")
+    if recording.cycle_reference is not None:
+        cols.append(recording.cycle_reference)
+        names.append("cycle [V]")
     for ch in recording.channels:
         dim = "length" if ch.quantity == "displacement" else ch.quantity
         cols.append(from_si(ch.values, ch.unit, dim))

@@ -76,6 +76,9 @@ class RawRecording:
         File read.
     comments : list of str
         Notes from the file (e.g. a SYNTHETIC label).
+    cycle_reference : ndarray (n,) or None
+        Once-per-engine-cycle pulse train [V] (cam or injection signal), which fixes the
+        720° crank angle of the order phases (:mod:`powertrain.analysis.phase`).
     """
 
     time: np.ndarray
@@ -84,6 +87,7 @@ class RawRecording:
     tacho: np.ndarray | None = None
     source: str = ""
     comments: list = field(default_factory=list)
+    cycle_reference: np.ndarray | None = None
 
     @property
     def sample_rate(self) -> float:
@@ -149,7 +153,7 @@ class RawRecording:
                 raise InputError(f"channel {ch.label} ({ch.quantity}) appears twice",
                                  file=self.source, key=ch.name)
             seen.add(ch.label + ch.quantity)
-        for name in ("rpm", "tacho"):
+        for name in ("rpm", "tacho", "cycle_reference"):
             arr = getattr(self, name)
             if arr is not None:
                 arr = np.asarray(arr, float)

@@ -33,9 +33,8 @@ DEFINITIONS = {
     "bias_db": "mean(gap_db) over the compared speeds of the channel",
     "max_abs_db": "max |gap_db| over the compared speeds, at rpm_at_max_abs_db",
     "frac": "(sum_n s_n m_n)^2 / (sum_n s_n^2 * sum_n m_n^2), summed over the compared speeds "
-            "n of one channel and quantity; RMS magnitudes (no phase in measured order "
-            "curves); 1 = same shape, blind to a common scale (Heylen et al. 1997; "
-            "Allemang 2003)",
+            "n of one channel and quantity; RMS magnitudes; 1 = same shape, blind to a "
+            "common scale (Heylen et al. 1997; Allemang 2003)",
     "csac": "(sum_j s_j m_j)^2 / (sum_j s_j^2 * sum_j m_j^2), summed over the channels j "
             "compared at one speed and quantity; RMS magnitudes; shape across the channels, "
             "sensitive to mass/stiffness errors (Zang, Grafe & Imregun 2001)",
@@ -56,6 +55,15 @@ DEFINITIONS = {
                              "simulation is exactly zero",
     "overall_rms_db": "sqrt(mean(gap_db^2)) pooled over every compared point of every "
                       "channel and quantity (not the measured-not-modelled points)",
+    "phase_gap_deg": "phase_sim - phase_meas at each compared speed, wrapped to (-180, 180]; "
+                     "phase re cylinder-1 firing TDC (order component sqrt2*RMS*cos(k*theta "
+                     "+ phase)); null where a side gives no phase; only for channels with "
+                     "phase on both sides; phase_rms_deg its RMS, phase_bias_deg the angle of "
+                     "its mean phasor, n_phase_compared the points with both phases",
+    "complex_gap": "complex_gap_db = 20*log10|a|, complex_gap_deg = arg a, a = sum(S conj(M)) "
+                   "/ sum(|M|^2) over the points with both phases, S and M the complex RMS "
+                   "amplitudes (level * exp(i phase)) of simulation and measurement: the "
+                   "least-squares complex ratio sim/measured",
 }
 
 
@@ -82,6 +90,9 @@ class ChannelComparison:
     scored: np.ndarray             # bool
     gap_db: np.ndarray             # at the scored speeds
     stats: dict = field(default_factory=dict)
+    #: phase gap sim - measured [deg] at the scored speeds, NaN where a side has no phase;
+    #: None when a side gives no phase for this channel and quantity
+    phase_gap_deg: np.ndarray | None = None
 
     def to_dict(self) -> dict:
         r = self.rpm[self.scored]
@@ -99,6 +110,8 @@ class ChannelComparison:
             "simulated_m_per_s": [json_number(x) for x in self.simulated[self.scored]],
             "gap_db": [json_number(x) for x in self.gap_db],
         })
+        if self.phase_gap_deg is not None:
+            d["phase_gap_deg"] = [json_number(x) for x in self.phase_gap_deg]
         return d
 
 
@@ -298,6 +311,7 @@ class ComparisonResult:
                                    "per quantity (CSAC/CSF across the channels at each "
                                    "speed, RMS magnitudes):"]
         lines += [_quantity_line(pq) for pq in self.per_quantity()]
+        lines += self._phase_lines()
         lines += self._not_modelled_lines()
         if self.missing:
             lines += ["", "not compared:"] + [f"  {x}" for x in missing_lines(self.missing)]
@@ -318,6 +332,21 @@ class ComparisonResult:
                      f"floor {self.noise_floor * 1e3:g} mm/s (measured points below "
                      f"{self.exclusion_limit * 1e3:g} mm/s excluded)")
         return lines
+
+    def _phase_lines(self) -> list:
+        """The phase and complex gaps of the channels with phase on both sides (no lines
+        without)."""
+        phased = [c for c in self.worst_first() if c.stats.get("n_phase_compared")]
+        if not phased:
+            return []
+        rows = [[c.mount, c.direction, c.quantity, c.stats["n_phase_compared"],
+                 f"{c.stats['phase_rms_deg']:.1f}", f"{c.stats['phase_bias_deg']:+.1f}",
+                 f"{c.stats['complex_gap_db']:+.2f}", f"{c.stats['complex_gap_deg']:+.1f}"]
+                for c in phased]
+        return ["", "phase where given on both sides (gap = sim - measured, wrapped to ±180°; "
+                "complex gap = least-squares complex ratio sim/measured):",
+                _format_table(["mount", "dir", "quantity", "n", "rms °", "bias °",
+                               "complex dB", "complex °"], rows)]
 
     def _not_modelled_lines(self) -> list:
         """The measured-not-modelled points, per channel and quantity (not in any dB gap)."""

@@ -32,10 +32,12 @@ body side (``left/passive``) and the body points of interest (``seat_rail``).
 
 Long-format CSV (also the measured-data format): columns
 ``mount,direction,quantity,rpm,side,velocity_rms_mm_per_s,acceleration_rms_m_per_s2,
-force_rms_n`` with ``quantity`` = ``order_0.5``, ``order_1``, ... ``order_8`` or
+force_rms_n,phase_deg`` with ``quantity`` = ``order_0.5``, ``order_1``, ... ``order_8`` or
 ``synthesis``, ``side`` = ``active`` or ``passive``; ``force_rms_n`` is the force the mount
-transmits to the body (empty for body points). Files with only the first four columns and
-``velocity_rms_mm_per_s`` stay valid input.
+transmits to the body (empty for body points); ``phase_deg`` the velocity's order phase re
+cylinder-1 firing TDC (:mod:`powertrain.analysis.phase`; acceleration leads it by 90°), empty
+on synthesis rows and where the order is round-off. Files with only the first four columns
+and ``velocity_rms_mm_per_s`` stay valid input.
 """
 
 from __future__ import annotations
@@ -58,7 +60,7 @@ QUANTITIES = {
 RIGID_BODY_MODES_LABEL = "rigid-body modes, undamped, mounts at their static stiffness [Hz]"
 #: Columns written by :meth:`RunupResult.csv_text` (files with only the first five stay valid).
 CSV_HEADER = ("mount,direction,quantity,rpm,side,velocity_rms_mm_per_s,"
-              "acceleration_rms_m_per_s2,force_rms_n")
+              "acceleration_rms_m_per_s2,force_rms_n,phase_deg")
 
 
 @dataclass
@@ -201,11 +203,14 @@ class RunupResult:
 
     # ----------------------------------------------------------------- writers
     def csv_text(self, comments=()) -> str:
-        """Long-format CSV text: RMS velocity [mm/s], acceleration [m/s²] and the force the
-        mount transmits to the body [N] per channel, side, order and speed (body points
-        have no force: empty cell). ``comments`` become ``#`` lines above the header (a
-        SYNTHETIC label, the provenance)."""
+        """Long-format CSV text: RMS velocity [mm/s], acceleration [m/s²], the force the
+        mount transmits to the body [N] and the velocity's phase [deg] per channel, side,
+        order and speed (body points have no force, synthesis rows no phase: empty cells).
+        ``comments`` become ``#`` lines above the header (a SYNTHETIC label, the
+        provenance)."""
         from powertrain.analysis.channel import split_side
+        from powertrain.analysis.phase import phase_deg
+        phase = phase_deg(self.velocity)
         lines = [f"# {' '.join(str(c).split())}" for c in comments] + [CSV_HEADER]
         values = [(self.order_rms("velocity") * 1e3, self.synthesis_rms("velocity") * 1e3),
                   (self.order_rms("acceleration"), self.synthesis_rms("acceleration")),
@@ -221,8 +226,10 @@ class RunupResult:
                     cells = [(rms[i, c, k] if k < len(self.orders) else syn[i, c])
                              for rms, syn in values]
                     force = "" if name in points else f"{cells[2]:.8g}"
+                    angle = phase[i, c, k] if k < len(self.orders) else np.nan
+                    angle = f"{angle:.6g}" if np.isfinite(angle) else ""
                     lines.append(f"{base},{direction},{q},{r:g},{side},{cells[0]:.8g},"
-                                 f"{cells[1]:.8g},{force}")
+                                 f"{cells[1]:.8g},{force},{angle}")
         return "\n".join(lines) + "\n"
 
     def to_csv(self, path, comments=()) -> None:

@@ -9,7 +9,11 @@ Long-format CSV (read by ``compare`` and ``diagnose``; :mod:`powertrain.iotools.
     left,z,overall,1050,0.0163
 
 The level column states the channels' quantity and unit (:data:`LEVEL_COLUMNS`); a
-``side`` column (``active``/``passive``) follows ``mount`` when any channel is passive.
+``side`` column (``active``/``passive``) follows ``mount`` when any channel is passive. With
+the phase measured (``track --tdc-offset``) a ``phase_deg`` column follows the level: the
+order's phase re cylinder-1 firing TDC (:mod:`powertrain.analysis.phase`), empty on
+``synthesis`` and ``overall`` rows and for orders whose phase is undefined (half orders
+without ``--cycle-reference``).
 ``synthesis`` is the RMS sum over the orders tracked; ``overall`` rows (``track --overall``)
 the RMS of the raw signal in a band (:mod:`powertrain.analysis.overall`).
 
@@ -27,9 +31,11 @@ HDF5 (``--out``)::
     /orders          (n_o,)            1
     /channels/{name,mount,side,direction,quantity,unit}   (n_ch,) str (unit = SI unit)
     /amplitude       (k, n_ch, n_o) complex   SI peak amplitude, phase re crank angle 0
+                                              (re cylinder-1 firing TDC with --tdc-offset)
     /order_rms       (k, n_ch, n_o)           SI RMS
     /synthesis_rms   (k, n_ch)                SI RMS
-/overall_rms     (k, n_ch)                SI RMS (only with --overall)
+    /overall_rms     (k, n_ch)                SI RMS (only with --overall)
+    /phase_deg       (k, n_ch, n_o)           deg, NaN where undefined (only with --tdc-offset)
 """
 
 from __future__ import annotations
@@ -51,6 +57,15 @@ LEVEL_COLUMNS = {
     "displacement": ("displacement_rms_mm", 1e3),
     "force": ("force_rms_n", 1.0),
 }
+
+
+def _phase_cell(phase, index) -> list:
+    """The ``phase_deg`` cell of an order row: none without the column, empty where
+    undefined."""
+    if phase is None:
+        return []
+    value = phase[index]
+    return [f"{value:.6g}" if np.isfinite(value) else ""]
 
 
 @dataclass
@@ -110,6 +125,17 @@ class TrackedOrders:
         """RMS sum over the tracked orders per speed and channel [SI]."""
         return np.sqrt(np.sum(self.order_rms() ** 2, axis=-1))
 
+    def phase_deg(self) -> np.ndarray | None:
+        """Phase per speed, channel and order re cylinder-1 firing TDC [deg], NaN for orders
+        whose phase is undefined (``settings["phase"]["orders"]``); None when the phase was
+        not measured."""
+        from powertrain.analysis.phase import phase_deg
+        ref = self.settings.get("phase")
+        if not ref:
+            return None
+        defined = np.isin(np.round(self.orders, 9), np.round(ref["orders"], 9))
+        return np.where(defined, phase_deg(self.amplitude), np.nan)
+
     @property
     def quantity(self) -> str:
         """The one quantity of all channels (InputError if mixed)."""
@@ -150,21 +176,25 @@ class TrackedOrders:
         tag = " [SYNTHETIC]" if any("synthetic" in c.lower() for c in self.comments) else ""
         lines = [f"# tracked by powertrain track ({self.method}) from {self.source}{tag}"]
         lines += [f"# {c}" for c in self.comments]
+        phase = self.phase_deg()
+        tail = [] if phase is None else [""]            # empty phase_deg cell
         lines.append(",".join(["mount"] + (["side"] if with_side else [])
-                              + ["direction", "quantity", "rpm", col]))
+                              + ["direction", "quantity", "rpm", col]
+                              + ([] if phase is None else ["phase_deg"])))
         rms = self.order_rms() * factor
         syn = self.synthesis_rms() * factor
         for c, ch in enumerate(self.channels):
             key = [ch.mount] + ([ch.side] if with_side else []) + [ch.direction]
             for k, order in enumerate(self.orders):
                 q = order_label(order)
-                lines += [",".join(key + [q, f"{r:g}", f"{rms[i, c, k]:.8g}"])
+                lines += [",".join(key + [q, f"{r:g}", f"{rms[i, c, k]:.8g}"]
+                                   + _phase_cell(phase, (i, c, k)))
                           for i, r in enumerate(self.rpm)]
-            lines += [",".join(key + ["synthesis", f"{r:g}", f"{syn[i, c]:.8g}"])
+            lines += [",".join(key + ["synthesis", f"{r:g}", f"{syn[i, c]:.8g}"] + tail)
                       for i, r in enumerate(self.rpm)]
             if self.overall is not None:
                 lines += [",".join(key + ["overall", f"{r:g}",
-                                          f"{self.overall[i, c] * factor:.8g}"])
+                                          f"{self.overall[i, c] * factor:.8g}"] + tail)
                           for i, r in enumerate(self.rpm)]
         return "\n".join(lines) + "\n"
 
@@ -220,6 +250,8 @@ class TrackedOrders:
                 h5.create_dataset("synthesis_rms", data=self.synthesis_rms())
                 if self.overall is not None:
                     h5.create_dataset("overall_rms", data=self.overall)
+                if self.phase_deg() is not None:
+                    h5.create_dataset("phase_deg", data=self.phase_deg()).attrs["unit"] = "deg"
 
     @classmethod
     def from_hdf5(cls, path) -> TrackedOrders:
@@ -257,6 +289,7 @@ class TrackedOrders:
                  f"speed: {s['speed_source']}; tracked ({self.method}) at {self.rpm.size} "
                  f"speeds {self.rpm[0]:g}..{self.rpm[-1]:g} rpm (step {s['rpm_step']:g}) of "
                  f"the measured {s['measured_rpm'][0]:.0f}..{s['measured_rpm'][1]:.0f} rpm"]
+        lines += self._phase_lines()
         if "ends_dropped_s" in s:
             (lo, hi), (start, end) = s["bandwidth_hz_range"], s["ends_dropped_s"]
             lines.append(f"Vold-Kalman bandwidth {lo:.3g}..{hi:.3g} Hz ({s['bandwidth_rule']}); "
@@ -270,6 +303,23 @@ class TrackedOrders:
         if written:
             lines.append("wrote " + ", ".join(written))
         return "\n".join(lines)
+
+    def _phase_lines(self) -> list:
+        """What the phases refer to and, without a cycle reference, why half orders have
+        none (no lines when the phase was not measured)."""
+        ref = self.settings.get("phase")
+        if not ref:
+            return []
+        after = ("the first tacho reference pulse after each cycle-reference edge"
+                 if ref["cycle_reference"] else "the tacho reference pulse")
+        lines = [f"phase: re cylinder-1 firing TDC, {ref['tdc_offset_deg']:g}° after {after}; "
+                 f"defined for {len(ref['orders'])} of {self.orders.size} orders"]
+        if not ref["cycle_reference"] and any(abs(2 * o - round(2 * o)) < 1e-9
+                                              and o % 1 for o in self.orders):
+            lines.append("half-order phases empty: one crank revolution cannot tell firing "
+                         "from gas-exchange TDC (give --cycle-reference COL, a cam or "
+                         "injection signal)")
+        return lines
 
     def _rms_rows(self) -> list:
         """Median, min and max over the speeds per channel and order, synthesis, overall."""

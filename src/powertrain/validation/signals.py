@@ -5,6 +5,11 @@ A linear sweep :math:`n(t) = n_0 + (n_1 - n_0)\,t/T` has the crank angle
 form, so a sum of orders :math:`\sum_o A_o\cos(o\theta + \varphi_o)` is exact at every
 sample; its derivative :math:`-\sum_o A_o\,o\,\omega(t)\sin(o\theta + \varphi_o)` is the
 matching acceleration. None of this passes through the tracker's speed estimate.
+
+Phases follow :mod:`powertrain.analysis.phase`: :math:`\theta` here is the crank angle from
+cylinder-1 firing TDC, so :math:`\varphi_o` is the phase the tracker should report. The tacho's
+reference pulse sits ``tdc_offset_deg`` before that TDC (TDC lies that far after it), and a
+once-per-cycle pulse (:func:`cycle_pulse`) marks the 720° cycle.
 """
 
 from __future__ import annotations
@@ -37,10 +42,30 @@ def order_sum_derivative(theta, rpm, orders, amplitudes, phases=None):
                for o, a, p in zip(orders, amplitudes, phases))
 
 
-def tacho(theta, pulses_per_rev, *, high=5.0, duty=0.5):
-    """Rectangular tacho pulse train, ``pulses_per_rev`` pulses per revolution [V]."""
-    phase = np.mod(theta * pulses_per_rev / (2 * np.pi), 1.0)
-    return np.where(phase < duty, high, 0.0)
+def tacho(theta, pulses_per_rev, *, high=5.0, duty=0.5, rise_deg=0.0, missing_teeth=0):
+    """Tacho pulse train, ``pulses_per_rev`` pulses per revolution [V], rising at ``theta``
+    = 0, 2π/N, ...: rectangular, or with ``rise_deg`` > 0 a linear rise over that crank
+    angle that passes the tracker's trigger level (:data:`~powertrain.analysis.speed.
+    TRIGGER_HIGH` of the swing) exactly there, as a sensor with a finite slope would (a
+    rectangular edge is only known to within a sample interval). ``missing_teeth``: the
+    last pulses of each revolution left out (a 60-2 wheel), so the pulse at 0 follows the
+    gap."""
+    from powertrain.analysis.speed import TRIGGER_HIGH
+    rise = max(rise_deg, 0.0) * pulses_per_rev / 360.0              # fraction of a pulse
+    x = theta * pulses_per_rev / (2 * np.pi) + TRIGGER_HIGH * rise  # the rise starts at 0
+    tooth, x = np.mod(np.floor(x), pulses_per_rev), np.mod(x, 1.0)
+    if rise > 0:
+        level = np.clip(np.minimum(x / rise, (duty + rise - x) / rise), 0.0, 1.0)
+    else:
+        level = (x < duty).astype(float)
+    return high * np.where(tooth < pulses_per_rev - missing_teeth, level, 0.0)
+
+
+def cycle_pulse(theta, at_deg, *, width_deg=30.0, high=5.0):
+    """Once-per-cycle pulse [V] (cam or injection signal): rising edge at cycle angle
+    ``at_deg`` (crank angle from cylinder-1 firing TDC, modulo 720°)."""
+    cycle = np.mod(np.degrees(theta) - at_deg, 720.0)
+    return np.where(cycle < width_deg, high, 0.0)
 
 
 #: Published order-tracking example of a commercial signal-processing toolbox: 600 Hz,
@@ -66,17 +91,24 @@ ANALYTIC_PHASES = 0.4 * np.arange(16)
 
 
 def analytic_sweep(fs=8192.0, duration=20.0, rpm0=1000.0, rpm1=6000.0,
-                   pulses_per_rev=4) -> RawRecording:
-    """Velocity channel ``right.z`` [mm/s] with known orders, the matching acceleration
-    ``left.z`` [g], the rpm and a tacho."""
+                   pulses_per_rev=4, *, tdc_offset_deg=0.0, cycle_at_deg=None,
+                   tacho_rise_deg=0.0, missing_teeth=0) -> RawRecording:
+    """Velocity channel ``right.z`` [mm/s] with known orders (phases
+    :data:`ANALYTIC_PHASES` re cylinder-1 firing TDC), the matching acceleration ``left.z``
+    [g], the rpm and a tacho (:func:`tacho`, ``tacho_rise_deg``, ``missing_teeth``) whose
+    reference pulse lies ``tdc_offset_deg`` before TDC; with ``cycle_at_deg`` also a
+    once-per-cycle pulse there (:func:`cycle_pulse`)."""
     t, rpm, theta = linear_sweep(fs, duration, rpm0, rpm1)
     v = order_sum(theta, ANALYTIC_ORDERS, ANALYTIC_VELOCITY, ANALYTIC_PHASES)
     a = order_sum_derivative(theta, rpm, ANALYTIC_ORDERS, ANALYTIC_VELOCITY, ANALYTIC_PHASES)
     chans = [RawChannel("left.z", "left", "active", "z", "acceleration", a, "g"),
              RawChannel("right.z", "right", "active", "z", "velocity", v, "mm/s")]
-    return RawRecording(t, chans, rpm, tacho(theta, pulses_per_rev), "analytic sweep",
+    cycle = None if cycle_at_deg is None else cycle_pulse(theta, cycle_at_deg)
+    pulses = tacho(theta + np.radians(tdc_offset_deg), pulses_per_rev, rise_deg=tacho_rise_deg,
+                   missing_teeth=missing_teeth)
+    return RawRecording(t, chans, rpm, pulses, "analytic sweep",
                         [f"SYNTHETIC: analytic linear sweep {rpm0:g}->{rpm1:g} rpm in "
-                         f"{duration:g} s, orders 0.5..8"])
+                         f"{duration:g} s, orders 0.5..8"], cycle)
 
 
 def crossing(fs=4096.0, duration=10.0, tone_hz=100.0, tone_amplitude=0.5) -> RawRecording:

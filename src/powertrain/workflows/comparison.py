@@ -23,6 +23,11 @@ Rules:
 * Channels or quantities present on one side only are listed as missing, never scored as a
   zero level; so are channels with no scoreable point.
 * CSAC and CSF need at least :data:`MIN_CHANNELS_CSAC` channels at a speed (counted otherwise).
+* Where both sides give the order phase (``MeasuredRunup.phases``; a simulation run here
+  always does), each compared point also gets a phase gap (sim − measured, wrapped to ±180°;
+  the simulated phase interpolated linearly in rpm between simulated speeds) and each
+  channel and quantity a complex gap (:mod:`powertrain.analysis.compare`); the levels' gaps
+  do not change.
 """
 
 from __future__ import annotations
@@ -240,6 +245,8 @@ def compare_runup(simulated, measured: MeasuredRunup, *, noise_floor=DEFAULT_NOI
                 continue
             c = _compare_channel(where, measured.curves[key], simulated.curves[key],
                                  noise_floor, sigma_db)
+            _compare_phase(c, measured.phases.get(key), simulated.phases.get(key),
+                           simulated.curves[key][0])
             if c.not_modelled.any():
                 not_modelled.append({**where, **_points(c, c.not_modelled)})
             if c.scored.any():
@@ -272,6 +279,18 @@ def _compare_channel(where, measured_curve, simulated_curve, noise_floor, sigma_
     return ChannelComparison(where["mount"], where["direction"], where["quantity"], rpm_m,
                              lev_m, sim, ~inside, floor, zero, unmodelled, inside & ~at_node,
                              scored, gap, stats)
+
+
+def _compare_phase(c: ChannelComparison, measured_phase, simulated_phase, rpm_s) -> None:
+    """Phase gap per scored point and the phase and complex gap of ``c``
+    (:func:`~powertrain.analysis.compare.phase_statistics`), where both sides give phase."""
+    if measured_phase is None or simulated_phase is None or not c.scored.any():
+        return
+    sim = cm.interpolate_phase(rpm_s, simulated_phase, c.rpm[c.scored])
+    stats = cm.phase_statistics(c.simulated[c.scored], c.measured[c.scored], sim,
+                                np.asarray(measured_phase, float)[c.scored])
+    c.phase_gap_deg = stats.pop("phase_gap_deg")
+    c.stats.update(stats)
 
 
 def _points(c: ChannelComparison, mask) -> dict:

@@ -13,6 +13,7 @@ import numpy as np
 
 from powertrain.analysis import order_tracking as cot
 from powertrain.analysis.orders import ORDERS
+from powertrain.analysis.phase import tdc_origin, to_tdc
 from powertrain.analysis.speed import speed_from_rpm, speed_from_tacho
 from powertrain.errors import InputError
 from powertrain.results.tracked import TrackedChannel, TrackedOrders
@@ -51,7 +52,8 @@ def speed_profile(rec, *, use="auto", pulses_per_rev=None, smooth_s=0.1):
 def track(raw, *, orders=None, rpm_step=50.0, method="cot", bandwidth=None, channel_map=None,
           rpm_column=None, tacho_column=None, pulses_per_rev=None, quantity=None,
           as_quantity=None, overall=False, overall_band=None, spectrum_at=(),
-          map_channel=None, maps=False, progress=False) -> TrackedOrders:
+          map_channel=None, maps=False, tdc_offset=None, cycle_reference=None,
+          progress=False) -> TrackedOrders:
     """Order-track raw run-up time data (``powertrain track``).
 
     Parameters
@@ -76,27 +78,25 @@ def track(raw, *, orders=None, rpm_step=50.0, method="cot", bandwidth=None, chan
         Channel of the maps: its name in the file or its label (default the first).
     maps : bool
         Campbell and rpm-frequency maps of that channel (``result.maps``).
+    tdc_offset, cycle_reference : float, str, optional
+        Measure the phases: see :func:`track_recording`; the cycle reference's file channel.
 
     Returns
     -------
     TrackedOrders
         With ``spectra`` and ``maps`` when asked; ``to_text()`` is the command's report.
     """
-    from powertrain.analysis.speed import MAX_PULSES_PER_REV
-    if tacho_column and pulses_per_rev is None:
-        raise InputError("--tacho needs --pulses-per-rev N", key="--pulses-per-rev")
-    if pulses_per_rev is not None and not 1 <= pulses_per_rev <= MAX_PULSES_PER_REV:
-        raise InputError(f"must be 1..{MAX_PULSES_PER_REV}", key="--pulses-per-rev")
-    if map_channel and not maps:
-        raise InputError("--map-channel needs --map FILE.png", key="--map-channel")
+    _check_options(tacho_column, pulses_per_rev, map_channel, maps, tdc_offset,
+                   cycle_reference)
     if isinstance(orders, str):
         orders = cot.parse_orders(orders)
     overall_opts = _overall_options(overall, overall_band, as_quantity)
-    rec = _recording(raw, channel_map, rpm_column, tacho_column)
+    rec = _recording(raw, channel_map, rpm_column, tacho_column, cycle_reference)
     use = "tacho" if tacho_column else "rpm" if rpm_column else "auto"
     tracked = track_recording(rec, orders, rpm_step=rpm_step, method=method, use=use,
                               pulses_per_rev=pulses_per_rev, quantity=quantity,
-                              bandwidth_hz=bandwidth, overall=overall_opts, progress=progress)
+                              bandwidth_hz=bandwidth, overall=overall_opts,
+                              tdc_offset_deg=tdc_offset, progress=progress)
     spectra = _spectra(rec, use, pulses_per_rev, spectrum_at, tracked.orders, quantity)
     if as_quantity == "velocity":
         tracked = tracked.as_velocity()
@@ -110,7 +110,22 @@ def track(raw, *, orders=None, rpm_step=50.0, method="cot", bandwidth=None, chan
     return tracked
 
 
-def _recording(raw, channel_map, rpm_column, tacho_column):
+def _check_options(tacho_column, pulses_per_rev, map_channel, maps, tdc_offset,
+                   cycle_reference) -> None:
+    """Refuse options that need another one, or out of range."""
+    from powertrain.analysis.speed import MAX_PULSES_PER_REV
+    if tacho_column and pulses_per_rev is None:
+        raise InputError("--tacho needs --pulses-per-rev N", key="--pulses-per-rev")
+    if pulses_per_rev is not None and not 1 <= pulses_per_rev <= MAX_PULSES_PER_REV:
+        raise InputError(f"must be 1..{MAX_PULSES_PER_REV}", key="--pulses-per-rev")
+    if map_channel and not maps:
+        raise InputError("--map-channel needs --map FILE.png", key="--map-channel")
+    if cycle_reference and tdc_offset is None:
+        raise InputError("needs --tdc-offset DEG (where cylinder-1 firing TDC lies)",
+                         key="--cycle-reference")
+
+
+def _recording(raw, channel_map, rpm_column, tacho_column, cycle_reference=None):
     """The recording of ``raw`` (read through ``channel_map`` if a path)."""
     from powertrain.iotools.raw import read_raw
     if not isinstance(raw, (str, os.PathLike)):
@@ -118,7 +133,8 @@ def _recording(raw, channel_map, rpm_column, tacho_column):
     if isinstance(channel_map, (str, os.PathLike)):
         from powertrain.iotools.channel_map import read_channel_map
         channel_map = read_channel_map(channel_map)
-    return read_raw(raw, channel_map, rpm=rpm_column, tacho=tacho_column)
+    return read_raw(raw, channel_map, rpm=rpm_column, tacho=tacho_column,
+                    cycle_reference=cycle_reference)
 
 
 def _overall_options(overall, overall_band, as_quantity):
@@ -183,7 +199,7 @@ def _maps(rec, use, pulses_per_rev, rpm_step, channel, max_order):
 
 def track_recording(rec, orders=None, *, rpm_step=50.0, method="cot", use="auto",
                     pulses_per_rev=None, quantity=None, bandwidth_hz=None, block_revs=None,
-                    overall=None, progress=False) -> TrackedOrders:
+                    overall=None, tdc_offset_deg=None, progress=False) -> TrackedOrders:
     """Order-track every channel of a recording.
 
     Parameters
@@ -210,12 +226,16 @@ def track_recording(rec, orders=None, *, rpm_step=50.0, method="cot", use="auto"
         Also the overall level of the raw signal per speed
         (:mod:`powertrain.analysis.overall`): ``band`` (lo, hi) [Hz] or None for
         :func:`overall_band`, ``velocity`` True to give it as velocity.
+    tdc_offset_deg : float, optional
+        Measure the phases: crank angle of cylinder-1 firing TDC after the tacho reference
+        pulse [deg] (:func:`~powertrain.analysis.phase.tdc_origin`; ``use`` auto: tacho).
     progress : bool
         tqdm bar on stderr (hidden when stderr is not a terminal).
 
     Returns
     -------
     TrackedOrders
+        Amplitudes re cylinder-1 firing TDC when ``tdc_offset_deg`` is given.
     """
     orders = np.asarray(ORDERS if orders is None else orders, float)
     if method not in ("cot", "vkf"):
@@ -223,24 +243,65 @@ def track_recording(rec, orders=None, *, rpm_step=50.0, method="cot", use="auto"
     chans = [c for c in rec.channels if quantity is None or c.quantity == quantity]
     if not chans:
         raise InputError(f"no {quantity} channel", file=rec.source, key="--quantity")
-    profile = speed_profile(rec, use=use, pulses_per_rev=pulses_per_rev)
-    if method == "cot":
-        amp, rpm, settings = _track_cot(rec, chans, profile, orders, rpm_step, block_revs,
-                                        progress)
-    else:
-        amp, rpm, settings = _track_vkf(rec, chans, profile, orders, rpm_step, bandwidth_hz,
-                                        progress)
-    i0, i1 = profile.valid
-    settings.update({"rpm_step": float(rpm_step), "speed_source": profile.source,
-                     "speed_notes": profile.notes, "sample_rate_hz": rec.sample_rate,
-                     "measured_rpm": [float(np.min(profile.rpm[i0:i1 + 1])),
-                                      float(np.max(profile.rpm[i0:i1 + 1]))]})
+    profile, origin = _profile_and_origin(rec, use, pulses_per_rev, tdc_offset_deg)
+    amp, rpm, settings = _track_channels(rec, chans, profile, orders, method, rpm_step,
+                                         block_revs if method == "cot" else bandwidth_hz,
+                                         progress)
+    if origin is not None:
+        amp = to_tdc(amp, orders, origin[0])
+        settings["phase"] = _phase_settings(orders, tdc_offset_deg, origin[1])
     tracked = [TrackedChannel(c.name, c.mount, c.side, c.direction, c.quantity) for c in chans]
     result = TrackedOrders(rpm, orders, tracked, amp, method, rec.source, settings,
                            list(rec.comments), recording=_summary(rec))
     if overall is not None:
         _add_overall(result, rec, chans, profile, overall.get("band"), overall.get("velocity"))
     return result
+
+
+def _track_channels(rec, chans, profile, orders, method, rpm_step, block_or_bandwidth,
+                    progress):
+    """``(amplitudes, rpm, settings)`` of :func:`_track_cot` or :func:`_track_vkf`, the
+    settings with the speed grid and source."""
+    track_with = _track_cot if method == "cot" else _track_vkf
+    amp, rpm, settings = track_with(rec, chans, profile, orders, rpm_step, block_or_bandwidth,
+                                    progress)
+    i0, i1 = profile.valid
+    settings.update({"rpm_step": float(rpm_step), "speed_source": profile.source,
+                     "speed_notes": profile.notes, "sample_rate_hz": rec.sample_rate,
+                     "measured_rpm": [float(np.min(profile.rpm[i0:i1 + 1])),
+                                      float(np.max(profile.rpm[i0:i1 + 1]))]})
+    return amp, rpm, settings
+
+
+def _profile_and_origin(rec, use, pulses_per_rev, tdc_offset_deg):
+    """The speed profile (from the tacho, where there is one, when the phase is measured)
+    and :func:`_tdc_origin` (None without ``tdc_offset_deg``)."""
+    if tdc_offset_deg is not None and use == "auto" and rec.tacho is not None:
+        use = "tacho"
+    profile = speed_profile(rec, use=use, pulses_per_rev=pulses_per_rev)
+    origin = None if tdc_offset_deg is None else _tdc_origin(rec, profile, tdc_offset_deg)
+    return profile, origin
+
+
+def _tdc_origin(rec, profile, tdc_offset_deg):
+    """``(origin [rad], per_cycle)``: the profile angle of cylinder-1 firing TDC and whether
+    the cycle reference fixed it modulo 720° (:func:`powertrain.analysis.phase.tdc_origin`)."""
+    from powertrain.analysis.speed import tacho_edges
+    edges = None
+    if rec.cycle_reference is not None:
+        edges = tacho_edges(rec.time, rec.cycle_reference, file=rec.source,
+                            key="--cycle-reference", what="cycle reference")
+    origin, per_cycle = tdc_origin(profile, float(tdc_offset_deg), edges, file=rec.source)
+    return origin, per_cycle
+
+
+def _phase_settings(orders, tdc_offset_deg, per_cycle) -> dict:
+    """What the phase of a tracked result refers to, and the orders whose phase is defined:
+    whole orders, and with a cycle reference half orders too."""
+    step = 0.5 if per_cycle else 1.0
+    defined = [float(o) for o in orders if abs(o / step - round(o / step)) < 1e-9]
+    return {"tdc_offset_deg": float(tdc_offset_deg), "cycle_reference": bool(per_cycle),
+            "orders": defined}
 
 
 def _summary(rec) -> dict:
