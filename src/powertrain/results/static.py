@@ -20,7 +20,7 @@ deflection; 1 without a curve).
 from __future__ import annotations
 
 import json
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -36,7 +36,6 @@ class StaticResult:
     points: list
     mounts: list
     engine: str = ""
-    meta: dict = field(default_factory=dict)
 
     @property
     def rpm(self) -> np.ndarray:

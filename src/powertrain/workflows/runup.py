@@ -36,6 +36,7 @@ from powertrain.errors import InputError, require_finite, solved
 from powertrain.progress import progress_bar
 from powertrain.results.runup import RunupResult, SweepRunup
 from powertrain.results.static import StaticResult
+from powertrain.solvers.operating_point import StaticSupport, operating_points
 from powertrain.solvers.steppers import Cycles, choose_stepper
 
 #: Largest speed grid a run-up command accepts (about 0.1 s per speed step).
@@ -136,14 +137,17 @@ def _run_runup(engine, rpm=None, *, solver="newmark", angle_step_deg=ANGLE_STEP_
     _warn_periodicity(rpm, [o.periodicity for o in speeds])
     result = _result(engine, system, step, rpm, speeds, step.setup_seconds + seconds)
     if points is not None:
-        result.operating_point = StaticResult(points, engine.mount_names, engine.name)
+        result.operating_point = _static_result(engine, points)
     return result
+
+
+def _static_result(engine, points) -> StaticResult:
+    return StaticResult(points, engine.mount_names, engine.name)
 
 
 def _operating_points(engine, rpm):
     """The static operating point of every speed when some mount direction has a static
     curve (its networks are then scaled per speed); None otherwise (nothing is solved)."""
-    from powertrain.solvers.operating_point import StaticSupport, operating_points
     if not StaticSupport.of(engine).has_curves:
         return None
     return operating_points(engine, rpm)
@@ -365,8 +369,7 @@ def runup(engine=None, rpm=None, *, solver="newmark", stepper="auto",
                       angle_step_deg=angle_step_deg, stepper=stepper)
     result.engine, result.modifications = engine, modifications
     if result.operating_point is None:
-        from powertrain.workflows.static import static
-        result.operating_point = static(engine, rpm)
+        result.operating_point = _static_result(engine, operating_points(engine, rpm))
     result.meta["engine_file"] = str(engine.file)
     result.meta["rigid_body_mode_dominant"] = mode_coordinates(engine,
                                                                result.rigid_body_modes_hz)

@@ -44,5 +44,4 @@ def static(engine=None, rpm=None) -> StaticResult:
     if bad.size:
         raise InputError(f"{bad[0]:g} rpm is outside the engine's range {lo:g}..{hi:g} rpm",
                          key="--rpm")
-    return StaticResult(operating_points(engine, rpm), engine.mount_names, engine.name,
-                        {"engine_file": str(engine.file)})
+    return StaticResult(operating_points(engine, rpm), engine.mount_names, engine.name)
