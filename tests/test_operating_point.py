@@ -234,3 +234,15 @@ def test_bad_rpm(tmp_path, rpm):
     assert res.exit_code == 1
     assert "--rpm" in res.output and "Traceback" not in res.output
     assert not out.exists()
+
+
+def test_runup_with_effects_records_every_speed(tmp_path):
+    """An amplitude effect runs one speed at a time: the operating points of every speed
+    are kept, in order, and the HDF5 file reads back."""
+    from powertrain import runup
+    from powertrain.iotools.runup_hdf5 import read_runup_hdf5
+    run = runup(NONLINEAR, [1500.0, 2500.0], solver="harmonic",
+                effects=["amplitude_stiffness:kappa=1,a_c=0.02mm"])
+    assert run.operating_point.rpm.tolist() == [1500.0, 2500.0]
+    run.to_hdf5(tmp_path / "e.h5")
+    assert read_runup_hdf5(tmp_path / "e.h5").operating_point.rpm.tolist() == [1500.0, 2500.0]

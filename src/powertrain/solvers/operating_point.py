@@ -80,11 +80,6 @@ class StaticSupport:
                 k0.append(model.static_stiffness())
         return cls(np.array(rows), curves, np.array(k0))
 
-    @property
-    def has_curves(self) -> bool:
-        """True when some network has a static curve."""
-        return any(c is not None for c in self.curves)
-
     def forces(self, deflection) -> np.ndarray:
         """Force of every network [N] at its deflection [m]."""
         return np.array([k * d if c is None else float(c.force_at(d)) for c, k, d in
@@ -133,6 +128,12 @@ class OperatingPoint:
     static_factor: np.ndarray
     iterations: int
     residual: tuple
+
+
+def has_static_curves(engine) -> bool:
+    """True when some mount direction of ``engine`` has a static curve."""
+    return any(getattr(model, "static_curve", None) is not None
+               for mount in engine.mounts for model in mount.directions.values())
 
 
 def static_load(engine, mean_torque: float) -> np.ndarray:
@@ -186,10 +187,9 @@ def static_factors(engine, rpm) -> np.ndarray:
     """Static factor of every network (mount order, then local x, y, z) at the operating
     point of ``rpm`` [rpm], shape ``(n_networks,)``; all 1 when no mount direction has a
     static curve (then nothing is solved)."""
-    support = StaticSupport.of(engine)
-    if not support.has_curves:
-        return np.ones(len(support.curves))
-    return operating_point(engine, rpm, support).static_factor
+    if not has_static_curves(engine):
+        return np.ones(3 * len(engine.mounts))
+    return operating_point(engine, rpm).static_factor
 
 
 def _residual(support, load, weight, q):

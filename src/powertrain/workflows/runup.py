@@ -36,7 +36,7 @@ from powertrain.errors import InputError, require_finite, solved
 from powertrain.progress import progress_bar
 from powertrain.results.runup import RunupResult, SweepRunup
 from powertrain.results.static import StaticResult
-from powertrain.solvers.operating_point import StaticSupport, operating_points
+from powertrain.solvers.operating_point import has_static_curves, operating_points
 from powertrain.solvers.steppers import Cycles, choose_stepper
 
 #: Largest speed grid a run-up command accepts (about 0.1 s per speed step).
@@ -148,7 +148,7 @@ def _static_result(engine, points) -> StaticResult:
 def _operating_points(engine, rpm):
     """The static operating point of every speed when some mount direction has a static
     curve (its networks are then scaled per speed); None otherwise (nothing is solved)."""
-    if not StaticSupport.of(engine).has_curves:
+    if not has_static_curves(engine):
         return None
     return operating_points(engine, rpm)
 
@@ -309,6 +309,9 @@ def _concatenate(parts):
                  "mean_mount_force", "periodicity"):
         setattr(out, attr, np.concatenate([getattr(p, attr) for p in parts], axis=0))
     out.solver_seconds = float(sum(p.solver_seconds for p in parts))
+    if first.operating_point is not None:
+        out.operating_point = dataclasses.replace(first.operating_point, points=[
+            op for p in parts for op in p.operating_point.points])
     out.settings = dict(first.settings)
     out.meta = dict(first.meta)
     return out
