@@ -344,9 +344,11 @@ class Engine:
     def indicated_work(self, rpm: float, load: float = 1.0) -> np.ndarray:
         r"""Net indicated work per cycle of every cylinder, :math:`W_i = \oint p_i\,dV` [J]."""
         theta_g, p_g, _ = self.cycle_pressures(rpm, load)
-        _, dV = self.crank.volume(theta_g)
+        key = ("dV", theta_g.size, float(theta_g[0]), float(theta_g[-1]))
+        if key not in self._cache:                   # the same grid at every speed
+            self._cache[key] = self.crank.volume(theta_g)[1]
         dtheta = theta_g[1] - theta_g[0]
-        return np.array([comb.indicated_work(pc, dV, dtheta) for pc in p_g])
+        return np.array([comb.indicated_work(pc, self._cache[key], dtheta) for pc in p_g])
 
     def mean_brake_torque(self, rpm: float, load: float = 1.0) -> float:
         r"""Mean brake torque at ``rpm`` [N·m]: the cycle mean of the indicated torque of the
