@@ -34,6 +34,7 @@ API = {
     "read_raw": ("powertrain.iotools.raw", "read_raw"),
     "runup": ("powertrain.workflows.runup", "runup"),
     "modes": ("powertrain.workflows.modes", "modes"),
+    "static": ("powertrain.workflows.static", "static"),
     "excitation": ("powertrain.workflows.excitation", "excitation"),
     "stiffness": ("powertrain.workflows.stiffness", "stiffness"),
     "fit_mount": ("powertrain.workflows.fitting", "fit_mount"),

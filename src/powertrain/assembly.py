@@ -158,7 +158,7 @@ class AssembledSystem:
         return np.sqrt(np.clip(w2, 0, None)) / (2 * np.pi), vec
 
 
-def assemble(mass, cg, inertia, mounts, chassis=None) -> AssembledSystem:
+def assemble(mass, cg, inertia, mounts, chassis=None, static_factors=None) -> AssembledSystem:
     """Assemble the rigid body, its mounts and (optionally) a modal body under them.
 
     Parameters
@@ -176,6 +176,11 @@ def assemble(mass, cg, inertia, mounts, chassis=None) -> AssembledSystem:
         ``modal``: the body modes become the last coordinates; each network's base node moves
         with the body at its mount's attachment point. ``frf`` is coupled in the harmonic
         solver only (:mod:`powertrain.solvers.harmonic`); ``rigid`` or None: fixed base.
+    static_factors : array_like (3 n_mounts,), optional
+        Each network's static factor at an operating point
+        (:mod:`powertrain.solvers.operating_point`): its springs and dampers scaled by it
+        (:meth:`~powertrain.physics.mount_elements.MountElement.at_operating_point`);
+        None: unscaled.
 
     Outputs: the channels of every mount's engine-side point; with a non-rigid chassis also
     its body side (``NAME/passive``) and the body points of interest.
@@ -183,7 +188,7 @@ def assemble(mass, cg, inertia, mounts, chassis=None) -> AssembledSystem:
     cg = np.asarray(cg, float)
     body_modes = chassis.body_modes if chassis is not None else ()
     modal = bool(body_modes)
-    blocks, labels = _network_blocks(mounts, cg, modal)
+    blocks, labels = _network_blocks(mounts, cg, modal, static_factors)
     body0 = 6 + sum(b[4].size - 1 for b in blocks)
     n = body0 + len(body_modes)
     retained = np.r_[np.arange(6), np.arange(body0, n)].astype(int)
@@ -246,10 +251,10 @@ def _add_networks(matrices, blocks, mounts, shapes, body0):
     return networks, base_rows, port_rows - np.array(base_rows).reshape(-1, n), port_map
 
 
-def _network_blocks(mounts, cg, with_ground):
+def _network_blocks(mounts, cg, with_ground, static_factors=None):
     """Per network: (engine-side row, its M, C, K, ground-force rows kg, dg, mount index,
-    axis index, element), and the labels of the coordinates (rigid body, then internal
-    nodes)."""
+    axis index, element, at its static factor if given), and the labels of the coordinates
+    (rigid body, then internal nodes)."""
     blocks = []
     labels = ["u_x", "u_y", "u_z", "theta_x", "theta_y", "theta_z"]
     for mi, mount in enumerate(mounts):
@@ -257,6 +262,8 @@ def _network_blocks(mounts, cg, with_ground):
         R = np.asarray(mount.rotation, float)
         for ai, axis in enumerate(DIRECTIONS):
             element = mount.directions[axis].element()
+            if static_factors is not None:
+                element = element.at_operating_point(static_factors[3 * mi + ai])
             Mn, Cn, Kn = element.matrices(include_ground=with_ground)
             masses, elem_nodes, c, d = element.network()
             kg, dg = ground_force_rows(masses.size, elem_nodes, c, d)

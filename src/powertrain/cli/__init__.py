@@ -21,6 +21,7 @@ def _register():
         fit_mount,
         modes,
         runup,
+        static,
         stiffness,
         track,
         whatif,

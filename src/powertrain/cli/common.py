@@ -30,6 +30,30 @@ MAX_FREQUENCY_HZ = 1e5
 
 def parse_frequencies(text: str, option: str = "--freq") -> np.ndarray:
     """``5,10,12`` or ``start:stop:step`` (inclusive) or a mix, e.g. ``1:10:1,20,40`` [Hz]."""
+    arr = _parse_list(text, option, "frequency", "5,10,20 or 1:400:1", MAX_FREQUENCIES)
+    if not np.all(np.isfinite(arr)) or np.any(arr < 0) or np.any(arr > MAX_FREQUENCY_HZ):
+        raise InputError(f"frequencies must be finite, >= 0 and <= {MAX_FREQUENCY_HZ:g} Hz",
+                         key=option)
+    if np.any(np.diff(arr) <= 0):
+        raise InputError("frequencies must be strictly increasing", key=option)
+    return arr
+
+
+def parse_speeds(text: str, option: str = "--rpm") -> np.ndarray:
+    """Speeds [rpm] as a comma list or ``start:stop:step`` (inclusive) or a mix, e.g.
+    ``1000:6000:500`` or ``1500,3000``; finite, > 0, strictly increasing."""
+    from powertrain.workflows.runup import MAX_SPEEDS
+    arr = _parse_list(text, option, "speed", "1000,2000 or 1000:6000:500", MAX_SPEEDS)
+    if not np.all(np.isfinite(arr)) or np.any(arr <= 0):
+        raise InputError("speeds must be finite and > 0 [rpm]", key=option)
+    if np.any(np.diff(arr) <= 0):
+        raise InputError("speeds must be strictly increasing", key=option)
+    return arr
+
+
+def _parse_list(text: str, option: str, noun: str, example: str, most: int) -> np.ndarray:
+    """Numbers of a comma list whose items may be ``start:stop:step`` ranges (inclusive);
+    at most ``most`` of them, at least one."""
     values: list[float] = []
     for part in text.split(","):
         part = part.strip()
@@ -44,9 +68,9 @@ def parse_frequencies(text: str, option: str = "--freq") -> np.ndarray:
                 if not all(math.isfinite(x) for x in fields):
                     raise ValueError
                 ratio = (stop - start) / step
-                if not math.isfinite(ratio) or ratio + 1 + len(values) > MAX_FREQUENCIES:
-                    raise InputError(f"{part!r} asks for {ratio + 1:.3g} frequencies; at most "
-                                     f"{MAX_FREQUENCIES}", key=option)
+                if not math.isfinite(ratio) or ratio + 1 + len(values) > most:
+                    raise InputError(f"{part!r} asks for {ratio + 1:.3g} values; at most "
+                                     f"{most}", key=option)
                 n = math.floor(ratio + 1e-9) + 1
                 values.extend(start + step * np.arange(n))
             else:
@@ -54,18 +78,13 @@ def parse_frequencies(text: str, option: str = "--freq") -> np.ndarray:
         except InputError:
             raise
         except ValueError:
-            raise InputError(f"cannot read frequency {part!r} (use 5,10,20 or 1:400:1)",
+            raise InputError(f"cannot read {noun} {part!r} (use {example})",
                              key=option) from None
     arr = np.array(values, dtype=float)
     if arr.size == 0:
-        raise InputError("no frequency given", key=option)
-    if not np.all(np.isfinite(arr)) or np.any(arr < 0) or np.any(arr > MAX_FREQUENCY_HZ):
-        raise InputError(f"frequencies must be finite, >= 0 and <= {MAX_FREQUENCY_HZ:g} Hz",
-                         key=option)
-    if arr.size > MAX_FREQUENCIES:
-        raise InputError(f"{arr.size} frequencies; at most {MAX_FREQUENCIES}", key=option)
-    if np.any(np.diff(arr) <= 0):
-        raise InputError("frequencies must be strictly increasing", key=option)
+        raise InputError(f"no {noun} given", key=option)
+    if arr.size > most:
+        raise InputError(f"{arr.size} values; at most {most}", key=option)
     return arr
 
 

@@ -20,6 +20,8 @@ Layout (see ``engines/default.toml`` for a complete, commented example)::
     [combustion]        model = "single-zone" (parameters below) or "measured"
                         (traces = "file.csv", see powertrain.iotools.pressure_csv)
     [combustion.full_load]  speed, torque, fmep (lists of equal length)
+    [drive]             gear_ratio (> 0, default 1 = the engine alone): multiplies the mean
+                        drive-torque reaction of the static operating point
 
 Only ``[engine]``, ``[body]`` and ``[mounts.*]`` are required: without ``[crank_train]`` and
 ``[combustion]`` the engine has no excitation (enough for ``modes``); commands that need one
@@ -68,7 +70,9 @@ MIN_MOUNTS = 3
 DIRECTIONS = ("x", "y", "z")
 
 _ALLOWED = {
-    "": {"engine", "crank_train", "body", "mounts", "balancer", "combustion", "chassis"},
+    "": {"engine", "crank_train", "body", "mounts", "balancer", "combustion", "chassis",
+         "drive"},
+    "drive": {"gear_ratio"},
     "chassis": {"model", "modes", "points", "frf"},
     "chassis_mode": {"frequency", "damping_ratio", "modal_mass", "shape"},
     "chassis_point": {"description"},
@@ -129,11 +133,24 @@ def read_engine(path=DEFAULT_ENGINE_PATH) -> em.Engine:
     chassis = None
     if "chassis" in doc:
         chassis = _read_chassis(subtable(doc, "chassis", path), path, [m.name for m in mounts])
+    gear_ratio = _read_drive(doc, path)
     engine = em.Engine(name=name, crank=crank, body=body, mounts=mounts, balancer=balancer,
-                       combustion=combustion, file=path, chassis=chassis)
+                       combustion=combustion, file=path, chassis=chassis,
+                       gear_ratio=gear_ratio)
     from powertrain.iotools.engine_checks import check_engine
     check_engine(engine, path)
     return engine
+
+
+def _read_drive(doc, path) -> float:
+    """``[drive] gear_ratio`` (dimensionless, > 0; 1 without the section or the key)."""
+    if "drive" not in doc:
+        return 1.0
+    t = subtable(doc, "drive", path)
+    check_keys(t, _ALLOWED["drive"], path, "drive")
+    if "gear_ratio" not in t:
+        return 1.0
+    return scalar_quantity(t, "gear_ratio", "dimensionless", path, "drive", positive=True)
 
 
 def _read_chassis(t, path, mount_names):

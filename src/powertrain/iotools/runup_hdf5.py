@@ -52,7 +52,30 @@ def _read_open(h5, path) -> RunupResult:
         settings=_h5_json(h5, "settings", path),
         solver_seconds=float(_h5_array(h5, "diagnostics/solver_seconds", path, "f", 0)),
         rigid_body_modes_hz=_h5_array(h5, "diagnostics/rigid_body_modes_hz", path, "f", 1),
-        meta=_h5_json(h5, "meta", path), path_contribution=_h5_paths(h5, path, n))
+        meta=_h5_json(h5, "meta", path), path_contribution=_h5_paths(h5, path, n),
+        operating_point=_h5_operating_point(h5, path, rpm))
+
+
+def _h5_operating_point(h5, path, rpm):
+    """/operating_point as a :class:`~powertrain.results.static.StaticResult`, or None."""
+    from powertrain.results.runup import OPERATING_POINT
+    from powertrain.results.static import StaticResult
+    from powertrain.solvers.operating_point import OperatingPoint
+    if "operating_point" not in h5:
+        return None
+    mounts = _h5_names(h5, "operating_point/mounts", path)
+    n, m = rpm.size, len(mounts)
+    shapes = {"mean_torque": (n,), "body": (n, 6), "deflection": (n, m, 3),
+              "force": (n, m, 3), "tangent_stiffness": (n, m, 3), "static_factor": (n, 3 * m),
+              "iterations": (n,), "residual": (n, 2)}
+    d = {k: _h5_array(h5, f"operating_point/{k}", path, "f", len(shapes[k]), shapes[k])
+         for k in OPERATING_POINT}
+    ratio = float(h5["operating_point"].attrs.get("gear_ratio", 1.0))
+    points = [OperatingPoint(float(rpm[i]), float(d["mean_torque"][i]), ratio, d["body"][i],
+                             d["deflection"][i], d["force"][i], d["tangent_stiffness"][i],
+                             d["static_factor"][i], int(d["iterations"][i]),
+                             tuple(d["residual"][i])) for i in range(n)]
+    return StaticResult(points, mounts)
 
 
 def _h5_array(h5, key, path, kinds, ndim, shape=None):

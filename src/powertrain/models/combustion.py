@@ -43,7 +43,11 @@ class FullLoadCurve:
         .. math:: \mathrm{IMEP} = \frac{4\pi\,T_b}{V_D} + \mathrm{FMEP}
         """
         tb = load * np.interp(omega, self.speed, self.torque)
-        return float(4.0 * np.pi * tb / displacement + np.interp(omega, self.speed, self.fmep))
+        return float(4.0 * np.pi * tb / displacement + self.fmep_at(omega))
+
+    def fmep_at(self, omega: float) -> float:
+        """FMEP [Pa] at ``omega`` [rad/s], interpolated linearly in the curve."""
+        return float(np.interp(omega, self.speed, self.fmep))
 
 
 @dataclass(frozen=True, eq=False)
@@ -116,6 +120,10 @@ class SingleZoneCombustion:
         return theta, pressure, {"imep_target": targets, "heat": heats, "p_intake": p_in,
                                  "p_exhaust": p_ex}
 
+    def friction_mean_effective_pressure(self, omega: float) -> float:
+        """FMEP [Pa] at ``omega`` [rad/s]: the full-load curve's."""
+        return self.full_load.fmep_at(omega)
+
     def speed_range(self):
         """(min, max) speed of the full-load curve [rad/s]."""
         return float(self.full_load.speed[0]), float(self.full_load.speed[-1])
@@ -168,6 +176,10 @@ class MeasuredPressure:
         imep = np.array([comb.indicated_work(pc, dV, dtheta) for pc in p]) / crank.swept_volume
         return self.theta, p, {"imep_target": imep, "heat": np.full(len(p), np.nan),
                                "p_intake": float("nan"), "p_exhaust": float("nan")}
+
+    def friction_mean_effective_pressure(self, omega: float) -> float:
+        """0: measured traces give no FMEP (their brake torque is the indicated one)."""
+        return 0.0
 
     def speed_range(self):
         return float(self.speed[0]), float(self.speed[-1])

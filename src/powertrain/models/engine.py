@@ -159,6 +159,10 @@ class Engine:
         Engine file it was read from ("" if built in code).
     chassis : Chassis or None
         The body under the mounts (:mod:`powertrain.models.chassis`); None = rigid.
+    gear_ratio : float
+        Gear ratio :math:`i` of the run (``[drive] gear_ratio``; 1 = the engine alone): it
+        multiplies the mean drive-torque reaction of the operating point
+        (:mod:`powertrain.solvers.operating_point`), not the order excitation.
     """
 
     name: str
@@ -169,6 +173,7 @@ class Engine:
     combustion: object
     file: str = ""
     chassis: object = None
+    gear_ratio: float = 1.0
     _cache: dict = field(default_factory=dict, repr=False, compare=False)
 
     # ------------------------------------------------------------------ copies
@@ -329,14 +334,30 @@ class Engine:
                 add(f_u[:, None] * u + f_s[:, None] * s, sh.position)
         if not detail:
             return np.hstack([force, moment])
-        theta_g, p_g, info = self.cycle_pressures(rpm, load)
-        _, dV = ct.volume(theta_g)
-        dtheta = theta_g[1] - theta_g[0]
-        imep = np.array([comb.indicated_work(pc, dV, dtheta) for pc in p_g]) / ct.swept_volume
+        info = self.cycle_pressures(rpm, load)[2]
+        imep = self.indicated_work(rpm, load) / ct.swept_volume
         return Excitation(rpm=float(rpm), crank_angle=th, pressure=p, gas_force=fg,
                           inertia_force=out["inertia"], torque=out["torque"],
                           torque_gas=out["torque_gas"], torque_inertia=out["torque_inertia"],
                           load=np.hstack([force, moment]), imep=imep, info=dict(info))
+
+    def indicated_work(self, rpm: float, load: float = 1.0) -> np.ndarray:
+        r"""Net indicated work per cycle of every cylinder, :math:`W_i = \oint p_i\,dV` [J]."""
+        theta_g, p_g, _ = self.cycle_pressures(rpm, load)
+        key = ("dV", theta_g.size, float(theta_g[0]), float(theta_g[-1]))
+        if key not in self._cache:                   # the same grid at every speed
+            self._cache[key] = self.crank.volume(theta_g)[1]
+        dtheta = theta_g[1] - theta_g[0]
+        return np.array([comb.indicated_work(pc, self._cache[key], dtheta) for pc in p_g])
+
+    def mean_brake_torque(self, rpm: float, load: float = 1.0) -> float:
+        r"""Mean brake torque at ``rpm`` [N·m]: the cycle mean of the indicated torque of the
+        cylinder pressures, :math:`\sum_i W_i/(4\pi)`, less
+        :math:`\mathrm{FMEP}\,V_D/(4\pi)` where the combustion model gives an FMEP (the
+        single-zone model's full-load curve at that speed; measured traces: none)."""
+        fmep = self.combustion.friction_mean_effective_pressure(self._check_speed(rpm) * RPM)
+        work = float(np.sum(self.indicated_work(rpm, load)))
+        return (work - fmep * self.crank.displacement) / (4.0 * np.pi)
 
     def generalized_load(self, rpm: float, crank_angle_rad, load: float = 1.0) -> np.ndarray:
         """``[Fx, Fy, Fz, Mx, My, Mz]`` on the powertrain about its CG, engine axes.

@@ -20,6 +20,13 @@ HDF5 layout (all arrays SI, units in each dataset's ``unit`` attribute)::
     /diagnostics/periodicity        (n_rpm,)              1 (cycle-to-cycle, Newmark)
     /diagnostics/rigid_body_modes_hz (6,)                 Hz
     /diagnostics/solver_seconds     ()                    s
+    /operating_point       the static operating point per speed (powertrain.solvers.
+                           operating_point), attrs gear_ratio:
+        mounts (n_m,) str; mean_torque (n_rpm,) N*m (mean brake torque);
+        body (n_rpm, 6) m, rad (displacement and rotation at the CG, engine axes);
+        deflection, force, tangent_stiffness (n_rpm, n_m, 3) m, N, N/m (local x, y, z);
+        static_factor (n_rpm, 3 n_m) 1; iterations (n_rpm,); residual (n_rpm, 2)
+        (force / weight, moment / (weight x 1 m))
 
     /channels/side         (n_ch,) str                    active (engine side) / passive (body)
     /channels/location     (n_ch,) str                    mount or body-point name
@@ -88,6 +95,9 @@ class RunupResult:
     #: direction), shape (n_rpm, 3 n_points, 3 n_mounts, n_orders) [m/s]; None without
     #: body points (see :func:`powertrain.workflows.runup.path_contributions`)
     path_contribution: np.ndarray | None = None
+    #: the static operating point per speed (:class:`~powertrain.results.static.StaticResult`)
+    #: the networks were scaled at; None when not computed
+    operating_point: object = None
     #: the engine that ran (balancers as run, before effects), when
     #: :func:`powertrain.workflows.runup.runup` made the result; its file and mounts go into
     #: the HDF5 file
@@ -295,6 +305,9 @@ class RunupResult:
                                  data=self.rigid_body_modes_hz).attrs["unit"] = "Hz"
                 g.create_dataset("solver_seconds", data=self.solver_seconds).attrs["unit"] = "s"
                 self._write_sides(h5)
+                if self.operating_point is not None:
+                    write_operating_point(h5.create_group("operating_point"),
+                                          self.operating_point)
 
     def _run_record(self, snapshot, mounts, description, provenance):
         """Engine file text, mount snapshots, description and provenance of the HDF5 file:
@@ -372,6 +385,21 @@ class RunupResult:
         return plot_runup([("simulation", self)] + list(others or []), path, quantities,
                           signal, ax=ax, channel=channel, quantity=quantity,
                           provenance=provenance or getattr(self, "provenance", None))
+
+
+#: /operating_point datasets: (result attribute, unit); shapes (n_rpm, ...) as in the result.
+OPERATING_POINT = {"mean_torque": "N*m", "body": "m, m, m, rad, rad, rad",
+                   "deflection": "m", "force": "N", "tangent_stiffness": "N/m",
+                   "static_factor": "1", "iterations": "1", "residual": "1"}
+
+
+def write_operating_point(g, static) -> None:
+    """The operating point per speed into the HDF5 group ``g`` (layout in the module
+    docstring)."""
+    g.attrs["gear_ratio"] = float(static.points[0].gear_ratio) if static.points else 1.0
+    g.create_dataset("mounts", data=np.array(static.mounts, dtype="S"))
+    for name, unit in OPERATING_POINT.items():
+        g.create_dataset(name, data=static.stack(name)).attrs["unit"] = unit
 
 
 def effects_text(scenario) -> str:

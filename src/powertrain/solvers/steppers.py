@@ -84,6 +84,13 @@ class Stepper:
         #: the last speed's equivalent-linear amplitudes (the next speed's first guess)
         self.amplitudes = None
 
+    def on_system(self, system) -> Stepper:
+        """A stepper of this kind on another assembly of the same model (the networks
+        scaled at an operating point), warm-started from this one's amplitudes."""
+        new = type(self)(system, self.grid)
+        new.amplitudes = self.amplitudes
+        return new
+
     def equivalent_linear(self, solve, relative_motion, omega):
         """``(amplitudes, solve(amplitudes))``: the nonlinear elements' equivalent-linear
         fixed point (:func:`amplitude_fixed_point`), warm-started from the last speed;

@@ -35,6 +35,8 @@ from powertrain.assembly import assemble
 from powertrain.errors import InputError, require_finite, solved
 from powertrain.progress import progress_bar
 from powertrain.results.runup import RunupResult, SweepRunup
+from powertrain.results.static import StaticResult
+from powertrain.solvers.operating_point import has_static_curves, operating_points
 from powertrain.solvers.steppers import Cycles, choose_stepper
 
 #: Largest speed grid a run-up command accepts (about 0.1 s per speed step).
@@ -126,11 +128,46 @@ def _run_runup(engine, rpm=None, *, solver="newmark", angle_step_deg=ANGLE_STEP_
                           getattr(engine, "chassis", None))
     step = choose_stepper(system, solver, stepper, grid)
     loads = [_cycle_load(engine, n_rpm, grid.n_cycle) for n_rpm in rpm]
-    speeds, seconds = _solve_speeds(step, rpm, loads, workers,
-                                    {"desc": f"run-up ({solver})", "unit": "speed",
-                                     "enabled": bool(progress)})
+    bar = {"desc": f"run-up ({solver})", "unit": "speed", "enabled": bool(progress)}
+    points = _operating_points(engine, rpm)
+    if points is None:
+        speeds, seconds = _solve_speeds(step, rpm, loads, workers, bar)
+    else:
+        speeds, seconds = _solve_at_operating_points(engine, step, rpm, loads, points, bar)
     _warn_periodicity(rpm, [o.periodicity for o in speeds])
-    return _result(engine, system, step, rpm, speeds, step.setup_seconds + seconds)
+    result = _result(engine, system, step, rpm, speeds, step.setup_seconds + seconds)
+    if points is not None:
+        result.operating_point = _static_result(engine, points)
+    return result
+
+
+def _static_result(engine, points) -> StaticResult:
+    return StaticResult(points, engine.mount_names, engine.name)
+
+
+def _operating_points(engine, rpm):
+    """The static operating point of every speed when some mount direction has a static
+    curve (its networks are then scaled per speed); None otherwise (nothing is solved)."""
+    if not has_static_curves(engine):
+        return None
+    return operating_points(engine, rpm)
+
+
+def _solve_at_operating_points(engine, step, rpm, loads, points, bar):
+    """Every speed solved by a stepper of the kind chosen once, on the model assembled with
+    the networks scaled at that speed's operating point
+    (:meth:`~powertrain.physics.mount_elements.MountElement.at_operating_point`); the
+    equivalent-linear amplitudes carried from speed to speed. Returns the speeds' orders
+    and the solver time (the per-speed setups included)."""
+    b, chassis = engine.body, getattr(engine, "chassis", None)
+    speeds, total = [], 0.0
+    for i in progress_bar(range(rpm.size), **bar):
+        system = assemble(b.mass, b.cg, b.inertia, engine.mounts, chassis,
+                          static_factors=points[i].static_factor)
+        step = step.on_system(system)
+        speeds.append(step.solve(loads[i], rpm[i] * 2 * np.pi / 60.0))
+        total += speeds[-1].seconds + step.setup_seconds
+    return speeds, total
 
 
 def _speeds(rpm) -> np.ndarray:
@@ -272,6 +309,9 @@ def _concatenate(parts):
                  "mean_mount_force", "periodicity"):
         setattr(out, attr, np.concatenate([getattr(p, attr) for p in parts], axis=0))
     out.solver_seconds = float(sum(p.solver_seconds for p in parts))
+    if first.operating_point is not None:
+        out.operating_point = dataclasses.replace(first.operating_point, points=[
+            op for p in parts for op in p.operating_point.points])
     out.settings = dict(first.settings)
     out.meta = dict(first.meta)
     return out
@@ -331,6 +371,8 @@ def runup(engine=None, rpm=None, *, solver="newmark", stepper="auto",
     result = _stepped(engine, rpm, scenario, progress, solver=solver,
                       angle_step_deg=angle_step_deg, stepper=stepper)
     result.engine, result.modifications = engine, modifications
+    if result.operating_point is None:
+        result.operating_point = _static_result(engine, operating_points(engine, rpm))
     result.meta["engine_file"] = str(engine.file)
     result.meta["rigid_body_mode_dominant"] = mode_coordinates(engine,
                                                                result.rigid_body_modes_hz)

@@ -1,0 +1,93 @@
+"""The static operating point per speed (``powertrain static``): the result of
+:func:`powertrain.workflows.static.static` (the physics:
+:mod:`powertrain.solvers.operating_point`), with its text and JSON.
+
+JSON (full float precision, one entry per speed; lengths in mm, forces in N, stiffness in
+N/mm, angles in degrees)::
+
+    {"rpm": [...], "mean_torque_nm": [...], "gear_ratio": i,
+     "body": {"displacement_mm": [[x, y, z], ...], "rotation_deg": [[rx, ry, rz], ...]},
+     "mounts": {"NAME": {"deflection_mm": [[x, y, z], ...], "force_n": [...],
+                         "tangent_stiffness_n_per_mm": [...], "static_factor": [...]}}}
+
+Body displacement and rotation at the centre of gravity, engine axes; per mount its local
+directions x, y, z: deflection of the engine-side point relative to the base, the static
+curve's force there (the mount pushes the engine with minus it), its tangent stiffness and
+the network's static factor (tangent stiffness there over that at the curve's reference
+deflection; 1 without a curve).
+"""
+
+from __future__ import annotations
+
+import json
+from dataclasses import dataclass
+
+import numpy as np
+
+from powertrain.analysis.text_table import format_table
+from powertrain.units import from_si
+
+
+@dataclass
+class StaticResult:
+    """Operating points (:class:`~powertrain.solvers.operating_point.OperatingPoint`, one
+    per speed) of an engine's mounts ``mounts`` (names, in order)."""
+
+    points: list
+    mounts: list
+    engine: str = ""
+
+    @property
+    def rpm(self) -> np.ndarray:
+        return np.array([p.rpm for p in self.points])
+
+    def stack(self, name) -> np.ndarray:
+        """Attribute ``name`` of every operating point, stacked along a first speed axis."""
+        return np.array([getattr(p, name) for p in self.points])
+
+    def to_dict(self) -> dict:
+        """The JSON document (module docstring)."""
+        body = self.stack("body")
+        mounts = {}
+        for m, name in enumerate(self.mounts):
+            mounts[name] = {
+                "deflection_mm": from_si(self.stack("deflection")[:, m], "mm").tolist(),
+                "force_n": self.stack("force")[:, m].tolist(),
+                "tangent_stiffness_n_per_mm": from_si(self.stack("tangent_stiffness")[:, m],
+                                                      "N/mm").tolist(),
+                "static_factor": self.stack("static_factor")[:, 3 * m:3 * m + 3].tolist()}
+        return {"rpm": self.rpm.tolist(),
+                "mean_torque_nm": self.stack("mean_torque").tolist(),
+                "gear_ratio": float(self.points[0].gear_ratio) if self.points else 1.0,
+                "body": {"displacement_mm": from_si(body[:, :3], "mm").tolist(),
+                         "rotation_deg": np.rad2deg(body[:, 3:]).tolist()},
+                "mounts": mounts}
+
+    def to_json(self, path=None) -> str:
+        """JSON text of :meth:`to_dict`; written atomically to ``path`` if given."""
+        text = json.dumps(self.to_dict(), indent=1) + "\n"
+        if path is not None:
+            from powertrain.outputs import atomic_write
+            with atomic_write(path) as fh:
+                fh.write(text)
+        return text
+
+    def to_text(self) -> str:
+        """Per speed: the body's displacement [mm] and rotation [deg] at the CG, then each
+        mount's deflection [mm], force [N] and tangent stiffness [N/mm] per local
+        direction."""
+        blocks = [f"static operating point{f' of {self.engine}' if self.engine else ''}: "
+                  "weight and mean drive-torque reaction on the mounts' static curves"]
+        for p in self.points:
+            u, th = from_si(p.body[:3], "mm"), np.rad2deg(p.body[3:])
+            head = (f"{p.rpm:g} rpm: mean torque {p.mean_torque:.1f} N*m x gear ratio "
+                    f"{p.gear_ratio:g}; body at CG u = [{', '.join(f'{v:.3f}' for v in u)}]"
+                    f" mm, rotation = [{', '.join(f'{v:.4f}' for v in th)}] deg")
+            rows = [[f"{name}.{a}", float(from_si(p.deflection[m, k], "mm")),
+                     float(p.force[m, k]), float(from_si(p.tangent_stiffness[m, k], "N/mm")),
+                     float(p.static_factor[3 * m + k])]
+                    for m, name in enumerate(self.mounts) for k, a in enumerate("xyz")]
+            blocks.append(head + "\n" + format_table(
+                ["mount.dir", "deflection [mm]", "force [N]", "tangent [N/mm]",
+                 "static factor"], rows))
+        return "\n\n".join(blocks)
