@@ -27,6 +27,7 @@ applies them:
 
 from __future__ import annotations
 
+import functools
 from dataclasses import dataclass
 
 import numpy as np
@@ -36,6 +37,12 @@ from powertrain.kernels.port_forces import BERG
 #: Gauss–Legendre nodes per loop branch of Berg's describing function: the branch is smooth
 #: (a rational function of sin θ), so 48 nodes give the first harmonic to round-off.
 _GAUSS_NODES = 48
+
+
+@functools.lru_cache(maxsize=4)
+def _gauss_legendre(n: int):
+    """Gauss–Legendre nodes and weights on [-1, 1] (computed once: an eigenproblem)."""
+    return np.polynomial.legendre.leggauss(n)
 
 
 @dataclass(frozen=True)
@@ -218,7 +225,7 @@ class BergFriction:
         if self.max_force <= 0 or not big.any():
             return out.reshape(np.shape(amplitude))
         a = A[big][:, None]
-        t, w = np.polynomial.legendre.leggauss(_GAUSS_NODES)
+        t, w = _gauss_legendre(_GAUSS_NODES)
         theta = 0.5 * np.pi * t[None, :]
         fr = self.loop_amplitude_force(a)
         fm, x2 = self.max_force, self.half_displacement
