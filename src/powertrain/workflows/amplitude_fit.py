@@ -105,7 +105,9 @@ def fit_amplitudes(data, model="triple-parallel", *, friction=False, reference=N
     """Fit network, power amplitude law and (``friction``) Berg's element to ``data``
     (:class:`~powertrain.iotools.stiffness_csv.MeasuredStiffness` at two or more
     amplitudes); see the module docstring."""
+    from powertrain.iotools.mount_file import MAX_SI
     t0 = time.perf_counter()
+    max_mass = MAX_SI["m"] if max_mass is None else max_mass   # what a mount file holds
     topology = TOPOLOGIES[model] if isinstance(model, str) else model
     amps = data.amplitudes
     a_ref = _reference(amps, reference, data.source)
