@@ -31,8 +31,14 @@ _MODELS = tuple(TOPOLOGIES)
 @click.option("--max-mass", type=float,
               help="Upper bound of every internal mass [kg]. K_CP alone does not identify the "
                    "internal masses, but the engine feels them (input-point stiffness).")
+@click.option("--friction", is_flag=True,
+              help="With data at several amplitudes: fit Berg's friction element too.")
+@click.option("--reference", type=float,
+              help="With data at several amplitudes: the reference amplitude of the network "
+                   "and the amplitude law [mm], one of the data's (default the smallest).")
 @click.option("--quiet", is_flag=True, help="No progress indicator on stderr.")
-def fit_mount(measured, model, out, plot, form, freq_axis, starts, seed, fmin, fmax, max_mass, quiet):
+def fit_mount(measured, model, out, plot, form, freq_axis, starts, seed, fmin, fmax, max_mass,
+              friction, reference, quiet):
     """Fit a lumped mount model to the measured dynamic stiffness in MEASURED (CSV).
 
     MEASURED has a header line and the columns frequency_hz plus either k_real_n_per_mm,
@@ -42,28 +48,47 @@ def fit_mount(measured, model, out, plot, form, freq_axis, starts, seed, fmin, f
     (Kovarik 2016, eq. 19): the Euclidean norm over the frequencies of the complex stiffness
     error. Printed: f_obj [N] and the relative RMS error sqrt(sum|K-K_m|^2 / sum|K_m|^2).
 
+    With a column amplitude_mm (K*(f) at several amplitudes, from `stiffness --amplitude`)
+    the network at the reference amplitude, a power amplitude law (exponent fitted, limits
+    fixed) and, with --friction, Berg's friction element are fitted together; the error is
+    printed per amplitude.
+
     \b
     Examples:
       powertrain stiffness mounts/hydraulic-engine-mount-z.toml --format csv > k.csv
       powertrain fit-mount k.csv --model triple-parallel --out fitted.toml --plot fit.png
       powertrain stiffness fitted.toml --freq 5,10,20,50,100,200,400
+      powertrain fit-mount multi-amplitude.csv --friction --out fitted.toml
     """
     from powertrain.cli.common import check_outputs
     from powertrain.iotools.mount_file import write_mount
     from powertrain.progress import activity
-    from powertrain.workflows.fitting import fit_mount as fit
+    from powertrain.workflows.amplitude_fit import fit_mount_csv
 
     check_outputs(out=out, plot=plot)
+    ref = _reference(reference)
     with activity(f"fit-mount ({model}, {starts} starts)", enabled=not quiet):
-        result = fit(measured, model=model, starts=starts, seed=seed, max_mass=max_mass,
-                     fmin=fmin, fmax=fmax)
+        result = fit_mount_csv(measured, model, friction=friction, reference=ref,
+                               starts=starts, seed=seed, max_mass=max_mass, fmin=fmin,
+                               fmax=fmax)
     write_mount(result.model, out, comment=result.file_comment())
+    _plot(result, plot, form, freq_axis)
+    click.echo(result.to_text())
+    if not result.success:
+        click.echo("warning: the best local solve stopped at its evaluation limit", err=True)
+    click.echo("wrote " + ", ".join(p for p in (out, plot) if p))
+
+
+def _plot(result, plot, form, freq_axis) -> None:
+    """The measured-vs-fitted figure, when asked."""
     if plot:
         from powertrain.cli.common import cli_provenance, write_plot
         prov = cli_provenance()
         write_plot(lambda p: result.plot(path=p, form=form, freq_axis=freq_axis,
                                          provenance=prov), plot)
-    click.echo(result.to_text())
-    if not result.success:
-        click.echo("warning: the best local solve stopped at its evaluation limit", err=True)
-    click.echo("wrote " + ", ".join(p for p in (out, plot) if p))
+
+
+def _reference(reference_mm):
+    """``--reference`` [mm] in [m] (None when not given)."""
+    from powertrain.units import to_si
+    return None if reference_mm is None else to_si(reference_mm, "mm", "length")

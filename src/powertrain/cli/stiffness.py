@@ -28,10 +28,14 @@ from powertrain.cli.group import main
               help="Write a K*(f) plot (PNG); prints a summary (|K*| range, loss-angle peak) "
                    "and the path instead of the full table unless --format is given.")
 @plot_form_options
+@click.option("--amplitude", metavar="LIST",
+              help="Displacement test amplitudes in the mount file's x unit (mm by default), "
+                   "e.g. 0.05,0.1,0.5: K*(f, X) per amplitude with the amplitude law and "
+                   "friction; the CSV gains a first column amplitude_mm.")
 @click.option("--engine-mass", type=float, help="Engine mass on the mount [kg] (verification set-up).")
 @click.option("--force", type=float, help="Harmonic force amplitude on the engine mass [N].")
 def stiffness(mount_file, engine_file, mount_dir, freq, method, fmt, plot, form, freq_axis,
-              engine_mass, force):
+              amplitude, engine_mass, force):
     """Cross-point dynamic stiffness K*(f) of MOUNT_FILE: real, imaginary, magnitude, loss angle.
 
     With --engine-mass and --force it reproduces the thesis's verification set-up (a harmonic
@@ -47,17 +51,27 @@ def stiffness(mount_file, engine_file, mount_dir, freq, method, fmt, plot, form,
       powertrain stiffness mounts/thesis-appendix-a.toml --freq 5,10,12,15,17,20,25,30,40 \\
           --engine-mass 100 --force 100 --method time --format csv
       powertrain stiffness --engine engines/default-torque-rod.toml --mount torque_rod.x
+      powertrain stiffness mounts/hydraulic-engine-mount-z.toml --amplitude 0.05,0.1,0.5 \\
+          --method time --freq 1:100:1 --plot k.png
     """
     from powertrain.cli.common import parse_frequencies, require_finite, solved
+    from powertrain.workflows.stiffness import parse_amplitudes
     from powertrain.workflows.stiffness import stiffness as run
 
     freqs = parse_frequencies(freq)
     mount = _mount(mount_file, engine_file, mount_dir)
+    amps = None if amplitude is None else parse_amplitudes(amplitude, mount_file)
     source = mount_file or engine_file
     key = "parameters" if mount_file else f"--mount {mount_dir}"
     result = solved(lambda: run(mount, engine=engine_file, freq=freqs, method=method,
-                                engine_mass=engine_mass, force=force), source, key)
+                                engine_mass=engine_mass, force=force, amplitude=amps),
+                    source, key)
     require_finite(result.columns(), source, key)
+    _report(result, fmt, plot, form, freq_axis)
+
+
+def _report(result, fmt, plot, form, freq_axis):
+    """Write the plot (when asked) and print the table, the CSV or the plot's summary."""
     if plot:
         from powertrain.cli.common import cli_provenance, write_plot
         prov = cli_provenance()

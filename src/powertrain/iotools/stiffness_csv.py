@@ -13,7 +13,18 @@ or, instead of the real and imaginary parts, magnitude and phase (loss angle)::
 
 ``frequency_hz`` [Hz] must be finite, non-negative and strictly increasing; stiffness in
 N/mm, phase in degrees. When both pairs are present the real/imaginary pair is used. The
-output of ``powertrain stiffness --format csv`` is a valid input. Every problem raises
+output of ``powertrain stiffness --format csv`` is a valid input.
+
+Multi-amplitude data (a supplier's K*(f) at several test amplitudes, Kovarik 2016 Fig. 14;
+``powertrain stiffness --amplitude`` writes it) add a column ``amplitude_mm``, the
+displacement amplitude of the test [mm] (> 0): the rows of one amplitude form one block, its
+frequencies strictly increasing, each amplitude one block::
+
+    amplitude_mm,frequency_hz,k_real_n_per_mm,k_imag_n_per_mm
+    0.05,1,262.1,28.3
+    ...
+    0.5,1,171.0,30.2
+ Every problem raises
 :class:`powertrain.errors.InputError` naming the file, the column and (for values) the line.
 """
 
@@ -29,6 +40,7 @@ from powertrain.iotools.textfile import parse_number, read_text
 from powertrain.units import to_si
 
 FREQUENCY = "frequency_hz"
+AMPLITUDE = "amplitude_mm"
 REAL, IMAG = "k_real_n_per_mm", "k_imag_n_per_mm"
 ABS, PHASE = "k_abs_n_per_mm", "phase_deg"
 
@@ -50,6 +62,8 @@ class MeasuredStiffness:
     frequency_hz: np.ndarray
     kcp: np.ndarray
     source: str = ""
+    #: Test amplitude of each point [m] (multi-amplitude data), None without that column.
+    amplitude_m: np.ndarray | None = None
 
     def select(self, fmin=None, fmax=None) -> MeasuredStiffness:
         """The points with ``fmin <= f <= fmax`` [Hz] (either bound optional)."""
@@ -58,12 +72,24 @@ class MeasuredStiffness:
             keep &= self.frequency_hz >= fmin
         if fmax is not None:
             keep &= self.frequency_hz <= fmax
-        return MeasuredStiffness(self.frequency_hz[keep], self.kcp[keep], self.source)
+        amp = None if self.amplitude_m is None else self.amplitude_m[keep]
+        return MeasuredStiffness(self.frequency_hz[keep], self.kcp[keep], self.source, amp)
+
+    @property
+    def amplitudes(self) -> np.ndarray:
+        """The distinct test amplitudes [m], increasing (empty without the column)."""
+        return np.zeros(0) if self.amplitude_m is None else np.unique(self.amplitude_m)
+
+    def at(self, amplitude) -> MeasuredStiffness:
+        """The curve measured at one test ``amplitude`` [m] (one of :attr:`amplitudes`)."""
+        keep = self.amplitude_m == amplitude
+        return MeasuredStiffness(self.frequency_hz[keep], self.kcp[keep], self.source,
+                                 self.amplitude_m[keep])
 
 
 #: Plausible magnitudes: frequency [Hz], stiffness [N/mm] (a steel bar is ~1e6 N/mm), phase
 #: [deg]; beyond them a value is a unit or export error.
-LIMITS = {FREQUENCY: 1e5, REAL: 1e9, IMAG: 1e9, ABS: 1e9, PHASE: 360.0}
+LIMITS = {FREQUENCY: 1e5, REAL: 1e9, IMAG: 1e9, ABS: 1e9, PHASE: 360.0, AMPLITUDE: 1e3}
 
 
 def _open_rows(path):
@@ -106,7 +132,8 @@ def read_stiffness_csv(path) -> MeasuredStiffness:
         raise InputError("empty file, expected a header line", file=path, key=FREQUENCY)
     header_line, header = rows[0]
     pair, polar = _columns(header, header_line, path)
-    data = _values(rows[1:], header, [FREQUENCY, *pair], path)
+    amp = [AMPLITUDE] if AMPLITUDE in header else []
+    data = _values(rows[1:], header, [*amp, FREQUENCY, *pair], path)
     f = np.array(data[FREQUENCY])
     a = np.array(data[pair[0]])
     b = np.array(data[pair[1]])
@@ -115,7 +142,8 @@ def read_stiffness_csv(path) -> MeasuredStiffness:
         kcp = mag * np.exp(1j * to_si(b, "deg", "angle"))
     else:
         kcp = to_si(a, "N/mm", "stiffness") + 1j * to_si(b, "N/mm", "stiffness")
-    return MeasuredStiffness(f, kcp, path)
+    amplitude = to_si(np.array(data[AMPLITUDE]), "mm", "length") if amp else None
+    return MeasuredStiffness(f, kcp, path, amplitude)
 
 
 def _columns(header, header_line, path):
@@ -145,6 +173,7 @@ def _values(rows, header, cols, path) -> dict:
     """Column name -> list of numbers (file units) of the data ``rows``, checked."""
     index = {name: header.index(name) for name in cols}
     data = {name: [] for name in cols}
+    blocks = _Blocks(path)
     for lineno, fields in rows:
         if len(fields) != len(header):
             raise InputError(f"expected {len(header)} fields, got {len(fields)}",
@@ -152,10 +181,10 @@ def _values(rows, header, cols, path) -> dict:
         for name in cols:
             raw = fields[index[name]]
             value = parse_number(raw, path, lineno, name, nonneg=name in (FREQUENCY, ABS))
-            if data[FREQUENCY] and name == FREQUENCY and value <= data[FREQUENCY][-1]:
-                raise InputError(f"frequencies must be strictly increasing ({raw} after "
-                                 f"{data[FREQUENCY][-1]:g})", file=path, key=name,
-                                 line=lineno)
+            if name == AMPLITUDE:
+                blocks.start(value, lineno)
+            elif name == FREQUENCY:
+                blocks.check(value, raw, lineno)
             limit = LIMITS.get(name)
             if limit is not None and abs(value) > limit:
                 raise InputError(f"|{raw}| above the plausible {limit:g}", file=path,
@@ -164,3 +193,30 @@ def _values(rows, header, cols, path) -> dict:
     if not data[FREQUENCY]:
         raise InputError("no data rows", file=path, key=FREQUENCY)
     return data
+
+
+class _Blocks:
+    """The frequency order of a table: strictly increasing within each amplitude block,
+    each amplitude (> 0) one block (one block without an amplitude column)."""
+
+    def __init__(self, path):
+        self.path, self.seen, self.last = path, [], None
+
+    def start(self, amplitude, lineno) -> None:
+        if amplitude <= 0:
+            raise InputError(f"amplitude must be > 0, got {amplitude:g}", file=self.path,
+                             key=AMPLITUDE, line=lineno)
+        if self.seen and amplitude == self.seen[-1]:
+            return
+        if amplitude in self.seen:
+            raise InputError(f"amplitude {amplitude:g} mm again after other amplitudes "
+                             "(one block of rows per amplitude)", file=self.path,
+                             key=AMPLITUDE, line=lineno)
+        self.seen.append(amplitude)
+        self.last = None
+
+    def check(self, frequency, raw, lineno) -> None:
+        if self.last is not None and frequency <= self.last:
+            raise InputError(f"frequencies must be strictly increasing ({raw} after "
+                             f"{self.last:g})", file=self.path, key=FREQUENCY, line=lineno)
+        self.last = frequency

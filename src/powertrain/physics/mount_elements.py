@@ -19,7 +19,9 @@ between the engine-side node and the base node, acting on their relative displac
 A port law is an object with ``kind`` (its code in :mod:`powertrain.kernels.port_forces`),
 ``parameters()`` (float array), ``initial_state(u0, f0)`` (float array: the memory at the
 start, where the relative displacement is ``u0`` and the force expected from the
-equivalent-linear solution ``f0``)
+equivalent-linear solution ``f0``), ``steady_state(amplitude)`` (the memory on its steady
+loop of that amplitude about 0, at the lower tip, moving up: where the displacement-driven
+test of :func:`powertrain.solvers.mount_time_domain.time_cross_point_stiffness` starts)
 and ``describing_stiffness(amplitude)`` (complex [N/m]). :class:`JenkinsFriction` is the one
 implemented here: simple, with a closed-form describing function, it proves the plug-in
 (tests/test_mount_elements.py).
@@ -68,6 +70,12 @@ class JenkinsFriction:
         if self.stiffness <= 0:
             return np.array([u0], float)
         return np.array([u0 - np.clip(f0, -self.slip_force, self.slip_force) / self.stiffness])
+
+    def steady_state(self, amplitude: float) -> np.ndarray:
+        """Slider at the lower tip of the steady loop of amplitude ``amplitude`` [m] about 0,
+        where the motion turns up."""
+        return np.array([-amplitude + min(self.stiffness * amplitude, self.slip_force)
+                         / self.stiffness])
 
     def describing_stiffness(self, amplitude) -> np.ndarray:
         """Equivalent complex stiffness [N/m] at the displacement amplitude [m]."""
@@ -149,6 +157,13 @@ class MountElement:
         k = np.where(np.asarray(s) == 0, 0.0, self.port_law.describing_stiffness(amplitude))
         return (res[0] + k, res[1] - k, res[2] + k) + res[3:]
 
+
+    def cross_point_stiffness(self, frequency_hz, amplitude=0.0) -> np.ndarray:
+        """Equivalent-linear cross-point dynamic stiffness K*(f, A) [N/m]: the base force
+        per engine-side displacement under a sine of amplitude ``amplitude`` [m] at
+        ``frequency_hz`` [Hz], base grounded (minus the two-port's ``b``)."""
+        s = 2j * np.pi * np.asarray(frequency_hz, float)
+        return -self.two_port(s, amplitude)[1]
 
 @dataclass(frozen=True)
 class PortForces:

@@ -27,6 +27,7 @@ applies them:
 
 from __future__ import annotations
 
+import functools
 from dataclasses import dataclass
 
 import numpy as np
@@ -36,6 +37,12 @@ from powertrain.kernels.port_forces import BERG
 #: Gauss–Legendre nodes per loop branch of Berg's describing function: the branch is smooth
 #: (a rational function of sin θ), so 48 nodes give the first harmonic to round-off.
 _GAUSS_NODES = 48
+
+
+@functools.lru_cache(maxsize=4)
+def _gauss_legendre(n: int):
+    """Gauss–Legendre nodes and weights on [-1, 1] (computed once: an eigenproblem)."""
+    return np.polynomial.legendre.leggauss(n)
 
 
 @dataclass(frozen=True)
@@ -184,6 +191,13 @@ class BergFriction:
         y = f * x2 / (fm - abs(f))
         return np.array([u0 - y, 0.0, np.sign(f), u0, f])
 
+    def steady_state(self, amplitude: float) -> np.ndarray:
+        """State on the symmetric steady loop of amplitude ``amplitude`` [m] about 0, just
+        reversed at its lower tip :math:`(-A, -F_r)` and moving up (a displacement-driven
+        test started here is periodic from its first cycle)."""
+        fr = float(self.loop_amplitude_force(amplitude))
+        return np.array([-amplitude, -fr, 1.0, -amplitude, -fr])
+
     @property
     def initial_stiffness(self) -> float:
         """Tangent stiffness at a reversal point [N/m]: F_max / x2."""
@@ -211,7 +225,7 @@ class BergFriction:
         if self.max_force <= 0 or not big.any():
             return out.reshape(np.shape(amplitude))
         a = A[big][:, None]
-        t, w = np.polynomial.legendre.leggauss(_GAUSS_NODES)
+        t, w = _gauss_legendre(_GAUSS_NODES)
         theta = 0.5 * np.pi * t[None, :]
         fr = self.loop_amplitude_force(a)
         fm, x2 = self.max_force, self.half_displacement

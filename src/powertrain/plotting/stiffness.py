@@ -185,3 +185,27 @@ def plot_retune(target_fit, path=None, *, ax=None, form=DEFAULT_FORM,
     axes[0].set_title(f"{tf.target.spec}: max error in band {100 * tf.max_band_error:.1f} %, "
                       f"mean change {100 * tf.mean_band_change:+.1f} %", fontsize=TITLE_SIZE)
     return finish(fig, own, path, provenance)
+
+
+def plot_amplitude_fit(curves, path=None, *, ax=None, form=DEFAULT_FORM,
+                       freq_axis=DEFAULT_FREQ_AXIS, title=None, provenance=None):
+    """Measured (dots) and fitted (lines) K*(f) at several test amplitudes, one colour per
+    amplitude (Kovarik 2016, Fig. 14 with the fit over it).
+
+    Parameters
+    ----------
+    curves : list of (label, frequency_hz, kcp_measured, kcp_fitted)
+        Per amplitude; stiffness [N/m].
+    path, ax, form, freq_axis, title, provenance
+        As for :func:`plot_stiffness`.
+    """
+    fig, axes, own = stiffness_axes(ax, form)
+    for k, (label, f, measured, fitted) in enumerate(curves):
+        draw_stiffness(axes, f, measured, form, label=f"{label} measured", color=colour(k),
+                       marker=".", freq_axis=freq_axis)
+        draw_stiffness(axes, f, fitted, form, label=f"{label} fitted", color=colour(k),
+                       freq_axis=freq_axis)
+    style_stiffness(axes, form, freq_axis, own=own)
+    if title:
+        axes[0].set_title(title, fontsize=TITLE_SIZE)
+    return finish(fig, own, path, provenance)

@@ -44,36 +44,18 @@ class StiffnessResult:
 
     def to_csv(self, path=None) -> str:
         """The CSV text (datasheet units); written atomically to ``path`` when given."""
-        cols = self.columns()
-        lines = [",".join(cols)]
-        for i in range(self.frequency_hz.size):
-            lines.append(",".join(f"{cols[c][i]:.10g}" for c in cols))
-        text = "\n".join(lines) + "\n"
-        if path is not None:
-            from powertrain.outputs import atomic_write
-            with atomic_write(path) as fh:
-                fh.write(text)
-        return text
+        return _csv(self.columns(), path)
 
     def to_text(self) -> str:
         """The table of every frequency (``powertrain stiffness``)."""
-        from powertrain.analysis.text_table import format_table
-        cols = self.columns()
-        header = list(cols)
-        rows = [[float(cols[c][i]) for c in cols] for i in range(self.frequency_hz.size)]
-        return f"# method: {self.method}\n" + format_table(header, rows) + "\n"
+        return _table(self.columns(), self.method)
 
     def summary(self) -> str:
         """What a plot reader checks first: |K*| range and the loss-angle peak, in N/mm, deg
         (``powertrain stiffness --plot`` without ``--format``)."""
-        cols = self.columns()
-        f, k, phi = cols["frequency_hz"], cols["k_abs_n_per_mm"], cols["loss_angle_deg"]
-        lo, hi, top = int(np.argmin(k)), int(np.argmax(k)), int(np.argmax(phi))
+        f = self.frequency_hz
         return (f"# method: {self.method}; {f.size} frequencies {f[0]:g}..{f[-1]:g} Hz "
-                "(every value: --format table or csv)\n"
-                f"|K*| {k[0]:.4g} N/mm at {f[0]:g} Hz; min {k[lo]:.4g} N/mm at {f[lo]:g} Hz, "
-                f"max {k[hi]:.4g} N/mm at {f[hi]:g} Hz\n"
-                f"loss angle max {phi[top]:.3g} deg at {f[top]:g} Hz")
+                "(every value: --format table or csv)\n" + _ranges(self.columns()))
 
     def plot(self, ax=None, *, path=None, label=None, form="magnitude-phase", freq_axis="log",
              measured=None, provenance=None):
@@ -88,3 +70,87 @@ class StiffnessResult:
         return plot_stiffness([(name, self)], path, measured=measured, ax=ax, form=form,
                               freq_axis=freq_axis,
                               provenance=provenance or getattr(self, "provenance", None))
+
+
+def _ranges(cols) -> str:
+    """|K*| at the first frequency, its min and max, and the loss-angle peak (two lines)."""
+    f, k, phi = cols["frequency_hz"], cols["k_abs_n_per_mm"], cols["loss_angle_deg"]
+    lo, hi, top = int(np.argmin(k)), int(np.argmax(k)), int(np.argmax(phi))
+    return (f"|K*| {k[0]:.4g} N/mm at {f[0]:g} Hz; min {k[lo]:.4g} N/mm at {f[lo]:g} Hz, "
+            f"max {k[hi]:.4g} N/mm at {f[hi]:g} Hz\n"
+            f"loss angle max {phi[top]:.3g} deg at {f[top]:g} Hz")
+
+
+def _csv(cols: dict, path=None) -> str:
+    """CSV text of equal-length columns (10 significant digits); written atomically to
+    ``path`` when given."""
+    n = len(next(iter(cols.values())))
+    lines = [",".join(cols)]
+    for i in range(n):
+        lines.append(",".join(f"{cols[c][i]:.10g}" for c in cols))
+    text = "\n".join(lines) + "\n"
+    if path is not None:
+        from powertrain.outputs import atomic_write
+        with atomic_write(path) as fh:
+            fh.write(text)
+    return text
+
+
+def _table(cols: dict, method: str) -> str:
+    from powertrain.analysis.text_table import format_table
+    n = len(next(iter(cols.values())))
+    rows = [[float(cols[c][i]) for c in cols] for i in range(n)]
+    return f"# method: {method}\n" + format_table(list(cols), rows) + "\n"
+
+
+@dataclass
+class AmplitudeStiffnessResult:
+    """K*(f, X) of the sinusoidal displacement test at several amplitudes X (``powertrain
+    stiffness --amplitude``): one :class:`StiffnessResult` per amplitude.
+
+    :meth:`columns` are those of :class:`StiffnessResult` after a first column
+    ``amplitude_mm``, the amplitudes one block after the other (a valid ``fit-mount`` input).
+    """
+
+    amplitude_m: np.ndarray               #: test amplitudes X [m]
+    curves: list                          #: StiffnessResult per amplitude
+    method: str
+    label: str = ""
+
+    def columns(self) -> dict[str, np.ndarray]:
+        per = [c.columns() for c in self.curves]
+        cols = {"amplitude_mm": np.concatenate(
+            [np.full(c.frequency_hz.size, a * 1e3) for a, c in zip(self.amplitude_m,
+                                                                   self.curves)])}
+        for name in per[0]:
+            cols[name] = np.concatenate([p[name] for p in per])
+        return cols
+
+    def to_csv(self, path=None) -> str:
+        """The CSV text (datasheet units); written atomically to ``path`` when given."""
+        return _csv(self.columns(), path)
+
+    def to_text(self) -> str:
+        """The table of every amplitude and frequency."""
+        return _table(self.columns(), self.method)
+
+    def summary(self) -> str:
+        """:meth:`StiffnessResult.summary` per amplitude."""
+        f = self.curves[0].frequency_hz
+        lines = [f"# method: {self.method}; {self.amplitude_m.size} amplitudes x "
+                 f"{f.size} frequencies {f[0]:g}..{f[-1]:g} Hz "
+                 "(every value: --format table or csv)"]
+        for a, c in zip(self.amplitude_m, self.curves):
+            lines.append(f"X = {a * 1e3:g} mm: " + _ranges(c.columns()).replace("\n", "; "))
+        return "\n".join(lines)
+
+    def plot(self, ax=None, *, path=None, form="magnitude-phase", freq_axis="log",
+             provenance=None):
+        """One K*(f) curve per amplitude (see :meth:`StiffnessResult.plot`)."""
+        from powertrain.plotting import plot_stiffness
+        from powertrain.plotting.style import target_and_path
+        ax, path = target_and_path(ax, path)
+        curves = [(f"X = {a * 1e3:g} mm", c) for a, c in zip(self.amplitude_m, self.curves)]
+        return plot_stiffness(curves, path, ax=ax, form=form, freq_axis=freq_axis,
+                              title=f"{self.label} ({self.method} method)" if self.label
+                              else None, provenance=provenance)

@@ -8,8 +8,8 @@ so that no transient contaminates the window, and report the cycle-to-cycle peri
 
 Two set-ups:
 
-* :func:`time_cross_point_stiffness` — the rate-machine test (sec. 1.8): the engine-side
-  node follows :math:`x_1 = X\cos\omega t` with the base grounded, the force transmitted to
+* :func:`time_cross_point_stiffness` — the rate-machine test (sec. 1.8, Fig. 13): the
+  engine-side node follows :math:`x_1 = X\sin\omega t` with the base grounded, the force transmitted to
   ground is recorded, :math:`K_{CP} = \hat F_T/X`.
 * :func:`time_forced_response` — the verification set-up (sec. 3.2, Appendix A): a force
   :math:`F\cos\omega t` on an engine mass carried by the mount; records :math:`\hat X_1` and
@@ -23,7 +23,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from powertrain.analysis.fourier import harmonic_amplitudes
-from powertrain.physics.mount_network import ground_force_rows
+from powertrain.kernels.port_forces import port_force_loop
+from powertrain.physics.mount_network import ground_force_rows, network_matrices
 from powertrain.solvers.newmark import newmark, periodic_state
 
 #: Default number of Newmark steps per excitation period: period error (2π/N)²/12 ≈ 3e-6.
@@ -56,49 +57,77 @@ def _periodicity(sig, N):
 
 def time_cross_point_stiffness(model, frequency_hz, amplitude=1e-4,
                                steps_per_period=STEPS_PER_PERIOD) -> TimeDomainResult:
-    """Cross-point stiffness by imposing x1 = X cos(ωt) and integrating the internal masses.
+    r"""Cross-point stiffness by imposing :math:`x_1 = X\sin\omega t` on the engine-side node
+    (base grounded) and integrating the internal masses: the first harmonic of the base force
+    over that of :math:`x_1` (the sinusoidal displacement test, Kovarik 2016 Fig. 13).
+
+    A mount element acts as in a time-domain run-up: its network scaled by its amplitude law
+    at :math:`A = \sqrt2\,\mathrm{RMS}` of the last cycle of :math:`x_1` (:math:`X` for the
+    pure sine), its port law integrated along the prescribed motion
+    (:func:`powertrain.kernels.port_forces.port_force_loop`) from its steady loop
+    (``steady_state``) and added to the base force. The network starts in the exactly
+    periodic state of the Newmark recurrence, so two periods are integrated and the second
+    one is transformed; ``periodicity`` is the steady-state check, max |F(t+T) - F(t)| over
+    max |F|.
 
     Parameters
     ----------
-    model : MountModel
+    model : MountModel or MountElement
     frequency_hz : array_like
         [Hz], > 0.
     amplitude : float
         Engine-side displacement amplitude X [m] (default 0.1 mm, the thesis's test amplitude;
-        the model is linear so it cancels).
+        a linear model cancels it).
     steps_per_period : int
     """
+    element = model.element() if hasattr(model, "element") else model
     freqs = np.atleast_1d(np.asarray(frequency_hz, float))
     if np.any(freqs <= 0):
         raise ValueError("time-domain method needs frequencies > 0 Hz")
-    masses, elem_nodes, c, d = model.network()
-    M, C, K = model.matrices()
+    N = int(steps_per_period)
+    phase = 2 * np.pi * np.arange(2 * N + 1) / N
+    x1 = amplitude * np.sin(phase)
+    law_amplitude = np.sqrt(2 * np.mean(x1[N:2 * N] ** 2))
+    masses, elem_nodes, c, d = element.network(law_amplitude)
+    M, C, K = network_matrices(masses, elem_nodes, c, d)
     kg, dg = ground_force_rows(masses.size, elem_nodes, c, d)
-    n = M.shape[0]
     out_k, out_p = [], []
     for f in freqs:
         w = 2 * np.pi * f
-        N = int(steps_per_period)
         h = 1.0 / (f * N)
-        t = np.arange(2 * N + 1) * h
-        x1 = amplitude * np.cos(w * t)
-        v1 = -amplitude * w * np.sin(w * t)
-        if n > 1:
-            Mi, Ci, Ki = M[1:, 1:], C[1:, 1:], K[1:, 1:]
-            # load on the internal masses from the prescribed engine-side motion
-            Fi = -(np.outer(x1[:N + 1], K[1:, 0]) + np.outer(v1[:N + 1], C[1:, 0]))
-            Xi, Vi, _ = _run_periodic(Mi, Ci, Ki, Fi, h)
-            X = np.column_stack([x1, Xi])
-            V = np.column_stack([v1, Vi])
-        else:
-            X, V = x1[:, None], v1[:, None]
-        ft = X @ kg + V @ dg
-        spec = harmonic_amplitudes(ft[N:2 * N])
-        out_k.append(spec[1] / amplitude)
+        v1 = amplitude * w * np.cos(phase)
+        X, V = _driven(M, C, K, x1, v1, h, N)
+        ft = X @ kg + V @ dg + _port_force(element.port_law, x1, v1, amplitude)
+        out_k.append(harmonic_amplitudes(ft[N:2 * N])[1] / harmonic_amplitudes(x1[N:2 * N])[1])
         out_p.append(_periodicity(ft, N))
     kcp = np.array(out_k)
     return TimeDomainResult(freqs, kcp, np.full(freqs.size, amplitude, complex),
                             kcp * amplitude, np.array(out_p))
+
+
+def _driven(M, C, K, x1, v1, h, N):
+    """Motion ``(X, V)`` of the network with the engine-side node prescribed (``x1``,
+    ``v1`` over two periods) and the internal masses integrated from their periodic state."""
+    if M.shape[0] == 1:
+        return x1[:, None], v1[:, None]
+    Mi, Ci, Ki = M[1:, 1:], C[1:, 1:], K[1:, 1:]
+    # load on the internal masses from the prescribed engine-side motion
+    Fi = -(np.outer(x1[:N + 1], K[1:, 0]) + np.outer(v1[:N + 1], C[1:, 0]))
+    Xi, Vi, _ = _run_periodic(Mi, Ci, Ki, Fi, h)
+    return np.column_stack([x1, Xi]), np.column_stack([v1, Vi])
+
+
+def _port_force(law, x1, v1, amplitude):
+    """Force [N] of the port law ``law`` (None: zero) on the base along the prescribed
+    relative motion ``x1``, ``v1``, from its steady loop at ``amplitude``."""
+    if law is None:
+        return 0.0
+    U = np.ascontiguousarray(x1[:, None])
+    F = np.zeros_like(U)
+    state = np.atleast_2d(law.steady_state(amplitude)).astype(float)
+    port_force_loop(np.array([law.kind], np.int64), np.atleast_2d(law.parameters()), state,
+                    U, np.ascontiguousarray(v1[:, None]), F)
+    return F[:, 0]
 
 
 def time_forced_response(model, frequency_hz, engine_mass, force,

@@ -181,7 +181,7 @@ def starting_points(topology: Topology, frequency_hz, kcp_measured, n: int, seed
     return np.clip(out, lo, hi)
 
 
-class _Problem:
+class NetworkProblem:
     """Normalised complex residual and its Jacobian in log-parameters, with a soft wall."""
 
     def __init__(self, topology: Topology, frequency_hz, kcp_measured, max_mass=None):
@@ -219,14 +219,18 @@ class _Problem:
                             self._kcp, self._dm, self._dc, self._dd)
         return self._kcp
 
+    def gradient(self, p):
+        """``(K_CP [N/m], dK_CP/dp (n_freq, n_parameters))`` at SI parameters ``p``."""
+        kcp = self.kcp(p)
+        return kcp, self._dc @ self.to_c + self._dd @ self.to_d + self._dm @ self.to_m
+
     def _evaluate(self, q):
         if self._q is not None and np.array_equal(self._q, q):
             return
         self.nfev += 1
         p = np.exp(np.clip(q, self.lo - 30.0, self.hi + 30.0))
-        kcp = self.kcp(p)
-        jac = (self._dc @ self.to_c + self._dd @ self.to_d + self._dm @ self.to_m) \
-            * (p / self.norm)[None, :]
+        kcp, grad = self.gradient(p)
+        jac = grad * (p / self.norm)[None, :]
         r = (kcp - self.km) / self.norm
         wall = q - np.clip(q, self.lo, self.hi)
         res = np.concatenate([r.real, r.imag, wall])
@@ -327,7 +331,7 @@ def _fit_arrays(frequency_hz, kcp_measured, topology, *, starts, seed, polish, h
     starts, polish, hops = int(starts), min(int(polish), int(starts)), int(hops)
     if max_mass is not None and not max_mass > 0:
         raise ValueError("max_mass must be positive")
-    prob = _Problem(topology, f, km, max_mass)
+    prob = NetworkProblem(topology, f, km, max_mass)
     rng = np.random.default_rng(seed)
     fresh = starting_points(topology, f, km, starts + hops, rng, max_mass)
     with np.errstate(all="ignore"):
@@ -417,7 +421,7 @@ def fit_mount_file(measured, model: str = DEFAULT_TOPOLOGY, *, starts: int = DEF
     from pathlib import Path
 
     from powertrain.iotools.stiffness_csv import FREQUENCY, read_stiffness_csv
-    _check_options(measured, model, starts, seed, max_mass, fmin, fmax)
+    check_options(measured, model, starts, seed, max_mass, fmin, fmax)
     data = read_stiffness_csv(measured).select(fmin, fmax)
     topo = TOPOLOGIES[model]
     need = (len(topo.parameters) + 1) // 2
@@ -436,7 +440,7 @@ def fit_mount_file(measured, model: str = DEFAULT_TOPOLOGY, *, starts: int = DEF
     return dataclasses.replace(result, data_name=file)
 
 
-def _check_options(measured, model, starts, seed, max_mass, fmin, fmax) -> None:
+def check_options(measured, model, starts, seed, max_mass, fmin, fmax) -> None:
     """Refuse options :func:`fit_mount_file` cannot use, naming the option."""
     import math
     if model not in TOPOLOGIES:

@@ -8,14 +8,15 @@ import os
 import numpy as np
 
 from powertrain.errors import InputError
-from powertrain.results.stiffness import StiffnessResult
+from powertrain.physics.mount_elements import MountElement
+from powertrain.results.stiffness import AmplitudeStiffnessResult, StiffnessResult
 
 #: Frequencies of :func:`stiffness` by default (``powertrain stiffness --freq 1:400:1``) [Hz].
 DEFAULT_FREQUENCIES_HZ = np.arange(1.0, 401.0)
 
 
 def stiffness(mount, *, engine=None, freq=None, method="frequency", force=None,
-              engine_mass=None, steps_per_period=None) -> StiffnessResult:
+              engine_mass=None, steps_per_period=None, amplitude=None):
     """Cross-point dynamic stiffness K*(f) of a mount model (``powertrain stiffness``).
 
     Parameters
@@ -35,17 +36,28 @@ def stiffness(mount, *, engine=None, freq=None, method="frequency", force=None,
         transmitted force F_T.
     steps_per_period : int, optional
         Newmark steps per excitation period for the time method.
+    amplitude : array_like, optional
+        Test amplitudes X [m] (> 0): K*(f, X) of the sinusoidal displacement test with the
+        mount's amplitude law and friction (:func:`amplitude_stiffness`). Without: the
+        network alone, as fitted.
 
     Returns
     -------
-    StiffnessResult
+    StiffnessResult, or AmplitudeStiffnessResult with ``amplitude``
     """
     _check_set_up(engine_mass, force)
     f = DEFAULT_FREQUENCIES_HZ if freq is None else np.asarray(freq, float)
     if method == "time" and f[0] <= 0:
         raise InputError("the time method needs frequencies > 0 Hz", key="--freq")
     model, label = mount_model(mount, engine)
-    result = stiffness_table(model, f, method, engine_mass, force, steps_per_period)
+    if amplitude is not None:
+        if engine_mass is not None:
+            raise InputError("--amplitude is the displacement test, without --engine-mass",
+                             key="--amplitude")
+        result = amplitude_stiffness(model, f, _amplitudes(amplitude), method,
+                                     steps_per_period)
+    else:
+        result = stiffness_table(model, f, method, engine_mass, force, steps_per_period)
     result.label = model.name or label
     return result
 
@@ -113,8 +125,79 @@ def stiffness_table(model, frequency_hz, method="frequency", engine_mass=None, f
             time_forced_response,
         )
         if engine_mass is None:
-            r = time_cross_point_stiffness(model, f, **kw)
+            r = time_cross_point_stiffness(MountElement(model), f, **kw)
             return StiffnessResult(f, r.kcp, method, meta={"periodicity": r.periodicity})
         r = time_forced_response(model, f, engine_mass, force, **kw)
         return StiffnessResult(f, r.kcp, method, r.x1, r.ft, meta={"periodicity": r.periodicity})
     raise ValueError(f"unknown method {method!r}")
+
+
+def _amplitudes(amplitude, unit="m") -> np.ndarray:
+    """The amplitudes as an array, refused unless positive, finite and distinct."""
+    a = np.atleast_1d(np.asarray(amplitude, float))
+    if a.size == 0 or not np.all(np.isfinite(a)) or np.any(a <= 0):
+        raise InputError(f"amplitudes [{unit}] must be positive and finite, got "
+                         f"{a.tolist()}", key="--amplitude")
+    if np.unique(a).size != a.size:
+        raise InputError(f"duplicate amplitudes [{unit}] in {a.tolist()}", key="--amplitude")
+    return a
+
+
+def amplitude_stiffness(model, frequency_hz, amplitude_m, method="frequency",
+                        steps_per_period=None) -> AmplitudeStiffnessResult:
+    """K*(f, X) of the sinusoidal displacement test (Kovarik 2016, Fig. 13: engine side
+    driven with x = X sin 2πft, base force measured) at each amplitude X.
+
+    Parameters
+    ----------
+    model : MountModel or MountElement
+        With its amplitude law and friction (port law).
+    frequency_hz : ndarray
+        [Hz] (> 0 for the time method).
+    amplitude_m : array_like
+        Test amplitudes X [m].
+    method : {"frequency", "time"}
+        ``frequency``: the element's equivalent-linear two-port (the amplitude law at X and
+        the port law's describing function); ``time``: the network scaled at the drive's
+        amplitude, integrated with the port law from its steady loop, first harmonic of the
+        base force
+        (:func:`powertrain.solvers.mount_time_domain.time_cross_point_stiffness`).
+    steps_per_period : int, optional
+        Newmark steps per period of the time method.
+    """
+    element = model.element() if hasattr(model, "element") else model
+    f = np.asarray(frequency_hz, float)
+    curves = []
+    for a in np.asarray(amplitude_m, float):
+        if method == "frequency":
+            curves.append(StiffnessResult(f, element.cross_point_stiffness(f, a), method))
+        elif method == "time":
+            from powertrain.solvers.mount_time_domain import time_cross_point_stiffness
+            kw = {} if steps_per_period is None else {"steps_per_period": steps_per_period}
+            r = time_cross_point_stiffness(element, f, a, **kw)
+            curves.append(StiffnessResult(f, r.kcp, method,
+                                          meta={"periodicity": r.periodicity}))
+        else:
+            raise ValueError(f"unknown method {method!r}")
+    return AmplitudeStiffnessResult(np.asarray(amplitude_m, float), curves, method)
+
+
+def parse_amplitudes(text: str, mount_file=None) -> np.ndarray:
+    """``powertrain stiffness --amplitude``: a comma list of amplitudes in the mount file's
+    displacement unit (``[units] x``; mm when it declares none or with ``--engine``), in
+    [m]."""
+    from powertrain.units import to_si
+    unit = _length_unit(mount_file) if mount_file is not None else "mm"
+    try:
+        values = [float(part) for part in text.split(",") if part.strip()]
+    except ValueError:
+        raise InputError(f"cannot read {text!r} (use a comma list, e.g. 0.05,0.1,0.5)",
+                         key="--amplitude") from None
+    where = {"file": str(mount_file), "key": "units.x"} if mount_file is not None else {}
+    return to_si(_amplitudes(values, unit), unit, "length", **where)
+
+
+def _length_unit(mount_file) -> str:
+    from powertrain.iotools.tomlfile import read_toml
+    units = read_toml(str(mount_file)).get("units", {})
+    return str(units.get("x", "mm")) if isinstance(units, dict) else "mm"
