@@ -110,13 +110,11 @@ def speed_steps(rpm_from: float, rpm_to: float, rpm_step: float) -> np.ndarray:
             raise InputError(f"must be a finite speed > 0 [rpm], got {value:g}", key=key)
     if rpm_to < rpm_from:
         raise InputError(f"{rpm_to:g} rpm is below --from {rpm_from:g} rpm", key="--to")
-    n = math.floor((rpm_to - rpm_from) / rpm_step + 1e-9) + 1
-    if n > MAX_SPEEDS:
-        raise InputError(f"{n:.3g} speed steps from --from/--to/--step; at most {MAX_SPEEDS}",
+    ratio = (rpm_to - rpm_from) / rpm_step
+    if not math.isfinite(ratio) or ratio + 1 > MAX_SPEEDS:
+        raise InputError(f"{ratio + 1:.3g} speed steps from --from/--to/--step; at most {MAX_SPEEDS}",
                          key="--step")
     return default_rpm(rpm_from, rpm_to, rpm_step)
-
-
 
 
 def check_outputs(**targets) -> None:
