@@ -63,3 +63,94 @@ def size(target, higher_is_better=True, worse_by=WORSE_BY, power=POWER, z=Z_ONE_
         if fail_probability(n, target, worse, higher_is_better, z) >= power:
             return n, threshold(n, target, higher_is_better, z)
     raise ValueError(f"no n <= {n_max} reaches power {power}")
+
+
+# --- group-sequential rate tests -------------------------------------------------------------
+#
+# A fixed-size test spends its n cases even when the first dozen already show a rate far
+# above its target. The group-sequential version draws the cases in batches and, after each
+# batch, stops early on Wald's likelihood ratio between the target and the rate WORSE_BY worse
+# (Wald 1947, *Sequential Analysis*): it passes when the ratio falls below
+# WALD_PASS = beta/(1 - alpha) and fails when it rises above WALD_FAIL = (1 - beta)/alpha
+# (alpha 0.05, beta 0.2: the same error rates as the fixed-size test). Truncated at ``n_max``,
+# where the Wilson rule decides as above. :func:`sequential_plan` picks the smallest
+# ``n_max`` whose exact operating characteristic (:func:`sequential_oc`, a sum over every
+# path of the batches) still fails a rate WORSE_BY worse with probability >= POWER.
+
+WALD_ALPHA = 0.05
+WALD_BETA = 0.2
+WALD_PASS = WALD_BETA / (1 - WALD_ALPHA)
+WALD_FAIL = (1 - WALD_BETA) / WALD_ALPHA
+#: Cases per batch (a multiple of the cores of a CI runner).
+BATCH = 8
+
+
+def _good_rates(target, higher_is_better, worse_by=WORSE_BY):
+    """The target and the worse rate as rates of *good* outcomes (a ceiling on a bad rate
+    is a floor on the good one)."""
+    q0 = target if higher_is_better else 1 - target
+    return q0, q0 - worse_by
+
+
+def look(n_good, n, target, higher_is_better=True, n_max=None):
+    """Decision after ``n`` cases with ``n_good`` good outcomes (successes for a target to
+    reach, non-events for a ceiling): ``"pass"``, ``"fail"`` or ``"go on"``."""
+    q0, q1 = _good_rates(target, higher_is_better)
+    llr = n_good * math.log(q1 / q0) + (n - n_good) * math.log((1 - q1) / (1 - q0))
+    if n_max is not None and n >= n_max:
+        k = n_good if higher_is_better else n - n_good
+        return "pass" if passes(k, n, target, higher_is_better) else "fail"
+    if llr <= math.log(WALD_PASS):
+        return "pass"
+    if llr >= math.log(WALD_FAIL):
+        return "fail"
+    return "go on"
+
+
+def sequential_oc(n_max, target, higher_is_better, true_rate, batch=BATCH):
+    """``(P(fail), expected number of cases)`` of the truncated group-sequential test when
+    the true rate is ``true_rate`` (as ``target``: of successes, or of events for a
+    ceiling), by exact sums over the batches."""
+    g = true_rate if higher_is_better else 1 - true_rate
+    alive = {0: 1.0}                       # good outcomes -> probability, still going on
+    n, p_fail, e_n = 0, 0.0, 0.0
+    while alive:
+        m = min(batch, n_max - n)
+        nxt = {}
+        for k, p in alive.items():
+            for j in range(m + 1):
+                nxt[k + j] = nxt.get(k + j, 0.0) + p * _binom_pmf(j, m, g)
+        n += m
+        alive = {}
+        for k, p in nxt.items():
+            verdict = look(k, n, target, higher_is_better, n_max)
+            if verdict == "go on":
+                alive[k] = p
+                continue
+            e_n += p * n
+            p_fail += p if verdict == "fail" else 0.0
+    return p_fail, e_n
+
+
+def sequential_plan(target, higher_is_better=True, batch=BATCH, n_limit=600):
+    """Smallest ``n_max`` (a multiple of ``batch``) at which the sequential test fails a rate
+    WORSE_BY worse than ``target`` with probability >= POWER."""
+    worse = target - WORSE_BY if higher_is_better else target + WORSE_BY
+    for n_max in range(batch, n_limit + 1, batch):
+        if sequential_oc(n_max, target, higher_is_better, worse, batch)[0] >= POWER:
+            return n_max
+    raise ValueError(f"no n_max <= {n_limit} reaches power {POWER}")
+
+
+def run_sequential(rows_of, is_good, target, higher_is_better=True, batch=BATCH):
+    """Draw batches ``rows_of(start, count)`` (a list of result rows) until :func:`look`
+    decides; returns ``(passed, rows, n_good)``."""
+    n_max = sequential_plan(target, higher_is_better, batch)
+    rows, good = [], 0
+    while True:
+        new = rows_of(len(rows), min(batch, n_max - len(rows)))
+        rows += new
+        good += sum(bool(is_good(r)) for r in new)
+        verdict = look(good, len(rows), target, higher_is_better, n_max)
+        if verdict != "go on":
+            return verdict == "pass", rows, good

@@ -2,13 +2,13 @@
 
 Each test draws new cases from :mod:`powertrain.validation` (Newmark truth, its own effect
 models, scatter and noise floor) with a seed from ``os.urandom``, diagnoses them (on every
-core, :func:`powertrain.parallel.run_map`) and applies the Wilson rule of
-``tests/rates.py``: it fails when the data show, at one-sided 95 % confidence, that the
-issue's target is missed. The number of cases is sized by :func:`rates.size` so that a true
-rate 0.1 worse than the target fails with probability >= 0.8 (top-1 and passive-side
-0.9: 61 cases; unexplained 0.8: 105; false claims 0.05: 36), hence their ``slow`` and
-``rates`` markers: about 20 min on 2 cores, so they run on request (``python -m pytest -m
-rates``), not in the default run or CI. The
+core, :func:`powertrain.parallel.run_map`) and applies the group-sequential Wilson rule of
+``tests/rates.py``: batches of 8 cases until Wald's likelihood ratio between the target and
+a rate 0.1 worse decides, truncated where the Wilson rule (one-sided 95 %) decides; a true
+rate 0.1 worse than the target fails with probability >= 0.8 (exact sums,
+tests/test_rates.py). At most 80 cases (top-1 and passive side, target 0.9), 136
+(unexplained, 0.8), 48 (false claims, 0.05); at a true rate of 0.95 about 26, 18 and 22.
+They carry the ``slow`` and ``rates`` markers. The
 seeds are in the failure message; rerun one with
 :func:`powertrain.validation.cases.make_case`. The 50-case rates of the benchmark are printed
 by ``scripts/blind_diagnosis.py``.
@@ -85,34 +85,37 @@ def _detectable_row(task):
     return answer(detectable_case(kinds, _engine_kind(i), seed + i, i))
 
 
+def _sequential(row_fn, task_of, is_good, target, higher_is_better=True):
+    """The group-sequential Wilson test of ``tests/rates.py`` over fresh draws: batches of
+    ``row_fn(task_of(i, seed))`` on every core until the test decides."""
+    seed = fresh_seed()
+    passed, rows, good = rates.run_sequential(
+        lambda start, count: run_map(row_fn, [task_of(i, seed) for i in
+                                              range(start, start + count)]),
+        is_good, target, higher_is_better)
+    k = good if higher_is_better else len(rows) - good
+    assert passed, _report(seed, rows, k, len(rows), "the sequential rule")
+
+
 @pytest.mark.slow
 @pytest.mark.rates
 def test_effect_free_runs_make_no_false_claims():
-    n, k_pass = rates.size(TARGETS["false_claims"], higher_is_better=False)
-    seed = fresh_seed()
-    rows = run_map(_effect_free_row, [(i, seed) for i in range(n)])
-    k = sum(false_claim(r) for r in rows)
-    assert k <= k_pass, _report(seed, rows, k, n, f"<= {k_pass}")
+    _sequential(_effect_free_row, lambda i, seed: (i, seed),
+                lambda r: not false_claim(r), TARGETS["false_claims"], False)
 
 
 @pytest.mark.slow
 @pytest.mark.rates
 def test_detectable_in_library_effects_are_named():
-    n, k_pass = rates.size(TARGETS["top1"])
-    seed = fresh_seed()
-    rows = run_map(_detectable_row, [(TOP1_KINDS, i, seed) for i in range(n)])
-    k = sum(top1_hit(r) for r in rows)
-    assert k >= k_pass, _report(seed, rows, k, n, k_pass)
+    _sequential(_detectable_row, lambda i, seed: (TOP1_KINDS, i, seed), top1_hit,
+                TARGETS["top1"])
 
 
 @pytest.mark.slow
 @pytest.mark.rates
 def test_detectable_out_of_library_effects_are_unexplained():
-    n, k_pass = rates.size(TARGETS["unexplained_ok"])
-    seed = fresh_seed()
-    rows = run_map(_detectable_row, [(OUT_OF_LIBRARY, i, seed) for i in range(n)])
-    k = sum(is_unexplained(r) for r in rows)
-    assert k >= k_pass, _report(seed, rows, k, n, k_pass)
+    _sequential(_detectable_row, lambda i, seed: (OUT_OF_LIBRARY, i, seed), is_unexplained,
+                TARGETS["unexplained_ok"])
 
 
 def test_every_in_library_kind_has_a_library_match():
@@ -144,8 +147,4 @@ def _passive_row(task):
 def test_passive_side_body_and_mount_changes_are_named():
     """Issue 13's target (>= 0.9 of detectable body-mode and one-mount stiffness cases named,
     both sides of every mount measured) is not excluded by fresh draws."""
-    n, k_pass = rates.size(PASSIVE_TARGET)
-    seed = fresh_seed()
-    rows = run_map(_passive_row, [(i, seed) for i in range(n)])
-    k = sum(top1_hit(r) for r in rows)
-    assert k >= k_pass, _report(seed, rows, k, n, k_pass)
+    _sequential(_passive_row, lambda i, seed: (i, seed), top1_hit, PASSIVE_TARGET)

@@ -53,3 +53,54 @@ def test_the_old_sizes_have_no_power(n):
         fail = binomial_cdf(k_pass - 1, n, target - 0.1) if k_pass > 0 else 0.0
         assert fail == pytest.approx(rates.fail_probability(n, target, target - 0.1, z=1.96))
         assert fail < rates.POWER
+
+
+def _paths_fail_probability(n_max, target, higher, rate, batch):
+    """P(fail) of the sequential test by brute-force enumeration of batch outcomes (an
+    independent check of rates.sequential_oc): a recursion over looks."""
+    g = rate if higher else 1 - rate
+
+    def go(n, good):
+        total = 0.0
+        m = min(batch, n_max - n)
+        for j in range(m + 1):
+            p = comb(m, j) * g ** j * (1 - g) ** (m - j)
+            verdict = rates.look(good + j, n + m, target, higher, n_max)
+            if verdict == "fail":
+                total += p
+            elif verdict == "go on":
+                total += p * go(n + m, good + j)
+        return total
+    return go(0, 0)
+
+
+@pytest.mark.parametrize("target,higher", [(TARGETS["top1"], True),
+                                            (TARGETS["unexplained_ok"], True),
+                                            (TARGETS["false_claims"], False)])
+def test_sequential_test_keeps_the_power_and_size(target, higher):
+    n_max = rates.sequential_plan(target, higher)
+    worse = target - 0.1 if higher else target + 0.1
+    p_worse, _ = rates.sequential_oc(n_max, target, higher, worse)
+    p_target, _ = rates.sequential_oc(n_max, target, higher, target)
+    assert p_worse >= rates.POWER
+    assert p_target <= 0.11
+    # the smallest truncation with that power
+    assert rates.sequential_oc(n_max - rates.BATCH, target, higher, worse)[0] < rates.POWER
+
+
+def test_sequential_oc_matches_enumeration():
+    for target, higher, rate in [(0.9, True, 0.8), (0.9, True, 0.93), (0.05, False, 0.15)]:
+        n_max = 32
+        exact = rates.sequential_oc(n_max, target, higher, rate, batch=8)[0]
+        assert exact == pytest.approx(_paths_fail_probability(n_max, target, higher, rate, 8),
+                                      rel=1e-12)
+
+
+def test_sequential_run_stops_early_on_a_perfect_record():
+    calls = []
+
+    def rows_of(start, count):
+        calls.append(count)
+        return [True] * count
+    passed, rows, good = rates.run_sequential(rows_of, bool, 0.9)
+    assert passed and len(rows) == 16 and good == 16 and calls == [8, 8]
