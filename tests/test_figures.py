@@ -176,7 +176,6 @@ def _with_phases(measured, keys, shift_deg):
     """``measured`` with an order phase (a ramp over speed, plus ``shift_deg``) on ``keys``."""
     import copy
 
-    import numpy as np
     out = copy.deepcopy(measured)
     for key in keys:
         rpm = out.curves[key][0]
