@@ -139,18 +139,8 @@ def plot_comparison(comparison, path=None, quantities=None, *, ax=None, channel=
     fig, panels, phase_panels, own, axes = _grid(ax, rows, quantities, channel, quantity,
                                                  phased)
     limit = comparison.exclusion_limit * MM
-    compared = {(c.mount, c.direction, c.quantity): c for c in comparison.channels}
-    unmodelled = {(e["mount"], e["direction"], e["quantity"]): e
-                  for e in comparison.not_modelled}
-    missing = {(m["mount"], m["direction"], m["quantity"]): m["reason"]
-               for m in comparison.missing}
     margin_titles = not is_axes(ax)
-    for key, a in panels.items():
-        head = _head(key, rows[0], margin_titles)
-        if key in compared or key in unmodelled:
-            _panel(a, key, comparison, compared.get(key), unmodelled.get(key), limit, head)
-        else:
-            _empty_panel(a, head, missing.get(key, "no comparable point"))
+    _level_panels(panels, comparison, rows[0], limit, margin_titles)
     bottom = set(map(id, axes[-1]))
     for key, a in phase_panels.items():
         if key in phased:
@@ -158,18 +148,37 @@ def plot_comparison(comparison, path=None, quantities=None, *, ax=None, channel=
         else:
             _no_phase(a, id(a) in bottom)
     if margin_titles:
-        from matplotlib.ticker import MaxNLocator
-        axes[0, 0].xaxis.set_major_locator(MaxNLocator(nbins=3,
-                                                       steps=[1, 2, 5, 10]))
-        for mount, direction in rows:
-            panels[(mount, direction, quantities[0])].set_ylabel(f"{mount} {direction.upper()}",
-                                                                 fontsize=LABEL_SIZE)
+        _margin_labels(axes, panels, rows, quantities[0])
     label_grid(fig, axes, "RMS velocity [mm/s]" + (", under it phase φ [°]" if phased
                                                    else ""))
     if own:
         _legend(fig, axes, limit)
     return finish(fig, own, path, provenance,
                   title=_title(comparison, bool(phased)) if own else None)
+
+
+def _level_panels(panels, comparison, top_channel, limit, margin_titles):
+    """Draw every level panel: compared or measured-not-modelled, else labelled empty."""
+    compared = {(c.mount, c.direction, c.quantity): c for c in comparison.channels}
+    unmodelled = {(e["mount"], e["direction"], e["quantity"]): e
+                  for e in comparison.not_modelled}
+    missing = {(m["mount"], m["direction"], m["quantity"]): m["reason"]
+               for m in comparison.missing}
+    for key, a in panels.items():
+        head = _head(key, top_channel, margin_titles)
+        if key in compared or key in unmodelled:
+            _panel(a, key, comparison, compared.get(key), unmodelled.get(key), limit, head)
+        else:
+            _empty_panel(a, head, missing.get(key, "no comparable point"))
+
+
+def _margin_labels(axes, panels, rows, first_quantity):
+    """Speed ticks of the grid and each row's channel on the left."""
+    from matplotlib.ticker import MaxNLocator
+    axes[0, 0].xaxis.set_major_locator(MaxNLocator(nbins=3, steps=[1, 2, 5, 10]))
+    for mount, direction in rows:
+        panels[(mount, direction, first_quantity)].set_ylabel(f"{mount} {direction.upper()}",
+                                                              fontsize=LABEL_SIZE)
 
 
 def _grid(ax, rows, quantities, channel, quantity, phased):
