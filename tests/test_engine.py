@@ -229,6 +229,26 @@ def test_default_engine_file_structure(engine):
     assert engine.balancer.enabled is True          # copies do not touch the original
 
 
+
+def test_rotated_crank_pins_keep_theta_zero_at_cylinder_1_firing_tdc(tmp_path, engine):
+    """Oracle: only the pins' differences are geometry — the engine file with every crank-pin
+    angle turned by 37 deg must load the block exactly as the shipped one (complex order
+    amplitudes, i.e. magnitude and phase re cylinder-1 firing TDC, to round-off); before the
+    reader referred the pins to cylinder 1, the forces took the raw pins and the firing the
+    relative ones: the rotated file's forces then differed by 54 times the largest force order
+    of the shipped one (the balancer shafts, phased re cylinder-1 TDC, no longer matched)."""
+    pins = 'crank_pin_angles = {value = [0.0, 180.0, 180.0, 0.0], unit = "deg"}'
+    turned = read_engine(_variant(tmp_path, pins, pins.replace(
+        "[0.0, 180.0, 180.0, 0.0]", "[37.0, 217.0, 217.0, 397.0]")))
+    np.testing.assert_allclose(turned.crank.firing_angles, engine.crank.firing_angles,
+                               atol=1e-12)
+    for rpm in (1500.0, 4500.0):
+        _, ref = engine.excitation(rpm).order_spectrum(8.0)
+        _, got = turned.excitation(rpm).order_spectrum(8.0)
+        for part in (slice(0, 3), slice(3, 6)):          # forces [N], moments [N m]
+            err = np.abs(got[:, part] - ref[:, part]).max() / np.abs(ref[:, part]).max()
+            assert err < EXACT_REL, (rpm, part, err)
+
 def _variant(tmp_path, old, new, count=1):
     text = Path(DEFAULT_ENGINE_PATH).read_text()
     mounts = (Path(DEFAULT_ENGINE_PATH).parent.parent / "mounts").resolve()

@@ -172,6 +172,58 @@ def test_compare_figure_marks_measured_not_modelled_points():
     plt.close(fig)
 
 
+def _with_phases(measured, keys, shift_deg):
+    """``measured`` with an order phase (a ramp over speed, plus ``shift_deg``) on ``keys``."""
+    import copy
+
+    out = copy.deepcopy(measured)
+    for key in keys:
+        rpm = out.curves[key][0]
+        out.phases[key] = (rpm / 10.0 + shift_deg + 180.0) % 360.0 - 180.0
+    return out
+
+
+def _phase_axes(fig):
+    from powertrain.plotting.compare import PHASE_LIMIT_DEG
+    return [a for a in fig.axes if a.get_visible() and a.get_lines()
+            and a.get_ylim() == (-PHASE_LIMIT_DEG, PHASE_LIMIT_DEG)]
+
+
+@pytest.mark.parametrize("phased", ["none", "one side", "left Z", "every order"])
+def test_compare_figure_phase_panels_exactly_where_both_sides_give_phase(phased):
+    """A phase panel under each level panel with phase on both sides (and nowhere else);
+    without, the figure is the level grid alone. Every layout: clean text >= 8 pt, no
+    legend over data, palette colours, no taller than the A4 text height."""
+    import matplotlib.pyplot as plt
+
+    from powertrain.iotools.measured import read_measured
+    from powertrain.plotting.style import MAX_HEIGHT_IN, PRINT_WIDTH_IN
+    from powertrain.workflows.comparison import compare_runup
+    meas = read_measured(MEASURED)
+    orders = [k for k in meas.curves if k[2] != "synthesis"]
+    keys = {"none": [], "one side": orders, "left Z": [k for k in orders if k[:2] ==
+                                                        ("left", "z")],
+            "every order": orders}[phased]
+    sim = _with_phases(meas, keys, 20.0)
+    meas = _with_phases(meas, [] if phased == "one side" else keys, 0.0)
+    fig = compare_runup(sim, meas).plot()
+    fig.canvas.draw()
+    shown = _phase_axes(fig)
+    expected = 0 if phased == "one side" else len(keys)
+    assert len(shown) == expected
+    bottom_slot = phased == "every order"   # a bottom phase row's synthesis slot: speed axis
+    assert len([a for a in fig.axes if a.get_visible()]) == 9 * 4 + expected + bottom_slot
+    for a in shown:
+        assert {ln.get_label() for ln in a.get_lines()} == {"measured", "simulated"}
+    assert fig.get_figwidth() == pytest.approx(PRINT_WIDTH_IN)
+    assert fig.get_figheight() <= MAX_HEIGHT_IN + 1e-9
+    problems = (text_problems(fig) + small_texts(__import__("figure_text").drawn_texts(fig),
+                                                 fig.get_figwidth())
+                + legends_over_data(fig) + off_palette_colours(fig))
+    assert not problems, "\n".join(problems[:10])
+    plt.close(fig)
+
+
 @pytest.mark.slow          # ~7-11 s: keeps the fast lane under 3 min
 def test_runup_body_figures(tmp_path, monkeypatch, saved):
     engine = str(ROOT / "engines" / "default-modal-body.toml")

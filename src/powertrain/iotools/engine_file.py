@@ -255,6 +255,7 @@ def _read_crank(t, path) -> em.CrankTrain:
         raise InputError(f"expected \"+X\" or \"-X\", got {rot!r}", file=path,
                          key=f"{p}.rotation")
     pins = array_quantity(t, "crank_pin_angles", "angle", path, p, (n,))
+    pins = pins - pins[0]      # re cylinder 1: θ = 0 is its firing TDC, for forces and gas
     order_raw = get(t, "firing_order", path, p, types=list)
     key_fo = f"{p}.firing_order"
     if (any(isinstance(c, bool) or not isinstance(c, int) for c in order_raw)
@@ -277,13 +278,14 @@ def _read_crank(t, path) -> em.CrankTrain:
 
 
 def _firing_angles(pins, order, path, key):
-    """Cylinder-1 crank angle of each cylinder's firing TDC on [0, 4π).
+    """Cylinder-1 crank angle of each cylinder's firing TDC on [0, 4π) (``pins`` re
+    cylinder 1).
 
     Walk the firing order from cylinder 1 (fired at 0): each next cylinder fires at the first
     of its TDC angles (``pin + 2πk``) after the previous firing.
     """
     two_pi = 2.0 * np.pi
-    pins = np.mod(pins - pins[0], two_pi)
+    pins = np.mod(pins, two_pi)
     firing = np.zeros(len(pins))
     last = 0.0
     for cyl in order[1:]:

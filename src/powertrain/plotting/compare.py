@@ -1,4 +1,5 @@
-"""Comparison figure: measured and simulated run-up order curves, level gap shaded."""
+"""Comparison figure: measured and simulated run-up order curves, level gap shaded; under
+each level panel with phase on both sides, the order phase."""
 
 from __future__ import annotations
 
@@ -6,13 +7,20 @@ from pathlib import Path
 
 import numpy as np
 
-from powertrain.plotting.runup import SYNTHESIS_NOTE, grid, label_grid, panel_title, style_panel
+from powertrain.plotting.runup import (
+    SYNTHESIS_NOTE,
+    grid,
+    label_grid,
+    panel_title,
+    style_panel,
+)
 from powertrain.plotting.style import (
     GAP_ABOVE,
     GAP_BELOW,
     LABEL_SIZE,
     MAX_HEIGHT_IN,
     OKABE_ITO,
+    PRINT_WIDTH_IN,
     TICK_SIZE,
     TITLE_SIZE,
     colour,
@@ -21,6 +29,7 @@ from powertrain.plotting.style import (
     is_axes,
     no_data,
     quantity_label,
+    subplots,
 )
 
 #: Display factor of the levels: m/s -> mm/s.
@@ -34,6 +43,23 @@ FRAME_HEIGHT_IN = 1.6
 #: Most labelled ticks on a panel's level axis: 1-2-5 per decade would collide at 8 pt on a
 #: compact row; the 1-3 or decade ticks do not.
 MAX_LEVEL_TICKS = 3
+#: Drawn height of a phase panel [in] and its labelled ticks [deg]: inside the ±180° range,
+#: so that no label reaches the level panel above; two 8-pt labels (9.3 pt boxes) 180° of
+#: the 400° axis apart need 0.29 in, and constrained layout trims a little.
+PHASE_AXES_IN = 0.32
+PHASE_TICKS = (-90.0, 90.0)
+#: Phase axis limit [deg]: a little beyond ±180° so that points at the wrap stay visible.
+PHASE_LIMIT_DEG = 200.0
+#: Vertical pad around each panel of a figure with phase rows [in] (constrained layout's
+#: default 3 pt halved: the phase panel sits close under its level panel), and what a level
+#: row holds besides its axes there: its one-line title and the pads [in].
+PHASE_FIGURE_PAD_IN = 1.5 / 72
+LEVEL_DECORATION_IN = 0.2
+#: Said in the title of a figure with phase rows.
+#: Height of the two title lines :data:`PHASE_NOTE` adds [in].
+PHASE_NOTE_HEIGHT_IN = 0.3
+PHASE_NOTE = ("; under a level panel, where both sides give it: the order phase φ re "
+              "cylinder-1 firing TDC (√2·RMS·cos(kθ + φ))")
 #: Simulated speeds are marked when there are at most this many (a coarse grid, joined by
 #: the lines of the log-level interpolation); a simulation at the measured speeds is a line.
 MAX_MARKED_SPEEDS = 30
@@ -52,11 +78,28 @@ def comparison_quantities(comparison) -> list:
     return comparison.requested_quantities()
 
 
-def row_height(n_rows: int) -> float:
-    """Panel row height [in] that fits ``n_rows`` rows in :data:`MAX_HEIGHT_IN` (within
-    :data:`ROW_HEIGHT_IN`)."""
+def row_height(n_rows: int, n_phase_rows: int = 0) -> float:
+    """Level row height [in] that fits ``n_rows`` level rows and ``n_phase_rows`` phase rows
+    (:func:`phase_row_height` each) in :data:`MAX_HEIGHT_IN`: within :data:`ROW_HEIGHT_IN`,
+    except that a figure with phase rows goes below its lower bound rather than past the
+    page (the log ticks are thinned to the drawn height)."""
     lo, hi = ROW_HEIGHT_IN
-    return float(np.clip((MAX_HEIGHT_IN - FRAME_HEIGHT_IN) / max(n_rows, 1), lo, hi))
+    room = MAX_HEIGHT_IN - FRAME_HEIGHT_IN - n_phase_rows * phase_row_height() - \
+        (PHASE_NOTE_HEIGHT_IN if n_phase_rows else 0.0)
+    fit = room / max(n_rows, 1)
+    return float(min(fit, hi) if n_phase_rows else np.clip(fit, lo, hi))
+
+
+def phase_row_height() -> float:
+    """Height of a phase row [in]: its panel and the pads above and below."""
+    return PHASE_AXES_IN + 4 * PHASE_FIGURE_PAD_IN
+
+
+def phased_channels(comparison) -> dict:
+    """``{(mount, direction, quantity): ChannelComparison}`` of the channel-quantities with
+    a phase gap (phase on both sides at a compared point; the report's phase table)."""
+    return {(c.mount, c.direction, c.quantity): c for c in comparison.channels
+            if c.stats.get("n_phase_compared")}
 
 
 def plot_comparison(comparison, path=None, quantities=None, *, ax=None, channel=None,
@@ -91,30 +134,126 @@ def plot_comparison(comparison, path=None, quantities=None, *, ax=None, channel=
     rows = list(comparison.simulated.channels)
     rows += [c for c in comparison.measured.channels if c not in rows]
     quantities = list(quantities or comparison_quantities(comparison))
-    fig, panels, own, axes = grid(ax, rows, quantities, channel, quantity,
-                                  panel_height=row_height(len(rows)))
+    phased = {} if is_axes(ax) else {k: c for k, c in phased_channels(comparison).items()
+                                     if k[2] in quantities}
+    fig, panels, phase_panels, own, axes = _grid(ax, rows, quantities, channel, quantity,
+                                                 phased)
     limit = comparison.exclusion_limit * MM
+    margin_titles = not is_axes(ax)
+    _level_panels(panels, comparison, rows[0], limit, margin_titles)
+    bottom = set(map(id, axes[-1]))
+    for key, a in phase_panels.items():
+        if key in phased:
+            _phase_panel(a, comparison, phased[key])
+        else:
+            _no_phase(a, id(a) in bottom)
+    if margin_titles:
+        _margin_labels(axes, panels, rows, quantities[0])
+    label_grid(fig, axes, "RMS velocity [mm/s]" + (", under it phase φ [°]" if phased
+                                                   else ""))
+    if own:
+        _legend(fig, axes, limit)
+    return finish(fig, own, path, provenance,
+                  title=_title(comparison, bool(phased)) if own else None)
+
+
+def _level_panels(panels, comparison, top_channel, limit, margin_titles):
+    """Draw every level panel: compared or measured-not-modelled, else labelled empty."""
     compared = {(c.mount, c.direction, c.quantity): c for c in comparison.channels}
     unmodelled = {(e["mount"], e["direction"], e["quantity"]): e
                   for e in comparison.not_modelled}
     missing = {(m["mount"], m["direction"], m["quantity"]): m["reason"]
                for m in comparison.missing}
-    margin_titles = not is_axes(ax)
     for key, a in panels.items():
-        head = _head(key, rows[0], margin_titles)
+        head = _head(key, top_channel, margin_titles)
         if key in compared or key in unmodelled:
             _panel(a, key, comparison, compared.get(key), unmodelled.get(key), limit, head)
         else:
             _empty_panel(a, head, missing.get(key, "no comparable point"))
-    if margin_titles:
-        from matplotlib.ticker import MaxNLocator
-        axes[0, 0].xaxis.set_major_locator(MaxNLocator(nbins=3, steps=[1, 2, 5, 10]))
-        for r, (mount, direction) in enumerate(rows):
-            axes[r, 0].set_ylabel(f"{mount} {direction.upper()}", fontsize=LABEL_SIZE)
-    label_grid(fig, axes, "RMS velocity [mm/s]")
+
+
+def _margin_labels(axes, panels, rows, first_quantity):
+    """Speed ticks of the grid and each row's channel on the left."""
+    from matplotlib.ticker import MaxNLocator
+    axes[0, 0].xaxis.set_major_locator(MaxNLocator(nbins=3, steps=[1, 2, 5, 10]))
+    for mount, direction in rows:
+        panels[(mount, direction, first_quantity)].set_ylabel(f"{mount} {direction.upper()}",
+                                                              fontsize=LABEL_SIZE)
+
+
+def _grid(ax, rows, quantities, channel, quantity, phased):
+    """Level panels as :func:`~powertrain.plotting.runup.grid` (``phased`` empty), else a
+    phase row under each channel row with some phase.
+
+    Returns
+    -------
+    fig, panels : {key: level Axes}, phase_panels : {key: phase Axes}, own : bool,
+    axes : 2-D array of every panel, rows top to bottom
+    """
+    with_phase = [ch for ch in rows if any(k[:2] == tuple(ch) for k in phased)]
+    height = row_height(len(rows), len(with_phase))
+    if not with_phase:
+        fig, panels, own, axes = grid(ax, rows, quantities, channel, quantity,
+                                      panel_height=height)
+        return fig, panels, {}, own, axes
+    kinds = [(tuple(ch), kind) for ch in rows
+             for kind in (("level", "phase") if ch in with_phase else ("level",))]
+    rows_in = [height if kind == "level" else phase_row_height() for _, kind in kinds]
+    axes_in = [height - LEVEL_DECORATION_IN if kind == "level" else PHASE_AXES_IN
+               for _, kind in kinds]
+    fig, all_axes, own = subplots(ax, len(kinds), len(quantities), sharex=True,
+                                  figsize=(PRINT_WIDTH_IN, sum(rows_in) + FRAME_HEIGHT_IN
+                                           + PHASE_NOTE_HEIGHT_IN),
+                                  gridspec_kw={"height_ratios": axes_in})
     if own:
-        _legend(fig, axes, limit)
-    return finish(fig, own, path, provenance, title=_title(comparison) if own else None)
+        fig.get_layout_engine().set(h_pad=PHASE_FIGURE_PAD_IN)
+    level = [i for i, (_, kind) in enumerate(kinds) if kind == "level"]
+    panels = {(*rows[r], q): all_axes[i, j] for r, i in enumerate(level)
+              for j, q in enumerate(quantities)}
+    phase_panels = {(*ch, q): all_axes[i, j] for i, (ch, kind) in enumerate(kinds)
+                    if kind == "phase" for j, q in enumerate(quantities)}
+    return fig, panels, phase_panels, own, all_axes
+
+
+def _no_phase(ax, bottom):
+    """A phase slot without phase: hidden, or on the bottom row only its speed axis (so that
+    every column's speed labels stay on one line)."""
+    if not bottom:
+        ax.set_visible(False)
+        return
+    for side in ("left", "right", "top"):
+        ax.spines[side].set_visible(False)
+    ax.tick_params(axis="y", left=False, labelleft=False)
+    ax.tick_params(axis="x", labelsize=TICK_SIZE)
+    ax.patch.set_visible(False)
+
+
+def _phase_panel(ax, comparison, c):
+    """Order phase [deg] of one channel-quantity, wrapped to ±180° (measured where not at
+    the noise floor, simulated where its level is not zero), a line broken at each wrap."""
+    key = (c.mount, c.direction, c.quantity)
+    meas = np.asarray(comparison.measured.phases[key], float)
+    _phase_line(ax, c.rpm, np.where(c.at_floor, np.nan, meas), "-", color="k", lw=0.7,
+                label="measured", zorder=3)
+    rpm, level = comparison.simulated.curves[key]
+    sim = np.where(level > 0, comparison.simulated.phases[key], np.nan)
+    sparse = len(comparison.sim_rpm) <= MAX_MARKED_SPEEDS
+    _phase_line(ax, rpm, sim, "o-" if sparse else "-", color=colour(0), ms=2, lw=1.2,
+                label="simulated")
+    ax.set_ylim(-PHASE_LIMIT_DEG, PHASE_LIMIT_DEG)
+    ax.set_yticks(PHASE_TICKS)
+    ax.set_yticks([-180.0, 0.0, 180.0], minor=True)
+    ax.grid(True, which="both", alpha=0.35)
+    ax.tick_params(which="both", labelsize=TICK_SIZE)
+
+
+def _phase_line(ax, rpm, phase_deg, fmt, **style):
+    """Draw a wrapped phase against speed, the line broken where it wraps (a step over
+    180°) instead of crossing the panel."""
+    rpm, phase = np.asarray(rpm, float), np.asarray(phase_deg, float)
+    jump = np.abs(np.diff(phase)) > 180.0
+    at = np.nonzero(jump)[0] + 1
+    ax.plot(np.insert(rpm, at, np.nan), np.insert(phase, at, np.nan), fmt, **style)
 
 
 def _head(key, top_channel, margin_titles) -> str:
@@ -139,7 +278,7 @@ def _legend(fig, axes, limit):
     figure_legend(fig, axes, extra)
 
 
-def _title(comparison) -> str:
+def _title(comparison, phased=False) -> str:
     src = Path(comparison.measured.source).name
     tag = "SYNTHETIC measurement" if comparison.measured.synthetic else "measurement"
     n = comparison.n_not_modelled
@@ -147,7 +286,7 @@ def _title(comparison) -> str:
                   f"{comparison.noise_floor * MM:g} mm/s floor; in no gap)") if n else ""
     return (f"{tag} {src} vs simulation: overall RMS gap {comparison.overall_rms_db:.2f} dB"
             f"{unmodelled} (gap = 20 log10(sim/measured); over each panel its RMS and bias "
-            f"[dB]){SYNTHESIS_NOTE}")
+            f"[dB]){SYNTHESIS_NOTE}" + (PHASE_NOTE if phased else ""))
 
 
 def _panel(ax, key, comparison, c, unmodelled, limit, head):

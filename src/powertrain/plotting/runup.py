@@ -54,14 +54,22 @@ def panel_title(mount, direction, quantity) -> str:
     return f"{mount} {direction.upper()} · {quantity_label(quantity)}"
 
 
+#: Most columns that each get their own x label (more: one under the middle column, as a
+#: label per column would run into its neighbours).
+MAX_LABELLED_COLUMNS = 4
+
+
 def label_grid(fig, axes, ylabel):
-    """Shared axis labels: one x label under the grid and one y label beside it, or the
-    labels of a single axes."""
+    """Shared axis labels: an x label under each column (only under the middle one beyond
+    :data:`MAX_LABELLED_COLUMNS`) and one y label beside it, or the labels of a single
+    axes."""
     if axes.size == 1:
         axes.flat[0].set_xlabel(RPM_LABEL, fontsize=LABEL_SIZE)
         axes.flat[0].set_ylabel(ylabel, fontsize=LABEL_SIZE)
         return
-    for ax in axes[-1]:
+    columns = axes[-1] if axes.shape[1] <= MAX_LABELLED_COLUMNS else \
+        [axes[-1, axes.shape[1] // 2]]
+    for ax in columns:
         ax.set_xlabel(RPM_LABEL, fontsize=LABEL_SIZE)
     fig.supylabel(ylabel, fontsize=LABEL_SIZE + 0.5)
 
