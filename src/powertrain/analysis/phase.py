@@ -75,6 +75,8 @@ def tdc_origin(profile, tdc_offset_deg, cycle_edges=None, *, file=None, key="--t
         a cycle reference, 0..720 with one.
     cycle_edges : ndarray, optional
         Times [s] of the cycle reference's rising edges.
+    file, key : str, optional
+        Named in an :class:`~powertrain.errors.InputError` (the recording and the option).
 
     Returns
     -------
