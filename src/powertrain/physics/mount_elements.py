@@ -20,9 +20,10 @@ A port law is an object with ``kind`` (its code in :mod:`powertrain.kernels.port
 ``parameters()`` (float array), ``initial_state(u0, f0)`` (float array: the memory at the
 start, where the relative displacement is ``u0`` and the force expected from the
 equivalent-linear solution ``f0``)
-and ``describing_stiffness(amplitude)`` (complex [N/m]). :class:`JenkinsFriction` is the one
-implemented here: simple, with a closed-form describing function, it proves the plug-in
-(tests/test_mount_elements.py).
+``describing_stiffness(amplitude)`` (complex [N/m]) and ``loop_amplitude_force(amplitude)``
+(the force at the tips of its steady loop, where a time-domain run starts it).
+:class:`JenkinsFriction` is the one implemented here: simple, with a closed-form describing
+function, it proves the plug-in (tests/test_mount_elements.py).
 """
 
 from __future__ import annotations
@@ -68,6 +69,10 @@ class JenkinsFriction:
         if self.stiffness <= 0:
             return np.array([u0], float)
         return np.array([u0 - np.clip(f0, -self.slip_force, self.slip_force) / self.stiffness])
+
+    def loop_amplitude_force(self, amplitude) -> np.ndarray:
+        """Force at the tips ±A of the steady loop [N]: k A while it sticks, else F_s."""
+        return np.minimum(self.stiffness * np.asarray(amplitude, float), self.slip_force)
 
     def describing_stiffness(self, amplitude) -> np.ndarray:
         """Equivalent complex stiffness [N/m] at the displacement amplitude [m]."""
@@ -200,7 +205,11 @@ class PortForces:
     def initial_state(self, x0, f0=None) -> np.ndarray:
         """State rows (m, n_state) of every law at the initial coordinates ``x0``, expected
         to carry the forces ``f0`` (m,) [N] (default: unloaded)."""
-        u0 = self.rows @ np.asarray(x0, float)
+        return self.states_at(self.rows @ np.asarray(x0, float), f0)
+
+    def states_at(self, u0, f0=None) -> np.ndarray:
+        """State rows (m, n_state) of every law at the relative displacements ``u0`` (m,)
+        [m], carrying the forces ``f0`` (m,) [N] (default: unloaded)."""
         f0 = np.zeros(u0.size) if f0 is None else f0
         states = [np.zeros(1) if law is None else np.atleast_1d(law.initial_state(u, f))
                   for law, u, f in zip(self.laws, u0, f0)]
@@ -208,6 +217,15 @@ class PortForces:
         for e, st in enumerate(states):
             out[e, :st.size] = st
         return out
+
+    def select(self, keep) -> PortForces:
+        """The port laws where the boolean mask ``keep`` (m,) is true."""
+        keep = np.asarray(keep, bool)
+        return PortForces(self.rows[keep], self.kinds[keep], self.parameters[keep],
+                          [law for law, k in zip(self.laws, keep) if k],
+                          np.ascontiguousarray(self.force_map[:, keep]),
+                          [name for name, k in zip(self.names, keep) if k], self.index[keep],
+                          self.n_networks)
 
     def forces(self, u, v, state) -> np.ndarray:
         """Port forces (m,) [N] at the relative motions ``u``, ``v`` (m,) from ``state``."""

@@ -36,6 +36,8 @@ from powertrain.kernels.port_forces import BERG
 #: Gauss–Legendre nodes per loop branch of Berg's describing function: the branch is smooth
 #: (a rational function of sin θ), so 48 nodes give the first harmonic to round-off.
 _GAUSS_NODES = 48
+#: Their nodes and weights on [-1, 1], computed once (``leggauss`` costs ~1 ms a call).
+_GAUSS = np.polynomial.legendre.leggauss(_GAUSS_NODES)
 
 
 @dataclass(frozen=True)
@@ -211,7 +213,7 @@ class BergFriction:
         if self.max_force <= 0 or not big.any():
             return out.reshape(np.shape(amplitude))
         a = A[big][:, None]
-        t, w = np.polynomial.legendre.leggauss(_GAUSS_NODES)
+        t, w = _GAUSS
         theta = 0.5 * np.pi * t[None, :]
         fr = self.loop_amplitude_force(a)
         fm, x2 = self.max_force, self.half_displacement
