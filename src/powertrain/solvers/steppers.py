@@ -159,9 +159,13 @@ class HarmonicStepper(Stepper):
         w = omegas[j][:, None]
         q_o = qh[j]                                       # (n_orders, n)
         s = self.system
+        Fk, Fd = s.force_matrix_k, s.force_matrix_d
+        if A is not None:        # the force rows of the networks at their amplitudes
+            Fk, Fd = self.scaling.matrices(self.scaling.scales(
+                self.ports.network_amplitudes(A)))[2:]
         x = (q_o @ s.channel_matrix.T).T
-        force = ((q_o @ s.force_matrix_k.T) + 1j * w * (q_o @ s.force_matrix_d.T)).T
-        mean = s.force_matrix_k @ qh[0].real
+        force = ((q_o @ Fk.T) + 1j * w * (q_o @ Fd.T)).T
+        mean = Fk @ qh[0].real
         if A is not None:
             z = self.ports.describing_forces(A, qh @ self.ports.rows.T) @ self.ports.force_map.T
             force, mean = force + z[j].T, mean + z[0].real
