@@ -32,10 +32,14 @@ from powertrain.analysis.fourier import harmonic_amplitudes
 from powertrain.analysis.orders import ORDERS, order_spectrum
 from powertrain.kernels.port_forces import NONE
 from powertrain.solvers.cycle_newmark import CycleRun, NetworkScaling, run_cycles, start_state
-from powertrain.solvers.equivalent_linear import AMPLITUDE_HARMONICS, amplitude_fixed_point
+from powertrain.solvers.equivalent_linear import AMPLITUDE_HARMONICS, TOLERANCE, amplitude_fixed_point
 from powertrain.solvers.harmonic import harmonic_response
 from powertrain.solvers.newmark import ModalNewmark, newmark
 
+#: Relative tolerance of the equivalent-linear fixed point a nonlinear Newmark run starts
+#: from (its amplitudes differ from the time domain's own by more: the harmonics above
+#: order 8, the friction's exact loop).
+START_TOLERANCE = 1e-4
 #: Highest order in the frequency-domain initial-state estimate of the Newmark run (the
 #: stepper itself sees the full sampled load): load harmonics above order 40 are < 2e-5 of
 #: the 2nd order for the default engine, and their response is smaller still.
@@ -82,6 +86,8 @@ class Stepper:
     #: static-curve factor at that speed (:meth:`MountElement.at_operating_point`); None:
     #: each element's own ``static_factor``.
     static_factors = None
+    #: Relative change of the amplitudes at which the equivalent-linear fixed point stops.
+    fixed_point_tolerance = TOLERANCE
 
     def __init__(self, system, grid: Cycles):
         self.system = system
@@ -115,7 +121,8 @@ class Stepper:
         if self.ports is None:
             return None, solve(None)
         A, solution = amplitude_fixed_point(solve, relative_motion, self.ports,
-                                            omega * 30.0 / np.pi, self.amplitudes)
+                                            omega * 30.0 / np.pi, self.amplitudes,
+                                            self.fixed_point_tolerance)
         self.amplitudes = A
         return A, solution
 
@@ -263,9 +270,12 @@ class ModalNewmarkStepper(_NewmarkStepper):
 
 
 class DenseNewmarkStepper(_NewmarkStepper):
-    """Newmark recurrence in physical coordinates (any mass matrix)."""
+    """Newmark recurrence in physical coordinates (any mass matrix); nonlinear elements
+    cycle by cycle (:func:`powertrain.solvers.cycle_newmark.run_cycles`)."""
 
     implementation = "dense"
+    #: the start's fixed point: the run goes on to its own steady state from it
+    fixed_point_tolerance = START_TOLERANCE
 
     def solve(self, load, omega) -> SpeedOrders:
         t0 = time.perf_counter()
