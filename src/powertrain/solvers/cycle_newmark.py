@@ -28,6 +28,7 @@ import dataclasses
 import numpy as np
 
 from powertrain.kernels.port_forces import NONE, port_force_loop
+from powertrain.physics.mount_elements import PortForces
 from powertrain.solvers.newmark import newmark, newmark_ports
 
 #: Engine cycles of prescribed harmonic motion that settle the port laws' minor loops
@@ -125,6 +126,14 @@ def steady_loop_state(ports, relative, n_cycle, cycles=LOOP_CYCLES) -> np.ndarra
     return state
 
 
+def no_ports(system):
+    """A :class:`PortForces` holding no element (a linear model run cycle by cycle, e.g.
+    for its static factors)."""
+    n_net = len(system.networks)
+    return PortForces(np.zeros((0, system.n_dof)), np.zeros(0, np.int64), np.zeros((0, 1)),
+                      [], np.zeros((len(system.channels), 0)), [], np.zeros(0, int), n_net)
+
+
 def start_state(ports, qh, n_cycle):
     """The port laws' states at t = 0 on their steady loop along the harmonic response
     ``qh`` (n_h, n) (:func:`steady_loop_state`); None when no element has a port law."""
@@ -146,40 +155,75 @@ class CycleRun:
     segments: list
 
 
+class CycleIntegrator:
+    """Integrates the nonlinear model one stretch (an engine cycle) at a time at the network
+    scales of the amplitudes of the stretch before (:func:`run_cycles`, the sweep).
+
+    The amplitude law scales the networks about the static deflection ``mean`` (n,) [m] of
+    the start: a stretch whose stiffness differs by dK from the first one's is loaded by dK
+    times it, so the static equilibrium stays where the harmonic fixed point put it and a
+    change of scale does not move it (which would be a step load of the size of the motion
+    itself).
+
+    Parameters
+    ----------
+    scaling : NetworkScaling
+    ports : PortForces
+        The nonlinear elements (their rows make the amplitudes; those with a port law are
+        integrated by Newton per step).
+    h : float
+        Time step [s].
+    mean : ndarray (n,)
+    """
+
+    def __init__(self, scaling, ports, h, mean):
+        self.scaling, self.ports, self.h, self.mean = scaling, ports, h, mean
+        self.laws = ports.select(ports.kinds != NONE)
+        #: True when some network's scale follows its amplitude
+        self.varying = any(el.amplitude_law is not None and not el.amplitude_law.constant
+                           for el in scaling.elements)
+        self._first = None
+
+    def run(self, F, start, amplitudes, state, factors=None):
+        """States ``(X, V, A, Z)`` over the load rows ``F`` (k + 1, n) [N] from ``start``
+        = (x, v, a) (row 0), the port-law ``state`` updated in place, and the stretch's
+        force rows ``(Fk, Fd, offset)`` (:class:`CycleRun`)."""
+        s = self.scaling
+        C, K, Fk, Fd = s.matrices(s.scales(self.ports.network_amplitudes(amplitudes),
+                                           factors))
+        self._first = self._first or (K, Fk)
+        shifted = K is not self._first[0]
+        load = F + (K - self._first[0]) @ self.mean if shifted else F
+        if self.laws.kinds.size:
+            X, V, A, Z = newmark_ports(s.system.M, C, K, load, self.h, self.laws, *start,
+                                       state=state)
+        else:
+            (X, V, A), Z = newmark(s.system.M, C, K, load, self.h, *start), None
+        return (X, V, A, Z), (Fk, Fd, (Fk - self._first[1]) @ self.mean if shifted else None)
+
+
 def run_cycles(scaling, ports, F, h, n_cycle, start, amplitudes, factors=None) -> CycleRun:
     """Integrate the nonlinear model under the load ``F`` (n_t, n) [N] with step ``h`` [s]
     from ``start`` = (x0, v0, a0, port-law states or None, static deflection (n,) [m]),
     the amplitude law updated once per ``n_cycle`` steps from the amplitudes (m,) [m] of the
-    first cycle (``ports``: the nonlinear elements).
-
-    The amplitude law scales the networks about the static deflection of the start: a cycle
-    whose stiffness differs by dK from the first one's is loaded by dK times it, so the
-    static equilibrium stays where the harmonic fixed point put it and a change of scale
-    does not move it (which would be a step load of the size of the motion itself).
-    """
+    first cycle (``ports``: the nonlinear elements; :class:`CycleIntegrator`)."""
     x0, v0, a0, state, mean = start
-    laws = ports.select(ports.kinds != NONE)
-    varying = any(el.amplitude_law is not None and not el.amplitude_law.constant
-                  for el in scaling.elements)
+    integrator = CycleIntegrator(scaling, ports, h, mean)
     n_t = F.shape[0]
-    bounds = list(range(0, n_t - 1, n_cycle)) + [n_t - 1] if varying else [0, n_t - 1]
-    X, V, A = (np.empty((n_t, F.shape[1])) for _ in range(3))
-    Z = np.empty((n_t, laws.kinds.size)) if laws.kinds.size else None
-    X[0], V[0], A[0] = x0, v0, a0
-    segments, first = [], None
+    bounds = list(range(0, n_t - 1, n_cycle)) + [n_t - 1] if integrator.varying \
+        else [0, n_t - 1]
+    out = [np.empty((n_t, F.shape[1])) for _ in range(3)]
+    out.append(np.empty((n_t, integrator.laws.kinds.size)) if integrator.laws.kinds.size
+               else None)
+    out[0][0], out[1][0], out[2][0] = x0, v0, a0
+    segments = []
     for lo, hi in zip(bounds[:-1], bounds[1:]):
-        C, K, Fk, Fd = scaling.matrices(scaling.scales(ports.network_amplitudes(amplitudes),
-                                                       factors))
-        first = first or (K, Fk)
         rows = slice(lo, hi + 1)
-        load = F[rows] if K is first[0] else F[rows] + (K - first[0]) @ mean
-        if Z is None:
-            X[rows], V[rows], A[rows] = newmark(scaling.system.M, C, K, load, h, X[lo],
-                                                V[lo], A[lo])
-        else:
-            X[rows], V[rows], A[rows], Z[rows] = newmark_ports(
-                scaling.system.M, C, K, load, h, laws, X[lo], V[lo], A[lo], state=state)
-        segments.append((slice(lo, hi if hi < n_t - 1 else n_t), Fk, Fd,
-                         None if K is first[0] else (Fk - first[1]) @ mean))
-        amplitudes = cycle_amplitudes(X[lo:hi] @ ports.rows.T)
-    return CycleRun(X, V, A, Z, segments)
+        states, forces = integrator.run(F[rows], [o[lo] for o in out[:3]], amplitudes, state,
+                                        factors)
+        for o, value in zip(out, states):
+            if o is not None:
+                o[rows] = value
+        segments.append((slice(lo, hi if hi < n_t - 1 else n_t),) + forces)
+        amplitudes = cycle_amplitudes(out[0][lo:hi] @ ports.rows.T)
+    return CycleRun(*out, segments)
