@@ -16,7 +16,12 @@ Rules and tolerances (each stated where it is checked):
   force levels and the motion, large beside a weak force order;
 * exponent 0 and zero friction (MountModel objects built here) give the linear dense
   Newmark run-up bit for bit; a static factor f on every network through the
-  ``static_factors`` hook equals every spring and damper times f to 1e-9.
+  ``static_factors`` hook equals every spring and damper times f to 1e-9;
+* continuous sweep: neutral laws equal the linear (modal) sweep to 1e-6 of the largest
+  acceleration (a different path: dense, cycle by cycle); with the power law on every mount
+  the tracked orders 2, 4 and the synthesis agree with the stepped harmonic run-up of the
+  same model to the linear sweep's tolerance (median |dB| over the channels,
+  tests/tolerances.py).
 """
 
 from __future__ import annotations
@@ -25,11 +30,13 @@ import dataclasses
 
 import numpy as np
 import pytest
+from tolerances import SWEEP_VS_STEPPED_MEDIAN_DB
 
 from powertrain.models.mount import MountModel
 from powertrain.physics.mount_laws import BergFriction, PowerLaw, TableLaw
 from powertrain.solvers import steppers
-from powertrain.workflows.runup import run_runup
+from powertrain.solvers.speed_ramp import simulate_sweep
+from powertrain.workflows.runup import run_runup, runup
 
 POWER = PowerLaw(reference=1e-4, exponent=0.15, limits=(0.2, 5.0))
 BERG = BergFriction(max_force=40.0, half_displacement=5e-5)
@@ -115,3 +122,32 @@ def test_static_factors_hook_scales_every_network(engine, monkeypatch):
     for name in ("velocity", "mount_force", "mean_mount_force"):
         x, y = getattr(expected, name), getattr(hooked, name)
         assert np.max(np.abs(x - y)) <= 1e-9 * np.max(np.abs(x)), name
+
+
+def test_sweep_with_neutral_laws_equals_the_linear_sweep(engine):
+    linear = simulate_sweep(engine, 2000.0, 2300.0, 300.0)
+    neutral = simulate_sweep(with_laws(engine, amplitude_law=PowerLaw(1e-4, 0.0),
+                                       port_law=BergFriction(0.0, 5e-5)), 2000.0, 2300.0, 300.0)
+    assert "cycle by cycle" in neutral.comments[0]
+    a = np.array([c.values for c in linear.channels])
+    b = np.array([c.values for c in neutral.channels])
+    assert a.shape == b.shape
+    assert np.max(np.abs(a - b)) <= 1e-6 * np.max(np.abs(a))
+
+
+@pytest.mark.slow          # ~15-25 s: a 5 s sweep, dense and cycle by cycle, and its tracking
+def test_sweep_with_the_power_law_agrees_with_stepped_harmonic(engine):
+    nonlinear = with_laws(engine, amplitude_law=POWER)
+    swept = runup(nonlinear, [2000.0, 3000.0], sweep=200.0).tracked
+    stepped = run_runup(nonlinear, swept.rpm, solver="harmonic")
+    for q in (2.0, 4.0, None):
+        gaps = []
+        for c, ch in enumerate(swept.channels):
+            a = swept.synthesis_rms()[:, c] if q is None else swept.order_rms()[
+                :, c, list(swept.orders).index(q)]
+            b = stepped.curve(ch.mount, ch.direction, "synthesis" if q is None
+                              else f"order_{q:g}")
+            gaps.append(np.median(np.abs(20 * np.log10(a / b))))
+        print(f"sweep with the power law, order {q}: median |dB| {np.median(gaps):.2e}, "
+              f"largest channel median {np.max(gaps):.2e}")
+        assert np.median(gaps) <= SWEEP_VS_STEPPED_MEDIAN_DB
