@@ -129,10 +129,11 @@ def simulate_sweep(engine, rpm_from, rpm_to, rate_rpm_per_s, sample_rate=8192.0,
 
 def _integrate(modal, system, load, ramp, eta, decimator, progress):
     """Decimated channel accelerations (n_out, n_ch) of the ramp ``(rpm_from, rate [rpm/s],
-    step h [s], steps)`` from the modal state ``eta``, chunk by chunk (trapezoid kernel)."""
-    from powertrain.kernels.newmark import modal_trapezoid_kernel
+    step h [s], steps)`` from the modal state ``eta``, chunk by chunk (one Numba kernel:
+    load, recurrence and outputs, :func:`powertrain.kernels.speed_ramp.modal_ramp_kernel`)."""
+    from powertrain.kernels.speed_ramp import modal_ramp_kernel
     rpm_from, rate_rpm_per_s, h, n_steps = ramp
-    speeds, table, n_theta = load
+    speeds, table, _ = load
     Z = np.zeros_like(system.channel_matrix)
     (w_re, w_im), w_load = modal.output_map(Z, Z, system.channel_matrix)
     lam_d = (1 + 0.5 * h * modal.lam_r) / (1 - 0.5 * h * modal.lam_r)
@@ -142,19 +143,15 @@ def _integrate(modal, system, load, ramp, eta, decimator, progress):
     if progress:
         from tqdm import tqdm
         starts = tqdm(starts, desc="sweep", unit="chunk", leave=False, disable=None)
+    eta = np.ascontiguousarray(eta, complex)
+    arrays = (lam_d, gain, np.ascontiguousarray(modal.load_map_r), w_re, w_im,
+              np.ascontiguousarray(w_load), np.ascontiguousarray(table))
     outputs = []
     for s in starts:
-        t = np.arange(s, min(s + chunk, n_steps) + 1) * h
-        rpm = rpm_from + rate_rpm_per_s * t
-        theta = (2 * np.pi / 60.0) * (rpm_from * t + 0.5 * rate_rpm_per_s * t * t)
-        F = _load_at(speeds, table, n_theta, rpm, theta)
-        G = np.ascontiguousarray(F @ modal.load_map_r.T)
-        out_re = np.empty((t.size, lam_d.size))
-        out_im = np.empty_like(out_re)
-        modal_trapezoid_kernel(lam_d, gain, G, t.size - 1, eta, 0, out_re, out_im)
-        eta = out_re[-1] + 1j * out_im[-1]
-        acc = out_re @ w_re - out_im @ w_im + F @ w_load.T          # (k, n_ch)
-        outputs.append(decimator.push(acc[:-1]))                    # last row starts the next
+        acc = np.empty((min(s + chunk, n_steps) - s, w_re.shape[1]))
+        modal_ramp_kernel(*arrays, float(speeds[0]), LOAD_RPM_STEP, float(rpm_from),
+                          float(rate_rpm_per_s), float(h), s, eta, acc)
+        outputs.append(decimator.push(acc))
     return np.concatenate(outputs)
 
 
@@ -260,13 +257,14 @@ class _Decimator:
         return (-(-(2 * self.L) // self.m) * self.m - self.L) // self.m
 
     def push(self, rows):
-        from scipy.signal import upfirdn
-        buf = np.concatenate([self.tail, rows])
-        dec = upfirdn(self.fir, buf, 1, self.m, axis=0)
+        from powertrain.kernels.speed_ramp import fir_decimate
+        buf = np.ascontiguousarray(np.concatenate([self.tail, rows]))
         i_lo = -(-(2 * self.L) // self.m)
         i_hi = (buf.shape[0] - 1) // self.m
         self.tail = buf[max(0, buf.shape[0] - 2 * self.L):]
-        return dec[i_lo:i_hi + 1] if i_hi >= i_lo else dec[:0]
+        out = np.empty((max(0, i_hi - i_lo + 1), buf.shape[1]))
+        fir_decimate(self.fir, np.ascontiguousarray(buf.T), self.m, i_lo, out)
+        return out
 
 
 def _check(engine, rpm_from, rpm_to, rate, sample_rate):
