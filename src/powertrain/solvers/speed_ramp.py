@@ -96,6 +96,8 @@ def simulate_sweep(engine, rpm_from, rpm_to, rate_rpm_per_s, sample_rate=8192.0,
     RawRecording
         Nine acceleration channels [m/s^2] (engine side) and the speed [rpm].
     """
+    from threadpoolctl import threadpool_limits
+
     from powertrain.assembly import assemble
     from powertrain.solvers.newmark import ModalNewmark
     _check(engine, rpm_from, rpm_to, rate_rpm_per_s, sample_rate)
@@ -107,14 +109,15 @@ def simulate_sweep(engine, rpm_from, rpm_to, rate_rpm_per_s, sample_rate=8192.0,
     load = _load_table(engine, rpm_from, rpm_to)
     decimator = _Decimator(m, len(system.channels))
     ramp = (rpm_from, rate_rpm_per_s, h, n_steps)
-    if system.port_forces() is None and static_factors is None:
-        modal = ModalNewmark(system.M, system.C, system.K, load_dofs=6)
-        y = _integrate(modal, system, load, ramp, _initial_state(engine, modal, rpm_from),
-                       decimator, progress)
-        method = "modal"
-    else:
-        y = _integrate_nonlinear(engine, system, load, ramp, decimator, static_factors)
-        method = "dense, nonlinear mount elements cycle by cycle"
+    with threadpool_limits(limits=1, user_api="blas"):     # small matrices: see run_runup
+        if system.port_forces() is None and static_factors is None:
+            modal = ModalNewmark(system.M, system.C, system.K, load_dofs=6)
+            y = _integrate(modal, system, load, ramp, _initial_state(engine, modal, rpm_from),
+                           decimator, progress)
+            method = "modal"
+        else:
+            y = _integrate_nonlinear(engine, system, load, ramp, decimator, static_factors)
+            method = "dense, nonlinear mount elements cycle by cycle"
     t_out = (decimator.first_output_index + np.arange(y.shape[0])) / sample_rate
     rpm_out = rpm_from + rate_rpm_per_s * t_out
     block = np.ascontiguousarray(y.T)
