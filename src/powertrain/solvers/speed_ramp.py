@@ -99,7 +99,6 @@ def simulate_sweep(engine, rpm_from, rpm_to, rate_rpm_per_s, sample_rate=8192.0,
     from threadpoolctl import threadpool_limits
 
     from powertrain.assembly import assemble
-    from powertrain.solvers.newmark import ModalNewmark
     _check(engine, rpm_from, rpm_to, rate_rpm_per_s, sample_rate)
     m, n_steps = sweep_steps(rpm_from, rpm_to, rate_rpm_per_s, sample_rate)
     h = 1.0 / (m * sample_rate)
@@ -110,14 +109,8 @@ def simulate_sweep(engine, rpm_from, rpm_to, rate_rpm_per_s, sample_rate=8192.0,
     decimator = _Decimator(m, len(system.channels))
     ramp = (rpm_from, rate_rpm_per_s, h, n_steps)
     with threadpool_limits(limits=1, user_api="blas"):     # small matrices: see run_runup
-        if system.port_forces() is None and static_factors is None:
-            modal = ModalNewmark(system.M, system.C, system.K, load_dofs=6)
-            y = _integrate(modal, system, load, ramp, _initial_state(engine, modal, rpm_from),
-                           decimator, progress)
-            method = "modal"
-        else:
-            y = _integrate_nonlinear(engine, system, load, ramp, decimator, static_factors)
-            method = "dense, nonlinear mount elements cycle by cycle"
+        y, method = _integrate_ramp(engine, system, load, ramp, decimator, progress,
+                                    static_factors)
     t_out = (decimator.first_output_index + np.arange(y.shape[0])) / sample_rate
     rpm_out = rpm_from + rate_rpm_per_s * t_out
     block = np.ascontiguousarray(y.T)
@@ -128,6 +121,18 @@ def simulate_sweep(engine, rpm_from, rpm_to, rate_rpm_per_s, sample_rate=8192.0,
             f"acceleration, {method}, {m * sample_rate:g} Hz internal, decimated to "
             f"{sample_rate:g} Hz)")
     return RawRecording(t_out, chans, rpm_out, None, "simulated sweep", [note]).validate()
+
+
+def _integrate_ramp(engine, system, load, ramp, decimator, progress, static_factors):
+    """Decimated channel accelerations of the ramp and the method's name: modal for a
+    linear model, else dense engine cycle by engine cycle."""
+    from powertrain.solvers.newmark import ModalNewmark
+    if system.port_forces() is None and static_factors is None:
+        modal = ModalNewmark(system.M, system.C, system.K, load_dofs=6)
+        return _integrate(modal, system, load, ramp, _initial_state(engine, modal, ramp[0]),
+                          decimator, progress), "modal"
+    return (_integrate_nonlinear(engine, system, load, ramp, decimator, static_factors),
+            "dense, nonlinear mount elements cycle by cycle")
 
 
 def _integrate(modal, system, load, ramp, eta, decimator, progress):
