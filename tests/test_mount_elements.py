@@ -187,9 +187,3 @@ def test_a_fixed_point_that_does_not_converge_names_the_element_and_speed(engine
     with pytest.raises(FloatingPointError, match=r"left\.[xyz] at 3000 rpm|[a-z]+\.[xyz] at "
                                                  r"3000 rpm"):
         run_runup(with_law(engine, LAW), [3000.0], solver="harmonic")
-
-
-def test_continuous_sweep_refuses_a_nonlinear_model(engine):
-    from powertrain.solvers.speed_ramp import simulate_sweep
-    with pytest.raises(ValueError, match=r"linear mounts only \(left\.x"):
-        simulate_sweep(with_law(engine, LAW), 1000.0, 1100.0, 100.0)

@@ -22,7 +22,7 @@ import numpy as np
 from powertrain.analysis.channel import DIRECTIONS, PASSIVE, passive_name, split_side  # noqa: F401 (re-export)
 from powertrain.physics.condensation import NetworkPorts, condense
 from powertrain.physics.mount_elements import PortForces, port_forces
-from powertrain.physics.mount_network import ground_force_rows
+from powertrain.physics.mount_network import ground_force_rows, network_matrices
 from powertrain.physics.rigid_body import direction_row, point_motion_matrix, rigid_body_mass_matrix
 
 
@@ -70,6 +70,8 @@ class AssembledSystem:
     port_rows: np.ndarray | None = None
     #: transmitted-force channels per unit force across each network, (n_ch, n_net)
     port_force_map: np.ndarray | None = None
+    #: per network: its node map L (network nodes per unit q) and its base row (n,)
+    network_maps: list = field(default_factory=list)
 
     def __post_init__(self):
         if not self.body_start:
@@ -130,6 +132,24 @@ class AssembledSystem:
             return None
         return port_forces([el for *_, el in self.networks], self.port_rows,
                            self.port_force_map, self.network_names)
+
+    def network_parts(self):
+        r"""Each network's contribution at unit scale (its model's springs and dampers as
+        given, no amplitude law or static factor): ``(C_k, K_k, gk_k, gd_k)`` stacked over
+        the networks, :math:`\mathbf L^T\mathbf C_n\mathbf L` (n_net, n, n), likewise K, and
+        the transmitted-force rows (n_net, n) that ``port_force_map`` spreads on the
+        channels; a network scaled by ``(ks, ds)`` adds ``ds C_k``, ``ks K_k``, ``ks gk_k``,
+        ``ds gd_k``."""
+        parts = [[], [], [], []]
+        for (*_, element), (L, base) in zip(self.networks, self.network_maps):
+            network = element.model.network()
+            _, Cn, Kn = network_matrices(*network, include_ground=L.shape[0] >
+                                         network[0].size + 1)
+            kg, dg = ground_force_rows(network[0].size, *network[1:])
+            for out, value in zip(parts, (L.T @ Cn @ L, L.T @ Kn @ L, _force_row(kg, L, base),
+                                          _force_row(dg, L, base))):
+                out.append(value)
+        return tuple(np.array(p) for p in parts)
 
     def ports(self) -> NetworkPorts:
         """The networks on the retained coordinates (:mod:`powertrain.physics.condensation`);
@@ -198,8 +218,9 @@ def assemble(mass, cg, inertia, mounts, chassis=None, static_factors=None) -> As
     n_m = len(mounts)
     Fk, Fd = np.zeros((3 * n_m, n)), np.zeros((3 * n_m, n))
     shapes = {m.name: chassis.body_rows(m.name) for m in mounts} if modal else {}
-    networks, base_rows, port_rows, port_map = _add_networks((M, C, K, Fk, Fd), blocks, mounts,
-                                                             shapes, body0)
+    networks, maps, port_rows, port_map = _add_networks((M, C, K, Fk, Fd), blocks, mounts,
+                                                        shapes, body0)
+    base_rows = [base for _, base in maps]
     for X, X0 in zip((M, C, K), frame):
         X[np.ix_(retained, retained)] += X0
     channels = [(m.name, a) for m in mounts for a in DIRECTIONS]
@@ -207,7 +228,7 @@ def assemble(mass, cg, inertia, mounts, chassis=None, static_factors=None) -> As
     for mi, mount in enumerate(mounts):
         Cm[3 * mi:3 * mi + 3, :6] = point_motion_matrix(np.asarray(mount.position, float) - cg)
     system = AssembledSystem(M, C, K, channels, Cm, Fk, Fd, labels, networks,
-                             port_rows=port_rows, port_force_map=port_map)
+                             port_rows=port_rows, port_force_map=port_map, network_maps=maps)
     system.mount_axes = [np.asarray(m.rotation, float) for m in mounts]
     system.network_ports = NetworkPorts(
         retained, frame, np.array([np.r_[b[0], np.zeros(len(body_modes))] for b in blocks]
@@ -221,12 +242,12 @@ def assemble(mass, cg, inertia, mounts, chassis=None, static_factors=None) -> As
 
 def _add_networks(matrices, blocks, mounts, shapes, body0):
     """Add every network to the global M, C, K and its transmitted force to the force rows
-    ``Fk``, ``Fd`` (in place); returns the network list, each network's base row (the
-    body motion under its base node; zero on the ground), its port row (engine side minus
-    base) and its force-map column (the mount axis on the mount's force rows)."""
+    ``Fk``, ``Fd`` (in place); returns the network list, each network's node map and base
+    row (the body motion under its base node; zero on the ground), its port row (engine side
+    minus base) and its force-map column (the mount axis on the mount's force rows)."""
     M, C, K, Fk, Fd = matrices
     n = M.shape[0]
-    start, networks, base_rows = 6, [], []
+    start, networks, maps = 6, [], []
     port_map = np.zeros((Fk.shape[0], len(blocks)))
     for k, (row, Mn, Cn, Kn, kg, dg, mi, ai, element) in enumerate(blocks):
         ni = kg.size - 1
@@ -240,15 +261,23 @@ def _add_networks(matrices, blocks, mounts, shapes, body0):
             X += L.T @ Xn @ L
         # force on the base along the local axis, expressed in engine axes
         base = L[ni + 1] if shapes else np.zeros(n)
-        Fk[3 * mi:3 * mi + 3] += np.outer(e, kg @ L[:ni + 1] - kg.sum() * base)
-        Fd[3 * mi:3 * mi + 3] += np.outer(e, dg @ L[:ni + 1] - dg.sum() * base)
+        Fk[3 * mi:3 * mi + 3] += np.outer(e, _force_row(kg, L, base))
+        Fd[3 * mi:3 * mi + 3] += np.outer(e, _force_row(dg, L, base))
         port_map[3 * mi:3 * mi + 3, k] = e
         networks.append((row, start, ni, element))
-        base_rows.append(base)
+        maps.append((L, base))
         start += ni
     port_rows = np.zeros((len(blocks), n))
     port_rows[:, :6] = [b[0] for b in blocks]
-    return networks, base_rows, port_rows - np.array(base_rows).reshape(-1, n), port_map
+    base_rows = np.array([base for _, base in maps]).reshape(-1, n)
+    return networks, maps, port_rows - base_rows, port_map
+
+
+def _force_row(g, L, base):
+    """Force on a network's base along its axis per unit q, from the network's ground-force
+    row ``g`` over its engine-side and internal nodes (:func:`ground_force_rows`)."""
+    ni = g.size - 1
+    return g @ L[:ni + 1] - g.sum() * base
 
 
 def _network_blocks(mounts, cg, with_ground, static_factors=None):

@@ -56,8 +56,10 @@ def newmark_kernel(G, H, Fs, h, x0, v0, a0, X, V, A):
             vt[j] = V[k - 1, j] + hv * A[k - 1, j]
         for i in range(n):
             s = Fs[k, i]
+            Gi = G[i]            # row views: 2-D indexing in the inner loop is slower
+            Hi = H[i]
             for j in range(n):
-                s -= G[i, j] * vt[j] + H[i, j] * xt[j]
+                s -= Gi[j] * vt[j] + Hi[j] * xt[j]
             A[k, i] = s
         for j in range(n):
             X[k, j] = xt[j] + hh * A[k, j]

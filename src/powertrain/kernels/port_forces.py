@@ -219,17 +219,23 @@ def newmark_port_kernel(G, H, Fs, h, x0, v0, a0, W, P, Q, kinds, par, state, X, 
         for j in range(n):
             xt[j] = X[k - 1, j] + h * V[k - 1, j] + hh * A[k - 1, j]
             vt[j] = V[k - 1, j] + hv * A[k - 1, j]
+        Ak = A[k]
         for i in range(n):
             s = Fs[k, i]
+            Gi = G[i]            # row views: 2-D indexing in the inner loop is slower
+            Hi = H[i]
             for j in range(n):
-                s -= G[i, j] * vt[j] + H[i, j] * xt[j]
-            A[k, i] = s
+                s -= Gi[j] * vt[j] + Hi[j] * xt[j]
+            Ak[i] = s
         for e in range(m):
-            ul[e] = 0.0
-            vl[e] = 0.0
+            Pe = P[e]
+            su = 0.0
+            sv = 0.0
             for j in range(n):
-                ul[e] += P[e, j] * (xt[j] + hh * A[k, j])
-                vl[e] += P[e, j] * (vt[j] + hv * A[k, j])
+                su += Pe[j] * (xt[j] + hh * Ak[j])
+                sv += Pe[j] * (vt[j] + hv * Ak[j])
+            ul[e] = su
+            vl[e] = sv
         converged = False
         for _ in range(max_iter):
             big = 1.0

@@ -21,10 +21,12 @@ A port law is an object with ``kind`` (its code in :mod:`powertrain.kernels.port
 start, where the relative displacement is ``u0`` and the force expected from the
 equivalent-linear solution ``f0``), ``steady_state(amplitude)`` (the memory on its steady
 loop of that amplitude about 0, at the lower tip, moving up: where the displacement-driven
-test of :func:`powertrain.solvers.mount_time_domain.time_cross_point_stiffness` starts)
-and ``describing_stiffness(amplitude)`` (complex [N/m]). :class:`JenkinsFriction` is the one
-implemented here: simple, with a closed-form describing function, it proves the plug-in
-(tests/test_mount_elements.py).
+test of :func:`powertrain.solvers.mount_time_domain.time_cross_point_stiffness` starts),
+``loop_amplitude_force(amplitude)`` (the force at the tips of its steady loop, where a
+time-domain run-up starts it) and ``describing_stiffness(amplitude)`` (complex [N/m]).
+:class:`JenkinsFriction` is the simplest: with a closed-form describing function, it proves
+the plug-in (tests/test_mount_elements.py); :class:`~powertrain.physics.mount_laws.BergFriction`
+is the mount files' ``[friction]``.
 """
 
 from __future__ import annotations
@@ -76,6 +78,10 @@ class JenkinsFriction:
         where the motion turns up."""
         return np.array([-amplitude + min(self.stiffness * amplitude, self.slip_force)
                          / self.stiffness])
+
+    def loop_amplitude_force(self, amplitude) -> np.ndarray:
+        """Force at the tips ±A of the steady loop [N]: k A while it sticks, else F_s."""
+        return np.minimum(self.stiffness * np.asarray(amplitude, float), self.slip_force)
 
     def describing_stiffness(self, amplitude) -> np.ndarray:
         """Equivalent complex stiffness [N/m] at the displacement amplitude [m]."""
@@ -215,7 +221,11 @@ class PortForces:
     def initial_state(self, x0, f0=None) -> np.ndarray:
         """State rows (m, n_state) of every law at the initial coordinates ``x0``, expected
         to carry the forces ``f0`` (m,) [N] (default: unloaded)."""
-        u0 = self.rows @ np.asarray(x0, float)
+        return self.states_at(self.rows @ np.asarray(x0, float), f0)
+
+    def states_at(self, u0, f0=None) -> np.ndarray:
+        """State rows (m, n_state) of every law at the relative displacements ``u0`` (m,)
+        [m], carrying the forces ``f0`` (m,) [N] (default: unloaded)."""
         f0 = np.zeros(u0.size) if f0 is None else f0
         states = [np.zeros(1) if law is None else np.atleast_1d(law.initial_state(u, f))
                   for law, u, f in zip(self.laws, u0, f0)]
@@ -223,6 +233,15 @@ class PortForces:
         for e, st in enumerate(states):
             out[e, :st.size] = st
         return out
+
+    def select(self, keep) -> PortForces:
+        """The port laws where the boolean mask ``keep`` (m,) is true."""
+        keep = np.asarray(keep, bool)
+        return PortForces(self.rows[keep], self.kinds[keep], self.parameters[keep],
+                          [law for law, k in zip(self.laws, keep) if k],
+                          np.ascontiguousarray(self.force_map[:, keep]),
+                          [name for name, k in zip(self.names, keep) if k], self.index[keep],
+                          self.n_networks)
 
     def forces(self, u, v, state) -> np.ndarray:
         """Port forces (m,) [N] at the relative motions ``u``, ``v`` (m,) from ``state``."""

@@ -85,11 +85,12 @@ PORT_TOL = 1e-10
 PORT_MAX_ITER = 50
 
 
-def newmark_ports(M, C, K, F, h, ports, x0=None, v0=None, a0=None, z0=None):
+def newmark_ports(M, C, K, F, h, ports, x0=None, v0=None, a0=None, z0=None, state=None):
     """:func:`newmark` with the port laws ``ports``
     (:class:`~powertrain.physics.mount_elements.PortForces`) in parallel with the linear
     model: :func:`powertrain.kernels.port_forces.newmark_port_kernel`, Newton per step. The
-    laws start from the state carrying the forces ``z0`` (m,) [N] (default: unloaded).
+    laws start from ``state`` (m, n_state), updated in place to the state after the last
+    step, or else from the state carrying the forces ``z0`` (m,) [N] (default: unloaded).
 
     Returns
     -------
@@ -106,7 +107,8 @@ def newmark_ports(M, C, K, F, h, ports, x0=None, v0=None, a0=None, z0=None):
     P = np.ascontiguousarray(ports.rows, float)
     x0 = np.zeros(P.shape[1]) if x0 is None else x0
     v0 = np.zeros(P.shape[1]) if v0 is None else v0
-    state = ports.initial_state(x0, z0)
+    if state is None:
+        state = ports.initial_state(x0, z0)
     z0 = ports.forces(P @ x0, P @ v0, state)
     Fs, x0, v0, a0 = _start(M, C, K, F, Sinv, x0, v0, a0, P.T @ z0)
     W = np.ascontiguousarray(Sinv @ P.T)

@@ -67,17 +67,12 @@ def _load_at(speeds, table, n_theta, rpm, theta):
     return a * (1 - fv) + b * fv
 
 
-def _require_linear(system):
-    """The sweep's modal recurrence holds no port law (nonlinear mount element)."""
-    ports = system.port_forces()
-    if ports is not None:
-        raise ValueError(f"the continuous sweep integrates linear mounts only "
-                         f"({', '.join(ports.names)} nonlinear)")
-
-
 def simulate_sweep(engine, rpm_from, rpm_to, rate_rpm_per_s, sample_rate=8192.0, *,
-                   system=None, progress=False) -> RawRecording:
-    """Simulate a continuous linear run-up; mount-point accelerations as raw time data.
+                   system=None, progress=False, static_factors=None) -> RawRecording:
+    """Simulate a continuous run-up; mount-point accelerations as raw time data.
+
+    A linear model is integrated in modal form; one with nonlinear mount elements in
+    physical coordinates one engine cycle at a time (:func:`_integrate_nonlinear`).
 
     Parameters
     ----------
@@ -91,27 +86,31 @@ def simulate_sweep(engine, rpm_from, rpm_to, rate_rpm_per_s, sample_rate=8192.0,
     system : AssembledSystem, optional
     progress : bool
         tqdm bar on stderr (hidden when not a terminal).
+    static_factors : callable, optional
+        Hook of the operating point: ``static_factors(rpm) -> (n_net,)`` every network's
+        static-curve factor at a speed, applied per engine cycle (default: each element's
+        own ``static_factor``).
 
     Returns
     -------
     RawRecording
         Nine acceleration channels [m/s^2] (engine side) and the speed [rpm].
     """
+    from threadpoolctl import threadpool_limits
+
     from powertrain.assembly import assemble
-    from powertrain.solvers.newmark import ModalNewmark
     _check(engine, rpm_from, rpm_to, rate_rpm_per_s, sample_rate)
     m, n_steps = sweep_steps(rpm_from, rpm_to, rate_rpm_per_s, sample_rate)
     h = 1.0 / (m * sample_rate)
     if system is None:
         b = engine.body
         system = assemble(b.mass, b.cg, b.inertia, engine.mounts)
-    _require_linear(system)
     load = _load_table(engine, rpm_from, rpm_to)
-    modal = ModalNewmark(system.M, system.C, system.K, load_dofs=6)
     decimator = _Decimator(m, len(system.channels))
     ramp = (rpm_from, rate_rpm_per_s, h, n_steps)
-    y = _integrate(modal, system, load, ramp, _initial_state(engine, modal, rpm_from),
-                   decimator, progress)
+    with threadpool_limits(limits=1, user_api="blas"):     # small matrices: see run_runup
+        y, method = _integrate_ramp(engine, system, load, ramp, decimator, progress,
+                                    static_factors)
     t_out = (decimator.first_output_index + np.arange(y.shape[0])) / sample_rate
     rpm_out = rpm_from + rate_rpm_per_s * t_out
     block = np.ascontiguousarray(y.T)
@@ -119,17 +118,30 @@ def simulate_sweep(engine, rpm_from, rpm_to, rate_rpm_per_s, sample_rate=8192.0,
                         block[c], "m/s^2") for c, (mnt, d) in enumerate(system.channels)]
     note = (f"SYNTHETIC: simulated continuous run-up {rpm_from:g}->{rpm_to:g} rpm at "
             f"{rate_rpm_per_s:g} rpm/s ({getattr(engine, 'name', '')}; Newmark average "
-            f"acceleration, modal, {m * sample_rate:g} Hz internal, decimated to "
+            f"acceleration, {method}, {m * sample_rate:g} Hz internal, decimated to "
             f"{sample_rate:g} Hz)")
     return RawRecording(t_out, chans, rpm_out, None, "simulated sweep", [note]).validate()
 
 
+def _integrate_ramp(engine, system, load, ramp, decimator, progress, static_factors):
+    """Decimated channel accelerations of the ramp and the method's name: modal for a
+    linear model, else dense engine cycle by engine cycle."""
+    from powertrain.solvers.newmark import ModalNewmark
+    if system.port_forces() is None and static_factors is None:
+        modal = ModalNewmark(system.M, system.C, system.K, load_dofs=6)
+        return _integrate(modal, system, load, ramp, _initial_state(engine, modal, ramp[0]),
+                          decimator, progress), "modal"
+    return (_integrate_nonlinear(engine, system, load, ramp, decimator, static_factors),
+            "dense, nonlinear mount elements cycle by cycle")
+
+
 def _integrate(modal, system, load, ramp, eta, decimator, progress):
     """Decimated channel accelerations (n_out, n_ch) of the ramp ``(rpm_from, rate [rpm/s],
-    step h [s], steps)`` from the modal state ``eta``, chunk by chunk (trapezoid kernel)."""
-    from powertrain.kernels.newmark import modal_trapezoid_kernel
+    step h [s], steps)`` from the modal state ``eta``, chunk by chunk (one Numba kernel:
+    load, recurrence and outputs, :func:`powertrain.kernels.speed_ramp.modal_ramp_kernel`)."""
+    from powertrain.kernels.speed_ramp import modal_ramp_kernel
     rpm_from, rate_rpm_per_s, h, n_steps = ramp
-    speeds, table, n_theta = load
+    speeds, table, _ = load
     Z = np.zeros_like(system.channel_matrix)
     (w_re, w_im), w_load = modal.output_map(Z, Z, system.channel_matrix)
     lam_d = (1 + 0.5 * h * modal.lam_r) / (1 - 0.5 * h * modal.lam_r)
@@ -139,20 +151,94 @@ def _integrate(modal, system, load, ramp, eta, decimator, progress):
     if progress:
         from tqdm import tqdm
         starts = tqdm(starts, desc="sweep", unit="chunk", leave=False, disable=None)
+    eta = np.ascontiguousarray(eta, complex)
+    arrays = (lam_d, gain, np.ascontiguousarray(modal.load_map_r), w_re, w_im,
+              np.ascontiguousarray(w_load), np.ascontiguousarray(table))
     outputs = []
     for s in starts:
-        t = np.arange(s, min(s + chunk, n_steps) + 1) * h
-        rpm = rpm_from + rate_rpm_per_s * t
-        theta = (2 * np.pi / 60.0) * (rpm_from * t + 0.5 * rate_rpm_per_s * t * t)
-        F = _load_at(speeds, table, n_theta, rpm, theta)
-        G = np.ascontiguousarray(F @ modal.load_map_r.T)
-        out_re = np.empty((t.size, lam_d.size))
-        out_im = np.empty_like(out_re)
-        modal_trapezoid_kernel(lam_d, gain, G, t.size - 1, eta, 0, out_re, out_im)
-        eta = out_re[-1] + 1j * out_im[-1]
-        acc = out_re @ w_re - out_im @ w_im + F @ w_load.T          # (k, n_ch)
-        outputs.append(decimator.push(acc[:-1]))                    # last row starts the next
+        acc = np.empty((min(s + chunk, n_steps) - s, w_re.shape[1]))
+        modal_ramp_kernel(*arrays, float(speeds[0]), LOAD_RPM_STEP, float(rpm_from),
+                          float(rate_rpm_per_s), float(h), s, eta, acc)
+        outputs.append(decimator.push(acc))
     return np.concatenate(outputs)
+
+
+def _cycle_bounds(rpm_from, rate, h, n_steps):
+    """Step indices (n_c + 1,) where the engine cycles of the ramp begin (and the last
+    step): the crank angle passes a multiple of 4 pi."""
+    t_end = n_steps * h
+    cycles = (np.pi / 30.0) * (rpm_from * t_end + 0.5 * rate * t_end ** 2) / (4 * np.pi)
+    angle = 4 * np.pi * np.arange(1, int(np.ceil(cycles)))
+    t = (np.sqrt(rpm_from ** 2 + 2 * rate * angle * 30.0 / np.pi) - rpm_from) / rate
+    inner = np.unique(np.clip(np.ceil(t / h - 1e-9).astype(np.int64), 1, n_steps - 1))
+    return np.r_[0, inner, n_steps]
+
+
+def _integrate_nonlinear(engine, system, load, ramp, decimator, static_factors):
+    """Decimated channel accelerations of the ramp with nonlinear mount elements: dense
+    Newmark engine cycle by engine cycle (:class:`~powertrain.solvers.cycle_newmark.
+    CycleIntegrator`), from the harmonic fixed point at the first speed with the port laws
+    on their steady loop, the amplitude law and the static factors updated per cycle."""
+    from powertrain.solvers.cycle_newmark import CycleIntegrator, cycle_amplitudes
+    rpm_from, rate, h, n_steps = ramp
+    x, state, amplitudes, stepper = _nonlinear_start(engine, system, rpm_from, static_factors)
+    integrator = CycleIntegrator(stepper.scaling, stepper.ports, h, x[3])
+    bounds = _cycle_bounds(rpm_from, rate, h, n_steps)
+    rows = _Rows(decimator)
+    for lo, hi in zip(bounds[:-1], bounds[1:]):
+        t = np.arange(lo, hi + 1) * h
+        F = np.zeros((t.size, system.n_dof))
+        F[:, :6] = _load_at(*load, rpm_from + rate * t,
+                            (np.pi / 30.0) * (rpm_from * t + 0.5 * rate * t * t))
+        factors = stepper.factors_at((rpm_from + rate * t.mean()) * np.pi / 30.0)
+        (X, V, A, _), _ = integrator.run(F, x[:3], amplitudes, state, factors)
+        rows.push(A[:-1] @ system.channel_matrix.T)
+        amplitudes = cycle_amplitudes(X[:-1] @ stepper.ports.rows.T)
+        x = (X[-1], V[-1], A[-1], x[3])
+    return rows.done()
+
+
+def _nonlinear_start(engine, system, rpm, static_factors):
+    """State ``(x0, v0, a0, static deflection)``, port-law states and amplitudes of the
+    harmonic fixed point at ``rpm`` and the stepper that solved it."""
+    from powertrain.solvers.cycle_newmark import no_ports, start_state
+    from powertrain.solvers.steppers import Cycles, DenseNewmarkStepper
+    grid = Cycles(1440, 0.5, 1, 1)
+    stepper = DenseNewmarkStepper(system, grid)
+    stepper.static_factors = static_factors
+    omega = rpm * np.pi / 30.0
+    theta = np.arange(grid.n_cycle) * (4 * np.pi / grid.n_cycle)
+    fh, omegas = stepper.harmonics(np.asarray(engine.generalized_load(rpm, theta), float),
+                                   omega, 40.0)
+    qh, A = stepper.harmonic_state(fh, omegas, omega,
+                                   stepper.system_at(stepper.factors_at(omega)))
+    x = (qh.real.sum(0), (1j * omegas[:, None] * qh).real.sum(0),
+         (-(omegas ** 2)[:, None] * qh).real.sum(0), qh[0].real)
+    if stepper.ports is None:                 # linear, static factors only
+        stepper.ports, A = no_ports(system), np.zeros(0)
+    return x, start_state(stepper.ports, qh, grid.n_cycle), A, stepper
+
+
+class _Rows:
+    """Rows for a :class:`_Decimator` arriving in any lengths, pushed in multiples of m."""
+
+    def __init__(self, decimator):
+        self.decimator, self.pending, self.out = decimator, [], []
+
+    def push(self, rows):
+        self.pending.append(rows)
+        if sum(r.shape[0] for r in self.pending) >= CHUNK_OUT * self.decimator.m:
+            self._flush()
+
+    def _flush(self, last=False):
+        buf = np.concatenate(self.pending)
+        k = buf.shape[0] if last else buf.shape[0] - buf.shape[0] % self.decimator.m
+        self.out.append(self.decimator.push(buf[:k]))
+        self.pending = [buf[k:]]
+
+    def done(self):
+        self._flush(last=True)
+        return np.concatenate(self.out)
 
 
 class _Decimator:
@@ -179,13 +265,14 @@ class _Decimator:
         return (-(-(2 * self.L) // self.m) * self.m - self.L) // self.m
 
     def push(self, rows):
-        from scipy.signal import upfirdn
-        buf = np.concatenate([self.tail, rows])
-        dec = upfirdn(self.fir, buf, 1, self.m, axis=0)
+        from powertrain.kernels.speed_ramp import fir_decimate
+        buf = np.ascontiguousarray(np.concatenate([self.tail, rows]))
         i_lo = -(-(2 * self.L) // self.m)
         i_hi = (buf.shape[0] - 1) // self.m
         self.tail = buf[max(0, buf.shape[0] - 2 * self.L):]
-        return dec[i_lo:i_hi + 1] if i_hi >= i_lo else dec[:0]
+        out = np.empty((max(0, i_hi - i_lo + 1), buf.shape[1]))
+        fir_decimate(self.fir, np.ascontiguousarray(buf.T), self.m, i_lo, out)
+        return out
 
 
 def _check(engine, rpm_from, rpm_to, rate, sample_rate):

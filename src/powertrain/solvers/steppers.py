@@ -30,10 +30,16 @@ import numpy as np
 
 from powertrain.analysis.fourier import harmonic_amplitudes
 from powertrain.analysis.orders import ORDERS, order_spectrum
-from powertrain.solvers.equivalent_linear import AMPLITUDE_HARMONICS, amplitude_fixed_point
+from powertrain.kernels.port_forces import NONE
+from powertrain.solvers.cycle_newmark import CycleRun, NetworkScaling, run_cycles, start_state
+from powertrain.solvers.equivalent_linear import AMPLITUDE_HARMONICS, TOLERANCE, amplitude_fixed_point
 from powertrain.solvers.harmonic import harmonic_response
-from powertrain.solvers.newmark import ModalNewmark, newmark, newmark_ports
+from powertrain.solvers.newmark import ModalNewmark, newmark
 
+#: Relative tolerance of the equivalent-linear fixed point a nonlinear Newmark run starts
+#: from (its amplitudes differ from the time domain's own by more: the harmonics above
+#: order 8, the friction's exact loop).
+START_TOLERANCE = 1e-4
 #: Highest order in the frequency-domain initial-state estimate of the Newmark run (the
 #: stepper itself sees the full sampled load): load harmonics above order 40 are < 2e-5 of
 #: the 2nd order for the default engine, and their response is smaller still.
@@ -76,6 +82,12 @@ class Stepper:
 
     solver = ""
     setup_seconds = 0.0
+    #: Hook of the operating point: ``static_factors(rpm) -> (n_net,)``, every network's
+    #: static-curve factor at that speed (:meth:`MountElement.at_operating_point`); None:
+    #: each element's own ``static_factor``.
+    static_factors = None
+    #: Relative change of the amplitudes at which the equivalent-linear fixed point stops.
+    fixed_point_tolerance = TOLERANCE
 
     def __init__(self, system, grid: Cycles):
         self.system = system
@@ -83,6 +95,24 @@ class Stepper:
         self.ports = system.port_forces()
         #: the last speed's equivalent-linear amplitudes (the next speed's first guess)
         self.amplitudes = None
+        self._scaling = None
+
+    @property
+    def scaling(self) -> NetworkScaling:
+        """The model's networks rescalable (built on first use)."""
+        if self._scaling is None:
+            self._scaling = NetworkScaling(self.system)
+        return self._scaling
+
+    def factors_at(self, omega):
+        """The static factors (n_net,) at the speed ``omega`` [rad/s] from the hook, or
+        None."""
+        return None if self.static_factors is None else \
+            np.asarray(self.static_factors(omega * 30.0 / np.pi), float)
+
+    def system_at(self, factors):
+        """The model at the operating point of the static ``factors`` (None: as assembled)."""
+        return self.system if factors is None else self.scaling.at_operating_point(factors)
 
     def on_system(self, system) -> Stepper:
         """A stepper of this kind on another assembly of the same model (the networks
@@ -98,15 +128,17 @@ class Stepper:
         if self.ports is None:
             return None, solve(None)
         A, solution = amplitude_fixed_point(solve, relative_motion, self.ports,
-                                            omega * 30.0 / np.pi, self.amplitudes)
+                                            omega * 30.0 / np.pi, self.amplitudes,
+                                            self.fixed_point_tolerance)
         self.amplitudes = A
         return A, solution
 
-    def harmonic_state(self, fh, omegas, omega):
-        """Harmonic response (n_h, n_dof) of the (equivalent-linear) model and the
-        nonlinear elements' amplitudes (None: linear model). The fixed point iterates on
-        the harmonics that make the amplitudes only; one solve of all follows."""
-        s = self.system
+    def harmonic_state(self, fh, omegas, omega, system=None):
+        """Harmonic response (n_h, n_dof) of the (equivalent-linear) model (``system``,
+        default the stepper's) and the nonlinear elements' amplitudes (None: linear model).
+        The fixed point iterates on the harmonics that make the amplitudes only; one solve of
+        all follows."""
+        s = self.system if system is None else system
         if self.ports is None:
             return harmonic_response(s, fh, omegas), None
         k = AMPLITUDE_HARMONICS.stop
@@ -141,9 +173,13 @@ class HarmonicStepper(Stepper):
         w = omegas[j][:, None]
         q_o = qh[j]                                       # (n_orders, n)
         s = self.system
+        Fk, Fd = s.force_matrix_k, s.force_matrix_d
+        if A is not None:        # the force rows of the networks at their amplitudes
+            Fk, Fd = self.scaling.matrices(self.scaling.scales(
+                self.ports.network_amplitudes(A)))[2:]
         x = (q_o @ s.channel_matrix.T).T
-        force = ((q_o @ s.force_matrix_k.T) + 1j * w * (q_o @ s.force_matrix_d.T)).T
-        mean = s.force_matrix_k @ qh[0].real
+        force = ((q_o @ Fk.T) + 1j * w * (q_o @ Fd.T)).T
+        mean = Fk @ qh[0].real
         if A is not None:
             z = self.ports.describing_forces(A, qh @ self.ports.rows.T) @ self.ports.force_map.T
             force, mean = force + z[j].T, mean + z[0].real
@@ -241,15 +277,20 @@ class ModalNewmarkStepper(_NewmarkStepper):
 
 
 class DenseNewmarkStepper(_NewmarkStepper):
-    """Newmark recurrence in physical coordinates (any mass matrix)."""
+    """Newmark recurrence in physical coordinates (any mass matrix); nonlinear elements
+    cycle by cycle (:func:`powertrain.solvers.cycle_newmark.run_cycles`)."""
 
     implementation = "dense"
+    #: the start's fixed point: the run goes on to its own steady state from it
+    fixed_point_tolerance = START_TOLERANCE
 
     def solve(self, load, omega) -> SpeedOrders:
         t0 = time.perf_counter()
-        g, s = self.grid, self.system
+        g = self.grid
+        factors = self.factors_at(omega)
+        s = self.system_at(factors)
         fh, omegas = self.harmonics(load, omega, INITIAL_STATE_MAX_ORDER)
-        qh, amplitudes = self.harmonic_state(fh, omegas, omega)
+        qh, amplitudes = self.harmonic_state(fh, omegas, omega, s)
         # periodic steady-state estimate at t = 0: static preload + harmonic solution
         x0 = qh.real.sum(axis=0)
         v0 = (1j * omegas[:, None] * qh).real.sum(axis=0)
@@ -258,28 +299,32 @@ class DenseNewmarkStepper(_NewmarkStepper):
         F[:, :6] = np.concatenate([np.tile(load, (g.cycles, 1)), load[:1]])
         h = np.deg2rad(g.angle_step_deg) / omega
         if self.ports is None:
-            X, V, A = newmark(s.M, s.C, s.K, F, h, x0, v0, a0)
-            Z = None
+            run = CycleRun(*newmark(s.M, s.C, s.K, F, h, x0, v0, a0), None,
+                           [(slice(0, F.shape[0]), s.force_matrix_k, s.force_matrix_d, None)])
         else:
-            z0 = self.ports.describing_forces(amplitudes, qh @ self.ports.rows.T).real.sum(0)
-            X, V, A, Z = newmark_ports(s.M, s.C, s.K, F, h, self.ports, x0, v0, a0, z0)
+            start = (x0, v0, a0, start_state(self.ports, qh, g.n_cycle), qh[0].real)
+            run = run_cycles(self.scaling, self.ports, F, h, g.n_cycle, start, amplitudes,
+                             factors)
         seconds = time.perf_counter() - t0
         n = g.n_cycle
         win = slice(g.start, g.start + g.processed_cycles * n)
-        d_c, v_c, a_c, f_c = self._outputs(X, V, A, Z, win)
+        d_c, v_c, a_c, f_c = self._outputs(run, win)
         v_prev = v_c[:n] if g.processed_cycles >= 2 else \
-            self._outputs(X, V, A, Z, slice(g.start - n, g.start))[1]
+            self._outputs(run, slice(g.start - n, g.start))[1]
         return self.window_orders(d_c, v_c, a_c, f_c, v_prev, seconds)
 
-    def _outputs(self, X, V, A, Z, win):
+    def _outputs(self, run, win):
         """Channel displacement, velocity, acceleration and transmitted force over ``win``
-        (the port laws' forces ``Z`` added to the force)."""
-        s = self.system
-        Cm = s.channel_matrix
-        q, v, a = X[win], V[win], A[win]
-        force = q @ s.force_matrix_k.T + v @ s.force_matrix_d.T
-        if Z is not None:
-            force += Z[win] @ self.ports.force_map.T
+        (each part of it with the force rows of its cycle, the port laws' forces added)."""
+        Cm = self.system.channel_matrix
+        q, v, a = run.X[win], run.V[win], run.A[win]
+        force = [run.X[lo:hi] @ Fk.T + run.V[lo:hi] @ Fd.T - (0.0 if off is None else off)
+                 for lo, hi, Fk, Fd, off in
+                 ((max(r.start, win.start), min(r.stop, win.stop), Fk, Fd, off)
+                  for r, Fk, Fd, off in run.segments) if lo < hi]
+        force = force[0] if len(force) == 1 else np.concatenate(force)
+        if run.Z is not None:
+            force += run.Z[win] @ self.ports.select(self.ports.kinds != NONE).force_map.T
         return q @ Cm.T, v @ Cm.T, a @ Cm.T, force
 
 

@@ -1,0 +1,116 @@
+r"""The continuous sweep's per-sample loops over plain arrays: the load of the speed ramp
+interpolated in its table, the modal Newmark recurrence and the channel outputs, fused so that
+no array of all steps is ever built (:mod:`powertrain.solvers.speed_ramp`).
+
+Ramp: :math:`n(t) = n_0 + \dot n t`, :math:`\theta(t) = \tfrac{2\pi}{60}(n_0 t +
+\tfrac12\dot n t^2)`, step :math:`t_k = k h`. The load table holds the generalized load
+(6 components) at ``n_speeds`` speeds from ``speed0`` every ``speed_step`` rpm and
+``n_theta`` angles over the cycle (plus the periodic wrap); it is read bilinearly.
+"""
+
+import numpy as np
+from numba import njit
+
+
+@njit(cache=True, nogil=True)
+def ramp_load(table, speed0, speed_step, rpm_from, rate, h, k, out):
+    """Load ``out`` (6,) of the ramp at step ``k``, bilinear in the ``table``
+    (n_speeds, n_theta + 1, 6)."""
+    n_speeds = table.shape[0]
+    n_theta = table.shape[1] - 1
+    t = k * h
+    rpm = rpm_from + rate * t
+    theta = (2.0 * np.pi / 60.0) * (rpm_from * t + 0.5 * rate * t * t)
+    u = (theta % (4.0 * np.pi)) * (n_theta / (4.0 * np.pi))
+    i = min(int(u), n_theta - 1)
+    fu = u - i
+    v = (rpm - speed0) / speed_step
+    v = min(max(v, 0.0), n_speeds - 1 - 1e-12)
+    s = int(v)
+    fv = v - s
+    s1 = min(s + 1, n_speeds - 1)
+    for c in range(6):
+        a = table[s, i, c] * (1.0 - fu) + table[s, i + 1, c] * fu
+        b = table[s1, i, c] * (1.0 - fu) + table[s1, i + 1, c] * fu
+        out[c] = a * (1.0 - fv) + b * fv
+
+
+@njit(cache=True, nogil=True, fastmath=True)
+def _modal_load(map_re, map_im, f, g_re, g_im):
+    """Modal load ``g = map f`` of the load ``f`` (6,), as real and imaginary parts."""
+    for j in range(g_re.shape[0]):
+        g_re[j] = 0.0
+        g_im[j] = 0.0
+    for c in range(6):
+        fc = f[c]
+        mr = map_re[c]
+        mi = map_im[c]
+        for j in range(g_re.shape[0]):
+            g_re[j] += mr[j] * fc
+            g_im[j] += mi[j] * fc
+
+
+@njit(cache=True, nogil=True, fastmath=True)
+def modal_ramp_kernel(lam_d, gain, load_map, w_re, w_im, w_load, table, speed0, speed_step,
+                      rpm_from, rate, h, k0, eta, out):
+    r"""Channel outputs ``out`` (n_rows, n_ch) at steps ``k0 .. k0 + n_rows - 1`` of the
+    modal recurrence :math:`\eta_{k+1} = \lambda_d\eta_k + \gamma(g_k + g_{k+1})`,
+    :math:`g = ` ``load_map`` :math:`\cdot f` (:func:`modal_trapezoid_kernel` of
+    :mod:`powertrain.kernels.newmark`), output
+    :math:`y = \mathrm{Re}(\eta)W_{re} - \mathrm{Im}(\eta)W_{im} + W_{load}f`; the modal
+    arrays split into real and imaginary parts so that the loops over the modes vectorise.
+
+    ``eta`` (m,) complex is the state at step ``k0`` on entry and at ``k0 + n_rows`` on
+    return.
+    """
+    m = eta.shape[0]
+    n_ch = out.shape[1]
+    map_re = np.ascontiguousarray(load_map.real.T)
+    map_im = np.ascontiguousarray(load_map.imag.T)
+    wr = np.ascontiguousarray(w_re.T)
+    wi = np.ascontiguousarray(w_im.T)
+    lr, li, gr, gi = lam_d.real.copy(), lam_d.imag.copy(), gain.real.copy(), gain.imag.copy()
+    er, ei = eta.real.copy(), eta.imag.copy()
+    f = np.empty(6)
+    g_re, g_im, n_re, n_im = np.empty(m), np.empty(m), np.empty(m), np.empty(m)
+    ramp_load(table, speed0, speed_step, rpm_from, rate, h, k0, f)
+    _modal_load(map_re, map_im, f, g_re, g_im)
+    for r in range(out.shape[0]):
+        for c in range(n_ch):
+            y = 0.0
+            for q in range(6):
+                y += w_load[c, q] * f[q]
+            wrc = wr[c]
+            wic = wi[c]
+            for j in range(m):
+                y += er[j] * wrc[j] - ei[j] * wic[j]
+            out[r, c] = y
+        ramp_load(table, speed0, speed_step, rpm_from, rate, h, k0 + r + 1, f)
+        _modal_load(map_re, map_im, f, n_re, n_im)
+        for j in range(m):
+            sr = g_re[j] + n_re[j]
+            si = g_im[j] + n_im[j]
+            a = lr[j] * er[j] - li[j] * ei[j] + gr[j] * sr - gi[j] * si
+            ei[j] = lr[j] * ei[j] + li[j] * er[j] + gr[j] * si + gi[j] * sr
+            er[j] = a
+            g_re[j] = n_re[j]
+            g_im[j] = n_im[j]
+    for j in range(m):
+        eta[j] = er[j] + 1j * ei[j]
+
+
+@njit(cache=True, nogil=True, fastmath=True)
+def fir_decimate(fir, buf_t, m, i_lo, out):
+    """Rows ``i_lo ..`` of the full convolution of the signals ``buf_t`` (n_ch, n) with
+    ``fir`` kept every ``m``-th (scipy's ``upfirdn(fir, buf_t.T, 1, m, axis=0)``), into
+    ``out`` (n_out, n_ch)."""
+    last = fir.shape[0] - 1
+    rev = fir[::-1].copy()
+    for r in range(out.shape[0]):
+        start = (i_lo + r) * m - last
+        for c in range(out.shape[1]):
+            row = buf_t[c, start:start + last + 1]
+            y = 0.0
+            for k in range(last + 1):
+                y += rev[k] * row[k]
+            out[r, c] = y

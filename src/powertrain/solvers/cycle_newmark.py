@@ -1,0 +1,229 @@
+r"""Time-domain run of a model with nonlinear mount elements, one engine cycle at a time.
+
+The dense Newmark stepper and the continuous sweep integrate the same elements
+(:mod:`powertrain.physics.mount_elements`) this way:
+
+* **port laws** (Berg's friction, the Jenkins element) exactly, Newton per step inside the
+  kernel (:func:`powertrain.kernels.port_forces.newmark_port_kernel`), each law's memory
+  (reversal point) carried from step to step and from cycle to cycle;
+* the **amplitude law** once per engine cycle: after each cycle the amplitude of every
+  nonlinear element, :math:`A = \sqrt 2\,` RMS over that cycle of the relative displacement
+  across it (mean removed), rescales its network's springs and dampers for the next cycle
+  (:class:`NetworkScaling`: the global matrices are the assembled ones plus each network's
+  unit contribution times its change of scale, so a rebuild is a few array additions);
+* the **static factor** of every network (the static curve at the operating point, hook
+  ``static_factors``: one factor per network, default each element's own ``static_factor``)
+  multiplies its scale (:meth:`MountElement.at_operating_point`).
+
+A run starts from the harmonic fixed point (:meth:`Stepper.harmonic_state`): the state at
+t = 0 of the equivalent-linear solution and its amplitudes, and the port laws on their
+steady loop along the harmonic relative motion (:func:`steady_loop_state`): Berg's loop,
+started unloaded, approaches its steady state only slowly (16 cycles at A = 0.4 x2).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+
+import numpy as np
+
+from powertrain.kernels.port_forces import NONE, port_force_loop
+from powertrain.physics.mount_elements import PortForces
+from powertrain.solvers.newmark import newmark, newmark_ports
+
+#: Engine cycles of prescribed harmonic motion that settle the port laws' minor loops
+#: before t = 0 (after a start at the tip of the steady loop of the cycle's range).
+LOOP_CYCLES = 2
+
+
+class NetworkScaling:
+    """The assembled model's damping, stiffness and force rows with rescaled networks.
+
+    Parameters
+    ----------
+    system : AssembledSystem
+    """
+
+    def __init__(self, system):
+        self.system = system
+        self.elements = [el for *_, el in system.networks]
+        self.C_parts, self.K_parts, self.gk, self.gd = system.network_parts()
+        #: the scales the assembled matrices hold (every element at amplitude 0)
+        self.assembled = self.scales(np.zeros(len(self.elements)))
+
+    def elements_at(self, factors=None) -> list:
+        """The elements at the operating point of the static ``factors`` (n_net,) (None:
+        each element's own)."""
+        if factors is None:
+            return self.elements
+        return [el.at_operating_point(f) for el, f in zip(self.elements, factors)]
+
+    def scales(self, amplitudes, factors=None) -> np.ndarray:
+        """``(stiffness, damping)`` factor (n_net, 2) of every network at its amplitude
+        (n_net,) [m] and static factor."""
+        return np.array([el.scales(a) for el, a in zip(self.elements_at(factors),
+                                                        amplitudes)], float).reshape(-1, 2)
+
+    def matrices(self, scales):
+        """``(C, K, force_matrix_k, force_matrix_d)`` at the network ``scales`` (n_net, 2);
+        the assembled arrays themselves where no scale changed (bit-identical)."""
+        s = self.system
+        dk, dd = (np.asarray(scales, float) - self.assembled).T
+        if not (dk.any() or dd.any()):
+            return s.C, s.K, s.force_matrix_k, s.force_matrix_d
+        fmap = s.port_force_map
+        return (s.C + np.tensordot(dd, self.C_parts, 1), s.K + np.tensordot(dk, self.K_parts, 1),
+                s.force_matrix_k + (fmap * dk) @ self.gk,
+                s.force_matrix_d + (fmap * dd) @ self.gd)
+
+    def at_operating_point(self, factors):
+        """The assembled model with its elements at the static ``factors`` (n_net,): the
+        same model, its elements, C, K and force rows replaced (for the harmonic start)."""
+        s = self.system
+        elements = self.elements_at(factors)
+        C, K, Fk, Fd = self.matrices(self.scales(np.zeros(len(elements)), factors))
+        ports = dataclasses.replace(s.network_ports, elements=elements)
+        return dataclasses.replace(s, C=C, K=K, force_matrix_k=Fk, force_matrix_d=Fd,
+                                   networks=[(*n[:3], el) for n, el in zip(s.networks,
+                                                                           elements)],
+                                   network_ports=ports)
+
+
+def cycle_signal(harmonics, n_cycle) -> np.ndarray:
+    """Samples (n_cycle, m) over one engine cycle of the harmonics (n_h, m) (index j =
+    order j/2, ``Re sum_j c_j exp(i j theta / 2)``)."""
+    spectrum = np.zeros((n_cycle,) + harmonics.shape[1:], complex)
+    spectrum[:harmonics.shape[0]] = harmonics
+    return (n_cycle * np.fft.ifft(spectrum, axis=0)).real
+
+
+def cycle_amplitudes(u) -> np.ndarray:
+    """:math:`\\sqrt 2\\,` RMS (mean removed) over the rows of ``u`` (n, m) [m]."""
+    return np.sqrt(2.0) * np.std(u, axis=0)
+
+
+def steady_loop_state(ports, relative, n_cycle, cycles=LOOP_CYCLES) -> np.ndarray:
+    """States (m, n_state) of the port laws at t = 0 on their steady loop along the harmonic
+    relative motion ``relative`` (n_h, m): each law starts at the lowest point of the cycle
+    at the tip of the steady loop centred on the mean motion (``law.loop_amplitude_force``
+    of the lowest point's distance below the mean: no mean force, as in the harmonic
+    solution, where a loop is not unique, e.g. a friction element that sticks), then follows
+    the motion for ``cycles`` engine cycles and on to t = 0
+    (:func:`powertrain.kernels.port_forces.port_force_loop`)."""
+    u = cycle_signal(relative, n_cycle)
+    low = np.argmin(u, axis=0)
+    m = u.shape[1]
+    u_low = u[low, np.arange(m)]
+    tips = np.array([law.loop_amplitude_force(u[:, e].mean() - u_low[e])
+                     for e, law in enumerate(ports.laws)], float)
+    state = ports.states_at(u_low, -tips)
+    n = (cycles + 1) * n_cycle + 1
+    U = np.empty((n, m))
+    for e in range(m):
+        path = u[np.arange(low[e], n) % n_cycle, e]
+        U[:, e] = np.concatenate([np.full(low[e], u_low[e]), path])
+    port_force_loop(ports.kinds, ports.parameters, state, U, np.zeros_like(U), np.empty_like(U))
+    return state
+
+
+def no_ports(system):
+    """A :class:`PortForces` holding no element (a linear model run cycle by cycle, e.g.
+    for its static factors)."""
+    n_net = len(system.networks)
+    return PortForces(np.zeros((0, system.n_dof)), np.zeros(0, np.int64), np.zeros((0, 1)),
+                      [], np.zeros((len(system.channels), 0)), [], np.zeros(0, int), n_net)
+
+
+def start_state(ports, qh, n_cycle):
+    """The port laws' states at t = 0 on their steady loop along the harmonic response
+    ``qh`` (n_h, n) (:func:`steady_loop_state`); None when no element has a port law."""
+    laws = ports.select(ports.kinds != NONE)
+    return steady_loop_state(laws, qh @ laws.rows.T, n_cycle) if laws.kinds.size else None
+
+
+@dataclasses.dataclass
+class CycleRun:
+    """A time-domain run: states (n_t, n) ``X``, ``V``, ``A``, the port forces ``Z``
+    (n_t, m; None without port laws) and the force rows the run used, ``(rows,
+    force_matrix_k, force_matrix_d, offset)``: the transmitted force over ``rows`` is
+    ``X Fk^T + V Fd^T - offset`` (offset (n_ch,) or None)."""
+
+    X: np.ndarray
+    V: np.ndarray
+    A: np.ndarray
+    Z: np.ndarray | None
+    segments: list
+
+
+class CycleIntegrator:
+    """Integrates the nonlinear model one stretch (an engine cycle) at a time at the network
+    scales of the amplitudes of the stretch before (:func:`run_cycles`, the sweep).
+
+    The amplitude law scales the networks about the static deflection ``mean`` (n,) [m] of
+    the start: a stretch whose stiffness differs by dK from the first one's is loaded by dK
+    times it, so the static equilibrium stays where the harmonic fixed point put it and a
+    change of scale does not move it (which would be a step load of the size of the motion
+    itself).
+
+    Parameters
+    ----------
+    scaling : NetworkScaling
+    ports : PortForces
+        The nonlinear elements (their rows make the amplitudes; those with a port law are
+        integrated by Newton per step).
+    h : float
+        Time step [s].
+    mean : ndarray (n,)
+    """
+
+    def __init__(self, scaling, ports, h, mean):
+        self.scaling, self.ports, self.h, self.mean = scaling, ports, h, mean
+        self.laws = ports.select(ports.kinds != NONE)
+        #: True when some network's scale follows its amplitude
+        self.varying = any(el.amplitude_law is not None and not el.amplitude_law.constant
+                           for el in scaling.elements)
+        self._first = None
+
+    def run(self, F, start, amplitudes, state, factors=None):
+        """States ``(X, V, A, Z)`` over the load rows ``F`` (k + 1, n) [N] from ``start``
+        = (x, v, a) (row 0), the port-law ``state`` updated in place, and the stretch's
+        force rows ``(Fk, Fd, offset)`` (:class:`CycleRun`)."""
+        s = self.scaling
+        C, K, Fk, Fd = s.matrices(s.scales(self.ports.network_amplitudes(amplitudes),
+                                           factors))
+        self._first = self._first or (K, Fk)
+        shifted = K is not self._first[0]
+        load = F + (K - self._first[0]) @ self.mean if shifted else F
+        if self.laws.kinds.size:
+            X, V, A, Z = newmark_ports(s.system.M, C, K, load, self.h, self.laws, *start,
+                                       state=state)
+        else:
+            (X, V, A), Z = newmark(s.system.M, C, K, load, self.h, *start), None
+        return (X, V, A, Z), (Fk, Fd, (Fk - self._first[1]) @ self.mean if shifted else None)
+
+
+def run_cycles(scaling, ports, F, h, n_cycle, start, amplitudes, factors=None) -> CycleRun:
+    """Integrate the nonlinear model under the load ``F`` (n_t, n) [N] with step ``h`` [s]
+    from ``start`` = (x0, v0, a0, port-law states or None, static deflection (n,) [m]),
+    the amplitude law updated once per ``n_cycle`` steps from the amplitudes (m,) [m] of the
+    first cycle (``ports``: the nonlinear elements; :class:`CycleIntegrator`)."""
+    x0, v0, a0, state, mean = start
+    integrator = CycleIntegrator(scaling, ports, h, mean)
+    n_t = F.shape[0]
+    bounds = list(range(0, n_t - 1, n_cycle)) + [n_t - 1] if integrator.varying \
+        else [0, n_t - 1]
+    out = [np.empty((n_t, F.shape[1])) for _ in range(3)]
+    out.append(np.empty((n_t, integrator.laws.kinds.size)) if integrator.laws.kinds.size
+               else None)
+    out[0][0], out[1][0], out[2][0] = x0, v0, a0
+    segments = []
+    for lo, hi in zip(bounds[:-1], bounds[1:]):
+        rows = slice(lo, hi + 1)
+        states, forces = integrator.run(F[rows], [o[lo] for o in out[:3]], amplitudes, state,
+                                        factors)
+        for o, value in zip(out, states):
+            if o is not None:
+                o[rows] = value
+        segments.append((slice(lo, hi if hi < n_t - 1 else n_t),) + forces)
+        amplitudes = cycle_amplitudes(out[0][lo:hi] @ ports.rows.T)
+    return CycleRun(*out, segments)
