@@ -36,7 +36,11 @@ from powertrain.errors import InputError, require_finite, solved
 from powertrain.progress import progress_bar
 from powertrain.results.runup import RunupResult, SweepRunup
 from powertrain.results.static import StaticResult
-from powertrain.solvers.operating_point import has_static_curves, operating_points
+from powertrain.solvers.operating_point import (
+    has_static_curves,
+    operating_points,
+    static_factors,
+)
 from powertrain.solvers.steppers import Cycles, choose_stepper
 
 #: Largest speed grid a run-up command accepts (about 0.1 s per speed step).
@@ -406,7 +410,9 @@ def _sweep_runup(engine, rpm, rate, sample_rate, effects, progress) -> SweepRunu
         raise InputError("effects are not simulated in a sweep (use stepped run-ups)",
                          key="--effect")
     rpm = _speeds(rpm)
-    rec = simulate_sweep(engine, rpm[0], rpm[-1], rate, sample_rate, progress=progress)
+    factors = (lambda r: static_factors(engine, r)) if has_static_curves(engine) else None
+    rec = simulate_sweep(engine, rpm[0], rpm[-1], rate, sample_rate, progress=progress,
+                         static_factors=factors)
     try:
         tracked = track_recording(rec, rpm_step=TRACK_RPM_STEP, progress=progress).as_velocity()
     except InputError as exc:        # the simulated ramp is too short or fast to be tracked
