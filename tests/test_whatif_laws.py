@@ -139,11 +139,12 @@ def test_whatif_runs_the_laws_through_the_harmonic_fixed_point(engine):
     assert np.max(np.abs(v - base.velocity)) > 1e-3 * np.max(np.abs(base.velocity))
 
 
+@pytest.mark.slow
 def test_target_at_an_amplitude_meets_the_request_there(lawed):
     t = parse_target("left.z:+20%:100-300Hz:0.03mm")
     assert t.amplitude == pytest.approx(3e-5)
     model = lawed.mount("left").directions["z"]
-    tf = retune(model, t, seed=1)
+    tf = retune(model, t, seed=1, starts=4, hops=0)
     assert (tf.model.amplitude_law, tf.model.port_law) == (model.amplitude_law,
                                                            model.port_law)
     s = 2j * np.pi * tf.frequency_hz
