@@ -257,6 +257,7 @@ def seeds(worker: Worker, folder: Path) -> dict:
     if _SEEDS:
         return _SEEDS
     _SEEDS["engine"] = _read("engines/default.toml")
+    _SEEDS["engine-nonlinear"] = _read("engines/default-nonlinear.toml")   # issue 20 sections
     for p in sorted((ROOT / "mounts").glob("*.toml")):
         _SEEDS[f"mounts/{p.name}"] = p.read_bytes()
     _SEEDS["pressure.csv"] = seed_pressure_csv()
@@ -569,7 +570,9 @@ def case_mount(draw) -> Case:
     if draw(st.booleans()):
         return Case(files, ["stiffness", name, "--freq", "1:200:10", "--format", "csv"], [],
                     Path(name).name, "mount TOML (stiffness)")
-    files["engines/e.toml"] = _SEEDS["engine"]
+    # a mount file with [amplitude], [friction] or [static] runs in the engine that uses it
+    nonlinear = Path(name).name.encode() in _SEEDS["engine-nonlinear"]
+    files["engines/e.toml"] = _SEEDS["engine-nonlinear" if nonlinear else "engine"]
     return Case(files, ["runup", "--engine", "engines/e.toml", *QUICK_RUNUP, "--csv", "o.csv"],
                 ["o.csv"], Path(name).name, "mount TOML (run-up)")
 

@@ -83,3 +83,13 @@ def test_warm_start_converges_to_the_cold_answer_in_fewer_iterations(engine):
                    warm_amplitudes=cold.amplitudes)
     assert warm.iterations < near.iterations
     assert np.max(np.abs(warm.velocity - near.velocity)) <= 1e-5 * np.max(np.abs(near.velocity))
+
+
+def test_fast_path_on_the_shipped_nonlinear_engine_equals_the_runup():
+    """engines/default-nonlinear.toml (power law, table law, Berg friction from its mount
+    files): the diagnosis' cached model and the run-up's harmonic fixed point agree."""
+    eng = read_engine(DEFAULT_ENGINE_PATH.parent / "default-nonlinear.toml")
+    fast = predict(HarmonicModel(eng, RPM), {})
+    ref = run_runup(eng, RPM, solver="harmonic").velocity
+    assert fast.iterations > 1
+    assert _db_gap(fast.velocity, ref) <= AGREE_DB

@@ -157,3 +157,19 @@ def test_target_at_an_amplitude_meets_the_request_there(lawed):
           f"max band error {100 * tf.max_band_error:.1f} %")
     assert abs(change - 0.2) < 0.05
     assert tf.to_dict()["amplitude_mm"] == pytest.approx(0.03)
+
+
+def test_scale_and_set_on_the_shipped_nonlinear_engine():
+    from powertrain.iotools.engine_file import DEFAULT_ENGINE_PATH, read_engine
+    eng = read_engine(DEFAULT_ENGINE_PATH.parent / "default-nonlinear.toml")
+    fr0 = _law(eng, "left", "z", "port_law")
+    e = apply_operations(eng, [parse_scale("*.z.friction.max_force=0.5"),
+                               parse_scale("left.y.amplitude.exponent=2"),
+                               parse_set("right.z.friction.half_displacement=0.1")])
+    assert _law(e, "left", "z", "port_law").max_force == pytest.approx(0.5 * fr0.max_force)
+    assert _law(e, "right", "z", "port_law").half_displacement == pytest.approx(1e-4)
+    assert _law(e, "left", "y", "amplitude_law").exponent == pytest.approx(
+        2 * _law(eng, "left", "y", "amplitude_law").exponent)
+    assert _law(e, "gearbox", "z", "port_law") is None          # the wildcard skipped it
+    with pytest.raises(InputError, match="TableLaw, which has no exponent"):
+        parse_scale("gearbox.z.amplitude.exponent=2").apply(eng)
