@@ -25,16 +25,18 @@ WILDCARD = "*"
 
 #: What-if keys of a mount direction's laws (the mount file's ``[amplitude]``,
 #: ``[friction]`` and ``[static]`` sections): ``"section.key"`` -> (dimension of the value,
-#: its datasheet unit, ``--scale`` allowed, ``--set`` allowed). ``amplitude.limits`` is set
-#: as ``LO,HI``; ``static.force`` scales every force of the curve.
+#: its unit family in the mount file's ``[units]``, ``x`` or ``F``
+#: (:data:`powertrain.iotools.mount_file.SECTION_UNITS`; None: no unit), ``--scale``
+#: allowed, ``--set`` allowed). ``amplitude.limits`` is set as ``LO,HI``; ``static.force``
+#: scales every force of the curve.
 LAW_KEYS = {
-    "amplitude.reference": ("length", "mm", True, True),
-    "amplitude.exponent": (None, "1", True, True),
-    "amplitude.limits": (None, "1", False, True),
-    "friction.max_force": ("force", "N", True, True),
-    "friction.half_displacement": ("length", "mm", True, True),
-    "static.force": ("force", "N", True, False),
-    "static.reference_deflection": ("length", "mm", False, True),
+    "amplitude.reference": ("length", "x", True, True),
+    "amplitude.exponent": (None, None, True, True),
+    "amplitude.limits": (None, None, False, True),
+    "friction.max_force": ("force", "F", True, True),
+    "friction.half_displacement": ("length", "x", True, True),
+    "static.force": ("force", "F", True, False),
+    "static.reference_deflection": ("length", "x", False, True),
 }
 #: The law a ``--set`` creates in a direction without the section: one that leaves the mount
 #: linear until the set key changes it (amplitude: power law at 0.1 mm, exponent 0, limits

@@ -211,8 +211,9 @@ def _law_value(key, right, text, origin):
     """SI value of a law key's ``--set`` (:data:`LAW_KEYS`: its datasheet unit, or an
     explicit one of the same dimension; ``LO,HI`` for ``amplitude.limits``), checked as the
     mount file checks it."""
+    from powertrain.iotools.mount_file import SECTION_UNITS
     from powertrain.units import UNITS, to_si
-    dimension, unit0 = LAW_KEYS[key][:2]
+    dimension, family = LAW_KEYS[key][:2]
     if key == "amplitude.limits":
         parts = right.split(",")
         lo, hi = (_float(p.strip(), text, origin) for p in parts) if len(parts) == 2 else \
@@ -223,7 +224,8 @@ def _law_value(key, right, text, origin):
     m = re.match(r"^([-+0-9.eE]+)\s*(.*)$", right)
     if not m:
         raise origin.error(f"{text!r}: {right!r} is not a number")
-    value, unit = _float(m.group(1), text, origin), m.group(2).strip() or unit0
+    value, unit = _float(m.group(1), text, origin), m.group(2).strip()
+    unit = unit or (SECTION_UNITS[family] if family else "1")
     if dimension is None:
         if unit != "1":
             raise origin.error(f"{text!r}: {key} has no unit, got {unit!r}")
