@@ -21,7 +21,8 @@ changed, effect-free) and a line ``passive: chassis_and_mount_top1=...`` (issue 
 is printed before the raw scores.
 
 Usage: ``python scripts/blind_diagnosis.py --cases 50 [--seed S] [--jobs 2]
-[--scheduler local|tcp://HOST:PORT] [--dump rows.json] [--plan default|passive]``.
+[--scheduler local|tcp://HOST:PORT] [--dump rows.json] [--plan default|passive]
+[--kind KIND]`` (``--kind amplitude_elastomer``: every case of that truth kind).
 Without ``--seed`` the seed is drawn from ``os.urandom`` and printed.
 """
 
@@ -179,6 +180,9 @@ def main(argv=None):
     ap.add_argument("--plan", choices=("default", "passive"), default="default",
                     help="'passive': cases with both sides of every mount measured on the "
                          "modal-body engine (powertrain.validation.passive)")
+    ap.add_argument("--kind", default=None,
+                    help="every case of this one truth kind (e.g. amplitude_elastomer), "
+                         "engines alternating single-zone and traces")
     args = ap.parse_args(argv)
     from powertrain.validation.cases import DETECT_LOCAL_DB, DETECT_RMS_DB, case_plan
     from powertrain.validation.passive import passive_plan
@@ -196,6 +200,8 @@ def main(argv=None):
     plan = passive_plan if args.plan == "passive" else case_plan
     tasks = [(i, names, eng, s) for i, (names, eng, s) in
              enumerate(plan(args.cases, seed))]
+    if args.kind:
+        tasks = [(i, [args.kind], ("sz", "traces")[i % 2], s) for i, _, _, s in tasks]
     if args.generate_only:
         _print_truth(tasks)
         return

@@ -515,7 +515,7 @@ def freq_spec():
 def effect_spec():
     from powertrain.effects import EFFECTS
     names = sorted(EFFECTS) + ["nope", ""]
-    param = st.tuples(st.sampled_from(["k1", "c_base", "m_base", "kappa", "a_c", "g3", "lag",
+    param = st.tuples(st.sampled_from(["k1", "c_base", "m_base", "exponent", "g3", "lag",
                                        "x", ""]),
                       st.one_of(option_value(), st.sampled_from(["400N/mm", "8kg", "5deg",
                                                                  "1furlong", "1e300N/mm"])))

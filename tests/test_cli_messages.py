@@ -89,7 +89,7 @@ def test_fit_mount_names_the_plot_it_wrote(tmp_path):
     assert f"wrote {out}, {png}" in res.output and png.stat().st_size > 0
 
 
-@pytest.mark.parametrize("effect", [None, "amplitude_stiffness:kappa=1,a_c=0.02mm"])
+@pytest.mark.parametrize("effect", [None, "amplitude_stiffness:exponent=0.2"])
 def test_runup_csv_with_effects_is_labelled_synthetic_with_provenance(tmp_path, effect):
     """With --effect the run-up CSV stands in for a measurement: SYNTHETIC label and
     provenance, as `synth` and `track` label theirs; a plain run-up CSV starts with its
@@ -104,6 +104,6 @@ def test_runup_csv_with_effects_is_labelled_synthetic_with_provenance(tmp_path, 
         assert head[0].startswith("mount,direction,quantity,rpm,")
         return
     assert head[0].startswith("# SYNTHETIC: simulated run-up with added effects "
-                              "amplitude_stiffness(kappa=1, a_c=2e-05)")
+                              "amplitude_stiffness(exponent=0.2)")
     assert head[1].startswith("# provenance: powertrain ") and "$ powertrain runup" in head[1]
-    assert "--effect amplitude_stiffness:kappa=1,a_c=0.02mm" in head[1]
+    assert "--effect amplitude_stiffness:exponent=0.2" in head[1]

@@ -230,7 +230,7 @@ def test_effects_through_the_normal_runup_match_the_fast_path(engine):
     from powertrain.workflows.runup import runup_with_effects
     scenarios = [{"base_compliance": {"c_base": 4e5, "m_base": 8.0}},
                  {"mount_stiffness": {"k1": 1.5, "k3": 0.7}},
-                 {"amplitude_stiffness": {"kappa": 1.0, "a_c": 2e-5}},
+                 {"amplitude_stiffness": {"exponent": 0.2}},
                  {"balancer_error": {"gain": 0.8, "lag": 0.1, "asym": 0.2}},
                  {"sensor_error": {"g2": 3.0, "r1z": 0.05}}]
     for sc in scenarios:
@@ -239,8 +239,8 @@ def test_effects_through_the_normal_runup_match_the_fast_path(engine):
         err = np.max(np.abs(nm.velocity - ref.velocity)) / np.max(np.abs(ref.velocity))
         assert err < NEWMARK_REL, (sc, err)
         assert nm.settings["effects"][next(iter(sc))]
-    amp = runup_with_effects(engine, RPM, scenarios[2], solver="harmonic")
-    assert np.asarray(amp.meta["amplitude_factors"]).shape == (RPM.size, 9)
+        if "amplitude_stiffness" in sc:        # Newmark: the laws frozen per speed
+            assert np.asarray(nm.meta["amplitude_factors"]).shape == (RPM.size, 9)
 
 
 def test_whatif_effect_option_units_and_variants_file(tmp_path, engine):

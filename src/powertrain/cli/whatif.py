@@ -24,10 +24,14 @@ from powertrain.cli.group import main
                    "integration as in `runup`.")
 @click.option("--scale", multiple=True, metavar="MOUNT.DIR.KIND=FACTOR",
               help="Scale springs (stiffness), dampers (damping) or c, d and m together "
-                   "(dynamic: K_CP(f) x FACTOR); MOUNT/DIR may be *. Repeatable.")
+                   "(dynamic: K_CP(f) x FACTOR), or a law of the mount file "
+                   "(left.z.amplitude.exponent=0.5, friction.max_force, static.force...); "
+                   "MOUNT/DIR may be *. Repeatable.")
 @click.option("--set", "set_", multiple=True, metavar="MOUNT.DIR.PARAM=VALUE",
               help="Set one parameter in its datasheet unit (c N/mm, d N*s/mm, m kg) or an "
-                   "explicit unit (150N/mm). Repeatable.")
+                   "explicit unit (150N/mm), or a law value in the mount file's units "
+                   "(left.z.friction.max_force=20 [N], amplitude.reference [mm], "
+                   "amplitude.limits=0.2,5; creates [amplitude]/[friction]). Repeatable.")
 @click.option("--swap", multiple=True, metavar="MOUNT.DIR=FILE.toml",
               help="Replace one direction's model by a mount file. Repeatable.")
 @click.option("--move", multiple=True, metavar="MOUNT=DX,DY,DZ",
@@ -40,9 +44,10 @@ from powertrain.cli.group import main
                    "(see `powertrain diagnose`). Repeatable.")
 @click.option("--variants", "variants_file", type=click.Path(dir_okay=False),
               help="TOML file of named variants ([[variant]] name = ..., scale = [...], ...).")
-@click.option("--target", multiple=True, metavar="MOUNT.DIR:CHANGE:BAND[:WIDTH]",
+@click.option("--target", multiple=True, metavar="MOUNT.DIR:CHANGE:BAND[:WIDTH][:AMPLITUDE]",
               help="Retune to a K_CP change over a band, e.g. left.z:+20%:100-300Hz "
-                   "(blend 0.5 octave outside, or :1oct); each target is its own variant.")
+                   "(blend 0.5 octave outside, or :1oct; at an amplitude of a mount with "
+                   "an amplitude law or friction: :0.3mm); each target is its own variant.")
 @click.option("--target-out", type=click.Path(dir_okay=False),
               help="Write the fitted mount file of the (single) target.")
 @click.option("--target-plot", type=click.Path(dir_okay=False),
@@ -88,6 +93,7 @@ def whatif(engine_file, rpm_from, rpm_to, rpm_step, solver, scale, set_, swap, m
       powertrain whatif --scale "*.*.dynamic=0.9" --set right.y.c2=150 --json out.json
       powertrain whatif --move gearbox=0,0,10 --rotate left=0,0,5 --plot whatif.png
       powertrain whatif --target left.z:+20%:100-300Hz --target-out left-z-retuned.toml
+      powertrain whatif --set left.z.amplitude.exponent=0.15 --set "*.z.friction.max_force=30"
       powertrain whatif --variants variants.toml --measured measured.csv --plot w.png
       powertrain whatif --effect mount_stiffness:k1=1.5,k2=1.5 --effect sensor_error:g3=2
       powertrain whatif --engine engines/default-modal-body.toml --scale left.z.stiffness=0.8 \\

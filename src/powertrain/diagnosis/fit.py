@@ -132,10 +132,10 @@ class Problem:
         if last is not None and last[0] == key:
             vel = last[1]
         else:
-            pred = predict(self.hm[part], phys, warm_factors=self._warm.get(part))
+            pred = predict(self.hm[part], phys, warm_amplitudes=self._warm.get(part))
             vel = pred.velocity
-            if pred.factors is not None:
-                self._warm[part] = pred.factors
+            if pred.amplitudes is not None:
+                self._warm[part] = pred.amplitudes
             self.solves += max(1, pred.iterations)
             self._last[part] = (key, vel)
         for k, v in scenario.items():

@@ -13,8 +13,8 @@ base_compliance    structure   every mount stands on a local chassis base: mass 
                                c_b (damping ratio ζ_b = 5 %) instead of the rigid ground
 mount_stiffness    structure   each mount's elastomer times a factor k_i: springs and dampers
                                × k_i, masses (fluid and rubber inertia) unchanged
-amplitude_stiffness structure  springs and dampers × g(a) of the engine-side amplitude a,
-                               g(a) = 1 + κ[1/(1 + a/a_c) − 1/(1 + a_ref/a_c)] (a_ref = 0.1 mm)
+amplitude_stiffness structure  every mount's amplitude law: springs and dampers ×
+                               (A_ref/A)^n (PowerLaw, A_ref = 0.1 mm, A across the mount)
 chassis_modes      structure   the body modes shared by the mount bases (modal body only):
                                frequency, modal mass and damping of each mode fitted
 balancer_error     excitation  balancer shafts' unbalance g(1 ± a/2) and timing δ ± s/2 per shaft
@@ -30,7 +30,7 @@ fast cached path :func:`predict` (the diagnosis), and through the ordinary run-u
 (:func:`powertrain.workflows.runup.runup_with_effects`).
 """
 
-from powertrain.effects.amplitude_stiffness import A_REF, amplitude_factor, time_domain_amplitude_check
+from powertrain.effects.amplitude_stiffness import A_REF, amplitude_law, time_domain_amplitude_check
 from powertrain.effects.balancer_error import with_balancer_error
 from powertrain.effects.base import Effect, Parameter, map_networks, with_network_elastomer
 from powertrain.effects.base_compliance import BASE_ZETA, with_base_compliance_all
@@ -41,7 +41,7 @@ from powertrain.effects.registry import EFFECT_CLASSES, EFFECTS, RESPONSE_EFFECT
 from powertrain.effects.sensor_error import apply_sensor_error, rotation_matrix, sensor_reading
 
 __all__ = ["A_REF", "BASE_ZETA", "EFFECTS", "EFFECT_CLASSES", "RESPONSE_EFFECTS", "Effect",
-           "Parameter", "Prediction", "amplitude_factor", "apply_sensor_error",
+           "Parameter", "Prediction", "amplitude_law", "apply_sensor_error",
            "check_scenario", "map_networks", "predict", "rotation_matrix", "sensor_reading",
            "time_domain_amplitude_check", "with_balancer_error", "with_base_compliance_all",
            "with_cylinder_imbalance", "with_mount_stiffness", "with_network_elastomer"]

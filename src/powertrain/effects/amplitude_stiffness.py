@@ -1,48 +1,68 @@
-r"""``amplitude_stiffness``: the elastomer's stiffness depends on the engine-side amplitude.
+r"""``amplitude_stiffness``: the elastomer's stiffness depends on the amplitude across the mount.
 
-Springs and dampers × :math:`g(a) = 1 + \kappa[1/(1 + a/a_c) - 1/(1 + a_{ref}/a_c)]`
-(mount data at :math:`a_{ref}` = 0.1 mm), masses kept. Equivalent linearisation: at each
-speed every network's elastomer is scaled by :math:`g(a_n)`, :math:`a_n` the engine-side
-peak displacement of network n, iterated to consistency (:func:`powertrain.effects.predict`).
-Its time-domain check is :func:`time_domain_amplitude_check`.
+A fit of the mount laws of issue 20, not a physics of its own: the candidate puts one
+:class:`~powertrain.physics.mount_laws.PowerLaw` on every mount direction,
+
+.. math:: \text{springs and dampers} \times \mathrm{clip}\big((A_{ref}/A)^{n},\ 0.2,\ 5\big),
+
+:math:`A_{ref}` = 0.1 mm (where mount data are measured and the networks fitted, so the
+network is unchanged at :math:`A_{ref}`), :math:`A` the amplitude of the relative
+displacement across the mount direction (√2 × RMS of orders 0.5–8), masses kept; one
+exponent :math:`n` for all mounts (one law per mount design doubled the fit time without
+separating it from ``mount_stiffness``, docs/validation/diagnosis.md). :meth:`~AmplitudeStiffness.apply`
+sets :attr:`MountModel.amplitude_law <powertrain.models.mount.MountModel.amplitude_law>`,
+which the run-up's harmonic fixed point
+(:mod:`powertrain.solvers.equivalent_linear`) solves; the fast path
+(:func:`powertrain.effects.predict`) evaluates the same
+:meth:`MountElement.two_port <powertrain.physics.mount_elements.MountElement.two_port>` at
+its own fixed-point amplitudes. At :math:`n = 0` (the default) the mounts are left as they
+are (a law of the engine's mount files included); otherwise the candidate's law replaces
+theirs. Its time-domain check is :func:`time_domain_amplitude_check`.
 """
 
 from __future__ import annotations
 
+import dataclasses
+
 import numpy as np
 
-from powertrain.effects.base import Effect, Parameter, with_network_elastomer
+from powertrain.effects.base import Effect, Parameter, map_networks, with_network_elastomer
+from powertrain.physics.mount_laws import PowerLaw
 
 #: Reference amplitude of the mount data (dynamic stiffness measured at 0.1 mm) [m].
 A_REF = 1.0e-4
 
 
-def amplitude_factor(a, kappa, a_c):
-    r"""Stiffness factor :math:`g(a) = 1 + \kappa\,[1/(1 + a/a_c) - 1/(1 + a_{ref}/a_c)]`,
-    g(a_ref) = 1; ``a`` engine-side peak displacement [m], ``kappa`` [1], ``a_c`` [m]."""
-    a = np.asarray(a, float)
-    return 1.0 + kappa * (1.0 / (1.0 + a / a_c) - 1.0 / (1.0 + A_REF / a_c))
+def amplitude_law(exponent: float) -> PowerLaw:
+    """The candidate's law: :class:`PowerLaw` at :data:`A_REF` with its default limits."""
+    return PowerLaw(A_REF, float(exponent))
 
 
 class AmplitudeStiffness(Effect):
     name = "amplitude_stiffness"
     kind = "structure"
-    description = ("amplitude-dependent mount stiffness, equivalent linearisation iterated to "
-                   "consistency (mount data at 0.1 mm)")
-    engine_change = False
+    description = ("amplitude-dependent mount stiffness: springs and dampers x (A_ref/A)^n "
+                   "(A_ref = 0.1 mm, A across the mount), at the harmonic fixed point")
 
     def parameters(self, engine=None):
-        return (Parameter("kappa", "1", 0.0, 3.0, 0.0, False,
-                          "stiffening from large to vanishing amplitude"),
-                Parameter("a_c", "m", 1.0e-6, 1.0e-3, 2.0e-5, True, "characteristic amplitude"))
+        return (Parameter("exponent", "1", 0.0, 1.0, 0.0, False,
+                          "power-law exponent n of every mount's elastomer"),)
 
     def start_grid(self, engine=None):
-        return ((0.3, 1.0, 2.0), (3e-6, 2e-5, 1.5e-4))
+        return ((0.1, 0.2, 0.35),)
 
-    def amplitude_factors(self, amplitude, p):
-        if p["kappa"] == 0.0:
-            return None
-        return amplitude_factor(amplitude, p["kappa"], p["a_c"])
+    def apply(self, engine, **params):
+        if params.get("exponent", 0.0) == 0.0:
+            return engine
+        law = amplitude_law(params["exponent"])
+        return map_networks(engine, lambda mi, m, ax, mod:
+                            dataclasses.replace(mod, amplitude_law=law))
+
+    def elements(self, hm, elements, p):
+        if p["exponent"] == 0.0:
+            return elements
+        law = amplitude_law(p["exponent"])
+        return [dataclasses.replace(el, amplitude_law=law) for el in elements]
 
 
 def _rows(engine):
@@ -64,14 +84,15 @@ def _initial_state(system, load, n_cycle, omega):
             (-(om ** 2)[:, None] * qh).real.sum(0))
 
 
-def time_domain_amplitude_check(engine, rpm, kappa, a_c, *, cycles=40, angle_step_deg=1.0):
-    r"""Amplitude-dependent mounts in the time domain, for checking the linearisation.
+def time_domain_amplitude_check(engine, rpm, exponent, *, cycles=40, angle_step_deg=1.0):
+    r"""The candidate's law in the time domain, for checking the linearisation (rigid
+    ground: the engine-side displacement is the relative one).
 
-    The assembled model is integrated by Newmark (average acceleration) cycle by cycle; at
-    the start of each engine cycle every network's springs and dampers are rescaled by
-    :math:`g(a_n)` (masses kept; under-relaxed by 0.7 like the frequency-domain iteration)
-    with :math:`a_n = \sqrt2\,\mathrm{RMS}` of its engine-side displacement over the
-    previous cycle. After ``cycles`` cycles the last cycle is order-analysed.
+    The assembled linear model is integrated by Newmark (average acceleration) cycle by
+    cycle; at the start of each engine cycle every network's springs and dampers are
+    rescaled by the law's factor :math:`g(A_n)` (masses kept; under-relaxed by 0.7) with
+    :math:`A_n = \sqrt2\,\mathrm{RMS}` of its displacement over the previous cycle. After
+    ``cycles`` cycles the last cycle is order-analysed.
 
     Returns
     -------
@@ -85,6 +106,7 @@ def time_domain_amplitude_check(engine, rpm, kappa, a_c, *, cycles=40, angle_ste
     from powertrain.analysis.orders import order_spectrum
     from powertrain.assembly import assemble
     from powertrain.solvers.newmark import newmark
+    law = amplitude_law(exponent)
     n_cycle = int(round(720.0 / angle_step_deg))
     omega = rpm * 2 * np.pi / 60.0
     h = np.deg2rad(angle_step_deg) / omega
@@ -104,7 +126,7 @@ def time_domain_amplitude_check(engine, rpm, kappa, a_c, *, cycles=40, angle_ste
         a = np.sqrt(2.0) * np.std(X[:-1, :6] @ rows.T, axis=0)
         last_v = V[:-1] @ system.channel_matrix.T
         g_used = g
-        g = g + 0.7 * (amplitude_factor(a, kappa, a_c) - g)
+        g = g + 0.7 * (law.scales(a)[0] - g)
         per = float("nan") if prev_v is None else \
             np.max(np.abs(last_v - prev_v)) / np.max(np.abs(last_v))
         prev_v = last_v

@@ -6,7 +6,7 @@ balancer shafts and channels), ``applicable(engine)`` and ``apply(engine, params
 changed engine model, where the effect is one). For the fast cached path
 (:func:`powertrain.effects.predict`) an effect contributes through hooks, each a no-op by
 default: an elastomer scale per network, a change of the networks' two-ports, a load
-change, amplitude-dependent network factors, a change of the sensor reading. To add an
+change, the networks' mount elements (an amplitude law), a change of the sensor reading. To add an
 effect: one new module with a subclass and its tests, and one line in
 :mod:`powertrain.effects.registry` (docs/extending.md).
 """
@@ -118,10 +118,12 @@ class Effect:
         """Change of the load harmonics (n_r, 17, 6), or None."""
         return None
 
-    def amplitude_factors(self, amplitude, p):
-        """Elastomer factors at the networks' amplitudes (n_r, n_net), or None if the
-        effect does not depend on amplitude (or is switched off)."""
-        return None
+    def elements(self, hm, elements, p):
+        """The networks' mount elements (list in network order,
+        :class:`~powertrain.physics.mount_elements.MountElement`) with the effect, e.g. an
+        amplitude law set; a nonlinear element makes :func:`powertrain.effects.predict`
+        iterate to its amplitudes. Unchanged by default."""
+        return elements
 
     def body_change(self, hm, p, body):
         """The modal body under the mounts (:class:`~powertrain.solvers.body_coupling.ModalBody`)

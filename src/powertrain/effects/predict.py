@@ -4,20 +4,30 @@ r"""The fast cached path: channel velocities of a scenario on one
 Each effect of the scenario contributes through its hooks (:class:`Effect`): elastomer
 scales change the networks' two-ports (condensed by the one kernel,
 :func:`powertrain.kernels.two_port.two_port_kernel`), the effects' two-port changes follow,
-load changes add, amplitude-dependent factors are iterated to consistency (under-relaxation
-0.7, at most 60 iterations, tolerance 1e-6), sensor readings come last. Every effect that
-changes the engine model predicts what its ``apply()`` runs, to round-off
-(tests/test_diagnosis_physics.py).
+load changes add, sensor readings come last. Nonlinear mount elements (an amplitude law or
+a port law, the engine's own or an effect's, :meth:`Effect.elements`) act through
+:meth:`MountElement.two_port <powertrain.physics.mount_elements.MountElement.two_port>` at
+the amplitudes of the relative displacement across them, iterated to consistency at all
+speeds at once (:func:`amplitude_iteration`) — the physics of the run-up's harmonic fixed
+point (:mod:`powertrain.solvers.equivalent_linear`). Every effect that changes the engine
+model predicts what its ``apply()`` runs, to round-off (tests/test_diagnosis_physics.py).
 """
 
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass
 
 import numpy as np
 
 from powertrain.effects.registry import EFFECTS
 from powertrain.solvers.fast_harmonic import HarmonicModel
+
+#: Amplitude fixed point: relative change of every speed's amplitudes at convergence, first
+#: relaxation (halved whenever the change grows, down to 1/64) and iteration limit.
+TOLERANCE = 1e-6
+RELAXATION = 0.7
+MAX_ITERATIONS = 200
 
 
 @dataclass
@@ -29,14 +39,18 @@ class Prediction:
     velocity : ndarray (n_r, n_ch, 16) complex
         Peak amplitudes of orders 0.5..8 [m/s].
     iterations : int
-        Fixed-point iterations of the equivalent linearisation (0 if none).
-    factors : ndarray (n_r, n_net) or None
-        Amplitude factors g(a_n) at convergence.
+        Fixed-point iterations of the nonlinear elements (0 if none).
+    amplitudes : ndarray (n_r, n_net) or None
+        Relative-displacement amplitudes of the networks at convergence [m] (None: every
+        element linear).
+    elements : list or None
+        The networks' mount elements the prediction used (None: every element linear).
     """
 
     velocity: np.ndarray
     iterations: int = 0
-    factors: np.ndarray | None = None
+    amplitudes: np.ndarray | None = None
+    elements: list | None = None
 
 
 def _filled(hm, scenario):
@@ -65,34 +79,52 @@ def _body(hm, sc):
     return body
 
 
-def _amplitude_effect(hm, sc):
-    """The amplitude-dependent effect of the scenario (switched on), or None."""
+def _elements(hm, sc, s_el):
+    """The networks' mount elements with the elastomer scales ``s_el`` and the effects'
+    changes; None when every one is linear (the cached two-ports serve)."""
+    els = list(hm.elements)
+    if s_el is not None:
+        els = [dataclasses.replace(el, model=el.model.scaled(float(s), float(s)))
+               for el, s in zip(els, s_el)]
     for eff, p in sc.values():
-        if eff.amplitude_factors(np.ones((1, len(hm.networks))), p) is not None:
-            return eff, p
-    return None
+        els = eff.elements(hm, els, p)
+    return els if any(el.nonlinear for el in els) else None
 
 
-def _iterate(hm, sc, s0, load, amp, tol, max_iter, g0=None):
-    eff, p = amp
-    g = np.ones((hm.rpm.size, len(hm.networks)))
-    if g0 is not None and np.shape(g0) == g.shape:
-        g = np.array(g0, float)
-    iterations = 0
-    for iterations in range(1, max_iter + 1):  # noqa: B007 (count returned)
-        abc = hm.two_ports_scaled((s0[None, :] * g)[:, None, :])
-        eff_abc = _two_ports(sc, hm, abc)
-        q = hm.solve(eff_abc[0], load, abc=eff_abc, body=_body(hm, sc))
-        g_new = eff.amplitude_factors(hm.network_amplitude(q), p)
-        change = np.max(np.abs(g_new - g))
-        g = g + 0.7 * (g_new - g)
-        if change < tol:
-            break
-    return hm.two_ports_scaled((s0[None, :] * g)[:, None, :]), iterations, g
+def amplitude_iteration(hm, sc, els, load, body, *, tol=TOLERANCE, start=None):
+    """The nonlinear elements' fixed point at every speed: :math:`A \\leftarrow A +
+    \\rho(A(\\hat{\\mathbf q}(A)) - A)` with :meth:`HarmonicModel.relative_amplitude`, until
+    the largest change is below ``tol`` of each speed's largest amplitude.
+
+    Returns ``(two-ports with the effects, rigid-body amplitudes q, A (n_r, n_net),
+    iterations)``; raises ``FloatingPointError`` naming the mount direction and speed when
+    it does not converge in :data:`MAX_ITERATIONS`."""
+    nl = np.array([el.nonlinear for el in els])
+    A = np.zeros((hm.rpm.size, len(els)))
+    if start is not None and np.shape(start) == A.shape:
+        A = np.array(start, float)
+    relax, last = RELAXATION, np.inf
+    for it in range(1, MAX_ITERATIONS + 1):
+        abc = _two_ports(sc, hm, hm.two_ports_at(A, els))
+        q = hm.solve(abc[0], load, abc=abc, body=body)
+        change = (hm.relative_amplitude(q) - A)[:, nl]
+        size = np.maximum(np.max(np.abs(A[:, nl] + change), axis=1), np.finfo(float).tiny)
+        err = np.max(np.abs(change), axis=1) / size
+        if np.max(err) <= tol:
+            return abc, q, A, it
+        if np.max(err) > last:
+            relax = max(relax / 2, 1.0 / 64)
+        last = np.max(err)
+        A[:, nl] += relax * change
+    r = int(np.argmax(err))
+    mi, axis, _ = [n for n, k in zip(hm.networks, nl) if k][int(np.argmax(np.abs(change[r])))]
+    raise FloatingPointError(f"{hm.mount_names[mi]}.{axis} at {hm.rpm[r]:g} rpm: the "
+                             f"amplitude fixed point did not converge in {MAX_ITERATIONS} "
+                             f"iterations (change {np.max(err):.1e})")
 
 
-def predict(hm: HarmonicModel, scenario: dict, *, tol=1e-6, max_iter=60,
-            warm_factors=None) -> Prediction:
+def predict(hm: HarmonicModel, scenario: dict, *, tol=TOLERANCE,
+            warm_amplitudes=None) -> Prediction:
     """Channel velocities with the effects of ``scenario`` on the cached model.
 
     Parameters
@@ -100,12 +132,12 @@ def predict(hm: HarmonicModel, scenario: dict, *, tol=1e-6, max_iter=60,
     hm : HarmonicModel
     scenario : dict
         ``{effect name: {parameter: value}}`` (SI); missing parameters take their defaults.
-    tol, max_iter
-        Convergence of amplitude-dependent factors.
-    warm_factors : ndarray (n_r, n_net), optional
-        Start of the amplitude fixed point (a nearby scenario's converged ``factors``: a
-        fit's finite-difference steps then converge in one or two iterations instead of
-        ten to twenty); the result agrees with a cold start to ``tol``.
+    tol : float
+        Convergence of the nonlinear elements' amplitudes (relative).
+    warm_amplitudes : ndarray (n_r, n_net), optional
+        Start of the amplitude fixed point (a nearby scenario's converged ``amplitudes``: a
+        fit's finite-difference steps then converge in a few iterations instead of ten to
+        twenty); the result agrees with a cold start to ``tol``.
     """
     sc = _filled(hm, scenario)
     s_el = None
@@ -113,19 +145,21 @@ def predict(hm: HarmonicModel, scenario: dict, *, tol=1e-6, max_iter=60,
         s = eff.elastomer_scale(hm, p)
         if s is not None:
             s_el = s if s_el is None else s_el * s
-    abc = hm.two_ports() if s_el is None else hm.two_ports_scaled(s_el[None, None, :])
     load = hm.load
     for eff, p in sc.values():
         d = eff.load_delta(hm, p)
         if d is not None:
             load = load + d
-    iterations, g = 0, None
-    amp = _amplitude_effect(hm, sc)
-    if amp is not None:
-        s0 = np.ones(len(hm.networks)) if s_el is None else s_el
-        abc, iterations, g = _iterate(hm, sc, s0, load, amp, tol, max_iter, warm_factors)
-    abc = _two_ports(sc, hm, abc)
-    v = hm.velocity(hm.solve(abc[0], load, abc=abc, body=_body(hm, sc)))
+    body = _body(hm, sc)
+    els = _elements(hm, sc, s_el)
+    if els is not None:
+        _, q, A, iterations = amplitude_iteration(hm, sc, els, load, body, tol=tol,
+                                                  start=warm_amplitudes)
+    else:
+        abc = hm.two_ports() if s_el is None else hm.two_ports_scaled(s_el[None, None, :])
+        abc = _two_ports(sc, hm, abc)
+        q, A, iterations = hm.solve(abc[0], load, abc=abc, body=body), None, 0
+    v = hm.velocity(q)
     for eff, p in sc.values():
         v = eff.reading(v, p)
-    return Prediction(v, iterations, g)
+    return Prediction(v, iterations, A, els)

@@ -156,11 +156,20 @@ class MountElement:
         """Equivalent-linear two-port ``(a, b, c)`` at the Laplace variable ``s`` and the
         relative-displacement amplitude [m] (and the internal motions when ``internal``, see
         :func:`powertrain.physics.mount_network.laplace_two_port`; a port law moves no
-        internal node)."""
-        res = laplace_two_port(s, *self.network(amplitude), internal=internal)
+        internal node). ``amplitude`` may be an array that broadcasts to ``s`` (one
+        amplitude per speed of a run-up, :mod:`powertrain.solvers.fast_harmonic`)."""
+        lam = np.asarray(s, complex)
+        if np.ndim(amplitude) == 0:
+            res = laplace_two_port(lam, *self.network(amplitude), internal=internal)
+        else:
+            amplitude = np.broadcast_to(np.asarray(amplitude, float), lam.shape)
+            ks, ds = ((1.0, 1.0) if self.amplitude_law is None
+                      else self.amplitude_law.scales(amplitude))
+            res = laplace_two_port(lam, *self.model.network(), self.static_factor * ks,
+                                   self.static_factor * ds, internal=internal)
         if self.port_law is None:
             return res
-        k = np.where(np.asarray(s) == 0, 0.0, self.port_law.describing_stiffness(amplitude))
+        k = np.where(lam == 0, 0.0, self.port_law.describing_stiffness(amplitude))
         return (res[0] + k, res[1] - k, res[2] + k) + res[3:]
 
 

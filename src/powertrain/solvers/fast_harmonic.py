@@ -91,6 +91,8 @@ class HarmonicModel:
     channel_matrix : ndarray (n_ch, 6)
         Rigid-body coordinates to mount-point motion in engine X/Y/Z.
     networks : list of (mount index, axis name, MountModel)
+    elements : list of MountElement
+        One per network; nonlinear ones act through :meth:`two_ports_at`.
     """
 
     def __init__(self, engine, rpm, n_angle=N_ANGLE):
@@ -113,6 +115,9 @@ class HarmonicModel:
             cm.append(point_motion_matrix(r))
         self.rows = np.array(rows)
         self.networks = nets
+        #: each network's mount element (:class:`~powertrain.physics.mount_elements.MountElement`:
+        #: its amplitude law and port law with it)
+        self.elements = [mod.element() for _, _, mod in nets]
         self.channel_matrix = np.vstack(cm)
         self.channels = [(m.name, a) for m in engine.mounts for a in DIRECTIONS]
         self.mount_names = [m.name for m in engine.mounts]
@@ -208,6 +213,22 @@ class HarmonicModel:
                 abc[j][..., k] = res[j]
         return tuple(abc)
 
+    def two_ports_at(self, amplitudes, elements=None):
+        r"""``(a, b, c)`` of every network's element at its relative-displacement amplitude,
+        each (n_r, 17, n_net): :meth:`MountElement.two_port
+        <powertrain.physics.mount_elements.MountElement.two_port>` at :math:`s = i\omega`
+        with one amplitude per speed, ``amplitudes`` (n_r, n_net) [m]; ``elements``
+        default :attr:`elements` (the amplitude law scales springs and dampers, the port
+        law adds its describing function)."""
+        els = self.elements if elements is None else elements
+        A = np.asarray(amplitudes, float)
+        abc = [np.empty(self.omega.shape + (len(els),), complex) for _ in range(3)]
+        for k, el in enumerate(els):
+            res = el.two_port(1j * self.omega, A[:, k:k + 1])
+            for j in range(3):
+                abc[j][..., k] = res[j]
+        return tuple(abc)
+
     # ------------------------------------------------------------------ solves
     def solve(self, kip, load=None, harmonics=slice(1, N_HARMONICS), abc=None,
               body=None) -> np.ndarray:
@@ -242,6 +263,18 @@ class HarmonicModel:
         r"""Engine-side peak displacement of each network :math:`a_n =
         \sqrt{\sum_h |\mathbf r_n\cdot\hat{\mathbf q}_h|^2}` [m] (= √2 × RMS sum), (n_r, n_net)."""
         x = np.einsum("ni,rhi->rhn", self.rows, q[..., :6])
+        return np.sqrt(np.sum(np.abs(x) ** 2, axis=1))
+
+    def relative_amplitude(self, q) -> np.ndarray:
+        r"""Amplitude of the relative displacement across each network (engine-side point
+        minus base, along its direction), :math:`A_n = \sqrt{\sum_h |\mathbf r_n\cdot
+        \hat{\mathbf q}_h - \mathbf s_n\cdot\hat{\boldsymbol\eta}_h|^2}` [m] over
+        :meth:`solve`'s harmonics (√2 × RMS, as
+        :func:`powertrain.solvers.equivalent_linear.amplitudes_of`), (n_r, n_net); the base
+        term only with a modal body."""
+        x = np.einsum("ni,rhi->rhn", self.rows, q[..., :6])
+        if self.body is not None:
+            x = x - np.einsum("nk,rhk->rhn", self.body_shapes, q[..., 6:])
         return np.sqrt(np.sum(np.abs(x) ** 2, axis=1))
 
     def __getstate__(self):

@@ -18,9 +18,34 @@ from dataclasses import dataclass
 import numpy as np
 
 from powertrain.errors import InputError
+from powertrain.physics.mount_laws import BergFriction, PowerLaw, StaticCurve
 
 #: Mount or direction name that matches every mount or direction.
 WILDCARD = "*"
+
+#: What-if keys of a mount direction's laws (the mount file's ``[amplitude]``,
+#: ``[friction]`` and ``[static]`` sections): ``"section.key"`` -> (dimension of the value,
+#: its unit family in the mount file's ``[units]``, ``x`` or ``F``
+#: (:data:`powertrain.iotools.mount_file.SECTION_UNITS`; None: no unit), ``--scale``
+#: allowed, ``--set`` allowed). ``amplitude.limits`` is set as ``LO,HI``; ``static.force``
+#: scales every force of the curve.
+LAW_KEYS = {
+    "amplitude.reference": ("length", "x", True, True),
+    "amplitude.exponent": (None, None, True, True),
+    "amplitude.limits": (None, None, False, True),
+    "friction.max_force": ("force", "F", True, True),
+    "friction.half_displacement": ("length", "x", True, True),
+    "static.force": ("force", "F", True, False),
+    "static.reference_deflection": ("length", "x", False, True),
+}
+#: The law a ``--set`` creates in a direction without the section: one that leaves the mount
+#: linear until the set key changes it (amplitude: power law at 0.1 mm, exponent 0, limits
+#: [0.2, 5]; friction: max_force 0 N, half_displacement 0.05 mm). A static curve is never
+#: invented: ``static.*`` needs the section.
+LAW_DEFAULTS = {"amplitude": PowerLaw(1e-4, 0.0, (0.2, 5.0)),
+                "friction": BergFriction(0.0, 5e-5)}
+_LAW_FIELDS = {"amplitude": ("amplitude_law", PowerLaw), "friction": ("port_law", BergFriction),
+               "static": ("static_curve", StaticCurve)}
 
 
 @dataclass(frozen=True)
@@ -54,7 +79,7 @@ class Scale:
     ----------
     mount, direction : str
         Names or ``*``.
-    kind : {"stiffness", "damping", "dynamic"}
+    kind : {"stiffness", "damping", "dynamic"} or a scalable key of :data:`LAW_KEYS`
     factor : float
         > 0 [1].
     """
@@ -67,6 +92,11 @@ class Scale:
     origin: Origin = Origin("--scale")
 
     def apply(self, engine):
+        if self.kind in LAW_KEYS:
+            f = self.factor
+            return _map_laws(engine, self, self.kind, lambda v: tuple(f * x for x in v)
+                             if isinstance(v, tuple) else f * v)
+
         def change(model):
             if self.kind == "stiffness":
                 return model.scaled(stiffness=self.factor)
@@ -85,9 +115,12 @@ class SetParameter:
     mount, direction : str
         Names or ``*``.
     parameter : str
-        ``c2``, ``d4``, ``m1``...
-    value : float
-        SI value: [N/m], [N·s/m] or [kg].
+        ``c2``, ``d4``, ``m1``... or a settable key of :data:`LAW_KEYS`
+        (``friction.max_force``); a direction without that section gets
+        :data:`LAW_DEFAULTS`' law first.
+    value : float or tuple
+        SI value: [N/m], [N·s/m], [kg], [m], [N], [1]; ``(lo, hi)`` for
+        ``amplitude.limits``.
     """
 
     mount: str
@@ -98,6 +131,9 @@ class SetParameter:
     origin: Origin = Origin("--set")
 
     def apply(self, engine):
+        if self.parameter in LAW_KEYS:
+            return _map_laws(engine, self, self.parameter, lambda v: self.value, create=True)
+
         def change(model):
             if self.parameter not in model.topology.parameters:
                 raise self.origin.error(
@@ -199,6 +235,9 @@ class Target:
         Band [Hz], 0 < f_lo < f_hi.
     blend_octaves : float
         Width of the smooth transition outside the band [octaves] (default 0.5).
+    amplitude : float or None
+        Relative-displacement amplitude [m] at which the change is asked (the direction's
+        K_CP with its amplitude law and friction there); None: the network as it is.
     """
 
     mount: str
@@ -209,6 +248,7 @@ class Target:
     blend_octaves: float = 0.5
     spec: str = ""
     origin: Origin = Origin("--target")
+    amplitude: float | None = None
 
     def apply(self, engine):
         raise TypeError("a Target must be resolved by powertrain.workflows.retune.resolve_targets first")
@@ -313,6 +353,45 @@ def _map_directions(engine, mount, direction, change, origin):
                for d, model in m.directions.items()}
         return dataclasses.replace(m, directions=new)
     return _map_mounts(engine, mount, per_mount, origin)
+
+
+def law_changed(model, key, change, create=False):
+    """``model`` (MountModel) with the law value ``key`` (of :data:`LAW_KEYS`) replaced by
+    ``change(old value)``; ``create``: a missing section starts from :data:`LAW_DEFAULTS`.
+    Raises ``LookupError`` (one line) when the direction has no such law."""
+    section, name = key.split(".")
+    field, kind = _LAW_FIELDS[section]
+    law = getattr(model, field)
+    if law is None and create:
+        law = LAW_DEFAULTS.get(section)
+    if law is None:
+        raise LookupError(f"the mount direction has no [{section}] section"
+                          + (" (--set creates [amplitude] and [friction] only)" if create
+                             else " (--set creates one)" if section in LAW_DEFAULTS else ""))
+    if not isinstance(law, kind):
+        raise LookupError(f"its [{section}] law is a {type(law).__name__}, which has no "
+                          f"{name}")
+    new = dataclasses.replace(law, **{name: change(getattr(law, name))})
+    return dataclasses.replace(model, **{field: new})
+
+
+def _map_laws(engine, op, key, change, create=False):
+    """``engine`` with ``law_changed`` on the directions ``op`` names. A named direction
+    without the law is an error; a wildcard skips such directions but must match one."""
+    done, missing = [], []
+
+    def one(model):
+        try:
+            new = law_changed(model, key, change, create)
+        except LookupError as exc:
+            missing.append(str(exc))
+            return model
+        done.append(new)
+        return new
+    new = _map_directions(engine, op.mount, op.direction, one, op.origin)
+    if missing and (not done or WILDCARD not in (op.mount, op.direction)):
+        raise op.origin.error(f"{op.spec!r}: {missing[0]}")
+    return new
 
 
 def apply_operations(engine, operations):

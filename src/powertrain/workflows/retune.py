@@ -51,6 +51,17 @@ on the mount: K_IP 80 times the baseline's at 33 Hz, and the left mount's veloci
    baseline parameters (its zero parameters kept zero: same network); the lower joint cost
    wins.
 
+At an amplitude
+---------------
+``--target left.z:+20%:100-300Hz:0.3mm`` asks the change of the mount direction's K_CP at
+a relative-displacement amplitude (x units, mm by default) for a direction with an
+amplitude law or friction (an error otherwise): :math:`K_0` is then the equivalent-linear
+K_CP at that amplitude -- the network with its law's factors there plus the friction's
+describing stiffness (:func:`network_at`) -- the network at that amplitude is fitted to
+:math:`K_t` less the friction, and the fitted springs and dampers are divided by the law's
+factors, so that the retuned mount, law and friction unchanged, meets the request at that
+amplitude. Its reported curves are at that amplitude.
+
 Frequencies: 0 Hz plus :data:`N_FREQUENCIES` log-spaced from 1 Hz to
 :math:`\max(1000\,\mathrm{Hz},\ 2^{h+1} f_2)` (the run-up's orders reach 8 × 6000/60 = 800 Hz).
 Fit quality reported (:class:`TargetFit`): the relative RMS errors of :math:`K_{CP}` and
@@ -61,6 +72,7 @@ inside the band against the requested one.
 
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass
 
 import numpy as np
@@ -151,16 +163,43 @@ def target_curve(model, target: Target, frequency_hz) -> np.ndarray:
     Parameters
     ----------
     model : MountModel
-        Baseline model of the mount direction.
+        Baseline model of the mount direction (its network; at an amplitude see
+        :func:`retune`).
     target : Target
     frequency_hz : array_like
         [Hz]
     """
+    return model.cross_point_stiffness(frequency_hz) * _gain(target, frequency_hz)
+
+
+def _gain(target: Target, frequency_hz) -> np.ndarray:
+    r""":math:`g\,e^{i\varphi}` of the module docstring at ``frequency_hz`` [Hz]."""
     f = np.asarray(frequency_hz, float)
     a = np.log(target.factor)
     lng = a * band_weight(f, target.f_lo, target.f_hi, target.blend_octaves)
-    phi = bode_phase(f, a, target.f_lo, target.f_hi, target.blend_octaves)
-    return model.cross_point_stiffness(f) * np.exp(lng + 1j * phi)
+    return np.exp(lng + 1j * bode_phase(f, a, target.f_lo, target.f_hi, target.blend_octaves))
+
+
+def network_at(model, target: Target, frequency_hz):
+    """What a target retunes: ``(network, friction [N/m] per frequency, (ks, ds))``.
+
+    Without an amplitude: ``model`` itself, no friction term, factors 1. At an amplitude A:
+    the network with its amplitude law's factors ``(ks, ds)`` at A and the friction's
+    describing stiffness at A beside it (zero at 0 Hz: it carries no static force), the
+    equivalent-linear element of :meth:`MountElement.two_port
+    <powertrain.physics.mount_elements.MountElement.two_port>`."""
+    f = np.asarray(frequency_hz, float)
+    if target.amplitude is None:
+        return model, np.zeros(f.shape), (1.0, 1.0)
+    el = model.element()
+    if not el.nonlinear:
+        raise target.origin.error(f"{target.spec!r}: {target.mount}.{target.direction} has "
+                                  "no amplitude law or friction: its K_CP does not depend "
+                                  "on the amplitude")
+    ks, ds = el.scales(target.amplitude)
+    law = el.port_law
+    k = 0.0 if law is None else complex(law.describing_stiffness(target.amplitude))
+    return model.scaled(ks, ds), np.where(f == 0, 0.0, k), (ks, ds)
 
 
 def fit_frequencies(target: Target) -> np.ndarray:
@@ -233,6 +272,7 @@ class TargetFit:
                 "max_band_error_pct": 100 * self.max_band_error,
                 "achieved_mean_band_change_pct": 100 * self.mean_band_change,
                 "refinement_start": self.start,
+                "amplitude_mm": None if t.amplitude is None else 1e3 * t.amplitude,
                 "fitted_params_si": dict(self.model.params)}
 
     def summary(self) -> str:
@@ -292,7 +332,13 @@ REFINE_NFEV = 3000
 
 
 def retune(model, target: Target, **fit_kwargs) -> TargetFit:
-    """Retune ``model`` (same topology) to the requested curve of ``target``.
+    """Retune ``model`` (same topology, its laws kept) to the requested curve of ``target``.
+
+    At ``target.amplitude`` the curve is the mount's K_CP there (:func:`network_at`: the
+    network at its amplitude law's factors plus the friction's describing stiffness); the
+    network at that amplitude is fitted to it less the friction, and divided by the law's
+    factors back to the reference amplitude, so that the retuned mount meets the request at
+    the amplitude asked (the law and the friction unchanged).
 
     Parameters
     ----------
@@ -305,27 +351,34 @@ def retune(model, target: Target, **fit_kwargs) -> TargetFit:
     Returns
     -------
     TargetFit
+        Its curves at the target's amplitude (with the friction).
     """
     from powertrain.models.mount import MountModel
     from powertrain.workflows.fitting import fit_mount
     f = fit_frequencies(target)
-    k0 = model.cross_point_stiffness(f)
-    kt = target_curve(model, target, f)
-    kip_t = model.input_point_stiffness(f) + (kt - k0)
-    fit = fit_mount(f, kt, model.topology, **fit_kwargs)
+    net, k_fr, (ks, ds) = network_at(model, target, f)
+    k0 = net.cross_point_stiffness(f) + k_fr
+    kt = k0 * _gain(target, f)
+    kip_t = net.input_point_stiffness(f) + k_fr + (kt - k0)
+    fit = fit_mount(f, kt - k_fr, net.topology, **fit_kwargs)
     candidates = []
-    for label, p0 in (("baseline", model.values), ("fit_mount", fit.model.values)):
-        p, cost = _refine(model.topology, p0, p0 > 0, f, kt, kip_t)
+    for label, p0 in (("baseline", net.values), ("fit_mount", fit.model.values)):
+        p, cost = _refine(net.topology, p0, p0 > 0, f, kt - k_fr, kip_t - k_fr)
         candidates.append((cost, label, p))
     cost, start, p = min(candidates, key=lambda c: c[0])
-    fitted = MountModel.from_values(
-        model.topology, p, name=f"{model.name or model.topology.description} retuned "
-                                f"{target.spec}",
+    at = MountModel.from_values(net.topology, p)
+    fitted = dataclasses.replace(
+        model, params=at.scaled(1.0 / ks, 1.0 / ds).params,
+        name=f"{model.name or model.topology.description} retuned {target.spec}",
         source=f"powertrain whatif --target {target.spec}",
         notes=f"retuned from the baseline: K_CP changed by {target.spec} (Bode phase), "
               "K_IP by the same amount; joint K_CP/K_IP least squares")
-    kf = fitted.cross_point_stiffness(f)
-    kip_f = fitted.input_point_stiffness(f)
+    return _target_fit(target, model, fitted, f, k0, kt, kip_t,
+                       at.cross_point_stiffness(f) + k_fr, at.input_point_stiffness(f) + k_fr,
+                       start, fit.summary())
+
+
+def _target_fit(target, model, fitted, f, k0, kt, kip_t, kf, kip_f, start, summary):
     band = (f >= target.f_lo) & (f <= target.f_hi)
     return TargetFit(target=target, baseline=model, model=fitted, frequency_hz=f,
                      kcp_baseline=k0, kcp_target=kt, kcp_fitted=kf, kip_target=kip_t,
@@ -334,7 +387,7 @@ def retune(model, target: Target, **fit_kwargs) -> TargetFit:
                      max_band_error=float(np.max(np.abs(kf[band] - kt[band])
                                                  / np.abs(kt[band]))),
                      mean_band_change=float(np.mean(np.abs(kf[band]) / np.abs(k0[band])) - 1),
-                     start=start, fit_summary=fit.summary())
+                     start=start, fit_summary=summary)
 
 
 def retuned_swap(engine, target: Target, **fit_kwargs):

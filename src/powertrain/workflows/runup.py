@@ -269,31 +269,22 @@ def runup_with_effects(engine, rpm, scenario: dict, **options):
     value}}``, SI) through :func:`run_runup` (``**options``: its keyword arguments);
     ``settings["effects"]`` records the scenario.
 
-    * engine-model effects change the engine (``Effect.apply``), in registry order;
-    * amplitude-dependent effects: the factors :math:`g(a_n)` of the equivalent linearisation
-      are converged at each speed on the frequency-domain model
-      (:func:`powertrain.effects.predict`); then each speed step runs with every network's
-      springs and dampers scaled by its factor at that speed (``meta["amplitude_factors"]``);
+    * engine-model effects change the engine (``Effect.apply``), in registry order
+      (``amplitude_stiffness`` sets every mount's amplitude law, which the harmonic solver's
+      fixed point solves);
+    * with the Newmark solver, amplitude laws are frozen per speed at the harmonic fixed
+      point (:func:`frozen_amplitude_runup`);
     * sensor effects: the channels' displacement, velocity and acceleration are read through
       the effect (the transmitted forces are not sensor readings and stay as they are).
     """
-    from powertrain.effects import EFFECTS, check_scenario, predict, with_network_elastomer
-    from powertrain.solvers.fast_harmonic import HarmonicModel
+    from powertrain.effects import EFFECTS, check_scenario
     sc = check_scenario(scenario, engine)
     rpm = np.atleast_1d(np.asarray(rpm, float))
     for name, eff in EFFECTS.items():
         if name in sc and eff.engine_change:
             engine = eff.apply(engine, **sc[name])
-    amp = {n: p for n, p in sc.items()
-           if EFFECTS[n].amplitude_factors(np.ones((1, 1)), p) is not None}
-    if amp:
-        g = predict(HarmonicModel(engine, rpm), amp).factors
-        parts = [run_runup(with_network_elastomer(engine, g[i]), [r], **options)
-                 for i, r in enumerate(rpm)]
-        result = _concatenate(parts)
-        result.rigid_body_modes_hz = run_runup(engine, rpm[:1], solver="harmonic"
-                                               ).rigid_body_modes_hz
-        result.meta["amplitude_factors"] = g.tolist()
+    if options.get("solver", "newmark") == "newmark" and _amplitude_dependent(engine):
+        result = frozen_amplitude_runup(engine, rpm, **options)
     else:
         result = run_runup(engine, rpm, **options)
     for name, p in sc.items():
@@ -301,6 +292,35 @@ def runup_with_effects(engine, rpm, scenario: dict, **options):
             for attr in ("displacement", "velocity", "acceleration"):
                 setattr(result, attr, EFFECTS[name].reading(getattr(result, attr), p))
     result.settings["effects"] = sc
+    return result
+
+
+def _amplitude_dependent(engine) -> bool:
+    return any(mod.amplitude_law is not None and not mod.amplitude_law.constant
+               for m in engine.mounts for mod in m.directions.values())
+
+
+def frozen_amplitude_runup(engine, rpm, **options):
+    """Run-up whose mount amplitude laws are frozen per speed: the amplitudes of the
+    harmonic fixed point (:func:`powertrain.effects.predict`), then each speed step with
+    every network's springs and dampers scaled by its law there and the law removed (port
+    laws kept); ``meta["amplitude_factors"]`` (n_rpm, n_net) the stiffness factors."""
+    import dataclasses
+
+    from powertrain.effects import map_networks, predict
+    from powertrain.solvers.fast_harmonic import HarmonicModel
+    hm = HarmonicModel(engine, rpm)
+    pred = predict(hm, {})
+    ks = np.array([[el.scales(a) for el, a in zip(hm.elements, amps)]
+                   for amps in pred.amplitudes])                 # (n_rpm, n_net, 2)
+
+    def frozen(i):
+        f = iter(ks[i])
+        return map_networks(engine, lambda mi, m, ax, mod: dataclasses.replace(
+            mod.scaled(*next(f)), amplitude_law=None))
+    parts = [run_runup(frozen(i), [r], **options) for i, r in enumerate(rpm)]
+    result = _concatenate(parts)                  # rigid-body modes: the first speed's
+    result.meta["amplitude_factors"] = ks[..., 0].tolist()
     return result
 
 

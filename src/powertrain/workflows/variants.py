@@ -21,12 +21,17 @@ mount, ``x``, ``y``, ``z`` or ``*``; the default engine's mounts are ``left``, `
 ``--scale MOUNT.DIR.KIND=FACTOR``          ``KIND``: ``stiffness`` (every spring c_i of the
                                            network times FACTOR), ``damping`` (every damper
                                            d_i), ``dynamic`` (every c_i, d_i and m_i: the
-                                           whole K_CP(ω) times FACTOR, exactly); FACTOR > 0
+                                           whole K_CP(ω) times FACTOR, exactly), or a law
+                                           key ``SECTION.KEY`` of :data:`LAW_KEYS`
+                                           (``amplitude.exponent``; its section must
+                                           exist); FACTOR > 0
 ``--set MOUNT.DIR.PARAM=VALUE[UNIT]``      one network parameter in its datasheet unit
                                            (c in N/mm, d in N·s/mm, m in kg, the table
                                            :data:`powertrain.iotools.mount_file.DATASHEET_UNITS`)
                                            or in an explicit unit of :mod:`powertrain.units`
-                                           (``150N/mm``, ``1.5e5 N/m``); VALUE >= 0
+                                           (``150N/mm``, ``1.5e5 N/m``); VALUE >= 0; or a
+                                           law key (x in mm, F in N, ``LAW_KEYS``; a
+                                           missing section: ``LAW_DEFAULTS``)
 ``--swap MOUNT.DIR=FILE.toml``             replace one direction's model by a mount file
 ``--move MOUNT=DX,DY,DZ``                  shift the mount point [mm], engine axes
 ``--rotate MOUNT=AX,AY,AZ``                rotate the mount's local axes about the engine
@@ -34,7 +39,8 @@ mount, ``x``, ``y``, ``z`` or ``*``; the default engine's mounts are ``left``, `
                                            about X, then AY about Y, then AZ about Z (fixed
                                            axes), :math:`R' = R_z R_y R_x R`
 ``--target MOUNT.DIR:CHANGE:BAND[:WIDTH]`` retune to a desired K_CP change, see
-                                           :mod:`powertrain.workflows.retune`
+``[:AMPLITUDE]``                           :mod:`powertrain.workflows.retune` (at an
+                                           amplitude ``0.3mm``: the laws' K_CP there)
 ``--effect NAME[:PARAM=VALUE[UNIT],...]``  add an unmodelled effect of
                                            :data:`powertrain.effects.EFFECTS` (e.g.
                                            ``mount_stiffness:k1=1.5``,
@@ -69,6 +75,7 @@ from pathlib import Path
 
 from powertrain.errors import InputError
 from powertrain.workflows.operations import (  # noqa: F401 (re-export: the operations' home)
+    LAW_KEYS,
     WILDCARD,
     AddEffect,
     Move,
@@ -133,15 +140,32 @@ def _vector3(s, text, origin):
     return tuple(_float(p.strip(), text, origin) for p in parts)
 
 
-def parse_scale(text: str, origin: Origin = Origin("--scale")) -> Scale:
-    """``MOUNT.DIR.KIND=FACTOR`` -> :class:`Scale` (KIND stiffness|damping|dynamic)."""
-    form = "MOUNT.DIR.KIND=FACTOR, e.g. left.z.stiffness=1.2"
-    left, right = _split(text, origin, form)
-    mount, direction, kind = _path_parts(left, 3, text, origin, form)
+def _law_key(left, text, origin, form, column):
+    """``(mount, direction, key)`` of ``MOUNT.DIR.SECTION.KEY``, the key one that
+    :data:`LAW_KEYS` allows in ``column`` (2: --scale, 3: --set)."""
+    mount, direction, section, name = _path_parts(left, 4, text, origin, form)
     _direction(direction, text, origin)
-    if kind not in SCALE_KINDS:
-        raise origin.error(f"{text!r}: unknown kind {kind!r} (expected "
-                           f"{', '.join(SCALE_KINDS)})")
+    key = f"{section}.{name}"
+    allowed = [k for k, v in LAW_KEYS.items() if v[column]]
+    if key not in allowed:
+        raise origin.error(f"{text!r}: unknown key {key!r} (expected {', '.join(allowed)})")
+    return mount, direction, key
+
+
+def parse_scale(text: str, origin: Origin = Origin("--scale")) -> Scale:
+    """``MOUNT.DIR.KIND=FACTOR`` -> :class:`Scale` (KIND stiffness|damping|dynamic, or a
+    law key ``SECTION.KEY`` of :data:`LAW_KEYS`: ``left.z.amplitude.exponent=0.5``)."""
+    form = "MOUNT.DIR.KIND=FACTOR, e.g. left.z.stiffness=1.2 or left.z.amplitude.exponent=0.5"
+    left, right = _split(text, origin, form)
+    if left.count(".") == 3:
+        mount, direction, kind = _law_key(left, text, origin, form, 2)
+    else:
+        mount, direction, kind = _path_parts(left, 3, text, origin, form)
+        _direction(direction, text, origin)
+        if kind not in SCALE_KINDS:
+            raise origin.error(f"{text!r}: unknown kind {kind!r} (expected "
+                               f"{', '.join(SCALE_KINDS)}, or a law key such as "
+                               "amplitude.exponent)")
     factor = _float(right, text, origin, "a factor")
     if factor <= 0:
         raise origin.error(f"{text!r}: factor must be positive, got {factor:g}")
@@ -155,8 +179,12 @@ def parse_set(text: str, origin: Origin = Origin("--set")) -> SetParameter:
     """
     from powertrain.iotools.mount_file import DATASHEET_UNITS
     from powertrain.units import UNITS, to_si
-    form = "MOUNT.DIR.PARAM=VALUE, e.g. right.y.c2=150 (N/mm)"
+    form = "MOUNT.DIR.PARAM=VALUE, e.g. right.y.c2=150 (N/mm) or left.z.friction.max_force=20"
     left, right = _split(text, origin, form)
+    if left.count(".") == 3:
+        mount, direction, key = _law_key(left, text, origin, form, 3)
+        return SetParameter(mount, direction, key, _law_value(key, right, text, origin),
+                            spec=text, origin=origin)
     mount, direction, param = _path_parts(left, 3, text, origin, form)
     _direction(direction, text, origin)
     if not re.match(r"^[cdm][0-9]+$", param):
@@ -177,6 +205,38 @@ def parse_set(text: str, origin: Origin = Origin("--set")) -> SetParameter:
     except InputError as exc:
         raise origin.error(f"{text!r}: {exc.message}") from None
     return SetParameter(mount, direction, param, si, spec=text, origin=origin)
+
+
+def _law_value(key, right, text, origin):
+    """SI value of a law key's ``--set`` (:data:`LAW_KEYS`: its datasheet unit, or an
+    explicit one of the same dimension; ``LO,HI`` for ``amplitude.limits``), checked as the
+    mount file checks it."""
+    from powertrain.iotools.mount_file import SECTION_UNITS
+    from powertrain.units import UNITS, to_si
+    dimension, family = LAW_KEYS[key][:2]
+    if key == "amplitude.limits":
+        parts = right.split(",")
+        lo, hi = (_float(p.strip(), text, origin) for p in parts) if len(parts) == 2 else \
+            (math.nan, math.nan)
+        if not 0 < lo <= 1 <= hi:
+            raise origin.error(f"{text!r}: expected LO,HI with 0 < LO <= 1 <= HI")
+        return (lo, hi)
+    m = re.match(r"^([-+0-9.eE]+)\s*(.*)$", right)
+    if not m:
+        raise origin.error(f"{text!r}: {right!r} is not a number")
+    value, unit = _float(m.group(1), text, origin), m.group(2).strip()
+    unit = unit or (SECTION_UNITS[family] if family else "1")
+    if dimension is None:
+        if unit != "1":
+            raise origin.error(f"{text!r}: {key} has no unit, got {unit!r}")
+        return value
+    if unit not in UNITS or UNITS[unit][0] != dimension:
+        raise origin.error(f"{text!r}: unit {unit!r} is unknown or not a unit of {dimension}")
+    si = float(to_si(value, unit, dimension))
+    if key != "static.reference_deflection" and (si < 0 or si == 0 and "max" not in key):
+        raise origin.error(f"{text!r}: the value must be {'>= 0' if 'max' in key else '> 0'}"
+                           f", got {value:g}")
+    return si
 
 
 def parse_swap(text: str, origin: Origin = Origin("--swap"), base: Path | None = None) -> Swap:
@@ -216,14 +276,16 @@ def parse_rotate(text: str, origin: Origin = Origin("--rotate")) -> Rotate:
 
 
 def parse_target(text: str, origin: Origin = Origin("--target")) -> Target:
-    """``MOUNT.DIR:CHANGE:BAND[:WIDTH]`` -> :class:`Target`.
+    """``MOUNT.DIR:CHANGE:BAND[:WIDTH][:AMPLITUDE]`` -> :class:`Target`.
 
     CHANGE: ``+20%``, ``-15%`` or a factor ``*1.2``; BAND: ``100-300Hz`` (``Hz`` optional);
-    WIDTH: transition outside the band, ``0.5oct`` (default half an octave).
+    WIDTH: transition outside the band, ``0.5oct`` (default half an octave); AMPLITUDE:
+    the relative-displacement amplitude the change is asked at, with a length unit
+    (``0.3mm``, ``50um``), for a direction with an amplitude law or friction.
     """
-    form = "MOUNT.DIR:CHANGE:BAND, e.g. left.z:+20%:100-300Hz"
+    form = "MOUNT.DIR:CHANGE:BAND[:WIDTH][:AMPLITUDE], e.g. left.z:+20%:100-300Hz:0.3mm"
     parts = [p.strip() for p in text.split(":")] if isinstance(text, str) else []
-    if len(parts) not in (3, 4):
+    if len(parts) not in (3, 4, 5):
         raise origin.error(f"cannot read {text!r} (expected {form})")
     mount, direction = _path_parts(parts[0], 2, text, origin, form, wildcard=False)
     _direction(direction, text, origin)
@@ -247,16 +309,20 @@ def parse_target(text: str, origin: Origin = Origin("--target")) -> Target:
     f_hi = _float(m_band.group(2), text, origin)
     if not 0 < f_lo < f_hi:
         raise origin.error(f"{text!r}: band must satisfy 0 < low < high [Hz]")
-    width = 0.5
-    if len(parts) == 4:
-        m_w = re.match(r"^([0-9.eE+]+)\s*oct$", parts[3])
-        if not m_w:
-            raise origin.error(f"{text!r}: cannot read width {parts[3]!r} (expected e.g. "
+    width, amplitude = 0.5, None
+    for k, extra in enumerate(parts[3:]):
+        m_w = re.match(r"^([0-9.eE+]+)\s*oct$", extra)
+        if m_w and k == 0:
+            width = _float(m_w.group(1), text, origin)
+            if width <= 0:
+                raise origin.error(f"{text!r}: width must be positive")
+        elif k == len(parts) - 4:        # the last part: an amplitude, x units (mm)
+            amplitude = _law_value("amplitude.reference", extra, text, origin)
+        else:
+            raise origin.error(f"{text!r}: cannot read width {extra!r} (expected e.g. "
                                "0.5oct)")
-        width = _float(m_w.group(1), text, origin)
-        if width <= 0:
-            raise origin.error(f"{text!r}: width must be positive")
-    return Target(mount, direction, factor, f_lo, f_hi, width, spec=text, origin=origin)
+    return Target(mount, direction, factor, f_lo, f_hi, width, spec=text, origin=origin,
+                  amplitude=amplitude)
 
 
 def parse_effect(text: str, origin: Origin = Origin("--effect"), engine=None) -> AddEffect:
