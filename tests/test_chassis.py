@@ -144,8 +144,9 @@ def test_csv_and_hdf5_carry_both_sides(tmp_path, runups):
     newm.to_csv(tmp_path / "r.csv")
     newm.to_hdf5(tmp_path / "r.h5")
     lines = (tmp_path / "r.csv").read_text().splitlines()
-    assert lines[0] == ("mount,direction,quantity,rpm,side,velocity_rms_mm_per_s,"
-                        "acceleration_rms_m_per_s2,force_rms_n")
+    # the columns, in order (columns may be added after them, e.g. phase_deg)
+    assert lines[0].startswith("mount,direction,quantity,rpm,side,velocity_rms_mm_per_s,"
+                               "acceleration_rms_m_per_s2,force_rms_n")
     passive = [ln for ln in lines if ",passive," in ln]
     assert any(ln.startswith("left,z,order_2,") for ln in passive)
     assert any(ln.startswith("seat_rail,z,") and ln.endswith(",") for ln in passive)

@@ -36,6 +36,8 @@ tests/test_diagnose.py).
 
 from __future__ import annotations
 
+import dataclasses
+
 import numpy as np
 
 from powertrain.analysis.fourier import harmonic_amplitudes
@@ -49,11 +51,20 @@ from powertrain.solvers.body_coupling import (
     body_channels,
     coupled_solve,
 )
+from powertrain.solvers.operating_point import has_static_curves, static_factors
 
 #: Harmonics of the engine cycle solved: h = 1..16 are orders 0.5..8.
 N_HARMONICS = 17
 #: Samples per engine cycle for the load harmonics (1° like the run-up default).
 N_ANGLE = 720
+
+
+def static_factor_table(engine, rpm):
+    """Static factors (n_r, n_net) of every network at each speed's operating point, or
+    None when no mount direction has a static curve."""
+    if not has_static_curves(engine):
+        return None
+    return np.array([static_factors(engine, r) for r in np.atleast_1d(rpm)])
 
 
 def shaft_load(engine, shaft, rpm, theta):
@@ -118,6 +129,9 @@ class HarmonicModel:
         #: each network's mount element (:class:`~powertrain.physics.mount_elements.MountElement`:
         #: its amplitude law and port law with it)
         self.elements = [mod.element() for _, _, mod in nets]
+        #: every network's static factor per speed (n_r, n_net) at the operating point of
+        #: the static curves (:mod:`powertrain.solvers.operating_point`); None without any
+        self.static_scale = static_factor_table(engine, self.rpm)
         self.channel_matrix = np.vstack(cm)
         self.channels = [(m.name, a) for m in engine.mounts for a in DIRECTIONS]
         self.mount_names = [m.name for m in engine.mounts]
@@ -187,7 +201,7 @@ class HarmonicModel:
         mods = [n[2] for n in self.networks] if models is None else models
         abc = [np.empty(self.omega.shape + (len(mods),), complex) for _ in range(3)]
         for k, mod in enumerate(mods):
-            res = two_port(self.omega, *mod.network())
+            res = two_port(self.omega, *mod.network(), self._static(k))
             for j in range(3):
                 abc[j][..., k] = res[j]
         if models is None:
@@ -208,7 +222,7 @@ class HarmonicModel:
         sc = np.broadcast_to(np.asarray(scale, float), self.omega.shape + (n_net,))
         abc = [np.empty(self.omega.shape + (n_net,), complex) for _ in range(3)]
         for k, (_, _, mod) in enumerate(self.networks):
-            res = two_port(self.omega, *mod.network(), spring_scale=sc[..., k])
+            res = two_port(self.omega, *mod.network(), spring_scale=sc[..., k] * self._static(k))
             for j in range(3):
                 abc[j][..., k] = res[j]
         return tuple(abc)
@@ -221,6 +235,9 @@ class HarmonicModel:
         default :attr:`elements` (the amplitude law scales springs and dampers, the port
         law adds its describing function)."""
         els = self.elements if elements is None else elements
+        if self.static_scale is not None:
+            els = [dataclasses.replace(el, static_factor=self._static(k))
+                   for k, el in enumerate(els)]
         A = np.asarray(amplitudes, float)
         abc = [np.empty(self.omega.shape + (len(els),), complex) for _ in range(3)]
         for k, el in enumerate(els):
@@ -228,6 +245,10 @@ class HarmonicModel:
             for j in range(3):
                 abc[j][..., k] = res[j]
         return tuple(abc)
+
+    def _static(self, k):
+        """Network ``k``'s static factor per speed, shape (n_r, 1) (1.0 without curves)."""
+        return 1.0 if self.static_scale is None else self.static_scale[:, k:k + 1]
 
     # ------------------------------------------------------------------ solves
     def solve(self, kip, load=None, harmonics=slice(1, N_HARMONICS), abc=None,
@@ -294,5 +315,7 @@ class HarmonicModel:
         new.omega = self.omega[index]
         new._load = None if self._load is None else self._load[index]
         new._abc = None if self._abc is None else tuple(x[index] for x in self._abc)
+        if self.static_scale is not None:
+            new.static_scale = self.static_scale[index]
         new._extra = {k: v[:, index] for k, v in self._extra.items()}
         return new

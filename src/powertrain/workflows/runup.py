@@ -270,10 +270,8 @@ def runup_with_effects(engine, rpm, scenario: dict, **options):
     ``settings["effects"]`` records the scenario.
 
     * engine-model effects change the engine (``Effect.apply``), in registry order
-      (``amplitude_stiffness`` sets every mount's amplitude law, which the harmonic solver's
-      fixed point solves);
-    * with the Newmark solver, amplitude laws are frozen per speed at the harmonic fixed
-      point (:func:`frozen_amplitude_runup`);
+      (``amplitude_stiffness`` sets every mount's amplitude law, which either solver
+      carries: the harmonic fixed point, or the Newmark stepper once per engine cycle);
     * sensor effects: the channels' displacement, velocity and acceleration are read through
       the effect (the transmitted forces are not sensor readings and stay as they are).
     """
@@ -283,62 +281,13 @@ def runup_with_effects(engine, rpm, scenario: dict, **options):
     for name, eff in EFFECTS.items():
         if name in sc and eff.engine_change:
             engine = eff.apply(engine, **sc[name])
-    if options.get("solver", "newmark") == "newmark" and _amplitude_dependent(engine):
-        result = frozen_amplitude_runup(engine, rpm, **options)
-    else:
-        result = run_runup(engine, rpm, **options)
+    result = run_runup(engine, rpm, **options)
     for name, p in sc.items():
         if EFFECTS[name].response_only:
             for attr in ("displacement", "velocity", "acceleration"):
                 setattr(result, attr, EFFECTS[name].reading(getattr(result, attr), p))
     result.settings["effects"] = sc
     return result
-
-
-def _amplitude_dependent(engine) -> bool:
-    return any(mod.amplitude_law is not None and not mod.amplitude_law.constant
-               for m in engine.mounts for mod in m.directions.values())
-
-
-def frozen_amplitude_runup(engine, rpm, **options):
-    """Run-up whose mount amplitude laws are frozen per speed: the amplitudes of the
-    harmonic fixed point (:func:`powertrain.effects.predict`), then each speed step with
-    every network's springs and dampers scaled by its law there and the law removed (port
-    laws kept); ``meta["amplitude_factors"]`` (n_rpm, n_net) the stiffness factors."""
-    import dataclasses
-
-    from powertrain.effects import map_networks, predict
-    from powertrain.solvers.fast_harmonic import HarmonicModel
-    hm = HarmonicModel(engine, rpm)
-    pred = predict(hm, {})
-    ks = np.array([[el.scales(a) for el, a in zip(hm.elements, amps)]
-                   for amps in pred.amplitudes])                 # (n_rpm, n_net, 2)
-
-    def frozen(i):
-        f = iter(ks[i])
-        return map_networks(engine, lambda mi, m, ax, mod: dataclasses.replace(
-            mod.scaled(*next(f)), amplitude_law=None))
-    parts = [run_runup(frozen(i), [r], **options) for i, r in enumerate(rpm)]
-    result = _concatenate(parts)                  # rigid-body modes: the first speed's
-    result.meta["amplitude_factors"] = ks[..., 0].tolist()
-    return result
-
-
-def _concatenate(parts):
-    """One RunupResult from single-speed results (same channels and orders)."""
-    import dataclasses
-    first = parts[0]
-    out = dataclasses.replace(first)
-    for attr in ("rpm", "displacement", "velocity", "acceleration", "mount_force",
-                 "mean_mount_force", "periodicity"):
-        setattr(out, attr, np.concatenate([getattr(p, attr) for p in parts], axis=0))
-    out.solver_seconds = float(sum(p.solver_seconds for p in parts))
-    if first.operating_point is not None:
-        out.operating_point = dataclasses.replace(first.operating_point, points=[
-            op for p in parts for op in p.operating_point.points])
-    out.settings = dict(first.settings)
-    out.meta = dict(first.meta)
-    return out
 
 
 # --------------------------------------------------------------------------- public entry
