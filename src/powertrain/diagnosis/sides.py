@@ -167,6 +167,22 @@ def side_attribution(gap, data, sigma_db=None) -> dict | None:
             "band_hz": _band(gap, data, cols) if (where == "body" and cols) else None}
 
 
+def with_measured_body_side(engine, measured):
+    """``engine`` as the diagnosis models it: a rigid chassis whose body side is measured
+    (channels ``NAME/passive`` of its mounts) is a modal body without modes — the body side
+    predicted still, so that a missing body mode can give it motion
+    (:func:`powertrain.effects.missing_body_mode.body_side_engine`); else unchanged."""
+    from powertrain.effects.missing_body_mode import body_side_engine
+    ch = getattr(engine, "chassis", None)
+    if ch is not None and not ch.is_rigid:
+        return engine
+    names = {m.name for m in engine.mounts}
+    sides = {split_side(m) for m, _, _ in measured.curves}
+    if any(side == "passive" and base in names for base, side in sides):
+        return body_side_engine(engine)
+    return engine
+
+
 def side_text(s) -> str:
     """One phrase for the where step ('' without body-side channels)."""
     if not s:

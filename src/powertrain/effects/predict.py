@@ -125,7 +125,8 @@ def predict(hm: HarmonicModel, scenario: dict, *, tol=1e-6, max_iter=60,
         s0 = np.ones(len(hm.networks)) if s_el is None else s_el
         abc, iterations, g = _iterate(hm, sc, s0, load, amp, tol, max_iter, warm_factors)
     abc = _two_ports(sc, hm, abc)
-    v = hm.velocity(hm.solve(abc[0], load, abc=abc, body=_body(hm, sc)))
+    body = _body(hm, sc)
+    v = hm.velocity(hm.solve(abc[0], load, abc=abc, body=body), body=body)
     for eff, p in sc.values():
         v = eff.reading(v, p)
     return Prediction(v, iterations, g)
