@@ -17,8 +17,9 @@ unexplained_ok=...``.
 
 With ``--plan passive`` the cases measure both sides of every mount on the modal-body
 engine (:mod:`powertrain.validation.passive`: body modes changed, one mount's stiffness
-changed, effect-free) and a line ``passive: chassis_and_mount_top1=...`` (issue 13's target)
-is printed before the raw scores.
+changed, balancer errors, a body mode the file lacks, effect-free) and the lines
+``passive: chassis_and_mount_top1=...`` (issue 13's target) and ``two-sided:
+sides_right=... missing_mode_found=...`` (issue 21's) are printed before the raw scores.
 
 Usage: ``python scripts/blind_diagnosis.py --cases 50 [--seed S] [--jobs 2]
 [--scheduler local|tcp://HOST:PORT] [--dump rows.json] [--plan default|passive]``.
@@ -87,8 +88,17 @@ def run_case(task):
             "parameters": chosen.get("parameters") if chosen else None,
             "ambiguous": d.get("ambiguous_between", []), "shrink": shrink,
             "where_side": (where.get("sides") or {}).get("location"),
+            "truth_mode": _truth_mode(case),
             "measured_shrink": 1 - after / before if before else 0.0,
             "t_gen": t_gen, "t_diag": t_diag, "cpu_diag": c_diag}
+
+
+def _truth_mode(case):
+    """Frequency and modal mass of a hidden missing body mode (None for other cases)."""
+    for name, p in case.truth:
+        if name == "missing_mode":
+            return {"frequency_hz": p["frequency_hz"], "modal_mass_kg": p["modal_mass"]}
+    return None
 
 
 def _print_truth(tasks):
@@ -189,6 +199,7 @@ def main(argv=None):
         passive_where_line,
         score,
         score_line,
+        two_sided_line,
     )
     seed = args.seed if args.seed is not None else int.from_bytes(os.urandom(4), "little")
     print(f"seed {seed}{'' if args.seed is not None else ' (drawn from os.urandom)'}"
@@ -229,6 +240,7 @@ def main(argv=None):
     if args.plan == "passive":
         print(passive_where_line(rows))
         print(passive_line(rows))
+        print(two_sided_line(rows))
     print("raw: " + score_line(sc["raw"]))
     print(score_line(sc))
 
