@@ -21,8 +21,12 @@ changed, balancer errors, a body mode the file lacks, effect-free) and the lines
 ``passive: chassis_and_mount_top1=...`` (issue 13's target) and ``two-sided:
 sides_right=... missing_mode_found=...`` (issue 21's) are printed before the raw scores.
 
+With ``--plan passive --where-only`` only the diagnosis' "where" step runs (no fits, a few
+seconds a case) and the line ``sides_right=...`` gives issue 21's side-attribution rate.
+
 Usage: ``python scripts/blind_diagnosis.py --cases 50 [--seed S] [--jobs 2]
-[--scheduler local|tcp://HOST:PORT] [--dump rows.json] [--plan default|passive]``.
+[--scheduler local|tcp://HOST:PORT] [--dump rows.json] [--plan default|passive]
+[--where-only]``.
 Without ``--seed`` the seed is drawn from ``os.urandom`` and printed.
 """
 
@@ -55,6 +59,21 @@ def _make(i, names, eng, seed):
         return make_passive_case(i, names, eng, seed), passive_engines()[eng]
     from powertrain.validation.cases import engines, make_case
     return make_case(i, names, eng, seed), engines()[eng]
+
+
+def where_case(task):
+    """Make one two-sided case and run only the diagnosis' "where" step (side attribution);
+    its row for :func:`powertrain.validation.scoring.sides_rate`."""
+    from powertrain.diagnosis.sides import measured_sides
+    from powertrain.validation.cases import FLOOR
+    i, names, eng, seed = task
+    case, engine = _make(i, names, eng, seed)
+    t0, c0 = time.perf_counter(), time.process_time()
+    side = measured_sides(case.measured, engine, FLOOR)["location"]
+    return {"i": i, "names": names, "engine": eng, "seed": seed, "category": case.category,
+            "detectable": case.detectable, "where_side": side, "claimed": [],
+            "verdict": side, "t_diag": time.perf_counter() - t0,
+            "cpu_diag": time.process_time() - c0}
 
 
 def run_case(task):
@@ -110,8 +129,9 @@ def _print_truth(tasks):
               f"{c.stats[1]:>5.1f} {c.noise_db:>4.2f} {det:>3}  {'+'.join(c.expected_set)}")
 
 
-def _run_all(tasks, jobs, scheduler):
-    """Rows of all tasks in order; one line per finished case on stderr."""
+def _run_all(tasks, jobs, scheduler, fn=None):
+    """Rows of all tasks in order (``fn``: :func:`run_case`); one line per finished case on
+    stderr."""
     import sys
     from contextlib import contextmanager
     try:
@@ -125,7 +145,7 @@ def _run_all(tasks, jobs, scheduler):
                 yield ex
     rows = []
     with executor(scheduler, workers=jobs, n_jobs=len(tasks)) as ex:
-        futures = [ex.submit(run_case, t) for t in tasks]
+        futures = [ex.submit(fn or run_case, t) for t in tasks]
         for f in futures:
             r = f.result()
             print(f"case {r['i']}: {'+'.join(r['names']) or 'none'} -> {_answer(r)} "
@@ -175,6 +195,20 @@ def _print_misses(rows):
               + (f"; misses: {dict(miss)}" if miss else ""))
 
 
+def _where_only(tasks, args):
+    """The side attribution of every case (``--where-only``): per kind, then the rate."""
+    from powertrain.validation.scoring import PASSIVE_WHERE, sides_rate
+    rows = _run_all(tasks, args.jobs, args.scheduler, where_case)
+    for kind, loc in PASSIVE_WHERE.items():
+        sel = [r for r in rows if r["detectable"] and r["names"] == [kind]]
+        got = Counter(r["where_side"] for r in sel)
+        print(f"  {kind:<18} expected {loc!r}: {dict(got)}")
+    print(f"sides_right={sides_rate(rows)} (where step only, detectable single cases)")
+    if args.dump:
+        with open(args.dump, "w") as fh:
+            json.dump(rows, fh, indent=1)
+
+
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--cases", type=int, default=50)
@@ -189,6 +223,9 @@ def main(argv=None):
     ap.add_argument("--plan", choices=("default", "passive"), default="default",
                     help="'passive': cases with both sides of every mount measured on the "
                          "modal-body engine (powertrain.validation.passive)")
+    ap.add_argument("--where-only", action="store_true",
+                    help="with --plan passive: only the 'where' step (side attribution) of "
+                         "every case, no fits; prints the sides_right line")
     args = ap.parse_args(argv)
     from powertrain.validation.cases import DETECT_LOCAL_DB, DETECT_RMS_DB, case_plan
     from powertrain.validation.passive import passive_plan
@@ -209,6 +246,9 @@ def main(argv=None):
              enumerate(plan(args.cases, seed))]
     if args.generate_only:
         _print_truth(tasks)
+        return
+    if args.where_only:
+        _where_only(tasks, args)
         return
     t0 = time.perf_counter()
     rows = _run_all(tasks, args.jobs, args.scheduler)

@@ -17,6 +17,7 @@ from powertrain.diagnosis import diagnose, gap_data
 from powertrain.diagnosis.sides import (
     BODY_MIN_DB,
     BODY_RATIO,
+    MOUNT_ENGINE_DB,
     MOUNT_RATIO,
     side_attribution,
     side_text,
@@ -81,14 +82,17 @@ def _data_and_gap(active_db, passive_db, n_off=3):
 
 
 @pytest.mark.parametrize("active, passive, n_off, where", [
-    (0.2, 3.0, 3, "body"),                         # ratio 15 >= BODY_RATIO, every base
-    (0.5, 3.0, 3, "mounts"),                       # ratio 6: mounts
+    (0.2, 3.0, 3, "body"),                         # ratio 15, no mount's engine side off
+    (0.5, 3.0, 3, "body"),                         # ratio 6, engine side below MOUNT_ENGINE_DB
+    (1.2 * MOUNT_ENGINE_DB, 3.0, 3, "mounts"),     # a mount's own engine side off
+    (0.8 * MOUNT_ENGINE_DB, 3.0, 3, "body"),
     (0.1, 3.0, 1, "body"),                         # one base only: local, not shared
-    (0.05, 0.8 * BODY_MIN_DB, 3, "mounts"),        # ratio 16 but below BODY_MIN_DB
+    (0.2, 0.8 * BODY_MIN_DB, 3, "mounts"),         # ratio 4 but below BODY_MIN_DB
+    (0.05, 0.8 * BODY_MIN_DB, 3, "body"),          # ... unless the ratio reaches BODY_RATIO
     (1.0, 1.0, 3, "engine side or excitation"),    # both sides alike: ratio 1
     (1.0, 0.8 * MOUNT_RATIO, 3, "engine side or excitation"),
     (1.0, 1.2 * MOUNT_RATIO, 3, "mounts"),
-    (1.0, 1.2 * BODY_RATIO, 3, "body"),
+    (1.0, 1.2 * BODY_RATIO, 3, "mounts"),          # ratio > 10, but a mount's engine side off
     (0.0, 0.0, 3, "none"),                         # nothing beyond the noise
 ])
 def test_side_attribution_both_sides_of_each_threshold(active, passive, n_off, where):

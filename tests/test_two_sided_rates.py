@@ -45,23 +45,15 @@ def _detectable(kind, eng, rng, i):
 
 
 def _side_row(task):
-    from powertrain.diagnosis.data import gap_data, model_levels, residuals_db
-    from powertrain.diagnosis.sides import side_attribution
-    from powertrain.effects import predict
-    from powertrain.solvers.fast_harmonic import HarmonicModel
+    from powertrain.diagnosis.sides import measured_sides
     from powertrain.validation.passive import passive_engines
     i, seed = task
     kind = list(PASSIVE_WHERE)[i % len(PASSIVE_WHERE)]
     eng = ("body_sz", "body_traces")[(i // len(PASSIVE_WHERE)) % 2]
     case = _detectable(kind, eng, np.random.default_rng([seed, i]), i)
-    engine = passive_engines()[eng]
-    d = gap_data(case.measured, engine, FLOOR)
-    hm = HarmonicModel(engine, d.rpm)
-    hm.use_channels(d.channels)
-    g = residuals_db(model_levels(predict(hm, {}).velocity, d), d.level, d.floor)
-    s = side_attribution(np.where(d.censored, np.nan, g), d)
-    return {"kind": kind, "seed": case.seed, "where": s["location"],
-            "right": s["location"] == PASSIVE_WHERE[kind]}
+    where = measured_sides(case.measured, passive_engines()[eng], FLOOR)["location"]
+    return {"kind": kind, "seed": case.seed, "where": where,
+            "right": where == PASSIVE_WHERE[kind]}
 
 
 @pytest.mark.slow

@@ -22,13 +22,21 @@ from the **ratio of the body-side to the engine-side excess**,
 * a changed or missing **body** mode reaches the engine side only through the bases'
   motion (0.06-0.3 dB for several dB on the body side): R ≥ 15, unbounded.
 
-So: **body** when :math:`E_p` ≥ :data:`BODY_MIN_DB` and R ≥ :data:`BODY_RATIO`; **mounts**
-when R ≥ :data:`MOUNT_RATIO` (and :math:`E_p` resolved); **engine side or excitation** when
-either side's excess is resolved and R is smaller; **none** when neither is. A body-side
-gap is *shared* by several bases when the excess at :data:`MIN_SHARED_MOUNTS` or more
-mount bases reaches :data:`MOUNT_OFF_DB` and its resolution (its band: the frequencies where
-the body-side gap is largest). The isolation change :math:`\Delta L_a - \Delta L_p` is
-reported (its excess, with :math:`\sigma_a^2 + \sigma_p^2`).
+A ratio of several times does not yet tell body from mounts: with the noise left, the
+engine-side excess of a mount change often stays below its resolution, as a body change's
+does. What tells them apart is the engine side of **one mount**: a changed mount moves its
+own engine-side channels (0.7-1.5 dB in development draws of the two-sided plan), a body
+change moves none of them by more than about 0.55 dB. So: **engine side or excitation**
+when either side's excess is resolved and R < :data:`MOUNT_RATIO`; with R ≥
+:data:`MOUNT_RATIO` (body side resolved), **mounts** when the largest engine-side excess of
+one mount, A, reaches :data:`MOUNT_ENGINE_DB` (and its resolution), **body** when it does
+not and :math:`E_p` ≥ :data:`BODY_MIN_DB`, or whenever R ≥ :data:`BODY_RATIO` with A below
+:data:`MOUNT_ENGINE_DB`; **mounts** otherwise; **none** when neither side is resolved. A
+body-side gap is *shared* by several bases when the excess at :data:`MIN_SHARED_MOUNTS` or
+more mount bases reaches :data:`MOUNT_OFF_DB` and its resolution (its band: the
+frequencies where the body-side gap is largest). The isolation change
+:math:`\Delta L_a - \Delta L_p` is reported (its excess, with :math:`\sigma_a^2 +
+\sigma_p^2`).
 """
 
 from __future__ import annotations
@@ -43,6 +51,10 @@ BODY_RATIO = 10.0
 #: Mounts when the ratio is at least this [1]: the geometric middle between excitation
 #: changes (≤ 0.91) and mount changes (≥ 3.1).
 MOUNT_RATIO = 1.7
+#: A mount's own engine-side excess that points at the mounts [dB]: between the largest
+#: of body changes (about 0.55) and the smallest of one-mount stiffness changes (about 0.7)
+#: in development draws of the two-sided plan.
+MOUNT_ENGINE_DB = 0.65
 #: ... and the body side carries at least this much [dB] for a body answer (twice the
 #: 0.5 dB by which a model may miss).
 BODY_MIN_DB = 1.0
@@ -106,18 +118,25 @@ def _band(gap, data, cols, n_bins=24):
     return [float(edges[lo]), float(edges[hi + 1])]
 
 
-def _location(ea, da, ep, dp):
-    """The side from the two excesses and their resolutions (module docstring)."""
+def _location(ea, da, ep, dp, a_mount):
+    """The side from the two excesses, their resolutions and the largest resolved
+    engine-side excess of one mount ``a_mount`` (module docstring)."""
     a_on = np.isfinite(ea) and ea > da
     p_on = np.isfinite(ep) and ep > dp
     if not (a_on or p_on):
         return "none", 0.0
     ratio = (ep if p_on else 0.0) / max(ea if a_on else 0.0, da)
-    if p_on and ep >= BODY_MIN_DB and ratio >= BODY_RATIO:
+    if not (p_on and ratio >= MOUNT_RATIO):
+        return "engine side or excitation", ratio
+    if a_mount < MOUNT_ENGINE_DB and (ep >= BODY_MIN_DB or ratio >= BODY_RATIO):
         return "body", ratio
-    if p_on and ratio >= MOUNT_RATIO:
-        return "mounts", ratio
-    return "engine side or excitation", ratio
+    return "mounts", ratio
+
+
+def _per_mount(gap, sig, cols_of, om):
+    """``{mount: (excess, resolution)}`` of each mount's channels ``cols_of[mount]``."""
+    return {m: excess(gap[:, cols][:, :, om], sig[:, cols][:, :, om])
+            for m, cols in cols_of.items()}
 
 
 def side_attribution(gap, data, sigma_db=None) -> dict | None:
@@ -148,23 +167,38 @@ def side_attribution(gap, data, sigma_db=None) -> dict | None:
     ea, da = excess(ga, sa)
     ep, dp = excess(gp, sp)
     iso, _ = excess(ga - gp, np.sqrt(sa ** 2 + sp ** 2))
-    where, ratio = _location(ea, da, ep, dp)
-    per_mount = {}
-    for (_, p, base) in pairs:
-        per_mount.setdefault(base, []).append(p)
-    off = []
-    for m, cols in per_mount.items():
-        e, d = excess(gap[:, cols][:, :, om], sig[:, cols][:, :, om])
-        if np.isfinite(e) and e >= MOUNT_OFF_DB and e > d:
-            off.append(m)
-    cols = [p for m in off for p in per_mount[m]]
+    body_cols, engine_cols = {}, {}
+    for (a, p, base) in pairs:
+        body_cols.setdefault(base, []).append(p)
+        engine_cols.setdefault(base, []).append(a)
+    engine = _per_mount(gap, sig, engine_cols, om)
+    a_mount = max([e for e, d in engine.values() if np.isfinite(e) and e > d], default=0.0)
+    where, ratio = _location(ea, da, ep, dp, a_mount)
+    off = [m for m, (e, d) in _per_mount(gap, sig, body_cols, om).items()
+           if np.isfinite(e) and e >= MOUNT_OFF_DB and e > d]
+    cols = [p for m in off for p in body_cols[m]]
     return {"location": where, "engine_side_rms_db": ea, "body_side_rms_db": ep,
             "isolation_change_rms_db": iso, "body_to_engine_ratio": ratio,
             "engine_side_resolution_db": da, "body_side_resolution_db": dp,
+            "largest_mount_engine_side_db": a_mount,
             "mounts_off_body_side": off, "shared": len(off) >= MIN_SHARED_MOUNTS,
             "noise_sigma_db": float(np.nanmedian(sig)) if np.isfinite(sig).any() else
             float("nan"),
             "band_hz": _band(gap, data, cols) if (where == "body" and cols) else None}
+
+
+def measured_sides(measured, engine, noise_floor) -> dict | None:
+    """The side attribution of a measured run-up alone: the diagnosis' "where" step on the
+    gap against the model without effects, no fit (cheap; the validation's side rate)."""
+    from powertrain.diagnosis.data import gap_data, model_levels, residuals_db
+    from powertrain.effects import predict
+    from powertrain.solvers.fast_harmonic import HarmonicModel
+    engine = with_measured_body_side(engine, measured)
+    d = gap_data(measured, engine, noise_floor)
+    hm = HarmonicModel(engine, d.rpm)
+    hm.use_channels(d.channels)
+    g = residuals_db(model_levels(predict(hm, {}).velocity, d), d.level, d.floor)
+    return side_attribution(np.where(d.censored, np.nan, g), d)
 
 
 def with_measured_body_side(engine, measured):

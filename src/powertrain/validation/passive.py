@@ -92,3 +92,4 @@ def make_passive_case(index, names, engine_kind, seed) -> Case:
     engine = passive_engines()[engine_kind]
     return draw_case(index, names, engine_kind, seed, engine, baseline_velocity(engine_kind),
                      truth_velocity, channels(engine), "blind passive case")
+
