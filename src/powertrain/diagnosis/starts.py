@@ -50,7 +50,8 @@ def start_points(problem, pack, effects, starts, grid, fun):
 
 def _data_starts(problem, pack, effect, fun, lo, hi):
     """The :data:`DATA_KEPT` cheapest of the effect's starts read from the training gaps
-    against the model without it (``Effect.data_starts``); every evaluation charged."""
+    against the model without it (``Effect.data_starts``), the signs of its ``signed``
+    parameters then chosen (:func:`_signs`); every evaluation charged."""
     from powertrain.effects.missing_body_mode import BodyGaps
     d = problem.data
     fun.evaluate(problem, pack.x0)
@@ -61,7 +62,28 @@ def _data_starts(problem, pack, effect, fun, lo, hi):
     pts = [np.clip(np.array([np.log(st[n]) if lg else st[n] for (_, n), lg in
                              zip(pack.names, pack.log)]), lo, hi) for st in starts]
     costs = [np.sum(fun(p) ** 2) for p in pts]
-    return [pts[i] for i in np.argsort(costs)[:DATA_KEPT]]
+    kept = [pts[i] for i in np.argsort(costs)[:DATA_KEPT]]
+    signed = [pack.names.index((effect, n)) for n in EFFECTS[effect].signed(problem.engine)]
+    return [_signs(fun, x, signed) for x in kept] if signed else kept
+
+
+def _signs(fun, x, signed, passes=2):
+    """Signs of the ``signed`` parameters of a start (magnitudes read from the data carry
+    none): each flipped in turn, largest first, and kept when it lowers the cost."""
+    best = float(np.sum(fun(x) ** 2))
+    for _ in range(passes):
+        changed = False
+        for i in sorted(signed, key=lambda i: -abs(x[i])):
+            if x[i] == 0:
+                continue
+            y = x.copy()
+            y[i] = -y[i]
+            c = float(np.sum(fun(y) ** 2))
+            if c < best:
+                x, best, changed = y, c, True
+        if not changed:
+            break
+    return x
 
 
 def _block_start(fun, pack, effect):

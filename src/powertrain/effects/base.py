@@ -91,6 +91,11 @@ class Effect:
         the effect), screened with the grid's starts; none by default."""
         return []
 
+    def signed(self, engine=None) -> list:
+        """Parameters whose sign the data's magnitudes leave open at a data start (a mode's
+        shape): the fit's starts try both (:mod:`powertrain.diagnosis.starts`)."""
+        return []
+
     def applicable(self, engine) -> bool:
         """Whether the effect can act on ``engine``."""
         return True

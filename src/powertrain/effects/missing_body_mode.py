@@ -104,6 +104,9 @@ class MissingBodyMode(Effect):
                 for n in shape_names(engine)]
         return tuple(out)
 
+    def signed(self, engine=None) -> list:
+        return shape_names(engine)
+
     def applicable(self, engine) -> bool:
         from powertrain.solvers.body_coupling import ModalBody
         return ModalBody.of(engine) is not None
