@@ -26,8 +26,9 @@ DATA_KEPT = 2
 
 
 def start_points(problem, pack, effects, starts, grid, fun):
-    """Start vectors of a fit: the defaults, the given ``starts``, the two best points of
-    the effect's coarse start grid and the block-wise multi-start's optimum."""
+    """Start vectors of a fit: the starts read from the data (first), the defaults, the
+    given ``starts``, the two best points of the effect's coarse start grid and the
+    block-wise multi-start's optimum."""
     span = pack.upper - pack.lower
     lo, hi = pack.lower + 1e-9 * span, pack.upper - 1e-9 * span
     cands = [np.clip(pack.x0, lo, hi)] + [np.clip(s, lo, hi) for s in starts or []]
@@ -41,7 +42,8 @@ def start_points(problem, pack, effects, starts, grid, fun):
         costs = [np.sum(fun(p) ** 2) for p in pts]
         cands += [np.clip(pts[i], lo, hi) for i in np.argsort(costs)[:2]]
     if grid and len(effects) == 1:
-        cands += _data_starts(problem, pack, effects[0], fun, lo, hi)
+        # read from the data: fitted first (a default that is "no effect" starts nowhere)
+        cands = _data_starts(problem, pack, effects[0], fun, lo, hi) + cands
         xb = _block_start(fun, pack, effects[0])
         if xb is not None:
             cands.append(np.clip(xb, lo, hi))
