@@ -17,12 +17,17 @@ unexplained_ok=...``.
 
 With ``--plan passive`` the cases measure both sides of every mount on the modal-body
 engine (:mod:`powertrain.validation.passive`: body modes changed, one mount's stiffness
-changed, effect-free) and a line ``passive: chassis_and_mount_top1=...`` (issue 13's target)
-is printed before the raw scores.
+changed, balancer errors, a body mode the file lacks, effect-free) and the lines
+``passive: chassis_and_mount_top1=...`` (issue 13's target) and ``two-sided:
+sides_right=... missing_mode_found=...`` (issue 21's) are printed before the raw scores.
+
+With ``--plan passive --where-only`` only the diagnosis' "where" step runs (no fits, a few
+seconds a case) and the line ``sides_right=...`` gives issue 21's side-attribution rate.
 
 Usage: ``python scripts/blind_diagnosis.py --cases 50 [--seed S] [--jobs 2]
 [--scheduler local|tcp://HOST:PORT] [--dump rows.json] [--plan default|passive]
-[--kind KIND]`` (``--kind amplitude_elastomer``: every case of that truth kind).
+[--kind KIND] [--where-only]`` (``--kind amplitude_elastomer``: every case of that truth
+kind; ``--where-only``: the side attribution only).
 Without ``--seed`` the seed is drawn from ``os.urandom`` and printed.
 """
 
@@ -57,6 +62,21 @@ def _make(i, names, eng, seed):
     return make_case(i, names, eng, seed), engines()[eng]
 
 
+def where_case(task):
+    """Make one two-sided case and run only the diagnosis' "where" step (side attribution);
+    its row for :func:`powertrain.validation.scoring.sides_rate`."""
+    from powertrain.diagnosis.sides import measured_sides
+    from powertrain.validation.cases import FLOOR
+    i, names, eng, seed = task
+    case, engine = _make(i, names, eng, seed)
+    t0, c0 = time.perf_counter(), time.process_time()
+    side = measured_sides(case.measured, engine, FLOOR)["location"]
+    return {"i": i, "names": names, "engine": eng, "seed": seed, "category": case.category,
+            "detectable": case.detectable, "where_side": side, "claimed": [],
+            "verdict": side, "t_diag": time.perf_counter() - t0,
+            "cpu_diag": time.process_time() - c0}
+
+
 def run_case(task):
     """Make one case, diagnose it, return its row (plain JSON types)."""
     from powertrain.diagnosis import diagnose
@@ -88,8 +108,17 @@ def run_case(task):
             "parameters": chosen.get("parameters") if chosen else None,
             "ambiguous": d.get("ambiguous_between", []), "shrink": shrink,
             "where_side": (where.get("sides") or {}).get("location"),
+            "truth_mode": _truth_mode(case),
             "measured_shrink": 1 - after / before if before else 0.0,
             "t_gen": t_gen, "t_diag": t_diag, "cpu_diag": c_diag}
+
+
+def _truth_mode(case):
+    """Frequency and modal mass of a hidden missing body mode (None for other cases)."""
+    for name, p in case.truth:
+        if name == "missing_mode":
+            return {"frequency_hz": p["frequency_hz"], "modal_mass_kg": p["modal_mass"]}
+    return None
 
 
 def _print_truth(tasks):
@@ -101,8 +130,9 @@ def _print_truth(tasks):
               f"{c.stats[1]:>5.1f} {c.noise_db:>4.2f} {det:>3}  {'+'.join(c.expected_set)}")
 
 
-def _run_all(tasks, jobs, scheduler):
-    """Rows of all tasks in order; one line per finished case on stderr."""
+def _run_all(tasks, jobs, scheduler, fn=None):
+    """Rows of all tasks in order (``fn``: :func:`run_case`); one line per finished case on
+    stderr."""
     import sys
     from contextlib import contextmanager
     try:
@@ -116,7 +146,7 @@ def _run_all(tasks, jobs, scheduler):
                 yield ex
     rows = []
     with executor(scheduler, workers=jobs, n_jobs=len(tasks)) as ex:
-        futures = [ex.submit(run_case, t) for t in tasks]
+        futures = [ex.submit(fn or run_case, t) for t in tasks]
         for f in futures:
             r = f.result()
             print(f"case {r['i']}: {'+'.join(r['names']) or 'none'} -> {_answer(r)} "
@@ -166,6 +196,20 @@ def _print_misses(rows):
               + (f"; misses: {dict(miss)}" if miss else ""))
 
 
+def _where_only(tasks, args):
+    """The side attribution of every case (``--where-only``): per kind, then the rate."""
+    from powertrain.validation.scoring import PASSIVE_WHERE, sides_rate
+    rows = _run_all(tasks, args.jobs, args.scheduler, where_case)
+    for kind, loc in PASSIVE_WHERE.items():
+        sel = [r for r in rows if r["detectable"] and r["names"] == [kind]]
+        got = Counter(r["where_side"] for r in sel)
+        print(f"  {kind:<18} expected {loc!r}: {dict(got)}")
+    print(f"sides_right={sides_rate(rows)} (where step only, detectable single cases)")
+    if args.dump:
+        with open(args.dump, "w") as fh:
+            json.dump(rows, fh, indent=1)
+
+
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--cases", type=int, default=50)
@@ -183,6 +227,9 @@ def main(argv=None):
     ap.add_argument("--kind", default=None,
                     help="every case of this one truth kind (e.g. amplitude_elastomer), "
                          "engines alternating single-zone and traces")
+    ap.add_argument("--where-only", action="store_true",
+                    help="with --plan passive: only the 'where' step (side attribution) of "
+                         "every case, no fits; prints the sides_right line")
     args = ap.parse_args(argv)
     from powertrain.validation.cases import DETECT_LOCAL_DB, DETECT_RMS_DB, case_plan
     from powertrain.validation.passive import passive_plan
@@ -193,6 +240,7 @@ def main(argv=None):
         passive_where_line,
         score,
         score_line,
+        two_sided_line,
     )
     seed = args.seed if args.seed is not None else int.from_bytes(os.urandom(4), "little")
     print(f"seed {seed}{'' if args.seed is not None else ' (drawn from os.urandom)'}"
@@ -204,6 +252,9 @@ def main(argv=None):
         tasks = [(i, [args.kind], ("sz", "traces")[i % 2], s) for i, _, _, s in tasks]
     if args.generate_only:
         _print_truth(tasks)
+        return
+    if args.where_only:
+        _where_only(tasks, args)
         return
     t0 = time.perf_counter()
     rows = _run_all(tasks, args.jobs, args.scheduler)
@@ -235,6 +286,7 @@ def main(argv=None):
     if args.plan == "passive":
         print(passive_where_line(rows))
         print(passive_line(rows))
+        print(two_sided_line(rows))
     print("raw: " + score_line(sc["raw"]))
     print(score_line(sc))
 

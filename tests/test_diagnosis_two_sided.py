@@ -16,7 +16,9 @@ import pytest
 from powertrain.diagnosis import diagnose, gap_data
 from powertrain.diagnosis.sides import (
     BODY_MIN_DB,
-    ISO_MIN_DB,
+    BODY_RATIO,
+    MOUNT_ENGINE_DB,
+    MOUNT_RATIO,
     side_attribution,
     side_text,
 )
@@ -80,18 +82,22 @@ def _data_and_gap(active_db, passive_db, n_off=3):
 
 
 @pytest.mark.parametrize("active, passive, n_off, where", [
-    (0.2, 3.0, 3, "body"),                         # body side carries it, at every base
-    (0.5, 3.0, 3, "mounts"),                       # engine side off too: ratio 6 < 10
-    (0.2, 1.5, 3, "body"),                         # ratio 7.5, but engine side < 0.3 dB
+    (0.2, 3.0, 3, "body"),                         # ratio 15, no mount's engine side off
+    (0.5, 3.0, 3, "body"),                         # ratio 6, engine side below MOUNT_ENGINE_DB
+    (1.2 * MOUNT_ENGINE_DB, 3.0, 3, "mounts"),     # a mount's own engine side off
+    (0.8 * MOUNT_ENGINE_DB, 3.0, 3, "body"),
     (0.1, 3.0, 1, "body"),                         # one base only: local, not shared
-    (0.2, 0.8 * BODY_MIN_DB, 3, "engine side or excitation"),   # below BODY_MIN_DB
-    (1.0, 1.0, 3, "engine side or excitation"),    # both sides alike: isolation kept
-    (1.0, 1.0 - 1.2 * ISO_MIN_DB, 3, "mounts"),    # isolation changed, engine side off
-    (1.0, 1.0 - 0.8 * ISO_MIN_DB, 3, "engine side or excitation"),
+    (0.2, 0.8 * BODY_MIN_DB, 3, "mounts"),         # ratio 4 but below BODY_MIN_DB
+    (0.05, 0.8 * BODY_MIN_DB, 3, "body"),          # ... unless the ratio reaches BODY_RATIO
+    (1.0, 1.0, 3, "engine side or excitation"),    # both sides alike: ratio 1
+    (1.0, 0.8 * MOUNT_RATIO, 3, "engine side or excitation"),
+    (1.0, 1.2 * MOUNT_RATIO, 3, "mounts"),
+    (1.0, 1.2 * BODY_RATIO, 3, "mounts"),          # ratio > 10, but a mount's engine side off
+    (0.0, 0.0, 3, "none"),                         # nothing beyond the noise
 ])
 def test_side_attribution_both_sides_of_each_threshold(active, passive, n_off, where):
     d, gap = _data_and_gap(active, passive, n_off)
-    s = side_attribution(gap, d, sigma_db=0.0)
+    s = side_attribution(gap, d, sigma_db=0.01)
     assert s["location"] == where, s
     if where == "body":
         assert s["shared"] == (n_off >= 2)
@@ -99,13 +105,36 @@ def test_side_attribution_both_sides_of_each_threshold(active, passive, n_off, w
 
 
 def test_side_attribution_discounts_the_scatter():
-    """Independent scatter σ on both sides is no isolation change: a gap map of pure noise
-    (σ = 1 dB, fresh draw) is not put in the mounts or the body."""
+    """Independent scatter σ on both sides is no gap: a gap map of pure noise (σ = 1 dB,
+    fresh draw) is put nowhere; read with a scatter too small it looks like an excitation
+    change (both sides alike)."""
     d, _ = _data_and_gap(0.0, 0.0)
     gap = np.random.default_rng().normal(0.0, 1.0, d.level.shape)
     s = side_attribution(gap, d, sigma_db=1.0)
-    assert s["location"] == "engine side or excitation", s
-    assert side_attribution(gap, d, sigma_db=0.0)["location"] == "mounts"
+    assert s["location"] == "none", s
+    assert side_attribution(gap, d, sigma_db=0.1)["location"] == "engine side or excitation"
+
+
+def test_side_attribution_reads_each_point_with_its_own_scatter():
+    """A body side scattering 2 dB (levels near the floor) and an engine side scattering
+    0.3 dB: with one σ of 0.3 dB the body side's noise looks like a body or mount change, with the
+    noise model per point it is noise."""
+    d, _ = _data_and_gap(0.0, 0.0)
+    rng = np.random.default_rng()
+    sig = np.full(d.level.shape, 0.3)
+    sig[:, 9:] = 2.0
+    gap = rng.normal(0.0, 1.0, d.level.shape) * sig
+    assert side_attribution(gap, d, sigma_db=0.3)["location"] in ("body", "mounts")
+    assert side_attribution(gap, d, sigma_db=sig)["location"] == "none"
+
+
+def test_excess_resolution_shrinks_with_points_and_scatter():
+    from powertrain.diagnosis.sides import excess
+    e, d = excess(np.zeros(100), 1.0)
+    e4, d4 = excess(np.zeros(400), 1.0)
+    assert e == 0.0 and d4 == pytest.approx(d / np.sqrt(2.0))
+    assert excess(np.zeros(100), 0.5)[1] == pytest.approx(d / 2.0)
+    assert excess(np.full(100, 2.0), 1.0)[0] == pytest.approx(np.sqrt(3.0))
 
 
 def test_no_body_side_channels_no_side_attribution():
@@ -121,7 +150,7 @@ def test_own_two_sided_runup_is_no_effect(engine, own):
     d = r.to_dict()
     assert d["verdict"] == "no effect", d["verdict_text"]
     assert [list(c) for c in both_sides(engine)] == d["where"]["channels"]
-    assert d["where"]["sides"]["location"] == "engine side or excitation"
+    assert d["where"]["sides"]["location"] == "none"
     assert "chassis_modes" in [o["effect"] for o in d["ranking"]]
 
 

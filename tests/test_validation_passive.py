@@ -20,6 +20,7 @@ from powertrain.validation.passive import (
     baseline_velocity,
     channels,
     make_passive_case,
+    nominal_body,
     passive_engines,
     passive_plan,
     truth_velocity,
@@ -58,17 +59,33 @@ def test_body_change_moves_the_body_side_not_the_engine_side(engine):
 
 
 def test_default_plan_is_unchanged_by_the_passive_kinds():
-    assert "body_modes" not in IN_LIBRARY and set(PASSIVE_KINDS) <= set(KINDS)
+    assert not set(PASSIVE_KINDS) & set(IN_LIBRARY) and set(PASSIVE_KINDS) <= set(KINDS)
     names = {n for names, _, _ in case_plan(50, 7) for n in names}
-    assert "body_modes" not in names
+    assert not set(PASSIVE_KINDS) & names
+
+
+def test_missing_mode_truth_adds_one_mode_to_the_body():
+    """The truth kind draws one more body mode (shape normalised to its largest component)
+    and the truth path's body gets it; the body side moves far more than the engine side."""
+    from powertrain.validation.kinds import KINDS as K
+    e = passive_engines()["body_sz"]
+    p = K["missing_mode"].draw(np.random.default_rng(), e)
+    assert 40 <= p["frequency_hz"] <= 110 and 6 <= p["modal_mass"] <= 30
+    assert np.max(np.abs(p["shape"])) == 1.0
+    parts = {"body": nominal_body(e)}
+    K["missing_mode"].apply(p, parts)
+    assert parts["body"].mode_hz.size == len(e.chassis.modes) + 1
+    assert parts["body"].shapes.shape == (len(e.chassis.modes) + 1, len(e.mounts), 3)
 
 
 def test_passive_plan_counts_and_reproducible():
-    plan = passive_plan(20, 5)
-    assert plan == passive_plan(20, 5) and plan != passive_plan(20, 6)
+    plan = passive_plan(28, 5)
+    assert plan == passive_plan(28, 5) and plan != passive_plan(28, 6)
     kinds = [tuple(n) for n, _, _ in plan]
     assert kinds.count(("body_modes",)) == 8 and kinds.count(("mount_temperature",)) == 8
     assert kinds.count(()) == 4
+    # issue 21: excitation changes and body modes the file lacks, two of each per lap
+    assert kinds.count(("balancer_shafts",)) == 4 and kinds.count(("missing_mode",)) == 4
     assert {e for _, e, _ in plan} == {"body_sz", "body_traces"}
 
 

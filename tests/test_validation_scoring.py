@@ -110,3 +110,28 @@ def test_noise_free_shrink_from_reported_gaps():
     assert s == pytest.approx(0.75, abs=1e-6)
     assert noise_free_shrink({**where, "gap_db_after": None}, rpm, lambda *a: truth,
                              lambda *a: meas, 1e-9) is None
+
+
+def test_two_sided_rates_of_hand_made_rows():
+    """Issue 21: side attribution right per kind, a missing mode found only within 5 % in
+    frequency and 30 % in modal mass, undetectable cases not counted."""
+    from powertrain.validation.scoring import mode_found, sides_rate, two_sided_line
+    truth = {"frequency_hz": 50.0, "modal_mass_kg": 10.0}
+
+    def mode(f, m, claimed=("missing_body_mode",)):
+        return {"names": ["missing_mode"], "detectable": True, "where_side": "body",
+                "claimed": list(claimed), "truth_mode": truth,
+                "parameters": {"missing_body_mode": {"frequency_hz": f, "modal_mass_kg": m}}}
+    assert mode_found(mode(52.4, 12.9)) and not mode_found(mode(52.6, 10.0))
+    assert not mode_found(mode(50.0, 13.1)) and not mode_found(mode(50.0, 10.0, ()))
+    rows = [mode(50.0, 10.0), mode(60.0, 10.0),
+            {"names": ["balancer_shafts"], "detectable": True,
+             "where_side": "engine side or excitation", "claimed": []},
+            {"names": ["mount_temperature"], "detectable": True, "where_side": "body",
+             "claimed": []},
+            {"names": ["body_modes"], "detectable": False, "where_side": "mounts",
+             "claimed": []}]
+    r = sides_rate(rows)
+    assert (r.k, r.n) == (3, 4)
+    assert two_sided_line(rows).startswith("two-sided: sides_right=0.75 (3/4, Wilson ")
+    assert "missing_mode_found=0.50 (1/2," in two_sided_line(rows)

@@ -51,3 +51,20 @@ def below_floor(level, noise_floor):
     v = np.asarray(level, float)
     with np.errstate(invalid="ignore"):
         return (v < noise_floor) | (v <= 0)
+
+
+#: dB per unit relative amplitude error, 20/ln 10 [dB].
+DB_PER_NEPER = float(20.0 / np.log(10.0))
+
+
+def floor_scatter_db(measured, noise_floor):
+    r"""Scatter [dB, 1σ] the noise floor adds to a measured level :math:`m` (RMS).
+
+    Complex Gaussian noise of RMS :math:`f` has a component of RMS :math:`f/\sqrt2` in phase
+    with the signal; to first order it moves the level by
+    :math:`(20/\ln 10)\,f/(\sqrt2\,m)` dB (2.0 dB at the censoring level 3f, 0.6 dB at 10f,
+    0.2 dB at 30f). Infinite where ``measured`` is not positive, NaN where it is NaN."""
+    m = np.asarray(measured, float)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        return np.where(m > 0, DB_PER_NEPER * noise_floor / (np.sqrt(2.0) * m),
+                        np.where(np.isnan(m), np.nan, np.inf))

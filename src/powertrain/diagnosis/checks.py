@@ -7,7 +7,8 @@ the noise a perfect model would leave, and the speed-band confounding check.
   must predict them at the held-out speeds. Physical effects withhold channels (folds
   generated from the mounts, :func:`channel_folds`: one channel of every mount triad each —
   the rigid body carries the effect to a channel it was not fitted on); candidates with
-  sensor errors withhold orders per channel (:func:`order_folds`: each channel's
+  sensor errors or per-channel parameters (``Effect.withhold_orders``: a missing body
+  mode's shape at each base) withhold orders per channel (:func:`order_folds`: each channel's
   *informative* orders, those with measured points of that channel above the noise floor,
   dealt into :data:`ORDER_FOLDS` folds in a staggered pattern, so every refit still sees an
   informative order of every channel: a gain or a triad rotation is the same on every order of its channels, a
@@ -142,7 +143,7 @@ def order_folds(problem: Problem) -> list:
 
 def _folds(problem: Problem, effects):
     n_ch, n_o = problem.valid["test"].shape[1:]
-    if any(EFFECTS[e].response_only for e in effects):
+    if any(EFFECTS[e].response_only or EFFECTS[e].withhold_orders for e in effects):
         return "orders", order_folds(problem)
     folds = []
     for f in channel_folds(n_ch // 3):

@@ -39,7 +39,7 @@ from powertrain.diagnosis.data import (
 from powertrain.diagnosis.fit import EVAL_BUDGET, Problem, baseline_outcome, fit_candidate
 from powertrain.diagnosis.result import DiagnosisResult
 from powertrain.diagnosis.rule import CandidateEvidence, DecisionRule, Evidence, VerdictKind, decide
-from powertrain.diagnosis.sides import side_attribution
+from powertrain.diagnosis.sides import side_attribution, with_measured_body_side
 from powertrain.diagnosis.where import decompose_gap, regions, rigid_span_gap, where_text
 from powertrain.effects import predict
 from powertrain.errors import InputError
@@ -124,6 +124,7 @@ class _Setup:
 
     def __init__(self, measured, engine, noise_floor, effects):
         self.src = getattr(measured, "source", "")
+        engine = with_measured_body_side(engine, measured)
         self.data = data = gap_data(measured, engine, noise_floor)
         _check_data(data, self.src)
         self.train_all, self.test_all = split_rpm(data.rpm)

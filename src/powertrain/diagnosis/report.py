@@ -5,6 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 from powertrain.diagnosis.where import REGION_DB, attribution_text
+from powertrain.effects import EFFECTS
 
 
 def _header(r) -> list:
@@ -60,6 +61,9 @@ def _which(r) -> list:
             txt = ", ".join(f"{k} = {v:.4g} +- {r.chosen.sigma[e][k]:.2g} {unit.get(k, '')}"
                             for k, v in ps.items())
             lines.append(f"    {e}: {txt}")
+            said = EFFECTS[e].summary(ps)
+            if said:
+                lines.append(f"    = {said}")
     for eq in r.equivalents:
         lines.append(f"  equivalent explanation: {eq['text']}")
     if r.band_check:

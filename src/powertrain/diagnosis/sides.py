@@ -1,25 +1,42 @@
-r"""Part of step 1 (where): does the gap live in the body, or in the mounts / the excitation?
+r"""Part of step 1 (where): does the gap live in the body, in the mounts or in the excitation?
 
 Used when the measured file carries body-side (passive) channels the model predicts (a
-modal body under the mounts). Every RMS below is the *excess over the measurement
-scatter* σ̂ (:func:`powertrain.diagnosis.data.noise_sigma_db`):
-:math:`\sqrt{\max(0, \mathrm{rms}^2 - \hat\sigma^2)}` for a gap,
-:math:`\sqrt{\max(0, \mathrm{rms}^2 - 2\hat\sigma^2)}` for a difference of two gaps.
+modal body under the mounts, or a rigid chassis whose body side the model holds still).
 With the gap :math:`\Delta L` [dB] (+ = simulation higher) on the engine side (a) and the
-body side (p) of each mount, order and speed:
+body side (p) of every mount direction measured on both sides, each point carrying its own
+scatter σ (:func:`powertrain.diagnosis.noise_model.point_sigma_db`: per channel and level),
+the **excess over noise** of a set of points is
 
-* the **isolation change** of a mount, :math:`\Delta I = \Delta L_a - \Delta L_p`, the
-  model's isolation (engine-side minus body-side level) minus the measured one; a changed
-  excitation moves both sides alike (:math:`\Delta I \approx 0`);
-* the gap lives **in the body** when the body side carries it: passive-side gap RMS at
-  least :data:`BODY_MIN_DB` and either :data:`BODY_RATIO` × the engine side's, or the
-  isolation changed while the engine side stays below :data:`ENGINE_OFF_DB`; it is a
-  *shared* body resonance when the passive gap reaches :data:`MOUNT_OFF_DB` at
-  :data:`MIN_SHARED_MOUNTS` or more mount bases (its band: the frequencies where the
-  passive gap is largest), local to one base otherwise;
-* **in the mounts** when the isolation changed (:math:`\Delta I` RMS ≥ :data:`ISO_MIN_DB`)
-  with the engine side off too (≥ :data:`ENGINE_OFF_DB`);
-* otherwise **engine side / excitation**: both sides off alike, isolation kept.
+.. math:: E^2 = \frac{\sum_i w_i(\Delta L_i^2 - \sigma_i^2)}{\sum_i w_i},\quad
+          w_i = \sigma_i^{-2},
+
+(0 when negative) and its resolution :math:`\delta^2 = Z\sqrt{2n}/\sum_i w_i` (Z =
+:data:`Z_RESOLUTION` standard errors of :math:`E^2` under noise alone). The side is read
+from the **ratio of the body-side to the engine-side excess**,
+:math:`R = E_p/\max(E_a, \delta_a)`:
+
+* a changed **excitation** (balancer, combustion) moves both sides alike through the same
+  transfer: R about 1 (issue 21 measured 0.65-0.91 for balancer errors);
+* a changed **mount** moves the engine side directly and the body side more, through the
+  changed isolation: R 3.1-6.8 (mount stiffness and amplitude-dependent mounts);
+* a changed or missing **body** mode reaches the engine side only through the bases'
+  motion (0.06-0.3 dB for several dB on the body side): R ≥ 15, unbounded.
+
+A ratio of several times does not yet tell body from mounts: with the noise left, the
+engine-side excess of a mount change often stays below its resolution, as a body change's
+does. What tells them apart is the engine side of **one mount**: a changed mount moves its
+own engine-side channels (0.7-1.5 dB in development draws of the two-sided plan), a body
+change moves none of them by more than about 0.55 dB. So: **engine side or excitation**
+when either side's excess is resolved and R < :data:`MOUNT_RATIO`; with R ≥
+:data:`MOUNT_RATIO` (body side resolved), **mounts** when the largest engine-side excess of
+one mount, A, reaches :data:`MOUNT_ENGINE_DB` (and its resolution), **body** when it does
+not and :math:`E_p` ≥ :data:`BODY_MIN_DB`, or whenever R ≥ :data:`BODY_RATIO` with A below
+:data:`MOUNT_ENGINE_DB`; **mounts** otherwise; **none** when neither side is resolved. A
+body-side gap is *shared* by several bases when the excess at :data:`MIN_SHARED_MOUNTS` or
+more mount bases reaches :data:`MOUNT_OFF_DB` and its resolution (its band: the
+frequencies where the body-side gap is largest). The isolation change
+:math:`\Delta L_a - \Delta L_p` is reported (its excess, with :math:`\sigma_a^2 +
+\sigma_p^2`).
 """
 
 from __future__ import annotations
@@ -28,33 +45,41 @@ import numpy as np
 
 from powertrain.analysis.channel import split_side
 
-#: The passive side must carry at least this multiple of the engine side's excess RMS [1]:
-#: a body change reaches the engine side only through the bases' motion (issue 13 measured
-#: 0.06-0.3 dB there for several dB on the body side), a mount change moves the engine side
-#: directly and the body side follows the changed force (body/engine ratio 2.5-8 in the
-#: development draws of the blind benchmark's passive plan, 15 to unbounded for body modes).
+#: Body when the body-side excess is at least this multiple of the engine side's [1]: the
+#: geometric middle between mount changes (≤ 6.8) and body modes (≥ 15).
 BODY_RATIO = 10.0
-#: ... and at least this much [dB] (twice the 0.5 dB by which a model may miss).
+#: Mounts when the ratio is at least this [1]: the geometric middle between excitation
+#: changes (≤ 0.91) and mount changes (≥ 3.1).
+MOUNT_RATIO = 1.7
+#: A mount's own engine-side excess that points at the mounts [dB]: between the largest
+#: of body changes (about 0.55) and the smallest of one-mount stiffness changes (about 0.7)
+#: in development draws of the two-sided plan.
+MOUNT_ENGINE_DB = 0.65
+#: ... and the body side carries at least this much [dB] for a body answer (twice the
+#: 0.5 dB by which a model may miss).
 BODY_MIN_DB = 1.0
-#: A mount base counts as off when its passive gap RMS reaches this [dB] (a test lab's
-#: run-to-run repeatability of order levels).
+#: A mount base counts as off when its body-side excess reaches this [dB] (a test lab's
+#: run-to-run repeatability of order levels) and its resolution.
 MOUNT_OFF_DB = 0.5
 #: Mount bases that must be off for a shared (body) resonance [1].
 MIN_SHARED_MOUNTS = 2
-#: Isolation change RMS that points at the mounts [dB] ...
-ISO_MIN_DB = 1.0
-#: ... with the engine side off by at least this much [dB] (issue 13's largest engine-side
-#: effect of a body change).
-ENGINE_OFF_DB = 0.3
+#: Standard errors of the squared excess under noise alone that resolve an excess [1].
+Z_RESOLUTION = 3.0
 
 
-def _rms(x, noise_var=0.0) -> float:
-    """RMS excess over the noise variance ``noise_var`` [dB²] of the finite values."""
-    x = np.asarray(x, float)
-    x = x[np.isfinite(x)]
-    if not x.size:
-        return float("nan")
-    return float(np.sqrt(max(float(np.mean(x ** 2)) - noise_var, 0.0)))
+def excess(gap, sigma) -> tuple:
+    r"""``(E, δ)`` [dB]: the excess RMS over noise of the finite gaps and its resolution
+    (module docstring); ``(nan, nan)`` without points. ``sigma`` broadcasts to ``gap``."""
+    g = np.asarray(gap, float)
+    s = np.broadcast_to(np.asarray(sigma, float), g.shape)
+    ok = np.isfinite(g) & np.isfinite(s)
+    if not ok.any():
+        return float("nan"), float("nan")
+    g, v = g[ok], np.maximum(s[ok] ** 2, 1e-12)
+    w = 1.0 / v
+    e2 = float(np.sum(w * (g ** 2 - v)) / np.sum(w))
+    d2 = float(Z_RESOLUTION * np.sqrt(2.0 * g.size) / np.sum(w))
+    return float(np.sqrt(max(e2, 0.0))), float(np.sqrt(d2))
 
 
 def _pairs(channels):
@@ -93,6 +118,27 @@ def _band(gap, data, cols, n_bins=24):
     return [float(edges[lo]), float(edges[hi + 1])]
 
 
+def _location(ea, da, ep, dp, a_mount):
+    """The side from the two excesses, their resolutions and the largest resolved
+    engine-side excess of one mount ``a_mount`` (module docstring)."""
+    a_on = np.isfinite(ea) and ea > da
+    p_on = np.isfinite(ep) and ep > dp
+    if not (a_on or p_on):
+        return "none", 0.0
+    ratio = (ep if p_on else 0.0) / max(ea if a_on else 0.0, da)
+    if not (p_on and ratio >= MOUNT_RATIO):
+        return "engine side or excitation", ratio
+    if a_mount < MOUNT_ENGINE_DB and (ep >= BODY_MIN_DB or ratio >= BODY_RATIO):
+        return "body", ratio
+    return "mounts", ratio
+
+
+def _per_mount(gap, sig, cols_of, om):
+    """``{mount: (excess, resolution)}`` of each mount's channels ``cols_of[mount]``."""
+    return {m: excess(gap[:, cols][:, :, om], sig[:, cols][:, :, om])
+            for m, cols in cols_of.items()}
+
+
 def side_attribution(gap, data, sigma_db=None) -> dict | None:
     """Which side carries the order gap (module docstring); None without body-side pairs.
 
@@ -101,40 +147,74 @@ def side_attribution(gap, data, sigma_db=None) -> dict | None:
     gap : ndarray (n_r, n_ch, n_q)
         Gap map [dB], NaN where censored or not measured.
     data : GapData
-    sigma_db : float, optional
-        Measurement scatter [dB, 1σ] (default: estimated from ``data``).
+    sigma_db : float or ndarray, optional
+        Scatter [dB, 1σ]: one number for every point, or per point like ``gap`` (default:
+        the noise model per channel and level, :mod:`powertrain.diagnosis.noise_model`).
     """
     pairs = _pairs(data.channels)
     if not pairs:
         return None
     if sigma_db is None:
-        from powertrain.diagnosis.data import noise_sigma_db
-        sigma_db = noise_sigma_db(data)
-    v = float(sigma_db) ** 2 if np.isfinite(sigma_db) else 0.0
+        from powertrain.diagnosis.noise_model import point_sigma_db
+        sigma_db = point_sigma_db(data)
+    sig = np.broadcast_to(np.asarray(sigma_db, float), gap.shape)
     om = data.order_mask
-    a_idx = [a for a, _, _ in pairs]
-    p_idx = [p for _, p, _ in pairs]
-    ga, gp = gap[:, a_idx][:, :, om], gap[:, p_idx][:, :, om]
-    rms_a, rms_p, rms_iso = _rms(ga, v), _rms(gp, v), _rms(ga - gp, 2 * v)
-    per_mount = {}
-    for (_, p, base) in pairs:
-        per_mount.setdefault(base, []).append(p)
-    off = [m for m, cols in per_mount.items()
-           if _rms(gap[:, cols][:, :, om], v) >= MOUNT_OFF_DB]
-    a = rms_a if np.isfinite(rms_a) else 0.0
-    body_side = bool(np.isfinite(rms_p) and rms_p >= BODY_MIN_DB)
-    iso = bool(np.isfinite(rms_iso) and rms_iso >= ISO_MIN_DB)
-    if body_side and (rms_p >= BODY_RATIO * a or (iso and a < ENGINE_OFF_DB)):
-        where = "body"
-    elif iso and a >= ENGINE_OFF_DB:
-        where = "mounts"
-    else:
-        where = "engine side or excitation"
-    cols = [p for m in off for p in per_mount[m]]
-    return {"location": where, "engine_side_rms_db": rms_a, "body_side_rms_db": rms_p,
-            "isolation_change_rms_db": rms_iso, "mounts_off_body_side": off,
-            "shared": len(off) >= MIN_SHARED_MOUNTS, "noise_sigma_db": float(sigma_db),
+    a_idx, p_idx = [a for a, _, _ in pairs], [p for _, p, _ in pairs]
+    both = np.isfinite(gap[:, a_idx]) & np.isfinite(gap[:, p_idx])
+    ga = np.where(both, gap[:, a_idx], np.nan)[:, :, om]
+    gp = np.where(both, gap[:, p_idx], np.nan)[:, :, om]
+    sa, sp = sig[:, a_idx][:, :, om], sig[:, p_idx][:, :, om]
+    ea, da = excess(ga, sa)
+    ep, dp = excess(gp, sp)
+    iso, _ = excess(ga - gp, np.sqrt(sa ** 2 + sp ** 2))
+    body_cols, engine_cols = {}, {}
+    for (a, p, base) in pairs:
+        body_cols.setdefault(base, []).append(p)
+        engine_cols.setdefault(base, []).append(a)
+    engine = _per_mount(gap, sig, engine_cols, om)
+    a_mount = max([e for e, d in engine.values() if np.isfinite(e) and e > d], default=0.0)
+    where, ratio = _location(ea, da, ep, dp, a_mount)
+    off = [m for m, (e, d) in _per_mount(gap, sig, body_cols, om).items()
+           if np.isfinite(e) and e >= MOUNT_OFF_DB and e > d]
+    cols = [p for m in off for p in body_cols[m]]
+    return {"location": where, "engine_side_rms_db": ea, "body_side_rms_db": ep,
+            "isolation_change_rms_db": iso, "body_to_engine_ratio": ratio,
+            "engine_side_resolution_db": da, "body_side_resolution_db": dp,
+            "largest_mount_engine_side_db": a_mount,
+            "mounts_off_body_side": off, "shared": len(off) >= MIN_SHARED_MOUNTS,
+            "noise_sigma_db": float(np.nanmedian(sig)) if np.isfinite(sig).any() else
+            float("nan"),
             "band_hz": _band(gap, data, cols) if (where == "body" and cols) else None}
+
+
+def measured_sides(measured, engine, noise_floor) -> dict | None:
+    """The side attribution of a measured run-up alone: the diagnosis' "where" step on the
+    gap against the model without effects, no fit (cheap; the validation's side rate)."""
+    from powertrain.diagnosis.data import gap_data, model_levels, residuals_db
+    from powertrain.effects import predict
+    from powertrain.solvers.fast_harmonic import HarmonicModel
+    engine = with_measured_body_side(engine, measured)
+    d = gap_data(measured, engine, noise_floor)
+    hm = HarmonicModel(engine, d.rpm)
+    hm.use_channels(d.channels)
+    g = residuals_db(model_levels(predict(hm, {}).velocity, d), d.level, d.floor)
+    return side_attribution(np.where(d.censored, np.nan, g), d)
+
+
+def with_measured_body_side(engine, measured):
+    """``engine`` as the diagnosis models it: a rigid chassis whose body side is measured
+    (channels ``NAME/passive`` of its mounts) is a modal body without modes — the body side
+    predicted still, so that a missing body mode can give it motion
+    (:func:`powertrain.effects.missing_body_mode.body_side_engine`); else unchanged."""
+    from powertrain.effects.missing_body_mode import body_side_engine
+    ch = getattr(engine, "chassis", None)
+    if ch is not None and not ch.is_rigid:
+        return engine
+    names = {m.name for m in engine.mounts}
+    sides = {split_side(m) for m, _, _ in measured.curves}
+    if any(side == "passive" and base in names for base, side in sides):
+        return body_side_engine(engine)
+    return engine
 
 
 def side_text(s) -> str:
@@ -142,8 +222,8 @@ def side_text(s) -> str:
     if not s:
         return ""
     nums = (f"excess over noise: body side {s['body_side_rms_db']:.1f} dB RMS vs engine side "
-            f"{s['engine_side_rms_db']:.1f} dB, isolation changed by "
-            f"{s['isolation_change_rms_db']:.1f} dB RMS")
+            f"{s['engine_side_rms_db']:.2f} dB (ratio {s['body_to_engine_ratio']:.1f}), "
+            f"isolation changed by {s['isolation_change_rms_db']:.1f} dB RMS")
     if s["location"] == "body":
         band = s.get("band_hz")
         at = f" near {band[0]:.0f}-{band[1]:.0f} Hz" if band else ""
@@ -152,6 +232,9 @@ def side_text(s) -> str:
                 f"local to the base of {off}{at}, not a mode shared by several bases")
         return f"the gap lives in the body: {what} ({nums})"
     if s["location"] == "mounts":
-        return f"the gap changes the mounts' isolation: it lives in the mounts ({nums})"
+        return f"the body side is off several times more than the engine side: the gap " \
+               f"lives in the mounts ({nums})"
+    if s["location"] == "none":
+        return f"neither side of the mounts is off beyond the noise ({nums})"
     return (f"both sides of the mounts are off alike: the gap lives on the engine side or in "
-            f"the excitation, not in the body ({nums})")
+            f"the excitation, not in the body or the mounts ({nums})")

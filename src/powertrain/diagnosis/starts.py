@@ -1,7 +1,8 @@
 """Start points of the candidate fits (:mod:`powertrain.diagnosis.fit`): the defaults, given
-starts, the effects' coarse start grids, and a block-wise multi-start for effects whose
-parameters act on disjoint channels (``Effect.separable_groups``: a sensor triad's gains,
-rotation and cross-axis terms).
+starts, the effects' coarse start grids, starts read from the data (``Effect.data_starts``:
+a missing body mode from the body-side gap's peak), and a block-wise multi-start for
+effects whose parameters act on disjoint channels (``Effect.separable_groups``: a sensor
+triad's gains, rotation and cross-axis terms).
 
 Every evaluation made here is charged to the fit's budget through ``fun`` (the fit's
 counted residual function).
@@ -20,11 +21,14 @@ from powertrain.effects import EFFECTS
 BLOCK_REFINED = 2
 #: Share of a fit's evaluation budget the block-wise multi-start may use.
 BLOCK_SHARE = 0.4
+#: Starts read from the data kept after screening.
+DATA_KEPT = 2
 
 
 def start_points(problem, pack, effects, starts, grid, fun):
-    """Start vectors of a fit: the defaults, the given ``starts``, the two best points of
-    the effect's coarse start grid and the block-wise multi-start's optimum."""
+    """Start vectors of a fit: the starts read from the data (first), the defaults, the
+    given ``starts``, the two best points of the effect's coarse start grid and the
+    block-wise multi-start's optimum."""
     span = pack.upper - pack.lower
     lo, hi = pack.lower + 1e-9 * span, pack.upper - 1e-9 * span
     cands = [np.clip(pack.x0, lo, hi)] + [np.clip(s, lo, hi) for s in starts or []]
@@ -38,10 +42,50 @@ def start_points(problem, pack, effects, starts, grid, fun):
         costs = [np.sum(fun(p) ** 2) for p in pts]
         cands += [np.clip(pts[i], lo, hi) for i in np.argsort(costs)[:2]]
     if grid and len(effects) == 1:
+        # read from the data: fitted first (a default that is "no effect" starts nowhere)
+        cands = _data_starts(problem, pack, effects[0], fun, lo, hi) + cands
         xb = _block_start(fun, pack, effects[0])
         if xb is not None:
             cands.append(np.clip(xb, lo, hi))
     return cands
+
+
+def _data_starts(problem, pack, effect, fun, lo, hi):
+    """The :data:`DATA_KEPT` cheapest of the effect's starts read from the training gaps
+    against the model without it (``Effect.data_starts``), the signs of its ``signed``
+    parameters then chosen (:func:`_signs`); every evaluation charged."""
+    from powertrain.effects.missing_body_mode import BodyGaps
+    d = problem.data
+    fun.evaluate(problem, pack.x0)
+    gaps = BodyGaps(d.rpm[problem.idx["train"]], list(d.channels),
+                    (d.harmonic[d.order_mask] + 1) / 2.0,
+                    problem.gaps(pack.scenario(pack.x0)), problem.meas["train"])
+    starts = EFFECTS[effect].data_starts(problem.engine, gaps)
+    pts = [np.clip(np.array([np.log(st[n]) if lg else st[n] for (_, n), lg in
+                             zip(pack.names, pack.log)]), lo, hi) for st in starts]
+    costs = [np.sum(fun(p) ** 2) for p in pts]
+    kept = [pts[i] for i in np.argsort(costs)[:DATA_KEPT]]
+    signed = [pack.names.index((effect, n)) for n in EFFECTS[effect].signed(problem.engine)]
+    return [_signs(fun, x, signed) for x in kept] if signed else kept
+
+
+def _signs(fun, x, signed, passes=2):
+    """Signs of the ``signed`` parameters of a start (magnitudes read from the data carry
+    none): each flipped in turn, largest first, and kept when it lowers the cost."""
+    best = float(np.sum(fun(x) ** 2))
+    for _ in range(passes):
+        changed = False
+        for i in sorted(signed, key=lambda i: -abs(x[i])):
+            if x[i] == 0:
+                continue
+            y = x.copy()
+            y[i] = -y[i]
+            c = float(np.sum(fun(y) ** 2))
+            if c < best:
+                x, best, changed = y, c, True
+        if not changed:
+            break
+    return x
 
 
 def _block_start(fun, pack, effect):

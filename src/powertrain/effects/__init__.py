@@ -17,6 +17,9 @@ amplitude_stiffness structure  every mount's amplitude law: springs and dampers 
                                (A_ref/A)^n (PowerLaw, A_ref = 0.1 mm, A across the mount)
 chassis_modes      structure   the body modes shared by the mount bases (modal body only):
                                frequency, modal mass and damping of each mode fitted
+missing_body_mode  structure   one body mode the model lacks: frequency, modal mass, damping
+                               and its shape at each mount base (also a rigid chassis with
+                               its body side measured)
 balancer_error     excitation  balancer shafts' unbalance g(1 ± a/2) and timing δ ± s/2 per shaft
 cylinder_imbalance excitation  cylinder i's combustion (IMEP, or the combustion part of its
                                measured trace) times (1 + ε_i)

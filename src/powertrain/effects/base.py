@@ -65,6 +65,9 @@ class Effect:
     engine_change = True
     #: True when the effect only changes what the sensors read (the physics is untouched).
     response_only = False
+    #: True when some parameters belong to one channel each (a gain, a mode's shape at one
+    #: base): the held-out cells check then withholds orders per channel, not channels.
+    withhold_orders = False
 
     # ------------------------------------------------------------------ description
     def parameters(self, engine=None) -> tuple:
@@ -80,6 +83,17 @@ class Effect:
         before the joint fit: ``[(parameter names, channel indices, [start dicts]), ...]``
         (empty: none). Only meaningful for effects whose channels do not interact (sensor
         readings)."""
+        return []
+
+    def data_starts(self, engine, gaps) -> list:
+        """Start parameter sets read from the data (``gaps``:
+        :class:`~powertrain.effects.missing_body_mode.BodyGaps` against the model without
+        the effect), screened with the grid's starts; none by default."""
+        return []
+
+    def signed(self, engine=None) -> list:
+        """Parameters whose sign the data's magnitudes leave open at a data start (a mode's
+        shape): the fit's starts try both (:mod:`powertrain.diagnosis.starts`)."""
         return []
 
     def applicable(self, engine) -> bool:
@@ -133,6 +147,10 @@ class Effect:
     def reading(self, velocity, p):
         """What the sensors read from the channel velocities (n_r, n_ch, n_h)."""
         return velocity
+
+    def summary(self, params) -> str:
+        """The fitted effect in one phrase for the report ('' : none)."""
+        return ""
 
     # ------------------------------------------------------------------ identifiability
     def alternatives(self, params, engine=None) -> list:

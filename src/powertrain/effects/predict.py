@@ -159,7 +159,7 @@ def predict(hm: HarmonicModel, scenario: dict, *, tol=TOLERANCE,
         abc = hm.two_ports() if s_el is None else hm.two_ports_scaled(s_el[None, None, :])
         abc = _two_ports(sc, hm, abc)
         q, A, iterations = hm.solve(abc[0], load, abc=abc, body=body), None, 0
-    v = hm.velocity(q)
+    v = hm.velocity(q, body=body)
     for eff, p in sc.values():
         v = eff.reading(v, p)
     return Prediction(v, iterations, A, els)

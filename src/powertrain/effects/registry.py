@@ -11,12 +11,13 @@ from powertrain.effects.balancer_error import BalancerError
 from powertrain.effects.base_compliance import BaseCompliance
 from powertrain.effects.chassis_modes import ChassisModes
 from powertrain.effects.cylinder_imbalance import CylinderImbalance
+from powertrain.effects.missing_body_mode import MissingBodyMode
 from powertrain.effects.mount_stiffness import MountStiffness
 from powertrain.effects.sensor_error import SensorError
 
 #: Effect classes in the order they act on the model (structure, excitation, sensor).
-EFFECT_CLASSES = (BaseCompliance, ChassisModes, MountStiffness, AmplitudeStiffness, BalancerError,
-                  CylinderImbalance, SensorError)
+EFFECT_CLASSES = (BaseCompliance, ChassisModes, MissingBodyMode, MountStiffness,
+                  AmplitudeStiffness, BalancerError, CylinderImbalance, SensorError)
 #: name -> effect instance.
 EFFECTS: dict = {cls.name: cls() for cls in EFFECT_CLASSES}
 #: Effects that are not a change of the linear engine model (applied to the response).

@@ -60,9 +60,10 @@ class ModalBody:
     @classmethod
     def of(cls, engine):
         """The modal body of ``engine`` (None for a rigid, absent or measured-receptance
-        chassis: the fast path predicts body-side motion only for a modal body)."""
+        chassis: the fast path predicts body-side motion only for a modal body; a modal
+        chassis without modes is a body side held still, K = 0)."""
         ch = getattr(engine, "chassis", None)
-        if ch is None or not ch.body_modes:
+        if ch is None or ch.is_rigid or ch.coupled_by_admittance:
             return None
         ms = np.array([ch.shape_matrix(m.name) for m in engine.mounts], float)
         ps = np.array([ch.shape_matrix(p) for p in ch.points], float).reshape(
@@ -85,6 +86,19 @@ class ModalBody:
                        else np.asarray(modal_mass, float),
                        damping_ratio=self.damping_ratio if damping_ratio is None
                        else np.asarray(damping_ratio, float))
+
+    def with_extra_mode(self, frequency_hz, modal_mass, damping_ratio, mount_shape) -> ModalBody:
+        """The body with one more mode (last): ``mount_shape`` (n_mounts, 3) its shape at
+        the mount attachment points, zero at the body points."""
+        shape = np.asarray(mount_shape, float).reshape(self.mount_shapes.shape[0], 3, 1)
+        return replace(self,
+                       frequency_hz=np.append(self.frequency_hz, float(frequency_hz)),
+                       modal_mass=np.append(self.modal_mass, float(modal_mass)),
+                       damping_ratio=np.append(self.damping_ratio, float(damping_ratio)),
+                       mount_shapes=np.concatenate([self.mount_shapes, shape], axis=2),
+                       point_shapes=np.concatenate(
+                           [self.point_shapes, np.zeros(self.point_shapes.shape[:2] + (1,))],
+                           axis=2))
 
     def impedance(self, omega) -> np.ndarray:
         r"""Modal dynamic stiffness :math:`Z_k(\omega)` (omega.shape + (K,)) [N/m]."""

@@ -149,8 +149,8 @@ class HarmonicModel:
         self.active_channels = list(self.channels)
         if self.body is None:
             return
-        axes = [np.asarray(m.rotation, float) for m in engine.mounts]
-        self.body_shapes = self.body.network_shapes(self.networks, axes)
+        self.mount_axes = [np.asarray(m.rotation, float) for m in engine.mounts]
+        self.body_shapes = self.body.network_shapes(self.networks, self.mount_axes)
         self.channels = self.channels + body_channels(self.mount_names, self.body)
         n_a, K = self.channel_matrix.shape[0], self.body.n_modes
         full = np.zeros((len(self.channels), 6 + K))
@@ -258,24 +258,31 @@ class HarmonicModel:
 
         With a modal body (:attr:`body`) the amplitudes are (n_r, n_h, 6 + K), the body
         modes last, coupled through the networks' two-ports ``abc`` (default nominal) to the
-        body ``body`` (default :attr:`body`) by
+        body ``body`` (default :attr:`body`; it may have other modes, e.g. one more) by
         :func:`powertrain.solvers.body_coupling.coupled_solve`."""
         load = self.load if load is None else load
         w = self.omega[:, harmonics]
         K = kip[:, harmonics]
         if self.body is not None:
             abc = self.two_ports() if abc is None else abc
-            return coupled_solve(self.M, w, self.rows, self.body_shapes,
-                                 tuple(x[:, harmonics] for x in abc), K,
-                                 self.body if body is None else body, load[:, harmonics])
+            body = self.body if body is None else body
+            shapes = (self.body_shapes if body is self.body
+                      else body.network_shapes(self.networks, self.mount_axes))
+            return coupled_solve(self.M, w, self.rows, shapes,
+                                 tuple(x[:, harmonics] for x in abc), K, body,
+                                 load[:, harmonics])
         frame = (self.M, np.zeros((6, 6)), np.zeros((6, 6)))
         D = condensed_matrix(frame, self.rows, None, (K, None, None), 1j * w)
         return np.linalg.solve(D, load[:, harmonics][..., None])[..., 0]
 
-    def velocity(self, q, harmonics=slice(1, N_HARMONICS)) -> np.ndarray:
-        """Complex peak channel velocities (n_r, n_ch, n_h) [m/s] from :meth:`solve`'s q."""
+    def velocity(self, q, harmonics=slice(1, N_HARMONICS), body=None) -> np.ndarray:
+        """Complex peak channel velocities (n_r, n_ch, n_h) [m/s] from :meth:`solve`'s q
+        (solved with the modal body ``body``, default :attr:`body`)."""
         w = self.omega[:, harmonics]
         C = self.channel_matrix if self.body is None else self.output_matrix
+        if body is not None and body is not self.body:
+            C = np.hstack([C[:, :6], np.zeros((C.shape[0], body.n_modes))])
+            C[self.channel_matrix.shape[0]:, 6:] = body.output_rows()
         if self.output is not None:
             C = C[self.output]
         return np.einsum("ci,rhi->rch", C, q) * (1j * w)[:, None, :]

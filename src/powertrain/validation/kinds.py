@@ -28,6 +28,10 @@ truth effect            library match        drawn parameters
                                              (one or two shifted 12–25 % in frequency, their
                                              mass and damping changed, all ± a few %,
                                              shape components ± 5 %)
+``missing_mode``        missing_body_mode    passive-side plan only: one more body mode,
+                                             40–110 Hz, 6–30 kg (shape normalised to its
+                                             largest component), ζ 2–6 %, one base and
+                                             direction dominant
 ======================= ==================== ==============================================
 
 Cases, measurement noise and detectability: :mod:`powertrain.validation.cases`.
@@ -216,8 +220,30 @@ def _apply_body_modes(p, parts):
     parts["body"] = p["body"]
 
 
+def _draw_missing_mode(rng, engine):
+    """One body mode the file lacks: frequency U(40, 110) Hz (inside what order 2 sweeps
+    from 1000 to 6000 rpm), modal mass U(6, 30) kg for the shape normalised to its largest
+    component, damping U(0.02, 0.06); shape components N(0, 0.35) with one base and
+    direction set to ±1 (the largest)."""
+    n_m = len(engine.mounts)
+    shape = np.clip(rng.normal(0, 0.35, (n_m, 3)), -0.9, 0.9)
+    shape[int(rng.integers(n_m)), int(rng.integers(3))] = rng.choice([-1.0, 1.0])
+    return {"frequency_hz": float(rng.uniform(40, 110)), "modal_mass": float(rng.uniform(6, 30)),
+            "zeta": float(rng.uniform(0.02, 0.06)), "shape": shape}
+
+
+def _apply_missing_mode(p, parts):
+    b = parts["body"]
+    parts["body"] = tr.BodyModes(np.append(b.mode_hz, p["frequency_hz"]),
+                                 np.append(b.modal_mass, p["modal_mass"]),
+                                 np.append(b.zeta, p["zeta"]),
+                                 np.concatenate([b.shapes, p["shape"][None]], axis=0))
+
+
 #: Truth kinds of the passive-side plan only (:mod:`powertrain.validation.passive`); kept out
 #: of :data:`IN_LIBRARY`, so the default plan's draws are unchanged.
 PASSIVE_KINDS = {"body_modes": TruthKind("body_modes", "chassis_modes", _draw_body_modes,
-                                         _apply_body_modes)}
+                                         _apply_body_modes),
+                 "missing_mode": TruthKind("missing_mode", "missing_body_mode",
+                                           _draw_missing_mode, _apply_missing_mode)}
 KINDS.update(PASSIVE_KINDS)

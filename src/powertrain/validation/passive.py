@@ -8,10 +8,11 @@ body's modes, Newmark run-up) with the body side of every mount as further chann
 (``NAME/passive``), measured with the same scatter and noise floor as the engine side
 (:func:`powertrain.validation.cases.measure`).
 
-**Plan** (:func:`passive_plan`), repeated every 10 cases: ``body_modes`` four times (the
+**Plan** (:func:`passive_plan`), repeated every 14 cases: ``body_modes`` four times (the
 body's modes differ from the file's, :data:`powertrain.validation.kinds.PASSIVE_KINDS`),
-``mount_temperature`` four times (one mount 0.5–0.8× or 1.25–2× as stiff), two effect-free;
-engines alternating. The diagnosis gets the modal-body engine (nominal body) and the
+``mount_temperature`` four times (one mount 0.5–0.8× or 1.25–2× as stiff), two effect-free,
+and (issue 21) two excitation changes (``balancer_shafts``) and two body modes the file
+lacks (``missing_mode``); engines alternating. The diagnosis gets the modal-body engine (nominal body) and the
 measured file with both sides.
 """
 
@@ -31,7 +32,9 @@ ENGINE_KINDS = ("body_sz", "body_traces")
 _LAP = [("body_modes", "body_sz"), ("mount_temperature", "body_traces"), ("none", "body_sz"),
         ("body_modes", "body_traces"), ("mount_temperature", "body_sz"),
         ("body_modes", "body_sz"), ("mount_temperature", "body_traces"),
-        ("none", "body_traces"), ("body_modes", "body_traces"), ("mount_temperature", "body_sz")]
+        ("none", "body_traces"), ("body_modes", "body_traces"), ("mount_temperature", "body_sz"),
+        ("balancer_shafts", "body_traces"), ("missing_mode", "body_sz"),
+        ("balancer_shafts", "body_sz"), ("missing_mode", "body_traces")]
 
 
 def passive_plan(n_cases, seed):
@@ -89,3 +92,4 @@ def make_passive_case(index, names, engine_kind, seed) -> Case:
     engine = passive_engines()[engine_kind]
     return draw_case(index, names, engine_kind, seed, engine, baseline_velocity(engine_kind),
                      truth_velocity, channels(engine), "blind passive case")
+

@@ -1,0 +1,232 @@
+r"""``missing_body_mode``: a body mode the engine file's body model lacks.
+
+One more mode of the body under the mounts, :math:`\mathbf x_B(P) \mathrel{+}=
+\boldsymbol\psi(P)\,\eta`, :math:`m(\ddot\eta + 2\zeta\omega_0\dot\eta + \omega_0^2\eta) =
+\sum_P \boldsymbol\psi(P)\cdot\mathbf f_P`, with its natural frequency ``frequency_hz``,
+modal mass ``modal_mass_kg``, damping ratio ``damping_ratio`` and its shape at each mount
+base, ``shape_<mount>_<x|y|z>`` (engine axes). Only :math:`\boldsymbol\psi\boldsymbol\psi^T/m`
+reaches the data, so the shape is **normalised to its largest component** (±1) and the
+modal mass belongs to that scaling: the mode acts with :math:`\boldsymbol\psi/\max|\psi_j|`.
+At the modal-mass bound :data:`MASS_OFF` (the default) or with a zero shape the mode is
+absent (the baseline).
+
+**Where it applies.** An engine with a modal body (``[chassis] model = "modal"``): the mode
+is added to the file's modes. A rigid chassis when body-side channels are measured: the
+diagnosis reads it as a modal body without modes (:func:`body_side_engine`; the model holds
+the body side still, the new mode gives it motion). On the engine (:meth:`apply`) the
+effect is a modal chassis with one more mode, which every solver runs; on the fast path
+(:meth:`body_change`) the same mode is appended to the cached modal body
+(:meth:`~powertrain.solvers.body_coupling.ModalBody.with_extra_mode`); both are one
+:func:`mode_arrays` (tests/test_missing_body_mode.py holds them equal).
+
+**Starts** (:meth:`data_starts`): from the body-side gap's peaks — the frequencies where
+the measured body side most exceeds the model relative to the engine side
+(:func:`body_gap_peak`), the shape from the excess velocity at each base and direction
+there; three peaks × three modal masses, screened by the fit (:mod:`powertrain.diagnosis.starts`).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+
+import numpy as np
+
+from powertrain.effects.base import Effect, Parameter, mount_labels
+
+#: Frequency bounds [Hz].
+FREQ_RANGE = (5.0, 200.0)
+#: Modal-mass bounds [kg]; the upper one is the mode absent (the default).
+MASS_RANGE = (0.5, 1.0e4)
+MASS_OFF = MASS_RANGE[1]
+#: Damping-ratio bounds and default [1].
+ZETA_RANGE = (0.005, 0.25)
+ZETA_DEFAULT = 0.04
+#: Prior standard deviation of ln(damping ratio) about the default [1] (a body mode's
+#: damping is known within a factor of two; without it a sharp resonance between two
+#: measured speeds fits noise).
+DAMPING_PRIOR = 0.7
+#: Modal masses screened at the data's start frequency [kg].
+START_MASSES = (3.0, 12.0, 50.0)
+#: Start frequencies relative to a peak [1]: the mode on the mounts resonates above its own
+#: (uncoupled) frequency.
+START_SHIFTS = (0.7, 1.0)
+#: Peaks of the body-side excess tried as start frequencies.
+START_PEAKS = 3
+AXES = "xyz"
+
+
+def shape_names(engine) -> list:
+    """``shape_<mount>_<axis>`` of every mount (file order) and axis."""
+    return [f"shape_{m}_{a}" for m in mount_labels(engine) for a in AXES]
+
+
+def mode_arrays(params, n_mounts):
+    """``(frequency, modal mass, damping, shape (n_mounts, 3) normalised to its largest
+    component)`` of the parameters, or None when the mode is absent (mass at the bound or a
+    zero shape). The one reading of the parameters (engine and fast path)."""
+    shape = np.array([v for k, v in params.items() if k.startswith("shape_")], float)
+    peak = float(np.max(np.abs(shape))) if shape.size else 0.0
+    if params["modal_mass_kg"] >= MASS_OFF or peak == 0.0:
+        return None
+    return (float(params["frequency_hz"]), float(params["modal_mass_kg"]),
+            float(params["damping_ratio"]), (shape / peak).reshape(n_mounts, 3))
+
+
+def body_side_engine(engine):
+    """``engine`` with a rigid (or absent) chassis read as a modal body without modes: its
+    body side is held still and predicted (zero) instead of left out."""
+    from powertrain.models.chassis import Chassis
+    ch = getattr(engine, "chassis", None)
+    if ch is not None and not ch.is_rigid:
+        return engine
+    return engine.replace(chassis=Chassis(model="modal", modes=(), points=(),
+                                          file=getattr(ch, "file", "")))
+
+
+class MissingBodyMode(Effect):
+    name = "missing_body_mode"
+    kind = "structure"
+    #: the shape at a base is seen on that base's channels only (held-out orders instead)
+    withhold_orders = True
+    description = ("one body mode the body model lacks: frequency, modal mass, damping and "
+                   "its shape at each mount base (normalised to its largest component)")
+
+    def parameters(self, engine=None):
+        out = [Parameter("frequency_hz", "Hz", *FREQ_RANGE, 30.0, True,
+                         "natural frequency of the missing body mode"),
+               Parameter("modal_mass_kg", "kg", *MASS_RANGE, MASS_OFF, True,
+                         "modal mass for the shape normalised to its largest component "
+                         f"(the upper bound {MASS_OFF:g} kg: no mode)"),
+               Parameter("damping_ratio", "1", *ZETA_RANGE, ZETA_DEFAULT, True,
+                         "damping ratio of the missing body mode", DAMPING_PRIOR)]
+        out += [Parameter(n, "1", -1.0, 1.0, 0.0, False,
+                          f"shape of the mode at the base of {n[6:-2]}, {n[-1]} (engine axes)")
+                for n in shape_names(engine)]
+        return tuple(out)
+
+    def signed(self, engine=None) -> list:
+        return shape_names(engine)
+
+    def applicable(self, engine) -> bool:
+        from powertrain.solvers.body_coupling import ModalBody
+        return ModalBody.of(engine) is not None
+
+    def apply(self, engine, **params):
+        from powertrain.models.chassis import BodyMode, Chassis
+        p = {**self.defaults(engine), **params}
+        mode = mode_arrays(p, len(engine.mounts))
+        if mode is None:
+            return engine
+        f, m, z, shape = mode
+        ch = body_side_engine(engine).chassis
+        shapes = {mt.name: shape[i] for i, mt in enumerate(engine.mounts)}
+        shapes.update({pt: np.zeros(3) for pt in ch.points})
+        new = BodyMode(frequency=f, damping_ratio=z, modal_mass=m, shapes=shapes)
+        return engine.replace(chassis=Chassis(
+            model="modal", modes=tuple(ch.modes) + (new,), points=ch.points,
+            receptance=None, file=ch.file, notes=dict(ch.notes)))
+
+    def body_change(self, hm, p, body):
+        mode = mode_arrays(p, body.mount_shapes.shape[0])
+        return body if mode is None else body.with_extra_mode(*mode)
+
+    def summary(self, params) -> str:
+        """'a body mode missing from the model near f Hz, m kg, moving mostly X's z'."""
+        shape = {k: v for k, v in params.items() if k.startswith("shape_")}
+        if not shape or params["modal_mass_kg"] >= MASS_OFF:
+            return ""
+        top = max(shape, key=lambda k: abs(shape[k]))
+        return (f"a body mode missing from the model near {params['frequency_hz']:.1f} Hz, "
+                f"{params['modal_mass_kg']:.3g} kg, moving mostly {top[6:-2]}'s {top[-1]}")
+
+    def data_starts(self, engine, gaps):
+        """Start parameter sets from the body-side gap (module docstring), [] without one.
+        ``gaps``: :class:`BodyGaps` of the data against the model without the mode."""
+        out = []
+        for f0, shape in body_gap_peak(gaps, [m.name for m in engine.mounts],
+                                       n_peaks=START_PEAKS):
+            base = {"frequency_hz": float(np.clip(f0, *FREQ_RANGE)),
+                    "damping_ratio": ZETA_DEFAULT}
+            base.update(dict(zip(shape_names(engine), shape.ravel().tolist())))
+            out += [dict(base, modal_mass_kg=m, frequency_hz=float(np.clip(s * f0, *FREQ_RANGE)))
+                    for m in START_MASSES for s in START_SHIFTS]
+        return out
+
+
+@dataclasses.dataclass
+class BodyGaps:
+    """Gaps of measured order levels against a model, for start points.
+
+    ``rpm`` (n_r,), ``channels`` [(mount, direction)], ``orders`` (n_o,), ``gap`` [dB] and
+    ``measured`` [m/s RMS], each (n_r, n_ch, n_o), NaN where not scored."""
+
+    rpm: np.ndarray
+    channels: list
+    orders: np.ndarray
+    gap: np.ndarray
+    measured: np.ndarray
+
+
+#: Relative half-width of the frequency window around the peak read for the shape [1].
+PEAK_WINDOW = 0.08
+
+
+def body_gap_peak(g: BodyGaps, mount_names, n_bins=32, n_peaks=1):
+    r"""``(f0, shape (n_mounts, 3))`` of the body side's excess over the model, or None
+    (with ``n_peaks`` > 1: a list of those of the ``n_peaks`` largest bins).
+
+    The excess velocity of a point, :math:`e = \sqrt{\max(0, m^2 - s^2)}` (measured m,
+    model :math:`s = m\,10^{\Delta L/20}`), on the body-side channels ``NAME/passive``,
+    relative to the measured engine side of the same mount and direction (the excess
+    transmissibility, which peaks at a mode's resonance); f0 its weighted mean frequency in
+    the log-frequency bin (of ``n_bins``) with the largest mean of
+    :math:`(e/m_\mathrm{engine})^2`; the shape the RMS excess of each base and direction
+    within ± :data:`PEAK_WINDOW` of f0, normalised to its largest component."""
+    from powertrain.analysis.channel import split_side
+    where = {c: i for i, c in enumerate(g.channels)}
+    cols = {}
+    for c, (m, d) in enumerate(g.channels):
+        base, side = split_side(m)
+        if side == "passive" and base in mount_names and (base, d) in where:
+            cols[c] = (mount_names.index(base), "xyz".index(d), where[(base, d)])
+    if not cols:
+        return None
+    idx = list(cols)
+    f = g.rpm[:, None, None] * g.orders[None, None, :] / 60.0 * np.ones((1, len(idx), 1))
+    meas = g.measured[:, idx]
+    engine_side = g.measured[:, [cols[c][2] for c in idx]]
+    with np.errstate(invalid="ignore", over="ignore", divide="ignore"):
+        model = meas * 10 ** (g.gap[:, idx] / 20)
+        ex = np.sqrt(np.maximum(meas ** 2 - model ** 2, 0.0))
+        w = (ex / engine_side) ** 2
+    w = np.where(np.isfinite(w), w, 0.0)
+    if not np.any(w > 0):
+        return None
+    edges = np.geomspace(f.min(), f.max() * 1.0001, n_bins + 1)
+    k = np.clip(np.searchsorted(edges, f, side="right") - 1, 0, n_bins - 1)
+    n_in = np.bincount(k.ravel(), (w > 0).ravel(), n_bins)
+    sums = np.bincount(k.ravel(), w.ravel(), n_bins) / np.maximum(n_in, 1)
+    out = []
+    for top in np.argsort(sums)[::-1][:n_peaks]:
+        sel = k == top
+        if sums[top] <= 0:
+            break
+        f0 = float(np.sum(f[sel] * w[sel]) / np.sum(w[sel]))
+        shape = _shape_near(f, ex, f0, [cols[c][:2] for c in idx], len(mount_names))
+        if shape is not None:
+            out.append((f0, shape))
+    if n_peaks == 1:
+        return out[0] if out else None
+    return out
+
+
+def _shape_near(f, ex, f0, places, n_mounts):
+    """RMS excess of each base and direction within ± PEAK_WINDOW of f0, normalised."""
+    near = np.abs(f / f0 - 1) <= PEAK_WINDOW
+    shape = np.zeros((n_mounts, 3))
+    for j, place in enumerate(places):
+        e = ex[:, j][near[:, j] & np.isfinite(ex[:, j])]
+        if e.size:
+            shape[place] = np.sqrt(np.mean(e ** 2))
+    peak = shape.max()
+    return shape / peak if peak > 0 else None
