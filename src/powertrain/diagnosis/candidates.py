@@ -20,6 +20,13 @@ def applicable(engine, names=None) -> list:
     return [e for e in (names or EFFECTS) if EFFECTS[e].applicable(engine)]
 
 
+def at_location(names, sides) -> list:
+    """The candidates among ``names`` at the side attribution ``sides`` (None: no body side
+    measured): an effect with ``locations`` only where the gap lies there."""
+    where = None if not sides else sides.get("location")
+    return [e for e in names if EFFECTS[e].locations is None or where in EFFECTS[e].locations]
+
+
 def warm_caches(hm, effects):
     """Fill the cached model's parts the candidates need (two-ports, loads, derivatives)
     once, before any subset is taken."""

@@ -286,6 +286,7 @@ def _diagnose(measured, engine, noise_floor, effects, pairs, do_bands, rule, sch
     t0 = time.perf_counter()
     s = _Setup(measured, engine, noise_floor, effects)
     gap_map, parts, rigid, found = _where(s)
+    s.effects = cand.at_location(s.effects, parts.get("sides"))
     sigma = noise_sigma_db(s.data)
     baseline = baseline_outcome(s.problem)
     _structure(s, baseline, [], sigma)

@@ -68,6 +68,9 @@ class Effect:
     #: True when some parameters belong to one channel each (a gain, a mode's shape at one
     #: base): the held-out cells check then withholds orders per channel, not channels.
     withhold_orders = False
+    #: Side attributions (``location`` of :func:`powertrain.diagnosis.sides.side_attribution`)
+    #: at which the effect is a candidate; None: at any (also without body-side data).
+    locations = None
 
     # ------------------------------------------------------------------ description
     def parameters(self, engine=None) -> tuple:

@@ -88,6 +88,10 @@ class MissingBodyMode(Effect):
     kind = "structure"
     #: the shape at a base is seen on that base's channels only (held-out orders instead)
     withhold_orders = True
+    #: a candidate only where the gap lies on the body side: the mode moves the bases, and
+    #: its 12-parameter fit is the slowest of the library (31-74 CPU-s a diagnosis when it
+    #: ran on every modal-body engine)
+    locations = ("body",)
     description = ("one body mode the body model lacks: frequency, modal mass, damping and "
                    "its shape at each mount base (normalised to its largest component)")
 
