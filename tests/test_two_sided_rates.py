@@ -2,14 +2,15 @@
 
 Both sides of every mount measured on the modal-body engine
 (:mod:`powertrain.validation.passive`), cases from a seed drawn from ``os.urandom``, the
-Wilson rule of ``tests/rates.py`` (fails when the data show, at one-sided 95 % confidence,
-that the target is missed; sized so that a rate 0.1 worse fails with probability ≥ 0.8):
+group-sequential Wilson rule of ``tests/rates.py`` (batches of 8 until Wald's ratio
+decides, truncated where the Wilson rule does; a rate 0.1 worse fails with probability
+≥ 0.8):
 
 * side attribution (body / mounts / excitation) right ≥ 0.9 on detectable body-mode,
-  mount-stiffness, balancer and missing-mode cases (61 cases; the "where" step only, no fit:
+  mount-stiffness, balancer and missing-mode cases (at most 80 cases; the "where" step only, no fit:
   a few seconds each);
 * a missing body mode found, frequency within 5 % and modal mass within 30 %, in ≥ 0.8 of
-  the detectable cases (105 cases, full diagnoses);
+  the detectable cases (at most 136 cases, full diagnoses);
 
 hence the ``slow`` and ``rates`` markers (``python -m pytest -m rates``). The small tests of
 the scoring logic are in tests/test_validation_scoring.py.
@@ -59,12 +60,12 @@ def _side_row(task):
 @pytest.mark.slow
 @pytest.mark.rates
 def test_side_attribution_on_two_sided_cases():
-    n, k_pass = rates.size(SIDES_TARGET)
     seed = int.from_bytes(os.urandom(4), "little")
-    rows = run_map(_side_row, [(i, seed) for i in range(n)])
-    k = sum(r["right"] for r in rows)
-    assert k >= k_pass, (f"seed {seed}: {k}/{n} right (pass >= {k_pass}); misses "
-                         f"{[(r['kind'], r['where'], r['seed']) for r in rows if not r['right']]}")
+    passed, rows, k = rates.run_sequential(
+        lambda start, count: run_map(_side_row, [(i, seed) for i in range(start, start + count)]),
+        lambda r: r["right"], SIDES_TARGET)
+    assert passed, (f"seed {seed}: {k}/{len(rows)} right; misses "
+                    f"{[(r['kind'], r['where'], r['seed']) for r in rows if not r['right']]}")
 
 
 def _mode_row(task):
@@ -83,9 +84,9 @@ def _mode_row(task):
 @pytest.mark.slow
 @pytest.mark.rates
 def test_missing_body_mode_is_found():
-    n, k_pass = rates.size(MISSING_MODE_TARGET)
     seed = int.from_bytes(os.urandom(4), "little")
-    rows = run_map(_mode_row, [(i, seed) for i in range(n)])
-    k = sum(mode_found(r) for r in rows)
-    assert k >= k_pass, (f"seed {seed}: {k}/{n} found (pass >= {k_pass}); misses "
-                         f"{[(r['verdict'], r['seed']) for r in rows if not mode_found(r)]}")
+    passed, rows, k = rates.run_sequential(
+        lambda start, count: run_map(_mode_row, [(i, seed) for i in range(start, start + count)]),
+        mode_found, MISSING_MODE_TARGET)
+    assert passed, (f"seed {seed}: {k}/{len(rows)} found; misses "
+                    f"{[(r['verdict'], r['seed']) for r in rows if not mode_found(r)]}")
