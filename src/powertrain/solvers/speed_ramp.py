@@ -4,7 +4,8 @@ The speed rises linearly, :math:`n(t) = n_0 + \dot n\,t`, so the crank angle is
 :math:`\theta(t) = \tfrac{2\pi}{60}(n_0 t + \tfrac12\dot n t^2)`. The load at every step is
 the engine's generalized load at that speed and angle, interpolated bilinearly in a table
 sampled every :data:`LOAD_RPM_STEP` rpm and :data:`LOAD_ANGLE_STEP_DEG` degrees of the
-cycle (speed-dependent inertia and gas forces). The same assembled model as the stepped
+cycle (speed-dependent inertia and gas forces; :meth:`Engine.load_table` evaluates the engine
+model's speed-independent patterns once). The same assembled model as the stepped
 run-up is integrated by Newmark average acceleration in modal form
 (:class:`~powertrain.solvers.newmark.ModalNewmark`, the same recurrence as the run-up's
 stepper) at ``oversample`` times the output rate (at least one step per crank degree at the
@@ -47,8 +48,7 @@ def _load_table(engine, rpm_from, rpm_to):
     speeds = np.clip(speeds, rpm_from, rpm_to)
     n_theta = int(round(720.0 / LOAD_ANGLE_STEP_DEG))
     theta = np.arange(n_theta) * (4 * np.pi / n_theta)
-    table = np.stack([np.asarray(engine.generalized_load(float(n), theta), float)
-                      for n in speeds])                            # (n_rpm, n_theta, 6)
+    table = engine.load_table(speeds, theta)                       # (n_rpm, n_theta, 6)
     table = np.concatenate([table, table[:, :1]], axis=1)           # periodic wrap
     return speeds, table, n_theta
 
