@@ -106,11 +106,13 @@ def simulate_sweep(engine, rpm_from, rpm_to, rate_rpm_per_s, sample_rate=8192.0,
         b = engine.body
         system = assemble(b.mass, b.cg, b.inertia, engine.mounts)
     load = _load_table(engine, rpm_from, rpm_to)
-    decimator = _Decimator(m, len(system.channels))
+    dofs, to_channels = _channel_dofs(system.channel_matrix)
+    decimator = _Decimator(m, dofs.size)
     ramp = (rpm_from, rate_rpm_per_s, h, n_steps)
     with threadpool_limits(limits=1, user_api="blas"):     # small matrices: see run_runup
-        y, method = _integrate_ramp(engine, system, load, ramp, decimator, progress,
+        y, method = _integrate_ramp(engine, system, load, ramp, dofs, decimator, progress,
                                     static_factors)
+    y = y @ to_channels.T
     t_out = (decimator.first_output_index + np.arange(y.shape[0])) / sample_rate
     rpm_out = rpm_from + rate_rpm_per_s * t_out
     block = np.ascontiguousarray(y.T)
@@ -123,27 +125,38 @@ def simulate_sweep(engine, rpm_from, rpm_to, rate_rpm_per_s, sample_rate=8192.0,
     return RawRecording(t_out, chans, rpm_out, None, "simulated sweep", [note]).validate()
 
 
-def _integrate_ramp(engine, system, load, ramp, decimator, progress, static_factors):
-    """Decimated channel accelerations of the ramp and the method's name: modal for a
-    linear model, else dense engine cycle by engine cycle."""
+def _channel_dofs(channel_matrix):
+    """The coordinates the channels read (columns of ``channel_matrix`` not all zero: the
+    body's six) and the map (n_ch, n_read) from their accelerations to the channels. The
+    sweep integrates and decimates those and maps them after the decimation (both linear, so
+    equal to round-off, and fewer signals than channels)."""
+    dofs = np.flatnonzero(np.any(channel_matrix != 0, axis=0))
+    return dofs, np.ascontiguousarray(channel_matrix[:, dofs])
+
+
+def _integrate_ramp(engine, system, load, ramp, dofs, decimator, progress, static_factors):
+    """Decimated accelerations of the coordinates ``dofs`` over the ramp and the method's
+    name: modal for a linear model, else dense engine cycle by engine cycle."""
     from powertrain.solvers.newmark import ModalNewmark
     if system.port_forces() is None and static_factors is None:
         modal = ModalNewmark(system.M, system.C, system.K, load_dofs=6)
-        return _integrate(modal, system, load, ramp, _initial_state(engine, modal, ramp[0]),
+        return _integrate(modal, dofs, load, ramp, _initial_state(engine, modal, ramp[0]),
                           decimator, progress), "modal"
-    return (_integrate_nonlinear(engine, system, load, ramp, decimator, static_factors),
+    return (_integrate_nonlinear(engine, system, load, ramp, dofs, decimator, static_factors),
             "dense, nonlinear mount elements cycle by cycle")
 
 
-def _integrate(modal, system, load, ramp, eta, decimator, progress):
-    """Decimated channel accelerations (n_out, n_ch) of the ramp ``(rpm_from, rate [rpm/s],
-    step h [s], steps)`` from the modal state ``eta``, chunk by chunk (one Numba kernel:
+def _integrate(modal, dofs, load, ramp, eta, decimator, progress):
+    """Decimated accelerations (n_out, n_read) of the coordinates ``dofs`` over the ramp
+    ``(rpm_from, rate [rpm/s], step h [s], steps)`` from the modal state ``eta``, chunk by
+    chunk (one Numba kernel:
     load, recurrence and outputs, :func:`powertrain.kernels.speed_ramp.modal_ramp_kernel`)."""
     from powertrain.kernels.speed_ramp import modal_ramp_kernel
     rpm_from, rate_rpm_per_s, h, n_steps = ramp
     speeds, table, _ = load
-    Z = np.zeros_like(system.channel_matrix)
-    (w_re, w_im), w_load = modal.output_map(Z, Z, system.channel_matrix)
+    read = np.eye(modal.n)[dofs]
+    Z = np.zeros_like(read)
+    (w_re, w_im), w_load = modal.output_map(Z, Z, read)
     lam_d = (1 + 0.5 * h * modal.lam_r) / (1 - 0.5 * h * modal.lam_r)
     gain = (0.5 * h) / (1 - 0.5 * h * modal.lam_r)
     chunk = CHUNK_OUT * decimator.m         # a multiple of m keeps the decimation aligned
@@ -174,9 +187,9 @@ def _cycle_bounds(rpm_from, rate, h, n_steps):
     return np.r_[0, inner, n_steps]
 
 
-def _integrate_nonlinear(engine, system, load, ramp, decimator, static_factors):
-    """Decimated channel accelerations of the ramp with nonlinear mount elements: dense
-    Newmark engine cycle by engine cycle (:class:`~powertrain.solvers.cycle_newmark.
+def _integrate_nonlinear(engine, system, load, ramp, dofs, decimator, static_factors):
+    """Decimated accelerations of the coordinates ``dofs`` over the ramp with nonlinear
+    mount elements: dense Newmark engine cycle by engine cycle (:class:`~powertrain.solvers.cycle_newmark.
     CycleIntegrator`), from the harmonic fixed point at the first speed with the port laws
     on their steady loop, the amplitude law and the static factors updated per cycle."""
     from powertrain.solvers.cycle_newmark import CycleIntegrator, cycle_amplitudes
@@ -192,7 +205,7 @@ def _integrate_nonlinear(engine, system, load, ramp, decimator, static_factors):
                             (np.pi / 30.0) * (rpm_from * t + 0.5 * rate * t * t))
         factors = stepper.factors_at((rpm_from + rate * t.mean()) * np.pi / 30.0)
         (X, V, A, _), _ = integrator.run(F, x[:3], amplitudes, state, factors)
-        rows.push(A[:-1] @ system.channel_matrix.T)
+        rows.push(A[:-1, dofs])
         amplitudes = cycle_amplitudes(X[:-1] @ stepper.ports.rows.T)
         x = (X[-1], V[-1], A[-1], x[3])
     return rows.done()
