@@ -142,8 +142,7 @@ def _integrate_ramp(engine, system, load, ramp, dofs, decimator, progress, stati
         modal = ModalNewmark(system.M, system.C, system.K, load_dofs=6)
         return _integrate(modal, dofs, load, ramp, _initial_state(engine, modal, ramp[0]),
                           decimator, progress), "modal"
-    return (_integrate_nonlinear(engine, system, load, ramp, dofs, decimator, static_factors),
-            "dense, nonlinear mount elements cycle by cycle")
+    return _integrate_nonlinear(engine, system, load, ramp, dofs, decimator, static_factors)
 
 
 def _integrate(modal, dofs, load, ramp, eta, decimator, progress):
@@ -189,13 +188,19 @@ def _cycle_bounds(rpm_from, rate, h, n_steps):
 
 def _integrate_nonlinear(engine, system, load, ramp, dofs, decimator, static_factors):
     """Decimated accelerations of the coordinates ``dofs`` over the ramp with nonlinear
-    mount elements: dense Newmark engine cycle by engine cycle (:class:`~powertrain.solvers.cycle_newmark.
-    CycleIntegrator`), from the harmonic fixed point at the first speed with the port laws
-    on their steady loop, the amplitude law and the static factors updated per cycle."""
+    mount elements and the method's name: modal with the port forces when the networks keep
+    their scale (:func:`_integrate_ports`; it starts with the acceleration of the equation
+    of motion), else dense Newmark engine cycle by engine cycle
+    (:class:`~powertrain.solvers.cycle_newmark.CycleIntegrator`), from the harmonic fixed
+    point at the first speed with the port laws on their steady loop, the amplitude law and
+    the static factors updated per cycle."""
     from powertrain.solvers.cycle_newmark import CycleIntegrator, cycle_amplitudes
     rpm_from, rate, h, n_steps = ramp
     x, state, amplitudes, stepper = _nonlinear_start(engine, system, rpm_from, static_factors)
     integrator = CycleIntegrator(stepper.scaling, stepper.ports, h, x[3])
+    if not integrator.varying and static_factors is None and integrator.laws.kinds.size:
+        return _integrate_ports(integrator, load, ramp, (x, state, amplitudes), dofs,
+                                decimator), "modal with the port laws, Newton per step"
     bounds = _cycle_bounds(rpm_from, rate, h, n_steps)
     rows = _Rows(decimator)
     for lo, hi in zip(bounds[:-1], bounds[1:]):
@@ -208,7 +213,31 @@ def _integrate_nonlinear(engine, system, load, ramp, dofs, decimator, static_fac
         rows.push(A[:-1, dofs])
         amplitudes = cycle_amplitudes(X[:-1] @ stepper.ports.rows.T)
         x = (X[-1], V[-1], A[-1], x[3])
-    return rows.done()
+    return rows.done(), "dense, nonlinear mount elements cycle by cycle"
+
+
+def _integrate_ports(integrator, load, ramp, start, dofs, decimator):
+    """Decimated accelerations of the coordinates ``dofs`` over the ramp of a model whose
+    networks keep their scale (port laws only, no amplitude law or static hook): modal
+    Newmark with the port forces, Newton per step, chunk by chunk
+    (:class:`~powertrain.solvers.newmark.ModalPortNewmark`), from ``start`` = (state
+    ``(x0, v0, a0, mean)``, port-law states, amplitudes)."""
+    from powertrain.solvers.newmark import ModalNewmark, ModalPortNewmark
+    rpm_from, rate, h, n_steps = ramp
+    (x0, v0, *_), state, amplitudes = start
+    s, laws = integrator.scaling, integrator.laws
+    C, K, _, _ = s.matrices(s.scales(integrator.ports.network_amplitudes(amplitudes)))
+    run = ModalPortNewmark(ModalNewmark(s.system.M, C, K, load_dofs=6), laws, h, dofs)
+    eta = run.modal_state(x0, v0)
+    z = laws.forces(laws.rows @ x0, laws.rows @ v0, state)
+    chunk = CHUNK_OUT * decimator.m         # a multiple of m keeps the decimation aligned
+    outputs = []
+    for lo in range(0, n_steps, chunk):
+        t = np.arange(lo, min(lo + chunk, n_steps) + 1) * h
+        F = _load_at(*load, rpm_from + rate * t,
+                     (np.pi / 30.0) * (rpm_from * t + 0.5 * rate * t * t))
+        outputs.append(decimator.push(run.run(F, eta, z, state)))
+    return np.concatenate(outputs)
 
 
 def _nonlinear_start(engine, system, rpm, static_factors):
