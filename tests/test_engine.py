@@ -349,6 +349,20 @@ def test_measured_traces_reproduce_the_model_load(tmp_path, engine):
     assert info.value.key == "speed" and info.value.file == str(csv)
 
 
+def test_load_table_equals_the_load_at_each_speed(engine):
+    """Oracle: the sweep's load table (patterns of unit gas force per cylinder and of unit
+    omega^2 evaluated once, pressures interpolated with weights found once) equals
+    ``generalized_load`` speed by speed to round-off (1e-12 of the peak), with one weaker
+    cylinder so that the cylinders differ."""
+    weak = engine.with_imep_factors([1.0, 1.0, 0.9, 1.0])
+    speeds = np.array([1000.0, 2345.0, 6000.0])
+    theta = np.linspace(-3.0, 15.0, 301)                   # beyond one cycle, both sides
+    table = weak.load_table(speeds, theta)
+    direct = np.stack([weak.generalized_load(n, theta) for n in speeds])
+    assert table.shape == (3, 301, 6)
+    assert np.abs(table - direct).max() < 1e-12 * np.abs(direct).max()
+
+
 # ----------------------------------------------------------------- rigid-body modes
 
 def test_rigid_body_frequencies_of_the_default_powertrain(engine):

@@ -267,3 +267,151 @@ def newmark_port_kernel(G, H, Fs, h, x0, v0, a0, W, P, Q, kinds, par, state, X, 
             X[k, j] = xt[j] + hh * A[k, j]
             V[k, j] = vt[j] + hv * A[k, j]
     return failed
+
+
+@njit(cache=True, nogil=True, fastmath=True, inline="always")
+def _modal_load(Lr, Li, f, n_re, n_im):
+    """Modal load ``n = L f`` (real and imaginary parts) of the load ``f``."""
+    for j in range(n_re.shape[0]):
+        n_re[j] = 0.0
+        n_im[j] = 0.0
+    for c in range(f.shape[0]):
+        fc = f[c]
+        Lrc = Lr[c]
+        Lic = Li[c]
+        for j in range(n_re.shape[0]):
+            n_re[j] += Lrc[j] * fc
+            n_im[j] += Lic[j] * fc
+
+
+@njit(cache=True, nogil=True, fastmath=True, inline="always")
+def _modal_predictor(lr, li, gr, gi, g_re, g_im, n_re, n_im, er, ei):
+    """``eta <- lam_d eta + gain (g + n)`` in place: the step without the new port forces."""
+    for j in range(er.shape[0]):
+        sr = g_re[j] + n_re[j]
+        si = g_im[j] + n_im[j]
+        a = lr[j] * er[j] - li[j] * ei[j] + gr[j] * sr - gi[j] * si
+        ei[j] = lr[j] * ei[j] + li[j] * er[j] + gr[j] * si + gi[j] * sr
+        er[j] = a
+
+
+@njit(cache=True, nogil=True, fastmath=True, inline="always")
+def _real_rows(Wr, Wi, er, ei, out):
+    """``out = Re(W eta)`` for the rows of ``W`` (real and imaginary parts)."""
+    for c in range(out.shape[0]):
+        Wrc = Wr[c]
+        Wic = Wi[c]
+        y = 0.0
+        for j in range(er.shape[0]):
+            y += Wrc[j] * er[j] - Wic[j] * ei[j]
+        out[c] = y
+
+
+@njit(cache=True, nogil=True, fastmath=True, inline="always")
+def _port_load(Br, Bi, z, n_re, n_im, g_re, g_im):
+    """Modal load of the step ``g = n + B z`` (external and port forces)."""
+    for j in range(g_re.shape[0]):
+        g_re[j] = n_re[j]
+        g_im[j] = n_im[j]
+    for e in range(z.shape[0]):
+        ze = z[e]
+        Bre = Br[e]
+        Bie = Bi[e]
+        for j in range(g_re.shape[0]):
+            g_re[j] += Bre[j] * ze
+            g_im[j] += Bie[j] * ze
+
+
+@njit(cache=True, nogil=True, fastmath=True, inline="always")
+def _port_correction(gr, gi, g_re, g_im, n_re, n_im, er, ei):
+    """``eta += gain (g - n)``: the port forces' part of the step."""
+    for j in range(er.shape[0]):
+        br = g_re[j] - n_re[j]
+        bi = g_im[j] - n_im[j]
+        er[j] += gr[j] * br - gi[j] * bi
+        ei[j] += gr[j] * bi + gi[j] * br
+
+
+@njit(cache=True, nogil=True)
+def _port_newton(kinds, par, state, ul, vl, Qu, Qv, z, r, J, tol, max_iter):
+    """Newton on the port forces ``z`` (in place) of one step: ``z_e = f_e(ul_e - (Qu z)_e,
+    vl_e - (Qv z)_e)``, from the given ``z``; the states are committed. True on success."""
+    m = z.shape[0]
+    converged = False
+    for _ in range(max_iter):
+        big = 1.0
+        worst = 0.0
+        for e in range(m):
+            f, kt, ct = port_force(kinds[e], ul[e] - _dot(Qu[e], z), vl[e] - _dot(Qv[e], z),
+                                   par[e], state[e])
+            r[e] = f - z[e]
+            big = max(big, abs(z[e]))
+            worst = max(worst, abs(r[e]))
+            for j in range(m):
+                J[e, j] = kt * Qu[e, j] + ct * Qv[e, j]
+            J[e, e] += 1.0
+        if worst <= tol * big:
+            converged = True
+            break
+        _solve_in_place(J, r)
+        for e in range(m):
+            z[e] += r[e]
+    for e in range(m):
+        commit_state(kinds[e], ul[e] - _dot(Qu[e], z), vl[e] - _dot(Qv[e], z), par[e],
+                     state[e])
+    return converged
+
+
+@njit(cache=True, nogil=True, fastmath=True)
+def modal_port_kernel(lam_d, gain, L, B, Up, Vp, Qu, Qv, W, Wl, Wz, F, eta, z, kinds, par,
+                      state, out, tol, max_iter):
+    r"""Newmark average acceleration with port laws in modal coordinates: the trapezoidal
+    modal recurrence :math:`\eta_{k+1} = \lambda_d\eta_k + \gamma(g_k + g_{k+1})` of the linear
+    model (:class:`~powertrain.solvers.newmark.ModalNewmark`) with the modal load
+    :math:`g = \mathbf L\mathbf f + \mathbf B\mathbf z` of the external load and of the port
+    forces :math:`\mathbf z` (``B`` the modal map of :math:`-\mathbf P^T\mathbf z`). The port
+    motions are :math:`\mathbf u = \mathrm{Re}(\mathbf U_p\eta)`,
+    :math:`\dot{\mathbf u} = \mathrm{Re}(\mathbf V_p\eta)`, so with the predictor
+    :math:`\eta^*` (the step without the new port forces)
+    :math:`\mathbf u = \mathrm{Re}(\mathbf U_p\eta^*) - \mathbf Q_u\mathbf z`,
+    :math:`\mathbf Q_u = -\mathrm{Re}(\mathbf U_p\,\mathrm{diag}\gamma\,\mathbf B)`
+    (:math:`= \tfrac{h^2}4\mathbf Q` of :func:`newmark_port_kernel`; :math:`\mathbf Q_v` with
+    :math:`\mathbf V_p`, :math:`= \tfrac h2\mathbf Q`), and Newton solves the m port equations
+    per step as there.
+
+    Modal arrays are split into real and imaginary parts, rows per load, port or output
+    (``L = (Lr, Li)`` (n_load, n_modes), ``B`` (m, n_modes), ``Up``, ``Vp`` (m, n_modes),
+    ``W`` (n_out, n_modes)). Outputs ``out`` (n_rows, n_out) at steps 0 .. n_rows - 1 of the
+    loads ``F`` (n_rows + 1, n_load): ``y = Re(W eta) + Wl f + Wz z``. ``eta`` (n_modes,)
+    complex and the port forces ``z`` (m,) are the state at step 0 on entry and at step
+    n_rows on return; ``state`` the port laws' (updated in place). Returns the number of
+    steps at which Newton did not converge.
+    """
+    Lr, Li = L
+    Br, Bi = B
+    n_modes = eta.shape[0]
+    m = z.shape[0]
+    lr, li, gr, gi = lam_d.real.copy(), lam_d.imag.copy(), gain.real.copy(), gain.imag.copy()
+    er, ei = eta.real.copy(), eta.imag.copy()
+    n_re, n_im = np.zeros(n_modes), np.zeros(n_modes)
+    g_re, g_im = np.zeros(n_modes), np.zeros(n_modes)
+    _modal_load(Lr, Li, F[0], n_re, n_im)
+    _port_load(Br, Bi, z, n_re, n_im, g_re, g_im)
+    ul, vl, r, y = np.empty(m), np.empty(m), np.empty(m), np.empty(out.shape[1])
+    J = np.empty((m, m))
+    failed = 0
+    for k in range(out.shape[0]):
+        _real_rows(W[0], W[1], er, ei, y)
+        for c in range(y.shape[0]):
+            out[k, c] = y[c] + _dot(Wl[c], F[k]) + _dot(Wz[c], z)
+        _modal_load(Lr, Li, F[k + 1], n_re, n_im)
+        _modal_predictor(lr, li, gr, gi, g_re, g_im, n_re, n_im, er, ei)
+        _real_rows(Up[0], Up[1], er, ei, ul)
+        _real_rows(Vp[0], Vp[1], er, ei, vl)
+        if not _port_newton(kinds, par, state, ul, vl, Qu, Qv, z, r, J, tol, max_iter):
+            failed += 1
+        _port_load(Br, Bi, z, n_re, n_im, g_re, g_im)
+        _port_correction(gr, gi, g_re, g_im, n_re, n_im, er, ei)
+    for j in range(n_modes):
+        eta[j] = er[j] + 1j * ei[j]
+    return failed

@@ -8,6 +8,7 @@ Each model gives the pressure of every cylinder over an engine cycle at a speed
 from __future__ import annotations
 
 import dataclasses
+import functools
 from dataclasses import dataclass
 
 import numpy as np
@@ -97,9 +98,7 @@ class SingleZoneCombustion:
             ``imep_target`` [Pa] per cylinder, ``heat`` [J] per cylinder, ``p_intake``,
             ``p_exhaust`` [Pa].
         """
-        n = self.grid_points
-        theta = -np.pi + 4.0 * np.pi * np.arange(n) / n
-        V, dV = crank.volume(theta)
+        theta, V, dV, (b_in, b_ex, p1) = _cycle_basis(self, crank)
         vd = crank.swept_volume
         imep = self.full_load.imep(omega, crank.displacement, load)
         p_in = comb.boost_pressure(
@@ -109,11 +108,8 @@ class SingleZoneCombustion:
             volumetric_efficiency=self.volumetric_efficiency)
         p_in = float(np.clip(p_in, self.intake_pressure_min, self.intake_pressure_max))
         p_ex = max(self.ambient_pressure, self.exhaust_pressure_ratio * p_in)
-        p0, p1 = comb.pressure_parts(theta, V, p_in, p_ex, self.n_compression, self.n_expansion,
-                                     self.start, self.duration, self.wiebe_a, self.wiebe_m,
-                                     self.exhaust_valve_opening, self.blowdown_end,
-                                     self.valve_overlap)
-        dtheta = 4.0 * np.pi / n
+        p0 = p_in * b_in + p_ex * b_ex
+        dtheta = 4.0 * np.pi / theta.size
         targets = imep * np.asarray(self.imep_factors, dtype=float)
         heats = np.array([comb.calibrate_heat(p0, p1, dV, dtheta, vd, t) for t in targets])
         pressure = p0[None, :] + heats[:, None] * p1[None, :]
@@ -127,6 +123,23 @@ class SingleZoneCombustion:
     def speed_range(self):
         """(min, max) speed of the full-load curve [rad/s]."""
         return float(self.full_load.speed[0]), float(self.full_load.speed[-1])
+
+
+@functools.lru_cache(maxsize=8)
+def _cycle_basis(model: SingleZoneCombustion, crank: CrankTrain):
+    """The single-zone model's cycle grid, volume, dV/dtheta and pressure basis
+    (:func:`powertrain.physics.combustion.pressure_basis`), which do not depend on the
+    speed: computed once per model and crank train (both compared by identity)."""
+    n = model.grid_points
+    theta = -np.pi + 4.0 * np.pi * np.arange(n) / n
+    V, dV = crank.volume(theta)
+    basis = comb.pressure_basis(theta, V, model.n_compression, model.n_expansion, model.start,
+                                model.duration, model.wiebe_a, model.wiebe_m,
+                                model.exhaust_valve_opening, model.blowdown_end,
+                                model.valve_overlap)
+    for a in (theta, V, dV, *basis):
+        a.setflags(write=False)               # shared by every call
+    return theta, V, dV, basis
 
 
 @dataclass(frozen=True, eq=False)

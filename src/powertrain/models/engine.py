@@ -262,6 +262,20 @@ class Engine:
             out[:, i] = np.interp(local[:, i], theta_g, p[i], period=period)
         return out
 
+    def cylinder_pressures(self, speeds_rpm, crank_angle_rad, load: float = 1.0) -> np.ndarray:
+        """:meth:`cylinder_pressure` at every speed [rpm], shape ``(n_speeds, n, n_cyl)``:
+        the same periodic linear interpolation (to round-off), its weights found once."""
+        local = self.local_angles(crank_angle_rad)
+        cycles = [self.cycle_pressures(n, load) for n in np.atleast_1d(speeds_rpm)]
+        theta_g = cycles[0][0]
+        if any(not np.array_equal(c[0], theta_g) for c in cycles):
+            return np.stack([self.cylinder_pressure(n, crank_angle_rad, load)
+                             for n in np.atleast_1d(speeds_rpm)])
+        i0, i1, w = _periodic_interpolation(local, theta_g, 4.0 * np.pi)
+        p = np.stack([c[1] for c in cycles])                        # (n_speeds, n_cyl, N)
+        cyl = np.arange(local.shape[1])[None, :]
+        return p[:, cyl, i0] * (1.0 - w) + p[:, cyl, i1] * w
+
     def local_angles(self, crank_angle_rad) -> np.ndarray:
         """Each cylinder's cycle angle on ``[-π, 3π)`` [rad], shape ``(n, n_cyl)``."""
         th = np.atleast_1d(np.asarray(crank_angle_rad, dtype=float))
@@ -293,6 +307,22 @@ class Engine:
         omega = self._check_speed(rpm) * RPM
         p = self.cylinder_pressure(rpm, th, load)
         fg = (p - ct.crankcase_pressure) * ct.piston_area
+        total, out = self._block_load(th, omega, fg)
+        if not detail:
+            return total
+        info = self.cycle_pressures(rpm, load)[2]
+        imep = self.indicated_work(rpm, load) / ct.swept_volume
+        return Excitation(rpm=float(rpm), crank_angle=th, pressure=p, gas_force=fg,
+                          inertia_force=out["inertia"], torque=out["torque"],
+                          torque_gas=out["torque_gas"], torque_inertia=out["torque_inertia"],
+                          load=total, imep=imep, info=dict(info))
+
+    def _block_load(self, th, omega, fg):
+        """Generalized load (n, 6) on the block at angles ``th`` [rad], speed ``omega``
+        [rad/s] and gas forces ``fg`` (n, n_cyl) [N], and the per-cylinder forces of
+        :func:`~powertrain.physics.slider_crank.crank_forces` (dict of (n, n_cyl)). Linear in
+        the gas forces and in omega^2 (:meth:`load_table` relies on it)."""
+        ct = self.crank
         u = ct.cylinder_axis
         s = ct.lateral_axis
         su = np.cross(s, u)
@@ -332,14 +362,7 @@ class Engine:
                 f_u, f_s = bal.shaft_force(th, omega, sh.mass_radius, sh.phase, sh.sense,
                                            self.balancer.ratio)
                 add(f_u[:, None] * u + f_s[:, None] * s, sh.position)
-        if not detail:
-            return np.hstack([force, moment])
-        info = self.cycle_pressures(rpm, load)[2]
-        imep = self.indicated_work(rpm, load) / ct.swept_volume
-        return Excitation(rpm=float(rpm), crank_angle=th, pressure=p, gas_force=fg,
-                          inertia_force=out["inertia"], torque=out["torque"],
-                          torque_gas=out["torque_gas"], torque_inertia=out["torque_inertia"],
-                          load=np.hstack([force, moment]), imep=imep, info=dict(info))
+        return np.hstack([force, moment]), out
 
     def indicated_work(self, rpm: float, load: float = 1.0) -> np.ndarray:
         r"""Net indicated work per cycle of every cylinder, :math:`W_i = \oint p_i\,dV` [J]."""
@@ -378,6 +401,25 @@ class Engine:
         """
         return self._evaluate(rpm, crank_angle_rad, load, detail=False)
 
+    def load_table(self, speeds_rpm, crank_angle_rad, load: float = 1.0) -> np.ndarray:
+        """Generalized load (n_speeds, n, 6) at every speed [rpm] and angle [rad]: the
+        :meth:`generalized_load` of each speed to round-off, from patterns evaluated once: the
+        block load is linear in the gas forces and in omega^2 (:meth:`_block_load`), so it is
+        sum_i F_g,i G_i + omega^2 I with G_i the load of a unit gas force in cylinder i and I
+        that of a unit omega^2."""
+        th = np.atleast_1d(np.asarray(crank_angle_rad, dtype=float))
+        speeds = np.atleast_1d(np.asarray(speeds_rpm, dtype=float))
+        ct = self.crank
+        unit = np.eye(ct.n_cylinders)
+        gas = [self._block_load(th, 0.0, np.broadcast_to(unit[i], (th.size, unit.shape[0])))[0]
+               for i in range(unit.shape[0])]
+        inertia = self._block_load(th, 1.0, np.zeros((th.size, unit.shape[0])))[0]
+        table = ((speeds * RPM) ** 2)[:, None, None] * inertia
+        fg = (self.cylinder_pressures(speeds, th, load) - ct.crankcase_pressure) * ct.piston_area
+        for i, g in enumerate(gas):
+            table += fg[:, :, i, None] * g
+        return table
+
     def assemble(self):
         """The assembled linear model: body, mounts and chassis
         (:func:`powertrain.assembly.assemble`)."""
@@ -392,3 +434,17 @@ class Engine:
         from powertrain.assembly import assemble
         b = self.body
         return assemble(b.mass, b.cg, b.inertia, self.mounts).rigid_body_modes()
+
+
+def _periodic_interpolation(x, xp, period):
+    """Indices ``i0``, ``i1`` into ``xp`` and weights ``w`` (shapes of ``x``) of the linear
+    interpolation of a ``period``-periodic function sampled at ``xp``, as ``np.interp(x, xp,
+    fp, period=period)``: ``fp[i0] (1 - w) + fp[i1] w``."""
+    xp_m = np.mod(xp, period)
+    order = np.argsort(xp_m, kind="stable")
+    xs = np.concatenate([[xp_m[order[-1]] - period], xp_m[order], [xp_m[order[0]] + period]])
+    idx = np.concatenate([[order[-1]], order, [order[0]]])
+    x_m = np.mod(x, period)
+    j = np.clip(np.searchsorted(xs, x_m, side="right") - 1, 0, xs.size - 2)
+    w = (x_m - xs[j]) / (xs[j + 1] - xs[j])
+    return idx[j], idx[j + 1], w

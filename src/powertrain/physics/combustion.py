@@ -78,9 +78,12 @@ def _ramp(theta, start, end):
     return 0.5 - 0.5 * np.cos(np.pi * t)
 
 
-def pressure_parts(theta, volume, p_intake, p_exhaust, n_c, n_e, theta_start, duration,
-                   a, m, theta_evo, theta_evc, overlap):
-    r"""Cylinder pressure split as :math:`p = p_0 + Q_{tot}\,p_1`.
+def pressure_basis(theta, volume, n_c, n_e, theta_start, duration, a, m, theta_evo, theta_evc,
+                   overlap):
+    r"""Cylinder pressure split as :math:`p = p_i\,b_i + p_e\,b_e + Q_{tot}\,p_1`: the
+    pressure is linear in the intake pressure :math:`p_i`, the exhaust back-pressure
+    :math:`p_e` and the heat released :math:`Q_{tot}`, so the three traces do not depend on
+    the operating point.
 
     Parameters
     ----------
@@ -89,8 +92,6 @@ def pressure_parts(theta, volume, p_intake, p_exhaust, n_c, n_e, theta_start, du
         :math:`-\pi` (bottom dead centre before compression).
     volume : ndarray
         Cylinder volume on the grid [m³].
-    p_intake, p_exhaust : float
-        Intake (boost) and exhaust back-pressure [Pa].
     n_c, n_e : float
         Polytropic exponents of compression and of combustion/expansion [-].
     theta_start, duration : float
@@ -104,18 +105,18 @@ def pressure_parts(theta, volume, p_intake, p_exhaust, n_c, n_e, theta_start, du
 
     Returns
     -------
-    p0 : ndarray
-        Pressure without heat release [Pa].
+    b_i, b_e : ndarray
+        Pressure without heat release per unit intake and exhaust pressure [-].
     p1 : ndarray
         Pressure per joule of heat released [Pa/J].
     """
     theta = np.asarray(theta, dtype=float)
     V = np.asarray(volume, dtype=float)
     v_bdc = V[0]
-    comp = p_intake * (v_bdc / V) ** n_c
+    comp = (v_bdc / V) ** n_c
     i_s = np.searchsorted(theta, theta_start)
     v_s = np.interp(theta_start, theta, V)
-    p_s = p_intake * (v_bdc / v_s) ** n_c
+    p_s = (v_bdc / v_s) ** n_c
     # p V^ne after the start of combustion, without and with (unit) heat release
     xb, _ = wiebe(theta, theta_start, duration, a, m)
     integrand = V ** (n_e - 1.0)
@@ -123,7 +124,7 @@ def pressure_parts(theta, volume, p_intake, p_exhaust, n_c, n_e, theta_start, du
     inc = 0.5 * (integrand[1:] + integrand[:-1]) * np.diff(xb)
     cum = np.concatenate([[0.0], np.cumsum(inc)])
     closed = theta >= theta_start
-    p0 = np.where(closed, p_s * v_s**n_e / V**n_e, comp)
+    b0 = np.where(closed, p_s * v_s**n_e / V**n_e, comp)
     p1 = np.where(closed, (n_e - 1.0) * cum / V**n_e, 0.0)
     if i_s == 0:
         raise ValueError("start of combustion must lie after bottom dead centre")
@@ -131,10 +132,7 @@ def pressure_parts(theta, volume, p_intake, p_exhaust, n_c, n_e, theta_start, du
     # valve overlap around gas-exchange TDC, intake stroke
     w_bd = _ramp(theta, theta_evo, theta_evc)
     w_ov = _ramp(theta, 2 * np.pi - overlap, 2 * np.pi + overlap)
-    gas_exchange = p_exhaust + (p_intake - p_exhaust) * w_ov
-    p0 = p0 * (1 - w_bd) + gas_exchange * w_bd
-    p1 = p1 * (1 - w_bd)
-    return p0, p1
+    return b0 * (1 - w_bd) + w_ov * w_bd, (1 - w_ov) * w_bd, p1 * (1 - w_bd)
 
 
 def indicated_work(pressure, dvolume, dtheta):

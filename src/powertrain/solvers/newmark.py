@@ -16,7 +16,7 @@ import threading
 import numpy as np
 
 from powertrain.kernels.newmark import modal_trapezoid_kernel, newmark_kernel
-from powertrain.kernels.port_forces import newmark_port_kernel
+from powertrain.kernels.port_forces import modal_port_kernel, newmark_port_kernel
 
 
 def _prepare(M, C, K, h):
@@ -307,3 +307,69 @@ class ModalNewmark:
             work.arrays = (np.empty((rows, m)), np.empty((rows, m)), np.empty((rows, n_out)),
                            np.empty((rows, n_out)), np.empty((n_load, m), dtype=complex))
         return work.arrays
+
+
+class ModalPortNewmark:
+    r""":func:`newmark_ports` in modal coordinates, for a model whose matrices stay fixed:
+    the port laws ``ports`` in parallel with the linear model of ``modal``
+    (:class:`ModalNewmark`), Newton on the m port forces per step with the m x m matrices
+    :math:`\mathbf Q_u = \tfrac{h^2}4\mathbf Q`, :math:`\mathbf Q_v = \tfrac h2\mathbf Q` in
+    their modal form (:func:`powertrain.kernels.port_forces.modal_port_kernel`; equal to
+    :func:`newmark_ports` to round-off, tests/test_time_domain_laws.py). Outputs: the
+    accelerations of the coordinates ``dofs``.
+
+    Parameters
+    ----------
+    modal : ModalNewmark
+    ports : PortForces
+        The port laws (every row with a law; ``ports.select(ports.kinds != NONE)``).
+    h : float
+        Time step [s].
+    dofs : ndarray of int
+        Coordinates whose accelerations are returned.
+    """
+
+    def __init__(self, modal, ports, h, dofs):
+        n = modal.n
+        self.modal, self.ports, self.h = modal, ports, float(h)
+        P = np.asarray(ports.rows, float)
+        lam = modal.lam_r
+        self.lam_d = (1 + 0.5 * h * lam) / (1 - 0.5 * h * lam)
+        self.gain = (0.5 * h) / (1 - 0.5 * h * lam)
+        B = -(modal.Psi_inv_r[:, n:] @ (modal.Minv @ P.T))            # (n_modes, m)
+        Up, Vp = P @ modal.Psi_r[:n], P @ modal.Psi_r[n:]
+        read = np.eye(n)[np.asarray(dofs, int)]
+        (w_re, w_im), w_load = modal.output_map(0 * read, 0 * read, read)
+        self.arrays = (_parts(modal.load_map_r.T), _parts(B.T), _parts(Up), _parts(Vp),
+                       np.ascontiguousarray(-((Up * self.gain) @ B).real),
+                       np.ascontiguousarray(-((Vp * self.gain) @ B).real),
+                       (np.ascontiguousarray(w_re.T), np.ascontiguousarray(w_im.T)),
+                       np.ascontiguousarray(w_load), np.ascontiguousarray(-read @ modal.Minv @ P.T))
+
+    def modal_state(self, x, v) -> np.ndarray:
+        """Modal coordinates (n_modes,) complex of the state ``(x, v)``."""
+        return self.modal.Psi_inv_r @ np.concatenate([x, v]).astype(complex)
+
+    def run(self, F, eta, z, state) -> np.ndarray:
+        """Accelerations (n_rows, n_read) at steps 0 .. n_rows - 1 of the loads ``F``
+        (n_rows + 1, load_dofs) [N]; ``eta``, the port forces ``z`` (m,) [N] and the laws'
+        ``state`` are the state at step 0 and are updated in place to step n_rows.
+
+        Raises
+        ------
+        FloatingPointError
+            Newton did not converge at some step (the names of the port laws are given).
+        """
+        out = np.empty((F.shape[0] - 1, self.arrays[-2].shape[0]))
+        failed = modal_port_kernel(self.lam_d, self.gain, *self.arrays,
+                                   np.ascontiguousarray(F, float), eta, z, self.ports.kinds,
+                                   self.ports.parameters, state, out, PORT_TOL, PORT_MAX_ITER)
+        if failed:
+            raise FloatingPointError(f"port laws {', '.join(self.ports.names)}: Newton did "
+                                     f"not converge at {failed} of {out.shape[0]} steps")
+        return out
+
+
+def _parts(a):
+    """Real and imaginary parts of ``a`` as contiguous arrays (the kernels' modal form)."""
+    return np.ascontiguousarray(a.real), np.ascontiguousarray(a.imag)

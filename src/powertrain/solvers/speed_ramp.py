@@ -4,7 +4,8 @@ The speed rises linearly, :math:`n(t) = n_0 + \dot n\,t`, so the crank angle is
 :math:`\theta(t) = \tfrac{2\pi}{60}(n_0 t + \tfrac12\dot n t^2)`. The load at every step is
 the engine's generalized load at that speed and angle, interpolated bilinearly in a table
 sampled every :data:`LOAD_RPM_STEP` rpm and :data:`LOAD_ANGLE_STEP_DEG` degrees of the
-cycle (speed-dependent inertia and gas forces). The same assembled model as the stepped
+cycle (speed-dependent inertia and gas forces; :meth:`Engine.load_table` evaluates the engine
+model's speed-independent patterns once). The same assembled model as the stepped
 run-up is integrated by Newmark average acceleration in modal form
 (:class:`~powertrain.solvers.newmark.ModalNewmark`, the same recurrence as the run-up's
 stepper) at ``oversample`` times the output rate (at least one step per crank degree at the
@@ -47,8 +48,7 @@ def _load_table(engine, rpm_from, rpm_to):
     speeds = np.clip(speeds, rpm_from, rpm_to)
     n_theta = int(round(720.0 / LOAD_ANGLE_STEP_DEG))
     theta = np.arange(n_theta) * (4 * np.pi / n_theta)
-    table = np.stack([np.asarray(engine.generalized_load(float(n), theta), float)
-                      for n in speeds])                            # (n_rpm, n_theta, 6)
+    table = engine.load_table(speeds, theta)                       # (n_rpm, n_theta, 6)
     table = np.concatenate([table, table[:, :1]], axis=1)           # periodic wrap
     return speeds, table, n_theta
 
@@ -106,11 +106,13 @@ def simulate_sweep(engine, rpm_from, rpm_to, rate_rpm_per_s, sample_rate=8192.0,
         b = engine.body
         system = assemble(b.mass, b.cg, b.inertia, engine.mounts)
     load = _load_table(engine, rpm_from, rpm_to)
-    decimator = _Decimator(m, len(system.channels))
+    dofs, to_channels = _channel_dofs(system.channel_matrix)
+    decimator = _Decimator(m, dofs.size)
     ramp = (rpm_from, rate_rpm_per_s, h, n_steps)
     with threadpool_limits(limits=1, user_api="blas"):     # small matrices: see run_runup
-        y, method = _integrate_ramp(engine, system, load, ramp, decimator, progress,
+        y, method = _integrate_ramp(engine, system, load, ramp, dofs, decimator, progress,
                                     static_factors)
+    y = y @ to_channels.T
     t_out = (decimator.first_output_index + np.arange(y.shape[0])) / sample_rate
     rpm_out = rpm_from + rate_rpm_per_s * t_out
     block = np.ascontiguousarray(y.T)
@@ -123,27 +125,37 @@ def simulate_sweep(engine, rpm_from, rpm_to, rate_rpm_per_s, sample_rate=8192.0,
     return RawRecording(t_out, chans, rpm_out, None, "simulated sweep", [note]).validate()
 
 
-def _integrate_ramp(engine, system, load, ramp, decimator, progress, static_factors):
-    """Decimated channel accelerations of the ramp and the method's name: modal for a
-    linear model, else dense engine cycle by engine cycle."""
+def _channel_dofs(channel_matrix):
+    """The coordinates the channels read (columns of ``channel_matrix`` not all zero: the
+    body's six) and the map (n_ch, n_read) from their accelerations to the channels. The
+    sweep integrates and decimates those and maps them after the decimation (both linear, so
+    equal to round-off, and fewer signals than channels)."""
+    dofs = np.flatnonzero(np.any(channel_matrix != 0, axis=0))
+    return dofs, np.ascontiguousarray(channel_matrix[:, dofs])
+
+
+def _integrate_ramp(engine, system, load, ramp, dofs, decimator, progress, static_factors):
+    """Decimated accelerations of the coordinates ``dofs`` over the ramp and the method's
+    name: modal for a linear model, else dense engine cycle by engine cycle."""
     from powertrain.solvers.newmark import ModalNewmark
     if system.port_forces() is None and static_factors is None:
         modal = ModalNewmark(system.M, system.C, system.K, load_dofs=6)
-        return _integrate(modal, system, load, ramp, _initial_state(engine, modal, ramp[0]),
+        return _integrate(modal, dofs, load, ramp, _initial_state(engine, modal, ramp[0]),
                           decimator, progress), "modal"
-    return (_integrate_nonlinear(engine, system, load, ramp, decimator, static_factors),
-            "dense, nonlinear mount elements cycle by cycle")
+    return _integrate_nonlinear(engine, system, load, ramp, dofs, decimator, static_factors)
 
 
-def _integrate(modal, system, load, ramp, eta, decimator, progress):
-    """Decimated channel accelerations (n_out, n_ch) of the ramp ``(rpm_from, rate [rpm/s],
-    step h [s], steps)`` from the modal state ``eta``, chunk by chunk (one Numba kernel:
+def _integrate(modal, dofs, load, ramp, eta, decimator, progress):
+    """Decimated accelerations (n_out, n_read) of the coordinates ``dofs`` over the ramp
+    ``(rpm_from, rate [rpm/s], step h [s], steps)`` from the modal state ``eta``, chunk by
+    chunk (one Numba kernel:
     load, recurrence and outputs, :func:`powertrain.kernels.speed_ramp.modal_ramp_kernel`)."""
     from powertrain.kernels.speed_ramp import modal_ramp_kernel
     rpm_from, rate_rpm_per_s, h, n_steps = ramp
     speeds, table, _ = load
-    Z = np.zeros_like(system.channel_matrix)
-    (w_re, w_im), w_load = modal.output_map(Z, Z, system.channel_matrix)
+    read = np.eye(modal.n)[dofs]
+    Z = np.zeros_like(read)
+    (w_re, w_im), w_load = modal.output_map(Z, Z, read)
     lam_d = (1 + 0.5 * h * modal.lam_r) / (1 - 0.5 * h * modal.lam_r)
     gain = (0.5 * h) / (1 - 0.5 * h * modal.lam_r)
     chunk = CHUNK_OUT * decimator.m         # a multiple of m keeps the decimation aligned
@@ -174,15 +186,21 @@ def _cycle_bounds(rpm_from, rate, h, n_steps):
     return np.r_[0, inner, n_steps]
 
 
-def _integrate_nonlinear(engine, system, load, ramp, decimator, static_factors):
-    """Decimated channel accelerations of the ramp with nonlinear mount elements: dense
-    Newmark engine cycle by engine cycle (:class:`~powertrain.solvers.cycle_newmark.
-    CycleIntegrator`), from the harmonic fixed point at the first speed with the port laws
-    on their steady loop, the amplitude law and the static factors updated per cycle."""
+def _integrate_nonlinear(engine, system, load, ramp, dofs, decimator, static_factors):
+    """Decimated accelerations of the coordinates ``dofs`` over the ramp with nonlinear
+    mount elements and the method's name: modal with the port forces when the networks keep
+    their scale (:func:`_integrate_ports`; it starts with the acceleration of the equation
+    of motion), else dense Newmark engine cycle by engine cycle
+    (:class:`~powertrain.solvers.cycle_newmark.CycleIntegrator`), from the harmonic fixed
+    point at the first speed with the port laws on their steady loop, the amplitude law and
+    the static factors updated per cycle."""
     from powertrain.solvers.cycle_newmark import CycleIntegrator, cycle_amplitudes
     rpm_from, rate, h, n_steps = ramp
     x, state, amplitudes, stepper = _nonlinear_start(engine, system, rpm_from, static_factors)
     integrator = CycleIntegrator(stepper.scaling, stepper.ports, h, x[3])
+    if not integrator.varying and static_factors is None and integrator.laws.kinds.size:
+        return _integrate_ports(integrator, load, ramp, (x, state, amplitudes), dofs,
+                                decimator), "modal with the port laws, Newton per step"
     bounds = _cycle_bounds(rpm_from, rate, h, n_steps)
     rows = _Rows(decimator)
     for lo, hi in zip(bounds[:-1], bounds[1:]):
@@ -192,10 +210,34 @@ def _integrate_nonlinear(engine, system, load, ramp, decimator, static_factors):
                             (np.pi / 30.0) * (rpm_from * t + 0.5 * rate * t * t))
         factors = stepper.factors_at((rpm_from + rate * t.mean()) * np.pi / 30.0)
         (X, V, A, _), _ = integrator.run(F, x[:3], amplitudes, state, factors)
-        rows.push(A[:-1] @ system.channel_matrix.T)
+        rows.push(A[:-1, dofs])
         amplitudes = cycle_amplitudes(X[:-1] @ stepper.ports.rows.T)
         x = (X[-1], V[-1], A[-1], x[3])
-    return rows.done()
+    return rows.done(), "dense, nonlinear mount elements cycle by cycle"
+
+
+def _integrate_ports(integrator, load, ramp, start, dofs, decimator):
+    """Decimated accelerations of the coordinates ``dofs`` over the ramp of a model whose
+    networks keep their scale (port laws only, no amplitude law or static hook): modal
+    Newmark with the port forces, Newton per step, chunk by chunk
+    (:class:`~powertrain.solvers.newmark.ModalPortNewmark`), from ``start`` = (state
+    ``(x0, v0, a0, mean)``, port-law states, amplitudes)."""
+    from powertrain.solvers.newmark import ModalNewmark, ModalPortNewmark
+    rpm_from, rate, h, n_steps = ramp
+    (x0, v0, *_), state, amplitudes = start
+    s, laws = integrator.scaling, integrator.laws
+    C, K, _, _ = s.matrices(s.scales(integrator.ports.network_amplitudes(amplitudes)))
+    run = ModalPortNewmark(ModalNewmark(s.system.M, C, K, load_dofs=6), laws, h, dofs)
+    eta = run.modal_state(x0, v0)
+    z = laws.forces(laws.rows @ x0, laws.rows @ v0, state)
+    chunk = CHUNK_OUT * decimator.m         # a multiple of m keeps the decimation aligned
+    outputs = []
+    for lo in range(0, n_steps, chunk):
+        t = np.arange(lo, min(lo + chunk, n_steps) + 1) * h
+        F = _load_at(*load, rpm_from + rate * t,
+                     (np.pi / 30.0) * (rpm_from * t + 0.5 * rate * t * t))
+        outputs.append(decimator.push(run.run(F, eta, z, state)))
+    return np.concatenate(outputs)
 
 
 def _nonlinear_start(engine, system, rpm, static_factors):
