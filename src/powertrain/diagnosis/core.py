@@ -310,13 +310,45 @@ def _diagnose(measured, engine, noise_floor, effects, pairs, do_bands, rule, sch
             bands = band_check(factory, chosen.effects[0], s.data,
                                s.train_all[::max(1, s.train_all.size // 48)])
     eq = cand.equivalents(s, chosen, rule, noise_mse=e_n)
+    what = "order magnitudes and phases" if s.data.has_phase else "order magnitudes"
     text = verdict.text if not eq else verdict.text + (
-        f"; the order magnitudes cannot tell it from {len(eq)} equivalent explanation(s): "
+        f"; the {what} cannot tell it from {len(eq)} equivalent explanation(s): "
         + "; ".join(x["text"] for x in eq[:3]) + ("; ..." if len(eq) > 3 else ""))
+    finding = _finding(s, chosen)
+    if finding is not None:
+        text += f"; {finding['text']}"
     return DiagnosisResult(
         s.data, s.src, getattr(engine, "name", ""), gap_map, gap_after, parts, rigid, found,
         sigma, s.split_dict(), baseline, outcomes, chosen, verdict.label, text, bands,
         time.perf_counter() - t0, synthetic=bool(getattr(measured, "synthetic", False)),
         noise_mse_heldout=e_n, ambiguous=verdict.ambiguous, rule=rule,
         verdict_kind=verdict.kind, equivalents=eq,
-        budget_hits=[o.label for o in outcomes if o.budget_hit])
+        budget_hits=[o.label for o in outcomes if o.budget_hit], finding=finding,
+        phase=_phase_dict(s, chosen))
+
+
+def phase_kind(data) -> str:
+    """Measured phase: ``"all"`` (half orders too), ``"whole"`` (whole orders only) or
+    ``"none"``."""
+    return "all" if data.has_half_order_phase else "whole" if data.has_phase else "none"
+
+
+def _finding(s, chosen):
+    """What the chosen single effect names (``Effect.finding``), or None."""
+    if chosen is None or len(chosen.effects) != 1:
+        return None
+    e = chosen.effects[0]
+    from powertrain.effects import EFFECTS
+    return EFFECTS[e].finding(chosen.params[e], s.problem.engine, phase_kind(s.data))
+
+
+def _phase_dict(s, chosen) -> dict:
+    """The ``phase`` entry of the JSON: what phase was measured, the crank-angle offset
+    estimated with the chosen answer (baseline if none) [deg]."""
+    sc = {} if chosen is None else {e: chosen.params[e] for e in chosen.effects}
+    offset = None
+    if s.problem.phase_w is not None:
+        offset = math.degrees(s.problem.crank_offset(sc))
+    return {"measured": phase_kind(s.data), "crank_offset_deg": offset,
+            "scored_points": 0 if s.problem.phase_w is None
+            else int(s.problem.phase_on["train"].sum() + s.problem.phase_on["test"].sum())}

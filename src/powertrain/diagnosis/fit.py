@@ -27,6 +27,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from powertrain.diagnosis.data import GapData, model_levels, noise_sigma_db, residuals_db
+from powertrain.diagnosis.phase import crank_offset, offset_prior, phase_gaps, phase_weights
 from powertrain.diagnosis.starts import start_points
 from powertrain.effects import EFFECTS, predict
 
@@ -102,6 +103,20 @@ class Problem:
         for part, cells in (("train", train_cells), ("test", test_cells)):
             if cells is not None:
                 self.valid[part] = self.valid[part] & np.asarray(cells, bool)[None]
+        self._phase_setup()
+
+    def _phase_setup(self):
+        """Measured phases and their weights per part (:mod:`powertrain.diagnosis.phase`);
+        ``phase_w`` None without phase."""
+        self.order = (self.sub.harmonic + 1) / 2.0
+        self.phase_w = None
+        if not self.data.has_phase:
+            return
+        self.phase = {k: self.sub.phase[v] for k, v in self.idx.items()}
+        self.phase_w = {k: np.where(self.valid[k], phase_weights(
+            self.meas[k], self.phase[k], self.data.floor, self.sigma_db), np.nan)
+            for k in self.idx}
+        self.phase_on = {k: np.isfinite(w) for k, w in self.phase_w.items()}
 
     def __getstate__(self):
         # sent to other processes (parallel fits): the engine without its pressure cache
@@ -123,7 +138,8 @@ class Problem:
         return Problem(self.hm["train"], self.hm["test"], self.data, self.idx["train"],
                        self.idx["test"], train_cells, test_cells)
 
-    def gaps(self, scenario, part="train"):
+    def velocity(self, scenario, part="train"):
+        """Complex model velocities of the measured orders (n_r, n_ch, 16) [m/s peak]."""
         # the physical part of the scenario is solved once per distinct value: a sensor
         # error only re-reads the same velocities (cheap finite-difference columns)
         phys = {k: v for k, v in scenario.items() if not EFFECTS[k].response_only}
@@ -141,13 +157,39 @@ class Problem:
         for k, v in scenario.items():
             if EFFECTS[k].response_only:
                 vel = EFFECTS[k].reading(vel, v)
-        sim = model_levels(vel, self.sub)
+        return vel
+
+    def gaps(self, scenario, part="train"):
+        """Level gaps [dB] (n_r, n_ch, n_q), NaN where not scored."""
+        sim = model_levels(self.velocity(scenario, part), self.sub)
         g = residuals_db(sim, self.meas[part], self.data.floor)
         return np.where(self.valid[part], g, np.nan)
 
+    def crank_offset(self, scenario) -> float:
+        """The run's crank-angle offset [rad] profiled on the training speeds."""
+        d = np.angle(self._order_velocity(scenario, "train")) - np.deg2rad(self.phase["train"])
+        return crank_offset(d, self.order, self.phase_w["train"], self.sigma_db)
+
+    def _order_velocity(self, scenario, part):
+        return self.velocity(scenario, part)[..., self.sub.harmonic]
+
+    def phase_gaps(self, scenario, part="train", delta=None):
+        """Phase residuals [dB] (n_r, n_ch, n_q), NaN where no phase is scored; None without
+        phase. ``delta``: the crank offset [rad] (default: profiled on the training
+        speeds)."""
+        if self.phase_w is None:
+            return None
+        delta = self.crank_offset(scenario) if delta is None else delta
+        return phase_gaps(self._order_velocity(scenario, part), self.phase[part],
+                          self.phase_w[part], self.order, delta)
+
     def vector(self, scenario, part="train"):
-        g = self.gaps(scenario, part)
-        return g[self.valid[part]]
+        g = self.gaps(scenario, part)[self.valid[part]]
+        if self.phase_w is None:
+            return g
+        delta = self.crank_offset(scenario)
+        gp = self.phase_gaps(scenario, part, delta)[self.phase_on[part]]
+        return np.concatenate([g, gp, [offset_prior(delta, self.sigma_db)]])
 
 
 @dataclass
@@ -312,9 +354,12 @@ def score(problem, effects, sc, params, sigma, rss, n, p, nfev, seconds, x=None)
     """Held-out scores of a scenario: mean squared gap per speed, overall, per channel."""
     g = problem.gaps(sc, "test")
     valid = np.isfinite(g)
-    per_rpm = np.array([np.mean(g[i][valid[i]] ** 2) if valid[i].any() else np.nan
+    both = g if problem.phase_w is None else np.concatenate(
+        [g, problem.phase_gaps(sc, "test")], axis=-1)        # level and phase gaps
+    ok = np.isfinite(both)
+    per_rpm = np.array([np.mean(both[i][ok[i]] ** 2) if ok[i].any() else np.nan
                         for i in range(g.shape[0])])
-    mse = float(np.mean(g[valid] ** 2))
+    mse = float(np.mean(both[ok] ** 2))
     ch = []
     for c in range(g.shape[1]):
         v = g[:, c][valid[:, c]]
