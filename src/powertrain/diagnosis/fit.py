@@ -170,6 +170,10 @@ class Problem:
         d = np.angle(self._order_velocity(scenario, "train")) - np.deg2rad(self.phase["train"])
         return crank_offset(d, self.order, self.phase_w["train"], self.sigma_db)
 
+    def crank_offsets(self, scenario) -> list:
+        """``[offset [rad]]`` (``[None]`` without phase); one per run, as for a plan."""
+        return [None if self.phase_w is None else self.crank_offset(scenario)]
+
     def _order_velocity(self, scenario, part):
         return self.velocity(scenario, part)[..., self.sub.harmonic]
 
