@@ -140,10 +140,9 @@ class _Setup:
         self.hm = HarmonicModel(engine, data.rpm)
         if data.channels != self.hm.channels:       # body-side channels measured (or not)
             self.hm.use_channels(data.channels)
-        self.hm.two_ports()
+        cand.warm_caches(self.hm, self.effects)     # once, on every speed: subsets share it
         need = np.union1d(self.train_all, self.test_idx)
         self.hm_need = self.hm.subset(need)
-        cand.warm_caches(self.hm_need, self.effects)
         self.pos = {int(r): i for i, r in enumerate(need)}
         self.problem = Problem(self.sub(self.train_idx), self.sub(self.test_idx), data,
                                self.train_idx, self.test_idx)

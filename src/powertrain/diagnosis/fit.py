@@ -27,7 +27,13 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from powertrain.diagnosis.data import GapData, model_levels, noise_sigma_db, residuals_db
-from powertrain.diagnosis.phase import crank_offset, offset_prior, phase_gaps, phase_weights
+from powertrain.diagnosis.phase import (
+    crank_offset,
+    offset_prior,
+    phase_gaps,
+    phase_weights,
+    wrap,
+)
 from powertrain.diagnosis.starts import start_points
 from powertrain.effects import EFFECTS, predict
 
@@ -117,6 +123,10 @@ class Problem:
             self.meas[k], self.phase[k], self.data.floor, self.sigma_db), np.nan)
             for k in self.idx}
         self.phase_on = {k: np.isfinite(w) for k, w in self.phase_w.items()}
+        self._phase_rad = {k: np.deg2rad(v) for k, v in self.phase.items()}
+        self._order_on = {k: np.broadcast_to(self.order, on.shape)[on]
+                          for k, on in self.phase_on.items()}
+        self._w_on = {k: self.phase_w[k][on] for k, on in self.phase_on.items()}
 
     def __getstate__(self):
         # sent to other processes (parallel fits): the engine without its pressure cache
@@ -159,16 +169,24 @@ class Problem:
                 vel = EFFECTS[k].reading(vel, v)
         return vel
 
-    def gaps(self, scenario, part="train"):
-        """Level gaps [dB] (n_r, n_ch, n_q), NaN where not scored."""
-        sim = model_levels(self.velocity(scenario, part), self.sub)
-        g = residuals_db(sim, self.meas[part], self.data.floor)
+    def gaps(self, scenario, part="train", vel=None):
+        """Level gaps [dB] (n_r, n_ch, n_q), NaN where not scored (``vel``: the scenario's
+        velocities if already at hand)."""
+        vel = self.velocity(scenario, part) if vel is None else vel
+        g = residuals_db(model_levels(vel, self.sub), self.meas[part], self.data.floor)
         return np.where(self.valid[part], g, np.nan)
 
-    def crank_offset(self, scenario) -> float:
-        """The run's crank-angle offset [rad] profiled on the training speeds."""
-        d = np.angle(self._order_velocity(scenario, "train")) - np.deg2rad(self.phase["train"])
-        return crank_offset(d, self.order, self.phase_w["train"], self.sigma_db)
+    def crank_offset(self, scenario, vel=None) -> float:
+        """The run's crank-angle offset [rad] profiled on the training speeds (``vel``: the
+        scenario's training velocities if already at hand)."""
+        vel = self.velocity(scenario, "train") if vel is None else vel
+        return crank_offset(self._phase_diff(vel, "train"), self._order_on["train"],
+                            self._w_on["train"], self.sigma_db)
+
+    def _phase_diff(self, vel, part):
+        """Model minus measured phase [rad] at the scored phase points of ``part``."""
+        on = self.phase_on[part]
+        return np.angle(vel[..., self.sub.harmonic][on]) - self._phase_rad[part][on]
 
     def crank_offsets(self, scenario) -> list:
         """``[offset [rad]]`` (``[None]`` without phase); one per run, as for a plan."""
@@ -188,11 +206,16 @@ class Problem:
                           self.phase_w[part], self.order, delta)
 
     def vector(self, scenario, part="train"):
-        g = self.gaps(scenario, part)[self.valid[part]]
+        vel = self.velocity(scenario, part)
+        g = self.gaps(scenario, part, vel)[self.valid[part]]
         if self.phase_w is None:
             return g
-        delta = self.crank_offset(scenario)
-        gp = self.phase_gaps(scenario, part, delta)[self.phase_on[part]]
+        d = self._phase_diff(vel, part)
+        if part == "train":
+            delta = crank_offset(d, self._order_on[part], self._w_on[part], self.sigma_db)
+        else:
+            delta = self.crank_offset(scenario)
+        gp = self._w_on[part] * wrap(d - self._order_on[part] * delta)
         return np.concatenate([g, gp, [offset_prior(delta, self.sigma_db)]])
 
 

@@ -34,8 +34,8 @@ CRANK_OFFSET_SD_DEG = 1.0
 
 
 def wrap(x):
-    """Angle wrapped to (−π, π] [rad]."""
-    return np.angle(np.exp(1j * np.asarray(x)))
+    """Angle wrapped to [−π, π) [rad]."""
+    return np.mod(np.asarray(x) + np.pi, 2 * np.pi) - np.pi
 
 
 def phase_weights(level, phase_deg, floor, sigma_db):
@@ -53,11 +53,10 @@ def crank_offset(d, order, w, sigma_db) -> float:
     r"""Profiled crank-angle offset δ [rad] of one run: minimises
     :math:`\sum w^2\,\mathrm{wrap}(d - k\delta)^2 + (\sigma\delta/\sigma_\delta)^2` by two
     re-wrapped weighted least-squares steps (``d`` model minus measured phase [rad], ``order``
-    k, ``w`` the weights, NaN ignored)."""
-    ok = np.isfinite(d) & np.isfinite(w)
-    if not ok.any():
+    k and ``w`` the weights at the scored phase points, 1-D)."""
+    if d.size == 0:
         return 0.0
-    d, k, w2 = d[ok], np.broadcast_to(order, ok.shape)[ok], w[ok] ** 2
+    k, w2 = order, w ** 2
     ridge = (sigma_db / math.radians(CRANK_OFFSET_SD_DEG)) ** 2
     delta = 0.0
     for _ in range(2):
