@@ -99,11 +99,15 @@ def diagnose(measured, plan_file, engine_file, report_dir, json_file, noise_floo
     if json_file:
         _write_json(res, json_file, engine_file)
     if report_dir:
-        from powertrain.cli.common import cli_provenance, engine_description, use_agg
-        use_agg()
-        files = res.report(report_dir, provenance=cli_provenance(
-            engine_description(res.engine, res.engine.file)))
-        click.echo(f"wrote {len(files)} files to {report_dir}")
+        _write_report(res, report_dir)
+
+
+def _write_report(res, report_dir) -> None:
+    from powertrain.cli.common import cli_provenance, engine_description, use_agg
+    use_agg()
+    files = res.report(report_dir, provenance=cli_provenance(
+        engine_description(res.engine, res.engine.file)))
+    click.echo(f"wrote {len(files)} files to {report_dir}")
 
 
 def _measured_or_plan(measured, plan_file):
