@@ -118,3 +118,25 @@ def test_plan_diagnosis_keeps_every_single_run_key_and_adds_runs(default_engine)
     assert joint["phase"]["measured"] == "all"
     assert all(abs(o) < 4 for o in joint["phase"]["crank_offset_deg_per_run"])
     assert joint["verdict"] == "mount_stiffness"
+
+
+def test_a_run_with_traces_uses_them_as_the_engines_combustion(tmp_path, default_engine):
+    """``traces =`` (relative to the plan) replaces the combustion model for that run: the
+    part-load single-zone pressures written as a trace CSV give that run's load back."""
+    from powertrain.models.engine import RPM
+    e = default_engine
+    rows = ["speed [rpm],cylinder,crank_angle [deg],pressure [Pa]"]
+    for n in (1000.0, 6000.0):
+        theta, p, _ = e.combustion.cycle_pressures(e.crank, n * RPM, 0.4)
+        for c in range(p.shape[0]):
+            rows += [f"{n:g},{c + 1},{np.degrees(t):.4f},{v:.6g}"
+                     for t, v in zip(theta[::8], p[c, ::8])]
+    (tmp_path / "p.csv").write_text("\n".join(rows) + "\n")
+    _csv(tmp_path / "a.csv")
+    (tmp_path / "plan.toml").write_text('[[runs]]\nfile = "a.csv"\ntraces = "p.csv"\n')
+    run = read_plan(tmp_path / "plan.toml", e).runs[0]
+    eng = run.engine(e)
+    assert run.traces == str(tmp_path / "p.csv")
+    part, full = (x.excitation(1000.0).imep.mean() for x in (eng, e))
+    ref = e.at_load(0.4).excitation(1000.0).imep.mean()
+    assert part == pytest.approx(ref, rel=0.02) and part < 0.6 * full
