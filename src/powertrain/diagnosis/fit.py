@@ -26,14 +26,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from powertrain.diagnosis import phase as ph
 from powertrain.diagnosis.data import GapData, model_levels, noise_sigma_db, residuals_db
-from powertrain.diagnosis.phase import (
-    crank_offset,
-    offset_prior,
-    phase_gaps,
-    phase_weights,
-    wrap,
-)
 from powertrain.diagnosis.starts import start_points
 from powertrain.effects import EFFECTS, predict
 
@@ -119,7 +113,7 @@ class Problem:
         if not self.data.has_phase:
             return
         self.phase = {k: self.sub.phase[v] for k, v in self.idx.items()}
-        self.phase_w = {k: np.where(self.valid[k], phase_weights(
+        self.phase_w = {k: np.where(self.valid[k], ph.phase_weights(
             self.meas[k], self.phase[k], self.data.floor, self.sigma_db), np.nan)
             for k in self.idx}
         self.phase_on = {k: np.isfinite(w) for k, w in self.phase_w.items()}
@@ -180,7 +174,7 @@ class Problem:
         """The run's crank-angle offset [rad] profiled on the training speeds (``vel``: the
         scenario's training velocities if already at hand)."""
         vel = self.velocity(scenario, "train") if vel is None else vel
-        return crank_offset(self._phase_diff(vel, "train"), self._order_on["train"],
+        return ph.crank_offset(self._phase_diff(vel, "train"), self._order_on["train"],
                             self._w_on["train"], self.sigma_db)
 
     def _phase_diff(self, vel, part):
@@ -202,7 +196,7 @@ class Problem:
         if self.phase_w is None:
             return None
         delta = self.crank_offset(scenario) if delta is None else delta
-        return phase_gaps(self._order_velocity(scenario, part), self.phase[part],
+        return ph.phase_gaps(self._order_velocity(scenario, part), self.phase[part],
                           self.phase_w[part], self.order, delta)
 
     def vector(self, scenario, part="train"):
@@ -212,11 +206,11 @@ class Problem:
             return g
         d = self._phase_diff(vel, part)
         if part == "train":
-            delta = crank_offset(d, self._order_on[part], self._w_on[part], self.sigma_db)
+            delta = ph.crank_offset(d, self._order_on[part], self._w_on[part], self.sigma_db)
         else:
             delta = self.crank_offset(scenario)
-        gp = self._w_on[part] * wrap(d - self._order_on[part] * delta)
-        return np.concatenate([g, gp, [offset_prior(delta, self.sigma_db)]])
+        gp = self._w_on[part] * ph.wrap(d - self._order_on[part] * delta)
+        return np.concatenate([g, gp, [ph.offset_prior(delta, self.sigma_db)]])
 
 
 @dataclass
