@@ -78,3 +78,20 @@ def test_whole_orders_cannot_tell_a_weak_cylinder_from_a_strong_one_on_the_other
     big = np.abs(a[..., 0]) > 1e-3 * np.abs(a[..., 0]).max()
     dphi = np.angle(b[..., 0][big] / a[..., 0][big])
     assert np.all(np.abs(np.abs(dphi) - math.pi / 2) < 1e-6)   # order 0.5: 90 deg apart
+
+
+@pytest.mark.parametrize("kind", ["sz", "traces"])
+def test_cylinder_load_derivative_is_exact_by_one_forward_difference(kind):
+    """The cached derivative (forward differences) equals central differences to round-off:
+    the load is linear in the cylinder factors for the single-zone model and for traces."""
+    from powertrain.effects.cylinder_imbalance import STEP
+    from powertrain.solvers.fast_harmonic import HarmonicModel
+    from powertrain.validation.cases import engines
+    e = engines()[kind]
+    hm = HarmonicModel(e, np.array([1200.0, 5400.0]))
+    eff = EFFECTS["cylinder_imbalance"]
+    d = eff.warm(hm)
+    for k in range(d.shape[0]):
+        up, dn = (hm.load_of(eff.apply(e, **{f"e{k + 1}": s})) for s in (STEP, -STEP))
+        central = (up - dn) / (2 * STEP)
+        assert np.abs(d[k] - central).max() <= 1e-12 * np.abs(central).max()

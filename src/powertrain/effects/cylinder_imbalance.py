@@ -8,8 +8,10 @@ r"""``cylinder_imbalance``: cylinder i delivers (1 + e_i) times its nominal comb
   :data:`REF_ANGLE` before firing TDC, over the closed cycle (−180…180°); the gas-exchange
   strokes are kept. The IMEP changes by about e_i times the combustion part's share.
 
-On the cached path the load is linearised in the e_i (central differences of the load
-harmonics, step :data:`STEP`).
+On the cached path the load is linear in the e_i: both models scale a cylinder's pressure
+(its combustion part) linearly, so one forward difference of the load harmonics per cylinder
+(step :data:`STEP`) is exact to round-off (tests/test_diagnosis_phase.py compares it with
+central differences).
 """
 
 from __future__ import annotations
@@ -25,7 +27,7 @@ N_MOTORED = 1.32
 #: Crank angle (cylinder cycle, before firing TDC) where the motored pressure is matched to
 #: the trace: well before any start of combustion, after intake valve closing [rad].
 REF_ANGLE = -np.deg2rad(60.0)
-#: Central-difference step of the linearised load [1].
+#: Forward-difference step of the load derivatives [1].
 STEP = 0.05
 
 
@@ -108,8 +110,7 @@ class CylinderImbalance(Effect):
             out = np.zeros((n, hm.rpm.size) + hm.load.shape[1:], complex)
             for k in range(n):
                 up = self.apply(eng, **{f"e{k + 1}": STEP})
-                dn = self.apply(eng, **{f"e{k + 1}": -STEP})
-                out[k] = (hm.load_of(up) - hm.load_of(dn)) / (2 * STEP)
+                out[k] = (hm.load_of(up) - hm.load) / STEP
             hm._extra["cylinder_imbalance"] = out
         return hm._extra["cylinder_imbalance"]
 
