@@ -103,12 +103,16 @@ def test_cli_bad_plan_is_one_line_naming_file_and_key(tmp_path):
 
 @pytest.mark.slow
 def test_plan_diagnosis_keeps_every_single_run_key_and_adds_runs(default_engine):
-    """Two load cases of one stiffer mount from the truth generator; the plan's JSON has
+    """Two load cases of one stiffer mount from the truth generator: named; the plan's JSON has
     every key of a single-run diagnosis, and a run entry per run."""
     from powertrain.diagnosis import diagnose
     from powertrain.validation.cases import FLOOR
     from powertrain.validation.plans import make_plan_case
-    case = make_plan_case(0, ["mount_temperature"], 11, phase="all")
+    stiff = np.ones((3, 3))
+    stiff[0] = 2.0                                   # the left mount twice as stiff
+    case = make_plan_case(0, ["mount_temperature"], 1, phase="all", params={
+        "mount_temperature": {"spring_factors": stiff, "mount": 0, "factor": 2.0}})
+    assert case.detectable
     kw = {"noise_floor": FLOOR, "effects": ["mount_stiffness", "cylinder_imbalance"],
           "pairs": False, "band_check": False, "progress": False}
     single = diagnose(case.runs[0].measured, default_engine, **kw).to_dict()

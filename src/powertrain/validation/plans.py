@@ -61,11 +61,12 @@ class PlanCase:
                     source=f"plan case {self.index} (seed {self.seed})")
 
 
-def make_plan_case(index, names, seed, loads=LOADS, phase=None) -> PlanCase:
-    """Draw the hidden effects ``names`` once and measure them at every load."""
+def make_plan_case(index, names, seed, loads=LOADS, phase=None, params=None) -> PlanCase:
+    """Draw the hidden effects ``names`` once (``params``: ``{name: parameters}`` fixed
+    instead of drawn) and measure them at every load."""
     engine = cs.engines()["sz"]
     rng = np.random.default_rng(seed)
-    truth = [(n, KINDS[n].draw(rng, engine)) for n in names]
+    truth = [(n, {**KINDS[n].draw(rng, engine), **(params or {}).get(n, {})}) for n in names]
     runs = []
     for k, load in enumerate(loads):
         e = engine.at_load(load)
