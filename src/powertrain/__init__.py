@@ -32,6 +32,7 @@ API = {
     "read_mount": ("powertrain.iotools.mount_file", "read_mount"),
     "read_measured": ("powertrain.iotools.measured", "read_measured"),
     "read_raw": ("powertrain.iotools.raw", "read_raw"),
+    "read_plan": ("powertrain.iotools.plan", "read_plan"),
     "runup": ("powertrain.workflows.runup", "runup"),
     "modes": ("powertrain.workflows.modes", "modes"),
     "static": ("powertrain.workflows.static", "static"),

@@ -36,7 +36,11 @@ def _truth_names() -> str:
 
 
 @main.command()
-@click.argument("measured", type=click.Path(dir_okay=False))
+@click.argument("measured", type=click.Path(dir_okay=False), required=False)
+@click.option("--plan", "plan_file", type=click.Path(dir_okay=False),
+              help="Test plan (TOML, [[runs]] with file and load or traces; paths relative "
+                   "to the plan): all its run-ups diagnosed together, one set of effect "
+                   "parameters. Instead of MEASURED.")
 @click.option("--engine", "engine_file", type=click.Path(dir_okay=False),
               help="Baseline engine file (default: the shipped engines/default.toml).")
 @click.option("--report", "report_dir", type=click.Path(file_okay=False),
@@ -58,8 +62,8 @@ def _truth_names() -> str:
                    "this machine's cores) or an existing scheduler's address; also "
                    "'processes' or 'serial'. Default: serial (starts fastest). Same result "
                    "on every scheduler.")
-def diagnose(measured, engine_file, report_dir, json_file, noise_floor, effects, no_pairs,
-             quiet, scheduler):
+def diagnose(measured, plan_file, engine_file, report_dir, json_file, noise_floor, effects,
+             no_pairs, quiet, scheduler):
     """Diagnose the gap between the simulated and a measured run-up.
 
     1. Where: the gap map per channel, quantity and speed, the regions beyond +-3 dB and
@@ -68,19 +72,21 @@ def diagnose(measured, engine_file, report_dir, json_file, noise_floor, effects,
     (and pairs of the best three) fitted on training speeds, ranked on held-out speeds.
     3. How far: held-out RMS gap before and after the chosen effect.
 
-    MEASURED: long-format CSV (mount,direction,quantity,rpm,velocity_rms_mm_per_s) or
-    run-up HDF5, as for 'powertrain compare'.
+    MEASURED: long-format CSV (mount,direction,quantity,rpm,velocity_rms_mm_per_s, and
+    phase_deg where measured) or run-up HDF5, as for 'powertrain compare'; or --plan.
 
     \b
     Examples:
       powertrain synth --effect balancer_error --seed 3 --out case.csv
       powertrain diagnose case.csv --report out/diag --json out/diag.json
+      powertrain diagnose --plan plan.toml --json out/plan.json
     """
     from powertrain.cli.common import check_outputs
     from powertrain.diagnosis import diagnose as run
     from powertrain.parallel import check_scheduler
     from powertrain.progress import activity
 
+    measured = _measured_or_plan(measured, plan_file)
     noise_floor = _noise_floor(noise_floor)
     names = [e.strip() for e in effects.split(",") if e.strip()] or None
     scheduler = check_scheduler(scheduler or "serial", reach=True)
@@ -93,11 +99,27 @@ def diagnose(measured, engine_file, report_dir, json_file, noise_floor, effects,
     if json_file:
         _write_json(res, json_file, engine_file)
     if report_dir:
-        from powertrain.cli.common import cli_provenance, engine_description, use_agg
-        use_agg()
-        files = res.report(report_dir, provenance=cli_provenance(
-            engine_description(res.engine, res.engine.file)))
-        click.echo(f"wrote {len(files)} files to {report_dir}")
+        _write_report(res, report_dir)
+
+
+def _write_report(res, report_dir) -> None:
+    from powertrain.cli.common import cli_provenance, engine_description, use_agg
+    use_agg()
+    files = res.report(report_dir, provenance=cli_provenance(
+        engine_description(res.engine, res.engine.file)))
+    click.echo(f"wrote {len(files)} files to {report_dir}")
+
+
+def _measured_or_plan(measured, plan_file):
+    """MEASURED or ``--plan``, exactly one of them."""
+    from powertrain.errors import InputError
+    if (measured is None) == (plan_file is None):
+        raise InputError("give either a MEASURED file or --plan PLAN.toml (not both)"
+                         if measured else "missing MEASURED file or --plan PLAN.toml",
+                         key="--plan")
+    if plan_file is not None and not plan_file.lower().endswith(".toml"):
+        raise InputError("a plan is a TOML file (PLAN.toml)", file=plan_file, key="--plan")
+    return measured or plan_file
 
 
 def _noise_floor(value: float) -> float:

@@ -57,8 +57,9 @@ def equivalents(setup, chosen, rule, budget=400, noise_mse=0.0) -> list:
     swapped mirror-image mounts...). A refit that lands elsewhere is *equivalent* when the
     held-out speeds do not prefer the answer significantly (per-speed t ≤ ``rule.t_min``, as
     between rival candidates) and its training BIC is not worse by more than
-    ``rule.bic_margin``; the report lists them instead of picking one silently. (Order
-    magnitudes only: measured phases, which would separate some of them, are not read.)
+    ``rule.bic_margin``; the report lists them instead of picking one silently. Where order
+    phases are measured the refits score them too (:mod:`powertrain.diagnosis.phase`), so an
+    alternative is listed only while it stays equivalent with phase.
     """
     if chosen is None or len(chosen.effects) != 1:
         return []

@@ -106,15 +106,19 @@ def noise_mse(problem: Problem, sigma, cells=None) -> float:
     r"""Expected held-out mean squared gap of a perfect model [dB²]: :math:`\hat\sigma^2`
     times the fraction of scored held-out points that are not censored (a censored point's
     residual, :math:`\max(0, 20\log_{10}(s'/\kappa f))`, is 0 for a model below the
-    censoring level, whatever the noise)."""
+    censoring level, whatever the noise); a scored phase gap (:mod:`powertrain.diagnosis.phase`,
+    all cells only) counts as one uncensored point."""
     if not (np.isfinite(sigma) and sigma > 0):
         return 0.0
     valid = problem.valid["test"]
     if cells is not None:
         valid = valid & np.asarray(cells, bool)[None]
-    unc = valid & above_floor(problem.meas["test"], problem.data.floor)
+    unc = int((valid & above_floor(problem.meas["test"], problem.data.floor)).sum())
     n = int(valid.sum())
-    return float(sigma ** 2 * unc.sum() / n) if n else 0.0
+    if cells is None and problem.phase_w is not None:   # phase gaps: uncensored, 1σ each
+        n_phase = int(problem.phase_on["test"].sum())
+        unc, n = unc + n_phase, n + n_phase
+    return float(sigma ** 2 * unc / n) if n else 0.0
 
 
 def order_folds(problem: Problem) -> list:

@@ -53,9 +53,12 @@ def diagnose(measured, engine=None, *, noise_floor=DEFAULT_NOISE_FLOOR, effects=
 
     Parameters
     ----------
-    measured : MeasuredRunup, str or path
+    measured : MeasuredRunup, Plan, str or path
         Measured order curves [m/s RMS], or the file to read them from (CSV or run-up
-        HDF5, :func:`powertrain.iotools.measured.read_measured`).
+        HDF5, :func:`powertrain.iotools.measured.read_measured`); or a test plan of several
+        run-ups (:class:`powertrain.iotools.plan.Plan`, or its ``.toml`` file,
+        :func:`powertrain.iotools.plan.read_plan`): one set of effect parameters fitted to
+        all runs (:mod:`powertrain.diagnosis.plan`).
     engine : Engine, str or path, optional
         Baseline model, or its file (default: the shipped ``engines/default.toml``).
     noise_floor : float
@@ -110,12 +113,16 @@ def _inputs(measured, engine, effects):
     if engine is None or isinstance(engine, (str, os.PathLike)):
         from powertrain.iotools.engine_file import DEFAULT_ENGINE_PATH, read_engine
         engine = read_engine(str(engine or DEFAULT_ENGINE_PATH))
-    if isinstance(measured, (str, os.PathLike)):
+    if isinstance(measured, (str, os.PathLike)) and str(measured).lower().endswith(".toml"):
+        from powertrain.iotools.plan import read_plan
+        measured = read_plan(measured, engine)
+    elif isinstance(measured, (str, os.PathLike)):
         from powertrain.iotools.measured import read_measured
         measured = read_measured(measured, mounts=engine.mount_names)
-    if measured.signal != "velocity":
-        raise InputError("diagnose needs velocity, acceleration or displacement order curves "
-                         f"(this file holds {measured.signal})", file=measured.source or None)
+    for m in [r.measured for r in measured.runs] if hasattr(measured, "runs") else [measured]:
+        if m.signal != "velocity":
+            raise InputError("diagnose needs velocity, acceleration or displacement order "
+                             f"curves (this file holds {m.signal})", file=m.source or None)
     return engine, measured
 
 
@@ -134,10 +141,9 @@ class _Setup:
         self.hm = HarmonicModel(engine, data.rpm)
         if data.channels != self.hm.channels:       # body-side channels measured (or not)
             self.hm.use_channels(data.channels)
-        self.hm.two_ports()
+        cand.warm_caches(self.hm, self.effects)     # once, on every speed: subsets share it
         need = np.union1d(self.train_all, self.test_idx)
         self.hm_need = self.hm.subset(need)
-        cand.warm_caches(self.hm_need, self.effects)
         self.pos = {int(r): i for i, r in enumerate(need)}
         self.problem = Problem(self.sub(self.train_idx), self.sub(self.test_idx), data,
                                self.train_idx, self.test_idx)
@@ -284,8 +290,13 @@ def _structure(s, baseline, outcomes, sigma):
 def _diagnose(measured, engine, noise_floor, effects, pairs, do_bands, rule, scheduler,
               progress, budget):
     t0 = time.perf_counter()
-    s = _Setup(measured, engine, noise_floor, effects)
-    gap_map, parts, rigid, found = _where(s)
+    if hasattr(measured, "runs"):
+        from powertrain.diagnosis.plan import PlanSetup
+        s = PlanSetup(measured, engine, noise_floor, effects, _Setup)
+    else:
+        s = _Setup(measured, engine, noise_floor, effects)
+    w = getattr(s, "first", s)                 # step 1 and the figures: a plan's first run
+    gap_map, parts, rigid, found = _where(w)
     s.effects = cand.at_location(s.effects, parts.get("sides"))
     sigma = noise_sigma_db(s.data)
     baseline = baseline_outcome(s.problem)
@@ -303,22 +314,53 @@ def _diagnose(measured, engine, noise_floor, effects, pairs, do_bands, rule, sch
     gap_after, bands = None, []
     if chosen is not None:
         sc = {e: chosen.params[e] for e in chosen.effects}
-        g1 = residuals_db(model_levels(predict(s.hm, sc).velocity, s.data), s.data.level,
-                          s.data.floor)
-        gap_after = np.where(s.data.censored, np.nan, g1)
-        if do_bands and len(chosen.effects) == 1:
+        g1 = residuals_db(model_levels(predict(w.hm, sc).velocity, w.data), w.data.level,
+                          w.data.floor)
+        gap_after = np.where(w.data.censored, np.nan, g1)
+        if do_bands and len(chosen.effects) == 1 and w is s:
             def factory(idx):
                 return Problem(s.sub(idx), s.problem.hm["test"], s.data, idx, s.test_idx)
             bands = band_check(factory, chosen.effects[0], s.data,
                                s.train_all[::max(1, s.train_all.size // 48)])
     eq = cand.equivalents(s, chosen, rule, noise_mse=e_n)
+    what = "order magnitudes and phases" if s.data.has_phase else "order magnitudes"
     text = verdict.text if not eq else verdict.text + (
-        f"; the order magnitudes cannot tell it from {len(eq)} equivalent explanation(s): "
+        f"; the {what} cannot tell it from {len(eq)} equivalent explanation(s): "
         + "; ".join(x["text"] for x in eq[:3]) + ("; ..." if len(eq) > 3 else ""))
+    finding = _finding(s, chosen)
+    if finding is not None:
+        text += f"; {finding['text']}"
     return DiagnosisResult(
-        s.data, s.src, getattr(engine, "name", ""), gap_map, gap_after, parts, rigid, found,
-        sigma, s.split_dict(), baseline, outcomes, chosen, verdict.label, text, bands,
+        w.data, s.src, getattr(engine, "name", ""), gap_map, gap_after, parts, rigid, found,
+        sigma, w.split_dict(), baseline, outcomes, chosen, verdict.label, text, bands,
         time.perf_counter() - t0, synthetic=bool(getattr(measured, "synthetic", False)),
         noise_mse_heldout=e_n, ambiguous=verdict.ambiguous, rule=rule,
         verdict_kind=verdict.kind, equivalents=eq,
-        budget_hits=[o.label for o in outcomes if o.budget_hit])
+        budget_hits=[o.label for o in outcomes if o.budget_hit], finding=finding,
+        phase=_phase_dict(s, chosen), runs=s.run_entries(chosen) if w is not s else [])
+
+
+def phase_kind(data) -> str:
+    """Measured phase: ``"all"`` (half orders too), ``"whole"`` (whole orders only) or
+    ``"none"``."""
+    return "all" if data.has_half_order_phase else "whole" if data.has_phase else "none"
+
+
+def _finding(s, chosen):
+    """What the chosen single effect names (``Effect.finding``), or None."""
+    if chosen is None or len(chosen.effects) != 1:
+        return None
+    e = chosen.effects[0]
+    from powertrain.effects import EFFECTS
+    return EFFECTS[e].finding(chosen.params[e], s.problem.engine, phase_kind(s.data))
+
+
+def _phase_dict(s, chosen) -> dict:
+    """The ``phase`` entry of the JSON: what phase was measured, the crank-angle offset
+    estimated with the chosen answer (baseline if none) [deg]."""
+    sc = {} if chosen is None else {e: chosen.params[e] for e in chosen.effects}
+    offsets = [None if o is None else math.degrees(o) for o in s.problem.crank_offsets(sc)]
+    return {"measured": phase_kind(s.data), "crank_offset_deg": offsets[0],
+            "crank_offset_deg_per_run": offsets,
+            "scored_points": 0 if s.problem.phase_w is None
+            else int(s.problem.phase_on["train"].sum() + s.problem.phase_on["test"].sum())}

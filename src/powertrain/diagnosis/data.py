@@ -76,6 +76,22 @@ class GapData:
     #: Engine-side channels (the first ones; body-side channels and body points follow);
     #: None: all.
     n_engine_side: int | None = None
+    #: Measured order phase [deg] like ``level`` (NaN where not given; None: no phase at all).
+    #: The order-k component is √2·RMS·cos(kθ + φ), θ from cylinder-1 firing TDC.
+    phase: np.ndarray | None = None
+
+    @property
+    def has_phase(self) -> bool:
+        """Some order phase is measured."""
+        return self.phase is not None and bool(np.isfinite(self.phase).any())
+
+    @property
+    def has_half_order_phase(self) -> bool:
+        """Some half-order (0.5, 1.5, ...) phase is measured (a cycle reference was used)."""
+        if not self.has_phase:
+            return False
+        half = (self.harmonic >= 0) & (self.harmonic % 2 == 0)
+        return bool(np.isfinite(self.phase[:, :, half]).any())
 
     @property
     def n_active(self) -> int:
@@ -86,13 +102,15 @@ class GapData:
         """The same data on the engine-side channels only."""
         n = self.n_active
         return GapData(self.rpm, self.channels[:n], self.quantities, self.harmonic,
-                       self.level[:, :n], self.floor)
+                       self.level[:, :n], self.floor,
+                       phase=None if self.phase is None else self.phase[:, :n])
 
     def orders_only(self) -> GapData:
         """The same data without the synthesis."""
         om = self.order_mask
         return GapData(self.rpm, self.channels, [q for q, o in zip(self.quantities, om) if o],
-                       self.harmonic[om], self.level[:, :, om], self.floor, self.n_engine_side)
+                       self.harmonic[om], self.level[:, :, om], self.floor, self.n_engine_side,
+                       None if self.phase is None else self.phase[:, :, om])
 
 
 def model_channels(engine) -> list:
@@ -133,6 +151,8 @@ def gap_data(measured, engine, noise_floor=DEFAULT_NOISE_FLOOR) -> GapData:
     harmonic = np.array([-1 if q == "synthesis" else int(round(2 * float(q[6:]))) - 1
                          for q in quantities])
     level = np.full((rpm.size, len(channels), len(quantities)), np.nan)
+    phases = getattr(measured, "phases", None) or {}
+    phase = np.full(level.shape, np.nan) if phases else None
     for (m, d, q), (r, v) in measured.curves.items():
         if (m, d) not in channels or q not in quantities:
             continue
@@ -140,8 +160,10 @@ def gap_data(measured, engine, noise_floor=DEFAULT_NOISE_FLOOR) -> GapData:
         idx = np.searchsorted(rpm, r)
         ok = (idx < rpm.size) & (rpm[np.minimum(idx, rpm.size - 1)] == r)
         level[idx[ok], c, k] = v[ok]
+        if (m, d, q) in phases and q != "synthesis":
+            phase[idx[ok], c, k] = np.asarray(phases[(m, d, q)], float)[ok]
     return GapData(rpm, channels, quantities, harmonic, level, float(noise_floor),
-                   3 * len(engine.mounts))
+                   3 * len(engine.mounts), phase)
 
 
 def model_levels(velocity, data: GapData):

@@ -26,6 +26,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from powertrain.diagnosis import phase as ph
 from powertrain.diagnosis.data import GapData, model_levels, noise_sigma_db, residuals_db
 from powertrain.diagnosis.starts import start_points
 from powertrain.effects import EFFECTS, predict
@@ -102,6 +103,24 @@ class Problem:
         for part, cells in (("train", train_cells), ("test", test_cells)):
             if cells is not None:
                 self.valid[part] = self.valid[part] & np.asarray(cells, bool)[None]
+        self._phase_setup()
+
+    def _phase_setup(self):
+        """Measured phases and their weights per part (:mod:`powertrain.diagnosis.phase`);
+        ``phase_w`` None without phase."""
+        self.order = (self.sub.harmonic + 1) / 2.0
+        self.phase_w = None
+        if not self.data.has_phase:
+            return
+        self.phase = {k: self.sub.phase[v] for k, v in self.idx.items()}
+        self.phase_w = {k: np.where(self.valid[k], ph.phase_weights(
+            self.meas[k], self.phase[k], self.data.floor, self.sigma_db), np.nan)
+            for k in self.idx}
+        self.phase_on = {k: np.isfinite(w) for k, w in self.phase_w.items()}
+        self._phase_rad = {k: np.deg2rad(v) for k, v in self.phase.items()}
+        self._order_on = {k: np.broadcast_to(self.order, on.shape)[on]
+                          for k, on in self.phase_on.items()}
+        self._w_on = {k: self.phase_w[k][on] for k, on in self.phase_on.items()}
 
     def __getstate__(self):
         # sent to other processes (parallel fits): the engine without its pressure cache
@@ -123,7 +142,8 @@ class Problem:
         return Problem(self.hm["train"], self.hm["test"], self.data, self.idx["train"],
                        self.idx["test"], train_cells, test_cells)
 
-    def gaps(self, scenario, part="train"):
+    def velocity(self, scenario, part="train"):
+        """Complex model velocities of the measured orders (n_r, n_ch, 16) [m/s peak]."""
         # the physical part of the scenario is solved once per distinct value: a sensor
         # error only re-reads the same velocities (cheap finite-difference columns)
         phys = {k: v for k, v in scenario.items() if not EFFECTS[k].response_only}
@@ -141,13 +161,56 @@ class Problem:
         for k, v in scenario.items():
             if EFFECTS[k].response_only:
                 vel = EFFECTS[k].reading(vel, v)
-        sim = model_levels(vel, self.sub)
-        g = residuals_db(sim, self.meas[part], self.data.floor)
+        return vel
+
+    def gaps(self, scenario, part="train", vel=None):
+        """Level gaps [dB] (n_r, n_ch, n_q), NaN where not scored (``vel``: the scenario's
+        velocities if already at hand)."""
+        vel = self.velocity(scenario, part) if vel is None else vel
+        g = residuals_db(model_levels(vel, self.sub), self.meas[part], self.data.floor)
         return np.where(self.valid[part], g, np.nan)
 
+    def crank_offset(self, scenario, vel=None) -> float:
+        """The run's crank-angle offset [rad] profiled on the training speeds (``vel``: the
+        scenario's training velocities if already at hand)."""
+        vel = self.velocity(scenario, "train") if vel is None else vel
+        return ph.crank_offset(self._phase_diff(vel, "train"), self._order_on["train"],
+                            self._w_on["train"], self.sigma_db)
+
+    def _phase_diff(self, vel, part):
+        """Model minus measured phase [rad] at the scored phase points of ``part``."""
+        on = self.phase_on[part]
+        return np.angle(vel[..., self.sub.harmonic][on]) - self._phase_rad[part][on]
+
+    def crank_offsets(self, scenario) -> list:
+        """``[offset [rad]]`` (``[None]`` without phase); one per run, as for a plan."""
+        return [None if self.phase_w is None else self.crank_offset(scenario)]
+
+    def _order_velocity(self, scenario, part):
+        return self.velocity(scenario, part)[..., self.sub.harmonic]
+
+    def phase_gaps(self, scenario, part="train", delta=None):
+        """Phase residuals [dB] (n_r, n_ch, n_q), NaN where no phase is scored; None without
+        phase. ``delta``: the crank offset [rad] (default: profiled on the training
+        speeds)."""
+        if self.phase_w is None:
+            return None
+        delta = self.crank_offset(scenario) if delta is None else delta
+        return ph.phase_gaps(self._order_velocity(scenario, part), self.phase[part],
+                          self.phase_w[part], self.order, delta)
+
     def vector(self, scenario, part="train"):
-        g = self.gaps(scenario, part)
-        return g[self.valid[part]]
+        vel = self.velocity(scenario, part)
+        g = self.gaps(scenario, part, vel)[self.valid[part]]
+        if self.phase_w is None:
+            return g
+        d = self._phase_diff(vel, part)
+        if part == "train":
+            delta = ph.crank_offset(d, self._order_on[part], self._w_on[part], self.sigma_db)
+        else:
+            delta = self.crank_offset(scenario)
+        gp = self._w_on[part] * ph.wrap(d - self._order_on[part] * delta)
+        return np.concatenate([g, gp, [ph.offset_prior(delta, self.sigma_db)]])
 
 
 @dataclass
@@ -312,9 +375,12 @@ def score(problem, effects, sc, params, sigma, rss, n, p, nfev, seconds, x=None)
     """Held-out scores of a scenario: mean squared gap per speed, overall, per channel."""
     g = problem.gaps(sc, "test")
     valid = np.isfinite(g)
-    per_rpm = np.array([np.mean(g[i][valid[i]] ** 2) if valid[i].any() else np.nan
+    both = g if problem.phase_w is None else np.concatenate(
+        [g, problem.phase_gaps(sc, "test")], axis=-1)        # level and phase gaps
+    ok = np.isfinite(both)
+    per_rpm = np.array([np.mean(both[i][ok[i]] ** 2) if ok[i].any() else np.nan
                         for i in range(g.shape[0])])
-    mse = float(np.mean(g[valid] ** 2))
+    mse = float(np.mean(both[ok] ** 2))
     ch = []
     for c in range(g.shape[1]):
         v = g[:, c][valid[:, c]]

@@ -7,6 +7,9 @@ import numpy as np
 from powertrain.diagnosis.where import REGION_DB, attribution_text
 from powertrain.effects import EFFECTS
 
+_PHASE_WORDS = {"all": "order phases measured, half orders too",
+                "whole": "whole-order phases only (no cycle reference)"}
+
 
 def _header(r) -> list:
     d, p = r.data, r.parts
@@ -15,8 +18,19 @@ def _header(r) -> list:
              f"data: {d.rpm.size} speeds {d.rpm[0]:g}..{d.rpm[-1]:g} rpm, "
              f"{len(d.channels)} channels, quantities {', '.join(d.quantities)}; "
              f"noise estimate {r.noise_db:.2f} dB (1 sigma)",
-             f"split: {r.split['description']}", "",
-             "1. WHERE",
+             f"split: {r.split['description']}"]
+    if r.runs:
+        lines.append(f"plan: {len(r.runs)} runs diagnosed together (one set of effect "
+                     f"parameters; speeds held out within each run): " + "; ".join(
+                         _run_text(k, run) for k, run in enumerate(r.runs, start=1))
+                     + "; WHERE and the figures describe run 1, data and split above too")
+    ph = r.phase or {}
+    if ph.get("measured", "none") != "none":
+        offs = ", ".join(f"{o:+.2f}" for o in ph["crank_offset_deg_per_run"] if o is not None)
+        lines.append(f"phase: {_PHASE_WORDS[ph['measured']]}; {ph['scored_points']} phase "
+                     f"points scored as complex residuals; crank-angle offset estimated "
+                     f"{offs} deg")
+    lines += ["", "1. WHERE",
              f"  decomposition of the order gaps (share of sum of squares, each part "
              f"alone): structure/frequency {p['share_alone']['structure']:.0%}, "
              f"excitation/order {p['share_alone']['excitation']:.0%}, "
@@ -74,6 +88,13 @@ def _which(r) -> list:
     return lines
 
 
+def _run_text(k, run) -> str:
+    """``run 2 part.csv (load 0.4)`` or ``(traces wot-p.csv)``."""
+    from pathlib import Path
+    how = f"traces {Path(run['traces']).name}" if run.get("traces") else f"load {run['load']:g}"
+    return f"run {k} {Path(run['file']).name} ({how})"
+
+
 def _db(value) -> str:
     """A channel's held-out RMS [dB], or "-" where it has no held-out point (a channel
     measured on part of the speeds only)."""
@@ -90,7 +111,12 @@ def summary(r) -> str:
     for c, (m, di) in enumerate(d.channels):
         lines.append(f"  {m:>7} {di:>3} {_db(b.heldout_channel_rms[c]):>9} "
                      f"{_db(after.heldout_channel_rms[c]):>8}")
-    lines.append(f"  overall {b.heldout_rms_db:.2f} -> {after.heldout_rms_db:.2f} dB RMS")
+    lines.append(f"  overall {b.heldout_rms_db:.2f} -> {after.heldout_rms_db:.2f} dB RMS"
+                 + (" (all runs; phase gaps included)" if r.phase.get("scored_points") else
+                    " (all runs)" if r.runs else ""))
+    for k, run in enumerate(r.runs, start=1):
+        lines.append(f"  run {k}: {run['heldout_rms_db_before']:.2f} -> "
+                     f"{run['heldout_rms_db_after']:.2f} dB RMS")
     if r.budget_hits:
         lines.append(f"  evaluation budget hit by: {', '.join(r.budget_hits)} (best point "
                      f"so far kept)")

@@ -56,6 +56,13 @@ class DiagnosisResult:
     budget_hits: list = field(default_factory=list)
     #: The baseline engine diagnosed (:class:`~powertrain.models.engine.Engine`).
     engine: object = field(default=None, repr=False, compare=False)
+    #: What the chosen effect names (``Effect.finding``: e.g. which cylinder), or None.
+    finding: dict | None = None
+    #: Phase used: ``measured`` ("all", "whole", "none"), ``crank_offset_deg``,
+    #: ``scored_points``.
+    phase: dict = field(default_factory=dict)
+    #: Per-run entries of a plan diagnosis (empty for a single run-up).
+    runs: list = field(default_factory=list)
 
     # ------------------------------------------------------------------ dicts
     def _per_channel(self):
@@ -149,6 +156,7 @@ class DiagnosisResult:
             "baseline_heldout_structured_db": b.struct_db,
             "effects_library": [e.to_dict() for e in EFFECTS.values()],
             "seconds": self.seconds, "notes": self.notes,
+            "finding": self.finding, "phase": self.phase, "runs": self.runs,
         }
 
     def to_json(self, path=None) -> str:

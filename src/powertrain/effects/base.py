@@ -162,6 +162,12 @@ class Effect:
         apart from ``params``); none by default."""
         return []
 
+    def finding(self, params, engine=None, phase="none") -> dict | None:
+        """What the fitted ``params`` name in the field's words (e.g. which cylinder, weak or
+        strong), as a dict with a ``text``, given the measured ``phase`` (``"none"``,
+        ``"whole"``: whole orders only, ``"all"``); None by default."""
+        return None
+
 
 def map_networks(engine, fn):
     """The engine with every mount network replaced by ``fn(mount index, mount, axis, model)``."""

@@ -8,8 +8,10 @@ r"""``cylinder_imbalance``: cylinder i delivers (1 + e_i) times its nominal comb
   :data:`REF_ANGLE` before firing TDC, over the closed cycle (−180…180°); the gas-exchange
   strokes are kept. The IMEP changes by about e_i times the combustion part's share.
 
-On the cached path the load is linearised in the e_i (central differences of the load
-harmonics, step :data:`STEP`).
+On the cached path the load is linear in the e_i: both models scale a cylinder's pressure
+(its combustion part) linearly, so one forward difference of the load harmonics per cylinder
+(step :data:`STEP`) is exact to round-off (tests/test_diagnosis_phase.py compares it with
+central differences).
 """
 
 from __future__ import annotations
@@ -25,7 +27,7 @@ N_MOTORED = 1.32
 #: Crank angle (cylinder cycle, before firing TDC) where the motored pressure is matched to
 #: the trace: well before any start of combustion, after intake valve closing [rad].
 REF_ANGLE = -np.deg2rad(60.0)
-#: Central-difference step of the linearised load [1].
+#: Forward-difference step of the load derivatives [1].
 STEP = 0.05
 
 
@@ -108,8 +110,7 @@ class CylinderImbalance(Effect):
             out = np.zeros((n, hm.rpm.size) + hm.load.shape[1:], complex)
             for k in range(n):
                 up = self.apply(eng, **{f"e{k + 1}": STEP})
-                dn = self.apply(eng, **{f"e{k + 1}": -STEP})
-                out[k] = (hm.load_of(up) - hm.load_of(dn)) / (2 * STEP)
+                out[k] = (hm.load_of(up) - hm.load) / STEP
             hm._extra["cylinder_imbalance"] = out
         return hm._extra["cylinder_imbalance"]
 
@@ -138,10 +139,69 @@ class CylinderImbalance(Effect):
                             {f"e{i + 1}": float(x) for i, x in enumerate(g)}))
         return out
 
+    def finding(self, params, engine=None, phase="none"):
+        """The cylinder furthest from the median cylinder, weak or strong, with the
+        cylinders the measured phases cannot tell it from (:func:`equivalent_cylinders`)."""
+        f = 1.0 + np.array([params.get(f"e{i + 1}", 0.0) for i in range(len(params))])
+        rel = f / np.median(f) - 1.0
+        j = int(np.argmax(np.abs(rel)))
+        word = "weak" if rel[j] < 0 else "strong"
+        same = equivalent_cylinders(engine, j, rel[j] < 0, phase)
+        named = " or ".join(_cylinder_words(same))
+        text = f"{named} ({rel[j]:+.1%} against the median cylinder)"
+        if phase == "none":
+            text = (f"one cylinder {abs(rel[j]):.1%} off the median cylinder; which one, and "
+                    "whether weak or strong, needs the order phases")
+        elif phase == "whole":
+            text += ("; without half-order phases (no cycle reference) cylinders sharing a "
+                     f"crank pin ({_pin_text(engine)}) cannot be told apart, nor a weak "
+                     "cylinder on one pin from a strong one on the other")
+        return {"cylinder": j + 1, "sign": word, "deviation": float(rel[j]),
+                "could_be": [{"cylinder": c + 1, "sign": "weak" if w else "strong"}
+                             for c, w in same], "phase": phase, "text": text}
+
     def load_delta(self, hm, p):
         d = self.warm(hm)
         eps = np.array([p.get(f"e{i + 1}", 0.0) for i in range(d.shape[0])])
         return None if not eps.any() else np.tensordot(eps, d, axes=1)
+
+
+def equivalent_cylinders(engine, j, weak, phase) -> list:
+    r"""``[(cylinder, weak)]`` (0-based) whose single-cylinder deviation the measured orders
+    cannot tell from cylinder ``j`` weak/strong: all of them without phase; with whole-order
+    phases those with the same phasor :math:`s\,e^{-iklpha}` (α the firing angle, s = ±1)
+    at every whole order k that is not a firing order (the firing orders' common part is
+    free: the others' mean); only itself with half-order phases."""
+    n = len(engine.crank.firing_angles)
+    if phase == "all":
+        return [(j, weak)]
+    every = [(c, w) for c in range(n) for w in (True, False)]
+    if phase == "none":
+        return sorted(every, key=lambda cw: (cw != (j, weak), not cw[1], cw[0]))
+    alpha = np.asarray(engine.crank.firing_angles, float)
+    ks = [k for k in range(1, 9) if abs(np.sum(np.exp(-1j * k * alpha))) < 1e-6]
+
+    def phasor(c, w):
+        return (-1.0 if w else 1.0) * np.exp(-1j * np.array(ks) * alpha[c])
+    mine = phasor(j, weak)
+    same = [(c, w) for c, w in every if np.allclose(phasor(c, w), mine, atol=1e-6)]
+    return sorted(same, key=lambda cw: (cw != (j, weak), not cw[1], cw[0]))
+
+
+def _cylinder_words(cyls) -> list:
+    """``["cylinder 2 weak", "cylinder 3 weak", ...]``; cylinders of one sign joined."""
+    out = []
+    for weak in dict.fromkeys(w for _, w in cyls):
+        nums = [str(c + 1) for c, w in cyls if w == weak]
+        out.append(f"cylinder {' or '.join(nums)} {'weak' if weak else 'strong'}")
+    return out
+
+
+def _pin_text(engine) -> str:
+    """``"1 and 4, 2 and 3"``: cylinders on the same crank pin angle."""
+    pins = np.round(np.mod(np.asarray(engine.crank.crank_pin_angles, float), 2 * np.pi), 6)
+    groups = [np.flatnonzero(pins == a) + 1 for a in dict.fromkeys(pins)]
+    return ", ".join(" and ".join(str(c) for c in g) for g in groups if g.size > 1) or "none"
 
 
 __all__ = ["CylinderImbalance", "ScaledCombustion", "motored_pressure",

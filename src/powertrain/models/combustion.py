@@ -196,3 +196,34 @@ class MeasuredPressure:
 
     def speed_range(self):
         return float(self.speed[0]), float(self.speed[-1])
+
+
+@dataclass(frozen=True, eq=False)
+class LoadedCombustion:
+    """A combustion model run at ``load`` times its nominal load (the IMEP scale of the model:
+    for the single-zone model the fraction of full-load torque; a plan's part-load run)."""
+
+    base: object
+    load: float
+
+    @property
+    def model(self):
+        return self.base.model
+
+    @property
+    def speed_key(self):
+        return self.base.speed_key
+
+    @property
+    def with_cylinder_factors(self):
+        """The base's ``with_cylinder_factors`` at this load (None when the base has none)."""
+        scale = getattr(self.base, "with_cylinder_factors", None)
+        if scale is None:
+            return None
+        return lambda factors: LoadedCombustion(scale(factors), self.load)
+
+    def cycle_pressures(self, crank: CrankTrain, omega: float, load: float = 1.0):
+        return self.base.cycle_pressures(crank, omega, self.load * load)
+
+    def speed_range(self):
+        return self.base.speed_range()

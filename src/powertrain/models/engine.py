@@ -199,6 +199,14 @@ class Engine:
         return self.replace(combustion=dataclasses.replace(self.combustion,
                                                            imep_factors=factors))
 
+    def at_load(self, load: float) -> Engine:
+        """A copy whose combustion runs at ``load`` times its nominal load (IMEP scale;
+        :class:`~powertrain.models.combustion.LoadedCombustion`). Load 1 returns ``self``."""
+        if float(load) == 1.0:
+            return self
+        from powertrain.models.combustion import LoadedCombustion
+        return self.replace(combustion=LoadedCombustion(self.combustion, float(load)))
+
     @property
     def mount_names(self) -> list:
         return [m.name for m in self.mounts]

@@ -54,6 +54,8 @@ DETECT_RMS_DB = 1.0
 DETECT_LOCAL_DB = 3.0
 #: Scatter range [dB, 1σ].
 SIGMA_DB = (0.5, 1.0)
+#: 1σ of a lab's crank-angle error at cylinder-1 firing TDC [deg crank] (phase cases).
+TDC_SD_DEG = 1.0
 
 _LAP = [("mount_temperature", "sz"), ("weak_cylinder", "traces"), ("none", "sz"),
         ("balancer_shafts", "sz"), ("sensor_bracket", "sz"), ("sensor_triads", "traces"),
@@ -155,21 +157,41 @@ def is_detectable(stats) -> bool:
     return bool(stats[0] >= DETECT_RMS_DB or stats[1] >= DETECT_LOCAL_DB)
 
 
-def measure(velocity, sigma_db, rng, source="", channels=None, rpm=RPM):
+def measure(velocity, sigma_db, rng, source="", channels=None, rpm=RPM, phase=None):
     """Noisy measured run-up (:class:`~powertrain.iotools.measured.MeasuredRunup`) of the
-    noise-free ``velocity`` (n_r, n_ch, 16) at the speeds ``rpm``."""
+    noise-free ``velocity`` (n_r, n_ch, 16) at the speeds ``rpm``.
+
+    ``phase``: None (levels only), ``"all"`` (every written order's phase, as with a cycle
+    reference) or ``"whole"`` (whole orders only: no cycle reference). Phases carry a
+    scatter of σ·ln10/20 rad (the phase twin of the level scatter), the noise's phase and
+    the lab's TDC error δ ~ N(0, :data:`TDC_SD_DEG`) crank (order k: −kδ); drawn after the
+    levels, which stay as without phase."""
     from powertrain.analysis.orders import order_label
     from powertrain.iotools.measured import MeasuredRunup
     amp = velocity / np.sqrt(2) * 10 ** (rng.normal(0, sigma_db, velocity.shape) / 20)
     noise = FLOOR * (rng.normal(size=amp.shape) + 1j * rng.normal(size=amp.shape)) / np.sqrt(2)
     lev = np.abs(amp + noise)
     syn = np.sqrt(np.sum(lev ** 2, axis=-1))
-    curves = {}
+    phi = None if phase is None else _measured_phase(amp + noise, sigma_db, rng)
+    curves, phases = {}, {}
     for c, (m, d) in enumerate(channels):
         for o in WRITTEN_ORDERS:
-            curves[(m, d, order_label(o))] = (rpm.copy(), lev[:, c, int(round(2 * o)) - 1].copy())
+            h = int(round(2 * o)) - 1
+            curves[(m, d, order_label(o))] = (rpm.copy(), lev[:, c, h].copy())
+            if phi is not None and (phase == "all" or h % 2 == 1):
+                phases[(m, d, order_label(o))] = phi[:, c, h].copy()
         curves[(m, d, "synthesis")] = (rpm.copy(), syn[:, c].copy())
-    return MeasuredRunup(curves, source=source, comments=[f"SYNTHETIC: {source}"])
+    return MeasuredRunup(curves, source=source, comments=[f"SYNTHETIC: {source}"],
+                         phases=phases)
+
+
+def _measured_phase(complex_rms, sigma_db, rng):
+    """Measured phase [deg] of every order (n_r, n_ch, 16): the scatter's phase twin and the
+    run's TDC error added (:func:`measure`)."""
+    scatter = rng.normal(0, sigma_db * np.log(10) / 20, complex_rms.shape)
+    delta = np.deg2rad(rng.normal(0, TDC_SD_DEG))
+    k = 0.5 * np.arange(1, complex_rms.shape[-1] + 1)
+    return np.rad2deg(np.angle(complex_rms * np.exp(1j * (scatter - k * delta))))
 
 
 @dataclass
@@ -239,17 +261,17 @@ class Case:
         return "\n".join(lines) + "\n"
 
 
-def make_case(index, names, engine_kind, seed) -> Case:
-    """Draw, simulate and measure one case."""
+def make_case(index, names, engine_kind, seed, phase=None) -> Case:
+    """Draw, simulate and measure one case (``phase``: :func:`measure`)."""
     engine = engines()[engine_kind]
     return draw_case(index, names, engine_kind, seed, engine, baseline_velocity(engine_kind),
                      truth_velocity, [(mt.name, a) for mt in engine.mounts for a in "xyz"],
-                     "blind case")
+                     "blind case", phase=phase)
 
 
 def draw_case(index, names, engine_kind, seed, engine, base, simulate, channels, label, *,
               kinds=KINDS, rpm=RPM, noise_db=None, params=None, redraws=1,
-              worth=None) -> Case:
+              worth=None, phase=None) -> Case:
     """The one case maker: draw the hidden effects ``names`` (:class:`TruthKind` of
     ``kinds``) on ``engine``, simulate them (``simulate(engine, truth)``, noise-free,
     ``base`` without them) and measure ``channels`` at ``rpm`` (source
@@ -257,7 +279,8 @@ def draw_case(index, names, engine_kind, seed, engine, base, simulate, channels,
 
     ``params`` (``{name: parameters}``) fixes parameters instead of drawing them; the draw
     is repeated up to ``redraws`` times until ``worth(base, clean)`` holds; ``noise_db``
-    fixes the scatter (default uniform :data:`SIGMA_DB`).
+    fixes the scatter (default uniform :data:`SIGMA_DB`); ``phase`` what phase is measured
+    (:func:`measure`).
     """
     rng = np.random.default_rng(seed)
     truth, clean = [], base
@@ -268,7 +291,8 @@ def draw_case(index, names, engine_kind, seed, engine, base, simulate, channels,
         if worth is None or worth(base, clean):
             break
     sigma = float(rng.uniform(*SIGMA_DB)) if noise_db is None else float(noise_db)
-    measured = measure(clean, sigma, rng, f"{label} {index} (seed {seed})", channels, rpm)
+    measured = measure(clean, sigma, rng, f"{label} {index} (seed {seed})", channels, rpm,
+                       phase)
     members = {}
     if len(truth) > 1:
         members = {t[0]: gap_stats(base, simulate(engine, [t])) for t in truth}

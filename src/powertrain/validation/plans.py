@@ -1,0 +1,79 @@
+"""Plan cases of the blind benchmark: one car, one hidden truth, several load cases.
+
+:func:`make_plan_case` draws the hidden effects once (:data:`~powertrain.validation.kinds.KINDS`)
+on the default single-zone engine and simulates them on the truth path
+(:mod:`powertrain.validation.truth`) at every load of the plan (the combustion model's IMEP
+scale, :meth:`~powertrain.models.engine.Engine.at_load`; the amplitude-dependent elastomer
+then works at each run's own amplitudes); every run is measured on its own (its own scatter
+draw, noise and TDC error, :func:`powertrain.validation.cases.measure`). The case is
+detectable when one of its runs is (:func:`powertrain.validation.cases.is_detectable`).
+"""
+
+from __future__ import annotations
+
+import functools
+from dataclasses import dataclass
+
+import numpy as np
+
+from powertrain.validation import cases as cs
+from powertrain.validation.kinds import KINDS
+
+#: Loads of the two-run plan (full load, part load).
+LOADS = (1.0, 0.4)
+
+
+@functools.cache
+def baseline_at(load):
+    """Noise-free baseline of the default engine at ``load`` on the truth path."""
+    from powertrain.validation import truth as tr
+    e = cs.engines()["sz"].at_load(load)
+    return tr.simulate_truth(tr.TruthSpec(e, list(e.mounts)), cs.RPM)
+
+
+@dataclass
+class PlanCase:
+    """One car's runs (:class:`~powertrain.validation.cases.Case` per load) and its truth."""
+
+    index: int
+    names: list
+    seed: int
+    loads: tuple
+    runs: list
+    truth: list
+
+    @property
+    def category(self) -> str:
+        return self.runs[0].category
+
+    @property
+    def detectable(self) -> bool:
+        return any(r.detectable for r in self.runs)
+
+    @property
+    def truth_set(self) -> list:
+        return self.runs[0].truth_set
+
+    def plan(self):
+        """The :class:`~powertrain.iotools.plan.Plan` the diagnosis gets."""
+        from powertrain.iotools.plan import Plan, PlanRun
+        return Plan([PlanRun(r.measured, load) for r, load in zip(self.runs, self.loads)],
+                    source=f"plan case {self.index} (seed {self.seed})")
+
+
+def make_plan_case(index, names, seed, loads=LOADS, phase=None, params=None) -> PlanCase:
+    """Draw the hidden effects ``names`` once (``params``: ``{name: parameters}`` fixed
+    instead of drawn) and measure them at every load."""
+    engine = cs.engines()["sz"]
+    rng = np.random.default_rng(seed)
+    truth = [(n, {**KINDS[n].draw(rng, engine), **(params or {}).get(n, {})}) for n in names]
+    runs = []
+    for k, load in enumerate(loads):
+        e = engine.at_load(load)
+        run_seed = int(np.random.SeedSequence([seed, k]).generate_state(1)[0])
+        runs.append(cs.draw_case(index, names, "sz", run_seed, e, baseline_at(load),
+                                 lambda eng, _t: cs.truth_velocity(eng, truth),
+                                 [(mt.name, a) for mt in e.mounts for a in "xyz"],
+                                 f"plan case load {load:g}", phase=phase,
+                                 params={n: p for n, p in truth}))
+    return PlanCase(index, list(names), seed, tuple(loads), runs, truth)
