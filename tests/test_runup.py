@@ -140,7 +140,7 @@ def test_results_roundtrip_hdf5_and_csv(tmp_path, runups):
     assert back.settings["solver"] == "newmark"
     text = newm.csv_text().splitlines()
     assert text[0] == ("mount,direction,quantity,rpm,side,velocity_rms_mm_per_s,"
-                       "acceleration_rms_m_per_s2,force_rms_n")
+                       "acceleration_rms_m_per_s2,force_rms_n,phase_deg")
     n_rows = len(newm.channels) * newm.rpm.size * (ORDERS.size + 1)
     assert len(text) == 1 + n_rows
     quantities = {line.split(",")[2] for line in text[1:]}

@@ -68,7 +68,7 @@ def runup(rpm_from, rpm_to, rpm_step, engine_file, solver, stepper, angle_step, 
       powertrain runup --from 1000 --to 6000 --step 500
       powertrain runup --out runup.h5 --no-balancers
       powertrain runup --solver harmonic --csv runup.csv --plot runup.png
-      powertrain runup --effect amplitude_stiffness:kappa=1,a_c=0.02mm
+      powertrain runup --effect amplitude_stiffness:exponent=0.2
       powertrain runup --engine engines/default-modal-body.toml --path-plot paths.png
       powertrain runup --from 2000 --to 3000 --sweep 200 --raw sweep.h5 --csv sweep.csv
     """
