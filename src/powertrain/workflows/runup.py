@@ -36,6 +36,7 @@ from powertrain.errors import InputError, require_finite, solved
 from powertrain.progress import progress_bar
 from powertrain.results.runup import RunupResult, SweepRunup
 from powertrain.results.static import StaticResult
+from powertrain.solvers.equivalent_linear import AmplitudeNotConverged
 from powertrain.solvers.operating_point import (
     has_static_curves,
     operating_points,
@@ -454,8 +455,13 @@ def check_path_plot(engine, order) -> None:
 
 def checked_runup(engine, engine_path, run, *args, **kwargs):
     """``run(engine, *args, **kwargs)`` (a run-up) through :func:`~powertrain.errors.solved`,
-    its result checked finite (errors name the engine file)."""
-    result = solved(lambda: run(engine, *args, **kwargs), engine_path, "engine")
+    checked finite; errors name the engine file (amplitudes not converged: the mount file)."""
+    def run_naming_mounts():
+        try:
+            return run(engine, *args, **kwargs)
+        except AmplitudeNotConverged as exc:
+            raise InputError(str(exc), *engine.mount_section(exc.element)) from None
+    result = solved(run_naming_mounts, engine_path, "engine")
     values = {name.replace("_", " "): getattr(result, name) for name in (
         "displacement", "velocity", "acceleration", "mount_force", "mean_mount_force")}
     with np.errstate(over="ignore"):   # finite amplitudes whose squares overflow: absurd levels
