@@ -60,8 +60,8 @@ WORKERS = 1
 MIN_ANGLE_STEP_DEG = 0.05
 #: Coarsest crank-angle step [deg]: 72 steps a cycle still resolve order 8 without aliasing.
 MAX_ANGLE_STEP_DEG = 10.0
-#: Speed grid of the tracked curves of a continuous run-up [rpm] (the ``track`` default).
-TRACK_RPM_STEP = 50.0
+#: Tracking of a continuous run-up: 50 rpm grid; speed, phase from its tacho (TDC offset 0).
+SWEEP_TRACKING = {"rpm_step": 50.0, "pulses_per_rev": 1, "tdc_offset_deg": 0.0}
 
 
 class PeriodicityWarning(UserWarning):
@@ -415,7 +415,7 @@ def _sweep_runup(engine, rpm, rate, sample_rate, effects, progress) -> SweepRunu
     rec = simulate_sweep(engine, rpm[0], rpm[-1], rate, sample_rate, progress=progress,
                          static_factors=factors)
     try:
-        tracked = track_recording(rec, rpm_step=TRACK_RPM_STEP, progress=progress).as_velocity()
+        tracked = track_recording(rec, **SWEEP_TRACKING, progress=progress).as_velocity()
     except InputError as exc:        # the simulated ramp is too short or fast to be tracked
         raise InputError(f"the {rec.time[-1] - rec.time[0]:.3g} s sweep cannot be order-"
                          f"tracked ({exc.message}); a slower sweep or a wider speed range",
