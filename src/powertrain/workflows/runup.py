@@ -235,7 +235,8 @@ def _result(engine, system, step, rpm, speeds, solver_seconds) -> RunupResult:
                        path_contribution=paths,
                        meta={"engine": getattr(engine, "name", ""),
                              "chassis": "rigid" if chassis is None else chassis.model,
-                             "points": list(chassis.points) if chassis is not None else []})
+                             "points": list(chassis.points) if chassis is not None else [],
+                             "nonlinear_mounts": system.port_forces() is not None})
 
 
 def path_contributions(system, rpm, force) -> np.ndarray:
@@ -317,8 +318,7 @@ def _concatenate(parts):
     if first.operating_point is not None:
         out.operating_point = dataclasses.replace(first.operating_point, points=[
             op for p in parts for op in p.operating_point.points])
-    out.settings = dict(first.settings)
-    out.meta = dict(first.meta)
+    out.settings, out.meta = dict(first.settings), dict(first.meta)
     return out
 
 
