@@ -230,3 +230,27 @@ def test_negative_energy_shares_are_explained():
     assert "adds up to 100 %" in text and " -0.0 " not in text
     for m in res.modes:
         assert m.ked_percent.sum() == pytest.approx(100.0, abs=1e-9)
+
+
+def test_modes_of_nonlinear_mounts_take_the_networks_as_measured():
+    """engines/default-nonlinear.toml has the default engine's networks with amplitude laws,
+    friction and static curves (factor 1 at the reference deflection) added: its printed
+    static modes and its damped modes are the linear engine's to 1e-9, and both say so; the
+    linear engine's label is unchanged."""
+    from conftest import ENGINES
+
+    from powertrain.results.runup import RIGID_BODY_MODES_LABEL
+    from powertrain.solvers.modes import AS_MEASURED
+    from powertrain.workflows.runup import runup
+    linear = read_engine(DEFAULT_ENGINE_PATH)
+    nonlinear = read_engine(ENGINES / "default-nonlinear.toml")
+    a, b = (e.rigid_body_modes()[0] for e in (nonlinear, linear))
+    assert np.allclose(a, b, rtol=1e-9, atol=0)
+    da, db = (engine_modes(e) for e in (nonlinear, linear))
+    assert np.allclose([m.frequency_hz for m in da.modes], [m.frequency_hz for m in db.modes],
+                       rtol=1e-9, atol=0)
+    assert AS_MEASURED in da.to_text() and AS_MEASURED not in db.to_text()
+    text = runup(nonlinear, [3000.0], solver="harmonic").to_text().splitlines()[1]
+    assert text.startswith(f"rigid-body modes, undamped, {AS_MEASURED} at their static")
+    assert runup(linear, [3000.0], solver="harmonic").to_text().splitlines()[1].startswith(
+        RIGID_BODY_MODES_LABEL)

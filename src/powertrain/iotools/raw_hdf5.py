@@ -7,6 +7,7 @@ Layout written by :func:`write_raw_hdf5` (``powertrain runup --sweep --raw``)::
     /time             (n,)  attrs unit="s"
     /rpm              (n,)  attrs unit="rpm"         (optional)
     /tacho            (n,)  attrs unit="V"           (optional)
+    /cycle            (n,)  attrs unit="V"           (optional: once-per-cycle reference)
     /channels/<name>  (n,)  attrs unit (the values' unit, e.g. "m/s^2" or "g"), mount, side,
                             direction, quantity; <name> = MOUNT.DIRECTION or
                             MOUNT.SIDE.DIRECTION
@@ -118,7 +119,7 @@ def _read_own(h5, path):
     from powertrain.units import to_si
     time = to_si(time, unit, "time", file=path, key="time")
     signals, times = [], {}
-    for name in ("rpm", "tacho"):
+    for name in ("rpm", "tacho", "cycle"):
         if name in h5:
             signals.append((name, _dataset(h5, name, path, budget), _unit(h5[name])))
             _own_time(h5, name, path, times, budget)
@@ -176,8 +177,10 @@ def write_raw_hdf5(path, recording, *, description: str = "", synthetic: bool = 
             h5.create_dataset("time", data=recording.time).attrs["unit"] = "s"
             if recording.rpm is not None:
                 h5.create_dataset("rpm", data=recording.rpm).attrs["unit"] = "rpm"
-            if recording.tacho is not None:
-                h5.create_dataset("tacho", data=recording.tacho).attrs["unit"] = "V"
+            for name, pulses in (("tacho", recording.tacho),
+                                 ("cycle", recording.cycle_reference)):
+                if pulses is not None:
+                    h5.create_dataset(name, data=pulses).attrs["unit"] = "V"
             g = h5.create_group("channels", track_order=True)
             for ch in recording.channels:
                 dim = "length" if ch.quantity == "displacement" else ch.quantity

@@ -218,6 +218,20 @@ class Engine:
                 return m
         raise KeyError(name)
 
+    def mount_section(self, element: str):
+        """``(file, key)`` of the mount direction ``element`` (``"left.y"``): its mount file
+        and the section of its amplitude law (``amplitude``) or else its friction element
+        (``friction``); the engine file and ``engine`` where unknown (an effect's)."""
+        name, _, direction = element.rpartition(".")
+        try:
+            mount = self.mount(name)
+            model = mount.directions[direction]
+        except KeyError:
+            return self.file, "engine"
+        law = getattr(model, "amplitude_law", None)
+        key = "amplitude" if law is not None and not law.constant else "friction"
+        return mount.files.get(direction, self.file), key
+
     # ------------------------------------------------------------------ pressure
     @property
     def has_excitation(self) -> bool:

@@ -22,7 +22,7 @@ two-port values, :func:`frame_and_ports`) all go through :func:`condensed_matrix
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -102,7 +102,10 @@ def condensed_matrix(frame, engine_rows, base_rows, abc, s):
 
 def condense(system, keep, s):
     r"""Dynamic stiffness :math:`\mathbf K + s\mathbf C + s^2\mathbf M` of ``system`` on the
-    coordinates ``keep`` with all others eliminated exactly.
+    coordinates ``keep`` with all others eliminated exactly, every mount network as measured
+    (:meth:`~powertrain.physics.mount_elements.MountElement.as_measured`: amplitude laws at
+    factor 1, no friction; a linear network as it is): the linear view of the static
+    stiffness and the modes, independent of any response amplitude.
 
     Parameters
     ----------
@@ -117,6 +120,7 @@ def condense(system, keep, s):
     ndarray complex, ``shape(s) + (n_keep, n_keep)``
     """
     ports = system.ports()
+    ports = replace(ports, elements=[element.as_measured() for element in ports.elements])
     s = np.asarray(s, complex)
     D = _retained_matrix(ports, two_ports(ports, s), s)
     pos = {int(j): i for i, j in enumerate(ports.retained)}

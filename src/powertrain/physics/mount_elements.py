@@ -139,6 +139,13 @@ class MountElement:
         """A copy with the static curve's factor at an operating point."""
         return MountElement(self.model, self.port_law, self.amplitude_law, float(static_factor))
 
+    def as_measured(self) -> MountElement:
+        """The network as its mount file gives it, at the static factor: the amplitude law
+        at factor 1 (its reference amplitude, where the network was measured) and no port
+        law. What the linear analyses of the assembly take (static stiffness, modes:
+        :func:`powertrain.physics.condensation.condense`)."""
+        return MountElement(self.model, static_factor=self.static_factor)
+
     def network(self, amplitude=0.0):
         """``(masses, elem_nodes, c, d)`` of the linear network at the amplitude [m]."""
         masses, nodes, c, d = self.model.network()

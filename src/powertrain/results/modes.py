@@ -9,7 +9,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from powertrain.solvers.modes import COORDINATES, number_or_null
+from powertrain.solvers.modes import AS_MEASURED, COORDINATES, number_or_null
 
 
 @dataclass
@@ -123,6 +123,8 @@ class ModesResult:
                 + ("" if static else f"  {'static f':>8}  {'MAC':>4}") + f"  {'dominant':>8}  "
                 + "  ".join(f"{c:>6}" for c in COORDINATES) + "  TRA angle")
         lines = [self.title(), head, "-" * len(head)]
+        if AS_MEASURED in self.method:
+            lines.insert(1, AS_MEASURED)
         for i, m in enumerate(self.modes, 1):
             tag = "" if m.kind == "rigid-body" else f"  ({m.kind})"
             lines.append(f"{i:4d}  {m.frequency_hz:7.3f}  {m.damping_ratio:6.3f}"

@@ -56,6 +56,7 @@ import numpy as np
 
 from powertrain.analysis.channel import Channel
 from powertrain.analysis.orders import order_label, order_rms, synthesis_rms
+from powertrain.solvers.modes import AS_MEASURED
 
 QUANTITIES = {
     "displacement": "m",
@@ -65,6 +66,10 @@ QUANTITIES = {
 }
 #: What the run-up's rigid-body mode frequencies are (printed by ``runup`` and ``whatif``).
 RIGID_BODY_MODES_LABEL = "rigid-body modes, undamped, mounts at their static stiffness [Hz]"
+#: The same modes of an engine with amplitude laws or friction, saying which stiffness that is
+#: (:func:`powertrain.physics.condensation.condense`).
+RIGID_BODY_MODES_LABEL_AS_MEASURED = \
+    f"rigid-body modes, undamped, {AS_MEASURED} at their static stiffness [Hz]"
 #: Columns written by :meth:`RunupResult.csv_text` (files with only the first five stay valid).
 CSV_HEADER = ("mount,direction,quantity,rpm,side,velocity_rms_mm_per_s,"
               "acceleration_rms_m_per_s2,force_rms_n,phase_deg")
@@ -180,7 +185,7 @@ class RunupResult:
         from powertrain.analysis.text_table import format_table
         name, file = self.meta.get("engine", ""), self.meta.get("engine_file", "")
         lines = [f"engine: {name} ({file})" if file else f"engine: {name}",
-                 f"{RIGID_BODY_MODES_LABEL}: {self._labelled_modes()} (damped, at the "
+                 f"{self.modes_label}: {self._labelled_modes()} (damped, at the "
                  "mounts' dynamic stiffness: 'powertrain modes')"]
         if self.settings.get("effects"):
             lines.append("effects: " + effects_text(self.settings["effects"]))
@@ -193,6 +198,13 @@ class RunupResult:
             lines.append("periodicity of processed windows: max "
                          f"{100 * np.max(self.periodicity):.2g} %")
         return "\n".join(lines)
+
+    @property
+    def modes_label(self) -> str:
+        """What the printed rigid-body modes are (``meta["nonlinear_mounts"]``: the engine
+        has amplitude laws or friction)."""
+        return RIGID_BODY_MODES_LABEL_AS_MEASURED if self.meta.get("nonlinear_mounts") \
+            else RIGID_BODY_MODES_LABEL
 
     def _labelled_modes(self) -> str:
         """``5.9 (y), 6.7 (z), ...``: each mode with its dominant coordinate, where known."""

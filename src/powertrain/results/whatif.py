@@ -21,7 +21,6 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from powertrain.analysis.channel import Channel
-from powertrain.results.runup import RIGID_BODY_MODES_LABEL
 
 #: Quantities reported by default.
 QUANTITIES = ("synthesis", "order_2", "order_4")
@@ -97,7 +96,7 @@ class WhatIfResult:
         step = "" if self.rpm_step is None else f" step {self.rpm_step:g}"
         lines = [f"baseline: {d.get('engine')} ({d.get('engine_file')}), solver "
                  f"{d.get('solver')}, {rpm[0]:g}-{rpm[-1]:g} rpm{step}",
-                 f"baseline {RIGID_BODY_MODES_LABEL}: {modes}"]
+                 f"baseline {self.baseline.modes_label}: {modes}"]
         lines += [tf.summary() for tf in self.target_fits]
         lines += [f"change of RMS {self.signal.replace('_', ' ')} vs baseline, 20 log10(v/v0) "
                   "[dB]: mean over speeds / max |d|", self.table()]
@@ -250,7 +249,7 @@ class WhatIfResult:
             header = ["channel"] + [f"{q} mean/max|d| [dB]" for q in self.quantities]
             modes = ", ".join(f"{f:.2f}" for f in v.result.rigid_body_modes_hz)
             blocks.append(f"variant {v.name!r} ({'; '.join(v.specs)}) vs baseline\n"
-                          f"{RIGID_BODY_MODES_LABEL}: {modes}\n"
+                          f"{v.result.modes_label}: {modes}\n"
                           + _format_table(header, list(rows.values())))
         return "\n\n".join(blocks)
 

@@ -79,9 +79,20 @@ class NetworkScaling:
     def at_operating_point(self, factors):
         """The assembled model with its elements at the static ``factors`` (n_net,): the
         same model, its elements, C, K and force rows replaced (for the harmonic start)."""
+        return self.with_elements(self.elements_at(factors))
+
+    def as_measured(self):
+        """The assembled model with every network as measured
+        (:meth:`~powertrain.physics.mount_elements.MountElement.as_measured`): the linear
+        view the modes take."""
+        return self.with_elements([el.as_measured() for el in self.elements])
+
+    def with_elements(self, elements):
+        """The assembled model with ``elements`` (one per network, at amplitude 0): its
+        elements, C, K and force rows replaced."""
         s = self.system
-        elements = self.elements_at(factors)
-        C, K, Fk, Fd = self.matrices(self.scales(np.zeros(len(elements)), factors))
+        C, K, Fk, Fd = self.matrices(np.array([el.scales(0.0) for el in elements],
+                                              float).reshape(-1, 2))
         ports = dataclasses.replace(s.network_ports, elements=elements)
         return dataclasses.replace(s, C=C, K=K, force_matrix_k=Fk, force_matrix_d=Fd,
                                    networks=[(*n[:3], el) for n, el in zip(s.networks,

@@ -38,6 +38,11 @@ import numpy as np
 import scipy.linalg as sla
 
 from powertrain.physics.condensation import condense
+from powertrain.solvers.cycle_newmark import NetworkScaling
+
+#: What the modes of a model with amplitude laws or friction take (printed with them).
+AS_MEASURED = ("mounts as measured (networks as in their mount files: amplitude laws at "
+               "factor 1, no friction)")
 
 COORDINATES = ("x", "y", "z", "rx", "ry", "rz")
 #: Relative change of s at which the secant iteration stops.
@@ -212,6 +217,7 @@ def rigid_body_modes(system, inertia, *, static=False, crank_axis=(1.0, 0.0, 0.0
     Returns ``{"modes": [fields of a powertrain.results.modes.Mode, by frequency],
     "torque_roll_axis": {...}, "method": str}``.
     """
+    system, note = _as_measured(system)
     keep = system.retained
     MR = system.M[np.ix_(keep, keep)]
     w2, vec = sla.eigh(_static_condensed(system, keep), MR)
@@ -248,4 +254,14 @@ def rigid_body_modes(system, inertia, *, static=False, crank_axis=(1.0, 0.0, 0.0
     method = ("static: static stiffness, undamped" if static else
               "dynamic: network dynamic stiffness at each mode's complex frequency "
               "(internal degrees of freedom condensed exactly, secant iteration)")
-    return {"modes": modes, "torque_roll_axis": tra_info, "method": method}
+    return {"modes": modes, "torque_roll_axis": tra_info, "method": method + note}
+
+
+def _as_measured(system):
+    """``(system, note)``: a model with amplitude laws or friction with every network as
+    measured (:meth:`NetworkScaling.as_measured`, the view of
+    :func:`~powertrain.physics.condensation.condense`) and the note its method gets; a
+    linear model as it is."""
+    if system.port_forces() is None:
+        return system, ""
+    return NetworkScaling(system).as_measured(), "; " + AS_MEASURED

@@ -12,7 +12,9 @@ stepper) at ``oversample`` times the output rate (at least one step per crank de
 top speed), starting from the periodic steady state at the first speed. The mount-point
 accelerations are decimated to ``sample_rate`` with a zero-phase polyphase FIR (Kaiser,
 beta 8) and returned as a :class:`~powertrain.models.recording.RawRecording` (synthetic,
-labelled so) with the speed channel, ready for the tracker.
+labelled so) with the speed channel, a once-per-revolution tacho whose rising edges are
+cylinder-1 firing TDC and a once-per-cycle reference (:func:`crank_pulses`, from the exact
+crank angle), ready for the tracker, phases included.
 """
 
 from __future__ import annotations
@@ -22,6 +24,7 @@ import math
 import numpy as np
 
 from powertrain.analysis.channel import Channel
+from powertrain.analysis.speed import TRIGGER_HIGH
 from powertrain.errors import InputError
 from powertrain.models.recording import RawChannel, RawRecording
 
@@ -41,6 +44,11 @@ MAX_SWEEP_SAMPLES = 2 ** 22
 MAX_SWEEP_STEPS = 2 ** 24
 #: Highest output sampling rate [Hz].
 MAX_SAMPLE_RATE = 2 ** 20
+#: Simulated tacho and cycle reference: pulse level [V], rising and falling flank [deg of
+#: crank angle], and the cycle reference's edge before cylinder-1 firing TDC [deg].
+PULSE_VOLTS = 5.0
+PULSE_FLANK_DEG = 30.0
+CYCLE_LEAD_DEG = 90.0
 
 
 def _load_table(engine, rpm_from, rpm_to):
@@ -94,7 +102,8 @@ def simulate_sweep(engine, rpm_from, rpm_to, rate_rpm_per_s, sample_rate=8192.0,
     Returns
     -------
     RawRecording
-        Nine acceleration channels [m/s^2] (engine side) and the speed [rpm].
+        Nine acceleration channels [m/s^2] (engine side), the speed [rpm], the tacho and the
+        cycle reference [V] (:func:`crank_pulses`).
     """
     from threadpoolctl import threadpool_limits
 
@@ -122,7 +131,34 @@ def simulate_sweep(engine, rpm_from, rpm_to, rate_rpm_per_s, sample_rate=8192.0,
             f"{rate_rpm_per_s:g} rpm/s ({getattr(engine, 'name', '')}; Newmark average "
             f"acceleration, {method}, {m * sample_rate:g} Hz internal, decimated to "
             f"{sample_rate:g} Hz)")
-    return RawRecording(t_out, chans, rpm_out, None, "simulated sweep", [note]).validate()
+    tacho, cycle = crank_pulses(t_out, rpm_from, rate_rpm_per_s)
+    return RawRecording(t_out, chans, rpm_out, tacho, "simulated sweep", [note],
+                        cycle).validate()
+
+
+def crank_pulses(time, rpm_from, rate_rpm_per_s):
+    r"""The sweep's tacho and cycle reference [V] at ``time`` [s], from its exact crank angle
+    (module docstring): one pulse per revolution whose rising edge is cylinder-1 firing TDC
+    (:math:`\theta = 0` mod :math:`2\pi`), and one per cycle whose edge is
+    :data:`CYCLE_LEAD_DEG` before the TDC at :math:`\theta = 0` mod :math:`4\pi` (as a cam
+    signal: the first tacho reference after it is that TDC,
+    :func:`~powertrain.analysis.phase.cycle_origin`)."""
+    theta = (2 * np.pi / 60.0) * (rpm_from * time + 0.5 * rate_rpm_per_s * time ** 2)
+    return (_pulse_train(theta, 2 * np.pi, 0.0),
+            _pulse_train(theta, 4 * np.pi, -np.radians(CYCLE_LEAD_DEG)))
+
+
+def _pulse_train(theta, period, edge):
+    """Pulses [V] at the crank angles ``theta`` [rad], one per ``period``, high for half of
+    it: the rising flank, linear in angle over :data:`PULSE_FLANK_DEG`, crosses the
+    tracker's trigger level (:data:`~powertrain.analysis.speed.TRIGGER_HIGH` of the swing)
+    at ``edge`` modulo ``period``, so that the edge time interpolated between samples is
+    exact but for the speed's change over one sample."""
+    flank = np.radians(PULSE_FLANK_DEG)
+    phi = np.mod(theta - edge + TRIGGER_HIGH * flank, period)
+    rise = np.clip(phi / flank, 0.0, 1.0)
+    fall = np.clip((0.5 * period - phi) / flank, 0.0, 1.0)
+    return PULSE_VOLTS * np.minimum(rise, fall)
 
 
 def _channel_dofs(channel_matrix):

@@ -36,6 +36,7 @@ from powertrain.errors import InputError, require_finite, solved
 from powertrain.progress import progress_bar
 from powertrain.results.runup import RunupResult, SweepRunup
 from powertrain.results.static import StaticResult
+from powertrain.solvers.equivalent_linear import AmplitudeNotConverged
 from powertrain.solvers.operating_point import (
     has_static_curves,
     operating_points,
@@ -59,8 +60,8 @@ WORKERS = 1
 MIN_ANGLE_STEP_DEG = 0.05
 #: Coarsest crank-angle step [deg]: 72 steps a cycle still resolve order 8 without aliasing.
 MAX_ANGLE_STEP_DEG = 10.0
-#: Speed grid of the tracked curves of a continuous run-up [rpm] (the ``track`` default).
-TRACK_RPM_STEP = 50.0
+#: Tracking of a continuous run-up: 50 rpm grid; speed, phase from its tacho (TDC offset 0).
+SWEEP_TRACKING = {"rpm_step": 50.0, "pulses_per_rev": 1, "tdc_offset_deg": 0.0}
 
 
 class PeriodicityWarning(UserWarning):
@@ -234,7 +235,8 @@ def _result(engine, system, step, rpm, speeds, solver_seconds) -> RunupResult:
                        path_contribution=paths,
                        meta={"engine": getattr(engine, "name", ""),
                              "chassis": "rigid" if chassis is None else chassis.model,
-                             "points": list(chassis.points) if chassis is not None else []})
+                             "points": list(chassis.points) if chassis is not None else [],
+                             "nonlinear_mounts": system.port_forces() is not None})
 
 
 def path_contributions(system, rpm, force) -> np.ndarray:
@@ -383,7 +385,7 @@ def _sweep_runup(engine, rpm, rate, sample_rate, effects, progress) -> SweepRunu
     rec = simulate_sweep(engine, rpm[0], rpm[-1], rate, sample_rate, progress=progress,
                          static_factors=factors)
     try:
-        tracked = track_recording(rec, rpm_step=TRACK_RPM_STEP, progress=progress).as_velocity()
+        tracked = track_recording(rec, **SWEEP_TRACKING, progress=progress).as_velocity()
     except InputError as exc:        # the simulated ramp is too short or fast to be tracked
         raise InputError(f"the {rec.time[-1] - rec.time[0]:.3g} s sweep cannot be order-"
                          f"tracked ({exc.message}); a slower sweep or a wider speed range",
@@ -423,8 +425,13 @@ def check_path_plot(engine, order) -> None:
 
 def checked_runup(engine, engine_path, run, *args, **kwargs):
     """``run(engine, *args, **kwargs)`` (a run-up) through :func:`~powertrain.errors.solved`,
-    its result checked finite (errors name the engine file)."""
-    result = solved(lambda: run(engine, *args, **kwargs), engine_path, "engine")
+    checked finite; errors name the engine file (amplitudes not converged: the mount file)."""
+    def run_naming_mounts():
+        try:
+            return run(engine, *args, **kwargs)
+        except AmplitudeNotConverged as exc:
+            raise InputError(str(exc), *engine.mount_section(exc.element)) from None
+    result = solved(run_naming_mounts, engine_path, "engine")
     values = {name.replace("_", " "): getattr(result, name) for name in (
         "displacement", "velocity", "acceleration", "mount_force", "mean_mount_force")}
     with np.errstate(over="ignore"):   # finite amplitudes whose squares overflow: absurd levels
