@@ -5,8 +5,9 @@ node, on the relative displacement :math:`u = x_E - x_B` and velocity :math:`\do
 cannot call Python objects fast, so every law is a kind code, a row of parameters and a row
 of state (its memory, e.g. the friction element's reversal point), dispatched here by code:
 
-* :func:`port_force` gives the trial force :math:`f` (on the base; :math:`-f` on the engine
-  side), the tangent stiffness :math:`\partial f/\partial u` and the tangent damping
+* :func:`law_force` (:func:`port_force` for one law's rows) gives the trial force
+  :math:`f` (on the base; :math:`-f` on the engine side), the tangent stiffness
+  :math:`\partial f/\partial u` and the tangent damping
   :math:`\partial f/\partial\dot u` at :math:`(u, \dot u)` from the committed state, without
   changing it (Newton iterates on it);
 * :func:`commit_state` updates the state once the step has converged.
