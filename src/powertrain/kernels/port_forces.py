@@ -5,8 +5,9 @@ node, on the relative displacement :math:`u = x_E - x_B` and velocity :math:`\do
 cannot call Python objects fast, so every law is a kind code, a row of parameters and a row
 of state (its memory, e.g. the friction element's reversal point), dispatched here by code:
 
-* :func:`port_force` gives the trial force :math:`f` (on the base; :math:`-f` on the engine
-  side), the tangent stiffness :math:`\partial f/\partial u` and the tangent damping
+* :func:`law_force` (:func:`port_force` for one law's rows) gives the trial force
+  :math:`f` (on the base; :math:`-f` on the engine side), the tangent stiffness
+  :math:`\partial f/\partial u` and the tangent damping
   :math:`\partial f/\partial\dot u` at :math:`(u, \dot u)` from the committed state, without
   changing it (Newton iterates on it);
 * :func:`commit_state` updates the state once the step has converged.
@@ -31,77 +32,87 @@ JENKINS = 1
 BERG = 2
 
 
-@njit(cache=True, nogil=True)
-def _berg_branch(u, par, state):
+@njit(cache=True, nogil=True, inline="always")
+def _berg_branch(u, state, e):
     """``(direction, x_s, F_s)`` of the branch the point ``u`` lies on: the committed one
     while the motion keeps its direction, else a new one from the last committed point."""
-    du = u - state[3]
-    d = 1.0 if du > 0 else (-1.0 if du < 0 else state[2])
-    if d == state[2]:
-        return d, state[0], state[1]
-    return d, state[3], state[4]
+    du = u - state[e, 3]
+    d = 1.0 if du > 0 else (-1.0 if du < 0 else state[e, 2])
+    if d == state[e, 2]:
+        return d, state[e, 0], state[e, 1]
+    return d, state[e, 3], state[e, 4]
 
 
-@njit(cache=True, nogil=True)
-def _berg(u, par, state):
+@njit(cache=True, nogil=True, inline="always")
+def _berg(u, par, state, e):
     """Berg's force and tangent stiffness at ``u`` from the committed ``state``."""
-    fm = par[0]
-    x2 = par[1]
+    fm = par[e, 0]
+    x2 = par[e, 1]
     if fm <= 0.0:
         return 0.0, 0.0
-    d, xs, fs = _berg_branch(u, par, state)
+    d, xs, fs = _berg_branch(u, state, e)
     if d == 0.0:
-        return state[4], fm / x2
+        return state[e, 4], fm / x2
     y = u - xs
     if d > 0:
         a = x2 * (1.0 - fs / fm)
         if y < 0.0:
             y = 0.0
-        return fs + y / (a + y) * (fm - fs), a * (fm - fs) / ((a + y) * (a + y))
+        w = (fm - fs) / (a + y)
+        return fs + y * w, a * w / (a + y)
     b = x2 * (1.0 + fs / fm)
     if y > 0.0:
         y = 0.0
-    return fs + y / (b - y) * (fm + fs), b * (fm + fs) / ((b - y) * (b - y))
+    w = (fm + fs) / (b - y)
+    return fs + y * w, b * w / (b - y)
 
 
-@njit(cache=True, nogil=True)
-def port_force(kind, u, v, par, state):
+@njit(cache=True, nogil=True, inline="always")
+def law_force(kind, u, v, par, state, e):
     """``(f, df/du, df/dv)`` of the port law ``kind`` at ``(u, v)`` from the committed
-    ``state`` (unchanged) [N, N/m, N·s/m]."""
+    state, row ``e`` of ``par`` and ``state`` (unchanged) [N, N/m, N·s/m] (2-D arrays and a
+    row index: no array view per call in the kernels' loops)."""
     if kind == JENKINS:
-        k = par[0]
-        fs = par[1]
-        f = k * (u - state[0])
+        k = par[e, 0]
+        fs = par[e, 1]
+        f = k * (u - state[e, 0])
         if f > fs:
             return fs, 0.0, 0.0
         if f < -fs:
             return -fs, 0.0, 0.0
         return f, k, 0.0
     if kind == BERG:
-        f, kt = _berg(u, par, state)
+        f, kt = _berg(u, par, state, e)
         return f, kt, 0.0
     return 0.0, 0.0, 0.0
 
 
 @njit(cache=True, nogil=True)
-def commit_state(kind, u, v, par, state):
-    """Update ``state`` in place after a converged step ending at ``(u, v)``."""
+def port_force(kind, u, v, par, state):
+    """:func:`law_force` of one law, its parameters ``par`` and ``state`` as rows."""
+    return law_force(kind, u, v, par.reshape((1, par.size)), state.reshape((1, state.size)),
+                     0)
+
+
+@njit(cache=True, nogil=True, inline="always")
+def commit_state(kind, u, v, par, state, e, f):
+    """Update row ``e`` of ``state`` in place after a converged step ending at ``(u, v)``,
+    where the law gives the force ``f`` (:func:`law_force`)."""
     if kind == JENKINS:
-        k = par[0]
-        fs = par[1]
-        f = k * (u - state[0])
+        k = par[e, 0]
+        fs = par[e, 1]
+        f = k * (u - state[e, 0])
         if f > fs:
-            state[0] = u - fs / k
+            state[e, 0] = u - fs / k
         elif f < -fs:
-            state[0] = u + fs / k
+            state[e, 0] = u + fs / k
     elif kind == BERG:
-        f = _berg(u, par, state)[0]
-        d, xs, fsr = _berg_branch(u, par, state)
-        state[0] = xs
-        state[1] = fsr
-        state[2] = d
-        state[3] = u
-        state[4] = f
+        d, xs, fsr = _berg_branch(u, state, e)
+        state[e, 0] = xs
+        state[e, 1] = fsr
+        state[e, 2] = d
+        state[e, 3] = u
+        state[e, 4] = f
 
 
 @njit(cache=True, nogil=True)
@@ -110,11 +121,11 @@ def port_force_loop(kinds, par, state, U, V, F):
     (n_t, m), committing the state after every point (a displacement-driven test)."""
     for t in range(U.shape[0]):
         for e in range(kinds.shape[0]):
-            F[t, e] = port_force(kinds[e], U[t, e], V[t, e], par[e], state[e])[0]
-            commit_state(kinds[e], U[t, e], V[t, e], par[e], state[e])
+            F[t, e] = law_force(kinds[e], U[t, e], V[t, e], par, state, e)[0]
+            commit_state(kinds[e], U[t, e], V[t, e], par, state, e, F[t, e])
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, inline="always")
 def _dot(a, b):
     """Dot product of two short vectors (a loop: no BLAS call per step)."""
     s = 0.0
@@ -165,8 +176,9 @@ def newmark_port_kernel(G, H, Fs, h, x0, v0, a0, W, P, Q, kinds, par, state, X, 
     :math:`\dot{\mathbf u} = \dot{\mathbf u}_{lin} - \tfrac h2\mathbf Q\mathbf z`,
     :math:`\mathbf Q = \mathbf P\mathbf W`. Newton solves the m equations
     :math:`z_e = f_e(u_e, \dot u_e)` per step (Jacobian
-    :math:`\mathbf I + \mathrm{diag}(\tfrac{h^2}{4}k_t + \tfrac h2 c_t)\mathbf Q`), from the
-    previous step's forces; the states are committed once it has converged.
+    :math:`\mathbf I + \mathrm{diag}(\tfrac{h^2}{4}k_t + \tfrac h2 c_t)\mathbf Q`; its
+    diagonal first, :func:`_port_forces_step`), from the tangent at the previous step; the
+    states are committed once it has converged.
 
     Parameters
     ----------
@@ -207,13 +219,15 @@ def newmark_port_kernel(G, H, Fs, h, x0, v0, a0, W, P, Q, kinds, par, state, X, 
     z = np.empty(m)
     r = np.empty(m)
     J = np.empty((m, m))
+    coupled = _coupling(hh * Q, hv * Q)
+    last = np.zeros((6, m))
     failed = 0
     for j in range(n):
         X[0, j] = x0[j]
         V[0, j] = v0[j]
         A[0, j] = a0[j]
     for e in range(m):
-        z[e] = port_force(kinds[e], _dot(P[e], x0), _dot(P[e], v0), par[e], state[e])[0]
+        z[e] = law_force(kinds[e], _dot(P[e], x0), _dot(P[e], v0), par, state, e)[0]
         Z[0, e] = z[e]
     for k in range(1, ns):
         for j in range(n):
@@ -236,31 +250,10 @@ def newmark_port_kernel(G, H, Fs, h, x0, v0, a0, W, P, Q, kinds, par, state, X, 
                 sv += Pe[j] * (vt[j] + hv * Ak[j])
             ul[e] = su
             vl[e] = sv
-        converged = False
-        for _ in range(max_iter):
-            big = 1.0
-            worst = 0.0
-            for e in range(m):
-                qz = _dot(Q[e], z)
-                f, kt, ct = port_force(kinds[e], ul[e] - hh * qz, vl[e] - hv * qz, par[e],
-                                       state[e])
-                r[e] = f - z[e]
-                big = max(big, abs(z[e]))
-                worst = max(worst, abs(r[e]))
-                for j in range(m):
-                    J[e, j] = (hh * kt + hv * ct) * Q[e, j]
-                J[e, e] += 1.0
-            if worst <= tol * big:
-                converged = True
-                break
-            _solve_in_place(J, r)
-            for e in range(m):
-                z[e] += r[e]
-        if not converged:
+        if not _port_forces_step(kinds, par, state, ul, vl, coupled, z, last, r, J, tol,
+                                 max_iter):
             failed += 1
         for e in range(m):
-            qz = _dot(Q[e], z)
-            commit_state(kinds[e], ul[e] - hh * qz, vl[e] - hv * qz, par[e], state[e])
             Z[k, e] = z[e]
         for j in range(n):
             A[k, j] -= _dot(W[j], z)
@@ -269,81 +262,17 @@ def newmark_port_kernel(G, H, Fs, h, x0, v0, a0, W, P, Q, kinds, par, state, X, 
     return failed
 
 
-@njit(cache=True, nogil=True, fastmath=True, inline="always")
-def _modal_load(Lr, Li, f, n_re, n_im):
-    """Modal load ``n = L f`` (real and imaginary parts) of the load ``f``."""
-    for j in range(n_re.shape[0]):
-        n_re[j] = 0.0
-        n_im[j] = 0.0
-    for c in range(f.shape[0]):
-        fc = f[c]
-        Lrc = Lr[c]
-        Lic = Li[c]
-        for j in range(n_re.shape[0]):
-            n_re[j] += Lrc[j] * fc
-            n_im[j] += Lic[j] * fc
-
-
-@njit(cache=True, nogil=True, fastmath=True, inline="always")
-def _modal_predictor(lr, li, gr, gi, g_re, g_im, n_re, n_im, er, ei):
-    """``eta <- lam_d eta + gain (g + n)`` in place: the step without the new port forces."""
-    for j in range(er.shape[0]):
-        sr = g_re[j] + n_re[j]
-        si = g_im[j] + n_im[j]
-        a = lr[j] * er[j] - li[j] * ei[j] + gr[j] * sr - gi[j] * si
-        ei[j] = lr[j] * ei[j] + li[j] * er[j] + gr[j] * si + gi[j] * sr
-        er[j] = a
-
-
-@njit(cache=True, nogil=True, fastmath=True, inline="always")
-def _real_rows(Wr, Wi, er, ei, out):
-    """``out = Re(W eta)`` for the rows of ``W`` (real and imaginary parts)."""
-    for c in range(out.shape[0]):
-        Wrc = Wr[c]
-        Wic = Wi[c]
-        y = 0.0
-        for j in range(er.shape[0]):
-            y += Wrc[j] * er[j] - Wic[j] * ei[j]
-        out[c] = y
-
-
-@njit(cache=True, nogil=True, fastmath=True, inline="always")
-def _port_load(Br, Bi, z, n_re, n_im, g_re, g_im):
-    """Modal load of the step ``g = n + B z`` (external and port forces)."""
-    for j in range(g_re.shape[0]):
-        g_re[j] = n_re[j]
-        g_im[j] = n_im[j]
-    for e in range(z.shape[0]):
-        ze = z[e]
-        Bre = Br[e]
-        Bie = Bi[e]
-        for j in range(g_re.shape[0]):
-            g_re[j] += Bre[j] * ze
-            g_im[j] += Bie[j] * ze
-
-
-@njit(cache=True, nogil=True, fastmath=True, inline="always")
-def _port_correction(gr, gi, g_re, g_im, n_re, n_im, er, ei):
-    """``eta += gain (g - n)``: the port forces' part of the step."""
-    for j in range(er.shape[0]):
-        br = g_re[j] - n_re[j]
-        bi = g_im[j] - n_im[j]
-        er[j] += gr[j] * br - gi[j] * bi
-        ei[j] += gr[j] * bi + gi[j] * br
-
-
 @njit(cache=True, nogil=True)
 def _port_newton(kinds, par, state, ul, vl, Qu, Qv, z, r, J, tol, max_iter):
     """Newton on the port forces ``z`` (in place) of one step: ``z_e = f_e(ul_e - (Qu z)_e,
-    vl_e - (Qv z)_e)``, from the given ``z``; the states are committed. True on success."""
+    vl_e - (Qv z)_e)``, from the given ``z``. True on success."""
     m = z.shape[0]
-    converged = False
     for _ in range(max_iter):
         big = 1.0
         worst = 0.0
         for e in range(m):
-            f, kt, ct = port_force(kinds[e], ul[e] - _dot(Qu[e], z), vl[e] - _dot(Qv[e], z),
-                                   par[e], state[e])
+            f, kt, ct = law_force(kinds[e], ul[e] - _dot(Qu[e], z), vl[e] - _dot(Qv[e], z),
+                                  par, state, e)
             r[e] = f - z[e]
             big = max(big, abs(z[e]))
             worst = max(worst, abs(r[e]))
@@ -351,67 +280,219 @@ def _port_newton(kinds, par, state, ul, vl, Qu, Qv, z, r, J, tol, max_iter):
                 J[e, j] = kt * Qu[e, j] + ct * Qv[e, j]
             J[e, e] += 1.0
         if worst <= tol * big:
-            converged = True
-            break
+            return True
         _solve_in_place(J, r)
         for e in range(m):
             z[e] += r[e]
+    return False
+
+
+#: Iterations of the diagonal Newton before full Newton takes over (:func:`_port_forces_step`).
+JACOBI_ITER = 8
+
+
+@njit(cache=True, nogil=True, inline="always")
+def _port_forces_step(kinds, par, state, ul, vl, Q, z, last, r, J, tol, max_iter):
+    """The port forces ``z`` (in place, from the last step's) of one step, ``z_e =
+    f_e(ul_e - (Qu z)_e, vl_e - (Qv z)_e)``, ``Q = (Qu, Qv, row sums of |Qu|, |Qv|)``
+    (:func:`_coupling`), and the states committed. True on success.
+
+    The ports are coupled only through the body's motion within one step (``Qu``, ``Qv`` of
+    the order h^2/mass: ``|k_t Qu|`` ~ 1e-5 for the default engine's friction at 40 kHz): the
+    forces ``f`` the laws give at the motion of forces ``z`` are those of the solution to
+    within ``rho |f - z|``, ``rho = max_e |k_t,e| sum_j |Qu_ej| + |c_t,e| sum_j |Qv_ej|``
+    (first order). So from a predictor on the tangent of the last committed point,
+    ``last`` (6, m) = ``(u, v, df/du, df/dv)`` and two rows of work space (updated here;
+    zeros: from ``z``), one
+    evaluation mostly suffices: ``z = f`` is accepted when ``rho |f - z|`` is below ``tol``
+    times (1 + the largest force) (the tolerance of :func:`_port_newton`, which takes over
+    after :data:`JACOBI_ITER` iterations of Newton with the Jacobian's diagonal), and the
+    states are committed at that evaluation."""
+    Qu, Qv, qa = Q
+    m = z.shape[0]
+    _port_motions(ul, vl, Qu, Qv, z, last, 4)
     for e in range(m):
-        commit_state(kinds[e], ul[e] - _dot(Qu[e], z), vl[e] - _dot(Qv[e], z), par[e],
-                     state[e])
+        z[e] += last[2, e] * (last[4, e] - last[0, e]) + last[3, e] * (last[5, e] - last[1, e])
+    for _ in range(JACOBI_ITER):
+        big, worst, rho = _port_residual(kinds, par, state, ul, vl, Qu, Qv, qa, z, last, r)
+        if rho < 1.0 and rho * worst <= tol * big:
+            for e in range(m):
+                z[e] += r[e]
+            _commit(kinds, par, state, last, z)
+            return True
+        for e in range(m):
+            z[e] += r[e] / (1.0 + last[2, e] * Qu[e, e] + last[3, e] * Qv[e, e])
+    converged = _port_newton(kinds, par, state, ul, vl, Qu, Qv, z, r, J, tol, max_iter)
+    _port_residual(kinds, par, state, ul, vl, Qu, Qv, qa, z, last, r)
+    for e in range(m):
+        z[e] += r[e]
+    _commit(kinds, par, state, last, z)
     return converged
 
 
+@njit(cache=True, nogil=True)
+def _coupling(Qu, Qv):
+    """``(Qu, Qv, qa)`` of :func:`_port_forces_step`: ``qa`` (2, m) the row sums of
+    ``|Qu|``, ``|Qv|``."""
+    qa = np.zeros((2, Qu.shape[0]))
+    for e in range(Qu.shape[0]):
+        for j in range(Qu.shape[1]):
+            qa[0, e] += abs(Qu[e, j])
+            qa[1, e] += abs(Qv[e, j])
+    return Qu, Qv, qa
+
+
+@njit(cache=True, nogil=True, inline="always")
+def _port_motions(ul, vl, Qu, Qv, z, out, row):
+    """Port motions ``u = ul - Qu z``, ``v = vl - Qv z`` into rows ``row``, ``row + 1`` of
+    ``out`` (independent sums: no chain of dependent additions per port)."""
+    for e in range(z.shape[0]):
+        out[row, e] = ul[e]
+        out[row + 1, e] = vl[e]
+    for j in range(z.shape[0]):
+        zj = z[j]
+        for e in range(z.shape[0]):
+            out[row, e] -= Qu[e, j] * zj
+            out[row + 1, e] -= Qv[e, j] * zj
+
+
+@njit(cache=True, nogil=True, inline="always")
+def _port_residual(kinds, par, state, ul, vl, Qu, Qv, qa, z, last, r):
+    """Residuals ``r = f(u, v) - z`` of the port forces ``z`` and the points ``last`` (4, m)
+    = ``(u, v, df/du, df/dv)``; returns (1 + the largest force, the largest residual, the
+    coupling bound rho of :func:`_port_forces_step`)."""
+    _port_motions(ul, vl, Qu, Qv, z, last, 0)
+    big = 1.0
+    worst = 0.0
+    rho = 0.0
+    for e in range(z.shape[0]):
+        f, last[2, e], last[3, e] = law_force(kinds[e], last[0, e], last[1, e], par, state,
+                                              e)
+        r[e] = f - z[e]
+        big = max(big, abs(z[e]))
+        worst = max(worst, abs(r[e]))
+        rho = max(rho, abs(last[2, e]) * qa[0, e] + abs(last[3, e]) * qa[1, e])
+    return big, worst, rho
+
+
+@njit(cache=True, nogil=True, inline="always")
+def _commit(kinds, par, state, last, f):
+    """Commit the states at the points ``last`` where the laws give the forces ``f``."""
+    for e in range(f.shape[0]):
+        commit_state(kinds[e], last[0, e], last[1, e], par, state, e, f[e])
+
+
+@njit(cache=True, nogil=True, fastmath=True, inline="always")
+def _read_rows(Rr, Ri, er, ei, out):
+    """``out = Re(R eta)`` for the rows of ``R`` (real and imaginary parts)."""
+    for c in range(out.shape[0]):
+        y = 0.0
+        for j in range(er.shape[0]):
+            y += Rr[c, j] * er[j] - Ri[c, j] * ei[j]
+        out[c] = y
+
+
+@njit(cache=True, nogil=True, fastmath=True, inline="always")
+def _body_force(load_at, T, F, k, z, p):
+    """Generalized force ``p`` (q,) on the reduced coordinates: the load ``F[k]`` placed at
+    ``load_at`` minus the port forces ``T^T z``."""
+    for c in range(p.shape[0]):
+        p[c] = 0.0
+    for c in range(F.shape[1]):
+        p[load_at[c]] += F[k, c]
+    for e in range(z.shape[0]):
+        ze = z[e]
+        for c in range(p.shape[0]):
+            p[c] -= T[e, c] * ze
+
+
 @njit(cache=True, nogil=True, fastmath=True)
-def modal_port_kernel(lam_d, gain, L, B, Up, Vp, Qu, Qv, W, Wl, Wz, F, eta, z, kinds, par,
+def modal_port_kernel(lam_d, G, R, Dx, Dv, Wd, T, load_at, Qu, Qv, F, eta, z, kinds, par,
                       state, out, tol, max_iter):
     r"""Newmark average acceleration with port laws in modal coordinates: the trapezoidal
-    modal recurrence :math:`\eta_{k+1} = \lambda_d\eta_k + \gamma(g_k + g_{k+1})` of the linear
-    model (:class:`~powertrain.solvers.newmark.ModalNewmark`) with the modal load
-    :math:`g = \mathbf L\mathbf f + \mathbf B\mathbf z` of the external load and of the port
-    forces :math:`\mathbf z` (``B`` the modal map of :math:`-\mathbf P^T\mathbf z`). The port
-    motions are :math:`\mathbf u = \mathrm{Re}(\mathbf U_p\eta)`,
-    :math:`\dot{\mathbf u} = \mathrm{Re}(\mathbf V_p\eta)`, so with the predictor
-    :math:`\eta^*` (the step without the new port forces)
-    :math:`\mathbf u = \mathrm{Re}(\mathbf U_p\eta^*) - \mathbf Q_u\mathbf z`,
-    :math:`\mathbf Q_u = -\mathrm{Re}(\mathbf U_p\,\mathrm{diag}\gamma\,\mathbf B)`
-    (:math:`= \tfrac{h^2}4\mathbf Q` of :func:`newmark_port_kernel`; :math:`\mathbf Q_v` with
-    :math:`\mathbf V_p`, :math:`= \tfrac h2\mathbf Q`), and Newton solves the m port equations
-    per step as there.
+    modal recurrence of the linear model (:class:`~powertrain.solvers.newmark.ModalNewmark`)
+    :math:`\eta_{k+1} = \lambda_d\eta_k + \mathbf G(\mathbf p_k + \mathbf p_{k+1})`, the
+    generalized force :math:`\mathbf p` on the q reduced coordinates :math:`\mathbf y` (those
+    the load or a port row touches: the body's six) being the load minus the port forces,
+    :math:`\mathbf p = \mathbf E\mathbf f - \mathbf T^T\mathbf z` (port rows
+    :math:`\mathbf P = \mathbf T\,\partial\mathbf y/\partial\mathbf x`), and
+    :math:`\mathbf G = \mathrm{diag}\gamma\,\Psi^{-1}[0; \mathbf M^{-1}]` on them.
 
-    Modal arrays are split into real and imaginary parts, rows per load, port or output
-    (``L = (Lr, Li)`` (n_load, n_modes), ``B`` (m, n_modes), ``Up``, ``Vp`` (m, n_modes),
-    ``W`` (n_out, n_modes)). Outputs ``out`` (n_rows, n_out) at steps 0 .. n_rows - 1 of the
-    loads ``F`` (n_rows + 1, n_load): ``y = Re(W eta) + Wl f + Wz z``. ``eta`` (n_modes,)
+    Per step one pass over the modes reads :math:`\mathrm{Re}(\mathbf R\eta_k)`: the
+    outputs (their modal part) and the reduced motions of the step without the new port
+    forces, :math:`\mathbf y^* = \mathrm{Re}(\Psi_y\lambda_d\eta_k) + \mathbf D_x\mathbf s`,
+    :math:`\mathbf s = \mathbf p_k + \mathbf E\mathbf f_{k+1}`,
+    :math:`\mathbf D_x = \mathrm{Re}(\Psi_y\mathbf G)` (velocities alike with
+    :math:`\mathbf D_v`); the port motions are :math:`\mathbf u = \mathbf T\mathbf y^* -
+    \mathbf Q_u\mathbf z`, :math:`\mathbf Q_u = \mathbf T\mathbf D_x\mathbf T^T`
+    (:math:`= \tfrac{h^2}4\mathbf P\mathbf S^{-1}\mathbf P^T` of
+    :func:`newmark_port_kernel`), solved for :math:`\mathbf z` per step
+    (:func:`_port_forces_step`); a second pass updates :math:`\eta`.
+
+    Modal arrays split into real and imaginary parts: ``G`` (q, n_modes) (columns of the map
+    as rows), ``R`` (n_out + 2 q, n_modes): rows of the outputs, then
+    :math:`\Psi_y\lambda_d`, :math:`\Psi_{\dot y}\lambda_d`. Outputs ``out`` (n_rows,
+    n_out) at steps 0 .. n_rows - 1 of the loads ``F`` (n_rows + 1, n_load):
+    :math:`\mathrm{Re}(\mathbf W\eta) + \mathbf W_d\mathbf p`. ``eta`` (n_modes,)
     complex and the port forces ``z`` (m,) are the state at step 0 on entry and at step
     n_rows on return; ``state`` the port laws' (updated in place). Returns the number of
     steps at which Newton did not converge.
     """
-    Lr, Li = L
-    Br, Bi = B
+    Gr, Gi = G
+    Rr, Ri = R
     n_modes = eta.shape[0]
     m = z.shape[0]
-    lr, li, gr, gi = lam_d.real.copy(), lam_d.imag.copy(), gain.real.copy(), gain.imag.copy()
+    q = Dx.shape[0]
+    n_out = out.shape[1]
+    lr, li = lam_d.real.copy(), lam_d.imag.copy()
     er, ei = eta.real.copy(), eta.imag.copy()
-    n_re, n_im = np.zeros(n_modes), np.zeros(n_modes)
-    g_re, g_im = np.zeros(n_modes), np.zeros(n_modes)
-    _modal_load(Lr, Li, F[0], n_re, n_im)
-    _port_load(Br, Bi, z, n_re, n_im, g_re, g_im)
-    ul, vl, r, y = np.empty(m), np.empty(m), np.empty(m), np.empty(out.shape[1])
+    y = np.empty(Rr.shape[0])
+    p, p_next, s = np.empty(q), np.empty(q), np.empty(q)
+    ul, vl, r = np.empty(m), np.empty(m), np.empty(m)
     J = np.empty((m, m))
+    last = np.zeros((6, m))
+    coupled = _coupling(Qu, Qv)
+    _body_force(load_at, T, F, 0, z, p)
     failed = 0
     for k in range(out.shape[0]):
-        _real_rows(W[0], W[1], er, ei, y)
-        for c in range(y.shape[0]):
-            out[k, c] = y[c] + _dot(Wl[c], F[k]) + _dot(Wz[c], z)
-        _modal_load(Lr, Li, F[k + 1], n_re, n_im)
-        _modal_predictor(lr, li, gr, gi, g_re, g_im, n_re, n_im, er, ei)
-        _real_rows(Up[0], Up[1], er, ei, ul)
-        _real_rows(Vp[0], Vp[1], er, ei, vl)
-        if not _port_newton(kinds, par, state, ul, vl, Qu, Qv, z, r, J, tol, max_iter):
+        _read_rows(Rr, Ri, er, ei, y)
+        for c in range(n_out):
+            o = y[c]
+            for d in range(q):
+                o += Wd[c, d] * p[d]
+            out[k, c] = o
+        for c in range(q):
+            s[c] = p[c]
+        for c in range(F.shape[1]):
+            s[load_at[c]] += F[k + 1, c]
+        for c in range(q):
+            for d in range(q):
+                y[n_out + c] += Dx[c, d] * s[d]
+                y[n_out + q + c] += Dv[c, d] * s[d]
+        for e in range(m):
+            su = 0.0
+            sv = 0.0
+            for c in range(q):
+                su += T[e, c] * y[n_out + c]
+                sv += T[e, c] * y[n_out + q + c]
+            ul[e] = su
+            vl[e] = sv
+        if not _port_forces_step(kinds, par, state, ul, vl, coupled, z, last, r, J, tol,
+                                 max_iter):
             failed += 1
-        _port_load(Br, Bi, z, n_re, n_im, g_re, g_im)
-        _port_correction(gr, gi, g_re, g_im, n_re, n_im, er, ei)
+        _body_force(load_at, T, F, k + 1, z, p_next)
+        for c in range(q):
+            s[c] = p[c] + p_next[c]
+            p[c] = p_next[c]
+        for j in range(n_modes):
+            a = lr[j] * er[j] - li[j] * ei[j]
+            ei[j] = lr[j] * ei[j] + li[j] * er[j]
+            er[j] = a
+        for c in range(q):
+            sc = s[c]
+            for j in range(n_modes):
+                er[j] += Gr[c, j] * sc
+                ei[j] += Gi[c, j] * sc
     for j in range(n_modes):
         eta[j] = er[j] + 1j * ei[j]
     return failed

@@ -35,6 +35,13 @@ def ramp_load(table, speed0, speed_step, rpm_from, rate, h, k, out):
         out[c] = a * (1.0 - fv) + b * fv
 
 
+@njit(cache=True, nogil=True)
+def ramp_loads(table, speed0, speed_step, rpm_from, rate, h, k0, out):
+    """Loads ``out`` (n, 6) of the ramp at steps ``k0 .. k0 + n - 1`` (:func:`ramp_load`)."""
+    for r in range(out.shape[0]):
+        ramp_load(table, speed0, speed_step, rpm_from, rate, h, k0 + r, out[r])
+
+
 @njit(cache=True, nogil=True, fastmath=True)
 def _modal_load(map_re, map_im, f, g_re, g_im):
     """Modal load ``g = map f`` of the load ``f`` (6,), as real and imaginary parts."""

@@ -312,11 +312,13 @@ class ModalNewmark:
 class ModalPortNewmark:
     r""":func:`newmark_ports` in modal coordinates, for a model whose matrices stay fixed:
     the port laws ``ports`` in parallel with the linear model of ``modal``
-    (:class:`ModalNewmark`), Newton on the m port forces per step with the m x m matrices
-    :math:`\mathbf Q_u = \tfrac{h^2}4\mathbf Q`, :math:`\mathbf Q_v = \tfrac h2\mathbf Q` in
-    their modal form (:func:`powertrain.kernels.port_forces.modal_port_kernel`; equal to
-    :func:`newmark_ports` to round-off, tests/test_time_domain_laws.py). Outputs: the
-    accelerations of the coordinates ``dofs``.
+    (:class:`ModalNewmark`), the port forces solved per step
+    (:func:`powertrain.kernels.port_forces.modal_port_kernel`; equal to
+    :func:`newmark_ports` to round-off and the Newton tolerance,
+    tests/test_time_domain_laws.py). The recurrence is written on the reduced coordinates
+    the load and the port rows touch (the body's six: a port row is a rigid body's motion at
+    a mount): the port motions are read from their motions, the port forces act through
+    their generalized force. Outputs: the accelerations of the coordinates ``dofs``.
 
     Parameters
     ----------
@@ -333,18 +335,23 @@ class ModalPortNewmark:
         n = modal.n
         self.modal, self.ports, self.h = modal, ports, float(h)
         P = np.asarray(ports.rows, float)
+        reduced = np.union1d(np.arange(modal.load_dofs), np.flatnonzero(np.any(P != 0, 0)))
+        T = P[:, reduced]
         lam = modal.lam_r
-        self.lam_d = (1 + 0.5 * h * lam) / (1 - 0.5 * h * lam)
-        self.gain = (0.5 * h) / (1 - 0.5 * h * lam)
-        B = -(modal.Psi_inv_r[:, n:] @ (modal.Minv @ P.T))            # (n_modes, m)
-        Up, Vp = P @ modal.Psi_r[:n], P @ modal.Psi_r[n:]
+        lam_d = (1 + 0.5 * h * lam) / (1 - 0.5 * h * lam)
+        G = ((0.5 * h) / (1 - 0.5 * h * lam))[:, None] * (
+            modal.Psi_inv_r[:, n:] @ modal.Minv[:, reduced])                # (n_modes, q)
+        Py, Pv = modal.Psi_r[reduced], modal.Psi_r[n + reduced]
         read = np.eye(n)[np.asarray(dofs, int)]
-        (w_re, w_im), w_load = modal.output_map(0 * read, 0 * read, read)
-        self.arrays = (_parts(modal.load_map_r.T), _parts(B.T), _parts(Up), _parts(Vp),
-                       np.ascontiguousarray(-((Up * self.gain) @ B).real),
-                       np.ascontiguousarray(-((Vp * self.gain) @ B).real),
-                       (np.ascontiguousarray(w_re.T), np.ascontiguousarray(w_im.T)),
-                       np.ascontiguousarray(w_load), np.ascontiguousarray(-read @ modal.Minv @ P.T))
+        Wa = read @ (modal.Psi_r[n:] * lam[None, :])
+        Dx, Dv = (G.T @ Py.T).real.T, (G.T @ Pv.T).real.T
+        self.lam_d = lam_d
+        self.arrays = (_parts(G.T), _parts(np.vstack([Wa, Py * lam_d, Pv * lam_d])),
+                       np.ascontiguousarray(Dx), np.ascontiguousarray(Dv),
+                       np.ascontiguousarray(read @ modal.Minv[:, reduced]),
+                       np.ascontiguousarray(T),
+                       np.searchsorted(reduced, np.arange(modal.load_dofs)).astype(np.int64),
+                       np.ascontiguousarray(T @ Dx @ T.T), np.ascontiguousarray(T @ Dv @ T.T))
 
     def modal_state(self, x, v) -> np.ndarray:
         """Modal coordinates (n_modes,) complex of the state ``(x, v)``."""
@@ -360,10 +367,10 @@ class ModalPortNewmark:
         FloatingPointError
             Newton did not converge at some step (the names of the port laws are given).
         """
-        out = np.empty((F.shape[0] - 1, self.arrays[-2].shape[0]))
-        failed = modal_port_kernel(self.lam_d, self.gain, *self.arrays,
-                                   np.ascontiguousarray(F, float), eta, z, self.ports.kinds,
-                                   self.ports.parameters, state, out, PORT_TOL, PORT_MAX_ITER)
+        out = np.empty((F.shape[0] - 1, self.arrays[4].shape[0]))
+        failed = modal_port_kernel(self.lam_d, *self.arrays, np.ascontiguousarray(F, float),
+                                   eta, z, self.ports.kinds, self.ports.parameters, state, out,
+                                   PORT_TOL, PORT_MAX_ITER)
         if failed:
             raise FloatingPointError(f"port laws {', '.join(self.ports.names)}: Newton did "
                                      f"not converge at {failed} of {out.shape[0]} steps")

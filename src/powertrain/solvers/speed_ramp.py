@@ -258,8 +258,11 @@ def _integrate_ports(integrator, load, ramp, start, dofs, decimator):
     Newmark with the port forces, Newton per step, chunk by chunk
     (:class:`~powertrain.solvers.newmark.ModalPortNewmark`), from ``start`` = (state
     ``(x0, v0, a0, mean)``, port-law states, amplitudes)."""
+    from powertrain.kernels.speed_ramp import ramp_loads
     from powertrain.solvers.newmark import ModalNewmark, ModalPortNewmark
     rpm_from, rate, h, n_steps = ramp
+    speeds, table, _ = load
+    table = np.ascontiguousarray(table)
     (x0, v0, *_), state, amplitudes = start
     s, laws = integrator.scaling, integrator.laws
     C, K, _, _ = s.matrices(s.scales(integrator.ports.network_amplitudes(amplitudes)))
@@ -269,9 +272,9 @@ def _integrate_ports(integrator, load, ramp, start, dofs, decimator):
     chunk = CHUNK_OUT * decimator.m         # a multiple of m keeps the decimation aligned
     outputs = []
     for lo in range(0, n_steps, chunk):
-        t = np.arange(lo, min(lo + chunk, n_steps) + 1) * h
-        F = _load_at(*load, rpm_from + rate * t,
-                     (np.pi / 30.0) * (rpm_from * t + 0.5 * rate * t * t))
+        F = np.empty((min(lo + chunk, n_steps) + 1 - lo, 6))
+        ramp_loads(table, float(speeds[0]), LOAD_RPM_STEP, float(rpm_from), float(rate),
+                   float(h), lo, F)
         outputs.append(decimator.push(run.run(F, eta, z, state)))
     return np.concatenate(outputs)
 
