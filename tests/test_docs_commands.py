@@ -567,6 +567,7 @@ def doc_runs(request, shim_bin, tmp_path_factory) -> dict:
 
 
 @pytest.mark.slow
+@pytest.mark.xdist_group(name="doc_commands")   # one test process runs every doc file once
 @pytest.mark.parametrize("doc", RUN_FILES)
 def test_doc_commands_run(doc, doc_runs):
     failure = doc_runs[doc].result()
