@@ -261,6 +261,12 @@ class Packing:
         return params, sigma
 
 
+#: Residual of every point (far beyond any fit's) where a trial parameter set has no steady state
+#: (the amplitude fixed point does not converge): far worse than any fit, so the search
+#: turns back, while the diagnosis goes on.
+NO_STEADY_STATE_RESIDUAL = 1e3
+
+
 class _Budget(Exception):
     """Raised inside the residual function when the fit's evaluation budget is spent."""
 
@@ -289,7 +295,13 @@ class _Counted:
         if self.n >= self.budget:
             raise _Budget
         before = problem.solves
-        r = np.concatenate([problem.vector(self.pack.scenario(x)), self.prior(x)])
+        try:
+            v = problem.vector(self.pack.scenario(x))
+        except FloatingPointError:          # no equivalent-linear steady state there
+            if self.best[2] is None:
+                raise
+            v = np.full(self.best[2].size - self.prior(x).size, NO_STEADY_STATE_RESIDUAL)
+        r = np.concatenate([v, self.prior(x)])
         self.n += max(1, problem.solves - before)
         return r
 

@@ -21,12 +21,13 @@ from dataclasses import dataclass
 import numpy as np
 
 from powertrain.effects.registry import EFFECTS
+from powertrain.solvers.equivalent_linear import AMPLITUDE_FLOOR, DEPTH, AndersonSteps
 from powertrain.solvers.fast_harmonic import HarmonicModel
 
-#: Amplitude fixed point: relative change of every speed's amplitudes at convergence, first
-#: relaxation (halved whenever the change grows, down to 1/64) and iteration limit.
+#: Amplitude fixed point: relative change of every speed's amplitudes at convergence and
+#: iteration limit (the steps: Anderson acceleration in log amplitudes, as the run-up's
+#: :func:`powertrain.solvers.equivalent_linear.amplitude_fixed_point`).
 TOLERANCE = 1e-6
-RELAXATION = 0.7
 MAX_ITERATIONS = 200
 
 
@@ -92,9 +93,10 @@ def _elements(hm, sc, s_el):
 
 
 def amplitude_iteration(hm, sc, els, load, body, *, tol=TOLERANCE, start=None):
-    """The nonlinear elements' fixed point at every speed: :math:`A \\leftarrow A +
-    \\rho(A(\\hat{\\mathbf q}(A)) - A)` with :meth:`HarmonicModel.relative_amplitude`, until
-    the largest change is below ``tol`` of each speed's largest amplitude.
+    """The nonlinear elements' fixed point :math:`A = g(A)` at every speed, ``g`` the
+    amplitudes of :meth:`HarmonicModel.relative_amplitude`: Anderson steps in log amplitudes
+    over all speeds at once (damped where the residual grows), until the largest change is
+    below ``tol`` of each speed's largest amplitude.
 
     Returns ``(two-ports with the effects, rigid-body amplitudes q, A (n_r, n_net),
     iterations)``; raises ``FloatingPointError`` naming the mount direction and speed when
@@ -103,21 +105,21 @@ def amplitude_iteration(hm, sc, els, load, body, *, tol=TOLERANCE, start=None):
     A = np.zeros((hm.rpm.size, len(els)))
     if start is not None and np.shape(start) == A.shape:
         A = np.array(start, float)
-    relax, last = RELAXATION, np.inf
+    steps = AndersonSteps(DEPTH)
     for it in range(1, MAX_ITERATIONS + 1):
         abc = _two_ports(sc, hm, hm.two_ports_at(A, els))
         q = hm.solve(abc[0], load, abc=abc, body=body)
-        change = (hm.relative_amplitude(q) - A)[:, nl]
-        size = np.maximum(np.max(np.abs(A[:, nl] + change), axis=1), np.finfo(float).tiny)
-        err = np.max(np.abs(change), axis=1) / size
+        G = hm.relative_amplitude(q)[:, nl]
+        size = np.maximum(np.max(np.abs(G), axis=1), np.finfo(float).tiny)
+        err = np.max(np.abs(G - A[:, nl]), axis=1) / size
         if np.max(err) <= tol:
             return abc, q, A, it
-        if np.max(err) > last:
-            relax = max(relax / 2, 1.0 / 64)
-        last = np.max(err)
-        A[:, nl] += relax * change
+        floor = AMPLITUDE_FLOOR * size[:, None]
+        x = np.log(np.maximum(A[:, nl], floor))
+        residual = np.log(np.maximum(G, floor)) - x
+        A[:, nl] = np.exp(steps.next(x.ravel(), residual.ravel())).reshape(x.shape)
     r = int(np.argmax(err))
-    mi, axis, _ = [n for n, k in zip(hm.networks, nl) if k][int(np.argmax(np.abs(change[r])))]
+    mi, axis, _ = [n for n, k in zip(hm.networks, nl) if k][int(np.argmax(np.abs(residual[r])))]
     raise FloatingPointError(f"{hm.mount_names[mi]}.{axis} at {hm.rpm[r]:g} rpm: the "
                              f"amplitude fixed point did not converge in {MAX_ITERATIONS} "
                              f"iterations (change {np.max(err):.1e})")

@@ -80,7 +80,7 @@ def amplitude_fixed_point(solve, relative_motion, ports, rpm, start=None, tolera
         No convergence within :data:`MAX_ITERATIONS` (a FloatingPointError).
     """
     A = np.zeros(len(ports.names)) if start is None else np.asarray(start, float).copy()
-    steps = _AndersonSteps(DEPTH)
+    steps = AndersonSteps(DEPTH)
     for _ in range(MAX_ITERATIONS):
         solution = solve(ports.network_amplitudes(A))
         G = amplitudes_of(relative_motion(solution))
@@ -95,7 +95,7 @@ def amplitude_fixed_point(solve, relative_motion, ports, rpm, start=None, tolera
                                 MAX_ITERATIONS)
 
 
-class _AndersonSteps:
+class AndersonSteps:
     """Anderson acceleration of ``ln A = ln g(A)``, with a damped step as the fallback where
     the residual grows (module docstring)."""
 
