@@ -171,11 +171,10 @@ def model_levels(velocity, data: GapData):
     rms = np.abs(velocity) / np.sqrt(2.0)                      # (n_r, n_ch, 16)
     out = np.empty(velocity.shape[:2] + (data.harmonic.size,))
     f2 = data.floor ** 2
-    for k, h in enumerate(data.harmonic):
-        if h < 0:
-            out[..., k] = np.sqrt(np.sum(rms ** 2, axis=-1) + 16 * f2)
-        else:
-            out[..., k] = np.sqrt(rms[..., h] ** 2 + f2)
+    order = data.harmonic >= 0
+    out[..., order] = np.sqrt(rms[..., data.harmonic[order]] ** 2 + f2)
+    if not order.all():                                        # the synthesis
+        out[..., ~order] = np.sqrt(np.sum(rms ** 2, axis=-1) + 16 * f2)[..., None]
     return out
 
 

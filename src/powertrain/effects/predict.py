@@ -158,9 +158,13 @@ def predict(hm: HarmonicModel, scenario: dict, *, tol=TOLERANCE,
         _, q, A, iterations = amplitude_iteration(hm, sc, els, load, body, tol=tol,
                                                   start=warm_amplitudes)
     else:
-        abc = hm.two_ports() if s_el is None else hm.two_ports_scaled(s_el[None, None, :])
-        abc = _two_ports(sc, hm, abc)
-        q, A, iterations = hm.solve(abc[0], load, abc=abc, body=body), None, 0
+        nominal = hm.two_ports() if s_el is None else hm.two_ports_scaled(s_el[None, None, :])
+        abc = _two_ports(sc, hm, nominal)
+        if s_el is None and abc is nominal and body is getattr(hm, "body", None):
+            q = hm.load_response(load)          # only the load changed: no solve
+        else:
+            q = hm.solve(abc[0], load, abc=abc, body=body)
+        A, iterations = None, 0
     v = hm.velocity(q, body=body)
     for eff, p in sc.values():
         v = eff.reading(v, p)

@@ -59,15 +59,15 @@ def sensor_reading(velocity, gain_db, rotation, cross_axis=None):
         Cross-axis sensitivities (xy, xz, yz) of each triad [1] (default none).
     """
     v = np.asarray(velocity)
-    out = np.empty_like(v)
-    for m in range(v.shape[1] // 3):
-        sl = slice(3 * m, 3 * m + 3)
-        T = rotation_matrix(rotation[m])
-        if cross_axis is not None:
-            sxy, sxz, syz = cross_axis[m]
-            T = T + np.array([[0.0, sxy, sxz], [sxy, 0.0, syz], [sxz, syz, 0.0]])
-        out[:, sl] = np.einsum("ij,rjh->rih", T, v[:, sl])
-    return out * 10.0 ** (np.asarray(gain_db, float) / 20.0)[None, :, None]
+    n_m = v.shape[1] // 3
+    T = np.array([rotation_matrix(rotation[m]) for m in range(n_m)])
+    if cross_axis is not None:
+        S = np.zeros((n_m, 3, 3))
+        for (i, j), s in zip(((0, 1), (0, 2), (1, 2)), np.asarray(cross_axis, float).T):
+            S[:, i, j] = S[:, j, i] = s
+        T = T + S
+    out = np.einsum("mij,rmjh->rmih", T, v.reshape(v.shape[0], n_m, 3, -1))
+    return out.reshape(v.shape) * 10.0 ** (np.asarray(gain_db, float) / 20.0)[None, :, None]
 
 
 def apply_sensor_error(velocity, params: dict):

@@ -53,11 +53,13 @@ def condense_nodes(D, n, order, X):
     :data:`PIVOT_RTOL` times the largest entry (singular network).
     """
     size = n + 2
-    big = 0.0
+    big2 = 0.0                    # the largest entry by its squared modulus (no hypot)
     for i in range(size):
         for j in range(size):
-            if abs(D[i, j]) > big:
-                big = abs(D[i, j])
+            m2 = D[i, j].real * D[i, j].real + D[i, j].imag * D[i, j].imag
+            if m2 > big2:
+                big2 = m2
+    big = np.sqrt(big2)
     gone = np.zeros(size, np.bool_)
     for step in range(n):             # boundary nodes 0 and n + 1 are never eliminated
         k = -1

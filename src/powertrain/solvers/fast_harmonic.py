@@ -138,6 +138,7 @@ class HarmonicModel:
         self._load = None
         self._abc = None
         self._extra = {}
+        self._scaled = {}
         self._body_setup(engine)
 
     def _body_setup(self, engine):
@@ -219,13 +220,30 @@ class HarmonicModel:
         as :meth:`two_ports`.
         """
         n_net = len(self.networks)
-        sc = np.broadcast_to(np.asarray(scale, float), self.omega.shape + (n_net,))
+        scale = np.asarray(scale, float)
+        sc = np.broadcast_to(scale, self.omega.shape + (n_net,))
         abc = [np.empty(self.omega.shape + (n_net,), complex) for _ in range(3)]
         for k, (_, _, mod) in enumerate(self.networks):
-            res = two_port(self.omega, *mod.network(), spring_scale=sc[..., k] * self._static(k))
+            if scale.size == n_net:          # one factor per network: the last two kept
+                res = self._scaled_network(k, float(scale.flat[k]))
+            else:
+                res = two_port(self.omega, *mod.network(),
+                               spring_scale=sc[..., k] * self._static(k))
             for j in range(3):
                 abc[j][..., k] = res[j]
         return tuple(abc)
+
+    def _scaled_network(self, k, factor):
+        """Network ``k``'s two-port with every spring and damper times ``factor`` at every
+        speed; the last two factors per network are kept (a finite-difference Jacobian
+        column changes the factors of one mount only: the others' are reused)."""
+        kept = self._scaled.setdefault(k, {})
+        if factor not in kept:
+            if len(kept) >= 2:
+                del kept[next(iter(kept))]
+            kept[factor] = two_port(self.omega, *self.networks[k][2].network(),
+                                    spring_scale=factor * self._static(k))
+        return kept[factor]
 
     def two_ports_at(self, amplitudes, elements=None):
         r"""``(a, b, c)`` of every network's element at its relative-displacement amplitude,
@@ -274,6 +292,24 @@ class HarmonicModel:
         frame = (self.M, np.zeros((6, 6)), np.zeros((6, 6)))
         D = condensed_matrix(frame, self.rows, None, (K, None, None), 1j * w)
         return np.linalg.solve(D, load[:, harmonics][..., None])[..., 0]
+
+    def load_response(self, load) -> np.ndarray:
+        r""":meth:`solve`'s amplitudes (n_r, 16, 6 [+ K]) of the nominal model (its own
+        two-ports and body) for the load ``load`` (n_r, 17, 6), without a solve: they are
+        linear in the load, so the response to each unit load component is solved once
+        (cached, :attr:`_extra` ``"load_transfer"``, (6, n_r, 16, n_q)) and combined —
+        the same as :meth:`solve` to round-off. For the effects that change the load only
+        (a balancer error, a cylinder imbalance)."""
+        if "load_transfer" not in self._extra:
+            abc = self.two_ports()
+            unit = np.zeros(self.omega.shape + (6,), complex)
+            cols = []
+            for j in range(6):
+                unit[..., :] = 0.0
+                unit[..., j] = 1.0
+                cols.append(self.solve(abc[0], unit, abc=abc))
+            self._extra["load_transfer"] = np.stack(cols)
+        return np.einsum("jrhq,rhj->rhq", self._extra["load_transfer"], load[:, 1:])
 
     def velocity(self, q, harmonics=slice(1, N_HARMONICS), body=None) -> np.ndarray:
         """Complex peak channel velocities (n_r, n_ch, n_h) [m/s] from :meth:`solve`'s q
@@ -325,4 +361,5 @@ class HarmonicModel:
         if self.static_scale is not None:
             new.static_scale = self.static_scale[index]
         new._extra = {k: v[:, index] for k, v in self._extra.items()}
+        new._scaled = {}
         return new
