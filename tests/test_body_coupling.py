@@ -107,10 +107,12 @@ def test_chassis_modes_effect_parameters(engine):
         f"z{k + 1}" for k in range(len(engine.chassis.modes))}
     assert all(ps[f"z{k + 1}"].prior_sd == DAMPING_PRIOR and ps[f"z{k + 1}"].log
                for k in range(len(engine.chassis.modes)))
-    # defaults are the file's body: the baseline, exactly
+    # defaults are the file's body: the baseline, to round-off (the baseline takes the
+    # cached load responses, the effect a solve of its own)
     hm = HarmonicModel(engine, RPM[:2])
-    np.testing.assert_array_equal(predict(hm, {"chassis_modes": {}}).velocity,
-                                  predict(hm, {}).velocity)
+    base = predict(hm, {}).velocity
+    np.testing.assert_allclose(predict(hm, {"chassis_modes": {}}).velocity, base, rtol=0,
+                               atol=1e-12 * np.max(np.abs(base)))
 
 
 def test_chassis_modes_on_a_rigid_chassis_is_one_line(tmp_path):

@@ -13,8 +13,10 @@ Parameters with a prior (``Parameter.prior_sd``) add the residual
 dB): a maximum a posteriori fit, so that directions the magnitudes do not identify stay at
 the prior's centre; the BIC and the held-out scores use the data residuals only.
 
-Parameter uncertainties are the 1σ of the Gauss–Newton covariance
-:math:`\hat s^2 (J^TJ)^{-1}` (residual correlation along speed ignored: optimistic).
+Parameter uncertainties are the 1σ of the Gauss–Newton covariance :math:`\hat s^2
+(J^TJ)^{-1}` (residual correlation along speed ignored: optimistic). A trial parameter set
+without a steady state (the amplitude fixed point diverges) is a point far worse than any
+fit (:data:`NO_STEADY_STATE_RESIDUAL`): the search turns back, the diagnosis goes on.
 """
 
 from __future__ import annotations
@@ -28,15 +30,17 @@ import numpy as np
 
 from powertrain.diagnosis import phase as ph
 from powertrain.diagnosis.data import GapData, model_levels, noise_sigma_db, residuals_db
+from powertrain.diagnosis.packing import Packing
 from powertrain.diagnosis.starts import start_points
 from powertrain.effects import EFFECTS, predict
 
 #: Evaluation budget per fit, in solves of the cached model (all starts, grid and Jacobian
 #: columns included; an evaluation costs the solves it made, at least 1: a sensor reading
 #: of cached velocities counts 1, an amplitude-dependent evaluation its fixed-point
-#: iterations); a fit that reaches it stops with the best point so far and reports
-#: ``budget_hit``.
+#: iterations); reached, the fit stops with the best point so far (``budget_hit``).
 EVAL_BUDGET = 2500
+#: Residual of every point where a trial parameter set has no steady state.
+NO_STEADY_STATE_RESIDUAL = 1e3
 
 
 @dataclass
@@ -213,60 +217,6 @@ class Problem:
         return np.concatenate([g, gp, [ph.offset_prior(delta, self.sigma_db)]])
 
 
-@dataclass
-class Packing:
-    """Parameters of a candidate as one vector (log space for scale-like parameters)."""
-
-    names: list
-    lower: np.ndarray
-    upper: np.ndarray
-    log: np.ndarray
-    x0: np.ndarray
-
-    units: dict = None
-    prior_sd: np.ndarray = None
-
-    @property
-    def n_prior(self) -> int:
-        return 0 if self.prior_sd is None else int(np.isfinite(self.prior_sd).sum())
-
-    @classmethod
-    def of(cls, effects, engine=None):
-        names, lo, hi, logs, x0, units, prior = [], [], [], [], [], {}, []
-        for e in effects:
-            for p in EFFECTS[e].parameters(engine):
-                prior.append(np.nan if p.prior_sd is None else p.prior_sd)
-                units[(e, p.name)] = p.unit
-                names.append((e, p.name))
-                lo.append(math.log(p.lower) if p.log else p.lower)
-                hi.append(math.log(p.upper) if p.log else p.upper)
-                logs.append(p.log)
-                x0.append(math.log(p.default) if p.log else p.default)
-        return cls(names, np.array(lo), np.array(hi), np.array(logs, bool), np.array(x0), units,
-                   np.array(prior, float))
-
-    def scenario(self, x):
-        sc = {}
-        for (e, p), lg, v in zip(self.names, self.log, x):
-            sc.setdefault(e, {})[p] = float(math.exp(v) if lg else v)
-        return sc
-
-    def values(self, x, sd):
-        """``params``, ``sigma`` dicts (SI) from the vector and its 1σ."""
-        params, sigma = {}, {}
-        for (e, pn), lg, v, s in zip(self.names, self.log, x, sd):
-            val = math.exp(v) if lg else v
-            params.setdefault(e, {})[pn] = float(val)
-            sigma.setdefault(e, {})[pn] = float(val * s if lg else s)
-        return params, sigma
-
-
-#: Residual of every point (far beyond any fit's) where a trial parameter set has no steady state
-#: (the amplitude fixed point does not converge): far worse than any fit, so the search
-#: turns back, while the diagnosis goes on.
-NO_STEADY_STATE_RESIDUAL = 1e3
-
-
 class _Budget(Exception):
     """Raised inside the residual function when the fit's evaluation budget is spent."""
 
@@ -297,7 +247,7 @@ class _Counted:
         before = problem.solves
         try:
             v = problem.vector(self.pack.scenario(x))
-        except FloatingPointError:          # no equivalent-linear steady state there
+        except FloatingPointError:  # no steady state there: a point worse than any fit
             if self.best[2] is None:
                 raise
             v = np.full(self.best[2].size - self.prior(x).size, NO_STEADY_STATE_RESIDUAL)
