@@ -245,3 +245,14 @@ def atomic_write(target, mode="w", **kwargs):
     with atomic_path(target) as tmp:
         with open(tmp, mode, **kwargs) as fh:
             yield fh
+
+
+def json_text(data, path=None) -> str:
+    """``data`` as the indented JSON text of the result files; written atomically to ``path``
+    when given."""
+    import json
+    text = json.dumps(data, indent=1) + "\n"
+    if path is not None:
+        with atomic_write(path) as fh:
+            fh.write(text)
+    return text

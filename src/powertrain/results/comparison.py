@@ -5,7 +5,6 @@ its text report, JSON and figure.
 
 from __future__ import annotations
 
-import json
 from dataclasses import dataclass, field
 from typing import ClassVar
 
@@ -14,6 +13,7 @@ import numpy as np
 from powertrain.analysis import compare as cm
 from powertrain.analysis.noise_floor import censoring_level
 from powertrain.analysis.orders import quantity_sort_key
+from powertrain.outputs import json_text
 
 #: Quantities always expected (the thesis's comparison, sec. 4.4); any other measured order is
 #: compared too.
@@ -269,12 +269,7 @@ class ComparisonResult:
 
     def to_json(self, path=None) -> str:
         """JSON text of :meth:`to_dict`; written atomically to ``path`` if given."""
-        text = json.dumps(self.to_dict(), indent=1) + "\n"
-        if path is not None:
-            from powertrain.outputs import atomic_write
-            with atomic_write(path) as fh:
-                fh.write(text)
-        return text
+        return json_text(self.to_dict(), path)
 
     def worst_first(self) -> list:
         """Channels sorted by RMS gap, largest first."""

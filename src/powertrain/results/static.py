@@ -19,12 +19,12 @@ deflection; 1 without a curve).
 
 from __future__ import annotations
 
-import json
 from dataclasses import dataclass
 
 import numpy as np
 
 from powertrain.analysis.text_table import format_table
+from powertrain.outputs import json_text
 from powertrain.units import from_si
 
 
@@ -65,12 +65,7 @@ class StaticResult:
 
     def to_json(self, path=None) -> str:
         """JSON text of :meth:`to_dict`; written atomically to ``path`` if given."""
-        text = json.dumps(self.to_dict(), indent=1) + "\n"
-        if path is not None:
-            from powertrain.outputs import atomic_write
-            with atomic_write(path) as fh:
-                fh.write(text)
-        return text
+        return json_text(self.to_dict(), path)
 
     def to_text(self) -> str:
         """Per speed: the body's displacement [mm] and rotation [deg] at the CG, then each
