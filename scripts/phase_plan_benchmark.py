@@ -18,11 +18,14 @@ of a stiffer/softer mount, amplitude-dependent mounts, a weak cylinder, a balanc
 and effect-free cars, engine side only; each run diagnosed alone and the plan; the line
 ``plans: plan_right=... best_single_right=... plan_less_right=... wrong_names=...
 false_claims=...``. A *wrong name* is a claim outside the hidden truth's library match;
-"ambiguous" and "no effect"/"unexplained" are no claims.
+"ambiguous" and "no effect"/"unexplained" are no claims. With ``--sides both`` the plans are
+drawn on the modal-body engine with both sides of every mount measured, and only the two
+kinds issue 21 asks to tell apart there (amplitude-dependent mounts, a stiffer/softer mount):
+the line ``two_sided_plans: named_right=... ambiguous=... wrong_names=...``.
 
 Every case prints the CPU seconds of its diagnoses; the last lines the medians.
 Usage: ``python scripts/phase_plan_benchmark.py --bench cylinder|loads --cases N
-[--seed S] [--jobs 2] [--phase all|whole|none]``.
+[--seed S] [--jobs 2] [--phase all|whole|none] [--sides engine|both]``.
 """
 
 from __future__ import annotations
@@ -36,6 +39,12 @@ import numpy as np
 
 LOAD_KINDS = ("mount_temperature", "amplitude_elastomer", "weak_cylinder", "balancer_shafts",
               "none")
+#: Kinds of the two-sided plans: amplitude law or a stiffer mount, issue 21's pair.
+TWO_SIDED_KINDS = ("amplitude_elastomer", "mount_temperature")
+
+
+def _load_kinds(sides):
+    return TWO_SIDED_KINDS if sides == "both" else LOAD_KINDS
 
 
 def _diagnose(measured, engine):
@@ -67,13 +76,13 @@ def cylinder_case(task):
 
 def loads_case(task):
     """One two-run plan case: the singles' and the plan's answers, CPU seconds."""
-    from powertrain.validation.cases import engines
     from powertrain.validation.plans import make_plan_case
-    i, seed, phase = task
-    kind = LOAD_KINDS[i % len(LOAD_KINDS)]
+    i, seed, phase, sides = task
+    kinds = _load_kinds(sides)
+    kind = kinds[i % len(kinds)]
     case = make_plan_case(i, [] if kind == "none" else [kind], seed,
-                          phase=None if phase == "none" else phase)
-    e = engines()["sz"]
+                          phase=None if phase == "none" else phase, sides=sides)
+    e = case.engine
     singles = [_diagnose(r.measured, e.at_load(load))
                for r, load in zip(case.runs, case.loads)]
     plan, cpu = _diagnose(case.plan(), e)
@@ -114,6 +123,29 @@ def report_cylinder(rows, phase):
     print(f"time: diagnosis CPU median {np.median(cpu):.1f} s, longest {cpu.max():.1f} s")
 
 
+def report_two_sided(rows):
+    det = [r for r in rows if r["detectable"]]
+    right = sum(r["plan_claim"] == r["truth_set"] for r in det)
+    ambiguous = sum(r["plan_verdict"].startswith("ambiguous") for r in det)
+    wrong = sum(bool(r["plan_claim"]) and r["plan_claim"] != r["truth_set"] for r in det)
+    print(f"two_sided_plans: named_right={_rate(right, len(det))} "
+          f"ambiguous={_rate(ambiguous, len(det))} wrong_names={_rate(wrong, len(det))} "
+          f"(target named_right >= 0.9, no ambiguous; {len(rows) - len(det)} undetectable "
+          "left out)")
+    for k in TWO_SIDED_KINDS:
+        rs = [r for r in det if r["kind"] == k]
+        print(f"  {k:<20} plan {[('+'.join(r['plan_claim']) or r['plan_verdict'])[:28] for r in rs]}")
+    _report_time(rows)
+
+
+def _report_time(rows):
+    single = np.array([c for r in rows for c in r["single_cpu"]])
+    plan = np.array([r["plan_cpu"] for r in rows])
+    print(f"time: single run CPU median {np.median(single):.1f} s (longest {single.max():.1f}"
+          f" s); two-run plan CPU median {np.median(plan):.1f} s (longest {plan.max():.1f} s)"
+          f", {np.median(plan) / np.median(single):.2f}x the single median")
+
+
 def report_loads(rows):
     def right(claim, r):
         return claim == r["truth_set"] if r["truth_set"] else not claim
@@ -136,11 +168,7 @@ def report_loads(rows):
     for k in LOAD_KINDS:
         rs = [r for r in scored if r["kind"] == k]
         print(f"  {k:<20} plan {[('+'.join(r['plan_claim']) or r['plan_verdict'])[:28] for r in rs]}")
-    single = np.array([c for r in rows for c in r["single_cpu"]])
-    plan = np.array([r["plan_cpu"] for r in rows])
-    print(f"time: single run CPU median {np.median(single):.1f} s (longest {single.max():.1f}"
-          f" s); two-run plan CPU median {np.median(plan):.1f} s (longest {plan.max():.1f} s)"
-          f", {np.median(plan) / np.median(single):.2f}x the single median")
+    _report_time(rows)
 
 
 def main(argv=None):
@@ -150,18 +178,22 @@ def main(argv=None):
     ap.add_argument("--seed", type=int, default=None)
     ap.add_argument("--jobs", type=int, default=2)
     ap.add_argument("--phase", choices=("all", "whole", "none"), default="all")
+    ap.add_argument("--sides", choices=("engine", "both"), default="engine",
+                    help="loads bench: engine side alone, or both sides of every mount")
     args = ap.parse_args(argv)
     seed = args.seed if args.seed is not None else int.from_bytes(os.urandom(4), "little")
     print(f"seed {seed}{'' if args.seed is not None else ' (drawn from os.urandom)'}; "
-          f"bench {args.bench}, phase {args.phase}, {args.cases} cases")
-    tasks = [(i, int(np.random.SeedSequence([seed, i]).generate_state(1)[0]), args.phase)
+          f"bench {args.bench}, phase {args.phase}, "
+          f"{'both sides, ' if args.sides == 'both' else ''}{args.cases} cases")
+    seeds = [int(np.random.SeedSequence([seed, i]).generate_state(1)[0])
              for i in range(args.cases)]
-    fn = cylinder_case if args.bench == "cylinder" else loads_case
-    rows = _run(fn, tasks, args.jobs)
     if args.bench == "cylinder":
-        report_cylinder(rows, args.phase)
-    else:
-        report_loads(rows)
+        report_cylinder(_run(cylinder_case, [(i, s, args.phase) for i, s in enumerate(seeds)],
+                             args.jobs), args.phase)
+        return
+    rows = _run(loads_case, [(i, s, args.phase, args.sides) for i, s in enumerate(seeds)],
+                args.jobs)
+    (report_two_sided if args.sides == "both" else report_loads)(rows)
 
 
 if __name__ == "__main__":

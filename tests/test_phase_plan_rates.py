@@ -1,7 +1,9 @@
 """Rates of issue 21 over fresh draws of the independent truth (no pinned seeds): a weak
 cylinder named with its sign when the order phases are measured; with whole-order phases
 only, never a set of cylinders without the true one; a two-run plan (loads 1.0 and 0.4)
-never less right than its best single run, and no wrong name with engine-side channels.
+never less right than its best single run, and no wrong name with engine-side channels; on
+two-sided plans, amplitude-dependent mounts told from a stiffer mount (named right, never
+"ambiguous").
 
 Sized and judged by the Wilson rule of ``tests/rates.py`` (as tests/test_diagnosis_rates.py);
 ``slow`` and ``rates``: they run on request (``python -m pytest -m rates``). The benchmark
@@ -24,6 +26,8 @@ from powertrain.validation.plans import make_plan_case
 MAX_DRAWS = 30
 #: Plan kinds (engine side only).
 PLAN_KINDS = ("mount_temperature", "amplitude_elastomer", "weak_cylinder", "balancer_shafts")
+#: Two-sided plan kinds: issue 21's pair, an amplitude law or a stiffer mount.
+TWO_SIDED_KINDS = ("amplitude_elastomer", "mount_temperature")
 
 
 def _seed():
@@ -93,3 +97,30 @@ def test_two_run_plan_is_never_less_right_than_its_best_single_run_nor_wrong():
     wrong = sum(bool(r["plan"]) and r["plan"] != r["truth"] for r in rows)
     assert less <= k_pass and wrong <= k_pass, \
         f"seed {seed}: less right {less}, wrong {wrong} of {n} (<= {k_pass}): {rows}"
+
+
+def _two_sided_plan_row(task):
+    i, seed = task
+    kind = TWO_SIDED_KINDS[i % len(TWO_SIDED_KINDS)]
+    rng = np.random.default_rng([seed, i])
+    for _ in range(MAX_DRAWS):
+        case = make_plan_case(i, [kind], int(rng.integers(2 ** 31)), phase="all",
+                              sides="both")
+        if case.detectable:
+            break
+    d = diagnose(case.plan(), case.engine, noise_floor=FLOOR).to_dict()
+    return {"truth_set": case.truth_set, "verdict": d["verdict"],
+            "claimed": sorted((d.get("chosen") or {}).get("effects", []))}
+
+
+@pytest.mark.slow
+@pytest.mark.rates
+def test_two_sided_plans_tell_an_amplitude_law_from_a_stiffer_mount():
+    """Named right >= 0.9 (group-sequential Wilson rule), and "ambiguous" never."""
+    seed = _seed()
+    passed, rows, good = rates.run_sequential(
+        lambda start, count: run_map(_two_sided_plan_row,
+                                     [(i, seed) for i in range(start, start + count)]),
+        lambda r: r["claimed"] == r["truth_set"], 0.9)
+    ambiguous = [r for r in rows if r["verdict"].startswith("ambiguous")]
+    assert passed and not ambiguous, f"seed {seed}: {good}/{len(rows)} right: {rows}"

@@ -7,6 +7,9 @@ scale, :meth:`~powertrain.models.engine.Engine.at_load`; the amplitude-dependent
 then works at each run's own amplitudes); every run is measured on its own (its own scatter
 draw, noise and TDC error, :func:`powertrain.validation.cases.measure`). The case is
 detectable when one of its runs is (:func:`powertrain.validation.cases.is_detectable`).
+
+``sides="both"`` draws the same plan on the modal-body engine with both sides of every mount
+measured (:mod:`powertrain.validation.passive`: the body side as further channels).
 """
 
 from __future__ import annotations
@@ -21,14 +24,31 @@ from powertrain.validation.kinds import KINDS
 
 #: Loads of the two-run plan (full load, part load).
 LOADS = (1.0, 0.4)
+#: Measured sides of a plan: engine side alone, or both sides of every mount.
+SIDES = ("engine", "both")
+
+
+def plan_engine(sides="engine"):
+    """The engine a plan of ``sides`` is drawn on and diagnosed with (full load)."""
+    if sides == "both":
+        from powertrain.validation.passive import passive_engines
+        return passive_engines()["body_sz"]
+    return cs.engines()["sz"]
+
+
+def _truth_path(sides):
+    """``(simulate(engine, truth), channels(engine))`` of the truth path for ``sides``."""
+    if sides == "both":
+        from powertrain.validation import passive
+        return passive.truth_velocity, passive.channels
+    return cs.truth_velocity, lambda e: [(mt.name, a) for mt in e.mounts for a in "xyz"]
 
 
 @functools.cache
-def baseline_at(load):
-    """Noise-free baseline of the default engine at ``load`` on the truth path."""
-    from powertrain.validation import truth as tr
-    e = cs.engines()["sz"].at_load(load)
-    return tr.simulate_truth(tr.TruthSpec(e, list(e.mounts)), cs.RPM)
+def baseline_at(load, sides="engine"):
+    """Noise-free baseline of the plan engine at ``load`` on the truth path."""
+    simulate, _ = _truth_path(sides)
+    return simulate(plan_engine(sides).at_load(load), [])
 
 
 @dataclass
@@ -41,6 +61,12 @@ class PlanCase:
     loads: tuple
     runs: list
     truth: list
+    sides: str = "engine"
+
+    @property
+    def engine(self):
+        """The engine the diagnosis gets (full load; each run at its own load)."""
+        return plan_engine(self.sides)
 
     @property
     def category(self) -> str:
@@ -61,19 +87,23 @@ class PlanCase:
                     source=f"plan case {self.index} (seed {self.seed})")
 
 
-def make_plan_case(index, names, seed, loads=LOADS, phase=None, params=None) -> PlanCase:
+def make_plan_case(index, names, seed, loads=LOADS, phase=None, params=None,
+                   sides="engine") -> PlanCase:
     """Draw the hidden effects ``names`` once (``params``: ``{name: parameters}`` fixed
-    instead of drawn) and measure them at every load."""
-    engine = cs.engines()["sz"]
+    instead of drawn) and measure them at every load, on the ``sides`` of :data:`SIDES`."""
+    if sides not in SIDES:
+        raise ValueError(f"sides must be one of {SIDES}, not {sides!r}")
+    engine = plan_engine(sides)
+    simulate, channels = _truth_path(sides)
     rng = np.random.default_rng(seed)
     truth = [(n, {**KINDS[n].draw(rng, engine), **(params or {}).get(n, {})}) for n in names]
     runs = []
     for k, load in enumerate(loads):
         e = engine.at_load(load)
         run_seed = int(np.random.SeedSequence([seed, k]).generate_state(1)[0])
-        runs.append(cs.draw_case(index, names, "sz", run_seed, e, baseline_at(load),
-                                 lambda eng, _t: cs.truth_velocity(eng, truth),
-                                 [(mt.name, a) for mt in e.mounts for a in "xyz"],
+        runs.append(cs.draw_case(index, names, "sz" if sides == "engine" else "body_sz",
+                                 run_seed, e, baseline_at(load, sides),
+                                 lambda eng, _t: simulate(eng, truth), channels(e),
                                  f"plan case load {load:g}", phase=phase,
                                  params={n: p for n, p in truth}))
-    return PlanCase(index, list(names), seed, tuple(loads), runs, truth)
+    return PlanCase(index, list(names), seed, tuple(loads), runs, truth, sides)
