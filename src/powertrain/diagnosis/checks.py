@@ -22,8 +22,10 @@ the noise a perfect model would leave, and the speed-band confounding check.
 * :func:`crossfit`: the candidate refitted with each other third of the speed blocks held
   out, so that every speed is scored once by a fit that did not see it (for candidates
   whose held-out t on one third of the speeds is short of the rule's);
-* :func:`band_check`: the chosen effect refitted on four speed bands: a parameter believed
-  constant that trends with speed points to a different effect.
+* :func:`band_check`: the chosen effect refitted on four speed bands, each started from its
+  whole-range optimum (no start grid: the trend of one answer is asked for, not another
+  basin): a parameter believed constant that trends with speed points to a different
+  effect.
 """
 
 from __future__ import annotations
@@ -226,15 +228,16 @@ def crossfit_baseline(folds, baseline: FitOutcome) -> np.ndarray:
     return np.concatenate([baseline.heldout_per_rpm] + [b.heldout_per_rpm for _, b in folds])
 
 
-def band_check(problem_factory, effect, data, train_idx, n_bands=4):
-    """Refit one effect on speed bands of the training data: parameter trend with speed."""
+def band_check(problem_factory, effect, data, train_idx, start, n_bands=4):
+    """Refit one effect on speed bands of the training data, from its whole-range optimum
+    ``start`` (fitted vector): parameter trend with speed."""
     out = []
     edges = np.linspace(0, train_idx.size, n_bands + 1).astype(int)
     for b in range(n_bands):
         idx = train_idx[edges[b]:edges[b + 1]]
         if idx.size < 3:
             continue
-        fo = fit_candidate(problem_factory(idx), (effect,))
+        fo = fit_candidate(problem_factory(idx), (effect,), starts=[start], grid=False)
         out.append({"rpm_from": float(data.rpm[idx[0]]), "rpm_to": float(data.rpm[idx[-1]]),
                     "parameters": fo.params[effect], "sigma": fo.sigma[effect]})
     return out

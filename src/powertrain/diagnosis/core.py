@@ -321,7 +321,7 @@ def _diagnose(measured, engine, noise_floor, effects, pairs, do_bands, rule, sch
             def factory(idx):
                 return Problem(s.sub(idx), s.problem.hm["test"], s.data, idx, s.test_idx)
             bands = band_check(factory, chosen.effects[0], s.data,
-                               s.train_all[::max(1, s.train_all.size // 48)])
+                               s.train_all[::max(1, s.train_all.size // 48)], chosen.x)
     eq = cand.equivalents(s, chosen, rule, noise_mse=e_n)
     what = "order magnitudes and phases" if s.data.has_phase else "order magnitudes"
     text = verdict.text if not eq else verdict.text + (

@@ -182,10 +182,10 @@ def residuals_db(sim, meas, floor):
     """Gap [dB] with censoring at the noise-floor rule's level; NaN where nothing was
     measured."""
     cl = censoring_level(floor)
+    cens = meas < cl
     with np.errstate(divide="ignore", invalid="ignore"):
-        gap = 20 * np.log10(sim / meas)
-        cens = meas < cl
-        gap = np.where(cens, np.maximum(0.0, 20 * np.log10(sim / cl)), gap)
+        gap = 20 * np.log10(sim / np.where(cens, cl, meas))   # one log: censored or not
+    gap = np.where(cens, np.maximum(0.0, gap), gap)
     return np.where(np.isfinite(meas), gap, np.nan)
 
 

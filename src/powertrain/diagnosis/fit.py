@@ -33,6 +33,10 @@ from powertrain.diagnosis.data import GapData, model_levels, noise_sigma_db, res
 from powertrain.diagnosis.packing import Packing
 from powertrain.diagnosis.starts import start_points
 from powertrain.effects import EFFECTS, predict
+from powertrain.solvers.fast_harmonic import N_HARMONICS
+
+#: Orders 0.5..8 of the model velocities (harmonics 1..16).
+N_ORDERS = N_HARMONICS - 1
 
 #: Evaluation budget per fit, in solves of the cached model (all starts, grid and Jacobian
 #: columns included; an evaluation costs the solves it made, at least 1: a sensor reading
@@ -121,7 +125,13 @@ class Problem:
             self.meas[k], self.phase[k], self.data.floor, self.sigma_db), np.nan)
             for k in self.idx}
         self.phase_on = {k: np.isfinite(w) for k, w in self.phase_w.items()}
-        self._phase_rad = {k: np.deg2rad(v) for k, v in self.phase.items()}
+        self._phase_rad = {k: np.deg2rad(v[self.phase_on[k]]) for k, v in self.phase.items()}
+        # the scored phase points as flat indices into the velocities (n_r, n_ch, N_ORDERS)
+        n_ch = self.meas["train"].shape[1]
+        self._phase_at = {}
+        for k, on in self.phase_on.items():
+            r, c, q = np.nonzero(on)
+            self._phase_at[k] = (r * n_ch + c) * N_ORDERS + self.sub.harmonic[q]
         self._order_on = {k: np.broadcast_to(self.order, on.shape)[on]
                           for k, on in self.phase_on.items()}
         self._w_on = {k: self.phase_w[k][on] for k, on in self.phase_on.items()}
@@ -183,8 +193,7 @@ class Problem:
 
     def _phase_diff(self, vel, part):
         """Model minus measured phase [rad] at the scored phase points of ``part``."""
-        on = self.phase_on[part]
-        return np.angle(vel[..., self.sub.harmonic][on]) - self._phase_rad[part][on]
+        return np.angle(np.take(vel, self._phase_at[part])) - self._phase_rad[part]
 
     def crank_offsets(self, scenario) -> list:
         """``[offset [rad]]`` (``[None]`` without phase); one per run, as for a plan."""

@@ -82,14 +82,20 @@ def _body(hm, sc):
 
 def _elements(hm, sc, s_el):
     """The networks' mount elements with the elastomer scales ``s_el`` and the effects'
-    changes; None when every one is linear (the cached two-ports serve)."""
-    els = list(hm.elements)
-    if s_el is not None:
-        els = [dataclasses.replace(el, model=el.model.scaled(float(s), float(s)))
-               for el, s in zip(els, s_el)]
+    changes; None when every one is linear (the cached two-ports serve). The scales keep
+    every element's laws, so linearity is told before any element is scaled."""
+    probe = list(hm.elements)
+    for eff, p in sc.values():
+        probe = eff.elements(hm, probe, p)
+    if not any(el.nonlinear for el in probe):
+        return None
+    if s_el is None:
+        return probe
+    els = [dataclasses.replace(el, model=el.model.scaled(float(s), float(s)))
+           for el, s in zip(hm.elements, s_el)]
     for eff, p in sc.values():
         els = eff.elements(hm, els, p)
-    return els if any(el.nonlinear for el in els) else None
+    return els
 
 
 def amplitude_iteration(hm, sc, els, load, body, *, tol=TOLERANCE, start=None):

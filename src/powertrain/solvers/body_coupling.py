@@ -32,6 +32,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from powertrain.analysis.channel import DIRECTIONS, passive_name
+from powertrain.kernels.small_solve import batched_solve
 from powertrain.physics.condensation import condensed_matrix
 
 
@@ -172,4 +173,4 @@ def coupled_solve(M, omega, rows, shapes, abc, kip, body, load):
     D = condensed_matrix(frame, E, B, (kip, abc[1], abc[2]), 1j * np.asarray(omega, float))
     rhs = np.zeros(omega.shape + (6 + K,), complex)
     rhs[..., :6] = load
-    return np.linalg.solve(D, rhs[..., None])[..., 0]
+    return batched_solve(D, rhs)

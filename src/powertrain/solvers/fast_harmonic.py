@@ -42,6 +42,7 @@ import numpy as np
 
 from powertrain.analysis.fourier import harmonic_amplitudes
 from powertrain.assembly import DIRECTIONS
+from powertrain.kernels.small_solve import batched_solve
 from powertrain.physics import balancer as bal
 from powertrain.physics.condensation import condensed_matrix
 from powertrain.physics.mount_network import two_port
@@ -165,12 +166,11 @@ class HarmonicModel:
 
     # ------------------------------------------------------------------ cached parts
     def load_of(self, engine) -> np.ndarray:
-        """Load harmonics of ``engine`` at the model's speeds, (n_r, 17, 6) complex."""
-        out = np.empty((self.rpm.size, N_HARMONICS, 6), complex)
-        for i, r in enumerate(self.rpm):
-            load = np.asarray(engine.generalized_load(float(r), self.theta), float)
-            out[i] = harmonic_amplitudes(load, axis=0)[:N_HARMONICS]
-        return out
+        """Load harmonics of ``engine`` at the model's speeds, (n_r, 17, 6) complex: from
+        :meth:`Engine.load_table <powertrain.models.engine.Engine.load_table>` (the
+        ``generalized_load`` of every speed to round-off, its patterns evaluated once)."""
+        table = np.asarray(engine.load_table(self.rpm, self.theta), float)
+        return harmonic_amplitudes(table, axis=1)[:, :N_HARMONICS]
 
     @property
     def load(self) -> np.ndarray:
@@ -291,7 +291,7 @@ class HarmonicModel:
                                  load[:, harmonics])
         frame = (self.M, np.zeros((6, 6)), np.zeros((6, 6)))
         D = condensed_matrix(frame, self.rows, None, (K, None, None), 1j * w)
-        return np.linalg.solve(D, load[:, harmonics][..., None])[..., 0]
+        return batched_solve(D, load[:, harmonics])
 
     def load_response(self, load) -> np.ndarray:
         r""":meth:`solve`'s amplitudes (n_r, 16, 6 [+ K]) of the nominal model (its own
