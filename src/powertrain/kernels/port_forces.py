@@ -406,9 +406,58 @@ def _body_force(load_at, T, F, k, z, p):
             p[c] -= T[e, c] * ze
 
 
+@njit(cache=True, nogil=True, fastmath=True, inline="always")
+def _write_outputs(W, Wd, Wz, er, ei, p, z, row):
+    """One row of outputs ``Re(W eta) + Wd p + Wz z`` into ``row``."""
+    _read_rows(W[0], W[1], er, ei, row)
+    for c in range(row.shape[0]):
+        o = row[c]
+        for d in range(p.shape[0]):
+            o += Wd[c, d] * p[d]
+        for e in range(z.shape[0]):
+            o += Wz[c, e] * z[e]
+        row[c] = o
+
+
+@njit(cache=True, nogil=True, fastmath=True, inline="always")
+def _linear_port_motions(R, D, T, er, ei, s, y, ul, vl):
+    """Port motions ``ul``, ``vl`` (m,) of the step without its new port forces: the reduced
+    motions ``y = Re(R eta) + (Dx s; Dv s)`` (2 q,) read through the port rows ``T``."""
+    Dx, Dv = D
+    q = Dx.shape[0]
+    _read_rows(R[0], R[1], er, ei, y)
+    for c in range(q):
+        for d in range(q):
+            y[c] += Dx[c, d] * s[d]
+            y[q + c] += Dv[c, d] * s[d]
+    for e in range(ul.shape[0]):
+        su = 0.0
+        sv = 0.0
+        for c in range(q):
+            su += T[e, c] * y[c]
+            sv += T[e, c] * y[q + c]
+        ul[e] = su
+        vl[e] = sv
+
+
+@njit(cache=True, nogil=True, fastmath=True, inline="always")
+def _advance(lr, li, G, s, er, ei):
+    """The modal recurrence ``eta = lambda_d eta + G^T s`` in place (real and imaginary
+    parts)."""
+    Gr, Gi = G
+    for j in range(er.shape[0]):
+        a = lr[j] * er[j] - li[j] * ei[j]
+        ei[j] = lr[j] * ei[j] + li[j] * er[j]
+        er[j] = a
+    for c in range(s.shape[0]):
+        sc = s[c]
+        for j in range(er.shape[0]):
+            er[j] += Gr[c, j] * sc
+            ei[j] += Gi[c, j] * sc
+
+
 @njit(cache=True, nogil=True, fastmath=True)
-def modal_port_kernel(lam_d, G, R, Dx, Dv, Wd, T, load_at, Qu, Qv, F, eta, z, kinds, par,
-                      state, out, tol, max_iter):
+def modal_port_kernel(modal, outputs, ports, laws, F, eta, z, out, tol, max_iter):
     r"""Newmark average acceleration with port laws in modal coordinates: the trapezoidal
     modal recurrence of the linear model (:class:`~powertrain.solvers.newmark.ModalNewmark`)
     :math:`\eta_{k+1} = \lambda_d\eta_k + \mathbf G(\mathbf p_k + \mathbf p_{k+1})`, the
@@ -418,35 +467,39 @@ def modal_port_kernel(lam_d, G, R, Dx, Dv, Wd, T, load_at, Qu, Qv, F, eta, z, ki
     :math:`\mathbf P = \mathbf T\,\partial\mathbf y/\partial\mathbf x`), and
     :math:`\mathbf G = \mathrm{diag}\gamma\,\Psi^{-1}[0; \mathbf M^{-1}]` on them.
 
-    Per step one pass over the modes reads :math:`\mathrm{Re}(\mathbf R\eta_k)`: the
-    outputs (their modal part) and the reduced motions of the step without the new port
+    Per step: the outputs :math:`\mathrm{Re}(\mathbf W\eta_k) + \mathbf W_d\mathbf p_k +
+    \mathbf W_z\mathbf z_k`; the reduced motions of the next step without its new port
     forces, :math:`\mathbf y^* = \mathrm{Re}(\Psi_y\lambda_d\eta_k) + \mathbf D_x\mathbf s`,
     :math:`\mathbf s = \mathbf p_k + \mathbf E\mathbf f_{k+1}`,
     :math:`\mathbf D_x = \mathrm{Re}(\Psi_y\mathbf G)` (velocities alike with
-    :math:`\mathbf D_v`); the port motions are :math:`\mathbf u = \mathbf T\mathbf y^* -
+    :math:`\mathbf D_v`); the port motions :math:`\mathbf u = \mathbf T\mathbf y^* -
     \mathbf Q_u\mathbf z`, :math:`\mathbf Q_u = \mathbf T\mathbf D_x\mathbf T^T`
     (:math:`= \tfrac{h^2}4\mathbf P\mathbf S^{-1}\mathbf P^T` of
-    :func:`newmark_port_kernel`), solved for :math:`\mathbf z` per step
-    (:func:`_port_forces_step`); a second pass updates :math:`\eta`.
+    :func:`newmark_port_kernel`), solved for :math:`\mathbf z` (:func:`_port_forces_step`);
+    then the recurrence.
 
-    Modal arrays split into real and imaginary parts: ``G`` (q, n_modes) (columns of the map
-    as rows), ``R`` (n_out + 2 q, n_modes): rows of the outputs, then
-    :math:`\Psi_y\lambda_d`, :math:`\Psi_{\dot y}\lambda_d`. Outputs ``out`` (n_rows,
-    n_out) at steps 0 .. n_rows - 1 of the loads ``F`` (n_rows + 1, n_load):
-    :math:`\mathrm{Re}(\mathbf W\eta) + \mathbf W_d\mathbf p`. ``eta`` (n_modes,)
-    complex and the port forces ``z`` (m,) are the state at step 0 on entry and at step
-    n_rows on return; ``state`` the port laws' (updated in place). Returns the number of
-    steps at which Newton did not converge.
+    Arguments (modal arrays as pairs of real and imaginary parts):
+
+    * ``modal = (lam_d, G, R, (Dx, Dv))``: ``G`` (q, n_modes) (columns of the map as rows),
+      ``R`` (2 q, n_modes) the rows :math:`\Psi_y\lambda_d`, :math:`\Psi_{\dot y}\lambda_d`;
+    * ``outputs = (W, Wd, Wz)``: ``W`` (n_out, n_modes), ``Wd`` (n_out, q), ``Wz``
+      (n_out, m); ``out`` (n_rows, n_out) gets the outputs at steps 0 .. n_rows - 1 of the
+      loads ``F`` (n_rows + 1, n_load);
+    * ``ports = (T, load_at, Qu, Qv)``, ``laws = (kinds, par, state)``.
+
+    ``eta`` (n_modes,) complex and the port forces ``z`` (m,) are the state at step 0 on
+    entry and at step n_rows on return; ``state`` the port laws' (updated in place). Returns
+    the number of steps at which Newton did not converge.
     """
-    Gr, Gi = G
-    Rr, Ri = R
-    n_modes = eta.shape[0]
+    lam_d, G, R, D = modal
+    W, Wd, Wz = outputs
+    T, load_at, Qu, Qv = ports
+    kinds, par, state = laws
     m = z.shape[0]
-    q = Dx.shape[0]
-    n_out = out.shape[1]
+    q = T.shape[1]
     lr, li = lam_d.real.copy(), lam_d.imag.copy()
     er, ei = eta.real.copy(), eta.imag.copy()
-    y = np.empty(Rr.shape[0])
+    y = np.empty(2 * q)
     p, p_next, s = np.empty(q), np.empty(q), np.empty(q)
     ul, vl, r = np.empty(m), np.empty(m), np.empty(m)
     J = np.empty((m, m))
@@ -455,28 +508,12 @@ def modal_port_kernel(lam_d, G, R, Dx, Dv, Wd, T, load_at, Qu, Qv, F, eta, z, ki
     _body_force(load_at, T, F, 0, z, p)
     failed = 0
     for k in range(out.shape[0]):
-        _read_rows(Rr, Ri, er, ei, y)
-        for c in range(n_out):
-            o = y[c]
-            for d in range(q):
-                o += Wd[c, d] * p[d]
-            out[k, c] = o
+        _write_outputs(W, Wd, Wz, er, ei, p, z, out[k])
         for c in range(q):
             s[c] = p[c]
         for c in range(F.shape[1]):
             s[load_at[c]] += F[k + 1, c]
-        for c in range(q):
-            for d in range(q):
-                y[n_out + c] += Dx[c, d] * s[d]
-                y[n_out + q + c] += Dv[c, d] * s[d]
-        for e in range(m):
-            su = 0.0
-            sv = 0.0
-            for c in range(q):
-                su += T[e, c] * y[n_out + c]
-                sv += T[e, c] * y[n_out + q + c]
-            ul[e] = su
-            vl[e] = sv
+        _linear_port_motions(R, D, T, er, ei, s, y, ul, vl)
         if not _port_forces_step(kinds, par, state, ul, vl, coupled, z, last, r, J, tol,
                                  max_iter):
             failed += 1
@@ -484,15 +521,7 @@ def modal_port_kernel(lam_d, G, R, Dx, Dv, Wd, T, load_at, Qu, Qv, F, eta, z, ki
         for c in range(q):
             s[c] = p[c] + p_next[c]
             p[c] = p_next[c]
-        for j in range(n_modes):
-            a = lr[j] * er[j] - li[j] * ei[j]
-            ei[j] = lr[j] * ei[j] + li[j] * er[j]
-            er[j] = a
-        for c in range(q):
-            sc = s[c]
-            for j in range(n_modes):
-                er[j] += Gr[c, j] * sc
-                ei[j] += Gi[c, j] * sc
-    for j in range(n_modes):
+        _advance(lr, li, G, s, er, ei)
+    for j in range(er.shape[0]):
         eta[j] = er[j] + 1j * ei[j]
     return failed

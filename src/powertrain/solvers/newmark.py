@@ -318,7 +318,8 @@ class ModalPortNewmark:
     tests/test_time_domain_laws.py). The recurrence is written on the reduced coordinates
     the load and the port rows touch (the body's six: a port row is a rigid body's motion at
     a mount): the port motions are read from their motions, the port forces act through
-    their generalized force. Outputs: the accelerations of the coordinates ``dofs``.
+    their generalized force. Outputs: ``y = Wx x + Wv v + Wa a + Wz z`` (rows over the
+    coordinates, and over the port forces for ``Wz``; None: no such term).
 
     Parameters
     ----------
@@ -327,50 +328,70 @@ class ModalPortNewmark:
         The port laws (every row with a law; ``ports.select(ports.kinds != NONE)``).
     h : float
         Time step [s].
-    dofs : ndarray of int
-        Coordinates whose accelerations are returned.
+    Wx, Wv, Wa : ndarray (n_out, n), optional
+    Wz : ndarray (n_out, m), optional
     """
 
-    def __init__(self, modal, ports, h, dofs):
+    def __init__(self, modal, ports, h, Wx=None, Wv=None, Wa=None, Wz=None):
         n = modal.n
         self.modal, self.ports, self.h = modal, ports, float(h)
         P = np.asarray(ports.rows, float)
-        reduced = np.union1d(np.arange(modal.load_dofs), np.flatnonzero(np.any(P != 0, 0)))
-        T = P[:, reduced]
+        self.reduced = np.union1d(np.arange(modal.load_dofs),
+                                  np.flatnonzero(np.any(P != 0, 0)))
+        T = P[:, self.reduced]
         lam = modal.lam_r
         lam_d = (1 + 0.5 * h * lam) / (1 - 0.5 * h * lam)
         G = ((0.5 * h) / (1 - 0.5 * h * lam))[:, None] * (
-            modal.Psi_inv_r[:, n:] @ modal.Minv[:, reduced])                # (n_modes, q)
-        Py, Pv = modal.Psi_r[reduced], modal.Psi_r[n + reduced]
-        read = np.eye(n)[np.asarray(dofs, int)]
-        Wa = read @ (modal.Psi_r[n:] * lam[None, :])
+            modal.Psi_inv_r[:, n:] @ modal.Minv[:, self.reduced])           # (n_modes, q)
+        Py, Pv = modal.Psi_r[self.reduced], modal.Psi_r[n + self.reduced]
         Dx, Dv = (G.T @ Py.T).real.T, (G.T @ Pv.T).real.T
-        self.lam_d = lam_d
-        self.arrays = (_parts(G.T), _parts(np.vstack([Wa, Py * lam_d, Pv * lam_d])),
-                       np.ascontiguousarray(Dx), np.ascontiguousarray(Dv),
-                       np.ascontiguousarray(read @ modal.Minv[:, reduced]),
-                       np.ascontiguousarray(T),
-                       np.searchsorted(reduced, np.arange(modal.load_dofs)).astype(np.int64),
-                       np.ascontiguousarray(T @ Dx @ T.T), np.ascontiguousarray(T @ Dv @ T.T))
+        self.modal_arrays = (lam_d, _parts(G.T), _parts(np.vstack([Py * lam_d, Pv * lam_d])),
+                             (np.ascontiguousarray(Dx), np.ascontiguousarray(Dv)))
+        self.port_arrays = (np.ascontiguousarray(T), np.searchsorted(
+            self.reduced, np.arange(modal.load_dofs)).astype(np.int64),
+            np.ascontiguousarray(T @ Dx @ T.T), np.ascontiguousarray(T @ Dv @ T.T))
+        self.outputs = self._output_arrays(Wx, Wv, Wa, Wz)
+        self.silent = self._output_arrays(np.zeros((0, n)))
+
+    def _output_arrays(self, Wx=None, Wv=None, Wa=None, Wz=None):
+        """``(W, Wd, Wz)`` of :func:`modal_port_kernel` for the output rows: ``Re(W eta)``
+        the modal part, ``Wd`` the direct part of the acceleration (a = M^-1 (p - C v -
+        K x) on the reduced coordinates)."""
+        modal, n, m = self.modal, self.modal.n, self.ports.kinds.size
+        rows = next(w.shape[0] for w in (Wx, Wv, Wa, Wz) if w is not None)
+        W = np.zeros((rows, self.modal.lam_r.size), complex)
+        Wd = np.zeros((rows, self.reduced.size))
+        if Wx is not None:
+            W += np.asarray(Wx, float) @ modal.Psi_r[:n]
+        if Wv is not None:
+            W += np.asarray(Wv, float) @ modal.Psi_r[n:]
+        if Wa is not None:
+            W += np.asarray(Wa, float) @ (modal.Psi_r[n:] * modal.lam_r[None, :])
+            Wd = np.asarray(Wa, float) @ modal.Minv[:, self.reduced]
+        Wz = np.zeros((rows, m)) if Wz is None else np.asarray(Wz, float)
+        return _parts(W), np.ascontiguousarray(Wd), np.ascontiguousarray(Wz)
 
     def modal_state(self, x, v) -> np.ndarray:
         """Modal coordinates (n_modes,) complex of the state ``(x, v)``."""
         return self.modal.Psi_inv_r @ np.concatenate([x, v]).astype(complex)
 
-    def run(self, F, eta, z, state) -> np.ndarray:
-        """Accelerations (n_rows, n_read) at steps 0 .. n_rows - 1 of the loads ``F``
-        (n_rows + 1, load_dofs) [N]; ``eta``, the port forces ``z`` (m,) [N] and the laws'
-        ``state`` are the state at step 0 and are updated in place to step n_rows.
+    def run(self, F, eta, z, state, outputs=True) -> np.ndarray:
+        """Outputs (n_rows, n_out) at steps 0 .. n_rows - 1 of the loads ``F``
+        (n_rows + 1, load_dofs) [N] (``outputs`` False: none, (n_rows, 0)); ``eta``, the
+        port forces ``z`` (m,) [N] and the laws' ``state`` are the state at step 0 and are
+        updated in place to step n_rows.
 
         Raises
         ------
         FloatingPointError
             Newton did not converge at some step (the names of the port laws are given).
         """
-        out = np.empty((F.shape[0] - 1, self.arrays[4].shape[0]))
-        failed = modal_port_kernel(self.lam_d, *self.arrays, np.ascontiguousarray(F, float),
-                                   eta, z, self.ports.kinds, self.ports.parameters, state, out,
-                                   PORT_TOL, PORT_MAX_ITER)
+        arrays = self.outputs if outputs else self.silent
+        out = np.empty((F.shape[0] - 1, arrays[1].shape[0]))
+        laws = (self.ports.kinds, self.ports.parameters, state)
+        failed = modal_port_kernel(self.modal_arrays, arrays, self.port_arrays, laws,
+                                   np.ascontiguousarray(F, float), eta, z, out, PORT_TOL,
+                                   PORT_MAX_ITER)
         if failed:
             raise FloatingPointError(f"port laws {', '.join(self.ports.names)}: Newton did "
                                      f"not converge at {failed} of {out.shape[0]} steps")

@@ -266,7 +266,8 @@ def _integrate_ports(integrator, load, ramp, start, dofs, decimator):
     (x0, v0, *_), state, amplitudes = start
     s, laws = integrator.scaling, integrator.laws
     C, K, _, _ = s.matrices(s.scales(integrator.ports.network_amplitudes(amplitudes)))
-    run = ModalPortNewmark(ModalNewmark(s.system.M, C, K, load_dofs=6), laws, h, dofs)
+    run = ModalPortNewmark(ModalNewmark(s.system.M, C, K, load_dofs=6), laws, h,
+                           Wa=np.eye(C.shape[0])[dofs])
     eta = run.modal_state(x0, v0)
     z = laws.forces(laws.rows @ x0, laws.rows @ v0, state)
     chunk = CHUNK_OUT * decimator.m         # a multiple of m keeps the decimation aligned
