@@ -180,32 +180,14 @@ def newmark_port_kernel(G, H, Fs, h, x0, v0, a0, W, P, Q, kinds, par, state, X, 
     diagonal first, :func:`_port_forces_step`), from the tangent at the previous step; the
     states are committed once it has converged.
 
-    Parameters
-    ----------
-    G, H, Fs, h, x0, v0, a0, X, V, A
-        As :func:`newmark_kernel`.
-    W : ndarray (n, m)
-        S^-1 P^T.
-    P : ndarray (m, n)
-        Port rows: relative displacement across each port law per unit coordinate.
-    Q : ndarray (m, m)
-        P S^-1 P^T.
-    kinds : ndarray int64 (m,)
-        Port-law codes.
-    par : ndarray (m, n_par)
-        Their parameters.
-    state : ndarray (m, n_state)
-        Their state, updated in place (the state after the last step).
-    Z : ndarray (n_steps + 1, m)
-        Output: port forces at every time point [N].
-    tol : float
-        Newton stops when every residual is below ``tol`` times (1 + the largest force).
-    max_iter : int
-
-    Returns
-    -------
-    int
-        Steps at which Newton did not converge (0 on success).
+    Arguments: ``G, H, Fs, h, x0, v0, a0, X, V, A`` as :func:`newmark_kernel`; ``W`` (n, m)
+    = S^-1 P^T; ``P`` (m, n) the port rows (relative displacement across each port law per
+    unit coordinate); ``Q`` (m, m) = P S^-1 P^T; ``kinds`` (m,) int64 the port-law codes,
+    ``par`` (m, n_par) their parameters, ``state`` (m, n_state) their state (updated in
+    place to the state after the last step); output ``Z`` (n_steps + 1, m) the port forces
+    at every time point [N]; Newton stops when every residual is below ``tol`` times (1 +
+    the largest force), or after ``max_iter`` iterations. Returns the number of steps at
+    which Newton did not converge (0 on success).
     """
     n = x0.shape[0]
     m = kinds.shape[0]
@@ -332,8 +314,7 @@ def _port_forces_step(kinds, par, state, ul, vl, Q, z, last, r, J, tol, max_iter
 
 @njit(cache=True, nogil=True)
 def _coupling(Qu, Qv):
-    """``(Qu, Qv, qa)`` of :func:`_port_forces_step`: ``qa`` (2, m) the row sums of
-    ``|Qu|``, ``|Qv|``."""
+    """``(Qu, Qv, qa)`` of :func:`_port_forces_step`: ``qa`` (2, m) row sums of |Qu|, |Qv|."""
     qa = np.zeros((2, Qu.shape[0]))
     for e in range(Qu.shape[0]):
         for j in range(Qu.shape[1]):
@@ -421,8 +402,8 @@ def _write_outputs(W, Wd, Wz, er, ei, p, z, row):
 
 @njit(cache=True, nogil=True, fastmath=True, inline="always")
 def _linear_port_motions(R, D, T, er, ei, s, y, ul, vl):
-    """Port motions ``ul``, ``vl`` (m,) of the step without its new port forces: the reduced
-    motions ``y = Re(R eta) + (Dx s; Dv s)`` (2 q,) read through the port rows ``T``."""
+    """Port motions ``ul``, ``vl`` (m,) without the step's new port forces: the reduced ones
+    ``y = Re(R eta) + (Dx s; Dv s)`` (2 q,) through the port rows ``T``."""
     Dx, Dv = D
     q = Dx.shape[0]
     _read_rows(R[0], R[1], er, ei, y)
@@ -431,19 +412,14 @@ def _linear_port_motions(R, D, T, er, ei, s, y, ul, vl):
             y[c] += Dx[c, d] * s[d]
             y[q + c] += Dv[c, d] * s[d]
     for e in range(ul.shape[0]):
-        su = 0.0
-        sv = 0.0
-        for c in range(q):
-            su += T[e, c] * y[c]
-            sv += T[e, c] * y[q + c]
-        ul[e] = su
-        vl[e] = sv
+        ul[e] = _dot(T[e], y[:q])
+        vl[e] = _dot(T[e], y[q:])
 
 
 @njit(cache=True, nogil=True, fastmath=True, inline="always")
-def _advance(lr, li, G, s, er, ei):
-    """The modal recurrence ``eta = lambda_d eta + G^T s`` in place (real and imaginary
-    parts)."""
+def _advance(lam_d, G, s, er, ei):
+    """The modal recurrence ``eta = lambda_d eta + G^T s`` in place (real, imaginary parts)."""
+    lr, li = lam_d
     Gr, Gi = G
     for j in range(er.shape[0]):
         a = lr[j] * er[j] - li[j] * ei[j]
@@ -471,25 +447,19 @@ def modal_port_kernel(modal, outputs, ports, laws, F, eta, z, out, tol, max_iter
     \mathbf W_z\mathbf z_k`; the reduced motions of the next step without its new port
     forces, :math:`\mathbf y^* = \mathrm{Re}(\Psi_y\lambda_d\eta_k) + \mathbf D_x\mathbf s`,
     :math:`\mathbf s = \mathbf p_k + \mathbf E\mathbf f_{k+1}`,
-    :math:`\mathbf D_x = \mathrm{Re}(\Psi_y\mathbf G)` (velocities alike with
-    :math:`\mathbf D_v`); the port motions :math:`\mathbf u = \mathbf T\mathbf y^* -
-    \mathbf Q_u\mathbf z`, :math:`\mathbf Q_u = \mathbf T\mathbf D_x\mathbf T^T`
-    (:math:`= \tfrac{h^2}4\mathbf P\mathbf S^{-1}\mathbf P^T` of
-    :func:`newmark_port_kernel`), solved for :math:`\mathbf z` (:func:`_port_forces_step`);
-    then the recurrence.
-
-    Arguments (modal arrays as pairs of real and imaginary parts):
-
-    * ``modal = (lam_d, G, R, (Dx, Dv))``: ``G`` (q, n_modes) (columns of the map as rows),
-      ``R`` (2 q, n_modes) the rows :math:`\Psi_y\lambda_d`, :math:`\Psi_{\dot y}\lambda_d`;
-    * ``outputs = (W, Wd, Wz)``: ``W`` (n_out, n_modes), ``Wd`` (n_out, q), ``Wz``
-      (n_out, m); ``out`` (n_rows, n_out) gets the outputs at steps 0 .. n_rows - 1 of the
-      loads ``F`` (n_rows + 1, n_load);
-    * ``ports = (T, load_at, Qu, Qv)``, ``laws = (kinds, par, state)``.
-
-    ``eta`` (n_modes,) complex and the port forces ``z`` (m,) are the state at step 0 on
-    entry and at step n_rows on return; ``state`` the port laws' (updated in place). Returns
-    the number of steps at which Newton did not converge.
+    :math:`\mathbf D_x = \mathrm{Re}(\Psi_y\mathbf G)` (velocities alike); the port motions
+    :math:`\mathbf u = \mathbf T\mathbf y^* - \mathbf Q_u\mathbf z`, :math:`\mathbf Q_u =
+    \mathbf T\mathbf D_x\mathbf T^T` (the :math:`\tfrac{h^2}4\mathbf P\mathbf S^{-1}\mathbf
+    P^T` of :func:`newmark_port_kernel`), solved for :math:`\mathbf z`
+    (:func:`_port_forces_step`); then the recurrence. Arguments (modal arrays as pairs of
+    real and imaginary parts): ``modal = (lam_d, G, R, (Dx, Dv))``, ``G`` (q, n_modes) (the
+    map's columns as rows), ``R`` (2 q, n_modes) the rows :math:`\Psi_y\lambda_d`,
+    :math:`\Psi_{\dot y}\lambda_d`; ``outputs = (W, Wd, Wz)`` (n_out rows), ``out``
+    (n_rows, n_out) gets them at steps 0 .. n_rows - 1 of the loads ``F`` (n_rows + 1,
+    n_load); ``ports = (T, load_at, Qu, Qv)``, ``laws = (kinds, par, state)``. ``eta``
+    (n_modes,) complex and the port forces ``z`` (m,) are the state at step 0 on entry and
+    at step n_rows on return, ``state`` is updated in place. Returns the number of steps at
+    which Newton did not converge.
     """
     lam_d, G, R, D = modal
     W, Wd, Wz = outputs
@@ -497,7 +467,6 @@ def modal_port_kernel(modal, outputs, ports, laws, F, eta, z, out, tol, max_iter
     kinds, par, state = laws
     m = z.shape[0]
     q = T.shape[1]
-    lr, li = lam_d.real.copy(), lam_d.imag.copy()
     er, ei = eta.real.copy(), eta.imag.copy()
     y = np.empty(2 * q)
     p, p_next, s = np.empty(q), np.empty(q), np.empty(q)
@@ -521,7 +490,7 @@ def modal_port_kernel(modal, outputs, ports, laws, F, eta, z, out, tol, max_iter
         for c in range(q):
             s[c] = p[c] + p_next[c]
             p[c] = p_next[c]
-        _advance(lr, li, G, s, er, ei)
+        _advance(lam_d, G, s, er, ei)
     for j in range(er.shape[0]):
         eta[j] = er[j] + 1j * ei[j]
     return failed

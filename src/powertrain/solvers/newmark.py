@@ -345,7 +345,8 @@ class ModalPortNewmark:
             modal.Psi_inv_r[:, n:] @ modal.Minv[:, self.reduced])           # (n_modes, q)
         Py, Pv = modal.Psi_r[self.reduced], modal.Psi_r[n + self.reduced]
         Dx, Dv = (G.T @ Py.T).real.T, (G.T @ Pv.T).real.T
-        self.modal_arrays = (lam_d, _parts(G.T), _parts(np.vstack([Py * lam_d, Pv * lam_d])),
+        self.modal_arrays = (_parts(lam_d), _parts(G.T),
+                             _parts(np.vstack([Py * lam_d, Pv * lam_d])),
                              (np.ascontiguousarray(Dx), np.ascontiguousarray(Dv)))
         self.port_arrays = (np.ascontiguousarray(T), np.searchsorted(
             self.reduced, np.arange(modal.load_dofs)).astype(np.int64),
