@@ -364,12 +364,12 @@ def _commit(kinds, par, state, last, f):
 
 
 @njit(cache=True, nogil=True, fastmath=True, inline="always")
-def _read_rows(Rr, Ri, er, ei, out):
-    """``out = Re(R eta)`` for the rows of ``R`` (real and imaginary parts)."""
+def _read_rows(R, x, out):
+    """``out = R x``: rows of the modal state's real form (:func:`_advance`)."""
     for c in range(out.shape[0]):
         y = 0.0
-        for j in range(er.shape[0]):
-            y += Rr[c, j] * er[j] - Ri[c, j] * ei[j]
+        for j in range(x.shape[0]):
+            y += R[c, j] * x[j]
         out[c] = y
 
 
@@ -388,9 +388,9 @@ def _body_force(load_at, T, F, k, z, p):
 
 
 @njit(cache=True, nogil=True, fastmath=True, inline="always")
-def _write_outputs(W, Wd, Wz, er, ei, p, z, row):
-    """One row of outputs ``Re(W eta) + Wd p + Wz z`` into ``row``."""
-    _read_rows(W[0], W[1], er, ei, row)
+def _write_outputs(W, Wd, Wz, x, p, z, row):
+    """One row of outputs ``W x + Wd p + Wz z`` into ``row``."""
+    _read_rows(W, x, row)
     for c in range(row.shape[0]):
         o = row[c]
         for d in range(p.shape[0]):
@@ -401,12 +401,12 @@ def _write_outputs(W, Wd, Wz, er, ei, p, z, row):
 
 
 @njit(cache=True, nogil=True, fastmath=True, inline="always")
-def _linear_port_motions(R, D, T, er, ei, s, y, ul, vl):
+def _linear_port_motions(R, D, T, x, s, y, ul, vl):
     """Port motions ``ul``, ``vl`` (m,) without the step's new port forces: the reduced ones
-    ``y = Re(R eta) + (Dx s; Dv s)`` (2 q,) through the port rows ``T``."""
+    ``y = R x + (Dx s; Dv s)`` (2 q,) through the port rows ``T``."""
     Dx, Dv = D
     q = Dx.shape[0]
-    _read_rows(R[0], R[1], er, ei, y)
+    _read_rows(R, x, y)
     for c in range(q):
         for d in range(q):
             y[c] += Dx[c, d] * s[d]
@@ -417,19 +417,23 @@ def _linear_port_motions(R, D, T, er, ei, s, y, ul, vl):
 
 
 @njit(cache=True, nogil=True, fastmath=True, inline="always")
-def _advance(lam_d, G, s, er, ei):
-    """The modal recurrence ``eta = lambda_d eta + G^T s`` in place (real, imaginary parts)."""
+def _advance(lam_d, G, s, x):
+    """The modal recurrence ``eta = lambda_d eta + G s`` in place, in real form: ``x`` holds
+    the real parts of the n modes, then the imaginary parts of the complex ones, which come
+    first (a real mode's is zero but for round-off); ``lam_d = (real parts (n,), imaginary
+    parts (n_c,))``."""
     lr, li = lam_d
-    Gr, Gi = G
-    for j in range(er.shape[0]):
-        a = lr[j] * er[j] - li[j] * ei[j]
-        ei[j] = lr[j] * ei[j] + li[j] * er[j]
-        er[j] = a
+    n = lr.shape[0]
+    for j in range(li.shape[0]):
+        a = lr[j] * x[j] - li[j] * x[n + j]
+        x[n + j] = lr[j] * x[n + j] + li[j] * x[j]
+        x[j] = a
+    for j in range(li.shape[0], n):
+        x[j] *= lr[j]
     for c in range(s.shape[0]):
         sc = s[c]
-        for j in range(er.shape[0]):
-            er[j] += Gr[c, j] * sc
-            ei[j] += Gi[c, j] * sc
+        for j in range(x.shape[0]):
+            x[j] += G[c, j] * sc
 
 
 @njit(cache=True, nogil=True, fastmath=True)
@@ -451,10 +455,11 @@ def modal_port_kernel(modal, outputs, ports, laws, F, eta, z, out, tol, max_iter
     :math:`\mathbf u = \mathbf T\mathbf y^* - \mathbf Q_u\mathbf z`, :math:`\mathbf Q_u =
     \mathbf T\mathbf D_x\mathbf T^T` (the :math:`\tfrac{h^2}4\mathbf P\mathbf S^{-1}\mathbf
     P^T` of :func:`newmark_port_kernel`), solved for :math:`\mathbf z`
-    (:func:`_port_forces_step`); then the recurrence. Arguments (modal arrays as pairs of
-    real and imaginary parts): ``modal = (lam_d, G, R, (Dx, Dv))``, ``G`` (q, n_modes) (the
-    map's columns as rows), ``R`` (2 q, n_modes) the rows :math:`\Psi_y\lambda_d`,
-    :math:`\Psi_{\dot y}\lambda_d`; ``outputs = (W, Wd, Wz)`` (n_out rows), ``out``
+    (:func:`_port_forces_step`); then the recurrence. Arguments (modal arrays in the real
+    form of :func:`_advance`, n_x columns): ``modal = (lam_d, G, R, (Dx, Dv))``, ``G``
+    (q, n_x) (the map's columns as rows), ``R`` (2 q, n_x) the rows reading
+    :math:`\mathrm{Re}(\Psi_y\lambda_d\eta)`, :math:`\mathrm{Re}(\Psi_{\dot
+    y}\lambda_d\eta)`; ``outputs = (W, Wd, Wz)`` (n_out rows), ``out``
     (n_rows, n_out) gets them at steps 0 .. n_rows - 1 of the loads ``F`` (n_rows + 1,
     n_load); ``ports = (T, load_at, Qu, Qv)``, ``laws = (kinds, par, state)``. ``eta``
     (n_modes,) complex and the port forces ``z`` (m,) are the state at step 0 on entry and
@@ -467,7 +472,7 @@ def modal_port_kernel(modal, outputs, ports, laws, F, eta, z, out, tol, max_iter
     kinds, par, state = laws
     m = z.shape[0]
     q = T.shape[1]
-    er, ei = eta.real.copy(), eta.imag.copy()
+    x = _real_form(eta, lam_d[1].shape[0])
     y = np.empty(2 * q)
     p, p_next, s = np.empty(q), np.empty(q), np.empty(q)
     ul, vl, r = np.empty(m), np.empty(m), np.empty(m)
@@ -477,12 +482,12 @@ def modal_port_kernel(modal, outputs, ports, laws, F, eta, z, out, tol, max_iter
     _body_force(load_at, T, F, 0, z, p)
     failed = 0
     for k in range(out.shape[0]):
-        _write_outputs(W, Wd, Wz, er, ei, p, z, out[k])
+        _write_outputs(W, Wd, Wz, x, p, z, out[k])
         for c in range(q):
             s[c] = p[c]
         for c in range(F.shape[1]):
             s[load_at[c]] += F[k + 1, c]
-        _linear_port_motions(R, D, T, er, ei, s, y, ul, vl)
+        _linear_port_motions(R, D, T, x, s, y, ul, vl)
         if not _port_forces_step(kinds, par, state, ul, vl, coupled, z, last, r, J, tol,
                                  max_iter):
             failed += 1
@@ -490,7 +495,26 @@ def modal_port_kernel(modal, outputs, ports, laws, F, eta, z, out, tol, max_iter
         for c in range(q):
             s[c] = p[c] + p_next[c]
             p[c] = p_next[c]
-        _advance(lam_d, G, s, er, ei)
-    for j in range(er.shape[0]):
-        eta[j] = er[j] + 1j * ei[j]
+        _advance(lam_d, G, s, x)
+    _complex_form(x, eta)
     return failed
+
+
+@njit(cache=True, nogil=True)
+def _real_form(eta, n_complex):
+    """The real form (:func:`_advance`) of the modal state ``eta`` (n,) complex."""
+    n = eta.shape[0]
+    x = np.empty(n + n_complex)
+    for j in range(n):
+        x[j] = eta[j].real
+    for j in range(n_complex):
+        x[n + j] = eta[j].imag
+    return x
+
+
+@njit(cache=True, nogil=True)
+def _complex_form(x, eta):
+    """The modal state ``eta`` (n,) complex of its real form ``x`` (in place)."""
+    n = eta.shape[0]
+    for j in range(n):
+        eta[j] = x[j] + 1j * (x[n + j] if n + j < x.shape[0] else 0.0)

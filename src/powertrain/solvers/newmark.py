@@ -214,12 +214,25 @@ class ModalNewmark:
         if not np.isclose(2 * np.count_nonzero(lam.imag > 0) + np.count_nonzero(real_mode),
                           lam.size):
             raise np.linalg.LinAlgError("eigenvalues not in conjugate pairs")
-        weight = np.where(real_mode[keep], 1.0, 2.0)
+        # the kept modes, complex ones first (:meth:`real_form`)
+        order = np.r_[np.flatnonzero(keep & ~real_mode), np.flatnonzero(real_mode)]
+        #: kept modes with a complex eigenvalue (the first ones)
+        self.n_complex = int(np.count_nonzero(keep & ~real_mode))
+        weight = np.where(real_mode[order], 1.0, 2.0)
         self._work = threading.local()   # per-thread output buffers, see run_outputs
-        self.lam_r = lam[keep]
-        self.Psi_r = Psi[:, keep] * weight[None, :]
-        self.Psi_inv_r = self.Psi_inv[keep]
-        self.load_map_r = self.load_map[keep]
+        self.lam_r = lam[order]
+        self.Psi_r = Psi[:, order] * weight[None, :]
+        self.Psi_inv_r = self.Psi_inv[order]
+        self.load_map_r = self.load_map[order]
+
+    def real_form(self, a) -> np.ndarray:
+        """``a`` (..., kept modes) complex in the kernels' real form: the real parts, then
+        the imaginary parts of the complex modes (a real mode's is zero but for round-off),
+        contiguous (:func:`powertrain.kernels.port_forces._advance`). A row ``r`` read as
+        ``Re(r eta)`` is ``real_form(conj(r))``."""
+        a = np.asarray(a)
+        return np.ascontiguousarray(np.concatenate([a.real, a.imag[..., :self.n_complex]],
+                                                   axis=-1))
 
     def run(self, F, h, x0, v0, keep_from=0):
         """Integrate with the load ``F`` (n_steps + 1, load_dofs) [N] from (x0, v0).
@@ -345,8 +358,9 @@ class ModalPortNewmark:
             modal.Psi_inv_r[:, n:] @ modal.Minv[:, self.reduced])           # (n_modes, q)
         Py, Pv = modal.Psi_r[self.reduced], modal.Psi_r[n + self.reduced]
         Dx, Dv = (G.T @ Py.T).real.T, (G.T @ Pv.T).real.T
-        self.modal_arrays = (_parts(lam_d), _parts(G.T),
-                             _parts(np.vstack([Py * lam_d, Pv * lam_d])),
+        self.modal_arrays = ((lam_d.real.copy(), lam_d.imag[:modal.n_complex].copy()),
+                             modal.real_form(G.T),
+                             modal.real_form(np.conj(np.vstack([Py * lam_d, Pv * lam_d]))),
                              (np.ascontiguousarray(Dx), np.ascontiguousarray(Dv)))
         self.port_arrays = (np.ascontiguousarray(T), np.searchsorted(
             self.reduced, np.arange(modal.load_dofs)).astype(np.int64),
@@ -370,7 +384,8 @@ class ModalPortNewmark:
             W += np.asarray(Wa, float) @ (modal.Psi_r[n:] * modal.lam_r[None, :])
             Wd = np.asarray(Wa, float) @ modal.Minv[:, self.reduced]
         Wz = np.zeros((rows, m)) if Wz is None else np.asarray(Wz, float)
-        return _parts(W), np.ascontiguousarray(Wd), np.ascontiguousarray(Wz)
+        return (modal.real_form(np.conj(W)), np.ascontiguousarray(Wd),
+                np.ascontiguousarray(Wz))
 
     def modal_state(self, x, v) -> np.ndarray:
         """Modal coordinates (n_modes,) complex of the state ``(x, v)``."""
@@ -398,7 +413,3 @@ class ModalPortNewmark:
                                      f"not converge at {failed} of {out.shape[0]} steps")
         return out
 
-
-def _parts(a):
-    """Real and imaginary parts of ``a`` as contiguous arrays (the kernels' modal form)."""
-    return np.ascontiguousarray(a.real), np.ascontiguousarray(a.imag)

@@ -191,21 +191,24 @@ def _integrate(modal, dofs, load, ramp, eta, decimator, progress):
     read = np.eye(modal.n)[dofs]
     Z = np.zeros_like(read)
     (w_re, w_im), w_load = modal.output_map(Z, Z, read)
-    lam_d = (1 + 0.5 * h * modal.lam_r) / (1 - 0.5 * h * modal.lam_r)
-    gain = (0.5 * h) / (1 - 0.5 * h * modal.lam_r)
+    lam = modal.lam_r
+    lam_d = (1 + 0.5 * h * lam) / (1 - 0.5 * h * lam)
+    gain = (0.5 * h) / (1 - 0.5 * h * lam)
     chunk = CHUNK_OUT * decimator.m         # a multiple of m keeps the decimation aligned
     starts = range(0, n_steps, chunk)
     if progress:
         from tqdm import tqdm
         starts = tqdm(starts, desc="sweep", unit="chunk", leave=False, disable=None)
-    eta = np.ascontiguousarray(eta, complex)
-    arrays = (lam_d, gain, np.ascontiguousarray(modal.load_map_r), w_re, w_im,
-              np.ascontiguousarray(w_load), np.ascontiguousarray(table))
+    x = modal.real_form(eta)
+    arrays = ((lam_d.real.copy(), lam_d.imag[:modal.n_complex].copy()),
+              modal.real_form((gain[:, None] * modal.load_map_r).T),
+              modal.real_form(w_re.T - 1j * w_im.T), np.ascontiguousarray(w_load),
+              np.ascontiguousarray(table))
     outputs = []
     for s in starts:
         acc = np.empty((min(s + chunk, n_steps) - s, w_re.shape[1]))
         modal_ramp_kernel(*arrays, float(speeds[0]), LOAD_RPM_STEP, float(rpm_from),
-                          float(rate_rpm_per_s), float(h), s, eta, acc)
+                          float(rate_rpm_per_s), float(h), s, x, acc)
         outputs.append(decimator.push(acc))
     return np.concatenate(outputs)
 
