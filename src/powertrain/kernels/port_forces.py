@@ -437,7 +437,7 @@ def _advance(lam_d, G, s, x):
 
 
 @njit(cache=True, nogil=True, fastmath=True)
-def modal_port_kernel(modal, outputs, ports, laws, F, eta, z, out, tol, max_iter):
+def modal_port_kernel(modal, outputs, ports, laws, F, x, z, out, tol, max_iter):
     r"""Newmark average acceleration with port laws in modal coordinates: the trapezoidal
     modal recurrence of the linear model (:class:`~powertrain.solvers.newmark.ModalNewmark`)
     :math:`\eta_{k+1} = \lambda_d\eta_k + \mathbf G(\mathbf p_k + \mathbf p_{k+1})`, the
@@ -461,8 +461,8 @@ def modal_port_kernel(modal, outputs, ports, laws, F, eta, z, out, tol, max_iter
     :math:`\mathrm{Re}(\Psi_y\lambda_d\eta)`, :math:`\mathrm{Re}(\Psi_{\dot
     y}\lambda_d\eta)`; ``outputs = (W, Wd, Wz)`` (n_out rows), ``out``
     (n_rows, n_out) gets them at steps 0 .. n_rows - 1 of the loads ``F`` (n_rows + 1,
-    n_load); ``ports = (T, load_at, Qu, Qv)``, ``laws = (kinds, par, state)``. ``eta``
-    (n_modes,) complex and the port forces ``z`` (m,) are the state at step 0 on entry and
+    n_load); ``ports = (T, load_at, Qu, Qv)``, ``laws = (kinds, par, state)``. The modal
+    state ``x`` (n_x,) and the port forces ``z`` (m,) are the state at step 0 on entry and
     at step n_rows on return, ``state`` is updated in place. Returns the number of steps at
     which Newton did not converge.
     """
@@ -472,7 +472,6 @@ def modal_port_kernel(modal, outputs, ports, laws, F, eta, z, out, tol, max_iter
     kinds, par, state = laws
     m = z.shape[0]
     q = T.shape[1]
-    x = _real_form(eta, lam_d[1].shape[0])
     y = np.empty(2 * q)
     p, p_next, s = np.empty(q), np.empty(q), np.empty(q)
     ul, vl, r = np.empty(m), np.empty(m), np.empty(m)
@@ -496,25 +495,5 @@ def modal_port_kernel(modal, outputs, ports, laws, F, eta, z, out, tol, max_iter
             s[c] = p[c] + p_next[c]
             p[c] = p_next[c]
         _advance(lam_d, G, s, x)
-    _complex_form(x, eta)
     return failed
 
-
-@njit(cache=True, nogil=True)
-def _real_form(eta, n_complex):
-    """The real form (:func:`_advance`) of the modal state ``eta`` (n,) complex."""
-    n = eta.shape[0]
-    x = np.empty(n + n_complex)
-    for j in range(n):
-        x[j] = eta[j].real
-    for j in range(n_complex):
-        x[n + j] = eta[j].imag
-    return x
-
-
-@njit(cache=True, nogil=True)
-def _complex_form(x, eta):
-    """The modal state ``eta`` (n,) complex of its real form ``x`` (in place)."""
-    n = eta.shape[0]
-    for j in range(n):
-        eta[j] = x[j] + 1j * (x[n + j] if n + j < x.shape[0] else 0.0)

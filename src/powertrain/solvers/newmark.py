@@ -388,14 +388,15 @@ class ModalPortNewmark:
                 np.ascontiguousarray(Wz))
 
     def modal_state(self, x, v) -> np.ndarray:
-        """Modal coordinates (n_modes,) complex of the state ``(x, v)``."""
-        return self.modal.Psi_inv_r @ np.concatenate([x, v]).astype(complex)
+        """Modal coordinates of the state ``(x, v)`` in the kernel's real form
+        (:meth:`ModalNewmark.real_form`)."""
+        return self.modal.real_form(self.modal.Psi_inv_r @ np.concatenate([x, v]))
 
     def run(self, F, eta, z, state, outputs=True) -> np.ndarray:
         """Outputs (n_rows, n_out) at steps 0 .. n_rows - 1 of the loads ``F``
-        (n_rows + 1, load_dofs) [N] (``outputs`` False: none, (n_rows, 0)); ``eta``, the
-        port forces ``z`` (m,) [N] and the laws' ``state`` are the state at step 0 and are
-        updated in place to step n_rows.
+        (n_rows + 1, load_dofs) [N] (``outputs`` False: none, (n_rows, 0)); the modal state
+        ``eta`` (:meth:`modal_state`), the port forces ``z`` (m,) [N] and the laws'
+        ``state`` are the state at step 0 and are updated in place to step n_rows.
 
         Raises
         ------
