@@ -1,7 +1,7 @@
 r"""The run-up's per-speed solvers behind one protocol, chosen once per run.
 
 A :class:`Stepper` turns one speed's load over an engine cycle into the order amplitudes of
-every channel (:class:`SpeedOrders`). Four implement it:
+every channel (:class:`SpeedOrders`). Five implement it:
 
 * :class:`HarmonicStepper` — the frequency-domain steady state order by order through the one
   condensation (:func:`powertrain.solvers.harmonic.harmonic_response`);
@@ -9,14 +9,16 @@ every channel (:class:`SpeedOrders`). Four implement it:
   admittance (:func:`powertrain.solvers.admittance.frf_response`);
 * :class:`ModalNewmarkStepper` — Newmark average acceleration, the recurrence diagonalised
   once per model (:class:`powertrain.solvers.newmark.ModalNewmark`);
-* :class:`DenseNewmarkStepper` — the same recurrence in physical coordinates (Numba kernel).
+* :class:`DenseNewmarkStepper` — the same recurrence in physical coordinates (Numba kernel);
+* :class:`ModalPortStepper` — the modal recurrence with the port laws, Newton per step
+  (:class:`powertrain.solvers.newmark.ModalPortNewmark`), for networks of constant scale.
 
 :func:`choose_stepper` picks one from the solver and stepper names and the chassis (which
 says whether it can be integrated in time). A time stepper sees the assembled model through
 ``system.M``, ``C``, ``K``, its output rows and, when some mount element is nonlinear, the
 elements' port laws (``system.port_forces()``, :mod:`powertrain.physics.mount_elements`):
-the dense Newmark stepper integrates them (Newton per step in the kernel), the modal one
-refuses them, and the frequency-domain steppers solve the equivalent-linear model at the
+the Newmark steppers with port laws integrate them (Newton per step in the kernel), the
+linear modal one refuses them, and the frequency-domain steppers solve the equivalent-linear model at the
 elements' amplitudes (:mod:`powertrain.solvers.equivalent_linear`). No stepper asks which
 element it holds.
 """
