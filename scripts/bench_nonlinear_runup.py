@@ -9,8 +9,10 @@ CPU time (``time.process_time``), best of ``--repeat``:
 * linear: the default engine, Newmark (auto: the modal recurrence; the dense kernel's time is
   printed too);
 * friction: every mount direction with Berg's element (40 N, x2 = 0.05 mm) in parallel,
-  Newmark (dense: Newton per step in the kernel), each speed started from the harmonic fixed
-  point with the friction on its steady loop; with the power amplitude law too (printed).
+  Newmark (auto: the modal recurrence with the port laws, Newton per step in the kernel,
+  outputs over the processed window only), each speed started from the harmonic fixed point
+  with the friction on its steady loop; with the power amplitude law too (printed: its
+  networks change scale cycle by cycle, so that run is dense).
 
 Last line: ``linear_s=... friction_s=... ratio=...``.
 """

@@ -26,7 +26,7 @@ from powertrain.physics.mount_elements import JenkinsFriction, PortForces
 from powertrain.solvers import equivalent_linear
 from powertrain.solvers.equivalent_linear import amplitude_fixed_point
 from powertrain.solvers.newmark import newmark_ports
-from powertrain.solvers.steppers import Cycles, DenseNewmarkStepper, choose_stepper
+from powertrain.solvers.steppers import Cycles, DenseNewmarkStepper, ModalPortStepper, choose_stepper
 from powertrain.workflows.runup import run_runup
 
 RPM = [1500.0, 3000.0, 5000.0]
@@ -97,11 +97,15 @@ def test_zero_slip_force_is_the_linear_model(engine):
     h_lin = run_runup(engine, RPM, solver="harmonic")
     h_nl = run_runup(free, RPM, solver="harmonic")
     n_lin = run_runup(engine, RPM, stepper="dense")
-    n_nl = run_runup(free, RPM)                          # auto: dense for a nonlinear model
-    assert "dense" in n_nl.settings["integrator"]
+    n_nl = run_runup(free, RPM, stepper="dense")
+    n_modal = run_runup(free, RPM)              # auto: modal with the port laws
+    assert "modal with the port laws" in n_modal.settings["integrator"]
     for name in ("velocity", "mount_force", "mean_mount_force"):   # the same arithmetic
         np.testing.assert_array_equal(getattr(h_nl, name), getattr(h_lin, name))
         np.testing.assert_array_equal(getattr(n_nl, name), getattr(n_lin, name))
+        # the modal recurrence starts from the acceleration of the equation of motion
+        x, y = getattr(n_modal, name), getattr(n_lin, name)
+        assert np.max(np.abs(x - y)) <= 1e-5 * np.max(np.abs(y)), name
 
 
 def test_friction_that_never_slips_is_its_spring_in_parallel(engine):
@@ -170,13 +174,14 @@ def test_friction_through_the_admittance_coupling(tmp_path, engine):
         assert np.max(np.abs(x - y)) <= 1e-6 * np.max(np.abs(x)), sig
 
 
-def test_modal_stepper_refuses_a_nonlinear_model_and_auto_picks_dense(engine):
+def test_modal_stepper_refuses_a_nonlinear_model_and_auto_picks_modal_ports(engine):
     b = engine.body
     system = assemble(b.mass, b.cg, b.inertia, with_law(engine, LAW).mounts)
     grid = Cycles(720, 1.0, 6, 2)
     with pytest.raises(ValueError, match="linear models only"):
         choose_stepper(system, "newmark", "modal", grid)
-    assert isinstance(choose_stepper(system, "newmark", "auto", grid), DenseNewmarkStepper)
+    assert isinstance(choose_stepper(system, "newmark", "auto", grid), ModalPortStepper)
+    assert isinstance(choose_stepper(system, "newmark", "dense", grid), DenseNewmarkStepper)
     linear = assemble(b.mass, b.cg, b.inertia, engine.mounts)
     assert linear.port_forces() is None
 

@@ -168,7 +168,7 @@ def test_modal_port_newmark_equals_the_dense_kernel(engine):
                                state=state.copy())
     dofs = np.arange(6)
     modal = ModalPortNewmark(ModalNewmark(system.M, system.C, system.K, load_dofs=6), ports,
-                             h, dofs)
+                             h, Wa=np.eye(system.n_dof)[dofs])
     v0 = np.zeros(system.n_dof)
     z = ports.forces(ports.rows @ x0, ports.rows @ v0, state)
     acc = modal.run(F[:, :6], modal.modal_state(x0, v0), z, state)

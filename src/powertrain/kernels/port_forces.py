@@ -180,32 +180,14 @@ def newmark_port_kernel(G, H, Fs, h, x0, v0, a0, W, P, Q, kinds, par, state, X, 
     diagonal first, :func:`_port_forces_step`), from the tangent at the previous step; the
     states are committed once it has converged.
 
-    Parameters
-    ----------
-    G, H, Fs, h, x0, v0, a0, X, V, A
-        As :func:`newmark_kernel`.
-    W : ndarray (n, m)
-        S^-1 P^T.
-    P : ndarray (m, n)
-        Port rows: relative displacement across each port law per unit coordinate.
-    Q : ndarray (m, m)
-        P S^-1 P^T.
-    kinds : ndarray int64 (m,)
-        Port-law codes.
-    par : ndarray (m, n_par)
-        Their parameters.
-    state : ndarray (m, n_state)
-        Their state, updated in place (the state after the last step).
-    Z : ndarray (n_steps + 1, m)
-        Output: port forces at every time point [N].
-    tol : float
-        Newton stops when every residual is below ``tol`` times (1 + the largest force).
-    max_iter : int
-
-    Returns
-    -------
-    int
-        Steps at which Newton did not converge (0 on success).
+    Arguments: ``G, H, Fs, h, x0, v0, a0, X, V, A`` as :func:`newmark_kernel`; ``W`` (n, m)
+    = S^-1 P^T; ``P`` (m, n) the port rows (relative displacement across each port law per
+    unit coordinate); ``Q`` (m, m) = P S^-1 P^T; ``kinds`` (m,) int64 the port-law codes,
+    ``par`` (m, n_par) their parameters, ``state`` (m, n_state) their state (updated in
+    place to the state after the last step); output ``Z`` (n_steps + 1, m) the port forces
+    at every time point [N]; Newton stops when every residual is below ``tol`` times (1 +
+    the largest force), or after ``max_iter`` iterations. Returns the number of steps at
+    which Newton did not converge (0 on success).
     """
     n = x0.shape[0]
     m = kinds.shape[0]
@@ -332,8 +314,7 @@ def _port_forces_step(kinds, par, state, ul, vl, Q, z, last, r, J, tol, max_iter
 
 @njit(cache=True, nogil=True)
 def _coupling(Qu, Qv):
-    """``(Qu, Qv, qa)`` of :func:`_port_forces_step`: ``qa`` (2, m) the row sums of
-    ``|Qu|``, ``|Qv|``."""
+    """``(Qu, Qv, qa)`` of :func:`_port_forces_step`: ``qa`` (2, m) row sums of |Qu|, |Qv|."""
     qa = np.zeros((2, Qu.shape[0]))
     for e in range(Qu.shape[0]):
         for j in range(Qu.shape[1]):
@@ -383,12 +364,12 @@ def _commit(kinds, par, state, last, f):
 
 
 @njit(cache=True, nogil=True, fastmath=True, inline="always")
-def _read_rows(Rr, Ri, er, ei, out):
-    """``out = Re(R eta)`` for the rows of ``R`` (real and imaginary parts)."""
+def _read_rows(R, x, out):
+    """``out = R x``: rows of the modal state's real form (:func:`_advance`)."""
     for c in range(out.shape[0]):
         y = 0.0
-        for j in range(er.shape[0]):
-            y += Rr[c, j] * er[j] - Ri[c, j] * ei[j]
+        for j in range(x.shape[0]):
+            y += R[c, j] * x[j]
         out[c] = y
 
 
@@ -406,9 +387,57 @@ def _body_force(load_at, T, F, k, z, p):
             p[c] -= T[e, c] * ze
 
 
+@njit(cache=True, nogil=True, fastmath=True, inline="always")
+def _write_outputs(W, Wd, Wz, x, p, z, row):
+    """One row of outputs ``W x + Wd p + Wz z`` into ``row``."""
+    _read_rows(W, x, row)
+    for c in range(row.shape[0]):
+        o = row[c]
+        for d in range(p.shape[0]):
+            o += Wd[c, d] * p[d]
+        for e in range(z.shape[0]):
+            o += Wz[c, e] * z[e]
+        row[c] = o
+
+
+@njit(cache=True, nogil=True, fastmath=True, inline="always")
+def _linear_port_motions(R, D, T, x, s, y, ul, vl):
+    """Port motions ``ul``, ``vl`` (m,) without the step's new port forces: the reduced ones
+    ``y = R x + (Dx s; Dv s)`` (2 q,) through the port rows ``T``."""
+    Dx, Dv = D
+    q = Dx.shape[0]
+    _read_rows(R, x, y)
+    for c in range(q):
+        for d in range(q):
+            y[c] += Dx[c, d] * s[d]
+            y[q + c] += Dv[c, d] * s[d]
+    for e in range(ul.shape[0]):
+        ul[e] = _dot(T[e], y[:q])
+        vl[e] = _dot(T[e], y[q:])
+
+
+@njit(cache=True, nogil=True, fastmath=True, inline="always")
+def _advance(lam_d, G, s, x):
+    """The modal recurrence ``eta = lambda_d eta + G s`` in place, in real form: ``x`` holds
+    the real parts of the n modes, then the imaginary parts of the complex ones, which come
+    first (a real mode's is zero but for round-off); ``lam_d = (real parts (n,), imaginary
+    parts (n_c,))``."""
+    lr, li = lam_d
+    n = lr.shape[0]
+    for j in range(li.shape[0]):
+        a = lr[j] * x[j] - li[j] * x[n + j]
+        x[n + j] = lr[j] * x[n + j] + li[j] * x[j]
+        x[j] = a
+    for j in range(li.shape[0], n):
+        x[j] *= lr[j]
+    for c in range(s.shape[0]):
+        sc = s[c]
+        for j in range(x.shape[0]):
+            x[j] += G[c, j] * sc
+
+
 @njit(cache=True, nogil=True, fastmath=True)
-def modal_port_kernel(lam_d, G, R, Dx, Dv, Wd, T, load_at, Qu, Qv, F, eta, z, kinds, par,
-                      state, out, tol, max_iter):
+def modal_port_kernel(modal, outputs, ports, laws, F, x, z, out, tol, max_iter):
     r"""Newmark average acceleration with port laws in modal coordinates: the trapezoidal
     modal recurrence of the linear model (:class:`~powertrain.solvers.newmark.ModalNewmark`)
     :math:`\eta_{k+1} = \lambda_d\eta_k + \mathbf G(\mathbf p_k + \mathbf p_{k+1})`, the
@@ -418,35 +447,32 @@ def modal_port_kernel(lam_d, G, R, Dx, Dv, Wd, T, load_at, Qu, Qv, F, eta, z, ki
     :math:`\mathbf P = \mathbf T\,\partial\mathbf y/\partial\mathbf x`), and
     :math:`\mathbf G = \mathrm{diag}\gamma\,\Psi^{-1}[0; \mathbf M^{-1}]` on them.
 
-    Per step one pass over the modes reads :math:`\mathrm{Re}(\mathbf R\eta_k)`: the
-    outputs (their modal part) and the reduced motions of the step without the new port
+    Per step: the outputs :math:`\mathrm{Re}(\mathbf W\eta_k) + \mathbf W_d\mathbf p_k +
+    \mathbf W_z\mathbf z_k`; the reduced motions of the next step without its new port
     forces, :math:`\mathbf y^* = \mathrm{Re}(\Psi_y\lambda_d\eta_k) + \mathbf D_x\mathbf s`,
     :math:`\mathbf s = \mathbf p_k + \mathbf E\mathbf f_{k+1}`,
-    :math:`\mathbf D_x = \mathrm{Re}(\Psi_y\mathbf G)` (velocities alike with
-    :math:`\mathbf D_v`); the port motions are :math:`\mathbf u = \mathbf T\mathbf y^* -
-    \mathbf Q_u\mathbf z`, :math:`\mathbf Q_u = \mathbf T\mathbf D_x\mathbf T^T`
-    (:math:`= \tfrac{h^2}4\mathbf P\mathbf S^{-1}\mathbf P^T` of
-    :func:`newmark_port_kernel`), solved for :math:`\mathbf z` per step
-    (:func:`_port_forces_step`); a second pass updates :math:`\eta`.
-
-    Modal arrays split into real and imaginary parts: ``G`` (q, n_modes) (columns of the map
-    as rows), ``R`` (n_out + 2 q, n_modes): rows of the outputs, then
-    :math:`\Psi_y\lambda_d`, :math:`\Psi_{\dot y}\lambda_d`. Outputs ``out`` (n_rows,
-    n_out) at steps 0 .. n_rows - 1 of the loads ``F`` (n_rows + 1, n_load):
-    :math:`\mathrm{Re}(\mathbf W\eta) + \mathbf W_d\mathbf p`. ``eta`` (n_modes,)
-    complex and the port forces ``z`` (m,) are the state at step 0 on entry and at step
-    n_rows on return; ``state`` the port laws' (updated in place). Returns the number of
-    steps at which Newton did not converge.
+    :math:`\mathbf D_x = \mathrm{Re}(\Psi_y\mathbf G)` (velocities alike); the port motions
+    :math:`\mathbf u = \mathbf T\mathbf y^* - \mathbf Q_u\mathbf z`, :math:`\mathbf Q_u =
+    \mathbf T\mathbf D_x\mathbf T^T` (the :math:`\tfrac{h^2}4\mathbf P\mathbf S^{-1}\mathbf
+    P^T` of :func:`newmark_port_kernel`), solved for :math:`\mathbf z`
+    (:func:`_port_forces_step`); then the recurrence. Arguments (modal arrays in the real
+    form of :func:`_advance`, n_x columns): ``modal = (lam_d, G, R, (Dx, Dv))``, ``G``
+    (q, n_x) (the map's columns as rows), ``R`` (2 q, n_x) the rows reading
+    :math:`\mathrm{Re}(\Psi_y\lambda_d\eta)`, :math:`\mathrm{Re}(\Psi_{\dot
+    y}\lambda_d\eta)`; ``outputs = (W, Wd, Wz)`` (n_out rows), ``out``
+    (n_rows, n_out) gets them at steps 0 .. n_rows - 1 of the loads ``F`` (n_rows + 1,
+    n_load); ``ports = (T, load_at, Qu, Qv)``, ``laws = (kinds, par, state)``. The modal
+    state ``x`` (n_x,) and the port forces ``z`` (m,) are the state at step 0 on entry and
+    at step n_rows on return, ``state`` is updated in place. Returns the number of steps at
+    which Newton did not converge.
     """
-    Gr, Gi = G
-    Rr, Ri = R
-    n_modes = eta.shape[0]
+    lam_d, G, R, D = modal
+    W, Wd, Wz = outputs
+    T, load_at, Qu, Qv = ports
+    kinds, par, state = laws
     m = z.shape[0]
-    q = Dx.shape[0]
-    n_out = out.shape[1]
-    lr, li = lam_d.real.copy(), lam_d.imag.copy()
-    er, ei = eta.real.copy(), eta.imag.copy()
-    y = np.empty(Rr.shape[0])
+    q = T.shape[1]
+    y = np.empty(2 * q)
     p, p_next, s = np.empty(q), np.empty(q), np.empty(q)
     ul, vl, r = np.empty(m), np.empty(m), np.empty(m)
     J = np.empty((m, m))
@@ -455,28 +481,12 @@ def modal_port_kernel(lam_d, G, R, Dx, Dv, Wd, T, load_at, Qu, Qv, F, eta, z, ki
     _body_force(load_at, T, F, 0, z, p)
     failed = 0
     for k in range(out.shape[0]):
-        _read_rows(Rr, Ri, er, ei, y)
-        for c in range(n_out):
-            o = y[c]
-            for d in range(q):
-                o += Wd[c, d] * p[d]
-            out[k, c] = o
+        _write_outputs(W, Wd, Wz, x, p, z, out[k])
         for c in range(q):
             s[c] = p[c]
         for c in range(F.shape[1]):
             s[load_at[c]] += F[k + 1, c]
-        for c in range(q):
-            for d in range(q):
-                y[n_out + c] += Dx[c, d] * s[d]
-                y[n_out + q + c] += Dv[c, d] * s[d]
-        for e in range(m):
-            su = 0.0
-            sv = 0.0
-            for c in range(q):
-                su += T[e, c] * y[n_out + c]
-                sv += T[e, c] * y[n_out + q + c]
-            ul[e] = su
-            vl[e] = sv
+        _linear_port_motions(R, D, T, x, s, y, ul, vl)
         if not _port_forces_step(kinds, par, state, ul, vl, coupled, z, last, r, J, tol,
                                  max_iter):
             failed += 1
@@ -484,15 +494,6 @@ def modal_port_kernel(lam_d, G, R, Dx, Dv, Wd, T, load_at, Qu, Qv, F, eta, z, ki
         for c in range(q):
             s[c] = p[c] + p_next[c]
             p[c] = p_next[c]
-        for j in range(n_modes):
-            a = lr[j] * er[j] - li[j] * ei[j]
-            ei[j] = lr[j] * ei[j] + li[j] * er[j]
-            er[j] = a
-        for c in range(q):
-            sc = s[c]
-            for j in range(n_modes):
-                er[j] += Gr[c, j] * sc
-                ei[j] += Gi[c, j] * sc
-    for j in range(n_modes):
-        eta[j] = er[j] + 1j * ei[j]
+        _advance(lam_d, G, s, x)
     return failed
+

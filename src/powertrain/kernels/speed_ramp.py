@@ -42,68 +42,59 @@ def ramp_loads(table, speed0, speed_step, rpm_from, rate, h, k0, out):
         ramp_load(table, speed0, speed_step, rpm_from, rate, h, k0 + r, out[r])
 
 
-@njit(cache=True, nogil=True, fastmath=True)
-def _modal_load(map_re, map_im, f, g_re, g_im):
-    """Modal load ``g = map f`` of the load ``f`` (6,), as real and imaginary parts."""
-    for j in range(g_re.shape[0]):
-        g_re[j] = 0.0
-        g_im[j] = 0.0
+@njit(cache=True, nogil=True, fastmath=True, inline="always")
+def _modal_load(load_map, f, g):
+    """Modal load ``g = map f`` (real form) of the load ``f`` (6,)."""
+    for j in range(g.shape[0]):
+        g[j] = 0.0
     for c in range(6):
         fc = f[c]
-        mr = map_re[c]
-        mi = map_im[c]
-        for j in range(g_re.shape[0]):
-            g_re[j] += mr[j] * fc
-            g_im[j] += mi[j] * fc
+        row = load_map[c]
+        for j in range(g.shape[0]):
+            g[j] += row[j] * fc
 
 
 @njit(cache=True, nogil=True, fastmath=True)
-def modal_ramp_kernel(lam_d, gain, load_map, w_re, w_im, w_load, table, speed0, speed_step,
-                      rpm_from, rate, h, k0, eta, out):
+def modal_ramp_kernel(lam_d, load_map, w, w_load, table, speed0, speed_step, rpm_from, rate,
+                      h, k0, x, out):
     r"""Channel outputs ``out`` (n_rows, n_ch) at steps ``k0 .. k0 + n_rows - 1`` of the
-    modal recurrence :math:`\eta_{k+1} = \lambda_d\eta_k + \gamma(g_k + g_{k+1})`,
-    :math:`g = ` ``load_map`` :math:`\cdot f` (:func:`modal_trapezoid_kernel` of
-    :mod:`powertrain.kernels.newmark`), output
-    :math:`y = \mathrm{Re}(\eta)W_{re} - \mathrm{Im}(\eta)W_{im} + W_{load}f`; the modal
-    arrays split into real and imaginary parts so that the loops over the modes vectorise.
+    modal recurrence :math:`\eta_{k+1} = \lambda_d\eta_k + g_k + g_{k+1}`,
+    :math:`g = ` ``load_map`` :math:`\cdot f` (the gain folded in:
+    :func:`modal_trapezoid_kernel` of :mod:`powertrain.kernels.newmark`), output
+    :math:`y = \mathrm{Re}(W\eta) + W_{load}f`. The modal state and arrays are in real
+    form: the real parts of the n modes, then the imaginary parts of the complex ones, which
+    come first (a real mode's is zero but for round-off), so that every loop over the modes
+    is one plain loop: ``x`` (n_x,), ``load_map`` (6, n_x), ``w`` (n_ch, n_x) (the rows
+    reading the real part), ``lam_d = (real parts (n,), imaginary parts (n_c,))``.
 
-    ``eta`` (m,) complex is the state at step ``k0`` on entry and at ``k0 + n_rows`` on
-    return.
+    ``x`` is the state at step ``k0`` on entry and at ``k0 + n_rows`` on return.
     """
-    m = eta.shape[0]
-    n_ch = out.shape[1]
-    map_re = np.ascontiguousarray(load_map.real.T)
-    map_im = np.ascontiguousarray(load_map.imag.T)
-    wr = np.ascontiguousarray(w_re.T)
-    wi = np.ascontiguousarray(w_im.T)
-    lr, li, gr, gi = lam_d.real.copy(), lam_d.imag.copy(), gain.real.copy(), gain.imag.copy()
-    er, ei = eta.real.copy(), eta.imag.copy()
+    lr, li = lam_d
+    n = lr.shape[0]
     f = np.empty(6)
-    g_re, g_im, n_re, n_im = np.empty(m), np.empty(m), np.empty(m), np.empty(m)
+    g, g_next = np.empty(x.shape[0]), np.empty(x.shape[0])
     ramp_load(table, speed0, speed_step, rpm_from, rate, h, k0, f)
-    _modal_load(map_re, map_im, f, g_re, g_im)
+    _modal_load(load_map, f, g)
     for r in range(out.shape[0]):
-        for c in range(n_ch):
+        for c in range(out.shape[1]):
             y = 0.0
             for q in range(6):
                 y += w_load[c, q] * f[q]
-            wrc = wr[c]
-            wic = wi[c]
-            for j in range(m):
-                y += er[j] * wrc[j] - ei[j] * wic[j]
+            wc = w[c]
+            for j in range(x.shape[0]):
+                y += wc[j] * x[j]
             out[r, c] = y
         ramp_load(table, speed0, speed_step, rpm_from, rate, h, k0 + r + 1, f)
-        _modal_load(map_re, map_im, f, n_re, n_im)
-        for j in range(m):
-            sr = g_re[j] + n_re[j]
-            si = g_im[j] + n_im[j]
-            a = lr[j] * er[j] - li[j] * ei[j] + gr[j] * sr - gi[j] * si
-            ei[j] = lr[j] * ei[j] + li[j] * er[j] + gr[j] * si + gi[j] * sr
-            er[j] = a
-            g_re[j] = n_re[j]
-            g_im[j] = n_im[j]
-    for j in range(m):
-        eta[j] = er[j] + 1j * ei[j]
+        _modal_load(load_map, f, g_next)
+        for j in range(li.shape[0]):
+            a = lr[j] * x[j] - li[j] * x[n + j]
+            x[n + j] = lr[j] * x[n + j] + li[j] * x[j]
+            x[j] = a
+        for j in range(li.shape[0], n):
+            x[j] *= lr[j]
+        for j in range(x.shape[0]):
+            x[j] += g[j] + g_next[j]
+            g[j] = g_next[j]
 
 
 @njit(cache=True, nogil=True, fastmath=True)

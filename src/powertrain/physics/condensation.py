@@ -26,6 +26,8 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
+from powertrain.physics.mount_elements import describing_stiffnesses
+
 
 @dataclass(frozen=True)
 class NetworkPorts:
@@ -66,9 +68,11 @@ def two_ports(ports: NetworkPorts, s, internal=False, amplitudes=None):
     s = np.asarray(s, complex)
     abc = [np.empty(s.shape + (len(ports.elements),), complex) for _ in range(3)]
     shapes = []
+    amplitudes = np.zeros(len(ports.elements)) if amplitudes is None else amplitudes
+    describing = [None] * len(ports.elements) if any(np.ndim(a) for a in amplitudes) \
+        else describing_stiffnesses(ports.elements, amplitudes)
     for k, element in enumerate(ports.elements):
-        res = element.two_port(s, 0.0 if amplitudes is None else amplitudes[k],
-                               internal=internal)
+        res = element.two_port(s, amplitudes[k], internal=internal, describing=describing[k])
         for j in range(3):
             abc[j][..., k] = res[j]
         if internal:

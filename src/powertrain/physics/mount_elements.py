@@ -95,6 +95,22 @@ class JenkinsFriction:
         return np.where(delta >= 1.0, k + 0j, slip)
 
 
+def describing_stiffnesses(elements, amplitudes) -> list:
+    """Each element's port-law describing stiffness at its amplitude (scalars [m]; None
+    for an element without a port law), one vectorised call per distinct law (the
+    equivalent-linear fixed point asks for every element at every iteration)."""
+    out = [None] * len(elements)
+    groups = {}
+    for k, el in enumerate(elements):
+        if el.port_law is not None:
+            groups.setdefault(el.port_law, []).append(k)
+    for law, index in groups.items():
+        values = law.describing_stiffness(np.array([amplitudes[k] for k in index], float))
+        for k, value in zip(index, values):
+            out[k] = value
+    return out
+
+
 @dataclass(frozen=True, eq=False)
 class MountElement:
     """One mount direction: a linear network, scaled by its amplitude law and its static
@@ -159,12 +175,14 @@ class MountElement:
         them)."""
         return network_matrices(*self.network(amplitude), include_ground=include_ground)
 
-    def two_port(self, s, amplitude=0.0, internal=False):
+    def two_port(self, s, amplitude=0.0, internal=False, describing=None):
         """Equivalent-linear two-port ``(a, b, c)`` at the Laplace variable ``s`` and the
         relative-displacement amplitude [m] (and the internal motions when ``internal``, see
         :func:`powertrain.physics.mount_network.laplace_two_port`; a port law moves no
         internal node). ``amplitude`` may be an array that broadcasts to ``s`` (one
-        amplitude per speed of a run-up, :mod:`powertrain.solvers.fast_harmonic`)."""
+        amplitude per speed of a run-up, :mod:`powertrain.solvers.fast_harmonic`).
+        ``describing``: the port law's describing stiffness at the amplitude when the caller
+        has it (:func:`describing_stiffnesses`)."""
         lam = np.asarray(s, complex)
         if np.ndim(amplitude) == 0:
             res = laplace_two_port(lam, *self.network(amplitude), internal=internal)
@@ -176,7 +194,9 @@ class MountElement:
                                    self.static_factor * ds, internal=internal)
         if self.port_law is None:
             return res
-        k = np.where(lam == 0, 0.0, self.port_law.describing_stiffness(amplitude))
+        if describing is None:
+            describing = self.port_law.describing_stiffness(amplitude)
+        k = np.where(lam == 0, 0.0, describing)
         return (res[0] + k, res[1] - k, res[2] + k) + res[3:]
 
 

@@ -50,6 +50,9 @@ class NetworkScaling:
         self.C_parts, self.K_parts, self.gk, self.gd = system.network_parts()
         #: the scales the assembled matrices hold (every element at amplitude 0)
         self.assembled = self.scales(np.zeros(len(self.elements)))
+        #: True when some network's scale follows its amplitude
+        self.varying = any(el.amplitude_law is not None and not el.amplitude_law.constant
+                           for el in self.elements)
 
     def elements_at(self, factors=None) -> list:
         """The elements at the operating point of the static ``factors`` (n_net,) (None:
@@ -190,9 +193,7 @@ class CycleIntegrator:
     def __init__(self, scaling, ports, h, mean):
         self.scaling, self.ports, self.h, self.mean = scaling, ports, h, mean
         self.laws = ports.select(ports.kinds != NONE)
-        #: True when some network's scale follows its amplitude
-        self.varying = any(el.amplitude_law is not None and not el.amplitude_law.constant
-                           for el in scaling.elements)
+        self.varying = scaling.varying
         self._first = None
 
     def run(self, F, start, amplitudes, state, factors=None):

@@ -214,12 +214,25 @@ class ModalNewmark:
         if not np.isclose(2 * np.count_nonzero(lam.imag > 0) + np.count_nonzero(real_mode),
                           lam.size):
             raise np.linalg.LinAlgError("eigenvalues not in conjugate pairs")
-        weight = np.where(real_mode[keep], 1.0, 2.0)
+        # the kept modes, complex ones first (:meth:`real_form`)
+        order = np.r_[np.flatnonzero(keep & ~real_mode), np.flatnonzero(real_mode)]
+        #: kept modes with a complex eigenvalue (the first ones)
+        self.n_complex = int(np.count_nonzero(keep & ~real_mode))
+        weight = np.where(real_mode[order], 1.0, 2.0)
         self._work = threading.local()   # per-thread output buffers, see run_outputs
-        self.lam_r = lam[keep]
-        self.Psi_r = Psi[:, keep] * weight[None, :]
-        self.Psi_inv_r = self.Psi_inv[keep]
-        self.load_map_r = self.load_map[keep]
+        self.lam_r = lam[order]
+        self.Psi_r = Psi[:, order] * weight[None, :]
+        self.Psi_inv_r = self.Psi_inv[order]
+        self.load_map_r = self.load_map[order]
+
+    def real_form(self, a) -> np.ndarray:
+        """``a`` (..., kept modes) complex in the kernels' real form: the real parts, then
+        the imaginary parts of the complex modes (a real mode's is zero but for round-off),
+        contiguous (:func:`powertrain.kernels.port_forces._advance`). A row ``r`` read as
+        ``Re(r eta)`` is ``real_form(conj(r))``."""
+        a = np.asarray(a)
+        return np.ascontiguousarray(np.concatenate([a.real, a.imag[..., :self.n_complex]],
+                                                   axis=-1))
 
     def run(self, F, h, x0, v0, keep_from=0):
         """Integrate with the load ``F`` (n_steps + 1, load_dofs) [N] from (x0, v0).
@@ -318,7 +331,8 @@ class ModalPortNewmark:
     tests/test_time_domain_laws.py). The recurrence is written on the reduced coordinates
     the load and the port rows touch (the body's six: a port row is a rigid body's motion at
     a mount): the port motions are read from their motions, the port forces act through
-    their generalized force. Outputs: the accelerations of the coordinates ``dofs``.
+    their generalized force. Outputs: ``y = Wx x + Wv v + Wa a + Wz z`` (rows over the
+    coordinates, and over the port forces for ``Wz``; None: no such term).
 
     Parameters
     ----------
@@ -327,39 +341,61 @@ class ModalPortNewmark:
         The port laws (every row with a law; ``ports.select(ports.kinds != NONE)``).
     h : float
         Time step [s].
-    dofs : ndarray of int
-        Coordinates whose accelerations are returned.
+    Wx, Wv, Wa : ndarray (n_out, n), optional
+    Wz : ndarray (n_out, m), optional
     """
 
-    def __init__(self, modal, ports, h, dofs):
+    def __init__(self, modal, ports, h, Wx=None, Wv=None, Wa=None, Wz=None):
         n = modal.n
         self.modal, self.ports, self.h = modal, ports, float(h)
         P = np.asarray(ports.rows, float)
-        reduced = np.union1d(np.arange(modal.load_dofs), np.flatnonzero(np.any(P != 0, 0)))
-        T = P[:, reduced]
+        self.reduced = np.union1d(np.arange(modal.load_dofs),
+                                  np.flatnonzero(np.any(P != 0, 0)))
+        T = P[:, self.reduced]
         lam = modal.lam_r
         lam_d = (1 + 0.5 * h * lam) / (1 - 0.5 * h * lam)
         G = ((0.5 * h) / (1 - 0.5 * h * lam))[:, None] * (
-            modal.Psi_inv_r[:, n:] @ modal.Minv[:, reduced])                # (n_modes, q)
-        Py, Pv = modal.Psi_r[reduced], modal.Psi_r[n + reduced]
-        read = np.eye(n)[np.asarray(dofs, int)]
-        Wa = read @ (modal.Psi_r[n:] * lam[None, :])
+            modal.Psi_inv_r[:, n:] @ modal.Minv[:, self.reduced])           # (n_modes, q)
+        Py, Pv = modal.Psi_r[self.reduced], modal.Psi_r[n + self.reduced]
         Dx, Dv = (G.T @ Py.T).real.T, (G.T @ Pv.T).real.T
-        self.lam_d = lam_d
-        self.arrays = (_parts(G.T), _parts(np.vstack([Wa, Py * lam_d, Pv * lam_d])),
-                       np.ascontiguousarray(Dx), np.ascontiguousarray(Dv),
-                       np.ascontiguousarray(read @ modal.Minv[:, reduced]),
-                       np.ascontiguousarray(T),
-                       np.searchsorted(reduced, np.arange(modal.load_dofs)).astype(np.int64),
-                       np.ascontiguousarray(T @ Dx @ T.T), np.ascontiguousarray(T @ Dv @ T.T))
+        self.modal_arrays = ((lam_d.real.copy(), lam_d.imag[:modal.n_complex].copy()),
+                             modal.real_form(G.T),
+                             modal.real_form(np.conj(np.vstack([Py * lam_d, Pv * lam_d]))),
+                             (np.ascontiguousarray(Dx), np.ascontiguousarray(Dv)))
+        self.port_arrays = (np.ascontiguousarray(T), np.searchsorted(
+            self.reduced, np.arange(modal.load_dofs)).astype(np.int64),
+            np.ascontiguousarray(T @ Dx @ T.T), np.ascontiguousarray(T @ Dv @ T.T))
+        self.outputs = self._output_arrays(Wx, Wv, Wa, Wz)
+        self.silent = self._output_arrays(np.zeros((0, n)))
+
+    def _output_arrays(self, Wx=None, Wv=None, Wa=None, Wz=None):
+        """``(W, Wd, Wz)`` of :func:`modal_port_kernel` for the output rows: ``Re(W eta)``
+        the modal part, ``Wd`` the direct part of the acceleration (a = M^-1 (p - C v -
+        K x) on the reduced coordinates)."""
+        modal, n, m = self.modal, self.modal.n, self.ports.kinds.size
+        rows = next(w.shape[0] for w in (Wx, Wv, Wa, Wz) if w is not None)
+        W = np.zeros((rows, self.modal.lam_r.size), complex)
+        Wd = np.zeros((rows, self.reduced.size))
+        if Wx is not None:
+            W += np.asarray(Wx, float) @ modal.Psi_r[:n]
+        if Wv is not None:
+            W += np.asarray(Wv, float) @ modal.Psi_r[n:]
+        if Wa is not None:
+            W += np.asarray(Wa, float) @ (modal.Psi_r[n:] * modal.lam_r[None, :])
+            Wd = np.asarray(Wa, float) @ modal.Minv[:, self.reduced]
+        Wz = np.zeros((rows, m)) if Wz is None else np.asarray(Wz, float)
+        return (modal.real_form(np.conj(W)), np.ascontiguousarray(Wd),
+                np.ascontiguousarray(Wz))
 
     def modal_state(self, x, v) -> np.ndarray:
-        """Modal coordinates (n_modes,) complex of the state ``(x, v)``."""
-        return self.modal.Psi_inv_r @ np.concatenate([x, v]).astype(complex)
+        """Modal coordinates of the state ``(x, v)`` in the kernel's real form
+        (:meth:`ModalNewmark.real_form`)."""
+        return self.modal.real_form(self.modal.Psi_inv_r @ np.concatenate([x, v]))
 
-    def run(self, F, eta, z, state) -> np.ndarray:
-        """Accelerations (n_rows, n_read) at steps 0 .. n_rows - 1 of the loads ``F``
-        (n_rows + 1, load_dofs) [N]; ``eta``, the port forces ``z`` (m,) [N] and the laws'
+    def run(self, F, eta, z, state, outputs=True) -> np.ndarray:
+        """Outputs (n_rows, n_out) at steps 0 .. n_rows - 1 of the loads ``F``
+        (n_rows + 1, load_dofs) [N] (``outputs`` False: none, (n_rows, 0)); the modal state
+        ``eta`` (:meth:`modal_state`), the port forces ``z`` (m,) [N] and the laws'
         ``state`` are the state at step 0 and are updated in place to step n_rows.
 
         Raises
@@ -367,16 +403,14 @@ class ModalPortNewmark:
         FloatingPointError
             Newton did not converge at some step (the names of the port laws are given).
         """
-        out = np.empty((F.shape[0] - 1, self.arrays[4].shape[0]))
-        failed = modal_port_kernel(self.lam_d, *self.arrays, np.ascontiguousarray(F, float),
-                                   eta, z, self.ports.kinds, self.ports.parameters, state, out,
-                                   PORT_TOL, PORT_MAX_ITER)
+        arrays = self.outputs if outputs else self.silent
+        out = np.empty((F.shape[0] - 1, arrays[1].shape[0]))
+        laws = (self.ports.kinds, self.ports.parameters, state)
+        failed = modal_port_kernel(self.modal_arrays, arrays, self.port_arrays, laws,
+                                   np.ascontiguousarray(F, float), eta, z, out, PORT_TOL,
+                                   PORT_MAX_ITER)
         if failed:
             raise FloatingPointError(f"port laws {', '.join(self.ports.names)}: Newton did "
                                      f"not converge at {failed} of {out.shape[0]} steps")
         return out
 
-
-def _parts(a):
-    """Real and imaginary parts of ``a`` as contiguous arrays (the kernels' modal form)."""
-    return np.ascontiguousarray(a.real), np.ascontiguousarray(a.imag)

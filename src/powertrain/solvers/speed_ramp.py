@@ -61,18 +61,17 @@ def _load_table(engine, rpm_from, rpm_to):
     return speeds, table, n_theta
 
 
-def _load_at(speeds, table, n_theta, rpm, theta):
-    """Bilinear interpolation of the load table at speeds ``rpm`` and angles ``theta``."""
-    u = (np.mod(theta, 4 * np.pi)) * (n_theta / (4 * np.pi))
-    i = np.minimum(u.astype(np.int64), n_theta - 1)
-    fu = (u - i)[:, None]
-    v = np.clip((rpm - speeds[0]) / LOAD_RPM_STEP, 0, speeds.size - 1 - 1e-12)
-    k = v.astype(np.int64)
-    fv = (v - k)[:, None]
-    k1 = np.minimum(k + 1, speeds.size - 1)
-    a = table[k, i] * (1 - fu) + table[k, i + 1] * fu
-    b = table[k1, i] * (1 - fu) + table[k1, i + 1] * fu
-    return a * (1 - fv) + b * fv
+def _ramp_rows(load, ramp, lo, rows):
+    """Loads (rows, 6) [N] of the ramp ``(rpm_from, rate, h, steps)`` at steps ``lo ..
+    lo + rows - 1``, bilinear in the load table
+    (:func:`powertrain.kernels.speed_ramp.ramp_loads`)."""
+    from powertrain.kernels.speed_ramp import ramp_loads
+    speeds, table, _ = load
+    rpm_from, rate, h, _ = ramp
+    F = np.empty((rows, 6))
+    ramp_loads(np.ascontiguousarray(table), float(speeds[0]), LOAD_RPM_STEP, float(rpm_from),
+               float(rate), float(h), lo, F)
+    return F
 
 
 def simulate_sweep(engine, rpm_from, rpm_to, rate_rpm_per_s, sample_rate=8192.0, *,
@@ -192,21 +191,24 @@ def _integrate(modal, dofs, load, ramp, eta, decimator, progress):
     read = np.eye(modal.n)[dofs]
     Z = np.zeros_like(read)
     (w_re, w_im), w_load = modal.output_map(Z, Z, read)
-    lam_d = (1 + 0.5 * h * modal.lam_r) / (1 - 0.5 * h * modal.lam_r)
-    gain = (0.5 * h) / (1 - 0.5 * h * modal.lam_r)
+    lam = modal.lam_r
+    lam_d = (1 + 0.5 * h * lam) / (1 - 0.5 * h * lam)
+    gain = (0.5 * h) / (1 - 0.5 * h * lam)
     chunk = CHUNK_OUT * decimator.m         # a multiple of m keeps the decimation aligned
     starts = range(0, n_steps, chunk)
     if progress:
         from tqdm import tqdm
         starts = tqdm(starts, desc="sweep", unit="chunk", leave=False, disable=None)
-    eta = np.ascontiguousarray(eta, complex)
-    arrays = (lam_d, gain, np.ascontiguousarray(modal.load_map_r), w_re, w_im,
-              np.ascontiguousarray(w_load), np.ascontiguousarray(table))
+    x = modal.real_form(eta)
+    arrays = ((lam_d.real.copy(), lam_d.imag[:modal.n_complex].copy()),
+              modal.real_form((gain[:, None] * modal.load_map_r).T),
+              modal.real_form(w_re.T - 1j * w_im.T), np.ascontiguousarray(w_load),
+              np.ascontiguousarray(table))
     outputs = []
     for s in starts:
         acc = np.empty((min(s + chunk, n_steps) - s, w_re.shape[1]))
         modal_ramp_kernel(*arrays, float(speeds[0]), LOAD_RPM_STEP, float(rpm_from),
-                          float(rate_rpm_per_s), float(h), s, eta, acc)
+                          float(rate_rpm_per_s), float(h), s, x, acc)
         outputs.append(decimator.push(acc))
     return np.concatenate(outputs)
 
@@ -240,11 +242,9 @@ def _integrate_nonlinear(engine, system, load, ramp, dofs, decimator, static_fac
     bounds = _cycle_bounds(rpm_from, rate, h, n_steps)
     rows = _Rows(decimator)
     for lo, hi in zip(bounds[:-1], bounds[1:]):
-        t = np.arange(lo, hi + 1) * h
-        F = np.zeros((t.size, system.n_dof))
-        F[:, :6] = _load_at(*load, rpm_from + rate * t,
-                            (np.pi / 30.0) * (rpm_from * t + 0.5 * rate * t * t))
-        factors = stepper.factors_at((rpm_from + rate * t.mean()) * np.pi / 30.0)
+        F = np.zeros((hi + 1 - lo, system.n_dof))
+        F[:, :6] = _ramp_rows(load, ramp, lo, hi + 1 - lo)
+        factors = stepper.factors_at((rpm_from + rate * 0.5 * (lo + hi) * h) * np.pi / 30.0)
         (X, V, A, _), _ = integrator.run(F, x[:3], amplitudes, state, factors)
         rows.push(A[:-1, dofs])
         amplitudes = cycle_amplitudes(X[:-1] @ stepper.ports.rows.T)
@@ -258,23 +258,19 @@ def _integrate_ports(integrator, load, ramp, start, dofs, decimator):
     Newmark with the port forces, Newton per step, chunk by chunk
     (:class:`~powertrain.solvers.newmark.ModalPortNewmark`), from ``start`` = (state
     ``(x0, v0, a0, mean)``, port-law states, amplitudes)."""
-    from powertrain.kernels.speed_ramp import ramp_loads
     from powertrain.solvers.newmark import ModalNewmark, ModalPortNewmark
-    rpm_from, rate, h, n_steps = ramp
-    speeds, table, _ = load
-    table = np.ascontiguousarray(table)
+    _, _, h, n_steps = ramp
     (x0, v0, *_), state, amplitudes = start
     s, laws = integrator.scaling, integrator.laws
     C, K, _, _ = s.matrices(s.scales(integrator.ports.network_amplitudes(amplitudes)))
-    run = ModalPortNewmark(ModalNewmark(s.system.M, C, K, load_dofs=6), laws, h, dofs)
+    run = ModalPortNewmark(ModalNewmark(s.system.M, C, K, load_dofs=6), laws, h,
+                           Wa=np.eye(C.shape[0])[dofs])
     eta = run.modal_state(x0, v0)
     z = laws.forces(laws.rows @ x0, laws.rows @ v0, state)
     chunk = CHUNK_OUT * decimator.m         # a multiple of m keeps the decimation aligned
     outputs = []
     for lo in range(0, n_steps, chunk):
-        F = np.empty((min(lo + chunk, n_steps) + 1 - lo, 6))
-        ramp_loads(table, float(speeds[0]), LOAD_RPM_STEP, float(rpm_from), float(rate),
-                   float(h), lo, F)
+        F = _ramp_rows(load, ramp, lo, min(lo + chunk, n_steps) + 1 - lo)
         outputs.append(decimator.push(run.run(F, eta, z, state)))
     return np.concatenate(outputs)
 

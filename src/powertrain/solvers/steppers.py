@@ -1,7 +1,7 @@
 r"""The run-up's per-speed solvers behind one protocol, chosen once per run.
 
 A :class:`Stepper` turns one speed's load over an engine cycle into the order amplitudes of
-every channel (:class:`SpeedOrders`). Four implement it:
+every channel (:class:`SpeedOrders`). Five implement it:
 
 * :class:`HarmonicStepper` — the frequency-domain steady state order by order through the one
   condensation (:func:`powertrain.solvers.harmonic.harmonic_response`);
@@ -9,14 +9,16 @@ every channel (:class:`SpeedOrders`). Four implement it:
   admittance (:func:`powertrain.solvers.admittance.frf_response`);
 * :class:`ModalNewmarkStepper` — Newmark average acceleration, the recurrence diagonalised
   once per model (:class:`powertrain.solvers.newmark.ModalNewmark`);
-* :class:`DenseNewmarkStepper` — the same recurrence in physical coordinates (Numba kernel).
+* :class:`DenseNewmarkStepper` — the same recurrence in physical coordinates (Numba kernel);
+* :class:`ModalPortStepper` — the modal recurrence with the port laws, Newton per step
+  (:class:`powertrain.solvers.newmark.ModalPortNewmark`), for networks of constant scale.
 
 :func:`choose_stepper` picks one from the solver and stepper names and the chassis (which
 says whether it can be integrated in time). A time stepper sees the assembled model through
 ``system.M``, ``C``, ``K``, its output rows and, when some mount element is nonlinear, the
 elements' port laws (``system.port_forces()``, :mod:`powertrain.physics.mount_elements`):
-the dense Newmark stepper integrates them (Newton per step in the kernel), the modal one
-refuses them, and the frequency-domain steppers solve the equivalent-linear model at the
+the Newmark steppers with port laws integrate them (Newton per step in the kernel), the
+linear modal one refuses them, and the frequency-domain steppers solve the equivalent-linear model at the
 elements' amplitudes (:mod:`powertrain.solvers.equivalent_linear`). No stepper asks which
 element it holds.
 """
@@ -34,7 +36,7 @@ from powertrain.kernels.port_forces import NONE
 from powertrain.solvers.cycle_newmark import CycleRun, NetworkScaling, run_cycles, start_state
 from powertrain.solvers.equivalent_linear import AMPLITUDE_HARMONICS, TOLERANCE, amplitude_fixed_point
 from powertrain.solvers.harmonic import harmonic_response
-from powertrain.solvers.newmark import ModalNewmark, newmark
+from powertrain.solvers.newmark import ModalNewmark, ModalPortNewmark, newmark
 
 #: Relative tolerance of the equivalent-linear fixed point a nonlinear Newmark run starts
 #: from (its amplitudes differ from the time domain's own by more: the harmonics above
@@ -286,7 +288,6 @@ class DenseNewmarkStepper(_NewmarkStepper):
 
     def solve(self, load, omega) -> SpeedOrders:
         t0 = time.perf_counter()
-        g = self.grid
         factors = self.factors_at(omega)
         s = self.system_at(factors)
         fh, omegas = self.harmonics(load, omega, INITIAL_STATE_MAX_ORDER)
@@ -295,23 +296,32 @@ class DenseNewmarkStepper(_NewmarkStepper):
         x0 = qh.real.sum(axis=0)
         v0 = (1j * omegas[:, None] * qh).real.sum(axis=0)
         a0 = (-(omegas ** 2)[:, None] * qh).real.sum(axis=0)
+        h = np.deg2rad(self.grid.angle_step_deg) / omega
+        out = self.channels(s, load, h, (x0, v0, a0, qh), amplitudes, factors)
+        seconds = time.perf_counter() - t0
+        return self.window_orders(*out, seconds)
+
+    def channels(self, s, load, h, start, amplitudes, factors):
+        """Channel displacement, velocity, acceleration and transmitted force over the
+        processed window and the velocity of the cycle before its last: the model ``s``
+        (at the static ``factors``) from ``start`` = (x0, v0, a0, harmonic response),
+        nonlinear elements cycle by cycle from the ``amplitudes``."""
+        g = self.grid
+        x0, v0, a0, qh = start
         F = np.zeros((g.cycles * g.n_cycle + 1, s.n_dof))
         F[:, :6] = np.concatenate([np.tile(load, (g.cycles, 1)), load[:1]])
-        h = np.deg2rad(g.angle_step_deg) / omega
         if self.ports is None:
             run = CycleRun(*newmark(s.M, s.C, s.K, F, h, x0, v0, a0), None,
                            [(slice(0, F.shape[0]), s.force_matrix_k, s.force_matrix_d, None)])
         else:
-            start = (x0, v0, a0, start_state(self.ports, qh, g.n_cycle), qh[0].real)
-            run = run_cycles(self.scaling, self.ports, F, h, g.n_cycle, start, amplitudes,
+            begin = (x0, v0, a0, start_state(self.ports, qh, g.n_cycle), qh[0].real)
+            run = run_cycles(self.scaling, self.ports, F, h, g.n_cycle, begin, amplitudes,
                              factors)
-        seconds = time.perf_counter() - t0
         n = g.n_cycle
-        win = slice(g.start, g.start + g.processed_cycles * n)
-        d_c, v_c, a_c, f_c = self._outputs(run, win)
+        d_c, v_c, a_c, f_c = self._outputs(run, slice(g.start, g.start + g.processed_cycles * n))
         v_prev = v_c[:n] if g.processed_cycles >= 2 else \
             self._outputs(run, slice(g.start - n, g.start))[1]
-        return self.window_orders(d_c, v_c, a_c, f_c, v_prev, seconds)
+        return d_c, v_c, a_c, f_c, v_prev
 
     def _outputs(self, run, win):
         """Channel displacement, velocity, acceleration and transmitted force over ``win``
@@ -328,13 +338,57 @@ class DenseNewmarkStepper(_NewmarkStepper):
         return q @ Cm.T, v @ Cm.T, a @ Cm.T, force
 
 
+class ModalPortStepper(DenseNewmarkStepper):
+    """A nonlinear model whose networks keep their scale (port laws, no amplitude law
+    that varies): the modal recurrence of the assembled model with the port laws, Newton
+    per step (:class:`~powertrain.solvers.newmark.ModalPortNewmark`), from the same harmonic
+    start as the dense stepper; outputs only over the processed window. Needs a regular mass
+    matrix, at least two processed cycles and no static-factor hook."""
+
+    implementation = "modal with the port laws (Newton per step)"
+
+    def __init__(self, system, grid: Cycles):
+        super().__init__(system, grid)
+        if grid.processed_cycles < 2 or self.ports is None or self.scaling.varying:
+            raise ValueError("the modal port stepper needs processed_cycles >= 2 and port "
+                             "laws on networks of constant scale")
+        t0 = time.perf_counter()
+        self.laws = self.ports.select(self.ports.kinds != NONE)
+        self.modal = ModalNewmark(system.M, system.C, system.K, load_dofs=6)
+        Cm, Z = system.channel_matrix, np.zeros_like(system.channel_matrix)
+        zf = np.zeros_like(self.laws.force_map)
+        self.rows = (np.vstack([Cm, Z, Z, system.force_matrix_k]),
+                     np.vstack([Z, Cm, Z, system.force_matrix_d]), np.vstack([Z, Z, Cm, Z]),
+                     np.vstack([zf, zf, zf, self.laws.force_map]))
+        self.setup_seconds = time.perf_counter() - t0
+
+    def channels(self, s, load, h, start, amplitudes, factors):
+        if factors is not None:              # a static-factor hook: networks rescaled
+            return super().channels(s, load, h, start, amplitudes, factors)
+        g = self.grid
+        x0, v0, _, qh = start
+        run = ModalPortNewmark(self.modal, self.laws, h, *self.rows)
+        state = start_state(self.ports, qh, g.n_cycle)
+        z = self.laws.forces(self.laws.rows @ x0, self.laws.rows @ v0, state)
+        eta = run.modal_state(x0, v0)
+        F = np.concatenate([np.tile(load, (g.cycles, 1)), load[:1]])
+        run.run(F[:g.start + 1], eta, z, state, outputs=False)
+        Y = run.run(F[g.start:], eta, z, state)
+        n_ch = len(self.system.channels)
+        d_c, v_c, a_c, f_c = (Y[:, k * n_ch:(k + 1) * n_ch] for k in range(4))
+        return d_c, v_c, a_c, f_c, v_c[:g.n_cycle]
+
+
 def _auto_newmark(system, grid):
-    if grid.processed_cycles < 2 or system.port_forces() is not None:
-        return DenseNewmarkStepper(system, grid)
-    try:
-        return ModalNewmarkStepper(system, grid)
-    except np.linalg.LinAlgError:
-        return DenseNewmarkStepper(system, grid)
+    kinds = [ModalNewmarkStepper, DenseNewmarkStepper]
+    if system.port_forces() is not None:
+        kinds[0] = ModalPortStepper
+    for kind in kinds:
+        try:
+            return kind(system, grid)
+        except (ValueError, np.linalg.LinAlgError):
+            pass
+    return DenseNewmarkStepper(system, grid)
 
 
 #: Newmark implementations by their ``--stepper`` name.
