@@ -19,11 +19,11 @@ between the engine-side node and the base node, acting on their relative displac
 A port law is an object with ``kind`` (its code in :mod:`powertrain.kernels.port_forces`),
 ``parameters()`` (float array), ``initial_state(u0, f0)`` (float array: the memory at the
 start, where the relative displacement is ``u0`` and the force expected from the
-equivalent-linear solution ``f0``), ``steady_state(amplitude)`` (the memory on its steady
-loop of that amplitude about 0, at the lower tip, moving up: where the displacement-driven
-test of :func:`powertrain.solvers.mount_time_domain.time_cross_point_stiffness` starts),
-``loop_amplitude_force(amplitude)`` (the force at the tips of its steady loop, where a
-time-domain run-up starts it) and ``describing_stiffness(amplitude)`` (complex [N/m]).
+equivalent-linear solution ``f0``), ``steady_state(amplitude, centre=0)`` (the memory on its
+steady loop of that amplitude about ``centre``, at the lower tip, moving up: where the
+displacement-driven test of
+:func:`powertrain.solvers.mount_time_domain.time_cross_point_stiffness` and a time-domain
+run-up start it) and ``describing_stiffness(amplitude)`` (complex [N/m]).
 :class:`JenkinsFriction` is the simplest: with a closed-form describing function, it proves
 the plug-in (tests/test_mount_elements.py); :class:`~powertrain.physics.mount_laws.BergFriction`
 is the mount files' ``[friction]``.
@@ -73,15 +73,12 @@ class JenkinsFriction:
             return np.array([u0], float)
         return np.array([u0 - np.clip(f0, -self.slip_force, self.slip_force) / self.stiffness])
 
-    def steady_state(self, amplitude: float) -> np.ndarray:
-        """Slider at the lower tip of the steady loop of amplitude ``amplitude`` [m] about 0,
-        where the motion turns up."""
-        return np.array([-amplitude + min(self.stiffness * amplitude, self.slip_force)
+    def steady_state(self, amplitude: float, centre: float = 0.0) -> np.ndarray:
+        """Slider at the lower tip of the steady loop of amplitude ``amplitude`` [m] about
+        ``centre`` [m], where the motion turns up (the tip force: k A while it sticks, else
+        F_s)."""
+        return np.array([centre - amplitude + min(self.stiffness * amplitude, self.slip_force)
                          / self.stiffness])
-
-    def loop_amplitude_force(self, amplitude) -> np.ndarray:
-        """Force at the tips ±A of the steady loop [N]: k A while it sticks, else F_s."""
-        return np.minimum(self.stiffness * np.asarray(amplitude, float), self.slip_force)
 
     def describing_stiffness(self, amplitude) -> np.ndarray:
         """Equivalent complex stiffness [N/m] at the displacement amplitude [m]."""
@@ -265,6 +262,16 @@ class PortForces:
         f0 = np.zeros(u0.size) if f0 is None else f0
         states = [np.zeros(1) if law is None else np.atleast_1d(law.initial_state(u, f))
                   for law, u, f in zip(self.laws, u0, f0)]
+        out = np.zeros((len(states), max(s.size for s in states)))
+        for e, st in enumerate(states):
+            out[e, :st.size] = st
+        return out
+
+    def steady_states(self, amplitudes, centres) -> np.ndarray:
+        """State rows (m, n_state) of every law at the lower tip of its steady loop of
+        ``amplitudes`` (m,) [m] about ``centres`` (m,) [m] (``law.steady_state``)."""
+        states = [np.zeros(1) if law is None else np.atleast_1d(law.steady_state(a, c))
+                  for law, a, c in zip(self.laws, amplitudes, centres)]
         out = np.zeros((len(states), max(s.size for s in states)))
         for e, st in enumerate(states):
             out[e, :st.size] = st

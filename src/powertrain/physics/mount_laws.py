@@ -191,12 +191,13 @@ class BergFriction:
         y = f * x2 / (fm - abs(f))
         return np.array([u0 - y, 0.0, np.sign(f), u0, f])
 
-    def steady_state(self, amplitude: float) -> np.ndarray:
-        """State on the symmetric steady loop of amplitude ``amplitude`` [m] about 0, just
-        reversed at its lower tip :math:`(-A, -F_r)` and moving up (a displacement-driven
-        test started here is periodic from its first cycle)."""
+    def steady_state(self, amplitude: float, centre: float = 0.0) -> np.ndarray:
+        """State on the symmetric steady loop of amplitude ``amplitude`` [m] about
+        ``centre`` [m], just reversed at its lower tip :math:`(c - A, -F_r)` and moving up
+        (a displacement-driven test started here is periodic from its first cycle)."""
         fr = float(self.loop_amplitude_force(amplitude))
-        return np.array([-amplitude, -fr, 1.0, -amplitude, -fr])
+        low = centre - amplitude
+        return np.array([low, -fr, 1.0, low, -fr])
 
     @property
     def initial_stiffness(self) -> float:

@@ -119,18 +119,17 @@ def cycle_amplitudes(u) -> np.ndarray:
 def steady_loop_state(ports, relative, n_cycle, cycles=LOOP_CYCLES) -> np.ndarray:
     """States (m, n_state) of the port laws at t = 0 on their steady loop along the harmonic
     relative motion ``relative`` (n_h, m): each law starts at the lowest point of the cycle
-    at the tip of the steady loop centred on the mean motion (``law.loop_amplitude_force``
-    of the lowest point's distance below the mean: no mean force, as in the harmonic
-    solution, where a loop is not unique, e.g. a friction element that sticks), then follows
+    at the lower tip of its steady loop centred on the mean motion (``law.steady_state`` of
+    the lowest point's distance below the mean: no mean force, as in the harmonic solution,
+    where a loop is not unique, e.g. a friction element that sticks), then follows
     the motion for ``cycles`` engine cycles and on to t = 0
     (:func:`powertrain.kernels.port_forces.port_force_loop`)."""
     u = cycle_signal(relative, n_cycle)
     low = np.argmin(u, axis=0)
     m = u.shape[1]
     u_low = u[low, np.arange(m)]
-    tips = np.array([law.loop_amplitude_force(u[:, e].mean() - u_low[e])
-                     for e, law in enumerate(ports.laws)], float)
-    state = ports.states_at(u_low, -tips)
+    centre = u.mean(axis=0)
+    state = ports.steady_states(centre - u_low, centre)
     n = (cycles + 1) * n_cycle + 1
     U = np.empty((n, m))
     for e in range(m):
