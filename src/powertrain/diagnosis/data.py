@@ -166,15 +166,20 @@ def gap_data(measured, engine, noise_floor=DEFAULT_NOISE_FLOOR) -> GapData:
                    3 * len(engine.mounts), phase)
 
 
+def order_levels(velocity, floor):
+    """Model RMS levels [m/s] of complex order velocities (peak, any shape) with the noise
+    floor ``floor`` added in power."""
+    return np.sqrt((np.abs(velocity) / np.sqrt(2.0)) ** 2 + floor ** 2)
+
+
 def model_levels(velocity, data: GapData):
     """Model RMS levels (n_r, n_ch, n_q) with the noise floor added in power [m/s]."""
-    rms = np.abs(velocity) / np.sqrt(2.0)                      # (n_r, n_ch, 16)
     out = np.empty(velocity.shape[:2] + (data.harmonic.size,))
-    f2 = data.floor ** 2
     order = data.harmonic >= 0
-    out[..., order] = np.sqrt(rms[..., data.harmonic[order]] ** 2 + f2)
+    out[..., order] = order_levels(velocity[..., data.harmonic[order]], data.floor)
     if not order.all():                                        # the synthesis
-        out[..., ~order] = np.sqrt(np.sum(rms ** 2, axis=-1) + 16 * f2)[..., None]
+        rms = np.abs(velocity) / np.sqrt(2.0)                  # (n_r, n_ch, 16)
+        out[..., ~order] = np.sqrt(np.sum(rms ** 2, axis=-1) + 16 * data.floor ** 2)[..., None]
     return out
 
 

@@ -29,7 +29,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from powertrain.diagnosis import phase as ph
-from powertrain.diagnosis.data import GapData, model_levels, noise_sigma_db, residuals_db
+from powertrain.diagnosis.data import GapData, model_levels, noise_sigma_db, order_levels, residuals_db
 from powertrain.diagnosis.packing import Packing
 from powertrain.diagnosis.starts import start_points
 from powertrain.effects import EFFECTS, predict
@@ -111,7 +111,16 @@ class Problem:
         for part, cells in (("train", train_cells), ("test", test_cells)):
             if cells is not None:
                 self.valid[part] = self.valid[part] & np.asarray(cells, bool)[None]
+        # the scored level points as flat indices into the velocities (n_r, n_ch, N_ORDERS)
+        self._level_at = {k: self._flat(on) for k, on in self.valid.items()}
+        self._meas_on = {k: self.meas[k][on] for k, on in self.valid.items()}
         self._phase_setup()
+
+    def _flat(self, on):
+        """Flat indices into the velocities (n_r, n_ch, N_ORDERS) of the cells ``on``
+        (n_r, n_ch, n_q), in the order of ``array[on]``."""
+        r, c, q = np.nonzero(on)
+        return (r * on.shape[1] + c) * N_ORDERS + self.sub.harmonic[q]
 
     def _phase_setup(self):
         """Measured phases and their weights per part (:mod:`powertrain.diagnosis.phase`);
@@ -126,15 +135,12 @@ class Problem:
             for k in self.idx}
         self.phase_on = {k: np.isfinite(w) for k, w in self.phase_w.items()}
         self._phase_rad = {k: np.deg2rad(v[self.phase_on[k]]) for k, v in self.phase.items()}
-        # the scored phase points as flat indices into the velocities (n_r, n_ch, N_ORDERS)
-        n_ch = self.meas["train"].shape[1]
-        self._phase_at = {}
-        for k, on in self.phase_on.items():
-            r, c, q = np.nonzero(on)
-            self._phase_at[k] = (r * n_ch + c) * N_ORDERS + self.sub.harmonic[q]
+        self._phase_at = {k: self._flat(on) for k, on in self.phase_on.items()}
         self._order_on = {k: np.broadcast_to(self.order, on.shape)[on]
                           for k, on in self.phase_on.items()}
         self._w_on = {k: self.phase_w[k][on] for k, on in self.phase_on.items()}
+        self._offset = ph.OffsetProfile(self._order_on["train"], self._w_on["train"],
+                                        self.sigma_db)
 
     def __getstate__(self):
         # sent to other processes (parallel fits): the engine without its pressure cache
@@ -188,8 +194,7 @@ class Problem:
         """The run's crank-angle offset [rad] profiled on the training speeds (``vel``: the
         scenario's training velocities if already at hand)."""
         vel = self.velocity(scenario, "train") if vel is None else vel
-        return ph.crank_offset(self._phase_diff(vel, "train"), self._order_on["train"],
-                            self._w_on["train"], self.sigma_db)
+        return self._offset(self._phase_diff(vel, "train"))
 
     def _phase_diff(self, vel, part):
         """Model minus measured phase [rad] at the scored phase points of ``part``."""
@@ -213,15 +218,16 @@ class Problem:
                           self.phase_w[part], self.order, delta)
 
     def vector(self, scenario, part="train"):
+        """The residuals of ``part`` [dB]: the level gaps of the scored cells (as
+        :meth:`gaps`, in the order of ``gaps[valid]``), then with phase the phase gaps and
+        the crank offset's prior."""
         vel = self.velocity(scenario, part)
-        g = self.gaps(scenario, part, vel)[self.valid[part]]
+        level = order_levels(np.take(vel, self._level_at[part]), self.data.floor)
+        g = residuals_db(level, self._meas_on[part], self.data.floor)
         if self.phase_w is None:
             return g
         d = self._phase_diff(vel, part)
-        if part == "train":
-            delta = ph.crank_offset(d, self._order_on[part], self._w_on[part], self.sigma_db)
-        else:
-            delta = self.crank_offset(scenario)
+        delta = self._offset(d) if part == "train" else self.crank_offset(scenario)
         gp = self._w_on[part] * ph.wrap(d - self._order_on[part] * delta)
         return np.concatenate([g, gp, [ph.offset_prior(delta, self.sigma_db)]])
 

@@ -49,20 +49,34 @@ def phase_weights(level, phase_deg, floor, sigma_db):
     return np.where(ok, w, np.nan)
 
 
-def crank_offset(d, order, w, sigma_db) -> float:
-    r"""Profiled crank-angle offset δ [rad] of one run: minimises
+class OffsetProfile:
+    r"""The crank-angle offset δ [rad] of one run profiled from its phase gaps: minimises
     :math:`\sum w^2\,\mathrm{wrap}(d - k\delta)^2 + (\sigma\delta/\sigma_\delta)^2` by two
-    re-wrapped weighted least-squares steps (``d`` model minus measured phase [rad], ``order``
-    k and ``w`` the weights at the scored phase points, 1-D)."""
-    if d.size == 0:
-        return 0.0
-    k, w2 = order, w ** 2
-    ridge = (sigma_db / math.radians(CRANK_OFFSET_SD_DEG)) ** 2
-    delta = 0.0
-    for _ in range(2):
+    re-wrapped weighted least-squares steps, for the orders ``order`` k and weights ``w`` of
+    the scored phase points (1-D; their sums are formed once: a fit profiles δ at every
+    evaluation)."""
+
+    def __init__(self, order, w, sigma_db):
+        k, w2 = order, w ** 2
+        ridge = (sigma_db / math.radians(CRANK_OFFSET_SD_DEG)) ** 2
+        self.order, self.w2k = k, w2 * k
+        self.denominator = np.sum(w2 * k * k) + ridge
+
+    def __call__(self, d) -> float:
+        """δ [rad] for the model minus measured phases ``d`` [rad] at the scored points."""
+        if d.size == 0:
+            return 0.0
+        k = self.order
+        delta = float(np.sum(self.w2k * wrap(d)) / self.denominator)
         r = wrap(d - k * delta) + k * delta
-        delta = float(np.sum(w2 * k * r) / (np.sum(w2 * k * k) + ridge))
-    return delta
+        return float(np.sum(self.w2k * r) / self.denominator)
+
+
+def crank_offset(d, order, w, sigma_db) -> float:
+    """Profiled crank-angle offset δ [rad] of one run (:class:`OffsetProfile`; ``d`` model
+    minus measured phase [rad], ``order`` k and ``w`` the weights at the scored phase
+    points, 1-D)."""
+    return OffsetProfile(order, w, sigma_db)(d)
 
 
 def phase_gaps(velocity, phase_deg, w, order, delta):

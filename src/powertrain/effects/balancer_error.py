@@ -71,10 +71,10 @@ class BalancerError(Effect):
     def warm(self, hm):
         hm.shaft_loads()
 
-    def load_delta(self, hm, p):
+    def load_terms(self, hm, p):
         sh = hm.shaft_loads()
         n = sh.shape[0]
         on = 1.0 if hm.engine.balancer.enabled else 0.0
         f = shaft_factors(n, p["gain"], p["asym"]) * np.exp(
             -1j * shaft_lags(n, p["lag"], p.get("skew", 0.0)))
-        return np.tensordot(f - on, sh, axes=1)
+        return "shafts", f - on, sh

@@ -131,9 +131,20 @@ class Effect:
         """The networks' two-ports ``(a, b, c)``, each (n_r, 17, n_net), with the effect."""
         return abc
 
-    def load_delta(self, hm, p):
-        """Change of the load harmonics (n_r, 17, 6), or None."""
+    def load_terms(self, hm, p):
+        """The effect's change of the load harmonics as a weighted sum of fixed parts,
+        ``(name, weights (n_b,), parts (n_b, n_r, 17, 6))`` (``name`` names the parts on
+        ``hm``), or None: the cached model then solves each part once
+        (:meth:`HarmonicModel.load_velocity`)."""
         return None
+
+    def load_delta(self, hm, p):
+        """Change of the load harmonics (n_r, 17, 6), or None (no change): the sum of
+        :meth:`load_terms` (an effect changes the load through its terms only)."""
+        terms = self.load_terms(hm, p)
+        if terms is None or not np.any(terms[1]):
+            return None
+        return np.tensordot(terms[1], terms[2], axes=1)
 
     def elements(self, hm, elements, p):
         """The networks' mount elements (list in network order,

@@ -160,10 +160,9 @@ class CylinderImbalance(Effect):
                 "could_be": [{"cylinder": c + 1, "sign": "weak" if w else "strong"}
                              for c, w in same], "phase": phase, "text": text}
 
-    def load_delta(self, hm, p):
+    def load_terms(self, hm, p):
         d = self.warm(hm)
-        eps = np.array([p.get(f"e{i + 1}", 0.0) for i in range(d.shape[0])])
-        return None if not eps.any() else np.tensordot(eps, d, axes=1)
+        return self.name, np.array([p.get(f"e{i + 1}", 0.0) for i in range(d.shape[0])]), d
 
 
 def equivalent_cylinders(engine, j, weak, phase) -> list:

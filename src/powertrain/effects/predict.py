@@ -4,9 +4,11 @@ r"""The fast cached path: channel velocities of a scenario on one
 Each effect of the scenario contributes through its hooks (:class:`Effect`): elastomer
 scales change the networks' two-ports (condensed by the one kernel,
 :func:`powertrain.kernels.two_port.two_port_kernel`), the effects' two-port changes follow,
-load changes add, sensor readings come last. Nonlinear mount elements (an amplitude law or
-a port law, the engine's own or an effect's, :meth:`Effect.elements`) act through
-:meth:`MountElement.two_port <powertrain.physics.mount_elements.MountElement.two_port>` at
+load changes add (:meth:`Effect.load_terms`; where the load alone changes, as weighted sums
+of the velocities of fixed load parts), sensor readings come last. Nonlinear mount elements
+(an amplitude law or a port law, the engine's own or an effect's, :meth:`Effect.elements`)
+act through :meth:`MountElement.two_port
+<powertrain.physics.mount_elements.MountElement.two_port>` at
 the amplitudes of the relative displacement across them, iterated to consistency at all
 speeds at once (:func:`amplitude_iteration`) — the physics of the run-up's harmonic fixed
 point (:mod:`powertrain.solvers.equivalent_linear`). Every effect that changes the engine
@@ -78,6 +80,28 @@ def _body(hm, sc):
     for eff, p in sc.values():
         body = eff.body_change(hm, p, body)
     return body
+
+
+def _load(hm, sc):
+    """The load harmonics with every effect's change."""
+    load = hm.load
+    for eff, p in sc.values():
+        d = eff.load_delta(hm, p)
+        if d is not None:
+            load = load + d
+    return load
+
+
+def _load_velocity(hm, sc):
+    """Channel velocities of the nominal model under the load with every effect's change:
+    the nominal load's velocities plus the effects' weighted load parts' (each part solved
+    once, :meth:`HarmonicModel.load_velocity`)."""
+    v = hm.load_velocity("nominal load", hm.load[None])[0]
+    for eff, p in sc.values():
+        terms = eff.load_terms(hm, p)
+        if terms is not None and np.any(terms[1]):
+            v = v + np.tensordot(terms[1], hm.load_velocity(*terms[::2]), axes=1)
+    return v
 
 
 def _elements(hm, sc, s_el):
@@ -153,25 +177,20 @@ def predict(hm: HarmonicModel, scenario: dict, *, tol=TOLERANCE,
         s = eff.elastomer_scale(hm, p)
         if s is not None:
             s_el = s if s_el is None else s_el * s
-    load = hm.load
-    for eff, p in sc.values():
-        d = eff.load_delta(hm, p)
-        if d is not None:
-            load = load + d
     body = _body(hm, sc)
     els = _elements(hm, sc, s_el)
+    A, iterations = None, 0
     if els is not None:
-        _, q, A, iterations = amplitude_iteration(hm, sc, els, load, body, tol=tol,
+        _, q, A, iterations = amplitude_iteration(hm, sc, els, _load(hm, sc), body, tol=tol,
                                                   start=warm_amplitudes)
+        v = hm.velocity(q, body=body)
     else:
         nominal = hm.two_ports() if s_el is None else hm.two_ports_scaled(s_el[None, None, :])
         abc = _two_ports(sc, hm, nominal)
         if s_el is None and abc is nominal and body is getattr(hm, "body", None):
-            q = hm.load_response(load)          # only the load changed: no solve
+            v = _load_velocity(hm, sc)          # only the load changed: no solve
         else:
-            q = hm.solve(abc[0], load, abc=abc, body=body)
-        A, iterations = None, 0
-    v = hm.velocity(q, body=body)
+            v = hm.velocity(hm.solve(abc[0], _load(hm, sc), abc=abc, body=body), body=body)
     for eff, p in sc.values():
         v = eff.reading(v, p)
     return Prediction(v, iterations, A, els)

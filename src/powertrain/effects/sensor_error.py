@@ -36,12 +36,21 @@ def rotation_matrix(phi):
     r"""Rotation matrix of the rotation vector ``phi`` [rad] (Rodrigues):
     :math:`\mathbf R = \mathbf I + \frac{\sin\theta}{\theta}[\boldsymbol\varphi]_\times +
     \frac{1 - \cos\theta}{\theta^2}[\boldsymbol\varphi]_\times^2`, θ = |φ|."""
+    return rotation_matrices(np.reshape(phi, (1, 3)))[0]
+
+
+def rotation_matrices(phi):
+    """:func:`rotation_matrix` of each row of ``phi`` (n, 3) [rad] at once, (n, 3, 3)."""
     phi = np.asarray(phi, float)
-    th = float(np.linalg.norm(phi))
-    K = np.array([[0.0, -phi[2], phi[1]], [phi[2], 0.0, -phi[0]], [-phi[1], phi[0], 0.0]])
-    if th < 1e-12:
-        return np.eye(3) + K
-    return np.eye(3) + np.sin(th) / th * K + (1 - np.cos(th)) / th ** 2 * (K @ K)
+    th = np.array([np.linalg.norm(p) for p in phi])
+    zero = np.zeros(len(phi))
+    K = np.stack([zero, -phi[:, 2], phi[:, 1], phi[:, 2], zero, -phi[:, 0],
+                  -phi[:, 1], phi[:, 0], zero], axis=-1).reshape(-1, 3, 3)
+    small = th < 1e-12                      # R = I + [φ]×
+    t = np.where(small, 1.0, th)
+    a = np.where(small, 1.0, np.sin(t) / t)
+    b = np.where(small, 0.0, (1 - np.cos(t)) / t ** 2)
+    return np.eye(3) + a[:, None, None] * K + b[:, None, None] * (K @ K)
 
 
 def sensor_reading(velocity, gain_db, rotation, cross_axis=None):
@@ -60,7 +69,7 @@ def sensor_reading(velocity, gain_db, rotation, cross_axis=None):
     """
     v = np.asarray(velocity)
     n_m = v.shape[1] // 3
-    T = np.array([rotation_matrix(rotation[m]) for m in range(n_m)])
+    T = rotation_matrices(np.reshape(rotation, (n_m, 3)))
     if cross_axis is not None:
         S = np.zeros((n_m, 3, 3))
         for (i, j), s in zip(((0, 1), (0, 2), (1, 2)), np.asarray(cross_axis, float).T):

@@ -83,6 +83,10 @@ def shaft_load(engine, shaft, rpm, theta):
     return np.hstack([F, Mo])
 
 
+#: Prefix of the cached velocities of load parts in ``HarmonicModel._extra``.
+_VELOCITY_OF = "velocity of "
+
+
 class HarmonicModel:
     """Frequency-domain model of an engine at fixed speeds, with cached load harmonics.
 
@@ -163,6 +167,7 @@ class HarmonicModel:
     def use_channels(self, channels):
         """Let :meth:`velocity` return ``channels`` only (names as :attr:`channels`)."""
         self.output = np.array([self.channels.index(tuple(c)) for c in channels], int)
+        self._extra = {k: v for k, v in self._extra.items() if not k.startswith(_VELOCITY_OF)}
 
     # ------------------------------------------------------------------ cached parts
     def load_of(self, engine) -> np.ndarray:
@@ -310,6 +315,17 @@ class HarmonicModel:
                 cols.append(self.solve(abc[0], unit, abc=abc))
             self._extra["load_transfer"] = np.stack(cols)
         return np.einsum("jrhq,rhj->rhq", self._extra["load_transfer"], load[:, 1:])
+
+    def load_velocity(self, name, loads) -> np.ndarray:
+        """Channel velocities (n_b, n_r, n_ch, 16) of the nominal model (its own two-ports
+        and body) under each of the loads ``loads`` (n_b, n_r, 17, 6), solved once and kept
+        under ``name``: :meth:`velocity` of :meth:`load_response`, linear in the load, so
+        that a load made of these parts is a weighted sum of their velocities (equal to
+        solving the summed load to round-off)."""
+        key = _VELOCITY_OF + name
+        if key not in self._extra:
+            self._extra[key] = np.stack([self.velocity(self.load_response(x)) for x in loads])
+        return self._extra[key]
 
     def velocity(self, q, harmonics=slice(1, N_HARMONICS), body=None) -> np.ndarray:
         """Complex peak channel velocities (n_r, n_ch, n_h) [m/s] from :meth:`solve`'s q

@@ -75,11 +75,14 @@ def default_rpm(start=1000.0, stop=6000.0, step=500.0) -> np.ndarray:
     return start + step * np.arange(n)
 
 
-def _cycle_load(engine, rpm, n_per_cycle):
+def _cycle_loads(engine, rpm, n_per_cycle):
+    """Generalized load over one engine cycle at every speed, (n_speeds, n_per_cycle, 6):
+    :meth:`Engine.load_table <powertrain.models.engine.Engine.load_table>` (the block load's
+    patterns evaluated once; ``generalized_load`` of each speed to round-off)."""
     theta = np.arange(n_per_cycle) * (4 * np.pi / n_per_cycle)
-    load = np.asarray(engine.generalized_load(rpm, theta), float)
-    if load.shape != (n_per_cycle, 6) or not np.all(np.isfinite(load)):
-        raise ValueError("engine.generalized_load must return finite (n, 6) values")
+    load = np.asarray(engine.load_table(rpm, theta), float)
+    if load.shape != (len(rpm), n_per_cycle, 6) or not np.all(np.isfinite(load)):
+        raise ValueError("engine.load_table must return finite (n_speeds, n, 6) values")
     return load
 
 
@@ -102,7 +105,7 @@ def _run_runup(engine, rpm=None, *, solver="newmark", angle_step_deg=ANGLE_STEP_
     Parameters
     ----------
     engine : Engine
-        Provides ``body`` (mass, cg, inertia), ``mounts`` and ``generalized_load``.
+        Provides ``body`` (mass, cg, inertia), ``mounts`` and ``load_table``.
     rpm : array_like, optional
         Speed steps [rpm]; default 1000..6000 step 500.
     solver : {"newmark", "harmonic"}
@@ -132,7 +135,7 @@ def _run_runup(engine, rpm=None, *, solver="newmark", angle_step_deg=ANGLE_STEP_
         system = assemble(b.mass, b.cg, b.inertia, engine.mounts,
                           getattr(engine, "chassis", None))
     step = choose_stepper(system, solver, stepper, grid)
-    loads = [_cycle_load(engine, n_rpm, grid.n_cycle) for n_rpm in rpm]
+    loads = list(_cycle_loads(engine, rpm, grid.n_cycle))
     bar = {"desc": f"run-up ({solver})", "unit": "speed", "enabled": bool(progress)}
     points = _operating_points(engine, rpm)
     if points is None:
