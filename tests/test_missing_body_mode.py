@@ -155,3 +155,16 @@ def test_rigid_chassis_run_up_with_a_missing_mode_is_diagnosed(rigid):
     assert fit["frequency_hz"] == pytest.approx(60.0, rel=0.25)
     assert d["chosen"]["summary"].endswith("moving mostly left's z")
     assert d["where"]["sides"]["location"] == "body"
+
+
+def test_mode_with_an_amplitude_dependent_mount_on_the_fast_path(modal):
+    """A pair with an amplitude-dependent elastomer (the amplitude fixed point reads the
+    relative displacement across each mount, base motion included): the appended mode is
+    used there too, as on the engine with the mode added."""
+    p = _params(modal)
+    amp = {"exponent": 0.3}
+    fast = predict(HarmonicModel(modal, RPM), {"missing_body_mode": p,
+                                               "amplitude_stiffness": amp}).velocity
+    slow = predict(HarmonicModel(EFFECT.apply(modal, **p), RPM),
+                   {"amplitude_stiffness": amp}).velocity
+    np.testing.assert_allclose(fast, slow, rtol=1e-6, atol=1e-6 * np.abs(slow).max())
