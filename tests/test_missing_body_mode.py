@@ -11,13 +11,16 @@ import pytest
 
 from powertrain.effects import EFFECTS, predict
 from powertrain.effects.missing_body_mode import (
+    GRID_STEP,
     MASS_OFF,
     START_MASSES,
     START_SHIFTS,
     BodyGaps,
     body_gap_peak,
     body_side_engine,
+    frequency_grid,
     shape_names,
+    signed_shape,
 )
 from powertrain.iotools.engine_file import DEFAULT_ENGINE_PATH, read_engine
 from powertrain.solvers.fast_harmonic import HarmonicModel
@@ -109,6 +112,35 @@ def test_start_from_the_body_side_peak(rigid, f0):
     assert len(starts) == len(START_MASSES) * len(START_SHIFTS) * len(peaks)
     # the mode on the mounts resonates above its own frequency: a start within 25 %
     assert min(abs(st["frequency_hz"] / f0 - 1) for st in starts) < 0.25
+
+
+@pytest.mark.parametrize("f0", [38.0, 61.0, 95.0])
+def test_signed_shape_and_frequency_grid_from_the_complex_excess(rigid, f0):
+    """With phase: the complex body-side excess of a run-up with the mode over the model
+    without it gives the shape with its signs (up to one overall sign, which the data cannot
+    see; exact where the body side is held still without the mode, a start on a modal body,
+    whose own modes answer the changed mount forces too); the start grid steps by GRID_STEP
+    across the mode's frequency."""
+    rpm = np.arange(1000.0, 6001.0, 100.0)
+    p = _params(rigid, f=f0)
+    hm = HarmonicModel(rigid, rpm)
+    true = predict(hm, {"missing_body_mode": p}).velocity / np.sqrt(2)
+    model = predict(hm, {}).velocity / np.sqrt(2)
+    orders = np.array([0.5, 1.0, 1.5, 2.0, 2.5, 3.0, 4.0, 6.0])
+    h = (2 * orders).astype(int) - 1
+    g = BodyGaps(rpm, list(hm.channels), orders,
+                 20 * np.log10((np.abs(model[..., h]) + 1e-6) / (np.abs(true[..., h]) + 1e-6)),
+                 np.abs(true[..., h]) + 1e-6, (true - model)[..., h])
+    names = [m.name for m in rigid.mounts]
+    shape = signed_shape(g, names).ravel()
+    truth = np.array([v for k, v in p.items() if k.startswith("shape_")])
+    truth = truth / np.max(np.abs(truth))
+    sign = np.sign(shape @ truth)
+    np.testing.assert_allclose(sign * shape, truth, atol=1e-6)
+    grid = frequency_grid(g, names)
+    np.testing.assert_allclose(grid[1:] / grid[:-1], grid[1] / grid[0])
+    assert grid[1] / grid[0] <= GRID_STEP and grid[0] < f0 < grid[-1]
+    assert signed_shape(BodyGaps(rpm, g.channels, orders, g.gap, g.measured), names) is None
 
 
 def test_summary_names_frequency_mass_and_the_base_moving_most(modal):

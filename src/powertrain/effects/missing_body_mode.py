@@ -21,8 +21,10 @@ effect is a modal chassis with one more mode, which every solver runs; on the fa
 
 **Starts** (:meth:`data_starts`), screened by the fit (:mod:`powertrain.diagnosis.starts`).
 With order phase the body side's complex excess over the model, :math:`e = a\,\boldsymbol
-\psi^T` for a missing mode (one complex factor per speed and order times the real shape),
-gives the shape with its signs (:func:`signed_shape`, the best rank-1 fit); the frequency is
+\psi^T` for a missing mode (one complex factor per speed and order times the real shape;
+exact where the body side is held still without the mode, approximate on a modal body, whose
+own modes answer the changed mount forces too), gives the shape with its signs
+(:func:`signed_shape`, the best rank-1 fit; the fit then tries each sign flipped); the frequency is
 then a grid over the measured order frequencies in steps of :data:`GRID_STEP` (with the true
 shape the cost rises by 40 % at ±5 % of the frequency: phase marks the resonance, magnitudes
 hardly do). Without phase: from the body-side gap's peaks — the frequencies where the
