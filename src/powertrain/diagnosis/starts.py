@@ -60,7 +60,7 @@ def _data_starts(problem, pack, effect, fun, lo, hi):
     sc = pack.scenario(pack.x0)
     gaps = BodyGaps(d.rpm[problem.idx["train"]], list(d.channels),
                     (d.harmonic[d.order_mask] + 1) / 2.0, problem.gaps(sc),
-                    problem.meas["train"], _complex_excess(problem, sc))
+                    problem.meas["train"], problem.complex_excess(sc))
     starts = EFFECTS[effect].data_starts(problem.engine, gaps)
     pts = [np.clip(np.array([np.log(st[n]) if lg else st[n] for (_, n), lg in
                              zip(pack.names, pack.log)]), lo, hi) for st in starts]
@@ -68,20 +68,6 @@ def _data_starts(problem, pack, effect, fun, lo, hi):
     kept = [pts[i] for i in np.argsort(costs)[:DATA_KEPT]]
     signed = [pack.names.index((effect, n)) for n in EFFECTS[effect].signed(problem.engine)]
     return [_signs(fun, x, signed) for x in kept] if signed else kept
-
-
-def _complex_excess(problem, scenario):
-    r"""Measured minus model complex order amplitude [m/s RMS] on the training speeds,
-    (n_r, n_ch, n_o), NaN where no phase is scored; None without phase. The measured
-    amplitude is :math:`L\,e^{i(\varphi + k\delta)}` with the run's profiled crank offset δ
-    (:mod:`powertrain.diagnosis.phase`), the model's that of ``scenario``."""
-    if problem.phase_w is None:
-        return None
-    vel = problem.velocity(scenario)[..., problem.sub.harmonic] / np.sqrt(2.0)
-    delta = problem.crank_offset(scenario, problem.velocity(scenario))
-    meas = problem.meas["train"] * np.exp(1j * (np.deg2rad(problem.phase["train"])
-                                                + problem.order * delta))
-    return np.where(problem.phase_on["train"], meas - vel, np.nan)
 
 
 def _signs(fun, x, signed, passes=2):
