@@ -3,7 +3,7 @@
 0.4) and ``DIR/plan.toml``, one hidden truth effect measured at both loads by the
 independent truth generator (:func:`powertrain.validation.plans.make_plan_case`), with
 the order phase a lab records (every order's, as with a cycle reference; column
-``phase_deg``, empty where the level is at the noise floor).
+``phase_deg``, empty where the level is below the noise floor).
 
 Usage: ``python scripts/make_plan_example.py --out DIR [--effect KIND] [--seed S]``
 (KIND a truth kind of :mod:`powertrain.validation.kinds`, default ``mount_temperature``).

@@ -37,7 +37,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from powertrain.analysis.noise_floor import above_floor, censoring_level
+from powertrain.analysis.noise_floor import censoring_level
 from powertrain.validation import truth as tr
 from powertrain.validation.kinds import IN_LIBRARY, KINDS
 
@@ -166,16 +166,17 @@ def measure(velocity, sigma_db, rng, source="", channels=None, rpm=RPM, phase=No
     scatter of σ·ln10/20 rad (the phase twin of the level scatter), the noise's phase (so
     their scatter grows as the level nears the floor) and the lab's TDC error
     δ ~ N(0, :data:`TDC_SD_DEG`) crank (order k: −kδ); a phase is given only where the
-    measured level is above the floor (:func:`powertrain.analysis.noise_floor.above_floor`:
-    below it the order is noise, its phase undefined). Drawn after the levels, which stay
-    as without phase."""
+    measured level is above the floor's RMS (below it the order is noise, its phase
+    undefined; up to the censoring level it is written but mostly noise, and the diagnosis
+    does not score it, :mod:`powertrain.diagnosis.phase`). Drawn after the levels, which
+    stay as without phase."""
     from powertrain.analysis.orders import order_label
     from powertrain.iotools.measured import MeasuredRunup
     amp = velocity / np.sqrt(2) * 10 ** (rng.normal(0, sigma_db, velocity.shape) / 20)
     noise = FLOOR * (rng.normal(size=amp.shape) + 1j * rng.normal(size=amp.shape)) / np.sqrt(2)
     lev = np.abs(amp + noise)
     syn = np.sqrt(np.sum(lev ** 2, axis=-1))
-    phi = None if phase is None else np.where(above_floor(lev, FLOOR),
+    phi = None if phase is None else np.where(lev > FLOOR,
                                               _measured_phase(amp + noise, sigma_db, rng),
                                               np.nan)
     curves, phases = {}, {}
