@@ -24,11 +24,12 @@ With order phase the body side's complex excess over the model, :math:`e = a\,\b
 \psi^T` for a missing mode (one complex factor per speed and order times the real shape;
 exact where the body side is held still without the mode, approximate on a modal body, whose
 own modes answer the changed mount forces too), gives the shape with its signs
-(:func:`signed_shape`, the best rank-1 fit; the fit then tries each sign flipped); the frequency is
-then a grid over the measured order frequencies in steps of :data:`GRID_STEP` (the phase
-swings through the resonance and marks it; magnitudes alone hardly do). Without phase: from the body-side gap's peaks — the frequencies where the
-measured body side most exceeds the model relative to the engine side
-(:func:`body_gap_peak`), the shape from the excess velocity at each base and direction
+(:func:`signed_shape`, the best rank-1 fit; the fit then tries each sign flipped); the
+frequency is then a grid over the measured order frequencies in steps of :data:`GRID_STEP`
+(the phase swings through the resonance and marks it; magnitudes alone hardly do). Without
+phase: from the body-side gap's peaks — the frequencies where the measured body side most
+exceeds the model relative to the engine side (:func:`body_gap_peak`), the shape from the
+excess velocity at each base and direction
 there (signs chosen by the fit); three peaks × three modal masses.
 """
 
