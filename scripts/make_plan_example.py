@@ -1,7 +1,9 @@
 #!/usr/bin/env python
 """Write a SYNTHETIC two-run test plan: ``DIR/full.csv`` (load 1.0), ``DIR/part.csv`` (load
 0.4) and ``DIR/plan.toml``, one hidden truth effect measured at both loads by the
-independent truth generator (:func:`powertrain.validation.plans.make_plan_case`).
+independent truth generator (:func:`powertrain.validation.plans.make_plan_case`), with
+the order phase a lab records (every order's, as with a cycle reference; column
+``phase_deg``, empty where the level is below the noise floor).
 
 Usage: ``python scripts/make_plan_example.py --out DIR [--effect KIND] [--seed S]``
 (KIND a truth kind of :mod:`powertrain.validation.kinds`, default ``mount_temperature``).
@@ -20,7 +22,7 @@ def main(argv=None):
     ap.add_argument("--seed", type=int, default=1)
     args = ap.parse_args(argv)
     from powertrain.validation.plans import make_plan_case
-    case = make_plan_case(0, [args.effect], args.seed)
+    case = make_plan_case(0, [args.effect], args.seed, phase="all")
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
     lines = []

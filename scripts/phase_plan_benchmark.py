@@ -23,9 +23,16 @@ drawn on the modal-body engine with both sides of every mount measured, and only
 kinds issue 21 asks to tell apart there (amplitude-dependent mounts, a stiffer/softer mount):
 the line ``two_sided_plans: named_right=... ambiguous=... wrong_names=...``.
 
-Every case prints the CPU seconds of its diagnoses; the last lines the medians.
-Usage: ``python scripts/phase_plan_benchmark.py --bench cylinder|loads --cases N
-[--seed S] [--jobs 2] [--phase all|whole|none] [--sides engine|both]``.
+``--bench missing_mode``: a body mode the modal-body engine's file lacks, both sides of
+every mount measured (:mod:`powertrain.validation.passive`, detectable draws, engines
+alternating); the last line ``missing_mode_found=...`` counts the cases whose claim is
+``missing_body_mode`` with frequency within 5 % and modal mass within 30 % of the truth
+(:func:`powertrain.validation.scoring.mode_found`, the criterion of
+tests/test_two_sided_rates.py).
+
+Every case prints the CPU seconds of its diagnoses; the closing lines the medians.
+Usage: ``python scripts/phase_plan_benchmark.py --bench cylinder|loads|missing_mode
+--cases N [--seed S] [--jobs 2] [--phase all|whole|none] [--sides engine|both]``.
 """
 
 from __future__ import annotations
@@ -90,6 +97,36 @@ def loads_case(task):
             "detectable": case.detectable, "single_claims": [_claim(d) for d, _ in singles],
             "single_cpu": [c for _, c in singles], "plan_claim": _claim(plan),
             "plan_cpu": cpu, "plan_verdict": plan["verdict"]}
+
+
+def missing_mode_case(task):
+    """One detectable missing-mode case (both sides): truth, fitted mode, CPU seconds."""
+    from powertrain.validation.passive import detectable_case, passive_engines
+    i, seed, phase = task
+    eng = ("body_sz", "body_traces")[i % 2]
+    case = detectable_case("missing_mode", eng, np.random.default_rng(seed), i,
+                           phase=None if phase == "none" else phase)
+    d, cpu = _diagnose(case.measured, passive_engines()[eng])
+    p = case.truth[0][1]
+    return {"i": i, "engine": eng, "claimed": _claim(d),
+            "parameters": (d.get("chosen") or {}).get("parameters"),
+            "truth_mode": {"frequency_hz": p["frequency_hz"], "modal_mass_kg": p["modal_mass"]},
+            "verdict": d["verdict"], "seed": case.seed, "cpu": cpu}
+
+
+def report_missing_mode(rows, phase):
+    from powertrain.validation.scoring import MISSING_MODE_TARGET, mode_found
+    for r in rows:
+        fit = (r["parameters"] or {}).get("missing_body_mode", {})
+        t = r["truth_mode"]
+        print(f"  case {r['i']}: truth {t['frequency_hz']:.1f} Hz {t['modal_mass_kg']:.1f} kg;"
+              f" {r['verdict']} {fit.get('frequency_hz', float('nan')):.1f} Hz "
+              f"{fit.get('modal_mass_kg', float('nan')):.1f} kg"
+              f"{' found' if mode_found(r) else ''}")
+    cpu = np.array([r["cpu"] for r in rows])
+    print(f"time: diagnosis CPU median {np.median(cpu):.1f} s, longest {cpu.max():.1f} s")
+    print(f"missing_mode_found_{phase}={_rate(sum(map(mode_found, rows)), len(rows))} "
+          f"(target >= {MISSING_MODE_TARGET}; detectable cases)")
 
 
 def _run(fn, tasks, jobs):
@@ -173,7 +210,7 @@ def report_loads(rows):
 
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--bench", choices=("cylinder", "loads"), required=True)
+    ap.add_argument("--bench", choices=("cylinder", "loads", "missing_mode"), required=True)
     ap.add_argument("--cases", type=int, default=20)
     ap.add_argument("--seed", type=int, default=None)
     ap.add_argument("--jobs", type=int, default=2)
@@ -187,13 +224,15 @@ def main(argv=None):
           f"{'both sides, ' if args.sides == 'both' else ''}{args.cases} cases")
     seeds = [int(np.random.SeedSequence([seed, i]).generate_state(1)[0])
              for i in range(args.cases)]
-    if args.bench == "cylinder":
-        report_cylinder(_run(cylinder_case, [(i, s, args.phase) for i, s in enumerate(seeds)],
-                             args.jobs), args.phase)
+    if args.bench == "loads":
+        rows = _run(loads_case, [(i, s, args.phase, args.sides) for i, s in enumerate(seeds)],
+                    args.jobs)
+        (report_two_sided if args.sides == "both" else report_loads)(rows)
         return
-    rows = _run(loads_case, [(i, s, args.phase, args.sides) for i, s in enumerate(seeds)],
-                args.jobs)
-    (report_two_sided if args.sides == "both" else report_loads)(rows)
+    fn, report = {"cylinder": (cylinder_case, lambda r: report_cylinder(r, args.phase)),
+                  "missing_mode": (missing_mode_case,
+                                   lambda r: report_missing_mode(r, args.phase))}[args.bench]
+    report(_run(fn, [(i, s, args.phase) for i, s in enumerate(seeds)], args.jobs))
 
 
 if __name__ == "__main__":

@@ -96,6 +96,32 @@ def test_passive_case_measures_both_sides():
     assert c.category == "in" and c.truth_set == ["chassis_modes"]
 
 
+def test_passive_case_with_phase_writes_and_scores_both_sides_phase(tmp_path):
+    """With phase: the levels are those drawn without; both sides carry phase, only where
+    the level is above the floor's RMS; the CSV writes ``phase_deg`` (read back to 0.005 deg) and
+    the diagnosis scores body-side phase gaps in its complex residuals."""
+    from powertrain.diagnosis.core import _Setup
+    from powertrain.iotools.measured import read_measured
+    from powertrain.validation.cases import FLOOR
+    seed = int(np.random.default_rng().integers(2**31))
+    plain = make_passive_case(0, ["missing_mode"], "body_sz", seed)
+    c = make_passive_case(0, ["missing_mode"], "body_sz", seed, phase="all")
+    for key, (_rpm, lev) in c.measured.curves.items():
+        np.testing.assert_array_equal(lev, plain.measured.curves[key][1])
+        if key[2] != "synthesis":
+            on = np.isfinite(c.measured.phases[key])
+            np.testing.assert_array_equal(on, lev > FLOOR)
+    path = tmp_path / "case.csv"
+    path.write_text(c.csv_text())
+    back = read_measured(path)
+    for key, phi in back.phases.items():
+        np.testing.assert_allclose(phi, c.measured.phases[key], atol=5e-3, equal_nan=True)
+    s = _Setup(back, passive_engines()["body_sz"], FLOOR, ["missing_body_mode"])
+    n_a = s.data.n_active
+    on = s.problem.phase_on["train"]
+    assert on[:, n_a:].sum() > 0.3 * on[:, :n_a].sum() > 0
+
+
 def _row(names, det, claimed, side=None):
     lib = {"body_modes": "chassis_modes", "mount_temperature": "mount_stiffness"}
     ts = sorted(lib[n] for n in names)

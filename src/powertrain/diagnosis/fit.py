@@ -217,6 +217,18 @@ class Problem:
         return ph.phase_gaps(self._order_velocity(scenario, part), self.phase[part],
                           self.phase_w[part], self.order, delta)
 
+    def complex_excess(self, scenario):
+        r"""Measured minus model complex order amplitude [m/s RMS] on the training speeds,
+        (n_r, n_ch, n_o), NaN where no phase is scored; None without phase. The measured
+        amplitude is :math:`L\,e^{i(\varphi + k\delta)}` with the profiled crank offset δ."""
+        if self.phase_w is None:
+            return None
+        vel = self.velocity(scenario)
+        meas = self.meas["train"] * np.exp(1j * (self._phase_rad["train"] + self.order
+                                                 * self.crank_offset(scenario, vel)))
+        return np.where(self.phase_on["train"],
+                        meas - vel[..., self.sub.harmonic] / math.sqrt(2.0), np.nan)
+
     def vector(self, scenario, part="train"):
         """The residuals of ``part`` [dB]: the level gaps of the scored cells (as
         :meth:`gaps`, in the order of ``gaps[valid]``), then with phase the phase gaps and

@@ -79,6 +79,15 @@ class JointProblem:
     def gaps(self, scenario, part="train"):
         return np.concatenate([p.gaps(scenario, part) for p in self.runs])
 
+    def complex_excess(self, scenario):
+        """The runs' :meth:`Problem.complex_excess` stacked (NaN for a run without phase);
+        None when no run has phase."""
+        parts = [p.complex_excess(scenario) for p in self.runs]
+        if all(e is None for e in parts):
+            return None
+        return np.concatenate([np.full(p.meas["train"].shape, np.nan) if e is None else e
+                               for p, e in zip(self.runs, parts)])
+
     def phase_gaps(self, scenario, part="train"):
         if self.phase_w is None:
             return None

@@ -57,9 +57,10 @@ def _data_starts(problem, pack, effect, fun, lo, hi):
     from powertrain.effects.missing_body_mode import BodyGaps
     d = problem.data
     fun.evaluate(problem, pack.x0)
+    sc = pack.scenario(pack.x0)
     gaps = BodyGaps(d.rpm[problem.idx["train"]], list(d.channels),
-                    (d.harmonic[d.order_mask] + 1) / 2.0,
-                    problem.gaps(pack.scenario(pack.x0)), problem.meas["train"])
+                    (d.harmonic[d.order_mask] + 1) / 2.0, problem.gaps(sc),
+                    problem.meas["train"], problem.complex_excess(sc))
     starts = EFFECTS[effect].data_starts(problem.engine, gaps)
     pts = [np.clip(np.array([np.log(st[n]) if lg else st[n] for (_, n), lg in
                              zip(pack.names, pack.log)]), lo, hi) for st in starts]

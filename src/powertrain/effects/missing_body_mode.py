@@ -19,10 +19,18 @@ effect is a modal chassis with one more mode, which every solver runs; on the fa
 (:meth:`~powertrain.solvers.body_coupling.ModalBody.with_extra_mode`); both are one
 :func:`mode_arrays` (tests/test_missing_body_mode.py holds them equal).
 
-**Starts** (:meth:`data_starts`): from the body-side gap's peaks — the frequencies where
-the measured body side most exceeds the model relative to the engine side
-(:func:`body_gap_peak`), the shape from the excess velocity at each base and direction
-there; three peaks × three modal masses, screened by the fit (:mod:`powertrain.diagnosis.starts`).
+**Starts** (:meth:`data_starts`), screened by the fit (:mod:`powertrain.diagnosis.starts`).
+With order phase the body side's complex excess over the model, :math:`e = a\,\boldsymbol
+\psi^T` for a missing mode (one complex factor per speed and order times the real shape;
+exact where the body side is held still without the mode, approximate on a modal body, whose
+own modes answer the changed mount forces too), gives the shape with its signs
+(:func:`signed_shape`, the best rank-1 fit; the fit then tries each sign flipped); the
+frequency is then a grid over the measured order frequencies in steps of :data:`GRID_STEP`
+(the phase swings through the resonance and marks it; magnitudes alone hardly do). Without
+phase: from the body-side gap's peaks — the frequencies where the measured body side most
+exceeds the model relative to the engine side (:func:`body_gap_peak`), the shape from the
+excess velocity at each base and direction
+there (signs chosen by the fit); three peaks × three modal masses.
 """
 
 from __future__ import annotations
@@ -52,6 +60,11 @@ START_MASSES = (3.0, 12.0, 50.0)
 START_SHIFTS = (0.7, 1.0)
 #: Peaks of the body-side excess tried as start frequencies.
 START_PEAKS = 3
+#: Ratio of neighbouring start frequencies with phase [1] (a resonance at 2-6 % damping is
+#: 4-12 % wide).
+GRID_STEP = 1.06
+#: Modal mass of the frequency-grid starts [kg] (the fit moves it; a middle value).
+GRID_MASS = 12.0
 AXES = "xyz"
 
 
@@ -146,6 +159,12 @@ class MissingBodyMode(Effect):
     def data_starts(self, engine, gaps):
         """Start parameter sets from the body-side gap (module docstring), [] without one.
         ``gaps``: :class:`BodyGaps` of the data against the model without the mode."""
+        names = [m.name for m in engine.mounts]
+        shape = signed_shape(gaps, names)
+        if shape is not None:
+            base = {"modal_mass_kg": GRID_MASS, "damping_ratio": ZETA_DEFAULT,
+                    **dict(zip(shape_names(engine), shape.ravel().tolist()))}
+            return [dict(base, frequency_hz=float(f)) for f in frequency_grid(gaps, names)]
         out = []
         for f0, shape in body_gap_peak(gaps, [m.name for m in engine.mounts],
                                        n_peaks=START_PEAKS):
@@ -162,13 +181,16 @@ class BodyGaps:
     """Gaps of measured order levels against a model, for start points.
 
     ``rpm`` (n_r,), ``channels`` [(mount, direction)], ``orders`` (n_o,), ``gap`` [dB] and
-    ``measured`` [m/s RMS], each (n_r, n_ch, n_o), NaN where not scored."""
+    ``measured`` [m/s RMS], each (n_r, n_ch, n_o), NaN where not scored; ``excess`` the
+    measured minus model complex amplitude [m/s RMS] where phase is scored (NaN elsewhere;
+    None without phase)."""
 
     rpm: np.ndarray
     channels: list
     orders: np.ndarray
     gap: np.ndarray
     measured: np.ndarray
+    excess: np.ndarray | None = None
 
 
 #: Relative half-width of the frequency window around the peak read for the shape [1].
@@ -186,13 +208,7 @@ def body_gap_peak(g: BodyGaps, mount_names, n_bins=32, n_peaks=1):
     the log-frequency bin (of ``n_bins``) with the largest mean of
     :math:`(e/m_\mathrm{engine})^2`; the shape the RMS excess of each base and direction
     within ± :data:`PEAK_WINDOW` of f0, normalised to its largest component."""
-    from powertrain.analysis.channel import split_side
-    where = {c: i for i, c in enumerate(g.channels)}
-    cols = {}
-    for c, (m, d) in enumerate(g.channels):
-        base, side = split_side(m)
-        if side == "passive" and base in mount_names and (base, d) in where:
-            cols[c] = (mount_names.index(base), "xyz".index(d), where[(base, d)])
+    cols = _body_columns(g, mount_names)
     if not cols:
         return None
     idx = list(cols)
@@ -222,6 +238,54 @@ def body_gap_peak(g: BodyGaps, mount_names, n_bins=32, n_peaks=1):
     if n_peaks == 1:
         return out[0] if out else None
     return out
+
+
+def _body_columns(g: BodyGaps, mount_names) -> dict:
+    """``{channel index: (mount index, axis index, engine-side channel index)}`` of the
+    body-side channels ``NAME/passive`` whose engine side is measured too."""
+    from powertrain.analysis.channel import split_side
+    where = {c: i for i, c in enumerate(g.channels)}
+    cols = {}
+    for c, (m, d) in enumerate(g.channels):
+        base, side = split_side(m)
+        if side == "passive" and base in mount_names and (base, d) in where:
+            cols[c] = (mount_names.index(base), "xyz".index(d), where[(base, d)])
+    return cols
+
+
+def signed_shape(g: BodyGaps, mount_names):
+    r"""Shape (n_mounts, 3) with its signs, normalised to its largest component, from the
+    body side's complex excess (``g.excess``), or None without phase. A missing mode adds
+    :math:`a_{ro}\,oldsymbol\psi` at speed r and order o (one complex factor, the real
+    shape): ψ is the leading eigenvector of :math:`E^HE` (E: the excess, speeds × orders by
+    bases × directions, unscored points 0), turned real by the phase that makes
+    :math:`\sum_j \psi_j^2` real."""
+    cols = _body_columns(g, mount_names)
+    if g.excess is None or not cols:
+        return None
+    idx = list(cols)
+    E = np.moveaxis(g.excess[:, idx], 1, -1).reshape(-1, len(idx))
+    E = np.where(np.isfinite(E), E, 0.0)
+    if not np.any(E):
+        return None
+    v = np.linalg.eigh(E.conj().T @ E)[1][:, -1]
+    psi = np.real(v * np.exp(-0.5j * np.angle(np.sum(v ** 2))))
+    shape = np.zeros((len(mount_names), 3))
+    for j, c in enumerate(idx):
+        shape[cols[c][:2]] = psi[j]
+    peak = np.max(np.abs(shape))
+    return shape / peak if peak > 0 else None
+
+
+def frequency_grid(g: BodyGaps, mount_names) -> np.ndarray:
+    """Start frequencies [Hz]: steps of :data:`GRID_STEP` over the frequencies of the
+    body-side points with an excess (within :data:`FREQ_RANGE`)."""
+    idx = list(_body_columns(g, mount_names))
+    ok = np.isfinite(g.excess[:, idx])
+    f = (g.rpm[:, None, None] * g.orders[None, None, :] / 60.0 * np.ones(ok.shape))[ok]
+    lo, hi = np.clip([f.min(), f.max()], *FREQ_RANGE)
+    n = int(np.ceil(np.log(hi / lo) / np.log(GRID_STEP))) + 1
+    return np.geomspace(lo, hi, max(n, 1))
 
 
 def _shape_near(f, ex, f0, places, n_mounts):

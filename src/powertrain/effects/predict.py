@@ -139,7 +139,7 @@ def amplitude_iteration(hm, sc, els, load, body, *, tol=TOLERANCE, start=None):
     for it in range(1, MAX_ITERATIONS + 1):
         abc = _two_ports(sc, hm, hm.two_ports_at(A, els))
         q = hm.solve(abc[0], load, abc=abc, body=body)
-        G = hm.relative_amplitude(q)[:, nl]
+        G = hm.relative_amplitude(q, body)[:, nl]
         size = np.maximum(np.max(np.abs(G), axis=1), np.finfo(float).tiny)
         err = np.max(np.abs(G - A[:, nl]), axis=1) / size
         if np.max(err) <= tol:

@@ -289,9 +289,7 @@ class HarmonicModel:
         if self.body is not None:
             abc = self.two_ports() if abc is None else abc
             body = self.body if body is None else body
-            shapes = (self.body_shapes if body is self.body
-                      else body.network_shapes(self.networks, self.mount_axes))
-            return coupled_solve(self.M, w, self.rows, shapes,
+            return coupled_solve(self.M, w, self.rows, self._network_shapes(body),
                                  tuple(x[:, harmonics] for x in abc), K, body,
                                  load[:, harmonics])
         frame = (self.M, np.zeros((6, 6)), np.zeros((6, 6)))
@@ -345,16 +343,24 @@ class HarmonicModel:
         x = np.einsum("ni,rhi->rhn", self.rows, q[..., :6])
         return np.sqrt(np.sum(np.abs(x) ** 2, axis=1))
 
-    def relative_amplitude(self, q) -> np.ndarray:
+    def _network_shapes(self, body):
+        """Mode shapes of ``body`` along each network's direction (n_net, K) (cached for the
+        model's own body)."""
+        return (self.body_shapes if body is self.body
+                else body.network_shapes(self.networks, self.mount_axes))
+
+    def relative_amplitude(self, q, body=None) -> np.ndarray:
         r"""Amplitude of the relative displacement across each network (engine-side point
         minus base, along its direction), :math:`A_n = \sqrt{\sum_h |\mathbf r_n\cdot
         \hat{\mathbf q}_h - \mathbf s_n\cdot\hat{\boldsymbol\eta}_h|^2}` [m] over
         :meth:`solve`'s harmonics (√2 × RMS, as
         :func:`powertrain.solvers.equivalent_linear.amplitudes_of`), (n_r, n_net); the base
-        term only with a modal body."""
+        term only with a modal body (``body``: the one ``q`` was solved with, default
+        :attr:`body`)."""
         x = np.einsum("ni,rhi->rhn", self.rows, q[..., :6])
         if self.body is not None:
-            x = x - np.einsum("nk,rhk->rhn", self.body_shapes, q[..., 6:])
+            shapes = self._network_shapes(self.body if body is None else body)
+            x = x - np.einsum("nk,rhk->rhn", shapes, q[..., 6:])
         return np.sqrt(np.sum(np.abs(x) ** 2, axis=1))
 
     def __getstate__(self):

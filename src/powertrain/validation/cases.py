@@ -163,16 +163,22 @@ def measure(velocity, sigma_db, rng, source="", channels=None, rpm=RPM, phase=No
 
     ``phase``: None (levels only), ``"all"`` (every written order's phase, as with a cycle
     reference) or ``"whole"`` (whole orders only: no cycle reference). Phases carry a
-    scatter of σ·ln10/20 rad (the phase twin of the level scatter), the noise's phase and
-    the lab's TDC error δ ~ N(0, :data:`TDC_SD_DEG`) crank (order k: −kδ); drawn after the
-    levels, which stay as without phase."""
+    scatter of σ·ln10/20 rad (the phase twin of the level scatter), the noise's phase (so
+    their scatter grows as the level nears the floor) and the lab's TDC error
+    δ ~ N(0, :data:`TDC_SD_DEG`) crank (order k: −kδ); a phase is given only where the
+    measured level is above the floor's RMS (below it the order is noise, its phase
+    undefined; up to the censoring level it is written but mostly noise, and the diagnosis
+    does not score it, :mod:`powertrain.diagnosis.phase`). Drawn after the levels, which
+    stay as without phase."""
     from powertrain.analysis.orders import order_label
     from powertrain.iotools.measured import MeasuredRunup
     amp = velocity / np.sqrt(2) * 10 ** (rng.normal(0, sigma_db, velocity.shape) / 20)
     noise = FLOOR * (rng.normal(size=amp.shape) + 1j * rng.normal(size=amp.shape)) / np.sqrt(2)
     lev = np.abs(amp + noise)
     syn = np.sqrt(np.sum(lev ** 2, axis=-1))
-    phi = None if phase is None else _measured_phase(amp + noise, sigma_db, rng)
+    phi = None if phase is None else np.where(lev > FLOOR,
+                                              _measured_phase(amp + noise, sigma_db, rng),
+                                              np.nan)
     curves, phases = {}, {}
     for c, (m, d) in enumerate(channels):
         for o in WRITTEN_ORDERS:
@@ -243,21 +249,25 @@ class Case:
 
     def csv_text(self) -> str:
         """The measured CSV (long format); with a body under the mounts (channels
-        ``NAME/passive`` and body points) with the ``side`` column."""
+        ``NAME/passive`` and body points) with the ``side`` column; with measured phase the
+        ``phase_deg`` column (empty where none is given)."""
         from powertrain.analysis.channel import split_side
         names = {m for m, _, _ in self.measured.curves}
         bases = {split_side(m)[0] for m in names if split_side(m)[1] == "passive"}
+        phases = getattr(self.measured, "phases", None) or {}
+        header = ("mount,direction,quantity,rpm" + (",side" if bases else "")
+                  + ",velocity_rms_mm_per_s" + (",phase_deg" if phases else ""))
         lines = [f"# SYNTHETIC measured run-up (powertrain synth, seed {self.seed}); the hidden "
-                 "effect is not stated here",
-                 "mount,direction,quantity,rpm,side,velocity_rms_mm_per_s" if bases else
-                 "mount,direction,quantity,rpm,velocity_rms_mm_per_s"]
+                 "effect is not stated here", header]
         for (m, d, q), (r, v) in self.measured.curves.items():
             base, side = split_side(m)
             if bases and side == "active" and base not in bases:
                 side = "passive"                     # a body point of interest
             col = f",{side}" if bases else ""
-            for ri, vi in zip(r, v):
-                lines.append(f"{base},{d},{q},{ri:g}{col},{vi * 1e3:.6g}")
+            phi = phases.get((m, d, q), np.full(len(r), np.nan))
+            for ri, vi, pi in zip(r, v, phi):
+                tail = "" if not phases else "," if not np.isfinite(pi) else f",{pi:.2f}"
+                lines.append(f"{base},{d},{q},{ri:g}{col},{vi * 1e3:.6g}{tail}")
         return "\n".join(lines) + "\n"
 
 

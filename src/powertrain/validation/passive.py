@@ -12,8 +12,9 @@ body's modes, Newmark run-up) with the body side of every mount as further chann
 body's modes differ from the file's, :data:`powertrain.validation.kinds.PASSIVE_KINDS`),
 ``mount_temperature`` four times (one mount 0.5–0.8× or 1.25–2× as stiff), two effect-free,
 and (issue 21) two excitation changes (``balancer_shafts``) and two body modes the file
-lacks (``missing_mode``); engines alternating. The diagnosis gets the modal-body engine (nominal body) and the
-measured file with both sides.
+lacks (``missing_mode``); engines alternating. The diagnosis gets the modal-body engine
+(nominal body) and the measured file with both sides; with ``phase`` (:func:`make_passive_case`)
+the order phase of both sides too, drawn as on the engine side.
 """
 
 from __future__ import annotations
@@ -87,9 +88,25 @@ def baseline_velocity(engine_kind):
     return truth_velocity(passive_engines()[engine_kind], [])
 
 
-def make_passive_case(index, names, engine_kind, seed) -> Case:
-    """Draw, simulate and measure one passive-side case."""
+def make_passive_case(index, names, engine_kind, seed, phase=None) -> Case:
+    """Draw, simulate and measure one passive-side case; ``phase`` what order phase is
+    measured on both sides (:func:`powertrain.validation.cases.measure`; the levels are the
+    same with and without)."""
     engine = passive_engines()[engine_kind]
     return draw_case(index, names, engine_kind, seed, engine, baseline_velocity(engine_kind),
-                     truth_velocity, channels(engine), "blind passive case")
+                     truth_velocity, channels(engine), "blind passive case", phase=phase)
 
+
+
+#: Redraws allowed to find a detectable case (:func:`detectable_case`).
+MAX_DRAWS = 30
+
+
+def detectable_case(kind, engine_kind, rng, index, phase=None) -> Case:
+    """The first detectable ``kind`` case of up to :data:`MAX_DRAWS` draws (case seeds from
+    ``rng``); ValueError when none is."""
+    for _ in range(MAX_DRAWS):
+        case = make_passive_case(index, [kind], engine_kind, int(rng.integers(2 ** 31)), phase)
+        if case.detectable:
+            return case
+    raise ValueError(f"no detectable {kind} case in {MAX_DRAWS} draws")
