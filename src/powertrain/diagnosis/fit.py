@@ -224,7 +224,7 @@ class Problem:
         if self.phase_w is None:
             return None
         vel = self.velocity(scenario)
-        meas = self.meas["train"] * np.exp(1j * (self._phase_rad["train"] + self.order
+        meas = self.meas["train"] * np.exp(1j * (np.deg2rad(self.phase["train"]) + self.order
                                                  * self.crank_offset(scenario, vel)))
         return np.where(self.phase_on["train"],
                         meas - vel[..., self.sub.harmonic] / math.sqrt(2.0), np.nan)
