@@ -6,8 +6,9 @@ core, :func:`powertrain.parallel.run_map`) and applies the group-sequential Wils
 ``tests/rates.py``: batches of 8 cases until Wald's likelihood ratio between the target and
 a rate 0.1 worse decides, truncated where the Wilson rule (one-sided 95 %) decides; a true
 rate 0.1 worse than the target fails with probability >= 0.8 (exact sums,
-tests/test_rates.py). At most 80 cases (top-1 and passive side, target 0.9), 136
-(unexplained, 0.8), 48 (false claims, 0.05); at a true rate of 0.95 about 26, 18 and 22.
+tests/test_rates.py). At most 80 cases (top-1, unexplained and passive side, target 0.9;
+unexplained was 0.8 before issue 21), 48 (false claims, 0.05); at a true rate of 0.95 about
+26 and 22.
 They carry the ``slow`` and ``rates`` markers. The
 seeds are in the failure message; rerun one with
 :func:`powertrain.validation.cases.make_case`. The 50-case rates of the benchmark are printed

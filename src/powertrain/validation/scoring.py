@@ -40,7 +40,9 @@ from powertrain.analysis.noise_floor import censoring_level
 
 #: Targets of the benchmark (issue 11): top-1 and shrink at least, false claims at most,
 #: unexplained at least.
-TARGETS = {"top1": 0.9, "shrink_median": 0.7, "false_claims": 0.05, "unexplained_ok": 0.8}
+#: unexplained_ok: 0.8 since issue 13, raised to 0.9 by issue 21 ("out-of-library
+#: 'unexplained' >= 0.9").
+TARGETS = {"top1": 0.9, "shrink_median": 0.7, "false_claims": 0.05, "unexplained_ok": 0.9}
 
 
 def wilson_interval(k, n, z=1.96):
