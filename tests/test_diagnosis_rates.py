@@ -95,6 +95,7 @@ def _sequential(row_fn, task_of, is_good, target, higher_is_better=True):
                                               range(start, start + count)]),
         is_good, target, higher_is_better)
     k = good if higher_is_better else len(rows) - good
+    print(f"seed {seed}: {k}/{len(rows)} (rate judged against {target}), passed={passed}")
     assert passed, _report(seed, rows, k, len(rows), "the sequential rule")
 
 

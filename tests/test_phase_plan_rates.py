@@ -44,6 +44,7 @@ def _sequential(row_fn, is_good, target, higher_is_better=True, extra=()):
                                               for i in range(start, start + count)]),
         is_good, target, higher_is_better)
     k = good if higher_is_better else len(rows) - good
+    print(f"seed {seed}: {k}/{len(rows)} (rate judged against {target}), passed={passed}")
     assert passed, f"seed {seed}: {k}/{len(rows)} (target {target}): {rows}"
     return rows
 

@@ -54,6 +54,7 @@ def test_side_attribution_on_two_sided_cases():
     passed, rows, k = rates.run_sequential(
         lambda start, count: run_map(_side_row, [(i, seed) for i in range(start, start + count)]),
         lambda r: r["right"], SIDES_TARGET)
+    print(f"seed {seed}: {k}/{len(rows)} right, passed={passed}")
     assert passed, (f"seed {seed}: {k}/{len(rows)} right; misses "
                     f"{[(r['kind'], r['where'], r['seed']) for r in rows if not r['right']]}")
 
@@ -79,5 +80,6 @@ def test_missing_body_mode_is_found():
     passed, rows, k = rates.run_sequential(
         lambda start, count: run_map(_mode_row, [(i, seed) for i in range(start, start + count)]),
         mode_found, MISSING_MODE_TARGET)
+    print(f"seed {seed}: {k}/{len(rows)} found, passed={passed}")
     assert passed, (f"seed {seed}: {k}/{len(rows)} found; misses "
                     f"{[(r['verdict'], r['seed']) for r in rows if not mode_found(r)]}")
