@@ -39,7 +39,9 @@ def _data(sigmas, level=1e-3, floor=1e-6, n_r=60):
 
 
 def test_each_channel_gets_its_own_scatter():
-    d = _data([0.3, 0.6, 1.0, 1.5])
+    """Fresh draw: the MAD estimate's relative spread is ~9 % at 60 speeds (2.7 % of draws
+    missed 25 % on some channel) and ~5 % at 240, where 25 % is five standard errors."""
+    d = _data([0.3, 0.6, 1.0, 1.5], n_r=240)
     est = channel_scatter_db(d)
     np.testing.assert_allclose(est, [0.3, 0.6, 1.0, 1.5], rtol=0.25)
 
