@@ -260,22 +260,14 @@ class PortForces:
         """State rows (m, n_state) of every law at the relative displacements ``u0`` (m,)
         [m], carrying the forces ``f0`` (m,) [N] (default: unloaded)."""
         f0 = np.zeros(u0.size) if f0 is None else f0
-        states = [np.zeros(1) if law is None else np.atleast_1d(law.initial_state(u, f))
-                  for law, u, f in zip(self.laws, u0, f0)]
-        out = np.zeros((len(states), max(s.size for s in states)))
-        for e, st in enumerate(states):
-            out[e, :st.size] = st
-        return out
+        return _state_rows([np.zeros(1) if law is None else law.initial_state(u, f)
+                            for law, u, f in zip(self.laws, u0, f0)])
 
     def steady_states(self, amplitudes, centres) -> np.ndarray:
         """State rows (m, n_state) of every law at the lower tip of its steady loop of
         ``amplitudes`` (m,) [m] about ``centres`` (m,) [m] (``law.steady_state``)."""
-        states = [np.zeros(1) if law is None else np.atleast_1d(law.steady_state(a, c))
-                  for law, a, c in zip(self.laws, amplitudes, centres)]
-        out = np.zeros((len(states), max(s.size for s in states)))
-        for e, st in enumerate(states):
-            out[e, :st.size] = st
-        return out
+        return _state_rows([np.zeros(1) if law is None else law.steady_state(a, c)
+                            for law, a, c in zip(self.laws, amplitudes, centres)])
 
     def select(self, keep) -> PortForces:
         """The port laws where the boolean mask ``keep`` (m,) is true."""
@@ -307,3 +299,12 @@ def port_forces(elements, rows, force_map, names) -> PortForces | None:
     return PortForces(np.ascontiguousarray(rows[idx]), kinds, par, laws,
                       np.ascontiguousarray(force_map[:, idx]), [names[k] for k in idx],
                       np.array(idx, int), len(elements))
+
+
+def _state_rows(states) -> np.ndarray:
+    """The laws' states (a list of 1-D arrays of any length) as zero-padded rows (m, n)."""
+    states = [np.atleast_1d(st) for st in states]
+    out = np.zeros((len(states), max(st.size for st in states)))
+    for e, st in enumerate(states):
+        out[e, :st.size] = st
+    return out
