@@ -192,3 +192,23 @@ def test_a_fixed_point_that_does_not_converge_names_the_element_and_speed(engine
     with pytest.raises(FloatingPointError, match=r"left\.[xyz] at 3000 rpm|[a-z]+\.[xyz] at "
                                                  r"3000 rpm"):
         run_runup(with_law(engine, LAW), [3000.0], solver="harmonic")
+
+
+def test_elements_in_one_call_equal_each_element_alone(engine):
+    """``element_two_ports`` (the fixed point's batched call: amplitude laws, array static
+    factors, port laws) against ``MountElement.two_port`` of each element alone."""
+    from powertrain.physics.mount_elements import MountElement, element_two_ports
+    from powertrain.physics.mount_laws import PowerLaw
+    models = [m.directions[ax] for m in engine.mounts for ax in ("x", "y", "z")][:4]
+    static = np.array([[0.9], [1.1], [1.3]])
+    els = [MountElement(models[0]),
+           MountElement(models[1], amplitude_law=PowerLaw(1e-4, 0.2), static_factor=static),
+           MountElement(models[2], port_law=JenkinsFriction(3e5, 20.0)),
+           MountElement(models[3], JenkinsFriction(2e5, 5.0), PowerLaw(1e-4, 0.1), 1.2)]
+    s = 1j * np.array([0.0, 60.0, 400.0, 900.0]) * np.ones((3, 1))
+    A = np.array([[1e-5, 2e-4, 5e-5, 1e-4], [3e-5, 1e-4, 2e-4, 4e-5], [1e-6, 1e-3, 1e-4, 1e-4]])
+    got = element_two_ports(els, s, A[:, None, :])
+    for k, el in enumerate(els):
+        ref = el.two_port(s, A[:, k:k + 1])
+        for x, y in zip(got, ref):
+            np.testing.assert_allclose(x[..., k], y, rtol=1e-12, atol=0)

@@ -89,3 +89,45 @@ def test_condense_equals_dense_schur_complement():
     keep = system.retained
     got, ref = condense(bare, keep, 3j), dense_condense(bare, keep, 3j)
     assert np.max(np.abs(got - ref)) <= EXACT * np.max(np.abs(ref))
+
+
+def test_several_networks_in_one_call_equal_one_call_each():
+    """``laplace_two_ports`` (one kernel call over networks of different sizes, factors per
+    entry and network) against ``laplace_two_port`` of each network alone."""
+    from powertrain.physics.mount_network import laplace_two_ports
+    rng = np.random.default_rng(3)
+    nets = _networks()
+    nets = nets + [(np.zeros(0), np.array([[0, GROUND]]), np.array([2e5]), np.array([80.0]))]
+    s = 1j * np.geomspace(5.0, 2000.0, 12).reshape(3, 4)
+    ks = rng.uniform(0.3, 3.0, s.shape + (len(nets),))
+    ds = rng.uniform(0.3, 3.0, s.shape + (len(nets),))
+    got = laplace_two_ports(s, nets, ks, ds)
+    for k, net in enumerate(nets):
+        ref = laplace_two_port(s, *net, ks[..., k], ds[..., k])
+        for x, y in zip(got, ref):
+            assert x[..., k].shape == y.shape
+            assert np.max(np.abs(x[..., k] - y)) <= EXACT * np.max(np.abs(y))
+
+
+@pytest.mark.parametrize("grounded", [True, False])
+def test_condensed_matrix_equals_the_dense_sum(grounded):
+    """``condensed_matrix`` (the one assembly of the condensed model) against the dense
+    sum of the frame and every network's outer products, written out in NumPy."""
+    from powertrain.physics.condensation import condensed_matrix
+    rng = np.random.default_rng(11)
+    n, n_net = 9, 5
+    frame = [rng.normal(size=(n, n)) for _ in range(3)]
+    E, B = rng.normal(size=(n_net, n)), rng.normal(size=(n_net, n))
+    E[:, 6:], B[:, :6] = 0.0, 0.0                 # engine side on the body, base on modes
+    s = 1j * rng.uniform(1, 500, (4, 3))
+    abc = [rng.normal(size=s.shape + (n_net,)) + 1j * rng.normal(size=s.shape + (n_net,))
+           for _ in range(3)]
+    ref = (s ** 2)[..., None, None] * frame[0] + s[..., None, None] * frame[1] + frame[2]
+    ref = ref + np.einsum("...n,ni,nj->...ij", abc[0], E, E)
+    if not grounded:
+        ref = ref + np.einsum("...n,ni,nj->...ij", abc[1], E, B) \
+            + np.einsum("...n,ni,nj->...ij", abc[1], B, E) \
+            + np.einsum("...n,ni,nj->...ij", abc[2], B, B)
+    got = condensed_matrix(frame, E, None if grounded else B, abc, s)
+    assert got.shape == ref.shape
+    assert np.max(np.abs(got - ref)) <= EXACT * np.max(np.abs(ref))

@@ -43,14 +43,14 @@ PIVOT_RTOL = 1e-13
 
 
 @njit(cache=True, nogil=True)
-def condense_nodes(D, n, order, X):
+def condense_nodes(D, n, order, X, gone):
     """Eliminate the internal nodes 1..n of the nodal matrix ``D`` (n + 2, n + 2) in place.
 
     Symmetric pivoting on the largest remaining diagonal; afterwards ``D[0, 0]``,
     ``D[0, n + 1]``, ``D[n + 1, n + 1]`` are the two-port and, when ``X`` has n + 2 rows,
     ``X[:, 0]`` / ``X[:, 1]`` the nodal motion per unit engine-side / ground-node motion.
-    ``order`` (n,) int is work space. Returns False when a pivot is below
-    :data:`PIVOT_RTOL` times the largest entry (singular network).
+    ``order`` (n,) int and ``gone`` (n + 2,) bool are work space. Returns False when a
+    pivot is below :data:`PIVOT_RTOL` times the largest entry (singular network).
     """
     size = n + 2
     big2 = 0.0                    # the largest entry by its squared modulus (no hypot)
@@ -59,23 +59,23 @@ def condense_nodes(D, n, order, X):
             m2 = D[i, j].real * D[i, j].real + D[i, j].imag * D[i, j].imag
             if m2 > big2:
                 big2 = m2
-    big = np.sqrt(big2)
-    gone = np.zeros(size, np.bool_)
+    gone[:] = False
     for step in range(n):             # boundary nodes 0 and n + 1 are never eliminated
         k = -1
-        best = -1.0
+        best2 = -1.0                  # squared moduli: the same pivot as by modulus
         for i in range(1, n + 1):
-            if not gone[i] and abs(D[i, i]) > best:
-                best = abs(D[i, i])
+            m2 = D[i, i].real * D[i, i].real + D[i, i].imag * D[i, i].imag
+            if not gone[i] and m2 > best2:
+                best2 = m2
                 k = i
-        if best <= PIVOT_RTOL * big:
+        if best2 <= PIVOT_RTOL * PIVOT_RTOL * big2:
             return False
         gone[k] = True
         order[step] = k
-        p = D[k, k]
+        inv_p = 1.0 / D[k, k]
         for i in range(size):
             if not gone[i]:
-                f = D[i, k] / p
+                f = D[i, k] * inv_p
                 if f != 0.0:
                     for j in range(size):
                         if not gone[j]:
@@ -130,10 +130,11 @@ def two_port_kernel(lam, spring_scale, damper_scale, masses, elem_nodes, c, d, o
     size = n + 2
     D = np.empty((size, size), np.complex128)
     order = np.empty(n, np.int64)
+    gone = np.empty(size, np.bool_)
     X = np.empty((size if out_x.shape[0] else 0, 2), np.complex128)
     for w in range(lam.size):
         nodal_matrix(lam[w], spring_scale[w], damper_scale[w], masses, elem_nodes, c, d, D)
-        if not condense_nodes(D, n, order, X):
+        if not condense_nodes(D, n, order, X, gone):
             status = 1
             out_a[w] = np.nan
             out_b[w] = np.nan
@@ -146,6 +147,25 @@ def two_port_kernel(lam, spring_scale, damper_scale, masses, elem_nodes, c, d, o
             for i in range(n):
                 out_x[w, i, 0] = X[i + 1, 0]
                 out_x[w, i, 1] = X[i + 1, 1]
+    return status
+
+
+@njit(cache=True, nogil=True)
+def two_ports_kernel(lam, spring_scale, damper_scale, mass_ptr, masses, el_ptr, elem_nodes, c,
+                     d, out_a, out_b, out_c):
+    """:func:`two_port_kernel` of several networks in one call (the equivalent-linear fixed
+    point asks for every network at every iteration): network k has the masses
+    ``masses[mass_ptr[k]:mass_ptr[k + 1]]`` and the elements ``el_ptr[k]:el_ptr[k + 1]`` of
+    ``elem_nodes``, ``c``, ``d``; its factors and outputs are row k of ``spring_scale``,
+    ``damper_scale`` and ``out_a``, ``out_b``, ``out_c`` (n_net, n_w). Returns 0, or 1 when
+    some network was singular somewhere (NaN there)."""
+    no_x = np.empty((0, 0, 2), np.complex128)
+    status = 0
+    for k in range(out_a.shape[0]):
+        m0, m1, e0, e1 = mass_ptr[k], mass_ptr[k + 1], el_ptr[k], el_ptr[k + 1]
+        status |= two_port_kernel(lam, spring_scale[k], damper_scale[k], masses[m0:m1],
+                                  elem_nodes[e0:e1], c[e0:e1], d[e0:e1], out_a[k], out_b[k],
+                                  out_c[k], no_x)
     return status
 
 
@@ -208,10 +228,11 @@ def kcp_gradient_kernel(omega, B, masses, c, d, kcp, dk_dm, dk_dc, dk_dd):
     D = np.empty((n + 2, n + 2), dtype=np.complex128)
     XY = np.empty((n + 2, 2), dtype=np.complex128)
     order = np.empty(n, np.int64)
+    gone = np.empty(n + 2, np.bool_)
     for f in range(omega.shape[0]):
         w = omega[f]
         _incidence_nodal_matrix(1j * w, B, masses, c, d, D)
-        if not condense_nodes(D, n, order, XY):
+        if not condense_nodes(D, n, order, XY, gone):
             status = 1
             kcp[f] = np.nan
             for j in range(n):

@@ -84,24 +84,18 @@ def condensed_matrix(frame, engine_rows, base_rows, abc, s):
     r""":math:`\mathbf D_R(s)` of the module docstring, shape ``s.shape + (n_R, n_R)``, for
     given two-port values ``abc`` (each ``s.shape + (n_net,)``); ``base_rows`` None: every
     base grounded (``b``, ``c`` unused)."""
+    from powertrain.kernels.condensation import condensed_matrix_kernel
     s = np.asarray(s, complex)
-    M0, C0, K0 = frame
-    n = M0.shape[0]
-    a, b, c = abc
-    E = engine_rows
-    D = (s ** 2)[..., None, None] * M0 + s[..., None, None] * C0 + K0
-    if not E.shape[0]:
-        return D
-    D = D + (a.reshape(-1, E.shape[0]) @ np.einsum("ni,nj->nij", E, E).reshape(-1, n * n)
-             ).reshape(s.shape + (n, n))
-    if base_rows is not None:
-        B = base_rows
-        cross = (b.reshape(-1, E.shape[0]) @ np.einsum("ni,nj->nij", E, B).reshape(-1, n * n)
-                 ).reshape(s.shape + (n, n))
-        D = D + cross + np.swapaxes(cross, -1, -2) + (
-            c.reshape(-1, E.shape[0]) @ np.einsum("ni,nj->nij", B, B).reshape(-1, n * n)
-        ).reshape(s.shape + (n, n))
-    return D
+    M0, C0, K0 = (np.ascontiguousarray(x, float) for x in frame)
+    n, n_net = M0.shape[0], engine_rows.shape[0]
+    B = np.zeros((0, n)) if base_rows is None else base_rows
+    a, b, c = (np.ascontiguousarray(np.reshape(abc[0] if x is None else x, (s.size, n_net)),
+                                    complex) for x in abc)
+    D = np.empty((s.size, n, n), complex)
+    condensed_matrix_kernel(np.ascontiguousarray(s.reshape(-1)), M0, C0, K0,
+                            np.ascontiguousarray(engine_rows, float),
+                            np.ascontiguousarray(B, float), a, b, c, D)
+    return D.reshape(s.shape + (n, n))
 
 
 def condense(system, keep, s):

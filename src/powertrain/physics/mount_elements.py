@@ -36,7 +36,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from powertrain.kernels.port_forces import JENKINS, NONE, port_force
-from powertrain.physics.mount_network import laplace_two_port, network_matrices
+from powertrain.physics.mount_network import laplace_two_port, laplace_two_ports, network_matrices
 
 
 @dataclass(frozen=True)
@@ -108,6 +108,27 @@ def describing_stiffnesses(elements, amplitudes) -> list:
     return out
 
 
+def element_two_ports(elements, s, amplitudes):
+    r""":meth:`MountElement.two_port` of several elements, each ``s.shape + (n_el,)``:
+    element k at the amplitudes ``amplitudes[..., k]`` [m] (broadcast to ``s``), the
+    networks condensed in one kernel call (:func:`laplace_two_ports`), the port laws'
+    describing stiffnesses added at every :math:`s \ne 0`."""
+    lam = np.asarray(s, complex)
+    A = np.asarray(amplitudes, float)
+    scales = np.empty((2,) + lam.shape + (len(elements),))
+    for k, el in enumerate(elements):
+        ks, ds = el.scale_arrays(A[..., k])
+        scales[0, ..., k], scales[1, ..., k] = ks, ds
+    a, b, c = laplace_two_ports(lam, [el.model.network() for el in elements], *scales)
+    for k, el in enumerate(elements):
+        if el.port_law is not None:
+            kd = np.where(lam == 0, 0.0, el.port_law.describing_stiffness(A[..., k]))
+            a[..., k] += kd
+            b[..., k] -= kd
+            c[..., k] += kd
+    return a, b, c
+
+
 @dataclass(frozen=True, eq=False)
 class MountElement:
     """One mount direction: a linear network, scaled by its amplitude law and its static
@@ -148,6 +169,14 @@ class MountElement:
         ks, ds = self.amplitude_law.scales(amplitude)
         return self.static_factor * float(ks), self.static_factor * float(ds)
 
+    def scale_arrays(self, amplitude):
+        """:meth:`scales` at an array of amplitudes [m] (the static factor may be an array
+        too, one per speed): ``(stiffness factors, damping factors)`` broadcast together."""
+        if self.amplitude_law is None:
+            return self.static_factor * 1.0, self.static_factor * 1.0
+        ks, ds = self.amplitude_law.scales(amplitude)
+        return self.static_factor * ks, self.static_factor * ds
+
     def at_operating_point(self, static_factor: float) -> MountElement:
         """A copy with the static curve's factor at an operating point."""
         return MountElement(self.model, self.port_law, self.amplitude_law, float(static_factor))
@@ -185,10 +214,8 @@ class MountElement:
             res = laplace_two_port(lam, *self.network(amplitude), internal=internal)
         else:
             amplitude = np.broadcast_to(np.asarray(amplitude, float), lam.shape)
-            ks, ds = ((1.0, 1.0) if self.amplitude_law is None
-                      else self.amplitude_law.scales(amplitude))
-            res = laplace_two_port(lam, *self.model.network(), self.static_factor * ks,
-                                   self.static_factor * ds, internal=internal)
+            res = laplace_two_port(lam, *self.model.network(), *self.scale_arrays(amplitude),
+                                   internal=internal)
         if self.port_law is None:
             return res
         if describing is None:

@@ -174,6 +174,47 @@ def laplace_two_port(s, masses, elem_nodes, c, d, spring_scale=1.0, damper_scale
     return res + (x.reshape(lam.shape + x.shape[1:]),) if internal else res
 
 
+def laplace_two_ports(s, networks, spring_scales, damper_scales):
+    r""":func:`laplace_two_port` of several networks in one kernel call
+    (:func:`powertrain.kernels.two_port.two_ports_kernel`, the same elimination per network).
+
+    Parameters
+    ----------
+    s : array_like complex
+        Laplace variable [1/s], any shape.
+    networks : list of tuple
+        ``(masses, elem_nodes, c, d)`` per network (:func:`network_matrices`).
+    spring_scales, damper_scales : array_like float
+        Factors on network k's springs and dampers at ``[..., k]``, broadcast to
+        ``s.shape + (n_net,)``.
+
+    Returns
+    -------
+    a, b, c : ndarray complex, each ``s.shape + (n_net,)`` [N/m]
+
+    Raises
+    ------
+    FloatingPointError
+        A network is singular at some ``s``.
+    """
+    from powertrain.kernels.two_port import two_ports_kernel
+    lam = np.asarray(s, complex)
+    n, shape = len(networks), lam.shape + (len(networks),)
+    rows = [np.ascontiguousarray(np.moveaxis(np.broadcast_to(np.asarray(x, float), shape),
+                                             -1, 0).reshape(n, -1))
+            for x in (spring_scales, damper_scales)]
+    ptr = [np.cumsum([0] + [len(net[i]) for net in networks]) for i in (0, 2)]
+    packed = [np.concatenate([np.asarray(net[i], float).reshape(-1) for net in networks])
+              for i in (0, 2, 3)]
+    nodes = np.concatenate([np.asarray(net[1], np.int64).reshape(-1, 2) for net in networks])
+    out = [np.empty((n, lam.size), complex) for _ in range(3)]
+    if two_ports_kernel(np.ascontiguousarray(lam.reshape(-1)), *rows, ptr[0], packed[0],
+                        ptr[1], nodes, packed[1], packed[2], *out):
+        raise FloatingPointError("mount network singular at some frequency (two-port pivot "
+                                 "below tolerance)")
+    return tuple(np.moveaxis(v.reshape((n,) + lam.shape), 0, -1) for v in out)
+
+
 def cross_point_stiffness(omega, masses, elem_nodes, c, d):
     r"""Cross-point dynamic stiffness :math:`K_{CP}(\omega) = F_T/\hat X_1` [N/m].
 

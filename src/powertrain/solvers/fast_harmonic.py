@@ -45,6 +45,7 @@ from powertrain.assembly import DIRECTIONS
 from powertrain.kernels.small_solve import batched_solve
 from powertrain.physics import balancer as bal
 from powertrain.physics.condensation import condensed_matrix
+from powertrain.physics.mount_elements import element_two_ports
 from powertrain.physics.mount_network import two_port
 from powertrain.physics.rigid_body import direction_row, point_motion_matrix, rigid_body_mass_matrix
 from powertrain.solvers.body_coupling import (
@@ -261,13 +262,7 @@ class HarmonicModel:
         if self.static_scale is not None:
             els = [dataclasses.replace(el, static_factor=self._static(k))
                    for k, el in enumerate(els)]
-        A = np.asarray(amplitudes, float)
-        abc = [np.empty(self.omega.shape + (len(els),), complex) for _ in range(3)]
-        for k, el in enumerate(els):
-            res = el.two_port(1j * self.omega, A[:, k:k + 1])
-            for j in range(3):
-                abc[j][..., k] = res[j]
-        return tuple(abc)
+        return element_two_ports(els, 1j * self.omega, np.asarray(amplitudes, float)[:, None])
 
     def _static(self, k):
         """Network ``k``'s static factor per speed, shape (n_r, 1) (1.0 without curves)."""
