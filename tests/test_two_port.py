@@ -131,3 +131,18 @@ def test_condensed_matrix_equals_the_dense_sum(grounded):
     got = condensed_matrix(frame, E, None if grounded else B, abc, s)
     assert got.shape == ref.shape
     assert np.max(np.abs(got - ref)) <= EXACT * np.max(np.abs(ref))
+
+
+def test_several_networks_follow_arrays_changed_in_place():
+    """Packed networks are reused only for read-only arrays: a caller that changes its
+    writable arrays in place between calls gets the new values."""
+    from powertrain.physics.mount_network import laplace_two_ports
+    masses, en, c, d = (np.array(x) for x in _networks()[0])
+    s = 1j * np.array([50.0, 500.0])
+    first = laplace_two_ports(s, [(masses, en, c, d)], 1.0, 1.0)[0][..., 0]
+    c *= 2.0
+    d *= 2.0
+    again = laplace_two_ports(s, [(masses, en, c, d)], 1.0, 1.0)[0][..., 0]
+    ref = laplace_two_port(s, masses, en, c, d)[0]
+    assert np.max(np.abs(again - ref)) <= EXACT * np.max(np.abs(ref))
+    assert np.max(np.abs(again - first)) > 0.1 * np.max(np.abs(first))

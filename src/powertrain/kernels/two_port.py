@@ -72,10 +72,10 @@ def condense_nodes(D, n, order, X, gone):
             return False
         gone[k] = True
         order[step] = k
-        inv_p = 1.0 / D[k, k]
+        p = D[k, k]
         for i in range(size):
             if not gone[i]:
-                f = D[i, k] * inv_p
+                f = D[i, k] / p
                 if f != 0.0:
                     for j in range(size):
                         if not gone[j]:
@@ -156,16 +156,16 @@ def two_ports_kernel(lam, spring_scale, damper_scale, mass_ptr, masses, el_ptr, 
     """:func:`two_port_kernel` of several networks in one call (the equivalent-linear fixed
     point asks for every network at every iteration): network k has the masses
     ``masses[mass_ptr[k]:mass_ptr[k + 1]]`` and the elements ``el_ptr[k]:el_ptr[k + 1]`` of
-    ``elem_nodes``, ``c``, ``d``; its factors and outputs are row k of ``spring_scale``,
-    ``damper_scale`` and ``out_a``, ``out_b``, ``out_c`` (n_net, n_w). Returns 0, or 1 when
+    ``elem_nodes``, ``c``, ``d``; its factors and outputs are column k of ``spring_scale``,
+    ``damper_scale`` and ``out_a``, ``out_b``, ``out_c`` (n_w, n_net). Returns 0, or 1 when
     some network was singular somewhere (NaN there)."""
     no_x = np.empty((0, 0, 2), np.complex128)
     status = 0
-    for k in range(out_a.shape[0]):
+    for k in range(out_a.shape[1]):
         m0, m1, e0, e1 = mass_ptr[k], mass_ptr[k + 1], el_ptr[k], el_ptr[k + 1]
-        status |= two_port_kernel(lam, spring_scale[k], damper_scale[k], masses[m0:m1],
-                                  elem_nodes[e0:e1], c[e0:e1], d[e0:e1], out_a[k], out_b[k],
-                                  out_c[k], no_x)
+        status |= two_port_kernel(lam, spring_scale[:, k], damper_scale[:, k], masses[m0:m1],
+                                  elem_nodes[e0:e1], c[e0:e1], d[e0:e1], out_a[:, k],
+                                  out_b[:, k], out_c[:, k], no_x)
     return status
 
 

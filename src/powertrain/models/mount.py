@@ -190,12 +190,20 @@ class MountModel:
         return np.array([self.params[p] for p in self.topology.parameters], dtype=float)
 
     def network(self):
-        """``(masses, elem_nodes, c, d)`` arrays for :mod:`powertrain.physics.mount_network`."""
-        t = self.topology
-        masses = np.array([self.params[m] if m else 0.0 for m in t.masses], dtype=float)
-        c = np.array([self.params[e[2]] if e[2] else 0.0 for e in t.elements], dtype=float)
-        d = np.array([self.params[e[3]] if e[3] else 0.0 for e in t.elements], dtype=float)
-        return masses, t.elem_nodes, c, d
+        """``(masses, elem_nodes, c, d)`` arrays for :mod:`powertrain.physics.mount_network`
+        (read-only, made once: the model is frozen and the amplitude fixed point asks for
+        them at every iteration)."""
+        cached = self.__dict__.get("_network")
+        if cached is None:
+            t = self.topology
+            cached = (np.array([self.params[m] if m else 0.0 for m in t.masses], dtype=float),
+                      t.elem_nodes,
+                      np.array([self.params[e[2]] if e[2] else 0.0 for e in t.elements], float),
+                      np.array([self.params[e[3]] if e[3] else 0.0 for e in t.elements], float))
+            for array in cached:
+                array.setflags(write=False)
+            object.__setattr__(self, "_network", cached)
+        return cached
 
     def element(self) -> MountElement:
         """The element the assembled model holds for this direction."""

@@ -115,10 +115,16 @@ def element_two_ports(elements, s, amplitudes):
     describing stiffnesses added at every :math:`s \ne 0`."""
     lam = np.asarray(s, complex)
     A = np.asarray(amplitudes, float)
-    scales = np.empty((2,) + lam.shape + (len(elements),))
+    scales = np.ones((2,) + A.shape)
+    groups = {}
     for k, el in enumerate(elements):
-        ks, ds = el.scale_arrays(A[..., k])
-        scales[0, ..., k], scales[1, ..., k] = ks, ds
+        if el.amplitude_law is not None:
+            groups.setdefault(el.amplitude_law, []).append(k)
+    for law, index in groups.items():            # one call per distinct law
+        ks, ds = law.scales(A[..., index])
+        scales[0][..., index], scales[1][..., index] = ks, ds
+    for k, el in enumerate(elements):
+        scales[:, ..., k] *= el.static_factor
     a, b, c = laplace_two_ports(lam, [el.model.network() for el in elements], *scales)
     for k, el in enumerate(elements):
         if el.port_law is not None:

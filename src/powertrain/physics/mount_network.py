@@ -200,19 +200,41 @@ def laplace_two_ports(s, networks, spring_scales, damper_scales):
     from powertrain.kernels.two_port import two_ports_kernel
     lam = np.asarray(s, complex)
     n, shape = len(networks), lam.shape + (len(networks),)
-    rows = [np.ascontiguousarray(np.moveaxis(np.broadcast_to(np.asarray(x, float), shape),
-                                             -1, 0).reshape(n, -1))
-            for x in (spring_scales, damper_scales)]
-    ptr = [np.cumsum([0] + [len(net[i]) for net in networks]) for i in (0, 2)]
-    packed = [np.concatenate([np.asarray(net[i], float).reshape(-1) for net in networks])
-              for i in (0, 2, 3)]
-    nodes = np.concatenate([np.asarray(net[1], np.int64).reshape(-1, 2) for net in networks])
-    out = [np.empty((n, lam.size), complex) for _ in range(3)]
-    if two_ports_kernel(np.ascontiguousarray(lam.reshape(-1)), *rows, ptr[0], packed[0],
-                        ptr[1], nodes, packed[1], packed[2], *out):
+    scales = [np.ascontiguousarray(np.broadcast_to(np.asarray(x, float), shape).reshape(-1, n))
+              for x in (spring_scales, damper_scales)]
+    out = [np.empty((lam.size, n), complex) for _ in range(3)]
+    if two_ports_kernel(np.ascontiguousarray(lam.reshape(-1)), *scales, *_packed(networks),
+                        *out):
         raise FloatingPointError("mount network singular at some frequency (two-port pivot "
                                  "below tolerance)")
-    return tuple(np.moveaxis(v.reshape((n,) + lam.shape), 0, -1) for v in out)
+    return tuple(v.reshape(shape) for v in out)
+
+
+#: Packed networks of the last calls of :func:`laplace_two_ports` whose arrays are all
+#: read-only (:meth:`MountModel.network <powertrain.models.mount.MountModel.network>`), by
+#: the identity of those arrays (kept alive here, so that an identity is not reused while
+#: its entry exists; read-only, so that their values cannot change).
+_PACKED = {}
+
+
+def _packed(networks):
+    """``(mass_ptr, masses, el_ptr, elem_nodes, c, d)`` of the networks concatenated."""
+    frozen = all(isinstance(x, np.ndarray) and not x.flags.writeable
+                 for net in networks for x in net)
+    key = tuple(id(x) for net in networks for x in net)
+    hit = _PACKED.get(key) if frozen else None
+    if hit is not None and all(x is y for a, b in zip(hit[0], networks) for x, y in zip(a, b)):
+        return hit[1]
+    ptr = [np.cumsum([0] + [len(net[i]) for net in networks]) for i in (0, 2)]
+    arrays = [np.concatenate([np.asarray(net[i], float).reshape(-1) for net in networks])
+              for i in (0, 2, 3)]
+    nodes = np.concatenate([np.asarray(net[1], np.int64).reshape(-1, 2) for net in networks])
+    packed = (ptr[0], arrays[0], ptr[1], nodes, arrays[1], arrays[2])
+    if frozen:
+        if len(_PACKED) >= 16:
+            del _PACKED[next(iter(_PACKED))]
+        _PACKED[key] = (tuple(tuple(net) for net in networks), packed)
+    return packed
 
 
 def cross_point_stiffness(omega, masses, elem_nodes, c, d):
