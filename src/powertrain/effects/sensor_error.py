@@ -75,7 +75,7 @@ def sensor_reading(velocity, gain_db, rotation, cross_axis=None):
         for (i, j), s in zip(((0, 1), (0, 2), (1, 2)), np.asarray(cross_axis, float).T):
             S[:, i, j] = S[:, j, i] = s
         T = T + S
-    out = np.einsum("mij,rmjh->rmih", T, v.reshape(v.shape[0], n_m, 3, -1))
+    out = T @ v.reshape(v.shape[0], n_m, 3, -1)
     return out.reshape(v.shape) * 10.0 ** (np.asarray(gain_db, float) / 20.0)[None, :, None]
 
 

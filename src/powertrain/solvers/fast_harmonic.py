@@ -330,12 +330,12 @@ class HarmonicModel:
             C[self.channel_matrix.shape[0]:, 6:] = body.output_rows()
         if self.output is not None:
             C = C[self.output]
-        return np.einsum("ci,rhi->rch", C, q) * (1j * w)[:, None, :]
+        return np.swapaxes(q @ C.T, -1, -2) * (1j * w)[:, None, :]
 
     def network_amplitude(self, q) -> np.ndarray:
         r"""Engine-side peak displacement of each network :math:`a_n =
         \sqrt{\sum_h |\mathbf r_n\cdot\hat{\mathbf q}_h|^2}` [m] (= √2 × RMS sum), (n_r, n_net)."""
-        x = np.einsum("ni,rhi->rhn", self.rows, q[..., :6])
+        x = q[..., :6] @ self.rows.T
         return np.sqrt(np.sum(np.abs(x) ** 2, axis=1))
 
     def _network_shapes(self, body):
@@ -352,10 +352,10 @@ class HarmonicModel:
         :func:`powertrain.solvers.equivalent_linear.amplitudes_of`), (n_r, n_net); the base
         term only with a modal body (``body``: the one ``q`` was solved with, default
         :attr:`body`)."""
-        x = np.einsum("ni,rhi->rhn", self.rows, q[..., :6])
+        x = q[..., :6] @ self.rows.T
         if self.body is not None:
             shapes = self._network_shapes(self.body if body is None else body)
-            x = x - np.einsum("nk,rhk->rhn", shapes, q[..., 6:])
+            x = x - q[..., 6:] @ shapes.T
         return np.sqrt(np.sum(np.abs(x) ** 2, axis=1))
 
     def __getstate__(self):
