@@ -218,3 +218,27 @@ def test_runup_application_and_diagnosis_prediction_agree(name, engine_file):
     assert np.max(np.abs(ref - base)) > 1e-4 * np.max(np.abs(ref)), \
         "the moved parameters change nothing"
     assert np.max(np.abs(fast - ref)) <= FIRST_ORDER.get(name, EXACT) * np.max(np.abs(ref))
+
+
+def test_gap_decomposition_solve_is_the_minimum_norm_least_squares():
+    """``where._solve`` (sparse normal equations on the columns with entries) against
+    ``numpy.linalg.lstsq`` on a decomposition-like problem with empty columns (a channel
+    without data, knots without data or penalty)."""
+    from powertrain.diagnosis.where import _solve
+    rng = np.random.default_rng(5)
+    n, n_col = 300, 40
+    X = np.zeros((n, n_col))
+    rows = np.arange(n)
+    X[rows, rng.integers(0, 4, n)] = 1.0               # constants of channels 0-3 (4 empty)
+    j = rng.integers(5, 30, n)
+    t = rng.uniform(size=n)
+    X[rows, j], X[rows, j + 1] = 1 - t, t              # hat basis on knots 5-30
+    P = np.zeros((n_col - 5 - 6, n_col))                # ridge on 5..33; 34..39 left empty
+    P[np.arange(P.shape[0]), 5 + np.arange(P.shape[0])] = 0.3
+    y = rng.normal(size=n)
+    for cols in (np.arange(n_col), np.arange(5, n_col), np.arange(5)):
+        A = np.vstack([X[:, cols], P[:, cols]])
+        ref = np.linalg.lstsq(A, np.concatenate([y, np.zeros(P.shape[0])]), rcond=None)[0]
+        got = _solve(X, P, y, cols)
+        np.testing.assert_allclose(got[cols], ref, rtol=0, atol=1e-10 * np.abs(ref).max())
+        assert not np.any(np.delete(got, cols))

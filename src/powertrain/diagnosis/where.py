@@ -95,11 +95,22 @@ def _penalties(blocks, n_ch, n_q, nf, nr, n_col):
 
 
 def _solve(X, P, y, cols):
-    """Penalised least squares on the columns ``cols`` only; coefficients (full length)."""
-    A = np.vstack([X[:, cols], P[:, cols]])
+    """Penalised least squares on the columns ``cols`` only; coefficients (full length).
+
+    The minimum-norm solution (as ``numpy.linalg.lstsq``): columns without an entry (a
+    channel or knot with no data and no penalty) get zero, the others solve the normal
+    equations as a sparse system — a data row touches five columns and the ridge makes
+    every penalised column regular, so this takes milliseconds where a dense SVD of the
+    two-sided problem (~3400 × 670) took a quarter of a second."""
+    from scipy import sparse
+    from scipy.sparse.linalg import spsolve
+    cols = np.asarray(cols)
+    A = sparse.csc_matrix(np.vstack([X[:, cols], P[:, cols]]))
+    used = np.flatnonzero(np.diff(A.indptr))
+    A = A[:, used]
     b = np.concatenate([y, np.zeros(P.shape[0])])
     beta = np.zeros(X.shape[1])
-    beta[cols] = np.linalg.lstsq(A, b, rcond=None)[0]
+    beta[cols[used]] = spsolve((A.T @ A).tocsc(), A.T @ b)
     return beta
 
 
