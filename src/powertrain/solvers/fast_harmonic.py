@@ -46,7 +46,7 @@ from powertrain.kernels.small_solve import batched_solve
 from powertrain.physics import balancer as bal
 from powertrain.physics.condensation import condensed_matrix
 from powertrain.physics.mount_elements import element_two_ports
-from powertrain.physics.mount_network import two_port
+from powertrain.physics.mount_network import laplace_two_ports
 from powertrain.physics.rigid_body import direction_row, point_motion_matrix, rigid_body_mass_matrix
 from powertrain.solvers.body_coupling import (
     ModalBody,
@@ -206,14 +206,11 @@ class HarmonicModel:
         if models is None and self._abc is not None:
             return self._abc
         mods = [n[2] for n in self.networks] if models is None else models
-        abc = [np.empty(self.omega.shape + (len(mods),), complex) for _ in range(3)]
-        for k, mod in enumerate(mods):
-            res = two_port(self.omega, *mod.network(), self._static(k))
-            for j in range(3):
-                abc[j][..., k] = res[j]
+        static = self._statics(range(len(mods)))
+        abc = laplace_two_ports(1j * self.omega, [m.network() for m in mods], static, static)
         if models is None:
-            self._abc = tuple(abc)
-        return tuple(abc)
+            self._abc = abc
+        return abc
 
     def two_ports_scaled(self, scale):
         r"""``(a, b, c)`` of every network with its elastomer scaled, each (n_r, 17, n_net).
@@ -222,34 +219,35 @@ class HarmonicModel:
         ``scale[r, h, n]`` (any shape that broadcasts to (n_r, 17, n_net)), its masses
         kept — :math:`s(\mathbf K + i\omega\mathbf C) - \omega^2\mathbf M` condensed
         by the one two-port condensation
-        (:func:`powertrain.physics.mount_network.two_port`). With ``scale = 1`` the same
-        as :meth:`two_ports`.
+        (:func:`powertrain.physics.mount_network.laplace_two_ports`). With ``scale = 1`` the
+        same as :meth:`two_ports`.
         """
         n_net = len(self.networks)
         scale = np.asarray(scale, float)
-        sc = np.broadcast_to(scale, self.omega.shape + (n_net,))
-        abc = [np.empty(self.omega.shape + (n_net,), complex) for _ in range(3)]
-        for k, (_, _, mod) in enumerate(self.networks):
-            if scale.size == n_net:          # one factor per network: the last two kept
-                res = self._scaled_network(k, float(scale.flat[k]))
-            else:
-                res = two_port(self.omega, *mod.network(),
-                               spring_scale=sc[..., k] * self._static(k))
-            for j in range(3):
-                abc[j][..., k] = res[j]
-        return tuple(abc)
+        if scale.size == n_net:              # one factor per network: the last two kept
+            return self._scaled_networks([float(f) for f in scale.flat])
+        sc = np.broadcast_to(scale, self.omega.shape + (n_net,)) * self._statics(range(n_net))
+        return laplace_two_ports(1j * self.omega, [n[2].network() for n in self.networks],
+                                 sc, sc)
 
-    def _scaled_network(self, k, factor):
-        """Network ``k``'s two-port with every spring and damper times ``factor`` at every
-        speed; the last two factors per network are kept (a finite-difference Jacobian
-        column changes the factors of one mount only: the others' are reused)."""
-        kept = self._scaled.setdefault(k, {})
-        if factor not in kept:
-            if len(kept) >= 2:
-                del kept[next(iter(kept))]
-            kept[factor] = two_port(self.omega, *self.networks[k][2].network(),
-                                    spring_scale=factor * self._static(k))
-        return kept[factor]
+    def _scaled_networks(self, factors):
+        """Every network's two-port with its springs and dampers times ``factors[k]`` at
+        every speed; the last two factors per network are kept (a finite-difference
+        Jacobian column changes the factors of one mount only: the others' are reused), the
+        missing ones condensed in one call."""
+        kept = [self._scaled.setdefault(k, {}) for k in range(len(factors))]
+        missing = [k for k, f in enumerate(factors) if f not in kept[k]]
+        if missing:
+            scale = np.array([factors[k] for k in missing]) * self._statics(missing)
+            res = laplace_two_ports(1j * self.omega,
+                                    [self.networks[k][2].network() for k in missing],
+                                    scale, scale)
+            for j, k in enumerate(missing):
+                if len(kept[k]) >= 2:
+                    del kept[k][next(iter(kept[k]))]
+                kept[k][factors[k]] = tuple(r[..., j] for r in res)
+        return tuple(np.stack([kept[k][f][j] for k, f in enumerate(factors)], axis=-1)
+                     for j in range(3))
 
     def two_ports_at(self, amplitudes, elements=None):
         r"""``(a, b, c)`` of every network's element at its relative-displacement amplitude,
@@ -267,6 +265,13 @@ class HarmonicModel:
     def _static(self, k):
         """Network ``k``'s static factor per speed, shape (n_r, 1) (1.0 without curves)."""
         return 1.0 if self.static_scale is None else self.static_scale[:, k:k + 1]
+
+    def _statics(self, index):
+        """The static factors of the networks ``index`` per speed, (n_r, 1, len(index))
+        (1.0 without curves)."""
+        if self.static_scale is None:
+            return 1.0
+        return self.static_scale[:, None, list(index)]
 
     # ------------------------------------------------------------------ solves
     def solve(self, kip, load=None, harmonics=slice(1, N_HARMONICS), abc=None,
