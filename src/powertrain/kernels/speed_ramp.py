@@ -8,6 +8,8 @@ Ramp: :math:`n(t) = n_0 + \dot n t`, :math:`\theta(t) = \tfrac{2\pi}{60}(n_0 t +
 ``n_theta`` angles over the cycle (plus the periodic wrap); it is read bilinearly.
 """
 
+import math
+
 import numpy as np
 from numba import njit
 
@@ -21,7 +23,8 @@ def ramp_load(table, speed0, speed_step, rpm_from, rate, h, k, out):
     t = k * h
     rpm = rpm_from + rate * t
     theta = (2.0 * np.pi / 60.0) * (rpm_from * t + 0.5 * rate * t * t)
-    u = (theta % (4.0 * np.pi)) * (n_theta / (4.0 * np.pi))
+    cycles = theta * (1.0 / (4.0 * np.pi))
+    u = (cycles - math.floor(cycles)) * n_theta       # floor: no fmod call per step
     i = min(int(u), n_theta - 1)
     fu = u - i
     v = (rpm - speed0) / speed_step

@@ -120,10 +120,9 @@ def simulate_sweep(engine, rpm_from, rpm_to, rate_rpm_per_s, sample_rate=8192.0,
     with threadpool_limits(limits=1, user_api="blas"):     # small matrices: see run_runup
         y, method = _integrate_ramp(engine, system, load, ramp, dofs, decimator, progress,
                                     static_factors)
-    y = y @ to_channels.T
+        block = to_channels @ y.T                           # (n_ch, n_out), contiguous
     t_out = (decimator.first_output_index + np.arange(y.shape[0])) / sample_rate
     rpm_out = rpm_from + rate_rpm_per_s * t_out
-    block = np.ascontiguousarray(y.T)
     chans = [RawChannel(Channel(mnt, "active", d).label, mnt, "active", d, "acceleration",
                         block[c], "m/s^2") for c, (mnt, d) in enumerate(system.channels)]
     note = (f"SYNTHETIC: simulated continuous run-up {rpm_from:g}->{rpm_to:g} rpm at "
