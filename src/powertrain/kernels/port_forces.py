@@ -191,7 +191,7 @@ def newmark_port_kernel(G, H, Fs, h, x0, v0, a0, W, P, Q, kinds, par, state, X, 
     hv = 0.5 * h
     xt, vt = np.empty(n), np.empty(n)
     ul, vl, z, r = np.empty(m), np.empty(m), np.empty(m), np.empty(m)
-    J, last = np.empty((m, m)), np.zeros((9, m))
+    J, last = np.empty((m, m)), np.zeros((7, m))
     coupled = _coupling(hh * Q, hv / hh)
     failed = 0
     for j in range(n):
@@ -276,8 +276,8 @@ def _port_forces_step(kinds, par, state, ul, vl, Q, z, last, r, J, tol, max_iter
     within ``rho |f - z|``, ``rho = max_e (|k_t,e| + qv |c_t,e|) sum_j |Qu_ej|`` (first
     order). So from a predictor on the laws' curves through the last committed points
     (:func:`_predict`, at the motions without this step's change of the coupling), ``last``
-    (9, m) = ``(u, v, df/du, df/dv)``, two rows of work space, the point before and the
-    coupling ``Qu z`` (updated here; zeros: from ``z``), one evaluation mostly suffices:
+    (7, m) = ``(u, v, df/du, df/dv)``, the point before and the coupling ``Qu z`` (updated
+    here; zeros: from ``z``), one evaluation mostly suffices:
     ``z = f`` is accepted when ``rho |f - z|`` is below ``tol`` times (1 + the largest
     force) (the tolerance of :func:`_port_newton`, which takes over after
     :data:`JACOBI_ITER` iterations of Newton with the Jacobian's diagonal), and the states
@@ -305,52 +305,45 @@ def _port_forces_step(kinds, par, state, ul, vl, Q, z, last, r, J, tol, max_iter
 @njit(cache=True, nogil=True, inline="always")
 def _predict(ul, vl, qv, last, z):
     """The port forces ``z`` (in place, the last step's) moved along the laws' curves to the
-    motions with the last coupling (row 8 of ``last``; into rows 4, 5): ``k_t du + c_t dv``,
-    the tangent stiffness, while the motion keeps its direction, extrapolated to the middle
-    of the step from the last two committed points (rows 6, 7: the point before, moved on
-    here; a step as long as the last: the curvature to second order in du, no division)."""
+    motions with the last coupling (row 6 of ``last``): ``k_t du + c_t dv``, the tangent
+    stiffness, while the motion keeps its direction, extrapolated to the middle of the step
+    from the last two committed points (rows 4, 5: the point before, moved on here; a step
+    as long as the last: the curvature to second order in du, no division)."""
     for e in range(z.shape[0]):
-        last[4, e] = ul[e] - last[8, e]
-        last[5, e] = vl[e] - qv * last[8, e]
-        du = last[4, e] - last[0, e]
+        du = ul[e] - last[6, e] - last[0, e]
         kt = last[2, e]
-        if du * (last[0, e] - last[6, e]) > 0.0:
-            kt += 0.5 * (last[2, e] - last[7, e])
-        z[e] += kt * du + last[3, e] * (last[5, e] - last[1, e])
-        last[6, e] = last[0, e]
-        last[7, e] = last[2, e]
+        if du * (last[0, e] - last[4, e]) > 0.0:
+            kt += 0.5 * (kt - last[5, e])
+        z[e] += kt * du + last[3, e] * (vl[e] - qv * last[6, e] - last[1, e])
+        last[4, e] = last[0, e]
+        last[5, e] = last[2, e]
 
 
 @njit(cache=True, nogil=True)
 def _coupling(Qu, qv):
-    """``(Qu, qv, qa, Qu^T)`` of :func:`_port_forces_step`, ``qa`` the row sums of |Qu|."""
-    return Qu, qv, np.abs(Qu).sum(axis=1), np.ascontiguousarray(Qu.T)
+    """``(Qu, qv, qa)`` of :func:`_port_forces_step`, ``qa`` the row sums of |Qu|."""
+    return Qu, qv, np.abs(Qu).sum(axis=1)
 
 
 @njit(cache=True, nogil=True, inline="always")
 def _port_residual(kinds, par, state, ul, vl, Q, z, last, r):
     """Residuals ``r = f(u, v) - z`` of the port forces ``z`` and the points ``last`` (rows
-    0-3) = ``(u, v, df/du, df/dv)``, the coupling ``Qu z`` in row 8; returns (1 + the largest
+    0-3) = ``(u, v, df/du, df/dv)``, the coupling ``Qu z`` in row 6; returns (1 + the largest
     force, the largest residual, the coupling bound rho of :func:`_port_forces_step`)."""
-    Qt, qv, qa = Q[3], Q[1], Q[2]
-    m = z.shape[0]
-    for e in range(m):
-        last[8, e] = 0.0
-    for j in range(m):           # independent sums: no chain of dependent additions
-        zj = z[j]
-        Qj = Qt[j]
-        for e in range(m):
-            last[8, e] += Qj[e] * zj
+    Qu, qv, qa = Q
     big, worst, rho = 1.0, 0.0, 0.0
-    for e in range(m):
-        last[0, e] = ul[e] - last[8, e]
-        last[1, e] = vl[e] - qv * last[8, e]
-        f, last[2, e], last[3, e] = law_force(kinds[e], last[0, e], last[1, e], par, state,
-                                              e)
+    for e in range(z.shape[0]):
+        c = 0.0
+        for j in range(z.shape[0]):
+            c += Qu[e, j] * z[j]
+        u = ul[e] - c
+        v = vl[e] - qv * c
+        f, kt, ct = law_force(kinds[e], u, v, par, state, e)
+        last[0, e], last[1, e], last[2, e], last[3, e], last[6, e] = u, v, kt, ct, c
         r[e] = f - z[e]
         big = max(big, abs(z[e]))
         worst = max(worst, abs(r[e]))
-        rho = max(rho, (abs(last[2, e]) + qv * abs(last[3, e])) * qa[e])
+        rho = max(rho, (abs(kt) + qv * abs(ct)) * qa[e])
     return big, worst, rho
 
 
@@ -470,7 +463,7 @@ def modal_port_kernel(modal, outputs, ports, laws, F, x, y, z, out, tol, max_ite
     q = T.shape[1]
     p, p_next, base, a = np.empty(q), np.empty(q), np.empty(q), np.empty(q)
     ul, vl, r = np.empty(m), np.empty(m), np.empty(m)
-    J, w, last = np.empty((m, m)), np.empty(2 * q), np.zeros((9, m))
+    J, w, last = np.empty((m, m)), np.empty(2 * q), np.zeros((7, m))
     coupled = _coupling(Qu, 2.0 / h)
     _body_force(load_at, T, F, 0, z, p)
     failed = 0
