@@ -45,18 +45,6 @@ def ramp_loads(table, speed0, speed_step, rpm_from, rate, h, k0, out):
         ramp_load(table, speed0, speed_step, rpm_from, rate, h, k0 + r, out[r])
 
 
-@njit(cache=True, nogil=True, fastmath=True, inline="always")
-def _modal_load(load_map, f, g):
-    """Modal load ``g = map f`` (real form) of the load ``f`` (6,)."""
-    for j in range(g.shape[0]):
-        g[j] = 0.0
-    for c in range(6):
-        fc = f[c]
-        row = load_map[c]
-        for j in range(g.shape[0]):
-            g[j] += row[j] * fc
-
-
 @njit(cache=True, nogil=True, fastmath=True)
 def modal_ramp_kernel(lam_d, load_map, w, w_load, table, speed0, speed_step, rpm_from, rate,
                       h, k0, x, out):
@@ -74,10 +62,8 @@ def modal_ramp_kernel(lam_d, load_map, w, w_load, table, speed0, speed_step, rpm
     """
     lr, li = lam_d
     n = lr.shape[0]
-    f = np.empty(6)
-    g, g_next = np.empty(x.shape[0]), np.empty(x.shape[0])
+    f, f_next = np.empty(6), np.empty(6)
     ramp_load(table, speed0, speed_step, rpm_from, rate, h, k0, f)
-    _modal_load(load_map, f, g)
     for r in range(out.shape[0]):
         for c in range(out.shape[1]):
             y = 0.0
@@ -87,17 +73,19 @@ def modal_ramp_kernel(lam_d, load_map, w, w_load, table, speed0, speed_step, rpm
             for j in range(x.shape[0]):
                 y += wc[j] * x[j]
             out[r, c] = y
-        ramp_load(table, speed0, speed_step, rpm_from, rate, h, k0 + r + 1, f)
-        _modal_load(load_map, f, g_next)
+        ramp_load(table, speed0, speed_step, rpm_from, rate, h, k0 + r + 1, f_next)
         for j in range(li.shape[0]):
             a = lr[j] * x[j] - li[j] * x[n + j]
             x[n + j] = lr[j] * x[n + j] + li[j] * x[j]
             x[j] = a
         for j in range(li.shape[0], n):
             x[j] *= lr[j]
-        for j in range(x.shape[0]):
-            x[j] += g[j] + g_next[j]
-            g[j] = g_next[j]
+        for q in range(6):               # g_k + g_k+1 = map (f_k + f_k+1): one pass per load
+            s = f[q] + f_next[q]
+            row = load_map[q]
+            for j in range(x.shape[0]):
+                x[j] += row[j] * s
+            f[q] = f_next[q]
 
 
 @njit(cache=True, nogil=True, fastmath=True)
