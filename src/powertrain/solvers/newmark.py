@@ -330,9 +330,11 @@ class ModalPortNewmark:
     :func:`newmark_ports` to round-off and the Newton tolerance,
     tests/test_time_domain_laws.py). The recurrence is written on the reduced coordinates
     the load and the port rows touch (the body's six: a port row is a rigid body's motion at
-    a mount): the port motions are read from their motions, the port forces act through
-    their generalized force. Outputs: ``y = Wx x + Wv v + Wa a + Wz z`` (rows over the
-    coordinates, and over the port forces for ``Wz``; None: no such term).
+    a mount): the port motions are read from their motions (per step their accelerations
+    off the modes, displacements and velocities by Newmark's kinematics, read off the modes
+    again at each call), the port forces act through their generalized force. Outputs:
+    ``y = Wx x + Wv v + Wa a + Wz z`` (rows over the coordinates, and over the port forces
+    for ``Wz``; None: no such term).
 
     Parameters
     ----------
@@ -375,9 +377,9 @@ class ModalPortNewmark:
     def _output_arrays(self, Wx=None, Wv=None, Wa=None, Wz=None):
         """``((Wy, y_cols), (Wz, z_cols), w_rows, W, Wd)`` of :func:`modal_port_kernel` for
         the output rows: ``Wy`` over the reduced state, ``Wz`` over the port forces (the
-        columns they read, :func:`_read_columns`); the rows ``w_rows`` that read other coordinates also
-        through the modal state, ``Re(W eta) + Wd p`` (``Wd`` the direct part of the
-        acceleration, a = M^-1 (p - C v - K x))."""
+        columns they read, :func:`_read_columns`); the rows ``w_rows`` that read other
+        coordinates also through the modal state, ``Re(W eta) + Wd p`` (``Wd`` the direct
+        part of the acceleration, a = M^-1 (p - C v - K x))."""
         modal, n, r = self.modal, self.modal.n, self.reduced
         off = np.setdiff1d(np.arange(n), r)
         rows = next(w.shape[0] for w in (Wx, Wv, Wa, Wz) if w is not None)
