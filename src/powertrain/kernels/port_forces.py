@@ -53,18 +53,13 @@ def _berg(u, par, state, e):
     d, xs, fs = _berg_branch(u, state, e)
     if d == 0.0:
         return state[e, 4], fm / x2
-    y = u - xs
-    if d > 0:
-        a = x2 * (1.0 - fs / fm)
-        if y < 0.0:
-            y = 0.0
-        w = (fm - fs) / (a + y)
-        return fs + y * w, a * w / (a + y)
-    b = x2 * (1.0 + fs / fm)
-    if y > 0.0:
+    y = u - xs                  # force fs + y (fm - d fs) / (a + y), a = x2 (1 - d fs / fm)
+    if d * y < 0.0:
         y = 0.0
-    w = (fm + fs) / (b - y)
-    return fs + y * w, b * w / (b - y)
+    g = fm - d * fs
+    inv = 1.0 / (x2 * g + d * fm * y)                 # one division: 1 / (fm (a + y) / d)
+    w = g * inv
+    return fs + y * fm * w, x2 * fm * w * w
 
 
 @njit(cache=True, nogil=True, inline="always")
@@ -194,15 +189,10 @@ def newmark_port_kernel(G, H, Fs, h, x0, v0, a0, W, P, Q, kinds, par, state, X, 
     ns = Fs.shape[0]
     hh = 0.25 * h * h
     hv = 0.5 * h
-    xt = np.empty(n)
-    vt = np.empty(n)
-    ul = np.empty(m)
-    vl = np.empty(m)
-    z = np.empty(m)
-    r = np.empty(m)
-    J = np.empty((m, m))
-    coupled = _coupling(hh * Q, hv * Q)
-    last = np.zeros((6, m))
+    xt, vt = np.empty(n), np.empty(n)
+    ul, vl, z, r = np.empty(m), np.empty(m), np.empty(m), np.empty(m)
+    J, last = np.empty((m, m)), np.zeros((7, m))
+    coupled = _coupling(hh * Q, hv / hh)
     failed = 0
     for j in range(n):
         X[0, j] = x0[j]
@@ -245,21 +235,21 @@ def newmark_port_kernel(G, H, Fs, h, x0, v0, a0, W, P, Q, kinds, par, state, X, 
 
 
 @njit(cache=True, nogil=True)
-def _port_newton(kinds, par, state, ul, vl, Qu, Qv, z, r, J, tol, max_iter):
+def _port_newton(kinds, par, state, ul, vl, Q, z, r, J, tol, max_iter):
     """Newton on the port forces ``z`` (in place) of one step: ``z_e = f_e(ul_e - (Qu z)_e,
-    vl_e - (Qv z)_e)``, from the given ``z``. True on success."""
+    vl_e - qv (Qu z)_e)``, ``Q = (Qu, qv, ...)``, from the given ``z``. True on success."""
+    Qu, qv = Q[0], Q[1]
     m = z.shape[0]
     for _ in range(max_iter):
-        big = 1.0
-        worst = 0.0
+        big, worst = 1.0, 0.0
         for e in range(m):
-            f, kt, ct = law_force(kinds[e], ul[e] - _dot(Qu[e], z), vl[e] - _dot(Qv[e], z),
-                                  par, state, e)
+            c = _dot(Qu[e], z)
+            f, kt, ct = law_force(kinds[e], ul[e] - c, vl[e] - qv * c, par, state, e)
             r[e] = f - z[e]
             big = max(big, abs(z[e]))
             worst = max(worst, abs(r[e]))
             for j in range(m):
-                J[e, j] = kt * Qu[e, j] + ct * Qv[e, j]
+                J[e, j] = (kt + qv * ct) * Qu[e, j]
             J[e, e] += 1.0
         if worst <= tol * big:
             return True
@@ -276,83 +266,84 @@ JACOBI_ITER = 8
 @njit(cache=True, nogil=True, inline="always")
 def _port_forces_step(kinds, par, state, ul, vl, Q, z, last, r, J, tol, max_iter):
     """The port forces ``z`` (in place, from the last step's) of one step, ``z_e =
-    f_e(ul_e - (Qu z)_e, vl_e - (Qv z)_e)``, ``Q = (Qu, Qv, row sums of |Qu|, |Qv|)``
-    (:func:`_coupling`), and the states committed. True on success.
+    f_e(ul_e - (Qu z)_e, vl_e - qv (Qu z)_e)``, ``Q = (Qu, qv, row sums of |Qu|)``
+    (:func:`_coupling`; the velocities' coupling is ``qv = 2 / h`` times the displacements'
+    in Newmark's average acceleration), and the states committed. True on success.
 
-    The ports are coupled only through the body's motion within one step (``Qu``, ``Qv`` of
-    the order h^2/mass: ``|k_t Qu|`` ~ 1e-5 for the default engine's friction at 40 kHz): the
+    The ports are coupled only through the body's motion within one step (``Qu`` of the
+    order h^2/mass: ``|k_t Qu|`` ~ 1e-5 for the default engine's friction at 40 kHz): the
     forces ``f`` the laws give at the motion of forces ``z`` are those of the solution to
-    within ``rho |f - z|``, ``rho = max_e |k_t,e| sum_j |Qu_ej| + |c_t,e| sum_j |Qv_ej|``
-    (first order). So from a predictor on the tangent of the last committed point,
-    ``last`` (6, m) = ``(u, v, df/du, df/dv)`` and two rows of work space (updated here;
-    zeros: from ``z``), one
-    evaluation mostly suffices: ``z = f`` is accepted when ``rho |f - z|`` is below ``tol``
-    times (1 + the largest force) (the tolerance of :func:`_port_newton`, which takes over
-    after :data:`JACOBI_ITER` iterations of Newton with the Jacobian's diagonal), and the
-    states are committed at that evaluation."""
-    Qu, Qv, qa = Q
+    within ``rho |f - z|``, ``rho = max_e (|k_t,e| + qv |c_t,e|) sum_j |Qu_ej|`` (first
+    order). So from a predictor on the laws' curves through the last committed points
+    (:func:`_predict`, at the motions without this step's change of the coupling), ``last``
+    (7, m) = ``(u, v, df/du, df/dv)``, the point before and the coupling ``Qu z`` (updated
+    here; zeros: from ``z``), one evaluation mostly suffices:
+    ``z = f`` is accepted when ``rho |f - z|`` is below ``tol`` times (1 + the largest
+    force) (the tolerance of :func:`_port_newton`, which takes over after
+    :data:`JACOBI_ITER` iterations of Newton with the Jacobian's diagonal), and the states
+    are committed at that evaluation."""
+    Qu, qv = Q[0], Q[1]
     m = z.shape[0]
-    _port_motions(ul, vl, Qu, Qv, z, last, 4)
-    for e in range(m):
-        z[e] += last[2, e] * (last[4, e] - last[0, e]) + last[3, e] * (last[5, e] - last[1, e])
+    _predict(ul, vl, qv, last, z)
     for _ in range(JACOBI_ITER):
-        big, worst, rho = _port_residual(kinds, par, state, ul, vl, Qu, Qv, qa, z, last, r)
+        big, worst, rho = _port_residual(kinds, par, state, ul, vl, Q, z, last, r)
         if rho < 1.0 and rho * worst <= tol * big:
             for e in range(m):
                 z[e] += r[e]
             _commit(kinds, par, state, last, z)
             return True
         for e in range(m):
-            z[e] += r[e] / (1.0 + last[2, e] * Qu[e, e] + last[3, e] * Qv[e, e])
-    converged = _port_newton(kinds, par, state, ul, vl, Qu, Qv, z, r, J, tol, max_iter)
-    _port_residual(kinds, par, state, ul, vl, Qu, Qv, qa, z, last, r)
+            z[e] += r[e] / (1.0 + (last[2, e] + qv * last[3, e]) * Qu[e, e])
+    converged = _port_newton(kinds, par, state, ul, vl, Q, z, r, J, tol, max_iter)
+    _port_residual(kinds, par, state, ul, vl, Q, z, last, r)
     for e in range(m):
         z[e] += r[e]
     _commit(kinds, par, state, last, z)
     return converged
 
 
+@njit(cache=True, nogil=True, inline="always")
+def _predict(ul, vl, qv, last, z):
+    """The port forces ``z`` (in place, the last step's) moved along the laws' curves to the
+    motions with the last coupling (row 6 of ``last``): ``k_t du + c_t dv``, the tangent
+    stiffness, while the motion keeps its direction, extrapolated to the middle of the step
+    from the last two committed points (rows 4, 5: the point before, moved on here; a step
+    as long as the last: the curvature to second order in du, no division)."""
+    for e in range(z.shape[0]):
+        du = ul[e] - last[6, e] - last[0, e]
+        kt = last[2, e]
+        if du * (last[0, e] - last[4, e]) > 0.0:
+            kt += 0.5 * (kt - last[5, e])
+        z[e] += kt * du + last[3, e] * (vl[e] - qv * last[6, e] - last[1, e])
+        last[4, e] = last[0, e]
+        last[5, e] = last[2, e]
+
+
 @njit(cache=True, nogil=True)
-def _coupling(Qu, Qv):
-    """``(Qu, Qv, qa)`` of :func:`_port_forces_step`: ``qa`` (2, m) row sums of |Qu|, |Qv|."""
-    qa = np.zeros((2, Qu.shape[0]))
-    for e in range(Qu.shape[0]):
-        for j in range(Qu.shape[1]):
-            qa[0, e] += abs(Qu[e, j])
-            qa[1, e] += abs(Qv[e, j])
-    return Qu, Qv, qa
+def _coupling(Qu, qv):
+    """``(Qu, qv, qa)`` of :func:`_port_forces_step`, ``qa`` the row sums of |Qu|."""
+    return Qu, qv, np.abs(Qu).sum(axis=1)
 
 
 @njit(cache=True, nogil=True, inline="always")
-def _port_motions(ul, vl, Qu, Qv, z, out, row):
-    """Port motions ``u = ul - Qu z``, ``v = vl - Qv z`` into rows ``row``, ``row + 1`` of
-    ``out`` (independent sums: no chain of dependent additions per port)."""
+def _port_residual(kinds, par, state, ul, vl, Q, z, last, r):
+    """Residuals ``r = f(u, v) - z`` of the port forces ``z`` and the points ``last`` (rows
+    0-3) = ``(u, v, df/du, df/dv)``, the coupling ``Qu z`` in row 6; returns (1 + the largest
+    force, the largest residual, the coupling bound rho of :func:`_port_forces_step`)."""
+    Qu, qv, qa = Q
+    big, worst, rho = 1.0, 0.0, 0.0
     for e in range(z.shape[0]):
-        out[row, e] = ul[e]
-        out[row + 1, e] = vl[e]
-    for j in range(z.shape[0]):
-        zj = z[j]
-        for e in range(z.shape[0]):
-            out[row, e] -= Qu[e, j] * zj
-            out[row + 1, e] -= Qv[e, j] * zj
-
-
-@njit(cache=True, nogil=True, inline="always")
-def _port_residual(kinds, par, state, ul, vl, Qu, Qv, qa, z, last, r):
-    """Residuals ``r = f(u, v) - z`` of the port forces ``z`` and the points ``last`` (4, m)
-    = ``(u, v, df/du, df/dv)``; returns (1 + the largest force, the largest residual, the
-    coupling bound rho of :func:`_port_forces_step`)."""
-    _port_motions(ul, vl, Qu, Qv, z, last, 0)
-    big = 1.0
-    worst = 0.0
-    rho = 0.0
-    for e in range(z.shape[0]):
-        f, last[2, e], last[3, e] = law_force(kinds[e], last[0, e], last[1, e], par, state,
-                                              e)
+        c = 0.0
+        for j in range(z.shape[0]):
+            c += Qu[e, j] * z[j]
+        u = ul[e] - c
+        v = vl[e] - qv * c
+        f, kt, ct = law_force(kinds[e], u, v, par, state, e)
+        last[0, e], last[1, e], last[2, e], last[3, e], last[6, e] = u, v, kt, ct, c
         r[e] = f - z[e]
         big = max(big, abs(z[e]))
         worst = max(worst, abs(r[e]))
-        rho = max(rho, abs(last[2, e]) * qa[0, e] + abs(last[3, e]) * qa[1, e])
+        rho = max(rho, (abs(kt) + qv * abs(ct)) * qa[e])
     return big, worst, rho
 
 
@@ -364,19 +355,9 @@ def _commit(kinds, par, state, last, f):
 
 
 @njit(cache=True, nogil=True, fastmath=True, inline="always")
-def _read_rows(R, x, out):
-    """``out = R x``: rows of the modal state's real form (:func:`_advance`)."""
-    for c in range(out.shape[0]):
-        y = 0.0
-        for j in range(x.shape[0]):
-            y += R[c, j] * x[j]
-        out[c] = y
-
-
-@njit(cache=True, nogil=True, fastmath=True, inline="always")
 def _body_force(load_at, T, F, k, z, p):
     """Generalized force ``p`` (q,) on the reduced coordinates: the load ``F[k]`` placed at
-    ``load_at`` minus the port forces ``T^T z``."""
+    ``load_at`` minus the port forces ``T^T z`` (``z`` of length 0: the load alone)."""
     for c in range(p.shape[0]):
         p[c] = 0.0
     for c in range(F.shape[1]):
@@ -388,40 +369,46 @@ def _body_force(load_at, T, F, k, z, p):
 
 
 @njit(cache=True, nogil=True, fastmath=True, inline="always")
-def _write_outputs(W, Wd, Wz, x, p, z, row):
-    """One row of outputs ``W x + Wd p + Wz z`` into ``row``."""
-    _read_rows(W, x, row)
+def _write_outputs(outputs, x, y, p, z, row):
+    """One row of outputs ``Wy y[y_cols] + Wz z[z_cols]``, plus ``Re(W eta) + Wd p`` on the
+    rows ``w_rows`` (those reading coordinates off the reduced ones)."""
+    (Wy, y_cols), (Wz, z_cols), w_rows, W, Wd = outputs
     for c in range(row.shape[0]):
-        o = row[c]
-        for d in range(p.shape[0]):
-            o += Wd[c, d] * p[d]
-        for e in range(z.shape[0]):
-            o += Wz[c, e] * z[e]
+        o = 0.0
+        for d in range(y_cols.shape[0]):
+            o += Wy[c, d] * y[y_cols[d]]
+        for d in range(z_cols.shape[0]):
+            o += Wz[c, d] * z[z_cols[d]]
         row[c] = o
+    for i in range(w_rows.shape[0]):
+        row[w_rows[i]] += _dot(W[i], x) + _dot(Wd[i], p)
 
 
 @njit(cache=True, nogil=True, fastmath=True, inline="always")
-def _linear_port_motions(R, D, T, x, s, y, ul, vl):
-    """Port motions ``ul``, ``vl`` (m,) without the step's new port forces: the reduced ones
-    ``y = R x + (Dx s; Dv s)`` (2 q,) through the port rows ``T``."""
-    Dx, Dv = D
-    q = Dx.shape[0]
-    _read_rows(R, x, y)
+def _reduced_motions(T, y, a, h, ul, vl, w):
+    """Port motions ``ul``, ``vl`` (m,) of the next step whose reduced accelerations are
+    ``a``, by Newmark's kinematics from the reduced state ``y = (x, v, a)`` (3 q,); ``w``
+    (2 q,) work space."""
+    q = a.shape[0]
     for c in range(q):
-        for d in range(q):
-            y[c] += Dx[c, d] * s[d]
-            y[q + c] += Dv[c, d] * s[d]
+        s = y[2 * q + c] + a[c]
+        w[c] = y[c] + h * y[q + c] + 0.25 * h * h * s
+        w[q + c] = y[q + c] + 0.5 * h * s
     for e in range(ul.shape[0]):
-        ul[e] = _dot(T[e], y[:q])
-        vl[e] = _dot(T[e], y[q:])
+        su = 0.0
+        sv = 0.0
+        for c in range(q):
+            su += T[e, c] * w[c]
+            sv += T[e, c] * w[q + c]
+        ul[e] = su
+        vl[e] = sv
 
 
 @njit(cache=True, nogil=True, fastmath=True, inline="always")
 def _advance(lam_d, G, s, x):
     """The modal recurrence ``eta = lambda_d eta + G s`` in place, in real form: ``x`` holds
-    the real parts of the n modes, then the imaginary parts of the complex ones, which come
-    first (a real mode's is zero but for round-off); ``lam_d = (real parts (n,), imaginary
-    parts (n_c,))``."""
+    the real parts of the n modes, then the imaginary parts of the complex ones (first),
+    ``lam_d = (real parts (n,), imaginary parts (n_c,))``."""
     lr, li = lam_d
     n = lr.shape[0]
     for j in range(li.shape[0]):
@@ -437,7 +424,7 @@ def _advance(lam_d, G, s, x):
 
 
 @njit(cache=True, nogil=True, fastmath=True)
-def modal_port_kernel(modal, outputs, ports, laws, F, x, z, out, tol, max_iter):
+def modal_port_kernel(modal, outputs, ports, laws, F, x, y, z, out, tol, max_iter):
     r"""Newmark average acceleration with port laws in modal coordinates: the trapezoidal
     modal recurrence of the linear model (:class:`~powertrain.solvers.newmark.ModalNewmark`)
     :math:`\eta_{k+1} = \lambda_d\eta_k + \mathbf G(\mathbf p_k + \mathbf p_{k+1})`, the
@@ -447,53 +434,57 @@ def modal_port_kernel(modal, outputs, ports, laws, F, x, z, out, tol, max_iter):
     :math:`\mathbf P = \mathbf T\,\partial\mathbf y/\partial\mathbf x`), and
     :math:`\mathbf G = \mathrm{diag}\gamma\,\Psi^{-1}[0; \mathbf M^{-1}]` on them.
 
-    Per step: the outputs :math:`\mathrm{Re}(\mathbf W\eta_k) + \mathbf W_d\mathbf p_k +
-    \mathbf W_z\mathbf z_k`; the reduced motions of the next step without its new port
-    forces, :math:`\mathbf y^* = \mathrm{Re}(\Psi_y\lambda_d\eta_k) + \mathbf D_x\mathbf s`,
-    :math:`\mathbf s = \mathbf p_k + \mathbf E\mathbf f_{k+1}`,
-    :math:`\mathbf D_x = \mathrm{Re}(\Psi_y\mathbf G)` (velocities alike); the port motions
-    :math:`\mathbf u = \mathbf T\mathbf y^* - \mathbf Q_u\mathbf z`, :math:`\mathbf Q_u =
-    \mathbf T\mathbf D_x\mathbf T^T` (the :math:`\tfrac{h^2}4\mathbf P\mathbf S^{-1}\mathbf
-    P^T` of :func:`newmark_port_kernel`), solved for :math:`\mathbf z`
-    (:func:`_port_forces_step`); then the recurrence. Arguments (modal arrays in the real
-    form of :func:`_advance`, n_x columns): ``modal = (lam_d, G, R, (Dx, Dv))``, ``G``
-    (q, n_x) (the map's columns as rows), ``R`` (2 q, n_x) the rows reading
-    :math:`\mathrm{Re}(\Psi_y\lambda_d\eta)`, :math:`\mathrm{Re}(\Psi_{\dot
-    y}\lambda_d\eta)`; ``outputs = (W, Wd, Wz)`` (n_out rows), ``out``
-    (n_rows, n_out) gets them at steps 0 .. n_rows - 1 of the loads ``F`` (n_rows + 1,
-    n_load); ``ports = (T, load_at, Qu, Qv)``, ``laws = (kinds, par, state)``. The modal
-    state ``x`` (n_x,) and the port forces ``z`` (m,) are the state at step 0 on entry and
-    at step n_rows on return, ``state`` is updated in place. Returns the number of steps at
+    One modal read per step, the reduced accelerations of the next step,
+    :math:`\ddot{\mathbf y}_{k+1} = \mathrm{Re}(\Psi_a\lambda_d\eta_k) + \mathbf D_a\mathbf
+    p_k + \mathbf S\mathbf p_{k+1}` (:math:`\Psi_a = \Psi_{\dot y}\Lambda`, :math:`\mathbf
+    D_a = \mathrm{Re}(\Psi_a\mathbf G)`, :math:`\mathbf S = \mathbf D_a + \mathbf M^{-1}_{yy}`);
+    displacements and velocities follow by Newmark's kinematics, which the recurrence
+    satisfies exactly, :math:`\mathbf y_{k+1} = \mathbf y_k + h\dot{\mathbf y}_k +
+    \tfrac{h^2}4(\ddot{\mathbf y}_k + \ddot{\mathbf y}_{k+1})`. So the port motions are
+    :math:`\mathbf u = \mathbf u_{lin} - \mathbf Q_u\mathbf z`, :math:`\mathbf Q_u =
+    \tfrac{h^2}4\mathbf T\mathbf S\mathbf T^T` (the :math:`\tfrac{h^2}{4}\mathbf P\mathbf
+    S^{-1}\mathbf P^T` of :func:`newmark_port_kernel`), solved for :math:`\mathbf z`
+    (:func:`_port_forces_step`); then the recurrence.
+
+    Arguments (modal arrays in the real form of :func:`_advance`, n_x columns): ``modal =
+    (lam_d, G, Ra, (Da, S), h)``, ``G`` (q, n_x) (the map's columns as rows), ``Ra`` (q,
+    n_x) reading :math:`\mathrm{Re}(\Psi_a\lambda_d\eta)`; ``out`` (n_rows, n_out) gets
+    the ``outputs`` (:func:`_write_outputs`) at steps 0 .. n_rows - 1 of the loads ``F``
+    (n_rows + 1, n_load); ``ports = (T, load_at, Qu)``, ``laws = (kinds, par, state)``. The
+    modal state ``x`` (n_x,), the reduced state ``y`` (3 q,) (displacements, velocities,
+    accelerations) and the port forces ``z`` (m,) are the state at step 0 on entry and at
+    step n_rows on return, ``state`` is updated in place. Returns the number of steps at
     which Newton did not converge.
     """
-    lam_d, G, R, D = modal
-    W, Wd, Wz = outputs
-    T, load_at, Qu, Qv = ports
+    lam_d, G, Ra, (Da, S), h = modal
+    T, load_at, Qu = ports
     kinds, par, state = laws
     m = z.shape[0]
     q = T.shape[1]
-    y = np.empty(2 * q)
-    p, p_next, s = np.empty(q), np.empty(q), np.empty(q)
+    p, p_next, base, a = np.empty(q), np.empty(q), np.empty(q), np.empty(q)
     ul, vl, r = np.empty(m), np.empty(m), np.empty(m)
-    J = np.empty((m, m))
-    last = np.zeros((6, m))
-    coupled = _coupling(Qu, Qv)
+    J, w, last = np.empty((m, m)), np.empty(2 * q), np.zeros((7, m))
+    coupled = _coupling(Qu, 2.0 / h)
     _body_force(load_at, T, F, 0, z, p)
     failed = 0
     for k in range(out.shape[0]):
-        _write_outputs(W, Wd, Wz, x, p, z, out[k])
+        _write_outputs(outputs, x, y, p, z, out[k])
+        _body_force(load_at, T, F, k + 1, z[:0], p_next)
         for c in range(q):
-            s[c] = p[c]
-        for c in range(F.shape[1]):
-            s[load_at[c]] += F[k + 1, c]
-        _linear_port_motions(R, D, T, x, s, y, ul, vl)
+            base[c] = _dot(Ra[c], x) + _dot(Da[c], p)
+            a[c] = base[c] + _dot(S[c], p_next)
+        _reduced_motions(T, y, a, h, ul, vl, w)
         if not _port_forces_step(kinds, par, state, ul, vl, coupled, z, last, r, J, tol,
                                  max_iter):
             failed += 1
         _body_force(load_at, T, F, k + 1, z, p_next)
         for c in range(q):
-            s[c] = p[c] + p_next[c]
-            p[c] = p_next[c]
-        _advance(lam_d, G, s, x)
+            a[c] = base[c] + _dot(S[c], p_next)
+            s = y[2 * q + c] + a[c]
+            y[c] += h * y[q + c] + 0.25 * h * h * s
+            y[q + c] += 0.5 * h * s
+            y[2 * q + c] = a[c]
+            p[c] += p_next[c]
+        _advance(lam_d, G, p, x)
+        p[:] = p_next
     return failed
-

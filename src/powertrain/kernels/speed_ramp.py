@@ -8,6 +8,8 @@ Ramp: :math:`n(t) = n_0 + \dot n t`, :math:`\theta(t) = \tfrac{2\pi}{60}(n_0 t +
 ``n_theta`` angles over the cycle (plus the periodic wrap); it is read bilinearly.
 """
 
+import math
+
 import numpy as np
 from numba import njit
 
@@ -21,7 +23,8 @@ def ramp_load(table, speed0, speed_step, rpm_from, rate, h, k, out):
     t = k * h
     rpm = rpm_from + rate * t
     theta = (2.0 * np.pi / 60.0) * (rpm_from * t + 0.5 * rate * t * t)
-    u = (theta % (4.0 * np.pi)) * (n_theta / (4.0 * np.pi))
+    cycles = theta * (1.0 / (4.0 * np.pi))
+    u = (cycles - math.floor(cycles)) * n_theta       # floor: no fmod call per step
     i = min(int(u), n_theta - 1)
     fu = u - i
     v = (rpm - speed0) / speed_step
@@ -42,18 +45,6 @@ def ramp_loads(table, speed0, speed_step, rpm_from, rate, h, k0, out):
         ramp_load(table, speed0, speed_step, rpm_from, rate, h, k0 + r, out[r])
 
 
-@njit(cache=True, nogil=True, fastmath=True, inline="always")
-def _modal_load(load_map, f, g):
-    """Modal load ``g = map f`` (real form) of the load ``f`` (6,)."""
-    for j in range(g.shape[0]):
-        g[j] = 0.0
-    for c in range(6):
-        fc = f[c]
-        row = load_map[c]
-        for j in range(g.shape[0]):
-            g[j] += row[j] * fc
-
-
 @njit(cache=True, nogil=True, fastmath=True)
 def modal_ramp_kernel(lam_d, load_map, w, w_load, table, speed0, speed_step, rpm_from, rate,
                       h, k0, x, out):
@@ -71,10 +62,8 @@ def modal_ramp_kernel(lam_d, load_map, w, w_load, table, speed0, speed_step, rpm
     """
     lr, li = lam_d
     n = lr.shape[0]
-    f = np.empty(6)
-    g, g_next = np.empty(x.shape[0]), np.empty(x.shape[0])
+    f, f_next = np.empty(6), np.empty(6)
     ramp_load(table, speed0, speed_step, rpm_from, rate, h, k0, f)
-    _modal_load(load_map, f, g)
     for r in range(out.shape[0]):
         for c in range(out.shape[1]):
             y = 0.0
@@ -84,17 +73,19 @@ def modal_ramp_kernel(lam_d, load_map, w, w_load, table, speed0, speed_step, rpm
             for j in range(x.shape[0]):
                 y += wc[j] * x[j]
             out[r, c] = y
-        ramp_load(table, speed0, speed_step, rpm_from, rate, h, k0 + r + 1, f)
-        _modal_load(load_map, f, g_next)
+        ramp_load(table, speed0, speed_step, rpm_from, rate, h, k0 + r + 1, f_next)
         for j in range(li.shape[0]):
             a = lr[j] * x[j] - li[j] * x[n + j]
             x[n + j] = lr[j] * x[n + j] + li[j] * x[j]
             x[j] = a
         for j in range(li.shape[0], n):
             x[j] *= lr[j]
-        for j in range(x.shape[0]):
-            x[j] += g[j] + g_next[j]
-            g[j] = g_next[j]
+        for q in range(6):               # g_k + g_k+1 = map (f_k + f_k+1): one pass per load
+            s = f[q] + f_next[q]
+            row = load_map[q]
+            for j in range(x.shape[0]):
+                x[j] += row[j] * s
+            f[q] = f_next[q]
 
 
 @njit(cache=True, nogil=True, fastmath=True)

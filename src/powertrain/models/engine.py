@@ -294,9 +294,11 @@ class Engine:
             return np.stack([self.cylinder_pressure(n, crank_angle_rad, load)
                              for n in np.atleast_1d(speeds_rpm)])
         i0, i1, w = _periodic_interpolation(local, theta_g, 4.0 * np.pi)
-        p = np.stack([c[1] for c in cycles])                        # (n_speeds, n_cyl, N)
         cyl = np.arange(local.shape[1])[None, :]
-        return p[:, cyl, i0] * (1.0 - w) + p[:, cyl, i1] * w
+        out = np.empty((len(cycles),) + local.shape)
+        for s, (_, p, _) in enumerate(cycles):
+            out[s] = p[cyl, i0] * (1.0 - w) + p[cyl, i1] * w
+        return out
 
     def local_angles(self, crank_angle_rad) -> np.ndarray:
         """Each cylinder's cycle angle on ``[-π, 3π)`` [rad], shape ``(n, n_cyl)``."""

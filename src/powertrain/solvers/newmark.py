@@ -330,9 +330,11 @@ class ModalPortNewmark:
     :func:`newmark_ports` to round-off and the Newton tolerance,
     tests/test_time_domain_laws.py). The recurrence is written on the reduced coordinates
     the load and the port rows touch (the body's six: a port row is a rigid body's motion at
-    a mount): the port motions are read from their motions, the port forces act through
-    their generalized force. Outputs: ``y = Wx x + Wv v + Wa a + Wz z`` (rows over the
-    coordinates, and over the port forces for ``Wz``; None: no such term).
+    a mount): the port motions are read from their motions (per step their accelerations
+    off the modes, displacements and velocities by Newmark's kinematics, read off the modes
+    again at each call), the port forces act through their generalized force. Outputs:
+    ``y = Wx x + Wv v + Wa a + Wz z`` (rows over the coordinates, and over the port forces
+    for ``Wz``; None: no such term).
 
     Parameters
     ----------
@@ -349,43 +351,54 @@ class ModalPortNewmark:
         n = modal.n
         self.modal, self.ports, self.h = modal, ports, float(h)
         P = np.asarray(ports.rows, float)
-        self.reduced = np.union1d(np.arange(modal.load_dofs),
-                                  np.flatnonzero(np.any(P != 0, 0)))
-        T = P[:, self.reduced]
+        self.reduced = r = np.union1d(np.arange(modal.load_dofs),
+                                      np.flatnonzero(np.any(P != 0, 0)))
+        T = P[:, r]
         lam = modal.lam_r
         lam_d = (1 + 0.5 * h * lam) / (1 - 0.5 * h * lam)
         G = ((0.5 * h) / (1 - 0.5 * h * lam))[:, None] * (
-            modal.Psi_inv_r[:, n:] @ modal.Minv[:, self.reduced])           # (n_modes, q)
-        Py, Pv = modal.Psi_r[self.reduced], modal.Psi_r[n + self.reduced]
-        Dx, Dv = (G.T @ Py.T).real.T, (G.T @ Pv.T).real.T
+            modal.Psi_inv_r[:, n:] @ modal.Minv[:, r])                      # (n_modes, q)
+        Pa = modal.Psi_r[n + r] * lam                                        # (q, n_modes)
+        Da = (Pa @ G).real
+        S = Da + modal.Minv[np.ix_(r, r)]
         self.modal_arrays = ((lam_d.real.copy(), lam_d.imag[:modal.n_complex].copy()),
-                             modal.real_form(G.T),
-                             modal.real_form(np.conj(np.vstack([Py * lam_d, Pv * lam_d]))),
-                             (np.ascontiguousarray(Dx), np.ascontiguousarray(Dv)))
+                             modal.real_form(G.T), modal.real_form(np.conj(Pa * lam_d)),
+                             (np.ascontiguousarray(Da), np.ascontiguousarray(S)), self.h)
+        TST = T @ S @ T.T
         self.port_arrays = (np.ascontiguousarray(T), np.searchsorted(
-            self.reduced, np.arange(modal.load_dofs)).astype(np.int64),
-            np.ascontiguousarray(T @ Dx @ T.T), np.ascontiguousarray(T @ Dv @ T.T))
+            r, np.arange(modal.load_dofs)).astype(np.int64),
+            np.ascontiguousarray(0.25 * h * h * TST))
+        #: rows reading the reduced state (x, v, a) off the modal state (a less M^-1 p)
+        self._reduced_rows = modal.real_form(np.conj(np.vstack(
+            [modal.Psi_r[r], modal.Psi_r[n + r], Pa])))
         self.outputs = self._output_arrays(Wx, Wv, Wa, Wz)
         self.silent = self._output_arrays(np.zeros((0, n)))
 
     def _output_arrays(self, Wx=None, Wv=None, Wa=None, Wz=None):
-        """``(W, Wd, Wz)`` of :func:`modal_port_kernel` for the output rows: ``Re(W eta)``
-        the modal part, ``Wd`` the direct part of the acceleration (a = M^-1 (p - C v -
-        K x) on the reduced coordinates)."""
-        modal, n, m = self.modal, self.modal.n, self.ports.kinds.size
+        """``((Wy, y_cols), (Wz, z_cols), w_rows, W, Wd)`` of :func:`modal_port_kernel` for
+        the output rows: ``Wy`` over the reduced state, ``Wz`` over the port forces (the
+        columns they read, :func:`_read_columns`); the rows ``w_rows`` that read other
+        coordinates also through the modal state, ``Re(W eta) + Wd p`` (``Wd`` the direct
+        part of the acceleration, a = M^-1 (p - C v - K x))."""
+        modal, n, r = self.modal, self.modal.n, self.reduced
+        off = np.setdiff1d(np.arange(n), r)
         rows = next(w.shape[0] for w in (Wx, Wv, Wa, Wz) if w is not None)
         W = np.zeros((rows, self.modal.lam_r.size), complex)
-        Wd = np.zeros((rows, self.reduced.size))
-        if Wx is not None:
-            W += np.asarray(Wx, float) @ modal.Psi_r[:n]
-        if Wv is not None:
-            W += np.asarray(Wv, float) @ modal.Psi_r[n:]
+        Wd = np.zeros((rows, r.size))
+        Wy = np.zeros((rows, 3, r.size))
+        for i, (Wk, Psi) in enumerate(((Wx, modal.Psi_r[:n]), (Wv, modal.Psi_r[n:]),
+                                       (Wa, modal.Psi_r[n:] * modal.lam_r[None, :]))):
+            if Wk is not None:
+                Wk = np.asarray(Wk, float)
+                Wy[:, i] = Wk[:, r]
+                W += Wk[:, off] @ Psi[off]
         if Wa is not None:
-            W += np.asarray(Wa, float) @ (modal.Psi_r[n:] * modal.lam_r[None, :])
-            Wd = np.asarray(Wa, float) @ modal.Minv[:, self.reduced]
-        Wz = np.zeros((rows, m)) if Wz is None else np.asarray(Wz, float)
-        return (modal.real_form(np.conj(W)), np.ascontiguousarray(Wd),
-                np.ascontiguousarray(Wz))
+            Wd = np.asarray(Wa, float)[:, off] @ modal.Minv[np.ix_(off, r)]
+        Wz = np.zeros((rows, self.ports.kinds.size)) if Wz is None else np.asarray(Wz, float)
+        w_rows = np.flatnonzero(np.any(W != 0, 1) | np.any(Wd != 0, 1))
+        return (_read_columns(Wy.reshape(rows, 3 * r.size)), _read_columns(Wz),
+                w_rows.astype(np.int64), modal.real_form(np.conj(W[w_rows])),
+                np.ascontiguousarray(Wd[w_rows]))
 
     def modal_state(self, x, v) -> np.ndarray:
         """Modal coordinates of the state ``(x, v)`` in the kernel's real form
@@ -404,13 +417,24 @@ class ModalPortNewmark:
             Newton did not converge at some step (the names of the port laws are given).
         """
         arrays = self.outputs if outputs else self.silent
-        out = np.empty((F.shape[0] - 1, arrays[1].shape[0]))
+        out = np.empty((F.shape[0] - 1, arrays[1][0].shape[0]))
         laws = (self.ports.kinds, self.ports.parameters, state)
-        failed = modal_port_kernel(self.modal_arrays, arrays, self.port_arrays, laws,
-                                   np.ascontiguousarray(F, float), eta, z, out, PORT_TOL,
-                                   PORT_MAX_ITER)
+        F = np.ascontiguousarray(F, float)
+        T, load_at = self.port_arrays[:2]
+        p = -T.T @ z
+        p[load_at] += F[0]
+        y = self._reduced_rows @ eta
+        y[2 * p.size:] += self.modal.Minv[np.ix_(self.reduced, self.reduced)] @ p
+        failed = modal_port_kernel(self.modal_arrays, arrays, self.port_arrays, laws, F, eta,
+                                   y, z, out, PORT_TOL, PORT_MAX_ITER)
         if failed:
             raise FloatingPointError(f"port laws {', '.join(self.ports.names)}: Newton did "
                                      f"not converge at {failed} of {out.shape[0]} steps")
         return out
 
+
+def _read_columns(W):
+    """``(W[:, cols], cols)``: the columns of the output rows ``W`` that are not all zero
+    (the kernel reads only those)."""
+    cols = np.flatnonzero(np.any(W != 0, 0))
+    return np.ascontiguousarray(W[:, cols]), cols

@@ -120,10 +120,9 @@ def simulate_sweep(engine, rpm_from, rpm_to, rate_rpm_per_s, sample_rate=8192.0,
     with threadpool_limits(limits=1, user_api="blas"):     # small matrices: see run_runup
         y, method = _integrate_ramp(engine, system, load, ramp, dofs, decimator, progress,
                                     static_factors)
-    y = y @ to_channels.T
+        block = to_channels @ y.T                           # (n_ch, n_out), contiguous
     t_out = (decimator.first_output_index + np.arange(y.shape[0])) / sample_rate
     rpm_out = rpm_from + rate_rpm_per_s * t_out
-    block = np.ascontiguousarray(y.T)
     chans = [RawChannel(Channel(mnt, "active", d).label, mnt, "active", d, "acceleration",
                         block[c], "m/s^2") for c, (mnt, d) in enumerate(system.channels)]
     note = (f"SYNTHETIC: simulated continuous run-up {rpm_from:g}->{rpm_to:g} rpm at "
@@ -155,9 +154,14 @@ def _pulse_train(theta, period, edge):
     exact but for the speed's change over one sample."""
     flank = np.radians(PULSE_FLANK_DEG)
     phi = np.mod(theta - edge + TRIGGER_HIGH * flank, period)
-    rise = np.clip(phi / flank, 0.0, 1.0)
-    fall = np.clip((0.5 * period - phi) / flank, 0.0, 1.0)
-    return PULSE_VOLTS * np.minimum(rise, fall)
+    rise = phi / flank
+    np.clip(rise, 0.0, 1.0, out=rise)
+    fall = np.subtract(0.5 * period, phi, out=phi)         # in place: fewer temporaries
+    np.divide(fall, flank, out=fall)
+    np.clip(fall, 0.0, 1.0, out=fall)
+    np.minimum(rise, fall, out=rise)
+    rise *= PULSE_VOLTS
+    return rise
 
 
 def _channel_dofs(channel_matrix):
@@ -334,7 +338,7 @@ class _Decimator:
         self.L = FIR_HALF * m if m > 1 else 0          # m = 1: nothing to decimate
         self.fir = firwin(2 * self.L + 1, 1.0 / m, window=("kaiser", 8.0)) if m > 1 \
             else np.ones(1)
-        self.tail = np.zeros((0, n_ch))
+        self.tail = np.zeros((n_ch, 0))          # the last input rows, transposed
 
     @property
     def first_output_index(self) -> int:
@@ -343,12 +347,14 @@ class _Decimator:
 
     def push(self, rows):
         from powertrain.kernels.speed_ramp import fir_decimate
-        buf = np.ascontiguousarray(np.concatenate([self.tail, rows]))
+        buf = np.empty((rows.shape[1], self.tail.shape[1] + rows.shape[0]))   # (n_ch, n)
+        buf[:, :self.tail.shape[1]] = self.tail
+        buf[:, self.tail.shape[1]:] = rows.T
         i_lo = -(-(2 * self.L) // self.m)
-        i_hi = (buf.shape[0] - 1) // self.m
-        self.tail = buf[max(0, buf.shape[0] - 2 * self.L):]
-        out = np.empty((max(0, i_hi - i_lo + 1), buf.shape[1]))
-        fir_decimate(self.fir, np.ascontiguousarray(buf.T), self.m, i_lo, out)
+        i_hi = (buf.shape[1] - 1) // self.m
+        self.tail = buf[:, max(0, buf.shape[1] - 2 * self.L):].copy()
+        out = np.empty((max(0, i_hi - i_lo + 1), buf.shape[0]))
+        fir_decimate(self.fir, buf, self.m, i_lo, out)
         return out
 
 
