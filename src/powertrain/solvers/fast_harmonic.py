@@ -258,13 +258,9 @@ class HarmonicModel:
         law adds its describing function)."""
         els = self.elements if elements is None else elements
         if self.static_scale is not None:
-            els = [dataclasses.replace(el, static_factor=self._static(k))
+            els = [dataclasses.replace(el, static_factor=self.static_scale[:, k:k + 1])
                    for k, el in enumerate(els)]
         return element_two_ports(els, 1j * self.omega, np.asarray(amplitudes, float)[:, None])
-
-    def _static(self, k):
-        """Network ``k``'s static factor per speed, shape (n_r, 1) (1.0 without curves)."""
-        return 1.0 if self.static_scale is None else self.static_scale[:, k:k + 1]
 
     def _statics(self, index):
         """The static factors of the networks ``index`` per speed, (n_r, 1, len(index))
