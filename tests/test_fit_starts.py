@@ -88,3 +88,18 @@ def test_balancer_one_shaft_late_is_found_with_its_sign(engine):
     p = fit_candidate(s.problem, ("balancer_error",)).params["balancer_error"]
     assert p["skew"] == pytest.approx(0.17, abs=0.03)
     assert p["lag"] == pytest.approx(0.085, abs=0.03)
+
+
+def test_a_refit_starts_from_its_given_optimum_only():
+    """``defaults=False`` (the checks, the band check, the pairs): the given starts alone;
+    without starts the defaults still serve, and by default they come first."""
+    from powertrain.diagnosis.packing import Packing
+    from powertrain.diagnosis.starts import start_points
+    pack = Packing.of(("balancer_error",), None)
+    given = [pack.x0 + 0.25 * (pack.upper - pack.lower)]
+    only = start_points(None, pack, ("balancer_error",), given, False, None, defaults=False)
+    assert len(only) == 1 and np.allclose(only[0], given[0])
+    both = start_points(None, pack, ("balancer_error",), given, False, None)
+    assert len(both) == 2 and np.allclose(both[0], np.clip(pack.x0, pack.lower, pack.upper))
+    fallback = start_points(None, pack, ("balancer_error",), None, False, None, defaults=False)
+    assert len(fallback) == 1

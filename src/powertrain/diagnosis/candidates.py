@@ -42,7 +42,8 @@ def _refit(setup, e, params, budget):
     pack = Packing.of((e,), setup.problem.engine)
     x = np.array([math.log(params[pn]) if lg else params[pn]
                   for (_, pn), lg in zip(pack.names, pack.log)])
-    return fit_candidate(setup.problem, (e,), starts=[x], grid=False, budget=budget)
+    return fit_candidate(setup.problem, (e,), starts=[x], grid=False, budget=budget,
+                         defaults=False)
 
 
 def _same(a, b, tol=0.01):

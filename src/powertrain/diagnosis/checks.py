@@ -197,7 +197,7 @@ def _cells_fold(problem, o, baseline, cell_folds, sigma, kw) -> dict:
         if not held.any() or held.all():
             continue
         fo = fit_candidate(problem.restricted(~held, held), o.effects, starts=[o.x],
-                           grid=False, **kw)
+                           grid=False, defaults=False, **kw)
         g_all = np.where(np.isfinite(fo.heldout_gaps), fo.heldout_gaps, g_all)
     ok = np.isfinite(g_all)
     per_c = np.array([np.mean(g_all[i][ok[i]] ** 2) if ok[i].any() else np.nan
@@ -218,7 +218,8 @@ def crossfit(folds, o: FitOutcome, budget=None) -> np.ndarray:
     kw = {} if budget is None else {"budget": budget}
     parts = [o.heldout_per_rpm]
     for p, _ in folds:
-        parts.append(fit_candidate(p, o.effects, starts=[o.x], grid=False, **kw)
+        parts.append(fit_candidate(p, o.effects, starts=[o.x], grid=False, defaults=False,
+                                   **kw)
                      .heldout_per_rpm)
     return np.concatenate(parts)
 
@@ -237,7 +238,8 @@ def band_check(problem_factory, effect, data, train_idx, start, n_bands=4):
         idx = train_idx[edges[b]:edges[b + 1]]
         if idx.size < 3:
             continue
-        fo = fit_candidate(problem_factory(idx), (effect,), starts=[start], grid=False)
+        fo = fit_candidate(problem_factory(idx), (effect,), starts=[start], grid=False,
+                           defaults=False)
         out.append({"rpm_from": float(data.rpm[idx[0]]), "rpm_to": float(data.rpm[idx[-1]]),
                     "parameters": fo.params[effect], "sigma": fo.sigma[effect]})
     return out

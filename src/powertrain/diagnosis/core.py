@@ -207,7 +207,8 @@ def _fit_job(job):
     problem, effects, starts, budget = job
     from threadpoolctl import threadpool_limits
     with threadpool_limits(limits=1, user_api="blas"):
-        return fit_candidate(problem, effects, starts=starts, budget=budget)
+        return fit_candidate(problem, effects, starts=starts, budget=budget,
+                             defaults=starts is None)
 
 
 def _fit_all(s: _Setup, pairs, scheduler, progress, budget, e_n, rule, baseline, sigma):

@@ -325,14 +325,18 @@ def _jacobian(fun, x, pack):
 
 
 def fit_candidate(problem: Problem, effects, starts=None, grid=True,
-                  budget=EVAL_BUDGET) -> FitOutcome:
-    """Fit one effect or a combination on the training speeds, score on the held-out ones."""
+                  budget=EVAL_BUDGET, defaults=True) -> FitOutcome:
+    """Fit one effect or a combination on the training speeds, score on the held-out ones.
+
+    ``starts``: start vectors (fitted coordinates) besides the defaults, the start grid and
+    the data starts (``grid``); ``defaults=False`` with ``starts`` skips the defaults' start
+    (a refit from a known optimum: the checks, the band check, the pairs)."""
     t0 = time.perf_counter()
     problem.reset_warm()
     pack = Packing.of(effects, problem.engine)
     fun = _Counted(problem, pack, budget)
     try:
-        cands = start_points(problem, pack, effects, starts, grid, fun)
+        cands = start_points(problem, pack, effects, starts, grid, fun, defaults)
         best, nfev, hit = _least_squares(fun, pack, cands)
     except _Budget:                        # spent on the start grid already
         cands, best, nfev, hit = [pack.x0], None, 0, True

@@ -25,17 +25,20 @@ BLOCK_SHARE = 0.4
 DATA_KEPT = 2
 
 
-def start_points(problem, pack, effects, starts, grid, fun):
-    """Start vectors of a fit: the starts read from the data (first), the defaults, the
+def start_points(problem, pack, effects, starts, grid, fun, defaults=True):
+    """Start vectors of a fit: the starts read from the data (first), the defaults (unless
+    ``defaults`` is False and ``starts`` are given: a refit from a known optimum), the
     given ``starts``, the two best points of the effect's coarse start grid and the
     block-wise multi-start's optimum."""
     span = pack.upper - pack.lower
     lo, hi = pack.lower + 1e-9 * span, pack.upper - 1e-9 * span
-    cands = [np.clip(pack.x0, lo, hi)] + [np.clip(s, lo, hi) for s in starts or []]
+    cands = [np.clip(s, lo, hi) for s in starts or []]
+    if defaults or not cands:
+        cands = [np.clip(pack.x0, lo, hi)] + cands
     # coarse grid of start points for effects that declare one (the cylinder IMEP factors
     # need one: at e = 0 the half orders vanish and the gradient of their level with them)
-    sg = EFFECTS[effects[0]].start_grid(problem.engine) if len(effects) == 1 else ()
-    if grid and sg:
+    sg = EFFECTS[effects[0]].start_grid(problem.engine) if grid and len(effects) == 1 else ()
+    if sg:
         mesh = np.meshgrid(*sg, indexing="ij")
         pts = np.stack([m.ravel() for m in mesh], axis=1).astype(float)
         pts[:, pack.log] = np.log(pts[:, pack.log])
