@@ -16,14 +16,14 @@ the prior's centre; the BIC and the held-out scores use the data residuals only.
 Parameter uncertainties are the 1σ of the Gauss–Newton covariance :math:`\hat s^2
 (J^TJ)^{-1}` (residual correlation along speed ignored: optimistic). A trial parameter set
 without a steady state (the amplitude fixed point diverges) is a point far worse than any
-fit (:data:`NO_STEADY_STATE_RESIDUAL`): the search turns back, the diagnosis goes on.
+fit (:data:`powertrain.diagnosis.search.NO_STEADY_STATE_RESIDUAL`): the search turns back,
+the diagnosis goes on.
 """
 
 from __future__ import annotations
 
 import math
 import time
-import warnings
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -31,7 +31,9 @@ import numpy as np
 from powertrain.diagnosis import phase as ph
 from powertrain.diagnosis.data import GapData, model_levels, noise_sigma_db, order_levels, residuals_db
 from powertrain.diagnosis.packing import Packing
+from powertrain.diagnosis.search import Counted, Exhausted, jacobian, trust_region
 from powertrain.diagnosis.starts import start_points
+from powertrain.diagnosis.warm_start import AmplitudeStart, scenario_vector
 from powertrain.effects import EFFECTS, predict
 from powertrain.solvers.fast_harmonic import N_HARMONICS
 
@@ -43,8 +45,6 @@ N_ORDERS = N_HARMONICS - 1
 #: of cached velocities counts 1, an amplitude-dependent evaluation its fixed-point
 #: iterations); reached, the fit stops with the best point so far (``budget_hit``).
 EVAL_BUDGET = 2500
-#: Residual of every point where a trial parameter set has no steady state.
-NO_STEADY_STATE_RESIDUAL = 1e3
 
 
 @dataclass
@@ -150,7 +150,8 @@ class Problem:
         return state
 
     def reset_warm(self):
-        """Forget the cached velocities, the amplitude fixed point's warm start and the solve
+        """Forget the cached velocities, the amplitude fixed point's start
+        (:class:`~powertrain.diagnosis.warm_start.AmplitudeStart`) and the solve
         count (at the start of every fit, so that a fit's result does not depend on what ran
         before it)."""
         self._last = {}
@@ -172,10 +173,12 @@ class Problem:
         if last is not None and last[0] == key:
             vel = last[1]
         else:
-            pred = predict(self.hm[part], phys, warm_amplitudes=self._warm.get(part))
+            warm = self._warm.setdefault(part, AmplitudeStart())
+            v = scenario_vector(phys)
+            pred = predict(self.hm[part], phys, warm_amplitudes=warm.start(v))
             vel = pred.velocity
             if pred.amplitudes is not None:
-                self._warm[part] = pred.amplitudes
+                warm.record(v, pred.amplitudes)
             self.solves += max(1, pred.iterations)
             self._last[part] = (key, vel)
         for k, v in scenario.items():
@@ -244,86 +247,6 @@ class Problem:
         return np.concatenate([g, gp, [ph.offset_prior(delta, self.sigma_db)]])
 
 
-class _Budget(Exception):
-    """Raised inside the residual function when the fit's evaluation budget is spent."""
-
-
-class _Counted:
-    """Residual function with an evaluation count, a budget and the best point seen."""
-
-    def __init__(self, problem, pack, budget):
-        self.problem, self.pack, self.budget = problem, pack, budget
-        self.n = 0.0
-        self.best = (np.inf, None, None)
-        self.has_prior = pack.n_prior > 0
-        if self.has_prior:
-            self.prior_on = np.isfinite(pack.prior_sd)
-            self.prior_w = problem.sigma_db / pack.prior_sd[self.prior_on]
-
-    def prior(self, x):
-        """Prior residuals (empty without priors)."""
-        if not self.has_prior:
-            return np.empty(0)
-        return self.prior_w * (np.asarray(x) - self.pack.x0)[self.prior_on]
-
-    def evaluate(self, problem, x):
-        """Residuals of ``problem`` at ``x`` with the prior's, charged to the budget (raises
-        when it is spent)."""
-        if self.n >= self.budget:
-            raise _Budget
-        before = problem.solves
-        try:
-            v = problem.vector(self.pack.scenario(x))
-        except FloatingPointError:  # no steady state there: a point worse than any fit
-            if self.best[2] is None:
-                raise
-            v = np.full(self.best[2].size - self.prior(x).size, NO_STEADY_STATE_RESIDUAL)
-        r = np.concatenate([v, self.prior(x)])
-        self.n += max(1, problem.solves - before)
-        return r
-
-    def __call__(self, x):
-        r = self.evaluate(self.problem, x)
-        c = 0.5 * float(np.sum(r ** 2))
-        if c < self.best[0]:
-            self.best = (c, np.array(x, float), r)
-        return r
-
-
-def _least_squares(fun, pack, cands):
-    """Best trust-region fit over the start points; (result-like, nfev, budget hit)."""
-    from scipy.optimize import least_squares
-    span = pack.upper - pack.lower
-    best, nfev = None, 0
-    for x_start in cands:
-        try:
-            with warnings.catch_warnings():
-                warnings.simplefilter("ignore")
-                res = least_squares(fun, x_start, bounds=(pack.lower, pack.upper),
-                                    x_scale=np.maximum(span / 8, 1e-3), method="trf",
-                                    max_nfev=60 * len(x_start), diff_step=1e-4)
-        except _Budget:
-            return None, nfev, True
-        nfev += res.nfev
-        if best is None or res.cost < best.cost:
-            best = res
-    return best, nfev, False
-
-
-def _jacobian(fun, x, pack):
-    """Forward-difference Jacobian at ``x`` (used when the budget stopped the fit)."""
-    def full(x):
-        return np.concatenate([fun.problem.vector(pack.scenario(x)), fun.prior(x)])
-    r0 = full(x)
-    J = np.empty((r0.size, x.size))
-    for j in range(x.size):
-        h = 1e-4 * max(1.0, abs(x[j]))
-        xj = x.copy()
-        xj[j] = min(x[j] + h, pack.upper[j]) if x[j] + h <= pack.upper[j] else x[j] - h
-        J[:, j] = (full(xj) - r0) / (xj[j] - x[j])
-    return r0, J
-
-
 def fit_candidate(problem: Problem, effects, starts=None, grid=True,
                   budget=EVAL_BUDGET, defaults=True) -> FitOutcome:
     """Fit one effect or a combination on the training speeds, score on the held-out ones.
@@ -334,15 +257,15 @@ def fit_candidate(problem: Problem, effects, starts=None, grid=True,
     t0 = time.perf_counter()
     problem.reset_warm()
     pack = Packing.of(effects, problem.engine)
-    fun = _Counted(problem, pack, budget)
+    fun = Counted(problem, pack, budget)
     try:
         cands = start_points(problem, pack, effects, starts, grid, fun, defaults)
-        best, nfev, hit = _least_squares(fun, pack, cands)
-    except _Budget:                        # spent on the start grid already
+        best, nfev, hit = trust_region(fun, pack, cands)
+    except Exhausted:                      # spent on the start grid already
         cands, best, nfev, hit = [pack.x0], None, 0, True
-    if best is None:                       # budget spent: the best point evaluated so far
+    if best is None:                       # budget spent or stalled: the best point so far
         x = fun.best[1] if fun.best[1] is not None else cands[0]
-        r, J = _jacobian(fun, x, pack)
+        r, J = jacobian(fun, x, pack)
         nfev = int(fun.n)
     else:
         x, r, J = best.x, best.fun, best.jac

@@ -1,0 +1,97 @@
+"""The fits' trust-region search (:mod:`powertrain.diagnosis.search`): the stall watch, and
+the amplitude fixed point's start for the next evaluation
+(:mod:`powertrain.diagnosis.warm_start`)."""
+
+from __future__ import annotations
+
+from types import SimpleNamespace
+
+import numpy as np
+import pytest
+
+from powertrain.diagnosis import search
+from powertrain.diagnosis.warm_start import AmplitudeStart, scenario_vector
+
+
+class _Problem:
+    """A residual vector read from ``costs`` in turn (cost = 0.5 r^2)."""
+
+    def __init__(self, costs):
+        self.costs = iter(costs)
+        self.solves = 0
+        self.sigma_db = 1.0
+
+    def vector(self, scenario):
+        self.solves += 1
+        return np.array([np.sqrt(2.0 * next(self.costs))])
+
+
+def _counted(costs, budget=10_000):
+    pack = SimpleNamespace(n_prior=0, scenario=lambda x: {}, x0=np.zeros(1))
+    return search.Counted(_Problem(costs), pack, budget)
+
+
+def test_a_start_that_stops_improving_stalls_after_its_window():
+    window = search.STALL_STEPS * (1 + 1)
+    fun = _counted(1000.0 * (1 - 1e-6) ** np.arange(10 * window))
+    fun.watch(1)
+    with pytest.raises(search._Stalled):
+        for _ in range(10 * window):
+            fun(np.zeros(1))
+    assert fun.n == window + 2          # the first sets the reference, then window + 1 more
+
+
+def test_a_start_that_keeps_improving_never_stalls_and_no_watch_no_stall():
+    n = 20 * search.STALL_STEPS
+    fun = _counted(1000.0 * (1 - 1e-3) ** np.arange(n))
+    fun.watch(1)
+    for _ in range(n):
+        fun(np.zeros(1))
+    flat = _counted(np.full(n, 5.0))
+    for _ in range(n):                  # the start grid runs unwatched
+        flat(np.zeros(1))
+    assert flat.best[0] == pytest.approx(5.0)
+
+
+def test_a_stalled_search_hands_back_its_best_point():
+    """A cost that creeps down by 1e-6 a call, wherever the search goes: the search stops
+    on the stall, long before the budget or its iteration limit, and hands back None (the
+    caller takes ``fun.best``, the lowest point seen)."""
+    n_max = 10_000
+    pack = SimpleNamespace(n_prior=0, scenario=lambda x: {}, x0=np.zeros(1),
+                           lower=np.array([0.0]), upper=np.array([1.0]))
+    fun = search.Counted(_Problem(1000.0 * (1 - 1e-6) ** np.arange(n_max)), pack, n_max)
+    res, _, hit = search.trust_region(fun, pack, [np.array([0.5])])
+    assert res is None and not hit
+    assert fun.n == search.STALL_STEPS * 2 + 2
+    assert fun.best[0] == pytest.approx(1000.0 * (1 - 1e-6) ** (fun.n - 1))
+
+
+def test_the_amplitude_start_is_exact_for_amplitudes_log_linear_in_the_parameters():
+    rng = np.random.default_rng(1)
+    log_a0, slopes = rng.normal(-9, 1, (4, 3)), rng.normal(0, 2, (2, 4, 3))
+
+    def amplitudes(v):
+        return np.exp(log_a0 + np.tensordot(v, slopes, axes=1))
+
+    st = AmplitudeStart()
+    assert st.start(np.zeros(2)) is None
+    base = np.array([0.3, 1.2])
+    st.record(base, amplitudes(base))
+    for j in range(2):                  # the columns of the base point
+        col = base.copy()
+        col[j] += 1e-4 * max(1.0, abs(base[j]))
+        st.record(col, amplitudes(col))
+    assert np.array_equal(st.base[0], base)
+    trial = base + np.array([0.05, -0.2])
+    np.testing.assert_allclose(st.start(trial), amplitudes(trial), rtol=1e-9)
+    col = base.copy()
+    col[1] += 1e-4 * 1.2
+    np.testing.assert_allclose(st.start(col), amplitudes(col), rtol=1e-12)
+    st.record(trial, amplitudes(trial))  # a step, not a column: the new base
+    assert np.array_equal(st.base[0], trial)
+
+
+def test_scenario_vector_orders_effects_and_parameters_by_name():
+    v = scenario_vector({"b": {"y": 2.0, "x": 1.0}, "a": {"k": 3.0}})
+    assert v.tolist() == [3.0, 1.0, 2.0]
