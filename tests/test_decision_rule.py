@@ -151,6 +151,26 @@ def test_rivals_of_another_family_make_it_ambiguous():
     assert v.kind is VerdictKind.AMBIGUOUS and set(v.ambiguous) == {"a", "b"}
 
 
+@pytest.mark.parametrize("member_mse", [1.5, 2.5])
+def test_pairs_sharing_a_member_answer_the_member_when_it_stands_alone(member_mse):
+    """Two indistinguishable pairs m+x, m+y that each beat m: m is the answer when it is a
+    big supported candidate itself (explains 71 %), with its second effect not identified;
+    when m alone explains too little (43 % < explained_min) the verdict stays ambiguous."""
+    member = cand("m", member_mse, 950.0, spread=0.0)
+    mx = cand("m+x", 0.8, 900.0)
+    my = cand("m+y", 0.81, 901.0)
+    my.heldout_per_rpm = 0.81 + 0.3 * np.cos(np.arange(N) * 0.9)
+    singles = [cand(e, 3.9, 999.0, spread=0.0) for e in "xy"]   # weak on their own
+    v = decide(evidence(member, mx, my, *singles))
+    if member_mse < 2.0:
+        assert v.kind is VerdictKind.EFFECT and v.chosen == "m" and not v.ambiguous
+        assert set(v.second_effect_between) == {"m+x", "m+y"}
+        assert "cannot tell x from y" in v.text or "cannot tell y from x" in v.text
+        assert v.assessments["m+x"].status is Status.INDISTINGUISHABLE
+    else:
+        assert v.kind is VerdictKind.AMBIGUOUS and set(v.ambiguous) == {"m+x", "m+y"}
+
+
 def test_decide_is_pure():
     ev = evidence(cand("a", 1.0, 900.0))
     before = dataclasses.asdict(ev)

@@ -11,7 +11,8 @@ import math
 
 import numpy as np
 
-from powertrain.diagnosis.rule import CandidateEvidence, improvement_t
+from powertrain.diagnosis.rule import CandidateEvidence
+from powertrain.diagnosis.significance import improvement_t
 from powertrain.effects import EFFECTS
 
 

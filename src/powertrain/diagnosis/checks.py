@@ -37,7 +37,7 @@ import numpy as np
 
 from powertrain.analysis.noise_floor import above_floor
 from powertrain.diagnosis.fit import FitOutcome, Problem, fit_candidate
-from powertrain.diagnosis.rule import log_ratio_t
+from powertrain.diagnosis.significance import log_ratio_t
 from powertrain.effects import EFFECTS
 
 #: Fallback order split when fewer than two orders are informative: orders up to this one

@@ -48,6 +48,9 @@ class DiagnosisResult:
     noise_mse_heldout: float = 0.0
     #: Labels of candidates that pass the decision rule but cannot be told apart.
     ambiguous: list = field(default_factory=list)
+    #: With an answer: its pairs the held-out speeds cannot tell apart (a second effect
+    #: supported but not identified).
+    second_effect_between: list = field(default_factory=list)
     rule: DecisionRule = field(default_factory=DecisionRule)
     verdict_kind: VerdictKind | None = None
     #: Parameter sets that explain the data equally well within the noise.
@@ -148,6 +151,7 @@ class DiagnosisResult:
             "heldout_excess_rms_db_before": excess,
             "heldout_noise_mse_db2": self.noise_mse_heldout,
             "ambiguous_between": self.ambiguous,
+            "second_effect_between": self.second_effect_between,
             "equivalent_explanations": self.equivalents,
             "budget_hits": self.budget_hits,
             "split": self.split,

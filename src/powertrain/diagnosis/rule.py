@@ -18,7 +18,9 @@ would leave (noise):
   withheld (channel, order) cells (explains ≥ ``xv_explained_min`` of their excess with
   t > ``xv_t_min``; skipped when their excess is below ``excess_min_db``);
 * an admissible rival of another effect family that the held-out speeds cannot tell apart
-  from the answer (t ≤ ``t_min``) makes the verdict **ambiguous**;
+  from the answer (t ≤ ``t_min``) makes the verdict **ambiguous** — unless the answer and
+  its rivals are pairs that share one effect which is itself big and supported: then that
+  effect is the answer and the second effect is reported as not identified;
 * otherwise **no effect** when the excess RMS gap :math:`\sqrt{\max(E_0 - E_n, 0)}` is
   below ``excess_min_db`` (even if a candidate fits what is left "significantly": a model
   that agrees to round-off leaves round-off for candidates to fit), else **unexplained**
@@ -37,6 +39,8 @@ from dataclasses import dataclass, field
 from enum import Enum
 
 import numpy as np
+
+from powertrain.diagnosis.significance import crossfit_t, improvement_t
 
 
 @dataclass(frozen=True)
@@ -181,46 +185,10 @@ class Verdict:
     order: list = field(default_factory=list)
     chosen: str | None = None
     ambiguous: list = field(default_factory=list)
+    #: with an answer: its pairs that cannot be told apart (second effect not identified)
+    second_effect_between: list = field(default_factory=list)
     needs_cells_check: str | None = None
     needs_crossfit: list = field(default_factory=list)
-
-
-def improvement_t(base: CandidateEvidence, cand: CandidateEvidence, noise_mse=0.0):
-    r"""t statistic of the held-out improvement per speed of ``cand`` over ``base``.
-
-    The per-speed improvement is the log ratio
-    :math:`d_r = \ln\frac{E_{0,r} + E_n}{E_{c,r} + E_n}` of the mean squared gaps with the
-    noise's :math:`E_n` added: a relative improvement, about equally large at the speeds
-    where the gap is large (near a resonance) and where it is moderate, so that its scatter
-    over speeds measures chance rather than how the gap varies along the run-up (a
-    difference :math:`E_{0,r} - E_{c,r}` is dominated by the few speeds near a resonance
-    and its t stays small however certain the improvement); speeds within noise count as
-    no change. t = :math:`\bar d/(s_d/\sqrt{n_r})`.
-    """
-    return log_ratio_t(base.heldout_per_rpm, cand.heldout_per_rpm, noise_mse)
-
-
-def crossfit_t(base: CandidateEvidence, cand: CandidateEvidence, noise_mse=0.0):
-    """:func:`improvement_t` over every speed when both carry cross-fitted per-speed gaps
-    (``crossfit``), else over the held-out speeds."""
-    if base.crossfit is None or cand.crossfit is None:
-        return improvement_t(base, cand, noise_mse)
-    return log_ratio_t(base.crossfit, cand.crossfit, noise_mse)
-
-
-def log_ratio_t(per_0, per_c, noise_mse=0.0):
-    """t of the per-speed log ratios ln((per_0 + E_n)/(per_c + E_n)) (NaN entries dropped);
-    the statistic of :func:`improvement_t`."""
-    en = max(float(noise_mse), 1e-12)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        d = np.log((np.asarray(per_0, float) + en) / (np.asarray(per_c, float) + en))
-    d = d[np.isfinite(d)]
-    if d.size < 2:
-        return float("nan")
-    sd = float(np.std(d, ddof=1))
-    if sd > 0:
-        return float(np.mean(d)) / (sd / math.sqrt(d.size))
-    return float("inf") if np.mean(d) > 0 else 0.0
 
 
 def _assess(ev: Evidence, rule: DecisionRule) -> dict:
@@ -325,6 +293,10 @@ def decide(evidence: Evidence, rule: DecisionRule = DecisionRule()) -> Verdict:
                        needs_cells_check=pending)
     rivals = _rivals(ev, rule, ranked, ass, chosen) if chosen is not None else []
     if rivals:
+        pairs = [chosen] + [c for c, _ in rivals]
+        member = _shared_member(rule, ranked, ass, pairs)
+        if member is not None:
+            return _member_answer(ev, ass, order, member, pairs)
         return _ambiguous(ev, rule, ass, order, chosen, rivals)
     if chosen is not None:
         return _chosen(ev, ass, order, chosen)
@@ -345,6 +317,34 @@ def _ambiguous(ev, rule, ass, order, chosen, rivals):
               f"amplitudes, loads or channels are needed to decide")
     return Verdict(VerdictKind.AMBIGUOUS, "ambiguous", text, ass, order,
                    ambiguous=[chosen.label] + [c.label for c, _ in rivals])
+
+
+def _shared_member(rule, ranked, ass, pairs):
+    """The one effect every indistinguishable pair shares, when it is a big supported
+    candidate on its own (each pair beat it: a second effect is present, but which one the
+    data do not say); else None."""
+    if any(len(c.effects) != 2 for c in pairs):
+        return None
+    shared = set.intersection(*(set(c.effects) for c in pairs))
+    return next((c for c in ranked if len(shared) == 1 and set(c.effects) == shared
+                 and ass[c.label].status is Status.SUPPORTED and _big(ass[c.label], rule)),
+                None)
+
+
+def _member_answer(ev, ass, order, m, pairs):
+    """Answer ``m``; its indistinguishable pairs' second effects named as not identified."""
+    seconds = [next(e for e in c.effects if e not in m.effects) for c in pairs]
+    for c in pairs:
+        ass[c.label].status = Status.INDISTINGUISHABLE
+        ass[c.label].text = "second effect not identified: " + " or ".join(seconds)
+    a = ass[m.label]
+    a.status, a.text = Status.CHOSEN, Status.CHOSEN.value
+    text = (f"{m.label}: explains {a.explained:.0%} of the held-out excess gap over noise; "
+            f"held-out RMS gap {ev.baseline.heldout_mse ** 0.5:.2f} -> "
+            f"{m.heldout_mse ** 0.5:.2f} dB; with it a second effect is supported, but the "
+            f"held-out speeds cannot tell {' from '.join(seconds)}")
+    return Verdict(VerdictKind.EFFECT, m.label, text, ass, order, chosen=m.label,
+                   second_effect_between=[c.label for c in pairs])
 
 
 def _chosen(ev, ass, order, c):
