@@ -83,13 +83,25 @@ def test_the_amplitude_start_is_exact_for_amplitudes_log_linear_in_the_parameter
         col[j] += 1e-4 * max(1.0, abs(base[j]))
         st.record(col, amplitudes(col))
     assert np.array_equal(st.base[0], base)
-    trial = base + np.array([0.05, -0.2])
+    trial = base + np.array([0.02, -0.05])        # ln A changes by less than 1
     np.testing.assert_allclose(st.start(trial), amplitudes(trial), rtol=1e-9)
     col = base.copy()
     col[1] += 1e-4 * 1.2
     np.testing.assert_allclose(st.start(col), amplitudes(col), rtol=1e-12)
     st.record(trial, amplitudes(trial))  # a step, not a column: the new base
     assert np.array_equal(st.base[0], trial)
+
+
+def test_a_long_trial_step_is_predicted_within_a_factor_e_of_the_base():
+    from powertrain.diagnosis.warm_start import MAX_LOG_CHANGE
+    st = AmplitudeStart()
+    base = np.array([0.1])
+    st.record(base, np.full((2, 3), 1e-4))
+    st.record(base + 1e-4, np.full((2, 3), 1e-4 * np.exp(20e-4)))   # slope 20 per unit
+    far = st.start(np.array([0.9]))                                  # 20 * 0.8 = 16 in ln A
+    np.testing.assert_allclose(far, 1e-4 * np.exp(MAX_LOG_CHANGE))
+    near = st.start(np.array([0.11]))
+    np.testing.assert_allclose(near, 1e-4 * np.exp(0.2), rtol=1e-9)
 
 
 def test_scenario_vector_orders_effects_and_parameters_by_name():

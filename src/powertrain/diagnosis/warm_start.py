@@ -22,6 +22,10 @@ import numpy as np
 #: A point that differs from the base in one parameter by at most this (relative to
 #: max(1, |v|)) is a finite-difference column of it (the fits' steps are 1e-4).
 COLUMN_STEP = 1e-3
+#: Largest predicted change of ln A from the base: a long trial step extrapolated along
+#: the slopes may overshoot; within a factor e of the base's amplitudes the fixed point
+#: converges as it did from the base itself.
+MAX_LOG_CHANGE = 1.0
 
 
 def scenario_vector(scenario) -> np.ndarray:
@@ -43,10 +47,11 @@ class AmplitudeStart:
         vb, lb, on = self.base
         if v.shape != vb.shape:
             return np.where(on, np.exp(lb), 0.0)
-        pred = lb.copy()
+        change = np.zeros_like(lb)
         for j in np.flatnonzero(v != vb):
             if j in self.slope:
-                pred += self.slope[j] * (v[j] - vb[j])
+                change += self.slope[j] * (v[j] - vb[j])
+        pred = lb + np.clip(change, -MAX_LOG_CHANGE, MAX_LOG_CHANGE)
         return np.where(on, np.exp(pred), 0.0)
 
     def record(self, v, amplitudes):
