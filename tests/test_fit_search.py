@@ -107,3 +107,21 @@ def test_a_long_trial_step_is_predicted_within_a_factor_e_of_the_base():
 def test_scenario_vector_orders_effects_and_parameters_by_name():
     v = scenario_vector({"b": {"y": 2.0, "x": 1.0}, "a": {"k": 3.0}})
     assert v.tolist() == [3.0, 1.0, 2.0]
+
+
+def test_a_refit_that_starts_without_a_steady_state_is_a_bad_point_not_a_crash():
+    """A refit's first point (no best point yet) whose amplitude fixed point does not
+    converge: the residuals of a point without a steady state, sized by the defaults'."""
+
+    class NoSteadyState:
+        solves, sigma_db = 0, 1.0
+
+        def vector(self, sc):
+            if sc["x"] != 0.0:
+                raise FloatingPointError("left.z at 1000 rpm: did not converge")
+            return np.zeros(5)
+
+    pack = SimpleNamespace(n_prior=0, scenario=lambda x: {"x": float(x[0])}, x0=np.zeros(1))
+    fun = search.Counted(NoSteadyState(), pack, 100)
+    r = fun(np.array([0.7]))
+    assert r.shape == (5,) and np.all(r == search.NO_STEADY_STATE_RESIDUAL)

@@ -48,6 +48,14 @@ class Counted:
             return np.empty(0)
         return self.prior_w * (np.asarray(x) - self.pack.x0)[self.prior_on]
 
+    def _data_size(self, problem, x):
+        """Number of data residuals: the best point's, or before any point the defaults'
+        (a refit started at a point without a steady state; raises if the defaults have
+        none either)."""
+        if self.best[2] is not None:
+            return self.best[2].size - self.prior(x).size
+        return problem.vector(self.pack.scenario(self.pack.x0)).size
+
     def evaluate(self, problem, x):
         """Residuals of ``problem`` at ``x`` with the prior's, charged to the budget (raises
         when it is spent)."""
@@ -57,9 +65,7 @@ class Counted:
         try:
             v = problem.vector(self.pack.scenario(x))
         except FloatingPointError:  # no steady state there: a point worse than any fit
-            if self.best[2] is None:
-                raise
-            v = np.full(self.best[2].size - self.prior(x).size, NO_STEADY_STATE_RESIDUAL)
+            v = np.full(self._data_size(problem, x), NO_STEADY_STATE_RESIDUAL)
         r = np.concatenate([v, self.prior(x)])
         self.n += max(1, problem.solves - before)
         return r
