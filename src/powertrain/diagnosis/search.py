@@ -128,7 +128,11 @@ def jacobian(fun, x, pack):
     """Forward-difference Jacobian at ``x`` (used when the budget or a stall stopped the
     fit)."""
     def full(x):
-        return np.concatenate([fun.problem.vector(pack.scenario(x)), fun.prior(x)])
+        try:
+            v = fun.problem.vector(pack.scenario(x))
+        except FloatingPointError:         # no steady state: as in the search
+            v = np.full(fun._data_size(fun.problem, x), NO_STEADY_STATE_RESIDUAL)
+        return np.concatenate([v, fun.prior(x)])
     r0 = full(x)
     J = np.empty((r0.size, x.size))
     for j in range(x.size):
