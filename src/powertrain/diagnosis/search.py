@@ -62,13 +62,18 @@ class Counted:
         if self.n >= self.budget:
             raise Exhausted
         before = problem.solves
-        try:
-            v = problem.vector(self.pack.scenario(x))
-        except FloatingPointError:  # no steady state there: a point worse than any fit
-            v = np.full(self._data_size(problem, x), NO_STEADY_STATE_RESIDUAL)
-        r = np.concatenate([v, self.prior(x)])
+        r = self.residuals(problem, x)
         self.n += max(1, problem.solves - before)
         return r
+
+    def residuals(self, problem, x):
+        """Residuals of ``problem`` at ``x`` with the prior's, uncharged; a point without a
+        steady state is worse than any fit (:data:`NO_STEADY_STATE_RESIDUAL`)."""
+        try:
+            v = problem.vector(self.pack.scenario(x))
+        except FloatingPointError:
+            v = np.full(self._data_size(problem, x), NO_STEADY_STATE_RESIDUAL)
+        return np.concatenate([v, self.prior(x)])
 
     def watch(self, n_params):
         """Watch the next start for a stall (None: stop watching)."""
@@ -128,11 +133,7 @@ def jacobian(fun, x, pack):
     """Forward-difference Jacobian at ``x`` (used when the budget or a stall stopped the
     fit)."""
     def full(x):
-        try:
-            v = fun.problem.vector(pack.scenario(x))
-        except FloatingPointError:         # no steady state: as in the search
-            v = np.full(fun._data_size(fun.problem, x), NO_STEADY_STATE_RESIDUAL)
-        return np.concatenate([v, fun.prior(x)])
+        return fun.residuals(fun.problem, x)
     r0 = full(x)
     J = np.empty((r0.size, x.size))
     for j in range(x.size):
