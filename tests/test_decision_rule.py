@@ -129,11 +129,25 @@ def test_xv_explained_min(above):
 @pytest.mark.parametrize("above", [False, True])
 def test_xv_t_min(above):
     ev = evidence(cand("a", 1.0, 900.0))
-    ev.candidates[0].cells["t"] = 3.5
+    ev.candidates[0].cells.update(t=3.5, speed_folds=3)     # scored over every speed fold
     v = decide(ev, DecisionRule(xv_t_min=just(3.5, above)))
     assert (v.chosen == "a") is (not above)
     if above:
         assert v.assessments["a"].status is Status.FAILS_HELDOUT_CELLS
+
+
+@pytest.mark.parametrize("above", [False, True])
+def test_xv_t_screen(above):
+    """A cells check scored at the held-out speeds only that misses xv_t_min is asked for
+    again over every speed fold when its t is above xv_t_screen, else it fails."""
+    ev = evidence(cand("a", 1.0, 900.0))
+    ev.candidates[0].cells.update(t=2.5, speed_folds=1)
+    v = decide(ev, DecisionRule(xv_t_screen=just(2.5, above)))
+    if above:
+        assert v.kind is VerdictKind.UNEXPLAINED
+        assert v.assessments["a"].status is Status.FAILS_HELDOUT_CELLS
+    else:
+        assert v.kind is VerdictKind.PENDING and v.needs_cells_check == "a"
 
 
 @pytest.mark.parametrize("n_checked", [1, 2])
@@ -149,6 +163,45 @@ def test_rivals_of_another_family_make_it_ambiguous():
     b.heldout_per_rpm = 1.01 + 0.3 * np.cos(np.arange(N) * 0.9)
     v = decide(evidence(cand("a", 1.0, 900.0), b))
     assert v.kind is VerdictKind.AMBIGUOUS and set(v.ambiguous) == {"a", "b"}
+
+
+@pytest.mark.parametrize("restater_first", [True, False])
+def test_a_restating_rival_yields_to_the_candidate_it_restates(restater_first):
+    """A "missing" mode shaped like a file mode (b restates a) is neither the answer nor a
+    rival while the held-out speeds cannot tell them apart, whichever ranks first."""
+    a = cand("a", 1.01 if restater_first else 1.0, 900.0)
+    b = cand("b", 1.0 if restater_first else 1.01, 901.0)
+    b.heldout_per_rpm = b.heldout_mse + 0.3 * np.cos(np.arange(N) * 0.9)
+    b.restates = ((("a",), "shape pairs with mode 1"),)
+    v = decide(evidence(a, b))
+    assert v.kind is VerdictKind.EFFECT and v.chosen == "a" and not v.ambiguous
+    assert v.assessments["b"].status is Status.RESTATES
+    assert "restates a (shape pairs with mode 1)" in v.assessments["b"].text
+
+
+@pytest.mark.parametrize("above", [False, True])
+def test_rivals_in_the_screen_band_are_cross_fitted(above):
+    """A rival whose held-out t against the answer lies between t_screen and t_min is
+    judged on the cross-fitted speeds of both; below t_screen the verdict is final."""
+    a = cand("a", 1.0, 900.0)
+    b = cand("b", 1.01, 901.0)
+    b.heldout_per_rpm = 1.01 + 0.3 * np.cos(np.arange(N) * 0.9)
+    t = improvement_t(b, a, 0.5)
+    v = decide(evidence(a, b), DecisionRule(t_screen=just(abs(t), above)))
+    if above:
+        assert v.kind is VerdictKind.AMBIGUOUS
+    else:
+        assert v.kind is VerdictKind.PENDING and set(v.needs_crossfit) == {"a", "b"}
+
+
+def test_a_restating_candidate_clearly_better_is_the_answer():
+    """The restatement only settles what the data cannot: b, significantly better than the
+    candidate it restates (held-out t > t_min), stays the answer."""
+    a = cand("a", 2.5, 950.0, spread=0.0)
+    b = cand("b", 1.0, 900.0)
+    b.restates = ((("a",), "shape pairs with mode 1"),)
+    v = decide(evidence(a, b))
+    assert v.kind is VerdictKind.EFFECT and v.chosen == "b"
 
 
 @pytest.mark.parametrize("member_mse", [1.5, 2.5])

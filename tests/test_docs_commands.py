@@ -45,7 +45,6 @@ import signal
 import subprocess
 import sys
 import textwrap
-from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -70,8 +69,6 @@ TIMEOUT_S = 120.0
 #: Fences whose content is executed, and shell fences that are refused (use ```bash).
 RUN_FENCE = "bash"
 REFUSED_FENCES = ("sh", "shell", "console", "zsh")
-#: Doc files run side by side (each command is a separate process; CI has two cores).
-WORKERS = 2
 #: Options whose value is a file (or folder) the command writes.
 OUTPUT_OPTIONS = ("--out", "--csv", "--plot", "--json", "--truth", "--report", "--target-out",
                   "--target-plot")
@@ -554,21 +551,11 @@ def test_skipped_by_rule(cmd, part, reason):
                 "(rule: docs/extending.md, 'Writing docs')")
 
 
-@pytest.fixture(scope="module")
-def doc_runs(request, shim_bin, tmp_path_factory) -> dict:
-    """Run the selected doc files, WORKERS at a time (each in its own folder, its commands in
-    order); {doc: future of its first failure or None}."""
-    selected = [item.callspec.params["doc"] for item in request.session.items
-                if getattr(item, "originalname", "") == "test_doc_commands_run"]
-    env = doc_environment(shim_bin)
-    with ThreadPoolExecutor(max_workers=WORKERS) as pool:
-        return {doc: pool.submit(run_doc, doc, tmp_path_factory.mktemp("doc"), env)
-                for doc in selected}
-
-
+# Each doc file is its own test: the test processes (pytest-xdist) share them out, and each runs
+# once. (A module fixture that ran every file in a thread pool was instantiated by *each*
+# test process that drew one of these tests, so CI ran every doc command twice.)
 @pytest.mark.slow
-@pytest.mark.xdist_group(name="doc_commands")   # one test process runs every doc file once
 @pytest.mark.parametrize("doc", RUN_FILES)
-def test_doc_commands_run(doc, doc_runs):
-    failure = doc_runs[doc].result()
+def test_doc_commands_run(doc, shim_bin, tmp_path):
+    failure = run_doc(doc, tmp_path, doc_environment(shim_bin))
     assert failure is None, failure

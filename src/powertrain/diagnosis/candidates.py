@@ -37,6 +37,20 @@ def warm_caches(hm, effects):
         EFFECTS[e].warm(hm)
 
 
+def restatements(outcome, engine) -> tuple:
+    """``((effects, reason), ...)``: the candidates (effect tuples, sorted) whose finding
+    ``outcome``'s fit restates (``Effect.restates``; e.g. a missing body mode shaped like one
+    of the file's modes restates ``chassis_modes``; in a pair, the pair with that member
+    replaced)."""
+    out = []
+    for e in outcome.effects:
+        r = EFFECTS[e].restates(outcome.params[e], engine)
+        if r is not None:
+            other = tuple(sorted([x for x in outcome.effects if x != e] + [r[0]]))
+            out.append((other, r[1]))
+    return tuple(out)
+
+
 def _refit(setup, e, params, budget):
     """The chosen effect refitted from an alternative start (a few evaluations)."""
     from powertrain.diagnosis.fit import Packing, fit_candidate

@@ -253,7 +253,7 @@ def pair_candidates(singles, e_n, rule) -> list:
 def _evidence(o, struct=None):
     return CandidateEvidence(o.label, o.effects, o.heldout_mse, o.heldout_per_rpm, o.bic,
                              o.struct_db if struct is None else struct, o.cells_check,
-                             o.crossfit)
+                             o.crossfit, o.restates)
 
 
 def _decide(s, baseline, outcomes, sigma, rule, where_phrase, budget):
@@ -274,8 +274,10 @@ def _decide(s, baseline, outcomes, sigma, rule, where_phrase, budget):
                 by_label[label].crossfit = crossfit(folds, by_label[label], budget=budget)
             continue
         o = by_label[verdict.needs_cells_check]
-        # over all speed folds when its support itself needed them (held-out t short)
-        all_folds = not verdict.assessments[o.label].t_stat > rule.t_min
+        # over all speed folds when its support itself needed them (held-out t short), or
+        # asked again after a check at the held-out speeds fell short (rule.xv_t_screen)
+        all_folds = (not verdict.assessments[o.label].t_stat > rule.t_min
+                     or o.cells_check is not None)
         o.cells_check = heldout_cells_check(
             s.problem, o, baseline, sigma, budget=budget,
             folds=s.fold_problems() if all_folds else ())
@@ -304,6 +306,8 @@ def _diagnose(measured, engine, noise_floor, effects, pairs, do_bands, rule, sch
     _structure(s, baseline, [], sigma)
     outcomes = _fit_all(s, pairs, scheduler, progress, budget, noise_mse(s.problem, sigma), rule,
                         baseline, sigma)
+    for o in outcomes:
+        o.restates = cand.restatements(o, s.problem.engine)
     verdict, e_n = _decide(s, baseline, outcomes, sigma, rule, where_text(found, parts), budget)
     for o in outcomes:
         a = verdict.assessments[o.label]

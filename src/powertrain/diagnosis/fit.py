@@ -81,6 +81,8 @@ class FitOutcome:
     units: dict = field(default_factory=dict)
     #: Residual evaluations spent, weighted by cost (the budget's unit).
     n_eval: float = 0.0
+    #: candidates whose finding this fit restates (:func:`candidates.restatements`)
+    restates: tuple = ()
 
     @property
     def label(self) -> str:

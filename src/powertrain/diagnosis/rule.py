@@ -21,6 +21,10 @@ would leave (noise):
   from the answer (t ≤ ``t_min``) makes the verdict **ambiguous** — unless the answer and
   its rivals are pairs that share one effect which is itself big and supported: then that
   effect is the answer and the second effect is reported as not identified;
+* a candidate whose fit **restates** another supported one (``Effect.restates``: a "missing"
+  body mode whose shape pairs with one of the file's modes says "that mode is elsewhere") is
+  neither the answer nor a rival while the held-out speeds cannot tell it from the one it
+  restates (t ≤ ``t_min``): the more constrained statement is the answer;
 * otherwise **no effect** when the excess RMS gap :math:`\sqrt{\max(E_0 - E_n, 0)}` is
   below ``excess_min_db`` (even if a candidate fits what is left "significantly": a model
   that agrees to round-off leaves round-off for candidates to fit), else **unexplained**
@@ -35,11 +39,18 @@ from __future__ import annotations
 
 import dataclasses
 import math
-from dataclasses import dataclass, field
-from enum import Enum
+from dataclasses import dataclass
 
 import numpy as np
 
+from powertrain.diagnosis.evidence import (  # noqa: F401  (the rule's types, re-exported)
+    Assessment,
+    CandidateEvidence,
+    Evidence,
+    Status,
+    Verdict,
+    VerdictKind,
+)
 from powertrain.diagnosis.significance import crossfit_t, improvement_t
 
 
@@ -88,7 +99,13 @@ class DecisionRule:
         thirds of the speeds held out, so every speed is scored once) and judged on all
         speeds against the same ``t_min``: a gap that sits at a few resonance crossings
         leaves one third of the speeds too few informative ones; three times the speeds
-        raise t by about √3, so below 2 (2√3 ≈ 3.5 < 4) cross-fitting cannot succeed.
+        raise t by about √3, so below 2 (2√3 ≈ 3.5 < 4) cross-fitting cannot succeed. The
+        same holds between rivals: a rival whose held-out t against the answer lies between
+        ``t_screen`` and ``t_min`` is judged on the cross-fitted speeds of both.
+    xv_t_screen : float
+        Held-out cells check: a candidate whose withheld cells were scored at the held-out
+        speeds only, explain at least ``xv_explained_min`` but miss ``xv_t_min`` with t above
+        this is scored again over every speed fold (the same √3 argument: 3/√3 ≈ 1.7).
     """
 
     t_min: float = 4.0
@@ -103,92 +120,11 @@ class DecisionRule:
     n_checked: int = 3
 
     t_screen: float = 2.0
+    xv_t_screen: float = 1.7
 
     def to_dict(self) -> dict:
         """Upper-case keys (the diagnosis JSON's ``decision_rule``)."""
         return {k.upper(): v for k, v in dataclasses.asdict(self).items()}
-
-
-class Status(Enum):
-    """Status of a candidate after the decision."""
-
-    SUPPORTED = "supported"
-    NOT_SUPPORTED = "not supported"
-    NOT_BETTER_THAN_MEMBER = "not better than its better member"
-    STRUCTURED_RESIDUAL = "residual structured"
-    FAILS_HELDOUT_CELLS = "fails held-out cells"
-    INDISTINGUISHABLE = "indistinguishable"
-    PARTIAL = "partial"
-    CHOSEN = "chosen"
-
-
-class VerdictKind(Enum):
-    """Kind of answer."""
-
-    EFFECT = "effect"
-    NO_EFFECT = "no effect"
-    UNEXPLAINED = "unexplained"
-    AMBIGUOUS = "ambiguous"
-    PENDING = "pending"          # a held-out cells check is needed first
-
-
-@dataclass
-class CandidateEvidence:
-    """What the fits measured for one candidate (or the baseline, no effects)."""
-
-    label: str
-    effects: tuple
-    heldout_mse: float
-    heldout_per_rpm: np.ndarray
-    bic: float
-    struct_db: float = float("nan")
-    cells: dict | None = None
-    #: mean squared gap per speed over all three speed folds (each fold's refit scored on
-    #: the speeds it left out; the baseline's over the same speeds); None until cross-fitted
-    crossfit: np.ndarray | None = None
-
-
-@dataclass
-class Evidence:
-    """All the decision needs: baseline, candidates, noise, the 'where' phrase."""
-
-    baseline: CandidateEvidence
-    candidates: list
-    noise_mse: float
-    sigma_db: float
-    where_text: str = ""
-
-
-@dataclass
-class Assessment:
-    """A candidate's numbers and status after the decision."""
-
-    t_stat: float
-    bic_gain: float
-    explained: float
-    status: Status
-    text: str
-    t_crossfit: float = float("nan")
-    #: labels to cross-fit before this candidate can be judged (itself, a pair's member)
-    crossfit_labels: tuple = ()
-
-
-@dataclass
-class Verdict:
-    """The answer: kind, the JSON ``verdict`` label, text, per-candidate assessments (in
-    held-out order), the chosen label and the labels that cannot be told apart."""
-
-    kind: VerdictKind
-    label: str
-    text: str
-    assessments: dict = field(default_factory=dict)
-    order: list = field(default_factory=list)
-    chosen: str | None = None
-    ambiguous: list = field(default_factory=list)
-    #: with an answer: its pairs that cannot be told apart (second effect not identified)
-    second_effect_between: list = field(default_factory=list)
-    needs_cells_check: str | None = None
-    needs_crossfit: list = field(default_factory=list)
 
 
 def _assess(ev: Evidence, rule: DecisionRule) -> dict:
@@ -247,6 +183,11 @@ def _choose(ev, rule, ranked, ass):
            and _big(ass[c.label], rule)]
     for c in big[:rule.n_checked]:
         a = ass[c.label]
+        r = next((r for r in big if r is not c and _restated(c, r)
+                  and not crossfit_t(r, c, ev.noise_mse) > rule.t_min), None)
+        if r is not None:
+            a.status, a.text = Status.RESTATES, f"restates {r.label} ({_restated(c, r)})"
+            continue
         if not c.struct_db <= smax:
             a.status = Status.STRUCTURED_RESIDUAL
             a.text = f"residual structured ({c.struct_db:.2f} dB > {smax:.2f} dB beyond noise)"
@@ -256,6 +197,9 @@ def _choose(ev, rule, ranked, ass):
         xv = c.cells
         if xv["baseline_excess_db"] >= rule.excess_min_db and not (
                 xv["explained"] >= rule.xv_explained_min and xv["t"] > rule.xv_t_min):
+            if (xv.get("speed_folds", 1) == 1 and xv["explained"] >= rule.xv_explained_min
+                    and xv["t"] > rule.xv_t_screen):
+                return None, c.label             # again, over every speed fold
             a.status = Status.FAILS_HELDOUT_CELLS
             a.text = (f"fails held-out {xv['kind']} (explains {xv['explained']:.0%}, "
                       f"t {xv['t']:.1f})")
@@ -265,17 +209,30 @@ def _choose(ev, rule, ranked, ass):
 
 
 def _rivals(ev, rule, ranked, ass, chosen):
-    """Admissible candidates of another family the held-out speeds cannot tell apart."""
-    mine, smax, out = set(chosen.effects), _struct_max(ev, rule), []
+    """Admissible candidates of another family the held-out speeds cannot tell apart, and
+    the labels to cross-fit before that is final (t between ``t_screen`` and ``t_min``)."""
+    mine, smax, out, need = set(chosen.effects), _struct_max(ev, rule), [], []
     for c in ranked:
         theirs, a = set(c.effects), ass[c.label]
         if (c is chosen or a.status is not Status.SUPPORTED or theirs <= mine
                 or mine <= theirs or not _big(a, rule) or not c.struct_db <= smax):
             continue
         t_rival = crossfit_t(c, chosen, ev.noise_mse)
-        if not t_rival > rule.t_min:
-            out.append((c, t_rival))
-    return out
+        if t_rival > rule.t_min:
+            continue
+        if _restated(c, chosen):
+            a.status, a.text = Status.RESTATES, f"restates {chosen.label} ({_restated(c, chosen)})"
+            continue
+        if t_rival > rule.t_screen:
+            need += [x.label for x in (chosen, c) if x.crossfit is None]
+        out.append((c, t_rival))
+    return out, list(dict.fromkeys(need))
+
+
+def _restated(c, r) -> str:
+    """Why ``c``'s fit restates candidate ``r`` ('' when it does not)."""
+    key = tuple(sorted(r.effects))
+    return next((why for eff, why in c.restates if tuple(eff) == key), "")
 
 
 def decide(evidence: Evidence, rule: DecisionRule = DecisionRule()) -> Verdict:
@@ -291,7 +248,9 @@ def decide(evidence: Evidence, rule: DecisionRule = DecisionRule()) -> Verdict:
     if pending is not None:
         return Verdict(VerdictKind.PENDING, "pending", "", ass, order,
                        needs_cells_check=pending)
-    rivals = _rivals(ev, rule, ranked, ass, chosen) if chosen is not None else []
+    rivals, cross = _rivals(ev, rule, ranked, ass, chosen) if chosen is not None else ([], [])
+    if cross:
+        return Verdict(VerdictKind.PENDING, "pending", "", ass, order, needs_crossfit=cross)
     if rivals:
         pairs = [chosen] + [c for c, _ in rivals]
         member = _shared_member(rule, ranked, ass, pairs)

@@ -66,6 +66,12 @@ GRID_STEP = 1.06
 #: Modal mass of the frequency-grid starts [kg] (the fit moves it; a middle value).
 GRID_MASS = 12.0
 AXES = "xyz"
+#: Modal assurance criterion above which the fitted shape *pairs* with one of the file's body
+#: modes [1]: 0.9 is the usual threshold for a well-correlated pair of test and model modes
+#: (Allemang 2003, "The modal assurance criterion - twenty years of use and abuse"). Shapes
+#: drawn at random for a truly missing mode reach it about once in 4000 draws
+#: (docs/validation/diagnosis.md).
+MAC_PAIRED = 0.9
 
 
 def shape_names(engine) -> list:
@@ -155,6 +161,33 @@ class MissingBodyMode(Effect):
         top = max(shape, key=lambda k: abs(shape[k]))
         return (f"a body mode missing from the model near {params['frequency_hz']:.1f} Hz, "
                 f"{params['modal_mass_kg']:.3g} kg, moving mostly {top[6:-2]}'s {top[-1]}")
+
+    def restates(self, params, engine=None):
+        """``("chassis_modes", reason)`` when the fitted mode's shape at the mount bases pairs
+        (MAC >= :data:`MAC_PAIRED`) with a body mode of the engine file at a frequency
+        ``chassis_modes`` can move that mode to: the data then say "that mode is elsewhere",
+        with no new mode needed."""
+        from powertrain.effects.chassis_modes import FREQ_RANGE as MOVE
+        ch = getattr(engine, "chassis", None)
+        modes = () if ch is None else ch.body_modes
+        mode = mode_arrays(params, len(engine.mounts)) if modes else None
+        if mode is None:
+            return None
+        f, _, _, shape = mode
+        psi = shape.ravel()
+        best = None
+        for k, m in enumerate(modes):
+            phi = np.concatenate([np.asarray(m.shapes[mt.name], float) for mt in engine.mounts])
+            mac = float(phi @ psi) ** 2 / max(float(phi @ phi) * float(psi @ psi), 1e-300)
+            ratio = f / m.frequency
+            if mac >= MAC_PAIRED and MOVE[0] <= ratio <= MOVE[1] and (
+                    best is None or mac > best[1]):
+                best = (k, mac, ratio)
+        if best is None:
+            return None
+        k, mac, ratio = best
+        return ("chassis_modes", f"its shape pairs with body mode {k + 1} of the engine file "
+                                 f"(MAC {mac:.2f}) at {ratio:.2f}x its frequency")
 
     def data_starts(self, engine, gaps):
         """Start parameter sets from the body-side gap (module docstring), [] without one.
