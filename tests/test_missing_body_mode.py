@@ -204,3 +204,44 @@ def test_mode_with_an_amplitude_dependent_mount_on_the_fast_path(modal):
     slow = predict(HarmonicModel(EFFECT.apply(modal, **p), RPM),
                    {"amplitude_stiffness": amp}).velocity
     np.testing.assert_allclose(fast, slow, rtol=1e-6, atol=1e-6 * np.abs(slow).max())
+
+
+def _file_shape(engine, k):
+    return np.concatenate([engine.chassis.modes[k].shapes[m.name] for m in engine.mounts])
+
+
+@pytest.mark.parametrize("ratio, scale, restated", [(0.92, 1.0, True), (1.45, -0.7, True),
+                                                    (1.7, 1.0, False), (0.55, 1.0, False)])
+def test_a_mode_shaped_like_a_file_mode_restates_chassis_modes(modal, ratio, scale, restated):
+    """A fitted mode whose base shape pairs with a file mode (any scale or sign) at a
+    frequency chassis_modes can move that mode to (0.6-1.6x) restates chassis_modes."""
+    f0 = modal.chassis.modes[0].frequency
+    p = _params(modal, f=ratio * f0, shape=scale * _file_shape(modal, 0))
+    r = EFFECT.restates(p, modal)
+    assert (r is not None) is restated
+    if restated:
+        assert r[0] == "chassis_modes" and "body mode 1" in r[1] and "MAC 1.00" in r[1]
+
+
+def test_a_mode_of_its_own_shape_or_on_a_rigid_chassis_restates_nothing(modal, rigid):
+    assert EFFECT.restates(_params(modal), modal) is None
+    assert EFFECT.restates(_params(rigid), rigid) is None
+    absent = _params(modal, m=1e4, shape=_file_shape(modal, 0))
+    assert EFFECT.restates(absent, modal) is None
+
+
+def test_shapes_drawn_for_a_missing_mode_rarely_pair_with_a_file_mode(modal):
+    """The truth generator's missing-mode shapes (validation.kinds) pair (MAC >= 0.9) with one
+    of the default body's modes in fewer than 1 draw in 1000: the restatement rule leaves
+    truly missing modes alone (docs/guide/diagnose.md, 'restatement')."""
+    from powertrain.effects.missing_body_mode import MAC_PAIRED
+    from powertrain.validation.kinds import _draw_missing_mode
+    rng = np.random.default_rng()                    # fresh draws every run
+    phi = np.array([_file_shape(modal, k) for k in range(len(modal.chassis.modes))])
+    n, paired = 20000, 0
+    for _ in range(n):
+        psi = _draw_missing_mode(rng, modal)["shape"].ravel()
+        mac = (phi @ psi) ** 2 / (np.sum(phi ** 2, axis=1) * (psi @ psi))
+        paired += bool(mac.max() >= MAC_PAIRED)
+    print(f"missing-mode shapes paired with a file mode: {paired}/{n}")
+    assert paired / n < 1e-3

@@ -94,21 +94,25 @@ def _pairs(channels):
     return out
 
 
-def _band(gap, data, cols, n_bins=24):
-    """Frequency band [Hz] of the passive gap: mean squared gap in log-spaced frequency
-    bins (f = order × rpm / 60), the run of bins around the largest with at least half its
-    value."""
+def _band(gap, sig, data, cols, n_bins=24):
+    """Frequency band [Hz] of the passive gap: mean squared gap *beyond the noise* (each
+    point's σ² from the noise model taken off: points near the floor scatter most, and a
+    plain mean squared gap peaks where they lie, not at the resonance) in log-spaced
+    frequency bins (f = order × rpm / 60), the run of bins around the largest with at least
+    half its value."""
     order = (data.harmonic + 1) / 2.0
     f = np.broadcast_to(data.rpm[:, None, None] * order[None, None, :] / 60.0, gap.shape)
     g = gap[:, cols][:, :, data.order_mask]
+    v = sig[:, cols][:, :, data.order_mask] ** 2
     f = f[:, cols][:, :, data.order_mask]
-    ok = np.isfinite(g)
+    ok = np.isfinite(g) & np.isfinite(v)
     if not ok.any():
         return None
-    g, f = g[ok], f[ok]
+    g, v, f = g[ok], v[ok], f[ok]
     edges = np.geomspace(f.min(), f.max() * 1.0001, n_bins + 1)
     k = np.clip(np.searchsorted(edges, f, side="right") - 1, 0, n_bins - 1)
-    ms = np.array([np.mean(g[k == j] ** 2) if np.any(k == j) else 0.0 for j in range(n_bins)])
+    ms = np.array([max(np.mean(g[k == j] ** 2 - v[k == j]), 0.0) if np.any(k == j) else 0.0
+                   for j in range(n_bins)])
     top = int(np.argmax(ms))
     lo, hi = top, top
     while lo > 0 and ms[lo - 1] >= 0.5 * ms[top]:
@@ -184,7 +188,7 @@ def side_attribution(gap, data, sigma_db=None) -> dict | None:
             "mounts_off_body_side": off, "shared": len(off) >= MIN_SHARED_MOUNTS,
             "noise_sigma_db": float(np.nanmedian(sig)) if np.isfinite(sig).any() else
             float("nan"),
-            "band_hz": _band(gap, data, cols) if (where == "body" and cols) else None}
+            "band_hz": _band(gap, sig, data, cols) if (where == "body" and cols) else None}
 
 
 def measured_sides(measured, engine, noise_floor) -> dict | None:

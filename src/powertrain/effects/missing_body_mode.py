@@ -69,8 +69,8 @@ AXES = "xyz"
 #: Modal assurance criterion above which the fitted shape *pairs* with one of the file's body
 #: modes [1]: 0.9 is the usual threshold for a well-correlated pair of test and model modes
 #: (Allemang 2003, "The modal assurance criterion - twenty years of use and abuse"). Shapes
-#: drawn at random for a truly missing mode reach it about once in 4000 draws
-#: (docs/validation/diagnosis.md).
+#: the validation generator draws for a truly missing mode reach it with one of the default
+#: body's modes in fewer than 1 draw in 1000 (tests/test_missing_body_mode.py).
 MAC_PAIRED = 0.9
 
 
