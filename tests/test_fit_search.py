@@ -125,3 +125,25 @@ def test_a_refit_that_starts_without_a_steady_state_is_a_bad_point_not_a_crash()
     fun = search.Counted(NoSteadyState(), pack, 100)
     r = fun(np.array([0.7]))
     assert r.shape == (5,) and np.all(r == search.NO_STEADY_STATE_RESIDUAL)
+
+
+def test_a_fit_without_a_steady_state_at_a_held_out_speed_is_scored_unsupported():
+    """Parameters whose amplitude fixed point converges at the training speeds but not at a
+    held-out one (found by a rate run: a plan's pair fit) predict nothing there: the held-out
+    gap is infinite, the rule finds the candidate unsupported, and nothing crashes."""
+    from powertrain.diagnosis.fit import score
+    from powertrain.diagnosis.rule import CandidateEvidence, Evidence, Status, decide
+
+    def no_steady_state(sc, part):
+        raise FloatingPointError("gearbox.y at 1500 rpm: the amplitude fixed point did not "
+                                 "converge")
+
+    stub = SimpleNamespace(gaps=no_steady_state, phase_w=None,
+                           valid={"test": np.ones((17, 9, 8), bool)})
+    o = score(stub, ("amplitude_stiffness",), {}, {}, {}, 300.0, 2000, 1, 40, 0.1)
+    assert o.heldout_mse == np.inf and np.all(o.heldout_per_rpm == np.inf)
+    assert np.isnan(o.heldout_gaps).all() and np.isnan(o.heldout_channel_rms).all()
+    base = CandidateEvidence("", (), 2.0, np.full(17, 2.0), 1000.0, 0.5)
+    c = CandidateEvidence(o.label, o.effects, o.heldout_mse, o.heldout_per_rpm, o.bic, 0.2)
+    v = decide(Evidence(base, [c], 0.4, 0.63, ""))
+    assert v.assessments[o.label].status is Status.NOT_SUPPORTED and v.chosen is None

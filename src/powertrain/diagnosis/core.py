@@ -318,10 +318,7 @@ def _diagnose(measured, engine, noise_floor, effects, pairs, do_bands, rule, sch
     chosen = next((o for o in outcomes if o.label == verdict.chosen), None)
     gap_after, bands = None, []
     if chosen is not None:
-        sc = {e: chosen.params[e] for e in chosen.effects}
-        g1 = residuals_db(model_levels(predict(w.hm, sc).velocity, w.data), w.data.level,
-                          w.data.floor)
-        gap_after = np.where(w.data.censored, np.nan, g1)
+        gap_after = _gap_after(w, {e: chosen.params[e] for e in chosen.effects})
         if do_bands and len(chosen.effects) == 1 and w is s:
             def factory(idx):
                 return Problem(s.sub(idx), s.problem.hm["test"], s.data, idx, s.test_idx)
@@ -344,6 +341,17 @@ def _diagnose(measured, engine, noise_floor, effects, pairs, do_bands, rule, sch
         verdict_kind=verdict.kind, equivalents=eq,
         budget_hits=[o.label for o in outcomes if o.budget_hit], finding=finding,
         phase=_phase_dict(s, chosen), runs=s.run_entries(chosen) if w is not s else [])
+
+
+def _gap_after(w, sc):
+    """The gap map with the answer's effects on every measured speed; None where the
+    answer's amplitude fixed point has no steady state at a speed it was not fitted on."""
+    try:
+        vel = predict(w.hm, sc).velocity
+    except FloatingPointError:
+        return None
+    g1 = residuals_db(model_levels(vel, w.data), w.data.level, w.data.floor)
+    return np.where(w.data.censored, np.nan, g1)
 
 
 def phase_kind(data) -> str:

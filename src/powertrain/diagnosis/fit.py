@@ -290,22 +290,35 @@ def fit_candidate(problem: Problem, effects, starts=None, grid=True,
 
 
 def score(problem, effects, sc, params, sigma, rss, n, p, nfev, seconds, x=None) -> FitOutcome:
-    """Held-out scores of a scenario: mean squared gap per speed, overall, per channel."""
-    g = problem.gaps(sc, "test")
-    valid = np.isfinite(g)
-    both = g if problem.phase_w is None else np.concatenate(
-        [g, problem.phase_gaps(sc, "test")], axis=-1)        # level and phase gaps
-    ok = np.isfinite(both)
+    """Held-out scores of a scenario: mean squared gap per speed, overall, per channel. A
+    scenario without a steady state at a held-out speed (an amplitude fixed point that does
+    not converge there, though it did at the training speeds) predicts nothing there: its
+    held-out gap is infinite (the rule finds it unsupported; JSON null)."""
+    try:
+        g = problem.gaps(sc, "test")
+        both = g if problem.phase_w is None else np.concatenate(
+            [g, problem.phase_gaps(sc, "test")], axis=-1)    # level and phase gaps
+    except FloatingPointError:
+        g = np.full(problem.valid["test"].shape, np.nan)
+        per_rpm, mse, ch = np.full(g.shape[0], np.inf), math.inf, [math.nan] * g.shape[1]
+    else:
+        per_rpm, mse, ch = _heldout_means(g, both)
+    bic = n * math.log(max(rss, 1e-300) / n) + p * math.log(n)
+    return FitOutcome(tuple(effects), params, sigma, rss, n, p, bic, mse, math.sqrt(mse),
+                      per_rpm, ch, nfev, seconds, x=x, heldout_gaps=g)
+
+
+def _heldout_means(g, both):
+    """Mean squared held-out gap per speed and overall (levels and phases), RMS per channel
+    (levels)."""
+    valid, ok = np.isfinite(g), np.isfinite(both)
     per_rpm = np.array([np.mean(both[i][ok[i]] ** 2) if ok[i].any() else np.nan
                         for i in range(g.shape[0])])
-    mse = float(np.mean(both[ok] ** 2))
     ch = []
     for c in range(g.shape[1]):
         v = g[:, c][valid[:, c]]
         ch.append(float(np.sqrt(np.mean(v ** 2))) if v.size else float("nan"))
-    bic = n * math.log(max(rss, 1e-300) / n) + p * math.log(n)
-    return FitOutcome(tuple(effects), params, sigma, rss, n, p, bic, mse, math.sqrt(mse),
-                      per_rpm, ch, nfev, seconds, x=x, heldout_gaps=g)
+    return per_rpm, float(np.mean(both[ok] ** 2)), ch
 
 
 def baseline_outcome(problem: Problem) -> FitOutcome:
