@@ -88,6 +88,21 @@ def test_pair_gain_min(above):
 
 
 @pytest.mark.parametrize("above", [False, True])
+def test_a_member_leaving_less_than_excess_min_db_keeps_the_pair_out(above):
+    """Member a leaves sqrt(1.5 - 0.5) = 1 dB RMS over noise: with excess_min_db just above
+    that, a second effect has nothing beyond the lab's repeatability to explain and a is
+    the answer; just below, the pair (which passes every other pair test) is."""
+    a, b = cand("a", 1.5, 950.0), cand("b", 3.0, 980.0)
+    ab = cand("a+b", 0.8, 800.0)
+    rule = DecisionRule(excess_min_db=just(1.0, above))
+    v = decide(evidence(a, b, ab), rule)
+    assert v.chosen == ("a" if above else "a+b")
+    if above:
+        assert v.assessments["a+b"].status is Status.NOT_BETTER_THAN_MEMBER
+        assert "leaves 1.00 dB RMS over noise" in v.assessments["a+b"].text
+
+
+@pytest.mark.parametrize("above", [False, True])
 def test_excess_min_db_no_effect_vs_unexplained(above):
     excess = math.sqrt(4.0 - 0.5)
     v = decide(evidence(cand("a", 3.9, 999.0)), DecisionRule(excess_min_db=just(excess, above)))

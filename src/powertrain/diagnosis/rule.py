@@ -10,7 +10,9 @@ would leave (noise):
   :math:`\bar d/(s_d/\sqrt{n_r}) >` ``t_min`` and :math:`\bar d > 0`;
 * a pair is preferred to its better member only if it is supported against that member in
   the same way (cross-fitting both when that t lies between ``t_screen`` and ``t_min``) and
-  explains at least ``pair_gain_min`` of the excess that member leaves;
+  explains at least ``pair_gain_min`` of the excess that member leaves — and never when
+  that member is supported and leaves an excess over noise below ``excess_min_db`` with a
+  residual within the structure limit (nothing left beyond the lab's repeatability);
 * the **answer** is the best (lowest held-out gap) supported candidate, among the first
   ``n_checked`` that explain at least ``explained_min`` of :math:`E_0 - E_n`, whose
   held-out residual keeps a structured RMS beyond noise of at most
@@ -141,6 +143,11 @@ def _assess(ev: Evidence, rule: DecisionRule) -> dict:
         t, dbic = crossfit_t(best_m, c, ev.noise_mse), best_m.bic - c.bic
         left = best_m.heldout_mse - ev.noise_mse
         gain = (best_m.heldout_mse - c.heldout_mse) / left if left > 0 else 0.0
+        if _member_suffices(ev, rule, best_m, out[best_m.label]):
+            out[c.label].status = Status.NOT_BETTER_THAN_MEMBER
+            out[c.label].text = (f"not better than {best_m.label} alone (it leaves "
+                                 f"{math.sqrt(max(left, 0.0)):.2f} dB RMS over noise)")
+            continue
         if not (t > rule.t_min and dbic > rule.bic_margin and gain >= rule.pair_gain_min):
             out[c.label].status = Status.NOT_BETTER_THAN_MEMBER
             out[c.label].text = f"not better than {best_m.label} alone"
@@ -165,6 +172,15 @@ def _support(ev, rule, c, e0, excess0) -> Assessment:
             and np.isfinite(explained) and explained >= rule.explained_min)
     return Assessment(t, dbic, explained, st, st.value, t_crossfit=tx,
                       crossfit_labels=(c.label,) if need else ())
+
+
+def _member_suffices(ev, rule, m, a) -> bool:
+    """A supported member that leaves a held-out excess over noise below ``excess_min_db``
+    (the lab's repeatability: below it the model agrees) and a residual within the structure
+    limit leaves a second effect nothing it could be shown to explain."""
+    left = math.sqrt(max(m.heldout_mse - ev.noise_mse, 0.0))
+    return (a.status is Status.SUPPORTED and left < rule.excess_min_db
+            and m.struct_db <= _struct_max(ev, rule))
 
 
 def _struct_max(ev, rule):
