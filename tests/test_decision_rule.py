@@ -209,6 +209,23 @@ def test_rivals_in_the_screen_band_are_cross_fitted(above):
         assert v.kind is VerdictKind.PENDING and set(v.needs_crossfit) == {"a", "b"}
 
 
+@pytest.mark.parametrize("pair_bic", [880.0, 905.0])
+def test_a_pair_rival_worse_everywhere_than_a_single_answer_is_no_rival(pair_bic):
+    """Rival x+y (two effects) indistinguishable on the held-out speeds from the single a but
+    worse there: no rival when its training BIC is also worse by more than bic_margin (a
+    needs one cause where x+y need two); ambiguous while x+y is better in BIC."""
+    a = cand("a", 1.0, 890.0)
+    xy = cand("x+y", 1.01, pair_bic)
+    xy.heldout_per_rpm = 1.01 + 0.3 * np.cos(np.arange(N) * 0.9)
+    singles = [cand(e, 3.9, 999.0, spread=0.0) for e in "xy"]
+    v = decide(evidence(a, xy, *singles))
+    if pair_bic > 890.0 + DecisionRule().bic_margin:
+        assert v.kind is VerdictKind.EFFECT and v.chosen == "a"
+        assert "needs 2 effects where a does better" in v.assessments["x+y"].text
+    else:
+        assert v.kind is VerdictKind.AMBIGUOUS and set(v.ambiguous) == {"a", "x+y"}
+
+
 def test_a_restating_candidate_clearly_better_is_the_answer():
     """The restatement only settles what the data cannot: b, significantly better than the
     candidate it restates (held-out t > t_min), stays the answer."""

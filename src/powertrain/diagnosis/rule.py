@@ -26,7 +26,9 @@ would leave (noise):
 * a candidate whose fit **restates** another supported one (``Effect.restates``: a "missing"
   body mode whose shape pairs with one of the file's modes says "that mode is elsewhere") is
   neither the answer nor a rival while the held-out speeds cannot tell it from the one it
-  restates (t ≤ ``t_min``): the more constrained statement is the answer;
+  restates (t ≤ ``t_min``): the more constrained statement is the answer; nor is a rival
+  that names more effects than the answer while it is worse on the held-out speeds and in
+  training BIC (by more than ``bic_margin``);
 * otherwise **no effect** when the excess RMS gap :math:`\sqrt{\max(E_0 - E_n, 0)}` is
   below ``excess_min_db`` (even if a candidate fits what is left "significantly": a model
   that agrees to round-off leaves round-off for candidates to fit), else **unexplained**
@@ -239,10 +241,21 @@ def _rivals(ev, rule, ranked, ass, chosen):
         if _restated(c, chosen):
             a.status, a.text = Status.RESTATES, f"restates {chosen.label} ({_restated(c, chosen)})"
             continue
+        if _needs_more_causes(rule, c, chosen):
+            a.text = f"supported, but needs {len(c.effects)} effects where {chosen.label} does better"
+            continue
         if t_rival > rule.t_screen:
             need += [x.label for x in (chosen, c) if x.crossfit is None]
         out.append((c, t_rival))
     return out, list(dict.fromkeys(need))
+
+
+def _needs_more_causes(rule, c, chosen) -> bool:
+    """Rival ``c`` names more effects than the answer yet is worse on the held-out speeds
+    and in training BIC (by more than ``bic_margin``): not an equal explanation, as a pair
+    must beat its own member."""
+    return (len(c.effects) > len(chosen.effects) and c.heldout_mse > chosen.heldout_mse
+            and c.bic - chosen.bic > rule.bic_margin)
 
 
 def _restated(c, r) -> str:
