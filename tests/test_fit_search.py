@@ -147,3 +147,23 @@ def test_a_fit_without_a_steady_state_at_a_held_out_speed_is_scored_unsupported(
     c = CandidateEvidence(o.label, o.effects, o.heldout_mse, o.heldout_per_rpm, o.bic, 0.2)
     v = decide(Evidence(base, [c], 0.4, 0.63, ""))
     assert v.assessments[o.label].status is Status.NOT_SUPPORTED and v.chosen is None
+
+
+def test_starts_read_from_the_data_are_kept_inside_their_bounds(monkeypatch):
+    from powertrain.diagnosis import starts
+    seen = {}
+
+    def fake(problem, pack, effect, fun, lo, hi):
+        seen["lo"], seen["hi"] = lo, hi
+        return []
+    monkeypatch.setattr(starts, "_data_starts", fake)
+    monkeypatch.setattr(starts, "_block_start", lambda fun, pack, effect: None)
+    pack = SimpleNamespace(lower=np.array([0.0, -1.0]), upper=np.array([10.0, 1.0]),
+                           x0=np.array([1.0, 0.0]), log=np.array([False, False]))
+    problem = SimpleNamespace(engine=None)
+    monkeypatch.setattr(starts.EFFECTS["missing_body_mode"].__class__, "start_grid",
+                        lambda self, engine: ())
+    starts.start_points(problem, pack, ("missing_body_mode",), None, True, None)
+    margin = starts.DATA_START_MARGIN * (pack.upper - pack.lower)
+    np.testing.assert_allclose(seen["lo"], pack.lower + margin)
+    np.testing.assert_allclose(seen["hi"], pack.upper - margin)

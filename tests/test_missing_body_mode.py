@@ -193,6 +193,28 @@ def test_rigid_chassis_run_up_with_a_missing_mode_is_diagnosed(rigid, phase, f_t
     assert d["where"]["sides"]["location"] == "body"
 
 
+@pytest.mark.slow
+def test_the_draw_whose_fit_stayed_at_its_grid_start_now_finds_the_mode(rigid):
+    """Regression (noise draw 1008 of the test above, with phase): the starts read from the
+    data began *on* the shape's bound 1, the trust region stopped there (xtol) and the mode
+    was reported at its grid start, 57.3 Hz, 12 kg; with the starts kept
+    ``DATA_START_MARGIN`` inside their bounds it is found (fresh draws 1000-1059: 59.4-60.5
+    Hz)."""
+    from powertrain.diagnosis import diagnose
+    from powertrain.validation.cases import FLOOR, measure
+    rpm = np.arange(1000.0, 6001.0, 100.0)
+    shape = np.zeros(9)
+    shape[[2, 5, 7]] = [1.0, 0.4, -0.3]
+    hm = HarmonicModel(rigid, rpm)
+    v = predict(hm, {"missing_body_mode": _params(rigid, f=60.0, shape=shape)}).velocity
+    meas = measure(v, 0.0, np.random.default_rng(1008), "missing mode", hm.channels, rpm, "all")
+    d = diagnose(meas, read_engine(DEFAULT_ENGINE_PATH), noise_floor=FLOOR, progress=False,
+                 pairs=False, band_check=False, effects=["missing_body_mode"]).to_dict()
+    fit = d["chosen"]["parameters"]["missing_body_mode"]
+    assert fit["frequency_hz"] == pytest.approx(60.0, rel=0.02)
+    assert fit["modal_mass_kg"] == pytest.approx(14.0, rel=0.1)
+
+
 def test_mode_with_an_amplitude_dependent_mount_on_the_fast_path(modal):
     """A pair with an amplitude-dependent elastomer (the amplitude fixed point reads the
     relative displacement across each mount, base motion included): the appended mode is
