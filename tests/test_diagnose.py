@@ -168,6 +168,12 @@ def test_structured_residual_statistic():
     assert s < 0.25 and abs(chi - 1) < 0.2
     s, chi = structured_residual(g + 1.0, cens, groups, 0.8)
     assert abs(s - 1.0) < 0.15 and chi > 3
+    # no cell with two scored points (a rate run stopped on numpy's "mean of empty slice"):
+    # a fit that predicts nothing at the held-out speeds is infinitely structured, data all
+    # censored leave nothing to see; never a warning or NaN
+    assert structured_residual(np.full(g.shape, np.nan), cens, groups, 0.8)[0] == np.inf
+    s, chi = structured_residual(g, np.ones(g.shape, bool), groups, 0.8)
+    assert s == 0.0
 
 
 def test_detectability_classification(engine):

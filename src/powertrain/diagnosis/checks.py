@@ -62,7 +62,10 @@ def structured_residual(g, censored, groups, sigma, cells=None):
     residual :math:`\bar g` of the :math:`n` uncensored points is formed; pure noise of
     scatter :math:`\sigma` gives :math:`E[\bar g^2] = \sigma^2/n`. Returned:
     :math:`\sqrt{\max(0,\ \overline{\bar g^2 - \sigma^2/n})}` and the ratio
-    :math:`\overline{n\bar g^2/\sigma^2}` (≈ 1 for noise).
+    :math:`\overline{n\bar g^2/\sigma^2}` (≈ 1 for noise). Without a cell of two scored
+    points: infinite when no held-out gap is finite (a fit without a steady state at the
+    held-out speeds predicts nothing there), else 0 (all censored: nothing left to see) and
+    a NaN ratio.
 
     Parameters
     ----------
@@ -88,9 +91,9 @@ def structured_residual(g, censored, groups, sigma, cells=None):
         z.append(m ** 2 - s2 / n[use])
         if s2 > 0:
             chi.append(n[use] * m ** 2 / s2)
-    if not z:
-        return float("nan"), float("nan")
-    z = np.concatenate(z)
+    z = np.concatenate(z) if z else np.empty(0)
+    if not z.size:      # no cell with two scored points: nothing predicted, or nothing left
+        return (float("inf"), float("inf")) if not np.isfinite(g).any() else (0.0, float("nan"))
     chi_r = float(np.mean(np.concatenate(chi))) if chi else float("nan")
     return float(math.sqrt(max(float(np.mean(z)), 0.0))), chi_r
 
