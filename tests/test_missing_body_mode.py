@@ -245,6 +245,32 @@ def test_a_mode_shaped_like_a_file_mode_restates_chassis_modes(modal, ratio, sca
         assert r[0] == "chassis_modes" and "body mode 1" in r[1] and "MAC 1.00" in r[1]
 
 
+@pytest.mark.parametrize("f, band, restated", [(5.0, (8.3, 400.0), "mass line"),
+                                                (900.0, (8.3, 400.0), "spring line"),
+                                                (5.0, None, ""), (100.0, (8.3, 400.0), "")])
+def test_a_paired_mode_outside_the_measured_band_restates_chassis_modes(modal, f, band,
+                                                                        restated):
+    """Outside the measured band a mode shaped like a file mode is a mass or spring line on
+    that mode's shape: it restates chassis_modes at any frequency ratio (a moved 28 Hz mode
+    was fitted as a "missing" 5 Hz mode with its shape); inside the band or with the band
+    unknown, only at a ratio chassis_modes can reach (0.6-1.6x)."""
+    r = EFFECT.restates(_params(modal, f=f, shape=_file_shape(modal, 0)), modal, band)
+    assert (r is not None) is bool(restated)
+    if restated:
+        assert r[0] == "chassis_modes" and restated in r[1] and "outside the measured" in r[1]
+
+
+def test_the_measured_band_spans_the_orders_above_the_floor():
+    from powertrain.diagnosis.data import GapData
+    rpm = np.array([1200.0, 3000.0])
+    level = np.full((2, 1, 2), 1e-3)
+    level[1, 0, 1] = 1e-9                                  # order 4 at 3000 rpm: at the floor
+    d = GapData(rpm, [("left", "z")], ["order_2", "order_4"], np.array([3, 7]), level, 1e-6)
+    assert d.band_hz() == pytest.approx((40.0, 100.0))     # 2 x 20 Hz ... 2 x 50 Hz
+    d.level[:] = 1e-9
+    assert d.band_hz() is None
+
+
 def test_a_mode_of_its_own_shape_or_on_a_rigid_chassis_restates_nothing(modal, rigid):
     assert EFFECT.restates(_params(modal), modal) is None
     assert EFFECT.restates(_params(rigid), rigid) is None

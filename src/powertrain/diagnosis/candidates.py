@@ -37,14 +37,14 @@ def warm_caches(hm, effects):
         EFFECTS[e].warm(hm)
 
 
-def restatements(outcome, engine) -> tuple:
+def restatements(outcome, engine, band=None) -> tuple:
     """``((effects, reason), ...)``: the candidates (effect tuples, sorted) whose finding
     ``outcome``'s fit restates (``Effect.restates``; e.g. a missing body mode shaped like one
     of the file's modes restates ``chassis_modes``; in a pair, the pair with that member
-    replaced)."""
+    replaced). ``band``: the measured order frequencies' span [Hz] (``GapData.band_hz``)."""
     out = []
     for e in outcome.effects:
-        r = EFFECTS[e].restates(outcome.params[e], engine)
+        r = EFFECTS[e].restates(outcome.params[e], engine, band)
         if r is not None:
             other = tuple(sorted([x for x in outcome.effects if x != e] + [r[0]]))
             out.append((other, r[1]))

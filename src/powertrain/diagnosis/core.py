@@ -306,8 +306,9 @@ def _diagnose(measured, engine, noise_floor, effects, pairs, do_bands, rule, sch
     _structure(s, baseline, [], sigma)
     outcomes = _fit_all(s, pairs, scheduler, progress, budget, noise_mse(s.problem, sigma), rule,
                         baseline, sigma)
+    band = s.data.band_hz()
     for o in outcomes:
-        o.restates = cand.restatements(o, s.problem.engine)
+        o.restates = cand.restatements(o, s.problem.engine, band)
     verdict, e_n = _decide(s, baseline, outcomes, sigma, rule, where_text(found, parts), budget)
     for o in outcomes:
         a = verdict.assessments[o.label]

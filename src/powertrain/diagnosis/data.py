@@ -73,6 +73,15 @@ class GapData:
         """Measured points above the floor (bool, like ``level``)."""
         return above_floor(self.level, self.floor)
 
+    def band_hz(self) -> tuple | None:
+        """``(lowest, highest)`` order frequency [Hz] measured above the floor on any channel
+        (None without such a point): where a resonance can show in these data."""
+        k = (self.harmonic[self.order_mask] + 1) / 2.0
+        f = self.rpm[:, None, None] / 60.0 * k[None, None, :]
+        ok = self.usable[..., self.order_mask]
+        f = np.broadcast_to(f, ok.shape)[ok]
+        return (float(f.min()), float(f.max())) if f.size else None
+
     #: Engine-side channels (the first ones; body-side channels and body points follow);
     #: None: all.
     n_engine_side: int | None = None

@@ -173,11 +173,12 @@ class Effect:
         apart from ``params``); none by default."""
         return []
 
-    def restates(self, params, engine=None) -> tuple | None:
+    def restates(self, params, engine=None, band=None) -> tuple | None:
         """``(effect, reason)`` when the fitted ``params`` say what another, more constrained
         effect of the library says (e.g. a "missing" body mode whose shape pairs with one of
         the file's modes: that mode, misplaced); the decision rule then prefers that effect
-        while the held-out speeds cannot tell the two apart. None by default."""
+        while the held-out speeds cannot tell the two apart. ``band``: ``(lowest, highest)``
+        order frequency measured above the floor [Hz] (None: unknown). None by default."""
         return None
 
     def finding(self, params, engine=None, phase="none") -> dict | None:
