@@ -167,3 +167,25 @@ def test_starts_read_from_the_data_are_kept_inside_their_bounds(monkeypatch):
     margin = starts.DATA_START_MARGIN * (pack.upper - pack.lower)
     np.testing.assert_allclose(seen["lo"], pack.lower + margin)
     np.testing.assert_allclose(seen["hi"], pack.upper - margin)
+
+
+def test_a_cells_check_over_all_folds_reuses_the_held_out_speeds_part(monkeypatch):
+    """The retry of a cells check over every speed fold refits only the other folds: the
+    held-out speeds' part of the first check is reused (the same numbers, one refit fewer)."""
+    from powertrain.diagnosis import checks
+    calls = []
+
+    def fake_fold(problem, o, baseline, cells, sigma, kw):
+        calls.append(problem)
+        return {"n": 2, "e0": 4.0, "ec": 1.0, "e_n": 0.5, "per_0": np.array([4.0, 4.0]),
+                "per_c": np.array([1.0, 1.0])}
+    monkeypatch.setattr(checks, "_cells_fold", fake_fold)
+    monkeypatch.setattr(checks, "_folds", lambda problem, effects: ("orders", []))
+    o = SimpleNamespace(effects=("chassis_modes",))
+    first = checks.heldout_cells_check("held-out", o, None, 1.0)
+    assert calls == ["held-out"] and first["speed_folds"] == 1
+    again = checks.heldout_cells_check("held-out", o, None, 1.0, folds=[("f1", None),
+                                                                       ("f2", None)],
+                                       first=first["parts"][0])
+    assert calls == ["held-out", "f1", "f2"] and again["speed_folds"] == 3
+    assert again["explained"] == first["explained"]

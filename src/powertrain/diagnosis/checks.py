@@ -163,24 +163,27 @@ def _folds(problem: Problem, effects):
 
 
 def heldout_cells_check(problem: Problem, o: FitOutcome, baseline: FitOutcome, sigma,
-                        budget=None, folds=()):
+                        budget=None, folds=(), first=None):
     """Refit ``o``'s effects without some (channel, order) cells and score the withheld
     cells at the held-out speeds (cross-validation over cells as well as speeds). With
     ``folds`` (``[(Problem, its baseline FitOutcome)]`` of the other speed folds: a
     candidate judged on cross-fitted speeds, :func:`crossfit`) the withheld cells are scored
-    at the held-out speeds of every speed fold.
+    at the held-out speeds of every speed fold; ``first``: the held-out speeds' part of an
+    earlier check of ``o`` (its ``parts[0]``), reused instead of refitted.
 
     Returns
     -------
     dict
         ``kind``, ``explained`` (fraction of the withheld cells' held-out excess over noise
         removed), ``t`` (per-speed significance), ``baseline_excess_db``,
-        ``heldout_rms_db``, ``speed_folds`` and ``seconds``.
+        ``heldout_rms_db``, ``speed_folds`` and ``seconds``; and ``parts``, each speed
+        fold's sums (not written to the JSON).
     """
     t0 = time.perf_counter()
     kind, cells = _folds(problem, o.effects)
     kw = {} if budget is None else {"budget": budget}
-    parts = [_cells_fold(p, o, b, cells, sigma, kw) for p, b in [(problem, baseline), *folds]]
+    parts = [first or _cells_fold(problem, o, baseline, cells, sigma, kw)]
+    parts += [_cells_fold(p, o, b, cells, sigma, kw) for p, b in folds]
     n = sum(q["n"] for q in parts)
     e0, ec, e_n = (sum(q[k] * q["n"] for q in parts) / n if n else float("nan")
                    for k in ("e0", "ec", "e_n"))
@@ -189,7 +192,7 @@ def heldout_cells_check(problem: Problem, o: FitOutcome, baseline: FitOutcome, s
     return {"kind": kind, "explained": (e0 - ec) / excess if excess > 0 else float("nan"),
             "t": log_ratio_t(per_0, per_c, e_n), "baseline_excess_db": math.sqrt(excess),
             "heldout_rms_db": math.sqrt(ec), "speed_folds": len(parts),
-            "seconds": time.perf_counter() - t0}
+            "seconds": time.perf_counter() - t0, "parts": parts}
 
 
 def _cells_fold(problem, o, baseline, cell_folds, sigma, kw) -> dict:

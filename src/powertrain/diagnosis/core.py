@@ -276,11 +276,13 @@ def _decide(s, baseline, outcomes, sigma, rule, where_phrase, budget):
         o = by_label[verdict.needs_cells_check]
         # over all speed folds when its support itself needed them (held-out t short), or
         # asked again after a check at the held-out speeds fell short (rule.xv_t_screen)
+        # (a retry reuses the held-out speeds' refits of the first check)
         all_folds = (not verdict.assessments[o.label].t_stat > rule.t_min
                      or o.cells_check is not None)
+        first = o.cells_check["parts"][0] if o.cells_check is not None else None
         o.cells_check = heldout_cells_check(
             s.problem, o, baseline, sigma, budget=budget,
-            folds=s.fold_problems() if all_folds else ())
+            folds=s.fold_problems() if all_folds else (), first=first)
 
 
 def _structure(s, baseline, outcomes, sigma):

@@ -128,7 +128,8 @@ class DiagnosisResult:
                 "status": None if o.status_code is None else o.status_code.name.lower(),
                 "heldout_structured_residual_db": o.struct_db,
                 "heldout_block_chi2_ratio": o.chi2_ratio,
-                "heldout_cells_check": o.cells_check,
+                "heldout_cells_check": None if o.cells_check is None else {
+                    k: v for k, v in o.cells_check.items() if k != "parts"},
                 "nfev": o.nfev, "n_eval": o.n_eval, "budget_hit": o.budget_hit, "seconds": o.seconds}
 
     def _decision_rule_dict(self):
