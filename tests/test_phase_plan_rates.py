@@ -8,7 +8,8 @@ two-sided plans, amplitude-dependent mounts told from a stiffer mount (named rig
 Judged by the group-sequential Wilson rule of ``tests/rates.py`` (batches of 8 fresh cases
 until it decides; a true rate 0.1 worse than the target fails with probability >= 0.8, as
 tests/test_diagnosis_rates.py);
-``slow`` and ``rates``: they run on request (``python -m pytest -m rates``). The benchmark
+``slow`` and ``rates``; the two plan tests, the longest, also ``long_rates`` (on request:
+``python -m pytest -m long_rates``), the cylinder tests run with the suite. The benchmark
 lines quoted in docs/validation/diagnosis.md are printed by
 ``scripts/phase_plan_benchmark.py``.
 """
@@ -98,6 +99,7 @@ def _plan_row(task):
 
 @pytest.mark.slow
 @pytest.mark.rates
+@pytest.mark.long_rates
 def test_two_run_plan_is_never_less_right_than_its_best_single_run_nor_wrong():
     """Less right than the best single run, or a wrong name: <= 0.05 (one rule, both)."""
     _sequential(_plan_row, lambda r: not (r["truth"] in r["singles"] and r["plan"] != r["truth"]
@@ -121,6 +123,7 @@ def _two_sided_plan_row(task):
 
 @pytest.mark.slow
 @pytest.mark.rates
+@pytest.mark.long_rates
 def test_two_sided_plans_tell_an_amplitude_law_from_a_stiffer_mount():
     """Named right >= 0.9 (group-sequential Wilson rule), and "ambiguous" never."""
     rows = _sequential(_two_sided_plan_row, lambda r: r["claimed"] == r["truth_set"], 0.9)

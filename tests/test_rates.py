@@ -104,3 +104,30 @@ def test_sequential_run_stops_early_on_a_perfect_record():
         return [True] * count
     passed, rows, good = rates.run_sequential(rows_of, bool, 0.9)
     assert passed and len(rows) == 16 and good == 16 and calls == [8, 8]
+
+
+def _marked(marker):
+    """``{test name: its pytest markers}`` of the rate-test files' functions with ``marker``."""
+    import ast
+    from pathlib import Path
+    out = {}
+    for path in sorted(Path(__file__).parent.glob("test_*rates.py")):
+        for node in ast.parse(path.read_text()).body:
+            if isinstance(node, ast.FunctionDef):
+                marks = {d.attr for d in node.decorator_list if isinstance(d, ast.Attribute)}
+                if marker in marks:
+                    out[node.name] = marks
+    return out
+
+
+def test_the_suite_deselects_only_the_long_rate_tests_and_they_are_rate_tests():
+    """CI runs the suite's default selection: every rate test but the ``long_rates`` ones,
+    which also carry ``rates`` (``-m rates`` runs all ten) and ``slow`` (not the fast lane)."""
+    from pathlib import Path
+
+    import tomllib
+    conf = tomllib.loads((Path(__file__).parents[1] / "pyproject.toml").read_text())
+    assert "-m 'not long_rates'" in conf["tool"]["pytest"]["ini_options"]["addopts"]
+    long, all_rates = _marked("long_rates"), _marked("rates")
+    assert long and all(m >= {"rates", "slow"} for m in long.values())
+    assert len(all_rates) == 10 and len(all_rates) - len(long) == 6

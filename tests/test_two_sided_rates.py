@@ -14,8 +14,9 @@ decides, truncated where the Wilson rule does; a rate 0.1 worse fails with proba
   cases, full diagnoses; ``scripts/phase_plan_benchmark.py --bench missing_mode`` prints
   the rate for a fixed number of cases);
 
-hence the ``slow`` and ``rates`` markers (``python -m pytest -m rates``). The small tests of
-the scoring logic are in tests/test_validation_scoring.py.
+hence the ``slow`` and ``rates`` markers; the missing-mode test also ``long_rates`` (on
+request: ``python -m pytest -m long_rates``), side attribution runs with the suite. The
+small tests of the scoring logic are in tests/test_validation_scoring.py.
 """
 
 import os
@@ -75,6 +76,7 @@ def _mode_row(task):
 
 @pytest.mark.slow
 @pytest.mark.rates
+@pytest.mark.long_rates
 def test_missing_body_mode_is_found():
     seed = int.from_bytes(os.urandom(4), "little")
     passed, rows, k = rates.run_sequential(
