@@ -192,13 +192,12 @@ def test_body_side_band_is_where_the_gap_exceeds_the_noise_most():
     """The body-side band is the largest mean squared gap *beyond* each point's noise: a
     resonance at 40 Hz (3 dB on quiet points) is named, not the high orders near the floor
     that scatter 3.5 dB on noise alone (their plain mean squared gap is the larger)."""
-    from types import SimpleNamespace
-
+    from powertrain.diagnosis.data import GapData
     from powertrain.diagnosis.sides import _band
     rpm = np.arange(1000.0, 6001.0, 100.0)
     orders = np.array([1.0, 2.0, 4.0, 6.0])
-    data = SimpleNamespace(rpm=rpm, harmonic=(2 * orders).astype(int) - 1,
-                           order_mask=np.ones(orders.size, bool))
+    data = GapData(rpm, [("left", "z"), ("right", "z")], [f"order_{k:g}" for k in orders],
+                   (2 * orders).astype(int) - 1, np.ones((rpm.size, 2, orders.size)), 1e-9)
     f = rpm[:, None, None] * orders[None, None, :] / 60.0 * np.ones((1, 2, 1))
     sig = np.where(f > 250.0, 3.5, 0.3)
     flip = np.where(np.arange(f.size).reshape(f.shape) % 2, 1.0, -1.0)   # noise of size σ

@@ -73,13 +73,17 @@ class GapData:
         """Measured points above the floor (bool, like ``level``)."""
         return above_floor(self.level, self.floor)
 
+    @property
+    def order_hz(self):
+        """Frequency [Hz] of every speed and quantity, (n_r, n_q): order × rpm / 60 (0 for
+        the synthesis)."""
+        return self.rpm[:, None] * ((self.harmonic + 1) / 2.0)[None, :] / 60.0
+
     def band_hz(self) -> tuple | None:
         """``(lowest, highest)`` order frequency [Hz] measured above the floor on any channel
         (None without such a point): where a resonance can show in these data."""
-        k = (self.harmonic[self.order_mask] + 1) / 2.0
-        f = self.rpm[:, None, None] / 60.0 * k[None, None, :]
-        ok = self.usable[..., self.order_mask]
-        f = np.broadcast_to(f, ok.shape)[ok]
+        ok = self.usable & self.order_mask[None, None, :]
+        f = np.broadcast_to(self.order_hz[:, None, :], ok.shape)[ok]
         return (float(f.min()), float(f.max())) if f.size else None
 
     #: Engine-side channels (the first ones; body-side channels and body points follow);

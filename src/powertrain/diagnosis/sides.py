@@ -100,8 +100,7 @@ def _band(gap, sig, data, cols, n_bins=24):
     plain mean squared gap peaks where they lie, not at the resonance) in log-spaced
     frequency bins (f = order × rpm / 60), the run of bins around the largest with at least
     half its value."""
-    order = (data.harmonic + 1) / 2.0
-    f = np.broadcast_to(data.rpm[:, None, None] * order[None, None, :] / 60.0, gap.shape)
+    f = np.broadcast_to(data.order_hz[:, None, :], gap.shape)
     g = gap[:, cols][:, :, data.order_mask]
     v = sig[:, cols][:, :, data.order_mask] ** 2
     f = f[:, cols][:, :, data.order_mask]

@@ -57,8 +57,7 @@ def _hat_basis(x, knots):
 def _design(data: GapData, mask, n_ch, n_q):
     """Design matrix of the three parts and the column blocks of each."""
     r_i, c_i, q_i = np.nonzero(mask)
-    order = np.array([(data.harmonic[k] + 1) / 2.0 for k in range(n_q)])
-    f = order[q_i] * data.rpm[r_i] / 60.0
+    f = data.order_hz[r_i, q_i]
     fk = np.geomspace(max(f.min(), 1.0), f.max() * 1.0001, N_FREQ_KNOTS)
     rk = np.linspace(data.rpm.min(), data.rpm.max() * 1.0001 + 1e-6, N_RPM_KNOTS)
     Bf = _hat_basis(np.log(f), np.log(fk))
