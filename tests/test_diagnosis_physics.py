@@ -151,7 +151,7 @@ def test_weak_cylinder_alternatives_are_offered(engine):
 def test_mount_parameters_follow_the_engine(engine):
     n = len(engine.mounts)
     names = [p.name for p in EFFECTS["mount_stiffness"].parameters(engine)]
-    assert names == [f"k{i + 1}" for i in range(n)]
+    assert names == [f"k{i + 1}" for i in range(n)] + ["damping_exponent"]
     g = [p.name for p in EFFECTS["sensor_error"].parameters(engine) if p.name.startswith("g")]
     assert len(g) == 3 * n
 
@@ -165,8 +165,8 @@ def test_four_mount_engine_gets_its_own_parameters_and_folds():
     eng = read_engine(shipped_path("engines", "default-torque-rod.toml"))
     n = len(eng.mounts)
     assert n == 4
-    assert [p.name for p in EFFECTS["mount_stiffness"].parameters(eng)] == ["k1", "k2", "k3",
-                                                                             "k4"]
+    assert [p.name for p in EFFECTS["mount_stiffness"].parameters(eng)] == [
+        "k1", "k2", "k3", "k4", "damping_exponent"]
     ps = EFFECTS["sensor_error"].parameters(eng)
     assert sum(p.name.startswith("g") for p in ps) == 12 and sum(
         p.name.startswith("r") for p in ps) == 12
@@ -174,10 +174,11 @@ def test_four_mount_engine_gets_its_own_parameters_and_folds():
     assert sorted(c for f in folds for c in f) == list(range(12))
     assert all(len({c // 3 for c in f}) == n for f in folds)
     hm = HarmonicModel(eng, [2500.0])
-    v = predict(hm, {"mount_stiffness": {"k4": 1.7}}).velocity
-    ref = run_runup(EFFECTS["mount_stiffness"].apply(eng, k4=1.7), [2500.0],
-                    solver="harmonic").velocity
-    assert np.max(np.abs(v - ref)) <= EXACT * np.max(np.abs(ref))
+    for p in ({"k4": 1.7}, {"k4": 1.7, "k1": 0.6, "damping_exponent": 0.6}):
+        v = predict(hm, {"mount_stiffness": p}).velocity
+        ref = run_runup(EFFECTS["mount_stiffness"].apply(eng, **p), [2500.0],
+                        solver="harmonic").velocity
+        assert np.max(np.abs(v - ref)) <= EXACT * np.max(np.abs(ref))
 
 
 #: Linear effects: the fast path and the run-up of the changed engine are the same model.
@@ -242,3 +243,16 @@ def test_gap_decomposition_solve_is_the_minimum_norm_least_squares():
         got = _solve(X, P, y, cols)
         np.testing.assert_allclose(got[cols], ref, rtol=0, atol=1e-10 * np.abs(ref).max())
         assert not np.any(np.delete(got, cols))
+
+
+def test_mount_stiffness_scales_springs_by_k_and_dampers_by_k_to_the_exponent(engine):
+    """Springs × k, dampers × k^γ, masses kept; γ = 1 (the default) scales both alike."""
+    from powertrain.effects import with_mount_stiffness
+    for gamma in (1.0, 0.6):
+        e = with_mount_stiffness(engine, k1=2.0, damping_exponent=gamma)
+        for ax, mod in e.mounts[0].directions.items():
+            old = engine.mounts[0].directions[ax].params
+            for name, v in mod.params.items():
+                f = {"c": 2.0, "d": 2.0 ** gamma}.get(name[0], 1.0)
+                assert v == pytest.approx(f * old[name], rel=1e-12), (ax, name)
+        assert e.mounts[1].directions["z"].params == engine.mounts[1].directions["z"].params

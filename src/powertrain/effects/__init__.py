@@ -11,8 +11,9 @@ name               kind        physics
 ================== =========== ===================================================================
 base_compliance    structure   every mount stands on a local chassis base: mass m_b on a spring
                                c_b (damping ratio ζ_b = 5 %) instead of the rigid ground
-mount_stiffness    structure   each mount's elastomer times a factor k_i: springs and dampers
-                               × k_i, masses (fluid and rubber inertia) unchanged
+mount_stiffness    structure   each mount's elastomer times a factor k_i: springs × k_i, dampers
+                               × k_i^γ (γ one fitted damping exponent, prior 1 ± 0.5), masses
+                               (fluid and rubber inertia) unchanged
 amplitude_stiffness structure  every mount's amplitude law: springs and dampers ×
                                (A_ref/A)^n (PowerLaw, A_ref = 0.1 mm, A across the mount)
 chassis_modes      structure   the body modes shared by the mount bases (modal body only):

@@ -124,7 +124,8 @@ class Effect:
         """Fill the parts of the cached model ``hm`` this effect needs."""
 
     def elastomer_scale(self, hm, p):
-        """Factor on every network's springs and dampers, (n_net,), or None."""
+        """Factors on every network's springs and on its dampers, ``(spring (n_net,),
+        damper (n_net,))``, or None."""
         return None
 
     def two_port(self, hm, abc, p):

@@ -1,12 +1,19 @@
 r"""``mount_stiffness``: each mount's elastomer times its own factor :math:`k_i`.
 
-Temperature, preload and part-to-part spread change the rubber's modulus, and with a
-frequency-independent loss factor its damping in proportion; the fluid column of a
-hydromount and the lumped rubber masses keep their inertia. Every spring and damper of the
-mount's networks is therefore scaled by :math:`k_i` and every mass kept
-(:meth:`MountModel.scaled`): the network's dynamic stiffness becomes
-:math:`k_i(\mathbf K + i\omega\mathbf C) - \omega^2\mathbf M`, so its resonances move by
-about :math:`\sqrt{k_i}`. One parameter ``k<i>`` per mount of the engine (file order).
+Temperature, preload and part-to-part spread change the rubber's modulus and, with it, its
+damping; the fluid column of a hydromount and the lumped rubber masses keep their inertia.
+Every spring of the mount's networks is scaled by :math:`k_i`, every damper by
+:math:`k_i^{\gamma}` and every mass kept (:meth:`MountModel.scaled`): the network's dynamic
+stiffness becomes :math:`k_i\mathbf K + i\omega k_i^{\gamma}\mathbf C - \omega^2\mathbf M`,
+so its resonances move by about :math:`\sqrt{k_i}`. The damping exponent :math:`\gamma`
+(one for all mounts) says how the loss factor :math:`\eta \propto k^{\gamma - 1}` follows
+the modulus: 1 keeps it (the thesis' frequency-independent loss factor, the prior's centre),
+below 1 it falls as the rubber stiffens (a filled elastomer warming through its transition:
+both the storage and the loss modulus fall, the loss modulus less). Only a mount whose
+factor differs from 1 carries it, and a Gaussian prior (:data:`DAMPING_EXPONENT_PRIOR`)
+keeps it at 1 where the data do not say (engine-side velocities above the rigid-body
+modes hardly see a mount's damping). One parameter ``k<i>`` per mount of the engine (file
+order) and ``damping_exponent``.
 """
 
 from __future__ import annotations
@@ -15,31 +22,44 @@ import numpy as np
 
 from powertrain.effects.base import Effect, Parameter, map_networks, mount_labels
 
+#: Bounds of the damping exponent γ (dampers × k^γ) [1].
+DAMPING_EXPONENT_RANGE = (0.0, 2.0)
+#: Prior 1σ of γ about 1 (constant loss factor) [1]: measured filled elastomers put the
+#: loss modulus' exponent against the storage modulus' at roughly 0.5-1 over a temperature
+#: or preload change, so 0.5 lets the data move it there and keeps it at 1 otherwise.
+DAMPING_EXPONENT_PRIOR = 0.5
 
-def with_mount_stiffness(engine, *k, **named):
-    """Mount i's elastomer times ``k<i>`` [1] (i = 1..n in engine-file order; positional
-    factors or ``k1=...``), all three directions alike; missing factors 1."""
+
+def with_mount_stiffness(engine, *k, damping_exponent=1.0, **named):
+    """Mount i's springs times ``k<i>`` [1] and its dampers times ``k<i> **
+    damping_exponent`` (i = 1..n in engine-file order; positional factors or ``k1=...``),
+    all three directions alike; missing factors 1."""
     f = [float(x) for x in k] + [1.0] * len(engine.mounts)
     for key, v in named.items():
         f[int(key[1:]) - 1] = float(v)
-    return map_networks(engine, lambda mi, m, ax, mod: mod.scaled(f[mi], f[mi]))
+    g = float(damping_exponent)
+    return map_networks(engine, lambda mi, m, ax, mod: mod.scaled(f[mi], f[mi] ** g))
 
 
 class MountStiffness(Effect):
     name = "mount_stiffness"
     kind = "structure"
     description = ("per-mount elastomer stiffness offset (temperature, preload, spread): springs "
-                   "and dampers scaled, fluid and rubber inertia kept")
+                   "scaled, dampers with a fitted exponent, fluid and rubber inertia kept")
 
     def parameters(self, engine=None):
         return tuple(Parameter(f"k{i + 1}", "1", 0.3, 3.0, 1.0, True,
-                               f"elastomer (spring and damper) factor of mount {i + 1} "
-                               f"({name}); its masses unchanged")
-                     for i, name in enumerate(mount_labels(engine)))
+                               f"elastomer factor of mount {i + 1} ({name}): springs times "
+                               "it, dampers times it to the damping exponent; its masses "
+                               "unchanged")
+                     for i, name in enumerate(mount_labels(engine))) + (
+            Parameter("damping_exponent", "1", *DAMPING_EXPONENT_RANGE, 1.0, False,
+                      "exponent of the damper factor k_i^γ (1: constant loss factor)",
+                      DAMPING_EXPONENT_PRIOR),)
 
     def start_grid(self, engine=None):
         n = len(mount_labels(engine))
-        return ((0.5, 1.0, 2.0),) * n if n <= 4 else ((0.6, 1.6),) * n
+        return ((0.5, 1.0, 2.0),) * n + ((1.0,),) if n <= 4 else ((0.6, 1.6),) * n + ((1.0,),)
 
     def apply(self, engine, **params):
         return with_mount_stiffness(engine, **params)
@@ -60,4 +80,4 @@ class MountStiffness(Effect):
 
     def elastomer_scale(self, hm, p):
         s = np.array([p.get(f"k{mi + 1}", 1.0) for mi, _, _ in hm.networks])
-        return None if np.all(s == 1.0) else s
+        return None if np.all(s == 1.0) else (s, s ** p.get("damping_exponent", 1.0))

@@ -105,8 +105,8 @@ def _load_velocity(hm, sc):
 
 
 def _elements(hm, sc, s_el):
-    """The networks' mount elements with the elastomer scales ``s_el`` and the effects'
-    changes; None when every one is linear (the cached two-ports serve). The scales keep
+    """The networks' mount elements with the elastomer scales ``s_el`` (spring and damper
+    factors) and the effects' changes; None when every one is linear (the cached two-ports serve). The scales keep
     every element's laws, so linearity is told before any element is scaled."""
     probe = list(hm.elements)
     for eff, p in sc.values():
@@ -115,8 +115,8 @@ def _elements(hm, sc, s_el):
         return None
     if s_el is None:
         return probe
-    els = [dataclasses.replace(el, model=el.model.scaled(float(s), float(s)))
-           for el, s in zip(hm.elements, s_el)]
+    els = [dataclasses.replace(el, model=el.model.scaled(float(s), float(d)))
+           for el, s, d in zip(hm.elements, *s_el)]
     for eff, p in sc.values():
         els = eff.elements(hm, els, p)
     return els
@@ -176,7 +176,7 @@ def predict(hm: HarmonicModel, scenario: dict, *, tol=TOLERANCE,
     for eff, p in sc.values():
         s = eff.elastomer_scale(hm, p)
         if s is not None:
-            s_el = s if s_el is None else s_el * s
+            s_el = s if s_el is None else (s_el[0] * s[0], s_el[1] * s[1])
     body = _body(hm, sc)
     els = _elements(hm, sc, s_el)
     A, iterations = None, 0
@@ -185,7 +185,7 @@ def predict(hm: HarmonicModel, scenario: dict, *, tol=TOLERANCE,
                                                   start=warm_amplitudes)
         v = hm.velocity(q, body=body)
     else:
-        nominal = hm.two_ports() if s_el is None else hm.two_ports_scaled(s_el[None, None, :])
+        nominal = hm.two_ports() if s_el is None else hm.two_ports_scaled(*s_el)
         abc = _two_ports(sc, hm, nominal)
         if s_el is None and abc is nominal and body is getattr(hm, "body", None):
             v = _load_velocity(hm, sc)          # only the load changed: no solve

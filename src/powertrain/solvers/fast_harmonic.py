@@ -212,36 +212,42 @@ class HarmonicModel:
             self._abc = abc
         return abc
 
-    def two_ports_scaled(self, scale):
+    def two_ports_scaled(self, scale, damper_scale=None):
         r"""``(a, b, c)`` of every network with its elastomer scaled, each (n_r, 17, n_net).
 
-        Every spring and damper of network n at speed r and harmonic h times
-        ``scale[r, h, n]`` (any shape that broadcasts to (n_r, 17, n_net)), its masses
-        kept — :math:`s(\mathbf K + i\omega\mathbf C) - \omega^2\mathbf M` condensed
-        by the one two-port condensation
+        Every spring of network n at speed r and harmonic h times ``scale[r, h, n]`` and
+        every damper times ``damper_scale[r, h, n]`` (default ``scale``; any shapes that
+        broadcast to (n_r, 17, n_net)), its masses kept — :math:`s(\mathbf K + i\omega
+        d\,\mathbf C) - \omega^2\mathbf M` condensed by the one two-port condensation
         (:func:`powertrain.physics.mount_network.laplace_two_ports`). With ``scale = 1`` the
         same as :meth:`two_ports`.
         """
         n_net = len(self.networks)
         scale = np.asarray(scale, float)
-        if scale.size == n_net:              # one factor per network: the last two kept
-            return self._scaled_networks([float(f) for f in scale.flat])
-        sc = np.broadcast_to(scale, self.omega.shape + (n_net,)) * self._statics(range(n_net))
+        damper = scale if damper_scale is None else np.asarray(damper_scale, float)
+        if scale.size == n_net and damper.size == n_net:  # one pair per network: cached
+            return self._scaled_networks(list(zip(scale.flat, damper.flat)))
+        shape = self.omega.shape + (n_net,)
+        statics = self._statics(range(n_net))
         return laplace_two_ports(1j * self.omega, [n[2].network() for n in self.networks],
-                                 sc, sc)
+                                 np.broadcast_to(scale, shape) * statics,
+                                 np.broadcast_to(damper, shape) * statics)
 
     def _scaled_networks(self, factors):
-        """Every network's two-port with its springs and dampers times ``factors[k]`` at
-        every speed; the last two factors per network are kept (a finite-difference
-        Jacobian column changes the factors of one mount only: the others' are reused), the
-        missing ones condensed in one call."""
+        """Every network's two-port with its springs and dampers times ``factors[k]``
+        (a (spring, damper) pair) at every speed; the last two pairs per network are kept (a
+        finite-difference Jacobian column changes the factors of one mount only: the
+        others' are reused), the missing ones condensed in one call."""
+        factors = [(float(k), float(d)) for k, d in factors]
         kept = [self._scaled.setdefault(k, {}) for k in range(len(factors))]
         missing = [k for k, f in enumerate(factors) if f not in kept[k]]
         if missing:
-            scale = np.array([factors[k] for k in missing]) * self._statics(missing)
+            statics = self._statics(missing)
+            spring = np.array([factors[k][0] for k in missing]) * statics
+            damper = np.array([factors[k][1] for k in missing]) * statics
             res = laplace_two_ports(1j * self.omega,
                                     [self.networks[k][2].network() for k in missing],
-                                    scale, scale)
+                                    spring, damper)
             for j, k in enumerate(missing):
                 if len(kept[k]) >= 2:
                     del kept[k][next(iter(kept[k]))]

@@ -20,8 +20,8 @@ truth effect           library match       truth model (candidate model)
                                            base mass/spring per network, all alike)
 ``mount_temperature``  mount_stiffness     per mount *and direction* spring factors s·e^{N(0,
                                            0.05)}, dampers s^0.7, masses unchanged (candidate:
-                                           one elastomer factor per mount, springs and
-                                           dampers alike)
+                                           one elastomer factor per mount on the springs,
+                                           its power k^γ on the dampers)
 ``amplitude_power``    amplitude_stiffness springs only times (a/a_ref)^(−β), β per mount type
                                            (hydraulic, elastomeric) 0.08–0.25, a ≥ 1 µm;
                                            equivalent linearisation (candidate: rational law
