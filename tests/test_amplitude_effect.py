@@ -28,12 +28,15 @@ def _db_gap(a, b):
     return float(np.max(np.abs(20 * np.log10(a[m] / b[m]))))
 
 
-@pytest.mark.parametrize("engine_file", ["default.toml", "default-modal-body.toml"])
-def test_runup_application_and_fast_prediction_agree_within_0_05_db(engine_file):
+@pytest.mark.parametrize("engine_file,gamma", [("default.toml", 1.0),
+                                               ("default-modal-body.toml", 1.0),
+                                               ("default.toml", 0.4)])
+def test_runup_application_and_fast_prediction_agree_within_0_05_db(engine_file, gamma):
     eng = read_engine(DEFAULT_ENGINE_PATH.parent / engine_file)
-    fast = predict(HarmonicModel(eng, RPM), {"amplitude_stiffness": {"exponent": 0.25}})
-    lawed = EFFECTS["amplitude_stiffness"].apply(eng, exponent=0.25)
-    assert all(mod.amplitude_law == PowerLaw(A_REF, 0.25)
+    p = {"exponent": 0.25, "damping_exponent": gamma}
+    fast = predict(HarmonicModel(eng, RPM), {"amplitude_stiffness": p})
+    lawed = EFFECTS["amplitude_stiffness"].apply(eng, **p)
+    assert all(mod.amplitude_law == PowerLaw(A_REF, 0.25, damping_exponent=gamma)
                for m in lawed.mounts for mod in m.directions.values())
     ref = run_runup(lawed, RPM, solver="harmonic").velocity
     base = run_runup(eng, RPM, solver="harmonic").velocity

@@ -269,3 +269,24 @@ def test_unreadable_file(tmp_path, kind):
     with pytest.raises(InputError) as info:
         read_mount(p)
     assert info.value.file == str(p)
+
+
+def test_power_law_damping_exponent_read_written_and_applied(tmp_path):
+    """``damping_exponent`` (optional, default 1: dampers like springs) puts f^γ on the
+    dampers; written back only when not 1; a non-number names its key."""
+    p = tmp_path / "gamma.toml"
+    p.write_text(POWER.read_text().replace("limits = [0.5, 2.0]",
+                                           "limits = [0.5, 2.0]\ndamping_exponent = 0.5"))
+    law = read_mount(p).amplitude_law
+    assert law.damping_exponent == 0.5
+    ks, ds = law.scales(2e-4)
+    assert ks == pytest.approx(0.5 ** 0.1) and ds == pytest.approx(ks ** 0.5)
+    assert read_mount(POWER).amplitude_law.damping_exponent == 1.0
+    assert "damping_exponent" not in format_mount(read_mount(POWER))
+    out = tmp_path / "out.toml"
+    write_mount(read_mount(p), out)
+    assert read_mount(out).amplitude_law == law
+    p.write_text(POWER.read_text().replace("limits = [0.5, 2.0]",
+                                           'limits = [0.5, 2.0]\ndamping_exponent = "x"'))
+    with pytest.raises(InputError, match="damping_exponent"):
+        read_mount(p)

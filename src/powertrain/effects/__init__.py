@@ -14,8 +14,9 @@ base_compliance    structure   every mount stands on a local chassis base: mass 
 mount_stiffness    structure   each mount's elastomer times a factor k_i: springs × k_i, dampers
                                × k_i^γ (γ one fitted damping exponent, prior 1 ± 0.5), masses
                                (fluid and rubber inertia) unchanged
-amplitude_stiffness structure  every mount's amplitude law: springs and dampers ×
-                               (A_ref/A)^n (PowerLaw, A_ref = 0.1 mm, A across the mount)
+amplitude_stiffness structure  every mount's amplitude law: springs × f = (A_ref/A)^n,
+                               dampers × f^γ (PowerLaw, A_ref = 0.1 mm, A across the mount;
+                               γ as mount_stiffness')
 chassis_modes      structure   the body modes shared by the mount bases (modal body only):
                                frequency, modal mass and damping of each mode fitted
 missing_body_mode  structure   one body mode the model lacks: frequency, modal mass, damping

@@ -3,12 +3,14 @@ r"""``amplitude_stiffness``: the elastomer's stiffness depends on the amplitude 
 A fit of the mount laws of issue 20, not a physics of its own: the candidate puts one
 :class:`~powertrain.physics.mount_laws.PowerLaw` on every mount direction,
 
-.. math:: \text{springs and dampers} \times \mathrm{clip}\big((A_{ref}/A)^{n},\ 0.2,\ 5\big),
+.. math:: \text{springs} \times f,\quad \text{dampers} \times f^{\gamma},\qquad
+   f = \mathrm{clip}\big((A_{ref}/A)^{n},\ 0.2,\ 5\big),
 
 :math:`A_{ref}` = 0.1 mm (where mount data are measured and the networks fitted, so the
 network is unchanged at :math:`A_{ref}`), :math:`A` the amplitude of the relative
 displacement across the mount direction (√2 × RMS of orders 0.5–8), masses kept; one
-exponent :math:`n` for all mounts (one law per mount design doubled the fit time without
+exponent :math:`n` and one damping exponent :math:`\gamma` (as ``mount_stiffness``'s: prior
+1 ± 0.5, a constant loss factor at 1) for all mounts (one law per mount design doubled the fit time without
 separating it from ``mount_stiffness``, docs/validation/diagnosis.md). :meth:`~AmplitudeStiffness.apply`
 sets :attr:`MountModel.amplitude_law <powertrain.models.mount.MountModel.amplitude_law>`,
 which the run-up's harmonic fixed point
@@ -27,41 +29,45 @@ import dataclasses
 import numpy as np
 
 from powertrain.effects.base import Effect, Parameter, map_networks, with_network_elastomer
+from powertrain.effects.mount_stiffness import DAMPING_EXPONENT_PRIOR, DAMPING_EXPONENT_RANGE
 from powertrain.physics.mount_laws import PowerLaw
 
 #: Reference amplitude of the mount data (dynamic stiffness measured at 0.1 mm) [m].
 A_REF = 1.0e-4
 
 
-def amplitude_law(exponent: float) -> PowerLaw:
+def amplitude_law(exponent: float, damping_exponent: float = 1.0) -> PowerLaw:
     """The candidate's law: :class:`PowerLaw` at :data:`A_REF` with its default limits."""
-    return PowerLaw(A_REF, float(exponent))
+    return PowerLaw(A_REF, float(exponent), damping_exponent=float(damping_exponent))
 
 
 class AmplitudeStiffness(Effect):
     name = "amplitude_stiffness"
     kind = "structure"
-    description = ("amplitude-dependent mount stiffness: springs and dampers x (A_ref/A)^n "
-                   "(A_ref = 0.1 mm, A across the mount), at the harmonic fixed point")
+    description = ("amplitude-dependent mount stiffness: springs x f = (A_ref/A)^n, dampers "
+                   "x f^γ (A_ref = 0.1 mm, A across the mount), at the harmonic fixed point")
 
     def parameters(self, engine=None):
         return (Parameter("exponent", "1", 0.0, 1.0, 0.0, False,
-                          "power-law exponent n of every mount's elastomer"),)
+                          "power-law exponent n of every mount's elastomer"),
+                Parameter("damping_exponent", "1", *DAMPING_EXPONENT_RANGE, 1.0, False,
+                          "exponent γ of the dampers' factor f^γ (1: constant loss factor)",
+                          DAMPING_EXPONENT_PRIOR))
 
     def start_grid(self, engine=None):
-        return ((0.1, 0.2, 0.35),)
+        return ((0.1, 0.2, 0.35), (1.0,))
 
     def apply(self, engine, **params):
         if params.get("exponent", 0.0) == 0.0:
             return engine
-        law = amplitude_law(params["exponent"])
+        law = amplitude_law(params["exponent"], params.get("damping_exponent", 1.0))
         return map_networks(engine, lambda mi, m, ax, mod:
                             dataclasses.replace(mod, amplitude_law=law))
 
     def elements(self, hm, elements, p):
         if p["exponent"] == 0.0:
             return elements
-        law = amplitude_law(p["exponent"])
+        law = amplitude_law(p["exponent"], p.get("damping_exponent", 1.0))
         return [dataclasses.replace(el, amplitude_law=law) for el in elements]
 
 

@@ -106,8 +106,9 @@ def _load_velocity(hm, sc):
 
 def _elements(hm, sc, s_el):
     """The networks' mount elements with the elastomer scales ``s_el`` (spring and damper
-    factors) and the effects' changes; None when every one is linear (the cached two-ports serve). The scales keep
-    every element's laws, so linearity is told before any element is scaled."""
+    factors) and the effects' changes; None when every one is linear (the cached two-ports
+    serve). The scales keep every element's laws, so linearity is told before any element
+    is scaled."""
     probe = list(hm.elements)
     for eff, p in sc.values():
         probe = eff.elements(hm, probe, p)

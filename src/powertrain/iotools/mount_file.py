@@ -146,7 +146,8 @@ def _read_amplitude(t: dict, units: _Units):
     path = units.path
     law = get(t, "law", path, "amplitude", types=str)
     if law == "power":
-        _no_unknown_keys(t, {"law", "reference", "exponent", "limits"}, path, "amplitude")
+        _no_unknown_keys(t, {"law", "reference", "exponent", "limits", "damping_exponent"},
+                         path, "amplitude")
         reference = number(get(t, "reference", path, "amplitude"), path,
                            "amplitude.reference", positive=True)
         exponent = number(get(t, "exponent", path, "amplitude"), path, "amplitude.exponent")
@@ -155,7 +156,8 @@ def _read_amplitude(t: dict, units: _Units):
         if len(limits) != 2 or not limits[0] <= 1.0 <= limits[1]:
             raise InputError(f"expected [lo, hi] with 0 < lo <= 1 <= hi, got {list(limits)}",
                              file=path, key="amplitude.limits")
-        return PowerLaw(float(units.si(reference, "x")), exponent, limits)
+        gamma = number(t.get("damping_exponent", 1.0), path, "amplitude.damping_exponent")
+        return PowerLaw(float(units.si(reference, "x")), exponent, limits, gamma)
     if law == "table":
         _no_unknown_keys(t, {"law", "amplitudes", "stiffness_scale", "damping_scale"}, path,
                          "amplitude")
@@ -264,6 +266,8 @@ def _section_lines(model: MountModel) -> list:
     if isinstance(law, PowerLaw):
         lines += ["", "[amplitude]", 'law = "power"', f"reference = {x(law.reference)}",
                   f"exponent = {_toml_number(law.exponent)}", f"limits = {plain(law.limits)}"]
+        if law.damping_exponent != 1.0:
+            lines.append(f"damping_exponent = {_toml_number(law.damping_exponent)}")
     elif isinstance(law, TableLaw):
         lines += ["", "[amplitude]", 'law = "table"', f"amplitudes = {xs(law.amplitudes)}",
                   f"stiffness_scale = {plain(law.stiffness_scale)}"]

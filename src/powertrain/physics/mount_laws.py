@@ -47,7 +47,8 @@ def _gauss_legendre(n: int):
 
 @dataclass(frozen=True)
 class PowerLaw:
-    r"""Factor :math:`\mathrm{clip}((A_{ref}/A)^{n}, lo, hi)` on every spring and damper.
+    r"""Factor :math:`f = \mathrm{clip}((A_{ref}/A)^{n}, lo, hi)` on every spring and
+    :math:`f^{\gamma}` on every damper.
 
     Parameters
     ----------
@@ -57,11 +58,15 @@ class PowerLaw:
         :math:`n` (0: amplitude independent).
     limits : tuple of float
         ``(lo, hi)``, 0 < lo <= 1 <= hi.
+    damping_exponent : float
+        :math:`\gamma` (1, the default: dampers like springs, a constant loss factor; 0:
+        dampers unchanged, the loss factor rising as the rubber softens).
     """
 
     reference: float
     exponent: float
     limits: tuple = (0.2, 5.0)
+    damping_exponent: float = 1.0
 
     @property
     def constant(self) -> bool:
@@ -78,7 +83,7 @@ class PowerLaw:
     def scales(self, amplitude):
         """``(stiffness factor, damping factor)`` at the amplitude [m]."""
         f = self.factor(amplitude)
-        return f, f
+        return f, (f if self.damping_exponent == 1.0 else f ** self.damping_exponent)
 
 
 @dataclass(frozen=True)
