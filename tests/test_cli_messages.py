@@ -104,6 +104,6 @@ def test_runup_csv_with_effects_is_labelled_synthetic_with_provenance(tmp_path, 
         assert head[0].startswith("mount,direction,quantity,rpm,")
         return
     assert head[0].startswith("# SYNTHETIC: simulated run-up with added effects "
-                              "amplitude_stiffness(exponent=0.2)")
+                              "amplitude_stiffness(exponent=0.2, damping_exponent=1)")
     assert head[1].startswith("# provenance: powertrain ") and "$ powertrain runup" in head[1]
     assert "--effect amplitude_stiffness:exponent=0.2" in head[1]

@@ -217,8 +217,8 @@ class HarmonicModel:
 
         Every spring of network n at speed r and harmonic h times ``scale[r, h, n]`` and
         every damper times ``damper_scale[r, h, n]`` (default ``scale``; any shapes that
-        broadcast to (n_r, 17, n_net)), its masses kept — :math:`s(\mathbf K + i\omega
-        d\,\mathbf C) - \omega^2\mathbf M` condensed by the one two-port condensation
+        broadcast to (n_r, 17, n_net)), its masses kept — :math:`s\,\mathbf K + i\omega
+        d\,\mathbf C - \omega^2\mathbf M` condensed by the one two-port condensation
         (:func:`powertrain.physics.mount_network.laplace_two_ports`). With ``scale = 1`` the
         same as :meth:`two_ports`.
         """
