@@ -173,3 +173,14 @@ def test_scale_and_set_on_the_shipped_nonlinear_engine():
     assert _law(e, "gearbox", "z", "port_law") is None          # the wildcard skipped it
     with pytest.raises(InputError, match="TableLaw, which has no exponent"):
         parse_scale("gearbox.z.amplitude.exponent=2").apply(eng)
+
+
+def test_damping_exponent_of_an_amplitude_law_is_set_and_scaled(lawed):
+    """``amplitude.damping_exponent`` (the mount file's optional key): set, then scaled."""
+    e = apply_operations(lawed, [parse_set("left.z.amplitude.damping_exponent=0.5"),
+                                 parse_scale("left.z.amplitude.damping_exponent=0.4")])
+    law = _law(e, "left", "z", "amplitude_law")
+    assert law == PowerLaw(1e-4, 0.15, (0.2, 5.0), damping_exponent=pytest.approx(0.2))
+    ks, ds = law.scales(2e-4)
+    assert ds == pytest.approx(ks ** 0.2)
+    assert _law(lawed, "left", "z", "amplitude_law").damping_exponent == 1.0

@@ -33,6 +33,7 @@ LAW_KEYS = {
     "amplitude.reference": ("length", "x", True, True),
     "amplitude.exponent": (None, None, True, True),
     "amplitude.limits": (None, None, False, True),
+    "amplitude.damping_exponent": (None, None, True, True),
     "friction.max_force": ("force", "F", True, True),
     "friction.half_displacement": ("length", "x", True, True),
     "static.force": ("force", "F", True, False),
