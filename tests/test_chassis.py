@@ -304,3 +304,18 @@ def test_paths_of_a_rotated_mount_sum_to_the_point_response():
         total = res.velocity[:, res.channel_index("seat_rail", d), res.order_index(2.0)]
         np.testing.assert_allclose(pc.sum(axis=1), total, rtol=1e-9)
     assert len(res.paths) == 12 and ("torque_rod", "x") in res.paths
+
+
+def test_a_point_dropped_from_the_engine_file_names_the_engine_file(tmp_path, engine):
+    """Fuzz find: deleting ``[chassis.points.seat_rail]`` from an FRF engine file left its
+    receptance rows naming an unknown point; the one-line error names the receptance file
+    and the engine file that defines the names."""
+    _frf_csv(engine, np.array([2000.0]), tmp_path / "body.csv")
+    text = MODAL.read_text()
+    text = text[:text.index("\n[chassis]\n") + 1] + '[chassis]\nmodel = "frf"\nfrf = "body.csv"\n'
+    text = text.replace('"../mounts/', f'"{ENGINES.parent / "mounts"}/')
+    (tmp_path / "frf.toml").write_text(text)
+    with pytest.raises(InputError) as info:
+        read_engine(tmp_path / "frf.toml")
+    line = info.value.one_line()
+    assert "body.csv" in line and "frf.toml" in line and "seat_rail" in line, line

@@ -467,3 +467,14 @@ def test_not_compared_list_is_grouped_per_mount_and_reason():
     assert missing_lines(missing) == [
         "right x, y, z: synthesis, order_2, order_4: not in the measured data",
         "left z: order_1.5: no comparable point"]
+
+
+def test_a_step_that_puts_no_speed_at_the_measured_range_names_step(tmp_path):
+    """Fuzz find: ``--step 6500`` on a 1000-6000 rpm run-up made a one-speed grid at
+    6500 rpm, outside the measured range, and the error blamed ``--noise-floor``."""
+    out = tmp_path / "c.json"
+    res = run(EXAMPLE, "--solver", "harmonic", "--step", "6500", "--json", out, "--quiet")
+    assert res.exit_code == 1
+    lines = res.output.strip().splitlines()
+    assert len(lines) == 1 and "--step" in lines[0] and "6500" in lines[0], res.output
+    assert not out.exists()

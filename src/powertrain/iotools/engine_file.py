@@ -188,7 +188,7 @@ def _read_chassis(t, path, mount_names):
         full = Path(path).parent / rel
         if not full.is_file():
             raise InputError(f"receptance file not found: {full}", file=path, key=f"{p}.frf")
-        receptance = read_receptance(full, mount_names, points)
+        receptance = read_receptance(full, mount_names, points, defined_in=path)
     return Chassis(model=model, modes=modes, points=points, receptance=receptance, file=path)
 
 

@@ -201,7 +201,12 @@ def simulation_speeds(engine, meas, rpm_step=None):
     if (stop - start) / rpm_step + 1 > MAX_SPEEDS:
         raise InputError(f"{(stop - start) / rpm_step + 1:.3g} speed steps over the "
                          f"measured range; at most {MAX_SPEEDS}", key="--step")
-    return default_rpm(start, stop, rpm_step)
+    rpm = default_rpm(start, stop, rpm_step)
+    if rpm[0] > hi or rpm[-1] < lo:
+        raise InputError(f"{rpm_step:g} rpm puts no simulated speed at or around the measured "
+                         f"{lo:g}..{hi:g} rpm (grid {rpm[0]:g}..{rpm[-1]:g} rpm inside the "
+                         f"engine's {e_lo:g}..{e_hi:g}): give a smaller step", key="--step")
+    return rpm
 
 
 def compare_runup(simulated, measured: MeasuredRunup, *, noise_floor=DEFAULT_NOISE_FLOOR,
