@@ -29,7 +29,7 @@ import dataclasses
 import numpy as np
 
 from powertrain.effects.base import Effect, Parameter, map_networks, with_network_elastomer
-from powertrain.effects.mount_stiffness import DAMPING_EXPONENT_PRIOR, DAMPING_EXPONENT_RANGE
+from powertrain.effects.mount_stiffness import damping_exponent_parameter
 from powertrain.physics.mount_laws import PowerLaw
 
 #: Reference amplitude of the mount data (dynamic stiffness measured at 0.1 mm) [m].
@@ -50,9 +50,7 @@ class AmplitudeStiffness(Effect):
     def parameters(self, engine=None):
         return (Parameter("exponent", "1", 0.0, 1.0, 0.0, False,
                           "power-law exponent n of every mount's elastomer"),
-                Parameter("damping_exponent", "1", *DAMPING_EXPONENT_RANGE, 1.0, False,
-                          "exponent γ of the dampers' factor f^γ (1: constant loss factor)",
-                          DAMPING_EXPONENT_PRIOR))
+                damping_exponent_parameter("f"))
 
     def start_grid(self, engine=None):
         return ((0.1, 0.2, 0.35), (1.0,))

@@ -30,6 +30,14 @@ DAMPING_EXPONENT_RANGE = (0.0, 2.0)
 DAMPING_EXPONENT_PRIOR = 0.5
 
 
+def damping_exponent_parameter(factor: str) -> Parameter:
+    """The elastomer effects' ``damping_exponent`` γ: dampers × ``factor``^γ (one place for
+    its bounds and prior; ``mount_stiffness`` and ``amplitude_stiffness`` share it)."""
+    return Parameter("damping_exponent", "1", *DAMPING_EXPONENT_RANGE, 1.0, False,
+                     f"exponent γ of the dampers' factor {factor}^γ (1: constant loss factor)",
+                     DAMPING_EXPONENT_PRIOR)
+
+
 def with_mount_stiffness(engine, *k, damping_exponent=1.0, **named):
     """Mount i's springs times ``k<i>`` [1] and its dampers times ``k<i> **
     damping_exponent`` (i = 1..n in engine-file order; positional factors or ``k1=...``),
@@ -53,13 +61,12 @@ class MountStiffness(Effect):
                                "it, dampers times it to the damping exponent; its masses "
                                "unchanged")
                      for i, name in enumerate(mount_labels(engine))) + (
-            Parameter("damping_exponent", "1", *DAMPING_EXPONENT_RANGE, 1.0, False,
-                      "exponent of the damper factor k_i^γ (1: constant loss factor)",
-                      DAMPING_EXPONENT_PRIOR),)
+            damping_exponent_parameter("k_i"),)
 
     def start_grid(self, engine=None):
         n = len(mount_labels(engine))
-        return ((0.5, 1.0, 2.0),) * n + ((1.0,),) if n <= 4 else ((0.6, 1.6),) * n + ((1.0,),)
+        factors = ((0.5, 1.0, 2.0),) * n if n <= 4 else ((0.6, 1.6),) * n
+        return factors + ((1.0,),)                 # γ starts at its prior's centre
 
     def apply(self, engine, **params):
         return with_mount_stiffness(engine, **params)

@@ -33,14 +33,16 @@ COLUMNS = ("frequency_hz", "response", "excitation", "receptance_real_m_per_n",
 class _Names(tuple):
     """The NAMEs a receptance file may use, and the file that defines them (``source``)."""
 
-    source = ""
+    def __new__(cls, names, source=""):
+        self = super().__new__(cls, names)
+        self.source = str(source)
+        return self
 
 
 def _channel(text, names, path, line, column):
     parts = text.strip().split(".")
     if len(parts) != 2 or parts[0] not in names or parts[1].lower() not in ("x", "y", "z"):
-        where = f" (the mounts and [chassis] points of {names.source})" \
-            if getattr(names, "source", "") else ""
+        where = f" (the mounts and [chassis] points of {names.source})" if names.source else ""
         raise InputError(f"expected NAME.DIR with NAME one of {', '.join(names)}{where} and "
                          f"DIR x/y/z, got {text.strip()!r}", file=path, line=line, key=column)
     return parts[0], parts[1].lower()
@@ -50,8 +52,7 @@ def read_receptance(path, mounts, points, defined_in="") -> MeasuredReceptance:
     """Read a receptance file (``.uff``/``.unv`` as UFF 58, else CSV) and check coverage.
     ``defined_in``: the engine file that names the mounts and points (for messages)."""
     path = str(path)
-    names = _Names(list(mounts) + list(points))
-    names.source = str(defined_in)
+    names = _Names(list(mounts) + list(points), defined_in)
     if path.lower().endswith((".uff", ".unv")):
         freq, values = _read_uff(path, names)
     else:
