@@ -293,3 +293,27 @@ def test_shapes_drawn_for_a_missing_mode_rarely_pair_with_a_file_mode(modal):
         paired += bool(mac.max() >= MAC_PAIRED)
     print(f"missing-mode shapes paired with a file mode: {paired}/{n}")
     assert paired / n < 1e-3
+
+
+def test_one_more_mode_without_a_solve_equals_the_solve_at_the_scored_orders(modal):
+    """The fit's path for a mode alone (the nominal system solved once for the load and a
+    unit coupling per network, the mode added by the bordered system's Schur complement)
+    equals the coupled solve on the body with the mode, at the orders asked for (the others
+    zero); a body changed otherwise takes the solve."""
+    hm = HarmonicModel(modal, RPM)
+    p = _params(modal)
+    body = EFFECT.body_change(hm, {**EFFECT.defaults(modal), **p}, hm.body)
+    assert body.adds_one_mode_to(hm.body)
+    assert not hm.body.adds_one_mode_to(hm.body)
+    assert not body.with_modes(frequency_hz=body.frequency_hz * 1.01).adds_one_mode_to(hm.body)
+    orders = np.array([1, 3, 7])
+    fast = predict(hm, {"missing_body_mode": p}, orders=orders).velocity
+    abc = hm.two_ports()
+    slow = hm.velocity(hm.solve(abc[0], hm.load, abc=abc, body=body), body=body)
+    np.testing.assert_allclose(fast[..., orders], slow[..., orders], rtol=1e-9,
+                               atol=1e-14 * np.abs(slow).max())
+    assert not np.any(np.delete(fast, orders, axis=-1))
+    both = {"missing_body_mode": p, "mount_stiffness": {"k1": 1.3}}
+    np.testing.assert_allclose(predict(hm, both, orders=orders).velocity[..., orders],
+                               predict(hm, both).velocity[..., orders], rtol=1e-9,
+                               atol=1e-14 * np.abs(slow).max())

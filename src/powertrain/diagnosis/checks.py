@@ -235,9 +235,18 @@ def crossfit_baseline(folds, baseline: FitOutcome) -> np.ndarray:
     return np.concatenate([baseline.heldout_per_rpm] + [b.heldout_per_rpm for _, b in folds])
 
 
+#: Evaluation budget of one band refit in trust-region steps' worth of evaluations (p + 1
+#: each, p fitted parameters): a refit from the whole-range optimum moves there in a few
+#: steps when the answer holds on the band; one that wanders (a body mode refitted on a band
+#: that does not see its resonance crawled to 1100 evaluations, a quarter of a diagnosis's
+#: time) is stopped and says so (``budget_hit``).
+BAND_STEPS = 20
+
+
 def band_check(problem_factory, effect, data, train_idx, start, n_bands=4):
     """Refit one effect on speed bands of the training data, from its whole-range optimum
-    ``start`` (fitted vector): parameter trend with speed."""
+    ``start`` (fitted vector): parameter trend with speed. Each refit has a budget of
+    :data:`BAND_STEPS` steps."""
     out = []
     edges = np.linspace(0, train_idx.size, n_bands + 1).astype(int)
     for b in range(n_bands):
@@ -245,7 +254,8 @@ def band_check(problem_factory, effect, data, train_idx, start, n_bands=4):
         if idx.size < 3:
             continue
         fo = fit_candidate(problem_factory(idx), (effect,), starts=[start], grid=False,
-                           defaults=False)
+                           defaults=False, budget=BAND_STEPS * (np.size(start) + 1))
         out.append({"rpm_from": float(data.rpm[idx[0]]), "rpm_to": float(data.rpm[idx[-1]]),
-                    "parameters": fo.params[effect], "sigma": fo.sigma[effect]})
+                    "parameters": fo.params[effect], "sigma": fo.sigma[effect],
+                    "budget_hit": bool(fo.budget_hit)})
     return out

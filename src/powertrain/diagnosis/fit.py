@@ -105,6 +105,9 @@ class Problem:
         om = data.order_mask
         self.meas = {k: data.level[v][:, :, om] for k, v in self.idx.items()}
         self.sub = data.orders_only()
+        #: the velocity indices scored (a linear scenario solves only these; None: all,
+        #: the synthesis needs every order)
+        self.orders = np.unique(self.sub.harmonic) if np.all(self.sub.harmonic >= 0) else None
         self.valid = {k: np.isfinite(v) for k, v in self.meas.items()}
         sig = noise_sigma_db(data)
         #: measured scatter [dB, 1σ] (weight of the parameter priors; 1 dB if unknown)
@@ -177,7 +180,8 @@ class Problem:
         else:
             warm = self._warm.setdefault(part, AmplitudeStart())
             v = scenario_vector(phys)
-            pred = predict(self.hm[part], phys, warm_amplitudes=warm.start(v))
+            pred = predict(self.hm[part], phys, warm_amplitudes=warm.start(v),
+                           orders=self.orders)
             vel = pred.velocity
             if pred.amplitudes is not None:
                 warm.record(v, pred.amplitudes)

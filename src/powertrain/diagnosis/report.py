@@ -84,7 +84,8 @@ def _which(r) -> list:
         lines.append("  confounding check (refit on speed bands):")
         for bnd in r.band_check:
             txt = ", ".join(f"{k}={v:.3g}" for k, v in bnd["parameters"].items())
-            lines.append(f"    {bnd['rpm_from']:g}-{bnd['rpm_to']:g} rpm: {txt}")
+            stop = " (refit stopped at its budget)" if bnd.get("budget_hit") else ""
+            lines.append(f"    {bnd['rpm_from']:g}-{bnd['rpm_to']:g} rpm: {txt}{stop}")
     return lines
 
 

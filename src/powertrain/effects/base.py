@@ -14,9 +14,13 @@ effect: one new module with a subclass and its tests, and one line in
 from __future__ import annotations
 
 import dataclasses
+import weakref
 from dataclasses import dataclass
 
 import numpy as np
+
+#: Each effect's defaults per engine (:meth:`Effect.defaults`), held while the engine lives.
+_DEFAULTS: dict = {}
 
 
 @dataclass(frozen=True)
@@ -104,7 +108,17 @@ class Effect:
         return True
 
     def defaults(self, engine=None) -> dict:
-        return {p.name: p.default for p in self.parameters(engine)}
+        """``{parameter: default}`` for ``engine`` (kept per engine: the fast path fills
+        every scenario with them, thousands of times a fit)."""
+        if engine is None:
+            return {p.name: p.default for p in self.parameters(engine)}
+        kept = _DEFAULTS.setdefault(self.name, weakref.WeakKeyDictionary())
+        try:
+            if engine not in kept:
+                kept[engine] = {p.name: p.default for p in self.parameters(engine)}
+        except TypeError:                    # an engine stand-in without weak references
+            return {p.name: p.default for p in self.parameters(engine)}
+        return dict(kept[engine])
 
     def bounds(self, engine=None):
         ps = self.parameters(engine)

@@ -156,8 +156,26 @@ def amplitude_iteration(hm, sc, els, load, body, *, tol=TOLERANCE, start=None):
                              f"iterations (change {np.max(err):.1e})")
 
 
+def _linear_velocity(hm, abc, load, body, orders):
+    """Channel velocities (n_r, n_ch, 16) of the linear model with the two-ports ``abc``,
+    the load ``load`` and the body ``body``, solved at the ``orders`` only (zero at the
+    others; None: all)."""
+    h = slice(1, None) if orders is None else np.asarray(orders, int) + 1
+    if (abc is hm.two_ports() and load is hm.load and body is not hm.body
+            and body.adds_one_mode_to(hm.body)):
+        q = hm.solve_one_more_mode(body, harmonics=h)       # one mode added: no solve
+    else:
+        q = hm.solve(abc[0], load, harmonics=h, abc=abc, body=body)
+    sub = hm.velocity(q, harmonics=h, body=body)
+    if orders is None:
+        return sub
+    v = np.zeros(sub.shape[:2] + (hm.omega.shape[1] - 1,), complex)
+    v[..., h - 1] = sub
+    return v
+
+
 def predict(hm: HarmonicModel, scenario: dict, *, tol=TOLERANCE,
-            warm_amplitudes=None) -> Prediction:
+            warm_amplitudes=None, orders=None) -> Prediction:
     """Channel velocities with the effects of ``scenario`` on the cached model.
 
     Parameters
@@ -171,6 +189,11 @@ def predict(hm: HarmonicModel, scenario: dict, *, tol=TOLERANCE,
         Start of the amplitude fixed point (a nearby scenario's converged ``amplitudes``: a
         fit's finite-difference steps then converge in a few iterations instead of ten to
         twenty); the result agrees with a cold start to ``tol``.
+    orders : array_like of int, optional
+        Indices (0..15, orders 0.5..8) of the velocities wanted: where every element is
+        linear, only their harmonics are solved (the other velocities are zero; a fit that
+        scores some orders solves only those). None: all. The nonlinear elements' fixed
+        point needs every harmonic (the amplitudes sum over them) and solves them all.
     """
     sc = _filled(hm, scenario)
     s_el = None
@@ -191,7 +214,7 @@ def predict(hm: HarmonicModel, scenario: dict, *, tol=TOLERANCE,
         if s_el is None and abc is nominal and body is getattr(hm, "body", None):
             v = _load_velocity(hm, sc)          # only the load changed: no solve
         else:
-            v = hm.velocity(hm.solve(abc[0], _load(hm, sc), abc=abc, body=body), body=body)
+            v = _linear_velocity(hm, abc, _load(hm, sc), body, orders)
     for eff, p in sc.values():
         v = eff.reading(v, p)
     return Prediction(v, iterations, A, els)

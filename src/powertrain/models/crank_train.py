@@ -90,9 +90,21 @@ class CrankTrain:
         return self.rotation_sign * np.cross([1.0, 0.0, 0.0], self.cylinder_axis)
 
     def volume(self, theta):
-        """Cylinder volume [m³] and dV/dθ [m³/rad] at crank angle ``theta`` [rad]."""
-        return sc.cylinder_volume(theta, self.bore, self.crank_radius, self.rod_length,
-                                  self.pin_offset, self.compression_ratio)
+        """Cylinder volume [m³] and dV/dθ [m³/rad] at crank angle ``theta`` [rad].
+
+        The last grid's result is kept (read-only arrays): the combustion models ask for
+        the same cycle grid at every speed and cylinder (the measured-trace models' load
+        derivatives took 0.4 s of kinematics for it)."""
+        theta = np.asarray(theta, float)
+        memo = self.__dict__.get("_volume_memo")
+        if memo is not None and memo[0].shape == theta.shape and np.array_equal(memo[0], theta):
+            return memo[1]
+        out = sc.cylinder_volume(theta, self.bore, self.crank_radius, self.rod_length,
+                                 self.pin_offset, self.compression_ratio)
+        for a in out:
+            a.setflags(write=False)
+        object.__setattr__(self, "_volume_memo", (theta.copy(), out))
+        return out
 
 
 @dataclass(frozen=True, eq=False)

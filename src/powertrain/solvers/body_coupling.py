@@ -101,6 +101,18 @@ class ModalBody:
                            [self.point_shapes, np.zeros(self.point_shapes.shape[:2] + (1,))],
                            axis=2))
 
+    def adds_one_mode_to(self, base) -> bool:
+        """True when this body is ``base`` with one more mode (last) that is zero at the
+        body points (:meth:`with_extra_mode`): its response is :func:`one_more_mode`'s."""
+        k = base.n_modes
+        return (self.n_modes == k + 1 and self.points == base.points
+                and np.array_equal(self.frequency_hz[:k], base.frequency_hz)
+                and np.array_equal(self.modal_mass[:k], base.modal_mass)
+                and np.array_equal(self.damping_ratio[:k], base.damping_ratio)
+                and np.array_equal(self.mount_shapes[..., :k], base.mount_shapes)
+                and np.array_equal(self.point_shapes[..., :k], base.point_shapes)
+                and not np.any(self.point_shapes[..., k]))
+
     def impedance(self, omega) -> np.ndarray:
         r"""Modal dynamic stiffness :math:`Z_k(\omega)` (omega.shape + (K,)) [N/m]."""
         w = np.asarray(omega, float)[..., None]
@@ -174,3 +186,44 @@ def coupled_solve(M, omega, rows, shapes, abc, kip, body, load):
     rhs = np.zeros(omega.shape + (6 + K,), complex)
     rhs[..., :6] = load
     return batched_solve(D, rhs)
+
+
+def one_more_mode_basis(M, omega, rows, shapes, abc, kip, body, load):
+    r"""What :func:`one_more_mode` needs of the (6 + K) system of :func:`coupled_solve`
+    (its matrix :math:`\mathbf D`, load :math:`\mathbf f`), solved once: one more body mode
+    couples to it through :math:`\mathbf u = \mathbf U\mathbf s'`, :math:`\mathbf s'`
+    (n_net,) the new mode's shape along each network and :math:`\mathbf U` the columns
+    :math:`[b_n\mathbf r_n; c_n\mathbf s_n]`. Returns ``(x0, W, P, G, c)``:
+    :math:`\mathbf x_0 = \mathbf D^{-1}\mathbf f`, :math:`\mathbf W = \mathbf D^{-1}\mathbf U`,
+    :math:`\mathbf P = \mathbf U^T\mathbf x_0`, :math:`\mathbf G = \mathbf U^T\mathbf W`
+    and the networks' base terms ``c``, per speed and harmonic (arguments as
+    :func:`coupled_solve`)."""
+    K = shapes.shape[1]
+    E = np.hstack([rows, np.zeros((rows.shape[0], K))])
+    B = np.hstack([np.zeros_like(rows), shapes])
+    frame = modal_frame(M, body.frequency_hz, body.modal_mass, body.damping_ratio)
+    D = condensed_matrix(frame, E, B, (kip, abc[1], abc[2]), 1j * np.asarray(omega, float))
+    U = np.concatenate([abc[1][..., None, :] * rows.T, abc[2][..., None, :] * shapes.T],
+                       axis=-2)                                    # (..., 6 + K, n_net)
+    f = np.zeros(U.shape[:-1] + (1,), complex)
+    f[..., :6, 0] = load
+    X = np.linalg.solve(D, np.concatenate([f, U], axis=-1))
+    x0, W = X[..., 0], X[..., 1:]
+    return (x0, W, np.einsum("...in,...i->...n", U, x0), np.einsum("...in,...im->...nm", U, W),
+            abc[2])
+
+
+def one_more_mode(basis, shape, impedance):
+    r"""Amplitudes (..., 6 + K + 1) of the system of :func:`one_more_mode_basis` with one
+    more body mode, its shape along each network ``shape`` (n_net,) and its modal dynamic
+    stiffness ``impedance`` (...): the bordered system :math:`[[\mathbf D, \mathbf u];
+    [\mathbf u^T, z]]` with :math:`z = Z + \sum_n c_n s_n'^2` solved by its Schur
+    complement, :math:`\eta = -\mathbf s'\cdot\mathbf P/(z - \mathbf s'^T\mathbf G
+    \mathbf s')`, :math:`\mathbf x = \mathbf x_0 - \eta\,\mathbf W\mathbf s'` — exact,
+    the same as :func:`coupled_solve` on the body with the mode (tests/test_body_coupling.py)
+    at a few products per speed and harmonic instead of a solve."""
+    x0, W, P, G, c = basis
+    s = np.asarray(shape, float)
+    z = impedance + (c * s ** 2).sum(axis=-1) - np.einsum("n,...nm,m->...", s, G, s)
+    eta = -(P @ s) / z
+    return np.concatenate([x0 - (W @ s) * eta[..., None], eta[..., None]], axis=-1)

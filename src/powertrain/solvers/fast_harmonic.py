@@ -52,6 +52,8 @@ from powertrain.solvers.body_coupling import (
     ModalBody,
     body_channels,
     coupled_solve,
+    one_more_mode,
+    one_more_mode_basis,
 )
 from powertrain.solvers.operating_point import has_static_curves, static_factors
 
@@ -86,6 +88,8 @@ def shaft_load(engine, shaft, rpm, theta):
 
 #: Prefix of the cached velocities of load parts in ``HarmonicModel._extra``.
 _VELOCITY_OF = "velocity of "
+#: Cache keys of :meth:`HarmonicModel.solve_one_more_mode`'s basis.
+_ONE_MORE_MODE = tuple(f"one more mode {k}" for k in ("x0", "W", "P", "G", "c"))
 
 
 class HarmonicModel:
@@ -297,6 +301,32 @@ class HarmonicModel:
         frame = (self.M, np.zeros((6, 6)), np.zeros((6, 6)))
         D = condensed_matrix(frame, self.rows, None, (K, None, None), 1j * w)
         return batched_solve(D, load[:, harmonics])
+
+    def solve_one_more_mode(self, body, harmonics=slice(1, N_HARMONICS)) -> np.ndarray:
+        r""":meth:`solve`'s amplitudes (n_r, n_h, 6 + K + 1) of the nominal model (its own
+        two-ports and load) on ``body``, the model's body with one more mode
+        (:meth:`ModalBody.adds_one_mode_to
+        <powertrain.solvers.body_coupling.ModalBody.adds_one_mode_to>`): the nominal system
+        is solved once for the load and a unit coupling per network (cached,
+        :func:`~powertrain.solvers.body_coupling.one_more_mode_basis`), every mode after that
+        by :func:`~powertrain.solvers.body_coupling.one_more_mode` — the same as
+        :meth:`solve` to round-off."""
+        if _ONE_MORE_MODE[0] not in self._extra:
+            abc = self.two_ports()
+            h = slice(1, N_HARMONICS)
+            basis = one_more_mode_basis(self.M, self.omega[:, h], self.rows, self.body_shapes,
+                                        tuple(x[:, h] for x in abc), abc[0][:, h],
+                                        self.body, self.load[:, h])
+            self._extra.update({k: v[None] for k, v in zip(_ONE_MORE_MODE, basis)})
+        j = np.arange(N_HARMONICS)[harmonics] - 1
+        basis = tuple(self._extra[k][0][:, j] for k in _ONE_MORE_MODE)
+        axes = np.array([self.mount_axes[mi][:, DIRECTIONS.index(ax)]
+                         for mi, ax, _ in self.networks])
+        mi = [n[0] for n in self.networks]
+        shape = np.einsum("nj,nj->n", body.mount_shapes[mi, :, -1], axes)
+        w = self.omega[:, harmonics]
+        wk, m, z = 2 * np.pi * body.frequency_hz[-1], body.modal_mass[-1], body.damping_ratio[-1]
+        return one_more_mode(basis, shape, m * (wk ** 2 - w ** 2 + 2j * z * wk * w))
 
     def load_response(self, load) -> np.ndarray:
         r""":meth:`solve`'s amplitudes (n_r, 16, 6 [+ K]) of the nominal model (its own
