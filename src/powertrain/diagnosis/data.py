@@ -196,6 +196,24 @@ def model_levels(velocity, data: GapData):
     return out
 
 
+class ScoredLevels:
+    """:func:`residuals_db` of :func:`order_levels` at fixed scored points, the measured side
+    (censoring, its dB) formed once: a fit scores thousands of model evaluations against the
+    same points. ``meas`` (1-D) the measured RMS levels there [m/s], all finite."""
+
+    def __init__(self, meas, floor):
+        cl = censoring_level(floor)
+        self.censored = meas < cl
+        self.ref_db = 20.0 * np.log10(np.where(self.censored, cl, meas))
+        self.floor2 = float(floor) ** 2
+
+    def __call__(self, velocity):
+        """Gaps [dB] of the complex peak order velocities ``velocity`` (1-D, the points')."""
+        g = 10.0 * np.log10(0.5 * (velocity.real ** 2 + velocity.imag ** 2) + self.floor2)
+        g -= self.ref_db
+        return np.where(self.censored, np.maximum(g, 0.0), g)
+
+
 def residuals_db(sim, meas, floor):
     """Gap [dB] with censoring at the noise-floor rule's level; NaN where nothing was
     measured."""

@@ -29,7 +29,13 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from powertrain.diagnosis import phase as ph
-from powertrain.diagnosis.data import GapData, model_levels, noise_sigma_db, order_levels, residuals_db
+from powertrain.diagnosis.data import (
+    GapData,
+    ScoredLevels,
+    model_levels,
+    noise_sigma_db,
+    residuals_db,
+)
 from powertrain.diagnosis.packing import Packing
 from powertrain.diagnosis.search import Counted, Exhausted, jacobian, trust_region
 from powertrain.diagnosis.starts import start_points
@@ -118,7 +124,8 @@ class Problem:
                 self.valid[part] = self.valid[part] & np.asarray(cells, bool)[None]
         # the scored level points as flat indices into the velocities (n_r, n_ch, N_ORDERS)
         self._level_at = {k: self._flat(on) for k, on in self.valid.items()}
-        self._meas_on = {k: self.meas[k][on] for k, on in self.valid.items()}
+        self._scored = {k: ScoredLevels(self.meas[k][on], data.floor)
+                        for k, on in self.valid.items()}
         self._phase_setup()
 
     def _flat(self, on):
@@ -243,8 +250,7 @@ class Problem:
         :meth:`gaps`, in the order of ``gaps[valid]``), then with phase the phase gaps and
         the crank offset's prior."""
         vel = self.velocity(scenario, part)
-        level = order_levels(np.take(vel, self._level_at[part]), self.data.floor)
-        g = residuals_db(level, self._meas_on[part], self.data.floor)
+        g = self._scored[part](np.take(vel, self._level_at[part]))
         if self.phase_w is None:
             return g
         d = self._phase_diff(vel, part)

@@ -149,6 +149,7 @@ class HarmonicModel:
         self._abc = None
         self._extra = {}
         self._scaled = {}
+        self._one_more_mode_at = None
         self._body_setup(engine)
 
     def _body_setup(self, engine):
@@ -319,11 +320,15 @@ class HarmonicModel:
                                         self.body, self.load[:, h])
             self._extra.update({k: v[None] for k, v in zip(_ONE_MORE_MODE, basis)})
         j = np.arange(N_HARMONICS)[harmonics] - 1
-        basis = tuple(self._extra[k][0][:, j] for k in _ONE_MORE_MODE)
-        axes = np.array([self.mount_axes[mi][:, DIRECTIONS.index(ax)]
-                         for mi, ax, _ in self.networks])
-        mi = [n[0] for n in self.networks]
-        shape = np.einsum("nj,nj->n", body.mount_shapes[mi, :, -1], axes)
+        last = self._one_more_mode_at
+        if last is None or not np.array_equal(last[0], j):     # the fit's orders: once
+            axes = np.array([self.mount_axes[mi][:, DIRECTIONS.index(ax)]
+                             for mi, ax, _ in self.networks])
+            last = self._one_more_mode_at = (j, tuple(self._extra[k][0][:, j]
+                                                      for k in _ONE_MORE_MODE), axes)
+        _, basis, axes = last
+        shape = np.einsum("nj,nj->n", body.mount_shapes[[n[0] for n in self.networks], :, -1],
+                          axes)
         w = self.omega[:, harmonics]
         wk, m, z = 2 * np.pi * body.frequency_hz[-1], body.modal_mass[-1], body.damping_ratio[-1]
         return one_more_mode(basis, shape, m * (wk ** 2 - w ** 2 + 2j * z * wk * w))
@@ -416,4 +421,5 @@ class HarmonicModel:
             new.static_scale = self.static_scale[index]
         new._extra = {k: v[:, index] for k, v in self._extra.items()}
         new._scaled = {}
+        new._one_more_mode_at = None
         return new
