@@ -13,6 +13,9 @@ the amplitudes of the relative displacement across them, iterated to consistency
 speeds at once (:func:`amplitude_iteration`) — the physics of the run-up's harmonic fixed
 point (:mod:`powertrain.solvers.equivalent_linear`). Every effect that changes the engine
 model predicts what its ``apply()`` runs, to round-off (tests/test_diagnosis_physics.py).
+A linear scenario solves only the ``orders`` asked for; one body mode added to the nominal
+model (a missing mode alone) is the nominal system's bordered extension, solved without a
+new solve (:meth:`HarmonicModel.solve_one_more_mode`).
 """
 
 from __future__ import annotations
@@ -161,8 +164,8 @@ def _linear_velocity(hm, abc, load, body, orders):
     the load ``load`` and the body ``body``, solved at the ``orders`` only (zero at the
     others; None: all)."""
     h = slice(1, None) if orders is None else np.asarray(orders, int) + 1
-    if (abc is hm.two_ports() and load is hm.load and body is not hm.body
-            and body.adds_one_mode_to(hm.body)):
+    if (body is not None and body is not hm.body and abc is hm.two_ports()
+            and load is hm.load and body.adds_one_mode_to(hm.body)):
         q = hm.solve_one_more_mode(body, harmonics=h)       # one mode added: no solve
     else:
         q = hm.solve(abc[0], load, harmonics=h, abc=abc, body=body)
