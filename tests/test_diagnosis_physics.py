@@ -256,3 +256,18 @@ def test_mount_stiffness_scales_springs_by_k_and_dampers_by_k_to_the_exponent(en
                 f = {"c": 2.0, "d": 2.0 ** gamma}.get(name[0], 1.0)
                 assert v == pytest.approx(f * old[name], rel=1e-12), (ax, name)
         assert e.mounts[1].directions["z"].params == engine.mounts[1].directions["z"].params
+
+
+def test_scored_levels_equal_the_gap_rule_at_their_points():
+    """The fits' level gaps (``data.ScoredLevels``: the measured side formed once) equal
+    :func:`residuals_db` of :func:`order_levels` at the same points, censored or not."""
+    from powertrain.analysis.noise_floor import censoring_level
+    from powertrain.diagnosis.data import ScoredLevels, order_levels, residuals_db
+    rng = np.random.default_rng(3)
+    floor = 2e-6
+    vel = (rng.lognormal(-11, 2, 500) * np.exp(2j * np.pi * rng.random(500)))
+    meas = rng.lognormal(-11, 2, 500)
+    meas[:20] = censoring_level(floor) * 0.5                 # at the floor: censored
+    want = residuals_db(order_levels(vel, floor), meas, floor)
+    np.testing.assert_allclose(ScoredLevels(meas, floor)(vel), want, rtol=0, atol=1e-12)
+    assert np.any(want[:20] == 0.0) and np.all(want[:20] >= 0.0)

@@ -439,3 +439,20 @@ def test_math_helpers():
     a2 = -np.fft.rfft(sc.piston_kinematics(th, lam, 1.0)[2] / lam)[2].real * 2 / 4096
     assert abs(a2 - sc.second_order_coefficient(lam, 3)) < lam**7
     assert math.isclose(sc.second_order_coefficient(lam, 1), lam)
+
+
+def test_crank_volume_is_kept_per_grid_and_read_only():
+    """``CrankTrain.volume`` keeps its last grid's result (the combustion models ask for the
+    same grid at every speed and cylinder): equal to the kinematics on any grid, read-only,
+    recomputed when the grid changes; a replaced crank train starts afresh."""
+    crank = read_engine(DEFAULT_ENGINE_PATH).crank
+    for n in (720, 360, 720):
+        theta = np.linspace(-np.pi, 3 * np.pi, n, endpoint=False)
+        V, dV = crank.volume(theta)
+        want = sc.cylinder_volume(theta, crank.bore, crank.crank_radius, crank.rod_length,
+                                  crank.pin_offset, crank.compression_ratio)
+        np.testing.assert_array_equal(V, want[0])
+        np.testing.assert_array_equal(dV, want[1])
+        assert crank.volume(theta.copy())[0] is V and not V.flags.writeable
+    other = dataclasses.replace(crank, compression_ratio=crank.compression_ratio + 1.0)
+    assert not np.array_equal(other.volume(theta)[0], V)

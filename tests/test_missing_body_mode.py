@@ -317,3 +317,31 @@ def test_one_more_mode_without_a_solve_equals_the_solve_at_the_scored_orders(mod
     np.testing.assert_allclose(predict(hm, both, orders=orders).velocity[..., orders],
                                predict(hm, both).velocity[..., orders], rtol=1e-9,
                                atol=1e-14 * np.abs(slow).max())
+
+
+@pytest.mark.slow
+def test_band_refits_stop_at_their_budget_and_say_so(rigid, monkeypatch):
+    """The confounding check refits the chosen mode on four speed bands from its whole-range
+    optimum, each within ``checks.BAND_STEPS`` steps' worth of evaluations (a band away from
+    the resonance does not pin a 12-parameter mode down: one such refit crawled to 1100
+    evaluations); the JSON and the text say where a refit stopped at its budget."""
+    from powertrain.diagnosis import checks, diagnose
+    from powertrain.validation.cases import FLOOR, measure
+    rpm = np.arange(1000.0, 6001.0, 100.0)
+    shape = np.zeros(9)
+    shape[[2, 5, 7]] = [1.0, 0.4, -0.3]
+    hm = HarmonicModel(rigid, rpm)
+    v = predict(hm, {"missing_body_mode": _params(rigid, f=60.0, shape=shape)}).velocity
+    meas = measure(v, 0.0, np.random.default_rng(1008), "missing mode", hm.channels, rpm, "all")
+
+    def run():
+        return diagnose(meas, read_engine(DEFAULT_ENGINE_PATH), noise_floor=FLOOR,
+                        progress=False, pairs=False, effects=["missing_body_mode"])
+    bands = run().to_dict()["confounding_check"]
+    assert len(bands) == 4 and all(isinstance(b["budget_hit"], bool) for b in bands)
+    monkeypatch.setattr(checks, "BAND_STEPS", 1)      # one Jacobian: no refit can finish
+    res = run()
+    assert all(b["budget_hit"] for b in res.to_dict()["confounding_check"])
+    assert all(np.isfinite(list(b["parameters"].values())).all()
+               for b in res.to_dict()["confounding_check"])
+    assert res.to_text().count("(refit stopped at its budget)") == 4

@@ -42,7 +42,7 @@ def rotation_matrix(phi):
 def rotation_matrices(phi):
     """:func:`rotation_matrix` of each row of ``phi`` (n, 3) [rad] at once, (n, 3, 3)."""
     phi = np.asarray(phi, float)
-    th = np.array([np.linalg.norm(p) for p in phi])
+    th = np.sqrt(np.einsum("ij,ij->i", phi, phi))
     zero = np.zeros(len(phi))
     K = np.stack([zero, -phi[:, 2], phi[:, 1], phi[:, 2], zero, -phi[:, 0],
                   -phi[:, 1], phi[:, 0], zero], axis=-1).reshape(-1, 3, 3)
