@@ -178,14 +178,20 @@ def coupled_solve(M, omega, rows, shapes, abc, kip, body, load):
     -------
     ndarray (n_r, n_h, 6 + K) complex: :math:`\hat{\mathbf q}` then :math:`\hat{\boldsymbol\eta}`.
     """
+    D = coupled_matrix(M, omega, rows, shapes, abc, kip, body)
+    rhs = np.zeros(D.shape[:-1], complex)
+    rhs[..., :6] = load
+    return batched_solve(D, rhs)
+
+
+def coupled_matrix(M, omega, rows, shapes, abc, kip, body):
+    """The (6 + K) matrix of the module docstring per speed and harmonic, (..., 6 + K,
+    6 + K), through the one condensation (arguments as :func:`coupled_solve`)."""
     K = shapes.shape[1]
     E = np.hstack([rows, np.zeros((rows.shape[0], K))])
     B = np.hstack([np.zeros_like(rows), shapes])
     frame = modal_frame(M, body.frequency_hz, body.modal_mass, body.damping_ratio)
-    D = condensed_matrix(frame, E, B, (kip, abc[1], abc[2]), 1j * np.asarray(omega, float))
-    rhs = np.zeros(omega.shape + (6 + K,), complex)
-    rhs[..., :6] = load
-    return batched_solve(D, rhs)
+    return condensed_matrix(frame, E, B, (kip, abc[1], abc[2]), 1j * np.asarray(omega, float))
 
 
 def one_more_mode_basis(M, omega, rows, shapes, abc, kip, body, load):
@@ -198,11 +204,7 @@ def one_more_mode_basis(M, omega, rows, shapes, abc, kip, body, load):
     :math:`\mathbf P = \mathbf U^T\mathbf x_0`, :math:`\mathbf G = \mathbf U^T\mathbf W`
     and the networks' base terms ``c``, per speed and harmonic (arguments as
     :func:`coupled_solve`)."""
-    K = shapes.shape[1]
-    E = np.hstack([rows, np.zeros((rows.shape[0], K))])
-    B = np.hstack([np.zeros_like(rows), shapes])
-    frame = modal_frame(M, body.frequency_hz, body.modal_mass, body.damping_ratio)
-    D = condensed_matrix(frame, E, B, (kip, abc[1], abc[2]), 1j * np.asarray(omega, float))
+    D = coupled_matrix(M, omega, rows, shapes, abc, kip, body)
     U = np.concatenate([abc[1][..., None, :] * rows.T, abc[2][..., None, :] * shapes.T],
                        axis=-2)                                    # (..., 6 + K, n_net)
     f = np.zeros(U.shape[:-1] + (1,), complex)
@@ -220,7 +222,8 @@ def one_more_mode(basis, shape, impedance):
     [\mathbf u^T, z]]` with :math:`z = Z + \sum_n c_n s_n'^2` solved by its Schur
     complement, :math:`\eta = -\mathbf s'\cdot\mathbf P/(z - \mathbf s'^T\mathbf G
     \mathbf s')`, :math:`\mathbf x = \mathbf x_0 - \eta\,\mathbf W\mathbf s'` — exact,
-    the same as :func:`coupled_solve` on the body with the mode (tests/test_body_coupling.py)
+    the same as :func:`coupled_solve` on the body with the mode
+    (tests/test_missing_body_mode.py)
     at a few products per speed and harmonic instead of a solve."""
     x0, W, P, G, c = basis
     s = np.asarray(shape, float)
