@@ -193,6 +193,18 @@ def test_rigid_chassis_run_up_with_a_missing_mode_is_diagnosed(rigid, phase, f_t
     assert d["where"]["sides"]["location"] == "body"
 
 
+def _draw_1008(rigid):
+    """Both sides of the default engine's run-up with a 60 Hz, 14 kg mode moving mostly the
+    left mount's z, measured with order phase (noise draw 1008)."""
+    from powertrain.validation.cases import measure
+    rpm = np.arange(1000.0, 6001.0, 100.0)
+    shape = np.zeros(9)
+    shape[[2, 5, 7]] = [1.0, 0.4, -0.3]
+    hm = HarmonicModel(rigid, rpm)
+    v = predict(hm, {"missing_body_mode": _params(rigid, f=60.0, shape=shape)}).velocity
+    return measure(v, 0.0, np.random.default_rng(1008), "missing mode", hm.channels, rpm, "all")
+
+
 @pytest.mark.slow
 def test_the_draw_whose_fit_stayed_at_its_grid_start_now_finds_the_mode(rigid):
     """Regression (noise draw 1008 of the test above, with phase): the starts read from the
@@ -201,13 +213,8 @@ def test_the_draw_whose_fit_stayed_at_its_grid_start_now_finds_the_mode(rigid):
     ``DATA_START_MARGIN`` inside their bounds it is found (fresh draws 1000-1059: 59.4-60.5
     Hz)."""
     from powertrain.diagnosis import diagnose
-    from powertrain.validation.cases import FLOOR, measure
-    rpm = np.arange(1000.0, 6001.0, 100.0)
-    shape = np.zeros(9)
-    shape[[2, 5, 7]] = [1.0, 0.4, -0.3]
-    hm = HarmonicModel(rigid, rpm)
-    v = predict(hm, {"missing_body_mode": _params(rigid, f=60.0, shape=shape)}).velocity
-    meas = measure(v, 0.0, np.random.default_rng(1008), "missing mode", hm.channels, rpm, "all")
+    from powertrain.validation.cases import FLOOR
+    meas = _draw_1008(rigid)
     d = diagnose(meas, read_engine(DEFAULT_ENGINE_PATH), noise_floor=FLOOR, progress=False,
                  pairs=False, band_check=False, effects=["missing_body_mode"]).to_dict()
     fit = d["chosen"]["parameters"]["missing_body_mode"]
@@ -326,13 +333,8 @@ def test_band_refits_stop_at_their_budget_and_say_so(rigid, monkeypatch):
     the resonance does not pin a 12-parameter mode down: one such refit crawled to 1100
     evaluations); the JSON and the text say where a refit stopped at its budget."""
     from powertrain.diagnosis import checks, diagnose
-    from powertrain.validation.cases import FLOOR, measure
-    rpm = np.arange(1000.0, 6001.0, 100.0)
-    shape = np.zeros(9)
-    shape[[2, 5, 7]] = [1.0, 0.4, -0.3]
-    hm = HarmonicModel(rigid, rpm)
-    v = predict(hm, {"missing_body_mode": _params(rigid, f=60.0, shape=shape)}).velocity
-    meas = measure(v, 0.0, np.random.default_rng(1008), "missing mode", hm.channels, rpm, "all")
+    from powertrain.validation.cases import FLOOR
+    meas = _draw_1008(rigid)
 
     def run():
         return diagnose(meas, read_engine(DEFAULT_ENGINE_PATH), noise_floor=FLOOR,
