@@ -202,9 +202,7 @@ class ScoredLevels:
     same points. ``meas`` (1-D) the measured RMS levels there [m/s], all finite."""
 
     def __init__(self, meas, floor):
-        cl = censoring_level(floor)
-        self.censored = meas < cl
-        self.ref_db = 20.0 * np.log10(np.where(self.censored, cl, meas))
+        self.censored, self.ref_db = censored_reference_db(meas, floor)
         self.floor2 = float(floor) ** 2
 
     def __call__(self, velocity):
@@ -214,13 +212,22 @@ class ScoredLevels:
         return np.where(self.censored, np.maximum(g, 0.0), g)
 
 
+def censored_reference_db(meas, floor):
+    """The noise-floor rule on measured levels: ``(censored, reference [dB])``, censored where
+    a level is below the censoring level, whose dB is then the reference (a model gap
+    there counts only where the model is above it)."""
+    cl = censoring_level(floor)
+    censored = meas < cl
+    with np.errstate(divide="ignore", invalid="ignore"):
+        return censored, 20.0 * np.log10(np.where(censored, cl, meas))
+
+
 def residuals_db(sim, meas, floor):
     """Gap [dB] with censoring at the noise-floor rule's level; NaN where nothing was
     measured."""
-    cl = censoring_level(floor)
-    cens = meas < cl
+    cens, ref_db = censored_reference_db(meas, floor)
     with np.errstate(divide="ignore", invalid="ignore"):
-        gap = 20 * np.log10(sim / np.where(cens, cl, meas))   # one log: censored or not
+        gap = 20.0 * np.log10(sim) - ref_db
     gap = np.where(cens, np.maximum(0.0, gap), gap)
     return np.where(np.isfinite(meas), gap, np.nan)
 

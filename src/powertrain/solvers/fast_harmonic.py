@@ -322,13 +322,10 @@ class HarmonicModel:
         j = np.arange(N_HARMONICS)[harmonics] - 1
         last = self._one_more_mode_at
         if last is None or not np.array_equal(last[0], j):     # the fit's orders: once
-            axes = np.array([self.mount_axes[mi][:, DIRECTIONS.index(ax)]
-                             for mi, ax, _ in self.networks])
             last = self._one_more_mode_at = (j, tuple(self._extra[k][0][:, j]
-                                                      for k in _ONE_MORE_MODE), axes)
-        _, basis, axes = last
-        shape = np.einsum("nj,nj->n", body.mount_shapes[[n[0] for n in self.networks], :, -1],
-                          axes)
+                                                      for k in _ONE_MORE_MODE))
+        basis = last[1]
+        shape = body.network_shapes(self.networks, self.mount_axes)[:, -1]
         w = self.omega[:, harmonics]
         wk, m, z = 2 * np.pi * body.frequency_hz[-1], body.modal_mass[-1], body.damping_ratio[-1]
         return one_more_mode(basis, shape, m * (wk ** 2 - w ** 2 + 2j * z * wk * w))
