@@ -10,7 +10,7 @@ tests/test_rates.py). At most 80 cases (top-1, unexplained and passive side, tar
 unexplained was 0.8 before issue 21), 48 (false claims, 0.05); at a true rate of 0.95 about
 26 and 22.
 They carry the ``slow`` and ``rates`` markers and run with the suite; the passive-side test,
-the longest, also ``long_rates`` (on request: ``python -m pytest -m long_rates``). The
+the longest, also ``long_rates`` (run first; alone: ``python -m pytest -m long_rates``). The
 seeds are in the failure message; rerun one with
 :func:`powertrain.validation.cases.make_case`. The 50-case rates of the benchmark are printed
 by ``scripts/blind_diagnosis.py``.

@@ -456,3 +456,23 @@ def test_crank_volume_is_kept_per_grid_and_read_only():
         assert crank.volume(theta.copy())[0] is V and not V.flags.writeable
     other = dataclasses.replace(crank, compression_ratio=crank.compression_ratio + 1.0)
     assert not np.array_equal(other.volume(theta)[0], V)
+
+
+def test_load_table_keeps_its_patterns_per_grid_and_equals_the_generalized_load():
+    """``Engine.load_table`` keeps the unit-load patterns of its last crank-angle grid (the
+    amplitude truth runs hundreds of one-speed run-ups on one engine): on a repeated, a new
+    and the first grid again it equals ``generalized_load`` at every speed to round-off, and
+    the kept patterns are read-only."""
+    engine = read_engine(DEFAULT_ENGINE_PATH)
+    rpm = np.array([1500.0, 4200.0])
+    for n in (720, 360, 720, 720):
+        theta = np.arange(n) * (4 * np.pi / n)
+        table = engine.load_table(rpm, theta)
+        for i, r in enumerate(rpm):
+            want = engine.generalized_load(r, theta)
+            np.testing.assert_allclose(table[i], want, rtol=1e-10,
+                                       atol=1e-9 * np.abs(want).max())
+    gas, inertia = engine.__dict__["_load_patterns_memo"][1]
+    assert engine.load_table(rpm, theta.copy()) is not table
+    assert engine.__dict__["_load_patterns_memo"][1][1] is inertia and not inertia.flags.writeable
+    assert all(not g.flags.writeable for g in gas)

@@ -8,8 +8,8 @@ two-sided plans, amplitude-dependent mounts told from a stiffer mount (named rig
 Judged by the group-sequential Wilson rule of ``tests/rates.py`` (batches of 8 fresh cases
 until it decides; a true rate 0.1 worse than the target fails with probability >= 0.8, as
 tests/test_diagnosis_rates.py);
-``slow`` and ``rates``; the two plan tests, the longest, also ``long_rates`` (on request:
-``python -m pytest -m long_rates``), the cylinder tests run with the suite. The benchmark
+``slow`` and ``rates``, run with the suite; the two plan tests, the longest, also
+``long_rates`` (run first; alone: ``python -m pytest -m long_rates``). The benchmark
 lines quoted in docs/validation/diagnosis.md are printed by
 ``scripts/phase_plan_benchmark.py``.
 """

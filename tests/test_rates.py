@@ -120,14 +120,35 @@ def _marked(marker):
     return out
 
 
-def test_the_suite_deselects_only_the_long_rate_tests_and_they_are_rate_tests():
-    """CI runs the suite's default selection: every rate test but the ``long_rates`` ones,
-    which also carry ``rates`` (``-m rates`` runs all ten) and ``slow`` (not the fast lane)."""
+def test_the_suite_runs_every_rate_test_and_the_long_ones_are_rate_tests():
+    """CI runs the suite's default selection, which deselects nothing: all ten rate tests run
+    with it; the four ``long_rates`` ones also carry ``rates`` (``-m rates`` runs all ten)
+    and ``slow`` (not the fast lane)."""
     from pathlib import Path
 
     import tomllib
     conf = tomllib.loads((Path(__file__).parents[1] / "pyproject.toml").read_text())
-    assert "-m 'not long_rates'" in conf["tool"]["pytest"]["ini_options"]["addopts"]
+    assert "-m" not in conf["tool"]["pytest"]["ini_options"]["addopts"].split()
     long, all_rates = _marked("long_rates"), _marked("rates")
     assert long and all(m >= {"rates", "slow"} for m in long.values())
     assert len(all_rates) == 10 and len(all_rates) - len(long) == 6
+
+
+class _Item:
+    def __init__(self, name, *marks):
+        self.name, self.marks = name, set(marks)
+
+    def get_closest_marker(self, name):
+        return name if name in self.marks else None
+
+
+def test_the_rate_tests_are_collected_first_and_the_long_ones_lead():
+    """tests/conftest.py orders the collection: ``long_rates``, then the other rate tests,
+    then the rest, each group in its collected order (the test processes take the longest
+    first and finish together)."""
+    import conftest
+    items = [_Item("a"), _Item("r1", "rates", "slow"), _Item("b", "slow"),
+             _Item("l1", "rates", "long_rates", "slow"), _Item("r2", "rates"),
+             _Item("l2", "rates", "long_rates")]
+    conftest.pytest_collection_modifyitems(None, items)
+    assert [i.name for i in items] == ["l1", "l2", "r1", "r2", "a", "b"]

@@ -14,8 +14,8 @@ decides, truncated where the Wilson rule does; a rate 0.1 worse fails with proba
   cases, full diagnoses; ``scripts/phase_plan_benchmark.py --bench missing_mode`` prints
   the rate for a fixed number of cases);
 
-hence the ``slow`` and ``rates`` markers; the missing-mode test also ``long_rates`` (on
-request: ``python -m pytest -m long_rates``), side attribution runs with the suite. The
+hence the ``slow`` and ``rates`` markers (both run with the suite); the missing-mode test
+also ``long_rates`` (run first; alone: ``python -m pytest -m long_rates``). The
 small tests of the scoring logic are in tests/test_validation_scoring.py.
 """
 

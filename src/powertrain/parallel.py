@@ -23,11 +23,26 @@ Results do not depend on the choice: every job is a pure function of its argumen
 
 from __future__ import annotations
 
+import functools
 import os
 from concurrent.futures import Future, ProcessPoolExecutor
 from contextlib import contextmanager
 
 from powertrain.errors import InputError
+
+
+@functools.cache
+def _threadpools():
+    from threadpoolctl import ThreadpoolController
+    return ThreadpoolController()
+
+
+def single_blas_thread():
+    """Context manager limiting BLAS to one thread: the models' matrices are small (~33×33),
+    and OpenBLAS threads cost more than they give (5× slower run-ups on a busy 2-core
+    machine). The thread pools are found once per process (finding them took 0.7 ms, paid
+    at each of the amplitude truth's hundreds of one-speed run-ups)."""
+    return _threadpools().limit(limits=1, user_api="blas")
 
 
 class SerialExecutor:

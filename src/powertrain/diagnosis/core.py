@@ -43,6 +43,7 @@ from powertrain.diagnosis.sides import side_attribution, with_measured_body_side
 from powertrain.diagnosis.where import decompose_gap, regions, rigid_span_gap, where_text
 from powertrain.effects import predict
 from powertrain.errors import InputError
+from powertrain.parallel import single_blas_thread
 from powertrain.solvers.fast_harmonic import HarmonicModel
 
 
@@ -91,9 +92,8 @@ def diagnose(measured, engine=None, *, noise_floor=DEFAULT_NOISE_FLOOR, effects=
         An unknown effect, a file that cannot be read, order curves of another signal than
         velocity, too few speeds to split, or nothing comparable.
     """
-    from threadpoolctl import threadpool_limits
     engine, measured = _inputs(measured, engine, effects)
-    with threadpool_limits(limits=1, user_api="blas"):
+    with single_blas_thread():
         result = _diagnose(measured, engine, noise_floor, effects, pairs, band_check,
                            rule or DecisionRule(), scheduler or "serial", progress, budget)
     result.engine = engine
@@ -205,8 +205,7 @@ def _where(s: _Setup):
 
 def _fit_job(job):
     problem, effects, starts, budget = job
-    from threadpoolctl import threadpool_limits
-    with threadpool_limits(limits=1, user_api="blas"):
+    with single_blas_thread():
         return fit_candidate(problem, effects, starts=starts, budget=budget,
                              defaults=starts is None)
 

@@ -10,6 +10,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from powertrain.models.grid_memo import on_last_grid
 from powertrain.physics import slider_crank as sc
 
 
@@ -95,16 +96,9 @@ class CrankTrain:
         The last grid's result is kept (read-only arrays): the combustion models ask for
         the same cycle grid at every speed and cylinder (the measured-trace models' load
         derivatives took 0.4 s of kinematics for it)."""
-        theta = np.asarray(theta, float)
-        memo = self.__dict__.get("_volume_memo")
-        if memo is not None and memo[0].shape == theta.shape and np.array_equal(memo[0], theta):
-            return memo[1]
-        out = sc.cylinder_volume(theta, self.bore, self.crank_radius, self.rod_length,
-                                 self.pin_offset, self.compression_ratio)
-        for a in out:
-            a.setflags(write=False)
-        object.__setattr__(self, "_volume_memo", (theta.copy(), out))
-        return out
+        return on_last_grid(self, "_volume_memo", theta, lambda th: sc.cylinder_volume(
+            th, self.bore, self.crank_radius, self.rod_length, self.pin_offset,
+            self.compression_ratio))
 
 
 @dataclass(frozen=True, eq=False)

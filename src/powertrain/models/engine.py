@@ -39,6 +39,7 @@ import numpy as np
 
 from powertrain.models.combustion import RPM, FullLoadCurve, MeasuredPressure, SingleZoneCombustion  # noqa: F401 (re-export)
 from powertrain.models.crank_train import Balancer, BalancerShaft, CrankTrain  # noqa: F401 (re-export)
+from powertrain.models.grid_memo import on_last_grid
 from powertrain.physics import balancer as bal
 from powertrain.physics import combustion as comb
 from powertrain.physics import slider_crank as sc
@@ -341,6 +342,14 @@ class Engine:
                           torque_gas=out["torque_gas"], torque_inertia=out["torque_inertia"],
                           load=total, imep=imep, info=dict(info))
 
+    def _load_patterns(self, th):
+        """``(G, I)`` of :meth:`load_table`: the block load of a unit gas force in each
+        cylinder (list of (n, 6)) and of a unit omega^2 (n, 6) at the angles ``th`` [rad]."""
+        unit = np.eye(self.crank.n_cylinders)
+        gas = [self._block_load(th, 0.0, np.broadcast_to(u, (th.size, unit.shape[0])))[0]
+               for u in unit]
+        return gas, self._block_load(th, 1.0, np.zeros((th.size, unit.shape[0])))[0]
+
     def _block_load(self, th, omega, fg):
         """Generalized load (n, 6) on the block at angles ``th`` [rad], speed ``omega``
         [rad/s] and gas forces ``fg`` (n, n_cyl) [N], and the per-cylinder forces of
@@ -434,10 +443,7 @@ class Engine:
         th = np.atleast_1d(np.asarray(crank_angle_rad, dtype=float))
         speeds = np.atleast_1d(np.asarray(speeds_rpm, dtype=float))
         ct = self.crank
-        unit = np.eye(ct.n_cylinders)
-        gas = [self._block_load(th, 0.0, np.broadcast_to(unit[i], (th.size, unit.shape[0])))[0]
-               for i in range(unit.shape[0])]
-        inertia = self._block_load(th, 1.0, np.zeros((th.size, unit.shape[0])))[0]
+        gas, inertia = on_last_grid(self, "_load_patterns_memo", th, self._load_patterns)
         table = ((speeds * RPM) ** 2)[:, None, None] * inertia
         fg = (self.cylinder_pressures(speeds, th, load) - ct.crankcase_pressure) * ct.piston_area
         for i, g in enumerate(gas):

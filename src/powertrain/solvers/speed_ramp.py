@@ -27,6 +27,7 @@ from powertrain.analysis.channel import Channel
 from powertrain.analysis.speed import TRIGGER_HIGH
 from powertrain.errors import InputError
 from powertrain.models.recording import RawChannel, RawRecording
+from powertrain.parallel import single_blas_thread
 
 #: Load table spacing: speed [rpm] and crank angle [deg].
 LOAD_RPM_STEP = 25.0
@@ -104,8 +105,6 @@ def simulate_sweep(engine, rpm_from, rpm_to, rate_rpm_per_s, sample_rate=8192.0,
         Nine acceleration channels [m/s^2] (engine side), the speed [rpm], the tacho and the
         cycle reference [V] (:func:`crank_pulses`).
     """
-    from threadpoolctl import threadpool_limits
-
     from powertrain.assembly import assemble
     _check(engine, rpm_from, rpm_to, rate_rpm_per_s, sample_rate)
     m, n_steps = sweep_steps(rpm_from, rpm_to, rate_rpm_per_s, sample_rate)
@@ -117,7 +116,7 @@ def simulate_sweep(engine, rpm_from, rpm_to, rate_rpm_per_s, sample_rate=8192.0,
     dofs, to_channels = _channel_dofs(system.channel_matrix)
     decimator = _Decimator(m, dofs.size)
     ramp = (rpm_from, rate_rpm_per_s, h, n_steps)
-    with threadpool_limits(limits=1, user_api="blas"):     # small matrices: see run_runup
+    with single_blas_thread():
         y, method = _integrate_ramp(engine, system, load, ramp, dofs, decimator, progress,
                                     static_factors)
         block = to_channels @ y.T                           # (n_ch, n_out), contiguous

@@ -33,6 +33,7 @@ import numpy as np
 from powertrain.analysis.orders import ORDERS
 from powertrain.assembly import assemble
 from powertrain.errors import InputError, require_finite, solved
+from powertrain.parallel import single_blas_thread
 from powertrain.progress import progress_bar
 from powertrain.results.runup import RunupResult, SweepRunup
 from powertrain.results.static import StaticResult
@@ -87,13 +88,9 @@ def _cycle_loads(engine, rpm, n_per_cycle):
 
 
 def run_runup(*args, **kwargs) -> RunupResult:
-    """Simulate a run-up (see :func:`_run_runup` for the parameters).
-
-    BLAS is limited to one thread meanwhile: the model's matrices are small (~33×33), and
-    OpenBLAS threads cost more than they give (5× slower on a busy 2-core machine).
-    """
-    from threadpoolctl import threadpool_limits
-    with threadpool_limits(limits=1, user_api="blas"):
+    """Simulate a run-up (see :func:`_run_runup` for the parameters), BLAS limited to one
+    thread meanwhile (:func:`~powertrain.parallel.single_blas_thread`)."""
+    with single_blas_thread():
         return _run_runup(*args, **kwargs)
 
 
