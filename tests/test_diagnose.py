@@ -241,3 +241,27 @@ def test_sensor_error_rotates_then_scales_each_triad(engine):
     fast = predict(hm, {"sensor_error": p}).velocity
     general = predict(hm, {"sensor_error": p, "balancer_error": {}}).velocity
     assert np.max(np.abs(fast - general)) <= EXACT * np.max(np.abs(general))
+
+
+@pytest.mark.slow
+def test_the_band_check_enters_nothing_but_its_own_entry():
+    """The band check refits the chosen effect on speed bands after the verdict: a diagnosis
+    without it has the same verdict, claim, parameters and ranking (the rate tests skip it,
+    tests/rates.py ``diagnosis``), and only its ``confounding_check`` entry empty."""
+    from powertrain.validation.cases import FLOOR, engines
+    from powertrain.validation.cases import make_case as make_truth_case
+    case = make_truth_case(0, ["mount_temperature"], "sz", 11)
+    runs = [diagnose(case.measured, engines()["sz"], noise_floor=FLOOR, band_check=bc,
+                     progress=False).to_dict() for bc in (True, False)]
+    assert runs[0]["chosen"] and runs[0]["confounding_check"] and not runs[1]["confounding_check"]
+    for key in ("verdict", "chosen", "ranking", "ambiguous_between", "heldout_rms_db_after"):
+        assert json.dumps(_untimed(runs[0][key])) == json.dumps(_untimed(runs[1][key])), key
+
+
+def _untimed(x):
+    """``x`` without its ``seconds`` entries (at any depth; compared as JSON: NaN is NaN)."""
+    if isinstance(x, dict):
+        return {k: _untimed(v) for k, v in x.items() if k != "seconds"}
+    if isinstance(x, list):
+        return [_untimed(v) for v in x]
+    return x

@@ -5,9 +5,9 @@ never less right than its best single run, and no wrong name with engine-side ch
 two-sided plans, amplitude-dependent mounts told from a stiffer mount (named right, never
 "ambiguous").
 
-Judged by the group-sequential Wilson rule of ``tests/rates.py`` (batches of 8 fresh cases
-until it decides; a true rate 0.1 worse than the target fails with probability >= 0.8, as
-tests/test_diagnosis_rates.py);
+Judged by the group-sequential Wilson rule of ``tests/rates.py`` (batches of fresh cases,
+14 for a target of 0.9 and 16 for a ceiling of 0.05, until it decides; a true rate 0.1
+worse than the target fails with probability >= 0.8, as tests/test_diagnosis_rates.py);
 ``slow`` and ``rates``, run with the suite; the two plan tests, the longest, also
 ``long_rates`` (run first; alone: ``python -m pytest -m long_rates``). The benchmark
 lines quoted in docs/validation/diagnosis.md are printed by
@@ -20,9 +20,8 @@ import numpy as np
 import pytest
 import rates
 
-from powertrain.diagnosis import diagnose
 from powertrain.parallel import run_map
-from powertrain.validation.cases import FLOOR, engines, make_case
+from powertrain.validation.cases import engines, make_case
 from powertrain.validation.plans import make_plan_case
 
 #: Redraws allowed to find a detectable case.
@@ -58,7 +57,7 @@ def _cylinder_row(task):
         case = make_case(i, ["weak_cylinder"], eng, int(rng.integers(2 ** 31)), phase=phase)
         if case.detectable:
             break
-    d = diagnose(case.measured, engines()[eng], noise_floor=FLOOR).to_dict()
+    d = rates.diagnosis(case.measured, engines()[eng])
     f = d.get("finding") or {}
     return {"truth": (case.truth[0][1]["cylinder"] + 1, "weak"),
             "named": (f.get("cylinder"), f.get("sign")),
@@ -80,7 +79,7 @@ def test_without_half_order_phases_the_named_set_holds_the_truth():
 
 
 def _claim(measured, engine):
-    d = diagnose(measured, engine, noise_floor=FLOOR).to_dict()
+    d = rates.diagnosis(measured, engine)
     return sorted((d.get("chosen") or {}).get("effects", []))
 
 
@@ -136,7 +135,7 @@ def _two_sided_plan_row(task):
                               sides="both")
         if case.detectable:
             break
-    d = diagnose(case.plan(), case.engine, noise_floor=FLOOR).to_dict()
+    d = rates.diagnosis(case.plan(), case.engine)
     return {"truth_set": case.truth_set, "verdict": d["verdict"],
             "claimed": sorted((d.get("chosen") or {}).get("effects", []))}
 

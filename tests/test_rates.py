@@ -85,7 +85,8 @@ def test_sequential_test_keeps_the_power_and_size(target, higher):
     assert p_worse >= rates.POWER
     assert p_target <= 0.11
     # the smallest truncation with that power
-    assert rates.sequential_oc(n_max - rates.BATCH, target, higher, worse)[0] < rates.POWER
+    assert rates.sequential_oc(n_max - rates.batch_size(target, higher), target, higher,
+                               worse)[0] < rates.POWER
 
 
 def test_sequential_oc_matches_enumeration():
@@ -103,7 +104,17 @@ def test_sequential_run_stops_early_on_a_perfect_record():
         calls.append(count)
         return [True] * count
     passed, rows, good = rates.run_sequential(rows_of, bool, 0.9)
-    assert passed and len(rows) == 16 and good == 16 and calls == [8, 8]
+    assert passed and len(rows) == 14 and good == 14 and calls == [14]
+
+
+@pytest.mark.parametrize("target,higher,batch", [(0.9, True, 14), (0.8, True, 12),
+                                                  (0.05, False, 16)])
+def test_a_batch_is_the_fewest_cases_that_can_pass_at_the_first_look(target, higher, batch):
+    """All good (successes, or no event under a ceiling), a batch passes at once; the
+    cores' multiple below it goes on."""
+    assert rates.batch_size(target, higher) == batch and batch % rates.CORES == 0
+    assert rates.look(batch, batch, target, higher) == "pass"
+    assert rates.look(batch - 2, batch - 2, target, higher) == "go on"
 
 
 def _marked(marker):
