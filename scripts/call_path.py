@@ -5,8 +5,8 @@ of the target function, prints the call stack inside the package from the click 
 to it: the number of calls ("hops") and of distinct modules they pass, and how many times
 the variant's own ``apply`` ran. Issue 19 quotes these for two paths:
 
-    python scripts/call_path.py --target newmark_kernel --after apply -- \
-        whatif --scale left.z.stiffness=1.2 --json /tmp/w.json
+    python scripts/call_path.py --target harmonic_solve --after apply -- \
+        whatif --workers 1 --scale left.z.stiffness=1.2 --json /tmp/w.json --quiet
     python scripts/call_path.py --target harmonic_solve -- \
         runup --engine src/powertrain/data/engines/default-modal-body.toml \
         --solver harmonic --from 3000 --to 3000 --effect chassis_modes:f1=30
