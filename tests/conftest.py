@@ -52,8 +52,8 @@ def system(engine):
 def pytest_collection_modifyitems(config, items):
     """The rate tests first, the longest (``long_rates``) leading: with the tests shared out
     as they free up (pytest-xdist), the few minutes-long ones start at once and the many short
-    ones fill in around them, so that the test processes finish together (longest first; on
-    CI's two cores the whole suite ended several minutes later with them collected last).
+    ones fill in around them, so that the test processes finish together (longest first:
+    collected last, a plan test could start in the suite's last minutes and run on alone).
     The order is otherwise kept (a stable sort)."""
     def rank(item):
         return (item.get_closest_marker("long_rates") is None,
