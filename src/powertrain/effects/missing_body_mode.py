@@ -26,7 +26,8 @@ exact where the body side is held still without the mode, approximate on a modal
 own modes answer the changed mount forces too), gives the shape with its signs
 (:func:`signed_shape`, the best rank-1 fit; the fit then tries each sign flipped); the
 frequency is then a grid over the measured order frequencies in steps of :data:`GRID_STEP`
-(the phase swings through the resonance and marks it; magnitudes alone hardly do). Without
+(the phase swings through the resonance and marks it; magnitudes alone hardly do), each at
+the modal masses :data:`GRID_MASSES`. Without
 phase: from the body-side gap's peaks — the frequencies where the measured body side most
 exceeds the model relative to the engine side (:func:`body_gap_peak`), the shape from the
 excess velocity at each base and direction
@@ -63,15 +64,22 @@ START_PEAKS = 3
 #: Ratio of neighbouring start frequencies with phase [1] (a resonance at 2-6 % damping is
 #: 4-12 % wide).
 GRID_STEP = 1.06
-#: Modal mass of the frequency-grid starts [kg] (the fit moves it; a middle value).
-GRID_MASS = 12.0
+#: Modal masses of the frequency-grid starts [kg], a factor 3 apart: from one middle mass
+#: (12 kg) a 28 kg mode at 91 Hz was fitted at 64 Hz, 12 kg, 12 % damping (BIC +2712 against
+#: -2728 from the truth; docs/validation/diagnosis.md, "Eleventh round").
+GRID_MASSES = (4.0, 12.0, 36.0)
 AXES = "xyz"
 #: Modal assurance criterion above which the fitted shape *pairs* with one of the file's body
-#: modes [1]: 0.9 is the usual threshold for a well-correlated pair of test and model modes
-#: (Allemang 2003, "The modal assurance criterion - twenty years of use and abuse"). Shapes
-#: the validation generator draws for a truly missing mode reach it with one of the default
-#: body's modes in fewer than 1 draw in 1000 (tests/test_missing_body_mode.py).
-MAC_PAIRED = 0.9
+#: modes [1]. Below the 0.9 of a well-correlated pair of *measured* test and model modes
+#: (Allemang 2003, "The modal assurance criterion - twenty years of use and abuse"): a
+#: missing mode fitted where a file mode has moved is a stand-in whose shape also absorbs
+#: the file mode left at its old place; such stand-ins paired at 0.82 and 0.90 on moved-mode
+#: cases the held-out speeds could not tell from chassis_modes (verdict "ambiguous"; a third
+#: at 0.73, docs/validation/diagnosis.md, "Eleventh round"). The cost: the validation
+#: generator's truly missing modes restate chassis_modes at 0.8 in about 1 draw in 450 (at
+#: 0.7, 1 in 90; tests/test_missing_body_mode.py), and those only while chassis_modes
+#: explains the data as well (t <= t_min).
+MAC_PAIRED = 0.8
 
 
 def shape_names(engine) -> list:
@@ -202,9 +210,10 @@ class MissingBodyMode(Effect):
         names = [m.name for m in engine.mounts]
         shape = signed_shape(gaps, names)
         if shape is not None:
-            base = {"modal_mass_kg": GRID_MASS, "damping_ratio": ZETA_DEFAULT,
+            base = {"damping_ratio": ZETA_DEFAULT,
                     **dict(zip(shape_names(engine), shape.ravel().tolist()))}
-            return [dict(base, frequency_hz=float(f)) for f in frequency_grid(gaps, names)]
+            return [dict(base, frequency_hz=float(f), modal_mass_kg=m)
+                    for f in frequency_grid(gaps, names) for m in GRID_MASSES]
         out = []
         for f0, shape in body_gap_peak(gaps, [m.name for m in engine.mounts],
                                        n_peaks=START_PEAKS):
