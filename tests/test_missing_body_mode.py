@@ -120,8 +120,8 @@ def test_signed_shape_and_frequency_grid_from_the_complex_excess(rigid, f0):
     """With phase: the complex body-side excess of a run-up with the mode over the model
     without it gives the shape with its signs (up to one overall sign, which the data cannot
     see; exact where the body side is held still without the mode, a start on a modal body,
-    whose own modes answer the changed mount forces too); the start grid steps by GRID_STEP
-    across the mode's frequency."""
+    whose own modes answer the changed mount forces too), over all points and over those near
+    the mode's frequency; the start grid steps by GRID_STEP across the mode's frequency."""
     rpm = np.arange(1000.0, 6001.0, 100.0)
     p = _params(rigid, f=f0)
     hm = HarmonicModel(rigid, rpm)
@@ -141,8 +141,13 @@ def test_signed_shape_and_frequency_grid_from_the_complex_excess(rigid, f0):
     grid = frequency_grid(g, names)
     np.testing.assert_allclose(grid[1:] / grid[:-1], grid[1] / grid[0])
     assert grid[1] / grid[0] <= GRID_STEP and grid[0] < f0 < grid[-1]
-    starts = EFFECT.data_starts(rigid, g)           # every grid frequency at every grid mass
-    assert len(starts) == grid.size * len(GRID_MASSES)
+    local = signed_shape(g, names, f0=f0).ravel()    # of the points near f0: exact here too
+    np.testing.assert_allclose(np.sign(local @ truth) * local, truth, atol=1e-6)
+    assert signed_shape(g, names, f0=2000.0) is None  # no order frequency near 2 kHz
+    # every grid frequency with both shapes (one where no point lies near) at every grid mass
+    n_local = sum(signed_shape(g, names, f0=f) is not None for f in grid)
+    starts = EFFECT.data_starts(rigid, g)
+    assert len(starts) == (grid.size + n_local) * len(GRID_MASSES)
     assert {st["modal_mass_kg"] for st in starts} == set(GRID_MASSES)
     assert signed_shape(BodyGaps(rpm, g.channels, orders, g.gap, g.measured), names) is None
 
