@@ -4,6 +4,7 @@ written out here independently of the helper."""
 from __future__ import annotations
 
 from math import comb
+from pathlib import Path
 
 import pytest
 import rates
@@ -163,3 +164,20 @@ def test_the_rate_tests_are_collected_first_and_the_long_ones_lead():
              _Item("l2", "rates", "long_rates")]
     conftest.pytest_collection_modifyitems(None, items)
     assert [i.name for i in items] == ["l1", "l2", "r1", "r2", "a", "b"]
+
+
+@pytest.mark.parametrize("target, rate", [(0.9, 0.93), (0.8, 0.885), (0.9, 0.8)])
+def test_ci_length_stopping_counts_match_the_operating_characteristic(target, rate):
+    """scripts/ci_length.py's distribution of stopping case counts sums to one and has the
+    expected count of rates.sequential_oc (two exact sums over the same paths)."""
+    import importlib.util
+    spec = importlib.util.spec_from_file_location(
+        "ci_length", Path(__file__).resolve().parents[1] / "scripts" / "ci_length.py")
+    mod = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(mod)
+    dist = mod.stopping_counts(target, rate)
+    assert sum(dist.values()) == pytest.approx(1.0, abs=1e-12)
+    _, e_n = rates.sequential_oc(rates.sequential_plan(target), target, True, rate)
+    assert sum(n * p for n, p in dist.items()) == pytest.approx(e_n, rel=1e-12)
+    assert set(dist) <= set(range(0, rates.sequential_plan(target) + 1,
+                                  rates.batch_size(target)))
