@@ -314,7 +314,7 @@ def _body_columns(g: BodyGaps, mount_names) -> dict:
 def signed_shape(g: BodyGaps, mount_names, f0=None):
     r"""Shape (n_mounts, 3) with its signs, normalised to its largest component, from the
     body side's complex excess (``g.excess``), or None without phase. A missing mode adds
-    :math:`a_{ro}\,oldsymbol\psi` at speed r and order o (one complex factor, the real
+    :math:`a_{ro}\,\boldsymbol\psi` at speed r and order o (one complex factor, the real
     shape): ψ is the leading eigenvector of :math:`E^HE` (E: the excess, speeds × orders by
     bases × directions, unscored points 0), turned real by the phase that makes
     :math:`\sum_j \psi_j^2` real. With ``f0`` [Hz]: of the points whose order frequency lies
