@@ -3,7 +3,8 @@
 Most of CI (``bash .ci/run``) is fixed work; what varies is how many cases the passive-side
 and missing-mode rate tests draw before their group-sequential rule decides
 (``tests/rates.py``). This script sums the exact distributions of their stopping case counts
-(every path of the batches, at the given true rates) over a linear model of CI's wall time:
+(``rates.stopping_counts``: every path of the batches, at the given true rates) over a
+linear model of CI's wall time:
 
     wall = install + overhead × (fixed + (n_passive − n0_passive) × s_passive
                                         + (n_missing − n0_missing) × s_missing)
@@ -29,24 +30,9 @@ import rates  # noqa: E402
 
 
 def stopping_counts(target, rate) -> dict:
-    """``{n: probability}`` of the case count at which the group-sequential test of
-    ``target`` stops when the true rate is ``rate`` (exact sums over the batches)."""
-    batch, n_max = rates.batch_size(target), rates.sequential_plan(target)
-    alive, n, out = {0: 1.0}, 0, {}
-    while alive:
-        m = min(batch, n_max - n)
-        nxt = {}
-        for k, p in alive.items():
-            for j in range(m + 1):
-                nxt[k + j] = nxt.get(k + j, 0.0) + p * rates._binom_pmf(j, m, rate)
-        n += m
-        alive = {}
-        for k, p in nxt.items():
-            if rates.look(k, n, target, True, n_max) == "go on":
-                alive[k] = p
-            else:
-                out[n] = out.get(n, 0.0) + p
-    return out
+    """``{n: probability}`` of the case count at which the rate test of ``target`` stops
+    when the true rate is ``rate`` (:func:`rates.stopping_counts`, its batches and limit)."""
+    return rates.stopping_counts(rates.sequential_plan(target), target, True, rate)[0]
 
 
 def main(argv=None):

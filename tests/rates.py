@@ -117,14 +117,14 @@ def look(n_good, n, target, higher_is_better=True, n_max=None):
     return "go on"
 
 
-def sequential_oc(n_max, target, higher_is_better, true_rate, batch=None):
-    """``(P(fail), expected number of cases)`` of the truncated group-sequential test when
-    the true rate is ``true_rate`` (as ``target``: of successes, or of events for a
-    ceiling), by exact sums over the batches (``batch`` default :func:`batch_size`)."""
+def stopping_counts(n_max, target, higher_is_better, true_rate, batch=None):
+    """``({n: P(stop at n)}, P(fail))`` of the truncated group-sequential test when the true
+    rate is ``true_rate`` (as ``target``: of successes, or of events for a ceiling), by exact
+    sums over every path of the batches (``batch`` default :func:`batch_size`)."""
     batch = batch or batch_size(target, higher_is_better)
     g = true_rate if higher_is_better else 1 - true_rate
     alive = {0: 1.0}                       # good outcomes -> probability, still going on
-    n, p_fail, e_n = 0, 0.0, 0.0
+    n, p_fail, stops = 0, 0.0, {}
     while alive:
         m = min(batch, n_max - n)
         nxt = {}
@@ -138,9 +138,16 @@ def sequential_oc(n_max, target, higher_is_better, true_rate, batch=None):
             if verdict == "go on":
                 alive[k] = p
                 continue
-            e_n += p * n
+            stops[n] = stops.get(n, 0.0) + p
             p_fail += p if verdict == "fail" else 0.0
-    return p_fail, e_n
+    return stops, p_fail
+
+
+def sequential_oc(n_max, target, higher_is_better, true_rate, batch=None):
+    """``(P(fail), expected number of cases)`` of the truncated group-sequential test
+    (:func:`stopping_counts`)."""
+    stops, p_fail = stopping_counts(n_max, target, higher_is_better, true_rate, batch)
+    return p_fail, sum(n * p for n, p in stops.items())
 
 
 def sequential_plan(target, higher_is_better=True, batch=None, n_limit=600):

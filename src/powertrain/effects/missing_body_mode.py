@@ -250,6 +250,11 @@ class BodyGaps:
     measured: np.ndarray
     excess: np.ndarray | None = None
 
+    @property
+    def order_hz(self) -> np.ndarray:
+        """Order frequency of every speed and order [Hz], (n_r, n_o)."""
+        return self.rpm[:, None] * self.orders[None, :] / 60.0
+
 
 #: Relative half-width of the frequency window around the peak read for the shape [1].
 PEAK_WINDOW = 0.08
@@ -270,7 +275,7 @@ def body_gap_peak(g: BodyGaps, mount_names, n_bins=32, n_peaks=1):
     if not cols:
         return None
     idx = list(cols)
-    f = g.rpm[:, None, None] * g.orders[None, None, :] / 60.0 * np.ones((1, len(idx), 1))
+    f = g.order_hz[:, None, :] * np.ones((1, len(idx), 1))
     meas = g.measured[:, idx]
     engine_side = g.measured[:, [cols[c][2] for c in idx]]
     with np.errstate(invalid="ignore", over="ignore", divide="ignore"):
@@ -325,8 +330,7 @@ def signed_shape(g: BodyGaps, mount_names, f0=None):
     idx = list(cols)
     E = np.moveaxis(g.excess[:, idx], 1, -1)
     if f0 is not None:
-        f = g.rpm[:, None] * g.orders[None, :] / 60.0
-        E = E[np.abs(f / f0 - 1) <= PEAK_WINDOW]
+        E = E[np.abs(g.order_hz / f0 - 1) <= PEAK_WINDOW]
     E = E.reshape(-1, len(idx))
     E = np.where(np.isfinite(E), E, 0.0)
     if not np.any(E):
@@ -345,7 +349,7 @@ def frequency_grid(g: BodyGaps, mount_names) -> np.ndarray:
     body-side points with an excess (within :data:`FREQ_RANGE`)."""
     idx = list(_body_columns(g, mount_names))
     ok = np.isfinite(g.excess[:, idx])
-    f = (g.rpm[:, None, None] * g.orders[None, None, :] / 60.0 * np.ones(ok.shape))[ok]
+    f = (g.order_hz[:, None, :] * np.ones(ok.shape))[ok]
     lo, hi = np.clip([f.min(), f.max()], *FREQ_RANGE)
     n = int(np.ceil(np.log(hi / lo) / np.log(GRID_STEP))) + 1
     return np.geomspace(lo, hi, max(n, 1))
