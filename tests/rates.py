@@ -68,14 +68,15 @@ def size(target, higher_is_better=True, worse_by=WORSE_BY, power=POWER, z=Z_ONE_
 # --- group-sequential rate tests -------------------------------------------------------------
 #
 # A fixed-size test spends its n cases even when the first dozen already show a rate far
-# above its target. The group-sequential version draws the cases in batches and, after each
-# batch, stops early on Wald's likelihood ratio between the target and the rate WORSE_BY worse
-# (Wald 1947, *Sequential Analysis*): it passes when the ratio falls below
+# above its target. The group-sequential version draws a first batch (the fewest cases that
+# can pass at once, :func:`batch_size`), then STEP cases at a time, and after each draw stops
+# early on Wald's likelihood ratio between the target and the rate WORSE_BY worse (Wald
+# 1947, *Sequential Analysis*): it passes when the ratio falls below
 # WALD_PASS = beta/(1 - alpha) and fails when it rises above WALD_FAIL = (1 - beta)/alpha
 # (alpha 0.05, beta 0.2: the same error rates as the fixed-size test). Truncated at ``n_max``,
 # where the Wilson rule decides as above. :func:`sequential_plan` picks the smallest
 # ``n_max`` whose exact operating characteristic (:func:`sequential_oc`, a sum over every
-# path of the batches) still fails a rate WORSE_BY worse with probability >= POWER.
+# path of the draws) still fails a rate WORSE_BY worse with probability >= POWER.
 
 WALD_ALPHA = 0.05
 WALD_BETA = 0.2
@@ -83,6 +84,12 @@ WALD_PASS = WALD_BETA / (1 - WALD_ALPHA)
 WALD_FAIL = (1 - WALD_BETA) / WALD_ALPHA
 #: Cores of a CI runner: a batch is a multiple of them.
 CORES = 2
+#: Cases drawn at each later look, after the first batch: looking every 4 cases instead of
+#: every batch (14 at a target of 0.9) stops a test nearer the point where its record became
+#: clear: 27.8 instead of 30.2 cases on average at a true rate of 0.93 against 0.9, 22.4
+#: instead of 26.7 at 0.885 against 0.8, with the same power (exact sums,
+#: tests/test_rates.py); two cores still share each draw.
+STEP = 2 * CORES
 
 
 def _good_rates(target, higher_is_better, worse_by=WORSE_BY):
@@ -117,16 +124,23 @@ def look(n_good, n, target, higher_is_better=True, n_max=None):
     return "go on"
 
 
-def stopping_counts(n_max, target, higher_is_better, true_rate, batch=None):
+def draw_size(n, n_max, batch, step=STEP) -> int:
+    """Cases to draw after ``n`` drawn: the first batch, then ``step`` at a time, never past
+    ``n_max``."""
+    return min(batch if n == 0 else step, n_max - n)
+
+
+def stopping_counts(n_max, target, higher_is_better, true_rate, batch=None, step=STEP):
     """``({n: P(stop at n)}, P(fail))`` of the truncated group-sequential test when the true
     rate is ``true_rate`` (as ``target``: of successes, or of events for a ceiling), by exact
-    sums over every path of the batches (``batch`` default :func:`batch_size`)."""
+    sums over every path of the draws (a first ``batch``, default :func:`batch_size`, then
+    ``step`` at a time)."""
     batch = batch or batch_size(target, higher_is_better)
     g = true_rate if higher_is_better else 1 - true_rate
     alive = {0: 1.0}                       # good outcomes -> probability, still going on
     n, p_fail, stops = 0, 0.0, {}
     while alive:
-        m = min(batch, n_max - n)
+        m = draw_size(n, n_max, batch, step)
         nxt = {}
         for k, p in alive.items():
             for j in range(m + 1):
@@ -143,33 +157,34 @@ def stopping_counts(n_max, target, higher_is_better, true_rate, batch=None):
     return stops, p_fail
 
 
-def sequential_oc(n_max, target, higher_is_better, true_rate, batch=None):
+def sequential_oc(n_max, target, higher_is_better, true_rate, batch=None, step=STEP):
     """``(P(fail), expected number of cases)`` of the truncated group-sequential test
     (:func:`stopping_counts`)."""
-    stops, p_fail = stopping_counts(n_max, target, higher_is_better, true_rate, batch)
+    stops, p_fail = stopping_counts(n_max, target, higher_is_better, true_rate, batch, step)
     return p_fail, sum(n * p for n, p in stops.items())
 
 
-def sequential_plan(target, higher_is_better=True, batch=None, n_limit=600):
-    """Smallest ``n_max`` (a multiple of ``batch``, default :func:`batch_size`) at which the
-    sequential test fails a rate WORSE_BY worse than ``target`` with probability >= POWER."""
+def sequential_plan(target, higher_is_better=True, batch=None, step=STEP, n_limit=600):
+    """Smallest ``n_max`` (``batch``, default :func:`batch_size`, plus a multiple of
+    ``step``) at which the sequential test fails a rate WORSE_BY worse than ``target`` with
+    probability >= POWER."""
     batch = batch or batch_size(target, higher_is_better)
     worse = target - WORSE_BY if higher_is_better else target + WORSE_BY
-    for n_max in range(batch, n_limit + 1, batch):
-        if sequential_oc(n_max, target, higher_is_better, worse, batch)[0] >= POWER:
+    for n_max in range(batch, n_limit + 1, step):
+        if sequential_oc(n_max, target, higher_is_better, worse, batch, step)[0] >= POWER:
             return n_max
     raise ValueError(f"no n_max <= {n_limit} reaches power {POWER}")
 
 
-def run_sequential(rows_of, is_good, target, higher_is_better=True, batch=None):
-    """Draw batches ``rows_of(start, count)`` (a list of result rows, ``count`` at most
-    ``batch``, default :func:`batch_size`) until :func:`look` decides; returns ``(passed,
-    rows, n_good)``."""
+def run_sequential(rows_of, is_good, target, higher_is_better=True, batch=None, step=STEP):
+    """Draw ``rows_of(start, count)`` (a list of result rows: the first batch, default
+    :func:`batch_size`, then ``step`` at a time) until :func:`look` decides; returns
+    ``(passed, rows, n_good)``."""
     batch = batch or batch_size(target, higher_is_better)
-    n_max = sequential_plan(target, higher_is_better, batch)
+    n_max = sequential_plan(target, higher_is_better, batch, step)
     rows, good = [], 0
     while True:
-        new = rows_of(len(rows), min(batch, n_max - len(rows)))
+        new = rows_of(len(rows), draw_size(len(rows), n_max, batch, step))
         rows += new
         good += sum(bool(is_good(r)) for r in new)
         verdict = look(good, len(rows), target, higher_is_better, n_max)

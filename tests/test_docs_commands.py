@@ -6,7 +6,9 @@ The rules a docs author must know are in docs/extending.md, "Writing docs"; in s
 * ```bash blocks are executed, every other fence (```text for output, ```toml, ```python)
   is not; ```sh, ```shell, ```console and ```zsh are refused so that no command escapes;
   ```python blocks must compile.
-* Each doc file runs in its own empty temporary folder in which the repository's
+* README.md's commands run in the wheel test (tests/test_package.py: built, installed in a
+  fresh venv, every command in an empty folder, the same rules), not here again.
+* Each other doc file runs in its own empty temporary folder in which the repository's
   ``scripts/`` is reachable by that name (a symbolic link). A page that runs
   ``powertrain examples DIR`` makes its own copy of the shipped files, as a user after a wheel
   install does; on any other page ``examples/``, ``engines/`` and ``mounts/`` are linked too.
@@ -251,7 +253,10 @@ def output_paths(command: str) -> list:
 
 ALL_COMMANDS = {str(p.relative_to(ROOT)): commands_of(p) for p in doc_files()}
 SHOWN = {str(p.relative_to(ROOT)): shown_outputs(p) for p in doc_files()}
-RUN_FILES = [doc for doc, cmds in ALL_COMMANDS.items() if any(c.text for c in cmds)]
+#: README.md's commands run after a wheel install (tests/test_package.py), once.
+RUN_BY_WHEEL_TEST = "README.md"
+RUN_FILES = [doc for doc, cmds in ALL_COMMANDS.items()
+             if any(c.text for c in cmds) and doc != RUN_BY_WHEEL_TEST]
 SKIPPED_PARTS = [(c, part, reason) for cmds in ALL_COMMANDS.values() for c in cmds
                  for part, reason in c.skipped]
 
@@ -538,7 +543,13 @@ def test_python_examples_compile(doc):
 
 
 def test_every_doc_page_with_commands_is_collected():
-    assert "README.md" in RUN_FILES
+    """Every page with commands runs here, but README.md, whose commands the wheel test
+    runs (and checks its shown outputs) after a wheel install."""
+    import test_package
+    assert RUN_BY_WHEEL_TEST not in RUN_FILES and any(c.text for c in ALL_COMMANDS["README.md"])
+    assert "test_wheel_runs_the_readme_unchanged_in_an_empty_folder" in dir(test_package)
+    assert set(RUN_FILES) == {d for d, c in ALL_COMMANDS.items() if any(x.text for x in c)} \
+        - {"README.md"}
     assert len(RUN_FILES) >= 5, RUN_FILES
 
 

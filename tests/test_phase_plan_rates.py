@@ -5,8 +5,9 @@ never less right than its best single run, and no wrong name with engine-side ch
 two-sided plans, amplitude-dependent mounts told from a stiffer mount (named right, never
 "ambiguous").
 
-Judged by the group-sequential Wilson rule of ``tests/rates.py`` (batches of fresh cases,
-14 for a target of 0.9 and 16 for a ceiling of 0.05, until it decides; a true rate 0.1
+Judged by the group-sequential Wilson rule of ``tests/rates.py`` (a first batch of fresh
+cases, 14 for a target of 0.9 and 16 for a ceiling of 0.05, then 4 at a time until it
+decides; a true rate 0.1
 worse than the target fails with probability >= 0.8, as tests/test_diagnosis_rates.py);
 ``slow`` and ``rates``, run with the suite; the two plan tests, the longest, also
 ``long_rates`` (run first; alone: ``python -m pytest -m long_rates``). The benchmark

@@ -55,14 +55,15 @@ def test_the_old_sizes_have_no_power(n):
         assert fail < rates.POWER
 
 
-def _paths_fail_probability(n_max, target, higher, rate, batch):
-    """P(fail) of the sequential test by brute-force enumeration of batch outcomes (an
-    independent check of rates.sequential_oc): a recursion over looks."""
+def _paths_fail_probability(n_max, target, higher, rate, batch, step):
+    """P(fail) of the sequential test by brute-force enumeration of the draws' outcomes (an
+    independent check of rates.sequential_oc): a recursion over looks, the first after
+    ``batch`` cases, then every ``step``."""
     g = rate if higher else 1 - rate
 
     def go(n, good):
         total = 0.0
-        m = min(batch, n_max - n)
+        m = min(batch if n == 0 else step, n_max - n)
         for j in range(m + 1):
             p = comb(m, j) * g ** j * (1 - g) ** (m - j)
             verdict = rates.look(good + j, n + m, target, higher, n_max)
@@ -85,16 +86,16 @@ def test_sequential_test_keeps_the_power_and_size(target, higher):
     assert p_worse >= rates.POWER
     assert p_target <= 0.11
     # the smallest truncation with that power
-    assert rates.sequential_oc(n_max - rates.batch_size(target, higher), target, higher,
-                               worse)[0] < rates.POWER
+    assert rates.sequential_oc(n_max - rates.STEP, target, higher, worse)[0] < rates.POWER
 
 
 def test_sequential_oc_matches_enumeration():
-    for target, higher, rate in [(0.9, True, 0.8), (0.9, True, 0.93), (0.05, False, 0.15)]:
+    for target, higher, rate, step in [(0.9, True, 0.8, 8), (0.9, True, 0.93, 4),
+                                       (0.05, False, 0.15, 4)]:
         n_max = 32
-        exact = rates.sequential_oc(n_max, target, higher, rate, batch=8)[0]
-        assert exact == pytest.approx(_paths_fail_probability(n_max, target, higher, rate, 8),
-                                      rel=1e-12)
+        exact = rates.sequential_oc(n_max, target, higher, rate, batch=8, step=step)[0]
+        assert exact == pytest.approx(
+            _paths_fail_probability(n_max, target, higher, rate, 8, step), rel=1e-12)
 
 
 def test_sequential_run_stops_early_on_a_perfect_record():
@@ -105,6 +106,20 @@ def test_sequential_run_stops_early_on_a_perfect_record():
         return [True] * count
     passed, rows, good = rates.run_sequential(rows_of, bool, 0.9)
     assert passed and len(rows) == 14 and good == 14 and calls == [14]
+
+
+def test_after_the_first_batch_the_test_looks_every_step():
+    """One miss in the first batch: the rule goes on, drawing ``STEP`` cases at a time, and
+    passes at the first look where Wald's ratio allows (14 + 8 cases at a target of 0.9)."""
+    calls = []
+
+    def rows_of(start, count):
+        calls.append(count)
+        return [i + start != 0 for i in range(count)]
+    passed, rows, good = rates.run_sequential(rows_of, bool, 0.9)
+    assert passed and calls == [14] + [rates.STEP] * (len(calls) - 1) and len(calls) > 1
+    assert rates.look(good, len(rows), 0.9) == "pass"
+    assert rates.look(good - rates.STEP, len(rows) - rates.STEP, 0.9) == "go on"
 
 
 @pytest.mark.parametrize("target,higher,batch", [(0.9, True, 14), (0.8, True, 12),
@@ -166,21 +181,22 @@ def test_the_rate_tests_are_collected_first_and_the_long_ones_lead():
 
 
 @pytest.mark.parametrize("target, rate", [(0.9, 0.93), (0.8, 0.885), (0.9, 0.8)])
-def test_stopping_counts_are_a_distribution_on_the_batch_ends(target, rate):
+def test_stopping_counts_are_a_distribution_on_the_looks(target, rate):
     """The stopping case counts (rates.stopping_counts, behind sequential_oc and
-    scripts/ci_length.py) sum to one, fall on batch ends up to n_max, and the test's failures
+    scripts/ci_length.py) sum to one, fall on the looks (the first batch, then every
+    ``STEP`` cases, up to n_max), and the test's failures
     are those of the truncated Wilson rule or Wald's fail bound (checked by a simulation of
     the rule itself, 20000 runs, within 5 standard errors)."""
     import random
     n_max, batch = rates.sequential_plan(target), rates.batch_size(target)
     stops, p_fail = rates.stopping_counts(n_max, target, True, rate)
     assert sum(stops.values()) == pytest.approx(1.0, abs=1e-12)
-    assert set(stops) <= set(range(batch, n_max + 1, batch))
+    assert set(stops) <= set(range(batch, n_max + 1, rates.STEP)) | {n_max}
     rng, runs, fails, total_n = random.Random(), 20000, 0, 0
     for _ in range(runs):
         n = good = 0
         while True:
-            m = min(batch, n_max - n)
+            m = rates.draw_size(n, n_max, batch)
             good += sum(rng.random() < rate for _ in range(m))
             n += m
             verdict = rates.look(good, n, target, True, n_max)

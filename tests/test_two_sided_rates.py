@@ -2,15 +2,15 @@
 
 Both sides of every mount measured on the modal-body engine
 (:mod:`powertrain.validation.passive`), cases from a seed drawn from ``os.urandom``, the
-group-sequential Wilson rule of ``tests/rates.py`` (batches of the fewest cases that can pass
-at once, 14 for 0.9 and 12 for 0.8, until Wald's ratio decides, truncated where the Wilson
-rule does; a rate 0.1 worse fails with probability ≥ 0.8):
+group-sequential Wilson rule of ``tests/rates.py`` (a first batch of the fewest cases that
+can pass at once, 14 for 0.9 and 12 for 0.8, then 4 at a time until Wald's ratio decides,
+truncated where the Wilson rule does; a rate 0.1 worse fails with probability ≥ 0.8):
 
 * side attribution (body / mounts / excitation) right ≥ 0.9 on detectable body-mode,
-  mount-stiffness, balancer and missing-mode cases (at most 84 cases; the "where" step only, no fit:
+  mount-stiffness, balancer and missing-mode cases (at most 90 cases; the "where" step only, no fit:
   a few seconds each);
 * a missing body mode found, frequency within 5 % and modal mass within 30 %, in ≥ 0.8 of
-  the detectable cases, both sides' order phase measured as a lab records it (at most 132
+  the detectable cases, both sides' order phase measured as a lab records it (at most 140
   cases, full diagnoses; ``scripts/phase_plan_benchmark.py --bench missing_mode`` prints
   the rate for a fixed number of cases);
 

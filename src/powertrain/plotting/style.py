@@ -147,7 +147,7 @@ def keep_inside(fig, tries=3):
     if engine is None or "rect" not in engine.get():
         return
     for _ in range(tries):
-        fig.canvas.draw()       # the layout is computed at drawing time
+        fig.draw_without_rendering()   # the layout, computed at drawing time (no pixels)
         width, height = fig.get_figwidth(), fig.get_figheight()
         box = fig.get_tightbbox(fig.canvas.get_renderer())   # [in]
         over = np.array([-box.x0, -box.y0, box.x1 - width, box.y1 - height])
