@@ -192,6 +192,19 @@ def run_sequential(rows_of, is_good, target, higher_is_better=True, batch=None, 
             return verdict == "pass", rows, good
 
 
+def run_sequential_map(row_fn, task_of, is_good, target, higher_is_better=True):
+    """:func:`run_sequential` over rows ``row_fn(task_of(i))`` computed on every core by one
+    pool of processes kept for all the draws (:func:`powertrain.parallel.executor`): its
+    workers keep what they loaded (engines, compiled kernels) from one draw to the next,
+    where a pool per draw started them afresh each time (about a second per process)."""
+    from powertrain.parallel import executor
+    with executor(None, n_jobs=batch_size(target, higher_is_better)) as ex:
+        return run_sequential(
+            lambda start, count: list(ex.map(row_fn, [task_of(i) for i in
+                                                      range(start, start + count)])),
+            is_good, target, higher_is_better)
+
+
 # --- the diagnosis a rate test judges --------------------------------------------------------
 
 def diagnosis(measured, engine) -> dict:

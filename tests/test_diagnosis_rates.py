@@ -2,15 +2,15 @@
 
 Each test draws new cases from :mod:`powertrain.validation` (Newmark truth, its own effect
 models, scatter and noise floor) with a seed from ``os.urandom``, diagnoses them (on every
-core, :func:`powertrain.parallel.run_map`) and applies the group-sequential Wilson rule of
-``tests/rates.py``: a first batch (14 cases for a target of 0.9, 16 for a ceiling of 0.05:
-the fewest that can pass at once), then 4 at a time, until Wald's likelihood ratio between
-the target and a rate 0.1 worse decides, truncated where the Wilson rule (one-sided 95 %)
-decides; a true rate 0.1 worse than the target fails with probability >= 0.8 (exact sums,
-tests/test_rates.py). At most 90 cases (top-1, unexplained and passive side, target 0.9;
-unexplained was 0.8 before issue 21), 48 (false claims, 0.05); at a true rate of 0.95
-about 22, at 0.02 false claims about 20. The diagnoses skip the band check, which enters
-nothing the tests judge (``rates.diagnosis``).
+core, one pool of processes for all its draws: ``rates.run_sequential_map``) and applies the
+group-sequential Wilson rule of ``tests/rates.py``: a first batch (14 cases for a target of
+0.9, 16 for a ceiling of 0.05: the fewest that can pass at once), then 4 at a time, until
+Wald's likelihood ratio between the target and a rate 0.1 worse decides, truncated where the
+Wilson rule (one-sided 95 %) decides; a true rate 0.1 worse than the target fails with
+probability >= 0.8 (exact sums, tests/test_rates.py). At most 90 cases (top-1, unexplained
+and passive side, target 0.9; unexplained was 0.8 before issue 21), 48 (false claims, 0.05);
+at a true rate of 0.95 about 22, at 0.02 false claims about 20. The diagnoses skip the band
+check, which enters nothing the tests judge (``rates.diagnosis``).
 They carry the ``slow`` and ``rates`` markers and run with the suite; the passive-side test,
 the longest, also ``long_rates`` (run first; alone: ``python -m pytest -m long_rates``). The
 seeds are in the failure message; rerun one with
@@ -24,7 +24,6 @@ import numpy as np
 import pytest
 import rates
 
-from powertrain.parallel import run_map
 from powertrain.validation.cases import engines, make_case
 from powertrain.validation.kinds import IN_LIBRARY, OUT_OF_LIBRARY
 from powertrain.validation.scoring import (
@@ -92,10 +91,8 @@ def _sequential(row_fn, task_of, is_good, target, higher_is_better=True):
     """The group-sequential Wilson test of ``tests/rates.py`` over fresh draws: batches of
     ``row_fn(task_of(i, seed))`` on every core until the test decides."""
     seed = fresh_seed()
-    passed, rows, good = rates.run_sequential(
-        lambda start, count: run_map(row_fn, [task_of(i, seed) for i in
-                                              range(start, start + count)]),
-        is_good, target, higher_is_better)
+    passed, rows, good = rates.run_sequential_map(
+        row_fn, lambda i: task_of(i, seed), is_good, target, higher_is_better)
     k = good if higher_is_better else len(rows) - good
     print(f"seed {seed}: {k}/{len(rows)} (rate judged against {target}), passed={passed}")
     assert passed, _report(seed, rows, k, len(rows), "the sequential rule")

@@ -21,7 +21,6 @@ import numpy as np
 import pytest
 import rates
 
-from powertrain.parallel import run_map
 from powertrain.validation.cases import engines, make_case
 from powertrain.validation.plans import make_plan_case
 
@@ -40,10 +39,8 @@ def _seed():
 def _sequential(row_fn, is_good, target, higher_is_better=True, extra=()):
     """Rows ``row_fn((i, seed, *extra))`` in batches until the sequential rule decides."""
     seed = _seed()
-    passed, rows, good = rates.run_sequential(
-        lambda start, count: run_map(row_fn, [(i, seed, *extra)
-                                              for i in range(start, start + count)]),
-        is_good, target, higher_is_better)
+    passed, rows, good = rates.run_sequential_map(
+        row_fn, lambda i: (i, seed, *extra), is_good, target, higher_is_better)
     k = good if higher_is_better else len(rows) - good
     print(f"seed {seed}: {k}/{len(rows)} (rate judged against {target}), passed={passed}")
     assert passed, f"seed {seed}: {k}/{len(rows)} (target {target}): {rows}"

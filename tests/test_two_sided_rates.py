@@ -25,7 +25,6 @@ import numpy as np
 import pytest
 import rates
 
-from powertrain.parallel import run_map
 from powertrain.validation.cases import FLOOR
 from powertrain.validation.scoring import (
     MISSING_MODE_TARGET,
@@ -51,9 +50,8 @@ def _side_row(task):
 @pytest.mark.rates
 def test_side_attribution_on_two_sided_cases():
     seed = int.from_bytes(os.urandom(4), "little")
-    passed, rows, k = rates.run_sequential(
-        lambda start, count: run_map(_side_row, [(i, seed) for i in range(start, start + count)]),
-        lambda r: r["right"], SIDES_TARGET)
+    passed, rows, k = rates.run_sequential_map(
+        _side_row, lambda i: (i, seed), lambda r: r["right"], SIDES_TARGET)
     print(f"seed {seed}: {k}/{len(rows)} right, passed={passed}")
     assert passed, (f"seed {seed}: {k}/{len(rows)} right; misses "
                     f"{[(r['kind'], r['where'], r['seed']) for r in rows if not r['right']]}")
@@ -78,9 +76,8 @@ def _mode_row(task):
 @pytest.mark.long_rates
 def test_missing_body_mode_is_found():
     seed = int.from_bytes(os.urandom(4), "little")
-    passed, rows, k = rates.run_sequential(
-        lambda start, count: run_map(_mode_row, [(i, seed) for i in range(start, start + count)]),
-        mode_found, MISSING_MODE_TARGET)
+    passed, rows, k = rates.run_sequential_map(
+        _mode_row, lambda i: (i, seed), mode_found, MISSING_MODE_TARGET)
     print(f"seed {seed}: {k}/{len(rows)} found, passed={passed}")
     assert passed, (f"seed {seed}: {k}/{len(rows)} found; misses "
                     f"{[(r['verdict'], r['seed']) for r in rows if not mode_found(r)]}")
