@@ -2,8 +2,9 @@
 text is at least 8 pt when printed at the report's page width, no legend covers data, and
 every coloured line or area is drawn from the colour-blind-safe palette.
 
-The figure is drawn once with matplotlib's Agg renderer while every :class:`~matplotlib.text.Text`
-draw call is recorded, so exactly the text that appears in the PNG is checked — titles, axis
+The figure is drawn once at its dpi (matplotlib's ``draw_without_rendering``: the Agg draw's
+layout and text extents, no pixels) while every :class:`~matplotlib.text.Text` draw call is
+recorded, so exactly the text that appears in the PNG is checked — titles, axis
 labels, tick labels (only the ticks inside the view), legend entries and titles, colour-bar
 labels, annotations and the provenance line — each by its renderer bounding box.
 
@@ -44,9 +45,11 @@ def recording_texts():
 
 
 def drawn_texts(fig):
-    """(Text, Bbox in display pixels) of every text drawn when ``fig`` is rendered."""
+    """(Text, Bbox in display pixels) of every text drawn when ``fig`` is rendered: the
+    figure is drawn at its dpi without pixels (``draw_without_rendering``: the same layout
+    and text extents as the Agg draw, whose pixels no check reads)."""
     with recording_texts() as drawn:
-        fig.canvas.draw()
+        fig.draw_without_rendering()
     return drawn
 
 

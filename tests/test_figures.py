@@ -19,6 +19,7 @@ from click.testing import CliRunner
 from figure_text import (
     TOLERANCE_PX,
     check_boxes,
+    drawn_texts,
     legends_over_data,
     off_palette_colours,
     outside_problems,
@@ -154,7 +155,7 @@ def test_compare_figure_marks_measured_not_modelled_points():
                for e in comp.not_modelled}
     assert set(per_key) == {("left", "z", "order_4"), ("right", "x", "order_6")}
     fig = comp.plot()
-    fig.canvas.draw()
+    fig.draw_without_rendering()             # the layout, as drawn
     marked = [ln for a in fig.axes for ln in a.get_lines()
               if ln.get_label() == "measured, not modelled"]
     assert sorted(len(ln.get_xdata()) for ln in marked) == sorted(per_key.values())
@@ -207,7 +208,7 @@ def test_compare_figure_phase_panels_exactly_where_both_sides_give_phase(phased)
     sim = _with_phases(meas, keys, 20.0)
     meas = _with_phases(meas, [] if phased == "one side" else keys, 0.0)
     fig = compare_runup(sim, meas).plot()
-    fig.canvas.draw()
+    drawn = drawn_texts(fig)          # lays the figure out and records its texts, once
     shown = _phase_axes(fig)
     expected = 0 if phased == "one side" else len(keys)
     assert len(shown) == expected
@@ -217,8 +218,8 @@ def test_compare_figure_phase_panels_exactly_where_both_sides_give_phase(phased)
         assert {ln.get_label() for ln in a.get_lines()} == {"measured", "simulated"}
     assert fig.get_figwidth() == pytest.approx(PRINT_WIDTH_IN)
     assert fig.get_figheight() <= MAX_HEIGHT_IN + 1e-9
-    problems = (text_problems(fig) + small_texts(__import__("figure_text").drawn_texts(fig),
-                                                 fig.get_figwidth())
+    problems = (check_boxes(drawn, fig.bbox.width, fig.bbox.height)
+                + small_texts(drawn, fig.get_figwidth())
                 + legends_over_data(fig) + off_palette_colours(fig))
     assert not problems, "\n".join(problems[:10])
     plt.close(fig)
@@ -405,8 +406,8 @@ def test_track_plot_draws_every_requested_order(spec, expected):
     rec = signals.analytic_sweep(duration=3.0, rpm0=1500.0, rpm1=3500.0)
     tracked = track_recording(rec, parse_orders(spec), rpm_step=100.0, progress=False)
     fig = tracked.plot()
-    fig.canvas.draw()
-    assert not outside_problems(fig), outside_problems(fig)
+    outside = outside_problems(fig)          # draws the figure (layout, texts)
+    assert not outside, outside
     assert set(expected + ["synthesis"]) <= _drawn_labels(fig)
     for ax in fig.axes:          # at most the documented dynamic range, plain tick labels
         lo, hi = ax.get_ylim()
