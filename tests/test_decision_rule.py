@@ -312,25 +312,6 @@ def test_evaluation_budget_stops_a_fit_and_says_so():
     assert full.heldout_mse < small.heldout_mse
 
 
-def test_an_effects_own_budget_caps_its_fits(monkeypatch):
-    """An effect's ``fit_budget`` below the diagnosis's caps each of its fits (the missing
-    body mode's 1200: a fit standing in for another effect otherwise crawls to 2500); a
-    smaller budget asked for by the caller still holds."""
-    from powertrain.diagnosis.data import split_rpm
-    from powertrain.diagnosis.fit import EVAL_BUDGET, Problem, fit_candidate
-    from powertrain.effects import EFFECTS
-    assert EFFECTS["missing_body_mode"].fit_budget == 1200 < EVAL_BUDGET
-    assert all(e.fit_budget is None or e.fit_budget < EVAL_BUDGET for e in EFFECTS.values())
-    rpm = np.arange(1000.0, 6000.1, 250.0)
-    hm, data = _balancer_data(rpm, {"gain": 0.6, "lag": 0.2})
-    tr, te = split_rpm(rpm)
-    prob = Problem(hm.subset(tr), hm.subset(te), data, tr, te)
-    monkeypatch.setattr(type(EFFECTS["balancer_error"]), "fit_budget", 8)
-    capped = fit_candidate(prob, ("balancer_error",))
-    assert capped.budget_hit and capped.n_eval <= 8
-    assert fit_candidate(prob, ("balancer_error",), budget=4).n_eval <= 4
-
-
 def test_improvement_t_is_a_relative_improvement():
     """Per-speed log ratios: an improvement by the same factor at every speed has no scatter
     (unbounded t) however much the gap varies along the run-up, while a difference of the

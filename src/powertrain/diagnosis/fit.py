@@ -5,8 +5,7 @@ Each candidate (one effect of the registry, or a pair) is fitted on the training
 bounded least squares in dB (``scipy.optimize.least_squares``, trust region reflective,
 multi-start: the defaults, given starts and, for single effects that declare one, the two
 best points of a coarse grid) and scored on the held-out speeds. Every fit has an
-evaluation budget (:data:`EVAL_BUDGET` residual evaluations, Jacobian columns included, or the
-effect's smaller ``fit_budget``):
+evaluation budget (:data:`EVAL_BUDGET` residual evaluations, Jacobian columns included):
 when it is hit the best point so far is kept and the outcome says so (``budget_hit``).
 
 Parameters with a prior (``Parameter.prior_sd``) add the residual
@@ -269,8 +268,6 @@ def fit_candidate(problem: Problem, effects, starts=None, grid=True,
     (a refit from a known optimum: the checks, the band check, the pairs)."""
     t0 = time.perf_counter()
     problem.reset_warm()
-    budget = min([budget] + [EFFECTS[e].fit_budget for e in effects
-                             if EFFECTS[e].fit_budget is not None])
     pack = Packing.of(effects, problem.engine)
     fun = Counted(problem, pack, budget)
     try:

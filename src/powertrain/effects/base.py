@@ -75,9 +75,6 @@ class Effect:
     #: Side attributions (``location`` of :func:`powertrain.diagnosis.sides.side_attribution`)
     #: at which the effect is a candidate; None: at any (also without body-side data).
     locations = None
-    #: Evaluation budget of a fit of this effect, when below the diagnosis's own
-    #: (:data:`powertrain.diagnosis.fit.EVAL_BUDGET`); None: the diagnosis's.
-    fit_budget = None
 
     # ------------------------------------------------------------------ description
     def parameters(self, engine=None) -> tuple:

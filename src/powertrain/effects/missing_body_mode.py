@@ -123,11 +123,6 @@ class MissingBodyMode(Effect):
     #: its 12-parameter fit is the slowest of the library (31-74 CPU-s a diagnosis when it
     #: ran on every modal-body engine)
     locations = ("body",)
-    #: a fit of a mode that is missing converges within a few hundred evaluations (at most
-    #: 776 in 24 fits of fresh missing-mode cases); one standing in for another effect (a
-    #: moved file mode, a stiffer mount) crawls on to the diagnosis's 2500, gaining 1-3 % of
-    #: its cost past 1200 at 40 % of a passive-side diagnosis's time
-    fit_budget = 1200
     description = ("one body mode the body model lacks: frequency, modal mass, damping and "
                    "its shape at each mount base (normalised to its largest component)")
 
