@@ -53,9 +53,11 @@ def drawn_texts(fig):
     return drawn
 
 
-def text_problems(fig, tol=TOLERANCE_PX) -> list[str]:
-    """Descriptions of overlapping texts and texts outside the figure (empty list: fine)."""
-    return check_boxes(drawn_texts(fig), fig.bbox.width, fig.bbox.height, tol)
+def text_problems(fig, tol=TOLERANCE_PX, drawn=None) -> list[str]:
+    """Descriptions of overlapping texts and texts outside the figure (empty list: fine);
+    ``drawn``: the figure's :func:`drawn_texts` if already recorded."""
+    drawn = drawn_texts(fig) if drawn is None else drawn
+    return check_boxes(drawn, fig.bbox.width, fig.bbox.height, tol)
 
 
 def texts_outside(drawn, width, height, tol=TOLERANCE_PX) -> list[str]:

@@ -218,8 +218,7 @@ def test_compare_figure_phase_panels_exactly_where_both_sides_give_phase(phased)
         assert {ln.get_label() for ln in a.get_lines()} == {"measured", "simulated"}
     assert fig.get_figwidth() == pytest.approx(PRINT_WIDTH_IN)
     assert fig.get_figheight() <= MAX_HEIGHT_IN + 1e-9
-    problems = (check_boxes(drawn, fig.bbox.width, fig.bbox.height)
-                + small_texts(drawn, fig.get_figwidth())
+    problems = (text_problems(fig, drawn=drawn) + small_texts(drawn, fig.get_figwidth())
                 + legends_over_data(fig) + off_palette_colours(fig))
     assert not problems, "\n".join(problems[:10])
     plt.close(fig)
