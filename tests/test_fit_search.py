@@ -26,8 +26,12 @@ class _Problem:
         return np.array([np.sqrt(2.0 * next(self.costs))])
 
 
+#: One physical parameter (the fakes' packing).
+_NAMES = [("mount_stiffness", "k")]
+
+
 def _counted(costs, budget=10_000):
-    pack = SimpleNamespace(n_prior=0, scenario=lambda x: {}, x0=np.zeros(1))
+    pack = SimpleNamespace(n_prior=0, scenario=lambda x: {}, x0=np.zeros(1), names=_NAMES)
     return search.Counted(_Problem(costs), pack, budget)
 
 
@@ -58,7 +62,7 @@ def test_a_stalled_search_hands_back_its_best_point():
     on the stall, long before the budget or its iteration limit, and hands back None (the
     caller takes ``fun.best``, the lowest point seen)."""
     n_max = 10_000
-    pack = SimpleNamespace(n_prior=0, scenario=lambda x: {}, x0=np.zeros(1),
+    pack = SimpleNamespace(n_prior=0, scenario=lambda x: {}, x0=np.zeros(1), names=_NAMES,
                            lower=np.array([0.0]), upper=np.array([1.0]))
     fun = search.Counted(_Problem(1000.0 * (1 - 1e-6) ** np.arange(n_max)), pack, n_max)
     res, _, hit = search.trust_region(fun, pack, [np.array([0.5])])
@@ -121,7 +125,8 @@ def test_a_refit_that_starts_without_a_steady_state_is_a_bad_point_not_a_crash()
                 raise FloatingPointError("left.z at 1000 rpm: did not converge")
             return np.zeros(5)
 
-    pack = SimpleNamespace(n_prior=0, scenario=lambda x: {"x": float(x[0])}, x0=np.zeros(1))
+    pack = SimpleNamespace(n_prior=0, scenario=lambda x: {"x": float(x[0])}, x0=np.zeros(1),
+                           names=_NAMES)
     fun = search.Counted(NoSteadyState(), pack, 100)
     r = fun(np.array([0.7]))
     assert r.shape == (5,) and np.all(r == search.NO_STEADY_STATE_RESIDUAL)

@@ -13,6 +13,7 @@ import numpy as np
 import pytest
 
 from powertrain.analysis.orders import order_label
+from powertrain.diagnosis import fit, search
 from powertrain.diagnosis.checks import ORDER_FOLDS, order_folds
 from powertrain.diagnosis.core import _Setup
 from powertrain.diagnosis.fit import fit_candidate
@@ -103,3 +104,59 @@ def test_a_refit_starts_from_its_given_optimum_only():
     assert len(both) == 2 and np.allclose(both[0], np.clip(pack.x0, pack.lower, pack.upper))
     fallback = start_points(None, pack, ("balancer_error",), None, False, None, defaults=False)
     assert len(fallback) == 1
+
+
+def test_readings_at_once_equal_each_reading_alone():
+    """A Jacobian's sensor columns are read at once (:meth:`Effect.readings`): each reading
+    is bit for bit the one of its parameters alone, vectorised or not."""
+    rng = np.random.default_rng(3)
+    v = rng.normal(size=(12, 9, 16)) + 1j * rng.normal(size=(12, 9, 16))
+    params = [{}, {"g2": 1.5}, {"r1z": 0.04, "r3x": -0.1}, {"s2xy": 0.03, "g9": -2.0}]
+    for name in ("sensor_error", "balancer_error"):
+        eff = EFFECTS[name]
+        batch = eff.readings(np.broadcast_to(v, (len(params),) + v.shape), params)
+        for b, p in enumerate(params):
+            assert np.array_equal(batch[b], eff.reading(v, p if eff.response_only else {}))
+
+
+@pytest.mark.parametrize("effects, budget", [
+    (("sensor_error",), fit.EVAL_BUDGET),
+    (("mount_stiffness", "sensor_error"), fit.EVAL_BUDGET),
+    (("sensor_error",), 700),                  # the budget runs out inside a Jacobian
+])
+def test_sensor_columns_read_at_once_fit_as_scipys_own_differences(engine, monkeypatch,
+                                                                   effects, budget):
+    """The trust region's Jacobian with its sensor columns read at once
+    (:class:`search.Differences`) is SciPy's ``jac="2-point"``: the same parameters,
+    evaluations, budget and best point, bit for bit; and it did read columns at once."""
+    s = _setup(engine, {"g2": 2.0, "r1z": 0.05})
+    read = []
+    real = fit.Problem.read_vectors
+    monkeypatch.setattr(fit.Problem, "read_vectors",
+                        lambda self, scs: read.append(len(scs)) or real(self, scs))
+    at_once = fit_candidate(s.problem, effects, budget=budget)
+    assert search.Differences.available() and sum(read) > 10
+    monkeypatch.setattr(search.Differences, "available", staticmethod(lambda: False))
+    one_by_one = fit_candidate(s.problem, effects, budget=budget)
+    for key in ("params", "nfev", "n_eval", "rss_train", "budget_hit", "heldout_mse"):
+        assert getattr(at_once, key) == getattr(one_by_one, key), key
+    assert np.array_equal(at_once.x, one_by_one.x)
+    assert at_once.budget_hit == (budget < fit.EVAL_BUDGET)
+
+
+def test_a_plans_sensor_columns_read_at_once_are_its_runs_vectors(engine):
+    """:meth:`JointProblem.read_vectors` (a plan's fit): each run's cached velocities read,
+    joined as :meth:`JointProblem.vector` joins them; None while one run's cache holds
+    another physical part (the point is then evaluated alone)."""
+    from powertrain.diagnosis.plan import JointProblem, stacked
+    runs = [_setup(engine, {"g2": 2.0}, seed=s) for s in (1, 2)]
+    joint = JointProblem([r.problem for r in runs], stacked([r.data for r in runs]))
+    base = {"mount_stiffness": {"k1": 1.1}, "sensor_error": {"g1": 0.5}}
+    cols = [{**base, "sensor_error": {"g1": 0.5, "g4": 1.0}},
+            {**base, "sensor_error": {"g1": 0.5, "r2x": 0.02}}]
+    joint.vector(base)
+    at_once = joint.read_vectors(cols)
+    for got, sc in zip(at_once, cols):
+        assert np.array_equal(got, joint.vector(sc))
+    runs[1].problem.vector({"mount_stiffness": {"k1": 1.3}})
+    assert joint.read_vectors(cols) is None

@@ -95,6 +95,13 @@ class FitOutcome:
         return "+".join(self.effects)
 
 
+def _physical(scenario) -> tuple:
+    """``(physical part, its key)`` of a scenario: the effects that are not response-only
+    (solved once per distinct value, :meth:`Problem.velocity`)."""
+    phys = {k: v for k, v in scenario.items() if not EFFECTS[k].response_only}
+    return phys, repr(sorted((k, sorted(v.items())) for k, v in phys.items()))
+
+
 class Problem:
     """Residual functions on the training and held-out speeds.
 
@@ -179,8 +186,7 @@ class Problem:
         """Complex model velocities of the measured orders (n_r, n_ch, 16) [m/s peak]."""
         # the physical part of the scenario is solved once per distinct value: a sensor
         # error only re-reads the same velocities (cheap finite-difference columns)
-        phys = {k: v for k, v in scenario.items() if not EFFECTS[k].response_only}
-        key = repr(sorted((k, sorted(v.items())) for k, v in phys.items()))
+        phys, key = _physical(scenario)
         last = self._last.get(part)
         if last is not None and last[0] == key:
             vel = last[1]
@@ -251,8 +257,29 @@ class Problem:
         the crank offset's prior."""
         vel = self.velocity(scenario, part)
         g = self._scored[part](np.take(vel, self._level_at[part]))
+        return g if self.phase_w is None else self._with_phase(g, vel, scenario, part)
+
+    def read_vectors(self, scenarios) -> list | None:
+        """:meth:`vector` on the training speeds of each of ``scenarios``, which differ
+        from one another in response-only effects only (a Jacobian's sensor columns): the
+        cached velocities of their physical part read at once (:meth:`Effect.readings
+        <powertrain.effects.base.Effect.readings>`); the same values, no solve. None when the
+        cache holds another physical part (:meth:`vector` then solves it)."""
+        last = self._last.get("train")
+        if last is None or last[0] != _physical(scenarios[0])[1]:
+            return None
+        vel = np.broadcast_to(last[1], (len(scenarios),) + last[1].shape)
+        for k in scenarios[0]:
+            if EFFECTS[k].response_only:
+                vel = EFFECTS[k].readings(vel, [sc[k] for sc in scenarios])
+        at = self._level_at["train"]
+        g = self._scored["train"](np.take(vel.reshape(len(scenarios), -1), at, axis=1))
         if self.phase_w is None:
-            return g
+            return list(g)
+        return [self._with_phase(gi, v, sc, "train") for gi, v, sc in zip(g, vel, scenarios)]
+
+    def _with_phase(self, g, vel, scenario, part):
+        """The level gaps ``g`` followed by the phase gaps and the crank offset's prior."""
         d = self._phase_diff(vel, part)
         delta = self._offset(d) if part == "train" else self.crank_offset(scenario)
         gp = self._w_on[part] * ph.wrap(d - self._order_on[part] * delta)

@@ -97,6 +97,14 @@ class JointProblem:
     def vector(self, scenario, part="train"):
         return np.concatenate([p.vector(scenario, part) for p in self.runs])
 
+    def read_vectors(self, scenarios) -> list | None:
+        """The runs' :meth:`Problem.read_vectors` joined (None if a run's cache holds
+        another physical part)."""
+        parts = [p.read_vectors(scenarios) for p in self.runs]
+        if any(v is None for v in parts):
+            return None
+        return [np.concatenate(vs) for vs in zip(*parts)]
+
     def crank_offsets(self, scenario) -> list:
         """Each run's crank-angle offset [rad] (None where the run has no phase)."""
         return [p.crank_offsets(scenario)[0] for p in self.runs]

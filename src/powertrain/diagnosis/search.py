@@ -1,13 +1,17 @@
 """The trust-region search of a candidate fit (:func:`powertrain.diagnosis.fit.fit_candidate`):
 the residual function with its evaluation count, budget, best point and stall watch, the
-multi-start over the start points, and the Jacobian of a point the search did not finish.
+forward-difference Jacobian the search asks for (SciPy's, its sensor columns read at once),
+the multi-start over the start points, and the Jacobian of a point the search did not finish.
 """
 
 from __future__ import annotations
 
+import inspect
 import warnings
 
 import numpy as np
+
+from powertrain.effects import EFFECTS
 
 #: Residual of every point where a trial parameter set has no steady state.
 NO_STEADY_STATE_RESIDUAL = 1e3
@@ -18,6 +22,8 @@ NO_STEADY_STATE_RESIDUAL = 1e3
 #: moves the BIC by about 0.2 per 1000 residuals, far below the decision's margin of 10.
 STALL_REL = 2e-4
 STALL_STEPS = 20
+#: Relative step of the forward-difference Jacobian columns.
+DIFF_STEP = 1e-4
 
 
 class Exhausted(Exception):
@@ -36,7 +42,9 @@ class Counted:
         self.problem, self.pack, self.budget = problem, pack, budget
         self.n = 0.0
         self.best = (np.inf, None, None)
+        self.last = (None, None)
         self._stall = None
+        self._response_only = np.array([EFFECTS[e].response_only for e, _ in pack.names])
         self.has_prior = pack.n_prior > 0
         if self.has_prior:
             self.prior_on = np.isfinite(pack.prior_sd)
@@ -91,12 +99,79 @@ class Counted:
             raise _Stalled
 
     def __call__(self, x):
-        r = self.evaluate(self.problem, x)
+        return self._seen(x, self.evaluate(self.problem, x))
+
+    def _seen(self, x, r):
+        """Keep ``r`` (the residuals at ``x``) as the best point if it is, watch the stall,
+        remember it as the last point (the Jacobian's ``f0``)."""
         c = 0.5 * float(np.sum(r ** 2))
         if c < self.best[0]:
             self.best = (c, np.array(x, float), r)
         self._check_stall(c)
+        self.last = (np.array(x, float), r)
         return r
+
+    def columns(self, x0, xs) -> list:
+        """The residuals at each of ``xs`` (the points of a forward-difference Jacobian at
+        ``x0``, in order), charged, kept and watched as by calling this one point after
+        another; runs of points that move response-only parameters of ``x0`` only are read
+        at once (:meth:`Problem.read_vectors
+        <powertrain.diagnosis.fit.Problem.read_vectors>`: the same values)."""
+        out, run = [], []
+        for x in xs:
+            moved = np.flatnonzero(x != x0)
+            if moved.size and np.all(self._response_only[moved]):
+                run.append(x)
+                continue
+            out += self._read(run)
+            run = []
+            out.append(self(x))
+        return out + self._read(run)
+
+    def _read(self, run) -> list:
+        """The residuals of the points ``run`` (see :meth:`columns`), read at once from the
+        cached velocities of their physical part; while the cache holds another, the next
+        point is evaluated alone (it solves that part)."""
+        out, scenarios = [], [self.pack.scenario(x) for x in run]
+        while run:
+            vs = self.problem.read_vectors(scenarios)
+            if vs is None:
+                out.append(self(run[0]))
+                run, scenarios = run[1:], scenarios[1:]
+                continue
+            for x, v in zip(run, vs):
+                if self.n >= self.budget:
+                    raise Exhausted
+                self.n += 1
+                out.append(self._seen(x, np.concatenate([v, self.prior(x)])))
+            break
+        return out
+
+
+class Differences:
+    """The Jacobian the trust region asks for: SciPy's own forward differences (its steps,
+    ``rel_step`` :data:`DIFF_STEP`, one-sided within the bounds; ``f0`` the residuals the
+    search has just computed at that point) with the points evaluated by
+    :meth:`Counted.columns`, so that a fit's sensor columns are read at once. The same
+    Jacobian, evaluation count, best point and stall as ``jac="2-point"``."""
+
+    def __init__(self, fun, pack):
+        self.fun, self.bounds = fun, (pack.lower, pack.upper)
+
+    @staticmethod
+    def available() -> bool:
+        """SciPy's forward differences take a map (``workers``, SciPy >= 1.16)."""
+        from scipy.optimize._numdiff import approx_derivative
+        return "workers" in inspect.signature(approx_derivative).parameters
+
+    def __call__(self, x):
+        from scipy.optimize._numdiff import approx_derivative
+        last_x, f0 = self.fun.last
+        if last_x is None or not np.array_equal(last_x, x):
+            f0 = self.fun(x)               # as "2-point" without f0: evaluated first
+        return approx_derivative(self.fun, x, method="2-point", rel_step=DIFF_STEP, f0=f0,
+                                 bounds=self.bounds,
+                                 workers=lambda _, xs: self.fun.columns(x, list(xs)))
 
 
 def trust_region(fun, pack, cands):
@@ -106,14 +181,15 @@ def trust_region(fun, pack, cands):
     from scipy.optimize import least_squares
     span = pack.upper - pack.lower
     best, nfev, stalled = None, 0, False
+    jac = Differences(fun, pack) if Differences.available() else "2-point"
     for x_start in cands:
         fun.watch(len(x_start))
         try:
             with warnings.catch_warnings():
                 warnings.simplefilter("ignore")
-                res = least_squares(fun, x_start, bounds=(pack.lower, pack.upper),
+                res = least_squares(fun, x_start, jac=jac, bounds=(pack.lower, pack.upper),
                                     x_scale=np.maximum(span / 8, 1e-3), method="trf",
-                                    max_nfev=60 * len(x_start), diff_step=1e-4)
+                                    max_nfev=60 * len(x_start), diff_step=DIFF_STEP)
         except Exhausted:
             return None, nfev, True
         except _Stalled:                   # its best point is in fun.best if best of all

@@ -177,6 +177,12 @@ class Effect:
         """What the sensors read from the channel velocities (n_r, n_ch, n_h)."""
         return velocity
 
+    def readings(self, velocities, params):
+        """:meth:`reading` of each of ``velocities`` (n_b, n_r, n_ch, n_h) with the parameter
+        dict of the same index in ``params``, stacked: a finite-difference Jacobian's columns
+        read at once (a response-only effect vectorises it; the same values)."""
+        return np.stack([self.reading(v, p) for v, p in zip(velocities, params)])
+
     def summary(self, params) -> str:
         """The fitted effect in one phrase for the report ('' : none)."""
         return ""

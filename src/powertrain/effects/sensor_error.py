@@ -58,37 +58,49 @@ def sensor_reading(velocity, gain_db, rotation, cross_axis=None):
 
     Parameters
     ----------
-    velocity : ndarray (n_r, 3 n_m, n_h) complex
+    velocity : ndarray (..., n_r, 3 n_m, n_h) complex
         True mount-point velocities, triads mount-major x, y, z.
-    gain_db : ndarray (3 n_m,)
+    gain_db : ndarray (..., 3 n_m)
         Channel gain errors [dB].
-    rotation : ndarray (n_m, 3)
+    rotation : ndarray (..., n_m, 3)
         Rotation vector of each triad [rad].
-    cross_axis : ndarray (n_m, 3), optional
+    cross_axis : ndarray (..., n_m, 3), optional
         Cross-axis sensitivities (xy, xz, yz) of each triad [1] (default none).
+
+    Leading axes (``...``, e.g. a Jacobian's columns) broadcast: each reading is the same
+    as that of its parameters alone.
     """
     v = np.asarray(velocity)
-    n_m = v.shape[1] // 3
-    T = rotation_matrices(np.reshape(rotation, (n_m, 3)))
+    gain_db = np.asarray(gain_db, float)
+    lead, n_m = gain_db.shape[:-1], v.shape[-2] // 3
+    T = rotation_matrices(np.reshape(rotation, (-1, 3))).reshape(lead + (n_m, 3, 3))
     if cross_axis is not None:
-        S = np.zeros((n_m, 3, 3))
-        for (i, j), s in zip(((0, 1), (0, 2), (1, 2)), np.asarray(cross_axis, float).T):
-            S[:, i, j] = S[:, j, i] = s
+        S = np.zeros(lead + (n_m, 3, 3))
+        cross = np.asarray(cross_axis, float)
+        for k, (i, j) in enumerate(((0, 1), (0, 2), (1, 2))):
+            S[..., i, j] = S[..., j, i] = cross[..., k]
         T = T + S
-    out = T @ v.reshape(v.shape[0], n_m, 3, -1)
-    return out.reshape(v.shape) * 10.0 ** (np.asarray(gain_db, float) / 20.0)[None, :, None]
+    T = T[..., None, :, :, :]                               # over the speeds
+    out = T @ v.reshape(v.shape[:-2] + (n_m, 3, v.shape[-1]))
+    out = out.reshape(out.shape[:-3] + v.shape[-2:])
+    return out * 10.0 ** (gain_db / 20.0)[..., None, :, None]
 
 
-def apply_sensor_error(velocity, params: dict):
-    """:func:`sensor_reading` with the parameters ``g<c>`` [dB], ``r<m><axis>`` [rad] and
-    ``s<m><axes>`` [1] (missing ones 0)."""
-    n_ch = velocity.shape[1]
+def _sensor_arrays(params: dict, n_ch: int):
+    """``(gains (3 n_m,), rotations (n_m, 3), cross-axis (n_m, 3))`` of a parameter dict
+    (missing ones 0)."""
     gains = np.array([params.get(f"g{c + 1}", 0.0) for c in range(n_ch)])
     rot = np.array([[params.get(f"r{m + 1}{ax}", 0.0) for ax in "xyz"]
                     for m in range(n_ch // 3)])
     cross = np.array([[params.get(f"s{m + 1}{ax}", 0.0) for ax in CROSS_AXES]
                       for m in range(n_ch // 3)])
-    return sensor_reading(velocity, gains, rot, cross)
+    return gains, rot, cross
+
+
+def apply_sensor_error(velocity, params: dict):
+    """:func:`sensor_reading` with the parameters ``g<c>`` [dB], ``r<m><axis>`` [rad] and
+    ``s<m><axes>`` [1] (missing ones 0)."""
+    return sensor_reading(velocity, *_sensor_arrays(params, velocity.shape[1]))
 
 
 class SensorError(Effect):
@@ -132,3 +144,7 @@ class SensorError(Effect):
 
     def reading(self, velocity, p):
         return apply_sensor_error(velocity, p)
+
+    def readings(self, velocities, params):
+        arrays = [_sensor_arrays(p, velocities.shape[-2]) for p in params]
+        return sensor_reading(velocities, *(np.stack(a) for a in zip(*arrays)))
