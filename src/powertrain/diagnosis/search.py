@@ -111,58 +111,71 @@ class Counted:
         self.last = (np.array(x, float), r)
         return r
 
-    def columns(self, x0, xs) -> list:
+    def columns(self, x0, xs, problem=None) -> list:
         """The residuals at each of ``xs`` (the points of a forward-difference Jacobian at
         ``x0``, in order), charged, kept and watched as by calling this one point after
         another; runs of points that move response-only parameters of ``x0`` only are read
         at once (:meth:`Problem.read_vectors
-        <powertrain.diagnosis.fit.Problem.read_vectors>`: the same values)."""
+        <powertrain.diagnosis.fit.Problem.read_vectors>`: the same values). ``problem``:
+        another than the fit's (a block start's channels), its points only charged, as by
+        :meth:`evaluate`."""
+        keep = problem is None
+        problem = self.problem if keep else problem
         out, run = [], []
         for x in xs:
             moved = np.flatnonzero(x != x0)
             if moved.size and np.all(self._response_only[moved]):
                 run.append(x)
                 continue
-            out += self._read(run)
+            out += self._read(problem, run, keep)
             run = []
-            out.append(self(x))
-        return out + self._read(run)
+            out.append(self._point(problem, x, keep))
+        return out + self._read(problem, run, keep)
 
-    def _read(self, run) -> list:
+    def _point(self, problem, x, keep):
+        r = self.evaluate(problem, x)
+        return self._seen(x, r) if keep else r
+
+    def _read(self, problem, run, keep) -> list:
         """The residuals of the points ``run`` (see :meth:`columns`), read at once from the
         cached velocities of their physical part; while the cache holds another, the next
         point is evaluated alone (it solves that part)."""
         out, scenarios = [], [self.pack.scenario(x) for x in run]
         while run:
-            vs = self.problem.read_vectors(scenarios)
+            vs = problem.read_vectors(scenarios)
             if vs is None:
-                out.append(self(run[0]))
+                out.append(self._point(problem, run[0], keep))
                 run, scenarios = run[1:], scenarios[1:]
                 continue
             for x, v in zip(run, vs):
                 if self.n >= self.budget:
                     raise Exhausted
                 self.n += 1
-                out.append(self._seen(x, np.concatenate([v, self.prior(x)])))
+                r = np.concatenate([v, self.prior(x)])
+                out.append(self._seen(x, r) if keep else r)
             break
         return out
 
 
 class Differences:
-    """The Jacobian the trust region asks for: SciPy's own forward differences (its steps,
-    ``rel_step`` :data:`DIFF_STEP`, one-sided within the bounds; ``f0`` the residuals the
-    search has just computed at that point) with the points evaluated by
-    :meth:`Counted.columns`, so that a fit's sensor columns are read at once. The same
-    Jacobian, evaluation count, best point and stall as ``jac="2-point"``."""
+    """The Jacobian a trust region asks for: SciPy's own forward differences (its steps,
+    ``rel_step`` :data:`DIFF_STEP`, one-sided within the bounds ``lower``, ``upper``;
+    ``f0`` the residuals the search has just computed at that point, ``fun.last``) with the
+    points evaluated by ``fun.columns`` (:meth:`Counted.columns`), so that a fit's sensor
+    columns are read at once. The same Jacobian, evaluation count, best point and stall as
+    ``jac="2-point"``."""
 
-    def __init__(self, fun, pack):
-        self.fun, self.bounds = fun, (pack.lower, pack.upper)
+    def __init__(self, fun, lower, upper):
+        self.fun, self.bounds = fun, (lower, upper)
 
-    @staticmethod
-    def available() -> bool:
-        """SciPy's forward differences take a map (``workers``, SciPy >= 1.16)."""
+    @classmethod
+    def or_two_point(cls, fun, lower, upper):
+        """A :class:`Differences`, or ``"2-point"`` where SciPy's forward differences take
+        no map (``workers``, SciPy < 1.16): the same Jacobian, point by point."""
         from scipy.optimize._numdiff import approx_derivative
-        return "workers" in inspect.signature(approx_derivative).parameters
+        if "workers" not in inspect.signature(approx_derivative).parameters:
+            return "2-point"
+        return cls(fun, lower, upper)
 
     def __call__(self, x):
         from scipy.optimize._numdiff import approx_derivative
@@ -181,7 +194,7 @@ def trust_region(fun, pack, cands):
     from scipy.optimize import least_squares
     span = pack.upper - pack.lower
     best, nfev, stalled = None, 0, False
-    jac = Differences(fun, pack) if Differences.available() else "2-point"
+    jac = Differences.or_two_point(fun, pack.lower, pack.upper)
     for x_start in cands:
         fun.watch(len(x_start))
         try:

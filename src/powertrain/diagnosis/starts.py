@@ -15,6 +15,7 @@ import warnings
 import numpy as np
 
 from powertrain.analysis.noise_floor import above_floor
+from powertrain.diagnosis.search import DIFF_STEP, Differences
 from powertrain.effects import EFFECTS
 
 #: Starts of a block refined after screening (block-wise multi-start).
@@ -151,14 +152,36 @@ def _projected(fun, sub, pack, effect, x, idx, start, chans):
     return float(np.sum(r ** 2)), xs
 
 
+class _BlockResiduals:
+    """The residuals of a block start's channels ``sub`` as a function of the block's
+    parameters ``idx`` (the others at ``x``), charged to the fit's budget (``fun``,
+    :class:`~powertrain.diagnosis.search.Counted`); ``last`` and :meth:`columns` for the
+    Jacobian (:class:`~powertrain.diagnosis.search.Differences`)."""
+
+    def __init__(self, fun, sub, x, idx):
+        self.fun, self.sub, self.x, self.idx = fun, sub, x, idx
+        self.last = (None, None)
+
+    def _full(self, v):
+        xx = self.x.copy()
+        xx[self.idx] = v
+        return xx
+
+    def __call__(self, v):
+        r = self.fun.evaluate(self.sub, self._full(v))
+        self.last = (np.array(v, float), r)
+        return r
+
+    def columns(self, v0, vs) -> list:
+        return self.fun.columns(self._full(v0), [self._full(v) for v in vs], self.sub)
+
+
 def _refine_block(fun, sub, pack, x, idx, xs):
     from scipy.optimize import least_squares
-
-    def f(v):
-        xx = x.copy()
-        xx[idx] = v
-        return fun.evaluate(sub, xx)
+    f = _BlockResiduals(fun, sub, x, idx)
+    lower, upper = pack.lower[idx], pack.upper[idx]
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        return least_squares(f, xs, bounds=(pack.lower[idx], pack.upper[idx]), method="trf",
-                             max_nfev=10 * idx.size, diff_step=1e-4)
+        return least_squares(f, xs, jac=Differences.or_two_point(f, lower, upper),
+                             bounds=(lower, upper), method="trf", max_nfev=10 * idx.size,
+                             diff_step=DIFF_STEP)
