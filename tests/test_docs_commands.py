@@ -13,7 +13,8 @@ The rules a docs author must know are in docs/extending.md, "Writing docs"; in s
   ``powertrain examples DIR`` makes its own copy of the shipped files, as a user after a wheel
   install does; on any other page ``examples/``, ``engines/`` and ``mounts/`` are linked too.
   Its commands run in order, so a later block may read what an earlier one wrote.
-  ``powertrain`` and ``python`` are the interpreter under test.
+  ``powertrain`` and ``python`` are the interpreter under test; ``powertrain`` runs in a
+  child of a fork server that imported the package once (tests/forked_commands.py).
 * One command is one line (backslash continuations joined); comment lines are dropped.
 * In a ``&&`` chain, install steps (``python3 -m venv``, ``. .venv/bin/activate``,
   ``source .venv/bin/activate``, ``pip install``) and the test-suite command
@@ -46,6 +47,7 @@ import shlex
 import signal
 import subprocess
 import sys
+import tempfile
 import textwrap
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -55,6 +57,8 @@ import pytest
 import powertrain
 
 ROOT = Path(__file__).resolve().parents[1]
+#: The fork server behind the docs commands' ``powertrain`` (its docstring says why).
+FORK_SERVER = Path(__file__).resolve().parent / "forked_commands.py"
 #: Folders of the repository reachable by their relative names from every doc command.
 LINKED = ("scripts",)
 #: Linked too, unless the page copies the shipped files itself with ``powertrain examples``.
@@ -263,15 +267,24 @@ SKIPPED_PARTS = [(c, part, reason) for cmds in ALL_COMMANDS.values() for c in cm
 
 @pytest.fixture(scope="module")
 def shim_bin(tmp_path_factory) -> Path:
-    """A folder with ``python``, ``python3`` and ``powertrain`` of the interpreter under test."""
+    """A folder with ``python``, ``python3`` and ``powertrain`` of the interpreter under test;
+    ``powertrain`` runs each command in a child of a fork server that imported the package
+    once (tests/forked_commands.py)."""
     bin_dir = tmp_path_factory.mktemp("docs-bin")
+    sock = Path(tempfile.mkdtemp(prefix="pt-docs-")) / "s"        # short: a socket path
+    server = subprocess.Popen([sys.executable, str(FORK_SERVER), "serve", str(sock)],
+                              env=doc_environment(bin_dir), stdout=subprocess.PIPE, text=True)
+    assert server.stdout.readline().strip() == "ready"
     exe = shlex.quote(sys.executable)
-    for name, target in (("python", exe), ("python3", exe),
-                         ("powertrain", f"{exe} -m powertrain.cli")):
+    client = f"{exe} -I -S {shlex.quote(str(FORK_SERVER))} run {shlex.quote(str(sock))}"
+    for name, target in (("python", exe), ("python3", exe), ("powertrain", client)):
         script = bin_dir / name
         script.write_text(f'#!/bin/sh\nexec {target} "$@"\n')
         script.chmod(0o755)
-    return bin_dir
+    yield bin_dir
+    server.kill()
+    server.wait()
+    server.stdout.close()
 
 
 def doc_environment(bin_dir: Path) -> dict:
