@@ -583,3 +583,21 @@ def test_skipped_by_rule(cmd, part, reason):
 def test_doc_commands_run(doc, shim_bin, tmp_path):
     failure = run_doc(doc, tmp_path, doc_environment(shim_bin))
     assert failure is None, failure
+
+
+@pytest.mark.parametrize("args", ["--version", "runup --angle-step 0",
+                                  "stiffness mounts/none.toml --freq 5", "modes --static"])
+def test_the_forked_powertrain_prints_and_exits_as_the_console_script(args, shim_bin,
+                                                                      tmp_path):
+    """The docs' ``powertrain`` (a fork server's child) against ``python -m powertrain.cli``
+    started afresh, in the same folder and environment: the same stdout, stderr and exit
+    code (bad input included), a relative output path in the command's folder."""
+    env = doc_environment(shim_bin)
+    (tmp_path / "engines").symlink_to(ROOT / "engines", target_is_directory=True)
+    forked = subprocess.run(["bash", "-c", f"powertrain {args} > out.txt"], cwd=tmp_path,
+                            env=env, capture_output=True, text=True)
+    fresh = subprocess.run([sys.executable, "-m", "powertrain.cli", *shlex.split(args)],
+                           cwd=tmp_path, env=env, capture_output=True, text=True)
+    assert (forked.returncode, forked.stderr) == (fresh.returncode, fresh.stderr)
+    assert (tmp_path / "out.txt").read_text() == fresh.stdout
+    assert fresh.returncode == (0 if args in ("--version", "modes --static") else 1)
