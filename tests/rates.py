@@ -20,6 +20,7 @@ checks the power, the size at the target and that ``n`` is the smallest, by exac
 from __future__ import annotations
 
 import math
+import os
 
 from powertrain.validation.scoring import wilson_interval
 
@@ -203,6 +204,20 @@ def run_sequential_map(row_fn, task_of, is_good, target, higher_is_better=True):
             lambda start, count: list(ex.map(row_fn, [task_of(i) for i in
                                                       range(start, start + count)])),
             is_good, target, higher_is_better)
+
+
+# --- the draws -------------------------------------------------------------------------------
+
+#: Environment variable that pins every rate test's seed (replaying a run's draws: each test
+#: prints its seed; or timing two versions of the code on the same cases).
+SEED_VARIABLE = "POWERTRAIN_RATE_SEED"
+
+
+def fresh_seed() -> int:
+    """A rate test's seed: from ``os.urandom`` (fresh draws every run), or the integer in
+    :data:`SEED_VARIABLE` when it is set."""
+    pinned = os.environ.get(SEED_VARIABLE, "").strip()
+    return int(pinned) if pinned else int.from_bytes(os.urandom(4), "little")
 
 
 # --- the diagnosis a rate test judges --------------------------------------------------------

@@ -18,7 +18,6 @@ seeds are in the failure message; rerun one with
 by ``scripts/blind_diagnosis.py``.
 """
 
-import os
 
 import numpy as np
 import pytest
@@ -42,7 +41,7 @@ MAX_DRAWS = 30
 
 
 def fresh_seed():
-    return int.from_bytes(os.urandom(4), "little")
+    return rates.fresh_seed()
 
 
 def detectable_case(kinds, engine_kind, seed, i):

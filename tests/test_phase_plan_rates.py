@@ -15,7 +15,6 @@ lines quoted in docs/validation/diagnosis.md are printed by
 ``scripts/phase_plan_benchmark.py``.
 """
 
-import os
 
 import numpy as np
 import pytest
@@ -33,7 +32,7 @@ TWO_SIDED_KINDS = ("amplitude_elastomer", "mount_temperature")
 
 
 def _seed():
-    return int.from_bytes(os.urandom(4), "little")
+    return rates.fresh_seed()
 
 
 def _sequential(row_fn, is_good, target, higher_is_better=True, extra=()):

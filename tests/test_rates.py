@@ -208,3 +208,12 @@ def test_stopping_counts_are_a_distribution_on_the_looks(target, rate):
     assert abs(fails / runs - p_fail) < 5 * se
     e_n = sum(n * p for n, p in stops.items())
     assert abs(total_n / runs - e_n) < 0.05 * e_n
+
+
+def test_a_pinned_seed_replays_the_draws(monkeypatch):
+    """``POWERTRAIN_RATE_SEED`` pins every rate test's seed (replaying a run); unset, each
+    run draws its own."""
+    monkeypatch.setenv(rates.SEED_VARIABLE, "424243")
+    assert rates.fresh_seed() == 424243
+    monkeypatch.delenv(rates.SEED_VARIABLE)
+    assert len({rates.fresh_seed() for _ in range(8)}) > 1

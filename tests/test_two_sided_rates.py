@@ -19,7 +19,6 @@ also ``long_rates`` (run first; alone: ``python -m pytest -m long_rates``). The
 small tests of the scoring logic are in tests/test_validation_scoring.py.
 """
 
-import os
 
 import numpy as np
 import pytest
@@ -49,7 +48,7 @@ def _side_row(task):
 @pytest.mark.slow
 @pytest.mark.rates
 def test_side_attribution_on_two_sided_cases():
-    seed = int.from_bytes(os.urandom(4), "little")
+    seed = rates.fresh_seed()
     passed, rows, k = rates.run_sequential_map(
         _side_row, lambda i: (i, seed), lambda r: r["right"], SIDES_TARGET)
     print(f"seed {seed}: {k}/{len(rows)} right, passed={passed}")
@@ -75,7 +74,7 @@ def _mode_row(task):
 @pytest.mark.rates
 @pytest.mark.long_rates
 def test_missing_body_mode_is_found():
-    seed = int.from_bytes(os.urandom(4), "little")
+    seed = rates.fresh_seed()
     passed, rows, k = rates.run_sequential_map(
         _mode_row, lambda i: (i, seed), mode_found, MISSING_MODE_TARGET)
     print(f"seed {seed}: {k}/{len(rows)} found, passed={passed}")
