@@ -67,12 +67,16 @@ class Counted:
     def evaluate(self, problem, x):
         """Residuals of ``problem`` at ``x`` with the prior's, charged to the budget (raises
         when it is spent)."""
-        if self.n >= self.budget:
-            raise Exhausted
+        self._check_budget()
         before = problem.solves
         r = self.residuals(problem, x)
         self.n += max(1, problem.solves - before)
         return r
+
+    def _check_budget(self):
+        """Raise :class:`Exhausted` when the budget is spent (before an evaluation)."""
+        if self.n >= self.budget:
+            raise Exhausted
 
     def residuals(self, problem, x):
         """Residuals of ``problem`` at ``x`` with the prior's, uncharged; a point without a
@@ -81,6 +85,10 @@ class Counted:
             v = problem.vector(self.pack.scenario(x))
         except FloatingPointError:
             v = np.full(self._data_size(problem, x), NO_STEADY_STATE_RESIDUAL)
+        return self._with_prior(v, x)
+
+    def _with_prior(self, v, x):
+        """The data residuals ``v`` at ``x`` followed by the prior's."""
         return np.concatenate([v, self.prior(x)])
 
     def watch(self, n_params):
@@ -148,10 +156,9 @@ class Counted:
                 run, scenarios = run[1:], scenarios[1:]
                 continue
             for x, v in zip(run, vs):
-                if self.n >= self.budget:
-                    raise Exhausted
-                self.n += 1
-                r = np.concatenate([v, self.prior(x)])
+                self._check_budget()
+                self.n += 1                # a reading of cached velocities: no solve
+                r = self._with_prior(v, x)
                 out.append(self._seen(x, r) if keep else r)
             break
         return out
