@@ -13,11 +13,12 @@ import json
 
 import numpy as np
 import pytest
+from amplitude_oracle import time_domain_amplitude_check
 from click.testing import CliRunner
 
 from powertrain.cli import main
 from powertrain.diagnosis import diagnose
-from powertrain.effects import EFFECTS, Effect, predict, time_domain_amplitude_check
+from powertrain.effects import EFFECTS, Effect, predict
 from powertrain.errors import InputError
 from powertrain.iotools.measured import MeasuredRunup
 from powertrain.solvers.fast_harmonic import HarmonicModel

@@ -35,7 +35,7 @@ fast cached path :func:`predict` (the diagnosis), and through the ordinary run-u
 (:func:`powertrain.workflows.runup.runup_with_effects`).
 """
 
-from powertrain.effects.amplitude_stiffness import A_REF, amplitude_law, time_domain_amplitude_check
+from powertrain.effects.amplitude_stiffness import A_REF, amplitude_law
 from powertrain.effects.balancer_error import with_balancer_error
 from powertrain.effects.base import Effect, Parameter, map_networks, with_network_elastomer
 from powertrain.effects.base_compliance import BASE_ZETA, with_base_compliance_all
@@ -48,5 +48,5 @@ from powertrain.effects.sensor_error import apply_sensor_error, rotation_matrix,
 __all__ = ["A_REF", "BASE_ZETA", "EFFECTS", "EFFECT_CLASSES", "RESPONSE_EFFECTS", "Effect",
            "Parameter", "Prediction", "amplitude_law", "apply_sensor_error",
            "check_scenario", "map_networks", "predict", "rotation_matrix", "sensor_reading",
-           "time_domain_amplitude_check", "with_balancer_error", "with_base_compliance_all",
+           "with_balancer_error", "with_base_compliance_all",
            "with_cylinder_imbalance", "with_mount_stiffness", "with_network_elastomer"]

@@ -43,12 +43,12 @@ def check_engine(engine, path) -> None:
 
 
 def check_support(engine, path) -> None:
-    """The mounts carry the body: finite rigid-body modes of at least :data:`MIN_MODE_HZ`."""
-    from powertrain.assembly import assemble
-    b = engine.body
+    """The mounts carry the body: a static stiffness in all six directions and finite
+    rigid-body modes of at least :data:`MIN_MODE_HZ` (mounts on rigid ground)."""
+    system = engine.assemble(rigid_ground=True)
+    _check_static_stiffness(system, engine.mounts, path)
     try:
         with np.errstate(all="ignore"):
-            system = assemble(b.mass, b.cg, b.inertia, engine.mounts)
             modes, _ = system.rigid_body_modes()
     except (np.linalg.LinAlgError, ValueError, ArithmeticError):
         modes = np.array([np.nan])
@@ -71,6 +71,18 @@ def check_support(engine, path) -> None:
                          f"{low:.3g} Hz, a static sag of about {sag:.3g} m under its weight "
                          f"(need >= {MIN_MODE_HZ:g} Hz); softest: "
                          f"{extreme_mount(engine.mounts, min)}", file=path, key="mounts")
+
+
+def _check_static_stiffness(system, mounts, path) -> None:
+    """The 6×6 static stiffness of the body on its mounts is positive definite."""
+    try:
+        kr = np.linalg.eigvalsh(system.static_stiffness_6())
+    except np.linalg.LinAlgError:
+        kr = np.zeros(1)
+    if kr.min() <= 1e-9 * max(kr.max(), 1e-300):
+        raise InputError("the mounts' static stiffness does not hold the body in every "
+                         "direction (a rigid-body mode at 0 Hz); softest: "
+                         f"{extreme_mount(mounts)}", file=path, key="mounts")
 
 
 def extreme_mount(mounts, pick=min) -> str:

@@ -129,7 +129,6 @@ def read_engine(path=DEFAULT_ENGINE_PATH) -> em.Engine:
     balancer = em.Balancer(enabled=False, ratio=2.0, shafts=())
     if "balancer" in doc:
         balancer = _read_balancer(subtable(doc, "balancer", path), path)
-    _check_static_support(body, mounts, path)
     chassis = None
     if "chassis" in doc:
         chassis = _read_chassis(subtable(doc, "chassis", path), path, [m.name for m in mounts])
@@ -211,21 +210,6 @@ def _read_body_mode(m, path, p, mount_names, points):
                              key=f"{sp}.{name}")
         shapes[name] = np.array([number(x, path, f"{sp}.{name}") for x in v])
     return BodyMode(frequency=f, damping_ratio=zeta, modal_mass=mass, shapes=shapes)
-
-
-def _check_static_support(body, mounts, path):
-    """The mounts' static stiffness must hold the body in all six directions."""
-    from powertrain.assembly import assemble
-    system = assemble(body.mass, body.cg, body.inertia, mounts)
-    try:
-        kr = np.linalg.eigvalsh(system.static_stiffness_6())
-    except np.linalg.LinAlgError:
-        kr = np.zeros(1)
-    if kr.min() <= 1e-9 * max(kr.max(), 1e-300):
-        from powertrain.iotools.engine_checks import extreme_mount
-        raise InputError("the mounts' static stiffness does not hold the body in every "
-                         "direction (a rigid-body mode at 0 Hz); softest: "
-                         f"{extreme_mount(mounts)}", file=path, key="mounts")
 
 
 def _read_crank(t, path) -> em.CrankTrain:

@@ -37,6 +37,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from powertrain.assembly import assemble
 from powertrain.models.combustion import RPM, FullLoadCurve, MeasuredPressure, SingleZoneCombustion  # noqa: F401 (re-export)
 from powertrain.models.crank_train import Balancer, BalancerShaft, CrankTrain  # noqa: F401 (re-export)
 from powertrain.models.grid_memo import on_last_grid
@@ -450,20 +451,28 @@ class Engine:
             table += fg[:, :, i, None] * g
         return table
 
-    def assemble(self):
-        """The assembled linear model: body, mounts and chassis
-        (:func:`powertrain.assembly.assemble`)."""
-        from powertrain.assembly import assemble
+    def assemble(self, static_factors=None, *, rigid_ground=False):
+        """The assembled linear model of body, mounts and chassis: the one way to the system
+        every solver, the what-if and the diagnosis work on (:func:`powertrain.assembly.assemble`).
+
+        Parameters
+        ----------
+        static_factors : array_like (3 n_mounts,), optional
+            Each network's static factor at an operating point
+            (:mod:`powertrain.solvers.operating_point`); None: unscaled.
+        rigid_ground : bool
+            Mounts on rigid ground whatever the chassis: the static support and the modes at
+            static stiffness are properties of the powertrain on its mounts alone.
+        """
         b = self.body
-        return assemble(b.mass, b.cg, b.inertia, self.mounts, self.chassis)
+        chassis = None if rigid_ground else self.chassis
+        return assemble(b.mass, b.cg, b.inertia, self.mounts, chassis, static_factors)
 
     def rigid_body_modes(self):
         """Natural frequencies [Hz] and mode shapes of the powertrain on its mounts' static
         stiffness (undamped, rigid chassis); see
         :meth:`powertrain.assembly.AssembledSystem.rigid_body_modes`."""
-        from powertrain.assembly import assemble
-        b = self.body
-        return assemble(b.mass, b.cg, b.inertia, self.mounts).rigid_body_modes()
+        return self.assemble(rigid_ground=True).rigid_body_modes()
 
 
 def _periodic_interpolation(x, xp, period):

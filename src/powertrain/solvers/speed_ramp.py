@@ -102,18 +102,20 @@ def simulate_sweep(engine, rpm_from, rpm_to, rate_rpm_per_s, sample_rate=8192.0,
     Returns
     -------
     RawRecording
-        Nine acceleration channels [m/s^2] (engine side), the speed [rpm], the tacho and the
-        cycle reference [V] (:func:`crank_pulses`).
+        Three acceleration channels [m/s^2] per mount (engine side; a modal body under the
+        mounts moves with them), the speed [rpm], the tacho and the cycle reference [V]
+        (:func:`crank_pulses`).
     """
-    from powertrain.assembly import assemble
     _check(engine, rpm_from, rpm_to, rate_rpm_per_s, sample_rate)
     m, n_steps = sweep_steps(rpm_from, rpm_to, rate_rpm_per_s, sample_rate)
     h = 1.0 / (m * sample_rate)
     if system is None:
-        b = engine.body
-        system = assemble(b.mass, b.cg, b.inertia, engine.mounts)
+        system = engine.assemble()
+    if system.chassis is not None:
+        system.chassis.require_time_domain()
     load = _load_table(engine, rpm_from, rpm_to)
-    dofs, to_channels = _channel_dofs(system.channel_matrix)
+    n_ch = system.n_mount_channels
+    dofs, to_channels = _channel_dofs(system.channel_matrix[:n_ch])
     decimator = _Decimator(m, dofs.size)
     ramp = (rpm_from, rate_rpm_per_s, h, n_steps)
     with single_blas_thread():
@@ -123,7 +125,7 @@ def simulate_sweep(engine, rpm_from, rpm_to, rate_rpm_per_s, sample_rate=8192.0,
     t_out = (decimator.first_output_index + np.arange(y.shape[0])) / sample_rate
     rpm_out = rpm_from + rate_rpm_per_s * t_out
     chans = [RawChannel(Channel(mnt, "active", d).label, mnt, "active", d, "acceleration",
-                        block[c], "m/s^2") for c, (mnt, d) in enumerate(system.channels)]
+                        block[c], "m/s^2") for c, (mnt, d) in enumerate(system.channels[:n_ch])]
     note = (f"SYNTHETIC: simulated continuous run-up {rpm_from:g}->{rpm_to:g} rpm at "
             f"{rate_rpm_per_s:g} rpm/s ({getattr(engine, 'name', '')}; Newmark average "
             f"acceleration, {method}, {m * sample_rate:g} Hz internal, decimated to "

@@ -31,7 +31,6 @@ import warnings
 import numpy as np
 
 from powertrain.analysis.orders import ORDERS
-from powertrain.assembly import assemble
 from powertrain.errors import InputError, require_finite, solved
 from powertrain.parallel import single_blas_thread
 from powertrain.progress import progress_bar
@@ -128,9 +127,7 @@ def _run_runup(engine, rpm=None, *, solver="newmark", angle_step_deg=ANGLE_STEP_
     rpm = _speeds(rpm)
     grid = _cycles(angle_step_deg, cycles, processed_cycles)
     if system is None:
-        b = engine.body
-        system = assemble(b.mass, b.cg, b.inertia, engine.mounts,
-                          getattr(engine, "chassis", None))
+        system = engine.assemble()
     step = choose_stepper(system, solver, stepper, grid)
     loads = list(_cycle_loads(engine, rpm, grid.n_cycle))
     bar = {"desc": f"run-up ({solver})", "unit": "speed", "enabled": bool(progress)}
@@ -164,11 +161,9 @@ def _solve_at_operating_points(engine, step, rpm, loads, points, bar):
     (:meth:`~powertrain.physics.mount_elements.MountElement.at_operating_point`); the
     equivalent-linear amplitudes carried from speed to speed. Returns the speeds' orders
     and the solver time (the per-speed setups included)."""
-    b, chassis = engine.body, getattr(engine, "chassis", None)
     speeds, total = [], 0.0
     for i in progress_bar(range(rpm.size), **bar):
-        system = assemble(b.mass, b.cg, b.inertia, engine.mounts, chassis,
-                          static_factors=points[i].static_factor)
+        system = engine.assemble(points[i].static_factor)
         step = step.on_system(system)
         speeds.append(step.solve(loads[i], rpm[i] * 2 * np.pi / 60.0))
         total += speeds[-1].seconds + step.setup_seconds
@@ -447,8 +442,7 @@ def mode_coordinates(engine, frequencies_hz) -> list:
     ``""`` where ``frequencies_hz`` holds a mode ``engine`` does not have (an effect moved
     it)."""
     from powertrain.solvers.modes import COORDINATES, kinetic_energy_percent
-    b = engine.body
-    system = assemble(b.mass, b.cg, b.inertia, engine.mounts, getattr(engine, "chassis", None))
+    system = engine.assemble()
     f_sys, shapes = system.rigid_body_modes()
     out = []
     for f in frequencies_hz:
