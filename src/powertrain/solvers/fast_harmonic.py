@@ -47,10 +47,8 @@ from powertrain.physics import balancer as bal
 from powertrain.physics.condensation import condensed_matrix
 from powertrain.physics.mount_elements import element_two_ports
 from powertrain.physics.mount_network import laplace_two_ports
-from powertrain.physics.rigid_body import direction_row, point_motion_matrix, rigid_body_mass_matrix
 from powertrain.solvers.body_coupling import (
     ModalBody,
-    body_channels,
     coupled_solve,
     one_more_mode,
     one_more_mode_basis,
@@ -102,6 +100,9 @@ class HarmonicModel:
         Speeds [rpm] (inside the engine's range).
     n_angle : int
         Samples per engine cycle for the load harmonics.
+    system : AssembledSystem, optional
+        The system this is a frequency view of; default ``engine.assemble()``. Its
+        retained coordinates, network rows, elements and output rows are used as they are.
 
     Attributes
     ----------
@@ -116,59 +117,52 @@ class HarmonicModel:
         One per network; nonlinear ones act through :meth:`two_ports_at`.
     """
 
-    def __init__(self, engine, rpm, n_angle=N_ANGLE):
+    def __init__(self, engine, rpm, n_angle=N_ANGLE, system=None):
         self.engine = engine
         self.rpm = np.atleast_1d(np.asarray(rpm, float))
         self.n_angle = int(n_angle)
         self.theta = 4 * np.pi * np.arange(self.n_angle) / self.n_angle
         Omega = self.rpm * 2 * np.pi / 60.0
         self.omega = 0.5 * Omega[:, None] * np.arange(N_HARMONICS)[None, :]
-        b = engine.body
-        self.M = rigid_body_mass_matrix(b.mass, b.inertia)
-        cg = np.asarray(b.cg, float)
-        rows, nets, cm = [], [], []
-        for mi, m in enumerate(engine.mounts):
-            r = np.asarray(m.position, float) - cg
-            R = np.asarray(m.rotation, float)
-            for ai, axis in enumerate(DIRECTIONS):
-                rows.append(direction_row(r, R[:, ai]))
-                nets.append((mi, axis, m.directions[axis]))
-            cm.append(point_motion_matrix(r))
-        self.rows = np.array(rows)
-        self.networks = nets
+        #: the assembled system this view is of (:meth:`Engine.assemble
+        #: <powertrain.models.engine.Engine.assemble>`)
+        self.system = engine.assemble() if system is None else system
+        ports = self.system.ports()
+        self.M = ports.frame[0][:6, :6]
+        self.rows = ports.engine_rows[:, :6]
+        self.networks = [(mi, axis, m.directions[axis]) for mi, m in enumerate(engine.mounts)
+                         for axis in DIRECTIONS]
         #: each network's mount element (:class:`~powertrain.physics.mount_elements.MountElement`:
         #: its amplitude law and port law with it)
-        self.elements = [mod.element() for _, _, mod in nets]
+        self.elements = list(ports.elements)
         #: every network's static factor per speed (n_r, n_net) at the operating point of
         #: the static curves (:mod:`powertrain.solvers.operating_point`); None without any
         self.static_scale = static_factor_table(engine, self.rpm)
-        self.channel_matrix = np.vstack(cm)
-        self.channels = [(m.name, a) for m in engine.mounts for a in DIRECTIONS]
-        self.mount_names = [m.name for m in engine.mounts]
+        n_a = self.system.n_mount_channels
+        self.channel_matrix = self.system.channel_matrix[:n_a, :6]
+        self.channels = list(self.system.channels[:n_a])
+        self.mount_names = list(self.system.mount_names)
         self._load = None
         self._abc = None
         self._extra = {}
         self._scaled = {}
         self._one_more_mode_at = None
-        self._body_setup(engine)
+        self._body_setup(engine, ports)
 
-    def _body_setup(self, engine):
+    def _body_setup(self, engine, ports):
         """A modal body under the mounts (:mod:`powertrain.solvers.body_coupling`): its
-        passive-side and body-point channels follow the engine-side ones."""
+        passive-side and body-point channels follow the engine-side ones, read from the
+        assembled system's output rows on the retained coordinates."""
         self.body = ModalBody.of(engine)
         #: indices of the channels :meth:`velocity` returns (None: all of ``channels``)
         self.output = None
         self.active_channels = list(self.channels)
         if self.body is None:
             return
-        self.mount_axes = [np.asarray(m.rotation, float) for m in engine.mounts]
-        self.body_shapes = self.body.network_shapes(self.networks, self.mount_axes)
-        self.channels = self.channels + body_channels(self.mount_names, self.body)
-        n_a, K = self.channel_matrix.shape[0], self.body.n_modes
-        full = np.zeros((len(self.channels), 6 + K))
-        full[:n_a, :6] = self.channel_matrix
-        full[n_a:, 6:] = self.body.output_rows()
-        self.output_matrix = full
+        self.mount_axes = list(self.system.mount_axes)
+        self.body_shapes = ports.base_rows[:, 6:]
+        self.channels = list(self.system.channels)
+        self.output_matrix = self.system.channel_matrix[:, ports.retained]
 
     def use_channels(self, channels):
         """Let :meth:`velocity` return ``channels`` only (names as :attr:`channels`)."""
