@@ -16,8 +16,8 @@ exact: the Schur complement of :math:`\mathbf K + s\mathbf C + s^2\mathbf M` on 
 (tests/test_two_port.py against a dense solve). :func:`condense` keeps any subset of R (the
 rest of R condensed densely, e.g. the body modes for the 6×6 static stiffness); the static
 stiffness (:math:`s = 0`), the modes (complex :math:`s`), the harmonic steady state
-(:math:`s = i\omega`, :func:`harmonic_solve`) and the cached diagnosis model (its own
-two-port values, :func:`frame_and_ports`) all go through :func:`condensed_matrix`.
+(:math:`s = i\omega`, :func:`harmonic_solve`, for the run-up and the cached diagnosis model
+alike) all go through :func:`condensed_matrix`.
 """
 
 from __future__ import annotations
@@ -26,6 +26,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
+from powertrain.kernels.small_solve import batched_solve
 from powertrain.physics.mount_elements import describing_stiffnesses
 
 
@@ -139,37 +140,25 @@ def _retained_matrix(ports, abc, s):
                             None if ports.grounded else ports.base_rows, abc, s)
 
 
-def harmonic_solve(system, load_harmonics, omegas, amplitudes=None):
-    r"""Steady-state amplitudes of every coordinate under a load on the rigid body:
-    :math:`\mathbf D_R(i\omega)\hat{\mathbf q}_R = \hat{\mathbf f}`, then each network's
-    internal motion from its engine-side and base motion.
+def harmonic_solve(frame, engine_rows, base_rows, abc, s, load):
+    r"""The one harmonic steady-state solve: :math:`\mathbf D_R(s)\hat{\mathbf q}_R =
+    \hat{\mathbf f}` on the retained coordinates, the load on the rigid body's six, for
+    every ``s`` at once (the run-up's harmonic stepper, the cached diagnosis model with or
+    without a modal body, the what-if).
 
     Parameters
     ----------
-    system : AssembledSystem
-    load_harmonics : ndarray (n_h, 6) complex
-        Amplitudes of the 6-vector load [N, N·m].
-    omegas : ndarray (n_h,)
-        Angular frequency of each harmonic [rad/s].
-    amplitudes : ndarray (n_net,), optional
-        Relative-displacement amplitude of every network [m], for the equivalent-linear
-        two-port of a nonlinear element (:mod:`powertrain.physics.mount_elements`).
+    frame, engine_rows, base_rows, abc, s
+        As :func:`condensed_matrix` (``s`` = :math:`i\omega` [1/s]).
+    load : ndarray ``s.shape + (6,)`` complex
+        Amplitudes of the 6-vector load about the CG [N, N·m].
 
     Returns
     -------
-    ndarray (n_h, n_dof) complex
+    ndarray ``s.shape + (n_R,)`` complex
+        Amplitudes of the retained coordinates [m, rad, modal].
     """
-    ports = system.ports()
-    s = 1j * np.asarray(omegas, float)
-    abc, shapes = two_ports(ports, s, internal=True, amplitudes=amplitudes)
-    D = _retained_matrix(ports, abc, s)
-    rhs = np.zeros(s.shape + (ports.retained.size,), complex)
-    rhs[:, :6] = load_harmonics
-    q_r = np.linalg.solve(D, rhs[..., None])[..., 0]
-    out = np.zeros((s.size, system.n_dof), complex)
-    out[:, ports.retained] = q_r
-    x_e = q_r @ ports.engine_rows.T
-    x_b = q_r @ ports.base_rows.T
-    for k, ((start, ni), X) in enumerate(zip(ports.internal, shapes)):
-        out[:, start:start + ni] = X[..., 0] * x_e[:, k, None] + X[..., 1] * x_b[:, k, None]
-    return out
+    D = condensed_matrix(frame, engine_rows, base_rows, abc, s)
+    rhs = np.zeros(D.shape[:-1], complex)
+    rhs[..., :6] = load
+    return batched_solve(D, rhs)

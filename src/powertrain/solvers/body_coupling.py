@@ -32,8 +32,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from powertrain.analysis.channel import DIRECTIONS, passive_name
-from powertrain.kernels.small_solve import batched_solve
-from powertrain.physics.condensation import condensed_matrix
+from powertrain.physics.condensation import condensed_matrix, harmonic_solve
 
 
 @dataclass(frozen=True)
@@ -156,8 +155,8 @@ def modal_frame(M, frequency_hz, modal_mass, damping_ratio):
 
 
 def coupled_solve(M, omega, rows, shapes, abc, kip, body, load):
-    r"""Solve the (6 + K) system of the module docstring for all speeds and harmonics through
-    the one condensation (:func:`powertrain.physics.condensation.condensed_matrix`).
+    r"""Solve the (6 + K) system of the module docstring for all speeds and harmonics by the
+    one harmonic solve (:func:`powertrain.physics.condensation.harmonic_solve`).
 
     Parameters
     ----------
@@ -178,19 +177,24 @@ def coupled_solve(M, omega, rows, shapes, abc, kip, body, load):
     -------
     ndarray (n_r, n_h, 6 + K) complex: :math:`\hat{\mathbf q}` then :math:`\hat{\boldsymbol\eta}`.
     """
-    D = coupled_matrix(M, omega, rows, shapes, abc, kip, body)
-    rhs = np.zeros(D.shape[:-1], complex)
-    rhs[..., :6] = load
-    return batched_solve(D, rhs)
+    frame, E, B = coupled_frame(M, rows, shapes, body)
+    return harmonic_solve(frame, E, B, (kip, abc[1], abc[2]), 1j * np.asarray(omega, float),
+                          load)
+
+
+def coupled_frame(M, rows, shapes, body):
+    """The retained coordinates' frame (rigid body, body modes) and the networks' engine and
+    base rows on them, ``(frame, E, B)`` (arguments as :func:`coupled_solve`)."""
+    K = shapes.shape[1]
+    E = np.hstack([rows, np.zeros((rows.shape[0], K))])
+    B = np.hstack([np.zeros_like(rows), shapes])
+    return modal_frame(M, body.frequency_hz, body.modal_mass, body.damping_ratio), E, B
 
 
 def coupled_matrix(M, omega, rows, shapes, abc, kip, body):
     """The (6 + K) matrix of the module docstring per speed and harmonic, (..., 6 + K,
     6 + K), through the one condensation (arguments as :func:`coupled_solve`)."""
-    K = shapes.shape[1]
-    E = np.hstack([rows, np.zeros((rows.shape[0], K))])
-    B = np.hstack([np.zeros_like(rows), shapes])
-    frame = modal_frame(M, body.frequency_hz, body.modal_mass, body.damping_ratio)
+    frame, E, B = coupled_frame(M, rows, shapes, body)
     return condensed_matrix(frame, E, B, (kip, abc[1], abc[2]), 1j * np.asarray(omega, float))
 
 

@@ -42,9 +42,8 @@ import numpy as np
 
 from powertrain.analysis.fourier import harmonic_amplitudes
 from powertrain.assembly import DIRECTIONS
-from powertrain.kernels.small_solve import batched_solve
 from powertrain.physics import balancer as bal
-from powertrain.physics.condensation import condensed_matrix
+from powertrain.physics.condensation import harmonic_solve
 from powertrain.physics.mount_elements import element_two_ports
 from powertrain.physics.mount_network import laplace_two_ports
 from powertrain.solvers.body_coupling import (
@@ -294,8 +293,8 @@ class HarmonicModel:
                                  tuple(x[:, harmonics] for x in abc), K, body,
                                  load[:, harmonics])
         frame = (self.M, np.zeros((6, 6)), np.zeros((6, 6)))
-        D = condensed_matrix(frame, self.rows, None, (K, None, None), 1j * w)
-        return batched_solve(D, load[:, harmonics])
+        return harmonic_solve(frame, self.rows, None, (K, None, None), 1j * w,
+                              load[:, harmonics])
 
     def solve_one_more_mode(self, body, harmonics=slice(1, N_HARMONICS)) -> np.ndarray:
         r""":meth:`solve`'s amplitudes (n_r, n_h, 6 + K + 1) of the nominal model (its own

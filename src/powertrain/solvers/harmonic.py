@@ -10,7 +10,7 @@ steady-state amplitude solves
 and :math:`\mathbf q(t) = \mathrm{Re}\sum_k \hat{\mathbf q}_k e^{i\omega_k t}`. Exact for the
 linear model; the time-domain Newmark stepper must agree with it.
 
-:func:`harmonic_response` solves it by the one condensation
+:func:`harmonic_response` solves it by the one harmonic solve
 (:func:`powertrain.physics.condensation.harmonic_solve`): the internal masses of each mount
 network are eliminated exactly through its two-port, so the retained coordinates (rigid body,
 body modes) feel each network through :math:`\mathbf P_n^T\mathbf T_n(i\omega)\mathbf P_n`
@@ -22,11 +22,15 @@ assembled matrices.
 
 from __future__ import annotations
 
-from powertrain.physics.condensation import harmonic_solve
+import numpy as np
+
+from powertrain.physics.condensation import harmonic_solve, two_ports
 
 
 def harmonic_response(system, load_harmonics, omegas, amplitudes=None):
-    """Complex amplitudes of q for each load harmonic (condensed solve).
+    """Complex amplitudes of every coordinate for each load harmonic: the retained ones by
+    the one harmonic solve (:func:`powertrain.physics.condensation.harmonic_solve`), each
+    network's internal motion from its engine-side and base motion.
 
     Parameters
     ----------
@@ -43,4 +47,15 @@ def harmonic_response(system, load_harmonics, omegas, amplitudes=None):
     -------
     ndarray (n_h, n_dof) complex
     """
-    return harmonic_solve(system, load_harmonics, omegas, amplitudes)
+    ports = system.ports()
+    s = 1j * np.asarray(omegas, float)
+    abc, shapes = two_ports(ports, s, internal=True, amplitudes=amplitudes)
+    q_r = harmonic_solve(ports.frame, ports.engine_rows,
+                         None if ports.grounded else ports.base_rows, abc, s, load_harmonics)
+    out = np.zeros((s.size, system.n_dof), complex)
+    out[:, ports.retained] = q_r
+    x_e = q_r @ ports.engine_rows.T
+    x_b = q_r @ ports.base_rows.T
+    for k, ((start, ni), X) in enumerate(zip(ports.internal, shapes)):
+        out[:, start:start + ni] = X[..., 0] * x_e[:, k, None] + X[..., 1] * x_b[:, k, None]
+    return out
