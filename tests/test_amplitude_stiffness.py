@@ -74,7 +74,7 @@ def test_time_and_frequency_agree_with_friction_and_amplitude_law():
 def test_time_method_against_the_closed_form_jenkins_describing_function():
     """An independent port law (Caughey's closed form) through the same time path."""
     law = JenkinsFriction(2e5, 15.0)                          # slips above 0.075 mm
-    element = MountElement(read_mount(HYDRAULIC), law)
+    element = MountElement(read_mount(HYDRAULIC).network(), law)
     t = amplitude_stiffness(element, BAND_HZ[::3], AMPLITUDES_M, "time")
     f = amplitude_stiffness(element, BAND_HZ[::3], AMPLITUDES_M, "frequency")
     rel, ang = _disagreement(t, f)

@@ -201,10 +201,10 @@ def test_elements_in_one_call_equal_each_element_alone(engine):
     from powertrain.physics.mount_laws import PowerLaw
     models = [m.directions[ax] for m in engine.mounts for ax in ("x", "y", "z")][:4]
     static = np.array([[0.9], [1.1], [1.3]])
-    els = [MountElement(models[0]),
-           MountElement(models[1], amplitude_law=PowerLaw(1e-4, 0.2), static_factor=static),
-           MountElement(models[2], port_law=JenkinsFriction(3e5, 20.0)),
-           MountElement(models[3], JenkinsFriction(2e5, 5.0), PowerLaw(1e-4, 0.1), 1.2)]
+    els = [MountElement(models[0].network()),
+           MountElement(models[1].network(), amplitude_law=PowerLaw(1e-4, 0.2), static_factor=static),
+           MountElement(models[2].network(), port_law=JenkinsFriction(3e5, 20.0)),
+           MountElement(models[3].network(), JenkinsFriction(2e5, 5.0), PowerLaw(1e-4, 0.1), 1.2)]
     s = 1j * np.array([0.0, 60.0, 400.0, 900.0]) * np.ones((3, 1))
     A = np.array([[1e-5, 2e-4, 5e-5, 1e-4], [3e-5, 1e-4, 2e-4, 4e-5], [1e-6, 1e-3, 1e-4, 1e-4]])
     got = element_two_ports(els, s, A[:, None, :])

@@ -142,7 +142,7 @@ class AssembledSystem:
         ``ds gd_k``."""
         parts = [[], [], [], []]
         for (*_, element), (L, base) in zip(self.networks, self.network_maps):
-            network = element.model.network()
+            network = element.lumped
             _, Cn, Kn = network_matrices(*network, include_ground=L.shape[0] >
                                          network[0].size + 1)
             kg, dg = ground_force_rows(network[0].size, *network[1:])

@@ -20,7 +20,6 @@ new solve (:meth:`HarmonicModel.solve_one_more_mode`).
 
 from __future__ import annotations
 
-import dataclasses
 from dataclasses import dataclass
 
 import numpy as np
@@ -119,7 +118,7 @@ def _elements(hm, sc, s_el):
         return None
     if s_el is None:
         return probe
-    els = [dataclasses.replace(el, model=el.model.scaled(float(s), float(d)))
+    els = [el.scaled(float(s), float(d))
            for el, s, d in zip(hm.elements, *s_el)]
     for eff, p in sc.values():
         els = eff.elements(hm, els, p)

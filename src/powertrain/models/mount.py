@@ -207,7 +207,7 @@ class MountModel:
 
     def element(self) -> MountElement:
         """The element the assembled model holds for this direction."""
-        return MountElement(self, self.port_law, self.amplitude_law)
+        return MountElement(self.network(), self.port_law, self.amplitude_law)
 
     @property
     def linear(self) -> bool:

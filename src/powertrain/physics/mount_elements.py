@@ -125,7 +125,7 @@ def element_two_ports(elements, s, amplitudes):
         scales[0][..., index], scales[1][..., index] = ks, ds
     for k, el in enumerate(elements):
         scales[:, ..., k] *= el.static_factor
-    a, b, c = laplace_two_ports(lam, [el.model.network() for el in elements], *scales)
+    a, b, c = laplace_two_ports(lam, [el.lumped for el in elements], *scales)
     for k, el in enumerate(elements):
         if el.port_law is not None:
             kd = np.where(lam == 0, 0.0, el.port_law.describing_stiffness(A[..., k]))
@@ -142,9 +142,10 @@ class MountElement:
 
     Parameters
     ----------
-    model : object
-        The linear network: ``network()`` gives ``(masses, elem_nodes, c, d)``
-        (:class:`powertrain.models.mount.MountModel`).
+    lumped : tuple
+        The linear network as its mount file gives it, ``(masses, elem_nodes, c, d)``
+        (:mod:`powertrain.physics.mount_network`; :meth:`MountModel.element
+        <powertrain.models.mount.MountModel.element>` makes it).
     port_law : object, optional
         Nonlinear force between the engine-side and base nodes (module docstring), e.g.
         :class:`powertrain.physics.mount_laws.BergFriction`.
@@ -157,7 +158,7 @@ class MountElement:
         (tangent stiffness there over that at the reference deflection); 1 without one.
     """
 
-    model: object
+    lumped: tuple
     port_law: object = None
     amplitude_law: object = None
     static_factor: float = 1.0
@@ -185,18 +186,25 @@ class MountElement:
 
     def at_operating_point(self, static_factor: float) -> MountElement:
         """A copy with the static curve's factor at an operating point."""
-        return MountElement(self.model, self.port_law, self.amplitude_law, float(static_factor))
+        return MountElement(self.lumped, self.port_law, self.amplitude_law, float(static_factor))
 
     def as_measured(self) -> MountElement:
         """The network as its mount file gives it, at the static factor: the amplitude law
         at factor 1 (its reference amplitude, where the network was measured) and no port
         law. What the linear analyses of the assembly take (static stiffness, modes:
         :func:`powertrain.physics.condensation.condense`)."""
-        return MountElement(self.model, static_factor=self.static_factor)
+        return MountElement(self.lumped, static_factor=self.static_factor)
+
+    def scaled(self, stiffness: float, damping: float) -> MountElement:
+        """A copy whose network has every spring times ``stiffness`` and every damper times
+        ``damping`` (masses kept), its laws and static factor as they are."""
+        masses, nodes, c, d = self.lumped
+        return MountElement((masses, nodes, c * stiffness, d * damping), self.port_law,
+                            self.amplitude_law, self.static_factor)
 
     def network(self, amplitude=0.0):
         """``(masses, elem_nodes, c, d)`` of the linear network at the amplitude [m]."""
-        masses, nodes, c, d = self.model.network()
+        masses, nodes, c, d = self.lumped
         ks, ds = self.scales(amplitude)
         if ks == 1.0 and ds == 1.0:
             return masses, nodes, c, d
@@ -220,7 +228,7 @@ class MountElement:
             res = laplace_two_port(lam, *self.network(amplitude), internal=internal)
         else:
             amplitude = np.broadcast_to(np.asarray(amplitude, float), lam.shape)
-            res = laplace_two_port(lam, *self.model.network(), *self.scale_arrays(amplitude),
+            res = laplace_two_port(lam, *self.lumped, *self.scale_arrays(amplitude),
                                    internal=internal)
         if self.port_law is None:
             return res

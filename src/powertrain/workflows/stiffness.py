@@ -125,7 +125,7 @@ def stiffness_table(model, frequency_hz, method="frequency", engine_mass=None, f
             time_forced_response,
         )
         if engine_mass is None:
-            r = time_cross_point_stiffness(MountElement(model), f, **kw)
+            r = time_cross_point_stiffness(MountElement(model.network()), f, **kw)
             return StiffnessResult(f, r.kcp, method, meta={"periodicity": r.periodicity})
         r = time_forced_response(model, f, engine_mass, force, **kw)
         return StiffnessResult(f, r.kcp, method, r.x1, r.ft, meta={"periodicity": r.periodicity})
