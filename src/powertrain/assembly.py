@@ -15,6 +15,7 @@ channels per mount) and the force each mount transmits to ground, in engine axes
 
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -313,3 +314,73 @@ def _frame(mass, inertia, body_modes):
         C0[j, j] = 2.0 * mode.damping_ratio * mode.omega * mode.modal_mass
         K0[j, j] = mode.omega ** 2 * mode.modal_mass
     return M0, C0, K0
+
+
+class NetworkScaling:
+    """The assembled model's damping, stiffness and force rows with rescaled networks: the
+    one view of the system at other network scales (an amplitude law's factors per cycle in
+    the time domain, the static curves' operating point for the harmonic start, the
+    networks as measured for the modes).
+
+    Parameters
+    ----------
+    system : AssembledSystem
+    """
+
+    def __init__(self, system):
+        self.system = system
+        self.elements = [el for *_, el in system.networks]
+        self.C_parts, self.K_parts, self.gk, self.gd = system.network_parts()
+        #: the scales the assembled matrices hold (every element at amplitude 0)
+        self.assembled = self.scales(np.zeros(len(self.elements)))
+        #: True when some network's scale follows its amplitude
+        self.varying = any(el.amplitude_law is not None and not el.amplitude_law.constant
+                           for el in self.elements)
+
+    def elements_at(self, factors=None) -> list:
+        """The elements at the operating point of the static ``factors`` (n_net,) (None:
+        each element's own)."""
+        if factors is None:
+            return self.elements
+        return [el.at_operating_point(f) for el, f in zip(self.elements, factors)]
+
+    def scales(self, amplitudes, factors=None) -> np.ndarray:
+        """``(stiffness, damping)`` factor (n_net, 2) of every network at its amplitude
+        (n_net,) [m] and static factor."""
+        return np.array([el.scales(a) for el, a in zip(self.elements_at(factors),
+                                                        amplitudes)], float).reshape(-1, 2)
+
+    def matrices(self, scales):
+        """``(C, K, force_matrix_k, force_matrix_d)`` at the network ``scales`` (n_net, 2);
+        the assembled arrays themselves where no scale changed (bit-identical)."""
+        s = self.system
+        dk, dd = (np.asarray(scales, float) - self.assembled).T
+        if not (dk.any() or dd.any()):
+            return s.C, s.K, s.force_matrix_k, s.force_matrix_d
+        fmap = s.port_force_map
+        return (s.C + np.tensordot(dd, self.C_parts, 1), s.K + np.tensordot(dk, self.K_parts, 1),
+                s.force_matrix_k + (fmap * dk) @ self.gk,
+                s.force_matrix_d + (fmap * dd) @ self.gd)
+
+    def at_operating_point(self, factors):
+        """The assembled model with its elements at the static ``factors`` (n_net,): the
+        same model, its elements, C, K and force rows replaced (for the harmonic start)."""
+        return self.with_elements(self.elements_at(factors))
+
+    def as_measured(self):
+        """The assembled model with every network as measured
+        (:meth:`~powertrain.physics.mount_elements.MountElement.as_measured`): the linear
+        view the modes take."""
+        return self.with_elements([el.as_measured() for el in self.elements])
+
+    def with_elements(self, elements):
+        """The assembled model with ``elements`` (one per network, at amplitude 0): its
+        elements, C, K and force rows replaced."""
+        s = self.system
+        C, K, Fk, Fd = self.matrices(np.array([el.scales(0.0) for el in elements],
+                                              float).reshape(-1, 2))
+        ports = dataclasses.replace(s.network_ports, elements=elements)
+        return dataclasses.replace(s, C=C, K=K, force_matrix_k=Fk, force_matrix_d=Fd,
+                                   networks=[(*n[:3], el) for n, el in zip(s.networks,
+                                                                           elements)],
+                                   network_ports=ports)

@@ -9,7 +9,7 @@ The dense Newmark stepper and the continuous sweep integrate the same elements
 * the **amplitude law** once per engine cycle: after each cycle the amplitude of every
   nonlinear element, :math:`A = \sqrt 2\,` RMS over that cycle of the relative displacement
   across it (mean removed), rescales its network's springs and dampers for the next cycle
-  (:class:`NetworkScaling`: the global matrices are the assembled ones plus each network's
+  (:class:`powertrain.assembly.NetworkScaling`: the global matrices are the assembled ones plus each network's
   unit contribution times its change of scale, so a rebuild is a few array additions);
 * the **static factor** of every network (the static curve at the operating point, hook
   ``static_factors``: one factor per network, default each element's own ``static_factor``)
@@ -34,73 +34,6 @@ from powertrain.solvers.newmark import newmark, newmark_ports
 #: Engine cycles of prescribed harmonic motion that settle the port laws' minor loops
 #: before t = 0 (after a start at the tip of the steady loop of the cycle's range).
 LOOP_CYCLES = 2
-
-
-class NetworkScaling:
-    """The assembled model's damping, stiffness and force rows with rescaled networks.
-
-    Parameters
-    ----------
-    system : AssembledSystem
-    """
-
-    def __init__(self, system):
-        self.system = system
-        self.elements = [el for *_, el in system.networks]
-        self.C_parts, self.K_parts, self.gk, self.gd = system.network_parts()
-        #: the scales the assembled matrices hold (every element at amplitude 0)
-        self.assembled = self.scales(np.zeros(len(self.elements)))
-        #: True when some network's scale follows its amplitude
-        self.varying = any(el.amplitude_law is not None and not el.amplitude_law.constant
-                           for el in self.elements)
-
-    def elements_at(self, factors=None) -> list:
-        """The elements at the operating point of the static ``factors`` (n_net,) (None:
-        each element's own)."""
-        if factors is None:
-            return self.elements
-        return [el.at_operating_point(f) for el, f in zip(self.elements, factors)]
-
-    def scales(self, amplitudes, factors=None) -> np.ndarray:
-        """``(stiffness, damping)`` factor (n_net, 2) of every network at its amplitude
-        (n_net,) [m] and static factor."""
-        return np.array([el.scales(a) for el, a in zip(self.elements_at(factors),
-                                                        amplitudes)], float).reshape(-1, 2)
-
-    def matrices(self, scales):
-        """``(C, K, force_matrix_k, force_matrix_d)`` at the network ``scales`` (n_net, 2);
-        the assembled arrays themselves where no scale changed (bit-identical)."""
-        s = self.system
-        dk, dd = (np.asarray(scales, float) - self.assembled).T
-        if not (dk.any() or dd.any()):
-            return s.C, s.K, s.force_matrix_k, s.force_matrix_d
-        fmap = s.port_force_map
-        return (s.C + np.tensordot(dd, self.C_parts, 1), s.K + np.tensordot(dk, self.K_parts, 1),
-                s.force_matrix_k + (fmap * dk) @ self.gk,
-                s.force_matrix_d + (fmap * dd) @ self.gd)
-
-    def at_operating_point(self, factors):
-        """The assembled model with its elements at the static ``factors`` (n_net,): the
-        same model, its elements, C, K and force rows replaced (for the harmonic start)."""
-        return self.with_elements(self.elements_at(factors))
-
-    def as_measured(self):
-        """The assembled model with every network as measured
-        (:meth:`~powertrain.physics.mount_elements.MountElement.as_measured`): the linear
-        view the modes take."""
-        return self.with_elements([el.as_measured() for el in self.elements])
-
-    def with_elements(self, elements):
-        """The assembled model with ``elements`` (one per network, at amplitude 0): its
-        elements, C, K and force rows replaced."""
-        s = self.system
-        C, K, Fk, Fd = self.matrices(np.array([el.scales(0.0) for el in elements],
-                                              float).reshape(-1, 2))
-        ports = dataclasses.replace(s.network_ports, elements=elements)
-        return dataclasses.replace(s, C=C, K=K, force_matrix_k=Fk, force_matrix_d=Fd,
-                                   networks=[(*n[:3], el) for n, el in zip(s.networks,
-                                                                           elements)],
-                                   network_ports=ports)
 
 
 def cycle_signal(harmonics, n_cycle) -> np.ndarray:

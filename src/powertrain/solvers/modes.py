@@ -37,8 +37,8 @@ from __future__ import annotations
 import numpy as np
 import scipy.linalg as sla
 
+from powertrain.assembly import NetworkScaling
 from powertrain.physics.condensation import condense
-from powertrain.solvers.cycle_newmark import NetworkScaling
 
 #: What the modes of a model with amplitude laws or friction take (printed with them).
 AS_MEASURED = ("mounts as measured (networks as in their mount files: amplitude laws at "

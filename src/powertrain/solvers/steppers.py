@@ -32,8 +32,9 @@ import numpy as np
 
 from powertrain.analysis.fourier import harmonic_amplitudes
 from powertrain.analysis.orders import ORDERS, order_spectrum
+from powertrain.assembly import NetworkScaling
 from powertrain.kernels.port_forces import NONE
-from powertrain.solvers.cycle_newmark import CycleRun, NetworkScaling, run_cycles, start_state
+from powertrain.solvers.cycle_newmark import CycleRun, run_cycles, start_state
 from powertrain.solvers.equivalent_linear import AMPLITUDE_HARMONICS, TOLERANCE, amplitude_fixed_point
 from powertrain.solvers.harmonic import harmonic_response
 from powertrain.solvers.newmark import ModalNewmark, ModalPortNewmark, newmark
