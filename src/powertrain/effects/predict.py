@@ -25,14 +25,13 @@ from dataclasses import dataclass
 import numpy as np
 
 from powertrain.effects.registry import EFFECTS
-from powertrain.solvers.equivalent_linear import AMPLITUDE_FLOOR, DEPTH, AndersonSteps
+from powertrain.solvers.equivalent_linear import fixed_point
 from powertrain.solvers.fast_harmonic import HarmonicModel
 
-#: Amplitude fixed point: relative change of every speed's amplitudes at convergence and
-#: iteration limit (the steps: Anderson acceleration in log amplitudes, as the run-up's
-#: :func:`powertrain.solvers.equivalent_linear.amplitude_fixed_point`).
+#: Amplitude fixed point: relative change of every speed's amplitudes at convergence (the
+#: run-up's :func:`powertrain.solvers.equivalent_linear.fixed_point`, looser: the fit's
+#: residuals are compared at ~1e-3).
 TOLERANCE = 1e-6
-MAX_ITERATIONS = 200
 
 
 @dataclass
@@ -126,36 +125,32 @@ def _elements(hm, sc, s_el):
 
 
 def amplitude_iteration(hm, sc, els, load, body, *, tol=TOLERANCE, start=None):
-    """The nonlinear elements' fixed point :math:`A = g(A)` at every speed, ``g`` the
-    amplitudes of :meth:`HarmonicModel.relative_amplitude`: Anderson steps in log amplitudes
-    over all speeds at once (damped where the residual grows), until the largest change is
-    below ``tol`` of each speed's largest amplitude.
+    """The nonlinear elements' fixed point at every speed at once
+    (:func:`powertrain.solvers.equivalent_linear.fixed_point`, the run-up's), ``g`` the
+    amplitudes of :meth:`HarmonicModel.relative_amplitude`.
 
     Returns ``(two-ports with the effects, rigid-body amplitudes q, A (n_r, n_net),
-    iterations)``; raises ``FloatingPointError`` naming the mount direction and speed when
-    it does not converge in :data:`MAX_ITERATIONS`."""
+    iterations)``; raises ``AmplitudeNotConverged`` (a ``FloatingPointError``) naming the
+    mount direction and speed when it does not converge."""
     nl = np.array([el.nonlinear for el in els])
-    A = np.zeros((hm.rpm.size, len(els)))
-    if start is not None and np.shape(start) == A.shape:
-        A = np.array(start, float)
-    steps = AndersonSteps(DEPTH)
-    for it in range(1, MAX_ITERATIONS + 1):
-        abc = _two_ports(sc, hm, hm.two_ports_at(A, els))
-        q = hm.solve(abc[0], load, abc=abc, body=body)
-        G = hm.relative_amplitude(q, body)[:, nl]
-        size = np.maximum(np.max(np.abs(G), axis=1), np.finfo(float).tiny)
-        err = np.max(np.abs(G - A[:, nl]), axis=1) / size
-        if np.max(err) <= tol:
-            return abc, q, A, it
-        floor = AMPLITUDE_FLOOR * size[:, None]
-        x = np.log(np.maximum(A[:, nl], floor))
-        residual = np.log(np.maximum(G, floor)) - x
-        A[:, nl] = np.exp(steps.next(x.ravel(), residual.ravel())).reshape(x.shape)
-    r = int(np.argmax(err))
-    mi, axis, _ = [n for n, k in zip(hm.networks, nl) if k][int(np.argmax(np.abs(residual[r])))]
-    raise FloatingPointError(f"{hm.mount_names[mi]}.{axis} at {hm.rpm[r]:g} rpm: the "
-                             f"amplitude fixed point did not converge in {MAX_ITERATIONS} "
-                             f"iterations (change {np.max(err):.1e})")
+    base = np.zeros((hm.rpm.size, len(els)))
+    if start is not None and np.shape(start) == base.shape:
+        base = np.array(start, float)
+    names = [f"{hm.mount_names[mi]}.{axis}" for (mi, axis, _), k in zip(hm.networks, nl) if k]
+
+    def full(a):
+        A = base.copy()
+        A[:, nl] = a
+        return A
+
+    def solve(a):
+        abc = _two_ports(sc, hm, hm.two_ports_at(full(a), els))
+        return abc, hm.solve(abc[0], load, abc=abc, body=body)
+
+    a, (abc, q), iterations = fixed_point(
+        solve, lambda x: hm.relative_amplitude(x[1], body)[:, nl], names, hm.rpm,
+        base[:, nl], tol)
+    return abc, q, full(a), iterations
 
 
 def _linear_velocity(hm, abc, load, body, orders):

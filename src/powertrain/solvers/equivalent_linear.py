@@ -4,7 +4,7 @@ In the frequency domain a nonlinear element (:mod:`powertrain.physics.mount_elem
 acts through its describing function at the amplitude :math:`A` of the relative
 displacement across it, :math:`A = \sqrt 2\,` RMS over the engine cycle of orders 0.5 to 8,
 i.e. :math:`A = (\sum_j |\hat u_j|^2)^{1/2}` over those harmonics. The amplitudes and the
-response depend on each other: :func:`amplitude_fixed_point` solves
+response depend on each other: :func:`fixed_point` solves
 :math:`A = g(A)`, :math:`g` the amplitudes of the response at :math:`A`, by Anderson
 acceleration (Walker & Ni 2011) in log amplitudes: each step combines the last
 :data:`DEPTH` iterates so that the linearised residual :math:`\ln g(A) - \ln A` vanishes (a
@@ -50,7 +50,8 @@ def amplitudes_of(relative) -> np.ndarray:
 
 
 def amplitude_fixed_point(solve, relative_motion, ports, rpm, start=None, tolerance=TOLERANCE):
-    """The equivalent-linear steady state.
+    """The equivalent-linear steady state at one speed (:func:`fixed_point` of the ports'
+    amplitudes).
 
     Parameters
     ----------
@@ -73,26 +74,61 @@ def amplitude_fixed_point(solve, relative_motion, ports, rpm, start=None, tolera
     Returns
     -------
     amplitudes : ndarray (m,); solution : the ``solve`` result at them.
+    """
+    A = np.zeros(len(ports.names)) if start is None else np.asarray(start, float).copy()
+    A, solution, _ = fixed_point(lambda a: solve(ports.network_amplitudes(a)),
+                                 lambda x: amplitudes_of(relative_motion(x)), ports.names,
+                                 rpm, A, tolerance)
+    return A, solution
+
+
+def fixed_point(solve, amplitudes, names, rpm, start, tolerance=TOLERANCE):
+    """The fixed point :math:`A = g(A)` of the module docstring, at one speed (``start``
+    (m,)) or at several at once (``start`` (n_r, m), each row converged on its own largest
+    amplitude; the run-up's stepper and the diagnosis's cached model alike).
+
+    Parameters
+    ----------
+    solve : callable
+        ``solve(A)``: the response at the nonlinear elements' amplitudes A [m].
+    amplitudes : callable
+        ``amplitudes(solution)``: :math:`g(A)`, the amplitudes of that response [m], A's shape.
+    names : sequence of str
+        ``mount.direction`` of each element, for the error.
+    rpm : float or ndarray (n_r,)
+        Speed of each row, for the error.
+    start : ndarray (m,) or (n_r, m)
+        First guess [m].
+    tolerance : float
+        Relative change of the amplitudes at convergence.
+
+    Returns
+    -------
+    amplitudes, solution, iterations (solves made)
 
     Raises
     ------
     AmplitudeNotConverged
         No convergence within :data:`MAX_ITERATIONS` (a FloatingPointError).
     """
-    A = np.zeros(len(ports.names)) if start is None else np.asarray(start, float).copy()
+    A = np.array(start, float)
     steps = AndersonSteps(DEPTH)
-    for _ in range(MAX_ITERATIONS):
-        solution = solve(ports.network_amplitudes(A))
-        G = amplitudes_of(relative_motion(solution))
-        if np.max(np.abs(G - A)) <= tolerance * np.max(G):
-            return A, solution
-        floor = AMPLITUDE_FLOOR * max(np.max(G), np.finfo(float).tiny)
+    for it in range(1, MAX_ITERATIONS + 1):
+        solution = solve(A)
+        G = amplitudes(solution)
+        size = np.maximum(np.max(np.abs(G), axis=-1, keepdims=True), np.finfo(float).tiny)
+        err = np.max(np.abs(G - A), axis=-1, keepdims=True) / size
+        if np.max(err) <= tolerance:
+            return A, solution, it
+        floor = AMPLITUDE_FLOOR * size
         x = np.log(np.maximum(A, floor))
         residual = np.log(np.maximum(G, floor)) - x
-        A = np.exp(steps.next(x, residual))
-    worst = int(np.argmax(np.abs(residual)))
-    raise AmplitudeNotConverged(ports.names[worst], rpm, -np.expm1(-abs(residual[worst])),
-                                MAX_ITERATIONS)
+        A = np.exp(steps.next(x.ravel(), residual.ravel())).reshape(x.shape)
+    r = int(np.argmax(err.ravel()))
+    row = np.atleast_2d(residual)[r]
+    worst = int(np.argmax(np.abs(row)))
+    raise AmplitudeNotConverged(names[worst], float(np.ravel(rpm)[r]),
+                                -np.expm1(-abs(row[worst])), MAX_ITERATIONS)
 
 
 class AndersonSteps:
