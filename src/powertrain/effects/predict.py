@@ -26,6 +26,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from powertrain.effects.registry import EFFECTS
+from powertrain.physics.mount_network import PackedNetworks
 from powertrain.solvers.equivalent_linear import AMPLITUDE_FLOOR, DEPTH, AndersonSteps
 from powertrain.solvers.fast_harmonic import HarmonicModel
 
@@ -64,7 +65,7 @@ def _filled(hm, scenario):
     for name, p in scenario.items():
         if name not in EFFECTS:
             raise KeyError(f"unknown effect {name!r}")
-        sc[name] = (EFFECTS[name], {**EFFECTS[name].defaults(hm.engine), **p})
+        sc[name] = (EFFECTS[name], {**hm.effect_defaults(EFFECTS[name]), **p})
     return sc
 
 
@@ -140,8 +141,9 @@ def amplitude_iteration(hm, sc, els, load, body, *, tol=TOLERANCE, start=None):
     if start is not None and np.shape(start) == A.shape:
         A = np.array(start, float)
     steps = AndersonSteps(DEPTH)
+    packed = PackedNetworks.of([el.model.network() for el in els])    # once per fixed point
     for it in range(1, MAX_ITERATIONS + 1):
-        abc = _two_ports(sc, hm, hm.two_ports_at(A, els))
+        abc = _two_ports(sc, hm, hm.two_ports_at(A, els, packed))
         q = hm.solve(abc[0], load, abc=abc, body=body)
         G = hm.relative_amplitude(q, body)[:, nl]
         size = np.maximum(np.max(np.abs(G), axis=1), np.finfo(float).tiny)
