@@ -241,6 +241,7 @@ class PackedNetworks:
 
     @property
     def n_networks(self) -> int:
+        """Number of networks packed."""
         return self.mass_ptr.size - 1
 
     def arrays(self) -> tuple:
