@@ -114,6 +114,11 @@ class HarmonicModel:
     networks : list of (mount index, axis name, MountModel)
     elements : list of MountElement
         One per network; nonlinear ones act through :meth:`two_ports_at`.
+    packed : PackedNetworks
+        The networks packed once for the two-port kernel.
+
+    What the model computes it keeps while it lives (the load harmonics, the two-ports, the
+    effects' defaults, :meth:`load_velocity`'s parts); nothing is kept outside it.
     """
 
     def __init__(self, engine, rpm, n_angle=N_ANGLE):
@@ -139,8 +144,6 @@ class HarmonicModel:
         #: each network's mount element (:class:`~powertrain.physics.mount_elements.MountElement`:
         #: its amplitude law and port law with it)
         self.elements = [mod.element() for _, _, mod in nets]
-        #: the networks packed once for the two-port kernel
-        #: (:class:`~powertrain.physics.mount_network.PackedNetworks`)
         self.packed = PackedNetworks.of([mod.network() for _, _, mod in nets])
         #: every network's static factor per speed (n_r, n_net) at the operating point of
         #: the static curves (:mod:`powertrain.solvers.operating_point`); None without any
