@@ -472,7 +472,7 @@ def test_load_table_keeps_its_patterns_per_grid_and_equals_the_generalized_load(
             want = engine.generalized_load(r, theta)
             np.testing.assert_allclose(table[i], want, rtol=1e-10,
                                        atol=1e-9 * np.abs(want).max())
-    gas, inertia = engine.__dict__["_load_patterns_memo"][1]
+    gas, inertia = engine._cache["load patterns"][1]
     assert engine.load_table(rpm, theta.copy()) is not table
-    assert engine.__dict__["_load_patterns_memo"][1][1] is inertia and not inertia.flags.writeable
+    assert engine._cache["load patterns"][1][1] is inertia and not inertia.flags.writeable
     assert all(not g.flags.writeable for g in gas)

@@ -161,3 +161,51 @@ def test_a_plans_sensor_columns_read_at_once_are_its_runs_vectors(engine):
         assert np.array_equal(got, joint.vector(sc))
     runs[1].problem.vector({"mount_stiffness": {"k1": 1.3}})
     assert joint.read_vectors(cols) is None
+
+
+def test_an_evaluation_counts_one_whether_solved_or_read_from_the_cache(engine):
+    """The budget's count does not see the problem's cache: a point whose amplitude fixed
+    point is solved (several iterations) and the same point read from the cache each count
+    one evaluation, with the same residuals."""
+    from powertrain.diagnosis.packing import Packing
+    problem = _setup(engine, {"exponent": 0.2}, effect="amplitude_stiffness").problem
+    pack = Packing.of(("amplitude_stiffness",), problem.engine)
+    x = pack.x0.copy()
+    x[0] = 0.25                                     # the exponent: a nonlinear point
+    problem.reset_warm()
+    solved = search.Counted(problem, pack, 100)
+    r_solved = solved(x)
+    cached = search.Counted(problem, pack, 100)
+    r_cached = cached(x)
+    assert solved.n == cached.n == 1
+    assert np.array_equal(r_solved, r_cached)
+
+
+def _same_fit(a, b):
+    for key in ("params", "sigma", "nfev", "n_eval", "rss_train", "budget_hit",
+                "heldout_mse"):
+        assert getattr(a, key) == getattr(b, key), key
+    assert np.array_equal(a.x, b.x)
+
+
+@pytest.mark.parametrize("budget", [fit.EVAL_BUDGET, 40])
+def test_a_fit_is_the_same_in_any_order_of_calls(engine, budget):
+    """A fit stops on its own criteria: the same candidates fitted on the same data give
+    the same outcomes, bit for bit, whether fitted first on a cold problem (its cached
+    model empty) or after other fits filled its caches, in either order; also when the
+    budget stops them (every evaluation counts one, solved or read from the cache, however
+    many iterations its amplitude fixed point took)."""
+    params = {"exponent": 0.2, "damping_exponent": 1.0}
+    first, second = ("amplitude_stiffness",), ("mount_stiffness", "sensor_error")
+    cold = _setup(engine, params, effect="amplitude_stiffness").problem
+    a_then_b = [fit_candidate(cold, first, budget=budget),
+                fit_candidate(cold, second, budget=budget)]
+    warm = _setup(engine, params, effect="amplitude_stiffness").problem
+    b_then_a = [fit_candidate(warm, second, budget=budget),
+                fit_candidate(warm, first, budget=budget)]
+    again = fit_candidate(cold, first, budget=budget)
+    _same_fit(a_then_b[0], b_then_a[1])
+    _same_fit(a_then_b[1], b_then_a[0])
+    _same_fit(a_then_b[0], again)
+    assert a_then_b[0].budget_hit == (budget < fit.EVAL_BUDGET)
+    assert a_then_b[0].n_eval <= budget

@@ -4,7 +4,8 @@ onto the target only when complete; a command's outputs are committed together.
 * :func:`atomic_path` / :func:`atomic_write` write one file. Outside a transaction the
   temporary file replaces the target as soon as its block succeeds.
 * :class:`OutputTransaction` (``with OutputTransaction(): ...``, used by the CLI for every
-  command) *stages* every file written inside it: nothing in the user's folders is replaced
+  command) *stages* every file written inside it (in the context that entered it, a
+  :class:`contextvars.ContextVar`: its thread): nothing in the user's folders is replaced
   until the block ends without error; then all staged files are renamed onto their targets
   together, under an exclusive lock of each target folder, so two concurrent runs writing
   the same paths leave the complete set of one of them. A failure anywhere (also a failure
@@ -20,6 +21,7 @@ onto the target only when complete; a command's outputs are committed together.
 from __future__ import annotations
 
 import contextlib
+import contextvars
 import errno
 import os
 import re
@@ -32,8 +34,9 @@ from powertrain.errors import InputError
 #: minus room for the temporary name's prefix and suffix.
 MAX_NAME_BYTES = 255 - 40
 _TEMP = re.compile(r"^\..+\.pt(\d+)-[A-Za-z0-9_]+\.tmp$")
-#: The transaction in progress (innermost), or None.
-_ACTIVE: list = []
+#: The transaction in progress in this context (the innermost ``with``), or None.
+_CURRENT: contextvars.ContextVar[OutputTransaction | None] = contextvars.ContextVar(
+    "powertrain_output_transaction", default=None)
 
 
 def current_umask() -> int:
@@ -131,13 +134,14 @@ class OutputTransaction:
         self.staged: dict = {}              # target -> temporary file
         self.created: list = []             # folders created for the outputs
         self.committed: list = []
+        self._token = None                  # the context variable's value before ``with``
 
     def __enter__(self):
-        _ACTIVE.append(self)
+        self._token = _CURRENT.set(self)
         return self
 
     def __exit__(self, exc_type, exc, tb):
-        _ACTIVE.remove(self)
+        _CURRENT.reset(self._token)
         if exc_type is None or not _failed(exc):
             self.commit()
         else:
@@ -212,7 +216,7 @@ def atomic_path(target):
     """Yield a temporary path in the target's folder; on success it replaces ``target``
     (at once, or at the commit of the :class:`OutputTransaction` in progress)."""
     target = Path(target)
-    txn = _ACTIVE[-1] if _ACTIVE else None
+    txn = _CURRENT.get()
     created = txn.created if txn is not None else []
     try:
         _make_parent(target, created)

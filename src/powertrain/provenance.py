@@ -21,6 +21,8 @@ which their ``plot`` methods use when none is passed.
 
 from __future__ import annotations
 
+import contextlib
+import contextvars
 import dataclasses
 import datetime as _dt
 import math
@@ -33,8 +35,20 @@ import numpy as np
 #: Arrays longer than this are summarised (shape, min, max) instead of listed.
 MAX_LISTED = 64
 
-#: The command line of the running CLI command (set by :mod:`powertrain.cli`).
-COMMAND_LINE: list[str] = []
+#: The command line of the running CLI command (:func:`recording_command`), or None.
+_COMMAND_LINE: contextvars.ContextVar[tuple | None] = contextvars.ContextVar(
+    "powertrain_command_line", default=None)
+
+
+@contextlib.contextmanager
+def recording_command(argv):
+    """Within the block, :func:`command_line` is ``argv`` (the CLI's arguments as typed,
+    program name first)."""
+    token = _COMMAND_LINE.set(tuple(str(a) for a in argv))
+    try:
+        yield
+    finally:
+        _COMMAND_LINE.reset(token)
 
 
 def stamp_hdf5(attrs, file_format: str) -> None:
@@ -48,8 +62,9 @@ def stamp_hdf5(attrs, file_format: str) -> None:
 
 
 def command_line() -> str:
-    """The command as typed: the CLI's record, else ``sys.argv``."""
-    argv = COMMAND_LINE or ["powertrain", *sys.argv[1:]]
+    """The command as typed: the CLI's record (:func:`recording_command`), else
+    ``sys.argv``."""
+    argv = _COMMAND_LINE.get() or ["powertrain", *sys.argv[1:]]
     return shlex.join(str(a) for a in argv)
 
 

@@ -28,7 +28,6 @@ Vold–Kalman filtering (:mod:`powertrain.analysis.vold_kalman`) is the second m
 
 from __future__ import annotations
 
-import functools
 import math
 
 import numpy as np
@@ -106,13 +105,10 @@ def samples_per_rev(orders) -> int:
     return int(2 ** math.ceil(math.log2(need)))
 
 
-@functools.lru_cache(maxsize=4)
 def kernel_table(K, beta, n_tab=16385):
     """Kaiser-windowed sinc with K zero crossings per side, on v = -1 ... 1."""
     v = np.linspace(-1.0, 1.0, n_tab)
-    table = np.sinc(K * v) * np.kaiser(n_tab, beta)
-    table.flags.writeable = False
-    return table
+    return np.sinc(K * v) * np.kaiser(n_tab, beta)
 
 
 def speed_grid(profile, rpm_step, block_revs, *, margin_s=0.0, file=None, key="rpm"):

@@ -19,10 +19,9 @@ class _Group(click.Group):
     """
 
     def main(self, args=None, *posargs, **kwargs):
-        from powertrain import provenance
-        provenance.COMMAND_LINE[:] = ["powertrain",
-                                      *(sys.argv[1:] if args is None else list(args))]
-        return super().main(args, *posargs, **kwargs)
+        from powertrain.provenance import recording_command
+        with recording_command(["powertrain", *(sys.argv[1:] if args is None else args)]):
+            return super().main(args, *posargs, **kwargs)
 
     def invoke(self, ctx):
         from powertrain.cli.common import terminate_as_exit

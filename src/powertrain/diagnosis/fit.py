@@ -5,8 +5,9 @@ Each candidate (one effect of the registry, or a pair) is fitted on the training
 bounded least squares in dB (``scipy.optimize.least_squares``, trust region reflective,
 multi-start: the defaults, given starts and, for single effects that declare one, the two
 best points of a coarse grid) and scored on the held-out speeds. Every fit has an
-evaluation budget (:data:`EVAL_BUDGET` residual evaluations, Jacobian columns included):
-when it is hit the best point so far is kept and the outcome says so (``budget_hit``).
+evaluation budget (:data:`EVAL_BUDGET` residual evaluations, Jacobian columns included,
+each counted once whether its velocities were solved or read from the cache): when it is hit
+the best point so far is kept and the outcome says so (``budget_hit``).
 
 Parameters with a prior (``Parameter.prior_sd``) add the residual
 :math:`\hat\sigma\,(x - x_0)/s_p` per parameter (:math:`\hat\sigma` the measured scatter in
@@ -46,10 +47,11 @@ from powertrain.solvers.fast_harmonic import N_HARMONICS
 #: Orders 0.5..8 of the model velocities (harmonics 1..16).
 N_ORDERS = N_HARMONICS - 1
 
-#: Evaluation budget per fit, in solves of the cached model (all starts, grid and Jacobian
-#: columns included; an evaluation costs the solves it made, at least 1: a sensor reading
-#: of cached velocities counts 1, an amplitude-dependent evaluation its fixed-point
-#: iterations); reached, the fit stops with the best point so far (``budget_hit``).
+#: Evaluation budget per fit, in residual evaluations (all starts, grid and Jacobian
+#: columns included; every point counts 1, whether its velocities were solved or read from
+#: the cache and however many iterations its amplitude fixed point took, so that where a
+#: fit stops depends on its points only); reached, the fit stops with the best point so far
+#: (``budget_hit``).
 EVAL_BUDGET = 2500
 
 
@@ -85,8 +87,8 @@ class FitOutcome:
     heldout_gaps: np.ndarray | None = field(default=None, repr=False)
     status_code: object = None
     units: dict = field(default_factory=dict)
-    #: Residual evaluations spent, weighted by cost (the budget's unit).
-    n_eval: float = 0.0
+    #: Residual evaluations spent (the budget's unit).
+    n_eval: int = 0
     #: candidates whose finding this fit restates (:func:`candidates.restatements`)
     restates: tuple = ()
 
@@ -161,21 +163,12 @@ class Problem:
         self._offset = ph.OffsetProfile(self._order_on["train"], self._w_on["train"],
                                         self.sigma_db)
 
-    def __getstate__(self):
-        # sent to other processes (parallel fits): the engine without its pressure cache
-        state = dict(self.__dict__)
-        if hasattr(self.engine, "replace"):
-            state["engine"] = self.engine.replace()
-        return state
-
     def reset_warm(self):
-        """Forget the cached velocities, the amplitude fixed point's start
-        (:class:`~powertrain.diagnosis.warm_start.AmplitudeStart`) and the solve
-        count (at the start of every fit, so that a fit's result does not depend on what ran
-        before it)."""
+        """Forget the cached velocities and the amplitude fixed point's start
+        (:class:`~powertrain.diagnosis.warm_start.AmplitudeStart`) (at the start of every
+        fit, so that a fit's result does not depend on what ran before it)."""
         self._last = {}
         self._warm = {}
-        self.solves = 0
 
     def restricted(self, train_cells=None, test_cells=None) -> Problem:
         """The same problem with (channel, order) cells withheld from fitting / scoring."""
@@ -198,7 +191,6 @@ class Problem:
             vel = pred.velocity
             if pred.amplitudes is not None:
                 warm.record(v, pred.amplitudes)
-            self.solves += max(1, pred.iterations)
             self._last[part] = (key, vel)
         for k, v in scenario.items():
             if EFFECTS[k].response_only:

@@ -64,10 +64,6 @@ class JointProblem:
         return p.phase_w[part] if p.phase_w is not None else np.full(p.meas[part].shape,
                                                                       np.nan)
 
-    @property
-    def solves(self) -> int:
-        return sum(p.solves for p in self.runs)
-
     def reset_warm(self):
         for p in self.runs:
             p.reset_warm()

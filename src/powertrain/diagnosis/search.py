@@ -40,7 +40,10 @@ class Counted:
 
     def __init__(self, problem, pack, budget):
         self.problem, self.pack, self.budget = problem, pack, budget
-        self.n = 0.0
+        #: residual evaluations charged so far: one per point, whether its velocities were
+        #: solved or read from the problem's cache and however many iterations its
+        #: amplitude fixed point took
+        self.n = 0
         self.best = (np.inf, None, None)
         self.last = (None, None)
         self._stall = None
@@ -65,12 +68,11 @@ class Counted:
         return problem.vector(self.pack.scenario(self.pack.x0)).size
 
     def evaluate(self, problem, x):
-        """Residuals of ``problem`` at ``x`` with the prior's, charged to the budget (raises
-        when it is spent)."""
+        """Residuals of ``problem`` at ``x`` with the prior's, charged one evaluation to the
+        budget (raises when it is spent)."""
         self._check_budget()
-        before = problem.solves
         r = self.residuals(problem, x)
-        self.n += max(1, problem.solves - before)
+        self.n += 1
         return r
 
     def _check_budget(self):
@@ -157,7 +159,7 @@ class Counted:
                 continue
             for x, v in zip(run, vs):
                 self._check_budget()
-                self.n += 1                # a reading of cached velocities: no solve
+                self.n += 1                # one evaluation, as by :meth:`evaluate`
                 r = self._with_prior(v, x)
                 out.append(self._seen(x, r) if keep else r)
             break

@@ -14,13 +14,9 @@ effect: one new module with a subclass and its tests, and one line in
 from __future__ import annotations
 
 import dataclasses
-import weakref
 from dataclasses import dataclass
 
 import numpy as np
-
-#: Each effect's defaults per engine (:meth:`Effect.defaults`), held while the engine lives.
-_DEFAULTS: dict = {}
 
 
 @dataclass(frozen=True)
@@ -108,17 +104,10 @@ class Effect:
         return True
 
     def defaults(self, engine=None) -> dict:
-        """``{parameter: default}`` for ``engine`` (kept per engine: the fast path fills
-        every scenario with them, thousands of times a fit)."""
-        if engine is None:
-            return {p.name: p.default for p in self.parameters(engine)}
-        kept = _DEFAULTS.setdefault(self.name, weakref.WeakKeyDictionary())
-        try:
-            if engine not in kept:
-                kept[engine] = {p.name: p.default for p in self.parameters(engine)}
-        except TypeError:                    # an engine stand-in without weak references
-            return {p.name: p.default for p in self.parameters(engine)}
-        return dict(kept[engine])
+        """``{parameter: default}`` for ``engine`` (the cached model keeps them per effect:
+        :meth:`HarmonicModel.effect_defaults
+        <powertrain.solvers.fast_harmonic.HarmonicModel.effect_defaults>`)."""
+        return {p.name: p.default for p in self.parameters(engine)}
 
     def bounds(self, engine=None):
         ps = self.parameters(engine)

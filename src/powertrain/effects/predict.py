@@ -25,6 +25,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from powertrain.effects.registry import EFFECTS
+from powertrain.physics.mount_network import PackedNetworks
 from powertrain.solvers.equivalent_linear import fixed_point
 from powertrain.solvers.fast_harmonic import HarmonicModel
 
@@ -62,7 +63,7 @@ def _filled(hm, scenario):
     for name, p in scenario.items():
         if name not in EFFECTS:
             raise KeyError(f"unknown effect {name!r}")
-        sc[name] = (EFFECTS[name], {**EFFECTS[name].defaults(hm.engine), **p})
+        sc[name] = (EFFECTS[name], {**hm.effect_defaults(EFFECTS[name]), **p})
     return sc
 
 
@@ -137,6 +138,7 @@ def amplitude_iteration(hm, sc, els, load, body, *, tol=TOLERANCE, start=None):
     if start is not None and np.shape(start) == base.shape:
         base = np.array(start, float)
     names = [f"{hm.mount_names[mi]}.{axis}" for (mi, axis, _), k in zip(hm.networks, nl) if k]
+    packed = PackedNetworks.of([el.lumped for el in els])    # once per fixed point
 
     def full(a):
         A = base.copy()
@@ -144,7 +146,7 @@ def amplitude_iteration(hm, sc, els, load, body, *, tol=TOLERANCE, start=None):
         return A
 
     def solve(a):
-        abc = _two_ports(sc, hm, hm.two_ports_at(full(a), els))
+        abc = _two_ports(sc, hm, hm.two_ports_at(full(a), els, packed))
         return abc, hm.solve(abc[0], load, abc=abc, body=body)
 
     a, (abc, q), iterations = fixed_point(

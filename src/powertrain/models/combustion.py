@@ -8,12 +8,12 @@ Each model gives the pressure of every cylinder over an engine cycle at a speed
 from __future__ import annotations
 
 import dataclasses
-import functools
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
 from powertrain.models.crank_train import CrankTrain
+from powertrain.models.memo import Memo
 from powertrain.physics import combustion as comb
 
 #: rad/s per rpm.
@@ -77,6 +77,8 @@ class SingleZoneCombustion:
     intake_temperature: float
     grid_points: int = 5760
     model: str = "single-zone"
+    #: the cycle grid and pressure basis of the last crank train (:meth:`cycle_basis`)
+    _memo: Memo = field(default_factory=Memo, init=False, repr=False, compare=False)
     #: engine-file key of the speed range (named in an out-of-range error)
     speed_key = "combustion.full_load.speed"
 
@@ -98,7 +100,7 @@ class SingleZoneCombustion:
             ``imep_target`` [Pa] per cylinder, ``heat`` [J] per cylinder, ``p_intake``,
             ``p_exhaust`` [Pa].
         """
-        theta, V, dV, (b_in, b_ex, p1) = _cycle_basis(self, crank)
+        theta, V, dV, (b_in, b_ex, p1) = self.cycle_basis(crank)
         vd = crank.swept_volume
         imep = self.full_load.imep(omega, crank.displacement, load)
         p_in = comb.boost_pressure(
@@ -116,6 +118,26 @@ class SingleZoneCombustion:
         return theta, pressure, {"imep_target": targets, "heat": heats, "p_intake": p_in,
                                  "p_exhaust": p_ex}
 
+    def cycle_basis(self, crank: CrankTrain):
+        """The cycle grid ``theta`` [rad], volume ``V`` [m³], ``dV/dtheta`` [m³/rad] and
+        pressure basis (:func:`powertrain.physics.combustion.pressure_basis`) of ``crank``,
+        which do not depend on the speed: kept in the model's memo with the crank train
+        they belong to (read-only arrays, shared by every call)."""
+        kept = self._memo.get("cycle basis")
+        if kept is not None and kept[0] is crank:
+            return kept[1]
+        n = self.grid_points
+        theta = -np.pi + 4.0 * np.pi * np.arange(n) / n
+        V, dV = crank.volume(theta)
+        basis = comb.pressure_basis(theta, V, self.n_compression, self.n_expansion,
+                                    self.start, self.duration, self.wiebe_a, self.wiebe_m,
+                                    self.exhaust_valve_opening, self.blowdown_end,
+                                    self.valve_overlap)
+        for a in (theta, V, dV, *basis):
+            a.setflags(write=False)
+        self._memo["cycle basis"] = (crank, (theta, V, dV, basis))
+        return theta, V, dV, basis
+
     def friction_mean_effective_pressure(self, omega: float) -> float:
         """FMEP [Pa] at ``omega`` [rad/s]: the full-load curve's."""
         return self.full_load.fmep_at(omega)
@@ -123,23 +145,6 @@ class SingleZoneCombustion:
     def speed_range(self):
         """(min, max) speed of the full-load curve [rad/s]."""
         return float(self.full_load.speed[0]), float(self.full_load.speed[-1])
-
-
-@functools.lru_cache(maxsize=8)
-def _cycle_basis(model: SingleZoneCombustion, crank: CrankTrain):
-    """The single-zone model's cycle grid, volume, dV/dtheta and pressure basis
-    (:func:`powertrain.physics.combustion.pressure_basis`), which do not depend on the
-    speed: computed once per model and crank train (both compared by identity)."""
-    n = model.grid_points
-    theta = -np.pi + 4.0 * np.pi * np.arange(n) / n
-    V, dV = crank.volume(theta)
-    basis = comb.pressure_basis(theta, V, model.n_compression, model.n_expansion, model.start,
-                                model.duration, model.wiebe_a, model.wiebe_m,
-                                model.exhaust_valve_opening, model.blowdown_end,
-                                model.valve_overlap)
-    for a in (theta, V, dV, *basis):
-        a.setflags(write=False)               # shared by every call
-    return theta, V, dV, basis
 
 
 @dataclass(frozen=True, eq=False)

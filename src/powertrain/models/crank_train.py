@@ -6,11 +6,11 @@ for the axes and the load they put on the powertrain.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
-from powertrain.models.grid_memo import on_last_grid
+from powertrain.models.memo import Memo
 from powertrain.physics import slider_crank as sc
 
 
@@ -59,6 +59,8 @@ class CrankTrain:
     rotating_mass: float
     counterweight_fraction: float
     crankcase_pressure: float
+    #: the last crank-angle grid's volumes (:meth:`volume`)
+    _memo: Memo = field(default_factory=Memo, init=False, repr=False, compare=False)
 
     @property
     def n_cylinders(self) -> int:
@@ -93,10 +95,9 @@ class CrankTrain:
     def volume(self, theta):
         """Cylinder volume [m³] and dV/dθ [m³/rad] at crank angle ``theta`` [rad].
 
-        The last grid's result is kept (read-only arrays): the combustion models ask for
-        the same cycle grid at every speed and cylinder (the measured-trace models' load
-        derivatives took 0.4 s of kinematics for it)."""
-        return on_last_grid(self, "_volume_memo", theta, lambda th: sc.cylinder_volume(
+        The last grid's result is kept in the crank train's memo (read-only arrays): the
+        combustion models ask for the same cycle grid at every speed and cylinder."""
+        return self._memo.last_grid("volume", theta, lambda th: sc.cylinder_volume(
             th, self.bore, self.crank_radius, self.rod_length, self.pin_offset,
             self.compression_ratio))
 

@@ -40,7 +40,7 @@ import numpy as np
 from powertrain.assembly import assemble
 from powertrain.models.combustion import RPM, FullLoadCurve, MeasuredPressure, SingleZoneCombustion  # noqa: F401 (re-export)
 from powertrain.models.crank_train import Balancer, BalancerShaft, CrankTrain  # noqa: F401 (re-export)
-from powertrain.models.grid_memo import on_last_grid
+from powertrain.models.memo import Memo
 from powertrain.physics import balancer as bal
 from powertrain.physics import combustion as comb
 from powertrain.physics import slider_crank as sc
@@ -176,12 +176,12 @@ class Engine:
     file: str = ""
     chassis: object = None
     gear_ratio: float = 1.0
-    _cache: dict = field(default_factory=dict, repr=False, compare=False)
+    #: cycle pressures per speed and load, the last crank-angle grid's load patterns
+    _cache: Memo = field(default_factory=Memo, init=False, repr=False, compare=False)
 
     # ------------------------------------------------------------------ copies
     def replace(self, **changes) -> Engine:
-        """A copy with fields replaced (``dataclasses.replace``; the pressure cache is reset)."""
-        changes.setdefault("_cache", {})
+        """A copy with fields replaced (``dataclasses.replace``; its memo starts empty)."""
         return dataclasses.replace(self, **changes)
 
     def with_balancers(self, enabled: bool = True, mass_radius: float | None = None) -> Engine:
@@ -269,11 +269,12 @@ class Engine:
         """Grid, pressures and model info of every cylinder (cached per speed and load)."""
         rpm = self._check_speed(rpm)
         key = (rpm, float(load))
-        if key not in self._cache:
-            if len(self._cache) > 64:
-                self._cache.clear()
-            self._cache[key] = self.combustion.cycle_pressures(self.crank, rpm * RPM, load)
-        return self._cache[key]
+        kept = self._cache.setdefault("cycle pressures", {})
+        if key not in kept:
+            if len(kept) > 64:
+                kept.clear()
+            kept[key] = self.combustion.cycle_pressures(self.crank, rpm * RPM, load)
+        return kept[key]
 
     def cylinder_pressure(self, rpm: float, crank_angle_rad, load: float = 1.0) -> np.ndarray:
         """Absolute pressure [Pa] of every cylinder, shape ``(n, n_cyl)``, at cylinder-1
@@ -444,7 +445,7 @@ class Engine:
         th = np.atleast_1d(np.asarray(crank_angle_rad, dtype=float))
         speeds = np.atleast_1d(np.asarray(speeds_rpm, dtype=float))
         ct = self.crank
-        gas, inertia = on_last_grid(self, "_load_patterns_memo", th, self._load_patterns)
+        gas, inertia = self._cache.last_grid("load patterns", th, self._load_patterns)
         table = ((speeds * RPM) ** 2)[:, None, None] * inertia
         fg = (self.cylinder_pressures(speeds, th, load) - ct.crankcase_pressure) * ct.piston_area
         for i, g in enumerate(gas):

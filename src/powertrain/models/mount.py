@@ -35,6 +35,7 @@ preset                 n    elements
 
 from __future__ import annotations
 
+import functools
 from dataclasses import dataclass, field, replace
 
 import numpy as np
@@ -191,19 +192,20 @@ class MountModel:
 
     def network(self):
         """``(masses, elem_nodes, c, d)`` arrays for :mod:`powertrain.physics.mount_network`
-        (read-only, made once: the model is frozen and the amplitude fixed point asks for
-        them at every iteration)."""
-        cached = self.__dict__.get("_network")
-        if cached is None:
-            t = self.topology
-            cached = (np.array([self.params[m] if m else 0.0 for m in t.masses], dtype=float),
-                      t.elem_nodes,
-                      np.array([self.params[e[2]] if e[2] else 0.0 for e in t.elements], float),
-                      np.array([self.params[e[3]] if e[3] else 0.0 for e in t.elements], float))
-            for array in cached:
-                array.setflags(write=False)
-            object.__setattr__(self, "_network", cached)
-        return cached
+        (read-only, made once per model: the model is frozen and the amplitude fixed point
+        asks for them at every iteration)."""
+        return self._network
+
+    @functools.cached_property
+    def _network(self):
+        t = self.topology
+        arrays = (np.array([self.params[m] if m else 0.0 for m in t.masses], dtype=float),
+                  t.elem_nodes,
+                  np.array([self.params[e[2]] if e[2] else 0.0 for e in t.elements], float),
+                  np.array([self.params[e[3]] if e[3] else 0.0 for e in t.elements], float))
+        for array in arrays:
+            array.setflags(write=False)
+        return arrays
 
     def element(self) -> MountElement:
         """The element the assembled model holds for this direction."""

@@ -36,7 +36,12 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from powertrain.kernels.port_forces import JENKINS, NONE, port_force
-from powertrain.physics.mount_network import laplace_two_port, laplace_two_ports, network_matrices
+from powertrain.physics.mount_network import (
+    PackedNetworks,
+    laplace_two_port,
+    laplace_two_ports,
+    network_matrices,
+)
 
 
 @dataclass(frozen=True)
@@ -108,10 +113,12 @@ def describing_stiffnesses(elements, amplitudes) -> list:
     return out
 
 
-def element_two_ports(elements, s, amplitudes):
+def element_two_ports(elements, s, amplitudes, packed=None):
     r""":meth:`MountElement.two_port` of several elements, each ``s.shape + (n_el,)``:
     element k at the amplitudes ``amplitudes[..., k]`` [m] (broadcast to ``s``), the
-    networks condensed in one kernel call (:func:`laplace_two_ports`), the port laws'
+    networks condensed in one kernel call (:func:`laplace_two_ports`; ``packed``: the
+    elements' networks packed once by the caller,
+    :class:`~powertrain.physics.mount_network.PackedNetworks`), the port laws'
     describing stiffnesses added at every :math:`s \ne 0`."""
     lam = np.asarray(s, complex)
     A = np.asarray(amplitudes, float)
@@ -125,7 +132,9 @@ def element_two_ports(elements, s, amplitudes):
         scales[0][..., index], scales[1][..., index] = ks, ds
     for k, el in enumerate(elements):
         scales[:, ..., k] *= el.static_factor
-    a, b, c = laplace_two_ports(lam, [el.lumped for el in elements], *scales)
+    if packed is None:
+        packed = PackedNetworks.of([el.lumped for el in elements])
+    a, b, c = laplace_two_ports(lam, packed, *scales)
     for k, el in enumerate(elements):
         if el.port_law is not None:
             kd = np.where(lam == 0, 0.0, el.port_law.describing_stiffness(A[..., k]))

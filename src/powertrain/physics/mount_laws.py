@@ -27,7 +27,6 @@ applies them:
 
 from __future__ import annotations
 
-import functools
 from dataclasses import dataclass
 
 import numpy as np
@@ -39,10 +38,15 @@ from powertrain.kernels.port_forces import BERG
 _GAUSS_NODES = 48
 
 
-@functools.lru_cache(maxsize=4)
-def _gauss_legendre(n: int):
-    """Gauss–Legendre nodes and weights on [-1, 1] (computed once: an eigenproblem)."""
-    return np.polynomial.legendre.leggauss(n)
+def _read_only(*arrays):
+    for a in arrays:
+        a.setflags(write=False)
+    return arrays
+
+
+#: The Gauss–Legendre rule of :data:`_GAUSS_NODES` nodes on [-1, 1]: nodes, weights
+#: (constants, read-only).
+_GAUSS_LEGENDRE = _read_only(*np.polynomial.legendre.leggauss(_GAUSS_NODES))
 
 
 @dataclass(frozen=True)
@@ -231,7 +235,7 @@ class BergFriction:
         if self.max_force <= 0 or not big.any():
             return out.reshape(np.shape(amplitude))
         a = A[big][:, None]
-        t, w = _gauss_legendre(_GAUSS_NODES)
+        t, w = _GAUSS_LEGENDRE
         theta = 0.5 * np.pi * t[None, :]
         fr = self.loop_amplitude_force(a)
         fm, x2 = self.max_force, self.half_displacement

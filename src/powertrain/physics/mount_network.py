@@ -30,6 +30,8 @@ References
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import numpy as np
 
 #: Index of the ground (chassis) node in ``elem_nodes``.
@@ -182,8 +184,9 @@ def laplace_two_ports(s, networks, spring_scales, damper_scales):
     ----------
     s : array_like complex
         Laplace variable [1/s], any shape.
-    networks : list of tuple
-        ``(masses, elem_nodes, c, d)`` per network (:func:`network_matrices`).
+    networks : list of tuple or PackedNetworks
+        ``(masses, elem_nodes, c, d)`` per network (:func:`network_matrices`), or the same
+        packed once (:meth:`PackedNetworks.of`) by a caller that condenses them many times.
     spring_scales, damper_scales : array_like float
         Factors on network k's springs and dampers at ``[..., k]``, broadcast to
         ``s.shape + (n_net,)``.
@@ -198,43 +201,52 @@ def laplace_two_ports(s, networks, spring_scales, damper_scales):
         A network is singular at some ``s``.
     """
     from powertrain.kernels.two_port import two_ports_kernel
+    packed = networks if isinstance(networks, PackedNetworks) else PackedNetworks.of(networks)
     lam = np.asarray(s, complex)
-    n, shape = len(networks), lam.shape + (len(networks),)
+    n = packed.n_networks
+    shape = lam.shape + (n,)
     scales = [np.ascontiguousarray(np.broadcast_to(np.asarray(x, float), shape).reshape(-1, n))
               for x in (spring_scales, damper_scales)]
     out = [np.empty((lam.size, n), complex) for _ in range(3)]
-    if two_ports_kernel(np.ascontiguousarray(lam.reshape(-1)), *scales, *_packed(networks),
+    if two_ports_kernel(np.ascontiguousarray(lam.reshape(-1)), *scales, *packed.arrays(),
                         *out):
         raise FloatingPointError("mount network singular at some frequency (two-port pivot "
                                  "below tolerance)")
     return tuple(v.reshape(shape) for v in out)
 
 
-#: Packed networks of the last calls of :func:`laplace_two_ports` whose arrays are all
-#: read-only (:meth:`MountModel.network <powertrain.models.mount.MountModel.network>`), by
-#: the identity of those arrays (kept alive here, so that an identity is not reused while
-#: its entry exists; read-only, so that their values cannot change).
-_PACKED = {}
+@dataclass(frozen=True, eq=False)
+class PackedNetworks:
+    """Several networks concatenated as :func:`laplace_two_ports` hands them to
+    :func:`powertrain.kernels.two_port.two_ports_kernel`: network k's masses are
+    ``masses[mass_ptr[k]:mass_ptr[k + 1]]``, its elements (node pairs ``elem_nodes``,
+    springs ``c`` [N/m], dampers ``d`` [N·s/m]) rows ``el_ptr[k]:el_ptr[k + 1]``."""
 
+    mass_ptr: np.ndarray
+    masses: np.ndarray
+    el_ptr: np.ndarray
+    elem_nodes: np.ndarray
+    c: np.ndarray
+    d: np.ndarray
 
-def _packed(networks):
-    """``(mass_ptr, masses, el_ptr, elem_nodes, c, d)`` of the networks concatenated."""
-    frozen = all(isinstance(x, np.ndarray) and not x.flags.writeable
-                 for net in networks for x in net)
-    key = tuple(id(x) for net in networks for x in net)
-    hit = _PACKED.get(key) if frozen else None
-    if hit is not None and all(x is y for a, b in zip(hit[0], networks) for x, y in zip(a, b)):
-        return hit[1]
-    ptr = [np.cumsum([0] + [len(net[i]) for net in networks]) for i in (0, 2)]
-    arrays = [np.concatenate([np.asarray(net[i], float).reshape(-1) for net in networks])
-              for i in (0, 2, 3)]
-    nodes = np.concatenate([np.asarray(net[1], np.int64).reshape(-1, 2) for net in networks])
-    packed = (ptr[0], arrays[0], ptr[1], nodes, arrays[1], arrays[2])
-    if frozen:
-        if len(_PACKED) >= 16:
-            del _PACKED[next(iter(_PACKED))]
-        _PACKED[key] = (tuple(tuple(net) for net in networks), packed)
-    return packed
+    @classmethod
+    def of(cls, networks) -> PackedNetworks:
+        """Pack ``(masses, elem_nodes, c, d)`` per network."""
+        ptr = [np.cumsum([0] + [len(net[i]) for net in networks]) for i in (0, 2)]
+        arrays = [np.concatenate([np.asarray(net[i], float).reshape(-1) for net in networks])
+                  for i in (0, 2, 3)]
+        nodes = np.concatenate([np.asarray(net[1], np.int64).reshape(-1, 2)
+                                for net in networks])
+        return cls(ptr[0], arrays[0], ptr[1], nodes, arrays[1], arrays[2])
+
+    @property
+    def n_networks(self) -> int:
+        """Number of networks packed."""
+        return self.mass_ptr.size - 1
+
+    def arrays(self) -> tuple:
+        """The kernel's arguments ``(mass_ptr, masses, el_ptr, elem_nodes, c, d)``."""
+        return self.mass_ptr, self.masses, self.el_ptr, self.elem_nodes, self.c, self.d
 
 
 def cross_point_stiffness(omega, masses, elem_nodes, c, d):

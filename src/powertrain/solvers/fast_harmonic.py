@@ -45,7 +45,7 @@ from powertrain.assembly import DIRECTIONS
 from powertrain.physics import balancer as bal
 from powertrain.physics.condensation import harmonic_solve
 from powertrain.physics.mount_elements import element_two_ports
-from powertrain.physics.mount_network import laplace_two_ports
+from powertrain.physics.mount_network import PackedNetworks, laplace_two_ports
 from powertrain.solvers.body_coupling import (
     ModalBody,
     coupled_solve,
@@ -114,6 +114,11 @@ class HarmonicModel:
     networks : list of (mount index, axis name, MountModel)
     elements : list of MountElement
         One per network; nonlinear ones act through :meth:`two_ports_at`.
+    packed : PackedNetworks
+        The networks packed once for the two-port kernel.
+
+    What the model computes it keeps while it lives (the load harmonics, the two-ports, the
+    effects' defaults, :meth:`load_velocity`'s parts); nothing is kept outside it.
     """
 
     def __init__(self, engine, rpm, n_angle=N_ANGLE, system=None):
@@ -134,6 +139,7 @@ class HarmonicModel:
         #: each network's mount element (:class:`~powertrain.physics.mount_elements.MountElement`:
         #: its amplitude law and port law with it)
         self.elements = list(ports.elements)
+        self.packed = PackedNetworks.of([el.lumped for el in self.elements])
         #: every network's static factor per speed (n_r, n_net) at the operating point of
         #: the static curves (:mod:`powertrain.solvers.operating_point`); None without any
         self.static_scale = static_factor_table(engine, self.rpm)
@@ -146,6 +152,7 @@ class HarmonicModel:
         self._extra = {}
         self._scaled = {}
         self._one_more_mode_at = None
+        self._effect_defaults = {}
         self._body_setup(engine, ports)
 
     def _body_setup(self, engine, ports):
@@ -183,6 +190,15 @@ class HarmonicModel:
             self._load = self.load_of(self.engine)
         return self._load
 
+    def effect_defaults(self, effect) -> dict:
+        """``effect.defaults(engine)`` for the model's engine (an
+        :class:`~powertrain.effects.base.Effect`), kept per effect: every prediction fills
+        its scenario with them."""
+        kept = self._effect_defaults.get(effect.name)
+        if kept is None:
+            kept = self._effect_defaults[effect.name] = effect.defaults(self.engine)
+        return dict(kept)
+
     def shaft_loads(self) -> np.ndarray:
         """Per balancer shaft load harmonics (n_shafts, n_r, 17, 6), nominal unbalance."""
         if "shafts" not in self._extra:
@@ -205,7 +221,8 @@ class HarmonicModel:
             return self._abc
         mods = [n[2] for n in self.networks] if models is None else models
         static = self._statics(range(len(mods)))
-        abc = laplace_two_ports(1j * self.omega, [m.network() for m in mods], static, static)
+        nets = self.packed if models is None else [m.network() for m in mods]
+        abc = laplace_two_ports(1j * self.omega, nets, static, static)
         if models is None:
             self._abc = abc
         return abc
@@ -227,7 +244,7 @@ class HarmonicModel:
             return self._scaled_networks(list(zip(scale.flat, damper.flat)))
         shape = self.omega.shape + (n_net,)
         statics = self._statics(range(n_net))
-        return laplace_two_ports(1j * self.omega, [n[2].network() for n in self.networks],
+        return laplace_two_ports(1j * self.omega, self.packed,
                                  np.broadcast_to(scale, shape) * statics,
                                  np.broadcast_to(damper, shape) * statics)
 
@@ -253,18 +270,23 @@ class HarmonicModel:
         return tuple(np.stack([kept[k][f][j] for k, f in enumerate(factors)], axis=-1)
                      for j in range(3))
 
-    def two_ports_at(self, amplitudes, elements=None):
+    def two_ports_at(self, amplitudes, elements=None, packed=None):
         r"""``(a, b, c)`` of every network's element at its relative-displacement amplitude,
         each (n_r, 17, n_net): :meth:`MountElement.two_port
         <powertrain.physics.mount_elements.MountElement.two_port>` at :math:`s = i\omega`
         with one amplitude per speed, ``amplitudes`` (n_r, n_net) [m]; ``elements``
         default :attr:`elements` (the amplitude law scales springs and dampers, the port
-        law adds its describing function)."""
+        law adds its describing function), ``packed`` their networks packed
+        (:class:`~powertrain.physics.mount_network.PackedNetworks`; default: packed here,
+        :attr:`packed` for :attr:`elements`)."""
         els = self.elements if elements is None else elements
+        if elements is None:
+            packed = self.packed
         if self.static_scale is not None:
             els = [dataclasses.replace(el, static_factor=self.static_scale[:, k:k + 1])
                    for k, el in enumerate(els)]
-        return element_two_ports(els, 1j * self.omega, np.asarray(amplitudes, float)[:, None])
+        return element_two_ports(els, 1j * self.omega, np.asarray(amplitudes, float)[:, None],
+                                 packed)
 
     def _statics(self, index):
         """The static factors of the networks ``index`` per speed, (n_r, 1, len(index))
@@ -389,14 +411,6 @@ class HarmonicModel:
             shapes = self._network_shapes(self.body if body is None else body)
             x = x - q[..., 6:] @ shapes.T
         return np.sqrt(np.sum(np.abs(x) ** 2, axis=1))
-
-    def __getstate__(self):
-        # sent to other processes (parallel fits): without the engine's pressure cache,
-        # which the cached load harmonics make unnecessary
-        state = dict(self.__dict__)
-        if hasattr(self.engine, "replace"):
-            state["engine"] = self.engine.replace()
-        return state
 
     def subset(self, index) -> HarmonicModel:
         """The model at the speeds ``rpm[index]``, sharing the cached parts computed so far."""
