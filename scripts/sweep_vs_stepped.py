@@ -95,7 +95,8 @@ def main(argv=None):
     for q in QUANTITIES:
         print(f"  {q:10s} |gap| to stepped harmonic: median {np.median(g[q]):.4f} dB, "
               f"95th percentile {np.percentile(g[q], 95):.4f} dB, max {g[q].max():.4f} dB")
-    from powertrain.workflows.variants import apply_operations, parse_operations
+    from powertrain.workflows.operations import apply_operations
+    from powertrain.workflows.variants import parse_operations
     stiff = apply_operations(engine, parse_operations(
         {"scale": [f"*.*.stiffness={args.plot_stiffness:g}"]}))
     base, _, _ = tracked_sweep(stiff, args.plot_from, args.plot_to, args.rate)

@@ -9,15 +9,8 @@ import math
 import numpy as np
 import pytest
 
-from powertrain.diagnosis.rule import (
-    CandidateEvidence,
-    DecisionRule,
-    Evidence,
-    Status,
-    VerdictKind,
-    decide,
-    improvement_t,
-)
+from powertrain.diagnosis.evidence import CandidateEvidence, Evidence, Status, VerdictKind
+from powertrain.diagnosis.rule import DecisionRule, decide, improvement_t
 
 N = 30
 WIGGLE = np.sin(np.arange(N) * 1.7)

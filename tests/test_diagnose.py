@@ -158,10 +158,10 @@ def test_out_of_library_channel_constant_gap_is_not_taken_for_a_sensor_error(eng
 def test_structured_residual_statistic():
     """Block means of adjacent speeds: pure noise gives ~0 dB beyond noise and chi2 ratio ~1;
     a 1 dB bias is found as ~1 dB."""
-    from powertrain.diagnosis import _speed_groups, structured_residual
+    from powertrain.diagnosis import speed_groups, structured_residual
     rng = np.random.default_rng(0)
     test_idx = np.concatenate([np.arange(10, 20), np.arange(40, 50), np.arange(70, 80)])
-    groups = _speed_groups(test_idx)
+    groups = speed_groups(test_idx)
     assert all(np.all(np.diff(test_idx[g]) == 1) for g in groups)
     g = rng.normal(0, 0.8, (test_idx.size, 9, 8))
     cens = np.zeros(g.shape, bool)

@@ -63,7 +63,7 @@ def test_plan_paths_are_relative_to_the_plan_file(tmp_path, default_engine):
 
 
 def test_engine_at_load_scales_the_combustion_model(default_engine):
-    from powertrain.models.engine import RPM
+    from powertrain.models.combustion import RPM
     e = default_engine
     part = e.at_load(0.4)
     assert e.at_load(1.0) is e
@@ -127,7 +127,7 @@ def test_plan_diagnosis_keeps_every_single_run_key_and_adds_runs(default_engine)
 def test_a_run_with_traces_uses_them_as_the_engines_combustion(tmp_path, default_engine):
     """``traces =`` (relative to the plan) replaces the combustion model for that run: the
     part-load single-zone pressures written as a trace CSV give that run's load back."""
-    from powertrain.models.engine import RPM
+    from powertrain.models.combustion import RPM
     e = default_engine
     rows = ["speed [rpm],cylinder,crank_angle [deg],pressure [Pa]"]
     for n in (1000.0, 6000.0):

@@ -446,7 +446,8 @@ def test_whatif_levels_and_delta_views():
 
     from powertrain.iotools.engine_file import DEFAULT_ENGINE_PATH, read_engine
     from powertrain.plotting.runup import VISIBLE_CHANGE_DB
-    from powertrain.workflows.variants import Variant, parse_operations
+    from powertrain.workflows.operations import Variant
+    from powertrain.workflows.variants import parse_operations
     from powertrain.workflows.whatif import run_whatif
     engine = read_engine(DEFAULT_ENGINE_PATH)
     variants = [Variant("gearbox x3", parse_operations({"scale": ["gearbox.*.stiffness=3"]}))]

@@ -134,8 +134,9 @@ def test_a_fit_without_a_steady_state_at_a_held_out_speed_is_scored_unsupported(
     """Parameters whose amplitude fixed point converges at the training speeds but not at a
     held-out one (found by a rate run: a plan's pair fit) predict nothing there: the held-out
     gap is infinite, the rule finds the candidate unsupported, and nothing crashes."""
+    from powertrain.diagnosis.evidence import CandidateEvidence, Evidence, Status
     from powertrain.diagnosis.fit import score
-    from powertrain.diagnosis.rule import CandidateEvidence, Evidence, Status, decide
+    from powertrain.diagnosis.rule import decide
 
     def no_steady_state(sc, part):
         raise FloatingPointError("gearbox.y at 1500 rpm: the amplitude fixed point did not "

@@ -21,11 +21,10 @@ from click.testing import CliRunner
 from powertrain.assembly import assemble
 from powertrain.cli import main
 from powertrain.errors import InputError
+from powertrain.workflows.operations import Variant, apply_operations
 from powertrain.workflows.retune import band_weight, retune
 from powertrain.workflows.sweeps import SerialExecutor, SweepTask, run_sweep
 from powertrain.workflows.variants import (
-    Variant,
-    apply_operations,
     parse_move,
     parse_rotate,
     parse_scale,

@@ -129,7 +129,7 @@ def test_whatif_runs_the_laws_through_the_harmonic_fixed_point(engine):
     """whatif's default solver (harmonic) solves the variant's laws: its variant run is the
     run-up of the changed engine."""
     rpm = np.array([1500.0, 3000.0])
-    from powertrain.workflows.variants import Variant
+    from powertrain.workflows.operations import Variant
     ops = (parse_set("left.z.amplitude.exponent=0.3"), parse_set("right.z.friction.max_force=30"))
     res = run_whatif(engine, [Variant("laws", ops)], rpm, workers=1)
     ref = run_runup(apply_operations(engine, ops), rpm, solver="harmonic")

@@ -20,7 +20,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from powertrain.analysis.channel import DIRECTIONS, PASSIVE, passive_name, split_side  # noqa: F401 (re-export)
+from powertrain.analysis.channel import DIRECTIONS, passive_name
 from powertrain.physics.condensation import NetworkPorts, condense
 from powertrain.physics.mount_elements import PortForces, port_forces
 from powertrain.physics.mount_network import ground_force_rows, network_matrices

@@ -73,8 +73,6 @@ from __future__ import annotations
 
 import numpy as np
 
-from powertrain.analysis.noise_floor import NOISE_FLOOR_MARGIN  # noqa: F401 (re-export)
-
 #: Standard deviation of the Gaussian kernel of :func:`frfsm_score` [dB].
 FRFSM_SIGMA_DB = 6.0
 

@@ -38,13 +38,11 @@ from powertrain.diagnosis.data import (
            speed_groups,
            split_rpm,
 )
+from powertrain.diagnosis.evidence import Status, Verdict, VerdictKind
 from powertrain.diagnosis.fit import EVAL_BUDGET, FitOutcome, fit_candidate
 from powertrain.diagnosis.result import DiagnosisResult
-from powertrain.diagnosis.rule import DecisionRule, Status, Verdict, VerdictKind, decide
+from powertrain.diagnosis.rule import DecisionRule, decide
 from powertrain.diagnosis.where import REGION_DB, decompose_gap
-
-#: Former private name, kept for old callers.
-_speed_groups = speed_groups
 
 __all__ = ["DEFAULT_NOISE_FLOOR", "EVAL_BUDGET", "MIN_RPM", "REGION_DB", "DecisionRule",
            "DiagnosisResult", "FitOutcome", "GapData", "Status", "Verdict", "VerdictKind",

@@ -11,7 +11,7 @@ import math
 
 import numpy as np
 
-from powertrain.diagnosis.rule import CandidateEvidence
+from powertrain.diagnosis.evidence import CandidateEvidence
 from powertrain.diagnosis.significance import improvement_t
 from powertrain.effects import EFFECTS
 

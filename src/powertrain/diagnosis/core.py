@@ -36,9 +36,10 @@ from powertrain.diagnosis.data import (
     speed_groups,
     split_rpm,
 )
+from powertrain.diagnosis.evidence import CandidateEvidence, Evidence, VerdictKind
 from powertrain.diagnosis.fit import EVAL_BUDGET, Problem, baseline_outcome, fit_candidate
 from powertrain.diagnosis.result import DiagnosisResult
-from powertrain.diagnosis.rule import CandidateEvidence, DecisionRule, Evidence, VerdictKind, decide
+from powertrain.diagnosis.rule import DecisionRule, decide
 from powertrain.diagnosis.sides import side_attribution, with_measured_body_side
 from powertrain.diagnosis.where import decompose_gap, regions, rigid_span_gap, where_text
 from powertrain.effects import predict

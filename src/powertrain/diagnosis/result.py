@@ -15,8 +15,9 @@ import numpy as np
 from powertrain.analysis.noise_floor import NOISE_FLOOR_MARGIN
 from powertrain.diagnosis.checks import ORDER_FOLDS, ORDER_SPLIT, channel_folds
 from powertrain.diagnosis.data import GapData
+from powertrain.diagnosis.evidence import VerdictKind
 from powertrain.diagnosis.fit import FitOutcome
-from powertrain.diagnosis.rule import DecisionRule, VerdictKind
+from powertrain.diagnosis.rule import DecisionRule
 from powertrain.effects import EFFECTS
 
 

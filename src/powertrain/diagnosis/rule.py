@@ -47,9 +47,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from powertrain.diagnosis.evidence import (  # noqa: F401  (the rule's types, re-exported)
+from powertrain.diagnosis.evidence import (
     Assessment,
-    CandidateEvidence,
     Evidence,
     Status,
     Verdict,

@@ -59,6 +59,7 @@ from powertrain.iotools.tomlfile import (
     vector3,
 )
 from powertrain.models import engine as em
+from powertrain.models.crank_train import Balancer, BalancerShaft, CrankTrain
 from powertrain.models.mount import MountModel
 
 #: The shipped default engine (package data, see :mod:`powertrain.data`).
@@ -126,7 +127,7 @@ def read_engine(path=DEFAULT_ENGINE_PATH) -> em.Engine:
             raise InputError("[combustion] needs a [crank_train] section", file=path,
                              key="crank_train")
         combustion = read_combustion(subtable(doc, "combustion", path), path, crank)
-    balancer = em.Balancer(enabled=False, ratio=2.0, shafts=())
+    balancer = Balancer(enabled=False, ratio=2.0, shafts=())
     if "balancer" in doc:
         balancer = _read_balancer(subtable(doc, "balancer", path), path)
     chassis = None
@@ -212,7 +213,7 @@ def _read_body_mode(m, path, p, mount_names, points):
     return BodyMode(frequency=f, damping_ratio=zeta, modal_mass=mass, shapes=shapes)
 
 
-def _read_crank(t, path) -> em.CrankTrain:
+def _read_crank(t, path) -> CrankTrain:
     p = "crank_train"
     check_keys(t, _ALLOWED[p], path, p)
     n = get(t, "cylinders", path, p, types=int)
@@ -253,7 +254,7 @@ def _read_crank(t, path) -> em.CrankTrain:
     m_rot = scalar_quantity(t, "rotating_mass", "mass", path, p, nonneg=True)
     cw = scalar_quantity(t, "counterweight_fraction", "dimensionless", path, p, nonneg=True)
     pcc = scalar_quantity(t, "crankcase_pressure", "pressure", path, p, nonneg=True)
-    return em.CrankTrain(bore=bore, stroke=stroke, rod_length=rod, pin_offset=offset,
+    return CrankTrain(bore=bore, stroke=stroke, rod_length=rod, pin_offset=offset,
                          compression_ratio=eps, cylinder_x=xs, cylinder_axis=axis,
                          rotation_sign=1 if rot == "+X" else -1, crank_pin_angles=pins,
                          firing_order=order, firing_angles=firing, reciprocating_mass=m_rec,
@@ -390,7 +391,7 @@ def _read_mount_directions(m, path, p):
     return directions, {}
 
 
-def _read_balancer(t, path) -> em.Balancer:
+def _read_balancer(t, path) -> Balancer:
     p = "balancer"
     check_keys(t, _ALLOWED[p], path, p)
     enabled = get(t, "enabled", path, p, types=bool)
@@ -405,9 +406,9 @@ def _read_balancer(t, path) -> em.Balancer:
         sense = get(s, "sense", path, sp, types=int)
         if sense not in (1, -1) or isinstance(sense, bool):
             raise InputError(f"expected +1 or -1, got {sense!r}", file=path, key=f"{sp}.sense")
-        shafts.append(em.BalancerShaft(
+        shafts.append(BalancerShaft(
             name=str(get(s, "name", path, sp, types=str)),
             mass_radius=scalar_quantity(s, "mass_radius", "unbalance", path, sp, nonneg=True),
             position=vector3(s, "position", "length", path, sp),
             phase=scalar_quantity(s, "phase", "angle", path, sp), sense=sense))
-    return em.Balancer(enabled=enabled, ratio=ratio, shafts=tuple(shafts))
+    return Balancer(enabled=enabled, ratio=ratio, shafts=tuple(shafts))

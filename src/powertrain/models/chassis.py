@@ -22,8 +22,6 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from powertrain.analysis.channel import PASSIVE, passive_name, split_side  # noqa: F401 (re-export)
-
 
 @dataclass(frozen=True, eq=False)
 class BodyMode:

@@ -38,8 +38,8 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from powertrain.assembly import assemble
-from powertrain.models.combustion import RPM, FullLoadCurve, MeasuredPressure, SingleZoneCombustion  # noqa: F401 (re-export)
-from powertrain.models.crank_train import Balancer, BalancerShaft, CrankTrain  # noqa: F401 (re-export)
+from powertrain.models.combustion import RPM
+from powertrain.models.crank_train import Balancer, CrankTrain
 from powertrain.models.memo import Memo
 from powertrain.physics import balancer as bal
 from powertrain.physics import combustion as comb

@@ -12,7 +12,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from powertrain.analysis.channel import DIRECTIONS, SIDES, Channel, ChannelFields  # noqa: F401 (re-export)
+from powertrain.analysis.channel import DIRECTIONS, SIDES, ChannelFields
 from powertrain.errors import InputError
 
 #: Largest sample magnitude accepted (in the channel's unit): far above any recorded

@@ -11,7 +11,7 @@ from typing import ClassVar
 import numpy as np
 
 from powertrain.analysis import compare as cm
-from powertrain.analysis.noise_floor import censoring_level
+from powertrain.analysis.noise_floor import NOISE_FLOOR_MARGIN, censoring_level
 from powertrain.analysis.orders import quantity_sort_key
 from powertrain.outputs import json_text
 
@@ -239,7 +239,7 @@ class ComparisonResult:
             "simulated_rpm": [float(r) for r in self.sim_rpm],
             "notes": list(self.measured.notes) + list(self.info.get("notes", [])),
             "noise_floor_m_per_s": self.noise_floor,
-            "noise_floor_margin": cm.NOISE_FLOOR_MARGIN,
+            "noise_floor_margin": NOISE_FLOOR_MARGIN,
             "noise_floor_exclusion_m_per_s": self.exclusion_limit,
             "simulated_at_measured_speeds": self.n_interpolated == 0,
             "frfsm_sigma_db": self.sigma_db,

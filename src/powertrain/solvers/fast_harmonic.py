@@ -40,8 +40,8 @@ import dataclasses
 
 import numpy as np
 
+from powertrain.analysis.channel import DIRECTIONS
 from powertrain.analysis.fourier import harmonic_amplitudes
-from powertrain.assembly import DIRECTIONS
 from powertrain.physics import balancer as bal
 from powertrain.physics.condensation import harmonic_solve
 from powertrain.physics.mount_elements import element_two_ports

@@ -99,8 +99,8 @@ def engines():
 def traces_engine(engine, step_rpm=250.0):
     """``engine`` with its single-zone pressures tabulated every ``step_rpm`` as measured
     traces (:class:`~powertrain.models.engine.MeasuredPressure`)."""
-    from powertrain.models.engine import RPM as RAD_PER_RPM
-    from powertrain.models.engine import MeasuredPressure
+    from powertrain.models.combustion import RPM as RAD_PER_RPM
+    from powertrain.models.combustion import MeasuredPressure
     lo, hi = engine.speed_range_rpm()
     speeds = np.arange(lo, hi + 1e-9, step_rpm)
     p = []

@@ -77,7 +77,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from powertrain.workflows.variants import Origin, Swap, Target
+from powertrain.workflows.operations import Origin, Swap, Target
 
 #: Log-spaced fit frequencies above 0 Hz.
 N_FREQUENCIES = 120

@@ -364,7 +364,8 @@ def _scenario(effects, engine) -> dict:
     """``{effect: {parameter: value}}`` of ``--effect`` strings (or a scenario as given)."""
     if isinstance(effects, dict):
         return effects
-    from powertrain.workflows.variants import effect_scenario, parse_operations
+    from powertrain.workflows.operations import effect_scenario
+    from powertrain.workflows.variants import parse_operations
     return effect_scenario(parse_operations({"effect": list(effects)}, engine=engine))
 
 

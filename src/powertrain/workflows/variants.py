@@ -74,7 +74,7 @@ import re
 from pathlib import Path
 
 from powertrain.errors import InputError
-from powertrain.workflows.operations import (  # noqa: F401 (re-export: the operations' home)
+from powertrain.workflows.operations import (
     LAW_KEYS,
     WILDCARD,
     AddEffect,
@@ -86,11 +86,6 @@ from powertrain.workflows.operations import (  # noqa: F401 (re-export: the oper
     Swap,
     Target,
     Variant,
-    apply_operations,
-    check_operations,
-    effect_scenario,
-    response_scenario,
-    rotation_matrix,
 )
 
 #: Scale kinds and what each scales.

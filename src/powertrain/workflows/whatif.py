@@ -104,13 +104,8 @@ def _run_on(executor, engine, variants, rpm, **kwargs) -> WhatIfResult:
 def command_variants(engine, ops: dict, targets=(), variants_file=None) -> list:
     """The variants of a command line: its operations (``{"scale": [...], ...}``) as the
     variant ``command line``, each target a variant, then those of ``variants_file``."""
-    from powertrain.workflows.variants import (
-        Origin,
-        Variant,
-        parse_operations,
-        parse_target,
-        read_variants,
-    )
+    from powertrain.workflows.operations import Origin, Variant
+    from powertrain.workflows.variants import parse_operations, parse_target, read_variants
     out = []
     parsed = parse_operations(ops, engine=engine)
     if parsed:
@@ -179,8 +174,8 @@ def variant_engine(engine, variant, **fit_kwargs):
     fits : list of TargetFit
     """
     from powertrain.iotools.engine_checks import check_support
+    from powertrain.workflows.operations import Target
     from powertrain.workflows.retune import retuned_swap
-    from powertrain.workflows.variants import Target
     stages, fits = [], []
     for op in variant.operations:
         retuned = isinstance(op, Target)
@@ -227,9 +222,9 @@ def run_whatif(engine, variants, rpm=None, *, solver: str = "harmonic", executor
     runup_options : dict, optional
         Further keyword arguments of :func:`powertrain.workflows.runup.run_runup`.
     """
+    from powertrain.workflows.operations import response_scenario
     from powertrain.workflows.runup import default_rpm
     from powertrain.workflows.sweeps import SweepTask, run_sweep
-    from powertrain.workflows.variants import response_scenario
     rpm = default_rpm() if rpm is None else np.atleast_1d(np.asarray(rpm, float))
     names = [v.name for v in variants]
     if len(set(names)) != len(names) or "baseline" in names:
