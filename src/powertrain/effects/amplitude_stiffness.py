@@ -25,9 +25,7 @@ Newmark integration.
 
 from __future__ import annotations
 
-import dataclasses
-
-from powertrain.effects.base import Effect, Parameter, map_networks
+from powertrain.effects.base import Effect, Parameter
 from powertrain.effects.mount_stiffness import damping_exponent_parameter
 from powertrain.physics.mount_laws import PowerLaw
 
@@ -54,15 +52,7 @@ class AmplitudeStiffness(Effect):
     def start_grid(self, engine=None):
         return ((0.1, 0.2, 0.35), (1.0,))
 
-    def apply(self, engine, **params):
-        if params.get("exponent", 0.0) == 0.0:
-            return engine
-        law = amplitude_law(params["exponent"], params.get("damping_exponent", 1.0))
-        return map_networks(engine, lambda mi, m, ax, mod:
-                            dataclasses.replace(mod, amplitude_law=law))
-
-    def elements(self, hm, elements, p):
-        if p["exponent"] == 0.0:
-            return elements
-        law = amplitude_law(p["exponent"], p.get("damping_exponent", 1.0))
-        return [dataclasses.replace(el, amplitude_law=law) for el in elements]
+    def mount_law(self, p):
+        if p.get("exponent", 0.0) == 0.0:
+            return None
+        return amplitude_law(p["exponent"], p.get("damping_exponent", 1.0))

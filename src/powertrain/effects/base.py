@@ -18,6 +18,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from powertrain.analysis.channel import DIRECTIONS
+from powertrain.models.extensions import with_base_compliance
+
 
 @dataclass(frozen=True)
 class Parameter:
@@ -118,9 +121,37 @@ class Effect:
                 "parameters": [dataclasses.asdict(p) for p in self.parameters(engine)]}
 
     # ------------------------------------------------------------------ engine model
+    # ------------------------------------------------------------------ what the effect changes
+    # A mount effect states its change once, by these declarations; :meth:`apply` puts it
+    # into the engine model and the fast-path hooks below into the frequency view.
+    def network_scales(self, engine, p):
+        """Factors on every network's springs and on its dampers (network order: mount-major
+        x, y, z), ``(spring (n_net,), damper (n_net,))``, or None (unchanged)."""
+        return None
+
+    def mount_law(self, p):
+        """The amplitude law every network takes, or None (each keeps its own)."""
+        return None
+
+    def base_under_mounts(self, p):
+        """``(mass [kg], stiffness [N/m], damping ratio [1])`` of a base under every network,
+        or None (the ground or body as the engine has it)."""
+        return None
+
     def apply(self, engine, **params):
-        """The engine with the effect (``engine_change`` effects)."""
-        raise NotImplementedError(f"{self.name} is not a change of the engine model")
+        """The engine with the effect: its declared network changes in every mount model
+        (effects that change the engine otherwise override this)."""
+        if not self.engine_change:
+            raise NotImplementedError(f"{self.name} is not a change of the engine model")
+        p = {**self.defaults(engine), **params}
+        scales, law, base = self.network_scales(engine, p), self.mount_law(p), \
+            self.base_under_mounts(p)
+        if scales is None and law is None and base is None:
+            return engine
+        return map_networks(engine, lambda mi, m, ax, mod: changed_network(
+            mod, None if scales is None else (scales[0][3 * mi + DIRECTIONS.index(ax)],
+                                              scales[1][3 * mi + DIRECTIONS.index(ax)]),
+            law, base))
 
     # ------------------------------------------------------------------ fast-path hooks
     def warm(self, hm):
@@ -128,12 +159,15 @@ class Effect:
 
     def elastomer_scale(self, hm, p):
         """Factors on every network's springs and on its dampers, ``(spring (n_net,),
-        damper (n_net,))``, or None."""
-        return None
+        damper (n_net,))``, or None: :meth:`network_scales`."""
+        return self.network_scales(hm.engine, p)
 
     def two_port(self, hm, abc, p):
-        """The networks' two-ports ``(a, b, c)``, each (n_r, 17, n_net), with the effect."""
-        return abc
+        """The networks' two-ports ``(a, b, c)``, each (n_r, 17, n_net), with the effect: on
+        :meth:`base_under_mounts` (:meth:`HarmonicModel.two_ports_on_base
+        <powertrain.solvers.fast_harmonic.HarmonicModel.two_ports_on_base>`)."""
+        base = self.base_under_mounts(p)
+        return abc if base is None else hm.two_ports_on_base(abc, *base)
 
     def load_terms(self, hm, p):
         """The effect's change of the load harmonics as a weighted sum of fixed parts,
@@ -153,9 +187,12 @@ class Effect:
     def elements(self, hm, elements, p):
         """The networks' mount elements (list in network order,
         :class:`~powertrain.physics.mount_elements.MountElement`) with the effect, e.g. an
-        amplitude law set; a nonlinear element makes :func:`powertrain.effects.predict`
+        amplitude law set (:meth:`mount_law`); a nonlinear element makes :func:`powertrain.effects.predict`
         iterate to its amplitudes. Unchanged by default."""
-        return elements
+        law = self.mount_law(p)
+        if law is None:
+            return elements
+        return [dataclasses.replace(el, amplitude_law=law) for el in elements]
 
     def body_change(self, hm, p, body):
         """The modal body under the mounts (:class:`~powertrain.solvers.body_coupling.ModalBody`)
@@ -212,3 +249,18 @@ def with_network_elastomer(engine, factors):
     x, y, z, as :attr:`HarmonicModel.networks`), masses kept (:meth:`MountModel.scaled`)."""
     f = iter(np.asarray(factors, float).ravel())
     return map_networks(engine, lambda mi, m, ax, mod: mod.scaled(*(2 * (float(next(f)),))))
+
+
+def changed_network(model, scales=None, law=None, base=None):
+    """A mount model with an effect's declared changes: springs and dampers times
+    ``scales`` = (spring, damper) factors, the amplitude law ``law``, a base ``base`` =
+    (mass [kg], stiffness [N/m], damping ratio [1]) under it
+    (:func:`powertrain.models.extensions.with_base_compliance`)."""
+    if scales is not None:
+        model = model.scaled(float(scales[0]), float(scales[1]))
+    if law is not None:
+        model = dataclasses.replace(model, amplitude_law=law)
+    if base is not None:
+        mass, stiffness, zeta = base
+        model = with_base_compliance(model, mass, stiffness, 2 * zeta * np.sqrt(stiffness * mass))
+    return model

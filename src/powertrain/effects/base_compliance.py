@@ -1,20 +1,19 @@
 r"""``base_compliance``: every mount stands on a local chassis base.
 
 Mass :math:`m_b` on a spring :math:`c_b` with damping ratio ζ_b = 5 % between the network
-and the ground (or the body). On the cached path the base node is condensed from the
-network's two-port exactly: with :math:`k_b = c_b + i\omega d_b` and
-:math:`z = c + k_b - \omega^2 m_b`,
-
-.. math:: a' = a - b^2/z,\quad b' = b\,k_b/z,\quad c' = k_b - k_b^2/z
-
-(:math:`a'` the input-point stiffness on a rigid ground; :math:`b', c'` couple a modal body).
+and the ground (or the body), declared once (:meth:`BaseCompliance.base_under_mounts`): the
+engine model gets the base node in every network
+(:func:`powertrain.models.extensions.with_base_compliance`), the cached model condenses it
+from each network's two-port (:meth:`HarmonicModel.two_ports_on_base
+<powertrain.solvers.fast_harmonic.HarmonicModel.two_ports_on_base>`). At the upper bound of
+``c_base`` (the default) the ground is rigid.
 """
 
 from __future__ import annotations
 
 import numpy as np
 
-from powertrain.effects.base import Effect, Parameter, map_networks
+from powertrain.effects.base import Effect, Parameter, changed_network, map_networks
 
 #: Damping ratio of the local base [1].
 BASE_ZETA = 0.05
@@ -30,12 +29,10 @@ def with_base_compliance_all(engine, c_base=np.inf, m_base=10.0, zeta=BASE_ZETA)
     (:func:`powertrain.models.extensions.with_base_compliance`). ``c_base = inf`` (default)
     is the rigid ground: the engine is returned unchanged.
     """
-    from powertrain.models.extensions import with_base_compliance
     if not np.isfinite(c_base):
         return engine
-    d_base = 2 * zeta * np.sqrt(c_base * m_base)
-    return map_networks(engine, lambda mi, m, ax, mod: with_base_compliance(
-        mod, m_base, c_base, d_base))
+    return map_networks(engine, lambda mi, m, ax, mod: changed_network(
+        mod, base=(m_base, c_base, zeta)))
 
 
 class BaseCompliance(Effect):
@@ -53,15 +50,8 @@ class BaseCompliance(Effect):
     def start_grid(self, engine=None):
         return ((1.5e5, 4e5, 1e6, 3e6), (2.0, 6.0, 15.0, 40.0))
 
-    def apply(self, engine, c_base=np.inf, m_base=10.0):
-        return with_base_compliance_all(engine, c_base, m_base)
-
-    def two_port(self, hm, abc, p):
-        cb, mb = p["c_base"], p["m_base"]
-        if cb >= C_RIGID:
-            return abc                       # upper bound = rigid ground (the default)
-        a, b, c = abc
-        w = hm.omega[..., None]
-        kb = cb + 1j * w * 2 * BASE_ZETA * np.sqrt(cb * mb)
-        z = c + kb - w ** 2 * mb
-        return a - b ** 2 / z, b * kb / z, kb - kb ** 2 / z
+    def base_under_mounts(self, p):
+        cb = p["c_base"]
+        if not cb < C_RIGID:
+            return None                      # the upper bound is the rigid ground (default)
+        return p["m_base"], cb, BASE_ZETA

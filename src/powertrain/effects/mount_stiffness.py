@@ -20,7 +20,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from powertrain.effects.base import Effect, Parameter, map_networks, mount_labels
+from powertrain.effects.base import Effect, Parameter, mount_labels
 
 #: Bounds of the damping exponent γ (dampers × k^γ) [1].
 DAMPING_EXPONENT_RANGE = (0.0, 2.0)
@@ -41,12 +41,12 @@ def damping_exponent_parameter(factor: str) -> Parameter:
 def with_mount_stiffness(engine, *k, damping_exponent=1.0, **named):
     """Mount i's springs times ``k<i>`` [1] and its dampers times ``k<i> **
     damping_exponent`` (i = 1..n in engine-file order; positional factors or ``k1=...``),
-    all three directions alike; missing factors 1."""
+    all three directions alike; missing factors 1 (:class:`MountStiffness`'s change)."""
     f = [float(x) for x in k] + [1.0] * len(engine.mounts)
     for key, v in named.items():
         f[int(key[1:]) - 1] = float(v)
-    g = float(damping_exponent)
-    return map_networks(engine, lambda mi, m, ax, mod: mod.scaled(f[mi], f[mi] ** g))
+    params = {f"k{i + 1}": f[i] for i in range(len(engine.mounts))}
+    return MountStiffness().apply(engine, damping_exponent=float(damping_exponent), **params)
 
 
 class MountStiffness(Effect):
@@ -68,9 +68,6 @@ class MountStiffness(Effect):
         factors = ((0.5, 1.0, 2.0),) * n if n <= 4 else ((0.6, 1.6),) * n
         return factors + ((1.0,),)                 # γ starts at its prior's centre
 
-    def apply(self, engine, **params):
-        return with_mount_stiffness(engine, **params)
-
     def alternatives(self, params, engine=None):
         """The factors of two mounts swapped (mirror-image mounts can give the same
         magnitudes), for every pair whose factors differ."""
@@ -85,6 +82,6 @@ class MountStiffness(Effect):
                                 f"k{j + 1}={k[i]:.3g}", alt))
         return out
 
-    def elastomer_scale(self, hm, p):
-        s = np.array([p.get(f"k{mi + 1}", 1.0) for mi, _, _ in hm.networks])
+    def network_scales(self, engine, p):
+        s = np.repeat([p.get(f"k{mi + 1}", 1.0) for mi in range(len(engine.mounts))], 3)
         return None if np.all(s == 1.0) else (s, s ** p.get("damping_exponent", 1.0))

@@ -288,6 +288,20 @@ class HarmonicModel:
         return element_two_ports(els, 1j * self.omega, np.asarray(amplitudes, float)[:, None],
                                  packed)
 
+    def two_ports_on_base(self, abc, mass, stiffness, zeta):
+        r"""The two-ports ``abc`` (each (n_r, 17, n_net)) with a base of ``mass`` [kg] on
+        ``stiffness`` [N/m] and damping ratio ``zeta`` [1] under every network, the base node
+        condensed exactly: with :math:`k_b = c_b + i\omega\,2\zeta\sqrt{c_b m_b}` and
+        :math:`z = c + k_b - \omega^2 m_b`, :math:`a' = a - b^2/z`, :math:`b' = b\,k_b/z`,
+        :math:`c' = k_b - k_b^2/z` (:math:`a'` the input-point stiffness on a rigid ground;
+        :math:`b', c'` couple a modal body) — the same network as
+        :func:`powertrain.models.extensions.with_base_compliance` gives."""
+        a, b, c = abc
+        w = self.omega[..., None]
+        kb = stiffness + 1j * w * 2 * zeta * np.sqrt(stiffness * mass)
+        z = c + kb - w ** 2 * mass
+        return a - b ** 2 / z, b * kb / z, kb - kb ** 2 / z
+
     def _statics(self, index):
         """The static factors of the networks ``index`` per speed, (n_r, 1, len(index))
         (1.0 without curves)."""
