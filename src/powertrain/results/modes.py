@@ -35,7 +35,7 @@ class Mode:
         ``rigid-body`` or ``chassis``.
     iterations : int
         Iterations taken to find the mode: 0, every mode comes from one eigensolve
-        (:func:`powertrain.solvers.modes.state_space_modes`).
+        (:func:`powertrain.solvers.modes.state_space_eigenvalues`).
     body_energy_percent : float
         Share of the mode's kinetic energy in the body modes of a modal chassis [%].
     static_frequency_hz : float

@@ -9,7 +9,8 @@ Two methods:
   (complex) frequency: the eigenvalues :math:`s` of the assembled model
   :math:`\mathbf M\ddot{\mathbf q} + \mathbf C\dot{\mathbf q} + \mathbf K\mathbf q = 0` with
   the networks' internal degrees of freedom (and the body modes of a modal chassis), in
-  first-order form, all found by one eigensolve (:func:`state_space_modes`). Lumped networks
+  first-order form, all found by one eigensolve (:func:`state_space_eigenvalues`), with the
+  shapes of those near the static modes (:func:`root_shapes`). Lumped networks
   make this exact: a root is a root of the condensed problem
   :math:`\big(s^2\mathbf M_R + \mathbf K_R(s)\big)\boldsymbol\varphi = 0` on the retained
   coordinates (rigid body, body modes; every network through its two-port at :math:`s`,
@@ -105,8 +106,8 @@ def _mac_matrix(P, Q, M) -> np.ndarray:
                           np.einsum("ij,ij->j", np.conj(Q), MQ).real)
 
 
-def state_space_modes(system):
-    r"""Eigenvalues and eigenvectors of the assembled model's equations of motion
+def state_space_eigenvalues(system) -> np.ndarray:
+    r"""Eigenvalues of the assembled model's equations of motion
     :math:`\mathbf M\ddot{\mathbf q} + \mathbf C\dot{\mathbf q} + \mathbf K\mathbf q = 0`
     in first-order form, every coordinate included (rigid body, the networks' internal
     degrees of freedom, body modes).
@@ -123,32 +124,50 @@ def state_space_modes(system):
 
     Returns
     -------
-    lam : ndarray complex (m,)
-        Finite eigenvalues :math:`s` [1/s] (m = 2n without massless nodes).
-    shapes : ndarray complex (n, m)
-        Displacement part of each eigenvector (any scale).
+    ndarray complex (m,)
+        The finite eigenvalues :math:`s` [1/s] (m = 2n without massless nodes).
     """
     n = system.n_dof
-    zero, eye = np.zeros((n, n)), np.eye(n)
     try:
         inverse = np.linalg.inv(system.M)
     except np.linalg.LinAlgError:
-        A = np.block([[zero, eye], [-system.K, -system.C]])
-        B = np.block([[eye, zero], [zero, system.M]])
-        lam, vec = sla.eig(A, B)
-        finite = np.isfinite(lam)
-        return lam[finite], vec[:n, finite]
+        zero, eye = np.zeros((n, n)), np.eye(n)
+        lam = sla.eig(np.block([[zero, eye], [-system.K, -system.C]]),
+                      np.block([[eye, zero], [zero, system.M]]), right=False)
+        return lam[np.isfinite(lam)]
     A = np.zeros((2 * n, 2 * n))
-    A[:n, n:] = eye
+    A[:n, n:] = np.eye(n)
     A[n:] = -inverse @ np.hstack([system.K, system.C])
-    lam, vec = np.linalg.eig(A)
-    return lam, vec[:n]
+    return np.linalg.eigvals(A)
+
+
+def root_shapes(system, roots) -> np.ndarray:
+    r"""The shape of the assembled model at each of its eigenvalues ``roots`` (k,) [1/s]: the
+    null vector of :math:`\mathbf K + s\mathbf C + s^2\mathbf M`, by one step of inverse
+    iteration from a generic start vector of its own for each root (so that a repeated root
+    gets independent shapes). For a root accurate to round-off the error of its shape is
+    round-off over the relative distance to the next root.
+
+    Returns
+    -------
+    ndarray complex (n, k)
+        One shape per column, every coordinate, any scale.
+    """
+    s = np.asarray(roots, complex)[:, None, None]
+    start = np.cos(np.outer(np.arange(1, s.shape[0] + 1), np.arange(1, system.n_dof + 1)))
+    try:
+        x = np.linalg.solve(system.K + s * system.C + s * s * system.M, start[..., None])
+    except np.linalg.LinAlgError:                 # a root exact to the last bit: shift off it
+        s = s * (1.0 + 1e-13)
+        x = np.linalg.solve(system.K + s * system.C + s * s * system.M, start[..., None])
+    return x[..., 0].T
 
 
 def _damped_roots(system, MR, omegas, vec):
     r"""The damped mode of each static mode: ``(s, phi)``, the roots (k,) and their shapes on
     the retained coordinates (n_R, k) in the order of ``omegas`` [rad/s], from the eigenvalues
-    of the full model (:func:`state_space_modes`).
+    of the full model (:func:`state_space_eigenvalues`) and their shapes
+    (:func:`root_shapes`).
 
     Candidates are the eigenvalues with positive imaginary part and a modulus below three
     times the highest static angular frequency (if these are fewer than the modes: every
@@ -164,14 +183,14 @@ def _damped_roots(system, MR, omegas, vec):
         Fewer candidates than modes, or a picked root with a damping ratio below
         -:data:`UNSTABLE` (matrices beyond what the eigensolve resolves in floating point).
     """
-    lam, shapes = state_space_modes(system)
-    keep = system.retained
+    lam = state_space_eigenvalues(system)
     top = 3.0 * max(omegas.max(), 1e-9)
     pick = (lam.imag > 0) & (np.abs(lam) < top)
     if np.count_nonzero(pick) < omegas.size:
         pick = lam.imag >= 0
-    lam, full = lam[pick], shapes[:, pick]
-    phi = full[keep]
+    lam = lam[pick]
+    full = root_shapes(system, lam)
+    phi = full[system.retained]
     moving = (np.einsum("ij,ij->j", np.conj(phi), MR @ phi).real
               > 1e-12 * np.einsum("ij,ij->j", np.conj(full), system.M @ full).real)
     lam, phi = lam[moving], phi[:, moving]
