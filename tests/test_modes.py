@@ -313,3 +313,14 @@ def test_modes_of_nonlinear_mounts_take_the_networks_as_measured():
     assert text.startswith(f"rigid-body modes, undamped, {AS_MEASURED} at their static")
     assert runup(linear, [3000.0], solver="harmonic").to_text().splitlines()[1].startswith(
         RIGID_BODY_MODES_LABEL)
+
+
+def test_the_shape_of_a_root_exact_to_the_last_bit():
+    """An undamped two-degree-of-freedom model whose root 2i makes K + sC + s²M exactly
+    singular: the shape is still its null vector (the first coordinate alone)."""
+    from types import SimpleNamespace
+
+    from powertrain.solvers.modes import root_shapes
+    model = SimpleNamespace(M=np.eye(2), C=np.zeros((2, 2)), K=np.diag([4.0, 9.0]), n_dof=2)
+    x = root_shapes(model, np.array([2j]))[:, 0]
+    assert abs(x[1]) < 1e-9 * abs(x[0])

@@ -156,11 +156,19 @@ def root_shapes(system, roots) -> np.ndarray:
     s = np.asarray(roots, complex)[:, None, None]
     start = np.cos(np.outer(np.arange(1, s.shape[0] + 1), np.arange(1, system.n_dof + 1)))
     try:
-        x = np.linalg.solve(system.K + s * system.C + s * s * system.M, start[..., None])
+        x = np.linalg.solve(_dynamic_stiffness(system, s), start[..., None])
     except np.linalg.LinAlgError:                 # a root exact to the last bit: shift off it
-        s = s * (1.0 + 1e-13)
-        x = np.linalg.solve(system.K + s * system.C + s * s * system.M, start[..., None])
+        x = np.linalg.solve(_dynamic_stiffness(system, s * (1.0 + 1e-13)), start[..., None])
     return x[..., 0].T
+
+
+def _dynamic_stiffness(system, s):
+    """:math:`\\mathbf K + s\\mathbf C + s^2\\mathbf M` at each ``s`` (k, 1, 1)."""
+    D = s * system.M
+    D += system.C
+    D *= s
+    D += system.K
+    return D
 
 
 def _damped_roots(system, MR, omegas, vec):
