@@ -118,8 +118,6 @@ def main(argv=None):
     ap.add_argument("--sample-speeds", default="1000,3500,6000",
                     help="speeds [rpm] for the slow solvers")
     ap.add_argument("--repeat", type=int, default=5, help="repeats of the warm Newmark run-up")
-    ap.add_argument("--workers", type=int, default=1,
-                    help="speed steps solved concurrently by our Newmark (threads)")
     args = ap.parse_args(argv)
 
     engine = read_engine(args.engine)
@@ -143,8 +141,7 @@ def main(argv=None):
     best = np.inf
     for _ in range(args.repeat):
         t0 = time.perf_counter()
-        res = run_runup(engine, rpms, system=system, angle_step_deg=args.angle_step,
-                        workers=args.workers)
+        res = run_runup(engine, rpms, system=system, angle_step_deg=args.angle_step)
         best = min(best, res.solver_seconds)
         wall = time.perf_counter() - t0
     err_nm = np.max(np.abs(res.synthesis_rms() / ref_syn - 1))
@@ -156,7 +153,7 @@ def main(argv=None):
     print(f"dense physical-coordinate Newmark kernel: run-up solver time {dense:.4f} s "
           f"({dense / rpms.size:.5f} s per speed), max synthesis deviation vs harmonic "
           f"{100 * err_dense:.3f} %")
-    print(f"Newmark (Numba, {args.workers} worker(s)): run-up of {rpms.size} speeds, "
+    print(f"Newmark (Numba): run-up of {rpms.size} speeds, "
           f"solver time {best:.4f} s warm "
           f"(best of {args.repeat}; wall incl. load sampling {wall:.3f} s), cold first run in a "
           f"fresh process {cold_total:.2f} s (solver {cold_solver:.2f} s); "

@@ -15,14 +15,15 @@ import scipy.linalg as sla
 from click.testing import CliRunner
 from scipy.spatial.transform import Rotation
 
-from powertrain.assembly import assemble
 from powertrain.cli import main
 from powertrain.iotools.engine_file import DEFAULT_ENGINE_PATH, read_engine
+from powertrain.physics.condensation import condense
 from powertrain.solvers.modes import COORDINATES
 from powertrain.workflows.modes import modes as engine_modes
 
 DATA = Path(__file__).parent / "data"
 REFERENCE = DATA / "modes-reference-engine.toml"
+MOUNTS = Path(DEFAULT_ENGINE_PATH).parents[1] / "mounts"
 FREQ_REL = 1e-6
 KED_PP = 0.01
 
@@ -165,27 +166,85 @@ def test_json_keys_and_order(tmp_path):
     assert (tmp_path / "m.png").stat().st_size > 0
 
 
+SLS_MOUNT = """
+[mount]
+name = "standard linear solid (a massless internal node)"
+model = "sls"
+
+[units]
+c = "N/mm"
+d = "N*s/mm"
+
+[parameters]
+c1 = 150.0
+c2 = 60.0
+d2 = 0.4
+"""
+
+
+def _engine_text():
+    """The default engine file's text with absolute mount paths (to be written elsewhere)."""
+    return Path(DEFAULT_ENGINE_PATH).read_text().replace("../mounts/", f"{MOUNTS}/")
+
+
+def _with_massless_node(tmp_path):
+    """The default engine with its gearbox mount's x direction an SLS network, whose internal
+    node has no mass (the model's mass matrix is singular)."""
+    (tmp_path / "sls-x.toml").write_text(SLS_MOUNT)
+    path = tmp_path / "sls.toml"
+    path.write_text(_engine_text().replace(f"{MOUNTS}/elastomeric-gearbox-mount-x.toml",
+                                           str(tmp_path / "sls-x.toml")))
+    return path
+
+
 @pytest.mark.parametrize("path", [DEFAULT_ENGINE_PATH,
                                   Path(DEFAULT_ENGINE_PATH).parent / "default-torque-rod.toml",
-                                  REFERENCE], ids=["default", "torque-rod", "reference"])
-def test_dynamic_modes_are_eigenvalues_of_the_full_model(path):
+                                  Path(DEFAULT_ENGINE_PATH).parent / "default-modal-body.toml",
+                                  REFERENCE, "massless-node"],
+                         ids=["default", "torque-rod", "modal-body", "reference", "massless-node"])
+def test_dynamic_modes_are_roots_of_the_condensed_model(path, tmp_path):
     """Oracle: a second solver. Every damped mode's complex frequency s is an eigenvalue of
     the full state-space model M q'' + C q' + K q = 0 with the networks' internal degrees of
-    freedom (scipy.linalg.eig), and the six modes are distinct."""
-    e = read_engine(path)
-    system = assemble(e.body.mass, e.body.cg, e.body.inertia, e.mounts)
+    freedom (scipy.linalg.eig, generalized), and a root of the condensed problem on the
+    retained coordinates, D_R(s) phi = 0 with every network through its two-port at s
+    (powertrain.physics.condensation.condense): D_R(s) is singular to round-off and its null
+    vector is the mode's shape (MAC 1). The modes are distinct and sorted."""
+    e = read_engine(_with_massless_node(tmp_path) if path == "massless-node" else path)
+    system = e.assemble()
     n = system.n_dof
     A = np.block([[np.zeros((n, n)), np.eye(n)], [-system.K, -system.C]])
     B = np.block([[np.eye(n), np.zeros((n, n))], [np.zeros((n, n)), system.M]])
     lam = sla.eig(A, B, right=False)
     lam = lam[np.isfinite(lam)]
     res = engine_modes(e)
-    s = [2 * np.pi * m.frequency_hz * (-m.damping_ratio + 1j * np.sqrt(1 - m.damping_ratio**2))
+    keep = system.retained
+    s = [2 * np.pi * (-m.damping_ratio * m.frequency_hz + 1j * m.damped_frequency_hz)
          for m in res.modes]
-    for si in s:
+    for si, m in zip(s, res.modes):
         assert np.min(np.abs(lam - si)) / abs(si) < 1e-8
+        _, sigma, vh = np.linalg.svd(condense(system, keep, si))
+        assert sigma[-1] / sigma[0] < 1e-8
+        null = np.conj(vh[-1])[:6]
+        mac = abs(np.vdot(null, m.shape)) ** 2 / (np.vdot(null, null).real
+                                                  * np.vdot(m.shape, m.shape).real)
+        assert mac == pytest.approx(1.0, abs=1e-6)
     assert min(abs(a - b) for i, a in enumerate(s) for b in s[i + 1:]) > 1e-6 * abs(s[0])
     assert [m.frequency_hz for m in res.modes] == sorted(m.frequency_hz for m in res.modes)
+
+
+def test_a_measured_frf_chassis_takes_the_ground_under_the_mounts(tmp_path):
+    """A measured receptance (``[chassis] model = "frf"``) is coupled in the harmonic solver
+    only: the modes of an engine with one are those of the same engine on a rigid ground."""
+    (tmp_path / "body.csv").write_text(
+        "frequency_hz,response,excitation,receptance_real_m_per_n,receptance_imag_m_per_n\n"
+        + "".join(f"{f},{r}.{a},{x}.{b},1e-8,0.0\n" for f in (10.0, 100.0)
+                  for r in ("left", "right", "gearbox") for x in ("left", "right", "gearbox")
+                  for a in "xyz" for b in "xyz"))
+    (tmp_path / "frf.toml").write_text(_engine_text() + '\n[chassis]\nmodel = "frf"\nfrf = "body.csv"\n')
+    rigid, frf = (engine_modes(read_engine(p)) for p in (DEFAULT_ENGINE_PATH,
+                                                          tmp_path / "frf.toml"))
+    assert [m.frequency_hz for m in frf.modes] == [m.frequency_hz for m in rigid.modes]
+    assert [m.damping_ratio for m in frf.modes] == [m.damping_ratio for m in rigid.modes]
 
 
 def test_modes_of_an_engine_file_without_excitation():
@@ -254,3 +313,14 @@ def test_modes_of_nonlinear_mounts_take_the_networks_as_measured():
     assert text.startswith(f"rigid-body modes, undamped, {AS_MEASURED} at their static")
     assert runup(linear, [3000.0], solver="harmonic").to_text().splitlines()[1].startswith(
         RIGID_BODY_MODES_LABEL)
+
+
+def test_the_shape_of_a_root_exact_to_the_last_bit():
+    """An undamped two-degree-of-freedom model whose root 2i makes K + sC + s²M exactly
+    singular: the shape is still its null vector (the first coordinate alone)."""
+    from types import SimpleNamespace
+
+    from powertrain.solvers.modes import root_shapes
+    model = SimpleNamespace(M=np.eye(2), C=np.zeros((2, 2)), K=np.diag([4.0, 9.0]), n_dof=2)
+    x = root_shapes(model, np.array([2j]))[:, 0]
+    assert abs(x[1]) < 1e-9 * abs(x[0])

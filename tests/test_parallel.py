@@ -89,6 +89,47 @@ def test_a_real_scheduler_passes_the_probe():
         probe_scheduler(cluster.scheduler_address)
 
 
+def test_a_given_executor_is_used_as_is_and_left_running():
+    """The factory yields an executor passed in (a dask Client, a concurrent.futures pool)
+    and does not shut it down."""
+    from concurrent.futures import ThreadPoolExecutor
+    with ThreadPoolExecutor(max_workers=2) as pool:
+        with executor(pool) as ex:
+            assert ex is pool
+        assert run_map(_square, range(4), pool) == [0, 1, 4, 9]
+        assert pool.submit(_square, 3).result() == 9         # still running
+
+
+def test_auto_runs_one_job_or_one_worker_serially():
+    from powertrain.parallel import SerialExecutor
+    for kwargs in ({"n_jobs": 1}, {"workers": 1, "n_jobs": 5}, {"n_jobs": 0}):
+        with executor(None, **kwargs) as ex:
+            assert isinstance(ex, SerialExecutor)
+
+
+def test_workers_below_one_is_one_line_input_error():
+    with pytest.raises(InputError) as e:
+        run_map(_square, range(3), "processes", workers=0)
+    assert "--workers" in str(e.value) and "\n" not in str(e.value)
+
+
+def test_a_failing_job_cancels_the_pending_ones():
+    """A job that raises ends the map at once: the pool's pending jobs are cancelled, not run
+    to the end."""
+    import time
+    t0 = time.perf_counter()
+    with pytest.raises(ZeroDivisionError):
+        run_map(_slow_inverse, [0] + [1] * 8, "processes", workers=1)
+    assert time.perf_counter() - t0 < 4.0
+
+
+def _slow_inverse(x):
+    import time
+    if x:
+        time.sleep(1.0)
+    return 1 / x
+
+
 def test_serial_executor_hands_exceptions_to_the_future():
     with executor("serial") as ex:
         fut = ex.submit(int, "x")

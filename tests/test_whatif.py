@@ -21,9 +21,10 @@ from click.testing import CliRunner
 from powertrain.assembly import assemble
 from powertrain.cli import main
 from powertrain.errors import InputError
+from powertrain.parallel import SerialExecutor
 from powertrain.workflows.operations import Variant, apply_operations
 from powertrain.workflows.retune import band_weight, retune
-from powertrain.workflows.sweeps import SerialExecutor, SweepTask, run_sweep
+from powertrain.workflows.sweeps import SweepTask, run_sweep
 from powertrain.workflows.variants import (
     parse_move,
     parse_rotate,
@@ -78,6 +79,10 @@ def test_variant_same_alone_and_in_process_pool_sweep(engine):
         swept = run_sweep(tasks, pool)
     assert np.array_equal(alone.velocity, swept[0].velocity)
     assert swept[1].meta["variant"] == "b"
+    for scheduler in ("processes", "serial", None):     # through the one executor factory
+        again = run_sweep(tasks, scheduler, workers=2)
+        assert np.array_equal(again[0].velocity, alone.velocity)
+        assert [r.meta["variant"] for r in again] == ["a", "b"]
 
 
 def test_dynamic_scaling_scales_kcp_exactly_and_modes_by_sqrt(engine):

@@ -1,8 +1,10 @@
 """One place to choose where independent jobs run: serially, in local processes, or on a
 dask.distributed cluster.
 
-``executor(scheduler)`` returns a context manager yielding an object with the
-``concurrent.futures`` interface (``submit`` → future with ``.result()``, ``map``):
+``executor(scheduler)`` is the one executor factory: a context manager yielding an object with
+the ``concurrent.futures`` interface (``submit`` → future with ``.result()``, ``map``).
+``powertrain whatif`` (its variants, through :func:`powertrain.workflows.sweeps.run_sweep`)
+and ``powertrain diagnose`` (its candidate fits, through :func:`run_map`) run on it.
 
 ================================ ==========================================================
 ``scheduler``                    runs on
@@ -15,6 +17,8 @@ dask.distributed cluster.
                                  (one single-threaded worker process per core)
 ``"tcp://HOST:PORT"``            an existing dask.distributed scheduler (start it with
                                  ``dask scheduler`` and workers with ``dask worker HOST:PORT``)
+an executor                      itself, left running: a ``distributed.Client``, a
+                                 ``concurrent.futures`` executor, anything with ``submit``
 ================================ ==========================================================
 
 Results do not depend on the choice: every job is a pure function of its arguments, and
@@ -134,26 +138,45 @@ def probe_scheduler(address: str, timeout: float = CONNECT_TIMEOUT_S) -> None:
 
 @contextmanager
 def executor(scheduler=None, *, workers=None, n_jobs=None):
-    """Executor for ``scheduler`` (see the module table), shut down on exit.
+    """The executor for ``scheduler`` (see the module table); one this function opens is shut
+    down on exit, pending jobs cancelled if the block raised.
 
     Parameters
     ----------
-    scheduler : str or None
-        ``None``/``"auto"``, ``"serial"``, ``"processes"``, ``"local"`` or ``"tcp://HOST:PORT"``.
+    scheduler : str, executor or None
+        ``None``/``"auto"``, ``"serial"``, ``"processes"``, ``"local"``,
+        ``"tcp://HOST:PORT"``, or an object with ``submit`` (yielded as it is).
     workers : int, optional
-        Local processes (default: the usable cores).
+        Local processes (default: the usable cores, :func:`cpu_count`; never more than
+        ``n_jobs``).
     n_jobs : int, optional
         Number of jobs about to be submitted (``auto`` runs one job serially).
+
+    Raises
+    ------
+    InputError
+        ``scheduler`` not understood (key ``--scheduler``), or ``workers`` < 1 (key
+        ``--workers``).
     """
+    if hasattr(scheduler, "submit"):
+        yield scheduler
+        return
     s = check_scheduler(scheduler)
+    if workers is not None and workers < 1:
+        raise InputError("must be >= 1", key="--workers")
     n = workers or cpu_count()
+    if n_jobs is not None:
+        n = max(1, min(n, n_jobs))
     if s == "auto":
-        s = "serial" if (n <= 1 or (n_jobs is not None and n_jobs <= 1)) else "processes"
+        s = "serial" if n <= 1 else "processes"
     if s == "serial":
         yield SerialExecutor()
     elif s == "processes":
-        with ProcessPoolExecutor(max_workers=n) as ex:
-            yield ex
+        pool = ProcessPoolExecutor(max_workers=n)
+        try:
+            yield pool
+        finally:
+            pool.shutdown(wait=True, cancel_futures=True)
     else:
         with _dask_client(s, n) as client:
             yield client
@@ -183,15 +206,17 @@ def _dask_client(address, n):
         client.close()
 
 
-def run_map(fn, items, scheduler=None, *, workers=None, progress=None):
-    """``[fn(x) for x in items]`` on ``scheduler``, results in the order of ``items``.
+def run_map(fn, items, scheduler=None, *, workers=None, progress=None, unit="job"):
+    """``[fn(x) for x in items]`` on the executor of ``scheduler`` (:func:`executor`: a
+    scheduler name or address, or an executor), results in the order of ``items``.
 
-    ``progress``: a description for a tqdm bar on stderr (shown only on a terminal).
+    ``progress``: a description for a tqdm bar on stderr (shown only on a terminal), counting
+    ``unit``.
     """
     items = list(items)
     with executor(scheduler, workers=workers, n_jobs=len(items)) as ex:
         futures = [ex.submit(fn, x) for x in items]
-        bar = progress_bar(len(futures), progress) if progress else None
+        bar = progress_bar(len(futures), progress, unit=unit) if progress else None
         out = []
         for f in futures:
             out.append(f.result())
@@ -202,8 +227,8 @@ def run_map(fn, items, scheduler=None, *, workers=None, progress=None):
     return out
 
 
-def progress_bar(total, desc, quiet=False):
+def progress_bar(total, desc, quiet=False, unit="it"):
     """tqdm bar on stderr (:func:`powertrain.progress.progress_bar`); disabled when
     ``quiet`` or stderr is not a terminal."""
     from powertrain.progress import progress_bar as bar
-    return bar(None, enabled=not quiet, total=total, desc=desc)
+    return bar(None, enabled=not quiet, total=total, desc=desc, unit=unit)

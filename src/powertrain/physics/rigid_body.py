@@ -29,8 +29,8 @@ def direction_row(r, e) -> np.ndarray:
     r"""1×6 row giving the motion of point ``r`` along unit vector ``e``:
     :math:`\mathbf e\cdot(\mathbf u + \boldsymbol\theta\times\mathbf r)
     = [\,\mathbf e^T \;\; (\mathbf r\times\mathbf e)^T\,]\,\mathbf q`."""
-    e = np.asarray(e, float)
-    return np.concatenate([e, np.cross(r, e)])
+    (r0, r1, r2), (e0, e1, e2) = (np.asarray(v, float).tolist() for v in (r, e))
+    return np.array([e0, e1, e2, r1 * e2 - r2 * e1, r2 * e0 - r0 * e2, r0 * e1 - r1 * e0])
 
 
 def rigid_body_mass_matrix(mass, inertia) -> np.ndarray:

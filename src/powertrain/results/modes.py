@@ -33,6 +33,11 @@ class Mode:
         Angle between the mode's rotation axis and the torque-roll axis [deg].
     kind : str
         ``rigid-body`` or ``chassis``.
+    iterations : int
+        Iterations taken to find the mode: 0, every mode comes from one eigensolve
+        (:func:`powertrain.solvers.modes.state_space_eigenvalues`).
+    body_energy_percent : float
+        Share of the mode's kinetic energy in the body modes of a modal chassis [%].
     static_frequency_hz : float
         Frequency of the undamped static-stiffness mode of the most similar shape (paired
         one to one by the modal assurance criterion; the frequency itself for the static

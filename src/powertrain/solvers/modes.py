@@ -6,16 +6,19 @@ Two methods:
   stiffness, the networks' internal nodes condensed statically:
   :math:`\mathbf K_{6}\boldsymbol\varphi = \omega^2\mathbf M_{6}\boldsymbol\varphi`.
 * ``dynamic`` (default) — each mode with the mount networks' dynamic stiffness at its own
-  (complex) frequency. The networks' internal degrees of freedom are condensed exactly at the
-  complex eigenvalue :math:`s`: every network adds :math:`K_{IP}(s)\,\mathbf r\mathbf r^T`
-  with :math:`K_{IP}(s) = D_{EE} - \mathbf D_{Ei}\mathbf D_{ii}^{-1}\mathbf D_{iE}`,
-  :math:`\mathbf D(s) = \mathbf K + s\mathbf C + s^2\mathbf M` of the network. The nonlinear
-  eigenproblem :math:`\big(s^2\mathbf M_6 + \sum K_{IP}(s)\mathbf r\mathbf r^T\big)\boldsymbol
-  \varphi = 0` is solved per mode by a secant iteration on :math:`s` starting from the static
-  mode (the branch is followed by the modal assurance criterion); every root is an eigenvalue
-  of the full state-space model with the internal degrees of freedom, which is checked.
-  Natural frequency :math:`|s|/2\pi`, damping ratio :math:`-\mathrm{Re}\,s/|s|`, damped
-  frequency :math:`\mathrm{Im}\,s/2\pi`.
+  (complex) frequency: the eigenvalues :math:`s` of the assembled model
+  :math:`\mathbf M\ddot{\mathbf q} + \mathbf C\dot{\mathbf q} + \mathbf K\mathbf q = 0` with
+  the networks' internal degrees of freedom (and the body modes of a modal chassis), in
+  first-order form, all found by one eigensolve (:func:`state_space_eigenvalues`), with the
+  shapes of those near the static modes (:func:`root_shapes`). Lumped networks
+  make this exact: a root is a root of the condensed problem
+  :math:`\big(s^2\mathbf M_R + \mathbf K_R(s)\big)\boldsymbol\varphi = 0` on the retained
+  coordinates (rigid body, body modes; every network through its two-port at :math:`s`,
+  :func:`powertrain.physics.condensation.condense`) and the retained part of its eigenvector
+  is :math:`\boldsymbol\varphi`. The full model has more roots than modes (the networks' own
+  modes); each static mode takes the root nearest to it in natural frequency and shape, one
+  to one (:func:`_damped_roots`). Natural frequency :math:`|s|/2\pi`, damping ratio
+  :math:`-\mathrm{Re}\,s/|s|`, damped frequency :math:`\mathrm{Im}\,s/2\pi`.
 
 Kinetic-energy distribution of mode :math:`\boldsymbol\varphi` over the coordinates
 ``x, y, z, rx, ry, rz`` (CG translations and rotations about axes through the CG parallel to
@@ -36,6 +39,7 @@ from __future__ import annotations
 
 import numpy as np
 import scipy.linalg as sla
+from scipy.optimize import linear_sum_assignment
 
 from powertrain.assembly import NetworkScaling
 from powertrain.physics.condensation import condense
@@ -45,9 +49,11 @@ AS_MEASURED = ("mounts as measured (networks as in their mount files: amplitude 
                "factor 1, no friction)")
 
 COORDINATES = ("x", "y", "z", "rx", "ry", "rz")
-#: Relative change of s at which the secant iteration stops.
-TOLERANCE = 1e-12
-MAX_ITERATIONS = 60
+#: Damping ratio below -UNSTABLE of a damped root: not a root of the passive model.
+UNSTABLE = 1e-8
+#: Share of a mode's kinetic energy in the powertrain's coordinates below which the mode does
+#: not move the powertrain (round-off): its energy distribution and axis are undefined (NaN).
+STILL = 1e-20
 
 
 # ---------------------------------------------------------------------------- physics
@@ -60,10 +66,11 @@ def torque_roll_axis(inertia, crank_axis=(1.0, 0.0, 0.0)) -> np.ndarray:
 
 def kinetic_energy_percent(M6, phi) -> np.ndarray:
     """:math:`100\\,\\mathrm{Re}(\\bar\\varphi_j(\\mathbf M\\varphi)_j)/\\mathrm{Re}(\\varphi^H
-    \\mathbf M\\varphi)` per coordinate [%]."""
+    \\mathbf M\\varphi)` per coordinate [%] of the mode ``phi`` (n,), or of each column of
+    ``phi`` (n, k)."""
     phi = np.asarray(phi, complex)
     e = (np.conj(phi) * (M6 @ phi)).real
-    return 100.0 * e / e.sum()
+    return 100.0 * e / e.sum(axis=0)
 
 
 def number_or_null(value):
@@ -72,128 +79,154 @@ def number_or_null(value):
     return float(value) if np.isfinite(value) else None
 
 
-def _axis_angle_deg(a, b) -> float:
-    na, nb = np.linalg.norm(a), np.linalg.norm(b)
-    if na == 0 or nb == 0:
-        return float("nan")
-    return float(np.degrees(np.arccos(np.clip(abs(a @ b) / (na * nb), 0.0, 1.0))))
+def _axis_angles_deg(A, b) -> np.ndarray:
+    """Angle [deg, 0..90] between the axis of each column of ``A`` (3, k) and the axis ``b``;
+    NaN where either is zero."""
+    norms = np.sqrt((A * A).sum(axis=0)) * np.sqrt(b @ b)
+    cosine = np.divide(np.abs(b @ A), norms, out=np.zeros(norms.shape), where=norms > 0)
+    return np.where(norms > 0, np.degrees(np.arccos(np.clip(cosine, 0.0, 1.0))), np.nan)
 
 
-def _normalise(M6, phi):
-    """Unit modal mass, phase so that the largest-energy entry is real positive."""
+def _normalise(M, phi):
+    """Each column of ``phi`` with unit modal mass, its phase such that its largest-energy
+    entry is real positive."""
     phi = np.asarray(phi, complex)
-    j = int(np.argmax((np.conj(phi) * (M6 @ phi)).real))
-    phi = phi * np.exp(-1j * np.angle(phi[j]))
-    return phi / np.sqrt((np.conj(phi) @ M6 @ phi).real)
+    j = np.argmax((np.conj(phi) * (M @ phi)).real, axis=0)
+    phi = phi * np.exp(-1j * np.angle(phi[j, np.arange(phi.shape[1])]))
+    return phi / np.sqrt(np.einsum("ij,ij->j", np.conj(phi), M @ phi).real)
 
 
-def _condensed_stiffness(system, s):
-    r""":math:`\mathbf D_R(s) - s^2\mathbf M_R` on the retained coordinates (rigid body, body
-    modes), the networks condensed exactly at complex ``s``
-    (:func:`powertrain.physics.condensation.condense`)."""
-    keep = system.retained
-    return condense(system, keep, s) - s * s * system.M[np.ix_(keep, keep)]
+def _mac_matrix(P, Q, M) -> np.ndarray:
+    r"""Modal assurance criterion of every column of ``P`` with every column of ``Q``,
+    :math:`|\mathbf p^H\mathbf M\mathbf q|^2 / (\mathbf p^H\mathbf M\mathbf p\;
+    \mathbf q^H\mathbf M\mathbf q)`, shape (P columns, Q columns)."""
+    MQ = M @ Q
+    num = np.abs(np.conj(P).T @ MQ) ** 2
+    return num / np.outer(np.einsum("ij,ij->j", np.conj(P), M @ P).real,
+                          np.einsum("ij,ij->j", np.conj(Q), MQ).real)
 
 
-def _mac(a, b, M6) -> float:
-    num = abs(np.conj(a) @ M6 @ b) ** 2
-    return float(num / ((np.conj(a) @ M6 @ a).real * (np.conj(b) @ M6 @ b).real))
+def state_space_eigenvalues(system) -> np.ndarray:
+    r"""Eigenvalues of the assembled model's equations of motion
+    :math:`\mathbf M\ddot{\mathbf q} + \mathbf C\dot{\mathbf q} + \mathbf K\mathbf q = 0`
+    in first-order form, every coordinate included (rigid body, the networks' internal
+    degrees of freedom, body modes).
 
+    With :math:`\mathbf M` invertible the standard eigenproblem of
+    :math:`\begin{bmatrix}\mathbf 0 & \mathbf I\\ -\mathbf M^{-1}\mathbf K &
+    -\mathbf M^{-1}\mathbf C\end{bmatrix}`; otherwise (a massless node) the generalized
+    one with :math:`\mathrm{diag}(\mathbf I, \mathbf M)`, its infinite eigenvalues dropped.
 
-def _follow(system, M6, s0, phi0):
-    """Secant iteration on s for the branch through (s0, phi0)."""
-    def step(s, phi_ref):
-        mu, vec = sla.eig(_condensed_stiffness(system, s), M6)
-        k = int(np.argmax([_mac(vec[:, j], phi_ref, M6) for j in range(mu.size)]))
-        return 1j * np.sqrt(mu[k]), vec[:, k]
+    Parameters
+    ----------
+    system : AssembledSystem
+        ``M``, ``C``, ``K`` (n, n) in SI units.
 
-    s_prev, phi = s0, phi0
-    f_prev, phi = step(s_prev, phi)
-    s = f_prev
-    g_prev = f_prev - s_prev
-    for it in range(1, MAX_ITERATIONS + 1):
-        f, phi_new = step(s, phi)
-        g = f - s
-        if abs(g) <= TOLERANCE * abs(s):
-            return f, phi_new, it
-        phi = phi_new
-        denom = g - g_prev
-        s_next = f if denom == 0 else s - g * (s - s_prev) / denom
-        s_prev, g_prev, s = s, g, s_next
-    return s, phi, MAX_ITERATIONS
-
-
-def _null_vector(system, M6, s):
-    """Shape of a root s: null vector of s²M_R + K_R(s) (condensed)."""
-    _, _, vh = np.linalg.svd(s * s * M6 + _condensed_stiffness(system, s))
-    return np.conj(vh[-1])
-
-
-def _body_roots(system, M6, cand):
-    """The candidate roots with their shapes, without the networks' own internal roots (where
-    a network's internal block is singular and the condensation has a pole)."""
-    kept, shapes = [], []
-    for c in cand:
-        try:
-            shapes.append(_null_vector(system, M6, c))
-        except FloatingPointError:
-            continue
-        kept.append(c)
-    return np.array(kept, complex), shapes
-
-
-def _dynamic_roots(system, M6, omegas, vec):
-    """Roots followed from each static mode, made unique against the exact eigenvalues.
-
-    Each static mode is followed by :func:`_follow`. The full state-space eigenvalues near
-    the rigid-body band are the candidates; static modes are assigned to distinct candidates
-    (nearest root and shape, :func:`scipy.optimize.linear_sum_assignment`), so two branches
-    can never land on the same eigenvalue.
+    Returns
+    -------
+    ndarray complex (m,)
+        The finite eigenvalues :math:`s` [1/s] (m = 2n without massless nodes).
     """
-    from scipy.optimize import linear_sum_assignment
-    followed = [_follow(system, M6, 1j * w, vec[:, i].astype(complex))
-                for i, w in enumerate(omegas)]
-    lam = _state_space_eigenvalues(system)
+    n = system.n_dof
+    try:
+        inverse = np.linalg.inv(system.M)
+    except np.linalg.LinAlgError:
+        zero, eye = np.zeros((n, n)), np.eye(n)
+        lam = sla.eig(np.block([[zero, eye], [-system.K, -system.C]]),
+                      np.block([[eye, zero], [zero, system.M]]), right=False)
+        return lam[np.isfinite(lam)]
+    A = np.zeros((2 * n, 2 * n))
+    A[:n, n:] = np.eye(n)
+    A[n:] = -inverse @ np.hstack([system.K, system.C])
+    return np.linalg.eigvals(A)
+
+
+def root_shapes(system, roots) -> np.ndarray:
+    r"""The shape of the assembled model at each of its eigenvalues ``roots`` (k,) [1/s]: the
+    null vector of :math:`\mathbf K + s\mathbf C + s^2\mathbf M`, by one step of inverse
+    iteration from a generic start vector of its own for each root (so that a repeated root
+    gets independent shapes). For a root accurate to round-off the error of its shape is
+    round-off over the relative distance to the next root.
+
+    Returns
+    -------
+    ndarray complex (n, k)
+        One shape per column, every coordinate, any scale.
+    """
+    s = np.asarray(roots, complex)[:, None, None]
+    start = np.cos(np.outer(np.arange(1, s.shape[0] + 1), np.arange(1, system.n_dof + 1)))
+    try:
+        x = np.linalg.solve(_dynamic_stiffness(system, s), start[..., None])
+    except np.linalg.LinAlgError:                 # a root exact to the last bit: shift off it
+        x = np.linalg.solve(_dynamic_stiffness(system, s * (1.0 + 1e-13)), start[..., None])
+    return x[..., 0].T
+
+
+def _dynamic_stiffness(system, s):
+    """:math:`\\mathbf K + s\\mathbf C + s^2\\mathbf M` at each ``s`` (k, 1, 1)."""
+    D = s * system.M
+    D += system.C
+    D *= s
+    D += system.K
+    return D
+
+
+def _damped_roots(system, MR, omegas, vec):
+    r"""The damped mode of each static mode: ``(s, phi)``, the roots (k,) and their shapes on
+    the retained coordinates (n_R, k) in the order of ``omegas`` [rad/s], from the eigenvalues
+    of the full model (:func:`state_space_eigenvalues`) and their shapes
+    (:func:`root_shapes`).
+
+    Candidates are the eigenvalues with positive imaginary part and a modulus below three
+    times the highest static angular frequency (if these are fewer than the modes: every
+    eigenvalue with imaginary part >= 0, overdamped ones included), without those that leave
+    the retained coordinates still (a network's own mode, decoupled from the body). Each
+    static mode i gets its own candidate (:func:`scipy.optimize.linear_sum_assignment`) at
+    the least total cost :math:`|\ln(\omega_i/|s|)| + 1 - \mathrm{MAC}(\boldsymbol\varphi_i,
+    \boldsymbol\varphi_s)`: nearest in natural frequency and in shape.
+
+    Raises
+    ------
+    ValueError
+        Fewer candidates than modes, or a picked root with a damping ratio below
+        -:data:`UNSTABLE` (matrices beyond what the eigensolve resolves in floating point).
+    """
+    lam = state_space_eigenvalues(system)
     top = 3.0 * max(omegas.max(), 1e-9)
-    cand, shapes = _body_roots(system, M6, lam[(lam.imag > 0) & (np.abs(lam) < top)])
-    if cand.size < len(followed):
-        return followed
-    cost = np.array([[abs(s - c) / abs(s) + 1.0 - _mac(phi, shapes[j], M6)
-                      for j, c in enumerate(cand)] for s, phi, _ in followed])
-    rows, cols = linear_sum_assignment(cost)
-    out = []
-    for i, j in zip(rows, cols):
-        s, phi, its = followed[i]
-        if abs(s - cand[j]) > 1e-6 * abs(s):           # branch lost: take the exact root
-            s, phi = cand[j], shapes[j]
-        out.append((s, phi, its))
-    return out
+    pick = (lam.imag > 0) & (np.abs(lam) < top)
+    if np.count_nonzero(pick) < omegas.size:
+        pick = lam.imag >= 0
+    lam = lam[pick]
+    full = root_shapes(system, lam)
+    phi = full[system.retained]
+    moving = (np.einsum("ij,ij->j", np.conj(phi), MR @ phi).real
+              > 1e-12 * np.einsum("ij,ij->j", np.conj(full), system.M @ full).real)
+    lam, phi = lam[moving], phi[:, moving]
+    if lam.size < omegas.size:
+        raise ValueError(f"{lam.size} damped roots for {omegas.size} modes")
+    with np.errstate(divide="ignore", invalid="ignore"):
+        cost = (np.abs(np.log(omegas[:, None] / np.abs(lam)[None, :]))
+                + 1.0 - _mac_matrix(vec.astype(complex), phi, MR))
+    _, cols = linear_sum_assignment(np.nan_to_num(cost, nan=1e300, posinf=1e300))
+    if np.any(lam[cols].real > UNSTABLE * np.abs(lam[cols])):
+        raise ValueError("a root with positive real part (no passive model has one): beyond "
+                         "floating-point range")
+    return lam[cols], phi[:, cols]
 
 
 def _pair_with_static(M, shapes, static_shapes) -> list:
-    """``(index of the static mode, MAC)`` for each shape: the one-to-one pairing of largest
-    total MAC (:func:`scipy.optimize.linear_sum_assignment`)."""
-    from scipy.optimize import linear_sum_assignment
-    mac = np.array([[_mac(phi, static_shapes[:, j].astype(complex), M)
-                     for j in range(static_shapes.shape[1])] for phi in shapes])
+    """``(index of the static mode, MAC)`` for each column of ``shapes``: the one-to-one
+    pairing of largest total MAC (:func:`scipy.optimize.linear_sum_assignment`)."""
+    mac = _mac_matrix(shapes, static_shapes.astype(complex), M)
     rows, cols = linear_sum_assignment(-mac)
     pair = dict(zip(rows, cols))
-    return [(int(pair[i]), float(mac[i, pair[i]])) for i in range(len(shapes))]
+    return [(int(pair[i]), float(mac[i, pair[i]])) for i in range(shapes.shape[1])]
 
 
 def _static_condensed(system, keep) -> np.ndarray:
     """Static stiffness on the kept coordinates, the others condensed."""
     Kr = condense(system, keep, 0.0).real
     return 0.5 * (Kr + Kr.T)
-
-
-def _state_space_eigenvalues(system) -> np.ndarray:
-    """Finite eigenvalues of the full model (internal degrees of freedom included)."""
-    n = system.n_dof
-    A = np.block([[np.zeros((n, n)), np.eye(n)], [-system.K, -system.C]])
-    B = np.block([[np.eye(n), np.zeros((n, n))], [np.zeros((n, n)), system.M]])
-    lam = sla.eig(A, B, right=False)
-    return lam[np.isfinite(lam)]
 
 
 def rigid_body_modes(system, inertia, *, static=False, crank_axis=(1.0, 0.0, 0.0)) -> dict:
@@ -223,38 +256,45 @@ def rigid_body_modes(system, inertia, *, static=False, crank_axis=(1.0, 0.0, 0.0
     w2, vec = sla.eigh(_static_condensed(system, keep), MR)
     tra = torque_roll_axis(inertia, crank_axis)
     omegas = np.sqrt(np.clip(w2, 0.0, None))
-    roots = [(1j * w, vec[:, i].astype(complex), 0) for i, w in enumerate(omegas)]
-    if not static:
-        roots = _dynamic_roots(system, MR, omegas, vec)
-    M6 = MR[:6, :6]
-    modes = []
-    pairs = _pair_with_static(MR, [phi for _, phi, _ in roots], vec)
-    for (s, phi, its), (k, mac) in zip(roots, pairs):
-        phi = _normalise(MR, phi)
-        e = (np.conj(phi) * (MR @ phi)).real
-        body_share = 100.0 * e[6:].sum() / e.sum()
-        ked = kinetic_energy_percent(M6, phi[:6])
-        rot = phi[3:6].real
-        modes.append({"frequency_hz": abs(s) / (2 * np.pi),
-                      "damping_ratio": 0.0 if static else float(-s.real / abs(s)),
-                      "damped_frequency_hz": float(s.imag / (2 * np.pi)), "shape": phi[:6],
-                      "ked_percent": ked, "iterations": its,
-                      "angle_to_torque_roll_axis_deg": _axis_angle_deg(rot, tra),
-                      "kind": "rigid-body" if body_share < 50.0 else "chassis",
-                      "body_energy_percent": float(body_share),
-                      "static_frequency_hz": float(omegas[k] / (2 * np.pi)),
-                      "static_mac": mac})
+    s, phi = (1j * omegas, vec.astype(complex)) if static else \
+        _damped_roots(system, MR, omegas, vec)
+    modes = _mode_fields(MR, s, phi, omegas, vec, tra, static)
     modes.sort(key=lambda m: m["frequency_hz"])
     crank = np.asarray(crank_axis, float)
     tra_info = {"direction": [float(v) for v in tra],
-                "angle_to_crank_axis_deg": _axis_angle_deg(tra, crank),
+                "angle_to_crank_axis_deg": float(_axis_angles_deg(tra[:, None], crank)[0]),
                 "angles_to_mode_rotation_axes_deg": [
                     number_or_null(m["angle_to_torque_roll_axis_deg"]) for m in modes],
                 "through": "centre of gravity"}
     method = ("static: static stiffness, undamped" if static else
               "dynamic: network dynamic stiffness at each mode's complex frequency "
-              "(internal degrees of freedom condensed exactly, secant iteration)")
+              "(eigenvalues of the full model with the networks' internal degrees of "
+              "freedom)")
     return {"modes": modes, "torque_roll_axis": tra_info, "method": method + note}
+
+
+def _mode_fields(MR, s, phi, omegas, static_shapes, tra, static) -> list:
+    """The fields of a :class:`powertrain.results.modes.Mode` for each root ``s`` (k,) with
+    its shape ``phi`` (n_R, k) on the retained coordinates (any scale), in that order."""
+    pairs = _pair_with_static(MR, phi, static_shapes)
+    phi = _normalise(MR, phi)
+    e = (np.conj(phi) * (MR @ phi)).real
+    body_share = (100.0 * e[6:].sum(axis=0) / e.sum(axis=0)).tolist()
+    ked = kinetic_energy_percent(MR[:6, :6], phi[:6])
+    still = e[:6].sum(axis=0) <= STILL * e.sum(axis=0)
+    ked[:, still] = np.nan
+    angles = np.where(still, np.nan, _axis_angles_deg(phi[3:6].real, tra)).tolist()
+    f = (np.abs(s) / (2 * np.pi)).tolist()
+    zeta = np.zeros(s.size).tolist() if static else (-s.real / np.abs(s)).tolist()
+    f_damped = (s.imag / (2 * np.pi)).tolist()
+    f_static = (omegas / (2 * np.pi)).tolist()
+    return [{"frequency_hz": f[i], "damping_ratio": zeta[i], "damped_frequency_hz": f_damped[i],
+             "shape": phi[:6, i], "ked_percent": ked[:, i],
+             "angle_to_torque_roll_axis_deg": angles[i],
+             "kind": "rigid-body" if body_share[i] < 50.0 else "chassis",
+             "body_energy_percent": body_share[i], "static_frequency_hz": f_static[k],
+             "static_mac": mac}
+            for i, (k, mac) in enumerate(pairs)]
 
 
 def _as_measured(system):

@@ -1,12 +1,11 @@
 """The rigid-body modes of an engine on its mounts (``powertrain modes``): the model
-assembled, the modes solved (:func:`powertrain.solvers.modes.rigid_body_modes`), every mode
-checked finite."""
+assembled (:meth:`powertrain.models.engine.Engine.assemble`), the modes solved
+(:func:`powertrain.solvers.modes.rigid_body_modes`), every mode checked finite."""
 
 from __future__ import annotations
 
 import numpy as np
 
-from powertrain.assembly import assemble
 from powertrain.errors import InputError
 from powertrain.results.modes import Mode, ModesResult
 from powertrain.solvers.modes import rigid_body_modes
@@ -39,11 +38,9 @@ def modes(engine=None, *, static=False) -> ModesResult:
     from powertrain.iotools.engine_file import engine_or_default
     engine = engine_or_default(engine)
     b = engine.body
-    chassis = engine.chassis if getattr(engine.chassis, "body_modes", ()) else None
     try:
         with np.errstate(all="ignore"):
-            system = assemble(b.mass, b.cg, b.inertia, engine.mounts, chassis)
-            result = ModesResult.from_solution(rigid_body_modes(system, b.inertia,
+            result = ModesResult.from_solution(rigid_body_modes(engine.assemble(), b.inertia,
                                                                 static=static),
                                                engine=engine.name)
     except (ValueError, ArithmeticError, np.linalg.LinAlgError) as exc:

@@ -25,7 +25,6 @@ solve per speed, the periodicity check, the result.
 from __future__ import annotations
 
 import os
-import time
 import warnings
 
 import numpy as np
@@ -53,9 +52,6 @@ CYCLES = 6
 PROCESSED_CYCLES = 2
 #: Periodicity above which a warning is raised.
 PERIODICITY_LIMIT = 1e-3
-#: Speed steps run concurrently in threads (the Newmark kernel releases the GIL); serial by
-#: default: on a busy 2-core machine threads were measured slower.
-WORKERS = 1
 #: Finest crank-angle step [deg] of the Newmark stepper (720 / 0.05 = 14 400 steps a cycle).
 MIN_ANGLE_STEP_DEG = 0.05
 #: Coarsest crank-angle step [deg]: 72 steps a cycle still resolve order 8 without aliasing.
@@ -95,7 +91,7 @@ def run_runup(*args, **kwargs) -> RunupResult:
 
 def _run_runup(engine, rpm=None, *, solver="newmark", angle_step_deg=ANGLE_STEP_DEG,
               cycles=CYCLES, processed_cycles=PROCESSED_CYCLES, progress=False,
-              system=None, workers=WORKERS, stepper="auto") -> RunupResult:
+              system=None, stepper="auto") -> RunupResult:
     """Simulate a run-up: steady state at each speed, order analysis of the mount points.
 
     Parameters
@@ -113,8 +109,6 @@ def _run_runup(engine, rpm=None, *, solver="newmark", angle_step_deg=ANGLE_STEP_
         Show a progress bar over the speed steps.
     system : AssembledSystem, optional
         Pre-assembled model (default: assembled from ``engine``).
-    workers : int
-        Speed steps solved concurrently (threads; 1 = serial).
     stepper : {"auto", "modal", "dense"}
         Newmark implementation: ``modal`` (the same recurrence diagonalised once per model,
         :class:`~powertrain.solvers.newmark.ModalNewmark`; needs a regular mass matrix),
@@ -133,7 +127,7 @@ def _run_runup(engine, rpm=None, *, solver="newmark", angle_step_deg=ANGLE_STEP_
     bar = {"desc": f"run-up ({solver})", "unit": "speed", "enabled": bool(progress)}
     points = _operating_points(engine, rpm)
     if points is None:
-        speeds, seconds = _solve_speeds(step, rpm, loads, workers, bar)
+        speeds, seconds = _solve_speeds(step, rpm, loads, bar)
     else:
         speeds, seconds = _solve_at_operating_points(engine, step, rpm, loads, points, bar)
     _warn_periodicity(rpm, [o.periodicity for o in speeds])
@@ -186,22 +180,12 @@ def _cycles(angle_step_deg, cycles, processed_cycles) -> Cycles:
     return Cycles(int(round(n_cycle)), angle_step_deg, cycles, processed_cycles)
 
 
-def _solve_speeds(step, rpm, loads, workers, bar):
-    """Every speed's :class:`SpeedOrders` and the solver time: summed per-speed solver
-    times (serial), wall-clock if run concurrently."""
+def _solve_speeds(step, rpm, loads, bar):
+    """Every speed's :class:`SpeedOrders` and the solver time (summed per-speed solver
+    times)."""
     omegas = rpm * 2 * np.pi / 60.0
-    wall0 = time.perf_counter()
-    if workers > 1 and rpm.size > 1:
-        from concurrent.futures import ThreadPoolExecutor
-        with ThreadPoolExecutor(max_workers=workers) as pool:
-            futures = [pool.submit(step.solve, load, w) for load, w in zip(loads, omegas)]
-            speeds = [fut.result() for fut in progress_bar(futures, **bar)]
-    else:
-        speeds = [step.solve(loads[i], omegas[i]) for i in progress_bar(range(rpm.size), **bar)]
-    total = float(sum(o.seconds for o in speeds))
-    if workers > 1:
-        total = min(time.perf_counter() - wall0, total)
-    return speeds, total
+    speeds = [step.solve(loads[i], omegas[i]) for i in progress_bar(range(rpm.size), **bar)]
+    return speeds, float(sum(o.seconds for o in speeds))
 
 
 def _warn_periodicity(rpm, periodicity):

@@ -3,36 +3,31 @@
 A :class:`SweepTask` is a small picklable description -- the variant's engine (its operations
 already applied), its response-level effects, speeds, solver -- and :func:`run_task` turns it
 into a :class:`~powertrain.results.runup.RunupResult` in whatever process runs it.
-:func:`run_sweep` hands the tasks to an *executor*: anything with the
-:class:`concurrent.futures.Executor` method ``submit(fn, *args) -> future`` whose futures have
-``result()``. Only ``submit`` and ``result`` are used (not ``map``, whose return type differs
-between libraries), results come back in task order.
-
-* default: :class:`concurrent.futures.ProcessPoolExecutor` on the local cores
-  (``workers`` processes, default ``os.cpu_count()``), created and shut down here;
-* ``workers=1`` (or a single task): :class:`SerialExecutor`, in this process;
-* a distributed engine: pass its client, e.g. Dask::
+:func:`run_sweep` runs the tasks on the one executor factory,
+:func:`powertrain.parallel.executor` (through :func:`powertrain.parallel.run_map`): by default
+a process pool on the local cores (serial for one task or ``workers=1``), or the scheduler
+named (``serial``, ``processes``, ``local``, ``tcp://HOST:PORT``), or an executor passed in,
+e.g. a Dask client::
 
       from distributed import Client
       client = Client("tcp://scheduler:8786")    # or Client() for a local cluster
       results = run_sweep(tasks, executor=client)
 
-  ``distributed.Client.submit(fn, *args)`` returns a future with ``.result()``, which is all
-  :func:`run_sweep` needs; the workers must have ``powertrain`` installed. An executor passed
-  in is not shut down. Nothing in the model knows which executor runs it.
+Only ``submit`` and the futures' ``result`` are used; results come back in task order; the
+workers must have ``powertrain`` installed; an executor passed in is not shut down. Nothing in
+the model knows which executor runs it.
 
-BLAS inside :func:`powertrain.workflows.runup.run_runup` is limited to one thread, so one process per
-core does not oversubscribe.
+BLAS inside :func:`powertrain.workflows.runup.run_runup` is limited to one thread, so one
+process per core does not oversubscribe.
 """
 
 from __future__ import annotations
 
-import os
 from dataclasses import dataclass, field
 
 import numpy as np
 
-from powertrain.parallel import SerialExecutor  # noqa: F401 (one serial executor)
+from powertrain.parallel import run_map
 
 
 @dataclass(frozen=True)
@@ -84,23 +79,18 @@ def run_task(task: SweepTask):
     return result
 
 
-def default_workers() -> int:
-    """Local cores (``os.cpu_count()``, at least 1)."""
-    return max(1, os.cpu_count() or 1)
-
-
 def run_sweep(tasks, executor=None, *, workers: int | None = None, progress: bool = False):
     """Run the tasks, return their results in task order.
 
     Parameters
     ----------
     tasks : sequence of SweepTask
-    executor : object with ``submit``, optional
-        Default: a process pool of ``workers`` processes (serial when ``workers == 1`` or
-        one task), shut down on return. Any given executor (a Dask ``distributed.Client``,
-        a ``ThreadPoolExecutor``...) is used as is and left running.
+    executor : str, object with ``submit``, or None
+        Where the tasks run (:func:`powertrain.parallel.executor`): None, a scheduler name
+        or address, or an executor (a Dask ``distributed.Client``, a
+        ``concurrent.futures`` executor...), used as is and left running.
     workers : int, optional
-        Processes of the default pool (default :func:`default_workers`).
+        Local processes (default: the usable cores; serial for one).
     progress : bool
         Progress bar over the tasks.
 
@@ -108,22 +98,5 @@ def run_sweep(tasks, executor=None, *, workers: int | None = None, progress: boo
     -------
     list of RunupResult
     """
-    tasks = list(tasks)
-    if workers is not None and workers < 1:
-        raise ValueError("workers must be >= 1")
-    own = None
-    if executor is None:
-        n = min(workers or default_workers(), len(tasks))
-        if n <= 1:
-            executor = SerialExecutor()
-        else:
-            from concurrent.futures import ProcessPoolExecutor
-            executor = own = ProcessPoolExecutor(max_workers=n)
-    try:
-        futures = [executor.submit(run_task, t) for t in tasks]
-        from powertrain.progress import progress_bar
-        bar = progress_bar(futures, enabled=progress, desc="variants", unit="run-up")
-        return [f.result() for f in bar]
-    finally:
-        if own is not None:
-            own.shutdown(cancel_futures=True)
+    return run_map(run_task, tasks, executor, workers=workers,
+                   progress="variants" if progress else None, unit="run-up")

@@ -7,8 +7,8 @@ each variant once (:func:`variant_engine`: operations in order, a retune target 
 against the engine the earlier operations left, :mod:`powertrain.workflows.retune`; every
 step checked to carry the body), builds one :class:`~powertrain.workflows.sweeps.SweepTask`
 per variant plus the baseline, runs them with :func:`powertrain.workflows.sweeps.run_sweep`
-and returns a :class:`~powertrain.results.whatif.WhatIfResult` (the change in dB is
-defined there).
+(on the one executor factory, :func:`powertrain.parallel.executor`) and returns a
+:class:`~powertrain.results.whatif.WhatIfResult` (the change in dB is defined there).
 """
 
 from __future__ import annotations
@@ -19,6 +19,7 @@ import numpy as np
 
 from powertrain.analysis.channel import Channel
 from powertrain.errors import InputError
+from powertrain.parallel import check_scheduler
 from powertrain.results.whatif import QUANTITIES, VariantRun, WhatIfResult
 
 
@@ -62,9 +63,10 @@ def whatif(engine=None, *, scale=(), set=(), swap=(), move=(), rotate=(), effect
         Measurement overlaid and compared.
     executor : object with ``submit``, or str, optional
         An executor, or a scheduler (``local``, ``tcp://HOST:PORT``, ``processes``,
-        ``serial``; :func:`powertrain.parallel.executor`); default a local process pool.
+        ``serial``), opened and shut down here (:func:`powertrain.parallel.executor`);
+        default a local process pool.
     workers : int, optional
-        Local processes.
+        Local processes (default: the usable cores; 1 = serial).
     progress : bool
 
     Returns
@@ -74,6 +76,8 @@ def whatif(engine=None, *, scale=(), set=(), swap=(), move=(), rotate=(), effect
     from powertrain.workflows.runup import default_rpm, engine_and_file
     if workers is not None and workers < 1:
         raise InputError("must be >= 1", key="--workers")
+    if isinstance(executor, str) or executor is None:
+        check_scheduler(executor)                # before any work
     engine, _ = engine_and_file(engine)
     rpm = default_rpm() if rpm is None else np.atleast_1d(np.asarray(rpm, float))
     ops = {"scale": scale, "set": set, "swap": swap, "move": move, "rotate": rotate,
@@ -83,22 +87,10 @@ def whatif(engine=None, *, scale=(), set=(), swap=(), move=(), rotate=(), effect
     if isinstance(measured, (str, os.PathLike)):
         from powertrain.iotools.measured import read_measured
         measured = read_measured(measured, mounts=engine.mount_names)
-    result = _run_on(executor, engine, runs, rpm, solver=solver, workers=workers,
-                     measured=measured, signal=signal, progress=progress)
+    result = run_whatif(engine, runs, rpm, solver=solver, executor=executor, workers=workers,
+                        measured=measured, signal=signal, progress=progress)
     result.objective = goal
     return result
-
-
-def _run_on(executor, engine, variants, rpm, **kwargs) -> WhatIfResult:
-    """:func:`run_whatif` on ``executor``: an executor, None (a local pool) or a scheduler
-    name, opened here and shut down on return."""
-    if not isinstance(executor, str):
-        return run_whatif(engine, variants, rpm, executor=executor, **kwargs)
-    from powertrain.parallel import check_scheduler
-    from powertrain.parallel import executor as open_executor
-    with open_executor(check_scheduler(executor), workers=kwargs.get("workers"),
-                       n_jobs=len(variants) + 1) as ex:
-        return run_whatif(engine, variants, rpm, executor=ex, **kwargs)
 
 
 def command_variants(engine, ops: dict, targets=(), variants_file=None) -> list:
@@ -211,7 +203,8 @@ def run_whatif(engine, variants, rpm=None, *, solver: str = "harmonic", executor
     solver : {"harmonic", "newmark"}
         Default harmonic: exact for the linear model and fast.
     executor, workers
-        See :func:`powertrain.workflows.sweeps.run_sweep`.
+        Where the run-ups run (:func:`powertrain.workflows.sweeps.run_sweep`, on
+        :func:`powertrain.parallel.executor`).
     measured : MeasuredRunup, optional
         Overlaid in the plot; gaps reported.
     quantities : tuple of str
