@@ -28,7 +28,7 @@ core does not oversubscribe.
 from __future__ import annotations
 
 import os
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -80,8 +80,7 @@ def run_task(task: SweepTask):
     else:
         from powertrain.workflows.runup import run_runup
         result = run_runup(task.engine, task.rpm, solver=task.solver, **task.options)
-    result.meta["variant"] = task.name
-    return result
+    return replace(result, meta={**result.meta, "variant": task.name})
 
 
 def default_workers() -> int:
