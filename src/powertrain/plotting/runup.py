@@ -208,7 +208,7 @@ def plot_whatif(whatif, path=None, *, ax=None, channel=None, quantity=None, prov
     rows, picked = select_panels(base.channels, quantities, channel, quantity)
     keys = [(m, d, q) for m, d in rows for q in picked]
     largest = {k: _largest_change(whatif, k) for k in keys}
-    shown = keys if view == "delta" or is_axes(ax) else \
+    shown = keys if view == "delta" else \
         [k for k in keys if largest[k] >= VISIBLE_CHANGE_DB] or [max(keys, key=largest.get)]
     signal = getattr(whatif, "signal", "velocity")
     title = _whatif_title(view, keys, shown, signal)
@@ -233,7 +233,12 @@ def _panels(ax, shown, quantities, channels, channel, quantity, title_lines=2):
     """The full channel × quantity grid when every panel is shown, else the shown panels
     three to a row in reading order."""
     rows, picked = select_panels(channels, quantities, channel, quantity)
-    if is_axes(ax) or len(shown) == len(rows) * len(picked):
+    if is_axes(ax):
+        if len(shown) != 1:
+            raise InputError(panels_error(len(shown), ", or choose one panel with "
+                                          "channel=(MOUNT, DIR) and quantity="), key="ax")
+        return ax.figure, {shown[0]: ax}, False, np.array([[ax]])
+    if len(shown) == len(rows) * len(picked):
         return grid(ax, channels, quantities, channel, quantity)
     ncol = min(3, len(shown))
     nrow = -(-len(shown) // ncol)

@@ -62,6 +62,7 @@ import numpy as np
 
 from powertrain.effects import A_REF
 from powertrain.iotools.engine_file import DEFAULT_ENGINE_PATH, engine_or_default
+from powertrain.results.base import Result
 from powertrain.solvers.body_coupling import coupled_solve
 from powertrain.solvers.fast_harmonic import N_HARMONICS, HarmonicModel
 from powertrain.validation.cases import draw_case, gaps_db
@@ -322,10 +323,11 @@ def _simulate(hm, engine, truth):
 
 
 # ---------------------------------------------------------------------------- public API
-@dataclasses.dataclass
-class SynthCase:
+@dataclasses.dataclass(frozen=True)
+class SynthCase(Result):
     """A synthetic measured run-up of :func:`synth` (``powertrain synth``): ``.to_text()``,
-    ``.to_csv(path)``, ``.to_truth_json(path)``, ``.plot()``.
+    ``.to_csv(path)``, ``.to_truth_json(path)``, ``.plot()``, ``.save(path)`` (``.csv``,
+    ``.png``).
 
     ``case`` is the :class:`~powertrain.validation.cases.Case` (``case.measured`` the
     :class:`~powertrain.iotools.measured.MeasuredRunup` a diagnosis reads).
@@ -359,6 +361,10 @@ class SynthCase:
                 "truth": [{"effect": n, "library_match": TRUTH_EFFECTS[n],
                            "parameters": {k: plain(v) for k, v in p.items()}}
                           for n, p in c.truth]}
+
+    def writers(self) -> dict:
+        """``.csv`` (:meth:`to_csv`), ``.png``."""
+        return {".csv": self.to_csv, **super().writers()}
 
     def to_truth_json(self, path=None) -> str:
         """:meth:`truth` as JSON, written atomically to ``path`` when given."""
