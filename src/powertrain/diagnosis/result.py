@@ -196,7 +196,7 @@ class DiagnosisResult(Result):
         from powertrain.plotting.style import target_and_path
         ax, path = target_and_path(ax, path)
         return plot_gap_map(self, path, ax=ax, quantity=quantity,
-                            provenance=provenance or getattr(self, "provenance", None))
+                            provenance=provenance)
 
     def report(self, directory, provenance=None) -> list:
         """Write ``summary.txt``, ``diagnosis.json`` and the figures into ``directory``."""

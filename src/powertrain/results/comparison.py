@@ -378,7 +378,7 @@ class ComparisonResult(Result):
         ax, path = target_and_path(ax, path)
         return plot_comparison(self, path, quantities, ax=ax, channel=channel,
                                quantity=quantity, phase=phase,
-                               provenance=provenance or getattr(self, "provenance", None))
+                               provenance=provenance)
 
 
 def _quantity_line(pq) -> str:

@@ -186,4 +186,4 @@ class ModesResult(Result):
         from powertrain.plotting.style import target_and_path
         ax, path = target_and_path(ax, path)
         return plot_modes(self, path, ax=ax,
-                          provenance=provenance or getattr(self, "provenance", None))
+                          provenance=provenance)

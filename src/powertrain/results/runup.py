@@ -378,8 +378,7 @@ class RunupResult(Result):
         from powertrain.plotting.style import target_and_path
         ax, path = target_and_path(ax, path)
         return plot_path_contributions(self, path, order, ax=ax,
-                                       provenance=provenance or getattr(self, "provenance",
-                                                                        None))
+                                       provenance=provenance)
 
     def plot(self, ax=None, *, path=None, quantities=("synthesis", "order_2", "order_4"),
              signal="velocity", others=None, channel=None, quantity=None, provenance=None):
@@ -402,11 +401,10 @@ class RunupResult(Result):
                 and any(self.side(m) == "passive" for m, _ in self.channels)):
             from powertrain.plotting.body import plot_runup_both_sides
             return plot_runup_both_sides(self, path, quantities, signal, ax=ax,
-                                         provenance=provenance or getattr(self, "provenance",
-                                                                          None))
+                                         provenance=provenance)
         return plot_runup([("simulation", self)] + list(others or []), path, quantities,
                           signal, ax=ax, channel=channel, quantity=quantity,
-                          provenance=provenance or getattr(self, "provenance", None))
+                          provenance=provenance)
 
 
 #: /operating_point datasets: (result attribute, unit); shapes (n_rpm, ...) as in the result.

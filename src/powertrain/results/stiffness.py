@@ -78,7 +78,7 @@ class StiffnessResult(Result):
         name = label or self.label or "model"
         return plot_stiffness([(name, self)], path, measured=measured, ax=ax, form=form,
                               freq_axis=freq_axis,
-                              provenance=provenance or getattr(self, "provenance", None))
+                              provenance=provenance)
 
 
 def _ranges(cols) -> str:

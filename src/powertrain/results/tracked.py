@@ -366,5 +366,5 @@ class TrackedOrders(Result):
         from powertrain.plotting.style import target_and_path
         ax, path = target_and_path(ax, path)
         return plot_tracked(self, path, quantities, ax=ax,
-                            provenance=provenance or getattr(self, "provenance", None))
+                            provenance=provenance)
 

@@ -269,7 +269,7 @@ class WhatIfResult(Result):
         from powertrain.plotting.style import target_and_path
         ax, path = target_and_path(ax, path)
         return plot_whatif(self, path, ax=ax, channel=channel, quantity=quantity,
-                           provenance=provenance or getattr(self, "provenance", None),
+                           provenance=provenance,
                            view=view)
 
 
