@@ -39,6 +39,11 @@ CASES = {
     "read_engine int": (lambda e: pt.read_engine(123), True),
     "read_mount None": (lambda e: pt.read_mount(None), True),
     "read_measured missing": (lambda e: pt.read_measured(MISSING), True),
+    "read_measured descriptor": (lambda e: pt.read_measured(0), True),
+    "read_measured mounts": (lambda e: pt.read_measured(MEASURED, mounts=5), True),
+    "read_raw channel map": (lambda e: pt.read_raw(RAW, 3), True),
+    "read_raw channel map file": (lambda e: pt.read_raw(RAW, str(EXAMPLES / "raw-channels"
+                                                                 ".toml")), False),
     "read_raw list": (lambda e: pt.read_raw([]), True),
     "read_plan missing": (lambda e: pt.read_plan(MISSING, e), True),
     # runup
@@ -83,6 +88,7 @@ CASES = {
     "stiffness mount int": (lambda e: pt.stiffness(5), True),
     "stiffness missing": (lambda e: pt.stiffness(MISSING), True),
     "stiffness mount.dir": (lambda e: pt.stiffness("left.q", engine=e), True),
+    "stiffness engine type": (lambda e: pt.stiffness("left.z", engine=5), True),
     "stiffness amplitude string": (lambda e: pt.stiffness(MOUNT, amplitude="0.05,0.1",
                                                           freq="1:20:1"), False),
     "stiffness amplitude zero": (lambda e: pt.stiffness(MOUNT, amplitude=[0.0]), True),
@@ -103,6 +109,7 @@ CASES = {
     # compare
     "compare missing": (lambda e: pt.compare(MISSING), True),
     "compare int": (lambda e: pt.compare(5), True),
+    "compare simulated int": (lambda e: pt.compare(MEASURED, simulated=5), True),
     "compare engine and sim": (lambda e: pt.compare(MEASURED, engine=e, simulated="x.h5"),
                                True),
     "compare noise floor": (lambda e: pt.compare(MEASURED, engine=e, noise_floor=-1,
@@ -121,10 +128,14 @@ CASES = {
                                           solver="x"), True),
     "whatif signal": (lambda e: pt.whatif(e, scale="left.z.stiffness=1.2", rpm=[1000],
                                           signal="x"), True),
+    "whatif measured type": (lambda e: pt.whatif(e, scale="left.z.stiffness=1.2", rpm=[1000],
+                                                 measured=5, workers=1), True),
     "whatif workers": (lambda e: pt.whatif(e, scale="left.z.stiffness=1.2", rpm=[1000],
                                            workers="two"), True),
     # track
     "track missing": (lambda e: pt.track(MISSING), True),
+    "track raw type": (lambda e: pt.track(5), True),
+    "track channel map type": (lambda e: pt.track(RAW, channel_map=5), True),
     "track orders text": (lambda e: pt.track(RAW, orders="a:b"), True),
     "track orders list": (lambda e: pt.track(RAW, orders=[2, "x"]), True),
     "track CLI orders": (lambda e: pt.track(RAW, orders="1,2,4"), False),

@@ -115,10 +115,11 @@ def mount_model(mount, engine=None):
                              key="MOUNT_FILE")
         raise InputError(f"expected a MountModel or a mount file, got {type(mount).__name__}",
                          key="MOUNT_FILE")
+    from powertrain.iotools.engine_file import engine_or_default, read_engine
     if isinstance(engine, (str, os.PathLike)):
-        from powertrain.iotools.engine_file import read_engine
         engine, where = read_engine(engine), str(engine)
     else:
+        engine = engine_or_default(engine)
         where = str(getattr(engine, "file", None) or engine.name)
     parts = str(mount or "").split(".")
     names = engine.mount_names

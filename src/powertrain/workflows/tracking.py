@@ -7,7 +7,6 @@ analysis.
 
 from __future__ import annotations
 
-import os
 from dataclasses import replace
 
 import numpy as np
@@ -17,6 +16,7 @@ from powertrain.analysis.orders import ORDERS
 from powertrain.analysis.phase import tdc_origin, to_tdc
 from powertrain.analysis.speed import speed_from_rpm, speed_from_tacho
 from powertrain.errors import InputError
+from powertrain.models.recording import RawRecording
 from powertrain.results.tracked import TrackedChannel, TrackedOrders
 from powertrain.workflows import arguments as args
 
@@ -153,11 +153,9 @@ def _check_options(tacho_column, pulses_per_rev, map_channel, maps, tdc_offset,
 def _recording(raw, channel_map, rpm_column, tacho_column, cycle_reference=None):
     """The recording of ``raw`` (read through ``channel_map`` if a path)."""
     from powertrain.iotools.raw import read_raw
-    if not isinstance(raw, (str, os.PathLike)):
+    if isinstance(raw, RawRecording):
         return raw
-    if isinstance(channel_map, (str, os.PathLike)):
-        from powertrain.iotools.channel_map import read_channel_map
-        channel_map = read_channel_map(channel_map)
+    args.path_or(raw, (), "RAW", "a raw recording or its file")
     return read_raw(raw, channel_map, rpm=rpm_column, tacho=tacho_column,
                     cycle_reference=cycle_reference)
 

@@ -13,15 +13,21 @@ defined there).
 
 from __future__ import annotations
 
-import os
-
 import numpy as np
 
 from powertrain.analysis.channel import Channel
 from powertrain.errors import InputError
 from powertrain.results.whatif import QUANTITIES, VariantRun, WhatIfResult
 from powertrain.solvers.steppers import SOLVERS
-from powertrain.workflows.arguments import choice, default_rpm, integer, real, speeds, texts
+from powertrain.workflows.arguments import (
+    choice,
+    default_rpm,
+    integer,
+    path_or,
+    real,
+    speeds,
+    texts,
+)
 
 #: Signals a what-if compares (``--signal``).
 SIGNALS = ("velocity", "mount_force")
@@ -93,12 +99,20 @@ def whatif(engine=None, *, scale=(), set=(), swap=(), move=(), rotate=(), effect
         ("effect", effects))}
     runs = command_variants(engine, ops, texts(targets, "--target"), variants)
     goal = parse_objective(objective, engine.assemble().channels, rpm) if objective else None
-    if isinstance(measured, (str, os.PathLike)):
-        from powertrain.iotools.measured import read_measured
-        measured = read_measured(measured, mounts=engine.mount_names)
+    measured = _measured(measured, engine)
     return _run_on(executor, engine, runs, rpm, solver=solver, workers=workers,
                    measured=measured, signal=signal, progress=progress, objective=goal,
                    rpm_step=real(rpm_step, "--step", unit="rpm", optional=True))
+
+
+def _measured(measured, engine):
+    """The measurement to overlay: None, a MeasuredRunup, or its file read for ``engine``'s
+    mounts."""
+    from powertrain.iotools.measured import MeasuredRunup, read_measured
+    if measured is None or isinstance(measured, MeasuredRunup):
+        return measured
+    path_or(measured, (), "--measured", "a MeasuredRunup or its file")
+    return read_measured(measured, mounts=engine.mount_names)
 
 
 def _checked(solver, signal, workers):
