@@ -92,6 +92,7 @@ CASES = {
     "stiffness amplitude string": (lambda e: pt.stiffness(MOUNT, amplitude="0.05,0.1",
                                                           freq="1:20:1"), False),
     "stiffness amplitude zero": (lambda e: pt.stiffness(MOUNT, amplitude=[0.0]), True),
+    "stiffness amplitude type": (lambda e: pt.stiffness(MOUNT, amplitude=["a"]), True),
     "stiffness set-up": (lambda e: pt.stiffness(MOUNT, engine_mass=100), True),
     "stiffness force text": (lambda e: pt.stiffness(MOUNT, engine_mass=100, force="x"), True),
     # fit_mount

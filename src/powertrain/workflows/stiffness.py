@@ -70,16 +70,26 @@ def stiffness(mount, *, engine=None, freq=None, method="frequency", force=None,
     if amplitude is not None and engine_mass is not None:
         raise InputError("--amplitude is the displacement test, without --engine-mass",
                          key="--amplitude")
-    amps = None if amplitude is None else parse_amplitudes(
-        amplitude, mount if engine is None else None) if isinstance(amplitude, str) \
-        else _amplitudes(amplitude)
+    amps = _amplitude_argument(amplitude, mount if engine is None else None)
+
+    def compute():
+        if amps is None:
+            return stiffness_table(model, f, method, engine_mass, force, steps_per_period)
+        return amplitude_stiffness(model, f, amps, method, steps_per_period)
     source, key = _source(mount, engine)
-    result = solved(lambda: stiffness_table(model, f, method, engine_mass, force,
-                                            steps_per_period) if amps is None
-                    else amplitude_stiffness(model, f, amps, method, steps_per_period),
-                    source, key)
+    result = solved(compute, source, key)
     require_finite(result.columns(), source, key)
     return replace(result, label=model.name or label)
+
+
+def _amplitude_argument(amplitude, mount_file):
+    """``amplitude`` of :func:`stiffness` in [m]: None, numbers [m], or the ``--amplitude``
+    text in the unit of ``mount_file`` (:func:`parse_amplitudes`)."""
+    if amplitude is None:
+        return None
+    if isinstance(amplitude, str):
+        return parse_amplitudes(amplitude, mount_file)
+    return _amplitudes(amplitude)
 
 
 def _source(mount, engine):
@@ -169,8 +179,12 @@ def stiffness_table(model, frequency_hz, method="frequency", engine_mass=None, f
 
 
 def _amplitudes(amplitude, unit="m") -> np.ndarray:
-    """The amplitudes as an array, refused unless positive, finite and distinct."""
-    a = np.atleast_1d(np.asarray(amplitude, float))
+    """The amplitudes as an array, refused unless numbers, positive, finite and distinct."""
+    try:
+        a = np.atleast_1d(np.asarray(amplitude, float)).ravel()
+    except (TypeError, ValueError):
+        raise InputError(f"cannot read amplitudes {str(amplitude)[:60]!r} [{unit}] (use "
+                         "numbers, e.g. 0.05,0.1,0.5)", key="--amplitude") from None
     if a.size == 0 or not np.all(np.isfinite(a)) or np.any(a <= 0):
         raise InputError(f"amplitudes [{unit}] must be positive and finite, got "
                          f"{a.tolist()}", key="--amplitude")
