@@ -12,6 +12,7 @@ from __future__ import annotations
 import math
 import numbers
 import os
+from collections.abc import Iterator
 
 import numpy as np
 
@@ -106,14 +107,19 @@ def floats(value, option: str, noun: str, example: str, most: int) -> np.ndarray
     one and at most ``most`` values (what :func:`_parse_list` returns for a string)."""
     items = [value] if is_number(value) else value
     try:
-        values = [_real(v) for v in np.ravel(np.asarray(items, dtype=object))]
+        items = np.ravel(np.asarray(list(items) if isinstance(items, Iterator) else items,
+                                    dtype=object))
+    except (TypeError, ValueError):
+        items = np.array([value], dtype=object)          # not a sequence: refused below
+    if items.size > most:
+        raise InputError(f"{items.size} values; at most {most}", key=option)
+    try:
+        values = [_real(v) for v in items]
     except (TypeError, ValueError):
         raise InputError(f"cannot read {noun} {_short(value)} (use {example})",
                          key=option) from None
     if not values:
         raise InputError(f"no {noun} given", key=option)
-    if len(values) > most:
-        raise InputError(f"{len(values)} values; at most {most}", key=option)
     return np.array(values, dtype=float)
 
 
