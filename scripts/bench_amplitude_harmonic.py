@@ -28,7 +28,8 @@ import numpy as np
 
 from powertrain.iotools.engine_file import DEFAULT_ENGINE_PATH, read_engine
 from powertrain.physics.mount_laws import PowerLaw
-from powertrain.workflows.runup import default_rpm, run_runup
+from powertrain.workflows.arguments import default_rpm
+from powertrain.workflows.runup import run_runup
 
 #: The issue's example law: reference 0.1 mm, exponent 0.15, limits [0.2, 5].
 LAW = PowerLaw(1e-4, 0.15, (0.2, 5.0))

@@ -39,7 +39,8 @@ from powertrain.analysis.orders import order_spectrum, synthesis_rms
 from powertrain.assembly import assemble
 from powertrain.iotools.engine_file import DEFAULT_ENGINE_PATH, read_engine
 from powertrain.solvers.harmonic import harmonic_response
-from powertrain.workflows.runup import default_rpm, run_runup
+from powertrain.workflows.arguments import default_rpm
+from powertrain.workflows.runup import run_runup
 
 ACCURACY = 5e-3   # synthesis agreement with the harmonic solution, relative
 

@@ -21,7 +21,8 @@ from pathlib import Path
 from powertrain.iotools.engine_file import read_engine
 from powertrain.physics.mount_laws import PowerLaw
 from powertrain.solvers import steppers
-from powertrain.workflows.runup import default_rpm, run_runup
+from powertrain.workflows.arguments import default_rpm
+from powertrain.workflows.runup import run_runup
 
 ENGINE = Path(__file__).resolve().parents[1] / "engines" / "default-nonlinear.toml"
 STEEP = PowerLaw(1e-4, 1.5, (0.001, 1000.0))

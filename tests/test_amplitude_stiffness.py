@@ -59,7 +59,7 @@ def test_time_and_frequency_agree_with_friction_and_amplitude_law():
     t = amplitude_stiffness(model, BAND_HZ, AMPLITUDES_M, "time")
     f = amplitude_stiffness(model, BAND_HZ, AMPLITUDES_M, "frequency")
     rel, ang = _disagreement(t, f)
-    worst_periodicity = max(float(c.meta["periodicity"].max()) for c in t.curves)
+    worst_periodicity = max(float(c.periodicity.max()) for c in t.curves)
     print(f"time vs frequency, Berg friction + power law, {BAND_HZ.size} frequencies "
           f"1..400 Hz x {AMPLITUDES_M.size} amplitudes: |K*| {100 * rel:.2e} % "
           f"(tolerance 0.5 %), loss angle {ang:.2e} deg (tolerance 0.3 deg); "

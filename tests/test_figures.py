@@ -29,6 +29,7 @@ from figure_text import (
 )
 
 from powertrain.cli import main
+from powertrain.errors import InputError
 
 ROOT = Path(__file__).resolve().parents[1]
 MEASURED = str(ROOT / "examples" / "measured-runup.csv")
@@ -376,7 +377,7 @@ def test_plot_into_user_axes_and_subfigures(no_backend_switch):
                        solver="harmonic", progress=False)
     assert result.plot(a2, channel=("left", "z"), quantity="order_2") is fig
     assert a2.get_title().startswith("left Z")
-    with pytest.raises(TypeError, match="Figure or SubFigure"):
+    with pytest.raises(InputError, match="pass a Figure or SubFigure"):
         table.plot(a1)    # |K*| and loss angle need two panels
     plt.close(fig)
     fig = plt.figure(layout="constrained")

@@ -9,22 +9,22 @@ through the table in :mod:`powertrain.units`.
 The functions a study calls are importable from here (``import powertrain as pt``)::
 
     engine = pt.read_engine()                       # the shipped default engine
-    run = pt.runup(engine, rpm=range(1000, 6001, 500))
+    run = pt.runup(engine, rpm="1000:6000:500")
     print(run.to_text())
     gap = pt.compare("measured.csv", engine=engine)
 
-Each returns a result object with ``to_text()`` (what the command line prints), ``plot()``
-and its file writers; docs/guide/python-api.md walks a whole study. They are imported on
-first use, so ``import powertrain`` stays light.
+Each checks its arguments as the command line does (bad input: :class:`InputError`, the
+line the command prints) and returns a result object with ``to_text()`` (what the command
+line prints), ``plot(ax=None)`` and ``save(path)`` (the format chosen by the suffix);
+docs/guide/python-api.md walks a whole study. They are imported on first use, so
+``import powertrain`` stays light.
 """
 
-from __future__ import annotations
+from importlib import import_module as _import_module
 
-import importlib
+from powertrain.errors import InputError
 
 __version__ = "0.1.0"
-
-from powertrain.errors import InputError  # noqa: E402
 
 #: Public name -> (module, attribute); imported on first access (PEP 562).
 API = {
@@ -38,7 +38,7 @@ API = {
     "static": ("powertrain.workflows.static", "static"),
     "excitation": ("powertrain.workflows.excitation", "excitation"),
     "stiffness": ("powertrain.workflows.stiffness", "stiffness"),
-    "fit_mount": ("powertrain.workflows.fitting", "fit_mount"),
+    "fit_mount": ("powertrain.workflows.amplitude_fit", "fit_mount"),
     "compare": ("powertrain.workflows.comparison", "compare"),
     "whatif": ("powertrain.workflows.whatif", "whatif"),
     "track": ("powertrain.workflows.tracking", "track"),
@@ -55,10 +55,11 @@ def __getattr__(name: str):
         module, attr = API[name]
     except KeyError:
         raise AttributeError(f"module 'powertrain' has no attribute {name!r}") from None
-    value = getattr(importlib.import_module(module), attr)
+    value = getattr(_import_module(module), attr)
     globals()[name] = value
     return value
 
 
 def __dir__():
-    return sorted(set(globals()) | set(API))
+    """The public names: :data:`__all__` and :data:`API`."""
+    return sorted([*__all__, "API"])

@@ -54,15 +54,12 @@ def compare(measured, sim_file, engine_file, plot, json_file, noise_floor, solve
       powertrain compare examples/measured-runup.csv --plot compare.png --json compare.json
       powertrain compare measured.csv --sim runup.h5
     """
-    import math
-
     from powertrain.cli.common import check_outputs, write_json, write_plot
-    from powertrain.errors import InputError
+    from powertrain.workflows.arguments import nonnegative
     from powertrain.workflows.comparison import compare as run_compare
     if sim_file and engine_file:
         raise click.UsageError("give --sim or --engine, not both")
-    if not (math.isfinite(noise_floor) and noise_floor >= 0):
-        raise InputError("must be a finite number >= 0 [mm/s]", key="--noise-floor")
+    nonnegative(noise_floor, "--noise-floor", "mm/s")
     check_outputs(plot=plot, json=json_file)
     comp = run_compare(measured, engine=engine_file, simulated=sim_file, solver=solver,
                        step=rpm_step, noise_floor=noise_floor * 1e-3, progress=not quiet)

@@ -124,13 +124,9 @@ def _measured_or_plan(measured, plan_file):
 
 def _noise_floor(value: float) -> float:
     """``--noise-floor`` [mm/s] checked, in SI [m/s]."""
-    import math
-
-    from powertrain.errors import InputError
     from powertrain.units import to_si
-    if not (math.isfinite(value) and value >= 0):
-        raise InputError("must be a finite number >= 0 [mm/s]", key="--noise-floor")
-    return to_si(value, "mm/s", "velocity")
+    from powertrain.workflows.arguments import nonnegative
+    return to_si(nonnegative(value, "--noise-floor", "mm/s"), "mm/s", "velocity")
 
 
 def _check_report(report_dir) -> None:

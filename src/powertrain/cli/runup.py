@@ -9,10 +9,10 @@ from powertrain.cli.common import (
     cli_provenance,
     engine_description,
     speed_options,
-    speed_steps,
     write_plot,
 )
 from powertrain.cli.group import main
+from powertrain.workflows.arguments import speed_steps
 
 
 @main.command()

@@ -29,9 +29,10 @@ def static(engine_file, rpm_list, json_file):
       powertrain static
       powertrain static --rpm 1000,3000,6000 --json static.json
     """
-    from powertrain.cli.common import check_outputs, parse_speeds, write_json
+    from powertrain.cli.common import check_outputs, write_json
     from powertrain.iotools.engine_file import engine_or_default
     from powertrain.provenance import provenance
+    from powertrain.workflows.arguments import parse_speeds
     from powertrain.workflows.static import static as solve
 
     rpm = None if rpm_list is None else parse_speeds(rpm_list)

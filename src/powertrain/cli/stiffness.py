@@ -54,19 +54,11 @@ def stiffness(mount_file, engine_file, mount_dir, freq, method, fmt, plot, form,
       powertrain stiffness mounts/hydraulic-engine-mount-z.toml --amplitude 0.05,0.1,0.5 \\
           --method time --freq 1:100:1 --plot k.png
     """
-    from powertrain.cli.common import parse_frequencies, require_finite, solved
-    from powertrain.workflows.stiffness import parse_amplitudes
     from powertrain.workflows.stiffness import stiffness as run
 
-    freqs = parse_frequencies(freq)
     mount = _mount(mount_file, engine_file, mount_dir)
-    amps = None if amplitude is None else parse_amplitudes(amplitude, mount_file)
-    source = mount_file or engine_file
-    key = "parameters" if mount_file else f"--mount {mount_dir}"
-    result = solved(lambda: run(mount, engine=engine_file, freq=freqs, method=method,
-                                engine_mass=engine_mass, force=force, amplitude=amps),
-                    source, key)
-    require_finite(result.columns(), source, key)
+    result = run(mount, engine=engine_file, freq=freq, method=method,
+                 engine_mass=engine_mass, force=force, amplitude=amplitude)
     _report(result, fmt, plot, form, freq_axis)
 
 

@@ -4,14 +4,9 @@ from __future__ import annotations
 
 import click
 
-from powertrain.cli.common import (
-    check_outputs,
-    runup_settings,
-    speed_options,
-    speed_steps,
-    write_json,
-)
+from powertrain.cli.common import check_outputs, speed_options, write_json
 from powertrain.cli.group import main
+from powertrain.workflows.arguments import speed_steps
 
 
 @main.command()
@@ -108,8 +103,7 @@ def whatif(engine_file, rpm_from, rpm_to, rpm_step, solver, scale, set_, swap, m
                         effects=effect, targets=target, variants=variants_file, rpm=rpm,
                         solver=solver, signal=signal, objective=objective,
                         measured=measured_file, executor=scheduler, workers=workers,
-                        progress=not quiet)
-    result.rpm_step = rpm_step
+                        progress=not quiet, rpm_step=rpm_step)
     fit = result.target_fit("--target-out" if target_out else "--target-plot") \
         if target_out or target_plot else None
     _write(result, fit, engine, engine_file, *outputs)
@@ -118,12 +112,10 @@ def whatif(engine_file, rpm_from, rpm_to, rpm_step, solver, scale, set_, swap, m
 
 
 def _baseline(engine_file, rpm_from, rpm_to, rpm_step):
-    """The baseline engine and the speed steps, checked against its speed range."""
+    """The baseline engine and the speed steps (checked against its range by the what-if)."""
     from powertrain.iotools.engine_file import DEFAULT_ENGINE_PATH, read_engine
     rpm = speed_steps(rpm_from, rpm_to, rpm_step)
-    engine = read_engine(engine_file or DEFAULT_ENGINE_PATH)
-    runup_settings(engine, rpm, 1.0)
-    return engine, rpm
+    return read_engine(engine_file or DEFAULT_ENGINE_PATH), rpm
 
 
 def _write(result, fit, engine, engine_file, target_out, target_plot, json_file, plot,

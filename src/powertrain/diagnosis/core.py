@@ -46,6 +46,7 @@ from powertrain.effects import predict
 from powertrain.errors import InputError
 from powertrain.parallel import single_blas_thread
 from powertrain.solvers.fast_harmonic import HarmonicModel
+from powertrain.workflows import arguments as args
 
 
 def diagnose(measured, engine=None, *, noise_floor=DEFAULT_NOISE_FLOOR, effects=None,
@@ -93,12 +94,14 @@ def diagnose(measured, engine=None, *, noise_floor=DEFAULT_NOISE_FLOOR, effects=
         An unknown effect, a file that cannot be read, order curves of another signal than
         velocity, too few speeds to split, or nothing comparable.
     """
+    effects = None if effects is None else args.names(effects, "--effects")
+    noise_floor = args.nonnegative(noise_floor, "--noise-floor", "m/s")
+    budget = args.integer(budget, "budget", minimum=1)
+    pairs, band_check = args.flag(pairs, "--no-pairs"), args.flag(band_check, "band_check")
     engine, measured = _inputs(measured, engine, effects)
     with single_blas_thread():
-        result = _diagnose(measured, engine, noise_floor, effects, pairs, band_check,
-                           rule or DecisionRule(), scheduler or "serial", progress, budget)
-    result.engine = engine
-    return result
+        return _diagnose(measured, engine, noise_floor, effects, pairs, band_check,
+                         rule or DecisionRule(), scheduler or "serial", progress, budget)
 
 
 def _inputs(measured, engine, effects):
@@ -111,15 +114,19 @@ def _inputs(measured, engine, effects):
         if e not in EFFECTS:
             raise InputError(f"unknown effect {e!r} (known: {', '.join(EFFECTS)})",
                              key="--effects")
+    from powertrain.iotools.engine_file import DEFAULT_ENGINE_PATH, engine_or_default
     if engine is None or isinstance(engine, (str, os.PathLike)):
-        from powertrain.iotools.engine_file import DEFAULT_ENGINE_PATH, read_engine
-        engine = read_engine(str(engine or DEFAULT_ENGINE_PATH))
+        engine = str(engine or DEFAULT_ENGINE_PATH)
+    engine = engine_or_default(engine)
     if isinstance(measured, (str, os.PathLike)) and str(measured).lower().endswith(".toml"):
         from powertrain.iotools.plan import read_plan
         measured = read_plan(measured, engine)
     elif isinstance(measured, (str, os.PathLike)):
         from powertrain.iotools.measured import read_measured
         measured = read_measured(measured, mounts=engine.mount_names)
+    elif not hasattr(measured, "runs") and not hasattr(measured, "signal"):
+        raise InputError("expected a MeasuredRunup, a Plan or a file, got "
+                         f"{type(measured).__name__}", key="MEASURED")
     for m in [r.measured for r in measured.runs] if hasattr(measured, "runs") else [measured]:
         if m.signal != "velocity":
             raise InputError("diagnose needs velocity, acceleration or displacement order "
@@ -343,7 +350,8 @@ def _diagnose(measured, engine, noise_floor, effects, pairs, do_bands, rule, sch
         second_effect_between=verdict.second_effect_between,
         verdict_kind=verdict.kind, equivalents=eq,
         budget_hits=[o.label for o in outcomes if o.budget_hit], finding=finding,
-        phase=_phase_dict(s, chosen), runs=s.run_entries(chosen) if w is not s else [])
+        phase=_phase_dict(s, chosen), runs=s.run_entries(chosen) if w is not s else [],
+        engine=engine)
 
 
 def _gap_after(w, sc):

@@ -138,7 +138,6 @@ def write_report(r, directory, provenance=None) -> list:
     r.to_json(out / "diagnosis.json")
     files = [out / "summary.txt", out / "diagnosis.json"]
     from powertrain.plotting.style import close_figure
-    provenance = provenance or getattr(r, "provenance", None)
     for name, fn in (("gap_map.png", plot_gap_map), ("gap_vs_frequency.png", plot_gap_frequency),
                      ("overlay.png", plot_diagnosis_overlay)):
         close_figure(fn(r, out / name, provenance=provenance))

@@ -19,12 +19,13 @@ from powertrain.diagnosis.evidence import VerdictKind
 from powertrain.diagnosis.fit import FitOutcome
 from powertrain.diagnosis.rule import DecisionRule
 from powertrain.effects import EFFECTS
+from powertrain.results.base import Result
 
 
-@dataclass
-class DiagnosisResult:
+@dataclass(frozen=True)
+class DiagnosisResult(Result):
     """Everything the diagnosis found; ``.to_text()``, ``.to_json()``, ``.plot()``,
-    ``.report(dir)``."""
+    ``.save(path)`` (``.json``, ``.png``), ``.report(dir)``."""
 
     data: GapData
     source: str
@@ -165,7 +166,13 @@ class DiagnosisResult:
             "finding": self.finding, "phase": self.phase, "runs": self.runs,
         }
 
+    def writers(self) -> dict:
+        """``.json`` (:meth:`to_json`), ``.png`` (the gap map)."""
+        return {".json": self.to_json, **super().writers()}
+
     def to_json(self, path=None) -> str:
+        """``diagnosis.json``: :meth:`to_dict`, non-finite numbers as null; written
+        atomically to ``path`` if given."""
         text = json.dumps(_finite_or_null(self.to_dict()), indent=1, allow_nan=False,
                           default=_jsonable)
         if path is not None:
@@ -182,12 +189,15 @@ class DiagnosisResult:
         return summary(self)
 
     def plot(self, ax=None, *, path=None, quantity=None, provenance=None):
-        """Gap map figure; returns it (see :func:`powertrain.plotting.plot_gap_map`)."""
+        """Gap map figure, one panel per quantity; returns it (see
+        :func:`powertrain.plotting.plot_gap_map`). ``ax``: None (a new figure), a Figure or
+        SubFigure, or one Axes when one quantity is shown or chosen (``quantity``); else an
+        InputError saying to pass a Figure."""
         from powertrain.plotting import plot_gap_map
         from powertrain.plotting.style import target_and_path
         ax, path = target_and_path(ax, path)
         return plot_gap_map(self, path, ax=ax, quantity=quantity,
-                            provenance=provenance or getattr(self, "provenance", None))
+                            provenance=provenance)
 
     def report(self, directory, provenance=None) -> list:
         """Write ``summary.txt``, ``diagnosis.json`` and the figures into ``directory``."""

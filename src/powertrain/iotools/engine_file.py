@@ -92,9 +92,13 @@ _ALLOWED = {
 
 def engine_or_default(engine=None) -> em.Engine:
     """``engine`` as an :class:`~powertrain.models.engine.Engine`: one given stays as it is,
-    a path is read (:func:`read_engine`), None reads the shipped default engine."""
+    a path is read (:func:`read_engine`), None reads the shipped default engine; anything
+    else is an :class:`~powertrain.errors.InputError` naming ``--engine``."""
     if engine is None or isinstance(engine, (str, os.PathLike)):
         return read_engine(DEFAULT_ENGINE_PATH if engine is None else engine)
+    if not isinstance(engine, em.Engine):
+        raise InputError(f"expected an Engine or an engine file, got {type(engine).__name__}",
+                         key="--engine")
     return engine
 
 

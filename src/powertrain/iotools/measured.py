@@ -226,8 +226,9 @@ def read_measured(path, mounts=None, points=None) -> MeasuredRunup:
     InputError
         One line naming file, line and column.
     """
-    path = str(path)
     check_regular_file(path)
+    path = str(path)
+    mounts, points = _names(mounts, "mounts"), _names(points, "points")
     try:
         with open(path, "rb") as fh:
             head = fh.read(8)
@@ -236,6 +237,21 @@ def read_measured(path, mounts=None, points=None) -> MeasuredRunup:
     if head == _HDF5_SIGNATURE:
         return _read_hdf5(path, mounts)
     return _read_csv(path, mounts, points)
+
+
+def _names(names, key):
+    """``mounts`` or ``points`` of :func:`read_measured` as a list of str (one str: that
+    name), None as it is."""
+    if names is None:
+        return None
+    items = [names] if isinstance(names, str) else names
+    try:
+        items = list(items)
+    except TypeError:
+        items = [items]
+    if not all(isinstance(n, str) for n in items):
+        raise InputError(f"expected names (str), got {names!r}"[:200], key=key)
+    return items
 
 
 def _read_hdf5(path, mounts):

@@ -10,6 +10,8 @@ through :mod:`powertrain.units`.
 
 from __future__ import annotations
 
+import os
+
 import numpy as np
 
 from powertrain.errors import InputError
@@ -17,6 +19,7 @@ from powertrain.iotools.channel_map import (
     ChannelMap,
     parse_channel_name,
     quantity_of_unit,
+    read_channel_map,
     split_unit,
 )
 from powertrain.iotools.raw_signals import FileSignals
@@ -57,8 +60,9 @@ def read_raw(path, channel_map: ChannelMap | None = None, *, rpm: str | None = N
     ----------
     path : str or Path
         Wide CSV, raw HDF5, UFF (dataset 58) or MDF4 file.
-    channel_map : ChannelMap, optional
-        File channel name -> mount, side, direction, quantity (default: the name convention).
+    channel_map : ChannelMap, str or Path, optional
+        File channel name -> mount, side, direction, quantity, or its TOML file (default: the
+        name convention).
     rpm, tacho : str, optional
         Name of the speed [rpm] or tacho channel (default: the map's, else a channel named
         ``rpm`` / ``tacho``).
@@ -72,8 +76,13 @@ def read_raw(path, channel_map: ChannelMap | None = None, *, rpm: str | None = N
         Validated, SI.
     """
     from powertrain.iotools.textfile import check_regular_file
-    path = str(path)
     check_regular_file(path)
+    path = str(path)
+    if isinstance(channel_map, (str, os.PathLike)):
+        channel_map = read_channel_map(channel_map)
+    elif channel_map is not None and not isinstance(channel_map, ChannelMap):
+        raise InputError(f"expected a channel map or its file, got "
+                         f"{type(channel_map).__name__}", key="--channels")
     fmt = detect_format(path)
     if fmt == "hdf5":
         from powertrain.iotools.raw_hdf5 import read_hdf5_signals as reader

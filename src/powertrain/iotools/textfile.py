@@ -12,9 +12,12 @@ MAX_FILE_BYTES = 512 * 2 ** 20
 
 def check_regular_file(path) -> None:
     """Refuse, without opening it, anything but an existing regular file of at most
-    :data:`MAX_FILE_BYTES` (a FIFO or device would block or never end)."""
+    :data:`MAX_FILE_BYTES` (a FIFO or device would block or never end), and anything but a
+    path (an int would name an open file descriptor)."""
     import os
     import stat
+    if not isinstance(path, (str, os.PathLike)):
+        raise InputError(f"expected a file path, got {type(path).__name__} {str(path)[:40]!r}")
     try:
         st = os.stat(path)
     except FileNotFoundError:

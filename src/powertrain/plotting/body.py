@@ -15,11 +15,12 @@ from powertrain.plotting.style import (
     PRINT_WIDTH_IN,
     TICK_SIZE,
     TITLE_SIZE,
-    figure_legend,
     finish,
+    legend,
     no_data,
     series_style,
     subplots,
+    whole_figure,
 )
 
 #: Rigid-body coordinates, as in :data:`powertrain.solvers.modes.COORDINATES`.
@@ -58,6 +59,30 @@ def plot_modes(result, path=None, ax=None, provenance=None):
     return finish(fig, own, path, provenance)
 
 
+def plot_static(result, path=None, ax=None, provenance=None):
+    """Static operating point against speed: the deflection [mm] of every mount's local
+    x, y, z direction (engine side relative to the base) under the weight and the mean
+    drive-torque reaction, one line each (markers at the speeds solved); returns the figure
+    (``ax``: None, an Axes, a Figure or SubFigure; one panel)."""
+    fig, axes, own = subplots(ax, figsize=(PRINT_WIDTH_IN, 4.2))
+    a = axes[0, 0]
+    rpm, deflection = result.rpm, result.stack("deflection") * 1e3     # (n_rpm, n_m, 3)
+    for m, name in enumerate(result.mounts):
+        for k, d in enumerate("xyz"):
+            a.plot(rpm, deflection[:, m, k], marker="o", ms=2.5, lw=1.1,
+                   label=f"{name} {d}", **series_style(3 * m + k))
+    a.axhline(0.0, color="0.5", lw=0.5)
+    a.set_xlabel("engine speed [rpm]", fontsize=LABEL_SIZE)
+    a.set_ylabel("static deflection [mm]", fontsize=LABEL_SIZE)
+    a.grid(True, alpha=0.3)
+    a.tick_params(labelsize=TICK_SIZE)
+    legend(fig, axes, ax)
+    title = ("static operating point" + (f" of {result.engine}" if result.engine else "")
+             + ": mount deflections (local axes) under the weight and the mean drive-torque "
+             "reaction")
+    return finish(fig, own, path, provenance, title=title if whole_figure(ax) else None)
+
+
 def _positive(values):
     """Mask non-positive values (a log axis cannot show an exact zero)."""
     return np.ma.masked_less_equal(np.asarray(values, float), 0.0)
@@ -87,8 +112,7 @@ def plot_runup_both_sides(result, path=None, quantities=("synthesis", "order_2",
     for a in axes[-1]:
         a.set_xlabel("engine speed [rpm]", fontsize=LABEL_SIZE)
     fig.supylabel(f"RMS {signal.replace('_', ' ')} [{unit}]", fontsize=LABEL_SIZE + 0.5)
-    if own:
-        figure_legend(fig, axes)
+    legend(fig, axes, ax)
     title = "run-up with the body model: both sides of each mount, then the body points"
     title += SYNTHESIS_NOTE
     if any(not np.any(result.curve(passive_name(m), d, q, signal) > 0)
@@ -97,7 +121,7 @@ def plot_runup_both_sides(result, path=None, quantities=("synthesis", "order_2",
     if silent:
         title += (". Zero at every speed (no mount path moves them), not drawn: "
                   + ", ".join(f"{p} {d.upper()}" for p, d in silent))
-    return finish(fig, own, path, provenance, title=title if own else None)
+    return finish(fig, own, path, provenance, title=title if whole_figure(ax) else None)
 
 
 def _both_sides_panel(a, result, row, quantity, signal, factor):
@@ -151,14 +175,13 @@ def plot_path_contributions(result, path=None, order=2.0, n_paths=6, ax=None,
         a.grid(True, alpha=0.3)
         a.tick_params(labelsize=TICK_SIZE)
     axes[-1, 0].set_xlabel("engine speed [rpm]", fontsize=LABEL_SIZE)
-    if own:
-        figure_legend(fig, axes)
+    legend(fig, axes, ax)
     title = (f"transfer paths at order {order:g}: each path's velocity in phase with the "
              "total (they add up to |v|), the largest paths")
     if silent:
         title += ". No response at every speed, not drawn: " + ", ".join(
             f"{p} {d.upper()}" for p, d, _ in silent)
-    return finish(fig, own, path, provenance, title=title if own else None)
+    return finish(fig, own, path, provenance, title=title if whole_figure(ax) else None)
 
 
 def _paths_panel(a, rpm, pc, labels, n_paths, colours):

@@ -7,11 +7,13 @@ from pathlib import Path
 
 import numpy as np
 
+from powertrain.errors import InputError
 from powertrain.plotting.runup import (
     SYNTHESIS_NOTE,
     grid,
     label_grid,
     panel_title,
+    select_panels,
     style_panel,
 )
 from powertrain.plotting.style import (
@@ -24,12 +26,14 @@ from powertrain.plotting.style import (
     TICK_SIZE,
     TITLE_SIZE,
     colour,
-    figure_legend,
     finish,
     is_axes,
+    legend,
     no_data,
+    panels_error,
     quantity_label,
     subplots,
+    whole_figure,
 )
 
 #: Display factor of the levels: m/s -> mm/s.
@@ -103,7 +107,7 @@ def phased_channels(comparison) -> dict:
 
 
 def plot_comparison(comparison, path=None, quantities=None, *, ax=None, channel=None,
-                    quantity=None, provenance=None):
+                    quantity=None, provenance=None, phase=True):
     """Measured and simulated RMS velocity against speed, level gap shaded.
 
     The thesis's layout (Kovarik 2016, Figs 45-71): one row per mount and direction (named
@@ -117,7 +121,8 @@ def plot_comparison(comparison, path=None, quantities=None, *, ax=None, channel=
     exclusion limit (:attr:`ComparisonResult.exclusion_limit`) a dotted line;
     measured-not-modelled points (simulation below the floor, measurement above the limit;
     in no gap) reddish-purple triangles. A panel with nothing compared says so. Panel
-    titles: the RMS gap and bias [dB].
+    titles: the RMS gap and bias [dB]. Phase panels (``phase``) under the channels with
+    phase on both sides.
 
     Parameters
     ----------
@@ -127,19 +132,26 @@ def plot_comparison(comparison, path=None, quantities=None, *, ax=None, channel=
     quantities : sequence of str, optional
         Columns; default :func:`comparison_quantities` (nothing requested is left out).
     ax : None, Axes, Figure or SubFigure
-        Where to draw; an Axes gets the one panel ``channel``/``quantity``.
+        Where to draw; an Axes takes one panel (``channel``, ``quantity`` and no phase
+        panel), else an InputError saying to pass a Figure.
+    channel, quantity : optional
+        Only this channel ((mount, direction)) and quantity.
     provenance : Provenance, optional
         Foot line of a new figure.
+    phase : bool
+        Draw the phase panels.
     """
     rows = list(comparison.simulated.channels)
     rows += [c for c in comparison.measured.channels if c not in rows]
-    quantities = list(quantities or comparison_quantities(comparison))
-    phased = {} if is_axes(ax) else {k: c for k, c in phased_channels(comparison).items()
-                                     if k[2] in quantities}
-    fig, panels, phase_panels, own, axes = _grid(ax, rows, quantities, channel, quantity,
-                                                 phased)
-    limit = comparison.exclusion_limit * MM
-    margin_titles = not is_axes(ax)
+    rows, quantities = select_panels(rows, list(quantities or comparison_quantities(
+        comparison)), channel, quantity)
+    phased = {k: c for k, c in phased_channels(comparison).items()
+              if k[:2] in rows and k[2] in quantities} if phase else {}
+    if is_axes(ax) and phased:
+        raise InputError(panels_error(2, ", or phase=False for the level panel alone"),
+                         key="ax")
+    fig, panels, phase_panels, own, axes = _grid(ax, rows, quantities, None, None, phased)
+    limit, margin_titles = comparison.exclusion_limit * MM, whole_figure(ax)
     _level_panels(panels, comparison, rows[0], limit, margin_titles)
     bottom = set(map(id, axes[-1]))
     for key, a in phase_panels.items():
@@ -151,10 +163,9 @@ def plot_comparison(comparison, path=None, quantities=None, *, ax=None, channel=
         _margin_labels(axes, panels, rows, quantities[0])
     label_grid(fig, axes, "RMS velocity [mm/s]" + (", under it phase φ [°]" if phased
                                                    else ""))
-    if own:
-        _legend(fig, axes, limit)
+    _legend(fig, axes, limit, ax)
     return finish(fig, own, path, provenance,
-                  title=_title(comparison, bool(phased)) if own else None)
+                  title=_title(comparison, bool(phased)) if whole_figure(ax) else None)
 
 
 def _level_panels(panels, comparison, top_channel, limit, margin_titles):
@@ -271,11 +282,11 @@ def _empty_panel(a, head, reason):
     a.tick_params(labelsize=TICK_SIZE)
 
 
-def _legend(fig, axes, limit):
+def _legend(fig, axes, limit, target):
     from matplotlib.lines import Line2D
     extra = [(Line2D([], [], color="0.5", ls=":", lw=0.8),
               f"noise-floor limit ({limit:g} mm/s)")] if limit > 0 else []
-    figure_legend(fig, axes, extra)
+    legend(fig, axes, target, extra)
 
 
 def _title(comparison, phased=False) -> str:

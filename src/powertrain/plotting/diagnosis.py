@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from powertrain.errors import InputError
 from powertrain.plotting.style import (
     LABEL_SIZE,
     LEGEND_SIZE,
@@ -12,13 +13,16 @@ from powertrain.plotting.style import (
     TICK_SIZE,
     TITLE_SIZE,
     colorbar,
-    figure_legend,
     finish,
+    is_axes,
+    legend,
     log_axis,
     no_data,
+    panels_error,
     quantity_label,
     series_style,
     subplots,
+    whole_figure,
     wrap,
 )
 
@@ -53,7 +57,10 @@ def plot_gap_map(diagnosis, path=None, *, ax=None, quantity=None, provenance=Non
     path : str, optional
         PNG written atomically.
     ax : None, Axes, Figure or SubFigure
-        An Axes gets the one panel ``quantity`` (default: the first).
+        An Axes takes one panel: the one quantity shown, or ``quantity``; else an
+        InputError saying to pass a Figure.
+    quantity : str, optional
+        Only this quantity.
     provenance : Provenance, optional
     """
     d = diagnosis.data
@@ -61,11 +68,18 @@ def plot_gap_map(diagnosis, path=None, *, ax=None, quantity=None, provenance=Non
     valid = np.isfinite(diagnosis.gap) & ~cens
     shown = [q for k, q in enumerate(d.quantities) if valid[:, :, k].any()]
     empty = [q for q in d.quantities if q not in shown]
-    if ax is not None and not hasattr(ax, "subplots"):
-        qs = [quantity or (shown or list(d.quantities))[0]]
+    qs = shown or list(d.quantities)[:1]
+    if quantity is not None:
+        if quantity not in d.quantities:
+            raise InputError(f"no quantity {quantity!r} (quantities: "
+                             f"{', '.join(d.quantities)})", key="quantity")
+        qs = [quantity]
+    if is_axes(ax):
+        if len(qs) != 1:
+            raise InputError(panels_error(len(qs), ", or choose one with quantity="),
+                             key="ax")
         fig, axes, own = subplots(ax)
     else:
-        qs = shown or list(d.quantities)[:1]
         ncol = 1 if len(qs) == 1 else 2
         nrow = -(-len(qs) // ncol)
         fig, axes, own = subplots(ax, nrow, ncol, sharex=True, sharey=True,
@@ -85,7 +99,7 @@ def plot_gap_map(diagnosis, path=None, *, ax=None, quantity=None, provenance=Non
                   + ", ".join(quantity_label(q) for q in empty))
     title += (f". Outlined: ≥ {GAP_OUTLINE_RUN} neighbouring speeds beyond "
               f"±{GAP_OUTLINE_DB:g} dB")
-    return finish(fig, own, path, provenance, title=title if own else None)
+    return finish(fig, own, path, provenance, title=title if whole_figure(ax) else None)
 
 
 def _gap_panels(axes, diagnosis, qs, cens, valid):
@@ -173,7 +187,7 @@ def plot_gap_frequency(diagnosis, path=None, *, ax=None, provenance=None):
     s = p["share_alone"]
     title = (f"gap split: structure {s['structure']:.0%}, excitation {s['excitation']:.0%}, "
              f"channel constant {s['const']:.0%} of the gap's sum of squares (each alone)")
-    return finish(fig, own, path, provenance, title=title if own else None)
+    return finish(fig, own, path, provenance, title=title if whole_figure(ax) else None)
 
 
 def _gap_by_channel(ax, diagnosis, orders):
@@ -254,10 +268,9 @@ def plot_diagnosis_overlay(diagnosis, path=None, n_panels=6, *, ax=None, provena
     for a in axes.flat[:len(score)]:
         a.set_xlabel("engine speed [rpm]", fontsize=LABEL_SIZE)
     fig.supylabel("RMS velocity [mm/s]", fontsize=LABEL_SIZE + 0.5)
-    if own:
-        figure_legend(fig, axes)
-    return finish(fig, own, path, provenance,
-                  title=f"before / after / measured: {diagnosis.verdict_text}" if own else None)
+    legend(fig, axes, ax)
+    return finish(fig, own, path, provenance, title=f"before / after / measured: "
+                  f"{diagnosis.verdict_text}" if whole_figure(ax) else None)
 
 
 def _overlay_panel(ax, diagnosis, c, k, held, rms):

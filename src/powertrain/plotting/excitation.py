@@ -12,9 +12,10 @@ from powertrain.plotting.style import (
     TICK_SIZE,
     TITLE_SIZE,
     colour,
-    figure_legend,
     finish,
+    legend,
     subplots,
+    whole_figure,
 )
 
 LOAD_NAMES = ["Fx [N]", "Fy [N]", "Fz [N]", "Mx [N·m]", "My [N·m]", "Mz [N·m]"]
@@ -69,10 +70,9 @@ def plot_excitation(exc, path=None, *, ax=None, provenance=None):
         a.grid(True, alpha=0.3)
         a.tick_params(labelsize=TICK_SIZE)
     _spectrum(axes[2], exc)
-    if own:
-        figure_legend(fig, axes)
+    legend(fig, axes, ax)
     return finish(fig, own, path, provenance,
-                  title=f"Excitation at {exc.rpm:g} rpm" if own else None)
+                  title=f"Excitation at {exc.rpm:g} rpm" if whole_figure(ax) else None)
 
 
 def _spectrum(axes, exc):

@@ -17,10 +17,12 @@ from powertrain.plotting.style import (
     colour,
     figure_legend,
     finish,
+    legend,
     log_axis,
     no_data,
     series_style,
     subplots,
+    whole_figure,
 )
 
 #: Display unit and factor per quantity.
@@ -47,7 +49,7 @@ def plot_tracked(tracked, path=None, quantities=None, *, ax=None, provenance=Non
     and line style; the y axis spans at most :data:`DYNAMIC_RANGE_DB` below the panel's
     largest level, and orders wholly below it are named in the title. One legend for the
     figure; returns the figure (``ax``: None, Figure or SubFigure, or an Axes when there is
-    one channel)."""
+    one channel, else an InputError saying to pass a Figure)."""
     from powertrain.plotting.runup import style_panel
     quantities = list(quantities or tracked_quantities(tracked))
     n = len(tracked.channels)
@@ -70,8 +72,7 @@ def plot_tracked(tracked, path=None, quantities=None, *, ax=None, provenance=Non
         a.set_xlabel("engine speed [rpm]", fontsize=LABEL_SIZE)
     for c in range(n, rows * cols):
         axes[c // cols][c % cols].set_visible(False)
-    if own:
-        figure_legend(fig, axes)
+    legend(fig, axes, ax)
     title = f"order tracking ({tracked.method}) of {Path(str(tracked.source)).name}"
     groups = {}
     for q, where in hidden.items():
@@ -80,7 +81,7 @@ def plot_tracked(tracked, path=None, quantities=None, *, ax=None, provenance=Non
         names = ", ".join(q.replace("order_", "") for q in qs)
         title += (f"; order{'s' * (len(qs) > 1)} {names} more than "
                   f"{DYNAMIC_RANGE_DB:g} dB below the largest level, off the axis in {where}")
-    return finish(fig, own, path, provenance, title=title if own else None)
+    return finish(fig, own, path, provenance, title=title if whole_figure(ax) else None)
 
 
 def _draw_curves(a, tracked, label, quantities, factor) -> dict:
@@ -128,7 +129,7 @@ def plot_maps(rpm, orders, order_rms, times, freqs, rpm_t, psd, title="", path=N
         a.set_ylim(lo, hi)
         a.tick_params(labelsize=TICK_SIZE)
         a.yaxis.set_tick_params(labelleft=True)
-    return finish(fig, own, path, provenance, title=title if own else None)
+    return finish(fig, own, path, provenance, title=title if whole_figure(ax) else None)
 
 
 def plot_sweep_rates(curves, path=None, title="", *, ax=None, provenance=None):

@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from powertrain.errors import InputError
 from powertrain.plotting.style import (
     LABEL_SIZE,
     PRINT_WIDTH_IN,
@@ -13,13 +14,15 @@ from powertrain.plotting.style import (
     TICK_SIZE,
     TITLE_SIZE,
     colour,
-    figure_legend,
     finish,
     is_axes,
+    legend,
     log_axis,
     no_data,
+    panels_error,
     quantity_label,
     subplots,
+    whole_figure,
     wrap,
 )
 
@@ -29,24 +32,46 @@ SYNTHESIS_NOTE = " (synthesis = RMS sum of the orders ≤ 8)"
 
 
 def grid(ax, rows, quantities, channel=None, quantity=None, panel_height=1.3):
-    """Panels of a channel × quantity figure.
+    """Panels of a channel × quantity figure: every row of ``rows`` and column of
+    ``quantities``, or only the row ``channel`` ((mount, direction)) and the column
+    ``quantity`` where given.
 
-    ``ax`` None, Figure or SubFigure: the full grid; an Axes: the one panel ``channel``
-    (default: the first) and ``quantity`` (default: the first).
+    ``ax`` None, Figure or SubFigure: those panels; an Axes: the one panel they leave
+    (:class:`~powertrain.errors.InputError`, saying to pass a Figure, when they leave
+    several).
 
     Returns
     -------
     fig, panels : dict {(mount, direction, quantity): Axes}, own : bool, axes : 2-D array
     """
+    rows, quantities = select_panels(rows, quantities, channel, quantity)
     if is_axes(ax):
-        ch = tuple(channel) if channel is not None else rows[0]
-        q = quantity or quantities[0]
-        return ax.figure, {(*ch, q): ax}, False, np.array([[ax]])
+        if len(rows) * len(quantities) != 1:
+            raise InputError(panels_error(len(rows) * len(quantities), ", or choose one "
+                                          "panel with channel=(MOUNT, DIR) and quantity="),
+                             key="ax")
+        return ax.figure, {(*rows[0], quantities[0]): ax}, False, np.array([[ax]])
     nr, nq = len(rows), len(quantities)
     fig, axes, own = subplots(ax, nr, nq, figsize=(PRINT_WIDTH_IN, panel_height * nr + 1.6),
                               sharex=True)
     panels = {(*rows[r], quantities[q]): axes[r, q] for r in range(nr) for q in range(nq)}
     return fig, panels, own, axes
+
+
+def select_panels(rows, quantities, channel=None, quantity=None):
+    """``rows`` and ``quantities`` narrowed to ``channel`` and ``quantity`` where given."""
+    rows = [tuple(r) for r in rows]
+    if channel is not None:
+        if tuple(channel) not in rows:
+            raise InputError(f"no channel {tuple(channel)!r} (channels: "
+                             f"{', '.join(f'{m}.{d}' for m, d in rows)})", key="channel")
+        rows = [tuple(channel)]
+    if quantity is not None:
+        if quantity not in quantities:
+            raise InputError(f"no quantity {quantity!r} (quantities: "
+                             f"{', '.join(quantities)})", key="quantity")
+        quantities = [quantity]
+    return rows, list(quantities)
 
 
 def panel_title(mount, direction, quantity) -> str:
@@ -141,11 +166,11 @@ def plot_runup(results, path=None, quantities=("synthesis", "order_2", "order_4"
         if not style_panel(a, title, np.concatenate(values) if values else []):
             no_data(a, "zero at every speed (not excited)")
     label_grid(fig, axes, f"RMS {signal.replace('_', ' ')} [{unit}]")
-    if len(results) > 1 and own:
-        figure_legend(fig, axes)
+    if len(results) > 1:
+        legend(fig, axes, ax)
     return finish(fig, own, path, provenance,
                   title=f"run-up: RMS {signal.replace('_', ' ')} at the mounts{SYNTHESIS_NOTE}"
-                  if own else None)
+                  if whole_figure(ax) else None)
 
 
 # --------------------------------------------------------------------------- what-if
@@ -177,12 +202,13 @@ def plot_whatif(whatif, path=None, *, ax=None, channel=None, quantity=None, prov
     view : {"levels", "delta"}
     """
     if view not in ("levels", "delta"):
-        raise ValueError(f"view must be 'levels' or 'delta', got {view!r}")
+        raise InputError(f"{view!r} is not one of 'levels', 'delta'", key="view")
     base = whatif.baseline
     quantities = list(whatif.quantities)
-    keys = [(m, d, q) for m, d in base.channels for q in quantities]
+    rows, picked = select_panels(base.channels, quantities, channel, quantity)
+    keys = [(m, d, q) for m, d in rows for q in picked]
     largest = {k: _largest_change(whatif, k) for k in keys}
-    shown = keys if view == "delta" or is_axes(ax) else \
+    shown = keys if view == "delta" else \
         [k for k in keys if largest[k] >= VISIBLE_CHANGE_DB] or [max(keys, key=largest.get)]
     signal = getattr(whatif, "signal", "velocity")
     title = _whatif_title(view, keys, shown, signal)
@@ -199,17 +225,21 @@ def plot_whatif(whatif, path=None, *, ax=None, channel=None, quantity=None, prov
     ylabel = "Δ = 20 log10(v/v0) [dB]" if view == "delta" else \
         f"RMS {signal.replace('_', ' ')} [{SIGNAL_UNITS[signal][1]}]"
     label_grid(fig, axes, ylabel)
-    if own:
-        figure_legend(fig, axes)
-    return finish(fig, own, path, provenance, title=title if own else None)
+    legend(fig, axes, ax)
+    return finish(fig, own, path, provenance, title=title if whole_figure(ax) else None)
 
 
 def _panels(ax, shown, quantities, channels, channel, quantity, title_lines=2):
     """The full channel × quantity grid when every panel is shown, else the shown panels
     three to a row in reading order."""
-    rows = list(channels)
-    if is_axes(ax) or len(shown) == len(rows) * len(quantities):
-        return grid(ax, rows, quantities, channel, quantity)
+    rows, picked = select_panels(channels, quantities, channel, quantity)
+    if is_axes(ax):
+        if len(shown) != 1:
+            raise InputError(panels_error(len(shown), ", or choose one panel with "
+                                          "channel=(MOUNT, DIR) and quantity="), key="ax")
+        return ax.figure, {shown[0]: ax}, False, np.array([[ax]])
+    if len(shown) == len(rows) * len(picked):
+        return grid(ax, channels, quantities, channel, quantity)
     ncol = min(3, len(shown))
     nrow = -(-len(shown) // ncol)
     fig, axes, own = subplots(ax, nrow, ncol, sharex=True,

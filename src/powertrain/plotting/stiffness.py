@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from powertrain.errors import InputError
 from powertrain.plotting.style import (
     LABEL_SIZE,
     LEGEND_SIZE,
@@ -29,10 +30,10 @@ DEFAULT_FORM, DEFAULT_FREQ_AXIS = "magnitude-phase", "log"
 
 def stiffness_axes(ax, form, figsize=(PRINT_WIDTH_IN, 5.2)):
     """Figure and axes of a stiffness plot: one Axes for ``real-imag``, two (|K*|, loss
-    angle) for ``magnitude-phase``; ``ax`` as for :func:`powertrain.plotting.style.subplots`,
-    or a pair of Axes for ``magnitude-phase``."""
+    angle) for ``magnitude-phase``; ``ax`` as for :func:`powertrain.plotting.style.subplots`
+    (one Axes only for ``real-imag``), or a pair of Axes for ``magnitude-phase``."""
     if form not in FORMS:
-        raise ValueError(f"form must be one of {FORMS}, got {form!r}")
+        raise InputError(f"{form!r} is not one of {', '.join(map(repr, FORMS))}", key="--form")
     if form == "magnitude-phase" and isinstance(ax, (list, tuple)) and len(ax) == 2:
         return ax[0].figure, list(ax), False
     if form == "real-imag":
@@ -71,7 +72,8 @@ def style_stiffness(axes, form, freq_axis, band=None, own=False):
     """Labels, grid, frequency axis (log with plain numbers, or linear), optional shaded
     band (f_lo, f_hi) [Hz]."""
     if freq_axis not in FREQ_AXES:
-        raise ValueError(f"freq_axis must be one of {FREQ_AXES}, got {freq_axis!r}")
+        raise InputError(f"{freq_axis!r} is not one of {', '.join(map(repr, FREQ_AXES))}",
+                         key="--freq-axis")
     if form == "real-imag":
         axes[0].set_ylabel("dynamic stiffness K* [N/mm]", fontsize=LABEL_SIZE)
     else:

@@ -13,6 +13,8 @@ import textwrap
 
 import numpy as np
 
+from powertrain.errors import InputError
+
 #: Display factor and unit of each run-up signal (SI -> plot unit).
 SIGNAL_UNITS = {"velocity": (1e3, "mm/s"), "displacement": (1e6, "µm"),
                 "acceleration": (1.0, "m/s²"), "mount_force": (1.0, "N")}
@@ -55,7 +57,8 @@ def subplots(target, nrows=1, ncols=1, figsize=(PRINT_WIDTH_IN, 3.6), **kwargs):
     target : None, matplotlib Axes, Figure or SubFigure
         None: a new pyplot figure with constrained layout (the current backend; never
         switched). Figure or SubFigure: the panels are made in it. Axes: used as is, allowed
-        only for a single panel.
+        only for a single panel (else :class:`~powertrain.errors.InputError` saying to pass
+        a Figure).
     nrows, ncols : int
     figsize : (float, float)
         Size of a new figure [in]; its width is the print width :data:`PRINT_WIDTH_IN`
@@ -81,11 +84,35 @@ def subplots(target, nrows=1, ncols=1, figsize=(PRINT_WIDTH_IN, 3.6), **kwargs):
             False
     if isinstance(target, Axes):
         if nrows * ncols != 1:
-            raise TypeError(f"this figure has {nrows * ncols} panels: pass a Figure or "
-                            "SubFigure (e.g. fig.subfigures()), not one Axes")
+            raise InputError(panels_error(nrows * ncols), key="ax")
         return target.figure, np.array([[target]]), False
-    raise TypeError(f"ax must be a matplotlib Axes, Figure or SubFigure, not "
-                    f"{type(target).__name__}")
+    raise InputError(f"must be a matplotlib Axes, Figure or SubFigure, not "
+                     f"{type(target).__name__}", key="ax")
+
+
+def panels_error(n: int, choose: str = "") -> str:
+    """The message for an Axes given to a figure of ``n`` panels (``choose``: how to ask
+    for one panel instead, if the figure can)."""
+    return (f"this figure has {n} panels: pass a Figure or SubFigure (e.g. fig or "
+            f"fig.subfigures()), not one Axes{choose}")
+
+
+def whole_figure(target) -> bool:
+    """True when a plot draws a whole figure (``target`` None, a Figure or SubFigure): its
+    legend and title go with it; False for one Axes (the legend goes into the Axes)."""
+    return not is_axes(target)
+
+
+def legend(fig, axes, target, extra=()):
+    """The legend of a plot: one for the figure above the panels
+    (:func:`figure_legend`), or inside the Axes when ``target`` is one Axes."""
+    if whole_figure(target):
+        return figure_legend(fig, axes, extra)
+    a = np.ravel(axes)[0]
+    handles, labels = a.get_legend_handles_labels()
+    handles += [h for h, _ in extra]
+    labels += [lab for _, lab in extra]
+    return a.legend(handles, labels, fontsize=LEGEND_SIZE, loc="best") if labels else None
 
 
 def colour(k: int) -> str:

@@ -8,11 +8,12 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from powertrain.results.base import Result
 from powertrain.results.fit import PARAMETER_UNITS, FitResult
 
 
 @dataclass(frozen=True)
-class AmplitudeFitResult:
+class AmplitudeFitResult(Result):
     """Outcome of :func:`~powertrain.workflows.amplitude_fit.fit_amplitudes`.
 
     Attributes
@@ -106,7 +107,8 @@ class AmplitudeFitResult:
     def plot(self, ax=None, path=None, *, form="magnitude-phase", freq_axis="log",
              provenance=None):
         """Measured (dots) and fitted (lines) K*(f), one colour per amplitude (see
-        :func:`powertrain.plotting.stiffness.plot_amplitude_fit`)."""
+        :func:`powertrain.plotting.stiffness.plot_amplitude_fit`; ``ax`` as for
+        :meth:`powertrain.results.stiffness.StiffnessResult.plot`)."""
         from powertrain.plotting.stiffness import plot_amplitude_fit
         from powertrain.plotting.style import target_and_path
         ax, path = target_and_path(ax, path)

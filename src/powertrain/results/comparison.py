@@ -14,6 +14,7 @@ from powertrain.analysis import compare as cm
 from powertrain.analysis.noise_floor import NOISE_FLOOR_MARGIN, censoring_level
 from powertrain.analysis.orders import quantity_sort_key
 from powertrain.outputs import json_text
+from powertrain.results.base import Result
 
 #: Quantities always expected (the thesis's comparison, sec. 4.4); any other measured order is
 #: compared too.
@@ -68,7 +69,7 @@ DEFINITIONS = {
 
 
 
-@dataclass
+@dataclass(frozen=True)
 class ChannelComparison:
     """Comparison of one channel (mount, direction) and quantity.
 
@@ -130,8 +131,8 @@ def json_number(x):
     return x if np.isfinite(x) else None
 
 
-@dataclass
-class ComparisonResult:
+@dataclass(frozen=True)
+class ComparisonResult(Result):
     """Outcome of :func:`compare_runup`: per-channel gaps and metrics, per-speed CSAC/CSF.
 
     Attributes
@@ -271,8 +272,13 @@ class ComparisonResult:
         """JSON text of :meth:`to_dict`; written atomically to ``path`` if given."""
         return json_text(self.to_dict(), path)
 
+    def writers(self) -> dict:
+        """``.json`` (:meth:`to_json`), ``.png``."""
+        return {".json": self.to_json, **super().writers()}
+
     def worst_first(self) -> list:
-        """Channels sorted by RMS gap, largest first."""
+        """The compared channels and quantities (:class:`ChannelComparison`) sorted by RMS
+        gap, largest first (:attr:`channels` keeps the files' order)."""
         return sorted(self.channels, key=lambda c: -c.stats["rms_db"])
 
     def table(self) -> str:
@@ -356,18 +362,23 @@ class ComparisonResult:
         return lines
 
     def plot(self, ax=None, *, path=None, quantities=None, channel=None, quantity=None,
-             provenance=None):
-        """Measured vs simulated curves, gap shaded (thesis layout, Figs 45-71); every
-        measured quantity is drawn unless ``quantities`` says otherwise. Returns the figure.
+             provenance=None, phase=True):
+        """Measured vs simulated curves, gap shaded (thesis layout, Figs 45-71), a row per
+        channel and a column per quantity (every measured one unless ``quantities`` says
+        otherwise), the order phase under the channels with phase on both sides
+        (``phase``). Returns the figure.
 
-        See :func:`powertrain.plotting.plot_comparison`.
+        ``ax``: None (a new figure), a Figure or SubFigure, or one Axes where ``channel``
+        ((mount, direction)) and ``quantity`` leave one panel and no phase panel is drawn
+        under it (``phase=False``); else an InputError saying to pass a Figure. See
+        :func:`powertrain.plotting.plot_comparison`.
         """
         from powertrain.plotting import plot_comparison
         from powertrain.plotting.style import target_and_path
         ax, path = target_and_path(ax, path)
         return plot_comparison(self, path, quantities, ax=ax, channel=channel,
-                               quantity=quantity,
-                               provenance=provenance or getattr(self, "provenance", None))
+                               quantity=quantity, phase=phase,
+                               provenance=provenance)
 
 
 def _quantity_line(pq) -> str:

@@ -8,12 +8,14 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from powertrain.results.base import Result
+
 #: Leading CSV columns: total load on the powertrain about its CG, engine axes.
 LOAD_COLUMNS = ["crank_angle_deg", "fx_n", "fy_n", "fz_n", "mx_nm", "my_nm", "mz_nm"]
 
 
 @dataclass(frozen=True, eq=False)
-class ExcitationResult:
+class ExcitationResult(Result):
     """Pressures, forces, torques and the total load over one engine cycle.
 
     Attributes
@@ -80,9 +82,14 @@ class ExcitationResult:
         with atomic_write(path) as fh:
             fh.write(text)
 
+    def writers(self) -> dict:
+        """``.csv`` (:meth:`to_csv`), ``.png``."""
+        return {".csv": self.to_csv, **super().writers()}
+
     def plot(self, ax=None, *, path=None, provenance=None):
-        """Summary figure (see :func:`powertrain.plotting.plot_excitation`); ``ax``: None
-        (new figure), a Figure/SubFigure or an Axes; returns the figure."""
+        """Summary figure of six panels (see :func:`powertrain.plotting.plot_excitation`);
+        ``ax``: None (a new figure), a Figure or SubFigure (one Axes: an InputError saying to
+        pass a Figure); returns the figure."""
         from powertrain.plotting import plot_excitation
         from powertrain.plotting.style import target_and_path
         ax, path = target_and_path(ax, path)

@@ -8,13 +8,14 @@ from dataclasses import dataclass
 import numpy as np
 
 from powertrain.models.mount import MountModel
+from powertrain.results.base import Result
 
 #: Datasheet unit of a mount parameter, by its first letter (spring, damper, mass).
 PARAMETER_UNITS = {"c": "N/mm", "d": "N*s/mm", "m": "kg"}
 
 
 @dataclass(frozen=True)
-class FitResult:
+class FitResult(Result):
     """Outcome of :func:`fit_mount`.
 
     Attributes
@@ -110,7 +111,9 @@ class FitResult:
         """Measured and fitted K*(f) [N/mm]: |K*| and loss angle (datasheets, ISO 10846) or
         real and imaginary part (``form="real-imag"``, the thesis), over ``log`` or
         ``linear`` frequency; returns the figure (see
-        :func:`powertrain.plotting.plot_mount_fit`)."""
+        :func:`powertrain.plotting.plot_mount_fit`). ``ax`` as for
+        :meth:`powertrain.results.stiffness.StiffnessResult.plot`; ``save(path)`` writes the
+        figure (``.png``)."""
         from powertrain.plotting import plot_mount_fit
         from powertrain.plotting.style import target_and_path
         ax, path = target_and_path(ax, path)

@@ -5,10 +5,11 @@ its text, JSON and kinetic-energy figure."""
 from __future__ import annotations
 
 import json
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import numpy as np
 
+from powertrain.results.base import Result
 from powertrain.solvers.modes import AS_MEASURED, COORDINATES, number_or_null
 
 
@@ -78,34 +79,65 @@ class Mode:
                 "static_mac": float(self.static_mac)}
 
 
-@dataclass
-class ModesResult:
-    """Modes sorted by frequency, the torque-roll axis and the method used."""
+@dataclass(frozen=True)
+class ModesResult(Result):
+    """Modes sorted by frequency, the torque-roll axis and the method used.
+
+    Attributes
+    ----------
+    modes : list of Mode
+    torque_roll_axis : dict
+        ``direction`` (unit vector, engine axes) and ``angle_to_crank_axis_deg``.
+    method : str
+    engine : str
+        The engine's name.
+    cg_m : list of float, optional
+        Centre of gravity of the powertrain [m, engine axes] (JSON key ``cg_m``).
+    mounts : list of str, optional
+        The engine's mount names (JSON key ``mounts``).
+    """
 
     modes: list
     torque_roll_axis: dict
     method: str
     engine: str = ""
-    meta: dict = field(default_factory=dict)
+    cg_m: list | None = None
+    mounts: list | None = None
 
     @classmethod
-    def from_solution(cls, solution: dict, engine: str = "") -> ModesResult:
+    def from_solution(cls, solution: dict, engine: str = "", *, cg_m=None,
+                      mounts=None) -> ModesResult:
         """The result of :func:`powertrain.solvers.modes.rigid_body_modes` (``engine``: the
-        engine's name, for reports and plots)."""
+        engine's name, for reports and plots; ``cg_m``, ``mounts``: as the attributes)."""
         return cls(modes=[Mode(**m) for m in solution["modes"]],
                    torque_roll_axis=solution["torque_roll_axis"], method=solution["method"],
-                   engine=engine)
+                   engine=engine, cg_m=cg_m, mounts=mounts)
 
     def to_dict(self) -> dict:
+        """The JSON document: modes, torque-roll axis, method, engine, then ``cg_m`` and
+        ``mounts`` where known."""
+        extra = {k: v for k, v in (("cg_m", self.cg_m), ("mounts", self.mounts))
+                 if v is not None}
         return {"modes": [m.to_dict() for m in self.modes],
                 "torque_roll_axis": self.torque_roll_axis, "method": self.method,
-                "engine": self.engine, **self.meta}
+                "engine": self.engine, **extra}
+
+    def to_json(self, path=None) -> str:
+        """JSON text of :meth:`to_dict`; written atomically to ``path`` if given."""
+        text = json.dumps(self.to_dict(), indent=2) + "\n"
+        if path is not None:
+            from powertrain.outputs import atomic_write
+            with atomic_write(path) as fh:
+                fh.write(text)
+        return text
 
     def write_json(self, path) -> None:
-        from powertrain.outputs import atomic_write
-        with atomic_write(path) as fh:
-            json.dump(self.to_dict(), fh, indent=2)
-            fh.write("\n")
+        """Write :meth:`to_json` to ``path`` atomically."""
+        self.to_json(path)
+
+    def writers(self) -> dict:
+        """``.json`` (:meth:`to_json`), ``.png``."""
+        return {".json": self.to_json, **super().writers()}
 
     def is_static(self) -> bool:
         """True for the undamped static-stiffness modes (``--static``)."""
@@ -152,10 +184,11 @@ class ModesResult:
         return "\n".join(lines)
 
     def plot(self, ax=None, *, path=None, provenance=None):
-        """Stacked kinetic-energy distribution per mode (PNG when ``path`` is given);
-        returns the figure."""
+        """Stacked kinetic-energy distribution per mode, one panel (PNG when ``path`` is
+        given); returns the figure. ``ax``: None (a new figure), an Axes, a Figure or
+        SubFigure."""
         from powertrain.plotting.body import plot_modes
         from powertrain.plotting.style import target_and_path
         ax, path = target_and_path(ax, path)
         return plot_modes(self, path, ax=ax,
-                          provenance=provenance or getattr(self, "provenance", None))
+                          provenance=provenance)

@@ -56,6 +56,7 @@ import numpy as np
 
 from powertrain.analysis.channel import Channel
 from powertrain.analysis.orders import order_label, order_rms, synthesis_rms
+from powertrain.results.base import HDF5_SUFFIXES, Result
 from powertrain.solvers.modes import AS_MEASURED
 
 QUANTITIES = {
@@ -75,12 +76,14 @@ CSV_HEADER = ("mount,direction,quantity,rpm,side,velocity_rms_mm_per_s,"
               "acceleration_rms_m_per_s2,force_rms_n,phase_deg")
 
 
-@dataclass
-class RunupResult:
+@dataclass(frozen=True)
+class RunupResult(Result):
     """Order spectra of a run-up (complex peak amplitudes, SI).
 
     Arrays ``displacement``, ``velocity``, ``acceleration``, ``mount_force`` have shape
     (n_rpm, n_channels, n_orders); ``channels`` lists (mount, direction) in engine axes.
+    Built once (a changed run-up is a new result, :func:`dataclasses.replace`);
+    ``save(path)`` writes ``.csv``, ``.h5`` or ``.png``.
     """
 
     rpm: np.ndarray
@@ -261,6 +264,11 @@ class RunupResult:
         with atomic_write(path) as fh:
             fh.write(text)
 
+    def writers(self) -> dict:
+        """``.csv`` (:meth:`to_csv`), ``.h5``/``.hdf5`` (:meth:`to_hdf5`), ``.png``."""
+        return {".csv": self.to_csv, **dict.fromkeys(HDF5_SUFFIXES, self.to_hdf5),
+                **super().writers()}
+
     def to_hdf5(self, path, *, engine_snapshot: str | None = None,
                 mount_snapshots: dict | None = None, synthetic: bool = False,
                 description: str | None = None, provenance: dict | None = None) -> None:
@@ -370,33 +378,33 @@ class RunupResult:
         from powertrain.plotting.style import target_and_path
         ax, path = target_and_path(ax, path)
         return plot_path_contributions(self, path, order, ax=ax,
-                                       provenance=provenance or getattr(self, "provenance",
-                                                                        None))
+                                       provenance=provenance)
 
     def plot(self, ax=None, *, path=None, quantities=("synthesis", "order_2", "order_4"),
              signal="velocity", others=None, channel=None, quantity=None, provenance=None):
         """The thesis's figure set (Figs 45–71): one row per mount and direction, one column
         per quantity (every one of ``quantities`` is drawn), RMS ``signal`` against rpm.
 
-        ``ax``: None (new figure), a Figure/SubFigure (the grid) or an Axes (the one panel
-        ``channel``/``quantity``); ``others``: optional list of (label, RunupResult)
-        overlaid; ``provenance``: foot line (default: ``self.provenance`` if set). Returns the
-        figure; see :func:`powertrain.plotting.plot_runup`. With a body model (body-side
-        channels), no ``others`` and no single panel: both sides of each mount in one panel,
-        and the body points (:func:`powertrain.plotting.body.plot_runup_both_sides`).
+        ``ax``: None (a new figure), a Figure or SubFigure (the grid is drawn in it), or one
+        Axes where ``channel`` ((mount, direction)) and ``quantity`` leave one panel (else
+        an InputError saying to pass a Figure); ``channel`` and ``quantity`` narrow the grid
+        on any target. ``others``: optional list of (label, RunupResult) overlaid;
+        ``provenance``: foot line of a new figure. Returns the figure; see
+        :func:`powertrain.plotting.plot_runup`. With a body model (body-side channels), no
+        ``others`` and no panel chosen: both sides of each mount in one panel, and the body
+        points (:func:`powertrain.plotting.body.plot_runup_both_sides`).
         """
         from powertrain.plotting import plot_runup
         from powertrain.plotting.style import is_axes, target_and_path
         ax, path = target_and_path(ax, path)
-        if (not others and not is_axes(ax)
+        if (not others and not is_axes(ax) and channel is None and quantity is None
                 and any(self.side(m) == "passive" for m, _ in self.channels)):
             from powertrain.plotting.body import plot_runup_both_sides
             return plot_runup_both_sides(self, path, quantities, signal, ax=ax,
-                                         provenance=provenance or getattr(self, "provenance",
-                                                                          None))
+                                         provenance=provenance)
         return plot_runup([("simulation", self)] + list(others or []), path, quantities,
                           signal, ax=ax, channel=channel, quantity=quantity,
-                          provenance=provenance or getattr(self, "provenance", None))
+                          provenance=provenance)
 
 
 #: /operating_point datasets: (result attribute, unit); shapes (n_rpm, ...) as in the result.
@@ -420,8 +428,8 @@ def effects_text(scenario) -> str:
                      for name, p in scenario.items())
 
 
-@dataclass
-class SweepRunup:
+@dataclass(frozen=True)
+class SweepRunup(Result):
     """A continuous run-up (one speed ramp, time-integrated): the raw recording, as a
     measurement would give it, and its tracked order curves.
 
@@ -468,3 +476,8 @@ class SweepRunup:
     def to_hdf5(self, path) -> None:
         """The tracked curves as HDF5."""
         self.tracked.to_hdf5(path)
+
+    def writers(self) -> dict:
+        """``.csv``, ``.h5``/``.hdf5`` (the tracked curves), ``.png``."""
+        return {".csv": self.to_csv, **dict.fromkeys(HDF5_SUFFIXES, self.to_hdf5),
+                **super().writers()}

@@ -25,13 +25,15 @@ import numpy as np
 
 from powertrain.analysis.text_table import format_table
 from powertrain.outputs import json_text
+from powertrain.results.base import Result
 from powertrain.units import from_si
 
 
-@dataclass
-class StaticResult:
+@dataclass(frozen=True)
+class StaticResult(Result):
     """Operating points (:class:`~powertrain.solvers.operating_point.OperatingPoint`, one
-    per speed) of an engine's mounts ``mounts`` (names, in order)."""
+    per speed) of an engine's mounts ``mounts`` (names, in order); ``to_text()``,
+    ``to_json()``, ``plot(ax=None)``, ``save(path)`` (``.json``, ``.png``)."""
 
     points: list
     mounts: list
@@ -66,6 +68,19 @@ class StaticResult:
     def to_json(self, path=None) -> str:
         """JSON text of :meth:`to_dict`; written atomically to ``path`` if given."""
         return json_text(self.to_dict(), path)
+
+    def writers(self) -> dict:
+        """``.json`` (:meth:`to_json`), ``.png``."""
+        return {".json": self.to_json, **super().writers()}
+
+    def plot(self, ax=None, *, path=None, provenance=None):
+        """The static deflection [mm] of every mount direction against speed, one panel;
+        returns the figure (see :func:`powertrain.plotting.body.plot_static`). ``ax``: None
+        (a new figure), an Axes, a Figure or SubFigure."""
+        from powertrain.plotting.body import plot_static
+        from powertrain.plotting.style import target_and_path
+        ax, path = target_and_path(ax, path)
+        return plot_static(self, path, ax=ax, provenance=provenance)
 
     def to_text(self) -> str:
         """Per speed: the body's displacement [mm] and rotation [deg] at the CG, then each

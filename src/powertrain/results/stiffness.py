@@ -3,18 +3,20 @@
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import numpy as np
 
+from powertrain.results.base import Result
 
-@dataclass
-class StiffnessResult:
+
+@dataclass(frozen=True)
+class StiffnessResult(Result):
     """K*(f) of a mount model, plus x1 and F_T for the verification set-up.
 
     Attributes are SI; :meth:`columns` gives the datasheet-unit columns written out;
     :meth:`to_text` the table, :meth:`summary` the short form printed with a plot,
-    :meth:`to_csv` the CSV, :meth:`plot` the figure.
+    :meth:`to_csv` the CSV, :meth:`plot` the figure, :meth:`save` either by suffix.
     """
 
     frequency_hz: np.ndarray
@@ -22,7 +24,8 @@ class StiffnessResult:
     method: str
     x1: np.ndarray | None = None         #: engine-mass displacement [m]
     ft: np.ndarray | None = None         #: transmitted force [N]
-    meta: dict = field(default_factory=dict)
+    #: Cycle-to-cycle periodicity per frequency of the time method [1] (None otherwise).
+    periodicity: np.ndarray | None = None
     #: Legend label of the plot (the model's name, else where it came from).
     label: str = ""
 
@@ -46,6 +49,10 @@ class StiffnessResult:
         """The CSV text (datasheet units); written atomically to ``path`` when given."""
         return _csv(self.columns(), path)
 
+    def writers(self) -> dict:
+        """``.csv`` (:meth:`to_csv`), ``.png``."""
+        return {".csv": self.to_csv, **super().writers()}
+
     def to_text(self) -> str:
         """The table of every frequency (``powertrain stiffness``)."""
         return _table(self.columns(), self.method)
@@ -59,17 +66,19 @@ class StiffnessResult:
 
     def plot(self, ax=None, *, path=None, label=None, form="magnitude-phase", freq_axis="log",
              measured=None, provenance=None):
-        """K*(f) as |K*| and loss angle (datasheets, ISO 10846; default) or real and imaginary
-        part (``form="real-imag"``, the thesis), over ``log`` or ``linear`` frequency, into
-        ``ax`` (an Axes, a pair of Axes, a Figure) or a new figure; returns the figure (see
-        :func:`powertrain.plotting.plot_stiffness`)."""
+        """K*(f) as |K*| and loss angle in two panels (datasheets, ISO 10846; default) or
+        real and imaginary part in one (``form="real-imag"``, the thesis), over ``log`` or
+        ``linear`` frequency; returns the figure (see
+        :func:`powertrain.plotting.plot_stiffness`). ``ax``: None (a new figure), a Figure or
+        SubFigure, a pair of Axes (magnitude-phase), or one Axes for ``real-imag`` (one Axes
+        for the two panels of magnitude-phase: an InputError saying to pass a Figure)."""
         from powertrain.plotting import plot_stiffness
         from powertrain.plotting.style import target_and_path
         ax, path = target_and_path(ax, path)
-        name = label or self.label or self.meta.get("name", "model")
+        name = label or self.label or "model"
         return plot_stiffness([(name, self)], path, measured=measured, ax=ax, form=form,
                               freq_axis=freq_axis,
-                              provenance=provenance or getattr(self, "provenance", None))
+                              provenance=provenance)
 
 
 def _ranges(cols) -> str:
@@ -103,8 +112,8 @@ def _table(cols: dict, method: str) -> str:
     return f"# method: {method}\n" + format_table(list(cols), rows) + "\n"
 
 
-@dataclass
-class AmplitudeStiffnessResult:
+@dataclass(frozen=True)
+class AmplitudeStiffnessResult(Result):
     """K*(f, X) of the sinusoidal displacement test at several amplitudes X (``powertrain
     stiffness --amplitude``): one :class:`StiffnessResult` per amplitude.
 
@@ -130,6 +139,10 @@ class AmplitudeStiffnessResult:
         """The CSV text (datasheet units); written atomically to ``path`` when given."""
         return _csv(self.columns(), path)
 
+    def writers(self) -> dict:
+        """``.csv`` (:meth:`to_csv`), ``.png``."""
+        return {".csv": self.to_csv, **super().writers()}
+
     def to_text(self) -> str:
         """The table of every amplitude and frequency."""
         return _table(self.columns(), self.method)
@@ -146,7 +159,8 @@ class AmplitudeStiffnessResult:
 
     def plot(self, ax=None, *, path=None, form="magnitude-phase", freq_axis="log",
              provenance=None):
-        """One K*(f) curve per amplitude (see :meth:`StiffnessResult.plot`)."""
+        """One K*(f) curve per amplitude (see :meth:`StiffnessResult.plot`, also for
+        ``ax``)."""
         from powertrain.plotting import plot_stiffness
         from powertrain.plotting.style import target_and_path
         ax, path = target_and_path(ax, path)

@@ -49,6 +49,7 @@ from powertrain.analysis.channel import ChannelFields
 from powertrain.analysis.orders import order_label
 from powertrain.errors import InputError
 from powertrain.models.recording import QUANTITIES
+from powertrain.results.base import HDF5_SUFFIXES, Result
 
 #: quantity -> (level column, factor from SI to the column's unit).
 LEVEL_COLUMNS = {
@@ -79,8 +80,8 @@ class TrackedChannel(ChannelFields):
     quantity: str
 
 
-@dataclass
-class TrackedOrders:
+@dataclass(frozen=True)
+class TrackedOrders(Result):
     """Complex order amplitudes of a tracked run-up.
 
     Attributes
@@ -218,10 +219,16 @@ class TrackedOrders:
         return "\n".join(lines) + "\n"
 
     def to_csv(self, path) -> None:
+        """Write :meth:`csv_text` atomically."""
         from powertrain.outputs import atomic_write
         text = self.csv_text()
         with atomic_write(path) as fh:
             fh.write(text)
+
+    def writers(self) -> dict:
+        """``.csv`` (:meth:`to_csv`), ``.h5``/``.hdf5`` (:meth:`to_hdf5`), ``.png``."""
+        return {".csv": self.to_csv, **dict.fromkeys(HDF5_SUFFIXES, self.to_hdf5),
+                **super().writers()}
 
     def to_hdf5(self, path) -> None:
         """Write the HDF5 layout of the module docstring atomically."""
@@ -352,10 +359,12 @@ class TrackedOrders:
         return plot_maps(**self.maps, path=path, ax=ax, provenance=provenance)
 
     def plot(self, ax=None, *, path=None, quantities=None, provenance=None):
-        """Order curves (RMS against rpm), one panel per channel; returns the figure."""
+        """Order curves (RMS against rpm), one panel per channel; returns the figure.
+        ``ax``: None (a new figure), a Figure or SubFigure, or one Axes when there is one
+        channel (else an InputError saying to pass a Figure)."""
         from powertrain.plotting.orders import plot_tracked
         from powertrain.plotting.style import target_and_path
         ax, path = target_and_path(ax, path)
         return plot_tracked(self, path, quantities, ax=ax,
-                            provenance=provenance or getattr(self, "provenance", None))
+                            provenance=provenance)
 

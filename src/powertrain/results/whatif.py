@@ -21,6 +21,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from powertrain.analysis.channel import Channel
+from powertrain.results.base import Result
 
 #: Quantities reported by default.
 QUANTITIES = ("synthesis", "order_2", "order_4")
@@ -28,7 +29,7 @@ QUANTITIES = ("synthesis", "order_2", "order_4")
 FLOOR_REL = 1e-9
 
 
-@dataclass
+@dataclass(frozen=True)
 class VariantRun:
     """One variant: name, the operations' specs and its run-up."""
 
@@ -56,8 +57,8 @@ def delta_db(base, variant, floor_rel=FLOOR_REL) -> np.ndarray:
     return out
 
 
-@dataclass
-class WhatIfResult:
+@dataclass(frozen=True)
+class WhatIfResult(Result):
     """Baseline and variant run-ups with their changes in dB.
 
     Attributes
@@ -236,6 +237,10 @@ class WhatIfResult:
                 fh.write(text)
         return text
 
+    def writers(self) -> dict:
+        """``.json`` (:meth:`to_json`), ``.png`` (the levels figure)."""
+        return {".json": self.to_json, **super().writers()}
+
     def table(self) -> str:
         """Text table per variant: rows = channels, columns = mean / max |Δ| [dB] per quantity."""
         blocks = []
@@ -257,12 +262,14 @@ class WhatIfResult:
              view="levels"):
         """Baseline, variants and measurement (``view="levels"``) or each variant's change
         Δ dB against the baseline (``view="delta"``); returns the figure (see
-        :func:`powertrain.plotting.plot_whatif`)."""
+        :func:`powertrain.plotting.plot_whatif`). ``ax``: None (a new figure), a Figure or
+        SubFigure, or one Axes where ``channel`` ((mount, direction)) and ``quantity`` leave
+        one panel (else an InputError saying to pass a Figure)."""
         from powertrain.plotting import plot_whatif
         from powertrain.plotting.style import target_and_path
         ax, path = target_and_path(ax, path)
         return plot_whatif(self, path, ax=ax, channel=channel, quantity=quantity,
-                           provenance=provenance or getattr(self, "provenance", None),
+                           provenance=provenance,
                            view=view)
 
 

@@ -61,10 +61,14 @@ from types import SimpleNamespace
 import numpy as np
 
 from powertrain.effects import A_REF
+from powertrain.iotools.engine_file import DEFAULT_ENGINE_PATH, engine_or_default
+from powertrain.results.base import Result
 from powertrain.solvers.body_coupling import coupled_solve
 from powertrain.solvers.fast_harmonic import N_HARMONICS, HarmonicModel
 from powertrain.validation.cases import draw_case, gaps_db
 from powertrain.validation.kinds import TruthKind
+from powertrain.workflows.arguments import integer
+from powertrain.workflows.arguments import names as listed
 
 TRUTH_EFFECTS = {
     "body_modes": "base_compliance",
@@ -319,10 +323,11 @@ def _simulate(hm, engine, truth):
 
 
 # ---------------------------------------------------------------------------- public API
-@dataclasses.dataclass
-class SynthCase:
+@dataclasses.dataclass(frozen=True)
+class SynthCase(Result):
     """A synthetic measured run-up of :func:`synth` (``powertrain synth``): ``.to_text()``,
-    ``.to_csv(path)``, ``.to_truth_json(path)``, ``.plot()``.
+    ``.to_csv(path)``, ``.to_truth_json(path)``, ``.plot()``, ``.save(path)`` (``.csv``,
+    ``.png``).
 
     ``case`` is the :class:`~powertrain.validation.cases.Case` (``case.measured`` the
     :class:`~powertrain.iotools.measured.MeasuredRunup` a diagnosis reads).
@@ -356,6 +361,10 @@ class SynthCase:
                 "truth": [{"effect": n, "library_match": TRUTH_EFFECTS[n],
                            "parameters": {k: plain(v) for k, v in p.items()}}
                           for n, p in c.truth]}
+
+    def writers(self) -> dict:
+        """``.csv`` (:meth:`to_csv`), ``.png``."""
+        return {".csv": self.to_csv, **super().writers()}
 
     def to_truth_json(self, path=None) -> str:
         """:meth:`truth` as JSON, written atomically to ``path`` when given."""
@@ -410,9 +419,9 @@ def synth(effects=(), seed=0, *, engine=None, rpm=None, noise_db=None) -> SynthC
 
     Parameters
     ----------
-    effects : sequence of str
-        Truth effects (:data:`TRUTH_EFFECTS`, former names :data:`TRUTH_ALIASES`); empty:
-        effect-free.
+    effects : str or sequence of str
+        Truth effects (:data:`TRUTH_EFFECTS`, former names :data:`TRUTH_ALIASES`), or as
+        ``--effect`` writes them (``"a,b"``, ``"none"``); empty: effect-free.
     seed : int
         0..2^63-1.
     engine : Engine, str or path, optional
@@ -428,14 +437,16 @@ def synth(effects=(), seed=0, *, engine=None, rpm=None, noise_db=None) -> SynthC
     import os
 
     from powertrain.errors import InputError
-    names = [truth_effect_name(e) for e in effects]
+    given = listed(effects, "--effect")
+    names = [truth_effect_name(e) for e in ([] if given == ["none"] else given)]
     for e in names:
         if e not in TRUTH_EFFECTS:
             raise InputError(f"unknown truth effect {e!r} (known: {', '.join(TRUTH_EFFECTS)})",
                              key="--effect")
     if engine is None or isinstance(engine, (str, os.PathLike)):
-        from powertrain.iotools.engine_file import DEFAULT_ENGINE_PATH, read_engine
-        engine = read_engine(str(engine or DEFAULT_ENGINE_PATH))
+        engine = str(engine or DEFAULT_ENGINE_PATH)
+    engine = engine_or_default(engine)
+    seed = integer(seed, "--seed")
     if not 0 <= seed < 2 ** 63:
         raise InputError(f"must be an integer 0..2^63-1, got {seed}", key="--seed")
     return SynthCase(make_case(engine, names, seed, rpm=rpm, noise_db=noise_db), seed)

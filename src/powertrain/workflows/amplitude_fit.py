@@ -41,13 +41,14 @@ from powertrain.errors import InputError
 from powertrain.models.mount import TOPOLOGIES, MountModel
 from powertrain.physics.mount_laws import BergFriction, PowerLaw
 from powertrain.results.amplitude_fit import AmplitudeFitResult
+from powertrain.workflows import fitting
+from powertrain.workflows.arguments import flag, real
 from powertrain.workflows.fitting import (
     DEFAULT_POLISH,
     DEFAULT_SEED,
     DEFAULT_STARTS,
     NetworkProblem,
     check_options,
-    fit_mount,
     fit_mount_file,
     parameter_box,
     relative_rms_error,
@@ -60,6 +61,56 @@ LIMITS = PowerLaw(1.0, 0.0).limits
 EXPONENT_BOUNDS = (-1.0, 2.0)
 #: Function evaluations of each joint start screened, and of the best one's final run.
 SCREEN_NFEV, JOINT_NFEV = 40, 400
+
+
+def fit_mount(measured, kcp_measured=None, model="triple-parallel", *, friction=False,
+              reference=None, starts=DEFAULT_STARTS, seed=DEFAULT_SEED, max_mass=None,
+              fmin=None, fmax=None, **options):
+    """Fit a mount model to a measured K*(f), as ``powertrain fit-mount`` does.
+
+    Parameters
+    ----------
+    measured : str, path or array_like
+        A dynamic-stiffness CSV (:mod:`powertrain.iotools.stiffness_csv`; with a column
+        ``amplitude_mm`` at several amplitudes: the network, a power amplitude law and,
+        with ``friction``, Berg's friction element fitted together), or the frequencies
+        [Hz] of ``kcp_measured``.
+    kcp_measured : array_like of complex, optional
+        Measured cross-point dynamic stiffness [N/m] at ``measured`` (arrays only).
+    model : str
+        A preset of :data:`powertrain.models.mount.TOPOLOGIES` (``--model``).
+    friction : bool
+        With several amplitudes: fit Berg's friction element too (``--friction``).
+    reference : float, optional
+        With several amplitudes: the reference amplitude [m], one of the data's (default the
+        smallest).
+    starts, seed, max_mass, fmin, fmax
+        As the options ``--starts``, ``--seed``, ``--max-mass`` [kg], ``--fmin``, ``--fmax``
+        [Hz] (:func:`powertrain.workflows.fitting.fit_mount`).
+    options
+        ``polish``, ``hops``, ``name``, ``source`` of
+        :func:`powertrain.workflows.fitting.fit_mount` (arrays).
+
+    Returns
+    -------
+    FitResult, or AmplitudeFitResult for data at several amplitudes
+        ``to_text()`` is what the command prints; ``plot(ax=None)``, ``save(path)``.
+
+    Raises
+    ------
+    InputError
+        Naming the file and key, or the option, of bad input.
+    """
+    if kcp_measured is None:
+        return fit_mount_csv(measured, model, friction=friction, reference=reference,
+                             starts=starts, seed=seed, max_mass=max_mass, fmin=fmin,
+                             fmax=fmax)
+    for option, value in (("--friction", friction), ("--reference", reference)):
+        if value:
+            raise InputError(f"{option} needs data at two or more amplitudes (a column "
+                             "amplitude_mm)", key=option)
+    return fitting.fit_mount(measured, kcp_measured, model, starts=starts, seed=seed,
+                             max_mass=max_mass, fmin=fmin, fmax=fmax, **options)
 
 
 def fit_mount_csv(measured, model="triple-parallel", *, friction=False, reference=None,
@@ -83,7 +134,10 @@ def fit_mount_csv(measured, model="triple-parallel", *, friction=False, referenc
     from pathlib import Path
 
     from powertrain.iotools.stiffness_csv import AMPLITUDE, read_stiffness_csv
-    check_options(measured, model, starts, seed, max_mass, fmin, fmax)
+    starts, seed, max_mass, fmin, fmax = check_options(measured, model, starts, seed,
+                                                       max_mass, fmin, fmax)
+    friction = flag(friction, "--friction")
+    reference = real(reference, "--reference", unit="m", optional=True)
     data = read_stiffness_csv(measured).select(fmin, fmax)
     if data.amplitudes.size < 2:
         for option, value in (("--friction", friction), ("--reference", reference)):
@@ -115,7 +169,7 @@ def fit_amplitudes(data, model="triple-parallel", *, friction=False, reference=N
     ref = data.at(a_ref)
     guess = problem.friction_guess() if friction else None
     k_ref = ref.kcp - (guess.describing_stiffness(a_ref) if friction else 0.0)
-    network = fit_mount(ref.frequency_hz, k_ref, topology, starts=starts, seed=seed,
+    network = fitting.fit_mount(ref.frequency_hz, k_ref, topology, starts=starts, seed=seed,
                         max_mass=max_mass)
     rng = np.random.default_rng(seed)
     q_nets = [np.log(network.model.values),

@@ -34,6 +34,7 @@ from __future__ import annotations
 
 import math
 import time
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -50,6 +51,8 @@ from powertrain.results.comparison import (
     ComparisonResult,
     json_number,
 )
+from powertrain.solvers.steppers import SOLVERS
+from powertrain.workflows.arguments import MAX_SPEEDS, choice, default_rpm, nonnegative, real
 
 #: Default RMS noise floor of the measured order curves [m/s] (0.001 mm/s, see README).
 DEFAULT_NOISE_FLOOR = 1e-6
@@ -88,7 +91,10 @@ def compare(measured, *, engine=None, simulated=None, solver="newmark", step=Non
     """
     t0 = time.perf_counter()
     if simulated is not None and engine is not None:
-        raise ValueError("give simulated or engine, not both")
+        raise InputError("give --sim or --engine, not both", key="--sim")
+    choice(solver, tuple(SOLVERS), "--solver")
+    noise_floor = nonnegative(noise_floor, "--noise-floor", "m/s")
+    step = real(step, "--step", unit="rpm", optional=True)
     if step is not None and not (math.isfinite(step) and step > 0):
         raise InputError("must be > 0 [rpm]", key="--step")
     if simulated is not None:
@@ -106,8 +112,7 @@ def compare(measured, *, engine=None, simulated=None, solver="newmark", step=Non
                          f"noise floor ({noise_floor * 1e3:g} mm/s) inside the simulated speed "
                          "range", file=meas.source if isinstance(measured, MeasuredRunup)
                          else measured, key="--noise-floor")
-    comp.run = {**run, "seconds": time.perf_counter() - t0}
-    return comp
+    return replace(comp, run={**run, "seconds": time.perf_counter() - t0})
 
 
 def _given_simulation(simulated, measured):
@@ -176,7 +181,6 @@ def _simulate(engine, engine_file, meas, rpm_step, solver, progress):
 def simulation_speeds(engine, meas, rpm_step=None):
     """Speeds to simulate [rpm]: every measured speed inside the engine's range, or a
     ``rpm_step`` grid covering the intersection of the measured and the engine's range."""
-    from powertrain.workflows.runup import MAX_SPEEDS, default_rpm
     lo, hi = meas.rpm_range()
     e_lo, e_hi = engine.speed_range_rpm()
     if hi < e_lo or lo > e_hi:
@@ -249,9 +253,8 @@ def compare_runup(simulated, measured: MeasuredRunup, *, noise_floor=DEFAULT_NOI
                 missing.append({**where, "reason": f"not in the {side}"})
                 continue
             c = _compare_channel(where, measured.curves[key], simulated.curves[key],
-                                 noise_floor, sigma_db)
-            _compare_phase(c, measured.phases.get(key), simulated.phases.get(key),
-                           simulated.curves[key][0])
+                                 noise_floor, sigma_db, measured.phases.get(key),
+                                 simulated.phases.get(key))
             if c.not_modelled.any():
                 not_modelled.append({**where, **_points(c, c.not_modelled)})
             if c.scored.any():
@@ -266,8 +269,10 @@ def compare_runup(simulated, measured: MeasuredRunup, *, noise_floor=DEFAULT_NOI
                             float(noise_floor), sim_rpm, sigma_db, not_modelled=not_modelled)
 
 
-def _compare_channel(where, measured_curve, simulated_curve, noise_floor, sigma_db):
-    """Classify and score the measured points of one channel and quantity."""
+def _compare_channel(where, measured_curve, simulated_curve, noise_floor, sigma_db,
+                     measured_phase=None, simulated_phase=None):
+    """Classify and score the measured points of one channel and quantity; with both
+    phases, also its phase and complex gaps (:func:`_phase_gap`)."""
     rpm_m, lev_m = measured_curve
     rpm_s, lev_s = simulated_curve
     sim, inside = cm.interpolate_log(rpm_s, lev_s, rpm_m)
@@ -281,21 +286,26 @@ def _compare_channel(where, measured_curve, simulated_curve, noise_floor, sigma_
     if scored.any():
         stats["frac"] = cm.frac(sim[scored], lev_m[scored])
         stats["frfsm"] = cm.frfsm_score(gap, sigma_db)
+    phase_gap = _phase_gap(stats, rpm_m[scored], sim[scored], lev_m[scored], measured_phase,
+                           simulated_phase, rpm_s, scored)
     return ChannelComparison(where["mount"], where["direction"], where["quantity"], rpm_m,
                              lev_m, sim, ~inside, floor, zero, unmodelled, inside & ~at_node,
-                             scored, gap, stats)
+                             scored, gap, stats, phase_gap)
 
 
-def _compare_phase(c: ChannelComparison, measured_phase, simulated_phase, rpm_s) -> None:
-    """Phase gap per scored point and the phase and complex gap of ``c``
-    (:func:`~powertrain.analysis.compare.phase_statistics`), where both sides give phase."""
-    if measured_phase is None or simulated_phase is None or not c.scored.any():
-        return
-    sim = cm.interpolate_phase(rpm_s, simulated_phase, c.rpm[c.scored])
-    stats = cm.phase_statistics(c.simulated[c.scored], c.measured[c.scored], sim,
-                                np.asarray(measured_phase, float)[c.scored])
-    c.phase_gap_deg = stats.pop("phase_gap_deg")
-    c.stats.update(stats)
+def _phase_gap(stats, rpm, simulated, measured, measured_phase, simulated_phase, rpm_s,
+               scored):
+    """Phase gap per scored point (None unless both sides give phase and a point is scored);
+    the phase and complex gap statistics
+    (:func:`~powertrain.analysis.compare.phase_statistics`) are added to ``stats``."""
+    if measured_phase is None or simulated_phase is None or not scored.any():
+        return None
+    sim = cm.interpolate_phase(rpm_s, simulated_phase, rpm)
+    more = cm.phase_statistics(simulated, measured, sim,
+                               np.asarray(measured_phase, float)[scored])
+    phase_gap = more.pop("phase_gap_deg")
+    stats.update(more)
+    return phase_gap
 
 
 def _points(c: ChannelComparison, mask) -> dict:

@@ -6,6 +6,7 @@ import math
 
 from powertrain.errors import InputError
 from powertrain.results.excitation import ExcitationResult
+from powertrain.workflows.arguments import flag, real
 
 #: Fewest crank-angle steps of one engine cycle (720 deg).
 MIN_STEPS = 32
@@ -20,8 +21,8 @@ def excitation(engine=None, rpm=None, *, load=1.0, balancers=True,
     ----------
     engine : Engine, str or Path, optional
         The engine, or its file (default: the shipped ``engines/default.toml``).
-    rpm : float
-        Engine speed [rpm].
+    rpm : float or str
+        Engine speed [rpm] (a number, or as ``--rpm`` writes it).
     load : float
         Fraction of the full-load torque [-] (single-zone model).
     balancers : bool
@@ -36,6 +37,10 @@ def excitation(engine=None, rpm=None, *, load=1.0, balancers=True,
         ``to_csv``.
     """
     from powertrain.iotools.engine_file import engine_or_default
+    rpm = real(rpm, "--rpm", unit="rpm", optional=True)
+    load = real(load, "--load")
+    angle_step_deg = real(angle_step_deg, "--step", unit="deg")
+    balancers = flag(balancers, "--no-balancers")
     if rpm is None or not math.isfinite(rpm) or rpm <= 0:
         raise InputError(f"must be a positive speed, got {rpm}", key="--rpm")
     if not math.isfinite(load) or load <= 0:

@@ -52,6 +52,7 @@ from powertrain.errors import InputError
 from powertrain.models.mount import DEFAULT_TOPOLOGY, TOPOLOGIES, MountModel, Topology
 from powertrain.physics.mount_network import incidence_matrix
 from powertrain.results.fit import FitResult
+from powertrain.workflows.arguments import integer, real
 
 #: Number of random starting points screened by default.
 DEFAULT_STARTS = 24
@@ -311,9 +312,9 @@ def fit_mount(measured, kcp_measured=None, model: str | Topology = DEFAULT_TOPOL
 
     Raises
     ------
-    ValueError
-        Unknown model, mismatched or non-finite data, too few frequencies
-        (:class:`~powertrain.errors.InputError` naming the file and option for a file).
+    InputError
+        Unknown model, mismatched or non-finite data, too few frequencies, naming the option
+        or argument (and the file for a file).
     """
     if kcp_measured is None:
         return fit_mount_file(measured, model, starts=starts, seed=seed, max_mass=max_mass,
@@ -326,11 +327,14 @@ def _fit_arrays(frequency_hz, kcp_measured, topology, *, starts, seed, polish, h
                 source, max_mass) -> FitResult:
     t0 = time.perf_counter()
     f, km = _checked_data(frequency_hz, kcp_measured, topology)
-    if int(starts) < 1 or int(polish) < 1 or int(hops) < 0:
-        raise ValueError("starts and polish must be >= 1, hops >= 0")
-    starts, polish, hops = int(starts), min(int(polish), int(starts)), int(hops)
+    starts = _starts(starts)
+    polish = min(integer(polish, "polish", minimum=1), starts)
+    hops = integer(hops, "hops", minimum=0)
+    if not isinstance(seed, np.random.Generator):
+        seed = integer(seed, "--seed", optional=True)
+    max_mass = real(max_mass, "--max-mass", unit="kg", optional=True)
     if max_mass is not None and not max_mass > 0:
-        raise ValueError("max_mass must be positive")
+        raise InputError(f"must be positive, got {max_mass}", key="--max-mass")
     prob = NetworkProblem(topology, f, km, max_mass)
     rng = np.random.default_rng(seed)
     fresh = starting_points(topology, f, km, starts + hops, rng, max_mass)
@@ -354,28 +358,39 @@ def _fit_arrays(frequency_hz, kcp_measured, topology, *, starts, seed, polish, h
 
 
 def _topology(model) -> Topology:
-    if not isinstance(model, str):
+    if isinstance(model, Topology):
         return model
-    if model not in TOPOLOGIES:
-        raise ValueError(f"unknown model {model!r} (known: {', '.join(TOPOLOGIES)})")
+    if not isinstance(model, str) or model not in TOPOLOGIES:
+        raise InputError(f"unknown model {model!r} (known: {', '.join(TOPOLOGIES)})",
+                         key="--model")
     return TOPOLOGIES[model]
 
 
 def _checked_data(frequency_hz, kcp_measured, topology):
-    """Frequencies [Hz] and K_CP [N/m] as flat arrays, refused when they cannot be fitted."""
-    f = np.asarray(frequency_hz, dtype=float).ravel()
-    km = np.asarray(kcp_measured, dtype=complex).ravel()
+    """Frequencies [Hz] and K_CP [N/m] as flat arrays, refused when they cannot be fitted
+    (an InputError naming ``frequency_hz`` or ``kcp_measured``)."""
+    try:
+        f = np.asarray(frequency_hz, dtype=float).ravel()
+    except (TypeError, ValueError):
+        raise InputError("must be numbers [Hz]", key="frequency_hz") from None
+    try:
+        km = np.asarray(kcp_measured, dtype=complex).ravel()
+    except (TypeError, ValueError):
+        raise InputError("must be numbers [N/m]", key="kcp_measured") from None
     if f.size != km.size:
-        raise ValueError("frequency_hz and kcp_measured differ in length")
+        raise InputError(f"{km.size} values for {f.size} frequencies", key="kcp_measured")
     if not (np.all(np.isfinite(f)) and np.all(np.isfinite(km))):
-        raise ValueError("data must be finite")
+        raise InputError("data must be finite", key="kcp_measured" if np.all(np.isfinite(f))
+                         else "frequency_hz")
     if np.any(f < 0) or np.any(np.diff(f) <= 0):
-        raise ValueError("frequencies must be non-negative and strictly increasing")
+        raise InputError("frequencies must be non-negative and strictly increasing",
+                         key="frequency_hz")
     n_par = len(topology.parameters)
     if 2 * f.size < n_par:
-        raise ValueError(f"{n_par} parameters need at least {(n_par + 1) // 2} frequencies")
+        raise InputError(f"{n_par} parameters need at least {(n_par + 1) // 2} frequencies",
+                         key="frequency_hz")
     if not np.any(np.abs(km) > 0):
-        raise ValueError("measured stiffness is zero everywhere")
+        raise InputError("measured stiffness is zero everywhere", key="kcp_measured")
     return f, km
 
 
@@ -421,7 +436,8 @@ def fit_mount_file(measured, model: str = DEFAULT_TOPOLOGY, *, starts: int = DEF
     from pathlib import Path
 
     from powertrain.iotools.stiffness_csv import FREQUENCY, read_stiffness_csv
-    check_options(measured, model, starts, seed, max_mass, fmin, fmax)
+    starts, seed, max_mass, fmin, fmax = check_options(measured, model, starts, seed,
+                                                       max_mass, fmin, fmax)
     data = read_stiffness_csv(measured).select(fmin, fmax)
     topo = TOPOLOGIES[model]
     need = (len(topo.parameters) + 1) // 2
@@ -440,16 +456,27 @@ def fit_mount_file(measured, model: str = DEFAULT_TOPOLOGY, *, starts: int = DEF
     return dataclasses.replace(result, data_name=file)
 
 
-def check_options(measured, model, starts, seed, max_mass, fmin, fmax) -> None:
-    """Refuse options :func:`fit_mount_file` cannot use, naming the option."""
+def _starts(starts) -> int:
+    """``--starts`` as an int in 1..:data:`MAX_STARTS`."""
+    starts = integer(starts, "--starts")
+    if not 1 <= starts <= MAX_STARTS:
+        raise InputError(f"must be 1..{MAX_STARTS}, got {starts}", key="--starts")
+    return starts
+
+
+def check_options(measured, model, starts, seed, max_mass, fmin, fmax) -> tuple:
+    """Refuse options :func:`fit_mount_file` cannot use, naming the option; ``(starts,
+    seed, max_mass, fmin, fmax)`` as numbers (a string as the option writes it is read)."""
     import math
-    if model not in TOPOLOGIES:
+    starts, seed = integer(starts, "--starts"), integer(seed, "--seed", optional=True)
+    max_mass, fmin, fmax = (real(v, k, optional=True) for v, k in (
+        (max_mass, "--max-mass"), (fmin, "--fmin"), (fmax, "--fmax")))
+    if not isinstance(model, str) or model not in TOPOLOGIES:
         raise InputError(f"unknown model {model!r} (known: {', '.join(TOPOLOGIES)})",
                          file=measured, key="--model")
     if max_mass is not None and not max_mass > 0:
         raise InputError(f"must be positive, got {max_mass}", key="--max-mass")
-    if not 1 <= starts <= MAX_STARTS:
-        raise InputError(f"must be 1..{MAX_STARTS}, got {starts}", key="--starts")
+    _starts(starts)
     if seed is not None and not 0 <= seed < 2 ** 63:
         raise InputError(f"must be an integer 0..2^63-1, got {seed}", key="--seed")
     for name, value in (("--fmin", fmin), ("--fmax", fmax), ("--max-mass", max_mass)):
@@ -457,3 +484,4 @@ def check_options(measured, model, starts, seed, max_mass, fmin, fmax) -> None:
             raise InputError(f"must be a finite number, got {value}", key=name)
     if fmin is not None and fmax is not None and not fmin < fmax:
         raise InputError(f"--fmin {fmin:g} must be below --fmax {fmax:g}", key="--fmin")
+    return starts, seed, max_mass, fmin, fmax

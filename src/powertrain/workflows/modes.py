@@ -9,6 +9,7 @@ import numpy as np
 from powertrain.errors import InputError
 from powertrain.results.modes import Mode, ModesResult
 from powertrain.solvers.modes import rigid_body_modes
+from powertrain.workflows.arguments import flag
 
 
 def modes(engine=None, *, static=False) -> ModesResult:
@@ -36,13 +37,14 @@ def modes(engine=None, *, static=False) -> ModesResult:
         (values at the edge of the float range, a body mode that couples to nothing).
     """
     from powertrain.iotools.engine_file import engine_or_default
+    static = flag(static, "--static")
     engine = engine_or_default(engine)
     b = engine.body
     try:
         with np.errstate(all="ignore"):
-            result = ModesResult.from_solution(rigid_body_modes(engine.assemble(), b.inertia,
-                                                                static=static),
-                                               engine=engine.name)
+            result = ModesResult.from_solution(
+                rigid_body_modes(engine.assemble(), b.inertia, static=static),
+                engine=engine.name, cg_m=[float(v) for v in b.cg], mounts=engine.mount_names)
     except (ValueError, ArithmeticError, np.linalg.LinAlgError) as exc:
         raise InputError(f"the modes cannot be computed ({type(exc).__name__}: "
                          f"{str(exc)[:100]}): mount, body or chassis values out of any "
@@ -53,8 +55,6 @@ def modes(engine=None, *, static=False) -> ModesResult:
             raise InputError(f"mode {i} ({mode.kind}) is not finite (NaN or inf): values out "
                              "of any physical range, or a body mode whose shape is zero at "
                              "every mount", file=engine.file, key=key)
-    result.meta["cg_m"] = [float(v) for v in b.cg]
-    result.meta["mounts"] = engine.mount_names
     return result
 
 

@@ -77,6 +77,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from powertrain.results.base import Result
 from powertrain.workflows.operations import Origin, Swap, Target
 
 #: Log-spaced fit frequencies above 0 Hz.
@@ -209,7 +210,7 @@ def fit_frequencies(target: Target) -> np.ndarray:
 
 
 @dataclass(frozen=True)
-class TargetFit:
+class TargetFit(Result):
     r"""Outcome of a retune.
 
     Attributes
@@ -275,7 +276,12 @@ class TargetFit:
                 "amplitude_mm": None if t.amplitude is None else 1e3 * t.amplitude,
                 "fitted_params_si": dict(self.model.params)}
 
+    def to_text(self) -> str:
+        """:meth:`summary` (what ``powertrain whatif`` prints of the target)."""
+        return self.summary()
+
     def summary(self) -> str:
+        """The fit in one line: its errors over the range and in the band, the change."""
         t = self.target
         return (f"target {t.spec}: retuned {self.model.topology.name} (from the {self.start} "
                 f"start): K_CP rel. RMS error {100 * self.rel_rms:.2f} %, K_IP "
@@ -287,7 +293,9 @@ class TargetFit:
     def plot(self, ax=None, *, path=None, form="magnitude-phase", freq_axis="log",
              provenance=None):
         """Baseline, requested and fitted K_CP; returns the figure (see
-        :func:`powertrain.plotting.plot_retune`)."""
+        :func:`powertrain.plotting.plot_retune`; ``ax`` as for
+        :meth:`powertrain.results.stiffness.StiffnessResult.plot`); ``save(path)`` writes
+        it (``.png``)."""
         from powertrain.plotting import plot_retune
         from powertrain.plotting.style import target_and_path
         ax, path = target_and_path(ax, path)

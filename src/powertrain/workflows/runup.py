@@ -26,6 +26,7 @@ from __future__ import annotations
 
 import os
 import warnings
+from dataclasses import replace
 
 import numpy as np
 
@@ -41,10 +42,10 @@ from powertrain.solvers.operating_point import (
     operating_points,
     static_factors,
 )
-from powertrain.solvers.steppers import Cycles, choose_stepper
+from powertrain.solvers.steppers import NEWMARK_STEPPERS, SOLVERS, Cycles, choose_stepper
+from powertrain.workflows import arguments as args
+from powertrain.workflows.arguments import default_rpm
 
-#: Largest speed grid a run-up command accepts (about 0.1 s per speed step).
-MAX_SPEEDS = 2000
 #: Default crank-angle increment [deg]; halving it moves the results < 0.1 % (see tests).
 ANGLE_STEP_DEG = 1.0
 #: Cycles simulated per speed step and cycles processed (thesis sec. 4.4).
@@ -62,13 +63,6 @@ SWEEP_TRACKING = {"rpm_step": 50.0, "pulses_per_rev": 1, "tdc_offset_deg": 0.0}
 
 class PeriodicityWarning(UserWarning):
     """The processed window is not periodic to the stated limit."""
-
-
-def default_rpm(start=1000.0, stop=6000.0, step=500.0) -> np.ndarray:
-    """Speed steps ``start, start + step, ... <= stop`` [rpm] (default: the thesis's 1000 to
-    6000 rpm in 500 rpm steps, sec. 4.4)."""
-    n = int(np.floor((stop - start) / step + 1e-9)) + 1
-    return start + step * np.arange(n)
 
 
 def _cycle_loads(engine, rpm, n_per_cycle):
@@ -131,10 +125,8 @@ def _run_runup(engine, rpm=None, *, solver="newmark", angle_step_deg=ANGLE_STEP_
     else:
         speeds, seconds = _solve_at_operating_points(engine, step, rpm, loads, points, bar)
     _warn_periodicity(rpm, [o.periodicity for o in speeds])
-    result = _result(engine, system, step, rpm, speeds, step.setup_seconds + seconds)
-    if points is not None:
-        result.operating_point = _static_result(engine, points)
-    return result
+    return _result(engine, system, step, rpm, speeds, step.setup_seconds + seconds,
+                   None if points is None else _static_result(engine, points))
 
 
 def _static_result(engine, points) -> StaticResult:
@@ -195,7 +187,7 @@ def _warn_periodicity(rpm, periodicity):
                           f"{100 * p:.3g} % (> 0.1 %)", PeriodicityWarning, stacklevel=4)
 
 
-def _result(engine, system, step, rpm, speeds, solver_seconds) -> RunupResult:
+def _result(engine, system, step, rpm, speeds, solver_seconds, operating_point) -> RunupResult:
     def stack(name):
         return np.array([getattr(o, name) for o in speeds])
 
@@ -211,7 +203,7 @@ def _result(engine, system, step, rpm, speeds, solver_seconds) -> RunupResult:
                        mean_mount_force=stack("mean_force"),
                        periodicity=stack("periodicity"), settings=step.settings(),
                        solver_seconds=solver_seconds, rigid_body_modes_hz=modes_hz,
-                       path_contribution=paths,
+                       path_contribution=paths, operating_point=operating_point,
                        meta={"engine": getattr(engine, "name", ""),
                              "chassis": "rigid" if chassis is None else chassis.model,
                              "points": list(chassis.points) if chassis is not None else [],
@@ -248,7 +240,7 @@ def path_contributions(system, rpm, force) -> np.ndarray:
 def runup_with_effects(engine, rpm, scenario: dict, **options):
     """Run-up of ``engine`` with the effects of ``scenario`` (``{effect: {parameter:
     value}}``, SI) through :func:`run_runup` (``**options``: its keyword arguments);
-    ``settings["effects"]`` records the scenario.
+    ``settings["effects"]`` records the scenario (a new result: the run-up's is not changed).
 
     * engine-model effects change the engine (``Effect.apply``), in registry order
       (``amplitude_stiffness`` sets every mount's amplitude law, which either solver
@@ -263,12 +255,12 @@ def runup_with_effects(engine, rpm, scenario: dict, **options):
         if name in sc and eff.engine_change:
             engine = eff.apply(engine, **sc[name])
     result = run_runup(engine, rpm, **options)
+    read = {}
     for name, p in sc.items():
         if EFFECTS[name].response_only:
             for attr in ("displacement", "velocity", "acceleration"):
-                setattr(result, attr, EFFECTS[name].reading(getattr(result, attr), p))
-    result.settings["effects"] = sc
-    return result
+                read[attr] = EFFECTS[name].reading(read.get(attr, getattr(result, attr)), p)
+    return replace(result, **read, settings={**result.settings, "effects": sc})
 
 
 # --------------------------------------------------------------------------- public entry
@@ -281,9 +273,9 @@ def runup(engine=None, rpm=None, *, solver="newmark", stepper="auto",
     ----------
     engine : Engine, str or Path, optional
         The engine, or its file (default: the shipped ``engines/default.toml``).
-    rpm : array_like, optional
-        Speed steps [rpm] (default 1000..6000 step 500); with ``sweep``, the ramp runs from
-        the first to the last.
+    rpm : array_like or str, optional
+        Speed steps [rpm], strictly increasing, or as ``"1000:6000:500"`` (default
+        1000..6000 step 500); with ``sweep``, the ramp runs from the first to the last.
     solver, stepper, angle_step_deg :
         As in :func:`run_runup`.
     balancers : bool
@@ -311,26 +303,50 @@ def runup(engine=None, rpm=None, *, solver="newmark", stepper="auto",
         Naming the engine file and key, or the option, of bad input.
     """
     from powertrain.iotools.engine_file import engine_or_default
+    options = _checked_options(solver, stepper, angle_step_deg, balancers, sweep, sample_rate,
+                               progress)
     engine = engine_or_default(engine)
     engine.require_excitation()
     modifications = []
-    if not balancers:
+    if not options["balancers"]:
         engine = engine.with_balancers(enabled=False)
         modifications.append("balancer shafts switched off (--no-balancers)")
-    if sweep is not None:
-        return _sweep_runup(engine, rpm, sweep, sample_rate, effects, progress)
-    rpm = _speeds(rpm)
+    if options["sweep"] is not None:
+        return _sweep_runup(engine, rpm, options["sweep"], options["sample_rate"], effects,
+                            options["progress"])
+    rpm = args.speeds(rpm)
     scenario = _scenario(effects, engine)
-    check_runup_settings(engine, rpm, angle_step_deg)
-    result = _stepped(engine, rpm, scenario, progress, solver=solver,
-                      angle_step_deg=angle_step_deg, stepper=stepper)
-    result.engine, result.modifications = engine, modifications
-    if result.operating_point is None:
-        result.operating_point = _static_result(engine, operating_points(engine, rpm))
-    result.meta["engine_file"] = str(engine.file)
-    result.meta["rigid_body_mode_dominant"] = mode_coordinates(engine,
-                                                               result.rigid_body_modes_hz)
-    return result
+    check_runup_settings(engine, rpm, options["angle_step_deg"])
+    result = _stepped(engine, rpm, scenario, options["progress"], solver=solver,
+                      angle_step_deg=options["angle_step_deg"], stepper=stepper)
+    return _with_engine(result, engine, rpm, modifications)
+
+
+def _with_engine(result, engine, rpm, modifications) -> RunupResult:
+    """The stepped run-up with what :func:`runup` adds: the engine that ran and what changed
+    on it, the operating point per speed, the engine file and each mode's dominant
+    coordinate (a new result; the run's is not changed)."""
+    operating_point = result.operating_point
+    if operating_point is None:
+        operating_point = _static_result(engine, operating_points(engine, rpm))
+    dominant = mode_coordinates(engine, result.rigid_body_modes_hz)
+    return replace(result, engine=engine, modifications=modifications,
+                   operating_point=operating_point,
+                   meta={**result.meta, "engine_file": str(engine.file),
+                         "rigid_body_mode_dominant": dominant})
+
+
+def _checked_options(solver, stepper, angle_step_deg, balancers, sweep, sample_rate,
+                     progress) -> dict:
+    """The options of :func:`runup` checked as the command checks them (its option names in
+    the errors); the numbers as floats."""
+    args.choice(solver, tuple(SOLVERS), "--solver")
+    args.choice(stepper, tuple(NEWMARK_STEPPERS), "--stepper")
+    return {"angle_step_deg": args.real(angle_step_deg, "--angle-step", unit="deg"),
+            "balancers": args.flag(balancers, "--no-balancers"),
+            "sweep": args.real(sweep, "--sweep", unit="rpm/s", optional=True),
+            "sample_rate": args.real(sample_rate, "--sample-rate", unit="Hz"),
+            "progress": args.flag(progress, "progress")}
 
 
 def _stepped(engine, rpm, scenario, progress, **options) -> RunupResult:
@@ -345,12 +361,14 @@ def _stepped(engine, rpm, scenario, progress, **options) -> RunupResult:
 
 
 def _scenario(effects, engine) -> dict:
-    """``{effect: {parameter: value}}`` of ``--effect`` strings (or a scenario as given)."""
+    """``{effect: {parameter: value}}`` of ``--effect`` strings (one string or a sequence),
+    or a scenario as given."""
     if isinstance(effects, dict):
         return effects
     from powertrain.workflows.operations import effect_scenario
     from powertrain.workflows.variants import parse_operations
-    return effect_scenario(parse_operations({"effect": list(effects)}, engine=engine))
+    return effect_scenario(parse_operations({"effect": args.texts(effects, "--effect")},
+                                            engine=engine))
 
 
 def _sweep_runup(engine, rpm, rate, sample_rate, effects, progress) -> SweepRunup:
@@ -360,7 +378,7 @@ def _sweep_runup(engine, rpm, rate, sample_rate, effects, progress) -> SweepRunu
     if effects:
         raise InputError("effects are not simulated in a sweep (use stepped run-ups)",
                          key="--effect")
-    rpm = _speeds(rpm)
+    rpm = args.speeds(rpm, increasing=False)
     factors = (lambda r: static_factors(engine, r)) if has_static_curves(engine) else None
     rec = simulate_sweep(engine, rpm[0], rpm[-1], rate, sample_rate, progress=progress,
                          static_factors=factors)
@@ -441,8 +459,9 @@ def mode_coordinates(engine, frequencies_hz) -> list:
 def engine_and_file(engine=None):
     """The engine to run and the file it came from: an Engine as it is (its ``file``), a
     path read, None the shipped ``engines/default.toml``."""
-    from powertrain.iotools.engine_file import DEFAULT_ENGINE_PATH, read_engine
+    from powertrain.iotools.engine_file import DEFAULT_ENGINE_PATH, engine_or_default, read_engine
     if engine is None or isinstance(engine, (str, os.PathLike)):
         path = str(engine or DEFAULT_ENGINE_PATH)
         return read_engine(path), path
+    engine = engine_or_default(engine)          # refuses what is not an Engine
     return engine, engine.file

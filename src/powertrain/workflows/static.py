@@ -9,6 +9,7 @@ import numpy as np
 from powertrain.errors import InputError
 from powertrain.results.static import StaticResult
 from powertrain.solvers.operating_point import operating_points
+from powertrain.workflows.arguments import speeds
 
 
 def static(engine=None, rpm=None) -> StaticResult:
@@ -18,8 +19,9 @@ def static(engine=None, rpm=None) -> StaticResult:
     ----------
     engine : Engine, str or Path, optional
         The engine, or its file (default: the shipped ``engines/default.toml``).
-    rpm : array_like, optional
-        Speeds [rpm] (default: the run-up's, 1000..6000 step 500).
+    rpm : array_like or str, optional
+        Speeds [rpm], or as ``--rpm`` writes them (``"1000:6000:500"``, ``"1500,3000"``)
+        (default: the run-up's, 1000..6000 step 500).
 
     Returns
     -------
@@ -33,13 +35,10 @@ def static(engine=None, rpm=None) -> StaticResult:
         the equilibrium is not found.
     """
     from powertrain.iotools.engine_file import engine_or_default
-    from powertrain.workflows.runup import default_rpm
+    rpm = speeds(rpm)
     engine = engine_or_default(engine)
     engine.require_excitation()
-    rpm = default_rpm() if rpm is None else np.atleast_1d(np.asarray(rpm, float))
     lo, hi = engine.speed_range_rpm()
-    if rpm.size == 0:
-        raise InputError("no speed given", key="--rpm")
     bad = rpm[~(np.isfinite(rpm) & (rpm >= lo - 1e-6) & (rpm <= hi + 1e-6))]
     if bad.size:
         raise InputError(f"{bad[0]:g} rpm is outside the engine's range {lo:g}..{hi:g} rpm",

@@ -4,12 +4,18 @@ an engine), from either solution method: :func:`stiffness`."""
 from __future__ import annotations
 
 import os
+from dataclasses import replace
 
 import numpy as np
 
-from powertrain.errors import InputError
+from powertrain.errors import InputError, require_finite, solved
+from powertrain.models.mount import MountModel
 from powertrain.physics.mount_elements import MountElement
 from powertrain.results.stiffness import AmplitudeStiffnessResult, StiffnessResult
+from powertrain.workflows.arguments import choice, frequencies, real
+
+#: Solution methods of :func:`stiffness` (``--method``).
+METHODS = ("frequency", "time")
 
 #: Frequencies of :func:`stiffness` by default (``powertrain stiffness --freq 1:400:1``) [Hz].
 DEFAULT_FREQUENCIES_HZ = np.arange(1.0, 401.0)
@@ -26,8 +32,9 @@ def stiffness(mount, *, engine=None, freq=None, method="frequency", force=None,
         (e.g. ``"torque_rod.x"``).
     engine : Engine, str or path, optional
         Engine (file) whose mount ``mount`` names.
-    freq : array_like, optional
-        Strictly increasing frequencies [Hz] (default :data:`DEFAULT_FREQUENCIES_HZ`).
+    freq : array_like or str, optional
+        Strictly increasing frequencies [Hz], or as ``--freq`` writes them (``"1:400:1"``,
+        ``"5,10,20"``) (default :data:`DEFAULT_FREQUENCIES_HZ`).
     method : {"frequency", "time"}
         Condensed network (eq. 39) or Newmark integration processed by FFT.
     force, engine_mass : float, optional
@@ -36,30 +43,62 @@ def stiffness(mount, *, engine=None, freq=None, method="frequency", force=None,
         transmitted force F_T.
     steps_per_period : int, optional
         Newmark steps per excitation period for the time method.
-    amplitude : array_like, optional
-        Test amplitudes X [m] (> 0): K*(f, X) of the sinusoidal displacement test with the
-        mount's amplitude law and friction (:func:`amplitude_stiffness`). Without: the
-        network alone, as fitted.
+    amplitude : array_like or str, optional
+        Test amplitudes X [m] (> 0), or as ``--amplitude`` writes them (a comma list in the
+        mount file's displacement unit, mm by default): K*(f, X) of the sinusoidal
+        displacement test with the mount's amplitude law and friction
+        (:func:`amplitude_stiffness`). Without: the network alone, as fitted.
 
     Returns
     -------
     StiffnessResult, or AmplitudeStiffnessResult with ``amplitude``
+
+    Raises
+    ------
+    InputError
+        Naming the mount file and key, or the option (``--freq``, ``--method`` ...), of bad
+        input.
     """
+    choice(method, METHODS, "--method")
+    engine_mass = real(engine_mass, "--engine-mass", unit="kg", optional=True)
+    force = real(force, "--force", unit="N", optional=True)
     _check_set_up(engine_mass, force)
-    f = DEFAULT_FREQUENCIES_HZ if freq is None else np.asarray(freq, float)
+    f = DEFAULT_FREQUENCIES_HZ if freq is None else frequencies(freq)
     if method == "time" and f[0] <= 0:
         raise InputError("the time method needs frequencies > 0 Hz", key="--freq")
     model, label = mount_model(mount, engine)
-    if amplitude is not None:
-        if engine_mass is not None:
-            raise InputError("--amplitude is the displacement test, without --engine-mass",
-                             key="--amplitude")
-        result = amplitude_stiffness(model, f, _amplitudes(amplitude), method,
-                                     steps_per_period)
-    else:
-        result = stiffness_table(model, f, method, engine_mass, force, steps_per_period)
-    result.label = model.name or label
-    return result
+    if amplitude is not None and engine_mass is not None:
+        raise InputError("--amplitude is the displacement test, without --engine-mass",
+                         key="--amplitude")
+    amps = _amplitude_argument(amplitude, mount if engine is None else None)
+
+    def compute():
+        if amps is None:
+            return stiffness_table(model, f, method, engine_mass, force, steps_per_period)
+        return amplitude_stiffness(model, f, amps, method, steps_per_period)
+    source, key = _source(mount, engine)
+    result = solved(compute, source, key)
+    require_finite(result.columns(), source, key)
+    return replace(result, label=model.name or label)
+
+
+def _amplitude_argument(amplitude, mount_file):
+    """``amplitude`` of :func:`stiffness` in [m]: None, numbers [m], or the ``--amplitude``
+    text in the unit of ``mount_file`` (:func:`parse_amplitudes`)."""
+    if amplitude is None:
+        return None
+    if isinstance(amplitude, str):
+        return parse_amplitudes(amplitude, mount_file)
+    return _amplitudes(amplitude)
+
+
+def _source(mount, engine):
+    """The file and key an error of the computation names: the mount file and its
+    parameters, or the engine file and the mount direction."""
+    if engine is None:
+        return (str(mount) if isinstance(mount, (str, os.PathLike)) else None), "parameters"
+    where = engine if isinstance(engine, (str, os.PathLike)) else getattr(engine, "file", None)
+    return (None if where is None else str(where)), f"--mount {mount}"
 
 
 def _check_set_up(engine_mass, force) -> None:
@@ -79,11 +118,18 @@ def mount_model(mount, engine=None):
     if engine is None:
         if isinstance(mount, (str, os.PathLike)):
             return read_mount(mount), str(mount)
-        return mount, "model"
+        if isinstance(mount, MountModel):
+            return mount, "model"
+        if mount is None:
+            raise InputError("give either MOUNT_FILE or --engine with --mount",
+                             key="MOUNT_FILE")
+        raise InputError(f"expected a MountModel or a mount file, got {type(mount).__name__}",
+                         key="MOUNT_FILE")
+    from powertrain.iotools.engine_file import engine_or_default, read_engine
     if isinstance(engine, (str, os.PathLike)):
-        from powertrain.iotools.engine_file import read_engine
         engine, where = read_engine(engine), str(engine)
     else:
+        engine = engine_or_default(engine)
         where = str(getattr(engine, "file", None) or engine.name)
     parts = str(mount or "").split(".")
     names = engine.mount_names
@@ -126,15 +172,19 @@ def stiffness_table(model, frequency_hz, method="frequency", engine_mass=None, f
         )
         if engine_mass is None:
             r = time_cross_point_stiffness(MountElement(model.network()), f, **kw)
-            return StiffnessResult(f, r.kcp, method, meta={"periodicity": r.periodicity})
+            return StiffnessResult(f, r.kcp, method, periodicity=r.periodicity)
         r = time_forced_response(model, f, engine_mass, force, **kw)
-        return StiffnessResult(f, r.kcp, method, r.x1, r.ft, meta={"periodicity": r.periodicity})
+        return StiffnessResult(f, r.kcp, method, r.x1, r.ft, periodicity=r.periodicity)
     raise ValueError(f"unknown method {method!r}")
 
 
 def _amplitudes(amplitude, unit="m") -> np.ndarray:
-    """The amplitudes as an array, refused unless positive, finite and distinct."""
-    a = np.atleast_1d(np.asarray(amplitude, float))
+    """The amplitudes as an array, refused unless numbers, positive, finite and distinct."""
+    try:
+        a = np.atleast_1d(np.asarray(amplitude, float)).ravel()
+    except (TypeError, ValueError):
+        raise InputError(f"cannot read amplitudes {str(amplitude)[:60]!r} [{unit}] (use "
+                         "numbers, e.g. 0.05,0.1,0.5)", key="--amplitude") from None
     if a.size == 0 or not np.all(np.isfinite(a)) or np.any(a <= 0):
         raise InputError(f"amplitudes [{unit}] must be positive and finite, got "
                          f"{a.tolist()}", key="--amplitude")
@@ -175,8 +225,7 @@ def amplitude_stiffness(model, frequency_hz, amplitude_m, method="frequency",
             from powertrain.solvers.mount_time_domain import time_cross_point_stiffness
             kw = {} if steps_per_period is None else {"steps_per_period": steps_per_period}
             r = time_cross_point_stiffness(element, f, a, **kw)
-            curves.append(StiffnessResult(f, r.kcp, method,
-                                          meta={"periodicity": r.periodicity}))
+            curves.append(StiffnessResult(f, r.kcp, method, periodicity=r.periodicity))
         else:
             raise ValueError(f"unknown method {method!r}")
     return AmplitudeStiffnessResult(np.asarray(amplitude_m, float), curves, method)
@@ -187,13 +236,14 @@ def parse_amplitudes(text: str, mount_file=None) -> np.ndarray:
     displacement unit (``[units] x``; mm when it declares none or with ``--engine``), in
     [m]."""
     from powertrain.units import to_si
-    unit = _length_unit(mount_file) if mount_file is not None else "mm"
+    unit = _length_unit(mount_file) if isinstance(mount_file, (str, os.PathLike)) else "mm"
     try:
         values = [float(part) for part in text.split(",") if part.strip()]
     except ValueError:
         raise InputError(f"cannot read {text!r} (use a comma list, e.g. 0.05,0.1,0.5)",
                          key="--amplitude") from None
-    where = {"file": str(mount_file), "key": "units.x"} if mount_file is not None else {}
+    where = {"file": str(mount_file), "key": "units.x"} \
+        if isinstance(mount_file, (str, os.PathLike)) else {}
     return to_si(_amplitudes(values, unit), unit, "length", **where)
 
 

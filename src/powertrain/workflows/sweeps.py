@@ -23,7 +23,7 @@ process per core does not oversubscribe.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -75,8 +75,7 @@ def run_task(task: SweepTask):
     else:
         from powertrain.workflows.runup import run_runup
         result = run_runup(task.engine, task.rpm, solver=task.solver, **task.options)
-    result.meta["variant"] = task.name
-    return result
+    return replace(result, meta={**result.meta, "variant": task.name})
 
 
 def run_sweep(tasks, executor=None, *, workers: int | None = None, progress: bool = False):

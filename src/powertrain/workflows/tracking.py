@@ -7,7 +7,7 @@ analysis.
 
 from __future__ import annotations
 
-import os
+from dataclasses import replace
 
 import numpy as np
 
@@ -16,7 +16,9 @@ from powertrain.analysis.orders import ORDERS
 from powertrain.analysis.phase import tdc_origin, to_tdc
 from powertrain.analysis.speed import speed_from_rpm, speed_from_tacho
 from powertrain.errors import InputError
+from powertrain.models.recording import RawRecording
 from powertrain.results.tracked import TrackedChannel, TrackedOrders
+from powertrain.workflows import arguments as args
 
 #: Highest tracked frequency allowed, as a fraction of the sampling rate (Nyquist 0.5).
 MAX_FREQUENCY_FRACTION = 0.4
@@ -86,10 +88,11 @@ def track(raw, *, orders=None, rpm_step=50.0, method="cot", bandwidth=None, chan
     TrackedOrders
         With ``spectra`` and ``maps`` when asked; ``to_text()`` is the command's report.
     """
+    rpm_step, bandwidth, pulses_per_rev, tdc_offset, spectrum_at = _numbers(
+        rpm_step, bandwidth, pulses_per_rev, tdc_offset, spectrum_at)
     _check_options(tacho_column, pulses_per_rev, map_channel, maps, tdc_offset,
                    cycle_reference)
-    if isinstance(orders, str):
-        orders = cot.parse_orders(orders)
+    orders = _orders(orders)
     overall_opts = _overall_options(overall, overall_band, as_quantity)
     rec = _recording(raw, channel_map, rpm_column, tacho_column, cycle_reference)
     use = "tacho" if tacho_column else "rpm" if rpm_column else "auto"
@@ -103,11 +106,33 @@ def track(raw, *, orders=None, rpm_step=50.0, method="cot", bandwidth=None, chan
         spectra = spectra and spectra.as_velocity()
     if spectra:
         _ = spectra.quantity                      # mixed quantities: fail before any file
-    tracked.spectra = spectra
-    if maps:
-        tracked.maps = _maps(rec, use, pulses_per_rev, rpm_step, _map_channel(rec, map_channel),
-                             float(np.max(tracked.orders)))
-    return tracked
+    drawn = _maps(rec, use, pulses_per_rev, rpm_step, _map_channel(rec, map_channel),
+                  float(np.max(tracked.orders))) if maps else None
+    return replace(tracked, spectra=spectra, maps=drawn)
+
+
+def _numbers(rpm_step, bandwidth, pulses_per_rev, tdc_offset, spectrum_at):
+    """The numeric options of :func:`track` as numbers (a string as the option writes it is
+    read), their ranges left to the checks that follow."""
+    return (args.real(rpm_step, "--rpm-step", unit="rpm"),
+            args.real(bandwidth, "--bandwidth", unit="Hz", optional=True),
+            args.integer(pulses_per_rev, "--pulses-per-rev", optional=True),
+            args.real(tdc_offset, "--tdc-offset", unit="deg", optional=True),
+            [args.real(r, "--spectrum-at", unit="rpm") for r in
+             ([spectrum_at] if args.is_number(spectrum_at) or isinstance(spectrum_at, str)
+              else spectrum_at or ())])
+
+
+def _orders(orders):
+    """``--orders`` as written (``0.5:8:0.5``, ``1,2,4.5``) or numbers: the orders checked
+    as :func:`~powertrain.analysis.order_tracking.parse_orders` checks them (None: the
+    default 0.5..8)."""
+    if orders is None:
+        return None
+    if isinstance(orders, str):
+        return cot.parse_orders(orders)
+    values = args.floats(orders, "--orders", "orders", "0.5:8:0.5 or 1,2,4", cot.MAX_ORDERS)
+    return cot.parse_orders(",".join(repr(float(v)) for v in values))
 
 
 def _check_options(tacho_column, pulses_per_rev, map_channel, maps, tdc_offset,
@@ -128,11 +153,9 @@ def _check_options(tacho_column, pulses_per_rev, map_channel, maps, tdc_offset,
 def _recording(raw, channel_map, rpm_column, tacho_column, cycle_reference=None):
     """The recording of ``raw`` (read through ``channel_map`` if a path)."""
     from powertrain.iotools.raw import read_raw
-    if not isinstance(raw, (str, os.PathLike)):
+    if isinstance(raw, RawRecording):
         return raw
-    if isinstance(channel_map, (str, os.PathLike)):
-        from powertrain.iotools.channel_map import read_channel_map
-        channel_map = read_channel_map(channel_map)
+    args.path_or(raw, (), "RAW", "a raw recording or its file")
     return read_raw(raw, channel_map, rpm=rpm_column, tacho=tacho_column,
                     cycle_reference=cycle_reference)
 
@@ -251,11 +274,10 @@ def track_recording(rec, orders=None, *, rpm_step=50.0, method="cot", use="auto"
         amp = to_tdc(amp, orders, origin[0])
         settings["phase"] = _phase_settings(orders, tdc_offset_deg, origin[1])
     tracked = [TrackedChannel(c.name, c.mount, c.side, c.direction, c.quantity) for c in chans]
-    result = TrackedOrders(rpm, orders, tracked, amp, method, rec.source, settings,
-                           list(rec.comments), recording=_summary(rec))
-    if overall is not None:
-        _add_overall(result, rec, chans, profile, overall.get("band"), overall.get("velocity"))
-    return result
+    level = None if overall is None else _overall(rec, chans, profile, orders, rpm, settings,
+                                                  overall.get("band"), overall.get("velocity"))
+    return TrackedOrders(rpm, orders, tracked, amp, method, rec.source, settings,
+                         list(rec.comments), level, recording=_summary(rec))
 
 
 def _track_channels(rec, chans, profile, orders, method, rpm_step, block_or_bandwidth,
@@ -318,21 +340,22 @@ def overall_band(orders, rpm, sample_rate):
         MAX_FREQUENCY_FRACTION * sample_rate
 
 
-def _add_overall(result, rec, chans, profile, band, velocity):
-    """Overall level per speed and channel into ``result`` (SI RMS; velocity if asked)."""
+def _overall(rec, chans, profile, orders, rpm, settings, band, velocity):
+    """Overall level per speed and channel (SI RMS; velocity if asked); its band,
+    revolutions and quantity are added to ``settings`` (the result's, still being built)."""
     from powertrain.analysis.overall import overall_rms
-    band = band or overall_band(result.orders, result.rpm, rec.sample_rate)
+    band = band or overall_band(orders, rpm, rec.sample_rate)
     turn = {"acceleration": -1, "velocity": 0, "displacement": 1}
     if velocity and any(c.quantity not in turn for c in chans):
         raise InputError("a force cannot be converted to velocity", file=rec.source,
                          key="--as")
     derivative = [turn[c.quantity] for c in chans] if velocity else None
-    B = int(result.settings.get("block_revolutions") or cot.block_revolutions(result.orders))
-    result.overall = overall_rms(rec.channel_matrix(chans), profile, result.rpm, B, band,
-                                 derivative)
-    result.settings.update({"overall_band_hz": [float(band[0]), float(band[1])],
-                            "overall_revolutions": B,
-                            "overall_quantity": "velocity" if velocity else "channel"})
+    B = int(settings.get("block_revolutions") or cot.block_revolutions(orders))
+    level = overall_rms(rec.channel_matrix(chans), profile, rpm, B, band, derivative)
+    settings.update({"overall_band_hz": [float(band[0]), float(band[1])],
+                     "overall_revolutions": B,
+                     "overall_quantity": "velocity" if velocity else "channel"})
+    return level
 
 
 def order_spectrum(rec, profile, rpm, top_order, *, quantity=None) -> TrackedOrders:

@@ -13,14 +13,25 @@ per variant plus the baseline, runs them with :func:`powertrain.workflows.sweeps
 
 from __future__ import annotations
 
-import os
-
 import numpy as np
 
 from powertrain.analysis.channel import Channel
 from powertrain.errors import InputError
 from powertrain.parallel import check_scheduler
 from powertrain.results.whatif import QUANTITIES, VariantRun, WhatIfResult
+from powertrain.solvers.steppers import SOLVERS
+from powertrain.workflows.arguments import (
+    choice,
+    default_rpm,
+    integer,
+    path_or,
+    real,
+    speeds,
+    texts,
+)
+
+#: Signals a what-if compares (``--signal``).
+SIGNALS = ("velocity", "mount_force")
 
 
 def describe_engine(engine, solver: str, rpm) -> dict:
@@ -37,24 +48,24 @@ def describe_engine(engine, solver: str, rpm) -> dict:
 
 def whatif(engine=None, *, scale=(), set=(), swap=(), move=(), rotate=(), effects=(),
            targets=(), variants=None, rpm=None, solver="harmonic", signal="velocity",
-           objective=None, measured=None, executor=None, workers=None,
-           progress=False) -> WhatIfResult:
-    """What-if: the baseline and variants of the mount system, the change in dB
-    (``powertrain whatif``).
+           objective=None, measured=None, executor=None, workers=None, progress=False,
+           rpm_step=None) -> WhatIfResult:
+    """What-if: the baseline and variants of the mount system, the change in dB (``whatif``).
 
     Parameters
     ----------
     engine : Engine, str, Path or None
         Baseline (default: the shipped ``engines/default.toml``).
-    scale, set, swap, move, rotate, effects : sequence of str
+    scale, set, swap, move, rotate, effects : str or sequence of str
         Operations as the command line writes them (``left.z.stiffness=1.2``...,
         :mod:`powertrain.workflows.variants`); together the variant ``command line``.
-    targets : sequence of str
+    targets : str or sequence of str
         Retune targets (``left.z:+20%:100-300Hz``), each a variant of its own.
     variants : str or Path, optional
         TOML file of named variants.
-    rpm : array_like, optional
-        Speed steps [rpm] (default 1000..6000 step 500).
+    rpm : array_like or str, optional
+        Speed steps [rpm] in the engine's range, or as ``"1000:6000:500"`` (default
+        1000..6000 step 500).
     solver : {"harmonic", "newmark"}
     signal : {"velocity", "mount_force"}
     objective : str, optional
@@ -68,29 +79,55 @@ def whatif(engine=None, *, scale=(), set=(), swap=(), move=(), rotate=(), effect
     workers : int, optional
         Local processes (default: the usable cores; 1 = serial).
     progress : bool
+    rpm_step : float, optional
+        The speed step [rpm] the report names (default: that of ``rpm``).
 
     Returns
     -------
     WhatIfResult
+
+    Raises
+    ------
+    InputError
+        Naming the option (``--scale``, ``--from`` ...) or file and key of bad input.
     """
-    from powertrain.workflows.runup import default_rpm, engine_and_file
+    from powertrain.workflows.runup import check_runup_settings, engine_and_file
+    workers = _checked(solver, signal, workers, executor)
+    engine, _ = engine_and_file(engine)
+    rpm = speeds(rpm)
+    check_runup_settings(engine, rpm, 1.0)
+    ops = {key: texts(value, f"--{key}") for key, value in (
+        ("scale", scale), ("set", set), ("swap", swap), ("move", move), ("rotate", rotate),
+        ("effect", effects))}
+    runs = command_variants(engine, ops, texts(targets, "--target"), variants)
+    goal = parse_objective(objective, engine.assemble().channels, rpm) if objective else None
+    measured = _measured(measured, engine)
+    return run_whatif(engine, runs, rpm, solver=solver, executor=executor, workers=workers,
+                      measured=measured, signal=signal, progress=progress, objective=goal,
+                      rpm_step=real(rpm_step, "--step", unit="rpm", optional=True))
+
+
+def _measured(measured, engine):
+    """The measurement to overlay: None, a MeasuredRunup, or its file read for ``engine``'s
+    mounts."""
+    from powertrain.iotools.measured import MeasuredRunup, read_measured
+    if measured is None or isinstance(measured, MeasuredRunup):
+        return measured
+    path_or(measured, (), "--measured", "a MeasuredRunup or its file")
+    return read_measured(measured, mounts=engine.mount_names)
+
+
+def _checked(solver, signal, workers, executor=None):
+    """``--solver``, ``--signal`` and a scheduler name checked before any work;
+    ``--workers`` as an int >= 1 (or None)."""
+    if isinstance(executor, str) or executor is None:
+        check_scheduler(executor)
+    choice(solver, tuple(SOLVERS), "--solver")
+    choice(signal, SIGNALS, "--signal")
+    workers = integer(workers, "--workers", optional=True)
     if workers is not None and workers < 1:
         raise InputError("must be >= 1", key="--workers")
-    if isinstance(executor, str) or executor is None:
-        check_scheduler(executor)                # before any work
-    engine, _ = engine_and_file(engine)
-    rpm = default_rpm() if rpm is None else np.atleast_1d(np.asarray(rpm, float))
-    ops = {"scale": scale, "set": set, "swap": swap, "move": move, "rotate": rotate,
-           "effect": effects}
-    runs = command_variants(engine, ops, targets, variants)
-    goal = parse_objective(objective, engine.assemble().channels, rpm) if objective else None
-    if isinstance(measured, (str, os.PathLike)):
-        from powertrain.iotools.measured import read_measured
-        measured = read_measured(measured, mounts=engine.mount_names)
-    result = run_whatif(engine, runs, rpm, solver=solver, executor=executor, workers=workers,
-                        measured=measured, signal=signal, progress=progress)
-    result.objective = goal
-    return result
+    return workers
 
 
 def command_variants(engine, ops: dict, targets=(), variants_file=None) -> list:
@@ -188,7 +225,8 @@ def variant_engine(engine, variant, **fit_kwargs):
 def run_whatif(engine, variants, rpm=None, *, solver: str = "harmonic", executor=None,
                workers: int | None = None, measured=None, quantities=QUANTITIES,
                signal: str = "velocity", progress: bool = False, fit_kwargs: dict | None = None,
-               runup_options: dict | None = None) -> WhatIfResult:
+               runup_options: dict | None = None, objective=None,
+               rpm_step: float | None = None) -> WhatIfResult:
     """Run the baseline and every variant; return their changes.
 
     Parameters
@@ -214,9 +252,13 @@ def run_whatif(engine, variants, rpm=None, *, solver: str = "harmonic", executor
         Passed to :func:`powertrain.workflows.fitting.fit_mount` for targets.
     runup_options : dict, optional
         Further keyword arguments of :func:`powertrain.workflows.runup.run_runup`.
+    objective : tuple, optional
+        The response to rank the variants by (:func:`parse_objective`).
+    rpm_step : float, optional
+        The speed step the report names [rpm] (default: that of ``rpm``; None for one
+        speed).
     """
     from powertrain.workflows.operations import response_scenario
-    from powertrain.workflows.runup import default_rpm
     from powertrain.workflows.sweeps import SweepTask, run_sweep
     rpm = default_rpm() if rpm is None else np.atleast_1d(np.asarray(rpm, float))
     names = [v.name for v in variants]
@@ -232,8 +274,9 @@ def run_whatif(engine, variants, rpm=None, *, solver: str = "harmonic", executor
                                response_scenario(v.operations)))
     results = run_sweep(tasks, executor, workers=workers, progress=progress)
     runs = [VariantRun(v.name, v.specs, r) for v, r in zip(variants, results[1:])]
+    if rpm_step is None and rpm.size > 1:
+        rpm_step = float(rpm[1] - rpm[0])
     return WhatIfResult(baseline=results[0], variants=runs,
                         description=describe_engine(engine, solver, rpm),
                         quantities=tuple(quantities), measured=measured, target_fits=fits,
-                        signal=signal, rpm_step=float(rpm[1] - rpm[0]) if rpm.size > 1
-                        else None)
+                        signal=signal, objective=objective, rpm_step=rpm_step)

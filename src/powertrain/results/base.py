@@ -1,0 +1,44 @@
+"""The protocol every result follows: ``to_text()`` (what its command prints),
+``plot(ax=None)`` (into a new figure, a Figure or SubFigure, or one Axes where the figure
+has one panel) and ``save(path)``, the writer chosen by the file's suffix."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from powertrain.errors import InputError
+from powertrain.plotting.style import close_figure
+
+#: Suffixes of an HDF5 file.
+HDF5_SUFFIXES = (".h5", ".hdf5")
+
+
+class Result:
+    """Base of the result classes: :meth:`save` picks the writer of a path's suffix among
+    :meth:`writers`; a subclass adds its own to the figure (``.png``)."""
+
+    def writers(self) -> dict:
+        """File suffix (``".csv"``) -> method writing this result to a path."""
+        return {".png": self.save_figure}
+
+    def save(self, path) -> Path:
+        """Write the result to ``path`` in the format its suffix names (:meth:`writers`:
+        e.g. ``.csv``, ``.json``, ``.h5``, ``.png``), atomically; returns the path.
+
+        Raises
+        ------
+        InputError
+            A suffix this result has no writer for.
+        """
+        writers = self.writers()
+        suffix = Path(path).suffix.lower()
+        if suffix not in writers:
+            raise InputError(f"cannot write {suffix or 'a file without a suffix'}: this "
+                             f"{type(self).__name__} writes {', '.join(writers)}",
+                             file=str(path), key="suffix")
+        writers[suffix](path)
+        return Path(path)
+
+    def save_figure(self, path) -> None:
+        """The figure of ``plot()`` as a PNG at ``path`` (the figure is closed after)."""
+        close_figure(self.plot(path=path))
