@@ -41,7 +41,7 @@ import numpy as np
 from benchmarks import truth as tr
 from benchmarks.kinds import IN_LIBRARY, KINDS
 from powertrain.workflows import measurement
-from powertrain.workflows.measurement import RPM, SyntheticCase, gap_stats
+from powertrain.workflows.measurement import RPM, SyntheticCase
 
 #: A case is detectable when its noise-free gap RMS reaches this [dB] (twice the 0.5 dB by
 #: which a model may miss and still count as agreeing) ...

@@ -41,7 +41,7 @@ def test_bad_plan_names_the_plan_file_and_key(tmp_path, default_engine, text, ke
 
 
 def test_load_is_refused_for_an_engine_with_measured_traces(tmp_path, default_engine):
-    from powertrain.validation.cases import traces_engine
+    from benchmarks.cases import traces_engine
     _csv(tmp_path / "a.csv")
     (tmp_path / "plan.toml").write_text('[[runs]]\nfile = "a.csv"\nload = 0.4\n')
     with pytest.raises(InputError, match="combustion model") as err:
@@ -105,9 +105,9 @@ def test_cli_bad_plan_is_one_line_naming_file_and_key(tmp_path):
 def test_plan_diagnosis_keeps_every_single_run_key_and_adds_runs(default_engine):
     """Two load cases of one stiffer mount from the truth generator: named; the plan's JSON has
     every key of a single-run diagnosis, and a run entry per run."""
+    from benchmarks.plans import make_plan_case
     from powertrain.diagnosis import diagnose
-    from powertrain.validation.cases import FLOOR
-    from powertrain.validation.plans import make_plan_case
+    from powertrain.workflows.measurement import FLOOR
     stiff = np.ones((3, 3))
     stiff[0] = 2.0                                   # the left mount twice as stiff
     case = make_plan_case(0, ["mount_temperature"], 1, phase="all", params={
