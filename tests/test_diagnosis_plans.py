@@ -144,3 +144,21 @@ def test_a_run_with_traces_uses_them_as_the_engines_combustion(tmp_path, default
     part, full = (x.excitation(1000.0).imep.mean() for x in (eng, e))
     ref = e.at_load(0.4).excitation(1000.0).imep.mean()
     assert part == pytest.approx(ref, rel=0.02) and part < 0.6 * full
+
+
+def test_the_shipped_plan_example_is_the_scripts_output(default_engine):
+    """examples/plan.toml and its runs (shipped, copied by ``powertrain examples``) are what
+    scripts/make_plan_example.py writes, marked SYNTHETIC, and read as a two-run plan."""
+    import importlib.util
+    from pathlib import Path
+    root = Path(__file__).resolve().parents[1]
+    spec = importlib.util.spec_from_file_location("make_plan_example",
+                                                  root / "scripts" / "make_plan_example.py")
+    script = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(script)
+    for name, text in script.plan_files().items():
+        shipped = (root / "examples" / name).read_text()
+        assert shipped == text, name
+        assert shipped.startswith("# SYNTHETIC"), name
+    plan = read_plan(root / "examples" / "plan.toml", default_engine)
+    assert [r.load for r in plan.runs] == [1.0, 0.4]
