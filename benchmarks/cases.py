@@ -121,7 +121,7 @@ def truth_velocity(engine, truth):
 
 
 def is_detectable(stats) -> bool:
-    """Detectability rule on :func:`gap_stats` (module docstring)."""
+    """Detectability rule on :func:`~powertrain.workflows.measurement.gap_stats` (module docstring)."""
     return bool(stats[0] >= DETECT_RMS_DB or stats[1] >= DETECT_LOCAL_DB)
 
 

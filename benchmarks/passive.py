@@ -24,9 +24,10 @@ import functools
 import numpy as np
 
 from benchmarks import truth as tr
-from benchmarks.cases import RPM, Case, draw_case, traces_engine
+from benchmarks.cases import Case, draw_case, traces_engine
 from benchmarks.kinds import KINDS
 from powertrain.analysis.channel import passive_name
+from powertrain.workflows.measurement import RPM
 
 #: Engine kinds of the passive-side cases.
 ENGINE_KINDS = ("body_sz", "body_traces")
