@@ -3,7 +3,7 @@
 
 Truth (:mod:`benchmarks`): time-domain Newmark run-ups of the default engine (or
 the same engine with measured pressure traces) on a 100-rpm grid, assembled by the
-validation package's own code, with higher-fidelity hidden effects (mount temperature per
+benchmark's own code, with higher-fidelity hidden effects (mount temperature per
 mount and direction, amplitude-dependent elastomer, per-shaft balancer errors, one weak
 cylinder, sensor gains/rotation/cross-axis, chassis bases and modes; out of the library: a
 sensor-bracket resonance, powertrain bending), log-normal scatter (0.5–1 dB) and a complex

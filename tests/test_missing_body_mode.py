@@ -296,7 +296,7 @@ def test_a_mode_of_its_own_shape_or_on_a_rigid_chassis_restates_nothing(modal, r
 
 
 def test_shapes_drawn_for_a_missing_mode_rarely_restate_chassis_modes(modal):
-    """The truth generator's missing modes (validation.kinds: shape, frequency, mass) restate
+    """The truth generator's missing modes (benchmarks.kinds: shape, frequency, mass) restate
     chassis_modes (shape paired with one of the default body's modes at MAC >= MAC_PAIRED,
     within chassis_modes' reach) in fewer than 1 draw in 100 (about 1 in 450 at MAC_PAIRED
     0.8): the restatement rule leaves truly missing modes alone (docs/guide/diagnose.md,
@@ -362,8 +362,8 @@ def test_band_refits_stop_at_their_budget_and_say_so(rigid, monkeypatch):
 
 @pytest.mark.slow
 def test_a_heavy_mode_far_from_the_middle_grid_mass_is_found():
-    """A regression draw (validation generator, seed [5150, 28], phase on both sides): a
-    28.5 kg mode at 91.3 Hz whose fit from the one middle grid mass (12 kg) ended at 64 Hz,
+    """A regression draw (the benchmark's truth generator, seed [5150, 28], phase on both
+    sides): a 28.5 kg mode at 91.3 Hz whose fit from the one middle grid mass (12 kg) ended at 64 Hz,
     12 kg, 12 % damping, BIC +2712 against -2728 from the truth; from the grid masses the
     fit finds it (frequency within 5 %, modal mass within 30 %: the rate tests' rule)."""
     from benchmarks.passive import detectable_case, passive_engines
