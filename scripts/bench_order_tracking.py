@@ -27,13 +27,17 @@ from __future__ import annotations
 
 import argparse
 import os
+import sys
 import time
+from pathlib import Path
 
 import numpy as np
 
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))  # benchmarks/, not installed
+
+from benchmarks.signals import linear_sweep, order_sum
 from powertrain.analysis.order_tracking import block_revolutions
 from powertrain.models.recording import RawChannel, RawRecording
-from powertrain.validation.signals import linear_sweep, order_sum
 from powertrain.workflows.tracking import track_recording
 
 FS = 25600.0

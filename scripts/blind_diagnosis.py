@@ -1,22 +1,22 @@
 #!/usr/bin/env python
 """Blind test of ``powertrain diagnose`` on run-ups made by an independent simulator.
 
-Truth (:mod:`powertrain.validation`): time-domain Newmark run-ups of the default engine (or
+Truth (:mod:`benchmarks`): time-domain Newmark run-ups of the default engine (or
 the same engine with measured pressure traces) on a 100-rpm grid, assembled by the
-validation package's own code, with higher-fidelity hidden effects (mount temperature per
+benchmark's own code, with higher-fidelity hidden effects (mount temperature per
 mount and direction, amplitude-dependent elastomer, per-shaft balancer errors, one weak
 cylinder, sensor gains/rotation/cross-axis, chassis bases and modes; out of the library: a
 sensor-bracket resonance, powertrain bending), log-normal scatter (0.5–1 dB) and a complex
 noise floor. The diagnosis sees only the measured curves and the baseline engine, through
 :func:`powertrain.diagnosis.diagnose`; its answer is read through ``to_dict()``.
 
-Scores (:mod:`powertrain.validation.scoring`; detectability from the noise-free truth,
+Scores (:mod:`benchmarks.scoring`; detectability from the noise-free truth,
 never shown to the diagnosis) are printed with 95 % Wilson intervals; the line before the
 last has the raw scores, the last line ``top1=... shrink_median=... false_claims=...
 unexplained_ok=...``.
 
 With ``--plan passive`` the cases measure both sides of every mount on the modal-body
-engine (:mod:`powertrain.validation.passive`: body modes changed, one mount's stiffness
+engine (:mod:`benchmarks.passive`: body modes changed, one mount's stiffness
 changed, balancer errors, a body mode the file lacks, effect-free) and the lines
 ``passive: chassis_and_mount_top1=...`` (issue 13's target) and ``two-sided:
 sides_right=... missing_mode_found=...`` (issue 21's) are printed before the raw scores.
@@ -36,14 +36,18 @@ from __future__ import annotations
 import argparse
 import json
 import os
+import sys
 import time
 from collections import Counter, defaultdict
+from pathlib import Path
 
 import numpy as np
 
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))  # benchmarks/, not installed
+
 
 def _levels(case, m, d, q, rpm, which):
-    from powertrain.validation.cases import RPM
+    from powertrain.workflows.measurement import RPM
     idx = np.searchsorted(RPM, rpm)
     if which == "measured":
         return case.measured.curves[(m, d, q)][1][idx]
@@ -54,19 +58,19 @@ def _levels(case, m, d, q, rpm, which):
 
 def _make(i, names, eng, seed):
     """(case, engine handed to the diagnosis): passive-side engine kinds (``body_*``) from
-    :mod:`powertrain.validation.passive`, the others from :mod:`powertrain.validation.cases`."""
+    :mod:`benchmarks.passive`, the others from :mod:`benchmarks.cases`."""
     if eng.startswith("body_"):
-        from powertrain.validation.passive import make_passive_case, passive_engines
+        from benchmarks.passive import make_passive_case, passive_engines
         return make_passive_case(i, names, eng, seed), passive_engines()[eng]
-    from powertrain.validation.cases import engines, make_case
+    from benchmarks.cases import engines, make_case
     return make_case(i, names, eng, seed), engines()[eng]
 
 
 def where_case(task):
     """Make one two-sided case and run only the diagnosis' "where" step (side attribution);
-    its row for :func:`powertrain.validation.scoring.sides_rate`."""
+    its row for :func:`benchmarks.scoring.sides_rate`."""
     from powertrain.diagnosis.sides import measured_sides
-    from powertrain.validation.cases import FLOOR
+    from powertrain.workflows.measurement import FLOOR
     i, names, eng, seed = task
     case, engine = _make(i, names, eng, seed)
     t0, c0 = time.perf_counter(), time.process_time()
@@ -79,9 +83,9 @@ def where_case(task):
 
 def run_case(task):
     """Make one case, diagnose it, return its row (plain JSON types)."""
+    from benchmarks.scoring import noise_free_shrink
     from powertrain.diagnosis import diagnose
-    from powertrain.validation.cases import FLOOR
-    from powertrain.validation.scoring import noise_free_shrink
+    from powertrain.workflows.measurement import FLOOR
     i, names, eng, seed = task
     t0 = time.perf_counter()
     case, engine = _make(i, names, eng, seed)
@@ -173,7 +177,7 @@ def _print_cases(rows):
 
 
 def _right(r):
-    from powertrain.validation.scoring import false_claim, is_unexplained, top1_hit
+    from benchmarks.scoring import false_claim, is_unexplained, top1_hit
     if r["category"] == "none":
         return not false_claim(r)
     return is_unexplained(r) if r["category"] == "out" else top1_hit(r)
@@ -198,7 +202,7 @@ def _print_misses(rows):
 
 def _where_only(tasks, args):
     """The side attribution of every case (``--where-only``): per kind, then the rate."""
-    from powertrain.validation.scoring import PASSIVE_WHERE, sides_rate
+    from benchmarks.scoring import PASSIVE_WHERE, sides_rate
     rows = _run_all(tasks, args.jobs, args.scheduler, where_case)
     for kind, loc in PASSIVE_WHERE.items():
         sel = [r for r in rows if r["detectable"] and r["names"] == [kind]]
@@ -223,7 +227,7 @@ def main(argv=None):
                     help="make the cases and print their truth, without diagnosing them")
     ap.add_argument("--plan", choices=("default", "passive"), default="default",
                     help="'passive': cases with both sides of every mount measured on the "
-                         "modal-body engine (powertrain.validation.passive)")
+                         "modal-body engine (benchmarks.passive)")
     ap.add_argument("--kind", default=None,
                     help="every case of this one truth kind (e.g. amplitude_elastomer), "
                          "engines alternating single-zone and traces")
@@ -231,9 +235,9 @@ def main(argv=None):
                     help="with --plan passive: only the 'where' step (side attribution) of "
                          "every case, no fits; prints the sides_right line")
     args = ap.parse_args(argv)
-    from powertrain.validation.cases import DETECT_LOCAL_DB, DETECT_RMS_DB, case_plan
-    from powertrain.validation.passive import passive_plan
-    from powertrain.validation.scoring import (
+    from benchmarks.cases import DETECT_LOCAL_DB, DETECT_RMS_DB, case_plan
+    from benchmarks.passive import passive_plan
+    from benchmarks.scoring import (
         TARGETS,
         meets_targets,
         passive_line,

@@ -1,8 +1,9 @@
-"""How often CI passes a time limit, from the two rate tests whose length varies.
+"""How long the two rate tests whose length varies run on fresh draws (``--fresh``).
 
-Most of CI (``bash .ci/run``) is fixed work; what varies is how many cases the passive-side
-and missing-mode rate tests draw before their group-sequential rule decides
-(``tests/rates.py``). This script sums the exact distributions of their stopping case counts
+CI runs the rate tests on fixed seeds, so its length is fixed; on fresh draws
+(``python -m benchmarks.rates --fresh``) what varies is how many cases the passive-side and
+missing-mode rate tests draw before their group-sequential rule decides
+(:mod:`benchmarks.sizing`). This script sums the exact distributions of their stopping case counts
 (``rates.stopping_counts``: every path of the batches, at the given true rates) over a
 linear model of CI's wall time:
 
@@ -25,8 +26,8 @@ import argparse
 import sys
 from pathlib import Path
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
-import rates  # noqa: E402
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+from benchmarks import sizing as rates  # noqa: E402
 
 
 def stopping_counts(target, rate) -> dict:

@@ -25,6 +25,7 @@ import time
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))  # benchmarks/, not installed
 
 import fuzz_harness as fh  # noqa: E402
 from hypothesis import HealthCheck, Phase, given, settings  # noqa: E402

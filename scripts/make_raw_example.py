@@ -17,15 +17,18 @@ Usage: python scripts/make_raw_example.py [--out examples]
 from __future__ import annotations
 
 import argparse
+import sys
 from pathlib import Path
 
 import numpy as np
 
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))  # benchmarks/, not installed
+
+from benchmarks.signals import tacho
 from powertrain.iotools.engine_file import DEFAULT_ENGINE_PATH, read_engine
 from powertrain.iotools.raw_csv import write_raw_csv
 from powertrain.models.recording import RawChannel, RawRecording
 from powertrain.solvers.speed_ramp import simulate_sweep
-from powertrain.validation.signals import tacho
 
 RPM0, RPM1, RATE, FS = 1500.0, 2500.0, 500.0, 2048.0
 MAP = """# Channel map of examples/raw-runup-lab.csv (SYNTHETIC): file channel -> mount point

@@ -1,10 +1,10 @@
 #!/usr/bin/env python
 """Blind benchmark of the diagnosis with order phase and with test plans (issue 21).
 
-Truth: the independent generator (:mod:`powertrain.validation`: Newmark run-ups on its own
+Truth: the independent generator (:mod:`benchmarks`: Newmark run-ups on its own
 assembly), measured with log-normal scatter, a complex noise floor and, with phase, the
 phase twin of the scatter and a TDC error of 1° crank per run
-(:func:`powertrain.validation.cases.measure`). Fresh cases per seed; rates with 95 % Wilson
+(:func:`powertrain.workflows.measurement.measure`). Fresh cases per seed; rates with 95 % Wilson
 intervals.
 
 ``--bench cylinder``: one weak cylinder (engines alternating single-zone / measured traces),
@@ -13,7 +13,7 @@ detectable cases whose named cylinder and sign are right; with ``--phase whole``
 reference) ``cylinder_whole: truth_among_named=... wrong_name=...`` counts the cases whose
 named set holds the truth, and those naming a set without it.
 
-``--bench loads``: two-run plans (loads 1.0 and 0.4, :mod:`powertrain.validation.plans`)
+``--bench loads``: two-run plans (loads 1.0 and 0.4, :mod:`benchmarks.plans`)
 of a stiffer/softer mount, amplitude-dependent mounts, a weak cylinder, a balancer error
 and effect-free cars, engine side only; each run diagnosed alone and the plan; the line
 ``plans: plan_right=... best_single_right=... plan_less_right=... wrong_names=...
@@ -24,10 +24,10 @@ kinds issue 21 asks to tell apart there (amplitude-dependent mounts, a stiffer/s
 the line ``two_sided_plans: named_right=... ambiguous=... wrong_names=...``.
 
 ``--bench missing_mode``: a body mode the modal-body engine's file lacks, both sides of
-every mount measured (:mod:`powertrain.validation.passive`, detectable draws, engines
+every mount measured (:mod:`benchmarks.passive`, detectable draws, engines
 alternating); the last line ``missing_mode_found=...`` counts the cases whose claim is
 ``missing_body_mode`` with frequency within 5 % and modal mass within 30 % of the truth
-(:func:`powertrain.validation.scoring.mode_found`, the criterion of
+(:func:`benchmarks.scoring.mode_found`, the criterion of
 tests/test_two_sided_rates.py).
 
 Every case prints the CPU seconds of its diagnoses; the closing lines the medians.
@@ -41,8 +41,11 @@ import argparse
 import os
 import sys
 import time
+from pathlib import Path
 
 import numpy as np
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))  # benchmarks/, not installed
 
 LOAD_KINDS = ("mount_temperature", "amplitude_elastomer", "weak_cylinder", "balancer_shafts",
               "none")
@@ -56,7 +59,7 @@ def _load_kinds(sides):
 
 def _diagnose(measured, engine):
     from powertrain.diagnosis import diagnose
-    from powertrain.validation.cases import FLOOR
+    from powertrain.workflows.measurement import FLOOR
     c0 = time.process_time()
     d = diagnose(measured, engine, noise_floor=FLOOR, progress=False).to_dict()
     return d, time.process_time() - c0
@@ -68,7 +71,7 @@ def _claim(d):
 
 def cylinder_case(task):
     """One weak-cylinder case: truth, finding, CPU seconds."""
-    from powertrain.validation.cases import engines, make_case
+    from benchmarks.cases import engines, make_case
     i, seed, phase = task
     eng = ("sz", "traces")[i % 2]
     case = make_case(i, ["weak_cylinder"], eng, seed, phase=None if phase == "none" else phase)
@@ -83,7 +86,7 @@ def cylinder_case(task):
 
 def loads_case(task):
     """One two-run plan case: the singles' and the plan's answers, CPU seconds."""
-    from powertrain.validation.plans import make_plan_case
+    from benchmarks.plans import make_plan_case
     i, seed, phase, sides = task
     kinds = _load_kinds(sides)
     kind = kinds[i % len(kinds)]
@@ -101,7 +104,7 @@ def loads_case(task):
 
 def missing_mode_case(task):
     """One detectable missing-mode case (both sides): truth, fitted mode, CPU seconds."""
-    from powertrain.validation.passive import detectable_case, passive_engines
+    from benchmarks.passive import detectable_case, passive_engines
     i, seed, phase = task
     eng = ("body_sz", "body_traces")[i % 2]
     case = detectable_case("missing_mode", eng, np.random.default_rng(seed), i,
@@ -115,7 +118,7 @@ def missing_mode_case(task):
 
 
 def report_missing_mode(rows, phase):
-    from powertrain.validation.scoring import MISSING_MODE_TARGET, mode_found
+    from benchmarks.scoring import MISSING_MODE_TARGET, mode_found
     for r in rows:
         fit = (r["parameters"] or {}).get("missing_body_mode", {})
         t = r["truth_mode"]
@@ -140,7 +143,7 @@ def _run(fn, tasks, jobs):
 
 
 def _rate(k, n):
-    from powertrain.validation.scoring import Rate
+    from benchmarks.scoring import Rate
     return str(Rate(int(k), int(n)))
 
 

@@ -30,9 +30,11 @@ from pathlib import Path
 import numpy as np
 from click.testing import CliRunner
 
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))  # benchmarks/, not installed
+
+from benchmarks import signals
 from powertrain.cli import main as cli
 from powertrain.iotools.measured import read_measured
-from powertrain.validation import signals
 
 WRITERS = {"csv": ("csv", "powertrain.iotools.raw_csv", "write_raw_csv"),
            "hdf5": ("h5", "powertrain.iotools.raw_hdf5", "write_raw_hdf5"),

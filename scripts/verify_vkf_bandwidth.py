@@ -1,7 +1,7 @@
 """Vold-Kalman default bandwidth against swept single-DOF resonances (issue 18, item 5).
 
 Order 2 sweeps 1000 -> 6000 rpm at 100 and 500 rpm/s through a resonance at 50 or 150 Hz with
-damping 0.005 ... 0.05 (:func:`powertrain.validation.signals.swept_resonance`, the exact response on the
+damping 0.005 ... 0.05 (:func:`benchmarks.signals.swept_resonance`, the exact response on the
 sample grid). For each case the peak of the tracked order 2 is compared with the peak of the
 fine-grid envelope of the response, for the default bandwidth (only order 2 tracked, so the
 order-spacing rule does not bind) and for the former fixed 0.5 Hz; COT for reference.
@@ -12,9 +12,14 @@ Prints one line per case and, last, the worst default-bandwidth peak error.
 
 from __future__ import annotations
 
+import sys
+from pathlib import Path
+
 import numpy as np
 
-from powertrain.validation import signals
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))  # benchmarks/, not installed
+
+from benchmarks import signals
 from powertrain.workflows.tracking import track_recording
 
 FS = 4096.0

@@ -1,9 +1,13 @@
-"""Shared test set-up: the data paths, the engines (each file read once per session) and the
-assembled rigid system.
+"""Shared test set-up: the data paths, the engines (each file read once per session), the
+assembled rigid system and hypothesis' fixed draws.
 
 ``engine`` is the engine of the test module: the file named by the module's
 ``ENGINE_FILE`` (e.g. ``ENGINE_FILE = MODAL``) or the shipped default engine. Engines are
 immutable, so one object per file serves every module.
+
+Every random draw of the suite is seeded (the seed is named in the failure message);
+hypothesis runs derandomised (the profile ``fixed``: the same examples every run, the
+failing example printed when one fails).
 """
 
 from __future__ import annotations
@@ -12,8 +16,12 @@ import functools
 from pathlib import Path
 
 import pytest
+from hypothesis import settings
 
 from powertrain.iotools.engine_file import DEFAULT_ENGINE_PATH, read_engine
+
+settings.register_profile("fixed", derandomize=True)
+settings.load_profile("fixed")
 
 ROOT = Path(__file__).resolve().parents[1]
 ENGINES = ROOT / "engines"

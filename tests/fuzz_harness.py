@@ -269,8 +269,8 @@ def seeds(worker: Worker, folder: Path) -> dict:
     assert res["code"] == 0, res
     _SEEDS["sim.h5"] = (folder / "sim.h5").read_bytes()
     _SEEDS["sim.csv"] = (folder / "sim.csv").read_bytes()
+    from benchmarks import signals
     from powertrain.iotools.raw_csv import write_raw_csv
-    from powertrain.validation import signals
     write_raw_csv(folder / "raw.csv", signals.analytic_sweep(fs=2048.0, duration=2.0,
                                                              rpm0=1500.0, rpm1=3000.0),
                   comment="SYNTHETIC: analytic sweep (fuzz seed)")

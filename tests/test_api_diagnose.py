@@ -17,9 +17,9 @@ from powertrain.diagnosis import DiagnosisResult, diagnose
 from powertrain.errors import InputError
 from powertrain.results.fit import FitResult
 from powertrain.results.stiffness import StiffnessResult
-from powertrain.validation.synth import SynthCase, synth
 from powertrain.workflows.fitting import fit_mount
 from powertrain.workflows.stiffness import stiffness
+from powertrain.workflows.synth import SynthCase, synth
 
 matplotlib.use("Agg")
 MOUNT = MOUNTS / "hydraulic-engine-mount-z.toml"

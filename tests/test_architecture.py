@@ -201,3 +201,51 @@ def test_the_size_checker_can_fail(tmp_path):
         == {"f", "c"}
     assert [c[1] for c in m.long_commands] == ["c"]
     assert len(m.variant_comparisons) == 1
+
+
+# ------------------------------------------------- the benchmark's scaffolding (issue 36)
+#: Modules of the blind benchmark and the rate tests, which live in ``benchmarks/`` (not
+#: installed): the truth generator, its truth effects, case plans, scoring and rate sizing.
+SCAFFOLDING = {"validation", "truth", "kinds", "cases", "passive", "plans", "scoring",
+               "sizing", "rates", "rate_tests", "signals"}
+#: Names only the scaffolding defines (a module moved back under another name still shows).
+SCAFFOLDING_DEFS = ("simulate_truth", "case_plan", "is_detectable", "wilson_interval",
+                    "sequential_plan", "make_plan_case", "passive_plan", "fresh_seed")
+
+
+def scaffolding_in(package: Path) -> list:
+    """Modules and packages of ``package`` named as the scaffolding, and functions the
+    scaffolding defines, as ``path`` or ``path:name``."""
+    found = [str(p.relative_to(package)) for p in package.rglob("*")
+             if (p.suffix == ".py" and p.stem in SCAFFOLDING)
+             or ((p / "__init__.py").is_file() and p.name in SCAFFOLDING)]
+    for path in package.rglob("*.py"):
+        tree = ast.parse(path.read_text(encoding="utf-8"), filename=str(path))
+        found += [f"{path.relative_to(package)}:{node.name}" for node in ast.walk(tree)
+                  if isinstance(node, (ast.FunctionDef, ast.ClassDef))
+                  and node.name in SCAFFOLDING_DEFS]
+    return found
+
+
+def test_the_package_holds_no_truth_generator_case_plan_scoring_or_rate_sizing():
+    """The installed package is the product: the benchmark's scaffolding is in benchmarks/,
+    beside it, and the wheel takes only src/ (``[tool.setuptools.packages.find]``; the wheel
+    test checks the built wheel the same way)."""
+    try:
+        import tomllib
+    except ModuleNotFoundError:                     # pragma: no cover (Python < 3.11)
+        import tomli as tomllib
+    assert scaffolding_in(PACKAGE) == []
+    root = PACKAGE.parents[1]
+    conf = tomllib.loads((root / "pyproject.toml").read_text(encoding="utf-8"))
+    assert conf["tool"]["setuptools"]["packages"]["find"]["where"] == ["src"]
+    assert (root / "benchmarks" / "__init__.py").is_file()
+    assert {p.stem for p in (root / "benchmarks").glob("*.py")} >= SCAFFOLDING - {"validation"}
+
+
+def test_the_scaffolding_checker_can_fail(tmp_path):
+    pkg = tmp_path / "powertrain"
+    (pkg / "validation").mkdir(parents=True)
+    (pkg / "validation" / "__init__.py").write_text("")
+    (pkg / "tools.py").write_text("def wilson_interval(k, n):\n    return k / n\n")
+    assert sorted(scaffolding_in(pkg)) == ["tools.py:wilson_interval", "validation"]

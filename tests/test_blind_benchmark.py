@@ -3,7 +3,6 @@ dask LocalCluster gives exactly the rows of a serial run."""
 
 import importlib.util
 import json
-import os
 import re
 from pathlib import Path
 
@@ -12,6 +11,8 @@ import pytest
 SCRIPT = Path(__file__).resolve().parents[1] / "scripts" / "blind_diagnosis.py"
 LAST = re.compile(r"^top1=\S+ shrink_median=\S+ false_claims=\S+ unexplained_ok=\S+$")
 TIMES = ("t_gen", "t_diag", "cpu_diag")
+#: Seed of the one-case benchmark (named in the failure message).
+SEED = 31
 
 
 def _script():
@@ -28,7 +29,7 @@ def _rows(path):
 @pytest.mark.slow
 def test_local_cluster_benchmark_equals_serial(tmp_path, capsys):
     pytest.importorskip("distributed")
-    seed = str(int.from_bytes(os.urandom(4), "little"))
+    seed = str(SEED)
     mod = _script()
     mod.main(["--cases", "1", "--seed", seed, "--scheduler", "serial", "--jobs", "1",
               "--dump", str(tmp_path / "serial.json")])

@@ -15,8 +15,8 @@ from powertrain.cli import main
 from powertrain.effects import EFFECTS
 from powertrain.iotools.engine_file import DEFAULT_ENGINE_PATH, read_engine
 from powertrain.iotools.measured import read_measured
-from powertrain.validation.synth import TRUTH_ALIASES, TRUTH_EFFECTS, make_case
 from powertrain.workflows.fitting import DEFAULT_SEED, DEFAULT_STARTS
+from powertrain.workflows.synth import TRUTH_ALIASES, TRUTH_EFFECTS, make_case
 
 MOUNT = Path(DEFAULT_ENGINE_PATH).parents[1] / "mounts" / "hydraulic-engine-mount-z.toml"
 QUICK = ["--from", "1000", "--to", "2000", "--step", "500", "--solver", "harmonic"]

@@ -4,7 +4,7 @@ linearisation, and blind diagnosis of synthetic data with a known (hidden) answe
 Oracles: the run-up's own harmonic solver and the assembled model with a compliant base
 (exact to round-off); a time-domain Newmark integration with the amplitude-dependent
 stiffness updated cycle by cycle (agreement limited by the 1° Newmark step); synthetic
-measurements from :mod:`powertrain.validation.synth` whose truth the diagnosis never sees.
+measurements from :mod:`powertrain.workflows.synth` whose truth the diagnosis never sees.
 """
 
 from __future__ import annotations
@@ -16,14 +16,15 @@ import pytest
 from amplitude_oracle import time_domain_amplitude_check
 from click.testing import CliRunner
 
+from benchmarks.cases import DETECT_RMS_DB, is_detectable
 from powertrain.cli import main
 from powertrain.diagnosis import diagnose
 from powertrain.effects import EFFECTS, Effect, predict
 from powertrain.errors import InputError
 from powertrain.iotools.measured import MeasuredRunup
 from powertrain.solvers.fast_harmonic import HarmonicModel
-from powertrain.validation.synth import make_case
 from powertrain.workflows.runup import run_runup
+from powertrain.workflows.synth import make_case
 
 #: Same linear model solved two ways: only round-off separates them.
 EXACT = 1e-9
@@ -145,7 +146,7 @@ def test_out_of_library_channel_constant_gap_is_not_taken_for_a_sensor_error(eng
     case = make_case(engine, ["powertrain_bending"], 3, rpm=np.arange(1000.0, 6000.1, 100.0),
                      noise_db=0.7, params={"powertrain_bending": {"freq": 50.0, "kappa": 0.5,
                                                                   "zeta": 0.06}})
-    assert case.detectable
+    assert is_detectable(case.stats)
     res = diagnose(case.measured, engine, pairs=False, band_check=False)
     share = res.parts["share_alone"]
     assert share["const"] == max(share.values())          # looks like a sensor gain ...
@@ -180,18 +181,17 @@ def test_structured_residual_statistic():
 def test_detectability_classification(engine):
     """The generator, which knows the truth, classifies a ``synth`` case with the one
     detectability rule of the truth generators (noise-free gap RMS >= 1 dB or its 95th
-    percentile >= 3 dB, :func:`powertrain.validation.cases.is_detectable`); the diagnosis
+    percentile >= 3 dB, :func:`benchmarks.cases.is_detectable`); the diagnosis
     never sees it."""
-    from powertrain.validation.cases import DETECT_RMS_DB
     rpm = np.arange(1000.0, 6000.1, 100.0)
     none = make_case(engine, [], 1, rpm=rpm)
-    assert none.stats == (0.0, 0.0) and not none.detectable
+    assert none.stats == (0.0, 0.0) and not is_detectable(none.stats)
     weak = make_case(engine, ["mount_temperature"], 2, rpm=rpm, noise_db=1.0,
                      params={"mount_temperature": {"spring": np.full(9, 1.05),
                                                    "damper": np.full(9, 1.03)}})
-    assert weak.effect_rms_db < 0.5 * DETECT_RMS_DB and not weak.detectable
+    assert weak.effect_rms_db < 0.5 * DETECT_RMS_DB and not is_detectable(weak.stats)
     strong = make_case(engine, ["balancer_shafts"], 5, rpm=rpm)
-    assert strong.effect_rms_db > DETECT_RMS_DB and strong.detectable
+    assert strong.effect_rms_db > DETECT_RMS_DB and is_detectable(strong.stats)
 
 
 def test_scaled_two_port_kernel_equals_lapack_condensation(engine):
@@ -248,9 +248,10 @@ def test_sensor_error_rotates_then_scales_each_triad(engine):
 def test_the_band_check_enters_nothing_but_its_own_entry():
     """The band check refits the chosen effect on speed bands after the verdict: a diagnosis
     without it has the same verdict, claim, parameters and ranking (the rate tests skip it,
-    tests/rates.py ``diagnosis``), and only its ``confounding_check`` entry empty."""
-    from powertrain.validation.cases import FLOOR, engines
-    from powertrain.validation.cases import make_case as make_truth_case
+    benchmarks/rate_tests.py ``diagnosis``), and only its ``confounding_check`` entry empty."""
+    from benchmarks.cases import engines
+    from benchmarks.cases import make_case as make_truth_case
+    from powertrain.workflows.measurement import FLOOR
     case = make_truth_case(0, ["mount_temperature"], "sz", 11)
     runs = [diagnose(case.measured, engines()["sz"], noise_floor=FLOOR, band_check=bc,
                      progress=False).to_dict() for bc in (True, False)]

@@ -84,9 +84,9 @@ def test_whole_orders_cannot_tell_a_weak_cylinder_from_a_strong_one_on_the_other
 def test_cylinder_load_derivative_is_exact_by_one_forward_difference(kind):
     """The cached derivative (forward differences) equals central differences to round-off:
     the load is linear in the cylinder factors for the single-zone model and for traces."""
+    from benchmarks.cases import engines
     from powertrain.effects.cylinder_imbalance import STEP
     from powertrain.solvers.fast_harmonic import HarmonicModel
-    from powertrain.validation.cases import engines
     e = engines()[kind]
     hm = HarmonicModel(e, np.array([1200.0, 5400.0]))
     eff = EFFECTS["cylinder_imbalance"]

@@ -107,7 +107,7 @@ def test_where_attributes_an_order_bound_gap_to_excitation_with_its_orders(step)
 
 
 def test_cylinder_imbalance_applies_to_measured_pressure_traces(engine):
-    from powertrain.validation.cases import traces_engine
+    from benchmarks.cases import traces_engine
     tr = traces_engine(engine, step_rpm=500.0)
     assert EFFECTS["cylinder_imbalance"].applicable(tr)
     rpm = [2000.0]

@@ -41,7 +41,7 @@ def test_bad_plan_names_the_plan_file_and_key(tmp_path, default_engine, text, ke
 
 
 def test_load_is_refused_for_an_engine_with_measured_traces(tmp_path, default_engine):
-    from powertrain.validation.cases import traces_engine
+    from benchmarks.cases import traces_engine
     _csv(tmp_path / "a.csv")
     (tmp_path / "plan.toml").write_text('[[runs]]\nfile = "a.csv"\nload = 0.4\n')
     with pytest.raises(InputError, match="combustion model") as err:
@@ -105,9 +105,9 @@ def test_cli_bad_plan_is_one_line_naming_file_and_key(tmp_path):
 def test_plan_diagnosis_keeps_every_single_run_key_and_adds_runs(default_engine):
     """Two load cases of one stiffer mount from the truth generator: named; the plan's JSON has
     every key of a single-run diagnosis, and a run entry per run."""
+    from benchmarks.plans import make_plan_case
     from powertrain.diagnosis import diagnose
-    from powertrain.validation.cases import FLOOR
-    from powertrain.validation.plans import make_plan_case
+    from powertrain.workflows.measurement import FLOOR
     stiff = np.ones((3, 3))
     stiff[0] = 2.0                                   # the left mount twice as stiff
     case = make_plan_case(0, ["mount_temperature"], 1, phase="all", params={
@@ -144,3 +144,21 @@ def test_a_run_with_traces_uses_them_as_the_engines_combustion(tmp_path, default
     part, full = (x.excitation(1000.0).imep.mean() for x in (eng, e))
     ref = e.at_load(0.4).excitation(1000.0).imep.mean()
     assert part == pytest.approx(ref, rel=0.02) and part < 0.6 * full
+
+
+def test_the_shipped_plan_example_is_the_scripts_output(default_engine):
+    """examples/plan.toml and its runs (shipped, copied by ``powertrain examples``) are what
+    scripts/make_plan_example.py writes, marked SYNTHETIC, and read as a two-run plan."""
+    import importlib.util
+    from pathlib import Path
+    root = Path(__file__).resolve().parents[1]
+    spec = importlib.util.spec_from_file_location("make_plan_example",
+                                                  root / "scripts" / "make_plan_example.py")
+    script = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(script)
+    for name, text in script.plan_files().items():
+        shipped = (root / "examples" / name).read_text()
+        assert shipped == text, name
+        assert shipped.startswith("# SYNTHETIC"), name
+    plan = read_plan(root / "examples" / "plan.toml", default_engine)
+    assert [r.load for r in plan.runs] == [1.0, 0.4]

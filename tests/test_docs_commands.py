@@ -13,8 +13,8 @@ The rules a docs author must know are in docs/extending.md, "Writing docs"; in s
   ``powertrain examples DIR`` makes its own copy of the shipped files, as a user after a wheel
   install does; on any other page ``examples/``, ``engines/`` and ``mounts/`` are linked too.
   Its commands run in order, so a later block may read what an earlier one wrote.
-  ``powertrain`` and ``python`` are the interpreter under test; ``powertrain`` runs in a
-  child of a fork server that imported the package once (tests/forked_commands.py).
+  ``powertrain`` and ``python`` are the interpreter under test; ``powertrain`` is
+  ``python -m powertrain.cli``, a plain subprocess of its own.
 * One command is one line (backslash continuations joined); comment lines are dropped.
 * In a ``&&`` chain, install steps (``python3 -m venv``, ``. .venv/bin/activate``,
   ``source .venv/bin/activate``, ``pip install``) and the test-suite command
@@ -47,7 +47,6 @@ import shlex
 import signal
 import subprocess
 import sys
-import tempfile
 import textwrap
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -57,8 +56,6 @@ import pytest
 import powertrain
 
 ROOT = Path(__file__).resolve().parents[1]
-#: The fork server behind the docs commands' ``powertrain`` (its docstring says why).
-FORK_SERVER = Path(__file__).resolve().parent / "forked_commands.py"
 #: Folders of the repository reachable by their relative names from every doc command.
 LINKED = ("scripts",)
 #: Linked too, unless the page copies the shipped files itself with ``powertrain examples``.
@@ -267,24 +264,16 @@ SKIPPED_PARTS = [(c, part, reason) for cmds in ALL_COMMANDS.values() for c in cm
 
 @pytest.fixture(scope="module")
 def shim_bin(tmp_path_factory) -> Path:
-    """A folder with ``python``, ``python3`` and ``powertrain`` of the interpreter under test;
-    ``powertrain`` runs each command in a child of a fork server that imported the package
-    once (tests/forked_commands.py)."""
+    """A folder with ``python``, ``python3`` and ``powertrain`` of the interpreter under test
+    (``powertrain``: ``python -m powertrain.cli``, started afresh for each command)."""
     bin_dir = tmp_path_factory.mktemp("docs-bin")
-    sock = Path(tempfile.mkdtemp(prefix="pt-docs-")) / "s"        # short: a socket path
-    server = subprocess.Popen([sys.executable, str(FORK_SERVER), "serve", str(sock)],
-                              env=doc_environment(bin_dir), stdout=subprocess.PIPE, text=True)
-    assert server.stdout.readline().strip() == "ready"
     exe = shlex.quote(sys.executable)
-    client = f"{exe} -I -S {shlex.quote(str(FORK_SERVER))} run {shlex.quote(str(sock))}"
-    for name, target in (("python", exe), ("python3", exe), ("powertrain", client)):
+    for name, target in (("python", exe), ("python3", exe),
+                         ("powertrain", f"{exe} -m powertrain.cli")):
         script = bin_dir / name
         script.write_text(f'#!/bin/sh\nexec {target} "$@"\n')
         script.chmod(0o755)
-    yield bin_dir
-    server.kill()
-    server.wait()
-    server.stdout.close()
+    return bin_dir
 
 
 def doc_environment(bin_dir: Path) -> dict:
@@ -583,21 +572,3 @@ def test_skipped_by_rule(cmd, part, reason):
 def test_doc_commands_run(doc, shim_bin, tmp_path):
     failure = run_doc(doc, tmp_path, doc_environment(shim_bin))
     assert failure is None, failure
-
-
-@pytest.mark.parametrize("args", ["--version", "runup --angle-step 0",
-                                  "stiffness mounts/none.toml --freq 5", "modes --static"])
-def test_the_forked_powertrain_prints_and_exits_as_the_console_script(args, shim_bin,
-                                                                      tmp_path):
-    """The docs' ``powertrain`` (a fork server's child) against ``python -m powertrain.cli``
-    started afresh, in the same folder and environment: the same stdout, stderr and exit
-    code (bad input included), a relative output path in the command's folder."""
-    env = doc_environment(shim_bin)
-    (tmp_path / "engines").symlink_to(ROOT / "engines", target_is_directory=True)
-    forked = subprocess.run(["bash", "-c", f"powertrain {args} > out.txt"], cwd=tmp_path,
-                            env=env, capture_output=True, text=True)
-    fresh = subprocess.run([sys.executable, "-m", "powertrain.cli", *shlex.split(args)],
-                           cwd=tmp_path, env=env, capture_output=True, text=True)
-    assert (forked.returncode, forked.stderr) == (fresh.returncode, fresh.stderr)
-    assert (tmp_path / "out.txt").read_text() == fresh.stdout
-    assert fresh.returncode == (0 if args in ("--version", "modes --static") else 1)

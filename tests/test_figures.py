@@ -284,8 +284,8 @@ def test_modes_figure(tmp_path, monkeypatch, saved, args):
 
 
 def test_track_figures(tmp_path, monkeypatch, saved):
+    from benchmarks import signals
     from powertrain.iotools.raw_csv import write_raw_csv
-    from powertrain.validation import signals
     write_raw_csv(tmp_path / "sweep.csv",
                   signals.analytic_sweep(duration=4.0, rpm0=1500.0, rpm1=4500.0),
                   comment="SYNTHETIC: analytic sweep")
@@ -400,8 +400,8 @@ def test_track_plot_draws_every_requested_order(spec, expected):
     import matplotlib.pyplot as plt
     import numpy as np
 
+    from benchmarks import signals
     from powertrain.analysis.order_tracking import parse_orders
-    from powertrain.validation import signals
     from powertrain.workflows.tracking import track_recording
     rec = signals.analytic_sweep(duration=3.0, rpm0=1500.0, rpm1=3500.0)
     tracked = track_recording(rec, parse_orders(spec), rpm_step=100.0, progress=False)
@@ -419,8 +419,8 @@ def test_track_plot_draws_every_requested_order(spec, expected):
 def test_map_channel_and_reference_unit(tmp_path, monkeypatch, saved):
     import matplotlib.pyplot as plt
 
+    from benchmarks import signals
     from powertrain.iotools.raw_csv import write_raw_csv
-    from powertrain.validation import signals
     write_raw_csv(tmp_path / "sweep.csv",
                   signals.analytic_sweep(duration=3.0, rpm0=1500.0, rpm1=3500.0),
                   comment="SYNTHETIC: analytic sweep")

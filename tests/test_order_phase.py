@@ -8,13 +8,13 @@ import numpy as np
 import pytest
 from click.testing import CliRunner
 
+from benchmarks import signals
 from powertrain.analysis.orders import order_spectrum
 from powertrain.analysis.phase import phase_deg, wrap_deg
 from powertrain.cli import main
 from powertrain.errors import InputError
 from powertrain.iotools.measured import MeasuredRunup, read_measured
 from powertrain.iotools.raw_csv import write_raw_csv
-from powertrain.validation import signals
 from powertrain.workflows.tracking import track_recording
 
 TRUE_DEG = np.degrees(signals.ANALYTIC_PHASES)

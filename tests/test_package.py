@@ -16,6 +16,7 @@ import subprocess
 import sys
 import sysconfig
 import venv
+import zipfile
 from pathlib import Path
 
 import pytest
@@ -110,6 +111,16 @@ def _install_wheel(tmp_path: Path) -> tuple:
     return venv_dir, env
 
 
+def _check_no_scaffolding(wheel: Path) -> None:
+    """The wheel holds the package and its data only: no ``benchmarks/`` and no truth
+    generator, case plan, scoring or rate-sizing module (tests/test_architecture.py)."""
+    from test_architecture import SCAFFOLDING
+    names = zipfile.ZipFile(wheel).namelist()
+    tops = {n.split("/")[0] for n in names}
+    assert tops <= {"powertrain", f"{wheel.name.split('-')[0]}-{wheel.name.split('-')[1]}.dist-info"}, tops
+    assert not [n for n in names if n.endswith(".py") and Path(n).stem in SCAFFOLDING]
+
+
 @pytest.mark.slow
 def test_wheel_runs_the_readme_unchanged_in_an_empty_folder(tmp_path):
     """Issue 18: every command README.md shows (the front door's main job, then the
@@ -118,6 +129,7 @@ def test_wheel_runs_the_readme_unchanged_in_an_empty_folder(tmp_path):
     which leaves README.md to this test so that its commands run once)."""
     from test_docs_commands import check_shown, commands_of, run_command, shown_outputs
     venv_dir, env = _install_wheel(tmp_path)
+    _check_no_scaffolding(next((tmp_path / "wheels").glob("powertrain-*.whl")))
     env["MPLBACKEND"] = "Agg"
     empty = tmp_path / "empty"
     empty.mkdir()

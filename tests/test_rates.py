@@ -1,14 +1,23 @@
-"""The sizing helper of the rate tests (tests/rates.py), checked by exact binomial sums
-written out here independently of the helper."""
+"""The sizing helper of the rate tests (benchmarks/sizing.py), checked by exact binomial sums
+written out here independently of the helper; the ten rate tests' fixed seeds and their
+printed line (benchmarks/rate_tests.py, ``python -m benchmarks.rates``)."""
 
 from __future__ import annotations
 
+import ast
+import random
 from math import comb
+from pathlib import Path
 
 import pytest
-import rates
 
-from powertrain.validation.scoring import TARGETS
+from benchmarks import rates as rates_cli
+from benchmarks import sizing as rates
+from benchmarks.rate_tests import RATE_TESTS, RateOutcome, RateTest
+from benchmarks.scoring import TARGETS
+
+#: Seed of the simulation of the sequential rule (printed on failure).
+SIMULATION_SEED = 20000
 
 
 def binomial_cdf(k, n, p):
@@ -182,17 +191,15 @@ def test_the_rate_tests_are_collected_first_and_the_long_ones_lead():
 
 @pytest.mark.parametrize("target, rate", [(0.9, 0.93), (0.8, 0.885), (0.9, 0.8)])
 def test_stopping_counts_are_a_distribution_on_the_looks(target, rate):
-    """The stopping case counts (rates.stopping_counts, behind sequential_oc and
-    scripts/ci_length.py) sum to one, fall on the looks (the first batch, then every
-    ``STEP`` cases, up to n_max), and the test's failures
-    are those of the truncated Wilson rule or Wald's fail bound (checked by a simulation of
+    """The stopping case counts (rates.stopping_counts, behind sequential_oc) sum to one, fall
+    on the looks (the first batch, then every ``STEP`` cases, up to n_max), and the test's
+    failures are those of the truncated Wilson rule or Wald's fail bound (checked by a simulation of
     the rule itself, 20000 runs, within 5 standard errors)."""
-    import random
     n_max, batch = rates.sequential_plan(target), rates.batch_size(target)
     stops, p_fail = rates.stopping_counts(n_max, target, True, rate)
     assert sum(stops.values()) == pytest.approx(1.0, abs=1e-12)
     assert set(stops) <= set(range(batch, n_max + 1, rates.STEP)) | {n_max}
-    rng, runs, fails, total_n = random.Random(), 20000, 0, 0
+    rng, runs, fails, total_n = random.Random(SIMULATION_SEED), 20000, 0, 0
     for _ in range(runs):
         n = good = 0
         while True:
@@ -205,15 +212,46 @@ def test_stopping_counts_are_a_distribution_on_the_looks(target, rate):
         fails += verdict == "fail"
         total_n += n
     se = (p_fail * (1 - p_fail) / runs) ** 0.5 + 1e-4
-    assert abs(fails / runs - p_fail) < 5 * se
+    assert abs(fails / runs - p_fail) < 5 * se, f"seed {SIMULATION_SEED}"
     e_n = sum(n * p for n, p in stops.items())
-    assert abs(total_n / runs - e_n) < 0.05 * e_n
+    assert abs(total_n / runs - e_n) < 0.05 * e_n, f"seed {SIMULATION_SEED}"
 
 
-def test_a_pinned_seed_replays_the_draws(monkeypatch):
-    """``POWERTRAIN_RATE_SEED`` pins every rate test's seed (replaying a run); unset, each
-    run draws its own."""
-    monkeypatch.setenv(rates.SEED_VARIABLE, "424243")
-    assert rates.fresh_seed() == 424243
-    monkeypatch.delenv(rates.SEED_VARIABLE)
-    assert len({rates.fresh_seed() for _ in range(8)}) > 1
+def _run_calls() -> list:
+    """Names ``RATE_TESTS[NAME]`` read by the rate-test files' tests, in order."""
+    names = []
+    for path in sorted(Path(__file__).parent.glob("test_*rates.py")):
+        for node in ast.walk(ast.parse(path.read_text())):
+            if (isinstance(node, ast.Subscript) and isinstance(node.value, ast.Name)
+                    and node.value.id == "RATE_TESTS"):
+                names.append(node.slice.value)
+    return names
+
+
+def test_every_rate_test_runs_once_on_its_own_fixed_seed():
+    """The ten rate tests of the suite are the ten of benchmarks.rate_tests, each on a fixed
+    seed of its own (the same cases every run: CI is a test, not a draw)."""
+    assert sorted(_run_calls()) == sorted(RATE_TESTS) and len(RATE_TESTS) == 10
+    seeds = [t.seed for t in RATE_TESTS.values()]
+    assert all(isinstance(s, int) for s in seeds) and len(set(seeds)) == len(seeds)
+
+
+def test_the_printed_line_names_the_rate_its_interval_and_the_verdict():
+    def good(r):
+        return r
+    ceiling = RateTest("x", None, good, 0.05, 7, higher_is_better=False)
+    rows = [True] * 15 + [False]
+    out = RateOutcome(ceiling, 7, rows, 1, True)
+    assert out.line() == ("x: seed 7: 1/16 = 0.062 (95% Wilson 0.01-0.28), target <= 0.05: "
+                          "pass")
+    assert out.misses() == [False] and out.failure().endswith("misses: [False]")
+    floor = RateTest("y", None, good, 0.9, 8)
+    assert RateOutcome(floor, 9, rows, 15, False, "; note").line().endswith(
+        "target >= 0.9: FAIL; note")
+
+
+def test_the_command_refuses_an_unknown_rate_test(capsys):
+    with pytest.raises(SystemExit) as exit_:
+        rates_cli.main(["no_such_test"])
+    assert exit_.value.code == 2 and "unknown rate test(s) no_such_test" in capsys.readouterr().err
+    assert 0 <= rates_cli.fresh_seed() < 2 ** 32

@@ -5,6 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from benchmarks import signals
 from powertrain.errors import InputError
 from powertrain.iotools.channel_map import parse_channel_name, read_channel_map
 from powertrain.iotools.raw import detect_format, read_raw
@@ -14,7 +15,6 @@ from powertrain.iotools.raw_mdf import write_raw_mdf
 from powertrain.iotools.raw_uff import write_raw_uff
 from powertrain.models.recording import RawChannel, RawRecording
 from powertrain.units import STANDARD_GRAVITY, to_si
-from powertrain.validation import signals
 
 WRITERS = {"csv": write_raw_csv, "h5": write_raw_hdf5, "uff": write_raw_uff,
            "mf4": write_raw_mdf}

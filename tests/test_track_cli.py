@@ -7,12 +7,12 @@ import pytest
 from click.testing import CliRunner
 from tolerances import TRACKED_ORDER_DB
 
+from benchmarks import signals
 from powertrain.cli import main
 from powertrain.iotools.raw_csv import write_raw_csv
 from powertrain.iotools.raw_hdf5 import write_raw_hdf5
 from powertrain.models.recording import RawChannel, RawRecording
 from powertrain.results.tracked import TrackedOrders
-from powertrain.validation import signals
 
 
 def run(*args):

@@ -9,7 +9,7 @@ import math
 import numpy as np
 import pytest
 
-from powertrain.validation.scoring import (
+from benchmarks.scoring import (
     Rate,
     false_claim,
     meets_targets,
@@ -115,7 +115,7 @@ def test_noise_free_shrink_from_reported_gaps():
 def test_two_sided_rates_of_hand_made_rows():
     """Issue 21: side attribution right per kind, a missing mode found only within 5 % in
     frequency and 30 % in modal mass, undetectable cases not counted."""
-    from powertrain.validation.scoring import mode_found, sides_rate, two_sided_line
+    from benchmarks.scoring import mode_found, sides_rate, two_sided_line
     truth = {"frequency_hz": 50.0, "modal_mass_kg": 10.0}
 
     def mode(f, m, claimed=("missing_body_mode",)):

@@ -9,21 +9,12 @@ weak cylinder, and counts of the case plan.
 import numpy as np
 import pytest
 
+from benchmarks import truth as tr
+from benchmarks.cases import baseline_velocity, case_plan, engines, is_detectable, make_case, truth_velocity
+from benchmarks.kinds import IN_LIBRARY, KINDS, PASSIVE_KINDS
 from powertrain.effects import with_balancer_error
 from powertrain.physics.combustion import indicated_work
-from powertrain.validation import truth as tr
-from powertrain.validation.cases import (
-    RPM,
-    baseline_velocity,
-    case_plan,
-    engines,
-    gap_stats,
-    is_detectable,
-    make_case,
-    measure,
-    truth_velocity,
-)
-from powertrain.validation.kinds import IN_LIBRARY, KINDS, PASSIVE_KINDS
+from powertrain.workflows.measurement import RPM, gap_stats, measure
 from powertrain.workflows.runup import run_runup
 
 #: Newmark (1 deg steps) vs exact harmonic steady state: relative to the largest amplitude.

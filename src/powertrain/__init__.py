@@ -43,7 +43,7 @@ API = {
     "whatif": ("powertrain.workflows.whatif", "whatif"),
     "track": ("powertrain.workflows.tracking", "track"),
     "diagnose": ("powertrain.diagnosis", "diagnose"),
-    "synth": ("powertrain.validation.synth", "synth"),
+    "synth": ("powertrain.workflows.synth", "synth"),
 }
 
 __all__ = ["InputError", "__version__", *API]

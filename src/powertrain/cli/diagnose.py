@@ -29,7 +29,7 @@ def _library_names() -> str:
 
 
 def _truth_names() -> str:
-    from powertrain.validation.synth import TRUTH_ALIASES, TRUTH_EFFECTS
+    from powertrain.workflows.synth import TRUTH_ALIASES, TRUTH_EFFECTS
     old = ", ".join(f"{a} (= {n})" for a, n in TRUTH_ALIASES.items())
     return (f"Known: {', '.join(TRUTH_EFFECTS)}; or 'none'. Former names still accepted: "
             f"{old}.")
@@ -169,7 +169,7 @@ def synth(effect_names, seed, out, truth_file, engine_file, quiet):
     """
     from powertrain.cli.common import check_outputs
     from powertrain.progress import activity
-    from powertrain.validation.synth import synth as run
+    from powertrain.workflows.synth import synth as run
 
     names = [] if effect_names.strip() == "none" else [
         e.strip() for e in effect_names.split(",") if e.strip()]

@@ -1,15 +1,11 @@
-r"""The quick truth generator of ``powertrain synth``: the harmonic model with effects of its own.
+r"""``powertrain synth``: a SYNTHETIC measured run-up with hidden effects and noise.
 
 A case is the default (or any) engine plus zero, one or two hidden *truth* effects with
-random parameters, measured like every case of :mod:`powertrain.validation.cases` (one case
-maker, :func:`~powertrain.validation.cases.draw_case`: one measurement model, one noise floor
-:data:`~powertrain.validation.cases.FLOOR`, one detectability rule
-:func:`~powertrain.validation.cases.is_detectable`), on a 50-rpm grid. Unlike the blind
-benchmark's truth (:mod:`powertrain.validation.truth`, Newmark on its own assembly) the
-noise-free truth here is the frequency-domain harmonic model
-(:class:`~powertrain.solvers.fast_harmonic.HarmonicModel`) with truth effects of higher
-fidelity than, and parametrised differently from, the diagnosis candidates of
-:mod:`powertrain.effects`:
+random parameters, simulated noise-free on the frequency-domain harmonic model
+(:class:`~powertrain.solvers.fast_harmonic.HarmonicModel`, the effect models in
+:mod:`powertrain.workflows.synth_effects`) on a 50-rpm grid and measured with scatter and
+noise (:mod:`powertrain.workflows.measurement`). The truth effects are of higher fidelity
+than, and parametrised differently from, the diagnosis candidates of :mod:`powertrain.effects`:
 
 =====================  ==================  =====================================================
 truth effect           library match       truth model (candidate model)
@@ -45,8 +41,8 @@ truth effect           library match       truth model (candidate model)
 =====================  ==================  =====================================================
 
 Effects are redrawn (up to :data:`REDRAWS` times) until their noise-free gap
-(:func:`~powertrain.validation.cases.gaps_db`) is at least :data:`MIN_EFFECT_DB` RMS or reaches
-:data:`MIN_EFFECT_MAX_DB` somewhere: smaller effects are not worth diagnosing at 0.5–1 dB
+(:func:`~powertrain.workflows.measurement.gaps_db`) is at least :data:`MIN_EFFECT_DB` RMS or
+reaches :data:`MIN_EFFECT_MAX_DB` somewhere: smaller effects are not worth diagnosing at 0.5–1 dB
 measurement noise (chassis modes rarely reach 0.5 dB RMS on the engine-side velocities,
 which are mass-controlled above the rigid-body modes, so for them the local criterion is
 what counts). The diagnosis is never imported here.
@@ -56,19 +52,28 @@ from __future__ import annotations
 
 import dataclasses
 import functools
-from types import SimpleNamespace
+import json
+import os
 
 import numpy as np
 
-from powertrain.effects import A_REF
+from powertrain.errors import InputError
 from powertrain.iotools.engine_file import DEFAULT_ENGINE_PATH, engine_or_default
+from powertrain.outputs import atomic_write
+from powertrain.plotting.style import (
+    figure_legend,
+    finish,
+    log_axis,
+    series_style,
+    subplots,
+    target_and_path,
+)
 from powertrain.results.base import Result
-from powertrain.solvers.body_coupling import coupled_solve
-from powertrain.solvers.fast_harmonic import N_HARMONICS, HarmonicModel
-from powertrain.validation.cases import draw_case, gaps_db
-from powertrain.validation.kinds import TruthKind
+from powertrain.solvers.fast_harmonic import HarmonicModel
 from powertrain.workflows.arguments import integer
 from powertrain.workflows.arguments import names as listed
+from powertrain.workflows.measurement import FLOOR, SyntheticCase, draw_case, gaps_db
+from powertrain.workflows.synth_effects import truth_velocity
 
 TRUTH_EFFECTS = {
     "body_modes": "base_compliance",
@@ -91,138 +96,6 @@ MIN_EFFECT_DB = 0.5
 MIN_EFFECT_MAX_DB = 4.0
 #: Draws of a hidden effect before the last one is kept whatever its size.
 REDRAWS = 40
-
-
-# ---------------------------------------------------------------------------- truth models
-def _two_port_springs(omega, model, s):
-    """Two-port (a, b, c) with the network's springs times s (n_r,) per speed (dampers and
-    masses kept): the one condensation, :func:`powertrain.physics.mount_network.two_port`."""
-    from powertrain.physics.mount_network import two_port
-    return two_port(omega, *model.network(), spring_scale=np.asarray(s, float)[:, None],
-                    damper_scale=1.0)
-
-
-def _solve_body(hm, abc, load, body):
-    """Rigid body + flexible chassis body (modal) under all networks; q (n_r, 16, 6)."""
-    modes = SimpleNamespace(frequency_hz=body["freq"], modal_mass=body["mass"],
-                            damping_ratio=body["zeta"])
-    return coupled_solve(hm.M, hm.omega[:, 1:], hm.rows, body["shapes"],
-                         tuple(x[:, 1:] for x in abc), abc[0][:, 1:], modes,
-                         load[:, 1:])[..., :6]
-
-
-class _PerCylinderCombustion:
-    """Single-zone combustion with per-cylinder IMEP factor and start of combustion."""
-
-    def __init__(self, base, factors, start_shift):
-        self.base = base
-        self.imep_factors = np.asarray(factors, float)
-        self.shift = np.asarray(start_shift, float)
-        self.model = "single-zone"
-
-    def speed_range(self):
-        return self.base.speed_range()
-
-    def cycle_pressures(self, crank, omega, load=1.0):
-        rows, info0, theta = [], None, None
-        for i, (f, dsh) in enumerate(zip(self.imep_factors, self.shift)):
-            comb = dataclasses.replace(self.base, start=self.base.start + dsh,
-                                       imep_factors=np.full(self.imep_factors.size, f))
-            theta, p, info = comb.cycle_pressures(crank, omega, load)
-            rows.append(p[i])
-            info0 = info0 or info
-        return theta, np.array(rows), info0
-
-
-def truth_velocity(engine, hm: HarmonicModel, truth) -> np.ndarray:
-    """Noise-free channel velocities (n_r, 9, 16) of ``engine`` with the truth effects."""
-    names = dict(truth)
-    load = _truth_load(engine, hm, names)
-    models = _truth_networks(hm, names)
-
-    def abc_for(s):                         # s (n_r, n_net) spring factors
-        out = [np.empty(hm.omega.shape + (len(models),), complex) for _ in range(3)]
-        for k, m in enumerate(models):
-            res = _two_port_springs(hm.omega, m, s[:, k])
-            for j in range(3):
-                out[j][..., k] = res[j]
-        return out
-
-    def solve(abc):
-        if "body_modes" in names:
-            return _solve_body(hm, abc, load, names["body_modes"])
-        return hm.solve(abc[0], load, abc=abc)
-
-    s = np.ones((hm.rpm.size, len(models)))
-    if "amplitude_power" in names:
-        p = names["amplitude_power"]
-        last = len(hm.mount_names) - 1          # engine mounts hydraulic, last elastomeric
-        beta = np.array([p["beta"][0] if hm.networks[k][0] < last else p["beta"][1]
-                         for k in range(len(models))])
-        for _ in range(60):
-            q = solve(abc_for(s))
-            a = np.maximum(hm.network_amplitude(q), 1e-6)
-            s_new = (a / A_REF) ** (-beta[None, :])
-            change = np.max(np.abs(s_new - s))
-            s = s + 0.7 * (s_new - s)
-            if change < 1e-6:
-                break
-    return _truth_readings(hm, hm.velocity(solve(abc_for(s))), names)
-
-
-def _truth_load(engine, hm, names):
-    """Load harmonics with the load-side truth effects (combustion, balancer, driveline)."""
-    load = hm.load
-    if "cylinder_combustion" in names:
-        p = names["cylinder_combustion"]
-        eng = engine.replace(combustion=_PerCylinderCombustion(
-            engine.combustion, np.asarray(engine.combustion.imep_factors) * (1 + np.array(
-                p["imep_dev"])), np.deg2rad(p["start_shift_deg"])))
-        load = hm.load_of(eng)
-    if "balancer_error" in names:
-        p = names["balancer_error"]
-        sh = hm.shaft_loads()
-        on = 1.0 if engine.balancer.enabled else 0.0
-        for k in range(sh.shape[0]):
-            load = load + (p["gain"][k] * np.exp(-1j * (p["lag"] + p["lag_shaft"][k])) - on
-                           ) * sh[k]
-    if "torsional_driveline" in names:
-        p = names["torsional_driveline"]
-        w, wt = hm.omega, 2 * np.pi * p["freq"]
-        fac = 1 + p["kappa"] * w ** 2 / (wt ** 2 - w ** 2 + 2j * p["zeta"] * wt * w)
-        load = load.copy()
-        load[..., 3] = load[..., 3] * fac
-    return load
-
-
-def _truth_networks(hm, names) -> list:
-    """The mount networks with the ``mount_temperature`` truth's spring and damper factors."""
-    nets = [n[2] for n in hm.networks]
-    spring = np.ones(len(nets))
-    damp = np.ones(len(nets))
-    if "mount_temperature" in names:
-        p = names["mount_temperature"]
-        spring = np.asarray(p["spring"], float)
-        damp = np.asarray(p["damper"], float)
-    return [m.with_params(**{k: v * (sf if k[0] == "c" else df if k[0] == "d" else 1.0)
-                             for k, v in m.params.items()})
-            for m, sf, df in zip(nets, spring, damp)]
-
-
-def _truth_readings(hm, v, names):
-    """Channel velocities as read: the powertrain's bending and the sensor triads' truths."""
-    if "powertrain_bending" in names:
-        p = names["powertrain_bending"]
-        w, wb = hm.omega[:, 1:N_HARMONICS], 2 * np.pi * p["freq"]
-        fac = 1 + p["kappa"] * w ** 2 / (wb ** 2 - w ** 2 + 2j * p["zeta"] * wb * w)
-        gb = [i for i, (m, _) in enumerate(hm.channels) if m == hm.mount_names[-1]]
-        v = v.copy()
-        v[:, gb, :] *= fac[:, None, :]
-    if "sensor_triads" in names:
-        p = names["sensor_triads"]
-        T = np.asarray(p["matrix"])                         # (9, 9) block diagonal
-        v = np.einsum("cd,rdh->rch", T, v)
-    return v
 
 
 def truth_effect_name(name: str) -> str:
@@ -269,13 +142,8 @@ def draw_truth(name, rng, n_net=9):
 
 
 def _draw(name, rng, engine):
+    """:func:`draw_truth` for ``engine`` (three mount networks per mount)."""
     return draw_truth(name, rng, 3 * len(engine.mounts))
-
-
-#: The truth kinds of ``powertrain synth`` (drawn by :func:`draw_truth`; their models act
-#: together in :func:`truth_velocity`, so they have no ``apply`` of their own).
-SYNTH_KINDS = {n: TruthKind(n, lib, functools.partial(_draw, n), None)
-               for n, lib in TRUTH_EFFECTS.items()}
 
 
 def worth_diagnosing(base, velocity) -> bool:
@@ -286,9 +154,10 @@ def worth_diagnosing(base, velocity) -> bool:
                                  or np.max(g) >= MIN_EFFECT_MAX_DB)
 
 
-def make_case(engine, truth_names, seed, *, rpm=None, hm=None, noise_db=None, params=None):
-    """One synthetic measurement (:class:`~powertrain.validation.cases.Case`) with the named
-    truth effects (random parameters).
+def make_case(engine, truth_names, seed, *, rpm=None, hm=None, noise_db=None,
+              params=None) -> SyntheticCase:
+    """One synthetic measurement (:class:`~powertrain.workflows.measurement.SyntheticCase`)
+    with the named truth effects (random parameters).
 
     Parameters
     ----------
@@ -297,6 +166,7 @@ def make_case(engine, truth_names, seed, *, rpm=None, hm=None, noise_db=None, pa
     truth_names : sequence of str
         Names from :data:`TRUTH_EFFECTS` or :data:`TRUTH_ALIASES` (empty: effect-free).
     seed : int
+        Seed of every draw of the case (effects, scatter, noise).
     rpm : array_like, optional
         Speeds [rpm] (default :data:`RPM`).
     hm : HarmonicModel, optional
@@ -312,13 +182,13 @@ def make_case(engine, truth_names, seed, *, rpm=None, hm=None, noise_db=None, pa
     rpm = RPM if rpm is None else np.asarray(rpm, float)
     hm = HarmonicModel(engine, rpm) if hm is None else hm
     base = hm.velocity(hm.solve(hm.two_ports()[0]))
-    return draw_case(0, list(truth_names), "", seed, engine, base,
-                     functools.partial(_simulate, hm), hm.channels, "synthetic case",
-                     kinds=SYNTH_KINDS, rpm=rpm, noise_db=noise_db, params=params,
-                     redraws=REDRAWS, worth=worth_diagnosing)
+    return draw_case(list(truth_names), seed, engine, base, functools.partial(_simulate, hm),
+                     _draw, hm.channels, f"synthetic case 0 (seed {seed})", rpm=rpm,
+                     noise_db=noise_db, params=params, redraws=REDRAWS, worth=worth_diagnosing)
 
 
 def _simulate(hm, engine, truth):
+    """Noise-free run-up of ``engine`` with ``truth`` on the harmonic model ``hm``."""
     return truth_velocity(engine, hm, truth)
 
 
@@ -329,7 +199,7 @@ class SynthCase(Result):
     ``.to_csv(path)``, ``.to_truth_json(path)``, ``.plot()``, ``.save(path)`` (``.csv``,
     ``.png``).
 
-    ``case`` is the :class:`~powertrain.validation.cases.Case` (``case.measured`` the
+    ``case`` is the :class:`~powertrain.workflows.measurement.SyntheticCase` (``case.measured`` the
     :class:`~powertrain.iotools.measured.MeasuredRunup` a diagnosis reads).
     """
 
@@ -368,22 +238,12 @@ class SynthCase(Result):
 
     def to_truth_json(self, path=None) -> str:
         """:meth:`truth` as JSON, written atomically to ``path`` when given."""
-        import json
         return _written(json.dumps(self.truth(), indent=1), path)
 
     def plot(self, ax=None, *, path=None, mount=None, direction="z", provenance=None):
         """The measured order curves [mm/s RMS] of one channel (default: the first mount,
         ``direction``) against speed, with the generator's noise floor, into ``ax`` or a new
         figure; returns the figure."""
-        from powertrain.plotting.style import (
-            figure_legend,
-            finish,
-            log_axis,
-            series_style,
-            subplots,
-            target_and_path,
-        )
-        from powertrain.validation.cases import FLOOR
         ax, path = target_and_path(ax, path)
         curves = self.measured.curves
         mount = mount or next(iter(curves))[0]
@@ -408,7 +268,6 @@ class SynthCase(Result):
 
 def _written(text: str, path) -> str:
     if path is not None:
-        from powertrain.outputs import atomic_write
         with atomic_write(path) as fh:
             fh.write(text)
     return text
@@ -434,9 +293,6 @@ def synth(effects=(), seed=0, *, engine=None, rpm=None, noise_db=None) -> SynthC
     InputError
         An unknown effect (``--effect``) or seed (``--seed``).
     """
-    import os
-
-    from powertrain.errors import InputError
     given = listed(effects, "--effect")
     names = [truth_effect_name(e) for e in ([] if given == ["none"] else given)]
     for e in names:

@@ -3,13 +3,13 @@ r"""Passive-side cases of the blind benchmark: both sides of every mount measure
 A test lab measures the engine side *and* the body side of each mount. These cases are run
 on the default engine with the modal body of ``engines/default-modal-body.toml`` (four
 **illustrative** body modes; also with measured pressure traces), and the truth is made on
-the truth path (:mod:`powertrain.validation.truth`: own assembly with the mount bases on the
+the truth path (:mod:`benchmarks.truth`: own assembly with the mount bases on the
 body's modes, Newmark run-up) with the body side of every mount as further channels
 (``NAME/passive``), measured with the same scatter and noise floor as the engine side
-(:func:`powertrain.validation.cases.measure`).
+(:func:`powertrain.workflows.measurement.measure`).
 
 **Plan** (:func:`passive_plan`), repeated every 14 cases: ``body_modes`` four times (the
-body's modes differ from the file's, :data:`powertrain.validation.kinds.PASSIVE_KINDS`),
+body's modes differ from the file's, :data:`benchmarks.kinds.PASSIVE_KINDS`),
 ``mount_temperature`` four times (one mount 0.5–0.8× or 1.25–2× as stiff), two effect-free,
 and (issue 21) two excitation changes (``balancer_shafts``) and two body modes the file
 lacks (``missing_mode``); engines alternating. The diagnosis gets the modal-body engine
@@ -23,10 +23,11 @@ import functools
 
 import numpy as np
 
+from benchmarks import truth as tr
+from benchmarks.cases import Case, draw_case, traces_engine
+from benchmarks.kinds import KINDS
 from powertrain.analysis.channel import passive_name
-from powertrain.validation import truth as tr
-from powertrain.validation.cases import RPM, Case, draw_case, traces_engine
-from powertrain.validation.kinds import KINDS
+from powertrain.workflows.measurement import RPM
 
 #: Engine kinds of the passive-side cases.
 ENGINE_KINDS = ("body_sz", "body_traces")
@@ -90,7 +91,7 @@ def baseline_velocity(engine_kind):
 
 def make_passive_case(index, names, engine_kind, seed, phase=None) -> Case:
     """Draw, simulate and measure one passive-side case; ``phase`` what order phase is
-    measured on both sides (:func:`powertrain.validation.cases.measure`; the levels are the
+    measured on both sides (:func:`powertrain.workflows.measurement.measure`; the levels are the
     same with and without)."""
     engine = passive_engines()[engine_kind]
     return draw_case(index, names, engine_kind, seed, engine, baseline_velocity(engine_kind),

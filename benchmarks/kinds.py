@@ -1,6 +1,6 @@
 r"""Truth effects of the blind benchmark: how each is drawn and applied.
 
-**Truth effects** (:data:`KINDS`; physics in :mod:`powertrain.validation.truth`), each with
+**Truth effects** (:data:`KINDS`; physics in :mod:`benchmarks.truth`), each with
 the diagnosis candidate it should be found as (``library``; ``None`` = outside the library):
 
 ======================= ==================== ==============================================
@@ -34,7 +34,7 @@ truth effect            library match        drawn parameters
                                              direction dominant
 ======================= ==================== ==============================================
 
-Cases, measurement noise and detectability: :mod:`powertrain.validation.cases`.
+Cases, measurement noise and detectability: :mod:`benchmarks.cases`.
 """
 
 from __future__ import annotations
@@ -43,7 +43,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from powertrain.validation import truth as tr
+from benchmarks import truth as tr
 
 
 @dataclass(frozen=True)
@@ -240,7 +240,7 @@ def _apply_missing_mode(p, parts):
                                  np.concatenate([b.shapes, p["shape"][None]], axis=0))
 
 
-#: Truth kinds of the passive-side plan only (:mod:`powertrain.validation.passive`); kept out
+#: Truth kinds of the passive-side plan only (:mod:`benchmarks.passive`); kept out
 #: of :data:`IN_LIBRARY`, so the default plan's draws are unchanged.
 PASSIVE_KINDS = {"body_modes": TruthKind("body_modes", "chassis_modes", _draw_body_modes,
                                          _apply_body_modes),

@@ -1,15 +1,15 @@
 """Plan cases of the blind benchmark: one car, one hidden truth, several load cases.
 
-:func:`make_plan_case` draws the hidden effects once (:data:`~powertrain.validation.kinds.KINDS`)
+:func:`make_plan_case` draws the hidden effects once (:data:`~benchmarks.kinds.KINDS`)
 on the default single-zone engine and simulates them on the truth path
-(:mod:`powertrain.validation.truth`) at every load of the plan (the combustion model's IMEP
+(:mod:`benchmarks.truth`) at every load of the plan (the combustion model's IMEP
 scale, :meth:`~powertrain.models.engine.Engine.at_load`; the amplitude-dependent elastomer
 then works at each run's own amplitudes); every run is measured on its own (its own scatter
-draw, noise and TDC error, :func:`powertrain.validation.cases.measure`). The case is
-detectable when one of its runs is (:func:`powertrain.validation.cases.is_detectable`).
+draw, noise and TDC error, :func:`powertrain.workflows.measurement.measure`). The case is
+detectable when one of its runs is (:func:`benchmarks.cases.is_detectable`).
 
 ``sides="both"`` draws the same plan on the modal-body engine with both sides of every mount
-measured (:mod:`powertrain.validation.passive`: the body side as further channels).
+measured (:mod:`benchmarks.passive`: the body side as further channels).
 """
 
 from __future__ import annotations
@@ -19,8 +19,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from powertrain.validation import cases as cs
-from powertrain.validation.kinds import KINDS
+from benchmarks import cases as cs
+from benchmarks.kinds import KINDS
 
 #: Loads of the two-run plan (full load, part load).
 LOADS = (1.0, 0.4)
@@ -31,7 +31,7 @@ SIDES = ("engine", "both")
 def plan_engine(sides="engine"):
     """The engine a plan of ``sides`` is drawn on and diagnosed with (full load)."""
     if sides == "both":
-        from powertrain.validation.passive import passive_engines
+        from benchmarks.passive import passive_engines
         return passive_engines()["body_sz"]
     return cs.engines()["sz"]
 
@@ -39,7 +39,7 @@ def plan_engine(sides="engine"):
 def _truth_path(sides):
     """``(simulate(engine, truth), channels(engine))`` of the truth path for ``sides``."""
     if sides == "both":
-        from powertrain.validation import passive
+        from benchmarks import passive
         return passive.truth_velocity, passive.channels
     return cs.truth_velocity, lambda e: [(mt.name, a) for mt in e.mounts for a in "xyz"]
 
@@ -53,7 +53,7 @@ def baseline_at(load, sides="engine"):
 
 @dataclass
 class PlanCase:
-    """One car's runs (:class:`~powertrain.validation.cases.Case` per load) and its truth."""
+    """One car's runs (:class:`~benchmarks.cases.Case` per load) and its truth."""
 
     index: int
     names: list

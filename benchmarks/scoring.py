@@ -3,7 +3,7 @@ r"""Scores of the blind benchmark, from one row per case.
 A row is a dict with the generator's side (never shown to the diagnosis) and the answer:
 
 ``category``      ``"in"`` (every hidden effect in the library), ``"out"`` or ``"none"``
-``detectable``    bool, from the noise-free truth (:func:`powertrain.validation.cases.is_detectable`)
+``detectable``    bool, from the noise-free truth (:func:`benchmarks.cases.is_detectable`)
 ``truth_set``     library matches of the hidden effects (``"outside"`` for the others)
 ``expected_set``  the matches of the members detectable alone (pairs), else ``truth_set``
 ``claimed``       the effects of the diagnosis' chosen answer (``[]``: no claim)

@@ -1,9 +1,9 @@
-r"""Sizing of the statistical rate tests (the Wilson rule).
+r"""Sizing of the statistical rate tests (the Wilson rule) and their group-sequential rule.
 
-A rate test draws ``n`` fresh cases, counts the successes ``k`` and **fails when the data
+A rate test draws ``n`` cases, counts the successes ``k`` and **fails when the data
 show, at one-sided 95 % confidence, that the target is missed**: for a target to reach
 (``higher_is_better``, e.g. top-1 ≥ 0.9) it fails when the upper end of the Wilson score
-interval of ``k/n`` (:func:`powertrain.validation.scoring.wilson_interval`, ``z`` =
+interval of ``k/n`` (:func:`benchmarks.scoring.wilson_interval`, ``z`` =
 :data:`Z_ONE_SIDED`) is below the target; for a ceiling (false claims ≤ 0.05) when its
 lower end is above it. For a given ``n`` that is a count threshold: the test passes for
 ``k >= k_pass`` (target to reach) or ``k <= k_pass`` (ceiling).
@@ -20,9 +20,9 @@ checks the power, the size at the target and that ``n`` is the smallest, by exac
 from __future__ import annotations
 
 import math
-import os
 
-from powertrain.validation.scoring import wilson_interval
+from benchmarks.scoring import wilson_interval
+from powertrain.parallel import executor
 
 #: Normal quantile of a one-sided 95 % bound.
 Z_ONE_SIDED = 1.6448536269514722
@@ -198,37 +198,8 @@ def run_sequential_map(row_fn, task_of, is_good, target, higher_is_better=True):
     pool of processes kept for all the draws (:func:`powertrain.parallel.executor`): its
     workers keep what they loaded (engines, compiled kernels) from one draw to the next,
     where a pool per draw started them afresh each time (about a second per process)."""
-    from powertrain.parallel import executor
     with executor(None, n_jobs=batch_size(target, higher_is_better)) as ex:
         return run_sequential(
             lambda start, count: list(ex.map(row_fn, [task_of(i) for i in
                                                       range(start, start + count)])),
             is_good, target, higher_is_better)
-
-
-# --- the draws -------------------------------------------------------------------------------
-
-#: Environment variable that pins every rate test's seed (replaying a run's draws: each test
-#: prints its seed; or timing two versions of the code on the same cases).
-SEED_VARIABLE = "POWERTRAIN_RATE_SEED"
-
-
-def fresh_seed() -> int:
-    """A rate test's seed: from ``os.urandom`` (fresh draws every run), or the integer in
-    :data:`SEED_VARIABLE` when it is set."""
-    pinned = os.environ.get(SEED_VARIABLE, "").strip()
-    return int(pinned) if pinned else int.from_bytes(os.urandom(4), "little")
-
-
-# --- the diagnosis a rate test judges --------------------------------------------------------
-
-def diagnosis(measured, engine) -> dict:
-    """``diagnose(measured, engine)`` as the rate tests judge it (a dict, the benchmark's
-    noise floor), without the band check: that check refits the chosen effect on speed bands
-    *after* the verdict and enters none of what the tests judge (the verdict, the claim, its
-    parameters; tests/test_diagnose.py holds them equal with and without it), and it is a
-    fifth of a passive-side diagnosis."""
-    from powertrain.diagnosis import diagnose
-    from powertrain.validation.cases import FLOOR
-    return diagnose(measured, engine, noise_floor=FLOOR, band_check=False,
-                    progress=False).to_dict()
