@@ -249,3 +249,19 @@ def test_the_scaffolding_checker_can_fail(tmp_path):
     (pkg / "validation" / "__init__.py").write_text("")
     (pkg / "tools.py").write_text("def wilson_interval(k, n):\n    return k / n\n")
     assert sorted(scaffolding_in(pkg)) == ["tools.py:wilson_interval", "validation"]
+
+
+def test_no_re_exports_below_the_package_top():
+    """Every symbol is imported from its home: no ``noqa: F401`` hand-on imports and no module
+    ``__getattr__`` anywhere but the package's own ``__init__`` (the public API)."""
+    src = PACKAGE
+    found = []
+    for path in sorted(src.rglob("*.py")):
+        text = path.read_text()
+        if "noqa: F401" in text:
+            found.append(f"{path.relative_to(src)}: noqa: F401")
+        tree = ast.parse(text)
+        if path != src / "__init__.py" and any(
+                isinstance(n, ast.FunctionDef) and n.name == "__getattr__" for n in tree.body):
+            found.append(f"{path.relative_to(src)}: module __getattr__")
+    assert not found, found

@@ -6,26 +6,24 @@ Exit codes: 0 success, 1 bad input (one line on stderr naming file and key), 2 u
 
 from __future__ import annotations
 
+from powertrain.cli import (
+    compare,
+    diagnose,
+    examples,
+    excitation,
+    fit_mount,
+    modes,
+    runup,
+    static,
+    stiffness,
+    track,
+    whatif,
+)
 from powertrain.cli.group import main
 
 __all__ = ["main"]
 
 
-def _register():
-    """Import the command modules: each adds its command to :func:`main`."""
-    from powertrain.cli import (  # noqa: F401
-        compare,
-        diagnose,
-        examples,
-        excitation,
-        fit_mount,
-        modes,
-        runup,
-        static,
-        stiffness,
-        track,
-        whatif,
-    )
-
-
-_register()
+#: The command modules: importing each adds its commands to :func:`main` (``@main.command``).
+COMMAND_MODULES = (compare, diagnose, examples, excitation, fit_mount, modes, runup, static,
+                   stiffness, track, whatif)

@@ -7,19 +7,8 @@ import contextlib
 
 import click
 
-from powertrain.analysis.text_table import format_table  # noqa: F401 (re-export)
-from powertrain.errors import InputError, require_finite, solved  # noqa: F401 (re-export)
+from powertrain.errors import InputError
 
-#: Names of :mod:`powertrain.workflows.runup` the commands import from here (loaded lazily:
-#: ``powertrain --help`` imports no solver).
-_RUNUP_NAMES = ("checked_runup", "require_finite", "solved")
-
-
-def __getattr__(name):
-    if name in _RUNUP_NAMES:
-        from powertrain.workflows import runup
-        return getattr(runup, name)
-    raise AttributeError(name)
 
 def speed_options(func):
     """The ``--from/--to/--step`` speed-step options [rpm] shared by the run-up commands."""
@@ -41,12 +30,6 @@ def check_outputs(**targets) -> None:
     for name, path in targets.items():
         if path:
             check_writable(path, key=f"--{name.replace('_', '-')}")
-
-
-def checked_runup(engine, engine_path, run, *args, **kwargs):
-    """:func:`powertrain.workflows.runup.checked_runup` (a run-up, checked finite)."""
-    from powertrain.workflows.runup import checked_runup as checked
-    return checked(engine, engine_path, run, *args, **kwargs)
 
 
 def write_json(path, text: str, provenance: dict, key: str = "--json") -> None:
