@@ -12,6 +12,7 @@ import math
 import numpy as np
 
 from powertrain.diagnosis.evidence import CandidateEvidence
+from powertrain.diagnosis.fit import Packing, fit_candidate
 from powertrain.diagnosis.significance import improvement_t
 from powertrain.effects import EFFECTS
 
@@ -53,7 +54,6 @@ def restatements(outcome, engine, band=None) -> tuple:
 
 def _refit(setup, e, params, budget):
     """The chosen effect refitted from an alternative start (a few evaluations)."""
-    from powertrain.diagnosis.fit import Packing, fit_candidate
     pack = Packing.of((e,), setup.problem.engine)
     x = np.array([math.log(params[pn]) if lg else params[pn]
                   for (_, pn), lg in zip(pack.names, pack.log)])

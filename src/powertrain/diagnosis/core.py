@@ -7,6 +7,7 @@ is taken by the pure :func:`powertrain.diagnosis.rule.decide`.
 from __future__ import annotations
 
 import math
+import os
 import time
 
 import numpy as np
@@ -38,13 +39,17 @@ from powertrain.diagnosis.data import (
 )
 from powertrain.diagnosis.evidence import CandidateEvidence, Evidence, VerdictKind
 from powertrain.diagnosis.fit import EVAL_BUDGET, Problem, baseline_outcome, fit_candidate
+from powertrain.diagnosis.plan import PlanSetup
 from powertrain.diagnosis.result import DiagnosisResult
 from powertrain.diagnosis.rule import DecisionRule, decide
 from powertrain.diagnosis.sides import side_attribution, with_measured_body_side
 from powertrain.diagnosis.where import decompose_gap, regions, rigid_span_gap, where_text
-from powertrain.effects import predict
+from powertrain.effects import EFFECTS, predict
 from powertrain.errors import InputError
-from powertrain.parallel import single_blas_thread
+from powertrain.iotools.engine_file import DEFAULT_ENGINE_PATH, engine_or_default
+from powertrain.iotools.measured import read_measured
+from powertrain.iotools.plan import read_plan
+from powertrain.parallel import run_map, single_blas_thread
 from powertrain.solvers.fast_harmonic import HarmonicModel
 from powertrain.workflows import arguments as args
 
@@ -107,22 +112,17 @@ def diagnose(measured, engine=None, *, noise_floor=DEFAULT_NOISE_FLOOR, effects=
 def _inputs(measured, engine, effects):
     """``(engine, measured)`` read from their files when given as paths; the effect names
     checked against the registry."""
-    import os
 
-    from powertrain.effects import EFFECTS
     for e in effects or []:
         if e not in EFFECTS:
             raise InputError(f"unknown effect {e!r} (known: {', '.join(EFFECTS)})",
                              key="--effects")
-    from powertrain.iotools.engine_file import DEFAULT_ENGINE_PATH, engine_or_default
     if engine is None or isinstance(engine, (str, os.PathLike)):
         engine = str(engine or DEFAULT_ENGINE_PATH)
     engine = engine_or_default(engine)
     if isinstance(measured, (str, os.PathLike)) and str(measured).lower().endswith(".toml"):
-        from powertrain.iotools.plan import read_plan
         measured = read_plan(measured, engine)
     elif isinstance(measured, (str, os.PathLike)):
-        from powertrain.iotools.measured import read_measured
         measured = read_measured(measured, mounts=engine.mount_names)
     elif not hasattr(measured, "runs") and not hasattr(measured, "signal"):
         raise InputError("expected a MeasuredRunup, a Plan or a file, got "
@@ -221,7 +221,6 @@ def _fit_job(job):
 def _fit_all(s: _Setup, pairs, scheduler, progress, budget, e_n, rule, baseline, sigma):
     """Singles, then pairs (:func:`pair_candidates`); in the order of submission, each with
     its structured residual."""
-    from powertrain.parallel import run_map
     desc = "diagnose: candidate fits" if progress else None
     jobs = [(s.problem, (e,), None, budget) for e in s.effects]
     singles = run_map(_fit_job, jobs, scheduler, progress=desc)
@@ -303,7 +302,6 @@ def _diagnose(measured, engine, noise_floor, effects, pairs, do_bands, rule, sch
               progress, budget):
     t0 = time.perf_counter()
     if hasattr(measured, "runs"):
-        from powertrain.diagnosis.plan import PlanSetup
         s = PlanSetup(measured, engine, noise_floor, effects, _Setup)
     else:
         s = _Setup(measured, engine, noise_floor, effects)
@@ -376,7 +374,6 @@ def _finding(s, chosen):
     if chosen is None or len(chosen.effects) != 1:
         return None
     e = chosen.effects[0]
-    from powertrain.effects import EFFECTS
     return EFFECTS[e].finding(chosen.params[e], s.problem.engine, phase_kind(s.data))
 
 

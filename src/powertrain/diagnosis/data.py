@@ -18,6 +18,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from powertrain.analysis.noise_floor import above_floor, at_floor, censoring_level
+from powertrain.iotools.measured import quantity_sort_key
+from powertrain.solvers.body_coupling import ModalBody, body_channels
 
 #: Default RMS noise floor of the measured order curves [m/s].
 DEFAULT_NOISE_FLOOR = 1.0e-6
@@ -130,7 +132,6 @@ def model_channels(engine) -> list:
     """Channels the fast model predicts for ``engine``: every mount's engine side, and with
     a modal body (:mod:`powertrain.solvers.body_coupling`) every mount's body side
     (``NAME/passive``) and the body points of interest."""
-    from powertrain.solvers.body_coupling import ModalBody, body_channels
     active = [(m.name, a) for m in engine.mounts for a in ("x", "y", "z")]
     body = ModalBody.of(engine)
     if body is None:
@@ -139,7 +140,6 @@ def model_channels(engine) -> list:
 
 
 def _half_order_quantities(measured):
-    from powertrain.iotools.measured import quantity_sort_key
     quantities = []
     for q in sorted({q for _, _, q in measured.curves}, key=quantity_sort_key):
         if q == "synthesis":

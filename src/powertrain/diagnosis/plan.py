@@ -17,6 +17,7 @@ from __future__ import annotations
 import numpy as np
 
 from powertrain.diagnosis.data import GapData, noise_sigma_db
+from powertrain.diagnosis.fit import baseline_outcome, score
 from powertrain.errors import InputError
 
 
@@ -130,7 +131,6 @@ class PlanSetup:
 
     def fold_problems(self) -> list:
         """``[(JointProblem, baseline outcome)]`` of speed folds 1, 2 of every run."""
-        from powertrain.diagnosis.fit import baseline_outcome
         if self._folds is None:
             per_run = [s.fold_problems() for s in self.runs]
             self._folds = []
@@ -142,7 +142,6 @@ class PlanSetup:
     def run_entries(self, chosen) -> list:
         """The ``runs`` entries of the JSON: each run's file, load, held-out RMS gap before
         and after the chosen answer [dB] and crank-angle offset [deg]."""
-        from powertrain.diagnosis.fit import baseline_outcome, score
         sc = {} if chosen is None else {e: chosen.params[e] for e in chosen.effects}
         out = []
         for run, s in zip(self.plan.runs, self.runs):

@@ -2,10 +2,16 @@
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import numpy as np
 
+from powertrain.diagnosis.sides import side_text
 from powertrain.diagnosis.where import REGION_DB, attribution_text
 from powertrain.effects import EFFECTS
+from powertrain.outputs import atomic_write
+from powertrain.plotting import plot_diagnosis_overlay, plot_gap_frequency, plot_gap_map
+from powertrain.plotting.style import close_figure
 
 _PHASE_WORDS = {"all": "order phases measured, half orders too",
                 "whole": "whole-order phases only (no cycle reference)"}
@@ -38,7 +44,6 @@ def _header(r) -> list:
              f"{p['r2_full']:.0%}, residual {p['residual_rms_db']:.2f} dB RMS",
              f"  attribution (each part fitted alone): {attribution_text(p['attribution'])}"]
     if p.get("sides"):
-        from powertrain.diagnosis.sides import side_text
         lines.append(f"  sides: {side_text(p['sides'])}")
     rg = r.rigid_gap[np.isfinite(r.rigid_gap)]
     if rg.size:
@@ -91,7 +96,6 @@ def _which(r) -> list:
 
 def _run_text(k, run) -> str:
     """``run 2 part.csv (load 0.4)`` or ``(traces wot-p.csv)``."""
-    from pathlib import Path
     how = f"traces {Path(run['traces']).name}" if run.get("traces") else f"load {run['load']:g}"
     return f"run {k} {Path(run['file']).name} ({how})"
 
@@ -127,17 +131,13 @@ def summary(r) -> str:
 
 def write_report(r, directory, provenance=None) -> list:
     """Write ``summary.txt``, ``diagnosis.json`` and the figures into ``directory``."""
-    from pathlib import Path
 
-    from powertrain.outputs import atomic_write
-    from powertrain.plotting import plot_diagnosis_overlay, plot_gap_frequency, plot_gap_map
     out = Path(directory)
     out.mkdir(parents=True, exist_ok=True)
     with atomic_write(out / "summary.txt") as fh:
         fh.write(r.to_text() + "\n")
     r.to_json(out / "diagnosis.json")
     files = [out / "summary.txt", out / "diagnosis.json"]
-    from powertrain.plotting.style import close_figure
     for name, fn in (("gap_map.png", plot_gap_map), ("gap_vs_frequency.png", plot_gap_frequency),
                      ("overlay.png", plot_diagnosis_overlay)):
         close_figure(fn(r, out / name, provenance=provenance))

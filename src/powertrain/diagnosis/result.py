@@ -17,8 +17,12 @@ from powertrain.diagnosis.checks import ORDER_FOLDS, ORDER_SPLIT, channel_folds
 from powertrain.diagnosis.data import GapData
 from powertrain.diagnosis.evidence import VerdictKind
 from powertrain.diagnosis.fit import FitOutcome
+from powertrain.diagnosis.report import summary, write_report
 from powertrain.diagnosis.rule import DecisionRule
 from powertrain.effects import EFFECTS
+from powertrain.outputs import atomic_write
+from powertrain.plotting import plot_gap_map
+from powertrain.plotting.style import target_and_path
 from powertrain.results.base import Result
 
 
@@ -176,7 +180,6 @@ class DiagnosisResult(Result):
         text = json.dumps(_finite_or_null(self.to_dict()), indent=1, allow_nan=False,
                           default=_jsonable)
         if path is not None:
-            from powertrain.outputs import atomic_write
             with atomic_write(path) as fh:
                 fh.write(text)
         return text
@@ -185,7 +188,6 @@ class DiagnosisResult(Result):
     def to_text(self) -> str:
         """Plain-text report: where, which, how far, verdict (what ``powertrain diagnose``
         prints and ``summary.txt`` holds; :func:`powertrain.diagnosis.report.summary`)."""
-        from powertrain.diagnosis.report import summary
         return summary(self)
 
     def plot(self, ax=None, *, path=None, quantity=None, provenance=None):
@@ -193,15 +195,12 @@ class DiagnosisResult(Result):
         :func:`powertrain.plotting.plot_gap_map`). ``ax``: None (a new figure), a Figure or
         SubFigure, or one Axes when one quantity is shown or chosen (``quantity``); else an
         InputError saying to pass a Figure."""
-        from powertrain.plotting import plot_gap_map
-        from powertrain.plotting.style import target_and_path
         ax, path = target_and_path(ax, path)
         return plot_gap_map(self, path, ax=ax, quantity=quantity,
                             provenance=provenance)
 
     def report(self, directory, provenance=None) -> list:
         """Write ``summary.txt``, ``diagnosis.json`` and the figures into ``directory``."""
-        from powertrain.diagnosis.report import write_report
         return write_report(self, directory, provenance=provenance)
 
 

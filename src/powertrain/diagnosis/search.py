@@ -10,6 +10,8 @@ import inspect
 import warnings
 
 import numpy as np
+from scipy.optimize import least_squares
+from scipy.optimize._numdiff import approx_derivative
 
 from powertrain.effects import EFFECTS
 
@@ -181,13 +183,11 @@ class Differences:
     def or_two_point(cls, fun, lower, upper):
         """A :class:`Differences`, or ``"2-point"`` where SciPy's forward differences take
         no map (``workers``, SciPy < 1.16): the same Jacobian, point by point."""
-        from scipy.optimize._numdiff import approx_derivative
         if "workers" not in inspect.signature(approx_derivative).parameters:
             return "2-point"
         return cls(fun, lower, upper)
 
     def __call__(self, x):
-        from scipy.optimize._numdiff import approx_derivative
         last_x, f0 = self.fun.last
         if last_x is None or not np.array_equal(last_x, x):
             f0 = self.fun(x)               # as "2-point" without f0: evaluated first
@@ -200,7 +200,6 @@ def trust_region(fun, pack, cands):
     """Best trust-region fit over the start points; (result-like, nfev, budget hit). The
     result is None when the best point is a stalled start's or the budget was spent: the
     caller takes ``fun.best``."""
-    from scipy.optimize import least_squares
     span = pack.upper - pack.lower
     best, nfev, stalled = None, 0, False
     jac = Differences.or_two_point(fun, pack.lower, pack.upper)

@@ -44,6 +44,11 @@ from __future__ import annotations
 import numpy as np
 
 from powertrain.analysis.channel import split_side
+from powertrain.diagnosis.data import gap_data, model_levels, residuals_db
+from powertrain.diagnosis.noise_model import point_sigma_db
+from powertrain.effects import predict
+from powertrain.effects.missing_body_mode import body_side_engine
+from powertrain.solvers.fast_harmonic import HarmonicModel
 
 #: Body when the body-side excess is at least this multiple of the engine side's [1]: the
 #: geometric middle between mount changes (≤ 6.8) and body modes (≥ 15).
@@ -158,7 +163,6 @@ def side_attribution(gap, data, sigma_db=None) -> dict | None:
     if not pairs:
         return None
     if sigma_db is None:
-        from powertrain.diagnosis.noise_model import point_sigma_db
         sigma_db = point_sigma_db(data)
     sig = np.broadcast_to(np.asarray(sigma_db, float), gap.shape)
     om = data.order_mask
@@ -193,9 +197,6 @@ def side_attribution(gap, data, sigma_db=None) -> dict | None:
 def measured_sides(measured, engine, noise_floor) -> dict | None:
     """The side attribution of a measured run-up alone: the diagnosis' "where" step on the
     gap against the model without effects, no fit (cheap; the validation's side rate)."""
-    from powertrain.diagnosis.data import gap_data, model_levels, residuals_db
-    from powertrain.effects import predict
-    from powertrain.solvers.fast_harmonic import HarmonicModel
     engine = with_measured_body_side(engine, measured)
     d = gap_data(measured, engine, noise_floor)
     hm = HarmonicModel(engine, d.rpm)
@@ -209,7 +210,6 @@ def with_measured_body_side(engine, measured):
     (channels ``NAME/passive`` of its mounts) is a modal body without modes — the body side
     predicted still, so that a missing body mode can give it motion
     (:func:`powertrain.effects.missing_body_mode.body_side_engine`); else unchanged."""
-    from powertrain.effects.missing_body_mode import body_side_engine
     ch = getattr(engine, "chassis", None)
     if ch is not None and not ch.is_rigid:
         return engine

@@ -13,10 +13,12 @@ from __future__ import annotations
 import warnings
 
 import numpy as np
+from scipy.optimize import least_squares
 
 from powertrain.analysis.noise_floor import above_floor
 from powertrain.diagnosis.search import DIFF_STEP, Differences
 from powertrain.effects import EFFECTS
+from powertrain.effects.missing_body_mode import BodyGaps
 
 #: Starts of a block refined after screening (block-wise multi-start).
 BLOCK_REFINED = 2
@@ -66,7 +68,6 @@ def _data_starts(problem, pack, effect, fun, lo, hi):
     """The :data:`DATA_KEPT` cheapest of the effect's starts read from the training gaps
     against the model without it (``Effect.data_starts``), the signs of its ``signed``
     parameters then chosen (:func:`_signs`); every evaluation charged."""
-    from powertrain.effects.missing_body_mode import BodyGaps
     d = problem.data
     fun.evaluate(problem, pack.x0)
     sc = pack.scenario(pack.x0)
@@ -177,7 +178,6 @@ class _BlockResiduals:
 
 
 def _refine_block(fun, sub, pack, x, idx, xs):
-    from scipy.optimize import least_squares
     f = _BlockResiduals(fun, sub, x, idx)
     lower, upper = pack.lower[idx], pack.upper[idx]
     with warnings.catch_warnings():

@@ -24,8 +24,11 @@ Finally the gap outside the span of rigid-body motion (:func:`rigid_span_gap`).
 from __future__ import annotations
 
 import numpy as np
+from scipy import sparse
+from scipy.sparse.linalg import spsolve
 
 from powertrain.diagnosis.data import GapData
+from powertrain.diagnosis.sides import side_text
 
 #: Gap beyond which a region is listed [dB].
 REGION_DB = 3.0
@@ -101,8 +104,6 @@ def _solve(X, P, y, cols):
     equations as a sparse system — a data row touches five columns and the ridge makes
     every penalised column regular, so this takes milliseconds where a dense SVD of the
     two-sided problem (~3400 × 670) took a quarter of a second."""
-    from scipy import sparse
-    from scipy.sparse.linalg import spsolve
     cols = np.asarray(cols)
     A = sparse.csc_matrix(np.vstack([X[:, cols], P[:, cols]]))
     used = np.flatnonzero(np.diff(A.indptr))
@@ -276,7 +277,6 @@ def where_text(found, parts):
     """The 'where' phrase of an unexplained verdict."""
     txt = attribution_text(parts["attribution"])
     if parts.get("sides"):
-        from powertrain.diagnosis.sides import side_text
         txt += "; " + side_text(parts["sides"])
     if found:
         r = found[0]
