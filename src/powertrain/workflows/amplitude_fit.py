@@ -34,10 +34,14 @@ reported per amplitude (relative RMS error, :func:`~powertrain.workflows.fitting
 from __future__ import annotations
 
 import time
+from pathlib import Path
 
 import numpy as np
+from scipy.optimize import least_squares
 
 from powertrain.errors import InputError
+from powertrain.iotools.mount_file import MAX_SI
+from powertrain.iotools.stiffness_csv import AMPLITUDE, read_stiffness_csv
 from powertrain.models.mount import TOPOLOGIES, MountModel
 from powertrain.physics.mount_laws import BergFriction, PowerLaw
 from powertrain.results.amplitude_fit import AmplitudeFitResult
@@ -131,9 +135,7 @@ def fit_mount_csv(measured, model="triple-parallel", *, friction=False, referenc
     model, starts, seed, max_mass, fmin, fmax
         As :func:`powertrain.workflows.fitting.fit_mount_file`.
     """
-    from pathlib import Path
 
-    from powertrain.iotools.stiffness_csv import AMPLITUDE, read_stiffness_csv
     starts, seed, max_mass, fmin, fmax = check_options(measured, model, starts, seed,
                                                        max_mass, fmin, fmax)
     friction = flag(friction, "--friction")
@@ -159,7 +161,6 @@ def fit_amplitudes(data, model="triple-parallel", *, friction=False, reference=N
     """Fit network, power amplitude law and (``friction``) Berg's element to ``data``
     (:class:`~powertrain.iotools.stiffness_csv.MeasuredStiffness` at two or more
     amplitudes); see the module docstring."""
-    from powertrain.iotools.mount_file import MAX_SI
     t0 = time.perf_counter()
     max_mass = MAX_SI["m"] if max_mass is None else max_mass   # what a mount file holds
     topology = TOPOLOGIES[model] if isinstance(model, str) else model
@@ -292,7 +293,6 @@ class _Joint:
         """Berg's element whose loss (imaginary describing stiffness) matches the loss of
         the data at each amplitude's lowest frequency, where the network's viscous loss is
         smallest and friction's, independent of frequency, stays."""
-        from scipy.optimize import least_squares
         a = self.amplitudes
         loss = np.array([max(c.kcp[0].imag, 0.0) for c in self.curves])
         scale = float(np.max(loss)) or 1.0
@@ -329,7 +329,6 @@ class _Joint:
         return np.clip(q, self.lo + 1e-9, self.hi - 1e-9)
 
     def solve(self, q0, max_nfev):
-        from scipy.optimize import least_squares
         with np.errstate(all="ignore"):
             return least_squares(self.residual, q0, jac=self.jacobian,
                                  bounds=(self.lo, self.hi), method="trf", x_scale="jac",

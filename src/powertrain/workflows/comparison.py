@@ -43,7 +43,9 @@ from powertrain.analysis import compare as cm
 from powertrain.analysis.noise_floor import at_floor, below_floor
 from powertrain.analysis.orders import quantity_sort_key
 from powertrain.errors import InputError
-from powertrain.iotools.measured import MeasuredRunup
+from powertrain.iotools.channel_map import split_unit
+from powertrain.iotools.measured import MeasuredRunup, read_measured
+from powertrain.iotools.raw import detect_format
 from powertrain.results.comparison import (
     EXPECTED_QUANTITIES,
     MIN_CHANNELS_CSAC,
@@ -53,6 +55,7 @@ from powertrain.results.comparison import (
 )
 from powertrain.solvers.steppers import SOLVERS
 from powertrain.workflows.arguments import MAX_SPEEDS, choice, default_rpm, nonnegative, real
+from powertrain.workflows.runup import checked_runup, engine_and_file, run_runup
 
 #: Default RMS noise floor of the measured order curves [m/s] (0.001 mm/s, see README).
 DEFAULT_NOISE_FLOOR = 1e-6
@@ -100,7 +103,6 @@ def compare(measured, *, engine=None, simulated=None, solver="newmark", step=Non
     if simulated is not None:
         sim, meas, run = _given_simulation(simulated, measured)
     else:
-        from powertrain.workflows.runup import engine_and_file
         engine, engine_file = engine_and_file(engine)
         meas = _read_curves(measured, list(engine.mount_names))
         sim = _simulate(engine, engine_file, meas, step, solver, progress)
@@ -139,8 +141,6 @@ def _given_simulation(simulated, measured):
 def _read_curves(path, mounts=None):
     """Order curves of ``path`` (a MeasuredRunup is taken as it is); raw time data are
     refused with a pointer to ``track``."""
-    from powertrain.iotools.measured import read_measured
-    from powertrain.iotools.raw import detect_format
     if isinstance(path, MeasuredRunup):
         return path
     kind = detect_format(path)
@@ -161,14 +161,12 @@ def _read_curves(path, mounts=None):
 
 def _is_raw_csv(exc) -> bool:
     """True if the order-curve reader refused a wide raw CSV (its time column)."""
-    from powertrain.iotools.channel_map import split_unit
     return bool(exc.key) and split_unit(str(exc.key))[0].strip().lower() == "time" \
         and exc.message.startswith("unknown column")
 
 
 def _simulate(engine, engine_file, meas, rpm_step, solver, progress):
     """Run the engine at the measured speeds (or on a ``rpm_step`` grid over them)."""
-    from powertrain.workflows.runup import checked_runup, run_runup
     rpm = simulation_speeds(engine, meas, rpm_step)
     grid = (f"{rpm[0]:g}..{rpm[-1]:g} rpm step {rpm_step:g}, interpolated" if rpm_step
             else f"at the {rpm.size} measured speeds {rpm[0]:g}..{rpm[-1]:g} rpm")

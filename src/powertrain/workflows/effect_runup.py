@@ -7,7 +7,9 @@ from __future__ import annotations
 
 import numpy as np
 
+from powertrain.analysis.orders import ORDERS
 from powertrain.effects import predict
+from powertrain.results.runup import RunupResult
 from powertrain.solvers.fast_harmonic import N_HARMONICS, HarmonicModel
 
 
@@ -15,8 +17,6 @@ def simulate(engine, rpm, scenario: dict):
     """Run-up velocities (harmonic steady state) of ``engine`` with the effects of
     ``scenario``; a :class:`~powertrain.results.runup.RunupResult` holding the velocity only
     (displacement = velocity/(iω), acceleration = iω·velocity, no mount forces)."""
-    from powertrain.analysis.orders import ORDERS
-    from powertrain.results.runup import RunupResult
     hm = HarmonicModel(engine, rpm)
     w = hm.omega[:, 1:N_HARMONICS][:, None, :]
     v = predict(hm, scenario).velocity

@@ -5,6 +5,7 @@ from __future__ import annotations
 import math
 
 from powertrain.errors import InputError
+from powertrain.iotools.engine_file import engine_or_default
 from powertrain.results.excitation import ExcitationResult
 from powertrain.workflows.arguments import flag, real
 
@@ -36,7 +37,6 @@ def excitation(engine=None, rpm=None, *, load=1.0, balancers=True,
         ``to_text()`` is what ``powertrain excitation`` prints; ``plot(ax=None)``,
         ``to_csv``.
     """
-    from powertrain.iotools.engine_file import engine_or_default
     rpm = real(rpm, "--rpm", unit="rpm", optional=True)
     load = real(load, "--load")
     angle_step_deg = real(angle_step_deg, "--step", unit="deg")

@@ -44,11 +44,16 @@ References
 from __future__ import annotations
 
 import dataclasses
+import math
 import time
+from pathlib import Path
 
 import numpy as np
+from scipy.optimize import least_squares
 
 from powertrain.errors import InputError
+from powertrain.iotools.stiffness_csv import FREQUENCY, read_stiffness_csv
+from powertrain.kernels.two_port import kcp_gradient_kernel
 from powertrain.models.mount import DEFAULT_TOPOLOGY, TOPOLOGIES, MountModel, Topology
 from powertrain.physics.mount_network import incidence_matrix
 from powertrain.results.fit import FitResult
@@ -215,7 +220,6 @@ class NetworkProblem:
 
     def kcp(self, p):
         """K_CP [N/m] for SI parameters ``p`` (and fill the derivative buffers)."""
-        from powertrain.kernels.two_port import kcp_gradient_kernel
         kcp_gradient_kernel(self.omega, self.B, self.to_m @ p, self.to_c @ p, self.to_d @ p,
                             self._kcp, self._dm, self._dc, self._dd)
         return self._kcp
@@ -264,7 +268,6 @@ class NetworkProblem:
         return q + np.log(s) if s > 0 else q
 
     def solve(self, q0, max_nfev, tol):
-        from scipy.optimize import least_squares
         r = least_squares(self.residual, q0, jac=self.jacobian, method="lm", x_scale="jac",
                           ftol=tol, xtol=tol, gtol=1e-12, max_nfev=max_nfev)
         return r.x, self.rel_rms(r.x), bool(r.status > 0)
@@ -433,9 +436,7 @@ def fit_mount_file(measured, model: str = DEFAULT_TOPOLOGY, *, starts: int = DEF
     """:func:`fit_mount` on the dynamic-stiffness CSV ``measured`` (``powertrain fit-mount``),
     the points in ``fmin..fmax`` [Hz]; bad input raises :class:`InputError` naming the file
     and the option. ``options``: ``polish``, ``hops`` of :func:`fit_mount`."""
-    from pathlib import Path
 
-    from powertrain.iotools.stiffness_csv import FREQUENCY, read_stiffness_csv
     starts, seed, max_mass, fmin, fmax = check_options(measured, model, starts, seed,
                                                        max_mass, fmin, fmax)
     data = read_stiffness_csv(measured).select(fmin, fmax)
@@ -467,7 +468,6 @@ def _starts(starts) -> int:
 def check_options(measured, model, starts, seed, max_mass, fmin, fmax) -> tuple:
     """Refuse options :func:`fit_mount_file` cannot use, naming the option; ``(starts,
     seed, max_mass, fmin, fmax)`` as numbers (a string as the option writes it is read)."""
-    import math
     starts, seed = integer(starts, "--starts"), integer(seed, "--seed", optional=True)
     max_mass, fmin, fmax = (real(v, k, optional=True) for v, k in (
         (max_mass, "--max-mass"), (fmin, "--fmin"), (fmax, "--fmax")))

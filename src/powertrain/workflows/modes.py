@@ -7,6 +7,7 @@ from __future__ import annotations
 import numpy as np
 
 from powertrain.errors import InputError
+from powertrain.iotools.engine_file import engine_or_default
 from powertrain.results.modes import Mode, ModesResult
 from powertrain.solvers.modes import rigid_body_modes
 from powertrain.workflows.arguments import flag
@@ -36,7 +37,6 @@ def modes(engine=None, *, static=False) -> ModesResult:
         Naming the engine file, when the model cannot be solved or a mode is not finite
         (values at the edge of the float range, a body mode that couples to nothing).
     """
-    from powertrain.iotools.engine_file import engine_or_default
     static = flag(static, "--static")
     engine = engine_or_default(engine)
     b = engine.body

@@ -17,6 +17,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from powertrain.effects import EFFECTS, RESPONSE_EFFECTS
 from powertrain.errors import InputError
 from powertrain.physics.mount_laws import BergFriction, PowerLaw, StaticCurve
 
@@ -284,7 +285,6 @@ class AddEffect:
         return {self.effect: dict(self.params)}
 
     def apply(self, engine):
-        from powertrain.effects import EFFECTS, RESPONSE_EFFECTS
         if self.effect in RESPONSE_EFFECTS:
             return engine
         eff = EFFECTS[self.effect]
@@ -303,7 +303,6 @@ def effect_scenario(operations, names=None) -> dict:
 
 def response_scenario(operations) -> dict:
     """The response-level effects of a variant's operations, merged in order."""
-    from powertrain.effects import RESPONSE_EFFECTS
     return effect_scenario(operations, RESPONSE_EFFECTS)
 
 

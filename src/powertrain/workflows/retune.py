@@ -76,8 +76,13 @@ import dataclasses
 from dataclasses import dataclass
 
 import numpy as np
+from scipy.optimize import least_squares
 
+from powertrain.models.mount import MountModel
+from powertrain.plotting import plot_retune
+from powertrain.plotting.style import target_and_path
 from powertrain.results.base import Result
+from powertrain.workflows.fitting import fit_mount
 from powertrain.workflows.operations import Origin, Swap, Target
 
 #: Log-spaced fit frequencies above 0 Hz.
@@ -296,8 +301,6 @@ class TargetFit(Result):
         :func:`powertrain.plotting.plot_retune`; ``ax`` as for
         :meth:`powertrain.results.stiffness.StiffnessResult.plot`); ``save(path)`` writes
         it (``.png``)."""
-        from powertrain.plotting import plot_retune
-        from powertrain.plotting.style import target_and_path
         ax, path = target_and_path(ax, path)
         return plot_retune(self, path, ax=ax, form=form, freq_axis=freq_axis,
                            provenance=provenance)
@@ -310,9 +313,7 @@ def _rel_rms(k, kt) -> float:
 def _refine(topology, p0, free, f, kt_cp, kt_ip):
     """Joint least squares of K_CP and K_IP relative errors over log-factors of the free
     parameters of ``p0``; returns (parameters [SI], cost)."""
-    from scipy.optimize import least_squares
 
-    from powertrain.models.mount import MountModel
     w_cp, w_ip = 1.0 / np.abs(kt_cp), 1.0 / np.abs(kt_ip)
 
     def params(q):
@@ -361,8 +362,6 @@ def retune(model, target: Target, **fit_kwargs) -> TargetFit:
     TargetFit
         Its curves at the target's amplitude (with the friction).
     """
-    from powertrain.models.mount import MountModel
-    from powertrain.workflows.fitting import fit_mount
     f = fit_frequencies(target)
     net, k_fr, (ks, ds) = network_at(model, target, f)
     k0 = net.cross_point_stiffness(f) + k_fr

@@ -24,27 +24,36 @@ solve per speed, the periodicity check, the result.
 
 from __future__ import annotations
 
+import math
 import os
 import warnings
 from dataclasses import replace
 
 import numpy as np
+from scipy.linalg import block_diag
 
 from powertrain.analysis.orders import ORDERS
+from powertrain.effects import EFFECTS, check_scenario
 from powertrain.errors import InputError, require_finite, solved
+from powertrain.iotools.engine_file import DEFAULT_ENGINE_PATH, engine_or_default, read_engine
 from powertrain.parallel import single_blas_thread
-from powertrain.progress import progress_bar
+from powertrain.progress import activity, progress_bar
 from powertrain.results.runup import RunupResult, SweepRunup
 from powertrain.results.static import StaticResult
 from powertrain.solvers.equivalent_linear import AmplitudeNotConverged
+from powertrain.solvers.modes import COORDINATES, kinetic_energy_percent
 from powertrain.solvers.operating_point import (
     has_static_curves,
     operating_points,
     static_factors,
 )
+from powertrain.solvers.speed_ramp import simulate_sweep
 from powertrain.solvers.steppers import NEWMARK_STEPPERS, SOLVERS, Cycles, choose_stepper
 from powertrain.workflows import arguments as args
 from powertrain.workflows.arguments import default_rpm
+from powertrain.workflows.operations import effect_scenario
+from powertrain.workflows.tracking import track_recording
+from powertrain.workflows.variants import parse_operations
 
 #: Default crank-angle increment [deg]; halving it moves the results < 0.1 % (see tests).
 ANGLE_STEP_DEG = 1.0
@@ -226,7 +235,6 @@ def path_contributions(system, rpm, force) -> np.ndarray:
     mounts = system.mount_names
     n_a = system.n_mount_channels
     out = np.zeros((len(rpm), 3 * len(ch.points), n_a, ORDERS.size), complex)
-    from scipy.linalg import block_diag
     E = block_diag(*system.mount_axes)          # column p: local axis of path p, at its mount
     w = np.outer(np.asarray(rpm, float) * 2 * np.pi / 60.0, ORDERS)      # (n_rpm, n_orders)
     G = ch.receptances(w, list(ch.points), mounts).reshape(w.shape + (3 * len(ch.points), n_a))
@@ -248,7 +256,6 @@ def runup_with_effects(engine, rpm, scenario: dict, **options):
     * sensor effects: the channels' displacement, velocity and acceleration are read through
       the effect (the transmitted forces are not sensor readings and stay as they are).
     """
-    from powertrain.effects import EFFECTS, check_scenario
     sc = check_scenario(scenario, engine)
     rpm = np.atleast_1d(np.asarray(rpm, float))
     for name, eff in EFFECTS.items():
@@ -302,7 +309,6 @@ def runup(engine=None, rpm=None, *, solver="newmark", stepper="auto",
     InputError
         Naming the engine file and key, or the option, of bad input.
     """
-    from powertrain.iotools.engine_file import engine_or_default
     options = _checked_options(solver, stepper, angle_step_deg, balancers, sweep, sample_rate,
                                progress)
     engine = engine_or_default(engine)
@@ -354,7 +360,6 @@ def _stepped(engine, rpm, scenario, progress, **options) -> RunupResult:
     if not scenario:
         return checked_runup(engine, engine.file, run_runup, rpm, progress=progress,
                              **options)
-    from powertrain.progress import activity
     with activity(f"run-up with effects ({options['solver']})", enabled=progress):
         return checked_runup(engine, engine.file, runup_with_effects, rpm, scenario,
                              **options)
@@ -365,16 +370,12 @@ def _scenario(effects, engine) -> dict:
     or a scenario as given."""
     if isinstance(effects, dict):
         return effects
-    from powertrain.workflows.operations import effect_scenario
-    from powertrain.workflows.variants import parse_operations
     return effect_scenario(parse_operations({"effect": args.texts(effects, "--effect")},
                                             engine=engine))
 
 
 def _sweep_runup(engine, rpm, rate, sample_rate, effects, progress) -> SweepRunup:
     """Simulate the speed ramp and track it (COT, orders 0.5..8, as velocity)."""
-    from powertrain.solvers.speed_ramp import simulate_sweep
-    from powertrain.workflows.tracking import track_recording
     if effects:
         raise InputError("effects are not simulated in a sweep (use stepped run-ups)",
                          key="--effect")
@@ -395,7 +396,6 @@ def _sweep_runup(engine, rpm, rate, sample_rate, effects, progress) -> SweepRunu
 def check_runup_settings(engine, rpm, angle_step: float) -> None:
     """Check a run-up's speeds against the engine's range and the crank-angle step, naming
     the option at fault."""
-    import math
     lo, hi = engine.speed_range_rpm()
     if rpm[0] < lo - 1e-6:
         raise InputError(f"{rpm[0]:g} rpm is below the engine's range {lo:g}..{hi:g} rpm",
@@ -444,7 +444,6 @@ def mode_coordinates(engine, frequencies_hz) -> list:
     (:meth:`~powertrain.assembly.AssembledSystem.rigid_body_modes`), matched by frequency;
     ``""`` where ``frequencies_hz`` holds a mode ``engine`` does not have (an effect moved
     it)."""
-    from powertrain.solvers.modes import COORDINATES, kinetic_energy_percent
     system = engine.assemble()
     f_sys, shapes = system.rigid_body_modes()
     out = []
@@ -459,7 +458,6 @@ def mode_coordinates(engine, frequencies_hz) -> list:
 def engine_and_file(engine=None):
     """The engine to run and the file it came from: an Engine as it is (its ``file``), a
     path read, None the shipped ``engines/default.toml``."""
-    from powertrain.iotools.engine_file import DEFAULT_ENGINE_PATH, engine_or_default, read_engine
     if engine is None or isinstance(engine, (str, os.PathLike)):
         path = str(engine or DEFAULT_ENGINE_PATH)
         return read_engine(path), path

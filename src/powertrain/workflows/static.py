@@ -7,6 +7,7 @@ from __future__ import annotations
 import numpy as np
 
 from powertrain.errors import InputError
+from powertrain.iotools.engine_file import engine_or_default
 from powertrain.results.static import StaticResult
 from powertrain.solvers.operating_point import operating_points
 from powertrain.workflows.arguments import speeds
@@ -34,7 +35,6 @@ def static(engine=None, rpm=None) -> StaticResult:
         Naming the engine file and key, or ``--rpm``, of bad input; naming the speed where
         the equilibrium is not found.
     """
-    from powertrain.iotools.engine_file import engine_or_default
     rpm = speeds(rpm)
     engine = engine_or_default(engine)
     engine.require_excitation()

@@ -9,9 +9,14 @@ from dataclasses import replace
 import numpy as np
 
 from powertrain.errors import InputError, require_finite, solved
+from powertrain.iotools.engine_file import engine_or_default, read_engine
+from powertrain.iotools.mount_file import read_mount
+from powertrain.iotools.tomlfile import read_toml
 from powertrain.models.mount import MountModel
 from powertrain.physics.mount_elements import MountElement
 from powertrain.results.stiffness import AmplitudeStiffnessResult, StiffnessResult
+from powertrain.solvers.mount_time_domain import time_cross_point_stiffness, time_forced_response
+from powertrain.units import to_si
 from powertrain.workflows.arguments import choice, frequencies, real
 
 #: Solution methods of :func:`stiffness` (``--method``).
@@ -114,7 +119,6 @@ def mount_model(mount, engine=None):
     """``(model, label)`` of :func:`stiffness`'s ``mount`` (and ``engine``): a model as given,
     a mount file read, or the direction ``"MOUNT.DIR"`` of the engine's mount (an engine file
     without excitation sections is enough)."""
-    from powertrain.iotools.mount_file import read_mount
     if engine is None:
         if isinstance(mount, (str, os.PathLike)):
             return read_mount(mount), str(mount)
@@ -125,7 +129,6 @@ def mount_model(mount, engine=None):
                              key="MOUNT_FILE")
         raise InputError(f"expected a MountModel or a mount file, got {type(mount).__name__}",
                          key="MOUNT_FILE")
-    from powertrain.iotools.engine_file import engine_or_default, read_engine
     if isinstance(engine, (str, os.PathLike)):
         engine, where = read_engine(engine), str(engine)
     else:
@@ -166,10 +169,6 @@ def stiffness_table(model, frequency_hz, method="frequency", engine_mass=None, f
         x1, ft = model.forced_engine_mass_response(f, engine_mass, force)
         return StiffnessResult(f, model.cross_point_stiffness(f), method, x1, ft)
     if method == "time":
-        from powertrain.solvers.mount_time_domain import (
-            time_cross_point_stiffness,
-            time_forced_response,
-        )
         if engine_mass is None:
             r = time_cross_point_stiffness(MountElement(model.network()), f, **kw)
             return StiffnessResult(f, r.kcp, method, periodicity=r.periodicity)
@@ -222,7 +221,6 @@ def amplitude_stiffness(model, frequency_hz, amplitude_m, method="frequency",
         if method == "frequency":
             curves.append(StiffnessResult(f, element.cross_point_stiffness(f, a), method))
         elif method == "time":
-            from powertrain.solvers.mount_time_domain import time_cross_point_stiffness
             kw = {} if steps_per_period is None else {"steps_per_period": steps_per_period}
             r = time_cross_point_stiffness(element, f, a, **kw)
             curves.append(StiffnessResult(f, r.kcp, method, periodicity=r.periodicity))
@@ -235,7 +233,6 @@ def parse_amplitudes(text: str, mount_file=None) -> np.ndarray:
     """``powertrain stiffness --amplitude``: a comma list of amplitudes in the mount file's
     displacement unit (``[units] x``; mm when it declares none or with ``--engine``), in
     [m]."""
-    from powertrain.units import to_si
     unit = _length_unit(mount_file) if isinstance(mount_file, (str, os.PathLike)) else "mm"
     try:
         values = [float(part) for part in text.split(",") if part.strip()]
@@ -248,6 +245,5 @@ def parse_amplitudes(text: str, mount_file=None) -> np.ndarray:
 
 
 def _length_unit(mount_file) -> str:
-    from powertrain.iotools.tomlfile import read_toml
     units = read_toml(str(mount_file)).get("units", {})
     return str(units.get("x", "mm")) if isinstance(units, dict) else "mm"

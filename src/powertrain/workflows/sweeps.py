@@ -28,6 +28,7 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from powertrain.parallel import run_map
+from powertrain.workflows.runup import run_runup, runup_with_effects
 
 
 @dataclass(frozen=True)
@@ -69,11 +70,9 @@ def run_task(task: SweepTask):
         ``meta["variant"]`` holds the task name.
     """
     if task.effects:
-        from powertrain.workflows.runup import runup_with_effects
         result = runup_with_effects(task.engine, task.rpm, task.effects, solver=task.solver,
                                     **task.options)
     else:
-        from powertrain.workflows.runup import run_runup
         result = run_runup(task.engine, task.rpm, solver=task.solver, **task.options)
     return replace(result, meta={**result.meta, "variant": task.name})
 

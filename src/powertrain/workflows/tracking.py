@@ -8,15 +8,21 @@ analysis.
 from __future__ import annotations
 
 from dataclasses import replace
+from pathlib import Path
 
 import numpy as np
+from scipy.signal import spectrogram
 
 from powertrain.analysis import order_tracking as cot
+from powertrain.analysis import vold_kalman as vk
 from powertrain.analysis.orders import ORDERS
+from powertrain.analysis.overall import overall_rms, parse_band
 from powertrain.analysis.phase import tdc_origin, to_tdc
-from powertrain.analysis.speed import speed_from_rpm, speed_from_tacho
+from powertrain.analysis.speed import MAX_PULSES_PER_REV, speed_from_rpm, speed_from_tacho, tacho_edges
 from powertrain.errors import InputError
+from powertrain.iotools.raw import read_raw
 from powertrain.models.recording import RawRecording
+from powertrain.plotting.orders import DISPLAY, MAP_MARGIN
 from powertrain.results.tracked import TrackedChannel, TrackedOrders
 from powertrain.workflows import arguments as args
 
@@ -138,7 +144,6 @@ def _orders(orders):
 def _check_options(tacho_column, pulses_per_rev, map_channel, maps, tdc_offset,
                    cycle_reference) -> None:
     """Refuse options that need another one, or out of range."""
-    from powertrain.analysis.speed import MAX_PULSES_PER_REV
     if tacho_column and pulses_per_rev is None:
         raise InputError("--tacho needs --pulses-per-rev N", key="--pulses-per-rev")
     if pulses_per_rev is not None and not 1 <= pulses_per_rev <= MAX_PULSES_PER_REV:
@@ -152,7 +157,6 @@ def _check_options(tacho_column, pulses_per_rev, map_channel, maps, tdc_offset,
 
 def _recording(raw, channel_map, rpm_column, tacho_column, cycle_reference=None):
     """The recording of ``raw`` (read through ``channel_map`` if a path)."""
-    from powertrain.iotools.raw import read_raw
     if isinstance(raw, RawRecording):
         return raw
     args.path_or(raw, (), "RAW", "a raw recording or its file")
@@ -164,7 +168,6 @@ def _overall_options(overall, overall_band, as_quantity):
     """The ``overall`` argument of track_recording, or None."""
     if not (overall or overall_band):
         return None
-    from powertrain.analysis.overall import parse_band
     band = parse_band(overall_band) if isinstance(overall_band, str) else overall_band
     return {"band": band, "velocity": as_quantity == "velocity"}
 
@@ -173,7 +176,6 @@ def _spectra(rec, use, pulses_per_rev, speeds, orders, quantity):
     """Order spectra at ``speeds`` (one TrackedOrders), or None."""
     if not len(speeds):
         return None
-    from dataclasses import replace
     profile = speed_profile(rec, use=use, pulses_per_rev=pulses_per_rev)
     parts = [order_spectrum(rec, profile, rpm, SPECTRUM_EXTENT * float(np.max(orders)),
                             quantity=quantity) for rpm in speeds]
@@ -200,11 +202,8 @@ def _maps(rec, use, pulses_per_rev, rpm_step, channel, max_order):
     """Campbell and rpm-frequency maps of one channel (arguments of
     :func:`~powertrain.plotting.orders.plot_maps`), both reaching 25 % above the highest
     tracked order."""
-    from pathlib import Path
 
-    from scipy.signal import spectrogram
 
-    from powertrain.plotting.orders import DISPLAY, MAP_MARGIN
     profile = speed_profile(rec, use=use, pulses_per_rev=pulses_per_rev)
     rpm, fine, rms = order_map(rec, profile, channel, rpm_step=rpm_step,
                                max_order=MAP_MARGIN * max_order)
@@ -308,7 +307,6 @@ def _profile_and_origin(rec, use, pulses_per_rev, tdc_offset_deg):
 def _tdc_origin(rec, profile, tdc_offset_deg):
     """``(origin [rad], per_cycle)``: the profile angle of cylinder-1 firing TDC and whether
     the cycle reference fixed it modulo 720° (:func:`powertrain.analysis.phase.tdc_origin`)."""
-    from powertrain.analysis.speed import tacho_edges
     edges = None
     if rec.cycle_reference is not None:
         edges = tacho_edges(rec.time, rec.cycle_reference, file=rec.source,
@@ -343,7 +341,6 @@ def overall_band(orders, rpm, sample_rate):
 def _overall(rec, chans, profile, orders, rpm, settings, band, velocity):
     """Overall level per speed and channel (SI RMS; velocity if asked); its band,
     revolutions and quantity are added to ``settings`` (the result's, still being built)."""
-    from powertrain.analysis.overall import overall_rms
     band = band or overall_band(orders, rpm, rec.sample_rate)
     turn = {"acceleration": -1, "velocity": 0, "displacement": 1}
     if velocity and any(c.quantity not in turn for c in chans):
@@ -408,7 +405,7 @@ def _track_cot(rec, chans, profile, orders, rpm_step, block_revs, progress):
     amp = np.empty((rpm.size, X.shape[0], orders.size), complex)
     steps = range(0, rpm.size, CHUNK)
     if progress:
-        from tqdm import tqdm
+        from tqdm import tqdm  # deferred: optional progress bar, imported only when shown
         steps = tqdm(steps, desc="order tracking", unit="block", leave=False,
                      disable=None, total=len(steps))
     for s in steps:
@@ -425,7 +422,6 @@ def _track_vkf(rec, chans, profile, orders, rpm_step, bandwidth_hz, progress):
     Speeds within EDGE_TIME_CONSTANTS / bandwidth of the record's ends are not reported; the
     time dropped at each end is returned in the settings (``ends_dropped_s``).
     """
-    from powertrain.analysis import vold_kalman as vk
     if bandwidth_hz is None:
         width = vk.default_bandwidth(profile, orders)
         rule = (f"per order and speed: {vk.SWEEP_FACTOR:g} x sqrt(order sweep rate), at "

@@ -73,7 +73,11 @@ import math
 import re
 from pathlib import Path
 
+from powertrain.effects import EFFECTS, check_scenario
 from powertrain.errors import InputError
+from powertrain.iotools.mount_file import DATASHEET_UNITS, SECTION_UNITS, read_mount
+from powertrain.iotools.tomlfile import read_toml
+from powertrain.units import UNITS, to_si
 from powertrain.workflows.operations import (
     LAW_KEYS,
     WILDCARD,
@@ -172,8 +176,6 @@ def parse_set(text: str, origin: Origin = Origin("--set")) -> SetParameter:
 
     Without a unit the parameter family's datasheet unit applies (c: N/mm, d: N·s/mm, m: kg).
     """
-    from powertrain.iotools.mount_file import DATASHEET_UNITS
-    from powertrain.units import UNITS, to_si
     form = "MOUNT.DIR.PARAM=VALUE, e.g. right.y.c2=150 (N/mm) or left.z.friction.max_force=20"
     left, right = _split(text, origin, form)
     if left.count(".") == 3:
@@ -206,8 +208,6 @@ def _law_value(key, right, text, origin):
     """SI value of a law key's ``--set`` (:data:`LAW_KEYS`: its datasheet unit, or an
     explicit one of the same dimension; ``LO,HI`` for ``amplitude.limits``), checked as the
     mount file checks it."""
-    from powertrain.iotools.mount_file import SECTION_UNITS
-    from powertrain.units import UNITS, to_si
     dimension, family = LAW_KEYS[key][:2]
     if key == "amplitude.limits":
         parts = right.split(",")
@@ -239,7 +239,6 @@ def parse_swap(text: str, origin: Origin = Origin("--swap"), base: Path | None =
 
     ``base``: folder relative paths are taken from (variants file folder; default cwd).
     """
-    from powertrain.iotools.mount_file import read_mount
     form = "MOUNT.DIR=FILE.toml, e.g. left.z=mounts/hydraulic-engine-mount-z.toml"
     left, right = _split(text, origin, form)
     mount, direction = _path_parts(left, 2, text, origin, form, wildcard=False)
@@ -331,8 +330,6 @@ def parse_effect(text: str, origin: Origin = Origin("--effect"), engine=None) ->
     (``c_base=400N/mm``, ``lag=5deg``). Unknown effect or parameter, a value outside the
     effect's bounds: an error naming the option.
     """
-    from powertrain.effects import EFFECTS, check_scenario
-    from powertrain.units import UNITS
     form = "NAME[:PARAM=VALUE,...], e.g. mount_stiffness:k1=1.5"
     name, _, rest = text.partition(":")
     name = name.strip()
@@ -411,7 +408,6 @@ def read_variants(path) -> list:
 
     Errors name the file, the line and the key (``variant[2].scale``).
     """
-    from powertrain.iotools.tomlfile import read_toml
     path = str(path)
     tables = _variant_tables(read_toml(path), path)
     locate = _block_locator(path)

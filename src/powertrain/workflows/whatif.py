@@ -16,7 +16,10 @@ from __future__ import annotations
 import numpy as np
 
 from powertrain.analysis.channel import Channel
+from powertrain.analysis.orders import ORDERS
 from powertrain.errors import InputError
+from powertrain.iotools.engine_checks import check_support
+from powertrain.iotools.measured import MeasuredRunup, normalise_quantity, read_measured
 from powertrain.parallel import check_scheduler
 from powertrain.results.whatif import QUANTITIES, VariantRun, WhatIfResult
 from powertrain.solvers.steppers import SOLVERS
@@ -29,6 +32,11 @@ from powertrain.workflows.arguments import (
     speeds,
     texts,
 )
+from powertrain.workflows.operations import Origin, Target, Variant, response_scenario
+from powertrain.workflows.retune import retuned_swap
+from powertrain.workflows.runup import check_runup_settings, engine_and_file
+from powertrain.workflows.sweeps import SweepTask, run_sweep
+from powertrain.workflows.variants import parse_operations, parse_target, read_variants
 
 #: Signals a what-if compares (``--signal``).
 SIGNALS = ("velocity", "mount_force")
@@ -91,7 +99,6 @@ def whatif(engine=None, *, scale=(), set=(), swap=(), move=(), rotate=(), effect
     InputError
         Naming the option (``--scale``, ``--from`` ...) or file and key of bad input.
     """
-    from powertrain.workflows.runup import check_runup_settings, engine_and_file
     workers = _checked(solver, signal, workers, executor)
     engine, _ = engine_and_file(engine)
     rpm = speeds(rpm)
@@ -110,7 +117,6 @@ def whatif(engine=None, *, scale=(), set=(), swap=(), move=(), rotate=(), effect
 def _measured(measured, engine):
     """The measurement to overlay: None, a MeasuredRunup, or its file read for ``engine``'s
     mounts."""
-    from powertrain.iotools.measured import MeasuredRunup, read_measured
     if measured is None or isinstance(measured, MeasuredRunup):
         return measured
     path_or(measured, (), "--measured", "a MeasuredRunup or its file")
@@ -133,8 +139,6 @@ def _checked(solver, signal, workers, executor=None):
 def command_variants(engine, ops: dict, targets=(), variants_file=None) -> list:
     """The variants of a command line: its operations (``{"scale": [...], ...}``) as the
     variant ``command line``, each target a variant, then those of ``variants_file``."""
-    from powertrain.workflows.operations import Origin, Variant
-    from powertrain.workflows.variants import parse_operations, parse_target, read_variants
     out = []
     parsed = parse_operations(ops, engine=engine)
     if parsed:
@@ -156,8 +160,6 @@ def command_variants(engine, ops: dict, targets=(), variants_file=None) -> list:
 def parse_objective(text, channels, rpm):
     """``CHANNEL.DIR:QUANTITY:FROM-TO`` checked against the model's ``channels`` and the
     speed steps ``rpm``: ``(channel, direction, quantity, rpm_lo, rpm_hi)``."""
-    from powertrain.analysis.orders import ORDERS
-    from powertrain.iotools.measured import normalise_quantity
     form = "CHANNEL.DIR:QUANTITY:FROM-TO, e.g. seat_rail.z:order_2:1500-3000"
     parts = [p.strip() for p in text.split(":")]
     if len(parts) != 3 or "." not in parts[0] or "-" not in parts[2]:
@@ -202,9 +204,6 @@ def variant_engine(engine, variant, **fit_kwargs):
     engine : Engine
     fits : list of TargetFit
     """
-    from powertrain.iotools.engine_checks import check_support
-    from powertrain.workflows.operations import Target
-    from powertrain.workflows.retune import retuned_swap
     stages, fits = [], []
     for op in variant.operations:
         retuned = isinstance(op, Target)
@@ -258,8 +257,6 @@ def run_whatif(engine, variants, rpm=None, *, solver: str = "harmonic", executor
         The speed step the report names [rpm] (default: that of ``rpm``; None for one
         speed).
     """
-    from powertrain.workflows.operations import response_scenario
-    from powertrain.workflows.sweeps import SweepTask, run_sweep
     rpm = default_rpm() if rpm is None else np.atleast_1d(np.asarray(rpm, float))
     names = [v.name for v in variants]
     if len(set(names)) != len(names) or "baseline" in names:
