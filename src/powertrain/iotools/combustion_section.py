@@ -14,6 +14,7 @@ from pathlib import Path
 import numpy as np
 
 from powertrain.errors import InputError
+from powertrain.iotools.pressure_csv import read_pressure_traces
 from powertrain.iotools.tomlfile import (
     array_quantity,
     check_keys,
@@ -81,7 +82,6 @@ def read_combustion(t: dict, path, crank):
 
 
 def _read_measured(t, path, crank):
-    from powertrain.iotools.pressure_csv import read_pressure_traces
     check_keys(t, KEYS["measured"], path, P)
     full = Path(path).parent / get(t, "traces", path, P, types=str)
     if not full.is_file():

@@ -46,7 +46,9 @@ from powertrain.analysis.channel import is_mount_name
 from powertrain.data import default_engine_path
 from powertrain.errors import InputError
 from powertrain.iotools.combustion_section import read_combustion
+from powertrain.iotools.engine_checks import check_engine
 from powertrain.iotools.mount_file import read_mount
+from powertrain.iotools.receptance import read_receptance
 from powertrain.iotools.tomlfile import (
     array_quantity,
     check_keys,
@@ -59,6 +61,7 @@ from powertrain.iotools.tomlfile import (
     vector3,
 )
 from powertrain.models import engine as em
+from powertrain.models.chassis import MODELS, BodyMode, Chassis
 from powertrain.models.crank_train import Balancer, BalancerShaft, CrankTrain
 from powertrain.models.mount import MountModel
 
@@ -141,7 +144,6 @@ def read_engine(path=DEFAULT_ENGINE_PATH) -> em.Engine:
     engine = em.Engine(name=name, crank=crank, body=body, mounts=mounts, balancer=balancer,
                        combustion=combustion, file=path, chassis=chassis,
                        gear_ratio=gear_ratio)
-    from powertrain.iotools.engine_checks import check_engine
     check_engine(engine, path)
     return engine
 
@@ -159,7 +161,6 @@ def _read_drive(doc, path) -> float:
 
 def _read_chassis(t, path, mount_names):
     """``[chassis]``: model rigid | modal | frf, body modes, body points of interest."""
-    from powertrain.models.chassis import MODELS, Chassis
     p = "chassis"
     check_keys(t, _ALLOWED[p], path, p)
     model = get(t, "model", path, p, types=str)
@@ -187,7 +188,6 @@ def _read_chassis(t, path, mount_names):
         modes = tuple(_read_body_mode(m, path, f"{p}.modes[{k}]", mount_names, points)
                       for k, m in enumerate(raw))
     elif model == "frf":
-        from powertrain.iotools.receptance import read_receptance
         rel = get(t, "frf", path, p, types=str)
         full = Path(path).parent / rel
         if not full.is_file():
@@ -197,7 +197,6 @@ def _read_chassis(t, path, mount_names):
 
 
 def _read_body_mode(m, path, p, mount_names, points):
-    from powertrain.models.chassis import BodyMode
     if not isinstance(m, dict):
         raise InputError("expected a table", file=path, key=p)
     check_keys(m, _ALLOWED["chassis_mode"], path, p)

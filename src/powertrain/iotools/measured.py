@@ -63,8 +63,9 @@ import numpy as np
 
 from powertrain.analysis.channel import DIRECTIONS, SIDES, Channel, passive_name, split_side
 from powertrain.analysis.orders import order_label, quantity_sort_key
-from powertrain.analysis.phase import wrap_deg
+from powertrain.analysis.phase import phase_deg, wrap_deg
 from powertrain.errors import InputError
+from powertrain.iotools.runup_hdf5 import read_runup_hdf5
 from powertrain.iotools.textfile import check_regular_file, parse_number, read_text
 
 #: Recognised level columns: name -> (factor to SI, statistic).
@@ -187,7 +188,6 @@ class MeasuredRunup:
         :class:`~powertrain.results.runup.RunupResult`: velocity, or ``mount_force``; the
         phases of its complex amplitudes (the simulation's crank angle is counted from
         cylinder-1 firing TDC)."""
-        from powertrain.analysis.phase import phase_deg
         rpm = np.asarray(result.rpm, float)
         order_idx = np.argsort(rpm)
         rms = result.order_rms(signal)[order_idx]
@@ -255,7 +255,6 @@ def _names(names, key):
 
 
 def _read_hdf5(path, mounts):
-    from powertrain.iotools.runup_hdf5 import read_runup_hdf5
     try:
         result = read_runup_hdf5(path)
     except KeyError as exc:

@@ -20,6 +20,8 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from powertrain.errors import InputError
+from powertrain.iotools.measured import read_measured
+from powertrain.iotools.pressure_csv import read_pressure_traces
 from powertrain.iotools.tomlfile import get, number, read_toml
 
 #: Keys a run may have.
@@ -50,7 +52,6 @@ class PlanRun:
     def engine(self, engine):
         """``engine`` in this run's operating state."""
         if self.traces is not None:
-            from powertrain.iotools.pressure_csv import read_pressure_traces
             comb = read_pressure_traces(self.traces, engine.crank.n_cylinders)
             engine = engine.replace(combustion=comb)
         return engine.at_load(self.load)
@@ -81,7 +82,6 @@ def read_plan(path, engine) -> Plan:
     InputError
         Naming the plan file and the key (``runs[2].load``) or the run's own file.
     """
-    from powertrain.iotools.measured import read_measured
     path = str(path)
     data = read_toml(path)
     extra = sorted(set(data) - {"runs"})

@@ -32,6 +32,7 @@ import numpy as np
 
 from powertrain.errors import InputError
 from powertrain.iotools.textfile import parse_number, read_text
+from powertrain.models.combustion import MeasuredPressure
 from powertrain.units import to_si
 
 #: Largest allowed gap between crank angles of one trace [deg].
@@ -55,7 +56,6 @@ def read_pressure_traces(path, n_cylinders: int):
     n_cylinders : int
         Number of cylinders the engine has.
     """
-    from powertrain.models.combustion import MeasuredPressure
     path = str(path)
     lines = list(enumerate(read_text(path, "CSV").splitlines(), start=1))
     body = [(n, s) for n, s in lines if s.strip() and not s.lstrip().startswith("#")]

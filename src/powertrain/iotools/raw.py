@@ -22,7 +22,12 @@ from powertrain.iotools.channel_map import (
     read_channel_map,
     split_unit,
 )
+from powertrain.iotools.raw_csv import read_csv_signals
+from powertrain.iotools.raw_hdf5 import read_hdf5_signals
+from powertrain.iotools.raw_mdf import read_mdf_signals
 from powertrain.iotools.raw_signals import FileSignals
+from powertrain.iotools.raw_uff import read_uff_signals
+from powertrain.iotools.textfile import check_regular_file
 from powertrain.models.recording import RawChannel, RawRecording
 from powertrain.units import to_si
 
@@ -33,7 +38,6 @@ _MDF = b"MDF     "
 def detect_format(path) -> str:
     """``hdf5``, ``mdf``, ``uff`` or ``csv`` from the first bytes of the file (a regular file:
     a FIFO or device is refused before it is opened, so nothing blocks)."""
-    from powertrain.iotools.textfile import check_regular_file
     check_regular_file(path)
     try:
         with open(path, "rb") as fh:
@@ -75,7 +79,6 @@ def read_raw(path, channel_map: ChannelMap | None = None, *, rpm: str | None = N
     RawRecording
         Validated, SI.
     """
-    from powertrain.iotools.textfile import check_regular_file
     check_regular_file(path)
     path = str(path)
     if isinstance(channel_map, (str, os.PathLike)):
@@ -84,14 +87,8 @@ def read_raw(path, channel_map: ChannelMap | None = None, *, rpm: str | None = N
         raise InputError(f"expected a channel map or its file, got "
                          f"{type(channel_map).__name__}", key="--channels")
     fmt = detect_format(path)
-    if fmt == "hdf5":
-        from powertrain.iotools.raw_hdf5 import read_hdf5_signals as reader
-    elif fmt == "mdf":
-        from powertrain.iotools.raw_mdf import read_mdf_signals as reader
-    elif fmt == "uff":
-        from powertrain.iotools.raw_uff import read_uff_signals as reader
-    else:
-        from powertrain.iotools.raw_csv import read_csv_signals as reader
+    reader = {"hdf5": read_hdf5_signals, "mdf": read_mdf_signals,
+              "uff": read_uff_signals}.get(fmt, read_csv_signals)
     found = reader(path, channel_map)
     return assemble(found, channel_map, rpm=rpm, tacho=tacho, cycle_reference=cycle_reference)
 

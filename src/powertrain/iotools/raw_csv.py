@@ -25,7 +25,8 @@ from powertrain.errors import InputError
 from powertrain.iotools.channel_map import split_unit
 from powertrain.iotools.raw_signals import FileSignals
 from powertrain.iotools.textfile import read_text
-from powertrain.units import to_si
+from powertrain.outputs import atomic_write
+from powertrain.units import from_si, to_si
 
 
 def read_csv_signals(path, channel_map=None) -> FileSignals:
@@ -92,8 +93,6 @@ def _numbers(lines, start, n_cols, path):
 
 def write_raw_csv(path, recording, *, comment: str = "") -> None:
     """Write a :class:`RawRecording` as a wide CSV in its channels' file units."""
-    from powertrain.outputs import atomic_write
-    from powertrain.units import from_si
     cols, names = [recording.time], ["time [s]"]
     if recording.rpm is not None:
         cols.append(recording.rpm)

@@ -30,6 +30,9 @@ import numpy as np
 
 from powertrain.errors import InputError
 from powertrain.iotools.raw_signals import FileSignals
+from powertrain.outputs import atomic_path
+from powertrain.provenance import stamp_hdf5
+from powertrain.units import from_si, to_si
 
 FORMAT = "powertrain-raw"
 
@@ -46,7 +49,7 @@ def _unit(ds):
 
 def read_hdf5_signals(path, channel_map=None) -> FileSignals:
     """Signals of a raw HDF5 file (see module docstring)."""
-    import h5py
+    import h5py  # deferred: heavy optional package
     try:
         h5 = h5py.File(path, "r")
     except OSError as exc:
@@ -116,7 +119,6 @@ def _read_own(h5, path):
     budget = _Budget()
     time = _dataset(h5, "time", path, budget)
     unit = _unit(h5["time"]) or "s"
-    from powertrain.units import to_si
     time = to_si(time, unit, "time", file=path, key="time")
     signals, times = [], {}
     for name in ("rpm", "tacho", "cycle"):
@@ -141,7 +143,6 @@ def _own_time(h5, name, path, times, budget):
     if ref is None:
         return
     ref = ref.decode() if isinstance(ref, bytes) else str(ref)
-    from powertrain.units import to_si
     times[name] = to_si(_dataset(h5, ref, path, budget), _unit(h5[ref]) or "s", "time", file=path,
                         key=ref)
 
@@ -162,11 +163,8 @@ def _read_mapped(h5, path, cmap):
 
 def write_raw_hdf5(path, recording, *, description: str = "", synthetic: bool = False) -> None:
     """Write a :class:`RawRecording` in the layout above (values in each channel's unit)."""
-    import h5py
+    import h5py  # deferred: heavy optional package
 
-    from powertrain.outputs import atomic_path
-    from powertrain.provenance import stamp_hdf5
-    from powertrain.units import from_si
     with atomic_path(path) as tmp:
         with h5py.File(tmp, "w") as h5:
             a = h5.attrs

@@ -10,6 +10,7 @@ Names follow the ``MOUNT.DIRECTION`` convention or a channel map.
 from __future__ import annotations
 
 import gc
+import os
 import sys
 import warnings
 
@@ -17,11 +18,13 @@ import numpy as np
 
 from powertrain.errors import InputError
 from powertrain.iotools.raw_signals import FileSignals
+from powertrain.outputs import atomic_path
+from powertrain.units import from_si
 
 
 def read_mdf_signals(path, channel_map=None) -> FileSignals:
     """Signals of an MDF file."""
-    from asammdf import MDF
+    from asammdf import MDF  # deferred: heavy optional package
     with open(path, "rb") as fh:
         head = fh.read(72)
     if len(head) < 72 or head[64:68] not in (b"##HD", b"HD\x00\x00") and head[64:66] != b"HD":
@@ -105,10 +108,8 @@ def _quiet_collect():
 
 def write_raw_mdf(path, recording) -> None:
     """Write a :class:`RawRecording` as MDF 4.10, one group, one channel per signal."""
-    from asammdf import MDF, Signal
+    from asammdf import MDF, Signal  # deferred: heavy optional package
 
-    from powertrain.outputs import atomic_path
-    from powertrain.units import from_si
     t = np.asarray(recording.time, float)
     sigs = []
     if recording.rpm is not None:
@@ -123,7 +124,6 @@ def write_raw_mdf(path, recording) -> None:
     mdf.append(sigs, comment=recording.source or "powertrain")
     with atomic_path(path) as tmp:
         out = mdf.save(str(tmp), overwrite=True)
-        import os
         if str(out) != str(tmp):
             os.replace(out, tmp)
     mdf.close()

@@ -13,6 +13,7 @@ tacho channels unless the map (or ``--rpm/--tacho``) says otherwise.
 from __future__ import annotations
 
 import gc
+import os
 import re
 import warnings
 
@@ -20,6 +21,8 @@ import numpy as np
 
 from powertrain.errors import InputError
 from powertrain.iotools.raw_signals import FileSignals
+from powertrain.outputs import atomic_path
+from powertrain.units import from_si
 
 #: UFF specific data types (record 8/9 field 1) of the ordinate, by our quantity.
 SPECIFIC_DATA_TYPE = {"displacement": 8, "force": 13, "velocity": 11, "acceleration": 12,
@@ -28,7 +31,7 @@ SPECIFIC_DATA_TYPE = {"displacement": 8, "force": 13, "velocity": 11, "accelerat
 
 def read_uff_signals(path, channel_map=None) -> FileSignals:
     """Signals of the datasets 58 of a UFF file."""
-    import pyuff
+    import pyuff  # deferred: heavy optional package
     problem = None
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")     # pyuff leaves its file handles to the GC
@@ -102,12 +105,9 @@ def _check_count(path, sets) -> None:
 
 def write_raw_uff(path, recording) -> None:
     """Write a :class:`RawRecording` as datasets 58 (binary, double precision)."""
-    import os
 
-    import pyuff
+    import pyuff  # deferred: heavy optional package
 
-    from powertrain.outputs import atomic_path
-    from powertrain.units import from_si
     rows = []
     if recording.rpm is not None:
         rows.append(("rpm", recording.rpm, "rpm", "rpm"))

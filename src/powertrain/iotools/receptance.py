@@ -23,7 +23,8 @@ from __future__ import annotations
 import numpy as np
 
 from powertrain.errors import InputError
-from powertrain.iotools.textfile import parse_number, read_text
+from powertrain.iotools.raw_uff import check_complete
+from powertrain.iotools.textfile import check_regular_file, parse_number, read_text
 from powertrain.models.chassis import MeasuredReceptance
 
 COLUMNS = ("frequency_hz", "response", "excitation", "receptance_real_m_per_n",
@@ -104,11 +105,9 @@ def _to_grid(data, path):
 
 
 def _read_uff(path, names):
-    from powertrain.iotools.raw_uff import check_complete
-    from powertrain.iotools.textfile import check_regular_file
     check_regular_file(path)
     try:
-        import pyuff
+        import pyuff  # deferred: heavy optional package
         sets = pyuff.UFF(path).read_sets()
     except Exception as exc:  # pyuff raises bare Exceptions on malformed files
         raise InputError(f"not a readable UFF file ({exc})"[:200], file=path) from None

@@ -9,14 +9,16 @@ import numpy as np
 
 from powertrain.errors import InputError
 from powertrain.iotools.textfile import check_regular_file
-from powertrain.results.runup import RunupResult
+from powertrain.results.runup import OPERATING_POINT, RunupResult
+from powertrain.results.static import StaticResult
+from powertrain.solvers.operating_point import OperatingPoint
 
 
 def read_runup_hdf5(path) -> RunupResult:
     """Read a run-up HDF5 file (the layout of :mod:`powertrain.results.runup`, written by
     :meth:`RunupResult.to_hdf5`); every dataset's type and shape is checked (errors name the
     file and the dataset or attribute)."""
-    import h5py
+    import h5py  # deferred: heavy optional package
     check_regular_file(path)
     try:
         h5 = h5py.File(path, "r")
@@ -58,9 +60,6 @@ def _read_open(h5, path) -> RunupResult:
 
 def _h5_operating_point(h5, path, rpm):
     """/operating_point as a :class:`~powertrain.results.static.StaticResult`, or None."""
-    from powertrain.results.runup import OPERATING_POINT
-    from powertrain.results.static import StaticResult
-    from powertrain.solvers.operating_point import OperatingPoint
     if "operating_point" not in h5:
         return None
     mounts = _h5_names(h5, "operating_point/mounts", path)
@@ -81,7 +80,7 @@ def _h5_operating_point(h5, path, rpm):
 def _h5_array(h5, key, path, kinds, ndim, shape=None):
     """Dataset ``key`` as an array of dtype kind in ``kinds`` ("f": real, "c": complex),
     ``ndim`` dimensions and, if given, ``shape``."""
-    import h5py
+    import h5py  # deferred: heavy optional package
     obj = h5.get(key)
     if not isinstance(obj, h5py.Dataset):
         raise InputError("missing dataset", file=path, key=key)
@@ -109,7 +108,7 @@ def _h5_paths(h5, path, n):
 
 def _h5_names(h5, key, path) -> list[str]:
     """1-D dataset of strings (bytes or str)."""
-    import h5py
+    import h5py  # deferred: heavy optional package
     obj = h5.get(key)
     if not isinstance(obj, h5py.Dataset) or obj.ndim != 1 or obj.dtype.kind not in "SOU":
         raise InputError("expected a 1-D dataset of names", file=path, key=key)

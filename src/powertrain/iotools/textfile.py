@@ -3,6 +3,8 @@
 from __future__ import annotations
 
 import math
+import os
+import stat
 
 from powertrain.errors import InputError
 
@@ -14,8 +16,6 @@ def check_regular_file(path) -> None:
     """Refuse, without opening it, anything but an existing regular file of at most
     :data:`MAX_FILE_BYTES` (a FIFO or device would block or never end), and anything but a
     path (an int would name an open file descriptor)."""
-    import os
-    import stat
     if not isinstance(path, (str, os.PathLike)):
         raise InputError(f"expected a file path, got {type(path).__name__} {str(path)[:40]!r}")
     try:
