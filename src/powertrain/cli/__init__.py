@@ -1,6 +1,6 @@
 """Command line: ``powertrain <command>``. Thin: parses, calls the library, prints.
 
-Each command lives in its own module and imports the library lazily, so ``--help`` is fast.
+Each command lives in its own module.
 Exit codes: 0 success, 1 bad input (one line on stderr naming file and key), 2 usage error.
 """
 

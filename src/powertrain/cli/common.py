@@ -4,10 +4,17 @@
 from __future__ import annotations
 
 import contextlib
+import json
+import os
+import signal
+import threading
 
 import click
 
 from powertrain.errors import InputError
+from powertrain.outputs import atomic_write, check_writable
+from powertrain.plotting.style import close_figure
+from powertrain.provenance import Provenance, command_line
 
 
 def speed_options(func):
@@ -26,7 +33,6 @@ def speed_options(func):
 
 def check_outputs(**targets) -> None:
     """Refuse, before any work, output paths that cannot be written (``--name=path``)."""
-    from powertrain.outputs import check_writable
     for name, path in targets.items():
         if path:
             check_writable(path, key=f"--{name.replace('_', '-')}")
@@ -35,9 +41,7 @@ def check_outputs(**targets) -> None:
 def write_json(path, text: str, provenance: dict, key: str = "--json") -> None:
     """Write a result's JSON ``text`` with a ``provenance`` key added, atomically; a result
     with a non-finite number is refused (no NaN in an output file)."""
-    import json
 
-    from powertrain.outputs import atomic_write
     doc = json.loads(text)
     doc["provenance"] = provenance
     try:
@@ -60,13 +64,11 @@ def use_agg() -> None:
 def cli_provenance(engine: str = ""):
     """:class:`~powertrain.provenance.Provenance` of this command: the command line as given,
     ``engine`` (what ran), version and time."""
-    from powertrain.provenance import Provenance, command_line
     return Provenance.now(command=command_line(), engine=engine)
 
 
 def engine_description(engine, path, *, no_balancers=False, effects=()) -> str:
     """``name (file)`` plus what the command line changed (balancers off, effects)."""
-    import os
     try:
         rel = os.path.relpath(str(path))
     except ValueError:          # another drive (Windows)
@@ -84,7 +86,6 @@ def write_plot(draw, path) -> None:
     """Draw a figure with ``draw(path)`` (a result's ``plot``) under the Agg backend, then
     release it."""
     use_agg()
-    from powertrain.plotting.style import close_figure
     close_figure(draw(path))
 
 
@@ -107,8 +108,6 @@ def terminate_as_exit():
     """Turn SIGTERM (``kill PID``) into ``SystemExit(143)`` while a command runs, so that its
     staged outputs and temporary files are removed as on any other failure (main thread
     only; other signals keep their handlers)."""
-    import signal
-    import threading
     if threading.current_thread() is not threading.main_thread():
         yield
         return

@@ -5,7 +5,11 @@ from __future__ import annotations
 import click
 
 from powertrain.analysis.noise_floor import NOISE_FLOOR_MARGIN, NOISE_FLOOR_MARGIN_DB
+from powertrain.cli.common import check_outputs, cli_provenance, engine_description, write_json, write_plot
 from powertrain.cli.group import main
+from powertrain.provenance import provenance
+from powertrain.workflows.arguments import nonnegative
+from powertrain.workflows.comparison import compare as run_compare
 
 
 @main.command()
@@ -54,9 +58,6 @@ def compare(measured, sim_file, engine_file, plot, json_file, noise_floor, solve
       powertrain compare examples/measured-runup.csv --plot compare.png --json compare.json
       powertrain compare measured.csv --sim runup.h5
     """
-    from powertrain.cli.common import check_outputs, write_json, write_plot
-    from powertrain.workflows.arguments import nonnegative
-    from powertrain.workflows.comparison import compare as run_compare
     if sim_file and engine_file:
         raise click.UsageError("give --sim or --engine, not both")
     nonnegative(noise_floor, "--noise-floor", "mm/s")
@@ -73,8 +74,6 @@ def compare(measured, sim_file, engine_file, plot, json_file, noise_floor, solve
 
 def _provenance(comp, sim_file):
     """Provenance of the figure (what ran, this command) and of the JSON file."""
-    from powertrain.cli.common import cli_provenance, engine_description
-    from powertrain.provenance import provenance
     engine = comp.run["engine"]
     if engine is None:
         return (cli_provenance(f"simulation from {sim_file}"),

@@ -3,15 +3,30 @@ unmodelled effect explains it, how far it shrinks; and synthetic measurements to
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import click
 
 from powertrain.analysis.noise_floor import NOISE_FLOOR_MARGIN
+from powertrain.cli.common import check_outputs, cli_provenance, engine_description, use_agg, write_json
 from powertrain.cli.group import main
+from powertrain.diagnosis import diagnose as run_diagnosis
+from powertrain.effects import EFFECTS
+from powertrain.errors import InputError
+from powertrain.iotools.engine_file import DEFAULT_ENGINE_PATH
+from powertrain.outputs import check_writable
+from powertrain.parallel import check_scheduler
+from powertrain.progress import activity
+from powertrain.provenance import provenance
+from powertrain.units import to_si
+from powertrain.workflows.arguments import nonnegative
+from powertrain.workflows.synth import TRUTH_ALIASES, TRUTH_EFFECTS
+from powertrain.workflows.synth import synth as run_synth
 
 
 class _ListedOption(click.Option):
     """An option whose help ends with names read from a registry when the help is shown
-    (``names`` returns them), so the registry is not imported at every start-up."""
+    (``names`` returns them)."""
 
     def __init__(self, *args, names, **kwargs):
         super().__init__(*args, **kwargs)
@@ -24,12 +39,10 @@ class _ListedOption(click.Option):
 
 
 def _library_names() -> str:
-    from powertrain.effects import EFFECTS
     return f"Known: {', '.join(EFFECTS)}."
 
 
 def _truth_names() -> str:
-    from powertrain.workflows.synth import TRUTH_ALIASES, TRUTH_EFFECTS
     old = ", ".join(f"{a} (= {n})" for a, n in TRUTH_ALIASES.items())
     return (f"Known: {', '.join(TRUTH_EFFECTS)}; or 'none'. Former names still accepted: "
             f"{old}.")
@@ -81,10 +94,6 @@ def diagnose(measured, plan_file, engine_file, report_dir, json_file, noise_floo
       powertrain diagnose case.csv --report out/diag --json out/diag.json
       powertrain diagnose --plan plan.toml --json out/plan.json
     """
-    from powertrain.cli.common import check_outputs
-    from powertrain.diagnosis import diagnose as run
-    from powertrain.parallel import check_scheduler
-    from powertrain.progress import activity
 
     measured = _measured_or_plan(measured, plan_file)
     noise_floor = _noise_floor(noise_floor)
@@ -93,7 +102,7 @@ def diagnose(measured, plan_file, engine_file, report_dir, json_file, noise_floo
     check_outputs(json=json_file)
     _check_report(report_dir)
     with activity("diagnose (fitting the effect library)", enabled=not quiet):
-        res = run(measured, engine_file, noise_floor=noise_floor, effects=names,
+        res = run_diagnosis(measured, engine_file, noise_floor=noise_floor, effects=names,
                   pairs=not no_pairs, scheduler=scheduler, progress=False)
     click.echo(res.to_text())
     if json_file:
@@ -103,7 +112,6 @@ def diagnose(measured, plan_file, engine_file, report_dir, json_file, noise_floo
 
 
 def _write_report(res, report_dir) -> None:
-    from powertrain.cli.common import cli_provenance, engine_description, use_agg
     use_agg()
     files = res.report(report_dir, provenance=cli_provenance(
         engine_description(res.engine, res.engine.file)))
@@ -112,7 +120,6 @@ def _write_report(res, report_dir) -> None:
 
 def _measured_or_plan(measured, plan_file):
     """MEASURED or ``--plan``, exactly one of them."""
-    from powertrain.errors import InputError
     if (measured is None) == (plan_file is None):
         raise InputError("give either a MEASURED file or --plan PLAN.toml (not both)"
                          if measured else "missing MEASURED file or --plan PLAN.toml",
@@ -124,23 +131,16 @@ def _measured_or_plan(measured, plan_file):
 
 def _noise_floor(value: float) -> float:
     """``--noise-floor`` [mm/s] checked, in SI [m/s]."""
-    from powertrain.units import to_si
-    from powertrain.workflows.arguments import nonnegative
     return to_si(nonnegative(value, "--noise-floor", "mm/s"), "mm/s", "velocity")
 
 
 def _check_report(report_dir) -> None:
     if report_dir:
-        from pathlib import Path
 
-        from powertrain.outputs import check_writable
         check_writable(Path(report_dir) / "summary.txt", key="--report")
 
 
 def _write_json(res, json_file, engine_file) -> None:
-    from powertrain.cli.common import write_json
-    from powertrain.iotools.engine_file import DEFAULT_ENGINE_PATH
-    from powertrain.provenance import provenance
     write_json(json_file, res.to_json(),
                provenance(res.engine, engine_file=engine_file or DEFAULT_ENGINE_PATH))
     click.echo(f"wrote {json_file}")
@@ -167,15 +167,12 @@ def synth(effect_names, seed, out, truth_file, engine_file, quiet):
       powertrain synth --effect mount_temperature --seed 1 --out m.csv --truth t.json
       powertrain synth --effect none --out clean.csv
     """
-    from powertrain.cli.common import check_outputs
-    from powertrain.progress import activity
-    from powertrain.workflows.synth import synth as run
 
     names = [] if effect_names.strip() == "none" else [
         e.strip() for e in effect_names.split(",") if e.strip()]
     check_outputs(out=out, truth=truth_file)
     with activity("synth (simulating the hidden truth)", enabled=not quiet):
-        case = run(names, seed, engine=engine_file)
+        case = run_synth(names, seed, engine=engine_file)
     case.to_csv(out)
     if truth_file:
         case.to_truth_json(truth_file)

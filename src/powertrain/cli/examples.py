@@ -9,6 +9,9 @@ from pathlib import Path
 import click
 
 from powertrain.cli.group import main
+from powertrain.data import FOLDERS, shipped_files
+from powertrain.errors import InputError
+from powertrain.outputs import atomic_path
 
 
 @main.command()
@@ -31,9 +34,6 @@ def examples(folder):
       powertrain examples .
       powertrain examples ~/powertrain-tour && cd ~/powertrain-tour
     """
-    from powertrain.data import FOLDERS, shipped_files
-    from powertrain.errors import InputError
-    from powertrain.outputs import atomic_path
 
     root = Path(folder)
     if root.exists() and not root.is_dir():

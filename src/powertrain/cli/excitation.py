@@ -6,6 +6,7 @@ import click
 
 from powertrain.cli.common import cli_provenance, engine_description, write_plot
 from powertrain.cli.group import main
+from powertrain.workflows.excitation import excitation as run
 
 
 @main.command()
@@ -41,7 +42,6 @@ def excitation(rpm, engine_file, load, no_balancers, step, csv_path, plot):
       powertrain excitation --rpm 3000 --csv out/load-3000.csv --plot out/load-3000.png
       powertrain excitation --rpm 2000 --engine engines/default.toml --no-balancers
     """
-    from powertrain.workflows.excitation import excitation as run
 
     result = run(engine_file, rpm, load=load, balancers=not no_balancers, angle_step_deg=step)
     if csv_path:

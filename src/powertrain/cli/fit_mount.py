@@ -4,9 +4,13 @@ from __future__ import annotations
 
 import click
 
-from powertrain.cli.common import plot_form_options
+from powertrain.cli.common import check_outputs, cli_provenance, plot_form_options, write_plot
 from powertrain.cli.group import main
+from powertrain.iotools.mount_file import write_mount
 from powertrain.models.mount import TOPOLOGIES
+from powertrain.progress import activity
+from powertrain.units import to_si
+from powertrain.workflows.amplitude_fit import fit_mount_csv
 from powertrain.workflows.fitting import DEFAULT_SEED, DEFAULT_STARTS
 
 _MODELS = tuple(TOPOLOGIES)
@@ -60,10 +64,6 @@ def fit_mount(measured, model, out, plot, form, freq_axis, starts, seed, fmin, f
       powertrain stiffness fitted.toml --freq 5,10,20,50,100,200,400
       powertrain fit-mount multi-amplitude.csv --friction --out fitted.toml
     """
-    from powertrain.cli.common import check_outputs
-    from powertrain.iotools.mount_file import write_mount
-    from powertrain.progress import activity
-    from powertrain.workflows.amplitude_fit import fit_mount_csv
 
     check_outputs(out=out, plot=plot)
     ref = _reference(reference)
@@ -82,7 +82,6 @@ def fit_mount(measured, model, out, plot, form, freq_axis, starts, seed, fmin, f
 def _plot(result, plot, form, freq_axis) -> None:
     """The measured-vs-fitted figure, when asked."""
     if plot:
-        from powertrain.cli.common import cli_provenance, write_plot
         prov = cli_provenance()
         write_plot(lambda p: result.plot(path=p, form=form, freq_axis=freq_axis,
                                          provenance=prov), plot)
@@ -90,5 +89,4 @@ def _plot(result, plot, form, freq_axis) -> None:
 
 def _reference(reference_mm):
     """``--reference`` [mm] in [m] (None when not given)."""
-    from powertrain.units import to_si
     return None if reference_mm is None else to_si(reference_mm, "mm", "length")

@@ -8,6 +8,10 @@ import sys
 import click
 
 from powertrain import __version__
+from powertrain.cli.common import terminate_as_exit
+from powertrain.errors import InputError
+from powertrain.outputs import OutputTransaction
+from powertrain.provenance import recording_command
 
 
 class _Group(click.Group):
@@ -19,14 +23,10 @@ class _Group(click.Group):
     """
 
     def main(self, args=None, *posargs, **kwargs):
-        from powertrain.provenance import recording_command
         with recording_command(["powertrain", *(sys.argv[1:] if args is None else args)]):
             return super().main(args, *posargs, **kwargs)
 
     def invoke(self, ctx):
-        from powertrain.cli.common import terminate_as_exit
-        from powertrain.errors import InputError
-        from powertrain.outputs import OutputTransaction
         try:
             with terminate_as_exit(), OutputTransaction():
                 return super().invoke(ctx)

@@ -4,7 +4,10 @@ from __future__ import annotations
 
 import click
 
+from powertrain.cli.common import cli_provenance, engine_description, write_plot
 from powertrain.cli.group import main
+from powertrain.iotools.engine_file import engine_or_default
+from powertrain.workflows.modes import modes as solve_modes
 
 
 @main.command()
@@ -29,9 +32,6 @@ def modes(engine_file, static, json_file, plot):
       powertrain modes --engine engines/default-torque-rod.toml --json modes.json
       powertrain modes --static --plot modes.png
     """
-    from powertrain.cli.common import cli_provenance, engine_description, write_plot
-    from powertrain.iotools.engine_file import engine_or_default
-    from powertrain.workflows.modes import modes as solve_modes
 
     engine = engine_or_default(engine_file)
     result = solve_modes(engine, static=static)

@@ -12,7 +12,12 @@ from powertrain.cli.common import (
     write_plot,
 )
 from powertrain.cli.group import main
+from powertrain.errors import InputError
+from powertrain.iotools.engine_file import engine_or_default
+from powertrain.iotools.raw_hdf5 import write_raw_hdf5
+from powertrain.workflows import runup as workflow
 from powertrain.workflows.arguments import speed_steps
+from powertrain.workflows.runup import check_path_plot
 
 
 @main.command()
@@ -72,8 +77,6 @@ def runup(rpm_from, rpm_to, rpm_step, engine_file, solver, stepper, angle_step, 
       powertrain runup --engine engines/default-modal-body.toml --path-plot paths.png
       powertrain runup --from 2000 --to 3000 --sweep 200 --raw sweep.h5 --csv sweep.csv
     """
-    from powertrain.iotools.engine_file import engine_or_default
-    from powertrain.workflows import runup as workflow
 
     rpm = speed_steps(rpm_from, rpm_to, rpm_step)
     check_outputs(out=out, csv=csv_file, plot=plot, path_plot=path_plot)
@@ -96,8 +99,6 @@ def runup(rpm_from, rpm_to, rpm_step, engine_file, solver, stepper, angle_step, 
 def _check_options(engine, path_order, raw_file, sweep) -> None:
     """The path plot's body points and order (``path_order`` None: no path plot); --raw
     only with --sweep, to a writable path."""
-    from powertrain.errors import InputError
-    from powertrain.workflows.runup import check_path_plot
     if path_order is not None:
         check_path_plot(engine, path_order)
     if raw_file and sweep is None:
@@ -123,7 +124,6 @@ def _write_runup(result, files, engine, path_order) -> list:
 
 def _write_sweep(result, files, engine) -> list:
     """The continuous run-up's raw HDF5 and tracked HDF5, CSV and figure."""
-    from powertrain.iotools.raw_hdf5 import write_raw_hdf5
     prov = cli_provenance(engine)
     if files["raw"]:
         write_raw_hdf5(files["raw"], result.recording,

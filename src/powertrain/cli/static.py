@@ -5,7 +5,12 @@ from __future__ import annotations
 
 import click
 
+from powertrain.cli.common import check_outputs, write_json
 from powertrain.cli.group import main
+from powertrain.iotools.engine_file import engine_or_default
+from powertrain.provenance import provenance
+from powertrain.workflows.arguments import parse_speeds
+from powertrain.workflows.static import static as solve
 
 
 @main.command()
@@ -29,11 +34,6 @@ def static(engine_file, rpm_list, json_file):
       powertrain static
       powertrain static --rpm 1000,3000,6000 --json static.json
     """
-    from powertrain.cli.common import check_outputs, write_json
-    from powertrain.iotools.engine_file import engine_or_default
-    from powertrain.provenance import provenance
-    from powertrain.workflows.arguments import parse_speeds
-    from powertrain.workflows.static import static as solve
 
     rpm = None if rpm_list is None else parse_speeds(rpm_list)
     check_outputs(json=json_file)

@@ -4,8 +4,10 @@ from __future__ import annotations
 
 import click
 
-from powertrain.cli.common import plot_form_options
+from powertrain.cli.common import cli_provenance, plot_form_options, write_plot
 from powertrain.cli.group import main
+from powertrain.errors import InputError
+from powertrain.workflows.stiffness import stiffness as run
 
 
 @main.command()
@@ -54,7 +56,6 @@ def stiffness(mount_file, engine_file, mount_dir, freq, method, fmt, plot, form,
       powertrain stiffness mounts/hydraulic-engine-mount-z.toml --amplitude 0.05,0.1,0.5 \\
           --method time --freq 1:100:1 --plot k.png
     """
-    from powertrain.workflows.stiffness import stiffness as run
 
     mount = _mount(mount_file, engine_file, mount_dir)
     result = run(mount, engine=engine_file, freq=freq, method=method,
@@ -65,7 +66,6 @@ def stiffness(mount_file, engine_file, mount_dir, freq, method, fmt, plot, form,
 def _report(result, fmt, plot, form, freq_axis):
     """Write the plot (when asked) and print the table, the CSV or the plot's summary."""
     if plot:
-        from powertrain.cli.common import cli_provenance, write_plot
         prov = cli_provenance()
         write_plot(lambda p: result.plot(path=p, form=form, freq_axis=freq_axis,
                                          provenance=prov), plot)
@@ -81,7 +81,6 @@ def _report(result, fmt, plot, form, freq_axis):
 def _mount(mount_file, engine_file, mount_dir):
     """The ``mount`` of :func:`powertrain.workflows.stiffness.stiffness`: MOUNT_FILE, or
     --mount of --engine."""
-    from powertrain.errors import InputError
     if (mount_file is None) == (engine_file is None):
         raise InputError("give either MOUNT_FILE or --engine with --mount", key="MOUNT_FILE")
     if mount_file is not None and mount_dir:

@@ -4,7 +4,10 @@ from __future__ import annotations
 
 import click
 
+from powertrain.cli.common import check_outputs, cli_provenance, write_plot
 from powertrain.cli.group import main
+from powertrain.errors import InputError
+from powertrain.workflows.tracking import track as run_track
 
 
 @main.command()
@@ -78,9 +81,6 @@ def track(raw, map_file, rpm_column, tacho_column, pulses_per_rev, orders_spec, 
       powertrain track run.csv --overall --spectrum-at 3000 --spectrum-out s.csv --csv t.csv
       powertrain track run.csv --pulses-per-rev 1 --tdc-offset 42 --cycle-reference cam
     """
-    from powertrain.cli.common import check_outputs
-    from powertrain.errors import InputError
-    from powertrain.workflows.tracking import track as run_track
     if rpm_column and tacho_column:
         raise click.UsageError("give --rpm or --tacho, not both")
     if bool(spectrum_at) != bool(spectrum_out):
@@ -112,7 +112,6 @@ def _write(tracked, csv_file, out, spectrum_out) -> None:
 
 def _figures(tracked, raw, plot, map_png) -> None:
     """The order curves and the maps, if asked for."""
-    from powertrain.cli.common import cli_provenance, write_plot
     prov = cli_provenance(f"none (raw time data {raw})")
     if plot:
         write_plot(lambda p: tracked.plot(path=p, provenance=prov), plot)

@@ -4,9 +4,20 @@ from __future__ import annotations
 
 import click
 
-from powertrain.cli.common import check_outputs, speed_options, write_json
+from powertrain.cli.common import (
+    check_outputs,
+    cli_provenance,
+    engine_description,
+    speed_options,
+    write_json,
+    write_plot,
+)
 from powertrain.cli.group import main
+from powertrain.iotools.engine_file import DEFAULT_ENGINE_PATH, read_engine
+from powertrain.iotools.mount_file import write_mount
+from powertrain.provenance import provenance
 from powertrain.workflows.arguments import speed_steps
+from powertrain.workflows.whatif import whatif as run_whatif
 
 
 @main.command()
@@ -94,7 +105,6 @@ def whatif(engine_file, rpm_from, rpm_to, rpm_step, solver, scale, set_, swap, m
       powertrain whatif --engine engines/default-modal-body.toml --scale left.z.stiffness=0.8 \\
           --objective seat_rail.z:order_2:1500-3000
     """
-    from powertrain.workflows.whatif import whatif as run_whatif
     outputs = (target_out, target_plot, json_file, plot, delta_plot)
     check_outputs(target_out=target_out, target_plot=target_plot, plot=plot, json=json_file,
                   delta_plot=delta_plot)
@@ -113,7 +123,6 @@ def whatif(engine_file, rpm_from, rpm_to, rpm_step, solver, scale, set_, swap, m
 
 def _baseline(engine_file, rpm_from, rpm_to, rpm_step):
     """The baseline engine and the speed steps (checked against its range by the what-if)."""
-    from powertrain.iotools.engine_file import DEFAULT_ENGINE_PATH, read_engine
     rpm = speed_steps(rpm_from, rpm_to, rpm_step)
     return read_engine(engine_file or DEFAULT_ENGINE_PATH), rpm
 
@@ -121,12 +130,8 @@ def _baseline(engine_file, rpm_from, rpm_to, rpm_step):
 def _write(result, fit, engine, engine_file, target_out, target_plot, json_file, plot,
            delta_plot) -> None:
     """Write the files asked for, each atomically."""
-    from powertrain.cli.common import cli_provenance, engine_description, write_plot
-    from powertrain.iotools.engine_file import DEFAULT_ENGINE_PATH
-    from powertrain.provenance import provenance
     prov = cli_provenance(engine_description(engine, engine.file))
     if target_out:
-        from powertrain.iotools.mount_file import write_mount
         write_mount(fit.model, target_out, comment=f"powertrain whatif: {fit.summary()}")
     if target_plot:
         write_plot(lambda p: fit.plot(path=p, provenance=prov), target_plot)
