@@ -9,14 +9,10 @@ the noise a perfect model would leave, and the speed-band confounding check.
   the rigid body carries the effect to a channel it was not fitted on); candidates with
   sensor errors or per-channel parameters (``Effect.withhold_orders``: a missing body
   mode's shape at each base) withhold orders per channel (:func:`order_folds`: each channel's
-  *informative* orders, those with measured points of that channel above the noise floor,
-  dealt into :data:`ORDER_FOLDS` folds in a staggered pattern, so every refit still sees an
-  informative order of every channel: a gain or a triad rotation is the same on every order of its channels, a
-  frequency-tied gap is not). Free gains thus cannot absorb a structural gap. The folds
-  are dealt over informative orders because orders that are all at the floor (the half
-  orders of a balanced four-cylinder engine) identify nothing, and staggered because
-  withholding an order from every channel at once leaves channels that are weak in the
-  remaining orders with unidentified gains, which a refit then moves at will;
+  *informative* orders, with points above the noise floor, dealt into :data:`ORDER_FOLDS`
+  staggered folds so that every refit still sees an informative order of every channel).
+  A gain or a triad rotation is the same on every order of its channels, a frequency-tied
+  gap is not, so free gains cannot absorb a structural gap;
 * :func:`noise_mse`: :math:`E_n = \hat\sigma^2 u`, the held-out mean squared gap a perfect
   model would leave, :math:`u` the fraction of scored held-out points that are not censored;
 * :func:`crossfit`: the candidate refitted with each other third of the speed blocks held

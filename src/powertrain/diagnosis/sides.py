@@ -16,7 +16,7 @@ from the **ratio of the body-side to the engine-side excess**,
 :math:`R = E_p/\max(E_a, \delta_a)`:
 
 * a changed **excitation** (balancer, combustion) moves both sides alike through the same
-  transfer: R about 1 (issue 21 measured 0.65-0.91 for balancer errors);
+  transfer: R about 1 (0.65-0.91 for balancer errors);
 * a changed **mount** moves the engine side directly and the body side more, through the
   changed isolation: R 3.1-6.8 (mount stiffness and amplitude-dependent mounts);
 * a changed or missing **body** mode reaches the engine side only through the bases'

@@ -101,9 +101,8 @@ def _solve(X, P, y, cols):
 
     The minimum-norm solution (as ``numpy.linalg.lstsq``): columns without an entry (a
     channel or knot with no data and no penalty) get zero, the others solve the normal
-    equations as a sparse system — a data row touches five columns and the ridge makes
-    every penalised column regular, so this takes milliseconds where a dense SVD of the
-    two-sided problem (~3400 × 670) took a quarter of a second."""
+    equations as a sparse system (a data row touches five columns and the ridge makes
+    every penalised column regular)."""
     cols = np.asarray(cols)
     A = sparse.csc_matrix(np.vstack([X[:, cols], P[:, cols]]))
     used = np.flatnonzero(np.diff(A.indptr))
