@@ -18,7 +18,7 @@ import numpy as np
 
 from powertrain.errors import InputError
 
-#: Largest speed grid a run-up accepts (about 0.1 s per speed step).
+#: Largest speed grid a run-up accepts.
 MAX_SPEEDS = 2000
 #: Most frequencies one option may ask for, and the highest frequency [Hz] (a mount model
 #: fitted below 1 kHz says nothing at 100 kHz; the limits keep a typo from hanging the run).

@@ -28,19 +28,14 @@ follows from the gain (Bode's gain-phase relation),
                    \ln\coth\frac{|u|}{2}\, du, \qquad u = \ln(f / f_0),
 
 so the requested curve is :math:`K_t(f) = K_0(f)\,g(f)\,e^{i\varphi(f)}`. (Multiplying real and
-imaginary part by :math:`g` alone -- keeping the loss angle -- is not realisable by a
-network: on the default ``left.z`` mount with ``+20%:100-300Hz`` the best triple-parallel
-fit to it misses by 9.6 % in the band and reaches only +14.7 % on average; with the Bode
-phase it fits to 3.6 % and +19.8 %.)
+imaginary part by :math:`g` alone, keeping the loss angle, is not realisable by a network.)
 
 Fit
 ---
 The body feels a mount through its *input-point* stiffness :math:`K_{IP}` (which carries the
 inertia of the network's internal masses), a test rig measures the *cross-point* one
-:math:`K_{CP}`; a fit to :math:`K_{CP}` alone does not determine :math:`K_{IP}` (on
-``left.z +20%:100-300Hz`` the K_CP-only fit meets K_CP to 3.6 % but puts a 10 t internal mass
-on the mount: K_IP 80 times the baseline's at 33 Hz, and the left mount's velocity drops by
-25 dB). The retune therefore has two stages:
+:math:`K_{CP}`; a fit to :math:`K_{CP}` alone does not determine :math:`K_{IP}` (it can
+meet K_CP with an unphysically large internal mass). The retune therefore has two stages:
 
 1. :func:`~powertrain.workflows.fitting.fit_mount` (multi-start, log-parameters, its default seeded
    starts -- it takes no user starting point) of the baseline topology to :math:`K_t` alone;

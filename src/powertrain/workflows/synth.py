@@ -85,8 +85,7 @@ TRUTH_EFFECTS = {
     "powertrain_bending": None,
     "torsional_driveline": None,
 }
-#: Former names still accepted (scripts written before the names were made one with the
-#: diagnosis library's): old name -> truth effect.
+#: Other names accepted for a truth effect: alias -> truth effect.
 TRUTH_ALIASES = {"balancer_shafts": "balancer_error"}
 #: Speed grid of a synth case [rpm].
 RPM = np.arange(1000.0, 6000.1, 50.0)
@@ -99,7 +98,7 @@ REDRAWS = 40
 
 
 def truth_effect_name(name: str) -> str:
-    """The truth effect's name, former names (:data:`TRUTH_ALIASES`) resolved."""
+    """The truth effect's name, aliases (:data:`TRUTH_ALIASES`) resolved."""
     return TRUTH_ALIASES.get(name, name)
 
 
@@ -279,7 +278,7 @@ def synth(effects=(), seed=0, *, engine=None, rpm=None, noise_db=None) -> SynthC
     Parameters
     ----------
     effects : str or sequence of str
-        Truth effects (:data:`TRUTH_EFFECTS`, former names :data:`TRUTH_ALIASES`), or as
+        Truth effects (:data:`TRUTH_EFFECTS`, aliases :data:`TRUTH_ALIASES`), or as
         ``--effect`` writes them (``"a,b"``, ``"none"``); empty: effect-free.
     seed : int
         0..2^63-1.
