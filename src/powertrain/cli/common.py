@@ -57,7 +57,7 @@ def write_json(path, text: str, provenance: dict, key: str = "--json") -> None:
 def use_agg() -> None:
     """Select matplotlib's file-only Agg backend: the CLI draws no windows. Only the CLI
     does this; the library never switches the backend."""
-    import matplotlib  # deferred: heavy optional package
+    import matplotlib  # deferred: heavy package, loaded only when a figure is drawn
     matplotlib.use("Agg")
 
 

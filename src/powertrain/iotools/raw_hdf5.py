@@ -49,7 +49,7 @@ def _unit(ds):
 
 def read_hdf5_signals(path, channel_map=None) -> FileSignals:
     """Signals of a raw HDF5 file (see module docstring)."""
-    import h5py  # deferred: heavy optional package
+    import h5py  # deferred: heavy package, loaded only when this format is used
     try:
         h5 = h5py.File(path, "r")
     except OSError as exc:
@@ -163,7 +163,7 @@ def _read_mapped(h5, path, cmap):
 
 def write_raw_hdf5(path, recording, *, description: str = "", synthetic: bool = False) -> None:
     """Write a :class:`RawRecording` in the layout above (values in each channel's unit)."""
-    import h5py  # deferred: heavy optional package
+    import h5py  # deferred: heavy package, loaded only when this format is used
 
     with atomic_path(path) as tmp:
         with h5py.File(tmp, "w") as h5:

@@ -24,7 +24,7 @@ from powertrain.units import from_si
 
 def read_mdf_signals(path, channel_map=None) -> FileSignals:
     """Signals of an MDF file."""
-    from asammdf import MDF  # deferred: heavy optional package
+    from asammdf import MDF  # deferred: heavy package, loaded only when this format is used
     with open(path, "rb") as fh:
         head = fh.read(72)
     if len(head) < 72 or head[64:68] not in (b"##HD", b"HD\x00\x00") and head[64:66] != b"HD":
@@ -108,7 +108,7 @@ def _quiet_collect():
 
 def write_raw_mdf(path, recording) -> None:
     """Write a :class:`RawRecording` as MDF 4.10, one group, one channel per signal."""
-    from asammdf import MDF, Signal  # deferred: heavy optional package
+    from asammdf import MDF, Signal  # deferred: heavy package, loaded only when this format is used
 
     t = np.asarray(recording.time, float)
     sigs = []

@@ -31,7 +31,7 @@ SPECIFIC_DATA_TYPE = {"displacement": 8, "force": 13, "velocity": 11, "accelerat
 
 def read_uff_signals(path, channel_map=None) -> FileSignals:
     """Signals of the datasets 58 of a UFF file."""
-    import pyuff  # deferred: heavy optional package
+    import pyuff  # deferred: heavy package, loaded only when this format is used
     problem = None
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")     # pyuff leaves its file handles to the GC
@@ -106,7 +106,7 @@ def _check_count(path, sets) -> None:
 def write_raw_uff(path, recording) -> None:
     """Write a :class:`RawRecording` as datasets 58 (binary, double precision)."""
 
-    import pyuff  # deferred: heavy optional package
+    import pyuff  # deferred: heavy package, loaded only when this format is used
 
     rows = []
     if recording.rpm is not None:

@@ -107,7 +107,7 @@ def _to_grid(data, path):
 def _read_uff(path, names):
     check_regular_file(path)
     try:
-        import pyuff  # deferred: heavy optional package
+        import pyuff  # deferred: heavy package, loaded only when this format is used
         sets = pyuff.UFF(path).read_sets()
     except Exception as exc:  # pyuff raises bare Exceptions on malformed files
         raise InputError(f"not a readable UFF file ({exc})"[:200], file=path) from None

@@ -18,7 +18,7 @@ def read_runup_hdf5(path) -> RunupResult:
     """Read a run-up HDF5 file (the layout of :mod:`powertrain.results.runup`, written by
     :meth:`RunupResult.to_hdf5`); every dataset's type and shape is checked (errors name the
     file and the dataset or attribute)."""
-    import h5py  # deferred: heavy optional package
+    import h5py  # deferred: heavy package, loaded only when this format is used
     check_regular_file(path)
     try:
         h5 = h5py.File(path, "r")
@@ -80,7 +80,7 @@ def _h5_operating_point(h5, path, rpm):
 def _h5_array(h5, key, path, kinds, ndim, shape=None):
     """Dataset ``key`` as an array of dtype kind in ``kinds`` ("f": real, "c": complex),
     ``ndim`` dimensions and, if given, ``shape``."""
-    import h5py  # deferred: heavy optional package
+    import h5py  # deferred: heavy package, loaded only when this format is used
     obj = h5.get(key)
     if not isinstance(obj, h5py.Dataset):
         raise InputError("missing dataset", file=path, key=key)
@@ -108,7 +108,7 @@ def _h5_paths(h5, path, n):
 
 def _h5_names(h5, key, path) -> list[str]:
     """1-D dataset of strings (bytes or str)."""
-    import h5py  # deferred: heavy optional package
+    import h5py  # deferred: heavy package, loaded only when this format is used
     obj = h5.get(key)
     if not isinstance(obj, h5py.Dataset) or obj.ndim != 1 or obj.dtype.kind not in "SOU":
         raise InputError("expected a 1-D dataset of names", file=path, key=key)

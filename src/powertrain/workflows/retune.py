@@ -186,8 +186,7 @@ def network_at(model, target: Target, frequency_hz):
 
     Without an amplitude: ``model`` itself, no friction term, factors 1. At an amplitude A:
     the network with its amplitude law's factors ``(ks, ds)`` at A and the friction's
-    describing stiffness at A beside it (zero at 0 Hz: it carries no static force), the
-    equivalent-linear element of :meth:`MountElement.two_port
+    describing stiffness at A (zero at 0 Hz), as in :meth:`MountElement.two_port
     <powertrain.physics.mount_elements.MountElement.two_port>`."""
     f = np.asarray(frequency_hz, float)
     if target.amplitude is None:
@@ -336,13 +335,8 @@ REFINE_NFEV = 3000
 
 
 def retune(model, target: Target, **fit_kwargs) -> TargetFit:
-    """Retune ``model`` (same topology, its laws kept) to the requested curve of ``target``.
-
-    At ``target.amplitude`` the curve is the mount's K_CP there (:func:`network_at`: the
-    network at its amplitude law's factors plus the friction's describing stiffness); the
-    network at that amplitude is fitted to it less the friction, and divided by the law's
-    factors back to the reference amplitude, so that the retuned mount meets the request at
-    the amplitude asked (the law and the friction unchanged).
+    """Retune ``model`` (same topology, its laws kept) to the requested curve of ``target``
+    (at ``target.amplitude``: module docstring, *At an amplitude*).
 
     Parameters
     ----------
