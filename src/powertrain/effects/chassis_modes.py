@@ -24,9 +24,12 @@ body-side motion to compare with).
 
 from __future__ import annotations
 
+import dataclasses
+
 import numpy as np
 
 from powertrain.effects.base import Effect, Parameter
+from powertrain.errors import InputError
 
 #: Frequency bounds relative to the file's value [1].
 FREQ_RANGE = (0.6, 1.6)
@@ -97,10 +100,8 @@ class ChassisModes(Effect):
         return tuple(out)
 
     def apply(self, engine, **params):
-        import dataclasses
         if not _modes(engine):
             if params and params != self.defaults(None):
-                from powertrain.errors import InputError
                 raise InputError("effect chassis_modes needs an engine with a modal body "
                                  "([chassis] model = \"modal\")", key="chassis_modes")
             return engine             # nothing to change: the defaults are the baseline

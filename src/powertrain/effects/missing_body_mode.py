@@ -44,7 +44,11 @@ import dataclasses
 
 import numpy as np
 
+from powertrain.analysis.channel import split_side
 from powertrain.effects.base import Effect, Parameter, mount_labels
+from powertrain.effects.chassis_modes import FREQ_RANGE as MOVE
+from powertrain.models.chassis import BodyMode, Chassis
+from powertrain.solvers.body_coupling import ModalBody
 
 #: Frequency bounds [Hz].
 FREQ_RANGE = (5.0, 200.0)
@@ -106,7 +110,6 @@ def mode_arrays(params, n_mounts):
 def body_side_engine(engine):
     """``engine`` with a rigid (or absent) chassis read as a modal body without modes: its
     body side is held still and predicted (zero) instead of left out."""
-    from powertrain.models.chassis import Chassis
     ch = getattr(engine, "chassis", None)
     if ch is not None and not ch.is_rigid:
         return engine
@@ -143,11 +146,9 @@ class MissingBodyMode(Effect):
         return shape_names(engine)
 
     def applicable(self, engine) -> bool:
-        from powertrain.solvers.body_coupling import ModalBody
         return ModalBody.of(engine) is not None
 
     def apply(self, engine, **params):
-        from powertrain.models.chassis import BodyMode, Chassis
         p = {**self.defaults(engine), **params}
         mode = mode_arrays(p, len(engine.mounts))
         if mode is None:
@@ -182,7 +183,6 @@ class MissingBodyMode(Effect):
         its receptance on the paired shape is a mass line (below) or a spring line (above),
         which added to the paired mode's only moves that mode and changes its mass (a moved
         28 Hz mode was fitted as a "missing" 5 Hz mode with its shape, MAC 0.99)."""
-        from powertrain.effects.chassis_modes import FREQ_RANGE as MOVE
         ch = getattr(engine, "chassis", None)
         modes = () if ch is None else ch.body_modes
         mode = mode_arrays(params, len(engine.mounts)) if modes else None
@@ -306,7 +306,6 @@ def body_gap_peak(g: BodyGaps, mount_names, n_bins=32, n_peaks=1):
 def _body_columns(g: BodyGaps, mount_names) -> dict:
     """``{channel index: (mount index, axis index, engine-side channel index)}`` of the
     body-side channels ``NAME/passive`` whose engine side is measured too."""
-    from powertrain.analysis.channel import split_side
     where = {c: i for i, c in enumerate(g.channels)}
     cols = {}
     for c, (m, d) in enumerate(g.channels):
