@@ -57,8 +57,7 @@ class ChassisModes(Effect):
     #: are not what this effect claims (a trimmed body's shapes differ from the FE model's by
     #: a few % per component; predicting a withheld channel tests them), while a moved body
     #: resonance is crossed by every order at its own speed, so orders it was not fitted on
-    #: test what it claims (on the passive benchmark's missed cases: channels explain 30-60 %,
-    #: orders 69-94 %, docs/validation/diagnosis.md)
+    #: test what it claims (docs/validation/diagnosis.md)
     withhold_orders = True
     description = ("body modes shared by the mount bases: frequency, modal mass and damping "
                    "of each of the engine file's body modes (shapes kept)")
