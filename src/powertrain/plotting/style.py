@@ -387,8 +387,8 @@ def save_figure(fig, path):
 
 
 def target_and_path(ax, path):
-    """Accept the old call ``result.plot("file.png")``: a str or path given as ``ax`` is the
-    output file."""
+    """``(ax, path)``, with a str or path given as ``ax`` taken as the output file
+    (``result.plot("file.png")``)."""
     if isinstance(ax, (str, os.PathLike)):
         return None, ax
     return ax, path
