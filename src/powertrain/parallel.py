@@ -47,9 +47,8 @@ def _threadpools():
 
 def single_blas_thread():
     """Context manager limiting BLAS to one thread: the models' matrices are small (~33×33),
-    and OpenBLAS threads cost more than they give (5× slower run-ups on a busy 2-core
-    machine). The thread pools are found once per process (finding them took 0.7 ms, paid
-    at each of the amplitude truth's hundreds of one-speed run-ups)."""
+    and BLAS threads cost more than they give on them. The thread pools are found once per
+    process."""
     return _threadpools().limit(limits=1, user_api="blas")
 
 
