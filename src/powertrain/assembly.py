@@ -19,6 +19,7 @@ import dataclasses
 from dataclasses import dataclass, field
 
 import numpy as np
+import scipy.linalg as sla
 
 from powertrain.analysis.channel import DIRECTIONS, passive_name
 from powertrain.physics.condensation import NetworkPorts, condense
@@ -174,7 +175,6 @@ class AssembledSystem:
     def rigid_body_modes(self):
         """Natural frequencies [Hz] and mode shapes of the 6-DOF body on the mounts'
         static (0 Hz) cross-point stiffness, internal masses condensed statically."""
-        import scipy.linalg as sla
         w2, vec = sla.eigh(self.static_stiffness_6(), self.M[:6, :6])
         return np.sqrt(np.clip(w2, 0, None)) / (2 * np.pi), vec
 

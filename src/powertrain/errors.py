@@ -51,7 +51,7 @@ def solved(solve, file, key):
     """``solve()``, with a model that cannot be solved (singular, overflow) reported as bad
     input naming ``file`` and ``key`` (the last guard: the checks at load catch the known
     causes first)."""
-    import numpy as np
+    import numpy as np  # deferred: keeps `import powertrain` (which loads InputError) free of numpy
     try:
         with np.errstate(all="ignore"):
             return solve()
@@ -64,7 +64,7 @@ def solved(solve, file, key):
 
 def require_finite(values: dict, file, key) -> None:
     """Refuse results holding NaN or inf (``values``: name -> array), naming the input."""
-    import numpy as np
+    import numpy as np  # deferred: keeps `import powertrain` (which loads InputError) free of numpy
     for name, value in values.items():
         if value is not None and not np.all(np.isfinite(value)):
             raise InputError(f"the computed {name} is not finite (NaN or "

@@ -23,6 +23,7 @@ from __future__ import annotations
 import contextlib
 import contextvars
 import errno
+import json
 import os
 import re
 import tempfile
@@ -194,7 +195,7 @@ def _failed(exc) -> bool:
 def _folder_lock(folder):
     """Exclusive ``flock`` of a folder (POSIX); no lock where the OS has none."""
     try:
-        import fcntl
+        import fcntl  # POSIX only: absent on Windows
     except ImportError:                  # pragma: no cover (Windows)
         yield
         return
@@ -254,7 +255,6 @@ def atomic_write(target, mode="w", **kwargs):
 def json_text(data, path=None) -> str:
     """``data`` as the indented JSON text of the result files; written atomically to ``path``
     when given."""
-    import json
     text = json.dumps(data, indent=1) + "\n"
     if path is not None:
         with atomic_write(path) as fh:

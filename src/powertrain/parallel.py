@@ -29,23 +29,26 @@ from __future__ import annotations
 
 import functools
 import os
+import socket
+import struct
 from concurrent.futures import Future, ProcessPoolExecutor
 from contextlib import contextmanager
 
+from threadpoolctl import ThreadpoolController
+
 from powertrain.errors import InputError
+from powertrain.progress import progress_bar as bar
 
 
 @functools.cache
 def _threadpools():
-    from threadpoolctl import ThreadpoolController
     return ThreadpoolController()
 
 
 def single_blas_thread():
     """Context manager limiting BLAS to one thread: the models' matrices are small (~33×33),
-    and OpenBLAS threads cost more than they give (5× slower run-ups on a busy 2-core
-    machine). The thread pools are found once per process (finding them took 0.7 ms, paid
-    at each of the amplitude truth's hundreds of one-speed run-ups)."""
+    and BLAS threads cost more than they give on them. The thread pools are found once per
+    process."""
     return _threadpools().limit(limits=1, user_api="blas")
 
 
@@ -112,8 +115,6 @@ def probe_scheduler(address: str, timeout: float = CONNECT_TIMEOUT_S) -> None:
 
     A dask scheduler greets every new connection first: a frame header (total length, then
     the number of frames, both unsigned 64-bit little-endian) and its handshake."""
-    import socket
-    import struct
     host, port = scheduler_host_port(address)
     try:
         with socket.create_connection((host, port), timeout=timeout) as sock:
@@ -185,7 +186,7 @@ def executor(scheduler=None, *, workers=None, n_jobs=None):
 @contextmanager
 def _dask_client(address, n):
     try:
-        from distributed import Client, LocalCluster
+        from distributed import Client, LocalCluster  # deferred: heavy optional package
     except ImportError as exc:          # pragma: no cover (declared dependency)
         raise InputError("dask.distributed is not installed (pip install 'dask[distributed]')",
                          key="--scheduler") from exc
@@ -230,5 +231,4 @@ def run_map(fn, items, scheduler=None, *, workers=None, progress=None, unit="job
 def progress_bar(total, desc, quiet=False, unit="it"):
     """tqdm bar on stderr (:func:`powertrain.progress.progress_bar`); disabled when
     ``quiet`` or stderr is not a terminal."""
-    from powertrain.progress import progress_bar as bar
     return bar(None, enabled=not quiet, total=total, desc=desc, unit=unit)

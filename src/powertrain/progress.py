@@ -13,7 +13,7 @@ import threading
 
 def progress_bar(iterable=None, *, enabled: bool = True, **kwargs):
     """A tqdm bar over ``iterable`` on stderr; shown only if ``enabled`` and stderr is a TTY."""
-    from tqdm import tqdm
+    from tqdm import tqdm  # deferred: heavy optional package
     kwargs.setdefault("leave", False)
     kwargs.setdefault("dynamic_ncols", True)
     return tqdm(iterable, disable=None if enabled else True, file=sys.stderr, **kwargs)

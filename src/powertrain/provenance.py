@@ -32,6 +32,8 @@ from datetime import datetime, timezone
 
 import numpy as np
 
+from powertrain import __version__
+
 #: Arrays longer than this are summarised (shape, min, max) instead of listed.
 MAX_LISTED = 64
 
@@ -54,7 +56,6 @@ def recording_command(argv):
 def stamp_hdf5(attrs, file_format: str) -> None:
     """The header every HDF5 file of the project carries: ``format``, ``format_version`` (1),
     ``powertrain_version`` and ``created`` (UTC, ISO 8601) on the root attributes."""
-    from powertrain import __version__
     attrs["format"] = file_format
     attrs["format_version"] = 1
     attrs["powertrain_version"] = __version__
@@ -109,7 +110,6 @@ def engine_as_run(engine) -> dict:
 
 def provenance(engine=None, *, engine_file=None, modifications=(), effects=None) -> dict:
     """The provenance record (see the module docstring)."""
-    from powertrain import __version__
     doc = {"command_line": command_line(), "powertrain_version": __version__,
            "created": datetime.now(timezone.utc).isoformat(timespec="seconds")}
     if engine is not None:
@@ -148,7 +148,6 @@ class Provenance:
     @classmethod
     def now(cls, command: str = "", engine: str = "") -> Provenance:
         """A provenance stamped with the current UTC time and this version."""
-        from powertrain import __version__
         stamp = _dt.datetime.now(_dt.timezone.utc).replace(microsecond=0)
         return cls(command=command, engine=engine, version=__version__,
                    date=stamp.strftime("%Y-%m-%dT%H:%M:%SZ"))
@@ -169,7 +168,6 @@ class Provenance:
     def line(self) -> str:
         """One line for a figure foot: ``powertrain 0.1.0 · 2026-11-23 18:30 UTC · engine:
         ... · $ command``."""
-        from powertrain import __version__
         parts = [f"powertrain {self.version or __version__}"]
         if self.date:
             parts.append(self.date.replace("T", " ").replace("Z", " UTC"))

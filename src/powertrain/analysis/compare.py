@@ -73,6 +73,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from powertrain.analysis.phase import wrap_deg
+
 #: Standard deviation of the Gaussian kernel of :func:`frfsm_score` [dB].
 FRFSM_SIGMA_DB = 6.0
 
@@ -274,7 +276,6 @@ def frfsm_score(gap_db, sigma_db=FRFSM_SIGMA_DB):
 def interpolate_phase(rpm, phase_deg, rpm_new):
     """Phase [deg] at ``rpm_new``: linear in rpm on the unwrapped phase between the speeds
     where it is given; NaN outside them (no extrapolation), wrapped to (-180°, 180°]."""
-    from powertrain.analysis.phase import wrap_deg
     rpm, phase = np.asarray(rpm, float), np.asarray(phase_deg, float)
     ok = np.isfinite(phase)
     rpm_new = np.asarray(rpm_new, float)
@@ -290,7 +291,6 @@ def phase_statistics(simulated, measured, sim_phase_deg, meas_phase_deg) -> dict
     """Phase gap [deg] per point and its summary (module docstring) over the points where
     both phases are finite: ``phase_gap_deg`` (NaN elsewhere), ``n_phase_compared``,
     ``phase_rms_deg``, ``phase_bias_deg``, ``complex_gap_db``, ``complex_gap_deg``."""
-    from powertrain.analysis.phase import wrap_deg
     gap = wrap_deg(np.asarray(sim_phase_deg, float) - np.asarray(meas_phase_deg, float))
     ok = np.isfinite(gap)
     out = {"phase_gap_deg": gap, "n_phase_compared": int(ok.sum())}

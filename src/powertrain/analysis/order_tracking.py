@@ -33,6 +33,7 @@ import math
 import numpy as np
 
 from powertrain.errors import InputError
+from powertrain.kernels.order_tracking import sinc_resample_kernel
 
 #: Angle samples per revolution: at least this many per unit of the highest order.
 SAMPLES_PER_ORDER = 6
@@ -199,7 +200,6 @@ def cot_amplitudes(X, profile, orders, rpm_centre, angle_centre, block_revs=None
     ndarray complex (k, n_ch, n_o)
         Peak complex amplitudes [SI], phase relative to crank angle 0.
     """
-    from powertrain.kernels.order_tracking import sinc_resample_kernel
     X = np.ascontiguousarray(X, float)
     orders = np.asarray(orders, float)
     B = block_revs or block_revolutions(orders)

@@ -17,6 +17,7 @@ fixed-frequency resonances, untracked orders — inside the band.
 from __future__ import annotations
 
 import numpy as np
+from scipy.fft import irfft, next_fast_len, rfft, rfftfreq
 
 from powertrain.analysis.order_tracking import first_passing
 from powertrain.errors import InputError
@@ -40,7 +41,6 @@ def band_limited(x, fs, band, derivative=None):
     ``derivative`` (n_ch,) of -1, 0, 1 per channel integrates (divides by :math:`i\omega`)
     or differentiates in the same pass: acceleration or displacement to velocity.
     """
-    from scipy.fft import irfft, next_fast_len, rfft, rfftfreq
     n = x.shape[-1]
     m = next_fast_len(n, real=True)
     f = rfftfreq(m, 1.0 / fs)

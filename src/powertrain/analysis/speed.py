@@ -28,6 +28,9 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 import numpy as np
+from scipy.interpolate import make_lsq_spline
+from scipy.ndimage import median_filter
+from scipy.signal import savgol_filter
 
 from powertrain.errors import InputError
 
@@ -95,7 +98,6 @@ def speed_from_rpm(time, rpm, *, smooth_s=0.1, file=None, key="rpm") -> SpeedPro
     file, key : str, optional
         File and channel named in error messages.
     """
-    from scipy.signal import savgol_filter
     time = np.asarray(time, float)
     rpm = np.asarray(rpm, float)
     window = _savgol_window(time, smooth_s)
@@ -160,7 +162,6 @@ def count_teeth(edge_times, *, file=None, key="tacho"):
         Edge times [s] kept and the cumulative pulse count at each (0 at the first).
     notes : list of str
     """
-    from scipy.ndimage import median_filter
     t = np.asarray(edge_times, float)
     notes = []
     for _ in range(3):                       # drop spikes, then re-evaluate the median
@@ -204,7 +205,6 @@ def reference_count(counts, pulses_per_rev):
 def speed_from_tacho(time, tacho, pulses_per_rev, *, smooth_s=0.1, file=None,
                      key="tacho") -> SpeedProfile:
     """Speed profile from a tacho pulse train (see module docstring)."""
-    from scipy.interpolate import make_lsq_spline
     time = np.asarray(time, float)
     if not (1 <= pulses_per_rev <= MAX_PULSES_PER_REV
             and float(pulses_per_rev).is_integer()):

@@ -55,8 +55,12 @@ from __future__ import annotations
 import math
 
 import numpy as np
+from scipy.linalg import cho_solve_banded, cholesky_banded
+from scipy.ndimage import uniform_filter1d
+from scipy.signal import resample_poly
 
 from powertrain.analysis.order_tracking import first_passing
+from powertrain.errors import InputError
 
 #: Sweep rule: f_b = SWEEP_FACTOR * sqrt(order frequency rate [Hz/s]) (module docstring).
 SWEEP_FACTOR = 1.5
@@ -80,7 +84,6 @@ def check_bandwidth(bandwidth_hz, duration_s, sample_rate):
     """Refuse a bandwidth [Hz] that is not finite and > 0, above a quarter of the sampling
     rate, or so narrow that the end transients (:data:`EDGE_TIME_CONSTANTS` / bandwidth at
     each end) leave no data of the ``duration_s`` record."""
-    from powertrain.errors import InputError
     if not 0 < bandwidth_hz <= 0.25 * sample_rate:
         raise InputError(f"must be > 0 and <= {0.25 * sample_rate:g} Hz (a quarter of the "
                          f"sampling rate), got {bandwidth_hz:g}", key="--bandwidth")
@@ -105,7 +108,6 @@ def default_bandwidth(profile, orders):
     ndarray (n_o, n)
         Bandwidth of each order at each sample of ``profile.time``.
     """
-    from scipy.ndimage import uniform_filter1d
     t, rpm = profile.time, profile.rpm
     dt = (t[-1] - t[0]) / (t.size - 1)
     i0, i1 = profile.valid
@@ -124,7 +126,6 @@ def default_bandwidth(profile, orders):
 
 def _factor(r):
     """Banded Cholesky factor of I + D^T diag(r^2) D (upper form for scipy); r (n-2,)."""
-    from scipy.linalg import cholesky_banded
     w = np.asarray(r, float) ** 2
     n = w.size + 2
     ab = np.zeros((3, n))
@@ -160,8 +161,6 @@ def vkf_amplitudes(X, profile, orders, rpm_centre, *, bandwidth_hz, progress=Fal
     ndarray complex (k, n_ch, n_o)
         Peak complex amplitudes [SI], phase relative to crank angle 0.
     """
-    from scipy.linalg import cho_solve_banded
-    from scipy.signal import resample_poly
     X = np.asarray(X, float)
     t, angle, rpm = profile.time, profile.angle, profile.rpm
     width = np.broadcast_to(np.asarray(bandwidth_hz, float), (len(orders), t.size))
@@ -177,7 +176,7 @@ def vkf_amplitudes(X, profile, orders, rpm_centre, *, bandwidth_hz, progress=Fal
     out = np.empty((len(rpm_centre), X.shape[0], len(orders)), complex)
     iterator = range(len(orders))
     if progress:
-        from tqdm import tqdm
+        from tqdm import tqdm  # deferred: heavy optional package
         iterator = tqdm(iterator, desc="Vold-Kalman", unit="order", leave=False, disable=None)
     for k in iterator:
         cb = _factor(weight_from_bandwidth(width[k, 1:-1], dt))

@@ -1,7 +1,7 @@
 r"""``amplitude_stiffness``: the elastomer's stiffness depends on the amplitude across the mount.
 
-A fit of the mount laws of issue 20, not a physics of its own: the candidate puts one
-:class:`~powertrain.physics.mount_laws.PowerLaw` on every mount direction,
+A fit of the mount laws (:mod:`powertrain.physics.mount_laws`), not a physics of its own: the
+candidate puts one :class:`~powertrain.physics.mount_laws.PowerLaw` on every mount direction,
 
 .. math:: \text{springs} \times f,\quad \text{dampers} \times f^{\gamma},\qquad
    f = \mathrm{clip}\big((A_{ref}/A)^{n},\ 0.2,\ 5\big),
@@ -10,9 +10,9 @@ A fit of the mount laws of issue 20, not a physics of its own: the candidate put
 network is unchanged at :math:`A_{ref}`), :math:`A` the amplitude of the relative
 displacement across the mount direction (√2 × RMS of orders 0.5–8), masses kept; one
 exponent :math:`n` and one damping exponent :math:`\gamma` (as ``mount_stiffness``'s: prior
-1 ± 0.5, a constant loss factor at 1) for all mounts (one law per mount design doubled the fit time without
-separating it from ``mount_stiffness``, docs/validation/diagnosis.md). :meth:`~AmplitudeStiffness.apply`
-sets :attr:`MountModel.amplitude_law <powertrain.models.mount.MountModel.amplitude_law>`,
+1 ± 0.5, a constant loss factor at 1) for all mounts (one law per mount design is not
+separable from ``mount_stiffness``). :meth:`~AmplitudeStiffness.apply` sets
+:attr:`MountModel.amplitude_law <powertrain.models.mount.MountModel.amplitude_law>`,
 which the run-up's harmonic fixed point
 (:mod:`powertrain.solvers.equivalent_linear`) solves; the fast path
 (:func:`powertrain.effects.predict`) evaluates the same

@@ -24,9 +24,12 @@ body-side motion to compare with).
 
 from __future__ import annotations
 
+import dataclasses
+
 import numpy as np
 
 from powertrain.effects.base import Effect, Parameter
+from powertrain.errors import InputError
 
 #: Frequency bounds relative to the file's value [1].
 FREQ_RANGE = (0.6, 1.6)
@@ -54,8 +57,7 @@ class ChassisModes(Effect):
     #: are not what this effect claims (a trimmed body's shapes differ from the FE model's by
     #: a few % per component; predicting a withheld channel tests them), while a moved body
     #: resonance is crossed by every order at its own speed, so orders it was not fitted on
-    #: test what it claims (on the passive benchmark's missed cases: channels explain 30-60 %,
-    #: orders 69-94 %, docs/validation/diagnosis.md)
+    #: test what it claims (docs/validation/diagnosis.md)
     withhold_orders = True
     description = ("body modes shared by the mount bases: frequency, modal mass and damping "
                    "of each of the engine file's body modes (shapes kept)")
@@ -97,10 +99,8 @@ class ChassisModes(Effect):
         return tuple(out)
 
     def apply(self, engine, **params):
-        import dataclasses
         if not _modes(engine):
             if params and params != self.defaults(None):
-                from powertrain.errors import InputError
                 raise InputError("effect chassis_modes needs an engine with a modal body "
                                  "([chassis] model = \"modal\")", key="chassis_modes")
             return engine             # nothing to change: the defaults are the baseline

@@ -21,6 +21,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from powertrain.effects.base import Effect, Parameter
+from powertrain.physics.combustion import indicated_work
 
 #: Polytropic exponent of the motored pressure [1].
 N_MOTORED = 1.32
@@ -61,7 +62,6 @@ class ScaledCombustion:
         return self.base.speed_range()
 
     def cycle_pressures(self, crank, omega, load=1.0):
-        from powertrain.physics.combustion import indicated_work
         theta, p, info = self.base.cycle_pressures(crank, omega, load)
         pm = motored_pressure(theta, p, crank)
         p_new = pm + np.asarray(self.factors, float)[:, None] * (p - pm)

@@ -29,9 +29,8 @@ frequency is a grid over the measured order frequencies in steps of :data:`GRID_
 phase swings through the resonance and marks it; magnitudes alone hardly do), each
 frequency with two shapes, that rank-1 fit over all points and over the points within ±
 :data:`PEAK_WINDOW` of it, and at the modal masses :data:`GRID_MASSES`. Over all points a
-stronger error elsewhere, or the file modes' answer on a modal body, can dominate the excess
-(a fit from that shape alone ended at BIC +2983 where one from the truth reached -6391, the
-shape at MAC 0.35 with the truth's); near the frequency the mode may not dominate either,
+stronger error elsewhere, or the file modes' answer on a modal body, can dominate the excess;
+near the frequency the mode may not dominate either,
 when its resonance on the mounts lies well above its own frequency. Without phase: from the
 body-side gap's peaks — the frequencies where the measured body side most exceeds the model
 relative to the engine side (:func:`body_gap_peak`), the shape from the excess velocity at
@@ -44,7 +43,11 @@ import dataclasses
 
 import numpy as np
 
+from powertrain.analysis.channel import split_side
 from powertrain.effects.base import Effect, Parameter, mount_labels
+from powertrain.effects.chassis_modes import FREQ_RANGE as MOVE
+from powertrain.models.chassis import BodyMode, Chassis
+from powertrain.solvers.body_coupling import ModalBody
 
 #: Frequency bounds [Hz].
 FREQ_RANGE = (5.0, 200.0)
@@ -68,21 +71,15 @@ START_PEAKS = 3
 #: Ratio of neighbouring start frequencies with phase [1] (a resonance at 2-6 % damping is
 #: 4-12 % wide).
 GRID_STEP = 1.06
-#: Modal masses of the frequency-grid starts [kg], a factor 3 apart: from one middle mass
-#: (12 kg) a 28 kg mode at 91 Hz was fitted at 64 Hz, 12 kg, 12 % damping (BIC +2712 against
-#: -2728 from the truth; docs/validation/diagnosis.md, "Eleventh round").
+#: Modal masses of the frequency-grid starts [kg], a factor 3 apart (one middle mass alone
+#: lets the fit settle on a wrong frequency; docs/validation/diagnosis.md).
 GRID_MASSES = (4.0, 12.0, 36.0)
 AXES = "xyz"
 #: Modal assurance criterion above which the fitted shape *pairs* with one of the file's body
 #: modes [1]. Below the 0.9 of a well-correlated pair of *measured* test and model modes
 #: (Allemang 2003, "The modal assurance criterion - twenty years of use and abuse"): a
 #: missing mode fitted where a file mode has moved is a stand-in whose shape also absorbs
-#: the file mode left at its old place; such stand-ins paired at 0.82 and 0.90 on moved-mode
-#: cases the held-out speeds could not tell from chassis_modes (verdict "ambiguous"; a third
-#: at 0.73, docs/validation/diagnosis.md, "Eleventh round"). The cost: the validation
-#: generator's truly missing modes restate chassis_modes at 0.8 in about 1 draw in 450 (at
-#: 0.7, 1 in 90; tests/test_missing_body_mode.py), and those only while chassis_modes
-#: explains the data as well (t <= t_min).
+#: the file mode left at its old place, and pairs less well (docs/validation/diagnosis.md).
 MAC_PAIRED = 0.8
 
 
@@ -106,7 +103,6 @@ def mode_arrays(params, n_mounts):
 def body_side_engine(engine):
     """``engine`` with a rigid (or absent) chassis read as a modal body without modes: its
     body side is held still and predicted (zero) instead of left out."""
-    from powertrain.models.chassis import Chassis
     ch = getattr(engine, "chassis", None)
     if ch is not None and not ch.is_rigid:
         return engine
@@ -120,8 +116,7 @@ class MissingBodyMode(Effect):
     #: the shape at a base is seen on that base's channels only (held-out orders instead)
     withhold_orders = True
     #: a candidate only where the gap lies on the body side: the mode moves the bases, and
-    #: its 12-parameter fit is the slowest of the library (31-74 CPU-s a diagnosis when it
-    #: ran on every modal-body engine)
+    #: its 12-parameter fit is the slowest of the library
     locations = ("body",)
     description = ("one body mode the body model lacks: frequency, modal mass, damping and "
                    "its shape at each mount base (normalised to its largest component)")
@@ -143,11 +138,9 @@ class MissingBodyMode(Effect):
         return shape_names(engine)
 
     def applicable(self, engine) -> bool:
-        from powertrain.solvers.body_coupling import ModalBody
         return ModalBody.of(engine) is not None
 
     def apply(self, engine, **params):
-        from powertrain.models.chassis import BodyMode, Chassis
         p = {**self.defaults(engine), **params}
         mode = mode_arrays(p, len(engine.mounts))
         if mode is None:
@@ -180,9 +173,7 @@ class MissingBodyMode(Effect):
         ``chassis_modes`` can move that mode to: the data then say "that mode is elsewhere",
         with no new mode needed. Also when it resonates outside the measured ``band``: there
         its receptance on the paired shape is a mass line (below) or a spring line (above),
-        which added to the paired mode's only moves that mode and changes its mass (a moved
-        28 Hz mode was fitted as a "missing" 5 Hz mode with its shape, MAC 0.99)."""
-        from powertrain.effects.chassis_modes import FREQ_RANGE as MOVE
+        which added to the paired mode's only moves that mode and changes its mass."""
         ch = getattr(engine, "chassis", None)
         modes = () if ch is None else ch.body_modes
         mode = mode_arrays(params, len(engine.mounts)) if modes else None
@@ -306,7 +297,6 @@ def body_gap_peak(g: BodyGaps, mount_names, n_bins=32, n_peaks=1):
 def _body_columns(g: BodyGaps, mount_names) -> dict:
     """``{channel index: (mount index, axis index, engine-side channel index)}`` of the
     body-side channels ``NAME/passive`` whose engine side is measured too."""
-    from powertrain.analysis.channel import split_side
     where = {c: i for i, c in enumerate(g.channels)}
     cols = {}
     for c, (m, d) in enumerate(g.channels):

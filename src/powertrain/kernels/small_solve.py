@@ -4,9 +4,8 @@ harmonic, and the modal body's coupled ones).
 
 Gaussian elimination with partial pivoting (the largest :math:`|\Re|+|\Im|` of the column,
 as LAPACK's ``zgesv``), per system in place on a copy. For a few hundred systems of size
-6–12 a hand-written loop beats the batched LAPACK call of ``numpy.linalg.solve`` several
-times over (its per-matrix overhead dominates); the results agree to round-off
-(tests/test_small_solve.py).
+6–12 a hand-written loop is faster than the batched ``numpy.linalg.solve`` (whose
+per-matrix overhead dominates); the results agree to round-off.
 """
 
 from __future__ import annotations

@@ -23,14 +23,10 @@ network is singular at that frequency, the outputs are NaN and the status is 1),
 (:math:`a = K_{IP}` with the ground fixed, :math:`b = -K_{CP}`), and, on request, the
 internal motion per unit :math:`x_E` (ground held) and per unit :math:`x_B` (engine side
 held) by back substitution. The same elimination (:func:`condense_nodes`) gives the
-cross-point stiffness and its parameter derivatives (:func:`kcp_gradient_kernel`, behind
-:func:`powertrain.physics.mount_network.cross_point_stiffness_gradient`, whose docstring has
-the maths): with the internal motion for a unit engine-side and a unit ground displacement,
-:math:`\partial K/\partial c_e = -u_e v_e`, :math:`\partial K/\partial d_e = -i\omega u_e
-v_e`, :math:`\partial K/\partial m_j = \omega^2 X_j Y_j`. The networks are small, so a
-hand-written elimination per frequency beats batched LAPACK calls by a wide margin (parameter
-identification evaluates the Jacobian thousands of times). Checked against a plain NumPy
-solve of the assembled network in tests/test_two_port.py.
+cross-point stiffness and its parameter derivatives (:func:`kcp_gradient_kernel`; the maths
+in :func:`powertrain.physics.mount_network.cross_point_stiffness_gradient`). The networks are
+small, so a hand-written elimination per frequency is much faster than batched LAPACK calls
+(parameter identification evaluates the Jacobian thousands of times).
 """
 
 from __future__ import annotations

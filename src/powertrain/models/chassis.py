@@ -22,6 +22,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from powertrain.errors import InputError
+
 
 @dataclass(frozen=True, eq=False)
 class BodyMode:
@@ -175,7 +177,6 @@ class MeasuredChassis(Chassis):
     coupled_by_admittance = True
 
     def require_time_domain(self) -> None:
-        from powertrain.errors import InputError
         raise InputError("a measured-receptance chassis (model = \"frf\") is coupled in the "
                          "frequency domain only: use the harmonic solver",
                          file=self.file or None, key="chassis.model")

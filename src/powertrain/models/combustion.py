@@ -12,6 +12,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from powertrain.errors import InputError
 from powertrain.models.crank_train import CrankTrain
 from powertrain.models.memo import Memo
 from powertrain.physics import combustion as comb
@@ -174,7 +175,6 @@ class MeasuredPressure:
 
         ``load`` must be 1 (traces are what they are).
         """
-        from powertrain.errors import InputError
         if load != 1.0:
             raise InputError("measured pressure traces cannot be scaled to another load",
                              file=self.file, key="load")

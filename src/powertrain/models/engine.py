@@ -37,8 +37,10 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from powertrain.analysis.fourier import harmonic_amplitudes
 from powertrain.assembly import assemble
-from powertrain.models.combustion import RPM
+from powertrain.errors import InputError
+from powertrain.models.combustion import RPM, LoadedCombustion
 from powertrain.models.crank_train import Balancer, CrankTrain
 from powertrain.models.memo import Memo
 from powertrain.physics import balancer as bal
@@ -136,7 +138,6 @@ class Excitation:
         amplitudes : ndarray of complex, shape (n_orders, 6)
             Complex amplitude of each load component [N, N·m] (order 0: the mean).
         """
-        from powertrain.analysis.fourier import harmonic_amplitudes
         spec = harmonic_amplitudes(self.load, axis=0)
         n_h = int(round(2 * max_order)) + 1
         return np.arange(n_h) / 2.0, spec[:n_h]
@@ -206,7 +207,6 @@ class Engine:
         :class:`~powertrain.models.combustion.LoadedCombustion`). Load 1 returns ``self``."""
         if float(load) == 1.0:
             return self
-        from powertrain.models.combustion import LoadedCombustion
         return self.replace(combustion=LoadedCombustion(self.combustion, float(load)))
 
     @property
@@ -243,7 +243,6 @@ class Engine:
     def require_excitation(self):
         """Raise :class:`~powertrain.errors.InputError` naming the missing section when the
         engine file describes no excitation."""
-        from powertrain.errors import InputError
         for section, value in (("crank_train", self.crank), ("combustion", self.combustion)):
             if value is None:
                 raise InputError(f"missing section [{section}]: this command needs the "
@@ -256,7 +255,6 @@ class Engine:
         return lo / RPM, hi / RPM
 
     def _check_speed(self, rpm):
-        from powertrain.errors import InputError
         rpm = float(rpm)
         lo, hi = self.speed_range_rpm()
         if not np.isfinite(rpm) or not lo - 1e-6 <= rpm <= hi + 1e-6:

@@ -26,6 +26,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
+from powertrain.kernels.condensation import condensed_matrix_kernel
 from powertrain.kernels.small_solve import batched_solve
 from powertrain.physics.mount_elements import describing_stiffnesses
 
@@ -85,7 +86,6 @@ def condensed_matrix(frame, engine_rows, base_rows, abc, s):
     r""":math:`\mathbf D_R(s)` of the module docstring, shape ``s.shape + (n_R, n_R)``, for
     given two-port values ``abc`` (each ``s.shape + (n_net,)``); ``base_rows`` None: every
     base grounded (``b``, ``c`` unused)."""
-    from powertrain.kernels.condensation import condensed_matrix_kernel
     s = np.asarray(s, complex)
     M0, C0, K0 = (np.ascontiguousarray(x, float) for x in frame)
     n, n_net = M0.shape[0], engine_rows.shape[0]

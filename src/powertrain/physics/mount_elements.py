@@ -11,7 +11,7 @@ between the engine-side node and the base node, acting on their relative displac
   :math:`s \ne 0`; without a port law exactly the network's two-port. A port law carries
   no mean force: it starts unloaded at the operating point (its ``initial_state`` at the
   static deflection), so at :math:`s = 0` (the static preload, the mean of a run-up) it adds
-  nothing; a static force–deflection curve is a separate matter (issue 20's operating point);
+  nothing; a static force–deflection curve is a separate matter (:mod:`powertrain.solvers.operating_point`);
 * the time domain: the port law's **kernel arrays** (kind code, parameters, initial state,
   :class:`PortForces`), integrated with the linear model by
   :func:`powertrain.kernels.port_forces.newmark_port_kernel` (Newton per step over plain arrays).

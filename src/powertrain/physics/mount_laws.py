@@ -30,6 +30,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+from scipy.interpolate import PchipInterpolator
 
 from powertrain.kernels.port_forces import BERG
 
@@ -137,7 +138,6 @@ class StaticCurve:
     reference_deflection: float = 0.0
 
     def _pchip(self):
-        from scipy.interpolate import PchipInterpolator
         return PchipInterpolator(np.asarray(self.deflection, float),
                                  np.asarray(self.force, float), extrapolate=False)
 

@@ -34,6 +34,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from powertrain.kernels.two_port import kcp_gradient_kernel, two_port_kernel, two_ports_kernel
+
 #: Index of the ground (chassis) node in ``elem_nodes``.
 GROUND = -1
 #: Index of the engine-side node.
@@ -156,7 +158,6 @@ def laplace_two_port(s, masses, elem_nodes, c, d, spring_scale=1.0, damper_scale
     FloatingPointError
         The network is singular at some ``s`` (a pivot below the kernel's tolerance).
     """
-    from powertrain.kernels.two_port import two_port_kernel
     lam = np.asarray(s, complex)
     sc = np.broadcast_to(np.asarray(spring_scale, float), lam.shape)
     t = sc if damper_scale is None else np.broadcast_to(np.asarray(damper_scale, float),
@@ -200,7 +201,6 @@ def laplace_two_ports(s, networks, spring_scales, damper_scales):
     FloatingPointError
         A network is singular at some ``s``.
     """
-    from powertrain.kernels.two_port import two_ports_kernel
     packed = networks if isinstance(networks, PackedNetworks) else PackedNetworks.of(networks)
     lam = np.asarray(s, complex)
     n = packed.n_networks
@@ -395,7 +395,6 @@ def cross_point_stiffness_gradient(omega, masses, elem_nodes, c, d):
     d = np.asarray(d, dtype=float)
     n = masses.size
     B = incidence_matrix(n, elem_nodes)
-    from powertrain.kernels.two_port import kcp_gradient_kernel
     nf, n_el = omega.size, c.size
     kcp = np.empty(nf, dtype=complex)
     dk_dm = np.empty((nf, n), dtype=complex)

@@ -7,7 +7,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from powertrain.plotting.runup import SYNTHESIS_NOTE
+from powertrain.analysis.channel import passive_name
+from powertrain.plotting import SIGNAL_UNITS
+from powertrain.plotting.runup import SYNTHESIS_NOTE, panel_title, style_panel
 from powertrain.plotting.style import (
     LABEL_SIZE,
     LEGEND_SIZE,
@@ -96,8 +98,6 @@ def plot_runup_both_sides(result, path=None, quantities=("synthesis", "order_2",
     at every speed is said in its panel title; a body-point direction zero in every column
     is not drawn but named in the figure title. Returns the figure (``ax``: None, a Figure
     or SubFigure)."""
-    from powertrain.analysis.channel import passive_name
-    from powertrain.plotting import SIGNAL_UNITS
     factor, unit = SIGNAL_UNITS[signal][:2]
     rows = [(m, d, True) for m in result.mounts for d in "xyz"]
     points = [(p, d, False) for p in result.points for d in "xyz"]
@@ -125,8 +125,6 @@ def plot_runup_both_sides(result, path=None, quantities=("synthesis", "order_2",
 
 
 def _both_sides_panel(a, result, row, quantity, signal, factor):
-    from powertrain.analysis.channel import passive_name
-    from powertrain.plotting.runup import panel_title, style_panel
     name, d, is_mount = row
     y = result.curve(name, d, quantity, signal) * factor
     values = [y]

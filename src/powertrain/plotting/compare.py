@@ -185,7 +185,7 @@ def _level_panels(panels, comparison, top_channel, limit, margin_titles):
 
 def _margin_labels(axes, panels, rows, first_quantity):
     """Speed ticks of the grid and each row's channel on the left."""
-    from matplotlib.ticker import MaxNLocator
+    from matplotlib.ticker import MaxNLocator  # deferred: heavy optional package
     axes[0, 0].xaxis.set_major_locator(MaxNLocator(nbins=3, steps=[1, 2, 5, 10]))
     for mount, direction in rows:
         panels[(mount, direction, first_quantity)].set_ylabel(f"{mount} {direction.upper()}",
@@ -283,7 +283,7 @@ def _empty_panel(a, head, reason):
 
 
 def _legend(fig, axes, limit, target):
-    from matplotlib.lines import Line2D
+    from matplotlib.lines import Line2D  # deferred: heavy optional package
     extra = [(Line2D([], [], color="0.5", ls=":", lw=0.8),
               f"noise-floor limit ({limit:g} mm/s)")] if limit > 0 else []
     legend(fig, axes, target, extra)

@@ -4,7 +4,9 @@ from __future__ import annotations
 
 import numpy as np
 
+from powertrain.analysis.noise_floor import NOISE_FLOOR_MARGIN, at_floor
 from powertrain.errors import InputError
+from powertrain.plotting.runup import style_panel
 from powertrain.plotting.style import (
     LABEL_SIZE,
     LEGEND_SIZE,
@@ -38,7 +40,6 @@ GAP_OUTLINE_RUN = 3
 def _censored(diagnosis):
     """Measured points at the noise floor (the one rule, :mod:`powertrain.analysis.noise_floor`)
     and the rule's margin."""
-    from powertrain.analysis.noise_floor import NOISE_FLOOR_MARGIN, at_floor
     d = diagnosis.data
     return np.isfinite(d.level) & at_floor(d.level, d.floor), NOISE_FLOOR_MARGIN
 
@@ -104,7 +105,7 @@ def plot_gap_map(diagnosis, path=None, *, ax=None, quantity=None, provenance=Non
 
 def _gap_panels(axes, diagnosis, qs, cens, valid):
     """Draw the gap panels; returns the last colour mesh (None when nothing was drawn)."""
-    from matplotlib.colors import ListedColormap
+    from matplotlib.colors import ListedColormap  # deferred: heavy optional package
     d = diagnosis.data
     rows = np.flatnonzero(valid.any(axis=(0, 2))) if valid.any() else \
         np.arange(len(d.channels))                       # channels with a point to show
@@ -274,7 +275,6 @@ def plot_diagnosis_overlay(diagnosis, path=None, n_panels=6, *, ax=None, provena
 
 
 def _overlay_panel(ax, diagnosis, c, k, held, rms):
-    from powertrain.plotting.runup import style_panel
     d = diagnosis.data
     g = diagnosis.gap
     m = d.level[:, c, k] * 1e3

@@ -7,6 +7,8 @@ from pathlib import Path
 
 import numpy as np
 
+from powertrain.analysis.orders import order_label
+from powertrain.plotting.runup import style_panel
 from powertrain.plotting.style import (
     LABEL_SIZE,
     LEGEND_SIZE,
@@ -39,7 +41,6 @@ MAP_MARGIN = 1.25
 
 def tracked_quantities(tracked) -> list:
     """What ``track --plot`` draws: the synthesis and every tracked order."""
-    from powertrain.analysis.orders import order_label
     return ["synthesis"] + [order_label(o) for o in tracked.orders]
 
 
@@ -50,7 +51,6 @@ def plot_tracked(tracked, path=None, quantities=None, *, ax=None, provenance=Non
     largest level, and orders wholly below it are named in the title. One legend for the
     figure; returns the figure (``ax``: None, Figure or SubFigure, or an Axes when there is
     one channel, else an InputError saying to pass a Figure)."""
-    from powertrain.plotting.runup import style_panel
     quantities = list(quantities or tracked_quantities(tracked))
     n = len(tracked.channels)
     cols = min(3, n)

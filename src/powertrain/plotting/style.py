@@ -9,11 +9,15 @@ backend (the CLI picks Agg, :func:`powertrain.cli.common.use_agg`).
 from __future__ import annotations
 
 import math
+import os
 import textwrap
 
 import numpy as np
 
+from powertrain import __version__
 from powertrain.errors import InputError
+from powertrain.outputs import atomic_path
+from powertrain.provenance import Provenance
 
 #: Display factor and unit of each run-up signal (SI -> plot unit).
 SIGNAL_UNITS = {"velocity": (1e3, "mm/s"), "displacement": (1e6, "µm"),
@@ -73,10 +77,10 @@ def subplots(target, nrows=1, ncols=1, figsize=(PRINT_WIDTH_IN, 3.6), **kwargs):
     own : bool
         True when the figure was made here (then the caller adds title, legend, provenance).
     """
-    from matplotlib.axes import Axes
-    from matplotlib.figure import FigureBase
+    from matplotlib.axes import Axes  # deferred: heavy optional package
+    from matplotlib.figure import FigureBase  # deferred: heavy optional package
     if target is None:
-        import matplotlib.pyplot as plt
+        import matplotlib.pyplot as plt  # deferred: heavy optional package
         fig = plt.figure(figsize=figsize, layout="constrained")
         return fig, _use_palette(fig.subplots(nrows, ncols, squeeze=False, **kwargs)), True
     if isinstance(target, FigureBase):
@@ -136,7 +140,7 @@ def is_axes(target) -> bool:
     """True for a single matplotlib Axes (then grid plots draw one chosen panel)."""
     if target is None:
         return False
-    from matplotlib.axes import Axes
+    from matplotlib.axes import Axes  # deferred: heavy optional package
     return isinstance(target, Axes)
 
 
@@ -205,9 +209,7 @@ def add_provenance(fig, provenance):
         A :class:`~powertrain.provenance.Provenance`, or a record of
         :func:`powertrain.provenance.provenance`; None: only the program version is shown.
     """
-    from powertrain import __version__
     if isinstance(provenance, dict):   # a record of powertrain.provenance.provenance()
-        from powertrain.provenance import Provenance
         provenance = Provenance.from_record(provenance)
     text = provenance.line() if provenance is not None else f"powertrain {__version__}"
     width, height = fig.get_figwidth(), fig.get_figheight()
@@ -271,7 +273,7 @@ def _log_ticks(vmin, vmax, max_ticks, min_gap=0.0):
         fine = _spaced(inside(subs), min_gap)
         if 2 <= len(fine) <= max_ticks:
             return np.array(fine)
-    from matplotlib.ticker import MaxNLocator
+    from matplotlib.ticker import MaxNLocator  # deferred: heavy optional package
     lin = MaxNLocator(nbins=3, steps=[1, 2, 2.5, 5, 10]).tick_values(vmin, vmax)
     return np.array(_spaced([v for v in lin if vmin <= v <= vmax and v > 0], min_gap))
 
@@ -299,7 +301,12 @@ def log_axis(ax, axis="x", max_ticks=8, minor=True):
     minor : bool
         Unlabelled minor ticks at 2..9 × 10^n (off in large grids: they cost drawing time).
     """
-    from matplotlib.ticker import FuncFormatter, Locator, LogLocator, NullFormatter
+    from matplotlib.ticker import (  # deferred: heavy optional package
+        FuncFormatter,
+        Locator,
+        LogLocator,
+        NullFormatter,
+    )
 
     class PlainLogLocator(Locator):
         def __call__(self):
@@ -326,7 +333,7 @@ def log_axis(ax, axis="x", max_ticks=8, minor=True):
     if minor:
         target.set_minor_locator(LogLocator(subs=np.arange(2, 10), numticks=100))
     else:
-        from matplotlib.ticker import NullLocator
+        from matplotlib.ticker import NullLocator  # deferred: heavy optional package
         target.set_minor_locator(NullLocator())
     target.set_minor_formatter(NullFormatter())
 
@@ -372,7 +379,6 @@ def figure_legend(fig, axes, extra=(), fontsize=LEGEND_SIZE):
 # ------------------------------------------------------------------ output
 def save_figure(fig, path):
     """Save a figure as PNG atomically (no half-written file on failure)."""
-    from powertrain.outputs import atomic_path
     root = fig
     while getattr(root, "figure", None) is not None and root.figure is not root:
         root = root.figure
@@ -381,9 +387,8 @@ def save_figure(fig, path):
 
 
 def target_and_path(ax, path):
-    """Accept the old call ``result.plot("file.png")``: a str or path given as ``ax`` is the
-    output file."""
-    import os
+    """``(ax, path)``, with a str or path given as ``ax`` taken as the output file
+    (``result.plot("file.png")``)."""
     if isinstance(ax, (str, os.PathLike)):
         return None, ax
     return ax, path
@@ -391,5 +396,5 @@ def target_and_path(ax, path):
 
 def close_figure(fig):
     """Release a pyplot figure (after saving it, when nobody will show it)."""
-    import matplotlib.pyplot as plt
+    import matplotlib.pyplot as plt  # deferred: heavy optional package
     plt.close(fig)

@@ -8,8 +8,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from powertrain.plotting.stiffness import plot_amplitude_fit
+from powertrain.plotting.style import target_and_path
 from powertrain.results.base import Result
 from powertrain.results.fit import PARAMETER_UNITS, FitResult
+from powertrain.units import from_si
 
 
 @dataclass(frozen=True)
@@ -81,7 +84,6 @@ class AmplitudeFitResult(Result):
     def to_text(self) -> str:
         """:meth:`summary` and the fitted values in datasheet units (what ``powertrain
         fit-mount`` prints)."""
-        from powertrain.units import from_si
         m = self.model
         lines = [self.summary(), "parameters:"]
         for p in m.topology.parameters:
@@ -109,8 +111,6 @@ class AmplitudeFitResult(Result):
         """Measured (dots) and fitted (lines) K*(f), one colour per amplitude (see
         :func:`powertrain.plotting.stiffness.plot_amplitude_fit`; ``ax`` as for
         :meth:`powertrain.results.stiffness.StiffnessResult.plot`)."""
-        from powertrain.plotting.stiffness import plot_amplitude_fit
-        from powertrain.plotting.style import target_and_path
         ax, path = target_and_path(ax, path)
         curves = [(f"{a * 1e3:g} mm", c.frequency_hz, c.kcp, self.kcp_fitted(i))
                   for i, (a, c) in enumerate(zip(self.amplitude_m, self.curves))]

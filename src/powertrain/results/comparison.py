@@ -14,6 +14,8 @@ from powertrain.analysis import compare as cm
 from powertrain.analysis.noise_floor import NOISE_FLOOR_MARGIN, censoring_level
 from powertrain.analysis.orders import quantity_sort_key
 from powertrain.outputs import json_text
+from powertrain.plotting import plot_comparison
+from powertrain.plotting.style import target_and_path
 from powertrain.results.base import Result
 
 #: Quantities always expected (the thesis's comparison, sec. 4.4); any other measured order is
@@ -373,8 +375,6 @@ class ComparisonResult(Result):
         under it (``phase=False``); else an InputError saying to pass a Figure. See
         :func:`powertrain.plotting.plot_comparison`.
         """
-        from powertrain.plotting import plot_comparison
-        from powertrain.plotting.style import target_and_path
         ax, path = target_and_path(ax, path)
         return plot_comparison(self, path, quantities, ax=ax, channel=channel,
                                quantity=quantity, phase=phase,

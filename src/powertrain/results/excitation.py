@@ -8,6 +8,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from powertrain.analysis.text_table import format_table
+from powertrain.outputs import atomic_write
+from powertrain.plotting import plot_excitation
+from powertrain.plotting.style import target_and_path
 from powertrain.results.base import Result
 
 #: Leading CSV columns: total load on the powertrain about its CG, engine axes.
@@ -32,7 +36,6 @@ class ExcitationResult(Result):
     def to_text(self) -> str:
         """Per-cylinder peak pressure and IMEP, mean torque, load orders (what ``powertrain
         excitation`` prints)."""
-        from powertrain.analysis.text_table import format_table
         exc, engine = self.excitation, self.engine
         lines = [f"engine: {engine.name}",
                  f"speed {exc.rpm:g} rpm, balancer shafts "
@@ -77,7 +80,6 @@ class ExcitationResult(Result):
 
     def to_csv(self, path) -> None:
         """Write :meth:`csv_text` atomically."""
-        from powertrain.outputs import atomic_write
         text = self.csv_text()
         with atomic_write(path) as fh:
             fh.write(text)
@@ -90,7 +92,5 @@ class ExcitationResult(Result):
         """Summary figure of six panels (see :func:`powertrain.plotting.plot_excitation`);
         ``ax``: None (a new figure), a Figure or SubFigure (one Axes: an InputError saying to
         pass a Figure); returns the figure."""
-        from powertrain.plotting import plot_excitation
-        from powertrain.plotting.style import target_and_path
         ax, path = target_and_path(ax, path)
         return plot_excitation(self.excitation, path, ax=ax, provenance=provenance)

@@ -8,7 +8,10 @@ from dataclasses import dataclass
 import numpy as np
 
 from powertrain.models.mount import MountModel
+from powertrain.plotting import plot_mount_fit
+from powertrain.plotting.style import target_and_path
 from powertrain.results.base import Result
+from powertrain.units import from_si
 
 #: Datasheet unit of a mount parameter, by its first letter (spring, damper, mass).
 PARAMETER_UNITS = {"c": "N/mm", "d": "N*s/mm", "m": "kg"}
@@ -90,7 +93,6 @@ class FitResult(Result):
     def to_text(self) -> str:
         """:meth:`summary` and the fitted parameters in datasheet units (what
         ``powertrain fit-mount`` prints)."""
-        from powertrain.units import from_si
         lines = [self.summary(), "parameters:"]
         for p in self.model.topology.parameters:
             unit = PARAMETER_UNITS[p[0]]
@@ -114,8 +116,6 @@ class FitResult(Result):
         :func:`powertrain.plotting.plot_mount_fit`). ``ax`` as for
         :meth:`powertrain.results.stiffness.StiffnessResult.plot`; ``save(path)`` writes the
         figure (``.png``)."""
-        from powertrain.plotting import plot_mount_fit
-        from powertrain.plotting.style import target_and_path
         ax, path = target_and_path(ax, path)
         return plot_mount_fit(self.frequency_hz, self.kcp_measured, self.kcp_fitted,
                               label=f"{self.model.topology.name} fit",

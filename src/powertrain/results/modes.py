@@ -9,6 +9,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from powertrain.outputs import atomic_write
+from powertrain.plotting.body import plot_modes
+from powertrain.plotting.style import target_and_path
 from powertrain.results.base import Result
 from powertrain.solvers.modes import AS_MEASURED, COORDINATES, number_or_null
 
@@ -126,7 +129,6 @@ class ModesResult(Result):
         """JSON text of :meth:`to_dict`; written atomically to ``path`` if given."""
         text = json.dumps(self.to_dict(), indent=2) + "\n"
         if path is not None:
-            from powertrain.outputs import atomic_write
             with atomic_write(path) as fh:
                 fh.write(text)
         return text
@@ -187,8 +189,6 @@ class ModesResult(Result):
         """Stacked kinetic-energy distribution per mode, one panel (PNG when ``path`` is
         given); returns the figure. ``ax``: None (a new figure), an Axes, a Figure or
         SubFigure."""
-        from powertrain.plotting.body import plot_modes
-        from powertrain.plotting.style import target_and_path
         ax, path = target_and_path(ax, path)
         return plot_modes(self, path, ax=ax,
                           provenance=provenance)

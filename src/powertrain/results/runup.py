@@ -51,11 +51,20 @@ from __future__ import annotations
 
 import json
 from dataclasses import dataclass, field
+from pathlib import Path
 
 import numpy as np
 
-from powertrain.analysis.channel import Channel
+from powertrain.analysis.channel import Channel, passive_name, split_side
 from powertrain.analysis.orders import order_label, order_rms, synthesis_rms
+from powertrain.analysis.phase import phase_deg
+from powertrain.analysis.text_table import format_table
+from powertrain.outputs import atomic_path, atomic_write
+from powertrain.plotting import plot_runup
+from powertrain.plotting.body import plot_path_contributions, plot_runup_both_sides
+from powertrain.plotting.style import is_axes, target_and_path
+from powertrain.provenance import provenance as record
+from powertrain.provenance import stamp_hdf5
 from powertrain.results.base import HDF5_SUFFIXES, Result
 from powertrain.solvers.modes import AS_MEASURED
 
@@ -117,7 +126,6 @@ class RunupResult(Result):
     @property
     def mounts(self) -> list:
         """Mount names (engine-side channels), in order."""
-        from powertrain.analysis.channel import split_side
         names = [m for m, _ in self.channels if split_side(m)[1] == "active"]
         points = set(self.points)
         return [m for m in dict.fromkeys(names) if m not in points]
@@ -129,13 +137,11 @@ class RunupResult(Result):
 
     def side(self, name) -> str:
         """``active`` (engine side of a mount), ``passive`` (body side or body point)."""
-        from powertrain.analysis.channel import split_side
         return "passive" if name in self.points else split_side(name)[1]
 
     def isolation_db(self, mount, direction, quantity="synthesis") -> np.ndarray:
         """Isolation of a mount: 20 log10(engine-side / body-side RMS velocity) [dB]
         per speed (needs a non-rigid chassis)."""
-        from powertrain.analysis.channel import passive_name
         a = self.curve(mount, direction, quantity)
         b = self.curve(passive_name(mount), direction, quantity)
         tiny = np.finfo(float).tiny
@@ -185,7 +191,6 @@ class RunupResult(Result):
         """The engine, the rigid-body modes, the effects, the synthesis RMS velocity per speed
         and channel [mm/s] and, for a time integration, the periodicity (what ``powertrain
         runup`` prints)."""
-        from powertrain.analysis.text_table import format_table
         name, file = self.meta.get("engine", ""), self.meta.get("engine_file", "")
         lines = [f"engine: {name} ({file})" if file else f"engine: {name}",
                  f"{self.modes_label}: {self._labelled_modes()} (damped, at the "
@@ -233,8 +238,6 @@ class RunupResult(Result):
         order and speed (body points have no force, synthesis rows no phase: empty cells).
         ``comments`` become ``#`` lines above the header (a SYNTHETIC label, the
         provenance)."""
-        from powertrain.analysis.channel import split_side
-        from powertrain.analysis.phase import phase_deg
         phase = phase_deg(self.velocity)
         lines = [f"# {' '.join(str(c).split())}" for c in comments] + [CSV_HEADER]
         values = [(self.order_rms("velocity") * 1e3, self.synthesis_rms("velocity") * 1e3),
@@ -259,7 +262,6 @@ class RunupResult(Result):
 
     def to_csv(self, path, comments=()) -> None:
         """Write :meth:`csv_text` atomically."""
-        from powertrain.outputs import atomic_write
         text = self.csv_text(comments)
         with atomic_write(path) as fh:
             fh.write(text)
@@ -280,10 +282,8 @@ class RunupResult(Result):
         version and the time. With :attr:`engine` set, all three (and the description)
         default to that engine's.
         """
-        import h5py
+        import h5py  # deferred: heavy optional package
 
-        from powertrain.outputs import atomic_path
-        from powertrain.provenance import stamp_hdf5
         snapshot, mount_snapshots, description, provenance = self._run_record(
             engine_snapshot, mount_snapshots, description, provenance)
         with atomic_path(path) as tmp:
@@ -335,9 +335,7 @@ class RunupResult(Result):
         e = self.engine
         if e is None:
             return snapshot or "", mounts, description or "", provenance
-        from pathlib import Path
 
-        from powertrain.provenance import provenance as record
         if snapshot is None:
             snapshot = Path(e.file).read_text(encoding="utf-8") if e.file else ""
         if mounts is None:
@@ -354,7 +352,6 @@ class RunupResult(Result):
 
     def _write_sides(self, h5):
         """/channels/side and /channels/location; /path_contribution with body points."""
-        from powertrain.analysis.channel import split_side
         g = h5["channels"]
         g.create_dataset("side", data=np.array([self.side(m) for m, _ in self.channels],
                                                dtype="S"))
@@ -374,8 +371,6 @@ class RunupResult(Result):
     def plot_paths(self, ax=None, *, path=None, order=2.0, provenance=None):
         """Path contributions at the body points (see
         :func:`powertrain.plotting.body.plot_path_contributions`)."""
-        from powertrain.plotting.body import plot_path_contributions
-        from powertrain.plotting.style import target_and_path
         ax, path = target_and_path(ax, path)
         return plot_path_contributions(self, path, order, ax=ax,
                                        provenance=provenance)
@@ -394,12 +389,9 @@ class RunupResult(Result):
         ``others`` and no panel chosen: both sides of each mount in one panel, and the body
         points (:func:`powertrain.plotting.body.plot_runup_both_sides`).
         """
-        from powertrain.plotting import plot_runup
-        from powertrain.plotting.style import is_axes, target_and_path
         ax, path = target_and_path(ax, path)
         if (not others and not is_axes(ax) and channel is None and quantity is None
                 and any(self.side(m) == "passive" for m, _ in self.channels)):
-            from powertrain.plotting.body import plot_runup_both_sides
             return plot_runup_both_sides(self, path, quantities, signal, ax=ax,
                                          provenance=provenance)
         return plot_runup([("simulation", self)] + list(others or []), path, quantities,
@@ -454,7 +446,6 @@ class SweepRunup(Result):
     def to_text(self) -> str:
         """What was simulated and the tracked synthesis RMS velocity at about 12 speeds
         [mm/s] (what ``powertrain runup --sweep`` prints)."""
-        from powertrain.analysis.text_table import format_table
         tracked = self.tracked
         syn = tracked.synthesis_rms() * 1e3
         labels = [f"{c.mount}.{c.direction}" for c in tracked.channels]

@@ -25,6 +25,8 @@ import numpy as np
 
 from powertrain.analysis.text_table import format_table
 from powertrain.outputs import json_text
+from powertrain.plotting.body import plot_static
+from powertrain.plotting.style import target_and_path
 from powertrain.results.base import Result
 from powertrain.units import from_si
 
@@ -77,8 +79,6 @@ class StaticResult(Result):
         """The static deflection [mm] of every mount direction against speed, one panel;
         returns the figure (see :func:`powertrain.plotting.body.plot_static`). ``ax``: None
         (a new figure), an Axes, a Figure or SubFigure."""
-        from powertrain.plotting.body import plot_static
-        from powertrain.plotting.style import target_and_path
         ax, path = target_and_path(ax, path)
         return plot_static(self, path, ax=ax, provenance=provenance)
 

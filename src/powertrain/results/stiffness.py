@@ -7,6 +7,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from powertrain.analysis.text_table import format_table
+from powertrain.outputs import atomic_write
+from powertrain.plotting import plot_stiffness
+from powertrain.plotting.style import target_and_path
 from powertrain.results.base import Result
 
 
@@ -72,8 +76,6 @@ class StiffnessResult(Result):
         :func:`powertrain.plotting.plot_stiffness`). ``ax``: None (a new figure), a Figure or
         SubFigure, a pair of Axes (magnitude-phase), or one Axes for ``real-imag`` (one Axes
         for the two panels of magnitude-phase: an InputError saying to pass a Figure)."""
-        from powertrain.plotting import plot_stiffness
-        from powertrain.plotting.style import target_and_path
         ax, path = target_and_path(ax, path)
         name = label or self.label or "model"
         return plot_stiffness([(name, self)], path, measured=measured, ax=ax, form=form,
@@ -99,14 +101,12 @@ def _csv(cols: dict, path=None) -> str:
         lines.append(",".join(f"{cols[c][i]:.10g}" for c in cols))
     text = "\n".join(lines) + "\n"
     if path is not None:
-        from powertrain.outputs import atomic_write
         with atomic_write(path) as fh:
             fh.write(text)
     return text
 
 
 def _table(cols: dict, method: str) -> str:
-    from powertrain.analysis.text_table import format_table
     n = len(next(iter(cols.values())))
     rows = [[float(cols[c][i]) for c in cols] for i in range(n)]
     return f"# method: {method}\n" + format_table(list(cols), rows) + "\n"
@@ -161,8 +161,6 @@ class AmplitudeStiffnessResult(Result):
              provenance=None):
         """One K*(f) curve per amplitude (see :meth:`StiffnessResult.plot`, also for
         ``ax``)."""
-        from powertrain.plotting import plot_stiffness
-        from powertrain.plotting.style import target_and_path
         ax, path = target_and_path(ax, path)
         curves = [(f"X = {a * 1e3:g} mm", c) for a, c in zip(self.amplitude_m, self.curves)]
         return plot_stiffness(curves, path, ax=ax, form=form, freq_axis=freq_axis,

@@ -47,8 +47,14 @@ import numpy as np
 
 from powertrain.analysis.channel import ChannelFields
 from powertrain.analysis.orders import order_label
+from powertrain.analysis.phase import phase_deg
+from powertrain.analysis.text_table import format_table
 from powertrain.errors import InputError
 from powertrain.models.recording import QUANTITIES
+from powertrain.outputs import atomic_path, atomic_write
+from powertrain.plotting.orders import DISPLAY, plot_maps, plot_tracked
+from powertrain.plotting.style import target_and_path
+from powertrain.provenance import stamp_hdf5
 from powertrain.results.base import HDF5_SUFFIXES, Result
 
 #: quantity -> (level column, factor from SI to the column's unit).
@@ -130,7 +136,6 @@ class TrackedOrders(Result):
         """Phase per speed, channel and order re cylinder-1 firing TDC [deg], NaN for orders
         whose phase is undefined (``settings["phase"]["orders"]``); None when the phase was
         not measured."""
-        from powertrain.analysis.phase import phase_deg
         ref = self.settings.get("phase")
         if not ref:
             return None
@@ -220,7 +225,6 @@ class TrackedOrders(Result):
 
     def to_csv(self, path) -> None:
         """Write :meth:`csv_text` atomically."""
-        from powertrain.outputs import atomic_write
         text = self.csv_text()
         with atomic_write(path) as fh:
             fh.write(text)
@@ -232,10 +236,8 @@ class TrackedOrders(Result):
 
     def to_hdf5(self, path) -> None:
         """Write the HDF5 layout of the module docstring atomically."""
-        import h5py
+        import h5py  # deferred: heavy optional package
 
-        from powertrain.outputs import atomic_path
-        from powertrain.provenance import stamp_hdf5
         with atomic_path(path) as tmp:
             with h5py.File(tmp, "w") as h5:
                 a = h5.attrs
@@ -262,7 +264,7 @@ class TrackedOrders(Result):
 
     @classmethod
     def from_hdf5(cls, path) -> TrackedOrders:
-        import h5py
+        import h5py  # deferred: heavy optional package
         with h5py.File(path, "r") as h5:
             if h5.attrs.get("format") != "powertrain-tracked":
                 raise InputError("not a powertrain tracked-orders file", file=path,
@@ -288,7 +290,6 @@ class TrackedOrders(Result):
     def to_text(self, written=()) -> str:
         """The report ``powertrain track`` prints: the recording, the speed grid, the
         Vold-Kalman settings, the tracked RMS table; the files in ``written`` at its end."""
-        from powertrain.analysis.text_table import format_table
         r, s = self.recording, self.settings
         lines = [f"raw: {self.source}{' [SYNTHETIC]' if r.get('synthetic') else ''}: "
                  f"{r.get('n_channels')} channel(s), {r.get('sample_rate_hz'):g} Hz, "
@@ -330,7 +331,6 @@ class TrackedOrders(Result):
 
     def _rms_rows(self) -> list:
         """Median, min and max over the speeds per channel and order, synthesis, overall."""
-        from powertrain.plotting.orders import DISPLAY
         rows, rms, syn = [], self.order_rms(), self.synthesis_rms()
         for c, ch in enumerate(self.channels):
             unit, f = DISPLAY[ch.quantity]
@@ -345,7 +345,6 @@ class TrackedOrders(Result):
 
     def write_spectra(self, path) -> None:
         """Write the order spectra (:attr:`spectra`) as CSV, atomically."""
-        from powertrain.outputs import atomic_write
         text = self.spectra.spectrum_csv_text()
         with atomic_write(path) as fh:
             fh.write(text)
@@ -353,8 +352,6 @@ class TrackedOrders(Result):
     def plot_maps(self, ax=None, *, path=None, provenance=None):
         """The Campbell and rpm-frequency maps (:attr:`maps`); returns the figure (see
         :func:`powertrain.plotting.orders.plot_maps`)."""
-        from powertrain.plotting.orders import plot_maps
-        from powertrain.plotting.style import target_and_path
         ax, path = target_and_path(ax, path)
         return plot_maps(**self.maps, path=path, ax=ax, provenance=provenance)
 
@@ -362,8 +359,6 @@ class TrackedOrders(Result):
         """Order curves (RMS against rpm), one panel per channel; returns the figure.
         ``ax``: None (a new figure), a Figure or SubFigure, or one Axes when there is one
         channel (else an InputError saying to pass a Figure)."""
-        from powertrain.plotting.orders import plot_tracked
-        from powertrain.plotting.style import target_and_path
         ax, path = target_and_path(ax, path)
         return plot_tracked(self, path, quantities, ax=ax,
                             provenance=provenance)

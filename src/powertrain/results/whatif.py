@@ -20,7 +20,12 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from powertrain import __version__
 from powertrain.analysis.channel import Channel
+from powertrain.errors import InputError
+from powertrain.outputs import atomic_write
+from powertrain.plotting import plot_whatif
+from powertrain.plotting.style import target_and_path
 from powertrain.results.base import Result
 
 #: Quantities reported by default.
@@ -112,7 +117,6 @@ class WhatIfResult(Result):
         """The one retune of this what-if (:class:`~powertrain.workflows.retune.TargetFit`);
         an InputError naming ``key`` unless exactly one target was given."""
         if len(self.target_fits) != 1:
-            from powertrain.errors import InputError
             raise InputError(f"needs exactly one target, {len(self.target_fits)} given",
                              key=key)
         return self.target_fits[0]
@@ -200,7 +204,6 @@ class WhatIfResult(Result):
 
     # ------------------------------------------------------------------ output
     def to_dict(self) -> dict:
-        from powertrain import __version__
         base = dict(self.description)
         base.setdefault("rpm", [float(r) for r in self.baseline.rpm])
         base["rigid_body_modes_hz"] = [float(f) for f in self.baseline.rigid_body_modes_hz]
@@ -232,7 +235,6 @@ class WhatIfResult(Result):
         """JSON text of :meth:`to_dict`; written atomically to ``path`` if given."""
         text = json.dumps(self.to_dict(), indent=2) + "\n"
         if path is not None:
-            from powertrain.outputs import atomic_write
             with atomic_write(path) as fh:
                 fh.write(text)
         return text
@@ -265,8 +267,6 @@ class WhatIfResult(Result):
         :func:`powertrain.plotting.plot_whatif`). ``ax``: None (a new figure), a Figure or
         SubFigure, or one Axes where ``channel`` ((mount, direction)) and ``quantity`` leave
         one panel (else an InputError saying to pass a Figure)."""
-        from powertrain.plotting import plot_whatif
-        from powertrain.plotting.style import target_and_path
         ax, path = target_and_path(ax, path)
         return plot_whatif(self, path, ax=ax, channel=channel, quantity=quantity,
                            provenance=provenance,

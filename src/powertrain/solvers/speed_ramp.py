@@ -22,12 +22,18 @@ from __future__ import annotations
 import math
 
 import numpy as np
+from scipy.signal import firwin
 
 from powertrain.analysis.channel import Channel
+from powertrain.analysis.fourier import harmonic_amplitudes
 from powertrain.analysis.speed import TRIGGER_HIGH
 from powertrain.errors import InputError
+from powertrain.kernels.speed_ramp import fir_decimate, modal_ramp_kernel, ramp_loads
 from powertrain.models.recording import RawChannel, RawRecording
 from powertrain.parallel import single_blas_thread
+from powertrain.solvers.cycle_newmark import CycleIntegrator, cycle_amplitudes, no_ports, start_state
+from powertrain.solvers.newmark import ModalNewmark, ModalPortNewmark
+from powertrain.solvers.steppers import Cycles, DenseNewmarkStepper
 
 #: Load table spacing: speed [rpm] and crank angle [deg].
 LOAD_RPM_STEP = 25.0
@@ -66,7 +72,6 @@ def _ramp_rows(load, ramp, lo, rows):
     """Loads (rows, 6) [N] of the ramp ``(rpm_from, rate, h, steps)`` at steps ``lo ..
     lo + rows - 1``, bilinear in the load table
     (:func:`powertrain.kernels.speed_ramp.ramp_loads`)."""
-    from powertrain.kernels.speed_ramp import ramp_loads
     speeds, table, _ = load
     rpm_from, rate, h, _ = ramp
     F = np.empty((rows, 6))
@@ -177,7 +182,6 @@ def _channel_dofs(channel_matrix):
 def _integrate_ramp(engine, system, load, ramp, dofs, decimator, progress, static_factors):
     """Decimated accelerations of the coordinates ``dofs`` over the ramp and the method's
     name: modal for a linear model, else dense engine cycle by engine cycle."""
-    from powertrain.solvers.newmark import ModalNewmark
     if system.port_forces() is None and static_factors is None:
         modal = ModalNewmark(system.M, system.C, system.K, load_dofs=6)
         return _integrate(modal, dofs, load, ramp, _initial_state(engine, modal, ramp[0]),
@@ -190,7 +194,6 @@ def _integrate(modal, dofs, load, ramp, eta, decimator, progress):
     ``(rpm_from, rate [rpm/s], step h [s], steps)`` from the modal state ``eta``, chunk by
     chunk (one Numba kernel:
     load, recurrence and outputs, :func:`powertrain.kernels.speed_ramp.modal_ramp_kernel`)."""
-    from powertrain.kernels.speed_ramp import modal_ramp_kernel
     rpm_from, rate_rpm_per_s, h, n_steps = ramp
     speeds, table, _ = load
     read = np.eye(modal.n)[dofs]
@@ -202,7 +205,7 @@ def _integrate(modal, dofs, load, ramp, eta, decimator, progress):
     chunk = CHUNK_OUT * decimator.m         # a multiple of m keeps the decimation aligned
     starts = range(0, n_steps, chunk)
     if progress:
-        from tqdm import tqdm
+        from tqdm import tqdm  # deferred: heavy optional package
         starts = tqdm(starts, desc="sweep", unit="chunk", leave=False, disable=None)
     x = modal.real_form(eta)
     arrays = ((lam_d.real.copy(), lam_d.imag[:modal.n_complex].copy()),
@@ -237,7 +240,6 @@ def _integrate_nonlinear(engine, system, load, ramp, dofs, decimator, static_fac
     (:class:`~powertrain.solvers.cycle_newmark.CycleIntegrator`), from the harmonic fixed
     point at the first speed with the port laws on their steady loop, the amplitude law and
     the static factors updated per cycle."""
-    from powertrain.solvers.cycle_newmark import CycleIntegrator, cycle_amplitudes
     rpm_from, rate, h, n_steps = ramp
     x, state, amplitudes, stepper = _nonlinear_start(engine, system, rpm_from, static_factors)
     integrator = CycleIntegrator(stepper.scaling, stepper.ports, h, x[3])
@@ -263,7 +265,6 @@ def _integrate_ports(integrator, load, ramp, start, dofs, decimator):
     Newmark with the port forces, Newton per step, chunk by chunk
     (:class:`~powertrain.solvers.newmark.ModalPortNewmark`), from ``start`` = (state
     ``(x0, v0, a0, mean)``, port-law states, amplitudes)."""
-    from powertrain.solvers.newmark import ModalNewmark, ModalPortNewmark
     _, _, h, n_steps = ramp
     (x0, v0, *_), state, amplitudes = start
     s, laws = integrator.scaling, integrator.laws
@@ -283,8 +284,6 @@ def _integrate_ports(integrator, load, ramp, start, dofs, decimator):
 def _nonlinear_start(engine, system, rpm, static_factors):
     """State ``(x0, v0, a0, static deflection)``, port-law states and amplitudes of the
     harmonic fixed point at ``rpm`` and the stepper that solved it."""
-    from powertrain.solvers.cycle_newmark import no_ports, start_state
-    from powertrain.solvers.steppers import Cycles, DenseNewmarkStepper
     grid = Cycles(1440, 0.5, 1, 1)
     stepper = DenseNewmarkStepper(system, grid)
     stepper.static_factors = static_factors
@@ -334,7 +333,6 @@ class _Decimator:
     """
 
     def __init__(self, m, n_ch):
-        from scipy.signal import firwin
         self.m = m
         self.L = FIR_HALF * m if m > 1 else 0          # m = 1: nothing to decimate
         self.fir = firwin(2 * self.L + 1, 1.0 / m, window=("kaiser", 8.0)) if m > 1 \
@@ -347,7 +345,6 @@ class _Decimator:
         return (-(-(2 * self.L) // self.m) * self.m - self.L) // self.m
 
     def push(self, rows):
-        from powertrain.kernels.speed_ramp import fir_decimate
         buf = np.empty((rows.shape[1], self.tail.shape[1] + rows.shape[0]))   # (n_ch, n)
         buf[:, :self.tail.shape[1]] = self.tail
         buf[:, self.tail.shape[1]:] = rows.T
@@ -394,7 +391,6 @@ def sweep_steps(rpm_from, rpm_to, rate, sample_rate) -> tuple[int, int]:
 
 def _initial_state(engine, modal, rpm):
     """Modal state of the periodic steady state at ``rpm`` (orders up to 40) at t = 0."""
-    from powertrain.analysis.fourier import harmonic_amplitudes
     n = 1440
     theta = np.arange(n) * (4 * np.pi / n)
     fh = harmonic_amplitudes(np.asarray(engine.generalized_load(rpm, theta), float))[:81]

@@ -34,6 +34,7 @@ from powertrain.analysis.fourier import harmonic_amplitudes
 from powertrain.analysis.orders import ORDERS, order_spectrum
 from powertrain.assembly import NetworkScaling
 from powertrain.kernels.port_forces import NONE
+from powertrain.solvers.admittance import frf_response, relative_motion
 from powertrain.solvers.cycle_newmark import CycleRun, run_cycles, start_state
 from powertrain.solvers.equivalent_linear import AMPLITUDE_HARMONICS, TOLERANCE, amplitude_fixed_point
 from powertrain.solvers.harmonic import harmonic_response
@@ -196,7 +197,6 @@ class AdmittanceStepper(Stepper):
     solver = "harmonic"
 
     def solve(self, load, omega) -> SpeedOrders:
-        from powertrain.solvers.admittance import frf_response, relative_motion
         t0 = time.perf_counter()
         fh, omegas = self.harmonics(load, omega)
         s = self.system
