@@ -125,6 +125,9 @@ def test_diagnose_text_is_the_command_output(tmp_path):
     out = _cli("diagnose", csv, "--effects", "balancer_error", "--no-pairs", "--quiet")
     assert TIMING.sub("", out) == TIMING.sub("", res.to_text() + "\n")
     fig, ax = _axes()
-    assert res.plot(ax) is fig and _drew_into(ax)
+    with pytest.raises(InputError, match="pass a Figure"):     # the gap map has 4 panels
+        res.plot(ax)
+    assert res.plot(ax, quantity="order_2") is fig and _drew_into(ax)
+    assert res.plot(fig) is fig and len(fig.axes) > 1
     with pytest.raises(InputError, match="unknown effect"):
         diagnose(csv, effects=["no_such_effect"])
