@@ -3,6 +3,7 @@ input becomes one line on stderr and exit code 1 (imported by every command modu
 
 from __future__ import annotations
 
+import importlib
 import sys
 
 import click
@@ -13,14 +14,30 @@ from powertrain.errors import InputError
 from powertrain.outputs import OutputTransaction
 from powertrain.provenance import recording_command
 
+#: Every command and the module of :mod:`powertrain.cli` that defines it (``@main.command``).
+COMMANDS = {"compare": "compare", "diagnose": "diagnose", "examples": "examples",
+            "excitation": "excitation", "fit-mount": "fit_mount", "modes": "modes",
+            "runup": "runup", "static": "static", "stiffness": "stiffness",
+            "synth": "diagnose", "track": "track", "whatif": "whatif"}
+
 
 class _Group(click.Group):
     """Turns :class:`powertrain.errors.InputError` into one line on stderr and exit code 1.
 
     Every command runs inside one :class:`~powertrain.outputs.OutputTransaction`:
     its output files are staged and replace the targets together only when the command
-    succeeds; a failed command changes no file (docs/reference/outputs.md).
+    succeeds; a failed command changes no file (docs/reference/outputs.md). A command's
+    module is loaded when the command is asked for (:data:`COMMANDS`; click's lazily loaded
+    subcommands), so a command starts with its own workflow only.
     """
+
+    def list_commands(self, ctx):
+        return sorted(COMMANDS)
+
+    def get_command(self, ctx, name):
+        if name in COMMANDS and name not in self.commands:
+            importlib.import_module(f"powertrain.cli.{COMMANDS[name]}")    # registers it
+        return super().get_command(ctx, name)
 
     def main(self, args=None, *posargs, **kwargs):
         with recording_command(["powertrain", *(sys.argv[1:] if args is None else args)]):
