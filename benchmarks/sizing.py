@@ -20,6 +20,7 @@ checks the power, the size at the target and that ``n`` is the smallest, by exac
 from __future__ import annotations
 
 import math
+import os
 
 from benchmarks.scoring import wilson_interval
 from powertrain.parallel import executor
@@ -198,7 +199,9 @@ def run_sequential_map(row_fn, task_of, is_good, target, higher_is_better=True):
     pool of processes kept for all the draws (:func:`powertrain.parallel.executor`): its
     workers keep what they loaded (engines, compiled kernels) from one draw to the next,
     where a pool per draw started them afresh each time (about a second per process)."""
-    with executor(None, n_jobs=batch_size(target, higher_is_better)) as ex:
+    # under pytest-xdist every core already runs a test: the rows run in its process
+    where = "serial" if os.environ.get("PYTEST_XDIST_WORKER") else None
+    with executor(where, n_jobs=batch_size(target, higher_is_better)) as ex:
         return run_sequential(
             lambda start, count: list(ex.map(row_fn, [task_of(i) for i in
                                                       range(start, start + count)])),
