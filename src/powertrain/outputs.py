@@ -252,10 +252,10 @@ def atomic_write(target, mode="w", **kwargs):
             yield fh
 
 
-def json_text(data, path=None) -> str:
+def json_text(data, path=None, indent=1) -> str:
     """``data`` as the indented JSON text of the result files; written atomically to ``path``
     when given."""
-    text = json.dumps(data, indent=1) + "\n"
+    text = json.dumps(data, indent=indent) + "\n"
     if path is not None:
         with atomic_write(path) as fh:
             fh.write(text)

@@ -4,12 +4,11 @@ its text, JSON and kinetic-energy figure."""
 
 from __future__ import annotations
 
-import json
 from dataclasses import dataclass
 
 import numpy as np
 
-from powertrain.outputs import atomic_write
+from powertrain.outputs import json_text
 from powertrain.plotting.body import plot_modes
 from powertrain.plotting.style import target_and_path
 from powertrain.results.base import Result
@@ -127,11 +126,7 @@ class ModesResult(Result):
 
     def to_json(self, path=None) -> str:
         """JSON text of :meth:`to_dict`; written atomically to ``path`` if given."""
-        text = json.dumps(self.to_dict(), indent=2) + "\n"
-        if path is not None:
-            with atomic_write(path) as fh:
-                fh.write(text)
-        return text
+        return json_text(self.to_dict(), path, indent=2)
 
     def write_json(self, path) -> None:
         """Write :meth:`to_json` to ``path`` atomically."""

@@ -15,7 +15,6 @@ RMS force the mount transmits to ground). Reported: ``mean_delta_db`` (the arith
 
 from __future__ import annotations
 
-import json
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -23,7 +22,7 @@ import numpy as np
 from powertrain import __version__
 from powertrain.analysis.channel import Channel
 from powertrain.errors import InputError
-from powertrain.outputs import atomic_write
+from powertrain.outputs import json_text
 from powertrain.plotting import plot_whatif
 from powertrain.plotting.style import target_and_path
 from powertrain.results.base import Result
@@ -233,11 +232,7 @@ class WhatIfResult(Result):
 
     def to_json(self, path=None) -> str:
         """JSON text of :meth:`to_dict`; written atomically to ``path`` if given."""
-        text = json.dumps(self.to_dict(), indent=2) + "\n"
-        if path is not None:
-            with atomic_write(path) as fh:
-                fh.write(text)
-        return text
+        return json_text(self.to_dict(), path, indent=2)
 
     def writers(self) -> dict:
         """``.json`` (:meth:`to_json`), ``.png`` (the levels figure)."""
