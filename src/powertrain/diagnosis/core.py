@@ -46,7 +46,7 @@ from powertrain.diagnosis.sides import side_attribution, with_measured_body_side
 from powertrain.diagnosis.where import decompose_gap, regions, rigid_span_gap, where_text
 from powertrain.effects import EFFECTS, predict
 from powertrain.errors import InputError
-from powertrain.iotools.engine_file import DEFAULT_ENGINE_PATH, engine_or_default
+from powertrain.iotools.engine_file import engine_or_default
 from powertrain.iotools.measured import read_measured
 from powertrain.iotools.plan import read_plan
 from powertrain.parallel import run_map, single_blas_thread
@@ -117,8 +117,6 @@ def _inputs(measured, engine, effects):
         if e not in EFFECTS:
             raise InputError(f"unknown effect {e!r} (known: {', '.join(EFFECTS)})",
                              key="--effects")
-    if engine is None or isinstance(engine, (str, os.PathLike)):
-        engine = str(engine or DEFAULT_ENGINE_PATH)
     engine = engine_or_default(engine)
     if isinstance(measured, (str, os.PathLike)) and str(measured).lower().endswith(".toml"):
         measured = read_plan(measured, engine)

@@ -53,12 +53,11 @@ from __future__ import annotations
 import dataclasses
 import functools
 import json
-import os
 
 import numpy as np
 
 from powertrain.errors import InputError
-from powertrain.iotools.engine_file import DEFAULT_ENGINE_PATH, engine_or_default
+from powertrain.iotools.engine_file import engine_or_default
 from powertrain.outputs import atomic_write
 from powertrain.plotting.style import (
     figure_legend,
@@ -298,8 +297,6 @@ def synth(effects=(), seed=0, *, engine=None, rpm=None, noise_db=None) -> SynthC
         if e not in TRUTH_EFFECTS:
             raise InputError(f"unknown truth effect {e!r} (known: {', '.join(TRUTH_EFFECTS)})",
                              key="--effect")
-    if engine is None or isinstance(engine, (str, os.PathLike)):
-        engine = str(engine or DEFAULT_ENGINE_PATH)
     engine = engine_or_default(engine)
     seed = integer(seed, "--seed")
     if not 0 <= seed < 2 ** 63:
