@@ -13,8 +13,10 @@ The rules a docs author must know are in docs/extending.md, "Writing docs"; in s
   ``powertrain examples DIR`` makes its own copy of the shipped files, as a user after a wheel
   install does; on any other page ``examples/``, ``engines/`` and ``mounts/`` are linked too.
   Its commands run in order, so a later block may read what an earlier one wrote.
-  ``powertrain`` and ``python`` are the interpreter under test; ``powertrain`` is
-  ``python -m powertrain.cli``, a plain subprocess of its own.
+  ``powertrain`` and ``python`` are the interpreter under test; a ``powertrain`` command
+  that needs no shell (no pipe, redirection, glob or variable) runs in the test's own process
+  through click's test runner, as the console script would run it; any other command runs in
+  ``bash``, where ``powertrain`` is ``python -m powertrain.cli``.
 * One command is one line (backslash continuations joined); comment lines are dropped.
 * In a ``&&`` chain, install steps (``python3 -m venv``, ``. .venv/bin/activate``,
   ``source .venv/bin/activate``, ``pip install``) and the test-suite command
@@ -48,6 +50,7 @@ import signal
 import subprocess
 import sys
 import textwrap
+import warnings
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -285,9 +288,83 @@ def doc_environment(bin_dir: Path) -> dict:
     return env
 
 
+#: Characters that make a command line need a shell (pipes, redirection, globs, variables).
+SHELL_SYNTAX = re.compile(r"[|<>;&$`*?~(){}\[\]\\]")
+
+
+def in_process_argvs(text: str):
+    """The argument lists of ``text`` when it is ``powertrain ARGS`` (or an ``&&`` chain of
+    such) with nothing a shell must expand, else None."""
+    argvs = []
+    for part in _split_outside_quotes(text, "&&"):
+        if SHELL_SYNTAX.search(part.replace("&&", "")):
+            return None
+        try:
+            tokens = shlex.split(part)
+        except ValueError:
+            return None
+        if not tokens or tokens[0] != "powertrain":
+            return None
+        argvs.append(tokens[1:])
+    return argvs or None
+
+
+class _Timeout(Exception):
+    pass
+
+
+def _raise_timeout(signum, frame):
+    raise _Timeout
+
+
+def run_in_process(argvs: list, cwd: Path) -> tuple:
+    """``(exit code, stdout, stderr)`` of ``powertrain ARGS`` run in this process, as the console
+    script runs it (click's test runner: its own streams, a fresh set of warning filters as a
+    new interpreter has them, ``cwd`` as the working folder); a chain stops at its first
+    failure. Saves an interpreter start and the imports per command (about 1.3 CPU-s each);
+    commands that need a shell still run in one (:func:`run_command`)."""
+    from click.testing import CliRunner
+
+    from powertrain.cli.group import main
+    code, out, err = 0, "", ""
+    here = os.getcwd()
+    old_alarm = signal.signal(signal.SIGALRM, _raise_timeout)
+    signal.setitimer(signal.ITIMER_REAL, TIMEOUT_S)
+    try:
+        os.chdir(cwd)
+        for argv in argvs:
+            with warnings.catch_warnings():
+                warnings.resetwarnings()
+                for category in (DeprecationWarning, PendingDeprecationWarning, ImportWarning,
+                                 ResourceWarning):
+                    warnings.simplefilter("ignore", category)
+                result = CliRunner().invoke(main, argv, prog_name="powertrain")
+            if isinstance(result.exception, _Timeout):
+                raise _Timeout
+            if result.exception is not None and not isinstance(result.exception, SystemExit):
+                raise result.exception
+            out, err, code = out + result.stdout, err + result.stderr, result.exit_code
+            if code:
+                break
+    finally:
+        signal.setitimer(signal.ITIMER_REAL, 0)
+        signal.signal(signal.SIGALRM, old_alarm)
+        os.chdir(here)
+    return code, out, err
+
+
 def run_command(cmd: Command, cwd: Path, env: dict, printed: list | None = None):
-    """Run one command; the failure message (None if it passed). The whole process group is
-    killed on timeout. ``printed`` (if given) receives ``(stdout, stderr)``."""
+    """Run one command; the failure message (None if it passed). ``powertrain`` commands that
+    need no shell run in this process (:func:`run_in_process`), others in ``bash``, whose
+    whole process group is killed on timeout. ``printed`` (if given) receives
+    ``(stdout, stderr)``."""
+    argvs = in_process_argvs(cmd.text)
+    if argvs is not None:
+        try:
+            returncode, out, err = run_in_process(argvs, cwd)
+        except _Timeout:
+            return _timed_out(cmd)
+        return _judge(cmd, cwd, returncode, out, err, printed)
     proc = subprocess.Popen(["bash", "-c", "set -o pipefail\n" + cmd.text], cwd=cwd, env=env,
                             stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
                             start_new_session=True)
@@ -296,14 +373,23 @@ def run_command(cmd: Command, cwd: Path, env: dict, printed: list | None = None)
     except subprocess.TimeoutExpired:
         os.killpg(proc.pid, signal.SIGKILL)
         proc.communicate()
-        return (f"{cmd.where}: `{cmd.text}` did not finish within {TIMEOUT_S:.0f} s (docs "
-                "commands must be quick: show the quick form, quote the full one in a "
-                "```text block)")
+        return _timed_out(cmd)
+    return _judge(cmd, cwd, proc.returncode, out, err, printed)
+
+
+def _timed_out(cmd: Command) -> str:
+    return (f"{cmd.where}: `{cmd.text}` did not finish within {TIMEOUT_S:.0f} s (docs "
+            "commands must be quick: show the quick form, quote the full one in a "
+            "```text block)")
+
+
+def _judge(cmd: Command, cwd: Path, returncode: int, out: str, err: str, printed):
+    """The failure message of a finished command (exit code, stderr, outputs), else None."""
     if printed is not None:
         printed.append((out, err))
-    if proc.returncode != cmd.expect_exit:
+    if returncode != cmd.expect_exit:
         tail = "\n".join((out + err).strip().splitlines()[-15:])
-        return (f"{cmd.where}: `{cmd.text}` exited {proc.returncode} (expected "
+        return (f"{cmd.where}: `{cmd.text}` exited {returncode} (expected "
                 f"{cmd.expect_exit}):\n{tail}")
     if cmd.expect_exit and len(err.strip().splitlines()) != 1:
         return f"{cmd.where}: `{cmd.text}`: expected one line on stderr, got:\n{err}"
