@@ -22,7 +22,8 @@ from powertrain.plotting.style import (
     legend,
     log_axis,
     no_data,
-    series_style,
+    quantity_label,
+    quantity_style,
     subplots,
     whole_figure,
 )
@@ -46,11 +47,15 @@ def tracked_quantities(tracked) -> list:
 
 def plot_tracked(tracked, path=None, quantities=None, *, ax=None, provenance=None):
     """Order RMS against rpm, one panel per channel: the synthesis (black) and every order
-    asked (default: every tracked order, :func:`tracked_quantities`), each in its own colour
-    and line style; the y axis spans at most :data:`DYNAMIC_RANGE_DB` below the panel's
-    largest level, and orders wholly below it are named in the title. One legend for the
-    figure; returns the figure (``ax``: None, Figure or SubFigure, or an Axes when there is
-    one channel, else an InputError saying to pass a Figure)."""
+    asked (default: every tracked order, :func:`tracked_quantities`), each in the colour and
+    line style it has in every figure (:func:`~powertrain.plotting.style.quantity_style`).
+
+    A curve wholly more than :data:`DYNAMIC_RANGE_DB` below the panel's largest level is not
+    drawn (numerical noise, 1e-5 of the signal); the orders left out so are named in the
+    title. Each y axis spans the drawn curves (at most that range). The one legend of the
+    figure lists exactly the curves drawn. Returns the figure (``ax``: None, Figure or
+    SubFigure, or an Axes when there is one channel, else an InputError saying to pass a
+    Figure)."""
     quantities = list(quantities or tracked_quantities(tracked))
     n = len(tracked.channels)
     cols = min(3, n)
@@ -60,41 +65,55 @@ def plot_tracked(tracked, path=None, quantities=None, *, ax=None, provenance=Non
     for c, ch in enumerate(tracked.channels):
         a = axes[c // cols][c % cols]
         label = ch.label
-        peaks = _draw_curves(a, tracked, label, quantities, DISPLAY[ch.quantity][1])
-        if not style_panel(a, f"{label} ({ch.quantity})", list(peaks.values()),
-                           DYNAMIC_RANGE_DB):
+        drawn, left_out = _draw_curves(a, tracked, label, quantities, DISPLAY[ch.quantity][1])
+        for q in left_out:
+            hidden.setdefault(q, []).append(label)
+        if not style_panel(a, f"{label} ({ch.quantity})", drawn, DYNAMIC_RANGE_DB):
             no_data(a, "zero at every speed")
-        bottom = a.get_ylim()[0]
-        for q, peak in peaks.items():
-            if peak < bottom:
-                hidden.setdefault(q, []).append(label)
         a.set_ylabel(f"RMS [{DISPLAY[ch.quantity][0]}]", fontsize=LABEL_SIZE)
         a.set_xlabel("engine speed [rpm]", fontsize=LABEL_SIZE)
     for c in range(n, rows * cols):
         axes[c // cols][c % cols].set_visible(False)
     legend(fig, axes, ax)
     title = f"order tracking ({tracked.method}) of {Path(str(tracked.source)).name}"
+    return finish(fig, own, path, provenance,
+                  title=title + _hidden_note(hidden, n) if whole_figure(ax) else None)
+
+
+def _hidden_note(hidden, n_channels) -> str:
+    """The title's note on the orders not drawn, grouped by where."""
     groups = {}
     for q, where in hidden.items():
-        groups.setdefault("every panel" if len(where) == n else ", ".join(where), []).append(q)
+        groups.setdefault("any panel" if len(where) == n_channels else ", ".join(where),
+                          []).append(q)
+    note = ""
     for where, qs in groups.items():
         names = ", ".join(q.replace("order_", "") for q in qs)
-        title += (f"; order{'s' * (len(qs) > 1)} {names} more than "
-                  f"{DYNAMIC_RANGE_DB:g} dB below the largest level, off the axis in {where}")
-    return finish(fig, own, path, provenance, title=title if whole_figure(ax) else None)
+        note += (f"; not drawn in {where}: order{'s' * (len(qs) > 1)} {names}, more than "
+                 f"{DYNAMIC_RANGE_DB:g} dB below the panel's largest level")
+    return note
 
 
-def _draw_curves(a, tracked, label, quantities, factor) -> dict:
-    """Draw the requested curves of one channel; returns {quantity: largest level}."""
-    peaks = {}
-    for k, q in enumerate(quantities):
+def _draw_curves(a, tracked, label, quantities, factor):
+    """Draw the curves of one channel that reach within :data:`DYNAMIC_RANGE_DB` of its
+    largest level; returns (the drawn levels, clipped to that range, the quantities not
+    drawn)."""
+    curves = {}
+    for q in quantities:
         v = tracked.curve(label, q) * factor
         ok = np.isfinite(v) & (v > 0)
-        style = {"color": "k", "lw": 1.8} if q == "synthesis" else \
-            {**series_style(k - ("synthesis" in quantities)), "lw": 1.1}
-        a.plot(tracked.rpm[ok], v[ok], label=q.replace("_", " "), **style)
-        peaks[q] = float(v[ok].max()) if ok.any() else 0.0
-    return peaks
+        curves[q] = (tracked.rpm[ok], v[ok])
+    peak = max((float(v.max()) for _, v in curves.values() if v.size), default=0.0)
+    floor = peak * 10 ** (-DYNAMIC_RANGE_DB / 20)
+    drawn, left_out = [], []
+    for q, (r, v) in curves.items():
+        if not v.size or v.max() < floor:
+            left_out.append(q)
+            continue
+        a.plot(r, v, label=quantity_label(q), lw=1.8 if q == "synthesis" else 1.1,
+               **quantity_style(q))
+        drawn.append(np.maximum(v, floor))
+    return (np.concatenate(drawn) if drawn else np.array([])), left_out
 
 
 def plot_maps(rpm, orders, order_rms, times, freqs, rpm_t, psd, title="", path=None,
