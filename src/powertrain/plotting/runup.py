@@ -15,10 +15,14 @@ from powertrain.plotting.style import (
     TITLE_SIZE,
     colour,
     finish,
+    first_page,
     is_axes,
     legend,
     log_axis,
     no_data,
+    page_note,
+    page_path,
+    page_rows,
     panels_error,
     quantity_label,
     subplots,
@@ -31,7 +35,11 @@ RPM_LABEL = "engine speed [rpm]"
 SYNTHESIS_NOTE = " (synthesis = RMS sum of the orders ≤ 8)"
 
 
-def grid(ax, rows, quantities, channel=None, quantity=None, panel_height=1.3):
+#: Height of a grid figure outside its panel rows [in]: title, legend, x labels, foot line.
+GRID_FRAME_IN = 1.6
+
+
+def grid(ax, rows, quantities, channel=None, quantity=None, panel_height=None):
     """Panels of a channel × quantity figure: every row of ``rows`` and column of
     ``quantities``, or only the row ``channel`` ((mount, direction)) and the column
     ``quantity`` where given.
@@ -39,6 +47,9 @@ def grid(ax, rows, quantities, channel=None, quantity=None, panel_height=1.3):
     ``ax`` None, Figure or SubFigure: those panels; an Axes: the one panel they leave
     (:class:`~powertrain.errors.InputError`, saying to pass a Figure, when they leave
     several).
+
+    ``panel_height``: of a row [in]; default as tall as fit one page
+    (:func:`~powertrain.plotting.style.page_rows`).
 
     Returns
     -------
@@ -52,7 +63,10 @@ def grid(ax, rows, quantities, channel=None, quantity=None, panel_height=1.3):
                              key="ax")
         return ax.figure, {(*rows[0], quantities[0]): ax}, False, np.array([[ax]])
     nr, nq = len(rows), len(quantities)
-    fig, axes, own = subplots(ax, nr, nq, figsize=(PRINT_WIDTH_IN, panel_height * nr + 1.6),
+    if panel_height is None:
+        panel_height = page_rows(rows, GRID_FRAME_IN)[1]
+    fig, axes, own = subplots(ax, nr, nq,
+                              figsize=(PRINT_WIDTH_IN, panel_height * nr + GRID_FRAME_IN),
                               sharex=True)
     panels = {(*rows[r], quantities[q]): axes[r, q] for r in range(nr) for q in range(nq)}
     return fig, panels, own, axes
@@ -133,11 +147,15 @@ def plot_runup(results, path=None, quantities=("synthesis", "order_2", "order_4"
                signal="velocity", *, ax=None, channel=None, quantity=None, provenance=None):
     """RMS curves of one or more run-ups: rows = mount × direction, columns = ``quantities``.
 
+    The rows are made as tall as fit one A4 page (:func:`grid`); written to ``path``, a grid
+    whose rows do not fit one page at the smallest row height is written as pages:
+    ``path``, then ``NAME_p2.png`` … (:func:`~powertrain.plotting.style.page_path`).
+
     Parameters
     ----------
     results : list of (label, RunupResult)
     path : str or Path, optional
-        PNG written atomically.
+        PNG written atomically (the first page).
     quantities : sequence of str
         ``synthesis`` and/or ``order_<n>``; every one is drawn.
     signal : {"velocity", "displacement", "acceleration", "mount_force"}
@@ -149,10 +167,22 @@ def plot_runup(results, path=None, quantities=("synthesis", "order_2", "order_4"
     Returns
     -------
     matplotlib Figure (or SubFigure)
+        The first page; its ``pages`` attribute lists the files written when there are
+        several.
     """
-    first = results[0][1]
-    rows = list(first.channels)
-    fig, panels, own, axes = grid(ax, rows, list(quantities), channel, quantity)
+    rows, picked = select_panels(results[0][1].channels, list(quantities), channel, quantity)
+    if is_axes(ax):
+        return _runup_page(results, rows, picked, signal, ax, provenance, path, "")
+    pages = page_rows(rows, GRID_FRAME_IN)[0] if ax is None and path else [rows]
+    paths = [page_path(path, k) for k in range(len(pages))]
+    figures = [_runup_page(results, chunk, picked, signal, ax, provenance, paths[k],
+                           page_note(k, pages, path)) for k, chunk in enumerate(pages)]
+    return figures[0] if len(figures) == 1 else first_page(figures, paths)
+
+
+def _runup_page(results, rows, quantities, signal, ax, provenance, path, note):
+    """One page of :func:`plot_runup`: the grid of ``rows`` × ``quantities``."""
+    fig, panels, own, axes = grid(ax, rows, quantities)
     scale, unit = SIGNAL_UNITS[signal]
     for (mount, direction, q), a in panels.items():
         values = []
@@ -170,7 +200,7 @@ def plot_runup(results, path=None, quantities=("synthesis", "order_2", "order_4"
         legend(fig, axes, ax)
     return finish(fig, own, path, provenance,
                   title=f"run-up: RMS {signal.replace('_', ' ')} at the mounts{SYNTHESIS_NOTE}"
-                  if whole_figure(ax) else None)
+                  f"{note}" if whole_figure(ax) else None)
 
 
 # --------------------------------------------------------------------------- what-if
