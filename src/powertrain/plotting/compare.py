@@ -32,6 +32,7 @@ from powertrain.plotting.style import (
     no_data,
     panels_error,
     quantity_label,
+    signed,
     subplots,
     whole_figure,
 )
@@ -317,7 +318,7 @@ def _panel(ax, key, comparison, c, unmodelled, limit, head):
         ax.fill_between(c.rpm, m, s, where=c.scored & (s < m), interpolate=True,
                         color=GAP_BELOW, alpha=0.45, lw=0, label="sim < measured")
         title += ("\n" if title else "") + \
-            f"{c.stats['rms_db']:.1f} rms, {c.stats['bias_db']:+.1f} bias"
+            f"rms {c.stats['rms_db']:.1f}, bias {signed(c.stats['bias_db'])} dB"
     if c is not None and c.at_floor.any():
         ax.plot(c.rpm[c.at_floor], np.maximum(c.measured[c.at_floor] * MM, limit * 0.5), "x",
                 color="0.55", ms=3, label="excluded (noise floor)")
