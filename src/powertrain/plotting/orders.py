@@ -26,6 +26,7 @@ from powertrain.plotting.style import (
     quantity_style,
     subplots,
     whole_figure,
+    wrap,
 )
 
 #: Display unit and factor per quantity.
@@ -117,12 +118,18 @@ def _draw_curves(a, tracked, label, quantities, factor):
 
 
 def plot_maps(rpm, orders, order_rms, times, freqs, rpm_t, psd, title="", path=None,
-              unit="m/s²", *, factor=1.0, max_order=None, ax=None, provenance=None):
-    """Campbell (rpm-order) above rpm-frequency colour map, over the speed range where both
-    have data, levels in dB re the maximum on an 80 dB scale (colour-bar arrows where lower
-    levels are clipped); the order axis and the frequency axis end :data:`MAP_MARGIN` above
-    ``max_order`` (default: the highest order of the map). ``order_rms`` is SI, shown in
-    ``unit`` = SI × ``factor``. Returns the figure (``ax``: None, Figure or SubFigure)."""
+              unit="m/s²", *, factor=1.0, max_order=None, tracked_rpm=None, block_revs=None,
+              window_s=None, ax=None, provenance=None):
+    """Campbell (rpm-order) above rpm-frequency colour map, levels in dB re the maximum on an
+    80 dB scale (colour-bar arrows where lower levels are clipped); the order axis and the
+    frequency axis end :data:`MAP_MARGIN` above ``max_order`` (default: the highest order of
+    the map). ``order_rms`` is SI, shown in ``unit`` = SI × ``factor``.
+
+    Both speed axes span ``tracked_rpm`` (the order curves' speed range; default the maps'
+    own): a map reaches less far, as its analysis blocks (``block_revs`` revolutions) or
+    windows (``window_s`` seconds) are centred inside the record, and each panel's title
+    says so; the speeds it does not reach are shaded grey. Returns the figure (``ax``:
+    None, Figure or SubFigure)."""
     fig, axes, own = subplots(ax, 2, 1, figsize=(PRINT_WIDTH_IN, 7.4), sharey=True)
     a1, a2 = axes[:, 0]
     top = MAP_MARGIN * float(max_order or np.max(orders))
@@ -131,24 +138,41 @@ def plot_maps(rpm, orders, order_rms, times, freqs, rpm_t, psd, title="", path=N
     m1 = a1.pcolormesh(orders, rpm, db1, shading="nearest", cmap="viridis", vmin=-80, vmax=0)
     a1.set_xlabel("order", fontsize=LABEL_SIZE)
     a1.set_xlim(0, min(top, float(np.max(orders))))
-    a1.set_title("rpm-order map (Campbell)", fontsize=TITLE_SIZE)
     colorbar(fig, m1, a1, db1, -80, 0, f"order RMS [dB re {ref * factor:.3g} {unit}]")
     refp = max(np.max(psd), 1e-30)
     db2 = 10 * np.log10(np.maximum(psd, refp * 1e-8) / refp)
     m2 = a2.pcolormesh(freqs, rpm_t, db2, shading="nearest", cmap="viridis", vmin=-80, vmax=0)
     a2.set_xlabel("frequency [Hz]", fontsize=LABEL_SIZE)
-    a2.set_title("rpm-frequency map (waterfall)", fontsize=TITLE_SIZE)
     colorbar(fig, m2, a2, db2, -80, 0, "PSD [dB re max]")
     f_top = top * float(np.max(rpm)) / 60.0
     a2.set_xlim(float(np.min(freqs)), min(f_top, float(np.max(freqs))))
-    lo = max(float(np.min(rpm)), float(np.min(rpm_t)))    # where both maps have data
-    hi = min(float(np.max(rpm)), float(np.max(rpm_t)))
-    for a in (a1, a2):
-        a.set_ylabel("engine speed [rpm]", fontsize=LABEL_SIZE)
-        a.set_ylim(lo, hi)
-        a.tick_params(labelsize=TICK_SIZE)
-        a.yaxis.set_tick_params(labelleft=True)
+    lo, hi = tracked_rpm or (min(np.min(rpm), np.min(rpm_t)), max(np.max(rpm), np.max(rpm_t)))
+    for a, name, speeds, span in (
+            (a1, "rpm-order map (Campbell)", rpm, block_revs and f"{block_revs:g}-revolution "
+             "blocks"),
+            (a2, "rpm-frequency map (waterfall)", rpm_t, window_s and f"{window_s:.2g} s "
+             "windows")):
+        _speed_axis(a, name, float(np.min(speeds)), float(np.max(speeds)), (lo, hi), span)
     return finish(fig, own, path, provenance, title=title if whole_figure(ax) else None)
+
+
+def _speed_axis(a, name, first, last, limits, span):
+    """The speed axis ``limits`` [rpm] of one map whose data reach ``first``..``last``: the
+    speeds beyond shaded, the title saying why (``span``: its blocks or windows)."""
+    lo, hi = float(min(limits)), float(max(limits))
+    step = (last - first) / 50 if last > first else 0.0
+    title = name
+    if first - step > lo or last + step < hi:
+        title += (f": data {first:.0f}–{last:.0f} rpm of {lo:.0f}–{hi:.0f}"
+                  + (f" ({span} centred in the record)" if span else ""))
+        for a0, a1_ in ((lo, first), (last, hi)):
+            if a1_ > a0:
+                a.axhspan(a0, a1_, color="0.88", lw=0, zorder=0)
+    a.set_title(wrap(title, PRINT_WIDTH_IN * 0.75, TITLE_SIZE), fontsize=TITLE_SIZE)
+    a.set_ylabel("engine speed [rpm]", fontsize=LABEL_SIZE)
+    a.set_ylim(lo, hi)
+    a.tick_params(labelsize=TICK_SIZE)
+    a.yaxis.set_tick_params(labelleft=True)
 
 
 def plot_sweep_rates(curves, path=None, title="", *, ax=None, provenance=None):
