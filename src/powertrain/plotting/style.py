@@ -289,9 +289,17 @@ def foot_text(provenance, width_in) -> str:
 def shell_lines(command: str, chars: int) -> list:
     """``command`` in lines of at most ``chars`` characters, broken between arguments, each
     but the last ending in a shell continuation `` \\``, the following ones indented; an
-    argument longer than a line stands on a line of its own."""
-    lines, current = [], ""
+    option stays with its value, and an argument longer than a line stands on a line of its
+    own."""
+    words = []
     for word in command.split(" "):
+        if words and words[-1].startswith("-") and not word.startswith("-") \
+                and " " not in words[-1]:
+            words[-1] += " " + word
+        else:
+            words.append(word)
+    lines, current = [], ""
+    for word in words:
         indent = "  " if lines else ""
         if current and len(indent + current + " " + word) + 2 > chars:
             lines.append(indent + current + " \\")
