@@ -136,8 +136,9 @@ def order_style(order) -> dict:
 
     Even orders (2, 4, 6, 8: the firing orders of a four-cylinder engine) are solid lines in
     blue, orange, bluish green, vermillion; odd orders (1, 3, 5, 7) dashed in reddish purple,
-    sky blue, blue, orange; half orders (0.5, 1.5 ...) dotted, coloured by their integer part;
-    any other order dash-dotted. The synthesis and totals are black (:func:`quantity_style`).
+    sky blue, blue, orange; half orders 0.5 … 5.5 dotted and 6.5, 7.5 dash-dotted, coloured
+    by their integer part (the 16 orders 0.5 … 8 all differ); any other order dash-dot-dot.
+    The synthesis and totals are black (:func:`quantity_style`).
 
     Parameters
     ----------
@@ -153,12 +154,12 @@ def order_style(order) -> dict:
         order = float(order.replace("order_", "").replace("order ", ""))
     halves = round(2 * float(order))
     if abs(2 * float(order) - halves) > 1e-9:
-        return {"color": colour(round(4 * float(order))), "ls": "-."}
+        return {"color": colour(round(4 * float(order))), "ls": (0, (3, 1, 1, 1, 1, 1))}
     if halves % 4 == 0:
         return {"color": colour(halves // 4 - 1), "ls": "-"}
     if halves % 2 == 0:
         return {"color": colour(halves // 4 + 4), "ls": "--"}
-    return {"color": colour(halves // 2), "ls": ":"}
+    return {"color": colour(halves // 2), "ls": ":" if halves // 2 < len(PALETTE) else "-."}
 
 
 def quantity_style(quantity: str) -> dict:
