@@ -241,7 +241,7 @@ def plot_whatif(whatif, path=None, *, ax=None, channel=None, quantity=None, prov
     frame = GRID_FRAME_IN + 0.16 * (wrap(title, PRINT_WIDTH_IN * 0.95, 9).count("\n") + 1
                                     + entries)
     pages, height = page_rows(rows, frame)
-    if is_axes(ax) or ax is not None or not path:
+    if ax is not None or not path:
         pages = [rows]
     paths = [page_path(path, k) for k in range(len(pages))]
     overall = {v.name: _mean_change(whatif, v.name, base.channels, list(whatif.quantities))
