@@ -251,10 +251,13 @@ def test_compare_figure_phase_panels_exactly_where_both_sides_give_phase(phased)
 @pytest.mark.slow          # ~7-11 s: keeps the fast lane under 3 min
 def test_runup_body_figures(tmp_path, monkeypatch, saved):
     engine = str(ROOT / "engines" / "default-modal-body.toml")
-    run(tmp_path, monkeypatch, "runup", "--engine", engine, "--solver", "harmonic", "--from",
-        "1000", "--to", "3000", "--step", "1000", "--plot", "body.png", "--path-plot",
-        "paths.png", "--quiet")
-    _assert_clean(saved, ["body.png", "paths.png"], "runup", panel_legends=False)
+    res = run(tmp_path, monkeypatch, "runup", "--engine", engine, "--solver", "harmonic",
+              "--from", "1000", "--to", "3000", "--step", "1000", "--plot", "body.png",
+              "--path-plot", "paths.png")
+    # more rows than fit an A4 page: a second page, named with the files written
+    _assert_clean(saved, ["body.png", "body_p2.png", "paths.png"], "runup",
+                  panel_legends=False)
+    assert "wrote body.png, body_p2.png, paths.png" in res.output
 
 
 def test_runup_sweep_figure(tmp_path, monkeypatch, saved):
