@@ -1,6 +1,8 @@
 """Checks of a rendered figure: no two text elements overlap, none leaves the figure, all
-text is at least 8 pt when printed at the report's page width, no legend covers data, and
-every coloured line or area is drawn from the colour-blind-safe palette.
+text is at least 8 pt when printed at the report's page width, no legend covers data,
+every coloured line or area is drawn from the colour-blind-safe palette, the legend lists
+exactly the series drawn, every data axis is labelled with its unit, and the figure fits an
+A4 page at 300 dpi.
 
 The figure is drawn once at its dpi (matplotlib's ``draw_without_rendering``: the Agg draw's
 layout and text extents, no pixels) while every :class:`~matplotlib.text.Text` draw call is
@@ -147,3 +149,101 @@ def off_palette_colours(fig) -> list[str]:
             if not (abs(r - g) < 1e-6 and abs(g - b) < 1e-6) and to_hex(c) not in allowed:
                 found.add(f"{to_hex(c)} in {ax.get_title()!r}")
     return sorted(found)
+
+
+# --------------------------------------------------------------------------- legends, units, size
+#: Axis labels that name a dimensionless quantity (no unit to give).
+UNITLESS_LABELS = {"order"}
+
+
+def _in_view(ax, artist) -> bool:
+    """Some data point of the line ``artist`` is drawn inside ``ax`` (display coordinates,
+    so lines in axes coordinates such as ``axhline`` count where they are drawn)."""
+    xy = np.ma.filled(np.ma.asarray(artist.get_xydata(), float), np.nan)
+    xy = xy[np.isfinite(xy).all(axis=1)] if xy.ndim == 2 else xy[:0]
+    if not xy.size:
+        return False
+    px = artist.get_transform().transform(xy)
+    box = ax.bbox
+    tol = 0.5
+    inside = ((px[:, 0] >= box.x0 - tol) & (px[:, 0] <= box.x1 + tol)
+              & (px[:, 1] >= box.y0 - tol) & (px[:, 1] <= box.y1 + tol))
+    return bool(inside.any())
+
+
+def drawn_series(fig) -> dict:
+    """{label: where} of every line, shaded area and bar series visible inside an axes'
+    view after drawing; unlabelled lines (matplotlib's ``_child`` names) under
+    ``"(unlabelled line)"``."""
+    from matplotlib.collections import PolyCollection
+    found = {}
+    for ax in fig.axes:
+        if not ax.get_visible() or hasattr(ax, "_colorbar"):
+            continue
+        for ln in ax.get_lines():
+            if ln.get_visible() and _in_view(ax, ln):
+                label = ln.get_label()
+                found.setdefault("(unlabelled line)" if label.startswith("_") else label,
+                                 ax.get_title())
+        for c in ax.collections:
+            if isinstance(c, PolyCollection) and c.get_visible() and c.get_paths() \
+                    and not c.get_label().startswith("_"):
+                found.setdefault(c.get_label(), ax.get_title())
+        for cont in ax.containers:
+            if not cont.get_label().startswith("_"):
+                found.setdefault(cont.get_label(), ax.get_title())
+    return found
+
+
+def legend_entries(fig) -> set:
+    """The texts of every legend entry (figure and axes legends, not their titles)."""
+    legends = list(fig.legends) + [a.get_legend() for a in fig.axes if a.get_legend()]
+    return {t.get_text() for g in legends for t in g.get_texts()}
+
+
+def legend_problems(fig) -> list[str]:
+    """A drawn series missing from the legend or a legend entry not drawn anywhere. A figure
+    without a legend may draw one labelled series (its title says what it is); unlabelled
+    lines are allowed only then."""
+    drawn, entries = drawn_series(fig), legend_entries(fig)
+    if not entries:
+        return [f"{len(drawn)} series drawn and no legend: {sorted(drawn)[:6]}"] \
+            if len(drawn) > 1 else []
+    return ([f"drawn, not in the legend: {lab!r} (in {where!r})"
+             for lab, where in drawn.items() if lab not in entries]
+            + [f"in the legend, not drawn: {lab!r}" for lab in sorted(entries)
+               if lab not in drawn])
+
+
+def _has_unit(label: str) -> bool:
+    label = label.strip()
+    return ("[" in label and "]" in label) or label in UNITLESS_LABELS
+
+
+def unit_problems(fig) -> list[str]:
+    """Data axes whose x or y axis has no label with a unit ``[…]``: its own label, one of a
+    panel sharing the axis (a grid labels its bottom row or one column), or the figure's
+    ``supxlabel`` / ``supylabel``."""
+    problems = []
+    for ax in fig.axes:
+        if not ax.get_visible() or hasattr(ax, "_colorbar") or not (
+                ax.get_lines() or ax.collections or ax.patches):
+            continue
+        for axis, sup, shared in (("x", fig.get_supxlabel(), ax.get_shared_x_axes()),
+                                  ("y", fig.get_supylabel(), ax.get_shared_y_axes())):
+            own = ax.get_xlabel() if axis == "x" else ax.get_ylabel()
+            siblings = [a.get_xlabel() if axis == "x" else a.get_ylabel()
+                        for a in shared.get_siblings(ax)]
+            if not any(_has_unit(lab) for lab in [own, sup, *siblings] if lab):
+                problems.append(f"{axis} axis without a unit in {ax.get_title()!r} "
+                                f"(label {own!r})")
+    return problems
+
+
+def page_problems(fig, dpi) -> list[str]:
+    """A figure larger than an A4 page at ``dpi`` (2480 x 3508 px at 300 dpi, portrait)."""
+    from powertrain.plotting.pages import A4_PX
+    w, h = fig.get_figwidth() * dpi, fig.get_figheight() * dpi
+    limit = (A4_PX[0] * dpi / 300, A4_PX[1] * dpi / 300)
+    return [f"{w:.0f} x {h:.0f} px at {dpi:g} dpi: larger than A4 ({limit[0]:.0f} x "
+            f"{limit[1]:.0f} px)"] if w > limit[0] + 0.5 or h > limit[1] + 0.5 else []

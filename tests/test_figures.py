@@ -1,7 +1,9 @@
 """Every figure the command line writes: no overlapping text, no text outside the figure, all
 text at least 8 pt at the 16 cm print width, no legend over data, only colour-blind-safe
 colours (Okabe-Ito palette, greys; colour maps viridis and RdBu_r), every requested quantity
-drawn, a provenance line; and the library's ``plot(ax=None)`` contract.
+drawn, the legend listing exactly the series drawn, every data axis labelled with its unit,
+no figure larger than an A4 page at 300 dpi, a provenance line; and the library's
+``plot(ax=None)`` contract.
 
 Each CLI command runs in-process with quick settings. ``Figure.savefig`` is wrapped so that
 the very draw that writes the PNG records every text drawn (titles, axis and tick labels,
@@ -20,12 +22,15 @@ from figure_text import (
     TOLERANCE_PX,
     check_boxes,
     drawn_texts,
+    legend_problems,
     legends_over_data,
     off_palette_colours,
     outside_problems,
+    page_problems,
     recording_texts,
     small_texts,
     text_problems,
+    unit_problems,
 )
 
 from powertrain.cli import main
@@ -39,7 +44,8 @@ MOUNT = str(ROOT / "mounts" / "hydraulic-engine-mount-z.toml")
 
 @pytest.fixture
 def saved(monkeypatch):
-    """{png name: (text problems, provenance lines)} of every figure saved meanwhile."""
+    """{png name: (problems, provenance lines, panel legends, legend and unit problems)} of
+    every figure saved meanwhile."""
     from matplotlib.figure import Figure
     found = {}
     original = Figure.savefig
@@ -51,10 +57,11 @@ def saved(monkeypatch):
         found[Path(str(fname)).name] = (_problems(drawn, self, dpi) + small_texts(
                                             drawn, self.get_figwidth())
                                         + legends_over_data(self) + off_palette_colours(self)
-                                        + _colour_maps(self),
+                                        + _colour_maps(self) + page_problems(self, dpi),
                                         [t.get_text() for t, _ in drawn
                                          if t.get_text().startswith("powertrain ")],
-                                        sum(a.get_legend() is not None for a in self.axes))
+                                        sum(a.get_legend() is not None for a in self.axes),
+                                        legend_problems(self) + unit_problems(self))
 
     monkeypatch.setattr(Figure, "savefig", savefig)
     return found
@@ -87,17 +94,29 @@ def run(tmp_path, monkeypatch, *args):
     return res
 
 
+def _one_line(foot: str) -> str:
+    """The provenance line with its line breaks and shell continuations undone."""
+    return foot.replace(" \\\n  ", " ").replace("\n", " ")
+
+
+#: The figures of a report (issue 39), also checked for a legend listing exactly the series
+#: drawn and units on every data axis.
+REPORT_FIGURES = {"orders.png", "sweep.png", "maps.png", "whatif.png", "runup.png",
+                  "compare.png", "fit.png", "fit-amplitudes.png"}
+
+
 def _assert_clean(saved, names, command, panel_legends=True):
     for name in names:
         # an atomic write saves a temporary ".NAME.<random>.tmp" first
         keys = [k for k in saved if k == name or k.startswith(f".{name}.")]
         assert keys, f"{name} not written by `powertrain {command}`"
-        problems, foot, n_axes_legends = saved[keys[-1]]
+        problems, foot, n_axes_legends, labelling = saved[keys[-1]]
+        problems = problems + (labelling if name in REPORT_FIGURES else [])
         if not panel_legends:
             assert n_axes_legends == 0, f"{name}: {n_axes_legends} panel legends, want one " \
                                         "legend for the figure"
         assert not problems, f"{name}:\n" + "\n".join(problems[:10])
-        assert foot and f"$ powertrain {command}" in foot[0].replace("\n", " "), \
+        assert foot and f"$ powertrain {command}" in _one_line(foot[0]), \
             f"{name}: no provenance line naming the command ({foot})"
         assert foot[0].startswith(f"powertrain {__import__('powertrain').__version__}")
 
@@ -127,6 +146,10 @@ def test_compare_figure_at_the_measured_speeds_fits_a_page(tmp_path, monkeypatch
     assert fig.get_figwidth() == pytest.approx(PRINT_WIDTH_IN)
     assert fig.get_figheight() <= MAX_HEIGHT_IN + 1e-9 < 24.7 / 2.54
     assert len([a for a in fig.axes if a.get_visible()]) == 9 * 4
+    gaps = [a.get_title().split("\n")[-1] for a in fig.axes if "bias" in a.get_title()]
+    assert len(gaps) == 9 * 4                      # every panel: RMS and bias, in dB
+    assert all(g.startswith("rms ") and g.endswith(" dB") and "-0.0 " not in g
+               for g in gaps), gaps
 
 
 def _without_orders(measured, cut):
@@ -228,10 +251,13 @@ def test_compare_figure_phase_panels_exactly_where_both_sides_give_phase(phased)
 @pytest.mark.slow          # ~7-11 s: keeps the fast lane under 3 min
 def test_runup_body_figures(tmp_path, monkeypatch, saved):
     engine = str(ROOT / "engines" / "default-modal-body.toml")
-    run(tmp_path, monkeypatch, "runup", "--engine", engine, "--solver", "harmonic", "--from",
-        "1000", "--to", "3000", "--step", "1000", "--plot", "body.png", "--path-plot",
-        "paths.png", "--quiet")
-    _assert_clean(saved, ["body.png", "paths.png"], "runup", panel_legends=False)
+    res = run(tmp_path, monkeypatch, "runup", "--engine", engine, "--solver", "harmonic",
+              "--from", "1000", "--to", "3000", "--step", "1000", "--plot", "body.png",
+              "--path-plot", "paths.png")
+    # more rows than fit an A4 page: a second page, named with the files written
+    _assert_clean(saved, ["body.png", "body_p2.png", "paths.png"], "runup",
+                  panel_legends=False)
+    assert "wrote body.png, body_p2.png, paths.png" in res.output
 
 
 def test_runup_sweep_figure(tmp_path, monkeypatch, saved):
@@ -264,11 +290,43 @@ def test_diagnose_report_figures(tmp_path, monkeypatch, saved):
 def test_stiffness_and_fit_figures(tmp_path, monkeypatch, saved, form, axis):
     res = run(tmp_path, monkeypatch, "stiffness", MOUNT, "--freq", "1:300:1", "--format",
               "csv", "--plot", "k.png", "--form", form, "--freq-axis", axis)
-    (tmp_path / "k.csv").write_text(res.stdout)   # the "wrote k.png" note goes to stderr
+    (tmp_path / "k.csv").write_text("# SYNTHETIC: the model's own curve\n" + res.stdout)
+    import matplotlib.pyplot as plt
+
+    from powertrain.plotting.stiffness import FIT_POINTS
+    shown = []
+    monkeypatch.setattr(plt, "close", lambda fig=None: shown.append(fig))
     run(tmp_path, monkeypatch, "fit-mount", "k.csv", "--model", "sls", "--starts", "2",
         "--out", "fit.toml", "--plot", "fit.png", "--form", form, "--freq-axis", axis)
     _assert_clean(saved, ["k.png"], "stiffness")
     _assert_clean(saved, ["fit.png"], "fit-mount")
+    fig = shown[-1]
+    title = fig.axes[0].get_title().replace("\n", " ")
+    assert title.startswith("SYNTHETIC data") and "fitted to k.csv" in title   # the mount
+    fitted = [ln for ln in fig.axes[0].get_lines() if "fit" in ln.get_label()]
+    assert fitted and all(len(ln.get_xdata()) == FIT_POINTS for ln in fitted)  # a curve
+    assert any(ln.get_label().startswith("SYNTHETIC data") for ln in fig.axes[0].get_lines())
+
+
+def test_fit_amplitudes_figure(tmp_path, monkeypatch, saved):
+    """Multi-amplitude fit of the shipped SYNTHETIC table: marked SYNTHETIC, the fit a
+    continuous curve per amplitude."""
+    import matplotlib.pyplot as plt
+
+    from powertrain.plotting.stiffness import FIT_POINTS
+    shown = []
+    monkeypatch.setattr(plt, "close", lambda fig=None: shown.append(fig))
+    run(tmp_path, monkeypatch, "fit-mount", ROOT / "examples" / "hydraulic-mount-amplitudes.csv",
+        "--model", "sls", "--starts", "1", "--out", "f.toml", "--plot", "fit-amplitudes.png",
+        "--quiet")
+    _assert_clean(saved, ["fit-amplitudes.png"], "fit-mount")
+    a = shown[-1].axes[0]
+    assert a.get_title().startswith("SYNTHETIC data")
+    labels = [ln.get_label() for ln in a.get_lines()]
+    assert labels and not any("measured" in lab for lab in labels)
+    assert sum(lab.endswith("SYNTHETIC data") for lab in labels) == 4
+    assert all(len(ln.get_xdata()) == FIT_POINTS for ln in a.get_lines()
+               if ln.get_label().endswith("fitted"))
 
 
 def test_excitation_figure(tmp_path, monkeypatch, saved):
@@ -311,6 +369,55 @@ def test_the_checker_finds_overlap_and_overflow():
 
 
 # --------------------------------------------------------------------------- style helpers
+def test_one_style_per_order():
+    """Every half order to 8 has its own colour and line style, from the palette, the same
+    through order_style and quantity_style."""
+    from powertrain.plotting.style import PALETTE, order_style, quantity_style
+    orders = [k / 2 for k in range(1, 17)]
+    styles = [(order_style(o)["color"], order_style(o)["ls"]) for o in orders]
+    assert len(set(styles)) == len(orders)
+    assert {c for c, _ in styles} <= set(PALETTE)
+    assert all(quantity_style(f"order_{o:g}") == order_style(o) for o in orders)
+    assert quantity_style("synthesis")["color"] == "k"
+    assert order_style(2) == {"color": PALETTE[0], "ls": "-"}
+
+
+def test_foot_keeps_the_command_whole():
+    """The provenance foot breaks the command only between arguments, with shell
+    continuations: joined again, it is the command as typed."""
+    from powertrain.plotting.style import PRINT_WIDTH_IN, foot_text
+    from powertrain.provenance import Provenance
+    command = ("powertrain runup --engine engines/default-modal-body.toml --from 1000 --to "
+               "6000 --step 500 --csv runup.csv --plot runup.png --path-plot paths.png --quiet")
+    text = foot_text(Provenance.now(command, "1.8 L TGDI inline-4 (EA888-like), "
+                                    "longitudinal (default.toml)"), PRINT_WIDTH_IN * 0.98)
+    lines = text.split("\n")
+    first = next(i for i, ln in enumerate(lines) if ln.startswith("$ "))
+    shell = lines[first:]
+    assert all(ln.endswith(" \\") for ln in shell[:-1]) and len(shell) > 1
+    assert " ".join(ln.removesuffix(" \\").strip() for ln in shell) == "$ " + command
+    assert not any(ln.endswith(("--from", "--to", "--plot")) for ln in lines)  # option+value
+
+
+def test_pages_of_a_tall_grid():
+    from powertrain.plotting.pages import MIN_ROW_IN, page_path, page_rows
+    from powertrain.plotting.style import MAX_HEIGHT_IN
+    pages, row = page_rows(list(range(9)), 1.6)
+    assert len(pages) == 1 and row * 9 + 1.6 <= MAX_HEIGHT_IN + 1e-9
+    pages, row = page_rows(list(range(30)), 1.6)
+    assert [r for p in pages for r in p] == list(range(30)) and len(pages) == 3
+    assert row >= MIN_ROW_IN and max(map(len, pages)) * row + 1.6 <= MAX_HEIGHT_IN + 1e-9
+    assert [page_path("out/runup.png", k) for k in range(3)] == [
+        "out/runup.png", "out/runup_p2.png", "out/runup_p3.png"]
+
+
+def test_signed_never_prints_minus_zero():
+    from powertrain.plotting.style import signed
+    assert [signed(v) for v in (-0.04, 0.0, -0.0, 0.04, 0.06, -0.26)] == [
+        "0.0", "0.0", "0.0", "0.0", "+0.1", "-0.3"]
+    assert signed(-0.004, 2) == "0.00"
+
+
 @pytest.mark.parametrize("lo,hi", [(1, 400), (0.003, 0.2), (0.6, 0.9), (1e-5, 1e3), (30, 600),
                                    (0.95, 1.02), (2.1, 2.9)])
 def test_log_ticks_are_plain_numbers(lo, hi):
@@ -405,14 +512,26 @@ def test_track_plot_draws_every_requested_order(spec, expected):
     from powertrain.workflows.tracking import track_recording
     rec = signals.analytic_sweep(duration=3.0, rpm0=1500.0, rpm1=3500.0)
     tracked = track_recording(rec, parse_orders(spec), rpm_step=100.0, progress=False)
+    from powertrain.plotting.style import order_style
     fig = tracked.plot()
     outside = outside_problems(fig)          # draws the figure (layout, texts)
     assert not outside, outside
-    assert set(expected + ["synthesis"]) <= _drawn_labels(fig)
+    assert not legend_problems(fig) and not unit_problems(fig)
+    title = fig.legends[0].get_title().get_text().replace("\n", " ")
+    drawn = _drawn_labels(fig)
+    assert "synthesis" in drawn
+    for label in expected:       # drawn, or named in the title as more than 60 dB down
+        assert label in drawn or f" {label[6:]}," in title.split("not drawn")[-1] + ",", label
     for ax in fig.axes:          # at most the documented dynamic range, plain tick labels
         lo, hi = ax.get_ylim()
         assert 20 * np.log10(hi / lo) <= 60 + 20 * np.log10(1.4) + 1e-6
         assert not any("e" in t.get_text() for t in ax.get_yticklabels())
+        levels = np.concatenate([ln.get_ydata() for ln in ax.get_lines()])
+        assert lo >= levels.min() / 1.4 - 1e-12        # the range from the drawn curves
+        for ln in ax.get_lines():                      # one colour per order, everywhere
+            if ln.get_label() != "synthesis":
+                style = order_style(float(ln.get_label()[6:]))
+                assert (ln.get_color(), ln.get_linestyle()) == (style["color"], style["ls"])
     plt.close(fig)
 
 
@@ -427,11 +546,15 @@ def test_map_channel_and_reference_unit(tmp_path, monkeypatch, saved):
     shown = []
     monkeypatch.setattr(plt, "close", lambda fig=None: shown.append(fig))
     run(tmp_path, monkeypatch, "track", "sweep.csv", "--orders", "2,4", "--quiet",
-        "--map", "maps.png", "--map-channel", "left.z", "--as", "velocity")
+        "--map", "maps.png", "--map-channel", "left.z", "--as", "velocity", "--csv", "t.csv")
     _assert_clean(saved, ["maps.png"], "track")
     fig = shown[-1]
     a1, a2 = fig.axes[:2]
-    assert a1.get_ylim() == a2.get_ylim()                     # one speed range
+    import csv
+    lines = [ln for ln in (tmp_path / "t.csv").read_text().splitlines() if ln[:1] != "#"]
+    rpm = [float(row["rpm"]) for row in csv.DictReader(lines)]
+    assert a1.get_ylim() == a2.get_ylim() == (min(rpm), max(rpm))  # the tracked range
+    assert "centred in the record" in a1.get_title()          # why the map stops short
     assert a1.get_xlim()[1] == pytest.approx(1.25 * 4)       # 25 % above the highest order
     assert "left.z" in fig.legends[0].get_title().get_text() if fig.legends else \
         "left.z" in fig._suptitle.get_text()
@@ -442,11 +565,12 @@ def test_map_channel_and_reference_unit(tmp_path, monkeypatch, saved):
 
 
 def test_whatif_levels_and_delta_views():
+    """Both views draw every channel-quantity (the retuned mount's included however little
+    it changes), a legend of exactly what is drawn, and name no figure that was not made."""
     import matplotlib.pyplot as plt
     import numpy as np
 
     from powertrain.iotools.engine_file import DEFAULT_ENGINE_PATH, read_engine
-    from powertrain.plotting.runup import VISIBLE_CHANGE_DB
     from powertrain.workflows.operations import Variant
     from powertrain.workflows.variants import parse_operations
     from powertrain.workflows.whatif import run_whatif
@@ -455,19 +579,17 @@ def test_whatif_levels_and_delta_views():
     result = run_whatif(engine, variants, np.array([1000.0, 2000.0, 3000.0]), workers=1,
                         progress=False)
     keys = [(m, d, q) for m, d in result.baseline.channels for q in result.quantities]
-    fig = result.plot()
-    assert not outside_problems(fig), outside_problems(fig)
-    titles = [a.get_title() for a in fig.axes if a.get_visible()]
-    text = fig.texts[0].get_text() if not fig.legends else fig.legends[0].get_title().get_text()
-    for m, d, q in keys:       # every quantity drawn, or named as unchanged
-        big = max(np.nanmax(np.abs(result.delta_db(v.name, m, d, q))) for v in result.variants)
-        drawn = any(t.startswith(f"{m} {d.upper()} · ") and q.replace("_", " ") in t
-                    for t in titles)
-        assert drawn == (big >= VISIBLE_CHANGE_DB) or (drawn and len(titles) == 1)
-        assert drawn or f"{m} {d.upper()}" in text.replace("\n", " ")
-    plt.close(fig)
-    fig = result.plot(view="delta")
-    assert not outside_problems(fig), outside_problems(fig)
-    assert len([a for a in fig.axes if a.get_visible()]) == len(keys)
-    assert any(v.name in lab for v in result.variants for lab in _drawn_labels(fig))
-    plt.close(fig)
+    for view in ("levels", "delta"):
+        fig = result.plot(view=view)
+        assert not outside_problems(fig), outside_problems(fig)
+        assert not legend_problems(fig) and not unit_problems(fig)
+        assert not page_problems(fig, 300)
+        titles = [a.get_title() for a in fig.axes if a.get_visible()]
+        assert len(titles) == len(keys)
+        for m, d, q in keys:
+            assert f"{m} {d.upper()} · {q.replace('_', ' ')}" in titles
+        text = fig.legends[0].get_title().get_text()
+        assert "figure" not in text and "-0.00" not in " ".join(
+            t.get_text() for t in fig.legends[0].get_texts())
+        assert any(v.name in lab for v in result.variants for lab in _drawn_labels(fig))
+        plt.close(fig)

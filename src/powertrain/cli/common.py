@@ -82,11 +82,14 @@ def engine_description(engine, path, *, no_balancers=False, effects=()) -> str:
     return text
 
 
-def write_plot(draw, path) -> None:
+def write_plot(draw, path) -> list:
     """Draw a figure with ``draw(path)`` (a result's ``plot``) under the Agg backend, then
-    release it."""
+    release it; returns the files written: ``path``, and the further pages of a figure
+    drawn on several (its ``pages``)."""
     use_agg()
-    close_figure(draw(path))
+    fig = draw(path)
+    close_figure(fig)
+    return list(getattr(fig, "pages", None) or [path])
 
 
 def plot_form_options(func):

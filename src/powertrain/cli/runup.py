@@ -114,12 +114,15 @@ def _write_runup(result, files, engine, path_order) -> list:
         result.to_hdf5(files["out"])
     if files["csv"]:
         result.to_csv(files["csv"], result.synthetic_comments(prov))
+    plots = {}
     if files["plot"]:
-        write_plot(lambda p: result.plot(path=p, provenance=prov), files["plot"])
+        plots["plot"] = write_plot(lambda p: result.plot(path=p, provenance=prov),
+                                   files["plot"])
     if files["path_plot"]:
         write_plot(lambda p: result.plot_paths(path=p, order=path_order, provenance=prov),
                    files["path_plot"])
-    return [files[k] for k in ("out", "csv", "plot", "path_plot") if files[k]]
+    return [f for k in ("out", "csv", "plot", "path_plot") if files[k]
+            for f in plots.get(k, [files[k]])]
 
 
 def _write_sweep(result, files, engine) -> list:

@@ -64,6 +64,8 @@ class MeasuredStiffness:
     source: str = ""
     #: Test amplitude of each point [m] (multi-amplitude data), None without that column.
     amplitude_m: np.ndarray | None = None
+    #: A comment line of the file says the data are synthetic (figures mark them SYNTHETIC).
+    synthetic: bool = False
 
     def select(self, fmin=None, fmax=None) -> MeasuredStiffness:
         """The points with ``fmin <= f <= fmax`` [Hz] (either bound optional)."""
@@ -73,7 +75,8 @@ class MeasuredStiffness:
         if fmax is not None:
             keep &= self.frequency_hz <= fmax
         amp = None if self.amplitude_m is None else self.amplitude_m[keep]
-        return MeasuredStiffness(self.frequency_hz[keep], self.kcp[keep], self.source, amp)
+        return MeasuredStiffness(self.frequency_hz[keep], self.kcp[keep], self.source, amp,
+                                 self.synthetic)
 
     @property
     def amplitudes(self) -> np.ndarray:
@@ -84,7 +87,7 @@ class MeasuredStiffness:
         """The curve measured at one test ``amplitude`` [m] (one of :attr:`amplitudes`)."""
         keep = self.amplitude_m == amplitude
         return MeasuredStiffness(self.frequency_hz[keep], self.kcp[keep], self.source,
-                                 self.amplitude_m[keep])
+                                 self.amplitude_m[keep], self.synthetic)
 
 
 #: Plausible magnitudes: frequency [Hz], stiffness [N/mm] (a steel bar is ~1e6 N/mm), phase
@@ -93,17 +96,22 @@ LIMITS = {FREQUENCY: 1e5, REAL: 1e9, IMAG: 1e9, ABS: 1e9, PHASE: 360.0, AMPLITUD
 
 
 def _open_rows(path):
+    """The data rows (line number, fields) of a CSV file, and whether a comment line says
+    the data are synthetic."""
     text = read_text(path, "CSV")
-    rows = []
+    rows, synthetic = [], False
     try:
         parsed = list(csv.reader(text.splitlines()))
     except csv.Error as exc:
         raise InputError(f"not a CSV table ({exc})", file=path) from None
     for lineno, fields in zip(range(1, 10**9), parsed):
-        if not fields or all(not f.strip() for f in fields) or fields[0].lstrip().startswith("#"):
+        if fields and fields[0].lstrip().startswith("#"):
+            synthetic = synthetic or "synthetic" in ",".join(fields).lower()
+            continue
+        if not fields or all(not f.strip() for f in fields):
             continue
         rows.append((lineno, [f.strip() for f in fields]))
-    return rows
+    return rows, synthetic
 
 
 def read_stiffness_csv(path) -> MeasuredStiffness:
@@ -127,7 +135,7 @@ def read_stiffness_csv(path) -> MeasuredStiffness:
         increasing, no data rows.
     """
     path = str(path)
-    rows = _open_rows(path)
+    rows, synthetic = _open_rows(path)
     if not rows:
         raise InputError("empty file, expected a header line", file=path, key=FREQUENCY)
     header_line, header = rows[0]
@@ -143,7 +151,7 @@ def read_stiffness_csv(path) -> MeasuredStiffness:
     else:
         kcp = to_si(a, "N/mm", "stiffness") + 1j * to_si(b, "N/mm", "stiffness")
     amplitude = to_si(np.array(data[AMPLITUDE]), "mm", "length") if amp else None
-    return MeasuredStiffness(f, kcp, path, amplitude)
+    return MeasuredStiffness(f, kcp, path, amplitude, synthetic)
 
 
 def _columns(header, header_line, path):

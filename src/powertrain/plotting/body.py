@@ -9,6 +9,7 @@ import numpy as np
 
 from powertrain.analysis.channel import passive_name
 from powertrain.plotting import SIGNAL_UNITS
+from powertrain.plotting.pages import first_page, page_note, page_path, page_rows
 from powertrain.plotting.runup import SYNTHESIS_NOTE, panel_title, style_panel
 from powertrain.plotting.style import (
     LABEL_SIZE,
@@ -23,8 +24,11 @@ from powertrain.plotting.style import (
     series_style,
     subplots,
     whole_figure,
+    wrap,
 )
 
+#: Height of a both-sides figure outside its panel rows [in]: title, legend, x labels, foot.
+FRAME_IN = 1.9
 #: Rigid-body coordinates, as in :data:`powertrain.solvers.modes.COORDINATES`.
 COORDINATES = ("x", "y", "z", "rx", "ry", "rz")
 _COLOURS = dict(zip(COORDINATES, (OKABE_ITO[c] for c in (
@@ -96,23 +100,15 @@ def plot_runup_both_sides(result, path=None, quantities=("synthesis", "order_2",
     engine side (solid) and the body side (dashed), then one per body-point direction;
     columns = ``quantities``; log-scaled RMS [mm/s for velocity]. A body side that is zero
     at every speed is said in its panel title; a body-point direction zero in every column
-    is not drawn but named in the figure title. Returns the figure (``ax``: None, a Figure
-    or SubFigure)."""
-    factor, unit = SIGNAL_UNITS[signal][:2]
+    is not drawn but named in the figure title. The rows are as tall as fit one A4 page;
+    written to ``path``, more rows than fit go on further pages (``NAME_p2.png`` …, as
+    :func:`~powertrain.plotting.runup.plot_runup`). Returns the figure, the first page
+    (``ax``: None, a Figure or SubFigure)."""
     rows = [(m, d, True) for m in result.mounts for d in "xyz"]
     points = [(p, d, False) for p in result.points for d in "xyz"]
     silent = [(p, d) for p, d, _ in points
               if not any(np.any(result.curve(p, d, q, signal) > 0) for q in quantities)]
     rows += [r for r in points if r[:2] not in silent]
-    fig, axes, own = subplots(ax, len(rows), len(quantities),
-                              figsize=(PRINT_WIDTH_IN, 1.3 * len(rows) + 1.9), sharex=True)
-    for r, row in enumerate(rows):
-        for q, quantity in enumerate(quantities):
-            _both_sides_panel(axes[r, q], result, row, quantity, signal, factor)
-    for a in axes[-1]:
-        a.set_xlabel("engine speed [rpm]", fontsize=LABEL_SIZE)
-    fig.supylabel(f"RMS {signal.replace('_', ' ')} [{unit}]", fontsize=LABEL_SIZE + 0.5)
-    legend(fig, axes, ax)
     title = "run-up with the body model: both sides of each mount, then the body points"
     title += SYNTHESIS_NOTE
     if any(not np.any(result.curve(passive_name(m), d, q, signal) > 0)
@@ -121,7 +117,30 @@ def plot_runup_both_sides(result, path=None, quantities=("synthesis", "order_2",
     if silent:
         title += (". Zero at every speed (no mount path moves them), not drawn: "
                   + ", ".join(f"{p} {d.upper()}" for p, d in silent))
-    return finish(fig, own, path, provenance, title=title if whole_figure(ax) else None)
+    frame = FRAME_IN + 0.16 * wrap(title, PRINT_WIDTH_IN * 0.95, 9).count("\n")
+    pages, height = page_rows(rows, frame)
+    pages = pages if ax is None and path else [rows]
+    paths = [page_path(path, k) for k in range(len(pages))]
+    figures = []
+    for k, chunk in enumerate(pages):
+        fig, axes, own = subplots(ax, len(chunk), len(quantities), sharex=True,
+                                  figsize=(PRINT_WIDTH_IN, height * len(chunk) + frame))
+        _both_sides_grid(fig, axes, result, chunk, quantities, signal)
+        legend(fig, axes, ax)
+        figures.append(finish(fig, own, paths[k], provenance, title=title + page_note(
+            k, pages, path) if whole_figure(ax) else None))
+    return figures[0] if len(figures) == 1 else first_page(figures, paths)
+
+
+def _both_sides_grid(fig, axes, result, rows, quantities, signal):
+    """The panels of one page of :func:`plot_runup_both_sides` and their axis labels."""
+    factor, unit = SIGNAL_UNITS[signal][:2]
+    for r, row in enumerate(rows):
+        for q, quantity in enumerate(quantities):
+            _both_sides_panel(axes[r, q], result, row, quantity, signal, factor)
+    for a in axes[-1]:
+        a.set_xlabel("engine speed [rpm]", fontsize=LABEL_SIZE)
+    fig.supylabel(f"RMS {signal.replace('_', ' ')} [{unit}]", fontsize=LABEL_SIZE + 0.5)
 
 
 def _both_sides_panel(a, result, row, quantity, signal, factor):

@@ -32,6 +32,7 @@ from powertrain.plotting.style import (
     no_data,
     panels_error,
     quantity_label,
+    signed,
     subplots,
     whole_figure,
 )
@@ -163,7 +164,7 @@ def plot_comparison(comparison, path=None, quantities=None, *, ax=None, channel=
         _margin_labels(axes, panels, rows, quantities[0])
     label_grid(fig, axes, "RMS velocity [mm/s]" + (", under it phase φ [°]" if phased
                                                    else ""))
-    _legend(fig, axes, limit, ax)
+    legend(fig, axes, ax)
     return finish(fig, own, path, provenance,
                   title=_title(comparison, bool(phased)) if whole_figure(ax) else None)
 
@@ -282,11 +283,9 @@ def _empty_panel(a, head, reason):
     a.tick_params(labelsize=TICK_SIZE)
 
 
-def _legend(fig, axes, limit, target):
-    from matplotlib.lines import Line2D  # deferred: heavy optional package
-    extra = [(Line2D([], [], color="0.5", ls=":", lw=0.8),
-              f"noise-floor limit ({limit:g} mm/s)")] if limit > 0 else []
-    legend(fig, axes, target, extra)
+def limit_label(limit) -> str:
+    """Legend label of the noise-floor exclusion limit [mm/s]."""
+    return f"noise-floor limit ({limit:g} mm/s)"
 
 
 def _title(comparison, phased=False) -> str:
@@ -317,7 +316,7 @@ def _panel(ax, key, comparison, c, unmodelled, limit, head):
         ax.fill_between(c.rpm, m, s, where=c.scored & (s < m), interpolate=True,
                         color=GAP_BELOW, alpha=0.45, lw=0, label="sim < measured")
         title += ("\n" if title else "") + \
-            f"{c.stats['rms_db']:.1f} rms, {c.stats['bias_db']:+.1f} bias"
+            f"rms {c.stats['rms_db']:.1f}, bias {signed(c.stats['bias_db'])} dB"
     if c is not None and c.at_floor.any():
         ax.plot(c.rpm[c.at_floor], np.maximum(c.measured[c.at_floor] * MM, limit * 0.5), "x",
                 color="0.55", ms=3, label="excluded (noise floor)")
@@ -330,7 +329,7 @@ def _panel(ax, key, comparison, c, unmodelled, limit, head):
         if limit / 2 < hi and lo < limit:
             ax.set_ylim(max(lo, limit / 2), hi)
         if lo < limit < hi:
-            ax.axhline(limit, color="0.5", ls=":", lw=0.8)
+            ax.axhline(limit, color="0.5", ls=":", lw=0.8, label=limit_label(limit))
 
 
 def _curve(ax, curves, key, fmt, **style):

@@ -22,9 +22,11 @@ from powertrain.plotting.style import (
     legend,
     log_axis,
     no_data,
-    series_style,
+    quantity_label,
+    quantity_style,
     subplots,
     whole_figure,
+    wrap,
 )
 
 #: Display unit and factor per quantity.
@@ -46,11 +48,15 @@ def tracked_quantities(tracked) -> list:
 
 def plot_tracked(tracked, path=None, quantities=None, *, ax=None, provenance=None):
     """Order RMS against rpm, one panel per channel: the synthesis (black) and every order
-    asked (default: every tracked order, :func:`tracked_quantities`), each in its own colour
-    and line style; the y axis spans at most :data:`DYNAMIC_RANGE_DB` below the panel's
-    largest level, and orders wholly below it are named in the title. One legend for the
-    figure; returns the figure (``ax``: None, Figure or SubFigure, or an Axes when there is
-    one channel, else an InputError saying to pass a Figure)."""
+    asked (default: every tracked order, :func:`tracked_quantities`), each in the colour and
+    line style it has in every figure (:func:`~powertrain.plotting.style.quantity_style`).
+
+    A curve wholly more than :data:`DYNAMIC_RANGE_DB` below the panel's largest level is not
+    drawn (numerical noise, 1e-5 of the signal); the orders left out so are named in the
+    title. Each y axis spans the drawn curves (at most that range). The one legend of the
+    figure lists exactly the curves drawn. Returns the figure (``ax``: None, Figure or
+    SubFigure, or an Axes when there is one channel, else an InputError saying to pass a
+    Figure)."""
     quantities = list(quantities or tracked_quantities(tracked))
     n = len(tracked.channels)
     cols = min(3, n)
@@ -60,50 +66,70 @@ def plot_tracked(tracked, path=None, quantities=None, *, ax=None, provenance=Non
     for c, ch in enumerate(tracked.channels):
         a = axes[c // cols][c % cols]
         label = ch.label
-        peaks = _draw_curves(a, tracked, label, quantities, DISPLAY[ch.quantity][1])
-        if not style_panel(a, f"{label} ({ch.quantity})", list(peaks.values()),
-                           DYNAMIC_RANGE_DB):
+        drawn, left_out = _draw_curves(a, tracked, label, quantities, DISPLAY[ch.quantity][1])
+        for q in left_out:
+            hidden.setdefault(q, []).append(label)
+        if not style_panel(a, f"{label} ({ch.quantity})", drawn, DYNAMIC_RANGE_DB):
             no_data(a, "zero at every speed")
-        bottom = a.get_ylim()[0]
-        for q, peak in peaks.items():
-            if peak < bottom:
-                hidden.setdefault(q, []).append(label)
         a.set_ylabel(f"RMS [{DISPLAY[ch.quantity][0]}]", fontsize=LABEL_SIZE)
         a.set_xlabel("engine speed [rpm]", fontsize=LABEL_SIZE)
     for c in range(n, rows * cols):
         axes[c // cols][c % cols].set_visible(False)
     legend(fig, axes, ax)
     title = f"order tracking ({tracked.method}) of {Path(str(tracked.source)).name}"
+    return finish(fig, own, path, provenance,
+                  title=title + _hidden_note(hidden, n) if whole_figure(ax) else None)
+
+
+def _hidden_note(hidden, n_channels) -> str:
+    """The title's note on the orders not drawn, grouped by where."""
     groups = {}
     for q, where in hidden.items():
-        groups.setdefault("every panel" if len(where) == n else ", ".join(where), []).append(q)
+        groups.setdefault("any panel" if len(where) == n_channels else ", ".join(where),
+                          []).append(q)
+    note = ""
     for where, qs in groups.items():
         names = ", ".join(q.replace("order_", "") for q in qs)
-        title += (f"; order{'s' * (len(qs) > 1)} {names} more than "
-                  f"{DYNAMIC_RANGE_DB:g} dB below the largest level, off the axis in {where}")
-    return finish(fig, own, path, provenance, title=title if whole_figure(ax) else None)
+        note += (f"; not drawn in {where}: order{'s' * (len(qs) > 1)} {names}, more than "
+                 f"{DYNAMIC_RANGE_DB:g} dB below the panel's largest level")
+    return note
 
 
-def _draw_curves(a, tracked, label, quantities, factor) -> dict:
-    """Draw the requested curves of one channel; returns {quantity: largest level}."""
-    peaks = {}
-    for k, q in enumerate(quantities):
+def _draw_curves(a, tracked, label, quantities, factor):
+    """Draw the curves of one channel that reach within :data:`DYNAMIC_RANGE_DB` of its
+    largest level; returns (the drawn levels, clipped to that range, the quantities not
+    drawn)."""
+    curves = {}
+    for q in quantities:
         v = tracked.curve(label, q) * factor
         ok = np.isfinite(v) & (v > 0)
-        style = {"color": "k", "lw": 1.8} if q == "synthesis" else \
-            {**series_style(k - ("synthesis" in quantities)), "lw": 1.1}
-        a.plot(tracked.rpm[ok], v[ok], label=q.replace("_", " "), **style)
-        peaks[q] = float(v[ok].max()) if ok.any() else 0.0
-    return peaks
+        curves[q] = (tracked.rpm[ok], v[ok])
+    peak = max((float(v.max()) for _, v in curves.values() if v.size), default=0.0)
+    floor = peak * 10 ** (-DYNAMIC_RANGE_DB / 20)
+    drawn, left_out = [], []
+    for q, (r, v) in curves.items():
+        if not v.size or v.max() < floor:
+            left_out.append(q)
+            continue
+        a.plot(r, v, label=quantity_label(q), lw=1.8 if q == "synthesis" else 1.1,
+               **quantity_style(q))
+        drawn.append(np.maximum(v, floor))
+    return (np.concatenate(drawn) if drawn else np.array([])), left_out
 
 
 def plot_maps(rpm, orders, order_rms, times, freqs, rpm_t, psd, title="", path=None,
-              unit="m/s²", *, factor=1.0, max_order=None, ax=None, provenance=None):
-    """Campbell (rpm-order) above rpm-frequency colour map, over the speed range where both
-    have data, levels in dB re the maximum on an 80 dB scale (colour-bar arrows where lower
-    levels are clipped); the order axis and the frequency axis end :data:`MAP_MARGIN` above
-    ``max_order`` (default: the highest order of the map). ``order_rms`` is SI, shown in
-    ``unit`` = SI × ``factor``. Returns the figure (``ax``: None, Figure or SubFigure)."""
+              unit="m/s²", *, factor=1.0, max_order=None, tracked_rpm=None, block_revs=None,
+              window_s=None, ax=None, provenance=None):
+    """Campbell (rpm-order) above rpm-frequency colour map, levels in dB re the maximum on an
+    80 dB scale (colour-bar arrows where lower levels are clipped); the order axis and the
+    frequency axis end :data:`MAP_MARGIN` above ``max_order`` (default: the highest order of
+    the map). ``order_rms`` is SI, shown in ``unit`` = SI × ``factor``.
+
+    Both speed axes span ``tracked_rpm`` (the order curves' speed range; default the maps'
+    own): a map reaches less far, as its analysis blocks (``block_revs`` revolutions) or
+    windows (``window_s`` seconds) are centred inside the record, and each panel's title
+    says so; the speeds it does not reach are shaded grey. Returns the figure (``ax``:
+    None, Figure or SubFigure)."""
     fig, axes, own = subplots(ax, 2, 1, figsize=(PRINT_WIDTH_IN, 7.4), sharey=True)
     a1, a2 = axes[:, 0]
     top = MAP_MARGIN * float(max_order or np.max(orders))
@@ -112,24 +138,41 @@ def plot_maps(rpm, orders, order_rms, times, freqs, rpm_t, psd, title="", path=N
     m1 = a1.pcolormesh(orders, rpm, db1, shading="nearest", cmap="viridis", vmin=-80, vmax=0)
     a1.set_xlabel("order", fontsize=LABEL_SIZE)
     a1.set_xlim(0, min(top, float(np.max(orders))))
-    a1.set_title("rpm-order map (Campbell)", fontsize=TITLE_SIZE)
     colorbar(fig, m1, a1, db1, -80, 0, f"order RMS [dB re {ref * factor:.3g} {unit}]")
     refp = max(np.max(psd), 1e-30)
     db2 = 10 * np.log10(np.maximum(psd, refp * 1e-8) / refp)
     m2 = a2.pcolormesh(freqs, rpm_t, db2, shading="nearest", cmap="viridis", vmin=-80, vmax=0)
     a2.set_xlabel("frequency [Hz]", fontsize=LABEL_SIZE)
-    a2.set_title("rpm-frequency map (waterfall)", fontsize=TITLE_SIZE)
     colorbar(fig, m2, a2, db2, -80, 0, "PSD [dB re max]")
     f_top = top * float(np.max(rpm)) / 60.0
     a2.set_xlim(float(np.min(freqs)), min(f_top, float(np.max(freqs))))
-    lo = max(float(np.min(rpm)), float(np.min(rpm_t)))    # where both maps have data
-    hi = min(float(np.max(rpm)), float(np.max(rpm_t)))
-    for a in (a1, a2):
-        a.set_ylabel("engine speed [rpm]", fontsize=LABEL_SIZE)
-        a.set_ylim(lo, hi)
-        a.tick_params(labelsize=TICK_SIZE)
-        a.yaxis.set_tick_params(labelleft=True)
+    lo, hi = tracked_rpm or (min(np.min(rpm), np.min(rpm_t)), max(np.max(rpm), np.max(rpm_t)))
+    for a, name, speeds, span in (
+            (a1, "rpm-order map (Campbell)", rpm, block_revs and f"{block_revs:g}-revolution "
+             "blocks"),
+            (a2, "rpm-frequency map (waterfall)", rpm_t, window_s and f"{window_s:.2g} s "
+             "windows")):
+        _speed_axis(a, name, float(np.min(speeds)), float(np.max(speeds)), (lo, hi), span)
     return finish(fig, own, path, provenance, title=title if whole_figure(ax) else None)
+
+
+def _speed_axis(a, name, first, last, limits, span):
+    """The speed axis ``limits`` [rpm] of one map whose data reach ``first``..``last``: the
+    speeds beyond shaded, the title saying why (``span``: its blocks or windows)."""
+    lo, hi = float(min(limits)), float(max(limits))
+    step = (last - first) / 50 if last > first else 0.0
+    title = name
+    if first - step > lo or last + step < hi:
+        title += (f": data {first:.0f}–{last:.0f} rpm of {lo:.0f}–{hi:.0f}"
+                  + (f" ({span} centred in the record)" if span else ""))
+        for a0, a1_ in ((lo, first), (last, hi)):
+            if a1_ > a0:
+                a.axhspan(a0, a1_, color="0.88", lw=0, zorder=0)
+    a.set_title(wrap(title, PRINT_WIDTH_IN * 0.75, TITLE_SIZE), fontsize=TITLE_SIZE)
+    a.set_ylabel("engine speed [rpm]", fontsize=LABEL_SIZE)
+    a.set_ylim(lo, hi)
+    a.tick_params(labelsize=TICK_SIZE)
+    a.yaxis.set_tick_params(labelleft=True)
 
 
 def plot_sweep_rates(curves, path=None, title="", *, ax=None, provenance=None):

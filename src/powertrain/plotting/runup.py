@@ -7,6 +7,7 @@ from __future__ import annotations
 import numpy as np
 
 from powertrain.errors import InputError
+from powertrain.plotting.pages import first_page, page_note, page_path, page_rows
 from powertrain.plotting.style import (
     LABEL_SIZE,
     PRINT_WIDTH_IN,
@@ -21,6 +22,7 @@ from powertrain.plotting.style import (
     no_data,
     panels_error,
     quantity_label,
+    signed,
     subplots,
     whole_figure,
     wrap,
@@ -31,7 +33,12 @@ RPM_LABEL = "engine speed [rpm]"
 SYNTHESIS_NOTE = " (synthesis = RMS sum of the orders ≤ 8)"
 
 
-def grid(ax, rows, quantities, channel=None, quantity=None, panel_height=1.3):
+#: Height of a grid figure outside its panel rows [in]: title, legend, x labels, foot line.
+GRID_FRAME_IN = 1.6
+
+
+def grid(ax, rows, quantities, channel=None, quantity=None, panel_height=None,
+         frame_in=GRID_FRAME_IN):
     """Panels of a channel × quantity figure: every row of ``rows`` and column of
     ``quantities``, or only the row ``channel`` ((mount, direction)) and the column
     ``quantity`` where given.
@@ -39,6 +46,10 @@ def grid(ax, rows, quantities, channel=None, quantity=None, panel_height=1.3):
     ``ax`` None, Figure or SubFigure: those panels; an Axes: the one panel they leave
     (:class:`~powertrain.errors.InputError`, saying to pass a Figure, when they leave
     several).
+
+    ``panel_height``: of a row [in]; default as tall as fit one page
+    (:func:`~powertrain.plotting.style.page_rows`) with ``frame_in`` [in] for the title,
+    legend, x labels and foot line.
 
     Returns
     -------
@@ -52,7 +63,10 @@ def grid(ax, rows, quantities, channel=None, quantity=None, panel_height=1.3):
                              key="ax")
         return ax.figure, {(*rows[0], quantities[0]): ax}, False, np.array([[ax]])
     nr, nq = len(rows), len(quantities)
-    fig, axes, own = subplots(ax, nr, nq, figsize=(PRINT_WIDTH_IN, panel_height * nr + 1.6),
+    if panel_height is None:
+        panel_height = page_rows(rows, frame_in)[1]
+    fig, axes, own = subplots(ax, nr, nq,
+                              figsize=(PRINT_WIDTH_IN, panel_height * nr + frame_in),
                               sharex=True)
     panels = {(*rows[r], quantities[q]): axes[r, q] for r in range(nr) for q in range(nq)}
     return fig, panels, own, axes
@@ -133,11 +147,15 @@ def plot_runup(results, path=None, quantities=("synthesis", "order_2", "order_4"
                signal="velocity", *, ax=None, channel=None, quantity=None, provenance=None):
     """RMS curves of one or more run-ups: rows = mount × direction, columns = ``quantities``.
 
+    The rows are made as tall as fit one A4 page (:func:`grid`); written to ``path``, a grid
+    whose rows do not fit one page at the smallest row height is written as pages:
+    ``path``, then ``NAME_p2.png`` … (:func:`~powertrain.plotting.style.page_path`).
+
     Parameters
     ----------
     results : list of (label, RunupResult)
     path : str or Path, optional
-        PNG written atomically.
+        PNG written atomically (the first page).
     quantities : sequence of str
         ``synthesis`` and/or ``order_<n>``; every one is drawn.
     signal : {"velocity", "displacement", "acceleration", "mount_force"}
@@ -149,10 +167,22 @@ def plot_runup(results, path=None, quantities=("synthesis", "order_2", "order_4"
     Returns
     -------
     matplotlib Figure (or SubFigure)
+        The first page; its ``pages`` attribute lists the files written when there are
+        several.
     """
-    first = results[0][1]
-    rows = list(first.channels)
-    fig, panels, own, axes = grid(ax, rows, list(quantities), channel, quantity)
+    rows, picked = select_panels(results[0][1].channels, list(quantities), channel, quantity)
+    if is_axes(ax):
+        return _runup_page(results, rows, picked, signal, ax, provenance, path, "")
+    pages = page_rows(rows, GRID_FRAME_IN)[0] if ax is None and path else [rows]
+    paths = [page_path(path, k) for k in range(len(pages))]
+    figures = [_runup_page(results, chunk, picked, signal, ax, provenance, paths[k],
+                           page_note(k, pages, path)) for k, chunk in enumerate(pages)]
+    return figures[0] if len(figures) == 1 else first_page(figures, paths)
+
+
+def _runup_page(results, rows, quantities, signal, ax, provenance, path, note):
+    """One page of :func:`plot_runup`: the grid of ``rows`` × ``quantities``."""
+    fig, panels, own, axes = grid(ax, rows, quantities)
     scale, unit = SIGNAL_UNITS[signal]
     for (mount, direction, q), a in panels.items():
         values = []
@@ -170,87 +200,66 @@ def plot_runup(results, path=None, quantities=("synthesis", "order_2", "order_4"
         legend(fig, axes, ax)
     return finish(fig, own, path, provenance,
                   title=f"run-up: RMS {signal.replace('_', ' ')} at the mounts{SYNTHESIS_NOTE}"
-                  if whole_figure(ax) else None)
+                  f"{note}" if whole_figure(ax) else None)
 
 
 # --------------------------------------------------------------------------- what-if
-#: A what-if panel of absolute levels is drawn when some variant differs from the baseline
-#: by at least this much at some speed [dB]; smaller changes are invisible on a log axis
-#: spanning decades and are read from the Δ dB figure instead.
-VISIBLE_CHANGE_DB = 1.0
-
-
 def plot_whatif(whatif, path=None, *, ax=None, channel=None, quantity=None, provenance=None,
                 view="levels"):
     """A what-if study against speed: absolute levels (``view="levels"``) or the change of
     each variant against the baseline, Δ = 20 log10(v/v0) [dB] (``view="delta"``).
 
-    ``levels``: baseline black, each variant in colour, the measurement (when given) as grey
-    dots, only for the channel-quantities where some variant changes the level by at least
-    :data:`VISIBLE_CHANGE_DB` somewhere (the others are listed under the title: their lines
-    would lie on top of each other). ``delta``: every channel-quantity, one panel each, on one
-    shared Δ axis, a line per variant. The legend gives each variant's mean change over all
-    channels, quantities and speeds.
+    Every channel-quantity, one panel each (rows mount × direction, columns the quantities,
+    as tall as fit one A4 page; written to ``path``, a grid too tall for one page goes on
+    several, as :func:`plot_runup`). ``levels``: baseline black, each variant in colour, the
+    measurement (when given) as grey dots; a variant within a fraction of a dB of the
+    baseline lies on it. ``delta``: one shared Δ axis, a line per variant. The legend gives
+    each variant's mean change over all channels, quantities and speeds.
 
     Parameters
     ----------
     whatif : powertrain.workflows.whatif.WhatIfResult
     path : str, optional
-        PNG written atomically.
+        PNG written atomically (the first page).
     ax, channel, quantity, provenance
         As for :func:`plot_runup`.
     view : {"levels", "delta"}
+
+    Returns
+    -------
+    matplotlib Figure (or SubFigure)
+        The first page; its ``pages`` attribute lists the files written when there are
+        several.
     """
     if view not in ("levels", "delta"):
         raise InputError(f"{view!r} is not one of 'levels', 'delta'", key="view")
     base = whatif.baseline
-    quantities = list(whatif.quantities)
-    rows, picked = select_panels(base.channels, quantities, channel, quantity)
-    keys = [(m, d, q) for m, d in rows for q in picked]
-    largest = {k: _largest_change(whatif, k) for k in keys}
-    shown = keys if view == "delta" else \
-        [k for k in keys if largest[k] >= VISIBLE_CHANGE_DB] or [max(keys, key=largest.get)]
+    rows, picked = select_panels(base.channels, list(whatif.quantities), channel, quantity)
     signal = getattr(whatif, "signal", "velocity")
-    title = _whatif_title(view, keys, shown, signal)
-    fig, panels, own, axes = _panels(ax, shown, quantities, base.channels, channel, quantity,
-                                     title_lines=wrap(title, PRINT_WIDTH_IN * 0.95,
-                                                      9).count("\n") + 1)
-    overall = {v.name: _mean_change(whatif, v.name, base.channels, quantities)
+    title = _whatif_title(view, signal)
+    entries = len(whatif.variants) + 1 + (whatif.measured is not None and view == "levels")
+    frame = GRID_FRAME_IN + 0.16 * (wrap(title, PRINT_WIDTH_IN * 0.95, 9).count("\n") + 1
+                                    + entries)
+    pages, height = page_rows(rows, frame)
+    if ax is not None or not path:
+        pages = [rows]
+    paths = [page_path(path, k) for k in range(len(pages))]
+    overall = {v.name: _mean_change(whatif, v.name, base.channels, list(whatif.quantities))
                for v in whatif.variants}
-    draw = _delta_panel if view == "delta" else _levels_panel
-    for key, a in panels.items():
-        draw(a, whatif, key, overall)
-    if view == "delta":
-        _share_delta_axis(panels.values())
-    ylabel = "Δ = 20 log10(v/v0) [dB]" if view == "delta" else \
-        f"RMS {signal.replace('_', ' ')} [{SIGNAL_UNITS[signal][1]}]"
-    label_grid(fig, axes, ylabel)
-    legend(fig, axes, ax)
-    return finish(fig, own, path, provenance, title=title if whole_figure(ax) else None)
-
-
-def _panels(ax, shown, quantities, channels, channel, quantity, title_lines=2):
-    """The full channel × quantity grid when every panel is shown, else the shown panels
-    three to a row in reading order."""
-    rows, picked = select_panels(channels, quantities, channel, quantity)
-    if is_axes(ax):
-        if len(shown) != 1:
-            raise InputError(panels_error(len(shown), ", or choose one panel with "
-                                          "channel=(MOUNT, DIR) and quantity="), key="ax")
-        return ax.figure, {shown[0]: ax}, False, np.array([[ax]])
-    if len(shown) == len(rows) * len(picked):
-        return grid(ax, channels, quantities, channel, quantity)
-    ncol = min(3, len(shown))
-    nrow = -(-len(shown) // ncol)
-    fig, axes, own = subplots(ax, nrow, ncol, sharex=True,
-                              figsize=(PRINT_WIDTH_IN, 1.45 * nrow + 1.6 + 0.17 * title_lines))
-    for a in axes.flat[len(shown):]:
-        a.set_visible(False)
-    if len(shown) % ncol:   # x tick labels on the panels above the empty slots
-        for a in axes[-2, len(shown) % ncol:] if nrow > 1 else []:
-            a.xaxis.set_tick_params(labelbottom=True)
-            a.set_xlabel(RPM_LABEL, fontsize=LABEL_SIZE)
-    return fig, dict(zip(shown, axes.flat)), own, axes
+    figures = []
+    for k, chunk in enumerate(pages):
+        fig, panels, own, axes = grid(ax, chunk, picked, panel_height=height, frame_in=frame)
+        draw = _delta_panel if view == "delta" else _levels_panel
+        for key, a in panels.items():
+            draw(a, whatif, key, overall)
+        if view == "delta":
+            _share_delta_axis(panels.values())
+        label_grid(fig, axes, "Δ = 20 log10(v/v0) [dB]" if view == "delta" else
+                   f"RMS {signal.replace('_', ' ')} [{SIGNAL_UNITS[signal][1]}]")
+        legend(fig, axes, ax)
+        figures.append(finish(fig, own, paths[k], provenance, title=title + page_note(
+            k, pages, path) if whole_figure(ax) else None))
+    return figures[0] if len(figures) == 1 else first_page(figures, paths)
 
 
 def _levels_panel(a, whatif, key, overall):
@@ -269,7 +278,7 @@ def _levels_panel(a, whatif, key, overall):
     for k, var in enumerate(whatif.variants):
         r, v = _positive(var.result.rpm, var.result.curve(mount, direction, q, signal) * scale)
         a.plot(r, v, "o-", ms=2, lw=1.0, color=colour(k),
-               label=f"{var.name} (mean {overall[var.name]:+.2f} dB)")
+               label=f"{var.name} (mean {signed(overall[var.name], 2)} dB)")
         values.append(v)
     if not style_panel(a, panel_title(mount, direction, q), np.concatenate(values)):
         no_data(a, "zero at every speed (not excited)")
@@ -281,7 +290,7 @@ def _delta_panel(a, whatif, key, overall):
     for k, var in enumerate(whatif.variants):
         d = whatif.delta_db(var.name, mount, direction, q)
         a.plot(var.result.rpm, d, "-", lw=1.1, color=colour(k),
-               label=f"{var.name} (mean {overall[var.name]:+.2f} dB)")
+               label=f"{var.name} (mean {signed(overall[var.name], 2)} dB)")
     a.set_title(panel_title(mount, direction, q), fontsize=TITLE_SIZE)
     a.grid(True, alpha=0.35)
     a.tick_params(labelsize=TICK_SIZE)
@@ -299,31 +308,12 @@ def _share_delta_axis(axes):
         a.set_ylim(-top, top)
 
 
-def _whatif_title(view, keys, shown, signal) -> str:
+def _whatif_title(view, signal) -> str:
     if view == "delta":
         return ("what-if: change of each variant against the baseline, "
                 f"Δ = 20 log10(v/v0) of the RMS {signal.replace('_', ' ')} [dB]"
                 + SYNTHESIS_NOTE)
-    title = f"what-if: baseline vs variants{SYNTHESIS_NOTE}"
-    hidden = [k for k in keys if k not in shown]
-    if hidden:
-        per_channel = {}
-        for m, d, q in hidden:
-            per_channel.setdefault(f"{m} {d.upper()}", []).append(quantity_label(q))
-        n_q = len({q for _, _, q in keys})
-        names = "; ".join(ch if len(qs) == n_q else f"{ch} {', '.join(qs)}"
-                          for ch, qs in per_channel.items())
-        title += (f". Not drawn, every variant within ±{VISIBLE_CHANGE_DB:g} dB of the "
-                  f"baseline at every speed (see the Δ dB figure): {names}")
-    return title
-
-
-def _largest_change(whatif, key) -> float:
-    """Largest |Δ| [dB] of any variant at any speed on one channel-quantity (0 if none)."""
-    d = [np.abs(np.atleast_1d(whatif.delta_db(v.name, *key))) for v in whatif.variants]
-    d = np.concatenate(d) if d else np.array([])
-    d = d[np.isfinite(d)]
-    return float(d.max()) if d.size else 0.0
+    return f"what-if: baseline vs variants, RMS {signal.replace('_', ' ')}{SYNTHESIS_NOTE}"
 
 
 def _mean_change(whatif, name, channels, quantities) -> float:

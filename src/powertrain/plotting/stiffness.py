@@ -19,7 +19,9 @@ from powertrain.plotting.style import (
     colour,
     finish,
     log_axis,
+    root_size,
     subplots,
+    wrap,
 )
 
 FORMS = ("magnitude-phase", "real-imag")
@@ -98,7 +100,8 @@ def style_stiffness(axes, form, freq_axis, band=None, own=False):
 
 
 def plot_stiffness(curves, path=None, measured=None, ax=None, *, form=DEFAULT_FORM,
-                   freq_axis=DEFAULT_FREQ_AXIS, title=None, provenance=None):
+                   freq_axis=DEFAULT_FREQ_AXIS, title=None, provenance=None,
+                   measured_label="measured"):
     """Cross-point dynamic stiffness K*(f) of one or more mount models (and a measurement).
 
     Parameters
@@ -115,6 +118,8 @@ def plot_stiffness(curves, path=None, measured=None, ax=None, *, form=DEFAULT_FO
     title : str, optional
     provenance : Provenance, optional
         Foot line of a new figure.
+    measured_label : str
+        Legend label of ``measured``.
 
     Returns
     -------
@@ -122,7 +127,7 @@ def plot_stiffness(curves, path=None, measured=None, ax=None, *, form=DEFAULT_FO
     """
     fig, axes, own = stiffness_axes(ax, form)
     if measured is not None:
-        draw_stiffness(axes, measured[0], measured[1], form, label="measured", color="k",
+        draw_stiffness(axes, measured[0], measured[1], form, label=measured_label, color="k",
                        marker=".", freq_axis=freq_axis)
     for k, item in enumerate(curves):
         label, f, kcp = (item[0], item[1].frequency_hz, item[1].kcp) if len(item) == 2 \
@@ -131,13 +136,42 @@ def plot_stiffness(curves, path=None, measured=None, ax=None, *, form=DEFAULT_FO
                        freq_axis=freq_axis)
     style_stiffness(axes, form, freq_axis, own=own)
     if title:
-        axes[0].set_title(title, fontsize=TITLE_SIZE)
+        axes[0].set_title(wrap(title, root_size(axes[0].figure)[0] * 0.95, TITLE_SIZE),
+                          fontsize=TITLE_SIZE)
     return finish(fig, own, path, provenance)
+
+
+#: Points of a fitted curve drawn over the data's frequency range.
+FIT_POINTS = 400
+
+
+def fit_frequencies(frequency_hz, freq_axis=DEFAULT_FREQ_AXIS) -> np.ndarray:
+    """Frequencies [Hz] at which a fitted model is drawn as a continuous curve:
+    :data:`FIT_POINTS` spanning the data's ``frequency_hz`` range, evenly on the
+    ``freq_axis`` (log: from the lowest positive frequency)."""
+    f = np.asarray(frequency_hz, dtype=float)
+    if freq_axis == "log" and (f > 0).any():
+        return np.geomspace(f[f > 0].min(), f.max(), FIT_POINTS)
+    return np.linspace(f.min(), f.max(), FIT_POINTS)
+
+
+def _fitted(frequency_hz, fitted):
+    """(frequencies [Hz], K* [N/m]) of a fitted curve given at the data's frequencies or as
+    its own (frequencies, K*) pair."""
+    if isinstance(fitted, tuple):
+        return fitted
+    return frequency_hz, fitted
+
+
+def data_label(synthetic: bool) -> str:
+    """Legend word of data points: ``SYNTHETIC data`` when the file says so, else
+    ``measured``."""
+    return "SYNTHETIC data" if synthetic else "measured"
 
 
 def plot_mount_fit(frequency_hz, kcp_measured, kcp_fitted, *, label="fit", title=None,
                    ax=None, path=None, form=DEFAULT_FORM, freq_axis=DEFAULT_FREQ_AXIS,
-                   provenance=None):
+                   provenance=None, synthetic=False):
     """Measured (dots) and fitted (lines) K*(f) of a mount fit, in either form (see
     :func:`plot_stiffness`; the thesis shows real and imaginary parts, Kovarik 2016,
     Figs. 15–29 and 37–42).
@@ -146,21 +180,31 @@ def plot_mount_fit(frequency_hz, kcp_measured, kcp_fitted, *, label="fit", title
     ----------
     frequency_hz : ndarray
         [Hz]
-    kcp_measured, kcp_fitted : ndarray of complex
-        Cross-point dynamic stiffness [N/m].
+    kcp_measured : ndarray of complex
+        Cross-point dynamic stiffness [N/m] at ``frequency_hz``.
+    kcp_fitted : ndarray of complex, or (frequencies [Hz], ndarray of complex)
+        The fitted model's [N/m]: at ``frequency_hz``, or as a continuous curve at its own
+        frequencies (:func:`fit_frequencies`).
     label : str
         Legend label of the fitted curves.
     title : str, optional
     ax, path, form, freq_axis, provenance
         As for :func:`plot_stiffness`.
+    synthetic : bool
+        The data are synthetic: labelled ``SYNTHETIC data``, the title starts with
+        ``SYNTHETIC``.
 
     Returns
     -------
     matplotlib Figure (or SubFigure)
     """
-    return plot_stiffness([(label, frequency_hz, kcp_fitted)], path,
+    f_fit, k_fit = _fitted(frequency_hz, kcp_fitted)
+    if synthetic:
+        title = "SYNTHETIC data" + (f" · {title}" if title else "")
+    return plot_stiffness([(label, f_fit, k_fit)], path,
                           measured=(frequency_hz, kcp_measured), ax=ax, form=form,
-                          freq_axis=freq_axis, title=title, provenance=provenance)
+                          freq_axis=freq_axis, title=title, provenance=provenance,
+                          measured_label=data_label(synthetic))
 
 
 def plot_retune(target_fit, path=None, *, ax=None, form=DEFAULT_FORM,
@@ -190,24 +234,33 @@ def plot_retune(target_fit, path=None, *, ax=None, form=DEFAULT_FORM,
 
 
 def plot_amplitude_fit(curves, path=None, *, ax=None, form=DEFAULT_FORM,
-                       freq_axis=DEFAULT_FREQ_AXIS, title=None, provenance=None):
-    """Measured (dots) and fitted (lines) K*(f) at several test amplitudes, one colour per
-    amplitude (Kovarik 2016, Fig. 14 with the fit over it).
+                       freq_axis=DEFAULT_FREQ_AXIS, title=None, provenance=None,
+                       synthetic=False):
+    """Measured (dots) and fitted (continuous lines) K*(f) at several test amplitudes, one
+    colour per amplitude (Kovarik 2016, Fig. 14 with the fit over it).
 
     Parameters
     ----------
     curves : list of (label, frequency_hz, kcp_measured, kcp_fitted)
-        Per amplitude; stiffness [N/m].
+        Per amplitude; stiffness [N/m]; ``kcp_fitted`` at ``frequency_hz`` or as its own
+        (frequencies [Hz], K*) pair (:func:`fit_frequencies`).
     path, ax, form, freq_axis, title, provenance
         As for :func:`plot_stiffness`.
+    synthetic : bool
+        The data are synthetic: labelled ``SYNTHETIC data``, the title starts with
+        ``SYNTHETIC``.
     """
     fig, axes, own = stiffness_axes(ax, form)
     for k, (label, f, measured, fitted) in enumerate(curves):
-        draw_stiffness(axes, f, measured, form, label=f"{label} measured", color=colour(k),
-                       marker=".", freq_axis=freq_axis)
-        draw_stiffness(axes, f, fitted, form, label=f"{label} fitted", color=colour(k),
+        draw_stiffness(axes, f, measured, form, label=f"{label} {data_label(synthetic)}",
+                       color=colour(k), marker=".", freq_axis=freq_axis)
+        f_fit, k_fit = _fitted(f, fitted)
+        draw_stiffness(axes, f_fit, k_fit, form, label=f"{label} fitted", color=colour(k),
                        freq_axis=freq_axis)
     style_stiffness(axes, form, freq_axis, own=own)
+    if synthetic:
+        title = "SYNTHETIC data" + (f" · {title}" if title else "")
     if title:
-        axes[0].set_title(title, fontsize=TITLE_SIZE)
+        axes[0].set_title(wrap(title, root_size(axes[0].figure)[0] * 0.95, TITLE_SIZE),
+                          fontsize=TITLE_SIZE)
     return finish(fig, own, path, provenance)

@@ -8,6 +8,7 @@ backend (the CLI picks Agg, :func:`powertrain.cli.common.use_agg`).
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import os
 import textwrap
@@ -130,6 +131,47 @@ def series_style(k: int) -> dict:
     return {"color": colour(k), "ls": _LINE_STYLES[(k // len(PALETTE)) % len(_LINE_STYLES)]}
 
 
+def order_style(order) -> dict:
+    """Colour and line style of an engine order, the same in every figure.
+
+    Even orders (2, 4, 6, 8: the firing orders of a four-cylinder engine) are solid lines in
+    blue, orange, bluish green, vermillion; odd orders (1, 3, 5, 7) dashed in reddish purple,
+    sky blue, blue, orange; half orders 0.5 … 5.5 dotted and 6.5, 7.5 dash-dotted, coloured
+    by their integer part (the 16 orders 0.5 … 8 all differ); any other order dash-dot-dot.
+    The synthesis and totals are black (:func:`quantity_style`).
+
+    Parameters
+    ----------
+    order : float or str
+        The order [-] (``2.0``) or its quantity name (``"order_2"``).
+
+    Returns
+    -------
+    dict
+        ``color`` and ``ls`` for ``Axes.plot``.
+    """
+    if isinstance(order, str):
+        order = float(order.replace("order_", "").replace("order ", ""))
+    halves = round(2 * float(order))
+    if abs(2 * float(order) - halves) > 1e-9:
+        return {"color": colour(round(4 * float(order))), "ls": (0, (3, 1, 1, 1, 1, 1))}
+    if halves % 4 == 0:
+        return {"color": colour(halves // 4 - 1), "ls": "-"}
+    if halves % 2 == 0:
+        return {"color": colour(halves // 4 + 4), "ls": "--"}
+    return {"color": colour(halves // 2), "ls": ":" if halves // 2 < len(PALETTE) else "-."}
+
+
+def quantity_style(quantity: str) -> dict:
+    """Colour and line style of a run-up quantity: ``synthesis`` and ``overall`` black
+    (solid, dashed), an order as :func:`order_style`."""
+    if quantity == "synthesis":
+        return {"color": "k", "ls": "-"}
+    if quantity == "overall":
+        return {"color": "k", "ls": "--"}
+    return order_style(quantity)
+
+
 def _use_palette(axes):
     for a in np.ravel(axes):
         a.set_prop_cycle(color=list(PALETTE))
@@ -209,11 +251,8 @@ def add_provenance(fig, provenance):
         A :class:`~powertrain.provenance.Provenance`, or a record of
         :func:`powertrain.provenance.provenance`; None: only the program version is shown.
     """
-    if isinstance(provenance, dict):   # a record of powertrain.provenance.provenance()
-        provenance = Provenance.from_record(provenance)
-    text = provenance.line() if provenance is not None else f"powertrain {__version__}"
     width, height = fig.get_figwidth(), fig.get_figheight()
-    text = wrap(text, width * 0.98, FOOT_SIZE)
+    text = foot_text(provenance, width * 0.98)
     n_lines = text.count("\n") + 1
     strip = (n_lines * FOOT_SIZE * 1.25 + 4) / 72 / height
     engine = fig.get_layout_engine()
@@ -223,10 +262,66 @@ def add_provenance(fig, provenance):
              ha="left", va="bottom", linespacing=1.1)
 
 
+def foot_text(provenance, width_in) -> str:
+    """The provenance line in lines of ``width_in`` inches at :data:`FOOT_SIZE`: on one line
+    when it fits; else version, date and engine wrapped, then the command on lines of its
+    own, broken only between arguments with a shell continuation (`` \\``), so that it can
+    be copied and run as printed.
+
+    Parameters
+    ----------
+    provenance : powertrain.provenance.Provenance, dict or None
+        As for :func:`add_provenance`.
+    width_in : float
+        Width of a line [in].
+    """
+    if isinstance(provenance, dict):   # a record of powertrain.provenance.provenance()
+        provenance = Provenance.from_record(provenance)
+    if provenance is None:
+        return f"powertrain {__version__}"
+    chars = max(20, int(width_in * 72 / (FOOT_SIZE * _GLYPH) * 0.95))
+    line = provenance.line()
+    if len(line) <= chars or not provenance.command:
+        return wrap(line, width_in, FOOT_SIZE)
+    head = wrap(dataclasses.replace(provenance, command="").line(), width_in, FOOT_SIZE)
+    return head + "  ·\n" + "\n".join(shell_lines("$ " + provenance.command, chars))
+
+
+def shell_lines(command: str, chars: int) -> list:
+    """``command`` in lines of at most ``chars`` characters, broken between arguments, each
+    but the last ending in a shell continuation `` \\``, the following ones indented; an
+    option stays with its value, and an argument longer than a line stands on a line of its
+    own."""
+    words = []
+    for word in command.split(" "):
+        if words and words[-1].startswith("-") and not word.startswith("-") \
+                and " " not in words[-1]:
+            words[-1] += " " + word
+        else:
+            words.append(word)
+    lines, current = [], ""
+    for word in words:
+        indent = "  " if lines else ""
+        if current and len(indent + current + " " + word) + 2 > chars:
+            lines.append(indent + current + " \\")
+            current = word
+        else:
+            current = f"{current} {word}" if current else word
+    lines.append(("  " if lines else "") + current)
+    return lines
+
+
 def quantity_label(quantity: str) -> str:
     """``order_2`` -> ``order 2``; ``synthesis`` (the RMS sum of the orders ≤ 8, said once
     in the figure's title) stays."""
     return quantity.replace("order_", "order ")
+
+
+def signed(value, decimals: int = 1) -> str:
+    """``value`` with its sign and ``decimals`` decimals (``+0.1``, ``-2.0``); a value that
+    rounds to zero is ``0.0``, never ``-0.0`` or ``+0.0``."""
+    text = f"{value:+.{decimals}f}"
+    return text[1:] if float(text) == 0 else text
 
 
 def no_data(ax, text="no data above the noise floor", width=42):

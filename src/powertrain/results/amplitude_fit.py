@@ -8,7 +8,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from powertrain.plotting.stiffness import plot_amplitude_fit
+from powertrain.plotting.stiffness import fit_frequencies, plot_amplitude_fit
 from powertrain.plotting.style import target_and_path
 from powertrain.results.base import Result
 from powertrain.results.fit import PARAMETER_UNITS, FitResult
@@ -60,10 +60,16 @@ class AmplitudeFitResult(Result):
     seed: object = None
     data_name: str = ""
 
-    def kcp_fitted(self, index: int) -> np.ndarray:
-        """K*(f) [N/m] of the fitted mount at amplitude ``index``, at its data frequencies."""
-        return self.model.element().cross_point_stiffness(self.curves[index].frequency_hz,
-                                                          self.amplitude_m[index])
+    def kcp_fitted(self, index: int, frequency_hz=None) -> np.ndarray:
+        """K*(f) [N/m] of the fitted mount at amplitude ``index``, at its data frequencies
+        (or at ``frequency_hz`` [Hz])."""
+        f = self.curves[index].frequency_hz if frequency_hz is None else frequency_hz
+        return self.model.element().cross_point_stiffness(f, self.amplitude_m[index])
+
+    @property
+    def synthetic(self) -> bool:
+        """The data file says its data are synthetic (the figure marks them SYNTHETIC)."""
+        return any(getattr(c, "synthetic", False) for c in self.curves)
 
     def summary(self) -> str:
         """What was fitted and the residual per amplitude."""
@@ -112,9 +118,13 @@ class AmplitudeFitResult(Result):
         :func:`powertrain.plotting.stiffness.plot_amplitude_fit`; ``ax`` as for
         :meth:`powertrain.results.stiffness.StiffnessResult.plot`)."""
         ax, path = target_and_path(ax, path)
-        curves = [(f"{a * 1e3:g} mm", c.frequency_hz, c.kcp, self.kcp_fitted(i))
-                  for i, (a, c) in enumerate(zip(self.amplitude_m, self.curves))]
+        curves = []
+        for i, (a, c) in enumerate(zip(self.amplitude_m, self.curves)):
+            f = fit_frequencies(c.frequency_hz, freq_axis)
+            curves.append((f"{a * 1e3:g} mm", c.frequency_hz, c.kcp,
+                           (f, self.kcp_fitted(i, f))))
         worst = 100 * max(self.rel_rms)
         return plot_amplitude_fit(curves, path, ax=ax, form=form, freq_axis=freq_axis,
-                                  title=f"fit at {len(curves)} amplitudes: worst rel. RMS "
-                                        f"error {worst:.3g} %", provenance=provenance)
+                                  title=f"{self.model.name}: worst rel. RMS error {worst:.3g} "
+                                        "%", provenance=provenance,
+                                  synthetic=self.synthetic)

@@ -9,6 +9,7 @@ import numpy as np
 
 from powertrain.models.mount import MountModel
 from powertrain.plotting import plot_mount_fit
+from powertrain.plotting.stiffness import fit_frequencies
 from powertrain.plotting.style import target_and_path
 from powertrain.results.base import Result
 from powertrain.units import from_si
@@ -55,6 +56,8 @@ class FitResult(Result):
         Seed of the starting points.
     data_name : str
         Name of the file the data came from ("" for arrays).
+    synthetic : bool
+        The data file says its data are synthetic (the figure marks them SYNTHETIC).
     """
 
     model: MountModel
@@ -73,6 +76,7 @@ class FitResult(Result):
     nfev: int
     seed: object = None
     data_name: str = ""
+    synthetic: bool = False
 
     @property
     def kcp_fitted(self) -> np.ndarray:
@@ -117,11 +121,14 @@ class FitResult(Result):
         :meth:`powertrain.results.stiffness.StiffnessResult.plot`; ``save(path)`` writes the
         figure (``.png``)."""
         ax, path = target_and_path(ax, path)
-        return plot_mount_fit(self.frequency_hz, self.kcp_measured, self.kcp_fitted,
+        f = fit_frequencies(self.frequency_hz, freq_axis)
+        return plot_mount_fit(self.frequency_hz, self.kcp_measured,
+                              (f, self.model.cross_point_stiffness(f)),
                               label=f"{self.model.topology.name} fit",
-                              title=f"f_obj = {self.objective_n:.4g} N, "
+                              title=(f"{self.model.name}: " if self.model.name else "")
+                              + f"f_obj = {self.objective_n:.4g}\u00a0N, "
                                     f"rel. RMS error = {100 * self.rel_rms:.3g} %",
                               ax=ax, path=path, form=form, freq_axis=freq_axis,
-                              provenance=provenance)
+                              provenance=provenance, synthetic=self.synthetic)
 
 

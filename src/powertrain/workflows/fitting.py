@@ -454,7 +454,7 @@ def fit_mount_file(measured, model: str = DEFAULT_TOPOLOGY, *, starts: int = DEF
     result = fit_mount(data.frequency_hz, data.kcp, model, starts=starts, seed=seed,
                        max_mass=max_mass, name=f"{topo.description} fitted to {file}",
                        source=f"powertrain fit-mount {file} --model {model}", **options)
-    return dataclasses.replace(result, data_name=file)
+    return dataclasses.replace(result, data_name=file, synthetic=data.synthetic)
 
 
 def _starts(starts) -> int:

@@ -113,7 +113,8 @@ def track(raw, *, orders=None, rpm_step=50.0, method="cot", bandwidth=None, chan
     if spectra:
         _ = spectra.quantity                      # mixed quantities: fail before any file
     drawn = _maps(rec, use, pulses_per_rev, rpm_step, _map_channel(rec, map_channel),
-                  float(np.max(tracked.orders))) if maps else None
+                  float(np.max(tracked.orders)),
+                  (float(np.min(tracked.rpm)), float(np.max(tracked.rpm)))) if maps else None
     return replace(tracked, spectra=spectra, maps=drawn)
 
 
@@ -198,17 +199,17 @@ def _map_channel(rec, name):
                      key="--map-channel")
 
 
-def _maps(rec, use, pulses_per_rev, rpm_step, channel, max_order):
+def _maps(rec, use, pulses_per_rev, rpm_step, channel, max_order, tracked_rpm):
     """Campbell and rpm-frequency maps of one channel (arguments of
     :func:`~powertrain.plotting.orders.plot_maps`), both reaching 25 % above the highest
-    tracked order."""
+    tracked order; ``tracked_rpm``: (lowest, highest) speed of the order curves [rpm]."""
 
 
     profile = speed_profile(rec, use=use, pulses_per_rev=pulses_per_rev)
     rpm, fine, rms = order_map(rec, profile, channel, rpm_step=rpm_step,
                                max_order=MAP_MARGIN * max_order)
     fs = rec.sample_rate
-    nper = min(int(2 ** np.ceil(np.log2(max(64, fs / 2.0)))), rec.time.size)   # ~2 Hz
+    nper = min(int(2 ** np.ceil(np.log2(max(64, round(fs / 2.0))))), rec.time.size)  # ~2 Hz
     f, tt, p = spectrogram(rec.channels[channel].values, fs, nperseg=nper,
                            noverlap=nper * 7 // 8)
     rpm_t = np.interp(tt + rec.time[0], rec.time, profile.rpm)
@@ -216,7 +217,8 @@ def _maps(rec, use, pulses_per_rev, rpm_step, channel, max_order):
     return dict(rpm=rpm, orders=fine, order_rms=rms, times=tt, freqs=f, rpm_t=rpm_t, psd=p.T,
                 title=f"{ch.label} ({ch.quantity}) of {Path(str(rec.source)).name}",
                 unit=DISPLAY[ch.quantity][0], factor=DISPLAY[ch.quantity][1],
-                max_order=max_order)
+                max_order=max_order, tracked_rpm=tracked_rpm,
+                block_revs=cot.MIN_BLOCK_REVS * 2, window_s=nper / fs)
 
 
 def track_recording(rec, orders=None, *, rpm_step=50.0, method="cot", use="auto",
