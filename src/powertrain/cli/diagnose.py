@@ -11,6 +11,7 @@ from powertrain.analysis.noise_floor import NOISE_FLOOR_MARGIN
 from powertrain.cli.common import check_outputs, cli_provenance, engine_description, use_agg, write_json
 from powertrain.cli.group import main
 from powertrain.diagnosis import diagnose as run_diagnosis
+from powertrain.diagnosis.report import REPORT_FILES
 from powertrain.effects import EFFECTS
 from powertrain.errors import InputError
 from powertrain.iotools.engine_file import DEFAULT_ENGINE_PATH
@@ -135,9 +136,10 @@ def _noise_floor(value: float) -> float:
 
 
 def _check_report(report_dir) -> None:
+    """Every file of the report folder can be written (checked before any work)."""
     if report_dir:
-
-        check_writable(Path(report_dir) / "summary.txt", key="--report")
+        for name in REPORT_FILES:
+            check_writable(Path(report_dir) / name, key="--report")
 
 
 def _write_json(res, json_file, engine_file) -> None:
