@@ -300,11 +300,43 @@ def atomic_write(target, mode="w", **kwargs):
             yield fh
 
 
+_NONFINITE_CELL = re.compile(r"^(?!#)(?:[^\n]*,)?[ \t]*[-+]?(?:nan|inf|infinity)[ \t]*(?:,|$)",
+                             re.IGNORECASE | re.MULTILINE)
+
+
 def json_text(data, path=None, indent=1) -> str:
     """``data`` as the indented JSON text of the result files; written atomically to ``path``
-    when given."""
-    text = json.dumps(data, indent=indent) + "\n"
+    when given.
+
+    Raises
+    ------
+    InputError
+        ``data`` holds NaN or inf (JSON has no such numbers; nothing is written).
+    """
+    try:
+        text = json.dumps(data, indent=indent, allow_nan=False) + "\n"
+    except ValueError:
+        raise InputError("the result holds a non-finite number (NaN or inf); not written",
+                         file=path) from None
     if path is not None:
         with atomic_write(path) as fh:
             fh.write(text)
     return text
+
+
+def write_csv(path, text: str) -> None:
+    """Write the CSV ``text`` atomically to ``path``; an empty cell stands for a missing
+    value, and ``#`` lines are comments.
+
+    Raises
+    ------
+    InputError
+        A cell holds NaN or inf (line given; nothing is written).
+    """
+    bad = _NONFINITE_CELL.search(text)
+    if bad is not None:
+        line = text.count("\n", 0, bad.start()) + 1
+        raise InputError("the result holds a non-finite number (NaN or inf); not written",
+                         file=path, line=line)
+    with atomic_write(path) as fh:
+        fh.write(text)
