@@ -32,7 +32,8 @@ def speed_options(func):
 
 
 #: What ``--quiet`` means on every command.
-QUIET_HELP = "Print nothing but errors: no progress, no table, no list of files written."
+QUIET_HELP = ("Print nothing but errors and warnings (on stderr): no progress, no table, no "
+              "list of files written.")
 
 
 def quiet_option(func):
