@@ -1,7 +1,7 @@
-"""Long malformed-input campaign (issues 10 and 18): every input kind, many examples.
+"""Long malformed-input campaign (issues 10, 18 and 39): every input kind, many examples.
 
 Runs the hypothesis strategies of ``tests/fuzz_harness.py`` (the same as the CI suite
-``tests/test_fuzz_inputs.py``, more examples), the failures issues 10 and 18 listed, and the
+``tests/test_fuzz_inputs.py``, more examples), the failures issues 10, 18 and 39 listed, and the
 data-safety trials (concurrent runs to one path, SIGKILL mid-write at random moments);
 classifies every run and prints the counts, last line::
 
@@ -71,12 +71,15 @@ def main() -> int:
             case.description = name
             outcome, detail = fh.run_case(worker, case, tmp / "case")
             record("issue-10", case, outcome, detail)
-        for name, (case, expected) in fh.issue_18_cases().items():
-            case.description = name
-            outcome, detail = fh.run_case(worker, case, tmp / "case")
-            if outcome != expected and outcome not in fh.FAILURES:
-                outcome, detail = "unclear_error", f"expected {expected}: {detail}"
-            record("issue-18", case, outcome, detail)
+        cases_39, slow_39 = fh.issue_39_cases()
+        for issue, named in (("issue-18", fh.issue_18_cases()),
+                             ("issue-39", {**cases_39, **slow_39})):
+            for name, (case, expected) in named.items():
+                case.description = name
+                outcome, detail = fh.run_case(worker, case, tmp / "case")
+                if outcome != expected and outcome not in fh.FAILURES:
+                    outcome, detail = "unclear_error", f"expected {expected}: {detail}"
+                record(issue, case, outcome, detail)
         _safety(args, tmp, counts, per_kind, failures)
         for kind in kinds:
             run = _campaign(kind, args, worker, tmp, record)
@@ -87,6 +90,7 @@ def main() -> int:
         shutil.rmtree(tmp, ignore_errors=True)
     print(f"issue-10 named cases: {dict(per_kind['issue-10'])}")
     print(f"issue-18 named cases: {dict(per_kind['issue-18'])}")
+    print(f"issue-39 named cases: {dict(per_kind['issue-39'])}")
     print(f"data safety (concurrent runs, SIGKILL): {dict(per_kind['safety'])}; "
           f"{sum(n > 0 for n in fh.KILL_TEMPS)} of {len(fh.KILL_TEMPS)} kills left "
           f"{sum(fh.KILL_TEMPS)} temporary files, all swept by the next run unless counted "

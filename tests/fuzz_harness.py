@@ -871,7 +871,8 @@ def frf_uff(records) -> bytes:
 
 RAW_H5_MUTATIONS = ["comments_text", "comments_ints", "dangling_time", "dangling_channel",
                     "channels_dataset", "huge_time", "huge_channel", "delete", "string_time",
-                    "two_d", "nan_value", "time_backwards", "unit", "format", "flip"]
+                    "two_d", "nan_value", "time_backwards", "unit", "format", "flip",
+                    "empty_time", "synthetic_array"]
 
 
 def mutate_raw_hdf5(draw, data: bytes) -> tuple[bytes, str]:
@@ -927,6 +928,8 @@ _RAW_H5_EDITS = {
     "unit": lambda h5, c, d: h5[d(st.sampled_from(["time", "rpm", c]))].attrs.__setitem__(
         "unit", d(st.sampled_from(["furlong", "", "m/s^2", "1e300"]))),
     "format": lambda h5, c, d: h5.attrs.__setitem__("format", "other"),
+    "empty_time": lambda h5, c, d: _replace(h5, "time", np.zeros(0)),
+    "synthetic_array": lambda h5, c, d: h5.attrs.__setitem__("synthetic", np.array([1, 0])),
 }
 
 
@@ -1190,9 +1193,12 @@ def _modal_engine_sub(pattern: str, repl: str, count: int = 0) -> bytes:
     return text.encode()
 
 
-def _measured_with_level(value: str) -> bytes:
+def _measured_with_level(value: str, row: str = "") -> bytes:
+    """The seed measurement with the level of its first data row starting with ``row``
+    replaced by ``value``."""
     lines = _SEEDS["measured.csv"].decode().splitlines()
-    i = next(i for i, ln in enumerate(lines) if ln and ln[0] not in "#m")
+    i = next(i for i, ln in enumerate(lines) if ln and ln[0] not in "#m"
+             and ln.startswith(row))
     cells = lines[i].split(",")
     cells[-1] = value
     lines[i] = ",".join(cells)
@@ -1401,3 +1407,65 @@ def killed_run(folder: Path, delay: float) -> tuple[str, str]:
         return "ok", ""
     finally:
         shutil.rmtree(folder, ignore_errors=True)
+
+
+# --------------------------------------------------------------------------- issue 39
+def _one_zero_mount_file(name: str = "mounts/hydraulic-engine-mount-z.toml") -> bytes:
+    """A shipped mount file with every spring and damper 0 (masses kept): singular at 0 Hz."""
+    head, sep, params = _SEEDS[name].decode().partition("[parameters]")
+    return (head + sep + re.sub(r"^([cd]\d+) = .*$", r"\1 = 0", params, flags=re.M)).encode()
+
+
+def _frf_uff_with(record: int, index: int, value) -> bytes:
+    """The seed receptance UFF with one value of one record replaced (found by the long
+    campaign: left.z/left.z at the 4th frequency, inf, which pyuff writes as 1.8e308)."""
+    records = copy.deepcopy(_SEEDS["frf_records"])
+    data = np.array(records[record]["data"], complex)
+    data[index] = value
+    records[record]["data"] = data
+    return frf_uff(records)
+
+
+def _report_folder_in_the_way(folder: Path) -> None:
+    (folder / "rep" / "gap_map.png").mkdir(parents=True)
+
+
+def issue_39_cases() -> dict:
+    """The last bad inputs issue 39 lists (and what they led to), as named cases: name ->
+    (case, expected outcome). ``slow``: those that run a diagnosis (seconds each)."""
+    name_z = "mounts/hydraulic-engine-mount-z.toml"
+    zero = {**mount_files(), name_z: _one_zero_mount_file()}
+    cases = {
+        "runup: a mount file with every spring and damper 0": (Case(
+            {**zero, "engines/e.toml": _SEEDS["engine"]},
+            ["runup", "--engine", "engines/e.toml", *QUICK_RUNUP, "--csv", "o.csv"], ["o.csv"],
+            "hydraulic-engine-mount-z.toml", ""), "clean_error"),
+        "stiffness: a mount file with every spring and damper 0": (Case(
+            zero, ["stiffness", name_z, "--format", "csv"], [], "hydraulic-engine-mount-z.toml",
+            ""), "clean_error"),
+        "whatif --set leaving an internal mass on no spring": (Case(
+            {**mount_files()}, ["whatif", "--from", "1000", "--to", "2000", "--step", "1000",
+                                "--workers", "1", "--quiet", "--json", "w.json", "--set",
+                                "left.z.c3=0"], ["w.json"], "--set", ""), "clean_error"),
+        "raw HDF5: empty /time": (Case({"raw.h5": _raw_h5_with("empty_time")},
+                                       _track("raw.h5"), ["t.csv"], "raw.h5", ""),
+                                  "clean_error"),
+        "raw HDF5: synthetic attribute an array": (Case(
+            {"raw.h5": _raw_h5_with("synthetic_array")}, _track("raw.h5"), ["t.csv"],
+            "raw.h5", ""), "clean_error"),
+        "FRF chassis: a receptance of 1.8e308 m/N (pyuff's inf)": (Case(
+            {**mount_files(), "engines/e.toml": _SEEDS["frf-uff.toml"],
+             "body.uff": _frf_uff_with(8, 8, np.inf)}, FRF_RUNUP, ["o.csv"], "body.uff", ""),
+            "clean_error"),
+        "diagnose --report onto a folder named gap_map.png: d.json stays": (Case(
+            {"m.csv": _SEEDS["measured.csv"], "d.json": b"old\n"},
+            ["diagnose", "m.csv", *DIAGNOSE, "--report", "rep"], ["d.json"], "gap_map.png", "",
+            [_report_folder_in_the_way]), "clean_error"),
+    }
+    slow = {
+        "diagnose on a 1e-300 level --json --report": (Case(
+            {"m.csv": _measured_with_level("1e-300", "left,z,order_2,2000,")},
+            ["diagnose", "m.csv", *DIAGNOSE, "--report", "rep"],
+            ["d.json", "rep/diagnosis.json", "rep/summary.txt"], "m.csv", ""), "ok"),
+    }
+    return cases, slow

@@ -104,8 +104,8 @@ def test_synth_case_is_the_command(tmp_path):
     assert isinstance(case, SynthCase)
     out = tmp_path / "m.csv"
     text = _cli("synth", "--effect", "balancer_error", "--seed", "3", "--out", out,
-                "--truth", tmp_path / "t.json", "--quiet")
-    assert text == f"wrote {out}: {case.to_text()}\n"
+                "--truth", tmp_path / "t.json")
+    assert text == f"wrote {out}, {tmp_path / 't.json'}: {case.to_text()}\n"
     assert out.read_text() == case.to_csv()
     assert (tmp_path / "t.json").read_text() == case.to_truth_json()
     fig, ax = _axes()
@@ -122,7 +122,7 @@ def test_diagnose_text_is_the_command_output(tmp_path):
     res = diagnose(csv, None, progress=False, **kw)          # a path and the default engine
     assert isinstance(res, DiagnosisResult)
     assert res.chosen is not None and res.chosen.label == "balancer_error"
-    out = _cli("diagnose", csv, "--effects", "balancer_error", "--no-pairs", "--quiet")
+    out = _cli("diagnose", csv, "--effects", "balancer_error", "--no-pairs")
     assert TIMING.sub("", out) == TIMING.sub("", res.to_text() + "\n")
     fig, ax = _axes()
     with pytest.raises(InputError, match="pass a Figure"):     # the gap map has 4 panels

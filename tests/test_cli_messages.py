@@ -84,7 +84,7 @@ def test_fit_mount_names_the_plot_it_wrote(tmp_path):
     k.write_text(res.output)
     out, png = tmp_path / "fit.toml", tmp_path / "fit.png"
     res, _ = invoke("fit-mount", k, "--model", "kelvin-voigt", "--starts", "2", "--out", out,
-                    "--plot", png, "--quiet")
+                    "--plot", png)
     assert res.exit_code == 0, res.output
     assert f"wrote {out}, {png}" in res.output and png.stat().st_size > 0
 
@@ -107,3 +107,34 @@ def test_runup_csv_with_effects_is_labelled_synthetic_with_provenance(tmp_path, 
                               "amplitude_stiffness(exponent=0.2, damping_exponent=1)")
     assert head[1].startswith("# provenance: powertrain ") and "$ powertrain runup" in head[1]
     assert "--effect amplitude_stiffness:exponent=0.2" in head[1]
+
+
+def test_quiet_means_the_same_on_every_command():
+    """Every command has --quiet, with one help text: only errors are printed."""
+    from powertrain.cli.common import QUIET_HELP
+    from powertrain.cli.group import COMMANDS
+
+    ctx = main.make_context("powertrain", ["--help"], resilient_parsing=True)
+    for name in sorted(COMMANDS):
+        cmd = main.get_command(ctx, name)
+        quiet = [p for p in cmd.params if p.name == "quiet"]
+        assert quiet and quiet[0].help == QUIET_HELP, name
+
+
+def test_static_excitation_and_modes_name_the_files_they_wrote(tmp_path):
+    """The commands that did not say what they wrote (issue 39) end with ``wrote ...``;
+    with --quiet they print nothing and still write."""
+    runs = {("static", "--rpm", "1000", "--json", tmp_path / "s.json"): ["s.json"],
+            ("excitation", "--rpm", "3000", "--step", "4", "--csv", tmp_path / "e.csv"):
+                ["e.csv"],
+            ("modes", "--static", "--json", tmp_path / "m.json", "--plot", tmp_path / "m.png"):
+                ["m.json", "m.png"]}
+    for args, files in runs.items():
+        res, _ = invoke(*args)
+        assert res.exit_code == 0, res.output
+        last = res.output.strip().splitlines()[-1]
+        assert last == "wrote " + ", ".join(str(tmp_path / f) for f in files), last
+    (tmp_path / "s.json").unlink()
+    res, _ = invoke("static", "--rpm", "1000", "--json", tmp_path / "s.json", "--quiet")
+    assert res.exit_code == 0 and res.output == "", res.output
+    assert (tmp_path / "s.json").is_file()

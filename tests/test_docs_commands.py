@@ -8,8 +8,10 @@ The rules a docs author must know are in docs/extending.md, "Writing docs"; in s
   ```python blocks must compile.
 * README.md's commands run in the wheel test (tests/test_package.py: built, installed in a
   fresh venv, every command in an empty folder, the same rules), not here again.
-* Each other doc file runs in its own empty temporary folder in which the repository's
-  ``scripts/`` is reachable by that name (a symbolic link). A page that runs
+* Each other doc file runs in its own empty temporary folder. On the developer pages
+  (``docs/validation*``) the repository's ``scripts/`` is reachable by that name (a symbolic
+  link); the user pages (the guide, the reference) run only what a wheel install and
+  ``powertrain examples`` give, so a script call there fails. A page that runs
   ``powertrain examples DIR`` makes its own copy of the shipped files, as a user after a wheel
   install does; on any other page ``examples/``, ``engines/`` and ``mounts/`` are linked too.
   Its commands run in order, so a later block may read what an earlier one wrote.
@@ -59,8 +61,11 @@ import pytest
 import powertrain
 
 ROOT = Path(__file__).resolve().parents[1]
-#: Folders of the repository reachable by their relative names from every doc command.
+#: Folders of the repository reachable by their relative names from the commands of the
+#: developer pages (:data:`DEVELOPER_PAGES`).
 LINKED = ("scripts",)
+#: Pages for developers (validation figures, printed by scripts of a source checkout).
+DEVELOPER_PAGES = ("docs/validation",)
 #: Linked too, unless the page copies the shipped files itself with ``powertrain examples``.
 SHIPPED = ("examples", "engines", "mounts")
 COPIES_SHIPPED = re.compile(r"(^|&&\s*)powertrain examples\b")
@@ -490,7 +495,8 @@ def run_doc(doc: str, folder: Path, env: dict):
     first failing command, or every shown output that does not match (None if all pass)."""
     commands = ALL_COMMANDS[doc]
     copies = any(COPIES_SHIPPED.search(c.text) for c in commands)
-    for name in LINKED + (() if copies else SHIPPED):
+    linked = LINKED if doc.startswith(DEVELOPER_PAGES) else ()
+    for name in linked + (() if copies else SHIPPED):
         (folder / name).symlink_to(ROOT / name, target_is_directory=True)
     printed = {}
     for cmd in commands:

@@ -66,6 +66,30 @@ def test_sigkill_mid_write_leaves_no_temporary_file_after_the_next_run(worker, t
     assert outcome == "ok", detail
 
 
+def test_issue_39_last_bad_inputs(worker, tmp_path):
+    """Issue 39's last bad inputs: a mount singular at 0 Hz refused at reading (also reached
+    through ``whatif --set``), a raw HDF5 file with an empty /time or an array as its
+    synthetic flag, and a report folder in the way of a figure (the earlier d.json stays):
+    each a clean one-line error, no output, no earlier file lost."""
+    cases, _ = fh.issue_39_cases()
+    wrong = []
+    for name, (case, expected) in cases.items():
+        outcome, detail = fh.run_case(worker, case, tmp_path / "case")
+        if outcome != expected:
+            wrong.append(f"{name}: {outcome} ({detail[:200]})")
+    assert not wrong, "\n".join(wrong)
+
+
+@pytest.mark.slow
+def test_issue_39_tiny_level_report_is_finite(worker, tmp_path):
+    """A measured level of 1e-300 (a censored point) gives a finite diagnosis: JSON, report
+    folder and printout without NaN (its overlay figure once failed on the axis range)."""
+    _, slow = fh.issue_39_cases()
+    for name, (case, expected) in slow.items():
+        outcome, detail = fh.run_case(worker, case, tmp_path / "case")
+        assert outcome == expected, f"{name}: {outcome}: {detail}"
+
+
 @pytest.mark.parametrize("name", sorted(
     ["engine: list where a number belongs", "engine: firing order mixing strings and ints",
      "engine: huge counterweight_fraction", "engine: bore huge", "engine: imep_factors 1e-300",

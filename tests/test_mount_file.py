@@ -290,3 +290,33 @@ def test_power_law_damping_exponent_read_written_and_applied(tmp_path):
                                            'limits = [0.5, 2.0]\ndamping_exponent = "x"'))
     with pytest.raises(InputError, match="damping_exponent"):
         read_mount(p)
+
+
+def test_a_network_singular_at_0_hz_is_refused_at_reading(tmp_path):
+    """Issue 39: a mount file with every spring and damper 0 (masses kept) leaves the
+    internal masses on no spring; refused when read (mount file, engine file and the API),
+    naming the file, the key and the loose masses, not a FloatingPointError in a solver.
+    A damper-only hold is not enough either (no static stiffness)."""
+    import re
+
+    import powertrain as pt
+    text = BASE.read_text()
+    head, sep, params = text.partition("[parameters]")
+    (tmp_path / "mounts").mkdir()
+    zero = tmp_path / "mounts" / BASE.name
+    zero.write_text(head + sep + re.sub(r"^([cd]\d+) = .*$", r"\1 = 0", params, flags=re.M))
+    with pytest.raises(InputError, match=r"hydraulic-engine-mount-x.toml, key 'parameters': "
+                                         r"the mount network is singular at 0 Hz .*m1, m2, m3"):
+        read_mount(zero)
+    springs_only_zero = re.sub(r"^(c\d+) = .*$", r"\1 = 0", params, flags=re.M)
+    zero.write_text(head + sep + springs_only_zero)
+    with pytest.raises(InputError, match="singular at 0 Hz"):
+        read_mount(zero)
+    engines = Path(pt.read_engine().file).parent
+    (tmp_path / "engines").mkdir()
+    (tmp_path / "engines" / "default.toml").write_text((engines / "default.toml").read_text())
+    for p in MOUNTS.glob("*.toml"):
+        if p.name != BASE.name:
+            (tmp_path / "mounts" / p.name).write_text(p.read_text())
+    with pytest.raises(InputError, match="hydraulic-engine-mount-x.toml.*singular at 0 Hz"):
+        pt.read_engine(tmp_path / "engines" / "default.toml")

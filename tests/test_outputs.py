@@ -14,7 +14,14 @@ import pytest
 from click.testing import CliRunner
 
 from powertrain.cli import main
-from powertrain.outputs import OutputTransaction, atomic_write, sweep_stale_temps
+from powertrain.errors import InputError
+from powertrain.outputs import (
+    OutputTransaction,
+    atomic_write,
+    json_text,
+    sweep_stale_temps,
+    write_csv,
+)
 
 QUICK = ["--from", "1000", "--to", "2000", "--step", "500"]
 
@@ -74,6 +81,38 @@ def test_failed_transaction_keeps_earlier_files_and_removes_its_own(tmp_path):
             raise RuntimeError
     assert (tmp_path / "a.txt").read_text() == "old"
     assert [p.name for p in tmp_path.iterdir()] == ["a.txt"]      # no temp, no new folder
+
+
+def test_commit_replaces_all_targets_or_none(tmp_path, monkeypatch):
+    """Issue 39: a target that cannot take its file at the commit (a folder put in its way
+    after the work) fails the commit before any file is replaced; a rename that fails all
+    the same puts back the files replaced before it."""
+    import powertrain.outputs as outputs
+    for check in (True, False):
+        if not check:                                  # the rename itself fails
+            monkeypatch.setattr(outputs, "_check_target", lambda target: None)
+        (tmp_path / "a.txt").write_text("old")
+        with pytest.raises(InputError, match="b.txt"):
+            with OutputTransaction():
+                for name in ("a.txt", "new.txt", "b.txt"):
+                    with atomic_write(tmp_path / name) as fh:
+                        fh.write("new")
+                (tmp_path / "b.txt").mkdir()
+        assert (tmp_path / "a.txt").read_text() == "old"
+        assert sorted(p.name for p in tmp_path.iterdir()) == ["a.txt", "b.txt"]
+        (tmp_path / "b.txt").rmdir()
+
+
+def test_json_and_csv_writers_refuse_nan(tmp_path):
+    """No NaN or inf reaches a JSON or CSV file: refused naming the file (and the CSV line);
+    a comment line may say anything."""
+    with pytest.raises(InputError, match="r.json.*non-finite"):
+        json_text({"a": [1.0, float("nan")]}, tmp_path / "r.json")
+    with pytest.raises(InputError, match="r.csv, line 3.*non-finite"):
+        write_csv(tmp_path / "r.csv", "a,b\n1,2\n3,-inf\n")
+    assert not list(tmp_path.iterdir())
+    write_csv(tmp_path / "r.csv", "# nan and inf in a comment\na,b\n1,\n")
+    assert json.loads(json_text({"a": None}, tmp_path / "r.json")) == {"a": None}
 
 
 def test_stale_temporary_files_of_dead_processes_are_swept(tmp_path):

@@ -158,18 +158,33 @@ class OutputTransaction:
         self.staged[target] = tmp
 
     def commit(self) -> list[Path]:
-        """Rename every staged file onto its target, each target folder locked meanwhile."""
+        """Rename every staged file onto its target, each target folder locked meanwhile:
+        all of them or none. Every target is checked first (a folder in the way fails
+        before any file is replaced); a rename that fails all the same puts back the files
+        replaced before it (kept as hard links until the end)."""
         folders = sorted({str(t.parent.resolve()) for t in self.staged})
         with contextlib.ExitStack() as locks:
             for folder in folders:
                 locks.enter_context(_folder_lock(folder))
+            backups = []        # (target, hard link of its old file or None, it existed)
             try:
+                for target in self.staged:
+                    _check_target(target)
                 for target, tmp in list(self.staged.items()):
+                    backups.append((target, _backup(target), target.exists()))
                     _replace(tmp, target)
                     del self.staged[target]
                     self.committed.append(target)
+            except BaseException:
+                _restore(backups[:len(self.committed)])
+                self.committed.clear()
+                raise
             finally:
                 self.abort()
+                for _, backup, _ in backups:
+                    if backup is not None:
+                        with contextlib.suppress(OSError):
+                            os.unlink(backup)
         return self.committed
 
     def abort(self) -> None:
@@ -182,6 +197,39 @@ class OutputTransaction:
             with contextlib.suppress(OSError):
                 folder.rmdir()
         self.created.clear()
+
+
+def _check_target(target: Path) -> None:
+    """A staged file can replace ``target``: not a folder, its folder a folder."""
+    if target.is_dir():
+        raise InputError("cannot write: is a folder", file=target)
+    if not target.parent.is_dir():
+        raise InputError(f"cannot write: {target.parent} is not a folder", file=target)
+
+
+def _backup(target: Path) -> Path | None:
+    """A hard link to ``target``'s current file under a temporary name (None: no file, or
+    the file system has no hard links)."""
+    if not target.is_file():
+        return None
+    name = f".{target.name}.pt{os.getpid()}-{os.urandom(4).hex()}.tmp"
+    backup = target.parent / name
+    try:
+        os.link(target, backup)
+    except OSError:
+        return None
+    return backup
+
+
+def _restore(backups) -> None:
+    """Put the old files back onto the targets replaced so far; remove those that did not
+    exist before (a file replaced without a hard link stays replaced)."""
+    for target, backup, existed in reversed(backups):
+        with contextlib.suppress(OSError):
+            if backup is not None:
+                os.replace(backup, target)
+            elif not existed:
+                os.unlink(target)
 
 
 def _failed(exc) -> bool:
@@ -252,11 +300,43 @@ def atomic_write(target, mode="w", **kwargs):
             yield fh
 
 
+_NONFINITE_CELL = re.compile(r"^(?!#)(?:[^\n]*,)?[ \t]*[-+]?(?:nan|inf|infinity)[ \t]*(?:,|$)",
+                             re.IGNORECASE | re.MULTILINE)
+
+
 def json_text(data, path=None, indent=1) -> str:
     """``data`` as the indented JSON text of the result files; written atomically to ``path``
-    when given."""
-    text = json.dumps(data, indent=indent) + "\n"
+    when given.
+
+    Raises
+    ------
+    InputError
+        ``data`` holds NaN or inf (JSON has no such numbers; nothing is written).
+    """
+    try:
+        text = json.dumps(data, indent=indent, allow_nan=False) + "\n"
+    except ValueError:
+        raise InputError("the result holds a non-finite number (NaN or inf); not written",
+                         file=path) from None
     if path is not None:
         with atomic_write(path) as fh:
             fh.write(text)
     return text
+
+
+def write_csv(path, text: str) -> None:
+    """Write the CSV ``text`` atomically to ``path``; an empty cell stands for a missing
+    value, and ``#`` lines are comments.
+
+    Raises
+    ------
+    InputError
+        A cell holds NaN or inf (line given; nothing is written).
+    """
+    bad = _NONFINITE_CELL.search(text)
+    if bad is not None:
+        line = text.count("\n", 0, bad.start()) + 1
+        raise InputError("the result holds a non-finite number (NaN or inf); not written",
+                         file=path, line=line)
+    with atomic_write(path) as fh:
+        fh.write(text)

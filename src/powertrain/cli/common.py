@@ -31,6 +31,27 @@ def speed_options(func):
     return func
 
 
+#: What ``--quiet`` means on every command.
+QUIET_HELP = ("Print nothing but errors and warnings (on stderr): no progress, no table, no "
+              "list of files written.")
+
+
+def quiet_option(func):
+    """The ``--quiet`` flag of every command (:data:`QUIET_HELP`)."""
+    return click.option("--quiet", is_flag=True, help=QUIET_HELP)(func)
+
+
+def say(text: str, quiet: bool, **kwargs) -> None:
+    """Print ``text`` (``click.echo``) unless ``quiet``."""
+    if not quiet:
+        click.echo(text, **kwargs)
+
+
+def wrote(*paths) -> str:
+    """``wrote A, B``: the line naming the files a command wrote (empty paths skipped)."""
+    return "wrote " + ", ".join(str(p) for p in paths if p)
+
+
 def check_outputs(**targets) -> None:
     """Refuse, before any work, output paths that cannot be written (``--name=path``)."""
     for name, path in targets.items():

@@ -5,7 +5,15 @@ from __future__ import annotations
 import click
 
 from powertrain.analysis.noise_floor import NOISE_FLOOR_MARGIN, NOISE_FLOOR_MARGIN_DB
-from powertrain.cli.common import check_outputs, cli_provenance, engine_description, write_json, write_plot
+from powertrain.cli.common import (
+    check_outputs,
+    cli_provenance,
+    engine_description,
+    quiet_option,
+    say,
+    write_json,
+    write_plot,
+)
 from powertrain.cli.group import main
 from powertrain.provenance import provenance
 from powertrain.workflows.arguments import nonnegative
@@ -35,7 +43,7 @@ from powertrain.workflows.comparison import compare as run_compare
               help="Simulate on a grid of this speed step [rpm] covering the measured range "
                    "and interpolate it to the measured speeds. Default: simulate at every "
                    "measured speed (within the engine's range), no interpolation.")
-@click.option("--quiet", is_flag=True, help="No progress bar; print only the summary line.")
+@quiet_option
 def compare(measured, sim_file, engine_file, plot, json_file, noise_floor, solver, rpm_step,
             quiet):
     """Compare a simulated run-up with a measured one.
@@ -69,7 +77,7 @@ def compare(measured, sim_file, engine_file, plot, json_file, noise_floor, solve
         write_plot(lambda p: comp.plot(path=p, provenance=figure), plot)
     if json_file:
         write_json(json_file, comp.to_json(), file)
-    click.echo(comp.summary() if quiet else comp.to_text(written=(plot, json_file)))
+    say(comp.to_text(written=(plot, json_file)), quiet)
 
 
 def _provenance(comp, sim_file):

@@ -8,9 +8,19 @@ from pathlib import Path
 import click
 
 from powertrain.analysis.noise_floor import NOISE_FLOOR_MARGIN
-from powertrain.cli.common import check_outputs, cli_provenance, engine_description, use_agg, write_json
+from powertrain.cli.common import (
+    check_outputs,
+    cli_provenance,
+    engine_description,
+    quiet_option,
+    say,
+    use_agg,
+    write_json,
+    wrote,
+)
 from powertrain.cli.group import main
 from powertrain.diagnosis import diagnose as run_diagnosis
+from powertrain.diagnosis.report import REPORT_FILES
 from powertrain.effects import EFFECTS
 from powertrain.errors import InputError
 from powertrain.iotools.engine_file import DEFAULT_ENGINE_PATH
@@ -69,7 +79,7 @@ def _truth_names() -> str:
 @click.option("--effects", "effects", default="", cls=_ListedOption, names=_library_names,
               help="Comma-separated candidates (default: all of the library).")
 @click.option("--no-pairs", is_flag=True, help="Do not try pairs of effects.")
-@click.option("--quiet", is_flag=True, help="No progress indicator on stderr.")
+@quiet_option
 @click.option("--scheduler", default=None, metavar="local|tcp://HOST:PORT",
               help="Run the candidate fits on dask.distributed: 'local' (a LocalCluster on "
                    "this machine's cores) or an existing scheduler's address; also "
@@ -104,18 +114,19 @@ def diagnose(measured, plan_file, engine_file, report_dir, json_file, noise_floo
     with activity("diagnose (fitting the effect library)", enabled=not quiet):
         res = run_diagnosis(measured, engine_file, noise_floor=noise_floor, effects=names,
                   pairs=not no_pairs, scheduler=scheduler, progress=False)
-    click.echo(res.to_text())
+    say(res.to_text(), quiet)
     if json_file:
         _write_json(res, json_file, engine_file)
+        say(wrote(json_file), quiet)
     if report_dir:
-        _write_report(res, report_dir)
+        files = _write_report(res, report_dir)
+        say(f"wrote {len(files)} files to {report_dir}", quiet)
 
 
-def _write_report(res, report_dir) -> None:
+def _write_report(res, report_dir) -> list:
     use_agg()
-    files = res.report(report_dir, provenance=cli_provenance(
+    return res.report(report_dir, provenance=cli_provenance(
         engine_description(res.engine, res.engine.file)))
-    click.echo(f"wrote {len(files)} files to {report_dir}")
 
 
 def _measured_or_plan(measured, plan_file):
@@ -135,15 +146,15 @@ def _noise_floor(value: float) -> float:
 
 
 def _check_report(report_dir) -> None:
+    """Every file of the report folder can be written (checked before any work)."""
     if report_dir:
-
-        check_writable(Path(report_dir) / "summary.txt", key="--report")
+        for name in REPORT_FILES:
+            check_writable(Path(report_dir) / name, key="--report")
 
 
 def _write_json(res, json_file, engine_file) -> None:
     write_json(json_file, res.to_json(),
                provenance(res.engine, engine_file=engine_file or DEFAULT_ENGINE_PATH))
-    click.echo(f"wrote {json_file}")
 
 
 @main.command()
@@ -158,7 +169,7 @@ def _write_json(res, json_file, engine_file) -> None:
                    "diagnosis).")
 @click.option("--engine", "engine_file", type=click.Path(dir_okay=False),
               help="Baseline engine file (default: engines/default.toml).")
-@click.option("--quiet", is_flag=True, help="No progress indicator on stderr.")
+@quiet_option
 def synth(effect_names, seed, out, truth_file, engine_file, quiet):
     """Make a SYNTHETIC measured run-up with hidden effects and noise (truth generator).
 
@@ -176,4 +187,4 @@ def synth(effect_names, seed, out, truth_file, engine_file, quiet):
     case.to_csv(out)
     if truth_file:
         case.to_truth_json(truth_file)
-    click.echo(f"wrote {out}: {case.to_text()}")
+    say(f"{wrote(out, truth_file)}: {case.to_text()}", quiet)

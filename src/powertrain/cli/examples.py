@@ -8,6 +8,7 @@ from pathlib import Path
 
 import click
 
+from powertrain.cli.common import quiet_option, say
 from powertrain.cli.group import main
 from powertrain.data import FOLDERS, shipped_files
 from powertrain.errors import InputError
@@ -16,7 +17,8 @@ from powertrain.outputs import atomic_path
 
 @main.command()
 @click.argument("folder", type=click.Path(file_okay=True, dir_okay=True))
-def examples(folder):
+@quiet_option
+def examples(folder, quiet):
     """Copy the shipped files into FOLDER/engines, FOLDER/mounts and FOLDER/examples.
 
     \b
@@ -47,8 +49,8 @@ def examples(folder):
             with atomic_path(dest) as tmp:
                 shutil.copyfile(src, tmp)
     kept = len(pairs) - len(copied)
-    click.echo(f"copied {len(copied)} files into {root}/{{{','.join(FOLDERS)}}}"
-               + (f"; {kept} identical files were there already" if kept else ""))
+    say(f"copied {len(copied)} files into {root}/{{{','.join(FOLDERS)}}}"
+        + (f"; {kept} identical files were there already" if kept else ""), quiet)
 
 
 def _check_free(src: Path, dest: Path, error) -> None:

@@ -4,7 +4,15 @@ from __future__ import annotations
 
 import click
 
-from powertrain.cli.common import cli_provenance, engine_description, write_plot
+from powertrain.cli.common import (
+    check_outputs,
+    cli_provenance,
+    engine_description,
+    quiet_option,
+    say,
+    write_plot,
+    wrote,
+)
 from powertrain.cli.group import main
 from powertrain.workflows.excitation import excitation as run
 
@@ -21,7 +29,8 @@ from powertrain.workflows.excitation import excitation as run
 @click.option("--csv", "csv_path", default=None,
               help="Write one row per crank angle: total load, then per-cylinder columns.")
 @click.option("--plot", default=None, help="Write a summary figure (PNG).")
-def excitation(rpm, engine_file, load, no_balancers, step, csv_path, plot):
+@quiet_option
+def excitation(rpm, engine_file, load, no_balancers, step, csv_path, plot, quiet):
     """Cylinder pressures, gas and inertia forces, crank torque and the total load on the
     powertrain over one engine cycle at --rpm, with the load's order spectrum (0.5..8).
 
@@ -43,6 +52,7 @@ def excitation(rpm, engine_file, load, no_balancers, step, csv_path, plot):
       powertrain excitation --rpm 2000 --engine engines/default.toml --no-balancers
     """
 
+    check_outputs(csv=csv_path, plot=plot)
     result = run(engine_file, rpm, load=load, balancers=not no_balancers, angle_step_deg=step)
     if csv_path:
         result.to_csv(csv_path)
@@ -50,4 +60,6 @@ def excitation(rpm, engine_file, load, no_balancers, step, csv_path, plot):
         prov = cli_provenance(engine_description(result.engine, result.engine.file,
                                                  no_balancers=no_balancers))
         write_plot(lambda p: result.plot(path=p, provenance=prov), plot)
-    click.echo(result.to_text())
+    say(result.to_text(), quiet)
+    if csv_path or plot:
+        say(wrote(csv_path, plot), quiet)

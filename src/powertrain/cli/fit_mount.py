@@ -4,7 +4,15 @@ from __future__ import annotations
 
 import click
 
-from powertrain.cli.common import check_outputs, cli_provenance, plot_form_options, write_plot
+from powertrain.cli.common import (
+    check_outputs,
+    cli_provenance,
+    plot_form_options,
+    quiet_option,
+    say,
+    write_plot,
+    wrote,
+)
 from powertrain.cli.group import main
 from powertrain.iotools.mount_file import write_mount
 from powertrain.models.mount import TOPOLOGIES
@@ -40,7 +48,7 @@ _MODELS = tuple(TOPOLOGIES)
 @click.option("--reference", type=float,
               help="With data at several amplitudes: the reference amplitude of the network "
                    "and the amplitude law [mm], one of the data's (default the smallest).")
-@click.option("--quiet", is_flag=True, help="No progress indicator on stderr.")
+@quiet_option
 def fit_mount(measured, model, out, plot, form, freq_axis, starts, seed, fmin, fmax, max_mass,
               friction, reference, quiet):
     """Fit a lumped mount model to the measured dynamic stiffness in MEASURED (CSV).
@@ -73,10 +81,10 @@ def fit_mount(measured, model, out, plot, form, freq_axis, starts, seed, fmin, f
                                fmax=fmax)
     write_mount(result.model, out, comment=result.file_comment())
     _plot(result, plot, form, freq_axis)
-    click.echo(result.to_text())
+    say(result.to_text(), quiet)
     if not result.success:
         click.echo("warning: the best local solve stopped at its evaluation limit", err=True)
-    click.echo("wrote " + ", ".join(p for p in (out, plot) if p))
+    say(wrote(out, plot), quiet)
 
 
 def _plot(result, plot, form, freq_axis) -> None:

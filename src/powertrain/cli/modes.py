@@ -4,7 +4,15 @@ from __future__ import annotations
 
 import click
 
-from powertrain.cli.common import cli_provenance, engine_description, write_plot
+from powertrain.cli.common import (
+    check_outputs,
+    cli_provenance,
+    engine_description,
+    quiet_option,
+    say,
+    write_plot,
+    wrote,
+)
 from powertrain.cli.group import main
 from powertrain.iotools.engine_file import engine_or_default
 from powertrain.workflows.modes import modes as solve_modes
@@ -21,7 +29,8 @@ from powertrain.workflows.modes import modes as solve_modes
               help="Write the modes as JSON.")
 @click.option("--plot", type=click.Path(dir_okay=False),
               help="Write the kinetic-energy distribution per mode (PNG).")
-def modes(engine_file, static, json_file, plot):
+@quiet_option
+def modes(engine_file, static, json_file, plot, quiet):
     """Six rigid-body modes: frequency, damping ratio, dominant coordinate, kinetic-energy
     distribution [%] over x, y, z, rx, ry, rz about the CG in engine axes, and the angle of
     each mode's rotation axis to the torque-roll axis.
@@ -33,6 +42,7 @@ def modes(engine_file, static, json_file, plot):
       powertrain modes --static --plot modes.png
     """
 
+    check_outputs(json=json_file, plot=plot)
     engine = engine_or_default(engine_file)
     result = solve_modes(engine, static=static)
     if json_file:
@@ -40,4 +50,6 @@ def modes(engine_file, static, json_file, plot):
     if plot:
         prov = cli_provenance(engine_description(engine, engine.file))
         write_plot(lambda p: result.plot(path=p, provenance=prov), plot)
-    click.echo(result.to_text())
+    say(result.to_text(), quiet)
+    if json_file or plot:
+        say(wrote(json_file, plot), quiet)

@@ -8,6 +8,7 @@ from powertrain.cli.common import (
     check_outputs,
     cli_provenance,
     engine_description,
+    quiet_option,
     speed_options,
     write_plot,
 )
@@ -58,7 +59,7 @@ from powertrain.workflows.runup import check_path_plot
               help="With --sweep: write the raw mount-point accelerations (raw HDF5 layout).")
 @click.option("--sample-rate", type=float, default=8192.0, show_default=True,
               help="With --sweep: sampling rate of the raw data [Hz].")
-@click.option("--quiet", is_flag=True, help="No progress bar and no table.")
+@quiet_option
 def runup(rpm_from, rpm_to, rpm_step, engine_file, solver, stepper, angle_step, out, csv_file,
           plot, path_plot, path_order, no_balancers, effect, sweep, raw_file, sample_rate, quiet):
     """Run-up: steady-state mount-point velocities at each speed, order analysed.

@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import click
 
-from powertrain.cli.common import check_outputs, write_json
+from powertrain.cli.common import check_outputs, quiet_option, say, write_json, wrote
 from powertrain.cli.group import main
 from powertrain.iotools.engine_file import engine_or_default
 from powertrain.provenance import provenance
@@ -21,7 +21,8 @@ from powertrain.workflows.static import static as solve
                    "(default: the run-up's, 1000 to 6000 step 500).")
 @click.option("--json", "json_file", type=click.Path(dir_okay=False),
               help="Write the operating points as JSON.")
-def static(engine_file, rpm_list, json_file):
+@quiet_option
+def static(engine_file, rpm_list, json_file, quiet):
     """Static operating point per speed: the body under its weight and the mean
     drive-torque reaction (gear ratio of [drive] times the mean brake torque) on the
     mounts' static curves (a direction without [static] acts with its network's static
@@ -41,4 +42,6 @@ def static(engine_file, rpm_list, json_file):
     result = solve(engine, rpm)
     if json_file:
         write_json(json_file, result.to_json(), provenance(engine))
-    click.echo(result.to_text())
+    say(result.to_text(), quiet)
+    if json_file:
+        say(wrote(json_file), quiet)

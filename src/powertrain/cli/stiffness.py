@@ -4,7 +4,15 @@ from __future__ import annotations
 
 import click
 
-from powertrain.cli.common import cli_provenance, plot_form_options, write_plot
+from powertrain.cli.common import (
+    check_outputs,
+    cli_provenance,
+    plot_form_options,
+    quiet_option,
+    say,
+    write_plot,
+    wrote,
+)
 from powertrain.cli.group import main
 from powertrain.errors import InputError
 from powertrain.workflows.stiffness import stiffness as run
@@ -36,8 +44,9 @@ from powertrain.workflows.stiffness import stiffness as run
                    "friction; the CSV gains a first column amplitude_mm.")
 @click.option("--engine-mass", type=float, help="Engine mass on the mount [kg] (verification set-up).")
 @click.option("--force", type=float, help="Harmonic force amplitude on the engine mass [N].")
+@quiet_option
 def stiffness(mount_file, engine_file, mount_dir, freq, method, fmt, plot, form, freq_axis,
-              amplitude, engine_mass, force):
+              amplitude, engine_mass, force, quiet):
     """Cross-point dynamic stiffness K*(f) of MOUNT_FILE: real, imaginary, magnitude, loss angle.
 
     With --engine-mass and --force it reproduces the thesis's verification set-up (a harmonic
@@ -57,25 +66,27 @@ def stiffness(mount_file, engine_file, mount_dir, freq, method, fmt, plot, form,
           --method time --freq 1:100:1 --plot k.png
     """
 
+    check_outputs(plot=plot)
     mount = _mount(mount_file, engine_file, mount_dir)
     result = run(mount, engine=engine_file, freq=freq, method=method,
                  engine_mass=engine_mass, force=force, amplitude=amplitude)
-    _report(result, fmt, plot, form, freq_axis)
+    _report(result, fmt, plot, form, freq_axis, quiet)
 
 
-def _report(result, fmt, plot, form, freq_axis):
-    """Write the plot (when asked) and print the table, the CSV or the plot's summary."""
+def _report(result, fmt, plot, form, freq_axis, quiet):
+    """Write the plot (when asked) and print the table, the CSV or the plot's summary
+    (nothing with ``--quiet``)."""
     if plot:
         prov = cli_provenance()
         write_plot(lambda p: result.plot(path=p, form=form, freq_axis=freq_axis,
                                          provenance=prov), plot)
     explicit = click.get_current_context().get_parameter_source("fmt").name != "DEFAULT"
     if plot and not explicit:
-        click.echo(result.summary())
+        say(result.summary(), quiet)
     else:
-        click.echo(result.to_csv() if fmt == "csv" else result.to_text(), nl=False)
+        say(result.to_csv() if fmt == "csv" else result.to_text(), quiet, nl=False)
     if plot:   # on stderr when stdout carries CSV (often redirected to a file)
-        click.echo(f"wrote {plot}", err=explicit and fmt == "csv")
+        say(wrote(plot), quiet, err=explicit and fmt == "csv")
 
 
 def _mount(mount_file, engine_file, mount_dir):

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import click
 
-from powertrain.cli.common import check_outputs, cli_provenance, write_plot
+from powertrain.cli.common import check_outputs, cli_provenance, quiet_option, write_plot
 from powertrain.cli.group import main
 from powertrain.errors import InputError
 from powertrain.workflows.tracking import track as run_track
@@ -63,7 +63,7 @@ from powertrain.workflows.tracking import track as run_track
               help="Once-per-cycle pulse channel (cam or injection): fixes the 720° cycle, "
                    "so half orders get a phase too; the offset then counts from the first "
                    "tacho reference pulse after its edge.")
-@click.option("--quiet", is_flag=True, help="No progress bar and no table.")
+@quiet_option
 def track(raw, map_file, rpm_column, tacho_column, pulses_per_rev, orders_spec, rpm_step,
           method, bandwidth, quantity, as_quantity, csv_file, out, plot, map_png, map_channel,
           overall, overall_band, spectrum_at, spectrum_out, tdc_offset, cycle_reference, quiet):

@@ -8,6 +8,7 @@ from powertrain.cli.common import (
     check_outputs,
     cli_provenance,
     engine_description,
+    quiet_option,
     speed_options,
     write_json,
     write_plot,
@@ -80,7 +81,7 @@ from powertrain.workflows.whatif import whatif as run_whatif
               help="Run the variants on dask.distributed: 'local' (a LocalCluster on this "
                    "machine's cores) or an existing scheduler's address; also 'processes' "
                    "or 'serial'. Default: a local process pool (--workers). Same results.")
-@click.option("--quiet", is_flag=True, help="No progress bar and no table.")
+@quiet_option
 def whatif(engine_file, rpm_from, rpm_to, rpm_step, solver, scale, set_, swap, move, rotate,
            effect, variants_file, target, target_out, target_plot, measured_file, plot, json_file,
            delta_plot, signal, objective, workers, scheduler, quiet):

@@ -129,17 +129,22 @@ def summary(r) -> str:
     return "\n".join(lines)
 
 
+#: The files of a report folder (:func:`write_report`), in the order written.
+REPORT_FILES = ("summary.txt", "diagnosis.json", "gap_map.png", "gap_vs_frequency.png",
+                "overlay.png")
+
+
 def write_report(r, directory, provenance=None) -> list:
-    """Write ``summary.txt``, ``diagnosis.json`` and the figures into ``directory``."""
+    """Write ``summary.txt``, ``diagnosis.json`` and the figures (:data:`REPORT_FILES`) into
+    ``directory`` (created with its missing parents)."""
 
     out = Path(directory)
-    out.mkdir(parents=True, exist_ok=True)
     with atomic_write(out / "summary.txt") as fh:
         fh.write(r.to_text() + "\n")
     r.to_json(out / "diagnosis.json")
     files = [out / "summary.txt", out / "diagnosis.json"]
-    for name, fn in (("gap_map.png", plot_gap_map), ("gap_vs_frequency.png", plot_gap_frequency),
-                     ("overlay.png", plot_diagnosis_overlay)):
+    for name, fn in zip(REPORT_FILES[2:], (plot_gap_map, plot_gap_frequency,
+                                           plot_diagnosis_overlay)):
         close_figure(fn(r, out / name, provenance=provenance))
         files.append(out / name)
     return files

@@ -102,9 +102,52 @@ def read_mount(path) -> MountModel:
                              file=path, key=f"parameters.{p}")
     laws = {field: reader(get(doc, section, path, types=dict), _Units(units, path))
             for section, (field, reader) in _SECTIONS.items() if section in doc}
-    return MountModel(topo, params, name=str(mount.get("name", Path(path).stem)),
-                      source=str(mount.get("source", "")), notes=str(mount.get("notes", "")),
-                      **laws)
+    model = MountModel(topo, params, name=str(mount.get("name", Path(path).stem)),
+                       source=str(mount.get("source", "")), notes=str(mount.get("notes", "")),
+                       **laws)
+    check_network(model, path)
+    return model
+
+
+def check_network(model: MountModel, path) -> None:
+    """Refuse a network that is singular at 0 Hz: an internal node held by no spring to
+    the engine side or the ground (e.g. every spring and damper 0), so that its static
+    deflection is undetermined. Every solver condenses the network at 0 Hz (static
+    stiffness, rigid-body modes), where it would fail.
+
+    Raises
+    ------
+    InputError
+        Naming ``path``, key ``parameters``, and the loose internal masses.
+    """
+    try:
+        with np.errstate(all="ignore"):
+            model.static_stiffness()
+    except FloatingPointError:
+        loose = _loose_nodes(model)
+        held = (f"internal node{'s' if len(loose) > 1 else ''} {', '.join(loose)} "
+                "held by no spring to the engine side or the ground") if loose else \
+            "an internal node's springs are below 1e-13 of the stiffest"
+        raise InputError(f"the mount network is singular at 0 Hz ({held}; every spring and "
+                         "damper 0?): no static stiffness can be computed", file=path,
+                         key="parameters") from None
+
+
+def _loose_nodes(model: MountModel) -> list:
+    """Labels of the internal nodes (their mass parameter, or ``node k``) joined to
+    neither the engine side nor the ground by a chain of nonzero springs."""
+    topo = model.topology
+    held = {"E", "G"}
+    springs = [(a, b) for a, b, c, _ in topo.elements if c and model.params[c] > 0]
+    grown = True
+    while grown:
+        grown = False
+        for a, b in springs:
+            if (a in held) != (b in held):
+                held |= {a, b}
+                grown = True
+    return [topo.masses[k - 1] or f"node {k}" for k in range(1, topo.n_internal + 1)
+            if f"n{k}" not in held]
 
 
 class _Units:

@@ -127,7 +127,8 @@ def _pick_speed(found: FileSignals, cmap, rpm, tacho, cycle_reference=None):
 
 
 def _same_time(a, b) -> bool:
-    return a.shape == b.shape and np.allclose(a, b, rtol=0, atol=1e-9 * max(abs(b[-1]), 1.0))
+    return a.shape == b.shape and (b.size == 0 or np.allclose(
+        a, b, rtol=0, atol=1e-9 * max(abs(b[-1]), 1.0)))
 
 
 def _vibration_time(found: FileSignals, signals):

@@ -115,9 +115,30 @@ def _comments(h5, path):
     return comments
 
 
+def _flag_attr(h5, name, path) -> bool:
+    """A yes/no attribute: a boolean or the integer 0 or 1 (absent: no)."""
+    value = h5.attrs.get(name, False)
+    if isinstance(value, np.ndarray) and value.shape == ():
+        value = value[()]
+    if isinstance(value, (bool, np.bool_)) or (isinstance(value, (int, np.integer))
+                                               and value in (0, 1)):
+        return bool(value)
+    raise InputError("expected a boolean attribute (true or false)", file=path,
+                     key=f"/@{name}")
+
+
+def _time(h5, name, path, budget):
+    """The sample times of the vibration channels: at least two values."""
+    time = _dataset(h5, name, path, budget)
+    if time.size < 2:
+        raise InputError(f"has {time.size} sample time{'s' if time.size != 1 else ''}; "
+                         "at least 2 needed", file=path, key=name)
+    return time
+
+
 def _read_own(h5, path):
     budget = _Budget()
-    time = _dataset(h5, "time", path, budget)
+    time = _time(h5, "time", path, budget)
     unit = _unit(h5["time"]) or "s"
     time = to_si(time, unit, "time", file=path, key="time")
     signals, times = [], {}
@@ -132,7 +153,8 @@ def _read_own(h5, path):
         key = f"channels/{name}"
         signals.append((name, _dataset(h5, key, path, budget), _unit(h5[key])))
     comments = _comments(h5, path)
-    if h5.attrs.get("synthetic", False) and not any("synthetic" in c.lower() for c in comments):
+    if _flag_attr(h5, "synthetic", path) and \
+            not any("synthetic" in c.lower() for c in comments):
         comments.append("SYNTHETIC")
     return FileSignals(time, signals, str(path), "time", comments, times)
 
@@ -150,7 +172,7 @@ def _own_time(h5, name, path, times, budget):
 def _read_mapped(h5, path, cmap):
     budget = _Budget()
     tname = cmap.time or "time"
-    time = _dataset(h5, tname, path, budget)
+    time = _time(h5, tname, path, budget)
     signals, times = [], {}
     for name in [cmap.rpm, cmap.tacho, *cmap.channels]:
         if name:

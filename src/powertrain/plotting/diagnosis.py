@@ -283,7 +283,9 @@ def _overlay_panel(ax, diagnosis, c, k, held, rms):
     ax.plot(d.rpm[held], m[held], "o", mfc="none", mec="0.6", ms=4, label="held-out speeds")
     ax.plot(d.rpm, sim0, "-", color=OKABE_ITO["vermillion"], lw=1,
             label="baseline simulation")
-    values = [m, sim0]
+    # the axis spans the points above the noise floor: a censored point far below (a
+    # level of 1e-300) would stretch it over hundreds of decades
+    values = [np.where(_censored(diagnosis)[0][:, c, k], np.nan, m), sim0]
     if diagnosis.gap_after is not None and diagnosis.chosen is not None:
         after = m * 10 ** (diagnosis.gap_after[:, c, k] / 20)
         ax.plot(d.rpm, after, "-", color=OKABE_ITO["blue"], lw=1,

@@ -9,7 +9,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from powertrain.analysis.text_table import format_table
-from powertrain.outputs import atomic_write
+from powertrain.outputs import write_csv
 from powertrain.plotting import plot_excitation
 from powertrain.plotting.style import target_and_path
 from powertrain.results.base import Result
@@ -79,10 +79,8 @@ class ExcitationResult(Result):
         return "\n".join([",".join(header)] + rows) + "\n"
 
     def to_csv(self, path) -> None:
-        """Write :meth:`csv_text` atomically."""
-        text = self.csv_text()
-        with atomic_write(path) as fh:
-            fh.write(text)
+        """Write :meth:`csv_text` atomically (:func:`powertrain.outputs.write_csv`)."""
+        write_csv(path, self.csv_text())
 
     def writers(self) -> dict:
         """``.csv`` (:meth:`to_csv`), ``.png``."""

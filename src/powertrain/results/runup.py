@@ -59,7 +59,7 @@ from powertrain.analysis.channel import Channel, passive_name, split_side
 from powertrain.analysis.orders import order_label, order_rms, synthesis_rms
 from powertrain.analysis.phase import phase_deg
 from powertrain.analysis.text_table import format_table
-from powertrain.outputs import atomic_path, atomic_write
+from powertrain.outputs import atomic_path, write_csv
 from powertrain.plotting import plot_runup
 from powertrain.plotting.body import plot_path_contributions, plot_runup_both_sides
 from powertrain.plotting.style import is_axes, target_and_path
@@ -261,10 +261,8 @@ class RunupResult(Result):
         return "\n".join(lines) + "\n"
 
     def to_csv(self, path, comments=()) -> None:
-        """Write :meth:`csv_text` atomically."""
-        text = self.csv_text(comments)
-        with atomic_write(path) as fh:
-            fh.write(text)
+        """Write :meth:`csv_text` atomically (:func:`powertrain.outputs.write_csv`)."""
+        write_csv(path, self.csv_text(comments))
 
     def writers(self) -> dict:
         """``.csv`` (:meth:`to_csv`), ``.h5``/``.hdf5`` (:meth:`to_hdf5`), ``.png``."""

@@ -8,7 +8,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from powertrain.analysis.text_table import format_table
-from powertrain.outputs import atomic_write
+from powertrain.outputs import write_csv
 from powertrain.plotting import plot_stiffness
 from powertrain.plotting.style import target_and_path
 from powertrain.results.base import Result
@@ -101,8 +101,7 @@ def _csv(cols: dict, path=None) -> str:
         lines.append(",".join(f"{cols[c][i]:.10g}" for c in cols))
     text = "\n".join(lines) + "\n"
     if path is not None:
-        with atomic_write(path) as fh:
-            fh.write(text)
+        write_csv(path, text)
     return text
 
 

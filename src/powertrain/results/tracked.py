@@ -51,7 +51,7 @@ from powertrain.analysis.phase import phase_deg
 from powertrain.analysis.text_table import format_table
 from powertrain.errors import InputError
 from powertrain.models.recording import QUANTITIES
-from powertrain.outputs import atomic_path, atomic_write
+from powertrain.outputs import atomic_path, write_csv
 from powertrain.plotting.orders import DISPLAY, plot_maps, plot_tracked
 from powertrain.plotting.style import target_and_path
 from powertrain.provenance import stamp_hdf5
@@ -224,10 +224,8 @@ class TrackedOrders(Result):
         return "\n".join(lines) + "\n"
 
     def to_csv(self, path) -> None:
-        """Write :meth:`csv_text` atomically."""
-        text = self.csv_text()
-        with atomic_write(path) as fh:
-            fh.write(text)
+        """Write :meth:`csv_text` atomically (:func:`powertrain.outputs.write_csv`)."""
+        write_csv(path, self.csv_text())
 
     def writers(self) -> dict:
         """``.csv`` (:meth:`to_csv`), ``.h5``/``.hdf5`` (:meth:`to_hdf5`), ``.png``."""
@@ -345,9 +343,7 @@ class TrackedOrders(Result):
 
     def write_spectra(self, path) -> None:
         """Write the order spectra (:attr:`spectra`) as CSV, atomically."""
-        text = self.spectra.spectrum_csv_text()
-        with atomic_write(path) as fh:
-            fh.write(text)
+        write_csv(path, self.spectra.spectrum_csv_text())
 
     def plot_maps(self, ax=None, *, path=None, provenance=None):
         """The Campbell and rpm-frequency maps (:attr:`maps`); returns the figure (see

@@ -19,6 +19,7 @@ import numpy as np
 
 from powertrain.effects import EFFECTS, RESPONSE_EFFECTS
 from powertrain.errors import InputError
+from powertrain.iotools.mount_file import check_network
 from powertrain.physics.mount_laws import BergFriction, PowerLaw, StaticCurve
 
 #: Mount or direction name that matches every mount or direction.
@@ -141,7 +142,12 @@ class SetParameter:
                 raise self.origin.error(
                     f"{self.spec!r}: model {model.topology.name!r} has no parameter "
                     f"{self.parameter!r} (expected {', '.join(model.topology.parameters)})")
-            return model.with_params(**{self.parameter: self.value})
+            new = model.with_params(**{self.parameter: self.value})
+            try:
+                check_network(new, None)
+            except InputError as exc:
+                raise self.origin.error(f"{self.spec!r}: {exc.message}") from None
+            return new
         return _map_directions(engine, self.mount, self.direction, change, self.origin)
 
 

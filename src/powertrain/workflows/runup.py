@@ -429,13 +429,25 @@ def checked_runup(engine, engine_path, run, *args, **kwargs):
             return run(engine, *args, **kwargs)
         except AmplitudeNotConverged as exc:
             raise InputError(str(exc), *engine.mount_section(exc.element)) from None
-    result = solved(run_naming_mounts, engine_path, "engine")
+    file, key = _blamed_input(engine, engine_path)
+    result = solved(run_naming_mounts, file, key)
     values = {name.replace("_", " "): getattr(result, name) for name in (
         "displacement", "velocity", "acceleration", "mount_force", "mean_mount_force")}
     with np.errstate(over="ignore"):   # finite amplitudes whose squares overflow: absurd levels
         values["synthesis velocity"] = result.synthesis_rms("velocity")
-    require_finite(values, engine_path, "engine")
+    require_finite(values, file, key)
     return result
+
+
+def _blamed_input(engine, engine_path):
+    """``(file, key)`` a run-up that cannot be solved points at: the measured receptances of
+    an FRF body (the engine on rigid ground was checked when its file was read), else the
+    engine file."""
+    receptance = getattr(engine.chassis, "receptance", None)
+    if getattr(engine.chassis, "coupled_by_admittance", False) and \
+            getattr(receptance, "file", ""):
+        return receptance.file, None
+    return engine_path, "engine"
 
 
 def mode_coordinates(engine, frequencies_hz) -> list:

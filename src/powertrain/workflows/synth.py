@@ -58,7 +58,7 @@ import numpy as np
 
 from powertrain.errors import InputError
 from powertrain.iotools.engine_file import engine_or_default
-from powertrain.outputs import atomic_write
+from powertrain.outputs import atomic_write, write_csv
 from powertrain.plotting.style import (
     figure_legend,
     finish,
@@ -218,7 +218,10 @@ class SynthCase(Result):
     def to_csv(self, path=None) -> str:
         """The measured CSV (long format; the hidden effect is not written), written
         atomically to ``path`` when given."""
-        return _written(self.case.csv_text(), path)
+        text = self.case.csv_text()
+        if path is not None:
+            write_csv(path, text)
+        return text
 
     def truth(self) -> dict:
         """The hidden effects and their parameters (keep them away from the diagnosis)."""
