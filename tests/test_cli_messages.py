@@ -5,13 +5,16 @@ measurement."""
 
 from __future__ import annotations
 
+import warnings
 from pathlib import Path
 
+import click
 import numpy as np
 import pytest
 from click.testing import CliRunner
 
 from powertrain.cli import main
+from powertrain.cli.common import quiet_option
 from powertrain.effects import EFFECTS
 from powertrain.iotools.engine_file import DEFAULT_ENGINE_PATH, read_engine
 from powertrain.iotools.measured import read_measured
@@ -138,3 +141,19 @@ def test_static_excitation_and_modes_name_the_files_they_wrote(tmp_path):
     res, _ = invoke("static", "--rpm", "1000", "--json", tmp_path / "s.json", "--quiet")
     assert res.exit_code == 0 and res.output == "", res.output
     assert (tmp_path / "s.json").is_file()
+
+
+def test_quiet_silences_warnings_and_only_while_the_command_runs():
+    """--quiet: nothing but errors, so a Python warning raised by the command is not shown;
+    without it the warning reaches stderr; the filter ends with the command."""
+    @click.command()
+    @quiet_option
+    def warns(quiet):
+        warnings.warn("a questionable result")
+
+    with warnings.catch_warnings(record=True) as seen:
+        warnings.simplefilter("always")
+        quiet = CliRunner().invoke(warns, ["--quiet"])
+        loud = CliRunner().invoke(warns, [])
+    assert quiet.exit_code == loud.exit_code == 0
+    assert [str(w.message) for w in seen] == ["a questionable result"]

@@ -8,6 +8,7 @@ import json
 import os
 import signal
 import threading
+import warnings
 
 import click
 
@@ -32,13 +33,22 @@ def speed_options(func):
 
 
 #: What ``--quiet`` means on every command.
-QUIET_HELP = ("Print nothing but errors and warnings (on stderr): no progress, no table, no "
-              "list of files written.")
+QUIET_HELP = "Print nothing but errors (on stderr): no progress, no table, no warnings, no " \
+             "list of files written."
+
+
+def _silence_warnings(ctx, param, quiet):
+    """With ``--quiet``, Python warnings are ignored while the command runs."""
+    if quiet:
+        ctx.with_resource(warnings.catch_warnings())
+        warnings.simplefilter("ignore")
+    return quiet
 
 
 def quiet_option(func):
     """The ``--quiet`` flag of every command (:data:`QUIET_HELP`)."""
-    return click.option("--quiet", is_flag=True, help=QUIET_HELP)(func)
+    return click.option("--quiet", is_flag=True, help=QUIET_HELP,
+                        callback=_silence_warnings)(func)
 
 
 def say(text: str, quiet: bool, **kwargs) -> None:

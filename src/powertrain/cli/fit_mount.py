@@ -83,7 +83,7 @@ def fit_mount(measured, model, out, plot, form, freq_axis, starts, seed, fmin, f
     _plot(result, plot, form, freq_axis)
     say(result.to_text(), quiet)
     if not result.success:
-        click.echo("warning: the best local solve stopped at its evaluation limit", err=True)
+        say("warning: the best local solve stopped at its evaluation limit", quiet, err=True)
     say(wrote(out, plot), quiet)
 
 
