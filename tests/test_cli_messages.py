@@ -149,7 +149,7 @@ def test_quiet_silences_warnings_and_only_while_the_command_runs():
     @click.command()
     @quiet_option
     def warns(quiet):
-        warnings.warn("a questionable result")
+        warnings.warn("a questionable result", stacklevel=2)
 
     with warnings.catch_warnings(record=True) as seen:
         warnings.simplefilter("always")
