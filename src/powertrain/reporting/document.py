@@ -61,13 +61,15 @@ def _summary(rep) -> str:
            paragraph(rep.verdict(), "verdict")]
     gaps = rep.top_gaps()
     if gaps:
-        rows = [[g["run"], g["mount"], g["direction"], g["quantity"], number(g["rms_db"]),
-                 number(g["bias_db"], "+.2f"), number(g["max_abs_db"]),
-                 number(g.get("rpm_at_max_abs_db"), "g")] for g in gaps]
-        out.append(table(["run", "mount", "dir", "quantity", "RMS gap [dB]", "bias [dB]",
-                          "max |gap| [dB]", "at [rpm]"], rows,
-                         f"Top gaps: the {len(rows)} channel-quantities with the largest RMS "
-                         f"gap 20 log10(sim/measured) ({gaps[0]['from']})"))
+        runs = len(rep.parts.get("compare", [])) > 1
+        rows = [([g["run"]] if runs else []) + [
+            g["mount"], g["direction"], g["quantity"], number(g["rms_db"]),
+            number(g["bias_db"], "+.2f"), number(g["max_abs_db"]),
+            number(g.get("rpm_at_max_abs_db"), "g")] for g in gaps]
+        out.append(table((["run"] if runs else []) + [
+            "mount", "dir", "quantity", "RMS gap [dB]", "bias [dB]", "max |gap| [dB]",
+            "at [rpm]"], rows, f"Top gaps: the {len(rows)} channel-quantities with the "
+            f"largest RMS gap 20 log10(sim/measured) ({gaps[0]['from']})"))
     out.append(_files(rep.files))
     return "".join(out) + "</section>"
 

@@ -33,6 +33,8 @@ HTML_SUFFIXES = (".html", ".htm")
 TOP_GAPS = 5
 #: Bytes of a file read to find its first comment line.
 HEAD_BYTES = 4096
+#: Longest provenance text shown for a file [characters].
+MAX_COMMENT = 240
 
 
 @dataclass(frozen=True)
@@ -227,11 +229,22 @@ def _record(role: str, path: str) -> FileRecord:
         size = os.path.getsize(path)
     except OSError as exc:
         raise InputError(f"cannot read ({exc.strerror or exc})", file=path) from None
-    comment = next((line.lstrip("#").strip() for line in
-                    head.decode("utf-8", "replace").splitlines()
-                    if line.startswith("#") and line.lstrip("#").strip()), "")
+    comment = _first_comment(head.decode("utf-8", "replace"))
     return FileRecord(role, path, comment, size, digest.hexdigest(),
                       synthetic="SYNTHETIC" in comment)
+
+
+def _first_comment(text: str) -> str:
+    """The first block of ``#`` comment lines of a text, joined, cut to
+    :data:`MAX_COMMENT` characters ("" when it has none)."""
+    block = []
+    for line in text.splitlines():
+        if line.startswith("#"):
+            block.append(line.lstrip("#").strip())
+        elif block:
+            break
+    comment = " ".join(b for b in block if b)
+    return comment if len(comment) <= MAX_COMMENT else comment[:MAX_COMMENT - 3] + "..."
 
 
 def _versions() -> dict:

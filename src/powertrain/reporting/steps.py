@@ -207,10 +207,9 @@ def _whatif_run(study, opts, progress) -> list:
 
 
 def _whatif_figures(result, provenance) -> list:
-    return [("Levels of the baseline (black) and the variants where some variant changes "
-             "them by at least 1 dB.", lambda: result.plot(provenance=provenance)),
-            ("Change of every channel and quantity against the baseline, Δ = 20 log10(v/v0).",
-             lambda: result.plot(provenance=provenance, view="delta"))]
+    return [("Levels of the baseline (black), the variants and the measurement (grey) where "
+             "some variant changes them by at least 1 dB (the table gives every change).",
+             lambda: result.plot(provenance=provenance))]
 
 
 def _whatif_commands(study, opts) -> list:

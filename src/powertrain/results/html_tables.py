@@ -77,35 +77,69 @@ def _missing(missing) -> list:
 
 # ------------------------------------------------------------------ what-if
 def whatif_html(r) -> str:
-    """A :class:`~powertrain.results.whatif.WhatIfResult`: the baseline, then per variant its
-    rigid-body modes and the change of every channel and quantity, largest change first."""
+    """A :class:`~powertrain.results.whatif.WhatIfResult`: the baseline, one row per variant
+    (operations, modes, overall change), then the change of every channel and quantity in
+    each variant, the channel-quantity with the largest change first."""
     d, rpm = r.description, r.baseline.rpm
     modes = ", ".join(f"{f:.2f}" for f in r.baseline.rigid_body_modes_hz)
     parts = [paragraph(f"baseline: {d.get('engine')} ({d.get('engine_file')}), solver "
                        f"{d.get('solver')}, {rpm[0]:g}-{rpm[-1]:g} rpm; "
                        f"{r.baseline.modes_label}: {modes} Hz")]
     parts += [paragraph(tf.summary()) for tf in r.target_fits]
+    changes = {v.name: r.channel_changes(v.name) for v in r.variants}
+    parts.append(_variants_table(r, changes))
     signal = r.signal.replace("_", " ")
-    gap = r.measured is not None and r.signal == "velocity"
-    for v in r.variants:
-        rows = sorted(r.channel_changes(v.name), key=_largest_change)
-        header = ["mount", "dir", "quantity", "mean Δ [dB]", "max |Δ| [dB]", "at [rpm]"]
-        header += ["mean gap to measured [dB]"] if gap else []
-        body = [[c["mount"], c["direction"], c["quantity"], number(c["mean_delta_db"], "+.2f"),
-                 number(c["max_abs_delta_db"]), number(c["rpm_at_max_abs"], "g")]
-                + ([number(c.get("mean_gap_to_measured_db"), "+.2f")] if gap else [])
-                for c in rows]
-        vmodes = ", ".join(f"{f:.2f}" for f in v.result.rigid_body_modes_hz)
-        parts.append(f"<h4>{esc(v.name)}</h4>"
-                     + paragraph(f"{'; '.join(v.specs)}; {v.result.modes_label}: {vmodes} Hz")
-                     + table(header, body, f"Change of the RMS {signal} against the baseline, "
-                             "Δ = 20 log10(v/v0), largest |Δ| first"))
+    keys = [(c["mount"], c["direction"], c["quantity"]) for c in changes[r.variants[0].name]]
+    cells = {name: {(c["mount"], c["direction"], c["quantity"]): c for c in rows}
+             for name, rows in changes.items()}
+    largest = {key: max((_abs(cells[n][key]["max_abs_delta_db"]) for n in cells), default=0)
+               for key in keys}
+    rows = [[*key] + [f"{number(cells[n][key]['mean_delta_db'], '+.2f')} / "
+                      f"{number(cells[n][key]['max_abs_delta_db'])}" for n in cells]
+            for key in sorted(keys, key=lambda key: -largest[key])]
+    parts.append(table(["mount", "dir", "quantity"] + [f"{n}: mean / max |Δ| [dB]"
+                                                      for n in cells], rows,
+                       f"Change of the RMS {signal} against the baseline, Δ = 20 log10(v/v0): "
+                       "mean over the speeds / largest |Δ|, per variant; the largest change "
+                       "first"))
     return "".join(parts)
 
 
-def _largest_change(row) -> float:
-    value = row["max_abs_delta_db"]
-    return -value if value is not None else np.inf
+def _variants_table(r, changes) -> str:
+    gap = r.measured is not None and r.signal == "velocity"
+    header = ["variant", "operations", "modes [Hz]", "mean Δ [dB]", "largest |Δ| [dB]",
+              "where"] + (["mean |gap to measured| [dB]"] if gap else [])
+    rows = []
+    if gap:
+        base = _mean_abs([g["mean_gap_to_measured_db"] for g in r.baseline_gaps()])
+        rows.append(["baseline", "", ", ".join(f"{f:.2f}" for f in
+                                              r.baseline.rigid_body_modes_hz),
+                     "", "", "", number(base)])
+    for v in r.variants:
+        ch = changes[v.name]
+        worst = max(ch, key=lambda c: _abs(c["max_abs_delta_db"]))
+        means = [c["mean_delta_db"] for c in ch if c["mean_delta_db"] is not None]
+        rows.append([v.name, "; ".join(v.specs),
+                     ", ".join(f"{f:.2f}" for f in v.result.rigid_body_modes_hz),
+                     number(np.mean(means) if means else None, "+.2f"),
+                     number(worst["max_abs_delta_db"]),
+                     f"{worst['mount']} {worst['direction']} {worst['quantity']} at "
+                     f"{number(worst['rpm_at_max_abs'], 'g')} rpm"]
+                    + ([number(_mean_abs([c.get("mean_gap_to_measured_db") for c in ch]))]
+                       if gap else []))
+    return table(header, rows, "Variants: mean change over every channel, quantity and speed, "
+                 "the largest change and where"
+                 + ("; mean |gap| to the measurement over the channel-quantities" if gap
+                    else ""))
+
+
+def _abs(value) -> float:
+    return abs(value) if value is not None else -np.inf
+
+
+def _mean_abs(values) -> float | None:
+    ok = [abs(v) for v in values if v is not None]
+    return float(np.mean(ok)) if ok else None
 
 
 # ------------------------------------------------------------------ modes
