@@ -77,12 +77,12 @@ def _summary(rep) -> str:
 def _files(files) -> str:
     rows = "".join(
         f"<tr><td>{esc(f.role)}</td><td><code>{esc(shown(f.path))}</code>"
-        f"{synthetic_mark(f.synthetic)}</td><td>{esc(f.provenance)}</td>"
-        f'<td class="num">{f.size:,}</td><td class="hash">{esc(f.sha256)}</td></tr>'
+        f'{synthetic_mark(f.synthetic)}<br><span class="hash">{esc(f.sha256)}</span></td>'
+        f'<td>{esc(f.provenance)}</td><td class="num">{f.size:,}</td></tr>'
         for f in files)
-    return ("<table><caption>Files read: what each is (its first comment line), size in "
-            "bytes and SHA-256</caption><thead><tr><th>role</th><th>file</th>"
-            "<th>provenance</th><th>bytes</th><th>SHA-256</th></tr></thead>"
+    return ("<table><caption>Files read: path and SHA-256, what each is (its first comment "
+            "lines), size in bytes</caption><thead><tr><th>role</th><th>file, SHA-256</th>"
+            "<th>provenance</th><th>bytes</th></tr></thead>"
             f"<tbody>{rows}</tbody></table>")
 
 

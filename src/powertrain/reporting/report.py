@@ -34,7 +34,7 @@ TOP_GAPS = 5
 #: Bytes of a file read to find its first comment line.
 HEAD_BYTES = 4096
 #: Longest provenance text shown for a file [characters].
-MAX_COMMENT = 240
+MAX_COMMENT = 200
 
 
 @dataclass(frozen=True)
@@ -87,7 +87,9 @@ def report(study, out=None, *, progress: bool = False) -> ReportResult:
         except InputError as exc:
             raise restated(exc, where, name) from None
     parts = {name: parts[name] for name in STEPS if name in parts}
-    rep = ReportResult(study=s, parts=parts, files=[_record(role, f) for role, f in s.files],
+    synthetic = {os.path.realpath(m.source) for _, m, _, _ in s.runs() if m.synthetic}
+    rep = ReportResult(study=s, parts=parts, files=[_record(role, f, synthetic)
+                                                    for role, f in s.files],
                        versions=_versions(), created=_now(), out=str(out or ""),
                        seconds=time.perf_counter() - t0)
     prov = Provenance.now(command=rep.command(), engine=f"{s.engine.name} "
@@ -217,8 +219,9 @@ class ReportResult(Result):
         return self.parts[name][0][1].plot(ax, path=path, provenance=provenance)
 
 
-def _record(role: str, path: str) -> FileRecord:
-    """The hash, size and first comment line of one file."""
+def _record(role: str, path: str, synthetic=frozenset()) -> FileRecord:
+    """The hash, size and first comment lines of one file (SYNTHETIC when its real path is
+    in ``synthetic``: a measurement that says it is synthetic)."""
     digest = hashlib.sha256()
     try:
         with open(path, "rb") as fh:
@@ -231,7 +234,7 @@ def _record(role: str, path: str) -> FileRecord:
         raise InputError(f"cannot read ({exc.strerror or exc})", file=path) from None
     comment = _first_comment(head.decode("utf-8", "replace"))
     return FileRecord(role, path, comment, size, digest.hexdigest(),
-                      synthetic="SYNTHETIC" in comment)
+                      synthetic=os.path.realpath(path) in synthetic)
 
 
 def _first_comment(text: str) -> str:

@@ -46,9 +46,9 @@ STYLE = """
 .pt-report th { background: #eef4f9; }
 .pt-report td.num { text-align: right; font-variant-numeric: tabular-nums;
   white-space: nowrap; }
-.pt-report td.hash, .pt-report code, .pt-report pre { font-family: "DejaVu Sans Mono",
+.pt-report .hash, .pt-report code, .pt-report pre { font-family: "DejaVu Sans Mono",
   Consolas, monospace; font-size: 0.86em; }
-.pt-report td.hash { word-break: break-all; }
+.pt-report .hash { font-size: 0.72em; color: #444; word-break: break-all; }
 .pt-report pre { background: #f5f5f5; padding: 0.5em 0.7em; white-space: pre-wrap;
   overflow-wrap: anywhere; }
 .pt-report figure { margin: 0.8em 0 1.2em; break-inside: avoid; page-break-inside: avoid; }
