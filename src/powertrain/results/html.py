@@ -22,7 +22,9 @@ from powertrain.plotting.style import MAX_HEIGHT_IN, close_figure
 EMBED_DPI = 150
 #: CSS pixels per inch (fixed by CSS).
 CSS_PX_PER_IN = 96
-_NUMBER = re.compile(r"^[+\-−]?(\d|\.\d)[\d.,]*(e[+\-]?\d+)?\s*(%|dB|Hz|rpm|°)?$")
+_VALUE = r"[+\-−]?(\d|\.\d)[\d.,]*(e[+\-]?\d+)?"
+#: A cell that reads as a number (or ``a / b``, two numbers), right-aligned in tables.
+_NUMBER = re.compile(rf"^{_VALUE}(\s*/\s*{_VALUE})?\s*(%|dB|Hz|rpm|°)?$")
 
 #: The style sheet (scoped to ``.pt-report``); ``@page`` sets A4 for print to PDF.
 STYLE = """
@@ -69,7 +71,8 @@ def esc(value) -> str:
 
 
 def number(value, fmt: str = ".2f") -> str:
-    """A number formatted, ``-`` where it is None or not finite (never ``nan`` or ``-0.00``)."""
+    """A number formatted, ``-`` where it is None or not finite (never ``nan``; a value that
+    rounds to zero has no minus sign: ``0.00``, ``+0.00`` with a ``+`` format)."""
     if value is None:
         return "-"
     try:
@@ -79,7 +82,9 @@ def number(value, fmt: str = ".2f") -> str:
     if not math.isfinite(x):
         return "-"
     text = format(x, fmt)
-    return text.replace("-", "", 1) if _is_zero(text) and text.startswith("-") else text
+    if _is_zero(text) and text.startswith("-"):
+        return ("+" if fmt.startswith("+") else "") + text[1:]
+    return text
 
 
 def _is_zero(text: str) -> bool:
