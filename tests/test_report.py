@@ -35,6 +35,9 @@ STUDY = EXAMPLES / "study.toml"
 MAX_BYTES = 10_000_000
 #: The window of the screenshot [CSS px].
 WIDTH, HEIGHT = 1280, 900
+#: The tests of the example's report (about 12 s of CPU to make it, figures mostly, and a
+#: browser): with the slow tests, like the other many-panel figures; bad study files are quick.
+SLOW = pytest.mark.slow
 NO_CHROMIUM = ("headless Chromium not installed (Debian: apt-get install chromium; .ci/run "
                "installs it where apt-get works): the browser checks of the report did not run")
 
@@ -51,6 +54,7 @@ def html(made) -> str:
     return made[1].read_text(encoding="utf-8")
 
 
+@SLOW
 def test_one_self_contained_file_under_10_mb(made, html):
     rep, out = made
     assert out.stat().st_size < MAX_BYTES
@@ -63,6 +67,7 @@ def test_one_self_contained_file_under_10_mb(made, html):
     assert html.count("<img ") == html.count("data:image/png;base64,") == 6
 
 
+@SLOW
 def test_summary_first_then_a_section_per_step_then_reproduction(made, html):
     rep, _ = made
     ids = re.findall(r'<section[^>]* id="([a-z]+)"', html)
@@ -79,6 +84,7 @@ def test_summary_first_then_a_section_per_step_then_reproduction(made, html):
         r"<td>([^<]*)</td>", top)[:3]
 
 
+@SLOW
 def test_tables_are_worst_first(made, html):
     comp = made[0].parts["compare"][0][1]
     section = html[html.index('id="compare"'):html.index('id="diagnose"')]
@@ -88,6 +94,7 @@ def test_tables_are_worst_first(made, html):
     assert len(rms) == len(comp.channels) and rms == sorted(rms, reverse=True)
 
 
+@SLOW
 def test_the_commands_shown_reproduce_the_numbers(made, html):
     """The compare command of the reproduction section prints the report's overall gap."""
     rep, _ = made
@@ -105,6 +112,7 @@ def test_the_commands_shown_reproduce_the_numbers(made, html):
         assert f"<td>{package}</td>" in repro
 
 
+@SLOW
 def test_the_report_follows_the_result_protocol(made, tmp_path):
     rep, out = made
     with pytest.raises(AttributeError):
@@ -121,14 +129,25 @@ def test_the_report_follows_the_result_protocol(made, tmp_path):
         rep.plot(step="transient")
 
 
+@SLOW
 def test_results_render_in_jupyter(made):
     rep, _ = made
     results = [parts[0][1] for parts in rep.parts.values()] + [rep]
     for r in results:
         frag = r._repr_html_()
-        assert frag.startswith('<div class="pt-report"><style>') and "<table>" in frag, r
+        assert frag.startswith("<style>") and "<table>" in frag, r
+        assert re.match(r'<style>[^<]*</style><(div|main) class="pt-report">', frag), r
         assert "<img" not in frag or r is rep            # tables only: no figure is drawn
         assert "nan" not in re.sub(r"<[^>]*>", " ", frag).lower().split(), r
+
+
+def test_a_result_renders_in_jupyter_without_nan_or_minus_zero():
+    """The modes table as a notebook shows it: one row per mode, numbers right-aligned,
+    signed energy shares that round to zero printed as 0.0."""
+    frag = pt.modes(pt.read_engine())._repr_html_()
+    assert frag.count("<tr><td class=\"num\">") == 6
+    cells = re.findall(r"<td[^>]*>([^<]*)</td>", frag)
+    assert "-0.0" not in cells and not any("nan" in c.lower() for c in cells)
 
 
 # ------------------------------------------------------------------ in the browser
@@ -161,10 +180,12 @@ def browser(made, tmp_path_factory):
     return seen
 
 
+@SLOW
 def test_chromium_opens_it_with_no_console_error_and_no_failed_resource(browser):
     assert browser["problems"] == []
 
 
+@SLOW
 def test_the_screenshot_at_1280_px_shows_the_summary(browser, tmp_path):
     shot = mpimg.imread(io.BytesIO(browser["screenshot"]))
     (tmp_path / "summary.png").write_bytes(browser["screenshot"])
@@ -176,6 +197,7 @@ def test_the_screenshot_at_1280_px_shows_the_summary(browser, tmp_path):
     assert ink.mean() > 0.02, ink.mean()
 
 
+@SLOW
 def test_the_pdf_print_cuts_no_figure(browser, made):
     """Printed to PDF (A4 pages), each image of the report is drawn on exactly one page, and
     every figure of the report is there. An image cut by a page break is drawn on each page

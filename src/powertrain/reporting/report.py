@@ -23,7 +23,7 @@ from powertrain.reporting.keys import Where, restated
 from powertrain.reporting.steps import STEPS, shown
 from powertrain.reporting.study import Study, check_study_path, read_study
 from powertrain.results.base import Result
-from powertrain.results.html import fragment
+from powertrain.results.html import styled
 
 #: Packages whose versions the report names (besides Python and the platform).
 VERSIONED = ("powertrain", "numpy", "scipy", "numba", "matplotlib", "h5py")
@@ -203,7 +203,7 @@ class ReportResult(Result):
 
     def _repr_html_(self) -> str:
         """The report's content (Jupyter shows it)."""
-        return fragment(self.body)
+        return styled(self.body)
 
     def writers(self) -> dict:
         """``.html`` (:meth:`to_html`), ``.htm``, ``.png`` (the first step's figure)."""

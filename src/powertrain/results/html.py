@@ -138,4 +138,9 @@ def figure_html(fig, caption: str, dpi: int = EMBED_DPI) -> str:
 def fragment(inner: str) -> str:
     """``inner`` in a ``.pt-report`` block with the style sheet: what ``_repr_html_`` returns
     (Jupyter shows it as it is)."""
-    return f'<div class="pt-report"><style>{STYLE}</style>{inner}</div>'
+    return styled(f'<div class="pt-report">{inner}</div>')
+
+
+def styled(block: str) -> str:
+    """A ``.pt-report`` block preceded by the style sheet."""
+    return f"<style>{STYLE}</style>{block}"
