@@ -155,6 +155,11 @@ CASES = {
     "synth seed": (lambda e: pt.synth([], -1), True),
     "synth seed text": (lambda e: pt.synth([], "a"), True),
     "synth none": (lambda e: pt.synth("none", 0), False),
+    # report (every bad study file: tests/test_report.py)
+    "report missing": (lambda e: pt.report(MISSING), True),
+    "report type": (lambda e: pt.report(5), True),
+    "report not toml": (lambda e: pt.report(MEASURED), True),
+    "report out suffix": (lambda e: pt.report(str(EXAMPLES / "study.toml"), out="r.pdf"), True),
 }
 
 

@@ -44,6 +44,7 @@ API = {
     "track": ("powertrain.workflows.tracking", "track"),
     "diagnose": ("powertrain.diagnosis", "diagnose"),
     "synth": ("powertrain.workflows.synth", "synth"),
+    "report": ("powertrain.reporting.report", "report"),
 }
 
 __all__ = ["InputError", "__version__", *API]

@@ -17,7 +17,7 @@ from powertrain.provenance import recording_command
 #: Every command and the module of :mod:`powertrain.cli` that defines it (``@main.command``).
 COMMANDS = {"compare": "compare", "diagnose": "diagnose", "examples": "examples",
             "excitation": "excitation", "fit-mount": "fit_mount", "modes": "modes",
-            "runup": "runup", "static": "static", "stiffness": "stiffness",
+            "report": "report", "runup": "runup", "static": "static", "stiffness": "stiffness",
             "synth": "diagnose", "track": "track", "whatif": "whatif"}
 
 

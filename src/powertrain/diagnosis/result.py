@@ -17,6 +17,7 @@ from powertrain.diagnosis.checks import ORDER_FOLDS, ORDER_SPLIT, channel_folds
 from powertrain.diagnosis.data import GapData
 from powertrain.diagnosis.evidence import VerdictKind
 from powertrain.diagnosis.fit import FitOutcome
+from powertrain.diagnosis.html import diagnosis_html
 from powertrain.diagnosis.report import summary, write_report
 from powertrain.diagnosis.rule import DecisionRule
 from powertrain.effects import EFFECTS
@@ -24,6 +25,7 @@ from powertrain.outputs import atomic_write
 from powertrain.plotting import plot_gap_map
 from powertrain.plotting.style import target_and_path
 from powertrain.results.base import Result
+from powertrain.results.html import fragment
 
 
 @dataclass(frozen=True)
@@ -189,6 +191,10 @@ class DiagnosisResult(Result):
         """Plain-text report: where, which, how far, verdict (what ``powertrain diagnose``
         prints and ``summary.txt`` holds; :func:`powertrain.diagnosis.report.summary`)."""
         return summary(self)
+
+    def _repr_html_(self) -> str:
+        """HTML of the verdict, where, which and how far (Jupyter shows it)."""
+        return fragment(diagnosis_html(self))
 
     def plot(self, ax=None, *, path=None, quantity=None, provenance=None):
         """Gap map figure, one panel per quantity; returns it (see

@@ -17,6 +17,8 @@ from powertrain.outputs import json_text
 from powertrain.plotting import plot_comparison
 from powertrain.plotting.style import target_and_path
 from powertrain.results.base import Result
+from powertrain.results.html import fragment
+from powertrain.results.html_tables import comparison_html
 
 #: Quantities always expected (the thesis's comparison, sec. 4.4); any other measured order is
 #: compared too.
@@ -322,6 +324,10 @@ class ComparisonResult(Result):
         lines += ["", self.summary() + f" (simulation {t_sim:.2f} s)"
                   + "".join(f"; wrote {p}" for p in written if p)]
         return "\n".join(lines)
+
+    def _repr_html_(self) -> str:
+        """HTML tables of this result (Jupyter shows them; :mod:`powertrain.results.html`)."""
+        return fragment(comparison_html(self))
 
     def _sources(self) -> list:
         """What was compared with what, and the rules."""

@@ -12,6 +12,8 @@ from powertrain.outputs import json_text
 from powertrain.plotting.body import plot_modes
 from powertrain.plotting.style import target_and_path
 from powertrain.results.base import Result
+from powertrain.results.html import fragment
+from powertrain.results.html_tables import modes_html
 from powertrain.solvers.modes import AS_MEASURED, COORDINATES, number_or_null
 
 
@@ -179,6 +181,10 @@ class ModesResult(Result):
                          + ", so a coordinate can hold a slightly negative share; each row "
                          "adds up to 100 %")
         return "\n".join(lines)
+
+    def _repr_html_(self) -> str:
+        """HTML tables of this result (Jupyter shows them; :mod:`powertrain.results.html`)."""
+        return fragment(modes_html(self))
 
     def plot(self, ax=None, *, path=None, provenance=None):
         """Stacked kinetic-energy distribution per mode, one panel (PNG when ``path`` is

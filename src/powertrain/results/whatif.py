@@ -26,6 +26,8 @@ from powertrain.outputs import json_text
 from powertrain.plotting import plot_whatif
 from powertrain.plotting.style import target_and_path
 from powertrain.results.base import Result
+from powertrain.results.html import fragment
+from powertrain.results.html_tables import whatif_html
 
 #: Quantities reported by default.
 QUANTITIES = ("synthesis", "order_2", "order_4")
@@ -111,6 +113,10 @@ class WhatIfResult(Result):
         if written:
             lines.append(f"wrote {', '.join(written)}")
         return "\n".join(lines)
+
+    def _repr_html_(self) -> str:
+        """HTML tables of this result (Jupyter shows them; :mod:`powertrain.results.html`)."""
+        return fragment(whatif_html(self))
 
     def target_fit(self, key: str = "target"):
         """The one retune of this what-if (:class:`~powertrain.workflows.retune.TargetFit`);
