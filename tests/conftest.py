@@ -62,8 +62,10 @@ def pytest_collection_modifyitems(config, items):
     as they free up (pytest-xdist), the few minutes-long ones start at once and the many short
     ones fill in around them, so that the test processes finish together (longest first:
     collected last, a plan test could start in the suite's last minutes and run on alone).
-    The order is otherwise kept (a stable sort)."""
+    The browser tests run last, when the Chromium install that .ci/run starts in the
+    background has ended. The order is otherwise kept (a stable sort)."""
     def rank(item):
         return (item.get_closest_marker("long_rates") is None,
-                item.get_closest_marker("rates") is None)
+                item.get_closest_marker("rates") is None,
+                item.get_closest_marker("browser") is not None)
     items.sort(key=rank)

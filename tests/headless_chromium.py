@@ -28,6 +28,13 @@ CANDIDATES = ("/usr/bin/chromium", "chromium", "chromium-browser", "google-chrom
 TIMEOUT_S = 60.0
 
 
+#: Set by .ci/run to a folder while it installs Chromium in the background: the folder gets
+#: ``rc`` (apt-get's exit code) when the install ends, and ``log``.
+INSTALL_ENV = "PT_CHROMIUM_INSTALL"
+#: Seconds to wait for that install at the most.
+INSTALL_WAIT_S = 600.0
+
+
 def find_chromium():
     """The path of a Chromium executable, or None."""
     for name in CANDIDATES:
@@ -35,6 +42,23 @@ def find_chromium():
         if path:
             return path
     return None
+
+
+def installed_chromium():
+    """``(path or None, why not)``: a Chromium executable, after waiting for the background
+    install .ci/run started (:data:`INSTALL_ENV`) where it is still running."""
+    folder = os.environ.get(INSTALL_ENV)
+    if find_chromium() is None and folder:
+        rc = Path(folder) / "rc"
+        deadline = time.monotonic() + INSTALL_WAIT_S
+        while not rc.exists() and time.monotonic() < deadline:
+            time.sleep(2.0)
+        if not rc.exists():
+            return None, f"the background install did not end within {INSTALL_WAIT_S:.0f} s"
+        if rc.read_text().strip() != "0":
+            log = (Path(folder) / "log").read_text(errors="replace").strip().splitlines()
+            return None, f"apt-get failed: {log[-1] if log else 'no output'}"
+    return find_chromium(), "not installed"
 
 
 class Chromium:

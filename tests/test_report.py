@@ -19,7 +19,7 @@ import numpy as np
 import pytest
 from click.testing import CliRunner
 from conftest import EXAMPLES
-from headless_chromium import Chromium, find_chromium, images_per_page
+from headless_chromium import Chromium, images_per_page, installed_chromium
 
 matplotlib.use("Agg")
 import matplotlib.image as mpimg  # noqa: E402
@@ -37,7 +37,15 @@ MAX_BYTES = 10_000_000
 WIDTH, HEIGHT = 1280, 900
 #: The tests of the example's report (about 12 s of CPU to make it, figures mostly, and a
 #: browser): with the slow tests, like the other many-panel figures; bad study files are quick.
-SLOW = pytest.mark.slow
+
+
+def on_the_example(test):
+    """A slow test of the example's report: all of them on one test process (the report is
+    made once) and last (the ``browser`` marker, tests/conftest.py), so that the Chromium
+    install .ci/run starts in the background has ended by then."""
+    for mark in (pytest.mark.slow, pytest.mark.browser, pytest.mark.xdist_group("report")):
+        test = mark(test)
+    return test
 NO_CHROMIUM = ("headless Chromium not installed (Debian: apt-get install chromium; .ci/run "
                "installs it where apt-get works): the browser checks of the report did not run")
 
@@ -54,7 +62,7 @@ def html(made) -> str:
     return made[1].read_text(encoding="utf-8")
 
 
-@SLOW
+@on_the_example
 def test_one_self_contained_file_under_10_mb(made, html):
     rep, out = made
     assert out.stat().st_size < MAX_BYTES
@@ -67,7 +75,7 @@ def test_one_self_contained_file_under_10_mb(made, html):
     assert html.count("<img ") == html.count("data:image/png;base64,") == 6
 
 
-@SLOW
+@on_the_example
 def test_summary_first_then_a_section_per_step_then_reproduction(made, html):
     rep, _ = made
     ids = re.findall(r'<section[^>]* id="([a-z]+)"', html)
@@ -84,7 +92,7 @@ def test_summary_first_then_a_section_per_step_then_reproduction(made, html):
         r"<td>([^<]*)</td>", top)[:3]
 
 
-@SLOW
+@on_the_example
 def test_tables_are_worst_first(made, html):
     comp = made[0].parts["compare"][0][1]
     section = html[html.index('id="compare"'):html.index('id="diagnose"')]
@@ -94,7 +102,7 @@ def test_tables_are_worst_first(made, html):
     assert len(rms) == len(comp.channels) and rms == sorted(rms, reverse=True)
 
 
-@SLOW
+@on_the_example
 def test_the_commands_shown_reproduce_the_numbers(made, html):
     """The compare command of the reproduction section prints the report's overall gap."""
     rep, _ = made
@@ -104,7 +112,7 @@ def test_the_commands_shown_reproduce_the_numbers(made, html):
     assert lines[0] == rep.command()
     assert lines[0].startswith("powertrain report examples/study.toml --out ")
     words = shlex.split(next(ln for ln in lines if ln.startswith("powertrain compare")))
-    run = CliRunner().invoke(main, [*words[1:], "--quiet"])
+    run = CliRunner().invoke(main, words[1:])
     assert run.exit_code == 0, run.output
     gap = rep.parts["compare"][0][1].overall_rms_db
     assert f"overall RMS gap {gap:.2f} dB" in run.output
@@ -112,7 +120,7 @@ def test_the_commands_shown_reproduce_the_numbers(made, html):
         assert f"<td>{package}</td>" in repro
 
 
-@SLOW
+@on_the_example
 def test_the_report_follows_the_result_protocol(made, tmp_path):
     rep, out = made
     with pytest.raises(AttributeError):
@@ -129,7 +137,7 @@ def test_the_report_follows_the_result_protocol(made, tmp_path):
         rep.plot(step="transient")
 
 
-@SLOW
+@on_the_example
 def test_results_render_in_jupyter(made):
     rep, _ = made
     results = [parts[0][1] for parts in rep.parts.values()] + [rep]
@@ -156,9 +164,9 @@ def browser(made, tmp_path_factory):
     """What Chromium saw: problems while loading, the summary's boxes, a screenshot at
     1280 px, the PDF of the page; and the PDF of a page that cuts an image (the check's
     control)."""
-    exe = find_chromium()
+    exe, why = installed_chromium()
     if exe is None:
-        pytest.skip(NO_CHROMIUM)
+        pytest.skip(f"{NO_CHROMIUM} ({why})")
     _, out = made
     control = tmp_path_factory.mktemp("control") / "cut.html"
     image = re.search(r'src="(data:image/png;base64,[^"]*)"', out.read_text()).group(1)
@@ -180,12 +188,12 @@ def browser(made, tmp_path_factory):
     return seen
 
 
-@SLOW
+@on_the_example
 def test_chromium_opens_it_with_no_console_error_and_no_failed_resource(browser):
     assert browser["problems"] == []
 
 
-@SLOW
+@on_the_example
 def test_the_screenshot_at_1280_px_shows_the_summary(browser, tmp_path):
     shot = mpimg.imread(io.BytesIO(browser["screenshot"]))
     (tmp_path / "summary.png").write_bytes(browser["screenshot"])
@@ -197,7 +205,7 @@ def test_the_screenshot_at_1280_px_shows_the_summary(browser, tmp_path):
     assert ink.mean() > 0.02, ink.mean()
 
 
-@SLOW
+@on_the_example
 def test_the_pdf_print_cuts_no_figure(browser, made):
     """Printed to PDF (A4 pages), each image of the report is drawn on exactly one page, and
     every figure of the report is there. An image cut by a page break is drawn on each page
