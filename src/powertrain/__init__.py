@@ -44,6 +44,8 @@ API = {
     "track": ("powertrain.workflows.tracking", "track"),
     "diagnose": ("powertrain.diagnosis", "diagnose"),
     "synth": ("powertrain.workflows.synth", "synth"),
+    "transient": ("powertrain.workflows.transient", "transient"),
+    "read_manoeuvre": ("powertrain.iotools.manoeuvre_file", "read_manoeuvre"),
 }
 
 __all__ = ["InputError", "__version__", *API]

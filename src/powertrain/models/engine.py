@@ -351,9 +351,8 @@ class Engine:
         return gas, self._block_load(th, 1.0, np.zeros((th.size, unit.shape[0])))[0]
 
     def motion_patterns(self, crank_angle_rad):
-        """Generalized loads (n, 6) of a unit omega^2 and of a unit crank angular
-        acceleration [per rad/s^2] at the angles [rad], no gas force: the moving masses'
-        centripetal and tangential accelerations (:meth:`_block_load` is linear in both)."""
+        """Generalized loads (n, 6) of a unit omega^2 and of a unit crank acceleration at
+        the angles [rad], no gas force (:meth:`_block_load` is linear in both)."""
         th = np.atleast_1d(np.asarray(crank_angle_rad, dtype=float))
         zero = np.zeros((th.size, self.crank.n_cylinders))
         return self._block_load(th, 1.0, zero)[0], self._block_load(th, 0.0, zero, 1.0)[0]

@@ -1,0 +1,71 @@
+"""``powertrain transient``: an engine start, stop, tip-in or back-out on the mounts."""
+
+from __future__ import annotations
+
+import click
+
+from powertrain.cli.common import (
+    check_outputs,
+    cli_provenance,
+    engine_description,
+    write_json,
+    write_plot,
+)
+from powertrain.cli.group import main
+from powertrain.iotools.engine_file import engine_or_default
+from powertrain.iotools.manoeuvre_file import read_manoeuvre
+from powertrain.workflows import transient as workflow
+
+
+@main.command()
+@click.argument("manoeuvre_file", metavar="MANOEUVRE", type=click.Path(dir_okay=False))
+@click.option("--engine", "engine_file", type=click.Path(dir_okay=False),
+              help="Engine file (default: the shipped engines/default.toml).")
+@click.option("--angle-step", type=float, default=workflow.ANGLE_STEP_DEG, show_default=True,
+              help="Crank angle per integration step at the top speed [deg].")
+@click.option("--seat", help="Body point for the ISO 2631-1 values (default: a body point "
+                             "named seat...).")
+@click.option("--channels", help="Channels of the figure, comma separated (e.g. "
+                                 "left.z,right.z; default: the seat's, else each mount's z).")
+@click.option("--out", type=click.Path(dir_okay=False), help="Write the HDF5 time histories.")
+@click.option("--csv", "csv_file", type=click.Path(dir_okay=False),
+              help="Write the time histories as CSV, one row per step.")
+@click.option("--json", "json_file", type=click.Path(dir_okay=False),
+              help="Write the peaks and the seat's values as JSON.")
+@click.option("--plot", type=click.Path(dir_okay=False),
+              help="Speed and torque above the channels' accelerations (PNG).")
+@click.option("--quiet", is_flag=True, help="No table.")
+def transient(manoeuvre_file, engine_file, angle_step, seat, channels, out, csv_file,
+              json_file, plot, quiet):
+    """Transient manoeuvre: time histories of body, mounts and seat over a start, stop,
+    tip-in or back-out.
+
+    MANOEUVRE is a TOML file with the crank speed and load over time
+    (docs/guide/transient.md); it is checked before any work.
+
+    \b
+    Examples:
+      powertrain transient examples/start.toml
+      powertrain transient examples/tip-in.toml --engine engines/default-nonlinear.toml
+      powertrain transient examples/start.toml --engine engines/default-modal-body.toml \\
+          --plot start.png --json start.json
+    """
+    check_outputs(out=out, csv=csv_file, json=json_file, plot=plot)
+    manoeuvre = read_manoeuvre(manoeuvre_file)
+    engine = engine_or_default(engine_file)
+    result = workflow.transient(manoeuvre, engine, angle_step_deg=angle_step, seat=seat)
+    prov = cli_provenance(engine_description(engine, engine.file))
+    chosen = [c.strip() for c in channels.split(",")] if channels else None
+    written = []
+    for path, write in ((out, result.to_hdf5), (csv_file, result.to_csv),
+                        (json_file, lambda p: write_json(p, result.to_json(), prov.to_dict())),
+                        (plot, lambda p: write_plot(lambda q: result.plot(
+                            path=q, channels=chosen, provenance=prov), p))):
+        if path:
+            write(path)
+            written.append(path)
+    if not quiet:
+        click.echo(result.to_text())
+    click.echo(f"solver time: {result.solver_seconds:.3f} s; "
+               + (f"wrote {', '.join(map(str, written))}" if written
+                  else "no file written (ask with --out, --csv, --json or --plot)"))

@@ -1,0 +1,64 @@
+"""The figure of a transient manoeuvre: crank speed and torque over time above the chosen
+channels' accelerations, each channel's peak marked."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from powertrain.errors import InputError
+from powertrain.plotting.style import (
+    LABEL_SIZE,
+    PRINT_WIDTH_IN,
+    TICK_SIZE,
+    TITLE_SIZE,
+    colour,
+    finish,
+    legend,
+    subplots,
+)
+
+
+def plot_transient(result, channels, path=None, ax=None, provenance=None):
+    """Speed [rpm] and engine and starter torque [N·m] in the top panel, below it one panel
+    per channel of ``channels`` (labels ``mount.direction``) with its acceleration [m/s²]
+    and the largest magnitude marked; returns the figure (``ax``: None, an Axes for the
+    top panel alone with no channel, a Figure or SubFigure)."""
+    missing = [c for c in channels if c not in result.channels]
+    if missing:
+        raise InputError(f"unknown channel {missing[0]!r} (one of: "
+                         f"{', '.join(result.channels)})", key="channels")
+    n = 1 + len(channels)
+    fig, axes, own = subplots(ax, n, 1, figsize=(PRINT_WIDTH_IN, 1.6 + 1.5 * n), sharex=True)
+    top = axes[0, 0]
+    t = result.time
+    top.plot(t, result.rpm, color=colour(0), label="speed [rpm]")
+    top.set_ylabel("speed [rpm]", fontsize=LABEL_SIZE)
+    twin = top.twinx()
+    for k, (name, values) in enumerate(result.torques.items()):
+        if np.any(values):
+            twin.plot(t, values, color=colour(k + 1), lw=0.8, label=f"{name} torque")
+    twin.set_ylabel("torque [N·m]", fontsize=LABEL_SIZE)
+    twin.tick_params(labelsize=TICK_SIZE)
+    for row, c in enumerate(channels, start=1):
+        a = axes[row, 0]
+        y = result.acceleration[:, result.channel(c)]
+        i = int(np.argmax(np.abs(y)))
+        a.plot(t, y, color=colour(row + 3), lw=0.7, label=c)
+        a.plot(t[i], y[i], "v" if y[i] < 0 else "^", color="k", ms=5)
+        a.annotate(f"{y[i]:.3g} m/s² at {t[i]:.3f} s", (t[i], y[i]), fontsize=TICK_SIZE,
+                   xytext=(4, 0), textcoords="offset points", va="center")
+        a.set_ylabel(f"{c}\n[m/s²]", fontsize=LABEL_SIZE)
+    for a in axes[:, 0]:
+        a.tick_params(labelsize=TICK_SIZE)
+        a.grid(True, lw=0.3)
+    axes[-1, 0].set_xlabel("time [s]", fontsize=LABEL_SIZE)
+    handles, labels = twin.get_legend_handles_labels()
+    legend(fig, axes, ax, extra=list(zip(handles, labels)))
+    return finish(fig, own, path, provenance,
+                  title=f"{result.name} — {result.engine}" if own else None) \
+        if own else _titled(fig, top, result, path)
+
+
+def _titled(fig, top, result, path):
+    top.set_title(result.name, fontsize=TITLE_SIZE)
+    return finish(fig, False, path)

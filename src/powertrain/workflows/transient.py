@@ -1,0 +1,106 @@
+"""A transient manoeuvre on an engine: file -> model -> time integration -> result.
+
+:func:`transient` is the public entry (``powertrain transient`` calls it): the manoeuvre
+file read and checked before any work (:mod:`powertrain.iotools.manoeuvre_file`), the
+engine's model integrated over it (:func:`powertrain.solvers.transient.simulate_transient`),
+then the per-channel peaks and, at a seat point of a modal body, the ISO 2631-1 weighted RMS
+and vibration dose value (:mod:`powertrain.analysis.comfort`).
+"""
+
+from __future__ import annotations
+
+import os
+import time
+
+import numpy as np
+
+from powertrain.analysis.comfort import (
+    AXIS_WEIGHTING,
+    vibration_dose_value,
+    weighted,
+    weighted_rms,
+)
+from powertrain.errors import InputError
+from powertrain.iotools.engine_file import engine_or_default
+from powertrain.iotools.manoeuvre_file import read_manoeuvre
+from powertrain.models.manoeuvre import Manoeuvre
+from powertrain.parallel import single_blas_thread
+from powertrain.results.transient import TransientResult
+from powertrain.solvers.transient import simulate_transient
+
+#: Default crank angle per integration step at the top speed [deg].
+ANGLE_STEP_DEG = 1.0
+
+
+def manoeuvre_or_file(manoeuvre) -> Manoeuvre:
+    """A :class:`Manoeuvre` as it is, or read from its file."""
+    if isinstance(manoeuvre, (str, os.PathLike)):
+        return read_manoeuvre(manoeuvre)
+    if not isinstance(manoeuvre, Manoeuvre):
+        raise InputError(f"expected a Manoeuvre or a manoeuvre file, got "
+                         f"{type(manoeuvre).__name__}", key="MANOEUVRE")
+    return manoeuvre
+
+
+def transient(manoeuvre, engine=None, *, angle_step_deg=ANGLE_STEP_DEG, seat=None,
+              system=None) -> TransientResult:
+    """Simulate a transient manoeuvre as the ``powertrain transient`` command does.
+
+    Parameters
+    ----------
+    manoeuvre : Manoeuvre, str or Path
+        The manoeuvre or its TOML file (:mod:`powertrain.iotools.manoeuvre_file`).
+    engine : Engine, str or Path, optional
+        Default: the shipped ``engines/default.toml``.
+    angle_step_deg : float
+        Crank angle per integration step at the top speed [deg] (0.01..10).
+    seat : str, optional
+        Body point whose ISO 2631-1 values are reported (default: a body point whose name
+        starts with ``seat``, if the chassis has one).
+    system : AssembledSystem, optional
+        The assembled model (default ``engine.assemble()``; a what-if passes its variant's).
+
+    Returns
+    -------
+    TransientResult
+        ``to_text()``, ``plot(ax=None)``, ``save(path)`` (``.csv``, ``.json``, ``.h5``,
+        ``.png``).
+
+    Raises
+    ------
+    InputError
+        A bad manoeuvre file, engine or option, before any work.
+    """
+    m = manoeuvre_or_file(manoeuvre)
+    engine = engine_or_default(engine)
+    t0 = time.process_time()
+    with single_blas_thread():
+        run = simulate_transient(engine, m, system=system, angle_step_deg=float(angle_step_deg))
+    labels = [f"{c}.{d}" for c, d in run.channels]
+    load = run.load
+    result = TransientResult(
+        m.name, m.file, engine.name, load.t, load.omega * 30.0 / np.pi,
+        {"engine": load.engine_torque, "starter": load.starter_torque,
+         "driveline": load.driveline_torque},
+        run.body, labels, run.displacement, run.velocity, run.acceleration, run.force,
+        run.networks, run.deflection, _seat(engine, run, labels, seat), run.method,
+        time.process_time() - t0, [m.notes] if m.notes else [])
+    return result
+
+
+def _seat(engine, run, labels, seat):
+    """ISO 2631-1 values at the seat point (None without one)."""
+    points = list(getattr(engine.chassis, "points", ()) or ())
+    if seat is None:
+        seat = next((p for p in points if p.startswith("seat")), None)
+        if seat is None:
+            return None
+    elif seat not in points:
+        raise InputError(f"no body point {seat!r} (the chassis has: "
+                         f"{', '.join(points) or 'none'})", key="--seat")
+    fs = 1.0 / (run.load.t[1] - run.load.t[0])
+    rms, vdv = {}, {}
+    for a, w in AXIS_WEIGHTING.items():
+        aw = weighted(run.acceleration[:, labels.index(f"{seat}.{a}")], fs, w)
+        rms[a], vdv[a] = weighted_rms(aw, fs), vibration_dose_value(aw, fs)
+    return {"point": seat, "rms": rms, "vdv": vdv, "weighting": dict(AXIS_WEIGHTING)}
