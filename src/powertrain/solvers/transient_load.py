@@ -23,7 +23,8 @@ gas and inertia torque about its cycle mean reaches the block as in the run-up.
 The gas load is tabulated over the crank angle (0.5°), the speed (25 rpm, clamped to the
 combustion model's range: below it the pressure of its lowest speed) and the IMEP scale
 (the load table's values; the mean-torque form uses :math:`s = T_d / T_{full}(\omega)` on
-a 0.1 grid), and read trilinearly. :math:`T_e` is the model's mean brake torque at
+a 0.1 grid), and read trilinearly; below :data:`FADE_RPM` it fades out linearly to none at
+rest. :math:`T_e` is the model's mean brake torque at
 :math:`(\omega, s)`; in the IMEP form :math:`T_d = T_e - J\alpha` when a gear is engaged.
 """
 
@@ -40,6 +41,10 @@ N_THETA = 1440
 RPM_STEP = 25.0
 #: IMEP scales of the table of a mean-torque manoeuvre.
 TORQUE_SCALES = np.linspace(0.0, 1.0, 11)
+#: Below this speed [rpm] the gas load fades out linearly to none at rest: a crank at rest
+#: holds its cylinders' gas torque inside the engine (it stops where the compression torques
+#: balance); the run-up's excitation holds from here up.
+FADE_RPM = 50.0
 #: Most distinct IMEP scales of a table (else a regular grid over their range).
 MAX_SCALES = 32
 RPM = UNITS["rpm"][1]
@@ -78,7 +83,7 @@ def transient_load(engine, manoeuvre, t) -> TransientLoad:
         driveline = (engine_torque - manoeuvre.crank_inertia * alpha
                      if manoeuvre.gear_ratio > 0 else np.zeros_like(t))
     J = manoeuvre.crank_inertia
-    F = table.gas(theta, spin, scale)
+    F = table.gas(theta, spin, scale) * np.clip(spin / (FADE_RPM * RPM), 0.0, 1.0)[:, None]
     th = np.mod(theta, 4 * np.pi) * (N_THETA / (4 * np.pi))
     F += (omega ** 2)[:, None] * _periodic(table.inertia, th)
     F += alpha[:, None] * _periodic(table.acceleration, th)
