@@ -53,6 +53,8 @@ MAKERS = {
     "DiagnosisResult": lambda e: pt.diagnose(MEASURED, e, effects=["mount_stiffness"],
                                              pairs=False, progress=False),
     "SynthCase": lambda e: pt.synth([], 0),
+    "TransientResult": lambda e: pt.transient(str(EXAMPLES / "start.toml"), e,
+                                              angle_step_deg=5.0),
 }
 
 #: One panel chosen, for the grid figures given one Axes (keyword arguments of ``plot``).

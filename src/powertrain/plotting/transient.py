@@ -54,11 +54,7 @@ def plot_transient(result, channels, path=None, ax=None, provenance=None):
     axes[-1, 0].set_xlabel("time [s]", fontsize=LABEL_SIZE)
     handles, labels = twin.get_legend_handles_labels()
     legend(fig, axes, ax, extra=list(zip(handles, labels)))
+    if not own:
+        top.set_title(result.name, fontsize=TITLE_SIZE)
     return finish(fig, own, path, provenance,
-                  title=f"{result.name} — {result.engine}" if own else None) \
-        if own else _titled(fig, top, result, path)
-
-
-def _titled(fig, top, result, path):
-    top.set_title(result.name, fontsize=TITLE_SIZE)
-    return finish(fig, False, path)
+                  title=f"{result.name} — {result.engine}" if own else None)

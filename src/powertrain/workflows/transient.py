@@ -27,6 +27,7 @@ from powertrain.models.manoeuvre import Manoeuvre
 from powertrain.parallel import single_blas_thread
 from powertrain.results.transient import TransientResult
 from powertrain.solvers.transient import simulate_transient
+from powertrain.workflows.arguments import number
 
 #: Default crank angle per integration step at the top speed [deg].
 ANGLE_STEP_DEG = 1.0
@@ -71,11 +72,14 @@ def transient(manoeuvre, engine=None, *, angle_step_deg=ANGLE_STEP_DEG, seat=Non
     InputError
         A bad manoeuvre file, engine or option, before any work.
     """
+    step = number(angle_step_deg, "--angle-step", unit="deg", minimum=0.01, maximum=10.0)
+    if seat is not None and not isinstance(seat, str):
+        raise InputError(f"expected a body point name, got {type(seat).__name__}", key="--seat")
     m = manoeuvre_or_file(manoeuvre)
     engine = engine_or_default(engine)
     t0 = time.process_time()
     with single_blas_thread():
-        run = simulate_transient(engine, m, system=system, angle_step_deg=float(angle_step_deg))
+        run = simulate_transient(engine, m, system=system, angle_step_deg=step)
     labels = [f"{c}.{d}" for c, d in run.channels]
     load = run.load
     result = TransientResult(
