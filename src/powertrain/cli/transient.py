@@ -23,6 +23,9 @@ from powertrain.workflows import transient as workflow
               help="Engine file (default: the shipped engines/default.toml).")
 @click.option("--angle-step", type=float, default=workflow.ANGLE_STEP_DEG, show_default=True,
               help="Crank angle per integration step at the top speed [deg].")
+@click.option("--speed-from", type=click.Path(dir_okay=False),
+              help="Raw recording (CSV, HDF5, UFF, MDF4) whose rpm channel or tacho drives "
+                   "the crank instead of the file's speed table.")
 @click.option("--seat", help="Body point for the ISO 2631-1 values (default: a body point "
                              "named seat...).")
 @click.option("--channels", help="Channels of the figure, comma separated (e.g. "
@@ -35,8 +38,8 @@ from powertrain.workflows import transient as workflow
 @click.option("--plot", type=click.Path(dir_okay=False),
               help="Speed and torque above the channels' accelerations (PNG).")
 @click.option("--quiet", is_flag=True, help="No table.")
-def transient(manoeuvre_file, engine_file, angle_step, seat, channels, out, csv_file,
-              json_file, plot, quiet):
+def transient(manoeuvre_file, engine_file, angle_step, speed_from, seat, channels, out,
+              csv_file, json_file, plot, quiet):
     """Transient manoeuvre: time histories of body, mounts and seat over a start, stop,
     tip-in or back-out.
 
@@ -53,7 +56,8 @@ def transient(manoeuvre_file, engine_file, angle_step, seat, channels, out, csv_
     check_outputs(out=out, csv=csv_file, json=json_file, plot=plot)
     manoeuvre = read_manoeuvre(manoeuvre_file)
     engine = engine_or_default(engine_file)
-    result = workflow.transient(manoeuvre, engine, angle_step_deg=angle_step, seat=seat)
+    result = workflow.transient(manoeuvre, engine, angle_step_deg=angle_step, seat=seat,
+                                speed_from=speed_from)
     prov = cli_provenance(engine_description(engine, engine.file))
     chosen = [c.strip() for c in channels.split(",")] if channels else None
     written = []

@@ -24,7 +24,9 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from powertrain.analysis.channel import Channel
 from powertrain.analysis.text_table import format_table
+from powertrain.models.recording import RawChannel, RawRecording
 from powertrain.outputs import atomic_path, atomic_write, json_text
 from powertrain.plotting.style import target_and_path
 from powertrain.plotting.transient import plot_transient
@@ -91,6 +93,19 @@ class TransientResult(Result):
                 "peak_force": np.max(np.abs(self.force), axis=0),
                 "max_acceleration": a[i, np.arange(a.shape[1])],
                 "time_of_max_acceleration": self.time[i]}
+
+    def recording(self) -> RawRecording:
+        """The engine-side mount-point accelerations [m/s²] and the crank speed [rpm] as raw
+        time data (labelled SYNTHETIC), for the raw writers and readers."""
+        chans = []
+        for k, label in enumerate(self.channels):
+            mount, _, d = label.rpartition(".")
+            if "/" not in mount and d in "xyz" and k < len(self.networks):
+                chans.append(RawChannel(Channel(mount, "active", d).label, mount, "active", d,
+                                        "acceleration", self.acceleration[:, k], "m/s^2"))
+        note = f"SYNTHETIC: simulated transient '{self.name}' ({self.method})"
+        return RawRecording(self.time, chans, self.rpm, None, "simulated transient",
+                            [note]).validate()
 
     def to_dict(self) -> dict:
         """The JSON document (module docstring)."""

@@ -20,9 +20,11 @@ from powertrain.analysis.comfort import (
     weighted,
     weighted_rms,
 )
+from powertrain.analysis.speed import tacho_edges
 from powertrain.errors import InputError
 from powertrain.iotools.engine_file import engine_or_default
-from powertrain.iotools.manoeuvre_file import read_manoeuvre
+from powertrain.iotools.manoeuvre_file import MAX_RPM, read_manoeuvre
+from powertrain.iotools.raw import read_raw
 from powertrain.models.manoeuvre import Manoeuvre
 from powertrain.parallel import single_blas_thread
 from powertrain.results.transient import TransientResult
@@ -31,6 +33,9 @@ from powertrain.workflows.arguments import number
 
 #: Default crank angle per integration step at the top speed [deg].
 ANGLE_STEP_DEG = 1.0
+#: Most rows of a speed table taken from a recording (block means of its samples).
+SPEED_ROWS = 2000
+_RPM = np.pi / 30.0
 
 
 def manoeuvre_or_file(manoeuvre) -> Manoeuvre:
@@ -43,8 +48,41 @@ def manoeuvre_or_file(manoeuvre) -> Manoeuvre:
     return manoeuvre
 
 
+def speed_from_recording(manoeuvre, path) -> Manoeuvre:
+    """``manoeuvre`` driven by the crank speed recorded in the raw file ``path``
+    (:func:`~powertrain.iotools.raw.read_raw`): its rpm channel, else its once-per-revolution
+    tacho (speed between successive rising edges), from the file's first sample, as block
+    means on at most :data:`SPEED_ROWS` rows, cut where the load table ends; negative speeds
+    are cut to 0 unless the manoeuvre allows a reversal."""
+    rec = read_raw(path)
+    t = rec.time - rec.time[0]
+    if rec.rpm is not None:
+        rpm = np.asarray(rec.rpm, float)
+    elif rec.tacho is not None:
+        edges = tacho_edges(t, rec.tacho, file=str(path), key="tacho")
+        rpm = np.interp(t, 0.5 * (edges[1:] + edges[:-1]), 60.0 / np.diff(edges))
+    else:
+        raise InputError("no rpm or tacho channel to take the speed from", file=str(path),
+                         key="rpm")
+    n = int(np.count_nonzero(t <= manoeuvre.load_time[-1]))
+    k = max(1, -(-n // SPEED_ROWS))
+    rows = n // k
+    if rows < 2:
+        raise InputError("fewer than two samples within the manoeuvre's load table",
+                         file=str(path), key="time")
+    tt = np.r_[0.0, t[:rows * k].reshape(rows, k).mean(axis=1)[1:], t[rows * k - 1]]
+    rr = np.r_[rpm[0], rpm[:rows * k].reshape(rows, k).mean(axis=1)[1:], rpm[rows * k - 1]]
+    if not manoeuvre.reversal:
+        rr = np.maximum(rr, 0.0)
+    if not np.all(np.isfinite(rr)) or np.max(np.abs(rr)) > MAX_RPM:
+        raise InputError(f"speed not finite or above {MAX_RPM:g} rpm", file=str(path),
+                         key="rpm")
+    keep = np.r_[True, np.diff(tt) > 0]
+    return manoeuvre.with_speed(tt[keep], rr[keep] * _RPM)
+
+
 def transient(manoeuvre, engine=None, *, angle_step_deg=ANGLE_STEP_DEG, seat=None,
-              system=None) -> TransientResult:
+              system=None, speed_from=None) -> TransientResult:
     """Simulate a transient manoeuvre as the ``powertrain transient`` command does.
 
     Parameters
@@ -60,6 +98,9 @@ def transient(manoeuvre, engine=None, *, angle_step_deg=ANGLE_STEP_DEG, seat=Non
         starts with ``seat``, if the chassis has one).
     system : AssembledSystem, optional
         The assembled model (default ``engine.assemble()``; a what-if passes its variant's).
+    speed_from : str or Path, optional
+        Raw recording whose crank speed replaces the manoeuvre's speed table
+        (:func:`speed_from_recording`).
 
     Returns
     -------
@@ -76,6 +117,8 @@ def transient(manoeuvre, engine=None, *, angle_step_deg=ANGLE_STEP_DEG, seat=Non
     if seat is not None and not isinstance(seat, str):
         raise InputError(f"expected a body point name, got {type(seat).__name__}", key="--seat")
     m = manoeuvre_or_file(manoeuvre)
+    if speed_from is not None:
+        m = speed_from_recording(m, speed_from)
     engine = engine_or_default(engine)
     t0 = time.process_time()
     with single_blas_thread():
