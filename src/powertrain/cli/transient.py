@@ -30,6 +30,9 @@ from powertrain.workflows import transient as workflow
                              "named seat...).")
 @click.option("--channels", help="Channels of the figure, comma separated (e.g. "
                                  "left.z,right.z; default: the seat's, else each mount's z).")
+@click.option("--quantity", type=click.Choice(["acceleration", "displacement", "force"]),
+              default="acceleration", show_default=True, help="What the figure's channel "
+                                                              "panels show.")
 @click.option("--out", type=click.Path(dir_okay=False), help="Write the HDF5 time histories.")
 @click.option("--csv", "csv_file", type=click.Path(dir_okay=False),
               help="Write the time histories as CSV, one row per step.")
@@ -38,8 +41,8 @@ from powertrain.workflows import transient as workflow
 @click.option("--plot", type=click.Path(dir_okay=False),
               help="Speed and torque above the channels' accelerations (PNG).")
 @click.option("--quiet", is_flag=True, help="No table.")
-def transient(manoeuvre_file, engine_file, angle_step, speed_from, seat, channels, out,
-              csv_file, json_file, plot, quiet):
+def transient(manoeuvre_file, engine_file, angle_step, speed_from, seat, channels, quantity,
+              out, csv_file, json_file, plot, quiet):
     """Transient manoeuvre: time histories of body, mounts and seat over a start, stop,
     tip-in or back-out.
 
@@ -64,7 +67,7 @@ def transient(manoeuvre_file, engine_file, angle_step, speed_from, seat, channel
     for path, write in ((out, result.to_hdf5), (csv_file, result.to_csv),
                         (json_file, lambda p: write_json(p, result.to_json(), prov.to_dict())),
                         (plot, lambda p: write_plot(lambda q: result.plot(
-                            path=q, channels=chosen, provenance=prov), p))):
+                            path=q, channels=chosen, quantity=quantity, provenance=prov), p))):
         if path:
             write(path)
             written.append(path)

@@ -17,12 +17,22 @@ from powertrain.plotting.style import (
     subplots,
 )
 
+#: Quantities a channel panel shows: attribute, scale to the unit shown, unit.
+QUANTITIES = {"acceleration": ("acceleration", 1.0, "m/s²"),
+              "displacement": ("displacement", 1e3, "mm"),
+              "force": ("force", 1.0, "N")}
 
-def plot_transient(result, channels, path=None, ax=None, provenance=None):
-    """Speed [rpm] and engine and starter torque [N·m] in the top panel, below it one panel
-    per channel of ``channels`` (labels ``mount.direction``) with its acceleration [m/s²]
-    and the largest magnitude marked; returns the figure (``ax``: None, an Axes for the
-    top panel alone with no channel, a Figure or SubFigure)."""
+
+def plot_transient(result, channels, path=None, ax=None, provenance=None,
+                   quantity="acceleration"):
+    """Speed [rpm] and the torques [N·m] in the top panel, below it one panel per channel of
+    ``channels`` (labels ``mount.direction``) with its ``quantity`` (:data:`QUANTITIES`) and
+    the largest magnitude marked; returns the figure (``ax``: None, a Figure or SubFigure;
+    one Axes asks for a Figure)."""
+    if quantity not in QUANTITIES:
+        raise InputError(f"unknown quantity {quantity!r} (one of: {', '.join(QUANTITIES)})",
+                         key="--quantity")
+    attr, scale, unit = QUANTITIES[quantity]
     missing = [c for c in channels if c not in result.channels]
     if missing:
         raise InputError(f"unknown channel {missing[0]!r} (one of: "
@@ -36,18 +46,19 @@ def plot_transient(result, channels, path=None, ax=None, provenance=None):
     twin = top.twinx()
     for k, (name, values) in enumerate(result.torques.items()):
         if np.any(values):
-            twin.plot(t, values, color=colour(k + 1), lw=0.8, label=f"{name} torque")
+            twin.plot(t, values, color=colour(k + 1), lw=0.8, ls=("-", "--", ":")[k % 3],
+                      label=f"{name} torque")
     twin.set_ylabel("torque [N·m]", fontsize=LABEL_SIZE)
     twin.tick_params(labelsize=TICK_SIZE)
     for row, c in enumerate(channels, start=1):
         a = axes[row, 0]
-        y = result.acceleration[:, result.channel(c)]
+        y = getattr(result, attr)[:, result.channel(c)] * scale
         i = int(np.argmax(np.abs(y)))
         a.plot(t, y, color=colour(row + 3), lw=0.7, label=c)
         a.plot(t[i], y[i], "v" if y[i] < 0 else "^", color="k", ms=5)
-        a.annotate(f"{y[i]:.3g} m/s² at {t[i]:.3f} s", (t[i], y[i]), fontsize=TICK_SIZE,
+        a.annotate(f"{y[i]:.3g} {unit} at {t[i]:.3f} s", (t[i], y[i]), fontsize=TICK_SIZE,
                    xytext=(4, 0), textcoords="offset points", va="center")
-        a.set_ylabel(f"{c}\n[m/s²]", fontsize=LABEL_SIZE)
+        a.set_ylabel(f"{c}\n[{unit}]", fontsize=LABEL_SIZE)
     for a in axes[:, 0]:
         a.tick_params(labelsize=TICK_SIZE)
         a.grid(True, lw=0.3)

@@ -172,13 +172,15 @@ class TransientResult(Result):
         return {".csv": self.to_csv, ".json": self.to_json, ".h5": self.to_hdf5,
                 ".hdf5": self.to_hdf5, **super().writers()}
 
-    def plot(self, ax=None, *, path=None, channels=None, provenance=None):
-        """Crank speed and torque over time above the acceleration of ``channels``
-        (default: the seat's, else every mount's z), peaks marked; returns the figure
+    def plot(self, ax=None, *, path=None, channels=None, quantity="acceleration",
+             provenance=None):
+        """Crank speed and torque over time above the ``quantity`` (``acceleration``,
+        ``displacement``, ``force``) of ``channels`` (default: the seat's, else every mount's
+        z), peaks marked; returns the figure
         (:func:`powertrain.plotting.transient.plot_transient`)."""
         ax, path = target_and_path(ax, path)
         return plot_transient(self, channels or self.default_channels(), path, ax=ax,
-                              provenance=provenance)
+                              provenance=provenance, quantity=quantity)
 
     def default_channels(self) -> list:
         """The seat's three axes, else the engine-side z of every mount."""
