@@ -19,8 +19,11 @@ difference between the curve and that tangent,
 
 so that over the stretch the static force is the curve's tangent at :math:`\delta_c`
 (:math:`F(\delta_c) - F(\delta_0) + k_c\,\mathbf r^T(\mathbf x - \mathbf x_c)`): the body
-moves along the curves (small rotations), the dynamic network, the amplitude law and
-friction on top. Mount forces are changes from the zero-torque static point.
+moves along the curves (small rotations), the dynamic network and friction on top. The
+network's tangent :math:`k_c` is its static stiffness times its stiffness scale (static
+factor and amplitude law), so the curve sets the force at every stretch's start and the
+amplitude law acts on the motion within a stretch and on the dampers. Mount forces are
+changes from the zero-torque static point.
 
 **Start.** At rest when the manoeuvre starts at standstill; else from the periodic steady
 state at its first speed and load (the equivalent-linear harmonic fixed point, port laws
@@ -157,7 +160,8 @@ def _run(system, integrator, ports, curves, F, start, every):
     laws_map = integrator.laws.force_map
     bounds = list(range(0, n_t - 1, every)) + [n_t - 1]
     for lo, hi in zip(bounds[:-1], bounds[1:]):
-        factors, c = (None, None) if curves is None else curves.at(x)
+        factors, c = (None, None) if curves is None else curves.at(
+            x, integrator.scaling, ports.network_amplitudes(amplitudes))
         Fs = F[lo:hi + 1] if c is None else F[lo:hi + 1] - c @ system.port_rows
         (Xs, Vs, As, Zs), (Fk, Fd, off) = integrator.run(Fs, (x, v, a), amplitudes, state,
                                                         factors)
@@ -226,11 +230,13 @@ class _Curves:
         """Static factor of every network at the state ``x``."""
         return self.support.factors(self.d0 + self.rows @ x)
 
-    def at(self, x):
-        """Static factors and the curves' load ``c`` (n_net,) [N] at the state ``x``."""
+    def at(self, x, scaling, amplitudes):
+        """Static factors and the curves' load ``c`` (n_net,) [N] at the state ``x``, the
+        networks' tangent stiffness their static stiffness times their stiffness scale at
+        the static factors and the networks' ``amplitudes`` [m] (``scaling.scales``)."""
         u = self.rows @ x
         d = self.d0 + u
         factors = self.support.factors(d)
-        k = factors * self.support.stiffness
+        k = scaling.scales(amplitudes, factors)[:, 0] * self.support.stiffness
         c = np.where(self.has, self.support.forces(d) - self.f0 - k * u, 0.0)
         return factors, c
