@@ -215,28 +215,51 @@ def _cycle_load(engine, manoeuvre, theta):
     return out
 
 
+#: Samples of each static curve's force and tangent over its points' range and as much
+#: again on either side (the curve is straight beyond its points), read linearly: the
+#: force's interpolation error is below 1e-4 N for the shipped curves.
+CURVE_SAMPLES = 20001
+
+
 class _Curves:
-    """The networks' static curves about the zero-torque static point (module docstring)."""
+    """The networks' static curves about the zero-torque static point (module docstring),
+    each sampled once (:data:`CURVE_SAMPLES`)."""
 
     def __init__(self, engine, system):
-        self.support = StaticSupport.of(engine)
+        support = StaticSupport.of(engine)
+        self.stiffness = support.stiffness
         rpm = engine.speed_range_rpm()[0]
-        self.d0 = operating_point(engine, rpm, self.support, mean_torque=0.0).deflection.ravel()
-        self.f0 = self.support.forces(self.d0)
+        self.d0 = operating_point(engine, rpm, support, mean_torque=0.0).deflection.ravel()
         self.rows = system.port_rows
-        self.has = np.array([c is not None for c in self.support.curves])
+        self.has = np.array([c is not None for c in support.curves])
+        self.tables = [None if c is None else _sampled(c) for c in support.curves]
+        self.f0 = self._forces(self.d0)
+
+    def _forces(self, d):
+        return np.array([0.0 if t is None else np.interp(x, t[0], t[1])
+                         for t, x in zip(self.tables, d)])
 
     def factors(self, x):
-        """Static factor of every network at the state ``x``."""
-        return self.support.factors(self.d0 + self.rows @ x)
+        """Static factor of every network at the state ``x`` (1 without a curve)."""
+        d = self.d0 + self.rows @ x
+        return np.array([1.0 if t is None else np.interp(v, t[0], t[2]) / t[3]
+                         for t, v in zip(self.tables, d)])
 
     def at(self, x, scaling, amplitudes):
         """Static factors and the curves' load ``c`` (n_net,) [N] at the state ``x``, the
         networks' tangent stiffness their static stiffness times their stiffness scale at
         the static factors and the networks' ``amplitudes`` [m] (``scaling.scales``)."""
         u = self.rows @ x
-        d = self.d0 + u
-        factors = self.support.factors(d)
-        k = scaling.scales(amplitudes, factors)[:, 0] * self.support.stiffness
-        c = np.where(self.has, self.support.forces(d) - self.f0 - k * u, 0.0)
+        factors = self.factors(x)
+        k = scaling.scales(amplitudes, factors)[:, 0] * self.stiffness
+        c = np.where(self.has, self._forces(self.d0 + u) - self.f0 - k * u, 0.0)
         return factors, c
+
+
+def _sampled(curve):
+    """``(deflection, force, tangent, tangent at the reference)`` of a static curve."""
+    lo, hi = float(curve.deflection[0]), float(curve.deflection[-1])
+    grid = np.linspace(2 * lo - hi, 2 * hi - lo, CURVE_SAMPLES)
+    return (grid, np.asarray(curve.force_at(grid), float),
+            np.asarray(curve.tangent_at(grid), float),
+            float(curve.tangent_at(curve.reference_deflection)))
