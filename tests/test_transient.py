@@ -222,3 +222,15 @@ def test_solve_ivp_on_the_laws_written_out_agrees(tmp_path):
     assert np.max(np.abs(u)) > 3e-3                                  # millimetres on the curve
     assert np.max(np.abs(run.deflection[:, net] - u)) <= IVP_REL * np.max(np.abs(u))
     assert np.max(np.abs(run.force[:, ch] - force)) <= IVP_REL * np.max(np.abs(force))
+
+
+def test_whatif_over_a_manoeuvre_ranks_by_the_peak_deflection(default_engine, tmp_path):
+    """Without a seat the variants are ranked by the peak mount deflection: softer mounts
+    deflect more under the same start, so they rank last."""
+    (tmp_path / "m.toml").write_text(GOOD, encoding="utf-8")
+    rank = pt.whatif(default_engine, scale="*.*.dynamic=0.5", manoeuvre=tmp_path / "m.toml")
+    defl, _ = rank.peak_deflection()
+    assert rank.names == ["baseline", "command line"] and defl[1] > defl[0]
+    assert rank.to_dict()["ranking"] == ["baseline", "command line"]
+    assert rank.to_dict()["ranked_by"] == "peak_mount_deflection"
+    assert "ranked by peak mount deflection" in rank.to_text()

@@ -69,3 +69,22 @@ def plot_transient(result, channels, path=None, ax=None, provenance=None,
         top.set_title(result.name, fontsize=TITLE_SIZE)
     return finish(fig, own, path, provenance,
                   title=f"{result.name} — {result.engine}" if own else None)
+
+
+def plot_ranking(ranking, path=None, ax=None, provenance=None):
+    """Bars per run: the peak seat acceleration [m/s²] (with a seat) and the peak mount
+    deflection [mm]; returns the figure."""
+    seat = ranking.peak_seat()
+    defl = ranking.peak_deflection()[0] * 1e3
+    panels = [(defl, "peak mount deflection [mm]")]
+    if seat is not None:
+        panels.insert(0, (seat, "peak seat acceleration [m/s²]"))
+    fig, axes, own = subplots(ax, len(panels), 1, figsize=(PRINT_WIDTH_IN, 1.2 + 1.8 * len(panels)))
+    x = np.arange(len(ranking.names))
+    for a, (values, label) in zip(axes[:, 0], panels):
+        a.bar(x, values, color=[colour(k) for k in x])
+        a.set_ylabel(label, fontsize=LABEL_SIZE)
+        a.set_xticks(x)
+        a.set_xticklabels(ranking.names, fontsize=TICK_SIZE, rotation=15)
+        a.tick_params(labelsize=TICK_SIZE)
+    return finish(fig, own, path, provenance, title=f"what-if over {ranking.manoeuvre}")

@@ -26,10 +26,11 @@ import numpy as np
 
 from powertrain.analysis.channel import Channel
 from powertrain.analysis.text_table import format_table
+from powertrain.errors import InputError
 from powertrain.models.recording import RawChannel, RawRecording
 from powertrain.outputs import atomic_path, atomic_write, json_text
 from powertrain.plotting.style import target_and_path
-from powertrain.plotting.transient import plot_transient
+from powertrain.plotting.transient import plot_ranking, plot_transient
 from powertrain.results.base import Result
 from powertrain.units import from_si
 
@@ -206,3 +207,88 @@ class TransientResult(Result):
                      + " m/s^2; VDV " + ", ".join(f"{a} {s['vdv'][a]:.4f}" for a in "xyz")
                      + " m/s^1.75")
         return text
+
+
+@dataclass(frozen=True)
+class TransientRanking(Result):
+    """Baseline and variants of the mount system over one manoeuvre (``powertrain whatif
+    --manoeuvre``), ranked by the peak acceleration at the seat (the largest magnitude of
+    its three axes) where the chassis has a seat point, else by the peak mount deflection.
+
+    Attributes
+    ----------
+    manoeuvre : str
+    names : list of str
+        ``baseline`` first, then the variants.
+    runs : list of TransientResult
+    """
+
+    manoeuvre: str
+    names: list
+    runs: list = field(repr=False)
+
+    def peak_seat(self):
+        """Peak seat acceleration [m/s²] per run, or None without a seat."""
+        if self.runs[0].seat is None:
+            return None
+        return np.array([max(float(np.max(np.abs(r.acceleration[:, r.channel(c)])))
+                             for c in r.default_channels()) for r in self.runs])
+
+    def peak_deflection(self):
+        """Largest mount deflection magnitude [m] per run and the mount direction."""
+        k = [int(np.argmax(np.max(np.abs(r.deflection), axis=0))) for r in self.runs]
+        return (np.array([float(np.max(np.abs(r.deflection[:, j])))
+                          for r, j in zip(self.runs, k)]),
+                [r.networks[j] for r, j in zip(self.runs, k)])
+
+    def ranking(self) -> list:
+        """Indices of the runs, best (smallest) first."""
+        seat = self.peak_seat()
+        key = seat if seat is not None else self.peak_deflection()[0]
+        return [int(i) for i in np.argsort(key, kind="stable")]
+
+    def to_dict(self) -> dict:
+        seat = self.peak_seat()
+        defl, where = self.peak_deflection()
+        return {"manoeuvre": self.manoeuvre, "ranked_by": "peak_seat_acceleration"
+                if seat is not None else "peak_mount_deflection",
+                "ranking": [self.names[i] for i in self.ranking()],
+                "runs": {n: {"peak_seat_acceleration_m_per_s2":
+                             None if seat is None else float(seat[k]),
+                             "peak_mount_deflection_mm": float(from_si(defl[k], "mm")),
+                             "peak_mount_deflection_at": where[k]}
+                         for k, n in enumerate(self.names)}}
+
+    def to_json(self, path=None) -> str:
+        """JSON text of :meth:`to_dict`; written atomically to ``path`` if given."""
+        return json_text(self.to_dict(), path)
+
+    def writers(self) -> dict:
+        """``.json``, ``.png``."""
+        return {".json": self.to_json, **super().writers()}
+
+    def target_fit(self, key):
+        raise InputError("a retune target's files come with a run-up what-if, not with "
+                         "--manoeuvre", key=key)
+
+    def plot(self, ax=None, *, path=None, provenance=None, view=None):
+        """Peak seat acceleration (if any) and peak mount deflection per run, bars
+        (:func:`powertrain.plotting.transient.plot_ranking`)."""
+        ax, path = target_and_path(ax, path)
+        return plot_ranking(self, path, ax=ax, provenance=provenance)
+
+    def to_text(self, written=()) -> str:
+        seat = self.peak_seat()
+        defl, where = self.peak_deflection()
+        rows = [[rank + 1, self.names[k], "-" if seat is None else f"{seat[k]:.4g}",
+                 "-" if seat is None else f"{100 * (seat[k] / seat[0] - 1):+.1f}",
+                 float(from_si(defl[k], "mm")), where[k],
+                 f"{100 * (defl[k] / defl[0] - 1):+.1f}"]
+                for rank, k in enumerate(self.ranking())]
+        head = (f"what-if over '{self.manoeuvre}': ranked by "
+                + ("peak seat acceleration" if seat is not None else "peak mount deflection"))
+        text = head + "\n" + format_table(
+            ["rank", "run", "seat peak [m/s^2]", "vs base [%]", "max deflection [mm]",
+             "at", "vs base [%]"], rows)
+        files = [str(w) for w in written if w]
+        return text + (f"\nwrote {', '.join(files)}" if files else "")
