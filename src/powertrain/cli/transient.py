@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import json
+
 import click
 
 from powertrain.cli.common import (
@@ -12,8 +14,10 @@ from powertrain.cli.common import (
     write_plot,
 )
 from powertrain.cli.group import main
+from powertrain.errors import InputError
 from powertrain.iotools.engine_file import engine_or_default
 from powertrain.iotools.manoeuvre_file import read_manoeuvre
+from powertrain.iotools.raw_hdf5 import write_raw_hdf5
 from powertrain.workflows import transient as workflow
 
 
@@ -40,9 +44,18 @@ from powertrain.workflows import transient as workflow
               help="Write the peaks and the seat's values as JSON.")
 @click.option("--plot", type=click.Path(dir_okay=False),
               help="Speed and torque above the channels' accelerations (PNG).")
+@click.option("--raw", "raw_out", type=click.Path(dir_okay=False),
+              help="Write the engine-side accelerations and the crank speed as raw time data "
+                   "(raw HDF5 layout, labelled SYNTHETIC), e.g. to try --compare.")
+@click.option("--compare", "raw_file", type=click.Path(dir_okay=False),
+              help="A recording of the manoeuvre (raw CSV, HDF5, UFF, MDF4): aligned on its "
+                   "crank speed, every engine-side acceleration channel compared (peaks, RMS "
+                   "of the difference); in --json under 'compare'.")
+@click.option("--compare-plot", type=click.Path(dir_okay=False),
+              help="With --compare: measured and simulated accelerations overlaid (PNG).")
 @click.option("--quiet", is_flag=True, help="No table.")
 def transient(manoeuvre_file, engine_file, angle_step, speed_from, seat, channels, quantity,
-              out, csv_file, json_file, plot, quiet):
+              out, csv_file, json_file, plot, raw_out, raw_file, compare_plot, quiet):
     """Transient manoeuvre: time histories of body, mounts and seat over a start, stop,
     tip-in or back-out.
 
@@ -55,24 +68,46 @@ def transient(manoeuvre_file, engine_file, angle_step, speed_from, seat, channel
       powertrain transient examples/tip-in.toml --engine engines/default-nonlinear.toml
       powertrain transient examples/start.toml --engine engines/default-modal-body.toml \\
           --plot start.png --json start.json
+      powertrain transient examples/start.toml --compare start-raw.h5 --compare-plot o.png
     """
-    check_outputs(out=out, csv=csv_file, json=json_file, plot=plot)
+    files = dict(out=out, csv=csv_file, json=json_file, plot=plot, raw=raw_out,
+                 compare_plot=compare_plot)
+    check_outputs(**files)
+    if compare_plot and not raw_file:
+        raise InputError("--compare-plot needs --compare RAW", key="--compare-plot")
     manoeuvre = read_manoeuvre(manoeuvre_file)
     engine = engine_or_default(engine_file)
     result = workflow.transient(manoeuvre, engine, angle_step_deg=angle_step, seat=seat,
                                 speed_from=speed_from)
-    prov = cli_provenance(engine_description(engine, engine.file))
-    chosen = [c.strip() for c in channels.split(",")] if channels else None
-    written = []
-    for path, write in ((out, result.to_hdf5), (csv_file, result.to_csv),
-                        (json_file, lambda p: write_json(p, result.to_json(), prov.to_dict())),
-                        (plot, lambda p: write_plot(lambda q: result.plot(
-                            path=q, channels=chosen, quantity=quantity, provenance=prov), p))):
-        if path:
-            write(path)
-            written.append(path)
+    comparison = workflow.compare_transient(result, raw_file) if raw_file else None
+    written = _write(result, comparison, files, cli_provenance(engine_description(
+        engine, engine.file)), [c.strip() for c in channels.split(",")] if channels else None,
+        quantity)
     if not quiet:
         click.echo(result.to_text())
+    if comparison is not None:
+        click.echo(comparison.to_text())
     click.echo(f"solver time: {result.solver_seconds:.3f} s; "
                + (f"wrote {', '.join(map(str, written))}" if written
                   else "no file written (ask with --out, --csv, --json or --plot)"))
+
+
+def _write(result, comparison, files, prov, channels, quantity) -> list:
+    """The files asked for, each atomically; returns their paths."""
+    doc = result.to_dict()
+    if comparison is not None:
+        doc["compare"] = comparison.to_dict()
+    writers = {"out": result.to_hdf5, "csv": result.to_csv,
+               "json": lambda p: write_json(p, json.dumps(doc), prov.to_dict()),
+               "plot": lambda p: write_plot(lambda q: result.plot(
+                   path=q, channels=channels, quantity=quantity, provenance=prov), p),
+               "raw": lambda p: write_raw_hdf5(p, result.recording(), synthetic=True,
+                                               description=result.recording().comments[0]),
+               "compare_plot": lambda p: write_plot(lambda q: comparison.plot(
+                   path=q, provenance=prov), p)}
+    written = []
+    for key, path in files.items():
+        if path:
+            writers[key](path)
+            written.append(path)
+    return written

@@ -88,3 +88,23 @@ def plot_ranking(ranking, path=None, ax=None, provenance=None):
         a.set_xticklabels(ranking.names, fontsize=TICK_SIZE, rotation=15)
         a.tick_params(labelsize=TICK_SIZE)
     return finish(fig, own, path, provenance, title=f"what-if over {ranking.manoeuvre}")
+
+
+def plot_overlay(comparison, path=None, ax=None, provenance=None):
+    """Measured and simulated acceleration [m/s²] over time, one panel per channel;
+    returns the figure."""
+    n = len(comparison.channels)
+    fig, axes, own = subplots(ax, n, 1, figsize=(PRINT_WIDTH_IN, 1.2 + 1.4 * n), sharex=True)
+    t = comparison.time
+    for j, (a, c) in enumerate(zip(axes[:, 0], comparison.channels)):
+        a.plot(t, comparison.measured[:, j], color=colour(0), lw=0.7,
+               label="measured" if j == 0 else None)
+        a.plot(t, comparison.simulated[:, j], color=colour(1), lw=0.7, ls="--",
+               label="simulated" if j == 0 else None)
+        a.set_ylabel(f"{c}\n[m/s²]", fontsize=LABEL_SIZE)
+        a.tick_params(labelsize=TICK_SIZE)
+        a.grid(True, lw=0.3)
+    axes[-1, 0].set_xlabel("time [s] (simulation)", fontsize=LABEL_SIZE)
+    legend(fig, axes, ax)
+    return finish(fig, own, path, provenance,
+                  title=f"{comparison.name} — simulated vs {comparison.raw}")

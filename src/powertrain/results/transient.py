@@ -30,7 +30,7 @@ from powertrain.errors import InputError
 from powertrain.models.recording import RawChannel, RawRecording
 from powertrain.outputs import atomic_path, atomic_write, json_text
 from powertrain.plotting.style import target_and_path
-from powertrain.plotting.transient import plot_ranking, plot_transient
+from powertrain.plotting.transient import plot_overlay, plot_ranking, plot_transient
 from powertrain.results.base import Result
 from powertrain.units import from_si
 
@@ -292,3 +292,70 @@ class TransientRanking(Result):
              "at", "vs base [%]"], rows)
         files = [str(w) for w in written if w]
         return text + (f"\nwrote {', '.join(files)}" if files else "")
+
+
+@dataclass(frozen=True)
+class TransientComparison(Result):
+    """A simulated manoeuvre against a recording of it (``powertrain transient --compare``).
+
+    Attributes
+    ----------
+    name, raw : str
+        Manoeuvre name, the recording's file.
+    shift : float
+        Time of the simulation's start in the recording [s] (aligned on the speed).
+    time : ndarray (n,)
+        Simulated times [s].
+    channels : list of str
+    measured, simulated : ndarray (n, k)
+        Accelerations [m/s²] at the simulated times.
+    """
+
+    name: str
+    raw: str
+    shift: float
+    time: np.ndarray
+    channels: list
+    measured: np.ndarray
+    simulated: np.ndarray
+
+    def errors(self) -> dict:
+        """Per channel: the peaks [m/s²], the peak's error [%] and the RMS of the difference
+        over the event [m/s²] and relative to the measured RMS [%]."""
+        pm, ps = np.max(np.abs(self.measured), 0), np.max(np.abs(self.simulated), 0)
+        rms = np.sqrt(np.mean((self.simulated - self.measured) ** 2, axis=0))
+        base = np.sqrt(np.mean(self.measured ** 2, axis=0))
+        return {"peak_measured": pm, "peak_simulated": ps,
+                "peak_error_percent": 100.0 * (ps / np.where(pm > 0, pm, np.inf) - 1.0),
+                "rms_difference": rms,
+                "rms_difference_percent": 100.0 * rms / np.where(base > 0, base, np.inf)}
+
+    def to_dict(self) -> dict:
+        e = self.errors()
+        return {"manoeuvre": self.name, "recording": self.raw, "shift_s": self.shift,
+                "channels": {c: {k: float(v[j]) for k, v in e.items()}
+                             for j, c in enumerate(self.channels)}}
+
+    def to_json(self, path=None) -> str:
+        """JSON text of :meth:`to_dict`; written atomically to ``path`` if given."""
+        return json_text(self.to_dict(), path)
+
+    def writers(self) -> dict:
+        """``.json``, ``.png``."""
+        return {".json": self.to_json, **super().writers()}
+
+    def plot(self, ax=None, *, path=None, provenance=None):
+        """Measured and simulated acceleration per channel, overlaid; returns the figure
+        (:func:`powertrain.plotting.transient.plot_overlay`)."""
+        ax, path = target_and_path(ax, path)
+        return plot_overlay(self, path, ax=ax, provenance=provenance)
+
+    def to_text(self) -> str:
+        e = self.errors()
+        rows = [[c, float(e["peak_measured"][j]), float(e["peak_simulated"][j]),
+                 f"{e['peak_error_percent'][j]:+.1f}", float(e["rms_difference"][j]),
+                 f"{e['rms_difference_percent'][j]:.1f}"] for j, c in enumerate(self.channels)]
+        return (f"compared with {self.raw} (aligned on the crank speed: the simulation starts "
+                f"at {self.shift:.4f} s of the recording)\n" + format_table(
+                    ["channel", "measured peak [m/s^2]", "simulated peak", "peak error [%]",
+                     "RMS of difference", "of measured RMS [%]"], rows))

@@ -27,7 +27,7 @@ from powertrain.iotools.manoeuvre_file import MAX_RPM, read_manoeuvre
 from powertrain.iotools.raw import read_raw
 from powertrain.models.manoeuvre import Manoeuvre
 from powertrain.parallel import single_blas_thread
-from powertrain.results.transient import TransientResult
+from powertrain.results.transient import TransientComparison, TransientResult
 from powertrain.solvers.transient import simulate_transient
 from powertrain.workflows.arguments import number
 
@@ -48,6 +48,19 @@ def manoeuvre_or_file(manoeuvre) -> Manoeuvre:
     return manoeuvre
 
 
+def recorded_rpm(rec, path) -> np.ndarray:
+    """Crank speed [rpm] at every sample of the recording ``rec``: its rpm channel, else
+    the speed between successive rising edges of its once-per-revolution tacho."""
+    if rec.rpm is not None:
+        return np.asarray(rec.rpm, float)
+    if rec.tacho is not None:
+        t = rec.time - rec.time[0]
+        edges = tacho_edges(t, rec.tacho, file=str(path), key="tacho")
+        return np.interp(t, 0.5 * (edges[1:] + edges[:-1]), 60.0 / np.diff(edges))
+    raise InputError("no rpm or tacho channel to take the speed from", file=str(path),
+                     key="rpm")
+
+
 def speed_from_recording(manoeuvre, path) -> Manoeuvre:
     """``manoeuvre`` driven by the crank speed recorded in the raw file ``path``
     (:func:`~powertrain.iotools.raw.read_raw`): its rpm channel, else its once-per-revolution
@@ -56,14 +69,7 @@ def speed_from_recording(manoeuvre, path) -> Manoeuvre:
     are cut to 0 unless the manoeuvre allows a reversal."""
     rec = read_raw(path)
     t = rec.time - rec.time[0]
-    if rec.rpm is not None:
-        rpm = np.asarray(rec.rpm, float)
-    elif rec.tacho is not None:
-        edges = tacho_edges(t, rec.tacho, file=str(path), key="tacho")
-        rpm = np.interp(t, 0.5 * (edges[1:] + edges[:-1]), 60.0 / np.diff(edges))
-    else:
-        raise InputError("no rpm or tacho channel to take the speed from", file=str(path),
-                         key="rpm")
+    rpm = recorded_rpm(rec, path)
     n = int(np.count_nonzero(t <= manoeuvre.load_time[-1]))
     k = max(1, -(-n // SPEED_ROWS))
     rows = n // k
@@ -151,3 +157,43 @@ def _seat(engine, run, labels, seat):
         aw = weighted(run.acceleration[:, labels.index(f"{seat}.{a}")], fs, w)
         rms[a], vdv[a] = weighted_rms(aw, fs), vibration_dose_value(aw, fs)
     return {"point": seat, "rms": rms, "vdv": vdv, "weighting": dict(AXIS_WEIGHTING)}
+
+
+def compare_transient(result, raw) -> TransientComparison:
+    """A simulated manoeuvre against a recorded one (the raw file ``raw``, any format of
+    :func:`~powertrain.iotools.raw.read_raw`): the recording aligned on its crank speed
+    (rpm channel or tacho; the time shift that best matches the simulated speed,
+    :func:`align`), then every recorded engine-side acceleration channel the simulation has
+    compared over the simulated event (:class:`TransientComparison`)."""
+    rec = read_raw(raw)
+    t_rec = rec.time - rec.time[0]
+    shift = align(result.time, result.rpm, t_rec, recorded_rpm(rec, raw))
+    pairs = []
+    for ch in rec.channels:
+        label = f"{ch.mount}.{ch.direction}"
+        if ch.side == "active" and ch.quantity == "acceleration" and label in result.channels:
+            measured = np.interp(result.time + shift, t_rec, ch.values)
+            pairs.append((label, measured, result.acceleration[:, result.channel(label)]))
+    if not pairs:
+        raise InputError("no engine-side acceleration channel of the simulation in the "
+                         "recording", file=str(raw), key="channels")
+    return TransientComparison(result.name, str(raw), float(shift), result.time,
+                               [p[0] for p in pairs], np.array([p[1] for p in pairs]).T,
+                               np.array([p[2] for p in pairs]).T)
+
+
+def align(t_sim, rpm_sim, t_rec, rpm_rec) -> float:
+    """Time shift [s] of the recording against the simulation: ``rpm_rec(t + shift)``
+    closest to ``rpm_sim(t)`` in the least-squares sense over the simulated event (a grid
+    of shifts over the recording's length, then refined to a sample of the recording)."""
+    t = np.linspace(t_sim[0], t_sim[-1], 400)
+    target = np.interp(t, t_sim, rpm_sim)
+
+    def best(shifts):
+        cost = [np.sum((np.interp(t + s, t_rec, rpm_rec) - target) ** 2) for s in shifts]
+        return float(shifts[int(np.argmin(cost))])
+    span = t_rec[-1] - (t_sim[-1] - t_sim[0])
+    shifts = np.linspace(min(0.0, span), max(0.0, span), 801)
+    shift = best(shifts)
+    step = shifts[1] - shifts[0]
+    return best(shift + np.linspace(-2.0, 2.0, 201) * step) if step > 0 else shift
