@@ -268,3 +268,12 @@ def test_a_recorded_event_is_aligned_and_its_errors_reported(default_engine, tmp
     stiff = pt.transient(tmp_path / "m.toml", stiffer(default_engine))
     other = compare_transient(stiff, tmp_path / "raw.h5").errors()["rms_difference"]
     assert np.max(other) > 5 * np.max(rms)
+
+
+def test_a_speed_above_the_combustion_model_is_refused_before_any_work(default_engine,
+                                                                         tmp_path):
+    path = tmp_path / "fast.toml"
+    path.write_text(GOOD.replace("900.0]", "9000.0]"), encoding="utf-8")
+    with pytest.raises(pt.InputError, match="above the engine's combustion model") as err:
+        pt.transient(path, default_engine)
+    assert str(path) in str(err.value) and "'speed.speed'" in str(err.value)

@@ -116,7 +116,10 @@ def simulate_transient(engine, manoeuvre, *, system=None, angle_step_deg=1.0) ->
     -------
     TransientRun
     """
-    engine.require_excitation()
+    top = engine.speed_range_rpm()[1]
+    if manoeuvre.max_speed / RPM > top + 1e-6:
+        raise InputError(f"{manoeuvre.max_speed / RPM:g} rpm is above the engine's combustion "
+                         f"model ({top:g} rpm)", file=manoeuvre.file or None, key="speed.speed")
     system = engine.assemble() if system is None else system
     if system.chassis is not None:
         system.chassis.require_time_domain()
