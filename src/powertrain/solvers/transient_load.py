@@ -90,7 +90,7 @@ def transient_load(engine, manoeuvre, t) -> TransientLoad:
     F[:, 3:] -= (J * alpha + manoeuvre.gear_ratio * driveline)[:, None] * n[None, :]
     starter = np.zeros_like(t)
     if manoeuvre.starter is not None:
-        on = t <= manoeuvre.starter.until
+        on = t < manoeuvre.starter.until
         starter[on] = (J * alpha + driveline - engine_torque)[on]
     return TransientLoad(np.asarray(t, float), theta, omega, alpha, scale, engine_torque,
                          driveline, starter, F)
