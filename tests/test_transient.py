@@ -277,3 +277,20 @@ def test_a_speed_above_the_combustion_model_is_refused_before_any_work(default_e
     with pytest.raises(pt.InputError, match="above the engine's combustion model") as err:
         pt.transient(path, default_engine)
     assert str(path) in str(err.value) and "'speed.speed'" in str(err.value)
+
+
+def test_speed_from_removes_the_speed_profile_part_of_a_comparison(default_engine, tmp_path):
+    """A start recorded with another speed profile (300 -> 950 rpm instead of 250 -> 900):
+    compared with the file's own profile the RMS of the difference is above half the
+    measured RMS (measured 78-150 %); driven by the recorded speed (``speed_from``) it
+    falls below 1 % (measured 0.04-0.19 %: the speed table's block means)."""
+    (tmp_path / "m.toml").write_text(GOOD, encoding="utf-8")
+    (tmp_path / "other.toml").write_text(GOOD.replace("[0.0, 250.0, 900.0]",
+                                                      "[0.0, 300.0, 950.0]"), encoding="utf-8")
+    recorded = pt.transient(tmp_path / "other.toml", default_engine)
+    write_raw_hdf5(tmp_path / "raw.h5", recorded.recording(), synthetic=True)
+    nominal = pt.transient(tmp_path / "m.toml", default_engine)
+    driven = pt.transient(tmp_path / "m.toml", default_engine, speed_from=tmp_path / "raw.h5")
+    before = compare_transient(nominal, tmp_path / "raw.h5").errors()["rms_difference_percent"]
+    after = compare_transient(driven, tmp_path / "raw.h5").errors()["rms_difference_percent"]
+    assert np.min(before) > 50.0 and np.max(after) < 1.0, (before, after)
