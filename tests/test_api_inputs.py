@@ -11,7 +11,7 @@ import math
 import numpy as np
 import pytest
 from click.testing import CliRunner
-from conftest import EXAMPLES, MOUNTS
+from conftest import ENGINES, EXAMPLES, MOUNTS
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
@@ -24,6 +24,7 @@ MEASURED = str(EXAMPLES / "measured-runup.csv")
 RAW = str(EXAMPLES / "raw-runup.csv")
 AMPLITUDES = str(EXAMPLES / "hydraulic-mount-amplitudes.csv")
 MISSING = "no-such-file.toml"
+START = str(EXAMPLES / "start.toml")
 QUICK = {"solver": "harmonic"}
 
 
@@ -160,6 +161,15 @@ CASES = {
     "report type": (lambda e: pt.report(5), True),
     "report not toml": (lambda e: pt.report(MEASURED), True),
     "report out suffix": (lambda e: pt.report(str(EXAMPLES / "study.toml"), out="r.pdf"), True),
+    # transient, read_manoeuvre
+    "transient missing": (lambda e: pt.transient(MISSING, e), True),
+    "transient int": (lambda e: pt.transient(5, e), True),
+    "transient angle step": (lambda e: pt.transient(START, e, angle_step_deg="fine"), True),
+    "transient angle step range": (lambda e: pt.transient(START, e, angle_step_deg=50), True),
+    "transient seat": (lambda e: pt.transient(START, e, seat="seat_rail"), True),
+    "transient seat type": (lambda e: pt.transient(START, e, seat=3), True),
+    "read_manoeuvre missing": (lambda e: pt.read_manoeuvre(MISSING), True),
+    "read_manoeuvre engine file": (lambda e: pt.read_manoeuvre(ENGINES / "default.toml"), True),
 }
 
 

@@ -53,6 +53,10 @@ MAKERS = {
     "DiagnosisResult": lambda e: pt.diagnose(MEASURED, e, effects=["mount_stiffness"],
                                              pairs=False, progress=False),
     "SynthCase": lambda e: pt.synth([], 0),
+    "TransientResult": lambda e: pt.transient(str(EXAMPLES / "start.toml"), e,
+                                              angle_step_deg=5.0),
+    "TransientRanking": lambda e: pt.whatif(e, scale="left.z.stiffness=1.2",
+                                            manoeuvre=str(EXAMPLES / "stop.toml")),
 }
 
 #: One panel chosen, for the grid figures given one Axes (keyword arguments of ``plot``).

@@ -45,6 +45,8 @@ API = {
     "diagnose": ("powertrain.diagnosis", "diagnose"),
     "synth": ("powertrain.workflows.synth", "synth"),
     "report": ("powertrain.reporting.report", "report"),
+    "transient": ("powertrain.workflows.transient", "transient"),
+    "read_manoeuvre": ("powertrain.iotools.manoeuvre_file", "read_manoeuvre"),
 }
 
 __all__ = ["InputError", "__version__", *API]

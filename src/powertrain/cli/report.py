@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import click
 
-from powertrain.cli.common import use_agg
+from powertrain.cli.common import quiet_option, use_agg
 from powertrain.cli.group import main
 from powertrain.progress import activity
 from powertrain.reporting.report import report as run_report
@@ -15,7 +15,7 @@ from powertrain.reporting.report import report as run_report
 @click.option("--out", required=True, type=click.Path(dir_okay=False),
               help="HTML file written: one self-contained file (figures embedded, no "
                    "network, no script), printable to A4 PDF.")
-@click.option("--quiet", is_flag=True, help="Print only errors.")
+@quiet_option
 def report(study, out, quiet):
     """Run the steps of a study file and write its report as one HTML file.
 

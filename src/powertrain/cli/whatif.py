@@ -81,10 +81,14 @@ from powertrain.workflows.whatif import whatif as run_whatif
               help="Run the variants on dask.distributed: 'local' (a LocalCluster on this "
                    "machine's cores) or an existing scheduler's address; also 'processes' "
                    "or 'serial'. Default: a local process pool (--workers). Same results.")
+@click.option("--manoeuvre", "manoeuvre_file", type=click.Path(dir_okay=False),
+              help="Run baseline and variants over this transient manoeuvre (TOML, as for "
+                   "`transient`) instead of a run-up; ranks them by peak seat acceleration "
+                   "(else peak mount deflection).")
 @quiet_option
 def whatif(engine_file, rpm_from, rpm_to, rpm_step, solver, scale, set_, swap, move, rotate,
            effect, variants_file, target, target_out, target_plot, measured_file, plot, json_file,
-           delta_plot, signal, objective, workers, scheduler, quiet):
+           delta_plot, signal, objective, workers, scheduler, manoeuvre_file, quiet):
     """What-if: run the baseline and variants of the mount system, print the change in dB.
 
     The command-line operations (--scale/--set/--swap/--move/--rotate/--effect) form one
@@ -105,6 +109,7 @@ def whatif(engine_file, rpm_from, rpm_to, rpm_step, solver, scale, set_, swap, m
       powertrain whatif --effect mount_stiffness:k1=1.5,k2=1.5 --effect sensor_error:g3=2
       powertrain whatif --engine engines/default-modal-body.toml --scale left.z.stiffness=0.8 \\
           --objective seat_rail.z:order_2:1500-3000
+      powertrain whatif --manoeuvre examples/start.toml --variants variants.toml
     """
     outputs = (target_out, target_plot, json_file, plot, delta_plot)
     check_outputs(target_out=target_out, target_plot=target_plot, plot=plot, json=json_file,
@@ -114,7 +119,7 @@ def whatif(engine_file, rpm_from, rpm_to, rpm_step, solver, scale, set_, swap, m
                         effects=effect, targets=target, variants=variants_file, rpm=rpm,
                         solver=solver, signal=signal, objective=objective,
                         measured=measured_file, executor=scheduler, workers=workers,
-                        progress=not quiet, rpm_step=rpm_step)
+                        progress=not quiet, rpm_step=rpm_step, manoeuvre=manoeuvre_file)
     fit = result.target_fit("--target-out" if target_out else "--target-plot") \
         if target_out or target_plot else None
     _write(result, fit, engine, engine_file, *outputs)

@@ -350,11 +350,19 @@ class Engine:
                for u in unit]
         return gas, self._block_load(th, 1.0, np.zeros((th.size, unit.shape[0])))[0]
 
-    def _block_load(self, th, omega, fg):
+    def motion_patterns(self, crank_angle_rad):
+        """Generalized loads (n, 6) of a unit omega^2 and of a unit crank acceleration at
+        the angles [rad], no gas force (:meth:`_block_load` is linear in both)."""
+        th = np.atleast_1d(np.asarray(crank_angle_rad, dtype=float))
+        zero = np.zeros((th.size, self.crank.n_cylinders))
+        return self._block_load(th, 1.0, zero)[0], self._block_load(th, 0.0, zero, 1.0)[0]
+
+    def _block_load(self, th, omega, fg, alpha=0.0):
         """Generalized load (n, 6) on the block at angles ``th`` [rad], speed ``omega``
-        [rad/s] and gas forces ``fg`` (n, n_cyl) [N], and the per-cylinder forces of
+        [rad/s], crank acceleration ``alpha`` [rad/s^2] (not on the balancer shafts) and gas
+        forces ``fg`` (n, n_cyl) [N], and the per-cylinder forces of
         :func:`~powertrain.physics.slider_crank.crank_forces` (dict of (n, n_cyl)). Linear in
-        the gas forces and in omega^2 (:meth:`load_table` relies on it)."""
+        the gas forces, in omega^2 and in alpha (:meth:`load_table` relies on it)."""
         ct = self.crank
         u = ct.cylinder_axis
         s = ct.lateral_axis
@@ -374,7 +382,7 @@ class Engine:
 
         for i in range(n_cyl):
             theta_i = th - ct.crank_pin_angles[i]
-            k = sc.crank_forces(theta_i, omega, fg[:, i], r, l, e, ct.reciprocating_mass)
+            k = sc.crank_forces(theta_i, omega, fg[:, i], r, l, e, ct.reciprocating_mass, alpha)
             for name in out:
                 out[name][:, i] = k[name]
             origin = np.array([ct.cylinder_x[i], 0.0, 0.0])
@@ -386,9 +394,12 @@ class Engine:
             bearing = k["rod"][:, None] * (np.sin(k["beta"])[:, None] * s
                                            - np.cos(k["beta"])[:, None] * u)
             add(bearing, origin)                                            # main bearing
-            f_rot = (1.0 - ct.counterweight_fraction) * ct.rotating_mass * r * omega**2
-            if f_rot != 0.0:
-                add(f_rot * (np.cos(theta_i)[:, None] * u + np.sin(theta_i)[:, None] * s),
+            m_r = (1.0 - ct.counterweight_fraction) * ct.rotating_mass * r
+            if m_r * omega != 0.0:
+                add(m_r * omega**2 * (np.cos(theta_i)[:, None] * u + np.sin(theta_i)[:, None] * s),
+                    origin)
+            if m_r * alpha != 0.0:                  # the pin's tangential acceleration
+                add(m_r * alpha * (np.sin(theta_i)[:, None] * u - np.cos(theta_i)[:, None] * s),
                     origin)
         if self.balancer.enabled:
             for sh in self.balancer.shafts:

@@ -179,7 +179,7 @@ def swept_volume(bore, r, l, e=0.0):
     return np.pi * bore**2 / 4.0 * (y_tdc - y_bdc)
 
 
-def crank_forces(theta, omega, gas_force, r, l, e, m_rec):
+def crank_forces(theta, omega, gas_force, r, l, e, m_rec, alpha=0.0):
     r"""Rod force, side thrust and crank torque of one cylinder (exact kinematics).
 
     Parameters
@@ -194,6 +194,9 @@ def crank_forces(theta, omega, gas_force, r, l, e, m_rec):
         Crank radius, rod length, piston-pin offset [m].
     m_rec : float
         Reciprocating mass (piston group plus the rod's small-end share) [kg].
+    alpha : float or array_like
+        Crank angular acceleration [rad/s²] (0: constant speed); the piston acceleration
+        is :math:`\omega^2 y'' + \alpha y'`.
 
     Returns
     -------
@@ -205,7 +208,7 @@ def crank_forces(theta, omega, gas_force, r, l, e, m_rec):
         ``torque_gas`` and ``torque_inertia`` its gas and inertia parts [N·m].
     """
     y, dy, d2y, beta = piston_kinematics(theta, r, l, e)
-    acc = omega**2 * d2y
+    acc = omega**2 * d2y + alpha * dy
     fg = np.asarray(gas_force, dtype=float)
     rod = (fg + m_rec * acc) / np.cos(beta)
     return {

@@ -147,8 +147,9 @@ def static_load(engine, mean_torque: float) -> np.ndarray:
 
 
 def operating_point(engine, rpm: float, support: StaticSupport | None = None,
-                    start=None) -> OperatingPoint:
-    """The static operating point of ``engine`` at ``rpm`` (module docstring).
+                    start=None, mean_torque: float | None = None) -> OperatingPoint:
+    """The static operating point of ``engine`` at ``rpm`` (module docstring), under the
+    mean brake torque at that speed or else ``mean_torque`` [N·m].
 
     Raises
     ------
@@ -157,7 +158,7 @@ def operating_point(engine, rpm: float, support: StaticSupport | None = None,
     """
     engine.require_excitation()
     support = support or StaticSupport.of(engine)
-    torque = engine.mean_brake_torque(rpm)
+    torque = engine.mean_brake_torque(rpm) if mean_torque is None else float(mean_torque)
     q, iterations, residual = _equilibrium(support, static_load(engine, torque),
                                            engine.body.mass * STANDARD_GRAVITY, start)
     if q is None:

@@ -21,6 +21,7 @@ from powertrain.errors import InputError
 from powertrain.iotools.engine_checks import check_support
 from powertrain.iotools.measured import MeasuredRunup, normalise_quantity, read_measured
 from powertrain.parallel import check_scheduler
+from powertrain.results.transient import TransientRanking
 from powertrain.results.whatif import QUANTITIES, VariantRun, WhatIfResult
 from powertrain.solvers.steppers import SOLVERS
 from powertrain.workflows.arguments import (
@@ -36,6 +37,7 @@ from powertrain.workflows.operations import Origin, Target, Variant, response_sc
 from powertrain.workflows.retune import retuned_swap
 from powertrain.workflows.runup import check_runup_settings, engine_and_file
 from powertrain.workflows.sweeps import SweepTask, run_sweep
+from powertrain.workflows.transient import manoeuvre_or_file, transient
 from powertrain.workflows.variants import parse_operations, parse_target, read_variants
 
 #: Signals a what-if compares (``--signal``).
@@ -57,7 +59,7 @@ def describe_engine(engine, solver: str, rpm) -> dict:
 def whatif(engine=None, *, scale=(), set=(), swap=(), move=(), rotate=(), effects=(),
            targets=(), variants=None, rpm=None, solver="harmonic", signal="velocity",
            objective=None, measured=None, executor=None, workers=None, progress=False,
-           rpm_step=None) -> WhatIfResult:
+           rpm_step=None, manoeuvre=None) -> WhatIfResult | TransientRanking:
     """What-if: the baseline and variants of the mount system, the change in dB (``whatif``).
 
     Parameters
@@ -107,11 +109,24 @@ def whatif(engine=None, *, scale=(), set=(), swap=(), move=(), rotate=(), effect
         ("scale", scale), ("set", set), ("swap", swap), ("move", move), ("rotate", rotate),
         ("effect", effects))}
     runs = command_variants(engine, ops, texts(targets, "--target"), variants)
+    if manoeuvre is not None:
+        return whatif_manoeuvre(engine, runs, manoeuvre)
     goal = parse_objective(objective, engine.assemble().channels, rpm) if objective else None
     measured = _measured(measured, engine)
     return run_whatif(engine, runs, rpm, solver=solver, executor=executor, workers=workers,
                       measured=measured, signal=signal, progress=progress, objective=goal,
                       rpm_step=real(rpm_step, "--step", unit="rpm", optional=True))
+
+
+def whatif_manoeuvre(engine, variants, manoeuvre) -> TransientRanking:
+    """The baseline and every variant (:func:`variant_engine`) over ``manoeuvre``
+    (:func:`powertrain.workflows.transient.transient`, in this process), ranked by the peak
+    seat acceleration, else the peak mount deflection
+    (:class:`~powertrain.results.transient.TransientRanking`)."""
+    m = manoeuvre_or_file(manoeuvre)
+    engines = [engine] + [variant_engine(engine, v)[0] for v in variants]
+    runs = [transient(m, e) for e in engines]
+    return TransientRanking(m.name, ["baseline"] + [v.name for v in variants], runs)
 
 
 def _measured(measured, engine):

@@ -1,0 +1,135 @@
+#!/usr/bin/env python
+"""CPU time of transient manoeuvres (issue 38), in one process, warm (the Numba kernels
+compiled and cached before timing), ``time.process_time``, best of ``--repeat``:
+
+* the 3 s start of ``examples/start.toml`` (0 -> cranking -> flare to 1150 rpm -> idle) on
+  the default engine, linear mounts;
+* the same start with a static curve, the power amplitude law and Berg's friction on every
+  mount direction (each direction's curve the z-nonlinear mount's shape scaled to its own
+  static stiffness, reference deflection 0; amplitude law and friction as
+  scripts/bench_nonlinear_runup.py);
+* against ``solve_ivp``: the independent check of tests/test_transient.py (6-DOF body,
+  Kelvin-Voigt mounts, one direction with static curve, amplitude law and friction;
+  tests/transient_oracle.py), over a 0.3 s flare from rest: Radau at rtol 1e-8 (the
+  reference) and at rtol 1e-3..1e-7 until its error is at most ours; ours at 1 deg, error of
+  each against the rtol 1e-8 run (deflection and force of that direction, relative to their
+  peaks).
+
+Last line: ``linear_s=... nonlinear_s=... newmark_s=... solve_ivp_s=... ratio=...``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import dataclasses
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+import numpy as np
+from bench_nonlinear_runup import BERG, POWER
+
+from powertrain.iotools.engine_file import DEFAULT_ENGINE_PATH, read_engine
+from powertrain.iotools.manoeuvre_file import read_manoeuvre
+from powertrain.models.manoeuvre import Manoeuvre
+from powertrain.models.mount import MountModel
+from powertrain.physics.mount_laws import StaticCurve
+from powertrain.solvers.transient import STRETCH, simulate_transient
+
+ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT / "tests"))
+from transient_oracle import StretchODE, integrate, write_case  # noqa: E402
+
+#: The z-nonlinear mount's curve shape [mm, N] and its tangent at 0 [N/mm].
+SHAPE_MM = (-12.0, -9.0, -7.0, -5.0, -3.0, 0.0, 3.0, 6.0, 9.0)
+SHAPE_N = (-2743.42, -1419.01, -851.41, -586.52, -359.48, 0.0, 312.18, 662.2, 1419.01)
+
+
+def fully_nonlinear(engine):
+    """Every mount direction with a static curve, the power law and Berg's friction."""
+    tangent0 = float(StaticCurve(tuple(x * 1e-3 for x in SHAPE_MM), SHAPE_N).tangent_at(0.0))
+
+    def model(mod):
+        k0 = mod.static_stiffness()
+        curve = StaticCurve(tuple(x * 1e-3 for x in SHAPE_MM),
+                            tuple(f * k0 / tangent0 for f in SHAPE_N), 0.0)
+        return MountModel(mod.topology, dict(mod.params), name=mod.name, port_law=BERG,
+                          amplitude_law=POWER, static_curve=curve)
+    mounts = [dataclasses.replace(m, directions={a: model(mod) for a, mod in
+                                                 m.directions.items()})
+              for m in engine.mounts]
+    return dataclasses.replace(engine, mounts=mounts)
+
+
+def best_cpu(run, repeat):
+    run()
+    best = float("inf")
+    for _ in range(repeat):
+        t0 = time.process_time()
+        run()
+        best = min(best, time.process_time() - t0)
+    return best
+
+
+def peer_case(folder, seconds=0.3):
+    engine = read_engine(write_case(folder, Path(DEFAULT_ENGINE_PATH).read_text()))
+    system = engine.assemble()
+    w = 1200.0 * np.pi / 30.0
+    m = Manoeuvre("flare", np.array([0.0, seconds]), np.array([0.0, w]),
+                  np.array([0.0, seconds]), np.zeros(2), crank_inertia=0.3)
+    return engine, system, m
+
+
+def errors(u, f, u_ref, f_ref):
+    return max(np.max(np.abs(u - u_ref)) / np.max(np.abs(u_ref)),
+               np.max(np.abs(f - f_ref)) / np.max(np.abs(f_ref)))
+
+
+def against_solve_ivp(repeat):
+    """(ours [s], error, best solve_ivp [s] at an error <= ours, its rtol)."""
+    with tempfile.TemporaryDirectory() as tmp:
+        engine, system, m = peer_case(Path(tmp))
+        net = system.network_names.index("left.z")
+        ch = [f"{a}.{b}" for a, b in system.channels].index("left.z")
+        ours_s = best_cpu(lambda: simulate_transient(engine, m, system=system), repeat)
+        run = simulate_transient(engine, m, system=system)
+        every = max(1, round(STRETCH / (run.load.t[1] - run.load.t[0])))
+
+        def peer(rtol):
+            return integrate(StretchODE(engine, system, run.load.t, run.load.F, net), every,
+                             rtol)
+        u_ref, f_ref = peer(1e-8)
+        err = errors(run.deflection[:, net], run.force[:, ch], u_ref, f_ref)
+        print(f"ours (Newmark 1 deg) on the 6-DOF case: {ours_s:.4f} s, error {err:.2e} "
+              "against Radau rtol 1e-8")
+        for rtol in 10.0 ** -np.arange(3, 8):
+            t0 = time.process_time()
+            u, f = peer(rtol)
+            seconds = time.process_time() - t0
+            e = errors(u, f, u_ref, f_ref)
+            print(f"solve_ivp Radau rtol {rtol:.0e}: {seconds:.3f} s, error {e:.2e}")
+            if e <= err:
+                return ours_s, err, seconds, rtol
+        return ours_s, err, seconds, rtol
+
+
+def main():
+    p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    p.add_argument("--repeat", type=int, default=3)
+    args = p.parse_args()
+    engine = read_engine(DEFAULT_ENGINE_PATH)
+    start = read_manoeuvre(ROOT / "examples" / "start.toml")
+    linear = best_cpu(lambda: simulate_transient(engine, start), args.repeat)
+    nonlinear_engine = fully_nonlinear(engine)
+    run = simulate_transient(nonlinear_engine, start)
+    nonlinear = best_cpu(lambda: simulate_transient(nonlinear_engine, start), args.repeat)
+    print(f"3 s start ({run.load.t.size - 1} steps): linear {linear:.3f} s; static curve, "
+          f"amplitude law and friction on every mount {nonlinear:.3f} s ({run.method})")
+    ours_s, err, peer_s, rtol = against_solve_ivp(args.repeat)
+    print(f"linear_s={linear:.4f} nonlinear_s={nonlinear:.4f} newmark_s={ours_s:.4f} "
+          f"solve_ivp_s={peer_s:.3f} ratio={peer_s / ours_s:.0f}")
+
+
+if __name__ == "__main__":
+    main()

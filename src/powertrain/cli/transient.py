@@ -1,0 +1,115 @@
+"""``powertrain transient``: an engine start, stop, tip-in or back-out on the mounts."""
+
+from __future__ import annotations
+
+import json
+
+import click
+
+from powertrain.cli.common import (
+    check_outputs,
+    cli_provenance,
+    engine_description,
+    quiet_option,
+    say,
+    write_json,
+    write_plot,
+    wrote,
+)
+from powertrain.cli.group import main
+from powertrain.errors import InputError
+from powertrain.iotools.engine_file import engine_or_default
+from powertrain.iotools.manoeuvre_file import read_manoeuvre
+from powertrain.iotools.raw_hdf5 import write_raw_hdf5
+from powertrain.workflows import transient as workflow
+
+
+@main.command()
+@click.argument("manoeuvre_file", metavar="MANOEUVRE", type=click.Path(dir_okay=False))
+@click.option("--engine", "engine_file", type=click.Path(dir_okay=False),
+              help="Engine file (default: the shipped engines/default.toml).")
+@click.option("--angle-step", type=float, default=workflow.ANGLE_STEP_DEG, show_default=True,
+              help="Crank angle per integration step at the top speed [deg].")
+@click.option("--speed-from", type=click.Path(dir_okay=False),
+              help="Raw recording (CSV, HDF5, UFF, MDF4) whose rpm channel or tacho drives "
+                   "the crank instead of the file's speed table.")
+@click.option("--seat", help="Body point for the ISO 2631-1 values (default: a body point "
+                             "named seat...).")
+@click.option("--channels", help="Channels of the figure, comma separated (e.g. "
+                                 "left.z,right.z; default: the seat's, else each mount's z).")
+@click.option("--quantity", type=click.Choice(["acceleration", "displacement", "force"]),
+              default="acceleration", show_default=True, help="What the figure's channel "
+                                                              "panels show.")
+@click.option("--out", type=click.Path(dir_okay=False), help="Write the HDF5 time histories.")
+@click.option("--csv", "csv_file", type=click.Path(dir_okay=False),
+              help="Write the time histories as CSV, one row per step.")
+@click.option("--json", "json_file", type=click.Path(dir_okay=False),
+              help="Write the peaks and the seat's values as JSON.")
+@click.option("--plot", type=click.Path(dir_okay=False),
+              help="Speed and torque above the channels' accelerations (PNG).")
+@click.option("--raw", "raw_out", type=click.Path(dir_okay=False),
+              help="Write the engine-side accelerations and the crank speed as raw time data "
+                   "(raw HDF5 layout, labelled SYNTHETIC), e.g. to try --compare.")
+@click.option("--compare", "raw_file", type=click.Path(dir_okay=False),
+              help="A recording of the manoeuvre (raw CSV, HDF5, UFF, MDF4): aligned on its "
+                   "crank speed, every engine-side acceleration channel compared (peaks, RMS "
+                   "of the difference); in --json under 'compare'.")
+@click.option("--compare-plot", type=click.Path(dir_okay=False),
+              help="With --compare: measured and simulated accelerations overlaid (PNG).")
+@quiet_option
+def transient(manoeuvre_file, engine_file, angle_step, speed_from, seat, channels, quantity,
+              out, csv_file, json_file, plot, raw_out, raw_file, compare_plot, quiet):
+    """Transient manoeuvre: time histories of body, mounts and seat over a start, stop,
+    tip-in or back-out.
+
+    MANOEUVRE is a TOML file with the crank speed and load over time
+    (docs/guide/transient.md); it is checked before any work.
+
+    \b
+    Examples:
+      powertrain transient examples/start.toml
+      powertrain transient examples/tip-in.toml --engine engines/default-nonlinear.toml
+      powertrain transient examples/start.toml --engine engines/default-modal-body.toml \\
+          --plot start.png --json start.json
+      powertrain transient examples/start.toml --compare start-raw.h5 --compare-plot o.png
+    """
+    files = dict(out=out, csv=csv_file, json=json_file, plot=plot, raw=raw_out,
+                 compare_plot=compare_plot)
+    check_outputs(**files)
+    if compare_plot and not raw_file:
+        raise InputError("--compare-plot needs --compare RAW", key="--compare-plot")
+    manoeuvre = read_manoeuvre(manoeuvre_file)
+    engine = engine_or_default(engine_file)
+    result = workflow.transient(manoeuvre, engine, angle_step_deg=angle_step, seat=seat,
+                                speed_from=speed_from)
+    comparison = workflow.compare_transient(result, raw_file) if raw_file else None
+    written = _write(result, comparison, files, cli_provenance(engine_description(
+        engine, engine.file)), [c.strip() for c in channels.split(",")] if channels else None,
+        quantity)
+    say(result.to_text(), quiet)
+    if comparison is not None:
+        say(comparison.to_text(), quiet)
+    say(f"solver time: {result.solver_seconds:.3f} s; "
+        + (wrote(*written) if written
+           else "no file written (ask with --out, --csv, --json or --plot)"), quiet)
+
+
+def _write(result, comparison, files, prov, channels, quantity) -> list:
+    """The files asked for, each atomically; returns their paths."""
+    doc = result.to_dict()
+    if comparison is not None:
+        doc["compare"] = comparison.to_dict()
+    writers = {"out": result.to_hdf5, "csv": result.to_csv,
+               "json": lambda p: write_json(p, json.dumps(doc), prov.to_dict()),
+               "plot": lambda p: write_plot(lambda q: result.plot(
+                   path=q, channels=channels, quantity=quantity, provenance=prov), p),
+               "raw": lambda p: write_raw_hdf5(p, result.recording(), synthetic=True,
+                                               description=result.recording().comments[0]),
+               "compare_plot": lambda p: write_plot(lambda q: comparison.plot(
+                   path=q, provenance=prov), p)}
+    written = []
+    for key, path in files.items():
+        if path:
+            writers[key](path)
+            written.append(path)
+    return written

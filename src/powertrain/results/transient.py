@@ -1,0 +1,361 @@
+"""A transient manoeuvre's result (``powertrain transient``): time histories, per-channel
+peaks and the seat's ISO 2631-1 values, with its text, CSV, JSON, HDF5 and figure.
+
+JSON (SI but lengths in mm)::
+
+    {"manoeuvre": name, "file": ..., "engine": ..., "duration_s": T, "steps": n,
+     "method": ..., "channels": {"left.z": {"peak_to_peak_displacement_mm": ..,
+       "peak_force_n": .., "max_acceleration_m_per_s2": .., "time_of_max_acceleration_s": ..}},
+     "mounts": {"left.z": {"peak_to_peak_deflection_mm": .., "max_deflection_mm": ..}},
+     "seat": {"point": "seat_rail", "weighted_rms_m_per_s2": {"x": .., ...},
+              "vdv_m_per_s1_75": {...}, "weighting": {"x": "Wd", ...}} or null}
+
+CSV: one row per time step; columns ``time_s``, ``rpm``, ``engine_torque_nm``,
+``starter_torque_nm``, ``driveline_torque_nm``, ``body_x_mm`` .. ``body_rz_deg``, per
+channel ``CH_displacement_mm``, ``CH_velocity_mm_per_s``, ``CH_acceleration_m_per_s2``,
+``CH_force_n``, per mount direction ``NET_deflection_mm``. Displacements, deflections and
+forces are changes from the static operating point at zero mean torque.
+"""
+
+from __future__ import annotations
+
+import csv
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from powertrain.analysis.channel import Channel
+from powertrain.analysis.text_table import format_table
+from powertrain.errors import InputError
+from powertrain.models.recording import RawChannel, RawRecording
+from powertrain.outputs import atomic_path, atomic_write, json_text
+from powertrain.plotting.style import target_and_path
+from powertrain.plotting.transient import plot_overlay, plot_ranking, plot_transient
+from powertrain.results.base import Result
+from powertrain.units import from_si
+
+_BODY = ("x_mm", "y_mm", "z_mm", "rx_deg", "ry_deg", "rz_deg")
+
+
+@dataclass(frozen=True)
+class TransientResult(Result):
+    """Time histories of a manoeuvre (SI; module docstring for the files).
+
+    Attributes
+    ----------
+    name, file, engine : str
+        Manoeuvre name, its file, the engine that ran.
+    time, rpm : ndarray (n,)
+        [s], crank speed [rpm].
+    torques : dict of str -> ndarray (n,)
+        ``engine``, ``starter``, ``driveline`` torque [N·m].
+    body : ndarray (n, 6)
+        Body displacement [m] and rotation [rad] at the CG.
+    channels : list of str
+        ``mount.direction`` labels (engine side, then body side and body points).
+    displacement, velocity, acceleration, force : ndarray (n, n_ch)
+    networks : list of str
+    deflection : ndarray (n, n_net) [m]
+    seat : dict or None
+        ``point``, per axis ``rms`` [m/s²], ``vdv`` [m/s^1.75] and ``weighting``.
+    method : str
+    solver_seconds : float
+    """
+
+    name: str
+    file: str
+    engine: str
+    time: np.ndarray
+    rpm: np.ndarray
+    torques: dict
+    body: np.ndarray
+    channels: list
+    displacement: np.ndarray
+    velocity: np.ndarray
+    acceleration: np.ndarray
+    force: np.ndarray
+    networks: list
+    deflection: np.ndarray
+    seat: dict | None = None
+    method: str = ""
+    solver_seconds: float = 0.0
+    notes: list = field(default_factory=list)
+
+    def channel(self, label) -> int:
+        """Column of the channel ``label`` (``"left.z"``)."""
+        return self.channels.index(label)
+
+    def peaks(self) -> dict:
+        """Per channel: peak-to-peak displacement [m], peak force [N], maximum
+        acceleration [m/s²] and its time [s]."""
+        a = np.abs(self.acceleration)
+        i = np.argmax(a, axis=0)
+        return {"peak_to_peak": np.ptp(self.displacement, axis=0),
+                "peak_force": np.max(np.abs(self.force), axis=0),
+                "max_acceleration": a[i, np.arange(a.shape[1])],
+                "time_of_max_acceleration": self.time[i]}
+
+    def recording(self) -> RawRecording:
+        """The engine-side mount-point accelerations [m/s²] and the crank speed [rpm] as raw
+        time data (labelled SYNTHETIC), for the raw writers and readers."""
+        chans = []
+        for k, label in enumerate(self.channels):
+            mount, _, d = label.rpartition(".")
+            if "/" not in mount and d in "xyz" and k < len(self.networks):
+                chans.append(RawChannel(Channel(mount, "active", d).label, mount, "active", d,
+                                        "acceleration", self.acceleration[:, k], "m/s^2"))
+        note = f"SYNTHETIC: simulated transient '{self.name}' ({self.method})"
+        return RawRecording(self.time, chans, self.rpm, None, "simulated transient",
+                            [note]).validate()
+
+    def to_dict(self) -> dict:
+        """The JSON document (module docstring)."""
+        p = self.peaks()
+        chans = {c: {"peak_to_peak_displacement_mm": float(from_si(p["peak_to_peak"][k], "mm")),
+                     "peak_force_n": float(p["peak_force"][k]),
+                     "max_acceleration_m_per_s2": float(p["max_acceleration"][k]),
+                     "time_of_max_acceleration_s": float(p["time_of_max_acceleration"][k])}
+                 for k, c in enumerate(self.channels)}
+        d = from_si(self.deflection, "mm")
+        mounts = {n: {"peak_to_peak_deflection_mm": float(np.ptp(d[:, k])),
+                      "max_deflection_mm": float(np.max(np.abs(d[:, k])))}
+                  for k, n in enumerate(self.networks)}
+        seat = None if self.seat is None else {
+            "point": self.seat["point"], "weighted_rms_m_per_s2": self.seat["rms"],
+            "vdv_m_per_s1_75": self.seat["vdv"], "weighting": self.seat["weighting"]}
+        return {"manoeuvre": self.name, "file": self.file, "engine": self.engine,
+                "duration_s": float(self.time[-1]), "steps": int(self.time.size - 1),
+                "method": self.method, "channels": chans, "mounts": mounts, "seat": seat}
+
+    def to_json(self, path=None) -> str:
+        """JSON text of :meth:`to_dict`; written atomically to ``path`` if given."""
+        return json_text(self.to_dict(), path)
+
+    def columns(self) -> dict:
+        """CSV column name -> values (n,) (module docstring)."""
+        cols = {"time_s": self.time, "rpm": self.rpm}
+        cols.update({f"{k}_torque_nm": v for k, v in self.torques.items()})
+        body = np.hstack([from_si(self.body[:, :3], "mm"), np.rad2deg(self.body[:, 3:])])
+        cols.update({f"body_{n}": body[:, k] for k, n in enumerate(_BODY)})
+        for k, c in enumerate(self.channels):
+            cols[f"{c}_displacement_mm"] = from_si(self.displacement[:, k], "mm")
+            cols[f"{c}_velocity_mm_per_s"] = from_si(self.velocity[:, k], "mm/s")
+            cols[f"{c}_acceleration_m_per_s2"] = self.acceleration[:, k]
+            cols[f"{c}_force_n"] = self.force[:, k]
+        cols.update({f"{n}_deflection_mm": from_si(self.deflection[:, k], "mm")
+                     for k, n in enumerate(self.networks)})
+        return cols
+
+    def to_csv(self, path) -> None:
+        """The time histories, one row per step (module docstring), atomically."""
+        cols = self.columns()
+        with atomic_write(path, newline="") as fh:
+            fh.write(f"# {self.name}: transient simulated by powertrain ({self.method})\n")
+            writer = csv.writer(fh)
+            writer.writerow(list(cols))
+            writer.writerows(np.column_stack(list(cols.values())).tolist())
+
+    def to_hdf5(self, path) -> None:
+        """The time histories (SI) and the summary JSON as an attribute, atomically."""
+        import h5py  # deferred: heavy optional package
+        with atomic_path(path) as tmp, h5py.File(tmp, "w") as h5:
+            h5.attrs["summary"] = self.to_json()
+            for name in ("time", "rpm", "body", "displacement", "velocity", "acceleration",
+                         "force", "deflection"):
+                h5.create_dataset(name, data=getattr(self, name))
+            for k, v in self.torques.items():
+                h5.create_dataset(f"torque/{k}", data=v)
+            h5.attrs["channels"] = list(self.channels)
+            h5.attrs["networks"] = list(self.networks)
+
+    def writers(self) -> dict:
+        """``.csv``, ``.json``, ``.h5``/``.hdf5``, ``.png``."""
+        return {".csv": self.to_csv, ".json": self.to_json, ".h5": self.to_hdf5,
+                ".hdf5": self.to_hdf5, **super().writers()}
+
+    def plot(self, ax=None, *, path=None, channels=None, quantity="acceleration",
+             provenance=None):
+        """Crank speed and torque over time above the ``quantity`` (``acceleration``,
+        ``displacement``, ``force``) of ``channels`` (default: the seat's, else every mount's
+        z), peaks marked; returns the figure
+        (:func:`powertrain.plotting.transient.plot_transient`)."""
+        ax, path = target_and_path(ax, path)
+        return plot_transient(self, channels or self.default_channels(), path, ax=ax,
+                              provenance=provenance, quantity=quantity)
+
+    def default_channels(self) -> list:
+        """The seat's three axes, else the engine-side z of every mount."""
+        if self.seat is not None:
+            return [f"{self.seat['point']}.{a}" for a in "xyz"]
+        return [c for c in self.channels if c.endswith(".z") and "/" not in c][:3]
+
+    def to_text(self) -> str:
+        """Header, per channel peaks, seat values."""
+        p = self.peaks()
+        head = (f"transient '{self.name}' on {self.engine}: {self.time[-1]:g} s, "
+                f"{self.time.size - 1} steps ({self.method})")
+        rows = [[c, float(from_si(p["peak_to_peak"][k], "mm")), float(p["peak_force"][k]),
+                 float(p["max_acceleration"][k]), float(p["time_of_max_acceleration"][k])]
+                for k, c in enumerate(self.channels)]
+        text = head + "\n" + format_table(
+            ["channel", "p-p displ. [mm]", "peak force [N]", "max accel. [m/s^2]",
+             "at [s]"], rows)
+        if self.seat is not None:
+            s = self.seat
+            text += (f"\nseat {s['point']} (ISO 2631-1): weighted RMS "
+                     + ", ".join(f"{a} {s['rms'][a]:.4f}" for a in "xyz")
+                     + " m/s^2; VDV " + ", ".join(f"{a} {s['vdv'][a]:.4f}" for a in "xyz")
+                     + " m/s^1.75")
+        return text
+
+
+@dataclass(frozen=True)
+class TransientRanking(Result):
+    """Baseline and variants of the mount system over one manoeuvre (``powertrain whatif
+    --manoeuvre``), ranked by the peak acceleration at the seat (the largest magnitude of
+    its three axes) where the chassis has a seat point, else by the peak mount deflection.
+
+    Attributes
+    ----------
+    manoeuvre : str
+    names : list of str
+        ``baseline`` first, then the variants.
+    runs : list of TransientResult
+    """
+
+    manoeuvre: str
+    names: list
+    runs: list = field(repr=False)
+
+    def peak_seat(self):
+        """Peak seat acceleration [m/s²] per run, or None without a seat."""
+        if self.runs[0].seat is None:
+            return None
+        return np.array([max(float(np.max(np.abs(r.acceleration[:, r.channel(c)])))
+                             for c in r.default_channels()) for r in self.runs])
+
+    def peak_deflection(self):
+        """Largest mount deflection magnitude [m] per run and the mount direction."""
+        k = [int(np.argmax(np.max(np.abs(r.deflection), axis=0))) for r in self.runs]
+        return (np.array([float(np.max(np.abs(r.deflection[:, j])))
+                          for r, j in zip(self.runs, k)]),
+                [r.networks[j] for r, j in zip(self.runs, k)])
+
+    def ranking(self) -> list:
+        """Indices of the runs, best (smallest) first."""
+        seat = self.peak_seat()
+        key = seat if seat is not None else self.peak_deflection()[0]
+        return [int(i) for i in np.argsort(key, kind="stable")]
+
+    def to_dict(self) -> dict:
+        seat = self.peak_seat()
+        defl, where = self.peak_deflection()
+        return {"manoeuvre": self.manoeuvre, "ranked_by": "peak_seat_acceleration"
+                if seat is not None else "peak_mount_deflection",
+                "ranking": [self.names[i] for i in self.ranking()],
+                "runs": {n: {"peak_seat_acceleration_m_per_s2":
+                             None if seat is None else float(seat[k]),
+                             "peak_mount_deflection_mm": float(from_si(defl[k], "mm")),
+                             "peak_mount_deflection_at": where[k]}
+                         for k, n in enumerate(self.names)}}
+
+    def to_json(self, path=None) -> str:
+        """JSON text of :meth:`to_dict`; written atomically to ``path`` if given."""
+        return json_text(self.to_dict(), path)
+
+    def writers(self) -> dict:
+        """``.json``, ``.png``."""
+        return {".json": self.to_json, **super().writers()}
+
+    def target_fit(self, key):
+        raise InputError("a retune target's files come with a run-up what-if, not with "
+                         "--manoeuvre", key=key)
+
+    def plot(self, ax=None, *, path=None, provenance=None, view=None):
+        """Peak seat acceleration (if any) and peak mount deflection per run, bars
+        (:func:`powertrain.plotting.transient.plot_ranking`)."""
+        ax, path = target_and_path(ax, path)
+        return plot_ranking(self, path, ax=ax, provenance=provenance)
+
+    def to_text(self, written=()) -> str:
+        seat = self.peak_seat()
+        defl, where = self.peak_deflection()
+        rows = [[rank + 1, self.names[k], "-" if seat is None else f"{seat[k]:.4g}",
+                 "-" if seat is None else f"{100 * (seat[k] / seat[0] - 1):+.1f}",
+                 float(from_si(defl[k], "mm")), where[k],
+                 f"{100 * (defl[k] / defl[0] - 1):+.1f}"]
+                for rank, k in enumerate(self.ranking())]
+        head = (f"what-if over '{self.manoeuvre}': ranked by "
+                + ("peak seat acceleration" if seat is not None else "peak mount deflection"))
+        text = head + "\n" + format_table(
+            ["rank", "run", "seat peak [m/s^2]", "vs base [%]", "max deflection [mm]",
+             "at", "vs base [%]"], rows)
+        files = [str(w) for w in written if w]
+        return text + (f"\nwrote {', '.join(files)}" if files else "")
+
+
+@dataclass(frozen=True)
+class TransientComparison(Result):
+    """A simulated manoeuvre against a recording of it (``powertrain transient --compare``).
+
+    Attributes
+    ----------
+    name, raw : str
+        Manoeuvre name, the recording's file.
+    shift : float
+        Time of the simulation's start in the recording [s] (aligned on the speed).
+    time : ndarray (n,)
+        Simulated times [s].
+    channels : list of str
+    measured, simulated : ndarray (n, k)
+        Accelerations [m/s²] at the simulated times.
+    """
+
+    name: str
+    raw: str
+    shift: float
+    time: np.ndarray
+    channels: list
+    measured: np.ndarray
+    simulated: np.ndarray
+
+    def errors(self) -> dict:
+        """Per channel: the peaks [m/s²], the peak's error [%] and the RMS of the difference
+        over the event [m/s²] and relative to the measured RMS [%]."""
+        pm, ps = np.max(np.abs(self.measured), 0), np.max(np.abs(self.simulated), 0)
+        rms = np.sqrt(np.mean((self.simulated - self.measured) ** 2, axis=0))
+        base = np.sqrt(np.mean(self.measured ** 2, axis=0))
+        return {"peak_measured": pm, "peak_simulated": ps,
+                "peak_error_percent": 100.0 * (ps / np.where(pm > 0, pm, np.inf) - 1.0),
+                "rms_difference": rms,
+                "rms_difference_percent": 100.0 * rms / np.where(base > 0, base, np.inf)}
+
+    def to_dict(self) -> dict:
+        e = self.errors()
+        return {"manoeuvre": self.name, "recording": self.raw, "shift_s": self.shift,
+                "channels": {c: {k: float(v[j]) for k, v in e.items()}
+                             for j, c in enumerate(self.channels)}}
+
+    def to_json(self, path=None) -> str:
+        """JSON text of :meth:`to_dict`; written atomically to ``path`` if given."""
+        return json_text(self.to_dict(), path)
+
+    def writers(self) -> dict:
+        """``.json``, ``.png``."""
+        return {".json": self.to_json, **super().writers()}
+
+    def plot(self, ax=None, *, path=None, provenance=None):
+        """Measured and simulated acceleration per channel, overlaid; returns the figure
+        (:func:`powertrain.plotting.transient.plot_overlay`)."""
+        ax, path = target_and_path(ax, path)
+        return plot_overlay(self, path, ax=ax, provenance=provenance)
+
+    def to_text(self) -> str:
+        e = self.errors()
+        rows = [[c, float(e["peak_measured"][j]), float(e["peak_simulated"][j]),
+                 f"{e['peak_error_percent'][j]:+.1f}", float(e["rms_difference"][j]),
+                 f"{e['rms_difference_percent'][j]:.1f}"] for j, c in enumerate(self.channels)]
+        return (f"compared with {self.raw} (aligned on the crank speed: the simulation starts "
+                f"at {self.shift:.4f} s of the recording)\n" + format_table(
+                    ["channel", "measured peak [m/s^2]", "simulated peak", "peak error [%]",
+                     "RMS of difference", "of measured RMS [%]"], rows))

@@ -1,0 +1,268 @@
+r"""A transient manoeuvre integrated in time by the run-up's nonlinear stepper.
+
+The load of :mod:`powertrain.solvers.transient_load` at every step drives the model of
+:meth:`Engine.assemble` (rigid ground, modal body, base compliance) through
+:class:`~powertrain.solvers.cycle_newmark.CycleIntegrator`, the stretch-by-stretch Newmark
+stepper of the continuous sweep and of the dense run-up stepper (average acceleration; the
+port laws by Newton per step; the amplitude law once per stretch). Stretches are
+:data:`STRETCH` long (a linear model without static curves is one stretch).
+
+**Static curves, large deflection.** Coordinates are measured from the static operating
+point at zero mean torque (weight only, :func:`~powertrain.solvers.operating_point.operating_point`),
+whose network deflections are :math:`\delta_0`. At the start of every stretch, at the body's
+state :math:`\mathbf x_c`, each network with a static curve :math:`F(\delta)` is scaled by its
+static factor at :math:`\delta_c = \delta_0 + \mathbf r^T\mathbf x_c`
+(:meth:`MountElement.at_operating_point`: tangent stiffness :math:`k_c`) and loaded by the
+difference between the curve and that tangent,
+
+.. math:: c = F(\delta_c) - F(\delta_0) - k_c\,\mathbf r^T\mathbf x_c ,
+
+so that over the stretch the static force is the curve's tangent at :math:`\delta_c`
+(:math:`F(\delta_c) - F(\delta_0) + k_c\,\mathbf r^T(\mathbf x - \mathbf x_c)`): the body
+moves along the curves (small rotations), the dynamic network and friction on top. The
+network's tangent :math:`k_c` is its static stiffness times its stiffness scale (static
+factor and amplitude law), so the curve sets the force at every stretch's start and the
+amplitude law acts on the motion within a stretch and on the dampers. Mount forces are
+changes from the zero-torque static point.
+
+**Start.** At rest when the manoeuvre starts at standstill; else from the periodic steady
+state at its first speed and load (the equivalent-linear harmonic fixed point, port laws
+on their steady loop: :meth:`Stepper.harmonic_state`), as the run-up and the sweep start.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from powertrain.assembly import NetworkScaling
+from powertrain.errors import InputError
+from powertrain.kernels.port_forces import NONE
+from powertrain.solvers.cycle_newmark import CycleIntegrator, cycle_amplitudes, no_ports, start_state
+from powertrain.solvers.operating_point import StaticSupport, has_static_curves, operating_point
+from powertrain.solvers.steppers import Cycles, DenseNewmarkStepper
+from powertrain.solvers.transient_load import N_THETA, RPM, transient_load
+
+#: Length of a stretch [s]: the amplitude law and the static curves' tangents are updated
+#: this often (a rigid-body mode of 12 Hz is 8 stretches per period).
+STRETCH = 0.01
+#: Most integration steps of a manoeuvre (checked before any work).
+MAX_STEPS = 2 ** 21
+#: Speed below which the step is set as at this speed [rpm]: standstill needs a step too.
+FLOOR_RPM = 600.0
+
+
+@dataclass(frozen=True)
+class TransientRun:
+    """A manoeuvre's time histories at every step (SI).
+
+    Attributes
+    ----------
+    load : TransientLoad
+        Times, crank motion, torques and the load.
+    body : ndarray (n_t, 6)
+        Body displacement [m] and rotation [rad] at the CG from the zero-torque static point.
+    displacement, velocity, acceleration, force : ndarray (n_t, n_ch)
+        Channel motion [m, m/s, m/s²] (engine side, then body side and body points) and
+        transmitted force [N].
+    deflection : ndarray (n_t, n_net)
+        Network deflection (engine side minus base) from the zero-torque static point [m].
+    channels : list of (str, str)
+    networks : list of str
+    method : str
+    """
+
+    load: object
+    body: np.ndarray
+    displacement: np.ndarray
+    velocity: np.ndarray
+    acceleration: np.ndarray
+    force: np.ndarray
+    deflection: np.ndarray
+    channels: list
+    networks: list
+    method: str
+
+
+def transient_steps(manoeuvre, angle_step_deg) -> int:
+    """Integration steps: ``angle_step_deg`` of crank angle at the top speed (at least
+    :data:`FLOOR_RPM`), bounded by :data:`MAX_STEPS` before any work."""
+    if not (math.isfinite(angle_step_deg) and 0.01 <= angle_step_deg <= 10.0):
+        raise InputError("must be 0.01..10 [deg]", key="--angle-step")
+    top = max(manoeuvre.max_speed, FLOOR_RPM * RPM)
+    n = math.ceil(manoeuvre.duration * top / math.radians(angle_step_deg) - 1e-9)
+    if n > MAX_STEPS:
+        raise InputError(f"{n} integration steps; at most {MAX_STEPS} (a shorter manoeuvre "
+                         "or a larger --angle-step)", file=manoeuvre.file or None, key="speed")
+    return max(n, 1)
+
+
+def simulate_transient(engine, manoeuvre, *, system=None, angle_step_deg=1.0) -> TransientRun:
+    """Integrate ``manoeuvre`` on ``engine`` (module docstring).
+
+    Parameters
+    ----------
+    engine : Engine
+    manoeuvre : Manoeuvre
+    system : AssembledSystem, optional
+        The model (default ``engine.assemble()``).
+    angle_step_deg : float
+        Crank angle per step at the top speed [deg].
+
+    Returns
+    -------
+    TransientRun
+    """
+    top = engine.speed_range_rpm()[1]
+    if manoeuvre.max_speed / RPM > top + 1e-6:
+        raise InputError(f"{manoeuvre.max_speed / RPM:g} rpm is above the engine's combustion "
+                         f"model ({top:g} rpm)", file=manoeuvre.file or None, key="speed.speed")
+    system = engine.assemble() if system is None else system
+    if system.chassis is not None:
+        system.chassis.require_time_domain()
+    n_steps = transient_steps(manoeuvre, angle_step_deg)
+    t = np.linspace(0.0, manoeuvre.duration, n_steps + 1)
+    load = transient_load(engine, manoeuvre, t)
+    F = np.zeros((t.size, system.n_dof))
+    F[:, :6] = load.F
+    ports = system.port_forces() or no_ports(system)
+    integrator = CycleIntegrator(NetworkScaling(system), ports, t[1] - t[0],
+                                 np.zeros(system.n_dof))
+    curves = _Curves(engine, system) if has_static_curves(engine) else None
+    start = _start(engine, manoeuvre, system, load, ports, curves)
+    every = max(1, round(STRETCH / (t[1] - t[0]))) if (integrator.varying or curves) \
+        else n_steps
+    out = _run(system, integrator, ports, curves, F, start, every)
+    Cm = system.channel_matrix
+    X, V, A, force = out
+    return TransientRun(load, X[:, :6].copy(), X @ Cm.T, V @ Cm.T, A @ Cm.T, force,
+                        X @ system.port_rows.T, list(system.channels),
+                        system.network_names, _method(integrator, curves, every))
+
+
+def _method(integrator, curves, every):
+    parts = ["Newmark average acceleration, dense"]
+    if integrator.laws.kinds.size:
+        parts.append("port laws by Newton per step")
+    if integrator.varying:
+        parts.append(f"amplitude law every {every} steps")
+    if curves is not None:
+        parts.append(f"static curves' tangents every {every} steps")
+    return "; ".join(parts)
+
+
+def _run(system, integrator, ports, curves, F, start, every):
+    """States X, V, A (n_t, n) and channel forces (n_t, n_ch), stretch by stretch."""
+    x, v, a, state, amplitudes = start
+    n_t = F.shape[0]
+    X, V, A = (np.empty((n_t, system.n_dof)) for _ in range(3))
+    force = np.empty((n_t, system.channel_matrix.shape[0]))
+    laws_map = integrator.laws.force_map
+    bounds = list(range(0, n_t - 1, every)) + [n_t - 1]
+    for lo, hi in zip(bounds[:-1], bounds[1:]):
+        factors, c = (None, None) if curves is None else curves.at(
+            x, integrator.scaling, ports.network_amplitudes(amplitudes))
+        Fs = F[lo:hi + 1] if c is None else F[lo:hi + 1] - c @ system.port_rows
+        (Xs, Vs, As, Zs), (Fk, Fd, off) = integrator.run(Fs, (x, v, a), amplitudes, state,
+                                                        factors)
+        rows = slice(lo, hi + 1)
+        X[rows], V[rows], A[rows] = Xs, Vs, As
+        f = Xs @ Fk.T + Vs @ Fd.T - (0.0 if off is None else off)
+        if Zs is not None:
+            f += Zs @ laws_map.T
+        if c is not None:
+            f += c @ system.port_force_map.T
+        force[rows] = f
+        if integrator.varying:
+            amplitudes = cycle_amplitudes(Xs[:-1] @ ports.rows.T)
+        x, v, a = Xs[-1], Vs[-1], As[-1]
+    return X, V, A, force
+
+
+def _start(engine, manoeuvre, system, load, ports, curves):
+    """``(x0, v0, a0, port-law states, amplitudes)``: rest at standstill, else the periodic
+    steady state at the first speed and load."""
+    laws = ports.select(ports.kinds != NONE)
+    n = system.n_dof
+    omega = abs(float(load.omega[0]))
+    if omega == 0.0:
+        x0 = np.zeros(n)
+        state = laws.initial_state(x0) if laws.kinds.size else None
+        return x0, np.zeros(n), None, state, np.zeros(ports.kinds.size)
+    grid = Cycles(N_THETA, 720.0 / N_THETA, 1, 1)
+    stepper = DenseNewmarkStepper(system, grid)
+    theta = float(load.theta[0]) + np.arange(N_THETA) * (4 * np.pi / N_THETA)
+    cycle = _cycle_load(engine, manoeuvre, theta)
+    fh, omegas = stepper.harmonics(cycle, omega, 40.0)
+    factors = None if curves is None else curves.factors(np.zeros(n))
+    qh, A = stepper.harmonic_state(fh, omegas, omega, stepper.system_at(factors))
+    x0 = qh.real.sum(0)
+    v0 = (1j * omegas[:, None] * qh).real.sum(0)
+    a0 = (-(omegas ** 2)[:, None] * qh).real.sum(0)
+    state = start_state(ports, qh, N_THETA) if ports.kinds.size else None
+    return x0, v0, a0, state, (np.zeros(ports.kinds.size) if A is None else A)
+
+
+def _cycle_load(engine, manoeuvre, theta):
+    """The load (N_THETA, 6) over one cycle from the angles ``theta`` [rad] of the
+    manoeuvre held at its first speed and load (no acceleration)."""
+    w0 = float(manoeuvre.speed[0])
+    T = 4 * np.pi / abs(w0)
+    held = dataclasses.replace(manoeuvre, time=np.array([0.0, T]), speed=np.full(2, w0),
+                               load_time=np.array([0.0, T]),
+                               load=np.full(2, float(manoeuvre.load_at(0.0))), starter=None)
+    out = transient_load(engine, held, (theta - theta[0]) / abs(w0)).F
+    return out
+
+
+#: Samples of each static curve's force and tangent over its points' range and as much
+#: again on either side (the curve is straight beyond its points), read linearly: the
+#: force's interpolation error is below 1e-4 N for the shipped curves.
+CURVE_SAMPLES = 20001
+
+
+class _Curves:
+    """The networks' static curves about the zero-torque static point (module docstring),
+    each sampled once (:data:`CURVE_SAMPLES`)."""
+
+    def __init__(self, engine, system):
+        support = StaticSupport.of(engine)
+        self.stiffness = support.stiffness
+        rpm = engine.speed_range_rpm()[0]
+        self.d0 = operating_point(engine, rpm, support, mean_torque=0.0).deflection.ravel()
+        self.rows = system.port_rows
+        self.has = np.array([c is not None for c in support.curves])
+        self.tables = [None if c is None else _sampled(c) for c in support.curves]
+        self.f0 = self._forces(self.d0)
+
+    def _forces(self, d):
+        return np.array([0.0 if t is None else np.interp(x, t[0], t[1])
+                         for t, x in zip(self.tables, d)])
+
+    def factors(self, x):
+        """Static factor of every network at the state ``x`` (1 without a curve)."""
+        d = self.d0 + self.rows @ x
+        return np.array([1.0 if t is None else np.interp(v, t[0], t[2]) / t[3]
+                         for t, v in zip(self.tables, d)])
+
+    def at(self, x, scaling, amplitudes):
+        """Static factors and the curves' load ``c`` (n_net,) [N] at the state ``x``, the
+        networks' tangent stiffness their static stiffness times their stiffness scale at
+        the static factors and the networks' ``amplitudes`` [m] (``scaling.scales``)."""
+        u = self.rows @ x
+        factors = self.factors(x)
+        k = scaling.scales(amplitudes, factors)[:, 0] * self.stiffness
+        c = np.where(self.has, self._forces(self.d0 + u) - self.f0 - k * u, 0.0)
+        return factors, c
+
+
+def _sampled(curve):
+    """``(deflection, force, tangent, tangent at the reference)`` of a static curve."""
+    lo, hi = float(curve.deflection[0]), float(curve.deflection[-1])
+    grid = np.linspace(2 * lo - hi, 2 * hi - lo, CURVE_SAMPLES)
+    return (grid, np.asarray(curve.force_at(grid), float),
+            np.asarray(curve.tangent_at(grid), float),
+            float(curve.tangent_at(curve.reference_deflection)))

@@ -1,0 +1,191 @@
+r"""The load on the powertrain over a transient manoeuvre, at every time step.
+
+At crank angle :math:`\theta`, speed :math:`\omega` and angular acceleration
+:math:`\alpha` (:meth:`~powertrain.models.manoeuvre.Manoeuvre.crank_motion`) the block load
+is the run-up's excitation extended to any speed (:meth:`Engine.load_table`, linear in the
+gas forces and in :math:`\omega^2`) plus the moving masses' tangential accelerations
+(:meth:`Engine.motion_patterns`, linear in :math:`\alpha`):
+
+.. math:: \mathbf f(t) = \tilde{\mathbf G}(\theta, |\omega|, s)
+   + \omega^2\,\mathbf I(\theta) + \alpha\,\tilde{\mathbf A}(\theta)
+   - \big(J\alpha + i\,T_d\big)\,\mathbf n .
+
+:math:`\tilde{\mathbf G}` is the gas part with the cycle mean of its roll moment about the
+crank sense :math:`\mathbf n` removed (likewise :math:`\tilde{\mathbf A}`): the mean roll
+reaction is written out by the last term, from the powertrain's angular momentum: the crank
+train and flywheel (:math:`J`, ``crank_inertia``) accelerating at :math:`\alpha` push the
+housing back with :math:`-J\alpha\,\mathbf n`, and the driveline torque :math:`T_d` reacts
+with the gear ratio :math:`i` (0 in neutral). The starter's drive and its reaction on the
+block are both inside the powertrain, so they cancel in the net load on the rigid body; its
+torque :math:`T_s = J\alpha + T_d - T_e` (while engaged) is reported. The fluctuation of the
+gas and inertia torque about its cycle mean reaches the block as in the run-up.
+
+The gas load is tabulated over the crank angle (0.5°), the speed (25 rpm, clamped to the
+combustion model's range: below it the pressure of its lowest speed) and the IMEP scale
+(the load table's values; the mean-torque form uses :math:`s = T_d / T_{full}(\omega)` on
+a 0.1 grid), and read trilinearly; below :data:`FADE_RPM` it fades out linearly to none at
+rest. :math:`T_e` is the model's mean brake torque at
+:math:`(\omega, s)`; in the IMEP form :math:`T_d = T_e - J\alpha` when a gear is engaged.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from powertrain.units import UNITS
+
+#: Crank-angle samples of the load table over the cycle, and its speed step [rpm].
+N_THETA = 1440
+RPM_STEP = 25.0
+#: IMEP scales of the table of a mean-torque manoeuvre.
+TORQUE_SCALES = np.linspace(0.0, 1.0, 11)
+#: Below this speed [rpm] the gas load fades out linearly to none at rest: a crank at rest
+#: holds its cylinders' gas torque inside the engine (it stops where the compression torques
+#: balance); the run-up's excitation holds from here up.
+FADE_RPM = 50.0
+#: Most distinct IMEP scales of a table (else a regular grid over their range).
+MAX_SCALES = 32
+RPM = UNITS["rpm"][1]
+
+
+@dataclass(frozen=True)
+class TransientLoad:
+    """The manoeuvre at every time step: times [s], crank angle [rad], speed [rad/s],
+    acceleration [rad/s²], IMEP scale [-], engine mean brake torque, driveline torque and
+    starter torque [N·m], and the generalized load ``F`` (n_t, 6) [N, N·m] about the CG."""
+
+    t: np.ndarray
+    theta: np.ndarray
+    omega: np.ndarray
+    alpha: np.ndarray
+    scale: np.ndarray
+    engine_torque: np.ndarray
+    driveline_torque: np.ndarray
+    starter_torque: np.ndarray
+    F: np.ndarray
+
+
+def transient_load(engine, manoeuvre, t) -> TransientLoad:
+    """The load of ``manoeuvre`` on ``engine`` at the times ``t`` [s] (module docstring)."""
+    theta, omega, alpha = manoeuvre.crank_motion(t)
+    n = np.array([float(engine.crank.rotation_sign), 0.0, 0.0])
+    table = _GasTable(engine, manoeuvre)
+    spin = np.abs(omega)
+    if manoeuvre.load_kind == "mean_torque":
+        driveline = manoeuvre.load_at(t)
+        scale = np.clip(driveline / np.maximum(table.full_torque(spin), 1e-9), 0.0, 1.0)
+        engine_torque = table.torque(spin, scale)
+    else:
+        scale = manoeuvre.load_at(t)
+        engine_torque = table.torque(spin, scale)
+        driveline = (engine_torque - manoeuvre.crank_inertia * alpha
+                     if manoeuvre.gear_ratio > 0 else np.zeros_like(t))
+    J = manoeuvre.crank_inertia
+    F = table.gas(theta, spin, scale) * np.clip(spin / (FADE_RPM * RPM), 0.0, 1.0)[:, None]
+    th = np.mod(theta, 4 * np.pi) * (N_THETA / (4 * np.pi))
+    F += (omega ** 2)[:, None] * _periodic(table.inertia, th)
+    F += alpha[:, None] * _periodic(table.acceleration, th)
+    F[:, 3:] -= (J * alpha + manoeuvre.gear_ratio * driveline)[:, None] * n[None, :]
+    starter = np.zeros_like(t)
+    if manoeuvre.starter is not None:
+        on = t < manoeuvre.starter.until
+        starter[on] = (J * alpha + driveline - engine_torque)[on]
+    return TransientLoad(np.asarray(t, float), theta, omega, alpha, scale, engine_torque,
+                         driveline, starter, F)
+
+
+def _periodic(table, th):
+    """Rows of ``table`` (N_THETA + 1, 6) at the fractional indices ``th``, linear."""
+    i = np.minimum(th.astype(np.int64), N_THETA - 1)
+    w = (th - i)[:, None]
+    return table[i] * (1.0 - w) + table[i + 1] * w
+
+
+class _GasTable:
+    """The gas load per IMEP scale, speed and crank angle, the cycle mean of its roll
+    removed; the inertia and acceleration patterns; the mean brake torque per scale and
+    speed."""
+
+    def __init__(self, engine, manoeuvre):
+        lo, hi = engine.speed_range_rpm()
+        top = min(hi, max(lo, manoeuvre.max_speed / RPM))
+        self.speeds = np.arange(lo, top + RPM_STEP, RPM_STEP).clip(lo, top)
+        self.scales = _scales(manoeuvre)
+        theta = np.arange(N_THETA) * (4 * np.pi / N_THETA)
+        self.n = np.array([float(engine.crank.rotation_sign), 0.0, 0.0])
+        inertia, acceleration = engine.motion_patterns(theta)
+        w2 = ((self.speeds * RPM) ** 2)[:, None, None]
+        gas = np.stack([engine.load_table(self.speeds, theta, s) - w2 * inertia
+                        for s in self.scales])
+        self.table = _wrap(self._no_mean_roll(gas), axis=2)
+        self.inertia = _wrap(inertia, axis=0)
+        self.acceleration = _wrap(self._no_mean_roll(acceleration), axis=0)
+        self.torques = np.array([[engine.mean_brake_torque(n, s) for n in self.speeds]
+                                 for s in self.scales])
+        self.full = np.array([engine.mean_brake_torque(n, 1.0) for n in self.speeds])
+
+    def _no_mean_roll(self, load):
+        """``load`` (..., n_theta, 6) with the cycle mean of its roll moment removed."""
+        roll = np.mean(load[..., 3:] @ self.n, axis=-1)
+        out = load.copy()
+        out[..., 3:] -= roll[..., None, None] * self.n
+        return out
+
+    def _speed_index(self, spin):
+        v = np.clip((spin / RPM - self.speeds[0]) / RPM_STEP, 0.0, self.speeds.size - 1.0)
+        i = np.minimum(v.astype(np.int64), max(self.speeds.size - 2, 0))
+        return i, np.minimum(i + 1, self.speeds.size - 1), v - i
+
+    def _scale_index(self, scale):
+        s = self.scales
+        if s.size == 1:
+            return np.zeros(scale.size, np.int64), np.zeros(scale.size, np.int64), \
+                np.zeros(scale.size)
+        j = np.clip(np.searchsorted(s, scale, side="right") - 1, 0, s.size - 2)
+        w = np.clip((scale - s[j]) / (s[j + 1] - s[j]), 0.0, 1.0)
+        return j, j + 1, w
+
+    def gas(self, theta, spin, scale):
+        """Gas load (n_t, 6), trilinear in the table."""
+        th = np.mod(theta, 4 * np.pi) * (N_THETA / (4 * np.pi))
+        u0 = np.minimum(th.astype(np.int64), N_THETA - 1)
+        fu = (th - u0)[:, None]
+        s0, s1, fs = self._scale_index(scale)
+        v0, v1, fv = self._speed_index(spin)
+        out = np.zeros((theta.size, 6))
+        for s, ws in ((s0, 1.0 - fs), (s1, fs)):
+            for v, wv in ((v0, 1.0 - fv), (v1, fv)):
+                w = (ws * wv)[:, None]
+                out += w * (self.table[s, v, u0] * (1.0 - fu) + self.table[s, v, u0 + 1] * fu)
+        return out
+
+    def torque(self, spin, scale):
+        """Mean brake torque [N·m] at the speeds [rad/s] and scales, bilinear."""
+        s0, s1, fs = self._scale_index(scale)
+        v0, v1, fv = self._speed_index(spin)
+        T = self.torques
+        return ((T[s0, v0] * (1 - fv) + T[s0, v1] * fv) * (1 - fs)
+                + (T[s1, v0] * (1 - fv) + T[s1, v1] * fv) * fs)
+
+    def full_torque(self, spin):
+        """Full-load mean brake torque [N·m] at the speeds [rad/s]."""
+        v0, v1, fv = self._speed_index(spin)
+        return self.full[v0] * (1 - fv) + self.full[v1] * fv
+
+
+def _wrap(a, axis):
+    """``a`` with its first row along ``axis`` appended (periodic wrap)."""
+    first = np.take(a, [0], axis=axis)
+    return np.concatenate([a, first], axis=axis)
+
+
+def _scales(manoeuvre):
+    """IMEP scales of the gas table."""
+    if manoeuvre.load_kind == "mean_torque":
+        return TORQUE_SCALES
+    values = np.unique(manoeuvre.load)
+    if values.size > MAX_SCALES:
+        values = np.linspace(values[0], values[-1], MAX_SCALES)
+    return values
