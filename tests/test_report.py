@@ -72,14 +72,15 @@ def test_one_self_contained_file_under_10_mb(made, html):
     assert sources and all(s.startswith("data:") for s in sources), \
         [s[:40] for s in sources if not s.startswith("data:")]
     assert "default-src 'none'" in html           # the page itself forbids any other source
-    assert html.count("<img ") == html.count("data:image/png;base64,") == 6
+    assert html.count("<img ") == html.count("data:image/png;base64,") == 7
 
 
 @on_the_example
 def test_summary_first_then_a_section_per_step_then_reproduction(made, html):
     rep, _ = made
     ids = re.findall(r'<section[^>]* id="([a-z]+)"', html)
-    assert ids == ["summary", "compare", "diagnose", "whatif", "modes", "reproduce"]
+    assert ids == ["summary", "compare", "diagnose", "whatif", "modes", "transient",
+                   "reproduce"]
     summary = html[html.index('id="summary"'):html.index('id="compare"')]
     assert rep.study.engine.name in summary and "SYNTHETIC" in summary
     assert html_text("VERDICT: " + rep.parts["diagnose"][0][1].verdict_text) in summary
@@ -133,8 +134,8 @@ def test_the_report_follows_the_result_protocol(made, tmp_path):
     fig = plt.figure()
     assert rep.plot(fig, step="modes") is fig
     plt.close(fig)
-    with pytest.raises(pt.InputError, match="no step 'transient'"):
-        rep.plot(step="transient")
+    with pytest.raises(pt.InputError, match="no step 'shaker'"):
+        rep.plot(step="shaker")
 
 
 @on_the_example
@@ -237,7 +238,7 @@ def _study(tmp_path, text: str) -> Path:
 
 
 BAD = {
-    "unknown key": ('measured = "MEASURED"\ntransient = {}\n[modes]\n', "transient",
+    "unknown key": ('measured = "MEASURED"\nshaker = {}\n[modes]\n', "shaker",
                     "unknown key"),
     "both measured and plan": ('measured = "MEASURED"\nplan = "p.toml"\n[modes]\n', "plan",
                                "not both"),
@@ -259,6 +260,11 @@ BAD = {
     "whatif speeds": ('[whatif]\nscale = "left.z.stiffness=1.2"\nfrom = 3000\nto = 2000\n',
                       "whatif.to", "below"),
     "modes static": ("[modes]\nstatic = 1\n", "modes.static", "true or false"),
+    "no manoeuvre": ("[transient]\nmanoeuvres = []\n", "transient.manoeuvres", "at least one"),
+    "manoeuvre file": ('[transient]\nmanoeuvres = "nope.toml"\n', "transient.manoeuvres",
+                       "no such file"),
+    "transient key": ('[transient]\nmanoeuvres = "MEASURED"\nspeed = 1\n', "transient.speed",
+                      "unknown key"),
     "step not a table": ("modes = 1\n", "modes", "expected a table"),
     "no step": ('measured = "MEASURED"\n', "steps", "no step"),
     "noise floor unit": ('noise_floor = {value = 1, unit = "kg"}\n[modes]\n', "noise_floor",

@@ -21,10 +21,10 @@ def report(study, out, quiet):
 
     STUDY: a study file (TOML) naming the engine, the measured run-up (measured = FILE) or
     a test plan (plan = PLAN.toml), and the steps to include as tables: [compare],
-    [diagnose], [whatif], [modes]. Paths in it are relative to it. The report: a summary
-    (engine, files with provenance and SHA-256, verdict, top gaps), a section per step
-    with its tables (per channel, worst first) and figures, and the commands and versions
-    that reproduce it.
+    [diagnose], [whatif], [modes], [transient]. Paths in it are relative to it. The report:
+    a summary (engine, files with provenance and SHA-256, verdict, top gaps), a section per
+    step with its tables (per channel, worst first) and figures, and the commands and
+    versions that reproduce it.
 
     \b
     Examples:

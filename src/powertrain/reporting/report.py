@@ -56,7 +56,8 @@ def report(study, out=None, *, progress: bool = False) -> ReportResult:
     ----------
     study : str or Path
         Study file (TOML; docs/reference/study-file.md): the engine, the measured run-up or a
-        plan, and the steps (``[compare]``, ``[diagnose]``, ``[whatif]``, ``[modes]``).
+        plan, and the steps (``[compare]``, ``[diagnose]``, ``[whatif]``, ``[modes]``,
+        ``[transient]``).
     out : str or Path, optional
         HTML file written (atomically) when given.
     progress : bool

@@ -1,12 +1,12 @@
 """The steps a study may include, each a table of the study file (``[compare]``,
-``[diagnose]``, ``[whatif]``, ``[modes]``) run through the library's own function
+``[diagnose]``, ``[whatif]``, ``[modes]``, ``[transient]``) run through the library's own function
 (:func:`powertrain.compare` ...), and shown as a section of the report.
 
 A :class:`Step` says how to check its table, run it, draw its figures, show its result in
-HTML and repeat it on the command line. Adding a kind of step (e.g. transient manoeuvres,
-once ``pt.transient`` exists) is one more entry in :data:`STEPS`: a checker of its keys, a
-function calling the library, its figures, its result's ``_repr_html_`` tables and its
-command line; the study reader, the summary and the document take every entry as it is.
+HTML and repeat it on the command line. A kind of step is one entry in :data:`STEPS`: a
+checker of its keys, a function calling the library, its figures, its result's
+``_repr_html_`` tables and its command line; the study reader, the summary and the document
+take every entry as it is. ``[transient]`` runs manoeuvre files (:func:`powertrain.transient`).
 """
 
 from __future__ import annotations
@@ -22,11 +22,12 @@ from powertrain.effects import EFFECTS
 from powertrain.errors import InputError
 from powertrain.plotting.diagnosis import plot_diagnosis_overlay, plot_gap_frequency
 from powertrain.reporting import keys as k
-from powertrain.results.html_tables import comparison_html, modes_html, whatif_html
+from powertrain.results.html_tables import comparison_html, modes_html, transient_html, whatif_html
 from powertrain.solvers.steppers import SOLVERS
 from powertrain.workflows.arguments import speed_steps
 from powertrain.workflows.comparison import compare
 from powertrain.workflows.modes import modes
+from powertrain.workflows.transient import transient
 from powertrain.workflows.whatif import command_variants, whatif
 
 #: What-if operations a study may list (the command's repeatable options), in their order.
@@ -207,8 +208,8 @@ def _whatif_run(study, opts, progress) -> list:
 
 
 def _whatif_figures(result, provenance) -> list:
-    return [("Levels of the baseline (black), the variants and the measurement (grey) where "
-             "some variant changes them by at least 1 dB (the table gives every change).",
+    return [("Levels of the baseline (black), the variants and the measurement (grey), every "
+             "channel (the table gives every change in dB).",
              lambda: result.plot(provenance=provenance))]
 
 
@@ -256,6 +257,32 @@ def _modes_commands(study, opts) -> list:
                    *(["--static"] if opts["static"] else [])])]
 
 
+# ------------------------------------------------------------------ transient
+def _transient_options(table, where) -> dict:
+    k.check_keys(table, ("manoeuvres", "seat"), where, "transient")
+    files = k.strings(table, "manoeuvres", where, "transient")
+    if not files:
+        raise where.error("expected at least one manoeuvre file", "transient.manoeuvres")
+    return {"files": [k.existing(f, where, "transient.manoeuvres") for f in files],
+            "seat": k.string(table, "seat", where, "transient")}
+
+
+def _transient_run(study, opts, progress) -> list:
+    results = [transient(f, study.engine, seat=opts["seat"]) for f in opts["files"]]
+    return [(r.name, r) for r in results]
+
+
+def _transient_figures(result, provenance) -> list:
+    return [("Crank speed and torque over the manoeuvre above the seat's (else the mounts') "
+             "accelerations, peaks marked.", lambda: result.plot(provenance=provenance))]
+
+
+def _transient_commands(study, opts) -> list:
+    seat = ["--seat", opts["seat"]] if opts["seat"] else []
+    return [_line(["powertrain", "transient", shown(f), *_engine_words(study), *seat])
+            for f in opts["files"]]
+
+
 #: The steps a study may include, in the order of the report's sections.
 STEPS = {
     "compare": Step("Compare: simulated against measured", _compare_options, _compare_run,
@@ -268,4 +295,7 @@ STEPS = {
                    _whatif_figures, whatif_html, _whatif_commands, cost=1),
     "modes": Step("Rigid-body modes", _modes_options, _modes_run, _modes_figures, modes_html,
                   _modes_commands, cost=0),
+    "transient": Step("Transient manoeuvres: starts, stops, tip-ins", _transient_options,
+                      _transient_run, _transient_figures, transient_html,
+                      _transient_commands, cost=1),
 }

@@ -146,7 +146,7 @@ def _noise_floor(doc, where) -> float:
 
 def _with_files(study: Study, where) -> Study:
     """``study`` with ``files``: the study file, the engine and its mount files, the
-    measurement (plan, runs, pressure traces) and the what-if files."""
+    measurement (plan, runs, pressure traces), the what-if files and the manoeuvres."""
     files = [("study", study.path), ("engine", study.engine.file)]
     for m in study.engine.mounts:
         files += [(f"mount {m.name}.{d}", os.path.normpath(f)) for d, f in m.files.items()]
@@ -163,6 +163,7 @@ def _with_files(study: Study, where) -> Study:
         files.append(("what-if variants", opts["variants"]))
     for spec in (opts or {}).get("ops", {}).get("swap", []):
         files.append((f"what-if swap {spec.partition('=')[0]}", spec.partition("=")[2]))
+    files += [("manoeuvre", f) for f in study.steps.get("transient", {}).get("files", [])]
     roles = {}                               # real path -> [path, roles]
     for role, f in files:
         roles.setdefault(os.path.realpath(f), [f, []])[1].append(role)

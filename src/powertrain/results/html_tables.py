@@ -161,3 +161,28 @@ def modes_html(r) -> str:
             + table(header, rows, "Modes by frequency; kinetic energy per coordinate")
             + paragraph(f"torque-roll axis through the CG, direction [{axis}] (engine axes), "
                         f"{t['angle_to_crank_axis_deg']:.2f}° from the crank axis"))
+
+
+# ------------------------------------------------------------------ transient
+def transient_html(r) -> str:
+    """A :class:`~powertrain.results.transient.TransientResult`: per channel the peak-to-peak
+    displacement, peak force and maximum acceleration (largest acceleration first), the
+    mounts' deflections, and the seat's ISO 2631-1 values."""
+    p = r.peaks()
+    order = np.argsort(-p["max_acceleration"], kind="stable")
+    rows = [[r.channels[k], number(p["max_acceleration"][k], ".2f"),
+             number(p["time_of_max_acceleration"][k], ".3f"),
+             number(p["peak_to_peak"][k] * 1e3, ".2f"), number(p["peak_force"][k], ".0f")]
+            for k in order]
+    head = paragraph(f"manoeuvre {r.name} ({r.file}): {r.time[-1]:g} s, {r.time.size - 1} "
+                     f"steps ({r.method}); peak crank speed {np.max(r.rpm):.0f} rpm")
+    out = head + table(["channel", "max accel. [m/s²]", "at [s]", "p-p displ. [mm]",
+                        "peak force [N]"], rows,
+                       "Per channel, largest acceleration first")
+    if r.seat is not None:
+        s = r.seat
+        out += table(["seat axis", "weighted RMS [m/s²]", "VDV [m/s^1.75]", "weighting"],
+                     [[a, number(s["rms"][a], ".4f"), number(s["vdv"][a], ".4f"),
+                       s["weighting"][a] if isinstance(s["weighting"], dict) else s["weighting"]]
+                      for a in "xyz"], f"Seat {s['point']}: ISO 2631-1")
+    return out

@@ -32,6 +32,8 @@ from powertrain.outputs import atomic_path, atomic_write, json_text
 from powertrain.plotting.style import target_and_path
 from powertrain.plotting.transient import plot_overlay, plot_ranking, plot_transient
 from powertrain.results.base import Result
+from powertrain.results.html import fragment
+from powertrain.results.html_tables import transient_html
 from powertrain.units import from_si
 
 _BODY = ("x_mm", "y_mm", "z_mm", "rx_deg", "ry_deg", "rz_deg")
@@ -182,6 +184,10 @@ class TransientResult(Result):
         ax, path = target_and_path(ax, path)
         return plot_transient(self, channels or self.default_channels(), path, ax=ax,
                               provenance=provenance, quantity=quantity)
+
+    def _repr_html_(self) -> str:
+        """HTML tables of this result (Jupyter shows them; :mod:`powertrain.results.html`)."""
+        return fragment(transient_html(self))
 
     def default_channels(self) -> list:
         """The seat's three axes, else the engine-side z of every mount."""
