@@ -68,11 +68,10 @@ def _which(r) -> list:
              f"  {'(baseline)':<40} {0:>2} {b.heldout_rms_db:>11.2f} {'':>6} {'':>8} "
              f"{'':>6} {b.struct_db:>9.2f}"]
     for o in r.outcomes:
-        flag = " [evaluation budget hit]" if o.budget_hit else ""
         expl = f"{o.explained:>6.0%}" if np.isfinite(o.explained) else f"{'-':>6}"
         lines.append(f"  {o.label:<40} {o.n_params:>2} {o.heldout_rms_db:>11.2f} "
                      f"{o.t_stat:>6.1f} {o.bic_gain:>8.1f} {expl} "
-                     f"{o.struct_db:>9.2f}  {o.status}{flag}")
+                     f"{o.struct_db:>9.2f}  {o.status}")
     if r.chosen is not None:
         lines.append("  parameters (1 sigma, Gauss-Newton, optimistic):")
         for e, ps in r.chosen.params.items():
@@ -89,8 +88,7 @@ def _which(r) -> list:
         lines.append("  confounding check (refit on speed bands):")
         for bnd in r.band_check:
             txt = ", ".join(f"{k}={v:.3g}" for k, v in bnd["parameters"].items())
-            stop = " (refit stopped at its budget)" if bnd.get("budget_hit") else ""
-            lines.append(f"    {bnd['rpm_from']:g}-{bnd['rpm_to']:g} rpm: {txt}{stop}")
+            lines.append(f"    {bnd['rpm_from']:g}-{bnd['rpm_to']:g} rpm: {txt}")
     return lines
 
 
@@ -122,9 +120,6 @@ def summary(r) -> str:
     for k, run in enumerate(r.runs, start=1):
         lines.append(f"  run {k}: {run['heldout_rms_db_before']:.2f} -> "
                      f"{run['heldout_rms_db_after']:.2f} dB RMS")
-    if r.budget_hits:
-        lines.append(f"  evaluation budget hit by: {', '.join(r.budget_hits)} (best point "
-                     f"so far kept)")
     lines += ["", f"VERDICT: {r.verdict_text}", f"({r.seconds:.1f} s)"]
     return "\n".join(lines)
 

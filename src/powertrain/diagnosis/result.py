@@ -136,7 +136,8 @@ class DiagnosisResult(Result):
                 "heldout_block_chi2_ratio": o.chi2_ratio,
                 "heldout_cells_check": None if o.cells_check is None else {
                     k: v for k, v in o.cells_check.items() if k != "parts"},
-                "nfev": o.nfev, "n_eval": o.n_eval, "budget_hit": o.budget_hit, "seconds": o.seconds}
+                "nfev": o.nfev, "n_eval": o.n_eval, "budget_hit": o.budget_hit, "seconds": o.seconds,
+                "alternatives": o.alternatives}
 
     def _decision_rule_dict(self):
         return {**self.rule.to_dict(),
