@@ -42,7 +42,7 @@ from powertrain.diagnosis.fit import EVAL_BUDGET, Problem, baseline_outcome, fit
 from powertrain.diagnosis.plan import PlanSetup
 from powertrain.diagnosis.result import DiagnosisResult
 from powertrain.diagnosis.rule import DecisionRule, decide
-from powertrain.diagnosis.sides import side_attribution, with_measured_body_side
+from powertrain.diagnosis.sides import fitted_shape, side_attribution, with_measured_body_side
 from powertrain.diagnosis.where import decompose_gap, regions, rigid_span_gap, where_text
 from powertrain.effects import EFFECTS, predict
 from powertrain.errors import InputError
@@ -322,6 +322,9 @@ def _diagnose(measured, engine, noise_floor, effects, pairs, do_bands, rule, sch
         o.status, o.status_code = a.text, a.status
     outcomes.sort(key=lambda o: o.heldout_mse)
     chosen = next((o for o in outcomes if o.label == verdict.chosen), None)
+    if chosen is not None and len(chosen.effects) == 1 and parts.get("sides"):
+        e = chosen.effects[0]
+        parts["sides"]["fitted_shape"] = fitted_shape(e, chosen.params[e], s.problem.engine)
     gap_after, bands = None, []
     if chosen is not None:
         gap_after = _gap_after(w, {e: chosen.params[e] for e in chosen.effects})
