@@ -199,14 +199,15 @@ def _check_data(data, src):
 def _where(s: _Setup):
     data = s.data
     vel0 = predict(s.hm, {}).velocity
-    gap = residuals_db(model_levels(vel0, data), data.level, data.floor)
+    sim = model_levels(vel0, data)
+    gap = residuals_db(sim, data.level, data.floor)
     gap_map = np.where(data.censored, np.nan, gap)
     mask = np.isfinite(gap_map) & data.order_mask[None, None, :]
     parts = decompose_gap(gap_map, data, mask)
     parts["sides"] = side_attribution(gap_map, data)
     na = data.n_active
     return gap_map, parts, rigid_span_gap(vel0[:, :na], data.active_only(), s.hm.channel_matrix), \
-        regions(gap_map, data, parts)
+        regions(gap_map, data, parts), sim
 
 
 def _fit_job(job):
@@ -304,7 +305,7 @@ def _diagnose(measured, engine, noise_floor, effects, pairs, do_bands, rule, sch
     else:
         s = _Setup(measured, engine, noise_floor, effects)
     w = getattr(s, "first", s)                 # step 1 and the figures: a plan's first run
-    gap_map, parts, rigid, found = _where(w)
+    gap_map, parts, rigid, found, sim0 = _where(w)
     s.effects = cand.at_location(s.effects, parts.get("sides"))
     sigma = noise_sigma_db(s.data)
     baseline = baseline_outcome(s.problem)
@@ -325,9 +326,9 @@ def _diagnose(measured, engine, noise_floor, effects, pairs, do_bands, rule, sch
     if chosen is not None and len(chosen.effects) == 1 and parts.get("sides"):
         e = chosen.effects[0]
         parts["sides"]["fitted_shape"] = fitted_shape(e, chosen.params[e], s.problem.engine)
-    gap_after, bands = None, []
+    gap_after, sim_after, bands = None, None, []
     if chosen is not None:
-        gap_after = _gap_after(w, {e: chosen.params[e] for e in chosen.effects})
+        gap_after, sim_after = _gap_after(w, {e: chosen.params[e] for e in chosen.effects})
         if do_bands and len(chosen.effects) == 1 and w is s:
             def factory(idx):
                 return Problem(s.sub(idx), s.problem.hm["test"], s.data, idx, s.test_idx)
@@ -351,7 +352,7 @@ def _diagnose(measured, engine, noise_floor, effects, pairs, do_bands, rule, sch
         verdict_kind=verdict.kind, equivalents=eq,
         budget_hits=[o.label for o in outcomes if o.budget_hit], finding=finding,
         phase=_phase_dict(s, chosen), runs=s.run_entries(chosen) if w is not s else [],
-        engine=engine)
+        engine=engine, sim_levels=sim0, sim_after=sim_after)
 
 
 def fit_notes(chosen, outcomes, bands, budget) -> list:
@@ -385,14 +386,16 @@ def fit_notes(chosen, outcomes, bands, budget) -> list:
 
 
 def _gap_after(w, sc):
-    """The gap map with the answer's effects on every measured speed; None where the
-    answer's amplitude fixed point has no steady state at a speed it was not fitted on."""
+    """The gap map with the answer's effects on every measured speed and the model levels
+    [m/s RMS] it compares; ``(None, None)`` where the answer's amplitude fixed point has no
+    steady state at a speed it was not fitted on."""
     try:
         vel = predict(w.hm, sc).velocity
     except FloatingPointError:
-        return None
-    g1 = residuals_db(model_levels(vel, w.data), w.data.level, w.data.floor)
-    return np.where(w.data.censored, np.nan, g1)
+        return None, None
+    sim = model_levels(vel, w.data)
+    g1 = residuals_db(sim, w.data.level, w.data.floor)
+    return np.where(w.data.censored, np.nan, g1), sim
 
 
 def phase_kind(data) -> str:

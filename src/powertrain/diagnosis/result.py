@@ -63,6 +63,10 @@ class DiagnosisResult(Result):
     equivalents: list = field(default_factory=list)
     #: Fits stopped by their evaluation budget (labels).
     budget_hits: list = field(default_factory=list)
+    #: Model levels [m/s RMS] like ``data.level`` (noise floor added in power): the
+    #: baseline, and with the chosen effect (None without one); the overlays draw them.
+    sim_levels: np.ndarray | None = field(default=None, repr=False, compare=False)
+    sim_after: np.ndarray | None = field(default=None, repr=False, compare=False)
     #: The baseline engine diagnosed (:class:`~powertrain.models.engine.Engine`).
     engine: object = field(default=None, repr=False, compare=False)
     #: What the chosen effect names (``Effect.finding``: e.g. which cylinder), or None.
