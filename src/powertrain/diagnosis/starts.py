@@ -29,6 +29,9 @@ DATA_KEPT = 2
 #: Ratio of ``Effect.basin_parameter`` beyond which a start lies in another basin (a body
 #: mode at 2-6 % damping is 4-12 % wide; two minima a quarter apart are separate resonances).
 BASIN_RATIO = 1.25
+#: Starts kept besides the cheapest, each in a basin of its own (a cost nearly flat in a
+#: missing mode's frequency, as from magnitudes alone, ranks the grid's starts by noise).
+OTHER_BASINS = 2
 #: Distance of a start read from the data from its bounds [share of the bounds' span]. A
 #: start *on* a bound (a missing mode's shape normalised to its largest entry, which is the
 #: bound 1) stops the trust-region fit at once: scipy's ``trf`` truncates a step that crosses
@@ -83,8 +86,9 @@ def _data_starts(problem, pack, effect, fun, lo, hi):
     costs = [np.sum(fun(p) ** 2) for p in pts]
     order = np.argsort(costs)
     kept = [pts[i] for i in order[:DATA_KEPT]]
-    other = _other_basin(pack, effect, pts, order, kept)
-    kept += [] if other is None else [other]
+    for _ in range(OTHER_BASINS):
+        other = _other_basin(pack, effect, pts, order, kept)
+        kept += [] if other is None else [other]
     signed = [pack.names.index((effect, n)) for n in EFFECTS[effect].signed(problem.engine)]
     return [_signs(fun, x, signed) for x in kept] if signed else kept
 
