@@ -40,6 +40,7 @@ from powertrain.diagnosis.data import (
 from powertrain.diagnosis.evidence import CandidateEvidence, Evidence, VerdictKind
 from powertrain.diagnosis.fit import EVAL_BUDGET, Problem, baseline_outcome, fit_candidate
 from powertrain.diagnosis.plan import PlanSetup
+from powertrain.diagnosis.report import fit_notes
 from powertrain.diagnosis.result import DiagnosisResult
 from powertrain.diagnosis.rule import DecisionRule, decide
 from powertrain.diagnosis.sides import fitted_shape, side_attribution, with_measured_body_side
@@ -353,36 +354,6 @@ def _diagnose(measured, engine, noise_floor, effects, pairs, do_bands, rule, sch
         budget_hits=[o.label for o in outcomes if o.budget_hit], finding=finding,
         phase=_phase_dict(s, chosen), runs=s.run_entries(chosen) if w is not s else [],
         engine=engine, sim_levels=sim0, sim_after=sim_after)
-
-
-def fit_notes(chosen, outcomes, bands, budget) -> list:
-    """Sentences of the verdict on how far the fits can be trusted: a second minimum of the
-    answer that explains the data alike (``FitOutcome.alternatives``), parameters of the
-    answer at a bound (``Effect.bound_warnings``), and, said once, the fits that stopped at
-    their evaluation budget with what that means for the answer."""
-    out = []
-    if chosen is not None and len(chosen.effects) == 1:
-        eff = EFFECTS[chosen.effects[0]]
-        ps = chosen.params[chosen.effects[0]]
-        for alt in chosen.alternatives:
-            out.append(eff.alternative_text(ps, alt["parameters"][chosen.effects[0]],
-                                            alt["delta_chi2"]))
-        out += eff.bound_warnings(ps)
-    if chosen is not None and chosen.budget_hit:
-        out.append(f"the {chosen.label} fit stopped at its evaluation budget ({budget}): its "
-                   f"parameters are the best point found, not a converged optimum (the "
-                   f"verdict rests on that point's held-out scores)")
-    others = [o.label for o in outcomes if o.budget_hit and o is not chosen]
-    if others:
-        out.append(f"{len(others)} other fit(s) stopped at their evaluation budget "
-                   f"({', '.join(others)}): scored at their best point so far, they may fit "
-                   f"better than ranked")
-    n_band = sum(bool(b.get("budget_hit")) for b in bands)
-    if n_band:
-        out.append(f"{n_band} of {len(bands)} speed-band refits stopped at their budget: "
-                   f"those bands do not pin the parameters down (e.g. a mode refitted away "
-                   f"from its resonance), so their trend with speed says nothing")
-    return out
 
 
 def _gap_after(w, sc):

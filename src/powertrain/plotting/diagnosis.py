@@ -199,28 +199,8 @@ def plot_gap_frequency(diagnosis, path=None, *, ax=None, provenance=None):
                  if np.isfinite(diagnosis.gap[:, :, k]).any()]
     chans = [c for c in range(len(d.channels))
              if np.isfinite(diagnosis.gap[:, c, with_data]).any()]
-    groups = _channel_groups(d.channels, chans)
     many = len(chans) > MAX_CHANNELS_ONE_AXIS
-    ncol = 3 if many else 1
-    nrow = -(-len(groups) // ncol) if many else 1
-    fig, axes, own = subplots(ax, nrow + 2, ncol,
-                              figsize=(PRINT_WIDTH_IN, (2.0 * nrow if many else 4.2) + 4.2))
-    gs = axes[0, 0].get_gridspec()
-    for a in axes.flat:
-        a.remove()
-    small = []
-    if many:
-        for j, (key, cs) in enumerate(groups.items()):
-            a = fig.add_subplot(gs[j // ncol, j % ncol])
-            _gap_by_channel(a, diagnosis, with_data, cs, sides=True)
-            a.set_title(f"{key[0]} {key[1].upper()}", fontsize=TITLE_SIZE)
-            small.append(a)
-    else:
-        a = fig.add_subplot(gs[0, 0])
-        _gap_by_channel(a, diagnosis, with_data, chans, sides=False)
-        small.append(a)
-    a2 = fig.add_subplot(gs[nrow:, :])
-    _gap_by_order(a2, diagnosis, with_data)
+    fig, own, small, a2 = _frequency_layout(ax, diagnosis, with_data, chans, many)
     for a in small:
         log_axis(a, "x", max_ticks=4 if many else 9)
         a.set_xlabel("frequency [Hz]" if many else "frequency = order × rpm / 60 [Hz]",
@@ -244,6 +224,29 @@ def plot_gap_frequency(diagnosis, path=None, *, ax=None, provenance=None):
              f"{sh['excitation']:.0%}, channel constant {sh['const']:.0%} (each alone)"
              + ("; (a) per base and direction, line: fitted structure part" if many else ""))
     return finish(fig, own, path, provenance, title=title if whole_figure(ax) else None)
+
+
+def _frequency_layout(ax, diagnosis, orders, chans, many):
+    """``(fig, own, panels of (a), panel (b))`` of :func:`plot_gap_frequency`, drawn: (a)
+    one panel, or with ``many`` small multiples in three columns; (b) below, full width."""
+    groups = _channel_groups(diagnosis.data.channels, chans)
+    ncol = 3 if many else 1
+    nrow = -(-len(groups) // ncol) if many else 1
+    fig, axes, own = subplots(ax, nrow + 2, ncol,
+                              figsize=(PRINT_WIDTH_IN, (2.0 * nrow if many else 4.2) + 4.2))
+    gs = axes[0, 0].get_gridspec()
+    for a in axes.flat:
+        a.remove()
+    small = []
+    for j, (key, cs) in enumerate(groups.items() if many else [(None, chans)]):
+        a = fig.add_subplot(gs[j // ncol, j % ncol])
+        _gap_by_channel(a, diagnosis, orders, cs, sides=many)
+        if many:
+            a.set_title(f"{key[0]} {key[1].upper()}", fontsize=TITLE_SIZE)
+        small.append(a)
+    a2 = fig.add_subplot(gs[nrow:, :])
+    _gap_by_order(a2, diagnosis, orders)
+    return fig, own, small, a2
 
 
 def _channel_groups(channels, chans) -> dict:
