@@ -29,9 +29,9 @@ truth effect            library match        drawn parameters
                                              mass and damping changed, all ± a few %,
                                              shape components ± 5 %)
 ``missing_mode``        missing_body_mode    passive-side plan only: one more body mode,
-                                             40–110 Hz, 6–30 kg (shape normalised to its
-                                             largest component), ζ 2–6 %, one base and
-                                             direction dominant
+                                             20–150 Hz, 5–40 kg (shape U(−1, 1) at every
+                                             base and direction, normalised to its
+                                             largest component), ζ 2–6 %
 ======================= ==================== ==============================================
 
 Cases, measurement noise and detectability: :mod:`benchmarks.cases`.
@@ -221,14 +221,14 @@ def _apply_body_modes(p, parts):
 
 
 def _draw_missing_mode(rng, engine):
-    """One body mode the file lacks: frequency U(40, 110) Hz (inside what order 2 sweeps
-    from 1000 to 6000 rpm), modal mass U(6, 30) kg for the shape normalised to its largest
-    component, damping U(0.02, 0.06); shape components N(0, 0.35) with one base and
-    direction set to ±1 (the largest)."""
+    """One body mode the file lacks, as wide as the physics: frequency U(20, 150) Hz, modal
+    mass U(5, 40) kg for the shape normalised to its largest component, damping
+    U(0.02, 0.06); shape components U(-1, 1) at every mount base and direction, normalised so
+    that the largest is ±1 (no base or direction made dominant)."""
     n_m = len(engine.mounts)
-    shape = np.clip(rng.normal(0, 0.35, (n_m, 3)), -0.9, 0.9)
-    shape[int(rng.integers(n_m)), int(rng.integers(3))] = rng.choice([-1.0, 1.0])
-    return {"frequency_hz": float(rng.uniform(40, 110)), "modal_mass": float(rng.uniform(6, 30)),
+    shape = rng.uniform(-1.0, 1.0, (n_m, 3))
+    shape /= np.abs(shape).max()
+    return {"frequency_hz": float(rng.uniform(20, 150)), "modal_mass": float(rng.uniform(5, 40)),
             "zeta": float(rng.uniform(0.02, 0.06)), "shape": shape}
 
 

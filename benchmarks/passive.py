@@ -29,7 +29,7 @@ from benchmarks.kinds import KINDS
 from powertrain.analysis.channel import passive_name
 from powertrain.workflows.measurement import RPM
 
-#: Engine kinds of the passive-side cases.
+#: Engine kinds of the passive-side cases (the rigid ones for missing body modes).
 ENGINE_KINDS = ("body_sz", "body_traces")
 _LAP = [("body_modes", "body_sz"), ("mount_temperature", "body_traces"), ("none", "body_sz"),
         ("body_modes", "body_traces"), ("mount_temperature", "body_sz"),
@@ -52,14 +52,21 @@ def passive_plan(n_cases, seed):
 @functools.cache
 def passive_engines():
     """``{"body_sz": the modal-body engine, "body_traces": the same with measured
-    traces}``."""
+    traces, "rigid_sz", "rigid_traces": the default (rigid-chassis) engine, whose body side
+    the diagnosis holds still}``."""
     from powertrain.iotools.engine_file import DEFAULT_ENGINE_PATH, read_engine
     e = read_engine(DEFAULT_ENGINE_PATH.parent / "default-modal-body.toml")
-    return {"body_sz": e, "body_traces": traces_engine(e)}
+    r = read_engine(DEFAULT_ENGINE_PATH)
+    return {"body_sz": e, "body_traces": traces_engine(e), "rigid_sz": r,
+            "rigid_traces": traces_engine(r)}
 
 
 def nominal_body(engine) -> tr.BodyModes:
-    """The engine file's modal body as the truth path's :class:`~.truth.BodyModes`."""
+    """The engine file's modal body as the truth path's :class:`~.truth.BodyModes` (no
+    modes for a rigid chassis: the body side held still)."""
+    if engine.chassis is None or engine.chassis.is_rigid:
+        n_m = len(engine.mounts)
+        return tr.BodyModes(np.empty(0), np.empty(0), np.empty(0), np.empty((0, n_m, 3)))
     modes = engine.chassis.modes
     shapes = np.array([[m.shapes[mt.name] for mt in engine.mounts] for m in modes], float)
     return tr.BodyModes(np.array([m.frequency for m in modes], float),

@@ -232,17 +232,23 @@ def _side_right(r) -> bool:
     return r["right"]
 
 
+#: Engines of the missing-mode rate test: a modal body (the mode beside the file's four)
+#: and a rigid chassis (the body side held still), each with and without measured traces.
+MODE_ENGINES = ("body_sz", "rigid_sz", "body_traces", "rigid_traces")
+
+
 def mode_row(task) -> dict:
     i, seed = task
-    eng = ("body_sz", "body_traces")[i % 2]
+    eng = MODE_ENGINES[i % len(MODE_ENGINES)]
     case = detectable_case("missing_mode", eng, np.random.default_rng([seed, i]), i,
                            phase="all")
     d = diagnosis(case.measured, passive_engines()[eng])
     p = case.truth[0][1]
     return {"claimed": sorted(d["chosen"]["effects"]) if d["chosen"] else [],
             "parameters": d["chosen"]["parameters"] if d["chosen"] else None,
+            "alternatives": d["chosen"]["alternatives"] if d["chosen"] else [],
             "truth_mode": {"frequency_hz": p["frequency_hz"], "modal_mass_kg": p["modal_mass"]},
-            "verdict": d["verdict"], "seed": case.seed}
+            "verdict": d["verdict"], "seed": case.seed, "engine": eng}
 
 
 # ------------------------------------------------------------------------- the tests

@@ -433,3 +433,14 @@ def test_pair_cross_fitted_against_member_uses_t_min(above):
     v = decide(ev, DecisionRule(t_min=just(tx, above)))
     assert v.kind is not VerdictKind.PENDING
     assert v.chosen == ("a" if above else "a+b")
+
+
+@pytest.mark.parametrize("above", [False, True])
+def test_no_claim_without_excess_over_noise(above):
+    """A baseline within noise (excess sqrt(0.54 - 0.5) = 0.2 dB) with a structured residual
+    within struct_abs_db: no effect before any candidate is weighed, however well one passes
+    the rest of the rule (it fits round-off); just below the excess, the candidate."""
+    ev = evidence(cand("a", 0.501, 900.0, struct=0.1, spread=0.0001), base_mse=0.54,
+                  base_struct=0.3)
+    v = decide(ev, DecisionRule(excess_min_db=just(0.2, above), explained_min=0.5))
+    assert v.kind is (VerdictKind.NO_EFFECT if above else VerdictKind.EFFECT), v.text

@@ -40,9 +40,10 @@ from powertrain.diagnosis.data import (
 from powertrain.diagnosis.evidence import CandidateEvidence, Evidence, VerdictKind
 from powertrain.diagnosis.fit import EVAL_BUDGET, Problem, baseline_outcome, fit_candidate
 from powertrain.diagnosis.plan import PlanSetup
+from powertrain.diagnosis.report import fit_notes
 from powertrain.diagnosis.result import DiagnosisResult
 from powertrain.diagnosis.rule import DecisionRule, decide
-from powertrain.diagnosis.sides import side_attribution, with_measured_body_side
+from powertrain.diagnosis.sides import fitted_shape, side_attribution, with_measured_body_side
 from powertrain.diagnosis.where import decompose_gap, regions, rigid_span_gap, where_text
 from powertrain.effects import EFFECTS, predict
 from powertrain.errors import InputError
@@ -199,14 +200,15 @@ def _check_data(data, src):
 def _where(s: _Setup):
     data = s.data
     vel0 = predict(s.hm, {}).velocity
-    gap = residuals_db(model_levels(vel0, data), data.level, data.floor)
+    sim = model_levels(vel0, data)
+    gap = residuals_db(sim, data.level, data.floor)
     gap_map = np.where(data.censored, np.nan, gap)
     mask = np.isfinite(gap_map) & data.order_mask[None, None, :]
     parts = decompose_gap(gap_map, data, mask)
     parts["sides"] = side_attribution(gap_map, data)
     na = data.n_active
     return gap_map, parts, rigid_span_gap(vel0[:, :na], data.active_only(), s.hm.channel_matrix), \
-        regions(gap_map, data, parts)
+        regions(gap_map, data, parts), sim
 
 
 def _fit_job(job):
@@ -304,7 +306,7 @@ def _diagnose(measured, engine, noise_floor, effects, pairs, do_bands, rule, sch
     else:
         s = _Setup(measured, engine, noise_floor, effects)
     w = getattr(s, "first", s)                 # step 1 and the figures: a plan's first run
-    gap_map, parts, rigid, found = _where(w)
+    gap_map, parts, rigid, found, sim0 = _where(w)
     s.effects = cand.at_location(s.effects, parts.get("sides"))
     sigma = noise_sigma_db(s.data)
     baseline = baseline_outcome(s.problem)
@@ -322,9 +324,12 @@ def _diagnose(measured, engine, noise_floor, effects, pairs, do_bands, rule, sch
         o.status, o.status_code = a.text, a.status
     outcomes.sort(key=lambda o: o.heldout_mse)
     chosen = next((o for o in outcomes if o.label == verdict.chosen), None)
-    gap_after, bands = None, []
+    if chosen is not None and len(chosen.effects) == 1 and parts.get("sides"):
+        e = chosen.effects[0]
+        parts["sides"]["fitted_shape"] = fitted_shape(e, chosen.params[e], s.problem.engine)
+    gap_after, sim_after, bands = None, None, []
     if chosen is not None:
-        gap_after = _gap_after(w, {e: chosen.params[e] for e in chosen.effects})
+        gap_after, sim_after = _gap_after(w, {e: chosen.params[e] for e in chosen.effects})
         if do_bands and len(chosen.effects) == 1 and w is s:
             def factory(idx):
                 return Problem(s.sub(idx), s.problem.hm["test"], s.data, idx, s.test_idx)
@@ -338,6 +343,7 @@ def _diagnose(measured, engine, noise_floor, effects, pairs, do_bands, rule, sch
     finding = _finding(s, chosen)
     if finding is not None:
         text += f"; {finding['text']}"
+    text += "".join(f"; {t}" for t in fit_notes(chosen, outcomes, bands, budget))
     return DiagnosisResult(
         w.data, s.src, getattr(engine, "name", ""), gap_map, gap_after, parts, rigid, found,
         sigma, w.split_dict(), baseline, outcomes, chosen, verdict.label, text, bands,
@@ -347,18 +353,20 @@ def _diagnose(measured, engine, noise_floor, effects, pairs, do_bands, rule, sch
         verdict_kind=verdict.kind, equivalents=eq,
         budget_hits=[o.label for o in outcomes if o.budget_hit], finding=finding,
         phase=_phase_dict(s, chosen), runs=s.run_entries(chosen) if w is not s else [],
-        engine=engine)
+        engine=engine, sim_levels=sim0, sim_after=sim_after)
 
 
 def _gap_after(w, sc):
-    """The gap map with the answer's effects on every measured speed; None where the
-    answer's amplitude fixed point has no steady state at a speed it was not fitted on."""
+    """The gap map with the answer's effects on every measured speed and the model levels
+    [m/s RMS] it compares; ``(None, None)`` where the answer's amplitude fixed point has no
+    steady state at a speed it was not fitted on."""
     try:
         vel = predict(w.hm, sc).velocity
     except FloatingPointError:
-        return None
-    g1 = residuals_db(model_levels(vel, w.data), w.data.level, w.data.floor)
-    return np.where(w.data.censored, np.nan, g1)
+        return None, None
+    sim = model_levels(vel, w.data)
+    g1 = residuals_db(sim, w.data.level, w.data.floor)
+    return np.where(w.data.censored, np.nan, g1), sim
 
 
 def phase_kind(data) -> str:

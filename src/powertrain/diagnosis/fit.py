@@ -39,7 +39,7 @@ from powertrain.diagnosis.data import (
 )
 from powertrain.diagnosis.packing import Packing
 from powertrain.diagnosis.search import Counted, Exhausted, jacobian, trust_region
-from powertrain.diagnosis.starts import start_points
+from powertrain.diagnosis.starts import BASIN_RATIO, start_points
 from powertrain.diagnosis.warm_start import AmplitudeStart, scenario_vector
 from powertrain.effects import EFFECTS, predict
 from powertrain.solvers.fast_harmonic import N_HARMONICS
@@ -91,6 +91,9 @@ class FitOutcome:
     n_eval: int = 0
     #: candidates whose finding this fit restates (:func:`candidates.restatements`)
     restates: tuple = ()
+    #: a second minimum in another basin of ``Effect.basin_parameter`` that explains the
+    #: training data alike (:func:`second_minimum`): ``[{"parameters", "delta_chi2"}]``
+    alternatives: list = field(default_factory=list)
 
     @property
     def label(self) -> str:
@@ -313,9 +316,38 @@ def fit_candidate(problem: Problem, effects, starts=None, grid=True,
     out = score(problem, effects, pack.scenario(x), params, sigma, rss, n, p, nfev,
                 time.perf_counter() - t0, x)
     out.budget_hit = hit
+    out.alternatives = second_minimum(fun, pack, effects, x, problem.sigma_db)
     out.n_eval = fun.n
     out.units = {e: {pn: pack.units[(e, pn)] for pn in ps} for e, ps in params.items()}
     return out
+
+
+#: Training χ² (residuals over the scatter squared) within which a second minimum explains
+#: the data alike: the decision rule's BIC margin, "very strong" evidence (Kass & Raftery).
+ALIKE_CHI2 = 10.0
+
+
+def second_minimum(fun, pack, effects, x, sigma_db) -> list:
+    """``[{"parameters", "delta_chi2"}]`` of the best finished start whose
+    ``Effect.basin_parameter`` lies a factor :data:`~powertrain.diagnosis.starts.BASIN_RATIO`
+    or more from the fit's at ``x`` and whose training χ² exceeds the fit's by less than
+    :data:`ALIKE_CHI2` (two minima that explain the data alike: both are reported, never
+    more); [] for pairs, effects without such a parameter, or no such minimum."""
+    name = EFFECTS[effects[0]].basin_parameter if len(effects) == 1 else None
+    if name is None or not fun.minima:
+        return []
+    j = pack.names.index((effects[0], name))
+    val = (lambda v: math.exp(v[j])) if pack.log[j] else (lambda v: v[j])
+    c0 = min([c for c, _ in fun.minima] + [float(fun.best[0])])
+    far = [(c, v) for c, v in fun.minima
+           if abs(math.log(val(v) / val(x))) >= math.log(BASIN_RATIO)]
+    if not far:
+        return []
+    c, v = min(far, key=lambda t: t[0])
+    d = 2.0 * (c - c0) / sigma_db ** 2
+    if d >= ALIKE_CHI2:
+        return []
+    return [{"parameters": pack.values(v, np.full(v.size, np.nan))[0], "delta_chi2": d}]
 
 
 def score(problem, effects, sc, params, sigma, rss, n, p, nfev, seconds, x=None) -> FitOutcome:

@@ -68,11 +68,10 @@ def _which(r) -> list:
              f"  {'(baseline)':<40} {0:>2} {b.heldout_rms_db:>11.2f} {'':>6} {'':>8} "
              f"{'':>6} {b.struct_db:>9.2f}"]
     for o in r.outcomes:
-        flag = " [evaluation budget hit]" if o.budget_hit else ""
         expl = f"{o.explained:>6.0%}" if np.isfinite(o.explained) else f"{'-':>6}"
         lines.append(f"  {o.label:<40} {o.n_params:>2} {o.heldout_rms_db:>11.2f} "
                      f"{o.t_stat:>6.1f} {o.bic_gain:>8.1f} {expl} "
-                     f"{o.struct_db:>9.2f}  {o.status}{flag}")
+                     f"{o.struct_db:>9.2f}  {o.status}")
     if r.chosen is not None:
         lines.append("  parameters (1 sigma, Gauss-Newton, optimistic):")
         for e, ps in r.chosen.params.items():
@@ -89,8 +88,7 @@ def _which(r) -> list:
         lines.append("  confounding check (refit on speed bands):")
         for bnd in r.band_check:
             txt = ", ".join(f"{k}={v:.3g}" for k, v in bnd["parameters"].items())
-            stop = " (refit stopped at its budget)" if bnd.get("budget_hit") else ""
-            lines.append(f"    {bnd['rpm_from']:g}-{bnd['rpm_to']:g} rpm: {txt}{stop}")
+            lines.append(f"    {bnd['rpm_from']:g}-{bnd['rpm_to']:g} rpm: {txt}")
     return lines
 
 
@@ -104,6 +102,36 @@ def _db(value) -> str:
     """A channel's held-out RMS [dB], or "-" where it has no held-out point (a channel
     measured on part of the speeds only)."""
     return f"{value:.2f}" if np.isfinite(value) else "-"
+
+
+def fit_notes(chosen, outcomes, bands, budget) -> list:
+    """Sentences of the verdict on how far the fits can be trusted: a second minimum of the
+    answer that explains the data alike (``FitOutcome.alternatives``), parameters of the
+    answer at a bound (``Effect.bound_warnings``), and, said once, the fits that stopped at
+    their evaluation budget with what that means for the answer."""
+    out = []
+    if chosen is not None and len(chosen.effects) == 1:
+        eff = EFFECTS[chosen.effects[0]]
+        ps = chosen.params[chosen.effects[0]]
+        for alt in chosen.alternatives:
+            out.append(eff.alternative_text(ps, alt["parameters"][chosen.effects[0]],
+                                            alt["delta_chi2"]))
+        out += eff.bound_warnings(ps)
+    if chosen is not None and chosen.budget_hit:
+        out.append(f"the {chosen.label} fit stopped at its evaluation budget ({budget}): its "
+                   f"parameters are the best point found, not a converged optimum (the "
+                   f"verdict rests on that point's held-out scores)")
+    others = [o.label for o in outcomes if o.budget_hit and o is not chosen]
+    if others:
+        out.append(f"{len(others)} other fit(s) stopped at their evaluation budget "
+                   f"({', '.join(others)}): scored at their best point so far, they may fit "
+                   f"better than ranked")
+    n_band = sum(bool(b.get("budget_hit")) for b in bands)
+    if n_band:
+        out.append(f"{n_band} of {len(bands)} speed-band refits stopped at their budget: "
+                   f"those bands do not pin the parameters down (e.g. a mode refitted away "
+                   f"from its resonance), so their trend with speed says nothing")
+    return out
 
 
 def summary(r) -> str:
@@ -122,9 +150,6 @@ def summary(r) -> str:
     for k, run in enumerate(r.runs, start=1):
         lines.append(f"  run {k}: {run['heldout_rms_db_before']:.2f} -> "
                      f"{run['heldout_rms_db_after']:.2f} dB RMS")
-    if r.budget_hits:
-        lines.append(f"  evaluation budget hit by: {', '.join(r.budget_hits)} (best point "
-                     f"so far kept)")
     lines += ["", f"VERDICT: {r.verdict_text}", f"({r.seconds:.1f} s)"]
     return "\n".join(lines)
 

@@ -65,6 +65,10 @@ class DiagnosisResult(Result):
     equivalents: list = field(default_factory=list)
     #: Fits stopped by their evaluation budget (labels).
     budget_hits: list = field(default_factory=list)
+    #: Model levels [m/s RMS] like ``data.level`` (noise floor added in power): the
+    #: baseline, and with the chosen effect (None without one); the overlays draw them.
+    sim_levels: np.ndarray | None = field(default=None, repr=False, compare=False)
+    sim_after: np.ndarray | None = field(default=None, repr=False, compare=False)
     #: The baseline engine diagnosed (:class:`~powertrain.models.engine.Engine`).
     engine: object = field(default=None, repr=False, compare=False)
     #: What the chosen effect names (``Effect.finding``: e.g. which cylinder), or None.
@@ -138,7 +142,8 @@ class DiagnosisResult(Result):
                 "heldout_block_chi2_ratio": o.chi2_ratio,
                 "heldout_cells_check": None if o.cells_check is None else {
                     k: v for k, v in o.cells_check.items() if k != "parts"},
-                "nfev": o.nfev, "n_eval": o.n_eval, "budget_hit": o.budget_hit, "seconds": o.seconds}
+                "nfev": o.nfev, "n_eval": o.n_eval, "budget_hit": o.budget_hit, "seconds": o.seconds,
+                "alternatives": o.alternatives}
 
     def _decision_rule_dict(self):
         return {**self.rule.to_dict(),

@@ -29,6 +29,10 @@ would leave (noise):
   restates (t ≤ ``t_min``): the more constrained statement is the answer; nor is a rival
   that names more effects than the answer while it is worse on the held-out speeds and in
   training BIC (by more than ``bic_margin``);
+* **no effect**, before any candidate is chosen, when the baseline's excess RMS gap over
+  noise is below ``excess_min_db`` and its structured residual within ``struct_abs_db``
+  (with or without order phase): a candidate that fits what is left "significantly" fits
+  round-off or the model's own numerical error;
 * otherwise **no effect** when the excess RMS gap :math:`\sqrt{\max(E_0 - E_n, 0)}` is
   below ``excess_min_db`` (even if a candidate fits what is left "significantly": a model
   that agrees to round-off leaves round-off for candidates to fit), else **unexplained**
@@ -184,6 +188,15 @@ def _member_suffices(ev, rule, m, a) -> bool:
             and m.struct_db <= _struct_max(ev, rule))
 
 
+def _within_noise(ev, rule) -> bool:
+    """The baseline leaves a held-out excess over noise below ``excess_min_db`` and a
+    structured residual within ``struct_abs_db``: nothing beyond the lab's repeatability that
+    a candidate could be shown to explain (the same guard with and without order phase: the
+    phase gaps enter the excess as dB-equivalent residuals)."""
+    left = math.sqrt(max(ev.baseline.heldout_mse - ev.noise_mse, 0.0))
+    return left < rule.excess_min_db and ev.baseline.struct_db <= rule.struct_abs_db
+
+
 def _struct_max(ev, rule):
     return max(rule.struct_abs_db, rule.struct_rel * ev.baseline.struct_db)
 
@@ -272,6 +285,8 @@ def decide(evidence: Evidence, rule: DecisionRule = DecisionRule()) -> Verdict:
     cross = list(dict.fromkeys(lab for c in ranked for lab in ass[c.label].crossfit_labels))
     if cross:
         return Verdict(VerdictKind.PENDING, "pending", "", ass, order, needs_crossfit=cross)
+    if _within_noise(ev, rule):
+        return _no_answer(ev, rule, ass, order, ranked)
     chosen, pending = _choose(ev, rule, ranked, ass)
     if pending is not None:
         return Verdict(VerdictKind.PENDING, "pending", "", ass, order,

@@ -47,6 +47,8 @@ class Counted:
         #: amplitude fixed point took
         self.n = 0
         self.best = (np.inf, None, None)
+        #: ``(cost, x)`` of every start the trust region finished (:func:`trust_region`)
+        self.minima = []
         self.last = (None, None)
         self._stall = None
         self._response_only = np.array([EFFECTS[e].response_only for e, _ in pack.names])
@@ -219,6 +221,7 @@ def trust_region(fun, pack, cands):
         finally:
             fun.watch(None)
         nfev += res.nfev
+        fun.minima.append((float(res.cost), np.array(res.x, float)))
         if best is None or res.cost < best.cost:
             best = res
     if stalled and (best is None or fun.best[0] < best.cost):

@@ -47,7 +47,7 @@ from powertrain.analysis.channel import split_side
 from powertrain.diagnosis.data import gap_data, model_levels, residuals_db
 from powertrain.diagnosis.noise_model import point_sigma_db
 from powertrain.effects import predict
-from powertrain.effects.missing_body_mode import body_side_engine
+from powertrain.effects.missing_body_mode import body_side_engine, mode_arrays
 from powertrain.solvers.fast_harmonic import HarmonicModel
 
 #: Body when the body-side excess is at least this multiple of the engine side's [1]: the
@@ -220,6 +220,55 @@ def with_measured_body_side(engine, measured):
     return engine
 
 
+#: A base takes part in a fitted body mode when its largest shape component reaches this
+#: share of the mode's largest [1] (half: the base moves at least half as much).
+SHAPE_SHARED = 0.5
+
+
+def fitted_shape(effect, params, engine) -> dict | None:
+    """The body mode an answer names, by its shape over the mount bases: ``{"effect",
+    "mode", "frequency_hz", "bases": {mount: largest |shape component| at its base,
+    normalised to the mode's largest}, "shape": where the shape comes from, "shared": two or
+    more bases at least :data:`SHAPE_SHARED`}``; None for other answers.
+    ``missing_body_mode``: its fitted shape; ``chassis_modes``: the file mode changed most
+    (frequency and modal mass, in log), with its shape from the engine file."""
+    names = [m.name for m in engine.mounts]
+    if effect == "missing_body_mode":
+        mode = mode_arrays(params, len(names))
+        if mode is None:
+            return None
+        f, shape, what, source = mode[0], mode[3], "the missing mode", "fitted shape"
+    elif effect == "chassis_modes" and getattr(engine, "chassis", None) is not None:
+        modes = engine.chassis.body_modes
+        if not modes:
+            return None
+        moved = [abs(np.log(params[f"f{k + 1}"] / m.frequency))
+                 + abs(np.log(params[f"m{k + 1}"] / m.modal_mass)) for k, m in enumerate(modes)]
+        k = int(np.argmax(moved))
+        shape = np.array([modes[k].shapes[n] for n in names], float)
+        f, what = params[f"f{k + 1}"], f"body mode {k + 1} of the engine file"
+        source = "shape (engine file)"
+    else:
+        return None
+    top = np.abs(shape).max(axis=1)
+    top = top / top.max() if top.max() > 0 else top
+    bases = {n: float(v) for n, v in zip(names, top)}
+    return {"effect": effect, "mode": what, "frequency_hz": float(f), "bases": bases,
+            "shape": source, "shared": int(np.sum(top >= SHAPE_SHARED)) >= MIN_SHARED_MOUNTS}
+
+
+def _shape_phrase(fs) -> str:
+    """'body mode 2 of the engine file near 45 Hz, shared by the bases of left, gearbox
+    (its shape (engine file), largest component at each base: left 0.6, right 0.2, gearbox
+    1.0)'."""
+    on = [m for m, v in fs["bases"].items() if v >= SHAPE_SHARED]
+    quoted = ", ".join(f"{m} {v:.1f}" for m, v in fs["bases"].items())
+    where = (f"shared by the bases of {', '.join(on)}" if fs["shared"] else
+             f"local to the base of {on[0]}")
+    return (f"{fs['mode']} near {fs['frequency_hz']:.0f} Hz, {where} (its {fs['shape']}, "
+            f"largest component at each base: {quoted})")
+
+
 def side_text(s) -> str:
     """One phrase for the where step ('' without body-side channels)."""
     if not s:
@@ -233,6 +282,8 @@ def side_text(s) -> str:
         off = ", ".join(s["mounts_off_body_side"]) or "none"
         what = (f"a resonance shared by the bases of {off}{at}" if s["shared"] else
                 f"local to the base of {off}{at}, not a mode shared by several bases")
+        if s.get("fitted_shape"):
+            what = _shape_phrase(s["fitted_shape"])
         return f"the gap lives in the body: {what} ({nums})"
     if s["location"] == "mounts":
         return f"the body side is off several times more than the engine side: the gap " \

@@ -26,6 +26,12 @@ BLOCK_REFINED = 2
 BLOCK_SHARE = 0.4
 #: Starts read from the data kept after screening.
 DATA_KEPT = 2
+#: Ratio of ``Effect.basin_parameter`` beyond which a start lies in another basin (a body
+#: mode at 2-6 % damping is 4-12 % wide; two minima a quarter apart are separate resonances).
+BASIN_RATIO = 1.25
+#: Starts kept besides the cheapest, each in a basin of its own (a cost nearly flat in a
+#: missing mode's frequency, as from magnitudes alone, ranks the grid's starts by noise).
+OTHER_BASINS = 2
 #: Distance of a start read from the data from its bounds [share of the bounds' span]. A
 #: start *on* a bound (a missing mode's shape normalised to its largest entry, which is the
 #: bound 1) stops the trust-region fit at once: scipy's ``trf`` truncates a step that crosses
@@ -78,9 +84,28 @@ def _data_starts(problem, pack, effect, fun, lo, hi):
     pts = [np.clip(np.array([np.log(st[n]) if lg else st[n] for (_, n), lg in
                              zip(pack.names, pack.log)]), lo, hi) for st in starts]
     costs = [np.sum(fun(p) ** 2) for p in pts]
-    kept = [pts[i] for i in np.argsort(costs)[:DATA_KEPT]]
+    order = np.argsort(costs)
+    kept = [pts[i] for i in order[:DATA_KEPT]]
+    for _ in range(OTHER_BASINS):
+        other = _other_basin(pack, effect, pts, order, kept)
+        kept += [] if other is None else [other]
     signed = [pack.names.index((effect, n)) for n in EFFECTS[effect].signed(problem.engine)]
     return [_signs(fun, x, signed) for x in kept] if signed else kept
+
+
+def _other_basin(pack, effect, pts, order, kept):
+    """The cheapest start whose ``Effect.basin_parameter`` lies at least a factor
+    :data:`BASIN_RATIO` from every kept start's (a second minimum, searched globally before
+    the local fits); None when the effect declares no such parameter or none does."""
+    name = EFFECTS[effect].basin_parameter
+    if name is None:
+        return None
+    j = pack.names.index((effect, name))
+    val = (lambda x: np.exp(x[j])) if pack.log[j] else (lambda x: x[j])
+    for i in order:
+        if all(abs(np.log(val(pts[i]) / val(k))) >= np.log(BASIN_RATIO) for k in kept):
+            return pts[i]
+    return None
 
 
 def _signs(fun, x, signed, passes=2):

@@ -74,6 +74,10 @@ class Effect:
     #: Side attributions (``location`` of :func:`powertrain.diagnosis.sides.side_attribution`)
     #: at which the effect is a candidate; None: at any (also without body-side data).
     locations = None
+    #: A parameter whose distant values can each explain the data (a resonance's frequency):
+    #: the fit then keeps a start in a second basin of it and reports a second minimum that
+    #: explains alike (:mod:`powertrain.diagnosis.starts`); None: no such parameter.
+    basin_parameter = None
 
     # ------------------------------------------------------------------ description
     def parameters(self, engine=None) -> tuple:
@@ -227,6 +231,19 @@ class Effect:
         while the held-out speeds cannot tell the two apart. ``band``: ``(lowest, highest)``
         order frequency measured above the floor [Hz] (None: unknown). None by default."""
         return None
+
+    def alternative_text(self, params, other, delta_chi2) -> str:
+        """The verdict's sentence on a second minimum ``other`` (parameters) of the fitted
+        ``params`` that explains the data alike (training χ² higher by ``delta_chi2``)."""
+        name = self.basin_parameter
+        return (f"two minima explain the data alike: {name} {params[name]:.4g} or "
+                f"{other[name]:.4g} (the data prefer {params[name]:.4g}: training chi2 lower "
+                f"by {delta_chi2:.1f})")
+
+    def bound_warnings(self, params) -> list:
+        """Warnings for the verdict on fitted ``params`` at a bound that matters to what the
+        answer says; [] by default."""
+        return []
 
     def finding(self, params, engine=None, phase="none") -> dict | None:
         """What the fitted ``params`` name in the field's words (e.g. which cylinder, weak or

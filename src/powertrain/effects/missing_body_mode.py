@@ -115,6 +115,8 @@ class MissingBodyMode(Effect):
     kind = "structure"
     #: the shape at a base is seen on that base's channels only (held-out orders instead)
     withhold_orders = True
+    #: parameter whose separate minima are told apart (:mod:`powertrain.diagnosis.starts`)
+    basin_parameter = "frequency_hz"
     #: a candidate only where the gap lies on the body side: the mode moves the bases, and
     #: its 12-parameter fit is the slowest of the library
     locations = ("body",)
@@ -167,6 +169,29 @@ class MissingBodyMode(Effect):
         return (f"a body mode missing from the model near {params['frequency_hz']:.1f} Hz, "
                 f"{params['modal_mass_kg']:.3g} kg, moving mostly {top[6:-2]}'s {top[-1]}")
 
+    def alternative_text(self, params, other, delta_chi2) -> str:
+        """'the missing mode lies near 55 or 24 Hz ... the data prefer 55 Hz ...'."""
+        f, g = params["frequency_hz"], other["frequency_hz"]
+        return (f"the missing mode lies near {f:.3g} or {g:.3g} Hz ({params['modal_mass_kg']:.3g}"
+                f" or {other['modal_mass_kg']:.3g} kg): both explain the data alike (training "
+                f"chi2 differs by {delta_chi2:.1f} < 10); the data prefer {f:.3g} Hz")
+
+    def bound_warnings(self, params) -> list:
+        """The damping ratio or the frequency at its bound (within 1 % of it)."""
+        out = []
+        z, f = params["damping_ratio"], params["frequency_hz"]
+        if params["modal_mass_kg"] >= MASS_OFF:
+            return out
+        if z <= ZETA_RANGE[0] * 1.01 or z >= ZETA_RANGE[1] * 0.99:
+            out.append(f"warning: the missing mode's damping ratio stopped at its bound "
+                       f"({z:.3g}): the data do not resolve the resonance's width, so its "
+                       f"frequency and modal mass are less certain than their 1 sigma says")
+        if f <= FREQ_RANGE[0] * 1.01 or f >= FREQ_RANGE[1] * 0.99:
+            out.append(f"warning: the missing mode's frequency stopped at its bound "
+                       f"({f:.3g} Hz): the measured orders see only its mass or spring line, "
+                       f"not the mode itself")
+        return out
+
     def restates(self, params, engine=None, band=None):
         """``("chassis_modes", reason)`` when the fitted mode's shape at the mount bases pairs
         (MAC >= :data:`MAC_PAIRED`) with a body mode of the engine file at a frequency
@@ -214,7 +239,7 @@ class MissingBodyMode(Effect):
                     out += [dict(base, frequency_hz=float(f), modal_mass_kg=m)
                             for m in GRID_MASSES]
             return out
-        out = []
+        out = _magnitude_grid_starts(engine, gaps, names)
         for f0, shape in body_gap_peak(gaps, [m.name for m in engine.mounts],
                                        n_peaks=START_PEAKS):
             base = {"frequency_hz": float(np.clip(f0, *FREQ_RANGE)),
@@ -223,6 +248,37 @@ class MissingBodyMode(Effect):
             out += [dict(base, modal_mass_kg=m, frequency_hz=float(np.clip(s * f0, *FREQ_RANGE)))
                     for m in START_MASSES for s in START_SHIFTS]
         return out
+
+
+def _magnitude_grid_starts(engine, gaps, names) -> list:
+    """Without phase: a start at every frequency of :func:`frequency_grid`, the shape the
+    body side's excess near it (:func:`_excess_near`), at the modal masses
+    :data:`GRID_MASSES` (a global search in frequency before the local fit: the peaks of the
+    excess alone miss a mode whose excess is spread over orders and speeds)."""
+    cols = _body_columns(gaps, names)
+    if not cols:
+        return []
+    ex = _excess(gaps, cols)
+    f = gaps.order_hz[:, None, :] * np.ones((1, len(cols), 1))
+    places = [cols[c][:2] for c in cols]
+    out = []
+    for f0 in frequency_grid(gaps, names):
+        shape = _shape_near(f, ex, f0, places, len(names))
+        if shape is None:
+            continue
+        base = {"damping_ratio": ZETA_DEFAULT, "frequency_hz": float(f0),
+                **dict(zip(shape_names(engine), shape.ravel().tolist()))}
+        out += [dict(base, modal_mass_kg=m) for m in GRID_MASSES]
+    return out
+
+
+def _excess(g, cols):
+    """Excess velocity [m/s RMS] of the body-side points over the model (NaN where not
+    scored), (n_r, len(cols), n_o) (:func:`body_gap_peak`)."""
+    meas = g.measured[:, list(cols)]
+    with np.errstate(invalid="ignore", over="ignore"):
+        model = meas * 10 ** (g.gap[:, list(cols)] / 20)
+        return np.sqrt(np.maximum(meas ** 2 - model ** 2, 0.0))
 
 
 @dataclasses.dataclass
@@ -336,10 +392,13 @@ def signed_shape(g: BodyGaps, mount_names, f0=None):
 
 def frequency_grid(g: BodyGaps, mount_names) -> np.ndarray:
     """Start frequencies [Hz]: steps of :data:`GRID_STEP` over the frequencies of the
-    body-side points with an excess (within :data:`FREQ_RANGE`)."""
+    body-side points scored (with phase: with a complex excess), within
+    :data:`FREQ_RANGE`."""
     idx = list(_body_columns(g, mount_names))
-    ok = np.isfinite(g.excess[:, idx])
+    ok = np.isfinite(g.gap[:, idx] if g.excess is None else g.excess[:, idx])
     f = (g.order_hz[:, None, :] * np.ones(ok.shape))[ok]
+    if not f.size:
+        return np.empty(0)
     lo, hi = np.clip([f.min(), f.max()], *FREQ_RANGE)
     n = int(np.ceil(np.log(hi / lo) / np.log(GRID_STEP))) + 1
     return np.geomspace(lo, hi, max(n, 1))

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from powertrain.analysis.channel import split_side
 from powertrain.analysis.noise_floor import NOISE_FLOOR_MARGIN, at_floor
 from powertrain.errors import InputError
 from powertrain.plotting.runup import style_panel
@@ -11,10 +12,12 @@ from powertrain.plotting.style import (
     LABEL_SIZE,
     LEGEND_SIZE,
     OKABE_ITO,
+    PALETTE,
     PRINT_WIDTH_IN,
     TICK_SIZE,
     TITLE_SIZE,
     colorbar,
+    figure_legend,
     finish,
     is_axes,
     legend,
@@ -28,8 +31,13 @@ from powertrain.plotting.style import (
     wrap,
 )
 
-#: Colour scale of the gap map [dB]; cells beyond are clipped (the colour bar shows arrows).
+#: Smallest colour scale of the gap map [dB]; the scale is the data's largest gap rounded
+#: up to one of :data:`GAP_SCALES_DB` (cells beyond, none, would show as arrows).
 GAP_SCALE_DB = 6.0
+GAP_SCALES_DB = (3.0, 6.0, 10.0, 20.0, 30.0, 40.0, 60.0, 80.0, 100.0)
+#: Channels beyond which the gap against frequency is drawn as small multiples, one panel
+#: per mount base (or body point) and direction.
+MAX_CHANNELS_ONE_AXIS = 8
 #: Gap outlined on the map [dB] ...
 GAP_OUTLINE_DB = 3.0
 #: ... where it holds over at least this many neighbouring speeds (a lone noisy cell is not
@@ -46,9 +54,10 @@ def _censored(diagnosis):
 
 def plot_gap_map(diagnosis, path=None, *, ax=None, quantity=None, provenance=None):
     """Gap map of a :class:`powertrain.diagnosis.DiagnosisResult`: one panel per quantity
-    with a point above the censoring limit (3 × noise floor; the other quantities are named
-    in the title), channels against speed, colour = gap 20 log10(sim/measured) [dB] on a
-    ±6 dB scale (arrows on the colour bar when cells lie beyond); outlined: runs of at least
+    with a point above the censoring limit (3 × noise floor; the title counts the others),
+    channels against speed, colour = gap 20 log10(sim/measured) [dB] on a scale from the
+    data (:func:`gap_scale`); a title of the verdict's label (its text is in the summary);
+    every panel with its speed axis; outlined: runs of at least
     :data:`GAP_OUTLINE_RUN` neighbouring speeds beyond ±3 dB (single noisy cells are not);
     cells measured below the censoring limit grey.
 
@@ -83,27 +92,46 @@ def plot_gap_map(diagnosis, path=None, *, ax=None, quantity=None, provenance=Non
     else:
         ncol = 1 if len(qs) == 1 else 2
         nrow = -(-len(qs) // ncol)
-        fig, axes, own = subplots(ax, nrow, ncol, sharex=True, sharey=True,
-                                  figsize=(PRINT_WIDTH_IN, 0.2 * _n_rows(valid) * nrow + 2.6))
-    im = _gap_panels(axes, diagnosis, qs, cens, valid)
+        fig, axes, own = subplots(ax, nrow, ncol, sharey=True,
+                                  figsize=(PRINT_WIDTH_IN, 0.2 * _n_rows(valid) * nrow
+                                           + 0.45 * nrow + 2.2))
+    scale = gap_scale(diagnosis.gap[valid])
+    im = _gap_panels(axes, diagnosis, qs, cens, valid, scale)
     for a in axes.flat[len(qs):]:
         a.set_visible(False)
-    for a in axes[-1]:
+    for a in axes.flat[:len(qs)]:
         a.set_xlabel("engine speed [rpm]", fontsize=LABEL_SIZE)
+    for a in axes.flat[:len(qs)]:
+        a.set_ylabel("channel", fontsize=LABEL_SIZE)
     if im is not None:
-        colorbar(fig, im, axes.ravel().tolist(), diagnosis.gap[valid], -GAP_SCALE_DB,
-                 GAP_SCALE_DB, f"gap 20 log10(sim/measured) [dB]; grey: below {margin:g}× "
-                               "the noise floor")
-    title = f"gap map (baseline): {diagnosis.verdict_text}"
-    if empty:
-        title += (f". Every measured point below {margin:g}× the noise floor, not drawn: "
-                  + ", ".join(quantity_label(q) for q in empty))
-    title += (f". Outlined: ≥ {GAP_OUTLINE_RUN} neighbouring speeds beyond "
+        colorbar(fig, im, axes.ravel().tolist(), diagnosis.gap[valid], -scale, scale,
+                 f"gap 20 log10(sim/measured) [dB]; grey: below {margin:g}× the noise floor")
+    title = f"gap map (baseline){_run_name(diagnosis)}; verdict: {diagnosis.verdict}"
+    title += (f"; outlined: ≥ {GAP_OUTLINE_RUN} neighbouring speeds beyond "
               f"±{GAP_OUTLINE_DB:g} dB")
+    if empty:
+        title += f"; {len(empty)} quantities all below {margin:g}× the floor, not drawn"
     return finish(fig, own, path, provenance, title=title if whole_figure(ax) else None)
 
 
-def _gap_panels(axes, diagnosis, qs, cens, valid):
+def gap_scale(gaps) -> float:
+    """Colour scale [dB] of the gap map: the largest finite |gap| rounded up to one of
+    :data:`GAP_SCALES_DB` (at least :data:`GAP_SCALE_DB`)."""
+    g = np.abs(np.asarray(gaps, float))
+    top = float(g[np.isfinite(g)].max()) if np.isfinite(g).any() else 0.0
+    return next((v for v in GAP_SCALES_DB if v >= max(top, GAP_SCALE_DB)), GAP_SCALES_DB[-1])
+
+
+def _run_name(diagnosis) -> str:
+    """' of run 1 (FILE)' for a plan's figures (they show its first run), else ''."""
+    runs = getattr(diagnosis, "runs", None) or []
+    if not runs:
+        return ""
+    from pathlib import Path  # deferred: only plans need it
+    return f" of run 1 ({Path(runs[0]['file']).name}) of {len(runs)}"
+
+
+def _gap_panels(axes, diagnosis, qs, cens, valid, scale=GAP_SCALE_DB):
     """Draw the gap panels; returns the last colour mesh (None when nothing was drawn)."""
     from matplotlib.colors import ListedColormap  # deferred: heavy optional package
     d = diagnosis.data
@@ -125,7 +153,7 @@ def _gap_panels(axes, diagnosis, qs, cens, valid):
         a.pcolormesh(d.rpm, y, np.ma.masked_invalid(grey), shading="nearest",
                      cmap=ListedColormap(["0.7"], name="censored grey"))
         im = a.pcolormesh(d.rpm, y, np.ma.masked_where(~ok, g), cmap="RdBu_r",
-                          vmin=-GAP_SCALE_DB, vmax=GAP_SCALE_DB, shading="nearest")
+                          vmin=-scale, vmax=scale, shading="nearest")
         runs = _runs_beyond(np.where(ok, np.abs(g), 0.0) > GAP_OUTLINE_DB, GAP_OUTLINE_RUN)
         if runs.any():
             a.contour(d.rpm, y, runs.astype(float), [0.5], colors="k", linewidths=0.8)
@@ -149,12 +177,14 @@ def _runs_beyond(mask, run):
 
 
 def plot_gap_frequency(diagnosis, path=None, *, ax=None, provenance=None):
-    """Order gaps re-plotted (a) against frequency f = order·rpm/60 [Hz], one colour per
-    channel with that channel's fitted structure part dH(f) + constant (a structural cause
-    lines up across orders at one frequency), and (b), averaged over the channels, against
-    speed, one colour per order with that order's fitted excitation part (dashed; an
-    excitation cause lines up at one order). Only orders with a gap above the noise floor
-    are drawn and listed; each panel's legend sits above it, off the data.
+    """Order gaps re-plotted (a) against frequency f = order·rpm/60 [Hz], per channel with
+    that channel's fitted structure part dH(f) + constant (a structural cause lines up
+    across orders at one frequency), and (b), averaged over the channels, against speed,
+    one colour per order with that order's fitted excitation part (dashed; an excitation
+    cause lines up at one order). Up to :data:`MAX_CHANNELS_ONE_AXIS` channels share panel
+    (a), each its own colour and line style; beyond, (a) is small multiples, one panel per
+    mount base (or body point) and direction, its engine side and body side told apart by
+    colour and line style. Only orders with a gap above the noise floor are drawn.
 
     Parameters
     ----------
@@ -165,47 +195,94 @@ def plot_gap_frequency(diagnosis, path=None, *, ax=None, provenance=None):
     """
     d = diagnosis.data
     p = diagnosis.parts
-    fig, axes, own = subplots(ax, 2, 1, figsize=(PRINT_WIDTH_IN, 8.4))
-    a1, a2 = axes[:, 0]
     with_data = [k for k in np.flatnonzero(d.order_mask)
                  if np.isfinite(diagnosis.gap[:, :, k]).any()]
-    _gap_by_channel(a1, diagnosis, with_data)
-    _gap_by_order(a2, diagnosis, with_data)
-    log_axis(a1, "x", max_ticks=9)
-    a1.set_xlabel("frequency = order × rpm / 60 [Hz]", fontsize=LABEL_SIZE)
-    a1.set_ylabel("gap per channel [dB]", fontsize=LABEL_SIZE)
+    chans = [c for c in range(len(d.channels))
+             if np.isfinite(diagnosis.gap[:, c, with_data]).any()]
+    many = len(chans) > MAX_CHANNELS_ONE_AXIS
+    fig, own, small, a2 = _frequency_layout(ax, diagnosis, with_data, chans, many)
+    for a in small:
+        log_axis(a, "x", max_ticks=4 if many else 9)
+        a.set_xlabel("frequency [Hz]" if many else "frequency = order × rpm / 60 [Hz]",
+                     fontsize=LABEL_SIZE)
+        a.set_ylabel("gap [dB]" if many else "gap per channel [dB]", fontsize=LABEL_SIZE)
     a2.set_xlabel("engine speed [rpm]", fontsize=LABEL_SIZE)
     a2.set_ylabel("gap, mean over channels [dB]", fontsize=LABEL_SIZE)
-    titles = ("(a) gap of every order per channel against frequency; line: the channel's "
-              "fitted structure part dH(f) + constant",
-              "(b) gap per order, mean over the channels, against speed; dashed: the "
-              "order's fitted excitation part")
-    for a, title in zip((a1, a2), titles):
+    for a in small + [a2]:
         a.axhline(0, color="0.5", lw=0.5)
         a.grid(True, alpha=0.3)
         a.tick_params(which="both", labelsize=TICK_SIZE)
-        _legend_above(a, title)
-    s = p["share_alone"]
-    title = (f"gap split: structure {s['structure']:.0%}, excitation {s['excitation']:.0%}, "
-             f"channel constant {s['const']:.0%} of the gap's sum of squares (each alone)")
+    if many:
+        figure_legend(fig, small)
+    else:
+        _legend_above(small[0], "(a) gap of every order per channel against frequency; line: "
+                                "the channel's fitted structure part dH(f) + constant")
+    _legend_above(a2, "(b) gap per order, mean over the channels, against speed; dashed: the "
+                      "order's fitted excitation part")
+    sh = p["share_alone"]
+    title = (f"gap split{_run_name(diagnosis)}: structure {sh['structure']:.0%}, excitation "
+             f"{sh['excitation']:.0%}, channel constant {sh['const']:.0%} (each alone)"
+             + ("; (a) per base and direction, line: fitted structure part" if many else ""))
     return finish(fig, own, path, provenance, title=title if whole_figure(ax) else None)
 
 
-def _gap_by_channel(ax, diagnosis, orders):
+def _frequency_layout(ax, diagnosis, orders, chans, many):
+    """``(fig, own, panels of (a), panel (b))`` of :func:`plot_gap_frequency`, drawn: (a)
+    one panel, or with ``many`` small multiples in three columns; (b) below, full width."""
+    groups = _channel_groups(diagnosis.data.channels, chans)
+    ncol = 3 if many else 1
+    nrow = -(-len(groups) // ncol) if many else 1
+    fig, axes, own = subplots(ax, nrow + 2, ncol,
+                              figsize=(PRINT_WIDTH_IN, (2.0 * nrow if many else 4.2) + 4.2))
+    gs = axes[0, 0].get_gridspec()
+    for a in axes.flat:
+        a.remove()
+    small = []
+    for j, (key, cs) in enumerate(groups.items() if many else [(None, chans)]):
+        a = fig.add_subplot(gs[j // ncol, j % ncol])
+        _gap_by_channel(a, diagnosis, orders, cs, sides=many)
+        if many:
+            a.set_title(f"{key[0]} {key[1].upper()}", fontsize=TITLE_SIZE)
+        small.append(a)
+    a2 = fig.add_subplot(gs[nrow:, :])
+    _gap_by_order(a2, diagnosis, orders)
+    return fig, own, small, a2
+
+
+def _channel_groups(channels, chans) -> dict:
+    """``{(base, direction): [channel indices]}`` of ``chans``: a mount's engine side and
+    body side (``NAME/passive``) share their base's panel; a body point has its own."""
+    out = {}
+    for c in chans:
+        mount, direction = channels[c]
+        out.setdefault((split_side(mount)[0], direction), []).append(c)
+    return out
+
+
+def _gap_by_channel(ax, diagnosis, orders, chans, sides):
+    """Gap points and structure line of channels ``chans``: each its own series style, or
+    with ``sides`` (one base and direction per panel) the engine side blue solid with
+    circles, the body side orange dashed with squares, a body point green dotted with
+    triangles (markers: no order's line of panel (b) looks like them)."""
     d, p = diagnosis.data, diagnosis.parts
     sc = p["structure_curves"]
-    for c, (mount, direction) in enumerate(d.channels):
-        if not np.isfinite(diagnosis.gap[:, c, orders]).any():
-            continue
-        style = series_style(c)
-        marker = "o^s"[(c // 6) % 3]
+    for j, c in enumerate(chans):
+        mount, direction = d.channels[c]
+        base, side = split_side(mount)
+        if sides:
+            k = 0 if side != "passive" and c < d.n_active else 1 if side == "passive" else 2
+            style = {"color": PALETTE[k], "ls": ("-", "--", ":")[k], "marker": "os^"[k],
+                     "ms": 3, "markevery": 6}
+            label = ("engine side", "body side (passive)", "body point")[k]
+        else:
+            style = series_style(j)
+            label = f"{mount} {direction.upper()}"
         for k in orders:
             f = (d.harmonic[k] + 1) / 2.0 * d.rpm / 60.0
-            ax.plot(f, diagnosis.gap[:, c, k], marker, ms=1.6, color=style["color"],
+            ax.plot(f, diagnosis.gap[:, c, k], "o", ms=1.6, color=style["color"],
                     alpha=0.6, ls="none")
         ax.plot(sc["frequency_hz"], np.array(sc["by_channel"][c]) + p["channel_const_db"][c],
-                lw=1.2, marker=marker, ms=3, markevery=4,
-                label=f"{mount} {direction.upper()}", **style)
+                lw=1.2, label=label, **style)
 
 
 def _gap_by_order(ax, diagnosis, orders):
@@ -220,6 +297,9 @@ def _gap_by_order(ax, diagnosis, orders):
                 label=quantity_label(d.quantities[k]))
         ax.plot(ec["rpm"], ec["by_quantity"][k], lw=2.0, ls=(0, (4, 2)), color=style["color"],
                 alpha=0.7)
+    if orders:      # one entry for the dashed lines, each in its order's colour
+        ax.plot([], [], lw=2.0, ls=(0, (4, 2)), color="0.45",
+                label="fitted excitation part (dashed, the order's colour)")
 
 
 def _legend_above(ax, title):
@@ -235,7 +315,11 @@ def _legend_above(ax, title):
 
 def plot_diagnosis_overlay(diagnosis, path=None, n_panels=6, *, ax=None, provenance=None):
     """Measured vs baseline vs baseline + chosen effect for the channel-orders with the
-    largest baseline gaps; held-out speeds circled.
+    largest baseline gaps; held-out speeds circled; measured points below the censoring
+    level (3 × the noise floor) hollow, at that level (they say only "below it"). The
+    simulated curves are the model's levels at every measured speed (noise floor added in
+    power), drawn whole; where a curve cannot be drawn (no steady state with the effect) the
+    panel says so. A plan's overlay shows its first run and says so.
 
     Parameters
     ----------
@@ -258,39 +342,57 @@ def plot_diagnosis_overlay(diagnosis, path=None, n_panels=6, *, ax=None, provena
     score = sorted(score, reverse=True)[:n_panels]
     ncol = 2
     nrow = max(1, int(np.ceil(len(score) / ncol)))
-    fig, axes, own = subplots(ax, nrow, ncol, figsize=(PRINT_WIDTH_IN, 2.3 * nrow + 2.0))
+    fig, axes, own = subplots(ax, nrow, ncol, figsize=(PRINT_WIDTH_IN, 2.5 * nrow + 2.0))
     held = np.isin(d.rpm, diagnosis.split["heldout_rpm"])
     for a, (rms, c, k) in zip(axes.flat, score):
-        _overlay_panel(a, diagnosis, c, k, held, rms)
+        _overlay_panel(a, diagnosis, c, k, held, rms, cens[:, c, k])
     if not score:
         no_data(axes.flat[0], "no channel-order above the noise floor")
     for a in axes.flat[max(1, len(score)):]:
         a.set_visible(False)
     for a in axes.flat[:len(score)]:
         a.set_xlabel("engine speed [rpm]", fontsize=LABEL_SIZE)
-    fig.supylabel("RMS velocity [mm/s]", fontsize=LABEL_SIZE + 0.5)
+        a.set_ylabel("RMS velocity [mm/s]", fontsize=LABEL_SIZE)
     legend(fig, axes, ax)
-    return finish(fig, own, path, provenance, title=f"before / after / measured: "
-                  f"{diagnosis.verdict_text}" if whole_figure(ax) else None)
+    return finish(fig, own, path, provenance,
+                  title=f"before / after / measured{_run_name(diagnosis)}: verdict "
+                        f"{diagnosis.verdict}" if whole_figure(ax) else None)
 
 
-def _overlay_panel(ax, diagnosis, c, k, held, rms):
+def _overlay_panel(ax, diagnosis, c, k, held, rms, cens):
     d = diagnosis.data
-    g = diagnosis.gap
     m = d.level[:, c, k] * 1e3
-    sim0 = m * 10 ** (g[:, c, k] / 20)
-    ax.plot(d.rpm, m, "k.", ms=2.5, label="measured")
-    ax.plot(d.rpm[held], m[held], "o", mfc="none", mec="0.6", ms=4, label="held-out speeds")
-    ax.plot(d.rpm, sim0, "-", color=OKABE_ITO["vermillion"], lw=1,
-            label="baseline simulation")
-    # the axis spans the points above the noise floor: a censored point far below (a
-    # level of 1e-300) would stretch it over hundreds of decades
-    values = [np.where(_censored(diagnosis)[0][:, c, k], np.nan, m), sim0]
-    if diagnosis.gap_after is not None and diagnosis.chosen is not None:
-        after = m * 10 ** (diagnosis.gap_after[:, c, k] / 20)
-        ax.plot(d.rpm, after, "-", color=OKABE_ITO["blue"], lw=1,
-                label=f"baseline + {diagnosis.chosen.label}")
-        values.append(after)
+    cl = NOISE_FLOOR_MARGIN * d.floor * 1e3
+    up = np.isfinite(m) & ~cens
+    ax.plot(d.rpm[up], m[up], "k.", ms=2.5, label="measured")
+    if cens.any():
+        ax.plot(d.rpm[cens], np.full(int(cens.sum()), cl), "o", mfc="none", mec="k", ms=2.5,
+                mew=0.6, label=f"measured below {NOISE_FLOOR_MARGIN:g}× the floor (censored)")
+    ax.plot(d.rpm[held & up], m[held & up], "o", mfc="none", mec="0.6", ms=4,
+            label="held-out speeds")
+    values = [m[up], [cl] if cens.any() else []]
+    sim0 = _sim_curve(diagnosis, diagnosis.sim_levels, diagnosis.gap, c, k, m)
+    ax.plot(d.rpm, sim0, "-", color=OKABE_ITO["vermillion"], lw=1, label="baseline simulation")
+    values.append(sim0)
+    if diagnosis.chosen is not None:
+        after = _sim_curve(diagnosis, diagnosis.sim_after, diagnosis.gap_after, c, k, m)
+        if after is None:
+            ax.text(0.02, 0.03, f"baseline + {diagnosis.chosen.label} not drawn: no steady "
+                    "state", transform=ax.transAxes, fontsize=LABEL_SIZE, color="0.4")
+        else:
+            ax.plot(d.rpm, after, "-", color=OKABE_ITO["blue"], lw=1,
+                    label=f"baseline + {diagnosis.chosen.label}")
+            values.append(after)
     mnt, dr = d.channels[c]
     style_panel(ax, f"{mnt} {dr.upper()} — {quantity_label(d.quantities[k])}: "
-                    f"gap {rms:.1f} dB RMS", np.concatenate(values))
+                    f"gap {rms:.1f} dB RMS", np.concatenate([np.ravel(v) for v in values]))
+
+
+def _sim_curve(diagnosis, levels, gap, c, k, measured_mm):
+    """A simulated curve [mm/s] at every measured speed: the model levels when the result
+    carries them, else measured × 10^(gap/20) (where the gap is scored); None without."""
+    if levels is not None:
+        return levels[:, c, k] * 1e3
+    if gap is None:
+        return None
+    return measured_mm * 10 ** (gap[:, c, k] / 20)
