@@ -69,4 +69,6 @@ def main():
       powertrain diagnose examples/measured-runup.csv --report diagnosis/
       powertrain modes --engine engines/default-torque-rod.toml --json modes.json
       powertrain track run.csv --csv tracked.csv --plot orders.png
+      powertrain transient examples/start.toml --plot start.png --json start.json
+      powertrain report examples/study.toml --out report.html
     """
