@@ -62,24 +62,36 @@ class NetworkPorts:
         return not np.any(self.base_rows)
 
 
-def two_ports(ports: NetworkPorts, s, internal=False, amplitudes=None):
+def two_ports(ports: NetworkPorts, s, internal=False, amplitudes=None, linear=None):
     """``(a, b, c)`` each ``s.shape + (n_net,)`` of every network at ``s`` (and the list of
     internal motions per network when ``internal``): each element's equivalent-linear
     two-port at its relative-displacement amplitude (``amplitudes`` (n_net,) [m]; None:
-    zero, which a linear element ignores)."""
+    zero, which a linear element ignores). ``linear``: the networks' linear two-ports at
+    ``s`` where they do not depend on the amplitude (:func:`linear_two_ports`, same
+    ``internal``), reused."""
     s = np.asarray(s, complex)
     abc = [np.empty(s.shape + (len(ports.elements),), complex) for _ in range(3)]
     shapes = []
     amplitudes = np.zeros(len(ports.elements)) if amplitudes is None else amplitudes
     describing = [None] * len(ports.elements) if any(np.ndim(a) for a in amplitudes) \
         else describing_stiffnesses(ports.elements, amplitudes)
+    linear = [None] * len(ports.elements) if linear is None else linear
     for k, element in enumerate(ports.elements):
-        res = element.two_port(s, amplitudes[k], internal=internal, describing=describing[k])
+        res = element.two_port(s, amplitudes[k], internal=internal, describing=describing[k],
+                               linear=linear[k])
         for j in range(3):
             abc[j][..., k] = res[j]
         if internal:
             shapes.append(res[3])
     return (tuple(abc), shapes) if internal else tuple(abc)
+
+
+def linear_two_ports(ports: NetworkPorts, s, internal=False) -> list:
+    """Each network's linear two-port at ``s`` (:meth:`MountElement.linear_two_port`; None
+    where an amplitude law makes it depend on the amplitude), for :func:`two_ports` at many
+    amplitudes (the equivalent-linear fixed point)."""
+    s = np.asarray(s, complex)
+    return [element.linear_two_port(s, internal) for element in ports.elements]
 
 
 def condensed_matrix(frame, engine_rows, base_rows, abc, s):

@@ -224,16 +224,20 @@ class MountElement:
         them)."""
         return network_matrices(*self.network(amplitude), include_ground=include_ground)
 
-    def two_port(self, s, amplitude=0.0, internal=False, describing=None):
+    def two_port(self, s, amplitude=0.0, internal=False, describing=None, linear=None):
         """Equivalent-linear two-port ``(a, b, c)`` at the Laplace variable ``s`` and the
         relative-displacement amplitude [m] (and the internal motions when ``internal``, see
         :func:`powertrain.physics.mount_network.laplace_two_port`; a port law moves no
         internal node). ``amplitude`` may be an array that broadcasts to ``s`` (one
         amplitude per speed of a run-up, :mod:`powertrain.solvers.fast_harmonic`).
         ``describing``: the port law's describing stiffness at the amplitude when the caller
-        has it (:func:`describing_stiffnesses`)."""
+        has it (:func:`describing_stiffnesses`). ``linear``: the linear network's two-port
+        at ``s`` (with its internal motions when ``internal``) when the caller has it, for
+        an element without an amplitude law (:meth:`linear_two_port`)."""
         lam = np.asarray(s, complex)
-        if np.ndim(amplitude) == 0:
+        if linear is not None:
+            res = linear
+        elif np.ndim(amplitude) == 0:
             res = laplace_two_port(lam, *self.network(amplitude), internal=internal)
         else:
             amplitude = np.broadcast_to(np.asarray(amplitude, float), lam.shape)
@@ -246,6 +250,13 @@ class MountElement:
         k = np.where(lam == 0, 0.0, describing)
         return (res[0] + k, res[1] - k, res[2] + k) + res[3:]
 
+
+    def linear_two_port(self, s, internal=False):
+        """The linear network's two-port at ``s`` (:meth:`two_port` without the port law)
+        when it does not depend on the amplitude (no amplitude law), else None."""
+        if self.amplitude_law is not None:
+            return None
+        return laplace_two_port(np.asarray(s, complex), *self.network(0.0), internal=internal)
 
     def cross_point_stiffness(self, frequency_hz, amplitude=0.0) -> np.ndarray:
         """Equivalent-linear cross-point dynamic stiffness K*(f, A) [N/m]: the base force

@@ -375,9 +375,9 @@ class ModalPortNewmark:
         self.silent = self._output_arrays(np.zeros((0, n)))
 
     def _output_arrays(self, Wx=None, Wv=None, Wa=None, Wz=None):
-        """``((Wy, y_cols), (Wz, z_cols), w_rows, W, Wd)`` of :func:`modal_port_kernel` for
-        the output rows: ``Wy`` over the reduced state, ``Wz`` over the port forces (the
-        columns they read, :func:`_read_columns`); the rows ``w_rows`` that read other
+        """``((Wyz, y_cols, z_cols), w_rows, W, Wd)`` of :func:`modal_port_kernel` for
+        the output rows: ``Wyz`` over the reduced state's columns ``y_cols`` and then the
+        port forces' ``z_cols`` (the columns they read, :func:`_read_columns`); the rows ``w_rows`` that read other
         coordinates also through the modal state, ``Re(W eta) + Wd p`` (``Wd`` the direct
         part of the acceleration, a = M^-1 (p - C v - K x))."""
         modal, n, r = self.modal, self.modal.n, self.reduced
@@ -396,7 +396,9 @@ class ModalPortNewmark:
             Wd = np.asarray(Wa, float)[:, off] @ modal.Minv[np.ix_(off, r)]
         Wz = np.zeros((rows, self.ports.kinds.size)) if Wz is None else np.asarray(Wz, float)
         w_rows = np.flatnonzero(np.any(W != 0, 1) | np.any(Wd != 0, 1))
-        return (_read_columns(Wy.reshape(rows, 3 * r.size)), _read_columns(Wz),
+        (Wy, y_cols), (Wz, z_cols) = _read_columns(Wy.reshape(rows, 3 * r.size)), \
+            _read_columns(Wz)
+        return ((np.ascontiguousarray(np.hstack([Wy, Wz])), y_cols, z_cols),
                 w_rows.astype(np.int64), modal.real_form(np.conj(W[w_rows])),
                 np.ascontiguousarray(Wd[w_rows]))
 
@@ -417,7 +419,7 @@ class ModalPortNewmark:
             Newton did not converge at some step (the names of the port laws are given).
         """
         arrays = self.outputs if outputs else self.silent
-        out = np.empty((F.shape[0] - 1, arrays[1][0].shape[0]))
+        out = np.empty((F.shape[0] - 1, arrays[0][0].shape[0]))
         laws = (self.ports.kinds, self.ports.parameters, state)
         F = np.ascontiguousarray(F, float)
         T, load_at = self.port_arrays[:2]

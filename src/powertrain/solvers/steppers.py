@@ -34,6 +34,7 @@ from powertrain.analysis.fourier import harmonic_amplitudes
 from powertrain.analysis.orders import ORDERS, order_spectrum
 from powertrain.assembly import NetworkScaling
 from powertrain.kernels.port_forces import NONE
+from powertrain.physics.condensation import linear_two_ports
 from powertrain.solvers.admittance import frf_response, relative_motion
 from powertrain.solvers.cycle_newmark import CycleRun, run_cycles, start_state
 from powertrain.solvers.equivalent_linear import AMPLITUDE_HARMONICS, TOLERANCE, amplitude_fixed_point
@@ -141,14 +142,17 @@ class Stepper:
         """Harmonic response (n_h, n_dof) of the (equivalent-linear) model (``system``,
         default the stepper's) and the nonlinear elements' amplitudes (None: linear model).
         The fixed point iterates on the harmonics that make the amplitudes only; one solve of
-        all follows."""
+        all follows. The networks' linear two-ports are condensed once for all."""
         s = self.system if system is None else system
         if self.ports is None:
             return harmonic_response(s, fh, omegas), None
         k = AMPLITUDE_HARMONICS.stop
-        A = self.equivalent_linear(lambda a: harmonic_response(s, fh[:k], omegas[:k], a),
+        linear = linear_two_ports(s.ports(), 1j * np.asarray(omegas, float), True)
+        first = [None if r is None else tuple(x[:k] for x in r) for r in linear]
+        A = self.equivalent_linear(lambda a: harmonic_response(s, fh[:k], omegas[:k], a,
+                                                               first),
                                    lambda q: q @ self.ports.rows.T, omega)[0]
-        return harmonic_response(s, fh, omegas, self.ports.network_amplitudes(A)), A
+        return harmonic_response(s, fh, omegas, self.ports.network_amplitudes(A), linear), A
 
     def harmonics(self, load, omega, max_order=None):
         """Load harmonics of the cycle (index j is order j/2) and their frequencies."""
