@@ -11,6 +11,7 @@ out and do not borrow anything from the frequency-domain solution.
 
 from __future__ import annotations
 
+import copy
 import threading
 
 import numpy as np
@@ -349,11 +350,29 @@ class ModalPortNewmark:
 
     def __init__(self, modal, ports, h, Wx=None, Wv=None, Wa=None, Wz=None):
         n = modal.n
-        self.modal, self.ports, self.h = modal, ports, float(h)
+        self.modal, self.ports = modal, ports
         P = np.asarray(ports.rows, float)
         self.reduced = r = np.union1d(np.arange(modal.load_dofs),
                                       np.flatnonzero(np.any(P != 0, 0)))
-        T = P[:, r]
+        #: rows reading the reduced state (x, v, a) off the modal state (a less M^-1 p)
+        self._reduced_rows = modal.real_form(np.conj(np.vstack(
+            [modal.Psi_r[r], modal.Psi_r[n + r], modal.Psi_r[n + r] * modal.lam_r])))
+        self.outputs = self._output_arrays(Wx, Wv, Wa, Wz)
+        self.silent = self._output_arrays(np.zeros((0, n)))
+        self._set_step(h)
+
+    def at_step(self, h) -> ModalPortNewmark:
+        """The same model, port laws and outputs at the time step ``h`` [s] (the output
+        arrays, which do not depend on the step, shared)."""
+        other = copy.copy(self)
+        other._set_step(h)
+        return other
+
+    def _set_step(self, h):
+        """The kernel's arrays that depend on the time step ``h`` [s]."""
+        modal, n, r = self.modal, self.modal.n, self.reduced
+        self.h = float(h)
+        T = np.asarray(self.ports.rows, float)[:, r]
         lam = modal.lam_r
         lam_d = (1 + 0.5 * h * lam) / (1 - 0.5 * h * lam)
         G = ((0.5 * h) / (1 - 0.5 * h * lam))[:, None] * (
@@ -368,11 +387,6 @@ class ModalPortNewmark:
         self.port_arrays = (np.ascontiguousarray(T), np.searchsorted(
             r, np.arange(modal.load_dofs)).astype(np.int64),
             np.ascontiguousarray(0.25 * h * h * TST))
-        #: rows reading the reduced state (x, v, a) off the modal state (a less M^-1 p)
-        self._reduced_rows = modal.real_form(np.conj(np.vstack(
-            [modal.Psi_r[r], modal.Psi_r[n + r], Pa])))
-        self.outputs = self._output_arrays(Wx, Wv, Wa, Wz)
-        self.silent = self._output_arrays(np.zeros((0, n)))
 
     def _output_arrays(self, Wx=None, Wv=None, Wa=None, Wz=None):
         """``((Wyz, y_cols, z_cols), w_rows, W, Wd)`` of :func:`modal_port_kernel` for

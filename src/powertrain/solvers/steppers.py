@@ -149,8 +149,10 @@ class Stepper:
         k = AMPLITUDE_HARMONICS.stop
         linear = linear_two_ports(s.ports(), 1j * np.asarray(omegas, float), True)
         first = [None if r is None else tuple(x[:k] for x in r) for r in linear]
+        # the port rows read the retained coordinates only: no internal motion needed
+        internal = bool(np.any(np.delete(self.ports.rows, s.ports().retained, axis=1)))
         A = self.equivalent_linear(lambda a: harmonic_response(s, fh[:k], omegas[:k], a,
-                                                               first),
+                                                               first, internal),
                                    lambda q: q @ self.ports.rows.T, omega)[0]
         return harmonic_response(s, fh, omegas, self.ports.network_amplitudes(A), linear), A
 
@@ -365,14 +367,22 @@ class ModalPortStepper(DenseNewmarkStepper):
         self.rows = (np.vstack([Cm, Z, Z, system.force_matrix_k]),
                      np.vstack([Z, Cm, Z, system.force_matrix_d]), np.vstack([Z, Z, Cm, Z]),
                      np.vstack([zf, zf, zf, self.laws.force_map]))
+        self._runner = None
         self.setup_seconds = time.perf_counter() - t0
+
+    def runner(self, h) -> ModalPortNewmark:
+        """The modal recurrence with the port laws at the step ``h`` [s] (its outputs'
+        arrays built once per model)."""
+        if self._runner is None:
+            self._runner = ModalPortNewmark(self.modal, self.laws, h, *self.rows)
+        return self._runner.at_step(h)
 
     def channels(self, s, load, h, start, amplitudes, factors):
         if factors is not None:              # a static-factor hook: networks rescaled
             return super().channels(s, load, h, start, amplitudes, factors)
         g = self.grid
         x0, v0, _, qh = start
-        run = ModalPortNewmark(self.modal, self.laws, h, *self.rows)
+        run = self.runner(h)
         state = start_state(self.ports, qh, g.n_cycle)
         z = self.laws.forces(self.laws.rows @ x0, self.laws.rows @ v0, state)
         eta = run.modal_state(x0, v0)
