@@ -224,20 +224,16 @@ class MountElement:
         them)."""
         return network_matrices(*self.network(amplitude), include_ground=include_ground)
 
-    def two_port(self, s, amplitude=0.0, internal=False, describing=None, linear=None):
+    def two_port(self, s, amplitude=0.0, internal=False, describing=None):
         """Equivalent-linear two-port ``(a, b, c)`` at the Laplace variable ``s`` and the
         relative-displacement amplitude [m] (and the internal motions when ``internal``, see
         :func:`powertrain.physics.mount_network.laplace_two_port`; a port law moves no
         internal node). ``amplitude`` may be an array that broadcasts to ``s`` (one
         amplitude per speed of a run-up, :mod:`powertrain.solvers.fast_harmonic`).
         ``describing``: the port law's describing stiffness at the amplitude when the caller
-        has it (:func:`describing_stiffnesses`). ``linear``: the linear network's two-port
-        at ``s`` (with its internal motions when ``internal``) when the caller has it, for
-        an element without an amplitude law (:meth:`linear_two_port`)."""
+        has it (:func:`describing_stiffnesses`)."""
         lam = np.asarray(s, complex)
-        if linear is not None:
-            res = linear
-        elif np.ndim(amplitude) == 0:
+        if np.ndim(amplitude) == 0:
             res = laplace_two_port(lam, *self.network(amplitude), internal=internal)
         else:
             amplitude = np.broadcast_to(np.asarray(amplitude, float), lam.shape)

@@ -43,9 +43,9 @@ def harmonic_response(system, load_harmonics, omegas, amplitudes=None, linear=No
     amplitudes : ndarray (n_net,), optional
         Relative-displacement amplitude of every network [m]: nonlinear elements act
         through their equivalent-linear two-port there.
-    linear : list, optional
+    linear : LinearTwoPorts, optional
         The networks' linear two-ports at ``1j * omegas`` with their internal motions
-        (:func:`~powertrain.physics.condensation.linear_two_ports`), reused where given.
+        (:func:`~powertrain.physics.condensation.linear_two_ports`), reused.
     internal : bool
         False: the networks' internal coordinates are left zero (only the retained ones are
         solved).

@@ -147,8 +147,8 @@ class Stepper:
         if self.ports is None:
             return harmonic_response(s, fh, omegas), None
         k = AMPLITUDE_HARMONICS.stop
-        linear = linear_two_ports(s.ports(), 1j * np.asarray(omegas, float), True)
-        first = [None if r is None else tuple(x[:k] for x in r) for r in linear]
+        linear = linear_two_ports(s.ports(), 1j * np.asarray(omegas, float))
+        first = None if linear is None else linear.first(k)
         # the port rows read the retained coordinates only: no internal motion needed
         internal = bool(np.any(np.delete(self.ports.rows, s.ports().retained, axis=1)))
         A = self.equivalent_linear(lambda a: harmonic_response(s, fh[:k], omegas[:k], a,
