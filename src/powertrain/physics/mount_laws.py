@@ -28,6 +28,7 @@ applies them:
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import cached_property
 
 import numpy as np
 from scipy.interpolate import PchipInterpolator
@@ -137,29 +138,28 @@ class StaticCurve:
     force: tuple
     reference_deflection: float = 0.0
 
-    def _pchip(self):
-        return PchipInterpolator(np.asarray(self.deflection, float),
-                                 np.asarray(self.force, float), extrapolate=False)
-
-    def _ends(self, p):
+    @cached_property
+    def _interpolant(self):
+        """The curve's PCHIP (no extrapolation), its derivative and its ends ``(x0, x1,
+        F(x0), F(x1), F'(x0), F'(x1))``, built once per curve."""
         x = np.asarray(self.deflection, float)
+        p = PchipInterpolator(x, np.asarray(self.force, float), extrapolate=False)
         d = p.derivative()
-        return x[0], x[-1], float(p(x[0])), float(p(x[-1])), float(d(x[0])), float(d(x[-1]))
+        return p, d, (x[0], x[-1], float(p(x[0])), float(p(x[-1])), float(d(x[0])),
+                      float(d(x[-1])))
 
     def force_at(self, x) -> np.ndarray:
         """Force [N] at the deflection(s) ``x`` [m]."""
-        p = self._pchip()
-        x0, x1, f0, f1, k0, k1 = self._ends(p)
+        p, _, (x0, x1, f0, f1, k0, k1) = self._interpolant
         x = np.asarray(x, float)
         inside = np.nan_to_num(p(np.clip(x, x0, x1)))
         return np.where(x < x0, f0 + k0 * (x - x0), np.where(x > x1, f1 + k1 * (x - x1), inside))
 
     def tangent_at(self, x) -> np.ndarray:
         """Tangent stiffness dF/dx [N/m] at the deflection(s) ``x`` [m]."""
-        p = self._pchip()
-        x0, x1, _, _, k0, k1 = self._ends(p)
+        _, d, (x0, x1, _, _, k0, k1) = self._interpolant
         x = np.asarray(x, float)
-        inside = np.nan_to_num(p.derivative()(np.clip(x, x0, x1)))
+        inside = np.nan_to_num(d(np.clip(x, x0, x1)))
         return np.where(x < x0, k0, np.where(x > x1, k1, inside))
 
     def factor(self, x) -> np.ndarray:
