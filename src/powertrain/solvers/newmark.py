@@ -391,8 +391,8 @@ class ModalPortNewmark:
     def _output_arrays(self, Wx=None, Wv=None, Wa=None, Wz=None):
         """``((Wyz, y_cols, z_cols), w_rows, W, Wd)`` of :func:`modal_port_kernel` for
         the output rows: ``Wyz`` over the reduced state's columns ``y_cols`` and then the
-        port forces' ``z_cols`` (the columns they read, :func:`_read_columns`); the rows ``w_rows`` that read other
-        coordinates also through the modal state, ``Re(W eta) + Wd p`` (``Wd`` the direct
+        port forces' ``z_cols`` (the columns they read, :func:`_read_columns`); the rows
+        ``w_rows`` that read other coordinates also through the modal state, ``Re(W eta) + Wd p`` (``Wd`` the direct
         part of the acceleration, a = M^-1 (p - C v - K x))."""
         modal, n, r = self.modal, self.modal.n, self.reduced
         off = np.setdiff1d(np.arange(n), r)
