@@ -392,8 +392,9 @@ class ModalPortNewmark:
         """``((Wyz, y_cols, z_cols), w_rows, W, Wd)`` of :func:`modal_port_kernel` for
         the output rows: ``Wyz`` over the reduced state's columns ``y_cols`` and then the
         port forces' ``z_cols`` (the columns they read, :func:`_read_columns`); the rows
-        ``w_rows`` that read other coordinates also through the modal state, ``Re(W eta) + Wd p`` (``Wd`` the direct
-        part of the acceleration, a = M^-1 (p - C v - K x))."""
+        ``w_rows`` that read other coordinates also through the modal state,
+        ``Re(W eta) + Wd p`` (``Wd`` the direct part of the acceleration,
+        a = M^-1 (p - C v - K x))."""
         modal, n, r = self.modal, self.modal.n, self.reduced
         off = np.setdiff1d(np.arange(n), r)
         rows = next(w.shape[0] for w in (Wx, Wv, Wa, Wz) if w is not None)
