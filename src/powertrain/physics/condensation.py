@@ -68,7 +68,7 @@ def two_ports(ports: NetworkPorts, s, internal=False, amplitudes=None, linear=No
     two-port at its relative-displacement amplitude (``amplitudes`` (n_net,) [m]; None:
     zero, which a linear element ignores). ``linear``: the networks' linear two-ports at
     ``s`` (:func:`linear_two_ports`), reused: only the port laws' describing stiffnesses
-    are added."""
+    are added (one amplitude per network)."""
     s = np.asarray(s, complex)
     amplitudes = np.zeros(len(ports.elements)) if amplitudes is None else amplitudes
     if linear is not None:

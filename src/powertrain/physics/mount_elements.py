@@ -246,7 +246,6 @@ class MountElement:
         k = np.where(lam == 0, 0.0, describing)
         return (res[0] + k, res[1] - k, res[2] + k) + res[3:]
 
-
     def linear_two_port(self, s, internal=False):
         """The linear network's two-port at ``s`` (:meth:`two_port` without the port law)
         when it does not depend on the amplitude (no amplitude law), else None."""

@@ -255,7 +255,7 @@ class _Curves:
 
     def factors(self, x):
         """Static factor of every network at the state ``x`` (1 without a curve)."""
-        return self._read(self.tangent, self.d0 + self.rows @ x)
+        return np.where(self.has, self._read(self.tangent, self.d0 + self.rows @ x), 1.0)
 
     def at(self, x, scaling, amplitudes):
         """Static factors and the curves' load ``c`` (n_net,) [N] at the state ``x``, the
@@ -263,7 +263,7 @@ class _Curves:
         the static factors and the networks' ``amplitudes`` [m] (``scaling.scales``)."""
         u = self.rows @ x
         d = self.d0 + u
-        factors = self._read(self.tangent, d)
+        factors = np.where(self.has, self._read(self.tangent, d), 1.0)
         k = scaling.scales(amplitudes, factors)[:, 0] * self.stiffness
         c = np.where(self.has, self._read(self.force, d) - self.f0 - k * u, 0.0)
         return factors, c
