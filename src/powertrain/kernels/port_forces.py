@@ -111,6 +111,14 @@ def commit_state(kind, u, v, par, state, e, f):
 
 
 @njit(cache=True, nogil=True)
+def port_forces_at(kinds, par, state, u, v, out):
+    """Forces ``out`` (m,) of the port laws at the motions ``u``, ``v`` (m,) from the
+    committed ``state`` (unchanged; :func:`law_force` of every law)."""
+    for e in range(kinds.shape[0]):
+        out[e] = law_force(kinds[e], u[e], v[e], par, state, e)[0]
+
+
+@njit(cache=True, nogil=True)
 def port_force_loop(kinds, par, state, U, V, F):
     """Forces ``F`` (n_t, m) of the port laws along prescribed motions ``U``, ``V``
     (n_t, m), committing the state after every point (a displacement-driven test)."""

@@ -35,7 +35,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from powertrain.kernels.port_forces import JENKINS, NONE, port_force
+from powertrain.kernels.port_forces import JENKINS, NONE, port_forces_at
 from powertrain.physics.mount_network import (
     PackedNetworks,
     laplace_two_port,
@@ -336,8 +336,10 @@ class PortForces:
 
     def forces(self, u, v, state) -> np.ndarray:
         """Port forces (m,) [N] at the relative motions ``u``, ``v`` (m,) from ``state``."""
-        return np.array([port_force(k, ue, ve, p, st)[0] for k, ue, ve, p, st in
-                         zip(self.kinds, u, v, self.parameters, state)])
+        out = np.empty(self.kinds.size)
+        port_forces_at(self.kinds, self.parameters, np.ascontiguousarray(state, float),
+                       np.ascontiguousarray(u, float), np.ascontiguousarray(v, float), out)
+        return out
 
 
 def port_forces(elements, rows, force_map, names) -> PortForces | None:
