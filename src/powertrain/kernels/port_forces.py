@@ -112,8 +112,7 @@ def commit_state(kind, u, v, par, state, e, f):
 
 @njit(cache=True, nogil=True)
 def port_forces_at(kinds, par, state, u, v, out):
-    """Forces ``out`` (m,) of the port laws at the motions ``u``, ``v`` (m,) from the
-    committed ``state`` (unchanged; :func:`law_force` of every law)."""
+    """Forces ``out`` (m,) of the laws at ``u``, ``v`` (m,) from ``state`` (unchanged)."""
     for e in range(kinds.shape[0]):
         out[e] = law_force(kinds[e], u[e], v[e], par, state, e)[0]
 
