@@ -28,7 +28,6 @@ applies them:
 from __future__ import annotations
 
 from dataclasses import dataclass
-from functools import cached_property
 
 import numpy as np
 from scipy.interpolate import PchipInterpolator
@@ -138,33 +137,48 @@ class StaticCurve:
     force: tuple
     reference_deflection: float = 0.0
 
-    @cached_property
-    def _interpolant(self):
-        """The curve's PCHIP (no extrapolation), its derivative and its ends ``(x0, x1,
-        F(x0), F(x1), F'(x0), F'(x1))``, built once per curve."""
-        x = np.asarray(self.deflection, float)
-        p = PchipInterpolator(x, np.asarray(self.force, float), extrapolate=False)
-        d = p.derivative()
-        return p, d, (x[0], x[-1], float(p(x[0])), float(p(x[-1])), float(d(x[0])),
-                      float(d(x[-1])))
-
     def force_at(self, x) -> np.ndarray:
         """Force [N] at the deflection(s) ``x`` [m]."""
-        p, _, (x0, x1, f0, f1, k0, k1) = self._interpolant
-        x = np.asarray(x, float)
-        inside = np.nan_to_num(p(np.clip(x, x0, x1)))
-        return np.where(x < x0, f0 + k0 * (x - x0), np.where(x > x1, f1 + k1 * (x - x1), inside))
+        return CurveReader(self).force_at(x)
 
     def tangent_at(self, x) -> np.ndarray:
         """Tangent stiffness dF/dx [N/m] at the deflection(s) ``x`` [m]."""
-        _, d, (x0, x1, _, _, k0, k1) = self._interpolant
-        x = np.asarray(x, float)
-        inside = np.nan_to_num(d(np.clip(x, x0, x1)))
-        return np.where(x < x0, k0, np.where(x > x1, k1, inside))
+        return CurveReader(self).tangent_at(x)
 
     def factor(self, x) -> np.ndarray:
         """Tangent stiffness at ``x`` over that at ``reference_deflection``."""
         return self.tangent_at(x) / self.tangent_at(self.reference_deflection)
+
+
+class CurveReader:
+    """A :class:`StaticCurve` read many times: its PCHIP (no extrapolation), the PCHIP's
+    derivative and the curve's ends built once; straight beyond its points."""
+
+    def __init__(self, curve):
+        x = np.asarray(curve.deflection, float)
+        self.curve = curve
+        self.pchip = PchipInterpolator(x, np.asarray(curve.force, float), extrapolate=False)
+        self.slope = d = self.pchip.derivative()
+        self.ends = (x[0], x[-1], float(self.pchip(x[0])), float(self.pchip(x[-1])),
+                     float(d(x[0])), float(d(x[-1])))
+
+    def force_at(self, x) -> np.ndarray:
+        """Force [N] at the deflection(s) ``x`` [m]."""
+        x0, x1, f0, f1, k0, k1 = self.ends
+        x = np.asarray(x, float)
+        inside = np.nan_to_num(self.pchip(np.clip(x, x0, x1)))
+        return np.where(x < x0, f0 + k0 * (x - x0), np.where(x > x1, f1 + k1 * (x - x1), inside))
+
+    def tangent_at(self, x) -> np.ndarray:
+        """Tangent stiffness dF/dx [N/m] at the deflection(s) ``x`` [m]."""
+        x0, x1, _, _, k0, k1 = self.ends
+        x = np.asarray(x, float)
+        inside = np.nan_to_num(self.slope(np.clip(x, x0, x1)))
+        return np.where(x < x0, k0, np.where(x > x1, k1, inside))
+
+    def factor(self, x) -> np.ndarray:
+        """Tangent stiffness at ``x`` over that at the curve's ``reference_deflection``."""
+        return self.tangent_at(x) / self.tangent_at(self.curve.reference_deflection)
 
 
 @dataclass(frozen=True)

@@ -237,7 +237,7 @@ class _Curves:
         self.rows = system.port_rows
         self.has = np.array([c is not None for c in support.curves])
         flat = (np.array([-1.0, 1.0]), np.zeros(CURVE_SAMPLES), np.ones(CURVE_SAMPLES), 1.0)
-        tables = [flat if c is None else _sampled(c) for c in support.curves]
+        tables = [flat if c is None else _sampled(c) for c in support.readers]
         self.grid = np.array([(t[0][0], t[0][-1]) for t in tables])
         self.step = (self.grid[:, 1] - self.grid[:, 0]) / (CURVE_SAMPLES - 1)
         self.force = np.array([t[1] for t in tables])
@@ -270,9 +270,10 @@ class _Curves:
 
 
 def _sampled(curve):
-    """``(deflection, force, tangent, tangent at the reference)`` of a static curve."""
-    lo, hi = float(curve.deflection[0]), float(curve.deflection[-1])
+    """``(deflection, force, tangent, tangent at the reference)`` of a static curve (its
+    :class:`~powertrain.physics.mount_laws.CurveReader`)."""
+    lo, hi = float(curve.curve.deflection[0]), float(curve.curve.deflection[-1])
     grid = np.linspace(2 * lo - hi, 2 * hi - lo, CURVE_SAMPLES)
     return (grid, np.asarray(curve.force_at(grid), float),
             np.asarray(curve.tangent_at(grid), float),
-            float(curve.tangent_at(curve.reference_deflection)))
+            float(curve.tangent_at(curve.curve.reference_deflection)))
