@@ -111,7 +111,9 @@ class StretchODE:
 
     def __call__(self, t, y):
         x, v, z = y[:6], y[6:12], y[12]
-        load = np.array([np.interp(t, self.t, self.F[:, j]) for j in range(6)])
+        i = min(max(int(np.searchsorted(self.t, t, side="right")) - 1, 0), self.t.size - 2)
+        w = min(max((t - self.t[i]) / (self.t[i + 1] - self.t[i]), 0.0), 1.0)
+        load = self.F[i] * (1.0 - w) + self.F[i + 1] * w
         r = self.rows[self.n]
         a = self.Minv @ (load - self.K @ x - self.C @ v - r * self.network_force(y))
         fm, x2 = self.berg.max_force, self.berg.half_displacement
@@ -126,9 +128,9 @@ class StretchODE:
         return event
 
 
-def integrate(ode, every, rtol=1e-8):
+def integrate(ode, every, rtol=1e-8, method="Radau"):
     """Deflection and force of the nonlinear network at the load's times, stretch by
-    stretch from rest."""
+    stretch from rest (``solve_ivp``'s ``method``)."""
     t_all = ode.t
     bounds = list(range(0, t_all.size - 1, every)) + [t_all.size - 1]
     y = np.zeros(13)
@@ -139,7 +141,7 @@ def integrate(ode, every, rtol=1e-8):
         t, t_end, grid = t_all[lo], t_all[hi], t_all[lo:hi + 1]
         Y = [y]
         while True:
-            sol = solve_ivp(ode, (t, t_end), y, method="Radau", rtol=rtol, atol=1e-14,
+            sol = solve_ivp(ode, (t, t_end), y, method=method, rtol=rtol, atol=1e-14,
                             dense_output=True, events=ode.reversal())
             inside = grid[(grid > t) & (grid <= sol.t[-1])]
             Y += list(sol.sol(inside).T) if inside.size else []

@@ -331,6 +331,12 @@ class NetworkScaling:
         self.system = system
         self.elements = [el for *_, el in system.networks]
         self.C_parts, self.K_parts, self.gk, self.gd = system.network_parts()
+        laws = {}
+        for k, el in enumerate(self.elements):
+            if el.amplitude_law is not None:
+                laws.setdefault(el.amplitude_law, []).append(k)
+        self._laws = {law: np.array(index) for law, index in laws.items()}
+        self._static_factors = np.array([el.static_factor for el in self.elements], float)
         #: the scales the assembled matrices hold (every element at amplitude 0)
         self.assembled = self.scales(np.zeros(len(self.elements)))
         #: True when some network's scale follows its amplitude
@@ -346,9 +352,14 @@ class NetworkScaling:
 
     def scales(self, amplitudes, factors=None) -> np.ndarray:
         """``(stiffness, damping)`` factor (n_net, 2) of every network at its amplitude
-        (n_net,) [m] and static factor."""
-        return np.array([el.scales(a) for el, a in zip(self.elements_at(factors),
-                                                        amplitudes)], float).reshape(-1, 2)
+        (n_net,) [m] and static factor (:meth:`MountElement.scales`; one call per distinct
+        amplitude law)."""
+        out = np.ones((len(self.elements), 2))
+        a = np.asarray(amplitudes, float)
+        for law, index in self._laws.items():
+            out[index, 0], out[index, 1] = law.scales(a[index])
+        f = self._static_factors if factors is None else np.asarray(factors, float)
+        return out * f[:, None]
 
     def matrices(self, scales):
         """``(C, K, force_matrix_k, force_matrix_d)`` at the network ``scales`` (n_net, 2);

@@ -111,6 +111,13 @@ def commit_state(kind, u, v, par, state, e, f):
 
 
 @njit(cache=True, nogil=True)
+def port_forces_at(kinds, par, state, u, v, out):
+    """Forces ``out`` (m,) of the laws at ``u``, ``v`` (m,) from ``state`` (unchanged)."""
+    for e in range(kinds.shape[0]):
+        out[e] = law_force(kinds[e], u[e], v[e], par, state, e)[0]
+
+
+@njit(cache=True, nogil=True)
 def port_force_loop(kinds, par, state, U, V, F):
     """Forces ``F`` (n_t, m) of the port laws along prescribed motions ``U``, ``V``
     (n_t, m), committing the state after every point (a displacement-driven test)."""
@@ -369,17 +376,18 @@ def _body_force(load_at, T, F, k, z, p):
 
 
 @njit(cache=True, nogil=True, fastmath=True, inline="always")
-def _write_outputs(outputs, x, y, p, z, row):
-    """One row of outputs ``Wy y[y_cols] + Wz z[z_cols]``, plus ``Re(W eta) + Wd p`` on the
-    rows ``w_rows`` (those reading coordinates off the reduced ones)."""
-    (Wy, y_cols), (Wz, z_cols), w_rows, W, Wd = outputs
+def _write_outputs(outputs, x, y, p, z, row, g):
+    """One row of outputs ``Wyz [y[y_cols], z[z_cols]]`` (gathered into the work space
+    ``g`` first, then dense row products), plus ``Re(W eta) + Wd p`` on the rows ``w_rows``
+    (those reading coordinates off the reduced ones)."""
+    (Wyz, y_cols, z_cols), w_rows, W, Wd = outputs
+    ny = y_cols.shape[0]
+    for d in range(ny):
+        g[d] = y[y_cols[d]]
+    for d in range(z_cols.shape[0]):
+        g[ny + d] = z[z_cols[d]]
     for c in range(row.shape[0]):
-        o = 0.0
-        for d in range(y_cols.shape[0]):
-            o += Wy[c, d] * y[y_cols[d]]
-        for d in range(z_cols.shape[0]):
-            o += Wz[c, d] * z[z_cols[d]]
-        row[c] = o
+        row[c] = _dot(Wyz[c], g)
     for i in range(w_rows.shape[0]):
         row[w_rows[i]] += _dot(W[i], x) + _dot(Wd[i], p)
 
@@ -464,11 +472,12 @@ def modal_port_kernel(modal, outputs, ports, laws, F, x, y, z, out, tol, max_ite
     p, p_next, base, a = np.empty(q), np.empty(q), np.empty(q), np.empty(q)
     ul, vl, r = np.empty(m), np.empty(m), np.empty(m)
     J, w, last = np.empty((m, m)), np.empty(2 * q), np.zeros((7, m))
+    g = np.empty(outputs[0][0].shape[1])
     coupled = _coupling(Qu, 2.0 / h)
     _body_force(load_at, T, F, 0, z, p)
     failed = 0
     for k in range(out.shape[0]):
-        _write_outputs(outputs, x, y, p, z, out[k])
+        _write_outputs(outputs, x, y, p, z, out[k], g)
         _body_force(load_at, T, F, k + 1, z[:0], p_next)
         for c in range(q):
             base[c] = _dot(Ra[c], x) + _dot(Da[c], p)

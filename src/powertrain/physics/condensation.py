@@ -62,15 +62,19 @@ class NetworkPorts:
         return not np.any(self.base_rows)
 
 
-def two_ports(ports: NetworkPorts, s, internal=False, amplitudes=None):
+def two_ports(ports: NetworkPorts, s, internal=False, amplitudes=None, linear=None):
     """``(a, b, c)`` each ``s.shape + (n_net,)`` of every network at ``s`` (and the list of
     internal motions per network when ``internal``): each element's equivalent-linear
     two-port at its relative-displacement amplitude (``amplitudes`` (n_net,) [m]; None:
-    zero, which a linear element ignores)."""
+    zero, which a linear element ignores). ``linear``: the networks' linear two-ports at
+    ``s`` (:func:`linear_two_ports`), reused: only the port laws' describing stiffnesses
+    are added (one amplitude per network)."""
     s = np.asarray(s, complex)
+    amplitudes = np.zeros(len(ports.elements)) if amplitudes is None else amplitudes
+    if linear is not None:
+        return _with_port_laws(ports, s, internal, amplitudes, linear)
     abc = [np.empty(s.shape + (len(ports.elements),), complex) for _ in range(3)]
     shapes = []
-    amplitudes = np.zeros(len(ports.elements)) if amplitudes is None else amplitudes
     describing = [None] * len(ports.elements) if any(np.ndim(a) for a in amplitudes) \
         else describing_stiffnesses(ports.elements, amplitudes)
     for k, element in enumerate(ports.elements):
@@ -80,6 +84,47 @@ def two_ports(ports: NetworkPorts, s, internal=False, amplitudes=None):
         if internal:
             shapes.append(res[3])
     return (tuple(abc), shapes) if internal else tuple(abc)
+
+
+@dataclass(frozen=True)
+class LinearTwoPorts:
+    """The networks' linear two-ports at some ``s`` (:func:`linear_two_ports`): ``abc``
+    each ``s.shape + (n_net,)``, ``shapes`` their internal motions (one array per network,
+    :func:`~powertrain.physics.mount_network.laplace_two_port`)."""
+
+    abc: tuple
+    shapes: list
+
+    def first(self, k) -> LinearTwoPorts:
+        """The same at the first ``k`` values of a one-dimensional ``s``."""
+        return LinearTwoPorts(tuple(x[:k] for x in self.abc), [x[:k] for x in self.shapes])
+
+
+def linear_two_ports(ports: NetworkPorts, s) -> LinearTwoPorts | None:
+    """Each network's linear two-port and internal motions at ``s``
+    (:meth:`MountElement.linear_two_port`), for :func:`two_ports` at many amplitudes (the
+    equivalent-linear fixed point); None when an amplitude law makes one depend on the
+    amplitude."""
+    s = np.asarray(s, complex)
+    res = [element.linear_two_port(s, internal=True) for element in ports.elements]
+    if any(r is None for r in res):
+        return None
+    return LinearTwoPorts(tuple(np.stack([r[j] for r in res], axis=-1) for j in range(3)),
+                          [r[3] for r in res])
+
+
+def _with_port_laws(ports, s, internal, amplitudes, linear):
+    """:func:`two_ports` from the linear two-ports ``linear``: each port law's describing
+    stiffness at its amplitude added (at every ``s != 0``), as
+    :meth:`MountElement.two_port` adds it."""
+    kd = np.zeros(len(ports.elements), complex)
+    for k, d in enumerate(describing_stiffnesses(ports.elements, amplitudes)):
+        if d is not None:
+            kd[k] = d
+    kd = np.where(s[..., None] == 0, 0.0, kd)
+    a, b, c = linear.abc
+    abc = (a + kd, b - kd, c + kd)
+    return (abc, linear.shapes) if internal else abc
 
 
 def condensed_matrix(frame, engine_rows, base_rows, abc, s):

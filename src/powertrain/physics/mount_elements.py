@@ -35,7 +35,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from powertrain.kernels.port_forces import JENKINS, NONE, port_force
+from powertrain.kernels.port_forces import JENKINS, NONE, port_forces_at
 from powertrain.physics.mount_network import (
     PackedNetworks,
     laplace_two_port,
@@ -246,6 +246,12 @@ class MountElement:
         k = np.where(lam == 0, 0.0, describing)
         return (res[0] + k, res[1] - k, res[2] + k) + res[3:]
 
+    def linear_two_port(self, s, internal=False):
+        """The linear network's two-port at ``s`` (:meth:`two_port` without the port law)
+        when it does not depend on the amplitude (no amplitude law), else None."""
+        if self.amplitude_law is not None:
+            return None
+        return laplace_two_port(np.asarray(s, complex), *self.network(0.0), internal=internal)
 
     def cross_point_stiffness(self, frequency_hz, amplitude=0.0) -> np.ndarray:
         """Equivalent-linear cross-point dynamic stiffness K*(f, A) [N/m]: the base force
@@ -330,8 +336,10 @@ class PortForces:
 
     def forces(self, u, v, state) -> np.ndarray:
         """Port forces (m,) [N] at the relative motions ``u``, ``v`` (m,) from ``state``."""
-        return np.array([port_force(k, ue, ve, p, st)[0] for k, ue, ve, p, st in
-                         zip(self.kinds, u, v, self.parameters, state)])
+        out = np.empty(self.kinds.size)
+        port_forces_at(self.kinds, self.parameters, np.ascontiguousarray(state, float),
+                       np.ascontiguousarray(u, float), np.ascontiguousarray(v, float), out)
+        return out
 
 
 def port_forces(elements, rows, force_map, names) -> PortForces | None:

@@ -137,34 +137,48 @@ class StaticCurve:
     force: tuple
     reference_deflection: float = 0.0
 
-    def _pchip(self):
-        return PchipInterpolator(np.asarray(self.deflection, float),
-                                 np.asarray(self.force, float), extrapolate=False)
-
-    def _ends(self, p):
-        x = np.asarray(self.deflection, float)
-        d = p.derivative()
-        return x[0], x[-1], float(p(x[0])), float(p(x[-1])), float(d(x[0])), float(d(x[-1]))
-
     def force_at(self, x) -> np.ndarray:
         """Force [N] at the deflection(s) ``x`` [m]."""
-        p = self._pchip()
-        x0, x1, f0, f1, k0, k1 = self._ends(p)
-        x = np.asarray(x, float)
-        inside = np.nan_to_num(p(np.clip(x, x0, x1)))
-        return np.where(x < x0, f0 + k0 * (x - x0), np.where(x > x1, f1 + k1 * (x - x1), inside))
+        return CurveReader(self).force_at(x)
 
     def tangent_at(self, x) -> np.ndarray:
         """Tangent stiffness dF/dx [N/m] at the deflection(s) ``x`` [m]."""
-        p = self._pchip()
-        x0, x1, _, _, k0, k1 = self._ends(p)
-        x = np.asarray(x, float)
-        inside = np.nan_to_num(p.derivative()(np.clip(x, x0, x1)))
-        return np.where(x < x0, k0, np.where(x > x1, k1, inside))
+        return CurveReader(self).tangent_at(x)
 
     def factor(self, x) -> np.ndarray:
         """Tangent stiffness at ``x`` over that at ``reference_deflection``."""
         return self.tangent_at(x) / self.tangent_at(self.reference_deflection)
+
+
+class CurveReader:
+    """A :class:`StaticCurve` read many times: its PCHIP (no extrapolation), the PCHIP's
+    derivative and the curve's ends built once; straight beyond its points."""
+
+    def __init__(self, curve):
+        x = np.asarray(curve.deflection, float)
+        self.curve = curve
+        self.pchip = PchipInterpolator(x, np.asarray(curve.force, float), extrapolate=False)
+        self.slope = d = self.pchip.derivative()
+        self.ends = (x[0], x[-1], float(self.pchip(x[0])), float(self.pchip(x[-1])),
+                     float(d(x[0])), float(d(x[-1])))
+
+    def force_at(self, x) -> np.ndarray:
+        """Force [N] at the deflection(s) ``x`` [m]."""
+        x0, x1, f0, f1, k0, k1 = self.ends
+        x = np.asarray(x, float)
+        inside = np.nan_to_num(self.pchip(np.clip(x, x0, x1)))
+        return np.where(x < x0, f0 + k0 * (x - x0), np.where(x > x1, f1 + k1 * (x - x1), inside))
+
+    def tangent_at(self, x) -> np.ndarray:
+        """Tangent stiffness dF/dx [N/m] at the deflection(s) ``x`` [m]."""
+        x0, x1, _, _, k0, k1 = self.ends
+        x = np.asarray(x, float)
+        inside = np.nan_to_num(self.slope(np.clip(x, x0, x1)))
+        return np.where(x < x0, k0, np.where(x > x1, k1, inside))
+
+    def factor(self, x) -> np.ndarray:
+        """Tangent stiffness at ``x`` over that at the curve's ``reference_deflection``."""
+        return self.tangent_at(x) / self.tangent_at(self.curve.reference_deflection)
 
 
 @dataclass(frozen=True)

@@ -64,10 +64,8 @@ def steady_loop_state(ports, relative, n_cycle, cycles=LOOP_CYCLES) -> np.ndarra
     centre = u.mean(axis=0)
     state = ports.steady_states(centre - u_low, centre)
     n = (cycles + 1) * n_cycle + 1
-    U = np.empty((n, m))
-    for e in range(m):
-        path = u[np.arange(low[e], n) % n_cycle, e]
-        U[:, e] = np.concatenate([np.full(low[e], u_low[e]), path])
+    index = np.arange(n)
+    U = np.where(index[:, None] < low[None, :], u_low[None, :], u[index % n_cycle])
     port_force_loop(ports.kinds, ports.parameters, state, U, np.zeros_like(U), np.empty_like(U))
     return state
 

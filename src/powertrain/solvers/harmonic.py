@@ -27,7 +27,8 @@ import numpy as np
 from powertrain.physics.condensation import harmonic_solve, two_ports
 
 
-def harmonic_response(system, load_harmonics, omegas, amplitudes=None):
+def harmonic_response(system, load_harmonics, omegas, amplitudes=None, linear=None,
+                      internal=True):
     """Complex amplitudes of every coordinate for each load harmonic: the retained ones by
     the one harmonic solve (:func:`powertrain.physics.condensation.harmonic_solve`), each
     network's internal motion from its engine-side and base motion.
@@ -42,6 +43,12 @@ def harmonic_response(system, load_harmonics, omegas, amplitudes=None):
     amplitudes : ndarray (n_net,), optional
         Relative-displacement amplitude of every network [m]: nonlinear elements act
         through their equivalent-linear two-port there.
+    linear : LinearTwoPorts, optional
+        The networks' linear two-ports at ``1j * omegas`` with their internal motions
+        (:func:`~powertrain.physics.condensation.linear_two_ports`), reused.
+    internal : bool
+        False: the networks' internal coordinates are left zero (only the retained ones are
+        solved).
 
     Returns
     -------
@@ -49,7 +56,8 @@ def harmonic_response(system, load_harmonics, omegas, amplitudes=None):
     """
     ports = system.ports()
     s = 1j * np.asarray(omegas, float)
-    abc, shapes = two_ports(ports, s, internal=True, amplitudes=amplitudes)
+    abc, shapes = two_ports(ports, s, internal=True, amplitudes=amplitudes, linear=linear) \
+        if internal else (two_ports(ports, s, amplitudes=amplitudes, linear=linear), [])
     q_r = harmonic_solve(ports.frame, ports.engine_rows,
                          None if ports.grounded else ports.base_rows, abc, s, load_harmonics)
     out = np.zeros((s.size, system.n_dof), complex)

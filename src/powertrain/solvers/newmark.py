@@ -11,6 +11,7 @@ out and do not borrow anything from the frequency-domain solution.
 
 from __future__ import annotations
 
+import copy
 import threading
 
 import numpy as np
@@ -349,11 +350,29 @@ class ModalPortNewmark:
 
     def __init__(self, modal, ports, h, Wx=None, Wv=None, Wa=None, Wz=None):
         n = modal.n
-        self.modal, self.ports, self.h = modal, ports, float(h)
+        self.modal, self.ports = modal, ports
         P = np.asarray(ports.rows, float)
         self.reduced = r = np.union1d(np.arange(modal.load_dofs),
                                       np.flatnonzero(np.any(P != 0, 0)))
-        T = P[:, r]
+        #: rows reading the reduced state (x, v, a) off the modal state (a less M^-1 p)
+        self._reduced_rows = modal.real_form(np.conj(np.vstack(
+            [modal.Psi_r[r], modal.Psi_r[n + r], modal.Psi_r[n + r] * modal.lam_r])))
+        self.outputs = self._output_arrays(Wx, Wv, Wa, Wz)
+        self.silent = self._output_arrays(np.zeros((0, n)))
+        self._set_step(h)
+
+    def at_step(self, h) -> ModalPortNewmark:
+        """The same model, port laws and outputs at the time step ``h`` [s] (the output
+        arrays, which do not depend on the step, shared)."""
+        other = copy.copy(self)
+        other._set_step(h)
+        return other
+
+    def _set_step(self, h):
+        """The kernel's arrays that depend on the time step ``h`` [s]."""
+        modal, n, r = self.modal, self.modal.n, self.reduced
+        self.h = float(h)
+        T = np.asarray(self.ports.rows, float)[:, r]
         lam = modal.lam_r
         lam_d = (1 + 0.5 * h * lam) / (1 - 0.5 * h * lam)
         G = ((0.5 * h) / (1 - 0.5 * h * lam))[:, None] * (
@@ -368,18 +387,14 @@ class ModalPortNewmark:
         self.port_arrays = (np.ascontiguousarray(T), np.searchsorted(
             r, np.arange(modal.load_dofs)).astype(np.int64),
             np.ascontiguousarray(0.25 * h * h * TST))
-        #: rows reading the reduced state (x, v, a) off the modal state (a less M^-1 p)
-        self._reduced_rows = modal.real_form(np.conj(np.vstack(
-            [modal.Psi_r[r], modal.Psi_r[n + r], Pa])))
-        self.outputs = self._output_arrays(Wx, Wv, Wa, Wz)
-        self.silent = self._output_arrays(np.zeros((0, n)))
 
     def _output_arrays(self, Wx=None, Wv=None, Wa=None, Wz=None):
-        """``((Wy, y_cols), (Wz, z_cols), w_rows, W, Wd)`` of :func:`modal_port_kernel` for
-        the output rows: ``Wy`` over the reduced state, ``Wz`` over the port forces (the
-        columns they read, :func:`_read_columns`); the rows ``w_rows`` that read other
-        coordinates also through the modal state, ``Re(W eta) + Wd p`` (``Wd`` the direct
-        part of the acceleration, a = M^-1 (p - C v - K x))."""
+        """``((Wyz, y_cols, z_cols), w_rows, W, Wd)`` of :func:`modal_port_kernel` for
+        the output rows: ``Wyz`` over the reduced state's columns ``y_cols`` and then the
+        port forces' ``z_cols`` (the columns they read, :func:`_read_columns`); the rows
+        ``w_rows`` that read other coordinates also through the modal state,
+        ``Re(W eta) + Wd p`` (``Wd`` the direct part of the acceleration,
+        a = M^-1 (p - C v - K x))."""
         modal, n, r = self.modal, self.modal.n, self.reduced
         off = np.setdiff1d(np.arange(n), r)
         rows = next(w.shape[0] for w in (Wx, Wv, Wa, Wz) if w is not None)
@@ -396,7 +411,9 @@ class ModalPortNewmark:
             Wd = np.asarray(Wa, float)[:, off] @ modal.Minv[np.ix_(off, r)]
         Wz = np.zeros((rows, self.ports.kinds.size)) if Wz is None else np.asarray(Wz, float)
         w_rows = np.flatnonzero(np.any(W != 0, 1) | np.any(Wd != 0, 1))
-        return (_read_columns(Wy.reshape(rows, 3 * r.size)), _read_columns(Wz),
+        (Wy, y_cols), (Wz, z_cols) = _read_columns(Wy.reshape(rows, 3 * r.size)), \
+            _read_columns(Wz)
+        return ((np.ascontiguousarray(np.hstack([Wy, Wz])), y_cols, z_cols),
                 w_rows.astype(np.int64), modal.real_form(np.conj(W[w_rows])),
                 np.ascontiguousarray(Wd[w_rows]))
 
@@ -417,7 +434,7 @@ class ModalPortNewmark:
             Newton did not converge at some step (the names of the port laws are given).
         """
         arrays = self.outputs if outputs else self.silent
-        out = np.empty((F.shape[0] - 1, arrays[1][0].shape[0]))
+        out = np.empty((F.shape[0] - 1, arrays[0][0].shape[0]))
         laws = (self.ports.kinds, self.ports.parameters, state)
         F = np.ascontiguousarray(F, float)
         T, load_at = self.port_arrays[:2]

@@ -33,6 +33,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from powertrain.errors import InputError
+from powertrain.physics.mount_laws import CurveReader
 from powertrain.physics.rigid_body import direction_row
 from powertrain.units import STANDARD_GRAVITY
 
@@ -59,11 +60,15 @@ class StaticSupport:
         Each network's :class:`~powertrain.physics.mount_laws.StaticCurve` or None.
     stiffness : ndarray (n_net,)
         Static stiffness of the networks [N/m] (used where there is no curve).
+    readers : list
+        Each curve's :class:`~powertrain.physics.mount_laws.CurveReader` (built once) or
+        None.
     """
 
     rows: np.ndarray
     curves: list
     stiffness: np.ndarray
+    readers: list
 
     @classmethod
     def of(cls, engine) -> StaticSupport:
@@ -78,22 +83,23 @@ class StaticSupport:
                 rows.append(direction_row(r, R[:, a]))
                 curves.append(model.static_curve)
                 k0.append(model.static_stiffness())
-        return cls(np.array(rows), curves, np.array(k0))
+        return cls(np.array(rows), curves, np.array(k0),
+                   [None if c is None else CurveReader(c) for c in curves])
 
     def forces(self, deflection) -> np.ndarray:
         """Force of every network [N] at its deflection [m]."""
         return np.array([k * d if c is None else float(c.force_at(d)) for c, k, d in
-                         zip(self.curves, self.stiffness, deflection)])
+                         zip(self.readers, self.stiffness, deflection)])
 
     def tangents(self, deflection) -> np.ndarray:
         """Tangent stiffness of every network [N/m] at its deflection [m]."""
         return np.array([k if c is None else float(c.tangent_at(d)) for c, k, d in
-                         zip(self.curves, self.stiffness, deflection)])
+                         zip(self.readers, self.stiffness, deflection)])
 
     def factors(self, deflection) -> np.ndarray:
         """Static factor of every network at its deflection (1 without a curve)."""
         return np.array([1.0 if c is None else float(c.factor(d)) for c, d in
-                         zip(self.curves, deflection)])
+                         zip(self.readers, deflection)])
 
 
 @dataclass(frozen=True)

@@ -34,6 +34,7 @@ from powertrain.analysis.fourier import harmonic_amplitudes
 from powertrain.analysis.orders import ORDERS, order_spectrum
 from powertrain.assembly import NetworkScaling
 from powertrain.kernels.port_forces import NONE
+from powertrain.physics.condensation import linear_two_ports
 from powertrain.solvers.admittance import frf_response, relative_motion
 from powertrain.solvers.cycle_newmark import CycleRun, run_cycles, start_state
 from powertrain.solvers.equivalent_linear import AMPLITUDE_HARMONICS, TOLERANCE, amplitude_fixed_point
@@ -141,14 +142,19 @@ class Stepper:
         """Harmonic response (n_h, n_dof) of the (equivalent-linear) model (``system``,
         default the stepper's) and the nonlinear elements' amplitudes (None: linear model).
         The fixed point iterates on the harmonics that make the amplitudes only; one solve of
-        all follows."""
+        all follows. The networks' linear two-ports are condensed once for all."""
         s = self.system if system is None else system
         if self.ports is None:
             return harmonic_response(s, fh, omegas), None
         k = AMPLITUDE_HARMONICS.stop
-        A = self.equivalent_linear(lambda a: harmonic_response(s, fh[:k], omegas[:k], a),
+        linear = linear_two_ports(s.ports(), 1j * np.asarray(omegas, float))
+        first = None if linear is None else linear.first(k)
+        # the port rows read the retained coordinates only: no internal motion needed
+        internal = bool(np.any(np.delete(self.ports.rows, s.ports().retained, axis=1)))
+        A = self.equivalent_linear(lambda a: harmonic_response(s, fh[:k], omegas[:k], a,
+                                                               first, internal),
                                    lambda q: q @ self.ports.rows.T, omega)[0]
-        return harmonic_response(s, fh, omegas, self.ports.network_amplitudes(A)), A
+        return harmonic_response(s, fh, omegas, self.ports.network_amplitudes(A), linear), A
 
     def harmonics(self, load, omega, max_order=None):
         """Load harmonics of the cycle (index j is order j/2) and their frequencies."""
@@ -361,14 +367,22 @@ class ModalPortStepper(DenseNewmarkStepper):
         self.rows = (np.vstack([Cm, Z, Z, system.force_matrix_k]),
                      np.vstack([Z, Cm, Z, system.force_matrix_d]), np.vstack([Z, Z, Cm, Z]),
                      np.vstack([zf, zf, zf, self.laws.force_map]))
+        self._runner = None
         self.setup_seconds = time.perf_counter() - t0
+
+    def runner(self, h) -> ModalPortNewmark:
+        """The modal recurrence with the port laws at the step ``h`` [s] (its outputs'
+        arrays built once per model)."""
+        if self._runner is None:
+            self._runner = ModalPortNewmark(self.modal, self.laws, h, *self.rows)
+        return self._runner.at_step(h)
 
     def channels(self, s, load, h, start, amplitudes, factors):
         if factors is not None:              # a static-factor hook: networks rescaled
             return super().channels(s, load, h, start, amplitudes, factors)
         g = self.grid
         x0, v0, _, qh = start
-        run = ModalPortNewmark(self.modal, self.laws, h, *self.rows)
+        run = self.runner(h)
         state = start_state(self.ports, qh, g.n_cycle)
         z = self.laws.forces(self.laws.rows @ x0, self.laws.rows @ v0, state)
         eta = run.modal_state(x0, v0)

@@ -226,7 +226,8 @@ CURVE_SAMPLES = 20001
 
 class _Curves:
     """The networks' static curves about the zero-torque static point (module docstring),
-    each sampled once (:data:`CURVE_SAMPLES`)."""
+    each sampled once (:data:`CURVE_SAMPLES`) on its own uniform grid and read linearly,
+    all networks at once (a network without a curve: zero force, factor 1)."""
 
     def __init__(self, engine, system):
         support = StaticSupport.of(engine)
@@ -235,34 +236,44 @@ class _Curves:
         self.d0 = operating_point(engine, rpm, support, mean_torque=0.0).deflection.ravel()
         self.rows = system.port_rows
         self.has = np.array([c is not None for c in support.curves])
-        self.tables = [None if c is None else _sampled(c) for c in support.curves]
-        self.f0 = self._forces(self.d0)
+        flat = (np.array([-1.0, 1.0]), np.zeros(CURVE_SAMPLES), np.ones(CURVE_SAMPLES), 1.0)
+        tables = [flat if c is None else _sampled(c) for c in support.readers]
+        self.grid = np.array([(t[0][0], t[0][-1]) for t in tables])
+        self.step = (self.grid[:, 1] - self.grid[:, 0]) / (CURVE_SAMPLES - 1)
+        self.force = np.array([t[1] for t in tables])
+        self.tangent = np.array([t[2] / t[3] for t in tables])
+        self.f0 = self._read(self.force, self.d0)
 
-    def _forces(self, d):
-        return np.array([0.0 if t is None else np.interp(x, t[0], t[1])
-                         for t, x in zip(self.tables, d)])
+    def _read(self, table, d):
+        """Each network's row of ``table`` (n_net, CURVE_SAMPLES) at its deflection ``d``
+        (n_net,) [m], linear between samples, the end values outside."""
+        pos = (np.clip(d, self.grid[:, 0], self.grid[:, 1]) - self.grid[:, 0]) / self.step
+        j = np.minimum(pos.astype(np.int64), CURVE_SAMPLES - 2)
+        w = pos - j
+        rows = np.arange(d.size)
+        return table[rows, j] * (1.0 - w) + table[rows, j + 1] * w
 
     def factors(self, x):
         """Static factor of every network at the state ``x`` (1 without a curve)."""
-        d = self.d0 + self.rows @ x
-        return np.array([1.0 if t is None else np.interp(v, t[0], t[2]) / t[3]
-                         for t, v in zip(self.tables, d)])
+        return np.where(self.has, self._read(self.tangent, self.d0 + self.rows @ x), 1.0)
 
     def at(self, x, scaling, amplitudes):
         """Static factors and the curves' load ``c`` (n_net,) [N] at the state ``x``, the
         networks' tangent stiffness their static stiffness times their stiffness scale at
         the static factors and the networks' ``amplitudes`` [m] (``scaling.scales``)."""
         u = self.rows @ x
-        factors = self.factors(x)
+        d = self.d0 + u
+        factors = np.where(self.has, self._read(self.tangent, d), 1.0)
         k = scaling.scales(amplitudes, factors)[:, 0] * self.stiffness
-        c = np.where(self.has, self._forces(self.d0 + u) - self.f0 - k * u, 0.0)
+        c = np.where(self.has, self._read(self.force, d) - self.f0 - k * u, 0.0)
         return factors, c
 
 
 def _sampled(curve):
-    """``(deflection, force, tangent, tangent at the reference)`` of a static curve."""
-    lo, hi = float(curve.deflection[0]), float(curve.deflection[-1])
+    """``(deflection, force, tangent, tangent at the reference)`` of a static curve (its
+    :class:`~powertrain.physics.mount_laws.CurveReader`)."""
+    lo, hi = float(curve.curve.deflection[0]), float(curve.curve.deflection[-1])
     grid = np.linspace(2 * lo - hi, 2 * hi - lo, CURVE_SAMPLES)
     return (grid, np.asarray(curve.force_at(grid), float),
             np.asarray(curve.tangent_at(grid), float),
-            float(curve.tangent_at(curve.reference_deflection)))
+            float(curve.tangent_at(curve.curve.reference_deflection)))
