@@ -64,8 +64,7 @@ def test_compare_and_diagnose_accept_tracked_acceleration(sweep_files, tmp_path)
     run_runup(read_engine(DEFAULT_ENGINE_PATH), np.arange(2000.0, 3001.0, 100.0),
               solver="harmonic").to_hdf5(sim)
     out = tmp_path / "c.json"
-    r = CliRunner().invoke(main, ["compare", str(acc), "--sim", str(sim), "--json", str(out),
-                                  "--quiet"])
+    r = CliRunner().invoke(main, ["compare", str(acc), "--sim", str(sim), "--json", str(out)])
     assert r.exit_code == 0, r.output
     gap = float(r.output.split("overall RMS gap ")[1].split(" dB")[0])
     assert gap < 0.2                      # tracked sweep vs stepped, after per-order conversion
