@@ -252,7 +252,8 @@ def test_the_band_check_enters_nothing_but_its_own_entry():
     from benchmarks.cases import engines
     from benchmarks.cases import make_case as make_truth_case
     from powertrain.workflows.measurement import FLOOR
-    case = make_truth_case(0, ["mount_temperature"], "sz", 11)
+    case = make_truth_case(0, ["mount_temperature"], "sz", 15)    # detectable: a claim
+    assert case.detectable
     runs = [diagnose(case.measured, engines()["sz"], noise_floor=FLOOR, band_check=bc,
                      progress=False).to_dict() for bc in (True, False)]
     assert runs[0]["chosen"] and runs[0]["confounding_check"] and not runs[1]["confounding_check"]
