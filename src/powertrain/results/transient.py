@@ -190,9 +190,12 @@ class TransientResult(Result):
         return fragment(transient_html(self))
 
     def default_channels(self) -> list:
-        """The seat's three axes, else the engine-side z of every mount."""
+        """The seat's axes that move (a modal body whose modes have no component along an
+        axis at the seat leaves it at rest), else the engine-side z of every mount."""
         if self.seat is not None:
-            return [f"{self.seat['point']}.{a}" for a in "xyz"]
+            axes = [f"{self.seat['point']}.{a}" for a in "xyz"]
+            moving = [c for c in axes if np.any(self.acceleration[:, self.channel(c)])]
+            return moving or axes
         return [c for c in self.channels if c.endswith(".z") and "/" not in c][:3]
 
     def to_text(self) -> str:
