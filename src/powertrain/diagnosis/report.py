@@ -73,11 +73,13 @@ def _which(r) -> list:
                      f"{o.t_stat:>6.1f} {o.bic_gain:>8.1f} {expl} "
                      f"{o.struct_db:>9.2f}  {o.status}")
     if r.chosen is not None:
-        lines.append("  parameters (1 sigma, Gauss-Newton, optimistic):")
+        lines.append("  parameters (1 sigma and 95 % interval, cell-clustered: "
+                     "docs/guide/diagnose.md):")
         for e, ps in r.chosen.params.items():
             unit = r.chosen.units.get(e, {})
-            txt = ", ".join(f"{k} = {v:.4g} +- {r.chosen.sigma[e][k]:.2g} {unit.get(k, '')}"
-                            for k, v in ps.items())
+            txt = ", ".join(f"{k} = {v:.4g} +- {r.chosen.sigma[e][k]:.2g}"
+                            f"{_interval_text(r.chosen.interval.get(e, {}).get(k))} "
+                            f"{unit.get(k, '')}" for k, v in ps.items())
             lines.append(f"    {e}: {txt}")
             said = EFFECTS[e].summary(ps)
             if said:
@@ -90,6 +92,13 @@ def _which(r) -> list:
             txt = ", ".join(f"{k}={v:.3g}" for k, v in bnd["parameters"].items())
             lines.append(f"    {bnd['rpm_from']:g}-{bnd['rpm_to']:g} rpm: {txt}")
     return lines
+
+
+def _interval_text(iv) -> str:
+    """`` (95 % 70.1..79.3)``, or "" without a finite interval."""
+    if not iv or None in iv:
+        return ""
+    return f" (95 % {iv[0]:.4g}..{iv[1]:.4g})"
 
 
 def _run_text(k, run) -> str:
