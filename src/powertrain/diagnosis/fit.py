@@ -41,7 +41,12 @@ from powertrain.diagnosis.data import (
 from powertrain.diagnosis.packing import Packing
 from powertrain.diagnosis.search import Counted, Exhausted, jacobian, trust_region
 from powertrain.diagnosis.starts import BASIN_RATIO, start_points
-from powertrain.diagnosis.uncertainty import cluster_ids, intervals, parameter_sd
+from powertrain.diagnosis.uncertainty import (
+    cluster_ids,
+    intervals,
+    parameter_sd,
+    with_model_floor,
+)
 from powertrain.diagnosis.warm_start import AmplitudeStart, scenario_vector
 from powertrain.effects import EFFECTS, predict
 from powertrain.solvers.fast_harmonic import N_HARMONICS
@@ -319,7 +324,7 @@ def fit_candidate(problem: Problem, effects, starts=None, grid=True,
     s2 = rss / max(n - p, 1)
     if pack.n_prior:                       # prior rows were weighted with the scatter
         s2 = max(s2, problem.sigma_db ** 2)
-    sd = parameter_sd(J, r, n, problem.clusters(), s2)
+    sd = with_model_floor(pack, x, parameter_sd(J, r, n, problem.clusters(), s2))
     params, sigma = pack.values(x, sd)
     out = score(problem, effects, pack.scenario(x), params, sigma, rss, n, p, nfev,
                 time.perf_counter() - t0, x)

@@ -117,7 +117,8 @@ def fit_notes(chosen, outcomes, bands, budget) -> list:
     """Sentences of the verdict on how far the fits can be trusted: a second minimum of the
     answer that explains the data alike (``FitOutcome.alternatives``), parameters of the
     answer at a bound (``Effect.bound_warnings``), and, said once, the fits that stopped at
-    their evaluation budget with what that means for the answer."""
+    their evaluation budget with what that means for the answer; the answer's 95 %
+    intervals where its effect states them (``Effect.interval_text``)."""
     out = []
     if chosen is not None and len(chosen.effects) == 1:
         eff = EFFECTS[chosen.effects[0]]
@@ -125,7 +126,8 @@ def fit_notes(chosen, outcomes, bands, budget) -> list:
         for alt in chosen.alternatives:
             out.append(eff.alternative_text(ps, alt["parameters"][chosen.effects[0]],
                                             alt["delta_chi2"]))
-        out += eff.bound_warnings(ps)
+        said = eff.interval_text(chosen.interval.get(chosen.effects[0], {}))
+        out += ([said] if said else []) + eff.bound_warnings(ps)
     if chosen is not None and chosen.budget_hit:
         out.append(f"the {chosen.label} fit stopped at its evaluation budget ({budget}): its "
                    f"parameters are the best point found, not a converged optimum (the "

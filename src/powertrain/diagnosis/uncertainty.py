@@ -23,15 +23,31 @@ are formed at the optimum from the residuals :math:`r` [dB] and their Jacobian :
   pull each cell exerts on the parameters: cells that disagree on the frequency of a mode
   (one pulls it up, another down) widen it, whatever the size of the residuals.
 
-The reported 1σ is the larger of the two per parameter; the 95 % interval is
+The reported 1σ is the larger of the two per parameter, and for the parameters an effect
+names in ``Effect.model_floor`` (a missing body mode's frequency and modal mass) a
+model-discrepancy term is added in quadrature, the relative floor :data:`MODEL_FLOOR`
+(a systematic standard uncertainty combined with the statistical one, JCGM 100:2008
+§5.1.2): :math:`\sigma^2 = \max(\sigma_{GN}^2, \sigma_{CR}^2) + (\epsilon\,\theta)^2`
+(:math:`\epsilon^2` in log coordinates). Neither covariance sees a difference between the
+model and the data's source that every cell shares (a mode's resonance placed a little
+higher by the model on all channels and orders alike): the data cannot measure it, so it is
+a stated constant. The 95 % interval is
 :math:`x \pm z\,\sigma_x` in fitted coordinates (:data:`Z_95`), mapped back (asymmetric for
 log-scale parameters) and clipped to the parameter's bounds.
 """
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
+from powertrain.effects import EFFECTS
+
+#: Relative model-discrepancy floor of the parameters named in ``Effect.model_floor`` [1]
+#: (chosen on a calibration set of draws kept apart from those the coverage is measured on:
+#: docs/validation/diagnosis.md, issue 37).
+MODEL_FLOOR = 0.025
 #: Two-sided 95 % normal quantile [1].
 Z_95 = 1.959964
 
@@ -89,6 +105,19 @@ def parameter_sd(J, r, n_data, clusters, s2) -> np.ndarray:
         meat = meat + s2 * (jp.T @ jp)
         var = np.maximum(var, np.diag(a_inv @ meat @ a_inv))
     return np.sqrt(np.clip(var, 0, None))
+
+
+def with_model_floor(pack, x, sd, floor=None) -> np.ndarray:
+    """``sd`` (fitted coordinates) with the relative model-discrepancy floor (:data:`
+    MODEL_FLOOR` unless ``floor``) added in quadrature for the parameters of ``pack`` that
+    their effect names in ``Effect.model_floor``."""
+    eps = MODEL_FLOOR if floor is None else floor
+    out = np.array(sd, float)
+    for j, (e, name) in enumerate(pack.names):
+        if name in EFFECTS[e].model_floor:
+            add = math.log1p(eps) if pack.log[j] else eps * abs(x[j])
+            out[j] = math.hypot(out[j], add)
+    return out
 
 
 def intervals(pack, x, sd, z=Z_95) -> dict:
