@@ -8,7 +8,13 @@ from types import SimpleNamespace
 
 import numpy as np
 
-from powertrain.diagnosis.uncertainty import Z_95, cluster_ids, intervals, parameter_sd
+from powertrain.diagnosis.uncertainty import (
+    Z_95,
+    cluster_ids,
+    intervals,
+    parameter_sd,
+    with_model_floor,
+)
 
 
 def _line_fit(rng, n_clusters=30, per=20, tau=0.0, sigma=1.0):
@@ -70,3 +76,14 @@ def test_intervals_log_and_bounds():
     assert np.allclose(iv["mass"], [10 * math.exp(-Z_95 * 0.1), 10 * math.exp(Z_95 * 0.1)])
     assert np.allclose(iv["f"], [199.0 - Z_95 * 2.0, 200.0])
     assert iv["z"] == [None, None]
+
+
+def test_model_floor_on_a_missing_mode():
+    """The relative floor enters a missing body mode's frequency (linear) and modal mass
+    (log coordinates) in quadrature; its damping ratio keeps its statistical 1σ."""
+    e = "missing_body_mode"
+    pack = SimpleNamespace(names=[(e, "frequency_hz"), (e, "modal_mass_kg"),
+                                  (e, "damping_ratio")], log=np.array([False, True, True]))
+    x = np.array([100.0, math.log(10.0), math.log(0.04)])
+    sd = with_model_floor(pack, x, np.array([1.0, 0.01, 0.3]), floor=0.025)
+    assert np.allclose(sd, [math.hypot(1.0, 2.5), math.hypot(0.01, math.log1p(0.025)), 0.3])

@@ -15,8 +15,9 @@ dB): a maximum a posteriori fit, so that directions the magnitudes do not identi
 the prior's centre; the BIC and the held-out scores use the data residuals only.
 
 Parameter uncertainties (1σ and a 95 % interval) are the larger of the Gauss–Newton and the
-cluster-robust covariance, clusters the (channel, order) cells
-(:mod:`powertrain.diagnosis.uncertainty`). A trial parameter set
+cluster-robust covariance, clusters the (channel, order) cells, with a relative
+model-discrepancy floor where the effect names one (:mod:`powertrain.diagnosis.uncertainty`).
+A trial parameter set
 without a steady state (the amplitude fixed point diverges) is a point far worse than any
 fit (:data:`powertrain.diagnosis.search.NO_STEADY_STATE_RESIDUAL`): the search turns back,
 the diagnosis goes on.

@@ -10,7 +10,8 @@ are formed at the optimum from the residuals :math:`r` [dB] and their Jacobian :
   the data's source a little: the difference is smooth along speed in every (channel,
   order) cell, so the residuals of a cell are correlated at all lags and pull the
   parameters together;
-* cluster-robust (sandwich, Liang & Zeger 1986; Cameron & Miller 2015, eq. 11),
+* cluster-robust (sandwich; Liang & Zeger 1986, Biometrika 73; Cameron & Miller 2015,
+  "A practitioner's guide to cluster-robust inference", J. Human Resources 50),
   clusters the (channel, order) cells (level and phase residuals of a cell over all
   training speeds, and over all runs of a plan; the crank offset's prior row a cluster of
   its own):
