@@ -42,12 +42,7 @@ from powertrain.diagnosis.data import (
 from powertrain.diagnosis.packing import Packing
 from powertrain.diagnosis.search import Counted, Exhausted, jacobian, trust_region
 from powertrain.diagnosis.starts import BASIN_RATIO, start_points
-from powertrain.diagnosis.uncertainty import (
-    cluster_ids,
-    intervals,
-    parameter_sd,
-    with_model_floor,
-)
+from powertrain.diagnosis.uncertainty import cluster_ids, intervals, parameter_sd, with_model_floor
 from powertrain.diagnosis.warm_start import AmplitudeStart, scenario_vector
 from powertrain.effects import EFFECTS, predict
 from powertrain.solvers.fast_harmonic import N_HARMONICS
@@ -102,8 +97,7 @@ class FitOutcome:
     #: a second minimum in another basin of ``Effect.basin_parameter`` that explains the
     #: training data alike (:func:`second_minimum`): ``[{"parameters", "delta_chi2"}]``
     alternatives: list = field(default_factory=list)
-    #: 95 % interval of each parameter ``{effect: {parameter: [lo, hi]}}`` (SI;
-    #: :mod:`powertrain.diagnosis.uncertainty`)
+    #: 95 % interval ``{effect: {parameter: [lo, hi]}}`` (SI, :mod:`powertrain.diagnosis.uncertainty`)
     interval: dict = field(default_factory=dict)
 
     @property
