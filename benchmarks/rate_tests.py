@@ -247,6 +247,8 @@ def mode_row(task) -> dict:
     return {"claimed": sorted(d["chosen"]["effects"]) if d["chosen"] else [],
             "parameters": d["chosen"]["parameters"] if d["chosen"] else None,
             "alternatives": d["chosen"]["alternatives"] if d["chosen"] else [],
+            "sigma": d["chosen"]["parameter_sigma"] if d["chosen"] else None,
+            "interval_95": d["chosen"].get("parameter_interval_95") if d["chosen"] else None,
             "truth_mode": {"frequency_hz": p["frequency_hz"], "modal_mass_kg": p["modal_mass"]},
             "verdict": d["verdict"], "seed": case.seed, "engine": eng}
 

@@ -14,8 +14,10 @@ Parameters with a prior (``Parameter.prior_sd``) add the residual
 dB): a maximum a posteriori fit, so that directions the magnitudes do not identify stay at
 the prior's centre; the BIC and the held-out scores use the data residuals only.
 
-Parameter uncertainties are the 1σ of the Gauss–Newton covariance :math:`\hat s^2
-(J^TJ)^{-1}` (residual correlation along speed ignored: optimistic). A trial parameter set
+Parameter uncertainties (1σ and a 95 % interval) are the larger of the Gauss–Newton and the
+cluster-robust covariance, clusters the (channel, order) cells, with a relative
+model-discrepancy floor where the effect names one (:mod:`powertrain.diagnosis.uncertainty`).
+A trial parameter set
 without a steady state (the amplitude fixed point diverges) is a point far worse than any
 fit (:data:`powertrain.diagnosis.search.NO_STEADY_STATE_RESIDUAL`): the search turns back,
 the diagnosis goes on.
@@ -40,6 +42,7 @@ from powertrain.diagnosis.data import (
 from powertrain.diagnosis.packing import Packing
 from powertrain.diagnosis.search import Counted, Exhausted, jacobian, trust_region
 from powertrain.diagnosis.starts import BASIN_RATIO, start_points
+from powertrain.diagnosis.uncertainty import cluster_ids, intervals, parameter_sd, with_model_floor
 from powertrain.diagnosis.warm_start import AmplitudeStart, scenario_vector
 from powertrain.effects import EFFECTS, predict
 from powertrain.solvers.fast_harmonic import N_HARMONICS
@@ -94,6 +97,8 @@ class FitOutcome:
     #: a second minimum in another basin of ``Effect.basin_parameter`` that explains the
     #: training data alike (:func:`second_minimum`): ``[{"parameters", "delta_chi2"}]``
     alternatives: list = field(default_factory=list)
+    #: 95 % interval ``{effect: {parameter: [lo, hi]}}`` (SI, :mod:`powertrain.diagnosis.uncertainty`)
+    interval: dict = field(default_factory=dict)
 
     @property
     def label(self) -> str:
@@ -145,6 +150,12 @@ class Problem:
         (n_r, n_ch, n_q), in the order of ``array[on]``."""
         r, c, q = np.nonzero(on)
         return (r * on.shape[1] + c) * N_ORDERS + self.sub.harmonic[q]
+
+    def clusters(self) -> np.ndarray:
+        """Cluster of each residual of :meth:`vector` on the training speeds: its (channel,
+        order) cell (:func:`~powertrain.diagnosis.uncertainty.cluster_ids`)."""
+        return cluster_ids(self.valid["train"],
+                           None if self.phase_w is None else self.phase_on["train"])
 
     def _phase_setup(self):
         """Measured phases and their weights per part (:mod:`powertrain.diagnosis.phase`);
@@ -305,17 +316,15 @@ def fit_candidate(problem: Problem, effects, starts=None, grid=True,
         x, r, J = best.x, best.fun, best.jac
     n, p = r.size - pack.n_prior, len(pack.names)
     rss = float(np.sum(r[:n] ** 2))
-    try:                                   # Gauss-Newton covariance in fitted coordinates
-        s2 = rss / max(n - p, 1)
-        if pack.n_prior:                   # prior rows were weighted with the scatter
-            s2 = max(s2, problem.sigma_db ** 2)
-        sd = np.sqrt(np.clip(np.diag(s2 * np.linalg.pinv(J.T @ J)), 0, None))
-    except np.linalg.LinAlgError:
-        sd = np.full(p, np.nan)
+    s2 = rss / max(n - p, 1)
+    if pack.n_prior:                       # prior rows were weighted with the scatter
+        s2 = max(s2, problem.sigma_db ** 2)
+    sd = with_model_floor(pack, x, parameter_sd(J, r, n, problem.clusters(), s2))
     params, sigma = pack.values(x, sd)
     out = score(problem, effects, pack.scenario(x), params, sigma, rss, n, p, nfev,
                 time.perf_counter() - t0, x)
     out.budget_hit = hit
+    out.interval = intervals(pack, x, sd)
     out.alternatives = second_minimum(fun, pack, effects, x, problem.sigma_db)
     out.n_eval = fun.n
     out.units = {e: {pn: pack.units[(e, pn)] for pn in ps} for e, ps in params.items()}

@@ -85,7 +85,7 @@ def _which(r) -> str:
             said = EFFECTS[e].summary(ps)
             items.append(f"<li>{esc(e)}: {esc(txt)}" + (f" = {esc(said)}" if said else "")
                          + "</li>")
-        out += "<p>Parameters (1 sigma, Gauss-Newton, optimistic):</p><ul>" + "".join(items) \
+        out += "<p>Parameters (1 sigma, cell-clustered):</p><ul>" + "".join(items) \
             + "</ul>"
     out += "".join(paragraph(f"Equivalent explanation: {eq['text']}") for eq in r.equivalents)
     return out

@@ -94,6 +94,12 @@ class JointProblem:
     def vector(self, scenario, part="train"):
         return np.concatenate([p.vector(scenario, part) for p in self.runs])
 
+    def clusters(self) -> np.ndarray:
+        """The runs' :meth:`Problem.clusters` joined: a (channel, order) cell is one cluster
+        over all runs, each run's crank offset prior one of its own."""
+        return np.concatenate([np.where(c < 0, c - k, c)
+                               for k, c in enumerate(p.clusters() for p in self.runs)])
+
     def read_vectors(self, scenarios) -> list | None:
         """The runs' :meth:`Problem.read_vectors` joined (None if a run's cache holds
         another physical part)."""

@@ -73,11 +73,13 @@ def _which(r) -> list:
                      f"{o.t_stat:>6.1f} {o.bic_gain:>8.1f} {expl} "
                      f"{o.struct_db:>9.2f}  {o.status}")
     if r.chosen is not None:
-        lines.append("  parameters (1 sigma, Gauss-Newton, optimistic):")
+        lines.append("  parameters (1 sigma and 95 % interval, cell-clustered: "
+                     "docs/guide/diagnose.md):")
         for e, ps in r.chosen.params.items():
             unit = r.chosen.units.get(e, {})
-            txt = ", ".join(f"{k} = {v:.4g} +- {r.chosen.sigma[e][k]:.2g} {unit.get(k, '')}"
-                            for k, v in ps.items())
+            txt = ", ".join(f"{k} = {v:.4g} +- {r.chosen.sigma[e][k]:.2g}"
+                            f"{_interval_text(r.chosen.interval.get(e, {}).get(k))} "
+                            f"{unit.get(k, '')}" for k, v in ps.items())
             lines.append(f"    {e}: {txt}")
             said = EFFECTS[e].summary(ps)
             if said:
@@ -90,6 +92,13 @@ def _which(r) -> list:
             txt = ", ".join(f"{k}={v:.3g}" for k, v in bnd["parameters"].items())
             lines.append(f"    {bnd['rpm_from']:g}-{bnd['rpm_to']:g} rpm: {txt}")
     return lines
+
+
+def _interval_text(iv) -> str:
+    """`` (95 % 70.1..79.3)``, or "" without a finite interval."""
+    if not iv or None in iv:
+        return ""
+    return f" (95 % {iv[0]:.4g}..{iv[1]:.4g})"
 
 
 def _run_text(k, run) -> str:
@@ -108,7 +117,8 @@ def fit_notes(chosen, outcomes, bands, budget) -> list:
     """Sentences of the verdict on how far the fits can be trusted: a second minimum of the
     answer that explains the data alike (``FitOutcome.alternatives``), parameters of the
     answer at a bound (``Effect.bound_warnings``), and, said once, the fits that stopped at
-    their evaluation budget with what that means for the answer."""
+    their evaluation budget with what that means for the answer; the answer's 95 %
+    intervals where its effect states them (``Effect.interval_text``)."""
     out = []
     if chosen is not None and len(chosen.effects) == 1:
         eff = EFFECTS[chosen.effects[0]]
@@ -116,7 +126,8 @@ def fit_notes(chosen, outcomes, bands, budget) -> list:
         for alt in chosen.alternatives:
             out.append(eff.alternative_text(ps, alt["parameters"][chosen.effects[0]],
                                             alt["delta_chi2"]))
-        out += eff.bound_warnings(ps)
+        said = eff.interval_text(chosen.interval.get(chosen.effects[0], {}))
+        out += ([said] if said else []) + eff.bound_warnings(ps)
     if chosen is not None and chosen.budget_hit:
         out.append(f"the {chosen.label} fit stopped at its evaluation budget ({budget}): its "
                    f"parameters are the best point found, not a converged optimum (the "

@@ -129,7 +129,8 @@ class DiagnosisResult(Result):
         return {"effect": o.label, "effects": list(o.effects), "parameters": o.params,
                 "summary": "; ".join(t for t in (EFFECTS[e].summary(o.params[e])
                                                  for e in o.effects) if t),
-                "parameter_sigma": o.sigma, "n_parameters": o.n_params,
+                "parameter_sigma": o.sigma, "parameter_interval_95": o.interval,
+                "n_parameters": o.n_params,
                 "heldout_rms_db_before": self.baseline.heldout_rms_db,
                 "heldout_rms_db_after": o.heldout_rms_db,
                 "heldout_channel_rms_db_before": self.baseline.heldout_channel_rms,

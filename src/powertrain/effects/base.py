@@ -78,6 +78,9 @@ class Effect:
     #: the fit then keeps a start in a second basin of it and reports a second minimum that
     #: explains alike (:mod:`powertrain.diagnosis.starts`); None: no such parameter.
     basin_parameter = None
+    #: Parameters whose reported uncertainty carries the relative model-discrepancy floor
+    #: (:data:`powertrain.diagnosis.uncertainty.MODEL_FLOOR`).
+    model_floor = ()
 
     # ------------------------------------------------------------------ description
     def parameters(self, engine=None) -> tuple:
@@ -239,6 +242,11 @@ class Effect:
         return (f"two minima explain the data alike: {name} {params[name]:.4g} or "
                 f"{other[name]:.4g} (the data prefer {params[name]:.4g}: training chi2 lower "
                 f"by {delta_chi2:.1f})")
+
+    def interval_text(self, interval) -> str:
+        """The verdict's sentence on the 95 % intervals ``{parameter: [lo, hi]}`` of the
+        fitted parameters ("" : none said)."""
+        return ""
 
     def bound_warnings(self, params) -> list:
         """Warnings for the verdict on fitted ``params`` at a bound that matters to what the

@@ -117,6 +117,10 @@ class MissingBodyMode(Effect):
     withhold_orders = True
     #: parameter whose separate minima are told apart (:mod:`powertrain.diagnosis.starts`)
     basin_parameter = "frequency_hz"
+    #: parameters with the model-discrepancy floor in their uncertainty (a mode placed a
+    #: little apart by the model on every channel alike; :mod:`powertrain.diagnosis.
+    #: uncertainty`)
+    model_floor = ("frequency_hz", "modal_mass_kg")
     #: a candidate only where the gap lies on the body side: the mode moves the bases, and
     #: its 12-parameter fit is the slowest of the library
     locations = ("body",)
@@ -175,6 +179,15 @@ class MissingBodyMode(Effect):
         return (f"the missing mode lies near {f:.3g} or {g:.3g} Hz ({params['modal_mass_kg']:.3g}"
                 f" or {other['modal_mass_kg']:.3g} kg): both explain the data alike (training "
                 f"chi2 differs by {delta_chi2:.1f} < 10); the data prefer {f:.3g} Hz")
+
+    def interval_text(self, interval) -> str:
+        """'95 % intervals: frequency 70.1-79.3 Hz, modal mass 9.8-12.6 kg' ("" without
+        finite intervals)."""
+        f, m = interval.get("frequency_hz"), interval.get("modal_mass_kg")
+        if not f or not m or None in f + m:
+            return ""
+        return (f"95 % intervals of the missing mode: frequency {f[0]:.3g}-{f[1]:.3g} Hz, "
+                f"modal mass {m[0]:.3g}-{m[1]:.3g} kg")
 
     def bound_warnings(self, params) -> list:
         """The damping ratio or the frequency at its bound (within 1 % of it)."""
