@@ -302,7 +302,7 @@ def in_process_argvs(text: str):
     such) with nothing a shell must expand, else None."""
     argvs = []
     for part in _split_outside_quotes(text, "&&"):
-        if SHELL_SYNTAX.search(part.replace("&&", "")):
+        if SHELL_SYNTAX.search(part):
             return None
         try:
             tokens = shlex.split(part)
