@@ -1,50 +1,10 @@
 """Run-up results: order spectra of the mount channels (three per mount) against speed.
 
-HDF5 layout (all arrays SI, units in each dataset's ``unit`` attribute)::
-
-    /                      attrs: format="powertrain-runup", format_version, powertrain_version,
-                                  created (UTC ISO 8601), solver settings (JSON), engine name,
-                                  engine_snapshot (the engine file text), mount_snapshots (JSON
-                                  {path: text}), synthetic (bool), description
-    /rpm                   (n_rpm,)                       rpm
-    /orders                (n_orders,)                    1 (orders 0.5 ... 8)
-    /channels/mount        (n_ch,) str                    mount names (left/right/gearbox ...)
-    /channels/direction    (n_ch,) str                    x/y/z (engine axes)
-    /velocity/amplitude    (n_rpm, n_ch, n_orders) complex   m/s   (peak complex amplitude)
-    /velocity/order_rms    (n_rpm, n_ch, n_orders)           m/s
-    /velocity/synthesis_rms (n_rpm, n_ch)                  m/s   (RMS sum, orders <= 8)
-    /displacement/...      same, m
-    /acceleration/...      same, m/s^2
-    /mount_force/...       same, N (force transmitted to ground, engine axes)
-    /mount_force/mean      (n_rpm, n_ch)                   N (static preload part, no gravity)
-    /diagnostics/periodicity        (n_rpm,)              1 (cycle-to-cycle, Newmark)
-    /diagnostics/rigid_body_modes_hz (6,)                 Hz
-    /diagnostics/solver_seconds     ()                    s
-    /operating_point       the static operating point per speed (powertrain.solvers.
-                           operating_point), attrs gear_ratio:
-        mounts (n_m,) str; mean_torque (n_rpm,) N*m (mean brake torque);
-        body (n_rpm, 6) m, rad (displacement and rotation at the CG, engine axes);
-        deflection, force, tangent_stiffness (n_rpm, n_m, 3) m, N, N/m (local x, y, z);
-        static_factor (n_rpm, 3 n_m) 1; iterations (n_rpm,); residual (n_rpm, 2)
-        (force / weight, moment / (weight x 1 m))
-
-    /channels/side         (n_ch,) str                    active (engine side) / passive (body)
-    /channels/location     (n_ch,) str                    mount or body-point name
-    /path_contribution/velocity (n_rpm, 3 n_points, 3 n_mounts, n_orders) complex  m/s
-                           (with body points: velocity at each body-point channel carried
-                           by each path mount × local direction; /points, /paths name them)
-
 Channels: every mount's engine side (``left``), with a modal or measured chassis also its
-body side (``left/passive``) and the body points of interest (``seat_rail``).
-
-Long-format CSV (also the measured-data format): columns
-``mount,direction,quantity,rpm,side,velocity_rms_mm_per_s,acceleration_rms_m_per_s2,
-force_rms_n,phase_deg`` with ``quantity`` = ``order_0.5``, ``order_1``, ... ``order_8`` or
-``synthesis``, ``side`` = ``active`` or ``passive``; ``force_rms_n`` is the force the mount
-transmits to the body (empty for body points); ``phase_deg`` the velocity's order phase re
-cylinder-1 firing TDC (:mod:`powertrain.analysis.phase`; acceleration leads it by 90°), empty
-on synthesis rows and where the order is round-off. Files with only the first four columns
-and ``velocity_rms_mm_per_s`` stay valid input.
+body side (``left/passive``) and the body points of interest (``seat_rail``). Files: the HDF5
+layout (``runup --out``, all arrays SI with a ``unit`` attribute; docs/reference/outputs.md,
+the body-side datasets in docs/guide/chassis.md) and the long-format CSV (``runup --csv``,
+:data:`CSV_HEADER`; also the measured-data format, :mod:`powertrain.iotools.measured`).
 """
 
 from __future__ import annotations

@@ -22,10 +22,9 @@ import numpy as np
 from powertrain import __version__
 from powertrain.analysis.channel import Channel
 from powertrain.errors import InputError
-from powertrain.outputs import json_text
 from powertrain.plotting import plot_whatif
 from powertrain.plotting.style import target_and_path
-from powertrain.results.base import Result
+from powertrain.results.base import JsonResult
 from powertrain.results.html import fragment
 from powertrain.results.html_tables import whatif_html
 
@@ -64,7 +63,7 @@ def delta_db(base, variant, floor_rel=FLOOR_REL) -> np.ndarray:
 
 
 @dataclass(frozen=True)
-class WhatIfResult(Result):
+class WhatIfResult(JsonResult):
     """Baseline and variant run-ups with their changes in dB.
 
     Attributes
@@ -93,6 +92,8 @@ class WhatIfResult(Result):
     objective: tuple | None = None
     #: speed step of the grid [rpm] (None: one speed)
     rpm_step: float | None = None
+
+    JSON_INDENT = 2
 
     def to_text(self, written=()) -> str:
         """The report ``powertrain whatif`` prints: the baseline, the target fits, each
@@ -235,14 +236,6 @@ class WhatIfResult(Result):
                                                       v.result.rigid_body_modes_hz],
                               "channels": self.channel_changes(v.name)}
                              for v in self.variants]}
-
-    def to_json(self, path=None) -> str:
-        """JSON text of :meth:`to_dict`; written atomically to ``path`` if given."""
-        return json_text(self.to_dict(), path, indent=2)
-
-    def writers(self) -> dict:
-        """``.json`` (:meth:`to_json`), ``.png`` (the levels figure)."""
-        return {".json": self.to_json, **super().writers()}
 
     def table(self) -> str:
         """Text table per variant: rows = channels, columns = mean / max |Δ| [dB] per quantity."""
