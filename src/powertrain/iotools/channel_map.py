@@ -34,7 +34,7 @@ class ChannelSpec:
 
 @dataclass
 class ChannelMap:
-    """A parsed channel map (see module docstring)."""
+    """A parsed channel map (docs/reference/raw-data.md)."""
 
     channels: dict = field(default_factory=dict)    # file name -> ChannelSpec
     time: str | None = None
@@ -71,7 +71,7 @@ def quantity_of_unit(unit: str, file=None, key=None) -> str:
 
 
 def read_channel_map(path) -> ChannelMap:
-    """Read a channel-map TOML file (see module docstring)."""
+    """Read a channel-map TOML file (docs/reference/raw-data.md)."""
     path = str(path)
     data = read_toml(path)
     for key in data:

@@ -39,7 +39,7 @@ _SECTIONS = ("manoeuvre", "speed", "load", "starter")
 
 
 def read_manoeuvre(path) -> Manoeuvre:
-    """Read and check a manoeuvre file (module docstring).
+    """Read and check a manoeuvre file (docs/guide/transient.md).
 
     Raises
     ------

@@ -21,6 +21,7 @@ from powertrain.analysis.channel import DIRECTIONS, SIDES, Channel, passive_name
 from powertrain.analysis.orders import order_label, quantity_sort_key
 from powertrain.analysis.phase import phase_deg, wrap_deg
 from powertrain.errors import InputError
+from powertrain.iotools.raw import detect_format
 from powertrain.iotools.runup_hdf5 import read_runup_hdf5
 from powertrain.iotools.textfile import check_regular_file, parse_number, read_text
 
@@ -39,7 +40,6 @@ KEY_COLUMNS = ("mount", "direction", "quantity", "rpm")
 #: body side, or a body point of interest named in ``mount``) and further value columns
 #: (read and checked; the comparison uses the velocity level column).
 OPTIONAL_COLUMNS = ("side", "acceleration_rms_m_per_s2", "force_rms_n", "phase_deg")
-_HDF5_SIGNATURE = b"\x89HDF\r\n\x1a\n"
 
 
 #: Highest plausible order level [m/s RMS]: above 1 km/s it is a unit or export error.
@@ -166,7 +166,7 @@ def read_measured(path, mounts=None, points=None) -> MeasuredRunup:
     Parameters
     ----------
     path : str or Path
-        Long-format CSV (see module docstring) or run-up HDF5 file.
+        Long-format CSV (docs/reference/csv-formats.md) or run-up HDF5 file.
     mounts : sequence of str, optional
         Mount names allowed (those of the model compared with); None accepts any name.
     points : sequence of str, optional
@@ -185,12 +185,7 @@ def read_measured(path, mounts=None, points=None) -> MeasuredRunup:
     check_regular_file(path)
     path = str(path)
     mounts, points = _names(mounts, "mounts"), _names(points, "points")
-    try:
-        with open(path, "rb") as fh:
-            head = fh.read(8)
-    except OSError as exc:
-        raise InputError(f"cannot read file ({exc.strerror or exc})", file=path) from None
-    if head == _HDF5_SIGNATURE:
+    if detect_format(path) == "hdf5":
         return _read_hdf5(path, mounts)
     return _read_csv(path, mounts, points)
 

@@ -17,7 +17,7 @@ from powertrain.units import to_si
 
 
 def read_csv_signals(path, channel_map=None) -> FileSignals:
-    """Signals of a wide CSV file (see module docstring)."""
+    """Signals of a wide CSV file (docs/reference/raw-data.md)."""
     text = read_text(path, "CSV")
     comments, header, start = [], None, 0
     lines = text.splitlines()

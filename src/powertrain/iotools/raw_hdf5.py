@@ -31,7 +31,7 @@ def _unit(ds):
 
 
 def read_hdf5_signals(path, channel_map=None) -> FileSignals:
-    """Signals of a raw HDF5 file (see module docstring)."""
+    """Signals of a raw HDF5 file (docs/reference/raw-data.md)."""
     import h5py  # deferred: heavy package, loaded only when this format is used
     try:
         h5 = h5py.File(path, "r")

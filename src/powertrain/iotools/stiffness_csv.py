@@ -93,7 +93,7 @@ def _open_rows(path):
 
 
 def read_stiffness_csv(path) -> MeasuredStiffness:
-    """Read a measured K*(f) table (see the module docstring) into SI.
+    """Read a measured K*(f) table (docs/reference/csv-formats.md) into SI.
 
     Parameters
     ----------
