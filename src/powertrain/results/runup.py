@@ -259,30 +259,14 @@ class RunupResult(Result):
                     a["command_line"] = provenance.get("command_line", "")
                     a["engine_as_run"] = json.dumps(provenance.get("engine_as_run", {}),
                                                     allow_nan=False)
-                ds = h5.create_dataset("rpm", data=self.rpm)
-                ds.attrs["unit"] = "rpm"
-                ds = h5.create_dataset("orders", data=self.orders)
-                ds.attrs["unit"] = "1"
-                g = h5.create_group("channels")
-                g.create_dataset("mount", data=np.array([m for m, _ in self.channels], dtype="S"))
-                g.create_dataset("direction",
-                                 data=np.array([d for _, d in self.channels], dtype="S"))
-                g.attrs["axes"] = "engine coordinate system (Kovarik 2016, sec. 4.1)"
-                for name, unit in QUANTITIES.items():
-                    g = h5.create_group(name)
-                    arr = getattr(self, name)
-                    for key, data in (("amplitude", arr), ("order_rms", order_rms(arr)),
-                                      ("synthesis_rms", synthesis_rms(arr, axis=-1))):
-                        ds = g.create_dataset(key, data=data)
-                        ds.attrs["unit"] = unit
-                ds = h5["mount_force"].create_dataset("mean", data=self.mean_mount_force)
-                ds.attrs["unit"] = "N"
-                g = h5.create_group("diagnostics")
-                g.create_dataset("periodicity", data=self.periodicity).attrs["unit"] = "1"
-                g.create_dataset("rigid_body_modes_hz",
-                                 data=self.rigid_body_modes_hz).attrs["unit"] = "Hz"
-                g.create_dataset("solver_seconds", data=self.solver_seconds).attrs["unit"] = "s"
-                self._write_sides(h5)
+                for key, data, unit in self._datasets():
+                    h5.create_dataset(key, data=data).attrs["unit"] = unit
+                for key, names in self._names().items():
+                    h5.create_dataset(key, data=np.array(names, dtype="S"))
+                h5["channels"].attrs["axes"] = "engine coordinate system (Kovarik 2016, sec. 4.1)"
+                if self.path_contribution is not None:
+                    h5["path_contribution/velocity"].attrs["axes"] = \
+                        "rpm, point channel, path (mount x local direction), order"
                 if self.operating_point is not None:
                     write_operating_point(h5.create_group("operating_point"),
                                           self.operating_point)
@@ -308,22 +292,33 @@ class RunupResult(Result):
                                 effects=self.settings.get("effects"))
         return snapshot, mounts, description, provenance
 
-    def _write_sides(self, h5):
-        """/channels/side and /channels/location; /path_contribution with body points."""
-        g = h5["channels"]
-        g.create_dataset("side", data=np.array([self.side(m) for m, _ in self.channels],
-                                               dtype="S"))
-        g.create_dataset("location", data=np.array([split_side(m)[0] for m, _ in
-                                                    self.channels], dtype="S"))
+    def _datasets(self) -> list:
+        """``(path, array, unit)`` of every numeric dataset of the HDF5 layout but the
+        operating point's."""
+        out = [("rpm", self.rpm, "rpm"), ("orders", self.orders, "1")]
+        for name, unit in QUANTITIES.items():
+            arr = getattr(self, name)
+            out += [(f"{name}/amplitude", arr, unit), (f"{name}/order_rms", order_rms(arr), unit),
+                    (f"{name}/synthesis_rms", synthesis_rms(arr, axis=-1), unit)]
+        out += [("mount_force/mean", self.mean_mount_force, "N"),
+                ("diagnostics/periodicity", self.periodicity, "1"),
+                ("diagnostics/rigid_body_modes_hz", self.rigid_body_modes_hz, "Hz"),
+                ("diagnostics/solver_seconds", self.solver_seconds, "s")]
         if self.path_contribution is not None:
-            pg = h5.create_group("path_contribution")
-            ds = pg.create_dataset("velocity", data=self.path_contribution)
-            ds.attrs["unit"] = "m/s"
-            ds.attrs["axes"] = "rpm, point channel, path (mount x local direction), order"
-            pg.create_dataset("points", data=np.array(
-                [f"{p}.{d}" for p in self.points for d in "xyz"], dtype="S"))
-            pg.create_dataset("paths", data=np.array([f"{m}.{d}" for m, d in self.paths],
-                                                     dtype="S"))
+            out.append(("path_contribution/velocity", self.path_contribution, "m/s"))
+        return out
+
+    def _names(self) -> dict:
+        """Path -> names of the string datasets: the channels and, with body points, the
+        points and paths of the path contributions."""
+        out = {"channels/mount": [m for m, _ in self.channels],
+               "channels/direction": [d for _, d in self.channels],
+               "channels/side": [self.side(m) for m, _ in self.channels],
+               "channels/location": [split_side(m)[0] for m, _ in self.channels]}
+        if self.path_contribution is not None:
+            out["path_contribution/points"] = [f"{p}.{d}" for p in self.points for d in "xyz"]
+            out["path_contribution/paths"] = [f"{m}.{d}" for m, d in self.paths]
+        return out
 
     # ----------------------------------------------------------------- plots
     def plot_paths(self, ax=None, *, path=None, order=2.0, provenance=None):

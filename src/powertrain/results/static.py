@@ -35,7 +35,7 @@ class StaticResult(JsonResult):
         return np.array([getattr(p, name) for p in self.points])
 
     def to_dict(self) -> dict:
-        """The JSON document (module docstring)."""
+        """The JSON document (docs/reference/json.md)."""
         body = self.stack("body")
         mounts = {}
         for m, name in enumerate(self.mounts):

@@ -161,7 +161,7 @@ class TrackedOrders(Result):
         return " [SYNTHETIC]" if any("synthetic" in c.lower() for c in self.comments) else ""
 
     def csv_text(self) -> str:
-        """Long-format CSV text (module docstring)."""
+        """Long-format CSV text (docs/reference/raw-data.md)."""
         phase = self.phase_deg()
         tail = [] if phase is None else [""]            # empty phase_deg cell
         lines, factor, keys = self._csv_head(
@@ -184,7 +184,7 @@ class TrackedOrders(Result):
         return "\n".join(lines) + "\n"
 
     def spectrum_csv_text(self) -> str:
-        """Order spectrum CSV text (module docstring): RMS against order per speed."""
+        """Order spectrum CSV text (docs/reference/csv-formats.md): RMS against order per speed."""
         s = self.settings
         lines, factor, keys = self._csv_head(
             f"order spectrum by powertrain track from {self.source}{self._tag()}: COT block of "
@@ -206,7 +206,7 @@ class TrackedOrders(Result):
                 **super().writers()}
 
     def to_hdf5(self, path) -> None:
-        """Write the HDF5 layout of the module docstring atomically."""
+        """Write the HDF5 layout (docs/reference/raw-data.md) atomically."""
         import h5py  # deferred: heavy optional package
 
         with atomic_path(path) as tmp:

@@ -103,7 +103,7 @@ class TransientResult(JsonResult):
                             [note]).validate()
 
     def to_dict(self) -> dict:
-        """The JSON document (module docstring)."""
+        """The JSON document (docs/reference/json.md)."""
         p = self.peaks()
         chans = {c: {"peak_to_peak_displacement_mm": float(from_si(p["peak_to_peak"][k], "mm")),
                      "peak_force_n": float(p["peak_force"][k]),
