@@ -167,7 +167,8 @@ def _read_mapped(h5, path, cmap):
 
 
 def write_raw_hdf5(path, recording, *, description: str = "", synthetic: bool = False) -> None:
-    """Write a :class:`RawRecording` in the layout above (values in each channel's unit)."""
+    """Write a :class:`RawRecording` in the ``powertrain-raw`` layout (docs/reference/raw-data.md;
+    values in each channel's unit)."""
     import h5py  # deferred: heavy package, loaded only when this format is used
 
     with atomic_path(path) as tmp:

@@ -1,16 +1,9 @@
-r"""Result of ``powertrain whatif``: baseline and variant run-ups and their changes in dB
-(computed by :func:`powertrain.workflows.whatif.whatif`).
-
-Change of a variant against the baseline, per channel (mount × engine X/Y/Z) and quantity
-(``synthesis``, ``order_2``, ``order_4`` by default), at each speed step:
-
-.. math:: \Delta(n) = 20\log_{10}\frac{v_{var}(n)}{v_{base}(n)}\ \mathrm{dB}
-
-with :math:`v` the RMS velocity of the mount point (or, with ``signal="mount_force"``, the
-RMS force the mount transmits to ground). Reported: ``mean_delta_db`` (the arithmetic mean of
-:math:`\Delta` over the speed steps, "rpm-averaged"), ``max_abs_delta_db`` (the largest
-:math:`|\Delta|`) and the speed where it occurs. Speed steps where both levels are below
-:data:`FLOOR_REL` of the baseline curve's maximum (a cancelled order) are left out.
+"""Result of ``powertrain whatif``: baseline and variant run-ups and their changes in dB
+(computed by :func:`powertrain.workflows.whatif.whatif`; docs/guide/whatif.md): the change
+20 log10(v_variant / v_baseline) of the RMS velocity (or another ``signal``) per channel and
+quantity at each speed step, its mean (``mean_delta_db``) and largest magnitude
+(``max_abs_delta_db``). Speed steps where both levels are below :data:`FLOOR_REL` of the
+baseline curve's maximum (a cancelled order) are left out.
 """
 
 from __future__ import annotations
