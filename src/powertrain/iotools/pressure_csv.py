@@ -132,14 +132,3 @@ def _check_trace(a, ln, c, w, path) -> None:
                          f"{w * 60 / (2 * np.pi):.6g} rpm)", file=path,
                          line=int(ln[0]), key="crank_angle")
 
-
-def format_pressure_traces(speeds_rpm, theta, pressure) -> str:
-    """CSV text of traces: ``pressure[i_speed, i_cyl, k]`` [Pa] at angles ``theta`` [rad]
-    (written in rpm, deg, bar)."""
-    lines = ["# cylinder pressure traces (powertrain.iotools.pressure_csv)",
-             "speed [rpm],cylinder,crank_angle [deg],pressure [bar]"]
-    for i, n in enumerate(speeds_rpm):
-        for c in range(pressure.shape[1]):
-            for a, p in zip(theta, pressure[i, c]):
-                lines.append(f"{n:.6g},{c + 1},{math.degrees(a):.6g},{p / 1e5:.8g}")
-    return "\n".join(lines) + "\n"
