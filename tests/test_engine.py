@@ -312,12 +312,22 @@ def test_speed_outside_the_full_load_curve_is_an_input_error(engine):
 
 # ----------------------------------------------------------------- measured traces
 
+def _pressure_csv(speeds_rpm, theta, pressure) -> str:
+    """CSV text of traces ``pressure[i_speed, i_cyl, k]`` [Pa] at angles ``theta`` [rad]
+    (written in rpm, deg, bar: the format of powertrain.iotools.pressure_csv)."""
+    lines = ["# cylinder pressure traces", "speed [rpm],cylinder,crank_angle [deg],pressure [bar]"]
+    for i, n in enumerate(speeds_rpm):
+        for c in range(pressure.shape[1]):
+            lines += [f"{n:.6g},{c + 1},{math.degrees(a):.6g},{p / 1e5:.8g}"
+                      for a, p in zip(theta, pressure[i, c])]
+    return "\n".join(lines) + "\n"
+
+
 def test_measured_traces_reproduce_the_model_load(tmp_path, engine):
     """Oracle: two routes to the same load — single-zone pressures written as a trace CSV
     (0.25-deg steps, bar to 8 digits) and read back must give the same load to the
     resampling error (< 0.5 % of the peak), and between two speeds the traces blend
     linearly."""
-    from powertrain.iotools.pressure_csv import format_pressure_traces
     speeds = [2000.0, 4000.0]
     theta_g = -np.pi + 4 * np.pi * np.arange(2880) / 2880
     traces = np.empty((2, 4, theta_g.size))
@@ -326,7 +336,7 @@ def test_measured_traces_reproduce_the_model_load(tmp_path, engine):
         for c in range(4):
             traces[k, c] = np.interp(theta_g, th, pc[c], period=4 * np.pi)
     csv = tmp_path / "traces.csv"
-    csv.write_text(format_pressure_traces(speeds, theta_g, traces))
+    csv.write_text(_pressure_csv(speeds, theta_g, traces))
     text = Path(DEFAULT_ENGINE_PATH).read_text()
     start = text.index("[combustion]")
     text = text[:start] + f'[combustion]\nmodel = "measured"\ntraces = "{csv.name}"\n'

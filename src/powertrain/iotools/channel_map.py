@@ -1,22 +1,9 @@
 """Channel names of raw time data -> mount, side, direction, quantity.
 
-Two ways to say where a channel was measured:
-
-* the **name convention** of the wide CSV (also accepted in any format): ``MOUNT.DIRECTION
-  [UNIT]`` or ``MOUNT.SIDE.DIRECTION [UNIT]``, e.g. ``left.z [m/s^2]``, ``left.passive.z [g]``;
-  the unit decides the quantity (m/s^2 or g: acceleration; m/s or mm/s: velocity; m, mm:
-  displacement; N: force);
-* a **channel map** (TOML, ``--channels MAP.toml``) for formats whose names are free text::
-
-      time = "Time"                 # optional: channel holding time (default: the file's)
-      rpm = "EngineSpeed"           # optional: speed channel [rpm]
-      tacho = "Tacho1"              # optional: tacho pulse channel
-      [channels]
-      "ACC_ENG_LEFT_Z" = { mount = "left", direction = "z", quantity = "acceleration", unit = "g" }
-      "ACC_BODY_LEFT_Z" = { mount = "left", side = "passive", direction = "z", quantity = "acceleration" }
-
-  ``side`` defaults to ``active``; ``unit`` overrides the file's unit (needed when the file
-  declares none).
+Either the name convention ``MOUNT[.SIDE].DIRECTION [UNIT]`` (``left.z [m/s^2]``; the unit
+decides the quantity) or a channel map (TOML, ``--channels MAP.toml``: optional ``time``,
+``rpm``, ``tacho`` and a ``[channels]`` table ``"FILE NAME" = {mount, side, direction,
+quantity, unit}``); both in docs/reference/raw-data.md.
 """
 
 from __future__ import annotations
@@ -47,7 +34,7 @@ class ChannelSpec:
 
 @dataclass
 class ChannelMap:
-    """A parsed channel map (see module docstring)."""
+    """A parsed channel map (docs/reference/raw-data.md)."""
 
     channels: dict = field(default_factory=dict)    # file name -> ChannelSpec
     time: str | None = None
@@ -84,7 +71,7 @@ def quantity_of_unit(unit: str, file=None, key=None) -> str:
 
 
 def read_channel_map(path) -> ChannelMap:
-    """Read a channel-map TOML file (see module docstring)."""
+    """Read a channel-map TOML file (docs/reference/raw-data.md)."""
     path = str(path)
     data = read_toml(path)
     for key in data:

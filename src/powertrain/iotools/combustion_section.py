@@ -25,17 +25,6 @@ from powertrain.iotools.tomlfile import (
 )
 from powertrain.models.combustion import FullLoadCurve, SingleZoneCombustion
 
-#: Keys of each combustion model's table.
-KEYS = {
-    "single-zone": {"model", "imep_factors", "ambient_pressure", "start", "duration",
-                    "wiebe_a", "wiebe_m", "polytropic_compression", "polytropic_expansion",
-                    "exhaust_valve_opening", "blowdown_end", "valve_overlap",
-                    "exhaust_pressure_ratio", "intake_pressure_min", "intake_pressure_max",
-                    "indicated_efficiency", "volumetric_efficiency", "air_fuel_ratio",
-                    "heating_value", "intake_temperature", "full_load"},
-    "measured": {"model", "traces"},
-    "full_load": {"speed", "torque", "fmep"},
-}
 #: ``[combustion]`` single-zone key -> (model field, dimension, check of the number).
 _SINGLE_ZONE = {
     "ambient_pressure": ("ambient_pressure", "pressure", "positive"),
@@ -57,6 +46,10 @@ _SINGLE_ZONE = {
     "heating_value": ("heating_value", "specific_energy", "positive"),
     "intake_temperature": ("intake_temperature", "temperature", "positive"),
 }
+#: Keys of each combustion model's table.
+KEYS = {"single-zone": {"model", "imep_factors", "full_load", *_SINGLE_ZONE},
+        "measured": {"model", "traces"},
+        "full_load": {"speed", "torque", "fmep"}}
 P = "combustion"
 
 

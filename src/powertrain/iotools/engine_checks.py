@@ -1,17 +1,8 @@
-"""Physical plausibility of an engine, checked when its file is loaded.
-
-A file can be well-formed key by key and still describe an engine nothing sensible can be
-computed for. These checks run once, on the model in SI, and raise
-:class:`~powertrain.errors.InputError` naming the file, the section at fault and the reason,
-so that the failure shows at the input instead of deep in a solver (a singular matrix, an
-overflow, NaN in the results):
-
-* the mounts must carry the body: its rigid-body modes on the mounts' static stiffness must
-  be finite and at least :data:`MIN_MODE_HZ` (below it the static sag under the body's own
-  weight, ``g / (2 pi f)^2``, exceeds a quarter of a metre), and at most
-  :data:`MAX_MODE_HZ`;
-* the crank train's excitation (gas and inertia forces, balancers) must be finite and below
-  :data:`MAX_FORCE_N` at both ends of the engine's speed range.
+"""Physical plausibility of an engine, checked once when its file is loaded (on the model
+in SI), so that a well-formed but absurd file fails at the input, naming the file, the section
+and the reason, instead of deep in a solver: the mounts must carry the body (rigid-body modes
+finite, :data:`MIN_MODE_HZ` to :data:`MAX_MODE_HZ`) and the excitation must be finite and below
+:data:`MAX_FORCE_N` at both ends of the speed range.
 """
 
 from __future__ import annotations

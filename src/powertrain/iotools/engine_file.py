@@ -1,36 +1,9 @@
-"""Engine files: ``engines/*.toml``, every quantity written ``key = {value = ..., unit = "..."}``.
+"""Engine files (``engines/*.toml``) into an :class:`~powertrain.models.engine.Engine` in SI.
 
-Layout (see ``engines/default.toml`` for a complete, commented example)::
-
-    [engine]            name, source, notes
-    [crank_train]       cylinders, bore, stroke, rod_length, pin_offset, compression_ratio,
-                        cylinder_positions, cylinder_axis, rotation ("+X" or "-X"),
-                        crank_pin_angles, firing_order, reciprocating_mass, rotating_mass,
-                        counterweight_fraction, crankcase_pressure
-    [body]              mass, cg, inertia (3x3 nested list, tensor entries)
-    [mounts.NAME]       any number (>= 3) of named mounts, each with
-                        position; orientation as local_x + local_z, or
-                        orientation = {value = [a, b, c], unit = "deg"} (R = Rz(c) Ry(b) Rx(a));
-                        either files = {x = ..., y = ..., z = ...} (mount-file paths relative
-                        to the engine file) or an inline spring-damper per local direction,
-                        stiffness = {value = [kx, ky, kz], unit = "N/mm"} and optional
-                        damping = {value = [cx, cy, cz], unit = "N*s/mm"}
-    [balancer]          enabled, speed_ratio, [[balancer.shafts]] name, mass_radius,
-                        position, phase, sense (+1 with the crank, -1 against)
-    [combustion]        model = "single-zone" (parameters below) or "measured"
-                        (traces = "file.csv", see powertrain.iotools.pressure_csv)
-    [combustion.full_load]  speed, torque, fmep (lists of equal length)
-    [drive]             gear_ratio (> 0, default 1 = the engine alone): multiplies the mean
-                        drive-torque reaction of the static operating point
-
-Only ``[engine]``, ``[body]`` and ``[mounts.*]`` are required: without ``[crank_train]`` and
-``[combustion]`` the engine has no excitation (enough for ``modes``); commands that need one
-name the missing section. Without ``[balancer]`` the engine has no balancer shafts.
-
-All values are converted to SI here, once, through :mod:`powertrain.units`. Missing keys,
-unknown keys or units, negative masses, NaN, a non-positive-definite inertia tensor,
-unreadable engine or mount files raise :class:`powertrain.errors.InputError` naming the file
-and the key.
+Layout, keys and units: docs/reference/engine-file.md (``engines/default.toml`` is a complete,
+commented example). Every quantity is ``key = {value = ..., unit = "..."}``, converted to SI
+here once through :mod:`powertrain.units`; every problem is an
+:class:`~powertrain.errors.InputError` naming the file and the key.
 """
 
 from __future__ import annotations
@@ -68,8 +41,7 @@ from powertrain.models.mount import MountModel
 #: The shipped default engine (package data, see :mod:`powertrain.data`).
 DEFAULT_ENGINE_PATH: Path = default_engine_path()
 
-#: Mount names of the default engine (any names are accepted; at least three mounts).
-DEFAULT_MOUNT_NAMES = ("left", "right", "gearbox")
+#: Fewest mounts an engine may have (any names are accepted).
 MIN_MOUNTS = 3
 DIRECTIONS = ("x", "y", "z")
 

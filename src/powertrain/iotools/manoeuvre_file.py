@@ -1,29 +1,9 @@
 """Reading a manoeuvre file (TOML): crank speed and load tables of a transient.
 
-::
-
-    [manoeuvre]
-    name = "engine start"
-    notes = "INVENTED numbers"
-    gear_ratio = {value = 0.0, unit = "1"}          # 0: neutral
-    crank_inertia = {value = 0.18, unit = "kg*m^2"} # crank train + flywheel
-    reversal = false                                # may the crank turn backwards?
-
-    [speed]
-    time = {value = [0.0, 0.2, 0.5], unit = "s"}
-    speed = {value = [0.0, 250.0, 900.0], unit = "rpm"}
-
-    [load]                                          # imep_scale or mean_torque
-    time = {value = [0.0, 0.5], unit = "s"}
-    imep_scale = {value = [0.0, 0.1], unit = "1"}
-
-    [starter]                                       # optional
-    ratio = {value = 12.0, unit = "1"}
-    reaction_point = {value = [150.0, -180.0, -60.0], unit = "mm"}
-    until = {value = 0.25, unit = "s"}
-
-Every check runs here, before any work; sizes are bounded (:data:`MAX_ROWS`,
-:data:`MAX_DURATION`, :data:`MAX_GAP`).
+Sections ``[manoeuvre]`` (name, gear_ratio, crank_inertia, reversal), ``[speed]`` and
+``[load]`` (time tables), optional ``[starter]``: docs/guide/transient.md. Every check runs
+here, before any work; sizes are bounded (:data:`MAX_ROWS`, :data:`MAX_DURATION`,
+:data:`MAX_GAP`).
 """
 
 from __future__ import annotations
@@ -59,7 +39,7 @@ _SECTIONS = ("manoeuvre", "speed", "load", "starter")
 
 
 def read_manoeuvre(path) -> Manoeuvre:
-    """Read and check a manoeuvre file (module docstring).
+    """Read and check a manoeuvre file (docs/guide/transient.md).
 
     Raises
     ------

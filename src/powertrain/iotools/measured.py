@@ -1,57 +1,13 @@
-r"""Measured run-up order curves: long-format CSV or the run-up HDF5 layout.
+r"""Measured run-up order curves: the long-format CSV or the run-up HDF5 layout.
 
-CSV (the format :meth:`powertrain.results.runup.RunupResult.to_csv` writes)::
-
-    # lines starting with '#' are comments (kept, e.g. a SYNTHETIC label); blank lines skipped
-    mount,direction,quantity,rpm,velocity_rms_mm_per_s
-    left,x,order_2,1000,0.512
-    left,x,synthesis,1000,0.801
-    ...
-
-or, with both sides of the mounts (what ``powertrain runup --csv`` writes)::
-
-    mount,direction,quantity,rpm,side,velocity_rms_mm_per_s,acceleration_rms_m_per_s2,force_rms_n
-    left,z,order_2,1000,active,0.512,0.0064,41.2
-    left,z,order_2,1000,passive,0.020,0.00025,41.2
-    seat_rail,z,order_2,1000,passive,0.004,0.00005,
-
-``side`` = ``active`` (engine side, the default without the column) or ``passive`` (body
-side of the mount; a name that is not a mount is a body point of interest). Passive rows of
-mount ``left`` become channel ``left/passive``.
-
-* ``mount``: a mount name of the model (``left``, ``right``, ``gearbox`` for the default
-  engine); ``direction``: ``x``, ``y`` or ``z`` (engine axes; upper case accepted);
-  ``quantity``: ``synthesis`` or ``order_<n>`` (``order_2``, ``order_0.5``...); ``rpm`` > 0;
-  ``overall`` rows (the raw signal's overall level, ``track --overall``) are skipped: the
-  model has no overall level to compare with.
-* exactly one level column, whose name states quantity, statistic and unit (table
-  :data:`LEVEL_COLUMNS`): ``velocity_rms_mm_per_s``, ``velocity_rms_m_per_s``,
-  ``velocity_peak_mm_per_s`` or ``velocity_peak_m_per_s``; or, as ``powertrain track``
-  writes them, ``acceleration_rms_m_per_s2``, ``displacement_rms_mm`` or ``force_rms_n``.
-  Acceleration and displacement orders are converted to velocity order by order,
-  :math:`v_o = a_o/\omega_o` and :math:`v_o = \omega_o x_o` with
-  :math:`\omega_o = 2\pi\,o\,n/60`, and the synthesis is recomputed as the RMS sum of the
-  converted orders (a synthesis row cannot be converted by itself); force curves are
-  compared with the simulated mount forces (``signal = "mount_force"``). Peak values are converted to RMS
-  by :math:`1/\sqrt2`, exact for a single sinusoidal order; a ``synthesis`` row in a peak file
-  is read as the root-sum-square of the order peaks (the usual order-analyser convention),
-  for which the same factor is exact too.
-* ``phase_deg`` (optional): the order's phase [deg] re cylinder-1 firing TDC
-  (:mod:`powertrain.analysis.phase`: order component √2·RMS·cos(kθ + φ)) of the level
-  column read (in a run-up CSV the velocity's); empty where undefined, always empty on
-  ``synthesis`` rows. Converted with the levels (acceleration to velocity: φ − 90°,
-  displacement: φ + 90°) and wrapped to (-180°, 180°]; read into
-  :attr:`MeasuredRunup.phases`.
-* rows may come in any order; speeds need not be the same for every channel.
-
-Levels are returned in SI (m/s RMS). Any problem -- unreadable file, a header without a
-recognised level column, an unknown column, mount, direction or quantity, a non-numeric,
-negative or NaN value, a duplicate row -- raises :class:`~powertrain.errors.InputError`
-naming file, line and column.
-
-HDF5 files in the layout of :mod:`powertrain.results.runup` (``powertrain runup --out``) are read
-with :func:`powertrain.iotools.runup_hdf5.read_runup_hdf5`; every channel's synthesis and order
-RMS velocities become curves.
+The CSV (``runup --csv``, ``track --csv``, ``synth``; columns, level columns, ``side`` and
+``phase_deg``: docs/reference/csv-formats.md and raw-data.md) has one row per channel, quantity
+and speed. ``passive`` rows of mount ``left`` become channel ``left/passive``; a passive name
+that is not a mount is a body point. Peak levels become RMS by :math:`1/\sqrt2`; acceleration
+and displacement orders become velocity order by order (:func:`to_velocity`); force curves are
+compared with the simulated mount forces. HDF5 files are read with
+:func:`powertrain.iotools.runup_hdf5.read_runup_hdf5`. Levels are returned in SI (m/s RMS);
+every problem is an :class:`~powertrain.errors.InputError` naming file, line and column.
 """
 
 from __future__ import annotations
@@ -65,6 +21,7 @@ from powertrain.analysis.channel import DIRECTIONS, SIDES, Channel, passive_name
 from powertrain.analysis.orders import order_label, quantity_sort_key
 from powertrain.analysis.phase import phase_deg, wrap_deg
 from powertrain.errors import InputError
+from powertrain.iotools.raw import detect_format
 from powertrain.iotools.runup_hdf5 import read_runup_hdf5
 from powertrain.iotools.textfile import check_regular_file, parse_number, read_text
 
@@ -83,7 +40,6 @@ KEY_COLUMNS = ("mount", "direction", "quantity", "rpm")
 #: body side, or a body point of interest named in ``mount``) and further value columns
 #: (read and checked; the comparison uses the velocity level column).
 OPTIONAL_COLUMNS = ("side", "acceleration_rms_m_per_s2", "force_rms_n", "phase_deg")
-_HDF5_SIGNATURE = b"\x89HDF\r\n\x1a\n"
 
 
 #: Highest plausible order level [m/s RMS]: above 1 km/s it is a unit or export error.
@@ -210,7 +166,7 @@ def read_measured(path, mounts=None, points=None) -> MeasuredRunup:
     Parameters
     ----------
     path : str or Path
-        Long-format CSV (see module docstring) or run-up HDF5 file.
+        Long-format CSV (docs/reference/csv-formats.md) or run-up HDF5 file.
     mounts : sequence of str, optional
         Mount names allowed (those of the model compared with); None accepts any name.
     points : sequence of str, optional
@@ -229,12 +185,7 @@ def read_measured(path, mounts=None, points=None) -> MeasuredRunup:
     check_regular_file(path)
     path = str(path)
     mounts, points = _names(mounts, "mounts"), _names(points, "points")
-    try:
-        with open(path, "rb") as fh:
-            head = fh.read(8)
-    except OSError as exc:
-        raise InputError(f"cannot read file ({exc.strerror or exc})", file=path) from None
-    if head == _HDF5_SIGNATURE:
+    if detect_format(path) == "hdf5":
         return _read_hdf5(path, mounts)
     return _read_csv(path, mounts, points)
 

@@ -1,46 +1,9 @@
-"""Mount files: ``mounts/*.toml`` in datasheet units (c in N/mm, d in N·s/mm, m in kg).
+"""Mount files (``mounts/*.toml``, datasheet units) into a
+:class:`~powertrain.models.mount.MountModel` in SI, and back (:func:`write_mount`).
 
-Layout::
-
-    [mount]
-    name = "Hydraulic engine mount, X direction"
-    model = "triple-parallel"          # a preset of powertrain.models.mount.TOPOLOGIES
-    source = "Kovarik 2016, Fig. 37"   # optional
-    notes = "..."                      # optional
-
-    [units]                            # every quantity declares its unit
-    c = "N/mm"
-    d = "N*s/mm"
-    m = "kg"
-
-    [parameters]
-    c1 = 0.0
-    d1 = 0.0
-    ...
-
-    [amplitude]                        # optional: equivalent-linear amplitude law
-    law = "power"                      # factor clip((reference / A)^exponent, limits)
-    reference = 0.1                    # x units
-    exponent = 0.15
-    limits = [0.2, 5.0]                # optional, default [0.2, 5.0]
-    # law = "table": amplitudes = [...] (x units, increasing), stiffness_scale = [...],
-    # damping_scale = [...] (optional, default stiffness_scale)
-
-    [friction]                         # optional: Berg's friction element
-    max_force = 40.0                   # F units, >= 0
-    half_displacement = 0.05           # x units, > 0
-
-    [static]                           # optional: static force-deflection curve
-    deflection = [-4.0, 0.0, 4.0]      # x units, increasing
-    force = [-1100.0, 0.0, 1200.0]     # F units, increasing
-    reference_deflection = 1.5         # x units, optional, default 0
-
-``[units]`` gains ``x`` (length: displacements, amplitudes) and ``F`` (force), needed only by
-the sections that use them. Values are converted to SI once, here, into
-:mod:`powertrain.physics.mount_laws` objects. Missing or negative parameters, NaN, unknown
-units or models, unknown keys and laws that break their rules (scales <= 0, amplitudes not
-increasing, limits not around 1, a static curve that is not increasing...) raise
-:class:`powertrain.errors.InputError` naming file and key.
+Layout, the optional ``[amplitude]``, ``[friction]`` and ``[static]`` sections and the checks:
+docs/reference/mount-file.md. The sections become :mod:`powertrain.physics.mount_laws`
+objects; every problem is an :class:`~powertrain.errors.InputError` naming file and key.
 """
 
 from __future__ import annotations

@@ -1,17 +1,8 @@
 """Test plans: several measured run-ups of one car (load cases) diagnosed together.
 
-A plan file (TOML) lists its runs; paths are relative to the plan file::
-
-    [[runs]]
-    file = "wot.csv"
-    load = 1.0              # IMEP scale of the combustion model; or traces = "wot-pressure.csv"
-    [[runs]]
-    file = "part.csv"
-    load = 0.4
-
-``load`` applies to engines with a combustion model (the single-zone model's fraction of
-full-load torque), ``traces`` (a pressure-trace CSV, :mod:`powertrain.iotools.pressure_csv`)
-to any engine; neither: the engine as it is.
+A plan file (TOML, docs/guide/diagnose.md) lists ``[[runs]]`` with ``file`` and either
+``load`` (IMEP scale of the combustion model) or ``traces`` (a pressure-trace CSV); paths are
+relative to the plan file; neither: the engine as it is.
 """
 
 from __future__ import annotations

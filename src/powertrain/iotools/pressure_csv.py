@@ -1,25 +1,9 @@
-"""Measured cylinder-pressure traces: a small CSV format with declared units.
+"""Measured cylinder-pressure traces (``[combustion] model = "measured"``): a CSV with units.
 
-Format::
-
-    # any number of comment lines starting with '#'
-    speed [rpm],cylinder,crank_angle [deg],pressure [bar]
-    2000,1,-180.0,1.013
-    2000,1,-179.5,1.013
-    ...
-
-* one header line naming the four columns in this order; ``speed``, ``crank_angle`` and
-  ``pressure`` declare their unit in brackets (any unit of :mod:`powertrain.units` of the
-  right dimension: rpm or rad/s; deg or rad; bar, kPa, MPa or Pa);
-* ``cylinder`` is the cylinder number 1..n;
-* ``crank_angle`` is that cylinder's own crank angle from its firing top dead centre; each
-  (speed, cylinder) trace covers one 720° cycle once, strictly increasing, with no gap
-  larger than :data:`MAX_GAP_DEG` (including the wrap-around), e.g. -360..359.5 or 0..719;
-* ``pressure`` is absolute;
-* every speed lists every cylinder.
-
-Traces are resampled onto a common grid of cycle angles on [-π, 3π) by periodic linear
-interpolation. Errors name the file, line and column.
+Format (``speed [rpm],cylinder,crank_angle [deg],pressure [bar]``, each trace one 720° cycle,
+gaps at most :data:`MAX_GAP_DEG`): docs/reference/csv-formats.md. Traces are resampled onto a
+common grid of cycle angles on [-π, 3π) by periodic linear interpolation. Errors name the
+file, line and column.
 """
 
 from __future__ import annotations
@@ -148,14 +132,3 @@ def _check_trace(a, ln, c, w, path) -> None:
                          f"{w * 60 / (2 * np.pi):.6g} rpm)", file=path,
                          line=int(ln[0]), key="crank_angle")
 
-
-def format_pressure_traces(speeds_rpm, theta, pressure) -> str:
-    """CSV text of traces: ``pressure[i_speed, i_cyl, k]`` [Pa] at angles ``theta`` [rad]
-    (written in rpm, deg, bar)."""
-    lines = ["# cylinder pressure traces (powertrain.iotools.pressure_csv)",
-             "speed [rpm],cylinder,crank_angle [deg],pressure [bar]"]
-    for i, n in enumerate(speeds_rpm):
-        for c in range(pressure.shape[1]):
-            for a, p in zip(theta, pressure[i, c]):
-                lines.append(f"{n:.6g},{c + 1},{math.degrees(a):.6g},{p / 1e5:.8g}")
-    return "\n".join(lines) + "\n"

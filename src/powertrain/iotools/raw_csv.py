@@ -1,19 +1,6 @@
-"""Wide CSV of raw run-up time data.
-
-Layout (comment lines start with ``#``; a ``SYNTHETIC`` comment is kept as a label)::
-
-    # SYNTHETIC: analytic sweep
-    time [s],rpm [1/min],tacho [V],left.z [m/s^2],left.passive.z [g]
-    0.0,1000.0,0.0,0.0012,0.00003
-    ...
-
-* ``time [s]`` (or ``[ms]``) first or anywhere; uniformly sampled, strictly increasing;
-* optional ``rpm [1/min]`` (speed), ``tacho [V]`` (pulse train) and ``cycle [V]`` (a
-  once-per-cycle pulse, cam or injection signal; another name with ``track
-  --cycle-reference NAME``);
-* every other column a channel ``MOUNT.DIRECTION [UNIT]`` or ``MOUNT.SIDE.DIRECTION [UNIT]``
-  (or any name listed in a channel map).
-"""
+"""Wide CSV of raw run-up time data: a ``time [s]`` column, optional ``rpm``, ``tacho`` and
+``cycle`` columns, one column per channel ``MOUNT[.SIDE].DIRECTION [UNIT]``
+(docs/reference/raw-data.md); ``#`` comment lines are kept (a SYNTHETIC label)."""
 
 from __future__ import annotations
 
@@ -23,14 +10,14 @@ import numpy as np
 
 from powertrain.errors import InputError
 from powertrain.iotools.channel_map import split_unit
-from powertrain.iotools.raw_signals import FileSignals
+from powertrain.iotools.raw_signals import FileSignals, written_signals
 from powertrain.iotools.textfile import read_text
 from powertrain.outputs import atomic_write
-from powertrain.units import from_si, to_si
+from powertrain.units import to_si
 
 
 def read_csv_signals(path, channel_map=None) -> FileSignals:
-    """Signals of a wide CSV file (see module docstring)."""
+    """Signals of a wide CSV file (docs/reference/raw-data.md)."""
     text = read_text(path, "CSV")
     comments, header, start = [], None, 0
     lines = text.splitlines()
@@ -93,22 +80,12 @@ def _numbers(lines, start, n_cols, path):
 
 def write_raw_csv(path, recording, *, comment: str = "") -> None:
     """Write a :class:`RawRecording` as a wide CSV in its channels' file units."""
-    cols, names = [recording.time], ["time [s]"]
-    if recording.rpm is not None:
-        cols.append(recording.rpm)
-        names.append("rpm [1/min]")
-    if recording.tacho is not None:
-        cols.append(recording.tacho)
-        names.append("tacho [V]")
-    if recording.cycle_reference is not None:
-        cols.append(recording.cycle_reference)
-        names.append("cycle [V]")
-    for ch in recording.channels:
-        dim = "length" if ch.quantity == "displacement" else ch.quantity
-        cols.append(from_si(ch.values, ch.unit, dim))
-        names.append(f"{ch.label} [{ch.unit}]")
+    signals = written_signals(recording)
+    names = ["time [s]"] + [f"{name} [{'1/min' if name == 'rpm' else unit}]"
+                            for name, _, unit, _ in signals]
     with atomic_write(path) as fh:
         for line in (comment.splitlines() if comment else []):
             fh.write(f"# {line}\n")
         fh.write(",".join(names) + "\n")
-        np.savetxt(fh, np.column_stack(cols), delimiter=",", fmt="%.9g")
+        np.savetxt(fh, np.column_stack([recording.time] + [v for _, v, _, _ in signals]),
+                   delimiter=",", fmt="%.9g")

@@ -1,25 +1,8 @@
-"""Raw run-up time data in HDF5.
+"""Raw run-up time data in HDF5: the ``powertrain-raw`` layout :func:`write_raw_hdf5` writes,
+or any HDF5 file read with a channel map naming its datasets (docs/reference/raw-data.md).
 
-Layout written by :func:`write_raw_hdf5` (``powertrain runup --sweep --raw``)::
-
-    /                 attrs: format="powertrain-raw", format_version=1, powertrain_version,
-                             created, description, synthetic (bool), comments (JSON list)
-    /time             (n,)  attrs unit="s"
-    /rpm              (n,)  attrs unit="rpm"         (optional)
-    /tacho            (n,)  attrs unit="V"           (optional)
-    /cycle            (n,)  attrs unit="V"           (optional: once-per-cycle reference)
-    /channels/<name>  (n,)  attrs unit (the values' unit, e.g. "m/s^2" or "g"), mount, side,
-                            direction, quantity; <name> = MOUNT.DIRECTION or
-                            MOUNT.SIDE.DIRECTION
-
-Any other HDF5 file is read with a channel map: its keys are dataset paths (``time``,
-``rpm`` and ``tacho`` name the datasets holding those; a dataset's ``unit`` attribute is
-used unless the map gives one).
-
-In both layouts the speed (or tacho) dataset may have its own time base, e.g. CAN engine
-speed at 100 Hz: its attribute ``time`` names the dataset of its sample times (with a
-``unit`` attribute, default s), and it is resampled onto ``/time``
-(:func:`powertrain.iotools.raw.assemble`).
+A speed or tacho dataset may have its own time base (its attribute ``time`` names the dataset
+of its sample times); it is resampled onto ``/time`` (:func:`powertrain.iotools.raw.assemble`).
 """
 
 from __future__ import annotations
@@ -29,10 +12,10 @@ import json
 import numpy as np
 
 from powertrain.errors import InputError
-from powertrain.iotools.raw_signals import FileSignals
+from powertrain.iotools.raw_signals import FileSignals, written_signals
 from powertrain.outputs import atomic_path
 from powertrain.provenance import stamp_hdf5
-from powertrain.units import from_si, to_si
+from powertrain.units import to_si
 
 FORMAT = "powertrain-raw"
 
@@ -48,7 +31,7 @@ def _unit(ds):
 
 
 def read_hdf5_signals(path, channel_map=None) -> FileSignals:
-    """Signals of a raw HDF5 file (see module docstring)."""
+    """Signals of a raw HDF5 file (docs/reference/raw-data.md)."""
     import h5py  # deferred: heavy package, loaded only when this format is used
     try:
         h5 = h5py.File(path, "r")
@@ -184,7 +167,8 @@ def _read_mapped(h5, path, cmap):
 
 
 def write_raw_hdf5(path, recording, *, description: str = "", synthetic: bool = False) -> None:
-    """Write a :class:`RawRecording` in the layout above (values in each channel's unit)."""
+    """Write a :class:`RawRecording` in the ``powertrain-raw`` layout (docs/reference/raw-data.md;
+    values in each channel's unit)."""
     import h5py  # deferred: heavy package, loaded only when this format is used
 
     with atomic_path(path) as tmp:
@@ -195,15 +179,9 @@ def write_raw_hdf5(path, recording, *, description: str = "", synthetic: bool = 
             a["synthetic"] = bool(synthetic or recording.synthetic)
             a["comments"] = json.dumps(list(recording.comments))
             h5.create_dataset("time", data=recording.time).attrs["unit"] = "s"
-            if recording.rpm is not None:
-                h5.create_dataset("rpm", data=recording.rpm).attrs["unit"] = "rpm"
-            for name, pulses in (("tacho", recording.tacho),
-                                 ("cycle", recording.cycle_reference)):
-                if pulses is not None:
-                    h5.create_dataset(name, data=pulses).attrs["unit"] = "V"
             g = h5.create_group("channels", track_order=True)
-            for ch in recording.channels:
-                dim = "length" if ch.quantity == "displacement" else ch.quantity
-                ds = g.create_dataset(ch.label, data=from_si(ch.values, ch.unit, dim))
-                for k in ("unit", "mount", "side", "direction", "quantity"):
+            for name, values, unit, ch in written_signals(recording):
+                ds = (h5 if ch is None else g).create_dataset(name, data=values)
+                ds.attrs["unit"] = unit
+                for k in ("mount", "side", "direction", "quantity") if ch else ():
                     ds.attrs[k] = getattr(ch, k)

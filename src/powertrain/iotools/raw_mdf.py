@@ -17,9 +17,8 @@ import warnings
 import numpy as np
 
 from powertrain.errors import InputError
-from powertrain.iotools.raw_signals import FileSignals
+from powertrain.iotools.raw_signals import FileSignals, written_signals
 from powertrain.outputs import atomic_path
-from powertrain.units import from_si
 
 
 def read_mdf_signals(path, channel_map=None) -> FileSignals:
@@ -111,15 +110,8 @@ def write_raw_mdf(path, recording) -> None:
     from asammdf import MDF, Signal  # deferred: heavy package, loaded only when this format is used
 
     t = np.asarray(recording.time, float)
-    sigs = []
-    if recording.rpm is not None:
-        sigs.append(Signal(recording.rpm, t, name="rpm", unit="rpm"))
-    if recording.tacho is not None:
-        sigs.append(Signal(recording.tacho, t, name="tacho", unit="V"))
-    for ch in recording.channels:
-        dim = "length" if ch.quantity == "displacement" else ch.quantity
-        sigs.append(Signal(np.asarray(from_si(ch.values, ch.unit, dim), float), t,
-                           name=ch.label, unit=ch.unit))
+    sigs = [Signal(np.asarray(values, float), t, name=name, unit=unit)
+            for name, values, unit, _ in written_signals(recording, cycle=False)]
     mdf = MDF(version="4.10")
     mdf.append(sigs, comment=recording.source or "powertrain")
     with atomic_path(path) as tmp:

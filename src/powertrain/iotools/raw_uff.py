@@ -1,13 +1,10 @@
 """Raw run-up time data in the universal file format, dataset 58 (read and written by pyuff).
 
-Each dataset 58 holds one channel: its name is ID line 1 (``id1``), its unit the ordinate
-units label, its time base the even abscissa (``abscissa_min``, ``abscissa_inc``) or the
-abscissa values. All channels must share one time base. A truncated file is refused: it must
-end with the ``-1`` delimiter, every dataset started must be complete, and the datasets this
-module writes are numbered (ID line 4 ``powertrain dataset K of N``) so that a file cut at a
-dataset boundary is found too. Names follow the
-``MOUNT.DIRECTION`` convention or a channel map; ``rpm`` and ``tacho`` name the speed and
-tacho channels unless the map (or ``--rpm/--tacho``) says otherwise.
+One dataset 58 per channel: name = ID line 1, unit = the ordinate units label; all channels
+share one time base (docs/reference/raw-data.md). A truncated file is refused: it must end
+with the ``-1`` delimiter, every dataset started must be complete, and the datasets written
+here are numbered (ID line 4 ``powertrain dataset K of N``) so that a file cut at a dataset
+boundary is found too.
 """
 
 from __future__ import annotations
@@ -20,9 +17,8 @@ import warnings
 import numpy as np
 
 from powertrain.errors import InputError
-from powertrain.iotools.raw_signals import FileSignals
+from powertrain.iotools.raw_signals import FileSignals, written_signals
 from powertrain.outputs import atomic_path
-from powertrain.units import from_si
 
 #: UFF specific data types (record 8/9 field 1) of the ordinate, by our quantity.
 SPECIFIC_DATA_TYPE = {"displacement": 8, "force": 13, "velocity": 11, "acceleration": 12,
@@ -105,26 +101,18 @@ def _check_count(path, sets) -> None:
 
 def write_raw_uff(path, recording) -> None:
     """Write a :class:`RawRecording` as datasets 58 (binary, double precision)."""
-
     import pyuff  # deferred: heavy package, loaded only when this format is used
 
-    rows = []
-    if recording.rpm is not None:
-        rows.append(("rpm", recording.rpm, "rpm", "rpm"))
-    if recording.tacho is not None:
-        rows.append(("tacho", recording.tacho, "V", "tacho"))
-    for ch in recording.channels:
-        dim = "length" if ch.quantity == "displacement" else ch.quantity
-        rows.append((ch.label, from_si(ch.values, ch.unit, dim), ch.unit, ch.quantity))
+    rows = written_signals(recording, cycle=False)
     sets = []
-    for node, (name, values, unit, kind) in enumerate(rows, start=1):
+    for node, (name, values, unit, ch) in enumerate(rows, start=1):
         sets.append(pyuff.prepare_58(
             binary=1, id1=name, id2=recording.source or "powertrain",
             id4=f"powertrain dataset {node} of {len(rows)}", func_type=1,
             rsp_node=node, rsp_dir=0, ref_node=0, ref_dir=0, data=np.asarray(values, float),
             x=recording.time, abscissa_spec_data_type=17, abscissa_axis_units_lab="s",
-            ordinate_spec_data_type=SPECIFIC_DATA_TYPE[kind], ordinate_axis_units_lab=unit,
-            orddenom_spec_data_type=0, z_axis_spec_data_type=0))
+            ordinate_spec_data_type=SPECIFIC_DATA_TYPE[ch.quantity if ch else name],
+            ordinate_axis_units_lab=unit, orddenom_spec_data_type=0, z_axis_spec_data_type=0))
     with atomic_path(path) as tmp:
         os.unlink(tmp)               # pyuff appends to an existing file
         with warnings.catch_warnings():

@@ -1,24 +1,16 @@
 r"""Measured body receptances for ``[chassis] model = "frf"``: CSV or UFF 58.
 
-CSV (comments with ``#``)::
-
-    frequency_hz,response,excitation,receptance_real_m_per_n,receptance_imag_m_per_n
-    10,left.z,left.z,-1.2e-7,-3.0e-9
-    ...
-
-``response`` and ``excitation`` are ``NAME.DIR``: NAME a mount (its body-side attachment
-point) or a body point of interest, DIR ``x``, ``y`` or ``z`` in engine axes. Needed: every
-pair of attachment-point directions (reciprocity fills H_ab from H_ba) and, for each body
-point, its response to every attachment-point direction; every pair on the same frequency
-grid (strictly increasing, covering the run-up's order frequencies).
-
-UFF 58 (read with pyuff): one frequency response function (function type 4) per pair,
-receptance (ordinate displacement over force) in m/N; the point is named by the record's
-response/reference entity name (``rsp_ent_name``/``ref_ent_name`` = NAME), directions 1/2/3 =
-x/y/z in engine axes (negative = reversed).
+CSV columns ``frequency_hz,response,excitation,receptance_real_m_per_n,
+receptance_imag_m_per_n`` with ``response``/``excitation`` = ``NAME.DIR`` (a mount's body-side
+point or a body point); UFF 58: one receptance FRF (function type 4, m/N) per pair, the point
+named by ``rsp_ent_name``/``ref_ent_name``, directions 1/2/3 = x/y/z (negative = reversed).
+Needed: every pair of attachment-point directions (reciprocity fills H_ab from H_ba) and each
+body point's response to them, on one frequency grid (docs/guide/chassis.md).
 """
 
 from __future__ import annotations
+
+from itertools import product
 
 import numpy as np
 
@@ -164,19 +156,11 @@ def _uff_record(s, names, path, key):
 
 
 def _check_coverage(values, mounts, points, path):
-    def have(a, ad, b, bd):
-        return (a, ad, b, bd) in values or (b, bd, a, ad) in values
-    for a in mounts:
-        for b in mounts:
-            for ad in "xyz":
-                for bd in "xyz":
-                    if not have(a, ad, b, bd):
-                        raise InputError(f"missing receptance {a}.{ad} / {b}.{bd}",
-                                         file=path, key="response")
-    for p in points:
-        for b in mounts:
-            for pd in "xyz":
-                for bd in "xyz":
-                    if (p, pd, b, bd) not in values:
-                        raise InputError(f"missing receptance {p}.{pd} / {b}.{bd}",
-                                         file=path, key="response")
+    for a, b, ad, bd in product(mounts, mounts, "xyz", "xyz"):
+        if (a, ad, b, bd) not in values and (b, bd, a, ad) not in values:
+            raise InputError(f"missing receptance {a}.{ad} / {b}.{bd}", file=path,
+                             key="response")
+    for p, b, pd, bd in product(points, mounts, "xyz", "xyz"):
+        if (p, pd, b, bd) not in values:
+            raise InputError(f"missing receptance {p}.{pd} / {b}.{bd}", file=path,
+                             key="response")

@@ -1,31 +1,9 @@
-"""Measured dynamic stiffness tables: CSV in datasheet units, converted to SI here.
+"""Measured dynamic stiffness tables K*(f) (``fit-mount`` input): CSV in datasheet units.
 
-Format (comma-separated, one header line, ``#`` comment lines and blank lines ignored,
-extra columns ignored)::
-
-    frequency_hz,k_real_n_per_mm,k_imag_n_per_mm
-    1,241.7,13.2
-    ...
-
-or, instead of the real and imaginary parts, magnitude and phase (loss angle)::
-
-    frequency_hz,k_abs_n_per_mm,phase_deg
-
-``frequency_hz`` [Hz] must be finite, non-negative and strictly increasing; stiffness in
-N/mm, phase in degrees. When both pairs are present the real/imaginary pair is used. The
-output of ``powertrain stiffness --format csv`` is a valid input.
-
-Multi-amplitude data (a supplier's K*(f) at several test amplitudes, Kovarik 2016 Fig. 14;
-``powertrain stiffness --amplitude`` writes it) add a column ``amplitude_mm``, the
-displacement amplitude of the test [mm] (> 0): the rows of one amplitude form one block, its
-frequencies strictly increasing, each amplitude one block::
-
-    amplitude_mm,frequency_hz,k_real_n_per_mm,k_imag_n_per_mm
-    0.05,1,262.1,28.3
-    ...
-    0.5,1,171.0,30.2
- Every problem raises
-:class:`powertrain.errors.InputError` naming the file, the column and (for values) the line.
+Columns ``frequency_hz`` and ``k_real_n_per_mm,k_imag_n_per_mm`` or ``k_abs_n_per_mm,
+phase_deg``, optionally ``amplitude_mm`` first (one block of rows per test amplitude, Kovarik
+2016 Fig. 14): docs/reference/csv-formats.md. Converted to SI here; every problem is an
+:class:`~powertrain.errors.InputError` naming the file, the column and (for values) the line.
 """
 
 from __future__ import annotations
@@ -115,7 +93,7 @@ def _open_rows(path):
 
 
 def read_stiffness_csv(path) -> MeasuredStiffness:
-    """Read a measured K*(f) table (see the module docstring) into SI.
+    """Read a measured K*(f) table (docs/reference/csv-formats.md) into SI.
 
     Parameters
     ----------

@@ -1,12 +1,7 @@
-"""The steps a study may include, each a table of the study file (``[compare]``,
-``[diagnose]``, ``[whatif]``, ``[modes]``, ``[transient]``) run through the library's own function
-(:func:`powertrain.compare` ...), and shown as a section of the report.
-
-A :class:`Step` says how to check its table, run it, draw its figures, show its result in
-HTML and repeat it on the command line. A kind of step is one entry in :data:`STEPS`: a
-checker of its keys, a function calling the library, its figures, its result's
-``_repr_html_`` tables and its command line; the study reader, the summary and the document
-take every entry as it is. ``[transient]`` runs manoeuvre files (:func:`powertrain.transient`).
+"""The steps a study may include (``[compare]``, ``[diagnose]``, ``[whatif]``, ``[modes]``,
+``[transient]``), each run through the library's own function and shown as a section of the
+report. A kind of step is one :class:`Step` entry in :data:`STEPS`; the study reader, the
+summary and the document take every entry as it is.
 """
 
 from __future__ import annotations
@@ -79,6 +74,11 @@ def shown(path) -> str:
     return rel if not rel.startswith("..") else os.path.abspath(path)
 
 
+def _own_plot(caption: str) -> Callable:
+    """``figures`` of a step whose one figure is its result's own ``plot``."""
+    return lambda result, provenance: [(caption, lambda: result.plot(provenance=provenance))]
+
+
 def _line(words) -> str:
     return shlex.join(str(w) for w in words)
 
@@ -103,12 +103,6 @@ def _compare_run(study, opts, progress) -> list:
     return [(label, compare(measured, engine=engine, noise_floor=study.noise_floor,
                             progress=progress, **opts))
             for label, measured, engine, _ in study.runs()]
-
-
-def _compare_figures(result, provenance) -> list:
-    return [("Measured (black) against simulated (blue) order curves per channel, the gap "
-             "shaded; over each panel its RMS gap and bias.",
-             lambda: result.plot(provenance=provenance))]
 
 
 def _compare_commands(study, opts) -> list:
@@ -207,12 +201,6 @@ def _whatif_run(study, opts, progress) -> list:
                         rpm_step=opts["rpm"][2]))]
 
 
-def _whatif_figures(result, provenance) -> list:
-    return [("Levels of the baseline (black), the variants and the measurement (grey), every "
-             "channel (the table gives every change in dB).",
-             lambda: result.plot(provenance=provenance))]
-
-
 def _whatif_commands(study, opts) -> list:
     words = ["powertrain", "whatif", *_engine_words(study)]
     for op in WHATIF_OPERATIONS:
@@ -247,11 +235,6 @@ def _modes_run(study, opts, progress) -> list:
     return [("", modes(study.engine, **opts))]
 
 
-def _modes_figures(result, provenance) -> list:
-    return [("Kinetic-energy distribution of each mode over the six coordinates.",
-             lambda: result.plot(provenance=provenance))]
-
-
 def _modes_commands(study, opts) -> list:
     return [_line(["powertrain", "modes", *_engine_words(study),
                    *(["--static"] if opts["static"] else [])])]
@@ -272,11 +255,6 @@ def _transient_run(study, opts, progress) -> list:
     return [(r.name, r) for r in results]
 
 
-def _transient_figures(result, provenance) -> list:
-    return [("Crank speed and torque over the manoeuvre above the seat's (else the mounts') "
-             "accelerations, peaks marked.", lambda: result.plot(provenance=provenance))]
-
-
 def _transient_commands(study, opts) -> list:
     seat = ["--seat", opts["seat"]] if opts["seat"] else []
     return [_line(["powertrain", "transient", shown(f), *_engine_words(study), *seat])
@@ -286,16 +264,22 @@ def _transient_commands(study, opts) -> list:
 #: The steps a study may include, in the order of the report's sections.
 STEPS = {
     "compare": Step("Compare: simulated against measured", _compare_options, _compare_run,
-                    _compare_figures, comparison_html, _compare_commands,
-                    needs_measured=True, cost=2),
+                    _own_plot("Measured (black) against simulated (blue) order curves per "
+                              "channel, the gap shaded; over each panel its RMS gap and bias."),
+                    comparison_html, _compare_commands, needs_measured=True, cost=2),
     "diagnose": Step("Diagnose: where the gap lies, which effect explains it, how far it "
                      "shrinks", _diagnose_options, _diagnose_run, _diagnose_figures,
                      diagnosis_html, _diagnose_commands, needs_measured=True, cost=3),
     "whatif": Step("What if: mount retuning variants", _whatif_options, _whatif_run,
-                   _whatif_figures, whatif_html, _whatif_commands, cost=1),
-    "modes": Step("Rigid-body modes", _modes_options, _modes_run, _modes_figures, modes_html,
-                  _modes_commands, cost=0),
+                   _own_plot("Levels of the baseline (black), the variants and the measurement "
+                             "(grey), every channel (the table gives every change in dB)."),
+                   whatif_html, _whatif_commands, cost=1),
+    "modes": Step("Rigid-body modes", _modes_options, _modes_run,
+                  _own_plot("Kinetic-energy distribution of each mode over the six "
+                            "coordinates."), modes_html, _modes_commands, cost=0),
     "transient": Step("Transient manoeuvres: starts, stops, tip-ins", _transient_options,
-                      _transient_run, _transient_figures, transient_html,
-                      _transient_commands, cost=1),
+                      _transient_run,
+                      _own_plot("Crank speed and torque over the manoeuvre above the seat's "
+                                "(else the mounts') accelerations, peaks marked."),
+                      transient_html, _transient_commands, cost=1),
 }

@@ -1,20 +1,8 @@
-"""Reading a study file (TOML; every key in docs/reference/study-file.md)::
-
-    title = "Default engine against the SYNTHETIC measured run-up"
-    engine = "../engines/default.toml"      # default: the shipped engines/default.toml
-    measured = "measured-runup.csv"         # or plan = "plan.toml" (several load cases)
-    noise_floor = {value = 0.001, unit = "mm/s"}
-    [compare]
-    solver = "harmonic"
-    [diagnose]
-    effects = ["mount_stiffness", "base_compliance"]
-    [whatif]
-    variants = "whatif-variants.toml"
-    [modes]
-
-Paths are relative to the study file, as in a plan. A step is included when its table is
-there (an empty table: its defaults). Everything is checked, and every file read, before
-any step runs; a bad study file is one line naming it and the key.
+"""Reading a study file (TOML; every key in docs/reference/study-file.md): the engine, the
+measured run-up or a plan, the noise floor and one table per step. Paths are relative to the
+study file, as in a plan. A step is included when its table is there (an empty table: its
+defaults). Everything is checked, and every file read, before any step runs; a bad study file
+is one line naming it and the key.
 """
 
 from __future__ import annotations

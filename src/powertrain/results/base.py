@@ -7,6 +7,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from powertrain.errors import InputError
+from powertrain.outputs import json_text
 from powertrain.plotting.style import close_figure
 
 #: Suffixes of an HDF5 file.
@@ -42,3 +43,19 @@ class Result:
     def save_figure(self, path) -> None:
         """The figure of ``plot()`` as a PNG at ``path`` (the figure is closed after)."""
         close_figure(self.plot(path=path))
+
+
+class JsonResult(Result):
+    """A result with a JSON document (its ``to_dict()``): :meth:`to_json`, and ``.json``
+    among its :meth:`writers`."""
+
+    #: Indentation of the JSON text (:func:`powertrain.outputs.json_text`).
+    JSON_INDENT = 1
+
+    def to_json(self, path=None) -> str:
+        """JSON text of ``to_dict()``; written atomically to ``path`` if given."""
+        return json_text(self.to_dict(), path, indent=self.JSON_INDENT)
+
+    def writers(self) -> dict:
+        """``.json`` (:meth:`to_json`), ``.png``."""
+        return {".json": self.to_json, **super().writers()}

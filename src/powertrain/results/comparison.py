@@ -13,10 +13,10 @@ import numpy as np
 from powertrain.analysis import compare as cm
 from powertrain.analysis.noise_floor import NOISE_FLOOR_MARGIN, censoring_level
 from powertrain.analysis.orders import quantity_sort_key
-from powertrain.outputs import json_text
+from powertrain.analysis.text_table import format_table
 from powertrain.plotting import plot_comparison
 from powertrain.plotting.style import target_and_path
-from powertrain.results.base import Result
+from powertrain.results.base import JsonResult
 from powertrain.results.html import fragment
 from powertrain.results.html_tables import comparison_html
 
@@ -120,15 +120,6 @@ class ChannelComparison:
         return d
 
 
-def _format_table(header, rows) -> str:
-    cells = [[str(v) for v in row] for row in rows]
-    widths = [max([len(h)] + [len(r[i]) for r in cells]) for i, h in enumerate(header)]
-    lines = ["  ".join(h.rjust(w) for h, w in zip(header, widths)),
-             "  ".join("-" * w for w in widths)]
-    lines += ["  ".join(c.rjust(w) for c, w in zip(r, widths)) for r in cells]
-    return "\n".join(lines)
-
-
 def json_number(x):
     """``float(x)``, or None if not finite (JSON has no NaN)."""
     x = float(x)
@@ -136,7 +127,7 @@ def json_number(x):
 
 
 @dataclass(frozen=True)
-class ComparisonResult(Result):
+class ComparisonResult(JsonResult):
     """Outcome of :func:`compare_runup`: per-channel gaps and metrics, per-speed CSAC/CSF.
 
     Attributes
@@ -255,12 +246,10 @@ class ComparisonResult(Result):
                 "quantities": sorted({c.quantity for c in self.channels},
                                      key=quantity_sort_key),
                 "n_points_measured": int(n_total),
-                "n_points_compared": int(sum(c.scored.sum() for c in self.channels)),
-                "n_points_excluded_noise_floor": int(sum(c.at_floor.sum()
-                                                         for c in self.channels)),
-                "n_points_outside_simulated_range": int(sum(c.outside.sum()
-                                                            for c in self.channels)),
-                "n_points_simulation_zero": int(sum(c.sim_zero.sum() for c in self.channels)),
+                **{f"n_points_{key}": int(sum(getattr(c, flag).sum() for c in self.channels))
+                   for key, flag in (("compared", "scored"), ("excluded_noise_floor", "at_floor"),
+                                     ("outside_simulated_range", "outside"),
+                                     ("simulation_zero", "sim_zero"))},
                 "n_points_measured_not_modelled": self.n_not_modelled,
                 "n_points_interpolated": self.n_interpolated,
             },
@@ -271,14 +260,6 @@ class ComparisonResult(Result):
             "per_rpm": list(self.per_rpm),
             "definitions": dict(DEFINITIONS),
         }
-
-    def to_json(self, path=None) -> str:
-        """JSON text of :meth:`to_dict`; written atomically to ``path`` if given."""
-        return json_text(self.to_dict(), path)
-
-    def writers(self) -> dict:
-        """``.json`` (:meth:`to_json`), ``.png``."""
-        return {".json": self.to_json, **super().writers()}
 
     def worst_first(self) -> list:
         """The compared channels and quantities (:class:`ChannelComparison`) sorted by RMS
@@ -296,7 +277,7 @@ class ComparisonResult(Result):
                          f"{s['rms_db']:.2f}", f"{s['bias_db']:+.2f}", f"{s['max_abs_db']:.2f}",
                          f"{s['rpm_at_max_abs_db']:g}", f"{s['frac']:.3f}",
                          f"{s['frfsm']:.3f}", int(c.at_floor.sum()), int(c.outside.sum())])
-        return _format_table(header, rows)
+        return format_table(header, rows)
 
     def summary(self) -> str:
         """The one-line result (``compare --quiet`` prints only this)."""
@@ -354,7 +335,7 @@ class ComparisonResult(Result):
                 for c in phased]
         return ["", "phase where given on both sides (gap = sim - measured, wrapped to ±180°; "
                 "complex gap = least-squares complex ratio sim/measured):",
-                _format_table(["mount", "dir", "quantity", "n", "rms °", "bias °",
+                format_table(["mount", "dir", "quantity", "n", "rms °", "bias °",
                                "complex dB", "complex °"], rows)]
 
     def _not_modelled_lines(self) -> list:

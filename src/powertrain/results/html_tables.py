@@ -44,14 +44,13 @@ def comparison_html(r) -> str:
 
 
 def _quantity_row(pq) -> list:
+    head = [pq["quantity"], number(pq["rms_db"]), number(pq["bias_db"], "+.2f")]
     if not pq["n_rpm_with_csac"]:
-        return [pq["quantity"], number(pq["rms_db"]), number(pq["bias_db"], "+.2f"),
-                "-", "-", "-", "-"]
-    return [pq["quantity"], number(pq["rms_db"]), number(pq["bias_db"], "+.2f"),
-            number(pq["csac_mean"], ".3f"),
-            f"{number(pq['csac_min'], '.3f')} at {pq['rpm_at_csac_min']:g} rpm",
-            number(pq["csf_mean"], ".3f"),
-            f"{number(pq['csf_min'], '.3f')} at {pq['rpm_at_csf_min']:g} rpm"]
+        return head + ["-"] * 4
+    return head + [number(pq["csac_mean"], ".3f"),
+                   f"{number(pq['csac_min'], '.3f')} at {pq['rpm_at_csac_min']:g} rpm",
+                   number(pq["csf_mean"], ".3f"),
+                   f"{number(pq['csf_min'], '.3f')} at {pq['rpm_at_csf_min']:g} rpm"]
 
 
 def _phase_table(r) -> list:

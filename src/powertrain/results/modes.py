@@ -8,10 +8,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from powertrain.outputs import json_text
 from powertrain.plotting.body import plot_modes
 from powertrain.plotting.style import target_and_path
-from powertrain.results.base import Result
+from powertrain.results.base import JsonResult
 from powertrain.results.html import fragment
 from powertrain.results.html_tables import modes_html
 from powertrain.solvers.modes import AS_MEASURED, COORDINATES, number_or_null
@@ -84,7 +83,7 @@ class Mode:
 
 
 @dataclass(frozen=True)
-class ModesResult(Result):
+class ModesResult(JsonResult):
     """Modes sorted by frequency, the torque-roll axis and the method used.
 
     Attributes
@@ -108,6 +107,8 @@ class ModesResult(Result):
     cg_m: list | None = None
     mounts: list | None = None
 
+    JSON_INDENT = 2
+
     @classmethod
     def from_solution(cls, solution: dict, engine: str = "", *, cg_m=None,
                       mounts=None) -> ModesResult:
@@ -126,17 +127,9 @@ class ModesResult(Result):
                 "torque_roll_axis": self.torque_roll_axis, "method": self.method,
                 "engine": self.engine, **extra}
 
-    def to_json(self, path=None) -> str:
-        """JSON text of :meth:`to_dict`; written atomically to ``path`` if given."""
-        return json_text(self.to_dict(), path, indent=2)
-
     def write_json(self, path) -> None:
         """Write :meth:`to_json` to ``path`` atomically."""
         self.to_json(path)
-
-    def writers(self) -> dict:
-        """``.json`` (:meth:`to_json`), ``.png``."""
-        return {".json": self.to_json, **super().writers()}
 
     def is_static(self) -> bool:
         """True for the undamped static-stiffness modes (``--static``)."""

@@ -1,50 +1,10 @@
 """Run-up results: order spectra of the mount channels (three per mount) against speed.
 
-HDF5 layout (all arrays SI, units in each dataset's ``unit`` attribute)::
-
-    /                      attrs: format="powertrain-runup", format_version, powertrain_version,
-                                  created (UTC ISO 8601), solver settings (JSON), engine name,
-                                  engine_snapshot (the engine file text), mount_snapshots (JSON
-                                  {path: text}), synthetic (bool), description
-    /rpm                   (n_rpm,)                       rpm
-    /orders                (n_orders,)                    1 (orders 0.5 ... 8)
-    /channels/mount        (n_ch,) str                    mount names (left/right/gearbox ...)
-    /channels/direction    (n_ch,) str                    x/y/z (engine axes)
-    /velocity/amplitude    (n_rpm, n_ch, n_orders) complex   m/s   (peak complex amplitude)
-    /velocity/order_rms    (n_rpm, n_ch, n_orders)           m/s
-    /velocity/synthesis_rms (n_rpm, n_ch)                  m/s   (RMS sum, orders <= 8)
-    /displacement/...      same, m
-    /acceleration/...      same, m/s^2
-    /mount_force/...       same, N (force transmitted to ground, engine axes)
-    /mount_force/mean      (n_rpm, n_ch)                   N (static preload part, no gravity)
-    /diagnostics/periodicity        (n_rpm,)              1 (cycle-to-cycle, Newmark)
-    /diagnostics/rigid_body_modes_hz (6,)                 Hz
-    /diagnostics/solver_seconds     ()                    s
-    /operating_point       the static operating point per speed (powertrain.solvers.
-                           operating_point), attrs gear_ratio:
-        mounts (n_m,) str; mean_torque (n_rpm,) N*m (mean brake torque);
-        body (n_rpm, 6) m, rad (displacement and rotation at the CG, engine axes);
-        deflection, force, tangent_stiffness (n_rpm, n_m, 3) m, N, N/m (local x, y, z);
-        static_factor (n_rpm, 3 n_m) 1; iterations (n_rpm,); residual (n_rpm, 2)
-        (force / weight, moment / (weight x 1 m))
-
-    /channels/side         (n_ch,) str                    active (engine side) / passive (body)
-    /channels/location     (n_ch,) str                    mount or body-point name
-    /path_contribution/velocity (n_rpm, 3 n_points, 3 n_mounts, n_orders) complex  m/s
-                           (with body points: velocity at each body-point channel carried
-                           by each path mount × local direction; /points, /paths name them)
-
 Channels: every mount's engine side (``left``), with a modal or measured chassis also its
-body side (``left/passive``) and the body points of interest (``seat_rail``).
-
-Long-format CSV (also the measured-data format): columns
-``mount,direction,quantity,rpm,side,velocity_rms_mm_per_s,acceleration_rms_m_per_s2,
-force_rms_n,phase_deg`` with ``quantity`` = ``order_0.5``, ``order_1``, ... ``order_8`` or
-``synthesis``, ``side`` = ``active`` or ``passive``; ``force_rms_n`` is the force the mount
-transmits to the body (empty for body points); ``phase_deg`` the velocity's order phase re
-cylinder-1 firing TDC (:mod:`powertrain.analysis.phase`; acceleration leads it by 90°), empty
-on synthesis rows and where the order is round-off. Files with only the first four columns
-and ``velocity_rms_mm_per_s`` stay valid input.
+body side (``left/passive``) and the body points of interest (``seat_rail``). Files: the HDF5
+layout (``runup --out``, all arrays SI with a ``unit`` attribute; docs/reference/outputs.md,
+the body-side datasets in docs/guide/chassis.md) and the long-format CSV (``runup --csv``,
+:data:`CSV_HEADER`; also the measured-data format, :mod:`powertrain.iotools.measured`).
 """
 
 from __future__ import annotations
@@ -299,30 +259,14 @@ class RunupResult(Result):
                     a["command_line"] = provenance.get("command_line", "")
                     a["engine_as_run"] = json.dumps(provenance.get("engine_as_run", {}),
                                                     allow_nan=False)
-                ds = h5.create_dataset("rpm", data=self.rpm)
-                ds.attrs["unit"] = "rpm"
-                ds = h5.create_dataset("orders", data=self.orders)
-                ds.attrs["unit"] = "1"
-                g = h5.create_group("channels")
-                g.create_dataset("mount", data=np.array([m for m, _ in self.channels], dtype="S"))
-                g.create_dataset("direction",
-                                 data=np.array([d for _, d in self.channels], dtype="S"))
-                g.attrs["axes"] = "engine coordinate system (Kovarik 2016, sec. 4.1)"
-                for name, unit in QUANTITIES.items():
-                    g = h5.create_group(name)
-                    arr = getattr(self, name)
-                    for key, data in (("amplitude", arr), ("order_rms", order_rms(arr)),
-                                      ("synthesis_rms", synthesis_rms(arr, axis=-1))):
-                        ds = g.create_dataset(key, data=data)
-                        ds.attrs["unit"] = unit
-                ds = h5["mount_force"].create_dataset("mean", data=self.mean_mount_force)
-                ds.attrs["unit"] = "N"
-                g = h5.create_group("diagnostics")
-                g.create_dataset("periodicity", data=self.periodicity).attrs["unit"] = "1"
-                g.create_dataset("rigid_body_modes_hz",
-                                 data=self.rigid_body_modes_hz).attrs["unit"] = "Hz"
-                g.create_dataset("solver_seconds", data=self.solver_seconds).attrs["unit"] = "s"
-                self._write_sides(h5)
+                for key, data, unit in self._datasets():
+                    h5.create_dataset(key, data=data).attrs["unit"] = unit
+                for key, names in self._names().items():
+                    h5.create_dataset(key, data=np.array(names, dtype="S"))
+                h5["channels"].attrs["axes"] = "engine coordinate system (Kovarik 2016, sec. 4.1)"
+                if self.path_contribution is not None:
+                    h5["path_contribution/velocity"].attrs["axes"] = \
+                        "rpm, point channel, path (mount x local direction), order"
                 if self.operating_point is not None:
                     write_operating_point(h5.create_group("operating_point"),
                                           self.operating_point)
@@ -348,22 +292,33 @@ class RunupResult(Result):
                                 effects=self.settings.get("effects"))
         return snapshot, mounts, description, provenance
 
-    def _write_sides(self, h5):
-        """/channels/side and /channels/location; /path_contribution with body points."""
-        g = h5["channels"]
-        g.create_dataset("side", data=np.array([self.side(m) for m, _ in self.channels],
-                                               dtype="S"))
-        g.create_dataset("location", data=np.array([split_side(m)[0] for m, _ in
-                                                    self.channels], dtype="S"))
+    def _datasets(self) -> list:
+        """``(path, array, unit)`` of every numeric dataset of the HDF5 layout but the
+        operating point's."""
+        out = [("rpm", self.rpm, "rpm"), ("orders", self.orders, "1")]
+        for name, unit in QUANTITIES.items():
+            arr = getattr(self, name)
+            out += [(f"{name}/amplitude", arr, unit), (f"{name}/order_rms", order_rms(arr), unit),
+                    (f"{name}/synthesis_rms", synthesis_rms(arr, axis=-1), unit)]
+        out += [("mount_force/mean", self.mean_mount_force, "N"),
+                ("diagnostics/periodicity", self.periodicity, "1"),
+                ("diagnostics/rigid_body_modes_hz", self.rigid_body_modes_hz, "Hz"),
+                ("diagnostics/solver_seconds", self.solver_seconds, "s")]
         if self.path_contribution is not None:
-            pg = h5.create_group("path_contribution")
-            ds = pg.create_dataset("velocity", data=self.path_contribution)
-            ds.attrs["unit"] = "m/s"
-            ds.attrs["axes"] = "rpm, point channel, path (mount x local direction), order"
-            pg.create_dataset("points", data=np.array(
-                [f"{p}.{d}" for p in self.points for d in "xyz"], dtype="S"))
-            pg.create_dataset("paths", data=np.array([f"{m}.{d}" for m, d in self.paths],
-                                                     dtype="S"))
+            out.append(("path_contribution/velocity", self.path_contribution, "m/s"))
+        return out
+
+    def _names(self) -> dict:
+        """Path -> names of the string datasets: the channels and, with body points, the
+        points and paths of the path contributions."""
+        out = {"channels/mount": [m for m, _ in self.channels],
+               "channels/direction": [d for _, d in self.channels],
+               "channels/side": [self.side(m) for m, _ in self.channels],
+               "channels/location": [split_side(m)[0] for m, _ in self.channels]}
+        if self.path_contribution is not None:
+            out["path_contribution/points"] = [f"{p}.{d}" for p in self.points for d in "xyz"]
+            out["path_contribution/paths"] = [f"{m}.{d}" for m, d in self.paths]
+        return out
 
     # ----------------------------------------------------------------- plots
     def plot_paths(self, ax=None, *, path=None, order=2.0, provenance=None):

@@ -1,21 +1,7 @@
 """The static operating point per speed (``powertrain static``): the result of
 :func:`powertrain.workflows.static.static` (the physics:
-:mod:`powertrain.solvers.operating_point`), with its text and JSON.
-
-JSON (full float precision, one entry per speed; lengths in mm, forces in N, stiffness in
-N/mm, angles in degrees)::
-
-    {"rpm": [...], "mean_torque_nm": [...], "gear_ratio": i,
-     "body": {"displacement_mm": [[x, y, z], ...], "rotation_deg": [[rx, ry, rz], ...]},
-     "mounts": {"NAME": {"deflection_mm": [[x, y, z], ...], "force_n": [...],
-                         "tangent_stiffness_n_per_mm": [...], "static_factor": [...]}}}
-
-Body displacement and rotation at the centre of gravity, engine axes; per mount its local
-directions x, y, z: deflection of the engine-side point relative to the base, the static
-curve's force there (the mount pushes the engine with minus it), its tangent stiffness and
-the network's static factor (tangent stiffness there over that at the curve's reference
-deflection; 1 without a curve).
-"""
+:mod:`powertrain.solvers.operating_point`), with its text and JSON (keys and units:
+docs/reference/json.md)."""
 
 from __future__ import annotations
 
@@ -24,15 +10,14 @@ from dataclasses import dataclass
 import numpy as np
 
 from powertrain.analysis.text_table import format_table
-from powertrain.outputs import json_text
 from powertrain.plotting.body import plot_static
 from powertrain.plotting.style import target_and_path
-from powertrain.results.base import Result
+from powertrain.results.base import JsonResult
 from powertrain.units import from_si
 
 
 @dataclass(frozen=True)
-class StaticResult(Result):
+class StaticResult(JsonResult):
     """Operating points (:class:`~powertrain.solvers.operating_point.OperatingPoint`, one
     per speed) of an engine's mounts ``mounts`` (names, in order); ``to_text()``,
     ``to_json()``, ``plot(ax=None)``, ``save(path)`` (``.json``, ``.png``)."""
@@ -50,7 +35,7 @@ class StaticResult(Result):
         return np.array([getattr(p, name) for p in self.points])
 
     def to_dict(self) -> dict:
-        """The JSON document (module docstring)."""
+        """The JSON document (docs/reference/json.md)."""
         body = self.stack("body")
         mounts = {}
         for m, name in enumerate(self.mounts):
@@ -66,14 +51,6 @@ class StaticResult(Result):
                 "body": {"displacement_mm": from_si(body[:, :3], "mm").tolist(),
                          "rotation_deg": np.rad2deg(body[:, 3:]).tolist()},
                 "mounts": mounts}
-
-    def to_json(self, path=None) -> str:
-        """JSON text of :meth:`to_dict`; written atomically to ``path`` if given."""
-        return json_text(self.to_dict(), path)
-
-    def writers(self) -> dict:
-        """``.json`` (:meth:`to_json`), ``.png``."""
-        return {".json": self.to_json, **super().writers()}
 
     def plot(self, ax=None, *, path=None, provenance=None):
         """The static deflection [mm] of every mount direction against speed, one panel;

@@ -14,8 +14,32 @@ from powertrain.plotting.style import target_and_path
 from powertrain.results.base import Result
 
 
+class _Columns(Result):
+    """A result of datasheet-unit columns (``columns()``) computed by ``method``."""
+
+    def to_csv(self, path=None) -> str:
+        """The CSV text (datasheet units, 10 significant digits); written atomically to
+        ``path`` when given."""
+        cols = self.columns()
+        rows = zip(*cols.values())
+        text = "\n".join([",".join(cols)] + [",".join(f"{v:.10g}" for v in r) for r in rows])
+        if path is not None:
+            write_csv(path, text + "\n")
+        return text + "\n"
+
+    def writers(self) -> dict:
+        """``.csv`` (:meth:`to_csv`), ``.png``."""
+        return {".csv": self.to_csv, **super().writers()}
+
+    def to_text(self) -> str:
+        """The table of every row (``powertrain stiffness``)."""
+        cols = self.columns()
+        rows = [[float(v) for v in r] for r in zip(*cols.values())]
+        return f"# method: {self.method}\n" + format_table(list(cols), rows) + "\n"
+
+
 @dataclass(frozen=True)
-class StiffnessResult(Result):
+class StiffnessResult(_Columns):
     """K*(f) of a mount model, plus x1 and F_T for the verification set-up.
 
     Attributes are SI; :meth:`columns` gives the datasheet-unit columns written out;
@@ -49,18 +73,6 @@ class StiffnessResult(Result):
             cols["ft_imag_n"] = self.ft.imag
         return cols
 
-    def to_csv(self, path=None) -> str:
-        """The CSV text (datasheet units); written atomically to ``path`` when given."""
-        return _csv(self.columns(), path)
-
-    def writers(self) -> dict:
-        """``.csv`` (:meth:`to_csv`), ``.png``."""
-        return {".csv": self.to_csv, **super().writers()}
-
-    def to_text(self) -> str:
-        """The table of every frequency (``powertrain stiffness``)."""
-        return _table(self.columns(), self.method)
-
     def summary(self) -> str:
         """What a plot reader checks first: |K*| range and the loss-angle peak, in N/mm, deg
         (``powertrain stiffness --plot`` without ``--format``)."""
@@ -92,27 +104,8 @@ def _ranges(cols) -> str:
             f"loss angle max {phi[top]:.3g} deg at {f[top]:g} Hz")
 
 
-def _csv(cols: dict, path=None) -> str:
-    """CSV text of equal-length columns (10 significant digits); written atomically to
-    ``path`` when given."""
-    n = len(next(iter(cols.values())))
-    lines = [",".join(cols)]
-    for i in range(n):
-        lines.append(",".join(f"{cols[c][i]:.10g}" for c in cols))
-    text = "\n".join(lines) + "\n"
-    if path is not None:
-        write_csv(path, text)
-    return text
-
-
-def _table(cols: dict, method: str) -> str:
-    n = len(next(iter(cols.values())))
-    rows = [[float(cols[c][i]) for c in cols] for i in range(n)]
-    return f"# method: {method}\n" + format_table(list(cols), rows) + "\n"
-
-
 @dataclass(frozen=True)
-class AmplitudeStiffnessResult(Result):
+class AmplitudeStiffnessResult(_Columns):
     """K*(f, X) of the sinusoidal displacement test at several amplitudes X (``powertrain
     stiffness --amplitude``): one :class:`StiffnessResult` per amplitude.
 
@@ -133,18 +126,6 @@ class AmplitudeStiffnessResult(Result):
         for name in per[0]:
             cols[name] = np.concatenate([p[name] for p in per])
         return cols
-
-    def to_csv(self, path=None) -> str:
-        """The CSV text (datasheet units); written atomically to ``path`` when given."""
-        return _csv(self.columns(), path)
-
-    def writers(self) -> dict:
-        """``.csv`` (:meth:`to_csv`), ``.png``."""
-        return {".csv": self.to_csv, **super().writers()}
-
-    def to_text(self) -> str:
-        """The table of every amplitude and frequency."""
-        return _table(self.columns(), self.method)
 
     def summary(self) -> str:
         """:meth:`StiffnessResult.summary` per amplitude."""

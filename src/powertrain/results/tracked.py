@@ -1,41 +1,11 @@
-r"""Order-tracked run-up: complex order amplitudes per speed and channel, and their files.
+"""Order-tracked run-up: complex order amplitudes per speed and channel, and their files.
 
-Long-format CSV (read by ``compare`` and ``diagnose``; :mod:`powertrain.iotools.measured`)::
-
-    # tracked by powertrain track (cot) from run.h5 [SYNTHETIC: ...]
-    mount,direction,quantity,rpm,acceleration_rms_m_per_s2
-    left,z,order_2,1050,0.0123
-    left,z,synthesis,1050,0.0150
-    left,z,overall,1050,0.0163
-
-The level column states the channels' quantity and unit (:data:`LEVEL_COLUMNS`); a
-``side`` column (``active``/``passive``) follows ``mount`` when any channel is passive. With
-the phase measured (``track --tdc-offset``) a ``phase_deg`` column follows the level: the
-order's phase re cylinder-1 firing TDC (:mod:`powertrain.analysis.phase`), empty on
-``synthesis`` and ``overall`` rows and for orders whose phase is undefined (half orders
-without ``--cycle-reference``).
+The long-format CSV (read by ``compare`` and ``diagnose``; the level column by quantity:
+:data:`LEVEL_COLUMNS`), the order-spectrum CSV (``track --spectrum-at``) and the HDF5 layout
+(``format = "powertrain-tracked"``) are in docs/reference/raw-data.md and csv-formats.md.
 ``synthesis`` is the RMS sum over the orders tracked; ``overall`` rows (``track --overall``)
-the RMS of the raw signal in a band (:mod:`powertrain.analysis.overall`).
-
-Order spectrum CSV (``track --spectrum-at RPM --spectrum-out F``, :meth:`TrackedOrders.
-spectrum_csv_text`): one row per channel, speed and order of the fine order grid::
-
-    mount,direction,rpm,order,acceleration_rms_m_per_s2
-    left,z,3000,0.0625,1.2e-05
-
-HDF5 (``--out``)::
-
-    /                attrs format="powertrain-tracked", format_version=1, source, method,
-                           settings (JSON), comments (JSON), created, powertrain_version
-    /rpm             (k,)              rpm
-    /orders          (n_o,)            1
-    /channels/{name,mount,side,direction,quantity,unit}   (n_ch,) str (unit = SI unit)
-    /amplitude       (k, n_ch, n_o) complex   SI peak amplitude, phase re crank angle 0
-                                              (re cylinder-1 firing TDC with --tdc-offset)
-    /order_rms       (k, n_ch, n_o)           SI RMS
-    /synthesis_rms   (k, n_ch)                SI RMS
-    /overall_rms     (k, n_ch)                SI RMS (only with --overall)
-    /phase_deg       (k, n_ch, n_o)           deg, NaN where undefined (only with --tdc-offset)
+the RMS of the raw signal in a band (:mod:`powertrain.analysis.overall`); ``phase_deg`` the
+order's phase re cylinder-1 firing TDC (:mod:`powertrain.analysis.phase`).
 """
 
 from __future__ import annotations
@@ -175,22 +145,31 @@ class TrackedOrders(Result):
                        settings={**self.settings, "converted_to": "velocity"})
 
     # ------------------------------------------------------------------ writers
-    def csv_text(self) -> str:
-        """Long-format CSV text (module docstring)."""
+    def _csv_head(self, title: str, columns: list) -> tuple:
+        """``(lines, level factor, key of each channel)`` of a CSV: ``# title``, the comments,
+        the header (``side`` after ``mount`` when a channel is passive)."""
         col, factor = LEVEL_COLUMNS[self.quantity]
         with_side = any(c.side != "active" for c in self.channels)
-        tag = " [SYNTHETIC]" if any("synthetic" in c.lower() for c in self.comments) else ""
-        lines = [f"# tracked by powertrain track ({self.method}) from {self.source}{tag}"]
-        lines += [f"# {c}" for c in self.comments]
+        lines = [f"# {title}"] + [f"# {c}" for c in self.comments]
+        lines.append(",".join(["mount"] + (["side"] if with_side else []) + ["direction"]
+                              + [col if c == "LEVEL" else c for c in columns]))
+        keys = [[ch.mount] + ([ch.side] if with_side else []) + [ch.direction]
+                for ch in self.channels]
+        return lines, factor, keys
+
+    def _tag(self) -> str:
+        return " [SYNTHETIC]" if any("synthetic" in c.lower() for c in self.comments) else ""
+
+    def csv_text(self) -> str:
+        """Long-format CSV text (docs/reference/raw-data.md)."""
         phase = self.phase_deg()
         tail = [] if phase is None else [""]            # empty phase_deg cell
-        lines.append(",".join(["mount"] + (["side"] if with_side else [])
-                              + ["direction", "quantity", "rpm", col]
-                              + ([] if phase is None else ["phase_deg"])))
+        lines, factor, keys = self._csv_head(
+            f"tracked by powertrain track ({self.method}) from {self.source}{self._tag()}",
+            ["quantity", "rpm", "LEVEL"] + ([] if phase is None else ["phase_deg"]))
         rms = self.order_rms() * factor
         syn = self.synthesis_rms() * factor
-        for c, ch in enumerate(self.channels):
-            key = [ch.mount] + ([ch.side] if with_side else []) + [ch.direction]
+        for c, key in enumerate(keys):
             for k, order in enumerate(self.orders):
                 q = order_label(order)
                 lines += [",".join(key + [q, f"{r:g}", f"{rms[i, c, k]:.8g}"]
@@ -205,20 +184,14 @@ class TrackedOrders(Result):
         return "\n".join(lines) + "\n"
 
     def spectrum_csv_text(self) -> str:
-        """Order spectrum CSV text (module docstring): RMS against order per speed."""
-        col, factor = LEVEL_COLUMNS[self.quantity]
-        with_side = any(c.side != "active" for c in self.channels)
-        tag = " [SYNTHETIC]" if any("synthetic" in c.lower() for c in self.comments) else ""
+        """Order spectrum CSV text (docs/reference/csv-formats.md): RMS against order per speed."""
         s = self.settings
-        lines = [f"# order spectrum by powertrain track from {self.source}{tag}: COT block "
-                 f"of {s['block_revolutions']} revolutions, Hann window, orders in steps of "
-                 f"{s['order_resolution']:g}"]
-        lines += [f"# {c}" for c in self.comments]
-        lines.append(",".join(["mount"] + (["side"] if with_side else [])
-                              + ["direction", "rpm", "order", col]))
+        lines, factor, keys = self._csv_head(
+            f"order spectrum by powertrain track from {self.source}{self._tag()}: COT block of "
+            f"{s['block_revolutions']} revolutions, Hann window, orders in steps of "
+            f"{s['order_resolution']:g}", ["rpm", "order", "LEVEL"])
         rms = self.order_rms() * factor
-        for c, ch in enumerate(self.channels):
-            key = [ch.mount] + ([ch.side] if with_side else []) + [ch.direction]
+        for c, key in enumerate(keys):
             lines += [",".join(key + [f"{r:g}", f"{o:g}", f"{rms[i, c, k]:.8g}"])
                       for i, r in enumerate(self.rpm) for k, o in enumerate(self.orders)]
         return "\n".join(lines) + "\n"
@@ -233,7 +206,7 @@ class TrackedOrders(Result):
                 **super().writers()}
 
     def to_hdf5(self, path) -> None:
-        """Write the HDF5 layout of the module docstring atomically."""
+        """Write the HDF5 layout (docs/reference/raw-data.md) atomically."""
         import h5py  # deferred: heavy optional package
 
         with atomic_path(path) as tmp:

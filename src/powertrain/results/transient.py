@@ -1,14 +1,6 @@
 """A transient manoeuvre's result (``powertrain transient``): time histories, per-channel
-peaks and the seat's ISO 2631-1 values, with its text, CSV, JSON, HDF5 and figure.
-
-JSON (SI but lengths in mm)::
-
-    {"manoeuvre": name, "file": ..., "engine": ..., "duration_s": T, "steps": n,
-     "method": ..., "channels": {"left.z": {"peak_to_peak_displacement_mm": ..,
-       "peak_force_n": .., "max_acceleration_m_per_s2": .., "time_of_max_acceleration_s": ..}},
-     "mounts": {"left.z": {"peak_to_peak_deflection_mm": .., "max_deflection_mm": ..}},
-     "seat": {"point": "seat_rail", "weighted_rms_m_per_s2": {"x": .., ...},
-              "vdv_m_per_s1_75": {...}, "weighting": {"x": "Wd", ...}} or null}
+peaks and the seat's ISO 2631-1 values, with its text, CSV, JSON (docs/reference/json.md),
+HDF5 and figure.
 
 CSV: one row per time step; columns ``time_s``, ``rpm``, ``engine_torque_nm``,
 ``starter_torque_nm``, ``driveline_torque_nm``, ``body_x_mm`` .. ``body_rz_deg``, per
@@ -28,10 +20,10 @@ from powertrain.analysis.channel import Channel
 from powertrain.analysis.text_table import format_table
 from powertrain.errors import InputError
 from powertrain.models.recording import RawChannel, RawRecording
-from powertrain.outputs import atomic_path, atomic_write, json_text
+from powertrain.outputs import atomic_path, atomic_write
 from powertrain.plotting.style import target_and_path
 from powertrain.plotting.transient import plot_overlay, plot_ranking, plot_transient
-from powertrain.results.base import Result
+from powertrain.results.base import JsonResult
 from powertrain.results.html import fragment
 from powertrain.results.html_tables import transient_html
 from powertrain.units import from_si
@@ -40,7 +32,7 @@ _BODY = ("x_mm", "y_mm", "z_mm", "rx_deg", "ry_deg", "rz_deg")
 
 
 @dataclass(frozen=True)
-class TransientResult(Result):
+class TransientResult(JsonResult):
     """Time histories of a manoeuvre (SI; module docstring for the files).
 
     Attributes
@@ -111,7 +103,7 @@ class TransientResult(Result):
                             [note]).validate()
 
     def to_dict(self) -> dict:
-        """The JSON document (module docstring)."""
+        """The JSON document (docs/reference/json.md)."""
         p = self.peaks()
         chans = {c: {"peak_to_peak_displacement_mm": float(from_si(p["peak_to_peak"][k], "mm")),
                      "peak_force_n": float(p["peak_force"][k]),
@@ -128,10 +120,6 @@ class TransientResult(Result):
         return {"manoeuvre": self.name, "file": self.file, "engine": self.engine,
                 "duration_s": float(self.time[-1]), "steps": int(self.time.size - 1),
                 "method": self.method, "channels": chans, "mounts": mounts, "seat": seat}
-
-    def to_json(self, path=None) -> str:
-        """JSON text of :meth:`to_dict`; written atomically to ``path`` if given."""
-        return json_text(self.to_dict(), path)
 
     def columns(self) -> dict:
         """CSV column name -> values (n,) (module docstring)."""
@@ -219,7 +207,7 @@ class TransientResult(Result):
 
 
 @dataclass(frozen=True)
-class TransientRanking(Result):
+class TransientRanking(JsonResult):
     """Baseline and variants of the mount system over one manoeuvre (``powertrain whatif
     --manoeuvre``), ranked by the peak acceleration at the seat (the largest magnitude of
     its three axes) where the chassis has a seat point, else by the peak mount deflection.
@@ -268,14 +256,6 @@ class TransientRanking(Result):
                              "peak_mount_deflection_at": where[k]}
                          for k, n in enumerate(self.names)}}
 
-    def to_json(self, path=None) -> str:
-        """JSON text of :meth:`to_dict`; written atomically to ``path`` if given."""
-        return json_text(self.to_dict(), path)
-
-    def writers(self) -> dict:
-        """``.json``, ``.png``."""
-        return {".json": self.to_json, **super().writers()}
-
     def target_fit(self, key):
         raise InputError("a retune target's files come with a run-up what-if, not with "
                          "--manoeuvre", key=key)
@@ -304,7 +284,7 @@ class TransientRanking(Result):
 
 
 @dataclass(frozen=True)
-class TransientComparison(Result):
+class TransientComparison(JsonResult):
     """A simulated manoeuvre against a recording of it (``powertrain transient --compare``).
 
     Attributes
@@ -344,14 +324,6 @@ class TransientComparison(Result):
         return {"manoeuvre": self.name, "recording": self.raw, "shift_s": self.shift,
                 "channels": {c: {k: float(v[j]) for k, v in e.items()}
                              for j, c in enumerate(self.channels)}}
-
-    def to_json(self, path=None) -> str:
-        """JSON text of :meth:`to_dict`; written atomically to ``path`` if given."""
-        return json_text(self.to_dict(), path)
-
-    def writers(self) -> dict:
-        """``.json``, ``.png``."""
-        return {".json": self.to_json, **super().writers()}
 
     def plot(self, ax=None, *, path=None, provenance=None):
         """Measured and simulated acceleration per channel, overlaid; returns the figure

@@ -1,16 +1,9 @@
-r"""Result of ``powertrain whatif``: baseline and variant run-ups and their changes in dB
-(computed by :func:`powertrain.workflows.whatif.whatif`).
-
-Change of a variant against the baseline, per channel (mount × engine X/Y/Z) and quantity
-(``synthesis``, ``order_2``, ``order_4`` by default), at each speed step:
-
-.. math:: \Delta(n) = 20\log_{10}\frac{v_{var}(n)}{v_{base}(n)}\ \mathrm{dB}
-
-with :math:`v` the RMS velocity of the mount point (or, with ``signal="mount_force"``, the
-RMS force the mount transmits to ground). Reported: ``mean_delta_db`` (the arithmetic mean of
-:math:`\Delta` over the speed steps, "rpm-averaged"), ``max_abs_delta_db`` (the largest
-:math:`|\Delta|`) and the speed where it occurs. Speed steps where both levels are below
-:data:`FLOOR_REL` of the baseline curve's maximum (a cancelled order) are left out.
+"""Result of ``powertrain whatif``: baseline and variant run-ups and their changes in dB
+(computed by :func:`powertrain.workflows.whatif.whatif`; docs/guide/whatif.md): the change
+20 log10(v_variant / v_baseline) of the RMS velocity (or another ``signal``) per channel and
+quantity at each speed step, its mean (``mean_delta_db``) and largest magnitude
+(``max_abs_delta_db``). Speed steps where both levels are below :data:`FLOOR_REL` of the
+baseline curve's maximum (a cancelled order) are left out.
 """
 
 from __future__ import annotations
@@ -22,10 +15,9 @@ import numpy as np
 from powertrain import __version__
 from powertrain.analysis.channel import Channel
 from powertrain.errors import InputError
-from powertrain.outputs import json_text
 from powertrain.plotting import plot_whatif
 from powertrain.plotting.style import target_and_path
-from powertrain.results.base import Result
+from powertrain.results.base import JsonResult
 from powertrain.results.html import fragment
 from powertrain.results.html_tables import whatif_html
 
@@ -64,7 +56,7 @@ def delta_db(base, variant, floor_rel=FLOOR_REL) -> np.ndarray:
 
 
 @dataclass(frozen=True)
-class WhatIfResult(Result):
+class WhatIfResult(JsonResult):
     """Baseline and variant run-ups with their changes in dB.
 
     Attributes
@@ -93,6 +85,8 @@ class WhatIfResult(Result):
     objective: tuple | None = None
     #: speed step of the grid [rpm] (None: one speed)
     rpm_step: float | None = None
+
+    JSON_INDENT = 2
 
     def to_text(self, written=()) -> str:
         """The report ``powertrain whatif`` prints: the baseline, the target fits, each
@@ -235,14 +229,6 @@ class WhatIfResult(Result):
                                                       v.result.rigid_body_modes_hz],
                               "channels": self.channel_changes(v.name)}
                              for v in self.variants]}
-
-    def to_json(self, path=None) -> str:
-        """JSON text of :meth:`to_dict`; written atomically to ``path`` if given."""
-        return json_text(self.to_dict(), path, indent=2)
-
-    def writers(self) -> dict:
-        """``.json`` (:meth:`to_json`), ``.png`` (the levels figure)."""
-        return {".json": self.to_json, **super().writers()}
 
     def table(self) -> str:
         """Text table per variant: rows = channels, columns = mean / max |Δ| [dB] per quantity."""
