@@ -219,12 +219,8 @@ class Rotate:
     spec: str = ""
     origin: Origin = Origin("--rotate")
 
-    def matrix(self) -> np.ndarray:
-        """:math:`R_z(a_z) R_y(a_y) R_x(a_x)` (fixed engine axes)."""
-        return rotation_matrix(*self.angles)
-
     def apply(self, engine):
-        R = self.matrix()
+        R = rotation_matrix(*self.angles)
         return _map_mounts(engine, self.mount, lambda m: dataclasses.replace(
             m, rotation=R @ np.asarray(m.rotation, float)), self.origin)
 
@@ -324,10 +320,6 @@ class Variant:
     def specs(self) -> list:
         return [op.spec for op in self.operations]
 
-    @property
-    def targets(self) -> list:
-        return [op for op in self.operations if isinstance(op, Target)]
-
 
 # --------------------------------------------------------------------------- geometry
 def rotation_matrix(ax: float, ay: float, az: float) -> np.ndarray:
@@ -417,11 +409,3 @@ def apply_operations(engine, operations):
         engine = op.apply(engine)
     return engine
 
-
-def check_operations(engine, operations) -> None:
-    """Validate names of every operation against ``engine`` (targets included)."""
-    for op in operations:
-        if isinstance(op, Target):
-            op.check(engine)
-        else:
-            engine = op.apply(engine)

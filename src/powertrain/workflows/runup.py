@@ -1,25 +1,13 @@
 r"""The run-up: engine -> assembled model -> solver -> order results.
 
-:func:`runup` is the public entry (the ``powertrain runup`` command calls it): the engine
-checked, balancers and unmodelled effects applied, the settings checked, then a stepped run-up
-(:func:`run_runup`, :func:`runup_with_effects`) or a continuous one (``sweep``, tracked like a
-measurement).
-
-For each speed step the load over one engine cycle is sampled at a constant crank-angle
-increment. Two solvers give the periodic steady state of the same assembled linear model:
-
-* ``newmark`` (default, the thesis's way): Newmark average-acceleration time integration in
-  the Numba kernel over ``cycles`` engine cycles (6), processing the last ``processed_cycles``
-  (2) by FFT. Every speed step starts from the periodic steady-state estimate (static preload
-  plus the frequency-domain solution at t = 0), so the lightly damped rigid-body modes and
-  the step of the mean torque do not pollute the window; the cycle-to-cycle periodicity of
-  the processed window is reported and a warning raised above 0.1 %.
-* ``harmonic``: the frequency-domain solve order by order
-  (:mod:`powertrain.solvers.harmonic`), exact for the linear model and used as a cross-check.
-
-The solver is chosen once per run (:func:`powertrain.solvers.steppers.choose_stepper`); a
-run-up is then: speeds and time grid, the assembled model, the stepper, the cycle loads, one
-solve per speed, the periodicity check, the result.
+:func:`runup` is the public entry (``powertrain runup``): the engine and settings checked,
+balancers and unmodelled effects applied, then a stepped run-up (:func:`run_runup`,
+:func:`runup_with_effects`) or a continuous one (``sweep``, tracked like a measurement).
+Per speed step the load over one engine cycle at a constant crank-angle increment drives
+the periodic steady state of the assembled linear model, by Newmark time integration over
+:data:`CYCLES` cycles, :data:`PROCESSED_CYCLES` processed by FFT (the thesis's way, sec.
+4.4), or by the frequency-domain solve order by order (``harmonic``); the stepper is chosen
+once per run (:func:`powertrain.solvers.steppers.choose_stepper`). docs/guide/runup.md.
 """
 
 from __future__ import annotations
@@ -85,17 +73,11 @@ def _cycle_loads(engine, rpm, n_per_cycle):
     return load
 
 
-def run_runup(*args, **kwargs) -> RunupResult:
-    """Simulate a run-up (see :func:`_run_runup` for the parameters), BLAS limited to one
-    thread meanwhile (:func:`~powertrain.parallel.single_blas_thread`)."""
-    with single_blas_thread():
-        return _run_runup(*args, **kwargs)
-
-
-def _run_runup(engine, rpm=None, *, solver="newmark", angle_step_deg=ANGLE_STEP_DEG,
+def run_runup(engine, rpm=None, *, solver="newmark", angle_step_deg=ANGLE_STEP_DEG,
               cycles=CYCLES, processed_cycles=PROCESSED_CYCLES, progress=False,
               system=None, stepper="auto") -> RunupResult:
-    """Simulate a run-up: steady state at each speed, order analysis of the mount points.
+    """Simulate a run-up: steady state at each speed, order analysis of the mount points
+    (BLAS limited to one thread meanwhile, :func:`~powertrain.parallel.single_blas_thread`).
 
     Parameters
     ----------
@@ -123,19 +105,20 @@ def _run_runup(engine, rpm=None, *, solver="newmark", angle_step_deg=ANGLE_STEP_
     """
     rpm = _speeds(rpm)
     grid = _cycles(angle_step_deg, cycles, processed_cycles)
-    if system is None:
-        system = engine.assemble()
-    step = choose_stepper(system, solver, stepper, grid)
-    loads = list(_cycle_loads(engine, rpm, grid.n_cycle))
     bar = {"desc": f"run-up ({solver})", "unit": "speed", "enabled": bool(progress)}
-    points = _operating_points(engine, rpm)
-    if points is None:
-        speeds, seconds = _solve_speeds(step, rpm, loads, bar)
-    else:
-        speeds, seconds = _solve_at_operating_points(engine, step, rpm, loads, points, bar)
-    _warn_periodicity(rpm, [o.periodicity for o in speeds])
-    return _result(engine, system, step, rpm, speeds, step.setup_seconds + seconds,
-                   None if points is None else _static_result(engine, points))
+    with single_blas_thread():
+        if system is None:
+            system = engine.assemble()
+        step = choose_stepper(system, solver, stepper, grid)
+        loads = list(_cycle_loads(engine, rpm, grid.n_cycle))
+        points = _operating_points(engine, rpm)
+        if points is None:
+            speeds, seconds = _solve_speeds(step, rpm, loads, bar)
+        else:
+            speeds, seconds = _solve_at_operating_points(engine, step, rpm, loads, points, bar)
+        _warn_periodicity(rpm, [o.periodicity for o in speeds])
+        return _result(engine, system, step, rpm, speeds, step.setup_seconds + seconds,
+                       None if points is None else _static_result(engine, points))
 
 
 def _static_result(engine, points) -> StaticResult:
@@ -193,7 +176,7 @@ def _warn_periodicity(rpm, periodicity):
     for n_rpm, p in zip(rpm, periodicity):
         if p > PERIODICITY_LIMIT:
             warnings.warn(f"{n_rpm:g} rpm: processed window periodic only to "
-                          f"{100 * p:.3g} % (> 0.1 %)", PeriodicityWarning, stacklevel=4)
+                          f"{100 * p:.3g} % (> 0.1 %)", PeriodicityWarning, stacklevel=3)
 
 
 def _result(engine, system, step, rpm, speeds, solver_seconds, operating_point) -> RunupResult:

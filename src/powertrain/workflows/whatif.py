@@ -1,13 +1,9 @@
 r"""What-if: run the baseline and variants of the mount system, report the change in dB.
 
-:func:`whatif` takes the variants as the command line writes them (``scale``, ``set``,
-``swap``, ``move``, ``rotate``, ``effects``, ``targets``, a variants file), parses them
-(:mod:`powertrain.workflows.variants`) and hands them to :func:`run_whatif`, which applies
-each variant once (:func:`variant_engine`: operations in order, a retune target fitted
-against the engine the earlier operations left, :mod:`powertrain.workflows.retune`; every
-step checked to carry the body), builds one :class:`~powertrain.workflows.sweeps.SweepTask`
-per variant plus the baseline, runs them with :func:`powertrain.workflows.sweeps.run_sweep`
-(on the one executor factory, :func:`powertrain.parallel.executor`) and returns a
+:func:`whatif` parses the variants as the command line writes them
+(:mod:`powertrain.workflows.variants`); :func:`run_whatif` applies each once
+(:func:`variant_engine`), runs one :class:`~powertrain.workflows.sweeps.SweepTask` per
+variant plus the baseline (:func:`powertrain.workflows.sweeps.run_sweep`) and returns a
 :class:`~powertrain.results.whatif.WhatIfResult` (the change in dB is defined there).
 """
 
