@@ -111,7 +111,7 @@ def run_runup(engine, rpm=None, *, solver="newmark", angle_step_deg=ANGLE_STEP_D
             system = engine.assemble()
         step = choose_stepper(system, solver, stepper, grid)
         loads = list(_cycle_loads(engine, rpm, grid.n_cycle))
-        points = _operating_points(engine, rpm)
+        points = operating_points(engine, rpm) if has_static_curves(engine) else None
         if points is None:
             speeds, seconds = _solve_speeds(step, rpm, loads, bar)
         else:
@@ -123,14 +123,6 @@ def run_runup(engine, rpm=None, *, solver="newmark", angle_step_deg=ANGLE_STEP_D
 
 def _static_result(engine, points) -> StaticResult:
     return StaticResult(points, engine.mount_names, engine.name)
-
-
-def _operating_points(engine, rpm):
-    """The static operating point of every speed when some mount direction has a static
-    curve (its networks are then scaled per speed); None otherwise (nothing is solved)."""
-    if not has_static_curves(engine):
-        return None
-    return operating_points(engine, rpm)
 
 
 def _solve_at_operating_points(engine, step, rpm, loads, points, bar):

@@ -12,7 +12,6 @@ docs/guide/synth.md. The diagnosis is never imported here.
 from __future__ import annotations
 
 import dataclasses
-import functools
 import json
 
 import numpy as np
@@ -141,14 +140,10 @@ def make_case(engine, truth_names, seed, *, rpm=None, hm=None, noise_db=None,
     rpm = RPM if rpm is None else np.asarray(rpm, float)
     hm = HarmonicModel(engine, rpm) if hm is None else hm
     base = hm.velocity(hm.solve(hm.two_ports()[0]))
-    return draw_case(list(truth_names), seed, engine, base, functools.partial(_simulate, hm),
+    return draw_case(list(truth_names), seed, engine, base,
+                     lambda eng, truth: truth_velocity(eng, hm, truth),
                      _draw, hm.channels, f"synthetic case 0 (seed {seed})", rpm=rpm,
                      noise_db=noise_db, params=params, redraws=REDRAWS, worth=worth_diagnosing)
-
-
-def _simulate(hm, engine, truth):
-    """Noise-free run-up of ``engine`` with ``truth`` on the harmonic model ``hm``."""
-    return truth_velocity(engine, hm, truth)
 
 
 # ---------------------------------------------------------------------------- public API
