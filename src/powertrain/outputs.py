@@ -295,9 +295,9 @@ _NONFINITE_CELL = re.compile(r"^(?!#)(?:[^\n]*,)?[ \t]*[-+]?(?:nan|inf|infinity)
                              re.IGNORECASE | re.MULTILINE)
 
 
-def json_text(data, path=None, indent=1) -> str:
+def json_text(data, path=None, indent=1, key=None) -> str:
     """``data`` as the indented JSON text of the result files; written atomically to ``path``
-    when given.
+    when given (``key``: the option an error names).
 
     Raises
     ------
@@ -308,7 +308,7 @@ def json_text(data, path=None, indent=1) -> str:
         text = json.dumps(data, indent=indent, allow_nan=False) + "\n"
     except ValueError:
         raise InputError("the result holds a non-finite number (NaN or inf); not written",
-                         file=path) from None
+                         file=path, key=key) from None
     if path is not None:
         with atomic_write(path) as fh:
             fh.write(text)

@@ -11,6 +11,7 @@ from powertrain.cli.common import (
     quiet_option,
     speed_options,
     write_plot,
+    wrote,
 )
 from powertrain.cli.group import main
 from powertrain.errors import InputError
@@ -144,7 +145,6 @@ def _write_sweep(result, files, engine) -> list:
 def _files_line(result, written, sweep) -> str:
     """The solver time and the files written (a sweep: the files)."""
     if sweep is not None:
-        return "wrote " + ", ".join(map(str, written))
+        return wrote(*written)
     return (f"solver time: {result.solver_seconds:.3f} s; "
-            + (f"wrote {', '.join(map(str, written))}" if written else
-               "no file written (ask with --out, --csv or --plot)"))
+            + (wrote(*written) if written else "no file written (ask with --out, --csv or --plot)"))

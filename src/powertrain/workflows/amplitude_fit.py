@@ -89,10 +89,7 @@ def fit_mount(measured, kcp_measured=None, model="triple-parallel", *, friction=
         return fit_mount_csv(measured, model, friction=friction, reference=reference,
                              starts=starts, seed=seed, max_mass=max_mass, fmin=fmin,
                              fmax=fmax)
-    for option, value in (("--friction", friction), ("--reference", reference)):
-        if value:
-            raise InputError(f"{option} needs data at two or more amplitudes (a column "
-                             "amplitude_mm)", key=option)
+    _one_amplitude_options(friction, reference)
     return fitting.fit_mount(measured, kcp_measured, model, starts=starts, seed=seed,
                              max_mass=max_mass, fmin=fmin, fmax=fmax, **options)
 
@@ -122,10 +119,7 @@ def fit_mount_csv(measured, model="triple-parallel", *, friction=False, referenc
     reference = real(reference, "--reference", unit="m", optional=True)
     data = read_stiffness_csv(measured).select(fmin, fmax)
     if data.amplitudes.size < 2:
-        for option, value in (("--friction", friction), ("--reference", reference)):
-            if value:
-                raise InputError(f"{option} needs data at two or more amplitudes (a column "
-                                 f"{AMPLITUDE})", file=measured, key=option)
+        _one_amplitude_options(friction, reference, measured)
         return fit_mount_file(measured, model, starts=starts, seed=seed, max_mass=max_mass,
                               fmin=fmin, fmax=fmax)
     name = Path(measured).name
@@ -133,6 +127,14 @@ def fit_mount_csv(measured, model="triple-parallel", *, friction=False, referenc
                           seed=seed, max_mass=max_mass, data_name=name,
                           source=f"powertrain fit-mount {name} --model {model}"
                           + (" --friction" if friction else ""))
+
+
+def _one_amplitude_options(friction, reference, file=None) -> None:
+    """Refuse ``--friction`` and ``--reference`` on data at one amplitude."""
+    for option, value in (("--friction", friction), ("--reference", reference)):
+        if value:
+            raise InputError(f"{option} needs data at two or more amplitudes (a column "
+                             f"{AMPLITUDE})", file=file, key=option)
 
 
 def fit_amplitudes(data, model="triple-parallel", *, friction=False, reference=None,

@@ -36,7 +36,7 @@ from powertrain.models.mount import MountModel
 from powertrain.plotting import plot_retune
 from powertrain.plotting.style import target_and_path
 from powertrain.results.base import Result
-from powertrain.workflows.fitting import fit_mount
+from powertrain.workflows.fitting import fit_mount, relative_rms_error
 from powertrain.workflows.operations import Origin, Swap, Target
 
 #: Log-spaced fit frequencies above 0 Hz.
@@ -244,10 +244,6 @@ class TargetFit(Result):
                            provenance=provenance)
 
 
-def _rel_rms(k, kt) -> float:
-    return float(np.sqrt(np.sum(np.abs(k - kt) ** 2) / np.sum(np.abs(kt) ** 2)))
-
-
 def _refine(topology, p0, free, f, kt_cp, kt_ip):
     """Joint least squares of K_CP and K_IP relative errors over log-factors of the free
     parameters of ``p0``; returns (parameters [SI], cost)."""
@@ -322,8 +318,8 @@ def _target_fit(target, model, fitted, f, k0, kt, kip_t, kf, kip_f, start, summa
     band = (f >= target.f_lo) & (f <= target.f_hi)
     return TargetFit(target=target, baseline=model, model=fitted, frequency_hz=f,
                      kcp_baseline=k0, kcp_target=kt, kcp_fitted=kf, kip_target=kip_t,
-                     kip_fitted=kip_f, rel_rms=_rel_rms(kf, kt),
-                     kip_rel_rms=_rel_rms(kip_f, kip_t),
+                     kip_fitted=kip_f, rel_rms=relative_rms_error(kf, kt),
+                     kip_rel_rms=relative_rms_error(kip_f, kip_t),
                      max_band_error=float(np.max(np.abs(kf[band] - kt[band])
                                                  / np.abs(kt[band]))),
                      mean_band_change=float(np.mean(np.abs(kf[band]) / np.abs(k0[band])) - 1),
