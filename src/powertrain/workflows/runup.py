@@ -112,10 +112,7 @@ def run_runup(engine, rpm=None, *, solver="newmark", angle_step_deg=ANGLE_STEP_D
         step = choose_stepper(system, solver, stepper, grid)
         loads = list(_cycle_loads(engine, rpm, grid.n_cycle))
         points = operating_points(engine, rpm) if has_static_curves(engine) else None
-        if points is None:
-            speeds, seconds = _solve_speeds(step, rpm, loads, bar)
-        else:
-            speeds, seconds = _solve_at_operating_points(engine, step, rpm, loads, points, bar)
+        speeds, seconds = _solve_speeds(engine, step, rpm, loads, points, bar)
         _warn_periodicity(rpm, [o.periodicity for o in speeds])
         return _result(engine, system, step, rpm, speeds, step.setup_seconds + seconds,
                        None if points is None else _static_result(engine, points))
@@ -123,21 +120,6 @@ def run_runup(engine, rpm=None, *, solver="newmark", angle_step_deg=ANGLE_STEP_D
 
 def _static_result(engine, points) -> StaticResult:
     return StaticResult(points, engine.mount_names, engine.name)
-
-
-def _solve_at_operating_points(engine, step, rpm, loads, points, bar):
-    """Every speed solved by a stepper of the kind chosen once, on the model assembled with
-    the networks scaled at that speed's operating point
-    (:meth:`~powertrain.physics.mount_elements.MountElement.at_operating_point`); the
-    equivalent-linear amplitudes carried from speed to speed. Returns the speeds' orders
-    and the solver time (the per-speed setups included)."""
-    speeds, total = [], 0.0
-    for i in progress_bar(range(rpm.size), **bar):
-        system = engine.assemble(points[i].static_factor)
-        step = step.on_system(system)
-        speeds.append(step.solve(loads[i], rpm[i] * 2 * np.pi / 60.0))
-        total += speeds[-1].seconds + step.setup_seconds
-    return speeds, total
 
 
 def _speeds(rpm) -> np.ndarray:
@@ -156,12 +138,20 @@ def _cycles(angle_step_deg, cycles, processed_cycles) -> Cycles:
     return Cycles(int(round(n_cycle)), angle_step_deg, cycles, processed_cycles)
 
 
-def _solve_speeds(step, rpm, loads, bar):
-    """Every speed's :class:`SpeedOrders` and the solver time (summed per-speed solver
-    times)."""
-    omegas = rpm * 2 * np.pi / 60.0
-    speeds = [step.solve(loads[i], omegas[i]) for i in progress_bar(range(rpm.size), **bar)]
-    return speeds, float(sum(o.seconds for o in speeds))
+def _solve_speeds(engine, step, rpm, loads, points, bar):
+    """Every speed's :class:`SpeedOrders` and the solver time. With operating ``points``,
+    each speed on the model assembled with the networks scaled at its operating point
+    (:meth:`~powertrain.physics.mount_elements.MountElement.at_operating_point`), by a
+    stepper of the kind chosen once, the equivalent-linear amplitudes carried from speed
+    to speed (the per-speed setups timed too)."""
+    speeds, total = [], 0.0
+    for i in progress_bar(range(rpm.size), **bar):
+        if points is not None:
+            step = step.on_system(engine.assemble(points[i].static_factor))
+            total += step.setup_seconds
+        speeds.append(step.solve(loads[i], rpm[i] * 2 * np.pi / 60.0))
+        total += speeds[-1].seconds
+    return speeds, total
 
 
 def _warn_periodicity(rpm, periodicity):
