@@ -95,17 +95,13 @@ class Scale:
     origin: Origin = Origin("--scale")
 
     def apply(self, engine):
+        f = self.factor
         if self.kind in LAW_KEYS:
-            f = self.factor
             return _map_laws(engine, self, self.kind, lambda v: tuple(f * x for x in v)
                              if isinstance(v, tuple) else f * v)
-
-        def change(model):
-            if self.kind == "stiffness":
-                return model.scaled(stiffness=self.factor)
-            if self.kind == "damping":
-                return model.scaled(damping=self.factor)
-            return model.scaled_dynamic_stiffness(self.factor)
+        change = {"stiffness": lambda m: m.scaled(stiffness=f),
+                  "damping": lambda m: m.scaled(damping=f)}.get(
+            self.kind, lambda m: m.scaled_dynamic_stiffness(f))
         return _map_directions(engine, self.mount, self.direction, change, self.origin)
 
 
@@ -282,10 +278,6 @@ class AddEffect:
     spec: str = ""
     origin: Origin = Origin("--effect")
 
-    @property
-    def scenario(self) -> dict:
-        return {self.effect: dict(self.params)}
-
     def apply(self, engine):
         if self.effect in RESPONSE_EFFECTS:
             return engine
@@ -301,11 +293,6 @@ def effect_scenario(operations, names=None) -> dict:
         if isinstance(op, AddEffect) and (names is None or op.effect in names):
             sc.setdefault(op.effect, {}).update(dict(op.params))
     return sc
-
-
-def response_scenario(operations) -> dict:
-    """The response-level effects of a variant's operations, merged in order."""
-    return effect_scenario(operations, RESPONSE_EFFECTS)
 
 
 @dataclass(frozen=True)

@@ -13,6 +13,7 @@ import numpy as np
 
 from powertrain.analysis.channel import Channel
 from powertrain.analysis.orders import ORDERS
+from powertrain.effects import RESPONSE_EFFECTS
 from powertrain.errors import InputError
 from powertrain.iotools.engine_checks import check_support
 from powertrain.iotools.measured import MeasuredRunup, normalise_quantity, read_measured
@@ -29,7 +30,7 @@ from powertrain.workflows.arguments import (
     speeds,
     texts,
 )
-from powertrain.workflows.operations import Origin, Target, Variant, response_scenario
+from powertrain.workflows.operations import Origin, Target, Variant, effect_scenario
 from powertrain.workflows.retune import retuned_swap
 from powertrain.workflows.runup import check_runup_settings, engine_and_file
 from powertrain.workflows.sweeps import SweepTask, run_sweep
@@ -279,7 +280,7 @@ def run_whatif(engine, variants, rpm=None, *, solver: str = "harmonic", executor
         varied, f = variant_engine(engine, v, **(fit_kwargs or {}))
         fits += f
         tasks.append(SweepTask(v.name, varied, rpm, solver, opts,
-                               response_scenario(v.operations)))
+                               effect_scenario(v.operations, RESPONSE_EFFECTS)))
     results = run_sweep(tasks, executor, workers=workers, progress=progress)
     runs = [VariantRun(v.name, v.specs, r) for v, r in zip(variants, results[1:])]
     if rpm_step is None and rpm.size > 1:
