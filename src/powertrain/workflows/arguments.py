@@ -105,8 +105,7 @@ def floats(value, option: str, noun: str, example: str, most: int) -> np.ndarray
 
 
 def _parse_list(text: str, option: str, noun: str, example: str, most: int) -> np.ndarray:
-    """Numbers of a comma list whose items may be ``start:stop:step`` ranges (inclusive);
-    at most ``most`` of them, at least one."""
+    """Numbers (1..``most``) of a comma list whose items may be ``start:stop:step``."""
     values: list[float] = []
     for part in text.split(","):
         part = part.strip()

@@ -117,8 +117,7 @@ def _given_simulation(simulated, measured):
 
 
 def _read_curves(path, mounts=None):
-    """Order curves of ``path`` (a MeasuredRunup is taken as it is); raw time data are
-    refused with a pointer to ``track``."""
+    """Order curves of ``path``; raw time data refused with a pointer to ``track``."""
     if isinstance(path, MeasuredRunup):
         return path
     kind = detect_format(path)

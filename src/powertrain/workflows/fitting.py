@@ -376,8 +376,7 @@ def _checked_data(frequency_hz, kcp_measured, topology):
 
 
 def _screen_and_polish(prob, starts, polish) -> list:
-    """Run every start a few iterations, then the best ``polish`` to convergence:
-    ``[(q, relative RMS error, converged)]``."""
+    """Screen every start, polish the best ``polish``: ``[(q, rel. RMS error, ok)]``."""
     screened = []
     for q0 in starts:
         q, err, _ = prob.solve(prob.rescale(q0), SCREEN_NFEV, 1e-6)

@@ -309,8 +309,7 @@ def _with_engine(result, engine, rpm, modifications) -> RunupResult:
 
 def _checked_options(solver, stepper, angle_step_deg, balancers, sweep, sample_rate,
                      progress) -> dict:
-    """The options of :func:`runup` checked as the command checks them (its option names in
-    the errors); the numbers as floats."""
+    """The options of :func:`runup` checked as the command checks them."""
     args.choice(solver, tuple(SOLVERS), "--solver")
     args.choice(stepper, tuple(NEWMARK_STEPPERS), "--stepper")
     return {"angle_step_deg": args.real(angle_step_deg, "--angle-step", unit="deg"),
@@ -331,8 +330,7 @@ def _stepped(engine, rpm, scenario, progress, **options) -> RunupResult:
 
 
 def _scenario(effects, engine) -> dict:
-    """``{effect: {parameter: value}}`` of ``--effect`` strings (one string or a sequence),
-    or a scenario as given."""
+    """The scenario of ``--effect`` strings, or a scenario as given."""
     if isinstance(effects, dict):
         return effects
     return effect_scenario(parse_operations({"effect": args.texts(effects, "--effect")},

@@ -88,8 +88,7 @@ def stiffness(mount, *, engine=None, freq=None, method="frequency", force=None,
 
 
 def _amplitude_argument(amplitude, mount_file):
-    """``amplitude`` of :func:`stiffness` in [m]: None, numbers [m], or the ``--amplitude``
-    text in the unit of ``mount_file`` (:func:`parse_amplitudes`)."""
+    """``amplitude`` of :func:`stiffness` in [m] (text: :func:`parse_amplitudes`)."""
     if amplitude is None:
         return None
     if isinstance(amplitude, str):

@@ -120,8 +120,7 @@ def track(raw, *, orders=None, rpm_step=50.0, method="cot", bandwidth=None, chan
 
 
 def _numbers(rpm_step, bandwidth, pulses_per_rev, tdc_offset, spectrum_at):
-    """The numeric options of :func:`track` as numbers (a string as the option writes it is
-    read), their ranges left to the checks that follow."""
+    """The numeric options of :func:`track` as numbers (ranges checked later)."""
     return (args.real(rpm_step, "--rpm-step", unit="rpm"),
             args.real(bandwidth, "--bandwidth", unit="Hz", optional=True),
             args.integer(pulses_per_rev, "--pulses-per-rev", optional=True),
@@ -285,8 +284,7 @@ def _tracked(chans) -> list:
 
 def _track_channels(rec, chans, profile, orders, method, rpm_step, block_or_bandwidth,
                     progress):
-    """``(amplitudes, rpm, settings)`` of :func:`_track_cot` or :func:`_track_vkf`, the
-    settings with the speed grid and source."""
+    """``(amplitudes, rpm, settings)`` of COT or VKF, with the speed grid and source."""
     track_with = _track_cot if method == "cot" else _track_vkf
     amp, rpm, settings = track_with(rec, chans, profile, orders, rpm_step, block_or_bandwidth,
                                     progress)

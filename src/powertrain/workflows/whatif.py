@@ -127,8 +127,7 @@ def whatif_manoeuvre(engine, variants, manoeuvre) -> TransientRanking:
 
 
 def _measured(measured, engine):
-    """The measurement to overlay: None, a MeasuredRunup, or its file read for ``engine``'s
-    mounts."""
+    """The measurement to overlay: None, a MeasuredRunup, or its file read."""
     if measured is None or isinstance(measured, MeasuredRunup):
         return measured
     path_or(measured, (), "--measured", "a MeasuredRunup or its file")
@@ -136,8 +135,7 @@ def _measured(measured, engine):
 
 
 def _checked(solver, signal, workers, executor=None):
-    """``--solver``, ``--signal`` and a scheduler name checked before any work;
-    ``--workers`` as an int >= 1 (or None)."""
+    """Solver, signal and scheduler checked; ``--workers`` as an int >= 1 (or None)."""
     if isinstance(executor, str) or executor is None:
         check_scheduler(executor)
     choice(solver, tuple(SOLVERS), "--solver")
@@ -197,8 +195,7 @@ def parse_objective(text, channels, rpm):
 
 
 def _node_of(text, name):
-    """The result node of channel ``text`` (``left.passive.z`` -> ``left/passive``), else
-    ``name`` unchanged."""
+    """The node of channel ``text`` (``left.passive.z`` -> ``left/passive``), else ``name``."""
     try:
         return Channel.parse(text).node
     except ValueError:
