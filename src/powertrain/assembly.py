@@ -337,13 +337,6 @@ class NetworkScaling:
         self.varying = any(el.amplitude_law is not None and not el.amplitude_law.constant
                            for el in self.elements)
 
-    def elements_at(self, factors=None) -> list:
-        """The elements at the operating point of the static ``factors`` (n_net,) (None:
-        each element's own)."""
-        if factors is None:
-            return self.elements
-        return [el.at_operating_point(f) for el, f in zip(self.elements, factors)]
-
     def scales(self, amplitudes, factors=None) -> np.ndarray:
         """``(stiffness, damping)`` factor (n_net, 2) of every network at its amplitude
         (n_net,) [m] and static factor (:meth:`MountElement.scales`; one call per distinct
@@ -370,7 +363,8 @@ class NetworkScaling:
     def at_operating_point(self, factors):
         """The assembled model with its elements at the static ``factors`` (n_net,): the
         same model, its elements, C, K and force rows replaced (for the harmonic start)."""
-        return self.with_elements(self.elements_at(factors))
+        return self.with_elements([el.at_operating_point(f)
+                                   for el, f in zip(self.elements, factors)])
 
     def as_measured(self):
         """The assembled model with every network as measured
