@@ -229,8 +229,9 @@ NEWMARK_REL = 5e-3
 
 def test_effects_through_the_normal_runup_match_the_fast_path(engine):
     """Every diagnosis effect runs through run_runup (Newmark here) and agrees with the
-    cached frequency-domain path of the diagnosis (:func:`powertrain.effects.simulate`)."""
-    from powertrain.workflows.effect_runup import simulate
+    cached frequency-domain path of the diagnosis (:func:`powertrain.effects.predict`)."""
+    from powertrain.effects import predict
+    from powertrain.solvers.fast_harmonic import HarmonicModel
     from powertrain.workflows.runup import runup_with_effects
     scenarios = [{"base_compliance": {"c_base": 4e5, "m_base": 8.0}},
                  {"mount_stiffness": {"k1": 1.5, "k3": 0.7}},
@@ -239,8 +240,8 @@ def test_effects_through_the_normal_runup_match_the_fast_path(engine):
                  {"sensor_error": {"g2": 3.0, "r1z": 0.05}}]
     for sc in scenarios:
         nm = runup_with_effects(engine, RPM, sc, solver="newmark")
-        ref = simulate(engine, RPM, sc)
-        err = np.max(np.abs(nm.velocity - ref.velocity)) / np.max(np.abs(ref.velocity))
+        ref = predict(HarmonicModel(engine, RPM), sc).velocity
+        err = np.max(np.abs(nm.velocity - ref)) / np.max(np.abs(ref))
         assert err < NEWMARK_REL, (sc, err)
         assert nm.settings["effects"][next(iter(sc))]
 

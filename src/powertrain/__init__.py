@@ -1,23 +1,14 @@
 """powertrain: powertrain mount vibration (NVH) simulator.
 
-Data flows one way: files (:mod:`powertrain.iotools`) -> model objects
-(:mod:`powertrain.models`) -> assembled system -> solvers (:mod:`powertrain.kernels`,
-:mod:`powertrain.physics`) -> results -> analysis -> plots and reports.
-Everything inside the package is SI; datasheet units are converted once, in the loaders,
-through the table in :mod:`powertrain.units`.
+The functions a study calls are importable from here (``import powertrain as pt``), imported
+on first use so ``import powertrain`` stays light::
 
-The functions a study calls are importable from here (``import powertrain as pt``)::
-
-    engine = pt.read_engine()                       # the shipped default engine
-    run = pt.runup(engine, rpm="1000:6000:500")
+    run = pt.runup(pt.read_engine(), rpm="1000:6000:500")
     print(run.to_text())
-    gap = pt.compare("measured.csv", engine=engine)
 
-Each checks its arguments as the command line does (bad input: :class:`InputError`, the
-line the command prints) and returns a result object with ``to_text()`` (what the command
-line prints), ``plot(ax=None)`` and ``save(path)`` (the format chosen by the suffix);
-docs/guide/python-api.md walks a whole study. They are imported on first use, so
-``import powertrain`` stays light.
+Each checks its arguments as the command line does and returns a result object with
+``to_text()``, ``plot(ax=None)`` and ``save(path)``; docs/guide/python-api.md walks a whole
+study, docs/architecture.md the data flow (everything inside the package is SI).
 """
 
 from importlib import import_module as _import_module

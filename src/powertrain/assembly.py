@@ -44,7 +44,6 @@ class AssembledSystem:
         Force transmitted by each mount to ground in engine axes:
         F = force_matrix_k @ q + force_matrix_d @ q' (+ ``port_force_map`` @ the port
         laws' forces, :meth:`port_forces`).
-    dof_labels : list of str
     """
 
     M: np.ndarray
@@ -54,7 +53,6 @@ class AssembledSystem:
     channel_matrix: np.ndarray
     force_matrix_k: np.ndarray
     force_matrix_d: np.ndarray
-    dof_labels: list = field(default_factory=list)
     #: per network: (row (6,) mapping q_rb to the engine-side node, first internal dof,
     #: number of internal dofs, MountElement)
     networks: list = field(default_factory=list)
@@ -209,13 +207,12 @@ def assemble(mass, cg, inertia, mounts, chassis=None, static_factors=None) -> As
     cg = np.asarray(cg, float)
     body_modes = chassis.body_modes if chassis is not None else ()
     modal = bool(body_modes)
-    blocks, labels = _network_blocks(mounts, cg, modal, static_factors)
+    blocks = _network_blocks(mounts, cg, modal, static_factors)
     body0 = 6 + sum(b[4].size - 1 for b in blocks)
     n = body0 + len(body_modes)
     retained = np.r_[np.arange(6), np.arange(body0, n)].astype(int)
     frame = _frame(mass, inertia, body_modes)
     M, C, K = (np.zeros((n, n)) for _ in range(3))
-    labels += [f"body_mode_{k + 1}" for k in range(len(body_modes))]
     n_m = len(mounts)
     Fk, Fd = np.zeros((3 * n_m, n)), np.zeros((3 * n_m, n))
     shapes = {m.name: chassis.body_rows(m.name) for m in mounts} if modal else {}
@@ -228,7 +225,7 @@ def assemble(mass, cg, inertia, mounts, chassis=None, static_factors=None) -> As
     Cm = np.zeros((3 * n_m, n))
     for mi, mount in enumerate(mounts):
         Cm[3 * mi:3 * mi + 3, :6] = point_motion_matrix(np.asarray(mount.position, float) - cg)
-    system = AssembledSystem(M, C, K, channels, Cm, Fk, Fd, labels, networks,
+    system = AssembledSystem(M, C, K, channels, Cm, Fk, Fd, networks,
                              port_rows=port_rows, port_force_map=port_map, network_maps=maps)
     system.mount_axes = [np.asarray(m.rotation, float) for m in mounts]
     system.network_ports = NetworkPorts(
@@ -283,10 +280,8 @@ def _force_row(g, L, base):
 
 def _network_blocks(mounts, cg, with_ground, static_factors=None):
     """Per network: (engine-side row, its M, C, K, ground-force rows kg, dg, mount index,
-    axis index, element, at its static factor if given), and the labels of the coordinates
-    (rigid body, then internal nodes)."""
+    axis index, element, at its static factor if given)."""
     blocks = []
-    labels = ["u_x", "u_y", "u_z", "theta_x", "theta_y", "theta_z"]
     for mi, mount in enumerate(mounts):
         r = np.asarray(mount.position, float) - cg
         R = np.asarray(mount.rotation, float)
@@ -298,8 +293,7 @@ def _network_blocks(mounts, cg, with_ground, static_factors=None):
             masses, elem_nodes, c, d = element.network()
             kg, dg = ground_force_rows(masses.size, elem_nodes, c, d)
             blocks.append((direction_row(r, R[:, ai]), Mn, Cn, Kn, kg, dg, mi, ai, element))
-            labels += [f"{mount.name}.{axis}.m{j + 1}" for j in range(masses.size)]
-    return blocks, labels
+    return blocks
 
 
 def _frame(mass, inertia, body_modes):
@@ -343,13 +337,6 @@ class NetworkScaling:
         self.varying = any(el.amplitude_law is not None and not el.amplitude_law.constant
                            for el in self.elements)
 
-    def elements_at(self, factors=None) -> list:
-        """The elements at the operating point of the static ``factors`` (n_net,) (None:
-        each element's own)."""
-        if factors is None:
-            return self.elements
-        return [el.at_operating_point(f) for el, f in zip(self.elements, factors)]
-
     def scales(self, amplitudes, factors=None) -> np.ndarray:
         """``(stiffness, damping)`` factor (n_net, 2) of every network at its amplitude
         (n_net,) [m] and static factor (:meth:`MountElement.scales`; one call per distinct
@@ -376,7 +363,8 @@ class NetworkScaling:
     def at_operating_point(self, factors):
         """The assembled model with its elements at the static ``factors`` (n_net,): the
         same model, its elements, C, K and force rows replaced (for the harmonic start)."""
-        return self.with_elements(self.elements_at(factors))
+        return self.with_elements([el.at_operating_point(f)
+                                   for el, f in zip(self.elements, factors)])
 
     def as_measured(self):
         """The assembled model with every network as measured

@@ -1,21 +1,12 @@
 """Safe file output: every file is written to a temporary file beside its target and renamed
 onto the target only when complete; a command's outputs are committed together.
 
-* :func:`atomic_path` / :func:`atomic_write` write one file. Outside a transaction the
-  temporary file replaces the target as soon as its block succeeds.
-* :class:`OutputTransaction` (``with OutputTransaction(): ...``, used by the CLI for every
-  command) *stages* every file written inside it (in the context that entered it, a
-  :class:`contextvars.ContextVar`: its thread): nothing in the user's folders is replaced
-  until the block ends without error; then all staged files are renamed onto their targets
-  together, under an exclusive lock of each target folder, so two concurrent runs writing
-  the same paths leave the complete set of one of them. A failure anywhere (also a failure
-  after some outputs were written) removes the staged files and the folders the run created:
-  a failed command never deletes or truncates a file it did not create.
-* Temporary files are named ``.NAME.pt<PID>-<random>.tmp``. Every exit path through Python
-  removes them; a process killed outright (SIGKILL, power loss) cannot, so every later write
-  into the same folder first removes the temporary files of processes that no longer run.
-* The finished file gets the mode an ordinary ``open(path, "w")`` would give
-  (``0666 & ~umask``: 0644 under umask 022), not the private 0600 of the temporary file.
+:func:`atomic_path` / :func:`atomic_write` write one file; :class:`OutputTransaction` (the
+CLI's, around every command) stages every file written inside it and renames them onto their
+targets together when the block succeeds, under a lock of each target folder; a failure
+removes the staged files and the folders the run created. Temporary files are named
+``.NAME.pt<PID>-<random>.tmp``; finished files get ``0666 & ~umask``. The guarantees and
+their tests: docs/reference/outputs.md.
 """
 
 from __future__ import annotations
@@ -304,9 +295,9 @@ _NONFINITE_CELL = re.compile(r"^(?!#)(?:[^\n]*,)?[ \t]*[-+]?(?:nan|inf|infinity)
                              re.IGNORECASE | re.MULTILINE)
 
 
-def json_text(data, path=None, indent=1) -> str:
+def json_text(data, path=None, indent=1, key=None) -> str:
     """``data`` as the indented JSON text of the result files; written atomically to ``path``
-    when given.
+    when given (``key``: the option an error names).
 
     Raises
     ------
@@ -317,7 +308,7 @@ def json_text(data, path=None, indent=1) -> str:
         text = json.dumps(data, indent=indent, allow_nan=False) + "\n"
     except ValueError:
         raise InputError("the result holds a non-finite number (NaN or inf); not written",
-                         file=path) from None
+                         file=path, key=key) from None
     if path is not None:
         with atomic_write(path) as fh:
             fh.write(text)

@@ -1,28 +1,11 @@
 """One place to choose where independent jobs run: serially, in local processes, or on a
 dask.distributed cluster.
 
-``executor(scheduler)`` is the one executor factory: a context manager yielding an object with
-the ``concurrent.futures`` interface (``submit`` → future with ``.result()``, ``map``).
-``powertrain whatif`` (its variants, through :func:`powertrain.workflows.sweeps.run_sweep`)
-and ``powertrain diagnose`` (its candidate fits, through :func:`run_map`) run on it.
-
-================================ ==========================================================
-``scheduler``                    runs on
-================================ ==========================================================
-``None`` or ``"auto"``           whatever starts fastest locally: serial for one job or one
-                                 core, else a process pool (``workers`` processes)
-``"serial"``                     this process, one job after the other
-``"processes"``                  a local process pool
-``"local"``                      a dask.distributed ``LocalCluster`` on this machine's cores
-                                 (one single-threaded worker process per core)
-``"tcp://HOST:PORT"``            an existing dask.distributed scheduler (start it with
-                                 ``dask scheduler`` and workers with ``dask worker HOST:PORT``)
-an executor                      itself, left running: a ``distributed.Client``, a
-                                 ``concurrent.futures`` executor, anything with ``submit``
-================================ ==========================================================
-
-Results do not depend on the choice: every job is a pure function of its arguments, and
-:func:`run_map` returns them in submission order (tests/test_parallel.py).
+:func:`executor` is the one executor factory (``concurrent.futures`` interface) for a
+``scheduler``: None/``"auto"``, ``"serial"``, ``"processes"``, ``"local"`` (a dask
+``LocalCluster``), ``"tcp://HOST:PORT"`` or an executor (left running); the table:
+docs/guide/parallel.md. Results do not depend on the choice: :func:`run_map` returns them in
+submission order (tests/test_parallel.py).
 """
 
 from __future__ import annotations
@@ -37,7 +20,7 @@ from contextlib import contextmanager
 from threadpoolctl import ThreadpoolController
 
 from powertrain.errors import InputError
-from powertrain.progress import progress_bar as bar
+from powertrain.progress import progress_bar
 
 
 @functools.cache
@@ -139,7 +122,7 @@ def probe_scheduler(address: str, timeout: float = CONNECT_TIMEOUT_S) -> None:
 
 @contextmanager
 def executor(scheduler=None, *, workers=None, n_jobs=None):
-    """The executor for ``scheduler`` (see the module table); one this function opens is shut
+    """The executor for ``scheduler`` (docs/guide/parallel.md); one this function opens is shut
     down on exit, pending jobs cancelled if the block raised.
 
     Parameters
@@ -217,18 +200,10 @@ def run_map(fn, items, scheduler=None, *, workers=None, progress=None, unit="job
     items = list(items)
     with executor(scheduler, workers=workers, n_jobs=len(items)) as ex:
         futures = [ex.submit(fn, x) for x in items]
-        bar = progress_bar(len(futures), progress, unit=unit) if progress else None
         out = []
-        for f in futures:
-            out.append(f.result())
-            if bar is not None:
+        with progress_bar(enabled=bool(progress), total=len(futures), desc=progress,
+                          unit=unit) as bar:
+            for f in futures:
+                out.append(f.result())
                 bar.update(1)
-        if bar is not None:
-            bar.close()
     return out
-
-
-def progress_bar(total, desc, quiet=False, unit="it"):
-    """tqdm bar on stderr (:func:`powertrain.progress.progress_bar`); disabled when
-    ``quiet`` or stderr is not a terminal."""
-    return bar(None, enabled=not quiet, total=total, desc=desc, unit=unit)

@@ -1,22 +1,9 @@
 """Provenance of a result: what ran, how it was asked for, with which version and when.
 
-Written into every HDF5 (attribute ``provenance``) and JSON (key ``provenance``) output:
-
-* ``command_line``: the command as typed (``powertrain runup --no-balancers ...``);
-* ``powertrain_version``, ``created`` (UTC, ISO 8601);
-* ``engine_file``: the engine file read;
-* ``engine_as_run``: the engine that actually ran, in SI, after the command's modifications
-  (``--no-balancers`` shows as ``balancer.enabled = false``), every mount model by topology
-  and parameters;
-* ``modifications``: what the command changed on the engine as read, and ``effects``: the
-  unmodelled effects applied (name and SI parameters).
-
-For figures, a :class:`Provenance` value holds the short form (command, engine, version,
-date) printed as one line at the foot of every figure
-(:func:`powertrain.plotting.style.add_provenance`); the CLI fills it
-(:func:`powertrain.cli.common.cli_provenance`), library users make one with
-:meth:`Provenance.now`, and result objects may carry one in a ``provenance`` attribute,
-which their ``plot`` methods use when none is passed.
+:func:`provenance` is the record written into every HDF5 (attribute ``provenance``) and JSON
+(key ``provenance``) output (its keys: docs/reference/outputs.md); :class:`Provenance` is its
+short form, printed as one line at the foot of every figure
+(:func:`powertrain.plotting.style.add_provenance`).
 """
 
 from __future__ import annotations
@@ -24,7 +11,6 @@ from __future__ import annotations
 import contextlib
 import contextvars
 import dataclasses
-import datetime as _dt
 import math
 import shlex
 import sys
@@ -109,7 +95,9 @@ def engine_as_run(engine) -> dict:
 
 
 def provenance(engine=None, *, engine_file=None, modifications=(), effects=None) -> dict:
-    """The provenance record (see the module docstring)."""
+    """The provenance record of a result: ``command_line``, ``powertrain_version``,
+    ``created`` (UTC, ISO 8601) and, with ``engine``, ``engine_file``, ``engine_name``,
+    ``modifications``, ``effects`` and ``engine_as_run`` (SI)."""
     doc = {"command_line": command_line(), "powertrain_version": __version__,
            "created": datetime.now(timezone.utc).isoformat(timespec="seconds")}
     if engine is not None:
@@ -148,9 +136,8 @@ class Provenance:
     @classmethod
     def now(cls, command: str = "", engine: str = "") -> Provenance:
         """A provenance stamped with the current UTC time and this version."""
-        stamp = _dt.datetime.now(_dt.timezone.utc).replace(microsecond=0)
-        return cls(command=command, engine=engine, version=__version__,
-                   date=stamp.strftime("%Y-%m-%dT%H:%M:%SZ"))
+        stamp = datetime.now(timezone.utc).strftime("%Y-%m-%dT%H:%M:%SZ")
+        return cls(command=command, engine=engine, version=__version__, date=stamp)
 
     @classmethod
     def from_record(cls, record: dict) -> Provenance:

@@ -12,8 +12,7 @@ import warnings
 
 import click
 
-from powertrain.errors import InputError
-from powertrain.outputs import atomic_write, check_writable
+from powertrain.outputs import check_writable, json_text
 from powertrain.plotting.style import close_figure
 from powertrain.provenance import Provenance, command_line
 
@@ -72,16 +71,9 @@ def check_outputs(**targets) -> None:
 def write_json(path, text: str, provenance: dict, key: str = "--json") -> None:
     """Write a result's JSON ``text`` with a ``provenance`` key added, atomically; a result
     with a non-finite number is refused (no NaN in an output file)."""
-
     doc = json.loads(text)
     doc["provenance"] = provenance
-    try:
-        out = json.dumps(doc, indent=1, allow_nan=False) + "\n"
-    except ValueError:
-        raise InputError("the result holds a non-finite number (NaN or inf); not written",
-                         file=path, key=key) from None
-    with atomic_write(path) as fh:
-        fh.write(out)
+    json_text(doc, path, key=key)
 
 
 # ------------------------------------------------------------------ figures

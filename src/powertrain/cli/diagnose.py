@@ -35,8 +35,7 @@ from powertrain.workflows.synth import synth as run_synth
 
 
 class _ListedOption(click.Option):
-    """An option whose help ends with names read from a registry when the help is shown
-    (``names`` returns them)."""
+    """An option whose help ends with the names ``names()`` returns when it is shown."""
 
     def __init__(self, *args, names, **kwargs):
         super().__init__(*args, **kwargs)

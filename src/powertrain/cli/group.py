@@ -23,14 +23,9 @@ COMMANDS = {"compare": "compare", "diagnose": "diagnose", "examples": "examples"
 
 
 class _Group(click.Group):
-    """Turns :class:`powertrain.errors.InputError` into one line on stderr and exit code 1.
-
-    Every command runs inside one :class:`~powertrain.outputs.OutputTransaction`:
-    its output files are staged and replace the targets together only when the command
-    succeeds; a failed command changes no file (docs/reference/outputs.md). A command's
-    module is loaded when the command is asked for (:data:`COMMANDS`; click's lazily loaded
-    subcommands), so a command starts with its own workflow only.
-    """
+    """Runs every command in one :class:`~powertrain.outputs.OutputTransaction`, turns
+    :class:`~powertrain.errors.InputError` into one line on stderr and exit code 1, and
+    loads a command's module only when the command is asked for (:data:`COMMANDS`)."""
 
     def list_commands(self, ctx):
         return sorted(COMMANDS)

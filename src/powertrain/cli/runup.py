@@ -11,6 +11,7 @@ from powertrain.cli.common import (
     quiet_option,
     speed_options,
     write_plot,
+    wrote,
 )
 from powertrain.cli.group import main
 from powertrain.errors import InputError
@@ -98,8 +99,7 @@ def runup(rpm_from, rpm_to, rpm_step, engine_file, solver, stepper, angle_step, 
 
 
 def _check_options(engine, path_order, raw_file, sweep) -> None:
-    """The path plot's body points and order (``path_order`` None: no path plot); --raw
-    only with --sweep, to a writable path."""
+    """The path plot's body points and order (None: no path plot); --raw with --sweep."""
     if path_order is not None:
         check_path_plot(engine, path_order)
     if raw_file and sweep is None:
@@ -108,8 +108,7 @@ def _check_options(engine, path_order, raw_file, sweep) -> None:
 
 
 def _write_runup(result, files, engine, path_order) -> list:
-    """The stepped run-up's HDF5, CSV (SYNTHETIC with effects), figure and path figure
-    (``engine``: what ran, for the provenance)."""
+    """The stepped run-up's HDF5, CSV (SYNTHETIC with effects), figure and path figure."""
     prov = cli_provenance(engine)
     if files["out"]:
         result.to_hdf5(files["out"])
@@ -144,7 +143,6 @@ def _write_sweep(result, files, engine) -> list:
 def _files_line(result, written, sweep) -> str:
     """The solver time and the files written (a sweep: the files)."""
     if sweep is not None:
-        return "wrote " + ", ".join(map(str, written))
+        return wrote(*written)
     return (f"solver time: {result.solver_seconds:.3f} s; "
-            + (f"wrote {', '.join(map(str, written))}" if written else
-               "no file written (ask with --out, --csv or --plot)"))
+            + (wrote(*written) if written else "no file written (ask with --out, --csv or --plot)"))

@@ -9,7 +9,7 @@ from powertrain.cli.common import check_outputs, quiet_option, say, write_json, 
 from powertrain.cli.group import main
 from powertrain.iotools.engine_file import engine_or_default
 from powertrain.provenance import provenance
-from powertrain.workflows.arguments import parse_speeds
+from powertrain.workflows.arguments import speeds
 from powertrain.workflows.static import static as solve
 
 
@@ -36,7 +36,7 @@ def static(engine_file, rpm_list, json_file, quiet):
       powertrain static --rpm 1000,3000,6000 --json static.json
     """
 
-    rpm = None if rpm_list is None else parse_speeds(rpm_list)
+    rpm = speeds(rpm_list)
     check_outputs(json=json_file)
     engine = engine_or_default(engine_file)
     result = solve(engine, rpm)

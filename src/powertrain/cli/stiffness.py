@@ -74,8 +74,7 @@ def stiffness(mount_file, engine_file, mount_dir, freq, method, fmt, plot, form,
 
 
 def _report(result, fmt, plot, form, freq_axis, quiet):
-    """Write the plot (when asked) and print the table, the CSV or the plot's summary
-    (nothing with ``--quiet``)."""
+    """Write the plot (when asked); print the table, the CSV or the plot's summary."""
     if plot:
         prov = cli_provenance()
         write_plot(lambda p: result.plot(path=p, form=form, freq_axis=freq_axis,
@@ -90,8 +89,7 @@ def _report(result, fmt, plot, form, freq_axis, quiet):
 
 
 def _mount(mount_file, engine_file, mount_dir):
-    """The ``mount`` of :func:`powertrain.workflows.stiffness.stiffness`: MOUNT_FILE, or
-    --mount of --engine."""
+    """The ``mount`` of the stiffness workflow: MOUNT_FILE, or --mount of --engine."""
     if (mount_file is None) == (engine_file is None):
         raise InputError("give either MOUNT_FILE or --engine with --mount", key="MOUNT_FILE")
     if mount_file is not None and mount_dir:

@@ -2,33 +2,13 @@ r"""Fit a mount to multi-amplitude dynamic-stiffness data (``powertrain fit-moun
 K*(f) CSV with an ``amplitude_mm`` column, as a supplier sends it: Kovarik 2016, Fig. 14).
 
 The model is the one the solvers run (:class:`~powertrain.physics.mount_elements.MountElement`):
-a lumped network fitted at the reference amplitude :math:`A_{ref}`, its springs and dampers
-times the power amplitude law :math:`\mathrm{clip}((A_{ref}/A)^n, lo, hi)`, and, with
-``friction``, Berg's friction element in parallel
-(:class:`~powertrain.physics.mount_laws.BergFriction`: ``max_force``, ``half_displacement``).
-Its K*(f, A) is the element's equivalent-linear cross-point stiffness (the frequency method
-of ``powertrain stiffness --amplitude``), so what is fitted is what is run.
-
-Method, in two stages:
-
-1. the network alone, by the multi-start fit of
-   :func:`powertrain.workflows.fitting.fit_mount` (thesis eq. 19), at the reference
-   amplitude and, with friction, also at the largest amplitude (where friction's share of
-   K* is smallest: a network cannot take up friction's frequency-independent loss), brought
-   to the reference by the exponent guessed from the level of |K*| against amplitude;
-2. everything together: network log-parameters, exponent :math:`n` and, with friction,
-   :math:`\ln F_{max}`, :math:`\ln x_2`, by bounded least squares
-   (:func:`scipy.optimize.least_squares`, ``trf``) on the complex error over every
-   amplitude, each amplitude's error normalised by its own :math:`\lVert K_m\rVert` so that
-   every amplitude weighs the same, with the analytic Jacobian. Friction starts from a
-   small grid (:data:`FRICTION_STARTS`): :math:`x_2` a multiple of :math:`A_{ref}`,
-   :math:`F_{max}` carrying a share of the low-frequency stiffness at :math:`A_{ref}`; each
-   start is screened (:data:`SCREEN_NFEV` evaluations) and the best run to convergence.
-
-The law's **limits are fixed** at :data:`LIMITS` (the mount-file default), not fitted: a clip
-only shows in data that reach it, and a fitted limit inside the data's amplitude range would
-be a second exponent; widen the data's amplitude range rather than the law. The residual is
-reported per amplitude (relative RMS error, :func:`~powertrain.workflows.fitting.relative_rms_error`).
+a network fitted at the reference amplitude :math:`A_{ref}`, its springs and dampers times
+the power law :math:`\mathrm{clip}((A_{ref}/A)^n, lo, hi)` (limits fixed at :data:`LIMITS`)
+and, with ``friction``, Berg's friction element in parallel. Stage one fits the network
+alone (:func:`powertrain.workflows.fitting.fit_mount`), stage two everything together by
+bounded least squares over every amplitude, each normalised by its own
+:math:`\lVert K_m\rVert`, friction started from a small grid. Method and
+figures: docs/guide/amplitude-and-preload.md (*Dynamic stiffness at amplitudes and fitting*).
 """
 
 from __future__ import annotations
@@ -109,10 +89,7 @@ def fit_mount(measured, kcp_measured=None, model="triple-parallel", *, friction=
         return fit_mount_csv(measured, model, friction=friction, reference=reference,
                              starts=starts, seed=seed, max_mass=max_mass, fmin=fmin,
                              fmax=fmax)
-    for option, value in (("--friction", friction), ("--reference", reference)):
-        if value:
-            raise InputError(f"{option} needs data at two or more amplitudes (a column "
-                             "amplitude_mm)", key=option)
+    _one_amplitude_options(friction, reference)
     return fitting.fit_mount(measured, kcp_measured, model, starts=starts, seed=seed,
                              max_mass=max_mass, fmin=fmin, fmax=fmax, **options)
 
@@ -142,10 +119,7 @@ def fit_mount_csv(measured, model="triple-parallel", *, friction=False, referenc
     reference = real(reference, "--reference", unit="m", optional=True)
     data = read_stiffness_csv(measured).select(fmin, fmax)
     if data.amplitudes.size < 2:
-        for option, value in (("--friction", friction), ("--reference", reference)):
-            if value:
-                raise InputError(f"{option} needs data at two or more amplitudes (a column "
-                                 f"{AMPLITUDE})", file=measured, key=option)
+        _one_amplitude_options(friction, reference, measured)
         return fit_mount_file(measured, model, starts=starts, seed=seed, max_mass=max_mass,
                               fmin=fmin, fmax=fmax)
     name = Path(measured).name
@@ -153,6 +127,14 @@ def fit_mount_csv(measured, model="triple-parallel", *, friction=False, referenc
                           seed=seed, max_mass=max_mass, data_name=name,
                           source=f"powertrain fit-mount {name} --model {model}"
                           + (" --friction" if friction else ""))
+
+
+def _one_amplitude_options(friction, reference, file=None) -> None:
+    """Refuse ``--friction`` and ``--reference`` on data at one amplitude."""
+    for option, value in (("--friction", friction), ("--reference", reference)):
+        if value:
+            raise InputError(f"{option} needs data at two or more amplitudes (a column "
+                             f"{AMPLITUDE})", file=file, key=option)
 
 
 def fit_amplitudes(data, model="triple-parallel", *, friction=False, reference=None,

@@ -36,39 +36,31 @@ def default_rpm(start=1000.0, stop=6000.0, step=500.0) -> np.ndarray:
 
 
 # ------------------------------------------------------------------ lists of numbers
-def parse_frequencies(text: str, option: str = "--freq") -> np.ndarray:
-    """``5,10,12`` or ``start:stop:step`` (inclusive) or a mix, e.g. ``1:10:1,20,40`` [Hz]."""
-    return _checked_frequencies(_parse_list(text, option, "frequency", FREQUENCY_EXAMPLE,
-                                            MAX_FREQUENCIES), option)
-
-
-def parse_speeds(text: str, option: str = "--rpm") -> np.ndarray:
-    """Speeds [rpm] as a comma list or ``start:stop:step`` (inclusive) or a mix, e.g.
-    ``1000:6000:500`` or ``1500,3000``; finite, > 0, strictly increasing."""
-    return _checked_speeds(_parse_list(text, option, "speed", SPEED_EXAMPLE, MAX_SPEEDS),
-                           option)
-
-
 def frequencies(value, key: str = "--freq") -> np.ndarray:
-    """Frequencies [Hz] given as the option writes them (:func:`parse_frequencies`) or as
-    numbers: finite, >= 0, <= :data:`MAX_FREQUENCY_HZ`, strictly increasing."""
-    if isinstance(value, str):
-        return parse_frequencies(value, key)
-    arr = floats(value, key, "frequency", FREQUENCY_EXAMPLE, MAX_FREQUENCIES)
-    return _checked_frequencies(arr, key)
+    """Frequencies [Hz] given as the option writes them (``5,10,12``, ``start:stop:step``
+    inclusive, or a mix ``1:10:1,20,40``) or as numbers: finite, >= 0, <=
+    :data:`MAX_FREQUENCY_HZ`, strictly increasing."""
+    arr = _numbers(value, key, "frequency", FREQUENCY_EXAMPLE, MAX_FREQUENCIES)
+    if not np.all(np.isfinite(arr)) or np.any(arr < 0) or np.any(arr > MAX_FREQUENCY_HZ):
+        raise InputError(f"frequencies must be finite, >= 0 and <= {MAX_FREQUENCY_HZ:g} Hz",
+                         key=key)
+    if np.any(np.diff(arr) <= 0):
+        raise InputError("frequencies must be strictly increasing", key=key)
+    return arr
 
 
 def speeds(value, key: str = "--rpm", *, increasing: bool = True) -> np.ndarray:
-    """Speeds [rpm] given as the option writes them (:func:`parse_speeds`) or as numbers:
-    finite, > 0, at most :data:`MAX_SPEEDS` and (``increasing``) strictly increasing; None:
-    :func:`default_rpm`."""
+    """Speeds [rpm] given as the option writes them (``1000:6000:500``, ``1500,3000`` or a
+    mix) or as numbers: finite, > 0, at most :data:`MAX_SPEEDS` and (``increasing``)
+    strictly increasing; None: :func:`default_rpm`."""
     if value is None:
         return default_rpm()
-    if isinstance(value, str):
-        return _checked_speeds(_parse_list(value, key, "speed", SPEED_EXAMPLE, MAX_SPEEDS),
-                               key, increasing)
-    return _checked_speeds(floats(value, key, "speed", SPEED_EXAMPLE, MAX_SPEEDS), key,
-                           increasing)
+    arr = _numbers(value, key, "speed", SPEED_EXAMPLE, MAX_SPEEDS)
+    if not np.all(np.isfinite(arr)) or np.any(arr <= 0):
+        raise InputError("speeds must be finite and > 0 [rpm]", key=key)
+    if increasing and np.any(np.diff(arr) <= 0):
+        raise InputError("speeds must be strictly increasing", key=key)
+    return arr
 
 
 def speed_steps(rpm_from: float, rpm_to: float, rpm_step: float) -> np.ndarray:
@@ -85,21 +77,10 @@ def speed_steps(rpm_from: float, rpm_to: float, rpm_step: float) -> np.ndarray:
     return default_rpm(rpm_from, rpm_to, rpm_step)
 
 
-def _checked_frequencies(arr: np.ndarray, option: str) -> np.ndarray:
-    if not np.all(np.isfinite(arr)) or np.any(arr < 0) or np.any(arr > MAX_FREQUENCY_HZ):
-        raise InputError(f"frequencies must be finite, >= 0 and <= {MAX_FREQUENCY_HZ:g} Hz",
-                         key=option)
-    if np.any(np.diff(arr) <= 0):
-        raise InputError("frequencies must be strictly increasing", key=option)
-    return arr
-
-
-def _checked_speeds(arr: np.ndarray, option: str, increasing: bool = True) -> np.ndarray:
-    if not np.all(np.isfinite(arr)) or np.any(arr <= 0):
-        raise InputError("speeds must be finite and > 0 [rpm]", key=option)
-    if increasing and np.any(np.diff(arr) <= 0):
-        raise InputError("speeds must be strictly increasing", key=option)
-    return arr
+def _numbers(value, option, noun, example, most) -> np.ndarray:
+    """A comma list with ``start:stop:step`` items (a string) or numbers, as floats."""
+    read = _parse_list if isinstance(value, str) else floats
+    return read(value, option, noun, example, most)
 
 
 def floats(value, option: str, noun: str, example: str, most: int) -> np.ndarray:
@@ -124,8 +105,7 @@ def floats(value, option: str, noun: str, example: str, most: int) -> np.ndarray
 
 
 def _parse_list(text: str, option: str, noun: str, example: str, most: int) -> np.ndarray:
-    """Numbers of a comma list whose items may be ``start:stop:step`` ranges (inclusive);
-    at most ``most`` of them, at least one."""
+    """Numbers (1..``most``) of a comma list whose items may be ``start:stop:step``."""
     values: list[float] = []
     for part in text.split(","):
         part = part.strip()

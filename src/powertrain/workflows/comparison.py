@@ -1,33 +1,11 @@
 r"""Comparison of a simulated run-up with a measured one (``powertrain compare``).
 
-:func:`compare_runup` scores, for every mount, direction and quantity (synthesis and each
-order) present on both sides, the level gap :math:`20\log_{10}(v_\mathrm{sim}/v_\mathrm{meas})`
-[dB] at the measured speeds, and the correlation metrics of :mod:`powertrain.analysis.compare`
-(FRAC over speed per channel, CSAC and CSF across the channels at each speed, an FRFSM-like
-score).
-
-Rules:
-
-* The simulation is taken at the measured speeds: exactly where it was simulated there
-  (``powertrain compare`` simulates at the measured speeds by default), otherwise
-  interpolated linearly in rpm and linearly in log level
-  (:func:`~powertrain.analysis.compare.interpolate_log`); measured points outside the
-  simulated speed range are not compared (never extrapolated) and are counted.
-* Measured points at or near the noise floor (below ``NOISE_FLOOR_MARGIN`` × floor, i.e.
-  within 9.5 dB of it; :mod:`powertrain.analysis.noise_floor`) are excluded and counted,
-  never scored as gaps.
-* Points where the simulation is below the noise floor itself while the measurement is above
-  the exclusion limit are "measured, not modelled": the model predicts nothing measurable
-  there (e.g. tracker leakage into an order the model does not excite). They are listed
-  apart (:attr:`ComparisonResult.not_modelled`) and never enter a dB gap.
-* Channels or quantities present on one side only are listed as missing, never scored as a
-  zero level; so are channels with no scoreable point.
-* CSAC and CSF need at least :data:`MIN_CHANNELS_CSAC` channels at a speed (counted otherwise).
-* Where both sides give the order phase (``MeasuredRunup.phases``; a simulation run here
-  always does), each compared point also gets a phase gap (sim − measured, wrapped to ±180°;
-  the simulated phase interpolated linearly in rpm between simulated speeds) and each
-  channel and quantity a complex gap (:mod:`powertrain.analysis.compare`); the levels' gaps
-  do not change.
+:func:`compare_runup` scores, for every mount, direction and quantity present on both sides,
+the level gap :math:`20\log_{10}(v_\mathrm{sim}/v_\mathrm{meas})` [dB] at the measured
+speeds and the correlation metrics of :mod:`powertrain.analysis.compare` (FRAC, CSAC, CSF,
+an FRFSM-like score). The simulation is interpolated in rpm and log level, never
+extrapolated; measured points near the noise floor (``NOISE_FLOOR_MARGIN``) and points
+"measured, not modelled" are counted apart, never scored. The rules: docs/guide/compare.md.
 """
 
 from __future__ import annotations
@@ -139,8 +117,7 @@ def _given_simulation(simulated, measured):
 
 
 def _read_curves(path, mounts=None):
-    """Order curves of ``path`` (a MeasuredRunup is taken as it is); raw time data are
-    refused with a pointer to ``track``."""
+    """Order curves of ``path``; raw time data refused with a pointer to ``track``."""
     if isinstance(path, MeasuredRunup):
         return path
     kind = detect_format(path)

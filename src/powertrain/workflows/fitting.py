@@ -1,39 +1,17 @@
 r"""Mount parameter identification: fit a lumped mount model to a measured K*(f).
 
-Kovarik (2016), sec. 2.2, identifies the parameters of every model of Table 2 by minimising
-the Euclidean norm of the difference between the theoretical and the measured cross-point
-dynamic stiffness (eq. 17–19), with the parameters constrained to be non-negative:
+Kovarik (2016), sec. 2.2, eq. 17–19: minimise, over parameters >= 0,
 
 .. math::
-    f_{obj} = \lVert k_t - k_m \rVert \cdot 1\,\mathrm{mm}
-            = \Bigl(\sum_{i=1}^{N} \bigl|K_{CP}(\omega_i;\,\mathbf p) - K_m(\omega_i)\bigr|^2
-              \Bigr)^{1/2} \cdot 1\,\mathrm{mm} \qquad [\mathrm N]
+    f_{obj} = \Bigl(\sum_{i=1}^{N} \bigl|K_{CP}(\omega_i;\,\mathbf p) - K_m(\omega_i)\bigr|^2
+              \Bigr)^{1/2} \cdot 1\,\mathrm{mm} \qquad [\mathrm N],
 
-with :math:`K` in N/mm and a 1 mm displacement (eq. 18–19), the norm taken over the complex
-values at the N measured frequencies. The thesis used SQP (``fmincon``) and found the larger
-models "not robust" (sec. 2.3.5). This module solves the same problem more robustly:
-
-* **log-parameters** :math:`q_j = \ln p_j`: every parameter stays positive without
-  constraints, and stiffness [N/m], damping [N·s/m] and mass [kg] values spanning many
-  decades get comparable steps. A soft wall (an extra residual growing linearly outside a
-  wide box scaled to the data, see :func:`parameter_box`) keeps the search finite.
-* **analytic Jacobian** of :math:`K_{CP}` with respect to every parameter
-  (:func:`powertrain.physics.mount_network.cross_point_stiffness_gradient`), evaluated by a
-  compiled kernel, with residuals normalised by :math:`\lVert K_m\rVert` so that the cost is
-  the relative RMS error :math:`\varepsilon` (below).
-* **many starts**, screened then polished: ``starts`` random starting points (seeded;
-  springs around the data's stiffness level, each damper a loss factor at a random
-  frequency, each mass resonating at a random frequency in the band); each start is rescaled
-  by the optimal overall factor (:math:`K_{CP}` is homogeneous of degree one in the
-  parameters), run for a few Levenberg–Marquardt iterations
-  (:func:`scipy.optimize.least_squares`, ``method="lm"``), and the best ``polish`` of them are
-  run to convergence. The best is returned.
-
-Relative RMS error used throughout (one global normalisation, so that minimising it is
-minimising :math:`f_{obj}`):
-
-.. math:: \varepsilon = \sqrt{\frac{\sum_i |K_{CP}(\omega_i) - K_m(\omega_i)|^2}
-                               {\sum_i |K_m(\omega_i)|^2}} .
+equivalently the relative RMS error
+:math:`\varepsilon = \sqrt{\sum_i |K_{CP} - K_m|^2 / \sum_i |K_m|^2}`. Solved on
+log-parameters (a soft wall outside :func:`parameter_box`) with the analytic Jacobian
+(:func:`powertrain.physics.mount_network.cross_point_stiffness_gradient`), from many seeded
+starts screened then polished, then hops of the incumbent (:func:`fit_mount`); the method
+and its figures: docs/guide/fit-mount.md.
 
 References
 ----------
@@ -398,8 +376,7 @@ def _checked_data(frequency_hz, kcp_measured, topology):
 
 
 def _screen_and_polish(prob, starts, polish) -> list:
-    """Run every start a few iterations, then the best ``polish`` to convergence:
-    ``[(q, relative RMS error, converged)]``."""
+    """Screen every start, polish the best ``polish``: ``[(q, rel. RMS error, ok)]``."""
     screened = []
     for q0 in starts:
         q, err, _ = prob.solve(prob.rescale(q0), SCREEN_NFEV, 1e-6)

@@ -1,19 +1,10 @@
 r"""The synthetic measurement of ``powertrain synth``: scatter, noise floor and the measured file.
 
-**Measurement** (:func:`measure`): each order's complex amplitude [RMS] of a noise-free run-up
-times :math:`10^{\epsilon/20}`, :math:`\epsilon\sim N(0,\sigma)` (log-normal scatter, σ
-uniform in :data:`SIGMA_DB` per case unless given), plus complex Gaussian noise of RMS
-:data:`FLOOR`; the written orders :data:`WRITTEN_ORDERS` and the synthesis (RMS sum of all 16
-noisy orders), optionally with the order phase a lab records.
-
-**Size of a hidden effect** (:func:`gap_stats`): the noise-free gap of the run-up with the
-effect against the one without, over the written order points of all speeds (:func:`gaps_db`:
-floor added in power; points where both are at the floor,
-:func:`powertrain.analysis.noise_floor.censoring_level`, left out).
-
-:func:`draw_case` draws hidden effects, simulates them noise-free and measures them: a
-:class:`SyntheticCase`, whose :meth:`~SyntheticCase.csv_text` is the measured file (marked
-SYNTHETIC).
+:func:`measure`: each order's complex amplitude [RMS] times :math:`10^{\epsilon/20}`,
+:math:`\epsilon\sim N(0,\sigma)`, plus complex Gaussian noise of RMS :data:`FLOOR`.
+:func:`gap_stats`: the noise-free size of a hidden effect. :func:`draw_case`: a
+:class:`SyntheticCase` (draw, simulate, measure), whose :meth:`~SyntheticCase.csv_text` is
+the measured file (marked SYNTHETIC).
 """
 
 from __future__ import annotations

@@ -95,17 +95,13 @@ class Scale:
     origin: Origin = Origin("--scale")
 
     def apply(self, engine):
+        f = self.factor
         if self.kind in LAW_KEYS:
-            f = self.factor
             return _map_laws(engine, self, self.kind, lambda v: tuple(f * x for x in v)
                              if isinstance(v, tuple) else f * v)
-
-        def change(model):
-            if self.kind == "stiffness":
-                return model.scaled(stiffness=self.factor)
-            if self.kind == "damping":
-                return model.scaled(damping=self.factor)
-            return model.scaled_dynamic_stiffness(self.factor)
+        change = {"stiffness": lambda m: m.scaled(stiffness=f),
+                  "damping": lambda m: m.scaled(damping=f)}.get(
+            self.kind, lambda m: m.scaled_dynamic_stiffness(f))
         return _map_directions(engine, self.mount, self.direction, change, self.origin)
 
 
@@ -219,12 +215,8 @@ class Rotate:
     spec: str = ""
     origin: Origin = Origin("--rotate")
 
-    def matrix(self) -> np.ndarray:
-        """:math:`R_z(a_z) R_y(a_y) R_x(a_x)` (fixed engine axes)."""
-        return rotation_matrix(*self.angles)
-
     def apply(self, engine):
-        R = self.matrix()
+        R = rotation_matrix(*self.angles)
         return _map_mounts(engine, self.mount, lambda m: dataclasses.replace(
             m, rotation=R @ np.asarray(m.rotation, float)), self.origin)
 
@@ -286,10 +278,6 @@ class AddEffect:
     spec: str = ""
     origin: Origin = Origin("--effect")
 
-    @property
-    def scenario(self) -> dict:
-        return {self.effect: dict(self.params)}
-
     def apply(self, engine):
         if self.effect in RESPONSE_EFFECTS:
             return engine
@@ -307,11 +295,6 @@ def effect_scenario(operations, names=None) -> dict:
     return sc
 
 
-def response_scenario(operations) -> dict:
-    """The response-level effects of a variant's operations, merged in order."""
-    return effect_scenario(operations, RESPONSE_EFFECTS)
-
-
 @dataclass(frozen=True)
 class Variant:
     """A named sequence of operations applied in order to the baseline engine."""
@@ -323,10 +306,6 @@ class Variant:
     @property
     def specs(self) -> list:
         return [op.spec for op in self.operations]
-
-    @property
-    def targets(self) -> list:
-        return [op for op in self.operations if isinstance(op, Target)]
 
 
 # --------------------------------------------------------------------------- geometry
@@ -417,11 +396,3 @@ def apply_operations(engine, operations):
         engine = op.apply(engine)
     return engine
 
-
-def check_operations(engine, operations) -> None:
-    """Validate names of every operation against ``engine`` (targets included)."""
-    for op in operations:
-        if isinstance(op, Target):
-            op.check(engine)
-        else:
-            engine = op.apply(engine)

@@ -1,15 +1,8 @@
-r"""Retune a mount direction to a desired change of its dynamic stiffness over a band.
+r"""Retune a mount direction to a desired change of its dynamic stiffness over a band
+(``--target left.z:+20%:100-300Hz``, :func:`powertrain.workflows.variants.parse_target`).
 
-The way an engineer asks a mount supplier for a variant: "20 % stiffer between 100 and
-300 Hz, otherwise as it is". ``--target left.z:+20%:100-300Hz`` (syntax:
-:func:`powertrain.workflows.variants.parse_target`) builds the requested curve from the baseline
-cross-point stiffness :math:`K_0(f)` of that mount direction, fits the same lumped model to
-it with :func:`powertrain.workflows.fitting.fit_mount`, and runs the fitted model as a variant.
-
-Requested curve
----------------
-With :math:`a = \ln(\text{factor})` (factor 1.2 for ``+20%``), :math:`f_1, f_2` the band and
-:math:`h` the transition width in octaves (default 0.5), the log-gain is
+With :math:`a = \ln(\text{factor})`, :math:`f_1, f_2` the band and :math:`h` the transition
+width in octaves (default 0.5), the requested curve is :math:`K_t = K_0\,g\,e^{i\varphi}`:
 
 .. math::
     \ln g(f) = a\,w(f), \qquad
@@ -18,51 +11,17 @@ With :math:`a = \ln(\text{factor})` (factor 1.2 for ``+20%``), :math:`f_1, f_2` 
              0 & \delta \ge 1 \end{cases}, \qquad
     \delta = \frac{\max(\log_2(f_1/f),\ \log_2(f/f_2))}{h},
 
-a raised-cosine blend in log-frequency over ``h`` octaves on each side. The magnitude of
-the requested curve is :math:`|K_0(f)|\,g(f)`. A passive mount cannot change its magnitude in a
-band without changing its phase near the band edges: for a minimum-phase change the phase
-follows from the gain (Bode's gain-phase relation),
-
-.. math::
     \varphi(f_0) = \frac1\pi \int_{-\infty}^{\infty} \frac{d \ln g}{du}\,
                    \ln\coth\frac{|u|}{2}\, du, \qquad u = \ln(f / f_0),
 
-so the requested curve is :math:`K_t(f) = K_0(f)\,g(f)\,e^{i\varphi(f)}`. (Multiplying real and
-imaginary part by :math:`g` alone, keeping the loss angle, is not realisable by a network.)
-
-Fit
----
-The body feels a mount through its *input-point* stiffness :math:`K_{IP}` (which carries the
-inertia of the network's internal masses), a test rig measures the *cross-point* one
-:math:`K_{CP}`; a fit to :math:`K_{CP}` alone does not determine :math:`K_{IP}` (it can
-meet K_CP with an unphysically large internal mass). The retune therefore has two stages:
-
-1. :func:`~powertrain.workflows.fitting.fit_mount` (multi-start, log-parameters, its default seeded
-   starts -- it takes no user starting point) of the baseline topology to :math:`K_t` alone;
-2. a joint least-squares refinement (:func:`scipy.optimize.least_squares`, log-parameters)
-   of the relative errors of :math:`K_{CP}` against :math:`K_t` *and* of :math:`K_{IP}`
-   against :math:`K_{IP,t} = K_{IP,0} + (K_t - K_0)` (the requested change, the internal-mass
-   part of the baseline kept), equally weighted, started from the stage-1 fit and from the
-   baseline parameters (its zero parameters kept zero: same network); the lower joint cost
-   wins.
-
-At an amplitude
----------------
-``--target left.z:+20%:100-300Hz:0.3mm`` asks the change of the mount direction's K_CP at
-a relative-displacement amplitude (x units, mm by default) for a direction with an
-amplitude law or friction (an error otherwise): :math:`K_0` is then the equivalent-linear
-K_CP at that amplitude -- the network with its law's factors there plus the friction's
-describing stiffness (:func:`network_at`) -- the network at that amplitude is fitted to
-:math:`K_t` less the friction, and the fitted springs and dampers are divided by the law's
-factors, so that the retuned mount, law and friction unchanged, meets the request at that
-amplitude. Its reported curves are at that amplitude.
-
-Frequencies: 0 Hz plus :data:`N_FREQUENCIES` log-spaced from 1 Hz to
-:math:`\max(1000\,\mathrm{Hz},\ 2^{h+1} f_2)` (the run-up's orders reach 8 × 6000/60 = 800 Hz).
-Fit quality reported (:class:`TargetFit`): the relative RMS errors of :math:`K_{CP}` and
-:math:`K_{IP}` over all frequencies, the largest relative complex error
-:math:`|K_{fit} - K_t|/|K_t|` inside the band, and the achieved mean change of :math:`|K_{CP}|`
-inside the band against the requested one.
+the phase of a minimum-phase change (Bode's gain-phase relation). The fit has two stages:
+:func:`~powertrain.workflows.fitting.fit_mount` of the baseline topology to :math:`K_t`,
+then a joint least-squares refinement of the relative errors of :math:`K_{CP}` against
+:math:`K_t` and of :math:`K_{IP}` against :math:`K_{IP,0} + (K_t - K_0)`, started from that
+fit and from the baseline (lower cost wins). At an amplitude (``...:0.3mm``) :math:`K_0` is
+the equivalent-linear K_CP there (:func:`network_at`). Frequencies: 0 Hz plus
+:data:`N_FREQUENCIES` log-spaced from 1 Hz to :math:`\max(1000\,\mathrm{Hz},\ 2^{h+1} f_2)`.
+Why and the fit quality reported: docs/guide/whatif.md (*Retune to a target*).
 """
 
 from __future__ import annotations
@@ -77,7 +36,7 @@ from powertrain.models.mount import MountModel
 from powertrain.plotting import plot_retune
 from powertrain.plotting.style import target_and_path
 from powertrain.results.base import Result
-from powertrain.workflows.fitting import fit_mount
+from powertrain.workflows.fitting import fit_mount, relative_rms_error
 from powertrain.workflows.operations import Origin, Swap, Target
 
 #: Log-spaced fit frequencies above 0 Hz.
@@ -156,21 +115,6 @@ def bode_phase(frequency_hz, log_factor, f_lo, f_hi, blend_octaves=0.5) -> np.nd
     kernel = np.log(1.0 / np.tanh(np.maximum(u, 1e-12) / 2.0))
     out[pos] = kernel @ slope / np.pi
     return out
-
-
-def target_curve(model, target: Target, frequency_hz) -> np.ndarray:
-    r"""Requested cross-point stiffness :math:`K_t = K_0\,g\,e^{i\varphi}` [N/m].
-
-    Parameters
-    ----------
-    model : MountModel
-        Baseline model of the mount direction (its network; at an amplitude see
-        :func:`retune`).
-    target : Target
-    frequency_hz : array_like
-        [Hz]
-    """
-    return model.cross_point_stiffness(frequency_hz) * _gain(target, frequency_hz)
 
 
 def _gain(target: Target, frequency_hz) -> np.ndarray:
@@ -300,10 +244,6 @@ class TargetFit(Result):
                            provenance=provenance)
 
 
-def _rel_rms(k, kt) -> float:
-    return float(np.sqrt(np.sum(np.abs(k - kt) ** 2) / np.sum(np.abs(kt) ** 2)))
-
-
 def _refine(topology, p0, free, f, kt_cp, kt_ip):
     """Joint least squares of K_CP and K_IP relative errors over log-factors of the free
     parameters of ``p0``; returns (parameters [SI], cost)."""
@@ -336,7 +276,7 @@ REFINE_NFEV = 3000
 
 def retune(model, target: Target, **fit_kwargs) -> TargetFit:
     """Retune ``model`` (same topology, its laws kept) to the requested curve of ``target``
-    (at ``target.amplitude``: module docstring, *At an amplitude*).
+    (at ``target.amplitude``: the equivalent-linear K_CP there, :func:`network_at`).
 
     Parameters
     ----------
@@ -378,8 +318,8 @@ def _target_fit(target, model, fitted, f, k0, kt, kip_t, kf, kip_f, start, summa
     band = (f >= target.f_lo) & (f <= target.f_hi)
     return TargetFit(target=target, baseline=model, model=fitted, frequency_hz=f,
                      kcp_baseline=k0, kcp_target=kt, kcp_fitted=kf, kip_target=kip_t,
-                     kip_fitted=kip_f, rel_rms=_rel_rms(kf, kt),
-                     kip_rel_rms=_rel_rms(kip_f, kip_t),
+                     kip_fitted=kip_f, rel_rms=relative_rms_error(kf, kt),
+                     kip_rel_rms=relative_rms_error(kip_f, kip_t),
                      max_band_error=float(np.max(np.abs(kf[band] - kt[band])
                                                  / np.abs(kt[band]))),
                      mean_band_change=float(np.mean(np.abs(kf[band]) / np.abs(k0[band])) - 1),

@@ -1,25 +1,13 @@
 r"""The run-up: engine -> assembled model -> solver -> order results.
 
-:func:`runup` is the public entry (the ``powertrain runup`` command calls it): the engine
-checked, balancers and unmodelled effects applied, the settings checked, then a stepped run-up
-(:func:`run_runup`, :func:`runup_with_effects`) or a continuous one (``sweep``, tracked like a
-measurement).
-
-For each speed step the load over one engine cycle is sampled at a constant crank-angle
-increment. Two solvers give the periodic steady state of the same assembled linear model:
-
-* ``newmark`` (default, the thesis's way): Newmark average-acceleration time integration in
-  the Numba kernel over ``cycles`` engine cycles (6), processing the last ``processed_cycles``
-  (2) by FFT. Every speed step starts from the periodic steady-state estimate (static preload
-  plus the frequency-domain solution at t = 0), so the lightly damped rigid-body modes and
-  the step of the mean torque do not pollute the window; the cycle-to-cycle periodicity of
-  the processed window is reported and a warning raised above 0.1 %.
-* ``harmonic``: the frequency-domain solve order by order
-  (:mod:`powertrain.solvers.harmonic`), exact for the linear model and used as a cross-check.
-
-The solver is chosen once per run (:func:`powertrain.solvers.steppers.choose_stepper`); a
-run-up is then: speeds and time grid, the assembled model, the stepper, the cycle loads, one
-solve per speed, the periodicity check, the result.
+:func:`runup` is the public entry (``powertrain runup``): the engine and settings checked,
+balancers and unmodelled effects applied, then a stepped run-up (:func:`run_runup`,
+:func:`runup_with_effects`) or a continuous one (``sweep``, tracked like a measurement).
+Per speed step the load over one engine cycle at a constant crank-angle increment drives
+the periodic steady state of the assembled linear model, by Newmark time integration over
+:data:`CYCLES` cycles, :data:`PROCESSED_CYCLES` processed by FFT (the thesis's way, sec.
+4.4), or by the frequency-domain solve order by order (``harmonic``); the stepper is chosen
+once per run (:func:`powertrain.solvers.steppers.choose_stepper`). docs/guide/runup.md.
 """
 
 from __future__ import annotations
@@ -85,17 +73,11 @@ def _cycle_loads(engine, rpm, n_per_cycle):
     return load
 
 
-def run_runup(*args, **kwargs) -> RunupResult:
-    """Simulate a run-up (see :func:`_run_runup` for the parameters), BLAS limited to one
-    thread meanwhile (:func:`~powertrain.parallel.single_blas_thread`)."""
-    with single_blas_thread():
-        return _run_runup(*args, **kwargs)
-
-
-def _run_runup(engine, rpm=None, *, solver="newmark", angle_step_deg=ANGLE_STEP_DEG,
+def run_runup(engine, rpm=None, *, solver="newmark", angle_step_deg=ANGLE_STEP_DEG,
               cycles=CYCLES, processed_cycles=PROCESSED_CYCLES, progress=False,
               system=None, stepper="auto") -> RunupResult:
-    """Simulate a run-up: steady state at each speed, order analysis of the mount points.
+    """Simulate a run-up: steady state at each speed, order analysis of the mount points
+    (BLAS limited to one thread meanwhile, :func:`~powertrain.parallel.single_blas_thread`).
 
     Parameters
     ----------
@@ -123,46 +105,21 @@ def _run_runup(engine, rpm=None, *, solver="newmark", angle_step_deg=ANGLE_STEP_
     """
     rpm = _speeds(rpm)
     grid = _cycles(angle_step_deg, cycles, processed_cycles)
-    if system is None:
-        system = engine.assemble()
-    step = choose_stepper(system, solver, stepper, grid)
-    loads = list(_cycle_loads(engine, rpm, grid.n_cycle))
     bar = {"desc": f"run-up ({solver})", "unit": "speed", "enabled": bool(progress)}
-    points = _operating_points(engine, rpm)
-    if points is None:
-        speeds, seconds = _solve_speeds(step, rpm, loads, bar)
-    else:
-        speeds, seconds = _solve_at_operating_points(engine, step, rpm, loads, points, bar)
-    _warn_periodicity(rpm, [o.periodicity for o in speeds])
-    return _result(engine, system, step, rpm, speeds, step.setup_seconds + seconds,
-                   None if points is None else _static_result(engine, points))
+    with single_blas_thread():
+        if system is None:
+            system = engine.assemble()
+        step = choose_stepper(system, solver, stepper, grid)
+        loads = list(_cycle_loads(engine, rpm, grid.n_cycle))
+        points = operating_points(engine, rpm) if has_static_curves(engine) else None
+        speeds, seconds = _solve_speeds(engine, step, rpm, loads, points, bar)
+        _warn_periodicity(rpm, [o.periodicity for o in speeds])
+        return _result(engine, system, step, rpm, speeds, step.setup_seconds + seconds,
+                       None if points is None else _static_result(engine, points))
 
 
 def _static_result(engine, points) -> StaticResult:
     return StaticResult(points, engine.mount_names, engine.name)
-
-
-def _operating_points(engine, rpm):
-    """The static operating point of every speed when some mount direction has a static
-    curve (its networks are then scaled per speed); None otherwise (nothing is solved)."""
-    if not has_static_curves(engine):
-        return None
-    return operating_points(engine, rpm)
-
-
-def _solve_at_operating_points(engine, step, rpm, loads, points, bar):
-    """Every speed solved by a stepper of the kind chosen once, on the model assembled with
-    the networks scaled at that speed's operating point
-    (:meth:`~powertrain.physics.mount_elements.MountElement.at_operating_point`); the
-    equivalent-linear amplitudes carried from speed to speed. Returns the speeds' orders
-    and the solver time (the per-speed setups included)."""
-    speeds, total = [], 0.0
-    for i in progress_bar(range(rpm.size), **bar):
-        system = engine.assemble(points[i].static_factor)
-        step = step.on_system(system)
-        speeds.append(step.solve(loads[i], rpm[i] * 2 * np.pi / 60.0))
-        total += speeds[-1].seconds + step.setup_seconds
-    return speeds, total
 
 
 def _speeds(rpm) -> np.ndarray:
@@ -181,19 +138,27 @@ def _cycles(angle_step_deg, cycles, processed_cycles) -> Cycles:
     return Cycles(int(round(n_cycle)), angle_step_deg, cycles, processed_cycles)
 
 
-def _solve_speeds(step, rpm, loads, bar):
-    """Every speed's :class:`SpeedOrders` and the solver time (summed per-speed solver
-    times)."""
-    omegas = rpm * 2 * np.pi / 60.0
-    speeds = [step.solve(loads[i], omegas[i]) for i in progress_bar(range(rpm.size), **bar)]
-    return speeds, float(sum(o.seconds for o in speeds))
+def _solve_speeds(engine, step, rpm, loads, points, bar):
+    """Every speed's :class:`SpeedOrders` and the solver time. With operating ``points``,
+    each speed on the model assembled with the networks scaled at its operating point
+    (:meth:`~powertrain.physics.mount_elements.MountElement.at_operating_point`), by a
+    stepper of the kind chosen once, the equivalent-linear amplitudes carried from speed
+    to speed (the per-speed setups timed too)."""
+    speeds, total = [], 0.0
+    for i in progress_bar(range(rpm.size), **bar):
+        if points is not None:
+            step = step.on_system(engine.assemble(points[i].static_factor))
+            total += step.setup_seconds
+        speeds.append(step.solve(loads[i], rpm[i] * 2 * np.pi / 60.0))
+        total += speeds[-1].seconds
+    return speeds, total
 
 
 def _warn_periodicity(rpm, periodicity):
     for n_rpm, p in zip(rpm, periodicity):
         if p > PERIODICITY_LIMIT:
             warnings.warn(f"{n_rpm:g} rpm: processed window periodic only to "
-                          f"{100 * p:.3g} % (> 0.1 %)", PeriodicityWarning, stacklevel=4)
+                          f"{100 * p:.3g} % (> 0.1 %)", PeriodicityWarning, stacklevel=3)
 
 
 def _result(engine, system, step, rpm, speeds, solver_seconds, operating_point) -> RunupResult:
@@ -344,8 +309,7 @@ def _with_engine(result, engine, rpm, modifications) -> RunupResult:
 
 def _checked_options(solver, stepper, angle_step_deg, balancers, sweep, sample_rate,
                      progress) -> dict:
-    """The options of :func:`runup` checked as the command checks them (its option names in
-    the errors); the numbers as floats."""
+    """The options of :func:`runup` checked as the command checks them."""
     args.choice(solver, tuple(SOLVERS), "--solver")
     args.choice(stepper, tuple(NEWMARK_STEPPERS), "--stepper")
     return {"angle_step_deg": args.real(angle_step_deg, "--angle-step", unit="deg"),
@@ -366,8 +330,7 @@ def _stepped(engine, rpm, scenario, progress, **options) -> RunupResult:
 
 
 def _scenario(effects, engine) -> dict:
-    """``{effect: {parameter: value}}`` of ``--effect`` strings (one string or a sequence),
-    or a scenario as given."""
+    """The scenario of ``--effect`` strings, or a scenario as given."""
     if isinstance(effects, dict):
         return effects
     return effect_scenario(parse_operations({"effect": args.texts(effects, "--effect")},

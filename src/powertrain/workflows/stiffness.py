@@ -88,8 +88,7 @@ def stiffness(mount, *, engine=None, freq=None, method="frequency", force=None,
 
 
 def _amplitude_argument(amplitude, mount_file):
-    """``amplitude`` of :func:`stiffness` in [m]: None, numbers [m], or the ``--amplitude``
-    text in the unit of ``mount_file`` (:func:`parse_amplitudes`)."""
+    """``amplitude`` of :func:`stiffness` in [m] (text: :func:`parse_amplitudes`)."""
     if amplitude is None:
         return None
     if isinstance(amplitude, str):
@@ -164,10 +163,9 @@ def stiffness_table(model, frequency_hz, method="frequency", engine_mass=None, f
     f = np.asarray(frequency_hz, float)
     kw = {} if steps_per_period is None else {"steps_per_period": steps_per_period}
     if method == "frequency":
-        if engine_mass is None:
-            return StiffnessResult(f, model.cross_point_stiffness(f), method)
-        x1, ft = model.forced_engine_mass_response(f, engine_mass, force)
-        return StiffnessResult(f, model.cross_point_stiffness(f), method, x1, ft)
+        forced = () if engine_mass is None else model.forced_engine_mass_response(
+            f, engine_mass, force)
+        return StiffnessResult(f, model.cross_point_stiffness(f), method, *forced)
     if method == "time":
         if engine_mass is None:
             r = time_cross_point_stiffness(MountElement(model.network()), f, **kw)

@@ -1,24 +1,10 @@
 """The sweep engine: run many run-up variants on any executor.
 
-A :class:`SweepTask` is a small picklable description -- the variant's engine (its operations
-already applied), its response-level effects, speeds, solver -- and :func:`run_task` turns it
-into a :class:`~powertrain.results.runup.RunupResult` in whatever process runs it.
-:func:`run_sweep` runs the tasks on the one executor factory,
-:func:`powertrain.parallel.executor` (through :func:`powertrain.parallel.run_map`): by default
-a process pool on the local cores (serial for one task or ``workers=1``), or the scheduler
-named (``serial``, ``processes``, ``local``, ``tcp://HOST:PORT``), or an executor passed in,
-e.g. a Dask client::
-
-      from distributed import Client
-      client = Client("tcp://scheduler:8786")    # or Client() for a local cluster
-      results = run_sweep(tasks, executor=client)
-
-Only ``submit`` and the futures' ``result`` are used; results come back in task order; the
-workers must have ``powertrain`` installed; an executor passed in is not shut down. Nothing in
-the model knows which executor runs it.
-
-BLAS inside :func:`powertrain.workflows.runup.run_runup` is limited to one thread, so one
-process per core does not oversubscribe.
+A :class:`SweepTask` is a small picklable description of one variant's run-up;
+:func:`run_task` turns it into a :class:`~powertrain.results.runup.RunupResult` in whatever
+process runs it; :func:`run_sweep` runs the tasks on :func:`powertrain.parallel.executor`
+(a local process pool by default, a scheduler name or address, or an executor passed in,
+e.g. a Dask client, left running), results in task order. docs/guide/parallel.md.
 """
 
 from __future__ import annotations

@@ -1,57 +1,17 @@
 r"""``powertrain synth``: a SYNTHETIC measured run-up with hidden effects and noise.
 
-A case is the default (or any) engine plus zero, one or two hidden *truth* effects with
-random parameters, simulated noise-free on the frequency-domain harmonic model
-(:class:`~powertrain.solvers.fast_harmonic.HarmonicModel`, the effect models in
-:mod:`powertrain.workflows.synth_effects`) on a 50-rpm grid and measured with scatter and
-noise (:mod:`powertrain.workflows.measurement`). The truth effects are of higher fidelity
-than, and parametrised differently from, the diagnosis candidates of :mod:`powertrain.effects`:
-
-=====================  ==================  =====================================================
-truth effect           library match       truth model (candidate model)
-=====================  ==================  =====================================================
-``body_modes``         base_compliance     a chassis body with 3 modes (20–80 Hz, ζ 3–8 %,
-                                           modal mass 1.5–10 kg, random shapes) under *all* nine
-                                           mount networks, coupling them (candidate: one local
-                                           base mass/spring per network, all alike)
-``mount_temperature``  mount_stiffness     per mount *and direction* spring factors s·e^{N(0,
-                                           0.05)}, dampers s^0.7, masses unchanged (candidate:
-                                           one elastomer factor per mount on the springs,
-                                           its power k^γ on the dampers)
-``amplitude_power``    amplitude_stiffness springs only times (a/a_ref)^(−β), β per mount type
-                                           (hydraulic, elastomeric) 0.08–0.25, a ≥ 1 µm;
-                                           equivalent linearisation (candidate: rational law
-                                           on the whole dynamic stiffness, one for all)
-``balancer_error``     balancer_error      per-shaft unbalance 0.75–1.25 and common drive lag
-                                           ±0.35 rad plus per-shaft ±0.05 rad (candidate: gain,
-                                           shaft asymmetry, one common lag)
-``cylinder_combustion`` cylinder_imbalance per-cylinder IMEP ±12 % *and* start of combustion
-                                           ±2°, exact pressure model (candidate: IMEP factors,
-                                           load linearised)
-``sensor_triads``      sensor_error        per-channel gain ±5 dB and 1–3 % cross-axis
-                                           sensitivity within each triad, a random 3×3
-                                           matrix (candidate: gains and a rotation of
-                                           each triad)
-``powertrain_bending`` (none: outside)     engine–gearbox bending mode 50–140 Hz amplifying the
-                                           gearbox mount point, factor 1 + κω²/(ω_b² − ω² +
-                                           2iζω_bω), κ 0.15–0.5
-``torsional_driveline`` (none: outside)    roll-moment (torque reaction) filtered by a
-                                           driveline torsional mode 40–120 Hz, factor on M_x
-                                           1 + κω²/(ω_t² − ω² + 2iζω_tω)
-=====================  ==================  =====================================================
-
-Effects are redrawn (up to :data:`REDRAWS` times) until their noise-free gap
-(:func:`~powertrain.workflows.measurement.gaps_db`) is at least :data:`MIN_EFFECT_DB` RMS or
-reaches :data:`MIN_EFFECT_MAX_DB` somewhere: smaller effects are not worth diagnosing at 0.5–1 dB
-measurement noise (chassis modes rarely reach 0.5 dB RMS on the engine-side velocities,
-which are mass-controlled above the rigid-body modes, so for them the local criterion is
-what counts). The diagnosis is never imported here.
+A case is an engine plus zero, one or two hidden *truth* effects with random parameters
+(:func:`draw_truth`), simulated noise-free on the harmonic model
+(:mod:`powertrain.workflows.synth_effects`) and measured with scatter and noise
+(:mod:`powertrain.workflows.measurement`). Effects are redrawn (up to :data:`REDRAWS` times)
+until their noise-free gap is at least :data:`MIN_EFFECT_DB` RMS or reaches
+:data:`MIN_EFFECT_MAX_DB` somewhere. The truth effects and their library matches:
+docs/guide/synth.md. The diagnosis is never imported here.
 """
 
 from __future__ import annotations
 
 import dataclasses
-import functools
 import json
 
 import numpy as np
@@ -180,14 +140,10 @@ def make_case(engine, truth_names, seed, *, rpm=None, hm=None, noise_db=None,
     rpm = RPM if rpm is None else np.asarray(rpm, float)
     hm = HarmonicModel(engine, rpm) if hm is None else hm
     base = hm.velocity(hm.solve(hm.two_ports()[0]))
-    return draw_case(list(truth_names), seed, engine, base, functools.partial(_simulate, hm),
+    return draw_case(list(truth_names), seed, engine, base,
+                     lambda eng, truth: truth_velocity(eng, hm, truth),
                      _draw, hm.channels, f"synthetic case 0 (seed {seed})", rpm=rpm,
                      noise_db=noise_db, params=params, redraws=REDRAWS, worth=worth_diagnosing)
-
-
-def _simulate(hm, engine, truth):
-    """Noise-free run-up of ``engine`` with ``truth`` on the harmonic model ``hm``."""
-    return truth_velocity(engine, hm, truth)
 
 
 # ---------------------------------------------------------------------------- public API

@@ -1,21 +1,9 @@
 r"""The truth effects of ``powertrain synth`` on the frequency-domain harmonic model.
 
 :func:`truth_velocity` is the noise-free run-up (channel velocities) of an engine with hidden
-*truth* effects, solved on :class:`~powertrain.solvers.fast_harmonic.HarmonicModel`. The truth
-models are of higher fidelity than, and parametrised differently from, the diagnosis
-candidates of :mod:`powertrain.effects` (their parameters are drawn by
-:func:`powertrain.workflows.synth.draw_truth`; the table is in docs/guide/synth.md):
-
-* ``body_modes``: a chassis body with modes under all mount networks, coupling them
-  (:func:`powertrain.solvers.body_coupling.coupled_solve`);
-* ``mount_temperature``: spring and damper factors per mount network;
-* ``amplitude_power``: springs times (a/a_ref)^(-β) per mount type, equivalent
-  linearisation by damped fixed-point iteration;
-* ``balancer_error``: per-shaft unbalance and drive lags;
-* ``cylinder_combustion``: per-cylinder IMEP and start of combustion, exact pressure model;
-* ``sensor_triads``: a 3×3 gain and cross-axis matrix per triad;
-* ``powertrain_bending``: an engine-gearbox bending mode amplifying the gearbox mount point;
-* ``torsional_driveline``: the roll moment filtered by a driveline torsional mode.
+*truth* effects, solved on :class:`~powertrain.solvers.fast_harmonic.HarmonicModel`; their
+parameters are drawn by :func:`powertrain.workflows.synth.draw_truth`. The effects, their
+models and ranges: the table of docs/guide/synth.md.
 """
 
 from __future__ import annotations

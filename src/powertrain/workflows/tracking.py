@@ -23,6 +23,7 @@ from powertrain.errors import InputError
 from powertrain.iotools.raw import read_raw
 from powertrain.models.recording import RawRecording
 from powertrain.plotting.orders import DISPLAY, MAP_MARGIN
+from powertrain.progress import progress_bar
 from powertrain.results.tracked import TrackedChannel, TrackedOrders
 from powertrain.workflows import arguments as args
 
@@ -119,8 +120,7 @@ def track(raw, *, orders=None, rpm_step=50.0, method="cot", bandwidth=None, chan
 
 
 def _numbers(rpm_step, bandwidth, pulses_per_rev, tdc_offset, spectrum_at):
-    """The numeric options of :func:`track` as numbers (a string as the option writes it is
-    read), their ranges left to the checks that follow."""
+    """The numeric options of :func:`track` as numbers (ranges checked later)."""
     return (args.real(rpm_step, "--rpm-step", unit="rpm"),
             args.real(bandwidth, "--bandwidth", unit="Hz", optional=True),
             args.integer(pulses_per_rev, "--pulses-per-rev", optional=True),
@@ -203,8 +203,6 @@ def _maps(rec, use, pulses_per_rev, rpm_step, channel, max_order, tracked_rpm):
     """Campbell and rpm-frequency maps of one channel (arguments of
     :func:`~powertrain.plotting.orders.plot_maps`), both reaching 25 % above the highest
     tracked order; ``tracked_rpm``: (lowest, highest) speed of the order curves [rpm]."""
-
-
     profile = speed_profile(rec, use=use, pulses_per_rev=pulses_per_rev)
     rpm, fine, rms = order_map(rec, profile, channel, rpm_step=rpm_step,
                                max_order=MAP_MARGIN * max_order)
@@ -274,17 +272,19 @@ def track_recording(rec, orders=None, *, rpm_step=50.0, method="cot", use="auto"
     if origin is not None:
         amp = to_tdc(amp, orders, origin[0])
         settings["phase"] = _phase_settings(orders, tdc_offset_deg, origin[1])
-    tracked = [TrackedChannel(c.name, c.mount, c.side, c.direction, c.quantity) for c in chans]
     level = None if overall is None else _overall(rec, chans, profile, orders, rpm, settings,
                                                   overall.get("band"), overall.get("velocity"))
-    return TrackedOrders(rpm, orders, tracked, amp, method, rec.source, settings,
+    return TrackedOrders(rpm, orders, _tracked(chans), amp, method, rec.source, settings,
                          list(rec.comments), level, recording=_summary(rec))
+
+
+def _tracked(chans) -> list:
+    return [TrackedChannel(c.name, c.mount, c.side, c.direction, c.quantity) for c in chans]
 
 
 def _track_channels(rec, chans, profile, orders, method, rpm_step, block_or_bandwidth,
                     progress):
-    """``(amplitudes, rpm, settings)`` of :func:`_track_cot` or :func:`_track_vkf`, the
-    settings with the speed grid and source."""
+    """``(amplitudes, rpm, settings)`` of COT or VKF, with the speed grid and source."""
     track_with = _track_cot if method == "cot" else _track_vkf
     amp, rpm, settings = track_with(rec, chans, profile, orders, rpm_step, block_or_bandwidth,
                                     progress)
@@ -313,8 +313,7 @@ def _tdc_origin(rec, profile, tdc_offset_deg):
     if rec.cycle_reference is not None:
         edges = tacho_edges(rec.time, rec.cycle_reference, file=rec.source,
                             key="--cycle-reference", what="cycle reference")
-    origin, per_cycle = tdc_origin(profile, float(tdc_offset_deg), edges, file=rec.source)
-    return origin, per_cycle
+    return tdc_origin(profile, float(tdc_offset_deg), edges, file=rec.source)
 
 
 def _phase_settings(orders, tdc_offset_deg, per_cycle) -> dict:
@@ -378,8 +377,7 @@ def order_spectrum(rec, profile, rpm, top_order, *, quantity=None) -> TrackedOrd
                          file=rec.source, key="--spectrum-at")
     amp = cot.cot_amplitudes(rec.channel_matrix(chans), profile, fine, np.array([rpm]),
                              centre, B)
-    tracked = [TrackedChannel(c.name, c.mount, c.side, c.direction, c.quantity) for c in chans]
-    return TrackedOrders(np.array([float(rpm)]), fine, tracked, amp, "cot", rec.source,
+    return TrackedOrders(np.array([float(rpm)]), fine, _tracked(chans), amp, "cot", rec.source,
                          {"block_revolutions": B, "window": "hann",
                           "order_resolution": 1.0 / B}, list(rec.comments))
 
@@ -397,20 +395,13 @@ def _track_cot(rec, chans, profile, orders, rpm_step, block_revs, progress):
     """Computed order tracking over the speed grid: (amplitudes, rpm, settings)."""
     B = int(block_revs or cot.block_revolutions(orders))
     S = cot.samples_per_rev(orders)
-    i0, i1 = profile.valid
-    n_min = float(np.min(profile.rpm[i0:i1 + 1]))
-    margin = cot.KERNEL_ZERO_CROSSINGS / (cot.ANTI_ALIAS_FRACTION * S * n_min / 60.0)
-    rpm, centre = cot.speed_grid(profile, rpm_step, B, margin_s=margin, file=rec.source,
-                                 key=profile.source)
+    rpm, centre = cot.speed_grid(profile, rpm_step, B, margin_s=_kernel_margin(profile, S),
+                                 file=rec.source, key=profile.source)
     _check_rate(rec, orders, rpm)
     X = rec.channel_matrix(chans)
     amp = np.empty((rpm.size, X.shape[0], orders.size), complex)
-    steps = range(0, rpm.size, CHUNK)
-    if progress:
-        from tqdm import tqdm  # deferred: optional progress bar, imported only when shown
-        steps = tqdm(steps, desc="order tracking", unit="block", leave=False,
-                     disable=None, total=len(steps))
-    for s in steps:
+    for s in progress_bar(range(0, rpm.size, CHUNK), enabled=progress, desc="order tracking",
+                          unit="block"):
         amp[s:s + CHUNK] = cot.cot_amplitudes(X, profile, orders, rpm[s:s + CHUNK],
                                               centre[s:s + CHUNK], B)
     return amp, rpm, {"block_revolutions": B, "samples_per_revolution": S, "window": "hann",
@@ -447,7 +438,15 @@ def _track_vkf(rec, chans, profile, orders, rpm_step, bandwidth_hz, progress):
                       "structural_equation": "two-pole"}
 
 
-def order_map(rec, profile, channel=0, *, rpm_step=50.0, max_order=None, resolution=None):
+def _kernel_margin(profile, samples_per_rev) -> float:
+    """Time [s] the resampling kernel reaches beyond a block at the lowest valid speed."""
+    i0, i1 = profile.valid
+    n_min = float(np.min(profile.rpm[i0:i1 + 1]))
+    return cot.KERNEL_ZERO_CROSSINGS / (cot.ANTI_ALIAS_FRACTION * samples_per_rev * n_min
+                                        / 60.0)
+
+
+def order_map(rec, profile, channel=0, *, rpm_step=50.0, max_order=None):
     """Campbell (rpm-order) map of one channel: RMS over a fine order grid per speed.
 
     Returns
@@ -457,11 +456,9 @@ def order_map(rec, profile, channel=0, *, rpm_step=50.0, max_order=None, resolut
     top = float(max_order or 10.0)
     B = cot.MIN_BLOCK_REVS * 2
     fine = np.arange(1, int(top * B) + 1) / B
-    S = cot.samples_per_rev(fine)
-    i0, i1 = profile.valid
-    n_min = float(np.min(profile.rpm[i0:i1 + 1]))
-    margin = cot.KERNEL_ZERO_CROSSINGS / (cot.ANTI_ALIAS_FRACTION * S * n_min / 60.0)
-    rpm, centre = cot.speed_grid(profile, rpm_step, B, margin_s=margin, file=rec.source)
+    rpm, centre = cot.speed_grid(profile, rpm_step, B,
+                                 margin_s=_kernel_margin(profile, cot.samples_per_rev(fine)),
+                                 file=rec.source)
     X = rec.channels[channel].values[None, :]
     amp = cot.cot_amplitudes(X, profile, fine, rpm, centre, B)[:, 0, :]
     return rpm, fine, np.abs(amp) / np.sqrt(2.0)

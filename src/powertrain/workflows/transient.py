@@ -131,14 +131,13 @@ def transient(manoeuvre, engine=None, *, angle_step_deg=ANGLE_STEP_DEG, seat=Non
         run = simulate_transient(engine, m, system=system, angle_step_deg=step)
     labels = [f"{c}.{d}" for c, d in run.channels]
     load = run.load
-    result = TransientResult(
+    return TransientResult(
         m.name, m.file, engine.name, load.t, load.omega * 30.0 / np.pi,
         {"engine": load.engine_torque, "starter": load.starter_torque,
          "driveline": load.driveline_torque},
         run.body, labels, run.displacement, run.velocity, run.acceleration, run.force,
         run.networks, run.deflection, _seat(engine, run, labels, seat), run.method,
         time.process_time() - t0, [m.notes] if m.notes else [])
-    return result
 
 
 def _seat(engine, run, labels, seat):

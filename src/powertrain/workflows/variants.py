@@ -1,70 +1,11 @@
-r"""Variants of the mount system: parse spec strings into operations, apply them to an Engine.
+r"""Variants of the mount system: spec strings parsed into operations
+(:mod:`powertrain.workflows.operations`), and the variants file read.
 
-Three layers, all pure (nothing is mutated; every ``apply`` returns a new
-:class:`~powertrain.models.engine.Engine`):
-
-1. **parse** -- :func:`parse_scale`, :func:`parse_set`, :func:`parse_swap`, :func:`parse_move`,
-   :func:`parse_rotate`, :func:`parse_target` turn one spec string (command-line option or
-   variants-file entry) into an operation object; syntax errors raise
-   :class:`~powertrain.errors.InputError` naming the option (or file, line and key);
-2. **operations** (:mod:`powertrain.workflows.operations`) -- frozen, picklable
-   dataclasses (:class:`Scale`, :class:`SetParameter`, :class:`Swap`, :class:`Move`,
-   :class:`Rotate`, :class:`Target`) holding SI values and the spec they came from;
-3. **apply** -- :func:`apply_operations` applies a sequence in order; unknown mount,
-   direction or parameter names raise :class:`InputError` naming where the spec came from.
-
-Spec syntax (``MOUNT`` a mount name of the engine or ``*``; ``DIR`` a local direction of the
-mount, ``x``, ``y``, ``z`` or ``*``; the default engine's mounts are ``left``, ``right``,
-``gearbox`` with local axes parallel to the engine axes):
-
-=========================================  ==================================================
-``--scale MOUNT.DIR.KIND=FACTOR``          ``KIND``: ``stiffness`` (every spring c_i of the
-                                           network times FACTOR), ``damping`` (every damper
-                                           d_i), ``dynamic`` (every c_i, d_i and m_i: the
-                                           whole K_CP(ω) times FACTOR, exactly), or a law
-                                           key ``SECTION.KEY`` of :data:`LAW_KEYS`
-                                           (``amplitude.exponent``; its section must
-                                           exist); FACTOR > 0
-``--set MOUNT.DIR.PARAM=VALUE[UNIT]``      one network parameter in its datasheet unit
-                                           (c in N/mm, d in N·s/mm, m in kg, the table
-                                           :data:`powertrain.iotools.mount_file.DATASHEET_UNITS`)
-                                           or in an explicit unit of :mod:`powertrain.units`
-                                           (``150N/mm``, ``1.5e5 N/m``); VALUE >= 0; or a
-                                           law key (x in mm, F in N, ``LAW_KEYS``; a
-                                           missing section: ``LAW_DEFAULTS``)
-``--swap MOUNT.DIR=FILE.toml``             replace one direction's model by a mount file
-``--move MOUNT=DX,DY,DZ``                  shift the mount point [mm], engine axes
-``--rotate MOUNT=AX,AY,AZ``                rotate the mount's local axes about the engine
-                                           axes through the mount point [deg]: first AX
-                                           about X, then AY about Y, then AZ about Z (fixed
-                                           axes), :math:`R' = R_z R_y R_x R`
-``--target MOUNT.DIR:CHANGE:BAND[:WIDTH]`` retune to a desired K_CP change, see
-``[:AMPLITUDE]``                           :mod:`powertrain.workflows.retune` (at an
-                                           amplitude ``0.3mm``: the laws' K_CP there)
-``--effect NAME[:PARAM=VALUE[UNIT],...]``  add an unmodelled effect of
-                                           :data:`powertrain.effects.EFFECTS` (e.g.
-                                           ``mount_stiffness:k1=1.5``,
-                                           ``base_compliance:c_base=400N/mm,m_base=8kg``);
-                                           VALUE in the parameter's unit (N/m, kg, rad,
-                                           dB, 1) or an explicit one of the same
-                                           dimension; inside the effect's bounds; run by
-                                           :func:`powertrain.workflows.runup.runup_with_effects`
-=========================================  ==================================================
-
-What "scale stiffness" means for a lumped network
--------------------------------------------------
-A mount direction is a network of springs :math:`c_i`, dampers :math:`d_i` and internal
-masses :math:`m_i`. ``stiffness`` scales every :math:`c_i` by :math:`s`: the static
-stiffness :math:`K_{CP}(0)` (a function of the springs only, homogeneous of degree one in
-them) is scaled by exactly :math:`s`, and so is every rigid-body mode frequency's square
-when all mounts are scaled; at higher frequency :math:`K_{CP}(\omega)` is *not* simply
-scaled: the internal resonances move by :math:`\sqrt s` (masses unchanged) and the dampers
-weigh less (:math:`s>1`) or more. ``dynamic`` scales :math:`c_i, d_i, m_i` together:
-the dynamic stiffness matrix :math:`-\omega^2 M + i\omega C + K` of the network is scaled
-by :math:`s`, the internal motion per unit engine-side motion is unchanged, so
-:math:`K_{CP}(\omega)` is :math:`s` times the baseline at every frequency
-(:meth:`~powertrain.models.mount.MountModel.scaled_dynamic_stiffness`) -- the variant a
-supplier delivers with "20 % stiffer, same characteristic".
+One parser per option (:data:`PARSERS`: ``--scale``, ``--set``, ``--swap``, ``--move``,
+``--rotate``, ``--target``, ``--effect``), the same for the command line and a variants
+file; syntax errors raise :class:`~powertrain.errors.InputError` naming the option (or file,
+line and key). The spec syntax and what ``stiffness`` and ``dynamic`` scaling mean for a
+lumped network: docs/guide/whatif.md.
 """
 
 from __future__ import annotations
@@ -132,6 +73,14 @@ def _float(s, text, origin, what="a number"):
     return v
 
 
+def _quantity(s, text, origin):
+    """``(number, unit)`` of ``VALUE[UNIT]`` (unit ``""`` when none)."""
+    m = re.match(r"^([-+0-9.eE]+)\s*(.*)$", s.strip())
+    if not m:
+        raise origin.error(f"{text!r}: {s.strip()!r} is not a number")
+    return _float(m.group(1), text, origin), m.group(2).strip()
+
+
 def _vector3(s, text, origin):
     parts = s.split(",")
     if len(parts) != 3:
@@ -187,11 +136,8 @@ def parse_set(text: str, origin: Origin = Origin("--set")) -> SetParameter:
     if not re.match(r"^[cdm][0-9]+$", param):
         raise origin.error(f"{text!r}: unknown parameter {param!r} (expected c<n>, d<n> "
                            "or m<n>)")
-    m = re.match(r"^([-+0-9.eE]+)\s*(.*)$", right)
-    if not m:
-        raise origin.error(f"{text!r}: {right!r} is not a number")
-    value = _float(m.group(1), text, origin)
-    unit = m.group(2).strip() or DATASHEET_UNITS[param[0]]
+    value, unit = _quantity(right, text, origin)
+    unit = unit or DATASHEET_UNITS[param[0]]
     if value < 0:
         raise origin.error(f"{text!r}: value must not be negative, got {value:g}")
     dimension = {"c": "stiffness", "d": "damping", "m": "mass"}[param[0]]
@@ -216,10 +162,7 @@ def _law_value(key, right, text, origin):
         if not 0 < lo <= 1 <= hi:
             raise origin.error(f"{text!r}: expected LO,HI with 0 < LO <= 1 <= HI")
         return (lo, hi)
-    m = re.match(r"^([-+0-9.eE]+)\s*(.*)$", right)
-    if not m:
-        raise origin.error(f"{text!r}: {right!r} is not a number")
-    value, unit = _float(m.group(1), text, origin), m.group(2).strip()
+    value, unit = _quantity(right, text, origin)
     unit = unit or (SECTION_UNITS[family] if family else "1")
     if dimension is None:
         if unit != "1":
@@ -347,11 +290,8 @@ def parse_effect(text: str, origin: Origin = Origin("--effect"), engine=None) ->
             raise origin.error(f"{text!r}: effect {name!r} has no parameter {key!r} "
                                f"(expected {', '.join(spec)})")
         p = spec[key]
-        m = re.match(r"^([-+0-9.eE]+)\s*(.*)$", value.strip())
-        if not m:
-            raise origin.error(f"{text!r}: {value.strip()!r} is not a number")
-        v = _float(m.group(1), text, origin)
-        unit = m.group(2).strip() or p.unit
+        v, unit = _quantity(value, text, origin)
+        unit = unit or p.unit
         if unit != p.unit:
             if unit not in UNITS or p.unit not in UNITS or UNITS[unit][0] != UNITS[p.unit][0]:
                 raise origin.error(f"{text!r}: unit {unit!r} of {key} is unknown or not a "
@@ -374,17 +314,17 @@ def parse_operations(specs: dict, *, base: Path | None = None, engine=None) -> t
     """Operations from ``{"scale": [...], "set": [...], ...}`` of command-line strings, in
     the order scale, set, swap, move, rotate, target (each list in its given order);
     effects' parameters are those generated for ``engine`` (default layout without one)."""
-    ops = []
-    for kind, parser in PARSERS.items():
-        for text in specs.get(kind, ()) or ():
-            origin = Origin(f"--{kind}")
-            if kind == "swap":
-                ops.append(parser(text, origin, base=base))
-            elif kind == "effect" and engine is not None:
-                ops.append(parser(text, origin, engine=engine))
-            else:
-                ops.append(parser(text, origin))
-    return tuple(ops)
+    return tuple(_parse(kind, text, Origin(f"--{kind}"), base, engine)
+                 for kind in PARSERS for text in specs.get(kind, ()) or ())
+
+
+def _parse(kind, text, origin, base=None, engine=None):
+    """One spec of option ``kind`` (swap paths relative to ``base``)."""
+    if kind == "swap":
+        return parse_swap(text, origin, base=base)
+    if kind == "effect":
+        return parse_effect(text, origin, engine=engine)
+    return PARSERS[kind](text, origin)
 
 
 # --------------------------------------------------------------------------- variants file
@@ -462,19 +402,15 @@ def _read_variant(k: int, t: dict, path: str, locate, names: set) -> Variant:
         raise InputError(f"duplicate or reserved variant name {name!r}", file=path,
                          line=locate(k, "name"), key=f"{key0}.name")
     ops = []
-    for kind, parser in PARSERS.items():
+    for kind in PARSERS:
         specs = t.get(kind, [])
         if isinstance(specs, str):
             specs = [specs]
         if not isinstance(specs, list) or not all(isinstance(s, str) for s in specs):
             raise InputError("expected a list of strings", file=path,
                              line=locate(k, kind), key=f"{key0}.{kind}")
-        for text in specs:
-            origin = Origin(f"{key0}.{kind}", file=path, line=locate(k, text))
-            if kind == "swap":
-                ops.append(parser(text, origin, base=Path(path).parent))
-            else:
-                ops.append(parser(text, origin))
+        ops += [_parse(kind, text, Origin(f"{key0}.{kind}", file=path, line=locate(k, text)),
+                       Path(path).parent) for text in specs]
     if not ops:
         raise InputError("variant has no operation", file=path, line=locate(k, ""), key=key0)
     return Variant(name, tuple(ops), Origin(key0, file=path, line=locate(k, "")))

@@ -1,13 +1,9 @@
 r"""What-if: run the baseline and variants of the mount system, report the change in dB.
 
-:func:`whatif` takes the variants as the command line writes them (``scale``, ``set``,
-``swap``, ``move``, ``rotate``, ``effects``, ``targets``, a variants file), parses them
-(:mod:`powertrain.workflows.variants`) and hands them to :func:`run_whatif`, which applies
-each variant once (:func:`variant_engine`: operations in order, a retune target fitted
-against the engine the earlier operations left, :mod:`powertrain.workflows.retune`; every
-step checked to carry the body), builds one :class:`~powertrain.workflows.sweeps.SweepTask`
-per variant plus the baseline, runs them with :func:`powertrain.workflows.sweeps.run_sweep`
-(on the one executor factory, :func:`powertrain.parallel.executor`) and returns a
+:func:`whatif` parses the variants as the command line writes them
+(:mod:`powertrain.workflows.variants`); :func:`run_whatif` applies each once
+(:func:`variant_engine`), runs one :class:`~powertrain.workflows.sweeps.SweepTask` per
+variant plus the baseline (:func:`powertrain.workflows.sweeps.run_sweep`) and returns a
 :class:`~powertrain.results.whatif.WhatIfResult` (the change in dB is defined there).
 """
 
@@ -17,6 +13,7 @@ import numpy as np
 
 from powertrain.analysis.channel import Channel
 from powertrain.analysis.orders import ORDERS
+from powertrain.effects import RESPONSE_EFFECTS
 from powertrain.errors import InputError
 from powertrain.iotools.engine_checks import check_support
 from powertrain.iotools.measured import MeasuredRunup, normalise_quantity, read_measured
@@ -33,7 +30,7 @@ from powertrain.workflows.arguments import (
     speeds,
     texts,
 )
-from powertrain.workflows.operations import Origin, Target, Variant, response_scenario
+from powertrain.workflows.operations import Origin, Target, Variant, effect_scenario
 from powertrain.workflows.retune import retuned_swap
 from powertrain.workflows.runup import check_runup_settings, engine_and_file
 from powertrain.workflows.sweeps import SweepTask, run_sweep
@@ -130,8 +127,7 @@ def whatif_manoeuvre(engine, variants, manoeuvre) -> TransientRanking:
 
 
 def _measured(measured, engine):
-    """The measurement to overlay: None, a MeasuredRunup, or its file read for ``engine``'s
-    mounts."""
+    """The measurement to overlay: None, a MeasuredRunup, or its file read."""
     if measured is None or isinstance(measured, MeasuredRunup):
         return measured
     path_or(measured, (), "--measured", "a MeasuredRunup or its file")
@@ -139,8 +135,7 @@ def _measured(measured, engine):
 
 
 def _checked(solver, signal, workers, executor=None):
-    """``--solver``, ``--signal`` and a scheduler name checked before any work;
-    ``--workers`` as an int >= 1 (or None)."""
+    """Solver, signal and scheduler checked; ``--workers`` as an int >= 1 (or None)."""
     if isinstance(executor, str) or executor is None:
         check_scheduler(executor)
     choice(solver, tuple(SOLVERS), "--solver")
@@ -200,8 +195,7 @@ def parse_objective(text, channels, rpm):
 
 
 def _node_of(text, name):
-    """The result node of channel ``text`` (``left.passive.z`` -> ``left/passive``), else
-    ``name`` unchanged."""
+    """The node of channel ``text`` (``left.passive.z`` -> ``left/passive``), else ``name``."""
     try:
         return Channel.parse(text).node
     except ValueError:
@@ -283,7 +277,7 @@ def run_whatif(engine, variants, rpm=None, *, solver: str = "harmonic", executor
         varied, f = variant_engine(engine, v, **(fit_kwargs or {}))
         fits += f
         tasks.append(SweepTask(v.name, varied, rpm, solver, opts,
-                               response_scenario(v.operations)))
+                               effect_scenario(v.operations, RESPONSE_EFFECTS)))
     results = run_sweep(tasks, executor, workers=workers, progress=progress)
     runs = [VariantRun(v.name, v.specs, r) for v, r in zip(variants, results[1:])]
     if rpm_step is None and rpm.size > 1:
