@@ -132,6 +132,7 @@ def test_runup_and_compare_figures(tmp_path, monkeypatch, saved):
     _assert_clean(saved, ["compare.png"], "compare", panel_legends=False)
 
 
+@pytest.mark.slow
 def test_compare_figure_at_the_measured_speeds_fits_a_page(tmp_path, monkeypatch, saved):
     """The README's figure (simulated at the 50-rpm measured speeds): nothing clipped at the
     edges (the last column's titles and "6000" once were), and no taller than an A4 page."""
@@ -166,6 +167,7 @@ def _without_orders(measured, cut):
     return sim
 
 
+@pytest.mark.slow
 def test_compare_figure_marks_measured_not_modelled_points():
     import matplotlib.pyplot as plt
     import numpy as np
@@ -214,6 +216,7 @@ def _phase_axes(fig):
             and a.get_ylim() == (-PHASE_LIMIT_DEG, PHASE_LIMIT_DEG)]
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("phased", ["none", "one side", "left Z", "every order"])
 def test_compare_figure_phase_panels_exactly_where_both_sides_give_phase(phased):
     """A phase panel under each level panel with phase on both sides (and nowhere else);
@@ -266,6 +269,7 @@ def test_runup_sweep_figure(tmp_path, monkeypatch, saved):
     _assert_clean(saved, ["sweep.png"], "runup", panel_legends=False)
 
 
+@pytest.mark.slow
 def test_whatif_figures(tmp_path, monkeypatch, saved):
     run(tmp_path, monkeypatch, "whatif", "--variants", VARIANTS, "--measured", MEASURED,
         "--from", "1000", "--to", "3000", "--step", "1000", "--workers", "1", "--quiet",
@@ -277,6 +281,7 @@ def test_whatif_figures(tmp_path, monkeypatch, saved):
     _assert_clean(saved, ["target.png"], "whatif")
 
 
+@pytest.mark.slow
 def test_diagnose_report_figures(tmp_path, monkeypatch, saved):
     run(tmp_path, monkeypatch, "diagnose", MEASURED, "--effects", "mount_stiffness",
         "--no-pairs", "--noise-floor", "0.005", "--report", "diag")
@@ -564,6 +569,7 @@ def test_map_channel_and_reference_unit(tmp_path, monkeypatch, saved):
     assert not (tmp_path / "m.png").exists()
 
 
+@pytest.mark.slow
 def test_whatif_levels_and_delta_views():
     """Both views draw every channel-quantity (the retuned mount's included however little
     it changes), a legend of exactly what is drawn, and name no figure that was not made."""

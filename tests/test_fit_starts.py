@@ -119,6 +119,7 @@ def test_readings_at_once_equal_each_reading_alone():
             assert np.array_equal(batch[b], eff.reading(v, p if eff.response_only else {}))
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("effects, budget", [
     (("sensor_error",), fit.EVAL_BUDGET),
     (("mount_stiffness", "sensor_error"), fit.EVAL_BUDGET),
@@ -188,6 +189,7 @@ def _same_fit(a, b):
     assert np.array_equal(a.x, b.x)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("budget", [fit.EVAL_BUDGET, 40])
 def test_a_fit_is_the_same_in_any_order_of_calls(engine, budget):
     """A fit stops on its own criteria: the same candidates fitted on the same data give

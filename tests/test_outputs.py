@@ -137,6 +137,7 @@ def test_modes_failing_on_its_plot_keeps_the_old_json(tmp_path):
     assert sorted(p.name for p in tmp_path.iterdir()) == ["afile", "m.json"]
 
 
+@pytest.mark.slow
 def test_runup_outputs_0644_with_provenance_and_balancers_off(tmp_path):
     r = _cli(["runup", *QUICK, "--no-balancers", "--out", "r.h5", "--csv", "r.csv",
               "--plot", "r.png"], tmp_path)
