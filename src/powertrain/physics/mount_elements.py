@@ -1,31 +1,17 @@
 r"""Mount elements: one mount direction as the assembled model and its solvers see it.
 
-A :class:`MountElement` is a linear network (:mod:`powertrain.physics.mount_network`; its M,
-C, K go into the assembled matrices) and, optionally, a *port law* in parallel with it
-between the engine-side node and the base node, acting on their relative displacement
-:math:`u = x_E - x_B`. The solvers ask an element two things:
-
-* the frequency domain: its **equivalent-linear two-port** at a relative-displacement
-  amplitude, :meth:`MountElement.two_port` — the network's two-port plus the port law's
-  describing function :math:`k_{eq}(A)` (a spring between the two nodes) at every
-  :math:`s \ne 0`; without a port law exactly the network's two-port. A port law carries
-  no mean force: it starts unloaded at the operating point (its ``initial_state`` at the
-  static deflection), so at :math:`s = 0` (the static preload, the mean of a run-up) it adds
-  nothing; a static force–deflection curve is a separate matter (:mod:`powertrain.solvers.operating_point`);
-* the time domain: the port law's **kernel arrays** (kind code, parameters, initial state,
-  :class:`PortForces`), integrated with the linear model by
-  :func:`powertrain.kernels.port_forces.newmark_port_kernel` (Newton per step over plain arrays).
-
-A port law is an object with ``kind`` (its code in :mod:`powertrain.kernels.port_forces`),
-``parameters()`` (float array), ``initial_state(u0, f0)`` (float array: the memory at the
-start, where the relative displacement is ``u0`` and the force expected from the
-equivalent-linear solution ``f0``), ``steady_state(amplitude, centre=0)`` (the memory on its
-steady loop of that amplitude about ``centre``, at the lower tip, moving up: where the
-displacement-driven test of
-:func:`powertrain.solvers.mount_time_domain.time_cross_point_stiffness` and a time-domain
-run-up start it) and ``describing_stiffness(amplitude)`` (complex [N/m]).
-:class:`JenkinsFriction` is the simplest: with a closed-form describing function, it proves
-the plug-in (tests/test_mount_elements.py); :class:`~powertrain.physics.mount_laws.BergFriction`
+A :class:`MountElement` is a linear network (:mod:`powertrain.physics.mount_network`) and,
+optionally, a *port law* in parallel with it between the engine-side and base nodes, acting
+on their relative displacement :math:`u = x_E - x_B` (``docs/extending.md``, "Adding a mount
+element"). In the frequency domain it is an equivalent-linear two-port
+(:meth:`MountElement.two_port`: the law's describing function :math:`k_{eq}(A)` added at
+every :math:`s \ne 0`; a port law carries no mean force), in the time domain the law's
+kernel arrays (:class:`PortForces`, :func:`powertrain.kernels.port_forces.newmark_port_kernel`).
+A port law has ``kind``, ``parameters()``, ``initial_state(u0, f0)``,
+``describing_stiffness(amplitude)`` and ``steady_state(amplitude, centre=0)``: the memory on
+its steady loop at the lower tip, moving up, where a displacement-driven test
+(:func:`powertrain.solvers.mount_time_domain.time_cross_point_stiffness`) starts it.
+:class:`JenkinsFriction` is the simplest; :class:`~powertrain.physics.mount_laws.BergFriction`
 is the mount files' ``[friction]``.
 """
 
@@ -349,10 +335,7 @@ def port_forces(elements, rows, force_map, names) -> PortForces | None:
     if not idx:
         return None
     laws = [elements[k].port_law for k in idx]
-    pars = [np.zeros(1) if law is None else np.atleast_1d(law.parameters()) for law in laws]
-    par = np.zeros((len(pars), max(p.size for p in pars)))
-    for e, p in enumerate(pars):
-        par[e, :p.size] = p
+    par = _state_rows([np.zeros(1) if law is None else law.parameters() for law in laws])
     kinds = np.array([NONE if law is None else law.kind for law in laws], np.int64)
     return PortForces(np.ascontiguousarray(rows[idx]), kinds, par, laws,
                       np.ascontiguousarray(force_map[:, idx]), [names[k] for k in idx],
@@ -360,7 +343,7 @@ def port_forces(elements, rows, force_map, names) -> PortForces | None:
 
 
 def _state_rows(states) -> np.ndarray:
-    """The laws' states (a list of 1-D arrays of any length) as zero-padded rows (m, n)."""
+    """1-D arrays of any length (the laws' states or parameters) as zero-padded rows (m, n)."""
     states = [np.atleast_1d(st) for st in states]
     out = np.zeros((len(states), max(st.size for st in states)))
     for e, st in enumerate(states):

@@ -147,7 +147,7 @@ class StaticCurve:
 
     def factor(self, x) -> np.ndarray:
         """Tangent stiffness at ``x`` over that at ``reference_deflection``."""
-        return self.tangent_at(x) / self.tangent_at(self.reference_deflection)
+        return CurveReader(self).factor(x)
 
 
 class CurveReader:
