@@ -17,7 +17,7 @@ reader is :mod:`powertrain.iotools.manoeuvre_file`.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -112,6 +112,4 @@ class Manoeuvre:
 
     def with_speed(self, time, speed) -> Manoeuvre:
         """A copy driven by another speed table (e.g. a recorded one)."""
-        return Manoeuvre(self.name, np.asarray(time, float), np.asarray(speed, float),
-                         self.load_time, self.load, self.load_kind, self.gear_ratio,
-                         self.crank_inertia, self.starter, self.reversal, self.file, self.notes)
+        return replace(self, time=np.asarray(time, float), speed=np.asarray(speed, float))
