@@ -34,7 +34,6 @@ from powertrain.plotting.style import (
     quantity_label,
     signed,
     subplots,
-    whole_figure,
 )
 
 #: Display factor of the levels: m/s -> mm/s.
@@ -76,11 +75,6 @@ NOT_MODELLED_STYLE = {"marker": "^", "ls": "none", "ms": 2.5, "mew": 0,
 EMPTY_TEXT = {"not in the measured data": "not measured",
               "not in the simulation": "not simulated",
               "no comparable point": "every point below the limit"}
-
-
-def comparison_quantities(comparison) -> list:
-    """Every quantity requested: the default three and all measured or compared ones."""
-    return comparison.requested_quantities()
 
 
 def row_height(n_rows: int, n_phase_rows: int = 0) -> float:
@@ -131,7 +125,8 @@ def plot_comparison(comparison, path=None, quantities=None, *, ax=None, channel=
     path : str or Path, optional
         PNG file written atomically.
     quantities : sequence of str, optional
-        Columns; default :func:`comparison_quantities` (nothing requested is left out).
+        Columns; default ``comparison.requested_quantities()``: the default three and
+        every measured or compared one.
     ax : None, Axes, Figure or SubFigure
         Where to draw; an Axes takes one panel (``channel``, ``quantity`` and no phase
         panel), else an InputError saying to pass a Figure.
@@ -144,15 +139,16 @@ def plot_comparison(comparison, path=None, quantities=None, *, ax=None, channel=
     """
     rows = list(comparison.simulated.channels)
     rows += [c for c in comparison.measured.channels if c not in rows]
-    rows, quantities = select_panels(rows, list(quantities or comparison_quantities(
-        comparison)), channel, quantity)
+    rows, quantities = select_panels(rows, list(quantities or
+                                                comparison.requested_quantities()),
+                                     channel, quantity)
     phased = {k: c for k, c in phased_channels(comparison).items()
               if k[:2] in rows and k[2] in quantities} if phase else {}
     if is_axes(ax) and phased:
         raise InputError(panels_error(2, ", or phase=False for the level panel alone"),
                          key="ax")
     fig, panels, phase_panels, own, axes = _grid(ax, rows, quantities, None, None, phased)
-    limit, margin_titles = comparison.exclusion_limit * MM, whole_figure(ax)
+    limit, margin_titles = comparison.exclusion_limit * MM, not is_axes(ax)
     _level_panels(panels, comparison, rows[0], limit, margin_titles)
     bottom = set(map(id, axes[-1]))
     for key, a in phase_panels.items():
@@ -166,7 +162,7 @@ def plot_comparison(comparison, path=None, quantities=None, *, ax=None, channel=
                                                    else ""))
     legend(fig, axes, ax)
     return finish(fig, own, path, provenance,
-                  title=_title(comparison, bool(phased)) if whole_figure(ax) else None)
+                  title=_title(comparison, bool(phased)) if not is_axes(ax) else None)
 
 
 def _level_panels(panels, comparison, top_channel, limit, margin_titles):

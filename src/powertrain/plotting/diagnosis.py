@@ -27,7 +27,6 @@ from powertrain.plotting.style import (
     quantity_label,
     series_style,
     subplots,
-    whole_figure,
     wrap,
 )
 
@@ -46,10 +45,9 @@ GAP_OUTLINE_RUN = 3
 
 
 def _censored(diagnosis):
-    """Measured points at the noise floor (the one rule, :mod:`powertrain.analysis.noise_floor`)
-    and the rule's margin."""
+    """Measured points at the noise floor (the one rule, :mod:`powertrain.analysis.noise_floor`)."""
     d = diagnosis.data
-    return np.isfinite(d.level) & at_floor(d.level, d.floor), NOISE_FLOOR_MARGIN
+    return np.isfinite(d.level) & at_floor(d.level, d.floor)
 
 
 def plot_gap_map(diagnosis, path=None, *, ax=None, quantity=None, provenance=None):
@@ -74,7 +72,7 @@ def plot_gap_map(diagnosis, path=None, *, ax=None, quantity=None, provenance=Non
     provenance : Provenance, optional
     """
     d = diagnosis.data
-    cens, margin = _censored(diagnosis)
+    cens, margin = _censored(diagnosis), NOISE_FLOOR_MARGIN
     valid = np.isfinite(diagnosis.gap) & ~cens
     shown = [q for k, q in enumerate(d.quantities) if valid[:, :, k].any()]
     empty = [q for q in d.quantities if q not in shown]
@@ -101,7 +99,6 @@ def plot_gap_map(diagnosis, path=None, *, ax=None, quantity=None, provenance=Non
         a.set_visible(False)
     for a in axes.flat[:len(qs)]:
         a.set_xlabel("engine speed [rpm]", fontsize=LABEL_SIZE)
-    for a in axes.flat[:len(qs)]:
         a.set_ylabel("channel", fontsize=LABEL_SIZE)
     if im is not None:
         colorbar(fig, im, axes.ravel().tolist(), diagnosis.gap[valid], -scale, scale,
@@ -111,7 +108,7 @@ def plot_gap_map(diagnosis, path=None, *, ax=None, quantity=None, provenance=Non
               f"±{GAP_OUTLINE_DB:g} dB")
     if empty:
         title += f"; {len(empty)} quantities all below {margin:g}× the floor, not drawn"
-    return finish(fig, own, path, provenance, title=title if whole_figure(ax) else None)
+    return finish(fig, own, path, provenance, title=title if not is_axes(ax) else None)
 
 
 def gap_scale(gaps) -> float:
@@ -223,7 +220,7 @@ def plot_gap_frequency(diagnosis, path=None, *, ax=None, provenance=None):
     title = (f"gap split{_run_name(diagnosis)}: structure {sh['structure']:.0%}, excitation "
              f"{sh['excitation']:.0%}, channel constant {sh['const']:.0%} (each alone)"
              + ("; (a) per base and direction, line: fitted structure part" if many else ""))
-    return finish(fig, own, path, provenance, title=title if whole_figure(ax) else None)
+    return finish(fig, own, path, provenance, title=title if not is_axes(ax) else None)
 
 
 def _frequency_layout(ax, diagnosis, orders, chans, many):
@@ -332,7 +329,7 @@ def plot_diagnosis_overlay(diagnosis, path=None, n_panels=6, *, ax=None, provena
     """
     d = diagnosis.data
     g = diagnosis.gap
-    cens, _ = _censored(diagnosis)
+    cens = _censored(diagnosis)
     score = []
     for c in range(len(d.channels)):
         for k in np.flatnonzero(d.order_mask):
@@ -356,7 +353,7 @@ def plot_diagnosis_overlay(diagnosis, path=None, n_panels=6, *, ax=None, provena
     legend(fig, axes, ax)
     return finish(fig, own, path, provenance,
                   title=f"before / after / measured{_run_name(diagnosis)}: verdict "
-                        f"{diagnosis.verdict}" if whole_figure(ax) else None)
+                        f"{diagnosis.verdict}" if not is_axes(ax) else None)
 
 
 def _overlay_panel(ax, diagnosis, c, k, held, rms, cens):
