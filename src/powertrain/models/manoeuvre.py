@@ -7,12 +7,9 @@ exact (a quadratic in time per interval):
 .. math:: \theta(t) = \Theta_i + \omega_i (t - t_i) + \tfrac12\alpha_i (t - t_i)^2,
    \qquad \alpha_i = \frac{\omega_{i+1} - \omega_i}{t_{i+1} - t_i}.
 
-The load is a second table, linear between its rows: either the IMEP scale of the engine's
-combustion model (``imep_scale``; 0 = the model's cycle of zero brake torque, compression
-and expansion) or the mean torque the engine delivers into the driveline (``mean_torque``
-[N·m]). ``gear_ratio`` is the overall ratio the driveline torque reacts on the powertrain
-with (0: neutral or clutch open). Everything is SI (s, rad/s, N·m, kg·m², m); the file
-reader is :mod:`powertrain.iotools.manoeuvre_file`.
+The load is a second table, linear between its rows: the IMEP scale of the engine's
+combustion model or the mean torque into the driveline (:class:`Manoeuvre`; the file reader
+is :mod:`powertrain.iotools.manoeuvre_file`, the guide ``docs/guide/transient.md``). SI.
 """
 
 from __future__ import annotations

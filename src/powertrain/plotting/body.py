@@ -97,13 +97,9 @@ def _positive(values):
 def plot_runup_both_sides(result, path=None, quantities=("synthesis", "order_2", "order_4"),
                           signal="velocity", ax=None, provenance=None):
     """Run-up curves with a body model: one panel per mount and direction holding the
-    engine side (solid) and the body side (dashed), then one per body-point direction;
-    columns = ``quantities``; log-scaled RMS [mm/s for velocity]. A body side that is zero
-    at every speed is said in its panel title; a body-point direction zero in every column
-    is not drawn but named in the figure title. The rows are as tall as fit one A4 page;
-    written to ``path``, more rows than fit go on further pages (``NAME_p2.png`` …, as
-    :func:`~powertrain.plotting.runup.plot_runup`). Returns the figure, the first page
-    (``ax``: None, a Figure or SubFigure)."""
+    engine side (solid) and the body side (dashed), then one per body-point direction with
+    response; columns = ``quantities``; paged as :func:`~powertrain.plotting.runup.plot_runup`.
+    Returns the figure, the first page (``ax``: None, a Figure or SubFigure)."""
     rows = [(m, d, True) for m in result.mounts for d in "xyz"]
     points = [(p, d, False) for p in result.points for d in "xyz"]
     silent = [(p, d) for p, d, _ in points

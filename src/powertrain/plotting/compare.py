@@ -105,19 +105,10 @@ def plot_comparison(comparison, path=None, quantities=None, *, ax=None, channel=
                     quantity=None, provenance=None, phase=True):
     """Measured and simulated RMS velocity against speed, level gap shaded.
 
-    The thesis's layout (Kovarik 2016, Figs 45-71): one row per mount and direction (named
-    on the left), one column per quantity (synthesis and every measured order, named on
-    top), log-scaled velocity [mm/s]; the rows are made as tall as fit one A4 page
-    (:func:`row_height`). The measured curve is a thin black line over the blue simulation
-    (marked at its speeds when at most :data:`MAX_MARKED_SPEEDS`, joined by straight lines:
-    on the log axis exactly the log-level interpolation used for the gaps); the gap at the
-    compared speeds is shaded orange where the simulation is higher, sky blue where it is
-    lower (colour-blind safe). Points excluded at the noise floor are grey crosses, the
-    exclusion limit (:attr:`ComparisonResult.exclusion_limit`) a dotted line;
-    measured-not-modelled points (simulation below the floor, measurement above the limit;
-    in no gap) reddish-purple triangles. A panel with nothing compared says so. Panel
-    titles: the RMS gap and bias [dB]. Phase panels (``phase``) under the channels with
-    phase on both sides.
+    The thesis's layout (Kovarik 2016, Figs 45-71): one row per mount and direction, one
+    column per quantity, log-scaled velocity [mm/s], rows as tall as fit one A4 page
+    (:func:`row_height`); phase panels under the channels with phase on both sides.
+    ``docs/reference/figures.md`` (``compare --plot``) lists every mark.
 
     Parameters
     ----------

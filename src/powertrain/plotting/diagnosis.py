@@ -52,12 +52,10 @@ def _censored(diagnosis):
 
 def plot_gap_map(diagnosis, path=None, *, ax=None, quantity=None, provenance=None):
     """Gap map of a :class:`powertrain.diagnosis.DiagnosisResult`: one panel per quantity
-    with a point above the censoring limit (3 × noise floor; the title counts the others),
-    channels against speed, colour = gap 20 log10(sim/measured) [dB] on a scale from the
-    data (:func:`gap_scale`); a title of the verdict's label (its text is in the summary);
-    every panel with its speed axis; outlined: runs of at least
-    :data:`GAP_OUTLINE_RUN` neighbouring speeds beyond ±3 dB (single noisy cells are not);
-    cells measured below the censoring limit grey.
+    with a point above the censoring limit, channels against speed, colour = gap
+    20 log10(sim/measured) [dB] on a scale from the data (:func:`gap_scale`), runs of at
+    least :data:`GAP_OUTLINE_RUN` speeds beyond ±3 dB outlined, censored cells grey
+    (``docs/reference/figures.md``, ``gap_map.png``).
 
     Parameters
     ----------
@@ -174,14 +172,11 @@ def _runs_beyond(mask, run):
 
 
 def plot_gap_frequency(diagnosis, path=None, *, ax=None, provenance=None):
-    """Order gaps re-plotted (a) against frequency f = order·rpm/60 [Hz], per channel with
-    that channel's fitted structure part dH(f) + constant (a structural cause lines up
-    across orders at one frequency), and (b), averaged over the channels, against speed,
-    one colour per order with that order's fitted excitation part (dashed; an excitation
-    cause lines up at one order). Up to :data:`MAX_CHANNELS_ONE_AXIS` channels share panel
-    (a), each its own colour and line style; beyond, (a) is small multiples, one panel per
-    mount base (or body point) and direction, its engine side and body side told apart by
-    colour and line style. Only orders with a gap above the noise floor are drawn.
+    """Order gaps (a) against frequency f = order·rpm/60 [Hz] per channel, with its fitted
+    structure part (a structural cause lines up at one frequency), and (b), averaged over
+    the channels, against speed per order, with its fitted excitation part (dashed). Beyond
+    :data:`MAX_CHANNELS_ONE_AXIS` channels (a) is small multiples, one per mount base (or
+    body point) and direction (``docs/reference/figures.md``, ``gap_vs_frequency.png``).
 
     Parameters
     ----------
@@ -312,11 +307,9 @@ def _legend_above(ax, title):
 
 def plot_diagnosis_overlay(diagnosis, path=None, n_panels=6, *, ax=None, provenance=None):
     """Measured vs baseline vs baseline + chosen effect for the channel-orders with the
-    largest baseline gaps; held-out speeds circled; measured points below the censoring
-    level (3 × the noise floor) hollow, at that level (they say only "below it"). The
-    simulated curves are the model's levels at every measured speed (noise floor added in
-    power), drawn whole; where a curve cannot be drawn (no steady state with the effect) the
-    panel says so. A plan's overlay shows its first run and says so.
+    largest baseline gaps; held-out speeds circled, censored measured points hollow at the
+    censoring level; the simulated curves at every measured speed (noise floor added in
+    power), or a note where one has no steady state. A plan's overlay shows its first run.
 
     Parameters
     ----------

@@ -52,11 +52,8 @@ def plot_tracked(tracked, path=None, quantities=None, *, ax=None, provenance=Non
     line style it has in every figure (:func:`~powertrain.plotting.style.quantity_style`).
 
     A curve wholly more than :data:`DYNAMIC_RANGE_DB` below the panel's largest level is not
-    drawn (numerical noise, 1e-5 of the signal); the orders left out so are named in the
-    title. Each y axis spans the drawn curves (at most that range). The one legend of the
-    figure lists exactly the curves drawn. Returns the figure (``ax``: None, Figure or
-    SubFigure, or an Axes when there is one channel, else an InputError saying to pass a
-    Figure)."""
+    drawn but named in the title. Returns the figure (``ax``: None, Figure or SubFigure, or
+    an Axes when there is one channel, else an InputError saying to pass a Figure)."""
     quantities = list(quantities or tracked_quantities(tracked))
     n = len(tracked.channels)
     cols = min(3, n)

@@ -205,12 +205,9 @@ def plot_whatif(whatif, path=None, *, ax=None, channel=None, quantity=None, prov
     """A what-if study against speed: absolute levels (``view="levels"``) or the change of
     each variant against the baseline, Δ = 20 log10(v/v0) [dB] (``view="delta"``).
 
-    Every channel-quantity, one panel each (rows mount × direction, columns the quantities,
-    as tall as fit one A4 page; written to ``path``, a grid too tall for one page goes on
-    several, as :func:`plot_runup`). ``levels``: baseline black, each variant in colour, the
-    measurement (when given) as grey dots; a variant within a fraction of a dB of the
-    baseline lies on it. ``delta``: one shared Δ axis, a line per variant. The legend gives
-    each variant's mean change over all channels, quantities and speeds.
+    Every channel-quantity, one panel each, paged as :func:`plot_runup`; the legend gives
+    each variant's mean change over all channels, quantities and speeds
+    (``docs/reference/figures.md``, ``whatif --plot`` and ``--delta-plot``).
 
     Parameters
     ----------
