@@ -143,10 +143,6 @@ class ModalChassis(Chassis):
     def body_rows(self, name) -> np.ndarray:
         return self.shape_matrix(name)
 
-    def modal_receptance(self, omega, responses, excitations) -> np.ndarray:
-        """Modal receptance matrix (3 n_resp, 3 n_exc) [m/N] at ``omega`` [rad/s]."""
-        return self.receptances([omega], responses, excitations)[0]
-
     def receptances(self, omegas, responses, excitations) -> np.ndarray:
         omegas = np.asarray(omegas, float).ravel()
         P = np.vstack([self.shape_matrix(r) for r in responses])        # (3 nr, k)
@@ -159,7 +155,7 @@ class ModalChassis(Chassis):
         return np.einsum("ik,wk,jk->wij", P, 1.0 / d, Q)
 
     def receptance_at(self, omega, responses, excitations) -> np.ndarray:
-        return self.modal_receptance(omega, responses, excitations)
+        return self.receptances([omega], responses, excitations)[0]
 
 
 class MeasuredChassis(Chassis):

@@ -296,11 +296,7 @@ class PortForces:
     def initial_state(self, x0, f0=None) -> np.ndarray:
         """State rows (m, n_state) of every law at the initial coordinates ``x0``, expected
         to carry the forces ``f0`` (m,) [N] (default: unloaded)."""
-        return self.states_at(self.rows @ np.asarray(x0, float), f0)
-
-    def states_at(self, u0, f0=None) -> np.ndarray:
-        """State rows (m, n_state) of every law at the relative displacements ``u0`` (m,)
-        [m], carrying the forces ``f0`` (m,) [N] (default: unloaded)."""
+        u0 = self.rows @ np.asarray(x0, float)
         f0 = np.zeros(u0.size) if f0 is None else f0
         return _state_rows([np.zeros(1) if law is None else law.initial_state(u, f)
                             for law, u, f in zip(self.laws, u0, f0)])
