@@ -88,15 +88,20 @@ def describing_stiffnesses(elements, amplitudes) -> list:
     for an element without a port law), one vectorised call per distinct law (the
     equivalent-linear fixed point asks for every element at every iteration)."""
     out = [None] * len(elements)
-    groups = {}
-    for k, el in enumerate(elements):
-        if el.port_law is not None:
-            groups.setdefault(el.port_law, []).append(k)
-    for law, index in groups.items():
+    for law, index in _by_law(elements, "port_law").items():
         values = law.describing_stiffness(np.array([amplitudes[k] for k in index], float))
         for k, value in zip(index, values):
             out[k] = value
     return out
+
+
+def _by_law(elements, kind) -> dict:
+    """``{law: [indices of the elements holding it]}`` of their ``kind`` law (not None)."""
+    groups = {}
+    for k, el in enumerate(elements):
+        if getattr(el, kind) is not None:
+            groups.setdefault(getattr(el, kind), []).append(k)
+    return groups
 
 
 def element_two_ports(elements, s, amplitudes, packed=None):
@@ -109,11 +114,7 @@ def element_two_ports(elements, s, amplitudes, packed=None):
     lam = np.asarray(s, complex)
     A = np.asarray(amplitudes, float)
     scales = np.ones((2,) + A.shape)
-    groups = {}
-    for k, el in enumerate(elements):
-        if el.amplitude_law is not None:
-            groups.setdefault(el.amplitude_law, []).append(k)
-    for law, index in groups.items():            # one call per distinct law
+    for law, index in _by_law(elements, "amplitude_law").items():   # one call per law
         ks, ds = law.scales(A[..., index])
         scales[0][..., index], scales[1][..., index] = ks, ds
     for k, el in enumerate(elements):

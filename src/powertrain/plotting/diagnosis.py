@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import numpy as np
 
 from powertrain.analysis.channel import split_side
@@ -122,7 +124,6 @@ def _run_name(diagnosis) -> str:
     runs = getattr(diagnosis, "runs", None) or []
     if not runs:
         return ""
-    from pathlib import Path  # deferred: only plans need it
     return f" of run 1 ({Path(runs[0]['file']).name}) of {len(runs)}"
 
 
