@@ -181,14 +181,9 @@ def _margin_labels(axes, panels, rows, first_quantity):
 
 
 def _grid(ax, rows, quantities, channel, quantity, phased):
-    """Level panels as :func:`~powertrain.plotting.runup.grid` (``phased`` empty), else a
-    phase row under each channel row with some phase.
-
-    Returns
-    -------
-    fig, panels : {key: level Axes}, phase_panels : {key: phase Axes}, own : bool,
-    axes : 2-D array of every panel, rows top to bottom
-    """
+    """``(fig, {key: level Axes}, {key: phase Axes}, own, 2-D array of every panel)``: the
+    level panels as :func:`~powertrain.plotting.runup.grid`, and a phase row under each
+    channel row with some phase in ``phased``."""
     with_phase = [ch for ch in rows if any(k[:2] == tuple(ch) for k in phased)]
     height = row_height(len(rows), len(with_phase))
     if not with_phase:
