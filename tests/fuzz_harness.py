@@ -835,7 +835,7 @@ def _frf_seeds() -> None:
     records = []
     for r in engine.mount_names + list(ch.points):
         for e in engine.mount_names:
-            H = np.array([ch.modal_receptance(2 * np.pi * fi, [r], [e]) for fi in f])
+            H = np.array([ch.receptance_at(2 * np.pi * fi, [r], [e]) for fi in f])
             for a, rd in enumerate("xyz"):
                 for b, ed in enumerate("xyz"):
                     rows += [f"{fi!r},{r}.{rd},{e}.{ed},{h.real!r},{h.imag!r}"

@@ -103,7 +103,7 @@ def _frf_csv(engine, rpm, path):
              "frequency_hz,response,excitation,receptance_real_m_per_n,receptance_imag_m_per_n"]
     for r in names:
         for e in engine.mount_names:
-            H = np.array([ch.modal_receptance(2 * np.pi * fi, [r], [e]) for fi in f])
+            H = np.array([ch.receptance_at(2 * np.pi * fi, [r], [e]) for fi in f])
             for a, rd in enumerate("xyz"):
                 for b, ed in enumerate("xyz"):
                     lines += [f"{float(fi)!r},{r}.{rd},{e}.{ed},{float(h.real)!r},{float(h.imag)!r}"
@@ -239,7 +239,7 @@ def test_uff58_receptances_read_like_csv(tmp_path, engine):
     sets = []
     for r in engine.mount_names + list(ch.points):
         for e in engine.mount_names:
-            H = np.array([ch.modal_receptance(2 * np.pi * fi, [r], [e]) for fi in f])
+            H = np.array([ch.receptance_at(2 * np.pi * fi, [r], [e]) for fi in f])
             for a in range(3):
                 for b in range(3):
                     sets.append(pyuff.prepare_58(

@@ -96,7 +96,7 @@ def test_engine_without_excitation_names_missing_section(tmp_path):
     p = _write(tmp_path, MINIMAL.replace(
         "ORIENT_LEFT", 'orientation = {value = [0, 0, 0], unit = "deg"}'))
     e = read_engine(p)
-    assert e.crank is None and e.combustion is None and not e.has_excitation
+    assert e.crank is None and e.combustion is None
     with pytest.raises(InputError) as info:
         e.generalized_load(2000.0, [0.0])
     assert info.value.key == "crank_train"

@@ -4,13 +4,9 @@ One value type, one spelling. The label of a channel is ``MOUNT.DIRECTION`` on t
 (active) side and ``MOUNT.passive.DIRECTION`` on the body (passive) side, e.g. ``left.z``,
 ``left.passive.z``; it names the channels of raw recordings, tracked orders and their files.
 
-Results of a run-up key their curves by a *node* and a direction: the node of a mount's
-engine side is the mount's name (``left``), of its body side ``left/passive`` (the name
-files written by the run-up carry in their ``channels`` and wide CSV columns), a body point
-of interest its own name (``seat_rail``). :meth:`Channel.parse` reads every spelling users'
-files and options contain (``left.z``, ``left.active.z``, ``left.passive.z``,
-``left/passive.z``); :meth:`Channel.of_node` and :attr:`Channel.node` translate to and from
-the node of a result.
+Results of a run-up key their curves by a *node* and a direction: ``left`` (engine side),
+``left/passive`` (body side, as in the run-up's files), a body point's own name;
+:meth:`Channel.of_node` and :attr:`Channel.node` translate to and from it.
 """
 
 from __future__ import annotations

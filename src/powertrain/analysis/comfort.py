@@ -56,13 +56,6 @@ def weighting_analog(name):
     return num, den
 
 
-def weighting_gain(name, freq) -> np.ndarray:
-    """|H| of the analogue weighting ``name`` at the frequencies ``freq`` [Hz]."""
-    num, den = weighting_analog(name)
-    s = 2j * np.pi * np.asarray(freq, float)
-    return np.abs(np.polyval(num, s) / np.polyval(den, s))
-
-
 def weighted(acceleration, sample_rate, name) -> np.ndarray:
     """``acceleration`` (n,) [m/s²] sampled at ``sample_rate`` [Hz] through the digital
     weighting ``name`` (module docstring)."""

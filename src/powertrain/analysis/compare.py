@@ -1,60 +1,8 @@
 r"""Correlation of simulated and measured run-up order curves: pure functions on arrays.
 
-All levels are RMS magnitudes (the complex forms of the criteria below are used with real,
-non-negative vectors). Units do not matter as long as both sides use the same one; the
-package passes m/s. Where both sides give the order phase (:mod:`powertrain.analysis.phase`)
-two more measures compare it:
-
-Phase gap
-    :math:`\Delta\varphi = \varphi_\mathrm{sim} - \varphi_\mathrm{meas}` wrapped to
-    (-180°, 180°]; summarised by its RMS and by the angle of its mean phasor (the bias, a
-    circular mean).
-
-Complex gap, per channel and quantity over the points with phase on both sides: the
-least-squares complex ratio of simulated to measured order amplitudes,
-
-.. math:: a = \frac{\sum_n S_n \bar M_n}{\sum_n |M_n|^2}, \qquad
-          S_n = s_n e^{i\varphi_{\mathrm{sim},n}},\; M_n = m_n e^{i\varphi_{\mathrm{meas},n}},
-
-reported as :math:`20\log_{10}|a|` [dB] and :math:`\arg a` [deg]: a common level and phase
-error shows as both; phase scatter lowers :math:`|a|` below the magnitude gap.
-
-Level gap
-    :math:`\Delta L = 20\log_{10}(v_\mathrm{sim}/v_\mathrm{meas})` [dB]; positive when the
-    simulation is higher (a channel simulated at twice the measured level shows +6.02 dB).
-
-FRAC (frequency response assurance criterion), per channel and quantity, summed over the
-compared speeds :math:`n`:
-
-.. math:: \mathrm{FRAC} = \frac{\left(\sum_n s_n m_n\right)^2}
-                              {\sum_n s_n^2\,\sum_n m_n^2}
-
-1 for curves of the same shape whatever their scale; blind to a common level error [1]_ [2]_.
-With positive magnitudes FRAC is rarely far below 1 (two flat curves give 1 even if one is
-10× higher), so read it with the dB gap, never alone.
-
-CSAC and CSF (cross-signature assurance and scale factors), at each speed, summed over the
-channels :math:`j` (every mount × direction channel) [3]_:
-
-.. math:: \mathrm{CSAC}(n) = \frac{\left(\sum_j s_{nj} m_{nj}\right)^2}
-                                  {\sum_j s_{nj}^2\,\sum_j m_{nj}^2},\qquad
-          \mathrm{CSF}(n) = \frac{2\left|\sum_j s_{nj} m_{nj}\right|}
-                                 {\sum_j s_{nj}^2 + \sum_j m_{nj}^2}
-
-CSAC compares the deflection shape across the channels (sensitive to mass and stiffness
-errors, which move resonances and change the shape); CSF also compares the level (sensitive
-to damping and level errors). Both are 1 for identical data; CSF < CSAC when the levels
-differ. Zang et al. define both on complex FRFs; here on RMS magnitudes.
-
-FRFSM-like score, per channel and quantity, averaged over the compared speeds:
-
-.. math:: S = \frac1N\sum_n \exp\!\left(-\frac{\Delta L_n^2}{2\sigma^2}\right),
-          \qquad \sigma = 6\ \mathrm{dB}
-
-This follows the idea of the FRF similarity metric of Lee, Ahn & Kim [4]_ (the likelihood of
-the level difference under an assumed normal distribution, normalised over the band to a
-value between 0 and 1); it is our own simplified definition, not their exact formula: a
-uniform 6 dB gap scores :math:`e^{-1/2} = 0.61`, 3 dB scores 0.88, 12 dB scores 0.14.
+Levels are RMS magnitudes in one unit on both sides (the package passes m/s). The measures
+(level gap, FRAC, CSAC, CSF, FRFSM-like score, phase and complex gap) are defined in each
+function's docstring; ``docs/guide/compare.md`` tabulates them with what each is blind to.
 
 References
 ----------
@@ -176,19 +124,11 @@ def gap_statistics(rpm, gap_db):
             "max_abs_db": float(abs(g[k])), "rpm_at_max_abs_db": float(r[k])}
 
 
-def _assurance(s, m, axis):
-    s = np.asarray(s, float)
-    m = np.asarray(m, float)
-    num = np.sum(s * m, axis=axis) ** 2
-    den = np.sum(s ** 2, axis=axis) * np.sum(m ** 2, axis=axis)
-    with np.errstate(invalid="ignore", divide="ignore"):
-        return np.where(den > 0, num / np.where(den > 0, den, 1.0), np.nan)
-
-
 def frac(simulated, measured):
-    r"""Frequency response assurance criterion of two level curves over speed.
+    r"""Frequency response assurance criterion of two level curves over speed [1]_ [2]_.
 
-    :math:`(\sum_n s_n m_n)^2 / (\sum_n s_n^2 \sum_n m_n^2)`, summed over the compared speeds.
+    :math:`(\sum_n s_n m_n)^2 / (\sum_n s_n^2 \sum_n m_n^2)`, summed over the compared speeds:
+    the shape of the curve, blind to a common level error (read it with the dB gap).
 
     Parameters
     ----------
@@ -200,14 +140,14 @@ def frac(simulated, measured):
     float
         In [0, 1]; 1 for a scaled copy; NaN if either curve is all zero or ``n = 0``.
     """
-    return float(_assurance(simulated, measured, axis=-1))
+    return float(csac(simulated, measured, axis=-1))
 
 
 def csac(simulated, measured, axis=-1):
-    r"""Cross-signature assurance criterion across channels.
+    r"""Cross-signature assurance criterion across channels [3]_.
 
     :math:`(\sum_j s_j m_j)^2 / (\sum_j s_j^2 \sum_j m_j^2)`, summed along ``axis``
-    (the channels; one value per speed).
+    (the channels; one value per speed): the deflection shape across the mounts.
 
     Parameters
     ----------
@@ -221,13 +161,19 @@ def csac(simulated, measured, axis=-1):
     ndarray or float
         In [0, 1]; 1 for identical (or proportional) channel vectors.
     """
-    return _assurance(simulated, measured, axis)
+    s = np.asarray(simulated, float)
+    m = np.asarray(measured, float)
+    num = np.sum(s * m, axis=axis) ** 2
+    den = np.sum(s ** 2, axis=axis) * np.sum(m ** 2, axis=axis)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        return np.where(den > 0, num / np.where(den > 0, den, 1.0), np.nan)
 
 
 def csf(simulated, measured, axis=-1):
-    r"""Cross-signature scale factor across channels.
+    r"""Cross-signature scale factor across channels [3]_.
 
-    :math:`2|\sum_j s_j m_j| / (\sum_j s_j^2 + \sum_j m_j^2)`, summed along ``axis``.
+    :math:`2|\sum_j s_j m_j| / (\sum_j s_j^2 + \sum_j m_j^2)`, summed along ``axis``: shape
+    and level.
 
     Parameters
     ----------
@@ -252,8 +198,9 @@ def csf(simulated, measured, axis=-1):
 def frfsm_score(gap_db, sigma_db=FRFSM_SIGMA_DB):
     r"""FRFSM-like similarity: mean over points of :math:`\exp(-\Delta L^2/(2\sigma^2))`.
 
-    Follows the idea of Lee, Ahn & Kim (JSV 436, 2018); see the module docstring for the
-    exact definition used here.
+    Follows the idea of the FRF similarity metric of Lee, Ahn & Kim [4]_ (the likelihood of
+    the level difference under a normal distribution, normalised to 0..1); our own simplified
+    definition, not their formula: a uniform 6 dB gap scores 0.61, 3 dB 0.88, 12 dB 0.14.
 
     Parameters
     ----------
@@ -288,9 +235,13 @@ def interpolate_phase(rpm, phase_deg, rpm_new):
 
 
 def phase_statistics(simulated, measured, sim_phase_deg, meas_phase_deg) -> dict:
-    """Phase gap [deg] per point and its summary (module docstring) over the points where
-    both phases are finite: ``phase_gap_deg`` (NaN elsewhere), ``n_phase_compared``,
-    ``phase_rms_deg``, ``phase_bias_deg``, ``complex_gap_db``, ``complex_gap_deg``."""
+    r"""Phase gap :math:`\varphi_\mathrm{sim} - \varphi_\mathrm{meas}` [deg], wrapped to
+    (-180°, 180°], per point and its summary over the points where both phases are finite:
+    ``phase_gap_deg`` (NaN elsewhere), ``n_phase_compared``, ``phase_rms_deg``,
+    ``phase_bias_deg`` (angle of the mean phasor), and the complex gap
+    ``complex_gap_db``, ``complex_gap_deg``: :math:`20\log_{10}|a|` and :math:`\arg a` of the
+    least-squares ratio :math:`a = \sum_n S_n \bar M_n / \sum_n |M_n|^2` of the complex
+    amplitudes (phase scatter lowers :math:`|a|` below the magnitude gap)."""
     gap = wrap_deg(np.asarray(sim_phase_deg, float) - np.asarray(meas_phase_deg, float))
     ok = np.isfinite(gap)
     out = {"phase_gap_deg": gap, "n_phase_compared": int(ok.sum())}

@@ -2,16 +2,11 @@ r"""The one noise-floor rule: which measured levels are too close to the floor t
 
 A measured RMS level :math:`m` is *at the floor* (censored: it only says the true level is
 below :math:`\kappa f`) when :math:`m < \kappa f`, with :math:`f` the RMS noise floor and
-:math:`\kappa` = :data:`NOISE_FLOOR_MARGIN` = 3 (9.5 dB). Rationale: complex Gaussian noise
-of RMS :math:`f` alone exceeds :math:`\kappa f` with probability :math:`e^{-\kappa^2}` =
-1.2e-4, and a signal at :math:`\kappa f` is inflated by the floor (added in power) by
-:math:`10\log_{10}(1 + 1/\kappa^2)` = 0.46 dB, below the measurements' own scatter. Used by
-``powertrain compare`` (points excluded and counted) and ``powertrain diagnose`` (points
-censored).
-
-A *model* level below the floor itself (:func:`below_floor`) predicts nothing the
-measurement could see; where the measurement is above the censoring level there, the point is
-"measured, not modelled" (``powertrain compare`` reports it apart from the level gaps).
+:math:`\kappa` = :data:`NOISE_FLOOR_MARGIN` = 3 (9.5 dB): noise alone exceeds it with
+probability :math:`e^{-\kappa^2}` = 1.2e-4, and a signal there is inflated by the floor by
+only 0.46 dB. ``compare`` excludes and counts such points, ``diagnose`` censors them. A
+*model* level below the floor itself (:func:`below_floor`) with the measurement above the
+censoring level is "measured, not modelled".
 """
 
 from __future__ import annotations
@@ -40,9 +35,7 @@ def at_floor(measured, noise_floor):
 
 def above_floor(measured, noise_floor):
     """True where a measured level is finite and scoreable (not at the floor)."""
-    m = np.asarray(measured, float)
-    with np.errstate(invalid="ignore"):
-        return np.isfinite(m) & (m >= censoring_level(noise_floor)) & (m > 0)
+    return np.isfinite(np.asarray(measured, float)) & ~at_floor(measured, noise_floor)
 
 
 def below_floor(level, noise_floor):

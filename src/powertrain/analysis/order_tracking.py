@@ -1,29 +1,17 @@
-r"""Computed order tracking (COT) of run-up time data.
+r"""Computed order tracking (COT) of run-up time data (``docs/guide/track.md``, step 3).
 
-For each speed of the output grid (every ``rpm_step`` rpm the shaft passes through) one
-block of ``B`` revolutions centred on the instant the speed passes it is analysed:
+For each speed of the output grid one block of ``B`` revolutions centred on the instant the
+speed is passed is resampled to ``S`` samples per revolution (low-pass interpolation at
+:data:`ANTI_ALIAS_FRACTION` of the local angular Nyquist frequency :math:`S\,n/120` [Hz],
+:mod:`powertrain.kernels.order_tracking`), and its spectrum is evaluated at exactly the
+orders asked for, Hann window over the block (no picket-fence error):
 
-1. **angle-domain resampling with anti-alias filter**: ``S`` samples per revolution
-   (a power of two, at least :data:`SAMPLES_PER_ORDER` times the highest order), each the
-   low-pass interpolation of the time samples at its instant (the crank-angle curve of
-   :mod:`powertrain.analysis.speed` inverted), with the low-pass at
-   :data:`ANTI_ALIAS_FRACTION` of the local angular Nyquist frequency
-   :math:`S\,n/120` [Hz] (Kaiser-windowed sinc, :mod:`powertrain.kernels.order_tracking`):
-   content that the angle sampling would alias is removed first, the tracked orders stay
-   in the flat passband;
-2. **order spectrum of the block** at exactly the orders asked for (integer, fractional or
-   non-integer such as :math:`\sqrt2`), Hann window over the block:
+.. math:: \hat S_o = \frac{2}{\sum_j w_j}\sum_j w_j\,x(\theta_j)\,e^{-i o \theta_j},
+          \qquad \mathrm{RMS}_o = |\hat S_o|/\sqrt2.
 
-   .. math:: \hat S_o = \frac{2}{\sum_j w_j}\sum_j w_j\,x(\theta_j)\,e^{-i o \theta_j},
-             \qquad \mathrm{RMS}_o = |\hat S_o|/\sqrt2;
-
-   evaluating the window's transform at the order itself (not at the nearest FFT bin)
-   leaves no picket-fence error, and the block length (:func:`block_revolutions`, at least
-   4 bins between neighbouring orders) keeps the Hann side lobes of one order below
-   -50 dB at the next;
-3. the synthesis is the RMS sum over the orders tracked (:mod:`powertrain.analysis.orders`).
-
-Vold–Kalman filtering (:mod:`powertrain.analysis.vold_kalman`) is the second method.
+The block length (:func:`block_revolutions`, at least 4 bins between neighbouring orders)
+keeps the Hann side lobes of one order below -50 dB at the next. Vold–Kalman filtering
+(:mod:`powertrain.analysis.vold_kalman`) is the second method.
 """
 
 from __future__ import annotations
@@ -192,8 +180,6 @@ def cot_amplitudes(X, profile, orders, rpm_centre, angle_centre, block_revs=None
         From :func:`speed_grid`.
     block_revs : int, optional
         Block length [rev] (default :func:`block_revolutions`).
-    progress : bool, optional
-        Show a progress bar on stderr (quiet off a terminal).
 
     Returns
     -------

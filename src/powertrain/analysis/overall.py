@@ -7,11 +7,9 @@ whole record, bins outside the band set to zero), over the same span as the COT 
 
 .. math:: L = \sqrt{\sum_j w_j\,x_j^2 \Big/ \sum_j w_j}.
 
-For components whose frequencies differ by at least two Hann bins over the block (tracked
-orders do: the block keeps four bins between them) the cross terms average out, so on a
-signal made only of the tracked orders :math:`L` equals the synthesis (their RMS sum), and
-:math:`L^2 - \mathrm{synthesis}^2` is the power of what is not a tracked order — noise,
-fixed-frequency resonances, untracked orders — inside the band.
+On a signal made only of the tracked orders (at least two Hann bins apart over the block,
+so the cross terms average out) :math:`L` equals the synthesis, and
+:math:`L^2 - \mathrm{synthesis}^2` is the in-band power of what is not a tracked order.
 """
 
 from __future__ import annotations

@@ -13,15 +13,10 @@ order tracking and Vold–Kalman filtering) all satisfy
 firing TDC at :math:`\theta = 0`, :mod:`powertrain.models.engine`); a tracked recording's angle
 is counted from its first tacho edge, and :func:`to_tdc` moves the origin.
 
-**Measured origin.** The tacho's reference pulse (:attr:`SpeedProfile.reference
-<powertrain.analysis.speed.SpeedProfile>`) fixes the angle modulo 360°; the user states where
-cylinder-1 firing TDC lies after it (``--tdc-offset``, from the engine's trigger-wheel
-position, a TDC sensor or a pressure trace). That fixes the phase of every whole order
-(:math:`o\cdot 360°` is a multiple of 360°) but leaves half orders ambiguous by 180°: one
-crank revolution cannot tell the firing TDC from the gas-exchange TDC. A once-per-cycle
-signal (cam or injection pulse, ``--cycle-reference``) picks the revolution: the offset is
-then counted from the first tacho reference pulse after a cycle-reference edge, over 0..720°
-(:func:`cycle_origin`).
+**Measured origin** (``docs/guide/track.md``, order phase): the tacho's reference pulse
+fixes the angle modulo 360°, ``--tdc-offset`` places cylinder-1 firing TDC after it
+(:func:`tdc_origin`); half orders stay ambiguous by 180° unless a once-per-cycle signal
+(``--cycle-reference``) picks the revolution (:func:`cycle_origin`).
 """
 
 from __future__ import annotations

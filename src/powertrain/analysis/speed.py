@@ -4,23 +4,16 @@ From an **rpm channel**: the samples are smoothed (Savitzky–Golay, cubic, over
 ``smooth_s`` seconds: a straight or parabolic ramp passes unchanged) and the angle is their
 integral, :math:`\theta(t) = \int_0^t 2\pi n(\tau)/60\,d\tau` (trapezoidal rule).
 
-From a **tacho** (``pulses_per_rev`` pulses per revolution):
-
-1. levels: the 2nd and 98th percentiles are the low and high level; a tacho whose levels
-   do not differ gives "no edges";
-2. rising edges by a Schmitt trigger (switch on above 60 %, off below 40 % of the swing:
-   noise smaller than 20 % of the swing cannot make a false edge), edge time interpolated
-   linearly between the samples around the 60 % crossing;
-3. missing teeth: an interval ``k`` times the local median (k = 2, 3, ...; within 30 %)
-   counts ``k`` pulses; intervals under 30 % of the median (spikes) are dropped;
-4. the angle at the edges, :math:`2\pi\,\mathrm{count}/N`, is fitted by a least-squares
-   cubic spline with knots ``smooth_s`` apart (a linear sweep's quadratic angle is
-   reproduced exactly; edge jitter is averaged), which gives angle and speed at every sample;
-5. the **reference pulse** (:attr:`SpeedProfile.reference`), from which the crank angle of
-   the order phases is counted (:mod:`powertrain.analysis.phase`): every pulse of a
-   once-per-revolution tacho, or the first pulse after the missing-tooth gap of a wheel
-   with ``N > 1`` teeth (the gap recurring once per revolution). An rpm channel, or an
-   ``N``-tooth wheel without a gap, has no reference: its angle origin is arbitrary.
+From a **tacho** (``pulses_per_rev`` pulses per revolution): rising edges by a Schmitt
+trigger between the 2nd and 98th percentile levels (:data:`TRIGGER_HIGH`,
+:data:`TRIGGER_LOW`), missing teeth counted from the interval ratio to the local median and
+spikes dropped (:func:`count_teeth`); the angle at the edges, :math:`2\pi\,\mathrm{count}/N`,
+is fitted by a least-squares cubic spline with knots ``smooth_s`` apart (a linear sweep's
+quadratic angle is reproduced exactly), which gives angle and speed at every sample. The
+**reference pulse** (:attr:`SpeedProfile.reference`, the crank-angle origin of the order
+phases, :mod:`powertrain.analysis.phase`) is every pulse of a once-per-revolution tacho, or
+the first pulse after the missing-tooth gap of a wheel with ``N > 1`` teeth; an rpm channel,
+or a wheel without a gap, has none.
 """
 
 from __future__ import annotations
@@ -66,7 +59,7 @@ class SpeedProfile:
     notes : list of str
     reference : float or None
         Angle [rad] (on :attr:`angle`'s scale) of a once-per-revolution reference pulse,
-        known modulo 2π; None when the speed source has none (module docstring, step 5).
+        known modulo 2π; None when the speed source has none (module docstring).
     """
 
     time: np.ndarray

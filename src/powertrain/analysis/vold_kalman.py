@@ -15,34 +15,14 @@ filter's amplitude response to a component at :math:`f` Hz from the order is
 :math:`1/(1 + r^2 (2 - 2\cos 2\pi f\Delta t)^2)`; the weight is set from the -3 dB
 half-bandwidth :math:`f_b`: :math:`r = \sqrt{\sqrt2 - 1}/(2\pi f_b\Delta t)^2`.
 
-**Default bandwidth** (:func:`default_bandwidth`, per order and per sample, the weight
-:math:`r_k` then varies along the record) — the narrowest of three rules:
-
-* *sweep rule*: a resonance of half-power bandwidth :math:`\Delta f` is passed by an order
-  sweeping at :math:`\dot f_o = o\,\dot n/60` [Hz/s] in :math:`\Delta f/\dot f_o` seconds,
-  and its response cannot build up faster than its own decay, :math:`1/(\pi\Delta f)`; the
-  order's envelope therefore never changes faster than on a time scale of about
-  :math:`1/\sqrt{\dot f_o}`, whatever the damping (the time–frequency limit of a linear
-  chirp, e.g. A. Brandt, *Noise and Vibration Analysis*, Wiley 2011, ch. 12). The filter
-  is set to :math:`f_b = 1.5\sqrt{\dot f_o}` (:data:`SWEEP_FACTOR`): against the exact
-  response of a single-DOF resonance swept through at 100 and 500 rpm/s (damping 0.005 to
-  0.05, order 2 at 50 and 150 Hz) the peak is at most 0.21 dB below the fine-grid envelope
-  (0.5 Hz fixed: up to 7 dB at 100 rpm/s; ``scripts/verify_vkf_bandwidth.py``,
-  ``tests/test_order_tracking.py``);
-* *record rule*: never narrower than :math:`1.5/(0.05\,T)` for a record of :math:`T`
-  seconds, so that the end transient costs at most 5 % of the record at each end
-  (:data:`EDGE_FRACTION`);
-* *spacing rule*: never wider than a quarter of the distance to the nearest other tracked
-  order (or to 0 Hz) at the current speed, :math:`\Delta o\,n/(60\cdot 4)`, where the
-  neighbour is 40 dB down (:data:`SPACING_RATIO`). This rule wins over the other two: the
-  tracker then reports the bandwidth it used and how much of the record's ends it drops.
-
-A narrow fixed bandwidth (``--bandwidth 0.5``) instead rejects a fixed-frequency tone that
-crosses the order (``tests/test_order_tracking.py`` shows COT smearing where VKF holds), at
-the price of flattening sharp resonances crossed quickly. Each order is filtered on its own
-(the "one order at a time" form; the spacing rule keeps neighbours apart). Long records are
-first decimated (polyphase, Kaiser anti-alias) to about five times the highest tracked
-frequency.
+The default bandwidth (:func:`default_bandwidth`, per order and sample) is the narrowest of
+three rules, described with their verification in ``docs/guide/track.md``: *sweep*
+:math:`f_b = 1.5\sqrt{\dot f_o}` for an order sweeping at :math:`\dot f_o` [Hz/s] (the
+time-frequency limit of a linear chirp, A. Brandt, *Noise and Vibration Analysis*, Wiley 2011,
+ch. 12; ``scripts/verify_vkf_bandwidth.py``); *record* at least :math:`1.5/(0.05\,T)`; and,
+winning over both, *spacing* at most a quarter of the distance to the nearest other tracked
+order (or 0 Hz). Each order is filtered on its own; long records are first decimated
+(polyphase, Kaiser anti-alias) to about five times the highest tracked frequency.
 
 References
 ----------

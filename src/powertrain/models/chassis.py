@@ -1,19 +1,11 @@
 r"""The vehicle body (chassis) the mounts stand on: rigid, modal or measured receptances.
 
-* ``rigid`` — the mounts' body side does not move (the thesis's set-up).
-* ``modal`` — body modes shared by the mount attachment points:
-  :math:`\mathbf x_B(P) = \sum_k \boldsymbol\psi_k(P)\,\eta_k`, each mode a single-DOF
-  oscillator :math:`m_k(\ddot\eta_k + 2\zeta_k\omega_k\dot\eta_k + \omega_k^2\eta_k) =
-  \sum_P \boldsymbol\psi_k(P)\cdot\mathbf f_P`. Shapes are dimensionless vectors in engine
-  axes, one per mount attachment point and body point of interest; the modal mass belongs to
-  that scaling. Receptance from a force at Q to the motion at P:
-  :math:`\mathbf H_{PQ}(\omega) = \sum_k \boldsymbol\psi_k(P)\boldsymbol\psi_k(Q)^T /
-  \big(m_k(\omega_k^2 - \omega^2 + 2i\zeta_k\omega_k\omega)\big)`.
-* ``frf`` — measured receptances between the attachment points (and to the body points),
-  coupled by admittance in the harmonic solver.
-
-Body points of interest (``[chassis.points.NAME]``) are places where the body's response is
-wanted (seat rail, steering wheel); they carry no load.
+``rigid`` (the mounts' body side does not move, the thesis's set-up), ``modal`` (body modes
+shared by the attachment points, each a single-DOF oscillator in its modal coordinate;
+receptance :math:`\mathbf H_{PQ}(\omega) = \sum_k \boldsymbol\psi_k(P)\boldsymbol\psi_k(Q)^T /
+\big(m_k(\omega_k^2 - \omega^2 + 2i\zeta_k\omega_k\omega)\big)`) or ``frf`` (measured
+receptances, coupled by admittance); ``docs/guide/chassis.md`` describes them. Body points of
+interest (``[chassis.points.NAME]``: seat rail, steering wheel) carry no load.
 """
 
 from __future__ import annotations
@@ -151,10 +143,6 @@ class ModalChassis(Chassis):
     def body_rows(self, name) -> np.ndarray:
         return self.shape_matrix(name)
 
-    def modal_receptance(self, omega, responses, excitations) -> np.ndarray:
-        """Modal receptance matrix (3 n_resp, 3 n_exc) [m/N] at ``omega`` [rad/s]."""
-        return self.receptances([omega], responses, excitations)[0]
-
     def receptances(self, omegas, responses, excitations) -> np.ndarray:
         omegas = np.asarray(omegas, float).ravel()
         P = np.vstack([self.shape_matrix(r) for r in responses])        # (3 nr, k)
@@ -167,7 +155,7 @@ class ModalChassis(Chassis):
         return np.einsum("ik,wk,jk->wij", P, 1.0 / d, Q)
 
     def receptance_at(self, omega, responses, excitations) -> np.ndarray:
-        return self.modal_receptance(omega, responses, excitations)
+        return self.receptances([omega], responses, excitations)[0]
 
 
 class MeasuredChassis(Chassis):

@@ -6,28 +6,16 @@ sec. 4.1): origin at the centre of the 3rd main bearing, X along the crank axis 
 the vehicle's ISO 8855 X, i.e. rearwards for the longitudinal engine), Y opposite to the
 vehicle's Y (to the right), Z up.
 
-Load on the powertrain (:meth:`Engine.generalized_load`)
---------------------------------------------------------
-The powertrain is one rigid body that contains the moving parts; the load returned is what
-the moving parts, the gas and the crankshaft's output torque exert on it. For each cylinder,
-at its own position along X and at constant crank speed:
-
-* the gas force on the cylinder head, :math:`+F_g\,\mathbf u`, on the cylinder axis;
-* the piston side thrust :math:`-N\,\mathbf s` at the piston pin and the couple
-  :math:`e F_g\,(\mathbf s\times\mathbf u)` of the pin offset;
-* the main-bearing reaction :math:`F_r(\sin\beta\,\mathbf s - \cos\beta\,\mathbf u)` on the
-  crank axis (the crank torque :math:`T` leaves through the crankshaft to the driveline);
-* the residual rotating-mass force
-  :math:`(1-k_{cw})\,m_{rot}\,r\omega^2(\cos\theta_i\,\mathbf u + \sin\theta_i\,\mathbf s)` on
-  the crank axis: the rotating masses are *included*, and the crank counterweights
-  balance the fraction :math:`k_{cw}` of each throw's own rotating mass in its own plane
-  (default 1);
-
-plus the balancer-shaft forces at the shaft positions. Their sum per cylinder is the shaking
-force :math:`-m a\,\mathbf u` plus the torque reaction :math:`-T` about the axis of rotation
-(see :mod:`powertrain.physics.slider_crank`), so the net load is the shaking force plus the
-torque reaction, including its mean (the drive-torque reaction). Moments are taken about the
-powertrain's centre of gravity.
+**Load on the powertrain** (:meth:`Engine.generalized_load`, ``docs/guide/excitation.md``):
+the powertrain is one rigid body containing the moving parts. Per cylinder, at its own
+position along X, the forces of :func:`powertrain.physics.slider_crank.crank_forces` on the
+block (gas on the head, side thrust with the pin-offset couple, main-bearing reaction: their
+sum is the shaking force plus the torque reaction :math:`-T`, its mean included), plus the
+residual rotating-mass force
+:math:`(1-k_{cw})\,m_{rot}\,r\omega^2(\cos\theta_i\,\mathbf u + \sin\theta_i\,\mathbf s)` on the
+crank axis (the counterweights balance the fraction :math:`k_{cw}` of each throw's own rotating
+mass, default 1), and the balancer-shaft forces at the shaft positions. Moments are taken
+about the powertrain's centre of gravity.
 """
 
 from __future__ import annotations
@@ -235,11 +223,6 @@ class Engine:
         return mount.files.get(direction, self.file), key
 
     # ------------------------------------------------------------------ pressure
-    @property
-    def has_excitation(self) -> bool:
-        """True when the engine has a crank train and a combustion model."""
-        return self.crank is not None and self.combustion is not None
-
     def require_excitation(self):
         """Raise :class:`~powertrain.errors.InputError` naming the missing section when the
         engine file describes no excitation."""
@@ -276,18 +259,13 @@ class Engine:
 
     def cylinder_pressure(self, rpm: float, crank_angle_rad, load: float = 1.0) -> np.ndarray:
         """Absolute pressure [Pa] of every cylinder, shape ``(n, n_cyl)``, at cylinder-1
-        crank angles ``crank_angle_rad`` [rad] (periodic over 4π)."""
-        theta_g, p, _ = self.cycle_pressures(rpm, load)
-        local = self.local_angles(crank_angle_rad)
-        out = np.empty(local.shape)
-        period = 4.0 * np.pi
-        for i in range(self.crank.n_cylinders):
-            out[:, i] = np.interp(local[:, i], theta_g, p[i], period=period)
-        return out
+        crank angles ``crank_angle_rad`` [rad] (periodic over 4π, linear between the cycle
+        grid's points)."""
+        return self.cylinder_pressures([rpm], crank_angle_rad, load)[0]
 
     def cylinder_pressures(self, speeds_rpm, crank_angle_rad, load: float = 1.0) -> np.ndarray:
-        """:meth:`cylinder_pressure` at every speed [rpm], shape ``(n_speeds, n, n_cyl)``:
-        the same periodic linear interpolation (to round-off), its weights found once."""
+        """:meth:`cylinder_pressure` at every speed [rpm], shape ``(n_speeds, n, n_cyl)``: one
+        periodic linear interpolation, its weights found once when the grids agree."""
         local = self.local_angles(crank_angle_rad)
         cycles = [self.cycle_pressures(n, load) for n in np.atleast_1d(speeds_rpm)]
         theta_g = cycles[0][0]

@@ -7,17 +7,14 @@ exact (a quadratic in time per interval):
 .. math:: \theta(t) = \Theta_i + \omega_i (t - t_i) + \tfrac12\alpha_i (t - t_i)^2,
    \qquad \alpha_i = \frac{\omega_{i+1} - \omega_i}{t_{i+1} - t_i}.
 
-The load is a second table, linear between its rows: either the IMEP scale of the engine's
-combustion model (``imep_scale``; 0 = the model's cycle of zero brake torque, compression
-and expansion) or the mean torque the engine delivers into the driveline (``mean_torque``
-[N·m]). ``gear_ratio`` is the overall ratio the driveline torque reacts on the powertrain
-with (0: neutral or clutch open). Everything is SI (s, rad/s, N·m, kg·m², m); the file
-reader is :mod:`powertrain.iotools.manoeuvre_file`.
+The load is a second table, linear between its rows: the IMEP scale of the engine's
+combustion model or the mean torque into the driveline (:class:`Manoeuvre`; the file reader
+is :mod:`powertrain.iotools.manoeuvre_file`, the guide ``docs/guide/transient.md``). SI.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -112,6 +109,4 @@ class Manoeuvre:
 
     def with_speed(self, time, speed) -> Manoeuvre:
         """A copy driven by another speed table (e.g. a recorded one)."""
-        return Manoeuvre(self.name, np.asarray(time, float), np.asarray(speed, float),
-                         self.load_time, self.load, self.load_kind, self.gear_ratio,
-                         self.crank_inertia, self.starter, self.reversal, self.file, self.notes)
+        return replace(self, time=np.asarray(time, float), speed=np.asarray(speed, float))

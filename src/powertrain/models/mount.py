@@ -89,10 +89,6 @@ class Topology:
             return int(label[1:])
         return np.array([[idx(a), idx(b)] for a, b, _, _ in self.elements], dtype=int)
 
-    def kind(self, parameter: str) -> str:
-        """``stiffness``, ``damping`` or ``mass`` for a parameter name."""
-        return {"c": "stiffness", "d": "damping", "m": "mass"}[parameter[0]]
-
 
 def _t(name, description, order, masses, elements):
     return Topology(name, description, tuple(order.split()), tuple(masses), tuple(elements))

@@ -19,7 +19,7 @@ from powertrain.errors import InputError
 #: vibration, far below where squares and spectra overflow.
 MAX_SAMPLE = 1e15
 
-#: Measured quantity -> SI unit and the dimension name of :mod:`powertrain.units`.
+#: Measured quantity -> its SI unit.
 QUANTITIES = {
     "acceleration": "m/s^2",
     "velocity": "m/s",

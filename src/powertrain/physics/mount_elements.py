@@ -1,31 +1,17 @@
 r"""Mount elements: one mount direction as the assembled model and its solvers see it.
 
-A :class:`MountElement` is a linear network (:mod:`powertrain.physics.mount_network`; its M,
-C, K go into the assembled matrices) and, optionally, a *port law* in parallel with it
-between the engine-side node and the base node, acting on their relative displacement
-:math:`u = x_E - x_B`. The solvers ask an element two things:
-
-* the frequency domain: its **equivalent-linear two-port** at a relative-displacement
-  amplitude, :meth:`MountElement.two_port` — the network's two-port plus the port law's
-  describing function :math:`k_{eq}(A)` (a spring between the two nodes) at every
-  :math:`s \ne 0`; without a port law exactly the network's two-port. A port law carries
-  no mean force: it starts unloaded at the operating point (its ``initial_state`` at the
-  static deflection), so at :math:`s = 0` (the static preload, the mean of a run-up) it adds
-  nothing; a static force–deflection curve is a separate matter (:mod:`powertrain.solvers.operating_point`);
-* the time domain: the port law's **kernel arrays** (kind code, parameters, initial state,
-  :class:`PortForces`), integrated with the linear model by
-  :func:`powertrain.kernels.port_forces.newmark_port_kernel` (Newton per step over plain arrays).
-
-A port law is an object with ``kind`` (its code in :mod:`powertrain.kernels.port_forces`),
-``parameters()`` (float array), ``initial_state(u0, f0)`` (float array: the memory at the
-start, where the relative displacement is ``u0`` and the force expected from the
-equivalent-linear solution ``f0``), ``steady_state(amplitude, centre=0)`` (the memory on its
-steady loop of that amplitude about ``centre``, at the lower tip, moving up: where the
-displacement-driven test of
-:func:`powertrain.solvers.mount_time_domain.time_cross_point_stiffness` and a time-domain
-run-up start it) and ``describing_stiffness(amplitude)`` (complex [N/m]).
-:class:`JenkinsFriction` is the simplest: with a closed-form describing function, it proves
-the plug-in (tests/test_mount_elements.py); :class:`~powertrain.physics.mount_laws.BergFriction`
+A :class:`MountElement` is a linear network (:mod:`powertrain.physics.mount_network`) and,
+optionally, a *port law* in parallel with it between the engine-side and base nodes, acting
+on their relative displacement :math:`u = x_E - x_B` (``docs/extending.md``, "Adding a mount
+element"). In the frequency domain it is an equivalent-linear two-port
+(:meth:`MountElement.two_port`: the law's describing function :math:`k_{eq}(A)` added at
+every :math:`s \ne 0`; a port law carries no mean force), in the time domain the law's
+kernel arrays (:class:`PortForces`, :func:`powertrain.kernels.port_forces.newmark_port_kernel`).
+A port law has ``kind``, ``parameters()``, ``initial_state(u0, f0)``,
+``describing_stiffness(amplitude)`` and ``steady_state(amplitude, centre=0)``: the memory on
+its steady loop at the lower tip, moving up, where a displacement-driven test
+(:func:`powertrain.solvers.mount_time_domain.time_cross_point_stiffness`) starts it.
+:class:`JenkinsFriction` is the simplest; :class:`~powertrain.physics.mount_laws.BergFriction`
 is the mount files' ``[friction]``.
 """
 
@@ -102,15 +88,20 @@ def describing_stiffnesses(elements, amplitudes) -> list:
     for an element without a port law), one vectorised call per distinct law (the
     equivalent-linear fixed point asks for every element at every iteration)."""
     out = [None] * len(elements)
-    groups = {}
-    for k, el in enumerate(elements):
-        if el.port_law is not None:
-            groups.setdefault(el.port_law, []).append(k)
-    for law, index in groups.items():
+    for law, index in _by_law(elements, "port_law").items():
         values = law.describing_stiffness(np.array([amplitudes[k] for k in index], float))
         for k, value in zip(index, values):
             out[k] = value
     return out
+
+
+def _by_law(elements, kind) -> dict:
+    """``{law: [indices of the elements holding it]}`` of their ``kind`` law (not None)."""
+    groups = {}
+    for k, el in enumerate(elements):
+        if getattr(el, kind) is not None:
+            groups.setdefault(getattr(el, kind), []).append(k)
+    return groups
 
 
 def element_two_ports(elements, s, amplitudes, packed=None):
@@ -123,11 +114,7 @@ def element_two_ports(elements, s, amplitudes, packed=None):
     lam = np.asarray(s, complex)
     A = np.asarray(amplitudes, float)
     scales = np.ones((2,) + A.shape)
-    groups = {}
-    for k, el in enumerate(elements):
-        if el.amplitude_law is not None:
-            groups.setdefault(el.amplitude_law, []).append(k)
-    for law, index in groups.items():            # one call per distinct law
+    for law, index in _by_law(elements, "amplitude_law").items():   # one call per law
         ks, ds = law.scales(A[..., index])
         scales[0][..., index], scales[1][..., index] = ks, ds
     for k, el in enumerate(elements):
@@ -310,11 +297,7 @@ class PortForces:
     def initial_state(self, x0, f0=None) -> np.ndarray:
         """State rows (m, n_state) of every law at the initial coordinates ``x0``, expected
         to carry the forces ``f0`` (m,) [N] (default: unloaded)."""
-        return self.states_at(self.rows @ np.asarray(x0, float), f0)
-
-    def states_at(self, u0, f0=None) -> np.ndarray:
-        """State rows (m, n_state) of every law at the relative displacements ``u0`` (m,)
-        [m], carrying the forces ``f0`` (m,) [N] (default: unloaded)."""
+        u0 = self.rows @ np.asarray(x0, float)
         f0 = np.zeros(u0.size) if f0 is None else f0
         return _state_rows([np.zeros(1) if law is None else law.initial_state(u, f)
                             for law, u, f in zip(self.laws, u0, f0)])
@@ -349,10 +332,7 @@ def port_forces(elements, rows, force_map, names) -> PortForces | None:
     if not idx:
         return None
     laws = [elements[k].port_law for k in idx]
-    pars = [np.zeros(1) if law is None else np.atleast_1d(law.parameters()) for law in laws]
-    par = np.zeros((len(pars), max(p.size for p in pars)))
-    for e, p in enumerate(pars):
-        par[e, :p.size] = p
+    par = _state_rows([np.zeros(1) if law is None else law.parameters() for law in laws])
     kinds = np.array([NONE if law is None else law.kind for law in laws], np.int64)
     return PortForces(np.ascontiguousarray(rows[idx]), kinds, par, laws,
                       np.ascontiguousarray(force_map[:, idx]), [names[k] for k in idx],
@@ -360,7 +340,7 @@ def port_forces(elements, rows, force_map, names) -> PortForces | None:
 
 
 def _state_rows(states) -> np.ndarray:
-    """The laws' states (a list of 1-D arrays of any length) as zero-padded rows (m, n)."""
+    """1-D arrays of any length (the laws' states or parameters) as zero-padded rows (m, n)."""
     states = [np.atleast_1d(st) for st in states]
     out = np.zeros((len(states), max(st.size for st in states)))
     for e, st in enumerate(states):

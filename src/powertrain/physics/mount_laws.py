@@ -1,28 +1,13 @@
 r"""Amplitude, preload and friction laws of a mount direction (SI).
 
-The thesis (Kovarik 2016, sec. 6) names amplitude dependence as its model's main limitation
-and recommends a stiffness chosen from frequency and displacement amplitude, with a static
-force–deflection curve for the static nonlinearity. Three laws carry that physics here; a
-mount file's ``[amplitude]``, ``[friction]`` and ``[static]`` sections become them
-(:mod:`powertrain.iotools.mount_file`), and :class:`~powertrain.physics.mount_elements.MountElement`
-applies them:
-
-* :class:`PowerLaw`, :class:`TableLaw` — the **equivalent-linear amplitude law** of the
-  elastomer: every spring and damper of the network times a factor of the amplitude
-  :math:`A` of the relative displacement across the mount (masses never scaled);
-* :class:`BergFriction` — **Berg's friction element** (Berg 1998, *A non-linear rubber spring
-  model for rail vehicle dynamics analysis*, Vehicle System Dynamics 30), in parallel with the
-  whole network: from the last reversal point :math:`(x_s, F_s)`, with
-  :math:`\alpha = F_s/F_{max}` and :math:`y = x - x_s`,
-
-  .. math:: F = F_s + \frac{y}{x_2(1-\alpha) + y}(F_{max} - F_s)\ (y \ge 0),\qquad
-            F = F_s + \frac{y}{x_2(1+\alpha) - y}(F_{max} + F_s)\ (y \le 0),
-
-  so that from the unloaded state :math:`F = F_{max}/2` at :math:`y = x_2`;
-* :class:`StaticCurve` — the datasheet's **static force–deflection curve**: the monotone
-  cubic through its points (scipy's ``PchipInterpolator``), straight beyond them with the
-  end-point slope; the network's springs and dampers scale with its tangent stiffness at the
-  operating point over that at ``reference_deflection``.
+The thesis (Kovarik 2016, sec. 6) names amplitude dependence as its model's main limitation.
+A mount file's ``[amplitude]``, ``[friction]`` and ``[static]`` sections
+(:mod:`powertrain.iotools.mount_file`; ``docs/guide/amplitude-and-preload.md``) become
+:class:`PowerLaw` or :class:`TableLaw` (every spring and damper of the network times a factor
+of the amplitude :math:`A` across the mount, masses never scaled), :class:`BergFriction`
+(Berg 1998, *A non-linear rubber spring model for rail vehicle dynamics analysis*, Vehicle
+System Dynamics 30) and :class:`StaticCurve`;
+:class:`~powertrain.physics.mount_elements.MountElement` applies them.
 """
 
 from __future__ import annotations
@@ -123,7 +108,10 @@ class TableLaw:
 
 @dataclass(frozen=True)
 class StaticCurve:
-    """A static force–deflection curve: deflection [m] -> force [N] (both increasing).
+    """A static force–deflection curve: deflection [m] -> force [N] (both increasing), the
+    monotone cubic through its points (PCHIP), straight beyond them with the end slopes; the
+    network scales with its tangent stiffness at the operating point over that at
+    ``reference_deflection``.
 
     Parameters
     ----------
@@ -147,7 +135,7 @@ class StaticCurve:
 
     def factor(self, x) -> np.ndarray:
         """Tangent stiffness at ``x`` over that at ``reference_deflection``."""
-        return self.tangent_at(x) / self.tangent_at(self.reference_deflection)
+        return CurveReader(self).factor(x)
 
 
 class CurveReader:
@@ -183,8 +171,14 @@ class CurveReader:
 
 @dataclass(frozen=True)
 class BergFriction:
-    """Berg's friction element (module docstring); a port law of
-    :mod:`powertrain.physics.mount_elements`.
+    r"""Berg's friction element, in parallel with the whole network; a port law of
+    :mod:`powertrain.physics.mount_elements`. From the last reversal point
+    :math:`(x_s, F_s)`, with :math:`\alpha = F_s/F_{max}` and :math:`y = x - x_s`,
+
+    .. math:: F = F_s + \frac{y}{x_2(1-\alpha) + y}(F_{max} - F_s)\ (y \ge 0),\qquad
+              F = F_s + \frac{y}{x_2(1+\alpha) - y}(F_{max} + F_s)\ (y \le 0),
+
+    so that from the unloaded state :math:`F = F_{max}/2` at :math:`y = x_2`.
 
     Parameters
     ----------

@@ -66,27 +66,13 @@ def network_matrices(masses, elem_nodes, c, d, *, include_ground=False):
         The engine-side node carries no mass of its own [kg, N·s/m, N/m].
     """
     masses = np.asarray(masses, dtype=float)
-    elem_nodes = np.asarray(elem_nodes, dtype=int).reshape(-1, 2)
-    c = np.asarray(c, dtype=float)
-    d = np.asarray(d, dtype=float)
     n = masses.size
-    size = n + 2 if include_ground else n + 1
-    M = np.zeros((size, size))
+    B = incidence_matrix(n, elem_nodes)
+    keep = slice(None) if include_ground else slice(0, n + 1)
+    M = np.zeros((n + 2, n + 2))
     M[1:n + 1, 1:n + 1] = np.diag(masses)
-    C = np.zeros((size, size))
-    K = np.zeros((size, size))
-    for (a, b), ce, de in zip(elem_nodes, c, d):
-        ia = (n + 1 if include_ground else None) if a == GROUND else a
-        ib = (n + 1 if include_ground else None) if b == GROUND else b
-        for mat, val in ((K, ce), (C, de)):
-            if ia is not None:
-                mat[ia, ia] += val
-            if ib is not None:
-                mat[ib, ib] += val
-            if ia is not None and ib is not None:
-                mat[ia, ib] -= val
-                mat[ib, ia] -= val
-    return M, C, K
+    C, K = (B.T @ (np.asarray(v, dtype=float)[:, None] * B) for v in (d, c))
+    return M[keep, keep], C[keep, keep], K[keep, keep]
 
 
 def ground_force_rows(n_internal, elem_nodes, c, d):
@@ -100,16 +86,8 @@ def ground_force_rows(n_internal, elem_nodes, c, d):
     kg, dg : ndarray, shape (n_internal + 1,)
         [N/m] and [N·s/m].
     """
-    elem_nodes = np.asarray(elem_nodes, dtype=int).reshape(-1, 2)
-    kg = np.zeros(n_internal + 1)
-    dg = np.zeros(n_internal + 1)
-    for (a, b), ce, de in zip(elem_nodes, np.asarray(c, float), np.asarray(d, float)):
-        if (a == GROUND) == (b == GROUND):
-            continue
-        other = b if a == GROUND else a
-        kg[other] += ce
-        dg[other] += de
-    return kg, dg
+    _, C, K = network_matrices(np.zeros(n_internal), elem_nodes, c, d, include_ground=True)
+    return -K[:-1, -1], -C[:-1, -1]
 
 
 def two_port(omega, masses, elem_nodes, c, d, spring_scale=1.0, damper_scale=None, *,

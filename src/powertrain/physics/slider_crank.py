@@ -63,29 +63,6 @@ from __future__ import annotations
 import numpy as np
 
 
-def rod_angle(theta, r, l, e=0.0):
-    r"""Connecting-rod angle :math:`\beta` [rad], :math:`\sin\beta = (r\sin\theta - e)/l`.
-
-    Parameters
-    ----------
-    theta : array_like
-        Crank angle from the cylinder axis [rad].
-    r : float
-        Crank radius (half the stroke) [m].
-    l : float
-        Connecting-rod length, centre to centre [m].
-    e : float, optional
-        Piston-pin offset [m].
-
-    Returns
-    -------
-    ndarray
-        Rod angle [rad].
-    """
-    theta = np.asarray(theta, dtype=float)
-    return np.arcsin((r * np.sin(theta) - e) / l)
-
-
 def piston_kinematics(theta, r, l, e=0.0):
     r"""Exact piston position and its first two derivatives with respect to crank angle.
 
@@ -110,10 +87,10 @@ def piston_kinematics(theta, r, l, e=0.0):
         :math:`d^2y/d\theta^2` [m/rad²]; the acceleration at constant speed is
         :math:`\omega^2\,d^2y/d\theta^2` [m/s²].
     beta : ndarray
-        Rod angle [rad].
+        Rod angle [rad], :math:`\sin\beta = (r\sin\theta - e)/l`.
     """
     theta = np.asarray(theta, dtype=float)
-    beta = rod_angle(theta, r, l, e)
+    beta = np.arcsin((r * np.sin(theta) - e) / l)
     cb, sb = np.cos(beta), np.sin(beta)
     y = r * np.cos(theta) + l * cb
     b1 = r * np.cos(theta) / (l * cb)

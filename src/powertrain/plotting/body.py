@@ -9,7 +9,7 @@ import numpy as np
 
 from powertrain.analysis.channel import passive_name
 from powertrain.plotting import SIGNAL_UNITS
-from powertrain.plotting.pages import first_page, page_note, page_path, page_rows
+from powertrain.plotting.pages import draw_pages
 from powertrain.plotting.runup import SYNTHESIS_NOTE, panel_title, style_panel
 from powertrain.plotting.style import (
     LABEL_SIZE,
@@ -19,11 +19,11 @@ from powertrain.plotting.style import (
     TICK_SIZE,
     TITLE_SIZE,
     finish,
+    is_axes,
     legend,
     no_data,
     series_style,
     subplots,
-    whole_figure,
     wrap,
 )
 
@@ -86,7 +86,7 @@ def plot_static(result, path=None, ax=None, provenance=None):
     title = ("static operating point" + (f" of {result.engine}" if result.engine else "")
              + ": mount deflections (local axes) under the weight and the mean drive-torque "
              "reaction")
-    return finish(fig, own, path, provenance, title=title if whole_figure(ax) else None)
+    return finish(fig, own, path, provenance, title=title if not is_axes(ax) else None)
 
 
 def _positive(values):
@@ -97,13 +97,9 @@ def _positive(values):
 def plot_runup_both_sides(result, path=None, quantities=("synthesis", "order_2", "order_4"),
                           signal="velocity", ax=None, provenance=None):
     """Run-up curves with a body model: one panel per mount and direction holding the
-    engine side (solid) and the body side (dashed), then one per body-point direction;
-    columns = ``quantities``; log-scaled RMS [mm/s for velocity]. A body side that is zero
-    at every speed is said in its panel title; a body-point direction zero in every column
-    is not drawn but named in the figure title. The rows are as tall as fit one A4 page;
-    written to ``path``, more rows than fit go on further pages (``NAME_p2.png`` …, as
-    :func:`~powertrain.plotting.runup.plot_runup`). Returns the figure, the first page
-    (``ax``: None, a Figure or SubFigure)."""
+    engine side (solid) and the body side (dashed), then one per body-point direction with
+    response; columns = ``quantities``; paged as :func:`~powertrain.plotting.runup.plot_runup`.
+    Returns the figure, the first page (``ax``: None, a Figure or SubFigure)."""
     rows = [(m, d, True) for m in result.mounts for d in "xyz"]
     points = [(p, d, False) for p in result.points for d in "xyz"]
     silent = [(p, d) for p, d, _ in points
@@ -118,18 +114,15 @@ def plot_runup_both_sides(result, path=None, quantities=("synthesis", "order_2",
         title += (". Zero at every speed (no mount path moves them), not drawn: "
                   + ", ".join(f"{p} {d.upper()}" for p, d in silent))
     frame = FRAME_IN + 0.16 * wrap(title, PRINT_WIDTH_IN * 0.95, 9).count("\n")
-    pages, height = page_rows(rows, frame)
-    pages = pages if ax is None and path else [rows]
-    paths = [page_path(path, k) for k in range(len(pages))]
-    figures = []
-    for k, chunk in enumerate(pages):
+
+    def page(chunk, height, file, note):
         fig, axes, own = subplots(ax, len(chunk), len(quantities), sharex=True,
                                   figsize=(PRINT_WIDTH_IN, height * len(chunk) + frame))
         _both_sides_grid(fig, axes, result, chunk, quantities, signal)
         legend(fig, axes, ax)
-        figures.append(finish(fig, own, paths[k], provenance, title=title + page_note(
-            k, pages, path) if whole_figure(ax) else None))
-    return figures[0] if len(figures) == 1 else first_page(figures, paths)
+        return finish(fig, own, file, provenance,
+                      title=title + note if not is_axes(ax) else None)
+    return draw_pages(rows, frame, ax, path, page)
 
 
 def _both_sides_grid(fig, axes, result, rows, quantities, signal):
@@ -198,7 +191,7 @@ def plot_path_contributions(result, path=None, order=2.0, n_paths=6, ax=None,
     if silent:
         title += ". No response at every speed, not drawn: " + ", ".join(
             f"{p} {d.upper()}" for p, d, _ in silent)
-    return finish(fig, own, path, provenance, title=title if whole_figure(ax) else None)
+    return finish(fig, own, path, provenance, title=title if not is_axes(ax) else None)
 
 
 def _paths_panel(a, rpm, pc, labels, n_paths, colours):

@@ -34,7 +34,6 @@ from powertrain.plotting.style import (
     quantity_label,
     signed,
     subplots,
-    whole_figure,
 )
 
 #: Display factor of the levels: m/s -> mm/s.
@@ -78,11 +77,6 @@ EMPTY_TEXT = {"not in the measured data": "not measured",
               "no comparable point": "every point below the limit"}
 
 
-def comparison_quantities(comparison) -> list:
-    """Every quantity requested: the default three and all measured or compared ones."""
-    return comparison.requested_quantities()
-
-
 def row_height(n_rows: int, n_phase_rows: int = 0) -> float:
     """Level row height [in] that fits ``n_rows`` level rows and ``n_phase_rows`` phase rows
     (:func:`phase_row_height` each) in :data:`MAX_HEIGHT_IN`: within :data:`ROW_HEIGHT_IN`,
@@ -111,19 +105,10 @@ def plot_comparison(comparison, path=None, quantities=None, *, ax=None, channel=
                     quantity=None, provenance=None, phase=True):
     """Measured and simulated RMS velocity against speed, level gap shaded.
 
-    The thesis's layout (Kovarik 2016, Figs 45-71): one row per mount and direction (named
-    on the left), one column per quantity (synthesis and every measured order, named on
-    top), log-scaled velocity [mm/s]; the rows are made as tall as fit one A4 page
-    (:func:`row_height`). The measured curve is a thin black line over the blue simulation
-    (marked at its speeds when at most :data:`MAX_MARKED_SPEEDS`, joined by straight lines:
-    on the log axis exactly the log-level interpolation used for the gaps); the gap at the
-    compared speeds is shaded orange where the simulation is higher, sky blue where it is
-    lower (colour-blind safe). Points excluded at the noise floor are grey crosses, the
-    exclusion limit (:attr:`ComparisonResult.exclusion_limit`) a dotted line;
-    measured-not-modelled points (simulation below the floor, measurement above the limit;
-    in no gap) reddish-purple triangles. A panel with nothing compared says so. Panel
-    titles: the RMS gap and bias [dB]. Phase panels (``phase``) under the channels with
-    phase on both sides.
+    The thesis's layout (Kovarik 2016, Figs 45-71): one row per mount and direction, one
+    column per quantity, log-scaled velocity [mm/s], rows as tall as fit one A4 page
+    (:func:`row_height`); phase panels under the channels with phase on both sides.
+    ``docs/reference/figures.md`` (``compare --plot``) lists every mark.
 
     Parameters
     ----------
@@ -131,7 +116,8 @@ def plot_comparison(comparison, path=None, quantities=None, *, ax=None, channel=
     path : str or Path, optional
         PNG file written atomically.
     quantities : sequence of str, optional
-        Columns; default :func:`comparison_quantities` (nothing requested is left out).
+        Columns; default ``comparison.requested_quantities()``: the default three and
+        every measured or compared one.
     ax : None, Axes, Figure or SubFigure
         Where to draw; an Axes takes one panel (``channel``, ``quantity`` and no phase
         panel), else an InputError saying to pass a Figure.
@@ -144,15 +130,16 @@ def plot_comparison(comparison, path=None, quantities=None, *, ax=None, channel=
     """
     rows = list(comparison.simulated.channels)
     rows += [c for c in comparison.measured.channels if c not in rows]
-    rows, quantities = select_panels(rows, list(quantities or comparison_quantities(
-        comparison)), channel, quantity)
+    rows, quantities = select_panels(rows, list(quantities or
+                                                comparison.requested_quantities()),
+                                     channel, quantity)
     phased = {k: c for k, c in phased_channels(comparison).items()
               if k[:2] in rows and k[2] in quantities} if phase else {}
     if is_axes(ax) and phased:
         raise InputError(panels_error(2, ", or phase=False for the level panel alone"),
                          key="ax")
     fig, panels, phase_panels, own, axes = _grid(ax, rows, quantities, None, None, phased)
-    limit, margin_titles = comparison.exclusion_limit * MM, whole_figure(ax)
+    limit, margin_titles = comparison.exclusion_limit * MM, not is_axes(ax)
     _level_panels(panels, comparison, rows[0], limit, margin_titles)
     bottom = set(map(id, axes[-1]))
     for key, a in phase_panels.items():
@@ -166,7 +153,7 @@ def plot_comparison(comparison, path=None, quantities=None, *, ax=None, channel=
                                                    else ""))
     legend(fig, axes, ax)
     return finish(fig, own, path, provenance,
-                  title=_title(comparison, bool(phased)) if whole_figure(ax) else None)
+                  title=_title(comparison, bool(phased)) if not is_axes(ax) else None)
 
 
 def _level_panels(panels, comparison, top_channel, limit, margin_titles):
@@ -194,14 +181,9 @@ def _margin_labels(axes, panels, rows, first_quantity):
 
 
 def _grid(ax, rows, quantities, channel, quantity, phased):
-    """Level panels as :func:`~powertrain.plotting.runup.grid` (``phased`` empty), else a
-    phase row under each channel row with some phase.
-
-    Returns
-    -------
-    fig, panels : {key: level Axes}, phase_panels : {key: phase Axes}, own : bool,
-    axes : 2-D array of every panel, rows top to bottom
-    """
+    """``(fig, {key: level Axes}, {key: phase Axes}, own, 2-D array of every panel)``: the
+    level panels as :func:`~powertrain.plotting.runup.grid`, and a phase row under each
+    channel row with some phase in ``phased``."""
     with_phase = [ch for ch in rows if any(k[:2] == tuple(ch) for k in phased)]
     height = row_height(len(rows), len(with_phase))
     if not with_phase:

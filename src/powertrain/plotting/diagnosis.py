@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import numpy as np
 
 from powertrain.analysis.channel import split_side
@@ -27,7 +29,6 @@ from powertrain.plotting.style import (
     quantity_label,
     series_style,
     subplots,
-    whole_figure,
     wrap,
 )
 
@@ -46,20 +47,17 @@ GAP_OUTLINE_RUN = 3
 
 
 def _censored(diagnosis):
-    """Measured points at the noise floor (the one rule, :mod:`powertrain.analysis.noise_floor`)
-    and the rule's margin."""
+    """Measured points at the noise floor (the one rule, :mod:`powertrain.analysis.noise_floor`)."""
     d = diagnosis.data
-    return np.isfinite(d.level) & at_floor(d.level, d.floor), NOISE_FLOOR_MARGIN
+    return np.isfinite(d.level) & at_floor(d.level, d.floor)
 
 
 def plot_gap_map(diagnosis, path=None, *, ax=None, quantity=None, provenance=None):
     """Gap map of a :class:`powertrain.diagnosis.DiagnosisResult`: one panel per quantity
-    with a point above the censoring limit (3 × noise floor; the title counts the others),
-    channels against speed, colour = gap 20 log10(sim/measured) [dB] on a scale from the
-    data (:func:`gap_scale`); a title of the verdict's label (its text is in the summary);
-    every panel with its speed axis; outlined: runs of at least
-    :data:`GAP_OUTLINE_RUN` neighbouring speeds beyond ±3 dB (single noisy cells are not);
-    cells measured below the censoring limit grey.
+    with a point above the censoring limit, channels against speed, colour = gap
+    20 log10(sim/measured) [dB] on a scale from the data (:func:`gap_scale`), runs of at
+    least :data:`GAP_OUTLINE_RUN` speeds beyond ±3 dB outlined, censored cells grey
+    (``docs/reference/figures.md``, ``gap_map.png``).
 
     Parameters
     ----------
@@ -74,7 +72,7 @@ def plot_gap_map(diagnosis, path=None, *, ax=None, quantity=None, provenance=Non
     provenance : Provenance, optional
     """
     d = diagnosis.data
-    cens, margin = _censored(diagnosis)
+    cens, margin = _censored(diagnosis), NOISE_FLOOR_MARGIN
     valid = np.isfinite(diagnosis.gap) & ~cens
     shown = [q for k, q in enumerate(d.quantities) if valid[:, :, k].any()]
     empty = [q for q in d.quantities if q not in shown]
@@ -101,7 +99,6 @@ def plot_gap_map(diagnosis, path=None, *, ax=None, quantity=None, provenance=Non
         a.set_visible(False)
     for a in axes.flat[:len(qs)]:
         a.set_xlabel("engine speed [rpm]", fontsize=LABEL_SIZE)
-    for a in axes.flat[:len(qs)]:
         a.set_ylabel("channel", fontsize=LABEL_SIZE)
     if im is not None:
         colorbar(fig, im, axes.ravel().tolist(), diagnosis.gap[valid], -scale, scale,
@@ -111,7 +108,7 @@ def plot_gap_map(diagnosis, path=None, *, ax=None, quantity=None, provenance=Non
               f"±{GAP_OUTLINE_DB:g} dB")
     if empty:
         title += f"; {len(empty)} quantities all below {margin:g}× the floor, not drawn"
-    return finish(fig, own, path, provenance, title=title if whole_figure(ax) else None)
+    return finish(fig, own, path, provenance, title=title if not is_axes(ax) else None)
 
 
 def gap_scale(gaps) -> float:
@@ -127,7 +124,6 @@ def _run_name(diagnosis) -> str:
     runs = getattr(diagnosis, "runs", None) or []
     if not runs:
         return ""
-    from pathlib import Path  # deferred: only plans need it
     return f" of run 1 ({Path(runs[0]['file']).name}) of {len(runs)}"
 
 
@@ -177,14 +173,11 @@ def _runs_beyond(mask, run):
 
 
 def plot_gap_frequency(diagnosis, path=None, *, ax=None, provenance=None):
-    """Order gaps re-plotted (a) against frequency f = order·rpm/60 [Hz], per channel with
-    that channel's fitted structure part dH(f) + constant (a structural cause lines up
-    across orders at one frequency), and (b), averaged over the channels, against speed,
-    one colour per order with that order's fitted excitation part (dashed; an excitation
-    cause lines up at one order). Up to :data:`MAX_CHANNELS_ONE_AXIS` channels share panel
-    (a), each its own colour and line style; beyond, (a) is small multiples, one panel per
-    mount base (or body point) and direction, its engine side and body side told apart by
-    colour and line style. Only orders with a gap above the noise floor are drawn.
+    """Order gaps (a) against frequency f = order·rpm/60 [Hz] per channel, with its fitted
+    structure part (a structural cause lines up at one frequency), and (b), averaged over
+    the channels, against speed per order, with its fitted excitation part (dashed). Beyond
+    :data:`MAX_CHANNELS_ONE_AXIS` channels (a) is small multiples, one per mount base (or
+    body point) and direction (``docs/reference/figures.md``, ``gap_vs_frequency.png``).
 
     Parameters
     ----------
@@ -223,7 +216,7 @@ def plot_gap_frequency(diagnosis, path=None, *, ax=None, provenance=None):
     title = (f"gap split{_run_name(diagnosis)}: structure {sh['structure']:.0%}, excitation "
              f"{sh['excitation']:.0%}, channel constant {sh['const']:.0%} (each alone)"
              + ("; (a) per base and direction, line: fitted structure part" if many else ""))
-    return finish(fig, own, path, provenance, title=title if whole_figure(ax) else None)
+    return finish(fig, own, path, provenance, title=title if not is_axes(ax) else None)
 
 
 def _frequency_layout(ax, diagnosis, orders, chans, many):
@@ -315,11 +308,9 @@ def _legend_above(ax, title):
 
 def plot_diagnosis_overlay(diagnosis, path=None, n_panels=6, *, ax=None, provenance=None):
     """Measured vs baseline vs baseline + chosen effect for the channel-orders with the
-    largest baseline gaps; held-out speeds circled; measured points below the censoring
-    level (3 × the noise floor) hollow, at that level (they say only "below it"). The
-    simulated curves are the model's levels at every measured speed (noise floor added in
-    power), drawn whole; where a curve cannot be drawn (no steady state with the effect) the
-    panel says so. A plan's overlay shows its first run and says so.
+    largest baseline gaps; held-out speeds circled, censored measured points hollow at the
+    censoring level; the simulated curves at every measured speed (noise floor added in
+    power), or a note where one has no steady state. A plan's overlay shows its first run.
 
     Parameters
     ----------
@@ -332,7 +323,7 @@ def plot_diagnosis_overlay(diagnosis, path=None, n_panels=6, *, ax=None, provena
     """
     d = diagnosis.data
     g = diagnosis.gap
-    cens, _ = _censored(diagnosis)
+    cens = _censored(diagnosis)
     score = []
     for c in range(len(d.channels)):
         for k in np.flatnonzero(d.order_mask):
@@ -356,7 +347,7 @@ def plot_diagnosis_overlay(diagnosis, path=None, n_panels=6, *, ax=None, provena
     legend(fig, axes, ax)
     return finish(fig, own, path, provenance,
                   title=f"before / after / measured{_run_name(diagnosis)}: verdict "
-                        f"{diagnosis.verdict}" if whole_figure(ax) else None)
+                        f"{diagnosis.verdict}" if not is_axes(ax) else None)
 
 
 def _overlay_panel(ax, diagnosis, c, k, held, rms, cens):

@@ -13,12 +13,11 @@ from powertrain.plotting.style import (
     TITLE_SIZE,
     colour,
     finish,
+    is_axes,
     legend,
     subplots,
-    whole_figure,
 )
 
-LOAD_NAMES = ["Fx [N]", "Fy [N]", "Fz [N]", "Mx [N·m]", "My [N·m]", "Mz [N·m]"]
 #: Legend label of the x, y and z component (one colour each in every load panel).
 COMPONENTS = ("x: Fx, Mx", "y: Fy, My", "z: Fz, Mz")
 #: Colours of the components, apart from the cylinders' (palette colours 0-3).
@@ -72,7 +71,7 @@ def plot_excitation(exc, path=None, *, ax=None, provenance=None):
     _spectrum(axes[2], exc)
     legend(fig, axes, ax)
     return finish(fig, own, path, provenance,
-                  title=f"Excitation at {exc.rpm:g} rpm" if whole_figure(ax) else None)
+                  title=f"Excitation at {exc.rpm:g} rpm" if not is_axes(ax) else None)
 
 
 def _spectrum(axes, exc):

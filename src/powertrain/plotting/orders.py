@@ -19,13 +19,13 @@ from powertrain.plotting.style import (
     colour,
     figure_legend,
     finish,
+    is_axes,
     legend,
     log_axis,
     no_data,
     quantity_label,
     quantity_style,
     subplots,
-    whole_figure,
     wrap,
 )
 
@@ -52,11 +52,8 @@ def plot_tracked(tracked, path=None, quantities=None, *, ax=None, provenance=Non
     line style it has in every figure (:func:`~powertrain.plotting.style.quantity_style`).
 
     A curve wholly more than :data:`DYNAMIC_RANGE_DB` below the panel's largest level is not
-    drawn (numerical noise, 1e-5 of the signal); the orders left out so are named in the
-    title. Each y axis spans the drawn curves (at most that range). The one legend of the
-    figure lists exactly the curves drawn. Returns the figure (``ax``: None, Figure or
-    SubFigure, or an Axes when there is one channel, else an InputError saying to pass a
-    Figure)."""
+    drawn but named in the title. Returns the figure (``ax``: None, Figure or SubFigure, or
+    an Axes when there is one channel, else an InputError saying to pass a Figure)."""
     quantities = list(quantities or tracked_quantities(tracked))
     n = len(tracked.channels)
     cols = min(3, n)
@@ -78,7 +75,7 @@ def plot_tracked(tracked, path=None, quantities=None, *, ax=None, provenance=Non
     legend(fig, axes, ax)
     title = f"order tracking ({tracked.method}) of {Path(str(tracked.source)).name}"
     return finish(fig, own, path, provenance,
-                  title=title + _hidden_note(hidden, n) if whole_figure(ax) else None)
+                  title=title + _hidden_note(hidden, n) if not is_axes(ax) else None)
 
 
 def _hidden_note(hidden, n_channels) -> str:
@@ -153,7 +150,7 @@ def plot_maps(rpm, orders, order_rms, times, freqs, rpm_t, psd, title="", path=N
             (a2, "rpm-frequency map (waterfall)", rpm_t, window_s and f"{window_s:.2g} s "
              "windows")):
         _speed_axis(a, name, float(np.min(speeds)), float(np.max(speeds)), (lo, hi), span)
-    return finish(fig, own, path, provenance, title=title if whole_figure(ax) else None)
+    return finish(fig, own, path, provenance, title=title if not is_axes(ax) else None)
 
 
 def _speed_axis(a, name, first, last, limits, span):

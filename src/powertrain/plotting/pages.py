@@ -54,13 +54,22 @@ def page_path(path, k: int):
     return f"{base}_p{k + 1}{ext}"
 
 
-def first_page(figures, paths):
-    """The first of the page ``figures`` (the others, written to ``paths[1:]``, are
-    released): what a plot function returns. Its ``pages`` attribute lists every file
-    written, the first page's first."""
+def draw_pages(rows, frame_in, ax, path, draw):
+    """A grid's ``rows`` drawn on as many pages as :func:`page_rows` needs (one page when
+    drawn into ``ax`` or not written): ``draw(rows, row height [in], file, title note)``
+    makes a page's figure. Returns the first page (what a plot function returns; the others,
+    written, are released), its ``pages`` attribute listing every file written when there
+    are several."""
+    pages, height = page_rows(rows, frame_in)
+    if ax is not None or not path:
+        pages = [rows]
+    paths = [page_path(path, k) for k in range(len(pages))]
+    figures = [draw(chunk, height, paths[k], page_note(k, pages, path))
+               for k, chunk in enumerate(pages)]
     for fig in figures[1:]:
         close_figure(fig)
-    figures[0].pages = [p for p in paths if p]
+    if len(figures) > 1:
+        figures[0].pages = [p for p in paths if p]
     return figures[0]
 
 

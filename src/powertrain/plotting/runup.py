@@ -7,7 +7,7 @@ from __future__ import annotations
 import numpy as np
 
 from powertrain.errors import InputError
-from powertrain.plotting.pages import first_page, page_note, page_path, page_rows
+from powertrain.plotting.pages import draw_pages, page_rows
 from powertrain.plotting.style import (
     LABEL_SIZE,
     PRINT_WIDTH_IN,
@@ -24,7 +24,6 @@ from powertrain.plotting.style import (
     quantity_label,
     signed,
     subplots,
-    whole_figure,
     wrap,
 )
 
@@ -173,11 +172,8 @@ def plot_runup(results, path=None, quantities=("synthesis", "order_2", "order_4"
     rows, picked = select_panels(results[0][1].channels, list(quantities), channel, quantity)
     if is_axes(ax):
         return _runup_page(results, rows, picked, signal, ax, provenance, path, "")
-    pages = page_rows(rows, GRID_FRAME_IN)[0] if ax is None and path else [rows]
-    paths = [page_path(path, k) for k in range(len(pages))]
-    figures = [_runup_page(results, chunk, picked, signal, ax, provenance, paths[k],
-                           page_note(k, pages, path)) for k, chunk in enumerate(pages)]
-    return figures[0] if len(figures) == 1 else first_page(figures, paths)
+    return draw_pages(rows, GRID_FRAME_IN, ax, path, lambda chunk, _, file, note: _runup_page(
+        results, chunk, picked, signal, ax, provenance, file, note))
 
 
 def _runup_page(results, rows, quantities, signal, ax, provenance, path, note):
@@ -200,7 +196,7 @@ def _runup_page(results, rows, quantities, signal, ax, provenance, path, note):
         legend(fig, axes, ax)
     return finish(fig, own, path, provenance,
                   title=f"run-up: RMS {signal.replace('_', ' ')} at the mounts{SYNTHESIS_NOTE}"
-                  f"{note}" if whole_figure(ax) else None)
+                  f"{note}" if not is_axes(ax) else None)
 
 
 # --------------------------------------------------------------------------- what-if
@@ -209,12 +205,9 @@ def plot_whatif(whatif, path=None, *, ax=None, channel=None, quantity=None, prov
     """A what-if study against speed: absolute levels (``view="levels"``) or the change of
     each variant against the baseline, Δ = 20 log10(v/v0) [dB] (``view="delta"``).
 
-    Every channel-quantity, one panel each (rows mount × direction, columns the quantities,
-    as tall as fit one A4 page; written to ``path``, a grid too tall for one page goes on
-    several, as :func:`plot_runup`). ``levels``: baseline black, each variant in colour, the
-    measurement (when given) as grey dots; a variant within a fraction of a dB of the
-    baseline lies on it. ``delta``: one shared Δ axis, a line per variant. The legend gives
-    each variant's mean change over all channels, quantities and speeds.
+    Every channel-quantity, one panel each, paged as :func:`plot_runup`; the legend gives
+    each variant's mean change over all channels, quantities and speeds
+    (``docs/reference/figures.md``, ``whatif --plot`` and ``--delta-plot``).
 
     Parameters
     ----------
@@ -240,26 +233,21 @@ def plot_whatif(whatif, path=None, *, ax=None, channel=None, quantity=None, prov
     entries = len(whatif.variants) + 1 + (whatif.measured is not None and view == "levels")
     frame = GRID_FRAME_IN + 0.16 * (wrap(title, PRINT_WIDTH_IN * 0.95, 9).count("\n") + 1
                                     + entries)
-    pages, height = page_rows(rows, frame)
-    if ax is not None or not path:
-        pages = [rows]
-    paths = [page_path(path, k) for k in range(len(pages))]
     overall = {v.name: _mean_change(whatif, v.name, base.channels, list(whatif.quantities))
                for v in whatif.variants}
-    figures = []
-    for k, chunk in enumerate(pages):
+
+    def page(chunk, height, file, note):
         fig, panels, own, axes = grid(ax, chunk, picked, panel_height=height, frame_in=frame)
-        draw = _delta_panel if view == "delta" else _levels_panel
         for key, a in panels.items():
-            draw(a, whatif, key, overall)
+            (_delta_panel if view == "delta" else _levels_panel)(a, whatif, key, overall)
         if view == "delta":
             _share_delta_axis(panels.values())
         label_grid(fig, axes, "Δ = 20 log10(v/v0) [dB]" if view == "delta" else
                    f"RMS {signal.replace('_', ' ')} [{SIGNAL_UNITS[signal][1]}]")
         legend(fig, axes, ax)
-        figures.append(finish(fig, own, paths[k], provenance, title=title + page_note(
-            k, pages, path) if whole_figure(ax) else None))
-    return figures[0] if len(figures) == 1 else first_page(figures, paths)
+        return finish(fig, own, file, provenance,
+                      title=title + note if not is_axes(ax) else None)
+    return draw_pages(rows, frame, ax, path, page)
 
 
 def _levels_panel(a, whatif, key, overall):

@@ -55,11 +55,8 @@ def draw_stiffness(axes, f, kcp, form, *, label, style="-", color=None, marker=N
     if freq_axis == "log":
         ok = f > 0
         f, k = f[ok], k[ok]
-    if marker:
-        kw, kw_imag = {"ls": "none", "marker": marker, "ms": 3}, {"ls": "none",
-                                                                 "marker": marker, "ms": 3}
-    else:
-        kw, kw_imag = {"ls": style, "lw": 1.3}, {"ls": "--", "lw": 1.3}
+    kw = {"ls": "none", "marker": marker, "ms": 3} if marker else {"ls": style, "lw": 1.3}
+    kw_imag = kw if marker else {"ls": "--", "lw": 1.3}
     if form == "real-imag":
         line, = axes[0].plot(f, k.real, color=color, label=f"{label}, real", **kw)
         axes[0].plot(f, k.imag, color="0.55" if marker else line.get_color(),
@@ -155,14 +152,6 @@ def fit_frequencies(frequency_hz, freq_axis=DEFAULT_FREQ_AXIS) -> np.ndarray:
     return np.linspace(f.min(), f.max(), FIT_POINTS)
 
 
-def _fitted(frequency_hz, fitted):
-    """(frequencies [Hz], K* [N/m]) of a fitted curve given at the data's frequencies or as
-    its own (frequencies, K*) pair."""
-    if isinstance(fitted, tuple):
-        return fitted
-    return frequency_hz, fitted
-
-
 def data_label(synthetic: bool) -> str:
     """Legend word of data points: ``SYNTHETIC data`` when the file says so, else
     ``measured``."""
@@ -198,7 +187,7 @@ def plot_mount_fit(frequency_hz, kcp_measured, kcp_fitted, *, label="fit", title
     -------
     matplotlib Figure (or SubFigure)
     """
-    f_fit, k_fit = _fitted(frequency_hz, kcp_fitted)
+    f_fit, k_fit = kcp_fitted if isinstance(kcp_fitted, tuple) else (frequency_hz, kcp_fitted)
     if synthetic:
         title = "SYNTHETIC data" + (f" · {title}" if title else "")
     return plot_stiffness([(label, f_fit, k_fit)], path,
@@ -254,7 +243,7 @@ def plot_amplitude_fit(curves, path=None, *, ax=None, form=DEFAULT_FORM,
     for k, (label, f, measured, fitted) in enumerate(curves):
         draw_stiffness(axes, f, measured, form, label=f"{label} {data_label(synthetic)}",
                        color=colour(k), marker=".", freq_axis=freq_axis)
-        f_fit, k_fit = _fitted(f, fitted)
+        f_fit, k_fit = fitted if isinstance(fitted, tuple) else (f, fitted)
         draw_stiffness(axes, f_fit, k_fit, form, label=f"{label} fitted", color=colour(k),
                        freq_axis=freq_axis)
     style_stiffness(axes, form, freq_axis, own=own)

@@ -102,16 +102,10 @@ def panels_error(n: int, choose: str = "") -> str:
             f"fig.subfigures()), not one Axes{choose}")
 
 
-def whole_figure(target) -> bool:
-    """True when a plot draws a whole figure (``target`` None, a Figure or SubFigure): its
-    legend and title go with it; False for one Axes (the legend goes into the Axes)."""
-    return not is_axes(target)
-
-
 def legend(fig, axes, target, extra=()):
     """The legend of a plot: one for the figure above the panels
     (:func:`figure_legend`), or inside the Axes when ``target`` is one Axes."""
-    if whole_figure(target):
+    if not is_axes(target):      # a whole figure: the legend above its panels
         return figure_legend(fig, axes, extra)
     a = np.ravel(axes)[0]
     handles, labels = a.get_legend_handles_labels()
@@ -186,11 +180,16 @@ def is_axes(target) -> bool:
     return isinstance(target, Axes)
 
 
+def root_figure(fig):
+    """The top-level figure holding ``fig`` (a Figure, SubFigure or Axes)."""
+    while getattr(fig, "figure", None) is not None and fig.figure is not fig:
+        fig = fig.figure
+    return fig
+
+
 def root_size(fig):
     """(width, height) [in] of the top-level figure holding ``fig``."""
-    root = fig.figure if hasattr(fig, "figure") and fig.figure is not None else fig
-    while getattr(root, "figure", None) is not None and root.figure is not root:
-        root = root.figure
+    root = root_figure(fig)
     return root.get_figwidth(), root.get_figheight()
 
 
@@ -439,10 +438,9 @@ def colorbar(fig, mappable, axes, data, vmin, vmax, label):
     ``[vmin, vmax]`` scale."""
     finite = np.asarray(data, dtype=float)
     finite = finite[np.isfinite(finite)]
-    below = finite.size and finite.min() < vmin
-    above = finite.size and finite.max() > vmax
-    extend = {(1, 1): "both", (1, 0): "min", (0, 1): "max"}.get((int(bool(below)),
-                                                                    int(bool(above))), "neither")
+    below = bool(finite.size and finite.min() < vmin)
+    above = bool(finite.size and finite.max() > vmax)
+    extend = ("neither", "min", "max", "both")[below + 2 * above]
     cb = fig.colorbar(mappable, ax=axes, extend=extend, shrink=0.9, aspect=30)
     cb.set_label(label, fontsize=LABEL_SIZE)
     cb.ax.tick_params(labelsize=TICK_SIZE)
@@ -474,11 +472,8 @@ def figure_legend(fig, axes, extra=(), fontsize=LEGEND_SIZE):
 # ------------------------------------------------------------------ output
 def save_figure(fig, path):
     """Save a figure as PNG atomically (no half-written file on failure)."""
-    root = fig
-    while getattr(root, "figure", None) is not None and root.figure is not root:
-        root = root.figure
     with atomic_path(path) as tmp:
-        root.savefig(tmp, dpi=DPI, format="png")
+        root_figure(fig).savefig(tmp, dpi=DPI, format="png")
 
 
 def target_and_path(ax, path):
