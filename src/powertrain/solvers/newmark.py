@@ -229,7 +229,7 @@ class ModalNewmark:
     def real_form(self, a) -> np.ndarray:
         """``a`` (..., kept modes) complex in the kernels' real form: the real parts, then
         the imaginary parts of the complex modes (a real mode's is zero but for round-off),
-        contiguous (:func:`powertrain.kernels.port_forces._advance`). A row ``r`` read as
+        contiguous (:func:`powertrain.kernels.port_forces.modal_port_kernel`). A row ``r`` read as
         ``Re(r eta)`` is ``real_form(conj(r))``."""
         a = np.asarray(a)
         return np.ascontiguousarray(np.concatenate([a.real, a.imag[..., :self.n_complex]],
