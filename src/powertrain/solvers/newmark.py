@@ -284,11 +284,13 @@ class ModalNewmark:
         return z0[:self.n], z0[self.n:]
 
     def port_modes(self, rows):
-        """``(Pm, Bp)`` of the port rows ``rows`` (m, n) (:meth:`port_harmonics`): the
-        rows read off the modes, ``Pm`` (m, 2 n), and the modal load of a unit force along
-        each row pushing the model by minus the row, ``Bp`` (2 n, m)."""
+        """``(Pm, Bp, K)`` of the port rows ``rows`` (m, n) (:meth:`port_harmonics`): the
+        rows read off the modes, ``Pm`` (m, 2 n), the modal load of a unit force along
+        each row pushing the model by minus the row, ``Bp`` (2 n, m), and each mode's
+        part of the rows' response to the forces, ``K`` (2 n, m m) = ``Pm[:, j] Bp[j]``."""
         n = self.n
-        return rows @ self.Psi[:n], self.Psi_inv[:, n:] @ (self.Minv @ rows.T)
+        Pm, Bp = rows @ self.Psi[:n], self.Psi_inv[:, n:] @ (self.Minv @ rows.T)
+        return Pm, Bp, (Pm.T[:, :, None] * Bp[:, None, :]).reshape(Bp.shape[0], -1)
 
     def port_harmonics(self, modes, load_harmonics, omegas):
         """Per harmonic of the load (n_h, load_dofs) [N] at ``omegas`` (n_h,) [rad/s]:
@@ -297,12 +299,10 @@ class ModalNewmark:
         (:meth:`port_modes`) under the load, ``uf`` (n_h, m) [m], and per unit force along
         each row, ``Hp`` (n_h, m, m) [m/N]. Under port forces ``z`` (n_h, m) [N] the modal
         amplitudes are ``ef - g (z Bp^T)``, the coordinates' ``Psi[:n]`` times them."""
-        Pm, Bp = modes
+        Pm, _, K = modes
         g = 1.0 / (1j * np.asarray(omegas, float)[:, None] - self.lam[None, :])
         ef = g * (np.asarray(load_harmonics, complex) @ self.load_map.T)
-        m = Pm.shape[0]
-        Hp = ((Pm[None] * g[:, None, :]).reshape(-1, g.shape[1]) @ Bp).reshape(-1, m, m)
-        return g, ef, ef @ Pm.T, Hp
+        return g, ef, ef @ Pm.T, (g @ K).reshape(-1, Pm.shape[0], Pm.shape[0])
 
     def run_outputs(self, F_cycle, cycles, h, x0, v0, keep_from, W_modal, W_load):
         """Integrate ``cycles`` repetitions of the one-cycle load ``F_cycle`` (N, load_dofs)

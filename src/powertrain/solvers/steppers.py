@@ -34,9 +34,8 @@ from powertrain.analysis.fourier import harmonic_amplitudes
 from powertrain.analysis.orders import ORDERS, order_spectrum
 from powertrain.assembly import NetworkScaling
 from powertrain.kernels.port_forces import NONE
-from powertrain.kernels.small_solve import batched_solve
+from powertrain.kernels.small_solve import batched_solve_kernel
 from powertrain.physics.condensation import linear_two_ports
-from powertrain.physics.mount_elements import describing_stiffnesses
 from powertrain.solvers.admittance import frf_response, relative_motion
 from powertrain.solvers.cycle_newmark import CycleRun, run_cycles, start_state, steady_loop_state
 from powertrain.solvers.equivalent_linear import AMPLITUDE_HARMONICS, TOLERANCE, amplitude_fixed_point
@@ -371,6 +370,12 @@ class ModalPortStepper(DenseNewmarkStepper):
                      np.vstack([zf, zf, zf, self.laws.force_map]))
         self._runner = None
         self.port_modes = self.modal.port_modes(self.ports.rows)
+        groups = {}
+        for e, law in enumerate(self.ports.laws):
+            if law is not None:
+                groups.setdefault(law, []).append(e)
+        #: the port laws, each with the ports it acts at
+        self.law_groups = [(law, np.array(index)) for law, index in groups.items()]
         self.setup_seconds = time.perf_counter() - t0
 
     def harmonic_state(self, fh, omegas, omega, system=None):
@@ -391,10 +396,14 @@ class ModalPortStepper(DenseNewmarkStepper):
         def relative(amplitudes, n_h=AMPLITUDE_HARMONICS.stop):
             """Relative motions (n_h, m) along the port rows with the laws fed back at the
             network amplitudes, and the laws' describing stiffnesses (n_h, m)."""
-            kd = describing_stiffnesses(elements, amplitudes)
-            kd = np.array([0j if kd[i] is None else kd[i] for i in self.ports.index])
+            a, kd = amplitudes[self.ports.index], np.zeros(eye.shape[0], complex)
+            for law, index in self.law_groups:      # one call per distinct law
+                kd[index] = law.describing_stiffness(a[index])
             kd = np.where(omegas[:n_h, None] == 0, 0.0, kd[None, :])
-            return batched_solve(eye + Hp[:n_h] * kd[:, None, :], uf[:n_h]), kd
+            u = np.empty((n_h, kd.shape[1]), complex)
+            if batched_solve_kernel(eye + Hp[:n_h] * kd[:, None, :], uf[:n_h], u):
+                raise np.linalg.LinAlgError("singular equivalent-linear port feedback")
+            return u, kd
 
         A = self.equivalent_linear(lambda a: relative(a)[0], lambda u: u, omega)[0]
         u, kd = relative(self.ports.network_amplitudes(A), omegas.size)
