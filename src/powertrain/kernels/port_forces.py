@@ -439,15 +439,12 @@ def modal_port_kernel(modal, outputs, ports, laws, F, x, y, z, out, tol, max_ite
     (lr, li), G, Ra, (Da, S), h = modal
     T, load_at, Qu = ports
     kinds, par, state = laws
-    m, q = T.shape
-    n, nc, nx = lr.shape[0], li.shape[0], x.shape[0]
-    hh, hv = 0.25 * h * h, 0.5 * h
+    (m, q), n, nc, nx, hh, hv = T.shape, lr.shape[0], li.shape[0], x.shape[0], 0.25 * h * h, 0.5 * h
     p, p_next, base, wu, wv = np.empty(q), np.empty(q), np.empty(q), np.empty(q), np.empty(q)
     ul, vl, r, J, last = np.empty(m), np.empty(m), np.empty(m), np.empty((m, m)), np.zeros((7, m))
     g = np.empty(outputs[0][0].shape[1])
-    coupled = _coupling(Qu, 2.0 / h)
+    coupled, failed = _coupling(Qu, 2.0 / h), 0
     _load_less_ports(load_at, T, F, 0, z, p)
-    failed = 0
     for k in range(out.shape[0]):
         if out.shape[1]:
             _write_outputs(outputs, x, y, p, z, out, k, g)
