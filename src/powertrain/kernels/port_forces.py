@@ -362,9 +362,9 @@ def _commit(kinds, par, state, last, f):
 
 
 @njit(cache=True, nogil=True, fastmath=True, inline="always")
-def _body_force(load_at, T, F, k, z, p):
+def _load_less_ports(load_at, T, F, k, z, p):
     """Generalized force ``p`` (q,) on the reduced coordinates: the load ``F[k]`` placed at
-    ``load_at`` minus the port forces ``T^T z`` (``z`` of length 0: the load alone)."""
+    ``load_at`` minus the port forces ``T^T z``."""
     for c in range(p.shape[0]):
         p[c] = 0.0
     for c in range(F.shape[1]):
@@ -376,62 +376,32 @@ def _body_force(load_at, T, F, k, z, p):
 
 
 @njit(cache=True, nogil=True, fastmath=True, inline="always")
-def _write_outputs(outputs, x, y, p, z, row, g):
-    """One row of outputs ``Wyz [y[y_cols], z[z_cols]]`` (gathered into the work space
-    ``g`` first, then dense row products), plus ``Re(W eta) + Wd p`` on the rows ``w_rows``
-    (those reading coordinates off the reduced ones)."""
+def _write_outputs(outputs, x, y, p, z, out, k, g):
+    """Row ``k`` of the outputs ``out``: ``Wyz [y[y_cols], z[z_cols]]`` (gathered into the
+    work space ``g`` first), plus ``Re(W eta) + Wd p`` on the rows ``w_rows`` (those reading
+    coordinates off the reduced ones). Rows of 2-D arrays are indexed in place: a row view
+    per product costs more than the product at these sizes."""
     (Wyz, y_cols, z_cols), w_rows, W, Wd = outputs
     ny = y_cols.shape[0]
     for d in range(ny):
         g[d] = y[y_cols[d]]
     for d in range(z_cols.shape[0]):
         g[ny + d] = z[z_cols[d]]
-    for c in range(row.shape[0]):
-        row[c] = _dot(Wyz[c], g)
+    for c in range(out.shape[1]):
+        s = 0.0
+        for d in range(g.shape[0]):
+            s += Wyz[c, d] * g[d]
+        out[k, c] = s
     for i in range(w_rows.shape[0]):
-        row[w_rows[i]] += _dot(W[i], x) + _dot(Wd[i], p)
-
-
-@njit(cache=True, nogil=True, fastmath=True, inline="always")
-def _reduced_motions(T, y, a, h, ul, vl, w):
-    """Port motions ``ul``, ``vl`` (m,) of the next step whose reduced accelerations are
-    ``a``, by Newmark's kinematics from the reduced state ``y = (x, v, a)`` (3 q,); ``w``
-    (2 q,) work space."""
-    q = a.shape[0]
-    for c in range(q):
-        s = y[2 * q + c] + a[c]
-        w[c] = y[c] + h * y[q + c] + 0.25 * h * h * s
-        w[q + c] = y[q + c] + 0.5 * h * s
-    for e in range(ul.shape[0]):
-        su = 0.0
-        sv = 0.0
-        for c in range(q):
-            su += T[e, c] * w[c]
-            sv += T[e, c] * w[q + c]
-        ul[e] = su
-        vl[e] = sv
-
-
-@njit(cache=True, nogil=True, fastmath=True, inline="always")
-def _advance(lam_d, G, s, x):
-    """The modal recurrence ``eta = lambda_d eta + G s`` in place, in real form: ``x`` holds
-    the real parts of the n modes, then the imaginary parts of the complex ones (first),
-    ``lam_d = (real parts (n,), imaginary parts (n_c,))``."""
-    lr, li = lam_d
-    n = lr.shape[0]
-    for j in range(li.shape[0]):
-        a = lr[j] * x[j] - li[j] * x[n + j]
-        x[n + j] = lr[j] * x[n + j] + li[j] * x[j]
-        x[j] = a
-    for j in range(li.shape[0], n):
-        x[j] *= lr[j]
-    for c in range(s.shape[0]):
-        sc = s[c]
+        s = 0.0
         for j in range(x.shape[0]):
-            x[j] += G[c, j] * sc
+            s += W[i, j] * x[j]
+        for j in range(p.shape[0]):
+            s += Wd[i, j] * p[j]
+        out[k, w_rows[i]] += s
 
 
-@njit(cache=True, nogil=True, fastmath=True)
+@njit(cache=True, nogil=True, fastmath=True, error_model="numpy")
 def modal_port_kernel(modal, outputs, ports, laws, F, x, y, z, out, tol, max_iter):
     r"""Newmark average acceleration with port laws in modal coordinates: the trapezoidal
     modal recurrence of the linear model (:class:`~powertrain.solvers.newmark.ModalNewmark`)
@@ -454,9 +424,11 @@ def modal_port_kernel(modal, outputs, ports, laws, F, x, y, z, out, tol, max_ite
     S^{-1}\mathbf P^T` of :func:`newmark_port_kernel`), solved for :math:`\mathbf z`
     (:func:`_port_forces_step`); then the recurrence.
 
-    Arguments (modal arrays in the real form of :func:`_advance`, n_x columns): ``modal =
-    (lam_d, G, Ra, (Da, S), h)``, ``G`` (q, n_x) (the map's columns as rows), ``Ra`` (q,
-    n_x) reading :math:`\mathrm{Re}(\Psi_a\lambda_d\eta)`; ``out`` (n_rows, n_out) gets
+    Arguments (modal arrays in real form, n_x columns: the real parts of the n modes, then
+    the imaginary parts of the n_c complex ones, which come first): ``modal = (lam_d, G, Ra,
+    (Da, S), h)``, ``lam_d`` = (real parts (n,), imaginary parts (n_c,)), ``G`` (q, n_x)
+    (the map's columns as rows), ``Ra`` (q, n_x) reading
+    :math:`\mathrm{Re}(\Psi_a\lambda_d\eta)`; ``out`` (n_rows, n_out) gets
     the ``outputs`` (:func:`_write_outputs`) at steps 0 .. n_rows - 1 of the loads ``F``
     (n_rows + 1, n_load); ``ports = (T, load_at, Qu)``, ``laws = (kinds, par, state)``. The
     modal state ``x`` (n_x,), the reduced state ``y`` (3 q,) (displacements, velocities,
@@ -464,36 +436,62 @@ def modal_port_kernel(modal, outputs, ports, laws, F, x, y, z, out, tol, max_ite
     step n_rows on return, ``state`` is updated in place. Returns the number of steps at
     which Newton did not converge.
     """
-    lam_d, G, Ra, (Da, S), h = modal
+    (lr, li), G, Ra, (Da, S), h = modal
     T, load_at, Qu = ports
     kinds, par, state = laws
-    m = z.shape[0]
-    q = T.shape[1]
-    p, p_next, base, a = np.empty(q), np.empty(q), np.empty(q), np.empty(q)
-    ul, vl, r = np.empty(m), np.empty(m), np.empty(m)
-    J, w, last = np.empty((m, m)), np.empty(2 * q), np.zeros((7, m))
+    (m, q), n, nc, nx, hh, hv = T.shape, lr.shape[0], li.shape[0], x.shape[0], 0.25 * h * h, 0.5 * h
+    p, p_next, base, wu, wv = np.empty(q), np.empty(q), np.empty(q), np.empty(q), np.empty(q)
+    ul, vl, r, J, last = np.empty(m), np.empty(m), np.empty(m), np.empty((m, m)), np.zeros((7, m))
     g = np.empty(outputs[0][0].shape[1])
-    coupled = _coupling(Qu, 2.0 / h)
-    _body_force(load_at, T, F, 0, z, p)
-    failed = 0
+    coupled, failed = _coupling(Qu, 2.0 / h), 0
+    _load_less_ports(load_at, T, F, 0, z, p)
     for k in range(out.shape[0]):
-        _write_outputs(outputs, x, y, p, z, out[k], g)
-        _body_force(load_at, T, F, k + 1, z[:0], p_next)
+        if out.shape[1]:
+            _write_outputs(outputs, x, y, p, z, out, k, g)
+        _load_less_ports(load_at, T, F, k + 1, z[:0], p_next)       # the load alone
+        for c in range(q):      # the reduced accelerations: the modal read, the forces
+            s = 0.0
+            for j in range(nx):
+                s += Ra[c, j] * x[j]
+            for d in range(q):
+                s += Da[c, d] * p[d]
+            base[c] = s
         for c in range(q):
-            base[c] = _dot(Ra[c], x) + _dot(Da[c], p)
-            a[c] = base[c] + _dot(S[c], p_next)
-        _reduced_motions(T, y, a, h, ul, vl, w)
+            s = base[c]
+            for d in range(q):
+                s += S[c, d] * p_next[d]
+            s += y[2 * q + c]   # the port motions at the load alone: Newmark's kinematics
+            wu[c] = y[c] + h * y[q + c] + hh * s
+            wv[c] = y[q + c] + hv * s
+        for e in range(m):
+            su, sv = 0.0, 0.0
+            for c in range(q):
+                su += T[e, c] * wu[c]
+                sv += T[e, c] * wv[c]
+            ul[e], vl[e] = su, sv
         if not _port_forces_step(kinds, par, state, ul, vl, coupled, z, last, r, J, tol,
                                  max_iter):
             failed += 1
-        _body_force(load_at, T, F, k + 1, z, p_next)
+        _load_less_ports(load_at, T, F, k + 1, z, p_next)
         for c in range(q):
-            a[c] = base[c] + _dot(S[c], p_next)
-            s = y[2 * q + c] + a[c]
-            y[c] += h * y[q + c] + 0.25 * h * h * s
-            y[q + c] += 0.5 * h * s
-            y[2 * q + c] = a[c]
+            s = base[c]
+            for d in range(q):
+                s += S[c, d] * p_next[d]
+            s2 = y[2 * q + c] + s
+            y[c] += h * y[q + c] + hh * s2
+            y[q + c] += hv * s2
+            y[2 * q + c] = s
             p[c] += p_next[c]
-        _advance(lam_d, G, p, x)
-        p[:] = p_next
+        for j in range(nc):     # the modal recurrence, in real form
+            t = lr[j] * x[j] - li[j] * x[n + j]
+            x[n + j] = lr[j] * x[n + j] + li[j] * x[j]
+            x[j] = t
+        for j in range(nc, n):
+            x[j] *= lr[j]
+        for c in range(q):
+            sc = p[c]
+            for j in range(nx):
+                x[j] += G[c, j] * sc
+        for c in range(q):
+            p[c] = p_next[c]
     return failed

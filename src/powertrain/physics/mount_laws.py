@@ -35,6 +35,18 @@ def _read_only(*arrays):
 _GAUSS_LEGENDRE = _read_only(*np.polynomial.legendre.leggauss(_GAUSS_NODES))
 
 
+def _berg_rule():
+    """The rule on θ in [-π/2, π/2] as Berg's describing function takes it: 1 + sin θ at
+    the nodes, and the weights times sin θ and cos θ (read-only)."""
+    t, w = _GAUSS_LEGENDRE
+    theta, wq = 0.5 * np.pi * t, 0.5 * np.pi * w
+    return _read_only(1.0 + np.sin(theta), wq * np.sin(theta), wq * np.cos(theta))
+
+
+#: :func:`_berg_rule` (constants).
+_BERG_RULE = _berg_rule()
+
+
 @dataclass(frozen=True)
 class PowerLaw:
     r"""Factor :math:`f = \mathrm{clip}((A_{ref}/A)^{n}, lo, hi)` on every spring and
@@ -243,17 +255,14 @@ class BergFriction:
         if self.max_force <= 0 or not big.any():
             return out.reshape(np.shape(amplitude))
         a = A[big][:, None]
-        t, w = _GAUSS_LEGENDRE
-        theta = 0.5 * np.pi * t[None, :]
+        one_plus_sin, w_sin, w_cos = _BERG_RULE
         fr = self.loop_amplitude_force(a)
         fm, x2 = self.max_force, self.half_displacement
-        y = a * (np.sin(theta) + 1.0)                       # from the reversal at -A
+        y = a * one_plus_sin                                # from the reversal at -A
         fs = -fr
         f = fs + y / (x2 * (1 - fs / fm) + y) * (fm - fs)
-        wq = 0.5 * np.pi * w[None, :]
-        re = 2 / (np.pi * a[:, 0]) * np.sum(wq * f * np.sin(theta), axis=1)
-        im = 2 / (np.pi * a[:, 0]) * np.sum(wq * f * np.cos(theta), axis=1)
-        out[big] = re + 1j * im
+        scale = 2 / (np.pi * a[:, 0])
+        out[big] = scale * (f @ w_sin) + 1j * (scale * (f @ w_cos))
         return out.reshape(np.shape(amplitude))
 
     def energy_per_cycle(self, amplitude) -> np.ndarray:

@@ -39,9 +39,15 @@ LOOP_CYCLES = 2
 def cycle_signal(harmonics, n_cycle) -> np.ndarray:
     """Samples (n_cycle, m) over one engine cycle of the harmonics (n_h, m) (index j =
     order j/2, ``Re sum_j c_j exp(i j theta / 2)``)."""
-    spectrum = np.zeros((n_cycle,) + harmonics.shape[1:], complex)
-    spectrum[:harmonics.shape[0]] = harmonics
-    return (n_cycle * np.fft.ifft(spectrum, axis=0)).real
+    n_h = harmonics.shape[0]
+    if 2 * n_h > n_cycle:                 # up to the Nyquist harmonic: the full transform
+        spectrum = np.zeros((n_cycle,) + harmonics.shape[1:], complex)
+        spectrum[:n_h] = harmonics
+        return (n_cycle * np.fft.ifft(spectrum, axis=0)).real
+    half = np.zeros((n_cycle // 2 + 1,) + harmonics.shape[1:], complex)
+    half[:n_h] = harmonics                # the real transform doubles every harmonic but 0
+    half[1:n_h] *= 0.5
+    return n_cycle * np.fft.irfft(half, n_cycle, axis=0)
 
 
 def cycle_amplitudes(u) -> np.ndarray:
@@ -63,9 +69,9 @@ def steady_loop_state(ports, relative, n_cycle, cycles=LOOP_CYCLES) -> np.ndarra
     u_low = u[low, np.arange(m)]
     centre = u.mean(axis=0)
     state = ports.steady_states(centre - u_low, centre)
-    n = (cycles + 1) * n_cycle + 1
-    index = np.arange(n)
-    U = np.where(index[:, None] < low[None, :], u_low[None, :], u[index % n_cycle])
+    U = np.concatenate([np.tile(u, (cycles + 1, 1)), u[:1]])
+    for e in range(m):
+        U[:low[e], e] = u_low[e]
     port_force_loop(ports.kinds, ports.parameters, state, U, np.zeros_like(U), np.empty_like(U))
     return state
 

@@ -229,7 +229,7 @@ class ModalNewmark:
     def real_form(self, a) -> np.ndarray:
         """``a`` (..., kept modes) complex in the kernels' real form: the real parts, then
         the imaginary parts of the complex modes (a real mode's is zero but for round-off),
-        contiguous (:func:`powertrain.kernels.port_forces._advance`). A row ``r`` read as
+        contiguous (:func:`powertrain.kernels.port_forces.modal_port_kernel`). A row ``r`` read as
         ``Re(r eta)`` is ``real_form(conj(r))``."""
         a = np.asarray(a)
         return np.ascontiguousarray(np.concatenate([a.real, a.imag[..., :self.n_complex]],
@@ -282,6 +282,27 @@ class ModalNewmark:
         eta = g / (1j * np.asarray(omegas, float)[:, None] - self.lam[None, :])
         z0 = (self.Psi @ eta.sum(axis=0)).real
         return z0[:self.n], z0[self.n:]
+
+    def port_modes(self, rows):
+        """``(Pm, Bp, K)`` of the port rows ``rows`` (m, n) (:meth:`port_harmonics`): the
+        rows read off the modes, ``Pm`` (m, 2 n), the modal load of a unit force along
+        each row pushing the model by minus the row, ``Bp`` (2 n, m), and each mode's
+        part of the rows' response to the forces, ``K`` (2 n, m m) = ``Pm[:, j] Bp[j]``."""
+        n = self.n
+        Pm, Bp = rows @ self.Psi[:n], self.Psi_inv[:, n:] @ (self.Minv @ rows.T)
+        return Pm, Bp, (Pm.T[:, :, None] * Bp[:, None, :]).reshape(Bp.shape[0], -1)
+
+    def port_harmonics(self, modes, load_harmonics, omegas):
+        """Per harmonic of the load (n_h, load_dofs) [N] at ``omegas`` (n_h,) [rad/s]:
+        ``g`` (n_h, 2 n) = 1 / (i omega - lambda), the modal amplitudes under the load
+        ``ef`` (n_h, 2 n), the relative motions along the port rows of ``modes``
+        (:meth:`port_modes`) under the load, ``uf`` (n_h, m) [m], and per unit force along
+        each row, ``Hp`` (n_h, m, m) [m/N]. Under port forces ``z`` (n_h, m) [N] the modal
+        amplitudes are ``ef - g (z Bp^T)``, the coordinates' ``Psi[:n]`` times them."""
+        Pm, _, K = modes
+        g = 1.0 / (1j * np.asarray(omegas, float)[:, None] - self.lam[None, :])
+        ef = g * (np.asarray(load_harmonics, complex) @ self.load_map.T)
+        return g, ef, ef @ Pm.T, (g @ K).reshape(-1, Pm.shape[0], Pm.shape[0])
 
     def run_outputs(self, F_cycle, cycles, h, x0, v0, keep_from, W_modal, W_load):
         """Integrate ``cycles`` repetitions of the one-cycle load ``F_cycle`` (N, load_dofs)
@@ -359,6 +380,12 @@ class ModalPortNewmark:
             [modal.Psi_r[r], modal.Psi_r[n + r], modal.Psi_r[n + r] * modal.lam_r])))
         self.outputs = self._output_arrays(Wx, Wv, Wa, Wz)
         self.silent = self._output_arrays(np.zeros((0, n)))
+        #: what the step does not change: the port rows on the reduced coordinates, the
+        #: modal map of the reduced forces, the modes' reduced accelerations, M^-1 there
+        #: and where the load sits among the reduced coordinates
+        self._fixed = (np.ascontiguousarray(P[:, r]), modal.Psi_inv_r[:, n:] @ modal.Minv[:, r],
+                       modal.Psi_r[n + r] * modal.lam_r, modal.Minv[np.ix_(r, r)],
+                       np.searchsorted(r, np.arange(modal.load_dofs)).astype(np.int64))
         self._set_step(h)
 
     def at_step(self, h) -> ModalPortNewmark:
@@ -370,23 +397,18 @@ class ModalPortNewmark:
 
     def _set_step(self, h):
         """The kernel's arrays that depend on the time step ``h`` [s]."""
-        modal, n, r = self.modal, self.modal.n, self.reduced
+        modal = self.modal
+        T, load_map, Pa, Minv_r, load_at = self._fixed
         self.h = float(h)
-        T = np.asarray(self.ports.rows, float)[:, r]
         lam = modal.lam_r
         lam_d = (1 + 0.5 * h * lam) / (1 - 0.5 * h * lam)
-        G = ((0.5 * h) / (1 - 0.5 * h * lam))[:, None] * (
-            modal.Psi_inv_r[:, n:] @ modal.Minv[:, r])                      # (n_modes, q)
-        Pa = modal.Psi_r[n + r] * lam                                        # (q, n_modes)
+        G = ((0.5 * h) / (1 - 0.5 * h * lam))[:, None] * load_map          # (n_modes, q)
         Da = (Pa @ G).real
-        S = Da + modal.Minv[np.ix_(r, r)]
+        S = Da + Minv_r
         self.modal_arrays = ((lam_d.real.copy(), lam_d.imag[:modal.n_complex].copy()),
                              modal.real_form(G.T), modal.real_form(np.conj(Pa * lam_d)),
                              (np.ascontiguousarray(Da), np.ascontiguousarray(S)), self.h)
-        TST = T @ S @ T.T
-        self.port_arrays = (np.ascontiguousarray(T), np.searchsorted(
-            r, np.arange(modal.load_dofs)).astype(np.int64),
-            np.ascontiguousarray(0.25 * h * h * TST))
+        self.port_arrays = (T, load_at, np.ascontiguousarray(0.25 * h * h * (T @ S @ T.T)))
 
     def _output_arrays(self, Wx=None, Wv=None, Wa=None, Wz=None):
         """``((Wyz, y_cols, z_cols), w_rows, W, Wd)`` of :func:`modal_port_kernel` for
@@ -441,7 +463,7 @@ class ModalPortNewmark:
         p = -T.T @ z
         p[load_at] += F[0]
         y = self._reduced_rows @ eta
-        y[2 * p.size:] += self.modal.Minv[np.ix_(self.reduced, self.reduced)] @ p
+        y[2 * p.size:] += self._fixed[3] @ p
         failed = modal_port_kernel(self.modal_arrays, arrays, self.port_arrays, laws, F, eta,
                                    y, z, out, PORT_TOL, PORT_MAX_ITER)
         if failed:

@@ -34,9 +34,10 @@ from powertrain.analysis.fourier import harmonic_amplitudes
 from powertrain.analysis.orders import ORDERS, order_spectrum
 from powertrain.assembly import NetworkScaling
 from powertrain.kernels.port_forces import NONE
+from powertrain.kernels.small_solve import batched_solve_kernel
 from powertrain.physics.condensation import linear_two_ports
 from powertrain.solvers.admittance import frf_response, relative_motion
-from powertrain.solvers.cycle_newmark import CycleRun, run_cycles, start_state
+from powertrain.solvers.cycle_newmark import CycleRun, run_cycles, start_state, steady_loop_state
 from powertrain.solvers.equivalent_linear import AMPLITUDE_HARMONICS, TOLERANCE, amplitude_fixed_point
 from powertrain.solvers.harmonic import harmonic_response
 from powertrain.solvers.newmark import ModalNewmark, ModalPortNewmark, newmark
@@ -368,7 +369,46 @@ class ModalPortStepper(DenseNewmarkStepper):
                      np.vstack([Z, Cm, Z, system.force_matrix_d]), np.vstack([Z, Z, Cm, Z]),
                      np.vstack([zf, zf, zf, self.laws.force_map]))
         self._runner = None
+        self.port_modes = self.modal.port_modes(self.ports.rows)
+        groups = {}
+        for e, law in enumerate(self.ports.laws):
+            if law is not None:
+                groups.setdefault(law, []).append(e)
+        #: the port laws, each with the ports it acts at
+        self.law_groups = [(law, np.array(index)) for law, index in groups.items()]
         self.setup_seconds = time.perf_counter() - t0
+
+    def harmonic_state(self, fh, omegas, omega, system=None):
+        """:meth:`Stepper.harmonic_state` through the modes of the model the stepper
+        integrates, when ``system`` is that model and no network has an amplitude law: per
+        harmonic the linear response to the load and to forces along the port rows
+        (:meth:`ModalNewmark.port_harmonics`), the port laws' describing stiffnesses fed
+        back along them (zero at the mean, as in the condensation), the same fixed point
+        on the amplitudes; the condensation otherwise."""
+        s = self.system if system is None else system
+        elements = s.ports().elements
+        if s is not self.system or len(elements) != self.ports.n_networks or any(
+                el.amplitude_law is not None for el in elements):
+            return super().harmonic_state(fh, omegas, omega, system)
+        g, ef, uf, Hp = self.modal.port_harmonics(self.port_modes, fh, omegas)
+        eye = np.eye(self.ports.kinds.size)
+
+        def relative(amplitudes, n_h=AMPLITUDE_HARMONICS.stop):
+            """Relative motions (n_h, m) along the port rows with the laws fed back at the
+            network amplitudes, and the laws' describing stiffnesses (n_h, m)."""
+            a, kd = amplitudes[self.ports.index], np.zeros(eye.shape[0], complex)
+            for law, index in self.law_groups:      # one call per distinct law
+                kd[index] = law.describing_stiffness(a[index])
+            kd = np.where(omegas[:n_h, None] == 0, 0.0, kd[None, :])
+            u = np.empty((n_h, kd.shape[1]), complex)
+            if batched_solve_kernel(eye + Hp[:n_h] * kd[:, None, :], uf[:n_h], u):
+                raise np.linalg.LinAlgError("singular equivalent-linear port feedback")
+            return u, kd
+
+        A = self.equivalent_linear(lambda a: relative(a)[0], lambda u: u, omega)[0]
+        u, kd = relative(self.ports.network_amplitudes(A), omegas.size)
+        eta = ef - g * ((kd * u) @ self.port_modes[1].T)
+        return eta @ self.modal.Psi[:self.modal.n].T, A
 
     def runner(self, h) -> ModalPortNewmark:
         """The modal recurrence with the port laws at the step ``h`` [s] (its outputs'
@@ -383,7 +423,7 @@ class ModalPortStepper(DenseNewmarkStepper):
         g = self.grid
         x0, v0, _, qh = start
         run = self.runner(h)
-        state = start_state(self.ports, qh, g.n_cycle)
+        state = steady_loop_state(self.laws, qh @ self.laws.rows.T, g.n_cycle)
         z = self.laws.forces(self.laws.rows @ x0, self.laws.rows @ v0, state)
         eta = run.modal_state(x0, v0)
         F = np.concatenate([np.tile(load, (g.cycles, 1)), load[:1]])
