@@ -109,7 +109,7 @@ def _physical(scenario) -> tuple:
     """``(physical part, its key)`` of a scenario: the effects that are not response-only
     (solved once per distinct value, :meth:`Problem.velocity`)."""
     phys = {k: v for k, v in scenario.items() if not EFFECTS[k].response_only}
-    return phys, repr(sorted((k, sorted(v.items())) for k, v in phys.items()))
+    return phys, tuple(sorted((k, tuple(sorted(v.items()))) for k, v in phys.items()))
 
 
 class Problem:
