@@ -282,7 +282,12 @@ class Problem:
         g = self._scored["train"](np.take(vel.reshape(len(scenarios), -1), at, axis=1))
         if self.phase_w is None:
             return list(g)
-        return [self._with_phase(gi, v, sc, "train") for gi, v, sc in zip(g, vel, scenarios)]
+        d = (np.angle(np.take(vel.reshape(len(scenarios), -1), self._phase_at["train"], axis=1))
+             - self._phase_rad["train"])
+        delta = self._offset.rows(d)
+        gp = self._w_on["train"] * ph.wrap(d - self._order_on["train"] * delta[:, None])
+        return [np.concatenate([gi, gpi, [ph.offset_prior(float(di), self.sigma_db)]])
+                for gi, gpi, di in zip(g, gp, delta)]
 
     def _with_phase(self, g, vel, scenario, part):
         """The level gaps ``g`` followed by the phase gaps and the crank offset's prior."""

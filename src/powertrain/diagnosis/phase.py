@@ -71,6 +71,15 @@ class OffsetProfile:
         r = wrap(d - k * delta) + k * delta
         return float(np.sum(self.w2k * r) / self.denominator)
 
+    def rows(self, d) -> np.ndarray:
+        """δ [rad] of each row of ``d`` (n_b, n_points), as calling this on each row."""
+        if d.shape[1] == 0:
+            return np.zeros(d.shape[0])
+        k = self.order
+        delta = np.sum(self.w2k * wrap(d), axis=1) / self.denominator
+        r = wrap(d - k * delta[:, None]) + k * delta[:, None]
+        return np.sum(self.w2k * r, axis=1) / self.denominator
+
 
 def crank_offset(d, order, w, sigma_db) -> float:
     """Profiled crank-angle offset δ [rad] of one run (:class:`OffsetProfile`; ``d`` model

@@ -270,10 +270,11 @@ class HarmonicModel:
             res = laplace_two_ports(1j * self.omega[:, at],
                                     [self.networks[k][2].network() for k in missing],
                                     spring, damper)
+            res = [self._all_harmonics(r, h) for r in res]
             for j, k in enumerate(missing):
                 if len(kept[k]) >= 2:
                     del kept[k][next(iter(kept[k]))]
-                kept[k][keys[k]] = tuple(self._all_harmonics(r[..., j], h) for r in res)
+                kept[k][keys[k]] = tuple(r[..., j] for r in res)
         out = tuple(np.empty(self.omega.shape + (len(keys),), complex) for _ in range(3))
         for k, key in enumerate(keys):
             for j in range(3):
@@ -281,11 +282,11 @@ class HarmonicModel:
         return out
 
     def _all_harmonics(self, x, harmonics):
-        """``x`` (n_r, n_h) at the ``harmonics`` as (n_r, 17), NaN at the others (None: all,
-        ``x`` itself)."""
+        """``x`` (n_r, n_h, ...) at the ``harmonics`` as (n_r, 17, ...), NaN at the others
+        (None: all, ``x`` itself)."""
         if harmonics is None:
             return x
-        full = np.full(self.omega.shape, np.nan, complex)
+        full = np.full(self.omega.shape + x.shape[2:], np.nan, complex)
         full[:, list(harmonics)] = x
         return full
 
