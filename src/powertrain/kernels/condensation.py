@@ -63,11 +63,17 @@ def condensed_solve_kernel(s, M0, C0, K0, E, B, a, b, c, load, x):
     U = np.empty((2, n * n))
     A = np.empty((n, n), np.complex128)
     status = 0
+    y = np.empty(n, np.complex128)
+    n_f = load.shape[1]
     for w in range(s.size):
         _fill(w, s[w], M0, C0, K0, terms, a, b, c, U, A)
         for i in range(n):
-            x[w, i] = load[w, i] if i < load.shape[1] else 0.0
-        status |= solve_in_place(A, x[w])
+            y[i] = 0.0
+        for i in range(n_f):
+            y[i] = load[w, i]
+        status |= solve_in_place(A, y)
+        for i in range(n):
+            x[w, i] = y[i]
     return status
 
 
@@ -81,7 +87,7 @@ def _all_terms(E, B):
     return terms
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, inline="always")
 def _fill(w, sw, M0, C0, K0, terms, a, b, c, U, Dw):
     r"""Fill ``Dw`` (n, n) with :math:`\mathbf D_w` (``U`` (2, n²) work space)."""
     n = M0.shape[0]

@@ -44,7 +44,7 @@ def batched_solve_kernel(D, b, x):
     return status
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, inline="always")
 def solve_in_place(A, x):
     """Solve ``A y = x`` by Gaussian elimination with partial pivoting, ``A`` (n, n) and
     ``x`` (n,) complex overwritten (``x`` with the solution). Returns 0, or 1 when a pivot

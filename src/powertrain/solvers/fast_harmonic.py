@@ -152,6 +152,8 @@ class HarmonicModel:
         self._abc = None
         self._extra = {}
         self._scaled = {}
+        self._scaled_last = None
+        self._packed_of = {}
         self._one_more_mode_at = None
         self._effect_defaults = {}
         self._body_setup(engine, ports)
@@ -267,18 +269,35 @@ class HarmonicModel:
             spring = np.array([keys[k][0] for k in missing]) * statics
             damper = np.array([keys[k][1] for k in missing]) * statics
             at = slice(None) if h is None else list(h)
-            res = laplace_two_ports(1j * self.omega[:, at],
-                                    [self.networks[k][2].network() for k in missing],
-                                    spring, damper)
+            packed = self._packed_of.get(tuple(missing))
+            if packed is None:
+                packed = self._packed_of[tuple(missing)] = PackedNetworks.of(
+                    [self.networks[k][2].network() for k in missing])
+            res = laplace_two_ports(1j * self.omega[:, at], packed, spring, damper)
             res = [self._all_harmonics(r, h) for r in res]
             for j, k in enumerate(missing):
                 if len(kept[k]) >= 2:
                     del kept[k][next(iter(kept[k]))]
                 kept[k][keys[k]] = tuple(r[..., j] for r in res)
-        out = tuple(np.empty(self.omega.shape + (len(keys),), complex) for _ in range(3))
-        for k, key in enumerate(keys):
+        return self._assembled(keys, kept)
+
+    def _assembled(self, keys, kept):
+        """The two-ports (each (n_r, 17, n_net), read-only) of the networks' ``keys`` from
+        their ``kept`` ones: the last result with the networks whose key changed replaced
+        (a Jacobian column changes one mount's)."""
+        last = self._scaled_last
+        if last is None or len(last[0]) != len(keys):
+            out = tuple(np.empty(self.omega.shape + (len(keys),), complex) for _ in range(3))
+            changed = range(len(keys))
+        else:
+            out = tuple(x.copy() for x in last[1])
+            changed = [k for k, key in enumerate(keys) if key != last[0][k]]
+        for k in changed:
             for j in range(3):
-                out[j][..., k] = kept[k][key][j]
+                out[j][..., k] = kept[k][keys[k]][j]
+        for x in out:
+            x.setflags(write=False)
+        self._scaled_last = (keys, out)
         return out
 
     def _all_harmonics(self, x, harmonics):
@@ -484,6 +503,8 @@ class HarmonicModel:
             new.static_scale = self.static_scale[index]
         new._extra = {k: v[:, index] for k, v in self._extra.items()}
         new._scaled = {}
+        new._scaled_last = None
+        new._packed_of = {}
         new._one_more_mode_at = None
         new._body_memo = {}
         return new
