@@ -240,8 +240,8 @@ class HarmonicModel:
         d\,\mathbf C - \omega^2\mathbf M` condensed by the one two-port condensation
         (:func:`powertrain.physics.mount_network.laplace_two_ports`). With ``scale = 1`` the
         same as :meth:`two_ports`. ``harmonics`` (indices 0..16, optional): with one factor
-        pair per network, only these harmonics are condensed, the others are NaN (a linear
-        solve of some orders needs no more).
+        pair per network, only these harmonics are condensed, the others are zero (a linear
+        solve of some orders reads no more).
         """
         n_net = len(self.networks)
         scale = np.asarray(scale, float)
@@ -256,7 +256,7 @@ class HarmonicModel:
 
     def _scaled_networks(self, factors, harmonics=None):
         """Every network's two-port with its springs and dampers times ``factors[k]``
-        (a (spring, damper) pair) at every speed (at the ``harmonics`` only, the others NaN;
+        (a (spring, damper) pair) at every speed (at the ``harmonics`` only, the others zero;
         None: all); the last two pairs per network are kept (a finite-difference Jacobian
         column changes the factors of one mount only: the others' are reused), the missing
         ones condensed in one call."""
@@ -301,11 +301,11 @@ class HarmonicModel:
         return out
 
     def _all_harmonics(self, x, harmonics):
-        """``x`` (n_r, n_h, ...) at the ``harmonics`` as (n_r, 17, ...), NaN at the others
+        """``x`` (n_r, n_h, ...) at the ``harmonics`` as (n_r, 17, ...), zero at the others
         (None: all, ``x`` itself)."""
         if harmonics is None:
             return x
-        full = np.full(self.omega.shape + x.shape[2:], np.nan, complex)
+        full = np.zeros(self.omega.shape + x.shape[2:], complex)
         full[:, list(harmonics)] = x
         return full
 
