@@ -22,8 +22,6 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from powertrain.kernels.small_solve import solve_in_place
-
 
 @njit(cache=True, nogil=True)
 def condensed_matrix_kernel(s, M0, C0, K0, E, B, a, b, c, D):
@@ -43,67 +41,27 @@ def condensed_matrix_kernel(s, M0, C0, K0, E, B, a, b, c, D):
     D : ndarray (n_w, n, n) complex
         Filled.
     """
-    terms = _all_terms(E, B)
-    U = np.empty((2, M0.shape[0] ** 2))          # real, imaginary upper triangle
-    for w in range(s.size):
-        _fill(w, s[w], M0, C0, K0, terms, a, b, c, U, D[w])
-
-
-@njit(cache=True, nogil=True)
-def condensed_solve_kernel(s, M0, C0, K0, E, B, a, b, c, load, x):
-    r"""Fill ``x`` (n_w, n) complex with the solutions of :math:`\mathbf D_w\mathbf x_w =
-    [\mathbf f_w; \mathbf 0]`, ``load`` (n_w, n_f) complex the first n_f entries of the
-    right-hand side (the other arguments as :func:`condensed_matrix_kernel`): each matrix
-    filled as that kernel fills it and solved as
-    :func:`~powertrain.kernels.small_solve.batched_solve_kernel` solves it, without
-    keeping the matrices. Returns 0, or 1 when some matrix has an exactly zero pivot (its
-    solution NaN)."""
     n = M0.shape[0]
-    terms = _all_terms(E, B)
-    U = np.empty((2, n * n))
-    A = np.empty((n, n), np.complex128)
-    status = 0
-    y = np.empty(n, np.complex128)
-    n_f = load.shape[1]
-    for w in range(s.size):
-        _fill(w, s[w], M0, C0, K0, terms, a, b, c, U, A)
-        for i in range(n):
-            y[i] = 0.0
-        for i in range(n_f):
-            y[i] = load[w, i]
-        status |= solve_in_place(A, y)
-        for i in range(n):
-            x[w, i] = y[i]
-    return status
-
-
-@njit(cache=True, nogil=True)
-def _all_terms(E, B):
-    """The networks' terms ``[E E, E B, B B]`` (:func:`_outer_terms`; ``[E E]`` when ``B``
-    has no rows)."""
     terms = [_outer_terms(E, E, True)]
     if B.shape[0]:
         terms += [_outer_terms(E, B, False), _outer_terms(B, B, True)]
-    return terms
-
-
-@njit(cache=True, nogil=True, inline="always")
-def _fill(w, sw, M0, C0, K0, terms, a, b, c, U, Dw):
-    r"""Fill ``Dw`` (n, n) with :math:`\mathbf D_w` (``U`` (2, n²) work space)."""
-    n = M0.shape[0]
-    U[:] = 0.0
-    for kind in range(len(terms)):
-        z = (a, b, c)[kind]
-        net, pos, val = terms[kind]
-        for t in range(net.size):
-            zt = z[w, net[t]]
-            U[0, pos[t]] += zt.real * val[t]
-            U[1, pos[t]] += zt.imag * val[t]
-    s2 = sw * sw
-    for i in range(n):
-        for j in range(n):
-            u = min(i, j) * n + max(i, j)
-            Dw[i, j] = s2 * M0[i, j] + sw * C0[i, j] + K0[i, j] + (U[0, u] + 1j * U[1, u])
+    U = np.empty((2, n * n))                     # real, imaginary upper triangle
+    for w in range(s.size):
+        U[:] = 0.0
+        for kind in range(len(terms)):
+            z = (a, b, c)[kind]
+            net, pos, val = terms[kind]
+            for t in range(net.size):
+                zt = z[w, net[t]]
+                U[0, pos[t]] += zt.real * val[t]
+                U[1, pos[t]] += zt.imag * val[t]
+        sw = s[w]
+        s2 = sw * sw
+        for i in range(n):
+            for j in range(n):
+                u = min(i, j) * n + max(i, j)
+                D[w, i, j] = s2 * M0[i, j] + sw * C0[i, j] + K0[i, j] + (U[0, u]
+                                                                         + 1j * U[1, u])
 
 
 @njit(cache=True, nogil=True)

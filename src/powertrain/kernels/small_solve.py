@@ -40,49 +40,44 @@ def batched_solve_kernel(D, b, x):
             x[k, i] = b[k, i]
             for j in range(n):
                 A[i, j] = D[k, i, j]
-        status |= solve_in_place(A, x[k])
-    return status
-
-
-@njit(cache=True, nogil=True, inline="always")
-def solve_in_place(A, x):
-    """Solve ``A y = x`` by Gaussian elimination with partial pivoting, ``A`` (n, n) and
-    ``x`` (n,) complex overwritten (``x`` with the solution). Returns 0, or 1 when a pivot
-    is exactly zero (``x`` NaN)."""
-    n = x.size
-    for col in range(n):
-        p = col
-        best = abs(A[col, col].real) + abs(A[col, col].imag)
-        for i in range(col + 1, n):
-            v = abs(A[i, col].real) + abs(A[i, col].imag)
-            if v > best:
-                best = v
-                p = i
-        if best == 0.0:
+        singular = False
+        for col in range(n):
+            p = col
+            best = abs(A[col, col].real) + abs(A[col, col].imag)
+            for i in range(col + 1, n):
+                v = abs(A[i, col].real) + abs(A[i, col].imag)
+                if v > best:
+                    best = v
+                    p = i
+            if best == 0.0:
+                singular = True
+                break
+            if p != col:
+                for j in range(n):
+                    t = A[col, j]
+                    A[col, j] = A[p, j]
+                    A[p, j] = t
+                t = x[k, col]
+                x[k, col] = x[k, p]
+                x[k, p] = t
+            inv = 1.0 / A[col, col]
+            for i in range(col + 1, n):
+                f = A[i, col] * inv
+                if f != 0.0:
+                    for j in range(col + 1, n):
+                        A[i, j] -= f * A[col, j]
+                    x[k, i] -= f * x[k, col]
+        if singular:
+            status = 1
             for i in range(n):
-                x[i] = np.nan
-            return 1
-        if p != col:
-            for j in range(n):
-                t = A[col, j]
-                A[col, j] = A[p, j]
-                A[p, j] = t
-            t = x[col]
-            x[col] = x[p]
-            x[p] = t
-        inv = 1.0 / A[col, col]
-        for i in range(col + 1, n):
-            f = A[i, col] * inv
-            if f != 0.0:
-                for j in range(col + 1, n):
-                    A[i, j] -= f * A[col, j]
-                x[i] -= f * x[col]
-    for i in range(n - 1, -1, -1):
-        acc = x[i]
-        for j in range(i + 1, n):
-            acc -= A[i, j] * x[j]
-        x[i] = acc / A[i, i]
-    return 0
+                x[k, i] = np.nan
+            continue
+        for i in range(n - 1, -1, -1):
+            acc = x[k, i]
+            for j in range(i + 1, n):
+                acc -= A[i, j] * x[k, j]
+            x[k, i] = acc / A[i, i]
+    return status
 
 
 def batched_solve(D, b):

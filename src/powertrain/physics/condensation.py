@@ -26,7 +26,8 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from powertrain.kernels.condensation import condensed_matrix_kernel, condensed_solve_kernel
+from powertrain.kernels.condensation import condensed_matrix_kernel
+from powertrain.kernels.small_solve import batched_solve
 from powertrain.physics.mount_elements import describing_stiffnesses
 
 
@@ -130,25 +131,17 @@ def condensed_matrix(frame, engine_rows, base_rows, abc, s):
     r""":math:`\mathbf D_R(s)` of the module docstring, shape ``s.shape + (n_R, n_R)``, for
     given two-port values ``abc`` (each ``s.shape + (n_net,)``); ``base_rows`` None: every
     base grounded (``b``, ``c`` unused)."""
-    s, args = _kernel_arguments(frame, engine_rows, base_rows, abc, s)
-    n = args[1].shape[0]
-    D = np.empty((s.size, n, n), complex)
-    condensed_matrix_kernel(*args, D)
-    return D.reshape(s.shape + (n, n))
-
-
-def _kernel_arguments(frame, engine_rows, base_rows, abc, s):
-    """``(s, (s, M0, C0, K0, E, B, a, b, c))``: the arguments of :func:`condensed_matrix`
-    as its kernel takes them (contiguous, ``s`` flat)."""
     s = np.asarray(s, complex)
     M0, C0, K0 = (np.ascontiguousarray(x, float) for x in frame)
     n, n_net = M0.shape[0], engine_rows.shape[0]
     B = np.zeros((0, n)) if base_rows is None else base_rows
     a, b, c = (np.ascontiguousarray(np.reshape(abc[0] if x is None else x, (s.size, n_net)),
                                     complex) for x in abc)
-    return s, (np.ascontiguousarray(s.reshape(-1)), M0, C0, K0,
-               np.ascontiguousarray(engine_rows, float), np.ascontiguousarray(B, float),
-               a, b, c)
+    D = np.empty((s.size, n, n), complex)
+    condensed_matrix_kernel(np.ascontiguousarray(s.reshape(-1)), M0, C0, K0,
+                            np.ascontiguousarray(engine_rows, float),
+                            np.ascontiguousarray(B, float), a, b, c, D)
+    return D.reshape(s.shape + (n, n))
 
 
 def condense(system, keep, s):
@@ -210,9 +203,7 @@ def harmonic_solve(frame, engine_rows, base_rows, abc, s, load):
     ndarray ``s.shape + (n_R,)`` complex
         Amplitudes of the retained coordinates [m, rad, modal].
     """
-    s, args = _kernel_arguments(frame, engine_rows, base_rows, abc, s)
-    f = np.ascontiguousarray(np.broadcast_to(load, s.shape + (6,)).reshape(-1, 6), complex)
-    x = np.empty((s.size, args[1].shape[0]), complex)
-    if condensed_solve_kernel(*args, f, x):
-        raise np.linalg.LinAlgError("Singular matrix")
-    return x.reshape(s.shape + x.shape[-1:])
+    D = condensed_matrix(frame, engine_rows, base_rows, abc, s)
+    rhs = np.zeros(D.shape[:-1], complex)
+    rhs[..., :6] = load
+    return batched_solve(D, rhs)

@@ -274,7 +274,11 @@ class HarmonicModel:
                 packed = self._packed_of[tuple(missing)] = PackedNetworks.of(
                     [self.networks[k][2].network() for k in missing])
             res = laplace_two_ports(1j * self.omega[:, at], packed, spring, damper)
-            res = [self._all_harmonics(r, h) for r in res]
+            if h is not None:                      # zero at the harmonics not asked for
+                full = [np.zeros(self.omega.shape + (len(missing),), complex) for _ in res]
+                for f, r in zip(full, res):
+                    f[:, list(h)] = r
+                res = full
             for j, k in enumerate(missing):
                 if len(kept[k]) >= 2:
                     del kept[k][next(iter(kept[k]))]
@@ -299,15 +303,6 @@ class HarmonicModel:
             x.setflags(write=False)
         self._scaled_last = (keys, out)
         return out
-
-    def _all_harmonics(self, x, harmonics):
-        """``x`` (n_r, n_h, ...) at the ``harmonics`` as (n_r, 17, ...), zero at the others
-        (None: all, ``x`` itself)."""
-        if harmonics is None:
-            return x
-        full = np.zeros(self.omega.shape + x.shape[2:], complex)
-        full[:, list(harmonics)] = x
-        return full
 
     def two_ports_at(self, amplitudes, elements=None, packed=None):
         r"""``(a, b, c)`` of every network's element at its relative-displacement amplitude,
@@ -435,8 +430,10 @@ class HarmonicModel:
         (solved with the modal body ``body``, default :attr:`body`)."""
         w = self.omega[:, harmonics]
         C = self.channel_matrix if self.body is None else self.output_matrix
-        if body is not None and body is not self.body:
-            C = self._body_output(body, C)
+        if body is not None and body is not self.body:     # its modes' output rows
+            C = self._of_shapes("output", body, lambda: np.hstack(
+                [C[:, :6], np.vstack([np.zeros((self.channel_matrix.shape[0], body.n_modes)),
+                                      body.output_rows()])]))
         if self.output is not None:
             C = C[self.output]
         return np.swapaxes(q @ C.T, -1, -2) * (1j * w)[:, None, :]
@@ -455,15 +452,6 @@ class HarmonicModel:
             return self.body_shapes
         return self._of_shapes("network shapes", body, lambda: body.network_shapes(
             self.networks, self.mount_axes))
-
-    def _body_output(self, body, C):
-        """The output matrix ``C`` (rigid body, then the model's body modes) for another
-        ``body``: its modes' output rows (kept for the last such body's shapes)."""
-        def rows():
-            out = np.hstack([C[:, :6], np.zeros((C.shape[0], body.n_modes))])
-            out[self.channel_matrix.shape[0]:, 6:] = body.output_rows()
-            return out
-        return self._of_shapes("output", body, rows)
 
     def _of_shapes(self, name, body, make):
         """``make()``, a value that depends on ``body``'s mode shapes only, kept under
