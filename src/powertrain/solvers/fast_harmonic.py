@@ -119,7 +119,8 @@ class HarmonicModel:
         The networks packed once for the two-port kernel.
 
     What the model computes it keeps while it lives (the load harmonics, the two-ports, the
-    effects' defaults, :meth:`load_velocity`'s parts); nothing is kept outside it.
+    scaled ones, the effects' defaults, :meth:`load_velocity`'s parts, what the last other
+    modal body's shapes give); nothing is kept outside it.
     """
 
     def __init__(self, engine, rpm, n_angle=N_ANGLE, system=None):
