@@ -282,12 +282,9 @@ class Problem:
         g = self._scored["train"](np.take(vel.reshape(len(scenarios), -1), at, axis=1))
         if self.phase_w is None:
             return list(g)
-        d = (np.angle(np.take(vel.reshape(len(scenarios), -1), self._phase_at["train"], axis=1))
-             - self._phase_rad["train"])
-        delta = self._offset.rows(d)
-        gp = self._w_on["train"] * ph.wrap(d - self._order_on["train"] * delta[:, None])
-        return [np.concatenate([gi, gpi, [ph.offset_prior(float(di), self.sigma_db)]])
-                for gi, gpi, di in zip(g, gp, delta)]
+        d = np.angle(np.take(vel.reshape(len(scenarios), -1), self._phase_at["train"], axis=1))
+        return ph.rows_with_phase(g, d - self._phase_rad["train"], self._offset,
+                                  self._w_on["train"], self.sigma_db)
 
     def _with_phase(self, g, vel, scenario, part):
         """The level gaps ``g`` followed by the phase gaps and the crank offset's prior."""

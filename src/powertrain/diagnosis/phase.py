@@ -95,6 +95,17 @@ def phase_gaps(velocity, phase_deg, w, order, delta):
     return w * d
 
 
+def rows_with_phase(g, d, profile, w, sigma_db) -> list:
+    """Each row of the level gaps ``g`` (n_b, n) followed by its phase gaps and its crank
+    offset's prior: ``d`` (n_b, n_p) the model minus measured phases [rad] at the scored
+    phase points, ``w`` their weights, ``profile`` the run's :class:`OffsetProfile` (the
+    offset profiled per row, as one row at a time)."""
+    delta = profile.rows(d)
+    gp = w * wrap(d - profile.order * delta[:, None])
+    return [np.concatenate([gi, gpi, [offset_prior(float(di), sigma_db)]])
+            for gi, gpi, di in zip(g, gp, delta)]
+
+
 def offset_prior(delta, sigma_db) -> float:
     """The crank offset's prior residual [dB]."""
     return sigma_db * delta / math.radians(CRANK_OFFSET_SD_DEG)
