@@ -109,7 +109,7 @@ def _physical(scenario) -> tuple:
     """``(physical part, its key)`` of a scenario: the effects that are not response-only
     (solved once per distinct value, :meth:`Problem.velocity`)."""
     phys = {k: v for k, v in scenario.items() if not EFFECTS[k].response_only}
-    return phys, repr(sorted((k, sorted(v.items())) for k, v in phys.items()))
+    return phys, tuple(sorted((k, tuple(sorted(v.items()))) for k, v in phys.items()))
 
 
 class Problem:
@@ -282,7 +282,9 @@ class Problem:
         g = self._scored["train"](np.take(vel.reshape(len(scenarios), -1), at, axis=1))
         if self.phase_w is None:
             return list(g)
-        return [self._with_phase(gi, v, sc, "train") for gi, v, sc in zip(g, vel, scenarios)]
+        d = np.angle(np.take(vel.reshape(len(scenarios), -1), self._phase_at["train"], axis=1))
+        return ph.rows_with_phase(g, d - self._phase_rad["train"], self._offset,
+                                  self._w_on["train"], self.sigma_db)
 
     def _with_phase(self, g, vel, scenario, part):
         """The level gaps ``g`` followed by the phase gaps and the crank offset's prior."""

@@ -46,8 +46,8 @@ class Packing:
 
     def scenario(self, x):
         sc = {}
-        for (e, p), lg, v in zip(self.names, self.log, x):
-            sc.setdefault(e, {})[p] = float(math.exp(v) if lg else v)
+        for (e, p), lg, v in zip(self.names, self.log.tolist(), np.asarray(x, float).tolist()):
+            sc.setdefault(e, {})[p] = math.exp(v) if lg else v
         return sc
 
     def values(self, x, sd):

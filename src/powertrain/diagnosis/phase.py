@@ -71,6 +71,15 @@ class OffsetProfile:
         r = wrap(d - k * delta) + k * delta
         return float(np.sum(self.w2k * r) / self.denominator)
 
+    def rows(self, d) -> np.ndarray:
+        """δ [rad] of each row of ``d`` (n_b, n_points), as calling this on each row."""
+        if d.shape[1] == 0:
+            return np.zeros(d.shape[0])
+        k = self.order
+        delta = np.sum(self.w2k * wrap(d), axis=1) / self.denominator
+        r = wrap(d - k * delta[:, None]) + k * delta[:, None]
+        return np.sum(self.w2k * r, axis=1) / self.denominator
+
 
 def crank_offset(d, order, w, sigma_db) -> float:
     """Profiled crank-angle offset δ [rad] of one run (:class:`OffsetProfile`; ``d`` model
@@ -84,6 +93,17 @@ def phase_gaps(velocity, phase_deg, w, order, delta):
     velocities ``velocity`` (same cells) at the crank offset ``delta`` [rad]."""
     d = wrap(np.angle(velocity) - order * delta - np.deg2rad(phase_deg))
     return w * d
+
+
+def rows_with_phase(g, d, profile, w, sigma_db) -> list:
+    """Each row of the level gaps ``g`` (n_b, n) followed by its phase gaps and its crank
+    offset's prior: ``d`` (n_b, n_p) the model minus measured phases [rad] at the scored
+    phase points, ``w`` their weights, ``profile`` the run's :class:`OffsetProfile` (the
+    offset profiled per row, as one row at a time)."""
+    delta = profile.rows(d)
+    gp = w * wrap(d - profile.order * delta[:, None])
+    return [np.concatenate([gi, gpi, [offset_prior(float(di), sigma_db)]])
+            for gi, gpi, di in zip(g, gp, delta)]
 
 
 def offset_prior(delta, sigma_db) -> float:

@@ -208,7 +208,8 @@ def predict(hm: HarmonicModel, scenario: dict, *, tol=TOLERANCE,
                                                   start=warm_amplitudes)
         v = hm.velocity(q, body=body)
     else:
-        nominal = hm.two_ports() if s_el is None else hm.two_ports_scaled(*s_el)
+        h = None if orders is None else np.asarray(orders, int) + 1
+        nominal = hm.two_ports() if s_el is None else hm.two_ports_scaled(*s_el, harmonics=h)
         abc = _two_ports(sc, hm, nominal)
         if s_el is None and abc is nominal and body is getattr(hm, "body", None):
             v = _load_velocity(hm, sc)          # only the load changed: no solve

@@ -154,7 +154,7 @@ def modal_frame(M, frequency_hz, modal_mass, damping_ratio):
     return M0, C0, K0
 
 
-def coupled_solve(M, omega, rows, shapes, abc, kip, body, load):
+def coupled_solve(M, omega, rows, shapes, abc, kip, body, load, rows_on=None):
     r"""Solve the (6 + K) system of the module docstring for all speeds and harmonics by the
     one harmonic solve (:func:`powertrain.physics.condensation.harmonic_solve`).
 
@@ -172,23 +172,32 @@ def coupled_solve(M, omega, rows, shapes, abc, kip, body, load):
     body : ModalBody
         Or anything with ``frequency_hz``, ``modal_mass``, ``damping_ratio``.
     load : ndarray (n_r, n_h, 6)
+    rows_on : tuple, optional
+        :func:`coupled_rows` of ``rows``, ``shapes``, if at hand.
 
     Returns
     -------
     ndarray (n_r, n_h, 6 + K) complex: :math:`\hat{\mathbf q}` then :math:`\hat{\boldsymbol\eta}`.
     """
-    frame, E, B = coupled_frame(M, rows, shapes, body)
+    frame, E, B = coupled_frame(M, rows, shapes, body, rows_on)
     return harmonic_solve(frame, E, B, (kip, abc[1], abc[2]), 1j * np.asarray(omega, float),
                           load)
 
 
-def coupled_frame(M, rows, shapes, body):
+def coupled_frame(M, rows, shapes, body, rows_on=None):
     """The retained coordinates' frame (rigid body, body modes) and the networks' engine and
     base rows on them, ``(frame, E, B)`` (arguments as :func:`coupled_solve`)."""
-    K = shapes.shape[1]
-    E = np.hstack([rows, np.zeros((rows.shape[0], K))])
-    B = np.hstack([np.zeros_like(rows), shapes])
+    E, B = coupled_rows(rows, shapes) if rows_on is None else rows_on
     return modal_frame(M, body.frequency_hz, body.modal_mass, body.damping_ratio), E, B
+
+
+def coupled_rows(rows, shapes):
+    """The networks' engine and base rows ``(E, B)`` on the retained coordinates (rigid
+    body, body modes), each (n_net, 6 + K), from the network rows ``rows`` (n_net, 6) and
+    body shapes ``shapes`` (n_net, K)."""
+    K = shapes.shape[1]
+    return (np.hstack([rows, np.zeros((rows.shape[0], K))]),
+            np.hstack([np.zeros_like(rows), shapes]))
 
 
 def coupled_matrix(M, omega, rows, shapes, abc, kip, body):

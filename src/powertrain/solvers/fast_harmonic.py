@@ -48,6 +48,7 @@ from powertrain.physics.mount_elements import element_two_ports
 from powertrain.physics.mount_network import PackedNetworks, laplace_two_ports
 from powertrain.solvers.body_coupling import (
     ModalBody,
+    coupled_rows,
     coupled_solve,
     one_more_mode,
     one_more_mode_basis,
@@ -118,7 +119,8 @@ class HarmonicModel:
         The networks packed once for the two-port kernel.
 
     What the model computes it keeps while it lives (the load harmonics, the two-ports, the
-    effects' defaults, :meth:`load_velocity`'s parts); nothing is kept outside it.
+    scaled ones, the effects' defaults, :meth:`load_velocity`'s parts, what the last other
+    modal body's shapes give); nothing is kept outside it.
     """
 
     def __init__(self, engine, rpm, n_angle=N_ANGLE, system=None):
@@ -151,6 +153,8 @@ class HarmonicModel:
         self._abc = None
         self._extra = {}
         self._scaled = {}
+        self._scaled_last = None
+        self._packed_of = {}
         self._one_more_mode_at = None
         self._effect_defaults = {}
         self._body_setup(engine, ports)
@@ -160,6 +164,7 @@ class HarmonicModel:
         passive-side and body-point channels follow the engine-side ones, read from the
         assembled system's output rows on the retained coordinates."""
         self.body = ModalBody.of(engine)
+        self._body_memo = {}
         #: indices of the channels :meth:`velocity` returns (None: all of ``channels``)
         self.output = None
         self.active_channels = list(self.channels)
@@ -227,7 +232,7 @@ class HarmonicModel:
             self._abc = abc
         return abc
 
-    def two_ports_scaled(self, scale, damper_scale=None):
+    def two_ports_scaled(self, scale, damper_scale=None, harmonics=None):
         r"""``(a, b, c)`` of every network with its elastomer scaled, each (n_r, 17, n_net).
 
         Every spring of network n at speed r and harmonic h times ``scale[r, h, n]`` and
@@ -235,40 +240,70 @@ class HarmonicModel:
         broadcast to (n_r, 17, n_net)), its masses kept — :math:`s\,\mathbf K + i\omega
         d\,\mathbf C - \omega^2\mathbf M` condensed by the one two-port condensation
         (:func:`powertrain.physics.mount_network.laplace_two_ports`). With ``scale = 1`` the
-        same as :meth:`two_ports`.
+        same as :meth:`two_ports`. ``harmonics`` (indices 0..16, optional): with one factor
+        pair per network, only these harmonics are condensed, the others are zero (a linear
+        solve of some orders reads no more).
         """
         n_net = len(self.networks)
         scale = np.asarray(scale, float)
         damper = scale if damper_scale is None else np.asarray(damper_scale, float)
         if scale.size == n_net and damper.size == n_net:  # one pair per network: cached
-            return self._scaled_networks(list(zip(scale.flat, damper.flat)))
+            return self._scaled_networks(list(zip(scale.flat, damper.flat)), harmonics)
         shape = self.omega.shape + (n_net,)
         statics = self._statics(range(n_net))
         return laplace_two_ports(1j * self.omega, self.packed,
                                  np.broadcast_to(scale, shape) * statics,
                                  np.broadcast_to(damper, shape) * statics)
 
-    def _scaled_networks(self, factors):
+    def _scaled_networks(self, factors, harmonics=None):
         """Every network's two-port with its springs and dampers times ``factors[k]``
-        (a (spring, damper) pair) at every speed; the last two pairs per network are kept (a
-        finite-difference Jacobian column changes the factors of one mount only: the
-        others' are reused), the missing ones condensed in one call."""
-        factors = [(float(k), float(d)) for k, d in factors]
-        kept = [self._scaled.setdefault(k, {}) for k in range(len(factors))]
-        missing = [k for k, f in enumerate(factors) if f not in kept[k]]
+        (a (spring, damper) pair) at every speed (at the ``harmonics`` only, the others zero;
+        None: all); the last two pairs per network are kept (a finite-difference Jacobian
+        column changes the factors of one mount only: the others' are reused), the missing
+        ones condensed in one call."""
+        h = None if harmonics is None else tuple(int(i) for i in harmonics)
+        keys = [(float(k), float(d), h) for k, d in factors]
+        kept = [self._scaled.setdefault(k, {}) for k in range(len(keys))]
+        missing = [k for k, f in enumerate(keys) if f not in kept[k]]
         if missing:
             statics = self._statics(missing)
-            spring = np.array([factors[k][0] for k in missing]) * statics
-            damper = np.array([factors[k][1] for k in missing]) * statics
-            res = laplace_two_ports(1j * self.omega,
-                                    [self.networks[k][2].network() for k in missing],
-                                    spring, damper)
+            spring = np.array([keys[k][0] for k in missing]) * statics
+            damper = np.array([keys[k][1] for k in missing]) * statics
+            at = slice(None) if h is None else list(h)
+            packed = self._packed_of.get(tuple(missing))
+            if packed is None:
+                packed = self._packed_of[tuple(missing)] = PackedNetworks.of(
+                    [self.networks[k][2].network() for k in missing])
+            res = laplace_two_ports(1j * self.omega[:, at], packed, spring, damper)
+            if h is not None:                      # zero at the harmonics not asked for
+                full = [np.zeros(self.omega.shape + (len(missing),), complex) for _ in res]
+                for f, r in zip(full, res):
+                    f[:, list(h)] = r
+                res = full
             for j, k in enumerate(missing):
                 if len(kept[k]) >= 2:
                     del kept[k][next(iter(kept[k]))]
-                kept[k][factors[k]] = tuple(r[..., j] for r in res)
-        return tuple(np.stack([kept[k][f][j] for k, f in enumerate(factors)], axis=-1)
-                     for j in range(3))
+                kept[k][keys[k]] = tuple(r[..., j] for r in res)
+        return self._assembled(keys, kept)
+
+    def _assembled(self, keys, kept):
+        """The two-ports (each (n_r, 17, n_net), read-only) of the networks' ``keys`` from
+        their ``kept`` ones: the last result with the networks whose key changed replaced
+        (a Jacobian column changes one mount's)."""
+        last = self._scaled_last
+        if last is None or len(last[0]) != len(keys):
+            out = tuple(np.empty(self.omega.shape + (len(keys),), complex) for _ in range(3))
+            changed = range(len(keys))
+        else:
+            out = tuple(x.copy() for x in last[1])
+            changed = [k for k, key in enumerate(keys) if key != last[0][k]]
+        for k in changed:
+            for j in range(3):
+                out[j][..., k] = kept[k][keys[k]][j]
+        for x in out:
+            x.setflags(write=False)
+        self._scaled_last = (keys, out)
+        return out
 
     def two_ports_at(self, amplitudes, elements=None, packed=None):
         r"""``(a, b, c)`` of every network's element at its relative-displacement amplitude,
@@ -325,9 +360,12 @@ class HarmonicModel:
         if self.body is not None:
             abc = self.two_ports() if abc is None else abc
             body = self.body if body is None else body
-            return coupled_solve(self.M, w, self.rows, self._network_shapes(body),
+            shapes = self._network_shapes(body)
+            rows_on = self._of_shapes("own rows" if body is self.body else "rows", body,
+                                      lambda: coupled_rows(self.rows, shapes))
+            return coupled_solve(self.M, w, self.rows, shapes,
                                  tuple(x[:, harmonics] for x in abc), K, body,
-                                 load[:, harmonics])
+                                 load[:, harmonics], rows_on)
         frame = (self.M, np.zeros((6, 6)), np.zeros((6, 6)))
         return harmonic_solve(frame, self.rows, None, (K, None, None), 1j * w,
                               load[:, harmonics])
@@ -393,9 +431,10 @@ class HarmonicModel:
         (solved with the modal body ``body``, default :attr:`body`)."""
         w = self.omega[:, harmonics]
         C = self.channel_matrix if self.body is None else self.output_matrix
-        if body is not None and body is not self.body:
-            C = np.hstack([C[:, :6], np.zeros((C.shape[0], body.n_modes))])
-            C[self.channel_matrix.shape[0]:, 6:] = body.output_rows()
+        if body is not None and body is not self.body:     # its modes' output rows
+            C = self._of_shapes("output", body, lambda: np.hstack(
+                [C[:, :6], np.vstack([np.zeros((self.channel_matrix.shape[0], body.n_modes)),
+                                      body.output_rows()])]))
         if self.output is not None:
             C = C[self.output]
         return np.swapaxes(q @ C.T, -1, -2) * (1j * w)[:, None, :]
@@ -407,10 +446,24 @@ class HarmonicModel:
         return np.sqrt(np.sum(np.abs(x) ** 2, axis=1))
 
     def _network_shapes(self, body):
-        """Mode shapes of ``body`` along each network's direction (n_net, K) (cached for the
-        model's own body)."""
-        return (self.body_shapes if body is self.body
-                else body.network_shapes(self.networks, self.mount_axes))
+        """Mode shapes of ``body`` along each network's direction (n_net, K): the model's own
+        body's, or those of the last other body's mode shapes (kept while a fit changes the
+        modal parameters of the same shapes)."""
+        if body is self.body:
+            return self.body_shapes
+        return self._of_shapes("network shapes", body, lambda: body.network_shapes(
+            self.networks, self.mount_axes))
+
+    def _of_shapes(self, name, body, make):
+        """``make()``, a value that depends on ``body``'s mode shapes only, kept under
+        ``name`` with the shape arrays it was made of (the last body's: a fit's modal bodies
+        share their shape arrays, :meth:`ModalBody.with_modes
+        <powertrain.solvers.body_coupling.ModalBody.with_modes>`)."""
+        kept = self._body_memo.get(name)
+        if (kept is None or kept[0] is not body.mount_shapes
+                or kept[1] is not body.point_shapes):
+            kept = self._body_memo[name] = (body.mount_shapes, body.point_shapes, make())
+        return kept[2]
 
     def relative_amplitude(self, q, body=None) -> np.ndarray:
         r"""Amplitude of the relative displacement across each network (engine-side point
@@ -439,5 +492,8 @@ class HarmonicModel:
             new.static_scale = self.static_scale[index]
         new._extra = {k: v[:, index] for k, v in self._extra.items()}
         new._scaled = {}
+        new._scaled_last = None
+        new._packed_of = {}
         new._one_more_mode_at = None
+        new._body_memo = {}
         return new
