@@ -43,7 +43,7 @@ from powertrain.solvers.transient_load import transient_load
 
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "tests"))
-from transient_oracle import StretchODE, integrate, write_case  # noqa: E402
+from transient_oracle import Oracle, integrate, write_case  # noqa: E402
 
 #: The z-nonlinear mount's curve shape [mm, N] and its tangent at 0 [N/mm].
 SHAPE_MM = (-12.0, -9.0, -7.0, -5.0, -3.0, 0.0, 3.0, 6.0, 9.0)
