@@ -32,11 +32,14 @@ and scripts/bench_transient.py.
 
 from __future__ import annotations
 
+import dataclasses
 import time
 
 import numpy as np
 from scipy.integrate import solve_ivp
 
+from powertrain.models.mount import MountModel
+from powertrain.physics.mount_laws import StaticCurve
 from powertrain.solvers.operating_point import StaticSupport, operating_point
 
 KV = """[mount]
@@ -85,6 +88,30 @@ def write_case(folder, default_engine_text, nonlinear="left.z"):
     path = folder / "engine.toml"
     path.write_text("\n".join(lines) + "\n", encoding="utf-8")
     return path
+
+
+#: The z-nonlinear mount's static curve shape [mm, N] (its tangent at 0 set to each
+#: direction's static stiffness by :func:`with_curve_laws`).
+SHAPE_MM = (-12.0, -9.0, -7.0, -5.0, -3.0, 0.0, 3.0, 6.0, 9.0)
+SHAPE_N = (-2743.42, -1419.01, -851.41, -586.52, -359.48, 0.0, 312.18, 662.2, 1419.01)
+
+
+def with_curve_laws(engine, **laws):
+    """``engine`` with every mount direction on a static curve (:data:`SHAPE_N` scaled to
+    its static stiffness at 0, reference deflection 0) and ``laws`` (``port_law``,
+    ``amplitude_law``)."""
+    x = np.array(SHAPE_MM) * 1e-3
+    tangent0 = pchip_slopes(x, np.array(SHAPE_N))[list(SHAPE_MM).index(0.0)]
+
+    def model(mod):
+        k0 = mod.static_stiffness()
+        curve = StaticCurve(tuple(x), tuple(f * k0 / tangent0 for f in SHAPE_N), 0.0)
+        return MountModel(mod.topology, dict(mod.params), name=mod.name, static_curve=curve,
+                          **laws)
+    mounts = [dataclasses.replace(m, directions={a: model(mod) for a, mod in
+                                                 m.directions.items()})
+              for m in engine.mounts]
+    return dataclasses.replace(engine, mounts=mounts)
 
 
 def pchip_slopes(x, y):
