@@ -201,6 +201,7 @@ class Oracle:
     for the static factors' slope)."""
 
     def __init__(self, engine, system, load_t, load_F, continuous=True, deadline=None):
+        """``deadline``: ``time.process_time()`` after which a call raises TimeoutError."""
         els = [n[3] for n in system.networks]
         self.n, self.R = system.n_dof, system.port_rows
         self.Minv = np.linalg.inv(system.M)
@@ -253,8 +254,8 @@ class Oracle:
         return kap, c, z, kz
 
     def __call__(self, t, y):
-        if self.deadline is not None and time.perf_counter() > self.deadline:
-            raise TimeoutError("solve_ivp attempt over its wall-time cap")
+        if self.deadline is not None and time.process_time() > self.deadline:
+            raise TimeoutError("solve_ivp attempt over its CPU-time cap")
         x, v = y[:self.n], y[self.n:]
         kap, c, z, _ = self.parts(y)
         i = min(max(int(np.searchsorted(self.t, t, side="right")) - 1, 0), self.t.size - 2)
@@ -326,7 +327,7 @@ def integrate(ode, every, rtol=1e-8, method="Radau", atol=None):
     U, force = np.empty((t_all.size, ode.R.shape[0])), np.empty((t_all.size,
                                                                   ode.fmap.shape[0]))
     amplitudes = np.zeros(ode.R.shape[0])
-    jac = ode.jac if method in ("Radau", "BDF", "LSODA") else None
+    options = {"jac": ode.jac} if method in ("Radau", "BDF", "LSODA") else {}
     atol = 1e-3 * rtol if atol is None else atol
     events = ode.reversals()
     for lo, hi in zip(bounds[:-1], bounds[1:]):
@@ -335,7 +336,7 @@ def integrate(ode, every, rtol=1e-8, method="Radau", atol=None):
         rows = [ode.outputs(y[None, :])]
         while True:
             sol = solve_ivp(ode, (t, t_all[hi]), y, method=method, rtol=rtol, atol=atol,
-                            dense_output=True, events=events or None, jac=jac)
+                            dense_output=True, events=events or None, **options)
             inside = grid[(grid > t) & (grid <= sol.t[-1])]
             if inside.size:
                 rows.append(ode.outputs(sol.sol(inside).T))
