@@ -335,8 +335,11 @@ def integrate(ode, every, rtol=1e-8, method="Radau", atol=None):
         t, grid = t_all[lo], t_all[lo:hi + 1]
         rows = [ode.outputs(y[None, :])]
         while True:
-            sol = solve_ivp(ode, (t, t_all[hi]), y, method=method, rtol=rtol, atol=atol,
-                            dense_output=True, events=events or None, **options)
+            try:
+                sol = solve_ivp(ode, (t, t_all[hi]), y, method=method, rtol=rtol, atol=atol,
+                                dense_output=True, events=events or None, **options)
+            except ValueError as exc:          # an event's root outside its bracket
+                raise RuntimeError(f"solve_ivp {method}: {exc}") from exc
             inside = grid[(grid > t) & (grid <= sol.t[-1])]
             if inside.size:
                 rows.append(ode.outputs(sol.sol(inside).T))
