@@ -81,7 +81,7 @@ def errors(U, F, U_ref, F_ref):
 METHODS = ("Radau", "BDF", "LSODA", "RK45")
 RTOLS = 10.0 ** -np.arange(2, 9)
 #: CPU-time cap of one solve_ivp attempt [s] (CPU, not wall: the machine may be shared).
-CAP_S = 300.0
+CAP_S = 120.0
 
 
 class Case:
