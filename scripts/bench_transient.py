@@ -17,13 +17,15 @@ best of ``--repeat``:
   :data:`METHODS` the loosest rtol of :data:`RTOLS` whose error is at most ours counts
   (an attempt over :data:`CAP_S` CPU seconds is stopped and said so), the fastest of them
   against ours. The peer is timed from the engine, the model and the manoeuvre, as ours
-  (its time includes computing the manoeuvre's load), with the analytic Jacobian for the
-  implicit methods. Two systems: the **stretch rule** (the static curves' tangent and load
-  frozen for :data:`~powertrain.solvers.transient.STRETCH`, as ours: the same system, the
-  ratio of the last line) and the **continuous curve** (the curve itself at every instant:
+  (its time includes computing the manoeuvre's load), with the Jacobian for the implicit
+  methods (analytic but for the static factors' slope). Two systems: the **stretch rule**
+  (the static curves' tangent and load frozen for
+  :data:`~powertrain.solvers.transient.STRETCH`, as ours: the same system, the ratio of the
+  last line) and the **continuous curve** (the curve itself at every instant:
   ours then also carries the stretch rule's error);
 * the small case of tests/test_transient.py (6-DOF body, Kelvin-Voigt mounts, one direction
-  nonlinear, a 0.3 s flare from rest), the same comparison on the stretch rule, one line.
+  nonlinear, a 0.3 s flare from rest), the same comparison on the stretch rule, its own
+  lines.
 
 Last line: ``linear_s=... nonlinear_s=... newmark_s=... solve_ivp_s=... ratio=...
 solve_ivp_method=... solve_ivp_rtol=...`` then ``error=... ratio_continuous=...
