@@ -73,6 +73,16 @@ class TransientRun:
     channels : list of (str, str)
     networks : list of str
     method : str
+    coordinates, coordinate_velocity : ndarray (n_t, n)
+        Every coordinate of the model (body, then the networks' internal ones and any
+        others) [m, rad] and its velocity.
+    port_law_force : ndarray (n_t, m) or None
+        Force of each port law (friction) [N], in ``system.port_forces()`` order.
+    network_scales : ndarray (n_t, n_net, 2)
+        Stiffness and damping scale of every network at each step (amplitude law times
+        static factor).
+    curve_load : ndarray (n_t, n_net)
+        The static curves' load ``c`` at each step [N] (module docstring; 0 without one).
     """
 
     load: object
@@ -85,6 +95,11 @@ class TransientRun:
     channels: list
     networks: list
     method: str
+    coordinates: np.ndarray | None = None
+    coordinate_velocity: np.ndarray | None = None
+    port_law_force: np.ndarray | None = None
+    network_scales: np.ndarray | None = None
+    curve_load: np.ndarray | None = None
 
 
 def transient_steps(manoeuvre, angle_step_deg) -> int:
@@ -135,12 +150,12 @@ def simulate_transient(engine, manoeuvre, *, system=None, angle_step_deg=1.0) ->
     start = _start(engine, manoeuvre, system, load, ports, curves)
     every = max(1, round(STRETCH / (t[1] - t[0]))) if (integrator.varying or curves) \
         else n_steps
-    out = _run(system, integrator, ports, curves, F, start, every)
+    X, V, A, force, extra = _run(system, integrator, ports, curves, F, start, every)
     Cm = system.channel_matrix
-    X, V, A, force = out
     return TransientRun(load, X[:, :6].copy(), X @ Cm.T, V @ Cm.T, A @ Cm.T, force,
                         X @ system.port_rows.T, list(system.channels),
-                        system.network_names, _method(integrator, curves, every))
+                        system.network_names, _method(integrator, curves, every), X, V,
+                        *extra)
 
 
 def _method(integrator, curves, every):
@@ -155,31 +170,39 @@ def _method(integrator, curves, every):
 
 
 def _run(system, integrator, ports, curves, F, start, every):
-    """States X, V, A (n_t, n) and channel forces (n_t, n_ch), stretch by stretch."""
+    """States X, V, A (n_t, n), channel forces (n_t, n_ch) and ``(port-law forces,
+    network scales, curve loads)`` at every step, stretch by stretch."""
     x, v, a, state, amplitudes = start
     n_t = F.shape[0]
     X, V, A = (np.empty((n_t, system.n_dof)) for _ in range(3))
     force = np.empty((n_t, system.channel_matrix.shape[0]))
+    n_net = system.port_rows.shape[0]
+    Z = np.zeros((n_t, integrator.laws.kinds.size)) if integrator.laws.kinds.size else None
+    scales, loads = np.empty((n_t, n_net, 2)), np.zeros((n_t, n_net))
     laws_map = integrator.laws.force_map
     bounds = list(range(0, n_t - 1, every)) + [n_t - 1]
     for lo, hi in zip(bounds[:-1], bounds[1:]):
+        net_amplitudes = ports.network_amplitudes(amplitudes)
         factors, c = (None, None) if curves is None else curves.at(
-            x, integrator.scaling, ports.network_amplitudes(amplitudes))
+            x, integrator.scaling, net_amplitudes)
         Fs = F[lo:hi + 1] if c is None else F[lo:hi + 1] - c @ system.port_rows
         (Xs, Vs, As, Zs), (Fk, Fd, off) = integrator.run(Fs, (x, v, a), amplitudes, state,
                                                         factors)
         rows = slice(lo, hi + 1)
         X[rows], V[rows], A[rows] = Xs, Vs, As
+        scales[rows] = integrator.scaling.scales(net_amplitudes, factors)
         f = Xs @ Fk.T + Vs @ Fd.T - (0.0 if off is None else off)
         if Zs is not None:
             f += Zs @ laws_map.T
+            Z[rows] = Zs
         if c is not None:
             f += c @ system.port_force_map.T
+            loads[rows] = c
         force[rows] = f
         if integrator.varying:
             amplitudes = cycle_amplitudes(Xs[:-1] @ ports.rows.T)
         x, v, a = Xs[-1], Vs[-1], As[-1]
-    return X, V, A, force
+    return X, V, A, force, (Z, scales, loads)
 
 
 def _start(engine, manoeuvre, system, load, ports, curves):
