@@ -34,6 +34,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+import warnings
 from dataclasses import dataclass
 
 import numpy as np
@@ -45,6 +46,12 @@ from powertrain.solvers.cycle_newmark import CycleIntegrator, cycle_amplitudes, 
 from powertrain.solvers.operating_point import StaticSupport, has_static_curves, operating_point
 from powertrain.solvers.steppers import Cycles, DenseNewmarkStepper
 from powertrain.solvers.transient_load import N_THETA, RPM, transient_load
+
+
+class StretchRuleWarning(UserWarning):
+    """A mount direction has a static curve and an amplitude law: in a transient the law acts
+    per stretch about the curve's tangent, an approximation (docs/guide/transient.md)."""
+
 
 #: Length of a stretch [s]: the amplitude law and the static curves' tangents are updated
 #: this often (a rigid-body mode of 12 Hz is 8 stretches per period).
@@ -147,6 +154,7 @@ def simulate_transient(engine, manoeuvre, *, system=None, angle_step_deg=1.0) ->
     integrator = CycleIntegrator(NetworkScaling(system), ports, t[1] - t[0],
                                  np.zeros(system.n_dof))
     curves = _Curves(engine, system) if has_static_curves(engine) else None
+    _warn_curve_and_law(engine)
     start = _start(engine, manoeuvre, system, load, ports, curves)
     every = max(1, round(STRETCH / (t[1] - t[0]))) if (integrator.varying or curves) \
         else n_steps
@@ -156,6 +164,16 @@ def simulate_transient(engine, manoeuvre, *, system=None, angle_step_deg=1.0) ->
                         X @ system.port_rows.T, list(system.channels),
                         system.network_names, _method(integrator, curves, every), X, V,
                         *extra)
+
+
+def _warn_curve_and_law(engine):
+    both = [f"{m.name}.{axis}" for m in engine.mounts for axis, mod in m.directions.items()
+            if mod.static_curve is not None and mod.amplitude_law is not None]
+    if both:
+        warnings.warn(f"{', '.join(both)}: static curve and amplitude law together; in a "
+                      f"transient the law acts per {STRETCH * 1e3:g} ms stretch about the "
+                      "curve's tangent, peaks can differ from the continuous curve by tens "
+                      "of % (docs/guide/transient.md)", StretchRuleWarning, stacklevel=3)
 
 
 def _method(integrator, curves, every):
