@@ -22,8 +22,10 @@ import time
 import zlib
 from pathlib import Path
 
-#: Where Debian's ``chromium`` package puts the browser (``apt-get install chromium``).
-CANDIDATES = ("/usr/bin/chromium", "chromium", "chromium-browser", "google-chrome")
+#: The browsers tried, in order: Debian's ``chromium-headless-shell`` (the headless build
+#: .ci/run installs: no GTK, no desktop), then a full Chromium or Chrome.
+CANDIDATES = ("chromium-headless-shell", "/usr/bin/chromium", "chromium", "chromium-browser",
+              "google-chrome")
 #: Seconds to wait for one answer or for a page to load.
 TIMEOUT_S = 60.0
 

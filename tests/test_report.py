@@ -46,7 +46,7 @@ def on_the_example(test):
     for mark in (pytest.mark.slow, pytest.mark.browser, pytest.mark.xdist_group("report")):
         test = mark(test)
     return test
-NO_CHROMIUM = ("headless Chromium not installed (Debian: apt-get install chromium; .ci/run "
+NO_CHROMIUM = ("headless Chromium not installed (Debian: apt-get install chromium-headless-shell; .ci/run "
                "installs it where apt-get works): the browser checks of the report did not run")
 
 
