@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from powertrain.kernels.small_solve import batched_solve
+from powertrain.physics.condensation import batched_solve
 
 
 @pytest.mark.parametrize("n", [1, 6, 9])

@@ -50,6 +50,16 @@ def _modes(engine):
     return () if ch is None else ch.body_modes
 
 
+def mode_values(p, frequency_hz, modal_mass, damping_ratio):
+    """Each mode's frequency [Hz], modal mass [kg] and damping ratio [1] with the effect's
+    parameters ``p`` (``f1``, ``m1``, ``z1``, ...; a missing one keeps the given value):
+    the one mapping :meth:`ChassisModes.apply` (on the engine's modes) and
+    :meth:`ChassisModes.body_change` (on the frequency view's modal body) both use."""
+    return tuple([float(p.get(f"{key}{k + 1}", v)) for k, v in enumerate(values)]
+                 for key, values in (("f", frequency_hz), ("m", modal_mass),
+                                     ("z", damping_ratio)))
+
+
 class ChassisModes(Effect):
     name = "chassis_modes"
     kind = "structure"
@@ -104,17 +114,13 @@ class ChassisModes(Effect):
                 raise InputError("effect chassis_modes needs an engine with a modal body "
                                  "([chassis] model = \"modal\")", key="chassis_modes")
             return engine             # nothing to change: the defaults are the baseline
-        modes = []
-        for k, m in enumerate(engine.chassis.modes):
-            modes.append(dataclasses.replace(
-                m, frequency=float(params.get(f"f{k + 1}", m.frequency)),
-                modal_mass=float(params.get(f"m{k + 1}", m.modal_mass)),
-                damping_ratio=float(params.get(f"z{k + 1}", m.damping_ratio))))
-        return engine.replace(chassis=dataclasses.replace(engine.chassis, modes=tuple(modes)))
+        old = engine.chassis.modes
+        values = mode_values(params, *([getattr(m, key) for m in old] for key in
+                                       ("frequency", "modal_mass", "damping_ratio")))
+        modes = tuple(dataclasses.replace(m, frequency=f, modal_mass=mm, damping_ratio=z)
+                      for m, f, mm, z in zip(old, *values))
+        return engine.replace(chassis=dataclasses.replace(engine.chassis, modes=modes))
 
     def body_change(self, hm, p, body):
-        K = body.n_modes
-        f = [p.get(f"f{k + 1}", body.frequency_hz[k]) for k in range(K)]
-        m = [p.get(f"m{k + 1}", body.modal_mass[k]) for k in range(K)]
-        z = [p.get(f"z{k + 1}", body.damping_ratio[k]) for k in range(K)]
-        return body.with_modes(f, m, z)
+        return body.with_modes(*mode_values(p, body.frequency_hz, body.modal_mass,
+                                            body.damping_ratio))

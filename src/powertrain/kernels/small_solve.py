@@ -78,19 +78,3 @@ def batched_solve_kernel(D, b, x):
                 acc -= A[i, j] * x[k, j]
             x[k, i] = acc / A[i, i]
     return status
-
-
-def batched_solve(D, b):
-    """Solutions ``x`` (shape of ``b``, ``(..., n)``) of ``D x = b`` for a stack ``D``
-    ``(..., n, n)``: :func:`batched_solve_kernel` on contiguous complex copies. Raises
-    ``numpy.linalg.LinAlgError`` on a singular matrix, as ``numpy.linalg.solve``."""
-    D = np.asarray(D)
-    b = np.asarray(b)
-    n = D.shape[-1]
-    shape = np.broadcast_shapes(D.shape[:-2], b.shape[:-1]) + (n,)
-    Df = np.ascontiguousarray(np.broadcast_to(D, shape[:-1] + (n, n)), np.complex128)
-    bf = np.ascontiguousarray(np.broadcast_to(b, shape), np.complex128)
-    x = np.empty(shape, np.complex128)
-    if batched_solve_kernel(Df.reshape(-1, n, n), bf.reshape(-1, n), x.reshape(-1, n)):
-        raise np.linalg.LinAlgError("Singular matrix")
-    return x

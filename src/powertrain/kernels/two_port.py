@@ -152,16 +152,17 @@ def two_ports_kernel(lam, spring_scale, damper_scale, mass_ptr, masses, el_ptr, 
     """:func:`two_port_kernel` of several networks in one call (the equivalent-linear fixed
     point asks for every network at every iteration): network k has the masses
     ``masses[mass_ptr[k]:mass_ptr[k + 1]]`` and the elements ``el_ptr[k]:el_ptr[k + 1]`` of
-    ``elem_nodes``, ``c``, ``d``; its factors and outputs are column k of ``spring_scale``,
-    ``damper_scale`` and ``out_a``, ``out_b``, ``out_c`` (n_w, n_net). Returns 0, or 1 when
+    ``elem_nodes``, ``c``, ``d``; its factors and outputs are row k of ``spring_scale``,
+    ``damper_scale`` and ``out_a``, ``out_b``, ``out_c`` (n_net, n_w; rows, so that
+    :func:`two_port_kernel` gets contiguous arrays and compiles once). Returns 0, or 1 when
     some network was singular somewhere (NaN there)."""
     no_x = np.empty((0, 0, 2), np.complex128)
     status = 0
-    for k in range(out_a.shape[1]):
+    for k in range(out_a.shape[0]):
         m0, m1, e0, e1 = mass_ptr[k], mass_ptr[k + 1], el_ptr[k], el_ptr[k + 1]
-        status |= two_port_kernel(lam, spring_scale[:, k], damper_scale[:, k], masses[m0:m1],
-                                  elem_nodes[e0:e1], c[e0:e1], d[e0:e1], out_a[:, k],
-                                  out_b[:, k], out_c[:, k], no_x)
+        status |= two_port_kernel(lam, spring_scale[k], damper_scale[k], masses[m0:m1],
+                                  elem_nodes[e0:e1], c[e0:e1], d[e0:e1], out_a[k],
+                                  out_b[k], out_c[k], no_x)
     return status
 
 

@@ -26,8 +26,9 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
+from powertrain.kernels import kernel_input
 from powertrain.kernels.condensation import condensed_matrix_kernel
-from powertrain.kernels.small_solve import batched_solve
+from powertrain.kernels.small_solve import batched_solve_kernel
 from powertrain.physics.mount_elements import describing_stiffnesses
 
 
@@ -132,15 +133,14 @@ def condensed_matrix(frame, engine_rows, base_rows, abc, s):
     given two-port values ``abc`` (each ``s.shape + (n_net,)``); ``base_rows`` None: every
     base grounded (``b``, ``c`` unused)."""
     s = np.asarray(s, complex)
-    M0, C0, K0 = (np.ascontiguousarray(x, float) for x in frame)
+    M0, C0, K0 = (kernel_input(x) for x in frame)
     n, n_net = M0.shape[0], engine_rows.shape[0]
     B = np.zeros((0, n)) if base_rows is None else base_rows
-    a, b, c = (np.ascontiguousarray(np.reshape(abc[0] if x is None else x, (s.size, n_net)),
-                                    complex) for x in abc)
+    a, b, c = (kernel_input(np.reshape(abc[0] if x is None else x, (s.size, n_net)), complex)
+               for x in abc)
     D = np.empty((s.size, n, n), complex)
-    condensed_matrix_kernel(np.ascontiguousarray(s.reshape(-1)), M0, C0, K0,
-                            np.ascontiguousarray(engine_rows, float),
-                            np.ascontiguousarray(B, float), a, b, c, D)
+    condensed_matrix_kernel(kernel_input(s.reshape(-1), complex), M0, C0, K0,
+                            kernel_input(engine_rows), kernel_input(B), a, b, c, D)
     return D.reshape(s.shape + (n, n))
 
 
@@ -207,3 +207,20 @@ def harmonic_solve(frame, engine_rows, base_rows, abc, s, load):
     rhs = np.zeros(D.shape[:-1], complex)
     rhs[..., :6] = load
     return batched_solve(D, rhs)
+
+
+def batched_solve(D, b):
+    """Solutions ``x`` (shape of ``b``, ``(..., n)``) of ``D x = b`` for a stack ``D``
+    ``(..., n, n)``: :func:`powertrain.kernels.small_solve.batched_solve_kernel` on
+    contiguous complex copies. Raises ``numpy.linalg.LinAlgError`` on a singular matrix, as
+    ``numpy.linalg.solve``."""
+    D = np.asarray(D)
+    b = np.asarray(b)
+    n = D.shape[-1]
+    shape = np.broadcast_shapes(D.shape[:-2], b.shape[:-1]) + (n,)
+    Df = kernel_input(np.broadcast_to(D, shape[:-1] + (n, n)), np.complex128)
+    bf = kernel_input(np.broadcast_to(b, shape), np.complex128)
+    x = np.empty(shape, np.complex128)
+    if batched_solve_kernel(Df.reshape(-1, n, n), bf.reshape(-1, n), x.reshape(-1, n)):
+        raise np.linalg.LinAlgError("Singular matrix")
+    return x

@@ -34,6 +34,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from powertrain.kernels import kernel_input
 from powertrain.kernels.two_port import kcp_gradient_kernel, two_port_kernel, two_ports_kernel
 
 #: Index of the ground (chassis) node in ``elem_nodes``.
@@ -140,14 +141,13 @@ def laplace_two_port(s, masses, elem_nodes, c, d, spring_scale=1.0, damper_scale
     sc = np.broadcast_to(np.asarray(spring_scale, float), lam.shape)
     t = sc if damper_scale is None else np.broadcast_to(np.asarray(damper_scale, float),
                                                         lam.shape)
-    flat = [np.ascontiguousarray(x.reshape(-1)) for x in (lam, sc, t)]
-    masses = np.ascontiguousarray(masses, float).reshape(-1)
+    flat = [kernel_input(x.reshape(-1), x.dtype) for x in (lam, sc, t)]
+    masses = kernel_input(np.reshape(masses, -1))
     out = [np.empty(flat[0].size, complex) for _ in range(3)]
     x = np.empty((flat[0].size if internal else 0, masses.size, 2), complex)
     status = two_port_kernel(*flat, masses,
-                             np.ascontiguousarray(np.asarray(elem_nodes, np.int64).reshape(-1, 2)),
-                             np.ascontiguousarray(c, float), np.ascontiguousarray(d, float),
-                             *out, x)
+                             kernel_input(np.reshape(elem_nodes, (-1, 2)), np.int64),
+                             kernel_input(c), kernel_input(d), *out, x)
     if status:
         raise FloatingPointError("mount network singular at some frequency (two-port pivot "
                                  "below tolerance)")
@@ -183,14 +183,14 @@ def laplace_two_ports(s, networks, spring_scales, damper_scales):
     lam = np.asarray(s, complex)
     n = packed.n_networks
     shape = lam.shape + (n,)
-    scales = [np.ascontiguousarray(np.broadcast_to(np.asarray(x, float), shape).reshape(-1, n))
+    scales = [kernel_input(np.broadcast_to(np.asarray(x, float), shape).reshape(-1, n).T)
               for x in (spring_scales, damper_scales)]
-    out = [np.empty((lam.size, n), complex) for _ in range(3)]
-    if two_ports_kernel(np.ascontiguousarray(lam.reshape(-1)), *scales, *packed.arrays(),
+    out = [np.empty((n, lam.size), complex) for _ in range(3)]
+    if two_ports_kernel(kernel_input(lam.reshape(-1), complex), *scales, *packed.arrays(),
                         *out):
         raise FloatingPointError("mount network singular at some frequency (two-port pivot "
                                  "below tolerance)")
-    return tuple(v.reshape(shape) for v in out)
+    return tuple(v.T.reshape(shape) for v in out)
 
 
 @dataclass(frozen=True, eq=False)
@@ -224,7 +224,8 @@ class PackedNetworks:
 
     def arrays(self) -> tuple:
         """The kernel's arguments ``(mass_ptr, masses, el_ptr, elem_nodes, c, d)``."""
-        return self.mass_ptr, self.masses, self.el_ptr, self.elem_nodes, self.c, self.d
+        return tuple(kernel_input(a, a.dtype) for a in (self.mass_ptr, self.masses, self.el_ptr,
+                                                          self.elem_nodes, self.c, self.d))
 
 
 def cross_point_stiffness(omega, masses, elem_nodes, c, d):
@@ -367,12 +368,10 @@ def cross_point_stiffness_gradient(omega, masses, elem_nodes, c, d):
     dk_dd : ndarray of complex, shape (n_freq, n_el)
         [1/s]
     """
-    omega = np.atleast_1d(np.asarray(omega, dtype=float))
-    masses = np.asarray(masses, dtype=float)
-    c = np.asarray(c, dtype=float)
-    d = np.asarray(d, dtype=float)
+    omega = kernel_input(np.atleast_1d(np.asarray(omega, dtype=float)))
+    masses, c, d = (kernel_input(x) for x in (masses, c, d))
     n = masses.size
-    B = incidence_matrix(n, elem_nodes)
+    B = kernel_input(incidence_matrix(n, elem_nodes))
     nf, n_el = omega.size, c.size
     kcp = np.empty(nf, dtype=complex)
     dk_dm = np.empty((nf, n), dtype=complex)

@@ -33,6 +33,7 @@ import numpy as np
 from powertrain.analysis.fourier import harmonic_amplitudes
 from powertrain.analysis.orders import ORDERS, order_spectrum
 from powertrain.assembly import NetworkScaling
+from powertrain.kernels import kernel_input
 from powertrain.kernels.port_forces import NONE
 from powertrain.kernels.small_solve import batched_solve_kernel
 from powertrain.physics.condensation import linear_two_ports
@@ -401,7 +402,8 @@ class ModalPortStepper(DenseNewmarkStepper):
                 kd[index] = law.describing_stiffness(a[index])
             kd = np.where(omegas[:n_h, None] == 0, 0.0, kd[None, :])
             u = np.empty((n_h, kd.shape[1]), complex)
-            if batched_solve_kernel(eye + Hp[:n_h] * kd[:, None, :], uf[:n_h], u):
+            if batched_solve_kernel(kernel_input(eye + Hp[:n_h] * kd[:, None, :], complex),
+                                    kernel_input(uf[:n_h], complex), u):
                 raise np.linalg.LinAlgError("singular equivalent-linear port feedback")
             return u, kd
 

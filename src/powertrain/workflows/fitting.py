@@ -31,6 +31,7 @@ from scipy.optimize import least_squares
 
 from powertrain.errors import InputError
 from powertrain.iotools.stiffness_csv import FREQUENCY, read_stiffness_csv
+from powertrain.kernels import kernel_input
 from powertrain.kernels.two_port import kcp_gradient_kernel
 from powertrain.models.mount import DEFAULT_TOPOLOGY, TOPOLOGIES, MountModel, Topology
 from powertrain.physics.mount_network import incidence_matrix
@@ -198,7 +199,8 @@ class NetworkProblem:
 
     def kcp(self, p):
         """K_CP [N/m] for SI parameters ``p`` (and fill the derivative buffers)."""
-        kcp_gradient_kernel(self.omega, self.B, self.to_m @ p, self.to_c @ p, self.to_d @ p,
+        kcp_gradient_kernel(*(kernel_input(x) for x in (self.omega, self.B, self.to_m @ p,
+                                                        self.to_c @ p, self.to_d @ p)),
                             self._kcp, self._dm, self._dc, self._dd)
         return self._kcp
 
