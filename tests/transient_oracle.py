@@ -21,8 +21,11 @@ form, the three laws written out here from their published formulas (none of
 Each network :math:`n` (deflection :math:`u = \mathbf r^T\mathbf x` from the zero-torque
 static point, where its curve deflection is :math:`\delta_0`) has its springs scaled by
 :math:`\kappa = f(\delta)\,s(A)` and its dampers by :math:`f(\delta)\,s(A)` and is loaded
-at its port by :math:`c = F(\delta) - F(\delta_0) - \kappa k_0 u` (:math:`k_0` its static
-stiffness at unit scale), so that its static force follows the curve. ``continuous=True``
+at its port by :math:`c = F(\delta) - F(\delta_0) - f k_0 (u - \bar u) - \kappa k_0 \bar u`
+(:math:`k_0` its static stiffness at unit scale, :math:`\bar u` its centre: the mean of
+:math:`u` over the stretch before, the deflection itself at the first), so that its static
+force is the curve plus :math:`(\kappa - f) k_0 (u - \bar u)`: the amplitude law on the
+motion about the centre. ``continuous=True``
 evaluates :math:`f` and :math:`c` at every instant (the curve itself); ``continuous=False``
 freezes them at every stretch's start (the stretch rule of
 :mod:`powertrain.solvers.transient`). The linear network matrices at unit scale are the
@@ -222,25 +225,28 @@ class Oracle:
         self.t, self.F = load_t, np.zeros((load_t.size, self.n))
         self.F[:, :6] = load_F
         self.continuous, self.deadline = continuous, deadline
-        self.scale = np.ones(len(els))
+        self.scale, self.centre = np.ones(len(els)), np.zeros(len(els))
         self.frozen = None
 
-    def set_stretch(self, x, amplitudes):
-        """The amplitude scales of the stretch and, for the stretch rule, its static
-        factors and curve loads at the state ``x``."""
+    def set_stretch(self, x, amplitudes, centres=None):
+        """The amplitude scales and centres of the stretch (default centre: the deflection
+        at ``x``) and, for the stretch rule, its static factors and curve loads at the
+        state ``x``."""
         self.scale = np.ones(self.k0.size)
         for k, law in zip(self.ia, self.amp_laws):
             self.scale[k] = power_scale(law, amplitudes[k])
+        self.centre = self.R @ x if centres is None else np.asarray(centres, float)
         self.frozen = None if self.continuous else self.static(self.R @ x)
 
     def static(self, u):
         """Static factors (n_net,) and curve loads c (n_net,) [N] at the deflections u."""
         f, c = np.ones(u.size), np.zeros(u.size)
         if self.ic.size:
-            force, tangent = self.curves(self.d0[self.ic] + u[self.ic])
-            f[self.ic] = tangent / self.curves.ref_tangent
-            kap = f[self.ic] * self.scale[self.ic] * self.k0[self.ic]
-            c[self.ic] = force - self.f0 - kap * u[self.ic]
+            i, ub = self.ic, self.centre[self.ic]
+            force, tangent = self.curves(self.d0[i] + u[i])
+            f[i] = tangent / self.curves.ref_tangent
+            kap = f[i] * self.scale[i] * self.k0[i]
+            c[i] = force - self.f0 - f[i] * self.k0[i] * (u[i] - ub) - kap * ub
         return f, c
 
     def parts(self, y):
@@ -272,7 +278,7 @@ class Oracle:
             u = self.R @ y[:self.n]
             tangent = self.curves(self.d0[self.ic] + u[self.ic])[1]
             dc = np.zeros(u.size)
-            dc[self.ic] = tangent - kap[self.ic] * self.k0[self.ic]
+            dc[self.ic] = tangent - tangent / self.curves.ref_tangent * self.k0[self.ic]
             K += self.R.T @ (dc[:, None] * self.R)
         J = np.zeros((2 * self.n, 2 * self.n))
         J[:self.n, self.n:] = np.eye(self.n)
@@ -326,12 +332,12 @@ def integrate(ode, every, rtol=1e-8, method="Radau", atol=None):
     y = np.zeros(2 * ode.n)
     U, force = np.empty((t_all.size, ode.R.shape[0])), np.empty((t_all.size,
                                                                   ode.fmap.shape[0]))
-    amplitudes = np.zeros(ode.R.shape[0])
+    amplitudes, centres = np.zeros(ode.R.shape[0]), None
     options = {"jac": ode.jac} if method in ("Radau", "BDF", "LSODA") else {}
     atol = 1e-3 * rtol if atol is None else atol
     events = ode.reversals()
     for lo, hi in zip(bounds[:-1], bounds[1:]):
-        ode.set_stretch(y[:ode.n], amplitudes)
+        ode.set_stretch(y[:ode.n], amplitudes, centres)
         t, grid = t_all[lo], t_all[lo:hi + 1]
         rows = [ode.outputs(y[None, :])]
         while True:
@@ -353,4 +359,5 @@ def integrate(ode, every, rtol=1e-8, method="Radau", atol=None):
         U[lo:hi + 1] = np.vstack([r[0] for r in rows])
         force[lo:hi + 1] = np.vstack([r[1] for r in rows])
         amplitudes = np.sqrt(2.0) * np.std(U[lo:hi], axis=0)
+        centres = U[lo:hi].mean(0)
     return U, force

@@ -10,20 +10,26 @@ port laws by Newton per step; the amplitude law once per stretch). Stretches are
 **Static curves, large deflection.** Coordinates are measured from the static operating
 point at zero mean torque (weight only, :func:`~powertrain.solvers.operating_point.operating_point`),
 whose network deflections are :math:`\delta_0`. At the start of every stretch, at the body's
-state :math:`\mathbf x_c`, each network with a static curve :math:`F(\delta)` is scaled by its
-static factor at :math:`\delta_c = \delta_0 + \mathbf r^T\mathbf x_c`
-(:meth:`MountElement.at_operating_point`: tangent stiffness :math:`k_c`) and loaded by the
-difference between the curve and that tangent,
+state :math:`\mathbf x_c` (network deflection :math:`u_c = \mathbf r^T\mathbf x_c`,
+:math:`\delta_c = \delta_0 + u_c`), each network with a static curve :math:`F(\delta)` is
+scaled by :math:`\kappa = f\,s`: its static factor :math:`f` at :math:`\delta_c`
+(:meth:`MountElement.at_operating_point`: the curve's tangent is :math:`f k_0`, :math:`k_0`
+the network's static stiffness) times its amplitude law's scale :math:`s`; and it is
+loaded by
 
-.. math:: c = F(\delta_c) - F(\delta_0) - k_c\,\mathbf r^T\mathbf x_c ,
+.. math:: c = F(\delta_c) - F(\delta_0) - f k_0\,(u_c - \bar u) - \kappa k_0\,\bar u ,
 
-so that over the stretch the static force is the curve's tangent at :math:`\delta_c`
-(:math:`F(\delta_c) - F(\delta_0) + k_c\,\mathbf r^T(\mathbf x - \mathbf x_c)`): the body
-moves along the curves (small rotations), the dynamic network and friction on top. The
-network's tangent :math:`k_c` is its static stiffness times its stiffness scale (static
-factor and amplitude law), so the curve sets the force at every stretch's start and the
-amplitude law acts on the motion within a stretch and on the dampers. Mount forces are
-changes from the zero-torque static point.
+where :math:`\bar u` is the network's centre, its mean deflection over the stretch before
+(at the first stretch :math:`u_c`). Over the stretch the static force is then
+
+.. math:: F(\delta_c) - F(\delta_0) + f k_0\,(u - u_c) + (\kappa - f)\,k_0\,(u - \bar u):
+
+the curve's tangent at :math:`\delta_c`, and the amplitude law's change of stiffness on the
+motion about the centre only. The body moves along the curves (small rotations) wherever it
+moves slowly, the amplitude law acts on the vibration about the mean deflection, and the
+dynamic network and friction are on top. As the stretches shorten, the curve part tends to
+the curve itself at every instant (tests/transient_oracle.py, ``continuous=True``). Mount
+forces are changes from the zero-torque static point.
 
 **Start.** At rest when the manoeuvre starts at standstill; else from the periodic steady
 state at its first speed and load (the equivalent-linear harmonic fixed point, port laws
@@ -50,7 +56,8 @@ from powertrain.solvers.transient_load import N_THETA, RPM, transient_load
 
 class StretchRuleWarning(UserWarning):
     """A mount direction has a static curve and an amplitude law: in a transient the law acts
-    per stretch about the curve's tangent, an approximation (docs/guide/transient.md)."""
+    per stretch on the motion about the mean deflection and the curve is linearised per
+    stretch, an approximation (docs/guide/transient.md)."""
 
 
 #: Length of a stretch [s]: the amplitude law and the static curves' tangents are updated
@@ -171,9 +178,10 @@ def _warn_curve_and_law(engine):
             if mod.static_curve is not None and mod.amplitude_law is not None]
     if both:
         warnings.warn(f"{', '.join(both)}: static curve and amplitude law together; in a "
-                      f"transient the law acts per {STRETCH * 1e3:g} ms stretch about the "
-                      "curve's tangent, peaks can differ from the continuous curve by tens "
-                      "of % (docs/guide/transient.md)", StretchRuleWarning, stacklevel=3)
+                      f"transient the law acts per {STRETCH * 1e3:g} ms stretch on the motion "
+                      "about the mean deflection and the curve is linearised per stretch: "
+                      "peaks can differ from the curve evaluated at every instant by about "
+                      "10 % (docs/guide/transient.md)", StretchRuleWarning, stacklevel=3)
 
 
 def _method(integrator, curves, every):
@@ -199,10 +207,11 @@ def _run(system, integrator, ports, curves, F, start, every):
     scales, loads = np.empty((n_t, n_net, 2)), np.zeros((n_t, n_net))
     laws_map = integrator.laws.force_map
     bounds = list(range(0, n_t - 1, every)) + [n_t - 1]
+    centres = None
     for lo, hi in zip(bounds[:-1], bounds[1:]):
         net_amplitudes = ports.network_amplitudes(amplitudes)
         factors, c = (None, None) if curves is None else curves.at(
-            x, integrator.scaling, net_amplitudes)
+            x, integrator.scaling, net_amplitudes, centres)
         Fs = F[lo:hi + 1] if c is None else F[lo:hi + 1] - c @ system.port_rows
         (Xs, Vs, As, Zs), (Fk, Fd, off) = integrator.run(Fs, (x, v, a), amplitudes, state,
                                                         factors)
@@ -219,6 +228,7 @@ def _run(system, integrator, ports, curves, F, start, every):
         force[rows] = f
         if integrator.varying:
             amplitudes = cycle_amplitudes(Xs[:-1] @ ports.rows.T)
+        centres = (Xs[:-1] @ system.port_rows.T).mean(0)
         x, v, a = Xs[-1], Vs[-1], As[-1]
     return X, V, A, force, (Z, scales, loads)
 
@@ -298,16 +308,25 @@ class _Curves:
         """Static factor of every network at the state ``x`` (1 without a curve)."""
         return np.where(self.has, self._read(self.tangent, self.d0 + self.rows @ x), 1.0)
 
-    def at(self, x, scaling, amplitudes):
-        """Static factors and the curves' load ``c`` (n_net,) [N] at the state ``x``, the
-        networks' tangent stiffness their static stiffness times their stiffness scale at
-        the static factors and the networks' ``amplitudes`` [m] (``scaling.scales``)."""
+    def at(self, x, scaling, amplitudes, centres=None):
+        r"""Static factors and the curves' load ``c`` (n_net,) [N] at the state ``x``:
+        with the network stiffness :math:`\kappa k_0` (its static stiffness times its
+        stiffness scale at the static factors and the networks' ``amplitudes`` [m],
+        ``scaling.scales``) and the curve's tangent :math:`f k_0` there,
+        :math:`c = F(\delta_c) - F(\delta_0) - f k_0 (u_c - \bar u) - \kappa k_0 \bar u`
+        about the networks' ``centres`` :math:`\bar u` [m] (the mean deflection over the
+        stretch before; default: the deflection at ``x``), so that the static force is the
+        curve's tangent at :math:`u_c` plus :math:`(\kappa - f) k_0 (u - \bar u)`: the
+        amplitude law acts on the motion about the centre and the curve on the rest
+        (module docstring)."""
         u = self.rows @ x
+        centres = u if centres is None else centres
         d = self.d0 + u
         factors = np.where(self.has, self._read(self.tangent, d), 1.0)
         k = scaling.scales(amplitudes, factors)[:, 0] * self.stiffness
-        c = np.where(self.has, self._read(self.force, d) - self.f0 - k * u, 0.0)
-        return factors, c
+        tangent = factors * self.stiffness
+        c = self._read(self.force, d) - self.f0 - tangent * (u - centres) - k * centres
+        return factors, np.where(self.has, c, 0.0)
 
 
 def _sampled(curve):
