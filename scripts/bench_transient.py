@@ -20,8 +20,9 @@ best of ``--repeat``:
   (its time includes computing the manoeuvre's load), with the Jacobian for the implicit
   methods (analytic but for the static factors' slope). Two systems: the **stretch rule**
   (the static curves' tangent and load frozen for
-  :data:`~powertrain.solvers.transient.STRETCH`, as ours: the same system, the ratio of the
-  last line) and the **continuous curve** (the curve itself at every instant:
+  :data:`~powertrain.solvers.transient.CURVE_STEP`, the amplitude law's scale and centres
+  for :data:`~powertrain.solvers.transient.STRETCH`, as ours: the same system, the ratio of
+  the last line) and the **continuous curve** (the curve itself at every instant:
   ours then also carries the stretch rule's error);
 * the small case of tests/test_transient.py (6-DOF body, Kelvin-Voigt mounts, one direction
   nonlinear, a 0.3 s flare from rest), the same comparison on the stretch rule, its own
@@ -49,7 +50,7 @@ from bench_nonlinear_runup import BERG, POWER
 from powertrain.iotools.engine_file import DEFAULT_ENGINE_PATH, read_engine
 from powertrain.iotools.manoeuvre_file import read_manoeuvre
 from powertrain.models.manoeuvre import Manoeuvre
-from powertrain.solvers.transient import STRETCH, StretchRuleWarning, simulate_transient
+from powertrain.solvers.transient import StretchRuleWarning, simulate_transient
 from powertrain.solvers.transient_load import transient_load
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -94,7 +95,7 @@ class Case:
         self.engine, self.m, self.continuous = engine, manoeuvre, continuous
         self.system = engine.assemble()
         self.run = simulate_transient(engine, manoeuvre, system=self.system)
-        self.every = max(1, round(STRETCH / (self.run.load.t[1] - self.run.load.t[0])))
+        self.every, self.sub = self.run.stretch_steps, self.run.curve_steps
 
     def ours(self):
         return simulate_transient(self.engine, self.m, system=self.system)
@@ -104,7 +105,7 @@ class Case:
         load = transient_load(self.engine, self.m, t)
         deadline = None if cap is None else time.process_time() + cap
         ode = Oracle(self.engine, self.system, t, load.F, self.continuous, deadline)
-        return integrate(ode, self.every, rtol, method)
+        return integrate(ode, self.every, rtol, method, curve_every=self.sub)
 
 
 def fastest_peer(case, ref, err, repeat, label):

@@ -27,7 +27,7 @@ at its port by :math:`c = F(\delta) - F(\delta_0) - f k_0 (u - \bar u) - \kappa 
 force is the curve plus :math:`(\kappa - f) k_0 (u - \bar u)`: the amplitude law on the
 motion about the centre. ``continuous=True``
 evaluates :math:`f` and :math:`c` at every instant (the curve itself); ``continuous=False``
-freezes them at every stretch's start (the stretch rule of
+freezes them at every curve update (``integrate``'s ``curve_every``: the stretch rule of
 :mod:`powertrain.solvers.transient`). The linear network matrices at unit scale are the
 assembled model's (:meth:`AssembledSystem.network_parts`). Used by tests/test_transient.py
 and scripts/bench_transient.py.
@@ -236,6 +236,10 @@ class Oracle:
         for k, law in zip(self.ia, self.amp_laws):
             self.scale[k] = power_scale(law, amplitudes[k])
         self.centre = self.R @ x if centres is None else np.asarray(centres, float)
+        self.freeze(x)
+
+    def freeze(self, x):
+        """For the stretch rule, the static factors and curve loads at the state ``x``."""
         self.frozen = None if self.continuous else self.static(self.R @ x)
 
     def static(self, u):
@@ -323,10 +327,12 @@ class Oracle:
         return self.events
 
 
-def integrate(ode, every, rtol=1e-8, method="Radau", atol=None):
+def integrate(ode, every, rtol=1e-8, method="Radau", atol=None, curve_every=None):
     """Network deflections and channel forces (n_t, n_net), (n_t, n_ch) at the load's
     times, stretch by stretch from rest (``solve_ivp``'s ``method``; ``atol`` default
-    ``1e-3 rtol``, a millimetre's share; :meth:`Oracle.jac` for the implicit methods)."""
+    ``1e-3 rtol``, a millimetre's share; :meth:`Oracle.jac` for the implicit methods); for
+    the stretch rule the curves frozen anew every ``curve_every`` steps (default: each
+    stretch's start)."""
     t_all = ode.t
     bounds = list(range(0, t_all.size - 1, every)) + [t_all.size - 1]
     y = np.zeros(2 * ode.n)
@@ -334,30 +340,42 @@ def integrate(ode, every, rtol=1e-8, method="Radau", atol=None):
                                                                   ode.fmap.shape[0]))
     amplitudes, centres = np.zeros(ode.R.shape[0]), None
     options = {"jac": ode.jac} if method in ("Radau", "BDF", "LSODA") else {}
-    atol = 1e-3 * rtol if atol is None else atol
-    events = ode.reversals()
+    solver = dict(method=method, rtol=rtol, atol=1e-3 * rtol if atol is None else atol,
+                  events=ode.reversals() or None, **options)
+    sub = every if curve_every is None else curve_every
     for lo, hi in zip(bounds[:-1], bounds[1:]):
         ode.set_stretch(y[:ode.n], amplitudes, centres)
-        t, grid = t_all[lo], t_all[lo:hi + 1]
         rows = [ode.outputs(y[None, :])]
-        while True:
-            try:
-                sol = solve_ivp(ode, (t, t_all[hi]), y, method=method, rtol=rtol, atol=atol,
-                                dense_output=True, events=events or None, **options)
-            except ValueError as exc:          # an event's root outside its bracket
-                raise RuntimeError(f"solve_ivp {method}: {exc}") from exc
-            inside = grid[(grid > t) & (grid <= sol.t[-1])]
-            if inside.size:
-                rows.append(ode.outputs(sol.sol(inside).T))
-            y = sol.y[:, -1]
-            if sol.status == -1:
-                raise RuntimeError(f"solve_ivp {method}: {sol.message}")
-            if sol.status != 1:
-                break
-            t = sol.t[-1]
-            ode.reverse(sol.t_events, t, y)
+        cuts = list(range(lo, hi, sub)) + [hi]
+        for p, q in zip(cuts[:-1], cuts[1:]):
+            if p != lo:             # the update's instant reported with the new curve loads
+                ode.freeze(y[:ode.n])
+                u_last, f_last = rows[-1]
+                rows[-1] = (u_last, np.vstack([f_last[:-1], ode.outputs(y[None, :])[1]]))
+            y = _piece(ode, t_all[p:q + 1], y, solver, rows)
         U[lo:hi + 1] = np.vstack([r[0] for r in rows])
         force[lo:hi + 1] = np.vstack([r[1] for r in rows])
         amplitudes = np.sqrt(2.0) * np.std(U[lo:hi], axis=0)
         centres = U[lo:hi].mean(0)
     return U, force
+
+
+def _piece(ode, grid, y, solver, rows):
+    """Integrate from ``grid[0]`` to ``grid[-1]`` through the Berg reversals, appending the
+    outputs at ``grid[1:]`` to ``rows``; the end state."""
+    t = grid[0]
+    while True:
+        try:
+            sol = solve_ivp(ode, (t, grid[-1]), y, dense_output=True, **solver)
+        except ValueError as exc:          # an event's root outside its bracket
+            raise RuntimeError(f"solve_ivp {solver['method']}: {exc}") from exc
+        inside = grid[(grid > t) & (grid <= sol.t[-1])]
+        if inside.size:
+            rows.append(ode.outputs(sol.sol(inside).T))
+        y = sol.y[:, -1]
+        if sol.status == -1:
+            raise RuntimeError(f"solve_ivp {solver['method']}: {sol.message}")
+        if sol.status != 1:
+            return y
+        t = sol.t[-1]
+        ode.reverse(sol.t_events, t, y)

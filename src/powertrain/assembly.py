@@ -330,7 +330,8 @@ class NetworkScaling:
             if el.amplitude_law is not None:
                 laws.setdefault(el.amplitude_law, []).append(k)
         self._laws = {law: np.array(index) for law, index in laws.items()}
-        self._static_factors = np.array([el.static_factor for el in self.elements], float)
+        #: every network's static factor as assembled (1 without a static curve)
+        self.static_factors = np.array([el.static_factor for el in self.elements], float)
         #: the scales the assembled matrices hold (every element at amplitude 0)
         self.assembled = self.scales(np.zeros(len(self.elements)))
         #: True when some network's scale follows its amplitude
@@ -345,7 +346,7 @@ class NetworkScaling:
         a = np.asarray(amplitudes, float)
         for law, index in self._laws.items():
             out[index, 0], out[index, 1] = law.scales(a[index])
-        f = self._static_factors if factors is None else np.asarray(factors, float)
+        f = self.static_factors if factors is None else np.asarray(factors, float)
         return out * f[:, None]
 
     def matrices(self, scales):

@@ -132,13 +132,15 @@ class CycleIntegrator:
         self.varying = scaling.varying
         self._first = None
 
-    def run(self, F, start, amplitudes, state, factors=None):
+    def run(self, F, start, amplitudes, state, factors=None, scales=None):
         """States ``(X, V, A, Z)`` over the load rows ``F`` (k + 1, n) [N] from ``start``
         = (x, v, a) (row 0), the port-law ``state`` updated in place, and the stretch's
-        force rows ``(Fk, Fd, offset)`` (:class:`CycleRun`)."""
+        force rows ``(Fk, Fd, offset)`` (:class:`CycleRun`); ``scales`` (n_net, 2), where
+        given, are the networks' scales at ``amplitudes`` and ``factors``."""
         s = self.scaling
-        C, K, Fk, Fd = s.matrices(s.scales(self.ports.network_amplitudes(amplitudes),
-                                           factors))
+        if scales is None:
+            scales = s.scales(self.ports.network_amplitudes(amplitudes), factors)
+        C, K, Fk, Fd = s.matrices(scales)
         self._first = self._first or (K, Fk)
         shifted = K is not self._first[0]
         load = F + (K - self._first[0]) @ self.mean if shifted else F
