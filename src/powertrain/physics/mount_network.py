@@ -215,7 +215,8 @@ class PackedNetworks:
                   for i in (0, 2, 3)]
         nodes = np.concatenate([np.asarray(net[1], np.int64).reshape(-1, 2)
                                 for net in networks])
-        return cls(ptr[0], arrays[0], ptr[1], nodes, arrays[1], arrays[2])
+        return cls(*(kernel_input(a, a.dtype) for a in (ptr[0], arrays[0], ptr[1], nodes,
+                                                        arrays[1], arrays[2])))
 
     @property
     def n_networks(self) -> int:
@@ -223,9 +224,9 @@ class PackedNetworks:
         return self.mass_ptr.size - 1
 
     def arrays(self) -> tuple:
-        """The kernel's arguments ``(mass_ptr, masses, el_ptr, elem_nodes, c, d)``."""
-        return tuple(kernel_input(a, a.dtype) for a in (self.mass_ptr, self.masses, self.el_ptr,
-                                                          self.elem_nodes, self.c, self.d))
+        """The kernel's arguments ``(mass_ptr, masses, el_ptr, elem_nodes, c, d)`` (read-only
+        and contiguous since :meth:`of`)."""
+        return self.mass_ptr, self.masses, self.el_ptr, self.elem_nodes, self.c, self.d
 
 
 def cross_point_stiffness(omega, masses, elem_nodes, c, d):

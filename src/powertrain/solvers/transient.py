@@ -61,11 +61,11 @@ from powertrain.solvers.transient_load import N_THETA, RPM, transient_load
 
 class StretchRuleWarning(UserWarning):
     """A mount direction has a static curve and an amplitude law: in a transient the law acts
-    per stretch on the motion about the mean deflection and the curve is linearised per
-    stretch, an approximation (docs/guide/transient.md)."""
+    per stretch on the motion about the mean deflection, its amplitude each stretch's, a
+    model choice (docs/guide/transient.md)."""
 
 
-#: Length of a stretch [s]: the amplitude law and the static curves' tangents are updated
+#: Length of a stretch [s]: the amplitude law's scales and the networks' centres are updated
 #: this often (a rigid-body mode of 12 Hz is 8 stretches per period).
 STRETCH = 0.01
 #: Interval [s] at which the static curves' tangents and load are updated (a whole number

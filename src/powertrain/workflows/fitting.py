@@ -171,13 +171,13 @@ class NetworkProblem:
 
     def __init__(self, topology: Topology, frequency_hz, kcp_measured, max_mass=None):
         self.topology = topology
-        self.omega = 2 * np.pi * np.asarray(frequency_hz, float)
+        self.omega = kernel_input(2 * np.pi * np.asarray(frequency_hz, float))
         self.km = np.asarray(kcp_measured, complex)
         self.norm = float(np.sqrt(np.sum(np.abs(self.km) ** 2)))
         self.lo, self.hi = parameter_box(topology, frequency_hz, kcp_measured, max_mass)
         names = topology.parameters
         n_el, n = len(topology.elements), topology.n_internal
-        self.B = incidence_matrix(n, topology.elem_nodes)
+        self.B = kernel_input(incidence_matrix(n, topology.elem_nodes))
         self.to_c = np.zeros((n_el, len(names)))
         self.to_d = np.zeros((n_el, len(names)))
         self.to_m = np.zeros((n, len(names)))
@@ -199,8 +199,8 @@ class NetworkProblem:
 
     def kcp(self, p):
         """K_CP [N/m] for SI parameters ``p`` (and fill the derivative buffers)."""
-        kcp_gradient_kernel(*(kernel_input(x) for x in (self.omega, self.B, self.to_m @ p,
-                                                        self.to_c @ p, self.to_d @ p)),
+        kcp_gradient_kernel(self.omega, self.B,
+                            *(kernel_input(T @ p) for T in (self.to_m, self.to_c, self.to_d)),
                             self._kcp, self._dm, self._dc, self._dd)
         return self._kcp
 
