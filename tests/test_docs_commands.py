@@ -358,12 +358,14 @@ def run_in_process(argvs: list, cwd: Path) -> tuple:
     return code, out, err
 
 
-def run_command(cmd: Command, cwd: Path, env: dict, printed: list | None = None):
+def run_command(cmd: Command, cwd: Path, env: dict, printed: list | None = None,
+                in_process: bool = True):
     """Run one command; the failure message (None if it passed). ``powertrain`` commands that
-    need no shell run in this process (:func:`run_in_process`), others in ``bash``, whose
-    whole process group is killed on timeout. ``printed`` (if given) receives
-    ``(stdout, stderr)``."""
-    argvs = in_process_argvs(cmd.text)
+    need no shell run in this process (:func:`run_in_process`) unless ``in_process`` is
+    False (the wheel test: the installed console script, not this source tree), others in
+    ``bash``, whose whole process group is killed on timeout. ``printed`` (if given)
+    receives ``(stdout, stderr)``."""
+    argvs = in_process_argvs(cmd.text) if in_process else None
     if argvs is not None:
         try:
             returncode, out, err = run_in_process(argvs, cwd)

@@ -11,6 +11,7 @@ no editable install of this checkout), and the wheel is installed with ``--no-de
 from __future__ import annotations
 
 import os
+import shutil
 import site
 import subprocess
 import sys
@@ -126,7 +127,9 @@ def test_wheel_runs_the_readme_unchanged_in_an_empty_folder(tmp_path):
     """Issue 18: every command README.md shows (the front door's main job, then the
     five-minute tour), as shown, in an empty folder after a wheel install; each named output
     exists and each shown output matches (the docs test's rules, tests/test_docs_commands.py,
-    which leaves README.md to this test so that its commands run once)."""
+    which leaves README.md to this test so that its commands run once). Each command runs in
+    its own process through the wheel's console script, so that the package data and the
+    kernels' first compilation are the installed ones."""
     from test_docs_commands import check_shown, commands_of, run_command, shown_outputs
     venv_dir, env = _install_wheel(tmp_path)
     _check_no_scaffolding(next((tmp_path / "wheels").glob("powertrain-*.whl")))
@@ -136,13 +139,16 @@ def test_wheel_runs_the_readme_unchanged_in_an_empty_folder(tmp_path):
     where = subprocess.run(["python", "-c", "import powertrain; print(powertrain.__file__)"],
                            capture_output=True, text=True, env=env, cwd=empty, check=True)
     assert Path(where.stdout.strip()).resolve().is_relative_to(venv_dir.resolve())
+    script = shutil.which("powertrain", path=env["PATH"])
+    assert script and Path(script).resolve().is_relative_to(venv_dir.resolve()), script
     commands = [c for c in commands_of(ROOT / "README.md") if c.text]
     tour = [c.text for c in commands_of(readme_tour(tmp_path), root=tmp_path)]
     assert len(tour) >= 8 and tour[0] == "powertrain examples ."
     assert [c.text for c in commands][-len(tour):] == tour
     printed = {}
     for cmd in commands:
-        failure = run_command(cmd, empty, env, printed.setdefault(cmd.block, []))
+        failure = run_command(cmd, empty, env, printed.setdefault(cmd.block, []),
+                              in_process=False)     # the wheel's console script
         assert failure is None, failure
     for shown in shown_outputs(ROOT / "README.md"):
         failure = check_shown(shown, printed.get(shown.block, []))

@@ -159,11 +159,8 @@ def order_style(order) -> dict:
 def quantity_style(quantity: str) -> dict:
     """Colour and line style of a run-up quantity: ``synthesis`` and ``overall`` black
     (solid, dashed), an order as :func:`order_style`."""
-    if quantity == "synthesis":
-        return {"color": "k", "ls": "-"}
-    if quantity == "overall":
-        return {"color": "k", "ls": "--"}
-    return order_style(quantity)
+    totals = {"synthesis": "-", "overall": "--"}
+    return {"color": "k", "ls": totals[quantity]} if quantity in totals else order_style(quantity)
 
 
 def _use_palette(axes):
@@ -202,22 +199,24 @@ def finish(fig, own, path=None, provenance=None, title=None):
             fig.legends[0].get_title().set_multialignment("center")
         else:
             fig.suptitle(text, fontsize=9)
+    laid_out = False
     if own:
         add_provenance(fig, provenance)
-        keep_inside(fig)
+        laid_out = keep_inside(fig)
     if path:
-        save_figure(fig, path)
+        save_figure(fig, path, laid_out=laid_out)
     return fig
 
 
-def keep_inside(fig, tries=3):
+def keep_inside(fig, tries=3) -> bool:
     """Shrink the constrained-layout area of a top-level figure by as much as any text
     (a tick label or a panel title wider than its panel in the last column) overhangs the
     figure's edges: constrained layout keeps such overhangs inside the figure only when its
-    area is the whole figure, not with the provenance strip or a ``supylabel``."""
+    area is the whole figure, not with the provenance strip or a ``supylabel``. True when
+    the figure is laid out as last drawn here, nothing overhanging."""
     engine = fig.get_layout_engine()
     if engine is None or "rect" not in engine.get():
-        return
+        return False
     for _ in range(tries):
         fig.draw_without_rendering()   # the layout, computed at drawing time (no pixels)
         width, height = fig.get_figwidth(), fig.get_figheight()
@@ -225,10 +224,11 @@ def keep_inside(fig, tries=3):
         over = np.array([-box.x0, -box.y0, box.x1 - width, box.y1 - height])
         over = np.maximum(over, 0) + np.where(over > 0, 1 / 72, 0)   # 1 pt clear of the edge
         if not over.any():
-            return
+            return True
         x0, y0, w, h = engine.get()["rect"]
         engine.set(rect=(x0 + over[0] / width, y0 + over[1] / height,
                          w - (over[0] + over[2]) / width, h - (over[1] + over[3]) / height))
+    return False
 
 
 # ------------------------------------------------------------------ text
@@ -470,10 +470,19 @@ def figure_legend(fig, axes, extra=(), fontsize=LEGEND_SIZE):
 
 
 # ------------------------------------------------------------------ output
-def save_figure(fig, path):
-    """Save a figure as PNG atomically (no half-written file on failure)."""
+def save_figure(fig, path, laid_out=False):
+    """Save a figure as PNG atomically (no half-written file on failure); ``laid_out``: in
+    the layout :func:`keep_inside` has just made, its engine held off while saving."""
+    root = root_figure(fig)
+    engine = root.get_layout_engine() if laid_out else None
     with atomic_path(path) as tmp:
-        root_figure(fig).savefig(tmp, dpi=DPI, format="png")
+        if engine is not None:
+            root.set_layout_engine("none")
+        try:
+            root.savefig(tmp, dpi=DPI, format="png")
+        finally:
+            if engine is not None:
+                root.set_layout_engine(engine)
 
 
 def target_and_path(ax, path):
