@@ -30,9 +30,11 @@ best of ``--repeat``:
 
 Last line: ``linear_s=... nonlinear_s=... newmark_s=... solve_ivp_s=... ratio=...
 solve_ivp_method=... solve_ivp_rtol=...`` then ``error=... ratio_continuous=...
-error_continuous=...``: ``newmark_s`` is our time on the compared case (the fully nonlinear
-start), ``error`` ours against the stretch-rule reference, ``error_continuous`` against the
-continuous-curve one.
+error_continuous=... kernel_s=... ratio_kernel=...``: ``newmark_s`` is our time on the
+compared case (the fully nonlinear start), ``error`` ours against the stretch-rule reference,
+``error_continuous`` against the continuous-curve one, ``kernel_s`` the part of ``newmark_s``
+inside the time-step kernels (:func:`kernel_cpu`) and ``ratio_kernel`` the peer's time over
+it: the ratio's ceiling with the curves' and laws' updates between kernel calls free.
 """
 
 from __future__ import annotations
@@ -61,6 +63,28 @@ from transient_oracle import Oracle, integrate, with_curve_laws, write_case  # n
 def fully_nonlinear(engine):
     """Every mount direction with a static curve, the power law and Berg's friction."""
     return with_curve_laws(engine, port_law=BERG, amplitude_law=POWER)
+
+
+def kernel_cpu(run):
+    """CPU time [s] spent inside the time-step kernels (``newmark_kernel``,
+    ``newmark_port_kernel``) during ``run()``: ours' time were everything around them (the
+    curves' and laws' updates between the kernel calls, the force rows) free."""
+    import powertrain.solvers.newmark as nm
+    spent, kernels = [0.0], (nm.newmark_kernel, nm.newmark_port_kernel)
+
+    def timed(kernel):
+        def call(*args):
+            t0 = time.process_time()
+            out = kernel(*args)
+            spent[0] += time.process_time() - t0
+            return out
+        return call
+    nm.newmark_kernel, nm.newmark_port_kernel = map(timed, kernels)
+    try:
+        run()
+    finally:
+        nm.newmark_kernel, nm.newmark_port_kernel = kernels
+    return spent[0]
 
 
 def best_cpu(run, repeat):
@@ -168,10 +192,14 @@ def main():
     err, peer_s, method, rtol = compare(case, ours_s, args.repeat, "stretch rule")
     cont = Case(nonlinear_engine, start, continuous=True)
     err_c, peer_c, *_ = compare(cont, ours_s, args.repeat, "continuous curve")
+    kernel_s = min(kernel_cpu(case.ours) for _ in range(args.repeat))
+    print(f"of ours {ours_s:.4f} s, {kernel_s:.4f} s inside the time-step kernels: were "
+          f"everything around them free, the ratio would be {peer_s / kernel_s:.0f}")
     print(f"linear_s={linear:.4f} nonlinear_s={nonlinear:.4f} newmark_s={ours_s:.4f} "
           f"solve_ivp_s={peer_s:.3f} ratio={peer_s / ours_s:.0f} "
           f"solve_ivp_method={method} solve_ivp_rtol={rtol:.0e} error={err:.1e} "
-          f"ratio_continuous={peer_c / ours_s:.0f} error_continuous={err_c:.1e}")
+          f"ratio_continuous={peer_c / ours_s:.0f} error_continuous={err_c:.1e} "
+          f"kernel_s={kernel_s:.4f} ratio_kernel={peer_s / kernel_s:.0f}")
 
 
 def small(repeat):
