@@ -191,9 +191,7 @@ def newmark_port_kernel(G, H, Fs, h, x0, v0, a0, W, P, Q, kinds, par, state, X, 
     the largest force), or after ``max_iter`` iterations. Returns the number of steps at
     which Newton did not converge (0 on success).
     """
-    n = x0.shape[0]
-    m = kinds.shape[0]
-    ns = Fs.shape[0]
+    n, m, ns = x0.shape[0], kinds.shape[0], Fs.shape[0]
     hh = 0.25 * h * h
     hv = 0.5 * h
     xt, vt = np.empty(n), np.empty(n)
@@ -328,8 +326,11 @@ def _predict(ul, vl, qv, last, z):
 
 @njit(cache=True, nogil=True)
 def _coupling(Qu, qv):
-    """``(Qu, qv, qa)`` of :func:`_port_forces_step`, ``qa`` the row sums of |Qu|."""
-    return Qu, qv, np.abs(Qu).sum(axis=1)
+    """``(Qu, qv, qa)``, ``qa`` the row sums of |Qu| (looped: NumPy's costs a compile)."""
+    qa = np.zeros(Qu.shape[0])
+    for i, j in np.ndindex(Qu.shape):
+        qa[i] += abs(Qu[i, j])
+    return Qu, qv, qa
 
 
 @njit(cache=True, nogil=True, inline="always")
