@@ -1,7 +1,7 @@
 #!/usr/bin/env python
 """CPU time of transient manoeuvres (issue 38) and the same start by ``solve_ivp``, in one
-process, warm (the Numba kernels compiled and cached before timing), ``time.process_time``,
-best of ``--repeat``:
+process, warm (the Numba kernels compiled and cached before timing), ``time.process_time``
+with BLAS on one thread, best of ``--repeat``:
 
 * the 3 s start of ``examples/start.toml`` (0 -> cranking -> flare to 1150 rpm -> idle) on
   the default engine, linear mounts;
@@ -33,8 +33,8 @@ solve_ivp_method=... solve_ivp_rtol=...`` then ``error=... ratio_continuous=...
 error_continuous=... kernel_s=... ratio_kernel=...``: ``newmark_s`` is our time on the
 compared case (the fully nonlinear start), ``error`` ours against the stretch-rule reference,
 ``error_continuous`` against the continuous-curve one, ``kernel_s`` the part of ``newmark_s``
-inside the time-step kernels (:func:`kernel_cpu`) and ``ratio_kernel`` the peer's time over
-it: the ratio's ceiling with the curves' and laws' updates between kernel calls free.
+inside the stretch kernel (:func:`kernel_cpu`) and ``ratio_kernel`` the peer's time over
+it: the ratio's ceiling with everything around the kernel free.
 """
 
 from __future__ import annotations
@@ -48,6 +48,7 @@ from pathlib import Path
 
 import numpy as np
 from bench_nonlinear_runup import BERG, POWER
+from threadpoolctl import threadpool_limits
 
 from powertrain.iotools.engine_file import DEFAULT_ENGINE_PATH, read_engine
 from powertrain.iotools.manoeuvre_file import read_manoeuvre
@@ -66,24 +67,23 @@ def fully_nonlinear(engine):
 
 
 def kernel_cpu(run):
-    """CPU time [s] spent inside the time-step kernels (``newmark_kernel``,
-    ``newmark_port_kernel``) during ``run()``: ours' time were everything around them (the
-    curves' and laws' updates between the kernel calls, the force rows) free."""
-    import powertrain.solvers.newmark as nm
-    spent, kernels = [0.0], (nm.newmark_kernel, nm.newmark_port_kernel)
+    """CPU time [s] spent inside the stretch kernel
+    (:func:`~powertrain.kernels.transient.transient_stretch_kernel`: the curves' updates and
+    the Newmark steps) during ``run()``: ours' time were everything around it (the amplitude
+    law once per stretch, the load, the start, the force rows) free."""
+    import powertrain.solvers.transient as tr
+    spent, kernel = [0.0], tr.transient_stretch_kernel
 
-    def timed(kernel):
-        def call(*args):
-            t0 = time.process_time()
-            out = kernel(*args)
-            spent[0] += time.process_time() - t0
-            return out
-        return call
-    nm.newmark_kernel, nm.newmark_port_kernel = map(timed, kernels)
+    def timed(*args):
+        t0 = time.process_time()
+        out = kernel(*args)
+        spent[0] += time.process_time() - t0
+        return out
+    tr.transient_stretch_kernel = timed
     try:
         run()
     finally:
-        nm.newmark_kernel, nm.newmark_port_kernel = kernels
+        tr.transient_stretch_kernel = kernel
     return spent[0]
 
 
@@ -193,8 +193,8 @@ def main():
     cont = Case(nonlinear_engine, start, continuous=True)
     err_c, peer_c, *_ = compare(cont, ours_s, args.repeat, "continuous curve")
     kernel_s = min(kernel_cpu(case.ours) for _ in range(args.repeat))
-    print(f"of ours {ours_s:.4f} s, {kernel_s:.4f} s inside the time-step kernels: were "
-          f"everything around them free, the ratio would be {peer_s / kernel_s:.0f}")
+    print(f"of ours {ours_s:.4f} s, {kernel_s:.4f} s inside the stretch kernel: were "
+          f"everything around it free, the ratio would be {peer_s / kernel_s:.0f}")
     print(f"linear_s={linear:.4f} nonlinear_s={nonlinear:.4f} newmark_s={ours_s:.4f} "
           f"solve_ivp_s={peer_s:.3f} ratio={peer_s / ours_s:.0f} "
           f"solve_ivp_method={method} solve_ivp_rtol={rtol:.0e} error={err:.1e} "
@@ -217,4 +217,7 @@ def small(repeat):
 
 
 if __name__ == "__main__":
-    main()
+    # CPU time counts every thread: BLAS on one, for ours and the peer alike (at these sizes
+    # more threads add CPU time without saving any)
+    with threadpool_limits(limits=1, user_api="blas"):
+        main()

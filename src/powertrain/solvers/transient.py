@@ -1,10 +1,11 @@
 r"""A transient manoeuvre integrated in time by the run-up's nonlinear stepper.
 
 The load of :mod:`powertrain.solvers.transient_load` at every step drives the model of
-:meth:`Engine.assemble` (rigid ground, modal body, base compliance) through
-:class:`~powertrain.solvers.cycle_newmark.CycleIntegrator`, the stretch-by-stretch Newmark
-stepper of the continuous sweep and of the dense run-up stepper (average acceleration; the
-port laws by Newton per step; the amplitude law once per stretch). Stretches are
+:meth:`Engine.assemble` (rigid ground, modal body, base compliance) through the dense Newmark
+step of the run-up's dense stepper and the continuous sweep (average acceleration; the port
+laws by Newton per step, :func:`~powertrain.kernels.port_forces.newmark_port_kernel`), a
+stretch at a time (:func:`~powertrain.kernels.transient.transient_stretch_kernel`, the
+curves' updates inside it; the amplitude law once per stretch). Stretches are
 :data:`STRETCH` long (a linear model without static curves is one stretch); the static
 curves are updated every :data:`CURVE_STEP`. Where the laws change (a new stretch or
 curve update) the integration restarts from the position and velocity, the acceleration
@@ -53,7 +54,9 @@ import numpy as np
 from powertrain.assembly import NetworkScaling
 from powertrain.errors import InputError
 from powertrain.kernels.port_forces import NONE
-from powertrain.solvers.cycle_newmark import CycleIntegrator, cycle_amplitudes, no_ports, start_state
+from powertrain.kernels.transient import transient_stretch_kernel
+from powertrain.solvers.cycle_newmark import cycle_amplitudes, no_ports, start_state
+from powertrain.solvers.newmark import PORT_MAX_ITER, PORT_TOL
 from powertrain.solvers.operating_point import StaticSupport, has_static_curves, operating_point
 from powertrain.solvers.steppers import Cycles, DenseNewmarkStepper
 from powertrain.solvers.transient_load import N_THETA, RPM, transient_load
@@ -173,17 +176,17 @@ def simulate_transient(engine, manoeuvre, *, system=None, angle_step_deg=1.0) ->
     F = np.zeros((t.size, system.n_dof))
     F[:, :6] = load.F
     ports = system.port_forces() or no_ports(system)
-    integrator = CycleIntegrator(NetworkScaling(system), ports, t[1] - t[0],
-                                 np.zeros(system.n_dof))
+    scaling = NetworkScaling(system)
     curves = _Curves(engine, system) if has_static_curves(engine) else None
     _warn_curve_and_law(engine)
     start = _start(engine, manoeuvre, system, load, ports, curves)
-    every, sub = _stretch_steps(t[1] - t[0], n_steps, integrator.varying, curves is not None)
-    X, V, A, force, extra = _run(system, integrator, ports, curves, F, start, (every, sub))
+    every, sub = _stretch_steps(t[1] - t[0], n_steps, scaling.varying, curves is not None)
+    X, V, A, force, extra = _run(system, scaling, ports, curves, F, t[1] - t[0], start,
+                                 (every, sub))
     Cm = system.channel_matrix
     return TransientRun(load, X[:, :6].copy(), X @ Cm.T, V @ Cm.T, A @ Cm.T, force,
                         X @ system.port_rows.T, list(system.channels),
-                        system.network_names, _method(integrator, curves, every, sub), X, V,
+                        system.network_names, _method(scaling, ports, curves, every, sub), X, V,
                         *extra, every, sub)
 
 
@@ -207,68 +210,98 @@ def _warn_curve_and_law(engine):
                       StretchRuleWarning, stacklevel=3)
 
 
-def _method(integrator, curves, every, sub):
+def _method(scaling, ports, curves, every, sub):
     parts = ["Newmark average acceleration, dense"]
-    if integrator.laws.kinds.size:
+    if (ports.kinds != NONE).any():
         parts.append("port laws by Newton per step")
-    if integrator.varying:
+    if scaling.varying:
         parts.append(f"amplitude law every {every} steps")
     if curves is not None:
         parts.append(f"static curves' tangents every {sub} steps")
     return "; ".join(parts)
 
 
-def _run(system, integrator, ports, curves, F, start, steps):
+def _run(system, scaling, ports, curves, F, h, start, steps):
     """States X, V, A (n_t, n), channel forces (n_t, n_ch) and ``(port-law forces,
     network scales, curve loads)`` at every step: ``steps = (every, sub)``, the amplitude
     law and the centres updated every ``every`` steps (a stretch), the curves' tangents and
-    load every ``sub``."""
+    load every ``sub`` (:func:`~powertrain.kernels.transient.transient_stretch_kernel`)."""
     every, sub = steps
     x, v, a, state, amplitudes = start
-    n_t = F.shape[0]
-    X, V, A = (np.empty((n_t, system.n_dof)) for _ in range(3))
-    force = np.empty((n_t, system.channel_matrix.shape[0]))
+    laws = ports.select(ports.kinds != NONE)
+    n_t, n = F.shape
     n_net = system.port_rows.shape[0]
-    Z = np.zeros((n_t, integrator.laws.kinds.size)) if integrator.laws.kinds.size else None
-    scales, loads = np.empty((n_t, n_net, 2)), np.zeros((n_t, n_net))
-    laws_map = integrator.laws.force_map
-    bounds = list(range(0, n_t - 1, every)) + [n_t - 1]
+    X, V, A = (np.empty((n_t, n)) for _ in range(3))
+    X[0], V[0] = x, v
+    Z, scales, loads = np.zeros((n_t, laws.kinds.size)), np.empty((n_t, n_net, 2)), \
+        np.zeros((n_t, n_net))
+    model, kernel_curves = _kernel_model(system, scaling), _kernel_curves(system, scaling, curves)
+    kernel_laws = (np.array(laws.rows, float), np.array(laws.kinds, np.int64),
+                   np.array(laws.parameters, float),
+                   np.zeros((0, 1)) if state is None else state)
     centres = system.port_rows @ x             # the first stretch's: where it starts
-    ones = np.ones(n_net)
-    for lo, hi in zip(bounds[:-1], bounds[1:]):
-        net_amplitudes = ports.network_amplitudes(amplitudes)
-        law = integrator.scaling.scales(net_amplitudes, ones)     # the amplitude law's part
-        for p, q in _pieces(lo, hi, sub):
-            factors, c = (None, None) if curves is None else curves.at(x, law, centres)
-            sc = law * (integrator.scaling.static_factors if factors is None
-                        else factors)[:, None]
-            Fs = F[p:q + 1] if c is None else F[p:q + 1] - c @ system.port_rows
-            (Xs, Vs, As, Zs), (Fk, Fd, off) = integrator.run(Fs, (x, v, a), amplitudes,
-                                                            state, scales=sc)
-            rows = slice(p, q + 1)
-            X[rows], V[rows], A[rows] = Xs, Vs, As
-            scales[rows] = sc
-            f = Xs @ Fk.T + Vs @ Fd.T - (0.0 if off is None else off)
-            if Zs is not None:
-                f += Zs @ laws_map.T
-                Z[rows] = Zs
-            if c is not None:
-                f += c @ system.port_force_map.T
-                loads[rows] = c
-            force[rows] = f
-            # the next piece's laws differ: its acceleration is solved from them (None), or
-            # the trapezoidal rule would carry the jump on as an undamped alternating error
-            x, v, a = Xs[-1], Vs[-1], None
-        if integrator.varying:
+    a0, ones, failed = (np.empty(0) if a is None else np.array(a, float)), np.ones(n_net), 0
+    for lo in range(0, n_t - 1, every):
+        hi = min(lo + every, n_t - 1)
+        law = scaling.scales(ports.network_amplitudes(amplitudes), ones)
+        failed += transient_stretch_kernel(model, kernel_curves, kernel_laws, h, F, law,
+                                           centres, lo, hi, sub, a0, X, V, A, Z, scales,
+                                           loads, PORT_TOL, PORT_MAX_ITER)
+        a0 = np.empty(0)
+        if scaling.varying:
             amplitudes = cycle_amplitudes(X[lo:hi] @ ports.rows.T)
         centres = (X[lo:hi] @ system.port_rows.T).mean(0)
-    return X, V, A, force, (Z, scales, loads)
+    if failed:
+        raise FloatingPointError(f"port laws {', '.join(laws.names)}: Newton did not converge "
+                                 f"at {failed} of {n_t - 1} steps")
+    force = _channel_forces(system, scaling, (X, V, Z, scales, loads), laws.force_map)
+    return X, V, A, force, (Z if laws.kinds.size else None, scales, loads)
 
 
-def _pieces(lo, hi, sub):
-    """``(p, q)`` step bounds of ``sub`` steps from ``lo`` to ``hi`` (the last shorter)."""
-    cuts = list(range(lo, hi, sub)) + [hi]
-    return zip(cuts[:-1], cuts[1:])
+def _channel_forces(system, scaling, run, laws_map):
+    """Transmitted force (n_t, n_ch) [N] of the states, port-law forces, network scales and
+    curve loads ``run`` at every step: the force rows at each step's scales."""
+    X, V, Z, scales, loads = run
+    force = X @ system.force_matrix_k.T + V @ system.force_matrix_d.T
+    dk, dd = np.moveaxis(scales - scaling.assembled, 2, 0)
+    if dk.any() or dd.any():
+        force += ((X @ scaling.gk.T) * dk + (V @ scaling.gd.T) * dd) @ system.port_force_map.T
+    if Z.shape[1]:
+        force += Z @ laws_map.T
+    if loads.any():
+        force += loads @ system.port_force_map.T
+    return force
+
+
+def _kernel_model(system, scaling):
+    """The kernel's ``model`` tuple (:func:`~powertrain.kernels.transient.transient_stretch_kernel`)."""
+    M = np.array(system.M, float)
+    try:
+        np.linalg.inv(M)
+        regular = True
+    except np.linalg.LinAlgError:          # massless nodes: the start acceleration is 0
+        regular = False
+    return (M, np.array(system.C, float), np.array(system.K, float), _sparse(scaling.C_parts),
+            _sparse(scaling.K_parts), np.array(scaling.assembled, float), regular)
+
+
+def _sparse(parts):
+    """``(net, i, j, value)``: the nonzero entries of the stacked ``parts`` (n_net, n, n)."""
+    net, i, j = np.nonzero(parts)
+    return net, i, j, np.array(parts[net, i, j], float)
+
+
+def _kernel_curves(system, scaling, curves):
+    """The kernel's ``curves`` tuple (:func:`~powertrain.kernels.transient.curve_state`);
+    without static curves every network keeps its assembled factor."""
+    rows = np.array(system.port_rows, float)
+    n_net = rows.shape[0]
+    if curves is None:
+        zero, flat = np.zeros(n_net), np.zeros((n_net, 2))
+        return (rows, zero, zero, flat + [0.0, 1.0], np.ones(n_net), flat, flat,
+                np.zeros(n_net, bool), np.array(scaling.static_factors, float), zero)
+    return (rows, curves.d0, curves.f0, curves.grid, curves.step, curves.force,
+            curves.tangent, curves.has, np.ones(n_net), np.array(curves.stiffness, float))
 
 
 def _start(engine, manoeuvre, system, load, ports, curves):
@@ -345,26 +378,6 @@ class _Curves:
     def factors(self, x):
         """Static factor of every network at the state ``x`` (1 without a curve)."""
         return np.where(self.has, self._read(self.tangent, self.d0 + self.rows @ x), 1.0)
-
-    def at(self, x, law, centres=None):
-        r"""Static factors and the curves' load ``c`` (n_net,) [N] at the state ``x``:
-        with the network stiffness :math:`\kappa k_0` (its static stiffness times its
-        stiffness scale: the static factor times the amplitude law's stiffness and damping
-        scales ``law`` (n_net, 2)) and the curve's tangent :math:`f k_0` there,
-        :math:`c = F(\delta_c) - F(\delta_0) - f k_0 (u_c - \bar u) - \kappa k_0 \bar u`
-        about the networks' ``centres`` :math:`\bar u` [m] (the mean deflection over the
-        stretch before; default: the deflection at ``x``), so that the static force is the
-        curve's tangent at :math:`u_c` plus :math:`(\kappa - f) k_0 (u - \bar u)`: the
-        amplitude law acts on the motion about the centre and the curve on the rest
-        (module docstring)."""
-        u = self.rows @ x
-        centres = u if centres is None else centres
-        d = self.d0 + u
-        factors = np.where(self.has, self._read(self.tangent, d), 1.0)
-        k = law[:, 0] * factors * self.stiffness
-        tangent = factors * self.stiffness
-        c = self._read(self.force, d) - self.f0 - tangent * (u - centres) - k * centres
-        return factors, np.where(self.has, c, 0.0)
 
 
 def _sampled(curve):

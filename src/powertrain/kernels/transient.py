@@ -1,0 +1,174 @@
+r"""One stretch of a transient manoeuvre: the static curves' updates and the Newmark steps
+between them in one call (:mod:`powertrain.solvers.transient` holds the model and the
+formulas).
+
+A stretch is cut into pieces of ``sub`` steps. At the start of every piece, at the state
+:math:`\mathbf x`, each network's static factor :math:`f` and curve load :math:`c` are read
+from its sampled curve (:func:`curve_state`); the networks are scaled by the amplitude law's
+``law`` times :math:`f`; the damping and stiffness are the assembled ones plus each
+network's change of scale times its parts (sparse: the nonzero entries of every network's
+:math:`\mathbf L^T\mathbf C_n\mathbf L`, :math:`\mathbf L^T\mathbf K_n\mathbf L`); the piece
+is integrated from the position and velocity, its acceleration solved from the new laws,
+by :func:`powertrain.kernels.port_forces.newmark_port_kernel` (port laws, Newton per step)
+or :func:`powertrain.kernels.newmark.newmark_kernel` (none).
+
+Numba caches a kernel by its own file: after editing the step kernels it calls, touch this
+file (or clear ``__pycache__``) so that its cached machine code is rebuilt.
+"""
+
+import numpy as np
+from numba import njit
+
+from powertrain.kernels.newmark import newmark_kernel
+from powertrain.kernels.port_forces import newmark_port_kernel, port_forces_at
+
+
+@njit(cache=True, nogil=True, inline="always")
+def _read(table, grid, step, r, d):
+    """Row ``r`` of ``table`` at the deflection ``d`` [m]: linear between the samples of
+    the uniform grid from ``grid[r, 0]`` by ``step[r]``, the end values outside."""
+    lo, hi = grid[r, 0], grid[r, 1]
+    pos = (min(max(d, lo), hi) - lo) / step[r]
+    j = min(int(pos), table.shape[1] - 2)
+    w = pos - j
+    return table[r, j] * (1.0 - w) + table[r, j + 1] * w
+
+
+@njit(cache=True, nogil=True)
+def curve_state(x, curves, law, centres, factors, c):
+    r"""Static factor ``factors`` and curve load ``c`` (n_net,) [N] of every network at the
+    state ``x`` (n,), its amplitude-law scales ``law`` (n_net, 2) and ``centres``
+    (n_net,) [m]: :math:`c = F(\delta) - F(\delta_0) - f k_0 (u - \bar u) - s f k_0\bar u`
+    with :math:`u` the network deflection, :math:`\delta = \delta_0 + u`; a network
+    without a curve keeps its assembled factor and no load. ``curves = (rows, d0, f0,
+    grid, step, force, tangent, has, base, stiffness)``."""
+    rows, d0, f0, grid, step, force, tangent, has, base, stiffness = curves
+    for r in range(rows.shape[0]):
+        if not has[r]:
+            factors[r] = base[r]
+            c[r] = 0.0
+            continue
+        u = 0.0
+        for j in range(x.shape[0]):
+            u += rows[r, j] * x[j]
+        d = d0[r] + u
+        f = _read(tangent, grid, step, r, d)
+        factors[r] = f
+        k0 = f * stiffness[r]
+        c[r] = (_read(force, grid, step, r, d) - f0[r] - k0 * (u - centres[r])
+                - law[r, 0] * k0 * centres[r])
+
+
+@njit(cache=True, nogil=True)
+def _scaled(base, parts, change):
+    """``base`` plus each network's change of scale times its sparse part ``parts = (net,
+    i, j, value)``."""
+    out = base.copy()
+    net, i, j, value = parts
+    for e in range(value.shape[0]):
+        out[i[e], j[e]] += change[net[e]] * value[e]
+    return out
+
+
+@njit(cache=True, nogil=True)
+def _piece(model, laws, h, C, K, F, x, v, a, X, V, A, Z, tol, max_iter):
+    """Newmark over the load rows ``F`` (k + 1, n) from ``(x, v)`` with ``C``, ``K``;
+    ``a`` the acceleration at the start, or solved from the laws where it has no entry.
+    Returns the steps where Newton did not converge."""
+    M, _, _, _, _, _, mass_regular = model
+    P, kinds, par, state = laws
+    S = M + 0.5 * h * C + 0.25 * h * h * K
+    Sinv = np.linalg.inv(S)
+    SinvT = np.ascontiguousarray(Sinv.T)
+    G, H, Fs = Sinv @ C, Sinv @ K, F @ SinvT
+    if a.shape[0] == 0:
+        a = np.zeros(x.shape[0])
+        if mass_regular:
+            r = F[0] - C @ v - K @ x
+            if kinds.shape[0]:
+                z0 = np.zeros(kinds.shape[0])
+                port_forces_at(kinds, par, state, P @ x, P @ v, z0)
+                r -= np.ascontiguousarray(P.T) @ z0
+            a = np.linalg.solve(M, r)
+    if kinds.shape[0] == 0:
+        newmark_kernel(G, H, Fs, h, x, v, a, X, V, A)
+        return 0
+    W = Sinv @ np.ascontiguousarray(P.T)
+    return newmark_port_kernel(G, H, Fs, h, x, v, a, W, P, P @ W, kinds, par, state, X, V, A,
+                               Z, tol, max_iter)
+
+
+@njit(cache=True, nogil=True)
+def transient_stretch_kernel(model, curves, laws, h, F, law, centres, lo, hi, sub, a0, X, V,
+                             A, Z, scales, loads, tol, max_iter):
+    """Integrate steps ``lo`` to ``hi`` (module docstring), pieces of ``sub`` steps.
+
+    Parameters
+    ----------
+    model : tuple
+        ``(M, C, K, C_parts, K_parts, assembled, mass_regular)``: the assembled matrices,
+        each network's sparse parts ``(net, i, j, value)``, the scales (n_net, 2) the
+        assembled matrices hold and whether M is regular.
+    curves : tuple
+        :func:`curve_state`'s.
+    laws : tuple
+        ``(P, kinds, par, state)`` of the port laws (m rows; m = 0: none), ``state``
+        updated in place.
+    h : float
+        Time step [s].
+    F : ndarray (n_t, n)
+        Load at every step [N].
+    law : ndarray (n_net, 2)
+        The amplitude law's stiffness and damping scales over the stretch.
+    centres : ndarray (n_net,)
+        The networks' centres [m].
+    lo, hi, sub : int
+    a0 : ndarray (n,) or (0,)
+        Acceleration at ``lo`` [m/s²], or empty: solved from the laws.
+    X, V, A, Z, scales, loads : ndarray
+        Outputs over every step, row ``lo`` the start (X, V read from it).
+    tol, max_iter : float, int
+        Newton's tolerance and iteration limit
+        (:func:`~powertrain.kernels.port_forces.newmark_port_kernel`).
+
+    Returns
+    -------
+    int
+        Steps at which Newton did not converge.
+    """
+    _, C0, K0, C_parts, K_parts, assembled, _ = model
+    n, n_net = X.shape[1], law.shape[0]
+    factors, c = np.empty(n_net), np.empty(n_net)
+    change = np.empty((n_net, 2))
+    rows = curves[0]
+    failed = 0
+    a = a0
+    for p in range(lo, hi, sub):
+        q = min(p + sub, hi)
+        x, v = X[p].copy(), V[p].copy()
+        curve_state(x, curves, law, centres, factors, c)
+        for r in range(n_net):
+            for s in range(2):
+                scales[p:q + 1, r, s] = law[r, s] * factors[r]
+                change[r, s] = law[r, s] * factors[r] - assembled[r, s]
+            loads[p:q + 1, r] = c[r]
+        Fp = np.empty((q - p + 1, n))
+        for j in range(n):
+            load = 0.0
+            for r in range(n_net):
+                load += c[r] * rows[r, j]
+            for k in range(q - p + 1):
+                Fp[k, j] = F[p + k, j] - load
+        Xp, Vp, Ap = np.empty((q - p + 1, n)), np.empty((q - p + 1, n)), np.empty((q - p + 1, n))
+        Zp = np.empty((q - p + 1, Z.shape[1]))
+        failed += _piece(model, laws, h, _scaled(C0, C_parts, change[:, 1]),
+                         _scaled(K0, K_parts, change[:, 0]), Fp, x, v, a, Xp, Vp, Ap, Zp,
+                         tol, max_iter)
+        X[p:q + 1] = Xp
+        V[p:q + 1] = Vp
+        A[p:q + 1] = Ap
+        Z[p:q + 1] = Zp
+        # the next piece's laws differ: its acceleration is solved from them, or the
+        # trapezoidal rule would carry the jump on as an undamped alternating error
+        a = np.empty(0)
+    return failed
