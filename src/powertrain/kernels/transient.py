@@ -71,20 +71,24 @@ def _scaled(base, parts, change):
 
 
 @njit(cache=True, nogil=True)
-def _piece(model, laws, h, C, K, F, x, v, a, X, V, A, Z, tol, max_iter):
-    """Newmark over the load rows ``F`` (k + 1, n) from ``(x, v)`` with ``C``, ``K``;
-    ``a`` the acceleration at the start, or solved from the laws where it has no entry.
-    Returns the steps where Newton did not converge."""
+def _piece(model, laws, h, C, K, F, load, x, v, a, X, V, A, Z, tol, max_iter):
+    """Newmark over the load rows ``F`` (k + 1, n) less ``load`` (n,) from ``(x, v)`` with
+    ``C``, ``K`` into the rows ``X``, ``V``, ``A``, ``Z``; ``a`` the acceleration at the
+    start, or solved from the laws where it has no entry. Returns the steps where Newton
+    did not converge."""
     M, _, _, _, _, _, mass_regular = model
     P, kinds, par, state = laws
     S = M + 0.5 * h * C + 0.25 * h * h * K
     Sinv = np.linalg.inv(S)
-    SinvT = np.ascontiguousarray(Sinv.T)
-    G, H, Fs = Sinv @ C, Sinv @ K, F @ SinvT
+    G, H, Fs = Sinv @ C, Sinv @ K, F @ np.ascontiguousarray(Sinv.T)
+    shift = Sinv @ load                       # (F - load) S^-T, row by row
+    for k in range(Fs.shape[0]):
+        for j in range(Fs.shape[1]):
+            Fs[k, j] -= shift[j]
     if a.shape[0] == 0:
         a = np.zeros(x.shape[0])
         if mass_regular:
-            r = F[0] - C @ v - K @ x
+            r = F[0] - load - C @ v - K @ x
             if kinds.shape[0]:
                 z0 = np.zeros(kinds.shape[0])
                 port_forces_at(kinds, par, state, P @ x, P @ v, z0)
@@ -137,7 +141,7 @@ def transient_stretch_kernel(model, curves, laws, h, F, law, centres, lo, hi, su
         Steps at which Newton did not converge.
     """
     _, C0, K0, C_parts, K_parts, assembled, _ = model
-    n, n_net = X.shape[1], law.shape[0]
+    n_net = law.shape[0]
     factors, c = np.empty(n_net), np.empty(n_net)
     change = np.empty((n_net, 2))
     rows = curves[0]
@@ -152,22 +156,10 @@ def transient_stretch_kernel(model, curves, laws, h, F, law, centres, lo, hi, su
                 scales[p:q + 1, r, s] = law[r, s] * factors[r]
                 change[r, s] = law[r, s] * factors[r] - assembled[r, s]
             loads[p:q + 1, r] = c[r]
-        Fp = np.empty((q - p + 1, n))
-        for j in range(n):
-            load = 0.0
-            for r in range(n_net):
-                load += c[r] * rows[r, j]
-            for k in range(q - p + 1):
-                Fp[k, j] = F[p + k, j] - load
-        Xp, Vp, Ap = np.empty((q - p + 1, n)), np.empty((q - p + 1, n)), np.empty((q - p + 1, n))
-        Zp = np.empty((q - p + 1, Z.shape[1]))
+        load = c @ rows
         failed += _piece(model, laws, h, _scaled(C0, C_parts, change[:, 1]),
-                         _scaled(K0, K_parts, change[:, 0]), Fp, x, v, a, Xp, Vp, Ap, Zp,
-                         tol, max_iter)
-        X[p:q + 1] = Xp
-        V[p:q + 1] = Vp
-        A[p:q + 1] = Ap
-        Z[p:q + 1] = Zp
+                         _scaled(K0, K_parts, change[:, 0]), F[p:q + 1], load, x, v, a,
+                         X[p:q + 1], V[p:q + 1], A[p:q + 1], Z[p:q + 1], tol, max_iter)
         # the next piece's laws differ: its acceleration is solved from them, or the
         # trapezoidal rule would carry the jump on as an undamped alternating error
         a = np.empty(0)
