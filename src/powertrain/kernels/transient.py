@@ -71,29 +71,40 @@ def _scaled(base, parts, change):
 
 
 @njit(cache=True, nogil=True)
+def _times(A, x, transpose=False):
+    """``A x``, or ``A^T x`` where ``transpose`` (loops: each matrix-vector signature of
+    ``@`` would be compiled apart)."""
+    out = np.zeros(A.shape[1] if transpose else A.shape[0])
+    for i in range(A.shape[0]):
+        for j in range(A.shape[1]):
+            if transpose:
+                out[j] += A[i, j] * x[i]
+            else:
+                out[i] += A[i, j] * x[j]
+    return out
+
+
+@njit(cache=True, nogil=True)
 def _piece(model, laws, h, C, K, F, load, x, v, a, X, V, A, Z, tol, max_iter):
     """Newmark over the load rows ``F`` (k + 1, n) less ``load`` (n,) from ``(x, v)`` with
     ``C``, ``K`` into the rows ``X``, ``V``, ``A``, ``Z``; ``a`` the acceleration at the
     start, or solved from the laws where it has no entry. Returns the steps where Newton
     did not converge."""
-    M, _, _, _, _, _, mass_regular = model
+    M, M_inv = model[0], model[6]
     P, kinds, par, state = laws
-    S = M + 0.5 * h * C + 0.25 * h * h * K
-    Sinv = np.linalg.inv(S)
+    Sinv = np.linalg.inv(M + 0.5 * h * C + 0.25 * h * h * K)
     G, H, Fs = Sinv @ C, Sinv @ K, F @ np.ascontiguousarray(Sinv.T)
-    shift = Sinv @ load                       # (F - load) S^-T, row by row
+    shift = _times(Sinv, load)                # (F - load) S^-T, row by row
     for k in range(Fs.shape[0]):
         for j in range(Fs.shape[1]):
             Fs[k, j] -= shift[j]
     if a.shape[0] == 0:
-        a = np.zeros(x.shape[0])
-        if mass_regular:
-            r = F[0] - load - C @ v - K @ x
-            if kinds.shape[0]:
-                z0 = np.zeros(kinds.shape[0])
-                port_forces_at(kinds, par, state, P @ x, P @ v, z0)
-                r -= np.ascontiguousarray(P.T) @ z0
-            a = np.linalg.solve(M, r)
+        r = F[0] - load - _times(C, v) - _times(K, x)
+        if kinds.shape[0]:
+            z0 = np.zeros(kinds.shape[0])
+            port_forces_at(kinds, par, state, _times(P, x), _times(P, v), z0)
+            r -= _times(P, z0, True)
+        a = _times(M_inv, r)
     if kinds.shape[0] == 0:
         newmark_kernel(G, H, Fs, h, x, v, a, X, V, A)
         return 0
@@ -110,9 +121,10 @@ def transient_stretch_kernel(model, curves, laws, h, F, law, centres, lo, hi, su
     Parameters
     ----------
     model : tuple
-        ``(M, C, K, C_parts, K_parts, assembled, mass_regular)``: the assembled matrices,
-        each network's sparse parts ``(net, i, j, value)``, the scales (n_net, 2) the
-        assembled matrices hold and whether M is regular.
+        ``(M, C, K, C_parts, K_parts, assembled, M_inv)``: the assembled matrices, each
+        network's sparse parts ``(net, i, j, value)``, the scales (n_net, 2) the assembled
+        matrices hold and the inverse of M (zeros where M is singular: massless nodes, a
+        start acceleration of 0).
     curves : tuple
         :func:`curve_state`'s.
     laws : tuple
@@ -156,7 +168,7 @@ def transient_stretch_kernel(model, curves, laws, h, F, law, centres, lo, hi, su
                 scales[p:q + 1, r, s] = law[r, s] * factors[r]
                 change[r, s] = law[r, s] * factors[r] - assembled[r, s]
             loads[p:q + 1, r] = c[r]
-        load = c @ rows
+        load = _times(rows, c, True)
         failed += _piece(model, laws, h, _scaled(C0, C_parts, change[:, 1]),
                          _scaled(K0, K_parts, change[:, 0]), F[p:q + 1], load, x, v, a,
                          X[p:q + 1], V[p:q + 1], A[p:q + 1], Z[p:q + 1], tol, max_iter)

@@ -277,12 +277,11 @@ def _kernel_model(system, scaling):
     """The kernel's ``model`` tuple (:func:`~powertrain.kernels.transient.transient_stretch_kernel`)."""
     M = np.array(system.M, float)
     try:
-        np.linalg.inv(M)
-        regular = True
+        M_inv = np.linalg.inv(M)
     except np.linalg.LinAlgError:          # massless nodes: the start acceleration is 0
-        regular = False
+        M_inv = np.zeros_like(M)
     return (M, np.array(system.C, float), np.array(system.K, float), _sparse(scaling.C_parts),
-            _sparse(scaling.K_parts), np.array(scaling.assembled, float), regular)
+            _sparse(scaling.K_parts), np.array(scaling.assembled, float), M_inv)
 
 
 def _sparse(parts):
