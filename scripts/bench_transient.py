@@ -26,7 +26,9 @@ with BLAS on one thread, best of ``--repeat``:
   ours then also carries the stretch rule's error);
 * the small case of tests/test_transient.py (6-DOF body, Kelvin-Voigt mounts, one direction
   nonlinear, a 0.3 s flare from rest), the same comparison on the stretch rule, its own
-  lines.
+  lines;
+* the first linear and fully nonlinear start in a fresh process with an empty Numba cache
+  (what a first run on a machine costs, compiling the kernels), its own line.
 
 Last line: ``linear_s=... nonlinear_s=... newmark_s=... solve_ivp_s=... ratio=...
 solve_ivp_method=... solve_ivp_rtol=...`` then ``error=... ratio_continuous=...
@@ -40,6 +42,8 @@ it: the ratio's ceiling with everything around the kernel free.
 from __future__ import annotations
 
 import argparse
+import os
+import subprocess
 import sys
 import tempfile
 import time
@@ -85,6 +89,27 @@ def kernel_cpu(run):
     finally:
         tr.transient_stretch_kernel = kernel
     return spent[0]
+
+
+def cold_first_run():
+    """``(linear, nonlinear)`` CPU seconds of the first linear and the first fully nonlinear
+    start in a fresh process whose Numba cache is empty (the kernels compiled there)."""
+    with tempfile.TemporaryDirectory() as cache:
+        out = subprocess.run([sys.executable, __file__, "--cold-child"], check=True,
+                             capture_output=True, text=True,
+                             env={**os.environ, "NUMBA_CACHE_DIR": cache}).stdout
+    return tuple(float(x) for x in out.split())
+
+
+def cold_child():
+    engine = read_engine(DEFAULT_ENGINE_PATH)
+    start = read_manoeuvre(ROOT / "examples" / "start.toml")
+    spent = []
+    for e in (engine, fully_nonlinear(engine)):
+        t0 = time.process_time()
+        simulate_transient(e, start)
+        spent.append(time.process_time() - t0)
+    print(*spent)
 
 
 def best_cpu(run, repeat):
@@ -177,7 +202,10 @@ def main():
     warnings.simplefilter("ignore", StretchRuleWarning)
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     p.add_argument("--repeat", type=int, default=3)
+    p.add_argument("--cold-child", action="store_true", help=argparse.SUPPRESS)
     args = p.parse_args()
+    if args.cold_child:
+        return cold_child()
     engine = read_engine(DEFAULT_ENGINE_PATH)
     start = read_manoeuvre(ROOT / "examples" / "start.toml")
     linear = best_cpu(lambda: simulate_transient(engine, start), args.repeat)
@@ -193,6 +221,9 @@ def main():
     cont = Case(nonlinear_engine, start, continuous=True)
     err_c, peer_c, *_ = compare(cont, ours_s, args.repeat, "continuous curve")
     kernel_s = min(kernel_cpu(case.ours) for _ in range(args.repeat))
+    cold = cold_first_run()
+    print(f"first run in a fresh process, empty kernel cache: linear start {cold[0]:.1f} s, "
+          f"then the fully nonlinear one {cold[1]:.1f} s (compiling the kernels)")
     print(f"of ours {ours_s:.4f} s, {kernel_s:.4f} s inside the stretch kernel: were "
           f"everything around it free, the ratio would be {peer_s / kernel_s:.0f}")
     print(f"linear_s={linear:.4f} nonlinear_s={nonlinear:.4f} newmark_s={ours_s:.4f} "

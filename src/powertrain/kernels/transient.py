@@ -91,7 +91,6 @@ def _piece(model, laws, h, C, K, F, load, x, v, a, X, V, A, Z, tol, max_iter):
     start, or solved from the laws where it has no entry. Returns the steps where Newton
     did not converge."""
     M, M_inv = model[0], model[6]
-    P, kinds, par, state = laws
     Sinv = np.linalg.inv(M + 0.5 * h * C + 0.25 * h * h * K)
     G, H, Fs = Sinv @ C, Sinv @ K, F @ np.ascontiguousarray(Sinv.T)
     shift = _times(Sinv, load)                # (F - load) S^-T, row by row
@@ -100,14 +99,16 @@ def _piece(model, laws, h, C, K, F, load, x, v, a, X, V, A, Z, tol, max_iter):
             Fs[k, j] -= shift[j]
     if a.shape[0] == 0:
         r = F[0] - load - _times(C, v) - _times(K, x)
-        if kinds.shape[0]:
+        if laws is not None:
+            P, kinds, par, state = laws
             z0 = np.zeros(kinds.shape[0])
             port_forces_at(kinds, par, state, _times(P, x), _times(P, v), z0)
             r -= _times(P, z0, True)
         a = _times(M_inv, r)
-    if kinds.shape[0] == 0:
+    if laws is None:        # pruned at compile time: a linear model compiles no port kernel
         newmark_kernel(G, H, Fs, h, x, v, a, X, V, A)
         return 0
+    P, kinds, par, state = laws
     W = Sinv @ np.ascontiguousarray(P.T)
     return newmark_port_kernel(G, H, Fs, h, x, v, a, W, P, P @ W, kinds, par, state, X, V, A,
                                Z, tol, max_iter)
@@ -127,9 +128,9 @@ def transient_stretch_kernel(model, curves, laws, h, F, law, centres, lo, hi, su
         start acceleration of 0).
     curves : tuple
         :func:`curve_state`'s.
-    laws : tuple
-        ``(P, kinds, par, state)`` of the port laws (m rows; m = 0: none), ``state``
-        updated in place.
+    laws : tuple or None
+        ``(P, kinds, par, state)`` of the port laws (m rows), ``state`` updated in place;
+        None without port laws.
     h : float
         Time step [s].
     F : ndarray (n_t, n)

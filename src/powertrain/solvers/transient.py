@@ -236,9 +236,9 @@ def _run(system, scaling, ports, curves, F, h, start, steps):
     Z, scales, loads = np.zeros((n_t, laws.kinds.size)), np.empty((n_t, n_net, 2)), \
         np.zeros((n_t, n_net))
     model, kernel_curves = _kernel_model(system, scaling), _kernel_curves(system, scaling, curves)
-    kernel_laws = (np.array(laws.rows, float), np.array(laws.kinds, np.int64),
-                   np.array(laws.parameters, float),
-                   np.zeros((0, 1)) if state is None else state)
+    kernel_laws = None if not laws.kinds.size else (
+        np.array(laws.rows, float), np.array(laws.kinds, np.int64),
+        np.array(laws.parameters, float), state)
     centres = system.port_rows @ x             # the first stretch's: where it starts
     a0, ones, failed = (np.empty(0) if a is None else np.array(a, float)), np.ones(n_net), 0
     for lo in range(0, n_t - 1, every):
