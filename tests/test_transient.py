@@ -24,7 +24,7 @@ from powertrain.iotools.raw_hdf5 import write_raw_hdf5
 from powertrain.models.manoeuvre import Manoeuvre
 from powertrain.models.recording import RawRecording
 from powertrain.physics.mount_laws import BergFriction, PowerLaw
-from powertrain.solvers.newmark import newmark
+from powertrain.solvers.newmark import newmark, newmark_ports
 from powertrain.solvers.operating_point import StaticSupport, operating_point
 from powertrain.solvers.transient import StretchRuleWarning, simulate_transient
 from powertrain.workflows.transient import compare_transient
@@ -245,6 +245,26 @@ def test_the_energy_balance_closes_over_a_start_on_nonlinear_mounts(default_engi
     assert abs(e["input"] - out) <= ENERGY_REL * e["input"], e
     assert min(e["viscous"], e["friction"]) > 0.0, e
     assert e["amplitude law"] >= -1e-6 * e["input"], e       # 0 without a law, to round-off
+
+
+def test_the_stretch_kernel_steps_as_the_public_newmark_with_port_laws(default_engine):
+    """Berg's friction on every mount direction, no curve, no amplitude law: the start is one
+    piece of the stretch kernel, which must give the states and port forces that the public
+    wrapper :func:`newmark_ports` gives on the assembled matrices and the same load."""
+    mounts = [dataclasses.replace(m, directions={
+        a: dataclasses.replace(mod, port_law=BERG) for a, mod in m.directions.items()})
+        for m in default_engine.mounts]
+    engine = dataclasses.replace(default_engine, mounts=mounts)
+    m = read_manoeuvre(EXAMPLES / "start.toml")
+    run = simulate_transient(engine, m)
+    s = engine.assemble()
+    F = np.zeros((run.load.t.size, s.n_dof))
+    F[:, :6] = run.load.F
+    ports = s.port_forces()
+    X, _, _, Z = newmark_ports(s.M, s.C, s.K, F, run.load.t[1], ports)
+    assert run.curve_steps == run.load.t.size - 1 and ports.kinds.size == 9
+    assert np.max(np.abs(run.coordinates - X)) <= 1e-9 * np.max(np.abs(X))
+    assert np.max(np.abs(run.port_law_force - Z)) <= 1e-9 * np.max(np.abs(Z))
 
 
 def test_after_a_stop_the_body_rests_at_the_zero_torque_point(default_engine):
