@@ -35,6 +35,14 @@ def _read(table, grid, step, r, d):
 
 
 @njit(cache=True, nogil=True)
+def curve_values(table, grid, step, d, out):
+    """Each network's row of ``table`` at its deflection ``d`` (n_net,) [m] into ``out``
+    (:func:`_read`)."""
+    for r in range(d.shape[0]):
+        out[r] = _read(table, grid, step, r, d[r])
+
+
+@njit(cache=True, nogil=True)
 def curve_state(x, curves, law, centres, factors, c):
     r"""Static factor ``factors`` and curve load ``c`` (n_net,) [N] of every network at the
     state ``x`` (n,), its amplitude-law scales ``law`` (n_net, 2) and ``centres``

@@ -54,7 +54,7 @@ import numpy as np
 from powertrain.assembly import NetworkScaling
 from powertrain.errors import InputError
 from powertrain.kernels.port_forces import NONE
-from powertrain.kernels.transient import transient_stretch_kernel
+from powertrain.kernels.transient import curve_values, transient_stretch_kernel
 from powertrain.solvers.cycle_newmark import cycle_amplitudes, no_ports, start_state
 from powertrain.solvers.newmark import PORT_MAX_ITER, PORT_TOL
 from powertrain.solvers.operating_point import StaticSupport, has_static_curves, operating_point
@@ -260,12 +260,9 @@ def _run(system, scaling, ports, curves, F, h, start, steps):
 
 def _channel_forces(system, scaling, run, laws_map):
     """Transmitted force (n_t, n_ch) [N] of the states, port-law forces, network scales and
-    curve loads ``run`` at every step: the force rows at each step's scales."""
+    curve loads ``run`` at every step."""
     X, V, Z, scales, loads = run
-    force = X @ system.force_matrix_k.T + V @ system.force_matrix_d.T
-    dk, dd = np.moveaxis(scales - scaling.assembled, 2, 0)
-    if dk.any() or dd.any():
-        force += ((X @ scaling.gk.T) * dk + (V @ scaling.gd.T) * dd) @ system.port_force_map.T
+    force = scaling.transmitted_force(X, V, scales)
     if Z.shape[1]:
         force += Z @ laws_map.T
     if loads.any():
@@ -368,11 +365,9 @@ class _Curves:
     def _read(self, table, d):
         """Each network's row of ``table`` (n_net, CURVE_SAMPLES) at its deflection ``d``
         (n_net,) [m], linear between samples, the end values outside."""
-        pos = (np.clip(d, self.grid[:, 0], self.grid[:, 1]) - self.grid[:, 0]) / self.step
-        j = np.minimum(pos.astype(np.int64), CURVE_SAMPLES - 2)
-        w = pos - j
-        rows = np.arange(d.size)
-        return table[rows, j] * (1.0 - w) + table[rows, j + 1] * w
+        out = np.empty(d.size)
+        curve_values(table, self.grid, self.step, np.ascontiguousarray(d, float), out)
+        return out
 
     def factors(self, x):
         """Static factor of every network at the state ``x`` (1 without a curve)."""
