@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import warnings
 
 import click
 
@@ -21,7 +22,9 @@ from powertrain.errors import InputError
 from powertrain.iotools.engine_file import engine_or_default
 from powertrain.iotools.manoeuvre_file import read_manoeuvre
 from powertrain.iotools.raw_hdf5 import write_raw_hdf5
+from powertrain.solvers.transient import StretchRuleWarning
 from powertrain.workflows import transient as workflow
+from powertrain.workflows import transient_recording as recording
 
 
 @main.command()
@@ -56,9 +59,18 @@ from powertrain.workflows import transient as workflow
                    "of the difference); in --json under 'compare'.")
 @click.option("--compare-plot", type=click.Path(dir_okay=False),
               help="With --compare: measured and simulated accelerations overlaid (PNG).")
+@click.option("--trigger", metavar="CHANNEL",
+              help="Trigger channel of the --compare/--speed-from recording: the manoeuvre's "
+                   "time 0 at its first rising crossing of the mid level between its low "
+                   "and high levels (default: lined up on the crank speed).")
+@click.option("--channel-map", type=click.Path(dir_okay=False),
+              help="Channel map TOML of the --compare/--speed-from recording (the format of "
+                   "'powertrain track --channels'): file channel name -> mount, side, "
+                   "direction, quantity.")
 @quiet_option
 def transient(manoeuvre_file, engine_file, angle_step, speed_from, seat, channels, quantity,
-              out, csv_file, json_file, plot, raw_out, raw_file, compare_plot, quiet):
+              out, csv_file, json_file, plot, raw_out, raw_file, compare_plot, trigger,
+              channel_map, quiet):
     """Transient manoeuvre: time histories of body, mounts and seat over a start, stop,
     tip-in or back-out.
 
@@ -72,26 +84,64 @@ def transient(manoeuvre_file, engine_file, angle_step, speed_from, seat, channel
       powertrain transient examples/start.toml --engine engines/default-modal-body.toml \\
           --plot start.png --json start.json
       powertrain transient examples/start.toml --compare start-raw.h5 --compare-plot o.png
+      powertrain transient examples/tip-in.toml --compare rec.mf4 --trigger trig \\
+          --channel-map map.toml
     """
     files = dict(out=out, csv=csv_file, json=json_file, plot=plot, raw=raw_out,
                  compare_plot=compare_plot)
-    check_outputs(**files)
-    if compare_plot and not raw_file:
-        raise InputError("--compare-plot needs --compare RAW", key="--compare-plot")
-    manoeuvre = read_manoeuvre(manoeuvre_file)
-    engine = engine_or_default(engine_file)
-    result = workflow.transient(manoeuvre, engine, angle_step_deg=angle_step, seat=seat,
-                                speed_from=speed_from)
-    comparison = workflow.compare_transient(result, raw_file) if raw_file else None
+    _check_options(files, raw_file, speed_from, trigger, channel_map)
+    manoeuvre, engine = read_manoeuvre(manoeuvre_file), engine_or_default(engine_file)
+    system = engine.assemble()
+    figure = workflow.figure_channels(system, channels)
+    recorded = _recordings(raw_file, speed_from, trigger, channel_map, system)
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always", StretchRuleWarning)
+        result = workflow.transient(manoeuvre, engine, angle_step_deg=angle_step, seat=seat,
+                                    system=system, speed_from=recorded.get("speed"))
+    _warnings(caught, quiet)
+    comparison = recording.compare_transient(result, recorded["compare"]) if raw_file else None
     written = _write(result, comparison, files, cli_provenance(engine_description(
-        engine, engine.file)), [c.strip() for c in channels.split(",")] if channels else None,
-        quantity)
+        engine, engine.file)), figure, quantity)
     say(result.to_text(), quiet)
     if comparison is not None:
         say(comparison.to_text(), quiet)
     say(f"solver time: {result.solver_seconds:.3f} s; "
         + (wrote(*written) if written
            else "no file written (ask with --out, --csv, --json or --plot)"), quiet)
+
+
+def _check_options(files, raw_file, speed_from, trigger, channel_map) -> None:
+    """The output paths and the options that need another, before any work."""
+    check_outputs(**files)
+    if files["compare_plot"] and not raw_file:
+        raise InputError("--compare-plot needs --compare RAW", key="--compare-plot")
+    for key, value in (("--trigger", trigger), ("--channel-map", channel_map)):
+        if value is not None and not (raw_file or speed_from):
+            raise InputError("goes with --compare RAW or --speed-from RAW", key=key)
+
+
+def _recordings(raw_file, speed_from, trigger, channel_map, system) -> dict:
+    """The recordings of --compare and --speed-from read and checked before the run (the
+    compared channels against the model's); one read where both name the same file."""
+    out = {}
+    for kind, path in (("compare", raw_file), ("speed", speed_from)):
+        if path:
+            same = out.get("compare") if kind == "speed" and path == raw_file else None
+            out[kind] = same or recording.read_recording(path, channel_map=channel_map,
+                                                         trigger=trigger)
+    if raw_file:
+        recording.compared_channels(out["compare"], [f"{c}.{d}" for c, d in system.channels])
+    return out
+
+
+def _warnings(caught, quiet) -> None:
+    """The stretch rule's warnings as one line each; any other warning shown as Python
+    shows it."""
+    for w in caught:
+        if issubclass(w.category, StretchRuleWarning):
+            say(f"warning: {w.message}", quiet, err=True)
+        else:
+            warnings.showwarning(w.message, w.category, w.filename, w.lineno)
 
 
 def _write(result, comparison, files, prov, channels, quantity) -> list:

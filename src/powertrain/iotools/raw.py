@@ -31,6 +31,8 @@ from powertrain.iotools.textfile import check_regular_file
 from powertrain.models.recording import RawChannel, RawRecording
 from powertrain.units import to_si
 
+#: Start of the comment listing the channels a channel map leaves out.
+IGNORED_NOTE = "channels not in the channel map, ignored: "
 _HDF5 = b"\x89HDF\r\n\x1a\n"
 _MDF = b"MDF     "
 
@@ -57,7 +59,8 @@ def detect_format(path) -> str:
 
 
 def read_raw(path, channel_map: ChannelMap | None = None, *, rpm: str | None = None,
-             tacho: str | None = None, cycle_reference: str | None = None) -> RawRecording:
+             tacho: str | None = None, cycle_reference: str | None = None,
+             trigger: str | None = None, map_option: str = "--channels") -> RawRecording:
     """Read a raw run-up recording in any supported format.
 
     Parameters
@@ -73,6 +76,10 @@ def read_raw(path, channel_map: ChannelMap | None = None, *, rpm: str | None = N
     cycle_reference : str, optional
         Name of a once-per-cycle pulse channel [V] (cam or injection signal; default a
         channel named ``cycle``).
+    trigger : str, optional
+        Name of a trigger channel [V] (none by default).
+    map_option : str
+        The command-line option that gives a channel map, named in the hints of errors.
 
     Returns
     -------
@@ -89,8 +96,10 @@ def read_raw(path, channel_map: ChannelMap | None = None, *, rpm: str | None = N
     fmt = detect_format(path)
     reader = {"hdf5": read_hdf5_signals, "mdf": read_mdf_signals,
               "uff": read_uff_signals}.get(fmt, read_csv_signals)
-    found = reader(path, channel_map)
-    return assemble(found, channel_map, rpm=rpm, tacho=tacho, cycle_reference=cycle_reference)
+    found = (read_hdf5_signals(path, channel_map, map_option=map_option) if fmt == "hdf5"
+             else reader(path, channel_map))
+    return assemble(found, channel_map, rpm=rpm, tacho=tacho, cycle_reference=cycle_reference,
+                    trigger=trigger, map_option=map_option)
 
 
 def _find(signals, wanted):
@@ -101,14 +110,15 @@ def _find(signals, wanted):
     return None
 
 
-def _pick_speed(found: FileSignals, cmap, rpm, tacho, cycle_reference=None):
+def _pick_speed(found: FileSignals, cmap, rpm, tacho, cycle_reference=None, trigger=None):
     signals = list(found.signals)
     rpm_name = rpm or (cmap.rpm if cmap else None)
     tacho_name = tacho or (cmap.tacho if cmap else None)
     out = {}
     for kind, wanted, default in (("rpm", rpm_name, "rpm"), ("tacho", tacho_name, "tacho"),
+                                  ("trigger", trigger, None),
                                   ("cycle_reference", cycle_reference, "cycle")):
-        i = _find(signals, wanted or default)
+        i = _find(signals, wanted or default) if wanted or default else None
         if i is None:
             if wanted:
                 raise InputError(f"no channel named {wanted!r} for the "
@@ -182,10 +192,11 @@ def _onto_time(found: FileSignals, speed, time):
 
 
 def assemble(found: FileSignals, cmap: ChannelMap | None = None, *, rpm=None,
-             tacho=None, cycle_reference=None) -> RawRecording:
+             tacho=None, cycle_reference=None, trigger=None,
+             map_option="--channels") -> RawRecording:
     """Map the signals of a file to mount channels in SI (see :func:`read_raw`)."""
     src = found.source
-    speed, signals = _pick_speed(found, cmap, rpm, tacho, cycle_reference)
+    speed, signals = _pick_speed(found, cmap, rpm, tacho, cycle_reference, trigger)
     speed, time, keep = _onto_time(found, speed, _vibration_time(found, signals))
     channels, ignored = [], []
     used = set()
@@ -203,8 +214,8 @@ def assemble(found: FileSignals, cmap: ChannelMap | None = None, *, rpm=None,
             spec = parse_channel_name(name)
             if spec is None:
                 raise InputError("channel name maps to no mount (name it MOUNT.DIRECTION "
-                                 "[UNIT], e.g. 'left.z [m/s^2]', or give a --channels map)",
-                                 file=src, key=name)
+                                 f"[UNIT], e.g. 'left.z [m/s^2]', or give a {map_option} "
+                                 "map)", file=src, key=name)
         unit = spec.unit or file_unit or split_unit(name)[1]
         if not unit:
             raise InputError("channel declares no unit (add it in brackets or as 'unit' in "
@@ -227,7 +238,7 @@ def assemble(found: FileSignals, cmap: ChannelMap | None = None, *, rpm=None,
             ch.values = row
     comments = list(found.comments)
     if ignored:
-        comments.append("channels not in the channel map, ignored: " + ", ".join(ignored))
+        comments.append(IGNORED_NOTE + ", ".join(ignored))
     rec = RawRecording(time, channels, speed.get("rpm"), speed.get("tacho"), src, comments,
-                       speed.get("cycle_reference"))
+                       speed.get("cycle_reference"), speed.get("trigger"))
     return rec.validate(found.time_name)

@@ -30,8 +30,9 @@ def _unit(ds):
     return u.decode() if isinstance(u, bytes) else str(u)
 
 
-def read_hdf5_signals(path, channel_map=None) -> FileSignals:
-    """Signals of a raw HDF5 file (docs/reference/raw-data.md)."""
+def read_hdf5_signals(path, channel_map=None, *, map_option="--channels") -> FileSignals:
+    """Signals of a raw HDF5 file (docs/reference/raw-data.md); ``map_option`` is the
+    option named in the hint of a file that needs a channel map."""
     import h5py  # deferred: heavy package, loaded only when this format is used
     try:
         h5 = h5py.File(path, "r")
@@ -39,13 +40,13 @@ def read_hdf5_signals(path, channel_map=None) -> FileSignals:
         raise InputError(f"cannot open HDF5 file ({exc})", file=path) from None
     with h5:
         try:
-            return _read(h5, path, channel_map)
+            return _read(h5, path, channel_map, map_option)
         except (KeyError, OSError, RuntimeError, TypeError) as exc:
             # h5py's errors for broken links and unreadable objects
             raise InputError(f"unreadable HDF5 object ({str(exc)[:80]})", file=path) from None
 
 
-def _read(h5, path, channel_map):
+def _read(h5, path, channel_map, map_option):
     fmt = _text_attr(h5, "format", path)
     if fmt == "powertrain-runup":
         raise InputError("this is a run-up result (order curves), not raw time data; "
@@ -53,7 +54,7 @@ def _read(h5, path, channel_map):
     if fmt == FORMAT:
         return _read_own(h5, path)
     if channel_map is None:
-        raise InputError(f"not a '{FORMAT}' HDF5 file; give a --channels map naming its "
+        raise InputError(f"not a '{FORMAT}' HDF5 file; give a {map_option} map naming its "
                          "datasets", file=path, key="format")
     return _read_mapped(h5, path, channel_map)
 

@@ -79,6 +79,8 @@ class RawRecording:
     cycle_reference : ndarray (n,) or None
         Once-per-engine-cycle pulse train [V] (cam or injection signal), which fixes the
         720° crank angle of the order phases (:mod:`powertrain.analysis.phase`).
+    trigger : ndarray (n,) or None
+        Trigger channel [V] (the start of an event, :mod:`powertrain.analysis.alignment`).
     """
 
     time: np.ndarray
@@ -88,6 +90,7 @@ class RawRecording:
     source: str = ""
     comments: list = field(default_factory=list)
     cycle_reference: np.ndarray | None = None
+    trigger: np.ndarray | None = None
 
     @property
     def sample_rate(self) -> float:
@@ -153,7 +156,7 @@ class RawRecording:
                 raise InputError(f"channel {ch.label} ({ch.quantity}) appears twice",
                                  file=self.source, key=ch.name)
             seen.add(ch.label + ch.quantity)
-        for name in ("rpm", "tacho", "cycle_reference"):
+        for name in ("rpm", "tacho", "cycle_reference", "trigger"):
             arr = getattr(self, name)
             if arr is not None:
                 arr = np.asarray(arr, float)

@@ -54,6 +54,10 @@ class TransientResult(JsonResult):
         ``point``, per axis ``rms`` [m/s²], ``vdv`` [m/s^1.75] and ``weighting``.
     method : str
     solver_seconds : float
+    notes : list of str
+    speed_source : str
+        Where a recorded crank speed came from and how it was lined up ("" for the
+        manoeuvre's own speed table).
     """
 
     name: str
@@ -74,6 +78,7 @@ class TransientResult(JsonResult):
     method: str = ""
     solver_seconds: float = 0.0
     notes: list = field(default_factory=list)
+    speed_source: str = ""
 
     def channel(self, label) -> int:
         """Column of the channel ``label`` (``"left.z"``)."""
@@ -119,7 +124,8 @@ class TransientResult(JsonResult):
             "vdv_m_per_s1_75": self.seat["vdv"], "weighting": self.seat["weighting"]}
         return {"manoeuvre": self.name, "file": self.file, "engine": self.engine,
                 "duration_s": float(self.time[-1]), "steps": int(self.time.size - 1),
-                "method": self.method, "channels": chans, "mounts": mounts, "seat": seat}
+                "method": self.method, "channels": chans, "mounts": mounts, "seat": seat,
+                "speed_from": self.speed_source or None}
 
     def columns(self) -> dict:
         """CSV column name -> values (n,) (module docstring)."""
@@ -203,6 +209,8 @@ class TransientResult(JsonResult):
                      + ", ".join(f"{a} {s['rms'][a]:.4f}" for a in "xyz")
                      + " m/s^2; VDV " + ", ".join(f"{a} {s['vdv'][a]:.4f}" for a in "xyz")
                      + " m/s^1.75")
+        if self.speed_source:
+            text += "\n" + self.speed_source
         return text
 
 
@@ -292,12 +300,18 @@ class TransientComparison(JsonResult):
     name, raw : str
         Manoeuvre name, the recording's file.
     shift : float
-        Time of the simulation's start in the recording [s] (aligned on the speed).
+        Time of the simulation's start in the recording [s].
     time : ndarray (n,)
-        Simulated times [s].
+        Simulated times [s] compared: those the recording covers.
     channels : list of str
     measured, simulated : ndarray (n, k)
         Accelerations [m/s²] at the simulated times.
+    aligned_on : str
+        How the shift was found: ``crank speed`` or ``trigger 'NAME'``.
+    event : tuple of float
+        First and last time of the simulated event [s] (default: those compared).
+    not_compared : dict of str -> str
+        The recording's other channels and why each was not compared.
     """
 
     name: str
@@ -307,6 +321,14 @@ class TransientComparison(JsonResult):
     channels: list
     measured: np.ndarray
     simulated: np.ndarray
+    aligned_on: str = "crank speed"
+    event: tuple = ()
+    not_compared: dict = field(default_factory=dict)
+
+    def span(self) -> tuple:
+        """First and last time compared, first and last time of the event [s]."""
+        first, last = float(self.time[0]), float(self.time[-1])
+        return (first, last) + (tuple(self.event) if self.event else (first, last))
 
     def errors(self) -> dict:
         """Per channel: the peaks [m/s²], the peak's error [%] and the RMS of the difference
@@ -321,9 +343,14 @@ class TransientComparison(JsonResult):
 
     def to_dict(self) -> dict:
         e = self.errors()
+        first, last, t0, t1 = self.span()
         return {"manoeuvre": self.name, "recording": self.raw, "shift_s": self.shift,
                 "channels": {c: {k: float(v[j]) for k, v in e.items()}
-                             for j, c in enumerate(self.channels)}}
+                             for j, c in enumerate(self.channels)},
+                "aligned_on": self.aligned_on, "compared_from_s": first,
+                "compared_to_s": last, "event_from_s": t0, "event_to_s": t1,
+                "compared_percent": 100.0 * (last - first) / (t1 - t0),
+                "not_compared": dict(self.not_compared)}
 
     def plot(self, ax=None, *, path=None, provenance=None):
         """Measured and simulated acceleration per channel, overlaid; returns the figure
@@ -336,7 +363,16 @@ class TransientComparison(JsonResult):
         rows = [[c, float(e["peak_measured"][j]), float(e["peak_simulated"][j]),
                  f"{e['peak_error_percent'][j]:+.1f}", float(e["rms_difference"][j]),
                  f"{e['rms_difference_percent'][j]:.1f}"] for j, c in enumerate(self.channels)]
-        return (f"compared with {self.raw} (aligned on the crank speed: the simulation starts "
-                f"at {self.shift:.4f} s of the recording)\n" + format_table(
-                    ["channel", "measured peak [m/s^2]", "simulated peak", "peak error [%]",
-                     "RMS of difference", "of measured RMS [%]"], rows))
+        first, last, t0, t1 = self.span()
+        text = (f"compared with {self.raw} (aligned on the {self.aligned_on}: the simulation "
+                f"starts at {self.shift:.4f} s of the recording) over {first:.4f}..{last:.4f} s"
+                f" of the {t1 - t0:g} s event ({100.0 * (last - first) / (t1 - t0):.0f} %)\n"
+                + format_table(["channel", "measured peak [m/s^2]", "simulated peak",
+                                "peak error [%]", "RMS of difference", "of measured RMS [%]"],
+                               rows))
+        by_reason = {}
+        for name, reason in self.not_compared.items():
+            by_reason.setdefault(reason, []).append(name)
+        for reason, names in by_reason.items():
+            text += f"\nnot compared: {', '.join(names)}: {reason}"
+        return text

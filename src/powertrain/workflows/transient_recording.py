@@ -1,0 +1,258 @@
+"""A recording of a manoeuvre against its simulation: read and checked before any work,
+lined up with the manoeuvre (one rule, :func:`align`, for ``--compare`` and
+``--speed-from``), its crank speed driving the manoeuvre, its channels compared.
+
+Lining up: with a trigger channel, the manoeuvre's time 0 is the trigger's first rising
+crossing of its mid level (:func:`powertrain.analysis.alignment.trigger_time`); else the
+time shift whose recorded crank speed (rpm channel, else once-per-revolution tacho) best
+matches the manoeuvre's, refused where the speed varies too little to fix it
+(:func:`powertrain.analysis.alignment.align_speed`).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from powertrain.analysis.alignment import (
+    MIN_COVERAGE,
+    align_speed,
+    coverage,
+    tacho_rpm,
+    trigger_time,
+)
+from powertrain.errors import InputError
+from powertrain.iotools.manoeuvre_file import MAX_RPM
+from powertrain.iotools.raw import IGNORED_NOTE, read_raw
+from powertrain.models.manoeuvre import Manoeuvre
+from powertrain.results.transient import TransientComparison
+
+#: Most rows of a speed table taken from a recording (block means of its samples).
+SPEED_ROWS = 2000
+#: Option that gives a recording's channel map, named in error messages.
+MAP_OPTION = "--channel-map"
+_RPM = np.pi / 30.0
+
+
+@dataclass(frozen=True)
+class Recorded:
+    """A recording of a manoeuvre, read and checked (:func:`read_recording`).
+
+    Attributes
+    ----------
+    path : str
+    time : ndarray (n,)
+        From the first sample [s].
+    rpm : ndarray (n,) or None
+        Crank speed [rpm] at every sample (rpm channel, else tacho; None without either).
+    speed_source : str
+        ``rpm channel``, ``tacho`` or ``""``.
+    trigger : float or None
+        Time of the trigger [s] from the first sample (None without ``--trigger``).
+    trigger_name : str or None
+    channels : list of RawChannel
+    ignored : list of str
+        Channels of the file the channel map leaves out.
+    """
+
+    path: str
+    time: np.ndarray
+    rpm: np.ndarray | None
+    speed_source: str
+    trigger: float | None
+    trigger_name: str | None
+    channels: list
+    ignored: list = field(default_factory=list)
+
+
+def read_recording(path, *, channel_map=None, trigger=None) -> Recorded:
+    """Read and check a recording of a manoeuvre (any format of
+    :func:`~powertrain.iotools.raw.read_raw`; ``channel_map`` as ``powertrain track``'s;
+    ``trigger`` the name of a trigger channel).
+
+    Raises
+    ------
+    InputError
+        One line naming the file and the key: a bad file, channel map or trigger channel.
+    """
+    if trigger is not None and (not isinstance(trigger, str) or not trigger.strip()):
+        raise InputError("expected the name of a channel of the recording",
+                         key="--trigger")
+    rec = read_raw(path, channel_map, trigger=trigger, map_option=MAP_OPTION)
+    t = rec.time - rec.time[0]
+    when = None if rec.trigger is None else trigger_time(t, rec.trigger, file=str(path),
+                                                          key=trigger)
+    ignored = [n.strip() for c in rec.comments if c.startswith(IGNORED_NOTE)
+               for n in c[len(IGNORED_NOTE):].split(",")]
+    return Recorded(str(path), t, recorded_rpm(rec, path), _speed_source(rec), when, trigger,
+                    list(rec.channels), ignored)
+
+
+def recording_or_file(recording, *, channel_map=None, trigger=None) -> Recorded:
+    """A :class:`Recorded` as it is, or read from its file (:func:`read_recording`)."""
+    if isinstance(recording, Recorded):
+        return recording
+    return read_recording(recording, channel_map=channel_map, trigger=trigger)
+
+
+def _speed_source(rec) -> str:
+    return "rpm channel" if rec.rpm is not None else ("tacho" if rec.tacho is not None
+                                                      else "")
+
+
+def recorded_rpm(rec, path) -> np.ndarray | None:
+    """Crank speed [rpm] at every sample of the raw recording ``rec``: its rpm channel, else
+    its once-per-revolution tacho
+    (:func:`~powertrain.analysis.alignment.tacho_rpm`: at rest before the first pulse
+    where the record shows it), else None."""
+    if rec.rpm is not None:
+        return np.asarray(rec.rpm, float)
+    if rec.tacho is not None:
+        return tacho_rpm(rec.time - rec.time[0], rec.tacho, file=str(path), key="tacho")
+    return None
+
+
+def align(rec: Recorded, t_event, rpm_event) -> tuple:
+    """The recording's time [s] of the event's time 0 and how it was found (``trigger
+    'NAME'`` or ``crank speed``): the trigger's time, else the speed alignment against the
+    event's speed ``rpm_event`` [rpm] at ``t_event`` [s] (module docstring)."""
+    if rec.trigger is not None:
+        return rec.trigger - float(t_event[0]), f"trigger {rec.trigger_name!r}"
+    if rec.rpm is None:
+        raise InputError("no rpm or tacho channel to line the recording up on; give "
+                         "--trigger CHANNEL", file=rec.path, key="rpm")
+    key = "rpm" if rec.speed_source == "rpm channel" else "tacho"
+    shift, _ = align_speed(t_event, rpm_event, rec.time, rec.rpm, file=rec.path, key=key)
+    return shift, "crank speed"
+
+
+def speed_from_recording(manoeuvre: Manoeuvre, recording, *, channel_map=None,
+                         trigger=None) -> tuple:
+    """``manoeuvre`` driven by the crank speed of a recording (:func:`read_recording`):
+    lined up with the manoeuvre by :func:`align` (against the manoeuvre's own speed
+    table), its speed over the manoeuvre's span (block means on at most
+    :data:`SPEED_ROWS` rows) replaces the speed table; the load table stays on the
+    manoeuvre's times. Negative speeds are cut to 0 unless the manoeuvre allows a reversal.
+    Returns the manoeuvre and a line saying where its speed came from.
+
+    Raises
+    ------
+    InputError
+        No speed in the recording, or a recording that does not cover the manoeuvre after
+        alignment (one line naming the file and ``time``).
+    """
+    rec = recording_or_file(recording, channel_map=channel_map, trigger=trigger)
+    if rec.rpm is None:
+        raise InputError("no rpm or tacho channel to take the speed from", file=rec.path,
+                         key="rpm")
+    duration = manoeuvre.duration
+    if rec.time[-1] < duration:
+        raise InputError(f"the recording is {rec.time[-1]:.4g} s long, the manoeuvre "
+                         f"{duration:.4g} s; --speed-from needs all of it", file=rec.path,
+                         key="time")
+    shift, how = align(rec, manoeuvre.time, manoeuvre.speed / _RPM)
+    first, last = coverage(0.0, duration, rec.time[0], rec.time[-1], shift)
+    tol = rec.time[1] - rec.time[0]
+    if first > tol or last < duration - tol:
+        raise InputError(f"after alignment ({how}: the manoeuvre starts at {shift:.4f} s of "
+                         f"the recording) the recording covers {first:.4g}..{last:.4g} s of "
+                         f"the manoeuvre's 0..{duration:.4g} s; --speed-from needs all of it",
+                         file=rec.path, key="time")
+    tt, rr = _speed_rows(rec.time - shift, rec.rpm, duration)
+    if not manoeuvre.reversal:
+        rr = np.maximum(rr, 0.0)
+    if not np.all(np.isfinite(rr)) or np.max(np.abs(rr)) > MAX_RPM:
+        raise InputError(f"speed not finite or above {MAX_RPM:g} rpm", file=rec.path,
+                         key="rpm")
+    note = (f"crank speed from {rec.path} ({rec.speed_source}): the manoeuvre starts at "
+            f"{shift:.4f} s of the recording (aligned on the {how})")
+    return manoeuvre.with_speed(tt, rr * _RPM), note
+
+
+def _speed_rows(t, rpm, duration) -> tuple:
+    """Times [s] 0..``duration`` and speeds [rpm]: the samples inside as block means on at
+    most :data:`SPEED_ROWS` rows, the ends interpolated."""
+    inside = np.flatnonzero((t > 0.0) & (t < duration))
+    k = max(1, -(-inside.size // SPEED_ROWS))
+    rows = inside.size // k
+    sel = inside[:rows * k]
+    tt = np.r_[0.0, t[sel].reshape(rows, k).mean(axis=1), duration]
+    rr = np.r_[np.interp(0.0, t, rpm), rpm[sel].reshape(rows, k).mean(axis=1),
+               np.interp(duration, t, rpm)]
+    return tt, rr
+
+
+def compared_channels(rec: Recorded, labels) -> tuple:
+    """The recording's channels compared with the simulation's ``labels`` and, for every
+    other channel of the file, why not: ``([(label, RawChannel)], {name: reason})``.
+
+    Raises
+    ------
+    InputError
+        None compared (naming the file and ``channels``, with the reasons).
+    """
+    labels = list(labels)
+    mounts = sorted({c.rpartition(".")[0] for c in labels if "/" not in c})
+    pairs, skipped = [], {n: "not in the channel map" for n in rec.ignored}
+    for ch in rec.channels:
+        label = f"{ch.mount}.{ch.direction}"
+        if ch.side != "active":
+            skipped[ch.name] = "body side (only engine-side channels are compared)"
+        elif ch.quantity != "acceleration":
+            skipped[ch.name] = f"{ch.quantity} (only accelerations are compared)"
+        elif label not in labels:
+            skipped[ch.name] = (f"no mount or body point {ch.mount!r} in the model (it has "
+                                f"{', '.join(mounts)}; rename with {MAP_OPTION})")
+        else:
+            pairs.append((label, ch))
+    if not pairs:
+        why = "; ".join(f"{n}: {r}" for n, r in skipped.items())
+        raise InputError(f"no engine-side acceleration channel of the simulation in the "
+                         f"recording ({why})", file=rec.path, key="channels")
+    return pairs, skipped
+
+
+def compare_transient(result, raw, *, trigger=None, channel_map=None) -> TransientComparison:
+    """A simulated manoeuvre against a recorded one.
+
+    Parameters
+    ----------
+    result : TransientResult
+    raw : str, Path or Recorded
+        The recording (any format of :func:`~powertrain.iotools.raw.read_raw`).
+    trigger : str, optional
+        Trigger channel: the manoeuvre's time 0 at its first rising crossing of its mid
+        level (default: aligned on the crank speed, :func:`align`).
+    channel_map : ChannelMap, str or Path, optional
+        The recording's channel names -> mount, side, direction, quantity (the format of
+        ``powertrain track --channels``).
+
+    Returns
+    -------
+    TransientComparison
+        Every recorded engine-side acceleration channel the simulation has, over the part
+        of the event the recording covers; the others listed with the reason.
+
+    Raises
+    ------
+    InputError
+        A bad recording, no channel to compare, or less than half the event covered.
+    """
+    rec = recording_or_file(raw, channel_map=channel_map, trigger=trigger)
+    pairs, skipped = compared_channels(rec, result.channels)
+    shift, how = align(rec, result.time, result.rpm)
+    t0, t1 = float(result.time[0]), float(result.time[-1])
+    first, last = coverage(t0, t1, rec.time[0], rec.time[-1], shift)
+    if not last - first >= MIN_COVERAGE * (t1 - t0):
+        raise InputError(f"after alignment ({how}: the simulation starts at {shift:.4f} s of "
+                         f"the recording) the recording covers {max(last - first, 0.0):.4g} "
+                         f"s of the {t1 - t0:.4g} s event, less than {MIN_COVERAGE:.0%}",
+                         file=rec.path, key="time")
+    sel = (result.time >= first) & (result.time <= last)
+    t = result.time[sel]
+    measured = np.array([np.interp(t + shift, rec.time, ch.values) for _, ch in pairs]).T
+    simulated = result.acceleration[np.ix_(sel, [result.channel(lb) for lb, _ in pairs])]
+    return TransientComparison(result.name, rec.path, float(shift), t,
+                               [lb for lb, _ in pairs], measured, simulated, aligned_on=how,
+                               event=(t0, t1), not_compared=skipped)
