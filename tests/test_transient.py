@@ -27,7 +27,7 @@ from powertrain.physics.mount_laws import BergFriction, PowerLaw
 from powertrain.solvers.newmark import newmark, newmark_ports
 from powertrain.solvers.operating_point import StaticSupport, operating_point
 from powertrain.solvers.transient import StretchRuleWarning, simulate_transient
-from powertrain.workflows.transient import compare_transient
+from powertrain.workflows.transient_recording import compare_transient
 from powertrain.workflows.whatif import command_variants, variant_engine
 
 #: Linear limit: order levels of the transient held at one speed vs the run-up's Newmark
