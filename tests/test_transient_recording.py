@@ -205,10 +205,11 @@ def test_a_channel_map_renames_and_the_channels_left_out_are_listed(runs, tmp_pa
 
 def test_recording_and_figure_options_are_checked_before_the_run(runs, tmp_path,
                                                                    monkeypatch):
-    """Defects 6 and 14: a recording with no channel of the model, a bad channel map, a
-    --channels the model does not have, a --seat it does not have, --trigger without a
-    recording: one line naming file and key, exit 1, no file written, and the simulation
-    never started."""
+    """Defects 4, 5, 6 and 14: a recording with no channel of the model, lab names without
+    a map, a bad channel map, a recording too short for --compare or for --speed-from, a
+    flat speed without a trigger, a --channels the model does not have, a --seat it does
+    not have, --trigger without a recording: one line naming file and key, exit 1, no file
+    written, and the simulation never started."""
     def no_run(*args, **kwargs):
         raise AssertionError("the simulation ran")
     monkeypatch.setattr(workflow, "simulate_transient", no_run)
@@ -219,8 +220,14 @@ def test_recording_and_figure_options_are_checked_before_the_run(runs, tmp_path,
     lab.write_text("time [s],rpm [1/min],ACC1 [m/s^2]\n"
                    + "".join(f"{i * 1e-3},0,0\n" for i in range(20)), encoding="utf-8")
     (tmp_path / "bad.toml").write_text("[channels]\nx = 1\n", encoding="utf-8")
+    tiny = _written(tmp_path / "tiny.h5", runs["start"], keep=0.2)
+    short = _written(tmp_path / "short.h5", runs["start"], keep=0.4)
+    flat = _written(tmp_path / "flat.h5", runs["tip"], before=0.2, rpm_noise=3.0)
     out = tmp_path / "o.json"
     cases = {
+        "too short": ([m, "--compare", tiny], "tiny.h5", "'time'"),
+        "speed short": ([m, "--speed-from", short], "short.h5", "needs all of it"),
+        "flat": ([runs["dir"] / "tip.toml", "--compare", flat], "flat.h5", "--trigger"),
         "no channel": ([m, "--compare", raw], "other.h5", "'channels'"),
         "lab names": ([m, "--compare", lab], "ACC1", "give a --channel-map map"),
         "bad map": ([m, "--compare", raw, "--channel-map", tmp_path / "bad.toml"],

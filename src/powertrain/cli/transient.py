@@ -93,7 +93,7 @@ def transient(manoeuvre_file, engine_file, angle_step, speed_from, seat, channel
     manoeuvre, engine = read_manoeuvre(manoeuvre_file), engine_or_default(engine_file)
     system = engine.assemble()
     figure = workflow.figure_channels(system, channels)
-    recorded = _recordings(raw_file, speed_from, trigger, channel_map, system)
+    recorded = _recordings(raw_file, speed_from, trigger, channel_map, system, manoeuvre)
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always", StretchRuleWarning)
         result = workflow.transient(manoeuvre, engine, angle_step_deg=angle_step, seat=seat,
@@ -120,17 +120,18 @@ def _check_options(files, raw_file, speed_from, trigger, channel_map) -> None:
             raise InputError("goes with --compare RAW or --speed-from RAW", key=key)
 
 
-def _recordings(raw_file, speed_from, trigger, channel_map, system) -> dict:
+def _recordings(raw_file, speed_from, trigger, channel_map, system, manoeuvre) -> dict:
     """The recordings of --compare and --speed-from read and checked before the run (the
-    compared channels against the model's); one read where both name the same file."""
+    compared channels against the model's, the alignment and the span covered); one read
+    where both name the same file."""
     out = {}
     for kind, path in (("compare", raw_file), ("speed", speed_from)):
         if path:
             same = out.get("compare") if kind == "speed" and path == raw_file else None
             out[kind] = same or recording.read_recording(path, channel_map=channel_map,
                                                          trigger=trigger)
-    if raw_file:
-        recording.compared_channels(out["compare"], [f"{c}.{d}" for c, d in system.channels])
+    recording.check_recordings(manoeuvre, [f"{c}.{d}" for c, d in system.channels],
+                               compare=out.get("compare"), speed=out.get("speed"))
     return out
 
 

@@ -243,12 +243,7 @@ def compare_transient(result, raw, *, trigger=None, channel_map=None) -> Transie
     pairs, skipped = compared_channels(rec, result.channels)
     shift, how = align(rec, result.time, result.rpm)
     t0, t1 = float(result.time[0]), float(result.time[-1])
-    first, last = coverage(t0, t1, rec.time[0], rec.time[-1], shift)
-    if not last - first >= MIN_COVERAGE * (t1 - t0):
-        raise InputError(f"after alignment ({how}: the simulation starts at {shift:.4f} s of "
-                         f"the recording) the recording covers {max(last - first, 0.0):.4g} "
-                         f"s of the {t1 - t0:.4g} s event, less than {MIN_COVERAGE:.0%}",
-                         file=rec.path, key="time")
+    first, last = _covered(rec, t0, t1, shift, how)
     sel = (result.time >= first) & (result.time <= last)
     t = result.time[sel]
     measured = np.array([np.interp(t + shift, rec.time, ch.values) for _, ch in pairs]).T
@@ -256,3 +251,35 @@ def compare_transient(result, raw, *, trigger=None, channel_map=None) -> Transie
     return TransientComparison(result.name, rec.path, float(shift), t,
                                [lb for lb, _ in pairs], measured, simulated, aligned_on=how,
                                event=(t0, t1), not_compared=skipped)
+
+
+def _covered(rec: Recorded, t0, t1, shift, how) -> tuple:
+    """The event times ``t0..t1`` [s] the recording covers at ``shift``; at least
+    :data:`MIN_COVERAGE` of the event, else an error naming the file and ``time``."""
+    first, last = coverage(t0, t1, rec.time[0], rec.time[-1], shift)
+    if not last - first >= MIN_COVERAGE * (t1 - t0):
+        raise InputError(f"after alignment ({how}: the simulation starts at {shift:.4f} s of "
+                         f"the recording) the recording covers {max(last - first, 0.0):.4g} "
+                         f"s of the {t1 - t0:.4g} s event, less than {MIN_COVERAGE:.0%}",
+                         file=rec.path, key="time")
+    return first, last
+
+
+def check_recordings(manoeuvre: Manoeuvre, labels, *, compare=None, speed=None) -> None:
+    """Everything about the recordings of ``--compare`` and ``--speed-from`` that can be
+    checked before the simulation: the channels compared (against the model's ``labels``),
+    the recorded speed lined up with the manoeuvre and covering it, the compared recording
+    lined up with the (driven) manoeuvre's speed and covering at least half of it.
+
+    Raises
+    ------
+    InputError
+        As :func:`compared_channels`, :func:`speed_from_recording` and
+        :func:`compare_transient` would after the run.
+    """
+    if speed is not None:
+        manoeuvre, _ = speed_from_recording(manoeuvre, speed)
+    if compare is not None:
+        compared_channels(compare, labels)
+        shift, how = align(compare, manoeuvre.time, manoeuvre.speed / _RPM)
+        _covered(compare, 0.0, manoeuvre.duration, shift, how)
