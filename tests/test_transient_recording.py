@@ -147,7 +147,7 @@ def test_a_short_recording_is_compared_over_its_span_only(runs, tmp_path):
     doc = part.to_dict()
     assert doc["compared_to_s"] == pytest.approx(0.3, abs=2e-4)
     assert doc["compared_percent"] == pytest.approx(60.0, abs=0.1)
-    assert "over 0.0000..0.3000 s of the 0.5 s event (60 %)" in part.to_text()
+    assert "over 0.0000 to 0.3000 s of the 0.5 s event (60 %)" in part.to_text()
     assert np.max(part.errors()["rms_difference_percent"]) < SAME_PERCENT
     tiny = _written(tmp_path / "tiny.h5", first, keep=0.2)
     with pytest.raises(pt.InputError, match="less than 50%") as err:

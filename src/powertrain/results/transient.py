@@ -365,7 +365,7 @@ class TransientComparison(JsonResult):
                  f"{e['rms_difference_percent'][j]:.1f}"] for j, c in enumerate(self.channels)]
         first, last, t0, t1 = self.span()
         text = (f"compared with {self.raw} (aligned on the {self.aligned_on}: the simulation "
-                f"starts at {self.shift:.4f} s of the recording) over {first:.4f}..{last:.4f} s"
+                f"starts at {self.shift:.4f} s of the recording) over {first:.4f} to {last:.4f} s"
                 f" of the {t1 - t0:g} s event ({100.0 * (last - first) / (t1 - t0):.0f} %)\n"
                 + format_table(["channel", "measured peak [m/s^2]", "simulated peak",
                                 "peak error [%]", "RMS of difference", "of measured RMS [%]"],

@@ -156,8 +156,8 @@ def speed_from_recording(manoeuvre: Manoeuvre, recording, *, channel_map=None,
     tol = rec.time[1] - rec.time[0]
     if first > tol or last < duration - tol:
         raise InputError(f"after alignment ({how}: the manoeuvre starts at {shift:.4f} s of "
-                         f"the recording) the recording covers {first:.4g}..{last:.4g} s of "
-                         f"the manoeuvre's 0..{duration:.4g} s; --speed-from needs all of it",
+                         f"the recording) the recording covers {first:.4g} to {last:.4g} s of "
+                         f"the manoeuvre's 0 to {duration:.4g} s; --speed-from needs all of it",
                          file=rec.path, key="time")
     tt, rr = _speed_rows(rec.time - shift, rec.rpm, duration)
     if not manoeuvre.reversal:
