@@ -35,7 +35,8 @@ from powertrain.workflows import transient_recording as recording
               help="Crank angle per integration step at the top speed [deg].")
 @click.option("--speed-from", type=click.Path(dir_okay=False),
               help="Raw recording (CSV, HDF5, UFF, MDF4) whose rpm channel or tacho drives "
-                   "the crank instead of the file's speed table.")
+                   "the crank instead of the file's speed table, lined up with the "
+                   "manoeuvre as for --compare; it must cover the whole manoeuvre.")
 @click.option("--seat", help="Body point for the ISO 2631-1 values (default: a body point "
                              "named seat...).")
 @click.option("--channels", help="Channels of the figure, comma separated (e.g. "
@@ -54,9 +55,10 @@ from powertrain.workflows import transient_recording as recording
               help="Write the engine-side accelerations and the crank speed as raw time data "
                    "(raw HDF5 layout, labelled SYNTHETIC), e.g. to try --compare.")
 @click.option("--compare", "raw_file", type=click.Path(dir_okay=False),
-              help="A recording of the manoeuvre (raw CSV, HDF5, UFF, MDF4): aligned on its "
-                   "crank speed, every engine-side acceleration channel compared (peaks, RMS "
-                   "of the difference); in --json under 'compare'.")
+              help="A recording of the manoeuvre (raw CSV, HDF5, UFF, MDF4): lined up on its "
+                   "crank speed (or --trigger), every engine-side acceleration channel "
+                   "compared over the span it covers (peaks, RMS of the difference); in "
+                   "--json under 'compare'.")
 @click.option("--compare-plot", type=click.Path(dir_okay=False),
               help="With --compare: measured and simulated accelerations overlaid (PNG).")
 @click.option("--trigger", metavar="CHANNEL",

@@ -128,7 +128,7 @@ def seat_point(engine, seat) -> str | None:
 def figure_channels(system, channels) -> list | None:
     """The figure's channels (labels ``mount.direction``, or a comma-separated string)
     checked against the model's before any work; None for the default."""
-    if channels is None:
+    if not channels:
         return None
     if isinstance(channels, str):
         channels = [c.strip() for c in channels.split(",")]
