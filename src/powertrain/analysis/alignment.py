@@ -76,7 +76,17 @@ def tacho_rpm(time, tacho, *, file=None, key="tacho") -> np.ndarray:
 
 def trigger_time(time, signal, *, file=None, key="--trigger") -> float:
     """Time [s] of the first rising crossing of the mid level between the smallest and the
-    largest value of ``signal`` (linear between samples)."""
+    largest value of ``signal`` (linear between samples).
+
+    Parameters
+    ----------
+    time : ndarray (n,)
+        [s]
+    signal : ndarray (n,)
+        Trigger channel [V or any unit].
+    file, key : str, optional
+        Named in error messages.
+    """
     time = np.asarray(time, float)
     x = np.asarray(signal, float)
     lo, hi = float(np.min(x)), float(np.max(x))
@@ -101,6 +111,15 @@ def coverage(t0, t1, rec0, rec1, shift):
 def align_speed(t_sim, rpm_sim, t_rec, rpm_rec, *, file=None, key="rpm") -> tuple:
     """Time shift [s] of the recording against the event (the recording's time of the event's
     time 0) and its standard error [s], from the speeds (module docstring).
+
+    Parameters
+    ----------
+    t_sim, rpm_sim : ndarray
+        The event's times [s] and crank speed [rpm] (the manoeuvre's or the simulation's).
+    t_rec, rpm_rec : ndarray
+        The recording's sample times [s] and crank speed [rpm].
+    file, key : str, optional
+        Named in error messages.
 
     Raises
     ------
