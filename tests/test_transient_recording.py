@@ -112,6 +112,24 @@ def test_speed_from_lines_the_recording_up_with_the_manoeuvre(runs, tmp_path):
     assert abs(compare_transient(again, raw).shift - 0.3) < 1e-3
 
 
+def test_a_recording_of_two_starts_needs_a_trigger(runs, tmp_path):
+    """Defect 5: the start recorded twice, 0.3 s of standstill between: the speed matches
+    at both (0 s and 0.8 s), so the recording is refused, saying to give --trigger (before:
+    the first taken without a word)."""
+    first = runs["start"]
+    once = first.recording()
+    h = once.time[1] - once.time[0]
+    n0 = int(round(0.3 / h))
+    twice = [np.r_[v, np.zeros(n0), v] for v in [once.rpm] + [c.values for c in once.channels]]
+    chans = [dataclasses.replace(c, values=v) for c, v in zip(once.channels, twice[1:])]
+    write_raw_hdf5(tmp_path / "two.h5", RawRecording(np.arange(twice[0].size) * h, chans,
+                                                     twice[0], None, "test", ["SYNTHETIC"]),
+                   synthetic=True)
+    with pytest.raises(pt.InputError, match=r"at two places .* give --trigger") as err:
+        compare_transient(first, tmp_path / "two.h5")
+    assert "two.h5" in str(err.value)
+
+
 def test_a_once_per_rev_tacho_is_at_rest_before_its_first_pulses(tmp_path):
     """Defect 3: at rest until 0.5 s, then 20 rev/s² (1200 rpm at 1.5 s), one pulse per
     revolution 0.3 rev after the rest position. Before the crank moves the speed is 0 (it

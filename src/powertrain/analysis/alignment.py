@@ -26,7 +26,10 @@ parameter), :math:`\sigma` the recorded speed's scatter (the second differences'
 :math:`\sqrt 6`, at least :data:`SPEED_FLOOR_RPM`); where :data:`ALIGN_SIGMAS` standard
 errors exceed the time the crank takes to turn :data:`ALIGN_TOLERANCE_DEG` at the event's
 top speed, the speed varies too little to align on and the recording is refused (a trigger
-channel is then needed).
+channel is then needed). It is refused too where the speed matches as well elsewhere: a
+shift outside the valley of the best one (beyond where the cost first rises by
+:math:`\sigma^2` on either side) whose cost is within :math:`\sigma^2` of the best (a
+recording of two starts).
 """
 
 from __future__ import annotations
@@ -135,21 +138,25 @@ def align_speed(t_sim, rpm_sim, t_rec, rpm_rec, *, file=None, key="rpm") -> tupl
                          key="time")
     t = np.linspace(t_sim[0], t_sim[-1], GRID)
     target = np.interp(t, t_sim, rpm_sim)
-
-    def costs(shifts):
-        at = t[None, :] + shifts[:, None]
-        inside = (at >= t_rec[0]) & (at <= t_rec[-1])
-        err = np.where(inside, np.interp(at, t_rec, rpm_rec) - target, 0.0)
-        return np.sum(err ** 2, axis=1) / np.maximum(np.sum(inside, axis=1), 1)
-
+    costs = _costs(t, target, t_rec, rpm_rec)
     lo, hi = sorted((t_rec[0] - t_sim[0], t_rec[-1] - t_sim[-1]))
     shifts = np.linspace(lo, hi, 801)
-    shift = float(shifts[np.argmin(costs(shifts))])
+    coarse = costs(shifts)
+    best = int(np.argmin(coarse))
+    shift = float(shifts[best])
     step = shifts[1] - shifts[0]
     if step > 0:
         fine = np.clip(shift + np.linspace(-2.0, 2.0, 201) * step, lo, hi)
         shift = float(fine[np.argmin(costs(fine))])
-    error = _shift_error(t, target, t_rec, rpm_rec, shift)
+    sigma = _scatter(t, t_rec, rpm_rec, shift)
+    other = _second_match(coarse, best, sigma ** 2)
+    if other is not None:
+        raise InputError(f"the crank speed matches the event's at two places of the recording "
+                         f"(the event starting at {shift:.4f} s or at {shifts[other]:.4f} s); "
+                         "give --trigger CHANNEL", file=file, key=key)
+    slope = np.gradient(target, t)[(t + shift >= t_rec[0]) & (t + shift <= t_rec[-1])]
+    info = float(np.sum(slope ** 2))
+    error = sigma / np.sqrt(info) if info > 0 else np.inf
     top = max(float(np.max(np.abs(target))), SPEED_FLOOR_RPM)
     allowed = ALIGN_TOLERANCE_DEG / (6.0 * top)
     if not ALIGN_SIGMAS * error <= allowed:
@@ -161,14 +168,36 @@ def align_speed(t_sim, rpm_sim, t_rec, rpm_rec, *, file=None, key="rpm") -> tupl
     return shift, error
 
 
-def _shift_error(t, target, t_rec, rpm_rec, shift) -> float:
-    """Standard error [s] of the shift: the recorded speed's scatter over the slope of the
-    simulated one at the event times inside the recording."""
-    inside = (t + shift >= t_rec[0]) & (t + shift <= t_rec[-1])
-    sel = (t_rec >= t[inside][0] + shift) & (t_rec <= t[inside][-1] + shift)
+def _costs(t, target, t_rec, rpm_rec):
+    """Mean squared speed difference [rpm²] over the event times inside the recording, as
+    a function of an array of shifts."""
+    def costs(shifts):
+        at = t[None, :] + shifts[:, None]
+        inside = (at >= t_rec[0]) & (at <= t_rec[-1])
+        err = np.where(inside, np.interp(at, t_rec, rpm_rec) - target, 0.0)
+        return np.sum(err ** 2, axis=1) / np.maximum(np.sum(inside, axis=1), 1)
+    return costs
+
+
+def _second_match(costs, best, margin):
+    """Index of the best shift outside the valley of ``best`` whose cost is within
+    ``margin`` of the best (as good a match elsewhere), else None."""
+    above = np.flatnonzero(costs >= costs[best] + margin)
+    left = above[above < best]
+    right = above[above > best]
+    outside = np.zeros(costs.size, bool)
+    if left.size:
+        outside[:left[-1]] = True
+    if right.size:
+        outside[right[0] + 1:] = True
+    close = np.flatnonzero(outside & (costs < costs[best] + margin))
+    return int(close[np.argmin(costs[close])]) if close.size else None
+
+
+def _scatter(t, t_rec, rpm_rec, shift) -> float:
+    """The recorded speed's scatter [rpm] over the event at ``shift``: the RMS of its second
+    differences over sqrt(6) (white noise), at least :data:`SPEED_FLOOR_RPM`."""
+    sel = (t_rec >= t[0] + shift) & (t_rec <= t[-1] + shift)
     r = np.asarray(rpm_rec, float)[sel]
     scatter = np.sqrt(np.mean(np.diff(r, 2) ** 2) / 6.0) if r.size > 2 else 0.0
-    sigma = max(scatter, SPEED_FLOOR_RPM)
-    slope = np.gradient(target, t)[inside]
-    info = float(np.sum(slope ** 2))
-    return sigma / np.sqrt(info) if info > 0 else np.inf
+    return max(scatter, SPEED_FLOOR_RPM)

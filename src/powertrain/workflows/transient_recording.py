@@ -147,17 +147,17 @@ def speed_from_recording(manoeuvre: Manoeuvre, recording, *, channel_map=None,
         raise InputError("no rpm or tacho channel to take the speed from", file=rec.path,
                          key="rpm")
     duration = manoeuvre.duration
-    if rec.time[-1] < duration:
-        raise InputError(f"the recording is {rec.time[-1]:.4g} s long, the manoeuvre "
-                         f"{duration:.4g} s; --speed-from needs all of it", file=rec.path,
+    tol = rec.time[1] - rec.time[0]                 # one sample of the recording
+    if rec.time[-1] < duration - tol:
+        raise InputError(f"the recording is {rec.time[-1]:.6g} s long, the manoeuvre "
+                         f"{duration:.6g} s; --speed-from needs all of it", file=rec.path,
                          key="time")
     shift, how = align(rec, manoeuvre.time, manoeuvre.speed / _RPM)
     first, last = coverage(0.0, duration, rec.time[0], rec.time[-1], shift)
-    tol = rec.time[1] - rec.time[0]
     if first > tol or last < duration - tol:
         raise InputError(f"after alignment ({how}: the manoeuvre starts at {shift:.4f} s of "
-                         f"the recording) the recording covers {first:.4g} to {last:.4g} s of "
-                         f"the manoeuvre's 0 to {duration:.4g} s; --speed-from needs all of it",
+                         f"the recording) the recording covers {first:.6g} to {last:.6g} s of "
+                         f"the manoeuvre's 0 to {duration:.6g} s; --speed-from needs all of it",
                          file=rec.path, key="time")
     tt, rr = _speed_rows(rec.time - shift, rec.rpm, duration)
     if not manoeuvre.reversal:
