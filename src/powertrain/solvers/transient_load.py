@@ -87,13 +87,23 @@ def transient_load(engine, manoeuvre, t) -> TransientLoad:
     th = np.mod(theta, 4 * np.pi) * (N_THETA / (4 * np.pi))
     F += (omega ** 2)[:, None] * _periodic(table.inertia, th)
     F += alpha[:, None] * _periodic(table.acceleration, th)
-    F[:, 3:] -= (J * alpha + manoeuvre.gear_ratio * driveline)[:, None] * n[None, :]
+    F[:, 3:] -= (J * alpha)[:, None] * n[None, :]
+    F += driveline_reaction(engine, manoeuvre, driveline)
     starter = np.zeros_like(t)
     if manoeuvre.starter is not None:
         on = t < manoeuvre.starter.until
         starter[on] = (J * alpha + driveline - engine_torque)[on]
     return TransientLoad(np.asarray(t, float), theta, omega, alpha, scale, engine_torque,
                          driveline, starter, F)
+
+
+def driveline_reaction(engine, manoeuvre, driveline):
+    r"""The driveline torque's reaction on the block (..., 6) [N, N·m] about the CG:
+    :math:`-i\,T_d\,\mathbf n` for the driveline torque ``driveline`` (...) [N·m]."""
+    n = np.array([float(engine.crank.rotation_sign), 0.0, 0.0])
+    out = np.zeros(np.shape(driveline) + (6,))
+    out[..., 3:] = -manoeuvre.gear_ratio * np.asarray(driveline, float)[..., None] * n
+    return out
 
 
 def _periodic(table, th):
