@@ -73,6 +73,12 @@ time = {value = [0.0, 0.5], unit = "s"}
 imep_scale = {value = [0.0, 0.1], unit = "1"}
 """
 
+STARTER = """[starter]
+ratio = {value = 13.0, unit = "1"}
+reaction_point = {value = [380.0, -160.0, -120.0], unit = "mm"}
+until = {value = 0.2, unit = "s"}
+"""
+
 #: name -> (text replaced, replacement, key named in the error)
 BAD = {
     "non-monotonic time": ("[0.0, 0.2, 0.5], unit = \"s\"}\nspeed",
@@ -91,6 +97,14 @@ BAD = {
                    "[0.1, 0.2, 0.5], unit = \"s\"}\nspeed", "speed.time"),
     "wrong unit": ("unit = \"rpm\"", "unit = \"N\"", "speed.speed.unit"),
     "unknown key": ("name = \"t\"", "name = \"t\"\nspeeed = 1", "manoeuvre.speeed"),
+    "huge crank inertia": ("value = 0.18, unit", "value = 1e12, unit", "manoeuvre.crank_inertia"),
+    "no crank inertia where the speed changes": (
+        'crank_inertia = {value = 0.18, unit = "kg*m^2"}', "", "manoeuvre.crank_inertia"),
+    "huge gear ratio": ('name = "t"', 'name = "t"\ngear_ratio = {value = 1e9, unit = "1"}',
+                        "manoeuvre.gear_ratio"),
+    "starter ratio": ("[load]", STARTER.replace("13.0", "1e12") + "[load]", "starter.ratio"),
+    "starter far away": ("[load]", STARTER.replace("380.0", "3.8e9") + "[load]",
+                         "starter.reaction_point"),
     "too many rows": ("[0.0, 0.2, 0.5], unit = \"s\"}\nspeed",
                       "[" + ", ".join(str(i * 1e-3) for i in range(5000))
                       + "], unit = \"s\"}\nspeed", "speed.time.value"),
@@ -107,6 +121,34 @@ def test_a_bad_manoeuvre_file_is_one_line_naming_file_and_key(name, tmp_path):
         read_manoeuvre(path)
     text = str(err.value)
     assert "\n" not in text and str(path) in text and f"'{key}'" in text, text
+
+
+@pytest.mark.parametrize("change, key", [
+    (dict(time=[0.0, 1.0, 0.5, 3.0]), "speed.time"),                     # backwards
+    (dict(time=[0.0, 1.0, 1.0, 3.0]), "speed.time"),                     # repeated
+    (dict(speed=[0.0, np.nan, 50.0, 80.0]), "speed.speed"),
+    (dict(speed=[0.0, -5.0, 50.0, 80.0]), "speed.speed"),                # no reversal
+    (dict(time=[0.0, 1.0, 2.0, 4.0]), "load.time"),                      # load ends early
+])
+def test_a_manoeuvre_built_in_python_is_checked_as_its_file(change, key):
+    """The model checks itself: an object made in a notebook gets the file's one-line
+    errors (pt.InputError naming the key), not an IndexError deep in the solver."""
+    m = read_manoeuvre(EXAMPLES / "start.toml")
+    table = {"time": [0.0, 1.0, 2.0, 3.0], "speed": [0.0, 30.0, 50.0, 80.0], **change}
+    with pytest.raises(pt.InputError) as err:
+        m.with_speed(table["time"], table["speed"])
+    assert f"'{key}'" in str(err.value) and "\n" not in str(err.value), str(err.value)
+
+
+def test_a_hold_may_be_longer_than_the_gap_rule(tmp_path):
+    """Rows more than 5 s apart are a gap only where the value changes between them."""
+    path = tmp_path / "hold.toml"
+    path.write_text(GOOD.replace('"s"}\nimep_scale = {value = [0.0, 0.1]',
+                                 '"s"}\nimep_scale = {value = [0.1, 0.1]')
+                    .replace("time = {value = [0.0, 0.5], unit = \"s\"}\nimep",
+                             "time = {value = [0.0, 59.0], unit = \"s\"}\nimep"),
+                    encoding="utf-8")
+    assert read_manoeuvre(path).load_time[-1] == 59.0
 
 
 def test_a_good_file_reads_in_si_and_the_crank_angle_is_exact(tmp_path):

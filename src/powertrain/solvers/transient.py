@@ -78,6 +78,8 @@ STRETCH = 0.01
 CURVE_STEP = 0.002
 #: Most integration steps of a manoeuvre (checked before any work).
 MAX_STEPS = 2 ** 21
+#: Most memory of a run's time histories [B] (checked before any work).
+MAX_BYTES = 2e9
 #: Speed below which the step is set as at this speed [rpm]: standstill needs a step too.
 FLOOR_RPM = 600.0
 
@@ -171,6 +173,7 @@ def simulate_transient(engine, manoeuvre, *, system=None, angle_step_deg=1.0) ->
     if system.chassis is not None:
         system.chassis.require_time_domain()
     n_steps = transient_steps(manoeuvre, angle_step_deg)
+    _check_size(n_steps, system, manoeuvre)
     t = np.linspace(0.0, manoeuvre.duration, n_steps + 1)
     load = transient_load(engine, manoeuvre, t)
     F = np.zeros((t.size, system.n_dof))
@@ -188,6 +191,17 @@ def simulate_transient(engine, manoeuvre, *, system=None, angle_step_deg=1.0) ->
                         X @ system.port_rows.T, list(system.channels),
                         system.network_names, _method(scaling, ports, curves, every, sub), X, V,
                         *extra, every, sub)
+
+
+def _check_size(n_steps, system, manoeuvre):
+    """Refuse, before any work, a run whose time histories exceed :data:`MAX_BYTES`."""
+    n, n_ch, n_net = system.n_dof, len(system.channels), system.port_rows.shape[0]
+    size = 8.0 * (n_steps + 1) * (6 * n + 5 * n_ch + 4 * n_net)
+    if size > MAX_BYTES:
+        raise InputError(f"{n_steps} steps of {n} coordinates hold about {size / 1e9:.1f} GB "
+                         f"of time histories; at most {MAX_BYTES / 1e9:g} GB (a shorter "
+                         "manoeuvre or a larger --angle-step)", file=manoeuvre.file or None,
+                         key="speed")
 
 
 def _stretch_steps(h, n_steps, varying, curves):

@@ -23,9 +23,9 @@ from powertrain.analysis.comfort import (
 from powertrain.analysis.speed import tacho_edges
 from powertrain.errors import InputError
 from powertrain.iotools.engine_file import engine_or_default
-from powertrain.iotools.manoeuvre_file import MAX_RPM, read_manoeuvre
+from powertrain.iotools.manoeuvre_file import read_manoeuvre
 from powertrain.iotools.raw import read_raw
-from powertrain.models.manoeuvre import Manoeuvre
+from powertrain.models.manoeuvre import MAX_RPM, Manoeuvre
 from powertrain.parallel import single_blas_thread
 from powertrain.results.transient import TransientComparison, TransientResult
 from powertrain.solvers.transient import simulate_transient
