@@ -27,6 +27,7 @@ from powertrain.physics.mount_laws import BergFriction, PowerLaw
 from powertrain.solvers.newmark import newmark, newmark_ports
 from powertrain.solvers.operating_point import StaticSupport, operating_point
 from powertrain.solvers.transient import StretchRuleWarning, simulate_transient
+from powertrain.solvers.transient_load import transient_load
 from powertrain.workflows.transient import compare_transient
 from powertrain.workflows.whatif import command_variants, variant_engine
 
@@ -325,6 +326,27 @@ def test_under_a_held_torque_the_body_sits_at_its_static_operating_point(default
     static = (op.deflection - op0.deflection).ravel()
     assert np.max(np.abs(mean - static)) <= HELD_M, np.abs(mean - static).max()
     assert np.max(np.abs(static)) > 0.5e-3                      # a real roll, 0.5 mm+
+
+
+@pytest.mark.parametrize("kind", ["imep_scale", "mean_torque"])
+def test_the_load_table_runs_from_the_cycle_without_burn_to_full_load(default_engine, kind):
+    """IMEP scale 0 is the motored cycle (no burn: its brake torque is the friction's and
+    the pumping's drag), s0 the fired cycle of zero torque, 1 the full load; a negative
+    mean torque (engine braking) is as much of that drag."""
+    rpm, e = 1500.0, default_engine
+    drag = e.motored().mean_brake_torque(rpm)
+    work = [np.sum(e.indicated_work(rpm, x)) for x in (0.0, 1.0)]
+    s0 = work[0] / work[1]
+    values = ([0.0, 0.5 * s0, s0, 1.0] if kind == "imep_scale"
+              else [drag, 0.5 * drag, 0.0, e.mean_brake_torque(rpm)])
+    w = rpm * np.pi / 30.0
+    t = np.arange(4.0)
+    m = Manoeuvre("held", np.array([0.0, 3.0]), np.full(2, w), t, np.array(values), kind)
+    load = transient_load(e, m, t)
+    expected = [drag, 0.5 * drag, 0.0, e.mean_brake_torque(rpm)]
+    assert drag < -5.0                                      # friction and pumping
+    np.testing.assert_allclose(load.engine_torque, expected, atol=1e-6 * abs(expected[-1]))
+    np.testing.assert_allclose(load.scale, [0.0, 0.5 * s0, s0, 1.0], atol=1e-12)
 
 
 def test_a_held_torque_on_static_curves_starts_at_its_static_point():

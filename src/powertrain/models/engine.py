@@ -28,7 +28,7 @@ import numpy as np
 from powertrain.analysis.fourier import harmonic_amplitudes
 from powertrain.assembly import assemble
 from powertrain.errors import InputError
-from powertrain.models.combustion import RPM, LoadedCombustion
+from powertrain.models.combustion import RPM, LoadedCombustion, MotoredCombustion
 from powertrain.models.crank_train import Balancer, CrankTrain
 from powertrain.models.memo import Memo
 from powertrain.physics import balancer as bal
@@ -196,6 +196,10 @@ class Engine:
         if float(load) == 1.0:
             return self
         return self.replace(combustion=LoadedCombustion(self.combustion, float(load)))
+
+    def motored(self) -> Engine:
+        """A copy whose cylinders run without burn (:class:`MotoredCombustion`)."""
+        return self.replace(combustion=MotoredCombustion(self.combustion))
 
     @property
     def mount_names(self) -> list:
