@@ -198,8 +198,12 @@ class Engine:
         return self.replace(combustion=LoadedCombustion(self.combustion, float(load)))
 
     def motored(self) -> Engine:
-        """A copy whose cylinders run without burn (:class:`MotoredCombustion`)."""
-        return self.replace(combustion=MotoredCombustion(self.combustion))
+        """A copy whose cylinders run without burn (:class:`MotoredCombustion`); its memo
+        starts with this one's load patterns, which depend on the geometry only."""
+        out = self.replace(combustion=MotoredCombustion(self.combustion))
+        if "load patterns" in self._cache:
+            out._cache["load patterns"] = self._cache["load patterns"]
+        return out
 
     @property
     def mount_names(self) -> list:

@@ -132,10 +132,10 @@ class _GasTable:
         self.n = np.array([float(engine.crank.rotation_sign), 0.0, 0.0])
         inertia, acceleration = engine.motion_patterns(theta)
         w2 = ((self.speeds * RPM) ** 2)[:, None, None]
-        motored = engine.motored() if self.scales[0] < 0 else None
-        gas = np.stack([(motored.load_table(self.speeds, theta) if s < 0 else
-                         engine.load_table(self.speeds, theta, s)) - w2 * inertia
-                        for s in self.scales])
+        fired = {s: engine.load_table(self.speeds, theta, s) for s in self.scales if s >= 0}
+        motored = engine.motored() if self.scales[0] < 0 else None   # after: its patterns
+        gas = np.stack([(motored.load_table(self.speeds, theta) if s < 0 else fired[s])
+                        - w2 * inertia for s in self.scales])
         self.table = _wrap(self._no_mean_roll(gas), axis=2)
         self.inertia = _wrap(inertia, axis=0)
         self.acceleration = _wrap(self._no_mean_roll(acceleration), axis=0)
