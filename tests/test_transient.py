@@ -106,6 +106,10 @@ BAD = {
     "starter ratio": ("[load]", STARTER.replace("13.0", "1e12") + "[load]", "starter.ratio"),
     "starter far away": ("[load]", STARTER.replace("380.0", "3.8e9") + "[load]",
                          "starter.reaction_point"),
+    "motored intake pressure": ('imep_scale = {value = [0.0, 0.1], unit = "1"}',
+                                'imep_scale = {value = [0.0, 0.1], unit = "1"}\n'
+                                'motored_intake_pressure = {value = 10.0, unit = "bar"}',
+                                "load.motored_intake_pressure"),
     "too many rows": ("[0.0, 0.2, 0.5], unit = \"s\"}\nspeed",
                       "[" + ", ".join(str(i * 1e-3) for i in range(5000))
                       + "], unit = \"s\"}\nspeed", "speed.time.value"),
@@ -347,6 +351,9 @@ def test_the_load_table_runs_from_the_cycle_without_burn_to_full_load(default_en
     assert drag < -5.0                                      # friction and pumping
     np.testing.assert_allclose(load.engine_torque, expected, atol=1e-6 * abs(expected[-1]))
     np.testing.assert_allclose(load.scale, [0.0, 0.5 * s0, s0, 1.0], atol=1e-12)
+    throttled = dataclasses.replace(m, motored_intake_pressure=0.35e5)
+    assert transient_load(e, throttled, t).engine_torque[0] != load.engine_torque[0]
+    assert read_manoeuvre(EXAMPLES / "stop.toml").motored_intake_pressure == 0.35e5
 
 
 def test_a_held_torque_on_static_curves_starts_at_its_static_point():

@@ -46,7 +46,11 @@ def read_manoeuvre(path) -> Manoeuvre:
     reversal = get(head, "reversal", path, "manoeuvre", default=False, types=bool)
     time, speed = _columns(subtable(doc, "speed", path), ("speed",), "angular_speed", path,
                            "speed")[:2]
-    load_time, load, kind = _load_table(subtable(doc, "load", path), path)
+    load_section = subtable(doc, "load", path)
+    load_time, load, kind = _load_table(load_section, path)
+    motored = (scalar_quantity(load_section, "motored_intake_pressure", "pressure", path,
+                               "load", positive=True)
+               if "motored_intake_pressure" in load_section else None)
     gear = scalar_quantity(head, "gear_ratio", "dimensionless", path, "manoeuvre",
                            default=0.0, nonneg=True)
     inertia = scalar_quantity(head, "crank_inertia", "inertia", path, "manoeuvre",
@@ -55,7 +59,8 @@ def read_manoeuvre(path) -> Manoeuvre:
     return Manoeuvre(str(get(head, "name", path, "manoeuvre", default="manoeuvre",
                              types=str)),
                      time, speed, load_time, load, kind, gear, inertia, starter, reversal,
-                     path, str(get(head, "notes", path, "manoeuvre", default="", types=str)))
+                     path, str(get(head, "notes", path, "manoeuvre", default="", types=str)),
+                     motored)
 
 
 def _table(section, key, dimension, path, prefix):
@@ -75,7 +80,8 @@ def _table(section, key, dimension, path, prefix):
 def _columns(section, names, dimension, path, prefix):
     """``(time, value, name)`` of a table whose value column is the one of ``names``
     present (SI; the semantic checks are the model's, :class:`Manoeuvre`)."""
-    check_keys(section, ("time",) + names, path, prefix)
+    check_keys(section, ("time",) + names + (("motored_intake_pressure",)
+                                             if prefix == "load" else ()), path, prefix)
     present = [k for k in names if k in section]
     if len(present) > 1:
         raise InputError(f"two load columns (one of {', '.join(names)})", file=path,

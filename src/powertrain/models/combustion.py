@@ -119,12 +119,12 @@ class SingleZoneCombustion:
         return theta, pressure, {"imep_target": targets, "heat": heats, "p_intake": p_in,
                                  "p_exhaust": p_ex}
 
-    def motored_pressures(self, crank: CrankTrain, omega: float):
-        """Pressure of every cylinder on the cycle grid without burn (compression and
-        expansion, gas exchange at the model's lowest intake pressure): as
-        :meth:`cycle_pressures`, the heat 0."""
+    def motored_pressures(self, crank: CrankTrain, omega: float, intake_pressure=None):
+        """Pressure of every cylinder on the cycle grid without burn: compression and
+        expansion from ``intake_pressure`` [Pa] (default the ambient pressure: an unthrottled
+        crank), as :meth:`cycle_pressures` with the heat 0."""
         theta, _, _, (b_in, b_ex, _) = self.cycle_basis(crank)
-        p_in = self.intake_pressure_min
+        p_in = self.ambient_pressure if intake_pressure is None else float(intake_pressure)
         p_ex = max(self.ambient_pressure, self.exhaust_pressure_ratio * p_in)
         n_cyl = len(self.imep_factors)
         pressure = np.tile(p_in * b_in + p_ex * b_ex, (n_cyl, 1))
@@ -255,9 +255,11 @@ class LoadedCombustion:
 @dataclass(frozen=True, eq=False)
 class MotoredCombustion:
     """The cycle of a combustion model without burn (a crank turned by the starter or
-    coasting with the fuel cut): its ``motored_pressures``, its friction."""
+    coasting with the fuel cut) from the intake pressure ``intake_pressure`` [Pa] (None:
+    the model's default): its ``motored_pressures``, its friction."""
 
     base: object
+    intake_pressure: float | None = None
 
     @property
     def model(self):
@@ -274,7 +276,7 @@ class MotoredCombustion:
                              "scale below the fired one of zero torque, or a negative "
                              "mean torque)", file=getattr(self.base, "file", None),
                              key="load")
-        return motored(crank, omega)
+        return motored(crank, omega, self.intake_pressure)
 
     def friction_mean_effective_pressure(self, omega: float) -> float:
         return self.base.friction_mean_effective_pressure(omega)

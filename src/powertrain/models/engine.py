@@ -197,10 +197,11 @@ class Engine:
             return self
         return self.replace(combustion=LoadedCombustion(self.combustion, float(load)))
 
-    def motored(self) -> Engine:
-        """A copy whose cylinders run without burn (:class:`MotoredCombustion`); its memo
-        starts with this one's load patterns, which depend on the geometry only."""
-        out = self.replace(combustion=MotoredCombustion(self.combustion))
+    def motored(self, intake_pressure=None) -> Engine:
+        """A copy whose cylinders run without burn from ``intake_pressure`` [Pa] (None: the
+        combustion model's default; :class:`MotoredCombustion`); its memo starts with this
+        one's load patterns, which depend on the geometry only."""
+        out = self.replace(combustion=MotoredCombustion(self.combustion, intake_pressure))
         if "load patterns" in self._cache:
             out._cache["load patterns"] = self._cache["load patterns"]
         return out

@@ -33,6 +33,8 @@ MAX_IMEP_SCALE = 2.0
 MAX_TORQUE = 5000.0
 MAX_GEAR_RATIO = 50.0
 MAX_CRANK_INERTIA = 20.0
+#: Intake pressure of the cycle without burn [Pa], least and most.
+MOTORED_INTAKE_PRESSURE = (0.05e5, 4e5)
 #: A starter's ratio [-] and the largest distance of its reaction point from the engine
 #: origin [m].
 STARTER_RATIO = (0.1, 100.0)
@@ -95,6 +97,9 @@ class Manoeuvre:
     file : str
         The file it was read from.
     notes : str
+    motored_intake_pressure : float or None
+        Intake pressure of the cycle without burn (IMEP scale 0) [Pa]; None: the
+        combustion model's default (its ambient pressure: an unthrottled crank).
     """
 
     name: str
@@ -109,9 +114,14 @@ class Manoeuvre:
     reversal: bool = False
     file: str = ""
     notes: str = ""
+    motored_intake_pressure: float | None = None
 
     def __post_init__(self):
         f = self.file or None
+        lo, hi = MOTORED_INTAKE_PRESSURE
+        p = self.motored_intake_pressure
+        _require(p is None or (_finite(p) and lo <= p <= hi), f"must be {lo / 1e5:g}.."
+                 f"{hi / 1e5:g} bar", f, "load.motored_intake_pressure")
         t, w = _times(self.time, self.speed, f, "speed")
         _require(self.reversal or not np.any(w < 0), "negative speed but the manoeuvre "
                  "allows no reversal (set manoeuvre.reversal = true)", f, "speed.speed")

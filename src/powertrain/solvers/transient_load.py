@@ -133,7 +133,8 @@ class _GasTable:
         inertia, acceleration = engine.motion_patterns(theta)
         w2 = ((self.speeds * RPM) ** 2)[:, None, None]
         fired = {s: engine.load_table(self.speeds, theta, s) for s in self.scales if s >= 0}
-        motored = engine.motored() if self.scales[0] < 0 else None   # after: its patterns
+        motored = (engine.motored(manoeuvre.motored_intake_pressure)   # after: its patterns
+                   if self.scales[0] < 0 else None)
         gas = np.stack([(motored.load_table(self.speeds, theta) if s < 0 else fired[s])
                         - w2 * inertia for s in self.scales])
         self.table = _wrap(self._no_mean_roll(gas), axis=2)
