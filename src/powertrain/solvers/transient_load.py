@@ -21,11 +21,19 @@ torque :math:`T_s = J\alpha + T_d - T_e` (while engaged) is reported. The fluctu
 gas and inertia torque about its cycle mean reaches the block as in the run-up.
 
 The gas load is tabulated over the crank angle (0.5°), the speed (25 rpm, clamped to the
-combustion model's range: below it the pressure of its lowest speed) and the IMEP scale
-(the load table's values; the mean-torque form uses :math:`s = T_d / T_{full}(\omega)` on
-a 0.1 grid), and read trilinearly; below :data:`FADE_RPM` it fades out linearly to none at
-rest. :math:`T_e` is the model's mean brake torque at
-:math:`(\omega, s)`; in the IMEP form :math:`T_d = T_e - J\alpha` when a gear is engaged.
+combustion model's range: below it the pressure of its lowest speed) and the load level
+:math:`\lambda`, and read trilinearly; below :data:`FADE_RPM` it fades out linearly to none
+at rest. The IMEP scale :math:`s` (the cycle's IMEP over the full-load one) is 0 for the
+cycle without burn (:meth:`Engine.motored`, from the manoeuvre's intake pressure), 1 at
+full load; :math:`s_0(\omega) = W(0)/W(1)`, the indicated work of the fired cycle of zero
+brake torque over the full-load one. From :math:`s_0` up the level is the combustion
+model's load, :math:`\lambda = (s - s_0)/(1 - s_0)` (fraction of full-load brake torque,
+steps of :data:`LEVEL_STEP`); below, :math:`\lambda = s/s_0 - 1`, the mix of the motored
+cycle (:math:`\lambda = -1`) and the zero-torque one. A mean torque :math:`T_d` is the
+level :math:`T_d / T_{full}(\omega)`, or where negative (engine braking)
+:math:`T_d / |T_{motored}(\omega)|`. :math:`T_e` is the model's mean brake torque at
+:math:`(\omega, \lambda)`; in the IMEP form :math:`T_d = T_e - J\alpha` when a gear is
+engaged.
 """
 
 from __future__ import annotations
