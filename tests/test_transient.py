@@ -356,6 +356,19 @@ def test_the_load_table_runs_from_the_cycle_without_burn_to_full_load(default_en
     assert read_manoeuvre(EXAMPLES / "stop.toml").motored_intake_pressure == 0.35e5
 
 
+def test_the_motored_cycle_is_the_polytropes_closed_form(default_engine):
+    """Without burn the pressure at firing TDC is the intake pressure compressed from BDC
+    along n_c to the start of combustion, then along n_e (physics/combustion.py's model):
+    p = p_i (V_BDC/V_s)^n_c (V_s/V_TDC)^n_e, to the grid's rounding."""
+    c, crank = default_engine.combustion, default_engine.crank
+    theta, p, _ = c.motored_pressures(crank, 150.0, 0.8e5)
+    tdc, bdc = int(np.argmin(np.abs(theta))), int(np.argmin(np.abs(theta + np.pi)))
+    V = crank.volume(np.array([-np.pi, c.start, theta[tdc]]))[0]
+    closed = 0.8e5 * (V[0] / V[1]) ** c.n_compression * (V[1] / V[2]) ** c.n_expansion
+    assert p[0, bdc] == pytest.approx(0.8e5, rel=1e-9)
+    np.testing.assert_allclose(p[:, tdc], closed, rtol=1e-6)
+
+
 def test_a_held_torque_on_static_curves_starts_at_its_static_point():
     """back-out.toml starts at 1500 rpm under 200 N m in 2nd gear: on the static curves of
     default-nonlinear.toml the body starts where the curves hold that torque (before the
