@@ -27,6 +27,7 @@ from powertrain.physics.mount_laws import BergFriction, PowerLaw
 from powertrain.solvers.newmark import newmark, newmark_ports
 from powertrain.solvers.operating_point import StaticSupport, operating_point
 from powertrain.solvers.transient import StretchRuleWarning, simulate_transient
+from powertrain.solvers.transient_load import transient_load
 from powertrain.workflows.transient_recording import compare_transient
 from powertrain.workflows.whatif import command_variants, variant_engine
 
@@ -73,6 +74,12 @@ time = {value = [0.0, 0.5], unit = "s"}
 imep_scale = {value = [0.0, 0.1], unit = "1"}
 """
 
+STARTER = """[starter]
+ratio = {value = 13.0, unit = "1"}
+reaction_point = {value = [380.0, -160.0, -120.0], unit = "mm"}
+until = {value = 0.2, unit = "s"}
+"""
+
 #: name -> (text replaced, replacement, key named in the error)
 BAD = {
     "non-monotonic time": ("[0.0, 0.2, 0.5], unit = \"s\"}\nspeed",
@@ -91,6 +98,18 @@ BAD = {
                    "[0.1, 0.2, 0.5], unit = \"s\"}\nspeed", "speed.time"),
     "wrong unit": ("unit = \"rpm\"", "unit = \"N\"", "speed.speed.unit"),
     "unknown key": ("name = \"t\"", "name = \"t\"\nspeeed = 1", "manoeuvre.speeed"),
+    "huge crank inertia": ("value = 0.18, unit", "value = 1e12, unit", "manoeuvre.crank_inertia"),
+    "no crank inertia where the speed changes": (
+        'crank_inertia = {value = 0.18, unit = "kg*m^2"}', "", "manoeuvre.crank_inertia"),
+    "huge gear ratio": ('name = "t"', 'name = "t"\ngear_ratio = {value = 1e9, unit = "1"}',
+                        "manoeuvre.gear_ratio"),
+    "starter ratio": ("[load]", STARTER.replace("13.0", "1e12") + "[load]", "starter.ratio"),
+    "starter far away": ("[load]", STARTER.replace("380.0", "3.8e9") + "[load]",
+                         "starter.reaction_point"),
+    "motored intake pressure": ('imep_scale = {value = [0.0, 0.1], unit = "1"}',
+                                'imep_scale = {value = [0.0, 0.1], unit = "1"}\n'
+                                'motored_intake_pressure = {value = 10.0, unit = "bar"}',
+                                "load.motored_intake_pressure"),
     "too many rows": ("[0.0, 0.2, 0.5], unit = \"s\"}\nspeed",
                       "[" + ", ".join(str(i * 1e-3) for i in range(5000))
                       + "], unit = \"s\"}\nspeed", "speed.time.value"),
@@ -107,6 +126,34 @@ def test_a_bad_manoeuvre_file_is_one_line_naming_file_and_key(name, tmp_path):
         read_manoeuvre(path)
     text = str(err.value)
     assert "\n" not in text and str(path) in text and f"'{key}'" in text, text
+
+
+@pytest.mark.parametrize("change, key", [
+    (dict(time=[0.0, 1.0, 0.5, 3.0]), "speed.time"),                     # backwards
+    (dict(time=[0.0, 1.0, 1.0, 3.0]), "speed.time"),                     # repeated
+    (dict(speed=[0.0, np.nan, 50.0, 80.0]), "speed.speed"),
+    (dict(speed=[0.0, -5.0, 50.0, 80.0]), "speed.speed"),                # no reversal
+    (dict(time=[0.0, 1.0, 2.0, 4.0]), "load.time"),                      # load ends early
+])
+def test_a_manoeuvre_built_in_python_is_checked_as_its_file(change, key):
+    """The model checks itself: an object made in a notebook gets the file's one-line
+    errors (pt.InputError naming the key), not an IndexError deep in the solver."""
+    m = read_manoeuvre(EXAMPLES / "start.toml")
+    table = {"time": [0.0, 1.0, 2.0, 3.0], "speed": [0.0, 30.0, 50.0, 80.0], **change}
+    with pytest.raises(pt.InputError) as err:
+        m.with_speed(table["time"], table["speed"])
+    assert f"'{key}'" in str(err.value) and "\n" not in str(err.value), str(err.value)
+
+
+def test_a_hold_may_be_longer_than_the_gap_rule(tmp_path):
+    """Rows more than 5 s apart are a gap only where the value changes between them."""
+    path = tmp_path / "hold.toml"
+    path.write_text(GOOD.replace('"s"}\nimep_scale = {value = [0.0, 0.1]',
+                                 '"s"}\nimep_scale = {value = [0.1, 0.1]')
+                    .replace("time = {value = [0.0, 0.5], unit = \"s\"}\nimep",
+                             "time = {value = [0.0, 59.0], unit = \"s\"}\nimep"),
+                    encoding="utf-8")
+    assert read_manoeuvre(path).load_time[-1] == 59.0
 
 
 def test_a_good_file_reads_in_si_and_the_crank_angle_is_exact(tmp_path):
@@ -283,6 +330,58 @@ def test_under_a_held_torque_the_body_sits_at_its_static_operating_point(default
     static = (op.deflection - op0.deflection).ravel()
     assert np.max(np.abs(mean - static)) <= HELD_M, np.abs(mean - static).max()
     assert np.max(np.abs(static)) > 0.5e-3                      # a real roll, 0.5 mm+
+
+
+@pytest.mark.parametrize("kind", ["imep_scale", "mean_torque"])
+def test_the_load_table_runs_from_the_cycle_without_burn_to_full_load(default_engine, kind):
+    """IMEP scale 0 is the motored cycle (no burn: its brake torque is the friction's and
+    the pumping's drag), s0 the fired cycle of zero torque, 1 the full load; a negative
+    mean torque (engine braking) is as much of that drag."""
+    rpm, e = 1500.0, default_engine
+    drag = e.motored().mean_brake_torque(rpm)
+    work = [np.sum(e.indicated_work(rpm, x)) for x in (0.0, 1.0)]
+    s0 = work[0] / work[1]
+    values = ([0.0, 0.5 * s0, s0, 1.0] if kind == "imep_scale"
+              else [drag, 0.5 * drag, 0.0, e.mean_brake_torque(rpm)])
+    w = rpm * np.pi / 30.0
+    t = np.arange(4.0)
+    m = Manoeuvre("held", np.array([0.0, 3.0]), np.full(2, w), t, np.array(values), kind)
+    load = transient_load(e, m, t)
+    expected = [drag, 0.5 * drag, 0.0, e.mean_brake_torque(rpm)]
+    assert drag < -5.0                                      # friction and pumping
+    np.testing.assert_allclose(load.engine_torque, expected, atol=1e-6 * abs(expected[-1]))
+    np.testing.assert_allclose(load.scale, [0.0, 0.5 * s0, s0, 1.0], atol=1e-12)
+    throttled = dataclasses.replace(m, motored_intake_pressure=0.35e5)
+    assert transient_load(e, throttled, t).engine_torque[0] != load.engine_torque[0]
+    assert read_manoeuvre(EXAMPLES / "stop.toml").motored_intake_pressure == 0.35e5
+
+
+def test_the_motored_cycle_is_the_polytropes_closed_form(default_engine):
+    """Without burn the pressure at firing TDC is the intake pressure compressed from BDC
+    along n_c to the start of combustion, then along n_e (physics/combustion.py's model):
+    p = p_i (V_BDC/V_s)^n_c (V_s/V_TDC)^n_e, to the grid's rounding."""
+    c, crank = default_engine.combustion, default_engine.crank
+    theta, p, _ = c.motored_pressures(crank, 150.0, 0.8e5)
+    tdc, bdc = int(np.argmin(np.abs(theta))), int(np.argmin(np.abs(theta + np.pi)))
+    V = crank.volume(np.array([-np.pi, c.start, theta[tdc]]))[0]
+    closed = 0.8e5 * (V[0] / V[1]) ** c.n_compression * (V[1] / V[2]) ** c.n_expansion
+    assert p[0, bdc] == pytest.approx(0.8e5, rel=1e-9)
+    np.testing.assert_allclose(p[:, tdc], closed, rtol=1e-6)
+
+
+def test_a_held_torque_on_static_curves_starts_at_its_static_point():
+    """back-out.toml starts at 1500 rpm under 200 N m in 2nd gear: on the static curves of
+    default-nonlinear.toml the body starts where the curves hold that torque (before the
+    start was on the zero-torque tangents: right.z 2.8 mm off, its jolt the peak force)."""
+    engine = shared_engine(DEFAULT_ENGINE.parent / "default-nonlinear.toml")
+    m = read_manoeuvre(EXAMPLES / "back-out.toml")
+    run = simulate_transient(engine, m)
+    op0 = operating_point(engine, 1500.0, mean_torque=0.0)
+    op = operating_point(engine, 1500.0, mean_torque=m.gear_ratio * 200.0)
+    static = (op.deflection - op0.deflection).ravel()
+    first = run.deflection[run.load.t <= 0.1].mean(axis=0)
+    assert np.max(np.abs(static)) > 5e-3                          # 6.5 mm on left.z
+    assert np.max(np.abs(first - static)) <= 5e-5, np.abs(first - static).max()
 
 
 @pytest.mark.parametrize("name, freq, table", [

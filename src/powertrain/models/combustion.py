@@ -119,6 +119,19 @@ class SingleZoneCombustion:
         return theta, pressure, {"imep_target": targets, "heat": heats, "p_intake": p_in,
                                  "p_exhaust": p_ex}
 
+    def motored_pressures(self, crank: CrankTrain, omega: float, intake_pressure=None):
+        """Pressure of every cylinder on the cycle grid without burn: compression and
+        expansion from ``intake_pressure`` [Pa] (default the ambient pressure: an unthrottled
+        crank), as :meth:`cycle_pressures` with the heat 0."""
+        theta, _, _, (b_in, b_ex, _) = self.cycle_basis(crank)
+        p_in = self.ambient_pressure if intake_pressure is None else float(intake_pressure)
+        p_ex = max(self.ambient_pressure, self.exhaust_pressure_ratio * p_in)
+        n_cyl = len(self.imep_factors)
+        pressure = np.tile(p_in * b_in + p_ex * b_ex, (n_cyl, 1))
+        return theta, pressure, {"imep_target": np.full(n_cyl, np.nan),
+                                 "heat": np.zeros(n_cyl), "p_intake": p_in,
+                                 "p_exhaust": p_ex}
+
     def cycle_basis(self, crank: CrankTrain):
         """The cycle grid ``theta`` [rad], volume ``V`` [m³], ``dV/dtheta`` [m³/rad] and
         pressure basis (:func:`powertrain.physics.combustion.pressure_basis`) of ``crank``,
@@ -227,8 +240,46 @@ class LoadedCombustion:
             return None
         return lambda factors: LoadedCombustion(scale(factors), self.load)
 
+    @property
+    def motored_pressures(self):
+        """The base's cycle without burn (None where it has none)."""
+        return getattr(self.base, "motored_pressures", None)
+
     def cycle_pressures(self, crank: CrankTrain, omega: float, load: float = 1.0):
         return self.base.cycle_pressures(crank, omega, self.load * load)
+
+    def speed_range(self):
+        return self.base.speed_range()
+
+
+@dataclass(frozen=True, eq=False)
+class MotoredCombustion:
+    """The cycle of a combustion model without burn (a crank turned by the starter or
+    coasting with the fuel cut) from the intake pressure ``intake_pressure`` [Pa] (None:
+    the model's default): its ``motored_pressures``, its friction."""
+
+    base: object
+    intake_pressure: float | None = None
+
+    @property
+    def model(self):
+        return self.base.model
+
+    @property
+    def speed_key(self):
+        return self.base.speed_key
+
+    def cycle_pressures(self, crank: CrankTrain, omega: float, load: float = 1.0):
+        motored = getattr(self.base, "motored_pressures", None)
+        if motored is None:
+            raise InputError("measured pressure traces have no cycle without burn (an IMEP "
+                             "scale below the fired one of zero torque, or a negative "
+                             "mean torque)", file=getattr(self.base, "file", None),
+                             key="load")
+        return motored(crank, omega, self.intake_pressure)
+
+    def friction_mean_effective_pressure(self, omega: float) -> float:
+        return self.base.friction_mean_effective_pressure(omega)
 
     def speed_range(self):
         return self.base.speed_range()

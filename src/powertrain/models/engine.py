@@ -28,7 +28,7 @@ import numpy as np
 from powertrain.analysis.fourier import harmonic_amplitudes
 from powertrain.assembly import assemble
 from powertrain.errors import InputError
-from powertrain.models.combustion import RPM, LoadedCombustion
+from powertrain.models.combustion import RPM, LoadedCombustion, MotoredCombustion
 from powertrain.models.crank_train import Balancer, CrankTrain
 from powertrain.models.memo import Memo
 from powertrain.physics import balancer as bal
@@ -196,6 +196,15 @@ class Engine:
         if float(load) == 1.0:
             return self
         return self.replace(combustion=LoadedCombustion(self.combustion, float(load)))
+
+    def motored(self, intake_pressure=None) -> Engine:
+        """A copy whose cylinders run without burn from ``intake_pressure`` [Pa] (None: the
+        combustion model's default; :class:`MotoredCombustion`); its memo starts with this
+        one's load patterns, which depend on the geometry only."""
+        out = self.replace(combustion=MotoredCombustion(self.combustion, intake_pressure))
+        if "load patterns" in self._cache:
+            out._cache["load patterns"] = self._cache["load patterns"]
+        return out
 
     @property
     def mount_names(self) -> list:

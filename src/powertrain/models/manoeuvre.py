@@ -18,8 +18,27 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
+from powertrain.errors import InputError
+
 #: Load kinds a manoeuvre's load table may hold.
 LOAD_KINDS = ("imep_scale", "mean_torque")
+#: Longest manoeuvre [s]; longest interval between two rows of a table over which the value
+#: changes [s] (a hold may be longer).
+MAX_DURATION = 60.0
+MAX_GAP = 5.0
+#: Largest crank speed [rpm] and IMEP scale [-].
+MAX_RPM = 12000.0
+MAX_IMEP_SCALE = 2.0
+#: Largest mean torque magnitude [N·m], gear ratio [-] and crank train inertia [kg·m²].
+MAX_TORQUE = 5000.0
+MAX_GEAR_RATIO = 50.0
+MAX_CRANK_INERTIA = 20.0
+#: Intake pressure of the cycle without burn [Pa], least and most.
+MOTORED_INTAKE_PRESSURE = (0.05e5, 4e5)
+#: A starter's ratio [-] and the largest distance of its reaction point from the engine
+#: origin [m].
+STARTER_RATIO = (0.1, 100.0)
+MAX_REACH = 3.0
 
 
 @dataclass(frozen=True, eq=False)
@@ -39,6 +58,19 @@ class Starter:
     ratio: float
     reaction_point: np.ndarray
     until: float
+    file: str = ""
+
+    def __post_init__(self):
+        lo, hi = STARTER_RATIO
+        _require(_finite(self.ratio) and lo <= self.ratio <= hi,
+                 f"must be {lo:g}..{hi:g}, got {self.ratio!r}", self.file, "starter.ratio")
+        point = np.asarray(self.reaction_point, float)
+        _require(point.shape == (3,) and np.all(np.isfinite(point))
+                 and np.linalg.norm(point) <= MAX_REACH,
+                 f"a point on the block: at most {MAX_REACH:g} m from the engine origin",
+                 self.file, "starter.reaction_point")
+        _require(_finite(self.until) and self.until >= 0, "must be >= 0 s", self.file,
+                 "starter.until")
 
 
 @dataclass(frozen=True, eq=False)
@@ -65,6 +97,9 @@ class Manoeuvre:
     file : str
         The file it was read from.
     notes : str
+    motored_intake_pressure : float or None
+        Intake pressure of the cycle without burn (IMEP scale 0) [Pa]; None: the
+        combustion model's default (its ambient pressure: an unthrottled crank).
     """
 
     name: str
@@ -79,6 +114,38 @@ class Manoeuvre:
     reversal: bool = False
     file: str = ""
     notes: str = ""
+    motored_intake_pressure: float | None = None
+
+    def __post_init__(self):
+        f = self.file or None
+        lo, hi = MOTORED_INTAKE_PRESSURE
+        p = self.motored_intake_pressure
+        _require(p is None or (_finite(p) and lo <= p <= hi), f"must be {lo / 1e5:g}.."
+                 f"{hi / 1e5:g} bar", f, "load.motored_intake_pressure")
+        t, w = _times(self.time, self.speed, f, "speed")
+        _require(self.reversal or not np.any(w < 0), "negative speed but the manoeuvre "
+                 "allows no reversal (set manoeuvre.reversal = true)", f, "speed.speed")
+        _require(np.max(np.abs(w)) * 30.0 / np.pi <= MAX_RPM * (1 + 1e-12),
+                 f"at most {MAX_RPM:g} rpm", f, "speed.speed")
+        _require(self.load_kind in LOAD_KINDS, f"one of {', '.join(LOAD_KINDS)}", f, "load")
+        tl, load = _times(self.load_time, self.load, f, "load", self.load_kind)
+        _require(tl[-1] >= t[-1] - 1e-12, f"ends at {tl[-1]:g} s, before the speed table's "
+                 f"{t[-1]:g} s (a gap)", f, "load.time")
+        scale = self.load_kind == "imep_scale"
+        _require(not scale or np.all(load >= 0), "must not be negative", f,
+                 "load.imep_scale")
+        bound = MAX_IMEP_SCALE if scale else MAX_TORQUE
+        _require(np.max(np.abs(load)) <= bound, f"at most {bound:g} in magnitude", f,
+                 f"load.{self.load_kind}")
+        for key, value, top in (("gear_ratio", self.gear_ratio, MAX_GEAR_RATIO),
+                                ("crank_inertia", self.crank_inertia, MAX_CRANK_INERTIA)):
+            _require(_finite(value) and 0 <= value <= top, f"must be 0..{top:g}, got "
+                     f"{value!r}", f, f"manoeuvre.{key}")
+        _require(self.crank_inertia > 0 or np.ptp(w) == 0, "missing: the crank train's and "
+                 "flywheel's inertia, whose reaction J*alpha acts where the speed changes",
+                 f, "manoeuvre.crank_inertia")
+        _require(self.starter is None or self.starter.until <= t[-1],
+                 f"after the end of the manoeuvre ({t[-1]:g} s)", f, "starter.until")
 
     @property
     def duration(self) -> float:
@@ -110,3 +177,38 @@ class Manoeuvre:
     def with_speed(self, time, speed) -> Manoeuvre:
         """A copy driven by another speed table (e.g. a recorded one)."""
         return replace(self, time=np.asarray(time, float), speed=np.asarray(speed, float))
+
+
+def _finite(value) -> bool:
+    return isinstance(value, (int, float, np.floating, np.integer)) and bool(
+        np.isfinite(value))
+
+
+def _require(ok, message, file, key):
+    if not ok:
+        raise InputError(message, file=file, key=key)
+
+
+def _times(time, value, file, table, column="speed"):
+    """A table's time and value columns (n,) checked: finite, from 0, strictly increasing,
+    at most :data:`MAX_DURATION` long, rows at most :data:`MAX_GAP` apart where the value
+    changes between them."""
+    t, v = np.asarray(time, float), np.asarray(value, float)
+    key = f"{table}.time"
+    _require(t.ndim == 1 and t.size >= 2, "at least two rows", file, key)
+    _require(v.shape == t.shape, f"{v.size} values for {t.size} times", file, key)
+    _require(np.all(np.isfinite(t)), "not a finite number", file, key)
+    _require(np.all(np.isfinite(v)), "not a finite number", file, f"{table}.{column}")
+    _require(t[0] == 0.0, f"must start at 0 s, starts at {t[0]:g} s", file, key)
+    step = np.diff(t)
+    i = int(np.argmax(step <= 0)) + 1
+    _require(np.all(step > 0), f"times must increase (row {i + 1}: {t[i]:g} s after "
+             f"{t[i - 1]:g} s)", file, key)
+    _require(t[-1] <= MAX_DURATION, f"a {t[-1]:g} s profile; at most {MAX_DURATION:g} s",
+             file, key)
+    gaps = (step > MAX_GAP) & (np.diff(v) != 0)
+    i = int(np.argmax(gaps))
+    _require(not gaps.any(), f"a gap of {step[i]:g} s after {t[i]:g} s over which the "
+             f"value changes; rows at most {MAX_GAP:g} s apart there (a hold may be longer)",
+             file, key)
+    return t, v

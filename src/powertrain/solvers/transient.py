@@ -54,12 +54,12 @@ import numpy as np
 from powertrain.assembly import NetworkScaling
 from powertrain.errors import InputError
 from powertrain.kernels.port_forces import NONE
-from powertrain.kernels.transient import curve_values, transient_stretch_kernel
+from powertrain.kernels.transient import curve_state, curve_values, transient_stretch_kernel
 from powertrain.solvers.cycle_newmark import cycle_amplitudes, no_ports, start_state
 from powertrain.solvers.newmark import PORT_MAX_ITER, PORT_TOL
 from powertrain.solvers.operating_point import StaticSupport, has_static_curves, operating_point
 from powertrain.solvers.steppers import Cycles, DenseNewmarkStepper
-from powertrain.solvers.transient_load import N_THETA, RPM, transient_load
+from powertrain.solvers.transient_load import N_THETA, RPM, driveline_reaction, transient_load
 
 
 class StretchRuleWarning(UserWarning):
@@ -78,6 +78,8 @@ STRETCH = 0.01
 CURVE_STEP = 0.002
 #: Most integration steps of a manoeuvre (checked before any work).
 MAX_STEPS = 2 ** 21
+#: Most memory of a run's time histories [B] (checked before any work).
+MAX_BYTES = 2e9
 #: Speed below which the step is set as at this speed [rpm]: standstill needs a step too.
 FLOOR_RPM = 600.0
 
@@ -171,6 +173,7 @@ def simulate_transient(engine, manoeuvre, *, system=None, angle_step_deg=1.0) ->
     if system.chassis is not None:
         system.chassis.require_time_domain()
     n_steps = transient_steps(manoeuvre, angle_step_deg)
+    _check_size(n_steps, system, manoeuvre)
     t = np.linspace(0.0, manoeuvre.duration, n_steps + 1)
     load = transient_load(engine, manoeuvre, t)
     F = np.zeros((t.size, system.n_dof))
@@ -179,7 +182,7 @@ def simulate_transient(engine, manoeuvre, *, system=None, angle_step_deg=1.0) ->
     scaling = NetworkScaling(system)
     curves = _Curves(engine, system) if has_static_curves(engine) else None
     _warn_curve_and_law(engine)
-    start = _start(engine, manoeuvre, system, load, ports, curves)
+    start = _start(engine, manoeuvre, system, load, ports, (scaling, curves))
     every, sub = _stretch_steps(t[1] - t[0], n_steps, scaling.varying, curves is not None)
     X, V, A, force, extra = _run(system, scaling, ports, curves, F, t[1] - t[0], start,
                                  (every, sub))
@@ -188,6 +191,17 @@ def simulate_transient(engine, manoeuvre, *, system=None, angle_step_deg=1.0) ->
                         X @ system.port_rows.T, list(system.channels),
                         system.network_names, _method(scaling, ports, curves, every, sub), X, V,
                         *extra, every, sub)
+
+
+def _check_size(n_steps, system, manoeuvre):
+    """Refuse, before any work, a run whose time histories exceed :data:`MAX_BYTES`."""
+    n, n_ch, n_net = system.n_dof, len(system.channels), system.port_rows.shape[0]
+    size = 8.0 * (n_steps + 1) * (6 * n + 5 * n_ch + 4 * n_net)
+    if size > MAX_BYTES:
+        raise InputError(f"{n_steps} steps of {n} coordinates hold about {size / 1e9:.1f} GB "
+                         f"of time histories; at most {MAX_BYTES / 1e9:g} GB (a shorter "
+                         "manoeuvre or a larger --angle-step)", file=manoeuvre.file or None,
+                         key="speed")
 
 
 def _stretch_steps(h, n_steps, varying, curves):
@@ -300,28 +314,66 @@ def _kernel_curves(system, scaling, curves):
             curves.tangent, curves.has, np.ones(n_net), np.array(curves.stiffness, float))
 
 
-def _start(engine, manoeuvre, system, load, ports, curves):
-    """``(x0, v0, a0, port-law states, amplitudes)``: rest at standstill, else the periodic
-    steady state at the first speed and load."""
+def _start(engine, manoeuvre, system, load, ports, model):
+    """``(x0, v0, a0, port-law states, amplitudes)``: at standstill at rest, where the
+    driveline's torque holds the block; else the periodic steady state at the first speed
+    and load, on static curves about the static point of its mean (:func:`_static_state`).
+    ``model = (scaling, curves)``."""
+    scaling, curves = model
     laws = ports.select(ports.kinds != NONE)
     n = system.n_dof
     omega = abs(float(load.omega[0]))
-    if omega == 0.0:
-        x0 = np.zeros(n)
+    if omega == 0.0:        # at rest where the driveline holds the block (none: at zero)
+        held = driveline_reaction(engine, manoeuvre, load.driveline_torque[0])
+        x0 = _static_state(system, scaling, curves, held) if held.any() else np.zeros(n)
         state = laws.initial_state(x0) if laws.kinds.size else None
         return x0, np.zeros(n), None, state, np.zeros(ports.kinds.size)
     grid = Cycles(N_THETA, 720.0 / N_THETA, 1, 1)
     stepper = DenseNewmarkStepper(system, grid)
     theta = float(load.theta[0]) + np.arange(N_THETA) * (4 * np.pi / N_THETA)
-    cycle = _cycle_load(engine, manoeuvre, theta)
-    fh, omegas = stepper.harmonics(cycle, omega, 40.0)
-    factors = None if curves is None else curves.factors(np.zeros(n))
+    fh, omegas = stepper.harmonics(_cycle_load(engine, manoeuvre, theta), omega, 40.0)
+    factors, mean = None, None
+    if curves is not None:       # the mean on the curves, the vibration on their tangents
+        mean = _static_state(system, scaling, curves, fh[0].real)
+        factors, fh = curves.factors(mean), np.concatenate([0 * fh[:1], fh[1:]])
     qh, A = stepper.harmonic_state(fh, omegas, omega, stepper.system_at(factors))
+    if mean is not None:
+        qh[0] += mean
     x0 = qh.real.sum(0)
     v0 = (1j * omegas[:, None] * qh).real.sum(0)
     a0 = (-(omegas ** 2)[:, None] * qh).real.sum(0)
     state = start_state(ports, qh, N_THETA) if ports.kinds.size else None
     return x0, v0, a0, state, (np.zeros(ports.kinds.size) if A is None else A)
+
+
+#: Newton on the static point of the curves (:func:`_static_state`): most iterations and
+#: the step, relative to the state, at which it has converged.
+STATIC_MAX_ITER, STATIC_TOL = 100, 1e-12
+
+
+def _static_state(system, scaling, curves, load):
+    r"""State (n,) at rest under the body load ``load`` (6,) [N, N m] on the static curves:
+    :math:`\mathbf K(f)\,\mathbf x + \mathbf R^T \mathbf c = \mathbf F` with the
+    static factors :math:`f` and curve loads :math:`c` of
+    :func:`~powertrain.kernels.transient.curve_state` at :math:`\mathbf x` (the amplitude
+    law's scale 1: the static force of each network is its curve's), by Newton on the
+    tangent stiffness :math:`\mathbf K(f)`. Port laws carry no mean force (as in the
+    harmonic steady state)."""
+    kc = _kernel_curves(system, scaling, curves)
+    rows, n_net = kc[0], kc[0].shape[0]
+    F = np.zeros(system.n_dof)
+    F[:load.shape[0]] = load
+    x, law = np.zeros(system.n_dof), np.ones((n_net, 2))
+    f, c = np.empty(n_net), np.empty(n_net)
+    for _ in range(STATIC_MAX_ITER):
+        curve_state(x, kc, law, rows @ x, f, c)
+        K = system.K + np.tensordot(f - scaling.assembled[:, 0], scaling.K_parts, 1)
+        dx = np.linalg.solve(K, F - K @ x - rows.T @ c)
+        x += dx
+        if np.max(np.abs(dx)) <= STATIC_TOL * max(np.max(np.abs(x)), 1e-9):
+            return x
+    raise FloatingPointError("the static point of the first load on the mounts' static "
+                             f"curves did not converge in {STATIC_MAX_ITER} iterations")
 
 
 def _cycle_load(engine, manoeuvre, theta):

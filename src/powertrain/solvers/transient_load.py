@@ -21,11 +21,19 @@ torque :math:`T_s = J\alpha + T_d - T_e` (while engaged) is reported. The fluctu
 gas and inertia torque about its cycle mean reaches the block as in the run-up.
 
 The gas load is tabulated over the crank angle (0.5°), the speed (25 rpm, clamped to the
-combustion model's range: below it the pressure of its lowest speed) and the IMEP scale
-(the load table's values; the mean-torque form uses :math:`s = T_d / T_{full}(\omega)` on
-a 0.1 grid), and read trilinearly; below :data:`FADE_RPM` it fades out linearly to none at
-rest. :math:`T_e` is the model's mean brake torque at
-:math:`(\omega, s)`; in the IMEP form :math:`T_d = T_e - J\alpha` when a gear is engaged.
+combustion model's range: below it the pressure of its lowest speed) and the load level
+:math:`\lambda`, and read trilinearly; below :data:`FADE_RPM` it fades out linearly to none
+at rest. The IMEP scale :math:`s` (the cycle's IMEP over the full-load one) is 0 for the
+cycle without burn (:meth:`Engine.motored`, from the manoeuvre's intake pressure), 1 at
+full load; :math:`s_0(\omega) = W(0)/W(1)`, the indicated work of the fired cycle of zero
+brake torque over the full-load one. From :math:`s_0` up the level is the combustion
+model's load, :math:`\lambda = (s - s_0)/(1 - s_0)` (fraction of full-load brake torque,
+steps of :data:`LEVEL_STEP`); below, :math:`\lambda = s/s_0 - 1`, the mix of the motored
+cycle (:math:`\lambda = -1`) and the zero-torque one. A mean torque :math:`T_d` is the
+level :math:`T_d / T_{full}(\omega)`, or where negative (engine braking)
+:math:`T_d / |T_{motored}(\omega)|`. :math:`T_e` is the model's mean brake torque at
+:math:`(\omega, \lambda)`; in the IMEP form :math:`T_d = T_e - J\alpha` when a gear is
+engaged.
 """
 
 from __future__ import annotations
@@ -39,14 +47,13 @@ from powertrain.units import UNITS
 #: Crank-angle samples of the load table over the cycle, and its speed step [rpm].
 N_THETA = 1440
 RPM_STEP = 25.0
-#: IMEP scales of the table of a mean-torque manoeuvre.
+#: Load levels of the table of a mean-torque manoeuvre, and the step of an IMEP table's.
 TORQUE_SCALES = np.linspace(0.0, 1.0, 11)
+LEVEL_STEP = 0.1
 #: Below this speed [rpm] the gas load fades out linearly to none at rest: a crank at rest
 #: holds its cylinders' gas torque inside the engine (it stops where the compression torques
 #: balance); the run-up's excitation holds from here up.
 FADE_RPM = 50.0
-#: Most distinct IMEP scales of a table (else a regular grid over their range).
-MAX_SCALES = 32
 RPM = UNITS["rpm"][1]
 
 
@@ -75,25 +82,36 @@ def transient_load(engine, manoeuvre, t) -> TransientLoad:
     spin = np.abs(omega)
     if manoeuvre.load_kind == "mean_torque":
         driveline = manoeuvre.load_at(t)
-        scale = np.clip(driveline / np.maximum(table.full_torque(spin), 1e-9), 0.0, 1.0)
-        engine_torque = table.torque(spin, scale)
+        level = table.level_of_torque(spin, driveline)
+        engine_torque = table.torque(spin, level)
     else:
-        scale = manoeuvre.load_at(t)
-        engine_torque = table.torque(spin, scale)
+        level = table.level_of_scale(spin, manoeuvre.load_at(t))
+        engine_torque = table.torque(spin, level)
         driveline = (engine_torque - manoeuvre.crank_inertia * alpha
                      if manoeuvre.gear_ratio > 0 else np.zeros_like(t))
+    scale = table.scale_of_level(spin, level)
     J = manoeuvre.crank_inertia
-    F = table.gas(theta, spin, scale) * np.clip(spin / (FADE_RPM * RPM), 0.0, 1.0)[:, None]
+    F = table.gas(theta, spin, level) * np.clip(spin / (FADE_RPM * RPM), 0.0, 1.0)[:, None]
     th = np.mod(theta, 4 * np.pi) * (N_THETA / (4 * np.pi))
     F += (omega ** 2)[:, None] * _periodic(table.inertia, th)
     F += alpha[:, None] * _periodic(table.acceleration, th)
-    F[:, 3:] -= (J * alpha + manoeuvre.gear_ratio * driveline)[:, None] * n[None, :]
+    F[:, 3:] -= (J * alpha)[:, None] * n[None, :]
+    F += driveline_reaction(engine, manoeuvre, driveline)
     starter = np.zeros_like(t)
     if manoeuvre.starter is not None:
         on = t < manoeuvre.starter.until
         starter[on] = (J * alpha + driveline - engine_torque)[on]
     return TransientLoad(np.asarray(t, float), theta, omega, alpha, scale, engine_torque,
                          driveline, starter, F)
+
+
+def driveline_reaction(engine, manoeuvre, driveline):
+    r"""The driveline torque's reaction on the block (..., 6) [N, N·m] about the CG:
+    :math:`-i\,T_d\,\mathbf n` for the driveline torque ``driveline`` (...) [N·m]."""
+    n = np.array([float(engine.crank.rotation_sign), 0.0, 0.0])
+    out = np.zeros(np.shape(driveline) + (6,))
+    out[..., 3:] = -manoeuvre.gear_ratio * np.asarray(driveline, float)[..., None] * n
+    return out
 
 
 def _periodic(table, th):
@@ -104,27 +122,65 @@ def _periodic(table, th):
 
 
 class _GasTable:
-    """The gas load per IMEP scale, speed and crank angle, the cycle mean of its roll
-    removed; the inertia and acceleration patterns; the mean brake torque per scale and
-    speed."""
+    r"""The gas load per load level, speed and crank angle, the cycle mean of its roll
+    removed; the inertia and acceleration patterns; the mean brake torque per level and
+    speed. A level :math:`\lambda \ge 0` is the combustion model's load (fraction of
+    full-load brake torque), :math:`\lambda = -1` its cycle without burn, between them
+    linear (module docstring)."""
 
     def __init__(self, engine, manoeuvre):
         lo, hi = engine.speed_range_rpm()
         top = min(hi, max(lo, manoeuvre.max_speed / RPM))
         self.speeds = np.arange(lo, top + RPM_STEP, RPM_STEP).clip(lo, top)
-        self.scales = _scales(manoeuvre)
+        self.zero = None if _full_only(manoeuvre) else np.array(
+            [np.sum(engine.indicated_work(n, 0.0)) / np.sum(engine.indicated_work(n, 1.0))
+             for n in self.speeds])
+        self.scales = _levels(manoeuvre, self.zero)
         theta = np.arange(N_THETA) * (4 * np.pi / N_THETA)
         self.n = np.array([float(engine.crank.rotation_sign), 0.0, 0.0])
         inertia, acceleration = engine.motion_patterns(theta)
         w2 = ((self.speeds * RPM) ** 2)[:, None, None]
-        gas = np.stack([engine.load_table(self.speeds, theta, s) - w2 * inertia
-                        for s in self.scales])
+        fired = {s: engine.load_table(self.speeds, theta, s) for s in self.scales if s >= 0}
+        motored = (engine.motored(manoeuvre.motored_intake_pressure)   # after: its patterns
+                   if self.scales[0] < 0 else None)
+        gas = np.stack([(motored.load_table(self.speeds, theta) if s < 0 else fired[s])
+                        - w2 * inertia for s in self.scales])
         self.table = _wrap(self._no_mean_roll(gas), axis=2)
         self.inertia = _wrap(inertia, axis=0)
         self.acceleration = _wrap(self._no_mean_roll(acceleration), axis=0)
-        self.torques = np.array([[engine.mean_brake_torque(n, s) for n in self.speeds]
+        self.torques = np.array([[motored.mean_brake_torque(n) if s < 0 else
+                                  engine.mean_brake_torque(n, s) for n in self.speeds]
                                  for s in self.scales])
         self.full = np.array([engine.mean_brake_torque(n, 1.0) for n in self.speeds])
+
+    def level_of_scale(self, spin, scale):
+        """Load level at the speeds [rad/s] of the IMEP scales: :math:`s_0` (the fired
+        cycle of zero torque) and above on the model's loads, below it towards no burn."""
+        if self.zero is None:
+            return np.asarray(scale, float)
+        s0 = self._by_speed(self.zero, spin)
+        return np.where(scale >= s0, (scale - s0) / (1.0 - s0), scale / s0 - 1.0)
+
+    def scale_of_level(self, spin, level):
+        """IMEP scale [-] of the load levels at the speeds [rad/s]."""
+        if self.zero is None:
+            return np.asarray(level, float)
+        s0 = self._by_speed(self.zero, spin)
+        return np.where(level >= 0, s0 + level * (1.0 - s0), (1.0 + level) * s0)
+
+    def level_of_torque(self, spin, torque):
+        """Load level of the mean brake torques [N·m]: a fraction of full load, below 0 of
+        the torque without burn (engine braking), bounded to the table."""
+        full = np.maximum(self._by_speed(self.full, spin), 1e-9)
+        level = np.where(torque >= 0, torque / full, 0.0)
+        if self.scales[0] < 0:
+            drag = np.minimum(self._by_speed(self.torques[0], spin), -1e-9)
+            level = np.where(torque < 0, torque / -drag, level)
+        return np.clip(level, self.scales[0], self.scales[-1])
+
+    def _by_speed(self, values, spin):
+        v0, v1, fv = self._speed_index(spin)
+        return values[v0] * (1 - fv) + values[v1] * fv
 
     def _no_mean_roll(self, load):
         """``load`` (..., n_theta, 6) with the cycle mean of its roll moment removed."""
@@ -169,11 +225,6 @@ class _GasTable:
         return ((T[s0, v0] * (1 - fv) + T[s0, v1] * fv) * (1 - fs)
                 + (T[s1, v0] * (1 - fv) + T[s1, v1] * fv) * fs)
 
-    def full_torque(self, spin):
-        """Full-load mean brake torque [N·m] at the speeds [rad/s]."""
-        v0, v1, fv = self._speed_index(spin)
-        return self.full[v0] * (1 - fv) + self.full[v1] * fv
-
 
 def _wrap(a, axis):
     """``a`` with its first row along ``axis`` appended (periodic wrap)."""
@@ -181,11 +232,22 @@ def _wrap(a, axis):
     return np.concatenate([a, first], axis=axis)
 
 
-def _scales(manoeuvre):
-    """IMEP scales of the gas table."""
+def _full_only(manoeuvre):
+    """An IMEP table at the model's own load throughout (measured traces allow no other)."""
+    return manoeuvre.load_kind == "imep_scale" and bool(np.all(manoeuvre.load == 1.0))
+
+
+def _levels(manoeuvre, zero):
+    """Load levels of the gas table (:class:`_GasTable`): -1 (no burn) where the table
+    reaches below the fired cycle of zero torque, then the model's loads in steps of
+    :data:`LEVEL_STEP` up to the table's largest."""
+    if zero is None:
+        return np.array([1.0])
     if manoeuvre.load_kind == "mean_torque":
-        return TORQUE_SCALES
-    values = np.unique(manoeuvre.load)
-    if values.size > MAX_SCALES:
-        values = np.linspace(values[0], values[-1], MAX_SCALES)
-    return values
+        return np.r_[[-1.0] if np.any(manoeuvre.load < 0) else [], TORQUE_SCALES]
+    s_max = float(np.max(manoeuvre.load))
+    top = np.ceil(max(np.max((s_max - zero) / (1.0 - zero)), 0.0) / LEVEL_STEP - 1e-9) \
+        * LEVEL_STEP
+    fired = np.arange(0.0, top + LEVEL_STEP / 2, LEVEL_STEP)
+    low = [-1.0] if np.min(manoeuvre.load) < np.max(zero) else []
+    return np.r_[low, fired if fired.size > 1 or low else [0.0, LEVEL_STEP]]

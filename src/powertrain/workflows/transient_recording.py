@@ -23,9 +23,8 @@ from powertrain.analysis.alignment import (
     trigger_time,
 )
 from powertrain.errors import InputError
-from powertrain.iotools.manoeuvre_file import MAX_RPM
 from powertrain.iotools.raw import IGNORED_NOTE, read_raw
-from powertrain.models.manoeuvre import Manoeuvre
+from powertrain.models.manoeuvre import MAX_RPM, Manoeuvre
 from powertrain.results.transient import TransientComparison
 
 #: Most rows of a speed table taken from a recording (block means of its samples).
