@@ -39,6 +39,18 @@ from powertrain.workflows.variants import parse_operations, parse_target, read_v
 
 #: Signals a what-if compares (``--signal``).
 SIGNALS = ("velocity", "mount_force")
+#: Keywords (and options) of a run-up what-if that a what-if over a manoeuvre refuses:
+#: keyword -> what it is.
+RUNUP_ONLY = {"rpm": "the run-up's speed steps", "rpm_from": "the run-up's first speed",
+              "rpm_to": "the run-up's last speed", "rpm_step": "the run-up's speed step",
+              "solver": "the run-up's solver", "signal": "the run-up's compared signal",
+              "objective": "a run-up objective (a manoeuvre ranks by its peaks)",
+              "measured": "a measured run-up",
+              "executor": "a scheduler (a manoeuvre's runs are made here, in turn)",
+              "scheduler": "a scheduler (a manoeuvre's runs are made here, in turn)",
+              "workers": "a number of processes (a manoeuvre's runs are made here, in turn)",
+              "target_out": "a retune target's fitted mount file (of a run-up what-if)",
+              "target_plot": "a retune target's fit figure (of a run-up what-if)"}
 
 
 def describe_engine(engine, solver: str, rpm) -> dict:
@@ -54,7 +66,7 @@ def describe_engine(engine, solver: str, rpm) -> dict:
 
 
 def whatif(engine=None, *, scale=(), set=(), swap=(), move=(), rotate=(), effects=(),
-           targets=(), variants=None, rpm=None, solver="harmonic", signal="velocity",
+           targets=(), variants=None, rpm=None, solver=None, signal=None,
            objective=None, measured=None, executor=None, workers=None, progress=False,
            rpm_step=None, manoeuvre=None) -> WhatIfResult | TransientRanking:
     """What-if: the baseline and variants of the mount system, the change in dB (``whatif``).
@@ -73,8 +85,10 @@ def whatif(engine=None, *, scale=(), set=(), swap=(), move=(), rotate=(), effect
     rpm : array_like or str, optional
         Speed steps [rpm] in the engine's range, or as ``"1000:6000:500"`` (default
         1000..6000 step 500).
-    solver : {"harmonic", "newmark"}
-    signal : {"velocity", "mount_force"}
+    solver : {"harmonic", "newmark"}, optional
+        Default ``harmonic``.
+    signal : {"velocity", "mount_force"}, optional
+        Default ``velocity``.
     objective : str, optional
         ``CHANNEL.DIR:QUANTITY:FROM-TO`` to rank the variants by (:func:`parse_objective`).
     measured : str, Path or MeasuredRunup, optional
@@ -88,20 +102,32 @@ def whatif(engine=None, *, scale=(), set=(), swap=(), move=(), rotate=(), effect
     progress : bool
     rpm_step : float, optional
         The speed step [rpm] the report names (default: that of ``rpm``).
+    manoeuvre : str, Path or Manoeuvre, optional
+        Run baseline and variants over this transient manoeuvre instead of a run-up
+        (:func:`whatif_manoeuvre`); then ``rpm``, ``solver``, ``signal``, ``objective``,
+        ``measured``, ``rpm_step``, ``executor`` and ``workers`` have no meaning and are
+        refused (:data:`RUNUP_ONLY`).
 
     Returns
     -------
-    WhatIfResult
+    WhatIfResult, or TransientRanking with ``manoeuvre``
 
     Raises
     ------
     InputError
-        Naming the option (``--scale``, ``--from`` ...) or file and key of bad input.
+        Naming the option (``--scale``, ``--from`` ...) or file and key of bad input; with
+        ``manoeuvre``, naming a run-up keyword given (before any work).
     """
+    if manoeuvre is not None:
+        refuse_runup_options({"rpm": rpm, "solver": solver, "signal": signal,
+                              "objective": objective, "measured": measured,
+                              "rpm_step": rpm_step, "executor": executor, "workers": workers})
+    solver, signal = solver or "harmonic", signal or "velocity"
     workers = _checked(solver, signal, workers, executor)
     engine, _ = engine_and_file(engine)
-    rpm = speeds(rpm)
-    check_runup_settings(engine, rpm, 1.0)
+    if manoeuvre is None:
+        rpm = speeds(rpm)
+        check_runup_settings(engine, rpm, 1.0)
     ops = {key: texts(value, f"--{key}") for key, value in (
         ("scale", scale), ("set", set), ("swap", swap), ("move", move), ("rotate", rotate),
         ("effect", effects))}
@@ -113,6 +139,17 @@ def whatif(engine=None, *, scale=(), set=(), swap=(), move=(), rotate=(), effect
     return run_whatif(engine, runs, rpm, solver=solver, executor=executor, workers=workers,
                       measured=measured, signal=signal, progress=progress, objective=goal,
                       rpm_step=real(rpm_step, "--step", unit="rpm", optional=True))
+
+
+def refuse_runup_options(given: dict, what: str = "manoeuvre", keys=None) -> None:
+    """An InputError naming the first of ``given`` (keyword -> value; None: not given) that
+    is set: a run-up option (:data:`RUNUP_ONLY`) has no meaning over a manoeuvre.
+    ``what``: how the manoeuvre was asked for (``--manoeuvre`` on the command line);
+    ``keys``: keyword -> the name the error gives (default the keyword)."""
+    for name, value in given.items():
+        if value is not None:
+            raise InputError(f"{RUNUP_ONLY.get(name, 'a run-up option')} has no meaning "
+                             f"with {what}; leave it out", key=(keys or {}).get(name, name))
 
 
 def whatif_manoeuvre(engine, variants, manoeuvre) -> TransientRanking:
