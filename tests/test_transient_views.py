@@ -8,6 +8,7 @@ the run-up's options before any work (command line and API)."""
 from __future__ import annotations
 
 import csv
+import dataclasses
 import json
 
 import numpy as np
@@ -60,6 +61,7 @@ def test_the_transient_figure_marks_peaks_off_the_traces(tmp_path):
     top, *panels = [a for a in fig.axes if a.get_ylabel() != "torque [N·m]"]
     speed = top.get_lines()[0].get_color()
     for a, c in zip(panels, ("left.x", "left.y", "left.z")):
+        assert a.get_ylabel().startswith(c)
         assert not a.texts                                   # nothing written on the data
         assert a.get_title(loc="right").startswith("peak ")  # above the frame
         line, marker = a.get_lines()
@@ -167,3 +169,25 @@ def test_the_api_refuses_a_runup_keyword_with_a_manoeuvre(keyword, value):
     with pytest.raises(pt.InputError, match=f"key '{keyword}'.*no meaning"):
         pt.whatif(scale="left.z.dynamic=1.2", manoeuvre=EXAMPLES / "start.toml",
                   **{keyword: value})
+
+
+def test_what_plot_accepts():
+    """As documented (docs/guide/python-api.md): a transient's figure always has the speed
+    panel, so one Axes is refused; a one-channel comparison and a ranking without a seat
+    draw into one Axes; a SubFigure takes any of them."""
+    import matplotlib.pyplot as plt
+    r = synthetic()
+    fig, (a1, a2) = plt.subplots(1, 2)
+    with pytest.raises(pt.InputError, match="pass a Figure or SubFigure"):
+        r.plot(a1)
+    one = TransientComparison("s", "rec.h5", 0.0, r.time, ["left.z"], r.acceleration[:, 2:3],
+                              r.acceleration[:, 2:3])
+    assert one.plot(a1) is fig and a1.get_title().startswith("left.z: peak 0.0 %")
+    no_seat = [dataclasses.replace(x, seat=None) for x in _ranking().runs]
+    assert TransientRanking("s", ["baseline", "a", "b"], no_seat).plot(a2) is fig
+    plt.close(fig)
+    fig = plt.figure(layout="constrained")
+    left, right = fig.subfigures(1, 2)
+    assert r.plot(left, channels=["left.z"]) is left and len(left.axes) == 3   # + twin
+    assert _ranking().plot(right, view="delta") is right
+    plt.close(fig)

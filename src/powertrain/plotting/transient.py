@@ -168,6 +168,9 @@ def _bars(a, names, values, notes, unit, delta):
         colours = [OKABE_ITO["blue"] if v <= 0 else OKABE_ITO["vermillion"] for v in values]
         texts = [f"{signed(v)} %" for v in values]
         a.axvline(0.0, color="k", lw=0.8)
+        lo, hi = min(0.0, float(np.min(values))), max(0.0, float(np.max(values)))
+        pad = 0.08 * ((hi - lo) or 1.0)
+        a.set_xlim(lo - pad, hi + pad)            # the zero line clear of the frame
     else:
         colours = ["0.55" if n == "baseline" else OKABE_ITO["blue"] for n in names]
         texts = [f"{v:.4g} {unit}{note}" for v, note in zip(values, notes)]
