@@ -97,9 +97,8 @@ def whatif(engine_file, rpm_from, rpm_to, rpm_step, solver, scale, set_, swap, m
     """What-if: run the baseline and variants of the mount system, print the change in dB.
 
     The command-line operations (--scale/--set/--swap/--move/--rotate/--effect) form one
-    variant,
-    "command line"; each --target is a variant of its own; --variants adds the variants of
-    a file. For each channel (mount x engine X/Y/Z) and quantity (synthesis, 2nd, 4th order)
+    variant, "command line"; each --target is a variant of its own; --variants adds the
+    variants of a file. For each channel (mount x engine X/Y/Z) and quantity (synthesis, 2nd, 4th order)
     the change 20 log10(v_variant/v_baseline) is averaged over the speed steps (mean) and
     its largest magnitude reported (max|d|).
 
@@ -117,8 +116,7 @@ def whatif(engine_file, rpm_from, rpm_to, rpm_step, solver, scale, set_, swap, m
       powertrain whatif --manoeuvre examples/start.toml --variants variants.toml
     """
     outputs = (target_out, target_plot, json_file, plot, delta_plot)
-    if manoeuvre_file:
-        _refuse_runup_options(click.get_current_context())
+    _refuse_runup_options(click.get_current_context(), manoeuvre_file)
     check_outputs(target_out=target_out, target_plot=target_plot, plot=plot, json=json_file,
                   delta_plot=delta_plot)
     engine, rpm = _baseline(engine_file, rpm_from, rpm_to, rpm_step)
@@ -135,9 +133,11 @@ def whatif(engine_file, rpm_from, rpm_to, rpm_step, solver, scale, set_, swap, m
         click.echo(result.to_text(written=outputs))
 
 
-def _refuse_runup_options(ctx) -> None:
+def _refuse_runup_options(ctx, manoeuvre_file) -> None:
     """With ``--manoeuvre``: a one-line error naming the first run-up option given on the
     command line (:data:`~powertrain.workflows.whatif.RUNUP_ONLY`), before any work."""
+    if not manoeuvre_file:
+        return
     names = {"measured_file": "measured"}
     given, keys = {}, {}
     for param in ctx.command.params:

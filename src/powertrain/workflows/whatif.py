@@ -69,7 +69,8 @@ def whatif(engine=None, *, scale=(), set=(), swap=(), move=(), rotate=(), effect
            targets=(), variants=None, rpm=None, solver=None, signal=None,
            objective=None, measured=None, executor=None, workers=None, progress=False,
            rpm_step=None, manoeuvre=None) -> WhatIfResult | TransientRanking:
-    """What-if: the baseline and variants of the mount system, the change in dB (``whatif``).
+    """What-if: the baseline and variants of the mount system, the change in dB (``whatif``),
+    or over a transient manoeuvre their peaks (``whatif --manoeuvre``).
 
     Parameters
     ----------
@@ -83,30 +84,23 @@ def whatif(engine=None, *, scale=(), set=(), swap=(), move=(), rotate=(), effect
     variants : str or Path, optional
         TOML file of named variants.
     rpm : array_like or str, optional
-        Speed steps [rpm] in the engine's range, or as ``"1000:6000:500"`` (default
-        1000..6000 step 500).
-    solver : {"harmonic", "newmark"}, optional
-        Default ``harmonic``.
-    signal : {"velocity", "mount_force"}, optional
-        Default ``velocity``.
+        Speed steps [rpm] in the engine's range, or ``"1000:6000:500"`` (the default).
+    solver, signal : str, optional
+        ``harmonic`` (default) or ``newmark``; ``velocity`` (default) or ``mount_force``.
     objective : str, optional
         ``CHANNEL.DIR:QUANTITY:FROM-TO`` to rank the variants by (:func:`parse_objective`).
     measured : str, Path or MeasuredRunup, optional
         Measurement overlaid and compared.
-    executor : object with ``submit``, or str, optional
-        An executor, or a scheduler (``local``, ``tcp://HOST:PORT``, ``processes``,
-        ``serial``), opened and shut down here (:func:`powertrain.parallel.executor`);
-        default a local process pool.
-    workers : int, optional
-        Local processes (default: the usable cores; 1 = serial).
+    executor, workers : optional
+        An executor or a scheduler (``local``, ``tcp://HOST:PORT``, ``processes``,
+        ``serial``; :func:`powertrain.parallel.executor`), default a local process pool of
+        ``workers`` processes (default: the usable cores; 1 = serial).
     progress : bool
     rpm_step : float, optional
         The speed step [rpm] the report names (default: that of ``rpm``).
     manoeuvre : str, Path or Manoeuvre, optional
-        Run baseline and variants over this transient manoeuvre instead of a run-up
-        (:func:`whatif_manoeuvre`); then ``rpm``, ``solver``, ``signal``, ``objective``,
-        ``measured``, ``rpm_step``, ``executor`` and ``workers`` have no meaning and are
-        refused (:data:`RUNUP_ONLY`).
+        Over this manoeuvre instead of a run-up (:func:`whatif_manoeuvre`): the run-up
+        keywords ``rpm`` … ``workers`` are then refused (:data:`RUNUP_ONLY`).
 
     Returns
     -------
@@ -115,30 +109,44 @@ def whatif(engine=None, *, scale=(), set=(), swap=(), move=(), rotate=(), effect
     Raises
     ------
     InputError
-        Naming the option (``--scale``, ``--from`` ...) or file and key of bad input; with
-        ``manoeuvre``, naming a run-up keyword given (before any work).
+        Naming the option (``--scale``, ``--from`` ...) or file and key of bad input, or
+        a run-up keyword given with ``manoeuvre`` (before any work).
     """
+    ops = {"scale": scale, "set": set, "swap": swap, "move": move, "rotate": rotate,
+           "effect": effects}
     if manoeuvre is not None:
-        refuse_runup_options({"rpm": rpm, "solver": solver, "signal": signal,
-                              "objective": objective, "measured": measured,
-                              "rpm_step": rpm_step, "executor": executor, "workers": workers})
-    solver, signal = solver or "harmonic", signal or "velocity"
+        refuse_runup_options(dict(rpm=rpm, solver=solver, signal=signal, objective=objective,
+                                  measured=measured, rpm_step=rpm_step, executor=executor,
+                                  workers=workers))
+        engine, _ = engine_and_file(engine)
+        return whatif_manoeuvre(engine, _variants(engine, ops, targets, variants), manoeuvre)
+    return _runup_whatif(engine, ops, targets, variants, rpm=rpm, solver=solver or "harmonic",
+                         signal=signal or "velocity", objective=objective, measured=measured,
+                         executor=executor, workers=workers, progress=progress,
+                         rpm_step=rpm_step)
+
+
+def _runup_whatif(engine, ops, targets, variants, *, rpm, solver, signal, objective,
+                  measured, executor, workers, progress, rpm_step) -> WhatIfResult:
+    """:func:`whatif` over a run-up: the arguments checked in turn, then
+    :func:`run_whatif`."""
     workers = _checked(solver, signal, workers, executor)
     engine, _ = engine_and_file(engine)
-    if manoeuvre is None:
-        rpm = speeds(rpm)
-        check_runup_settings(engine, rpm, 1.0)
-    ops = {key: texts(value, f"--{key}") for key, value in (
-        ("scale", scale), ("set", set), ("swap", swap), ("move", move), ("rotate", rotate),
-        ("effect", effects))}
-    runs = command_variants(engine, ops, texts(targets, "--target"), variants)
-    if manoeuvre is not None:
-        return whatif_manoeuvre(engine, runs, manoeuvre)
+    rpm = speeds(rpm)
+    check_runup_settings(engine, rpm, 1.0)
+    runs = _variants(engine, ops, targets, variants)
     goal = parse_objective(objective, engine.assemble().channels, rpm) if objective else None
-    measured = _measured(measured, engine)
     return run_whatif(engine, runs, rpm, solver=solver, executor=executor, workers=workers,
-                      measured=measured, signal=signal, progress=progress, objective=goal,
+                      measured=_measured(measured, engine), signal=signal, progress=progress,
+                      objective=goal,
                       rpm_step=real(rpm_step, "--step", unit="rpm", optional=True))
+
+
+def _variants(engine, ops: dict, targets, variants) -> list:
+    """The variants of the keyword arguments (:func:`command_variants`): ``ops`` (option
+    name -> spec string or strings), ``targets`` and the ``variants`` file."""
+    ops = {key: texts(value, f"--{key}") for key, value in ops.items()}
+    return command_variants(engine, ops, texts(targets, "--target"), variants)
 
 
 def refuse_runup_options(given: dict, what: str = "manoeuvre", keys=None) -> None:
