@@ -39,7 +39,7 @@ TORQUE_STYLES = {"engine": (OKABE_ITO["orange"], "-"),
 CHANNEL_COLOURS = (OKABE_ITO["blue"], OKABE_ITO["bluish green"], OKABE_ITO["reddish purple"])
 #: Margins of the data inside a channel panel (fractions of the data range): a peak at the
 #: first or last step, or at the top or bottom, keeps its marker clear of the frame.
-X_MARGIN, Y_MARGIN = 0.03, 0.12
+X_MARGIN, Y_MARGIN = 0.05, 0.12
 #: Height of a panel of a transient figure [in], and the most panel rows of an overlay on
 #: one page (more channels are left out and named in the title).
 ROW_IN, MAX_OVERLAY_ROWS = 1.45, 5

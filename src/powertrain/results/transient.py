@@ -187,7 +187,9 @@ class TransientResult(JsonResult):
         """Crank speed and torque over time above the ``quantity`` (``acceleration``,
         ``displacement``, ``force``) of ``channels`` (default: the seat's, else every mount's
         z), peaks marked; returns the figure
-        (:func:`powertrain.plotting.transient.plot_transient`)."""
+        (:func:`powertrain.plotting.transient.plot_transient`). ``ax``: None (a new figure),
+        a Figure or SubFigure, or a path (then ``path``); one Axes raises an InputError
+        saying to pass a Figure: the speed panel always stands above the channels."""
         ax, path = target_and_path(ax, path)
         return plot_transient(self, channels or self.default_channels(), path, ax=ax,
                               provenance=provenance, quantity=quantity)
@@ -359,8 +361,10 @@ class TransientComparison(JsonResult):
                              for j, c in enumerate(self.channels)}}
 
     def plot(self, ax=None, *, path=None, provenance=None):
-        """Measured and simulated acceleration per channel, overlaid; returns the figure
-        (:func:`powertrain.plotting.transient.plot_overlay`)."""
+        """Measured and simulated acceleration per channel, overlaid, each panel headed by its
+        errors; returns the figure (:func:`powertrain.plotting.transient.plot_overlay`).
+        ``ax``: None (a new figure), a Figure or SubFigure, or one Axes when one channel is
+        compared (else an InputError saying to pass a Figure)."""
         ax, path = target_and_path(ax, path)
         return plot_overlay(self, path, ax=ax, provenance=provenance)
 
