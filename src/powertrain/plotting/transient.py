@@ -166,7 +166,7 @@ def _bars(a, names, values, notes, unit, delta):
     y = np.arange(len(names))
     if delta:
         colours = [OKABE_ITO["blue"] if v <= 0 else OKABE_ITO["vermillion"] for v in values]
-        texts = [f"{signed(v)} %" for v in values]
+        texts = [f"{signed(v, _decimals(v))} %" for v in values]
         a.axvline(0.0, color="k", lw=0.8)
         lo, hi = min(0.0, float(np.min(values))), max(0.0, float(np.max(values)))
         pad = 0.08 * ((hi - lo) or 1.0)
@@ -184,6 +184,13 @@ def _bars(a, names, values, notes, unit, delta):
                  fontsize=LABEL_SIZE)
     a.tick_params(labelsize=TICK_SIZE)
     a.grid(True, axis="x", lw=0.3)
+
+
+def _decimals(value) -> int:
+    """Decimals of a change [%]: one from 1 % on, below it two significant digits (at most
+    three decimals)."""
+    size = abs(float(value))
+    return 1 if size == 0 or size >= 1 else min(3, 1 - math.floor(math.log10(size)))
 
 
 # ------------------------------------------------------------------ overlay on a recording
