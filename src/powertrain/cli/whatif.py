@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import click
+from click.core import ParameterSource
 
 from powertrain.cli.common import (
     check_outputs,
@@ -18,6 +19,7 @@ from powertrain.iotools.engine_file import DEFAULT_ENGINE_PATH, read_engine
 from powertrain.iotools.mount_file import write_mount
 from powertrain.provenance import provenance
 from powertrain.workflows.arguments import speed_steps
+from powertrain.workflows.whatif import RUNUP_ONLY, refuse_runup_options
 from powertrain.workflows.whatif import whatif as run_whatif
 
 
@@ -64,7 +66,8 @@ from powertrain.workflows.whatif import whatif as run_whatif
 @click.option("--plot", type=click.Path(dir_okay=False),
               help="PNG overlay of baseline, variants (and measurement).")
 @click.option("--delta-plot", type=click.Path(dir_okay=False),
-              help="PNG of each variant's change against the baseline, 20 log10(v/v0) [dB].")
+              help="PNG of each variant's change against the baseline, 20 log10(v/v0) [dB]; "
+                   "with --manoeuvre the change of its peaks [%].")
 @click.option("--json", "json_file", type=click.Path(dir_okay=False),
               help="Write the changes as JSON.")
 @click.option("--signal", type=click.Choice(["velocity", "mount_force"]), default="velocity",
@@ -84,7 +87,9 @@ from powertrain.workflows.whatif import whatif as run_whatif
 @click.option("--manoeuvre", "manoeuvre_file", type=click.Path(dir_okay=False),
               help="Run baseline and variants over this transient manoeuvre (TOML, as for "
                    "`transient`) instead of a run-up; ranks them by peak seat acceleration "
-                   "(else peak mount deflection).")
+                   "(else peak mount deflection). The run-up's options (--from, --to, --step, "
+                   "--solver, --signal, --objective, --measured, --workers, --scheduler, "
+                   "--target-out, --target-plot) are refused with it.")
 @quiet_option
 def whatif(engine_file, rpm_from, rpm_to, rpm_step, solver, scale, set_, swap, move, rotate,
            effect, variants_file, target, target_out, target_plot, measured_file, plot, json_file,
@@ -92,9 +97,8 @@ def whatif(engine_file, rpm_from, rpm_to, rpm_step, solver, scale, set_, swap, m
     """What-if: run the baseline and variants of the mount system, print the change in dB.
 
     The command-line operations (--scale/--set/--swap/--move/--rotate/--effect) form one
-    variant,
-    "command line"; each --target is a variant of its own; --variants adds the variants of
-    a file. For each channel (mount x engine X/Y/Z) and quantity (synthesis, 2nd, 4th order)
+    variant, "command line"; each --target is a variant of its own; --variants adds the
+    variants of a file. For each channel (mount x engine X/Y/Z) and quantity (synthesis, 2nd, 4th order)
     the change 20 log10(v_variant/v_baseline) is averaged over the speed steps (mean) and
     its largest magnitude reported (max|d|).
 
@@ -112,19 +116,36 @@ def whatif(engine_file, rpm_from, rpm_to, rpm_step, solver, scale, set_, swap, m
       powertrain whatif --manoeuvre examples/start.toml --variants variants.toml
     """
     outputs = (target_out, target_plot, json_file, plot, delta_plot)
+    _refuse_runup_options(click.get_current_context(), manoeuvre_file)
     check_outputs(target_out=target_out, target_plot=target_plot, plot=plot, json=json_file,
                   delta_plot=delta_plot)
     engine, rpm = _baseline(engine_file, rpm_from, rpm_to, rpm_step)
+    runup = {} if manoeuvre_file else dict(
+        rpm=rpm, solver=solver, signal=signal, objective=objective, measured=measured_file,
+        executor=scheduler, workers=workers, rpm_step=rpm_step)
     result = run_whatif(engine, scale=scale, set=set_, swap=swap, move=move, rotate=rotate,
-                        effects=effect, targets=target, variants=variants_file, rpm=rpm,
-                        solver=solver, signal=signal, objective=objective,
-                        measured=measured_file, executor=scheduler, workers=workers,
-                        progress=not quiet, rpm_step=rpm_step, manoeuvre=manoeuvre_file)
+                        effects=effect, targets=target, variants=variants_file,
+                        progress=not quiet, manoeuvre=manoeuvre_file, **runup)
     fit = result.target_fit("--target-out" if target_out else "--target-plot") \
         if target_out or target_plot else None
     _write(result, fit, engine, engine_file, *outputs)
     if not quiet:
         click.echo(result.to_text(written=outputs))
+
+
+def _refuse_runup_options(ctx, manoeuvre_file) -> None:
+    """With ``--manoeuvre``: a one-line error naming the first run-up option given on the
+    command line (:data:`~powertrain.workflows.whatif.RUNUP_ONLY`), before any work."""
+    if not manoeuvre_file:
+        return
+    names = {"measured_file": "measured"}
+    given, keys = {}, {}
+    for param in ctx.command.params:
+        name = names.get(param.name, param.name)
+        if name in RUNUP_ONLY and ctx.get_parameter_source(param.name) not in (
+                ParameterSource.DEFAULT, ParameterSource.DEFAULT_MAP):
+            given[name], keys[name] = True, max(param.opts, key=len)
+    refuse_runup_options(given, "--manoeuvre", keys)
 
 
 def _baseline(engine_file, rpm_from, rpm_to, rpm_step):

@@ -171,7 +171,8 @@ def transient_html(r) -> str:
     order = np.argsort(-p["max_acceleration"], kind="stable")
     rows = [[r.channels[k], number(p["max_acceleration"][k], ".2f"),
              number(p["time_of_max_acceleration"][k], ".3f"),
-             number(p["peak_to_peak"][k] * 1e3, ".2f"), number(p["peak_force"][k], ".0f")]
+             number(p["peak_to_peak"][k] * 1e3, ".2f"),
+             "n/a" if np.isnan(p["peak_force"][k]) else number(p["peak_force"][k], ".0f")]
             for k in order]
     head = paragraph(f"manoeuvre {r.name} ({r.file}): {r.time[-1]:g} s, {r.time.size - 1} "
                      f"steps ({r.method}); peak crank speed {np.max(r.rpm):.0f} rpm")

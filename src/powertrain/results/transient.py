@@ -6,7 +6,10 @@ CSV: one row per time step; columns ``time_s``, ``rpm``, ``engine_torque_nm``,
 ``starter_torque_nm``, ``driveline_torque_nm``, ``body_x_mm`` .. ``body_rz_deg``, per
 channel ``CH_displacement_mm``, ``CH_velocity_mm_per_s``, ``CH_acceleration_m_per_s2``,
 ``CH_force_n``, per mount direction ``NET_deflection_mm``. Displacements, deflections and
-forces are changes from the static operating point at zero mean torque.
+forces are changes from the static operating point at zero mean torque. A body point (a
+channel that is neither a mount's engine side nor its body side, e.g. ``seat_rail.z``)
+transmits no force: its peak force is NaN in :meth:`TransientResult.peaks`, ``n/a`` in the
+text, null in the JSON and its ``CH_force_n`` cells are empty.
 """
 
 from __future__ import annotations
@@ -84,13 +87,21 @@ class TransientResult(JsonResult):
         """Column of the channel ``label`` (``"left.z"``)."""
         return self.channels.index(label)
 
+    def transmits_force(self) -> np.ndarray:
+        """Per channel: True for a mount's engine side (``left.z``) or body side
+        (``left/passive.z``), False for a body point (``seat_rail.z``: no force)."""
+        mounts = {n.rpartition(".")[0] for n in self.networks}
+        return np.array([c.rpartition(".")[0].split("/")[0] in mounts for c in self.channels],
+                        bool)
+
     def peaks(self) -> dict:
-        """Per channel: peak-to-peak displacement [m], peak force [N], maximum
-        acceleration [m/s²] and its time [s]."""
+        """Per channel: peak-to-peak displacement [m], peak force [N] (NaN at a body point,
+        :meth:`transmits_force`), maximum acceleration [m/s²] and its time [s]."""
         a = np.abs(self.acceleration)
         i = np.argmax(a, axis=0)
+        force = np.max(np.abs(self.force), axis=0)
         return {"peak_to_peak": np.ptp(self.displacement, axis=0),
-                "peak_force": np.max(np.abs(self.force), axis=0),
+                "peak_force": np.where(self.transmits_force(), force, np.nan),
                 "max_acceleration": a[i, np.arange(a.shape[1])],
                 "time_of_max_acceleration": self.time[i]}
 
@@ -111,7 +122,7 @@ class TransientResult(JsonResult):
         """The JSON document (docs/reference/json.md)."""
         p = self.peaks()
         chans = {c: {"peak_to_peak_displacement_mm": float(from_si(p["peak_to_peak"][k], "mm")),
-                     "peak_force_n": float(p["peak_force"][k]),
+                     "peak_force_n": _finite(p["peak_force"][k]),
                      "max_acceleration_m_per_s2": float(p["max_acceleration"][k]),
                      "time_of_max_acceleration_s": float(p["time_of_max_acceleration"][k])}
                  for k, c in enumerate(self.channels)}
@@ -143,13 +154,21 @@ class TransientResult(JsonResult):
         return cols
 
     def to_csv(self, path) -> None:
-        """The time histories, one row per step (module docstring), atomically."""
+        """The time histories, one row per step (module docstring; a body point's force
+        cells empty), atomically."""
         cols = self.columns()
+        names = list(cols)
+        blank = [names.index(f"{c}_force_n") for c, f in
+                 zip(self.channels, self.transmits_force()) if not f]
+        rows = np.column_stack(list(cols.values())).tolist()
+        for row in rows if blank else ():
+            for j in blank:
+                row[j] = ""
         with atomic_write(path, newline="") as fh:
             fh.write(f"# {self.name}: transient simulated by powertrain ({self.method})\n")
             writer = csv.writer(fh)
-            writer.writerow(list(cols))
-            writer.writerows(np.column_stack(list(cols.values())).tolist())
+            writer.writerow(names)
+            writer.writerows(rows)
 
     def to_hdf5(self, path) -> None:
         """The time histories (SI) and the summary JSON as an attribute, atomically."""
@@ -174,7 +193,9 @@ class TransientResult(JsonResult):
         """Crank speed and torque over time above the ``quantity`` (``acceleration``,
         ``displacement``, ``force``) of ``channels`` (default: the seat's, else every mount's
         z), peaks marked; returns the figure
-        (:func:`powertrain.plotting.transient.plot_transient`)."""
+        (:func:`powertrain.plotting.transient.plot_transient`). ``ax``: None (a new figure),
+        a Figure or SubFigure, or a path (then ``path``); one Axes raises an InputError
+        saying to pass a Figure: the speed panel always stands above the channels."""
         ax, path = target_and_path(ax, path)
         return plot_transient(self, channels or self.default_channels(), path, ax=ax,
                               provenance=provenance, quantity=quantity)
@@ -197,7 +218,8 @@ class TransientResult(JsonResult):
         p = self.peaks()
         head = (f"transient '{self.name}' on {self.engine}: {self.time[-1]:g} s, "
                 f"{self.time.size - 1} steps ({self.method})")
-        rows = [[c, float(from_si(p["peak_to_peak"][k], "mm")), float(p["peak_force"][k]),
+        rows = [[c, float(from_si(p["peak_to_peak"][k], "mm")),
+                 "n/a" if np.isnan(p["peak_force"][k]) else float(p["peak_force"][k]),
                  float(p["max_acceleration"][k]), float(p["time_of_max_acceleration"][k])]
                 for k, c in enumerate(self.channels)]
         text = head + "\n" + format_table(
@@ -212,6 +234,11 @@ class TransientResult(JsonResult):
         if self.speed_source:
             text += "\n" + self.speed_source
         return text
+
+
+def _finite(value):
+    """``value`` as a float, None where it is NaN (a JSON null)."""
+    return None if np.isnan(value) else float(value)
 
 
 @dataclass(frozen=True)
@@ -246,6 +273,11 @@ class TransientRanking(JsonResult):
                           for r, j in zip(self.runs, k)]),
                 [r.networks[j] for r, j in zip(self.runs, k)])
 
+    def ranked_by(self) -> str:
+        """``peak_seat_acceleration`` (with a seat) or ``peak_mount_deflection``."""
+        return "peak_mount_deflection" if self.peak_seat() is None else \
+            "peak_seat_acceleration"
+
     def ranking(self) -> list:
         """Indices of the runs, best (smallest) first."""
         seat = self.peak_seat()
@@ -255,8 +287,7 @@ class TransientRanking(JsonResult):
     def to_dict(self) -> dict:
         seat = self.peak_seat()
         defl, where = self.peak_deflection()
-        return {"manoeuvre": self.manoeuvre, "ranked_by": "peak_seat_acceleration"
-                if seat is not None else "peak_mount_deflection",
+        return {"manoeuvre": self.manoeuvre, "ranked_by": self.ranked_by(),
                 "ranking": [self.names[i] for i in self.ranking()],
                 "runs": {n: {"peak_seat_acceleration_m_per_s2":
                              None if seat is None else float(seat[k]),
@@ -268,11 +299,15 @@ class TransientRanking(JsonResult):
         raise InputError("a retune target's files come with a run-up what-if, not with "
                          "--manoeuvre", key=key)
 
-    def plot(self, ax=None, *, path=None, provenance=None, view=None):
-        """Peak seat acceleration (if any) and peak mount deflection per run, bars
-        (:func:`powertrain.plotting.transient.plot_ranking`)."""
+    def plot(self, ax=None, *, path=None, provenance=None, view="levels"):
+        """Bars in rank order, each with its value: ``view="levels"`` the peak seat
+        acceleration [m/s²] (if any) and the peak mount deflection [mm] per run,
+        ``view="delta"`` each variant's change of them against the baseline [%]
+        (:func:`powertrain.plotting.transient.plot_ranking`); returns the figure. ``ax``:
+        None (a new figure), a Figure or SubFigure, or one Axes when there is one panel (no
+        seat); else an InputError saying to pass a Figure."""
         ax, path = target_and_path(ax, path)
-        return plot_ranking(self, path, ax=ax, provenance=provenance)
+        return plot_ranking(self, path, ax=ax, provenance=provenance, view=view)
 
     def to_text(self, written=()) -> str:
         seat = self.peak_seat()
@@ -353,8 +388,10 @@ class TransientComparison(JsonResult):
                 "not_compared": dict(self.not_compared)}
 
     def plot(self, ax=None, *, path=None, provenance=None):
-        """Measured and simulated acceleration per channel, overlaid; returns the figure
-        (:func:`powertrain.plotting.transient.plot_overlay`)."""
+        """Measured and simulated acceleration per channel, overlaid, each panel headed by its
+        errors; returns the figure (:func:`powertrain.plotting.transient.plot_overlay`).
+        ``ax``: None (a new figure), a Figure or SubFigure, or one Axes when one channel is
+        compared (else an InputError saying to pass a Figure)."""
         ax, path = target_and_path(ax, path)
         return plot_overlay(self, path, ax=ax, provenance=provenance)
 

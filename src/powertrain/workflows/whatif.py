@@ -39,6 +39,18 @@ from powertrain.workflows.variants import parse_operations, parse_target, read_v
 
 #: Signals a what-if compares (``--signal``).
 SIGNALS = ("velocity", "mount_force")
+#: Keywords (and options) of a run-up what-if that a what-if over a manoeuvre refuses:
+#: keyword -> what it is.
+RUNUP_ONLY = {"rpm": "the run-up's speed steps", "rpm_from": "the run-up's first speed",
+              "rpm_to": "the run-up's last speed", "rpm_step": "the run-up's speed step",
+              "solver": "the run-up's solver", "signal": "the run-up's compared signal",
+              "objective": "a run-up objective (a manoeuvre ranks by its peaks)",
+              "measured": "a measured run-up",
+              "executor": "a scheduler (a manoeuvre's runs are made here, in turn)",
+              "scheduler": "a scheduler (a manoeuvre's runs are made here, in turn)",
+              "workers": "a number of processes (a manoeuvre's runs are made here, in turn)",
+              "target_out": "a retune target's fitted mount file (of a run-up what-if)",
+              "target_plot": "a retune target's fit figure (of a run-up what-if)"}
 
 
 def describe_engine(engine, solver: str, rpm) -> dict:
@@ -54,10 +66,11 @@ def describe_engine(engine, solver: str, rpm) -> dict:
 
 
 def whatif(engine=None, *, scale=(), set=(), swap=(), move=(), rotate=(), effects=(),
-           targets=(), variants=None, rpm=None, solver="harmonic", signal="velocity",
+           targets=(), variants=None, rpm=None, solver=None, signal=None,
            objective=None, measured=None, executor=None, workers=None, progress=False,
            rpm_step=None, manoeuvre=None) -> WhatIfResult | TransientRanking:
-    """What-if: the baseline and variants of the mount system, the change in dB (``whatif``).
+    """What-if: the baseline and variants of the mount system, the change in dB (``whatif``),
+    or over a transient manoeuvre their peaks (``whatif --manoeuvre``).
 
     Parameters
     ----------
@@ -71,48 +84,80 @@ def whatif(engine=None, *, scale=(), set=(), swap=(), move=(), rotate=(), effect
     variants : str or Path, optional
         TOML file of named variants.
     rpm : array_like or str, optional
-        Speed steps [rpm] in the engine's range, or as ``"1000:6000:500"`` (default
-        1000..6000 step 500).
-    solver : {"harmonic", "newmark"}
-    signal : {"velocity", "mount_force"}
+        Speed steps [rpm] in the engine's range, or ``"1000:6000:500"`` (the default).
+    solver, signal : str, optional
+        ``harmonic`` (default) or ``newmark``; ``velocity`` (default) or ``mount_force``.
     objective : str, optional
         ``CHANNEL.DIR:QUANTITY:FROM-TO`` to rank the variants by (:func:`parse_objective`).
     measured : str, Path or MeasuredRunup, optional
         Measurement overlaid and compared.
-    executor : object with ``submit``, or str, optional
-        An executor, or a scheduler (``local``, ``tcp://HOST:PORT``, ``processes``,
-        ``serial``), opened and shut down here (:func:`powertrain.parallel.executor`);
-        default a local process pool.
-    workers : int, optional
-        Local processes (default: the usable cores; 1 = serial).
+    executor, workers : optional
+        An executor or a scheduler (``local``, ``tcp://HOST:PORT``, ``processes``,
+        ``serial``; :func:`powertrain.parallel.executor`), default a local process pool of
+        ``workers`` processes (default: the usable cores; 1 = serial).
     progress : bool
     rpm_step : float, optional
         The speed step [rpm] the report names (default: that of ``rpm``).
+    manoeuvre : str, Path or Manoeuvre, optional
+        Over this manoeuvre instead of a run-up (:func:`whatif_manoeuvre`): the run-up
+        keywords ``rpm`` … ``workers`` are then refused (:data:`RUNUP_ONLY`).
 
     Returns
     -------
-    WhatIfResult
+    WhatIfResult, or TransientRanking with ``manoeuvre``
 
     Raises
     ------
     InputError
-        Naming the option (``--scale``, ``--from`` ...) or file and key of bad input.
+        Naming the option (``--scale``, ``--from`` ...) or file and key of bad input, or
+        a run-up keyword given with ``manoeuvre`` (before any work).
     """
+    ops = {"scale": scale, "set": set, "swap": swap, "move": move, "rotate": rotate,
+           "effect": effects}
+    if manoeuvre is not None:
+        refuse_runup_options(dict(rpm=rpm, solver=solver, signal=signal, objective=objective,
+                                  measured=measured, rpm_step=rpm_step, executor=executor,
+                                  workers=workers))
+        engine, _ = engine_and_file(engine)
+        return whatif_manoeuvre(engine, _variants(engine, ops, targets, variants), manoeuvre)
+    return _runup_whatif(engine, ops, targets, variants, rpm=rpm, solver=solver or "harmonic",
+                         signal=signal or "velocity", objective=objective, measured=measured,
+                         executor=executor, workers=workers, progress=progress,
+                         rpm_step=rpm_step)
+
+
+def _runup_whatif(engine, ops, targets, variants, *, rpm, solver, signal, objective,
+                  measured, executor, workers, progress, rpm_step) -> WhatIfResult:
+    """:func:`whatif` over a run-up: the arguments checked in turn, then
+    :func:`run_whatif`."""
     workers = _checked(solver, signal, workers, executor)
     engine, _ = engine_and_file(engine)
     rpm = speeds(rpm)
     check_runup_settings(engine, rpm, 1.0)
-    ops = {key: texts(value, f"--{key}") for key, value in (
-        ("scale", scale), ("set", set), ("swap", swap), ("move", move), ("rotate", rotate),
-        ("effect", effects))}
-    runs = command_variants(engine, ops, texts(targets, "--target"), variants)
-    if manoeuvre is not None:
-        return whatif_manoeuvre(engine, runs, manoeuvre)
+    runs = _variants(engine, ops, targets, variants)
     goal = parse_objective(objective, engine.assemble().channels, rpm) if objective else None
-    measured = _measured(measured, engine)
     return run_whatif(engine, runs, rpm, solver=solver, executor=executor, workers=workers,
-                      measured=measured, signal=signal, progress=progress, objective=goal,
+                      measured=_measured(measured, engine), signal=signal, progress=progress,
+                      objective=goal,
                       rpm_step=real(rpm_step, "--step", unit="rpm", optional=True))
+
+
+def _variants(engine, ops: dict, targets, variants) -> list:
+    """The variants of the keyword arguments (:func:`command_variants`): ``ops`` (option
+    name -> spec string or strings), ``targets`` and the ``variants`` file."""
+    ops = {key: texts(value, f"--{key}") for key, value in ops.items()}
+    return command_variants(engine, ops, texts(targets, "--target"), variants)
+
+
+def refuse_runup_options(given: dict, what: str = "manoeuvre", keys=None) -> None:
+    """An InputError naming the first of ``given`` (keyword -> value; None: not given) that
+    is set: a run-up option (:data:`RUNUP_ONLY`) has no meaning over a manoeuvre.
+    ``what``: how the manoeuvre was asked for (``--manoeuvre`` on the command line);
+    ``keys``: keyword -> the name the error gives (default the keyword)."""
+    for name, value in given.items():
+        if value is not None:
+            raise InputError(f"{RUNUP_ONLY.get(name, 'a run-up option')} has no meaning "
+                             f"with {what}; leave it out", key=(keys or {}).get(name, name))
 
 
 def whatif_manoeuvre(engine, variants, manoeuvre) -> TransientRanking:
