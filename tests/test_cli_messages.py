@@ -157,3 +157,20 @@ def test_quiet_silences_warnings_and_only_while_the_command_runs():
         loud = CliRunner().invoke(warns, [])
     assert quiet.exit_code == loud.exit_code == 0
     assert [str(w.message) for w in seen] == ["a questionable result"]
+
+
+def test_the_package_s_warnings_print_as_one_line_on_every_command():
+    """A warning class of the package (here the transient's stretch rule) prints as
+    ``warning: ...`` on one line, whatever command raises it; --quiet prints nothing."""
+    from powertrain.solvers.transient import StretchRuleWarning
+
+    @click.command()
+    @quiet_option
+    def warns(quiet):
+        warnings.warn("left.z: static curve and amplitude law together", StretchRuleWarning,
+                      stacklevel=2)
+
+    loud, quiet = CliRunner().invoke(warns, []), CliRunner().invoke(warns, ["--quiet"])
+    assert loud.exit_code == quiet.exit_code == 0
+    assert loud.stderr == "warning: left.z: static curve and amplitude law together\n"
+    assert not quiet.stderr

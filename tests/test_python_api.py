@@ -35,13 +35,15 @@ def test_unknown_names_are_attribute_errors():
 
 
 def test_the_top_namespace_shows_only_the_public_names():
-    """``dir(pt)`` lists the API, ``InputError``, ``__version__`` and ``API``: no
+    """``dir(pt)`` lists the API, ``InputError``, ``PowertrainWarning``, ``__version__`` and
+    ``API``: no
     ``annotations`` or ``importlib`` left by the module's own imports; every public name of
     before stays importable."""
     shown = dir(powertrain)
     assert "annotations" not in shown and "importlib" not in shown
     assert set(shown) == set(powertrain.__all__) | {"API"}
-    assert set(powertrain.__all__) == {"InputError", "__version__", *powertrain.API}
+    assert set(powertrain.__all__) == {"InputError", "PowertrainWarning", "__version__",
+                                       *powertrain.API}
     from powertrain import API, InputError, __version__  # noqa: F401
     assert powertrain.InputError is powertrain.errors.InputError
 

@@ -13,7 +13,7 @@ study, docs/architecture.md the data flow (everything inside the package is SI).
 
 from importlib import import_module as _import_module
 
-from powertrain.errors import InputError
+from powertrain.errors import InputError, PowertrainWarning
 
 __version__ = "0.1.0"
 
@@ -40,7 +40,7 @@ API = {
     "read_manoeuvre": ("powertrain.iotools.manoeuvre_file", "read_manoeuvre"),
 }
 
-__all__ = ["InputError", "__version__", *API]
+__all__ = ["InputError", "PowertrainWarning", "__version__", *API]
 
 
 def __getattr__(name: str):

@@ -69,3 +69,9 @@ def require_finite(values: dict, file, key) -> None:
         if value is not None and not np.all(np.isfinite(value)):
             raise InputError(f"the computed {name} is not finite (NaN or "
                              "inf): values out of any physical range", file=file, key=key)
+
+
+class PowertrainWarning(UserWarning):
+    """A result to be read with care (a model choice, a loose convergence): the package's
+    warnings derive from it, and the command line prints them as one line
+    ``warning: ...``."""

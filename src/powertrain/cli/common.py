@@ -12,6 +12,7 @@ import warnings
 
 import click
 
+from powertrain.errors import PowertrainWarning
 from powertrain.outputs import check_writable, json_text
 from powertrain.plotting.style import close_figure
 from powertrain.provenance import Provenance, command_line
@@ -37,11 +38,26 @@ QUIET_HELP = "Print nothing but errors (on stderr): no progress, no table, no wa
 
 
 def _silence_warnings(ctx, param, quiet):
-    """With ``--quiet``, Python warnings are ignored while the command runs."""
+    """While the command runs: with ``--quiet`` Python warnings are ignored; without it the
+    package's own (:class:`~powertrain.errors.PowertrainWarning`) print as one line
+    ``warning: ...``, any other as Python prints it."""
+    ctx.with_resource(warnings.catch_warnings())
     if quiet:
-        ctx.with_resource(warnings.catch_warnings())
         warnings.simplefilter("ignore")
+    else:
+        warnings.simplefilter("default", PowertrainWarning)
+        warnings.showwarning = _one_line(warnings.showwarning)
     return quiet
+
+
+def _one_line(default):
+    """A ``warnings.showwarning`` that prints the package's warnings as one line."""
+    def show(message, category, filename, lineno, file=None, line=None):
+        if issubclass(category, PowertrainWarning):
+            click.echo(f"warning: {message}", err=True)
+        else:
+            default(message, category, filename, lineno, file, line)
+    return show
 
 
 def quiet_option(func):

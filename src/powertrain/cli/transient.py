@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import json
-import warnings
 
 import click
 
@@ -22,7 +21,6 @@ from powertrain.errors import InputError
 from powertrain.iotools.engine_file import engine_or_default
 from powertrain.iotools.manoeuvre_file import read_manoeuvre
 from powertrain.iotools.raw_hdf5 import write_raw_hdf5
-from powertrain.solvers.transient import StretchRuleWarning
 from powertrain.workflows import transient as workflow
 from powertrain.workflows import transient_recording as recording
 
@@ -96,11 +94,8 @@ def transient(manoeuvre_file, engine_file, angle_step, speed_from, seat, channel
     system = engine.assemble()
     figure = workflow.figure_channels(system, channels)
     recorded = _recordings(raw_file, speed_from, trigger, channel_map, system, manoeuvre)
-    with warnings.catch_warnings(record=True) as caught:
-        warnings.simplefilter("always", StretchRuleWarning)
-        result = workflow.transient(manoeuvre, engine, angle_step_deg=angle_step, seat=seat,
-                                    system=system, speed_from=recorded.get("speed"))
-    _warnings(caught, quiet)
+    result = workflow.transient(manoeuvre, engine, angle_step_deg=angle_step, seat=seat,
+                                system=system, speed_from=recorded.get("speed"))
     comparison = recording.compare_transient(result, recorded["compare"]) if raw_file else None
     written = _write(result, comparison, files, cli_provenance(engine_description(
         engine, engine.file)), figure, quantity)
@@ -135,16 +130,6 @@ def _recordings(raw_file, speed_from, trigger, channel_map, system, manoeuvre) -
     recording.check_recordings(manoeuvre, [f"{c}.{d}" for c, d in system.channels],
                                compare=out.get("compare"), speed=out.get("speed"))
     return out
-
-
-def _warnings(caught, quiet) -> None:
-    """The stretch rule's warnings as one line each; any other warning shown as Python
-    shows it."""
-    for w in caught:
-        if issubclass(w.category, StretchRuleWarning):
-            say(f"warning: {w.message}", quiet, err=True)
-        else:
-            warnings.showwarning(w.message, w.category, w.filename, w.lineno)
 
 
 def _write(result, comparison, files, prov, channels, quantity) -> list:

@@ -52,7 +52,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from powertrain.assembly import NetworkScaling
-from powertrain.errors import InputError
+from powertrain.errors import InputError, PowertrainWarning
 from powertrain.kernels.port_forces import NONE
 from powertrain.kernels.transient import curve_state, curve_values, transient_stretch_kernel
 from powertrain.solvers.cycle_newmark import cycle_amplitudes, no_ports, start_state
@@ -62,7 +62,7 @@ from powertrain.solvers.steppers import Cycles, DenseNewmarkStepper
 from powertrain.solvers.transient_load import N_THETA, RPM, driveline_reaction, transient_load
 
 
-class StretchRuleWarning(UserWarning):
+class StretchRuleWarning(PowertrainWarning):
     """A mount direction has a static curve and an amplitude law: in a transient the law acts
     per stretch on the motion about the mean deflection, its amplitude each stretch's, a
     model choice (docs/guide/transient.md)."""

@@ -22,7 +22,7 @@ from scipy.linalg import block_diag
 
 from powertrain.analysis.orders import ORDERS
 from powertrain.effects import EFFECTS, check_scenario
-from powertrain.errors import InputError, require_finite, solved
+from powertrain.errors import InputError, PowertrainWarning, require_finite, solved
 from powertrain.iotools.engine_file import DEFAULT_ENGINE_PATH, engine_or_default, read_engine
 from powertrain.parallel import single_blas_thread
 from powertrain.progress import activity, progress_bar
@@ -58,7 +58,7 @@ MAX_ANGLE_STEP_DEG = 10.0
 SWEEP_TRACKING = {"rpm_step": 50.0, "pulses_per_rev": 1, "tdc_offset_deg": 0.0}
 
 
-class PeriodicityWarning(UserWarning):
+class PeriodicityWarning(PowertrainWarning):
     """The processed window is not periodic to the stated limit."""
 
 
