@@ -15,6 +15,7 @@ import warnings
 import numpy as np
 import pytest
 from click.testing import CliRunner
+from conftest import MODAL
 
 import powertrain as pt
 from powertrain.cli.group import main
@@ -279,3 +280,25 @@ def test_the_stretch_rule_warning_is_one_plain_line(runs, tmp_path, monkeypatch)
     assert json.loads((tmp_path / "o.json").read_text())["speed_from"] is None
     quiet = _cli(runs["dir"] / "start.toml", "--quiet")
     assert quiet.exit_code == 0 and not quiet.stderr and not quiet.output
+
+
+def test_body_side_and_body_point_channels_are_compared_on_a_modal_body(tmp_path):
+    """A modal body's run written as raw data holds its mounts' body sides and its body
+    points; compared with itself every channel is compared, and a channel at zero
+    throughout (gearbox body side x, on the body's symmetry plane) has no relative error
+    (n/a, JSON null) rather than -100 %."""
+    modal = pt.read_engine(MODAL)
+    path = tmp_path / "start.toml"
+    path.write_text(START, encoding="utf-8")
+    run = pt.transient(path, modal)
+    write_raw_hdf5(tmp_path / "raw.h5", run.recording())
+    cmp = compare_transient(run, tmp_path / "raw.h5")
+    assert set(cmp.channels) == set(run.channels) and not cmp.not_compared
+    assert any("/passive" in c for c in cmp.channels) and "seat_rail.z" in cmp.channels
+    e, d = cmp.errors(), cmp.to_dict()["channels"]
+    zero = [c for j, c in enumerate(cmp.channels) if e["peak_measured"][j] == 0]
+    assert zero and all(d[c]["peak_error_percent"] is None for c in zero)
+    assert all(" n/a " in ln for ln in cmp.to_text().splitlines() if ln.split()[:1] in
+               ([c] for c in zero))
+    rigid = compare_transient(pt.transient(path), tmp_path / "raw.h5")
+    assert all("body side" in r or "body point" in r for r in rigid.not_compared.values())

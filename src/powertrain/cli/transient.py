@@ -50,11 +50,11 @@ from powertrain.workflows import transient_recording as recording
 @click.option("--plot", type=click.Path(dir_okay=False),
               help="Speed and torque above the channels' accelerations (PNG).")
 @click.option("--raw", "raw_out", type=click.Path(dir_okay=False),
-              help="Write the engine-side accelerations and the crank speed as raw time data "
+              help="Write every channel's acceleration and the crank speed as raw time data "
                    "(raw HDF5 layout, labelled SYNTHETIC), e.g. to try --compare.")
 @click.option("--compare", "raw_file", type=click.Path(dir_okay=False),
               help="A recording of the manoeuvre (raw CSV, HDF5, UFF, MDF4): lined up on its "
-                   "crank speed (or --trigger), every engine-side acceleration channel "
+                   "crank speed (or --trigger), every acceleration channel of the model "
                    "compared over the span it covers (peaks, RMS of the difference); in "
                    "--json under 'compare'.")
 @click.option("--compare-plot", type=click.Path(dir_okay=False),

@@ -222,9 +222,12 @@ def plot_overlay(comparison, path=None, ax=None, provenance=None):
                label="measured")
         a.plot(t, comparison.simulated[:, j], color=OKABE_ITO["orange"], lw=0.7, ls="--",
                label="simulated")
-        a.set_title(f"{comparison.channels[j]}: peak {signed(e['peak_error_percent'][j])} %\n"
-                    f"RMS diff. {e['rms_difference'][j]:.3g} m/s² "
-                    f"({e['rms_difference_percent'][j]:.0f} %)", fontsize=TICK_SIZE, pad=3)
+        peak, share = e["peak_error_percent"][j], e["rms_difference_percent"][j]
+        a.set_title(f"{comparison.channels[j]}: peak "
+                    f"{'n/a' if np.isnan(peak) else signed(peak) + ' %'}\n"
+                    f"RMS diff. {e['rms_difference'][j]:.3g} m/s²"
+                    + ("" if np.isnan(share) else f" ({share:.0f} %)"), fontsize=TICK_SIZE,
+                    pad=3)
         a.margins(x=X_MARGIN, y=Y_MARGIN)
         a.tick_params(labelsize=TICK_SIZE)
         a.grid(True, lw=0.3)

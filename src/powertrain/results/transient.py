@@ -106,14 +106,15 @@ class TransientResult(JsonResult):
                 "time_of_max_acceleration": self.time[i]}
 
     def recording(self) -> RawRecording:
-        """The engine-side mount-point accelerations [m/s²] and the crank speed [rpm] as raw
-        time data (labelled SYNTHETIC), for the raw writers and readers."""
+        """Every channel's acceleration [m/s²] (the mounts' engine and body sides, the body
+        points) and the crank speed [rpm] as raw time data (labelled SYNTHETIC), for the raw
+        writers and readers."""
         chans = []
         for k, label in enumerate(self.channels):
-            mount, _, d = label.rpartition(".")
-            if "/" not in mount and d in "xyz" and k < len(self.networks):
-                chans.append(RawChannel(Channel(mount, "active", d).label, mount, "active", d,
-                                        "acceleration", self.acceleration[:, k], "m/s^2"))
+            node, _, d = label.rpartition(".")
+            c = Channel.of_node(node, d)
+            chans.append(RawChannel(c.label, c.mount, c.side, d, "acceleration",
+                                    self.acceleration[:, k], "m/s^2"))
         note = f"SYNTHETIC: simulated transient '{self.name}' ({self.method})"
         return RawRecording(self.time, chans, self.rpm, None, "simulated transient",
                             [note]).validate()
@@ -239,6 +240,17 @@ class TransientResult(JsonResult):
 def _finite(value):
     """``value`` as a float, None where it is NaN (a JSON null)."""
     return None if np.isnan(value) else float(value)
+
+
+def _relative(part, whole):
+    """``100 part / whole`` [%], NaN where ``whole`` is 0."""
+    safe = np.where(whole > 0, whole, 1.0)
+    return np.where(whole > 0, 100.0 * part / safe, np.nan)
+
+
+def _percent(value, spec):
+    """A percentage for a table: ``n/a`` where NaN."""
+    return "n/a" if np.isnan(value) else format(float(value), spec)
 
 
 @dataclass(frozen=True)
@@ -367,20 +379,20 @@ class TransientComparison(JsonResult):
 
     def errors(self) -> dict:
         """Per channel: the peaks [m/s²], the peak's error [%] and the RMS of the difference
-        over the event [m/s²] and relative to the measured RMS [%]."""
+        over the event [m/s²] and relative to the measured RMS [%]; the relative ones NaN
+        where the measured channel is zero throughout (nothing to be relative to)."""
         pm, ps = np.max(np.abs(self.measured), 0), np.max(np.abs(self.simulated), 0)
         rms = np.sqrt(np.mean((self.simulated - self.measured) ** 2, axis=0))
         base = np.sqrt(np.mean(self.measured ** 2, axis=0))
         return {"peak_measured": pm, "peak_simulated": ps,
-                "peak_error_percent": 100.0 * (ps / np.where(pm > 0, pm, np.inf) - 1.0),
-                "rms_difference": rms,
-                "rms_difference_percent": 100.0 * rms / np.where(base > 0, base, np.inf)}
+                "peak_error_percent": _relative(ps - pm, pm), "rms_difference": rms,
+                "rms_difference_percent": _relative(rms, base)}
 
     def to_dict(self) -> dict:
         e = self.errors()
         first, last, t0, t1 = self.span()
         return {"manoeuvre": self.name, "recording": self.raw, "shift_s": self.shift,
-                "channels": {c: {k: float(v[j]) for k, v in e.items()}
+                "channels": {c: {k: _finite(v[j]) for k, v in e.items()}
                              for j, c in enumerate(self.channels)},
                 "aligned_on": self.aligned_on, "compared_from_s": first,
                 "compared_to_s": last, "event_from_s": t0, "event_to_s": t1,
@@ -398,8 +410,9 @@ class TransientComparison(JsonResult):
     def to_text(self) -> str:
         e = self.errors()
         rows = [[c, float(e["peak_measured"][j]), float(e["peak_simulated"][j]),
-                 f"{e['peak_error_percent'][j]:+.1f}", float(e["rms_difference"][j]),
-                 f"{e['rms_difference_percent'][j]:.1f}"] for j, c in enumerate(self.channels)]
+                 _percent(e["peak_error_percent"][j], "+.1f"), float(e["rms_difference"][j]),
+                 _percent(e["rms_difference_percent"][j], ".1f")]
+                for j, c in enumerate(self.channels)]
         first, last, t0, t1 = self.span()
         text = (f"compared with {self.raw} (aligned on the {self.aligned_on}: the simulation "
                 f"starts at {self.shift:.4f} s of the recording) over {first:.4f} to {last:.4f} s"

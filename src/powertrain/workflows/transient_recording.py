@@ -195,20 +195,20 @@ def compared_channels(rec: Recorded, labels) -> tuple:
     mounts = sorted({c.rpartition(".")[0] for c in labels if "/" not in c})
     pairs, skipped = [], {n: "not in the channel map" for n in rec.ignored}
     for ch in rec.channels:
-        label = f"{ch.mount}.{ch.direction}"
-        if ch.side != "active":
-            skipped[ch.name] = "body side (only engine-side channels are compared)"
-        elif ch.quantity != "acceleration":
+        label = f"{ch.channel.node}.{ch.direction}"       # left.x, left/passive.x, seat.z
+        if ch.quantity != "acceleration":
             skipped[ch.name] = f"{ch.quantity} (only accelerations are compared)"
-        elif label not in labels:
+        elif label in labels:
+            pairs.append((label, ch))
+        elif ch.side == "passive" and f"{ch.mount}.{ch.direction}" in labels:
+            skipped[ch.name] = "body side: the model has none (its mounts stand on rigid ground)"
+        else:
             skipped[ch.name] = (f"no mount or body point {ch.mount!r} in the model (it has "
                                 f"{', '.join(mounts)}; rename with {MAP_OPTION})")
-        else:
-            pairs.append((label, ch))
     if not pairs:
         why = "; ".join(f"{n}: {r}" for n, r in skipped.items())
-        raise InputError(f"no engine-side acceleration channel of the simulation in the "
-                         f"recording ({why})", file=rec.path, key="channels")
+        raise InputError(f"no acceleration channel of the simulation in the recording "
+                         f"({why})", file=rec.path, key="channels")
     return pairs, skipped
 
 
@@ -230,7 +230,7 @@ def compare_transient(result, raw, *, trigger=None, channel_map=None) -> Transie
     Returns
     -------
     TransientComparison
-        Every recorded engine-side acceleration channel the simulation has, over the part
+        Every recorded acceleration channel the simulation has, over the part
         of the event the recording covers; the others listed with the reason.
 
     Raises
