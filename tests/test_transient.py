@@ -517,9 +517,10 @@ def test_a_speed_above_the_combustion_model_is_refused_before_any_work(default_e
 
 def test_speed_from_removes_the_speed_profile_part_of_a_comparison(default_engine, tmp_path):
     """A start recorded with another speed profile (300 -> 950 rpm instead of 250 -> 900):
-    compared with the file's own profile the RMS of the difference is above half the
-    measured RMS (measured 78-150 %); driven by the recorded speed (``speed_from``) it
-    falls below 1 % (measured 0.04-0.19 %: the speed table's block means)."""
+    compared with the file's own profile, lined up where the speeds match best, the RMS
+    of the difference is above a quarter of the measured RMS (measured 35-40 %); driven by
+    the recorded speed (``speed_from``) it falls below 1 % (measured 0.04-0.19 %: the speed
+    table's block means)."""
     (tmp_path / "m.toml").write_text(GOOD, encoding="utf-8")
     (tmp_path / "other.toml").write_text(GOOD.replace("[0.0, 250.0, 900.0]",
                                                       "[0.0, 300.0, 950.0]"), encoding="utf-8")
@@ -529,7 +530,7 @@ def test_speed_from_removes_the_speed_profile_part_of_a_comparison(default_engin
     driven = pt.transient(tmp_path / "m.toml", default_engine, speed_from=tmp_path / "raw.h5")
     before = compare_transient(nominal, tmp_path / "raw.h5").errors()["rms_difference_percent"]
     after = compare_transient(driven, tmp_path / "raw.h5").errors()["rms_difference_percent"]
-    assert np.min(before) > 50.0 and np.max(after) < 1.0, (before, after)
+    assert np.min(before) > 25.0 and np.max(after) < 1.0, (before, after)
 
 
 def test_a_static_curve_with_an_amplitude_law_is_said_to_be_approximate(default_engine):

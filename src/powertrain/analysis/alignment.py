@@ -18,18 +18,28 @@ than that, else the last interval's speed is held.
 between samples) of the mid level between the channel's smallest and largest values.
 
 **Alignment on the speed** (:func:`align_speed`): the shift :math:`s` minimising the mean of
-:math:`(n_\mathrm{rec}(t + s) - n_\mathrm{sim}(t))^2` over :data:`GRID` times of the
-event, the shorter of the two taken to lie inside the longer (a grid of 801 shifts, then
-refined 50 times finer about the best). Its standard error is
-:math:`\sigma / \sqrt{\sum \dot n_\mathrm{sim}^2}` over those times (least squares on one
-parameter), :math:`\sigma` the recorded speed's scatter (the second differences' RMS over
-:math:`\sqrt 6`, at least :data:`SPEED_FLOOR_RPM`); where :data:`ALIGN_SIGMAS` standard
-errors exceed the time the crank takes to turn :data:`ALIGN_TOLERANCE_DEG` at the event's
-top speed, the speed varies too little to align on and the recording is refused (a trigger
-channel is then needed). It is refused too where the speed matches as well elsewhere: a
-shift outside the valley of the best one (beyond where the cost first rises by
-:math:`\sigma^2` on either side) whose cost is within :math:`\sigma^2` of the best (a
-recording of two starts).
+:math:`(n_\mathrm{rec}(t) - n_\mathrm{sim}(t - s))^2` over the recorded samples inside the
+event (at most :data:`COST_SAMPLES`; an unsigned speed channel against the event's
+magnitude; a channel held between updates read at its updates, :func:`unheld_speed`),
+among the shifts where the recording covers :data:`MIN_COVERAGE` of the event at either end
+(or, not ``partial``, all of it; a grid, then refined 100 times finer about the best). At
+the best shift the speeds may differ by :data:`MISMATCH_SHARE` of the event's speed range
+(RMS), else no shift matches. Its standard error is
+:math:`\sigma / \sqrt{\sum \dot n_\mathrm{sim}^2}` over the recorded samples (least
+squares on one parameter), :math:`\sigma` the recorded speed's scatter (the second
+differences' RMS over :math:`\sqrt 6`, at least :data:`SPEED_FLOOR_RPM`); where
+:data:`ALIGN_SIGMAS` standard errors exceed the time the crank takes to turn
+:data:`ALIGN_TOLERANCE_DEG` at the event's top speed, the speed varies too little to align
+on and the recording is refused (a trigger channel is then needed). It is refused too where
+the speed matches as well elsewhere: a shift outside the valley of the best one (beyond
+where the cost first rises by :math:`\sigma^2` on either side) whose cost is within
+:math:`\sigma^2` of the best (a recording of two starts).
+
+**Alignment on a tacho's pulses** (:func:`align_tacho`): the event's crank angle at the
+rising edges less one revolution per edge is constant at the true shift (the pulse's phase
+unknown): the shift minimising its variance, among the shifts where the edges inside the
+event are as many as the revolutions it turns there (within one); its standard error the
+phase's scatter over :math:`\sqrt{\sum \dot\theta^2}` at the edges; refused as above.
 """
 
 from __future__ import annotations
@@ -50,6 +60,21 @@ ALIGN_SIGMAS = 3.0
 ALIGN_TOLERANCE_DEG = 2.0
 #: Least part of the event a recording must cover after alignment.
 MIN_COVERAGE = 0.5
+#: A speed channel whose samples change at fewer than this share of them is held between
+#: updates (:func:`unheld_speed`).
+HELD_SHARE = 0.5
+#: The speeds at the best shift may differ by at most this share of the event's speed range
+#: (RMS; else the recording does not match the event anywhere).
+MISMATCH_SHARE = 0.1
+#: A tacho's alignment: least pulses inside the event, the phase's scatter assumed at least
+#: [rev] (a sample of jitter), and the most [rev] at the best shift (else no match).
+MIN_EDGES = 4
+PHASE_FLOOR_REV = 1e-4
+MISMATCH_REV = 0.05
+#: Times at which an event's speed table is read for its angle and slope, and the most
+#: recorded samples a speed alignment's cost reads.
+FINE = 20001
+COST_SAMPLES = 20000
 
 
 def tacho_rpm(time, tacho, *, file=None, key="tacho") -> np.ndarray:
@@ -111,7 +136,8 @@ def coverage(t0, t1, rec0, rec1, shift):
     return max(t0, rec0 - shift), min(t1, rec1 - shift)
 
 
-def align_speed(t_sim, rpm_sim, t_rec, rpm_rec, *, file=None, key="rpm") -> tuple:
+def align_speed(t_sim, rpm_sim, t_rec, rpm_rec, *, file=None, key="rpm",
+                partial=True) -> tuple:
     """Time shift [s] of the recording against the event (the recording's time of the event's
     time 0) and its standard error [s], from the speeds (module docstring).
 
@@ -123,12 +149,15 @@ def align_speed(t_sim, rpm_sim, t_rec, rpm_rec, *, file=None, key="rpm") -> tupl
         The recording's sample times [s] and crank speed [rpm].
     file, key : str, optional
         Named in error messages.
+    partial : bool
+        The recording may cover part of the event (at least :data:`MIN_COVERAGE`, at either
+        end); False: it holds all of it.
 
     Raises
     ------
     InputError
-        The recording shorter than :data:`MIN_COVERAGE` of the event, or the speed too flat
-        to align on.
+        The recording shorter than :data:`MIN_COVERAGE` of the event, the speed too flat
+        to align on, matching at two places, or not matching anywhere.
     """
     t_sim, t_rec = np.asarray(t_sim, float), np.asarray(t_rec, float)
     length, event = t_rec[-1] - t_rec[0], t_sim[-1] - t_sim[0]
@@ -136,27 +165,24 @@ def align_speed(t_sim, rpm_sim, t_rec, rpm_rec, *, file=None, key="rpm") -> tupl
         raise InputError(f"the recording is {length:.4g} s long, less than "
                          f"{MIN_COVERAGE:.0%} of the {event:.4g} s event", file=file,
                          key="time")
-    t = np.linspace(t_sim[0], t_sim[-1], GRID)
-    target = np.interp(t, t_sim, rpm_sim)
+    sigma = _scatter(t_rec, rpm_rec)
+    t_rec, rpm_rec = unheld_speed(t_rec, np.asarray(rpm_rec, float))
+    t, target = _fine(t_sim, rpm_sim)
     costs = _costs(t, target, t_rec, rpm_rec)
-    lo, hi = sorted((t_rec[0] - t_sim[0], t_rec[-1] - t_sim[-1]))
-    shifts = np.linspace(lo, hi, 801)
+    lo, hi = _shift_range(t_sim, (t_rec[0], t_rec[-1]), partial)
+    shifts = np.linspace(lo, hi, max(801, int(np.ceil((hi - lo) / (event / GRID))) + 1))
     coarse = costs(shifts)
     best = int(np.argmin(coarse))
-    shift = float(shifts[best])
-    step = shifts[1] - shifts[0]
-    if step > 0:
-        fine = np.clip(shift + np.linspace(-2.0, 2.0, 201) * step, lo, hi)
-        shift = float(fine[np.argmin(costs(fine))])
-    sigma = _scatter(t, t_rec, rpm_rec, shift)
+    fine = np.clip(shifts[best] + np.linspace(-2.0, 2.0, 401) * (shifts[1] - shifts[0]),
+                   lo, hi)
+    shift = float(fine[np.argmin(costs(fine))])
     other = _second_match(coarse, best, sigma ** 2)
     if other is not None:
         raise InputError(f"the crank speed matches the event's at two places of the recording "
                          f"(the event starting at {shift:.4f} s or at {shifts[other]:.4f} s); "
                          "give --trigger CHANNEL", file=file, key=key)
-    slope = np.gradient(target, t)[(t + shift >= t_rec[0]) & (t + shift <= t_rec[-1])]
-    info = float(np.sum(slope ** 2))
-    error = sigma / np.sqrt(info) if info > 0 else np.inf
+    _check_match(float(np.sqrt(costs(np.array([shift]))[0])), sigma, target, file, key)
+    error = _shift_error(t_sim, rpm_sim, t_rec, shift, sigma)
     top = max(float(np.max(np.abs(target))), SPEED_FLOOR_RPM)
     allowed = ALIGN_TOLERANCE_DEG / (6.0 * top)
     if not ALIGN_SIGMAS * error <= allowed:
@@ -168,14 +194,145 @@ def align_speed(t_sim, rpm_sim, t_rec, rpm_rec, *, file=None, key="rpm") -> tupl
     return shift, error
 
 
+def align_tacho(t_sim, rpm_sim, span, edges, *, file=None, key="tacho",
+                partial=True) -> tuple:
+    """Time shift [s] of the recording against the event and its standard error [s] from a
+    once-per-revolution tacho's rising ``edges`` [s], the recording lasting ``span = (first,
+    last)`` [s]: the shift at which the event's crank angle at the edges, less one
+    revolution per edge, is most nearly constant (least squares, the pulse's phase
+    eliminated), among the shifts where the edges inside the event are as many as the
+    revolutions it turns there (module docstring); ``partial`` as :func:`align_speed`'s.
+
+    Raises
+    ------
+    InputError
+        Fewer than :data:`MIN_EDGES` edges in the event, no shift matching, two, or one not
+        determined to :data:`ALIGN_TOLERANCE_DEG`.
+    """
+    t_sim, rpm_sim = _fine(t_sim, rpm_sim)
+    edges = np.asarray(edges, float)
+    speed = np.abs(rpm_sim) / 60.0                                        # [rev/s]
+    rev = np.r_[0.0, np.cumsum(0.5 * (speed[1:] + speed[:-1]) * np.diff(t_sim))]
+    event = t_sim[-1] - t_sim[0]
+    lo, hi = _shift_range(t_sim, span, partial)
+    shifts = np.linspace(lo, hi, max(801, int(np.ceil((hi - lo) / (event / GRID))) + 1))
+    coarse = np.array([_phase_cost(s, t_sim, rev, edges, span) for s in shifts])
+    if not np.isfinite(coarse).any():
+        raise InputError(f"the tacho's pulses match the event's revolutions at no shift (at "
+                         f"least {MIN_EDGES} pulses in the event, one per revolution); give "
+                         "--trigger CHANNEL", file=file, key=key)
+    best = int(np.argmin(coarse))
+    fine = np.clip(shifts[best] + np.linspace(-2.0, 2.0, 401) * (shifts[1] - shifts[0]),
+                   lo, hi)
+    shift = float(fine[np.argmin([_phase_cost(s, t_sim, rev, edges, span) for s in fine])])
+    sigma = max(float(np.sqrt(_phase_cost(shift, t_sim, rev, edges, span))), PHASE_FLOOR_REV)
+    if sigma > MISMATCH_REV:
+        raise InputError(f"the tacho's pulses do not follow the event's crank angle at any "
+                         f"shift ({sigma:.2g} rev RMS at the best; a once-per-revolution "
+                         "tacho is expected); give --trigger CHANNEL", file=file, key=key)
+    other = _second_match(coarse, best, sigma ** 2)
+    if other is not None:
+        raise InputError(f"the tacho's pulses match the event at two places of the recording "
+                         f"(the event starting at {shift:.4f} s or at {shifts[other]:.4f} s); "
+                         "give --trigger CHANNEL", file=file, key=key)
+    at = edges - shift
+    rate = np.interp(at[(at >= t_sim[0]) & (at <= t_sim[-1])], t_sim, speed)
+    error = sigma / np.sqrt(float(np.sum(rate ** 2)))
+    allowed = ALIGN_TOLERANCE_DEG / (360.0 * max(float(np.max(speed)), 1e-9))
+    if not ALIGN_SIGMAS * error <= allowed:
+        raise InputError(f"the tacho's pulses fix the event's start to +-"
+                         f"{ALIGN_SIGMAS * error * 1e3:.3g} ms only, more than "
+                         f"{allowed * 1e3:.2g} ms = {ALIGN_TOLERANCE_DEG:g} deg of crank; give "
+                         "--trigger CHANNEL", file=file, key=key)
+    return shift, error
+
+
+def _phase_cost(shift, t_sim, rev, edges, span) -> float:
+    """Variance [rev²] of the event's crank angle at the edges inside it less their count
+    (inf where fewer than :data:`MIN_EDGES`, or where the edges are not as many as the
+    revolutions the event turns over the recorded part, within one)."""
+    first, last = max(t_sim[0], span[0] - shift), min(t_sim[-1], span[1] - shift)
+    at = edges - shift
+    at = at[(at >= first) & (at <= last)]
+    if at.size < MIN_EDGES:
+        return np.inf
+    turned = np.interp(last, t_sim, rev) - np.interp(first, t_sim, rev)
+    if abs(at.size - turned) > 1.5:
+        return np.inf
+    return float(np.var(np.interp(at, t_sim, rev) - np.arange(at.size)))
+
+
+def _shift_range(t_sim, span, partial) -> tuple:
+    """The shifts [s] searched: the recording covering at least :data:`MIN_COVERAGE` of the
+    event at either end (``partial``), else holding all of it (a shorter one: lying
+    inside it)."""
+    event = t_sim[-1] - t_sim[0]
+    if partial:
+        return (span[0] - t_sim[-1] + MIN_COVERAGE * event,
+                span[1] - t_sim[0] - MIN_COVERAGE * event)
+    return tuple(sorted((span[0] - t_sim[0], span[1] - t_sim[-1])))
+
+
+def unheld_speed(t_rec, rpm_rec):
+    """``(t_rec, rpm)``: a speed channel [rpm] held between updates (an ECU's or a bus's:
+    most samples repeat the one before) as its updates, linear between them; any other as
+    it is."""
+    changed = np.r_[True, np.diff(rpm_rec) != 0]
+    if np.mean(changed) >= HELD_SHARE or np.count_nonzero(changed) < 4:
+        return t_rec, rpm_rec
+    keep = changed | (np.arange(t_rec.size) == t_rec.size - 1)
+    return t_rec, np.interp(t_rec, t_rec[keep], rpm_rec[keep])
+
+
+def _check_match(residual, sigma, target, file, key):
+    """Refuse a best shift at which the speeds still differ by more than
+    :data:`MISMATCH_SHARE` of the event's speed range (and many times the scatter): the
+    recorded speed is not the event's anywhere."""
+    span = float(np.ptp(target))
+    if residual > max(MISMATCH_SHARE * span, 5.0 * sigma):
+        raise InputError(f"the recorded crank speed does not match the event's at any shift "
+                         f"(RMS difference {residual:.3g} rpm at the best, over "
+                         f"{MISMATCH_SHARE:.0%} of its {span:.4g} rpm range); give --trigger "
+                         "CHANNEL, or drive the simulation with --speed-from", file=file,
+                         key=key)
+
+
+def _fine(t_sim, rpm_sim):
+    """The event's speed [rpm] on :data:`FINE` times (a speed table's rows are linear between
+    them: its angle is not)."""
+    t_sim = np.asarray(t_sim, float)
+    t = np.linspace(t_sim[0], t_sim[-1], FINE)
+    return t, np.interp(t, t_sim, np.asarray(rpm_sim, float))
+
+
+def _shift_error(t_sim, rpm_sim, t_rec, shift, sigma) -> float:
+    """Standard error [s] of the shift: least squares on one parameter over every recorded
+    sample inside the event, :math:`\\sigma / \\sqrt{\\sum \\dot n_\\mathrm{sim}^2}`."""
+    t_sim, rpm_sim = _fine(t_sim, rpm_sim)
+    at = t_rec - shift
+    inside = (at >= t_sim[0]) & (at <= t_sim[-1])
+    slope = np.interp(at[inside], t_sim, np.gradient(rpm_sim, t_sim))
+    info = float(np.sum(slope ** 2))
+    return sigma / np.sqrt(info) if info > 0 else np.inf
+
+
 def _costs(t, target, t_rec, rpm_rec):
-    """Mean squared speed difference [rpm²] over the event times inside the recording, as
-    a function of an array of shifts."""
+    """Mean squared speed difference [rpm²] over the recorded samples (at most
+    :data:`COST_SAMPLES`, evenly taken) inside the event, as a function of an array of
+    shifts; an unsigned speed channel (never negative) against the event's magnitude."""
+    if np.min(rpm_rec) >= 0:
+        target = np.abs(target)
+    every = max(1, int(np.ceil(t_rec.size / COST_SAMPLES)))
+    tr, rr = t_rec[::every], rpm_rec[::every]
+
     def costs(shifts):
-        at = t[None, :] + shifts[:, None]
-        inside = (at >= t_rec[0]) & (at <= t_rec[-1])
-        err = np.where(inside, np.interp(at, t_rec, rpm_rec) - target, 0.0)
-        return np.sum(err ** 2, axis=1) / np.maximum(np.sum(inside, axis=1), 1)
+        out = np.empty(len(shifts))
+        for i in range(0, len(shifts), 32):
+            at = tr[None, :] - np.asarray(shifts[i:i + 32])[:, None]
+            inside = (at >= t[0]) & (at <= t[-1])
+            err = np.where(inside, rr - np.interp(at, t, target), 0.0)
+            out[i:i + 32] = np.sum(err ** 2, axis=1) / np.maximum(np.sum(inside, axis=1), 1)
+        return out
     return costs
 
 
@@ -194,10 +351,9 @@ def _second_match(costs, best, margin):
     return int(close[np.argmin(costs[close])]) if close.size else None
 
 
-def _scatter(t, t_rec, rpm_rec, shift) -> float:
-    """The recorded speed's scatter [rpm] over the event at ``shift``: the RMS of its second
-    differences over sqrt(6) (white noise), at least :data:`SPEED_FLOOR_RPM`."""
-    sel = (t_rec >= t[0] + shift) & (t_rec <= t[-1] + shift)
-    r = np.asarray(rpm_rec, float)[sel]
+def _scatter(t_rec, rpm_rec) -> float:
+    """The recorded speed's scatter [rpm]: the RMS of its second differences over sqrt(6)
+    (white noise), at least :data:`SPEED_FLOOR_RPM`."""
+    r = np.asarray(rpm_rec, float)
     scatter = np.sqrt(np.mean(np.diff(r, 2) ** 2) / 6.0) if r.size > 2 else 0.0
     return max(scatter, SPEED_FLOOR_RPM)

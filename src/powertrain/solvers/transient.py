@@ -80,6 +80,9 @@ CURVE_STEP = 0.002
 MAX_STEPS = 2 ** 21
 #: Most memory of a run's time histories [B] (checked before any work).
 MAX_BYTES = 2e9
+#: A manoeuvre starting below this speed [rpm] starts at rest (a recorded speed's creep at
+#: standstill: a cycle would last minutes, and the gas load is faded out there).
+REST_RPM = 5.0
 #: Speed below which the step is set as at this speed [rpm]: standstill needs a step too.
 FLOOR_RPM = 600.0
 
@@ -323,7 +326,7 @@ def _start(engine, manoeuvre, system, load, ports, model):
     laws = ports.select(ports.kinds != NONE)
     n = system.n_dof
     omega = abs(float(load.omega[0]))
-    if omega == 0.0:        # at rest where the driveline holds the block (none: at zero)
+    if omega < REST_RPM * RPM:  # at rest where the driveline holds the block (none: at zero)
         held = driveline_reaction(engine, manoeuvre, load.driveline_torque[0])
         x0 = _static_state(system, scaling, curves, held) if held.any() else np.zeros(n)
         state = laws.initial_state(x0) if laws.kinds.size else None

@@ -18,10 +18,13 @@ import numpy as np
 from powertrain.analysis.alignment import (
     MIN_COVERAGE,
     align_speed,
+    align_tacho,
     coverage,
     tacho_rpm,
     trigger_time,
+    unheld_speed,
 )
+from powertrain.analysis.speed import tacho_edges
 from powertrain.errors import InputError
 from powertrain.iotools.raw import IGNORED_NOTE, read_raw
 from powertrain.models.manoeuvre import MAX_RPM, Manoeuvre
@@ -53,6 +56,9 @@ class Recorded:
     channels : list of RawChannel
     ignored : list of str
         Channels of the file the channel map leaves out.
+    edges : ndarray or None
+        The once-per-revolution tacho's rising edges from the first sample [s] (None
+        where the speed is an rpm channel's).
     """
 
     path: str
@@ -63,6 +69,7 @@ class Recorded:
     trigger_name: str | None
     channels: list
     ignored: list = field(default_factory=list)
+    edges: np.ndarray | None = None
 
 
 def read_recording(path, *, channel_map=None, trigger=None) -> Recorded:
@@ -84,8 +91,10 @@ def read_recording(path, *, channel_map=None, trigger=None) -> Recorded:
                                                           key=trigger)
     ignored = [n.strip() for c in rec.comments if c.startswith(IGNORED_NOTE)
                for n in c[len(IGNORED_NOTE):].split(",")]
+    edges = (tacho_edges(t, rec.tacho, file=str(path), key="tacho")
+             if rec.rpm is None and rec.tacho is not None else None)
     return Recorded(str(path), t, recorded_rpm(rec, path), _speed_source(rec), when, trigger,
-                    list(rec.channels), ignored)
+                    list(rec.channels), ignored, edges)
 
 
 def recording_or_file(recording, *, channel_map=None, trigger=None) -> Recorded:
@@ -112,17 +121,22 @@ def recorded_rpm(rec, path) -> np.ndarray | None:
     return None
 
 
-def align(rec: Recorded, t_event, rpm_event) -> tuple:
+def align(rec: Recorded, t_event, rpm_event, *, partial=True) -> tuple:
     """The recording's time [s] of the event's time 0 and how it was found (``trigger
     'NAME'`` or ``crank speed``): the trigger's time, else the speed alignment against the
-    event's speed ``rpm_event`` [rpm] at ``t_event`` [s] (module docstring)."""
+    event's speed ``rpm_event`` [rpm] at ``t_event`` [s] (module docstring); ``partial``:
+    the recording may cover part of the event (:func:`align_speed`)."""
     if rec.trigger is not None:
         return rec.trigger - float(t_event[0]), f"trigger {rec.trigger_name!r}"
     if rec.rpm is None:
         raise InputError("no rpm or tacho channel to line the recording up on; give "
                          "--trigger CHANNEL", file=rec.path, key="rpm")
-    key = "rpm" if rec.speed_source == "rpm channel" else "tacho"
-    shift, _ = align_speed(t_event, rpm_event, rec.time, rec.rpm, file=rec.path, key=key)
+    if rec.edges is not None:
+        shift, _ = align_tacho(t_event, rpm_event, (rec.time[0], rec.time[-1]), rec.edges,
+                               file=rec.path, key="tacho", partial=partial)
+        return shift, "crank angle of the tacho's pulses"
+    shift, _ = align_speed(t_event, rpm_event, rec.time, rec.rpm, file=rec.path, key="rpm",
+                           partial=partial)
     return shift, "crank speed"
 
 
@@ -151,14 +165,14 @@ def speed_from_recording(manoeuvre: Manoeuvre, recording, *, channel_map=None,
         raise InputError(f"the recording is {rec.time[-1]:.6g} s long, the manoeuvre "
                          f"{duration:.6g} s; --speed-from needs all of it", file=rec.path,
                          key="time")
-    shift, how = align(rec, manoeuvre.time, manoeuvre.speed / _RPM)
+    shift, how = align(rec, manoeuvre.time, manoeuvre.speed / _RPM, partial=False)
     first, last = coverage(0.0, duration, rec.time[0], rec.time[-1], shift)
     if first > tol or last < duration - tol:
         raise InputError(f"after alignment ({how}: the manoeuvre starts at {shift:.4f} s of "
                          f"the recording) the recording covers {first:.6g} to {last:.6g} s of "
                          f"the manoeuvre's 0 to {duration:.6g} s; --speed-from needs all of it",
                          file=rec.path, key="time")
-    tt, rr = _speed_rows(rec.time - shift, rec.rpm, duration)
+    tt, rr = _speed_rows(rec.time - shift, unheld_speed(rec.time, rec.rpm)[1], duration)
     if not manoeuvre.reversal:
         rr = np.maximum(rr, 0.0)
     if not np.all(np.isfinite(rr)) or np.max(np.abs(rr)) > MAX_RPM:
