@@ -27,7 +27,7 @@ from powertrain.physics.mount_laws import BergFriction, PowerLaw
 from powertrain.solvers.newmark import newmark, newmark_ports
 from powertrain.solvers.operating_point import StaticSupport, operating_point
 from powertrain.solvers.transient import StretchRuleWarning, simulate_transient
-from powertrain.solvers.transient_load import transient_load
+from powertrain.solvers.transient_load import TorqueLimitWarning, transient_load
 from powertrain.workflows.transient_recording import compare_transient
 from powertrain.workflows.whatif import command_variants, variant_engine
 
@@ -354,6 +354,16 @@ def test_the_load_table_runs_from_the_cycle_without_burn_to_full_load(default_en
     throttled = dataclasses.replace(m, motored_intake_pressure=0.35e5)
     assert transient_load(e, throttled, t).engine_torque[0] != load.engine_torque[0]
     assert read_manoeuvre(EXAMPLES / "stop.toml").motored_intake_pressure == 0.35e5
+
+
+def test_a_mean_torque_beyond_the_engine_is_said(default_engine):
+    """Review 2: 500 N m from an engine of 250 N m full load (or braking beyond its motored
+    drag) is not silently cut: a TorqueLimitWarning says when and how much."""
+    w = 1500.0 * np.pi / 30.0
+    m = Manoeuvre("over", np.array([0.0, 1.0]), np.full(2, w), np.array([0.0, 1.0]),
+                  np.array([500.0, -500.0]), "mean_torque", 2.1, 0.18)
+    with pytest.warns(TorqueLimitWarning, match="beyond what the engine gives"):
+        transient_load(default_engine, m, np.linspace(0.0, 1.0, 11))
 
 
 def test_the_motored_cycle_is_the_polytropes_closed_form(default_engine):

@@ -319,3 +319,17 @@ def test_partial_and_held_speed_recordings_line_up(runs, tmp_path):
     held = rec.rpm[(np.arange(rec.time.size) // int(round(0.01 / h))) * int(round(0.01 / h))]
     held_cmp = compare_transient(first, dataclasses.replace(rec, rpm=held))
     assert held_cmp.shift == pytest.approx(0.3, abs=1e-4)
+
+
+def test_a_trigger_must_step_and_hold():
+    """Review 2: a channel of jitter only is no trigger (refused, naming it), and a one-sample
+    glitch before the step is passed over (before: accepted at the glitch, 0.2 s early)."""
+    from powertrain.analysis.alignment import trigger_time
+    t = np.arange(0.0, 1.0, 1e-4)
+    jitter = 0.03 * np.random.default_rng(3).uniform(-1.0, 1.0, t.size)
+    with pytest.raises(pt.InputError, match="does not step") as err:
+        trigger_time(t, jitter, file="rec.csv", key="trig")
+    assert "'trig'" in str(err.value)
+    step = np.where(t >= 0.5, 5.0, 0.0)
+    step[2000] = 4.0                                          # a glitch at 0.2 s
+    assert trigger_time(t, step) == pytest.approx(0.49995, abs=1e-4)

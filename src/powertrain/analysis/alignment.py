@@ -15,7 +15,9 @@ speed falls linearly to 0 at one last interval after it where the record goes on
 than that, else the last interval's speed is held.
 
 **Trigger** (:func:`trigger_time`): event time 0 is the first rising crossing (linear
-between samples) of the mid level between the channel's smallest and largest values.
+between samples) of the mid level between the channel's smallest and largest values after
+which the channel stays above it for :data:`TRIGGER_HOLD_S`; a channel whose range is under
+:data:`TRIGGER_STEP_NOISE` times its noise does not step and is refused.
 
 **Alignment on the speed** (:func:`align_speed`): the shift :math:`s` minimising the mean of
 :math:`(n_\mathrm{rec}(t) - n_\mathrm{sim}(t - s))^2` over the recorded samples inside the
@@ -58,6 +60,10 @@ SPEED_FLOOR_RPM = 1.0
 #: speed (2 deg: 4 deg of phase on the 2nd order, about 7 % RMS of an identical waveform).
 ALIGN_SIGMAS = 3.0
 ALIGN_TOLERANCE_DEG = 2.0
+#: A trigger channel steps by at least this many times its noise (second differences' RMS
+#: over sqrt 6) and stays above its mid level this long [s] after its rising crossing.
+TRIGGER_STEP_NOISE = 10.0
+TRIGGER_HOLD_S = 0.002
 #: Least part of the event a recording must cover after alignment.
 MIN_COVERAGE = 0.5
 #: A speed channel whose samples change at fewer than this share of them is held between
@@ -104,7 +110,9 @@ def tacho_rpm(time, tacho, *, file=None, key="tacho") -> np.ndarray:
 
 def trigger_time(time, signal, *, file=None, key="--trigger") -> float:
     """Time [s] of the first rising crossing of the mid level between the smallest and the
-    largest value of ``signal`` (linear between samples).
+    largest value of ``signal`` (linear between samples) after which it stays above for
+    :data:`TRIGGER_HOLD_S` (a glitch is no trigger); refused where its range is under
+    :data:`TRIGGER_STEP_NOISE` times its noise (no step).
 
     Parameters
     ----------
@@ -121,11 +129,18 @@ def trigger_time(time, signal, *, file=None, key="--trigger") -> float:
     if not hi - lo > 1e-12 * max(abs(hi), abs(lo), 1.0):
         raise InputError("the trigger channel is constant (no rising crossing)",
                          file=file, key=key)
+    noise = np.sqrt(np.mean(np.diff(x, 2) ** 2) / 6.0) if x.size > 2 else 0.0
+    if hi - lo < TRIGGER_STEP_NOISE * noise:
+        raise InputError(f"the trigger channel does not step (its range {hi - lo:.3g} is "
+                         f"less than {TRIGGER_STEP_NOISE:g} times its noise {noise:.3g})",
+                         file=file, key=key)
     mid = 0.5 * (lo + hi)
+    hold = max(1, int(np.ceil(TRIGGER_HOLD_S / np.median(np.diff(time)))))
     up = np.flatnonzero((x[:-1] < mid) & (x[1:] >= mid))
-    if up.size == 0:
-        raise InputError("the trigger channel never rises through its mid level "
-                         f"({mid:g})", file=file, key=key)
+    up = [i for i in up if np.all(x[i + 1:i + 1 + hold] >= mid)]
+    if not up:
+        raise InputError(f"the trigger channel never rises through its mid level ({mid:g}) "
+                         f"to stay there {TRIGGER_HOLD_S * 1e3:g} ms", file=file, key=key)
     i = int(up[0])
     return float(time[i] + (mid - x[i]) / (x[i + 1] - x[i]) * (time[i + 1] - time[i]))
 

@@ -59,7 +59,13 @@ from powertrain.solvers.cycle_newmark import cycle_amplitudes, no_ports, start_s
 from powertrain.solvers.newmark import PORT_MAX_ITER, PORT_TOL
 from powertrain.solvers.operating_point import StaticSupport, has_static_curves, operating_point
 from powertrain.solvers.steppers import Cycles, DenseNewmarkStepper
-from powertrain.solvers.transient_load import N_THETA, RPM, driveline_reaction, transient_load
+from powertrain.solvers.transient_load import (
+    N_THETA,
+    RPM,
+    TorqueLimitWarning,
+    driveline_reaction,
+    transient_load,
+)
 
 
 class StretchRuleWarning(PowertrainWarning):
@@ -387,8 +393,9 @@ def _cycle_load(engine, manoeuvre, theta):
     held = dataclasses.replace(manoeuvre, time=np.array([0.0, T]), speed=np.full(2, w0),
                                load_time=np.array([0.0, T]),
                                load=np.full(2, float(manoeuvre.load_at(0.0))), starter=None)
-    out = transient_load(engine, held, (theta - theta[0]) / abs(w0)).F
-    return out
+    with warnings.catch_warnings():     # the manoeuvre's own load says it once
+        warnings.simplefilter("ignore", TorqueLimitWarning)
+        return transient_load(engine, held, (theta - theta[0]) / abs(w0)).F
 
 
 #: Samples of each static curve's force and tangent over its points' range and as much

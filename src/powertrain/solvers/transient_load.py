@@ -38,10 +38,12 @@ engaged.
 
 from __future__ import annotations
 
+import warnings
 from dataclasses import dataclass
 
 import numpy as np
 
+from powertrain.errors import PowertrainWarning
 from powertrain.units import UNITS
 
 #: Crank-angle samples of the load table over the cycle, and its speed step [rpm].
@@ -84,6 +86,7 @@ def transient_load(engine, manoeuvre, t) -> TransientLoad:
         driveline = manoeuvre.load_at(t)
         level = table.level_of_torque(spin, driveline)
         engine_torque = table.torque(spin, level)
+        _warn_beyond(driveline, engine_torque, t)
     else:
         level = table.level_of_scale(spin, manoeuvre.load_at(t))
         engine_torque = table.torque(spin, level)
@@ -103,6 +106,23 @@ def transient_load(engine, manoeuvre, t) -> TransientLoad:
         starter[on] = (J * alpha + driveline - engine_torque)[on]
     return TransientLoad(np.asarray(t, float), theta, omega, alpha, scale, engine_torque,
                          driveline, starter, F)
+
+
+def _warn_beyond(driveline, engine_torque, t):
+    """Warn where a mean torque is beyond what the engine gives (more than its full load,
+    or more braking than its motored drag): the gas load is then the table's end."""
+    off = np.abs(driveline - engine_torque) > 1e-6 * np.maximum(np.abs(driveline), 1.0)
+    if off.any():
+        i = int(np.argmax(np.abs(driveline - engine_torque)))
+        warnings.warn(f"mean torque {driveline[i]:.4g} N*m at {t[i]:.4g} s is beyond what the "
+                      f"engine gives there ({engine_torque[i]:.4g} N*m, its full load or its "
+                      f"motored drag), during {np.mean(off):.0%} of the manoeuvre: the gas load "
+                      "is that of the engine's limit, the driveline reaction the table's",
+                      TorqueLimitWarning, stacklevel=3)
+
+
+class TorqueLimitWarning(PowertrainWarning):
+    """A manoeuvre's mean torque beyond the engine's full load or motored drag."""
 
 
 def driveline_reaction(engine, manoeuvre, driveline):
