@@ -134,6 +134,7 @@ def test_a_bad_manoeuvre_file_is_one_line_naming_file_and_key(name, tmp_path):
     (dict(speed=[0.0, np.nan, 50.0, 80.0]), "speed.speed"),
     (dict(speed=[0.0, -5.0, 50.0, 80.0]), "speed.speed"),                # no reversal
     (dict(time=[0.0, 1.0, 2.0, 4.0]), "load.time"),                      # load ends early
+    (dict(time=["a", "b", "c", "d"]), "speed.time"),                     # not numbers
 ])
 def test_a_manoeuvre_built_in_python_is_checked_as_its_file(change, key):
     """The model checks itself: an object made in a notebook gets the file's one-line

@@ -118,6 +118,9 @@ class Manoeuvre:
 
     def __post_init__(self):
         f = self.file or None
+        _require(isinstance(self.name, str), "expected a string", f, "manoeuvre.name")
+        _require(isinstance(self.reversal, (bool, np.bool_)), "expected true or false", f,
+                 "manoeuvre.reversal")
         lo, hi = MOTORED_INTAKE_PRESSURE
         p = self.motored_intake_pressure
         _require(p is None or (_finite(p) and lo <= p <= hi), f"must be {lo / 1e5:g}.."
@@ -176,7 +179,17 @@ class Manoeuvre:
 
     def with_speed(self, time, speed) -> Manoeuvre:
         """A copy driven by another speed table (e.g. a recorded one)."""
-        return replace(self, time=np.asarray(time, float), speed=np.asarray(speed, float))
+        f = self.file or None
+        return replace(self, time=_numbers(time, f, "speed.time"),
+                       speed=_numbers(speed, f, "speed.speed"))
+
+
+def _numbers(values, file, key) -> np.ndarray:
+    """``values`` as an array of floats (one line naming ``key`` where they are not)."""
+    try:
+        return np.asarray(values, float)
+    except (TypeError, ValueError):
+        raise InputError("expected numbers", file=file, key=key) from None
 
 
 def _finite(value) -> bool:
@@ -193,8 +206,8 @@ def _times(time, value, file, table, column="speed"):
     """A table's time and value columns (n,) checked: finite, from 0, strictly increasing,
     at most :data:`MAX_DURATION` long, rows at most :data:`MAX_GAP` apart where the value
     changes between them."""
-    t, v = np.asarray(time, float), np.asarray(value, float)
     key = f"{table}.time"
+    t, v = _numbers(time, file, key), _numbers(value, file, f"{table}.{column}")
     _require(t.ndim == 1 and t.size >= 2, "at least two rows", file, key)
     _require(v.shape == t.shape, f"{v.size} values for {t.size} times", file, key)
     _require(np.all(np.isfinite(t)), "not a finite number", file, key)
