@@ -121,19 +121,9 @@ class SingleZoneCombustion:
 
     def motored_pressures(self, crank: CrankTrain, omega: float, intake_pressure=None):
         """Pressure of every cylinder on the cycle grid without burn: compression and
-        expansion along the one polytrope of exponent ``n_compression`` (no burn: the
-        loop's work is the gas exchange's alone) from ``intake_pressure`` [Pa] (default the
-        ambient pressure: an unthrottled crank), as :meth:`cycle_pressures` with the heat
-        0."""
-        theta, V, _, _ = self.cycle_basis(crank)
-        kept = self._memo.get("motored basis")
-        if kept is None or kept[0] is not crank:
-            kept = (crank, comb.pressure_basis(
-                theta, V, self.n_compression, self.n_compression, self.start, self.duration,
-                self.wiebe_a, self.wiebe_m, self.exhaust_valve_opening, self.blowdown_end,
-                self.valve_overlap))
-            self._memo["motored basis"] = kept
-        b_in, b_ex, _ = kept[1]
+        expansion from ``intake_pressure`` [Pa] (default the ambient pressure: an unthrottled
+        crank), as :meth:`cycle_pressures` with the heat 0."""
+        theta, _, _, (b_in, b_ex, _) = self.cycle_basis(crank)
         p_in = self.ambient_pressure if intake_pressure is None else float(intake_pressure)
         p_ex = max(self.ambient_pressure, self.exhaust_pressure_ratio * p_in)
         n_cyl = len(self.imep_factors)
