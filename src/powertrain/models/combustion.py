@@ -216,13 +216,9 @@ class MeasuredPressure:
         return float(self.speed[0]), float(self.speed[-1])
 
 
-@dataclass(frozen=True, eq=False)
-class LoadedCombustion:
-    """A combustion model run at ``load`` times its nominal load (the IMEP scale of the model:
-    for the single-zone model the fraction of full-load torque; a plan's part-load run)."""
-
-    base: object
-    load: float
+class _OnBase:
+    """A combustion model run another way: its kind, speed key and speed range are its
+    base model's."""
 
     @property
     def model(self):
@@ -231,6 +227,18 @@ class LoadedCombustion:
     @property
     def speed_key(self):
         return self.base.speed_key
+
+    def speed_range(self):
+        return self.base.speed_range()
+
+
+@dataclass(frozen=True, eq=False)
+class LoadedCombustion(_OnBase):
+    """A combustion model run at ``load`` times its nominal load (the IMEP scale of the model:
+    for the single-zone model the fraction of full-load torque; a plan's part-load run)."""
+
+    base: object
+    load: float
 
     @property
     def with_cylinder_factors(self):
@@ -248,26 +256,15 @@ class LoadedCombustion:
     def cycle_pressures(self, crank: CrankTrain, omega: float, load: float = 1.0):
         return self.base.cycle_pressures(crank, omega, self.load * load)
 
-    def speed_range(self):
-        return self.base.speed_range()
-
 
 @dataclass(frozen=True, eq=False)
-class MotoredCombustion:
+class MotoredCombustion(_OnBase):
     """The cycle of a combustion model without burn (a crank turned by the starter or
     coasting with the fuel cut) from the intake pressure ``intake_pressure`` [Pa] (None:
     the model's default): its ``motored_pressures``, its friction."""
 
     base: object
     intake_pressure: float | None = None
-
-    @property
-    def model(self):
-        return self.base.model
-
-    @property
-    def speed_key(self):
-        return self.base.speed_key
 
     def cycle_pressures(self, crank: CrankTrain, omega: float, load: float = 1.0):
         motored = getattr(self.base, "motored_pressures", None)
@@ -280,6 +277,3 @@ class MotoredCombustion:
 
     def friction_mean_effective_pressure(self, omega: float) -> float:
         return self.base.friction_mean_effective_pressure(omega)
-
-    def speed_range(self):
-        return self.base.speed_range()
