@@ -184,13 +184,9 @@ def align_speed(t_sim, rpm_sim, t_rec, rpm_rec, *, file=None, key="rpm",
     t_rec, rpm_rec = unheld_speed(t_rec, np.asarray(rpm_rec, float))
     t, target = _fine(t_sim, rpm_sim)
     costs = _costs(t, target, t_rec, rpm_rec)
-    lo, hi = _shift_range(t_sim, (t_rec[0], t_rec[-1]), partial)
-    shifts = np.linspace(lo, hi, max(801, int(np.ceil((hi - lo) / (event / GRID))) + 1))
-    coarse = costs(shifts)
+    shifts, coarse, shift = _search(costs, _shift_range(t_sim, (t_rec[0], t_rec[-1]),
+                                                        partial), event)
     best = int(np.argmin(coarse))
-    fine = np.clip(shifts[best] + np.linspace(-2.0, 2.0, 401) * (shifts[1] - shifts[0]),
-                   lo, hi)
-    shift = float(fine[np.argmin(costs(fine))])
     other = _second_match(coarse, best, sigma ** 2)
     if other is not None:
         raise InputError(f"the crank speed matches the event's at two places of the recording "
@@ -229,17 +225,14 @@ def align_tacho(t_sim, rpm_sim, span, edges, *, file=None, key="tacho",
     speed = np.abs(rpm_sim) / 60.0                                        # [rev/s]
     rev = np.r_[0.0, np.cumsum(0.5 * (speed[1:] + speed[:-1]) * np.diff(t_sim))]
     event = t_sim[-1] - t_sim[0]
-    lo, hi = _shift_range(t_sim, span, partial)
-    shifts = np.linspace(lo, hi, max(801, int(np.ceil((hi - lo) / (event / GRID))) + 1))
-    coarse = np.array([_phase_cost(s, t_sim, rev, edges, span) for s in shifts])
+    shifts, coarse, shift = _search(
+        lambda ss: np.array([_phase_cost(s, t_sim, rev, edges, span) for s in ss]),
+        _shift_range(t_sim, span, partial), event)
     if not np.isfinite(coarse).any():
         raise InputError(f"the tacho's pulses match the event's revolutions at no shift (at "
                          f"least {MIN_EDGES} pulses in the event, one per revolution); give "
                          "--trigger CHANNEL", file=file, key=key)
     best = int(np.argmin(coarse))
-    fine = np.clip(shifts[best] + np.linspace(-2.0, 2.0, 401) * (shifts[1] - shifts[0]),
-                   lo, hi)
-    shift = float(fine[np.argmin([_phase_cost(s, t_sim, rev, edges, span) for s in fine])])
     sigma = max(float(np.sqrt(_phase_cost(shift, t_sim, rev, edges, span))), PHASE_FLOOR_REV)
     if sigma > MISMATCH_REV:
         raise InputError(f"the tacho's pulses do not follow the event's crank angle at any "
@@ -275,6 +268,18 @@ def _phase_cost(shift, t_sim, rev, edges, span) -> float:
     if abs(at.size - turned) > 1.5:
         return np.inf
     return float(np.var(np.interp(at, t_sim, rev) - np.arange(at.size)))
+
+
+def _search(costs, bounds, event) -> tuple:
+    """``(shifts, their costs, best shift)``: ``costs`` (of an array of shifts) on a grid
+    over ``bounds`` at most ``event / GRID`` apart, then 100 times finer about its best."""
+    lo, hi = bounds
+    shifts = np.linspace(lo, hi, max(801, int(np.ceil((hi - lo) / (event / GRID))) + 1))
+    coarse = costs(shifts)
+    best = int(np.argmin(coarse))
+    fine = np.clip(shifts[best] + np.linspace(-2.0, 2.0, 401) * (shifts[1] - shifts[0]),
+                   lo, hi)
+    return shifts, coarse, float(fine[np.argmin(costs(fine))])
 
 
 def _shift_range(t_sim, span, partial) -> tuple:
