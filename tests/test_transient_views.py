@@ -94,12 +94,15 @@ def test_the_overlay_fits_a_page_and_heads_each_panel_with_its_errors(n_channels
     assert len(shown) == min(n_channels, 15) and fig.axes[0].get_gridspec().get_geometry() \
         == grid
     e = comp.errors()
-    for j, a in enumerate(shown):
+    worst = sorted(np.argsort(-e["rms_difference"])[:15])      # the 15 worst, file order
+    for j, a in zip(worst, shown):
         title = a.get_title()
         assert title.startswith(f"{names[j]}: peak +{e['peak_error_percent'][j]:.1f} %")
         assert f"RMS diff. {e['rms_difference'][j]:.3g} m/s²" in title
     heading = fig.legends[0].get_title().get_text().replace("\n", " ")
-    assert ("6 channels not drawn" in heading and "m6.z" in heading) == (n_channels > 15)
+    left_out = [names[j] for j in range(n_channels) if j not in worst]
+    assert ("6 channels of smaller RMS difference not drawn" in heading) == (n_channels > 15)
+    assert all(f" {c}" in heading for c in left_out)
     plt.close(fig)
 
 
@@ -144,6 +147,13 @@ def test_a_body_point_transmits_no_force(tmp_path):
         rows = list(csv.DictReader(ln for ln in fh if not ln.startswith("#")))
     assert {row["seat_rail.z_force_n"] for row in rows} == {""}
     assert float(rows[5]["left.z_force_n"]) == pytest.approx(r.force[5, 2])
+    h5py = pytest.importorskip("h5py")
+    r.to_hdf5(tmp_path / "r.h5")
+    with h5py.File(tmp_path / "r.h5") as h5:
+        assert list(h5.attrs["transmits_force"]) == [True] * 6 + [False] * 3
+        assert h5["force"].attrs["unit"] == "N" and h5["acceleration"].attrs["unit"] == "m/s^2"
+        assert h5["torque/engine"].attrs["unit"] == "N*m"
+        np.testing.assert_array_equal(h5["force"][:, 6:], 0.0)
 
 
 @pytest.mark.parametrize("option", [

@@ -205,7 +205,8 @@ def overlay_grid(n: int) -> tuple:
 
 def plot_overlay(comparison, path=None, ax=None, provenance=None):
     """Measured and simulated acceleration [m/s²] over time, one panel per channel in a grid
-    that fits a page (:func:`overlay_grid`; channels left out are named in the title), each
+    that fits a page (:func:`overlay_grid`; where not all fit, those of the largest RMS of
+    the difference are drawn, in file order, and the others named in the title), each
     panel headed by the channel, the simulated peak's error [%] and the RMS of the
     difference [m/s²] (and of the measured RMS [%]). Returns the figure."""
     n = len(comparison.channels)
@@ -214,10 +215,12 @@ def plot_overlay(comparison, path=None, ax=None, provenance=None):
     fig, axes, own = subplots(ax, rows, cols, figsize=(PRINT_WIDTH_IN, height), sharex=True)
     e = comparison.errors()
     t = comparison.time
-    for j, a in enumerate(axes.ravel()):
-        if j >= shown:
-            _hide(axes, j, cols)
+    drawn = overlay_channels(e["rms_difference"], shown)
+    for k, a in enumerate(axes.ravel()):
+        if k >= shown:
+            _hide(axes, k, cols)
             continue
+        j = drawn[k]
         a.plot(t, comparison.measured[:, j], color=OKABE_ITO["blue"], lw=0.7,
                label="measured")
         a.plot(t, comparison.simulated[:, j], color=OKABE_ITO["orange"], lw=0.7, ls="--",
@@ -241,9 +244,17 @@ def plot_overlay(comparison, path=None, ax=None, provenance=None):
     title = (f"{comparison.name} — simulated vs {comparison.raw}; over each panel the "
              "simulated peak's error and the RMS of the difference (of the measured RMS)")
     if shown < n:
-        title += (f"; {n - shown} channels not drawn (in the table and JSON): "
-                  + ", ".join(comparison.channels[shown:]))
+        title += (f"; {n - shown} channels of smaller RMS difference not drawn (in the table "
+                  "and JSON): " + ", ".join(c for j, c in enumerate(comparison.channels)
+                                            if j not in drawn))
     return finish(fig, own, path, provenance, title=title)
+
+
+def overlay_channels(rms_difference, shown) -> list:
+    """Indices of the ``shown`` channels of the largest RMS of the difference [m/s²], in
+    their order."""
+    worst_first = np.argsort(-np.asarray(rms_difference, float), kind="stable")
+    return sorted(int(j) for j in worst_first[:shown])
 
 
 def _hide(axes, j, cols):

@@ -34,6 +34,12 @@ from powertrain.units import from_si
 _BODY = ("x_mm", "y_mm", "z_mm", "rx_deg", "ry_deg", "rz_deg")
 
 
+#: The HDF5 file's datasets and their units (``body``: per column, x y z then rx ry rz).
+HDF5_UNITS = {"time": "s", "rpm": "rpm", "body": "m, m, m, rad, rad, rad",
+              "displacement": "m", "velocity": "m/s", "acceleration": "m/s^2", "force": "N",
+              "deflection": "m"}
+
+
 @dataclass(frozen=True)
 class TransientResult(JsonResult):
     """Time histories of a manoeuvre (SI; module docstring for the files).
@@ -172,17 +178,19 @@ class TransientResult(JsonResult):
             writer.writerows(rows)
 
     def to_hdf5(self, path) -> None:
-        """The time histories (SI) and the summary JSON as an attribute, atomically."""
+        """The time histories (SI, each dataset's ``unit`` attribute) and the summary JSON as
+        an attribute, atomically; attribute ``transmits_force`` per channel
+        (:meth:`transmits_force`: a body point's ``force`` column is 0)."""
         import h5py  # deferred: heavy optional package
         with atomic_path(path) as tmp, h5py.File(tmp, "w") as h5:
             h5.attrs["summary"] = self.to_json()
-            for name in ("time", "rpm", "body", "displacement", "velocity", "acceleration",
-                         "force", "deflection"):
-                h5.create_dataset(name, data=getattr(self, name))
+            for name, unit in HDF5_UNITS.items():
+                h5.create_dataset(name, data=getattr(self, name)).attrs["unit"] = unit
             for k, v in self.torques.items():
-                h5.create_dataset(f"torque/{k}", data=v)
+                h5.create_dataset(f"torque/{k}", data=v).attrs["unit"] = "N*m"
             h5.attrs["channels"] = list(self.channels)
             h5.attrs["networks"] = list(self.networks)
+            h5.attrs["transmits_force"] = self.transmits_force()
 
     def writers(self) -> dict:
         """``.csv``, ``.json``, ``.h5``/``.hdf5``, ``.png``."""
