@@ -110,6 +110,10 @@ BAD = {
                                 'imep_scale = {value = [0.0, 0.1], unit = "1"}\n'
                                 'motored_intake_pressure = {value = 10.0, unit = "bar"}',
                                 "load.motored_intake_pressure"),
+    "trigger after the end": ('name = "t"', 'name = "t"\ntrigger_time = {value = 0.5, unit = "s"}',
+                              "manoeuvre.trigger_time"),
+    "negative trigger": ('name = "t"', 'name = "t"\ntrigger_time = {value = -1, unit = "ms"}',
+                         "manoeuvre.trigger_time.value"),
     "too many rows": ("[0.0, 0.2, 0.5], unit = \"s\"}\nspeed",
                       "[" + ", ".join(str(i * 1e-3) for i in range(5000))
                       + "], unit = \"s\"}\nspeed", "speed.time.value"),

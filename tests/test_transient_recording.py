@@ -15,7 +15,7 @@ import warnings
 import numpy as np
 import pytest
 from click.testing import CliRunner
-from conftest import MODAL
+from conftest import EXAMPLES, MODAL
 
 import powertrain as pt
 from powertrain.cli.group import main
@@ -333,3 +333,29 @@ def test_a_trigger_must_step_and_hold():
     step = np.where(t >= 0.5, 5.0, 0.0)
     step[2000] = 4.0                                          # a glitch at 0.2 s
     assert trigger_time(t, step) == pytest.approx(0.49995, abs=1e-4)
+
+
+@pytest.mark.parametrize("fmt", ["h5", "csv", "uff", "mf4"])
+def test_the_manoeuvres_trigger_time_is_written_and_lines_its_recording_up(fmt, tmp_path):
+    """A back-out, too flat to line up on its speed, written as raw data with the trigger
+    channel that rises at its ``trigger_time`` (0.3 s: the pedal) in every raw format, and
+    read back with ``--trigger trigger``: the trigger at 0.3 s, the shift 0 and identical
+    signals; without ``--trigger`` the channel is not read as a mount's. Off the time grid
+    the written trigger crosses its mid level at the trigger time exactly."""
+    from powertrain.analysis.alignment import trigger_time
+    from powertrain.iotools.raw_mdf import write_raw_mdf
+    from powertrain.iotools.raw_uff import write_raw_uff
+    result = pt.transient(EXAMPLES / "back-out.toml")
+    assert result.trigger_time == 0.3 and result.to_dict()["trigger_time_s"] == 0.3
+    writer = {"h5": write_raw_hdf5, "csv": write_raw_csv, "uff": write_raw_uff,
+              "mf4": write_raw_mdf}[fmt]
+    path = tmp_path / f"bo.{fmt}"
+    writer(path, result.recording())
+    assert read_recording(path, trigger="trigger").trigger == pytest.approx(0.3, abs=1e-9)
+    assert read_recording(path).trigger is None
+    same = compare_transient(result, path, trigger="trigger")
+    assert same.shift == pytest.approx(0.0, abs=1e-9)
+    assert np.max(same.errors()["rms_difference_percent"]) < 1e-3     # CSV: 7 digits
+    off = dataclasses.replace(result, trigger_time=0.123456)
+    assert trigger_time(off.time, off.trigger_signal()) == pytest.approx(0.123456, abs=1e-12)
+    assert dataclasses.replace(result, trigger_time=0.0).trigger_signal() is None

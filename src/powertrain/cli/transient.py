@@ -60,9 +60,10 @@ from powertrain.workflows import transient_recording as recording
 @click.option("--compare-plot", type=click.Path(dir_okay=False),
               help="With --compare: measured and simulated accelerations overlaid (PNG).")
 @click.option("--trigger", metavar="CHANNEL",
-              help="Trigger channel of the --compare/--speed-from recording: the manoeuvre's "
-                   "time 0 at its first rising crossing of the mid level between its low "
-                   "and high levels (default: lined up on the crank speed).")
+              help="Trigger channel of the --compare/--speed-from recording ('trigger' in "
+                   "--raw's files): the manoeuvre's trigger_time (default 0) at its first "
+                   "rising crossing of the mid level between its low and high levels "
+                   "(default: lined up on the crank speed).")
 @click.option("--channel-map", type=click.Path(dir_okay=False),
               help="Channel map TOML of the --compare/--speed-from recording (the format of "
                    "'powertrain track --channels'): file channel name -> mount, side, "

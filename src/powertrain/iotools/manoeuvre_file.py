@@ -1,6 +1,7 @@
 """Reading a manoeuvre file (TOML): crank speed and load tables of a transient.
 
-Sections ``[manoeuvre]`` (name, gear_ratio, crank_inertia, reversal), ``[speed]`` and
+Sections ``[manoeuvre]`` (name, gear_ratio, crank_inertia, reversal, trigger_time),
+``[speed]`` and
 ``[load]`` (time tables), optional ``[starter]``: docs/guide/transient.md. The keys, units
 and table sizes (:data:`MAX_ROWS`) are checked here, the values by the model
 (:class:`~powertrain.models.manoeuvre.Manoeuvre`, which names this file), before any work.
@@ -41,8 +42,8 @@ def read_manoeuvre(path) -> Manoeuvre:
     doc = read_toml(path)
     check_keys(doc, _SECTIONS, path, "")
     head = subtable(doc, "manoeuvre", path)
-    check_keys(head, ("name", "notes", "gear_ratio", "crank_inertia", "reversal"), path,
-               "manoeuvre")
+    check_keys(head, ("name", "notes", "gear_ratio", "crank_inertia", "reversal",
+                      "trigger_time"), path, "manoeuvre")
     reversal = get(head, "reversal", path, "manoeuvre", default=False, types=bool)
     time, speed = _columns(subtable(doc, "speed", path), ("speed",), "angular_speed", path,
                            "speed")[:2]
@@ -55,12 +56,14 @@ def read_manoeuvre(path) -> Manoeuvre:
                            default=0.0, nonneg=True)
     inertia = scalar_quantity(head, "crank_inertia", "inertia", path, "manoeuvre",
                               default=0.0, nonneg=True)
+    trigger = scalar_quantity(head, "trigger_time", "time", path, "manoeuvre", default=0.0,
+                              nonneg=True)
     starter = _starter(doc["starter"], path) if "starter" in doc else None
     return Manoeuvre(str(get(head, "name", path, "manoeuvre", default="manoeuvre",
                              types=str)),
                      time, speed, load_time, load, kind, gear, inertia, starter, reversal,
                      path, str(get(head, "notes", path, "manoeuvre", default="", types=str)),
-                     motored)
+                     motored, trigger)
 
 
 def _table(section, key, dimension, path, prefix):

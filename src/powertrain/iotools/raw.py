@@ -77,7 +77,7 @@ def read_raw(path, channel_map: ChannelMap | None = None, *, rpm: str | None = N
         Name of a once-per-cycle pulse channel [V] (cam or injection signal; default a
         channel named ``cycle``).
     trigger : str, optional
-        Name of a trigger channel [V] (none by default).
+        Name of a trigger channel [V] (default a channel named ``trigger``).
     map_option : str
         The command-line option that gives a channel map, named in the hints of errors.
 
@@ -116,7 +116,7 @@ def _pick_speed(found: FileSignals, cmap, rpm, tacho, cycle_reference=None, trig
     tacho_name = tacho or (cmap.tacho if cmap else None)
     out = {}
     for kind, wanted, default in (("rpm", rpm_name, "rpm"), ("tacho", tacho_name, "tacho"),
-                                  ("trigger", trigger, None),
+                                  ("trigger", trigger, "trigger"),
                                   ("cycle_reference", cycle_reference, "cycle")):
         i = _find(signals, wanted or default) if wanted or default else None
         if i is None:

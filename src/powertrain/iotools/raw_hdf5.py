@@ -126,7 +126,7 @@ def _read_own(h5, path):
     unit = _unit(h5["time"]) or "s"
     time = to_si(time, unit, "time", file=path, key="time")
     signals, times = [], {}
-    for name in ("rpm", "tacho", "cycle"):
+    for name in ("rpm", "tacho", "cycle", "trigger"):
         if name in h5:
             signals.append((name, _dataset(h5, name, path, budget), _unit(h5[name])))
             _own_time(h5, name, path, times, budget)

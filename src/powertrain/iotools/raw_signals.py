@@ -28,12 +28,14 @@ class FileSignals:
 
 
 def written_signals(recording, *, cycle: bool = True) -> list:
-    """``(name, values, unit, channel)`` a writer stores: ``rpm`` [rpm], ``tacho`` and (with
-    ``cycle``) ``cycle`` [V] where ``recording`` has them (``channel`` None), then every
+    """``(name, values, unit, channel)`` a writer stores: ``rpm`` [rpm], ``tacho``, (with
+    ``cycle``) ``cycle`` and ``trigger`` [V] where ``recording`` has them (``channel``
+    None), then every
     :class:`RawChannel` in its file unit."""
     out = [(name, values, unit, None) for name, values, unit in (
         ("rpm", recording.rpm, "rpm"), ("tacho", recording.tacho, "V"),
-        ("cycle", recording.cycle_reference if cycle else None, "V")) if values is not None]
+        ("cycle", recording.cycle_reference if cycle else None, "V"),
+        ("trigger", recording.trigger, "V")) if values is not None]
     for ch in recording.channels:
         dim = "length" if ch.quantity == "displacement" else ch.quantity
         out.append((ch.label, from_si(ch.values, ch.unit, dim), ch.unit, ch))

@@ -22,7 +22,7 @@ from powertrain.outputs import atomic_path
 
 #: UFF specific data types (record 8/9 field 1) of the ordinate, by our quantity.
 SPECIFIC_DATA_TYPE = {"displacement": 8, "force": 13, "velocity": 11, "acceleration": 12,
-                      "rpm": 0, "tacho": 0}
+                      "rpm": 0, "tacho": 0, "trigger": 0}
 
 
 def read_uff_signals(path, channel_map=None) -> FileSignals:

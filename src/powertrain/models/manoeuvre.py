@@ -100,6 +100,9 @@ class Manoeuvre:
     motored_intake_pressure : float or None
         Intake pressure of the cycle without burn (IMEP scale 0) [Pa]; None: the
         combustion model's default (its ambient pressure: an unthrottled crank).
+    trigger_time : float
+        The time of the manoeuvre [s] at which a recording's trigger channel rises (a tip-in's
+        pedal switch; default 0, the start), before its end.
     """
 
     name: str
@@ -115,6 +118,7 @@ class Manoeuvre:
     file: str = ""
     notes: str = ""
     motored_intake_pressure: float | None = None
+    trigger_time: float = 0.0
 
     def __post_init__(self):
         f = self.file or None
@@ -147,6 +151,9 @@ class Manoeuvre:
         _require(self.crank_inertia > 0 or np.ptp(w) == 0, "missing: the crank train's and "
                  "flywheel's inertia, whose reaction J*alpha acts where the speed changes",
                  f, "manoeuvre.crank_inertia")
+        _require(_finite(self.trigger_time) and 0 <= self.trigger_time < t[-1],
+                 f"must be 0 s or later and before the end ({t[-1]:g} s), got "
+                 f"{self.trigger_time!r}", f, "manoeuvre.trigger_time")
         _require(self.starter is None or self.starter.until <= t[-1],
                  f"after the end of the manoeuvre ({t[-1]:g} s)", f, "starter.until")
 

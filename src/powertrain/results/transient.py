@@ -67,6 +67,9 @@ class TransientResult(JsonResult):
     speed_source : str
         Where a recorded crank speed came from and how it was lined up ("" for the
         manoeuvre's own speed table).
+    trigger_time : float
+        The manoeuvre's time at which a recording's trigger channel rises [s]
+        (:class:`~powertrain.models.manoeuvre.Manoeuvre`).
     """
 
     name: str
@@ -88,6 +91,7 @@ class TransientResult(JsonResult):
     solver_seconds: float = 0.0
     notes: list = field(default_factory=list)
     speed_source: str = ""
+    trigger_time: float = 0.0
 
     def channel(self, label) -> int:
         """Column of the channel ``label`` (``"left.z"``)."""
@@ -122,8 +126,17 @@ class TransientResult(JsonResult):
             chans.append(RawChannel(c.label, c.mount, c.side, d, "acceleration",
                                     self.acceleration[:, k], "m/s^2"))
         note = f"SYNTHETIC: simulated transient '{self.name}' ({self.method})"
-        return RawRecording(self.time, chans, self.rpm, None, "simulated transient",
-                            [note]).validate()
+        return RawRecording(self.time, chans, self.rpm, None, "simulated transient", [note],
+                            trigger=self.trigger_signal()).validate()
+
+    def trigger_signal(self) -> np.ndarray | None:
+        """A trigger channel [V], 0 V to 5 V, whose rise crosses 2.5 V at
+        :attr:`trigger_time` exactly (linear over two samples either side; None where the
+        trigger is at the first sample: no rise to record)."""
+        h = float(self.time[1] - self.time[0])
+        if self.trigger_time < self.time[0] + h:
+            return None
+        return 5.0 * np.clip((self.time - self.trigger_time) / (4.0 * h) + 0.5, 0.0, 1.0)
 
     def to_dict(self) -> dict:
         """The JSON document (docs/reference/json.md)."""
@@ -143,7 +156,8 @@ class TransientResult(JsonResult):
         return {"manoeuvre": self.name, "file": self.file, "engine": self.engine,
                 "duration_s": float(self.time[-1]), "steps": int(self.time.size - 1),
                 "method": self.method, "channels": chans, "mounts": mounts, "seat": seat,
-                "speed_from": self.speed_source or None}
+                "speed_from": self.speed_source or None,
+                "trigger_time_s": float(self.trigger_time)}
 
     def columns(self) -> dict:
         """CSV column name -> values (n,) (module docstring)."""

@@ -392,7 +392,8 @@ def _cycle_load(engine, manoeuvre, theta):
     T = 4 * np.pi / abs(w0)
     held = dataclasses.replace(manoeuvre, time=np.array([0.0, T]), speed=np.full(2, w0),
                                load_time=np.array([0.0, T]),
-                               load=np.full(2, float(manoeuvre.load_at(0.0))), starter=None)
+                               load=np.full(2, float(manoeuvre.load_at(0.0))), starter=None,
+                               trigger_time=0.0)
     with warnings.catch_warnings():     # the manoeuvre's own load says it once
         warnings.simplefilter("ignore", TorqueLimitWarning)
         return transient_load(engine, held, (theta - theta[0]) / abs(w0)).F

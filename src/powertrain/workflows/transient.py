@@ -66,8 +66,9 @@ def transient(manoeuvre, engine=None, *, angle_step_deg=ANGLE_STEP_DEG, seat=Non
         manoeuvre's speed table over its span
         (:func:`~powertrain.workflows.transient_recording.speed_from_recording`).
     trigger : str, optional
-        With ``speed_from``: the recording's trigger channel (the manoeuvre's time 0 at its
-        first rising crossing of its mid level; default: lined up on the crank speed).
+        With ``speed_from``: the recording's trigger channel (the manoeuvre's
+        ``trigger_time``, default 0, at its first rising crossing of its mid level; default:
+        lined up on the crank speed).
     channel_map : ChannelMap, str or Path, optional
         With ``speed_from``: the recording's channel map (``powertrain track``'s format).
 
@@ -100,7 +101,8 @@ def transient(manoeuvre, engine=None, *, angle_step_deg=ANGLE_STEP_DEG, seat=Non
          "driveline": load.driveline_torque},
         run.body, labels, run.displacement, run.velocity, run.acceleration, run.force,
         run.networks, run.deflection, _seat(engine, run, labels, seat), run.method,
-        time.process_time() - t0, [m.notes] if m.notes else [], speed_note)
+        time.process_time() - t0, [m.notes] if m.notes else [], speed_note,
+        m.trigger_time)
 
 
 def _driven(m, speed_from, trigger, channel_map) -> tuple:

@@ -2,10 +2,11 @@
 lined up with the manoeuvre (one rule, :func:`align`, for ``--compare`` and
 ``--speed-from``), its crank speed driving the manoeuvre, its channels compared.
 
-Lining up: with a trigger channel, the manoeuvre's time 0 is the trigger's first rising
-crossing of its mid level (:func:`powertrain.analysis.alignment.trigger_time`); else the
-time shift whose recorded crank speed (rpm channel, else once-per-revolution tacho) best
-matches the manoeuvre's, refused where the speed varies too little to fix it
+Lining up: with a trigger channel, the manoeuvre's ``trigger_time`` (default 0) is the
+trigger's first rising crossing of its mid level
+(:func:`powertrain.analysis.alignment.trigger_time`); else the time shift whose recorded
+crank speed (rpm channel, else once-per-revolution tacho) best matches the manoeuvre's,
+refused where the speed varies too little to fix it
 (:func:`powertrain.analysis.alignment.align_speed`).
 """
 
@@ -87,8 +88,8 @@ def read_recording(path, *, channel_map=None, trigger=None) -> Recorded:
                          key="--trigger")
     rec = read_raw(path, channel_map, trigger=trigger, map_option=MAP_OPTION)
     t = rec.time - rec.time[0]
-    when = None if rec.trigger is None else trigger_time(t, rec.trigger, file=str(path),
-                                                          key=trigger)
+    when = None if trigger is None else trigger_time(t, rec.trigger, file=str(path),
+                                                      key=trigger)
     ignored = [n.strip() for c in rec.comments if c.startswith(IGNORED_NOTE)
                for n in c[len(IGNORED_NOTE):].split(",")]
     edges = (tacho_edges(t, rec.tacho, file=str(path), key="tacho")
@@ -121,13 +122,14 @@ def recorded_rpm(rec, path) -> np.ndarray | None:
     return None
 
 
-def align(rec: Recorded, t_event, rpm_event, *, partial=True) -> tuple:
+def align(rec: Recorded, t_event, rpm_event, *, partial=True, trigger_at=0.0) -> tuple:
     """The recording's time [s] of the event's time 0 and how it was found (``trigger
-    'NAME'`` or ``crank speed``): the trigger's time, else the speed alignment against the
-    event's speed ``rpm_event`` [rpm] at ``t_event`` [s] (module docstring); ``partial``:
-    the recording may cover part of the event (:func:`align_speed`)."""
+    'NAME'`` or ``crank speed``): the trigger's time less the event's time of the trigger
+    ``trigger_at`` [s], else the speed alignment against the event's speed ``rpm_event``
+    [rpm] at ``t_event`` [s] (module docstring); ``partial``: the recording may cover part
+    of the event (:func:`align_speed`)."""
     if rec.trigger is not None:
-        return rec.trigger - float(t_event[0]), f"trigger {rec.trigger_name!r}"
+        return rec.trigger - float(trigger_at), f"trigger {rec.trigger_name!r}"
     if rec.rpm is None:
         raise InputError("no rpm or tacho channel to line the recording up on; give "
                          "--trigger CHANNEL", file=rec.path, key="rpm")
@@ -165,7 +167,8 @@ def speed_from_recording(manoeuvre: Manoeuvre, recording, *, channel_map=None,
         raise InputError(f"the recording is {rec.time[-1]:.6g} s long, the manoeuvre "
                          f"{duration:.6g} s; --speed-from needs all of it", file=rec.path,
                          key="time")
-    shift, how = align(rec, manoeuvre.time, manoeuvre.speed / _RPM, partial=False)
+    shift, how = align(rec, manoeuvre.time, manoeuvre.speed / _RPM, partial=False,
+                       trigger_at=manoeuvre.trigger_time)
     first, last = coverage(0.0, duration, rec.time[0], rec.time[-1], shift)
     if first > tol or last < duration - tol:
         raise InputError(f"after alignment ({how}: the manoeuvre starts at {shift:.4f} s of "
@@ -235,8 +238,8 @@ def compare_transient(result, raw, *, trigger=None, channel_map=None) -> Transie
     raw : str, Path or Recorded
         The recording (any format of :func:`~powertrain.iotools.raw.read_raw`).
     trigger : str, optional
-        Trigger channel: the manoeuvre's time 0 at its first rising crossing of its mid
-        level (default: aligned on the crank speed, :func:`align`).
+        Trigger channel: the manoeuvre's ``trigger_time`` (default 0) at its first rising
+        crossing of its mid level (default: aligned on the crank speed, :func:`align`).
     channel_map : ChannelMap, str or Path, optional
         The recording's channel names -> mount, side, direction, quantity (the format of
         ``powertrain track --channels``).
@@ -254,7 +257,7 @@ def compare_transient(result, raw, *, trigger=None, channel_map=None) -> Transie
     """
     rec = recording_or_file(raw, channel_map=channel_map, trigger=trigger)
     pairs, skipped = compared_channels(rec, result.channels)
-    shift, how = align(rec, result.time, result.rpm)
+    shift, how = align(rec, result.time, result.rpm, trigger_at=result.trigger_time)
     t0, t1 = float(result.time[0]), float(result.time[-1])
     first, last = _covered(rec, t0, t1, shift, how)
     sel = (result.time >= first) & (result.time <= last)
@@ -294,5 +297,6 @@ def check_recordings(manoeuvre: Manoeuvre, labels, *, compare=None, speed=None) 
         manoeuvre, _ = speed_from_recording(manoeuvre, speed)
     if compare is not None:
         compared_channels(compare, labels)
-        shift, how = align(compare, manoeuvre.time, manoeuvre.speed / _RPM)
+        shift, how = align(compare, manoeuvre.time, manoeuvre.speed / _RPM,
+                           trigger_at=manoeuvre.trigger_time)
         _covered(compare, 0.0, manoeuvre.duration, shift, how)
