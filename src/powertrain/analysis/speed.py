@@ -118,6 +118,33 @@ def speed_from_rpm(time, rpm, *, smooth_s=0.1, file=None, key="rpm") -> SpeedPro
                         [f"rpm smoothed over {window} samples (Savitzky-Golay, cubic)"])
 
 
+#: Longest window of :func:`mean_speed` [s] (towards standstill).
+MEAN_SPEED_WINDOW_S = 0.2
+
+
+def mean_speed(time, rpm, interval) -> np.ndarray:
+    r"""Crank speed [rpm] at every sample ``time`` [s] averaged over the time the crank
+    takes to turn ``interval`` [rad] (the firing interval: its fluctuation at the firing
+    orders and their harmonics averages out), centred (moved inside the record at its
+    ends), at most :data:`MEAN_SPEED_WINDOW_S` long:
+    :math:`\bar n(t) = (\Theta(t + T/2) - \Theta(t - T/2)) / T`, :math:`\Theta` the
+    integral of the speed, :math:`T = \Phi/|\omega|`. The window is set by the speed
+    averaged once more (the fluctuation changes it by its own share). A centred mean
+    spreads a change of speed over the window: a crank at rest before a start reads the
+    mean of up to half a window of its run-off."""
+    t = np.asarray(time, float)
+    n = np.asarray(rpm, float)
+    angle = np.r_[0.0, np.cumsum(0.5 * (n[1:] + n[:-1]) * np.diff(t))]
+    out = n
+    for _ in range(2):
+        window = np.minimum(interval / np.maximum(np.abs(out) * np.pi / 30.0, 1e-12),
+                            MEAN_SPEED_WINDOW_S)
+        window = np.minimum(window, t[-1] - t[0])
+        lo = np.clip(t - 0.5 * window, t[0], t[-1] - window)
+        out = (np.interp(lo + window, t, angle) - np.interp(lo, t, angle)) / window
+    return out
+
+
 def tacho_edges(time, tacho, *, file=None, key="tacho", what="tacho"):
     """Times of the rising edges of a pulse train [s] (Schmitt trigger, interpolated);
     ``what`` names the signal in error messages."""

@@ -35,6 +35,10 @@ from powertrain.workflows import transient_recording as recording
               help="Raw recording (CSV, HDF5, UFF, MDF4) whose rpm channel or tacho drives "
                    "the crank instead of the file's speed table, lined up with the "
                    "manoeuvre as for --compare; it must cover the whole manoeuvre.")
+@click.option("--speed-average", is_flag=True,
+              help="With --speed-from: the recorded speed's mean over each firing interval "
+                   "of crank angle (a speed resolved within the cycle, an encoder's: its "
+                   "firing orders' fluctuation is in the gas and inertia torques already).")
 @click.option("--seat", help="Body point for the ISO 2631-1 values (default: a body point "
                              "named seat...).")
 @click.option("--channels", help="Channels of the figure, comma separated (e.g. "
@@ -69,9 +73,9 @@ from powertrain.workflows import transient_recording as recording
                    "'powertrain track --channels'): file channel name -> mount, side, "
                    "direction, quantity.")
 @quiet_option
-def transient(manoeuvre_file, engine_file, angle_step, speed_from, seat, channels, quantity,
-              out, csv_file, json_file, plot, raw_out, raw_file, compare_plot, trigger,
-              channel_map, quiet):
+def transient(manoeuvre_file, engine_file, angle_step, speed_from, speed_average, seat,
+              channels, quantity, out, csv_file, json_file, plot, raw_out, raw_file,
+              compare_plot, trigger, channel_map, quiet):
     """Transient manoeuvre: time histories of body, mounts and seat over a start, stop,
     tip-in or back-out.
 
@@ -90,13 +94,16 @@ def transient(manoeuvre_file, engine_file, angle_step, speed_from, seat, channel
     """
     files = dict(out=out, csv=csv_file, json=json_file, plot=plot, raw=raw_out,
                  compare_plot=compare_plot)
-    _check_options(files, raw_file, speed_from, trigger, channel_map)
+    _check_options(files, raw_file, speed_from, trigger, channel_map, speed_average)
     manoeuvre, engine = read_manoeuvre(manoeuvre_file), engine_or_default(engine_file)
     system = engine.assemble()
     figure = workflow.figure_channels(system, channels)
-    recorded = _recordings(raw_file, speed_from, trigger, channel_map, system, manoeuvre)
+    firing = engine.crank.firing_interval if speed_average else None
+    recorded = _recordings(raw_file, speed_from, trigger, channel_map, system, manoeuvre,
+                           firing)
     result = workflow.transient(manoeuvre, engine, angle_step_deg=angle_step, seat=seat,
-                                system=system, speed_from=recorded.get("speed"))
+                                system=system, speed_from=recorded.get("speed"),
+                                speed_average=speed_average)
     comparison = recording.compare_transient(result, recorded["compare"]) if raw_file else None
     written = _write(result, comparison, files, cli_provenance(engine_description(
         engine, engine.file)), figure, quantity)
@@ -108,9 +115,11 @@ def transient(manoeuvre_file, engine_file, angle_step, speed_from, seat, channel
            else "no file written (ask with --out, --csv, --json or --plot)"), quiet)
 
 
-def _check_options(files, raw_file, speed_from, trigger, channel_map) -> None:
+def _check_options(files, raw_file, speed_from, trigger, channel_map, speed_average) -> None:
     """The output paths and the options that need another, before any work."""
     check_outputs(**files)
+    if speed_average and not speed_from:
+        raise InputError("goes with --speed-from RAW", key="--speed-average")
     if files["compare_plot"] and not raw_file:
         raise InputError("--compare-plot needs --compare RAW", key="--compare-plot")
     for key, value in (("--trigger", trigger), ("--channel-map", channel_map)):
@@ -118,7 +127,8 @@ def _check_options(files, raw_file, speed_from, trigger, channel_map) -> None:
             raise InputError("goes with --compare RAW or --speed-from RAW", key=key)
 
 
-def _recordings(raw_file, speed_from, trigger, channel_map, system, manoeuvre) -> dict:
+def _recordings(raw_file, speed_from, trigger, channel_map, system, manoeuvre,
+                firing_interval) -> dict:
     """The recordings of --compare and --speed-from read and checked before the run (the
     compared channels against the model's, the alignment and the span covered); one read
     where both name the same file."""
@@ -129,6 +139,7 @@ def _recordings(raw_file, speed_from, trigger, channel_map, system, manoeuvre) -
             out[kind] = same or recording.read_recording(path, channel_map=channel_map,
                                                          trigger=trigger)
     recording.check_recordings(manoeuvre, [f"{c}.{d}" for c, d in system.channels],
+                               firing_interval=firing_interval,
                                compare=out.get("compare"), speed=out.get("speed"))
     return out
 

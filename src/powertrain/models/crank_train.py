@@ -67,6 +67,14 @@ class CrankTrain:
         return len(self.cylinder_x)
 
     @property
+    def firing_interval(self) -> float:
+        """Crank angle over which the gas torque repeats [rad]: 4π / n with the cylinders
+        firing at even intervals, else the cycle's 4π."""
+        gaps = np.diff(np.r_[np.sort(np.mod(self.firing_angles, 4 * np.pi)), 4 * np.pi])
+        even = 4 * np.pi / self.n_cylinders
+        return float(even) if np.allclose(gaps, even, atol=1e-6) else 4 * np.pi
+
+    @property
     def crank_radius(self) -> float:
         """[m]"""
         return 0.5 * self.stroke

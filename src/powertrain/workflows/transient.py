@@ -45,7 +45,8 @@ def manoeuvre_or_file(manoeuvre) -> Manoeuvre:
 
 
 def transient(manoeuvre, engine=None, *, angle_step_deg=ANGLE_STEP_DEG, seat=None,
-              system=None, speed_from=None, trigger=None, channel_map=None) -> TransientResult:
+              system=None, speed_from=None, trigger=None, channel_map=None,
+              speed_average=False) -> TransientResult:
     """Simulate a transient manoeuvre as the ``powertrain transient`` command does.
 
     Parameters
@@ -71,6 +72,10 @@ def transient(manoeuvre, engine=None, *, angle_step_deg=ANGLE_STEP_DEG, seat=Non
         lined up on the crank speed).
     channel_map : ChannelMap, str or Path, optional
         With ``speed_from``: the recording's channel map (``powertrain track``'s format).
+    speed_average : bool
+        With ``speed_from``: the recorded speed's mean over each firing interval of crank
+        angle (a speed resolved within the cycle, an encoder's: its firing orders'
+        fluctuation is in the gas and inertia torques already), not the speed as recorded.
 
     Returns
     -------
@@ -89,10 +94,16 @@ def transient(manoeuvre, engine=None, *, angle_step_deg=ANGLE_STEP_DEG, seat=Non
     m = manoeuvre_or_file(manoeuvre)
     engine = engine_or_default(engine)
     seat = seat_point(engine, seat)
-    m, speed_note = _driven(m, speed_from, trigger, channel_map)
+    m, speed_note = _driven(m, speed_from, trigger, channel_map,
+                            engine.crank.firing_interval if speed_average else None)
     t0 = time.process_time()
     with single_blas_thread():
         run = simulate_transient(engine, m, system=system, angle_step_deg=step)
+    return _result(m, engine, run, seat, time.process_time() - t0, speed_note)
+
+
+def _result(m, engine, run, seat, seconds, speed_note) -> TransientResult:
+    """The result of ``run``, the manoeuvre ``m`` simulated on ``engine``."""
     labels = [f"{c}.{d}" for c, d in run.channels]
     load = run.load
     return TransientResult(
@@ -100,19 +111,21 @@ def transient(manoeuvre, engine=None, *, angle_step_deg=ANGLE_STEP_DEG, seat=Non
         {"engine": load.engine_torque, "starter": load.starter_torque,
          "driveline": load.driveline_torque},
         run.body, labels, run.displacement, run.velocity, run.acceleration, run.force,
-        run.networks, run.deflection, _seat(engine, run, labels, seat), run.method,
-        time.process_time() - t0, [m.notes] if m.notes else [], speed_note,
-        m.trigger_time)
+        run.networks, run.deflection, _seat(engine, run, labels, seat), run.method, seconds,
+        [m.notes] if m.notes else [], speed_note, m.trigger_time)
 
 
-def _driven(m, speed_from, trigger, channel_map) -> tuple:
-    """The manoeuvre driven by a recorded speed, and the line saying so ("" without)."""
+def _driven(m, speed_from, trigger, channel_map, firing_interval) -> tuple:
+    """The manoeuvre driven by a recorded speed (its mean over each ``firing_interval``
+    [rad] where given), and the line saying so ("" without)."""
     if speed_from is None:
-        if trigger is not None or channel_map is not None:
-            raise InputError("goes with a recording (speed_from)",
-                             key="--trigger" if trigger is not None else "--channel-map")
+        for key, value in (("--trigger", trigger), ("--channel-map", channel_map),
+                           ("--speed-average", firing_interval)):
+            if value is not None:
+                raise InputError("goes with a recording (speed_from)", key=key)
         return m, ""
-    return speed_from_recording(m, speed_from, trigger=trigger, channel_map=channel_map)
+    return speed_from_recording(m, speed_from, firing_interval=firing_interval,
+                                trigger=trigger, channel_map=channel_map)
 
 
 def seat_point(engine, seat) -> str | None:

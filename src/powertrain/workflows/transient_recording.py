@@ -25,7 +25,7 @@ from powertrain.analysis.alignment import (
     trigger_time,
     unheld_speed,
 )
-from powertrain.analysis.speed import tacho_edges
+from powertrain.analysis.speed import mean_speed, tacho_edges
 from powertrain.errors import InputError
 from powertrain.iotools.raw import IGNORED_NOTE, read_raw
 from powertrain.models.manoeuvre import MAX_RPM, Manoeuvre
@@ -142,14 +142,18 @@ def align(rec: Recorded, t_event, rpm_event, *, partial=True, trigger_at=0.0) ->
     return shift, "crank speed"
 
 
-def speed_from_recording(manoeuvre: Manoeuvre, recording, *, channel_map=None,
-                         trigger=None) -> tuple:
+def speed_from_recording(manoeuvre: Manoeuvre, recording, *, firing_interval=None,
+                         channel_map=None, trigger=None) -> tuple:
     """``manoeuvre`` driven by the crank speed of a recording (:func:`read_recording`):
     lined up with the manoeuvre by :func:`align` (against the manoeuvre's own speed
-    table), its speed over the manoeuvre's span (block means on at most
-    :data:`SPEED_ROWS` rows) replaces the speed table; the load table stays on the
-    manoeuvre's times. Negative speeds are cut to 0 unless the manoeuvre allows a reversal.
-    Returns the manoeuvre and a line saying where its speed came from.
+    table), its speed as recorded or, given a ``firing_interval`` [rad], its mean over
+    each firing interval of crank angle (:func:`~powertrain.analysis.speed.mean_speed`: a
+    manoeuvre's speed is the mean one, the firing orders' fluctuation of a speed resolved
+    within the cycle is in the gas and inertia torques already), over the manoeuvre's span
+    (block means on at most :data:`SPEED_ROWS` rows), replaces the speed table; the load
+    table stays on the manoeuvre's times. Negative speeds are cut to 0 unless the
+    manoeuvre allows a reversal. Returns the manoeuvre and a line saying where its speed
+    came from.
 
     Raises
     ------
@@ -175,14 +179,19 @@ def speed_from_recording(manoeuvre: Manoeuvre, recording, *, channel_map=None,
                          f"the recording) the recording covers {first:.6g} to {last:.6g} s of "
                          f"the manoeuvre's 0 to {duration:.6g} s; --speed-from needs all of it",
                          file=rec.path, key="time")
-    tt, rr = _speed_rows(rec.time - shift, unheld_speed(rec.time, rec.rpm)[1], duration)
+    rpm = unheld_speed(rec.time, rec.rpm)[1]
+    if firing_interval is not None:
+        rpm = mean_speed(rec.time, rpm, firing_interval)
+    tt, rr = _speed_rows(rec.time - shift, rpm, duration)
     if not manoeuvre.reversal:
         rr = np.maximum(rr, 0.0)
     if not np.all(np.isfinite(rr)) or np.max(np.abs(rr)) > MAX_RPM:
         raise InputError(f"speed not finite or above {MAX_RPM:g} rpm", file=rec.path,
                          key="rpm")
-    note = (f"crank speed from {rec.path} ({rec.speed_source}): the manoeuvre starts at "
-            f"{shift:.4f} s of the recording (aligned on the {how})")
+    mean = ("" if firing_interval is None
+            else f", its mean over {np.degrees(firing_interval):.0f} deg of crank")
+    note = (f"crank speed from {rec.path} ({rec.speed_source}{mean}): the manoeuvre starts "
+            f"at {shift:.4f} s of the recording (aligned on the {how})")
     return manoeuvre.with_speed(tt, rr * _RPM), note
 
 
@@ -281,9 +290,11 @@ def _covered(rec: Recorded, t0, t1, shift, how) -> tuple:
     return first, last
 
 
-def check_recordings(manoeuvre: Manoeuvre, labels, *, compare=None, speed=None) -> None:
+def check_recordings(manoeuvre: Manoeuvre, labels, *, firing_interval=None, compare=None,
+                     speed=None) -> None:
     """Everything about the recordings of ``--compare`` and ``--speed-from`` that can be
-    checked before the simulation: the channels compared (against the model's ``labels``),
+    checked before the simulation (``firing_interval`` [rad] as
+    :func:`speed_from_recording`'s): the channels compared (against the model's ``labels``),
     the recorded speed lined up with the manoeuvre and covering it, the compared recording
     lined up with the (driven) manoeuvre's speed and covering at least half of it.
 
@@ -294,7 +305,8 @@ def check_recordings(manoeuvre: Manoeuvre, labels, *, compare=None, speed=None) 
         :func:`compare_transient` would after the run.
     """
     if speed is not None:
-        manoeuvre, _ = speed_from_recording(manoeuvre, speed)
+        manoeuvre, _ = speed_from_recording(manoeuvre, speed,
+                                            firing_interval=firing_interval)
     if compare is not None:
         compared_channels(compare, labels)
         shift, how = align(compare, manoeuvre.time, manoeuvre.speed / _RPM,
