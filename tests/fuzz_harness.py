@@ -120,7 +120,7 @@ _NONFINITE = re.compile(r"(?<![A-Za-z_])(nan|inf|infinity)(?![A-Za-z_])", re.IGN
 
 
 def _nonfinite_in(path: Path) -> bool:
-    if path.suffix == ".png":
+    if path.suffix == ".png" or path.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n":
         return False
     if path.suffix == ".h5":
         import h5py
@@ -1582,7 +1582,9 @@ def _mangle_table(draw, doc: dict) -> str:
         (k for k in ("imep_scale", "mean_torque") if k in table), "imep_scale")
     n = draw(st.sampled_from([0, 1, 2, 3, 50, 4096, 4097]))
     action = draw(st.sampled_from(["times", "values", "lengths", "unit", "long", "cross_zero",
-                                   "column", "swap_kind"]))
+                                   "column", "swap_kind", "extreme", "extreme"]))
+    if action == "extreme":
+        return _extreme_manoeuvre(draw, doc)
     if action == "times":
         table["time"] = {"value": _rows(draw, max(n, 2) if n < 4096 else 50, "time"),
                          "unit": "s"}
@@ -1616,6 +1618,33 @@ def _mangle_table(draw, doc: dict) -> str:
     elif action == "swap_kind" and section == "load" and col in table:
         table["mean_torque" if col == "imep_scale" else "imep_scale"] = table.pop(col)
     return f"{section}: {action}"
+
+
+def _extreme_manoeuvre(draw, doc: dict) -> str:
+    """Valid but extreme tables: very short or long, speeds at the bounds, crossing zero,
+    the largest load, gear ratio and inertia, a starter engaged to the end."""
+    end = draw(st.sampled_from([1e-6, 1e-3, 0.05, 0.3, 2.0, 5.0]))
+    n = draw(st.sampled_from([2, 3, 7, 200]))
+    t = [end * k / (n - 1) for k in range(n)]
+    rpm = draw(st.lists(st.sampled_from([0.0, 1e-9, 30.0, -40.0, 800.0, 6000.0, 12000.0,
+                                         -12000.0, 1e-300]), min_size=n, max_size=n))
+    doc["speed"] = {"time": {"value": t, "unit": "s"}, "speed": {"value": rpm, "unit": "rpm"}}
+    kind = draw(st.sampled_from(["imep_scale", "mean_torque"]))
+    load = draw(st.sampled_from([0.0, 2.0, 1e-300, 0.06]) if kind == "imep_scale" else
+                st.sampled_from([0.0, 5000.0, -5000.0, 1e-300]))
+    doc["load"] = {"time": {"value": [0.0, end], "unit": "s"},
+                   kind: {"value": [load, load], "unit": "1" if kind == "imep_scale" else "N*m"}}
+    head = doc.setdefault("manoeuvre", {})
+    head["reversal"] = True
+    head["gear_ratio"] = {"value": draw(st.sampled_from([0.0, 50.0, 1e-300, 3.0])), "unit": "1"}
+    head["crank_inertia"] = {"value": draw(st.sampled_from([20.0, 1e-300, 1e-9, 0.18])),
+                             "unit": "kg*m^2"}
+    head.pop("trigger_time", None)
+    if draw(st.booleans()):
+        doc["starter"] = {"ratio": {"value": draw(st.sampled_from([0.1, 100.0])), "unit": "1"},
+                          "reaction_point": {"value": [0.0, 0.0, 3000.0], "unit": "mm"},
+                          "until": {"value": end, "unit": "s"}}
+    return f"extreme: {end:g} s, {n} rows, {kind} {load:g}"
 
 
 MANOEUVRE_KEYS = {"manoeuvre": ["gear_ratio", "crank_inertia", "reversal", "trigger_time",
@@ -1673,13 +1702,15 @@ TRANSIENT_OUTPUTS = {"--out": ".h5", "--csv": ".csv", "--json": ".json", "--plot
                      "--raw": ".h5", "--compare-plot": ".png"}
 
 
-def _output_path(draw, opt: str, files: dict) -> str:
-    """An output path for ``opt``: ordinary, or odd (under a regular file, onto an input,
-    an existing folder, a long name, a wrong suffix, an earlier output)."""
+def _output_path(draw, opt: str) -> str:
+    """An output path for ``opt``: ordinary, or odd (under a regular file, an existing
+    folder, a long name, no suffix, onto an earlier output, onto the manoeuvre file or the
+    recording read)."""
+    suffix = TRANSIENT_OUTPUTS[opt]
+    odd = {".csv": ["m.toml"], ".json": ["m.toml"], ".h5": ["rec.h5"], ".png": []}[suffix]
     return draw(st.sampled_from([
-        "o" + TRANSIENT_OUTPUTS[opt], "sub/o" + TRANSIENT_OUTPUTS[opt], "afile/o.x",
-        "m.toml", "rec.h5", "dir", "a" * 300 + TRANSIENT_OUTPUTS[opt], "o.txt",
-        "old" + TRANSIENT_OUTPUTS[opt], "", "j.json"]))
+        "o" + suffix, "sub/o" + suffix, "afile/o" + suffix, "dir", "a" * 300 + suffix, "o",
+        "old" + suffix, "", *odd]))
 
 
 def case_transient_options(draw) -> Case:
@@ -1729,9 +1760,11 @@ def case_transient_options(draw) -> Case:
             files["m.toml"] = _SEEDS["m/start.toml"]
             args += ["--compare", "rec.h5"]
         for p in picks:
-            path = _output_path(draw, p, files)
+            path = _output_path(draw, p)
+            if path in args:                        # one output per path
+                continue
             args += [p, path]
-            if path != "dir":                               # a folder there before
+            if path not in ("dir", ""):                     # a folder there before
                 outputs.append(path)
         opt = tuple(picks) + ("afile", "dir", "j.json", "m.toml", "rec.h5")
     return Case(files, args, outputs, opt, f"transient option {opt}", setup)
@@ -1755,8 +1788,11 @@ def _recording_option_case(draw, opt, files) -> Case:
         files["map.toml"] = draw(st.sampled_from([_SEEDS["rec-map.toml"], _SEEDS["map.toml"]]))
         if draw(st.booleans()):
             files["map.toml"] = mutate_toml(draw, files["map.toml"])
-        args += [opt, draw(st.sampled_from(["map.toml", "map.toml", "nope.toml", "m.toml",
-                                            f"rec.{ext}"]))]
+        where = draw(st.sampled_from(["map.toml", "map.toml", "nope.toml", "m.toml",
+                                      f"rec.{ext}"]))
+        args += [opt, where]
+        return Case(files, args, ["j.json"], (opt, f"rec.{ext}", where),
+                    f"transient {opt} ({use}, {seed}, {ext})")
     else:
         args += [opt]
     return Case(files, args, ["j.json"], (opt, f"rec.{ext}", "map.toml", "m.toml"),
@@ -1919,9 +1955,18 @@ def case_whatif_manoeuvre(draw) -> Case:
     seed = draw(st.sampled_from(["m/start.toml", "m/stop.toml"]))
     files = {"m.toml": _SEEDS[seed], **mount_files()}
     args = ["whatif", "--manoeuvre", "m.toml", "--quiet", "--json", "w.json"]
-    what = draw(st.sampled_from(["variants", "spec", "spec", "spec", "runup_option",
-                                 "manoeuvre"]))
-    if what == "variants":
+    what = draw(st.sampled_from(["variants", "spec", "spec", "extreme", "extreme",
+                                 "runup_option", "manoeuvre"]))
+    if what == "extreme":                     # a valid spec, an extreme factor or value
+        op = draw(st.sampled_from(["scale", "scale", "set", "move"]))
+        target = draw(st.sampled_from(["left.z", "right.y", "gearbox.x", "*.*", "*.z"]))
+        value = draw(st.sampled_from(["1e-9", "1e-3", "0.5", "2", "1e3", "1e9", "1e12"]))
+        spec = {"scale": f"{target}.{draw(st.sampled_from(['stiffness', 'damping', 'dynamic', 'mass']))}={value}",
+                "set": f"{target}.{draw(st.sampled_from(['c1', 'd1', 'm1', 'c2']))}={value}",
+                "move": f"{target.split('.')[0].replace('*', 'left')}={value},0,{value}"}[op]
+        args += [f"--{op}", spec]
+        mutated = f"--{op}"
+    elif what == "variants":
         files["v.toml"] = mutate_toml(draw, _SEEDS["variants.toml"])
         args += ["--variants", "v.toml"]
         mutated = "v.toml"
