@@ -120,9 +120,10 @@ _NONFINITE = re.compile(r"(?<![A-Za-z_])(nan|inf|infinity)(?![A-Za-z_])", re.IGN
 
 
 def _nonfinite_in(path: Path) -> bool:
-    if path.suffix == ".png" or path.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n":
+    head = path.read_bytes()[:8]
+    if path.suffix == ".png" or head == b"\x89PNG\r\n\x1a\n":
         return False
-    if path.suffix == ".h5":
+    if path.suffix == ".h5" or head == b"\x89HDF\r\n\x1a\n":
         import h5py
         bad = []
 
@@ -1544,8 +1545,13 @@ def manoeuvre_files() -> dict:
 TRANSIENT_OUT = ["--quiet", "--json", "j.json", "--csv", "t.csv"]
 
 
-def _manoeuvre_case(text: bytes, what: str, *extra) -> Case:
-    return Case({"m.toml": text}, ["transient", "m.toml", *TRANSIENT_OUT, *extra],
+def _manoeuvre_case(text: bytes, what: str, *extra, engine: str = "") -> Case:
+    files = {"m.toml": text}
+    if engine:                                    # a shipped engine with its mount files
+        files.update({**mount_files(), "engines/e.toml": _read(f"engines/{engine}.toml")})
+        extra = (*extra, "--engine", "engines/e.toml")
+        what += f" on {engine}"
+    return Case(files, ["transient", "m.toml", *TRANSIENT_OUT, *extra],
                 ["j.json", "t.csv"], "m.toml", what)
 
 
@@ -1686,8 +1692,11 @@ def case_manoeuvre(draw) -> Case:
     """A mutated manoeuvre file (structural, semantic or byte-level) on ``transient``."""
     seed = draw(st.sampled_from(sorted(manoeuvre_files())))
     how = draw(st.sampled_from(["toml", "table", "table", "key", "key"]))
+    engine = draw(st.sampled_from(["", "", "", "default-modal-body", "default-nonlinear",
+                                   "default-torque-rod"]))
     if how == "toml":
-        return _manoeuvre_case(mutate_toml(draw, _SEEDS[seed]), f"manoeuvre TOML ({seed})")
+        return _manoeuvre_case(mutate_toml(draw, _SEEDS[seed]), f"manoeuvre TOML ({seed})",
+                               engine=engine)
     doc = toml_loads(_SEEDS[seed])
     what = [(_mangle_table if how == "table" else _mangle_key)(draw, doc)
             for _ in range(draw(st.integers(1, 2)))]
@@ -1695,7 +1704,7 @@ def case_manoeuvre(draw) -> Case:
         text = toml_dumps(doc).encode()
     except (TypeError, ValueError):
         text = _SEEDS[seed]
-    return _manoeuvre_case(text, f"manoeuvre ({seed}: {'; '.join(what)})")
+    return _manoeuvre_case(text, f"manoeuvre ({seed}: {'; '.join(what)})", engine=engine)
 
 
 TRANSIENT_OUTPUTS = {"--out": ".h5", "--csv": ".csv", "--json": ".json", "--plot": ".png",
@@ -1801,7 +1810,7 @@ def _recording_option_case(draw, opt, files) -> Case:
 
 REC_MUTATIONS = ["truncate", "tiny", "shift", "nan", "constant_rpm", "negative_rpm", "rename",
                  "nonuniform", "drop_rpm", "huge_rpm", "decimate", "pad", "reverse", "scale",
-                 "bytes"]
+                 "held_rpm", "tacho", "tacho", "trigger", "bytes"]
 
 
 def _rec_arrays(data: bytes, ext: str) -> tuple:
@@ -1848,10 +1857,11 @@ def _rec_bytes(cols: dict, comments: list, data: bytes, ext: str) -> bytes:
                 if name in cols:
                     h5[name] = cols[name]
                     h5[name].attrs.update(attrs)
-            for name in set(cols) - set(old):             # renamed: mount and direction too
+            for name in set(cols) - set(old):     # added or renamed: mount and direction too
                 h5[name] = cols[name]
                 mount, _, direction = name.rpartition("/")[2].rpartition(".")
-                h5[name].attrs.update({**attrs, "mount": mount, "direction": direction})
+                h5[name].attrs.update({"unit": "V"} if name in ("tacho", "trigger") else
+                                      {**attrs, "mount": mount, "direction": direction})
         return p.read_bytes()
 
 
@@ -1911,6 +1921,67 @@ def _mutate_columns(draw, cols: dict, action: str) -> dict:
                  "channels/" + new) if k == old else k: v for k, v in cols.items()}
     elif action == "drop_rpm":
         del cols[rpm]
+    elif action == "held_rpm":                   # an ECU's speed: held between updates
+        k = draw(st.sampled_from([10, 100, 1000]))
+        cols[rpm] = np.repeat(cols[rpm][::k], k)[:n]
+    elif action == "tacho":
+        cols = _tacho_columns(draw, cols, tname, rpm)
+    elif action == "trigger":
+        cols = _trigger_columns(draw, cols, tname)
+    return cols
+
+
+def _tacho_columns(draw, cols: dict, tname: str, rpm: str) -> dict:
+    """The rpm channel replaced by a once-per-revolution tacho [V] of the same speed, with
+    a defect: none, a pulse missing, two per revolution, flat, noisy, NaN."""
+    t, speed = cols[tname], cols.pop(rpm)
+    rev = np.r_[0.0, np.cumsum(0.5 * (speed[1:] + speed[:-1]) * np.diff(t))] / 60.0
+    defect = draw(st.sampled_from(["none", "none", "missing", "double", "flat", "noise",
+                                   "nan", "offset"]))
+    if defect == "double":
+        rev = 2.0 * rev
+    if defect == "offset":
+        rev = rev + draw(st.sampled_from([0.3, 0.99, -0.5]))
+    v = np.where(np.mod(rev, 1.0) < 0.25, 5.0, 0.0)
+    if defect == "missing":
+        hi = np.flatnonzero(v > 0)
+        v[hi[hi.size // 2:hi.size // 2 + 50]] = 0.0
+    elif defect == "flat":
+        v[:] = draw(st.sampled_from([0.0, 5.0]))
+    elif defect == "noise":
+        v = v + np.random.default_rng(0).normal(0.0, 2.0, v.size)
+    elif defect == "nan":
+        v[draw(st.integers(0, v.size - 1))] = np.nan
+    cols["tacho [V]" if " " in tname else "tacho"] = v
+    return cols
+
+
+def _trigger_columns(draw, cols: dict, tname: str) -> dict:
+    """The trigger channel (added where there is none) with a defect: flat, a glitch,
+    falling, noisy, NaN, two steps."""
+    t = cols[tname]
+    name = next((k for k in cols if k.split(" ")[0] == "trigger"),
+                "trigger [V]" if " " in tname else "trigger")
+    v = np.where(t >= t[0] + draw(st.sampled_from([0.0, 0.1, 0.3, 1e-9])), 5.0, 0.0)
+    defect = draw(st.sampled_from(["flat", "glitch", "falling", "noise", "nan", "two",
+                                   "late"]))
+    if defect == "flat":
+        v[:] = 5.0
+    elif defect == "glitch":
+        v[:] = 0.0
+        v[t.size // 3] = 5.0
+    elif defect == "falling":
+        v = 5.0 - v
+    elif defect == "noise":
+        v = v + np.random.default_rng(1).normal(0.0, 3.0, v.size)
+    elif defect == "nan":
+        v[draw(st.integers(0, v.size - 1))] = np.nan
+    elif defect == "two":
+        v[t > t[0] + 0.2] = 0.0
+        v[t > t[0] + 0.3] = 5.0
+    else:
+        v = np.where(t >= t[-1] - 1e-4, 5.0, 0.0)
+    cols[name] = v
     return cols
 
 
@@ -1937,7 +2008,7 @@ def case_transient_recording(draw) -> Case:
         args += ["--compare", f"rec.{ext}"]
     if use in ("--speed-from", "both"):
         args += ["--speed-from", f"rec.{ext}"]
-    if seed == "tip-in":                      # the start's trigger_time is 0: no trigger
+    if seed == "tip-in" or action == "trigger":     # the start's seed has no trigger
         args += ["--trigger", "trigger"]
     if "--speed-from" in args and draw(st.booleans()):
         args += ["--speed-average"]
