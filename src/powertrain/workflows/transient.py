@@ -96,6 +96,7 @@ def transient(manoeuvre, engine=None, *, angle_step_deg=ANGLE_STEP_DEG, seat=Non
     seat = seat_point(engine, seat)
     m, speed_note = _driven(m, speed_from, trigger, channel_map,
                             engine.crank.firing_interval if speed_average else None)
+    _check_recorded_top(m, speed_from, engine)
     t0 = time.process_time()
     with single_blas_thread():
         run = simulate_transient(engine, m, system=system, angle_step_deg=step)
@@ -126,6 +127,19 @@ def _driven(m, speed_from, trigger, channel_map, firing_interval) -> tuple:
         return m, ""
     return speed_from_recording(m, speed_from, firing_interval=firing_interval,
                                 trigger=trigger, channel_map=channel_map)
+
+
+def _check_recorded_top(m, speed_from, engine) -> None:
+    """A recorded speed (``speed_from``) above the engine's combustion model is the
+    recording's error, named by its file and ``rpm`` (the manoeuvre's own speed table is
+    checked by the solver, naming the manoeuvre file)."""
+    top = engine.speed_range_rpm()[1]
+    if speed_from is not None and m.max_speed * 30.0 / np.pi > top + 1e-6:
+        tacho = getattr(speed_from, "speed_source", "") == "tacho"
+        raise InputError(f"the recorded speed reaches {m.max_speed * 30.0 / np.pi:g} rpm, "
+                         f"above the engine's combustion model ({top:g} rpm)",
+                         file=str(getattr(speed_from, "path", speed_from)),
+                         key="tacho" if tacho else "rpm")
 
 
 def seat_point(engine, seat) -> str | None:
