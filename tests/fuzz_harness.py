@@ -2039,17 +2039,24 @@ def case_whatif_manoeuvre(draw) -> Case:
     what = draw(st.sampled_from(["variants", "spec", "spec", "extreme", "extreme",
                                  "runup_option", "manoeuvre"]))
     if what == "extreme":                     # a valid spec, an extreme factor or value
-        op = draw(st.sampled_from(["scale", "scale", "set", "move"]))
+        op = draw(st.sampled_from(["scale", "scale", "set", "move", "swap", "swap"]))
         target = draw(st.sampled_from(["left.z", "right.y", "gearbox.x", "*.*", "*.z"]))
         value = draw(st.sampled_from(["1e-9", "1e-3", "0.5", "2", "1e3", "1e9", "1e12"]))
         if op == "move":
             spec = f"{target.split('.')[0].replace('*', 'left')}={value},0,{value}"
+        elif op == "swap":                        # a mount file with static curve, law
+            spec = (target.replace("*", "left") + "=" + draw(st.sampled_from(
+                sorted(mount_files()) + ["mounts/nope.toml", "m.toml"])))
+            if draw(st.booleans()):               # ... and its law or curve mangled
+                files["mounts/x.toml"] = mutate_toml(draw, files[spec.split("=")[1]]) \
+                    if spec.split("=")[1] in files else b""
+                spec = spec.split("=")[0] + "=mounts/x.toml"
         else:
-            what = draw(st.sampled_from(["stiffness", "damping", "dynamic"] if op == "scale"
+            part = draw(st.sampled_from(["stiffness", "damping", "dynamic"] if op == "scale"
                                         else ["c1", "d1", "m1", "c2"]))
-            spec = f"{target}.{what}={value}"
+            spec = f"{target}.{part}={value}"
         args += [f"--{op}", spec]
-        mutated = f"--{op}"
+        mutated = (f"--{op}", spec.partition("=")[2].rpartition("/")[2] or "?")
     elif what == "variants":
         files["v.toml"] = mutate_toml(draw, _SEEDS["variants.toml"])
         args += ["--variants", "v.toml"]
