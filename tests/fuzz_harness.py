@@ -2114,6 +2114,9 @@ def issue_38_cases() -> dict:
                      "1", "--quiet", "--json", "w.json", "--scale", "left.z.stiffness=1e300"],
             ["w.json"], "--scale", ""),
     }
+    cases["whatif --manoeuvre --set right.y.d1=1e12 (N*s/mm: singular at some frequency)"] = \
+        Case({**mf, "m.toml": _SEEDS["m/start.toml"]}, [*whatif, "--set", "right.y.d1=1e12"],
+             ["w.json"], "--set", "")
     for ext in ("h5", "csv"):
         cases[f"--speed-from a tacho with a pulse split in two ({ext}): 9478 rpm"] = Case(
             {"m.toml": _SEEDS["m/tip-in.toml"],
