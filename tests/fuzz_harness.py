@@ -2115,7 +2115,7 @@ def issue_38_cases() -> dict:
             ["w.json"], "--scale", ""),
     }
     cases["whatif --manoeuvre --set right.y.d1=1e12 (N*s/mm: singular at some frequency)"] = \
-        Case({**mf, "m.toml": _SEEDS["m/start.toml"]}, [*whatif, "--set", "right.y.d1=1e12"],
+        Case({**mf, "m.toml": _SEEDS["m/stop.toml"]}, [*whatif, "--set", "right.y.d1=1e12"],
              ["w.json"], "--set", "")
     for ext in ("h5", "csv"):
         cases[f"--speed-from a tacho with a pulse split in two ({ext}): 9478 rpm"] = Case(
