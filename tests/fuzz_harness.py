@@ -2134,4 +2134,8 @@ def issue_38_cases() -> dict:
     # (FloatingPointError on every neutral start above standstill: stop.toml)
     out["stop (window) on the static curves: the static point near zero torque"] = (
         _manoeuvre_case(_SEEDS["m/stop.toml"], "", engine="default-nonlinear"), "ok")
+    out["whatif --manoeuvre (stop window) --swap left.z= a mount with a static curve"] = (
+        Case({**mf, "m.toml": _SEEDS["m/stop.toml"]},
+             [*whatif, "--swap", "left.z=mounts/hydraulic-engine-mount-z-nonlinear.toml"],
+             ["w.json"], "--swap", ""), "ok")
     return out
