@@ -1741,6 +1741,10 @@ def case_transient_options(draw) -> Case:
     if opt == "--angle-step":
         args += [opt, draw(st.one_of(option_value(), st.sampled_from(
             ["0.01", "10", "10.0001", "0.0099", "5", "1e-3"])))]
+        engine = draw(st.sampled_from(["", "default-nonlinear", "default-modal-body"]))
+        if engine:                                # friction and curves at coarse steps
+            files.update({**mount_files(), "engines/e.toml": _read(f"engines/{engine}.toml")})
+            args += ["--engine", "engines/e.toml"]
     elif opt in ("--seat", "--channels"):
         args += [opt, draw(st.sampled_from(["seat_rail", "left.z", "left.z,right.z", "left",
                                             "", ",", "left.z,,", "left.q", "seat_rail.z",
