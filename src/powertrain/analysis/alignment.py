@@ -112,7 +112,14 @@ def trigger_time(time, signal, *, file=None, key="--trigger") -> float:
     """Time [s] of the first rising crossing of the mid level between the smallest and the
     largest value of ``signal`` (linear between samples) after which it stays above for
     :data:`TRIGGER_HOLD_S` (a glitch is no trigger); refused where its range is under
-    :data:`TRIGGER_STEP_NOISE` times its noise (no step).
+    :data:`TRIGGER_STEP_NOISE` times its noise (no step). :func:`trigger_crossing` with
+    the time's standard error."""
+    return trigger_crossing(time, signal, file=file, key=key)[0]
+
+
+def trigger_crossing(time, signal, *, file=None, key="--trigger") -> tuple:
+    """:func:`trigger_time` [s] and its standard error [s]: the channel's noise (its second
+    differences' RMS over √6) over its slope at the crossing.
 
     Parameters
     ----------
@@ -142,7 +149,9 @@ def trigger_time(time, signal, *, file=None, key="--trigger") -> float:
         raise InputError(f"the trigger channel never rises through its mid level ({mid:g}) "
                          f"to stay there {TRIGGER_HOLD_S * 1e3:g} ms", file=file, key=key)
     i = int(up[0])
-    return float(time[i] + (mid - x[i]) / (x[i + 1] - x[i]) * (time[i + 1] - time[i]))
+    h = time[i + 1] - time[i]
+    slope = (x[i + 1] - x[i]) / h
+    return float(time[i] + (mid - x[i]) / slope), float(noise / slope)
 
 
 def coverage(t0, t1, rec0, rec1, shift):

@@ -381,6 +381,10 @@ class TransientComparison(JsonResult):
         First and last time of the simulated event [s] (default: those compared).
     not_compared : dict of str -> str
         The recording's other channels and why each was not compared.
+    shift_error : float
+        Standard error of ``shift`` [s] (:func:`~powertrain.analysis.alignment.align_speed`,
+        :func:`~powertrain.analysis.alignment.align_tacho`,
+        :func:`~powertrain.analysis.alignment.trigger_crossing`).
     """
 
     name: str
@@ -393,6 +397,7 @@ class TransientComparison(JsonResult):
     aligned_on: str = "crank speed"
     event: tuple = ()
     not_compared: dict = field(default_factory=dict)
+    shift_error: float = 0.0
 
     def span(self) -> tuple:
         """First and last time compared, first and last time of the event [s]."""
@@ -414,6 +419,7 @@ class TransientComparison(JsonResult):
         e = self.errors()
         first, last, t0, t1 = self.span()
         return {"manoeuvre": self.name, "recording": self.raw, "shift_s": self.shift,
+                "shift_standard_error_s": self.shift_error,
                 "channels": {c: {k: _finite(v[j]) for k, v in e.items()}
                              for j, c in enumerate(self.channels)},
                 "aligned_on": self.aligned_on, "compared_from_s": first,
@@ -437,7 +443,8 @@ class TransientComparison(JsonResult):
                 for j, c in enumerate(self.channels)]
         first, last, t0, t1 = self.span()
         text = (f"compared with {self.raw} (aligned on the {self.aligned_on}: the simulation "
-                f"starts at {self.shift:.4f} s of the recording) over {first:.4f} to {last:.4f} s"
+                f"starts at {self.shift:.4f} s of the recording, standard error "
+                f"{self.shift_error * 1e3:.2g} ms) over {first:.4f} to {last:.4f} s"
                 f" of the {t1 - t0:g} s event ({100.0 * (last - first) / (t1 - t0):.0f} %)\n"
                 + format_table(["channel", "measured peak [m/s^2]", "simulated peak",
                                 "peak error [%]", "RMS of difference", "of measured RMS [%]"],

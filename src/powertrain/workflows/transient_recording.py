@@ -22,7 +22,7 @@ from powertrain.analysis.alignment import (
     align_tacho,
     coverage,
     tacho_rpm,
-    trigger_time,
+    trigger_crossing,
     unheld_speed,
 )
 from powertrain.analysis.speed import mean_speed, tacho_edges
@@ -60,6 +60,8 @@ class Recorded:
     edges : ndarray or None
         The once-per-revolution tacho's rising edges from the first sample [s] (None
         where the speed is an rpm channel's).
+    trigger_error : float
+        Standard error of ``trigger`` [s].
     """
 
     path: str
@@ -71,6 +73,7 @@ class Recorded:
     channels: list
     ignored: list = field(default_factory=list)
     edges: np.ndarray | None = None
+    trigger_error: float = 0.0
 
 
 def read_recording(path, *, channel_map=None, trigger=None) -> Recorded:
@@ -88,14 +91,14 @@ def read_recording(path, *, channel_map=None, trigger=None) -> Recorded:
                          key="--trigger")
     rec = read_raw(path, channel_map, trigger=trigger, map_option=MAP_OPTION)
     t = rec.time - rec.time[0]
-    when = None if trigger is None else trigger_time(t, rec.trigger, file=str(path),
-                                                      key=trigger)
+    when = (None, 0.0) if trigger is None else trigger_crossing(t, rec.trigger,
+                                                                 file=str(path), key=trigger)
     ignored = [n.strip() for c in rec.comments if c.startswith(IGNORED_NOTE)
                for n in c[len(IGNORED_NOTE):].split(",")]
     edges = (tacho_edges(t, rec.tacho, file=str(path), key="tacho")
              if rec.rpm is None and rec.tacho is not None else None)
-    return Recorded(str(path), t, recorded_rpm(rec, path), _speed_source(rec), when, trigger,
-                    list(rec.channels), ignored, edges)
+    return Recorded(str(path), t, recorded_rpm(rec, path), _speed_source(rec), when[0],
+                    trigger, list(rec.channels), ignored, edges, when[1])
 
 
 def recording_or_file(recording, *, channel_map=None, trigger=None) -> Recorded:
@@ -123,23 +126,24 @@ def recorded_rpm(rec, path) -> np.ndarray | None:
 
 
 def align(rec: Recorded, t_event, rpm_event, *, partial=True, trigger_at=0.0) -> tuple:
-    """The recording's time [s] of the event's time 0 and how it was found (``trigger
-    'NAME'`` or ``crank speed``): the trigger's time less the event's time of the trigger
-    ``trigger_at`` [s], else the speed alignment against the event's speed ``rpm_event``
-    [rpm] at ``t_event`` [s] (module docstring); ``partial``: the recording may cover part
-    of the event (:func:`align_speed`)."""
+    """The recording's time [s] of the event's time 0, how it was found (``trigger
+    'NAME'`` or ``crank speed``) and its standard error [s]: the trigger's time less the
+    event's time of the trigger ``trigger_at`` [s], else the speed alignment against the
+    event's speed ``rpm_event`` [rpm] at ``t_event`` [s] (module docstring); ``partial``:
+    the recording may cover part of the event (:func:`align_speed`)."""
     if rec.trigger is not None:
-        return rec.trigger - float(trigger_at), f"trigger {rec.trigger_name!r}"
+        return (rec.trigger - float(trigger_at), f"trigger {rec.trigger_name!r}",
+                rec.trigger_error)
     if rec.rpm is None:
         raise InputError("no rpm or tacho channel to line the recording up on; give "
                          "--trigger CHANNEL", file=rec.path, key="rpm")
     if rec.edges is not None:
-        shift, _ = align_tacho(t_event, rpm_event, (rec.time[0], rec.time[-1]), rec.edges,
-                               file=rec.path, key="tacho", partial=partial)
-        return shift, "crank angle of the tacho's pulses"
-    shift, _ = align_speed(t_event, rpm_event, rec.time, rec.rpm, file=rec.path, key="rpm",
-                           partial=partial)
-    return shift, "crank speed"
+        shift, error = align_tacho(t_event, rpm_event, (rec.time[0], rec.time[-1]),
+                                   rec.edges, file=rec.path, key="tacho", partial=partial)
+        return shift, "crank angle of the tacho's pulses", error
+    shift, error = align_speed(t_event, rpm_event, rec.time, rec.rpm, file=rec.path,
+                               key="rpm", partial=partial)
+    return shift, "crank speed", error
 
 
 def speed_from_recording(manoeuvre: Manoeuvre, recording, *, firing_interval=None,
@@ -171,8 +175,8 @@ def speed_from_recording(manoeuvre: Manoeuvre, recording, *, firing_interval=Non
         raise InputError(f"the recording is {rec.time[-1]:.6g} s long, the manoeuvre "
                          f"{duration:.6g} s; --speed-from needs all of it", file=rec.path,
                          key="time")
-    shift, how = align(rec, manoeuvre.time, manoeuvre.speed / _RPM, partial=False,
-                       trigger_at=manoeuvre.trigger_time)
+    shift, how, error = align(rec, manoeuvre.time, manoeuvre.speed / _RPM, partial=False,
+                              trigger_at=manoeuvre.trigger_time)
     first, last = coverage(0.0, duration, rec.time[0], rec.time[-1], shift)
     if first > tol or last < duration - tol:
         raise InputError(f"after alignment ({how}: the manoeuvre starts at {shift:.4f} s of "
@@ -191,7 +195,8 @@ def speed_from_recording(manoeuvre: Manoeuvre, recording, *, firing_interval=Non
     mean = ("" if firing_interval is None
             else f", its mean over {np.degrees(firing_interval):.0f} deg of crank")
     note = (f"crank speed from {rec.path} ({rec.speed_source}{mean}): the manoeuvre starts "
-            f"at {shift:.4f} s of the recording (aligned on the {how})")
+            f"at {shift:.4f} s of the recording (aligned on the {how}, standard error "
+            f"{error * 1e3:.2g} ms)")
     return manoeuvre.with_speed(tt, rr * _RPM), note
 
 
@@ -266,7 +271,7 @@ def compare_transient(result, raw, *, trigger=None, channel_map=None) -> Transie
     """
     rec = recording_or_file(raw, channel_map=channel_map, trigger=trigger)
     pairs, skipped = compared_channels(rec, result.channels)
-    shift, how = align(rec, result.time, result.rpm, trigger_at=result.trigger_time)
+    shift, how, error = align(rec, result.time, result.rpm, trigger_at=result.trigger_time)
     t0, t1 = float(result.time[0]), float(result.time[-1])
     first, last = _covered(rec, t0, t1, shift, how)
     sel = (result.time >= first) & (result.time <= last)
@@ -275,7 +280,8 @@ def compare_transient(result, raw, *, trigger=None, channel_map=None) -> Transie
     simulated = result.acceleration[np.ix_(sel, [result.channel(lb) for lb, _ in pairs])]
     return TransientComparison(result.name, rec.path, float(shift), t,
                                [lb for lb, _ in pairs], measured, simulated, aligned_on=how,
-                               event=(t0, t1), not_compared=skipped)
+                               event=(t0, t1), not_compared=skipped,
+                               shift_error=float(error))
 
 
 def _covered(rec: Recorded, t0, t1, shift, how) -> tuple:
@@ -309,6 +315,6 @@ def check_recordings(manoeuvre: Manoeuvre, labels, *, firing_interval=None, comp
                                             firing_interval=firing_interval)
     if compare is not None:
         compared_channels(compare, labels)
-        shift, how = align(compare, manoeuvre.time, manoeuvre.speed / _RPM,
-                           trigger_at=manoeuvre.trigger_time)
+        shift, how, _ = align(compare, manoeuvre.time, manoeuvre.speed / _RPM,
+                              trigger_at=manoeuvre.trigger_time)
         _covered(compare, 0.0, manoeuvre.duration, shift, how)
