@@ -3,7 +3,9 @@ once-per-revolution tacho through standstill, a trigger channel's time, the time
 best matches two speed profiles and whether that shift is determined at all.
 
 **Tacho speed** (:func:`tacho_rpm`): each interval between rising edges gives its mean speed
-:math:`60/\Delta t` [rpm], placed at the interval's midpoint, linear between midpoints.
+:math:`60\,\Delta c/(N\Delta t)` [rpm], :math:`\Delta c` the pulses it spans (1, or a
+missing-tooth wheel's gap counted, :func:`tacho_counts`) of :math:`N` per revolution,
+placed at the interval's midpoint, linear between midpoints.
 Before the first edge :math:`e_0`, with :math:`d_1` the first interval: where the recording
 starts more than :math:`d_1` before :math:`e_0`, the crank cannot have turned at the first
 interval's speed over that time (it would have passed the pulse once more inside the
@@ -38,8 +40,8 @@ where the cost first rises by :math:`\sigma^2` on either side) whose cost is wit
 :math:`\sigma^2` of the best (a recording of two starts).
 
 **Alignment on a tacho's pulses** (:func:`align_tacho`): the event's crank angle at the
-rising edges less one revolution per edge is constant at the true shift (the pulse's phase
-unknown): the shift minimising its variance, among the shifts where the edges inside the
+rising edges less :math:`1/N` revolution per pulse counted is constant at the true shift
+(the pulses' phase unknown): the shift minimising its variance, among the shifts where the edges inside the
 event are as many as the revolutions it turns there (within one); its standard error the
 phase's scatter over :math:`\sqrt{\sum \dot\theta^2}` at the edges; refused as above.
 """
@@ -48,7 +50,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from powertrain.analysis.speed import tacho_edges
+from powertrain.analysis.speed import count_teeth, tacho_edges
 from powertrain.errors import InputError
 
 #: Times of the event at which the speeds are matched.
@@ -83,10 +85,22 @@ FINE = 20001
 COST_SAMPLES = 20000
 
 
-def tacho_rpm(time, tacho, *, file=None, key="tacho") -> np.ndarray:
-    """Crank speed [rpm] at every sample from a once-per-revolution tacho (module
-    docstring: interval means at their midpoints, standstill before the first and after
-    the last edge where the record is long enough to show it).
+def tacho_counts(edges, pulses_per_rev=1, *, file=None, key="tacho") -> tuple:
+    """``(edges, counts)``: a tacho's rising edges [s] and the pulses counted at each from
+    the first: one per edge with one pulse per revolution (a start's intervals change too
+    fast to tell a gap), else :func:`~powertrain.analysis.speed.count_teeth`'s (spikes
+    dropped, a missing-tooth wheel's gap counted)."""
+    edges = np.asarray(edges, float)
+    if pulses_per_rev == 1:
+        return edges, np.arange(edges.size, dtype=float)
+    edges, counts, _ = count_teeth(edges, file=file, key=key)
+    return edges, counts
+
+
+def tacho_rpm(time, tacho, *, pulses_per_rev=1, file=None, key="tacho") -> np.ndarray:
+    """Crank speed [rpm] at every sample from a tacho of ``pulses_per_rev`` pulses per
+    revolution (module docstring: interval means at their midpoints, standstill before the
+    first and after the last edge where the record is long enough to show it).
 
     Parameters
     ----------
@@ -94,13 +108,15 @@ def tacho_rpm(time, tacho, *, file=None, key="tacho") -> np.ndarray:
         [s]
     tacho : ndarray (n,)
         Pulse train [V].
+    pulses_per_rev : int
     file, key : str, optional
         Named in error messages.
     """
     time = np.asarray(time, float)
-    edges = tacho_edges(time, tacho, file=file, key=key)
+    edges, counts = tacho_counts(tacho_edges(time, tacho, file=file, key=key),
+                                 pulses_per_rev, file=file, key=key)
     d = np.diff(edges)
-    tt, rr = 0.5 * (edges[1:] + edges[:-1]), 60.0 / d
+    tt, rr = 0.5 * (edges[1:] + edges[:-1]), 60.0 * np.diff(counts) / (pulses_per_rev * d)
     if edges[0] - time[0] > d[0]:
         tt, rr = np.r_[edges[0] - d[0], tt], np.r_[0.0, rr]
     if time[-1] - edges[-1] > d[-1]:
@@ -214,14 +230,16 @@ def align_speed(t_sim, rpm_sim, t_rec, rpm_rec, *, file=None, key="rpm",
     return shift, error
 
 
-def align_tacho(t_sim, rpm_sim, span, edges, *, file=None, key="tacho",
-                partial=True) -> tuple:
+def align_tacho(t_sim, rpm_sim, span, edges, *, counts=None, pulses_per_rev=1, file=None,
+                key="tacho", partial=True) -> tuple:
     """Time shift [s] of the recording against the event and its standard error [s] from a
-    once-per-revolution tacho's rising ``edges`` [s], the recording lasting ``span = (first,
-    last)`` [s]: the shift at which the event's crank angle at the edges, less one
-    revolution per edge, is most nearly constant (least squares, the pulse's phase
-    eliminated), among the shifts where the edges inside the event are as many as the
-    revolutions it turns there (module docstring); ``partial`` as :func:`align_speed`'s.
+    tacho's rising ``edges`` [s] with ``counts`` pulses counted at each (default one per
+    edge; :func:`tacho_counts`) of ``pulses_per_rev`` per revolution, the recording lasting
+    ``span = (first, last)`` [s]: the shift at which the event's crank angle at the edges,
+    less 1/``pulses_per_rev`` revolution per pulse counted, is most nearly constant (least
+    squares, the pulses' phase eliminated), among the shifts where the pulses inside the
+    event span as many revolutions as it turns there (module docstring); ``partial`` as
+    :func:`align_speed`'s.
 
     Raises
     ------
@@ -231,22 +249,27 @@ def align_tacho(t_sim, rpm_sim, span, edges, *, file=None, key="tacho",
     """
     t_sim, rpm_sim = _fine(t_sim, rpm_sim)
     edges = np.asarray(edges, float)
+    revs = (np.arange(edges.size, dtype=float) if counts is None
+            else np.asarray(counts, float)) / pulses_per_rev
     speed = np.abs(rpm_sim) / 60.0                                        # [rev/s]
     rev = np.r_[0.0, np.cumsum(0.5 * (speed[1:] + speed[:-1]) * np.diff(t_sim))]
     event = t_sim[-1] - t_sim[0]
     shifts, coarse, shift = _search(
-        lambda ss: np.array([_phase_cost(s, t_sim, rev, edges, span) for s in ss]),
+        lambda ss: np.array([_phase_cost(s, t_sim, rev, edges, revs, span) for s in ss]),
         _shift_range(t_sim, span, partial), event)
     if not np.isfinite(coarse).any():
         raise InputError(f"the tacho's pulses match the event's revolutions at no shift (at "
-                         f"least {MIN_EDGES} pulses in the event, one per revolution); give "
+                         f"least {MIN_EDGES} pulses in the event, {pulses_per_rev} per "
+                         "revolution); give --pulses-per-rev N for a wheel of N teeth, or "
                          "--trigger CHANNEL", file=file, key=key)
     best = int(np.argmin(coarse))
-    sigma = max(float(np.sqrt(_phase_cost(shift, t_sim, rev, edges, span))), PHASE_FLOOR_REV)
+    sigma = max(float(np.sqrt(_phase_cost(shift, t_sim, rev, edges, revs, span))),
+                PHASE_FLOOR_REV)
     if sigma > MISMATCH_REV:
         raise InputError(f"the tacho's pulses do not follow the event's crank angle at any "
-                         f"shift ({sigma:.2g} rev RMS at the best; a once-per-revolution "
-                         "tacho is expected); give --trigger CHANNEL", file=file, key=key)
+                         f"shift ({sigma:.2g} rev RMS at the best, read as {pulses_per_rev} "
+                         "per revolution); give --pulses-per-rev N for a wheel of N teeth, "
+                         "or --trigger CHANNEL", file=file, key=key)
     other = _second_match(coarse, best, sigma ** 2)
     if other is not None:
         raise InputError(f"the tacho's pulses match the event at two places of the recording "
@@ -264,31 +287,49 @@ def align_tacho(t_sim, rpm_sim, span, edges, *, file=None, key="tacho",
     return shift, error
 
 
-def _phase_cost(shift, t_sim, rev, edges, span) -> float:
-    """Variance [rev²] of the event's crank angle at the edges inside it less their count
-    (inf where fewer than :data:`MIN_EDGES`, or where the edges are not as many as the
-    revolutions the event turns over the recorded part, within one)."""
+def _phase_cost(shift, t_sim, rev, edges, revs, span) -> float:
+    """Variance [rev²] of the event's crank angle at the edges inside it less their
+    revolutions counted ``revs`` (inf where fewer than :data:`MIN_EDGES`, or where the edges
+    span other revolutions than the event turns over the recorded part, within one)."""
     first, last = max(t_sim[0], span[0] - shift), min(t_sim[-1], span[1] - shift)
     at = edges - shift
-    at = at[(at >= first) & (at <= last)]
+    inside = (at >= first) & (at <= last)
+    at, counted = at[inside], revs[inside]
     if at.size < MIN_EDGES:
         return np.inf
     turned = np.interp(last, t_sim, rev) - np.interp(first, t_sim, rev)
-    if abs(at.size - turned) > 1.5:
+    if abs(counted[-1] - counted[0] + counted[1] - counted[0] - turned) > 1.5:
         return np.inf
-    return float(np.var(np.interp(at, t_sim, rev) - np.arange(at.size)))
+    return float(np.var(np.interp(at, t_sim, rev) - counted))
 
 
 def _search(costs, bounds, event) -> tuple:
     """``(shifts, their costs, best shift)``: ``costs`` (of an array of shifts) on a grid
-    over ``bounds`` at most ``event / GRID`` apart, then 100 times finer about its best."""
+    over ``bounds`` at most ``event / GRID`` apart, then 100 times finer about its best,
+    then the vertex of the parabola through the finer grid's best and its neighbours."""
     lo, hi = bounds
     shifts = np.linspace(lo, hi, max(801, int(np.ceil((hi - lo) / (event / GRID))) + 1))
     coarse = costs(shifts)
     best = int(np.argmin(coarse))
     fine = np.clip(shifts[best] + np.linspace(-2.0, 2.0, 401) * (shifts[1] - shifts[0]),
                    lo, hi)
-    return shifts, coarse, float(fine[np.argmin(costs(fine))])
+    near = costs(fine)
+    k = int(np.argmin(near))
+    return shifts, coarse, _vertex(fine, near, k)
+
+
+def _vertex(shifts, costs, k) -> float:
+    """The shift of the least cost: the vertex of the parabola through ``k`` and its
+    neighbours on the uniform grid ``shifts``, where they are finite and curve upwards;
+    else ``shifts[k]``."""
+    if not 0 < k < shifts.size - 1 or not np.all(np.isfinite(costs[k - 1:k + 2])):
+        return float(shifts[k])
+    left, mid, right = costs[k - 1:k + 2]
+    curve = left - 2.0 * mid + right
+    if not curve > 0:
+        return float(shifts[k])
+    step = 0.5 * (shifts[k + 1] - shifts[k - 1])
+    return float(shifts[k] + 0.5 * (left - right) / curve * step)
 
 
 def _shift_range(t_sim, span, partial) -> tuple:

@@ -222,14 +222,23 @@ def reference_count(counts, pulses_per_rev):
     return float(teeth[0]) if np.all(teeth == teeth[0]) else None
 
 
+def checked_pulses_per_rev(pulses_per_rev) -> int:
+    """``pulses_per_rev`` as an int, a whole number 1..:data:`MAX_PULSES_PER_REV` (else an
+    InputError naming ``--pulses-per-rev``)."""
+    if not (isinstance(pulses_per_rev, (int, float, np.integer, np.floating))
+            and not isinstance(pulses_per_rev, bool)
+            and 1 <= pulses_per_rev <= MAX_PULSES_PER_REV
+            and float(pulses_per_rev).is_integer()):
+        raise InputError(f"must be a whole number 1..{MAX_PULSES_PER_REV}, got "
+                         f"{pulses_per_rev!r}", key="--pulses-per-rev")
+    return int(pulses_per_rev)
+
+
 def speed_from_tacho(time, tacho, pulses_per_rev, *, smooth_s=0.1, file=None,
                      key="tacho") -> SpeedProfile:
     """Speed profile from a tacho pulse train (see module docstring)."""
     time = np.asarray(time, float)
-    if not (1 <= pulses_per_rev <= MAX_PULSES_PER_REV
-            and float(pulses_per_rev).is_integer()):
-        raise InputError(f"must be a whole number 1..{MAX_PULSES_PER_REV}",
-                         key="--pulses-per-rev")
+    checked_pulses_per_rev(pulses_per_rev)
     edges = tacho_edges(time, tacho, file=file, key=key)
     t_e, counts, notes = count_teeth(edges, file=file, key=key)
     if t_e.size < MIN_TACHO_EDGES:

@@ -72,10 +72,13 @@ from powertrain.workflows import transient_recording as recording
               help="Channel map TOML of the --compare/--speed-from recording (the format of "
                    "'powertrain track --channels'): file channel name -> mount, side, "
                    "direction, quantity.")
+@click.option("--pulses-per-rev", type=int, default=1, show_default=True,
+              help="Tacho pulses per revolution of the --compare/--speed-from recording, "
+                   "where its speed is a tacho's (a missing-tooth wheel's gap is counted).")
 @quiet_option
 def transient(manoeuvre_file, engine_file, angle_step, speed_from, speed_average, seat,
               channels, quantity, out, csv_file, json_file, plot, raw_out, raw_file,
-              compare_plot, trigger, channel_map, quiet):
+              compare_plot, trigger, channel_map, pulses_per_rev, quiet):
     """Transient manoeuvre: time histories of body, mounts and seat over a start, stop,
     tip-in or back-out.
 
@@ -91,22 +94,29 @@ def transient(manoeuvre_file, engine_file, angle_step, speed_from, speed_average
       powertrain transient examples/start.toml --compare start-raw.h5 --compare-plot o.png
       powertrain transient examples/tip-in.toml --compare rec.mf4 --trigger trig \\
           --channel-map map.toml
+      powertrain transient examples/start.toml --speed-from rec.mf4 --pulses-per-rev 60 \\
+          --speed-average
     """
     files = dict(out=out, csv=csv_file, json=json_file, plot=plot, raw=raw_out,
                  compare_plot=compare_plot)
-    _check_options(files, raw_file, speed_from, trigger, channel_map, speed_average)
+    reading = dict(trigger=trigger, channel_map=channel_map, pulses_per_rev=pulses_per_rev)
+    _check_options(files, raw_file, speed_from, reading, speed_average)
     manoeuvre, engine = read_manoeuvre(manoeuvre_file), engine_or_default(engine_file)
     system = engine.assemble()
     figure = workflow.figure_channels(system, channels)
     firing = engine.crank.firing_interval if speed_average else None
-    recorded = _recordings(raw_file, speed_from, trigger, channel_map, system, manoeuvre,
-                           firing)
+    recorded = _recordings(raw_file, speed_from, reading, system, manoeuvre, firing)
     result = workflow.transient(manoeuvre, engine, angle_step_deg=angle_step, seat=seat,
                                 system=system, speed_from=recorded.get("speed"),
                                 speed_average=speed_average)
     comparison = recording.compare_transient(result, recorded["compare"]) if raw_file else None
     written = _write(result, comparison, files, cli_provenance(engine_description(
         engine, engine.file)), figure, quantity)
+    _say(result, comparison, written, quiet)
+
+
+def _say(result, comparison, written, quiet) -> None:
+    """The run's text, the comparison's and what was written."""
     say(result.to_text(), quiet)
     if comparison is not None:
         say(comparison.to_text(), quiet)
@@ -115,20 +125,22 @@ def transient(manoeuvre_file, engine_file, angle_step, speed_from, speed_average
            else "no file written (ask with --out, --csv, --json or --plot)"), quiet)
 
 
-def _check_options(files, raw_file, speed_from, trigger, channel_map, speed_average) -> None:
-    """The output paths and the options that need another, before any work."""
+def _check_options(files, raw_file, speed_from, reading, speed_average) -> None:
+    """The output paths and the options that need another, before any work (``reading``:
+    the recordings' trigger, channel map and pulses per revolution)."""
     check_outputs(**files)
     if speed_average and not speed_from:
         raise InputError("goes with --speed-from RAW", key="--speed-average")
     if files["compare_plot"] and not raw_file:
         raise InputError("--compare-plot needs --compare RAW", key="--compare-plot")
-    for key, value in (("--trigger", trigger), ("--channel-map", channel_map)):
-        if value is not None and not (raw_file or speed_from):
+    for key, given in (("--trigger", reading["trigger"] is not None),
+                       ("--channel-map", reading["channel_map"] is not None),
+                       ("--pulses-per-rev", reading["pulses_per_rev"] != 1)):
+        if given and not (raw_file or speed_from):
             raise InputError("goes with --compare RAW or --speed-from RAW", key=key)
 
 
-def _recordings(raw_file, speed_from, trigger, channel_map, system, manoeuvre,
-                firing_interval) -> dict:
+def _recordings(raw_file, speed_from, reading, system, manoeuvre, firing_interval) -> dict:
     """The recordings of --compare and --speed-from read and checked before the run (the
     compared channels against the model's, the alignment and the span covered); one read
     where both name the same file."""
@@ -136,8 +148,7 @@ def _recordings(raw_file, speed_from, trigger, channel_map, system, manoeuvre,
     for kind, path in (("compare", raw_file), ("speed", speed_from)):
         if path:
             same = out.get("compare") if kind == "speed" and path == raw_file else None
-            out[kind] = same or recording.read_recording(path, channel_map=channel_map,
-                                                         trigger=trigger)
+            out[kind] = same or recording.read_recording(path, **reading)
     recording.check_recordings(manoeuvre, [f"{c}.{d}" for c, d in system.channels],
                                firing_interval=firing_interval,
                                compare=out.get("compare"), speed=out.get("speed"))

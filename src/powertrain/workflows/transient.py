@@ -46,7 +46,7 @@ def manoeuvre_or_file(manoeuvre) -> Manoeuvre:
 
 def transient(manoeuvre, engine=None, *, angle_step_deg=ANGLE_STEP_DEG, seat=None,
               system=None, speed_from=None, trigger=None, channel_map=None,
-              speed_average=False) -> TransientResult:
+              speed_average=False, pulses_per_rev=1) -> TransientResult:
     """Simulate a transient manoeuvre as the ``powertrain transient`` command does.
 
     Parameters
@@ -76,6 +76,9 @@ def transient(manoeuvre, engine=None, *, angle_step_deg=ANGLE_STEP_DEG, seat=Non
         With ``speed_from``: the recorded speed's mean over each firing interval of crank
         angle (a speed resolved within the cycle, an encoder's: its firing orders'
         fluctuation is in the gas and inertia torques already), not the speed as recorded.
+    pulses_per_rev : int
+        With ``speed_from``: its tacho's pulses per revolution (1 by default; a
+        missing-tooth wheel's gap is counted), where its speed is a tacho's.
 
     Returns
     -------
@@ -94,8 +97,9 @@ def transient(manoeuvre, engine=None, *, angle_step_deg=ANGLE_STEP_DEG, seat=Non
     m = manoeuvre_or_file(manoeuvre)
     engine = engine_or_default(engine)
     seat = seat_point(engine, seat)
-    m, speed_note = _driven(m, speed_from, trigger, channel_map,
-                            engine.crank.firing_interval if speed_average else None)
+    m, speed_note = _driven(m, speed_from, dict(
+        trigger=trigger, channel_map=channel_map, pulses_per_rev=pulses_per_rev,
+        firing_interval=engine.crank.firing_interval if speed_average else None))
     t0 = time.process_time()
     with single_blas_thread():
         run = simulate_transient(engine, m, system=system, angle_step_deg=step)
@@ -115,17 +119,19 @@ def _result(m, engine, run, seat, seconds, speed_note) -> TransientResult:
         [m.notes] if m.notes else [], speed_note, m.trigger_time)
 
 
-def _driven(m, speed_from, trigger, channel_map, firing_interval) -> tuple:
-    """The manoeuvre driven by a recorded speed (its mean over each ``firing_interval``
-    [rad] where given), and the line saying so ("" without)."""
+def _driven(m, speed_from, options) -> tuple:
+    """The manoeuvre driven by a recorded speed (``options``: those of
+    :func:`~powertrain.workflows.transient_recording.speed_from_recording`), and the line
+    saying so ("" without)."""
     if speed_from is None:
-        for key, value in (("--trigger", trigger), ("--channel-map", channel_map),
-                           ("--speed-average", firing_interval)):
-            if value is not None:
+        for key, given in (("--trigger", options["trigger"] is not None),
+                           ("--channel-map", options["channel_map"] is not None),
+                           ("--speed-average", options["firing_interval"] is not None),
+                           ("--pulses-per-rev", options["pulses_per_rev"] != 1)):
+            if given:
                 raise InputError("goes with a recording (speed_from)", key=key)
         return m, ""
-    return speed_from_recording(m, speed_from, firing_interval=firing_interval,
-                                trigger=trigger, channel_map=channel_map)
+    return speed_from_recording(m, speed_from, **options)
 
 
 def seat_point(engine, seat) -> str | None:

@@ -21,11 +21,12 @@ from powertrain.analysis.alignment import (
     align_speed,
     align_tacho,
     coverage,
+    tacho_counts,
     tacho_rpm,
     trigger_crossing,
     unheld_speed,
 )
-from powertrain.analysis.speed import mean_speed, tacho_edges
+from powertrain.analysis.speed import checked_pulses_per_rev, mean_speed, tacho_edges
 from powertrain.errors import InputError
 from powertrain.iotools.raw import IGNORED_NOTE, read_raw
 from powertrain.models.manoeuvre import MAX_RPM, Manoeuvre
@@ -62,6 +63,11 @@ class Recorded:
         where the speed is an rpm channel's).
     trigger_error : float
         Standard error of ``trigger`` [s].
+    counts : ndarray or None
+        The tacho's pulses counted at each of ``edges`` (a missing-tooth wheel's gap
+        counted).
+    pulses_per_rev : int
+        The tacho's pulses per revolution.
     """
 
     path: str
@@ -74,12 +80,15 @@ class Recorded:
     ignored: list = field(default_factory=list)
     edges: np.ndarray | None = None
     trigger_error: float = 0.0
+    counts: np.ndarray | None = None
+    pulses_per_rev: int = 1
 
 
-def read_recording(path, *, channel_map=None, trigger=None) -> Recorded:
+def read_recording(path, *, channel_map=None, trigger=None, pulses_per_rev=1) -> Recorded:
     """Read and check a recording of a manoeuvre (any format of
     :func:`~powertrain.iotools.raw.read_raw`; ``channel_map`` as ``powertrain track``'s;
-    ``trigger`` the name of a trigger channel).
+    ``trigger`` the name of a trigger channel; ``pulses_per_rev`` its tacho's, where the
+    speed comes from a tacho).
 
     Raises
     ------
@@ -89,23 +98,28 @@ def read_recording(path, *, channel_map=None, trigger=None) -> Recorded:
     if trigger is not None and (not isinstance(trigger, str) or not trigger.strip()):
         raise InputError("expected the name of a channel of the recording",
                          key="--trigger")
+    pulses_per_rev = checked_pulses_per_rev(pulses_per_rev)
     rec = read_raw(path, channel_map, trigger=trigger, map_option=MAP_OPTION)
     t = rec.time - rec.time[0]
     when = (None, 0.0) if trigger is None else trigger_crossing(t, rec.trigger,
                                                                  file=str(path), key=trigger)
     ignored = [n.strip() for c in rec.comments if c.startswith(IGNORED_NOTE)
                for n in c[len(IGNORED_NOTE):].split(",")]
-    edges = (tacho_edges(t, rec.tacho, file=str(path), key="tacho")
-             if rec.rpm is None and rec.tacho is not None else None)
-    return Recorded(str(path), t, recorded_rpm(rec, path), _speed_source(rec), when[0],
-                    trigger, list(rec.channels), ignored, edges, when[1])
+    edges, counts = (tacho_counts(tacho_edges(t, rec.tacho, file=str(path), key="tacho"),
+                                  pulses_per_rev, file=str(path), key="tacho")
+                     if rec.rpm is None and rec.tacho is not None else (None, None))
+    return Recorded(str(path), t, recorded_rpm(rec, path, pulses_per_rev), _speed_source(rec),
+                    when[0], trigger, list(rec.channels), ignored, edges, when[1], counts,
+                    pulses_per_rev)
 
 
-def recording_or_file(recording, *, channel_map=None, trigger=None) -> Recorded:
+def recording_or_file(recording, *, channel_map=None, trigger=None,
+                      pulses_per_rev=1) -> Recorded:
     """A :class:`Recorded` as it is, or read from its file (:func:`read_recording`)."""
     if isinstance(recording, Recorded):
         return recording
-    return read_recording(recording, channel_map=channel_map, trigger=trigger)
+    return read_recording(recording, channel_map=channel_map, trigger=trigger,
+                          pulses_per_rev=pulses_per_rev)
 
 
 def _speed_source(rec) -> str:
@@ -113,15 +127,16 @@ def _speed_source(rec) -> str:
                                                       else "")
 
 
-def recorded_rpm(rec, path) -> np.ndarray | None:
+def recorded_rpm(rec, path, pulses_per_rev=1) -> np.ndarray | None:
     """Crank speed [rpm] at every sample of the raw recording ``rec``: its rpm channel, else
-    its once-per-revolution tacho
+    its tacho of ``pulses_per_rev`` pulses per revolution
     (:func:`~powertrain.analysis.alignment.tacho_rpm`: at rest before the first pulse
     where the record shows it), else None."""
     if rec.rpm is not None:
         return np.asarray(rec.rpm, float)
     if rec.tacho is not None:
-        return tacho_rpm(rec.time - rec.time[0], rec.tacho, file=str(path), key="tacho")
+        return tacho_rpm(rec.time - rec.time[0], rec.tacho, pulses_per_rev=pulses_per_rev,
+                         file=str(path), key="tacho")
     return None
 
 
@@ -139,7 +154,9 @@ def align(rec: Recorded, t_event, rpm_event, *, partial=True, trigger_at=0.0) ->
                          "--trigger CHANNEL", file=rec.path, key="rpm")
     if rec.edges is not None:
         shift, error = align_tacho(t_event, rpm_event, (rec.time[0], rec.time[-1]),
-                                   rec.edges, file=rec.path, key="tacho", partial=partial)
+                                   rec.edges, counts=rec.counts,
+                                   pulses_per_rev=rec.pulses_per_rev, file=rec.path,
+                                   key="tacho", partial=partial)
         return shift, "crank angle of the tacho's pulses", error
     shift, error = align_speed(t_event, rpm_event, rec.time, rec.rpm, file=rec.path,
                                key="rpm", partial=partial)
@@ -147,7 +164,7 @@ def align(rec: Recorded, t_event, rpm_event, *, partial=True, trigger_at=0.0) ->
 
 
 def speed_from_recording(manoeuvre: Manoeuvre, recording, *, firing_interval=None,
-                         channel_map=None, trigger=None) -> tuple:
+                         channel_map=None, trigger=None, pulses_per_rev=1) -> tuple:
     """``manoeuvre`` driven by the crank speed of a recording (:func:`read_recording`):
     lined up with the manoeuvre by :func:`align` (against the manoeuvre's own speed
     table), its speed as recorded or, given a ``firing_interval`` [rad], its mean over
@@ -165,7 +182,8 @@ def speed_from_recording(manoeuvre: Manoeuvre, recording, *, firing_interval=Non
         No speed in the recording, or a recording that does not cover the manoeuvre after
         alignment (one line naming the file and ``time``).
     """
-    rec = recording_or_file(recording, channel_map=channel_map, trigger=trigger)
+    rec = recording_or_file(recording, channel_map=channel_map, trigger=trigger,
+                            pulses_per_rev=pulses_per_rev)
     if rec.rpm is None:
         raise InputError("no rpm or tacho channel to take the speed from", file=rec.path,
                          key="rpm")
@@ -243,7 +261,8 @@ def compared_channels(rec: Recorded, labels) -> tuple:
     return pairs, skipped
 
 
-def compare_transient(result, raw, *, trigger=None, channel_map=None) -> TransientComparison:
+def compare_transient(result, raw, *, trigger=None, channel_map=None,
+                      pulses_per_rev=1) -> TransientComparison:
     """A simulated manoeuvre against a recorded one.
 
     Parameters
@@ -257,6 +276,9 @@ def compare_transient(result, raw, *, trigger=None, channel_map=None) -> Transie
     channel_map : ChannelMap, str or Path, optional
         The recording's channel names -> mount, side, direction, quantity (the format of
         ``powertrain track --channels``).
+    pulses_per_rev : int
+        The recording's tacho pulses per revolution (1 by default; a missing-tooth wheel's
+        gap is counted), where its speed is a tacho's.
 
     Returns
     -------
@@ -269,7 +291,8 @@ def compare_transient(result, raw, *, trigger=None, channel_map=None) -> Transie
     InputError
         A bad recording, no channel to compare, or less than half the event covered.
     """
-    rec = recording_or_file(raw, channel_map=channel_map, trigger=trigger)
+    rec = recording_or_file(raw, channel_map=channel_map, trigger=trigger,
+                            pulses_per_rev=pulses_per_rev)
     pairs, skipped = compared_channels(rec, result.channels)
     shift, how, error = align(rec, result.time, result.rpm, trigger_at=result.trigger_time)
     t0, t1 = float(result.time[0]), float(result.time[-1])
