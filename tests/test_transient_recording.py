@@ -355,6 +355,9 @@ def test_the_manoeuvres_trigger_time_is_written_and_lines_its_recording_up(fmt, 
     writer(path, result.recording())
     assert read_recording(path, trigger="trigger").trigger == pytest.approx(0.3, abs=1e-9)
     assert read_recording(path).trigger is None
+    with pytest.raises(pt.InputError, match=r"give --trigger CHANNEL \(the recording has one "
+                                            r"named 'trigger'\)"):
+        compare_transient(result, path)
     same = compare_transient(result, path, trigger="trigger")
     assert same.shift == pytest.approx(0.0, abs=1e-9)
     assert np.max(same.errors()["rms_difference_percent"]) < 1e-3     # CSV: 7 digits

@@ -68,6 +68,9 @@ class Recorded:
         counted).
     pulses_per_rev : int
         The tacho's pulses per revolution.
+    unused_trigger : bool
+        The file has a channel named ``trigger`` that ``--trigger`` does not name (said
+        where the crank speed cannot line the recording up).
     """
 
     path: str
@@ -82,6 +85,7 @@ class Recorded:
     trigger_error: float = 0.0
     counts: np.ndarray | None = None
     pulses_per_rev: int = 1
+    unused_trigger: bool = False
 
 
 def read_recording(path, *, channel_map=None, trigger=None, pulses_per_rev=1) -> Recorded:
@@ -110,7 +114,7 @@ def read_recording(path, *, channel_map=None, trigger=None, pulses_per_rev=1) ->
                      if rec.rpm is None and rec.tacho is not None else (None, None))
     return Recorded(str(path), t, recorded_rpm(rec, path, pulses_per_rev), _speed_source(rec),
                     when[0], trigger, list(rec.channels), ignored, edges, when[1], counts,
-                    pulses_per_rev)
+                    pulses_per_rev, trigger is None and rec.trigger is not None)
 
 
 def recording_or_file(recording, *, channel_map=None, trigger=None,
@@ -152,6 +156,18 @@ def align(rec: Recorded, t_event, rpm_event, *, partial=True, trigger_at=0.0) ->
     if rec.rpm is None:
         raise InputError("no rpm or tacho channel to line the recording up on; give "
                          "--trigger CHANNEL", file=rec.path, key="rpm")
+    try:
+        return _align_on_speed(rec, t_event, rpm_event, partial)
+    except InputError as err:
+        if not rec.unused_trigger or "--trigger CHANNEL" not in err.message:
+            raise
+        raise InputError(err.message.replace("--trigger CHANNEL", "--trigger CHANNEL (the "
+                                             "recording has one named 'trigger')"),
+                         file=err.file, key=err.key) from None
+
+
+def _align_on_speed(rec: Recorded, t_event, rpm_event, partial) -> tuple:
+    """:func:`align` on the tacho's pulses, else on the rpm channel."""
     if rec.edges is not None:
         shift, error = align_tacho(t_event, rpm_event, (rec.time[0], rec.time[-1]),
                                    rec.edges, counts=rec.counts,
