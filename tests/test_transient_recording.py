@@ -326,7 +326,7 @@ def test_partial_and_held_speed_recordings_line_up(runs, tmp_path):
 def test_a_trigger_must_step_and_hold():
     """Review 2: a channel of jitter only is no trigger (refused, naming it), and a one-sample
     glitch before the step is passed over (before: accepted at the glitch, 0.2 s early)."""
-    from powertrain.analysis.alignment import trigger_time
+    from powertrain.analysis.trigger import trigger_time
     t = np.arange(0.0, 1.0, 1e-4)
     jitter = 0.03 * np.random.default_rng(3).uniform(-1.0, 1.0, t.size)
     with pytest.raises(pt.InputError, match="does not step") as err:
@@ -344,7 +344,7 @@ def test_the_manoeuvres_trigger_time_is_written_and_lines_its_recording_up(fmt, 
     read back with ``--trigger trigger``: the trigger at 0.3 s, the shift 0 and identical
     signals; without ``--trigger`` the channel is not read as a mount's. Off the time grid
     the written trigger crosses its mid level at the trigger time exactly."""
-    from powertrain.analysis.alignment import trigger_time
+    from powertrain.analysis.trigger import trigger_time
     from powertrain.iotools.raw_mdf import write_raw_mdf
     from powertrain.iotools.raw_uff import write_raw_uff
     result = pt.transient(EXAMPLES / "back-out.toml")
@@ -397,12 +397,34 @@ def test_speed_average_takes_the_firing_orders_fluctuation_out_of_a_recorded_spe
         pt.transient(EXAMPLES / "tip-in.toml", speed_average=True)
 
 
+def test_a_recorded_speed_that_cannot_drive_as_recorded_warns(tmp_path):
+    """The shipped stop, whose crank turns back, driven by its speed recorded unsigned (a
+    tacho's): a RecordedSpeedWarning says a crank turning back reads as turning forward;
+    the shipped start averaged over firing intervals (--speed-average): one says that below
+    600 rpm (180 deg in 50 ms) the mean smooths the flare."""
+    from powertrain.workflows.transient_recording import RecordedSpeedWarning
+    stop = pt.transient(EXAMPLES / "stop.toml")
+    rec = stop.recording()
+    write_raw_hdf5(tmp_path / "stop.h5", dataclasses.replace(rec, rpm=np.abs(rec.rpm)))
+    with pytest.warns(RecordedSpeedWarning, match="never negative"):
+        pt.transient(EXAMPLES / "stop.toml", speed_from=tmp_path / "stop.h5")
+    start = pt.transient(EXAMPLES / "start.toml")
+    write_raw_hdf5(tmp_path / "start.h5", start.recording())
+    with pytest.warns(RecordedSpeedWarning, match="below 600 rpm"):
+        pt.transient(EXAMPLES / "start.toml", speed_from=tmp_path / "start.h5",
+                     speed_average=True)
+
+
 def test_the_shifts_standard_error_is_the_scatter_of_the_shift(runs, tmp_path):
     """The standard error the comparison reports (JSON ``shift_standard_error_s``) is what
-    the shift scatters by over fresh noise: a start 0.3 s into a recording whose speed
-    carries 3 rpm of Gaussian noise, 10 draws (the ratio printed 0.95 on 12); a trigger
-    step with 1 % noise, 300 draws (0.95)."""
-    from powertrain.analysis.alignment import trigger_crossing
+    the shift errs by: a start 0.3 s into a recording whose speed carries 3 rpm of Gaussian
+    noise, 10 draws (scatter over the standard error printed 0.98); the same speed with a
+    30 rpm fluctuation at the 2nd order (an encoder's): 0.48 ms off, within two standard
+    errors, and an AlignmentWarning (more than 2 deg); a trigger's sharp step at a random
+    time within a sample (printed 0.97) and a 4-sample ramp with 1 % noise (0.86), 300
+    draws each."""
+    from powertrain.analysis.alignment import AlignmentWarning
+    from powertrain.analysis.trigger import trigger_crossing
     first = runs["start"]
     rec = read_recording(_written(tmp_path / "pre.h5", first, before=0.3))
     rng = np.random.default_rng(5)
@@ -412,11 +434,23 @@ def test_the_shifts_standard_error_is_the_scatter_of_the_shift(runs, tmp_path):
     reported = np.median([c.to_dict()["shift_standard_error_s"] for c in found])
     assert 0.5 < scatter / reported < 2.0, (scatter, reported)
     assert "standard error 0.03 ms" in found[0].to_text()
+    angle = np.r_[0.0, np.cumsum(0.5 * (rec.rpm[1:] + rec.rpm[:-1]) * np.diff(rec.time))] \
+        * np.pi / 30.0
+    encoder = rec.rpm + 30.0 * np.clip(rec.rpm / 200.0, 0.0, 1.0) * np.sin(2 * angle + 0.4)
+    with pytest.warns(AlignmentWarning, match="differs from the event's"):
+        fluctuating = compare_transient(first, dataclasses.replace(rec, rpm=encoder))
+    assert abs(fluctuating.shift - 0.3) < 2.0 * fluctuating.shift_error
     t = np.arange(0.0, 1.0, 1e-4)
-    step = 5.0 * np.clip((t - 0.5) / 4e-4 + 0.5, 0.0, 1.0)
-    crossings = np.array([trigger_crossing(t, step + rng.normal(0.0, 0.05, t.size))
-                          for _ in range(300)])
-    assert 0.75 < np.std(crossings[:, 0]) / np.median(crossings[:, 1]) < 1.33
+    for shape in ("sharp", "ramp"):
+        errors = []
+        for _ in range(300):
+            when = 0.5 + rng.uniform(0.0, 1e-4)
+            x = (np.where(t >= when, 5.0, 0.0) if shape == "sharp"
+                 else 5.0 * np.clip((t - when) / 4e-4 + 0.5, 0.0, 1.0))
+            found_at, error = trigger_crossing(t, x + rng.normal(0.0, 0.05, t.size))
+            errors.append((found_at - when, error))
+        errors = np.array(errors)
+        assert 0.75 < np.std(errors[:, 0]) / np.median(errors[:, 1]) < 1.33, shape
 
 
 def _tacho_recording(path, result, teeth, missing, before=0.3):
@@ -460,3 +494,37 @@ def test_a_tacho_lines_the_recording_up_on_its_pulses(teeth, missing, tmp_path):
     with pytest.raises(pt.InputError, match="give --pulses-per-rev N") as err:
         compare_transient(first, path)
     assert "t.h5" in str(err.value) and "'tacho'" in str(err.value)
+
+
+def test_a_trigger_edge_bounce_and_raster():
+    """An active-low trigger is refused with the option that reads it, and read with
+    ``edge="falling"``; a switch bouncing for 3.3 ms marks its first contact; a trigger
+    sampled at 100 Hz and resampled by interpolation (a straight rise over 10 ms) is
+    known to 10 ms/sqrt(12) only, too little to line up a 1500 rpm event on (2 deg is
+    0.22 ms): refused."""
+    from powertrain.analysis.alignment import trigger_shift
+    from powertrain.analysis.trigger import trigger_crossing
+    t = np.arange(0.0, 1.0, 1e-4)
+    step = np.where(t >= 0.30037, 5.0, 0.0)
+    with pytest.raises(pt.InputError, match="--trigger-edge falling"):
+        trigger_crossing(t, 5.0 - step)
+    assert trigger_crossing(t, 5.0 - step, edge="falling")[0] == pytest.approx(0.30037, abs=1e-4)
+    bounce = np.where((t >= 0.3) & ~((t >= 0.3005) & (t < 0.301))
+                      & ~((t >= 0.3013) & (t < 0.3033)), 5.0, 0.0)
+    assert trigger_crossing(t, bounce)[0] == pytest.approx(0.3, abs=1e-4)
+    raster = np.interp(t, t[::100], step[::100])
+    when, error = trigger_crossing(t, raster)
+    assert error > 0.9 * 0.01 / np.sqrt(12.0)
+    with pytest.raises(pt.InputError, match="fixes the event's start"):
+        trigger_shift(when, error, 0.0, [1500.0], file="rec.csv", key="trig")
+
+
+@pytest.mark.parametrize("angles, interval", [
+    ([0, 540, 180, 360], 180.0), ([0, 240, 480], 240.0), ([0, 120, 240, 360, 480, 600], 120.0),
+    ([0, 90, 240, 330, 480, 570], 240.0), ([0, 180, 270, 450], 720.0)])
+def test_the_firing_interval_is_the_gas_torques_period(default_engine, angles, interval):
+    """--speed-average's window: 720/n deg with even firing, 240 deg for a V6 firing at 90
+    and 150 deg (review 3: it was 720), the cycle where nothing repeats sooner."""
+    crank = dataclasses.replace(default_engine.crank, firing_angles=np.radians(angles),
+                                cylinder_x=np.zeros(len(angles)))
+    assert np.degrees(crank.firing_interval) == pytest.approx(interval)

@@ -1,6 +1,7 @@
-r"""A recorded manoeuvre lined up with a simulated one: the crank speed of a
-once-per-revolution tacho through standstill, a trigger channel's time, the time shift that
-best matches two speed profiles and whether that shift is determined at all.
+r"""A recorded manoeuvre lined up with a simulated one: the crank speed of a tacho through
+standstill, the time shift that best matches two speed profiles or a tacho's pulses, and
+whether that shift is determined at all (a trigger channel's time:
+:mod:`powertrain.analysis.trigger`).
 
 **Tacho speed** (:func:`tacho_rpm`): each interval between rising edges gives its mean speed
 :math:`60\,\Delta c/(N\Delta t)` [rpm], :math:`\Delta c` the pulses it spans (1, or a
@@ -15,11 +16,6 @@ to the first interval's speed at its midpoint; otherwise it was already turning 
 first interval's speed is held back to the first sample. After the last edge likewise: the
 speed falls linearly to 0 at one last interval after it where the record goes on longer
 than that, else the last interval's speed is held.
-
-**Trigger** (:func:`trigger_time`): event time 0 is the first rising crossing (linear
-between samples) of the mid level between the channel's smallest and largest values after
-which the channel stays above it for :data:`TRIGGER_HOLD_S`; a channel whose range is under
-:data:`TRIGGER_STEP_NOISE` times its noise does not step and is refused.
 
 **Alignment on the speed** (:func:`align_speed`): the shift :math:`s` minimising the mean of
 :math:`(n_\mathrm{rec}(t) - n_\mathrm{sim}(t - s))^2` over the recorded samples inside the
@@ -48,10 +44,12 @@ phase's scatter over :math:`\sqrt{\sum \dot\theta^2}` at the edges; refused as a
 
 from __future__ import annotations
 
+import warnings
+
 import numpy as np
 
-from powertrain.analysis.speed import count_teeth, tacho_edges
-from powertrain.errors import InputError
+from powertrain.analysis.speed import count_teeth, drop_spikes, tacho_edges
+from powertrain.errors import InputError, PowertrainWarning
 
 #: Times of the event at which the speeds are matched.
 GRID = 400
@@ -62,10 +60,6 @@ SPEED_FLOOR_RPM = 1.0
 #: speed (2 deg: 4 deg of phase on the 2nd order, about 7 % RMS of an identical waveform).
 ALIGN_SIGMAS = 3.0
 ALIGN_TOLERANCE_DEG = 2.0
-#: A trigger channel steps by at least this many times its noise (second differences' RMS
-#: over sqrt 6) and stays above its mid level this long [s] after its rising crossing.
-TRIGGER_STEP_NOISE = 10.0
-TRIGGER_HOLD_S = 0.002
 #: Least part of the event a recording must cover after alignment.
 MIN_COVERAGE = 0.5
 #: A speed channel whose samples change at fewer than this share of them is held between
@@ -79,19 +73,33 @@ MISMATCH_SHARE = 0.1
 MIN_EDGES = 4
 PHASE_FLOOR_REV = 1e-4
 MISMATCH_REV = 0.05
+#: Longest correlation of a speed residual [s] and of a tacho's phase residual [rev]
+#: the shift's standard error takes in (:func:`_correlated_error`: two periods of the 2nd
+#: order at 250 rpm; two revolutions).
+CORRELATION_S = 0.25
+CORRELATION_REV = 2.0
 #: Times at which an event's speed table is read for its angle and slope, and the most
 #: recorded samples a speed alignment's cost reads.
 FINE = 20001
 COST_SAMPLES = 20000
 
 
+class AlignmentWarning(PowertrainWarning):
+    """A recording lined up on its crank speed or tacho whose shift is uncertain by more
+    than :data:`ALIGN_TOLERANCE_DEG` (:data:`ALIGN_SIGMAS` standard errors) because the
+    recorded speed differs from the event's (a correlated residual: another profile, a
+    fluctuation at the firing orders), not because it varies too little."""
+
+
 def tacho_counts(edges, pulses_per_rev=1, *, file=None, key="tacho") -> tuple:
-    """``(edges, counts)``: a tacho's rising edges [s] and the pulses counted at each from
-    the first: one per edge with one pulse per revolution (a start's intervals change too
-    fast to tell a gap), else :func:`~powertrain.analysis.speed.count_teeth`'s (spikes
-    dropped, a missing-tooth wheel's gap counted)."""
+    """``(edges, counts)``: a tacho's rising edges [s], spikes dropped, and the pulses
+    counted at each from the first: one per edge with one pulse per revolution (a start's
+    intervals change too fast to tell a gap), else
+    :func:`~powertrain.analysis.speed.count_teeth`'s (a missing-tooth wheel's gap
+    counted)."""
     edges = np.asarray(edges, float)
     if pulses_per_rev == 1:
+        edges = drop_spikes(edges)[0]
         return edges, np.arange(edges.size, dtype=float)
     edges, counts, _ = count_teeth(edges, file=file, key=key)
     return edges, counts
@@ -124,50 +132,21 @@ def tacho_rpm(time, tacho, *, pulses_per_rev=1, file=None, key="tacho") -> np.nd
     return np.interp(time, tt, rr)
 
 
-def trigger_time(time, signal, *, file=None, key="--trigger") -> float:
-    """Time [s] of the first rising crossing of the mid level between the smallest and the
-    largest value of ``signal`` (linear between samples) after which it stays above for
-    :data:`TRIGGER_HOLD_S` (a glitch is no trigger); refused where its range is under
-    :data:`TRIGGER_STEP_NOISE` times its noise (no step). :func:`trigger_crossing` with
-    the time's standard error."""
-    return trigger_crossing(time, signal, file=file, key=key)[0]
-
-
-def trigger_crossing(time, signal, *, file=None, key="--trigger") -> tuple:
-    """:func:`trigger_time` [s] and its standard error [s]: the channel's noise (its second
-    differences' RMS over √6) over its slope at the crossing.
-
-    Parameters
-    ----------
-    time : ndarray (n,)
-        [s]
-    signal : ndarray (n,)
-        Trigger channel [V or any unit].
-    file, key : str, optional
-        Named in error messages.
-    """
-    time = np.asarray(time, float)
-    x = np.asarray(signal, float)
-    lo, hi = float(np.min(x)), float(np.max(x))
-    if not hi - lo > 1e-12 * max(abs(hi), abs(lo), 1.0):
-        raise InputError("the trigger channel is constant (no rising crossing)",
-                         file=file, key=key)
-    noise = np.sqrt(np.mean(np.diff(x, 2) ** 2) / 6.0) if x.size > 2 else 0.0
-    if hi - lo < TRIGGER_STEP_NOISE * noise:
-        raise InputError(f"the trigger channel does not step (its range {hi - lo:.3g} is "
-                         f"less than {TRIGGER_STEP_NOISE:g} times its noise {noise:.3g})",
-                         file=file, key=key)
-    mid = 0.5 * (lo + hi)
-    hold = max(1, int(np.ceil(TRIGGER_HOLD_S / np.median(np.diff(time)))))
-    up = np.flatnonzero((x[:-1] < mid) & (x[1:] >= mid))
-    up = [i for i in up if np.all(x[i + 1:i + 1 + hold] >= mid)]
-    if not up:
-        raise InputError(f"the trigger channel never rises through its mid level ({mid:g}) "
-                         f"to stay there {TRIGGER_HOLD_S * 1e3:g} ms", file=file, key=key)
-    i = int(up[0])
-    h = time[i + 1] - time[i]
-    slope = (x[i + 1] - x[i]) / h
-    return float(time[i] + (mid - x[i]) / slope), float(noise / slope)
+def trigger_shift(trigger, error, trigger_at, rpm_event, *, file=None, key="--trigger"):
+    """The recording's time [s] of the event's time 0 from a trigger at ``trigger`` [s]
+    (standard error ``error`` [s]) that marks the event's time ``trigger_at`` [s]; refused
+    where :data:`ALIGN_SIGMAS` standard errors exceed the time the crank takes to turn
+    :data:`ALIGN_TOLERANCE_DEG` at the event's top speed (``rpm_event`` [rpm]), as a
+    speed's alignment is."""
+    top = max(float(np.max(np.abs(rpm_event))), SPEED_FLOOR_RPM)
+    allowed = ALIGN_TOLERANCE_DEG / (6.0 * top)
+    if not ALIGN_SIGMAS * error <= allowed:
+        raise InputError(f"the trigger fixes the event's start to +-"
+                         f"{ALIGN_SIGMAS * error * 1e3:.3g} ms only (its noise over its slope, "
+                         f"or a step between samples {ALIGN_SIGMAS:g} standard errors wide), "
+                         f"more than {allowed * 1e3:.2g} ms = {ALIGN_TOLERANCE_DEG:g} deg of "
+                         f"crank at {top:.0f} rpm", file=file, key=key)
+    return trigger - float(trigger_at)
 
 
 def coverage(t0, t1, rec0, rec1, shift):
@@ -218,15 +197,16 @@ def align_speed(t_sim, rpm_sim, t_rec, rpm_rec, *, file=None, key="rpm",
                          f"(the event starting at {shift:.4f} s or at {shifts[other]:.4f} s); "
                          "give --trigger CHANNEL", file=file, key=key)
     _check_match(float(np.sqrt(costs(np.array([shift]))[0])), sigma, target, file, key)
-    error = _shift_error(t_sim, rpm_sim, t_rec, shift, sigma)
+    white, error = _shift_error(t, target, t_rec, rpm_rec, shift, sigma)
     top = max(float(np.max(np.abs(target))), SPEED_FLOOR_RPM)
     allowed = ALIGN_TOLERANCE_DEG / (6.0 * top)
-    if not ALIGN_SIGMAS * error <= allowed:
+    if not ALIGN_SIGMAS * white <= allowed:
         raise InputError(
             f"the crank speed varies too little over the event to line the recording up on "
-            f"it (shift uncertain by +-{ALIGN_SIGMAS * error * 1e3:.3g} ms, more than "
+            f"it (shift uncertain by +-{ALIGN_SIGMAS * white * 1e3:.3g} ms, more than "
             f"{allowed * 1e3:.2g} ms = {ALIGN_TOLERANCE_DEG:g} deg of crank at {top:.0f} "
             "rpm); give --trigger CHANNEL", file=file, key=key)
+    _warn_uncertain(error, allowed, "crank speed", file)
     return shift, error
 
 
@@ -275,16 +255,45 @@ def align_tacho(t_sim, rpm_sim, span, edges, *, counts=None, pulses_per_rev=1, f
         raise InputError(f"the tacho's pulses match the event at two places of the recording "
                          f"(the event starting at {shift:.4f} s or at {shifts[other]:.4f} s); "
                          "give --trigger CHANNEL", file=file, key=key)
-    at = edges - shift
-    rate = np.interp(at[(at >= t_sim[0]) & (at <= t_sim[-1])], t_sim, speed)
-    error = sigma / np.sqrt(float(np.sum(rate ** 2)))
+    white, error = _phase_error(shift, t_sim, rev, speed, edges, revs, span, sigma)
     allowed = ALIGN_TOLERANCE_DEG / (360.0 * max(float(np.max(speed)), 1e-9))
-    if not ALIGN_SIGMAS * error <= allowed:
+    if not ALIGN_SIGMAS * white <= allowed:
         raise InputError(f"the tacho's pulses fix the event's start to +-"
-                         f"{ALIGN_SIGMAS * error * 1e3:.3g} ms only, more than "
+                         f"{ALIGN_SIGMAS * white * 1e3:.3g} ms only, more than "
                          f"{allowed * 1e3:.2g} ms = {ALIGN_TOLERANCE_DEG:g} deg of crank; give "
                          "--trigger CHANNEL", file=file, key=key)
+    _warn_uncertain(error, allowed, "tacho's pulses", file)
     return shift, error
+
+
+def _warn_uncertain(error, allowed, what, file) -> None:
+    """:class:`AlignmentWarning` where :data:`ALIGN_SIGMAS` standard errors ``error`` [s]
+    exceed ``allowed`` [s]."""
+    if ALIGN_SIGMAS * error > allowed:
+        warnings.warn(AlignmentWarning(
+            f"{file or 'the recording'}: lined up on the {what}, but the recorded speed "
+            f"differs from the event's: the shift is uncertain by "
+            f"+-{ALIGN_SIGMAS * error * 1e3:.3g} ms, more "
+            f"than {allowed * 1e3:.2g} ms = {ALIGN_TOLERANCE_DEG:g} deg of crank; a trigger "
+            "channel (--trigger) lines it up better"), stacklevel=3)
+
+
+def _phase_error(shift, t_sim, rev, speed, edges, revs, span, sigma) -> tuple:
+    """Standard errors [s] of the tacho's shift, least squares on the shift with the
+    pulses' phase eliminated (the speed at the edges less its mean): ``(white, error)``,
+    the first from the phase's white scatter ``sigma`` [rev], the second from the phase
+    residual correlated as it is over the edges (:func:`_correlated_error`), at least the
+    first."""
+    first, last = max(t_sim[0], span[0] - shift), min(t_sim[-1], span[1] - shift)
+    at = edges - shift
+    inside = (at >= first) & (at <= last)
+    phase = np.interp(at[inside], t_sim, rev) - revs[inside]
+    rate = np.interp(at[inside], t_sim, speed)
+    lags = round(CORRELATION_REV * np.median(np.diff(revs)) ** -1)
+    design = rate - np.mean(rate)
+    white = _correlated_error(design, np.zeros_like(design), sigma, 0)
+    return white, max(white, _correlated_error(design, phase - np.mean(phase),
+                                               PHASE_FLOOR_REV, lags))
 
 
 def _phase_cost(shift, t_sim, rev, edges, revs, span) -> float:
@@ -375,15 +384,46 @@ def _fine(t_sim, rpm_sim):
     return t, np.interp(t, t_sim, np.asarray(rpm_sim, float))
 
 
-def _shift_error(t_sim, rpm_sim, t_rec, shift, sigma) -> float:
-    """Standard error [s] of the shift: least squares on one parameter over every recorded
-    sample inside the event, :math:`\\sigma / \\sqrt{\\sum \\dot n_\\mathrm{sim}^2}`."""
-    t_sim, rpm_sim = _fine(t_sim, rpm_sim)
-    at = t_rec - shift
-    inside = (at >= t_sim[0]) & (at <= t_sim[-1])
-    slope = np.interp(at[inside], t_sim, np.gradient(rpm_sim, t_sim))
-    info = float(np.sum(slope ** 2))
-    return sigma / np.sqrt(info) if info > 0 else np.inf
+def _shift_error(t, target, t_rec, rpm_rec, shift, sigma) -> tuple:
+    """Standard errors [s] of the shift against the event's speed ``target`` [rpm] at ``t``
+    (:func:`_fine`), least squares on one parameter over the recorded samples inside the
+    event (those the cost reads): ``(white, error)``, the first from the recorded speed's
+    white scatter ``sigma`` [rpm] (:func:`_scatter`: whether the speed varies enough), the
+    second from the residual at the shift, correlated as it is (:func:`_correlated_error`),
+    at least the first."""
+    if np.min(rpm_rec) >= 0:
+        target = np.abs(target)
+    every = max(1, int(np.ceil(t_rec.size / COST_SAMPLES)))
+    at, rr = t_rec[::every] - shift, rpm_rec[::every]
+    inside = (at >= t[0]) & (at <= t[-1])
+    slope = np.interp(at[inside], t, np.gradient(target, t))
+    residual = rr[inside] - np.interp(at[inside], t, target)
+    lags = round(CORRELATION_S / (every * (t_rec[1] - t_rec[0])))
+    white = _correlated_error(slope, np.zeros_like(slope), sigma, 0)
+    return white, max(white, _correlated_error(slope, residual, SPEED_FLOOR_RPM, lags))
+
+
+def _correlated_error(design, residual, floor, lags) -> float:
+    r"""Standard error of a one-parameter least-squares fit of slope ``design`` whose
+    ``residual`` (both at evenly spaced points) may be correlated and of unequal scatter
+    (a fluctuation at the firing orders, filtered noise, a profile that differs, a tacho's
+    edges jittering by a time, not an angle): Newey and West's (1987)
+    :math:`\sqrt{\sum_{|k|\le L} w_k \sum_i u_i u_{i+k}} / \sum_i d_i^2`,
+    :math:`u_i = d_i r_i`, Bartlett weights :math:`w_k = 1 - |k|/(L+1)` over ``lags``
+    :math:`L` (at most a tenth of the points); at least ``floor`` over
+    :math:`\sqrt{\sum d_i^2}` (white scatter of that size)."""
+    d, r = np.asarray(design, float), np.asarray(residual, float)
+    info = float(d @ d)
+    if not info > 0:
+        return np.inf
+    u = d * r
+    m = 1 << int(np.ceil(np.log2(2 * u.size)))             # zero-padded: no wrap-around
+    lags = int(min(max(lags, 0), u.size // 10))
+    cov = np.fft.irfft(np.abs(np.fft.rfft(u, m)) ** 2, m)[:lags + 1]
+    weight = 2.0 * (1.0 - np.arange(lags + 1) / (lags + 1.0))
+    weight[0] = 1.0
+    quad = float(np.sum(weight * cov))
+    return max(np.sqrt(max(quad, 0.0)), floor * np.sqrt(info)) / info
 
 
 def _costs(t, target, t_rec, rpm_rec):

@@ -173,15 +173,9 @@ def tacho_edges(time, tacho, *, file=None, key="tacho", what="tacho"):
     return time[i0] + frac * (time[i1] - time[i0])
 
 
-def count_teeth(edge_times, *, file=None, key="tacho"):
-    """Pulse count at each edge, with missing teeth counted and spikes dropped.
-
-    Returns
-    -------
-    times, counts : ndarray
-        Edge times [s] kept and the cumulative pulse count at each (0 at the first).
-    notes : list of str
-    """
+def drop_spikes(edge_times) -> tuple:
+    """Edge times [s] without the spikes' (an edge less than :data:`SPIKE_RATIO` of the
+    running median interval after the one before), and notes saying how many."""
     t = np.asarray(edge_times, float)
     notes = []
     for _ in range(3):                       # drop spikes, then re-evaluate the median
@@ -192,6 +186,19 @@ def count_teeth(edge_times, *, file=None, key="tacho"):
             break
         t = np.delete(t, np.flatnonzero(spike) + 1)
         notes.append(f"{int(spike.sum())} tacho spike(s) dropped")
+    return t, notes
+
+
+def count_teeth(edge_times, *, file=None, key="tacho"):
+    """Pulse count at each edge, with missing teeth counted and spikes dropped.
+
+    Returns
+    -------
+    times, counts : ndarray
+        Edge times [s] kept and the cumulative pulse count at each (0 at the first).
+    notes : list of str
+    """
+    t, notes = drop_spikes(edge_times)
     d = np.diff(t)
     med = median_filter(d, size=min(9, d.size) | 1, mode="nearest")
     ratio = d / med

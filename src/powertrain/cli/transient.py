@@ -72,13 +72,16 @@ from powertrain.workflows import transient_recording as recording
               help="Channel map TOML of the --compare/--speed-from recording (the format of "
                    "'powertrain track --channels'): file channel name -> mount, side, "
                    "direction, quantity.")
+@click.option("--trigger-edge", type=click.Choice(["rising", "falling"]), default="rising",
+              show_default=True, help="The edge the --trigger channel marks (falling: an "
+                                      "active-low trigger).")
 @click.option("--pulses-per-rev", type=int, default=1, show_default=True,
               help="Tacho pulses per revolution of the --compare/--speed-from recording, "
                    "where its speed is a tacho's (a missing-tooth wheel's gap is counted).")
 @quiet_option
 def transient(manoeuvre_file, engine_file, angle_step, speed_from, speed_average, seat,
               channels, quantity, out, csv_file, json_file, plot, raw_out, raw_file,
-              compare_plot, trigger, channel_map, pulses_per_rev, quiet):
+              compare_plot, trigger, channel_map, trigger_edge, pulses_per_rev, quiet):
     """Transient manoeuvre: time histories of body, mounts and seat over a start, stop,
     tip-in or back-out.
 
@@ -99,7 +102,8 @@ def transient(manoeuvre_file, engine_file, angle_step, speed_from, speed_average
     """
     files = dict(out=out, csv=csv_file, json=json_file, plot=plot, raw=raw_out,
                  compare_plot=compare_plot)
-    reading = dict(trigger=trigger, channel_map=channel_map, pulses_per_rev=pulses_per_rev)
+    reading = dict(trigger=trigger, channel_map=channel_map, pulses_per_rev=pulses_per_rev,
+                   trigger_edge=trigger_edge)
     _check_options(files, raw_file, speed_from, reading, speed_average)
     manoeuvre, engine = read_manoeuvre(manoeuvre_file), engine_or_default(engine_file)
     system = engine.assemble()
@@ -135,7 +139,8 @@ def _check_options(files, raw_file, speed_from, reading, speed_average) -> None:
         raise InputError("--compare-plot needs --compare RAW", key="--compare-plot")
     for key, given in (("--trigger", reading["trigger"] is not None),
                        ("--channel-map", reading["channel_map"] is not None),
-                       ("--pulses-per-rev", reading["pulses_per_rev"] != 1)):
+                       ("--pulses-per-rev", reading["pulses_per_rev"] != 1),
+                       ("--trigger-edge", reading["trigger_edge"] != "rising")):
         if given and not (raw_file or speed_from):
             raise InputError("goes with --compare RAW or --speed-from RAW", key=key)
 

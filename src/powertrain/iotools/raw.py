@@ -96,17 +96,20 @@ def read_raw(path, channel_map: ChannelMap | None = None, *, rpm: str | None = N
     fmt = detect_format(path)
     reader = {"hdf5": read_hdf5_signals, "mdf": read_mdf_signals,
               "uff": read_uff_signals}.get(fmt, read_csv_signals)
-    found = (read_hdf5_signals(path, channel_map, map_option=map_option) if fmt == "hdf5"
+    found = (read_hdf5_signals(path, channel_map, map_option=map_option,
+                               extra=(trigger, cycle_reference)) if fmt == "hdf5"
              else reader(path, channel_map))
     return assemble(found, channel_map, rpm=rpm, tacho=tacho, cycle_reference=cycle_reference,
                     trigger=trigger, map_option=map_option)
 
 
 def _find(signals, wanted):
-    """Index of the signal named ``wanted`` (full name or name without the unit bracket)."""
-    for i, (name, _, _) in enumerate(signals):
-        if name == wanted or split_unit(name)[0] == wanted:
-            return i
+    """Index of the signal named ``wanted`` (full name or name without the unit bracket;
+    else the same ignoring case: ``RPM [1/min]``, ``Trigger [V]``)."""
+    for same in (str.__eq__, lambda a, b: a.casefold() == b.casefold()):
+        for i, (name, _, _) in enumerate(signals):
+            if same(name, wanted) or same(split_unit(name)[0], wanted):
+                return i
     return None
 
 

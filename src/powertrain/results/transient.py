@@ -130,13 +130,21 @@ class TransientResult(JsonResult):
                             trigger=self.trigger_signal()).validate()
 
     def trigger_signal(self) -> np.ndarray | None:
-        """A trigger channel [V], 0 V to 5 V, whose rise crosses 2.5 V at
-        :attr:`trigger_time` exactly (linear over two samples either side; None where the
-        trigger is at the first sample: no rise to record)."""
-        h = float(self.time[1] - self.time[0])
-        if self.trigger_time < self.time[0] + h:
+        """A trigger channel [V], 0 V before :attr:`trigger_time` and 5 V after, with one
+        sample between whose level puts the rise's crossing of 2.5 V (linear between
+        samples) at :attr:`trigger_time` exactly (None where the trigger is at the first
+        sample: no rise to record)."""
+        t, when = self.time, float(self.trigger_time)
+        if when <= t[0]:
             return None
-        return 5.0 * np.clip((self.time - self.trigger_time) / (4.0 * h) + 0.5, 0.0, 1.0)
+        x = np.where(t >= when, 5.0, 0.0)
+        i = int(np.searchsorted(t, when)) - 1             # t[i] < when <= t[i + 1]
+        h = t[i + 1] - t[i]
+        if when - t[i] >= 0.5 * h:
+            x[i + 1] = 2.5 * h / (when - t[i])
+        else:
+            x[i] = 5.0 - 2.5 * h / (t[i + 1] - when)
+        return x
 
     def to_dict(self) -> dict:
         """The JSON document (docs/reference/json.md)."""
@@ -384,7 +392,7 @@ class TransientComparison(JsonResult):
     shift_error : float
         Standard error of ``shift`` [s] (:func:`~powertrain.analysis.alignment.align_speed`,
         :func:`~powertrain.analysis.alignment.align_tacho`,
-        :func:`~powertrain.analysis.alignment.trigger_crossing`).
+        :func:`~powertrain.analysis.trigger.trigger_crossing`).
     """
 
     name: str

@@ -46,7 +46,8 @@ def manoeuvre_or_file(manoeuvre) -> Manoeuvre:
 
 def transient(manoeuvre, engine=None, *, angle_step_deg=ANGLE_STEP_DEG, seat=None,
               system=None, speed_from=None, trigger=None, channel_map=None,
-              speed_average=False, pulses_per_rev=1) -> TransientResult:
+              speed_average=False, pulses_per_rev=1,
+              trigger_edge="rising") -> TransientResult:
     """Simulate a transient manoeuvre as the ``powertrain transient`` command does.
 
     Parameters
@@ -66,19 +67,15 @@ def transient(manoeuvre, engine=None, *, angle_step_deg=ANGLE_STEP_DEG, seat=Non
         Raw recording whose crank speed, lined up with the manoeuvre, replaces the
         manoeuvre's speed table over its span
         (:func:`~powertrain.workflows.transient_recording.speed_from_recording`).
-    trigger : str, optional
-        With ``speed_from``: the recording's trigger channel (the manoeuvre's
-        ``trigger_time``, default 0, at its first rising crossing of its mid level; default:
-        lined up on the crank speed).
-    channel_map : ChannelMap, str or Path, optional
-        With ``speed_from``: the recording's channel map (``powertrain track``'s format).
+    trigger, channel_map, pulses_per_rev, trigger_edge : optional
+        With ``speed_from``: how the recording is read and lined up: its trigger channel
+        (the manoeuvre's ``trigger_time`` at its ``trigger_edge``, ``rising`` or
+        ``falling``; default: on the crank speed), channel map, tacho pulses per revolution
+        (:func:`~powertrain.workflows.transient_recording.read_recording`).
     speed_average : bool
         With ``speed_from``: the recorded speed's mean over each firing interval of crank
         angle (a speed resolved within the cycle, an encoder's: its firing orders'
         fluctuation is in the gas and inertia torques already), not the speed as recorded.
-    pulses_per_rev : int
-        With ``speed_from``: its tacho's pulses per revolution (1 by default; a
-        missing-tooth wheel's gap is counted), where its speed is a tacho's.
 
     Returns
     -------
@@ -97,8 +94,11 @@ def transient(manoeuvre, engine=None, *, angle_step_deg=ANGLE_STEP_DEG, seat=Non
     m = manoeuvre_or_file(manoeuvre)
     engine = engine_or_default(engine)
     seat = seat_point(engine, seat)
+    if not isinstance(speed_average, (bool, np.bool_)):
+        raise InputError(f"expected true or false, got {speed_average!r}", key="--speed-average")
     m, speed_note = _driven(m, speed_from, dict(
         trigger=trigger, channel_map=channel_map, pulses_per_rev=pulses_per_rev,
+        trigger_edge=trigger_edge,
         firing_interval=engine.crank.firing_interval if speed_average else None))
     t0 = time.process_time()
     with single_blas_thread():
@@ -127,7 +127,8 @@ def _driven(m, speed_from, options) -> tuple:
         for key, given in (("--trigger", options["trigger"] is not None),
                            ("--channel-map", options["channel_map"] is not None),
                            ("--speed-average", options["firing_interval"] is not None),
-                           ("--pulses-per-rev", options["pulses_per_rev"] != 1)):
+                           ("--pulses-per-rev", options["pulses_per_rev"] != 1),
+                           ("--trigger-edge", options["trigger_edge"] != "rising")):
             if given:
                 raise InputError("goes with a recording (speed_from)", key=key)
         return m, ""

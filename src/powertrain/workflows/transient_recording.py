@@ -4,7 +4,7 @@ lined up with the manoeuvre (one rule, :func:`align`, for ``--compare`` and
 
 Lining up: with a trigger channel, the manoeuvre's ``trigger_time`` (default 0) is the
 trigger's first rising crossing of its mid level
-(:func:`powertrain.analysis.alignment.trigger_time`); else the time shift whose recorded
+(:func:`powertrain.analysis.trigger.trigger_time`); else the time shift whose recorded
 crank speed (rpm channel, else once-per-revolution tacho) best matches the manoeuvre's,
 refused where the speed varies too little to fix it
 (:func:`powertrain.analysis.alignment.align_speed`).
@@ -12,6 +12,7 @@ refused where the speed varies too little to fix it
 
 from __future__ import annotations
 
+import warnings
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -23,17 +24,20 @@ from powertrain.analysis.alignment import (
     coverage,
     tacho_counts,
     tacho_rpm,
-    trigger_crossing,
+    trigger_shift,
     unheld_speed,
 )
 from powertrain.analysis.speed import checked_pulses_per_rev, mean_speed, tacho_edges
-from powertrain.errors import InputError
+from powertrain.analysis.trigger import trigger_crossing
+from powertrain.errors import InputError, PowertrainWarning
 from powertrain.iotools.raw import IGNORED_NOTE, read_raw
 from powertrain.models.manoeuvre import MAX_RPM, Manoeuvre
 from powertrain.results.transient import TransientComparison
 
 #: Most rows of a speed table taken from a recording (block means of its samples).
 SPEED_ROWS = 2000
+#: Longest firing interval [s] whose mean speed (--speed-average) passes without a warning.
+AVERAGE_WINDOW_S = 0.05
 #: Option that gives a recording's channel map, named in error messages.
 MAP_OPTION = "--channel-map"
 _RPM = np.pi / 30.0
@@ -88,11 +92,13 @@ class Recorded:
     unused_trigger: bool = False
 
 
-def read_recording(path, *, channel_map=None, trigger=None, pulses_per_rev=1) -> Recorded:
+def read_recording(path, *, channel_map=None, trigger=None, pulses_per_rev=1,
+                   trigger_edge="rising") -> Recorded:
     """Read and check a recording of a manoeuvre (any format of
     :func:`~powertrain.iotools.raw.read_raw`; ``channel_map`` as ``powertrain track``'s;
-    ``trigger`` the name of a trigger channel; ``pulses_per_rev`` its tacho's, where the
-    speed comes from a tacho).
+    ``trigger`` the name of a trigger channel and ``trigger_edge`` the edge it marks,
+    ``rising`` or ``falling``; ``pulses_per_rev`` its tacho's, where the speed comes from a
+    tacho).
 
     Raises
     ------
@@ -105,8 +111,8 @@ def read_recording(path, *, channel_map=None, trigger=None, pulses_per_rev=1) ->
     pulses_per_rev = checked_pulses_per_rev(pulses_per_rev)
     rec = read_raw(path, channel_map, trigger=trigger, map_option=MAP_OPTION)
     t = rec.time - rec.time[0]
-    when = (None, 0.0) if trigger is None else trigger_crossing(t, rec.trigger,
-                                                                 file=str(path), key=trigger)
+    when = (None, 0.0) if trigger is None else trigger_crossing(
+        t, rec.trigger, edge=trigger_edge, file=str(path), key=trigger)
     ignored = [n.strip() for c in rec.comments if c.startswith(IGNORED_NOTE)
                for n in c[len(IGNORED_NOTE):].split(",")]
     edges, counts = (tacho_counts(tacho_edges(t, rec.tacho, file=str(path), key="tacho"),
@@ -117,13 +123,12 @@ def read_recording(path, *, channel_map=None, trigger=None, pulses_per_rev=1) ->
                     pulses_per_rev, trigger is None and rec.trigger is not None)
 
 
-def recording_or_file(recording, *, channel_map=None, trigger=None,
-                      pulses_per_rev=1) -> Recorded:
-    """A :class:`Recorded` as it is, or read from its file (:func:`read_recording`)."""
+def recording_or_file(recording, **options) -> Recorded:
+    """A :class:`Recorded` as it is, or read from its file with ``options``
+    (:func:`read_recording`'s)."""
     if isinstance(recording, Recorded):
         return recording
-    return read_recording(recording, channel_map=channel_map, trigger=trigger,
-                          pulses_per_rev=pulses_per_rev)
+    return read_recording(recording, **options)
 
 
 def _speed_source(rec) -> str:
@@ -151,8 +156,9 @@ def align(rec: Recorded, t_event, rpm_event, *, partial=True, trigger_at=0.0) ->
     event's speed ``rpm_event`` [rpm] at ``t_event`` [s] (module docstring); ``partial``:
     the recording may cover part of the event (:func:`align_speed`)."""
     if rec.trigger is not None:
-        return (rec.trigger - float(trigger_at), f"trigger {rec.trigger_name!r}",
-                rec.trigger_error)
+        shift = trigger_shift(rec.trigger, rec.trigger_error, trigger_at, rpm_event,
+                              file=rec.path, key=rec.trigger_name)
+        return shift, f"trigger {rec.trigger_name!r}", rec.trigger_error
     if rec.rpm is None:
         raise InputError("no rpm or tacho channel to line the recording up on; give "
                          "--trigger CHANNEL", file=rec.path, key="rpm")
@@ -180,7 +186,7 @@ def _align_on_speed(rec: Recorded, t_event, rpm_event, partial) -> tuple:
 
 
 def speed_from_recording(manoeuvre: Manoeuvre, recording, *, firing_interval=None,
-                         channel_map=None, trigger=None, pulses_per_rev=1) -> tuple:
+                         **options) -> tuple:
     """``manoeuvre`` driven by the crank speed of a recording (:func:`read_recording`):
     lined up with the manoeuvre by :func:`align` (against the manoeuvre's own speed
     table), its speed as recorded or, given a ``firing_interval`` [rad], its mean over
@@ -190,7 +196,7 @@ def speed_from_recording(manoeuvre: Manoeuvre, recording, *, firing_interval=Non
     (block means on at most :data:`SPEED_ROWS` rows), replaces the speed table; the load
     table stays on the manoeuvre's times. Negative speeds are cut to 0 unless the
     manoeuvre allows a reversal. Returns the manoeuvre and a line saying where its speed
-    came from.
+    came from. ``options``: :func:`read_recording`'s.
 
     Raises
     ------
@@ -198,8 +204,7 @@ def speed_from_recording(manoeuvre: Manoeuvre, recording, *, firing_interval=Non
         No speed in the recording, or a recording that does not cover the manoeuvre after
         alignment (one line naming the file and ``time``).
     """
-    rec = recording_or_file(recording, channel_map=channel_map, trigger=trigger,
-                            pulses_per_rev=pulses_per_rev)
+    rec = recording_or_file(recording, **options)
     if rec.rpm is None:
         raise InputError("no rpm or tacho channel to take the speed from", file=rec.path,
                          key="rpm")
@@ -221,6 +226,7 @@ def speed_from_recording(manoeuvre: Manoeuvre, recording, *, firing_interval=Non
     if firing_interval is not None:
         rpm = mean_speed(rec.time, rpm, firing_interval)
     tt, rr = _speed_rows(rec.time - shift, rpm, duration)
+    _warn_speed(manoeuvre, rec, rr, firing_interval)
     if not manoeuvre.reversal:
         rr = np.maximum(rr, 0.0)
     if not np.all(np.isfinite(rr)) or np.max(np.abs(rr)) > MAX_RPM:
@@ -232,6 +238,30 @@ def speed_from_recording(manoeuvre: Manoeuvre, recording, *, firing_interval=Non
             f"at {shift:.4f} s of the recording (aligned on the {how}, standard error "
             f"{error * 1e3:.2g} ms)")
     return manoeuvre.with_speed(tt, rr * _RPM), note
+
+
+class RecordedSpeedWarning(PowertrainWarning):
+    """A recorded speed driving a manoeuvre that it cannot drive as recorded: unsigned where
+    the crank may turn back, or averaged over firing intervals longer than
+    :data:`AVERAGE_WINDOW_S`."""
+
+
+def _warn_speed(manoeuvre, rec, rpm, firing_interval) -> None:
+    """:class:`RecordedSpeedWarning` where the manoeuvre allows a reversal and the recorded
+    speed is never negative, or where it is averaged below the speed whose firing interval
+    lasts :data:`AVERAGE_WINDOW_S`."""
+    if manoeuvre.reversal and np.min(rec.rpm) >= 0:
+        warnings.warn(RecordedSpeedWarning(
+            f"{rec.path}: the manoeuvre lets the crank turn back, but the recorded speed "
+            f"({rec.speed_source}) is never negative: a crank turning back reads as turning "
+            "forward"), stacklevel=3)
+    slow = firing_interval / AVERAGE_WINDOW_S * 30.0 / np.pi if firing_interval else 0.0
+    if np.min(np.abs(rpm)) < slow:
+        warnings.warn(RecordedSpeedWarning(
+            f"{rec.path}: below {slow:.0f} rpm a firing interval lasts more than "
+            f"{AVERAGE_WINDOW_S * 1e3:g} ms, and its mean (--speed-average) smooths the "
+            "speed's own changes, a start's flare among them; it suits a running engine"),
+            stacklevel=3)
 
 
 def _speed_rows(t, rpm, duration) -> tuple:
@@ -277,8 +307,8 @@ def compared_channels(rec: Recorded, labels) -> tuple:
     return pairs, skipped
 
 
-def compare_transient(result, raw, *, trigger=None, channel_map=None,
-                      pulses_per_rev=1) -> TransientComparison:
+def compare_transient(result, raw, *, trigger=None, channel_map=None, pulses_per_rev=1,
+                      trigger_edge="rising") -> TransientComparison:
     """A simulated manoeuvre against a recorded one.
 
     Parameters
@@ -295,6 +325,8 @@ def compare_transient(result, raw, *, trigger=None, channel_map=None,
     pulses_per_rev : int
         The recording's tacho pulses per revolution (1 by default; a missing-tooth wheel's
         gap is counted), where its speed is a tacho's.
+    trigger_edge : str
+        The edge the trigger marks: ``rising`` (default) or ``falling`` (active low).
 
     Returns
     -------
@@ -308,7 +340,7 @@ def compare_transient(result, raw, *, trigger=None, channel_map=None,
         A bad recording, no channel to compare, or less than half the event covered.
     """
     rec = recording_or_file(raw, channel_map=channel_map, trigger=trigger,
-                            pulses_per_rev=pulses_per_rev)
+                            pulses_per_rev=pulses_per_rev, trigger_edge=trigger_edge)
     pairs, skipped = compared_channels(rec, result.channels)
     shift, how, error = align(rec, result.time, result.rpm, trigger_at=result.trigger_time)
     t0, t1 = float(result.time[0]), float(result.time[-1])
