@@ -131,7 +131,10 @@ def trigger_levels(x, file=None, key="--trigger") -> tuple:
     split = 0.5 * (p1 + p99)
     below, over = x[x < split], x[x >= split]
     if not p99 - p1 > 1e-12 * max(abs(p1), abs(p99), 1.0) or not below.size:
-        raise InputError("the trigger channel is constant (no step)", file=file, key=key)
+        pulse = np.ptp(x) > 1e-12 * max(np.max(np.abs(x)), 1.0)
+        raise InputError("the trigger channel is constant" + (
+            " but for fewer than 1 % of its samples (a pulse or a spike, not a step)"
+            if pulse else " (no step)"), file=file, key=key)
     lo, hi = float(np.median(below)), float(np.median(over))
     noise = np.sqrt(np.mean(np.diff(x, 2) ** 2) / 6.0) if x.size > 2 else 0.0
     if hi - lo < TRIGGER_STEP_NOISE * noise:

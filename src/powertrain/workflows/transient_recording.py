@@ -115,6 +115,10 @@ def read_recording(path, *, channel_map=None, trigger=None, pulses_per_rev=1,
         t, rec.trigger, edge=trigger_edge, file=str(path), key=trigger)
     ignored = [n.strip() for c in rec.comments if c.startswith(IGNORED_NOTE)
                for n in c[len(IGNORED_NOTE):].split(",")]
+    if pulses_per_rev != 1 and rec.rpm is not None:
+        warnings.warn(RecordedSpeedWarning(
+            f"{path}: the speed is the rpm channel's; --pulses-per-rev is not used"),
+            stacklevel=2)
     edges, counts = (tacho_counts(tacho_edges(t, rec.tacho, file=str(path), key="tacho"),
                                   pulses_per_rev, file=str(path), key="tacho")
                      if rec.rpm is None and rec.tacho is not None else (None, None))
@@ -241,9 +245,9 @@ def speed_from_recording(manoeuvre: Manoeuvre, recording, *, firing_interval=Non
 
 
 class RecordedSpeedWarning(PowertrainWarning):
-    """A recorded speed driving a manoeuvre that it cannot drive as recorded: unsigned where
-    the crank may turn back, or averaged over firing intervals longer than
-    :data:`AVERAGE_WINDOW_S`."""
+    """A recorded speed that cannot be read as asked: unsigned where the crank may turn
+    back, averaged over firing intervals longer than :data:`AVERAGE_WINDOW_S`, or an rpm
+    channel's where a tacho's pulses per revolution were given."""
 
 
 def _warn_speed(manoeuvre, rec, rpm, firing_interval) -> None:
