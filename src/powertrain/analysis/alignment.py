@@ -132,21 +132,23 @@ def tacho_rpm(time, tacho, *, pulses_per_rev=1, file=None, key="tacho") -> np.nd
     return np.interp(time, tt, rr)
 
 
-def trigger_shift(trigger, error, trigger_at, rpm_event, *, file=None, key="--trigger"):
-    """The recording's time [s] of the event's time 0 from a trigger at ``trigger`` [s]
-    (standard error ``error`` [s]) that marks the event's time ``trigger_at`` [s]; refused
-    where :data:`ALIGN_SIGMAS` standard errors exceed the time the crank takes to turn
-    :data:`ALIGN_TOLERANCE_DEG` at the event's top speed (``rpm_event`` [rpm]), as a
-    speed's alignment is."""
+def trigger_shift(crossing, trigger_at, rpm_event, *, file=None, key="--trigger"):
+    """The recording's time [s] of the event's time 0 from a trigger's ``crossing``
+    (:class:`~powertrain.analysis.trigger.TriggerCrossing`) that marks the event's time
+    ``trigger_at`` [s]; refused where it is known worse than the time the crank takes to
+    turn :data:`ALIGN_TOLERANCE_DEG` at the event's top speed (``rpm_event`` [rpm]): the
+    root sum of squares of :data:`ALIGN_SIGMAS` times its noise's standard error and half
+    its sampling interval (the worst of a step anywhere in it)."""
     top = max(float(np.max(np.abs(rpm_event))), SPEED_FLOOR_RPM)
     allowed = ALIGN_TOLERANCE_DEG / (6.0 * top)
-    if not ALIGN_SIGMAS * error <= allowed:
-        raise InputError(f"the trigger fixes the event's start to +-"
-                         f"{ALIGN_SIGMAS * error * 1e3:.3g} ms only (its noise over its slope, "
-                         f"or a step between samples {ALIGN_SIGMAS:g} standard errors wide), "
-                         f"more than {allowed * 1e3:.2g} ms = {ALIGN_TOLERANCE_DEG:g} deg of "
-                         f"crank at {top:.0f} rpm", file=file, key=key)
-    return trigger - float(trigger_at)
+    bound = float(np.hypot(ALIGN_SIGMAS * crossing.spread, 0.5 * crossing.sampling))
+    if not bound <= allowed:
+        raise InputError(f"the trigger fixes the event's start to +-{bound * 1e3:.3g} ms "
+                         f"only ({ALIGN_SIGMAS:g} times its noise over its slope and half a "
+                         f"sampling interval of {crossing.sampling * 1e3:.3g} ms), more than "
+                         f"{allowed * 1e3:.3g} ms = {ALIGN_TOLERANCE_DEG:g} deg of crank at "
+                         f"{top:.0f} rpm", file=file, key=key)
+    return crossing.time - float(trigger_at)
 
 
 def coverage(t0, t1, rec0, rec1, shift):

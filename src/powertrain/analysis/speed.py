@@ -174,18 +174,23 @@ def tacho_edges(time, tacho, *, file=None, key="tacho", what="tacho"):
 
 
 def drop_spikes(edge_times) -> tuple:
-    """Edge times [s] without the spikes' (an edge less than :data:`SPIKE_RATIO` of the
-    running median interval after the one before), and notes saying how many."""
+    """Edge times [s] without the spikes' (of an interval shorter than :data:`SPIKE_RATIO`
+    of the running median, the edge whose removal leaves an interval nearer the median),
+    and notes saying how many."""
     t = np.asarray(edge_times, float)
     notes = []
     for _ in range(3):                       # drop spikes, then re-evaluate the median
         d = np.diff(t)
         med = median_filter(d, size=min(9, d.size) | 1, mode="nearest")
-        spike = d < SPIKE_RATIO * med
-        if not spike.any():
+        short = np.flatnonzero(d < SPIKE_RATIO * med)
+        if not short.size:
             break
-        t = np.delete(t, np.flatnonzero(spike) + 1)
-        notes.append(f"{int(spike.sum())} tacho spike(s) dropped")
+        before = np.where(short > 0, d[np.maximum(short - 1, 0)] + d[short], np.inf)
+        after = np.where(short + 1 < d.size, d[short] + d[np.minimum(short + 1, d.size - 1)],
+                         np.inf)
+        first = np.abs(before - med[short]) < np.abs(after - med[short])
+        t = np.delete(t, np.unique(np.where(first, short, short + 1)))
+        notes.append(f"{short.size} tacho spike(s) dropped")
     return t, notes
 
 

@@ -11,45 +11,68 @@ between samples; where three samples or more about it, one after the other, lie 
 which the channel stays above it for :data:`TRIGGER_HOLD_S` (a
 glitch is no trigger); where the channel crossed the level (either way) less than
 :data:`TRIGGER_BOUNCE_S` before, those crossings are one bounce and the trigger is the
-bounce's first rising crossing (a switch's first contact). A channel whose step is under
+bounce's first rising crossing (a switch's first contact). A channel above its level most
+of the time before it rises is read, with a :class:`TriggerWarning`, as it is: an
+active-low trigger's release. A channel whose step is under
 :data:`TRIGGER_STEP_NOISE` times its noise (the second differences' RMS over
 :math:`\sqrt 6`) does not step and is refused.
 
 **Standard error**: :math:`\sqrt{(\sigma/\dot x)^2 + t_r^2/12}`, the noise :math:`\sigma`
 over the slope at the crossing (of the line: its least-squares standard error) and the
 time :math:`t_r` the step may lie anywhere in,
-from the last sample below 10 % of the step to the first above 90 %: where that is one
-sample interval (a step sharper than the sampling) or where the samples lie on one straight
-line over three intervals or more (a channel resampled by linear interpolation from a
-slower one: the reader says so; then the time that line takes over the whole step); else
-(the rise resolved by its samples) 0.
+from the last sample below 10 % of the step to the first above 90 %: a channel held between
+updates (changing at ten samples or more but fewer than half of them, at intervals of more
+than a sample: a bus's), its update interval; a rise over one or two sample intervals, one;
+a straight rise over three or more (a channel resampled by linear interpolation from a
+slower one: the reader says so), the time that line takes over the whole step; else (a rise
+its samples resolve) 0.
 """
 
 from __future__ import annotations
 
+import warnings
+from typing import NamedTuple
+
 import numpy as np
 
-from powertrain.errors import InputError
+from powertrain.errors import InputError, PowertrainWarning
 
 #: A trigger channel steps by at least this many times its noise and stays above its level
 #: this long [s] after its rising crossing.
 TRIGGER_STEP_NOISE = 10.0
 TRIGGER_HOLD_S = 0.002
-#: Crossings less than this apart [s] are one bounce.
-TRIGGER_BOUNCE_S = 0.02
-
-
+#: Crossings less than this apart [s] are one bounce (a switch's).
+TRIGGER_BOUNCE_S = 0.005
+#: A channel changing at fewer than this share of its samples, but at ten or more, is held
+#: between updates (a bus's): its step lies anywhere in an update interval.
+HELD_SHARE = 0.5
 #: The edges a trigger may mark.
 TRIGGER_EDGES = ("rising", "falling")
+
+
+class TriggerWarning(PowertrainWarning):
+    """A trigger whose channel is above its level most of the time before it rises: an
+    active-low trigger read at its release (``--trigger-edge falling`` reads its press)."""
+
+
+class TriggerCrossing(NamedTuple):
+    """A trigger's step: ``time`` [s], its standard error ``error`` [s], from the noise
+    ``spread`` [s] and the ``sampling`` interval [s] the step may lie anywhere in."""
+
+    time: float
+    error: float
+    spread: float
+    sampling: float
 
 
 def trigger_time(time, signal, *, edge="rising", file=None, key="--trigger") -> float:
     """Time [s] of the trigger channel ``signal``'s step (module docstring;
     :func:`trigger_crossing` with its standard error)."""
-    return trigger_crossing(time, signal, edge=edge, file=file, key=key)[0]
+    return trigger_crossing(time, signal, edge=edge, file=file, key=key).time
 
 
-def trigger_crossing(time, signal, *, edge="rising", file=None, key="--trigger") -> tuple:
+def trigger_crossing(time, signal, *, edge="rising", file=None,
+                     key="--trigger") -> TriggerCrossing:
     """Time [s] of the trigger channel's step and its standard error [s] (module docstring).
 
     Parameters
@@ -88,16 +111,27 @@ def trigger_crossing(time, signal, *, edge="rising", file=None, key="--trigger")
                          f"{TRIGGER_HOLD_S * 1e3:g} ms (for its {other} edge give "
                          f"--trigger-edge {other})", file=file, key=key)
     i = _first_contact(time, above, int(up[0]))
-    start, end = _rise(x, lo, hi, i)
+    if np.mean(above[:i + 1]) > 0.5:
+        warnings.warn(TriggerWarning(
+            f"{file or 'the trigger'}: {key} is above its level most of the time before it "
+            "rises: an active-low trigger read at its release? (--trigger-edge falling reads "
+            "its press)"), stacklevel=2)
+    when, spread = _crossing(time, x, mid, 0.25 * (hi - lo), i)
+    sampling = _rise_time(time, x, *_rise(x, lo, hi, i), hi - lo)
+    return TriggerCrossing(when, float(np.hypot(spread, sampling / np.sqrt(12.0))),
+                           float(spread), float(sampling))
+
+
+def _crossing(time, x, level, width, i) -> tuple:
+    """Time [s] the channel crosses ``level`` after sample ``i`` and its standard error
+    [s] from the noise: of the least-squares line through three samples or more about it
+    within ``width`` of the level, else between the two samples."""
     noise = np.sqrt(np.mean(np.diff(x, 2) ** 2) / 6.0) if x.size > 2 else 0.0
-    band = _band(x, mid, 0.25 * (hi - lo), i)
-    if band.size < 3:
-        slope = (x[i + 1] - x[i]) / (time[i + 1] - time[i])
-        when, spread = float(time[i] + (mid - x[i]) / slope), noise / slope
-    else:
-        when, spread = _fitted_crossing(time[band], x[band], mid, noise)
-    rise = _rise_time(time, x, start, end, hi - lo)
-    return when, float(np.hypot(spread, rise / np.sqrt(12.0)))
+    band = _band(x, level, width, i)
+    if band.size >= 3:
+        return _fitted_crossing(time[band], x[band], level, noise)
+    slope = (x[i + 1] - x[i]) / (time[i + 1] - time[i])
+    return float(time[i] + (level - x[i]) / slope), noise / slope
 
 
 def _band(x, level, width, i) -> np.ndarray:
@@ -165,12 +199,17 @@ def _rise(x, lo, hi, i) -> tuple:
 
 
 def _rise_time(time, x, start, end, step) -> float:
-    """The time [s] the step may lie anywhere in (module docstring): an unresolved step's
-    sample interval, a straight rise over three intervals or more (the time that line
-    takes over the whole step), else 0."""
+    """The time [s] the step may lie anywhere in (module docstring): a channel held between
+    updates, its update interval; a step over at most two sample intervals, one; a straight
+    rise over three intervals or more, the time that line takes over the whole step; else
+    0."""
     span = float(time[end] - time[start])
-    if end - start == 1:
-        return span
+    changes = np.flatnonzero(np.diff(x) != 0)
+    update = float(np.median(np.diff(time[changes]))) if changes.size > 1 else 0.0
+    if 10 <= changes.size < HELD_SHARE * (x.size - 1) and update > 1.5 * (time[1] - time[0]):
+        return max(update, span / (end - start))
+    if end - start <= 2:
+        return span / (end - start)
     straight = end - start >= 3 and np.max(np.abs(np.diff(x[start:end + 1], 2))) <= \
         1e-6 * step
     return step / (x[end] - x[start]) * span if straight else 0.0      # the whole step's

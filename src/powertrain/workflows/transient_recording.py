@@ -28,7 +28,7 @@ from powertrain.analysis.alignment import (
     unheld_speed,
 )
 from powertrain.analysis.speed import checked_pulses_per_rev, mean_speed, tacho_edges
-from powertrain.analysis.trigger import trigger_crossing
+from powertrain.analysis.trigger import TriggerCrossing, trigger_crossing
 from powertrain.errors import InputError, PowertrainWarning
 from powertrain.iotools.raw import IGNORED_NOTE, read_raw
 from powertrain.models.manoeuvre import MAX_RPM, Manoeuvre
@@ -37,7 +37,7 @@ from powertrain.results.transient import TransientComparison
 #: Most rows of a speed table taken from a recording (block means of its samples).
 SPEED_ROWS = 2000
 #: Longest firing interval [s] whose mean speed (--speed-average) passes without a warning.
-AVERAGE_WINDOW_S = 0.05
+AVERAGE_WINDOW_S = 0.1
 #: Option that gives a recording's channel map, named in error messages.
 MAP_OPTION = "--channel-map"
 _RPM = np.pi / 30.0
@@ -67,6 +67,8 @@ class Recorded:
         where the speed is an rpm channel's).
     trigger_error : float
         Standard error of ``trigger`` [s].
+    trigger_crossing : TriggerCrossing or None
+        How ``trigger`` was found (:func:`~powertrain.analysis.trigger.trigger_crossing`).
     counts : ndarray or None
         The tacho's pulses counted at each of ``edges`` (a missing-tooth wheel's gap
         counted).
@@ -90,6 +92,7 @@ class Recorded:
     counts: np.ndarray | None = None
     pulses_per_rev: int = 1
     unused_trigger: bool = False
+    trigger_crossing: TriggerCrossing | None = None
 
 
 def read_recording(path, *, channel_map=None, trigger=None, pulses_per_rev=1,
@@ -111,8 +114,9 @@ def read_recording(path, *, channel_map=None, trigger=None, pulses_per_rev=1,
     pulses_per_rev = checked_pulses_per_rev(pulses_per_rev)
     rec = read_raw(path, channel_map, trigger=trigger, map_option=MAP_OPTION)
     t = rec.time - rec.time[0]
-    when = (None, 0.0) if trigger is None else trigger_crossing(
+    crossing = None if trigger is None else trigger_crossing(
         t, rec.trigger, edge=trigger_edge, file=str(path), key=trigger)
+    when = (None, 0.0) if crossing is None else crossing[:2]
     ignored = [n.strip() for c in rec.comments if c.startswith(IGNORED_NOTE)
                for n in c[len(IGNORED_NOTE):].split(",")]
     if pulses_per_rev != 1 and rec.rpm is not None:
@@ -124,7 +128,7 @@ def read_recording(path, *, channel_map=None, trigger=None, pulses_per_rev=1,
                      if rec.rpm is None and rec.tacho is not None else (None, None))
     return Recorded(str(path), t, recorded_rpm(rec, path, pulses_per_rev), _speed_source(rec),
                     when[0], trigger, list(rec.channels), ignored, edges, when[1], counts,
-                    pulses_per_rev, trigger is None and rec.trigger is not None)
+                    pulses_per_rev, trigger is None and rec.trigger is not None, crossing)
 
 
 def recording_or_file(recording, **options) -> Recorded:
@@ -160,8 +164,10 @@ def align(rec: Recorded, t_event, rpm_event, *, partial=True, trigger_at=0.0) ->
     event's speed ``rpm_event`` [rpm] at ``t_event`` [s] (module docstring); ``partial``:
     the recording may cover part of the event (:func:`align_speed`)."""
     if rec.trigger is not None:
-        shift = trigger_shift(rec.trigger, rec.trigger_error, trigger_at, rpm_event,
-                              file=rec.path, key=rec.trigger_name)
+        crossing = rec.trigger_crossing or TriggerCrossing(
+            rec.trigger, rec.trigger_error, rec.trigger_error, 0.0)
+        shift = trigger_shift(crossing, trigger_at, rpm_event, file=rec.path,
+                              key=rec.trigger_name)
         return shift, f"trigger {rec.trigger_name!r}", rec.trigger_error
     if rec.rpm is None:
         raise InputError("no rpm or tacho channel to line the recording up on; give "
@@ -385,6 +391,13 @@ def check_recordings(manoeuvre: Manoeuvre, labels, *, firing_interval=None, comp
         As :func:`compared_channels`, :func:`speed_from_recording` and
         :func:`compare_transient` would after the run.
     """
+    with warnings.catch_warnings():          # the run and the comparison warn once
+        warnings.simplefilter("ignore", PowertrainWarning)
+        _check(manoeuvre, labels, firing_interval, compare, speed)
+
+
+def _check(manoeuvre, labels, firing_interval, compare, speed) -> None:
+    """:func:`check_recordings`' checks."""
     if speed is not None:
         manoeuvre, _ = speed_from_recording(manoeuvre, speed,
                                             firing_interval=firing_interval)
