@@ -75,9 +75,9 @@ PHASE_FLOOR_REV = 1e-4
 MISMATCH_REV = 0.05
 #: Longest correlation of a speed residual [s] and of a tacho's phase residual [rev]
 #: the shift's standard error takes in (:func:`_correlated_error`: two periods of the 2nd
-#: order at 250 rpm; two revolutions).
+#: order at 250 rpm; eight revolutions: the slow drift of a sampled tacho's edges).
 CORRELATION_S = 0.25
-CORRELATION_REV = 2.0
+CORRELATION_REV = 8.0
 #: Times at which an event's speed table is read for its angle and slope, and the most
 #: recorded samples a speed alignment's cost reads.
 FINE = 20001
@@ -412,7 +412,7 @@ def _correlated_error(design, residual, floor, lags) -> float:
     edges jittering by a time, not an angle): Newey and West's (1987)
     :math:`\sqrt{\sum_{|k|\le L} w_k \sum_i u_i u_{i+k}} / \sum_i d_i^2`,
     :math:`u_i = d_i r_i`, Bartlett weights :math:`w_k = 1 - |k|/(L+1)` over ``lags``
-    :math:`L` (at most a tenth of the points); at least ``floor`` over
+    :math:`L` (at most a fifth of the points); at least ``floor`` over
     :math:`\sqrt{\sum d_i^2}` (white scatter of that size)."""
     d, r = np.asarray(design, float), np.asarray(residual, float)
     info = float(d @ d)
@@ -420,7 +420,7 @@ def _correlated_error(design, residual, floor, lags) -> float:
         return np.inf
     u = d * r
     m = 1 << int(np.ceil(np.log2(2 * u.size)))             # zero-padded: no wrap-around
-    lags = int(min(max(lags, 0), u.size // 10))
+    lags = int(min(max(lags, 0), u.size // 5))
     cov = np.fft.irfft(np.abs(np.fft.rfft(u, m)) ** 2, m)[:lags + 1]
     weight = 2.0 * (1.0 - np.arange(lags + 1) / (lags + 1.0))
     weight[0] = 1.0
