@@ -547,3 +547,15 @@ def test_the_firing_interval_is_the_gas_torques_period(default_engine, angles, i
     crank = dataclasses.replace(default_engine.crank, firing_angles=np.radians(angles),
                                 cylinder_x=np.zeros(len(angles)))
     assert np.degrees(crank.firing_interval) == pytest.approx(interval)
+
+
+@pytest.mark.parametrize("suffix, kind", [(".csv", "csv"), (".mf4", "mdf"), (".uff", "uff")])
+def test_raw_output_is_written_in_the_format_of_its_suffix(suffix, kind, tmp_path):
+    """Review 4: --raw x.csv wrote HDF5; now the suffix chooses the writer, and the file
+    reads back through --compare with its trigger."""
+    from powertrain.iotools.raw import detect_format
+    path = tmp_path / f"bo{suffix}"
+    assert _cli(EXAMPLES / "back-out.toml", "--raw", path, "--quiet").exit_code == 0
+    assert detect_format(path) == kind
+    res = _cli(EXAMPLES / "back-out.toml", "--compare", path, "--trigger", "trigger")
+    assert res.exit_code == 0 and "aligned on the trigger 'trigger'" in res.output

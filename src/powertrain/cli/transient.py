@@ -20,7 +20,7 @@ from powertrain.cli.group import main
 from powertrain.errors import InputError
 from powertrain.iotools.engine_file import engine_or_default
 from powertrain.iotools.manoeuvre_file import read_manoeuvre
-from powertrain.iotools.raw_hdf5 import write_raw_hdf5
+from powertrain.iotools.raw import write_raw
 from powertrain.workflows import transient as workflow
 from powertrain.workflows import transient_recording as recording
 
@@ -54,8 +54,9 @@ from powertrain.workflows import transient_recording as recording
 @click.option("--plot", type=click.Path(dir_okay=False),
               help="Speed and torque above the channels' accelerations (PNG).")
 @click.option("--raw", "raw_out", type=click.Path(dir_okay=False),
-              help="Write every channel's acceleration and the crank speed as raw time data "
-                   "(raw HDF5 layout, labelled SYNTHETIC), e.g. to try --compare.")
+              help="Write every channel's acceleration, the crank speed and the trigger as "
+                   "raw time data, labelled SYNTHETIC, in the format of the suffix (.csv, "
+                   ".uff, .mf4, else raw HDF5), e.g. to try --compare.")
 @click.option("--compare", "raw_file", type=click.Path(dir_okay=False),
               help="A recording of the manoeuvre (raw CSV, HDF5, UFF, MDF4): lined up on its "
                    "crank speed (or --trigger), every acceleration channel of the model "
@@ -169,8 +170,7 @@ def _write(result, comparison, files, prov, channels, quantity) -> list:
                "json": lambda p: write_json(p, json.dumps(doc), prov.to_dict()),
                "plot": lambda p: write_plot(lambda q: result.plot(
                    path=q, channels=channels, quantity=quantity, provenance=prov), p),
-               "raw": lambda p: write_raw_hdf5(p, result.recording(), synthetic=True,
-                                               description=result.recording().comments[0]),
+               "raw": lambda p: write_raw(p, result.recording()),
                "compare_plot": lambda p: write_plot(lambda q: comparison.plot(
                    path=q, provenance=prov), p)}
     written = []
