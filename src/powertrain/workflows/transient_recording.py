@@ -28,7 +28,7 @@ from powertrain.analysis.alignment import (
     unheld_speed,
 )
 from powertrain.analysis.speed import checked_pulses_per_rev, mean_speed, tacho_edges
-from powertrain.analysis.trigger import TriggerCrossing, trigger_crossing
+from powertrain.analysis.trigger import TRIGGER_EDGES, TriggerCrossing, trigger_crossing
 from powertrain.errors import InputError, PowertrainWarning
 from powertrain.iotools.raw import IGNORED_NOTE, read_raw
 from powertrain.models.manoeuvre import MAX_RPM, Manoeuvre
@@ -112,6 +112,9 @@ def read_recording(path, *, channel_map=None, trigger=None, pulses_per_rev=1,
         raise InputError("expected the name of a channel of the recording",
                          key="--trigger")
     pulses_per_rev = checked_pulses_per_rev(pulses_per_rev)
+    if trigger_edge not in TRIGGER_EDGES:
+        raise InputError(f"expected one of {', '.join(TRIGGER_EDGES)}, got {trigger_edge!r}",
+                         key="--trigger-edge")
     rec = read_raw(path, channel_map, trigger=trigger, map_option=MAP_OPTION)
     t = rec.time - rec.time[0]
     crossing = None if trigger is None else trigger_crossing(
