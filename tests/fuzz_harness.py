@@ -2121,10 +2121,10 @@ def issue_38_cases() -> dict:
     cases["whatif --manoeuvre --set right.y.d1=1e12 (N*s/mm: singular at some frequency)"] = \
         Case({**mf, "m.toml": _SEEDS["m/stop.toml"]}, [*whatif, "--set", "right.y.d1=1e12"],
              ["w.json"], "--set", "")
-    for ext in ("h5", "csv"):
-        cases[f"--speed-from a tacho with a pulse split in two ({ext}): 9478 rpm"] = Case(
+    for ext in ("h5", "csv"):          # found as a tacho's pulse split in two: 9478 rpm
+        cases[f"--speed-from a recorded speed of 7500 rpm, above the engine ({ext})"] = Case(
             {"m.toml": _SEEDS["m/tip-in.toml"],
-             f"rec.{ext}": _recording_with("tip-in", ext, "tacho", "missing")},
+             f"rec.{ext}": _recording_with("tip-in", ext, "huge_rpm", 5.0)},
             ["transient", "m.toml", "--quiet", "--json", "j.json", "--speed-from", f"rec.{ext}",
              "--trigger", "trigger", "--speed-average"], ["j.json"], f"rec.{ext}", "")
     rest = toml_loads(_SEEDS["m/tip-in.toml"])

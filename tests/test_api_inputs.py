@@ -168,6 +168,11 @@ CASES = {
     "transient angle step range": (lambda e: pt.transient(START, e, angle_step_deg=50), True),
     "transient seat": (lambda e: pt.transient(START, e, seat="seat_rail"), True),
     "transient seat type": (lambda e: pt.transient(START, e, seat=3), True),
+    "transient trigger edge alone": (lambda e: pt.transient(START, e, trigger_edge="up"), True),
+    "transient pulses alone": (lambda e: pt.transient(START, e, pulses_per_rev=60), True),
+    "transient pulses": (lambda e: pt.transient(START, e, speed_from=MISSING, pulses_per_rev=0),
+                         True),
+    "transient average type": (lambda e: pt.transient(START, e, speed_average="yes"), True),
     "read_manoeuvre missing": (lambda e: pt.read_manoeuvre(MISSING), True),
     "read_manoeuvre engine file": (lambda e: pt.read_manoeuvre(ENGINES / "default.toml"), True),
 }

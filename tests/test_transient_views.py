@@ -94,7 +94,7 @@ def test_the_overlay_fits_a_page_and_heads_each_panel_with_its_errors(n_channels
     assert len(shown) == min(n_channels, 15) and fig.axes[0].get_gridspec().get_geometry() \
         == grid
     e = comp.errors()
-    worst = sorted(np.argsort(-e["rms_difference"])[:15])      # the 15 worst, file order
+    worst = sorted(np.argsort(-e["rms_difference_percent"], kind="stable")[:15])
     for j, a in zip(worst, shown):
         title = a.get_title()
         assert title.startswith(f"{names[j]}: peak +{e['peak_error_percent'][j]:.1f} %")
@@ -201,3 +201,12 @@ def test_what_plot_accepts():
     assert r.plot(left, channels=["left.z"]) is left and len(left.axes) == 3   # + twin
     assert _ranking().plot(right, view="delta") is right
     plt.close(fig)
+
+
+def test_the_overlay_draws_the_seat_first_then_the_largest_relative_difference():
+    """Review 3: the seat's axes are drawn whatever their error (a modal body's 21 channels
+    left the seat rail out), then the channels of the largest RMS of the difference
+    relative to the measured RMS (a channel of noise only, with no relative error, last)."""
+    from powertrain.plotting.transient import overlay_channels
+    names = ["a.x", "seat_rail.z", "b.x", "c.x", "d.x"]
+    assert overlay_channels(names, [50.0, 1.0, np.nan, 80.0, 10.0], 3) == [0, 1, 3]

@@ -1,9 +1,12 @@
-r"""A recorded manoeuvre lined up with a simulated one: the crank speed of a
-once-per-revolution tacho through standstill, a trigger channel's time, the time shift that
-best matches two speed profiles and whether that shift is determined at all.
+r"""A recorded manoeuvre lined up with a simulated one: the crank speed of a tacho through
+standstill, the time shift that best matches two speed profiles or a tacho's pulses, and
+whether that shift is determined at all (a trigger channel's time:
+:mod:`powertrain.analysis.trigger`).
 
 **Tacho speed** (:func:`tacho_rpm`): each interval between rising edges gives its mean speed
-:math:`60/\Delta t` [rpm], placed at the interval's midpoint, linear between midpoints.
+:math:`60\,\Delta c/(N\Delta t)` [rpm], :math:`\Delta c` the pulses it spans (1, or a
+missing-tooth wheel's gap counted, :func:`tacho_counts`) of :math:`N` per revolution,
+placed at the interval's midpoint, linear between midpoints.
 Before the first edge :math:`e_0`, with :math:`d_1` the first interval: where the recording
 starts more than :math:`d_1` before :math:`e_0`, the crank cannot have turned at the first
 interval's speed over that time (it would have passed the pulse once more inside the
@@ -13,11 +16,6 @@ to the first interval's speed at its midpoint; otherwise it was already turning 
 first interval's speed is held back to the first sample. After the last edge likewise: the
 speed falls linearly to 0 at one last interval after it where the record goes on longer
 than that, else the last interval's speed is held.
-
-**Trigger** (:func:`trigger_time`): event time 0 is the first rising crossing (linear
-between samples) of the mid level between the channel's smallest and largest values after
-which the channel stays above it for :data:`TRIGGER_HOLD_S`; a channel whose range is under
-:data:`TRIGGER_STEP_NOISE` times its noise does not step and is refused.
 
 **Alignment on the speed** (:func:`align_speed`): the shift :math:`s` minimising the mean of
 :math:`(n_\mathrm{rec}(t) - n_\mathrm{sim}(t - s))^2` over the recorded samples inside the
@@ -38,18 +36,20 @@ where the cost first rises by :math:`\sigma^2` on either side) whose cost is wit
 :math:`\sigma^2` of the best (a recording of two starts).
 
 **Alignment on a tacho's pulses** (:func:`align_tacho`): the event's crank angle at the
-rising edges less one revolution per edge is constant at the true shift (the pulse's phase
-unknown): the shift minimising its variance, among the shifts where the edges inside the
+rising edges less :math:`1/N` revolution per pulse counted is constant at the true shift
+(the pulses' phase unknown): the shift minimising its variance, among the shifts where the edges inside the
 event are as many as the revolutions it turns there (within one); its standard error the
 phase's scatter over :math:`\sqrt{\sum \dot\theta^2}` at the edges; refused as above.
 """
 
 from __future__ import annotations
 
+import warnings
+
 import numpy as np
 
-from powertrain.analysis.speed import tacho_edges
-from powertrain.errors import InputError
+from powertrain.analysis.speed import count_teeth, drop_spikes, tacho_edges
+from powertrain.errors import InputError, PowertrainWarning
 
 #: Times of the event at which the speeds are matched.
 GRID = 400
@@ -60,10 +60,6 @@ SPEED_FLOOR_RPM = 1.0
 #: speed (2 deg: 4 deg of phase on the 2nd order, about 7 % RMS of an identical waveform).
 ALIGN_SIGMAS = 3.0
 ALIGN_TOLERANCE_DEG = 2.0
-#: A trigger channel steps by at least this many times its noise (second differences' RMS
-#: over sqrt 6) and stays above its mid level this long [s] after its rising crossing.
-TRIGGER_STEP_NOISE = 10.0
-TRIGGER_HOLD_S = 0.002
 #: Least part of the event a recording must cover after alignment.
 MIN_COVERAGE = 0.5
 #: A speed channel whose samples change at fewer than this share of them is held between
@@ -77,16 +73,42 @@ MISMATCH_SHARE = 0.1
 MIN_EDGES = 4
 PHASE_FLOOR_REV = 1e-4
 MISMATCH_REV = 0.05
+#: Longest correlation of a speed residual [s] and of a tacho's phase residual [rev]
+#: the shift's standard error takes in (:func:`_correlated_error`: two periods of the 2nd
+#: order at 250 rpm; eight revolutions: the slow drift of a sampled tacho's edges).
+CORRELATION_S = 0.25
+CORRELATION_REV = 8.0
 #: Times at which an event's speed table is read for its angle and slope, and the most
 #: recorded samples a speed alignment's cost reads.
 FINE = 20001
 COST_SAMPLES = 20000
 
 
-def tacho_rpm(time, tacho, *, file=None, key="tacho") -> np.ndarray:
-    """Crank speed [rpm] at every sample from a once-per-revolution tacho (module
-    docstring: interval means at their midpoints, standstill before the first and after
-    the last edge where the record is long enough to show it).
+class AlignmentWarning(PowertrainWarning):
+    """A recording lined up on its crank speed or tacho whose shift is uncertain by more
+    than :data:`ALIGN_TOLERANCE_DEG` (:data:`ALIGN_SIGMAS` standard errors) because the
+    recorded speed differs from the event's (a correlated residual: another profile, a
+    fluctuation at the firing orders), not because it varies too little."""
+
+
+def tacho_counts(edges, pulses_per_rev=1, *, file=None, key="tacho") -> tuple:
+    """``(edges, counts)``: a tacho's rising edges [s], spikes dropped, and the pulses
+    counted at each from the first: one per edge with one pulse per revolution (a start's
+    intervals change too fast to tell a gap), else
+    :func:`~powertrain.analysis.speed.count_teeth`'s (a missing-tooth wheel's gap
+    counted)."""
+    edges = np.asarray(edges, float)
+    if pulses_per_rev == 1:
+        edges = drop_spikes(edges)[0]
+        return edges, np.arange(edges.size, dtype=float)
+    edges, counts, _ = count_teeth(edges, file=file, key=key)
+    return edges, counts
+
+
+def tacho_rpm(time, tacho, *, pulses_per_rev=1, file=None, key="tacho") -> np.ndarray:
+    """Crank speed [rpm] at every sample from a tacho of ``pulses_per_rev`` pulses per
+    revolution (module docstring: interval means at their midpoints, standstill before the
+    first and after the last edge where the record is long enough to show it).
 
     Parameters
     ----------
@@ -94,13 +116,15 @@ def tacho_rpm(time, tacho, *, file=None, key="tacho") -> np.ndarray:
         [s]
     tacho : ndarray (n,)
         Pulse train [V].
+    pulses_per_rev : int
     file, key : str, optional
         Named in error messages.
     """
     time = np.asarray(time, float)
-    edges = tacho_edges(time, tacho, file=file, key=key)
+    edges, counts = tacho_counts(tacho_edges(time, tacho, file=file, key=key),
+                                 pulses_per_rev, file=file, key=key)
     d = np.diff(edges)
-    tt, rr = 0.5 * (edges[1:] + edges[:-1]), 60.0 / d
+    tt, rr = 0.5 * (edges[1:] + edges[:-1]), 60.0 * np.diff(counts) / (pulses_per_rev * d)
     if edges[0] - time[0] > d[0]:
         tt, rr = np.r_[edges[0] - d[0], tt], np.r_[0.0, rr]
     if time[-1] - edges[-1] > d[-1]:
@@ -108,41 +132,23 @@ def tacho_rpm(time, tacho, *, file=None, key="tacho") -> np.ndarray:
     return np.interp(time, tt, rr)
 
 
-def trigger_time(time, signal, *, file=None, key="--trigger") -> float:
-    """Time [s] of the first rising crossing of the mid level between the smallest and the
-    largest value of ``signal`` (linear between samples) after which it stays above for
-    :data:`TRIGGER_HOLD_S` (a glitch is no trigger); refused where its range is under
-    :data:`TRIGGER_STEP_NOISE` times its noise (no step).
-
-    Parameters
-    ----------
-    time : ndarray (n,)
-        [s]
-    signal : ndarray (n,)
-        Trigger channel [V or any unit].
-    file, key : str, optional
-        Named in error messages.
-    """
-    time = np.asarray(time, float)
-    x = np.asarray(signal, float)
-    lo, hi = float(np.min(x)), float(np.max(x))
-    if not hi - lo > 1e-12 * max(abs(hi), abs(lo), 1.0):
-        raise InputError("the trigger channel is constant (no rising crossing)",
-                         file=file, key=key)
-    noise = np.sqrt(np.mean(np.diff(x, 2) ** 2) / 6.0) if x.size > 2 else 0.0
-    if hi - lo < TRIGGER_STEP_NOISE * noise:
-        raise InputError(f"the trigger channel does not step (its range {hi - lo:.3g} is "
-                         f"less than {TRIGGER_STEP_NOISE:g} times its noise {noise:.3g})",
-                         file=file, key=key)
-    mid = 0.5 * (lo + hi)
-    hold = max(1, int(np.ceil(TRIGGER_HOLD_S / np.median(np.diff(time)))))
-    up = np.flatnonzero((x[:-1] < mid) & (x[1:] >= mid))
-    up = [i for i in up if np.all(x[i + 1:i + 1 + hold] >= mid)]
-    if not up:
-        raise InputError(f"the trigger channel never rises through its mid level ({mid:g}) "
-                         f"to stay there {TRIGGER_HOLD_S * 1e3:g} ms", file=file, key=key)
-    i = int(up[0])
-    return float(time[i] + (mid - x[i]) / (x[i + 1] - x[i]) * (time[i + 1] - time[i]))
+def trigger_shift(crossing, trigger_at, rpm_event, *, file=None, key="--trigger"):
+    """The recording's time [s] of the event's time 0 from a trigger's ``crossing``
+    (:class:`~powertrain.analysis.trigger.TriggerCrossing`) that marks the event's time
+    ``trigger_at`` [s]; refused where it is known worse than the time the crank takes to
+    turn :data:`ALIGN_TOLERANCE_DEG` at the event's top speed (``rpm_event`` [rpm]): the
+    root sum of squares of :data:`ALIGN_SIGMAS` times its noise's standard error and half
+    its sampling interval (the worst of a step anywhere in it)."""
+    top = max(float(np.max(np.abs(rpm_event))), SPEED_FLOOR_RPM)
+    allowed = ALIGN_TOLERANCE_DEG / (6.0 * top)
+    bound = float(np.hypot(ALIGN_SIGMAS * crossing.spread, 0.5 * crossing.sampling))
+    if not bound <= allowed:
+        raise InputError(f"the trigger fixes the event's start to +-{bound * 1e3:.3g} ms "
+                         f"only ({ALIGN_SIGMAS:g} times its noise over its slope and half a "
+                         f"sampling interval of {crossing.sampling * 1e3:.3g} ms), more than "
+                         f"{allowed * 1e3:.3g} ms = {ALIGN_TOLERANCE_DEG:g} deg of crank at "
+                         f"{top:.0f} rpm", file=file, key=key)
+    return crossing.time - float(trigger_at)
 
 
 def coverage(t0, t1, rec0, rec1, shift):
@@ -193,26 +199,29 @@ def align_speed(t_sim, rpm_sim, t_rec, rpm_rec, *, file=None, key="rpm",
                          f"(the event starting at {shift:.4f} s or at {shifts[other]:.4f} s); "
                          "give --trigger CHANNEL", file=file, key=key)
     _check_match(float(np.sqrt(costs(np.array([shift]))[0])), sigma, target, file, key)
-    error = _shift_error(t_sim, rpm_sim, t_rec, shift, sigma)
+    white, error = _shift_error(t, target, t_rec, rpm_rec, shift, sigma)
     top = max(float(np.max(np.abs(target))), SPEED_FLOOR_RPM)
     allowed = ALIGN_TOLERANCE_DEG / (6.0 * top)
-    if not ALIGN_SIGMAS * error <= allowed:
+    if not ALIGN_SIGMAS * white <= allowed:
         raise InputError(
             f"the crank speed varies too little over the event to line the recording up on "
-            f"it (shift uncertain by +-{ALIGN_SIGMAS * error * 1e3:.3g} ms, more than "
+            f"it (shift uncertain by +-{ALIGN_SIGMAS * white * 1e3:.3g} ms, more than "
             f"{allowed * 1e3:.2g} ms = {ALIGN_TOLERANCE_DEG:g} deg of crank at {top:.0f} "
             "rpm); give --trigger CHANNEL", file=file, key=key)
+    _warn_uncertain(error, allowed, "crank speed", file)
     return shift, error
 
 
-def align_tacho(t_sim, rpm_sim, span, edges, *, file=None, key="tacho",
-                partial=True) -> tuple:
+def align_tacho(t_sim, rpm_sim, span, edges, *, counts=None, pulses_per_rev=1, file=None,
+                key="tacho", partial=True) -> tuple:
     """Time shift [s] of the recording against the event and its standard error [s] from a
-    once-per-revolution tacho's rising ``edges`` [s], the recording lasting ``span = (first,
-    last)`` [s]: the shift at which the event's crank angle at the edges, less one
-    revolution per edge, is most nearly constant (least squares, the pulse's phase
-    eliminated), among the shifts where the edges inside the event are as many as the
-    revolutions it turns there (module docstring); ``partial`` as :func:`align_speed`'s.
+    tacho's rising ``edges`` [s] with ``counts`` pulses counted at each (default one per
+    edge; :func:`tacho_counts`) of ``pulses_per_rev`` per revolution, the recording lasting
+    ``span = (first, last)`` [s]: the shift at which the event's crank angle at the edges,
+    less 1/``pulses_per_rev`` revolution per pulse counted, is most nearly constant (least
+    squares, the pulses' phase eliminated), among the shifts where the pulses inside the
+    event span as many revolutions as it turns there (module docstring); ``partial`` as
+    :func:`align_speed`'s.
 
     Raises
     ------
@@ -222,64 +231,116 @@ def align_tacho(t_sim, rpm_sim, span, edges, *, file=None, key="tacho",
     """
     t_sim, rpm_sim = _fine(t_sim, rpm_sim)
     edges = np.asarray(edges, float)
+    revs = (np.arange(edges.size, dtype=float) if counts is None
+            else np.asarray(counts, float)) / pulses_per_rev
     speed = np.abs(rpm_sim) / 60.0                                        # [rev/s]
     rev = np.r_[0.0, np.cumsum(0.5 * (speed[1:] + speed[:-1]) * np.diff(t_sim))]
     event = t_sim[-1] - t_sim[0]
     shifts, coarse, shift = _search(
-        lambda ss: np.array([_phase_cost(s, t_sim, rev, edges, span) for s in ss]),
+        lambda ss: np.array([_phase_cost(s, t_sim, rev, edges, revs, span) for s in ss]),
         _shift_range(t_sim, span, partial), event)
     if not np.isfinite(coarse).any():
         raise InputError(f"the tacho's pulses match the event's revolutions at no shift (at "
-                         f"least {MIN_EDGES} pulses in the event, one per revolution); give "
+                         f"least {MIN_EDGES} pulses in the event, {pulses_per_rev} per "
+                         "revolution); give --pulses-per-rev N for a wheel of N teeth, or "
                          "--trigger CHANNEL", file=file, key=key)
     best = int(np.argmin(coarse))
-    sigma = max(float(np.sqrt(_phase_cost(shift, t_sim, rev, edges, span))), PHASE_FLOOR_REV)
+    sigma = max(float(np.sqrt(_phase_cost(shift, t_sim, rev, edges, revs, span))),
+                PHASE_FLOOR_REV)
     if sigma > MISMATCH_REV:
         raise InputError(f"the tacho's pulses do not follow the event's crank angle at any "
-                         f"shift ({sigma:.2g} rev RMS at the best; a once-per-revolution "
-                         "tacho is expected); give --trigger CHANNEL", file=file, key=key)
+                         f"shift ({sigma:.2g} rev RMS at the best, read as {pulses_per_rev} "
+                         "per revolution); give --pulses-per-rev N for a wheel of N teeth, "
+                         "or --trigger CHANNEL", file=file, key=key)
     other = _second_match(coarse, best, sigma ** 2)
     if other is not None:
         raise InputError(f"the tacho's pulses match the event at two places of the recording "
                          f"(the event starting at {shift:.4f} s or at {shifts[other]:.4f} s); "
                          "give --trigger CHANNEL", file=file, key=key)
-    at = edges - shift
-    rate = np.interp(at[(at >= t_sim[0]) & (at <= t_sim[-1])], t_sim, speed)
-    error = sigma / np.sqrt(float(np.sum(rate ** 2)))
+    white, error = _phase_error(shift, t_sim, rev, speed, edges, revs, span, sigma)
     allowed = ALIGN_TOLERANCE_DEG / (360.0 * max(float(np.max(speed)), 1e-9))
-    if not ALIGN_SIGMAS * error <= allowed:
+    if not ALIGN_SIGMAS * white <= allowed:
         raise InputError(f"the tacho's pulses fix the event's start to +-"
-                         f"{ALIGN_SIGMAS * error * 1e3:.3g} ms only, more than "
+                         f"{ALIGN_SIGMAS * white * 1e3:.3g} ms only, more than "
                          f"{allowed * 1e3:.2g} ms = {ALIGN_TOLERANCE_DEG:g} deg of crank; give "
                          "--trigger CHANNEL", file=file, key=key)
+    _warn_uncertain(error, allowed, "tacho's pulses", file)
     return shift, error
 
 
-def _phase_cost(shift, t_sim, rev, edges, span) -> float:
-    """Variance [rev²] of the event's crank angle at the edges inside it less their count
-    (inf where fewer than :data:`MIN_EDGES`, or where the edges are not as many as the
-    revolutions the event turns over the recorded part, within one)."""
+def _warn_uncertain(error, allowed, what, file) -> None:
+    """:class:`AlignmentWarning` where :data:`ALIGN_SIGMAS` standard errors ``error`` [s]
+    exceed ``allowed`` [s]."""
+    if ALIGN_SIGMAS * error > allowed:
+        warnings.warn(AlignmentWarning(
+            f"{file or 'the recording'}: lined up on the {what}, but the recorded speed "
+            f"differs from the event's: the shift is uncertain by "
+            f"+-{ALIGN_SIGMAS * error * 1e3:.3g} ms, more "
+            f"than {allowed * 1e3:.2g} ms = {ALIGN_TOLERANCE_DEG:g} deg of crank; a trigger "
+            "channel (--trigger) lines it up better"), stacklevel=3)
+
+
+def _phase_error(shift, t_sim, rev, speed, edges, revs, span, sigma) -> tuple:
+    """Standard errors [s] of the tacho's shift, least squares on the shift with the
+    pulses' phase eliminated (the speed at the edges less its mean): ``(white, error)``,
+    the first from the phase's white scatter ``sigma`` [rev], the second from the phase
+    residual correlated as it is over the edges (:func:`_correlated_error`), at least the
+    first."""
     first, last = max(t_sim[0], span[0] - shift), min(t_sim[-1], span[1] - shift)
     at = edges - shift
-    at = at[(at >= first) & (at <= last)]
+    inside = (at >= first) & (at <= last)
+    phase = np.interp(at[inside], t_sim, rev) - revs[inside]
+    rate = np.interp(at[inside], t_sim, speed)
+    lags = round(CORRELATION_REV * np.median(np.diff(revs)) ** -1)
+    design = rate - np.mean(rate)
+    white = _correlated_error(design, np.zeros_like(design), sigma, 0)
+    return white, max(white, _correlated_error(design, phase - np.mean(phase),
+                                               PHASE_FLOOR_REV, lags))
+
+
+def _phase_cost(shift, t_sim, rev, edges, revs, span) -> float:
+    """Variance [rev²] of the event's crank angle at the edges inside it less their
+    revolutions counted ``revs`` (inf where fewer than :data:`MIN_EDGES`, or where the edges
+    span other revolutions than the event turns over the recorded part, within one)."""
+    first, last = max(t_sim[0], span[0] - shift), min(t_sim[-1], span[1] - shift)
+    at = edges - shift
+    inside = (at >= first) & (at <= last)
+    at, counted = at[inside], revs[inside]
     if at.size < MIN_EDGES:
         return np.inf
     turned = np.interp(last, t_sim, rev) - np.interp(first, t_sim, rev)
-    if abs(at.size - turned) > 1.5:
+    if abs(counted[-1] - counted[0] + counted[1] - counted[0] - turned) > 1.5:
         return np.inf
-    return float(np.var(np.interp(at, t_sim, rev) - np.arange(at.size)))
+    return float(np.var(np.interp(at, t_sim, rev) - counted))
 
 
 def _search(costs, bounds, event) -> tuple:
     """``(shifts, their costs, best shift)``: ``costs`` (of an array of shifts) on a grid
-    over ``bounds`` at most ``event / GRID`` apart, then 100 times finer about its best."""
+    over ``bounds`` at most ``event / GRID`` apart, then 100 times finer about its best,
+    then the vertex of the parabola through the finer grid's best and its neighbours."""
     lo, hi = bounds
     shifts = np.linspace(lo, hi, max(801, int(np.ceil((hi - lo) / (event / GRID))) + 1))
     coarse = costs(shifts)
     best = int(np.argmin(coarse))
     fine = np.clip(shifts[best] + np.linspace(-2.0, 2.0, 401) * (shifts[1] - shifts[0]),
                    lo, hi)
-    return shifts, coarse, float(fine[np.argmin(costs(fine))])
+    near = costs(fine)
+    k = int(np.argmin(near))
+    return shifts, coarse, _vertex(fine, near, k)
+
+
+def _vertex(shifts, costs, k) -> float:
+    """The shift of the least cost: the vertex of the parabola through ``k`` and its
+    neighbours on the uniform grid ``shifts``, where they are finite and curve upwards;
+    else ``shifts[k]``."""
+    if not 0 < k < shifts.size - 1 or not np.all(np.isfinite(costs[k - 1:k + 2])):
+        return float(shifts[k])
+    left, mid, right = costs[k - 1:k + 2]
+    curve = left - 2.0 * mid + right
+    if not curve > 0:
+        return float(shifts[k])
+    step = 0.5 * (shifts[k + 1] - shifts[k - 1])
+    return float(shifts[k] + 0.5 * (left - right) / curve * step)
 
 
 def _shift_range(t_sim, span, partial) -> tuple:
@@ -325,15 +386,46 @@ def _fine(t_sim, rpm_sim):
     return t, np.interp(t, t_sim, np.asarray(rpm_sim, float))
 
 
-def _shift_error(t_sim, rpm_sim, t_rec, shift, sigma) -> float:
-    """Standard error [s] of the shift: least squares on one parameter over every recorded
-    sample inside the event, :math:`\\sigma / \\sqrt{\\sum \\dot n_\\mathrm{sim}^2}`."""
-    t_sim, rpm_sim = _fine(t_sim, rpm_sim)
-    at = t_rec - shift
-    inside = (at >= t_sim[0]) & (at <= t_sim[-1])
-    slope = np.interp(at[inside], t_sim, np.gradient(rpm_sim, t_sim))
-    info = float(np.sum(slope ** 2))
-    return sigma / np.sqrt(info) if info > 0 else np.inf
+def _shift_error(t, target, t_rec, rpm_rec, shift, sigma) -> tuple:
+    """Standard errors [s] of the shift against the event's speed ``target`` [rpm] at ``t``
+    (:func:`_fine`), least squares on one parameter over the recorded samples inside the
+    event (those the cost reads): ``(white, error)``, the first from the recorded speed's
+    white scatter ``sigma`` [rpm] (:func:`_scatter`: whether the speed varies enough), the
+    second from the residual at the shift, correlated as it is (:func:`_correlated_error`),
+    at least the first."""
+    if np.min(rpm_rec) >= 0:
+        target = np.abs(target)
+    every = max(1, int(np.ceil(t_rec.size / COST_SAMPLES)))
+    at, rr = t_rec[::every] - shift, rpm_rec[::every]
+    inside = (at >= t[0]) & (at <= t[-1])
+    slope = np.interp(at[inside], t, np.gradient(target, t))
+    residual = rr[inside] - np.interp(at[inside], t, target)
+    lags = round(CORRELATION_S / (every * (t_rec[1] - t_rec[0])))
+    white = _correlated_error(slope, np.zeros_like(slope), sigma, 0)
+    return white, max(white, _correlated_error(slope, residual, SPEED_FLOOR_RPM, lags))
+
+
+def _correlated_error(design, residual, floor, lags) -> float:
+    r"""Standard error of a one-parameter least-squares fit of slope ``design`` whose
+    ``residual`` (both at evenly spaced points) may be correlated and of unequal scatter
+    (a fluctuation at the firing orders, filtered noise, a profile that differs, a tacho's
+    edges jittering by a time, not an angle): Newey and West's (1987)
+    :math:`\sqrt{\sum_{|k|\le L} w_k \sum_i u_i u_{i+k}} / \sum_i d_i^2`,
+    :math:`u_i = d_i r_i`, Bartlett weights :math:`w_k = 1 - |k|/(L+1)` over ``lags``
+    :math:`L` (at most a fifth of the points); at least ``floor`` over
+    :math:`\sqrt{\sum d_i^2}` (white scatter of that size)."""
+    d, r = np.asarray(design, float), np.asarray(residual, float)
+    info = float(d @ d)
+    if not info > 0:
+        return np.inf
+    u = d * r
+    m = 1 << int(np.ceil(np.log2(2 * u.size)))             # zero-padded: no wrap-around
+    lags = int(min(max(lags, 0), u.size // 5))
+    cov = np.fft.irfft(np.abs(np.fft.rfft(u, m)) ** 2, m)[:lags + 1]
+    weight = 2.0 * (1.0 - np.arange(lags + 1) / (lags + 1.0))
+    weight[0] = 1.0
+    quad = float(np.sum(weight * cov))
+    return max(np.sqrt(max(quad, 0.0)), floor * np.sqrt(info)) / info
 
 
 def _costs(t, target, t_rec, rpm_rec):

@@ -173,6 +173,27 @@ def tacho_edges(time, tacho, *, file=None, key="tacho", what="tacho"):
     return time[i0] + frac * (time[i1] - time[i0])
 
 
+def drop_spikes(edge_times) -> tuple:
+    """Edge times [s] without the spikes' (of an interval shorter than :data:`SPIKE_RATIO`
+    of the running median, the edge whose removal leaves an interval nearer the median),
+    and notes saying how many."""
+    t = np.asarray(edge_times, float)
+    notes = []
+    for _ in range(3):                       # drop spikes, then re-evaluate the median
+        d = np.diff(t)
+        med = median_filter(d, size=min(9, d.size) | 1, mode="nearest")
+        short = np.flatnonzero(d < SPIKE_RATIO * med)
+        if not short.size:
+            break
+        before = np.where(short > 0, d[np.maximum(short - 1, 0)] + d[short], np.inf)
+        after = np.where(short + 1 < d.size, d[short] + d[np.minimum(short + 1, d.size - 1)],
+                         np.inf)
+        first = np.abs(before - med[short]) < np.abs(after - med[short])
+        t = np.delete(t, np.unique(np.where(first, short, short + 1)))
+        notes.append(f"{short.size} tacho spike(s) dropped")
+    return t, notes
+
+
 def count_teeth(edge_times, *, file=None, key="tacho"):
     """Pulse count at each edge, with missing teeth counted and spikes dropped.
 
@@ -182,16 +203,7 @@ def count_teeth(edge_times, *, file=None, key="tacho"):
         Edge times [s] kept and the cumulative pulse count at each (0 at the first).
     notes : list of str
     """
-    t = np.asarray(edge_times, float)
-    notes = []
-    for _ in range(3):                       # drop spikes, then re-evaluate the median
-        d = np.diff(t)
-        med = median_filter(d, size=min(9, d.size) | 1, mode="nearest")
-        spike = d < SPIKE_RATIO * med
-        if not spike.any():
-            break
-        t = np.delete(t, np.flatnonzero(spike) + 1)
-        notes.append(f"{int(spike.sum())} tacho spike(s) dropped")
+    t, notes = drop_spikes(edge_times)
     d = np.diff(t)
     med = median_filter(d, size=min(9, d.size) | 1, mode="nearest")
     ratio = d / med
@@ -222,14 +234,23 @@ def reference_count(counts, pulses_per_rev):
     return float(teeth[0]) if np.all(teeth == teeth[0]) else None
 
 
+def checked_pulses_per_rev(pulses_per_rev) -> int:
+    """``pulses_per_rev`` as an int, a whole number 1..:data:`MAX_PULSES_PER_REV` (else an
+    InputError naming ``--pulses-per-rev``)."""
+    if not (isinstance(pulses_per_rev, (int, float, np.integer, np.floating))
+            and not isinstance(pulses_per_rev, bool)
+            and 1 <= pulses_per_rev <= MAX_PULSES_PER_REV
+            and float(pulses_per_rev).is_integer()):
+        raise InputError(f"must be a whole number 1..{MAX_PULSES_PER_REV}, got "
+                         f"{pulses_per_rev!r}", key="--pulses-per-rev")
+    return int(pulses_per_rev)
+
+
 def speed_from_tacho(time, tacho, pulses_per_rev, *, smooth_s=0.1, file=None,
                      key="tacho") -> SpeedProfile:
     """Speed profile from a tacho pulse train (see module docstring)."""
     time = np.asarray(time, float)
-    if not (1 <= pulses_per_rev <= MAX_PULSES_PER_REV
-            and float(pulses_per_rev).is_integer()):
-        raise InputError(f"must be a whole number 1..{MAX_PULSES_PER_REV}",
-                         key="--pulses-per-rev")
+    checked_pulses_per_rev(pulses_per_rev)
     edges = tacho_edges(time, tacho, file=file, key=key)
     t_e, counts, notes = count_teeth(edges, file=file, key=key)
     if t_e.size < MIN_TACHO_EDGES:

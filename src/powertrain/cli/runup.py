@@ -16,7 +16,7 @@ from powertrain.cli.common import (
 from powertrain.cli.group import main
 from powertrain.errors import InputError
 from powertrain.iotools.engine_file import engine_or_default
-from powertrain.iotools.raw_hdf5 import write_raw_hdf5
+from powertrain.iotools.raw import write_raw
 from powertrain.workflows import runup as workflow
 from powertrain.workflows.arguments import speed_steps
 from powertrain.workflows.runup import check_path_plot
@@ -57,7 +57,8 @@ from powertrain.workflows.runup import check_path_plot
               help="Continuous run-up at this rate [rpm/s] (time integration of one speed "
                    "ramp) instead of steady states; tracked like measured data.")
 @click.option("--raw", "raw_file", type=click.Path(dir_okay=False),
-              help="With --sweep: write the raw mount-point accelerations (raw HDF5 layout).")
+              help="With --sweep: write the raw mount-point accelerations (format of the "
+                   "suffix: .csv, .uff, .mf4, else raw HDF5).")
 @click.option("--sample-rate", type=float, default=8192.0, show_default=True,
               help="With --sweep: sampling rate of the raw data [Hz].")
 @quiet_option
@@ -129,8 +130,7 @@ def _write_sweep(result, files, engine) -> list:
     """The continuous run-up's raw HDF5 and tracked HDF5, CSV and figure."""
     prov = cli_provenance(engine)
     if files["raw"]:
-        write_raw_hdf5(files["raw"], result.recording,
-                       description=result.recording.comments[0], synthetic=True)
+        write_raw(files["raw"], result.recording)
     if files["csv"]:
         result.to_csv(files["csv"])
     if files["out"]:

@@ -20,7 +20,7 @@ from powertrain.cli.group import main
 from powertrain.errors import InputError
 from powertrain.iotools.engine_file import engine_or_default
 from powertrain.iotools.manoeuvre_file import read_manoeuvre
-from powertrain.iotools.raw_hdf5 import write_raw_hdf5
+from powertrain.iotools.raw import write_raw
 from powertrain.workflows import transient as workflow
 from powertrain.workflows import transient_recording as recording
 
@@ -54,8 +54,9 @@ from powertrain.workflows import transient_recording as recording
 @click.option("--plot", type=click.Path(dir_okay=False),
               help="Speed and torque above the channels' accelerations (PNG).")
 @click.option("--raw", "raw_out", type=click.Path(dir_okay=False),
-              help="Write every channel's acceleration and the crank speed as raw time data "
-                   "(raw HDF5 layout, labelled SYNTHETIC), e.g. to try --compare.")
+              help="Write every channel's acceleration, the crank speed and the trigger as "
+                   "raw time data, labelled SYNTHETIC, in the format of the suffix (.csv, "
+                   ".uff, .mf4, else raw HDF5), e.g. to try --compare.")
 @click.option("--compare", "raw_file", type=click.Path(dir_okay=False),
               help="A recording of the manoeuvre (raw CSV, HDF5, UFF, MDF4): lined up on its "
                    "crank speed (or --trigger), every acceleration channel of the model "
@@ -72,10 +73,16 @@ from powertrain.workflows import transient_recording as recording
               help="Channel map TOML of the --compare/--speed-from recording (the format of "
                    "'powertrain track --channels'): file channel name -> mount, side, "
                    "direction, quantity.")
+@click.option("--trigger-edge", type=click.Choice(["rising", "falling"]), default="rising",
+              show_default=True, help="The edge the --trigger channel marks (falling: an "
+                                      "active-low trigger).")
+@click.option("--pulses-per-rev", type=int, default=1, show_default=True,
+              help="Tacho pulses per revolution of the --compare/--speed-from recording, "
+                   "where its speed is a tacho's (a missing-tooth wheel's gap is counted).")
 @quiet_option
 def transient(manoeuvre_file, engine_file, angle_step, speed_from, speed_average, seat,
               channels, quantity, out, csv_file, json_file, plot, raw_out, raw_file,
-              compare_plot, trigger, channel_map, quiet):
+              compare_plot, trigger, channel_map, trigger_edge, pulses_per_rev, quiet):
     """Transient manoeuvre: time histories of body, mounts and seat over a start, stop,
     tip-in or back-out.
 
@@ -91,22 +98,30 @@ def transient(manoeuvre_file, engine_file, angle_step, speed_from, speed_average
       powertrain transient examples/start.toml --compare start-raw.h5 --compare-plot o.png
       powertrain transient examples/tip-in.toml --compare rec.mf4 --trigger trig \\
           --channel-map map.toml
+      powertrain transient examples/start.toml --speed-from rec.mf4 --pulses-per-rev 60 \\
+          --speed-average
     """
     files = dict(out=out, csv=csv_file, json=json_file, plot=plot, raw=raw_out,
                  compare_plot=compare_plot)
-    _check_options(files, raw_file, speed_from, trigger, channel_map, speed_average)
+    reading = dict(trigger=trigger, channel_map=channel_map, pulses_per_rev=pulses_per_rev,
+                   trigger_edge=trigger_edge)
+    _check_options(files, raw_file, speed_from, reading, speed_average)
     manoeuvre, engine = read_manoeuvre(manoeuvre_file), engine_or_default(engine_file)
     system = engine.assemble()
     figure = workflow.figure_channels(system, channels)
     firing = engine.crank.firing_interval if speed_average else None
-    recorded = _recordings(raw_file, speed_from, trigger, channel_map, system, manoeuvre,
-                           firing)
+    recorded = _recordings(raw_file, speed_from, reading, system, manoeuvre, firing)
     result = workflow.transient(manoeuvre, engine, angle_step_deg=angle_step, seat=seat,
                                 system=system, speed_from=recorded.get("speed"),
                                 speed_average=speed_average)
     comparison = recording.compare_transient(result, recorded["compare"]) if raw_file else None
     written = _write(result, comparison, files, cli_provenance(engine_description(
         engine, engine.file)), figure, quantity)
+    _say(result, comparison, written, quiet)
+
+
+def _say(result, comparison, written, quiet) -> None:
+    """The run's text, the comparison's and what was written."""
     say(result.to_text(), quiet)
     if comparison is not None:
         say(comparison.to_text(), quiet)
@@ -115,20 +130,23 @@ def transient(manoeuvre_file, engine_file, angle_step, speed_from, speed_average
            else "no file written (ask with --out, --csv, --json or --plot)"), quiet)
 
 
-def _check_options(files, raw_file, speed_from, trigger, channel_map, speed_average) -> None:
-    """The output paths and the options that need another, before any work."""
+def _check_options(files, raw_file, speed_from, reading, speed_average) -> None:
+    """The output paths and the options that need another, before any work (``reading``:
+    the recordings' trigger, channel map and pulses per revolution)."""
     check_outputs(**files)
     if speed_average and not speed_from:
         raise InputError("goes with --speed-from RAW", key="--speed-average")
     if files["compare_plot"] and not raw_file:
         raise InputError("--compare-plot needs --compare RAW", key="--compare-plot")
-    for key, value in (("--trigger", trigger), ("--channel-map", channel_map)):
-        if value is not None and not (raw_file or speed_from):
+    for key, given in (("--trigger", reading["trigger"] is not None),
+                       ("--channel-map", reading["channel_map"] is not None),
+                       ("--pulses-per-rev", reading["pulses_per_rev"] != 1),
+                       ("--trigger-edge", reading["trigger_edge"] != "rising")):
+        if given and not (raw_file or speed_from):
             raise InputError("goes with --compare RAW or --speed-from RAW", key=key)
 
 
-def _recordings(raw_file, speed_from, trigger, channel_map, system, manoeuvre,
-                firing_interval) -> dict:
+def _recordings(raw_file, speed_from, reading, system, manoeuvre, firing_interval) -> dict:
     """The recordings of --compare and --speed-from read and checked before the run (the
     compared channels against the model's, the alignment and the span covered); one read
     where both name the same file."""
@@ -136,8 +154,7 @@ def _recordings(raw_file, speed_from, trigger, channel_map, system, manoeuvre,
     for kind, path in (("compare", raw_file), ("speed", speed_from)):
         if path:
             same = out.get("compare") if kind == "speed" and path == raw_file else None
-            out[kind] = same or recording.read_recording(path, channel_map=channel_map,
-                                                         trigger=trigger)
+            out[kind] = same or recording.read_recording(path, **reading)
     recording.check_recordings(manoeuvre, [f"{c}.{d}" for c, d in system.channels],
                                firing_interval=firing_interval,
                                compare=out.get("compare"), speed=out.get("speed"))
@@ -153,8 +170,7 @@ def _write(result, comparison, files, prov, channels, quantity) -> list:
                "json": lambda p: write_json(p, json.dumps(doc), prov.to_dict()),
                "plot": lambda p: write_plot(lambda q: result.plot(
                    path=q, channels=channels, quantity=quantity, provenance=prov), p),
-               "raw": lambda p: write_raw_hdf5(p, result.recording(), synthetic=True,
-                                               description=result.recording().comments[0]),
+               "raw": lambda p: write_raw(p, result.recording()),
                "compare_plot": lambda p: write_plot(lambda q: comparison.plot(
                    path=q, provenance=prov), p)}
     written = []

@@ -22,11 +22,11 @@ from powertrain.iotools.channel_map import (
     read_channel_map,
     split_unit,
 )
-from powertrain.iotools.raw_csv import read_csv_signals
-from powertrain.iotools.raw_hdf5 import read_hdf5_signals
-from powertrain.iotools.raw_mdf import read_mdf_signals
+from powertrain.iotools.raw_csv import read_csv_signals, write_raw_csv
+from powertrain.iotools.raw_hdf5 import read_hdf5_signals, write_raw_hdf5
+from powertrain.iotools.raw_mdf import read_mdf_signals, write_raw_mdf
 from powertrain.iotools.raw_signals import FileSignals
-from powertrain.iotools.raw_uff import read_uff_signals
+from powertrain.iotools.raw_uff import read_uff_signals, write_raw_uff
 from powertrain.iotools.textfile import check_regular_file
 from powertrain.models.recording import RawChannel, RawRecording
 from powertrain.units import to_si
@@ -35,6 +35,22 @@ from powertrain.units import to_si
 IGNORED_NOTE = "channels not in the channel map, ignored: "
 _HDF5 = b"\x89HDF\r\n\x1a\n"
 _MDF = b"MDF     "
+
+
+def write_raw(path, recording, *, synthetic=True) -> None:
+    """Write a :class:`RawRecording` in the format its suffix names: ``.csv`` (wide CSV),
+    ``.uff``/``.unv`` (datasets 58), ``.mf4``/``.mdf`` (MDF4), else the raw HDF5 layout;
+    a ``synthetic`` one says so (its first comment heads the CSV and describes the HDF5)."""
+    suffix = os.path.splitext(str(path))[1].lower()
+    note = recording.comments[0] if recording.comments else ""
+    if suffix == ".csv":
+        write_raw_csv(path, recording, comment=note)
+    elif suffix in (".uff", ".unv"):
+        write_raw_uff(path, recording)
+    elif suffix in (".mf4", ".mdf"):
+        write_raw_mdf(path, recording)
+    else:
+        write_raw_hdf5(path, recording, description=note, synthetic=synthetic)
 
 
 def detect_format(path) -> str:
@@ -96,17 +112,20 @@ def read_raw(path, channel_map: ChannelMap | None = None, *, rpm: str | None = N
     fmt = detect_format(path)
     reader = {"hdf5": read_hdf5_signals, "mdf": read_mdf_signals,
               "uff": read_uff_signals}.get(fmt, read_csv_signals)
-    found = (read_hdf5_signals(path, channel_map, map_option=map_option) if fmt == "hdf5"
+    found = (read_hdf5_signals(path, channel_map, map_option=map_option,
+                               extra=(trigger, cycle_reference)) if fmt == "hdf5"
              else reader(path, channel_map))
     return assemble(found, channel_map, rpm=rpm, tacho=tacho, cycle_reference=cycle_reference,
                     trigger=trigger, map_option=map_option)
 
 
 def _find(signals, wanted):
-    """Index of the signal named ``wanted`` (full name or name without the unit bracket)."""
-    for i, (name, _, _) in enumerate(signals):
-        if name == wanted or split_unit(name)[0] == wanted:
-            return i
+    """Index of the signal named ``wanted`` (full name or name without the unit bracket;
+    else the same ignoring case: ``RPM [1/min]``, ``Trigger [V]``)."""
+    for same in (str.__eq__, lambda a, b: a.casefold() == b.casefold()):
+        for i, (name, _, _) in enumerate(signals):
+            if same(name, wanted) or same(split_unit(name)[0], wanted):
+                return i
     return None
 
 

@@ -79,7 +79,9 @@ def _numbers(lines, start, n_cols, path):
 
 
 def write_raw_csv(path, recording, *, comment: str = "") -> None:
-    """Write a :class:`RawRecording` as a wide CSV in its channels' file units."""
+    """Write a :class:`RawRecording` as a wide CSV in its channels' file units (time to 15
+    significant digits: uniform to the reader's tolerance however late it starts, the
+    values to 9)."""
     signals = written_signals(recording)
     names = ["time [s]"] + [f"{name} [{'1/min' if name == 'rpm' else unit}]"
                             for name, _, unit, _ in signals]
@@ -88,4 +90,4 @@ def write_raw_csv(path, recording, *, comment: str = "") -> None:
             fh.write(f"# {line}\n")
         fh.write(",".join(names) + "\n")
         np.savetxt(fh, np.column_stack([recording.time] + [v for _, v, _, _ in signals]),
-                   delimiter=",", fmt="%.9g")
+                   delimiter=",", fmt=["%.15g"] + ["%.9g"] * len(signals))

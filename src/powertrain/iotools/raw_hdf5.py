@@ -30,9 +30,12 @@ def _unit(ds):
     return u.decode() if isinstance(u, bytes) else str(u)
 
 
-def read_hdf5_signals(path, channel_map=None, *, map_option="--channels") -> FileSignals:
+def read_hdf5_signals(path, channel_map=None, *, map_option="--channels",
+                      extra=()) -> FileSignals:
     """Signals of a raw HDF5 file (docs/reference/raw-data.md); ``map_option`` is the
-    option named in the hint of a file that needs a channel map."""
+    option named in the hint of a file that needs a channel map; ``extra``: names of more
+    datasets read where the file has them (a trigger or cycle reference named by an
+    option)."""
     import h5py  # deferred: heavy package, loaded only when this format is used
     try:
         h5 = h5py.File(path, "r")
@@ -40,23 +43,23 @@ def read_hdf5_signals(path, channel_map=None, *, map_option="--channels") -> Fil
         raise InputError(f"cannot open HDF5 file ({exc})", file=path) from None
     with h5:
         try:
-            return _read(h5, path, channel_map, map_option)
+            return _read(h5, path, channel_map, map_option, tuple(n for n in extra if n))
         except (KeyError, OSError, RuntimeError, TypeError) as exc:
             # h5py's errors for broken links and unreadable objects
             raise InputError(f"unreadable HDF5 object ({str(exc)[:80]})", file=path) from None
 
 
-def _read(h5, path, channel_map, map_option):
+def _read(h5, path, channel_map, map_option, extra):
     fmt = _text_attr(h5, "format", path)
     if fmt == "powertrain-runup":
         raise InputError("this is a run-up result (order curves), not raw time data; "
                          "give it to 'compare' or 'diagnose'", file=path, key="format")
     if fmt == FORMAT:
-        return _read_own(h5, path)
+        return _read_own(h5, path, extra)
     if channel_map is None:
         raise InputError(f"not a '{FORMAT}' HDF5 file; give a {map_option} map naming its "
                          "datasets", file=path, key="format")
-    return _read_mapped(h5, path, channel_map)
+    return _read_mapped(h5, path, channel_map, extra)
 
 
 def _text_attr(h5, name, path, default=""):
@@ -120,14 +123,14 @@ def _time(h5, name, path, budget):
     return time
 
 
-def _read_own(h5, path):
+def _read_own(h5, path, extra=()):
     budget = _Budget()
     time = _time(h5, "time", path, budget)
     unit = _unit(h5["time"]) or "s"
     time = to_si(time, unit, "time", file=path, key="time")
     signals, times = [], {}
-    for name in ("rpm", "tacho", "cycle", "trigger"):
-        if name in h5:
+    for name in dict.fromkeys(("rpm", "tacho", "cycle", "trigger", *extra)):
+        if name in h5 and not name.startswith("channels"):
             signals.append((name, _dataset(h5, name, path, budget), _unit(h5[name])))
             _own_time(h5, name, path, times, budget)
     group = h5.get("channels")
@@ -153,16 +156,17 @@ def _own_time(h5, name, path, times, budget):
                         key=ref)
 
 
-def _read_mapped(h5, path, cmap):
+def _read_mapped(h5, path, cmap, extra=()):
     budget = _Budget()
     tname = cmap.time or "time"
     time = _time(h5, tname, path, budget)
     signals, times = [], {}
-    for name in [cmap.rpm, cmap.tacho, *cmap.channels]:
+    named = [cmap.rpm, cmap.tacho, *cmap.channels]
+    for name in named + [n for n in extra if n in h5 and n not in named]:
         if name:
             signals.append((name, _dataset(h5, name, path, budget), _unit(h5[name])))
-    for name in (cmap.rpm, cmap.tacho):
-        if name:
+    for name in (cmap.rpm, cmap.tacho, *extra):
+        if name and name in h5:
             _own_time(h5, name, path, times, budget)
     return FileSignals(time, signals, str(path), tname, times=times)
 

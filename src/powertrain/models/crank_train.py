@@ -68,11 +68,17 @@ class CrankTrain:
 
     @property
     def firing_interval(self) -> float:
-        """Crank angle over which the gas torque repeats [rad]: 4π / n with the cylinders
-        firing at even intervals, else the cycle's 4π."""
-        gaps = np.diff(np.r_[np.sort(np.mod(self.firing_angles, 4 * np.pi)), 4 * np.pi])
-        even = 4 * np.pi / self.n_cylinders
-        return float(even) if np.allclose(gaps, even, atol=1e-6) else 4 * np.pi
+        """Crank angle over which the gas torque repeats [rad]: the least 4π / k whose
+        shift maps the firing angles onto themselves (4π / n with n cylinders firing at
+        even intervals; 240° for a V6 firing at 90° and 150°; else the cycle's 4π)."""
+        angles = np.sort(np.mod(self.firing_angles, 4 * np.pi))
+        for k in range(self.n_cylinders, 1, -1):
+            if self.n_cylinders % k == 0:
+                shifted = np.sort(np.mod(angles + 4 * np.pi / k, 4 * np.pi))
+                gap = np.abs(shifted - angles)
+                if np.all(np.minimum(gap, 4 * np.pi - gap) < 1e-6):
+                    return float(4 * np.pi / k)
+        return float(4 * np.pi)
 
     @property
     def crank_radius(self) -> float:

@@ -205,8 +205,9 @@ def overlay_grid(n: int) -> tuple:
 
 def plot_overlay(comparison, path=None, ax=None, provenance=None):
     """Measured and simulated acceleration [m/s²] over time, one panel per channel in a grid
-    that fits a page (:func:`overlay_grid`; where not all fit, those of the largest RMS of
-    the difference are drawn, in file order, and the others named in the title), each
+    that fits a page (:func:`overlay_grid`; where not all fit, the seat's and those of the
+    largest relative RMS of the difference are drawn, in file order
+    (:func:`overlay_channels`), and the others named in the title), each
     panel headed by the channel, the simulated peak's error [%] and the RMS of the
     difference [m/s²] (and of the measured RMS [%]). Returns the figure."""
     n = len(comparison.channels)
@@ -215,7 +216,7 @@ def plot_overlay(comparison, path=None, ax=None, provenance=None):
     fig, axes, own = subplots(ax, rows, cols, figsize=(PRINT_WIDTH_IN, height), sharex=True)
     e = comparison.errors()
     t = comparison.time
-    drawn = overlay_channels(e["rms_difference"], shown)
+    drawn = overlay_channels(comparison.channels, e["rms_difference_percent"], shown)
     for k, a in enumerate(axes.ravel()):
         if k >= shown:
             _hide(axes, k, cols)
@@ -250,11 +251,14 @@ def plot_overlay(comparison, path=None, ax=None, provenance=None):
     return finish(fig, own, path, provenance, title=title)
 
 
-def overlay_channels(rms_difference, shown) -> list:
-    """Indices of the ``shown`` channels of the largest RMS of the difference [m/s²], in
-    their order."""
-    worst_first = np.argsort(-np.asarray(rms_difference, float), kind="stable")
-    return sorted(int(j) for j in worst_first[:shown])
+def overlay_channels(channels, rms_difference_percent, shown) -> list:
+    """Indices of the ``shown`` channels drawn, in their order: the seat's axes (a body
+    point named ``seat...``) first, then those of the largest RMS of the difference
+    relative to the measured RMS [%] (a channel without one last)."""
+    share = np.nan_to_num(np.asarray(rms_difference_percent, float), nan=-np.inf)
+    seat = np.array([c.startswith("seat") for c in channels])
+    order = np.lexsort((-share, ~seat))
+    return sorted(int(j) for j in order[:shown])
 
 
 def _hide(axes, j, cols):

@@ -130,13 +130,21 @@ class TransientResult(JsonResult):
                             trigger=self.trigger_signal()).validate()
 
     def trigger_signal(self) -> np.ndarray | None:
-        """A trigger channel [V], 0 V to 5 V, whose rise crosses 2.5 V at
-        :attr:`trigger_time` exactly (linear over two samples either side; None where the
-        trigger is at the first sample: no rise to record)."""
-        h = float(self.time[1] - self.time[0])
-        if self.trigger_time < self.time[0] + h:
+        """A trigger channel [V], 0 V before :attr:`trigger_time` and 5 V after, with one
+        sample between whose level puts the rise's crossing of 2.5 V (linear between
+        samples) at :attr:`trigger_time` exactly (None where the trigger is at the first
+        sample: no rise to record)."""
+        t, when = self.time, float(self.trigger_time)
+        if when <= t[0]:
             return None
-        return 5.0 * np.clip((self.time - self.trigger_time) / (4.0 * h) + 0.5, 0.0, 1.0)
+        x = np.where(t >= when, 5.0, 0.0)
+        i = int(np.searchsorted(t, when)) - 1             # t[i] < when <= t[i + 1]
+        h = t[i + 1] - t[i]
+        if when - t[i] >= 0.5 * h:
+            x[i + 1] = 2.5 * h / (when - t[i])
+        else:
+            x[i] = 5.0 - 2.5 * h / (t[i + 1] - when)
+        return x
 
     def to_dict(self) -> dict:
         """The JSON document (docs/reference/json.md)."""
@@ -381,6 +389,10 @@ class TransientComparison(JsonResult):
         First and last time of the simulated event [s] (default: those compared).
     not_compared : dict of str -> str
         The recording's other channels and why each was not compared.
+    shift_error : float
+        Standard error of ``shift`` [s] (:func:`~powertrain.analysis.alignment.align_speed`,
+        :func:`~powertrain.analysis.alignment.align_tacho`,
+        :func:`~powertrain.analysis.trigger.trigger_crossing`).
     """
 
     name: str
@@ -393,6 +405,7 @@ class TransientComparison(JsonResult):
     aligned_on: str = "crank speed"
     event: tuple = ()
     not_compared: dict = field(default_factory=dict)
+    shift_error: float = 0.0
 
     def span(self) -> tuple:
         """First and last time compared, first and last time of the event [s]."""
@@ -414,6 +427,7 @@ class TransientComparison(JsonResult):
         e = self.errors()
         first, last, t0, t1 = self.span()
         return {"manoeuvre": self.name, "recording": self.raw, "shift_s": self.shift,
+                "shift_standard_error_s": self.shift_error,
                 "channels": {c: {k: _finite(v[j]) for k, v in e.items()}
                              for j, c in enumerate(self.channels)},
                 "aligned_on": self.aligned_on, "compared_from_s": first,
@@ -437,7 +451,8 @@ class TransientComparison(JsonResult):
                 for j, c in enumerate(self.channels)]
         first, last, t0, t1 = self.span()
         text = (f"compared with {self.raw} (aligned on the {self.aligned_on}: the simulation "
-                f"starts at {self.shift:.4f} s of the recording) over {first:.4f} to {last:.4f} s"
+                f"starts at {self.shift:.4f} s of the recording, standard error "
+                f"{self.shift_error * 1e3:.2g} ms) over {first:.4f} to {last:.4f} s"
                 f" of the {t1 - t0:g} s event ({100.0 * (last - first) / (t1 - t0):.0f} %)\n"
                 + format_table(["channel", "measured peak [m/s^2]", "simulated peak",
                                 "peak error [%]", "RMS of difference", "of measured RMS [%]"],

@@ -46,7 +46,8 @@ def manoeuvre_or_file(manoeuvre) -> Manoeuvre:
 
 def transient(manoeuvre, engine=None, *, angle_step_deg=ANGLE_STEP_DEG, seat=None,
               system=None, speed_from=None, trigger=None, channel_map=None,
-              speed_average=False) -> TransientResult:
+              speed_average=False, pulses_per_rev=1,
+              trigger_edge="rising") -> TransientResult:
     """Simulate a transient manoeuvre as the ``powertrain transient`` command does.
 
     Parameters
@@ -66,12 +67,11 @@ def transient(manoeuvre, engine=None, *, angle_step_deg=ANGLE_STEP_DEG, seat=Non
         Raw recording whose crank speed, lined up with the manoeuvre, replaces the
         manoeuvre's speed table over its span
         (:func:`~powertrain.workflows.transient_recording.speed_from_recording`).
-    trigger : str, optional
-        With ``speed_from``: the recording's trigger channel (the manoeuvre's
-        ``trigger_time``, default 0, at its first rising crossing of its mid level; default:
-        lined up on the crank speed).
-    channel_map : ChannelMap, str or Path, optional
-        With ``speed_from``: the recording's channel map (``powertrain track``'s format).
+    trigger, channel_map, pulses_per_rev, trigger_edge : optional
+        With ``speed_from``: how the recording is read and lined up: its trigger channel
+        (the manoeuvre's ``trigger_time`` at its ``trigger_edge``, ``rising`` or
+        ``falling``; default: on the crank speed), channel map, tacho pulses per revolution
+        (:func:`~powertrain.workflows.transient_recording.read_recording`).
     speed_average : bool
         With ``speed_from``: the recorded speed's mean over each firing interval of crank
         angle (a speed resolved within the cycle, an encoder's: its firing orders'
@@ -94,8 +94,12 @@ def transient(manoeuvre, engine=None, *, angle_step_deg=ANGLE_STEP_DEG, seat=Non
     m = manoeuvre_or_file(manoeuvre)
     engine = engine_or_default(engine)
     seat = seat_point(engine, seat)
-    m, speed_note = _driven(m, speed_from, trigger, channel_map,
-                            engine.crank.firing_interval if speed_average else None)
+    if not isinstance(speed_average, (bool, np.bool_)):
+        raise InputError(f"expected true or false, got {speed_average!r}", key="--speed-average")
+    m, speed_note = _driven(m, speed_from, dict(
+        trigger=trigger, channel_map=channel_map, pulses_per_rev=pulses_per_rev,
+        trigger_edge=trigger_edge,
+        firing_interval=engine.crank.firing_interval if speed_average else None))
     _check_recorded_top(m, speed_from, engine)
     t0 = time.process_time()
     with single_blas_thread():
@@ -116,17 +120,20 @@ def _result(m, engine, run, seat, seconds, speed_note) -> TransientResult:
         [m.notes] if m.notes else [], speed_note, m.trigger_time)
 
 
-def _driven(m, speed_from, trigger, channel_map, firing_interval) -> tuple:
-    """The manoeuvre driven by a recorded speed (its mean over each ``firing_interval``
-    [rad] where given), and the line saying so ("" without)."""
+def _driven(m, speed_from, options) -> tuple:
+    """The manoeuvre driven by a recorded speed (``options``: those of
+    :func:`~powertrain.workflows.transient_recording.speed_from_recording`), and the line
+    saying so ("" without)."""
     if speed_from is None:
-        for key, value in (("--trigger", trigger), ("--channel-map", channel_map),
-                           ("--speed-average", firing_interval)):
-            if value is not None:
+        for key, given in (("--trigger", options["trigger"] is not None),
+                           ("--channel-map", options["channel_map"] is not None),
+                           ("--speed-average", options["firing_interval"] is not None),
+                           ("--pulses-per-rev", options["pulses_per_rev"] != 1),
+                           ("--trigger-edge", options["trigger_edge"] != "rising")):
+            if given:
                 raise InputError("goes with a recording (speed_from)", key=key)
         return m, ""
-    return speed_from_recording(m, speed_from, firing_interval=firing_interval,
-                                trigger=trigger, channel_map=channel_map)
+    return speed_from_recording(m, speed_from, **options)
 
 
 def _check_recorded_top(m, speed_from, engine) -> None:

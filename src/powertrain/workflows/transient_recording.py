@@ -4,7 +4,7 @@ lined up with the manoeuvre (one rule, :func:`align`, for ``--compare`` and
 
 Lining up: with a trigger channel, the manoeuvre's ``trigger_time`` (default 0) is the
 trigger's first rising crossing of its mid level
-(:func:`powertrain.analysis.alignment.trigger_time`); else the time shift whose recorded
+(:func:`powertrain.analysis.trigger.trigger_time`); else the time shift whose recorded
 crank speed (rpm channel, else once-per-revolution tacho) best matches the manoeuvre's,
 refused where the speed varies too little to fix it
 (:func:`powertrain.analysis.alignment.align_speed`).
@@ -12,6 +12,7 @@ refused where the speed varies too little to fix it
 
 from __future__ import annotations
 
+import warnings
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -21,18 +22,22 @@ from powertrain.analysis.alignment import (
     align_speed,
     align_tacho,
     coverage,
+    tacho_counts,
     tacho_rpm,
-    trigger_time,
+    trigger_shift,
     unheld_speed,
 )
-from powertrain.analysis.speed import mean_speed, tacho_edges
-from powertrain.errors import InputError
+from powertrain.analysis.speed import checked_pulses_per_rev, mean_speed, tacho_edges
+from powertrain.analysis.trigger import TRIGGER_EDGES, TriggerCrossing, trigger_crossing
+from powertrain.errors import InputError, PowertrainWarning
 from powertrain.iotools.raw import IGNORED_NOTE, read_raw
 from powertrain.models.manoeuvre import MAX_RPM, Manoeuvre
 from powertrain.results.transient import TransientComparison
 
 #: Most rows of a speed table taken from a recording (block means of its samples).
 SPEED_ROWS = 2000
+#: Longest firing interval [s] whose mean speed (--speed-average) passes without a warning.
+AVERAGE_WINDOW_S = 0.1
 #: Option that gives a recording's channel map, named in error messages.
 MAP_OPTION = "--channel-map"
 _RPM = np.pi / 30.0
@@ -60,6 +65,18 @@ class Recorded:
     edges : ndarray or None
         The once-per-revolution tacho's rising edges from the first sample [s] (None
         where the speed is an rpm channel's).
+    trigger_error : float
+        Standard error of ``trigger`` [s].
+    trigger_crossing : TriggerCrossing or None
+        How ``trigger`` was found (:func:`~powertrain.analysis.trigger.trigger_crossing`).
+    counts : ndarray or None
+        The tacho's pulses counted at each of ``edges`` (a missing-tooth wheel's gap
+        counted).
+    pulses_per_rev : int
+        The tacho's pulses per revolution.
+    unused_trigger : bool
+        The file has a channel named ``trigger`` that ``--trigger`` does not name (said
+        where the crank speed cannot line the recording up).
     """
 
     path: str
@@ -71,12 +88,20 @@ class Recorded:
     channels: list
     ignored: list = field(default_factory=list)
     edges: np.ndarray | None = None
+    trigger_error: float = 0.0
+    counts: np.ndarray | None = None
+    pulses_per_rev: int = 1
+    unused_trigger: bool = False
+    trigger_crossing: TriggerCrossing | None = None
 
 
-def read_recording(path, *, channel_map=None, trigger=None) -> Recorded:
+def read_recording(path, *, channel_map=None, trigger=None, pulses_per_rev=1,
+                   trigger_edge="rising") -> Recorded:
     """Read and check a recording of a manoeuvre (any format of
     :func:`~powertrain.iotools.raw.read_raw`; ``channel_map`` as ``powertrain track``'s;
-    ``trigger`` the name of a trigger channel).
+    ``trigger`` the name of a trigger channel and ``trigger_edge`` the edge it marks,
+    ``rising`` or ``falling``; ``pulses_per_rev`` its tacho's, where the speed comes from a
+    tacho).
 
     Raises
     ------
@@ -86,23 +111,35 @@ def read_recording(path, *, channel_map=None, trigger=None) -> Recorded:
     if trigger is not None and (not isinstance(trigger, str) or not trigger.strip()):
         raise InputError("expected the name of a channel of the recording",
                          key="--trigger")
+    pulses_per_rev = checked_pulses_per_rev(pulses_per_rev)
+    if trigger_edge not in TRIGGER_EDGES:
+        raise InputError(f"expected one of {', '.join(TRIGGER_EDGES)}, got {trigger_edge!r}",
+                         key="--trigger-edge")
     rec = read_raw(path, channel_map, trigger=trigger, map_option=MAP_OPTION)
     t = rec.time - rec.time[0]
-    when = None if trigger is None else trigger_time(t, rec.trigger, file=str(path),
-                                                      key=trigger)
+    crossing = None if trigger is None else trigger_crossing(
+        t, rec.trigger, edge=trigger_edge, file=str(path), key=trigger)
+    when = (None, 0.0) if crossing is None else crossing[:2]
     ignored = [n.strip() for c in rec.comments if c.startswith(IGNORED_NOTE)
                for n in c[len(IGNORED_NOTE):].split(",")]
-    edges = (tacho_edges(t, rec.tacho, file=str(path), key="tacho")
-             if rec.rpm is None and rec.tacho is not None else None)
-    return Recorded(str(path), t, recorded_rpm(rec, path), _speed_source(rec), when, trigger,
-                    list(rec.channels), ignored, edges)
+    if pulses_per_rev != 1 and rec.rpm is not None:
+        warnings.warn(RecordedSpeedWarning(
+            f"{path}: the speed is the rpm channel's; --pulses-per-rev is not used"),
+            stacklevel=2)
+    edges, counts = (tacho_counts(tacho_edges(t, rec.tacho, file=str(path), key="tacho"),
+                                  pulses_per_rev, file=str(path), key="tacho")
+                     if rec.rpm is None and rec.tacho is not None else (None, None))
+    return Recorded(str(path), t, recorded_rpm(rec, path, pulses_per_rev), _speed_source(rec),
+                    when[0], trigger, list(rec.channels), ignored, edges, when[1], counts,
+                    pulses_per_rev, trigger is None and rec.trigger is not None, crossing)
 
 
-def recording_or_file(recording, *, channel_map=None, trigger=None) -> Recorded:
-    """A :class:`Recorded` as it is, or read from its file (:func:`read_recording`)."""
+def recording_or_file(recording, **options) -> Recorded:
+    """A :class:`Recorded` as it is, or read from its file with ``options``
+    (:func:`read_recording`'s)."""
     if isinstance(recording, Recorded):
         return recording
-    return read_recording(recording, channel_map=channel_map, trigger=trigger)
+    return read_recording(recording, **options)
 
 
 def _speed_source(rec) -> str:
@@ -110,40 +147,59 @@ def _speed_source(rec) -> str:
                                                       else "")
 
 
-def recorded_rpm(rec, path) -> np.ndarray | None:
+def recorded_rpm(rec, path, pulses_per_rev=1) -> np.ndarray | None:
     """Crank speed [rpm] at every sample of the raw recording ``rec``: its rpm channel, else
-    its once-per-revolution tacho
+    its tacho of ``pulses_per_rev`` pulses per revolution
     (:func:`~powertrain.analysis.alignment.tacho_rpm`: at rest before the first pulse
     where the record shows it), else None."""
     if rec.rpm is not None:
         return np.asarray(rec.rpm, float)
     if rec.tacho is not None:
-        return tacho_rpm(rec.time - rec.time[0], rec.tacho, file=str(path), key="tacho")
+        return tacho_rpm(rec.time - rec.time[0], rec.tacho, pulses_per_rev=pulses_per_rev,
+                         file=str(path), key="tacho")
     return None
 
 
 def align(rec: Recorded, t_event, rpm_event, *, partial=True, trigger_at=0.0) -> tuple:
-    """The recording's time [s] of the event's time 0 and how it was found (``trigger
-    'NAME'`` or ``crank speed``): the trigger's time less the event's time of the trigger
-    ``trigger_at`` [s], else the speed alignment against the event's speed ``rpm_event``
-    [rpm] at ``t_event`` [s] (module docstring); ``partial``: the recording may cover part
-    of the event (:func:`align_speed`)."""
+    """The recording's time [s] of the event's time 0, how it was found (``trigger
+    'NAME'`` or ``crank speed``) and its standard error [s]: the trigger's time less the
+    event's time of the trigger ``trigger_at`` [s], else the speed alignment against the
+    event's speed ``rpm_event`` [rpm] at ``t_event`` [s] (module docstring); ``partial``:
+    the recording may cover part of the event (:func:`align_speed`)."""
     if rec.trigger is not None:
-        return rec.trigger - float(trigger_at), f"trigger {rec.trigger_name!r}"
+        crossing = rec.trigger_crossing or TriggerCrossing(
+            rec.trigger, rec.trigger_error, rec.trigger_error, 0.0)
+        shift = trigger_shift(crossing, trigger_at, rpm_event, file=rec.path,
+                              key=rec.trigger_name)
+        return shift, f"trigger {rec.trigger_name!r}", rec.trigger_error
     if rec.rpm is None:
         raise InputError("no rpm or tacho channel to line the recording up on; give "
                          "--trigger CHANNEL", file=rec.path, key="rpm")
+    try:
+        return _align_on_speed(rec, t_event, rpm_event, partial)
+    except InputError as err:
+        if not rec.unused_trigger or "--trigger CHANNEL" not in err.message:
+            raise
+        raise InputError(err.message.replace("--trigger CHANNEL", "--trigger CHANNEL (the "
+                                             "recording has one named 'trigger')"),
+                         file=err.file, key=err.key) from None
+
+
+def _align_on_speed(rec: Recorded, t_event, rpm_event, partial) -> tuple:
+    """:func:`align` on the tacho's pulses, else on the rpm channel."""
     if rec.edges is not None:
-        shift, _ = align_tacho(t_event, rpm_event, (rec.time[0], rec.time[-1]), rec.edges,
-                               file=rec.path, key="tacho", partial=partial)
-        return shift, "crank angle of the tacho's pulses"
-    shift, _ = align_speed(t_event, rpm_event, rec.time, rec.rpm, file=rec.path, key="rpm",
-                           partial=partial)
-    return shift, "crank speed"
+        shift, error = align_tacho(t_event, rpm_event, (rec.time[0], rec.time[-1]),
+                                   rec.edges, counts=rec.counts,
+                                   pulses_per_rev=rec.pulses_per_rev, file=rec.path,
+                                   key="tacho", partial=partial)
+        return shift, "crank angle of the tacho's pulses", error
+    shift, error = align_speed(t_event, rpm_event, rec.time, rec.rpm, file=rec.path,
+                               key="rpm", partial=partial)
+    return shift, "crank speed", error
 
 
 def speed_from_recording(manoeuvre: Manoeuvre, recording, *, firing_interval=None,
-                         channel_map=None, trigger=None) -> tuple:
+                         **options) -> tuple:
     """``manoeuvre`` driven by the crank speed of a recording (:func:`read_recording`):
     lined up with the manoeuvre by :func:`align` (against the manoeuvre's own speed
     table), its speed as recorded or, given a ``firing_interval`` [rad], its mean over
@@ -153,7 +209,7 @@ def speed_from_recording(manoeuvre: Manoeuvre, recording, *, firing_interval=Non
     (block means on at most :data:`SPEED_ROWS` rows), replaces the speed table; the load
     table stays on the manoeuvre's times. Negative speeds are cut to 0 unless the
     manoeuvre allows a reversal. Returns the manoeuvre and a line saying where its speed
-    came from.
+    came from. ``options``: :func:`read_recording`'s.
 
     Raises
     ------
@@ -161,7 +217,7 @@ def speed_from_recording(manoeuvre: Manoeuvre, recording, *, firing_interval=Non
         No speed in the recording, or a recording that does not cover the manoeuvre after
         alignment (one line naming the file and ``time``).
     """
-    rec = recording_or_file(recording, channel_map=channel_map, trigger=trigger)
+    rec = recording_or_file(recording, **options)
     if rec.rpm is None:
         raise InputError("no rpm or tacho channel to take the speed from", file=rec.path,
                          key="rpm")
@@ -171,8 +227,8 @@ def speed_from_recording(manoeuvre: Manoeuvre, recording, *, firing_interval=Non
         raise InputError(f"the recording is {rec.time[-1]:.6g} s long, the manoeuvre "
                          f"{duration:.6g} s; --speed-from needs all of it", file=rec.path,
                          key="time")
-    shift, how = align(rec, manoeuvre.time, manoeuvre.speed / _RPM, partial=False,
-                       trigger_at=manoeuvre.trigger_time)
+    shift, how, error = align(rec, manoeuvre.time, manoeuvre.speed / _RPM, partial=False,
+                              trigger_at=manoeuvre.trigger_time)
     first, last = coverage(0.0, duration, rec.time[0], rec.time[-1], shift)
     if first > tol or last < duration - tol:
         raise InputError(f"after alignment ({how}: the manoeuvre starts at {shift:.4f} s of "
@@ -183,6 +239,7 @@ def speed_from_recording(manoeuvre: Manoeuvre, recording, *, firing_interval=Non
     if firing_interval is not None:
         rpm = mean_speed(rec.time, rpm, firing_interval)
     tt, rr = _speed_rows(rec.time - shift, rpm, duration)
+    _warn_speed(manoeuvre, rec, rr, firing_interval)
     if not manoeuvre.reversal:
         rr = np.maximum(rr, 0.0)
     if not np.all(np.isfinite(rr)) or np.max(np.abs(rr)) > MAX_RPM:
@@ -191,8 +248,33 @@ def speed_from_recording(manoeuvre: Manoeuvre, recording, *, firing_interval=Non
     mean = ("" if firing_interval is None
             else f", its mean over {np.degrees(firing_interval):.0f} deg of crank")
     note = (f"crank speed from {rec.path} ({rec.speed_source}{mean}): the manoeuvre starts "
-            f"at {shift:.4f} s of the recording (aligned on the {how})")
+            f"at {shift:.4f} s of the recording (aligned on the {how}, standard error "
+            f"{error * 1e3:.2g} ms)")
     return manoeuvre.with_speed(tt, rr * _RPM), note
+
+
+class RecordedSpeedWarning(PowertrainWarning):
+    """A recorded speed that cannot be read as asked: unsigned where the crank may turn
+    back, averaged over firing intervals longer than :data:`AVERAGE_WINDOW_S`, or an rpm
+    channel's where a tacho's pulses per revolution were given."""
+
+
+def _warn_speed(manoeuvre, rec, rpm, firing_interval) -> None:
+    """:class:`RecordedSpeedWarning` where the manoeuvre allows a reversal and the recorded
+    speed is never negative, or where it is averaged below the speed whose firing interval
+    lasts :data:`AVERAGE_WINDOW_S`."""
+    if manoeuvre.reversal and np.min(rec.rpm) >= 0:
+        warnings.warn(RecordedSpeedWarning(
+            f"{rec.path}: the manoeuvre lets the crank turn back, but the recorded speed "
+            f"({rec.speed_source}) is never negative: a crank turning back reads as turning "
+            "forward"), stacklevel=3)
+    slow = firing_interval / AVERAGE_WINDOW_S * 30.0 / np.pi if firing_interval else 0.0
+    if np.min(np.abs(rpm)) < slow:
+        warnings.warn(RecordedSpeedWarning(
+            f"{rec.path}: below {slow:.0f} rpm a firing interval lasts more than "
+            f"{AVERAGE_WINDOW_S * 1e3:g} ms, and its mean (--speed-average) smooths the "
+            "speed's own changes, a start's flare among them; it suits a running engine"),
+            stacklevel=3)
 
 
 def _speed_rows(t, rpm, duration) -> tuple:
@@ -238,7 +320,8 @@ def compared_channels(rec: Recorded, labels) -> tuple:
     return pairs, skipped
 
 
-def compare_transient(result, raw, *, trigger=None, channel_map=None) -> TransientComparison:
+def compare_transient(result, raw, *, trigger=None, channel_map=None, pulses_per_rev=1,
+                      trigger_edge="rising") -> TransientComparison:
     """A simulated manoeuvre against a recorded one.
 
     Parameters
@@ -252,6 +335,11 @@ def compare_transient(result, raw, *, trigger=None, channel_map=None) -> Transie
     channel_map : ChannelMap, str or Path, optional
         The recording's channel names -> mount, side, direction, quantity (the format of
         ``powertrain track --channels``).
+    pulses_per_rev : int
+        The recording's tacho pulses per revolution (1 by default; a missing-tooth wheel's
+        gap is counted), where its speed is a tacho's.
+    trigger_edge : str
+        The edge the trigger marks: ``rising`` (default) or ``falling`` (active low).
 
     Returns
     -------
@@ -264,9 +352,10 @@ def compare_transient(result, raw, *, trigger=None, channel_map=None) -> Transie
     InputError
         A bad recording, no channel to compare, or less than half the event covered.
     """
-    rec = recording_or_file(raw, channel_map=channel_map, trigger=trigger)
+    rec = recording_or_file(raw, channel_map=channel_map, trigger=trigger,
+                            pulses_per_rev=pulses_per_rev, trigger_edge=trigger_edge)
     pairs, skipped = compared_channels(rec, result.channels)
-    shift, how = align(rec, result.time, result.rpm, trigger_at=result.trigger_time)
+    shift, how, error = align(rec, result.time, result.rpm, trigger_at=result.trigger_time)
     t0, t1 = float(result.time[0]), float(result.time[-1])
     first, last = _covered(rec, t0, t1, shift, how)
     sel = (result.time >= first) & (result.time <= last)
@@ -275,7 +364,8 @@ def compare_transient(result, raw, *, trigger=None, channel_map=None) -> Transie
     simulated = result.acceleration[np.ix_(sel, [result.channel(lb) for lb, _ in pairs])]
     return TransientComparison(result.name, rec.path, float(shift), t,
                                [lb for lb, _ in pairs], measured, simulated, aligned_on=how,
-                               event=(t0, t1), not_compared=skipped)
+                               event=(t0, t1), not_compared=skipped,
+                               shift_error=float(error))
 
 
 def _covered(rec: Recorded, t0, t1, shift, how) -> tuple:
@@ -304,11 +394,18 @@ def check_recordings(manoeuvre: Manoeuvre, labels, *, firing_interval=None, comp
         As :func:`compared_channels`, :func:`speed_from_recording` and
         :func:`compare_transient` would after the run.
     """
+    with warnings.catch_warnings():          # the run and the comparison warn once
+        warnings.simplefilter("ignore", PowertrainWarning)
+        _check(manoeuvre, labels, firing_interval, compare, speed)
+
+
+def _check(manoeuvre, labels, firing_interval, compare, speed) -> None:
+    """:func:`check_recordings`' checks."""
     if speed is not None:
         manoeuvre, _ = speed_from_recording(manoeuvre, speed,
                                             firing_interval=firing_interval)
     if compare is not None:
         compared_channels(compare, labels)
-        shift, how = align(compare, manoeuvre.time, manoeuvre.speed / _RPM,
-                           trigger_at=manoeuvre.trigger_time)
+        shift, how, _ = align(compare, manoeuvre.time, manoeuvre.speed / _RPM,
+                              trigger_at=manoeuvre.trigger_time)
         _covered(compare, 0.0, manoeuvre.duration, shift, how)
