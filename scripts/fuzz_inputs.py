@@ -1,4 +1,4 @@
-"""Long malformed-input campaign (issues 10, 18 and 39): every input kind, many examples.
+"""Long malformed-input campaign (issues 10, 18, 38 and 39): every input kind, many examples.
 
 Runs the hypothesis strategies of ``tests/fuzz_harness.py`` (the same as the CI suite
 ``tests/test_fuzz_inputs.py``, more examples), the failures issues 10, 18 and 39 listed, and the
@@ -12,6 +12,10 @@ Failing cases are copied to ``--keep`` (default ``fuzz-failures/``) with the com
 
     python scripts/fuzz_inputs.py --examples 100          # ~100 per input kind
     python scripts/fuzz_inputs.py --examples 5 --kinds engine,options --safety 2
+    python scripts/fuzz_inputs.py --examples 300 --kinds transient --safety 0 --no-named
+
+``--kinds transient`` stands for the transient manoeuvre kinds (``fh.TRANSIENT_KINDS``);
+``--no-named`` skips the named failures of the issues (about a minute).
 """
 
 from __future__ import annotations
@@ -36,13 +40,19 @@ def main() -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--examples", type=int, default=100, help="examples per input kind")
     ap.add_argument("--kinds", default=",".join(fh.KINDS),
-                    help=f"comma-separated input kinds ({', '.join(fh.KINDS)})")
+                    help=f"comma-separated input kinds ({', '.join(fh.KINDS)}; 'transient' "
+                         "for the transient ones)")
     ap.add_argument("--seed", type=int, default=None, help="hypothesis seed (default random)")
     ap.add_argument("--keep", default="fuzz-failures", help="folder for failing cases")
     ap.add_argument("--safety", type=int, default=10,
                     help="concurrent-run and SIGKILL trials (each)")
+    ap.add_argument("--no-named", action="store_true",
+                    help="skip the named failures of issues 10, 18, 38 and 39")
     args = ap.parse_args()
     kinds = [k.strip() for k in args.kinds.split(",") if k.strip()]
+    if "transient" in kinds:
+        i = kinds.index("transient")
+        kinds[i:i + 1] = fh.TRANSIENT_KINDS
     unknown = [k for k in kinds if k not in fh.KINDS]
     if unknown:
         ap.error(f"unknown kind {unknown[0]!r}")
@@ -67,19 +77,8 @@ def main() -> int:
 
     try:
         fh.seeds(worker, tmp / "seeds")
-        for name, case in fh.issue_cases().items():
-            case.description = name
-            outcome, detail = fh.run_case(worker, case, tmp / "case")
-            record("issue-10", case, outcome, detail)
-        cases_39, slow_39 = fh.issue_39_cases()
-        for issue, named in (("issue-18", fh.issue_18_cases()),
-                             ("issue-39", {**cases_39, **slow_39})):
-            for name, (case, expected) in named.items():
-                case.description = name
-                outcome, detail = fh.run_case(worker, case, tmp / "case")
-                if outcome != expected and outcome not in fh.FAILURES:
-                    outcome, detail = "unclear_error", f"expected {expected}: {detail}"
-                record(issue, case, outcome, detail)
+        if not args.no_named:
+            _named(worker, tmp, record)
         _safety(args, tmp, counts, per_kind, failures)
         for kind in kinds:
             run = _campaign(kind, args, worker, tmp, record)
@@ -91,6 +90,7 @@ def main() -> int:
     print(f"issue-10 named cases: {dict(per_kind['issue-10'])}")
     print(f"issue-18 named cases: {dict(per_kind['issue-18'])}")
     print(f"issue-39 named cases: {dict(per_kind['issue-39'])}")
+    print(f"issue-38 (transient) named cases: {dict(per_kind['issue-38'])}")
     print(f"data safety (concurrent runs, SIGKILL): {dict(per_kind['safety'])}; "
           f"{sum(n > 0 for n in fh.KILL_TEMPS)} of {len(fh.KILL_TEMPS)} kills left "
           f"{sum(fh.KILL_TEMPS)} temporary files, all swept by the next run unless counted "
@@ -102,6 +102,24 @@ def main() -> int:
           f"lost_files={counts['lost_file']} clean_errors={counts['clean_error']} "
           f"ok={counts['ok']}")
     return 1 if failures else 0
+
+
+def _named(worker, tmp, record):
+    """The failures issues 10, 18, 38 and 39 list, each run once."""
+    for name, case in fh.issue_cases().items():
+        case.description = name
+        outcome, detail = fh.run_case(worker, case, tmp / "case")
+        record("issue-10", case, outcome, detail)
+    cases_39, slow_39 = fh.issue_39_cases()
+    for issue, named in (("issue-18", fh.issue_18_cases()),
+                         ("issue-39", {**cases_39, **slow_39}),
+                         ("issue-38", fh.issue_38_cases())):
+        for name, (case, expected) in named.items():
+            case.description = name
+            outcome, detail = fh.run_case(worker, case, tmp / "case")
+            if outcome != expected and outcome not in fh.FAILURES:
+                outcome, detail = "unclear_error", f"expected {expected}: {detail}"
+            record(issue, case, outcome, detail)
 
 
 def _safety(args, tmp, counts, per_kind, failures):

@@ -120,9 +120,10 @@ _NONFINITE = re.compile(r"(?<![A-Za-z_])(nan|inf|infinity)(?![A-Za-z_])", re.IGN
 
 
 def _nonfinite_in(path: Path) -> bool:
-    if path.suffix == ".png":
+    head = path.read_bytes()[:8]
+    if path.suffix == ".png" or head == b"\x89PNG\r\n\x1a\n":
         return False
-    if path.suffix == ".h5":
+    if path.suffix == ".h5" or head == b"\x89HDF\r\n\x1a\n":
         import h5py
         bad = []
 
@@ -279,6 +280,7 @@ def seeds(worker: Worker, folder: Path) -> dict:
                       "--freq", "1:200:10", "--format", "csv"], folder)
     _SEEDS["k.csv"] = res["stdout"].encode()
     raw_format_seeds(folder)
+    transient_seeds(worker, folder)
     shutil.rmtree(folder, ignore_errors=True)
     return _SEEDS
 
@@ -1469,3 +1471,675 @@ def issue_39_cases() -> dict:
             ["d.json", "rep/diagnosis.json", "rep/summary.txt"], "m.csv", ""), "ok"),
     }
     return cases, slow
+
+
+# --------------------------------------------------------------------------- transient (38)
+# `powertrain transient MANOEUVRE.toml` and `powertrain whatif --manoeuvre`: mutated manoeuvre
+# files, options, recordings for --compare / --speed-from, what-if specs. The seeds are
+# windows of the shipped examples (each runs in well under a second).
+#: Shipped manoeuvre -> the window [s] of it cut out as a seed.
+MANOEUVRE_WINDOWS = {"start": (0.0, 0.45), "stop": (0.8, 1.4), "tip-in": (0.2, 0.6),
+                     "back-out": (0.2, 0.6)}
+
+
+def _table_window(table: dict, t0: float, t1: float) -> dict:
+    """A [speed] or [load] table cut to ``t0..t1`` (the ends interpolated), from 0."""
+    t = np.asarray(table["time"]["value"], float)
+    tt = np.r_[t0, t[(t > t0) & (t < t1)], t1]
+    out = {"time": {"value": [round(x - t0, 9) for x in tt.tolist()],
+                    "unit": table["time"]["unit"]}}
+    for key, col in table.items():
+        if key == "time":
+            continue
+        if isinstance(col, dict) and isinstance(col.get("value"), list):
+            v = np.interp(tt, t, np.asarray(col["value"], float))
+            out[key] = {"value": [round(x, 9) for x in v.tolist()], "unit": col["unit"]}
+        else:
+            out[key] = col
+    return out
+
+
+def cut_manoeuvre(data: bytes, t0: float, t1: float) -> bytes:
+    """A manoeuvre file cut to its window ``t0..t1`` [s] (trigger and starter moved)."""
+    doc = toml_loads(data)
+    for section in ("speed", "load"):
+        doc[section] = _table_window(doc[section], t0, t1)
+    head = doc["manoeuvre"]
+    if "trigger_time" in head:
+        head["trigger_time"]["value"] = round(min(max(head["trigger_time"]["value"] - t0, 0.0),
+                                                  0.5 * (t1 - t0)), 9)
+    if "starter" in doc:
+        until = doc["starter"]["until"]
+        until["value"] = round(min(max(until["value"] - t0, 0.0), t1 - t0), 9)
+    return toml_dumps(doc).encode()
+
+
+def transient_seeds(worker: Worker, folder: Path) -> None:
+    """Manoeuvre windows ``m/NAME.toml``; the start's and the tip-in's recordings as raw
+    HDF5 (``--raw``) and CSV; a channel map of the start's recording."""
+    from powertrain.iotools.raw import read_raw
+    from powertrain.iotools.raw_csv import write_raw_csv
+    for name, (t0, t1) in MANOEUVRE_WINDOWS.items():
+        _SEEDS[f"m/{name}.toml"] = cut_manoeuvre(_read(f"examples/{name}.toml"), t0, t1)
+    (folder / "m").mkdir(parents=True, exist_ok=True)
+    (folder / "engines").mkdir(exist_ok=True)
+    (folder / "engines" / "e.toml").write_bytes(_read("engines/default-modal-body.toml"))
+    shutil.copytree(ROOT / "mounts", folder / "mounts", dirs_exist_ok=True)
+    for name in ("start", "tip-in", "stop", "start-modal"):
+        toml = name.removesuffix("-modal")
+        (folder / "m" / f"{toml}.toml").write_bytes(_SEEDS[f"m/{toml}.toml"])
+        engine = ["--engine", "engines/e.toml"] if name.endswith("-modal") else []
+        res = worker.run(["transient", f"m/{toml}.toml", "--quiet", "--raw", f"{name}-raw.h5",
+                          *engine], folder)
+        assert res["code"] == 0, res
+        _SEEDS[f"{name}-raw.h5"] = (folder / f"{name}-raw.h5").read_bytes()
+        rec = read_raw(folder / f"{name}-raw.h5")
+        write_raw_csv(folder / f"{name}-raw.csv", rec, comment=rec.comments[0])
+        _SEEDS[f"{name}-raw.csv"] = (folder / f"{name}-raw.csv").read_bytes()
+    _SEEDS["rec-map.toml"] = (b'rpm = "rpm"\n\n[channels]\n'
+                              b'"left.z" = { mount = "left", direction = "z", '
+                              b'quantity = "acceleration", unit = "m/s^2" }\n'
+                              b'"right.z" = { mount = "right", direction = "z", '
+                              b'quantity = "acceleration", unit = "m/s^2" }\n')
+
+
+def manoeuvre_files() -> dict:
+    return {k: v for k, v in _SEEDS.items() if k.startswith("m/")}
+
+
+TRANSIENT_OUT = ["--quiet", "--json", "j.json", "--csv", "t.csv"]
+
+
+def _manoeuvre_case(text: bytes, what: str, *extra, engine: str = "") -> Case:
+    files = {"m.toml": text}
+    if engine:                                    # a shipped engine with its mount files
+        files.update({**mount_files(), "engines/e.toml": _read(f"engines/{engine}.toml")})
+        extra = (*extra, "--engine", "engines/e.toml")
+        what += f" on {engine}"
+    return Case(files, ["transient", "m.toml", *TRANSIENT_OUT, *extra],
+                ["j.json", "t.csv"], "m.toml", what)
+
+
+def _rows(draw, n: int, kind: str) -> list:
+    """A column of ``n`` rows: times (``kind`` "time") or speeds [rpm]."""
+    if kind == "time":
+        style = draw(st.sampled_from(["uniform", "uniform", "duplicate", "backwards", "late",
+                                      "tiny", "huge", "nan"]))
+        dt = draw(st.sampled_from([1e-9, 1e-4, 0.01, 0.1, 1.0, 6.0, 3600.0]))
+        t = [k * dt for k in range(n)]
+        if style == "duplicate" and n > 2:
+            t[n // 2] = t[n // 2 - 1]
+        elif style == "backwards" and n > 2:
+            t[n // 2], t[n // 2 - 1] = t[n // 2 - 1], t[n // 2]
+        elif style == "late":
+            t = [x + draw(st.sampled_from([1e-12, 0.1, -0.1])) for x in t]
+        elif style == "tiny":
+            t = [k * 1e-300 for k in range(n)]
+        elif style == "huge":
+            t[-1] = draw(st.sampled_from([36000.0, 1e300, 60.0, 59.999]))
+        elif style == "nan":
+            t[draw(st.integers(0, n - 1))] = draw(st.sampled_from([math.nan, math.inf]))
+        return t
+    base = draw(st.sampled_from([0.0, 300.0, 800.0, 1500.0, 12000.0]))
+    slope = draw(st.sampled_from([0.0, 10.0, -200.0, 1000.0, -1e6]))
+    return [base + slope * k for k in range(n)]
+
+
+def _mangle_table(draw, doc: dict) -> str:
+    """One semantic mutation of the [speed] or [load] table (or of its neighbours)."""
+    section = draw(st.sampled_from(["speed", "load"]))
+    table = doc.setdefault(section, {})
+    col = "speed" if section == "speed" else next(
+        (k for k in ("imep_scale", "mean_torque") if k in table), "imep_scale")
+    n = draw(st.sampled_from([0, 1, 2, 3, 50, 4096, 4097]))
+    action = draw(st.sampled_from(["times", "values", "lengths", "unit", "long", "cross_zero",
+                                   "column", "swap_kind", "extreme", "extreme"]))
+    if action == "extreme":
+        return _extreme_manoeuvre(draw, doc)
+    if action == "times":
+        table["time"] = {"value": _rows(draw, max(n, 2) if n < 4096 else 50, "time"),
+                         "unit": "s"}
+        table[col] = {"value": [1.0] * len(table["time"]["value"]),
+                      "unit": table.get(col, {}).get("unit", "1")}
+    elif action == "values":
+        k = len(table.get("time", {}).get("value", [0, 1]))
+        table[col] = {"value": [draw(st.sampled_from(WEIRD_NUMBERS)) for _ in range(k)],
+                      "unit": table.get(col, {}).get("unit", "1")}
+    elif action == "lengths":
+        table["time"] = {"value": [0.1 * k for k in range(n)], "unit": "s"}
+    elif action == "unit":
+        key = draw(st.sampled_from(["time", col]))
+        if isinstance(table.get(key), dict):
+            table[key]["unit"] = draw(st.sampled_from(["ms", "min", "h", "rad/s", "Hz", "rpm",
+                                                       "N*m", "kN*m", "%", "1", "furlong", ""]))
+    elif action == "long":                                   # 10-hour, 60 s, 1 ms profiles
+        end = draw(st.sampled_from([36000.0, 60.0, 61.0, 1e-3, 1e-9]))
+        for sec in ("speed", "load"):
+            t = doc.get(sec, {}).get("time", {})
+            if isinstance(t, dict) and isinstance(t.get("value"), list) and t["value"]:
+                v = np.asarray(t["value"], float)
+                t["value"] = (v * end / v[-1] if np.all(np.isfinite(v)) and v[-1] > 0
+                              else v).tolist()
+    elif action == "cross_zero" and section == "speed":
+        k = len(table.get("time", {}).get("value", [0, 1]))
+        table["speed"] = {"value": _rows(draw, k, "speed"), "unit": "rpm"}
+        doc.setdefault("manoeuvre", {})["reversal"] = draw(st.booleans())
+    elif action == "column":
+        table.pop(draw(st.sampled_from(["time", col])), None)
+    elif action == "swap_kind" and section == "load" and col in table:
+        table["mean_torque" if col == "imep_scale" else "imep_scale"] = table.pop(col)
+    return f"{section}: {action}"
+
+
+def _extreme_manoeuvre(draw, doc: dict) -> str:
+    """Valid but extreme tables: very short or long, speeds at the bounds, crossing zero,
+    the largest load, gear ratio and inertia, a starter engaged to the end."""
+    end = draw(st.sampled_from([1e-6, 1e-3, 0.05, 0.3, 0.3, 1.0, 5.0]))
+    n = draw(st.sampled_from([2, 3, 7, 200]))
+    t = [end * k / (n - 1) for k in range(n)]
+    rpm = draw(st.lists(st.sampled_from([0.0, 1e-9, 30.0, -40.0, 800.0, 6000.0, 12000.0,
+                                         -12000.0, 1e-300]), min_size=n, max_size=n))
+    doc["speed"] = {"time": {"value": t, "unit": "s"}, "speed": {"value": rpm, "unit": "rpm"}}
+    kind = draw(st.sampled_from(["imep_scale", "mean_torque"]))
+    load = draw(st.sampled_from([0.0, 2.0, 1e-300, 0.06]) if kind == "imep_scale" else
+                st.sampled_from([0.0, 5000.0, -5000.0, 1e-300]))
+    doc["load"] = {"time": {"value": [0.0, end], "unit": "s"},
+                   kind: {"value": [load, load], "unit": "1" if kind == "imep_scale" else "N*m"}}
+    head = doc.setdefault("manoeuvre", {})
+    head["reversal"] = True
+    head["gear_ratio"] = {"value": draw(st.sampled_from([0.0, 50.0, 1e-300, 3.0])), "unit": "1"}
+    head["crank_inertia"] = {"value": draw(st.sampled_from([20.0, 1e-300, 1e-9, 0.18])),
+                             "unit": "kg*m^2"}
+    head.pop("trigger_time", None)
+    if draw(st.booleans()):
+        doc["starter"] = {"ratio": {"value": draw(st.sampled_from([0.1, 100.0])), "unit": "1"},
+                          "reaction_point": {"value": [0.0, 0.0, 3000.0], "unit": "mm"},
+                          "until": {"value": end, "unit": "s"}}
+    return f"extreme: {end:g} s, {n} rows, {kind} {load:g}"
+
+
+MANOEUVRE_KEYS = {"manoeuvre": ["gear_ratio", "crank_inertia", "reversal", "trigger_time",
+                                "name", "notes"],
+                  "load": ["motored_intake_pressure"],
+                  "starter": ["ratio", "reaction_point", "until"]}
+
+
+def _mangle_key(draw, doc: dict) -> str:
+    """A scalar of [manoeuvre], [load] or [starter] set weird, dropped or renamed, or a
+    section dropped or replaced."""
+    section = draw(st.sampled_from(sorted(MANOEUVRE_KEYS)))
+    key = draw(st.sampled_from(MANOEUVRE_KEYS[section]))
+    table = doc.setdefault(section, {})
+    if not isinstance(table, dict):
+        return f"{section} not a table"
+    action = draw(st.sampled_from(["number", "number", "weird", "drop", "rename", "section"]))
+    unit = {"gear_ratio": "1", "crank_inertia": "kg*m^2", "trigger_time": "s",
+            "motored_intake_pressure": "bar", "ratio": "1", "until": "s"}.get(key, "mm")
+    if action == "number":
+        v = draw(st.one_of(st.sampled_from(WEIRD_NUMBERS + [50.0, 50.1, 20.0, 0.1, 100.0,
+                                                             0.45, 0.4499, 4.0, 0.05]),
+                           st.floats(-1e3, 1e3)))
+        table[key] = ({"value": [v, v, v], "unit": unit} if key == "reaction_point"
+                      else {"value": v, "unit": unit} if key not in ("reversal", "name", "notes")
+                      else v)
+    elif action == "weird":
+        table[key] = draw(weird_value())
+    elif action == "drop":
+        table.pop(key, None)
+    elif action == "rename" and key in table:
+        table[draw(st.sampled_from([key.upper(), key + "s", "trigger", "x"]))] = table.pop(key)
+    elif action == "section":
+        doc[section] = draw(st.sampled_from([{}, [], 1, "x", [{}]]))
+    return f"{section}.{key}: {action}"
+
+
+def case_manoeuvre(draw) -> Case:
+    """A mutated manoeuvre file (structural, semantic or byte-level) on ``transient``."""
+    seed = draw(st.sampled_from(sorted(manoeuvre_files())))
+    how = draw(st.sampled_from(["toml", "table", "table", "key", "key"]))
+    engine = draw(st.sampled_from(["", "", "", "default-modal-body", "default-nonlinear",
+                                   "default-torque-rod"]))
+    if how == "toml":
+        return _manoeuvre_case(mutate_toml(draw, _SEEDS[seed]), f"manoeuvre TOML ({seed})",
+                               engine=engine)
+    doc = toml_loads(_SEEDS[seed])
+    what = [(_mangle_table if how == "table" else _mangle_key)(draw, doc)
+            for _ in range(draw(st.integers(1, 2)))]
+    try:
+        text = toml_dumps(doc).encode()
+    except (TypeError, ValueError):
+        text = _SEEDS[seed]
+    return _manoeuvre_case(text, f"manoeuvre ({seed}: {'; '.join(what)})", engine=engine)
+
+
+TRANSIENT_OUTPUTS = {"--out": ".h5", "--csv": ".csv", "--json": ".json", "--plot": ".png",
+                     "--raw": ".h5", "--compare-plot": ".png"}
+
+
+def _output_path(draw, opt: str) -> str:
+    """An output path for ``opt``: ordinary, or odd (under a regular file, an existing
+    folder, a long name, no suffix, onto an earlier output, onto the manoeuvre file or the
+    recording read)."""
+    suffix = TRANSIENT_OUTPUTS[opt]
+    odd = {".csv": ["m.toml"], ".json": ["m.toml"], ".h5": ["rec.h5"], ".png": []}[suffix]
+    return draw(st.sampled_from([
+        "o" + suffix, "sub/o" + suffix, "afile/o" + suffix, "dir", "a" * 300 + suffix, "o",
+        "old" + suffix, "", *odd]))
+
+
+def case_transient_options(draw) -> Case:
+    """``transient`` with one odd option (or two outputs) on a valid manoeuvre."""
+    seed = draw(st.sampled_from(["m/start.toml", "m/tip-in.toml"]))
+    files = {"m.toml": _SEEDS[seed], "afile": b"x", "old.h5": b"old\n", "old.csv": b"old\n",
+             "old.json": b"old\n", "old.png": b"old\n"}
+    setup = [lambda folder: (folder / "dir").mkdir()]
+    args = ["transient", "m.toml", "--quiet", "--json", "j.json"]
+    outputs = ["j.json"]
+    opt = draw(st.sampled_from(["--angle-step", "--seat", "--channels", "--quantity",
+                                "--trigger", "--channel-map", "--speed-average", "--engine",
+                                "output", "output", "output"]))
+    if opt == "--angle-step":
+        args += [opt, draw(st.one_of(option_value(), st.sampled_from(
+            ["0.01", "10", "10.0001", "0.0099", "5", "1e-3"])))]
+        engine = draw(st.sampled_from(["", "default-nonlinear", "default-modal-body"]))
+        if engine:                                # friction and curves at coarse steps
+            files.update({**mount_files(), "engines/e.toml": _read(f"engines/{engine}.toml")})
+            args += ["--engine", "engines/e.toml"]
+    elif opt in ("--seat", "--channels"):
+        args += [opt, draw(st.sampled_from(["seat_rail", "left.z", "left.z,right.z", "left",
+                                            "", ",", "left.z,,", "left.q", "seat_rail.z",
+                                            "left/passive.z", "x" * 500, "left.z," * 50]))]
+        if draw(st.booleans()):
+            files["engines/e.toml"] = _read("engines/default-modal-body.toml")
+            files.update(mount_files())
+            args += ["--engine", "engines/e.toml"]
+        if opt == "--channels":
+            args += ["--plot", "p.png"]
+            outputs.append("p.png")
+    elif opt == "--quantity":
+        args += [opt, draw(st.sampled_from(["force", "displacement", "velocity", "", "nan"])),
+                 "--plot", "p.png"]
+        outputs.append("p.png")
+    elif opt in ("--trigger", "--channel-map", "--speed-average"):
+        return _recording_option_case(draw, opt, files)
+    elif opt == "--engine":
+        files.update(mount_files())
+        files["engines/e.toml"] = draw(st.sampled_from([
+            _read("engines/default-modal-body.toml"), _read("engines/default-torque-rod.toml"),
+            _SEEDS["frf-csv.toml"], b"", _SEEDS["engine"][:200]]))
+        files["body.csv"] = _SEEDS["body.csv"]
+        args += [opt, "engines/e.toml"]
+        opt = (opt, "e.toml")
+    else:
+        picks = draw(st.lists(st.sampled_from(sorted(TRANSIENT_OUTPUTS)), min_size=1,
+                              max_size=3, unique=True))
+        if "--compare-plot" in picks:
+            files["rec.h5"] = _SEEDS["start-raw.h5"]
+            files["m.toml"] = _SEEDS["m/start.toml"]
+            args += ["--compare", "rec.h5"]
+        for p in picks:
+            path = _output_path(draw, p)
+            if path in args:                        # one output per path
+                continue
+            args += [p, path]
+            if path not in ("dir", ""):                     # a folder there before
+                outputs.append(path)
+        opt = tuple(picks) + ("afile", "dir", "j.json", "m.toml", "rec.h5")
+    return Case(files, args, outputs, opt, f"transient option {opt}", setup)
+
+
+def _recording_option_case(draw, opt, files) -> Case:
+    """--trigger, --channel-map or --speed-average with (or without) a recording."""
+    use = draw(st.sampled_from(["--compare", "--speed-from", "both", "none"]))
+    seed = draw(st.sampled_from(["start", "tip-in"]))
+    ext = draw(st.sampled_from(["h5", "csv"]))
+    files.update({"m.toml": _SEEDS[f"m/{seed}.toml"], f"rec.{ext}": _SEEDS[f"{seed}-raw.{ext}"]})
+    args = ["transient", "m.toml", "--quiet", "--json", "j.json"]
+    if use in ("--compare", "both"):
+        args += ["--compare", f"rec.{ext}"]
+    if use in ("--speed-from", "both"):
+        args += ["--speed-from", f"rec.{ext}"]
+    if opt == "--trigger":
+        args += [opt, draw(st.sampled_from(["trigger", "rpm", "left.z", "nope", "", " ",
+                                            "time", "cycle", "tacho", "TRIGGER"]))]
+    elif opt == "--channel-map":
+        files["map.toml"] = draw(st.sampled_from([_SEEDS["rec-map.toml"], _SEEDS["map.toml"]]))
+        if draw(st.booleans()):
+            files["map.toml"] = mutate_toml(draw, files["map.toml"])
+        where = draw(st.sampled_from(["map.toml", "map.toml", "nope.toml", "m.toml",
+                                      f"rec.{ext}"]))
+        args += [opt, where]
+        return Case(files, args, ["j.json"], (opt, f"rec.{ext}", where),
+                    f"transient {opt} ({use}, {seed}, {ext})")
+    else:
+        args += [opt]
+    return Case(files, args, ["j.json"], (opt, f"rec.{ext}", "map.toml", "m.toml"),
+                f"transient {opt} ({use}, {seed}, {ext})")
+
+
+REC_MUTATIONS = ["truncate", "tiny", "shift", "nan", "constant_rpm", "negative_rpm", "rename",
+                 "nonuniform", "drop_rpm", "huge_rpm", "decimate", "pad", "reverse", "scale",
+                 "held_rpm", "tacho", "tacho", "trigger", "bytes"]
+
+
+def _rec_arrays(data: bytes, ext: str) -> tuple:
+    """A seed recording's columns: (name -> values), the CSV header's comment lines."""
+    if ext == "csv":
+        lines = data.decode().splitlines()
+        head = next(i for i, ln in enumerate(lines) if not ln.startswith("#"))
+        values = np.loadtxt(lines[head + 1:], delimiter=",", ndmin=2)
+        return dict(zip(lines[head].split(","), values.T)), lines[:head]
+    import tempfile
+
+    import h5py
+    with tempfile.TemporaryDirectory() as tmp:
+        p = Path(tmp) / "x.h5"
+        p.write_bytes(data)
+        with h5py.File(p, "r") as h5:
+            cols = {"time": h5["time"][()], "rpm": h5["rpm"][()]}
+            if "trigger" in h5:
+                cols["trigger"] = h5["trigger"][()]
+            cols.update({f"channels/{k}": v[()] for k, v in h5["channels"].items()})
+    return cols, []
+
+
+def _rec_bytes(cols: dict, comments: list, data: bytes, ext: str) -> bytes:
+    """The recording with its columns replaced (CSV text, or the HDF5 seed's datasets
+    rewritten, their attributes kept)."""
+    if ext == "csv":
+        n = max(len(v) for v in cols.values())
+        rows = [",".join(f"{v[i]:.9g}" if i < len(v) else "" for v in cols.values())
+                for i in range(n)]
+        return ("\n".join(comments + [",".join(cols)] + rows) + "\n").encode()
+    import tempfile
+
+    import h5py
+    with tempfile.TemporaryDirectory() as tmp:
+        p = Path(tmp) / "x.h5"
+        p.write_bytes(data)
+        with h5py.File(p, "r+") as h5:
+            old = [k for k in ["time", "rpm", "trigger"] if k in h5] + \
+                [f"channels/{k}" for k in h5["channels"]]
+            for name in old:
+                attrs = dict(h5[name].attrs)
+                del h5[name]
+                if name in cols:
+                    h5[name] = cols[name]
+                    h5[name].attrs.update(attrs)
+            for name in set(cols) - set(old):     # added or renamed: mount and direction too
+                h5[name] = cols[name]
+                mount, _, direction = name.rpartition("/")[2].rpartition(".")
+                h5[name].attrs.update({"unit": "V"} if name in ("tacho", "trigger") else
+                                      {**attrs, "mount": mount, "direction": direction})
+        return p.read_bytes()
+
+
+def _mutate_columns(draw, cols: dict, action: str) -> dict:
+    """One defect of a recording's columns (REC_MUTATIONS)."""
+    names = list(cols)
+    tname = names[0]
+    rpm = next(n for n in names if n.split(" ")[0] == "rpm")
+    chans = [n for n in names if n not in (tname, rpm) and "trigger" not in n]
+    n = len(cols[tname])
+    if action in ("truncate", "tiny", "decimate", "pad", "reverse"):
+        if action == "truncate":
+            idx = np.arange(int(n * draw(st.sampled_from([0.05, 0.3, 0.49, 0.51, 0.7,
+                                                          0.95]))))
+        elif action == "tiny":
+            idx = np.arange(draw(st.integers(0, 3)))
+        elif action == "decimate":
+            idx = np.arange(0, n, draw(st.sampled_from([7, 50, 300, 1000])))
+        elif action == "reverse":
+            idx = np.arange(n)[::-1]
+        else:
+            idx = np.r_[np.arange(n), np.full(draw(st.sampled_from([n, 20 * n])), n - 1)]
+        out = {k: v[idx] for k, v in cols.items()}
+        if action == "pad":
+            dt = cols[tname][1] - cols[tname][0]
+            out[tname] = cols[tname][0] + dt * np.arange(idx.size)
+        return out
+    cols = {k: v.copy() for k, v in cols.items()}
+    if action == "shift":
+        cols[tname] += draw(st.sampled_from([-1.0, 0.3, 1e6, -1e6, 1e-9, 1e300, 100.0]))
+    elif action == "nan":
+        col = draw(st.sampled_from([tname, rpm] + chans))
+        cols[col][draw(st.integers(0, n - 1))] = draw(st.sampled_from([np.nan, np.inf,
+                                                                       -np.inf, 1e300]))
+    elif action == "constant_rpm":
+        cols[rpm][:] = draw(st.sampled_from([0.0, 800.0, 1e-300, 20000.0, -800.0]))
+    elif action == "negative_rpm":
+        cols[rpm] = -cols[rpm]
+    elif action == "huge_rpm":
+        cols[rpm] = cols[rpm] * draw(st.sampled_from([1e6, 20.0, 1e-6]))
+    elif action == "scale":
+        col = draw(st.sampled_from(chans))
+        cols[col] = cols[col] * draw(st.sampled_from([0.0, 1e300, -1.0, 1e-300]))
+    elif action == "nonuniform":
+        t = cols[tname]
+        k = draw(st.integers(1, n - 2))
+        t[k] = draw(st.sampled_from([t[k - 1], 0.5 * (t[k - 1] + t[k]), t[k + 1],
+                                     t[k] + 1e-9]))
+        if draw(st.booleans()):
+            t[k:] += draw(st.sampled_from([0.01, 1.0]))
+    elif action == "rename":
+        old = draw(st.sampled_from(chans + [rpm]))
+        new = draw(st.sampled_from(["front.z", "left.q", "left", "rpm2", "left.z", "seat.z",
+                                    "time", "left/passive.z"]))
+        unit = old.partition(" ")[2]
+        cols = {((new + (" " + unit if unit else "")) if "/" not in old else
+                 "channels/" + new) if k == old else k: v for k, v in cols.items()}
+    elif action == "drop_rpm":
+        del cols[rpm]
+    elif action == "held_rpm":                   # an ECU's speed: held between updates
+        k = draw(st.sampled_from([10, 100, 1000]))
+        cols[rpm] = np.repeat(cols[rpm][::k], k)[:n]
+    elif action == "tacho":
+        cols = _tacho_columns(draw, cols, tname, rpm)
+    elif action == "trigger":
+        cols = _trigger_columns(draw, cols, tname)
+    return cols
+
+
+def _tacho_columns(draw, cols: dict, tname: str, rpm: str) -> dict:
+    """The rpm channel replaced by a once-per-revolution tacho [V] of the same speed, with
+    a defect: none, a pulse missing, two per revolution, flat, noisy, NaN."""
+    t, speed = cols[tname], cols.pop(rpm)
+    rev = np.r_[0.0, np.cumsum(0.5 * (speed[1:] + speed[:-1]) * np.diff(t))] / 60.0
+    defect = draw(st.sampled_from(["none", "none", "missing", "double", "flat", "noise",
+                                   "nan", "offset"]))
+    if defect == "double":
+        rev = 2.0 * rev
+    if defect == "offset":
+        rev = rev + draw(st.sampled_from([0.3, 0.99, -0.5]))
+    v = np.where(np.mod(rev, 1.0) < 0.25, 5.0, 0.0)
+    if defect == "missing":
+        hi = np.flatnonzero(v > 0)
+        v[hi[hi.size // 2:hi.size // 2 + 50]] = 0.0
+    elif defect == "flat":
+        v[:] = draw(st.sampled_from([0.0, 5.0]))
+    elif defect == "noise":
+        v = v + np.random.default_rng(0).normal(0.0, 2.0, v.size)
+    elif defect == "nan":
+        v[draw(st.integers(0, v.size - 1))] = np.nan
+    cols["tacho [V]" if " " in tname else "tacho"] = v
+    return cols
+
+
+def _trigger_columns(draw, cols: dict, tname: str) -> dict:
+    """The trigger channel (added where there is none) with a defect: flat, a glitch,
+    falling, noisy, NaN, two steps."""
+    t = cols[tname]
+    name = next((k for k in cols if k.split(" ")[0] == "trigger"),
+                "trigger [V]" if " " in tname else "trigger")
+    v = np.where(t >= t[0] + draw(st.sampled_from([0.0, 0.1, 0.3, 1e-9])), 5.0, 0.0)
+    defect = draw(st.sampled_from(["flat", "glitch", "falling", "noise", "nan", "two",
+                                   "late"]))
+    if defect == "flat":
+        v[:] = 5.0
+    elif defect == "glitch":
+        v[:] = 0.0
+        v[t.size // 3] = 5.0
+    elif defect == "falling":
+        v = 5.0 - v
+    elif defect == "noise":
+        v = v + np.random.default_rng(1).normal(0.0, 3.0, v.size)
+    elif defect == "nan":
+        v[draw(st.integers(0, v.size - 1))] = np.nan
+    elif defect == "two":
+        v[t > t[0] + 0.2] = 0.0
+        v[t > t[0] + 0.3] = 5.0
+    else:
+        v = np.where(t >= t[-1] - 1e-4, 5.0, 0.0)
+    cols[name] = v
+    return cols
+
+
+def mutated_recording(draw, seed: str, ext: str) -> tuple[bytes, str]:
+    """A seed recording (``start``/``tip-in``, ``csv``/``h5``) with one defect."""
+    data = _SEEDS[f"{seed}-raw.{ext}"]
+    action = draw(st.sampled_from(REC_MUTATIONS))
+    if action == "bytes":
+        if ext == "csv":
+            return mutate_csv(draw, data), "csv cell"
+        return mutate_raw_hdf5(draw, data)
+    cols, comments = _rec_arrays(data, ext)
+    return _rec_bytes(_mutate_columns(draw, cols, action), comments, data, ext), action
+
+
+def case_transient_recording(draw) -> Case:
+    """A mutated recording for ``--compare`` and/or ``--speed-from`` (CSV or HDF5)."""
+    seed = draw(st.sampled_from(["start", "start", "tip-in", "stop", "start-modal"]))
+    ext = draw(st.sampled_from(["csv", "h5"]))
+    data, action = mutated_recording(draw, seed, ext)
+    files = {"m.toml": _SEEDS[f"m/{seed.removesuffix('-modal')}.toml"], f"rec.{ext}": data}
+    use = draw(st.sampled_from(["--compare", "--speed-from", "both"]))
+    args = ["transient", "m.toml", "--quiet", "--json", "j.json"]
+    if use in ("--compare", "both"):
+        args += ["--compare", f"rec.{ext}"]
+    if use in ("--speed-from", "both"):
+        args += ["--speed-from", f"rec.{ext}"]
+    if seed == "tip-in" or action == "trigger":     # the start's seed has no trigger
+        args += ["--trigger", "trigger"]
+    if "--speed-from" in args and draw(st.booleans()):
+        args += ["--speed-average"]
+    if seed.endswith("-modal") and draw(st.booleans()):       # else: body channels unused
+        files.update({**mount_files(),
+                      "engines/e.toml": _read("engines/default-modal-body.toml")})
+        args += ["--engine", "engines/e.toml"]
+    return Case(files, args, ["j.json"], f"rec.{ext}",
+                f"transient {use} recording ({seed} {ext}: {action})")
+
+
+RUNUP_ONLY = ["--from", "--to", "--step", "--solver", "--signal", "--objective", "--measured",
+              "--workers", "--scheduler", "--target-out", "--target-plot"]
+
+
+def case_whatif_manoeuvre(draw) -> Case:
+    """``whatif --manoeuvre`` with a mutated variants file, an odd --scale/--set/--move/
+    --rotate/--target spec, a run-up option, or a mutated manoeuvre."""
+    seed = draw(st.sampled_from(["m/start.toml", "m/stop.toml"]))
+    files = {"m.toml": _SEEDS[seed], **mount_files()}
+    args = ["whatif", "--manoeuvre", "m.toml", "--quiet", "--json", "w.json"]
+    what = draw(st.sampled_from(["variants", "spec", "spec", "extreme", "extreme",
+                                 "runup_option", "manoeuvre"]))
+    if what == "extreme":                     # a valid spec, an extreme factor or value
+        op = draw(st.sampled_from(["scale", "scale", "set", "move", "swap", "swap"]))
+        target = draw(st.sampled_from(["left.z", "right.y", "gearbox.x", "*.*", "*.z"]))
+        value = draw(st.sampled_from(["1e-9", "1e-3", "0.5", "2", "1e3", "1e9", "1e12"]))
+        if op == "move":
+            spec = f"{target.split('.')[0].replace('*', 'left')}={value},0,{value}"
+        elif op == "swap":                        # a mount file with static curve, law
+            spec = (target.replace("*", "left") + "=" + draw(st.sampled_from(
+                sorted(mount_files()) + ["mounts/nope.toml", "m.toml"])))
+            if draw(st.booleans()):               # ... and its law or curve mangled
+                files["mounts/x.toml"] = mutate_toml(draw, files[spec.split("=")[1]]) \
+                    if spec.split("=")[1] in files else b""
+                spec = spec.split("=")[0] + "=mounts/x.toml"
+        else:
+            part = draw(st.sampled_from(["stiffness", "damping", "dynamic"] if op == "scale"
+                                        else ["c1", "d1", "m1", "c2"]))
+            spec = f"{target}.{part}={value}"
+        args += [f"--{op}", spec]
+        mutated = (f"--{op}", spec.partition("=")[2].rpartition("/")[2] or "?")
+    elif what == "variants":
+        files["v.toml"] = mutate_toml(draw, _SEEDS["variants.toml"])
+        args += ["--variants", "v.toml"]
+        mutated = "v.toml"
+    elif what == "spec":
+        op = draw(st.sampled_from(["scale", "scale", "set", "move", "rotate", "target"]))
+        args += [f"--{op}", draw(mount_op_spec(op))]
+        mutated = f"--{op}"
+    elif what == "runup_option":
+        mutated = draw(st.sampled_from(RUNUP_ONLY))
+        args += [mutated, "1000", "--scale", "left.z.dynamic=1.2"]
+    else:
+        files["m.toml"] = mutate_toml(draw, _SEEDS[seed])
+        args += ["--scale", "left.z.stiffness=1.1"]
+        mutated = "m.toml"
+    if draw(st.integers(0, 4)) == 0:
+        args += ["--delta-plot", "d.png"]
+        return Case(files, args, ["w.json", "d.png"], mutated, f"whatif --manoeuvre ({what})")
+    return Case(files, args, ["w.json"], mutated, f"whatif --manoeuvre ({what})")
+
+
+KINDS.update({"manoeuvre": case_manoeuvre, "transient_options": case_transient_options,
+              "transient_recording": case_transient_recording,
+              "whatif_manoeuvre": case_whatif_manoeuvre})
+#: The input kinds of ``transient`` and ``whatif --manoeuvre`` (issue 38).
+TRANSIENT_KINDS = ("manoeuvre", "transient_options", "transient_recording",
+                   "whatif_manoeuvre")
+
+
+def _fixed(*values):
+    """A ``draw`` that returns ``values`` in order (a deterministic mutation)."""
+    it = iter(values)
+    return lambda strategy: next(it)
+
+
+def _recording_with(seed: str, ext: str, action: str, *draws) -> bytes:
+    """The seed recording with one defect of :func:`_mutate_columns`, drawn as given."""
+    data = _SEEDS[f"{seed}-raw.{ext}"]
+    cols, comments = _rec_arrays(data, ext)
+    return _rec_bytes(_mutate_columns(_fixed(*draws), cols, action), comments, data, ext)
+
+
+def issue_38_cases() -> dict:
+    """Every failure the transient kinds' campaign found, as a named case: name -> (case,
+    expected outcome)."""
+    mf = mount_files()
+    whatif = ["whatif", "--manoeuvre", "m.toml", "--quiet", "--json", "w.json"]
+    cases = {
+        "whatif --manoeuvre --scale left.z.stiffness=1.6e268 (a singular network)": Case(
+            {**mf, "m.toml": _SEEDS["m/start.toml"]},
+            [*whatif, "--scale", "left.z.stiffness=1.5746172860597073e+268"], ["w.json"],
+            "--scale", ""),
+        "whatif (run-up) --scale left.z.stiffness=1e300": Case(
+            {**mf}, ["whatif", "--from", "1000", "--to", "2000", "--step", "1000", "--workers",
+                     "1", "--quiet", "--json", "w.json", "--scale", "left.z.stiffness=1e300"],
+            ["w.json"], "--scale", ""),
+    }
+    cases["whatif --manoeuvre --set right.y.d1=1e12 (N*s/mm: singular at some frequency)"] = \
+        Case({**mf, "m.toml": _SEEDS["m/stop.toml"]}, [*whatif, "--set", "right.y.d1=1e12"],
+             ["w.json"], "--set", "")
+    for ext in ("h5", "csv"):          # found as a tacho's pulse split in two: 9478 rpm
+        cases[f"--speed-from a recorded speed of 7500 rpm, above the engine ({ext})"] = Case(
+            {"m.toml": _SEEDS["m/tip-in.toml"],
+             f"rec.{ext}": _recording_with("tip-in", ext, "huge_rpm", 5.0)},
+            ["transient", "m.toml", "--quiet", "--json", "j.json", "--speed-from", f"rec.{ext}",
+             "--trigger", "trigger", "--speed-average"], ["j.json"], f"rec.{ext}", "")
+    rest = toml_loads(_SEEDS["m/tip-in.toml"])
+    rest["speed"]["speed"]["value"] = [0.0] * len(rest["speed"]["time"]["value"])
+    rest["load"]["mean_torque"]["value"] = [5000.0] * len(rest["load"]["time"]["value"])
+    rest["manoeuvre"]["gear_ratio"]["value"] = 50.0
+    cases["at rest, 5000 N*m in a gear of 50 on the static curves (no static point)"] = \
+        _manoeuvre_case(toml_dumps(rest).encode(), "", engine="default-nonlinear")
+    out = {name: (case, "clean_error") for name, case in cases.items()}
+    # Newton on the curves' static point was held to round-off near the zero-torque point
+    # (FloatingPointError on every neutral start above standstill: stop.toml)
+    out["stop (window) on the static curves: the static point near zero torque"] = (
+        _manoeuvre_case(_SEEDS["m/stop.toml"], "", engine="default-nonlinear"), "ok")
+    out["whatif --manoeuvre (stop window) --swap left.z= a mount with a static curve"] = (
+        Case({**mf, "m.toml": _SEEDS["m/stop.toml"]},
+             [*whatif, "--swap", "left.z=mounts/hydraulic-engine-mount-z-nonlinear.toml"],
+             ["w.json"], "--swap", ""), "ok")
+    return out

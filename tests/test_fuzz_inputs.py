@@ -4,15 +4,19 @@ Hypothesis mutates valid seeds of every input kind -- engine TOML, mount TOML, p
 stiffness CSV, measured CSV and HDF5, what-if variants TOML, raw time data as CSV, HDF5, UFF
 58 and MDF4 (``track``), channel maps, the FRF (measured receptance) chassis, ``diagnose``,
 ``modes`` on a modal-body engine, and option specs (``--freq``, ``--effect``, ``--scale``,
-``--set``, ``--move``, ``--rotate``, ``--target``, speeds, seeds, track options, sweeps)
--- and runs the command that reads it (``tests/fuzz_harness.py``). Every run must end in a
+``--set``, ``--move``, ``--rotate``, ``--target``, speeds, seeds, track options, sweeps),
+and the transient manoeuvres of issue 38 -- manoeuvre TOML, ``transient``'s options and
+outputs, recordings for ``--compare`` and ``--speed-from`` (CSV and HDF5: cut, shifted,
+NaN, held or tacho speed, triggers), ``whatif --manoeuvre`` specs and variants -- and runs
+the command that reads it (``tests/fuzz_harness.py``). Every run must end in a
 clean one-line error naming the file or option (exit 1, no output file) or in a finite
 result; never a traceback, a hang, NaN/inf in an output, a leftover file, or a lost one
 (a file that was there before, changed or gone after a failed run).
 
 Examples per kind are bounded here (``FUZZ_EXAMPLES``, default 4) to keep CI short;
 ``python scripts/fuzz_inputs.py`` runs the long campaign and prints the counts.
-Every failure issues 10 and 18 list is also replayed by name, and data safety is checked
+Every failure issues 10 and 18 list, and every one the transient campaign found, is
+also replayed by name, and data safety is checked
 once each: concurrent runs to one path, a SIGKILL mid-write (these three in the slow lane:
 about 40 s together).
 """
@@ -88,6 +92,17 @@ def test_issue_39_tiny_level_report_is_finite(worker, tmp_path):
     for name, (case, expected) in slow.items():
         outcome, detail = fh.run_case(worker, case, tmp_path / "case")
         assert outcome == expected, f"{name}: {outcome}: {detail}"
+
+
+def test_issue_38_transient_failures(worker, tmp_path):
+    """Each failure the campaign over ``transient`` and ``whatif --manoeuvre`` found (issue
+    38's manoeuvres, recordings, options): a clean one-line error, no output."""
+    wrong = []
+    for name, (case, expected) in fh.issue_38_cases().items():
+        outcome, detail = fh.run_case(worker, case, tmp_path / "case")
+        if outcome != expected:
+            wrong.append(f"{name}: {outcome} ({detail[:200]})")
+    assert not wrong, "\n".join(wrong)
 
 
 @pytest.mark.parametrize("name", sorted(

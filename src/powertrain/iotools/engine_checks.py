@@ -70,6 +70,9 @@ def _check_static_stiffness(system, mounts, path) -> None:
         kr = np.linalg.eigvalsh(system.static_stiffness_6())
     except np.linalg.LinAlgError:
         kr = np.zeros(1)
+    except ArithmeticError:                  # a mount network singular at 0 Hz
+        raise InputError("a mount network is singular at 0 Hz (a stiffness or damping out "
+                         "of range?)", file=path, key="mounts") from None
     if kr.min() <= 1e-9 * max(kr.max(), 1e-300):
         raise InputError("the mounts' static stiffness does not hold the body in every "
                          "direction (a rigid-body mode at 0 Hz); softest: "

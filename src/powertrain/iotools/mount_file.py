@@ -72,6 +72,17 @@ def read_mount(path) -> MountModel:
     return model
 
 
+def check_plausible(model: MountModel, path) -> None:
+    """Refuse a parameter above :data:`MAX_SI` or not finite, as a mount file's (a value
+    set or scaled from the command line: ``whatif --set``, ``--scale``)."""
+    for p, value in model.params.items():
+        top = MAX_SI[p[0]]
+        if not value <= top:
+            unit = {"c": "N/m", "d": "N*s/m", "m": "kg"}[p[0]]
+            raise InputError(f"{p} = {value:g} {unit} above the plausible {top:g} {unit} "
+                             "(unit error?)", file=path, key=f"parameters.{p}")
+
+
 def check_network(model: MountModel, path) -> None:
     """Refuse a network that is singular at 0 Hz: an internal node held by no spring to
     the engine side or the ground (e.g. every spring and damper 0), so that its static

@@ -334,7 +334,8 @@ def _start(engine, manoeuvre, system, load, ports, model):
     omega = abs(float(load.omega[0]))
     if omega < REST_RPM * RPM:  # at rest where the driveline holds the block (none: at zero)
         held = driveline_reaction(engine, manoeuvre, load.driveline_torque[0])
-        x0 = _static_state(system, scaling, curves, held) if held.any() else np.zeros(n)
+        x0 = (_static_state(system, scaling, curves, held, manoeuvre.file) if held.any()
+              else np.zeros(n))
         state = laws.initial_state(x0) if laws.kinds.size else None
         return x0, np.zeros(n), None, state, np.zeros(ports.kinds.size)
     grid = Cycles(N_THETA, 720.0 / N_THETA, 1, 1)
@@ -343,7 +344,7 @@ def _start(engine, manoeuvre, system, load, ports, model):
     fh, omegas = stepper.harmonics(_cycle_load(engine, manoeuvre, theta), omega, 40.0)
     factors, mean = None, None
     if curves is not None:       # the mean on the curves, the vibration on their tangents
-        mean = _static_state(system, scaling, curves, fh[0].real)
+        mean = _static_state(system, scaling, curves, fh[0].real, manoeuvre.file)
         factors, fh = curves.factors(mean), np.concatenate([0 * fh[:1], fh[1:]])
     qh, A = stepper.harmonic_state(fh, omegas, omega, stepper.system_at(factors))
     if mean is not None:
@@ -356,18 +357,21 @@ def _start(engine, manoeuvre, system, load, ports, model):
 
 
 #: Newton on the static point of the curves (:func:`_static_state`): most iterations and
-#: the step, relative to the state, at which it has converged.
-STATIC_MAX_ITER, STATIC_TOL = 100, 1e-12
+#: the step, relative to the state or to :data:`STATIC_SCALE` [m] where the state is
+#: smaller (near the zero-torque point, which the curves are about), at which it has
+#: converged.
+STATIC_MAX_ITER, STATIC_TOL, STATIC_SCALE = 100, 1e-12, 1e-3
 
 
-def _static_state(system, scaling, curves, load):
+def _static_state(system, scaling, curves, load, file=None):
     r"""State (n,) at rest under the body load ``load`` (6,) [N, N m] on the static curves:
     :math:`\mathbf K(f)\,\mathbf x + \mathbf R^T \mathbf c = \mathbf F` with the
     static factors :math:`f` and curve loads :math:`c` of
     :func:`~powertrain.kernels.transient.curve_state` at :math:`\mathbf x` (the amplitude
     law's scale 1: the static force of each network is its curve's), by Newton on the
     tangent stiffness :math:`\mathbf K(f)`. Port laws carry no mean force (as in the
-    harmonic steady state)."""
+    harmonic steady state). No static point (a load beyond what the curves carry): one
+    line naming the manoeuvre ``file`` and its load."""
     kc = _kernel_curves(system, scaling, curves)
     rows, n_net = kc[0], kc[0].shape[0]
     F = np.zeros(system.n_dof)
@@ -379,10 +383,11 @@ def _static_state(system, scaling, curves, load):
         K = system.K + np.tensordot(f - scaling.assembled[:, 0], scaling.K_parts, 1)
         dx = np.linalg.solve(K, F - K @ x - rows.T @ c)
         x += dx
-        if np.max(np.abs(dx)) <= STATIC_TOL * max(np.max(np.abs(x)), 1e-9):
+        if np.max(np.abs(dx)) <= STATIC_TOL * max(np.max(np.abs(x)), STATIC_SCALE):
             return x
-    raise FloatingPointError("the static point of the first load on the mounts' static "
-                             f"curves did not converge in {STATIC_MAX_ITER} iterations")
+    raise InputError("no static point of the first load on the mounts' static curves (not "
+                     f"converged in {STATIC_MAX_ITER} iterations): a mean torque or gear ratio "
+                     "beyond what they carry?", file=file or None, key="load")
 
 
 def _cycle_load(engine, manoeuvre, theta):

@@ -19,7 +19,7 @@ import numpy as np
 
 from powertrain.effects import EFFECTS, RESPONSE_EFFECTS
 from powertrain.errors import InputError
-from powertrain.iotools.mount_file import check_network
+from powertrain.iotools.mount_file import check_network, check_plausible
 from powertrain.physics.mount_laws import BergFriction, PowerLaw, StaticCurve
 
 #: Mount or direction name that matches every mount or direction.
@@ -140,6 +140,7 @@ class SetParameter:
                     f"{self.parameter!r} (expected {', '.join(model.topology.parameters)})")
             new = model.with_params(**{self.parameter: self.value})
             try:
+                check_plausible(new, None)
                 check_network(new, None)
             except InputError as exc:
                 raise self.origin.error(f"{self.spec!r}: {exc.message}") from None

@@ -99,7 +99,7 @@ def transient(manoeuvre, engine=None, *, angle_step_deg=ANGLE_STEP_DEG, seat=Non
     m, speed_note = _driven(m, speed_from, dict(
         trigger=trigger, channel_map=channel_map, pulses_per_rev=pulses_per_rev,
         trigger_edge=trigger_edge,
-        firing_interval=engine.crank.firing_interval if speed_average else None))
+        firing_interval=engine.crank.firing_interval if speed_average else None), engine)
     t0 = time.process_time()
     with single_blas_thread():
         run = simulate_transient(engine, m, system=system, angle_step_deg=step)
@@ -119,10 +119,10 @@ def _result(m, engine, run, seat, seconds, speed_note) -> TransientResult:
         [m.notes] if m.notes else [], speed_note, m.trigger_time)
 
 
-def _driven(m, speed_from, options) -> tuple:
+def _driven(m, speed_from, options, engine) -> tuple:
     """The manoeuvre driven by a recorded speed (``options``: those of
-    :func:`~powertrain.workflows.transient_recording.speed_from_recording`), and the line
-    saying so ("" without)."""
+    :func:`~powertrain.workflows.transient_recording.speed_from_recording`; at most the
+    ``engine``'s top speed), and the line saying so ("" without)."""
     if speed_from is None:
         for key, given in (("--trigger", options["trigger"] is not None),
                            ("--channel-map", options["channel_map"] is not None),
@@ -132,7 +132,22 @@ def _driven(m, speed_from, options) -> tuple:
             if given:
                 raise InputError("goes with a recording (speed_from)", key=key)
         return m, ""
-    return speed_from_recording(m, speed_from, **options)
+    driven, note = speed_from_recording(m, speed_from, **options)
+    _check_recorded_top(driven, speed_from, engine)
+    return driven, note
+
+
+def _check_recorded_top(m, speed_from, engine) -> None:
+    """A recorded speed (``speed_from``) above the engine's combustion model is the
+    recording's error, named by its file and ``rpm`` (the manoeuvre's own speed table is
+    checked by the solver, naming the manoeuvre file)."""
+    top = engine.speed_range_rpm()[1]
+    if speed_from is not None and m.max_speed * 30.0 / np.pi > top + 1e-6:
+        tacho = getattr(speed_from, "speed_source", "") == "tacho"
+        raise InputError(f"the recorded speed reaches {m.max_speed * 30.0 / np.pi:g} rpm, "
+                         f"above the engine's combustion model ({top:g} rpm)",
+                         file=str(getattr(speed_from, "path", speed_from)),
+                         key="tacho" if tacho else "rpm")
 
 
 def seat_point(engine, seat) -> str | None:
