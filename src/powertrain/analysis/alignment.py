@@ -48,7 +48,7 @@ import warnings
 
 import numpy as np
 
-from powertrain.analysis.speed import count_teeth, drop_spikes, tacho_edges
+from powertrain.analysis.speed import count_teeth, drop_spikes
 from powertrain.errors import InputError, PowertrainWarning
 
 #: Times of the event at which the speeds are matched.
@@ -105,7 +105,7 @@ def tacho_counts(edges, pulses_per_rev=1, *, file=None, key="tacho") -> tuple:
     return edges, counts
 
 
-def tacho_rpm(time, tacho, *, pulses_per_rev=1, file=None, key="tacho") -> np.ndarray:
+def tacho_rpm(time, edges, counts, pulses_per_rev=1) -> np.ndarray:
     """Crank speed [rpm] at every sample from a tacho of ``pulses_per_rev`` pulses per
     revolution (module docstring: interval means at their midpoints, standstill before the
     first and after the last edge where the record is long enough to show it).
@@ -114,15 +114,11 @@ def tacho_rpm(time, tacho, *, pulses_per_rev=1, file=None, key="tacho") -> np.nd
     ----------
     time : ndarray (n,)
         [s]
-    tacho : ndarray (n,)
-        Pulse train [V].
+    edges, counts : ndarray (m,)
+        The tacho's rising edges [s] and the pulses counted at each (:func:`tacho_counts`).
     pulses_per_rev : int
-    file, key : str, optional
-        Named in error messages.
     """
     time = np.asarray(time, float)
-    edges, counts = tacho_counts(tacho_edges(time, tacho, file=file, key=key),
-                                 pulses_per_rev, file=file, key=key)
     d = np.diff(edges)
     tt, rr = 0.5 * (edges[1:] + edges[:-1]), 60.0 * np.diff(counts) / (pulses_per_rev * d)
     if edges[0] - time[0] > d[0]:
@@ -293,7 +289,7 @@ def _phase_error(shift, t_sim, rev, speed, edges, revs, span, sigma) -> tuple:
     rate = np.interp(at[inside], t_sim, speed)
     lags = round(CORRELATION_REV * np.median(np.diff(revs)) ** -1)
     design = rate - np.mean(rate)
-    white = _correlated_error(design, np.zeros_like(design), sigma, 0)
+    white = sigma / np.sqrt(float(design @ design)) if np.any(design) else np.inf
     return white, max(white, _correlated_error(design, phase - np.mean(phase),
                                                PHASE_FLOOR_REV, lags))
 
@@ -401,7 +397,7 @@ def _shift_error(t, target, t_rec, rpm_rec, shift, sigma) -> tuple:
     slope = np.interp(at[inside], t, np.gradient(target, t))
     residual = rr[inside] - np.interp(at[inside], t, target)
     lags = round(CORRELATION_S / (every * (t_rec[1] - t_rec[0])))
-    white = _correlated_error(slope, np.zeros_like(slope), sigma, 0)
+    white = sigma / np.sqrt(float(slope @ slope)) if np.any(slope) else np.inf
     return white, max(white, _correlated_error(slope, residual, SPEED_FLOOR_RPM, lags))
 
 

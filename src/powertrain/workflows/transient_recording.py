@@ -56,8 +56,9 @@ class Recorded:
         Crank speed [rpm] at every sample (rpm channel, else tacho; None without either).
     speed_source : str
         ``rpm channel``, ``tacho`` or ``""``.
-    trigger : float or None
-        Time of the trigger [s] from the first sample (None without ``--trigger``).
+    crossing : TriggerCrossing or None
+        The trigger's step from the first sample (None without ``--trigger``;
+        :func:`~powertrain.analysis.trigger.trigger_crossing`); :attr:`trigger` its time [s].
     trigger_name : str or None
     channels : list of RawChannel
     ignored : list of str
@@ -65,10 +66,6 @@ class Recorded:
     edges : ndarray or None
         The once-per-revolution tacho's rising edges from the first sample [s] (None
         where the speed is an rpm channel's).
-    trigger_error : float
-        Standard error of ``trigger`` [s].
-    trigger_crossing : TriggerCrossing or None
-        How ``trigger`` was found (:func:`~powertrain.analysis.trigger.trigger_crossing`).
     counts : ndarray or None
         The tacho's pulses counted at each of ``edges`` (a missing-tooth wheel's gap
         counted).
@@ -83,16 +80,19 @@ class Recorded:
     time: np.ndarray
     rpm: np.ndarray | None
     speed_source: str
-    trigger: float | None
+    crossing: TriggerCrossing | None
     trigger_name: str | None
     channels: list
     ignored: list = field(default_factory=list)
     edges: np.ndarray | None = None
-    trigger_error: float = 0.0
     counts: np.ndarray | None = None
     pulses_per_rev: int = 1
     unused_trigger: bool = False
-    trigger_crossing: TriggerCrossing | None = None
+
+    @property
+    def trigger(self) -> float | None:
+        """Time of the trigger [s] from the first sample (None without ``--trigger``)."""
+        return None if self.crossing is None else self.crossing.time
 
 
 def read_recording(path, *, channel_map=None, trigger=None, pulses_per_rev=1,
@@ -119,7 +119,6 @@ def read_recording(path, *, channel_map=None, trigger=None, pulses_per_rev=1,
     t = rec.time - rec.time[0]
     crossing = None if trigger is None else trigger_crossing(
         t, rec.trigger, edge=trigger_edge, file=str(path), key=trigger)
-    when = (None, 0.0) if crossing is None else crossing[:2]
     ignored = [n.strip() for c in rec.comments if c.startswith(IGNORED_NOTE)
                for n in c[len(IGNORED_NOTE):].split(",")]
     if pulses_per_rev != 1 and rec.rpm is not None:
@@ -129,9 +128,11 @@ def read_recording(path, *, channel_map=None, trigger=None, pulses_per_rev=1,
     edges, counts = (tacho_counts(tacho_edges(t, rec.tacho, file=str(path), key="tacho"),
                                   pulses_per_rev, file=str(path), key="tacho")
                      if rec.rpm is None and rec.tacho is not None else (None, None))
-    return Recorded(str(path), t, recorded_rpm(rec, path, pulses_per_rev), _speed_source(rec),
-                    when[0], trigger, list(rec.channels), ignored, edges, when[1], counts,
-                    pulses_per_rev, trigger is None and rec.trigger is not None, crossing)
+    rpm = (np.asarray(rec.rpm, float) if rec.rpm is not None
+           else None if edges is None else tacho_rpm(t, edges, counts, pulses_per_rev))
+    return Recorded(str(path), t, rpm, _speed_source(rec), crossing, trigger,
+                    list(rec.channels), ignored, edges, counts, pulses_per_rev,
+                    trigger is None and rec.trigger is not None)
 
 
 def recording_or_file(recording, **options) -> Recorded:
@@ -147,31 +148,16 @@ def _speed_source(rec) -> str:
                                                       else "")
 
 
-def recorded_rpm(rec, path, pulses_per_rev=1) -> np.ndarray | None:
-    """Crank speed [rpm] at every sample of the raw recording ``rec``: its rpm channel, else
-    its tacho of ``pulses_per_rev`` pulses per revolution
-    (:func:`~powertrain.analysis.alignment.tacho_rpm`: at rest before the first pulse
-    where the record shows it), else None."""
-    if rec.rpm is not None:
-        return np.asarray(rec.rpm, float)
-    if rec.tacho is not None:
-        return tacho_rpm(rec.time - rec.time[0], rec.tacho, pulses_per_rev=pulses_per_rev,
-                         file=str(path), key="tacho")
-    return None
-
-
 def align(rec: Recorded, t_event, rpm_event, *, partial=True, trigger_at=0.0) -> tuple:
     """The recording's time [s] of the event's time 0, how it was found (``trigger
     'NAME'`` or ``crank speed``) and its standard error [s]: the trigger's time less the
     event's time of the trigger ``trigger_at`` [s], else the speed alignment against the
     event's speed ``rpm_event`` [rpm] at ``t_event`` [s] (module docstring); ``partial``:
     the recording may cover part of the event (:func:`align_speed`)."""
-    if rec.trigger is not None:
-        crossing = rec.trigger_crossing or TriggerCrossing(
-            rec.trigger, rec.trigger_error, rec.trigger_error, 0.0)
-        shift = trigger_shift(crossing, trigger_at, rpm_event, file=rec.path,
+    if rec.crossing is not None:
+        shift = trigger_shift(rec.crossing, trigger_at, rpm_event, file=rec.path,
                               key=rec.trigger_name)
-        return shift, f"trigger {rec.trigger_name!r}", rec.trigger_error
+        return shift, f"trigger {rec.trigger_name!r}", rec.crossing.error
     if rec.rpm is None:
         raise InputError("no rpm or tacho channel to line the recording up on; give "
                          "--trigger CHANNEL", file=rec.path, key="rpm")
