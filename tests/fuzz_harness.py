@@ -2118,6 +2118,10 @@ def issue_38_cases() -> dict:
                      "1", "--quiet", "--json", "w.json", "--scale", "left.z.stiffness=1e300"],
             ["w.json"], "--scale", ""),
     }
+    cases["whatif --scale *.*.damping=1e9 (every damper above the plausible)"] = Case(
+        {**mf}, ["whatif", "--from", "1000", "--to", "2000", "--step", "1000", "--workers",
+                 "1", "--quiet", "--json", "w.json", "--scale", "*.*.damping=1e9"],
+        ["w.json"], "--scale", "a damper above the plausible")
     cases["whatif --manoeuvre --set right.y.d1=1e12 (N*s/mm: singular at some frequency)"] = \
         Case({**mf, "m.toml": _SEEDS["m/stop.toml"]}, [*whatif, "--set", "right.y.d1=1e12"],
              ["w.json"], "--set", "")

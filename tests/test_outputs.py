@@ -8,6 +8,7 @@ import os
 import stat
 import subprocess
 import sys
+from pathlib import Path
 
 import h5py
 import pytest
@@ -202,6 +203,22 @@ def test_unwritable_output_refused_before_work(tmp_path):
     assert r.returncode == 1
     assert r.stderr.count("\n") == 1 and "--plot" in r.stderr, r.stderr
     assert sorted(p.name for p in tmp_path.iterdir()) == ["file"]
+
+
+@pytest.mark.parametrize("args,key", [
+    (["runup", *QUICK, "--out", "r.h5", "--csv", "./r.h5"], "--csv"),
+    (["runup", "--from", "2000", "--to", "2100", "--sweep", "200", "--out", "s.h5",
+      "--raw", "sub/../s.h5"], "--raw"),
+    (["transient", "START", "--json", "t.out", "--plot", "t.out"], "--plot"),
+])
+def test_two_outputs_naming_one_file_are_refused_before_work(tmp_path, args, key):
+    """The second output would overwrite the first: one line naming both options."""
+    (tmp_path / "sub").mkdir()
+    start = str(Path(__file__).parents[1] / "examples" / "start.toml")
+    r = _cli([start if a == "START" else a for a in args], tmp_path)
+    assert r.returncode == 1
+    assert r.stderr.count("\n") == 1 and f"key '{key}'" in r.stderr, r.stderr
+    assert "also the" in r.stderr and sorted(p.name for p in tmp_path.iterdir()) == ["sub"]
 
 
 def test_failure_after_writing_removes_the_earlier_outputs(tmp_path, monkeypatch):

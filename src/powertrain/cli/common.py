@@ -9,10 +9,11 @@ import os
 import signal
 import threading
 import warnings
+from pathlib import Path
 
 import click
 
-from powertrain.errors import PowertrainWarning
+from powertrain.errors import InputError, PowertrainWarning
 from powertrain.outputs import check_writable, json_text
 from powertrain.plotting.style import close_figure
 from powertrain.provenance import Provenance, command_line
@@ -78,10 +79,17 @@ def wrote(*paths) -> str:
 
 
 def check_outputs(**targets) -> None:
-    """Refuse, before any work, output paths that cannot be written (``--name=path``)."""
+    """Refuse, before any work, output paths that cannot be written (``--name=path``) and
+    two options naming the same file (the second would overwrite the first)."""
+    seen = {}
     for name, path in targets.items():
         if path:
-            check_writable(path, key=f"--{name.replace('_', '-')}")
+            key = f"--{name.replace('_', '-')}"
+            check_writable(path, key=key)
+            same = seen.setdefault(Path(path).resolve(), key)
+            if same != key:
+                raise InputError(f"{path} is also the {same} file (one file per output)",
+                                 key=key)
 
 
 def write_json(path, text: str, provenance: dict, key: str = "--json") -> None:

@@ -82,7 +82,7 @@ def runup(rpm_from, rpm_to, rpm_step, engine_file, solver, stepper, angle_step, 
     """
 
     rpm = speed_steps(rpm_from, rpm_to, rpm_step)
-    check_outputs(out=out, csv=csv_file, plot=plot, path_plot=path_plot)
+    check_outputs(out=out, csv=csv_file, plot=plot, path_plot=path_plot, raw=raw_file)
     engine = engine_or_default(engine_file)
     _check_options(engine, path_order if path_plot else None, raw_file, sweep)
     result = workflow.runup(
@@ -105,7 +105,6 @@ def _check_options(engine, path_order, raw_file, sweep) -> None:
         check_path_plot(engine, path_order)
     if raw_file and sweep is None:
         raise InputError("--raw needs --sweep RPM_PER_S", key="--sweep")
-    check_outputs(raw=raw_file)
 
 
 def _write_runup(result, files, engine, path_order) -> list:

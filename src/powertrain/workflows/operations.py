@@ -102,7 +102,8 @@ class Scale:
         change = {"stiffness": lambda m: m.scaled(stiffness=f),
                   "damping": lambda m: m.scaled(damping=f)}.get(
             self.kind, lambda m: m.scaled_dynamic_stiffness(f))
-        return _map_directions(engine, self.mount, self.direction, change, self.origin)
+        return _map_directions(engine, self.mount, self.direction,
+                               lambda m: _plausible(change(m), self), self.origin)
 
 
 @dataclass(frozen=True)
@@ -138,13 +139,7 @@ class SetParameter:
                 raise self.origin.error(
                     f"{self.spec!r}: model {model.topology.name!r} has no parameter "
                     f"{self.parameter!r} (expected {', '.join(model.topology.parameters)})")
-            new = model.with_params(**{self.parameter: self.value})
-            try:
-                check_plausible(new, None)
-                check_network(new, None)
-            except InputError as exc:
-                raise self.origin.error(f"{self.spec!r}: {exc.message}") from None
-            return new
+            return _plausible(model.with_params(**{self.parameter: self.value}), self)
         return _map_directions(engine, self.mount, self.direction, change, self.origin)
 
 
@@ -359,6 +354,18 @@ def law_changed(model, key, change, create=False):
                           f"{name}")
     new = dataclasses.replace(law, **{name: change(getattr(law, name))})
     return dataclasses.replace(model, **{field: new})
+
+
+def _plausible(model, op):
+    """``model``, changed by ``op``, if its parameters are plausible and its network holds
+    at 0 Hz as a mount file's must (:func:`~powertrain.iotools.mount_file.check_plausible`);
+    else the error, located at ``op``'s origin."""
+    try:
+        check_plausible(model, None)
+        check_network(model, None)
+    except InputError as exc:
+        raise op.origin.error(f"{op.spec!r}: {exc.message}") from None
+    return model
 
 
 def _map_laws(engine, op, key, change, create=False):
