@@ -179,7 +179,7 @@ def newmark_port_kernel(G, H, Fs, h, x0, v0, a0, W, P, Q, kinds, par, state, X, 
     :math:`\mathbf Q = \mathbf P\mathbf W`. Newton solves the m equations
     :math:`z_e = f_e(u_e, \dot u_e)` per step (Jacobian
     :math:`\mathbf I + \mathrm{diag}(\tfrac{h^2}{4}k_t + \tfrac h2 c_t)\mathbf Q`; its
-    diagonal first, :func:`_port_forces_step`), from the tangent at the previous step; the
+    diagonal first, :func:`port_forces_step`), from the tangent at the previous step; the
     states are committed once it has converged.
 
     Arguments: ``G, H, Fs, h, x0, v0, a0, X, V, A`` as :func:`newmark_kernel`; ``W`` (n, m)
@@ -197,7 +197,7 @@ def newmark_port_kernel(G, H, Fs, h, x0, v0, a0, W, P, Q, kinds, par, state, X, 
     xt, vt = np.empty(n), np.empty(n)
     ul, vl, z, r = np.empty(m), np.empty(m), np.empty(m), np.empty(m)
     J, last = np.empty((m, m)), np.zeros((7, m))
-    coupled = _coupling(hh * Q, hv / hh)
+    coupled = port_coupling(hh * Q, hv / hh)
     failed = 0
     for j in range(n):
         X[0, j] = x0[j]
@@ -227,7 +227,7 @@ def newmark_port_kernel(G, H, Fs, h, x0, v0, a0, W, P, Q, kinds, par, state, X, 
                 sv += Pe[j] * (vt[j] + hv * Ak[j])
             ul[e] = su
             vl[e] = sv
-        if not _port_forces_step(kinds, par, state, ul, vl, coupled, z, last, r, J, tol,
+        if not port_forces_step(kinds, par, state, ul, vl, coupled, z, last, r, J, tol,
                                  max_iter):
             failed += 1
         for e in range(m):
@@ -264,15 +264,15 @@ def _port_newton(kinds, par, state, ul, vl, Q, z, r, J, tol, max_iter):
     return False
 
 
-#: Iterations of the diagonal Newton before full Newton takes over (:func:`_port_forces_step`).
+#: Iterations of the diagonal Newton before full Newton takes over (:func:`port_forces_step`).
 JACOBI_ITER = 8
 
 
 @njit(cache=True, nogil=True, inline="always")
-def _port_forces_step(kinds, par, state, ul, vl, Q, z, last, r, J, tol, max_iter):
+def port_forces_step(kinds, par, state, ul, vl, Q, z, last, r, J, tol, max_iter):
     """The port forces ``z`` (in place, from the last step's) of one step, ``z_e =
     f_e(ul_e - (Qu z)_e, vl_e - qv (Qu z)_e)``, ``Q = (Qu, qv, row sums of |Qu|)``
-    (:func:`_coupling`; the velocities' coupling is ``qv = 2 / h`` times the displacements'
+    (:func:`port_coupling`; the velocities' coupling is ``qv = 2 / h`` times the displacements'
     in Newmark's average acceleration), and the states committed. True on success.
 
     The ports are coupled only through the body's motion within one step (``Qu`` of the
@@ -325,7 +325,7 @@ def _predict(ul, vl, qv, last, z):
 
 
 @njit(cache=True, nogil=True)
-def _coupling(Qu, qv):
+def port_coupling(Qu, qv):
     """``(Qu, qv, qa)``, ``qa`` the row sums of |Qu| (looped: NumPy's costs a compile)."""
     qa = np.zeros(Qu.shape[0])
     for i, j in np.ndindex(Qu.shape):
@@ -337,7 +337,7 @@ def _coupling(Qu, qv):
 def _port_residual(kinds, par, state, ul, vl, Q, z, last, r):
     """Residuals ``r = f(u, v) - z`` of the port forces ``z`` and the points ``last`` (rows
     0-3) = ``(u, v, df/du, df/dv)``, the coupling ``Qu z`` in row 6; returns (1 + the largest
-    force, the largest residual, the coupling bound rho of :func:`_port_forces_step`)."""
+    force, the largest residual, the coupling bound rho of :func:`port_forces_step`)."""
     Qu, qv, qa = Q
     big, worst, rho = 1.0, 0.0, 0.0
     for e in range(z.shape[0]):
@@ -423,7 +423,7 @@ def modal_port_kernel(modal, outputs, ports, laws, F, x, y, z, out, tol, max_ite
     :math:`\mathbf u = \mathbf u_{lin} - \mathbf Q_u\mathbf z`, :math:`\mathbf Q_u =
     \tfrac{h^2}4\mathbf T\mathbf S\mathbf T^T` (the :math:`\tfrac{h^2}{4}\mathbf P\mathbf
     S^{-1}\mathbf P^T` of :func:`newmark_port_kernel`), solved for :math:`\mathbf z`
-    (:func:`_port_forces_step`); then the recurrence.
+    (:func:`port_forces_step`); then the recurrence.
 
     Arguments (modal arrays in real form, n_x columns: the real parts of the n modes, then
     the imaginary parts of the n_c complex ones, which come first): ``modal = (lam_d, G, Ra,
@@ -444,7 +444,7 @@ def modal_port_kernel(modal, outputs, ports, laws, F, x, y, z, out, tol, max_ite
     p, p_next, base, wu, wv = np.empty(q), np.empty(q), np.empty(q), np.empty(q), np.empty(q)
     ul, vl, r, J, last = np.empty(m), np.empty(m), np.empty(m), np.empty((m, m)), np.zeros((7, m))
     g = np.empty(outputs[0][0].shape[1])
-    coupled, failed = _coupling(Qu, 2.0 / h), 0
+    coupled, failed = port_coupling(Qu, 2.0 / h), 0
     _load_less_ports(load_at, T, F, 0, z, p)
     for k in range(out.shape[0]):
         if out.shape[1]:
@@ -470,7 +470,7 @@ def modal_port_kernel(modal, outputs, ports, laws, F, x, y, z, out, tol, max_ite
                 su += T[e, c] * wu[c]
                 sv += T[e, c] * wv[c]
             ul[e], vl[e] = su, sv
-        if not _port_forces_step(kinds, par, state, ul, vl, coupled, z, last, r, J, tol,
+        if not port_forces_step(kinds, par, state, ul, vl, coupled, z, last, r, J, tol,
                                  max_iter):
             failed += 1
         _load_less_ports(load_at, T, F, k + 1, z, p_next)

@@ -8,9 +8,14 @@ from its sampled curve (:func:`curve_state`); the networks are scaled by the amp
 ``law`` times :math:`f`; the damping and stiffness are the assembled ones plus each
 network's change of scale times its parts (sparse: the nonzero entries of every network's
 :math:`\mathbf L^T\mathbf C_n\mathbf L`, :math:`\mathbf L^T\mathbf K_n\mathbf L`); the piece
-is integrated from the position and velocity, its acceleration solved from the new laws,
-by :func:`powertrain.kernels.port_forces.newmark_port_kernel` (port laws, Newton per step)
-or :func:`powertrain.kernels.newmark.newmark_kernel` (none).
+is integrated from the position and velocity, its acceleration solved from the new laws.
+A step solves :math:`\mathbf S\ddot{\mathbf x} = \mathbf f - \mathbf C\tilde{\mathbf v}
+- \mathbf K\tilde{\mathbf x}` (:mod:`powertrain.kernels.newmark`) by S's sparse LU factors
+(:mod:`powertrain.kernels.sparse_lu`: a piece costs a factorization of the networks' small
+blocks, a step about the nonzeros of S), then the port laws by Newton as
+:func:`powertrain.kernels.port_forces.newmark_port_kernel`; where S is not positive
+definite (the elimination refuses a pivot) the piece runs on its dense inverse, by that
+kernel or :func:`powertrain.kernels.newmark.newmark_kernel`.
 
 Numba caches a kernel by its own file: after editing the step kernels it calls, touch this
 file (or clear ``__pycache__``) so that its cached machine code is rebuilt.
@@ -20,7 +25,20 @@ import numpy as np
 from numba import njit
 
 from powertrain.kernels.newmark import newmark_kernel
-from powertrain.kernels.port_forces import newmark_port_kernel, port_forces_at
+from powertrain.kernels.port_forces import (
+    law_force,
+    newmark_port_kernel,
+    port_coupling,
+    port_forces_at,
+    port_forces_step,
+)
+from powertrain.kernels.sparse_lu import (
+    compressed,
+    factor,
+    lu_solve,
+    sparse_factors,
+    subtract_product,
+)
 
 
 @njit(cache=True, nogil=True, inline="always")
@@ -92,27 +110,51 @@ def _times(A, x, transpose=False):
     return out
 
 
+#: A pivot of the sparse elimination at most this times the largest diagonal entry: the
+#: piece is solved densely with pivoting instead (:func:`~powertrain.kernels.sparse_lu.factor`).
+PIVOT_TOL = 1e-12
+
+
+@njit(cache=True, nogil=True)
+def _start_acceleration(model, laws, C, K, f, x, v):
+    """The acceleration [m/s²] at ``(x, v)`` under the load ``f`` and the port laws (0 on
+    massless nodes: ``M_inv`` holds zeros there)."""
+    r = f - _times(C, v) - _times(K, x)
+    if laws is not None:
+        P, kinds, par, state = laws
+        z0 = np.zeros(kinds.shape[0])
+        port_forces_at(kinds, par, state, _times(P, x), _times(P, v), z0)
+        r -= _times(P, z0, True)
+    return _times(model[6], r)
+
+
 @njit(cache=True, nogil=True)
 def _piece(model, laws, h, C, K, F, load, x, v, a, X, V, A, Z, tol, max_iter):
     """Newmark over the load rows ``F`` (k + 1, n) less ``load`` (n,) from ``(x, v)`` with
     ``C``, ``K`` into the rows ``X``, ``V``, ``A``, ``Z``; ``a`` the acceleration at the
-    start, or solved from the laws where it has no entry. Returns the steps where Newton
-    did not converge."""
-    M, M_inv = model[0], model[6]
-    Sinv = np.linalg.inv(M + 0.5 * h * C + 0.25 * h * h * K)
+    start, or solved from the laws where it has no entry. S factored sparsely in the
+    model's order (:mod:`powertrain.kernels.sparse_lu`), densely where that refuses a pivot.
+    Returns the steps where Newton did not converge."""
+    M, perm = model[0], model[7]
+    if a.shape[0] == 0:
+        a = _start_acceleration(model, laws, C, K, F[0] - load, x, v)
+    ok, B = factor(M + 0.5 * h * C + 0.25 * h * h * K, perm, PIVOT_TOL)
+    if ok:
+        return _sparse_steps((sparse_factors(B), perm), laws, h, C, K, F, load, x, v, a, X,
+                             V, A, Z, tol, max_iter)
+    return _dense_steps(model, laws, h, C, K, F, load, x, v, a, X, V, A, Z, tol, max_iter)
+
+
+@njit(cache=True, nogil=True)
+def _dense_steps(model, laws, h, C, K, F, load, x, v, a, X, V, A, Z, tol, max_iter):
+    """:func:`_piece` by the dense inverse of S (:func:`~powertrain.kernels.newmark.newmark_kernel`,
+    :func:`~powertrain.kernels.port_forces.newmark_port_kernel`)."""
+    Sinv = np.linalg.inv(model[0] + 0.5 * h * C + 0.25 * h * h * K)
     G, H, Fs = Sinv @ C, Sinv @ K, F @ np.ascontiguousarray(Sinv.T)
     shift = _times(Sinv, load)                # (F - load) S^-T, row by row
     for k in range(Fs.shape[0]):
         for j in range(Fs.shape[1]):
             Fs[k, j] -= shift[j]
-    if a.shape[0] == 0:
-        r = F[0] - load - _times(C, v) - _times(K, x)
-        if laws is not None:
-            P, kinds, par, state = laws
-            z0 = np.zeros(kinds.shape[0])
-            port_forces_at(kinds, par, state, _times(P, x), _times(P, v), z0)
-            r -= _times(P, z0, True)
-        a = _times(M_inv, r)
     if laws is None:        # pruned at compile time: a linear model compiles no port kernel
         newmark_kernel(G, H, Fs, h, x, v, a, X, V, A)
         return 0
@@ -123,6 +165,83 @@ def _piece(model, laws, h, C, K, F, load, x, v, a, X, V, A, Z, tol, max_iter):
 
 
 @njit(cache=True, nogil=True)
+def _port_setup(laws, lu, h, x, v, Z):
+    """``(W, coupling, P compressed, z, work)`` of the port laws for
+    :func:`_sparse_steps` (W = S^-1 P^T, :func:`~powertrain.kernels.port_forces.newmark_port_kernel`),
+    ``z`` and row 0 of ``Z`` the forces at ``(x, v)``; None without port laws."""
+    if laws is None:
+        return None
+    P, kinds, par, state = laws
+    n, m = x.shape[0], kinds.shape[0]
+    W, col, y = np.empty((n, m)), np.empty(n), np.empty(n)
+    for e in range(m):
+        lu_solve(lu[0], lu[1], P[e], y, col)
+        W[:, e] = col
+    z = np.empty(m)
+    for e in range(m):
+        z[e] = law_force(kinds[e], _times(P[e:e + 1], x)[0], _times(P[e:e + 1], v)[0], par,
+                         state, e)[0]
+        Z[0, e] = z[e]
+    hh = 0.25 * h * h
+    return (W, port_coupling(hh * (P @ W), 2.0 / h), compressed(P, True, True), z,
+            (np.empty(m), np.empty(m), np.empty(m), np.empty((m, m)), np.zeros((7, m))))
+
+
+@njit(cache=True, nogil=True, inline="always")
+def _port_step(laws, ports, h, xt, vt, a, z_out, tol, max_iter):
+    """The port forces of one step (:func:`~powertrain.kernels.port_forces.newmark_port_kernel`)
+    into ``z_out``, taken off the linear acceleration ``a`` in place. True on success."""
+    _, kinds, par, state = laws
+    W, coupled, (starts, columns, values), z, (ul, vl, r, J, last) = ports
+    hh, hv = 0.25 * h * h, 0.5 * h
+    for e in range(z.shape[0]):
+        su = 0.0
+        sv = 0.0
+        for k in range(starts[e], starts[e + 1]):
+            j = columns[k]
+            su += values[k] * (xt[j] + hh * a[j])
+            sv += values[k] * (vt[j] + hv * a[j])
+        ul[e] = su
+        vl[e] = sv
+    ok = port_forces_step(kinds, par, state, ul, vl, coupled, z, last, r, J, tol, max_iter)
+    for e in range(z.shape[0]):
+        z_out[e] = z[e]
+    for j in range(a.shape[0]):
+        s = 0.0
+        for e in range(z.shape[0]):
+            s += W[j, e] * z[e]
+        a[j] -= s
+    return ok
+
+
+@njit(cache=True, nogil=True)
+def _sparse_steps(lu, laws, h, C, K, F, load, x, v, a, X, V, A, Z, tol, max_iter):
+    """:func:`_piece` by the sparse factors ``lu = (factors, perm)`` of S: a step is the
+    residual by the compressed C and K, one sparse solve and the port laws."""
+    n, hh, hv = x.shape[0], 0.25 * h * h, 0.5 * h
+    Cs, Ks = compressed(C, True, True), compressed(K, True, True)
+    xt, vt, r, y = np.empty(n), np.empty(n), np.empty(n), np.empty(n)
+    X[0], V[0], A[0] = x, v, a
+    ports = _port_setup(laws, lu, h, x, v, Z)
+    failed = 0
+    for k in range(1, F.shape[0]):
+        for j in range(n):
+            xt[j] = X[k - 1, j] + h * V[k - 1, j] + hh * A[k - 1, j]
+            vt[j] = V[k - 1, j] + hv * A[k - 1, j]
+            r[j] = F[k, j] - load[j]
+        subtract_product(Cs, vt, r)
+        subtract_product(Ks, xt, r)
+        lu_solve(lu[0], lu[1], r, y, A[k])
+        if laws is not None and not _port_step(laws, ports, h, xt, vt, A[k], Z[k], tol,
+                                               max_iter):
+            failed += 1
+        for j in range(n):
+            X[k, j] = xt[j] + hh * A[k, j]
+            V[k, j] = vt[j] + hv * A[k, j]
+    return failed
+
+
+@njit(cache=True, nogil=True)
 def transient_stretch_kernel(model, curves, laws, h, F, law, centres, lo, hi, sub, a0, X, V,
                              A, Z, scales, loads, tol, max_iter):
     """Integrate steps ``lo`` to ``hi`` (module docstring), pieces of ``sub`` steps.
@@ -130,7 +249,7 @@ def transient_stretch_kernel(model, curves, laws, h, F, law, centres, lo, hi, su
     Parameters
     ----------
     model : tuple
-        ``(M, C, K, C_parts, K_parts, assembled, M_inv)``: the assembled matrices, each
+        ``(M, C, K, C_parts, K_parts, assembled, M_inv, perm)``: the assembled matrices, each
         network's sparse parts ``(net, i, j, value)``, the scales (n_net, 2) the assembled
         matrices hold and the inverse of M (zeros where M is singular: massless nodes, a
         start acceleration of 0).
@@ -161,7 +280,7 @@ def transient_stretch_kernel(model, curves, laws, h, F, law, centres, lo, hi, su
     int
         Steps at which Newton did not converge.
     """
-    _, C0, K0, C_parts, K_parts, assembled, _ = model
+    _, C0, K0, C_parts, K_parts, assembled, _, _ = model
     n_net = law.shape[0]
     factors, c = np.empty(n_net), np.empty(n_net)
     change = np.empty((n_net, 2))

@@ -234,7 +234,7 @@ def _warn_curve_and_law(engine):
 
 
 def _method(scaling, ports, curves, every, sub):
-    parts = ["Newmark average acceleration, dense"]
+    parts = ["Newmark average acceleration"]
     if (ports.kinds != NONE).any():
         parts.append("port laws by Newton per step")
     if scaling.varying:
@@ -300,8 +300,19 @@ def _kernel_model(system, scaling):
         M_inv = np.linalg.inv(M)
     except np.linalg.LinAlgError:          # massless nodes: the start acceleration is 0
         M_inv = np.zeros_like(M)
-    return (M, np.array(system.C, float), np.array(system.K, float), _sparse(scaling.C_parts),
-            _sparse(scaling.K_parts), np.array(scaling.assembled, float), M_inv)
+    C, K = np.array(system.C, float), np.array(system.K, float)
+    return (M, C, K, _sparse(scaling.C_parts), _sparse(scaling.K_parts),
+            np.array(scaling.assembled, float), M_inv,
+            _elimination_order(M, C, K, scaling.C_parts, scaling.K_parts))
+
+
+def _elimination_order(*matrices):
+    """Coordinates in the order of fewest nonzeros in any of ``matrices`` (or their stacked
+    parts) first: each network's internal ones before the body's, so that the sparse
+    factors of S have no fill-in but the body's rows
+    (:mod:`powertrain.kernels.sparse_lu`)."""
+    pattern = sum((np.abs(m).reshape(-1, *m.shape[-2:]).sum(0) != 0) for m in matrices)
+    return np.argsort((pattern != 0).sum(1), kind="stable").astype(np.int64)
 
 
 def _sparse(parts):

@@ -1,0 +1,101 @@
+"""The sparse LU of the transient's Newmark matrix (kernels/sparse_lu.py) against
+numpy.linalg.solve, and the transient piece on its sparse and its dense path against a
+Newmark step written out here."""
+
+import numpy as np
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from powertrain.kernels.sparse_lu import factor, lu_solve, sparse_factors
+from powertrain.kernels.transient import _piece
+from powertrain.solvers.transient import _elimination_order
+
+
+def arrow(rng, networks, inner, body=6):
+    """A symmetric positive definite matrix of a body (``body`` coordinates first) on
+    ``networks`` networks of ``inner`` internal coordinates each, coupled to the body and
+    within each network only; the spread of its entries as S's (mass and h²/4 K)."""
+    n = body + networks * inner
+    A = np.zeros((n, n))
+    B = rng.standard_normal((body, body))
+    A[:body, :body] = B @ B.T + body * np.eye(body)
+    for k in range(networks):
+        i = slice(body + k * inner, body + (k + 1) * inner)
+        R = rng.standard_normal((body + inner, body + inner)) * 10.0 ** rng.uniform(-3, 3)
+        block = np.zeros((n, n))
+        idx = np.r_[np.arange(body), np.arange(n)[i]]
+        block[np.ix_(idx, idx)] = R @ R.T
+        A += block
+    return A
+
+
+def solve(S, perm, b):
+    ok, B = factor(S, perm, 1e-12)
+    assert ok
+    out = np.empty(b.size)
+    lu_solve((sparse_factors(B)), perm, b, np.empty(b.size), out)
+    return out, B
+
+
+@settings(max_examples=40, deadline=None)
+@given(st.integers(1, 9), st.integers(1, 4), st.integers(0, 2**32 - 1))
+def test_the_sparse_solve_is_numpys_and_fills_only_the_body_rows(networks, inner, seed):
+    rng = np.random.default_rng(seed)
+    S = arrow(rng, networks, inner)
+    b = rng.standard_normal(S.shape[0])
+    perm = _elimination_order(S)
+    x, B = solve(S, perm, b)
+    ref = np.linalg.solve(S, b)
+    np.testing.assert_allclose(x, ref, rtol=1e-8, atol=1e-10 * np.abs(ref).max())
+    # the body's coordinates are eliminated last and no network's row gains an entry of
+    # another network: the factors are as sparse as S
+    if networks > 1:                            # with one, every row is full
+        assert set(perm[-6:]) == set(range(6))
+    fill = (B != 0) & (S[np.ix_(perm, perm)] == 0)
+    assert not fill[:-6, :-6].any()
+
+
+def test_a_pivot_not_above_the_tolerance_is_refused():
+    S = np.array([[0.0, 1.0], [1.0, 2.0]])
+    assert not factor(S, np.arange(2), 1e-12)[0]
+    assert not factor(S, np.array([1, 0]), 1e-12)[0]     # indefinite in any order
+    assert factor(np.array([[2.0, 1.0], [1.0, 2.0]]), np.array([1, 0]), 1e-12)[0]
+    assert not factor(np.array([[1.0, 0.0], [0.0, -1.0]]), np.arange(2), 1e-12)[0]
+
+
+def newmark(M, C, K, F, h, x, v):
+    """Average-acceleration Newmark written out (numpy, dense): the states (k + 1, n)."""
+    X, V, A = [x], [v], [np.linalg.solve(M, F[0] - C @ v - K @ x)]
+    S = M + h / 2 * C + h * h / 4 * K
+    for f in F[1:]:
+        xt = X[-1] + h * V[-1] + h * h / 4 * A[-1]
+        vt = V[-1] + h / 2 * A[-1]
+        a = np.linalg.solve(S, f - C @ vt - K @ xt)
+        X.append(xt + h * h / 4 * a)
+        V.append(vt + h / 2 * a)
+        A.append(a)
+    return np.array(X), np.array(V), np.array(A)
+
+
+def test_a_piece_is_newmarks_on_the_sparse_and_on_the_dense_path():
+    rng = np.random.default_rng(1)
+    M = np.diag(rng.uniform(1, 5, 8))
+    C = arrow(rng, 2, 1) * 1e-2
+    K = arrow(rng, 2, 1) * 1e3
+    h, steps = 1e-3, 50
+    F = rng.standard_normal((steps + 1, 8))
+    x, v = rng.standard_normal(8) * 1e-3, rng.standard_normal(8) * 1e-2
+    ref = newmark(M, C, K, F, h, x, v)
+    for K_used in (K, K - 1.5 * np.diag(np.diag(K)) - 4 / h ** 2 * M):
+        # the second K makes S indefinite: the sparse elimination refuses its first pivot
+        S = M + h / 2 * C + h * h / 4 * K_used
+        perm = _elimination_order(M, C, K_used)
+        assert factor(S, perm, 1e-12)[0] == (K_used is K)
+        ref = newmark(M, C, K_used, F, h, x, v)
+        model = (M, C, K_used, None, None, None, np.linalg.inv(M), perm)
+        X, V, A = (np.empty((steps + 1, 8)) for _ in range(3))
+        failed = _piece(model, None, h, C, K_used, F, np.zeros(8), x, v, np.empty(0), X, V,
+                        A, np.empty((steps + 1, 0)), 1e-12, 10)
+        assert failed == 0
+        for got, want in zip((X, V, A), ref, strict=True):
+            np.testing.assert_allclose(got, want, rtol=1e-9, atol=1e-9 * np.abs(want).max())
