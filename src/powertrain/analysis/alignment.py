@@ -78,6 +78,8 @@ MISMATCH_REV = 0.05
 #: order at 250 rpm; eight revolutions: the slow drift of a sampled tacho's edges).
 CORRELATION_S = 0.25
 CORRELATION_REV = 8.0
+#: What an alignment's error offers instead: the trigger channel's option.
+TRIGGER = "--trigger CHANNEL"
 #: Times at which an event's speed table is read for its angle and slope, and the most
 #: recorded samples a speed alignment's cost reads.
 FINE = 20001
@@ -154,7 +156,7 @@ def coverage(t0, t1, rec0, rec1, shift):
 
 
 def align_speed(t_sim, rpm_sim, t_rec, rpm_rec, *, file=None, key="rpm",
-                partial=True) -> tuple:
+                partial=True, trigger=TRIGGER) -> tuple:
     """Time shift [s] of the recording against the event (the recording's time of the event's
     time 0) and its standard error [s], from the speeds (module docstring).
 
@@ -169,6 +171,8 @@ def align_speed(t_sim, rpm_sim, t_rec, rpm_rec, *, file=None, key="rpm",
     partial : bool
         The recording may cover part of the event (at least :data:`MIN_COVERAGE`, at either
         end); False: it holds all of it.
+    trigger : str
+        The option an error message offers instead (default :data:`TRIGGER`).
 
     Raises
     ------
@@ -193,8 +197,9 @@ def align_speed(t_sim, rpm_sim, t_rec, rpm_rec, *, file=None, key="rpm",
     if other is not None:
         raise InputError(f"the crank speed matches the event's at two places of the recording "
                          f"(the event starting at {shift:.4f} s or at {shifts[other]:.4f} s); "
-                         "give --trigger CHANNEL", file=file, key=key)
-    _check_match(float(np.sqrt(costs(np.array([shift]))[0])), sigma, target, file, key)
+                         f"give {trigger}", file=file, key=key)
+    _check_match(float(np.sqrt(costs(np.array([shift]))[0])), sigma, target, (file, key),
+                 trigger)
     white, error = _shift_error(t, target, t_rec, rpm_rec, shift, sigma)
     top = max(float(np.max(np.abs(target))), SPEED_FLOOR_RPM)
     allowed = ALIGN_TOLERANCE_DEG / (6.0 * top)
@@ -203,21 +208,21 @@ def align_speed(t_sim, rpm_sim, t_rec, rpm_rec, *, file=None, key="rpm",
             f"the crank speed varies too little over the event to line the recording up on "
             f"it (shift uncertain by +-{ALIGN_SIGMAS * white * 1e3:.3g} ms, more than "
             f"{allowed * 1e3:.2g} ms = {ALIGN_TOLERANCE_DEG:g} deg of crank at {top:.0f} "
-            "rpm); give --trigger CHANNEL", file=file, key=key)
+            f"rpm); give {trigger}", file=file, key=key)
     _warn_uncertain(error, allowed, "crank speed", file)
     return shift, error
 
 
 def align_tacho(t_sim, rpm_sim, span, edges, *, counts=None, pulses_per_rev=1, file=None,
-                key="tacho", partial=True) -> tuple:
+                key="tacho", partial=True, trigger=TRIGGER) -> tuple:
     """Time shift [s] of the recording against the event and its standard error [s] from a
     tacho's rising ``edges`` [s] with ``counts`` pulses counted at each (default one per
     edge; :func:`tacho_counts`) of ``pulses_per_rev`` per revolution, the recording lasting
     ``span = (first, last)`` [s]: the shift at which the event's crank angle at the edges,
     less 1/``pulses_per_rev`` revolution per pulse counted, is most nearly constant (least
     squares, the pulses' phase eliminated), among the shifts where the pulses inside the
-    event span as many revolutions as it turns there (module docstring); ``partial`` as
-    :func:`align_speed`'s.
+    event span as many revolutions as it turns there (module docstring); ``partial`` and
+    ``trigger`` as :func:`align_speed`'s.
 
     Raises
     ------
@@ -239,7 +244,7 @@ def align_tacho(t_sim, rpm_sim, span, edges, *, counts=None, pulses_per_rev=1, f
         raise InputError(f"the tacho's pulses match the event's revolutions at no shift (at "
                          f"least {MIN_EDGES} pulses in the event, {pulses_per_rev} per "
                          "revolution); give --pulses-per-rev N for a wheel of N teeth, or "
-                         "--trigger CHANNEL", file=file, key=key)
+                         f"{trigger}", file=file, key=key)
     best = int(np.argmin(coarse))
     sigma = max(float(np.sqrt(_phase_cost(shift, t_sim, rev, edges, revs, span))),
                 PHASE_FLOOR_REV)
@@ -247,19 +252,19 @@ def align_tacho(t_sim, rpm_sim, span, edges, *, counts=None, pulses_per_rev=1, f
         raise InputError(f"the tacho's pulses do not follow the event's crank angle at any "
                          f"shift ({sigma:.2g} rev RMS at the best, read as {pulses_per_rev} "
                          "per revolution); give --pulses-per-rev N for a wheel of N teeth, "
-                         "or --trigger CHANNEL", file=file, key=key)
+                         f"or {trigger}", file=file, key=key)
     other = _second_match(coarse, best, sigma ** 2)
     if other is not None:
         raise InputError(f"the tacho's pulses match the event at two places of the recording "
                          f"(the event starting at {shift:.4f} s or at {shifts[other]:.4f} s); "
-                         "give --trigger CHANNEL", file=file, key=key)
+                         f"give {trigger}", file=file, key=key)
     white, error = _phase_error(shift, t_sim, rev, speed, edges, revs, span, sigma)
     allowed = ALIGN_TOLERANCE_DEG / (360.0 * max(float(np.max(speed)), 1e-9))
     if not ALIGN_SIGMAS * white <= allowed:
         raise InputError(f"the tacho's pulses fix the event's start to +-"
                          f"{ALIGN_SIGMAS * white * 1e3:.3g} ms only, more than "
                          f"{allowed * 1e3:.2g} ms = {ALIGN_TOLERANCE_DEG:g} deg of crank; give "
-                         "--trigger CHANNEL", file=file, key=key)
+                         f"{trigger}", file=file, key=key)
     _warn_uncertain(error, allowed, "tacho's pulses", file)
     return shift, error
 
@@ -361,16 +366,16 @@ def unheld_speed(t_rec, rpm_rec):
     return t_rec, np.interp(t_rec, t_rec[keep], rpm_rec[keep])
 
 
-def _check_match(residual, sigma, target, file, key):
+def _check_match(residual, sigma, target, where, trigger):
     """Refuse a best shift at which the speeds still differ by more than
     :data:`MISMATCH_SHARE` of the event's speed range (and many times the scatter): the
     recorded speed is not the event's anywhere."""
-    span = float(np.ptp(target))
+    span, (file, key) = float(np.ptp(target)), where
     if residual > max(MISMATCH_SHARE * span, 5.0 * sigma):
         raise InputError(f"the recorded crank speed does not match the event's at any shift "
                          f"(RMS difference {residual:.3g} rpm at the best, over "
-                         f"{MISMATCH_SHARE:.0%} of its {span:.4g} rpm range); give --trigger "
-                         "CHANNEL, or drive the simulation with --speed-from", file=file,
+                         f"{MISMATCH_SHARE:.0%} of its {span:.4g} rpm range); give {trigger}, or "
+                         "drive the simulation with --speed-from", file=file,
                          key=key)
 
 

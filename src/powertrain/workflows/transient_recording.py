@@ -19,6 +19,7 @@ import numpy as np
 
 from powertrain.analysis.alignment import (
     MIN_COVERAGE,
+    TRIGGER,
     align_speed,
     align_tacho,
     coverage,
@@ -161,26 +162,22 @@ def align(rec: Recorded, t_event, rpm_event, *, partial=True, trigger_at=0.0) ->
     if rec.rpm is None:
         raise InputError("no rpm or tacho channel to line the recording up on; give "
                          "--trigger CHANNEL", file=rec.path, key="rpm")
-    try:
-        return _align_on_speed(rec, t_event, rpm_event, partial)
-    except InputError as err:
-        if not rec.unused_trigger or "--trigger CHANNEL" not in err.message:
-            raise
-        raise InputError(err.message.replace("--trigger CHANNEL", "--trigger CHANNEL (the "
-                                             "recording has one named 'trigger')"),
-                         file=err.file, key=err.key) from None
+    return _align_on_speed(rec, t_event, rpm_event, partial)
 
 
 def _align_on_speed(rec: Recorded, t_event, rpm_event, partial) -> tuple:
-    """:func:`align` on the tacho's pulses, else on the rpm channel."""
+    """:func:`align` on the tacho's pulses, else on the rpm channel; an error offers the
+    recording's unused channel named ``trigger`` where it has one."""
+    trigger = TRIGGER + (" (the recording has one named 'trigger')" if rec.unused_trigger
+                         else "")
     if rec.edges is not None:
         shift, error = align_tacho(t_event, rpm_event, (rec.time[0], rec.time[-1]),
                                    rec.edges, counts=rec.counts,
                                    pulses_per_rev=rec.pulses_per_rev, file=rec.path,
-                                   key="tacho", partial=partial)
+                                   key="tacho", partial=partial, trigger=trigger)
         return shift, "crank angle of the tacho's pulses", error
     shift, error = align_speed(t_event, rpm_event, rec.time, rec.rpm, file=rec.path,
-                               key="rpm", partial=partial)
+                               key="rpm", partial=partial, trigger=trigger)
     return shift, "crank speed", error
 
 
