@@ -228,19 +228,22 @@ class Oracle:
         self.scale, self.centre = np.ones(len(els)), np.zeros(len(els))
         self.frozen = None
 
-    def set_stretch(self, x, amplitudes, centres=None):
-        """The amplitude scales and centres of the stretch (default centre: the deflection
-        at ``x``) and, for the stretch rule, its static factors and curve loads at the
-        state ``x``."""
+    def set_stretch(self, y, amplitudes, centres, half):
+        """The amplitude scales and centres of the stretch (None: the deflection at the
+        state ``y``) and, for the stretch rule, the first piece's static factors and curve
+        loads (:meth:`freeze`)."""
         self.scale = np.ones(self.k0.size)
         for k, law in zip(self.ia, self.amp_laws):
             self.scale[k] = power_scale(law, amplitudes[k])
-        self.centre = self.R @ x if centres is None else np.asarray(centres, float)
-        self.freeze(x)
+        self.centre = self.R @ y[:self.n] if centres is None else np.asarray(centres, float)
+        self.freeze(y, half)
 
-    def freeze(self, x):
-        """For the stretch rule, the static factors and curve loads at the state ``x``."""
-        self.frozen = None if self.continuous else self.static(self.R @ x)
+    def freeze(self, y, half):
+        """For the stretch rule, the static factors and curve loads of a piece starting at
+        the state ``y`` (positions, velocities): at its positions ``half`` [s] (half the
+        piece) on at its velocities, the piece's predicted middle."""
+        x, v = y[:self.n], y[self.n:]
+        self.frozen = None if self.continuous else self.static(self.R @ (x + half * v))
 
     def static(self, u):
         """Static factors (n_net,) and curve loads c (n_net,) [N] at the deflections u."""
@@ -344,12 +347,12 @@ def integrate(ode, every, rtol=1e-8, method="Radau", atol=None, curve_every=None
                   events=ode.reversals() or None, **options)
     sub = every if curve_every is None else curve_every
     for lo, hi in zip(bounds[:-1], bounds[1:]):
-        ode.set_stretch(y[:ode.n], amplitudes, centres)
-        rows = [ode.outputs(y[None, :])]
         cuts = list(range(lo, hi, sub)) + [hi]
+        ode.set_stretch(y, amplitudes, centres, 0.5 * (t_all[cuts[1]] - t_all[lo]))
+        rows = [ode.outputs(y[None, :])]
         for p, q in zip(cuts[:-1], cuts[1:]):
             if p != lo:             # the update's instant reported with the new curve loads
-                ode.freeze(y[:ode.n])
+                ode.freeze(y, 0.5 * (t_all[q] - t_all[p]))
                 u_last, f_last = rows[-1]
                 rows[-1] = (u_last, np.vstack([f_last[:-1], ode.outputs(y[None, :])[1]]))
             y = _piece(ode, t_all[p:q + 1], y, solver, rows)

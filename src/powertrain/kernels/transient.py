@@ -3,8 +3,9 @@ between them in one call (:mod:`powertrain.solvers.transient` holds the model an
 formulas).
 
 A stretch is cut into pieces of ``sub`` steps. At the start of every piece, at the state
-:math:`\mathbf x`, each network's static factor :math:`f` and curve load :math:`c` are read
-from its sampled curve (:func:`curve_state`); the networks are scaled by the amplitude law's
+predicted for its middle, :math:`\mathbf x + \tfrac T2\dot{\mathbf x}` (:math:`T` its
+length), each network's static factor :math:`f` and curve load :math:`c` are read from its
+sampled curve (:func:`curve_state`); the networks are scaled by the amplitude law's
 ``law`` times :math:`f`; the damping and stiffness are the assembled ones plus each
 network's change of scale times its parts (sparse: the nonzero entries of every network's
 :math:`\mathbf L^T\mathbf C_n\mathbf L`, :math:`\mathbf L^T\mathbf K_n\mathbf L`); the piece
@@ -290,7 +291,7 @@ def transient_stretch_kernel(model, curves, laws, h, F, law, centres, lo, hi, su
     for p in range(lo, hi, sub):
         q = min(p + sub, hi)
         x, v = X[p].copy(), V[p].copy()
-        curve_state(x, curves, law, centres, factors, c)
+        curve_state(x + 0.5 * (q - p) * h * v, curves, law, centres, factors, c)
         for r in range(n_net):
             for s in range(2):
                 scales[p:q + 1, r, s] = law[r, s] * factors[r]

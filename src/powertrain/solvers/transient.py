@@ -1,9 +1,10 @@
 r"""A transient manoeuvre integrated in time by the run-up's nonlinear stepper.
 
 The load of :mod:`powertrain.solvers.transient_load` at every step drives the model of
-:meth:`Engine.assemble` (rigid ground, modal body, base compliance) through the dense Newmark
-step of the run-up's dense stepper and the continuous sweep (average acceleration; the port
-laws by Newton per step, :func:`~powertrain.kernels.port_forces.newmark_port_kernel`), a
+:meth:`Engine.assemble` (rigid ground, modal body, base compliance) through the Newmark step
+of the run-up's dense stepper and the continuous sweep (average acceleration; the port
+laws by Newton per step, :func:`~powertrain.kernels.port_forces.newmark_port_kernel`; the
+Newmark matrix factored sparsely, :mod:`powertrain.kernels.sparse_lu`), a
 stretch at a time (:func:`~powertrain.kernels.transient.transient_stretch_kernel`, the
 curves' updates inside it; the amplitude law once per stretch). Stretches are
 :data:`STRETCH` long (a linear model without static curves is one stretch); the static
@@ -14,9 +15,12 @@ undamped alternating error).
 
 **Static curves, large deflection.** Coordinates are measured from the static operating
 point at zero mean torque (weight only, :func:`~powertrain.solvers.operating_point.operating_point`),
-whose network deflections are :math:`\delta_0`. At every curve update, at the body's
-state :math:`\mathbf x_c` (network deflection :math:`u_c = \mathbf r^T\mathbf x_c`,
-:math:`\delta_c = \delta_0 + u_c`), each network with a static curve :math:`F(\delta)` is
+whose network deflections are :math:`\delta_0`. At every curve update, at the state
+predicted for the middle of the piece it starts, :math:`\mathbf x_c = \mathbf x +
+\tfrac T2\dot{\mathbf x}` (:math:`T` the piece's length; network deflection
+:math:`u_c = \mathbf r^T\mathbf x_c`, :math:`\delta_c = \delta_0 + u_c`: read at the
+piece's start instead, the tangent lags the motion by half a piece, an error of first
+order in :math:`T` that the middle cancels), each network with a static curve :math:`F(\delta)` is
 scaled by :math:`\kappa = f\,s`: its static factor :math:`f` at :math:`\delta_c`
 (:meth:`MountElement.at_operating_point`: the curve's tangent is :math:`f k_0`, :math:`k_0`
 the network's static stiffness) times its amplitude law's scale :math:`s`; and it is
