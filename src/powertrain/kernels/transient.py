@@ -43,22 +43,31 @@ from powertrain.kernels.sparse_lu import (
 
 
 @njit(cache=True, nogil=True, inline="always")
-def _read(table, grid, step, r, d):
-    """Row ``r`` of ``table`` at the deflection ``d`` [m]: linear between the samples of
-    the uniform grid from ``grid[r, 0]`` by ``step[r]``, the end values outside."""
-    lo, hi = grid[r, 0], grid[r, 1]
-    pos = (min(max(d, lo), hi) - lo) / step[r]
-    j = min(int(pos), table.shape[1] - 2)
-    w = pos - j
-    return table[r, j] * (1.0 - w) + table[r, j + 1] * w
+def curve_point(breaks, coefficients, count, r, d):
+    """``(force, tangent)`` [N, N/m] of network ``r``'s static curve at the deflection
+    ``d`` [m]: the piecewise cubic of ``count[r]`` breakpoints ``breaks[r]`` (n_net, n_b)
+    with the coefficients ``coefficients[r, j]`` (highest power first, as
+    :class:`scipy.interpolate.PPoly`'s) on each segment, straight with the end slopes
+    beyond its ends."""
+    last = count[r] - 1
+    x0, x1 = breaks[r, 0], breaks[r, last]
+    x = min(max(d, x0), x1)
+    j = 0
+    while j < last - 1 and breaks[r, j + 1] <= x:
+        j += 1
+    c = coefficients[r, j]
+    dx = x - breaks[r, j]
+    force = ((c[0] * dx + c[1]) * dx + c[2]) * dx + c[3]
+    tangent = (3.0 * c[0] * dx + 2.0 * c[1]) * dx + c[2]
+    return force + tangent * (d - x), tangent
 
 
 @njit(cache=True, nogil=True)
-def curve_values(table, grid, step, d, out):
-    """Each network's row of ``table`` at its deflection ``d`` (n_net,) [m] into ``out``
-    (:func:`_read`)."""
+def curve_values(breaks, coefficients, count, d, force, tangent):
+    """Each network's curve force and tangent at its deflection ``d`` (n_net,) [m] into
+    ``force``, ``tangent`` (:func:`curve_point`)."""
     for r in range(d.shape[0]):
-        out[r] = _read(table, grid, step, r, d[r])
+        force[r], tangent[r] = curve_point(breaks, coefficients, count, r, d[r])
 
 
 @njit(cache=True, nogil=True)
@@ -66,10 +75,11 @@ def curve_state(x, curves, law, centres, factors, c):
     r"""Static factor ``factors`` and curve load ``c`` (n_net,) [N] of every network at the
     state ``x`` (n,), its amplitude-law scales ``law`` (n_net, 2) and ``centres``
     (n_net,) [m]: :math:`c = F(\delta) - F(\delta_0) - f k_0 (u - \bar u) - s f k_0\bar u`
-    with :math:`u` the network deflection, :math:`\delta = \delta_0 + u`; a network
-    without a curve keeps its assembled factor and no load. ``curves = (rows, d0, f0,
-    grid, step, force, tangent, has, base, stiffness)``."""
-    rows, d0, f0, grid, step, force, tangent, has, base, stiffness = curves
+    with :math:`u` the network deflection, :math:`\delta = \delta_0 + u`,
+    :math:`f = F'(\delta)/F'(\delta_{ref})`; a network without a curve keeps its
+    assembled factor and no load. ``curves = (rows, d0, f0, breaks, coefficients, count,
+    reference tangent, has, base, stiffness)`` (:func:`curve_point`)."""
+    rows, d0, f0, breaks, coefficients, count, ref, has, base, stiffness = curves
     for r in range(rows.shape[0]):
         if not has[r]:
             factors[r] = base[r]
@@ -78,12 +88,11 @@ def curve_state(x, curves, law, centres, factors, c):
         u = 0.0
         for j in range(x.shape[0]):
             u += rows[r, j] * x[j]
-        d = d0[r] + u
-        f = _read(tangent, grid, step, r, d)
+        force, tangent = curve_point(breaks, coefficients, count, r, d0[r] + u)
+        f = tangent / ref[r]
         factors[r] = f
         k0 = f * stiffness[r]
-        c[r] = (_read(force, grid, step, r, d) - f0[r] - k0 * (u - centres[r])
-                - law[r, 0] * k0 * centres[r])
+        c[r] = force - f0[r] - k0 * (u - centres[r]) - law[r, 0] * k0 * centres[r]
 
 
 @njit(cache=True, nogil=True)

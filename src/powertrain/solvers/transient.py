@@ -331,11 +331,11 @@ def _kernel_curves(system, scaling, curves):
     rows = np.array(system.port_rows, float)
     n_net = rows.shape[0]
     if curves is None:
-        zero, flat = np.zeros(n_net), np.zeros((n_net, 2))
-        return (rows, zero, zero, flat + [0.0, 1.0], np.ones(n_net), flat, flat,
-                np.zeros(n_net, bool), np.array(scaling.static_factors, float), zero)
-    return (rows, curves.d0, curves.f0, curves.grid, curves.step, curves.force,
-            curves.tangent, curves.has, np.ones(n_net), np.array(curves.stiffness, float))
+        zero = np.zeros(n_net)
+        return (rows, zero, zero, np.zeros((n_net, 2)), np.zeros((n_net, 1, 4)),
+                np.full(n_net, 2, np.int64), np.ones(n_net), np.zeros(n_net, bool),
+                np.array(scaling.static_factors, float), zero)
+    return (rows, *curves.kernel_tuple(), np.ones(n_net), np.array(curves.stiffness, float))
 
 
 def _start(engine, manoeuvre, system, load, ports, model):
@@ -419,16 +419,12 @@ def _cycle_load(engine, manoeuvre, theta):
         return transient_load(engine, held, (theta - theta[0]) / abs(w0)).F
 
 
-#: Samples of each static curve's force and tangent over its points' range and as much
-#: again on either side (the curve is straight beyond its points), read linearly: the
-#: force's interpolation error is below 1e-4 N for the shipped curves.
-CURVE_SAMPLES = 20001
-
-
 class _Curves:
-    """The networks' static curves about the zero-torque static point (module docstring),
-    each sampled once (:data:`CURVE_SAMPLES`) on its own uniform grid and read linearly,
-    all networks at once (a network without a curve: zero force, factor 1)."""
+    """The networks' static curves about the zero-torque static point (module docstring):
+    each curve's piecewise cubic (its
+    :class:`~powertrain.physics.mount_laws.CurveReader`'s PCHIP) as arrays, read exactly in
+    the kernel (:func:`~powertrain.kernels.transient.curve_point`; a network without a
+    curve: zero force, factor 1)."""
 
     def __init__(self, engine, system):
         support = StaticSupport.of(engine)
@@ -437,31 +433,39 @@ class _Curves:
         self.d0 = operating_point(engine, rpm, support, mean_torque=0.0).deflection.ravel()
         self.rows = system.port_rows
         self.has = np.array([c is not None for c in support.curves])
-        flat = (np.array([-1.0, 1.0]), np.zeros(CURVE_SAMPLES), np.ones(CURVE_SAMPLES), 1.0)
-        tables = [flat if c is None else _sampled(c) for c in support.readers]
-        self.grid = np.array([(t[0][0], t[0][-1]) for t in tables])
-        self.step = (self.grid[:, 1] - self.grid[:, 0]) / (CURVE_SAMPLES - 1)
-        self.force = np.array([t[1] for t in tables])
-        self.tangent = np.array([t[2] / t[3] for t in tables])
-        self.f0 = self._read(self.force, self.d0)
+        pieces = [_cubic(c) for c in support.readers]
+        size = max(b.size for b, _, _ in pieces)
+        self.breaks = np.array([np.pad(b, (0, size - b.size), mode="edge") for b, _, _ in pieces])
+        self.coefficients = np.array([np.pad(c, ((0, size - 1 - len(c)), (0, 0)))
+                                      for _, c, _ in pieces])
+        self.count = np.array([b.size for b, _, _ in pieces], np.int64)
+        self.reference = np.array([t for _, _, t in pieces], float)
+        self.f0 = self._read(self.d0)[0]
 
-    def _read(self, table, d):
-        """Each network's row of ``table`` (n_net, CURVE_SAMPLES) at its deflection ``d``
-        (n_net,) [m], linear between samples, the end values outside."""
-        out = np.empty(d.size)
-        curve_values(table, self.grid, self.step, np.ascontiguousarray(d, float), out)
-        return out
+    def kernel_tuple(self):
+        """``(d0, f0, breaks, coefficients, count, reference tangent, has)`` for
+        :func:`~powertrain.kernels.transient.curve_state`."""
+        return (self.d0, self.f0, self.breaks, self.coefficients, self.count, self.reference,
+                self.has)
+
+    def _read(self, d):
+        """Each network's curve force [N] and tangent [N/m] at its deflection ``d``
+        (n_net,) [m]."""
+        force, tangent = np.empty(d.size), np.empty(d.size)
+        curve_values(self.breaks, self.coefficients, self.count,
+                     np.ascontiguousarray(d, float), force, tangent)
+        return force, tangent
 
     def factors(self, x):
         """Static factor of every network at the state ``x`` (1 without a curve)."""
-        return np.where(self.has, self._read(self.tangent, self.d0 + self.rows @ x), 1.0)
+        return np.where(self.has, self._read(self.d0 + self.rows @ x)[1] / self.reference, 1.0)
 
 
-def _sampled(curve):
-    """``(deflection, force, tangent, tangent at the reference)`` of a static curve (its
-    :class:`~powertrain.physics.mount_laws.CurveReader`)."""
-    lo, hi = float(curve.curve.deflection[0]), float(curve.curve.deflection[-1])
-    grid = np.linspace(2 * lo - hi, 2 * hi - lo, CURVE_SAMPLES)
-    return (grid, np.asarray(curve.force_at(grid), float),
-            np.asarray(curve.tangent_at(grid), float),
+def _cubic(curve):
+    """``(breaks, coefficients (segments, 4), tangent at the reference)`` of a static
+    curve's :class:`~powertrain.physics.mount_laws.CurveReader` (a straight line of slope 1
+    for a network without a curve)."""
+    if curve is None:
+        return np.array([-1.0, 1.0]), np.array([[0.0, 0.0, 1.0, -1.0]]), 1.0
+    return (np.asarray(curve.pchip.x, float), np.ascontiguousarray(curve.pchip.c.T, float),
             float(curve.tangent_at(curve.curve.reference_deflection)))
