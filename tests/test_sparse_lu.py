@@ -1,6 +1,6 @@
 """The sparse LU of the transient's Newmark matrix (kernels/sparse_lu.py) against
-numpy.linalg.solve, and the transient piece on its sparse and its dense path against a
-Newmark step written out here."""
+numpy.linalg.solve, and the transient piece, with and without row swaps, against a Newmark
+step written out here."""
 
 import numpy as np
 from hypothesis import given, settings
@@ -30,11 +30,13 @@ def arrow(rng, networks, inner, body=6):
 
 
 def solve(S, perm, b):
-    ok, B = factor(S, perm, 1e-12)
+    """S^-1 b by the sparse factors, and the factors' array."""
+    zero = np.zeros_like(S)
+    ok, B, rows = factor(S, zero, zero, 0.0, 0.0, perm)
     assert ok
     out = np.empty(b.size)
-    lu_solve((sparse_factors(B)), perm, b, np.empty(b.size), out)
-    return out, B
+    lu_solve(sparse_factors(B), rows, perm, b, np.empty(b.size), out)
+    return out, B, rows
 
 
 @settings(max_examples=40, deadline=None)
@@ -44,8 +46,9 @@ def test_the_sparse_solve_is_numpys_and_fills_only_the_body_rows(networks, inner
     S = arrow(rng, networks, inner)
     b = rng.standard_normal(S.shape[0])
     perm = _elimination_order(S)
-    x, B = solve(S, perm, b)
+    x, B, rows = solve(S, perm, b)
     ref = np.linalg.solve(S, b)
+    assert np.array_equal(rows, perm)                     # positive definite: no swap
     np.testing.assert_allclose(x, ref, rtol=1e-8, atol=1e-10 * np.abs(ref).max())
     # the body's coordinates are eliminated last and no network's row gains an entry of
     # another network: the factors are as sparse as S
@@ -55,12 +58,17 @@ def test_the_sparse_solve_is_numpys_and_fills_only_the_body_rows(networks, inner
     assert not fill[:-6, :-6].any()
 
 
-def test_a_pivot_not_above_the_tolerance_is_refused():
-    S = np.array([[0.0, 1.0], [1.0, 2.0]])
-    assert not factor(S, np.arange(2), 1e-12)[0]
-    assert not factor(S, np.array([1, 0]), 1e-12)[0]     # indefinite in any order
-    assert factor(np.array([[2.0, 1.0], [1.0, 2.0]]), np.array([1, 0]), 1e-12)[0]
-    assert not factor(np.array([[1.0, 0.0], [0.0, -1.0]]), np.arange(2), 1e-12)[0]
+def test_a_small_pivot_is_swapped_and_a_singular_matrix_refused():
+    rng = np.random.default_rng(3)
+    S = rng.standard_normal((7, 7))
+    S[0, 0] = S[3, 3] = 0.0                       # no elimination without a row swap
+    b = rng.standard_normal(7)
+    x, _, rows = solve(S, np.arange(7), b)
+    assert not np.array_equal(rows, np.arange(7))
+    np.testing.assert_allclose(S @ x, b, atol=1e-12 * np.abs(b).max() * np.linalg.cond(S))
+    S[:, 4] = 0.0
+    zero = np.zeros_like(S)
+    assert not factor(S, zero, zero, 0.0, 0.0, np.arange(7))[0]
 
 
 def newmark(M, C, K, F, h, x, v):
@@ -77,7 +85,7 @@ def newmark(M, C, K, F, h, x, v):
     return np.array(X), np.array(V), np.array(A)
 
 
-def test_a_piece_is_newmarks_on_the_sparse_and_on_the_dense_path():
+def test_a_piece_is_newmarks_with_and_without_row_swaps():
     rng = np.random.default_rng(1)
     M = np.diag(rng.uniform(1, 5, 8))
     C = arrow(rng, 2, 1) * 1e-2
@@ -86,11 +94,13 @@ def test_a_piece_is_newmarks_on_the_sparse_and_on_the_dense_path():
     F = rng.standard_normal((steps + 1, 8))
     x, v = rng.standard_normal(8) * 1e-3, rng.standard_normal(8) * 1e-2
     ref = newmark(M, C, K, F, h, x, v)
-    for K_used in (K, K - 1.5 * np.diag(np.diag(K)) - 4 / h ** 2 * M):
-        # the second K makes S indefinite: the sparse elimination refuses its first pivot
-        S = M + h / 2 * C + h * h / 4 * K_used
-        perm = _elimination_order(M, C, K_used)
-        assert factor(S, perm, 1e-12)[0] == (K_used is K)
+    perm = _elimination_order(M, C, K)
+    first = perm[0]
+    K_zero = K.copy()                   # S's first pivot 0: the elimination swaps rows
+    K_zero[first, first] = -(M[first, first] + h / 2 * C[first, first]) * 4 / h ** 2
+    for K_used in (K, K_zero):
+        rows = factor(M, C, K_used, h / 2, h * h / 4, perm)[2]
+        assert np.array_equal(rows, perm) == (K_used is K)
         ref = newmark(M, C, K_used, F, h, x, v)
         model = (M, C, K_used, None, None, None, np.linalg.inv(M), perm)
         X, V, A = (np.empty((steps + 1, 8)) for _ in range(3))

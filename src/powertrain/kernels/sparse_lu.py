@@ -11,42 +11,60 @@ instead of :math:`n^3`.
 
 S is symmetric positive definite for passive mounts (every massless node held by a spring
 or damper), where elimination needs no pivoting (Golub & Van Loan, *Matrix Computations*,
-4th ed., 2013, §4.2). :func:`factor` refuses a pivot not above ``tol`` times the largest
-diagonal entry; the caller then solves densely with pivoting.
+4th ed., 2013, §4.2). :func:`factor` swaps a row in only where a pivot is small against
+its column (threshold pivoting, ibid. §3.4 and Duff, Erisman & Reid, *Direct Methods for
+Sparse Matrices*, 2nd ed., 2017, §5.4): never for such an S, so its factors stay sparse;
+any other regular S is still solved, with fill-in.
 """
 
 import numpy as np
 from numba import njit
 
+#: A pivot below this share of its column's largest entry is swapped for that entry's row.
+PIVOT_THRESHOLD = 0.01
+
 
 @njit(cache=True, nogil=True)
-def factor(S, perm, tol):
-    """``(ok, B)``: the LU factors of ``S`` (n, n) with rows and columns in the order
-    ``perm`` (int64, n) in one array ``B`` (L strictly below the diagonal with a unit
-    diagonal, U on and above); ``ok`` False where a pivot is not above ``tol`` times the
-    largest diagonal entry of ``S`` (B then incomplete)."""
-    n = S.shape[0]
+def factor(M, C, K, c, k, perm):
+    """``(ok, B, rows)``: the LU factors of S = ``M + c C + k K`` (n, n) with its columns
+    in the order ``perm`` (int64, n) in one array ``B`` (L strictly below the diagonal with
+    a unit diagonal, U on and above) and the order of its rows ``rows``: ``perm`` but where
+    a pivot is below :data:`PIVOT_THRESHOLD` of its column's largest entry, whose row is
+    swapped in (threshold pivoting: none for a positive definite S, whose factors keep its
+    sparsity); ``ok`` False where a column has no nonzero entry left (S singular)."""
+    n = M.shape[0]
     B = np.empty((n, n))
-    big = 0.0
+    rows = perm.copy()
     for i in range(n):
         for j in range(n):
-            B[i, j] = S[perm[i], perm[j]]
-        big = max(big, abs(B[i, i]))
-    for c in range(n):
-        p = B[c, c]
-        if not p > tol * big:
-            return False, B
-        for i in range(c + 1, n):
-            f = B[i, c]
+            a, b = perm[i], perm[j]
+            B[i, j] = M[a, b] + c * C[a, b] + k * K[a, b]
+    for col in range(n):
+        p, big = col, 0.0
+        for i in range(col, n):
+            big = max(big, abs(B[i, col]))
+        if not big > 0.0:
+            return False, B, rows
+        if abs(B[col, col]) < PIVOT_THRESHOLD * big:
+            for i in range(col, n):
+                if abs(B[i, col]) == big:
+                    p = i
+                    break
+            for j in range(n):
+                B[col, j], B[p, j] = B[p, j], B[col, j]
+            rows[col], rows[p] = rows[p], rows[col]
+        pivot = B[col, col]
+        for i in range(col + 1, n):
+            f = B[i, col]
             if f == 0.0:
                 continue
-            f /= p
-            B[i, c] = f
-            for j in range(c + 1, n):
-                u = B[c, j]
+            f /= pivot
+            B[i, col] = f
+            for j in range(col + 1, n):
+                u = B[col, j]
                 if u != 0.0:
                     B[i, j] -= f * u
-    return True, B
+    return True, B, rows
 
 
 @njit(cache=True, nogil=True)
@@ -85,14 +103,15 @@ def sparse_factors(B):
     return compressed(B, True, False), compressed(B, False, True), inv_d
 
 
-@njit(cache=True, nogil=True, inline="always")
-def lu_solve(factors, perm, b, y, out):
-    """``out`` = S^-1 ``b`` (n,) from :func:`sparse_factors`' ``factors`` of S in the order
-    ``perm``; ``y`` (n,) is work space."""
+@njit(cache=True, nogil=True)
+def lu_solve(factors, rows, perm, b, y, out):
+    """``out`` = S^-1 ``b`` (n,) from :func:`sparse_factors`' ``factors`` of S, its rows in
+    the order ``rows`` and its columns in the order ``perm`` (:func:`factor`); ``y`` (n,)
+    is work space."""
     (Lp, Li, Lx), (Up, Ui, Ux), inv_d = factors
     n = b.shape[0]
     for i in range(n):
-        s = b[perm[i]]
+        s = b[rows[i]]
         for k in range(Lp[i], Lp[i + 1]):
             s -= Lx[k] * y[Li[k]]
         y[i] = s
@@ -104,7 +123,7 @@ def lu_solve(factors, perm, b, y, out):
         out[perm[i]] = y[i]
 
 
-@njit(cache=True, nogil=True, inline="always")
+@njit(cache=True, nogil=True)
 def subtract_product(A, x, out):
     """``out -= A x`` for ``A`` compressed (:func:`compressed`)."""
     starts, columns, values = A

@@ -11,12 +11,11 @@ network's change of scale times its parts (sparse: the nonzero entries of every 
 :math:`\mathbf L^T\mathbf C_n\mathbf L`, :math:`\mathbf L^T\mathbf K_n\mathbf L`); the piece
 is integrated from the position and velocity, its acceleration solved from the new laws.
 A step solves :math:`\mathbf S\ddot{\mathbf x} = \mathbf f - \mathbf C\tilde{\mathbf v}
-- \mathbf K\tilde{\mathbf x}` (:mod:`powertrain.kernels.newmark`) by S's sparse LU factors
-(:mod:`powertrain.kernels.sparse_lu`: a piece costs a factorization of the networks' small
-blocks, a step about the nonzeros of S), then the port laws by Newton as
-:func:`powertrain.kernels.port_forces.newmark_port_kernel`; where S is not positive
-definite (the elimination refuses a pivot) the piece runs on its dense inverse, by that
-kernel or :func:`powertrain.kernels.newmark.newmark_kernel`.
+- \mathbf K\tilde{\mathbf x}` (:mod:`powertrain.kernels.newmark`) by S's LU factors kept
+sparse (:mod:`powertrain.kernels.sparse_lu`: a piece costs a factorization of the networks'
+small blocks, a step about the nonzeros of S), then the port laws by Newton as
+:func:`powertrain.kernels.port_forces.newmark_port_kernel`. Loops rather than NumPy
+expressions: each expression costs a compilation on a first run.
 
 Numba caches a kernel by its own file: after editing the step kernels it calls, touch this
 file (or clear ``__pycache__``) so that its cached machine code is rebuilt.
@@ -25,10 +24,8 @@ file (or clear ``__pycache__``) so that its cached machine code is rebuilt.
 import numpy as np
 from numba import njit
 
-from powertrain.kernels.newmark import newmark_kernel
 from powertrain.kernels.port_forces import (
     law_force,
-    newmark_port_kernel,
     port_coupling,
     port_forces_at,
     port_forces_step,
@@ -42,7 +39,7 @@ from powertrain.kernels.sparse_lu import (
 )
 
 
-@njit(cache=True, nogil=True, inline="always")
+@njit(cache=True, nogil=True)
 def curve_point(breaks, coefficients, count, r, d):
     """``(force, tangent)`` [N, N/m] of network ``r``'s static curve at the deflection
     ``d`` [m]: the piecewise cubic of ``count[r]`` breakpoints ``breaks[r]`` (n_net, n_b)
@@ -120,11 +117,6 @@ def _times(A, x, transpose=False):
     return out
 
 
-#: A pivot of the sparse elimination at most this times the largest diagonal entry: the
-#: piece is solved densely with pivoting instead (:func:`~powertrain.kernels.sparse_lu.factor`).
-PIVOT_TOL = 1e-12
-
-
 @njit(cache=True, nogil=True)
 def _start_acceleration(model, laws, C, K, f, x, v):
     """The acceleration [m/s²] at ``(x, v)`` under the load ``f`` and the port laws (0 on
@@ -142,36 +134,18 @@ def _start_acceleration(model, laws, C, K, f, x, v):
 def _piece(model, laws, h, C, K, F, load, x, v, a, X, V, A, Z, tol, max_iter):
     """Newmark over the load rows ``F`` (k + 1, n) less ``load`` (n,) from ``(x, v)`` with
     ``C``, ``K`` into the rows ``X``, ``V``, ``A``, ``Z``; ``a`` the acceleration at the
-    start, or solved from the laws where it has no entry. S factored sparsely in the
-    model's order (:mod:`powertrain.kernels.sparse_lu`), densely where that refuses a pivot.
-    Returns the steps where Newton did not converge."""
+    start, or solved from the laws where it has no entry. S factored in the model's order
+    (:mod:`powertrain.kernels.sparse_lu`). Returns the steps where Newton did not
+    converge."""
     M, perm = model[0], model[7]
     if a.shape[0] == 0:
         a = _start_acceleration(model, laws, C, K, F[0] - load, x, v)
-    ok, B = factor(M + 0.5 * h * C + 0.25 * h * h * K, perm, PIVOT_TOL)
-    if ok:
-        return _sparse_steps((sparse_factors(B), perm), laws, h, C, K, F, load, x, v, a, X,
-                             V, A, Z, tol, max_iter)
-    return _dense_steps(model, laws, h, C, K, F, load, x, v, a, X, V, A, Z, tol, max_iter)
-
-
-@njit(cache=True, nogil=True)
-def _dense_steps(model, laws, h, C, K, F, load, x, v, a, X, V, A, Z, tol, max_iter):
-    """:func:`_piece` by the dense inverse of S (:func:`~powertrain.kernels.newmark.newmark_kernel`,
-    :func:`~powertrain.kernels.port_forces.newmark_port_kernel`)."""
-    Sinv = np.linalg.inv(model[0] + 0.5 * h * C + 0.25 * h * h * K)
-    G, H, Fs = Sinv @ C, Sinv @ K, F @ np.ascontiguousarray(Sinv.T)
-    shift = _times(Sinv, load)                # (F - load) S^-T, row by row
-    for k in range(Fs.shape[0]):
-        for j in range(Fs.shape[1]):
-            Fs[k, j] -= shift[j]
-    if laws is None:        # pruned at compile time: a linear model compiles no port kernel
-        newmark_kernel(G, H, Fs, h, x, v, a, X, V, A)
-        return 0
-    P, kinds, par, state = laws
-    W = Sinv @ np.ascontiguousarray(P.T)
-    return newmark_port_kernel(G, H, Fs, h, x, v, a, W, P, P @ W, kinds, par, state, X, V, A,
-                               Z, tol, max_iter)
+    ok, B, rows = factor(M, C, K, 0.5 * h, 0.25 * h * h, perm)
+    if not ok:
+        raise FloatingPointError("the Newmark matrix M + h/2 C + h^2/4 K is singular (a "
+                                 "mount network without stiffness and damping?)")
+    return _sparse_steps((sparse_factors(B), rows, perm), laws, h, C, K, F, load, x, v, a,
+                         X, V, A, Z, tol, max_iter)
 
 
 @njit(cache=True, nogil=True)
@@ -183,21 +157,27 @@ def _port_setup(laws, lu, h, x, v, Z):
         return None
     P, kinds, par, state = laws
     n, m = x.shape[0], kinds.shape[0]
-    W, col, y = np.empty((n, m)), np.empty(n), np.empty(n)
-    for e in range(m):
-        lu_solve(lu[0], lu[1], P[e], y, col)
-        W[:, e] = col
-    z = np.empty(m)
-    for e in range(m):
-        z[e] = law_force(kinds[e], _times(P[e:e + 1], x)[0], _times(P[e:e + 1], v)[0], par,
-                         state, e)[0]
-        Z[0, e] = z[e]
+    W, Q, col, y, z = np.empty((n, m)), np.zeros((m, m)), np.empty(n), np.empty(n), \
+        np.empty(m)
     hh = 0.25 * h * h
-    return (W, port_coupling(hh * (P @ W), 2.0 / h), compressed(P, True, True), z,
+    for e in range(m):              # loops: each NumPy expression costs a compile
+        lu_solve(lu[0], lu[1], lu[2], P[e], y, col)
+        for j in range(n):
+            W[j, e] = col[j]
+            for i in range(m):
+                Q[i, e] += hh * P[i, j] * col[j]
+    for e in range(m):
+        u, du = 0.0, 0.0
+        for j in range(n):
+            u += P[e, j] * x[j]
+            du += P[e, j] * v[j]
+        z[e] = law_force(kinds[e], u, du, par, state, e)[0]
+        Z[0, e] = z[e]
+    return (W, port_coupling(Q, 2.0 / h), compressed(P, True, True), z,
             (np.empty(m), np.empty(m), np.empty(m), np.empty((m, m)), np.zeros((7, m))))
 
 
-@njit(cache=True, nogil=True, inline="always")
+@njit(cache=True, nogil=True)
 def _port_step(laws, ports, h, xt, vt, a, z_out, tol, max_iter):
     """The port forces of one step (:func:`~powertrain.kernels.port_forces.newmark_port_kernel`)
     into ``z_out``, taken off the linear acceleration ``a`` in place. True on success."""
@@ -226,12 +206,13 @@ def _port_step(laws, ports, h, xt, vt, a, z_out, tol, max_iter):
 
 @njit(cache=True, nogil=True)
 def _sparse_steps(lu, laws, h, C, K, F, load, x, v, a, X, V, A, Z, tol, max_iter):
-    """:func:`_piece` by the sparse factors ``lu = (factors, perm)`` of S: a step is the
+    """:func:`_piece` by the factors ``lu = (factors, rows, perm)`` of S: a step is the
     residual by the compressed C and K, one sparse solve and the port laws."""
     n, hh, hv = x.shape[0], 0.25 * h * h, 0.5 * h
     Cs, Ks = compressed(C, True, True), compressed(K, True, True)
     xt, vt, r, y = np.empty(n), np.empty(n), np.empty(n), np.empty(n)
-    X[0], V[0], A[0] = x, v, a
+    for j in range(n):
+        X[0, j], V[0, j], A[0, j] = x[j], v[j], a[j]
     ports = _port_setup(laws, lu, h, x, v, Z)
     failed = 0
     for k in range(1, F.shape[0]):
@@ -241,7 +222,7 @@ def _sparse_steps(lu, laws, h, C, K, F, load, x, v, a, X, V, A, Z, tol, max_iter
             r[j] = F[k, j] - load[j]
         subtract_product(Cs, vt, r)
         subtract_product(Ks, xt, r)
-        lu_solve(lu[0], lu[1], r, y, A[k])
+        lu_solve(lu[0], lu[1], lu[2], r, y, A[k])
         if laws is not None and not _port_step(laws, ports, h, xt, vt, A[k], Z[k], tol,
                                                max_iter):
             failed += 1
@@ -292,7 +273,7 @@ def transient_stretch_kernel(model, curves, laws, h, F, law, centres, lo, hi, su
     """
     _, C0, K0, C_parts, K_parts, assembled, _, _ = model
     n_net = law.shape[0]
-    factors, c = np.empty(n_net), np.empty(n_net)
+    factors, c, middle = np.empty(n_net), np.empty(n_net), np.empty(X.shape[1])
     change = np.empty((n_net, 2))
     rows = curves[0]
     failed = 0
@@ -300,7 +281,9 @@ def transient_stretch_kernel(model, curves, laws, h, F, law, centres, lo, hi, su
     for p in range(lo, hi, sub):
         q = min(p + sub, hi)
         x, v = X[p].copy(), V[p].copy()
-        curve_state(x + 0.5 * (q - p) * h * v, curves, law, centres, factors, c)
+        for j in range(x.shape[0]):       # the piece's predicted middle
+            middle[j] = x[j] + 0.5 * (q - p) * h * v[j]
+        curve_state(middle, curves, law, centres, factors, c)
         for r in range(n_net):
             for s in range(2):
                 scales[p:q + 1, r, s] = law[r, s] * factors[r]
