@@ -399,10 +399,26 @@ def _static_state(system, scaling, curves, load, file=None):
         dx = np.linalg.solve(K, F - K @ x - rows.T @ c)
         x += dx
         if np.max(np.abs(dx)) <= STATIC_TOL * max(np.max(np.abs(x)), STATIC_SCALE):
+            _check_within_curves(curves, rows @ x, system.network_names, file)
             return x
     raise InputError("no static point of the first load on the mounts' static curves (not "
                      f"converged in {STATIC_MAX_ITER} iterations): a mean torque or gear ratio "
                      "beyond what they carry?", file=file or None, key="load")
+
+
+def _check_within_curves(curves, u, names, file):
+    """Refuse a static point farther beyond a static curve's points than they span: the
+    datasheet says nothing of such a deflection (its straight continuation would carry any
+    load)."""
+    for r in np.flatnonzero(curves.has):
+        lo, hi = curves.breaks[r, 0], curves.breaks[r, curves.count[r] - 1]
+        d = curves.d0[r] + u[r]
+        if not lo - (hi - lo) <= d <= hi + (hi - lo):
+            raise InputError(f"the static point of the first load deflects {names[r]} "
+                             f"{d * 1e3:.4g} mm, beyond its static curve's points "
+                             f"({lo * 1e3:.4g} to {hi * 1e3:.4g} mm) by more than they span: "
+                             "a mean torque or gear ratio beyond what the mounts carry?",
+                             file=file or None, key="load")
 
 
 def _cycle_load(engine, manoeuvre, theta):
