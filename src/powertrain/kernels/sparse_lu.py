@@ -73,14 +73,8 @@ def compressed(A, lower, upper):
     entries below the diagonal where ``lower``, above it where ``upper``, the diagonal where
     both; zeros left out."""
     m, n = A.shape
-    count = 0
-    for i in range(m):
-        for j in range(n):
-            if A[i, j] != 0.0 and ((j < i and lower) or (j > i and upper)
-                                   or (j == i and lower and upper)):
-                count += 1
-    starts, columns, values = np.zeros(m + 1, np.int64), np.empty(count, np.int64), \
-        np.empty(count)
+    starts, columns, values = np.zeros(m + 1, np.int64), np.empty(m * n, np.int64), \
+        np.empty(m * n)
     k = 0
     for i in range(m):
         for j in range(n):
@@ -90,7 +84,7 @@ def compressed(A, lower, upper):
                 values[k] = A[i, j]
                 k += 1
         starts[i + 1] = k
-    return starts, columns, values
+    return starts, columns[:k].copy(), values[:k].copy()
 
 
 @njit(cache=True, nogil=True)

@@ -5,7 +5,7 @@ formulas).
 A stretch is cut into pieces of ``sub`` steps. At the start of every piece, at the state
 predicted for its middle, :math:`\mathbf x + \tfrac T2\dot{\mathbf x}` (:math:`T` its
 length), each network's static factor :math:`f` and curve load :math:`c` are read from its
-sampled curve (:func:`curve_state`); the networks are scaled by the amplitude law's
+curve's piecewise cubic (:func:`curve_state`); the networks are scaled by the amplitude law's
 ``law`` times :math:`f`; the damping and stiffness are the assembled ones plus each
 network's change of scale times its parts (sparse: the nonzero entries of every network's
 :math:`\mathbf L^T\mathbf C_n\mathbf L`, :math:`\mathbf L^T\mathbf K_n\mathbf L`); the piece
@@ -242,8 +242,9 @@ def transient_stretch_kernel(model, curves, laws, h, F, law, centres, lo, hi, su
     model : tuple
         ``(M, C, K, C_parts, K_parts, assembled, M_inv, perm)``: the assembled matrices, each
         network's sparse parts ``(net, i, j, value)``, the scales (n_net, 2) the assembled
-        matrices hold and the inverse of M (zeros where M is singular: massless nodes, a
-        start acceleration of 0).
+        matrices hold, the inverse of M (zeros where M is singular: massless nodes, a
+        start acceleration of 0) and the coordinates' elimination order (int64, n;
+        :mod:`powertrain.kernels.sparse_lu`).
     curves : tuple
         :func:`curve_state`'s.
     laws : tuple or None
