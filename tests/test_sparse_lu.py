@@ -1,14 +1,21 @@
 """The sparse LU of the transient's Newmark matrix (kernels/sparse_lu.py) against
-numpy.linalg.solve, and the transient piece, with and without row swaps, against a Newmark
-step written out here."""
+numpy.linalg.solve, its factorization on a fixed pattern against the general one, and the
+transient piece, with and without row swaps, against a Newmark step written out here."""
 
 import numpy as np
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from powertrain.kernels.sparse_lu import factor, lu_solve, sparse_factors
-from powertrain.kernels.transient import _piece
-from powertrain.solvers.transient import _elimination_order
+from powertrain.kernels.sparse_lu import (
+    compressed,
+    factor,
+    factor_on_pattern,
+    lu_pattern,
+    lu_solve,
+    sparse_factors,
+)
+from powertrain.kernels.transient import _piece, _scaled
+from powertrain.solvers.transient_model import _elimination_order, kernel_model
 
 
 def arrow(rng, networks, inner, body=6):
@@ -58,6 +65,42 @@ def test_the_sparse_solve_is_numpys_and_fills_only_the_body_rows(networks, inner
     assert not fill[:-6, :-6].any()
 
 
+def on_pattern(M, C, K, c, k, perm):
+    """``(ok, factors)`` of :func:`factor_on_pattern` on S = M + c C + k K's own pattern."""
+    where = np.empty_like(perm)
+    where[perm] = np.arange(perm.size)
+    mask = ((M != 0) | (C != 0) | (K != 0))[np.ix_(perm, perm)]
+    (lp, li), _, (up, ui) = pattern = lu_pattern(mask)
+    n = M.shape[0]
+    factors = ((lp, li, np.empty(li.size)), (up, ui, np.empty(ui.size)), np.empty(n))
+    terms = tuple((compressed(A, True, True), coefficient)
+                  for A, coefficient in ((M, 1.0), (C, c), (K, k)))
+    return factor_on_pattern(terms, where, pattern, np.empty((n, n)), factors), factors
+
+
+@settings(max_examples=40, deadline=None)
+@given(st.integers(1, 9), st.integers(1, 4), st.integers(0, 2**32 - 1))
+def test_factors_on_a_fixed_pattern_are_the_general_ones_bit_for_bit(networks, inner, seed):
+    rng = np.random.default_rng(seed)
+    M, C, K = (arrow(rng, networks, inner) for _ in range(3))
+    gone = rng.random(C.shape[0]) < 0.3           # C's pattern smaller than S's, C still
+    C[gone, :] = C[:, gone] = 0.0                   # positive semidefinite
+    perm = _elimination_order(M, C, K)
+    ok, factors = on_pattern(M, C, K, 0.5e-3, 0.25e-6, perm)
+    assert ok
+    B = factor(M, C, K, 0.5e-3, 0.25e-6, perm)[1]
+    for (starts, columns, values), want in zip(factors[:2], (np.tril(B, -1), np.triu(B, 1)),
+                                               strict=True):
+        got = np.zeros_like(B)
+        got[np.repeat(np.arange(B.shape[0]), np.diff(starts)), columns] = values
+        assert np.array_equal(got, want)
+    assert np.array_equal(factors[2], 1.0 / np.diag(B))
+    # a pivot that needs a row swap: the fixed pattern says so and leaves it to factor()
+    K_zero = K.copy()
+    K_zero[perm[0], perm[0]] = -(M[perm[0], perm[0]] + 0.5e-3 * C[perm[0], perm[0]]) / 0.25e-6
+    assert not on_pattern(M, C, K_zero, 0.5e-3, 0.25e-6, perm)[0]
+
+
 def test_a_small_pivot_is_swapped_and_a_singular_matrix_refused():
     rng = np.random.default_rng(3)
     S = rng.standard_normal((7, 7))
@@ -69,6 +112,14 @@ def test_a_small_pivot_is_swapped_and_a_singular_matrix_refused():
     S[:, 4] = 0.0
     zero = np.zeros_like(S)
     assert not factor(S, zero, zero, 0.0, 0.0, np.arange(7))[0]
+
+
+def work(model):
+    """The piece's work space (as transient_stretch_kernel makes it)."""
+    (lp, li), _, (up, ui) = model[8]
+    n = model[0].shape[0]
+    return np.empty((n, n)), ((lp, li, np.empty(li.size)), (up, ui, np.empty(ui.size)),
+                              np.empty(n))
 
 
 def newmark(M, C, K, F, h, x, v):
@@ -102,10 +153,12 @@ def test_a_piece_is_newmarks_with_and_without_row_swaps():
         rows = factor(M, C, K_used, h / 2, h * h / 4, perm)[2]
         assert np.array_equal(rows, perm) == (K_used is K)
         ref = newmark(M, C, K_used, F, h, x, v)
-        model = (M, C, K_used, None, None, None, np.linalg.inv(M), perm)
+        none = np.zeros((0, 8, 8))
+        model = kernel_model(M, C, K_used, none, none, np.zeros((0, 2)))
         X, V, A = (np.empty((steps + 1, 8)) for _ in range(3))
-        failed = _piece(model, None, h, C, K_used, F, np.zeros(8), x, v, np.empty(0), X, V,
-                        A, np.empty((steps + 1, 0)), 1e-12, 10)
+        failed = _piece(model, None, h, _scaled(model[3], np.zeros(0)),
+                        _scaled(model[4], np.zeros(0)), F, np.zeros(8), x, v, np.empty(0), X,
+                        V, A, np.empty((steps + 1, 0)), 1e-12, 10, work(model))
         assert failed == 0
         for got, want in zip((X, V, A), ref, strict=True):
             np.testing.assert_allclose(got, want, rtol=1e-9, atol=1e-9 * np.abs(want).max())

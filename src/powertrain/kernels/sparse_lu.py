@@ -4,7 +4,7 @@ kept sparse, and their solve; and a sparse matrix–vector product.
 The Newmark matrix :math:`\mathbf S = \mathbf M + \tfrac h2\mathbf C + \tfrac{h^2}{4}\mathbf K`
 of a body on mount networks is an arrow: each network's internal coordinates couple only
 to each other and to the body's. Eliminated networks first and the body last (the order
-of fewest nonzeros first, :func:`powertrain.solvers.transient` computes it once), its
+of fewest nonzeros first, :mod:`powertrain.solvers.transient_model` computes it once), its
 factors have no fill-in but the body's rows, so a solve costs about the number of nonzeros
 of S instead of :math:`n^2`, and a factorization a few of the networks' small blocks
 instead of :math:`n^3`.
@@ -15,6 +15,12 @@ or damper), where elimination needs no pivoting (Golub & Van Loan, *Matrix Compu
 its column (threshold pivoting, ibid. §3.4 and Duff, Erisman & Reid, *Direct Methods for
 Sparse Matrices*, 2nd ed., 2017, §5.4): never for such an S, so its factors stay sparse;
 any other regular S is still solved, with fill-in.
+
+S's pattern is the same at every factorization of a run (only the values of C and K
+change), so :func:`lu_pattern` finds its factors' pattern once (symbolic factorization,
+Duff, Erisman & Reid §10.2) and :func:`factor_on_pattern` computes the values on it: work
+about the factors' nonzeros. Where a pivot would need a swap it says so, and the caller
+falls back to :func:`factor`.
 """
 
 import numpy as np
@@ -67,6 +73,73 @@ def factor(M, C, K, c, k, perm):
     return True, B, rows
 
 
+def csr_pattern(mask):
+    """``(starts, columns)`` (int64) of the rows of the boolean ``mask`` (m, n): its
+    ``True`` entries row by row, columns ascending (:func:`compressed`'s layout)."""
+    rows, columns = np.nonzero(mask)
+    starts = np.zeros(mask.shape[0] + 1, np.int64)
+    np.cumsum(np.bincount(rows, minlength=mask.shape[0]), out=starts[1:])
+    return starts, columns.astype(np.int64)
+
+
+def lu_pattern(mask):
+    """``(L rows, L columns, U rows)``, each ``(starts, indices)`` (:func:`csr_pattern`):
+    the entries of the LU factors, without row swaps, of a matrix whose nonzeros are
+    ``mask`` (n, n), already in its elimination order: its own and the fill-in
+    (symbolic elimination)."""
+    P = np.array(mask, bool)
+    for col in range(P.shape[0]):
+        below = np.flatnonzero(P[col + 1:, col]) + col + 1
+        right = np.flatnonzero(P[col, col + 1:]) + col + 1
+        P[np.ix_(below, right)] = True
+    lower = np.tril(P, -1)
+    return csr_pattern(lower), csr_pattern(lower.T), csr_pattern(np.triu(P, 1))
+
+
+@njit(cache=True, nogil=True)
+def factor_on_pattern(terms, where, pattern, B, factors):
+    """The LU factors of S = Σ coefficient × A over ``terms`` (a tuple of ``(A compressed,
+    coefficient)``, :func:`compressed`) in the order whose position of each coordinate is
+    ``where`` (int64, n), into ``factors`` (:func:`sparse_factors`' layout on
+    :func:`lu_pattern`'s ``pattern``); ``B`` (n, n) work space. False, leaving ``factors``
+    unfinished, where a pivot is below :data:`PIVOT_THRESHOLD` of its column's largest
+    entry or a column is zero: :func:`factor` then decides (a row swap, or S singular).
+    Without a swap, the same arithmetic as :func:`factor`."""
+    (lower_p, lower_i), (col_p, col_i), (upper_p, upper_i) = pattern
+    (_, _, lower_x), (_, _, upper_x), inv_d = factors
+    n = B.shape[0]
+    B[:, :] = 0.0
+    for A, coefficient in terms:
+        starts, columns, values = A
+        for i in range(n):
+            for k in range(starts[i], starts[i + 1]):
+                B[where[i], where[columns[k]]] += coefficient * values[k]
+    for col in range(n):
+        pivot = B[col, col]
+        big = abs(pivot)
+        for t in range(col_p[col], col_p[col + 1]):
+            big = max(big, abs(B[col_i[t], col]))
+        if not big > 0.0 or abs(pivot) < PIVOT_THRESHOLD * big:
+            return False
+        for t in range(col_p[col], col_p[col + 1]):
+            i = col_i[t]
+            f = B[i, col]
+            if f == 0.0:
+                continue
+            f /= pivot
+            B[i, col] = f
+            for s in range(upper_p[col], upper_p[col + 1]):
+                j = upper_i[s]
+                B[i, j] -= f * B[col, j]
+    for i in range(n):
+        for k in range(lower_p[i], lower_p[i + 1]):
+            lower_x[k] = B[i, lower_i[k]]
+        for k in range(upper_p[i], upper_p[i + 1]):
+            upper_x[k] = B[i, upper_i[k]]
+        inv_d[i] = 1.0 / B[i, i]
+    return True
+
+
 @njit(cache=True, nogil=True)
 def compressed(A, lower, upper):
     """``(starts, columns, values)``: the rows of ``A`` (m, n) compressed (CSR), the
@@ -115,6 +188,17 @@ def lu_solve(factors, rows, perm, b, y, out):
             s -= Ux[k] * y[Ui[k]]
         y[i] = s * inv_d[i]
         out[perm[i]] = y[i]
+
+
+@njit(cache=True, nogil=True)
+def product(A, x, out):
+    """``out = A x`` for ``A`` compressed (:func:`compressed`)."""
+    starts, columns, values = A
+    for i in range(starts.shape[0] - 1):
+        s = 0.0
+        for k in range(starts[i], starts[i + 1]):
+            s += values[k] * x[columns[k]]
+        out[i] = s
 
 
 @njit(cache=True, nogil=True)

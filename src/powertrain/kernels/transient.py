@@ -1,6 +1,6 @@
 r"""One stretch of a transient manoeuvre: the static curves' updates and the Newmark steps
-between them in one call (:mod:`powertrain.solvers.transient` holds the model and the
-formulas).
+between them in one call (:mod:`powertrain.solvers.transient` holds the formulas,
+:mod:`powertrain.solvers.transient_model` builds the model).
 
 A stretch is cut into pieces of ``sub`` steps. At the start of every piece, at the state
 predicted for its middle, :math:`\mathbf x + \tfrac T2\dot{\mathbf x}` (:math:`T` its
@@ -13,7 +13,8 @@ is integrated from the position and velocity, its acceleration solved from the n
 A step solves :math:`\mathbf S\ddot{\mathbf x} = \mathbf f - \mathbf C\tilde{\mathbf v}
 - \mathbf K\tilde{\mathbf x}` (:mod:`powertrain.kernels.newmark`) by S's LU factors kept
 sparse (:mod:`powertrain.kernels.sparse_lu`: a piece costs a factorization of the networks'
-small blocks, a step about the nonzeros of S), then the port laws by Newton as
+small blocks on the factors' pattern, found once per run; a step about the nonzeros of S;
+C and K kept compressed on the pattern of them and their parts), then the port laws by Newton as
 :func:`powertrain.kernels.port_forces.newmark_port_kernel`. Loops rather than NumPy
 expressions: each expression costs a compilation on a first run.
 
@@ -31,9 +32,10 @@ from powertrain.kernels.port_forces import (
     port_forces_step,
 )
 from powertrain.kernels.sparse_lu import (
-    compressed,
     factor,
+    factor_on_pattern,
     lu_solve,
+    product,
     sparse_factors,
     subtract_product,
 )
@@ -93,59 +95,77 @@ def curve_state(x, curves, law, centres, factors, c):
 
 
 @njit(cache=True, nogil=True)
-def _scaled(base, parts, change):
-    """``base`` plus each network's change of scale times its sparse part ``parts = (net,
-    i, j, value)``."""
+def _scaled(fixed, change):
+    """The compressed matrix (:func:`~powertrain.kernels.sparse_lu.compressed`) of the
+    assembled one plus each network's change of scale times its part: ``fixed = (starts,
+    columns, assembled values, (network, position, value) of the parts' entries)``, the
+    pattern that of all of them."""
+    starts, columns, base, (net, position, value) = fixed
     out = base.copy()
-    net, i, j, value = parts
     for e in range(value.shape[0]):
-        out[i[e], j[e]] += change[net[e]] * value[e]
-    return out
+        out[position[e]] += change[net[e]] * value[e]
+    return starts, columns, out
 
 
 @njit(cache=True, nogil=True)
-def _times(A, x, transpose=False):
-    """``A x``, or ``A^T x`` where ``transpose`` (loops: each matrix-vector signature of
-    ``@`` would be compiled apart)."""
-    out = np.zeros(A.shape[1] if transpose else A.shape[0])
-    for i in range(A.shape[0]):
-        for j in range(A.shape[1]):
-            if transpose:
-                out[j] += A[i, j] * x[i]
-            else:
-                out[i] += A[i, j] * x[j]
+def _dense(A, n):
+    """The compressed ``A`` as an (n, n) array."""
+    starts, columns, values = A
+    out = np.zeros((n, n))
+    for i in range(n):
+        for k in range(starts[i], starts[i + 1]):
+            out[i, columns[k]] = values[k]
     return out
 
 
 @njit(cache=True, nogil=True)
 def _start_acceleration(model, laws, C, K, f, x, v):
-    """The acceleration [m/s²] at ``(x, v)`` under the load ``f`` and the port laws (0 on
-    massless nodes: ``M_inv`` holds zeros there)."""
-    r = f - _times(C, v) - _times(K, x)
+    """The acceleration [m/s²] at ``(x, v)`` under the load ``f`` and the port laws, ``C``,
+    ``K`` compressed (0 on massless nodes: ``M_inv`` holds zeros there)."""
+    r = f.copy()
+    subtract_product(C, v, r)
+    subtract_product(K, x, r)
     if laws is not None:
-        P, kinds, par, state = laws
-        z0 = np.zeros(kinds.shape[0])
-        port_forces_at(kinds, par, state, _times(P, x), _times(P, v), z0)
-        r -= _times(P, z0, True)
-    return _times(model[6], r)
+        _, kinds, par, state, (starts, columns, values) = laws
+        m = kinds.shape[0]
+        u, du, z0 = np.empty(m), np.empty(m), np.zeros(m)
+        product(laws[4], x, u)
+        product(laws[4], v, du)
+        port_forces_at(kinds, par, state, u, du, z0)
+        back = np.zeros(x.shape[0])
+        for e in range(m):
+            for k in range(starts[e], starts[e + 1]):
+                back[columns[k]] += values[k] * z0[e]
+        for j in range(x.shape[0]):
+            r[j] -= back[j]
+    out = np.empty(x.shape[0])
+    product(model[2], r, out)
+    return out
 
 
 @njit(cache=True, nogil=True)
-def _piece(model, laws, h, C, K, F, load, x, v, a, X, V, A, Z, tol, max_iter):
+def _piece(model, laws, h, C, K, F, load, x, v, a, X, V, A, Z, tol, max_iter, work):
     """Newmark over the load rows ``F`` (k + 1, n) less ``load`` (n,) from ``(x, v)`` with
-    ``C``, ``K`` into the rows ``X``, ``V``, ``A``, ``Z``; ``a`` the acceleration at the
-    start, or solved from the laws where it has no entry. S factored in the model's order
-    (:mod:`powertrain.kernels.sparse_lu`). Returns the steps where Newton did not
-    converge."""
-    M, perm = model[0], model[7]
+    ``C``, ``K`` (compressed) into the rows ``X``, ``V``, ``A``, ``Z``; ``a`` the
+    acceleration at the start, or solved from the laws where it has no entry. S factored
+    in the model's order on its factors' pattern into ``work = (B (n, n), factors)``, or with row
+    swaps where a pivot needs one (:mod:`powertrain.kernels.sparse_lu`). Returns the steps
+    where Newton did not converge."""
+    M, Ms, perm, where, pattern = model[0], model[1], model[6], model[7], model[8]
     if a.shape[0] == 0:
         a = _start_acceleration(model, laws, C, K, F[0] - load, x, v)
-    ok, B, rows = factor(M, C, K, 0.5 * h, 0.25 * h * h, perm)
-    if not ok:
-        raise FloatingPointError("the Newmark matrix M + h/2 C + h^2/4 K is singular (a "
-                                 "mount network without stiffness and damping?)")
-    return _sparse_steps((sparse_factors(B), rows, perm), laws, h, C, K, F, load, x, v, a,
-                         X, V, A, Z, tol, max_iter)
+    B, factors = work
+    if factor_on_pattern(((Ms, 1.0), (C, 0.5 * h), (K, 0.25 * h * h)), where, pattern, B,
+                         factors):
+        lu = (factors, perm, perm)
+    else:
+        n = x.shape[0]
+        ok, B, rows = factor(M, _dense(C, n), _dense(K, n), 0.5 * h, 0.25 * h * h, perm)
+        if not ok:
+            raise FloatingPointError("the Newmark matrix M + h/2 C + h^2/4 K is singular (a "
+                                     "mount network without stiffness and damping?)")
+        lu = (sparse_factors(B), rows, perm)
+    return _sparse_steps(lu, laws, h, C, K, F, load, x, v, a, X, V, A, Z, tol, max_iter)
 
 
 @njit(cache=True, nogil=True)
@@ -155,7 +175,7 @@ def _port_setup(laws, lu, h, x, v, Z):
     ``z`` and row 0 of ``Z`` the forces at ``(x, v)``; None without port laws."""
     if laws is None:
         return None
-    P, kinds, par, state = laws
+    P, kinds, par, state, (starts, columns, values) = laws
     n, m = x.shape[0], kinds.shape[0]
     W, Q, col, y, z = np.empty((n, m)), np.zeros((m, m)), np.empty(n), np.empty(n), \
         np.empty(m)
@@ -164,8 +184,9 @@ def _port_setup(laws, lu, h, x, v, Z):
         lu_solve(lu[0], lu[1], lu[2], P[e], y, col)
         for j in range(n):
             W[j, e] = col[j]
-            for i in range(m):
-                Q[i, e] += hh * P[i, j] * col[j]
+        for i in range(m):
+            for k in range(starts[i], starts[i + 1]):
+                Q[i, e] += hh * values[k] * col[columns[k]]
     for e in range(m):
         u, du = 0.0, 0.0
         for j in range(n):
@@ -173,7 +194,7 @@ def _port_setup(laws, lu, h, x, v, Z):
             du += P[e, j] * v[j]
         z[e] = law_force(kinds[e], u, du, par, state, e)[0]
         Z[0, e] = z[e]
-    return (W, port_coupling(Q, 2.0 / h), compressed(P, True, True), z,
+    return (W, port_coupling(Q, 2.0 / h), laws[4], z,
             (np.empty(m), np.empty(m), np.empty(m), np.empty((m, m)), np.zeros((7, m))))
 
 
@@ -181,7 +202,7 @@ def _port_setup(laws, lu, h, x, v, Z):
 def _port_step(laws, ports, h, xt, vt, a, z_out, tol, max_iter):
     """The port forces of one step (:func:`~powertrain.kernels.port_forces.newmark_port_kernel`)
     into ``z_out``, taken off the linear acceleration ``a`` in place. True on success."""
-    _, kinds, par, state = laws
+    _, kinds, par, state, _ = laws
     W, coupled, (starts, columns, values), z, (ul, vl, r, J, last) = ports
     hh, hv = 0.25 * h * h, 0.5 * h
     for e in range(z.shape[0]):
@@ -209,7 +230,6 @@ def _sparse_steps(lu, laws, h, C, K, F, load, x, v, a, X, V, A, Z, tol, max_iter
     """:func:`_piece` by the factors ``lu = (factors, rows, perm)`` of S: a step is the
     residual by the compressed C and K, one sparse solve and the port laws."""
     n, hh, hv = x.shape[0], 0.25 * h * h, 0.5 * h
-    Cs, Ks = compressed(C, True, True), compressed(K, True, True)
     xt, vt, r, y = np.empty(n), np.empty(n), np.empty(n), np.empty(n)
     for j in range(n):
         X[0, j], V[0, j], A[0, j] = x[j], v[j], a[j]
@@ -220,8 +240,8 @@ def _sparse_steps(lu, laws, h, C, K, F, load, x, v, a, X, V, A, Z, tol, max_iter
             xt[j] = X[k - 1, j] + h * V[k - 1, j] + hh * A[k - 1, j]
             vt[j] = V[k - 1, j] + hv * A[k - 1, j]
             r[j] = F[k, j] - load[j]
-        subtract_product(Cs, vt, r)
-        subtract_product(Ks, xt, r)
+        subtract_product(C, vt, r)
+        subtract_product(K, xt, r)
         lu_solve(lu[0], lu[1], lu[2], r, y, A[k])
         if laws is not None and not _port_step(laws, ports, h, xt, vt, A[k], Z[k], tol,
                                                max_iter):
@@ -240,16 +260,18 @@ def transient_stretch_kernel(model, curves, laws, h, F, law, centres, lo, hi, su
     Parameters
     ----------
     model : tuple
-        ``(M, C, K, C_parts, K_parts, assembled, M_inv, perm)``: the assembled matrices, each
-        network's sparse parts ``(net, i, j, value)``, the scales (n_net, 2) the assembled
-        matrices hold, the inverse of M (zeros where M is singular: massless nodes, a
-        start acceleration of 0) and the coordinates' elimination order (int64, n;
-        :mod:`powertrain.kernels.sparse_lu`).
+        ``(M, M compressed, inverse of M compressed, C, K, assembled, perm, where,
+        pattern)``: the mass matrix (n, n) and it and its inverse compressed
+        (:func:`~powertrain.kernels.sparse_lu.compressed`; the inverse zero where M is
+        singular: massless nodes, a start acceleration of 0); C and K as :func:`_scaled`
+        takes them; the scales (n_net, 2) the assembled matrices hold; the coordinates'
+        elimination order (int64, n), each coordinate's position in it and S's factors'
+        pattern there (:mod:`powertrain.kernels.sparse_lu`).
     curves : tuple
         :func:`curve_state`'s.
     laws : tuple or None
-        ``(P, kinds, par, state)`` of the port laws (m rows), ``state`` updated in place;
-        None without port laws.
+        ``(P, kinds, par, state, P compressed)`` of the port laws (m rows), ``state``
+        updated in place; None without port laws.
     h : float
         Time step [s].
     F : ndarray (n_t, n)
@@ -272,8 +294,11 @@ def transient_stretch_kernel(model, curves, laws, h, F, law, centres, lo, hi, su
     int
         Steps at which Newton did not converge.
     """
-    _, C0, K0, C_parts, K_parts, assembled, _, _ = model
-    n_net = law.shape[0]
+    C0, K0, assembled = model[3], model[4], model[5]
+    n_net, n = law.shape[0], X.shape[1]
+    (lp, li), _, (up, ui) = model[8]           # _piece's work space: S, its factors
+    work = np.empty((n, n)), ((lp, li, np.empty(li.shape[0])), (up, ui, np.empty(ui.shape[0])),
+                              np.empty(n))
     factors, c, middle = np.empty(n_net), np.empty(n_net), np.empty(X.shape[1])
     change = np.empty((n_net, 2))
     rows = curves[0]
@@ -290,10 +315,13 @@ def transient_stretch_kernel(model, curves, laws, h, F, law, centres, lo, hi, su
                 scales[p:q + 1, r, s] = law[r, s] * factors[r]
                 change[r, s] = law[r, s] * factors[r] - assembled[r, s]
             loads[p:q + 1, r] = c[r]
-        load = _times(rows, c, True)
-        failed += _piece(model, laws, h, _scaled(C0, C_parts, change[:, 1]),
-                         _scaled(K0, K_parts, change[:, 0]), F[p:q + 1], load, x, v, a,
-                         X[p:q + 1], V[p:q + 1], A[p:q + 1], Z[p:q + 1], tol, max_iter)
+        load = np.zeros(n)                 # the curve loads on the coordinates
+        for r in range(n_net):
+            for j in range(n):
+                load[j] += rows[r, j] * c[r]
+        failed += _piece(model, laws, h, _scaled(C0, change[:, 1]), _scaled(K0, change[:, 0]),
+                         F[p:q + 1], load, x, v, a, X[p:q + 1], V[p:q + 1], A[p:q + 1],
+                         Z[p:q + 1], tol, max_iter, work)
         # the next piece's laws differ: its acceleration is solved from them, or the
         # trapezoidal rule would carry the jump on as an undamped alternating error
         a = np.empty(0)

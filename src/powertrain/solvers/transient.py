@@ -58,6 +58,7 @@ import numpy as np
 from powertrain.assembly import NetworkScaling
 from powertrain.errors import InputError, PowertrainWarning
 from powertrain.kernels.port_forces import NONE
+from powertrain.kernels.sparse_lu import compressed
 from powertrain.kernels.transient import curve_state, curve_values, transient_stretch_kernel
 from powertrain.solvers.cycle_newmark import cycle_amplitudes, no_ports, start_state
 from powertrain.solvers.newmark import PORT_MAX_ITER, PORT_TOL
@@ -70,6 +71,7 @@ from powertrain.solvers.transient_load import (
     driveline_reaction,
     transient_load,
 )
+from powertrain.solvers.transient_model import stretch_kernel_model
 
 
 class StretchRuleWarning(PowertrainWarning):
@@ -262,10 +264,12 @@ def _run(system, scaling, ports, curves, F, h, start, steps):
     X[0], V[0] = x, v
     Z, scales, loads = np.zeros((n_t, laws.kinds.size)), np.empty((n_t, n_net, 2)), \
         np.zeros((n_t, n_net))
-    model, kernel_curves = _kernel_model(system, scaling), _kernel_curves(system, scaling, curves)
+    model = stretch_kernel_model(system, scaling)
+    kernel_curves = _kernel_curves(system, scaling, curves)
     kernel_laws = None if not laws.kinds.size else (
         np.array(laws.rows, float), np.array(laws.kinds, np.int64),
-        np.array(laws.parameters, float), state)
+        np.array(laws.parameters, float), state,
+        compressed(np.array(laws.rows, float), True, True))
     centres = system.port_rows @ x             # the first stretch's: where it starts
     a0, ones, failed = (np.empty(0) if a is None else np.array(a, float)), np.ones(n_net), 0
     for lo in range(0, n_t - 1, every):
@@ -295,34 +299,6 @@ def _channel_forces(system, scaling, run, laws_map):
     if loads.any():
         force += loads @ system.port_force_map.T
     return force
-
-
-def _kernel_model(system, scaling):
-    """The kernel's ``model`` tuple (:func:`~powertrain.kernels.transient.transient_stretch_kernel`)."""
-    M = np.array(system.M, float)
-    try:
-        M_inv = np.linalg.inv(M)
-    except np.linalg.LinAlgError:          # massless nodes: the start acceleration is 0
-        M_inv = np.zeros_like(M)
-    C, K = np.array(system.C, float), np.array(system.K, float)
-    return (M, C, K, _sparse(scaling.C_parts), _sparse(scaling.K_parts),
-            np.array(scaling.assembled, float), M_inv,
-            _elimination_order(M, C, K, scaling.C_parts, scaling.K_parts))
-
-
-def _elimination_order(*matrices):
-    """Coordinates in the order of fewest nonzeros in any of ``matrices`` (or their stacked
-    parts) first: each network's internal ones before the body's, so that the sparse
-    factors of S have no fill-in but the body's rows
-    (:mod:`powertrain.kernels.sparse_lu`)."""
-    pattern = sum((np.abs(m).reshape(-1, *m.shape[-2:]).sum(0) != 0) for m in matrices)
-    return np.argsort((pattern != 0).sum(1), kind="stable").astype(np.int64)
-
-
-def _sparse(parts):
-    """``(net, i, j, value)``: the nonzero entries of the stacked ``parts`` (n_net, n, n)."""
-    net, i, j = np.nonzero(parts)
-    return net, i, j, np.array(parts[net, i, j], float)
 
 
 def _kernel_curves(system, scaling, curves):

@@ -1,0 +1,59 @@
+"""The transient stretch kernel's model
+(:func:`~powertrain.kernels.transient.transient_stretch_kernel`) from the assembled system:
+the matrices compressed on the pattern of them and their networks' parts, the elimination
+order and the pattern of the Newmark matrix's LU factors there
+(:mod:`powertrain.kernels.sparse_lu`), found once per run."""
+
+import numpy as np
+
+from powertrain.kernels.sparse_lu import compressed, csr_pattern, lu_pattern
+
+
+def stretch_kernel_model(system, scaling):
+    """The kernel's ``model`` tuple (:func:`~powertrain.kernels.transient.transient_stretch_kernel`)."""
+    return kernel_model(*(np.array(A, float) for A in (system.M, system.C, system.K)),
+                        scaling.C_parts, scaling.K_parts, np.array(scaling.assembled, float))
+
+
+def kernel_model(M, C, K, C_parts, K_parts, assembled):
+    """The kernel's ``model`` tuple of the assembled M, C, K (n, n), each network's parts
+    (n_net, n, n) and the scales (n_net, 2) the assembled matrices hold."""
+    try:
+        M_inv = np.linalg.inv(M)
+    except np.linalg.LinAlgError:          # massless nodes: the start acceleration is 0
+        M_inv = np.zeros_like(M)
+    perm = _elimination_order(M, C, K, C_parts, K_parts)
+    where = np.empty_like(perm)
+    where[perm] = np.arange(perm.size)
+    mask = (M != 0) | _mask(C, C_parts) | _mask(K, K_parts)
+    return (M, compressed(M, True, True), compressed(M_inv, True, True),
+            _with_parts(C, C_parts), _with_parts(K, K_parts), assembled, perm, where,
+            lu_pattern(mask[np.ix_(perm, perm)]))
+
+
+def _elimination_order(*matrices):
+    """Coordinates in the order of fewest nonzeros in any of ``matrices`` (or their stacked
+    parts) first: each network's internal ones before the body's, so that the sparse
+    factors of S have no fill-in but the body's rows
+    (:mod:`powertrain.kernels.sparse_lu`)."""
+    pattern = sum((np.abs(m).reshape(-1, *m.shape[-2:]).sum(0) != 0) for m in matrices)
+    return np.argsort((pattern != 0).sum(1), kind="stable").astype(np.int64)
+
+
+def _mask(A, parts):
+    """Where ``A`` (n, n) or any of its networks' ``parts`` (n_net, n, n) is nonzero."""
+    return (A != 0) | (parts != 0).any(0)
+
+
+def _with_parts(A, parts):
+    """``(starts, columns, values, (network, position, value))``: ``A`` compressed on the
+    pattern of it and its networks' ``parts`` (:func:`_mask`), and each part's nonzero
+    entry with its position among the values
+    (:func:`~powertrain.kernels.transient._scaled`)."""
+    starts, columns = csr_pattern(_mask(A, parts))
+    rows = np.repeat(np.arange(A.shape[0]), np.diff(starts))
+    position = np.full(A.shape, -1, np.int64)
+    position[rows, columns] = np.arange(columns.size)
+    net, i, j = np.nonzero(parts)
+    return (starts, columns, np.ascontiguousarray(A[rows, columns], float),
+            (net.astype(np.int64), position[i, j], np.array(parts[net, i, j], float)))
