@@ -35,7 +35,7 @@ solve_ivp_method=... solve_ivp_rtol=...`` then ``error=... ratio_continuous=...
 error_continuous=... kernel_s=... ratio_kernel=...``: ``newmark_s`` is our time on the
 compared case (the fully nonlinear start), ``error`` ours against the stretch-rule reference,
 ``error_continuous`` against the continuous-curve one, ``kernel_s`` the part of ``newmark_s``
-inside the stretch kernel (:func:`kernel_cpu`) and ``ratio_kernel`` the peer's time over
+inside the manoeuvre's kernel (:func:`kernel_cpu`) and ``ratio_kernel`` the peer's time over
 it: the ratio's ceiling with everything around the kernel free.
 """
 
@@ -71,23 +71,23 @@ def fully_nonlinear(engine):
 
 
 def kernel_cpu(run):
-    """CPU time [s] spent inside the stretch kernel
-    (:func:`~powertrain.kernels.transient.transient_stretch_kernel`: the curves' updates and
-    the Newmark steps) during ``run()``: ours' time were everything around it (the amplitude
-    law once per stretch, the load, the start, the force rows) free."""
+    """CPU time [s] spent inside the manoeuvre's kernel
+    (:func:`~powertrain.kernels.transient.transient_kernel`: the amplitude law once per
+    stretch, the curves' updates and the Newmark steps) during ``run()``: ours' time were
+    everything around it (the load, the start, the force rows) free."""
     import powertrain.solvers.transient as tr
-    spent, kernel = [0.0], tr.transient_stretch_kernel
+    spent, kernel = [0.0], tr.transient_kernel
 
     def timed(*args):
         t0 = time.process_time()
         out = kernel(*args)
         spent[0] += time.process_time() - t0
         return out
-    tr.transient_stretch_kernel = timed
+    tr.transient_kernel = timed
     try:
         run()
     finally:
-        tr.transient_stretch_kernel = kernel
+        tr.transient_kernel = kernel
     return spent[0]
 
 
@@ -226,7 +226,7 @@ def main():
     cold = cold_first_run()
     print(f"first run in a fresh process, empty kernel cache: linear start {cold[0]:.1f} s, "
           f"then the fully nonlinear one {cold[1]:.1f} s (compiling the kernels)")
-    print(f"of ours {ours_s:.4f} s, {kernel_s:.4f} s inside the stretch kernel: were "
+    print(f"of ours {ours_s:.4f} s, {kernel_s:.4f} s inside the manoeuvre's kernel: were "
           f"everything around it free, the ratio would be {peer_s / kernel_s:.0f}")
     print(f"linear_s={linear:.4f} nonlinear_s={nonlinear:.4f} newmark_s={ours_s:.4f} "
           f"solve_ivp_s={peer_s:.3f} ratio={peer_s / ours_s:.0f} "

@@ -1,5 +1,7 @@
-r"""One stretch of a transient manoeuvre: the static curves' updates and the Newmark steps
-between them in one call (:mod:`powertrain.solvers.transient` holds the formulas,
+r"""A transient manoeuvre in one call, stretch by stretch (:func:`transient_kernel`: the
+amplitude laws' scales from the last stretch's amplitudes, :func:`amplitude_scales`), and
+one stretch: the static curves' updates and the Newmark steps between them
+(:mod:`powertrain.solvers.transient` holds the formulas,
 :mod:`powertrain.solvers.transient_model` builds the model).
 
 A stretch is cut into pieces of ``sub`` steps. At the start of every piece, at the state
@@ -39,6 +41,81 @@ from powertrain.kernels.sparse_lu import (
     sparse_factors,
     subtract_product,
 )
+
+#: Amplitude-law kinds (:func:`amplitude_scales`): none, :class:`~powertrain.physics.mount_laws.PowerLaw`,
+#: :class:`~powertrain.physics.mount_laws.TableLaw`.
+NO_LAW, POWER_LAW, TABLE_LAW = 0, 1, 2
+#: The smallest amplitude a power law reads [m] (``np.finfo(float).tiny``, as it does).
+TINY = np.finfo(np.float64).tiny
+
+
+@njit(cache=True, nogil=True)
+def _interp(x, xp, fp, count):
+    """``np.interp(x, xp[:count], fp[:count])``: linear, flat beyond the ends."""
+    if x <= xp[0]:
+        return fp[0]
+    if x >= xp[count - 1]:
+        return fp[count - 1]
+    j = 0
+    while xp[j + 1] < x:
+        j += 1
+    return (fp[j + 1] - fp[j]) / (xp[j + 1] - xp[j]) * (x - xp[j]) + fp[j]
+
+
+@njit(cache=True, nogil=True)
+def amplitude_scales(laws, amplitudes, law):
+    """The amplitude laws' ``(stiffness, damping)`` scales ``law`` (n_net, 2) of every
+    network at its amplitude ``amplitudes`` (n_net,) [m] (1 without a law), as the laws'
+    own ``scales``. ``laws = (kind (n_net,), power (n_net, 5) = (reference [m], exponent,
+    lowest, highest factor, damping exponent), table (n_net, 3, T) = (log amplitudes,
+    stiffness, damping factors), its points (n_net,))``: a table's first amplitude is
+    ``power[r, 0]``, below which it reads its first factors."""
+    kind, power, table, count = laws
+    for r in range(kind.shape[0]):
+        if kind[r] == POWER_LAW:
+            f = (power[r, 0] / max(amplitudes[r], TINY)) ** power[r, 1]
+            f = min(max(f, power[r, 2]), power[r, 3])
+            law[r, 0] = f
+            law[r, 1] = f if power[r, 4] == 1.0 else f ** power[r, 4]
+        elif kind[r] == TABLE_LAW:
+            la = np.log(max(amplitudes[r], power[r, 0]))
+            law[r, 0] = _interp(la, table[r, 0], table[r, 1], count[r])
+            law[r, 1] = _interp(la, table[r, 0], table[r, 2], count[r])
+        else:
+            law[r, 0] = law[r, 1] = 1.0
+
+
+@njit(cache=True, nogil=True)
+def stretch_motion(rows, network, X, lo, hi, amplitudes, centres):
+    """Over the rows ``lo`` to ``hi`` - 1 of ``X``: each port's amplitude, √2 times the
+    RMS about its mean of its motion (``rows`` compressed, m ports), on its ``network``
+    (m,) into ``amplitudes`` (n_net,; zero where no port), where ``amplitudes`` has
+    entries; and each network's centre, the mean of its deflection (``centres`` rows, the
+    second of ``rows``), into ``centres``."""
+    n_rows = hi - lo
+    for which in range(2):
+        starts, columns, values = rows[which]
+        m = starts.shape[0] - 1
+        if which == 0 and amplitudes.shape[0] == 0:
+            continue
+        for e in range(m):
+            mean = 0.0
+            for k in range(lo, hi):
+                u = 0.0
+                for t in range(starts[e], starts[e + 1]):
+                    u += values[t] * X[k, columns[t]]
+                mean += u
+            mean /= n_rows
+            if which == 1:
+                centres[e] = mean
+                continue
+            square = 0.0
+            for k in range(lo, hi):
+                u = 0.0
+                for t in range(starts[e], starts[e + 1]):
+                    u += values[t] * X[k, columns[t]]
+                square += (u - mean) * (u - mean)
+            amplitudes[network[e]] = np.sqrt(2.0) * np.sqrt(square / n_rows)
 
 
 @njit(cache=True, nogil=True)
@@ -325,4 +402,33 @@ def transient_stretch_kernel(model, curves, laws, h, F, law, centres, lo, hi, su
         # the next piece's laws differ: its acceleration is solved from them, or the
         # trapezoidal rule would carry the jump on as an undamped alternating error
         a = np.empty(0)
+    return failed
+
+
+@njit(cache=True, nogil=True)
+def transient_kernel(model, curves, laws, motion, h, F, steps, a0, amplitudes, centres, X, V,
+                     A, Z, scales, loads, tol, max_iter):
+    """Integrate the whole manoeuvre, stretch by stretch (:func:`transient_stretch_kernel`;
+    ``steps = (every, sub)``, steps per stretch and per piece): each stretch's amplitude-law
+    scales from the amplitudes of the one before (:func:`amplitude_scales`), its centres
+    their mean deflections (:func:`stretch_motion`). ``motion = (amplitude laws, (port
+    rows, network rows) compressed, each port's network, varying)``: without a varying
+    law the amplitudes stay. ``amplitudes`` (n_net,) [m] and ``centres`` (n_net,) [m] are
+    the start's, updated in place; the rest as :func:`transient_stretch_kernel`. Returns
+    the steps at which Newton did not converge."""
+    amplitude_laws, rows, network, varying = motion
+    every, sub = steps
+    n_t = F.shape[0]
+    law = np.empty((amplitudes.shape[0], 2))
+    none = np.empty(0)
+    failed, a = 0, a0
+    for lo in range(0, n_t - 1, every):
+        hi = min(lo + every, n_t - 1)
+        amplitude_scales(amplitude_laws, amplitudes, law)
+        failed += transient_stretch_kernel(model, curves, laws, h, F, law, centres, lo, hi,
+                                           sub, a, X, V, A, Z, scales, loads, tol, max_iter)
+        a = none
+        if hi < n_t - 1:
+            stretch_motion(rows, network, X, lo, hi, amplitudes if varying else none,
+                           centres)
     return failed

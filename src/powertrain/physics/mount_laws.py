@@ -18,6 +18,7 @@ import numpy as np
 from scipy.interpolate import PchipInterpolator
 
 from powertrain.kernels.port_forces import BERG
+from powertrain.kernels.transient import POWER_LAW, TABLE_LAW
 
 #: Gauss–Legendre nodes per loop branch of Berg's describing function: the branch is smooth
 #: (a rational function of sin θ), so 48 nodes give the first harmonic to round-off.
@@ -87,6 +88,11 @@ class PowerLaw:
         f = self.factor(amplitude)
         return f, (f if self.damping_exponent == 1.0 else f ** self.damping_exponent)
 
+    def kernel_law(self):
+        """``(kind, parameters, table)`` of :func:`powertrain.kernels.transient.amplitude_scales`."""
+        return (POWER_LAW, (self.reference, self.exponent, *self.limits,
+                            self.damping_exponent), ())
+
 
 @dataclass(frozen=True)
 class TableLaw:
@@ -116,6 +122,12 @@ class TableLaw:
         ks = np.interp(la, xp, self.stiffness_scale)
         d = self.stiffness_scale if self.damping_scale is None else self.damping_scale
         return ks, np.interp(la, xp, d)
+
+    def kernel_law(self):
+        """``(kind, parameters, table)`` of :func:`powertrain.kernels.transient.amplitude_scales`."""
+        d = self.stiffness_scale if self.damping_scale is None else self.damping_scale
+        return (TABLE_LAW, (self.amplitudes[0], 0.0, 0.0, 0.0, 0.0),
+                (np.log(np.asarray(self.amplitudes, float)), self.stiffness_scale, d))
 
 
 @dataclass(frozen=True)

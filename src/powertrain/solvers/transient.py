@@ -4,9 +4,9 @@ The load of :mod:`powertrain.solvers.transient_load` at every step drives the mo
 :meth:`Engine.assemble` (rigid ground, modal body, base compliance) through the Newmark step
 of the run-up's dense stepper and the continuous sweep (average acceleration; the port
 laws by Newton per step, :func:`~powertrain.kernels.port_forces.newmark_port_kernel`; the
-Newmark matrix factored sparsely, :mod:`powertrain.kernels.sparse_lu`), a
-stretch at a time (:func:`~powertrain.kernels.transient.transient_stretch_kernel`, the
-curves' updates inside it; the amplitude law once per stretch). Stretches are
+Newmark matrix factored sparsely, :mod:`powertrain.kernels.sparse_lu`), in one kernel
+call (:func:`~powertrain.kernels.transient.transient_kernel`: a stretch at a time, the
+amplitude law once per stretch, the curves' updates inside it). Stretches are
 :data:`STRETCH` long (a linear model without static curves is one stretch); the static
 curves are updated every :data:`CURVE_STEP`. Where the laws change (a new stretch or
 curve update) the integration restarts from the position and velocity, the acceleration
@@ -59,8 +59,8 @@ from powertrain.assembly import NetworkScaling
 from powertrain.errors import InputError, PowertrainWarning
 from powertrain.kernels.port_forces import NONE
 from powertrain.kernels.sparse_lu import compressed
-from powertrain.kernels.transient import curve_state, curve_values, transient_stretch_kernel
-from powertrain.solvers.cycle_newmark import cycle_amplitudes, no_ports, start_state
+from powertrain.kernels.transient import curve_state, curve_values, transient_kernel
+from powertrain.solvers.cycle_newmark import no_ports, start_state
 from powertrain.solvers.newmark import PORT_MAX_ITER, PORT_TOL
 from powertrain.solvers.operating_point import StaticSupport, has_static_curves, operating_point
 from powertrain.solvers.steppers import Cycles, DenseNewmarkStepper
@@ -71,7 +71,7 @@ from powertrain.solvers.transient_load import (
     driveline_reaction,
     transient_load,
 )
-from powertrain.solvers.transient_model import stretch_kernel_model
+from powertrain.solvers.transient_model import motion_model, stretch_kernel_model
 
 
 class StretchRuleWarning(PowertrainWarning):
@@ -254,7 +254,7 @@ def _run(system, scaling, ports, curves, F, h, start, steps):
     """States X, V, A (n_t, n), channel forces (n_t, n_ch) and ``(port-law forces,
     network scales, curve loads)`` at every step: ``steps = (every, sub)``, the amplitude
     law and the centres updated every ``every`` steps (a stretch), the curves' tangents and
-    load every ``sub`` (:func:`~powertrain.kernels.transient.transient_stretch_kernel`)."""
+    load every ``sub``, in one kernel call (:func:`~powertrain.kernels.transient.transient_kernel`)."""
     every, sub = steps
     x, v, a, state, amplitudes = start
     laws = ports.select(ports.kinds != NONE)
@@ -270,18 +270,12 @@ def _run(system, scaling, ports, curves, F, h, start, steps):
         np.array(laws.rows, float), np.array(laws.kinds, np.int64),
         np.array(laws.parameters, float), state,
         compressed(np.array(laws.rows, float), True, True))
+    a0 = np.empty(0) if a is None else np.array(a, float)
     centres = system.port_rows @ x             # the first stretch's: where it starts
-    a0, ones, failed = (np.empty(0) if a is None else np.array(a, float)), np.ones(n_net), 0
-    for lo in range(0, n_t - 1, every):
-        hi = min(lo + every, n_t - 1)
-        law = scaling.scales(ports.network_amplitudes(amplitudes), ones)
-        failed += transient_stretch_kernel(model, kernel_curves, kernel_laws, h, F, law,
-                                           centres, lo, hi, sub, a0, X, V, A, Z, scales,
-                                           loads, PORT_TOL, PORT_MAX_ITER)
-        a0 = np.empty(0)
-        if scaling.varying:
-            amplitudes = cycle_amplitudes(X[lo:hi] @ ports.rows.T)
-        centres = (X[lo:hi] @ system.port_rows.T).mean(0)
+    failed = transient_kernel(model, kernel_curves, kernel_laws,
+                              motion_model(system, scaling, ports), h, F, (every, sub), a0,
+                              ports.network_amplitudes(amplitudes), centres, X, V, A, Z,
+                              scales, loads, PORT_TOL, PORT_MAX_ITER)
     if failed:
         raise FloatingPointError(f"port laws {', '.join(laws.names)}: Newton did not converge "
                                  f"at {failed} of {n_t - 1} steps")

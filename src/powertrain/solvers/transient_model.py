@@ -1,12 +1,15 @@
-"""The transient stretch kernel's model
-(:func:`~powertrain.kernels.transient.transient_stretch_kernel`) from the assembled system:
+"""The transient kernel's model
+(:func:`~powertrain.kernels.transient.transient_kernel`) from the assembled system:
 the matrices compressed on the pattern of them and their networks' parts, the elimination
 order and the pattern of the Newmark matrix's LU factors there
-(:mod:`powertrain.kernels.sparse_lu`), found once per run."""
+(:mod:`powertrain.kernels.sparse_lu`), found once per run; the amplitude laws and the rows
+the stretches' amplitudes and centres are read on
+(:func:`~powertrain.kernels.transient.transient_kernel`)."""
 
 import numpy as np
 
 from powertrain.kernels.sparse_lu import compressed, csr_pattern, lu_pattern
+from powertrain.kernels.transient import NO_LAW
 
 
 def stretch_kernel_model(system, scaling):
@@ -57,3 +60,29 @@ def _with_parts(A, parts):
     net, i, j = np.nonzero(parts)
     return (starts, columns, np.ascontiguousarray(A[rows, columns], float),
             (net.astype(np.int64), position[i, j], np.array(parts[net, i, j], float)))
+
+
+def motion_model(system, scaling, ports):
+    """The kernel's ``motion`` tuple (:func:`~powertrain.kernels.transient.transient_kernel`):
+    the networks' amplitude laws (:func:`amplitude_laws`), the ports' and the networks' rows
+    compressed, each port's network and whether a law varies with amplitude."""
+    rows = (compressed(np.array(ports.rows, float), True, True),
+            compressed(np.array(system.port_rows, float), True, True))
+    return (amplitude_laws(scaling.elements), rows, np.array(ports.index, np.int64),
+            bool(scaling.varying))
+
+
+def amplitude_laws(elements):
+    """``(kind, power, table, count)`` of :func:`~powertrain.kernels.transient.amplitude_scales`
+    from each network element's amplitude law (its ``kernel_law``)."""
+    rows = [(NO_LAW, (0.0,) * 5, ()) if el.amplitude_law is None else
+            el.amplitude_law.kernel_law() for el in elements]
+    size = max([len(table[0]) for *_, table in rows if table], default=1)
+    table = np.zeros((len(rows), 3, size))
+    count = np.ones(len(rows), np.int64)
+    for r, (_, _, points) in enumerate(rows):
+        if points:
+            count[r] = len(points[0])
+            table[r, :, :count[r]] = np.array(points, float)
+    return (np.array([kind for kind, *_ in rows], np.int64),
+            np.array([p for _, p, _ in rows], float), table, count)
