@@ -14,7 +14,7 @@ from powertrain.kernels.sparse_lu import (
     lu_solve,
     sparse_factors,
 )
-from powertrain.kernels.transient import _piece, _scaled
+from powertrain.kernels.transient import NEEDS_PIVOTING, _piece, _scaled
 from powertrain.solvers.transient_model import _elimination_order, kernel_model
 
 
@@ -154,11 +154,14 @@ def test_a_piece_is_newmarks_with_and_without_row_swaps():
         assert np.array_equal(rows, perm) == (K_used is K)
         ref = newmark(M, C, K_used, F, h, x, v)
         none = np.zeros((0, 8, 8))
-        model = kernel_model(M, C, K_used, none, none, np.zeros((0, 2)))
         X, V, A = (np.empty((steps + 1, 8)) for _ in range(3))
-        failed = _piece(model, None, h, _scaled(model[3], np.zeros(0)),
-                        _scaled(model[4], np.zeros(0)), F, np.zeros(8), x, v, np.empty(0), X,
-                        V, A, np.empty((steps + 1, 0)), 1e-12, 10, work(model))
-        assert failed == 0
+        for pivoting in (False, True):
+            model = kernel_model(M, C, K_used, none, none, np.zeros((0, 2)), pivoting)
+            failed = _piece(model, None, h, _scaled(model[3], np.zeros(0)),
+                            _scaled(model[4], np.zeros(0)), F, np.zeros(8), x, v, np.empty(0),
+                            X, V, A, np.empty((steps + 1, 0)), 1e-12, 10, work(model),
+                            model[9])
+            # without pivoting compiled in, a swap is asked for instead of made
+            assert failed == (NEEDS_PIVOTING if K_used is K_zero and not pivoting else 0)
         for got, want in zip((X, V, A), ref, strict=True):
             np.testing.assert_allclose(got, want, rtol=1e-9, atol=1e-9 * np.abs(want).max())

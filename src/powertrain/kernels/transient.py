@@ -45,6 +45,9 @@ from powertrain.kernels.sparse_lu import (
 #: Amplitude-law kinds (:func:`amplitude_scales`): none, :class:`~powertrain.physics.mount_laws.PowerLaw`,
 #: :class:`~powertrain.physics.mount_laws.TableLaw`.
 NO_LAW, POWER_LAW, TABLE_LAW = 0, 1, 2
+#: What the kernels return where S needs a row swap and the model has no pivoting
+#: (:func:`_piece`).
+NEEDS_PIVOTING = -1
 #: The smallest amplitude a power law reads [m] (``np.finfo(float).tiny``, as it does).
 TINY = np.finfo(np.float64).tiny
 
@@ -221,13 +224,16 @@ def _start_acceleration(model, laws, C, K, f, x, v):
 
 
 @njit(cache=True, nogil=True)
-def _piece(model, laws, h, C, K, F, load, x, v, a, X, V, A, Z, tol, max_iter, work):
+def _piece(model, laws, h, C, K, F, load, x, v, a, X, V, A, Z, tol, max_iter, work,
+           pivoting):
     """Newmark over the load rows ``F`` (k + 1, n) less ``load`` (n,) from ``(x, v)`` with
     ``C``, ``K`` (compressed) into the rows ``X``, ``V``, ``A``, ``Z``; ``a`` the
     acceleration at the start, or solved from the laws where it has no entry. S factored
-    in the model's order on its factors' pattern into ``work = (B (n, n), factors)``, or with row
-    swaps where a pivot needs one (:mod:`powertrain.kernels.sparse_lu`). Returns the steps
-    where Newton did not converge."""
+    in the model's order on its factors' pattern into ``work = (B (n, n), factors)``, or,
+    where a pivot needs a row swap, with swaps if ``pivoting`` is not None
+    (:mod:`powertrain.kernels.sparse_lu`; None: that code is left out of the compiled
+    kernel and the piece returns :data:`NEEDS_PIVOTING`). Returns the steps where Newton
+    did not converge."""
     M, Ms, perm, where, pattern = model[0], model[1], model[6], model[7], model[8]
     if a.shape[0] == 0:
         a = _start_acceleration(model, laws, C, K, F[0] - load, x, v)
@@ -235,6 +241,8 @@ def _piece(model, laws, h, C, K, F, load, x, v, a, X, V, A, Z, tol, max_iter, wo
     if factor_on_pattern(((Ms, 1.0), (C, 0.5 * h), (K, 0.25 * h * h)), where, pattern, B,
                          factors):
         lu = (factors, perm, perm)
+    elif pivoting is None:
+        return NEEDS_PIVOTING
     else:
         n = x.shape[0]
         ok, B, rows = factor(M, _dense(C, n), _dense(K, n), 0.5 * h, 0.25 * h * h, perm)
@@ -338,12 +346,13 @@ def transient_stretch_kernel(model, curves, laws, h, F, law, centres, lo, hi, su
     ----------
     model : tuple
         ``(M, M compressed, inverse of M compressed, C, K, assembled, perm, where,
-        pattern)``: the mass matrix (n, n) and it and its inverse compressed
+        pattern, pivoting)``: the mass matrix (n, n) and it and its inverse compressed
         (:func:`~powertrain.kernels.sparse_lu.compressed`; the inverse zero where M is
         singular: massless nodes, a start acceleration of 0); C and K as :func:`_scaled`
         takes them; the scales (n_net, 2) the assembled matrices hold; the coordinates'
         elimination order (int64, n), each coordinate's position in it and S's factors'
-        pattern there (:mod:`powertrain.kernels.sparse_lu`).
+        pattern there (:mod:`powertrain.kernels.sparse_lu`); then ``pivoting`` (None, or
+        an empty array where a row swap is allowed, :func:`_piece`).
     curves : tuple
         :func:`curve_state`'s.
     laws : tuple or None
@@ -369,7 +378,7 @@ def transient_stretch_kernel(model, curves, laws, h, F, law, centres, lo, hi, su
     Returns
     -------
     int
-        Steps at which Newton did not converge.
+        Steps at which Newton did not converge, or :data:`NEEDS_PIVOTING`.
     """
     C0, K0, assembled = model[3], model[4], model[5]
     n_net, n = law.shape[0], X.shape[1]
@@ -396,9 +405,12 @@ def transient_stretch_kernel(model, curves, laws, h, F, law, centres, lo, hi, su
         for r in range(n_net):
             for j in range(n):
                 load[j] += rows[r, j] * c[r]
-        failed += _piece(model, laws, h, _scaled(C0, change[:, 1]), _scaled(K0, change[:, 0]),
-                         F[p:q + 1], load, x, v, a, X[p:q + 1], V[p:q + 1], A[p:q + 1],
-                         Z[p:q + 1], tol, max_iter, work)
+        got = _piece(model, laws, h, _scaled(C0, change[:, 1]), _scaled(K0, change[:, 0]),
+                     F[p:q + 1], load, x, v, a, X[p:q + 1], V[p:q + 1], A[p:q + 1],
+                     Z[p:q + 1], tol, max_iter, work, model[9])
+        if got == NEEDS_PIVOTING:
+            return got
+        failed += got
         # the next piece's laws differ: its acceleration is solved from them, or the
         # trapezoidal rule would carry the jump on as an undamped alternating error
         a = np.empty(0)
@@ -415,7 +427,8 @@ def transient_kernel(model, curves, laws, motion, h, F, steps, a0, amplitudes, c
     rows, network rows) compressed, each port's network, varying)``: without a varying
     law the amplitudes stay. ``amplitudes`` (n_net,) [m] and ``centres`` (n_net,) [m] are
     the start's, updated in place; the rest as :func:`transient_stretch_kernel`. Returns
-    the steps at which Newton did not converge."""
+    the steps at which Newton did not converge, or :data:`NEEDS_PIVOTING` where S needs a
+    row swap and the model allows none (its rows then unfinished)."""
     amplitude_laws, rows, network, varying = motion
     every, sub = steps
     n_t = F.shape[0]
@@ -425,8 +438,11 @@ def transient_kernel(model, curves, laws, motion, h, F, steps, a0, amplitudes, c
     for lo in range(0, n_t - 1, every):
         hi = min(lo + every, n_t - 1)
         amplitude_scales(amplitude_laws, amplitudes, law)
-        failed += transient_stretch_kernel(model, curves, laws, h, F, law, centres, lo, hi,
-                                           sub, a, X, V, A, Z, scales, loads, tol, max_iter)
+        got = transient_stretch_kernel(model, curves, laws, h, F, law, centres, lo, hi, sub, a,
+                                       X, V, A, Z, scales, loads, tol, max_iter)
+        if got == NEEDS_PIVOTING:
+            return got
+        failed += got
         a = none
         if hi < n_t - 1:
             stretch_motion(rows, network, X, lo, hi, amplitudes if varying else none,

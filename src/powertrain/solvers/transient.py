@@ -59,7 +59,12 @@ from powertrain.assembly import NetworkScaling
 from powertrain.errors import InputError, PowertrainWarning
 from powertrain.kernels.port_forces import NONE
 from powertrain.kernels.sparse_lu import compressed
-from powertrain.kernels.transient import curve_state, curve_values, transient_kernel
+from powertrain.kernels.transient import (
+    NEEDS_PIVOTING,
+    curve_state,
+    curve_values,
+    transient_kernel,
+)
 from powertrain.solvers.cycle_newmark import no_ports, start_state
 from powertrain.solvers.newmark import PORT_MAX_ITER, PORT_TOL
 from powertrain.solvers.operating_point import StaticSupport, has_static_curves, operating_point
@@ -264,18 +269,20 @@ def _run(system, scaling, ports, curves, F, h, start, steps):
     X[0], V[0] = x, v
     Z, scales, loads = np.zeros((n_t, laws.kinds.size)), np.empty((n_t, n_net, 2)), \
         np.zeros((n_t, n_net))
-    model = stretch_kernel_model(system, scaling)
     kernel_curves = _kernel_curves(system, scaling, curves)
-    kernel_laws = None if not laws.kinds.size else (
-        np.array(laws.rows, float), np.array(laws.kinds, np.int64),
-        np.array(laws.parameters, float), state,
-        compressed(np.array(laws.rows, float), True, True))
-    a0 = np.empty(0) if a is None else np.array(a, float)
-    centres = system.port_rows @ x             # the first stretch's: where it starts
-    failed = transient_kernel(model, kernel_curves, kernel_laws,
-                              motion_model(system, scaling, ports), h, F, (every, sub), a0,
-                              ports.network_amplitudes(amplitudes), centres, X, V, A, Z,
-                              scales, loads, PORT_TOL, PORT_MAX_ITER)
+    motion = motion_model(system, scaling, ports)
+    for pivoting in (False, True):    # row swaps compiled in only where S needs them
+        failed = transient_kernel(
+            stretch_kernel_model(system, scaling, pivoting), kernel_curves,
+            None if not laws.kinds.size else (
+                np.array(laws.rows, float), np.array(laws.kinds, np.int64),
+                np.array(laws.parameters, float), None if state is None else state.copy(),
+                compressed(np.array(laws.rows, float), True, True)),
+            motion, h, F, (every, sub), np.empty(0) if a is None else np.array(a, float),
+            ports.network_amplitudes(amplitudes), system.port_rows @ x, X, V, A, Z, scales,
+            loads, PORT_TOL, PORT_MAX_ITER)
+        if failed != NEEDS_PIVOTING:
+            break
     if failed:
         raise FloatingPointError(f"port laws {', '.join(laws.names)}: Newton did not converge "
                                  f"at {failed} of {n_t - 1} steps")

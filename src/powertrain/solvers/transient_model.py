@@ -12,15 +12,18 @@ from powertrain.kernels.sparse_lu import compressed, csr_pattern, lu_pattern
 from powertrain.kernels.transient import NO_LAW
 
 
-def stretch_kernel_model(system, scaling):
+def stretch_kernel_model(system, scaling, pivoting=False):
     """The kernel's ``model`` tuple (:func:`~powertrain.kernels.transient.transient_stretch_kernel`)."""
     return kernel_model(*(np.array(A, float) for A in (system.M, system.C, system.K)),
-                        scaling.C_parts, scaling.K_parts, np.array(scaling.assembled, float))
+                        scaling.C_parts, scaling.K_parts, np.array(scaling.assembled, float),
+                        pivoting)
 
 
-def kernel_model(M, C, K, C_parts, K_parts, assembled):
+def kernel_model(M, C, K, C_parts, K_parts, assembled, pivoting=False):
     """The kernel's ``model`` tuple of the assembled M, C, K (n, n), each network's parts
-    (n_net, n, n) and the scales (n_net, 2) the assembled matrices hold."""
+    (n_net, n, n) and the scales (n_net, 2) the assembled matrices hold; with ``pivoting``
+    the kernel swaps rows where a pivot needs it, without it the code is not compiled and
+    the kernel returns :data:`~powertrain.kernels.transient.NEEDS_PIVOTING` there."""
     try:
         M_inv = np.linalg.inv(M)
     except np.linalg.LinAlgError:          # massless nodes: the start acceleration is 0
@@ -31,7 +34,7 @@ def kernel_model(M, C, K, C_parts, K_parts, assembled):
     mask = (M != 0) | _mask(C, C_parts) | _mask(K, K_parts)
     return (M, compressed(M, True, True), compressed(M_inv, True, True),
             _with_parts(C, C_parts), _with_parts(K, K_parts), assembled, perm, where,
-            lu_pattern(mask[np.ix_(perm, perm)]))
+            lu_pattern(mask[np.ix_(perm, perm)]), np.empty(0) if pivoting else None)
 
 
 def _elimination_order(*matrices):
