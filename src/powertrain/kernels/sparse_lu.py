@@ -191,22 +191,24 @@ def lu_solve(factors, rows, perm, b, y, out):
 
 
 @njit(cache=True, nogil=True)
+def _row_product(A, i, x):
+    """Row ``i`` of ``A`` (compressed, :func:`compressed`) times ``x``."""
+    starts, columns, values = A
+    s = 0.0
+    for k in range(starts[i], starts[i + 1]):
+        s += values[k] * x[columns[k]]
+    return s
+
+
+@njit(cache=True, nogil=True)
 def product(A, x, out):
     """``out = A x`` for ``A`` compressed (:func:`compressed`)."""
-    starts, columns, values = A
-    for i in range(starts.shape[0] - 1):
-        s = 0.0
-        for k in range(starts[i], starts[i + 1]):
-            s += values[k] * x[columns[k]]
-        out[i] = s
+    for i in range(A[0].shape[0] - 1):
+        out[i] = _row_product(A, i, x)
 
 
 @njit(cache=True, nogil=True)
 def subtract_product(A, x, out):
     """``out -= A x`` for ``A`` compressed (:func:`compressed`)."""
-    starts, columns, values = A
-    for i in range(starts.shape[0] - 1):
-        s = 0.0
-        for k in range(starts[i], starts[i + 1]):
-            s += values[k] * x[columns[k]]
-        out[i] -= s
+    for i in range(A[0].shape[0] - 1):
+        out[i] -= _row_product(A, i, x)

@@ -89,36 +89,37 @@ def amplitude_scales(laws, amplitudes, law):
 
 
 @njit(cache=True, nogil=True)
+def _row_motion(A, e, X, lo, hi, u):
+    """Row ``e`` of ``A`` (compressed) times the rows ``lo`` to ``hi`` - 1 of ``X`` into
+    ``u``; returns their mean."""
+    starts, columns, values = A
+    mean = 0.0
+    for k in range(lo, hi):
+        s = 0.0
+        for t in range(starts[e], starts[e + 1]):
+            s += values[t] * X[k, columns[t]]
+        u[k - lo] = s
+        mean += s
+    return mean / (hi - lo)
+
+
+@njit(cache=True, nogil=True)
 def stretch_motion(rows, network, X, lo, hi, amplitudes, centres):
     """Over the rows ``lo`` to ``hi`` - 1 of ``X``: each port's amplitude, √2 times the
-    RMS about its mean of its motion (``rows`` compressed, m ports), on its ``network``
+    RMS about its mean of its motion (``rows[0]`` compressed, m ports), on its ``network``
     (m,) into ``amplitudes`` (n_net,; zero where no port), where ``amplitudes`` has
-    entries; and each network's centre, the mean of its deflection (``centres`` rows, the
-    second of ``rows``), into ``centres``."""
-    n_rows = hi - lo
-    for which in range(2):
-        starts, columns, values = rows[which]
-        m = starts.shape[0] - 1
-        if which == 0 and amplitudes.shape[0] == 0:
-            continue
-        for e in range(m):
-            mean = 0.0
-            for k in range(lo, hi):
-                u = 0.0
-                for t in range(starts[e], starts[e + 1]):
-                    u += values[t] * X[k, columns[t]]
-                mean += u
-            mean /= n_rows
-            if which == 1:
-                centres[e] = mean
-                continue
+    entries; and each network's centre, the mean of its deflection (``rows[1]``), into
+    ``centres``."""
+    u = np.empty(hi - lo)
+    if amplitudes.shape[0]:
+        for e in range(rows[0][0].shape[0] - 1):
+            mean = _row_motion(rows[0], e, X, lo, hi, u)
             square = 0.0
-            for k in range(lo, hi):
-                u = 0.0
-                for t in range(starts[e], starts[e + 1]):
-                    u += values[t] * X[k, columns[t]]
-                square += (u - mean) * (u - mean)
-            amplitudes[network[e]] = np.sqrt(2.0) * np.sqrt(square / n_rows)
+            for k in range(hi - lo):
+                square += (u[k] - mean) * (u[k] - mean)
+            amplitudes[network[e]] = np.sqrt(2.0) * np.sqrt(square / (hi - lo))
+    for e in range(rows[1][0].shape[0] - 1):
+        centres[e] = _row_motion(rows[1], e, X, lo, hi, u)
 
 
 @njit(cache=True, nogil=True)
