@@ -11,6 +11,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 from click.testing import CliRunner
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from powertrain.cli import main
 from powertrain.iotools.engine_file import read_engine
@@ -246,3 +248,30 @@ def test_runup_with_effects_records_every_speed(tmp_path):
     assert run.operating_point.rpm.tolist() == [1500.0, 2500.0]
     run.to_hdf5(tmp_path / "e.h5")
     assert read_runup_hdf5(tmp_path / "e.h5").operating_point.rpm.tolist() == [1500.0, 2500.0]
+
+
+@settings(max_examples=40, deadline=None)
+@given(st.floats(-0.02, -1e-3), st.lists(st.floats(1e-3, 1e-2), min_size=2, max_size=7),
+       st.floats(1e4, 1e6), st.lists(st.floats(-0.05, 0.05) | st.sampled_from([0.0, 1e-12]),
+                                    min_size=3, max_size=3))
+def test_the_supports_piecewise_cubics_read_as_the_curves_pchip(first, gaps, k, deflections):
+    """StaticSupport reads every network at once through the kernel's piecewise cubics:
+    a curve as its CurveReader (scipy's PCHIP, straight beyond its points) to round-off,
+    and a direction without a curve as exactly its static stiffness times the deflection."""
+    x = first + np.r_[0.0, np.cumsum(gaps)]
+    rng = np.random.default_rng(len(gaps))
+    force = np.cumsum(rng.uniform(0.2, 3.0, x.size)) * k * 1e-3
+    curve = StaticCurve(tuple(x), tuple(force - np.interp(0.0, x, force)), float(x[1]))
+    e = _symmetric_engine(z_curve=curve)
+    s = StaticSupport.of(e)
+    d = np.tile(np.asarray(deflections), len(e.mounts))
+    f, t = s.read(d)
+    reader = s.readers[2]
+    np.testing.assert_allclose(f[2], reader.force_at(d[2]), rtol=1e-12,
+                               atol=1e-12 * np.max(np.abs(force)))
+    np.testing.assert_allclose(t[2], reader.tangent_at(d[2]), rtol=1e-12,
+                               atol=1e-12 * k)
+    plain = [r for r, c in enumerate(s.curves) if c is None]
+    assert np.array_equal(f[plain], s.stiffness[plain] * d[plain])
+    assert np.array_equal(t[plain], s.stiffness[plain])
+    assert np.allclose(s.factors(d)[plain], 1.0, rtol=0, atol=0)

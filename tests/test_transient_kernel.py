@@ -5,6 +5,7 @@ import numpy as np
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
+from powertrain.kernels.load_table import table_load
 from powertrain.kernels.sparse_lu import compressed
 from powertrain.kernels.transient import amplitude_scales, stretch_motion
 from powertrain.physics.mount_laws import PowerLaw, TableLaw
@@ -51,3 +52,37 @@ def test_stretch_motion_is_root_two_times_the_std_and_the_mean():
     want[network] = np.sqrt(2.0) * np.std(X[10:40] @ P.T, axis=0)
     np.testing.assert_allclose(amplitudes, want, rtol=1e-12)
     np.testing.assert_allclose(centres, (X[10:40] @ R.T).mean(0), rtol=1e-12)
+
+
+def test_the_load_kernel_is_trilinear_in_its_tables():
+    """kernels/load_table.table_load against the same interpolation written with NumPy:
+    trilinear in level, speed and angle for the gas table, linear in the angle for the
+    patterns, at random points including both ends of every axis."""
+    rng = np.random.default_rng(3)
+    gas = rng.standard_normal((3, 4, 9, 6))
+    gas[:, :, -1] = gas[:, :, 0]
+    inertia, acceleration = rng.standard_normal((2, 9, 6))
+    n = 40
+    s0 = rng.integers(0, 2, n).astype(float)
+    fs = rng.uniform(0.0, 1.0, n)
+    v0 = rng.integers(0, 3, n).astype(float)
+    fv = rng.uniform(0.0, 1.0, n)
+    angle = rng.uniform(0.0, 8.0, n)
+    s0[:2], fs[:2], v0[:2], fv[:2], angle[:2] = (0, 1), (0, 1), (0, 2), (0, 1), (0, 8 - 1e-12)
+    fade, omega2, alpha = rng.uniform(0.0, 1.0, n), rng.uniform(0, 1e5, n), rng.normal(0, 1e3, n)
+    out = np.empty((n, 6))
+    table_load(gas, inertia, acceleration, np.column_stack([s0, fs]),
+               np.column_stack([v0, fv]), angle, fade, omega2, alpha, out)
+    u = np.minimum(angle.astype(int), 7)
+    fu = (angle - u)[:, None]
+    i, j = s0.astype(int), v0.astype(int)
+
+    def at(table, *index):
+        return table[(*index, u)] * (1 - fu) + table[(*index, u + 1)] * fu
+
+    ws, wv = fs[:, None], fv[:, None]
+    g = ((at(gas, i, j) * (1 - wv) + at(gas, i, np.minimum(j + 1, 3)) * wv) * (1 - ws)
+         + (at(gas, np.minimum(i + 1, 2), j) * (1 - wv)
+            + at(gas, np.minimum(i + 1, 2), np.minimum(j + 1, 3)) * wv) * ws)
+    want = fade[:, None] * g + omega2[:, None] * at(inertia) + alpha[:, None] * at(acceleration)
+    np.testing.assert_allclose(out, want, rtol=1e-12, atol=1e-12 * np.abs(want).max())

@@ -66,7 +66,7 @@ class ScaledCombustion:
         pm = motored_pressure(theta, p, crank)
         p_new = pm + np.asarray(self.factors, float)[:, None] * (p - pm)
         _, dV = crank.volume(theta)
-        imep = np.array([indicated_work(pc, dV, theta[1] - theta[0]) for pc in p_new])
+        imep = indicated_work(np.atleast_2d(p_new), dV, theta[1] - theta[0])
         return theta, p_new, dict(info, imep_target=imep / crank.swept_volume)
 
 

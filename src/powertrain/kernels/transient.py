@@ -41,6 +41,7 @@ from powertrain.kernels.sparse_lu import (
     sparse_factors,
     subtract_product,
 )
+from powertrain.kernels.static_curve import curve_point
 
 #: Amplitude-law kinds (:func:`amplitude_scales`): none, :class:`~powertrain.physics.mount_laws.PowerLaw`,
 #: :class:`~powertrain.physics.mount_laws.TableLaw`.
@@ -120,34 +121,6 @@ def stretch_motion(rows, network, X, lo, hi, amplitudes, centres):
             amplitudes[network[e]] = np.sqrt(2.0) * np.sqrt(square / (hi - lo))
     for e in range(rows[1][0].shape[0] - 1):
         centres[e] = _row_motion(rows[1], e, X, lo, hi, u)
-
-
-@njit(cache=True, nogil=True)
-def curve_point(breaks, coefficients, count, r, d):
-    """``(force, tangent)`` [N, N/m] of network ``r``'s static curve at the deflection
-    ``d`` [m]: the piecewise cubic of ``count[r]`` breakpoints ``breaks[r]`` (n_net, n_b)
-    with the coefficients ``coefficients[r, j]`` (highest power first, as
-    :class:`scipy.interpolate.PPoly`'s) on each segment, straight with the end slopes
-    beyond its ends."""
-    last = count[r] - 1
-    x0, x1 = breaks[r, 0], breaks[r, last]
-    x = min(max(d, x0), x1)
-    j = 0
-    while j < last - 1 and breaks[r, j + 1] <= x:
-        j += 1
-    c = coefficients[r, j]
-    dx = x - breaks[r, j]
-    force = ((c[0] * dx + c[1]) * dx + c[2]) * dx + c[3]
-    tangent = (3.0 * c[0] * dx + 2.0 * c[1]) * dx + c[2]
-    return force + tangent * (d - x), tangent
-
-
-@njit(cache=True, nogil=True)
-def curve_values(breaks, coefficients, count, d, force, tangent):
-    """Each network's curve force and tangent at its deflection ``d`` (n_net,) [m] into
-    ``force``, ``tangent`` (:func:`curve_point`)."""
-    for r in range(d.shape[0]):
-        force[r], tangent[r] = curve_point(breaks, coefficients, count, r, d[r])
 
 
 @njit(cache=True, nogil=True)

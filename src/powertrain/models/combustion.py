@@ -204,7 +204,7 @@ class MeasuredPressure:
             p = (1 - w) * self.pressure[j] + w * self.pressure[j + 1]
         dtheta = self.theta[1] - self.theta[0]
         _, dV = crank.volume(self.theta)
-        imep = np.array([comb.indicated_work(pc, dV, dtheta) for pc in p]) / crank.swept_volume
+        imep = comb.indicated_work(np.atleast_2d(p), dV, dtheta) / crank.swept_volume
         return self.theta, p, {"imep_target": imep, "heat": np.full(len(p), np.nan),
                                "p_intake": float("nan"), "p_exhaust": float("nan")}
 

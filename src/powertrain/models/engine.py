@@ -273,19 +273,26 @@ class Engine:
         return self.cylinder_pressures([rpm], crank_angle_rad, load)[0]
 
     def cylinder_pressures(self, speeds_rpm, crank_angle_rad, load: float = 1.0) -> np.ndarray:
-        """:meth:`cylinder_pressure` at every speed [rpm], shape ``(n_speeds, n, n_cyl)``: one
-        periodic linear interpolation, its weights found once when the grids agree."""
+        """:meth:`cylinder_pressure` at every speed [rpm], shape ``(n_speeds, n, n_cyl)``."""
+        return self.pressure_tables(speeds_rpm, crank_angle_rad, [load])[0]
+
+    def pressure_tables(self, speeds_rpm, crank_angle_rad, loads) -> np.ndarray:
+        """:meth:`cylinder_pressure` at every load [-] and speed [rpm], shape
+        ``(n_loads, n_speeds, n, n_cyl)``: one periodic linear interpolation, its weights
+        found once when the cycle grids agree."""
         local = self.local_angles(crank_angle_rad)
-        cycles = [self.cycle_pressures(n, load) for n in np.atleast_1d(speeds_rpm)]
-        theta_g = cycles[0][0]
-        if any(not np.array_equal(c[0], theta_g) for c in cycles):
-            return np.stack([self.cylinder_pressure(n, crank_angle_rad, load)
-                             for n in np.atleast_1d(speeds_rpm)])
+        speeds = np.atleast_1d(speeds_rpm)
+        cycles = [[self.cycle_pressures(n, load) for n in speeds] for load in loads]
+        theta_g = cycles[0][0][0]
+        if any(not np.array_equal(c[0], theta_g) for row in cycles for c in row):
+            return np.array([[self.cylinder_pressure(n, crank_angle_rad, load) for n in speeds]
+                             for load in loads])
         i0, i1, w = _periodic_interpolation(local, theta_g, 4.0 * np.pi)
         cyl = np.arange(local.shape[1])[None, :]
-        out = np.empty((len(cycles),) + local.shape)
-        for s, (_, p, _) in enumerate(cycles):
-            out[s] = p[cyl, i0] * (1.0 - w) + p[cyl, i1] * w
+        out = np.empty((len(cycles), speeds.size) + local.shape)
+        for j, row in enumerate(cycles):
+            for s, (_, p, _) in enumerate(row):
+                out[j, s] = p[cyl, i0] * (1.0 - w) + p[cyl, i1] * w
         return out
 
     def local_angles(self, crank_angle_rad) -> np.ndarray:
@@ -342,57 +349,52 @@ class Engine:
         the angles [rad], no gas force (:meth:`_block_load` is linear in both)."""
         th = np.atleast_1d(np.asarray(crank_angle_rad, dtype=float))
         zero = np.zeros((th.size, self.crank.n_cylinders))
-        return self._block_load(th, 1.0, zero)[0], self._block_load(th, 0.0, zero, 1.0)[0]
+        inertia = self._cache.last_grid("load patterns", th, self._load_patterns)[1]
+        return inertia, self._block_load(th, 0.0, zero, 1.0)[0]
 
     def _block_load(self, th, omega, fg, alpha=0.0):
-        """Generalized load (n, 6) on the block at angles ``th`` [rad], speed ``omega``
+        r"""Generalized load (n, 6) on the block at angles ``th`` [rad], speed ``omega``
         [rad/s], crank acceleration ``alpha`` [rad/s^2] (not on the balancer shafts) and gas
         forces ``fg`` (n, n_cyl) [N], and the per-cylinder forces of
         :func:`~powertrain.physics.slider_crank.crank_forces` (dict of (n, n_cyl)). Linear in
-        the gas forces, in omega^2 and in alpha (:meth:`load_table` relies on it)."""
+        the gas forces, in omega^2 and in alpha (:meth:`load_table` relies on it).
+
+        Cylinder :math:`c` at :math:`x_c\mathbf e_x` loads the block with the gas force
+        :math:`F_g\mathbf u` on the head (at :math:`y\mathbf u` from the crank axis), the side
+        thrust :math:`-N\mathbf s` at the pin (:math:`e\mathbf s + y\mathbf u`), the main
+        bearing's :math:`F_r(\sin\beta\,\mathbf s - \cos\beta\,\mathbf u)` (with
+        :math:`N = F_r\sin\beta`) and the unbalanced rotating mass's inertia on the crank
+        axis, and the pin offset's couple :math:`e F_g\,\mathbf s\times\mathbf u`. Summed,
+        the force is :math:`\sum_c (a_c\mathbf u + b_c\mathbf s)` and the moment about the CG
+        :math:`\sum_c (x_c\mathbf e_x - \mathbf r_G)\times(a_c\mathbf u + b_c\mathbf s)
+        + \sum_c (y N + e F_g)\,\mathbf s\times\mathbf u`, with
+        :math:`a_c = F_g - F_r\cos\beta + m_r r(\omega^2\cos\theta_c + \alpha\sin\theta_c)`
+        and :math:`b_c = m_r r(\omega^2\sin\theta_c - \alpha\cos\theta_c)`."""
         ct = self.crank
-        u = ct.cylinder_axis
-        s = ct.lateral_axis
-        su = np.cross(s, u)
-        r, l, e = ct.crank_radius, ct.rod_length, ct.pin_offset
-        cg = self.body.cg
-        force = np.zeros((th.size, 3))
-        moment = np.zeros((th.size, 3))
-        n_cyl = ct.n_cylinders
-        out = {k: np.empty((th.size, n_cyl)) for k in
-               ("inertia", "torque", "torque_gas", "torque_inertia")}
-
-        def add(f, point):
-            nonlocal force, moment
-            force = force + f
-            moment = moment + np.cross(point - cg, f)
-
-        for i in range(n_cyl):
-            theta_i = th - ct.crank_pin_angles[i]
-            k = sc.crank_forces(theta_i, omega, fg[:, i], r, l, e, ct.reciprocating_mass, alpha)
-            for name in out:
-                out[name][:, i] = k[name]
-            origin = np.array([ct.cylinder_x[i], 0.0, 0.0])
-            pin = origin + e * s + k["y"][:, None] * u
-            head = origin + k["y"][:, None] * u
-            add(fg[:, i, None] * u, head)                                   # gas on head
-            add(-k["side"][:, None] * s, pin)                               # side thrust
-            moment = moment + (e * fg[:, i])[:, None] * su                 # pin-offset couple
-            bearing = k["rod"][:, None] * (np.sin(k["beta"])[:, None] * s
-                                           - np.cos(k["beta"])[:, None] * u)
-            add(bearing, origin)                                            # main bearing
-            m_r = (1.0 - ct.counterweight_fraction) * ct.rotating_mass * r
-            if m_r * omega != 0.0:
-                add(m_r * omega**2 * (np.cos(theta_i)[:, None] * u + np.sin(theta_i)[:, None] * s),
-                    origin)
-            if m_r * alpha != 0.0:                  # the pin's tangential acceleration
-                add(m_r * alpha * (np.sin(theta_i)[:, None] * u - np.cos(theta_i)[:, None] * s),
-                    origin)
+        u, s = ct.cylinder_axis, ct.lateral_axis
+        theta = th[:, None] - np.asarray(ct.crank_pin_angles, float)[None, :]
+        k = sc.crank_forces(theta, omega, fg, ct.crank_radius, ct.rod_length, ct.pin_offset,
+                            ct.reciprocating_mass, alpha)
+        m_r = (1.0 - ct.counterweight_fraction) * ct.rotating_mass * ct.crank_radius
+        cos, sin = np.cos(theta), np.sin(theta)
+        a = fg - k["rod"] * np.cos(k["beta"]) + m_r * (omega**2 * cos + alpha * sin)
+        b = m_r * (omega**2 * sin - alpha * cos)
+        x = np.asarray(ct.cylinder_x, float)
+        ex, cg = np.array([1.0, 0.0, 0.0]), self.body.cg
+        arm_a = (a @ x)[:, None] * ex - a.sum(axis=1)[:, None] * cg
+        arm_b = (b @ x)[:, None] * ex - b.sum(axis=1)[:, None] * cg
+        force = np.outer(a.sum(axis=1), u) + np.outer(b.sum(axis=1), s)
+        moment = (np.cross(arm_a, u) + np.cross(arm_b, s)
+                  + np.outer(np.sum(k["y"] * k["side"] + ct.pin_offset * fg, axis=1),
+                             np.cross(s, u)))
         if self.balancer.enabled:
             for sh in self.balancer.shafts:
                 f_u, f_s = bal.shaft_force(th, omega, sh.mass_radius, sh.phase, sh.sense,
                                            self.balancer.ratio)
-                add(f_u[:, None] * u + f_s[:, None] * s, sh.position)
+                f = np.outer(f_u, u) + np.outer(f_s, s)
+                force = force + f
+                moment = moment + np.cross(sh.position - cg, f)
+        out = {name: k[name] for name in ("inertia", "torque", "torque_gas", "torque_inertia")}
         return np.hstack([force, moment]), out
 
     def indicated_work(self, rpm: float, load: float = 1.0) -> np.ndarray:
@@ -402,7 +404,7 @@ class Engine:
         if key not in self._cache:                   # the same grid at every speed
             self._cache[key] = self.crank.volume(theta_g)[1]
         dtheta = theta_g[1] - theta_g[0]
-        return np.array([comb.indicated_work(pc, self._cache[key], dtheta) for pc in p_g])
+        return comb.indicated_work(np.atleast_2d(p_g), self._cache[key], dtheta)
 
     def mean_brake_torque(self, rpm: float, load: float = 1.0) -> float:
         r"""Mean brake torque at ``rpm`` [N·m]: the cycle mean of the indicated torque of the
@@ -438,14 +440,19 @@ class Engine:
         block load is linear in the gas forces and in omega^2 (:meth:`_block_load`), so it is
         sum_i F_g,i G_i + omega^2 I with G_i the load of a unit gas force in cylinder i and I
         that of a unit omega^2."""
+        return self.load_tables(speeds_rpm, crank_angle_rad, [load])[0]
+
+    def load_tables(self, speeds_rpm, crank_angle_rad, loads) -> np.ndarray:
+        """:meth:`load_table` at every load [-], shape (n_loads, n_speeds, n, 6)."""
         th = np.atleast_1d(np.asarray(crank_angle_rad, dtype=float))
         speeds = np.atleast_1d(np.asarray(speeds_rpm, dtype=float))
         ct = self.crank
         gas, inertia = self._cache.last_grid("load patterns", th, self._load_patterns)
-        table = ((speeds * RPM) ** 2)[:, None, None] * inertia
-        fg = (self.cylinder_pressures(speeds, th, load) - ct.crankcase_pressure) * ct.piston_area
+        fg = (self.pressure_tables(speeds, th, loads) - ct.crankcase_pressure) * ct.piston_area
+        table = np.broadcast_to(((speeds * RPM) ** 2)[:, None, None] * inertia,
+                                fg.shape[:-1] + (6,)).copy()
         for i, g in enumerate(gas):
-            table += fg[:, :, i, None] * g
+            table += fg[..., i, None] * g
         return table
 
     def assemble(self, static_factors=None, *, rigid_ground=False):

@@ -143,14 +143,20 @@ def indicated_work(pressure, dvolume, dtheta):
 
     Parameters
     ----------
-    pressure : ndarray
-        Pressure [Pa] on the grid.
-    dvolume : ndarray
+    pressure : ndarray (..., n)
+        Pressure [Pa] on the grid (one row per cylinder: the work of each).
+    dvolume : ndarray (n,)
         :math:`dV/d\theta` [m³/rad] on the grid.
     dtheta : float
         Grid step [rad].
+
+    Returns
+    -------
+    float or ndarray (...)
+        [J]
     """
-    return float(np.sum(pressure * dvolume) * dtheta)
+    work = np.sum(np.asarray(pressure, float) * dvolume, axis=-1) * dtheta
+    return float(work) if np.ndim(work) == 0 else work
 
 
 def calibrate_heat(p0, p1, dvolume, dtheta, swept_volume, imep_target):

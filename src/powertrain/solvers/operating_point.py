@@ -33,6 +33,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from powertrain.errors import InputError
+from powertrain.kernels import kernel_input
+from powertrain.kernels.static_curve import curve_values
 from powertrain.physics.mount_laws import CurveReader
 from powertrain.physics.rigid_body import direction_row
 from powertrain.units import STANDARD_GRAVITY
@@ -63,12 +65,21 @@ class StaticSupport:
     readers : list
         Each curve's :class:`~powertrain.physics.mount_laws.CurveReader` (built once) or
         None.
+    cubics : tuple
+        ``(breaks (n_net, n_b), coefficients (n_net, n_b - 1, 4), count (n_net,))``: each
+        network's force as a piecewise cubic, its curve's PCHIP or the straight line of its
+        static stiffness, read by :func:`~powertrain.kernels.static_curve.curve_values`.
+    reference_tangent : ndarray (n_net,)
+        Each curve's tangent stiffness at its reference deflection, the static stiffness
+        where there is none [N/m].
     """
 
     rows: np.ndarray
     curves: list
     stiffness: np.ndarray
     readers: list
+    cubics: tuple
+    reference_tangent: np.ndarray
 
     @classmethod
     def of(cls, engine) -> StaticSupport:
@@ -83,23 +94,44 @@ class StaticSupport:
                 rows.append(direction_row(r, R[:, a]))
                 curves.append(model.static_curve)
                 k0.append(model.static_stiffness())
-        return cls(np.array(rows), curves, np.array(k0),
-                   [None if c is None else CurveReader(c) for c in curves])
+        readers = [None if c is None else CurveReader(c) for c in curves]
+        pieces = [_cubic(c, k) for c, k in zip(readers, k0)]
+        size = max(b.size for b, _ in pieces)
+        cubics = (np.array([np.pad(b, (0, size - b.size), mode="edge") for b, _ in pieces]),
+                  np.array([np.pad(c, ((0, size - 1 - len(c)), (0, 0))) for _, c in pieces]),
+                  np.array([b.size for b, _ in pieces], np.int64))
+        reference = [k if c is None else float(c.tangent_at(c.curve.reference_deflection))
+                     for c, k in zip(readers, k0)]
+        return cls(np.array(rows), curves, np.array(k0), readers,
+                   tuple(kernel_input(a, a.dtype) for a in cubics), np.array(reference))
+
+    def read(self, deflection):
+        """``(force [N], tangent stiffness [N/m])`` of every network at its deflection
+        (n_net,) [m]."""
+        force, tangent = np.empty(len(self.curves)), np.empty(len(self.curves))
+        curve_values(*self.cubics, kernel_input(deflection), force, tangent)
+        return force, tangent
 
     def forces(self, deflection) -> np.ndarray:
         """Force of every network [N] at its deflection [m]."""
-        return np.array([k * d if c is None else float(c.force_at(d)) for c, k, d in
-                         zip(self.readers, self.stiffness, deflection)])
+        return self.read(deflection)[0]
 
     def tangents(self, deflection) -> np.ndarray:
         """Tangent stiffness of every network [N/m] at its deflection [m]."""
-        return np.array([k if c is None else float(c.tangent_at(d)) for c, k, d in
-                         zip(self.readers, self.stiffness, deflection)])
+        return self.read(deflection)[1]
 
     def factors(self, deflection) -> np.ndarray:
         """Static factor of every network at its deflection (1 without a curve)."""
-        return np.array([1.0 if c is None else float(c.factor(d)) for c, d in
-                         zip(self.readers, deflection)])
+        return self.read(deflection)[1] / self.reference_tangent
+
+
+def _cubic(reader, stiffness):
+    """``(breaks, coefficients (segments, 4))`` of a network's force: its curve's PCHIP
+    (``reader``, a :class:`~powertrain.physics.mount_laws.CurveReader`), or without one
+    the line ``stiffness`` × deflection (about 0, so exact at any small deflection)."""
+    if reader is None:
+        return np.array([0.0, 1.0]), np.array([[0.0, 0.0, stiffness, 0.0]])
+    return np.asarray(reader.pchip.x, float), np.asarray(reader.pchip.c.T, float)
 
 
 @dataclass(frozen=True)

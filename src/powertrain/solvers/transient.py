@@ -62,7 +62,6 @@ from powertrain.kernels.sparse_lu import compressed
 from powertrain.kernels.transient import (
     NEEDS_PIVOTING,
     curve_state,
-    curve_values,
     transient_kernel,
 )
 from powertrain.solvers.cycle_newmark import no_ports, start_state
@@ -388,7 +387,8 @@ def _check_within_curves(curves, u, names, file):
     datasheet says nothing of such a deflection (its straight continuation would carry any
     load)."""
     for r in np.flatnonzero(curves.has):
-        lo, hi = curves.breaks[r, 0], curves.breaks[r, curves.count[r] - 1]
+        breaks, _, count = curves.support.cubics
+        lo, hi = breaks[r, 0], breaks[r, count[r] - 1]
         d = curves.d0[r] + u[r]
         if not lo - (hi - lo) <= d <= hi + (hi - lo):
             raise InputError(f"the static point of the first load deflects {names[r]} "
@@ -414,51 +414,25 @@ def _cycle_load(engine, manoeuvre, theta):
 
 class _Curves:
     """The networks' static curves about the zero-torque static point (module docstring):
-    each curve's piecewise cubic (its
-    :class:`~powertrain.physics.mount_laws.CurveReader`'s PCHIP) as arrays, read exactly in
-    the kernel (:func:`~powertrain.kernels.transient.curve_point`; a network without a
+    the support's piecewise cubics (:attr:`StaticSupport.cubics`), read exactly in the
+    kernel (:func:`~powertrain.kernels.static_curve.curve_point`; a network without a
     curve: zero force, factor 1)."""
 
     def __init__(self, engine, system):
-        support = StaticSupport.of(engine)
+        self.support = support = StaticSupport.of(engine)
         self.stiffness = support.stiffness
         rpm = engine.speed_range_rpm()[0]
         self.d0 = operating_point(engine, rpm, support, mean_torque=0.0).deflection.ravel()
         self.rows = system.port_rows
         self.has = np.array([c is not None for c in support.curves])
-        pieces = [_cubic(c) for c in support.readers]
-        size = max(b.size for b, _, _ in pieces)
-        self.breaks = np.array([np.pad(b, (0, size - b.size), mode="edge") for b, _, _ in pieces])
-        self.coefficients = np.array([np.pad(c, ((0, size - 1 - len(c)), (0, 0)))
-                                      for _, c, _ in pieces])
-        self.count = np.array([b.size for b, _, _ in pieces], np.int64)
-        self.reference = np.array([t for _, _, t in pieces], float)
-        self.f0 = self._read(self.d0)[0]
+        self.f0 = support.forces(self.d0)
 
     def kernel_tuple(self):
         """``(d0, f0, breaks, coefficients, count, reference tangent, has)`` for
         :func:`~powertrain.kernels.transient.curve_state`."""
-        return (self.d0, self.f0, self.breaks, self.coefficients, self.count, self.reference,
+        return (self.d0, self.f0, *self.support.cubics, self.support.reference_tangent,
                 self.has)
-
-    def _read(self, d):
-        """Each network's curve force [N] and tangent [N/m] at its deflection ``d``
-        (n_net,) [m]."""
-        force, tangent = np.empty(d.size), np.empty(d.size)
-        curve_values(self.breaks, self.coefficients, self.count,
-                     np.ascontiguousarray(d, float), force, tangent)
-        return force, tangent
 
     def factors(self, x):
         """Static factor of every network at the state ``x`` (1 without a curve)."""
-        return np.where(self.has, self._read(self.d0 + self.rows @ x)[1] / self.reference, 1.0)
-
-
-def _cubic(curve):
-    """``(breaks, coefficients (segments, 4), tangent at the reference)`` of a static
-    curve's :class:`~powertrain.physics.mount_laws.CurveReader` (a straight line of slope 1
-    for a network without a curve)."""
-    if curve is None:
-        return np.array([-1.0, 1.0]), np.array([[0.0, 0.0, 1.0, -1.0]]), 1.0
-    return (np.asarray(curve.pchip.x, float), np.ascontiguousarray(curve.pchip.c.T, float),
-            float(curve.tangent_at(curve.curve.reference_deflection)))
+        return self.support.factors(self.d0 + self.rows @ x)

@@ -44,6 +44,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from powertrain.errors import PowertrainWarning
+from powertrain.kernels import kernel_input
+from powertrain.kernels.load_table import table_load
 from powertrain.units import UNITS
 
 #: Crank-angle samples of the load table over the cycle, and its speed step [rpm].
@@ -94,10 +96,7 @@ def transient_load(engine, manoeuvre, t) -> TransientLoad:
                      if manoeuvre.gear_ratio > 0 else np.zeros_like(t))
     scale = table.scale_of_level(spin, level)
     J = manoeuvre.crank_inertia
-    F = table.gas(theta, spin, level) * np.clip(spin / (FADE_RPM * RPM), 0.0, 1.0)[:, None]
-    th = np.mod(theta, 4 * np.pi) * (N_THETA / (4 * np.pi))
-    F += (omega ** 2)[:, None] * _periodic(table.inertia, th)
-    F += alpha[:, None] * _periodic(table.acceleration, th)
+    F = table.load(theta, omega, alpha, level)
     F[:, 3:] -= (J * alpha)[:, None] * n[None, :]
     F += driveline_reaction(engine, manoeuvre, driveline)
     starter = np.zeros_like(t)
@@ -134,13 +133,6 @@ def driveline_reaction(engine, manoeuvre, driveline):
     return out
 
 
-def _periodic(table, th):
-    """Rows of ``table`` (N_THETA + 1, 6) at the fractional indices ``th``, linear."""
-    i = np.minimum(th.astype(np.int64), N_THETA - 1)
-    w = (th - i)[:, None]
-    return table[i] * (1.0 - w) + table[i + 1] * w
-
-
 class _GasTable:
     r"""The gas load per load level, speed and crank angle, the cycle mean of its roll
     removed; the inertia and acceleration patterns; the mean brake torque per level and
@@ -159,15 +151,18 @@ class _GasTable:
         theta = np.arange(N_THETA) * (4 * np.pi / N_THETA)
         self.n = np.array([float(engine.crank.rotation_sign), 0.0, 0.0])
         inertia, acceleration = engine.motion_patterns(theta)
-        w2 = ((self.speeds * RPM) ** 2)[:, None, None]
-        fired = {s: engine.load_table(self.speeds, theta, s) for s in self.scales if s >= 0}
         motored = (engine.motored(manoeuvre.motored_intake_pressure)   # after: its patterns
                    if self.scales[0] < 0 else None)
-        gas = np.stack([(motored.load_table(self.speeds, theta) if s < 0 else fired[s])
-                        - w2 * inertia for s in self.scales])
-        self.table = _wrap(self._no_mean_roll(gas), axis=2)
-        self.inertia = _wrap(inertia, axis=0)
-        self.acceleration = _wrap(self._no_mean_roll(acceleration), axis=0)
+        fired = self.scales >= 0
+        gas = np.empty((self.scales.size, self.speeds.size, N_THETA + 1, 6))
+        gas[fired, :, :-1] = engine.load_tables(self.speeds, theta, self.scales[fired])
+        if motored is not None:
+            gas[~fired, :, :-1] = motored.load_table(self.speeds, theta)
+        gas[:, :, :-1] -= ((self.speeds * RPM) ** 2)[:, None, None] * inertia
+        self.table = self._no_mean_roll(gas)
+        self.table[:, :, -1] = self.table[:, :, 0]               # the periodic wrap
+        self.inertia = np.r_[inertia, inertia[:1]]
+        self.acceleration = self._no_mean_roll(np.r_[acceleration, acceleration[:1]])
         self.torques = np.array([[motored.mean_brake_torque(n) if s < 0 else
                                   engine.mean_brake_torque(n, s) for n in self.speeds]
                                  for s in self.scales])
@@ -203,11 +198,11 @@ class _GasTable:
         return values[v0] * (1 - fv) + values[v1] * fv
 
     def _no_mean_roll(self, load):
-        """``load`` (..., n_theta, 6) with the cycle mean of its roll moment removed."""
-        roll = np.mean(load[..., 3:] @ self.n, axis=-1)
-        out = load.copy()
-        out[..., 3:] -= roll[..., None, None] * self.n
-        return out
+        """``load`` (..., n_theta + 1, 6) with the cycle mean of its roll moment (over all
+        but the last angle, the wrap's) removed, in place."""
+        roll = np.mean(load[..., :-1, 3:] @ self.n, axis=-1)
+        load[..., 3:] -= roll[..., None, None] * self.n
+        return load
 
     def _speed_index(self, spin):
         v = np.clip((spin / RPM - self.speeds[0]) / RPM_STEP, 0.0, self.speeds.size - 1.0)
@@ -223,18 +218,19 @@ class _GasTable:
         w = np.clip((scale - s[j]) / (s[j + 1] - s[j]), 0.0, 1.0)
         return j, j + 1, w
 
-    def gas(self, theta, spin, scale):
-        """Gas load (n_t, 6), trilinear in the table."""
-        th = np.mod(theta, 4 * np.pi) * (N_THETA / (4 * np.pi))
-        u0 = np.minimum(th.astype(np.int64), N_THETA - 1)
-        fu = (th - u0)[:, None]
-        s0, s1, fs = self._scale_index(scale)
-        v0, v1, fv = self._speed_index(spin)
-        out = np.zeros((theta.size, 6))
-        for s, ws in ((s0, 1.0 - fs), (s1, fs)):
-            for v, wv in ((v0, 1.0 - fv), (v1, fv)):
-                w = (ws * wv)[:, None]
-                out += w * (self.table[s, v, u0] * (1.0 - fu) + self.table[s, v, u0 + 1] * fu)
+    def load(self, theta, omega, alpha, level):
+        """Load (n_t, 6) at the crank angles [rad], speeds [rad/s], accelerations
+        [rad/s²] and load levels: the gas table trilinear, faded out below
+        :data:`FADE_RPM`, plus the inertia and acceleration patterns
+        (:func:`~powertrain.kernels.load_table.table_load`)."""
+        spin = np.abs(omega)
+        s0, _, fs = self._scale_index(level)
+        v0, _, fv = self._speed_index(spin)
+        out = np.empty((np.size(theta), 6))
+        table_load(*(kernel_input(a) for a in (
+            self.table, self.inertia, self.acceleration, np.column_stack([s0, fs]),
+            np.column_stack([v0, fv]), np.mod(theta, 4 * np.pi) * (N_THETA / (4 * np.pi)),
+            np.clip(spin / (FADE_RPM * RPM), 0.0, 1.0), omega ** 2, alpha)), out)
         return out
 
     def torque(self, spin, scale):
@@ -244,12 +240,6 @@ class _GasTable:
         T = self.torques
         return ((T[s0, v0] * (1 - fv) + T[s0, v1] * fv) * (1 - fs)
                 + (T[s1, v0] * (1 - fv) + T[s1, v1] * fv) * fs)
-
-
-def _wrap(a, axis):
-    """``a`` with its first row along ``axis`` appended (periodic wrap)."""
-    first = np.take(a, [0], axis=axis)
-    return np.concatenate([a, first], axis=axis)
 
 
 def _full_only(manoeuvre):
