@@ -180,7 +180,7 @@ def _start_acceleration(model, laws, C, K, f, x, v):
     subtract_product(C, v, r)
     subtract_product(K, x, r)
     if laws is not None:
-        _, kinds, par, state, (starts, columns, values) = laws
+        _, kinds, par, state, (starts, columns, values), _ = laws
         m = kinds.shape[0]
         u, du, z0 = np.empty(m), np.empty(m), np.zeros(m)
         product(laws[4], x, u)
@@ -229,12 +229,15 @@ def _piece(model, laws, h, C, K, F, load, x, v, a, X, V, A, Z, tol, max_iter, wo
 
 @njit(cache=True, nogil=True)
 def _port_setup(laws, lu, h, x, v, Z):
-    """``(W, coupling, P compressed, z, work)`` of the port laws for
+    r"""``(W, coupling, P compressed, z, work)`` of the port laws for
     :func:`_sparse_steps` (W = S^-1 P^T, :func:`~powertrain.kernels.port_forces.newmark_port_kernel`),
-    ``z`` and row 0 of ``Z`` the forces at ``(x, v)``; None without port laws."""
+    ``z`` and row 0 of ``Z`` the forces at ``(x, v)``; None without port laws. The
+    predictor's points (``laws[5]``, :func:`~powertrain.kernels.port_forces.port_forces_step`'s
+    ``last``) go on from the last piece: their coupling is set to this piece's,
+    :math:`\mathbf Q_u\mathbf z`, so that the laws' tangents predict the first step too."""
     if laws is None:
         return None
-    P, kinds, par, state, (starts, columns, values) = laws
+    P, kinds, par, state, (starts, columns, values), last = laws
     n, m = x.shape[0], kinds.shape[0]
     W, Q, col, y, z = np.empty((n, m)), np.zeros((m, m)), np.empty(n), np.empty(n), \
         np.empty(m)
@@ -253,15 +256,20 @@ def _port_setup(laws, lu, h, x, v, Z):
             du += P[e, j] * v[j]
         z[e] = law_force(kinds[e], u, du, par, state, e)[0]
         Z[0, e] = z[e]
+    for e in range(m):
+        c = 0.0
+        for j in range(m):
+            c += Q[e, j] * z[j]
+        last[6, e] = c
     return (W, port_coupling(Q, 2.0 / h), laws[4], z,
-            (np.empty(m), np.empty(m), np.empty(m), np.empty((m, m)), np.zeros((7, m))))
+            (np.empty(m), np.empty(m), np.empty(m), np.empty((m, m)), last))
 
 
 @njit(cache=True, nogil=True)
 def _port_step(laws, ports, h, xt, vt, a, z_out, tol, max_iter):
     """The port forces of one step (:func:`~powertrain.kernels.port_forces.newmark_port_kernel`)
     into ``z_out``, taken off the linear acceleration ``a`` in place. True on success."""
-    _, kinds, par, state, _ = laws
+    _, kinds, par, state, _, _ = laws
     W, coupled, (starts, columns, values), z, (ul, vl, r, J, last) = ports
     hh, hv = 0.25 * h * h, 0.5 * h
     for e in range(z.shape[0]):
@@ -330,8 +338,9 @@ def transient_stretch_kernel(model, curves, laws, h, F, law, centres, lo, hi, su
     curves : tuple
         :func:`curve_state`'s.
     laws : tuple or None
-        ``(P, kinds, par, state, P compressed)`` of the port laws (m rows), ``state``
-        updated in place; None without port laws.
+        ``(P, kinds, par, state, P compressed, last)`` of the port laws (m rows),
+        ``state`` and the predictor's points ``last`` (7, m) (zeros at the start) updated
+        in place; None without port laws.
     h : float
         Time step [s].
     F : ndarray (n_t, n)

@@ -276,7 +276,8 @@ def _run(system, scaling, ports, curves, F, h, start, steps):
             None if not laws.kinds.size else (
                 np.array(laws.rows, float), np.array(laws.kinds, np.int64),
                 np.array(laws.parameters, float), None if state is None else state.copy(),
-                compressed(np.array(laws.rows, float), True, True)),
+                compressed(np.array(laws.rows, float), True, True),
+                np.zeros((7, laws.kinds.size))),
             motion, h, F, (every, sub), np.empty(0) if a is None else np.array(a, float),
             ports.network_amplitudes(amplitudes), system.port_rows @ x, X, V, A, Z, scales,
             loads, PORT_TOL, PORT_MAX_ITER)
