@@ -88,12 +88,23 @@ def lu_pattern(mask):
     ``mask`` (n, n), already in its elimination order: its own and the fill-in
     (symbolic elimination)."""
     P = np.array(mask, bool)
-    for col in range(P.shape[0]):
-        below = np.flatnonzero(P[col + 1:, col]) + col + 1
-        right = np.flatnonzero(P[col, col + 1:]) + col + 1
-        P[np.ix_(below, right)] = True
+    _fill_in(P)
     lower = np.tril(P, -1)
     return csr_pattern(lower), csr_pattern(lower.T), csr_pattern(np.triu(P, 1))
+
+
+@njit(cache=True, nogil=True)
+def _fill_in(P):
+    """Mark in the boolean ``P`` (n, n), in place, the entries elimination without row
+    swaps fills in: row ``i`` takes row ``col``'s pattern right of ``col`` wherever
+    ``P[i, col]``."""
+    n = P.shape[0]
+    for col in range(n):
+        for i in range(col + 1, n):
+            if P[i, col]:
+                for j in range(col + 1, n):
+                    if P[col, j]:
+                        P[i, j] = True
 
 
 @njit(cache=True, nogil=True)

@@ -162,6 +162,13 @@ class StaticCurve:
         return CurveReader(self).factor(x)
 
 
+def curve_pchip(curve) -> PchipInterpolator:
+    """The monotone piecewise cubic (PCHIP, no extrapolation) through a
+    :class:`StaticCurve`'s points: force [N] of deflection [m]."""
+    return PchipInterpolator(np.asarray(curve.deflection, float),
+                             np.asarray(curve.force, float), extrapolate=False)
+
+
 class CurveReader:
     """A :class:`StaticCurve` read many times: its PCHIP (no extrapolation), the PCHIP's
     derivative and the curve's ends built once; straight beyond its points."""
@@ -169,7 +176,7 @@ class CurveReader:
     def __init__(self, curve):
         x = np.asarray(curve.deflection, float)
         self.curve = curve
-        self.pchip = PchipInterpolator(x, np.asarray(curve.force, float), extrapolate=False)
+        self.pchip = curve_pchip(curve)
         self.slope = d = self.pchip.derivative()
         self.ends = (x[0], x[-1], float(self.pchip(x[0])), float(self.pchip(x[-1])),
                      float(d(x[0])), float(d(x[-1])))

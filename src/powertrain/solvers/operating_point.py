@@ -35,7 +35,7 @@ import numpy as np
 from powertrain.errors import InputError
 from powertrain.kernels import kernel_input
 from powertrain.kernels.static_curve import curve_values
-from powertrain.physics.mount_laws import CurveReader
+from powertrain.physics.mount_laws import curve_pchip
 from powertrain.physics.rigid_body import direction_row
 from powertrain.units import STANDARD_GRAVITY
 
@@ -62,13 +62,13 @@ class StaticSupport:
         Each network's :class:`~powertrain.physics.mount_laws.StaticCurve` or None.
     stiffness : ndarray (n_net,)
         Static stiffness of the networks [N/m] (used where there is no curve).
-    readers : list
-        Each curve's :class:`~powertrain.physics.mount_laws.CurveReader` (built once) or
-        None.
     cubics : tuple
         ``(breaks (n_net, n_b), coefficients (n_net, n_b - 1, 4), count (n_net,))``: each
-        network's force as a piecewise cubic, its curve's PCHIP or the straight line of its
-        static stiffness, read by :func:`~powertrain.kernels.static_curve.curve_values`.
+        network's force as a piecewise cubic, its curve's PCHIP
+        (:func:`~powertrain.physics.mount_laws.curve_pchip`) or the straight line of its
+        static stiffness, read by :func:`~powertrain.kernels.static_curve.curve_values`
+        (straight with the end slopes beyond the points, as
+        :class:`~powertrain.physics.mount_laws.CurveReader`).
     reference_tangent : ndarray (n_net,)
         Each curve's tangent stiffness at its reference deflection, the static stiffness
         where there is none [N/m].
@@ -77,7 +77,6 @@ class StaticSupport:
     rows: np.ndarray
     curves: list
     stiffness: np.ndarray
-    readers: list
     cubics: tuple
     reference_tangent: np.ndarray
 
@@ -94,16 +93,16 @@ class StaticSupport:
                 rows.append(direction_row(r, R[:, a]))
                 curves.append(model.static_curve)
                 k0.append(model.static_stiffness())
-        readers = [None if c is None else CurveReader(c) for c in curves]
-        pieces = [_cubic(c, k) for c, k in zip(readers, k0)]
+        pieces = [_cubic(c, k) for c, k in zip(curves, k0)]
         size = max(b.size for b, _ in pieces)
-        cubics = (np.array([np.pad(b, (0, size - b.size), mode="edge") for b, _ in pieces]),
-                  np.array([np.pad(c, ((0, size - 1 - len(c)), (0, 0))) for _, c in pieces]),
-                  np.array([b.size for b, _ in pieces], np.int64))
-        reference = [k if c is None else float(c.tangent_at(c.curve.reference_deflection))
-                     for c, k in zip(readers, k0)]
-        return cls(np.array(rows), curves, np.array(k0), readers,
-                   tuple(kernel_input(a, a.dtype) for a in cubics), np.array(reference))
+        cubics = tuple(kernel_input(a, a.dtype) for a in (
+            np.array([np.pad(b, (0, size - b.size), mode="edge") for b, _ in pieces]),
+            np.array([np.pad(c, ((0, size - 1 - len(c)), (0, 0))) for _, c in pieces]),
+            np.array([b.size for b, _ in pieces], np.int64)))
+        reference = np.array([0.0 if c is None else c.reference_deflection for c in curves])
+        tangent = np.empty(len(curves))
+        curve_values(*cubics, kernel_input(reference), np.empty(len(curves)), tangent)
+        return cls(np.array(rows), curves, np.array(k0), cubics, tangent)
 
     def read(self, deflection):
         """``(force [N], tangent stiffness [N/m])`` of every network at its deflection
@@ -125,13 +124,14 @@ class StaticSupport:
         return self.read(deflection)[1] / self.reference_tangent
 
 
-def _cubic(reader, stiffness):
-    """``(breaks, coefficients (segments, 4))`` of a network's force: its curve's PCHIP
-    (``reader``, a :class:`~powertrain.physics.mount_laws.CurveReader`), or without one
-    the line ``stiffness`` × deflection (about 0, so exact at any small deflection)."""
-    if reader is None:
+def _cubic(curve, stiffness):
+    """``(breaks, coefficients (segments, 4))`` of a network's force: its static
+    ``curve``'s PCHIP, or without one the line ``stiffness`` × deflection (about 0, so
+    exact at any small deflection)."""
+    if curve is None:
         return np.array([0.0, 1.0]), np.array([[0.0, 0.0, stiffness, 0.0]])
-    return np.asarray(reader.pchip.x, float), np.asarray(reader.pchip.c.T, float)
+    pchip = curve_pchip(curve)
+    return np.asarray(pchip.x, float), np.asarray(pchip.c.T, float)
 
 
 @dataclass(frozen=True)
