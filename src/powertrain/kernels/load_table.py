@@ -1,12 +1,14 @@
-r"""A transient manoeuvre's load read from its tables at every step
-(:mod:`powertrain.solvers.transient_load`): the gas load trilinear in load level, speed and
+r"""The engine's load tables: built from the gas forces and the unit-load patterns
+(:func:`gas_table`, :meth:`powertrain.models.engine.Engine.load_tables`), and a transient
+manoeuvre's load read from them at every step (:func:`table_load`,
+:mod:`powertrain.solvers.transient_load`): the gas load trilinear in load level, speed and
 crank angle, the inertia and acceleration patterns linear in the angle,
 
 .. math:: \mathbf f_k = \phi_k\,\tilde{\mathbf G}(\lambda_k, n_k, \theta_k)
    + \omega_k^2\,\mathbf I(\theta_k) + \alpha_k\,\tilde{\mathbf A}(\theta_k).
 
-One loop rather than NumPy expressions over all steps: the eight gathers of those would each
-build an array of all steps.
+Loops rather than NumPy expressions: each of those would build an array of the whole table
+or of all steps.
 """
 
 from numba import njit
@@ -43,3 +45,22 @@ def table_load(gas, inertia, acceleration, levels, speeds, angles, fade, omega2,
                     + _angle_row(gas[s1, v1], u, fu, c) * fv) * fs)
             out[k, c] = (fade[k] * g + omega2[k] * _angle_row(inertia, u, fu, c)
                          + alpha[k] * _angle_row(acceleration, u, fu, c))
+
+
+@njit(cache=True, nogil=True)
+def gas_table(gas_force, patterns, inertia, omega2, out):
+    """Fill ``out`` (n_loads, n_speeds, n, 6) with the block load of the gas forces
+    ``gas_force`` (n_loads, n_speeds, n, n_cyl) [N] and of the speeds' ``omega2``
+    (n_speeds,) [rad²/s²]: ``omega2 I + sum over cylinders of F_g G`` with the load of a
+    unit gas force in each cylinder ``patterns`` (n_cyl, n, 6) and of a unit omega^2
+    ``inertia`` (n, 6) (:meth:`powertrain.models.engine.Engine.load_tables`), summed in that
+    order."""
+    n_load, n_speed, n, n_cyl = gas_force.shape
+    for a in range(n_load):
+        for s in range(n_speed):
+            for t in range(n):
+                for k in range(6):
+                    v = omega2[s] * inertia[t, k]
+                    for c in range(n_cyl):
+                        v += gas_force[a, s, t, c] * patterns[c, t, k]
+                    out[a, s, t, k] = v

@@ -28,6 +28,8 @@ import numpy as np
 from powertrain.analysis.fourier import harmonic_amplitudes
 from powertrain.assembly import assemble
 from powertrain.errors import InputError
+from powertrain.kernels import kernel_input
+from powertrain.kernels.load_table import gas_table
 from powertrain.models.combustion import RPM, LoadedCombustion, MotoredCombustion
 from powertrain.models.crank_train import Balancer, CrankTrain
 from powertrain.models.memo import Memo
@@ -346,11 +348,16 @@ class Engine:
 
     def motion_patterns(self, crank_angle_rad):
         """Generalized loads (n, 6) of a unit omega^2 and of a unit crank acceleration at
-        the angles [rad], no gas force (:meth:`_block_load` is linear in both)."""
+        the angles [rad], no gas force (:meth:`_block_load` is linear in both); kept for the
+        last grid, as the load patterns (they depend on the geometry only)."""
         th = np.atleast_1d(np.asarray(crank_angle_rad, dtype=float))
-        zero = np.zeros((th.size, self.crank.n_cylinders))
         inertia = self._cache.last_grid("load patterns", th, self._load_patterns)[1]
-        return inertia, self._block_load(th, 0.0, zero, 1.0)[0]
+        return inertia, self._cache.last_grid("acceleration pattern", th,
+                                              self._acceleration_pattern)
+
+    def _acceleration_pattern(self, th):
+        """The block load (n, 6) of a unit crank acceleration at the angles ``th`` [rad]."""
+        return self._block_load(th, 0.0, np.zeros((th.size, self.crank.n_cylinders)), 1.0)[0]
 
     def _block_load(self, th, omega, fg, alpha=0.0):
         r"""Generalized load (n, 6) on the block at angles ``th`` [rad], speed ``omega``
@@ -449,10 +456,9 @@ class Engine:
         ct = self.crank
         gas, inertia = self._cache.last_grid("load patterns", th, self._load_patterns)
         fg = (self.pressure_tables(speeds, th, loads) - ct.crankcase_pressure) * ct.piston_area
-        table = np.broadcast_to(((speeds * RPM) ** 2)[:, None, None] * inertia,
-                                fg.shape[:-1] + (6,)).copy()
-        for i, g in enumerate(gas):
-            table += fg[..., i, None] * g
+        table = np.empty(fg.shape[:-1] + (6,))
+        gas_table(*(kernel_input(a) for a in (fg, np.asarray(gas), inertia,
+                                              (speeds * RPM) ** 2)), table)
         return table
 
     def assemble(self, static_factors=None, *, rigid_ground=False):
