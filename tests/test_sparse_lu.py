@@ -12,7 +12,10 @@ from powertrain.kernels.sparse_lu import (
     factor_on_pattern,
     lu_pattern,
     lu_solve,
+    lu_solve_rows,
     sparse_factors,
+    subtract_product,
+    subtract_products,
 )
 from powertrain.kernels.transient import NEEDS_PIVOTING, _piece, _scaled
 from powertrain.solvers.transient_model import _elimination_order, kernel_model
@@ -63,6 +66,43 @@ def test_the_sparse_solve_is_numpys_and_fills_only_the_body_rows(networks, inner
         assert set(perm[-6:]) == set(range(6))
     fill = (B != 0) & (S[np.ix_(perm, perm)] == 0)
     assert not fill[:-6, :-6].any()
+
+
+@settings(max_examples=30, deadline=None)
+@given(st.integers(1, 9), st.integers(1, 4), st.integers(1, 9), st.booleans(),
+       st.integers(0, 2**32 - 1))
+def test_many_right_hand_sides_and_a_joint_pattern_are_the_single_ones_bit_for_bit(
+        networks, inner, m, swap, seed):
+    """lu_solve_rows is lu_solve on each row (also with row swaps); subtract_products on one
+    pattern (explicit zeros where only the other matrix has an entry) is subtract_product
+    twice."""
+    rng = np.random.default_rng(seed)
+    S = arrow(rng, networks, inner)
+    n = S.shape[0]
+    perm = _elimination_order(S)
+    if swap:                                   # a zero pivot: factor() swaps a row in
+        S[perm[0], perm[0]] = 0.0
+    zero = np.zeros_like(S)
+    ok, B, rows = factor(S, zero, zero, 0.0, 0.0, perm)
+    assert ok
+    factors = sparse_factors(B)
+    P = rng.standard_normal((m, n)) * (rng.random((m, n)) < 0.4)
+    W = np.empty((n, m))
+    lu_solve_rows(factors, rows, perm, P, np.empty((n, m)), W)
+    for e in range(m):
+        one = np.empty(n)
+        lu_solve(factors, rows, perm, P[e], np.empty(n), one)
+        assert np.array_equal(W[:, e], one)
+    C, K = (A * (rng.random(A.shape) < 0.5) for A in (arrow(rng, networks, inner),) * 2)
+    joint = (C != 0) | (K != 0)
+    starts, columns, _ = compressed(joint.astype(float), True, True)
+    on_joint = [(starts, columns, A[joint]) for A in (C, K)]
+    v, x, out = rng.standard_normal((3, n))
+    want = out.copy()
+    subtract_product(compressed(C, True, True), v, want)
+    subtract_product(compressed(K, True, True), x, want)
+    subtract_products(*on_joint[:1], v, on_joint[1], x, out)
+    assert np.array_equal(out, want)
 
 
 def on_pattern(M, C, K, c, k, perm):

@@ -202,6 +202,30 @@ def lu_solve(factors, rows, perm, b, y, out):
 
 
 @njit(cache=True, nogil=True)
+def lu_solve_rows(factors, rows, perm, B, Y, out):
+    """``out[:, e]`` = S^-1 ``B[e]`` for every row of ``B`` (m, n) at once, as
+    :func:`lu_solve` does each (the same arithmetic, bit for bit), the factors read once;
+    ``Y`` (n, m) is work space and ``out`` (n, m)."""
+    (Lp, Li, Lx), (Up, Ui, Ux), inv_d = factors
+    n, m = B.shape[1], B.shape[0]
+    for i in range(n):
+        for e in range(m):
+            Y[i, e] = B[e, rows[i]]
+        for k in range(Lp[i], Lp[i + 1]):
+            lx, c = Lx[k], Li[k]
+            for e in range(m):
+                Y[i, e] -= lx * Y[c, e]
+    for i in range(n - 1, -1, -1):
+        for k in range(Up[i], Up[i + 1]):
+            ux, c = Ux[k], Ui[k]
+            for e in range(m):
+                Y[i, e] -= ux * Y[c, e]
+        for e in range(m):
+            Y[i, e] *= inv_d[i]
+            out[perm[i], e] = Y[i, e]
+
+
+@njit(cache=True, nogil=True)
 def _row_product(A, i, x):
     """Row ``i`` of ``A`` (compressed, :func:`compressed`) times ``x``."""
     starts, columns, values = A
@@ -223,3 +247,20 @@ def subtract_product(A, x, out):
     """``out -= A x`` for ``A`` compressed (:func:`compressed`)."""
     for i in range(A[0].shape[0] - 1):
         out[i] -= _row_product(A, i, x)
+
+
+@njit(cache=True, nogil=True)
+def subtract_products(C, v, K, x, out):
+    """``out -= C v`` then ``-= K x`` row by row, ``C`` and ``K`` compressed on one pattern
+    (:func:`compressed`'s layout; the same sums as :func:`subtract_product` twice, in one
+    pass over the pattern)."""
+    starts, columns, c = C
+    k = K[2]
+    for i in range(starts.shape[0] - 1):
+        sc, sk = 0.0, 0.0
+        for t in range(starts[i], starts[i + 1]):
+            j = columns[t]
+            sc += c[t] * v[j]
+            sk += k[t] * x[j]
+        out[i] -= sc
+        out[i] -= sk

@@ -37,9 +37,10 @@ from powertrain.kernels.sparse_lu import (
     factor,
     factor_on_pattern,
     lu_solve,
+    lu_solve_rows,
     product,
     sparse_factors,
-    subtract_product,
+    subtract_products,
 )
 from powertrain.kernels.static_curve import curve_point
 
@@ -177,8 +178,7 @@ def _start_acceleration(model, laws, C, K, f, x, v):
     """The acceleration [m/s²] at ``(x, v)`` under the load ``f`` and the port laws, ``C``,
     ``K`` compressed (0 on massless nodes: ``M_inv`` holds zeros there)."""
     r = f.copy()
-    subtract_product(C, v, r)
-    subtract_product(K, x, r)
+    subtract_products(C, v, K, x, r)
     if laws is not None:
         _, kinds, par, state, (starts, columns, values), _ = laws
         m = kinds.shape[0]
@@ -239,16 +239,13 @@ def _port_setup(laws, lu, h, x, v, Z):
         return None
     P, kinds, par, state, (starts, columns, values), last = laws
     n, m = x.shape[0], kinds.shape[0]
-    W, Q, col, y, z = np.empty((n, m)), np.zeros((m, m)), np.empty(n), np.empty(n), \
-        np.empty(m)
+    W, Q, z = np.empty((n, m)), np.zeros((m, m)), np.empty(m)
     hh = 0.25 * h * h
+    lu_solve_rows(lu[0], lu[1], lu[2], P, np.empty((n, m)), W)
     for e in range(m):              # loops: each NumPy expression costs a compile
-        lu_solve(lu[0], lu[1], lu[2], P[e], y, col)
-        for j in range(n):
-            W[j, e] = col[j]
         for i in range(m):
             for k in range(starts[i], starts[i + 1]):
-                Q[i, e] += hh * values[k] * col[columns[k]]
+                Q[i, e] += hh * values[k] * W[columns[k], e]
     for e in range(m):
         u, du = 0.0, 0.0
         for j in range(n):
@@ -307,8 +304,7 @@ def _sparse_steps(lu, laws, h, C, K, F, load, x, v, a, X, V, A, Z, tol, max_iter
             xt[j] = X[k - 1, j] + h * V[k - 1, j] + hh * A[k - 1, j]
             vt[j] = V[k - 1, j] + hv * A[k - 1, j]
             r[j] = F[k, j] - load[j]
-        subtract_product(C, vt, r)
-        subtract_product(K, xt, r)
+        subtract_products(C, vt, K, xt, r)
         lu_solve(lu[0], lu[1], lu[2], r, y, A[k])
         if laws is not None and not _port_step(laws, ports, h, xt, vt, A[k], Z[k], tol,
                                                max_iter):

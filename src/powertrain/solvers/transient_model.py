@@ -31,10 +31,11 @@ def kernel_model(M, C, K, C_parts, K_parts, assembled, pivoting=False):
     perm = _elimination_order(M, C, K, C_parts, K_parts)
     where = np.empty_like(perm)
     where[perm] = np.arange(perm.size)
-    mask = (M != 0) | _mask(C, C_parts) | _mask(K, K_parts)
+    joint = _mask(C, C_parts) | _mask(K, K_parts)
+    mask = (M != 0) | joint
     return (M, compressed(M, True, True), compressed(M_inv, True, True),
-            _with_parts(C, C_parts), _with_parts(K, K_parts), assembled, perm, where,
-            lu_pattern(mask[np.ix_(perm, perm)]), np.empty(0) if pivoting else None)
+            _with_parts(C, C_parts, joint), _with_parts(K, K_parts, joint), assembled, perm,
+            where, lu_pattern(mask[np.ix_(perm, perm)]), np.empty(0) if pivoting else None)
 
 
 def _elimination_order(*matrices):
@@ -51,12 +52,13 @@ def _mask(A, parts):
     return (A != 0) | (parts != 0).any(0)
 
 
-def _with_parts(A, parts):
+def _with_parts(A, parts, mask):
     """``(starts, columns, values, (network, position, value))``: ``A`` compressed on the
-    pattern of it and its networks' ``parts`` (:func:`_mask`), and each part's nonzero
-    entry with its position among the values
+    pattern ``mask`` (that of C, K and their networks' ``parts``, :func:`_mask`: one pattern
+    for both, :func:`~powertrain.kernels.sparse_lu.subtract_products`), and each part's
+    nonzero entry with its position among the values
     (:func:`~powertrain.kernels.transient._scaled`)."""
-    starts, columns = csr_pattern(_mask(A, parts))
+    starts, columns = csr_pattern(mask)
     rows = np.repeat(np.arange(A.shape[0]), np.diff(starts))
     position = np.full(A.shape, -1, np.int64)
     position[rows, columns] = np.arange(columns.size)
