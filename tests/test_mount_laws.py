@@ -26,12 +26,14 @@ import numpy as np
 import pytest
 from click.testing import CliRunner
 from conftest import DEFAULT_ENGINE, ENGINES, MOUNTS
+from hypothesis import given, settings
+from hypothesis import strategies as st
 from scipy.interpolate import PchipInterpolator
 
 from powertrain.iotools.engine_file import read_engine
 from powertrain.iotools.mount_file import read_mount
 from powertrain.kernels.port_forces import port_force_loop
-from powertrain.physics.mount_laws import BergFriction, StaticCurve
+from powertrain.physics.mount_laws import BergFriction, StaticCurve, pchip_cubic
 from powertrain.workflows.runup import run_runup
 
 RPM = [1500.0, 3000.0, 5000.0]
@@ -156,3 +158,22 @@ def test_fixed_point_that_does_not_converge_is_one_line_at_the_cli(tmp_path, mon
     assert ".toml, key '" in lines[0]           # the mount file and section (or the engine)
     assert any(f"{m}.{d} at 3000 rpm" in lines[0] for m in ("left", "right", "gearbox")
                for d in "xyz")
+
+
+@settings(max_examples=80, deadline=None)
+@given(st.integers(2, 12), st.sampled_from(["rising", "any", "ties", "stiffening"]),
+       st.integers(0, 2**32 - 1))
+def test_the_static_curves_pchip_is_scipys_bit_for_bit(n, shape, seed):
+    """pchip_cubic (the static support's and CurveReader's cubic) against
+    scipy.interpolate.PchipInterpolator: the same breaks and coefficients, bit for bit, on
+    rising curves, any curve, curves with flat segments and a stiffening sinh shape."""
+    rng = np.random.default_rng(seed)
+    x = np.cumsum(rng.uniform(1e-4, 1e-2, n)) - 0.02
+    y = {"rising": np.cumsum(rng.uniform(-100.0, 1000.0, n)),
+         "any": rng.standard_normal(n) * 1e3,
+         "ties": np.round(rng.standard_normal(n)) * 500.0,
+         "stiffening": np.sinh(x * 300.0) * 2e3}[shape]
+    want = PchipInterpolator(x, y, extrapolate=False)
+    breaks, coefficients = pchip_cubic(x, y)
+    assert np.array_equal(breaks, want.x)
+    assert np.array_equal(coefficients, want.c.T)

@@ -361,17 +361,6 @@ class NetworkScaling:
                 s.force_matrix_k + (fmap * dk) @ self.gk,
                 s.force_matrix_d + (fmap * dd) @ self.gd)
 
-    def transmitted_force(self, X, V, scales) -> np.ndarray:
-        """Transmitted force (n_t, n_ch) [N] of the states ``X``, ``V`` (n_t, n) with the
-        networks at each step's ``scales`` (n_t, n_net, 2): the force rows of
-        :meth:`matrices` at every step's scales, at once."""
-        s = self.system
-        force = X @ s.force_matrix_k.T + V @ s.force_matrix_d.T
-        dk, dd = np.moveaxis(np.asarray(scales, float) - self.assembled, -1, 0)
-        if dk.any() or dd.any():
-            force += ((X @ self.gk.T) * dk + (V @ self.gd.T) * dd) @ s.port_force_map.T
-        return force
-
     def at_operating_point(self, factors):
         """The assembled model with its elements at the static ``factors`` (n_net,): the
         same model, its elements, C, K and force rows replaced (for the harmonic start)."""

@@ -226,7 +226,7 @@ def lu_solve_rows(factors, rows, perm, B, Y, out):
 
 
 @njit(cache=True, nogil=True)
-def _row_product(A, i, x):
+def row_product(A, i, x):
     """Row ``i`` of ``A`` (compressed, :func:`compressed`) times ``x``."""
     starts, columns, values = A
     s = 0.0
@@ -239,14 +239,14 @@ def _row_product(A, i, x):
 def product(A, x, out):
     """``out = A x`` for ``A`` compressed (:func:`compressed`)."""
     for i in range(A[0].shape[0] - 1):
-        out[i] = _row_product(A, i, x)
+        out[i] = row_product(A, i, x)
 
 
 @njit(cache=True, nogil=True)
 def subtract_product(A, x, out):
     """``out -= A x`` for ``A`` compressed (:func:`compressed`)."""
     for i in range(A[0].shape[0] - 1):
-        out[i] -= _row_product(A, i, x)
+        out[i] -= row_product(A, i, x)
 
 
 @njit(cache=True, nogil=True)

@@ -39,6 +39,7 @@ from powertrain.kernels.sparse_lu import (
     lu_solve,
     lu_solve_rows,
     product,
+    row_product,
     sparse_factors,
     subtract_products,
 )
@@ -125,6 +126,18 @@ def stretch_motion(rows, network, X, lo, hi, amplitudes, centres):
 
 
 @njit(cache=True, nogil=True)
+def network_force_change(on_x, on_v, scales, assembled, loads):
+    """Each network's force less the one its assembled scales give, in place of ``on_x``
+    (n_t, n_net): ``on_x`` and ``on_v`` its unit-scale force of the displacements and of
+    the velocities, times the step's ``scales`` (n_t, n_net, 2) less ``assembled``
+    (n_net, 2), plus the curve ``loads`` (n_t, n_net) [N]."""
+    for t in range(on_x.shape[0]):
+        for e in range(on_x.shape[1]):
+            on_x[t, e] = (on_x[t, e] * (scales[t, e, 0] - assembled[e, 0])
+                          + on_v[t, e] * (scales[t, e, 1] - assembled[e, 1]) + loads[t, e])
+
+
+@njit(cache=True, nogil=True)
 def curve_state(x, curves, law, centres, factors, c):
     r"""Static factor ``factors`` and curve load ``c`` (n_net,) [N] of every network at the
     state ``x`` (n,), its amplitude-law scales ``law`` (n_net, 2) and ``centres``
@@ -174,6 +187,18 @@ def _dense(A, n):
 
 
 @njit(cache=True, nogil=True)
+def _less(F, k, load, out):
+    """Row ``k`` of the load ``F`` (on the first ``F.shape[1]`` coordinates, none on the
+    others) less ``load`` (n,), into ``out`` (n,), returned."""
+    nf = F.shape[1]
+    for j in range(nf):
+        out[j] = F[k, j] - load[j]
+    for j in range(nf, load.shape[0]):
+        out[j] = 0.0 - load[j]
+    return out
+
+
+@njit(cache=True, nogil=True)
 def _start_acceleration(model, laws, C, K, f, x, v):
     """The acceleration [m/s²] at ``(x, v)`` under the load ``f`` and the port laws, ``C``,
     ``K`` compressed (0 on massless nodes: ``M_inv`` holds zeros there)."""
@@ -200,9 +225,10 @@ def _start_acceleration(model, laws, C, K, f, x, v):
 @njit(cache=True, nogil=True)
 def _piece(model, laws, h, C, K, F, load, x, v, a, X, V, A, Z, tol, max_iter, work,
            pivoting):
-    """Newmark over the load rows ``F`` (k + 1, n) less ``load`` (n,) from ``(x, v)`` with
-    ``C``, ``K`` (compressed) into the rows ``X``, ``V``, ``A``, ``Z``; ``a`` the
-    acceleration at the start, or solved from the laws where it has no entry. S factored
+    """Newmark over the load rows ``F`` (k + 1, n_f ≤ n: :func:`_less`) less ``load`` (n,)
+    from ``(x, v)`` with ``C``, ``K`` (compressed) into the rows ``X``, ``V``, ``A``,
+    ``Z``; ``a`` the acceleration at the start, or solved from the laws where it has no
+    entry. S factored
     in the model's order on its factors' pattern into ``work = (B (n, n), factors)``, or,
     where a pivot needs a row swap, with swaps if ``pivoting`` is not None
     (:mod:`powertrain.kernels.sparse_lu`; None: that code is left out of the compiled
@@ -210,7 +236,7 @@ def _piece(model, laws, h, C, K, F, load, x, v, a, X, V, A, Z, tol, max_iter, wo
     did not converge."""
     M, Ms, perm, where, pattern = model[0], model[1], model[6], model[7], model[8]
     if a.shape[0] == 0:
-        a = _start_acceleration(model, laws, C, K, F[0] - load, x, v)
+        a = _start_acceleration(model, laws, C, K, _less(F, 0, load, np.empty(x.shape[0])), x, v)
     B, factors = work
     if factor_on_pattern(((Ms, 1.0), (C, 0.5 * h), (K, 0.25 * h * h)), where, pattern, B,
                          factors):
@@ -303,7 +329,7 @@ def _sparse_steps(lu, laws, h, C, K, F, load, x, v, a, X, V, A, Z, tol, max_iter
         for j in range(n):
             xt[j] = X[k - 1, j] + h * V[k - 1, j] + hh * A[k - 1, j]
             vt[j] = V[k - 1, j] + hv * A[k - 1, j]
-            r[j] = F[k, j] - load[j]
+        _less(F, k, load, r)
         subtract_products(C, vt, K, xt, r)
         lu_solve(lu[0], lu[1], lu[2], r, y, A[k])
         if laws is not None and not _port_step(laws, ports, h, xt, vt, A[k], Z[k], tol,
@@ -317,7 +343,7 @@ def _sparse_steps(lu, laws, h, C, K, F, load, x, v, a, X, V, A, Z, tol, max_iter
 
 @njit(cache=True, nogil=True)
 def transient_stretch_kernel(model, curves, laws, h, F, law, centres, lo, hi, sub, a0, X, V,
-                             A, Z, scales, loads, tol, max_iter):
+                             acceleration, Z, scales, loads, tol, max_iter):
     """Integrate steps ``lo`` to ``hi`` (module docstring), pieces of ``sub`` steps.
 
     Parameters
@@ -339,8 +365,9 @@ def transient_stretch_kernel(model, curves, laws, h, F, law, centres, lo, hi, su
         in place; None without port laws.
     h : float
         Time step [s].
-    F : ndarray (n_t, n)
-        Load at every step [N].
+    F : ndarray (n_t, n_f)
+        Load at every step on the first n_f ≤ n coordinates (the body's), none on the
+        others [N].
     law : ndarray (n_net, 2)
         The amplitude law's stiffness and damping scales over the stretch.
     centres : ndarray (n_net,)
@@ -348,8 +375,12 @@ def transient_stretch_kernel(model, curves, laws, h, F, law, centres, lo, hi, su
     lo, hi, sub : int
     a0 : ndarray (n,) or (0,)
         Acceleration at ``lo`` [m/s²], or empty: solved from the laws.
-    X, V, A, Z, scales, loads : ndarray
+    X, V, Z, scales, loads : ndarray
         Outputs over every step, row ``lo`` the start (X, V read from it).
+    acceleration : tuple
+        ``(A, rows compressed, out)``: a piece's accelerations (sub + 1, n) (work space)
+        and the rows (:func:`~powertrain.kernels.sparse_lu.compressed`) whose product with
+        them fills ``out`` (n_t, n_rows) at every step.
     tol, max_iter : float, int
         Newton's tolerance and iteration limit
         (:func:`~powertrain.kernels.port_forces.newmark_port_kernel`).
@@ -367,6 +398,7 @@ def transient_stretch_kernel(model, curves, laws, h, F, law, centres, lo, hi, su
     factors, c, middle = np.empty(n_net), np.empty(n_net), np.empty(X.shape[1])
     change = np.empty((n_net, 2))
     rows = curves[0]
+    A, out_rows, out = acceleration
     failed = 0
     a = a0
     for p in range(lo, hi, sub):
@@ -385,10 +417,13 @@ def transient_stretch_kernel(model, curves, laws, h, F, law, centres, lo, hi, su
             for j in range(n):
                 load[j] += rows[r, j] * c[r]
         got = _piece(model, laws, h, _scaled(C0, change[:, 1]), _scaled(K0, change[:, 0]),
-                     F[p:q + 1], load, x, v, a, X[p:q + 1], V[p:q + 1], A[p:q + 1],
+                     F[p:q + 1], load, x, v, a, X[p:q + 1], V[p:q + 1], A[:q - p + 1],
                      Z[p:q + 1], tol, max_iter, work, model[9])
         if got == NEEDS_PIVOTING:
             return got
+        for k in range(q - p + 1):
+            for i in range(out.shape[1]):
+                out[p + k, i] = row_product(out_rows, i, A[k])
         failed += got
         # the next piece's laws differ: its acceleration is solved from them, or the
         # trapezoidal rule would carry the jump on as an undamped alternating error
@@ -398,7 +433,7 @@ def transient_stretch_kernel(model, curves, laws, h, F, law, centres, lo, hi, su
 
 @njit(cache=True, nogil=True)
 def transient_kernel(model, curves, laws, motion, h, F, steps, a0, amplitudes, centres, X, V,
-                     A, Z, scales, loads, tol, max_iter):
+                     acceleration, Z, scales, loads, tol, max_iter):
     """Integrate the whole manoeuvre, stretch by stretch (:func:`transient_stretch_kernel`;
     ``steps = (every, sub)``, steps per stretch and per piece): each stretch's amplitude-law
     scales from the amplitudes of the one before (:func:`amplitude_scales`), its centres
@@ -418,7 +453,7 @@ def transient_kernel(model, curves, laws, motion, h, F, steps, a0, amplitudes, c
         hi = min(lo + every, n_t - 1)
         amplitude_scales(amplitude_laws, amplitudes, law)
         got = transient_stretch_kernel(model, curves, laws, h, F, law, centres, lo, hi, sub, a,
-                                       X, V, A, Z, scales, loads, tol, max_iter)
+                                       X, V, acceleration, Z, scales, loads, tol, max_iter)
         if got == NEEDS_PIVOTING:
             return got
         failed += got

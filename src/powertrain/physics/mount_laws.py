@@ -15,7 +15,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.interpolate import PchipInterpolator
+from scipy.interpolate import PPoly
 
 from powertrain.kernels.port_forces import BERG
 from powertrain.kernels.transient import POWER_LAW, TABLE_LAW
@@ -162,11 +162,51 @@ class StaticCurve:
         return CurveReader(self).factor(x)
 
 
-def curve_pchip(curve) -> PchipInterpolator:
-    """The monotone piecewise cubic (PCHIP, no extrapolation) through a
-    :class:`StaticCurve`'s points: force [N] of deflection [m]."""
-    return PchipInterpolator(np.asarray(curve.deflection, float),
-                             np.asarray(curve.force, float), extrapolate=False)
+def pchip_cubic(x, y):
+    """``(breaks, coefficients (n - 1, 4))`` of the monotone piecewise cubic Hermite
+    interpolant (PCHIP) through the points ``(x, y)`` (x increasing, n ≥ 2), each segment's
+    polynomial about its left end, highest power first (:class:`scipy.interpolate.PPoly`'s
+    layout). Slopes: at an interior point the weighted harmonic mean of the secants on each
+    side, weights ``2 h_k + h_k-1`` and ``h_k + 2 h_k-1``, zero where they differ in sign or
+    one is zero (Fritsch & Butland 1984, *A method for constructing local monotone
+    piecewise cubic interpolants*, SIAM J. Sci. Stat. Comput. 5); at an end the one-sided
+    three-point estimate, zero where its sign is not the end secant's and three times that
+    secant where the secants change sign and it is larger (Moler 2004, *Numerical Computing
+    with MATLAB*, §3.6); two points: the line. The interpolant of
+    :class:`scipy.interpolate.PchipInterpolator`, the same operations (tested bit for bit)."""
+    x, y = np.asarray(x, float), np.asarray(y, float)
+    h = x[1:] - x[:-1]
+    m = (y[1:] - y[:-1]) / h
+    d = np.empty_like(y)
+    if y.size == 2:
+        d[:] = m[0]
+    else:
+        w1, w2 = 2 * h[1:] + h[:-1], h[1:] + 2 * h[:-1]
+        flat = (np.sign(m[1:]) != np.sign(m[:-1])) | (m[1:] == 0) | (m[:-1] == 0)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            d[1:-1] = np.where(flat, 0.0, 1.0 / ((w1 / m[:-1] + w2 / m[1:]) / (w1 + w2)))
+        d[0] = _pchip_end(h[0], h[1], m[0], m[1])
+        d[-1] = _pchip_end(h[-1], h[-2], m[-1], m[-2])
+    t = (d[:-1] + d[1:] - 2 * m) / h
+    return x, np.column_stack([t / h, (m - d[:-1]) / h - t, d[:-1], y[:-1]])
+
+
+def _pchip_end(h0, h1, m0, m1):
+    """:func:`pchip_cubic`'s slope at an end: ``h0``, ``m0`` its segment, ``h1``, ``m1`` the
+    next."""
+    d = ((2 * h0 + h1) * m0 - h0 * m1) / (h0 + h1)
+    if np.sign(d) != np.sign(m0):
+        return 0.0
+    if np.sign(m0) != np.sign(m1) and abs(d) > 3.0 * abs(m0):
+        return 3.0 * m0
+    return d
+
+
+def curve_pchip(curve) -> PPoly:
+    """The PCHIP (:func:`pchip_cubic`, no extrapolation) through a :class:`StaticCurve`'s
+    points: force [N] of deflection [m]."""
+    x, c = pchip_cubic(curve.deflection, curve.force)
+    return PPoly(c.T, x, extrapolate=False)
 
 
 class CurveReader:

@@ -35,7 +35,7 @@ import numpy as np
 from powertrain.errors import InputError
 from powertrain.kernels import kernel_input
 from powertrain.kernels.static_curve import curve_values
-from powertrain.physics.mount_laws import curve_pchip
+from powertrain.physics.mount_laws import pchip_cubic
 from powertrain.physics.rigid_body import direction_row
 from powertrain.units import STANDARD_GRAVITY
 
@@ -65,7 +65,7 @@ class StaticSupport:
     cubics : tuple
         ``(breaks (n_net, n_b), coefficients (n_net, n_b - 1, 4), count (n_net,))``: each
         network's force as a piecewise cubic, its curve's PCHIP
-        (:func:`~powertrain.physics.mount_laws.curve_pchip`) or the straight line of its
+        (:func:`~powertrain.physics.mount_laws.pchip_cubic`) or the straight line of its
         static stiffness, read by :func:`~powertrain.kernels.static_curve.curve_values`
         (straight with the end slopes beyond the points, as
         :class:`~powertrain.physics.mount_laws.CurveReader`).
@@ -130,8 +130,7 @@ def _cubic(curve, stiffness):
     exact at any small deflection)."""
     if curve is None:
         return np.array([0.0, 1.0]), np.array([[0.0, 0.0, stiffness, 0.0]])
-    pchip = curve_pchip(curve)
-    return np.asarray(pchip.x, float), np.asarray(pchip.c.T, float)
+    return pchip_cubic(curve.deflection, curve.force)
 
 
 @dataclass(frozen=True)

@@ -62,6 +62,7 @@ from powertrain.kernels.sparse_lu import compressed
 from powertrain.kernels.transient import (
     NEEDS_PIVOTING,
     curve_state,
+    network_force_change,
     transient_kernel,
 )
 from powertrain.solvers.cycle_newmark import no_ports, start_state
@@ -195,21 +196,19 @@ def simulate_transient(engine, manoeuvre, *, system=None, angle_step_deg=1.0) ->
     _check_size(n_steps, system, manoeuvre)
     t = np.linspace(0.0, manoeuvre.duration, n_steps + 1)
     load = transient_load(engine, manoeuvre, t)
-    F = np.zeros((t.size, system.n_dof))
-    F[:, :6] = load.F
+    F = np.ascontiguousarray(load.F, float)        # on the body; none on the other coordinates
     ports = system.port_forces() or no_ports(system)
     scaling = NetworkScaling(system)
     curves = _Curves(engine, system) if has_static_curves(engine) else None
     _warn_curve_and_law(engine)
     start = _start(engine, manoeuvre, system, load, ports, (scaling, curves))
     every, sub = _stretch_steps(t[1] - t[0], n_steps, scaling.varying, curves is not None)
-    X, V, A, force, extra = _run(system, scaling, ports, curves, F, t[1] - t[0], start,
-                                 (every, sub))
-    Cm = system.channel_matrix
-    return TransientRun(load, X[:, :6].copy(), X @ Cm.T, V @ Cm.T, A @ Cm.T, force,
-                        X @ system.port_rows.T, list(system.channels),
-                        system.network_names, _method(scaling, ports, curves, every, sub), X, V,
-                        *extra, every, sub)
+    X, V, A, extra, force_map = _run(system, scaling, ports, curves, F, t[1] - t[0], start,
+                                     (every, sub))
+    return TransientRun(load, X[:, :6].copy(), *_channel_outputs(system, scaling, (X, V, A),
+                                                                 extra, force_map),
+                        list(system.channels), system.network_names,
+                        _method(scaling, ports, curves, every, sub), X, V, *extra, every, sub)
 
 
 def _check_size(n_steps, system, manoeuvre):
@@ -255,17 +254,22 @@ def _method(scaling, ports, curves, every, sub):
 
 
 def _run(system, scaling, ports, curves, F, h, start, steps):
-    """States X, V, A (n_t, n), channel forces (n_t, n_ch) and ``(port-law forces,
-    network scales, curve loads)`` at every step: ``steps = (every, sub)``, the amplitude
-    law and the centres updated every ``every`` steps (a stretch), the curves' tangents and
-    load every ``sub``, in one kernel call (:func:`~powertrain.kernels.transient.transient_kernel`)."""
+    """States X, V (n_t, n), the channels' acceleration (n_t, n_ch), ``(port-law forces
+    or None, network scales, curve loads)`` at every step and the port laws' force rows
+    (:func:`_channel_outputs`) under the load ``F`` (n_t, 6) on the body: ``steps =
+    (every, sub)``, the amplitude law and the centres updated every ``every`` steps (a
+    stretch), the curves' tangents and load every ``sub``, in one kernel call
+    (:func:`~powertrain.kernels.transient.transient_kernel`)."""
     every, sub = steps
     x, v, a, state, amplitudes = start
     laws = ports.select(ports.kinds != NONE)
-    n_t, n = F.shape
+    n_t, n = F.shape[0], system.n_dof
     n_net = system.port_rows.shape[0]
-    X, V, A = (np.empty((n_t, n)) for _ in range(3))
+    X, V = np.empty((n_t, n)), np.empty((n_t, n))
     X[0], V[0] = x, v
+    acceleration = (np.empty((min(sub, n_t - 1) + 1, n)),    # a piece's; channels' at every step
+                    compressed(np.array(system.channel_matrix, float), True, True),
+                    np.empty((n_t, system.channel_matrix.shape[0])))
     Z, scales, loads = np.zeros((n_t, laws.kinds.size)), np.empty((n_t, n_net, 2)), \
         np.zeros((n_t, n_net))
     kernel_curves = _kernel_curves(system, scaling, curves)
@@ -279,27 +283,36 @@ def _run(system, scaling, ports, curves, F, h, start, steps):
                 compressed(np.array(laws.rows, float), True, True),
                 np.zeros((7, laws.kinds.size))),
             motion, h, F, (every, sub), np.empty(0) if a is None else np.array(a, float),
-            ports.network_amplitudes(amplitudes), system.port_rows @ x, X, V, A, Z, scales,
-            loads, PORT_TOL, PORT_MAX_ITER)
+            ports.network_amplitudes(amplitudes), system.port_rows @ x, X, V, acceleration, Z,
+            scales, loads, PORT_TOL, PORT_MAX_ITER)
         if failed != NEEDS_PIVOTING:
             break
     if failed:
         raise FloatingPointError(f"port laws {', '.join(laws.names)}: Newton did not converge "
                                  f"at {failed} of {n_t - 1} steps")
-    force = _channel_forces(system, scaling, (X, V, Z, scales, loads), laws.force_map)
-    return X, V, A, force, (Z if laws.kinds.size else None, scales, loads)
+    return X, V, acceleration[2], (Z if laws.kinds.size else None, scales, loads), \
+        laws.force_map
 
 
-def _channel_forces(system, scaling, run, laws_map):
-    """Transmitted force (n_t, n_ch) [N] of the states, port-law forces, network scales and
-    curve loads ``run`` at every step."""
-    X, V, Z, scales, loads = run
-    force = scaling.transmitted_force(X, V, scales)
-    if Z.shape[1]:
-        force += Z @ laws_map.T
-    if loads.any():
-        force += loads @ system.port_force_map.T
-    return force
+def _channel_outputs(system, scaling, states, extra, laws_map):
+    """Channel displacement, velocity, acceleration, transmitted force (n_t, n_ch) and
+    network deflection (n_t, n_net) of the ``states`` (X, V and the channels' acceleration)
+    with the port-law forces, network scales and curve loads ``extra`` at every step: the
+    force rows of
+    :meth:`~powertrain.assembly.NetworkScaling.matrices` at every step's scales (products
+    into one work array: each time history is a megabyte or more)."""
+    X, V, A = states
+    Z, scales, loads = extra
+    Cm, fmap = system.channel_matrix, system.port_force_map
+    force = X @ system.force_matrix_k.T
+    work = V @ system.force_matrix_d.T
+    force += work
+    net = X @ scaling.gk.T
+    network_force_change(net, V @ scaling.gd.T, scales, scaling.assembled, loads)
+    force += np.matmul(net, fmap.T, out=work)
+    if Z is not None:
+        force += np.matmul(Z, laws_map.T, out=work)
+    return X @ Cm.T, V @ Cm.T, A, force, X @ system.port_rows.T
 
 
 def _kernel_curves(system, scaling, curves):
