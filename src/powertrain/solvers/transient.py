@@ -52,6 +52,7 @@ import dataclasses
 import math
 import warnings
 from dataclasses import dataclass
+from typing import NamedTuple
 
 import numpy as np
 
@@ -203,12 +204,38 @@ def simulate_transient(engine, manoeuvre, *, system=None, angle_step_deg=1.0) ->
     _warn_curve_and_law(engine)
     start = _start(engine, manoeuvre, system, load, ports, (scaling, curves))
     every, sub = _stretch_steps(t[1] - t[0], n_steps, scaling.varying, curves is not None)
-    X, V, A, extra, force_map = _run(system, scaling, ports, curves, F, t[1] - t[0], start,
-                                     (every, sub))
-    return TransientRun(load, X[:, :6].copy(), *_channel_outputs(system, scaling, (X, V, A),
-                                                                 extra, force_map),
-                        list(system.channels), system.network_names,
-                        _method(scaling, ports, curves, every, sub), X, V, *extra, every, sub)
+    histories = _Histories(*time_histories(t.size, *_history_shapes(system, ports)))
+    _run(system, scaling, ports, curves, F, t[1] - t[0], start, (every, sub), histories)
+    _channel_outputs(system, scaling, histories, ports.select(ports.kinds != NONE).force_map)
+    h = histories
+    return TransientRun(load, h.body, h.displacement, h.velocity, h.acceleration, h.force,
+                        h.deflection, list(system.channels), system.network_names,
+                        _method(scaling, ports, curves, every, sub), h.X, h.V,
+                        h.Z if h.Z.shape[1] else None, h.scales, h.loads, every, sub)
+
+
+class _Histories(NamedTuple):
+    """A run's time histories (:func:`_history_shapes`), filled by :func:`_run` (the
+    kernel's) and :func:`_channel_outputs`."""
+
+    X: np.ndarray
+    V: np.ndarray
+    Z: np.ndarray
+    scales: np.ndarray
+    loads: np.ndarray
+    acceleration: np.ndarray
+    body: np.ndarray
+    displacement: np.ndarray
+    velocity: np.ndarray
+    force: np.ndarray
+    deflection: np.ndarray
+
+
+def _history_shapes(system, ports):
+    """Each time history's shape but the steps, in :class:`_Histories`' order."""
+    n, n_ch, n_net = system.n_dof, len(system.channels), system.port_rows.shape[0]
+    return ((n,), (n,), (int(np.count_nonzero(ports.kinds != NONE)),), (n_net, 2), (n_net,),
+            (n_ch,), (6,), (n_ch,), (n_ch,), (n_ch,), (n_net,))
 
 
 def _check_size(n_steps, system, manoeuvre):
@@ -253,25 +280,21 @@ def _method(scaling, ports, curves, every, sub):
     return "; ".join(parts)
 
 
-def _run(system, scaling, ports, curves, F, h, start, steps):
-    """States X, V (n_t, n), the channels' acceleration (n_t, n_ch), ``(port-law forces
-    or None, network scales, curve loads)`` at every step and the port laws' force rows
-    (:func:`_channel_outputs`) under the load ``F`` (n_t, 6) on the body: ``steps =
-    (every, sub)``, the amplitude law and the centres updated every ``every`` steps (a
-    stretch), the curves' tangents and load every ``sub``, in one kernel call
-    (:func:`~powertrain.kernels.transient.transient_kernel`)."""
+def _run(system, scaling, ports, curves, F, h, start, steps, histories):
+    """Fill the ``histories``' states X, V (n_t, n), the channels' acceleration (n_t, n_ch),
+    the port-law forces, network scales and curve loads at every step under the load ``F``
+    (n_t, 6) on the body: ``steps = (every, sub)``, the amplitude law and the centres
+    updated every ``every`` steps (a stretch), the curves' tangents and load every ``sub``,
+    in one kernel call (:func:`~powertrain.kernels.transient.transient_kernel`)."""
     every, sub = steps
     x, v, a, state, amplitudes = start
     laws = ports.select(ports.kinds != NONE)
     n_t, n = F.shape[0], system.n_dof
-    n_net = system.port_rows.shape[0]
-    X, V = np.empty((n_t, n)), np.empty((n_t, n))
+    X, V, Z, scales, loads = histories[:5]
     X[0], V[0] = x, v
     acceleration = (np.empty((min(sub, n_t - 1) + 1, n)),    # a piece's; channels' at every step
                     compressed(np.array(system.channel_matrix, float), True, True),
-                    np.empty((n_t, system.channel_matrix.shape[0])))
-    Z, scales, loads = np.zeros((n_t, laws.kinds.size)), np.empty((n_t, n_net, 2)), \
-        np.zeros((n_t, n_net))
+                    histories.acceleration)
     kernel_curves = _kernel_curves(system, scaling, curves)
     motion = motion_model(system, scaling, ports)
     for pivoting in (False, True):    # row swaps compiled in only where S needs them
@@ -290,29 +313,40 @@ def _run(system, scaling, ports, curves, F, h, start, steps):
     if failed:
         raise FloatingPointError(f"port laws {', '.join(laws.names)}: Newton did not converge "
                                  f"at {failed} of {n_t - 1} steps")
-    return X, V, acceleration[2], (Z if laws.kinds.size else None, scales, loads), \
-        laws.force_map
 
 
-def _channel_outputs(system, scaling, states, extra, laws_map):
-    """Channel displacement, velocity, acceleration, transmitted force (n_t, n_ch) and
-    network deflection (n_t, n_net) of the ``states`` (X, V and the channels' acceleration)
-    with the port-law forces, network scales and curve loads ``extra`` at every step: the
-    force rows of
-    :meth:`~powertrain.assembly.NetworkScaling.matrices` at every step's scales (products
-    into one work array: each time history is a megabyte or more)."""
-    X, V, A = states
-    Z, scales, loads = extra
-    Cm, fmap = system.channel_matrix, system.port_force_map
-    force = X @ system.force_matrix_k.T
-    work = V @ system.force_matrix_d.T
-    force += work
-    net = X @ scaling.gk.T
-    network_force_change(net, V @ scaling.gd.T, scales, scaling.assembled, loads)
-    force += np.matmul(net, fmap.T, out=work)
-    if Z is not None:
-        force += np.matmul(Z, laws_map.T, out=work)
-    return X @ Cm.T, V @ Cm.T, A, force, X @ system.port_rows.T
+def _channel_outputs(system, scaling, histories, laws_map):
+    """Fill the ``histories``' body motion (n_t, 6), channel displacement, velocity,
+    transmitted force (n_t, n_ch) and network deflection (n_t, n_net) from their states,
+    port-law forces, network scales and curve loads: the force rows of
+    :meth:`~powertrain.assembly.NetworkScaling.matrices` at every step's scales."""
+    h = histories
+    Cm = system.channel_matrix
+    n_t, n_ch, n_net = h.X.shape[0], Cm.shape[0], system.port_rows.shape[0]
+    work, net, net_v = time_histories(n_t, (n_ch,), (n_net,), (n_net,))
+    h.body[:] = h.X[:, :6]
+    np.matmul(h.X, Cm.T, out=h.displacement)
+    np.matmul(h.V, Cm.T, out=h.velocity)
+    np.matmul(h.X, system.port_rows.T, out=h.deflection)
+    force = np.matmul(h.X, system.force_matrix_k.T, out=h.force)
+    force += np.matmul(h.V, system.force_matrix_d.T, out=work)
+    network_force_change(np.matmul(h.X, scaling.gk.T, out=net),
+                         np.matmul(h.V, scaling.gd.T, out=net_v), h.scales, scaling.assembled,
+                         h.loads)
+    force += np.matmul(net, system.port_force_map.T, out=work)
+    if h.Z.shape[1]:
+        force += np.matmul(h.Z, laws_map.T, out=work)
+
+
+def time_histories(n_t, *shapes):
+    r"""Zeroed arrays (n_t, \*shape) for each of ``shapes``, each C-contiguous, all in one
+    buffer: a run's time histories are megabytes each, and the operating system maps one
+    buffer in far fewer page faults than several (in huge pages where it grants them:
+    NumPy asks for them from 4 MB)."""
+    sizes = [n_t * math.prod(shape) for shape in shapes]
+    buffer = np.zeros(sum(sizes))
+    edges = np.cumsum([0, *sizes])
+    return [buffer[a:b].reshape((n_t, *shape)) for a, b, shape in zip(edges, edges[1:], shapes)]
 
 
 def _kernel_curves(system, scaling, curves):
