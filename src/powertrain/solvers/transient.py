@@ -204,7 +204,7 @@ def simulate_transient(engine, manoeuvre, *, system=None, angle_step_deg=1.0) ->
     _warn_curve_and_law(engine)
     start = _start(engine, manoeuvre, system, load, ports, (scaling, curves))
     every, sub = _stretch_steps(t[1] - t[0], n_steps, scaling.varying, curves is not None)
-    histories = _Histories(*time_histories(t.size, *_history_shapes(system, ports)))
+    histories = _Histories(*_time_histories(t.size, *_history_shapes(system, ports)))
     _run(system, scaling, ports, curves, F, t[1] - t[0], start, (every, sub), histories)
     _channel_outputs(system, scaling, histories, ports.select(ports.kinds != NONE).force_map)
     h = histories
@@ -323,7 +323,7 @@ def _channel_outputs(system, scaling, histories, laws_map):
     h = histories
     Cm = system.channel_matrix
     n_t, n_ch, n_net = h.X.shape[0], Cm.shape[0], system.port_rows.shape[0]
-    work, net, net_v = time_histories(n_t, (n_ch,), (n_net,), (n_net,))
+    work, net, net_v = _time_histories(n_t, (n_ch,), (n_net,), (n_net,))
     h.body[:] = h.X[:, :6]
     np.matmul(h.X, Cm.T, out=h.displacement)
     np.matmul(h.V, Cm.T, out=h.velocity)
@@ -338,7 +338,7 @@ def _channel_outputs(system, scaling, histories, laws_map):
         force += np.matmul(h.Z, laws_map.T, out=work)
 
 
-def time_histories(n_t, *shapes):
+def _time_histories(n_t, *shapes):
     r"""Zeroed arrays (n_t, \*shape) for each of ``shapes``, each C-contiguous, all in one
     buffer: a run's time histories are megabytes each, and the operating system maps one
     buffer in far fewer page faults than several (in huge pages where it grants them:
