@@ -114,7 +114,8 @@ class TransientRun:
     load : TransientLoad
         Times, crank motion, torques and the load.
     body : ndarray (n_t, 6)
-        Body displacement [m] and rotation [rad] at the CG from the zero-torque static point.
+        Body displacement [m] and rotation [rad] at the CG from the zero-torque static point
+        (the first six of ``coordinates``).
     displacement, velocity, acceleration, force : ndarray (n_t, n_ch)
         Channel motion [m, m/s, m/s²] (engine side, then body side and body points) and
         transmitted force [N].
@@ -208,7 +209,7 @@ def simulate_transient(engine, manoeuvre, *, system=None, angle_step_deg=1.0) ->
     _run(system, scaling, ports, curves, F, t[1] - t[0], start, (every, sub), histories)
     _channel_outputs(system, scaling, histories, ports.select(ports.kinds != NONE).force_map)
     h = histories
-    return TransientRun(load, h.body, h.displacement, h.velocity, h.acceleration, h.force,
+    return TransientRun(load, h.X[:, :6], h.displacement, h.velocity, h.acceleration, h.force,
                         h.deflection, list(system.channels), system.network_names,
                         _method(scaling, ports, curves, every, sub), h.X, h.V,
                         h.Z if h.Z.shape[1] else None, h.scales, h.loads, every, sub)
@@ -224,7 +225,6 @@ class _Histories(NamedTuple):
     scales: np.ndarray
     loads: np.ndarray
     acceleration: np.ndarray
-    body: np.ndarray
     displacement: np.ndarray
     velocity: np.ndarray
     force: np.ndarray
@@ -235,7 +235,7 @@ def _history_shapes(system, ports):
     """Each time history's shape but the steps, in :class:`_Histories`' order."""
     n, n_ch, n_net = system.n_dof, len(system.channels), system.port_rows.shape[0]
     return ((n,), (n,), (int(np.count_nonzero(ports.kinds != NONE)),), (n_net, 2), (n_net,),
-            (n_ch,), (6,), (n_ch,), (n_ch,), (n_ch,), (n_net,))
+            (n_ch,), (n_ch,), (n_ch,), (n_ch,), (n_net,))
 
 
 def _check_size(n_steps, system, manoeuvre):
@@ -316,15 +316,14 @@ def _run(system, scaling, ports, curves, F, h, start, steps, histories):
 
 
 def _channel_outputs(system, scaling, histories, laws_map):
-    """Fill the ``histories``' body motion (n_t, 6), channel displacement, velocity,
-    transmitted force (n_t, n_ch) and network deflection (n_t, n_net) from their states,
-    port-law forces, network scales and curve loads: the force rows of
+    """Fill the ``histories``' channel displacement, velocity, transmitted force
+    (n_t, n_ch) and network deflection (n_t, n_net) from their states, port-law forces,
+    network scales and curve loads: the force rows of
     :meth:`~powertrain.assembly.NetworkScaling.matrices` at every step's scales."""
     h = histories
     Cm = system.channel_matrix
     n_t, n_ch, n_net = h.X.shape[0], Cm.shape[0], system.port_rows.shape[0]
     work, net, net_v = _time_histories(n_t, (n_ch,), (n_net,), (n_net,))
-    h.body[:] = h.X[:, :6]
     np.matmul(h.X, Cm.T, out=h.displacement)
     np.matmul(h.V, Cm.T, out=h.velocity)
     np.matmul(h.X, system.port_rows.T, out=h.deflection)

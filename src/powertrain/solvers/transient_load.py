@@ -97,8 +97,8 @@ def transient_load(engine, manoeuvre, t) -> TransientLoad:
     scale = table.scale_of_level(spin, level)
     J = manoeuvre.crank_inertia
     F = table.load(theta, omega, alpha, level)
-    F[:, 3:] -= (J * alpha)[:, None] * n[None, :]
-    F += driveline_reaction(engine, manoeuvre, driveline)
+    F[:, 3] -= J * alpha * n[0]                     # n: the crank axis, the engine's x
+    F[:, 3] += driveline_moment(engine, manoeuvre, driveline)
     starter = np.zeros_like(t)
     if manoeuvre.starter is not None:
         on = t < manoeuvre.starter.until
@@ -126,11 +126,18 @@ class TorqueLimitWarning(PowertrainWarning):
 
 def driveline_reaction(engine, manoeuvre, driveline):
     r"""The driveline torque's reaction on the block (..., 6) [N, N·m] about the CG:
-    :math:`-i\,T_d\,\mathbf n` for the driveline torque ``driveline`` (...) [N·m]."""
-    n = np.array([float(engine.crank.rotation_sign), 0.0, 0.0])
+    :math:`-i\,T_d\,\mathbf n` for the driveline torque ``driveline`` (...) [N·m], the
+    crank axis :math:`\mathbf n` the engine's x (:func:`driveline_moment`)."""
     out = np.zeros(np.shape(driveline) + (6,))
-    out[..., 3:] = -manoeuvre.gear_ratio * np.asarray(driveline, float)[..., None] * n
+    out[..., 3] = driveline_moment(engine, manoeuvre, driveline)
     return out
+
+
+def driveline_moment(engine, manoeuvre, driveline):
+    """The reaction's moment about the engine's x axis (...) [N·m] of
+    :func:`driveline_reaction`."""
+    return -manoeuvre.gear_ratio * np.asarray(driveline, float) * float(
+        engine.crank.rotation_sign)
 
 
 class _GasTable:
@@ -199,9 +206,10 @@ class _GasTable:
 
     def _no_mean_roll(self, load):
         """``load`` (..., n_theta + 1, 6) with the cycle mean of its roll moment (over all
-        but the last angle, the wrap's) removed, in place."""
-        roll = np.mean(load[..., :-1, 3:] @ self.n, axis=-1)
-        load[..., 3:] -= roll[..., None, None] * self.n
+        but the last angle, the wrap's) removed, in place: the moment about the crank axis,
+        the engine's x (``self.n``)."""
+        s = self.n[0]
+        load[..., 3] -= np.mean(load[..., :-1, 3] * s, axis=-1)[..., None] * s
         return load
 
     def _speed_index(self, spin):
