@@ -342,6 +342,27 @@ def _sparse_steps(lu, laws, h, C, K, F, load, x, v, a, X, V, A, Z, tol, max_iter
 
 
 @njit(cache=True, nogil=True)
+def _piece_curves(middle, curves, law, centres, assembled, change, scales, loads, load):
+    """A piece's curves at its predicted ``middle`` (:func:`curve_state`): every network's
+    scales (law times static factor) and curve load on each of the piece's rows of
+    ``scales`` and ``loads``, their change from the ``assembled`` scales into ``change``
+    (n_net, 2) and the curve loads on the coordinates into ``load`` (n,)."""
+    rows = curves[0]
+    n_net = law.shape[0]
+    factors, c = np.empty(n_net), np.empty(n_net)
+    curve_state(middle, curves, law, centres, factors, c)
+    for r in range(n_net):
+        for s in range(2):
+            scales[:, r, s] = law[r, s] * factors[r]
+            change[r, s] = law[r, s] * factors[r] - assembled[r, s]
+        loads[:, r] = c[r]
+    load[:] = 0.0
+    for r in range(n_net):
+        for j in range(load.shape[0]):
+            load[j] += rows[r, j] * c[r]
+
+
+@njit(cache=True, nogil=True)
 def transient_stretch_kernel(model, curves, laws, h, F, law, centres, lo, hi, sub, a0, X, V,
                              acceleration, Z, scales, loads, tol, max_iter):
     """Integrate steps ``lo`` to ``hi`` (module docstring), pieces of ``sub`` steps.
@@ -395,9 +416,7 @@ def transient_stretch_kernel(model, curves, laws, h, F, law, centres, lo, hi, su
     (lp, li), _, (up, ui) = model[8]           # _piece's work space: S, its factors
     work = np.empty((n, n)), ((lp, li, np.empty(li.shape[0])), (up, ui, np.empty(ui.shape[0])),
                               np.empty(n))
-    factors, c, middle = np.empty(n_net), np.empty(n_net), np.empty(X.shape[1])
-    change = np.empty((n_net, 2))
-    rows = curves[0]
+    middle, load, change = np.empty(n), np.empty(n), np.empty((n_net, 2))
     A, out_rows, out = acceleration
     failed = 0
     a = a0
@@ -406,16 +425,8 @@ def transient_stretch_kernel(model, curves, laws, h, F, law, centres, lo, hi, su
         x, v = X[p].copy(), V[p].copy()
         for j in range(x.shape[0]):       # the piece's predicted middle
             middle[j] = x[j] + 0.5 * (q - p) * h * v[j]
-        curve_state(middle, curves, law, centres, factors, c)
-        for r in range(n_net):
-            for s in range(2):
-                scales[p:q + 1, r, s] = law[r, s] * factors[r]
-                change[r, s] = law[r, s] * factors[r] - assembled[r, s]
-            loads[p:q + 1, r] = c[r]
-        load = np.zeros(n)                 # the curve loads on the coordinates
-        for r in range(n_net):
-            for j in range(n):
-                load[j] += rows[r, j] * c[r]
+        _piece_curves(middle, curves, law, centres, assembled, change, scales[p:q + 1],
+                      loads[p:q + 1], load)
         got = _piece(model, laws, h, _scaled(C0, change[:, 1]), _scaled(K0, change[:, 0]),
                      F[p:q + 1], load, x, v, a, X[p:q + 1], V[p:q + 1], A[:q - p + 1],
                      Z[p:q + 1], tol, max_iter, work, model[9])
