@@ -342,14 +342,15 @@ def _sparse_steps(lu, laws, h, C, K, F, load, x, v, a, X, V, A, Z, tol, max_iter
 
 
 @njit(cache=True, nogil=True)
-def _piece_curves(middle, curves, law, centres, assembled, change, scales, loads, load):
+def _piece_curves(middle, curves, law, centres, assembled, work, scales, loads, load):
     """A piece's curves at its predicted ``middle`` (:func:`curve_state`): every network's
     scales (law times static factor) and curve load on each of the piece's rows of
     ``scales`` and ``loads``, their change from the ``assembled`` scales into ``change``
-    (n_net, 2) and the curve loads on the coordinates into ``load`` (n,)."""
+    (n_net, 2) and the curve loads on the coordinates into ``load`` (n,); ``work =
+    (factors, c, change)``, the first two (n_net,) work space."""
     rows = curves[0]
     n_net = law.shape[0]
-    factors, c = np.empty(n_net), np.empty(n_net)
+    factors, c, change = work
     curve_state(middle, curves, law, centres, factors, c)
     for r in range(n_net):
         for s in range(2):
@@ -417,6 +418,7 @@ def transient_stretch_kernel(model, curves, laws, h, F, law, centres, lo, hi, su
     work = np.empty((n, n)), ((lp, li, np.empty(li.shape[0])), (up, ui, np.empty(ui.shape[0])),
                               np.empty(n))
     middle, load, change = np.empty(n), np.empty(n), np.empty((n_net, 2))
+    curve_work = np.empty(n_net), np.empty(n_net), change
     A, out_rows, out = acceleration
     failed = 0
     a = a0
@@ -425,7 +427,7 @@ def transient_stretch_kernel(model, curves, laws, h, F, law, centres, lo, hi, su
         x, v = X[p].copy(), V[p].copy()
         for j in range(x.shape[0]):       # the piece's predicted middle
             middle[j] = x[j] + 0.5 * (q - p) * h * v[j]
-        _piece_curves(middle, curves, law, centres, assembled, change, scales[p:q + 1],
+        _piece_curves(middle, curves, law, centres, assembled, curve_work, scales[p:q + 1],
                       loads[p:q + 1], load)
         got = _piece(model, laws, h, _scaled(C0, change[:, 1]), _scaled(K0, change[:, 0]),
                      F[p:q + 1], load, x, v, a, X[p:q + 1], V[p:q + 1], A[:q - p + 1],

@@ -205,9 +205,10 @@ def simulate_transient(engine, manoeuvre, *, system=None, angle_step_deg=1.0) ->
     _warn_curve_and_law(engine)
     start = _start(engine, manoeuvre, system, load, ports, (scaling, curves))
     every, sub = _stretch_steps(t[1] - t[0], n_steps, scaling.varying, curves is not None)
-    histories = _Histories(*_time_histories(t.size, *_history_shapes(system, ports)))
+    laws = ports.select(ports.kinds != NONE)
+    histories = _Histories(*_time_histories(t.size, *_history_shapes(system, laws)))
     _run(system, scaling, ports, curves, F, t[1] - t[0], start, (every, sub), histories)
-    _channel_outputs(system, scaling, histories, ports.select(ports.kinds != NONE).force_map)
+    _channel_outputs(system, scaling, histories, laws.force_map)
     h = histories
     return TransientRun(load, h.X[:, :6], h.displacement, h.velocity, h.acceleration, h.force,
                         h.deflection, list(system.channels), system.network_names,
@@ -231,10 +232,10 @@ class _Histories(NamedTuple):
     deflection: np.ndarray
 
 
-def _history_shapes(system, ports):
+def _history_shapes(system, laws):
     """Each time history's shape but the steps, in :class:`_Histories`' order."""
     n, n_ch, n_net = system.n_dof, len(system.channels), system.port_rows.shape[0]
-    return ((n,), (n,), (int(np.count_nonzero(ports.kinds != NONE)),), (n_net, 2), (n_net,),
+    return ((n,), (n,), (laws.kinds.size,), (n_net, 2), (n_net,),
             (n_ch,), (n_ch,), (n_ch,), (n_ch,), (n_net,))
 
 
