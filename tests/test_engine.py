@@ -373,6 +373,30 @@ def test_load_table_equals_the_load_at_each_speed(engine):
     assert np.abs(table - direct).max() < 1e-12 * np.abs(direct).max()
 
 
+def test_pressure_tables_are_numpys_periodic_interpolation_of_each_cycle(engine):
+    """Oracle: ``numpy.interp`` with the period 4 pi on each cylinder's cycle grid, at
+    every load and speed, angles beyond one cycle on both sides (the same sums: exact to
+    round-off)."""
+    speeds, loads = np.array([1000.0, 3456.0]), [0.3, 1.0]
+    theta = np.linspace(-3.0, 15.0, 301)
+    table = engine.pressure_tables(speeds, theta, loads)
+    local = engine.local_angles(theta)
+    for j, load in enumerate(loads):
+        for s, n in enumerate(speeds):
+            grid, p, _ = engine.cycle_pressures(n, load)
+            for c in range(p.shape[0]):
+                expect = np.interp(local[:, c], grid, p[c], period=4 * np.pi)
+                assert np.allclose(table[j, s, :, c], expect, rtol=1e-13, atol=0.0)
+
+
+def test_the_motored_copy_is_kept_per_intake_pressure(engine):
+    """The motored copy of an engine is one object per intake pressure, its own cycles
+    computed once; a copy of the engine keeps none."""
+    assert engine.motored() is engine.motored()
+    assert engine.motored(8e4) is engine.motored(8e4) is not engine.motored(9e4)
+    assert dataclasses.replace(engine).motored() is not engine.motored()
+
+
 # ----------------------------------------------------------------- rigid-body modes
 
 def test_rigid_body_frequencies_of_the_default_powertrain(engine):

@@ -1,5 +1,6 @@
 r"""The engine's load tables: built from the gas forces and the unit-load patterns
-(:func:`gas_table`, :meth:`powertrain.models.engine.Engine.load_tables`), and a transient
+(:func:`gas_table`, :meth:`powertrain.models.engine.Engine.load_tables`) from the cylinder
+pressures at the table's angles (:func:`cylinder_pressures`), and a transient
 manoeuvre's load read from them at every step (:func:`table_load`,
 :mod:`powertrain.solvers.transient_load`): the gas load trilinear in load level, speed and
 crank angle, the inertia and acceleration patterns linear in the angle,
@@ -64,3 +65,14 @@ def gas_table(gas_force, patterns, inertia, omega2, out):
                     for c in range(n_cyl):
                         v += gas_force[a, s, t, c] * patterns[c, t, k]
                     out[a, s, t, k] = v
+
+
+@njit(cache=True, nogil=True)
+def cylinder_pressures(cycle, i0, i1, w, out):
+    """Fill ``out`` (n, n_cyl) with each cylinder's pressure of ``cycle`` (n_cyl, n_grid)
+    [Pa] at the angles of the linear interpolation ``cycle[c, i0] (1 - w) + cycle[c, i1] w``
+    (``i0``, ``i1``, ``w`` (n, n_cyl):
+    :func:`powertrain.models.engine._periodic_interpolation`)."""
+    for t in range(i0.shape[0]):
+        for c in range(i0.shape[1]):
+            out[t, c] = cycle[c, i0[t, c]] * (1.0 - w[t, c]) + cycle[c, i1[t, c]] * w[t, c]

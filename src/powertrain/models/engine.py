@@ -10,12 +10,11 @@ vehicle's Y (to the right), Z up.
 the powertrain is one rigid body containing the moving parts. Per cylinder, at its own
 position along X, the forces of :func:`powertrain.physics.slider_crank.crank_forces` on the
 block (gas on the head, side thrust with the pin-offset couple, main-bearing reaction: their
-sum is the shaking force plus the torque reaction :math:`-T`, its mean included), plus the
-residual rotating-mass force
-:math:`(1-k_{cw})\,m_{rot}\,r\omega^2(\cos\theta_i\,\mathbf u + \sin\theta_i\,\mathbf s)` on the
-crank axis (the counterweights balance the fraction :math:`k_{cw}` of each throw's own rotating
-mass, default 1), and the balancer-shaft forces at the shaft positions. Moments are taken
-about the powertrain's centre of gravity.
+sum is the shaking force plus the torque reaction :math:`-T`, its mean included), plus the residual
+rotating-mass force :math:`(1-k_{cw})\,m_{rot}\,r\omega^2(\cos\theta_i\,\mathbf u
++ \sin\theta_i\,\mathbf s)` on the crank axis (the counterweights balance the fraction
+:math:`k_{cw}` of each throw's own rotating mass, default 1), and the balancer-shaft forces
+at the shaft positions. Moments are taken about the powertrain's centre of gravity.
 """
 
 from __future__ import annotations
@@ -29,7 +28,7 @@ from powertrain.analysis.fourier import harmonic_amplitudes
 from powertrain.assembly import assemble
 from powertrain.errors import InputError
 from powertrain.kernels import kernel_input
-from powertrain.kernels.load_table import gas_table
+from powertrain.kernels.load_table import cylinder_pressures, gas_table
 from powertrain.models.combustion import RPM, LoadedCombustion, MotoredCombustion
 from powertrain.models.crank_train import Balancer, CrankTrain
 from powertrain.models.memo import Memo
@@ -201,12 +200,14 @@ class Engine:
 
     def motored(self, intake_pressure=None) -> Engine:
         """A copy whose cylinders run without burn from ``intake_pressure`` [Pa] (None: the
-        combustion model's default; :class:`MotoredCombustion`); its memo starts with this
-        one's load patterns, which depend on the geometry only."""
-        out = self.replace(combustion=MotoredCombustion(self.combustion, intake_pressure))
-        if "load patterns" in self._cache:
-            out._cache["load patterns"] = self._cache["load patterns"]
-        return out
+        combustion model's default; :class:`MotoredCombustion`), kept in this one's memo;
+        its own starts with this one's load patterns (they depend on the geometry only)."""
+        if (key := ("motored", intake_pressure)) not in self._cache:
+            out = self.replace(combustion=MotoredCombustion(self.combustion, intake_pressure))
+            if "load patterns" in self._cache:
+                out._cache["load patterns"] = self._cache["load patterns"]
+            self._cache[key] = out
+        return self._cache[key]
 
     @property
     def mount_names(self) -> list:
@@ -290,11 +291,10 @@ class Engine:
             return np.array([[self.cylinder_pressure(n, crank_angle_rad, load) for n in speeds]
                              for load in loads])
         i0, i1, w = _periodic_interpolation(local, theta_g, 4.0 * np.pi)
-        cyl = np.arange(local.shape[1])[None, :]
         out = np.empty((len(cycles), speeds.size) + local.shape)
         for j, row in enumerate(cycles):
             for s, (_, p, _) in enumerate(row):
-                out[j, s] = p[cyl, i0] * (1.0 - w) + p[cyl, i1] * w
+                cylinder_pressures(kernel_input(p), i0, i1, w, out[j, s])
         return out
 
     def local_angles(self, crank_angle_rad) -> np.ndarray:
