@@ -93,12 +93,8 @@ class StaticSupport:
                 rows.append(direction_row(r, R[:, a]))
                 curves.append(model.static_curve)
                 k0.append(model.static_stiffness())
-        pieces = [_cubic(c, k) for c, k in zip(curves, k0)]
-        size = max(b.size for b, _ in pieces)
-        cubics = tuple(kernel_input(a, a.dtype) for a in (
-            np.array([np.pad(b, (0, size - b.size), mode="edge") for b, _ in pieces]),
-            np.array([np.pad(c, ((0, size - 1 - len(c)), (0, 0))) for _, c in pieces]),
-            np.array([b.size for b, _ in pieces], np.int64)))
+        cubics = tuple(kernel_input(a, a.dtype) for a in _padded(
+            [_cubic(c, k) for c, k in zip(curves, k0)]))
         reference = np.array([0.0 if c is None else c.reference_deflection for c in curves])
         tangent = np.empty(len(curves))
         curve_values(*cubics, kernel_input(reference), np.empty(len(curves)), tangent)
@@ -122,6 +118,18 @@ class StaticSupport:
     def factors(self, deflection) -> np.ndarray:
         """Static factor of every network at its deflection (1 without a curve)."""
         return self.read(deflection)[1] / self.reference_tangent
+
+
+def _padded(pieces):
+    """``(breaks (n, size), coefficients (n, size - 1, 4), counts (n,))`` of the networks'
+    ``(breaks, coefficients)``: the breaks padded with their last, the coefficients with
+    zeros."""
+    size = max(b.size for b, _ in pieces)
+    breaks, coefficients = np.empty((len(pieces), size)), np.zeros((len(pieces), size - 1, 4))
+    for i, (b, c) in enumerate(pieces):
+        breaks[i, :b.size], breaks[i, b.size:] = b, b[-1]
+        coefficients[i, :len(c)] = c
+    return breaks, coefficients, np.array([b.size for b, _ in pieces], np.int64)
 
 
 def _cubic(curve, stiffness):
