@@ -123,13 +123,9 @@ def cold_child():
 
 
 def best_cpu(run, repeat):
+    """The best CPU time [s] of ``repeat`` runs of ``run()`` after one untimed."""
     run()
-    best = float("inf")
-    for _ in range(repeat):
-        t0 = time.process_time()
-        run()
-        best = min(best, time.process_time() - t0)
-    return best
+    return min(cpu(run) for _ in range(repeat))
 
 
 def errors(U, F, U_ref, F_ref):
