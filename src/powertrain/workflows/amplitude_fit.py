@@ -1,14 +1,12 @@
-r"""Fit a mount to multi-amplitude dynamic-stiffness data (``powertrain fit-mount`` on a
-K*(f) CSV with an ``amplitude_mm`` column, as a supplier sends it: Kovarik 2016, Fig. 14).
+r"""Fit a mount to K*(f) measured at several amplitudes (``powertrain fit-mount`` on a CSV
+with an ``amplitude_mm`` column; Kovarik 2016, Fig. 14).
 
-The model is the one the solvers run (:class:`~powertrain.physics.mount_elements.MountElement`):
-a network fitted at the reference amplitude :math:`A_{ref}`, its springs and dampers times
-the power law :math:`\mathrm{clip}((A_{ref}/A)^n, lo, hi)` (limits fixed at :data:`LIMITS`)
-and, with ``friction``, Berg's friction element in parallel. Stage one fits the network
-alone (:func:`powertrain.workflows.fitting.fit_mount`), stage two everything together by
-bounded least squares over every amplitude, each normalised by its own
-:math:`\lVert K_m\rVert`, friction started from a small grid. Method and
-figures: docs/guide/amplitude-and-preload.md (*Dynamic stiffness at amplitudes and fitting*).
+Model (:class:`~powertrain.physics.mount_elements.MountElement`): a network at the reference
+amplitude :math:`A_{ref}`, springs and dampers times :math:`\mathrm{clip}((A_{ref}/A)^n, lo,
+hi)` (:data:`LIMITS`) and, with ``friction``, Berg's element in parallel. Stage one fits the
+network (:func:`powertrain.workflows.fitting.fit_mount`), stage two all together by bounded
+least squares, each amplitude normalised by its :math:`\lVert K_m\rVert`.
+Method: docs/guide/amplitude-and-preload.md.
 """
 
 from __future__ import annotations
@@ -39,7 +37,7 @@ from powertrain.workflows.fitting import (
     starting_points,
 )
 
-#: Limits of the fitted power law (fixed; module docstring).
+#: Limits of the fitted power law (fixed).
 LIMITS = PowerLaw(1.0, 0.0).limits
 #: Bounds of the fitted exponent.
 EXPONENT_BOUNDS = (-1.0, 2.0)
@@ -55,25 +53,21 @@ def fit_mount(measured, kcp_measured=None, model="triple-parallel", *, friction=
     Parameters
     ----------
     measured : str, path or array_like
-        A dynamic-stiffness CSV (:mod:`powertrain.iotools.stiffness_csv`; with a column
-        ``amplitude_mm`` at several amplitudes: the network, a power amplitude law and,
-        with ``friction``, Berg's friction element fitted together), or the frequencies
-        [Hz] of ``kcp_measured``.
+        Dynamic-stiffness CSV (several amplitudes: joint fit, :func:`fit_amplitudes`), or
+        the frequencies [Hz] of ``kcp_measured``.
     kcp_measured : array_like of complex, optional
         Measured cross-point dynamic stiffness [N/m] at ``measured`` (arrays only).
     model : str
         A preset of :data:`powertrain.models.mount.TOPOLOGIES` (``--model``).
     friction : bool
-        With several amplitudes: fit Berg's friction element too (``--friction``).
+        Several amplitudes: fit Berg's friction element too.
     reference : float, optional
-        With several amplitudes: the reference amplitude [m], one of the data's (default the
-        smallest).
+        Several amplitudes: reference amplitude [m], one of the data's (default smallest).
     starts, seed, max_mass, fmin, fmax
-        As the options ``--starts``, ``--seed``, ``--max-mass`` [kg], ``--fmin``, ``--fmax``
-        [Hz] (:func:`powertrain.workflows.fitting.fit_mount`).
+        As :func:`powertrain.workflows.fitting.fit_mount` (``max_mass`` [kg], ``fmin``,
+        ``fmax`` [Hz]).
     options
-        ``polish``, ``hops``, ``name``, ``source`` of
-        :func:`powertrain.workflows.fitting.fit_mount` (arrays).
+        ``polish``, ``hops``, ``name``, ``source`` of that function (arrays only).
 
     Returns
     -------
@@ -97,9 +91,7 @@ def fit_mount(measured, kcp_measured=None, model="triple-parallel", *, friction=
 def fit_mount_csv(measured, model="triple-parallel", *, friction=False, reference=None,
                   starts=DEFAULT_STARTS, seed=DEFAULT_SEED, max_mass=None, fmin=None,
                   fmax=None):
-    """``powertrain fit-mount``: the fit of :mod:`powertrain.workflows.fitting` on a
-    single-amplitude CSV, the joint fit of this module (:func:`fit_amplitudes`) on a CSV
-    with several amplitudes.
+    """``powertrain fit-mount`` on a CSV: single-amplitude fit, or :func:`fit_amplitudes`.
 
     Parameters
     ----------
@@ -112,7 +104,6 @@ def fit_mount_csv(measured, model="triple-parallel", *, friction=False, referenc
     model, starts, seed, max_mass, fmin, fmax
         As :func:`powertrain.workflows.fitting.fit_mount_file`.
     """
-
     starts, seed, max_mass, fmin, fmax = check_options(measured, model, starts, seed,
                                                        max_mass, fmin, fmax)
     friction = flag(friction, "--friction")
@@ -140,8 +131,7 @@ def _one_amplitude_options(friction, reference, file=None) -> None:
 def fit_amplitudes(data, model="triple-parallel", *, friction=False, reference=None,
                    starts=DEFAULT_STARTS, seed=DEFAULT_SEED, max_mass=None, data_name="",
                    source="") -> AmplitudeFitResult:
-    """Fit network, power amplitude law and (``friction``) Berg's element to ``data``
-    (:class:`~powertrain.iotools.stiffness_csv.MeasuredStiffness` at two or more
+    """Fit network, power law and (``friction``) Berg's element to ``data`` (two or more
     amplitudes); see the module docstring."""
     t0 = time.perf_counter()
     max_mass = MAX_SI["m"] if max_mass is None else max_mass   # what a mount file holds
@@ -187,15 +177,9 @@ def _reference(amplitudes, reference, path) -> float:
 
 
 class _Joint:
-    r"""The stage-2 problem: residual over every amplitude and its Jacobian in the
-    parameters ``q = [ln p (network), n, (ln F_max, ln x2)]``.
-
-    The network part comes from the fitter's analytic gradient
-    (:class:`~powertrain.workflows.fitting.NetworkProblem`) at the scaled parameters; the
-    exponent's column is the scaled springs' and dampers' columns times
-    :math:`\ln(A_{ref}/A)` (zero where the law is clipped); Berg's describing function is
-    proportional to :math:`F_{max}` and differentiated in :math:`x_2` numerically.
-    """
+    r"""Stage two: residual over every amplitude and its Jacobian in
+    ``q = [ln p, n, (ln F_max, ln x2)]``; the exponent's column is the scaled columns times
+    :math:`\ln(A_{ref}/A)` (zero where clipped), :math:`x_2`'s is numerical."""
 
     def __init__(self, topology, curves, a_ref, friction, max_mass):
         self.topology, self.curves, self.a_ref, self.friction = topology, curves, a_ref, friction
@@ -254,8 +238,7 @@ class _Joint:
         self._q = q.copy()
 
     def _friction(self, port):
-        """Berg's describing stiffness at every amplitude and its derivatives in
-        ``ln F_max`` (itself: proportional to F_max) and ``ln x2`` (numerical): (2, n_a)."""
+        """Berg's stiffness per amplitude and its derivative in ``ln x2``: (2, n_a)."""
         if port is None:
             return None
         kf = port.describing_stiffness(self.amplitudes)
@@ -272,9 +255,8 @@ class _Joint:
         return self._jac
 
     def friction_guess(self) -> BergFriction:
-        """Berg's element whose loss (imaginary describing stiffness) matches the loss of
-        the data at each amplitude's lowest frequency, where the network's viscous loss is
-        smallest and friction's, independent of frequency, stays."""
+        """Berg's element matching the data's loss at each amplitude's lowest frequency
+        (where viscous loss is smallest)."""
         a = self.amplitudes
         loss = np.array([max(c.kcp[0].imag, 0.0) for c in self.curves])
         scale = float(np.max(loss)) or 1.0
@@ -288,9 +270,7 @@ class _Joint:
         return BergFriction(float(np.exp(q[0])), float(np.exp(q[1])))
 
     def start(self, q_network, friction):
-        """A starting point: network log-parameters ``q_network``, the exponent guessed from
-        the level of |K*| (less ``friction``'s describing stiffness) against amplitude, and
-        ``friction`` (None without)."""
+        """Start from ``q_network``, a guessed exponent and ``friction`` (None: without)."""
         if friction is None:
             return self._inside(np.r_[q_network, self._exponent_guess()])
         rest = [c.kcp - friction.describing_stiffness(a) for a, c in
@@ -300,8 +280,7 @@ class _Joint:
                                   np.log(friction.half_displacement)])
 
     def _exponent_guess(self, kcp=None) -> float:
-        """Minus the slope of ln(mean |K*|) against ln A over the amplitudes (of ``kcp``, one
-        array per amplitude, default the data), inside :data:`EXPONENT_BOUNDS`."""
+        """Minus the slope of ln(mean |K*|) against ln A, inside :data:`EXPONENT_BOUNDS`."""
         kcp = [c.kcp for c in self.curves] if kcp is None else kcp
         level = [np.log(np.mean(np.abs(k))) for k in kcp]
         slope = np.polyfit(np.log(self.amplitudes / self.a_ref), level, 1)[0]

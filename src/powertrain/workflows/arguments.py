@@ -1,10 +1,8 @@
-"""The arguments of a study, checked once for the command line and the Python API alike.
+"""The arguments of a study, checked alike for the command line and the Python API.
 
-Speed and frequency lists as the options write them (``1000:6000:500``, ``5,10,20``, or a mix
-``1:10:1,20,40``) or as arrays, numbers, choices and lists of operation strings. Every check
-raises :class:`~powertrain.errors.InputError` with the one line the command prints, naming the
-option (``--rpm``), so ``pt.runup(rpm=[-100, 1000])`` and ``powertrain static --rpm
--100,1000`` say the same thing.
+Lists as the options write them (``1000:6000:500``, ``5,10,20``, ``1:10:1,20,40``) or arrays,
+numbers, choices and strings; every check raises :class:`~powertrain.errors.InputError`
+naming the option (``--rpm``).
 """
 
 from __future__ import annotations
@@ -20,8 +18,8 @@ from powertrain.errors import InputError
 
 #: Largest speed grid a run-up accepts.
 MAX_SPEEDS = 2000
-#: Most frequencies one option may ask for, and the highest frequency [Hz] (a mount model
-#: fitted below 1 kHz says nothing at 100 kHz; the limits keep a typo from hanging the run).
+#: Most frequencies one option may ask for, and the highest frequency [Hz] (a typo must not
+#: hang the run).
 MAX_FREQUENCIES = 100_000
 MAX_FREQUENCY_HZ = 1e5
 #: How a speed and a frequency list are written (quoted in the errors).
@@ -35,10 +33,8 @@ def default_rpm(start=1000.0, stop=6000.0, step=500.0) -> np.ndarray:
     return start + step * np.arange(n)
 
 
-# ------------------------------------------------------------------ lists of numbers
 def frequencies(value, key: str = "--freq") -> np.ndarray:
-    """Frequencies [Hz] given as the option writes them (``5,10,12``, ``start:stop:step``
-    inclusive, or a mix ``1:10:1,20,40``) or as numbers: finite, >= 0, <=
+    """Frequencies [Hz] as ``--freq`` writes them or numbers: finite, in 0..
     :data:`MAX_FREQUENCY_HZ`, strictly increasing."""
     arr = _numbers(value, key, "frequency", FREQUENCY_EXAMPLE, MAX_FREQUENCIES)
     if not np.all(np.isfinite(arr)) or np.any(arr < 0) or np.any(arr > MAX_FREQUENCY_HZ):
@@ -50,9 +46,8 @@ def frequencies(value, key: str = "--freq") -> np.ndarray:
 
 
 def speeds(value, key: str = "--rpm", *, increasing: bool = True) -> np.ndarray:
-    """Speeds [rpm] given as the option writes them (``1000:6000:500``, ``1500,3000`` or a
-    mix) or as numbers: finite, > 0, at most :data:`MAX_SPEEDS` and (``increasing``)
-    strictly increasing; None: :func:`default_rpm`."""
+    """Speeds [rpm] as ``--rpm`` writes them or numbers: finite, > 0, at most
+    :data:`MAX_SPEEDS`, (``increasing``) strictly increasing; None: :func:`default_rpm`."""
     if value is None:
         return default_rpm()
     arr = _numbers(value, key, "speed", SPEED_EXAMPLE, MAX_SPEEDS)
@@ -84,14 +79,13 @@ def _numbers(value, option, noun, example, most) -> np.ndarray:
 
 
 def floats(value, option: str, noun: str, example: str, most: int) -> np.ndarray:
-    """Numbers given as a number or a sequence of numbers: one flat float array, at least
-    one and at most ``most`` values (what :func:`_parse_list` returns for a string)."""
+    """A number or a sequence of numbers as a flat float array of 1..``most`` values."""
     items = [value] if is_number(value) else value
     try:
         items = np.ravel(np.asarray(list(items) if isinstance(items, Iterator) else items,
                                     dtype=object))
     except (TypeError, ValueError):
-        items = np.array([value], dtype=object)          # not a sequence: refused below
+        items = np.array([value], dtype=object)
     if items.size > most:
         raise InputError(f"{items.size} values; at most {most}", key=option)
     try:
@@ -130,8 +124,8 @@ def _parse_list(text: str, option: str, noun: str, example: str, most: int) -> n
 
 
 def _range(part: str, option: str, most: int, have: int) -> np.ndarray:
-    """The values of one ``start:stop:step`` item (ValueError when it is not one), refused
-    when they would make more than ``most`` with the ``have`` read before."""
+    """The values of one ``start:stop:step`` item (ValueError when it is not one), at most
+    ``most`` with the ``have`` read before."""
     fields = [float(x) for x in part.split(":")]
     if len(fields) != 3 or fields[2] <= 0 or fields[1] < fields[0]:
         raise ValueError
@@ -145,7 +139,6 @@ def _range(part: str, option: str, most: int, have: int) -> np.ndarray:
     return start + step * np.arange(math.floor(ratio + 1e-9) + 1)
 
 
-# ------------------------------------------------------------------ single values
 def is_number(value) -> bool:
     """True for a real number (int, float, numpy's), not a bool."""
     return isinstance(value, (numbers.Real, np.number)) and not isinstance(value, (bool,
@@ -167,9 +160,8 @@ def _short(value) -> str:
 
 
 def real(value, key: str, *, unit: str = "", optional: bool = False):
-    """``value`` as a float, unchecked (NaN and inf pass): a real number, or a string the
-    option would read (``"3000"``, ``"inf"``); None allowed (and returned) when
-    ``optional``. For the options whose range the workflow checks with its own message."""
+    """``value`` (a number or a string of one) as a float, NaN and inf passed; None passes
+    when ``optional``."""
     if value is None and optional:
         return None
     try:
@@ -181,15 +173,8 @@ def real(value, key: str, *, unit: str = "", optional: bool = False):
 
 def number(value, key: str, *, unit: str = "", minimum=None, above=None, maximum=None,
            optional: bool = False):
-    """``value`` as a float: a real number, or a string the option would read (``"3000"``);
-    ``minimum`` <= value, ``above`` < value, value <= ``maximum`` where given; None allowed
-    (and returned) when ``optional``.
-
-    Raises
-    ------
-    InputError
-        Naming ``key``: not a number, not finite, or out of range (``unit`` in the message).
-    """
+    """``value`` (a number or a string of one) as a finite float with ``minimum`` <= value,
+    ``above`` < value, value <= ``maximum`` where given; None passes when ``optional``."""
     if value is None and optional:
         return None
     x = real(value, key, unit=unit)
@@ -212,8 +197,8 @@ def nonnegative(value, key: str, unit: str) -> float:
 
 
 def integer(value, key: str, *, minimum=None, maximum=None, optional: bool = False):
-    """``value`` as an int (an integral number or such a string), in
-    ``minimum..maximum`` where given; None allowed when ``optional``."""
+    """``value`` (an integral number or string) as an int in ``minimum..maximum``; None
+    passes when ``optional``."""
     if value is None and optional:
         return None
     if isinstance(value, str):
@@ -247,8 +232,7 @@ def flag(value, key: str) -> bool:
 
 
 def texts(value, key: str) -> list:
-    """Option strings given as one string or a sequence of strings (as a repeatable option
-    takes them): a list of str; None is none."""
+    """One string or a sequence of strings as a list (None: empty)."""
     if value is None:
         return []
     items = [value] if isinstance(value, str) else value
@@ -264,15 +248,13 @@ def texts(value, key: str) -> list:
 
 
 def names(value, key: str) -> list:
-    """Comma-separated names (``"a,b"``, as the option writes them) or a sequence of names:
-    the names, blanks dropped."""
+    """Comma-separated names (``"a,b"``) or a sequence of them, blanks dropped."""
     items = texts(value, key)
     return [n.strip() for item in items for n in item.split(",") if n.strip()]
 
 
 def path_or(value, kinds, key: str, what: str):
-    """``value`` when it is a file path (str or os.PathLike) or an instance of ``kinds``;
-    else an error saying what was expected (``what``)."""
+    """``value`` if a path or an instance of ``kinds``, else an error expecting ``what``."""
     if isinstance(value, (str, os.PathLike)) or isinstance(value, kinds):
         return value
     raise InputError(f"expected {what}, got {type(value).__name__}", key=key)

@@ -1,11 +1,10 @@
 r"""Comparison of a simulated run-up with a measured one (``powertrain compare``).
 
-:func:`compare_runup` scores, for every mount, direction and quantity present on both sides,
-the level gap :math:`20\log_{10}(v_\mathrm{sim}/v_\mathrm{meas})` [dB] at the measured
-speeds and the correlation metrics of :mod:`powertrain.analysis.compare` (FRAC, CSAC, CSF,
-an FRFSM-like score). The simulation is interpolated in rpm and log level, never
-extrapolated; measured points near the noise floor (``NOISE_FLOOR_MARGIN``) and points
-"measured, not modelled" are counted apart, never scored. The rules: docs/guide/compare.md.
+Per mount, direction and quantity on both sides: the level gap
+:math:`20\log_{10}(v_\mathrm{sim}/v_\mathrm{meas})` [dB] at the measured speeds and the
+metrics of :mod:`powertrain.analysis.compare` (FRAC, CSAC, CSF, FRFSM-like). The simulation
+is interpolated in rpm and log level, never extrapolated; points at the noise floor and
+"measured, not modelled" are counted, not scored. Rules: docs/guide/compare.md.
 """
 
 from __future__ import annotations
@@ -48,27 +47,24 @@ def compare(measured, *, engine=None, simulated=None, solver="newmark", step=Non
     Parameters
     ----------
     measured : str, Path or MeasuredRunup
-        Measured order curves (long-format CSV or run-up HDF5; raw time data are refused
-        with a pointer to :func:`~powertrain.workflows.tracking.track`).
+        Measured order curves (long-format CSV or run-up HDF5; not raw time data).
     engine : Engine, str, Path or None
-        Engine simulated at the measured speeds (default: the shipped
-        ``engines/default.toml``); not with ``simulated``.
+        Engine simulated at the measured speeds (default ``engines/default.toml``).
     simulated : str, Path, MeasuredRunup or RunupResult, optional
-        A simulation to compare instead (no simulation is run).
+        A simulation to compare instead of ``engine``'s.
     solver : {"newmark", "harmonic"}
         Solver of the simulation run here.
     step : float, optional
-        Simulate on a grid of this step [rpm] over the measured range and interpolate it to
-        the measured speeds (default: simulate at every measured speed in the engine's range).
+        Simulate on a grid of this step [rpm] and interpolate (default: every measured speed).
     noise_floor : float
-        RMS noise floor of the measured curves [m/s] (:func:`compare_runup`).
+        RMS noise floor of the measured curves [m/s].
     progress : bool
         Progress bar of the simulation.
 
     Returns
     -------
     ComparisonResult
-        With ``run`` telling what ran; ``to_text()`` is the report of the command.
+        ``run`` tells what ran; ``to_text()`` is the command's report.
     """
     t0 = time.perf_counter()
     if simulated is not None and engine is not None:
@@ -96,11 +92,11 @@ def compare(measured, *, engine=None, simulated=None, solver="newmark", step=Non
 
 
 def _given_simulation(simulated, measured):
-    """The given simulation's curves, the measured ones and ``run`` (what was compared)."""
+    """The given simulation's curves, the measured ones and ``run``."""
     name = None
     if isinstance(simulated, MeasuredRunup):
         sim = simulated
-    elif hasattr(simulated, "velocity"):                       # a RunupResult
+    elif hasattr(simulated, "velocity"):
         sim = MeasuredRunup.from_result(simulated, source="simulation")
     else:
         name = str(simulated)
@@ -154,8 +150,8 @@ def _simulate(engine, engine_file, meas, rpm_step, solver, progress):
 
 
 def simulation_speeds(engine, meas, rpm_step=None):
-    """Speeds to simulate [rpm]: every measured speed inside the engine's range, or a
-    ``rpm_step`` grid covering the intersection of the measured and the engine's range."""
+    """Speeds to simulate [rpm]: the measured ones in the engine's range, or a ``rpm_step``
+    grid over both ranges' intersection."""
     lo, hi = meas.rpm_range()
     e_lo, e_hi = engine.speed_range_rpm()
     if hi < e_lo or lo > e_hi:
@@ -195,12 +191,11 @@ def compare_runup(simulated, measured: MeasuredRunup, *, noise_floor=DEFAULT_NOI
     Parameters
     ----------
     simulated : RunupResult or MeasuredRunup
-        The simulation (a result object, or curves read from a result CSV/HDF5).
+        The simulation.
     measured : MeasuredRunup
         Measured curves [m/s RMS].
     noise_floor : float
-        RMS noise floor of the measured curves [m/s]; points below
-        ``NOISE_FLOOR_MARGIN * noise_floor`` are excluded and counted.
+        RMS noise floor of the measured curves [m/s]; points at it are counted, not scored.
     sigma_db : float
         Kernel width of the FRFSM-like score [dB].
 
@@ -246,8 +241,7 @@ def compare_runup(simulated, measured: MeasuredRunup, *, noise_floor=DEFAULT_NOI
 
 def _compare_channel(where, measured_curve, simulated_curve, noise_floor, sigma_db,
                      measured_phase=None, simulated_phase=None):
-    """Classify and score the measured points of one channel and quantity; with both
-    phases, also its phase and complex gaps (:func:`_phase_gap`)."""
+    """Classify and score the measured points of one channel and quantity (and phase)."""
     rpm_m, lev_m = measured_curve
     rpm_s, lev_s = simulated_curve
     sim, inside = cm.interpolate_log(rpm_s, lev_s, rpm_m)
@@ -270,9 +264,7 @@ def _compare_channel(where, measured_curve, simulated_curve, noise_floor, sigma_
 
 def _phase_gap(stats, rpm, simulated, measured, measured_phase, simulated_phase, rpm_s,
                scored):
-    """Phase gap per scored point (None unless both sides give phase and a point is scored);
-    the phase and complex gap statistics
-    (:func:`~powertrain.analysis.compare.phase_statistics`) are added to ``stats``."""
+    """Phase gap per scored point (None without both phases); its statistics go to ``stats``."""
     if measured_phase is None or simulated_phase is None or not scored.any():
         return None
     sim = cm.interpolate_phase(rpm_s, simulated_phase, rpm)
@@ -284,7 +276,7 @@ def _phase_gap(stats, rpm, simulated, measured, measured_phase, simulated_phase,
 
 
 def _points(c: ChannelComparison, mask) -> dict:
-    """Speeds and both levels of the points of ``c`` selected by ``mask`` (JSON-ready)."""
+    """Speeds and both levels of ``c``'s points in ``mask`` (JSON-ready)."""
     return {"rpm": [json_number(x) for x in c.rpm[mask]],
             "measured_m_per_s": [json_number(x) for x in c.measured[mask]],
             "simulated_m_per_s": [json_number(x) for x in c.simulated[mask]]}
@@ -294,7 +286,7 @@ def _per_rpm(channels) -> list:
     """CSAC and CSF across the channels at each compared speed, per quantity."""
     out = []
     for q in sorted({c.quantity for c in channels}, key=quantity_sort_key):
-        pts = {}   # rounded rpm -> list of (s, m)
+        pts = {}
         for c in (c for c in channels if c.quantity == q):
             for r, s, m in zip(c.rpm[c.scored], c.simulated[c.scored], c.measured[c.scored]):
                 pts.setdefault(round(float(r) / RPM_TOL) * RPM_TOL, []).append((s, m))

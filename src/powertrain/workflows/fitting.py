@@ -7,11 +7,9 @@ Kovarik (2016), sec. 2.2, eq. 17–19: minimise, over parameters >= 0,
               \Bigr)^{1/2} \cdot 1\,\mathrm{mm} \qquad [\mathrm N],
 
 equivalently the relative RMS error
-:math:`\varepsilon = \sqrt{\sum_i |K_{CP} - K_m|^2 / \sum_i |K_m|^2}`. Solved on
-log-parameters (a soft wall outside :func:`parameter_box`) with the analytic Jacobian
-(:func:`powertrain.physics.mount_network.cross_point_stiffness_gradient`), from many seeded
-starts screened then polished, then hops of the incumbent (:func:`fit_mount`); the method
-and its figures: docs/guide/fit-mount.md.
+:math:`\varepsilon = \sqrt{\sum_i |K_{CP} - K_m|^2 / \sum_i |K_m|^2}`, on log-parameters
+(soft wall outside :func:`parameter_box`) with the analytic Jacobian, from seeded starts
+screened, polished, then hopped (:func:`fit_mount`). Method: docs/guide/fit-mount.md.
 
 References
 ----------
@@ -38,33 +36,26 @@ from powertrain.physics.mount_network import incidence_matrix
 from powertrain.results.fit import FitResult
 from powertrain.workflows.arguments import integer, real
 
-#: Number of random starting points screened by default.
+#: Random starting points screened, screened starts polished, and their seed by default.
 DEFAULT_STARTS = 24
-#: Number of screened starts run further by default.
 DEFAULT_POLISH = 4
-#: Seed of the starting points by default (the fit is deterministic for given data).
 DEFAULT_SEED = 0
 #: Levenberg–Marquardt function evaluations per start in the screening phase.
 SCREEN_NFEV = 100
-#: Perturbations ("hops") of the incumbent by default.
+#: Hops (perturbations of the incumbent) by default, and the fraction of it a hop replaces.
 DEFAULT_HOPS = 16
-#: Fraction of the log-parameters replaced in a hop.
 HOP_FRACTION = 0.3
-#: Further function evaluations of a promising hop.
+#: Function evaluations of a promising hop, of each polishing run, of the best one's last run.
 HOP_NFEV = 300
-#: Function evaluations of each polishing run.
 POLISH_NFEV = 500
-#: Further function evaluations allowed to the best polished start.
 FINAL_NFEV = 1000
 
 _DISPLACEMENT = 1e-3  # eq. 18-19: 1 mm displacement [m]
 
 
 def objective_n(kcp_model, kcp_measured) -> float:
-    r"""Thesis objective :math:`f_{obj} = \lVert k_t - k_m\rVert \cdot 1\,\mathrm{mm}` [N].
-
-    Euclidean norm over the frequencies of the complex stiffness difference, times the
-    1 mm displacement of Kovarik (2016), eq. 18–19.
+    r"""Thesis objective :math:`f_{obj} = \lVert k_t - k_m\rVert \cdot 1\,\mathrm{mm}` [N]
+    (Kovarik 2016, eq. 18–19).
 
     Parameters
     ----------
@@ -81,10 +72,8 @@ def objective_n(kcp_model, kcp_measured) -> float:
 
 
 def relative_rms_error(kcp_model, kcp_measured) -> float:
-    r"""Relative RMS error :math:`\sqrt{\sum|K - K_m|^2 / \sum|K_m|^2}` [1].
-
-    One global normalisation (not per point), so it is :math:`f_{obj}` divided by
-    :math:`\lVert K_m\rVert\cdot 1\,\mathrm{mm}`.
+    r"""Relative RMS error :math:`\sqrt{\sum|K - K_m|^2 / \sum|K_m|^2}` [1] (one global
+    normalisation: :math:`f_{obj} / (\lVert K_m\rVert\cdot 1\,\mathrm{mm})`).
 
     Parameters
     ----------
@@ -102,10 +91,9 @@ def parameter_box(topology: Topology, frequency_hz, kcp_measured, max_mass=None)
     With :math:`K_s` the RMS of :math:`|K_m|` [N/m] and :math:`\omega_{lo}, \omega_{hi}` the
     lowest non-zero and the highest angular frequency [rad/s]: springs
     :math:`K_s\,[10^{-8}, 10^{4}]`, dampers :math:`[10^{-8} K_s/\omega_{hi}, 10^{3}
-    K_s/\omega_{lo}]`, masses :math:`[10^{-8} K_s/\omega_{hi}^2, 10^{3} K_s/\omega_{lo}^2]`.
-    The lower ends stand for "absent" (a zero in a thesis parameter list). ``max_mass``
-    [kg], when given, caps every internal mass: K_CP alone does not identify the internal
-    masses (the engine, which feels K_IP, does), so a physically known bound helps.
+    K_s/\omega_{lo}]`, masses :math:`[10^{-8} K_s/\omega_{hi}^2, 10^{3} K_s/\omega_{lo}^2]`;
+    lower ends mean "absent". ``max_mass`` [kg] caps every internal mass (K_CP does not
+    identify them).
 
     Returns
     -------
@@ -257,10 +245,8 @@ def fit_mount(measured, kcp_measured=None, model: str | Topology = DEFAULT_TOPOL
               starts: int = DEFAULT_STARTS, seed=DEFAULT_SEED, polish: int = DEFAULT_POLISH,
               hops: int = DEFAULT_HOPS, name: str = "", source: str = "",
               max_mass: float | None = None, fmin=None, fmax=None) -> FitResult:
-    """Identify the parameters of a lumped mount model from a measured K*(f) (sec. 2.2).
-
-    Minimises :math:`f_{obj}` (Kovarik 2016, eq. 19) over non-negative parameters; see the
-    module docstring for the method.
+    """Identify a lumped mount model's parameters from a measured K*(f): minimise
+    :math:`f_{obj}` (Kovarik 2016, sec. 2.2, eq. 19) over parameters >= 0.
 
     Parameters
     ----------
@@ -278,14 +264,11 @@ def fit_mount(measured, kcp_measured=None, model: str | Topology = DEFAULT_TOPOL
     polish : int
         Best screened starts run further (>= 1).
     hops : int
-        Perturbations of the incumbent (>= 0): a random ~30 % of its log-parameters are
-        replaced by fresh starting values and the result kept when better.
+        Perturbations of the incumbent (>= 0), ~30 % of its log-parameters redrawn.
     name, source : str
         Metadata for the returned model.
     max_mass : float, optional
-        Upper bound of every internal mass [kg] (default: the data-scaled box of
-        :func:`parameter_box`). K_CP does not identify the internal masses, but the engine
-        feels them through K_IP: bound them when their physical size is known.
+        Upper bound of every internal mass [kg] (default :func:`parameter_box`'s).
     fmin, fmax : float, optional
         With a file: fit only the frequencies in ``fmin..fmax`` [Hz].
 
@@ -296,8 +279,7 @@ def fit_mount(measured, kcp_measured=None, model: str | Topology = DEFAULT_TOPOL
     Raises
     ------
     InputError
-        Unknown model, mismatched or non-finite data, too few frequencies, naming the option
-        or argument (and the file for a file).
+        Bad model or data, naming the option or argument (and file).
     """
     if kcp_measured is None:
         return fit_mount_file(measured, model, starts=starts, seed=seed, max_mass=max_mass,
@@ -350,8 +332,7 @@ def _topology(model) -> Topology:
 
 
 def _checked_data(frequency_hz, kcp_measured, topology):
-    """Frequencies [Hz] and K_CP [N/m] as flat arrays, refused when they cannot be fitted
-    (an InputError naming ``frequency_hz`` or ``kcp_measured``)."""
+    """Frequencies [Hz] and K_CP [N/m] as flat arrays, refused when they cannot be fitted."""
     try:
         f = np.asarray(frequency_hz, dtype=float).ravel()
     except (TypeError, ValueError):
@@ -388,8 +369,7 @@ def _screen_and_polish(prob, starts, polish) -> list:
 
 
 def _hop(prob, rng, fresh, best):
-    """Perturb the incumbent ``best = (q, err, ok)`` once per row of ``fresh`` (a random
-    ~30 % of its parameters replaced by the row's); returns the best and the hops accepted."""
+    """Hop from ``best = (q, err, ok)`` once per row of ``fresh``: best and hops accepted."""
     q_best, err_best, ok_best = best
     accepted = 0
     for q_new in fresh:
@@ -412,10 +392,8 @@ MAX_STARTS = 10_000
 def fit_mount_file(measured, model: str = DEFAULT_TOPOLOGY, *, starts: int = DEFAULT_STARTS,
                    seed=DEFAULT_SEED, max_mass=None, fmin=None, fmax=None,
                    **options) -> FitResult:
-    """:func:`fit_mount` on the dynamic-stiffness CSV ``measured`` (``powertrain fit-mount``),
-    the points in ``fmin..fmax`` [Hz]; bad input raises :class:`InputError` naming the file
-    and the option. ``options``: ``polish``, ``hops`` of :func:`fit_mount`."""
-
+    """:func:`fit_mount` on the CSV ``measured`` in ``fmin..fmax`` [Hz] (``powertrain
+    fit-mount``); ``options``: ``polish``, ``hops``."""
     starts, seed, max_mass, fmin, fmax = check_options(measured, model, starts, seed,
                                                        max_mass, fmin, fmax)
     data = read_stiffness_csv(measured).select(fmin, fmax)
@@ -445,8 +423,7 @@ def _starts(starts) -> int:
 
 
 def check_options(measured, model, starts, seed, max_mass, fmin, fmax) -> tuple:
-    """Refuse options :func:`fit_mount_file` cannot use, naming the option; ``(starts,
-    seed, max_mass, fmin, fmax)`` as numbers (a string as the option writes it is read)."""
+    """The options of :func:`fit_mount_file` checked: ``(starts, seed, max_mass, fmin, fmax)``."""
     starts, seed = integer(starts, "--starts"), integer(seed, "--seed", optional=True)
     max_mass, fmin, fmax = (real(v, k, optional=True) for v, k in (
         (max_mass, "--max-mass"), (fmin, "--fmin"), (fmax, "--fmax")))

@@ -1,10 +1,8 @@
-r"""The synthetic measurement of ``powertrain synth``: scatter, noise floor and the measured file.
+r"""The synthetic measurement of ``powertrain synth``: scatter, noise floor, measured file.
 
 :func:`measure`: each order's complex amplitude [RMS] times :math:`10^{\epsilon/20}`,
-:math:`\epsilon\sim N(0,\sigma)`, plus complex Gaussian noise of RMS :data:`FLOOR`.
-:func:`gap_stats`: the noise-free size of a hidden effect. :func:`draw_case`: a
-:class:`SyntheticCase` (draw, simulate, measure), whose :meth:`~SyntheticCase.csv_text` is
-the measured file (marked SYNTHETIC).
+:math:`\epsilon\sim N(0,\sigma)`, plus complex Gaussian noise of RMS :data:`FLOOR`;
+:func:`draw_case` draws, simulates and measures a :class:`SyntheticCase`.
 """
 
 from __future__ import annotations
@@ -45,17 +43,15 @@ def written_levels(velocity, floor=FLOOR):
 
 
 def gaps_db(reference, velocity) -> np.ndarray:
-    """``|gap|`` [dB] of ``velocity`` against ``reference`` (both (n_r, n_ch, 16) [m/s peak])
-    at the written order points that are not both at the floor (the one noise-floor rule,
-    :func:`powertrain.analysis.noise_floor.censoring_level`), flattened."""
+    """Flat ``|gap|`` [dB] of ``velocity`` against ``reference`` (both (n_r, n_ch, 16) [m/s
+    peak]) at the written order points not both at the floor."""
     a, b = written_levels(reference), written_levels(velocity)
     keep = np.maximum(a, b) >= censoring_level(FLOOR)
     return np.abs(20 * np.log10(b / a))[keep]
 
 
 def gap_stats(reference, velocity):
-    """(RMS, 95th percentile of |gap|) [dB] of ``velocity`` against ``reference``
-    (:func:`gaps_db`); ``(0, 0)`` where no point is above the floor."""
+    """(RMS, 95th percentile) of :func:`gaps_db` [dB]; ``(0, 0)`` with no point above floor."""
     g = gaps_db(reference, velocity)
     if g.size == 0:
         return 0.0, 0.0
@@ -64,13 +60,10 @@ def gap_stats(reference, velocity):
 
 def measure(velocity, sigma_db, rng, source="", channels=None, rpm=RPM, phase=None):
     """Noisy measured run-up (:class:`~powertrain.iotools.measured.MeasuredRunup`) of a
-    noise-free run-up.
+    noise-free one.
 
-    Phases carry a scatter of σ·ln10/20 rad (the phase twin of the level scatter), the
-    noise's phase (so their scatter grows as the level nears the floor) and the lab's TDC
-    error δ ~ N(0, :data:`TDC_SD_DEG`) crank (order k: −kδ); a phase is given only where the
-    measured level is above the floor's RMS (below it the order is noise, its phase
-    undefined). Drawn after the levels, which stay as without phase.
+    Phases carry a scatter of σ·ln10/20 rad, the noise's phase and a TDC error
+    δ ~ N(0, :data:`TDC_SD_DEG`) crank (order k: −kδ); given only above the floor.
 
     Parameters
     ----------
@@ -81,14 +74,13 @@ def measure(velocity, sigma_db, rng, source="", channels=None, rpm=RPM, phase=No
     rng : numpy.random.Generator
         Source of the scatter and noise.
     source : str
-        Description of the run-up (its comment line reads ``SYNTHETIC: source``).
+        Description of the run-up (comment ``SYNTHETIC: source``).
     channels : list of (str, str)
         ``(mount, direction)`` of each channel of ``velocity``.
     rpm : array_like
-        Speeds [rpm] of the rows of ``velocity`` (default :data:`RPM`).
+        Speeds [rpm] of the rows of ``velocity``.
     phase : {None, "all", "whole"}
-        None (levels only), ``"all"`` (every written order's phase, as with a cycle
-        reference) or ``"whole"`` (whole orders only: no cycle reference).
+        Levels only, every written order's phase, or whole orders' only.
     """
     amp = velocity / np.sqrt(2) * 10 ** (rng.normal(0, sigma_db, velocity.shape) / 20)
     noise = FLOOR * (rng.normal(size=amp.shape) + 1j * rng.normal(size=amp.shape)) / np.sqrt(2)
@@ -110,8 +102,7 @@ def measure(velocity, sigma_db, rng, source="", channels=None, rpm=RPM, phase=No
 
 
 def _measured_phase(complex_rms, sigma_db, rng):
-    """Measured phase [deg] of every order (n_r, n_ch, 16): the scatter's phase twin and the
-    run's TDC error added (:func:`measure`)."""
+    """Measured phase [deg] of every order (n_r, n_ch, 16), scatter and TDC error added."""
     scatter = rng.normal(0, sigma_db * np.log(10) / 20, complex_rms.shape)
     delta = np.deg2rad(rng.normal(0, TDC_SD_DEG))
     k = 0.5 * np.arange(1, complex_rms.shape[-1] + 1)
@@ -122,10 +113,9 @@ def _measured_phase(complex_rms, sigma_db, rng):
 class SyntheticCase:
     """A synthetic measured run-up and the hidden effects behind it.
 
-    ``names`` the hidden effects, ``truth`` ``[(name, parameters)]``, ``clean`` the noise-free
-    run-up with them (n_r, n_ch, 16) [m/s peak], ``noise_db`` the measurement scatter [dB,
-    1σ], ``stats`` the noise-free gap against the run-up without them (:func:`gap_stats`),
-    ``member_stats`` that of each member of a pair alone, ``measured`` what a diagnosis reads.
+    ``truth`` ``[(name, parameters)]``, ``clean`` the noise-free run-up (n_r, n_ch, 16) [m/s
+    peak], ``noise_db`` the scatter [dB, 1σ], ``stats`` the noise-free gap
+    (:func:`gap_stats`), ``member_stats`` each member of a pair's alone.
     """
 
     names: list
@@ -143,9 +133,8 @@ class SyntheticCase:
         return self.stats[0]
 
     def csv_text(self) -> str:
-        """The measured CSV (long format); with a body under the mounts (channels
-        ``NAME/passive`` and body points) with the ``side`` column; with measured phase the
-        ``phase_deg`` column (empty where none is given)."""
+        """The measured CSV (long format; ``side`` column with a body, ``phase_deg`` with
+        phase)."""
         names = {m for m, _, _ in self.measured.curves}
         bases = {split_side(m)[0] for m in names if split_side(m)[1] == "passive"}
         phases = getattr(self.measured, "phases", None) or {}
@@ -156,7 +145,7 @@ class SyntheticCase:
         for (m, d, q), (r, v) in self.measured.curves.items():
             base, side = split_side(m)
             if bases and side == "active" and base not in bases:
-                side = "passive"                     # a body point of interest
+                side = "passive"                     # a body point
             col = f",{side}" if bases else ""
             phi = phases.get((m, d, q), np.full(len(r), np.nan))
             for ri, vi, pi in zip(r, v, phi):
@@ -174,31 +163,24 @@ def draw_case(names, seed, engine, base, simulate, draw, channels, source, *, rp
     names : list of str
         Hidden effects (empty: effect-free).
     seed : int
-        Seed of every draw of the case (effects, scatter, noise).
+        Seed of every draw (effects, scatter, noise).
     engine : Engine
         Baseline model.
     base : ndarray
         Noise-free run-up without the effects (n_r, n_ch, 16) [m/s peak].
-    simulate : callable
-        ``simulate(engine, truth)``: noise-free run-up with ``truth`` ``[(name, parameters)]``.
-    draw : callable
-        ``draw(name, rng, engine)``: random parameters (dict) of one effect.
-    channels : list of (str, str)
-        Measured channels (:func:`measure`).
-    source : str
-        Description of the run-up.
-    rpm : array_like
-        Speeds [rpm].
+    simulate, draw : callable
+        ``simulate(engine, truth)``: noise-free run-up; ``draw(name, rng, engine)``: one
+        effect's random parameters.
+    channels, source, rpm, phase
+        As for :func:`measure` (``rpm`` [rpm]).
     noise_db : float, optional
         Scatter [dB, 1σ] (default uniform :data:`SIGMA_DB`).
     params : dict, optional
-        ``{name: parameters}`` fixed instead of drawn (missing keys are drawn).
+        ``{name: parameters}`` fixed instead of drawn.
     redraws : int
-        Draws of the effects until ``worth(base, clean)`` holds (the last is kept).
+        Draws until ``worth(base, clean)`` holds (else the last is kept).
     worth : callable, optional
         Redraw rule; None keeps the first draw.
-    phase : {None, "all", "whole"}
-        Measured phase (:func:`measure`).
     """
     rng = np.random.default_rng(seed)
     truth, clean = [], base

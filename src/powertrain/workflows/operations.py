@@ -1,12 +1,9 @@
 """Operations on the mount system: what a variant spec becomes, and how it is applied.
 
-Frozen, picklable dataclasses holding SI values and the spec they came from
-(:class:`Scale`, :class:`SetParameter`, :class:`Swap`, :class:`Move`, :class:`Rotate`,
-:class:`Target`, :class:`AddEffect`); each ``apply`` returns a new
-:class:`~powertrain.models.engine.Engine` (nothing is mutated). :func:`apply_operations`
-applies a sequence in order; unknown mount, direction or parameter names raise
-:class:`~powertrain.errors.InputError` naming where the spec came from. The spec syntax and
-its parsers: :mod:`powertrain.workflows.variants`.
+Frozen, picklable dataclasses of SI values and their spec; each ``apply`` returns a new
+:class:`~powertrain.models.engine.Engine`, unknown names raise
+:class:`~powertrain.errors.InputError` naming the spec's origin. Parsers:
+:mod:`powertrain.workflows.variants`.
 """
 
 from __future__ import annotations
@@ -25,12 +22,9 @@ from powertrain.physics.mount_laws import BergFriction, PowerLaw, StaticCurve
 #: Mount or direction name that matches every mount or direction.
 WILDCARD = "*"
 
-#: What-if keys of a mount direction's laws (the mount file's ``[amplitude]``,
-#: ``[friction]`` and ``[static]`` sections): ``"section.key"`` -> (dimension of the value,
-#: its unit family in the mount file's ``[units]``, ``x`` or ``F``
-#: (:data:`powertrain.iotools.mount_file.SECTION_UNITS`; None: no unit), ``--scale``
-#: allowed, ``--set`` allowed). ``amplitude.limits`` is set as ``LO,HI``; ``static.force``
-#: scales every force of the curve.
+#: What-if keys of a mount direction's laws: ``"section.key"`` -> (dimension, unit family
+#: ``x``/``F`` of :data:`powertrain.iotools.mount_file.SECTION_UNITS` or None, ``--scale``
+#: allowed, ``--set`` allowed). ``amplitude.limits`` is set as ``LO,HI``.
 LAW_KEYS = {
     "amplitude.reference": ("length", "x", True, True),
     "amplitude.exponent": (None, None, True, True),
@@ -41,10 +35,8 @@ LAW_KEYS = {
     "static.force": ("force", "F", True, False),
     "static.reference_deflection": ("length", "x", False, True),
 }
-#: The law a ``--set`` creates in a direction without the section: one that leaves the mount
-#: linear until the set key changes it (amplitude: power law at 0.1 mm, exponent 0, limits
-#: [0.2, 5]; friction: max_force 0 N, half_displacement 0.05 mm). A static curve is never
-#: invented: ``static.*`` needs the section.
+#: The law a ``--set`` creates in a direction without the section, linear until the set key
+#: changes it (a static curve is never invented).
 LAW_DEFAULTS = {"amplitude": PowerLaw(1e-4, 0.0, (0.2, 5.0)),
                 "friction": BergFriction(0.0, 5e-5)}
 _LAW_FIELDS = {"amplitude": ("amplitude_law", PowerLaw), "friction": ("port_law", BergFriction),
@@ -53,17 +45,7 @@ _LAW_FIELDS = {"amplitude": ("amplitude_law", PowerLaw), "friction": ("port_law"
 
 @dataclass(frozen=True)
 class Origin:
-    """Where a spec came from, for error messages.
-
-    Attributes
-    ----------
-    key : str
-        Command-line option (``--scale``) or variants-file key (``variant[2].scale``).
-    file : str or None
-        Variants file.
-    line : int or None
-        1-based line in ``file``.
-    """
+    """Where a spec came from: option or variants-file ``key``, ``file``, 1-based ``line``."""
 
     key: str
     file: str | None = None
@@ -76,16 +58,8 @@ class Origin:
 
 @dataclass(frozen=True)
 class Scale:
-    """Scale springs, dampers or the whole network of matching mount directions.
-
-    Attributes
-    ----------
-    mount, direction : str
-        Names or ``*``.
-    kind : {"stiffness", "damping", "dynamic"} or a scalable key of :data:`LAW_KEYS`
-    factor : float
-        > 0 [1].
-    """
+    """Scale springs, dampers or the whole network (``kind``; or a scalable key of
+    :data:`LAW_KEYS`) of matching mount directions (names or ``*``) by ``factor`` > 0."""
 
     mount: str
     direction: str
@@ -108,20 +82,8 @@ class Scale:
 
 @dataclass(frozen=True)
 class SetParameter:
-    """Set one parameter of matching mount directions.
-
-    Attributes
-    ----------
-    mount, direction : str
-        Names or ``*``.
-    parameter : str
-        ``c2``, ``d4``, ``m1``... or a settable key of :data:`LAW_KEYS`
-        (``friction.max_force``); a direction without that section gets
-        :data:`LAW_DEFAULTS`' law first.
-    value : float or tuple
-        SI value: [N/m], [N·s/m], [kg], [m], [N], [1]; ``(lo, hi)`` for
-        ``amplitude.limits``.
-    """
+    """Set ``parameter`` (``c2``, ``d4``, ``m1``... or a settable key of :data:`LAW_KEYS`) of
+    matching mount directions to ``value`` (SI; ``(lo, hi)`` for ``amplitude.limits``)."""
 
     mount: str
     direction: str
@@ -145,16 +107,7 @@ class SetParameter:
 
 @dataclass(frozen=True)
 class Swap:
-    """Replace one mount direction's model.
-
-    Attributes
-    ----------
-    mount, direction : str
-    model : MountModel
-        The new model (SI).
-    path : str
-        Mount file it was read from (or a description).
-    """
+    """Replace one mount direction's model by ``model``, read from ``path``."""
 
     mount: str
     direction: str
@@ -173,15 +126,7 @@ class Swap:
 
 @dataclass(frozen=True)
 class Move:
-    """Shift matching mount points.
-
-    Attributes
-    ----------
-    mount : str
-        Name or ``*``.
-    offset : tuple of float
-        (dx, dy, dz) in engine axes [m].
-    """
+    """Shift matching mount points by ``offset`` (dx, dy, dz) in engine axes [m]."""
 
     mount: str
     offset: tuple
@@ -196,15 +141,8 @@ class Move:
 
 @dataclass(frozen=True)
 class Rotate:
-    """Rotate matching mounts' local axes about the engine axes through the mount point.
-
-    Attributes
-    ----------
-    mount : str
-        Name or ``*``.
-    angles : tuple of float
-        (ax, ay, az) [rad]: first ax about engine X, then ay about Y, then az about Z.
-    """
+    """Rotate matching mounts' local axes by ``angles`` (ax, ay, az) [rad] about engine X,
+    then Y, then Z."""
 
     mount: str
     angles: tuple
@@ -219,22 +157,9 @@ class Rotate:
 
 @dataclass(frozen=True)
 class Target:
-    """A desired change of a mount direction's K_CP over a band (resolved by fitting, see
-    :func:`powertrain.workflows.retune.retune`; cannot be applied directly).
-
-    Attributes
-    ----------
-    mount, direction : str
-    factor : float
-        Desired K_CP ratio inside the band (1.2 for ``+20%``) [1], > 0.
-    f_lo, f_hi : float
-        Band [Hz], 0 < f_lo < f_hi.
-    blend_octaves : float
-        Width of the smooth transition outside the band [octaves] (default 0.5).
-    amplitude : float or None
-        Relative-displacement amplitude [m] at which the change is asked (the direction's
-        K_CP with its amplitude law and friction there); None: the network as it is.
-    """
+    """A desired K_CP ratio ``factor`` of a mount direction over the band ``f_lo..f_hi`` [Hz],
+    blended over ``blend_octaves`` outside, at ``amplitude`` [m] (None: the network alone);
+    resolved by :func:`powertrain.workflows.retune.retune`."""
 
     mount: str
     direction: str
@@ -256,18 +181,9 @@ class Target:
 
 @dataclass(frozen=True)
 class AddEffect:
-    """An unmodelled effect of :data:`powertrain.effects.EFFECTS` with its parameters.
-
-    Engine-model effects are applied by :meth:`apply`; the response-level ones
-    (``amplitude_stiffness``, ``sensor_error``) leave the engine unchanged here and are
-    applied to the run-up by :func:`powertrain.workflows.sweeps.run_task` through
-    :func:`powertrain.workflows.runup.runup_with_effects`.
-
-    Attributes
-    ----------
-    effect : str
-    params : tuple of (name, SI value)
-    """
+    """An unmodelled effect of :data:`powertrain.effects.EFFECTS` with ``params`` ((name, SI
+    value) pairs); response-level effects leave the engine as it is (they act on the run-up,
+    :func:`powertrain.workflows.runup.runup_with_effects`)."""
 
     effect: str
     params: tuple = ()
@@ -282,8 +198,7 @@ class AddEffect:
 
 
 def effect_scenario(operations, names=None) -> dict:
-    """``{effect: {parameter: value}}`` of the :class:`AddEffect` operations, merged in order
-    (only the effects in ``names``, if given)."""
+    """``{effect: {parameter: value}}`` of the :class:`AddEffect` operations (in ``names``)."""
     sc: dict = {}
     for op in operations:
         if isinstance(op, AddEffect) and (names is None or op.effect in names):
@@ -304,7 +219,6 @@ class Variant:
         return [op.spec for op in self.operations]
 
 
-# --------------------------------------------------------------------------- geometry
 def rotation_matrix(ax: float, ay: float, az: float) -> np.ndarray:
     """:math:`R_z(a_z) R_y(a_y) R_x(a_x)`: rotations about the fixed X, Y, Z axes [rad]."""
     cx, sx, cy, sy, cz, sz = (math.cos(ax), math.sin(ax), math.cos(ay), math.sin(ay),
@@ -315,7 +229,6 @@ def rotation_matrix(ax: float, ay: float, az: float) -> np.ndarray:
     return rz @ ry @ rx
 
 
-# --------------------------------------------------------------------------- apply
 def _map_mounts(engine, mount, change, origin):
     names = engine.mount_names
     if mount != WILDCARD and mount not in names:
@@ -337,9 +250,8 @@ def _map_directions(engine, mount, direction, change, origin):
 
 
 def law_changed(model, key, change, create=False):
-    """``model`` (MountModel) with the law value ``key`` (of :data:`LAW_KEYS`) replaced by
-    ``change(old value)``; ``create``: a missing section starts from :data:`LAW_DEFAULTS`.
-    Raises ``LookupError`` (one line) when the direction has no such law."""
+    """``model`` with the law value ``key`` replaced by ``change(old)`` (``create``: from
+    :data:`LAW_DEFAULTS` if missing); LookupError when there is no such law."""
     section, name = key.split(".")
     field, kind = _LAW_FIELDS[section]
     law = getattr(model, field)
@@ -357,9 +269,7 @@ def law_changed(model, key, change, create=False):
 
 
 def _plausible(model, op):
-    """``model``, changed by ``op``, if its parameters are plausible and its network holds
-    at 0 Hz as a mount file's must (:func:`~powertrain.iotools.mount_file.check_plausible`);
-    else the error, located at ``op``'s origin."""
+    """``model`` if plausible as a mount file's must be, else an error at ``op``'s origin."""
     try:
         check_plausible(model, None)
         check_network(model, None)
@@ -369,8 +279,7 @@ def _plausible(model, op):
 
 
 def _map_laws(engine, op, key, change, create=False):
-    """``engine`` with ``law_changed`` on the directions ``op`` names. A named direction
-    without the law is an error; a wildcard skips such directions but must match one."""
+    """``law_changed`` on ``op``'s directions; a wildcard skips those without the law."""
     done, missing = [], []
 
     def one(model):
@@ -388,17 +297,14 @@ def _map_laws(engine, op, key, change, create=False):
 
 
 def apply_operations(engine, operations):
-    """Apply operations in order; returns a new Engine (``engine`` is not changed).
+    """Apply operations in order; returns a new Engine.
 
     Parameters
     ----------
     engine : Engine
-    operations : sequence of operation objects (not :class:`Target`; resolve those first)
-
-    Raises
-    ------
-    InputError
-        Unknown mount, direction or parameter, named with the spec's origin.
+        The engine (not changed).
+    operations : sequence
+        Operation objects, :class:`Target` resolved first.
     """
     for op in operations:
         engine = op.apply(engine)
