@@ -14,14 +14,12 @@ width in octaves (default 0.5), the requested curve is :math:`K_t = K_0\,g\,e^{i
     \varphi(f_0) = \frac1\pi \int_{-\infty}^{\infty} \frac{d \ln g}{du}\,
                    \ln\coth\frac{|u|}{2}\, du, \qquad u = \ln(f / f_0),
 
-the phase of a minimum-phase change (Bode's gain-phase relation). The fit has two stages:
-:func:`~powertrain.workflows.fitting.fit_mount` of the baseline topology to :math:`K_t`,
-then a joint least-squares refinement of the relative errors of :math:`K_{CP}` against
-:math:`K_t` and of :math:`K_{IP}` against :math:`K_{IP,0} + (K_t - K_0)`, started from that
-fit and from the baseline (lower cost wins). At an amplitude (``...:0.3mm``) :math:`K_0` is
-the equivalent-linear K_CP there (:func:`network_at`). Frequencies: 0 Hz plus
-:data:`N_FREQUENCIES` log-spaced from 1 Hz to :math:`\max(1000\,\mathrm{Hz},\ 2^{h+1} f_2)`.
-Why and the fit quality reported: docs/guide/whatif.md (*Retune to a target*).
+the minimum-phase phase (Bode's gain-phase relation). Stage one fits the baseline topology
+to :math:`K_t` (:func:`~powertrain.workflows.fitting.fit_mount`); stage two refines by joint
+least squares the relative errors of :math:`K_{CP}` against :math:`K_t` and of :math:`K_{IP}`
+against :math:`K_{IP,0} + (K_t - K_0)`, from that fit and from the baseline (lower cost
+wins). At an amplitude :math:`K_0` is the equivalent-linear K_CP there (:func:`network_at`).
+docs/guide/whatif.md (*Retune to a target*).
 """
 
 from __future__ import annotations
@@ -55,7 +53,7 @@ def band_weight(frequency_hz, f_lo, f_hi, blend_octaves=0.5) -> np.ndarray:
     Parameters
     ----------
     frequency_hz : array_like
-        [Hz]; 0 Hz gives 0 (outside every band).
+        [Hz]; 0 Hz gives 0.
     f_lo, f_hi : float
         Band edges [Hz].
     blend_octaves : float
@@ -75,7 +73,7 @@ def _dlog_weight_dlnf(x, f_lo, f_hi, h):
     out = np.zeros_like(x)
     lo = (below > 0) & (below < 1)
     hi = (above > 0) & (above < 1)
-    # w = (1 + cos(pi delta))/2, d delta / d ln f = -1/(h ln2) below, +1/(h ln2) above
+    # d delta / d ln f = -1/(h ln2) below, +1/(h ln2) above
     out[lo] = 0.5 * np.pi * np.sin(np.pi * below[lo]) / (h * np.log(2))
     out[hi] = -0.5 * np.pi * np.sin(np.pi * above[hi]) / (h * np.log(2))
     return out
@@ -84,10 +82,8 @@ def _dlog_weight_dlnf(x, f_lo, f_hi, h):
 def bode_phase(frequency_hz, log_factor, f_lo, f_hi, blend_octaves=0.5) -> np.ndarray:
     r"""Minimum-phase phase [rad] of the gain :math:`\ln g = a\,w(f)` (Bode gain-phase).
 
-    :math:`\varphi(f_0) = \frac1\pi\int \frac{d\ln g}{du}\ln\coth\frac{|u|}2\,du`,
-    :math:`u = \ln(f/f_0)`; the derivative is non-zero only in the two transition zones,
-    integrated by the midpoint rule with :data:`_BODE_POINTS` points each (the log
-    singularity of the kernel is integrable). Positive inside a band of increased gain.
+    Midpoint rule over the two transition zones (:data:`_BODE_POINTS` points each; the
+    kernel's log singularity is integrable).
 
     Parameters
     ----------
@@ -126,12 +122,9 @@ def _gain(target: Target, frequency_hz) -> np.ndarray:
 
 
 def network_at(model, target: Target, frequency_hz):
-    """What a target retunes: ``(network, friction [N/m] per frequency, (ks, ds))``.
-
-    Without an amplitude: ``model`` itself, no friction term, factors 1. At an amplitude A:
-    the network with its amplitude law's factors ``(ks, ds)`` at A and the friction's
-    describing stiffness at A (zero at 0 Hz), as in :meth:`MountElement.two_port
-    <powertrain.physics.mount_elements.MountElement.two_port>`."""
+    """What a target retunes: ``(network, friction [N/m] per frequency, (ks, ds))``: at the
+    target's amplitude the network scaled by its amplitude law and Berg's describing
+    stiffness (0 at 0 Hz); without one ``model``, 0, factors 1."""
     f = np.asarray(frequency_hz, float)
     if target.amplitude is None:
         return model, np.zeros(f.shape), (1.0, 1.0)
@@ -147,41 +140,18 @@ def network_at(model, target: Target, frequency_hz):
 
 
 def fit_frequencies(target: Target) -> np.ndarray:
-    """0 Hz plus :data:`N_FREQUENCIES` log-spaced frequencies [Hz] (module docstring)."""
+    """0 Hz plus :data:`N_FREQUENCIES` log-spaced from 1 Hz to max(1 kHz, 2^(h+1) f_hi) [Hz]."""
     f_max = max(F_MAX_HZ, 2.0 ** (target.blend_octaves + 1) * target.f_hi)
     return np.concatenate([[0.0], np.geomspace(F_MIN_HZ, f_max, N_FREQUENCIES)])
 
 
 @dataclass(frozen=True)
 class TargetFit(Result):
-    r"""Outcome of a retune.
-
-    Attributes
-    ----------
-    target : Target
-    baseline : MountModel
-        The mount direction before retuning.
-    model : MountModel
-        Retuned model (SI).
-    frequency_hz : ndarray
-        Fit frequencies [Hz].
-    kcp_baseline, kcp_target, kcp_fitted : ndarray of complex
-        Cross-point stiffness [N/m] at ``frequency_hz``.
-    kip_target, kip_fitted : ndarray of complex
-        Input-point stiffness [N/m] at ``frequency_hz``.
-    rel_rms : float
-        Relative RMS error of K_CP over all frequencies, :math:`\sqrt{\sum|K-K_t|^2/\sum|K_t|^2}` [1].
-    kip_rel_rms : float
-        The same for K_IP against its target [1].
-    max_band_error : float
-        Largest :math:`|K_{fit}-K_t|/|K_t|` inside the band [1].
-    mean_band_change : float
-        Mean of :math:`|K_{fit}|/|K_0| - 1` inside the band (requested: factor - 1) [1].
-    start : str
-        Start of the retained refinement: ``baseline`` or ``fit_mount``.
-    fit_summary : str
-        :meth:`powertrain.workflows.fitting.FitResult.summary` of stage 1.
-    """
+    r"""Outcome of a retune: ``baseline`` and retuned ``model``; K_CP (baseline, target,
+    fitted) and K_IP (target, fitted) [N/m] at ``frequency_hz`` [Hz]; relative RMS errors
+    ``rel_rms`` (K_CP) and ``kip_rel_rms`` [1]; in the band the largest
+    :math:`|K_{fit}-K_t|/|K_t|` and the mean :math:`|K_{fit}|/|K_0| - 1` [1]; the refinement's
+    ``start`` (``baseline`` or ``fit_mount``) and stage one's summary."""
 
     target: Target
     baseline: object
@@ -235,10 +205,8 @@ class TargetFit(Result):
 
     def plot(self, ax=None, *, path=None, form="magnitude-phase", freq_axis="log",
              provenance=None):
-        """Baseline, requested and fitted K_CP; returns the figure (see
-        :func:`powertrain.plotting.plot_retune`; ``ax`` as for
-        :meth:`powertrain.results.stiffness.StiffnessResult.plot`); ``save(path)`` writes
-        it (``.png``)."""
+        """Baseline, requested and fitted K_CP (:func:`powertrain.plotting.plot_retune`);
+        returns the figure."""
         ax, path = target_and_path(ax, path)
         return plot_retune(self, path, ax=ax, form=form, freq_axis=freq_axis,
                            provenance=provenance)
@@ -247,7 +215,6 @@ class TargetFit(Result):
 def _refine(topology, p0, free, f, kt_cp, kt_ip):
     """Joint least squares of K_CP and K_IP relative errors over log-factors of the free
     parameters of ``p0``; returns (parameters [SI], cost)."""
-
     w_cp, w_ip = 1.0 / np.abs(kt_cp), 1.0 / np.abs(kt_ip)
 
     def params(q):
@@ -275,21 +242,21 @@ REFINE_NFEV = 3000
 
 
 def retune(model, target: Target, **fit_kwargs) -> TargetFit:
-    """Retune ``model`` (same topology, its laws kept) to the requested curve of ``target``
-    (at ``target.amplitude``: the equivalent-linear K_CP there, :func:`network_at`).
+    """Retune ``model`` (same topology, laws kept) to the requested curve of ``target``.
 
     Parameters
     ----------
     model : MountModel
         Baseline model of the mount direction (SI).
     target : Target
+        The requested change.
     **fit_kwargs
-        Passed to :func:`powertrain.workflows.fitting.fit_mount` (``starts``, ``seed``...).
+        Passed to :func:`powertrain.workflows.fitting.fit_mount`.
 
     Returns
     -------
     TargetFit
-        Its curves at the target's amplitude (with the friction).
+        Curves at the target's amplitude (with the friction).
     """
     f = fit_frequencies(target)
     net, k_fr, (ks, ds) = network_at(model, target, f)
@@ -327,14 +294,7 @@ def _target_fit(target, model, fitted, f, k0, kt, kip_t, kf, kip_f, start, summa
 
 
 def retuned_swap(engine, target: Target, **fit_kwargs):
-    """Retune the mount direction of ``target`` as ``engine`` has it: the :class:`Swap` that
-    puts the fitted model in, and the fit.
-
-    Returns
-    -------
-    swap : Swap
-    fit : TargetFit
-    """
+    """Retune ``target``'s mount direction of ``engine``: ``(Swap, TargetFit)``."""
     target.check(engine)
     tf = retune(engine.mount(target.mount).directions[target.direction], target, **fit_kwargs)
     return Swap(target.mount, target.direction, tf.model, path=f"<fitted: {target.spec}>",

@@ -1,13 +1,10 @@
 r"""The run-up: engine -> assembled model -> solver -> order results.
 
-:func:`runup` is the public entry (``powertrain runup``): the engine and settings checked,
-balancers and unmodelled effects applied, then a stepped run-up (:func:`run_runup`,
-:func:`runup_with_effects`) or a continuous one (``sweep``, tracked like a measurement).
-Per speed step the load over one engine cycle at a constant crank-angle increment drives
-the periodic steady state of the assembled linear model, by Newmark time integration over
-:data:`CYCLES` cycles, :data:`PROCESSED_CYCLES` processed by FFT (the thesis's way, sec.
-4.4), or by the frequency-domain solve order by order (``harmonic``); the stepper is chosen
-once per run (:func:`powertrain.solvers.steppers.choose_stepper`). docs/guide/runup.md.
+:func:`runup` (``powertrain runup``) checks the engine and settings, applies balancers and
+effects, then runs a stepped run-up (:func:`run_runup`) or a continuous one (``sweep``,
+tracked like a measurement). Per speed step the load over one engine cycle drives the
+periodic steady state: Newmark over :data:`CYCLES` cycles, :data:`PROCESSED_CYCLES` processed
+by FFT (thesis sec. 4.4), or the frequency-domain solve (``harmonic``). docs/guide/runup.md.
 """
 
 from __future__ import annotations
@@ -30,11 +27,7 @@ from powertrain.results.runup import RunupResult, SweepRunup
 from powertrain.results.static import StaticResult
 from powertrain.solvers.equivalent_linear import AmplitudeNotConverged
 from powertrain.solvers.modes import COORDINATES, kinetic_energy_percent
-from powertrain.solvers.operating_point import (
-    has_static_curves,
-    operating_points,
-    static_factors,
-)
+from powertrain.solvers.operating_point import has_static_curves, operating_points, static_factors
 from powertrain.solvers.speed_ramp import simulate_sweep
 from powertrain.solvers.steppers import NEWMARK_STEPPERS, SOLVERS, Cycles, choose_stepper
 from powertrain.workflows import arguments as args
@@ -43,16 +36,15 @@ from powertrain.workflows.operations import effect_scenario
 from powertrain.workflows.tracking import track_recording
 from powertrain.workflows.variants import parse_operations
 
-#: Default crank-angle increment [deg]; halving it moves the results < 0.1 % (see tests).
+#: Default crank-angle increment [deg]; halving it moves the results < 0.1 %.
 ANGLE_STEP_DEG = 1.0
 #: Cycles simulated per speed step and cycles processed (thesis sec. 4.4).
 CYCLES = 6
 PROCESSED_CYCLES = 2
 #: Periodicity above which a warning is raised.
 PERIODICITY_LIMIT = 1e-3
-#: Finest crank-angle step [deg] of the Newmark stepper (720 / 0.05 = 14 400 steps a cycle).
+#: Finest and coarsest crank-angle step [deg] (72 steps a cycle resolve order 8).
 MIN_ANGLE_STEP_DEG = 0.05
-#: Coarsest crank-angle step [deg]: 72 steps a cycle still resolve order 8 without aliasing.
 MAX_ANGLE_STEP_DEG = 10.0
 #: Tracking of a continuous run-up: 50 rpm grid; speed, phase from its tacho (TDC offset 0).
 SWEEP_TRACKING = {"rpm_step": 50.0, "pulses_per_rev": 1, "tdc_offset_deg": 0.0}
@@ -63,9 +55,7 @@ class PeriodicityWarning(PowertrainWarning):
 
 
 def _cycle_loads(engine, rpm, n_per_cycle):
-    """Generalized load over one engine cycle at every speed, (n_speeds, n_per_cycle, 6):
-    :meth:`Engine.load_table <powertrain.models.engine.Engine.load_table>` (the block load's
-    patterns evaluated once; ``generalized_load`` of each speed to round-off)."""
+    """Generalized load over one engine cycle at every speed, (n_speeds, n_per_cycle, 6)."""
     theta = np.arange(n_per_cycle) * (4 * np.pi / n_per_cycle)
     load = np.asarray(engine.load_table(rpm, theta), float)
     if load.shape != (len(rpm), n_per_cycle, 6) or not np.all(np.isfinite(load)):
@@ -76,8 +66,7 @@ def _cycle_loads(engine, rpm, n_per_cycle):
 def run_runup(engine, rpm=None, *, solver="newmark", angle_step_deg=ANGLE_STEP_DEG,
               cycles=CYCLES, processed_cycles=PROCESSED_CYCLES, progress=False,
               system=None, stepper="auto") -> RunupResult:
-    """Simulate a run-up: steady state at each speed, order analysis of the mount points
-    (BLAS limited to one thread meanwhile, :func:`~powertrain.parallel.single_blas_thread`).
+    """Simulate a run-up: steady state at each speed, order analysis of the mount points.
 
     Parameters
     ----------
@@ -86,18 +75,18 @@ def run_runup(engine, rpm=None, *, solver="newmark", angle_step_deg=ANGLE_STEP_D
     rpm : array_like, optional
         Speed steps [rpm]; default 1000..6000 step 500.
     solver : {"newmark", "harmonic"}
+        Time integration or frequency-domain solve.
     angle_step_deg : float
-        Constant crank-angle increment [deg]; must divide 720 into an even number of steps.
+        Crank-angle increment [deg]; must divide 720 into an even number of steps.
     cycles, processed_cycles : int
         Engine cycles simulated and processed (Newmark only).
     progress : bool
-        Show a progress bar over the speed steps.
+        Progress bar over the speed steps.
     system : AssembledSystem, optional
         Pre-assembled model (default: assembled from ``engine``).
     stepper : {"auto", "modal", "dense"}
-        Newmark implementation: ``modal`` (the same recurrence diagonalised once per model,
-        :class:`~powertrain.solvers.newmark.ModalNewmark`; needs a regular mass matrix),
-        ``dense`` (the physical-coordinate kernel) or ``auto`` (modal when possible).
+        Newmark implementation: ``modal`` (diagonalised once, needs a regular mass matrix),
+        ``dense`` or ``auto`` (modal when possible).
 
     Returns
     -------
@@ -139,11 +128,8 @@ def _cycles(angle_step_deg, cycles, processed_cycles) -> Cycles:
 
 
 def _solve_speeds(engine, step, rpm, loads, points, bar):
-    """Every speed's :class:`SpeedOrders` and the solver time. With operating ``points``,
-    each speed on the model assembled with the networks scaled at its operating point
-    (:meth:`~powertrain.physics.mount_elements.MountElement.at_operating_point`), by a
-    stepper of the kind chosen once, the equivalent-linear amplitudes carried from speed
-    to speed (the per-speed setups timed too)."""
+    """Every speed's :class:`SpeedOrders` and the solver time; with operating ``points``,
+    each speed on the model assembled at its operating point."""
     speeds, total = [], 0.0
     for i in progress_bar(range(rpm.size), **bar):
         if points is not None:
@@ -186,11 +172,9 @@ def _result(engine, system, step, rpm, speeds, solver_seconds, operating_point) 
 
 def path_contributions(system, rpm, force) -> np.ndarray:
     r"""Velocity at every body-point channel carried by each mount path (mount × local
-    direction), complex, per speed and order [m/s]:
-    :math:`\hat v_{P,(m,d)} = i\omega\,\mathbf G_{Pm}(\omega)\,\mathbf e_d\,
-    (\mathbf e_d\cdot\hat{\mathbf f}_m)`, :math:`\hat{\mathbf f}_m` the force mount m puts on
-    the body (engine axes) and :math:`\mathbf G_{Pm}` the body's receptance. The paths of a
-    point sum to its velocity (the body is loaded through the mounts only).
+    direction) per speed and order [m/s]: :math:`\hat v_{P,(m,d)} = i\omega\,\mathbf
+    G_{Pm}(\omega)\,\mathbf e_d\,(\mathbf e_d\cdot\hat{\mathbf f}_m)`, with the mount force
+    on the body :math:`\hat{\mathbf f}_m` and the body's receptance :math:`\mathbf G_{Pm}`.
 
     Returns
     -------
@@ -209,17 +193,12 @@ def path_contributions(system, rpm, force) -> np.ndarray:
     return out
 
 
-# --------------------------------------------------------------------------- effects
 def runup_with_effects(engine, rpm, scenario: dict, **options):
-    """Run-up of ``engine`` with the effects of ``scenario`` (``{effect: {parameter:
-    value}}``, SI) through :func:`run_runup` (``**options``: its keyword arguments);
-    ``settings["effects"]`` records the scenario (a new result: the run-up's is not changed).
+    """:func:`run_runup` (``**options``) of ``engine`` with the effects of ``scenario``
+    (``{effect: {parameter: value}}``, SI), recorded in ``settings["effects"]``.
 
-    * engine-model effects change the engine (``Effect.apply``), in registry order
-      (``amplitude_stiffness`` sets every mount's amplitude law, which either solver
-      carries: the harmonic fixed point, or the Newmark stepper once per engine cycle);
-    * sensor effects: the channels' displacement, velocity and acceleration are read through
-      the effect (the transmitted forces are not sensor readings and stay as they are).
+    Engine-model effects change the engine, in registry order; sensor effects change the
+    channels' displacement, velocity and acceleration (not the forces).
     """
     sc = check_scenario(scenario, engine)
     rpm = np.atleast_1d(np.asarray(rpm, float))
@@ -235,7 +214,6 @@ def runup_with_effects(engine, rpm, scenario: dict, **options):
     return replace(result, **read, settings={**result.settings, "effects": sc})
 
 
-# --------------------------------------------------------------------------- public entry
 def runup(engine=None, rpm=None, *, solver="newmark", stepper="auto",
           angle_step_deg=ANGLE_STEP_DEG, balancers=True, effects=(), sweep=None,
           sample_rate=8192.0, progress=False):
@@ -246,21 +224,19 @@ def runup(engine=None, rpm=None, *, solver="newmark", stepper="auto",
     engine : Engine, str or Path, optional
         The engine, or its file (default: the shipped ``engines/default.toml``).
     rpm : array_like or str, optional
-        Speed steps [rpm], strictly increasing, or as ``"1000:6000:500"`` (default
-        1000..6000 step 500); with ``sweep``, the ramp runs from the first to the last.
+        Speed steps [rpm], or as ``"1000:6000:500"`` (the default); a ``sweep`` ramps from
+        the first to the last.
     solver, stepper, angle_step_deg :
         As in :func:`run_runup`.
     balancers : bool
         False switches the balancer shafts off.
     effects : sequence of str or dict
-        Unmodelled effects, as the command's ``--effect`` strings
-        (``"base_compliance:c_base=400N/mm,m_base=8kg"``) or a scenario
+        ``--effect`` strings (``"base_compliance:c_base=400N/mm"``) or a scenario
         ``{effect: {parameter: value}}`` [SI].
     sweep : float, optional
-        Continuous run-up at this rate [rpm/s] (time integration of one speed ramp), tracked
-        like measured data (no effects).
+        Continuous run-up at this rate [rpm/s], tracked like measured data (no effects).
     sample_rate : float
-        With ``sweep``: sampling rate of the raw data [Hz].
+        With ``sweep``: sampling rate [Hz].
     progress : bool
         Progress bar on stderr.
 
@@ -294,9 +270,8 @@ def runup(engine=None, rpm=None, *, solver="newmark", stepper="auto",
 
 
 def _with_engine(result, engine, rpm, modifications) -> RunupResult:
-    """The stepped run-up with what :func:`runup` adds: the engine that ran and what changed
-    on it, the operating point per speed, the engine file and each mode's dominant
-    coordinate (a new result; the run's is not changed)."""
+    """The run-up with the engine, its modifications, operating points, file and each
+    mode's dominant coordinate."""
     operating_point = result.operating_point
     if operating_point is None:
         operating_point = _static_result(engine, operating_points(engine, rpm))
@@ -309,7 +284,7 @@ def _with_engine(result, engine, rpm, modifications) -> RunupResult:
 
 def _checked_options(solver, stepper, angle_step_deg, balancers, sweep, sample_rate,
                      progress) -> dict:
-    """The options of :func:`runup` checked as the command checks them."""
+    """The options of :func:`runup` checked."""
     args.choice(solver, tuple(SOLVERS), "--solver")
     args.choice(stepper, tuple(NEWMARK_STEPPERS), "--stepper")
     return {"angle_step_deg": args.real(angle_step_deg, "--angle-step", unit="deg"),
@@ -348,7 +323,7 @@ def _sweep_runup(engine, rpm, rate, sample_rate, effects, progress) -> SweepRunu
                          static_factors=factors)
     try:
         tracked = track_recording(rec, **SWEEP_TRACKING, progress=progress).as_velocity()
-    except InputError as exc:        # the simulated ramp is too short or fast to be tracked
+    except InputError as exc:
         raise InputError(f"the {rec.time[-1] - rec.time[0]:.3g} s sweep cannot be order-"
                          f"tracked ({exc.message}); a slower sweep or a wider speed range",
                          key="--sweep") from None
@@ -357,8 +332,7 @@ def _sweep_runup(engine, rpm, rate, sample_rate, effects, progress) -> SweepRunu
 
 
 def check_runup_settings(engine, rpm, angle_step: float) -> None:
-    """Check a run-up's speeds against the engine's range and the crank-angle step, naming
-    the option at fault."""
+    """Check a run-up's speeds against the engine's range and the crank-angle step."""
     lo, hi = engine.speed_range_rpm()
     if rpm[0] < lo - 1e-6:
         raise InputError(f"{rpm[0]:g} rpm is below the engine's range {lo:g}..{hi:g} rpm",
@@ -385,8 +359,8 @@ def check_path_plot(engine, order) -> None:
 
 
 def checked_runup(engine, engine_path, run, *args, **kwargs):
-    """``run(engine, *args, **kwargs)`` (a run-up) through :func:`~powertrain.errors.solved`,
-    checked finite; errors name the engine file (amplitudes not converged: the mount file)."""
+    """``run(engine, *args, **kwargs)`` (a run-up) checked solved and finite; errors name the
+    engine file (or the mount file)."""
     def run_naming_mounts():
         try:
             return run(engine, *args, **kwargs)
@@ -403,9 +377,7 @@ def checked_runup(engine, engine_path, run, *args, **kwargs):
 
 
 def _blamed_input(engine, engine_path):
-    """``(file, key)`` a run-up that cannot be solved points at: the measured receptances of
-    an FRF body (the engine on rigid ground was checked when its file was read), else the
-    engine file."""
+    """``(file, key)`` an unsolvable run-up blames: an FRF body's receptances, else the engine."""
     receptance = getattr(engine.chassis, "receptance", None)
     if getattr(engine.chassis, "coupled_by_admittance", False) and \
             getattr(receptance, "file", ""):
@@ -414,11 +386,8 @@ def _blamed_input(engine, engine_path):
 
 
 def mode_coordinates(engine, frequencies_hz) -> list:
-    """The dominant coordinate (largest kinetic-energy share) of each static-stiffness mode
-    of ``engine``, from the same eigenproblem as the run-up's
-    (:meth:`~powertrain.assembly.AssembledSystem.rigid_body_modes`), matched by frequency;
-    ``""`` where ``frequencies_hz`` holds a mode ``engine`` does not have (an effect moved
-    it)."""
+    """The dominant coordinate (largest kinetic-energy share) of each mode of ``engine``
+    matched to ``frequencies_hz``; ``""`` where none matches."""
     system = engine.assemble()
     f_sys, shapes = system.rigid_body_modes()
     out = []
@@ -431,10 +400,9 @@ def mode_coordinates(engine, frequencies_hz) -> list:
 
 
 def engine_and_file(engine=None):
-    """The engine to run and the file it came from: an Engine as it is (its ``file``), a
-    path read, None the shipped ``engines/default.toml``."""
+    """``(engine, file)`` of an Engine, a path, or None (``engines/default.toml``)."""
     if engine is None or isinstance(engine, (str, os.PathLike)):
         path = str(engine or DEFAULT_ENGINE_PATH)
         return read_engine(path), path
-    engine = engine_or_default(engine)          # refuses what is not an Engine
+    engine = engine_or_default(engine)
     return engine, engine.file

@@ -1,8 +1,6 @@
 """The tracking orchestrator: raw recording -> speed profile -> order curves.
 
-``powertrain track`` and the continuous run-up simulation (``runup --sweep``) both call
-:func:`track_recording`, so a measured sweep and a simulated one pass through the same
-analysis.
+``powertrain track`` and ``runup --sweep`` both call :func:`track_recording`.
 """
 
 from __future__ import annotations
@@ -31,8 +29,7 @@ from powertrain.workflows import arguments as args
 MAX_FREQUENCY_FRACTION = 0.4
 #: Grid speeds per COT call (progress granularity).
 CHUNK = 16
-#: Order spectrum (``track --spectrum-at``): block length [rev], i.e. orders in steps of
-#: 1/16 (integer and half orders fall on a line: no scalloping loss).
+#: Order spectrum block length [rev]: orders in steps of 1/16, no scalloping at half orders.
 SPECTRUM_REVS = 16
 #: ... up to this multiple of the highest tracked order.
 SPECTRUM_EXTENT = 1.25
@@ -68,27 +65,27 @@ def track(raw, *, orders=None, rpm_step=50.0, method="cot", bandwidth=None, chan
     Parameters
     ----------
     raw : str, Path or RawRecording
-        Wide CSV, raw HDF5, UFF 58 or MDF4 file, or a recording read already.
+        Wide CSV, raw HDF5, UFF 58 or MDF4 file, or a recording.
     orders : str or array_like, optional
-        ``start:stop:step`` and/or a list (``"1,2,4.5"``), or the orders (default 0.5..8).
+        ``start:stop:step`` and/or a list (``"1,2,4.5"``), or numbers (default 0.5..8).
     rpm_step, method, bandwidth, quantity, progress
         See :func:`track_recording` (``bandwidth`` [Hz]).
     channel_map : str, Path or ChannelMap, optional
         File channel name -> mount, side, direction, quantity.
     rpm_column, tacho_column : str, optional
-        Speed channel [rpm] or tacho pulse channel (needs ``pulses_per_rev``).
+        Speed channel [rpm] or tacho channel (needs ``pulses_per_rev``).
     as_quantity : {"velocity"}, optional
-        Convert order by order (the spectra and the overall level too).
+        Convert order by order (spectra and overall level too).
     overall : bool
         Also the overall level per speed, in ``overall_band`` (``"LO:HI"`` or (lo, hi) [Hz]).
     spectrum_at : sequence of float
-        Speeds [rpm] of order spectra (``result.spectra``, :func:`order_spectrum`).
+        Speeds [rpm] of order spectra (:func:`order_spectrum`).
     map_channel : str, optional
-        Channel of the maps: its name in the file or its label (default the first).
+        Channel of the maps, name or label (default the first).
     maps : bool
-        Campbell and rpm-frequency maps of that channel (``result.maps``).
+        Campbell and rpm-frequency maps of that channel.
     tdc_offset, cycle_reference : float, str, optional
-        Measure the phases: see :func:`track_recording`; the cycle reference's file channel.
+        Phase reference [deg] (:func:`track_recording`) and the cycle reference channel.
 
     Returns
     -------
@@ -112,7 +109,7 @@ def track(raw, *, orders=None, rpm_step=50.0, method="cot", bandwidth=None, chan
         tracked = tracked.as_velocity()
         spectra = spectra and spectra.as_velocity()
     if spectra:
-        _ = spectra.quantity                      # mixed quantities: fail before any file
+        _ = spectra.quantity                      # mixed quantities fail here
     drawn = _maps(rec, use, pulses_per_rev, rpm_step, _map_channel(rec, map_channel),
                   float(np.max(tracked.orders)),
                   (float(np.min(tracked.rpm)), float(np.max(tracked.rpm)))) if maps else None
@@ -131,9 +128,7 @@ def _numbers(rpm_step, bandwidth, pulses_per_rev, tdc_offset, spectrum_at):
 
 
 def _orders(orders):
-    """``--orders`` as written (``0.5:8:0.5``, ``1,2,4.5``) or numbers: the orders checked
-    as :func:`~powertrain.analysis.order_tracking.parse_orders` checks them (None: the
-    default 0.5..8)."""
+    """``--orders`` as written (``0.5:8:0.5``, ``1,2,4.5``) or numbers, checked (None: default)."""
     if orders is None:
         return None
     if isinstance(orders, str):
@@ -180,7 +175,7 @@ def _spectra(rec, use, pulses_per_rev, speeds, orders, quantity):
     profile = speed_profile(rec, use=use, pulses_per_rev=pulses_per_rev)
     parts = [order_spectrum(rec, profile, rpm, SPECTRUM_EXTENT * float(np.max(orders)),
                             quantity=quantity) for rpm in speeds]
-    size = min(p.orders.size for p in parts)        # the top order is capped by fs / rpm
+    size = min(p.orders.size for p in parts)        # top order capped by fs / rpm
     first = parts[0]
     amp = np.concatenate([p.amplitude[:, :, :size] for p in parts])
     return replace(first, rpm=np.concatenate([p.rpm for p in parts]),
@@ -200,9 +195,8 @@ def _map_channel(rec, name):
 
 
 def _maps(rec, use, pulses_per_rev, rpm_step, channel, max_order, tracked_rpm):
-    """Campbell and rpm-frequency maps of one channel (arguments of
-    :func:`~powertrain.plotting.orders.plot_maps`), both reaching 25 % above the highest
-    tracked order; ``tracked_rpm``: (lowest, highest) speed of the order curves [rpm]."""
+    """Campbell and rpm-frequency maps of one channel (:func:`~powertrain.plotting.orders.
+    plot_maps`'s arguments), reaching 25 % above the highest tracked order."""
     profile = speed_profile(rec, use=use, pulses_per_rev=pulses_per_rev)
     rpm, fine, rms = order_map(rec, profile, channel, rpm_step=rpm_step,
                                max_order=MAP_MARGIN * max_order)
@@ -227,11 +221,13 @@ def track_recording(rec, orders=None, *, rpm_step=50.0, method="cot", use="auto"
     Parameters
     ----------
     rec : RawRecording
+        The recording.
     orders : array_like, optional
         Orders (default 0.5 ... 8 step 0.5).
     rpm_step : float
         Output speed grid [rpm].
     method : {"cot", "vkf"}
+        Computed order tracking or Vold–Kalman filtering.
     use : {"auto", "rpm", "tacho"}
         Speed source.
     pulses_per_rev : int, optional
@@ -239,20 +235,18 @@ def track_recording(rec, orders=None, *, rpm_step=50.0, method="cot", use="auto"
     quantity : str, optional
         Track only channels of this quantity.
     bandwidth_hz : float, optional
-        Vold–Kalman -3 dB half-bandwidth [Hz] (default: per order and speed from the sweep
-        rate, the record length and the order spacing,
+        Vold–Kalman -3 dB half-bandwidth [Hz] (default
         :func:`~powertrain.analysis.vold_kalman.default_bandwidth`).
     block_revs : int, optional
         COT block length [rev].
     overall : dict, optional
-        Also the overall level of the raw signal per speed
-        (:mod:`powertrain.analysis.overall`): ``band`` (lo, hi) [Hz] or None for
-        :func:`overall_band`, ``velocity`` True to give it as velocity.
+        Also the overall level per speed: ``band`` (lo, hi) [Hz] or None
+        (:func:`overall_band`), ``velocity``.
     tdc_offset_deg : float, optional
-        Measure the phases: crank angle of cylinder-1 firing TDC after the tacho reference
-        pulse [deg] (:func:`~powertrain.analysis.phase.tdc_origin`; ``use`` auto: tacho).
+        Crank angle of cylinder-1 firing TDC after the tacho reference pulse [deg]: measure
+        the phases (:func:`~powertrain.analysis.phase.tdc_origin`).
     progress : bool
-        tqdm bar on stderr (hidden when stderr is not a terminal).
+        Progress bar on stderr.
 
     Returns
     -------
@@ -297,8 +291,7 @@ def _track_channels(rec, chans, profile, orders, method, rpm_step, block_or_band
 
 
 def _profile_and_origin(rec, use, pulses_per_rev, tdc_offset_deg):
-    """The speed profile (from the tacho, where there is one, when the phase is measured)
-    and :func:`_tdc_origin` (None without ``tdc_offset_deg``)."""
+    """The speed profile (the tacho's when measuring phase) and :func:`_tdc_origin`."""
     if tdc_offset_deg is not None and use == "auto" and rec.tacho is not None:
         use = "tacho"
     profile = speed_profile(rec, use=use, pulses_per_rev=pulses_per_rev)
@@ -307,8 +300,7 @@ def _profile_and_origin(rec, use, pulses_per_rev, tdc_offset_deg):
 
 
 def _tdc_origin(rec, profile, tdc_offset_deg):
-    """``(origin [rad], per_cycle)``: the profile angle of cylinder-1 firing TDC and whether
-    the cycle reference fixed it modulo 720° (:func:`powertrain.analysis.phase.tdc_origin`)."""
+    """``(origin [rad], per_cycle)`` of :func:`powertrain.analysis.phase.tdc_origin`."""
     edges = None
     if rec.cycle_reference is not None:
         edges = tacho_edges(rec.time, rec.cycle_reference, file=rec.source,
@@ -317,8 +309,7 @@ def _tdc_origin(rec, profile, tdc_offset_deg):
 
 
 def _phase_settings(orders, tdc_offset_deg, per_cycle) -> dict:
-    """What the phase of a tracked result refers to, and the orders whose phase is defined:
-    whole orders, and with a cycle reference half orders too."""
+    """The phase reference and the orders with a phase (half orders with a cycle reference)."""
     step = 0.5 if per_cycle else 1.0
     defined = [float(o) for o in orders if abs(o / step - round(o / step)) < 1e-9]
     return {"tdc_offset_deg": float(tdc_offset_deg), "cycle_reference": bool(per_cycle),
@@ -332,16 +323,14 @@ def _summary(rec) -> dict:
 
 
 def overall_band(orders, rpm, sample_rate):
-    """Default band of the overall level [Hz]: from half the lowest order's frequency at the
-    lowest grid speed (above drift and DC) to MAX_FREQUENCY_FRACTION x the sampling rate
-    (the whole range the tracker accepts)."""
+    """Default band of the overall level [Hz]: half the lowest order at the lowest speed to
+    MAX_FREQUENCY_FRACTION x the sampling rate."""
     return 0.5 * float(np.min(orders)) * float(np.min(rpm)) / 60.0, \
         MAX_FREQUENCY_FRACTION * sample_rate
 
 
 def _overall(rec, chans, profile, orders, rpm, settings, band, velocity):
-    """Overall level per speed and channel (SI RMS; velocity if asked); its band,
-    revolutions and quantity are added to ``settings`` (the result's, still being built)."""
+    """Overall level per speed and channel (SI RMS; velocity if asked), noted in ``settings``."""
     band = band or overall_band(orders, rpm, rec.sample_rate)
     turn = {"acceleration": -1, "velocity": 0, "displacement": 1}
     if velocity and any(c.quantity not in turn for c in chans):
@@ -357,9 +346,8 @@ def _overall(rec, chans, profile, orders, rpm, settings, band, velocity):
 
 
 def order_spectrum(rec, profile, rpm, top_order, *, quantity=None) -> TrackedOrders:
-    """Order spectrum of every channel at one speed: RMS at orders k/SPECTRUM_REVS up to
-    ``top_order`` (COT block of SPECTRUM_REVS revolutions, Hann), as a TrackedOrders with one
-    speed."""
+    """Order spectrum (RMS at orders k/SPECTRUM_REVS up to ``top_order``, Hann) of every
+    channel at one speed, as a one-speed TrackedOrders."""
     if not (np.isfinite(rpm) and rpm > 0):
         raise InputError("must be a speed > 0 [rpm]", key="--spectrum-at")
     chans = [c for c in rec.channels if quantity is None or c.quantity == quantity]
@@ -410,11 +398,8 @@ def _track_cot(rec, chans, profile, orders, rpm_step, block_revs, progress):
 
 
 def _track_vkf(rec, chans, profile, orders, rpm_step, bandwidth_hz, progress):
-    """Vold–Kalman filtering over the speed grid: (amplitudes, rpm, settings).
-
-    Speeds within EDGE_TIME_CONSTANTS / bandwidth of the record's ends are not reported; the
-    time dropped at each end is returned in the settings (``ends_dropped_s``).
-    """
+    """Vold–Kalman filtering over the speed grid, the record's transient ends dropped:
+    (amplitudes, rpm, settings)."""
     if bandwidth_hz is None:
         width = vk.default_bandwidth(profile, orders)
         rule = (f"per order and speed: {vk.SWEEP_FACTOR:g} x sqrt(order sweep rate), at "
@@ -447,12 +432,7 @@ def _kernel_margin(profile, samples_per_rev) -> float:
 
 
 def order_map(rec, profile, channel=0, *, rpm_step=50.0, max_order=None):
-    """Campbell (rpm-order) map of one channel: RMS over a fine order grid per speed.
-
-    Returns
-    -------
-    rpm : ndarray (k,), orders : ndarray (m,), rms : ndarray (k, m) [SI]
-    """
+    """Campbell map of one channel: ``(rpm (k,), orders (m,), RMS (k, m) [SI])``."""
     top = float(max_order or 10.0)
     B = cot.MIN_BLOCK_REVS * 2
     fine = np.arange(1, int(top * B) + 1) / B
