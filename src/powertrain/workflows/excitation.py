@@ -15,8 +15,7 @@ MIN_STEPS = 32
 
 def excitation(engine=None, rpm=None, *, load=1.0, balancers=True,
                angle_step_deg=0.5) -> ExcitationResult:
-    """Cylinder pressures, gas and inertia forces, crank torque and the total load on the
-    powertrain over one engine cycle at ``rpm``.
+    """Cylinder pressures, gas and inertia forces, crank torque and load over one cycle.
 
     Parameters
     ----------
@@ -34,8 +33,7 @@ def excitation(engine=None, rpm=None, *, load=1.0, balancers=True,
     Returns
     -------
     ExcitationResult
-        ``to_text()`` is what ``powertrain excitation`` prints; ``plot(ax=None)``,
-        ``to_csv``.
+        ``to_text()`` is what ``powertrain excitation`` prints.
     """
     rpm = real(rpm, "--rpm", unit="rpm", optional=True)
     load = real(load, "--load")

@@ -1,6 +1,4 @@
-"""The rigid-body modes of an engine on its mounts (``powertrain modes``): the model
-assembled (:meth:`powertrain.models.engine.Engine.assemble`), the modes solved
-(:func:`powertrain.solvers.modes.rigid_body_modes`), every mode checked finite."""
+"""The rigid-body modes of an engine on its mounts (``powertrain modes``), checked finite."""
 
 from __future__ import annotations
 
@@ -19,23 +17,15 @@ def modes(engine=None, *, static=False) -> ModesResult:
     Parameters
     ----------
     engine : Engine, str or Path, optional
-        The engine, or its file (default: the shipped ``engines/default.toml``); only
-        [engine], [body] and [mounts.*] are needed.
+        The engine, or its file (default: the shipped ``engines/default.toml``).
     static : bool
-        Static (0 Hz) mount stiffness, undamped (default: each mode with the networks'
-        dynamic stiffness at its own frequency, damped).
+        Static (0 Hz) mount stiffness, undamped (default: dynamic stiffness at each mode's
+        frequency, damped).
 
     Returns
     -------
     ModesResult
-        ``to_text()`` is what ``powertrain modes`` prints; ``plot(ax=None)``,
-        ``write_json``.
-
-    Raises
-    ------
-    InputError
-        Naming the engine file, when the model cannot be solved or a mode is not finite
-        (values at the edge of the float range, a body mode that couples to nothing).
+        ``to_text()`` is what ``powertrain modes`` prints.
     """
     static = flag(static, "--static")
     engine = engine_or_default(engine)
@@ -60,6 +50,6 @@ def modes(engine=None, *, static=False) -> ModesResult:
 
 def _finite(mode: Mode) -> bool:
     numbers = [mode.frequency_hz, mode.damping_ratio, mode.damped_frequency_hz,
-               mode.body_energy_percent]          # the axis angle may be undefined (NaN)
+               mode.body_energy_percent]          # the axis angle may be NaN
     return bool(np.all(np.isfinite(numbers)) and np.all(np.isfinite(mode.shape))
                 and np.all(np.isfinite(mode.ked_percent)))

@@ -1,6 +1,4 @@
-"""The static operating point per speed (``powertrain static``): the engine read, its
-excitation required, the speeds checked against its range, the equilibrium solved per speed
-(:func:`powertrain.solvers.operating_point.operating_points`)."""
+"""The static operating point per speed (``powertrain static``)."""
 
 from __future__ import annotations
 
@@ -21,19 +19,12 @@ def static(engine=None, rpm=None) -> StaticResult:
     engine : Engine, str or Path, optional
         The engine, or its file (default: the shipped ``engines/default.toml``).
     rpm : array_like or str, optional
-        Speeds [rpm], or as ``--rpm`` writes them (``"1000:6000:500"``, ``"1500,3000"``)
-        (default: the run-up's, 1000..6000 step 500).
+        Speeds [rpm], or as ``--rpm`` writes them (default 1000..6000 step 500).
 
     Returns
     -------
     StaticResult
-        ``to_text()`` is what ``powertrain static`` prints; ``to_json(path=None)``.
-
-    Raises
-    ------
-    InputError
-        Naming the engine file and key, or ``--rpm``, of bad input; naming the speed where
-        the equilibrium is not found.
+        ``to_text()`` is what ``powertrain static`` prints.
     """
     rpm = speeds(rpm)
     engine = engine_or_default(engine)

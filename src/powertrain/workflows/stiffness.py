@@ -1,5 +1,4 @@
-"""Dynamic stiffness K*(f) of a mount model (a mount file, a model, or one mount direction of
-an engine), from either solution method: :func:`stiffness`."""
+"""Dynamic stiffness K*(f) of a mount model, file or engine mount direction (:func:`stiffness`)."""
 
 from __future__ import annotations
 
@@ -21,7 +20,6 @@ from powertrain.workflows.arguments import choice, frequencies, real
 
 #: Solution methods of :func:`stiffness` (``--method``).
 METHODS = ("frequency", "time")
-
 #: Frequencies of :func:`stiffness` by default (``powertrain stiffness --freq 1:400:1``) [Hz].
 DEFAULT_FREQUENCIES_HZ = np.arange(1.0, 401.0)
 
@@ -33,36 +31,26 @@ def stiffness(mount, *, engine=None, freq=None, method="frequency", force=None,
     Parameters
     ----------
     mount : MountModel, str or path
-        The model, a mount file, or with ``engine`` one mount direction ``"MOUNT.DIR"``
-        (e.g. ``"torque_rod.x"``).
+        The model, a mount file, or with ``engine`` a direction ``"MOUNT.DIR"``.
     engine : Engine, str or path, optional
         Engine (file) whose mount ``mount`` names.
     freq : array_like or str, optional
-        Strictly increasing frequencies [Hz], or as ``--freq`` writes them (``"1:400:1"``,
-        ``"5,10,20"``) (default :data:`DEFAULT_FREQUENCIES_HZ`).
+        Strictly increasing frequencies [Hz], or as ``--freq`` writes them (default
+        :data:`DEFAULT_FREQUENCIES_HZ`).
     method : {"frequency", "time"}
         Condensed network (eq. 39) or Newmark integration processed by FFT.
     force, engine_mass : float, optional
-        Together: the thesis's verification set-up (a harmonic force [N] on an engine mass
-        [kg] carried by the mount), adding the engine-mass displacement x1 and the
-        transmitted force F_T.
+        Together: the thesis's verification set-up, a harmonic force [N] on an engine mass
+        [kg] (adds x1 and F_T).
     steps_per_period : int, optional
         Newmark steps per excitation period for the time method.
     amplitude : array_like or str, optional
-        Test amplitudes X [m] (> 0), or as ``--amplitude`` writes them (a comma list in the
-        mount file's displacement unit, mm by default): K*(f, X) of the sinusoidal
-        displacement test with the mount's amplitude law and friction
-        (:func:`amplitude_stiffness`). Without: the network alone, as fitted.
+        Test amplitudes X [m], or as ``--amplitude`` writes them (mount file's unit, mm by
+        default): K*(f, X) with the amplitude law and friction (:func:`amplitude_stiffness`).
 
     Returns
     -------
     StiffnessResult, or AmplitudeStiffnessResult with ``amplitude``
-
-    Raises
-    ------
-    InputError
-        Naming the mount file and key, or the option (``--freq``, ``--method`` ...), of bad
-        input.
     """
     choice(method, METHODS, "--method")
     engine_mass = real(engine_mass, "--engine-mass", unit="kg", optional=True)
@@ -88,7 +76,7 @@ def stiffness(mount, *, engine=None, freq=None, method="frequency", force=None,
 
 
 def _amplitude_argument(amplitude, mount_file):
-    """``amplitude`` of :func:`stiffness` in [m] (text: :func:`parse_amplitudes`)."""
+    """``amplitude`` of :func:`stiffness` in [m]."""
     if amplitude is None:
         return None
     if isinstance(amplitude, str):
@@ -97,8 +85,7 @@ def _amplitude_argument(amplitude, mount_file):
 
 
 def _source(mount, engine):
-    """The file and key an error of the computation names: the mount file and its
-    parameters, or the engine file and the mount direction."""
+    """The file and key an error of the computation names."""
     if engine is None:
         return (str(mount) if isinstance(mount, (str, os.PathLike)) else None), "parameters"
     where = engine if isinstance(engine, (str, os.PathLike)) else getattr(engine, "file", None)
@@ -115,9 +102,7 @@ def _check_set_up(engine_mass, force) -> None:
 
 
 def mount_model(mount, engine=None):
-    """``(model, label)`` of :func:`stiffness`'s ``mount`` (and ``engine``): a model as given,
-    a mount file read, or the direction ``"MOUNT.DIR"`` of the engine's mount (an engine file
-    without excitation sections is enough)."""
+    """``(model, label)`` of :func:`stiffness`'s ``mount`` and ``engine``."""
     if engine is None:
         if isinstance(mount, (str, os.PathLike)):
             return read_mount(mount), str(mount)
@@ -148,17 +133,15 @@ def stiffness_table(model, frequency_hz, method="frequency", engine_mass=None, f
     Parameters
     ----------
     model : MountModel
+        The mount model.
     frequency_hz : ndarray
-        [Hz]
+        Frequencies [Hz].
     method : {"frequency", "time"}
         Condensed network (eq. 39) or Newmark integration processed by FFT.
-    engine_mass : float, optional
-        [kg]
-    force : float, optional
-        [N]
+    engine_mass, force : float, optional
+        Engine mass [kg] and harmonic force [N] of the verification set-up.
     steps_per_period : int, optional
-        Newmark steps per excitation period for the time method (default
-        :data:`powertrain.solvers.mount_time_domain.STEPS_PER_PERIOD`).
+        Newmark steps per excitation period for the time method.
     """
     f = np.asarray(frequency_hz, float)
     kw = {} if steps_per_period is None else {"steps_per_period": steps_per_period}
@@ -176,7 +159,7 @@ def stiffness_table(model, frequency_hz, method="frequency", engine_mass=None, f
 
 
 def _amplitudes(amplitude, unit="m") -> np.ndarray:
-    """The amplitudes as an array, refused unless numbers, positive, finite and distinct."""
+    """The amplitudes as an array: positive, finite and distinct."""
     try:
         a = np.atleast_1d(np.asarray(amplitude, float)).ravel()
     except (TypeError, ValueError):
@@ -198,16 +181,13 @@ def amplitude_stiffness(model, frequency_hz, amplitude_m, method="frequency",
     Parameters
     ----------
     model : MountModel or MountElement
-        With its amplitude law and friction (port law).
+        With its amplitude law and friction.
     frequency_hz : ndarray
-        [Hz] (> 0 for the time method).
+        Frequencies [Hz] (> 0 for the time method).
     amplitude_m : array_like
         Test amplitudes X [m].
     method : {"frequency", "time"}
-        ``frequency``: the element's equivalent-linear two-port (the amplitude law at X and
-        the port law's describing function); ``time``: the network scaled at the drive's
-        amplitude, integrated with the port law from its steady loop, first harmonic of the
-        base force
+        Equivalent-linear two-port, or integration with the friction law, first harmonic
         (:func:`powertrain.solvers.mount_time_domain.time_cross_point_stiffness`).
     steps_per_period : int, optional
         Newmark steps per period of the time method.
@@ -228,9 +208,7 @@ def amplitude_stiffness(model, frequency_hz, amplitude_m, method="frequency",
 
 
 def parse_amplitudes(text: str, mount_file=None) -> np.ndarray:
-    """``powertrain stiffness --amplitude``: a comma list of amplitudes in the mount file's
-    displacement unit (``[units] x``; mm when it declares none or with ``--engine``), in
-    [m]."""
+    """``--amplitude``'s comma list in the mount file's ``[units] x`` (default mm), in [m]."""
     unit = _length_unit(mount_file) if isinstance(mount_file, (str, os.PathLike)) else "mm"
     try:
         values = [float(part) for part in text.split(",") if part.strip()]

@@ -1,12 +1,9 @@
 r"""``powertrain synth``: a SYNTHETIC measured run-up with hidden effects and noise.
 
-A case is an engine plus zero, one or two hidden *truth* effects with random parameters
-(:func:`draw_truth`), simulated noise-free on the harmonic model
-(:mod:`powertrain.workflows.synth_effects`) and measured with scatter and noise
-(:mod:`powertrain.workflows.measurement`). Effects are redrawn (up to :data:`REDRAWS` times)
-until their noise-free gap is at least :data:`MIN_EFFECT_DB` RMS or reaches
-:data:`MIN_EFFECT_MAX_DB` somewhere. The truth effects and their library matches:
-docs/guide/synth.md. The diagnosis is never imported here.
+A case: an engine with zero to two hidden *truth* effects of random parameters
+(:func:`draw_truth`), simulated noise-free (:mod:`powertrain.workflows.synth_effects`) and
+measured (:mod:`powertrain.workflows.measurement`), redrawn until the effect is visible
+(:func:`worth_diagnosing`). docs/guide/synth.md. The diagnosis is never imported here.
 """
 
 from __future__ import annotations
@@ -19,14 +16,7 @@ import numpy as np
 from powertrain.errors import InputError
 from powertrain.iotools.engine_file import engine_or_default
 from powertrain.outputs import atomic_write, write_csv
-from powertrain.plotting.style import (
-    figure_legend,
-    finish,
-    log_axis,
-    series_style,
-    subplots,
-    target_and_path,
-)
+from powertrain.plotting.style import figure_legend, finish, log_axis, series_style, subplots, target_and_path
 from powertrain.results.base import Result
 from powertrain.solvers.fast_harmonic import HarmonicModel
 from powertrain.workflows.arguments import integer
@@ -62,8 +52,7 @@ def truth_effect_name(name: str) -> str:
 
 
 def draw_truth(name, rng, n_net=9):
-    """Random parameters of a truth effect (``n_net`` mount networks, three per mount: one per
-    local direction; the engine has as many measured channels)."""
+    """Random parameters of a truth effect for ``n_net`` mount networks (three per mount)."""
     u = rng.uniform
     n_m = n_net // 3
     if name == "body_modes":
@@ -115,25 +104,24 @@ def worth_diagnosing(base, velocity) -> bool:
 def make_case(engine, truth_names, seed, *, rpm=None, hm=None, noise_db=None,
               params=None) -> SyntheticCase:
     """One synthetic measurement (:class:`~powertrain.workflows.measurement.SyntheticCase`)
-    with the named truth effects (random parameters).
+    with the named truth effects.
 
     Parameters
     ----------
     engine : Engine
         Baseline model.
     truth_names : sequence of str
-        Names from :data:`TRUTH_EFFECTS` or :data:`TRUTH_ALIASES` (empty: effect-free).
+        Names or aliases of truth effects (empty: effect-free).
     seed : int
-        Seed of every draw of the case (effects, scatter, noise).
+        Seed of every draw (effects, scatter, noise).
     rpm : array_like, optional
         Speeds [rpm] (default :data:`RPM`).
     hm : HarmonicModel, optional
-        Cached model of ``engine`` at ``rpm`` (reused across cases).
+        Cached model of ``engine`` at ``rpm``.
     noise_db : float, optional
         Measurement scatter [dB, 1σ] (default uniform 0.5–1.0).
     params : dict, optional
-        ``{truth name: parameters}`` fixing some truth effects' parameters instead of
-        drawing them (tests); missing keys of a given effect are drawn.
+        ``{truth name: parameters}`` fixed instead of drawn.
     """
     truth_names = [truth_effect_name(n) for n in truth_names]
     params = {truth_effect_name(k): v for k, v in (params or {}).items()} or None
@@ -146,16 +134,10 @@ def make_case(engine, truth_names, seed, *, rpm=None, hm=None, noise_db=None,
                      noise_db=noise_db, params=params, redraws=REDRAWS, worth=worth_diagnosing)
 
 
-# ---------------------------------------------------------------------------- public API
 @dataclasses.dataclass(frozen=True)
 class SynthCase(Result):
-    """A synthetic measured run-up of :func:`synth` (``powertrain synth``): ``.to_text()``,
-    ``.to_csv(path)``, ``.to_truth_json(path)``, ``.plot()``, ``.save(path)`` (``.csv``,
-    ``.png``).
-
-    ``case`` is the :class:`~powertrain.workflows.measurement.SyntheticCase` (``case.measured`` the
-    :class:`~powertrain.iotools.measured.MeasuredRunup` a diagnosis reads).
-    """
+    """A synthetic measured run-up of :func:`synth`; ``case`` is the
+    :class:`~powertrain.workflows.measurement.SyntheticCase`."""
 
     case: object
     seed: int
@@ -172,8 +154,7 @@ class SynthCase(Result):
                 f"noise-free effect {c.effect_rms_db:.2f} dB RMS")
 
     def to_csv(self, path=None) -> str:
-        """The measured CSV (long format; the hidden effect is not written), written
-        atomically to ``path`` when given."""
+        """The measured CSV (the hidden effect not written), written to ``path`` if given."""
         text = self.case.csv_text()
         if path is not None:
             write_csv(path, text)
@@ -194,13 +175,12 @@ class SynthCase(Result):
         return {".csv": self.to_csv, **super().writers()}
 
     def to_truth_json(self, path=None) -> str:
-        """:meth:`truth` as JSON, written atomically to ``path`` when given."""
+        """:meth:`truth` as JSON, written to ``path`` if given."""
         return _written(json.dumps(self.truth(), indent=1), path)
 
     def plot(self, ax=None, *, path=None, mount=None, direction="z", provenance=None):
-        """The measured order curves [mm/s RMS] of one channel (default: the first mount,
-        ``direction``) against speed, with the generator's noise floor, into ``ax`` or a new
-        figure; returns the figure."""
+        """The measured order curves [mm/s RMS] of one channel (default the first mount) and
+        the noise floor; returns the figure."""
         ax, path = target_and_path(ax, path)
         curves = self.measured.curves
         mount = mount or next(iter(curves))[0]
@@ -236,19 +216,14 @@ def synth(effects=(), seed=0, *, engine=None, rpm=None, noise_db=None) -> SynthC
     Parameters
     ----------
     effects : str or sequence of str
-        Truth effects (:data:`TRUTH_EFFECTS`, aliases :data:`TRUTH_ALIASES`), or as
-        ``--effect`` writes them (``"a,b"``, ``"none"``); empty: effect-free.
+        Truth effects (:data:`TRUTH_EFFECTS`, :data:`TRUTH_ALIASES`), or as ``--effect``
+        writes them (``"a,b"``, ``"none"``).
     seed : int
         0..2^63-1.
     engine : Engine, str or path, optional
         Baseline engine or its file (default: the shipped ``engines/default.toml``).
     rpm, noise_db
         As for :func:`make_case`.
-
-    Raises
-    ------
-    InputError
-        An unknown effect (``--effect``) or seed (``--seed``).
     """
     given = listed(effects, "--effect")
     names = [truth_effect_name(e) for e in ([] if given == ["none"] else given)]

@@ -1,9 +1,5 @@
-r"""The truth effects of ``powertrain synth`` on the frequency-domain harmonic model.
-
-:func:`truth_velocity` is the noise-free run-up (channel velocities) of an engine with hidden
-*truth* effects, solved on :class:`~powertrain.solvers.fast_harmonic.HarmonicModel`; their
-parameters are drawn by :func:`powertrain.workflows.synth.draw_truth`. The effects, their
-models and ranges: the table of docs/guide/synth.md.
+r"""The truth effects of ``powertrain synth`` on the harmonic model: :func:`truth_velocity`,
+the noise-free channel velocities with hidden effects. Models and ranges: docs/guide/synth.md.
 """
 
 from __future__ import annotations
@@ -20,8 +16,7 @@ from powertrain.solvers.fast_harmonic import N_HARMONICS, HarmonicModel
 
 
 def _two_port_springs(omega, model, s):
-    """Two-port (a, b, c) with the network's springs times s (n_r,) per speed (dampers and
-    masses kept): the one condensation, :func:`powertrain.physics.mount_network.two_port`."""
+    """Two-port (a, b, c) with the network's springs times s (n_r,) per speed."""
     return two_port(omega, *model.network(), spring_scale=np.asarray(s, float)[:, None],
                     damper_scale=1.0)
 

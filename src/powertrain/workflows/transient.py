@@ -1,10 +1,7 @@
-"""A transient manoeuvre on an engine: file -> model -> time integration -> result.
-
-:func:`transient` is the public entry (``powertrain transient`` calls it): the manoeuvre
-file read and checked before any work (:mod:`powertrain.iotools.manoeuvre_file`), the
-engine's model integrated over it (:func:`powertrain.solvers.transient.simulate_transient`),
-then the per-channel peaks and, at a seat point of a modal body, the ISO 2631-1 weighted RMS
-and vibration dose value (:mod:`powertrain.analysis.comfort`).
+"""A transient manoeuvre on an engine (``powertrain transient``): the manoeuvre file checked,
+the model integrated over it (:func:`powertrain.solvers.transient.simulate_transient`), the
+peaks and, at a seat point, the ISO 2631-1 weighted RMS and VDV
+(:mod:`powertrain.analysis.comfort`).
 """
 
 from __future__ import annotations
@@ -14,12 +11,7 @@ import time
 
 import numpy as np
 
-from powertrain.analysis.comfort import (
-    AXIS_WEIGHTING,
-    vibration_dose_value,
-    weighted,
-    weighted_rms,
-)
+from powertrain.analysis.comfort import AXIS_WEIGHTING, vibration_dose_value, weighted, weighted_rms
 from powertrain.errors import InputError
 from powertrain.iotools.engine_file import engine_or_default
 from powertrain.iotools.manoeuvre_file import read_manoeuvre
@@ -53,40 +45,29 @@ def transient(manoeuvre, engine=None, *, angle_step_deg=ANGLE_STEP_DEG, seat=Non
     Parameters
     ----------
     manoeuvre : Manoeuvre, str or Path
-        The manoeuvre or its TOML file (:mod:`powertrain.iotools.manoeuvre_file`).
+        The manoeuvre or its TOML file.
     engine : Engine, str or Path, optional
         Default: the shipped ``engines/default.toml``.
     angle_step_deg : float
         Crank angle per integration step at the top speed [deg] (0.01..10).
     seat : str, optional
-        Body point whose ISO 2631-1 values are reported (default: a body point whose name
-        starts with ``seat``, if the chassis has one).
+        Body point of the ISO 2631-1 values (default: the first named ``seat...``).
     system : AssembledSystem, optional
-        The assembled model (default ``engine.assemble()``; a what-if passes its variant's).
+        The assembled model (default ``engine.assemble()``).
     speed_from : str, Path or Recorded, optional
-        Raw recording whose crank speed, lined up with the manoeuvre, replaces the
-        manoeuvre's speed table over its span
+        Recording whose crank speed replaces the manoeuvre's
         (:func:`~powertrain.workflows.transient_recording.speed_from_recording`).
     trigger, channel_map, pulses_per_rev, trigger_edge : optional
-        With ``speed_from``: how the recording is read and lined up: its trigger channel
-        (the manoeuvre's ``trigger_time`` at its ``trigger_edge``, ``rising`` or
-        ``falling``; default: on the crank speed), channel map, tacho pulses per revolution
+        With ``speed_from``: how the recording is read and lined up
         (:func:`~powertrain.workflows.transient_recording.read_recording`).
     speed_average : bool
-        With ``speed_from``: the recorded speed's mean over each firing interval of crank
-        angle (a speed resolved within the cycle, an encoder's: its firing orders'
-        fluctuation is in the gas and inertia torques already), not the speed as recorded.
+        With ``speed_from``: the recorded speed's mean over each firing interval (a speed
+        resolved within the cycle), not the speed as recorded.
 
     Returns
     -------
     TransientResult
-        ``to_text()``, ``plot(ax=None)``, ``save(path)`` (``.csv``, ``.json``, ``.h5``,
-        ``.png``).
-
-    Raises
-    ------
-    InputError
-        A bad manoeuvre file, engine, recording or option, before any work.
+        ``to_text()``, ``plot(ax=None)``, ``save(path)``.
     """
     step = number(angle_step_deg, "--angle-step", unit="deg", minimum=0.01, maximum=10.0)
     if seat is not None and not isinstance(seat, str):
@@ -120,9 +101,8 @@ def _result(m, engine, run, seat, seconds, speed_note) -> TransientResult:
 
 
 def _driven(m, speed_from, options, engine) -> tuple:
-    """The manoeuvre driven by a recorded speed (``options``: those of
-    :func:`~powertrain.workflows.transient_recording.speed_from_recording`; at most the
-    ``engine``'s top speed), and the line saying so ("" without)."""
+    """``(manoeuvre, note)`` driven by a recorded speed (``options`` of
+    :func:`~powertrain.workflows.transient_recording.speed_from_recording`)."""
     if speed_from is None:
         for key, given in (("--trigger", options["trigger"] is not None),
                            ("--channel-map", options["channel_map"] is not None),
@@ -138,9 +118,7 @@ def _driven(m, speed_from, options, engine) -> tuple:
 
 
 def _check_recorded_top(m, speed_from, engine) -> None:
-    """A recorded speed (``speed_from``) above the engine's combustion model is the
-    recording's error, named by its file and ``rpm`` (the manoeuvre's own speed table is
-    checked by the solver, naming the manoeuvre file)."""
+    """Refuse a recorded speed above the engine's combustion model (the recording's error)."""
     top = engine.speed_range_rpm()[1]
     if speed_from is not None and m.max_speed * 30.0 / np.pi > top + 1e-6:
         tacho = getattr(speed_from, "speed_source", "") == "tacho"
@@ -151,8 +129,7 @@ def _check_recorded_top(m, speed_from, engine) -> None:
 
 
 def seat_point(engine, seat) -> str | None:
-    """The body point whose ISO 2631-1 values are reported: ``seat`` checked against the
-    chassis' points, else the first point named ``seat...``, else None."""
+    """The ISO 2631-1 body point: ``seat`` checked, else the first ``seat...``, else None."""
     points = list(getattr(engine.chassis, "points", ()) or ())
     if seat is None:
         return next((p for p in points if p.startswith("seat")), None)
@@ -163,8 +140,7 @@ def seat_point(engine, seat) -> str | None:
 
 
 def figure_channels(system, channels) -> list | None:
-    """The figure's channels (labels ``mount.direction``, or a comma-separated string)
-    checked against the model's before any work; None for the default."""
+    """The figure's channels (``mount.direction`` labels or a comma list) checked; None: default."""
     if not channels:
         return None
     if isinstance(channels, str):

@@ -1,12 +1,9 @@
-"""A recording of a manoeuvre against its simulation: read and checked before any work,
-lined up with the manoeuvre (one rule, :func:`align`, for ``--compare`` and
-``--speed-from``), its crank speed driving the manoeuvre, its channels compared.
+"""A recording of a manoeuvre against its simulation: read, lined up (:func:`align`, for
+``--compare`` and ``--speed-from``), its crank speed driving the manoeuvre, its channels
+compared.
 
-Lining up: with a trigger channel, the manoeuvre's ``trigger_time`` (default 0) is the
-trigger's first rising crossing of its mid level
-(:func:`powertrain.analysis.trigger.trigger_time`); else the time shift whose recorded
-crank speed (rpm channel, else once-per-revolution tacho) best matches the manoeuvre's,
-refused where the speed varies too little to fix it
+Lining up: the manoeuvre's ``trigger_time`` is the trigger channel's crossing of its mid
+level; without one, the shift whose recorded crank speed best matches the manoeuvre's
 (:func:`powertrain.analysis.alignment.align_speed`).
 """
 
@@ -39,7 +36,7 @@ from powertrain.results.transient import TransientComparison
 SPEED_ROWS = 2000
 #: Longest firing interval [s] whose mean speed (--speed-average) passes without a warning.
 AVERAGE_WINDOW_S = 0.1
-#: Option that gives a recording's channel map, named in error messages.
+#: Option of a recording's channel map, named in error messages.
 MAP_OPTION = "--channel-map"
 _RPM = np.pi / 30.0
 
@@ -50,31 +47,20 @@ class Recorded:
 
     Attributes
     ----------
-    path : str
     time : ndarray (n,)
         From the first sample [s].
     rpm : ndarray (n,) or None
-        Crank speed [rpm] at every sample (rpm channel, else tacho; None without either).
+        Crank speed [rpm] per sample (rpm channel, else tacho).
     speed_source : str
         ``rpm channel``, ``tacho`` or ``""``.
     crossing : TriggerCrossing or None
-        The trigger's step from the first sample (None without ``--trigger``;
-        :func:`~powertrain.analysis.trigger.trigger_crossing`); :attr:`trigger` its time [s].
-    trigger_name : str or None
-    channels : list of RawChannel
+        The trigger's step (None without ``--trigger``).
     ignored : list of str
-        Channels of the file the channel map leaves out.
-    edges : ndarray or None
-        The once-per-revolution tacho's rising edges from the first sample [s] (None
-        where the speed is an rpm channel's).
-    counts : ndarray or None
-        The tacho's pulses counted at each of ``edges`` (a missing-tooth wheel's gap
-        counted).
-    pulses_per_rev : int
-        The tacho's pulses per revolution.
+        Channels the channel map leaves out.
+    edges, counts : ndarray or None
+        The tacho's rising edges [s] and pulses counted at each (None with an rpm channel).
     unused_trigger : bool
-        The file has a channel named ``trigger`` that ``--trigger`` does not name (said
-        where the crank speed cannot line the recording up).
+        The file has a channel ``trigger`` that ``--trigger`` does not name.
     """
 
     path: str
@@ -99,16 +85,8 @@ class Recorded:
 def read_recording(path, *, channel_map=None, trigger=None, pulses_per_rev=1,
                    trigger_edge="rising") -> Recorded:
     """Read and check a recording of a manoeuvre (any format of
-    :func:`~powertrain.iotools.raw.read_raw`; ``channel_map`` as ``powertrain track``'s;
-    ``trigger`` the name of a trigger channel and ``trigger_edge`` the edge it marks,
-    ``rising`` or ``falling``; ``pulses_per_rev`` its tacho's, where the speed comes from a
-    tacho).
-
-    Raises
-    ------
-    InputError
-        One line naming the file and the key: a bad file, channel map or trigger channel.
-    """
+    :func:`~powertrain.iotools.raw.read_raw`), its ``trigger`` channel marking
+    ``trigger_edge`` (``rising`` or ``falling``), its tacho's ``pulses_per_rev``."""
     if trigger is not None and (not isinstance(trigger, str) or not trigger.strip()):
         raise InputError("expected the name of a channel of the recording",
                          key="--trigger")
@@ -137,8 +115,7 @@ def read_recording(path, *, channel_map=None, trigger=None, pulses_per_rev=1,
 
 
 def recording_or_file(recording, **options) -> Recorded:
-    """A :class:`Recorded` as it is, or read from its file with ``options``
-    (:func:`read_recording`'s)."""
+    """A :class:`Recorded` as it is, or read by :func:`read_recording` with ``options``."""
     if isinstance(recording, Recorded):
         return recording
     return read_recording(recording, **options)
@@ -150,11 +127,9 @@ def _speed_source(rec) -> str:
 
 
 def align(rec: Recorded, t_event, rpm_event, *, partial=True, trigger_at=0.0) -> tuple:
-    """The recording's time [s] of the event's time 0, how it was found (``trigger
-    'NAME'`` or ``crank speed``) and its standard error [s]: the trigger's time less the
-    event's time of the trigger ``trigger_at`` [s], else the speed alignment against the
-    event's speed ``rpm_event`` [rpm] at ``t_event`` [s] (module docstring); ``partial``:
-    the recording may cover part of the event (:func:`align_speed`)."""
+    """``(shift, how, standard error)``: the recording's time [s] of the event's time 0, by
+    the trigger (at event time ``trigger_at`` [s]) or by the speed ``rpm_event`` [rpm] at
+    ``t_event`` [s]; ``partial``: the recording may cover part of the event."""
     if rec.crossing is not None:
         shift = trigger_shift(rec.crossing, trigger_at, rpm_event, file=rec.path,
                               key=rec.trigger_name)
@@ -166,8 +141,7 @@ def align(rec: Recorded, t_event, rpm_event, *, partial=True, trigger_at=0.0) ->
 
 
 def _align_on_speed(rec: Recorded, t_event, rpm_event, partial) -> tuple:
-    """:func:`align` on the tacho's pulses, else on the rpm channel; an error offers the
-    recording's unused channel named ``trigger`` where it has one."""
+    """:func:`align` on the tacho's pulses, else on the rpm channel."""
     trigger = TRIGGER + (" (the recording has one named 'trigger')" if rec.unused_trigger
                          else "")
     if rec.edges is not None:
@@ -183,29 +157,17 @@ def _align_on_speed(rec: Recorded, t_event, rpm_event, partial) -> tuple:
 
 def speed_from_recording(manoeuvre: Manoeuvre, recording, *, firing_interval=None,
                          **options) -> tuple:
-    """``manoeuvre`` driven by the crank speed of a recording (:func:`read_recording`):
-    lined up with the manoeuvre by :func:`align` (against the manoeuvre's own speed
-    table), its speed as recorded or, given a ``firing_interval`` [rad], its mean over
-    each firing interval of crank angle (:func:`~powertrain.analysis.speed.mean_speed`: a
-    manoeuvre's speed is the mean one, the firing orders' fluctuation of a speed resolved
-    within the cycle is in the gas and inertia torques already), over the manoeuvre's span
-    (block means on at most :data:`SPEED_ROWS` rows), replaces the speed table; the load
-    table stays on the manoeuvre's times. Negative speeds are cut to 0 unless the
-    manoeuvre allows a reversal. Returns the manoeuvre and a line saying where its speed
-    came from. ``options``: :func:`read_recording`'s.
-
-    Raises
-    ------
-    InputError
-        No speed in the recording, or a recording that does not cover the manoeuvre after
-        alignment (one line naming the file and ``time``).
-    """
+    """``(manoeuvre, note)``: ``manoeuvre`` with its speed table replaced by the recording's
+    crank speed, lined up by :func:`align`, as recorded or (``firing_interval`` [rad]) its
+    mean over each firing interval (:func:`~powertrain.analysis.speed.mean_speed`), on at
+    most :data:`SPEED_ROWS` rows; negative speeds cut to 0 unless reversal is allowed.
+    ``options``: :func:`read_recording`'s. The recording must cover the manoeuvre."""
     rec = recording_or_file(recording, **options)
     if rec.rpm is None:
         raise InputError("no rpm or tacho channel to take the speed from", file=rec.path,
                          key="rpm")
     duration = manoeuvre.duration
-    tol = rec.time[1] - rec.time[0]                 # one sample of the recording
+    tol = rec.time[1] - rec.time[0]
     if rec.time[-1] < duration - tol:
         raise InputError(f"the recording is {rec.time[-1]:.6g} s long, the manoeuvre "
                          f"{duration:.6g} s; --speed-from needs all of it", file=rec.path,
@@ -237,15 +199,12 @@ def speed_from_recording(manoeuvre: Manoeuvre, recording, *, firing_interval=Non
 
 
 class RecordedSpeedWarning(PowertrainWarning):
-    """A recorded speed that cannot be read as asked: unsigned where the crank may turn
-    back, averaged over firing intervals longer than :data:`AVERAGE_WINDOW_S`, or an rpm
-    channel's where a tacho's pulses per revolution were given."""
+    """A recorded speed that cannot be read as asked (unsigned, averaged too long, or an
+    rpm channel's given pulses per revolution)."""
 
 
 def _warn_speed(manoeuvre, rec, rpm, firing_interval) -> None:
-    """:class:`RecordedSpeedWarning` where the manoeuvre allows a reversal and the recorded
-    speed is never negative, or where it is averaged below the speed whose firing interval
-    lasts :data:`AVERAGE_WINDOW_S`."""
+    """Warn of an unsigned speed where reversal is allowed, or one averaged too slow."""
     if manoeuvre.reversal and np.min(rec.rpm) >= 0:
         warnings.warn(RecordedSpeedWarning(
             f"{rec.path}: the manoeuvre lets the crank turn back, but the recorded speed "
@@ -261,8 +220,8 @@ def _warn_speed(manoeuvre, rec, rpm, firing_interval) -> None:
 
 
 def _speed_rows(t, rpm, duration) -> tuple:
-    """Times [s] 0..``duration`` and speeds [rpm]: the samples inside as block means on at
-    most :data:`SPEED_ROWS` rows, the ends interpolated."""
+    """Times [s] 0..``duration`` and speeds [rpm]: block means on at most :data:`SPEED_ROWS`
+    rows, the ends interpolated."""
     inside = np.flatnonzero((t > 0.0) & (t < duration))
     k = max(1, -(-inside.size // SPEED_ROWS))
     rows = inside.size // k
@@ -274,14 +233,8 @@ def _speed_rows(t, rpm, duration) -> tuple:
 
 
 def compared_channels(rec: Recorded, labels) -> tuple:
-    """The recording's channels compared with the simulation's ``labels`` and, for every
-    other channel of the file, why not: ``([(label, RawChannel)], {name: reason})``.
-
-    Raises
-    ------
-    InputError
-        None compared (naming the file and ``channels``, with the reasons).
-    """
+    """The recording's channels matching the simulation's ``labels`` and why others do not:
+    ``([(label, RawChannel)], {name: reason})``; an error when none matches."""
     labels = list(labels)
     mounts = sorted({c.rpartition(".")[0] for c in labels if "/" not in c})
     pairs, skipped = [], {n: "not in the channel map" for n in rec.ignored}
@@ -310,30 +263,22 @@ def compare_transient(result, raw, *, trigger=None, channel_map=None, pulses_per
     Parameters
     ----------
     result : TransientResult
+        The simulation.
     raw : str, Path or Recorded
         The recording (any format of :func:`~powertrain.iotools.raw.read_raw`).
     trigger : str, optional
-        Trigger channel: the manoeuvre's ``trigger_time`` (default 0) at its first rising
-        crossing of its mid level (default: aligned on the crank speed, :func:`align`).
+        Trigger channel (default: aligned on the crank speed, :func:`align`).
     channel_map : ChannelMap, str or Path, optional
-        The recording's channel names -> mount, side, direction, quantity (the format of
-        ``powertrain track --channels``).
+        The recording's channel names -> mount, side, direction, quantity.
     pulses_per_rev : int
-        The recording's tacho pulses per revolution (1 by default; a missing-tooth wheel's
-        gap is counted), where its speed is a tacho's.
+        The recording's tacho pulses per revolution.
     trigger_edge : str
-        The edge the trigger marks: ``rising`` (default) or ``falling`` (active low).
+        The edge the trigger marks: ``rising`` or ``falling``.
 
     Returns
     -------
     TransientComparison
-        Every recorded acceleration channel the simulation has, over the part
-        of the event the recording covers; the others listed with the reason.
-
-    Raises
-    ------
-    InputError
-        A bad recording, no channel to compare, or less than half the event covered.
+        Every recorded acceleration channel the simulation has, over the covered part.
     """
     rec = recording_or_file(raw, channel_map=channel_map, trigger=trigger,
                             pulses_per_rev=pulses_per_rev, trigger_edge=trigger_edge)
@@ -352,8 +297,7 @@ def compare_transient(result, raw, *, trigger=None, channel_map=None, pulses_per
 
 
 def _covered(rec: Recorded, t0, t1, shift, how) -> tuple:
-    """The event times ``t0..t1`` [s] the recording covers at ``shift``; at least
-    :data:`MIN_COVERAGE` of the event, else an error naming the file and ``time``."""
+    """The event times in ``t0..t1`` [s] the recording covers (at least :data:`MIN_COVERAGE`)."""
     first, last = coverage(t0, t1, rec.time[0], rec.time[-1], shift)
     if not last - first >= MIN_COVERAGE * (t1 - t0):
         raise InputError(f"after alignment ({how}: the simulation starts at {shift:.4f} s of "
@@ -365,18 +309,9 @@ def _covered(rec: Recorded, t0, t1, shift, how) -> tuple:
 
 def check_recordings(manoeuvre: Manoeuvre, labels, *, firing_interval=None, compare=None,
                      speed=None) -> None:
-    """Everything about the recordings of ``--compare`` and ``--speed-from`` that can be
-    checked before the simulation (``firing_interval`` [rad] as
-    :func:`speed_from_recording`'s): the channels compared (against the model's ``labels``),
-    the recorded speed lined up with the manoeuvre and covering it, the compared recording
-    lined up with the (driven) manoeuvre's speed and covering at least half of it.
-
-    Raises
-    ------
-    InputError
-        As :func:`compared_channels`, :func:`speed_from_recording` and
-        :func:`compare_transient` would after the run.
-    """
+    """Check the recordings of ``--compare`` and ``--speed-from`` before the simulation:
+    channels against ``labels``, alignment and coverage (``firing_interval`` [rad] as
+    :func:`speed_from_recording`'s)."""
     with warnings.catch_warnings():          # the run and the comparison warn once
         warnings.simplefilter("ignore", PowertrainWarning)
         _check(manoeuvre, labels, firing_interval, compare, speed)

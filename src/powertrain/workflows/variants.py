@@ -1,11 +1,7 @@
 r"""Variants of the mount system: spec strings parsed into operations
-(:mod:`powertrain.workflows.operations`), and the variants file read.
-
-One parser per option (:data:`PARSERS`: ``--scale``, ``--set``, ``--swap``, ``--move``,
-``--rotate``, ``--target``, ``--effect``), the same for the command line and a variants
-file; syntax errors raise :class:`~powertrain.errors.InputError` naming the option (or file,
-line and key). The spec syntax and what ``stiffness`` and ``dynamic`` scaling mean for a
-lumped network: docs/guide/whatif.md.
+(:mod:`powertrain.workflows.operations`), one parser per option (:data:`PARSERS`) for the
+command line and the variants file alike; errors name the option (or file, line and key).
+Syntax: docs/guide/whatif.md.
 """
 
 from __future__ import annotations
@@ -39,7 +35,6 @@ SCALE_KINDS = {"stiffness": "every spring c_i", "damping": "every damper d_i",
 _NAME = r"[A-Za-z_][A-Za-z0-9_\-]*"
 
 
-# --------------------------------------------------------------------------- parse
 def _split(text: str, origin: Origin, form: str):
     if not isinstance(text, str) or text.count("=") != 1:
         raise origin.error(f"cannot read {text!r} (expected {form})")
@@ -89,8 +84,8 @@ def _vector3(s, text, origin):
 
 
 def _law_key(left, text, origin, form, column):
-    """``(mount, direction, key)`` of ``MOUNT.DIR.SECTION.KEY``, the key one that
-    :data:`LAW_KEYS` allows in ``column`` (2: --scale, 3: --set)."""
+    """``(mount, direction, key)`` of ``MOUNT.DIR.SECTION.KEY``, a key of :data:`LAW_KEYS`
+    allowed in ``column`` (2: --scale, 3: --set)."""
     mount, direction, section, name = _path_parts(left, 4, text, origin, form)
     _direction(direction, text, origin)
     key = f"{section}.{name}"
@@ -121,10 +116,8 @@ def parse_scale(text: str, origin: Origin = Origin("--scale")) -> Scale:
 
 
 def parse_set(text: str, origin: Origin = Origin("--set")) -> SetParameter:
-    """``MOUNT.DIR.PARAM=VALUE[UNIT]`` -> :class:`SetParameter` (SI value).
-
-    Without a unit the parameter family's datasheet unit applies (c: N/mm, d: N·s/mm, m: kg).
-    """
+    """``MOUNT.DIR.PARAM=VALUE[UNIT]`` -> :class:`SetParameter` (SI value; default units
+    c: N/mm, d: N·s/mm, m: kg)."""
     form = "MOUNT.DIR.PARAM=VALUE, e.g. right.y.c2=150 (N/mm) or left.z.friction.max_force=20"
     left, right = _split(text, origin, form)
     if left.count(".") == 3:
@@ -151,9 +144,7 @@ def parse_set(text: str, origin: Origin = Origin("--set")) -> SetParameter:
 
 
 def _law_value(key, right, text, origin):
-    """SI value of a law key's ``--set`` (:data:`LAW_KEYS`: its datasheet unit, or an
-    explicit one of the same dimension; ``LO,HI`` for ``amplitude.limits``), checked as the
-    mount file checks it."""
+    """SI value of a law key's ``--set`` (``LO,HI`` for ``amplitude.limits``), checked."""
     dimension, family = LAW_KEYS[key][:2]
     if key == "amplitude.limits":
         parts = right.split(",")
@@ -178,10 +169,7 @@ def _law_value(key, right, text, origin):
 
 
 def parse_swap(text: str, origin: Origin = Origin("--swap"), base: Path | None = None) -> Swap:
-    """``MOUNT.DIR=FILE.toml`` -> :class:`Swap` (the mount file is read now).
-
-    ``base``: folder relative paths are taken from (variants file folder; default cwd).
-    """
+    """``MOUNT.DIR=FILE.toml`` -> :class:`Swap` (file read now, relative to ``base``)."""
     form = "MOUNT.DIR=FILE.toml, e.g. left.z=mounts/hydraulic-engine-mount-z.toml"
     left, right = _split(text, origin, form)
     mount, direction = _path_parts(left, 2, text, origin, form, wildcard=False)
@@ -213,13 +201,8 @@ def parse_rotate(text: str, origin: Origin = Origin("--rotate")) -> Rotate:
 
 
 def parse_target(text: str, origin: Origin = Origin("--target")) -> Target:
-    """``MOUNT.DIR:CHANGE:BAND[:WIDTH][:AMPLITUDE]`` -> :class:`Target`.
-
-    CHANGE: ``+20%``, ``-15%`` or a factor ``*1.2``; BAND: ``100-300Hz`` (``Hz`` optional);
-    WIDTH: transition outside the band, ``0.5oct`` (default half an octave); AMPLITUDE:
-    the relative-displacement amplitude the change is asked at, with a length unit
-    (``0.3mm``, ``50um``), for a direction with an amplitude law or friction.
-    """
+    """``MOUNT.DIR:CHANGE:BAND[:WIDTH][:AMPLITUDE]`` -> :class:`Target`: CHANGE ``+20%`` or
+    ``*1.2``, BAND ``100-300Hz``, WIDTH ``0.5oct`` (default), AMPLITUDE ``0.3mm``."""
     form = "MOUNT.DIR:CHANGE:BAND[:WIDTH][:AMPLITUDE], e.g. left.z:+20%:100-300Hz:0.3mm"
     parts = [p.strip() for p in text.split(":")] if isinstance(text, str) else []
     if len(parts) not in (3, 4, 5):
@@ -253,7 +236,7 @@ def parse_target(text: str, origin: Origin = Origin("--target")) -> Target:
             width = _float(m_w.group(1), text, origin)
             if width <= 0:
                 raise origin.error(f"{text!r}: width must be positive")
-        elif k == len(parts) - 4:        # the last part: an amplitude, x units (mm)
+        elif k == len(parts) - 4:        # the last part: an amplitude
             amplitude = _law_value("amplitude.reference", extra, text, origin)
         else:
             raise origin.error(f"{text!r}: cannot read width {extra!r} (expected e.g. "
@@ -263,16 +246,9 @@ def parse_target(text: str, origin: Origin = Origin("--target")) -> Target:
 
 
 def parse_effect(text: str, origin: Origin = Origin("--effect"), engine=None) -> AddEffect:
-    """``NAME[:PARAM=VALUE[UNIT][,PARAM=VALUE...]]`` -> :class:`AddEffect` (SI values).
-
-    Parameters are those the effect generates for ``engine`` (default: the default layout,
-    three mounts, four cylinders).
-
-    Without a unit a value is in the parameter's own unit (:data:`powertrain.effects.
-    EFFECTS`: N/m, kg, m, rad, dB or 1); an explicit unit must have the same dimension
-    (``c_base=400N/mm``, ``lag=5deg``). Unknown effect or parameter, a value outside the
-    effect's bounds: an error naming the option.
-    """
+    """``NAME[:PARAM=VALUE[UNIT][,PARAM=VALUE...]]`` -> :class:`AddEffect` (SI values), the
+    parameters those of ``engine`` (default layout without), values in their own unit
+    unless one of the same dimension is given (``c_base=400N/mm``)."""
     form = "NAME[:PARAM=VALUE,...], e.g. mount_stiffness:k1=1.5"
     name, _, rest = text.partition(":")
     name = name.strip()
@@ -299,7 +275,7 @@ def parse_effect(text: str, origin: Origin = Origin("--effect"), engine=None) ->
             v = v * UNITS[unit][1] / UNITS[p.unit][1]
         params.append((key, float(v)))
     try:
-        check_scenario({name: dict(params)}, engine)  # bounds, finiteness: one rule
+        check_scenario({name: dict(params)}, engine)
     except ValueError as exc:
         raise origin.error(f"{text!r}: {exc}") from None
     return AddEffect(name, tuple(params), spec=text, origin=origin)
@@ -311,9 +287,7 @@ PARSERS = {"scale": parse_scale, "set": parse_set, "swap": parse_swap, "move": p
 
 
 def parse_operations(specs: dict, *, base: Path | None = None, engine=None) -> tuple:
-    """Operations from ``{"scale": [...], "set": [...], ...}`` of command-line strings, in
-    the order scale, set, swap, move, rotate, target (each list in its given order);
-    effects' parameters are those generated for ``engine`` (default layout without one)."""
+    """Operations of ``{"scale": [...], "set": [...], ...}``, in :data:`PARSERS`' order."""
     return tuple(_parse(kind, text, Origin(f"--{kind}"), base, engine)
                  for kind in PARSERS for text in specs.get(kind, ()) or ())
 
@@ -327,7 +301,6 @@ def _parse(kind, text, origin, base=None, engine=None):
     return PARSERS[kind](text, origin)
 
 
-# --------------------------------------------------------------------------- variants file
 VARIANTS_FILE_KEYS = ("name",) + tuple(PARSERS)
 
 
@@ -359,7 +332,7 @@ def read_variants(path) -> list:
 
 
 def _variant_tables(doc: dict, path: str) -> list:
-    """The ``[[variant]]`` tables of a variants file (nothing else allowed at the top)."""
+    """The ``[[variant]]`` tables of a variants file (nothing else at the top)."""
     unknown = sorted(set(doc) - {"variant"})
     if unknown:
         raise InputError("unknown key (expected [[variant]] tables)", file=path, key=unknown[0])
@@ -371,8 +344,7 @@ def _variant_tables(doc: dict, path: str) -> list:
 
 
 def _block_locator(path: str):
-    """``locate(k, needle)``: 1-based line of ``needle`` within the k-th [[variant]] block
-    (or of its header; None past the last block)."""
+    """``locate(k, needle)``: 1-based line of ``needle`` in the k-th [[variant]] block."""
     lines = Path(path).read_text(encoding="utf-8").splitlines()
     headers = [i for i, ln in enumerate(lines) if re.match(r"^\s*\[\[\s*variant\s*\]\]", ln)]
 

@@ -1,10 +1,8 @@
 r"""What-if: run the baseline and variants of the mount system, report the change in dB.
 
-:func:`whatif` parses the variants as the command line writes them
-(:mod:`powertrain.workflows.variants`); :func:`run_whatif` applies each once
-(:func:`variant_engine`), runs one :class:`~powertrain.workflows.sweeps.SweepTask` per
-variant plus the baseline (:func:`powertrain.workflows.sweeps.run_sweep`) and returns a
-:class:`~powertrain.results.whatif.WhatIfResult` (the change in dB is defined there).
+:func:`whatif` parses the variants (:mod:`powertrain.workflows.variants`); :func:`run_whatif`
+runs the baseline and each variant (:func:`powertrain.workflows.sweeps.run_sweep`) into a
+:class:`~powertrain.results.whatif.WhatIfResult`.
 """
 
 from __future__ import annotations
@@ -21,15 +19,7 @@ from powertrain.parallel import check_scheduler
 from powertrain.results.transient import TransientRanking
 from powertrain.results.whatif import QUANTITIES, VariantRun, WhatIfResult
 from powertrain.solvers.steppers import SOLVERS
-from powertrain.workflows.arguments import (
-    choice,
-    default_rpm,
-    integer,
-    path_or,
-    real,
-    speeds,
-    texts,
-)
+from powertrain.workflows.arguments import choice, default_rpm, integer, path_or, real, speeds, texts
 from powertrain.workflows.operations import Origin, Target, Variant, effect_scenario
 from powertrain.workflows.retune import retuned_swap
 from powertrain.workflows.runup import check_runup_settings, engine_and_file
@@ -39,8 +29,7 @@ from powertrain.workflows.variants import parse_operations, parse_target, read_v
 
 #: Signals a what-if compares (``--signal``).
 SIGNALS = ("velocity", "mount_force")
-#: Keywords (and options) of a run-up what-if that a what-if over a manoeuvre refuses:
-#: keyword -> what it is.
+#: Keywords of a run-up what-if that a what-if over a manoeuvre refuses -> what they are.
 RUNUP_ONLY = {"rpm": "the run-up's speed steps", "rpm_from": "the run-up's first speed",
               "rpm_to": "the run-up's last speed", "rpm_step": "the run-up's speed step",
               "solver": "the run-up's solver", "signal": "the run-up's compared signal",
@@ -70,21 +59,21 @@ def whatif(engine=None, *, scale=(), set=(), swap=(), move=(), rotate=(), effect
            objective=None, measured=None, executor=None, workers=None, progress=False,
            rpm_step=None, manoeuvre=None) -> WhatIfResult | TransientRanking:
     """What-if: the baseline and variants of the mount system, the change in dB (``whatif``),
-    or over a transient manoeuvre their peaks (``whatif --manoeuvre``).
+    or their peaks over a transient manoeuvre (``whatif --manoeuvre``).
 
     Parameters
     ----------
     engine : Engine, str, Path or None
         Baseline (default: the shipped ``engines/default.toml``).
     scale, set, swap, move, rotate, effects : str or sequence of str
-        Operations as the command line writes them (``left.z.stiffness=1.2``...,
-        :mod:`powertrain.workflows.variants`); together the variant ``command line``.
+        Operations as the command line writes them (``left.z.stiffness=1.2``...), together
+        the variant ``command line``.
     targets : str or sequence of str
-        Retune targets (``left.z:+20%:100-300Hz``), each a variant of its own.
+        Retune targets (``left.z:+20%:100-300Hz``), each a variant.
     variants : str or Path, optional
         TOML file of named variants.
     rpm : array_like or str, optional
-        Speed steps [rpm] in the engine's range, or ``"1000:6000:500"`` (the default).
+        Speed steps [rpm], or ``"1000:6000:500"`` (the default).
     solver, signal : str, optional
         ``harmonic`` (default) or ``newmark``; ``velocity`` (default) or ``mount_force``.
     objective : str, optional
@@ -92,25 +81,18 @@ def whatif(engine=None, *, scale=(), set=(), swap=(), move=(), rotate=(), effect
     measured : str, Path or MeasuredRunup, optional
         Measurement overlaid and compared.
     executor, workers : optional
-        An executor or a scheduler (``local``, ``tcp://HOST:PORT``, ``processes``,
-        ``serial``; :func:`powertrain.parallel.executor`), default a local process pool of
-        ``workers`` processes (default: the usable cores; 1 = serial).
+        Executor or scheduler (:func:`powertrain.parallel.executor`); local processes.
     progress : bool
+        Progress bar.
     rpm_step : float, optional
         The speed step [rpm] the report names (default: that of ``rpm``).
     manoeuvre : str, Path or Manoeuvre, optional
-        Over this manoeuvre instead of a run-up (:func:`whatif_manoeuvre`): the run-up
-        keywords ``rpm`` … ``workers`` are then refused (:data:`RUNUP_ONLY`).
+        Over this manoeuvre instead of a run-up; the keywords of :data:`RUNUP_ONLY` are
+        refused then.
 
     Returns
     -------
     WhatIfResult, or TransientRanking with ``manoeuvre``
-
-    Raises
-    ------
-    InputError
-        Naming the option (``--scale``, ``--from`` ...) or file and key of bad input, or
-        a run-up keyword given with ``manoeuvre`` (before any work).
     """
     ops = {"scale": scale, "set": set, "swap": swap, "move": move, "rotate": rotate,
            "effect": effects}
@@ -128,8 +110,7 @@ def whatif(engine=None, *, scale=(), set=(), swap=(), move=(), rotate=(), effect
 
 def _runup_whatif(engine, ops, targets, variants, *, rpm, solver, signal, objective,
                   measured, executor, workers, progress, rpm_step) -> WhatIfResult:
-    """:func:`whatif` over a run-up: the arguments checked in turn, then
-    :func:`run_whatif`."""
+    """:func:`whatif` over a run-up: the arguments checked, then :func:`run_whatif`."""
     workers = _checked(solver, signal, workers, executor)
     engine, _ = engine_and_file(engine)
     rpm = speeds(rpm)
@@ -143,17 +124,14 @@ def _runup_whatif(engine, ops, targets, variants, *, rpm, solver, signal, object
 
 
 def _variants(engine, ops: dict, targets, variants) -> list:
-    """The variants of the keyword arguments (:func:`command_variants`): ``ops`` (option
-    name -> spec string or strings), ``targets`` and the ``variants`` file."""
+    """:func:`command_variants` of ``ops`` (option -> spec strings), targets and file."""
     ops = {key: texts(value, f"--{key}") for key, value in ops.items()}
     return command_variants(engine, ops, texts(targets, "--target"), variants)
 
 
 def refuse_runup_options(given: dict, what: str = "manoeuvre", keys=None) -> None:
-    """An InputError naming the first of ``given`` (keyword -> value; None: not given) that
-    is set: a run-up option (:data:`RUNUP_ONLY`) has no meaning over a manoeuvre.
-    ``what``: how the manoeuvre was asked for (``--manoeuvre`` on the command line);
-    ``keys``: keyword -> the name the error gives (default the keyword)."""
+    """Refuse the first run-up option (:data:`RUNUP_ONLY`) set in ``given`` (keyword ->
+    value or None) over a manoeuvre asked for by ``what``; ``keys``: keyword -> name shown."""
     for name, value in given.items():
         if value is not None:
             raise InputError(f"{RUNUP_ONLY.get(name, 'a run-up option')} has no meaning "
@@ -161,10 +139,8 @@ def refuse_runup_options(given: dict, what: str = "manoeuvre", keys=None) -> Non
 
 
 def whatif_manoeuvre(engine, variants, manoeuvre) -> TransientRanking:
-    """The baseline and every variant (:func:`variant_engine`) over ``manoeuvre``
-    (:func:`powertrain.workflows.transient.transient`, in this process), ranked by the peak
-    seat acceleration, else the peak mount deflection
-    (:class:`~powertrain.results.transient.TransientRanking`)."""
+    """The baseline and every variant over ``manoeuvre``, ranked by peak seat acceleration,
+    else peak mount deflection (:class:`~powertrain.results.transient.TransientRanking`)."""
     m = manoeuvre_or_file(manoeuvre)
     engines = [engine] + [variant_engine(engine, v)[0] for v in variants]
     runs = [transient(m, e) for e in engines]
@@ -192,8 +168,8 @@ def _checked(solver, signal, workers, executor=None):
 
 
 def command_variants(engine, ops: dict, targets=(), variants_file=None) -> list:
-    """The variants of a command line: its operations (``{"scale": [...], ...}``) as the
-    variant ``command line``, each target a variant, then those of ``variants_file``."""
+    """The variants: ``ops`` (``{"scale": [...], ...}``) as ``command line``, each target,
+    then those of ``variants_file``."""
     out = []
     parsed = parse_operations(ops, engine=engine)
     if parsed:
@@ -213,15 +189,15 @@ def command_variants(engine, ops: dict, targets=(), variants_file=None) -> list:
 
 
 def parse_objective(text, channels, rpm):
-    """``CHANNEL.DIR:QUANTITY:FROM-TO`` checked against the model's ``channels`` and the
-    speed steps ``rpm``: ``(channel, direction, quantity, rpm_lo, rpm_hi)``."""
+    """``CHANNEL.DIR:QUANTITY:FROM-TO`` checked against ``channels`` and the speeds ``rpm``:
+    ``(channel, direction, quantity, rpm_lo, rpm_hi)``."""
     form = "CHANNEL.DIR:QUANTITY:FROM-TO, e.g. seat_rail.z:order_2:1500-3000"
     parts = [p.strip() for p in text.split(":")]
     if len(parts) != 3 or "." not in parts[0] or "-" not in parts[2]:
         raise InputError(f"expected {form}, got {text!r}", key="--objective")
     name, d = parts[0].rsplit(".", 1)
     d = d.lower()
-    if (name, d) not in channels:          # left.passive.z spells the node left/passive too
+    if (name, d) not in channels:          # left.passive.z: node left/passive
         name = _node_of(parts[0], name)
     if (name, d) not in channels:
         known = sorted({m for m, _ in channels})
@@ -248,16 +224,8 @@ def _node_of(text, name):
 
 
 def variant_engine(engine, variant, **fit_kwargs):
-    """The engine of ``variant``: its operations applied once, in order (a retune target is
-    fitted against the engine the earlier operations left,
-    :func:`~powertrain.workflows.retune.retuned_swap`); then the engine after each
-    operation must carry the body (an error names the option or variants-file key).
-
-    Returns
-    -------
-    engine : Engine
-    fits : list of TargetFit
-    """
+    """``(engine, fits)`` of ``variant``: its operations applied in order (a target fitted
+    against the engine before it); each stage must carry the body."""
     stages, fits = [], []
     for op in variant.operations:
         retuned = isinstance(op, Target)
@@ -287,20 +255,19 @@ def run_whatif(engine, variants, rpm=None, *, solver: str = "harmonic", executor
     engine : Engine
         Baseline.
     variants : sequence of Variant
-        Names unique and not ``baseline``; targets are resolved here (fits run in this
-        process, before the sweep).
+        Names unique and not ``baseline``; targets are fitted here, before the sweep.
     rpm : array_like, optional
         Speed steps [rpm] (default 1000..6000 step 500).
     solver : {"harmonic", "newmark"}
-        Default harmonic: exact for the linear model and fast.
+        Solver of the run-ups.
     executor, workers
-        Where the run-ups run (:func:`powertrain.workflows.sweeps.run_sweep`, on
-        :func:`powertrain.parallel.executor`).
+        Where they run (:func:`powertrain.workflows.sweeps.run_sweep`).
     measured : MeasuredRunup, optional
         Overlaid in the plot; gaps reported.
     quantities : tuple of str
+        Quantities reported.
     signal : str
-        ``velocity`` (default), ``mount_force``, ``displacement`` or ``acceleration``.
+        ``velocity``, ``mount_force``, ``displacement`` or ``acceleration``.
     fit_kwargs : dict, optional
         Passed to :func:`powertrain.workflows.fitting.fit_mount` for targets.
     runup_options : dict, optional
@@ -308,8 +275,7 @@ def run_whatif(engine, variants, rpm=None, *, solver: str = "harmonic", executor
     objective : tuple, optional
         The response to rank the variants by (:func:`parse_objective`).
     rpm_step : float, optional
-        The speed step the report names [rpm] (default: that of ``rpm``; None for one
-        speed).
+        The speed step the report names [rpm] (default: that of ``rpm``).
     """
     rpm = default_rpm() if rpm is None else np.atleast_1d(np.asarray(rpm, float))
     names = [v.name for v in variants]
