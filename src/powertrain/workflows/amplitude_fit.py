@@ -81,16 +81,14 @@ def fit_mount(measured, kcp_measured=None, model="triple-parallel", *, friction=
     """
     if kcp_measured is None:
         return fit_mount_csv(measured, model, friction=friction, reference=reference,
-                             starts=starts, seed=seed, max_mass=max_mass, fmin=fmin,
-                             fmax=fmax)
+                             starts=starts, seed=seed, max_mass=max_mass, fmin=fmin, fmax=fmax)
     _one_amplitude_options(friction, reference)
     return fitting.fit_mount(measured, kcp_measured, model, starts=starts, seed=seed,
                              max_mass=max_mass, fmin=fmin, fmax=fmax, **options)
 
 
 def fit_mount_csv(measured, model="triple-parallel", *, friction=False, reference=None,
-                  starts=DEFAULT_STARTS, seed=DEFAULT_SEED, max_mass=None, fmin=None,
-                  fmax=None):
+                  starts=DEFAULT_STARTS, seed=DEFAULT_SEED, max_mass=None, fmin=None, fmax=None):
     """``powertrain fit-mount`` on a CSV: single-amplitude fit, or :func:`fit_amplitudes`.
 
     Parameters
@@ -104,8 +102,7 @@ def fit_mount_csv(measured, model="triple-parallel", *, friction=False, referenc
     model, starts, seed, max_mass, fmin, fmax
         As :func:`powertrain.workflows.fitting.fit_mount_file`.
     """
-    starts, seed, max_mass, fmin, fmax = check_options(measured, model, starts, seed,
-                                                       max_mass, fmin, fmax)
+    starts, seed, max_mass, fmin, fmax = check_options(measured, model, starts, seed, max_mass, fmin, fmax)
     friction = flag(friction, "--friction")
     reference = real(reference, "--reference", unit="m", optional=True)
     data = read_stiffness_csv(measured).select(fmin, fmax)
@@ -202,8 +199,7 @@ class _Joint:
     def model(self, q, **meta) -> MountModel:
         n_p = len(self.topology.parameters)
         law = PowerLaw(self.a_ref, float(q[n_p]), LIMITS)
-        port = BergFriction(float(np.exp(q[n_p + 1])), float(np.exp(q[n_p + 2]))) \
-            if self.friction else None
+        port = BergFriction(float(np.exp(q[n_p + 1])), float(np.exp(q[n_p + 2]))) if self.friction else None
         return MountModel.from_values(self.topology, np.exp(q[:n_p]), amplitude_law=law,
                                       port_law=port, **meta)
 
@@ -214,8 +210,7 @@ class _Joint:
         p, law, port = model.values, model.amplitude_law, model.port_law
         friction = self._friction(port)
         res, jac = [], []
-        for j, (a, net, c, norm) in enumerate(zip(self.amplitudes, self.nets, self.curves,
-                                                  self.norms)):
+        for j, (a, net, c, norm) in enumerate(zip(self.amplitudes, self.nets, self.curves, self.norms)):
             s = float(law.factor(a))
             ps = p * (1.0 + (s - 1.0) * self.scaled)
             k, grad = net.gradient(ps)
@@ -273,10 +268,8 @@ class _Joint:
         """Start from ``q_network``, a guessed exponent and ``friction`` (None: without)."""
         if friction is None:
             return self._inside(np.r_[q_network, self._exponent_guess()])
-        rest = [c.kcp - friction.describing_stiffness(a) for a, c in
-                zip(self.amplitudes, self.curves)]
-        return self._inside(np.r_[q_network, self._exponent_guess(rest),
-                                  np.log(friction.max_force),
+        rest = [c.kcp - friction.describing_stiffness(a) for a, c in zip(self.amplitudes, self.curves)]
+        return self._inside(np.r_[q_network, self._exponent_guess(rest), np.log(friction.max_force),
                                   np.log(friction.half_displacement)])
 
     def _exponent_guess(self, kcp=None) -> float:

@@ -38,8 +38,7 @@ def frequencies(value, key: str = "--freq") -> np.ndarray:
     :data:`MAX_FREQUENCY_HZ`, strictly increasing."""
     arr = _numbers(value, key, "frequency", FREQUENCY_EXAMPLE, MAX_FREQUENCIES)
     if not np.all(np.isfinite(arr)) or np.any(arr < 0) or np.any(arr > MAX_FREQUENCY_HZ):
-        raise InputError(f"frequencies must be finite, >= 0 and <= {MAX_FREQUENCY_HZ:g} Hz",
-                         key=key)
+        raise InputError(f"frequencies must be finite, >= 0 and <= {MAX_FREQUENCY_HZ:g} Hz", key=key)
     if np.any(np.diff(arr) <= 0):
         raise InputError("frequencies must be strictly increasing", key=key)
     return arr
@@ -82,8 +81,7 @@ def floats(value, option: str, noun: str, example: str, most: int) -> np.ndarray
     """A number or a sequence of numbers as a flat float array of 1..``most`` values."""
     items = [value] if is_number(value) else value
     try:
-        items = np.ravel(np.asarray(list(items) if isinstance(items, Iterator) else items,
-                                    dtype=object))
+        items = np.ravel(np.asarray(list(items) if isinstance(items, Iterator) else items, dtype=object))
     except (TypeError, ValueError):
         items = np.array([value], dtype=object)
     if items.size > most:
@@ -91,8 +89,7 @@ def floats(value, option: str, noun: str, example: str, most: int) -> np.ndarray
     try:
         values = [_real(v) for v in items]
     except (TypeError, ValueError):
-        raise InputError(f"cannot read {noun} {_short(value)} (use {example})",
-                         key=option) from None
+        raise InputError(f"cannot read {noun} {_short(value)} (use {example})", key=option) from None
     if not values:
         raise InputError(f"no {noun} given", key=option)
     return np.array(values, dtype=float)
@@ -113,8 +110,7 @@ def _parse_list(text: str, option: str, noun: str, example: str, most: int) -> n
         except InputError:
             raise
         except ValueError:
-            raise InputError(f"cannot read {noun} {part!r} (use {example})",
-                             key=option) from None
+            raise InputError(f"cannot read {noun} {part!r} (use {example})", key=option) from None
     arr = np.array(values, dtype=float)
     if arr.size == 0:
         raise InputError(f"no {noun} given", key=option)
@@ -134,15 +130,13 @@ def _range(part: str, option: str, most: int, have: int) -> np.ndarray:
         raise ValueError
     ratio = (stop - start) / step
     if not math.isfinite(ratio) or ratio + 1 + have > most:
-        raise InputError(f"{part!r} asks for {ratio + 1:.3g} values; at most {most}",
-                         key=option)
+        raise InputError(f"{part!r} asks for {ratio + 1:.3g} values; at most {most}", key=option)
     return start + step * np.arange(math.floor(ratio + 1e-9) + 1)
 
 
 def is_number(value) -> bool:
     """True for a real number (int, float, numpy's), not a bool."""
-    return isinstance(value, (numbers.Real, np.number)) and not isinstance(value, (bool,
-                                                                                   np.bool_))
+    return isinstance(value, (numbers.Real, np.number)) and not isinstance(value, (bool, np.bool_))
 
 
 def _real(value) -> float:
@@ -206,8 +200,7 @@ def integer(value, key: str, *, minimum=None, maximum=None, optional: bool = Fal
             value = int(value)
         except ValueError:
             pass
-    if not isinstance(value, (numbers.Integral, np.integer)) or isinstance(value, (bool,
-                                                                                   np.bool_)):
+    if not isinstance(value, (numbers.Integral, np.integer)) or isinstance(value, (bool, np.bool_)):
         raise InputError(f"must be an integer, got {_short(value)}", key=key)
     n = int(value)
     if (minimum is not None and n < minimum) or (maximum is not None and n > maximum):
@@ -219,8 +212,7 @@ def integer(value, key: str, *, minimum=None, maximum=None, optional: bool = Fal
 def choice(value, choices, key: str) -> str:
     """``value`` if it is one of ``choices`` (strings), else an error listing them."""
     if not isinstance(value, str) or value not in choices:
-        raise InputError(f"{_short(value)} is not one of {', '.join(map(repr, choices))}",
-                         key=key)
+        raise InputError(f"{_short(value)} is not one of {', '.join(map(repr, choices))}", key=key)
     return value
 
 
@@ -242,8 +234,7 @@ def texts(value, key: str) -> list:
         items = [items]
     bad = [v for v in items if not isinstance(v, str)]
     if bad:
-        raise InputError(f"expected a string or a list of strings, got {_short(bad[0])}",
-                         key=key)
+        raise InputError(f"expected a string or a list of strings, got {_short(bad[0])}", key=key)
     return items
 
 

@@ -107,8 +107,7 @@ def _given_simulation(simulated, measured):
             sim = MeasuredRunup.from_result(simulated, source="simulation", signal=meas.signal)
         else:
             raise InputError(f"measured {meas.signal} curves need a simulation of the same "
-                             "quantity; run without --sim (the simulation is run here)",
-                             file=name)
+                             "quantity; run without --sim (the simulation is run here)", file=name)
     return sim, meas, {"engine": None, "simulation_file": name or sim.source}
 
 
@@ -119,16 +118,14 @@ def _read_curves(path, mounts=None):
     kind = detect_format(path)
     if kind in ("mdf", "uff"):
         raise InputError(f"raw time data ({kind.upper()}), not order curves: track it first "
-                         f"('powertrain track {path} --csv curves.csv'), then compare "
-                         "curves.csv", file=path)
+                         f"('powertrain track {path} --csv curves.csv'), then compare curves.csv", file=path)
     try:
         return read_measured(path, mounts=mounts)
     except InputError as exc:
         if _is_raw_csv(exc):
             raise InputError("raw time data (a 'time' column), not order curves: track it "
                              f"first ('powertrain track {path} --csv curves.csv'), then "
-                             "compare curves.csv", file=path, line=exc.line,
-                             key=exc.key) from None
+                             "compare curves.csv", file=path, line=exc.line, key=exc.key) from None
         raise
 
 
@@ -143,10 +140,8 @@ def _simulate(engine, engine_file, meas, rpm_step, solver, progress):
     rpm = simulation_speeds(engine, meas, rpm_step)
     grid = (f"{rpm[0]:g}..{rpm[-1]:g} rpm step {rpm_step:g}, interpolated" if rpm_step
             else f"at the {rpm.size} measured speeds {rpm[0]:g}..{rpm[-1]:g} rpm")
-    result = checked_runup(engine, engine_file, run_runup, rpm, solver=solver,
-                           progress=progress)
-    return MeasuredRunup.from_result(result, source=f"{engine_file} ({solver}, {grid})",
-                                     signal=meas.signal)
+    result = checked_runup(engine, engine_file, run_runup, rpm, solver=solver, progress=progress)
+    return MeasuredRunup.from_result(result, source=f"{engine_file} ({solver}, {grid})", signal=meas.signal)
 
 
 def simulation_speeds(engine, meas, rpm_step=None):
@@ -165,14 +160,11 @@ def simulation_speeds(engine, meas, rpm_step=None):
                              "simulated one by one: give --step to simulate a grid",
                              file=meas.source, key="rpm")
         return rpm
-    start = max(math.floor(lo / rpm_step + 1e-9) * rpm_step,
-                math.ceil(e_lo / rpm_step - 1e-9) * rpm_step)
-    stop = min(math.ceil(hi / rpm_step - 1e-9) * rpm_step,
-               math.floor(e_hi / rpm_step + 1e-9) * rpm_step)
+    start = max(math.floor(lo / rpm_step + 1e-9) * rpm_step, math.ceil(e_lo / rpm_step - 1e-9) * rpm_step)
+    stop = min(math.ceil(hi / rpm_step - 1e-9) * rpm_step, math.floor(e_hi / rpm_step + 1e-9) * rpm_step)
     if stop < start or start <= 0:
         raise InputError(f"{rpm_step:g} rpm leaves no speed step inside both the measured "
-                         f"({lo:g}..{hi:g}) and the engine's ({e_lo:g}..{e_hi:g}) range",
-                         key="--step")
+                         f"({lo:g}..{hi:g}) and the engine's ({e_lo:g}..{e_hi:g}) range", key="--step")
     if (stop - start) / rpm_step + 1 > MAX_SPEEDS:
         raise InputError(f"{(stop - start) / rpm_step + 1:.3g} speed steps over the "
                          f"measured range; at most {MAX_SPEEDS}", key="--step")
@@ -204,14 +196,12 @@ def compare_runup(simulated, measured: MeasuredRunup, *, noise_floor=DEFAULT_NOI
     ComparisonResult
     """
     if not isinstance(simulated, MeasuredRunup):
-        simulated = MeasuredRunup.from_result(simulated, source="simulation",
-                                              signal=measured.signal)
+        simulated = MeasuredRunup.from_result(simulated, source="simulation", signal=measured.signal)
     if not (np.isfinite(noise_floor) and noise_floor >= 0):
         raise ValueError("noise floor must be finite and >= 0")
     channel_order = list(simulated.channels)
     channel_order += [c for c in measured.channels if c not in channel_order]
-    quantities = sorted(set(EXPECTED_QUANTITIES) | set(measured.quantities),
-                        key=quantity_sort_key)
+    quantities = sorted(set(EXPECTED_QUANTITIES) | set(measured.quantities), key=quantity_sort_key)
     sim_rpm = np.unique(np.concatenate([r for r, _ in simulated.curves.values()]))
     channels, missing, not_modelled = [], [], []
     for mount, direction in channel_order:
@@ -223,17 +213,14 @@ def compare_runup(simulated, measured: MeasuredRunup, *, noise_floor=DEFAULT_NOI
                 missing.append({**where, "reason": f"not in the {side}"})
                 continue
             c = _compare_channel(where, measured.curves[key], simulated.curves[key],
-                                 noise_floor, sigma_db, measured.phases.get(key),
-                                 simulated.phases.get(key))
+                                 noise_floor, sigma_db, measured.phases.get(key), simulated.phases.get(key))
             if c.not_modelled.any():
                 not_modelled.append({**where, **_points(c, c.not_modelled)})
             if c.scored.any():
                 channels.append(c)
             elif not c.not_modelled.any():
-                missing.append({**where, "reason":
-                                f"no comparable point ({int(c.outside.sum())} outside the "
-                                f"simulated range, {int(c.at_floor.sum())} at the noise "
-                                "floor)"})
+                missing.append({**where, "reason": f"no comparable point ({int(c.outside.sum())} outside the "
+                                f"simulated range, {int(c.at_floor.sum())} at the noise floor)"})
     per_rpm = _per_rpm(channels)
     return ComparisonResult(channels, per_rpm, missing, measured, simulated,
                             float(noise_floor), sim_rpm, sigma_db, not_modelled=not_modelled)
@@ -262,14 +249,12 @@ def _compare_channel(where, measured_curve, simulated_curve, noise_floor, sigma_
                              scored, gap, stats, phase_gap)
 
 
-def _phase_gap(stats, rpm, simulated, measured, measured_phase, simulated_phase, rpm_s,
-               scored):
+def _phase_gap(stats, rpm, simulated, measured, measured_phase, simulated_phase, rpm_s, scored):
     """Phase gap per scored point (None without both phases); its statistics go to ``stats``."""
     if measured_phase is None or simulated_phase is None or not scored.any():
         return None
     sim = cm.interpolate_phase(rpm_s, simulated_phase, rpm)
-    more = cm.phase_statistics(simulated, measured, sim,
-                               np.asarray(measured_phase, float)[scored])
+    more = cm.phase_statistics(simulated, measured, sim, np.asarray(measured_phase, float)[scored])
     phase_gap = more.pop("phase_gap_deg")
     stats.update(more)
     return phase_gap

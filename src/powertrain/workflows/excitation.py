@@ -13,8 +13,7 @@ from powertrain.workflows.arguments import flag, real
 MIN_STEPS = 32
 
 
-def excitation(engine=None, rpm=None, *, load=1.0, balancers=True,
-               angle_step_deg=0.5) -> ExcitationResult:
+def excitation(engine=None, rpm=None, *, load=1.0, balancers=True, angle_step_deg=0.5) -> ExcitationResult:
     """Cylinder pressures, gas and inertia forces, crank torque and load over one cycle.
 
     Parameters

@@ -125,8 +125,7 @@ def _scales(frequency_hz, kcp_measured):
     return ks, wlo, whi
 
 
-def starting_points(topology: Topology, frequency_hz, kcp_measured, n: int, seed=DEFAULT_SEED,
-                    max_mass=None):
+def starting_points(topology: Topology, frequency_hz, kcp_measured, n: int, seed=DEFAULT_SEED, max_mass=None):
     r"""``n`` random starting log-parameter vectors (seeded), scaled to the data.
 
     Springs :math:`K_s 10^{U(-2, 1)}`; dampers :math:`K_s/\omega_c \cdot 10^{U(-2, 0)}`;
@@ -306,8 +305,7 @@ def _fit_arrays(frequency_hz, kcp_measured, topology, *, starts, seed, polish, h
     with np.errstate(all="ignore"):
         polished = _screen_and_polish(prob, fresh[:starts], polish)
         q_best, err_best, ok_best = min(polished, key=lambda t: t[1])
-        q_best, err_best, ok_best, accepted = _hop(prob, rng, fresh[starts:],
-                                                   (q_best, err_best, ok_best))
+        q_best, err_best, ok_best, accepted = _hop(prob, rng, fresh[starts:], (q_best, err_best, ok_best))
         if not ok_best:
             q_best, err_best, ok_best = prob.solve(q_best, FINAL_NFEV, 1e-10)
     q_best = np.clip(q_best, prob.lo, prob.hi)
@@ -317,8 +315,7 @@ def _fit_arrays(frequency_hz, kcp_measured, topology, *, starts, seed, polish, h
                      objective_n=objective_n(kfit, km), rel_rms=relative_rms_error(kfit, km),
                      n_starts=starts, n_polished=len(polished),
                      success=ok_best, polish_success=tuple(p[2] for p in polished),
-                     polish_rel_rms=tuple(p[1] for p in polished),
-                     n_hops=hops, hops_accepted=accepted,
+                     polish_rel_rms=tuple(p[1] for p in polished), n_hops=hops, hops_accepted=accepted,
                      time_s=time.perf_counter() - t0, nfev=prob.nfev, seed=seed)
 
 
@@ -326,8 +323,7 @@ def _topology(model) -> Topology:
     if isinstance(model, Topology):
         return model
     if not isinstance(model, str) or model not in TOPOLOGIES:
-        raise InputError(f"unknown model {model!r} (known: {', '.join(TOPOLOGIES)})",
-                         key="--model")
+        raise InputError(f"unknown model {model!r} (known: {', '.join(TOPOLOGIES)})", key="--model")
     return TOPOLOGIES[model]
 
 
@@ -347,8 +343,7 @@ def _checked_data(frequency_hz, kcp_measured, topology):
         raise InputError("data must be finite", key="kcp_measured" if np.all(np.isfinite(f))
                          else "frequency_hz")
     if np.any(f < 0) or np.any(np.diff(f) <= 0):
-        raise InputError("frequencies must be non-negative and strictly increasing",
-                         key="frequency_hz")
+        raise InputError("frequencies must be non-negative and strictly increasing", key="frequency_hz")
     n_par = len(topology.parameters)
     if 2 * f.size < n_par:
         raise InputError(f"{n_par} parameters need at least {(n_par + 1) // 2} frequencies",
@@ -390,12 +385,10 @@ MAX_STARTS = 10_000
 
 
 def fit_mount_file(measured, model: str = DEFAULT_TOPOLOGY, *, starts: int = DEFAULT_STARTS,
-                   seed=DEFAULT_SEED, max_mass=None, fmin=None, fmax=None,
-                   **options) -> FitResult:
+                   seed=DEFAULT_SEED, max_mass=None, fmin=None, fmax=None, **options) -> FitResult:
     """:func:`fit_mount` on the CSV ``measured`` in ``fmin..fmax`` [Hz] (``powertrain
     fit-mount``); ``options``: ``polish``, ``hops``."""
-    starts, seed, max_mass, fmin, fmax = check_options(measured, model, starts, seed,
-                                                       max_mass, fmin, fmax)
+    starts, seed, max_mass, fmin, fmax = check_options(measured, model, starts, seed, max_mass, fmin, fmax)
     data = read_stiffness_csv(measured).select(fmin, fmax)
     topo = TOPOLOGIES[model]
     need = (len(topo.parameters) + 1) // 2

@@ -86,8 +86,7 @@ def measure(velocity, sigma_db, rng, source="", channels=None, rpm=RPM, phase=No
     noise = FLOOR * (rng.normal(size=amp.shape) + 1j * rng.normal(size=amp.shape)) / np.sqrt(2)
     lev = np.abs(amp + noise)
     syn = np.sqrt(np.sum(lev ** 2, axis=-1))
-    phi = None if phase is None else np.where(lev > FLOOR,
-                                              _measured_phase(amp + noise, sigma_db, rng),
+    phi = None if phase is None else np.where(lev > FLOOR, _measured_phase(amp + noise, sigma_db, rng),
                                               np.nan)
     curves, phases = {}, {}
     for c, (m, d) in enumerate(channels):
@@ -97,8 +96,7 @@ def measure(velocity, sigma_db, rng, source="", channels=None, rpm=RPM, phase=No
             if phi is not None and (phase == "all" or h % 2 == 1):
                 phases[(m, d, order_label(o))] = phi[:, c, h].copy()
         curves[(m, d, "synthesis")] = (rpm.copy(), syn[:, c].copy())
-    return MeasuredRunup(curves, source=source, comments=[f"SYNTHETIC: {source}"],
-                         phases=phases)
+    return MeasuredRunup(curves, source=source, comments=[f"SYNTHETIC: {source}"], phases=phases)
 
 
 def _measured_phase(complex_rms, sigma_db, rng):
@@ -194,5 +192,4 @@ def draw_case(names, seed, engine, base, simulate, draw, channels, source, *, rp
     members = {}
     if len(truth) > 1:
         members = {t[0]: gap_stats(base, simulate(engine, [t])) for t in truth}
-    return SyntheticCase(list(names), seed, measured, sigma, truth, clean,
-                         gap_stats(base, clean), members)
+    return SyntheticCase(list(names), seed, measured, sigma, truth, clean, gap_stats(base, clean), members)

@@ -73,8 +73,7 @@ class Scale:
         if self.kind in LAW_KEYS:
             return _map_laws(engine, self, self.kind, lambda v: tuple(f * x for x in v)
                              if isinstance(v, tuple) else f * v)
-        change = {"stiffness": lambda m: m.scaled(stiffness=f),
-                  "damping": lambda m: m.scaled(damping=f)}.get(
+        change = {"stiffness": lambda m: m.scaled(stiffness=f), "damping": lambda m: m.scaled(damping=f)}.get(
             self.kind, lambda m: m.scaled_dynamic_stiffness(f))
         return _map_directions(engine, self.mount, self.direction,
                                lambda m: _plausible(change(m), self), self.origin)
@@ -117,8 +116,7 @@ class Swap:
     origin: Origin = Origin("--swap")
 
     def apply(self, engine):
-        new = _map_directions(engine, self.mount, self.direction, lambda m: self.model,
-                              self.origin)
+        new = _map_directions(engine, self.mount, self.direction, lambda m: self.model, self.origin)
         mounts = [dataclasses.replace(m, files={**m.files, self.direction: self.path})
                   if m.name == self.mount else m for m in new.mounts]
         return new.replace(mounts=mounts)
@@ -243,8 +241,7 @@ def _map_directions(engine, mount, direction, change, origin):
         if direction != WILDCARD and direction not in dirs:
             raise origin.error(f"unknown direction {direction!r} of mount {m.name!r} "
                                f"(expected {', '.join(dirs)} or *)")
-        new = {d: change(model) if direction in (WILDCARD, d) else model
-               for d, model in m.directions.items()}
+        new = {d: change(model) if direction in (WILDCARD, d) else model for d, model in m.directions.items()}
         return dataclasses.replace(m, directions=new)
     return _map_mounts(engine, mount, per_mount, origin)
 
@@ -262,8 +259,7 @@ def law_changed(model, key, change, create=False):
                           + (" (--set creates [amplitude] and [friction] only)" if create
                              else " (--set creates one)" if section in LAW_DEFAULTS else ""))
     if not isinstance(law, kind):
-        raise LookupError(f"its [{section}] law is a {type(law).__name__}, which has no "
-                          f"{name}")
+        raise LookupError(f"its [{section}] law is a {type(law).__name__}, which has no {name}")
     new = dataclasses.replace(law, **{name: change(getattr(law, name))})
     return dataclasses.replace(model, **{field: new})
 

@@ -131,8 +131,7 @@ def network_at(model, target: Target, frequency_hz):
     el = model.element()
     if not el.nonlinear:
         raise target.origin.error(f"{target.spec!r}: {target.mount}.{target.direction} has "
-                                  "no amplitude law or friction: its K_CP does not depend "
-                                  "on the amplitude")
+                                  "no amplitude law or friction: its K_CP does not depend on the amplitude")
     ks, ds = el.scales(target.amplitude)
     law = el.port_law
     k = 0.0 if law is None else complex(law.describing_stiffness(target.amplitude))
@@ -181,11 +180,9 @@ class TargetFit(Result):
         return {"spec": t.spec, "mount": t.mount, "direction": t.direction,
                 "requested_change_pct": 100 * (t.factor - 1), "band_hz": [t.f_lo, t.f_hi],
                 "blend_octaves": t.blend_octaves, "model": self.model.topology.name,
-                "kcp_rel_rms_pct": 100 * self.rel_rms,
-                "kip_rel_rms_pct": 100 * self.kip_rel_rms,
+                "kcp_rel_rms_pct": 100 * self.rel_rms, "kip_rel_rms_pct": 100 * self.kip_rel_rms,
                 "max_band_error_pct": 100 * self.max_band_error,
-                "achieved_mean_band_change_pct": 100 * self.mean_band_change,
-                "refinement_start": self.start,
+                "achieved_mean_band_change_pct": 100 * self.mean_band_change, "refinement_start": self.start,
                 "amplitude_mm": None if t.amplitude is None else 1e3 * t.amplitude,
                 "fitted_params_si": dict(self.model.params)}
 
@@ -203,13 +200,11 @@ class TargetFit(Result):
                 f"{100 * self.max_band_error:.2f} %, mean |K_CP| change "
                 f"{100 * self.mean_band_change:+.2f} % (requested {100 * (t.factor - 1):+.2f} %)")
 
-    def plot(self, ax=None, *, path=None, form="magnitude-phase", freq_axis="log",
-             provenance=None):
+    def plot(self, ax=None, *, path=None, form="magnitude-phase", freq_axis="log", provenance=None):
         """Baseline, requested and fitted K_CP (:func:`powertrain.plotting.plot_retune`);
         returns the figure."""
         ax, path = target_and_path(ax, path)
-        return plot_retune(self, path, ax=ax, form=form, freq_axis=freq_axis,
-                           provenance=provenance)
+        return plot_retune(self, path, ax=ax, form=form, freq_axis=freq_axis, provenance=provenance)
 
 
 def _refine(topology, p0, free, f, kt_cp, kt_ip):
@@ -287,8 +282,7 @@ def _target_fit(target, model, fitted, f, k0, kt, kip_t, kf, kip_f, start, summa
                      kcp_baseline=k0, kcp_target=kt, kcp_fitted=kf, kip_target=kip_t,
                      kip_fitted=kip_f, rel_rms=relative_rms_error(kf, kt),
                      kip_rel_rms=relative_rms_error(kip_f, kip_t),
-                     max_band_error=float(np.max(np.abs(kf[band] - kt[band])
-                                                 / np.abs(kt[band]))),
+                     max_band_error=float(np.max(np.abs(kf[band] - kt[band]) / np.abs(kt[band]))),
                      mean_band_change=float(np.mean(np.abs(kf[band]) / np.abs(k0[band])) - 1),
                      start=start, fit_summary=summary)
 

@@ -250,8 +250,7 @@ def runup(engine=None, rpm=None, *, solver="newmark", stepper="auto",
     InputError
         Naming the engine file and key, or the option, of bad input.
     """
-    options = _checked_options(solver, stepper, angle_step_deg, balancers, sweep, sample_rate,
-                               progress)
+    options = _checked_options(solver, stepper, angle_step_deg, balancers, sweep, sample_rate, progress)
     engine = engine_or_default(engine)
     engine.require_excitation()
     modifications = []
@@ -276,14 +275,12 @@ def _with_engine(result, engine, rpm, modifications) -> RunupResult:
     if operating_point is None:
         operating_point = _static_result(engine, operating_points(engine, rpm))
     dominant = mode_coordinates(engine, result.rigid_body_modes_hz)
-    return replace(result, engine=engine, modifications=modifications,
-                   operating_point=operating_point,
+    return replace(result, engine=engine, modifications=modifications, operating_point=operating_point,
                    meta={**result.meta, "engine_file": str(engine.file),
                          "rigid_body_mode_dominant": dominant})
 
 
-def _checked_options(solver, stepper, angle_step_deg, balancers, sweep, sample_rate,
-                     progress) -> dict:
+def _checked_options(solver, stepper, angle_step_deg, balancers, sweep, sample_rate, progress) -> dict:
     """The options of :func:`runup` checked."""
     args.choice(solver, tuple(SOLVERS), "--solver")
     args.choice(stepper, tuple(NEWMARK_STEPPERS), "--stepper")
@@ -297,26 +294,22 @@ def _checked_options(solver, stepper, angle_step_deg, balancers, sweep, sample_r
 def _stepped(engine, rpm, scenario, progress, **options) -> RunupResult:
     """The stepped run-up, with the effects of ``scenario`` if any, checked finite."""
     if not scenario:
-        return checked_runup(engine, engine.file, run_runup, rpm, progress=progress,
-                             **options)
+        return checked_runup(engine, engine.file, run_runup, rpm, progress=progress, **options)
     with activity(f"run-up with effects ({options['solver']})", enabled=progress):
-        return checked_runup(engine, engine.file, runup_with_effects, rpm, scenario,
-                             **options)
+        return checked_runup(engine, engine.file, runup_with_effects, rpm, scenario, **options)
 
 
 def _scenario(effects, engine) -> dict:
     """The scenario of ``--effect`` strings, or a scenario as given."""
     if isinstance(effects, dict):
         return effects
-    return effect_scenario(parse_operations({"effect": args.texts(effects, "--effect")},
-                                            engine=engine))
+    return effect_scenario(parse_operations({"effect": args.texts(effects, "--effect")}, engine=engine))
 
 
 def _sweep_runup(engine, rpm, rate, sample_rate, effects, progress) -> SweepRunup:
     """Simulate the speed ramp and track it (COT, orders 0.5..8, as velocity)."""
     if effects:
-        raise InputError("effects are not simulated in a sweep (use stepped run-ups)",
-                         key="--effect")
+        raise InputError("effects are not simulated in a sweep (use stepped run-ups)", key="--effect")
     rpm = args.speeds(rpm, increasing=False)
     factors = (lambda r: static_factors(engine, r)) if has_static_curves(engine) else None
     rec = simulate_sweep(engine, rpm[0], rpm[-1], rate, sample_rate, progress=progress,
@@ -327,19 +320,16 @@ def _sweep_runup(engine, rpm, rate, sample_rate, effects, progress) -> SweepRunu
         raise InputError(f"the {rec.time[-1] - rec.time[0]:.3g} s sweep cannot be order-"
                          f"tracked ({exc.message}); a slower sweep or a wider speed range",
                          key="--sweep") from None
-    return SweepRunup(recording=rec, tracked=tracked, rate_rpm_per_s=float(rate),
-                      engine=engine)
+    return SweepRunup(recording=rec, tracked=tracked, rate_rpm_per_s=float(rate), engine=engine)
 
 
 def check_runup_settings(engine, rpm, angle_step: float) -> None:
     """Check a run-up's speeds against the engine's range and the crank-angle step."""
     lo, hi = engine.speed_range_rpm()
     if rpm[0] < lo - 1e-6:
-        raise InputError(f"{rpm[0]:g} rpm is below the engine's range {lo:g}..{hi:g} rpm",
-                         key="--from")
+        raise InputError(f"{rpm[0]:g} rpm is below the engine's range {lo:g}..{hi:g} rpm", key="--from")
     if rpm[-1] > hi + 1e-6:
-        raise InputError(f"{rpm[-1]:g} rpm is above the engine's range {lo:g}..{hi:g} rpm",
-                         key="--to")
+        raise InputError(f"{rpm[-1]:g} rpm is above the engine's range {lo:g}..{hi:g} rpm", key="--to")
     n_cycle = 720.0 / angle_step if math.isfinite(angle_step) and angle_step > 0 else 0.0
     if not (MIN_ANGLE_STEP_DEG <= angle_step <= MAX_ANGLE_STEP_DEG
             and abs(n_cycle - round(n_cycle)) < 1e-9 and round(n_cycle) % 2 == 0):
@@ -354,8 +344,7 @@ def check_path_plot(engine, order) -> None:
         raise InputError("needs body points ([chassis.points.NAME] with a modal or frf "
                          "chassis)", file=engine.file, key="--path-plot")
     if not np.any(np.isclose(ORDERS, order)):
-        raise InputError(f"order {order:g} not analysed (0.5 to 8 in steps of 0.5)",
-                         key="--path-order")
+        raise InputError(f"order {order:g} not analysed (0.5 to 8 in steps of 0.5)", key="--path-order")
 
 
 def checked_runup(engine, engine_path, run, *args, **kwargs):
@@ -379,8 +368,7 @@ def checked_runup(engine, engine_path, run, *args, **kwargs):
 def _blamed_input(engine, engine_path):
     """``(file, key)`` an unsolvable run-up blames: an FRF body's receptances, else the engine."""
     receptance = getattr(engine.chassis, "receptance", None)
-    if getattr(engine.chassis, "coupled_by_admittance", False) and \
-            getattr(receptance, "file", ""):
+    if getattr(engine.chassis, "coupled_by_admittance", False) and getattr(receptance, "file", ""):
         return receptance.file, None
     return engine_path, "engine"
 
@@ -394,8 +382,7 @@ def mode_coordinates(engine, frequencies_hz) -> list:
     for f in frequencies_hz:
         k = int(np.argmin(np.abs(f_sys - f)))
         energy = kinetic_energy_percent(system.M[:6, :6], shapes[:, k])
-        out.append(COORDINATES[int(np.argmax(energy))]
-                   if abs(f_sys[k] - f) <= 1e-6 * max(f, 1.0) else "")
+        out.append(COORDINATES[int(np.argmax(energy))] if abs(f_sys[k] - f) <= 1e-6 * max(f, 1.0) else "")
     return out
 
 

@@ -32,6 +32,5 @@ def static(engine=None, rpm=None) -> StaticResult:
     lo, hi = engine.speed_range_rpm()
     bad = rpm[~(np.isfinite(rpm) & (rpm >= lo - 1e-6) & (rpm <= hi + 1e-6))]
     if bad.size:
-        raise InputError(f"{bad[0]:g} rpm is outside the engine's range {lo:g}..{hi:g} rpm",
-                         key="--rpm")
+        raise InputError(f"{bad[0]:g} rpm is outside the engine's range {lo:g}..{hi:g} rpm", key="--rpm")
     return StaticResult(operating_points(engine, rpm), engine.mount_names, engine.name)

@@ -61,8 +61,7 @@ def stiffness(mount, *, engine=None, freq=None, method="frequency", force=None,
         raise InputError("the time method needs frequencies > 0 Hz", key="--freq")
     model, label = mount_model(mount, engine)
     if amplitude is not None and engine_mass is not None:
-        raise InputError("--amplitude is the displacement test, without --engine-mass",
-                         key="--amplitude")
+        raise InputError("--amplitude is the displacement test, without --engine-mass", key="--amplitude")
     amps = _amplitude_argument(amplitude, mount if engine is None else None)
 
     def compute():
@@ -109,8 +108,7 @@ def mount_model(mount, engine=None):
         if isinstance(mount, MountModel):
             return mount, "model"
         if mount is None:
-            raise InputError("give either MOUNT_FILE or --engine with --mount",
-                             key="MOUNT_FILE")
+            raise InputError("give either MOUNT_FILE or --engine with --mount", key="MOUNT_FILE")
         raise InputError(f"expected a MountModel or a mount file, got {type(mount).__name__}",
                          key="MOUNT_FILE")
     if isinstance(engine, (str, os.PathLike)):
@@ -146,8 +144,7 @@ def stiffness_table(model, frequency_hz, method="frequency", engine_mass=None, f
     f = np.asarray(frequency_hz, float)
     kw = {} if steps_per_period is None else {"steps_per_period": steps_per_period}
     if method == "frequency":
-        forced = () if engine_mass is None else model.forced_engine_mass_response(
-            f, engine_mass, force)
+        forced = () if engine_mass is None else model.forced_engine_mass_response(f, engine_mass, force)
         return StiffnessResult(f, model.cross_point_stiffness(f), method, *forced)
     if method == "time":
         if engine_mass is None:
@@ -215,8 +212,7 @@ def parse_amplitudes(text: str, mount_file=None) -> np.ndarray:
     except ValueError:
         raise InputError(f"cannot read {text!r} (use a comma list, e.g. 0.05,0.1,0.5)",
                          key="--amplitude") from None
-    where = {"file": str(mount_file), "key": "units.x"} \
-        if isinstance(mount_file, (str, os.PathLike)) else {}
+    where = {"file": str(mount_file), "key": "units.x"} if isinstance(mount_file, (str, os.PathLike)) else {}
     return to_si(_amplitudes(values, unit), unit, "length", **where)
 
 

@@ -29,8 +29,7 @@ class SweepTask:
 def run_task(task: SweepTask):
     """The task's run-up (with its effects), ``meta["variant"]`` the task name."""
     if task.effects:
-        result = runup_with_effects(task.engine, task.rpm, task.effects, solver=task.solver,
-                                    **task.options)
+        result = runup_with_effects(task.engine, task.rpm, task.effects, solver=task.solver, **task.options)
     else:
         result = run_runup(task.engine, task.rpm, solver=task.solver, **task.options)
     return replace(result, meta={**result.meta, "variant": task.name})

@@ -68,8 +68,7 @@ def draw_truth(name, rng, n_net=9):
     if name == "amplitude_power":
         return {"beta": u(0.08, 0.25, 2)}
     if name == "balancer_error":
-        return {"gain": u(0.75, 1.25, 2), "lag": u(-0.35, 0.35),
-                "lag_shaft": u(-0.05, 0.05, 2)}
+        return {"gain": u(0.75, 1.25, 2), "lag": u(-0.35, 0.35), "lag_shaft": u(-0.05, 0.05, 2)}
     if name == "cylinder_combustion":
         return {"imep_dev": u(-0.12, 0.12, 4), "start_shift_deg": u(-2, 2, 4)}
     if name == "sensor_triads":
@@ -97,12 +96,10 @@ def worth_diagnosing(base, velocity) -> bool:
     """Redraw rule: the noise-free gap reaches :data:`MIN_EFFECT_DB` RMS or
     :data:`MIN_EFFECT_MAX_DB` somewhere."""
     g = gaps_db(base, velocity)
-    return bool(g.size) and bool(np.sqrt(np.mean(g ** 2)) >= MIN_EFFECT_DB
-                                 or np.max(g) >= MIN_EFFECT_MAX_DB)
+    return bool(g.size) and bool(np.sqrt(np.mean(g ** 2)) >= MIN_EFFECT_DB or np.max(g) >= MIN_EFFECT_MAX_DB)
 
 
-def make_case(engine, truth_names, seed, *, rpm=None, hm=None, noise_db=None,
-              params=None) -> SyntheticCase:
+def make_case(engine, truth_names, seed, *, rpm=None, hm=None, noise_db=None, params=None) -> SyntheticCase:
     """One synthetic measurement (:class:`~powertrain.workflows.measurement.SyntheticCase`)
     with the named truth effects.
 
@@ -128,8 +125,7 @@ def make_case(engine, truth_names, seed, *, rpm=None, hm=None, noise_db=None,
     rpm = RPM if rpm is None else np.asarray(rpm, float)
     hm = HarmonicModel(engine, rpm) if hm is None else hm
     base = hm.velocity(hm.solve(hm.two_ports()[0]))
-    return draw_case(list(truth_names), seed, engine, base,
-                     lambda eng, truth: truth_velocity(eng, hm, truth),
+    return draw_case(list(truth_names), seed, engine, base, lambda eng, truth: truth_velocity(eng, hm, truth),
                      _draw, hm.channels, f"synthetic case 0 (seed {seed})", rpm=rpm,
                      noise_db=noise_db, params=params, redraws=REDRAWS, worth=worth_diagnosing)
 
@@ -167,8 +163,7 @@ class SynthCase(Result):
         c = self.case
         return {"seed": self.seed, "noise_db": c.noise_db, "effect_rms_db": c.effect_rms_db,
                 "truth": [{"effect": n, "library_match": TRUTH_EFFECTS[n],
-                           "parameters": {k: plain(v) for k, v in p.items()}}
-                          for n, p in c.truth]}
+                           "parameters": {k: plain(v) for k, v in p.items()}} for n, p in c.truth]}
 
     def writers(self) -> dict:
         """``.csv`` (:meth:`to_csv`), ``.png``."""
@@ -189,8 +184,7 @@ class SynthCase(Result):
         drawn = [(q, rpm, v) for (m, d, q), (rpm, v) in curves.items()
                  if (m, d) == (mount, direction) and q != "synthesis"]
         for k, (q, rpm, v) in enumerate(drawn):
-            a.plot(rpm, np.asarray(v) * 1e3, lw=1.0, label=q.replace("_", " "),
-                   **series_style(k))
+            a.plot(rpm, np.asarray(v) * 1e3, lw=1.0, label=q.replace("_", " "), **series_style(k))
         a.axhline(FLOOR * 1e3, color="0.4", lw=0.8, ls=(0, (1, 2)), label="noise floor")
         log_axis(a, "y")
         a.set_xlabel("engine speed [rpm]")

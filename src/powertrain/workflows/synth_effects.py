@@ -17,17 +17,14 @@ from powertrain.solvers.fast_harmonic import N_HARMONICS, HarmonicModel
 
 def _two_port_springs(omega, model, s):
     """Two-port (a, b, c) with the network's springs times s (n_r,) per speed."""
-    return two_port(omega, *model.network(), spring_scale=np.asarray(s, float)[:, None],
-                    damper_scale=1.0)
+    return two_port(omega, *model.network(), spring_scale=np.asarray(s, float)[:, None], damper_scale=1.0)
 
 
 def _solve_body(hm, abc, load, body):
     """Rigid body + flexible chassis body (modal) under all networks; q (n_r, 16, 6)."""
-    modes = SimpleNamespace(frequency_hz=body["freq"], modal_mass=body["mass"],
-                            damping_ratio=body["zeta"])
+    modes = SimpleNamespace(frequency_hz=body["freq"], modal_mass=body["mass"], damping_ratio=body["zeta"])
     return coupled_solve(hm.M, hm.omega[:, 1:], hm.rows, body["shapes"],
-                         tuple(x[:, 1:] for x in abc), abc[0][:, 1:], modes,
-                         load[:, 1:])[..., :6]
+                         tuple(x[:, 1:] for x in abc), abc[0][:, 1:], modes, load[:, 1:])[..., :6]
 
 
 class _PerCylinderCombustion:
@@ -103,8 +100,7 @@ def _truth_load(engine, hm, names):
         sh = hm.shaft_loads()
         on = 1.0 if engine.balancer.enabled else 0.0
         for k in range(sh.shape[0]):
-            load = load + (p["gain"][k] * np.exp(-1j * (p["lag"] + p["lag_shaft"][k])) - on
-                           ) * sh[k]
+            load = load + (p["gain"][k] * np.exp(-1j * (p["lag"] + p["lag_shaft"][k])) - on) * sh[k]
     if "torsional_driveline" in names:
         p = names["torsional_driveline"]
         w, wt = hm.omega, 2 * np.pi * p["freq"]
@@ -124,8 +120,7 @@ def _truth_networks(hm, names) -> list:
         spring = np.asarray(p["spring"], float)
         damp = np.asarray(p["damper"], float)
     return [m.with_params(**{k: v * (sf if k[0] == "c" else df if k[0] == "d" else 1.0)
-                             for k, v in m.params.items()})
-            for m, sf, df in zip(nets, spring, damp)]
+                             for k, v in m.params.items()}) for m, sf, df in zip(nets, spring, damp)]
 
 
 def _truth_readings(hm, v, names):

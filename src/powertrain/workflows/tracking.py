@@ -51,8 +51,7 @@ def speed_profile(rec, *, use="auto", pulses_per_rev=None, smooth_s=0.1):
         raise InputError("no tacho channel", file=rec.source, key="tacho")
     if pulses_per_rev is None:
         raise InputError("a tacho needs --pulses-per-rev N", file=rec.source, key="tacho")
-    return speed_from_tacho(rec.time, rec.tacho, pulses_per_rev, smooth_s=smooth_s,
-                            file=rec.source)
+    return speed_from_tacho(rec.time, rec.tacho, pulses_per_rev, smooth_s=smooth_s, file=rec.source)
 
 
 def track(raw, *, orders=None, rpm_step=50.0, method="cot", bandwidth=None, channel_map=None,
@@ -94,8 +93,7 @@ def track(raw, *, orders=None, rpm_step=50.0, method="cot", bandwidth=None, chan
     """
     rpm_step, bandwidth, pulses_per_rev, tdc_offset, spectrum_at = _numbers(
         rpm_step, bandwidth, pulses_per_rev, tdc_offset, spectrum_at)
-    _check_options(tacho_column, pulses_per_rev, map_channel, maps, tdc_offset,
-                   cycle_reference)
+    _check_options(tacho_column, pulses_per_rev, map_channel, maps, tdc_offset, cycle_reference)
     orders = _orders(orders)
     overall_opts = _overall_options(overall, overall_band, as_quantity)
     rec = _recording(raw, channel_map, rpm_column, tacho_column, cycle_reference)
@@ -137,8 +135,7 @@ def _orders(orders):
     return cot.parse_orders(",".join(repr(float(v)) for v in values))
 
 
-def _check_options(tacho_column, pulses_per_rev, map_channel, maps, tdc_offset,
-                   cycle_reference) -> None:
+def _check_options(tacho_column, pulses_per_rev, map_channel, maps, tdc_offset, cycle_reference) -> None:
     """Refuse options that need another one, or out of range."""
     if tacho_column and pulses_per_rev is None:
         raise InputError("--tacho needs --pulses-per-rev N", key="--pulses-per-rev")
@@ -147,8 +144,7 @@ def _check_options(tacho_column, pulses_per_rev, map_channel, maps, tdc_offset,
     if map_channel and not maps:
         raise InputError("--map-channel needs --map FILE.png", key="--map-channel")
     if cycle_reference and tdc_offset is None:
-        raise InputError("needs --tdc-offset DEG (where cylinder-1 firing TDC lies)",
-                         key="--cycle-reference")
+        raise InputError("needs --tdc-offset DEG (where cylinder-1 firing TDC lies)", key="--cycle-reference")
 
 
 def _recording(raw, channel_map, rpm_column, tacho_column, cycle_reference=None):
@@ -156,8 +152,7 @@ def _recording(raw, channel_map, rpm_column, tacho_column, cycle_reference=None)
     if isinstance(raw, RawRecording):
         return raw
     args.path_or(raw, (), "RAW", "a raw recording or its file")
-    return read_raw(raw, channel_map, rpm=rpm_column, tacho=tacho_column,
-                    cycle_reference=cycle_reference)
+    return read_raw(raw, channel_map, rpm=rpm_column, tacho=tacho_column, cycle_reference=cycle_reference)
 
 
 def _overall_options(overall, overall_band, as_quantity):
@@ -190,20 +185,17 @@ def _map_channel(rec, name):
         if name in (ch.name, ch.label):
             return i
     known = ", ".join(ch.label for ch in rec.channels)
-    raise InputError(f"no channel {name!r} in the file (channels: {known})",
-                     key="--map-channel")
+    raise InputError(f"no channel {name!r} in the file (channels: {known})", key="--map-channel")
 
 
 def _maps(rec, use, pulses_per_rev, rpm_step, channel, max_order, tracked_rpm):
     """Campbell and rpm-frequency maps of one channel (:func:`~powertrain.plotting.orders.
     plot_maps`'s arguments), reaching 25 % above the highest tracked order."""
     profile = speed_profile(rec, use=use, pulses_per_rev=pulses_per_rev)
-    rpm, fine, rms = order_map(rec, profile, channel, rpm_step=rpm_step,
-                               max_order=MAP_MARGIN * max_order)
+    rpm, fine, rms = order_map(rec, profile, channel, rpm_step=rpm_step, max_order=MAP_MARGIN * max_order)
     fs = rec.sample_rate
     nper = min(int(2 ** np.ceil(np.log2(max(64, round(fs / 2.0))))), rec.time.size)  # ~2 Hz
-    f, tt, p = spectrogram(rec.channels[channel].values, fs, nperseg=nper,
-                           noverlap=nper * 7 // 8)
+    f, tt, p = spectrogram(rec.channels[channel].values, fs, nperseg=nper, noverlap=nper * 7 // 8)
     rpm_t = np.interp(tt + rec.time[0], rec.time, profile.rpm)
     ch = rec.channels[channel]
     return dict(rpm=rpm, orders=fine, order_rms=rms, times=tt, freqs=f, rpm_t=rpm_t, psd=p.T,
@@ -261,8 +253,7 @@ def track_recording(rec, orders=None, *, rpm_step=50.0, method="cot", use="auto"
         raise InputError(f"no {quantity} channel", file=rec.source, key="--quantity")
     profile, origin = _profile_and_origin(rec, use, pulses_per_rev, tdc_offset_deg)
     amp, rpm, settings = _track_channels(rec, chans, profile, orders, method, rpm_step,
-                                         block_revs if method == "cot" else bandwidth_hz,
-                                         progress)
+                                         block_revs if method == "cot" else bandwidth_hz, progress)
     if origin is not None:
         amp = to_tdc(amp, orders, origin[0])
         settings["phase"] = _phase_settings(orders, tdc_offset_deg, origin[1])
@@ -276,12 +267,10 @@ def _tracked(chans) -> list:
     return [TrackedChannel(c.name, c.mount, c.side, c.direction, c.quantity) for c in chans]
 
 
-def _track_channels(rec, chans, profile, orders, method, rpm_step, block_or_bandwidth,
-                    progress):
+def _track_channels(rec, chans, profile, orders, method, rpm_step, block_or_bandwidth, progress):
     """``(amplitudes, rpm, settings)`` of COT or VKF, with the speed grid and source."""
     track_with = _track_cot if method == "cot" else _track_vkf
-    amp, rpm, settings = track_with(rec, chans, profile, orders, rpm_step, block_or_bandwidth,
-                                    progress)
+    amp, rpm, settings = track_with(rec, chans, profile, orders, rpm_step, block_or_bandwidth, progress)
     i0, i1 = profile.valid
     settings.update({"rpm_step": float(rpm_step), "speed_source": profile.source,
                      "speed_notes": profile.notes, "sample_rate_hz": rec.sample_rate,
@@ -312,8 +301,7 @@ def _phase_settings(orders, tdc_offset_deg, per_cycle) -> dict:
     """The phase reference and the orders with a phase (half orders with a cycle reference)."""
     step = 0.5 if per_cycle else 1.0
     defined = [float(o) for o in orders if abs(o / step - round(o / step)) < 1e-9]
-    return {"tdc_offset_deg": float(tdc_offset_deg), "cycle_reference": bool(per_cycle),
-            "orders": defined}
+    return {"tdc_offset_deg": float(tdc_offset_deg), "cycle_reference": bool(per_cycle), "orders": defined}
 
 
 def _summary(rec) -> dict:
@@ -325,8 +313,7 @@ def _summary(rec) -> dict:
 def overall_band(orders, rpm, sample_rate):
     """Default band of the overall level [Hz]: half the lowest order at the lowest speed to
     MAX_FREQUENCY_FRACTION x the sampling rate."""
-    return 0.5 * float(np.min(orders)) * float(np.min(rpm)) / 60.0, \
-        MAX_FREQUENCY_FRACTION * sample_rate
+    return 0.5 * float(np.min(orders)) * float(np.min(rpm)) / 60.0, MAX_FREQUENCY_FRACTION * sample_rate
 
 
 def _overall(rec, chans, profile, orders, rpm, settings, band, velocity):
@@ -334,13 +321,11 @@ def _overall(rec, chans, profile, orders, rpm, settings, band, velocity):
     band = band or overall_band(orders, rpm, rec.sample_rate)
     turn = {"acceleration": -1, "velocity": 0, "displacement": 1}
     if velocity and any(c.quantity not in turn for c in chans):
-        raise InputError("a force cannot be converted to velocity", file=rec.source,
-                         key="--as")
+        raise InputError("a force cannot be converted to velocity", file=rec.source, key="--as")
     derivative = [turn[c.quantity] for c in chans] if velocity else None
     B = int(settings.get("block_revolutions") or cot.block_revolutions(orders))
     level = overall_rms(rec.channel_matrix(chans), profile, rpm, B, band, derivative)
-    settings.update({"overall_band_hz": [float(band[0]), float(band[1])],
-                     "overall_revolutions": B,
+    settings.update({"overall_band_hz": [float(band[0]), float(band[1])], "overall_revolutions": B,
                      "overall_quantity": "velocity" if velocity else "channel"})
     return level
 
@@ -363,8 +348,7 @@ def order_spectrum(rec, profile, rpm, top_order, *, quantity=None) -> TrackedOrd
         raise InputError(f"speed does not pass {rpm:g} rpm with {B / 2:g} revolutions of data "
                          f"either side (speed {n.min():.0f}..{n.max():.0f} rpm)",
                          file=rec.source, key="--spectrum-at")
-    amp = cot.cot_amplitudes(rec.channel_matrix(chans), profile, fine, np.array([rpm]),
-                             centre, B)
+    amp = cot.cot_amplitudes(rec.channel_matrix(chans), profile, fine, np.array([rpm]), centre, B)
     return TrackedOrders(np.array([float(rpm)]), fine, _tracked(chans), amp, "cot", rec.source,
                          {"block_revolutions": B, "window": "hann",
                           "order_resolution": 1.0 / B}, list(rec.comments))
@@ -388,10 +372,8 @@ def _track_cot(rec, chans, profile, orders, rpm_step, block_revs, progress):
     _check_rate(rec, orders, rpm)
     X = rec.channel_matrix(chans)
     amp = np.empty((rpm.size, X.shape[0], orders.size), complex)
-    for s in progress_bar(range(0, rpm.size, CHUNK), enabled=progress, desc="order tracking",
-                          unit="block"):
-        amp[s:s + CHUNK] = cot.cot_amplitudes(X, profile, orders, rpm[s:s + CHUNK],
-                                              centre[s:s + CHUNK], B)
+    for s in progress_bar(range(0, rpm.size, CHUNK), enabled=progress, desc="order tracking", unit="block"):
+        amp[s:s + CHUNK] = cot.cot_amplitudes(X, profile, orders, rpm[s:s + CHUNK], centre[s:s + CHUNK], B)
     return amp, rpm, {"block_revolutions": B, "samples_per_revolution": S, "window": "hann",
                       "kernel": f"Kaiser-windowed sinc, {cot.KERNEL_ZERO_CROSSINGS} zero "
                       f"crossings, beta {cot.KERNEL_BETA:g}"}
@@ -411,24 +393,21 @@ def _track_vkf(rec, chans, profile, orders, rpm_step, bandwidth_hz, progress):
         rule = "given (--bandwidth)"
     i0, i1 = profile.valid
     ends = [vk.EDGE_TIME_CONSTANTS / float(np.min(width[:, i])) for i in (i0, i1)]
-    rpm, _ = cot.speed_grid(profile, rpm_step, 0, margin_s=ends, file=rec.source,
-                            key=profile.source)
+    rpm, _ = cot.speed_grid(profile, rpm_step, 0, margin_s=ends, file=rec.source, key=profile.source)
     _check_rate(rec, orders, rpm)
     amp = vk.vkf_amplitudes(rec.channel_matrix(chans), profile, orders, rpm,
                             bandwidth_hz=width, progress=progress)
     inside = width[:, i0:i1 + 1]
     return amp, rpm, {"bandwidth_hz": float(np.max(inside)),
                       "bandwidth_hz_range": [float(np.min(inside)), float(np.max(inside))],
-                      "bandwidth_rule": rule, "ends_dropped_s": ends,
-                      "structural_equation": "two-pole"}
+                      "bandwidth_rule": rule, "ends_dropped_s": ends, "structural_equation": "two-pole"}
 
 
 def _kernel_margin(profile, samples_per_rev) -> float:
     """Time [s] the resampling kernel reaches beyond a block at the lowest valid speed."""
     i0, i1 = profile.valid
     n_min = float(np.min(profile.rpm[i0:i1 + 1]))
-    return cot.KERNEL_ZERO_CROSSINGS / (cot.ANTI_ALIAS_FRACTION * samples_per_rev * n_min
-                                        / 60.0)
+    return cot.KERNEL_ZERO_CROSSINGS / (cot.ANTI_ALIAS_FRACTION * samples_per_rev * n_min / 60.0)
 
 
 def order_map(rec, profile, channel=0, *, rpm_step=50.0, max_order=None):
@@ -437,8 +416,7 @@ def order_map(rec, profile, channel=0, *, rpm_step=50.0, max_order=None):
     B = cot.MIN_BLOCK_REVS * 2
     fine = np.arange(1, int(top * B) + 1) / B
     rpm, centre = cot.speed_grid(profile, rpm_step, B,
-                                 margin_s=_kernel_margin(profile, cot.samples_per_rev(fine)),
-                                 file=rec.source)
+                                 margin_s=_kernel_margin(profile, cot.samples_per_rev(fine)), file=rec.source)
     X = rec.channels[channel].values[None, :]
     amp = cot.cot_amplitudes(X, profile, fine, rpm, centre, B)[:, 0, :]
     return rpm, fine, np.abs(amp) / np.sqrt(2.0)

@@ -38,8 +38,7 @@ def manoeuvre_or_file(manoeuvre) -> Manoeuvre:
 
 def transient(manoeuvre, engine=None, *, angle_step_deg=ANGLE_STEP_DEG, seat=None,
               system=None, speed_from=None, trigger=None, channel_map=None,
-              speed_average=False, pulses_per_rev=1,
-              trigger_edge="rising") -> TransientResult:
+              speed_average=False, pulses_per_rev=1, trigger_edge="rising") -> TransientResult:
     """Simulate a transient manoeuvre as the ``powertrain transient`` command does.
 
     Parameters
@@ -78,8 +77,7 @@ def transient(manoeuvre, engine=None, *, angle_step_deg=ANGLE_STEP_DEG, seat=Non
     if not isinstance(speed_average, (bool, np.bool_)):
         raise InputError(f"expected true or false, got {speed_average!r}", key="--speed-average")
     m, speed_note = _driven(m, speed_from, dict(
-        trigger=trigger, channel_map=channel_map, pulses_per_rev=pulses_per_rev,
-        trigger_edge=trigger_edge,
+        trigger=trigger, channel_map=channel_map, pulses_per_rev=pulses_per_rev, trigger_edge=trigger_edge,
         firing_interval=engine.crank.firing_interval if speed_average else None), engine)
     t0 = time.process_time()
     with single_blas_thread():
@@ -93,8 +91,7 @@ def _result(m, engine, run, seat, seconds, speed_note) -> TransientResult:
     load = run.load
     return TransientResult(
         m.name, m.file, engine.name, load.t, load.omega * 30.0 / np.pi,
-        {"engine": load.engine_torque, "starter": load.starter_torque,
-         "driveline": load.driveline_torque},
+        {"engine": load.engine_torque, "starter": load.starter_torque, "driveline": load.driveline_torque},
         run.body, labels, run.displacement, run.velocity, run.acceleration, run.force,
         run.networks, run.deflection, _seat(engine, run, labels, seat), run.method, seconds,
         [m.notes] if m.notes else [], speed_note, m.trigger_time)
@@ -124,8 +121,7 @@ def _check_recorded_top(m, speed_from, engine) -> None:
         tacho = getattr(speed_from, "speed_source", "") == "tacho"
         raise InputError(f"the recorded speed reaches {m.max_speed * 30.0 / np.pi:g} rpm, "
                          f"above the engine's combustion model ({top:g} rpm)",
-                         file=str(getattr(speed_from, "path", speed_from)),
-                         key="tacho" if tacho else "rpm")
+                         file=str(getattr(speed_from, "path", speed_from)), key="tacho" if tacho else "rpm")
 
 
 def seat_point(engine, seat) -> str | None:

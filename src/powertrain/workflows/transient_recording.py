@@ -88,8 +88,7 @@ def read_recording(path, *, channel_map=None, trigger=None, pulses_per_rev=1,
     :func:`~powertrain.iotools.raw.read_raw`), its ``trigger`` channel marking
     ``trigger_edge`` (``rising`` or ``falling``), its tacho's ``pulses_per_rev``."""
     if trigger is not None and (not isinstance(trigger, str) or not trigger.strip()):
-        raise InputError("expected the name of a channel of the recording",
-                         key="--trigger")
+        raise InputError("expected the name of a channel of the recording", key="--trigger")
     pulses_per_rev = checked_pulses_per_rev(pulses_per_rev)
     if trigger_edge not in TRIGGER_EDGES:
         raise InputError(f"expected one of {', '.join(TRIGGER_EDGES)}, got {trigger_edge!r}",
@@ -102,8 +101,7 @@ def read_recording(path, *, channel_map=None, trigger=None, pulses_per_rev=1,
                for n in c[len(IGNORED_NOTE):].split(",")]
     if pulses_per_rev != 1 and rec.rpm is not None:
         warnings.warn(RecordedSpeedWarning(
-            f"{path}: the speed is the rpm channel's; --pulses-per-rev is not used"),
-            stacklevel=2)
+            f"{path}: the speed is the rpm channel's; --pulses-per-rev is not used"), stacklevel=2)
     edges, counts = (tacho_counts(tacho_edges(t, rec.tacho, file=str(path), key="tacho"),
                                   pulses_per_rev, file=str(path), key="tacho")
                      if rec.rpm is None and rec.tacho is not None else (None, None))
@@ -122,8 +120,7 @@ def recording_or_file(recording, **options) -> Recorded:
 
 
 def _speed_source(rec) -> str:
-    return "rpm channel" if rec.rpm is not None else ("tacho" if rec.tacho is not None
-                                                      else "")
+    return "rpm channel" if rec.rpm is not None else ("tacho" if rec.tacho is not None else "")
 
 
 def align(rec: Recorded, t_event, rpm_event, *, partial=True, trigger_at=0.0) -> tuple:
@@ -131,8 +128,7 @@ def align(rec: Recorded, t_event, rpm_event, *, partial=True, trigger_at=0.0) ->
     the trigger (at event time ``trigger_at`` [s]) or by the speed ``rpm_event`` [rpm] at
     ``t_event`` [s]; ``partial``: the recording may cover part of the event."""
     if rec.crossing is not None:
-        shift = trigger_shift(rec.crossing, trigger_at, rpm_event, file=rec.path,
-                              key=rec.trigger_name)
+        shift = trigger_shift(rec.crossing, trigger_at, rpm_event, file=rec.path, key=rec.trigger_name)
         return shift, f"trigger {rec.trigger_name!r}", rec.crossing.error
     if rec.rpm is None:
         raise InputError("no rpm or tacho channel to line the recording up on; give "
@@ -142,8 +138,7 @@ def align(rec: Recorded, t_event, rpm_event, *, partial=True, trigger_at=0.0) ->
 
 def _align_on_speed(rec: Recorded, t_event, rpm_event, partial) -> tuple:
     """:func:`align` on the tacho's pulses, else on the rpm channel."""
-    trigger = TRIGGER + (" (the recording has one named 'trigger')" if rec.unused_trigger
-                         else "")
+    trigger = TRIGGER + (" (the recording has one named 'trigger')" if rec.unused_trigger else "")
     if rec.edges is not None:
         shift, error = align_tacho(t_event, rpm_event, (rec.time[0], rec.time[-1]),
                                    rec.edges, counts=rec.counts,
@@ -155,8 +150,7 @@ def _align_on_speed(rec: Recorded, t_event, rpm_event, partial) -> tuple:
     return shift, "crank speed", error
 
 
-def speed_from_recording(manoeuvre: Manoeuvre, recording, *, firing_interval=None,
-                         **options) -> tuple:
+def speed_from_recording(manoeuvre: Manoeuvre, recording, *, firing_interval=None, **options) -> tuple:
     """``(manoeuvre, note)``: ``manoeuvre`` with its speed table replaced by the recording's
     crank speed, lined up by :func:`align`, as recorded or (``firing_interval`` [rad]) its
     mean over each firing interval (:func:`~powertrain.analysis.speed.mean_speed`), on at
@@ -164,14 +158,12 @@ def speed_from_recording(manoeuvre: Manoeuvre, recording, *, firing_interval=Non
     ``options``: :func:`read_recording`'s. The recording must cover the manoeuvre."""
     rec = recording_or_file(recording, **options)
     if rec.rpm is None:
-        raise InputError("no rpm or tacho channel to take the speed from", file=rec.path,
-                         key="rpm")
+        raise InputError("no rpm or tacho channel to take the speed from", file=rec.path, key="rpm")
     duration = manoeuvre.duration
     tol = rec.time[1] - rec.time[0]
     if rec.time[-1] < duration - tol:
         raise InputError(f"the recording is {rec.time[-1]:.6g} s long, the manoeuvre "
-                         f"{duration:.6g} s; --speed-from needs all of it", file=rec.path,
-                         key="time")
+                         f"{duration:.6g} s; --speed-from needs all of it", file=rec.path, key="time")
     shift, how, error = align(rec, manoeuvre.time, manoeuvre.speed / _RPM, partial=False,
                               trigger_at=manoeuvre.trigger_time)
     first, last = coverage(0.0, duration, rec.time[0], rec.time[-1], shift)
@@ -188,13 +180,11 @@ def speed_from_recording(manoeuvre: Manoeuvre, recording, *, firing_interval=Non
     if not manoeuvre.reversal:
         rr = np.maximum(rr, 0.0)
     if not np.all(np.isfinite(rr)) or np.max(np.abs(rr)) > MAX_RPM:
-        raise InputError(f"speed not finite or above {MAX_RPM:g} rpm", file=rec.path,
-                         key="rpm")
+        raise InputError(f"speed not finite or above {MAX_RPM:g} rpm", file=rec.path, key="rpm")
     mean = ("" if firing_interval is None
             else f", its mean over {np.degrees(firing_interval):.0f} deg of crank")
     note = (f"crank speed from {rec.path} ({rec.speed_source}{mean}): the manoeuvre starts "
-            f"at {shift:.4f} s of the recording (aligned on the {how}, standard error "
-            f"{error * 1e3:.2g} ms)")
+            f"at {shift:.4f} s of the recording (aligned on the {how}, standard error {error * 1e3:.2g} ms)")
     return manoeuvre.with_speed(tt, rr * _RPM), note
 
 
@@ -215,8 +205,7 @@ def _warn_speed(manoeuvre, rec, rpm, firing_interval) -> None:
         warnings.warn(RecordedSpeedWarning(
             f"{rec.path}: below {slow:.0f} rpm a firing interval lasts more than "
             f"{AVERAGE_WINDOW_S * 1e3:g} ms, and its mean (--speed-average) smooths the "
-            "speed's own changes, a start's flare among them; it suits a running engine"),
-            stacklevel=3)
+            "speed's own changes, a start's flare among them; it suits a running engine"), stacklevel=3)
 
 
 def _speed_rows(t, rpm, duration) -> tuple:
@@ -227,8 +216,7 @@ def _speed_rows(t, rpm, duration) -> tuple:
     rows = inside.size // k
     sel = inside[:rows * k]
     tt = np.r_[0.0, t[sel].reshape(rows, k).mean(axis=1), duration]
-    rr = np.r_[np.interp(0.0, t, rpm), rpm[sel].reshape(rows, k).mean(axis=1),
-               np.interp(duration, t, rpm)]
+    rr = np.r_[np.interp(0.0, t, rpm), rpm[sel].reshape(rows, k).mean(axis=1), np.interp(duration, t, rpm)]
     return tt, rr
 
 
@@ -292,8 +280,7 @@ def compare_transient(result, raw, *, trigger=None, channel_map=None, pulses_per
     simulated = result.acceleration[np.ix_(sel, [result.channel(lb) for lb, _ in pairs])]
     return TransientComparison(result.name, rec.path, float(shift), t,
                                [lb for lb, _ in pairs], measured, simulated, aligned_on=how,
-                               event=(t0, t1), not_compared=skipped,
-                               shift_error=float(error))
+                               event=(t0, t1), not_compared=skipped, shift_error=float(error))
 
 
 def _covered(rec: Recorded, t0, t1, shift, how) -> tuple:
@@ -307,8 +294,7 @@ def _covered(rec: Recorded, t0, t1, shift, how) -> tuple:
     return first, last
 
 
-def check_recordings(manoeuvre: Manoeuvre, labels, *, firing_interval=None, compare=None,
-                     speed=None) -> None:
+def check_recordings(manoeuvre: Manoeuvre, labels, *, firing_interval=None, compare=None, speed=None) -> None:
     """Check the recordings of ``--compare`` and ``--speed-from`` before the simulation:
     channels against ``labels``, alignment and coverage (``firing_interval`` [rad] as
     :func:`speed_from_recording`'s)."""
@@ -320,8 +306,7 @@ def check_recordings(manoeuvre: Manoeuvre, labels, *, firing_interval=None, comp
 def _check(manoeuvre, labels, firing_interval, compare, speed) -> None:
     """:func:`check_recordings`' checks."""
     if speed is not None:
-        manoeuvre, _ = speed_from_recording(manoeuvre, speed,
-                                            firing_interval=firing_interval)
+        manoeuvre, _ = speed_from_recording(manoeuvre, speed, firing_interval=firing_interval)
     if compare is not None:
         compared_channels(compare, labels)
         shift, how, _ = align(compare, manoeuvre.time, manoeuvre.speed / _RPM,

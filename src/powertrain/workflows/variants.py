@@ -107,8 +107,7 @@ def parse_scale(text: str, origin: Origin = Origin("--scale")) -> Scale:
         _direction(direction, text, origin)
         if kind not in SCALE_KINDS:
             raise origin.error(f"{text!r}: unknown kind {kind!r} (expected "
-                               f"{', '.join(SCALE_KINDS)}, or a law key such as "
-                               "amplitude.exponent)")
+                               f"{', '.join(SCALE_KINDS)}, or a law key such as amplitude.exponent)")
     factor = _float(right, text, origin, "a factor")
     if factor <= 0:
         raise origin.error(f"{text!r}: factor must be positive, got {factor:g}")
@@ -127,8 +126,7 @@ def parse_set(text: str, origin: Origin = Origin("--set")) -> SetParameter:
     mount, direction, param = _path_parts(left, 3, text, origin, form)
     _direction(direction, text, origin)
     if not re.match(r"^[cdm][0-9]+$", param):
-        raise origin.error(f"{text!r}: unknown parameter {param!r} (expected c<n>, d<n> "
-                           "or m<n>)")
+        raise origin.error(f"{text!r}: unknown parameter {param!r} (expected c<n>, d<n> or m<n>)")
     value, unit = _quantity(right, text, origin)
     unit = unit or DATASHEET_UNITS[param[0]]
     if value < 0:
@@ -148,8 +146,7 @@ def _law_value(key, right, text, origin):
     dimension, family = LAW_KEYS[key][:2]
     if key == "amplitude.limits":
         parts = right.split(",")
-        lo, hi = (_float(p.strip(), text, origin) for p in parts) if len(parts) == 2 else \
-            (math.nan, math.nan)
+        lo, hi = (_float(p.strip(), text, origin) for p in parts) if len(parts) == 2 else (math.nan, math.nan)
         if not 0 < lo <= 1 <= hi:
             raise origin.error(f"{text!r}: expected LO,HI with 0 < LO <= 1 <= HI")
         return (lo, hi)
@@ -163,8 +160,7 @@ def _law_value(key, right, text, origin):
         raise origin.error(f"{text!r}: unit {unit!r} is unknown or not a unit of {dimension}")
     si = float(to_si(value, unit, dimension))
     if key != "static.reference_deflection" and (si < 0 or si == 0 and "max" not in key):
-        raise origin.error(f"{text!r}: the value must be {'>= 0' if 'max' in key else '> 0'}"
-                           f", got {value:g}")
+        raise origin.error(f"{text!r}: the value must be {'>= 0' if 'max' in key else '> 0'}, got {value:g}")
     return si
 
 
@@ -217,11 +213,9 @@ def parse_target(text: str, origin: Origin = Origin("--target")) -> Target:
     elif m_fac:
         factor = _float(m_fac.group(1), text, origin)
     else:
-        raise origin.error(f"{text!r}: cannot read change {parts[1]!r} (expected +20%, -15% "
-                           "or *1.2)")
+        raise origin.error(f"{text!r}: cannot read change {parts[1]!r} (expected +20%, -15% or *1.2)")
     if factor <= 0:
-        raise origin.error(f"{text!r}: the change must leave a positive stiffness "
-                           f"(factor {factor:g})")
+        raise origin.error(f"{text!r}: the change must leave a positive stiffness (factor {factor:g})")
     m_band = re.match(r"^([0-9.eE+]+)\s*-\s*([0-9.eE+]+)\s*(Hz)?$", parts[2])
     if not m_band:
         raise origin.error(f"{text!r}: cannot read band {parts[2]!r} (expected e.g. 100-300Hz)")
@@ -239,10 +233,8 @@ def parse_target(text: str, origin: Origin = Origin("--target")) -> Target:
         elif k == len(parts) - 4:        # the last part: an amplitude
             amplitude = _law_value("amplitude.reference", extra, text, origin)
         else:
-            raise origin.error(f"{text!r}: cannot read width {extra!r} (expected e.g. "
-                               "0.5oct)")
-    return Target(mount, direction, factor, f_lo, f_hi, width, spec=text, origin=origin,
-                  amplitude=amplitude)
+            raise origin.error(f"{text!r}: cannot read width {extra!r} (expected e.g. 0.5oct)")
+    return Target(mount, direction, factor, f_lo, f_hi, width, spec=text, origin=origin, amplitude=amplitude)
 
 
 def parse_effect(text: str, origin: Origin = Origin("--effect"), engine=None) -> AddEffect:
@@ -253,8 +245,7 @@ def parse_effect(text: str, origin: Origin = Origin("--effect"), engine=None) ->
     name, _, rest = text.partition(":")
     name = name.strip()
     if name not in EFFECTS:
-        raise origin.error(f"{text!r}: unknown effect {name!r} (expected "
-                           f"{', '.join(EFFECTS)})")
+        raise origin.error(f"{text!r}: unknown effect {name!r} (expected {', '.join(EFFECTS)})")
     spec = {p.name: p for p in EFFECTS[name].parameters(engine)}
     params = []
     for item in [x.strip() for x in rest.split(",")] if rest.strip() else []:
@@ -270,8 +261,7 @@ def parse_effect(text: str, origin: Origin = Origin("--effect"), engine=None) ->
         unit = unit or p.unit
         if unit != p.unit:
             if unit not in UNITS or p.unit not in UNITS or UNITS[unit][0] != UNITS[p.unit][0]:
-                raise origin.error(f"{text!r}: unit {unit!r} of {key} is unknown or not a "
-                                   f"unit of {p.unit}")
+                raise origin.error(f"{text!r}: unit {unit!r} of {key} is unknown or not a unit of {p.unit}")
             v = v * UNITS[unit][1] / UNITS[p.unit][1]
         params.append((key, float(v)))
     try:
@@ -337,8 +327,7 @@ def _variant_tables(doc: dict, path: str) -> list:
     if unknown:
         raise InputError("unknown key (expected [[variant]] tables)", file=path, key=unknown[0])
     tables = doc.get("variant")
-    if not isinstance(tables, list) or not tables or not all(isinstance(t, dict)
-                                                             for t in tables):
+    if not isinstance(tables, list) or not tables or not all(isinstance(t, dict) for t in tables):
         raise InputError("expected one or more [[variant]] tables", file=path, key="variant")
     return tables
 
@@ -368,8 +357,7 @@ def _read_variant(k: int, t: dict, path: str, locate, names: set) -> Variant:
                          file=path, line=locate(k, bad[0]), key=f"{key0}.{bad[0]}")
     name = t.get("name")
     if not isinstance(name, str) or not name.strip():
-        raise InputError("missing or empty name", file=path, line=locate(k, "name"),
-                         key=f"{key0}.name")
+        raise InputError("missing or empty name", file=path, line=locate(k, "name"), key=f"{key0}.name")
     if name in names or name == "baseline":
         raise InputError(f"duplicate or reserved variant name {name!r}", file=path,
                          line=locate(k, "name"), key=f"{key0}.name")

@@ -47,10 +47,8 @@ def describe_engine(engine, solver: str, rpm) -> dict:
     return {"name": "baseline", "engine": engine.name, "engine_file": engine.file,
             "solver": solver, "rpm": [float(r) for r in rpm],
             "balancers_enabled": bool(engine.balancer.enabled),
-            "mounts": {m.name: {"position_mm": [1e3 * float(x) for x in m.position],
-                                "files": dict(m.files),
-                                "models": {d: mdl.topology.name
-                                           for d, mdl in m.directions.items()}}
+            "mounts": {m.name: {"position_mm": [1e3 * float(x) for x in m.position], "files": dict(m.files),
+                                "models": {d: mdl.topology.name for d, mdl in m.directions.items()}}
                        for m in engine.mounts}}
 
 
@@ -94,18 +92,15 @@ def whatif(engine=None, *, scale=(), set=(), swap=(), move=(), rotate=(), effect
     -------
     WhatIfResult, or TransientRanking with ``manoeuvre``
     """
-    ops = {"scale": scale, "set": set, "swap": swap, "move": move, "rotate": rotate,
-           "effect": effects}
+    ops = {"scale": scale, "set": set, "swap": swap, "move": move, "rotate": rotate, "effect": effects}
     if manoeuvre is not None:
         refuse_runup_options(dict(rpm=rpm, solver=solver, signal=signal, objective=objective,
-                                  measured=measured, rpm_step=rpm_step, executor=executor,
-                                  workers=workers))
+                                  measured=measured, rpm_step=rpm_step, executor=executor, workers=workers))
         engine, _ = engine_and_file(engine)
         return whatif_manoeuvre(engine, _variants(engine, ops, targets, variants), manoeuvre)
     return _runup_whatif(engine, ops, targets, variants, rpm=rpm, solver=solver or "harmonic",
                          signal=signal or "velocity", objective=objective, measured=measured,
-                         executor=executor, workers=workers, progress=progress,
-                         rpm_step=rpm_step)
+                         executor=executor, workers=workers, progress=progress, rpm_step=rpm_step)
 
 
 def _runup_whatif(engine, ops, targets, variants, *, rpm, solver, signal, objective,
@@ -118,8 +113,7 @@ def _runup_whatif(engine, ops, targets, variants, *, rpm, solver, signal, object
     runs = _variants(engine, ops, targets, variants)
     goal = parse_objective(objective, engine.assemble().channels, rpm) if objective else None
     return run_whatif(engine, runs, rpm, solver=solver, executor=executor, workers=workers,
-                      measured=_measured(measured, engine), signal=signal, progress=progress,
-                      objective=goal,
+                      measured=_measured(measured, engine), signal=signal, progress=progress, objective=goal,
                       rpm_step=real(rpm_step, "--step", unit="rpm", optional=True))
 
 
@@ -183,8 +177,7 @@ def command_variants(engine, ops: dict, targets=(), variants_file=None) -> list:
     names = [v.name for v in out]
     dup = sorted({n for n in names if names.count(n) > 1})
     if dup:
-        raise InputError(f"duplicate variant name {dup[0]!r}", file=variants_file,
-                         key="variant.name")
+        raise InputError(f"duplicate variant name {dup[0]!r}", file=variants_file, key="variant.name")
     return out
 
 
@@ -293,7 +286,6 @@ def run_whatif(engine, variants, rpm=None, *, solver: str = "harmonic", executor
     runs = [VariantRun(v.name, v.specs, r) for v, r in zip(variants, results[1:])]
     if rpm_step is None and rpm.size > 1:
         rpm_step = float(rpm[1] - rpm[0])
-    return WhatIfResult(baseline=results[0], variants=runs,
-                        description=describe_engine(engine, solver, rpm),
+    return WhatIfResult(baseline=results[0], variants=runs, description=describe_engine(engine, solver, rpm),
                         quantities=tuple(quantities), measured=measured, target_fits=fits,
                         signal=signal, objective=objective, rpm_step=rpm_step)
