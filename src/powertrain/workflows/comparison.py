@@ -190,10 +190,6 @@ def compare_runup(simulated, measured: MeasuredRunup, *, noise_floor=DEFAULT_NOI
         RMS noise floor of the measured curves [m/s]; points at it are counted, not scored.
     sigma_db : float
         Kernel width of the FRFSM-like score [dB].
-
-    Returns
-    -------
-    ComparisonResult
     """
     if not isinstance(simulated, MeasuredRunup):
         simulated = MeasuredRunup.from_result(simulated, source="simulation", signal=measured.signal)

@@ -271,10 +271,6 @@ def fit_mount(measured, kcp_measured=None, model: str | Topology = DEFAULT_TOPOL
     fmin, fmax : float, optional
         With a file: fit only the frequencies in ``fmin..fmax`` [Hz].
 
-    Returns
-    -------
-    FitResult
-
     Raises
     ------
     InputError

@@ -87,10 +87,6 @@ def run_runup(engine, rpm=None, *, solver="newmark", angle_step_deg=ANGLE_STEP_D
     stepper : {"auto", "modal", "dense"}
         Newmark implementation: ``modal`` (diagonalised once, needs a regular mass matrix),
         ``dense`` or ``auto`` (modal when possible).
-
-    Returns
-    -------
-    RunupResult
     """
     rpm = _speeds(rpm)
     grid = _cycles(angle_step_deg, cycles, processed_cycles)

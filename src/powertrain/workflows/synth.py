@@ -87,11 +87,6 @@ def draw_truth(name, rng, n_net=9):
     raise KeyError(name)
 
 
-def _draw(name, rng, engine):
-    """:func:`draw_truth` for ``engine`` (three mount networks per mount)."""
-    return draw_truth(name, rng, 3 * len(engine.mounts))
-
-
 def worth_diagnosing(base, velocity) -> bool:
     """Redraw rule: the noise-free gap reaches :data:`MIN_EFFECT_DB` RMS or
     :data:`MIN_EFFECT_MAX_DB` somewhere."""
@@ -126,8 +121,9 @@ def make_case(engine, truth_names, seed, *, rpm=None, hm=None, noise_db=None, pa
     hm = HarmonicModel(engine, rpm) if hm is None else hm
     base = hm.velocity(hm.solve(hm.two_ports()[0]))
     return draw_case(list(truth_names), seed, engine, base, lambda eng, truth: truth_velocity(eng, hm, truth),
-                     _draw, hm.channels, f"synthetic case 0 (seed {seed})", rpm=rpm,
-                     noise_db=noise_db, params=params, redraws=REDRAWS, worth=worth_diagnosing)
+                     lambda name, rng, eng: draw_truth(name, rng, 3 * len(eng.mounts)), hm.channels,
+                     f"synthetic case 0 (seed {seed})", rpm=rpm, noise_db=noise_db, params=params,
+                     redraws=REDRAWS, worth=worth_diagnosing)
 
 
 @dataclasses.dataclass(frozen=True)
@@ -171,7 +167,11 @@ class SynthCase(Result):
 
     def to_truth_json(self, path=None) -> str:
         """:meth:`truth` as JSON, written to ``path`` if given."""
-        return _written(json.dumps(self.truth(), indent=1), path)
+        text = json.dumps(self.truth(), indent=1)
+        if path is not None:
+            with atomic_write(path) as fh:
+                fh.write(text)
+        return text
 
     def plot(self, ax=None, *, path=None, mount=None, direction="z", provenance=None):
         """The measured order curves [mm/s RMS] of one channel (default the first mount) and
@@ -195,13 +195,6 @@ class SynthCase(Result):
             a.legend(fontsize=7, ncol=3)
         return finish(fig, own, path, provenance,
                       title=f"synthetic measured run-up (seed {self.seed}): {self.to_text()}")
-
-
-def _written(text: str, path) -> str:
-    if path is not None:
-        with atomic_write(path) as fh:
-            fh.write(text)
-    return text
 
 
 def synth(effects=(), seed=0, *, engine=None, rpm=None, noise_db=None) -> SynthCase:

@@ -107,7 +107,8 @@ def read_recording(path, *, channel_map=None, trigger=None, pulses_per_rev=1,
                      if rec.rpm is None and rec.tacho is not None else (None, None))
     rpm = (np.asarray(rec.rpm, float) if rec.rpm is not None
            else None if edges is None else tacho_rpm(t, edges, counts, pulses_per_rev))
-    return Recorded(str(path), t, rpm, _speed_source(rec), crossing, trigger,
+    source = "rpm channel" if rec.rpm is not None else ("tacho" if rec.tacho is not None else "")
+    return Recorded(str(path), t, rpm, source, crossing, trigger,
                     list(rec.channels), ignored, edges, counts, pulses_per_rev,
                     trigger is None and rec.trigger is not None)
 
@@ -117,10 +118,6 @@ def recording_or_file(recording, **options) -> Recorded:
     if isinstance(recording, Recorded):
         return recording
     return read_recording(recording, **options)
-
-
-def _speed_source(rec) -> str:
-    return "rpm channel" if rec.rpm is not None else ("tacho" if rec.tacho is not None else "")
 
 
 def align(rec: Recorded, t_event, rpm_event, *, partial=True, trigger_at=0.0) -> tuple:

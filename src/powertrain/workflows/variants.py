@@ -36,12 +36,10 @@ _NAME = r"[A-Za-z_][A-Za-z0-9_\-]*"
 
 
 def _split(text: str, origin: Origin, form: str):
-    if not isinstance(text, str) or text.count("=") != 1:
+    parts = [s.strip() for s in text.split("=")] if isinstance(text, str) else []
+    if len(parts) != 2 or not all(parts):
         raise origin.error(f"cannot read {text!r} (expected {form})")
-    left, right = (s.strip() for s in text.split("="))
-    if not left or not right:
-        raise origin.error(f"cannot read {text!r} (expected {form})")
-    return left, right
+    return parts
 
 
 def _path_parts(left, n, text, origin, form, wildcard=True):
@@ -49,6 +47,8 @@ def _path_parts(left, n, text, origin, form, wildcard=True):
     pattern = re.compile(rf"^(\*|{_NAME})$" if wildcard else rf"^{_NAME}$")
     if len(parts) != n or not all(pattern.match(p) for p in parts):
         raise origin.error(f"cannot read {text!r} (expected {form})")
+    if n > 1:
+        _direction(parts[1], text, origin)
     return parts
 
 
@@ -87,7 +87,6 @@ def _law_key(left, text, origin, form, column):
     """``(mount, direction, key)`` of ``MOUNT.DIR.SECTION.KEY``, a key of :data:`LAW_KEYS`
     allowed in ``column`` (2: --scale, 3: --set)."""
     mount, direction, section, name = _path_parts(left, 4, text, origin, form)
-    _direction(direction, text, origin)
     key = f"{section}.{name}"
     allowed = [k for k, v in LAW_KEYS.items() if v[column]]
     if key not in allowed:
@@ -104,7 +103,6 @@ def parse_scale(text: str, origin: Origin = Origin("--scale")) -> Scale:
         mount, direction, kind = _law_key(left, text, origin, form, 2)
     else:
         mount, direction, kind = _path_parts(left, 3, text, origin, form)
-        _direction(direction, text, origin)
         if kind not in SCALE_KINDS:
             raise origin.error(f"{text!r}: unknown kind {kind!r} (expected "
                                f"{', '.join(SCALE_KINDS)}, or a law key such as amplitude.exponent)")
@@ -124,7 +122,6 @@ def parse_set(text: str, origin: Origin = Origin("--set")) -> SetParameter:
         return SetParameter(mount, direction, key, _law_value(key, right, text, origin),
                             spec=text, origin=origin)
     mount, direction, param = _path_parts(left, 3, text, origin, form)
-    _direction(direction, text, origin)
     if not re.match(r"^[cdm][0-9]+$", param):
         raise origin.error(f"{text!r}: unknown parameter {param!r} (expected c<n>, d<n> or m<n>)")
     value, unit = _quantity(right, text, origin)
@@ -169,7 +166,6 @@ def parse_swap(text: str, origin: Origin = Origin("--swap"), base: Path | None =
     form = "MOUNT.DIR=FILE.toml, e.g. left.z=mounts/hydraulic-engine-mount-z.toml"
     left, right = _split(text, origin, form)
     mount, direction = _path_parts(left, 2, text, origin, form, wildcard=False)
-    _direction(direction, text, origin)
     path = Path(right)
     if base is not None and not path.is_absolute():
         path = Path(base) / path
@@ -204,7 +200,6 @@ def parse_target(text: str, origin: Origin = Origin("--target")) -> Target:
     if len(parts) not in (3, 4, 5):
         raise origin.error(f"cannot read {text!r} (expected {form})")
     mount, direction = _path_parts(parts[0], 2, text, origin, form, wildcard=False)
-    _direction(direction, text, origin)
     change = parts[1].replace(" ", "")
     m_pct = re.match(r"^([+-][0-9.eE+-]+)%$", change)
     m_fac = re.match(r"^[*x]([0-9.eE+-]+)$", change)

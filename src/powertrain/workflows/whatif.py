@@ -191,7 +191,10 @@ def parse_objective(text, channels, rpm):
     name, d = parts[0].rsplit(".", 1)
     d = d.lower()
     if (name, d) not in channels:          # left.passive.z: node left/passive
-        name = _node_of(parts[0], name)
+        try:
+            name = Channel.parse(parts[0]).node
+        except ValueError:
+            pass
     if (name, d) not in channels:
         known = sorted({m for m, _ in channels})
         raise InputError(f"unknown channel {parts[0]!r} (channels: {', '.join(known)}; "
@@ -206,14 +209,6 @@ def parse_objective(text, channels, rpm):
     if not (lo <= hi) or not any(lo - 1e-9 <= r <= hi + 1e-9 for r in rpm):
         raise InputError(f"no speed step in {lo:g}-{hi:g} rpm", key="--objective")
     return (name, d, q, lo, hi)
-
-
-def _node_of(text, name):
-    """The node of channel ``text`` (``left.passive.z`` -> ``left/passive``), else ``name``."""
-    try:
-        return Channel.parse(text).node
-    except ValueError:
-        return name
 
 
 def variant_engine(engine, variant, **fit_kwargs):
