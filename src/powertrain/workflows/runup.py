@@ -257,7 +257,8 @@ def runup(engine=None, rpm=None, *, solver="newmark", stepper="auto",
         return _sweep_runup(engine, rpm, options["sweep"], options["sample_rate"], effects,
                             options["progress"])
     rpm = args.speeds(rpm)
-    scenario = _scenario(effects, engine)
+    scenario = effects if isinstance(effects, dict) else effect_scenario(
+        parse_operations({"effect": args.texts(effects, "--effect")}, engine=engine))
     check_runup_settings(engine, rpm, options["angle_step_deg"])
     result = _stepped(engine, rpm, scenario, options["progress"], solver=solver,
                       angle_step_deg=options["angle_step_deg"], stepper=stepper)
@@ -293,13 +294,6 @@ def _stepped(engine, rpm, scenario, progress, **options) -> RunupResult:
         return checked_runup(engine, engine.file, run_runup, rpm, progress=progress, **options)
     with activity(f"run-up with effects ({options['solver']})", enabled=progress):
         return checked_runup(engine, engine.file, runup_with_effects, rpm, scenario, **options)
-
-
-def _scenario(effects, engine) -> dict:
-    """The scenario of ``--effect`` strings, or a scenario as given."""
-    if isinstance(effects, dict):
-        return effects
-    return effect_scenario(parse_operations({"effect": args.texts(effects, "--effect")}, engine=engine))
 
 
 def _sweep_runup(engine, rpm, rate, sample_rate, effects, progress) -> SweepRunup:

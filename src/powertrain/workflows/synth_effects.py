@@ -15,11 +15,6 @@ from powertrain.solvers.body_coupling import coupled_solve
 from powertrain.solvers.fast_harmonic import N_HARMONICS, HarmonicModel
 
 
-def _two_port_springs(omega, model, s):
-    """Two-port (a, b, c) with the network's springs times s (n_r,) per speed."""
-    return two_port(omega, *model.network(), spring_scale=np.asarray(s, float)[:, None], damper_scale=1.0)
-
-
 def _solve_body(hm, abc, load, body):
     """Rigid body + flexible chassis body (modal) under all networks; q (n_r, 16, 6)."""
     modes = SimpleNamespace(frequency_hz=body["freq"], modal_mass=body["mass"], damping_ratio=body["zeta"])
@@ -59,7 +54,8 @@ def truth_velocity(engine, hm: HarmonicModel, truth) -> np.ndarray:
     def abc_for(s):                         # s (n_r, n_net) spring factors
         out = [np.empty(hm.omega.shape + (len(models),), complex) for _ in range(3)]
         for k, m in enumerate(models):
-            res = _two_port_springs(hm.omega, m, s[:, k])
+            res = two_port(hm.omega, *m.network(), spring_scale=np.asarray(s[:, k], float)[:, None],
+                           damper_scale=1.0)      # springs times s (n_r,) per speed
             for j in range(3):
                 out[j][..., k] = res[j]
         return out
