@@ -256,12 +256,10 @@ def fit_mount(measured, kcp_measured=None, model: str | Topology = DEFAULT_TOPOL
         Measured cross-point dynamic stiffness [N/m] (None with a file).
     model : str or Topology
         A preset of :data:`powertrain.models.mount.TOPOLOGIES` (default triple-parallel).
-    starts : int
-        Random starting points screened (>= 1).
+    starts, polish : int
+        Random starting points screened, and the best of them run further (>= 1 each).
     seed : int or None
         Seed of the starting points.
-    polish : int
-        Best screened starts run further (>= 1).
     hops : int
         Perturbations of the incumbent (>= 0), ~30 % of its log-parameters redrawn.
     name, source : str

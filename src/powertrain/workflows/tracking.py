@@ -220,10 +220,8 @@ def track_recording(rec, orders=None, *, rpm_step=50.0, method="cot", use="auto"
         Output speed grid [rpm].
     method : {"cot", "vkf"}
         Computed order tracking or Vold–Kalman filtering.
-    use : {"auto", "rpm", "tacho"}
-        Speed source.
-    pulses_per_rev : int, optional
-        Tacho pulses per revolution.
+    use, pulses_per_rev : {"auto", "rpm", "tacho"}, int
+        Speed source; tacho pulses per revolution.
     quantity : str, optional
         Track only channels of this quantity.
     bandwidth_hz : float, optional
@@ -232,8 +230,7 @@ def track_recording(rec, orders=None, *, rpm_step=50.0, method="cot", use="auto"
     block_revs : int, optional
         COT block length [rev].
     overall : dict, optional
-        Also the overall level per speed: ``band`` (lo, hi) [Hz] or None
-        (:func:`overall_band`), ``velocity``.
+        Overall level too: ``band`` (lo, hi) [Hz] or None (:func:`overall_band`), ``velocity``.
     tdc_offset_deg : float, optional
         Crank angle of cylinder-1 firing TDC after the tacho reference pulse [deg]: measure
         the phases (:func:`~powertrain.analysis.phase.tdc_origin`).

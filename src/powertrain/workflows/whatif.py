@@ -78,10 +78,9 @@ def whatif(engine=None, *, scale=(), set=(), swap=(), move=(), rotate=(), effect
         ``CHANNEL.DIR:QUANTITY:FROM-TO`` to rank the variants by (:func:`parse_objective`).
     measured : str, Path or MeasuredRunup, optional
         Measurement overlaid and compared.
-    executor, workers : optional
-        Executor or scheduler (:func:`powertrain.parallel.executor`); local processes.
-    progress : bool
-        Progress bar.
+    executor, workers, progress : optional
+        Executor or scheduler (:func:`powertrain.parallel.executor`); local processes;
+        progress bar.
     rpm_step : float, optional
         The speed step [rpm] the report names (default: that of ``rpm``).
     manoeuvre : str, Path or Manoeuvre, optional
