@@ -1,8 +1,5 @@
-"""The crank train and the balancer shafts of an engine (SI, engine axes).
-
-Thin objects over :mod:`powertrain.physics.slider_crank`; see :mod:`powertrain.models.engine`
-for the axes and the load they put on the powertrain.
-"""
+"""The crank train and the balancer shafts of an engine (SI, engine axes;
+:mod:`powertrain.models.engine`)."""
 
 from __future__ import annotations
 
@@ -59,7 +56,6 @@ class CrankTrain:
     rotating_mass: float
     counterweight_fraction: float
     crankcase_pressure: float
-    #: the last crank-angle grid's volumes (:meth:`volume`)
     _memo: Memo = field(default_factory=Memo, init=False, repr=False, compare=False)
 
     @property
@@ -68,9 +64,8 @@ class CrankTrain:
 
     @property
     def firing_interval(self) -> float:
-        """Crank angle over which the gas torque repeats [rad]: the least 4π / k whose
-        shift maps the firing angles onto themselves (4π / n with n cylinders firing at
-        even intervals; 240° for a V6 firing at 90° and 150°; else the cycle's 4π)."""
+        """Crank angle over which the gas torque repeats [rad]: the least 4π / k whose shift
+        maps the firing angles onto themselves (4π if none)."""
         angles = np.sort(np.mod(self.firing_angles, 4 * np.pi))
         for k in range(self.n_cylinders, 1, -1):
             if self.n_cylinders % k == 0:
@@ -107,10 +102,7 @@ class CrankTrain:
         return self.rotation_sign * np.cross([1.0, 0.0, 0.0], self.cylinder_axis)
 
     def volume(self, theta):
-        """Cylinder volume [m³] and dV/dθ [m³/rad] at crank angle ``theta`` [rad].
-
-        The last grid's result is kept in the crank train's memo (read-only arrays): the
-        combustion models ask for the same cycle grid at every speed and cylinder."""
+        """Cylinder volume [m³] and dV/dθ [m³/rad] at ``theta`` [rad] (last grid memoised)."""
         return self._memo.last_grid("volume", theta, lambda th: sc.cylinder_volume(
             th, self.bore, self.crank_radius, self.rod_length, self.pin_offset,
             self.compression_ratio))
