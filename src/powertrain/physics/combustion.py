@@ -18,9 +18,8 @@ R_AIR = 287.05
 
 
 def wiebe(theta, theta_start, duration, a=6.908, m=2.0):
-    r"""Wiebe mass fraction burned and its derivative.
-
-    :math:`x_b = 1 - \exp[-a((\theta-\theta_s)/\Delta\theta)^{m+1}]`, :math:`\theta \ge \theta_s`.
+    r"""Wiebe mass fraction burned
+    :math:`x_b = 1 - \exp[-a((\theta-\theta_s)/\Delta\theta)^{m+1}]` and its derivative.
 
     Parameters
     ----------
@@ -37,10 +36,8 @@ def wiebe(theta, theta_start, duration, a=6.908, m=2.0):
 
     Returns
     -------
-    xb : ndarray
-        Burned fraction [-].
-    dxb : ndarray
-        :math:`dx_b/d\theta` [1/rad].
+    xb, dxb : ndarray
+        Burned fraction [-] and :math:`dx_b/d\theta` [1/rad].
     """
     z = np.clip((np.asarray(theta, dtype=float) - theta_start) / duration, 0.0, None)
     e = np.exp(-a * z ** (m + 1.0))
@@ -76,10 +73,9 @@ def pressure_basis(theta, volume, n_c, n_e, theta_start, duration, a, m, theta_e
 
     Returns
     -------
-    b_i, b_e : ndarray
-        Pressure without heat release per unit intake and exhaust pressure [-].
-    p1 : ndarray
-        Pressure per joule of heat released [Pa/J].
+    b_i, b_e, p1 : ndarray
+        Pressure without heat release per unit intake and exhaust pressure [-], and per
+        joule of heat released [Pa/J].
     """
     theta = np.asarray(theta, dtype=float)
     V = np.asarray(volume, dtype=float)
@@ -114,7 +110,6 @@ def indicated_work(pressure, dvolume, dtheta):
         :math:`dV/d\theta` [m³/rad] on the grid.
     dtheta : float
         Grid step [rad].
-
     """
     work = np.sum(np.asarray(pressure, float) * dvolume, axis=-1) * dtheta
     return float(work) if np.ndim(work) == 0 else work

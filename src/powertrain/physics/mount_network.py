@@ -50,7 +50,7 @@ def network_matrices(masses, elem_nodes, c, d, *, include_ground=False):
     Returns
     -------
     M, C, K : ndarray, shape (n + 1, n + 1) or (n + 2, n + 2)
-        The engine-side node carries no mass of its own [kg, N·s/m, N/m].
+        [kg, N·s/m, N/m]; the engine-side node carries no mass.
     """
     masses = np.asarray(masses, dtype=float)
     n = masses.size
@@ -63,14 +63,9 @@ def network_matrices(masses, elem_nodes, c, d, *, include_ground=False):
 
 
 def ground_force_rows(n_internal, elem_nodes, c, d):
-    r"""Rows of :math:`F_T = \mathbf k_g \cdot \mathbf x + \mathbf d_g \cdot \dot{\mathbf x}`,
-    the force transmitted to ground (Kovarik 2016, eq. 24), state as :func:`network_matrices`.
-
-    Returns
-    -------
-    kg, dg : ndarray, shape (n_internal + 1,)
-        [N/m] and [N·s/m].
-    """
+    r"""Rows ``kg`` [N/m], ``dg`` [N·s/m] (n_internal + 1,) of the force to ground
+    :math:`F_T = \mathbf k_g \cdot \mathbf x + \mathbf d_g \cdot \dot{\mathbf x}` (Kovarik 2016,
+    eq. 24), state as :func:`network_matrices`."""
     _, C, K = network_matrices(np.zeros(n_internal), elem_nodes, c, d, include_ground=True)
     return -K[:-1, -1], -C[:-1, -1]
 
@@ -104,12 +99,7 @@ def laplace_two_port(s, masses, elem_nodes, c, d, spring_scale=1.0, damper_scale
     Returns
     -------
     a, b, c : ndarray complex, shape of ``s`` [N/m]
-        (and ``X`` when ``internal``).
-
-    Raises
-    ------
-    FloatingPointError
-        The network is singular at some ``s``.
+        (and ``X`` when ``internal``); raises ``FloatingPointError`` where singular.
     """
     lam = np.asarray(s, complex)
     sc = np.broadcast_to(np.asarray(spring_scale, float), lam.shape)
@@ -145,11 +135,7 @@ def laplace_two_ports(s, networks, spring_scales, damper_scales):
     Returns
     -------
     a, b, c : ndarray complex, each ``s.shape + (n_net,)`` [N/m]
-
-    Raises
-    ------
-    FloatingPointError
-        A network is singular at some ``s``.
+        Raises ``FloatingPointError`` where a network is singular.
     """
     packed = networks if isinstance(networks, PackedNetworks) else PackedNetworks.of(networks)
     lam = np.asarray(s, complex)
@@ -200,8 +186,8 @@ class PackedNetworks:
 
 
 def cross_point_stiffness(omega, masses, elem_nodes, c, d):
-    r"""Cross-point dynamic stiffness :math:`K_{CP}(\omega) = F_T/\hat X_1` [N/m], base
-    grounded (Kovarik 2016, eq. 1 and 39).
+    r"""Cross-point dynamic stiffness :math:`K_{CP}(\omega) = F_T/\hat X_1` [N/m], complex
+    (n_freq,), base grounded (Kovarik 2016, eq. 1 and 39).
 
     Parameters
     ----------
@@ -209,10 +195,6 @@ def cross_point_stiffness(omega, masses, elem_nodes, c, d):
         Angular frequency [rad/s].
     masses, elem_nodes, c, d
         Network, see :func:`network_matrices`.
-
-    Returns
-    -------
-    ndarray of complex, shape (n_freq,)
     """
     omega = np.atleast_1d(np.asarray(omega, dtype=float))
     return -two_port(omega, masses, elem_nodes, c, d)[1]
@@ -242,10 +224,8 @@ def forced_engine_mass_response(omega, masses, elem_nodes, c, d, engine_mass, fo
 
     Returns
     -------
-    x1 : ndarray of complex
-        Engine-mass displacement amplitude [m].
-    ft : ndarray of complex
-        Force transmitted to ground [N].
+    x1, ft : ndarray of complex
+        Engine-mass displacement amplitude [m] and force transmitted to ground [N].
     """
     kip = input_point_stiffness(omega, masses, elem_nodes, c, d, engine_mass)
     kcp = cross_point_stiffness(omega, masses, elem_nodes, c, d)
@@ -263,10 +243,6 @@ def incidence_matrix(n_internal, elem_nodes):
         Number of internal nodes ``n``.
     elem_nodes : array_like of int, shape (n_el, 2)
         Node pairs, see :func:`network_matrices`.
-
-    Returns
-    -------
-    ndarray, shape (n_el, n_internal + 2)
     """
     elem_nodes = np.asarray(elem_nodes, dtype=int).reshape(-1, 2)
     B = np.zeros((elem_nodes.shape[0], n_internal + 2))
@@ -296,14 +272,9 @@ def cross_point_stiffness_gradient(omega, masses, elem_nodes, c, d):
 
     Returns
     -------
-    kcp : ndarray of complex, shape (n_freq,)
-        Cross-point dynamic stiffness [N/m].
-    dk_dm : ndarray of complex, shape (n_freq, n_internal)
-        [N/(m·kg)]
-    dk_dc : ndarray of complex, shape (n_freq, n_el)
-        [1]
-    dk_dd : ndarray of complex, shape (n_freq, n_el)
-        [1/s]
+    kcp, dk_dm, dk_dc, dk_dd : ndarray of complex
+        :math:`K_{CP}` (n_freq,) [N/m] and its derivatives (n_freq, n_internal) [N/(m·kg)],
+        (n_freq, n_el) [1] and (n_freq, n_el) [1/s].
     """
     omega = kernel_input(np.atleast_1d(np.asarray(omega, dtype=float)))
     masses, c, d = (kernel_input(x) for x in (masses, c, d))

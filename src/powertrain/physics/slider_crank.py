@@ -32,24 +32,14 @@ def piston_kinematics(theta, r, l, e=0.0):
     ----------
     theta : array_like
         Crank angle from the cylinder axis [rad].
-    r : float
-        Crank radius [m].
-    l : float
-        Connecting-rod length [m].
-    e : float, optional
-        Piston-pin offset [m].
+    r, l, e : float
+        Crank radius, connecting-rod length, piston-pin offset [m].
 
     Returns
     -------
-    y : ndarray
-        Piston-pin distance from the crank axis along the cylinder axis [m].
-    dy : ndarray
-        :math:`dy/d\theta` [m/rad].
-    d2y : ndarray
-        :math:`d^2y/d\theta^2` [m/rad²]; the acceleration at constant speed is
-        :math:`\omega^2\,d^2y/d\theta^2` [m/s²].
-    beta : ndarray
-        Rod angle [rad], :math:`\sin\beta = (r\sin\theta - e)/l`.
+    y, dy, d2y, beta : ndarray
+        Piston-pin distance from the crank axis [m], :math:`dy/d\theta` [m/rad],
+        :math:`d^2y/d\theta^2` [m/rad²] and the rod angle [rad].
     """
     theta = np.asarray(theta, dtype=float)
     beta = np.arcsin((r * np.sin(theta) - e) / l)
@@ -90,10 +80,8 @@ def cylinder_volume(theta, bore, r, l, e, compression_ratio):
 
     Returns
     -------
-    V : ndarray
-        Volume [m³].
-    dV : ndarray
-        :math:`dV/d\theta` [m³/rad].
+    V, dV : ndarray
+        Volume [m³] and :math:`dV/d\theta` [m³/rad].
     """
     area = np.pi * bore**2 / 4.0
     y_tdc, y_bdc, _, _ = stroke_limits(r, l, e)
