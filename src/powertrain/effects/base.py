@@ -217,11 +217,9 @@ class Effect:
 
 def map_networks(engine, fn):
     """The engine with every mount network replaced by ``fn(mount index, mount, axis, model)``."""
-    mounts = []
-    for mi, m in enumerate(engine.mounts):
-        mounts.append(dataclasses.replace(
-            m, directions={ax: fn(mi, m, ax, mod) for ax, mod in m.directions.items()}))
-    return engine.replace(mounts=mounts)
+    return engine.replace(mounts=[dataclasses.replace(
+        m, directions={ax: fn(mi, m, ax, mod) for ax, mod in m.directions.items()})
+        for mi, m in enumerate(engine.mounts)])
 
 
 def with_network_elastomer(engine, factors):

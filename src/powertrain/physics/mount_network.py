@@ -28,6 +28,7 @@ from powertrain.kernels.two_port import kcp_gradient_kernel, two_port_kernel, tw
 GROUND = -1
 #: Index of the engine-side node.
 ENGINE = 0
+_SINGULAR = "mount network singular at some frequency (two-port pivot below tolerance)"
 
 
 def network_matrices(masses, elem_nodes, c, d, *, include_ground=False):
@@ -113,8 +114,7 @@ def laplace_two_port(s, masses, elem_nodes, c, d, spring_scale=1.0, damper_scale
                              kernel_input(np.reshape(elem_nodes, (-1, 2)), np.int64),
                              kernel_input(c), kernel_input(d), *out, x)
     if status:
-        raise FloatingPointError("mount network singular at some frequency (two-port pivot "
-                                 "below tolerance)")
+        raise FloatingPointError(_SINGULAR)
     res = tuple(v.reshape(lam.shape) for v in out)
     return res + (x.reshape(lam.shape + x.shape[1:]),) if internal else res
 
@@ -146,8 +146,7 @@ def laplace_two_ports(s, networks, spring_scales, damper_scales):
     out = [np.empty((n, lam.size), complex) for _ in range(3)]
     if two_ports_kernel(kernel_input(lam.reshape(-1), complex), *scales, *packed.arrays(),
                         *out):
-        raise FloatingPointError("mount network singular at some frequency (two-port pivot "
-                                 "below tolerance)")
+        raise FloatingPointError(_SINGULAR)
     return tuple(v.T.reshape(shape) for v in out)
 
 
