@@ -147,7 +147,8 @@ def condense(system, keep, s):
     ports = system.ports()
     ports = replace(ports, elements=[element.as_measured() for element in ports.elements])
     s = np.asarray(s, complex)
-    D = _retained_matrix(ports, two_ports(ports, s), s)
+    D = condensed_matrix(ports.frame, ports.engine_rows,
+                         None if ports.grounded else ports.base_rows, two_ports(ports, s), s)
     pos = {int(j): i for i, j in enumerate(ports.retained)}
     if any(int(j) not in pos for j in keep):
         raise ValueError("condense keeps only retained coordinates (rigid body, body modes)")
@@ -159,11 +160,6 @@ def condense(system, keep, s):
         Dk = Dk - Dkr @ np.linalg.solve(D[..., rest[:, None], rest[None, :]],
                                         D[..., rest[:, None], k[None, :]])
     return Dk
-
-
-def _retained_matrix(ports, abc, s):
-    return condensed_matrix(ports.frame, ports.engine_rows,
-                            None if ports.grounded else ports.base_rows, abc, s)
 
 
 def harmonic_solve(frame, engine_rows, base_rows, abc, s, load):
