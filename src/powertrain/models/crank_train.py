@@ -22,17 +22,16 @@ class CrankTrain:
     compression_ratio : float
         Geometric compression ratio [-].
     cylinder_x : ndarray
-        Position of each cylinder along the crank axis (engine X) [m], cylinder 1 first.
+        Each cylinder's position along the crank axis (engine X) [m], cylinder 1 first.
     cylinder_axis : ndarray, shape (3,)
-        Unit vector :math:`\\mathbf u` of the cylinder axis (crank axis to head), engine axes.
+        Unit vector :math:`\\mathbf u` of the cylinder axis (crank axis to head).
     rotation_sign : int
         +1: the crank turns positively about +X, −1: about −X.
-    crank_pin_angles : ndarray
-        Cylinder-1 crank angle at which each cylinder is at a top dead centre [rad].
+    crank_pin_angles, firing_angles : ndarray
+        Cylinder-1 crank angle at each cylinder's TDC, and at its firing TDC on ``[0, 4π)``
+        [rad].
     firing_order : tuple of int
         Cylinder numbers (1-based), starting with 1.
-    firing_angles : ndarray
-        Cylinder-1 crank angle of each cylinder's firing TDC on ``[0, 4π)`` [rad].
     reciprocating_mass, rotating_mass : float
         Per cylinder [kg].
     counterweight_fraction : float
@@ -120,8 +119,7 @@ class BalancerShaft:
     position : ndarray, shape (3,)
         A point of the shaft axis at the unbalance's plane, engine axes [m].
     phase : float
-        Angle of the unbalance at cylinder-1 TDC from :math:`\\mathbf u` towards
-        :math:`\\mathbf s` [rad].
+        Unbalance angle at cylinder-1 TDC from :math:`\\mathbf u` towards :math:`\\mathbf s` [rad].
     sense : int
         +1 turns with the crank, −1 against it.
     """

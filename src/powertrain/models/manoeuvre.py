@@ -86,9 +86,8 @@ class Manoeuvre:
     starter : Starter or None
     reversal : bool
         The crank may turn backwards (speed < 0).
-    file : str
-        The file it was read from.
-    notes : str
+    file, notes : str
+        The file it was read from; notes.
     motored_intake_pressure : float or None
         Intake pressure of the cycle without burn [Pa]; None: the model's ambient pressure.
     trigger_time : float
