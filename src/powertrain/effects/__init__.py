@@ -1,10 +1,7 @@
 r"""Unmodelled effects as model extensions: the candidates for the sim-to-real gap.
 
-One class per effect (:mod:`.base` defines the interface), one registry
-(:data:`EFFECTS`, :mod:`.registry`) read by ``powertrain runup/whatif --effect``,
-``powertrain synth``, the what-if variants and the diagnosis. Parameters are generated
-from the engine: one stiffness factor per mount, one gain per channel and one rotation per
-triad, one combustion deviation per cylinder, per-shaft balancer unbalance and timing.
+One class per effect (interface :mod:`.base`), one registry (:data:`EFFECTS`); parameters
+are generated from the engine (per mount, channel, triad, cylinder or balancer shaft).
 
 ================== =========== ===================================================================
 name               kind        physics
@@ -28,11 +25,6 @@ cylinder_imbalance excitation  cylinder i's combustion (IMEP, or the combustion 
 sensor_error       sensor      channel gains 10^(G_c/20) and triad rotations φ_m:
                                diag(10^(G/20)) R(φ_m) v
 ================== =========== ===================================================================
-
-Every effect can be used on an :class:`~powertrain.models.engine.Engine`
-(``EFFECTS[name].apply(engine, **params)``, where it is an engine-model change), on the
-fast cached path :func:`predict` (the diagnosis), and through the ordinary run-up
-(:func:`powertrain.workflows.runup.runup_with_effects`).
 """
 
 from powertrain.effects.amplitude_stiffness import A_REF, amplitude_law

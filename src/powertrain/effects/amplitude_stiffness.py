@@ -1,26 +1,11 @@
 r"""``amplitude_stiffness``: the elastomer's stiffness depends on the amplitude across the mount.
 
-A fit of the mount laws (:mod:`powertrain.physics.mount_laws`), not a physics of its own: the
-candidate puts one :class:`~powertrain.physics.mount_laws.PowerLaw` on every mount direction,
-
-.. math:: \text{springs} \times f,\quad \text{dampers} \times f^{\gamma},\qquad
-   f = \mathrm{clip}\big((A_{ref}/A)^{n},\ 0.2,\ 5\big),
-
-:math:`A_{ref}` = 0.1 mm (where mount data are measured and the networks fitted, so the
-network is unchanged at :math:`A_{ref}`), :math:`A` the amplitude of the relative
-displacement across the mount direction (√2 × RMS of orders 0.5–8), masses kept; one
-exponent :math:`n` and one damping exponent :math:`\gamma` (as ``mount_stiffness``'s: prior
-1 ± 0.5, a constant loss factor at 1) for all mounts (one law per mount design is not
-separable from ``mount_stiffness``). :meth:`~AmplitudeStiffness.apply` sets
-:attr:`MountModel.amplitude_law <powertrain.models.mount.MountModel.amplitude_law>`,
-which the run-up's harmonic fixed point
-(:mod:`powertrain.solvers.equivalent_linear`) solves; the fast path
-(:func:`powertrain.effects.predict`) evaluates the same
-:meth:`MountElement.two_port <powertrain.physics.mount_elements.MountElement.two_port>` at
-its own fixed-point amplitudes. At :math:`n = 0` (the default) the mounts are left as they
-are (a law of the engine's mount files included); otherwise the candidate's law replaces
-theirs. tests/amplitude_oracle.py checks the linearisation against a cycle-by-cycle
-Newmark integration.
+One :class:`~powertrain.physics.mount_laws.PowerLaw` on every mount direction: springs × f,
+dampers × :math:`f^{\gamma}`, :math:`f = \mathrm{clip}((A_{ref}/A)^{n}, 0.2, 5)`, with
+:math:`A_{ref}` = 0.1 mm (where the networks were fitted), :math:`A` the relative
+displacement amplitude across the mount, masses kept; one exponent :math:`n` and one
+damping exponent :math:`\gamma` for all mounts. Solved at the harmonic fixed point
+(:mod:`powertrain.solvers.equivalent_linear`); at :math:`n = 0` the mounts are unchanged.
 """
 
 from __future__ import annotations

@@ -1,13 +1,9 @@
 r"""``balancer_error``: the balancer shafts' unbalance and timing, per shaft.
 
-Shaft k's unbalance times :math:`g(1 \pm a/2)` and its drive lagging by
-:math:`\delta \pm s/2` [rad of shaft angle], + for the first half of the shafts (file
-order), − for the others: ``gain`` g and ``lag`` δ are common, ``asym`` a and ``skew`` s
-the shaft-to-shaft differences. With two shafts the four parameters are each shaft's own
-unbalance and timing (one shaft 20° late is ``lag`` = ``skew``/2 = 10°, not a gain). A lag
-is a pure delay of the shaft's force: its complex order amplitude times
-:math:`g_k e^{-i\delta_k}`; in the engine model
-:math:`\alpha = \sigma(\rho\theta - \delta_k) + \phi`.
+Shaft k's unbalance times :math:`g(1 \pm a/2)` and its drive lagging by :math:`\delta \pm s/2`
+[rad of shaft angle], + for the first half of the shafts (file order), − for the others.
+A lag delays the shaft's force: its order amplitude times :math:`g_k e^{-i\delta_k}`, in the
+engine model :math:`\alpha = \sigma(\rho\theta - \delta_k) + \phi`.
 """
 
 from __future__ import annotations
@@ -35,7 +31,7 @@ def shaft_lags(n, lag, skew):
 
 
 def with_balancer_error(engine, gain=1.0, lag=0.0, asym=0.0, skew=0.0):
-    """The engine with every shaft's unbalance and timing changed (see the module)."""
+    """The engine with every shaft's unbalance and timing changed (module docstring)."""
     n = len(engine.balancer.shafts)
     f, d = shaft_factors(n, gain, asym), shaft_lags(n, lag, skew)
     shafts = tuple(dataclasses.replace(s, mass_radius=s.mass_radius * fk,

@@ -1,12 +1,8 @@
 r"""``base_compliance``: every mount stands on a local chassis base.
 
-Mass :math:`m_b` on a spring :math:`c_b` with damping ratio ζ_b = 5 % between the network
-and the ground (or the body), declared once (:meth:`BaseCompliance.base_under_mounts`): the
-engine model gets the base node in every network
-(:func:`powertrain.models.extensions.with_base_compliance`), the cached model condenses it
-from each network's two-port (:meth:`HarmonicModel.two_ports_on_base
-<powertrain.solvers.fast_harmonic.HarmonicModel.two_ports_on_base>`). At the upper bound of
-``c_base`` (the default) the ground is rigid.
+Mass :math:`m_b` on a spring :math:`c_b` with damping ratio ζ_b = 5 % between each network
+and the ground (or the body) (:meth:`BaseCompliance.base_under_mounts`); at the upper bound
+of ``c_base`` (the default) the ground is rigid.
 """
 
 from __future__ import annotations
@@ -22,13 +18,8 @@ C_RIGID = 2.0e7
 
 
 def with_base_compliance_all(engine, c_base=np.inf, m_base=10.0, zeta=BASE_ZETA):
-    r"""Every mount network on a local compliant base (all mounts alike).
-
-    Base of mass ``m_base`` [kg] on a spring ``c_base`` [N/m] with the damper
-    :math:`d_b = 2\zeta\sqrt{c_b m_b}` [N·s/m]
-    (:func:`powertrain.models.extensions.with_base_compliance`). ``c_base = inf`` (default)
-    is the rigid ground: the engine is returned unchanged.
-    """
+    r"""Every mount network on a base of ``m_base`` [kg] on a spring ``c_base`` [N/m] with
+    :math:`d_b = 2\zeta\sqrt{c_b m_b}` [N·s/m]; ``c_base = inf`` returns the engine unchanged."""
     if not np.isfinite(c_base):
         return engine
     return map_networks(engine, lambda mi, m, ax, mod: changed_network(

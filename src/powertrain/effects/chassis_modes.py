@@ -1,25 +1,9 @@
 r"""``chassis_modes``: the body modes shared by the mount bases are not where the model has them.
 
-For an engine with a modal body (``[chassis] model = "modal"``, :mod:`powertrain.models.chassis`)
-each body mode k gets its natural frequency ``f<k>`` [Hz], modal mass ``m<k>`` [kg] and
-damping ratio ``z<k>`` [1] fitted; its shape at the mount attachment points (and body points)
-is kept from the engine file. The fast path couples the rigid powertrain to the changed
-modes through the mount two-ports (:mod:`powertrain.solvers.body_coupling`), so the effect
-moves the body-side (passive) channels most and the engine side a little.
-
-**Why shapes are not fitted.** The measured data are order *magnitudes* at the body side of
-three or four mounts: a mode's shape at the attachment points and its modal mass enter the
-receptance only as :math:`\psi\psi^T/m_k`, so a common scale of the shape is the modal mass
-itself, and free shapes would add 3 × (number of mounts) parameters per mode with only
-magnitudes (signs lost) to fix them — poorly identified and far over the evaluation budget.
-Frequency, modal mass and damping of the file's modes are what a body-in-white test or a
-trimmed-body FE update changes, are identifiable from where and how high the shared
-resonance appears on the passive side, and keep the fit to three parameters per mode.
-A body mode entirely missing from the file is outside this candidate (the diagnosis then
-answers "unexplained" with the gap attributed to the body side, :mod:`powertrain.diagnosis.sides`).
-
-Applicable to engines with a modal body only (on a rigid chassis the model predicts no
-body-side motion to compare with).
+For an engine with a modal body each body mode k gets its frequency ``f<k>`` [Hz], modal mass
+``m<k>`` [kg] and damping ratio ``z<k>`` [1] fitted; its shape is kept from the engine file
+(shape and modal mass enter only as :math:`\psi\psi^T/m_k`, and magnitudes alone would leave
+free shapes poorly identified). The effect moves the body-side channels most.
 """
 
 from __future__ import annotations
@@ -37,9 +21,7 @@ FREQ_RANGE = (0.6, 1.6)
 MASS_RANGE = (0.25, 4.0)
 #: Damping-ratio bounds [1].
 ZETA_RANGE = (0.005, 0.25)
-#: Prior standard deviation of ln(damping ratio) about the file's value [1]: a body's modal
-#: damping is known from its modal test within about a factor of two (e^0.7); without it a
-#: near-zero damping places a sharp resonance between two measured speeds and fits noise.
+#: Prior standard deviation of ln(damping ratio) about the file's value [1] (a factor of two).
 DAMPING_PRIOR = 0.7
 #: Frequency factors of the start grid (each mode) [1].
 GRID_FREQ = (0.85, 1.15)
@@ -51,10 +33,8 @@ def _modes(engine):
 
 
 def mode_values(p, frequency_hz, modal_mass, damping_ratio):
-    """Each mode's frequency [Hz], modal mass [kg] and damping ratio [1] with the effect's
-    parameters ``p`` (``f1``, ``m1``, ``z1``, ...; a missing one keeps the given value):
-    the one mapping :meth:`ChassisModes.apply` (on the engine's modes) and
-    :meth:`ChassisModes.body_change` (on the frequency view's modal body) both use."""
+    """Each mode's frequency [Hz], modal mass [kg] and damping ratio [1] with the parameters
+    ``p`` (``f1``, ``m1``, ``z1``, ...; a missing one keeps the given value)."""
     return tuple([float(p.get(f"{key}{k + 1}", v)) for k, v in enumerate(values)]
                  for key, values in (("f", frequency_hz), ("m", modal_mass),
                                      ("z", damping_ratio)))
@@ -63,11 +43,7 @@ def mode_values(p, frequency_hz, modal_mass, damping_ratio):
 class ChassisModes(Effect):
     name = "chassis_modes"
     kind = "structure"
-    #: held-out *orders* in the cells check, not channels: the shapes come from the file and
-    #: are not what this effect claims (a trimmed body's shapes differ from the FE model's by
-    #: a few % per component; predicting a withheld channel tests them), while a moved body
-    #: resonance is crossed by every order at its own speed, so orders it was not fitted on
-    #: test what it claims (docs/validation/diagnosis.md)
+    #: held-out orders, not channels: the file's shapes are not what this effect claims
     withhold_orders = True
     description = ("body modes shared by the mount bases: frequency, modal mass and damping "
                    "of each of the engine file's body modes (shapes kept)")
@@ -97,8 +73,7 @@ class ChassisModes(Effect):
         return bool(_modes(engine))
 
     def start_grid(self, engine=None):
-        """Each mode's frequency at 0.85 and 1.15 × the file's (masses, damping at the
-        file's values): 2^K start points, the two best kept."""
+        """Each mode's frequency at 0.85 and 1.15 × the file's (2^K start points)."""
         modes = _modes(engine)
         if not modes or len(modes) > 5:
             return ()

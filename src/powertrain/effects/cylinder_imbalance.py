@@ -1,17 +1,10 @@
 r"""``cylinder_imbalance``: cylinder i delivers (1 + e_i) times its nominal combustion.
 
-* single-zone combustion: cylinder i's IMEP target times (1 + e_i) (the heat release is
-  recalibrated to it);
-* measured pressure traces: cylinder i's *combustion part* of its trace times (1 + e_i),
-  :math:`p_i' = p_{m,i} + (1 + e_i)(p_i - p_{m,i})`, with :math:`p_{m,i}` the motored
-  (polytropic, n = :data:`N_MOTORED`) pressure through the trace's value at
-  :data:`REF_ANGLE` before firing TDC, over the closed cycle (−180…180°); the gas-exchange
-  strokes are kept. The IMEP changes by about e_i times the combustion part's share.
-
-On the cached path the load is linear in the e_i: both models scale a cylinder's pressure
-(its combustion part) linearly, so one forward difference of the load harmonics per cylinder
-(step :data:`STEP`) is exact to round-off (tests/test_diagnosis_phase.py compares it with
-central differences).
+Single-zone combustion: the IMEP target times (1 + e_i). Measured traces: the combustion part
+times (1 + e_i), :math:`p_i' = p_{m,i} + (1 + e_i)(p_i - p_{m,i})`, with :math:`p_{m,i}` the
+motored (polytropic, :data:`N_MOTORED`) pressure through the trace at :data:`REF_ANGLE` over
+the closed cycle. The load is linear in the e_i, so one forward difference per cylinder
+(:data:`STEP`) is exact to round-off.
 """
 
 from __future__ import annotations
@@ -25,16 +18,14 @@ from powertrain.physics.combustion import indicated_work
 
 #: Polytropic exponent of the motored pressure [1].
 N_MOTORED = 1.32
-#: Crank angle (cylinder cycle, before firing TDC) where the motored pressure is matched to
-#: the trace: well before any start of combustion, after intake valve closing [rad].
+#: Cycle angle where the motored pressure meets the trace (before combustion, after IVC) [rad].
 REF_ANGLE = -np.deg2rad(60.0)
 #: Forward-difference step of the load derivatives [1].
 STEP = 0.05
 
 
 def motored_pressure(theta, pressure, crank):
-    """Motored (no combustion) pressure of each cylinder's trace, same shape; equal to the
-    trace outside the closed cycle (−π..π)."""
+    """Motored pressure of each cylinder's trace [Pa] (the trace outside −π..π)."""
     V, _ = crank.volume(theta)
     j = int(np.argmin(np.abs(theta - REF_ANGLE)))
     closed = (theta > -np.pi) & (theta < np.pi)
@@ -115,10 +106,8 @@ class CylinderImbalance(Effect):
         return hm._extra["cylinder_imbalance"]
 
     def alternatives(self, params, engine=None):
-        """The same cylinder-to-cylinder pattern with another reference: the strongest
-        cylinder nominal (the others weak), the weakest nominal (the others strong), the mean
-        nominal. Orders 0.5, 1, 1.5 see only the deviations from the mean, so these differ
-        mainly in the firing orders' level, often below the noise."""
+        """The same pattern with another reference (strongest, weakest or mean cylinder
+        nominal) and single weak or strong cylinders."""
         n = len(params)
         f = 1.0 + np.array([params.get(f"e{i + 1}", 0.0) for i in range(n)])
         out = []
@@ -140,8 +129,7 @@ class CylinderImbalance(Effect):
         return out
 
     def finding(self, params, engine=None, phase="none"):
-        """The cylinder furthest from the median cylinder, weak or strong, with the
-        cylinders the measured phases cannot tell it from (:func:`equivalent_cylinders`)."""
+        """The cylinder furthest from the median, weak or strong, and its equivalents."""
         f = 1.0 + np.array([params.get(f"e{i + 1}", 0.0) for i in range(len(params))])
         rel = f / np.median(f) - 1.0
         j = int(np.argmax(np.abs(rel)))
@@ -166,11 +154,9 @@ class CylinderImbalance(Effect):
 
 
 def equivalent_cylinders(engine, j, weak, phase) -> list:
-    r"""``[(cylinder, weak)]`` (0-based) whose single-cylinder deviation the measured orders
-    cannot tell from cylinder ``j`` weak/strong: all of them without phase; with whole-order
-    phases those with the same phasor :math:`s\,e^{-iklpha}` (α the firing angle, s = ±1)
-    at every whole order k that is not a firing order (the firing orders' common part is
-    free: the others' mean); only itself with half-order phases."""
+    r"""``[(cylinder, weak)]`` (0-based) the measured orders cannot tell from cylinder ``j``
+    weak/strong: all without phase; with whole-order phases those with the same phasor
+    :math:`\pm e^{-ik\alpha}` at every non-firing whole order k; itself with half orders."""
     n = len(engine.crank.firing_angles)
     if phase == "all":
         return [(j, weak)]
@@ -188,7 +174,7 @@ def equivalent_cylinders(engine, j, weak, phase) -> list:
 
 
 def _cylinder_words(cyls) -> list:
-    """``["cylinder 2 weak", "cylinder 3 weak", ...]``; cylinders of one sign joined."""
+    """``["cylinder 2 or 3 weak", ...]``."""
     out = []
     for weak in dict.fromkeys(w for _, w in cyls):
         nums = [str(c + 1) for c, w in cyls if w == weak]

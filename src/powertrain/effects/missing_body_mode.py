@@ -1,40 +1,18 @@
 r"""``missing_body_mode``: a body mode the engine file's body model lacks.
 
-One more mode of the body under the mounts, :math:`\mathbf x_B(P) \mathrel{+}=
+One more body mode under the mounts, :math:`\mathbf x_B(P) \mathrel{+}=
 \boldsymbol\psi(P)\,\eta`, :math:`m(\ddot\eta + 2\zeta\omega_0\dot\eta + \omega_0^2\eta) =
-\sum_P \boldsymbol\psi(P)\cdot\mathbf f_P`, with its natural frequency ``frequency_hz``,
-modal mass ``modal_mass_kg``, damping ratio ``damping_ratio`` and its shape at each mount
-base, ``shape_<mount>_<x|y|z>`` (engine axes). Only :math:`\boldsymbol\psi\boldsymbol\psi^T/m`
-reaches the data, so the shape is **normalised to its largest component** (±1) and the
-modal mass belongs to that scaling: the mode acts with :math:`\boldsymbol\psi/\max|\psi_j|`.
-At the modal-mass bound :data:`MASS_OFF` (the default) or with a zero shape the mode is
-absent (the baseline).
+\sum_P \boldsymbol\psi(P)\cdot\mathbf f_P`, with ``frequency_hz``, ``modal_mass_kg``,
+``damping_ratio`` and its shape ``shape_<mount>_<x|y|z>`` at each base (engine axes). Only
+:math:`\boldsymbol\psi\boldsymbol\psi^T/m` reaches the data, so the shape is normalised to
+its largest component and the modal mass belongs to that scaling; at :data:`MASS_OFF` or a
+zero shape the mode is absent. A rigid chassis with body-side channels is read as a modal
+body without modes (:func:`body_side_engine`).
 
-**Where it applies.** An engine with a modal body (``[chassis] model = "modal"``): the mode
-is added to the file's modes. A rigid chassis when body-side channels are measured: the
-diagnosis reads it as a modal body without modes (:func:`body_side_engine`; the model holds
-the body side still, the new mode gives it motion). On the engine (:meth:`apply`) the
-effect is a modal chassis with one more mode, which every solver runs; on the fast path
-(:meth:`body_change`) the same mode is appended to the cached modal body
-(:meth:`~powertrain.solvers.body_coupling.ModalBody.with_extra_mode`); both are one
-:func:`mode_arrays` (tests/test_missing_body_mode.py holds them equal).
-
-**Starts** (:meth:`data_starts`), screened by the fit (:mod:`powertrain.diagnosis.starts`).
-With order phase the body side's complex excess over the model, :math:`e = a\,\boldsymbol
-\psi^T` for a missing mode (one complex factor per speed and order times the real shape;
-exact where the body side is held still without the mode, approximate on a modal body, whose
-own modes answer the changed mount forces too), gives the shape with its signs
-(:func:`signed_shape`, the best rank-1 fit; the fit then tries each sign flipped). The
-frequency is a grid over the measured order frequencies in steps of :data:`GRID_STEP` (the
-phase swings through the resonance and marks it; magnitudes alone hardly do), each
-frequency with two shapes, that rank-1 fit over all points and over the points within ±
-:data:`PEAK_WINDOW` of it, and at the modal masses :data:`GRID_MASSES`. Over all points a
-stronger error elsewhere, or the file modes' answer on a modal body, can dominate the excess;
-near the frequency the mode may not dominate either,
-when its resonance on the mounts lies well above its own frequency. Without phase: from the
-body-side gap's peaks — the frequencies where the measured body side most exceeds the model
-relative to the engine side (:func:`body_gap_peak`), the shape from the excess velocity at
-each base and direction there (signs chosen by the fit); three peaks × three modal masses.
+Starts (:meth:`MissingBodyMode.data_starts`): with order phase, the shape from the rank-1
+fit of the body side's complex excess over the model (:func:`signed_shape`) on a frequency
+grid (:data:`GRID_STEP`) at :data:`GRID_MASSES`; without phase, from the peaks of the
+body-side excess relative to the engine side (:func:`body_gap_peak`).
 """
 
 from __future__ import annotations
@@ -57,29 +35,21 @@ MASS_OFF = MASS_RANGE[1]
 #: Damping-ratio bounds and default [1].
 ZETA_RANGE = (0.005, 0.25)
 ZETA_DEFAULT = 0.04
-#: Prior standard deviation of ln(damping ratio) about the default [1] (a body mode's
-#: damping is known within a factor of two; without it a sharp resonance between two
-#: measured speeds fits noise).
+#: Prior standard deviation of ln(damping ratio) about the default [1].
 DAMPING_PRIOR = 0.7
 #: Modal masses screened at the data's start frequency [kg].
 START_MASSES = (3.0, 12.0, 50.0)
-#: Start frequencies relative to a peak [1]: the mode on the mounts resonates above its own
-#: (uncoupled) frequency.
+#: Start frequencies relative to a peak [1] (the coupled resonance lies above the mode's own).
 START_SHIFTS = (0.7, 1.0)
 #: Peaks of the body-side excess tried as start frequencies.
 START_PEAKS = 3
-#: Ratio of neighbouring start frequencies with phase [1] (a resonance at 2-6 % damping is
-#: 4-12 % wide).
+#: Ratio of neighbouring start frequencies with phase [1].
 GRID_STEP = 1.06
-#: Modal masses of the frequency-grid starts [kg], a factor 3 apart (one middle mass alone
-#: lets the fit settle on a wrong frequency; docs/validation/diagnosis.md).
+#: Modal masses of the frequency-grid starts [kg] (docs/validation/diagnosis.md).
 GRID_MASSES = (4.0, 12.0, 36.0)
 AXES = "xyz"
-#: Modal assurance criterion above which the fitted shape *pairs* with one of the file's body
-#: modes [1]. Below the 0.9 of a well-correlated pair of *measured* test and model modes
-#: (Allemang 2003, "The modal assurance criterion - twenty years of use and abuse"): a
-#: missing mode fitted where a file mode has moved is a stand-in whose shape also absorbs
-#: the file mode left at its old place, and pairs less well (docs/validation/diagnosis.md).
+#: Modal assurance criterion above which the fitted shape pairs with a file body mode [1]
+#: (below Allemang 2003's 0.9 for measured pairs: a stand-in mode pairs less well).
 MAC_PAIRED = 0.8
 
 
@@ -89,9 +59,8 @@ def shape_names(engine) -> list:
 
 
 def mode_arrays(params, n_mounts):
-    """``(frequency, modal mass, damping, shape (n_mounts, 3) normalised to its largest
-    component)`` of the parameters, or None when the mode is absent (mass at the bound or a
-    zero shape). The one reading of the parameters (engine and fast path)."""
+    """``(frequency, modal mass, damping, normalised shape (n_mounts, 3))``, or None when the
+    mode is absent."""
     shape = np.array([v for k, v in params.items() if k.startswith("shape_")], float)
     peak = float(np.max(np.abs(shape))) if shape.size else 0.0
     if params["modal_mass_kg"] >= MASS_OFF or peak == 0.0:
@@ -101,8 +70,7 @@ def mode_arrays(params, n_mounts):
 
 
 def body_side_engine(engine):
-    """``engine`` with a rigid (or absent) chassis read as a modal body without modes: its
-    body side is held still and predicted (zero) instead of left out."""
+    """``engine`` with a rigid (or absent) chassis read as a modal body without modes."""
     ch = getattr(engine, "chassis", None)
     if ch is not None and not ch.is_rigid:
         return engine
@@ -113,16 +81,9 @@ def body_side_engine(engine):
 class MissingBodyMode(Effect):
     name = "missing_body_mode"
     kind = "structure"
-    #: the shape at a base is seen on that base's channels only (held-out orders instead)
     withhold_orders = True
-    #: parameter whose separate minima are told apart (:mod:`powertrain.diagnosis.starts`)
     basin_parameter = "frequency_hz"
-    #: parameters with the model-discrepancy floor in their uncertainty (a mode placed a
-    #: little apart by the model on every channel alike; :mod:`powertrain.diagnosis.
-    #: uncertainty`)
     model_floor = ("frequency_hz", "modal_mass_kg")
-    #: a candidate only where the gap lies on the body side: the mode moves the bases, and
-    #: its 12-parameter fit is the slowest of the library
     locations = ("body",)
     description = ("one body mode the body model lacks: frequency, modal mass, damping and "
                    "its shape at each mount base (normalised to its largest component)")
@@ -206,12 +167,9 @@ class MissingBodyMode(Effect):
         return out
 
     def restates(self, params, engine=None, band=None):
-        """``("chassis_modes", reason)`` when the fitted mode's shape at the mount bases pairs
-        (MAC >= :data:`MAC_PAIRED`) with a body mode of the engine file at a frequency
-        ``chassis_modes`` can move that mode to: the data then say "that mode is elsewhere",
-        with no new mode needed. Also when it resonates outside the measured ``band``: there
-        its receptance on the paired shape is a mass line (below) or a spring line (above),
-        which added to the paired mode's only moves that mode and changes its mass."""
+        """``("chassis_modes", reason)`` when the fitted shape pairs (MAC >= :data:`MAC_PAIRED`)
+        with a file body mode at a frequency ``chassis_modes`` can move it to, or outside the
+        measured ``band`` (a mass or spring line on that mode)."""
         ch = getattr(engine, "chassis", None)
         modes = () if ch is None else ch.body_modes
         mode = mode_arrays(params, len(engine.mounts)) if modes else None
@@ -238,8 +196,7 @@ class MissingBodyMode(Effect):
                                  f"(MAC {mac:.2f}) {where}")
 
     def data_starts(self, engine, gaps):
-        """Start parameter sets from the body-side gap (module docstring), [] without one.
-        ``gaps``: :class:`BodyGaps` of the data against the model without the mode."""
+        """Start parameter sets from the body-side :class:`BodyGaps` ``gaps`` ([] without)."""
         names = [m.name for m in engine.mounts]
         shape = signed_shape(gaps, names)
         if shape is not None:
@@ -264,10 +221,7 @@ class MissingBodyMode(Effect):
 
 
 def _magnitude_grid_starts(engine, gaps, names) -> list:
-    """Without phase: a start at every frequency of :func:`frequency_grid`, the shape the
-    body side's excess near it (:func:`_excess_near`), at the modal masses
-    :data:`GRID_MASSES` (a global search in frequency before the local fit: the peaks of the
-    excess alone miss a mode whose excess is spread over orders and speeds)."""
+    """Without phase: a start at every grid frequency, the shape the excess near it."""
     cols = _body_columns(gaps, names)
     if not cols:
         return []
@@ -286,8 +240,7 @@ def _magnitude_grid_starts(engine, gaps, names) -> list:
 
 
 def _excess(g, cols):
-    """Excess velocity [m/s RMS] of the body-side points over the model (NaN where not
-    scored), (n_r, len(cols), n_o) (:func:`body_gap_peak`)."""
+    """Excess velocity [m/s RMS] of the body-side points over the model, (n_r, n_cols, n_o)."""
     meas = g.measured[:, list(cols)]
     with np.errstate(invalid="ignore", over="ignore"):
         model = meas * 10 ** (g.gap[:, list(cols)] / 20)
@@ -296,12 +249,10 @@ def _excess(g, cols):
 
 @dataclasses.dataclass
 class BodyGaps:
-    """Gaps of measured order levels against a model, for start points.
-
-    ``rpm`` (n_r,), ``channels`` [(mount, direction)], ``orders`` (n_o,), ``gap`` [dB] and
-    ``measured`` [m/s RMS], each (n_r, n_ch, n_o), NaN where not scored; ``excess`` the
-    measured minus model complex amplitude [m/s RMS] where phase is scored (NaN elsewhere;
-    None without phase)."""
+    """Gaps of measured order levels against a model: ``rpm`` (n_r,), ``channels``
+    [(mount, direction)], ``orders`` (n_o,), ``gap`` [dB] and ``measured`` [m/s RMS], each
+    (n_r, n_ch, n_o), NaN where not scored; ``excess`` measured minus model complex amplitude
+    [m/s RMS] (None without phase)."""
 
     rpm: np.ndarray
     channels: list
@@ -316,31 +267,24 @@ class BodyGaps:
         return self.rpm[:, None] * self.orders[None, :] / 60.0
 
 
-#: Relative half-width of the frequency window around the peak read for the shape [1].
+#: Relative half-width of the frequency window read for the shape [1].
 PEAK_WINDOW = 0.08
 
 
 def body_gap_peak(g: BodyGaps, mount_names, n_bins=32, n_peaks=1):
-    r"""``(f0, shape (n_mounts, 3))`` of the body side's excess over the model, or None
-    (with ``n_peaks`` > 1: a list of those of the ``n_peaks`` largest bins).
-
-    The excess velocity of a point, :math:`e = \sqrt{\max(0, m^2 - s^2)}` (measured m,
-    model :math:`s = m\,10^{\Delta L/20}`), on the body-side channels ``NAME/passive``,
-    relative to the measured engine side of the same mount and direction (the excess
-    transmissibility, which peaks at a mode's resonance); f0 its weighted mean frequency in
-    the log-frequency bin (of ``n_bins``) with the largest mean of
-    :math:`(e/m_\mathrm{engine})^2`; the shape the RMS excess of each base and direction
-    within ± :data:`PEAK_WINDOW` of f0, normalised to its largest component."""
+    r"""``(f0, shape (n_mounts, 3))`` of the body side's excess over the model, or None (a
+    list for ``n_peaks`` > 1). The excess :math:`e = \sqrt{\max(0, m^2 - s^2)}` relative to
+    the measured engine side peaks at a resonance; f0 is its weighted mean frequency in the
+    log bin (of ``n_bins``) with the largest mean :math:`(e/m_\mathrm{engine})^2`, the shape
+    the RMS excess within ± :data:`PEAK_WINDOW` of f0, normalised."""
     cols = _body_columns(g, mount_names)
     if not cols:
         return None
     idx = list(cols)
     f = g.order_hz[:, None, :] * np.ones((1, len(idx), 1))
-    meas = g.measured[:, idx]
+    ex = _excess(g, cols)
     engine_side = g.measured[:, [cols[c][2] for c in idx]]
     with np.errstate(invalid="ignore", over="ignore", divide="ignore"):
-        model = meas * 10 ** (g.gap[:, idx] / 20)
-        ex = np.sqrt(np.maximum(meas ** 2 - model ** 2, 0.0))
         w = (ex / engine_side) ** 2
     w = np.where(np.isfinite(w), w, 0.0)
     if not np.any(w > 0):
@@ -364,8 +308,8 @@ def body_gap_peak(g: BodyGaps, mount_names, n_bins=32, n_peaks=1):
 
 
 def _body_columns(g: BodyGaps, mount_names) -> dict:
-    """``{channel index: (mount index, axis index, engine-side channel index)}`` of the
-    body-side channels ``NAME/passive`` whose engine side is measured too."""
+    """``{channel: (mount index, axis index, engine-side channel)}`` of the body-side channels
+    whose engine side is measured too."""
     where = {c: i for i, c in enumerate(g.channels)}
     cols = {}
     for c, (m, d) in enumerate(g.channels):
@@ -376,13 +320,9 @@ def _body_columns(g: BodyGaps, mount_names) -> dict:
 
 
 def signed_shape(g: BodyGaps, mount_names, f0=None):
-    r"""Shape (n_mounts, 3) with its signs, normalised to its largest component, from the
-    body side's complex excess (``g.excess``), or None without phase. A missing mode adds
-    :math:`a_{ro}\,\boldsymbol\psi` at speed r and order o (one complex factor, the real
-    shape): ψ is the leading eigenvector of :math:`E^HE` (E: the excess, speeds × orders by
-    bases × directions, unscored points 0), turned real by the phase that makes
-    :math:`\sum_j \psi_j^2` real. With ``f0`` [Hz]: of the points whose order frequency lies
-    within ± :data:`PEAK_WINDOW` of it (None when none does)."""
+    r"""Signed, normalised shape (n_mounts, 3) from the complex excess, or None without phase:
+    the leading eigenvector of :math:`E^HE` turned real (a missing mode adds
+    :math:`a_{ro}\,\boldsymbol\psi`); with ``f0`` [Hz] only points within ± :data:`PEAK_WINDOW`."""
     cols = _body_columns(g, mount_names)
     if g.excess is None or not cols:
         return None
@@ -404,9 +344,7 @@ def signed_shape(g: BodyGaps, mount_names, f0=None):
 
 
 def frequency_grid(g: BodyGaps, mount_names) -> np.ndarray:
-    """Start frequencies [Hz]: steps of :data:`GRID_STEP` over the frequencies of the
-    body-side points scored (with phase: with a complex excess), within
-    :data:`FREQ_RANGE`."""
+    """Start frequencies [Hz] in steps of :data:`GRID_STEP` over the scored body-side points."""
     idx = list(_body_columns(g, mount_names))
     ok = np.isfinite(g.gap[:, idx] if g.excess is None else g.excess[:, idx])
     f = (g.order_hz[:, None, :] * np.ones(ok.shape))[ok]
@@ -418,7 +356,7 @@ def frequency_grid(g: BodyGaps, mount_names) -> np.ndarray:
 
 
 def _shape_near(f, ex, f0, places, n_mounts):
-    """RMS excess of each base and direction within ± PEAK_WINDOW of f0, normalised."""
+    """RMS excess per base and direction within ± PEAK_WINDOW of f0, normalised."""
     near = np.abs(f / f0 - 1) <= PEAK_WINDOW
     shape = np.zeros((n_mounts, 3))
     for j, place in enumerate(places):

@@ -1,19 +1,10 @@
 r"""``mount_stiffness``: each mount's elastomer times its own factor :math:`k_i`.
 
-Temperature, preload and part-to-part spread change the rubber's modulus and, with it, its
-damping; the fluid column of a hydromount and the lumped rubber masses keep their inertia.
-Every spring of the mount's networks is scaled by :math:`k_i`, every damper by
-:math:`k_i^{\gamma}` and every mass kept (:meth:`MountModel.scaled`): the network's dynamic
-stiffness becomes :math:`k_i\mathbf K + i\omega k_i^{\gamma}\mathbf C - \omega^2\mathbf M`,
-so its resonances move by about :math:`\sqrt{k_i}`. The damping exponent :math:`\gamma`
-(one for all mounts) says how the loss factor :math:`\eta \propto k^{\gamma - 1}` follows
-the modulus: 1 keeps it (the thesis' frequency-independent loss factor, the prior's centre),
-below 1 it falls as the rubber stiffens (a filled elastomer warming through its transition:
-both the storage and the loss modulus fall, the loss modulus less). Only a mount whose
-factor differs from 1 carries it, and a Gaussian prior (:data:`DAMPING_EXPONENT_PRIOR`)
-keeps it at 1 where the data do not say (engine-side velocities above the rigid-body
-modes hardly see a mount's damping). One parameter ``k<i>`` per mount of the engine (file
-order) and ``damping_exponent``.
+Temperature, preload and spread change the rubber's modulus and damping: every spring of
+the mount's networks × :math:`k_i`, every damper × :math:`k_i^{\gamma}`, masses kept, so
+resonances move by about :math:`\sqrt{k_i}`. The damping exponent :math:`\gamma` (one for
+all mounts; loss factor :math:`\eta \propto k^{\gamma - 1}`) has a Gaussian prior about 1,
+the thesis' constant loss factor (:data:`DAMPING_EXPONENT_PRIOR`).
 """
 
 from __future__ import annotations
@@ -24,24 +15,20 @@ from powertrain.effects.base import Effect, Parameter, mount_labels
 
 #: Bounds of the damping exponent γ (dampers × k^γ) [1].
 DAMPING_EXPONENT_RANGE = (0.0, 2.0)
-#: Prior 1σ of γ about 1 (constant loss factor) [1]: measured filled elastomers put the
-#: loss modulus' exponent against the storage modulus' at roughly 0.5-1 over a temperature
-#: or preload change, so 0.5 lets the data move it there and keeps it at 1 otherwise.
+#: Prior 1σ of γ about 1 (constant loss factor) [1].
 DAMPING_EXPONENT_PRIOR = 0.5
 
 
 def damping_exponent_parameter(factor: str) -> Parameter:
-    """The elastomer effects' ``damping_exponent`` γ: dampers × ``factor``^γ (one place for
-    its bounds and prior; ``mount_stiffness`` and ``amplitude_stiffness`` share it)."""
+    """The elastomer effects' ``damping_exponent`` γ: dampers × ``factor``^γ."""
     return Parameter("damping_exponent", "1", *DAMPING_EXPONENT_RANGE, 1.0, False,
                      f"exponent γ of the dampers' factor {factor}^γ (1: constant loss factor)",
                      DAMPING_EXPONENT_PRIOR)
 
 
 def with_mount_stiffness(engine, *k, damping_exponent=1.0, **named):
-    """Mount i's springs times ``k<i>`` [1] and its dampers times ``k<i> **
-    damping_exponent`` (i = 1..n in engine-file order; positional factors or ``k1=...``),
-    all three directions alike; missing factors 1 (:class:`MountStiffness`'s change)."""
+    """Mount i's springs times ``k<i>`` [1] and dampers times ``k<i> ** damping_exponent``
+    (positional or ``k1=...`` in file order; missing ones 1)."""
     f = [float(x) for x in k] + [1.0] * len(engine.mounts)
     for key, v in named.items():
         f[int(key[1:]) - 1] = float(v)
@@ -69,8 +56,7 @@ class MountStiffness(Effect):
         return factors + ((1.0,),)                 # γ starts at its prior's centre
 
     def alternatives(self, params, engine=None):
-        """The factors of two mounts swapped (mirror-image mounts can give the same
-        magnitudes), for every pair whose factors differ."""
+        """The factors of every differing pair of mounts swapped (mirror-image mounts)."""
         names = mount_labels(engine)
         k = [params.get(f"k{i + 1}", 1.0) for i in range(len(names))]
         out = []

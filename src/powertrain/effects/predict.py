@@ -1,21 +1,12 @@
 r"""The fast cached path: channel velocities of a scenario on one
 :class:`~powertrain.solvers.fast_harmonic.HarmonicModel`, many parameter sets.
 
-Each effect of the scenario contributes through its hooks (:class:`Effect`): elastomer
-scales change the networks' two-ports (condensed by the one kernel,
-:func:`powertrain.kernels.two_port.two_port_kernel`), the effects' two-port changes follow,
-load changes add (:meth:`Effect.load_terms`; where the load alone changes, as weighted sums
-of the velocities of fixed load parts), sensor readings come last. Nonlinear mount elements
-(an amplitude law or a port law, the engine's own or an effect's, :meth:`Effect.elements`)
-act through :meth:`MountElement.two_port
-<powertrain.physics.mount_elements.MountElement.two_port>` at
-the amplitudes of the relative displacement across them, iterated to consistency at all
-speeds at once (:func:`amplitude_iteration`) — the physics of the run-up's harmonic fixed
-point (:mod:`powertrain.solvers.equivalent_linear`). Every effect that changes the engine
-model predicts what its ``apply()`` runs, to round-off (tests/test_diagnosis_physics.py).
-A linear scenario solves only the ``orders`` asked for; one body mode added to the nominal
-model (a missing mode alone) is the nominal system's bordered extension, solved without a
-new solve (:meth:`HarmonicModel.solve_one_more_mode`).
+Each effect contributes through its hooks (:class:`Effect`): elastomer scales and two-port
+changes, load changes (weighted sums of the velocities of fixed load parts), sensor readings
+last. Nonlinear mount elements act at the amplitudes of the relative displacement across
+them, iterated to consistency at all speeds at once (:func:`amplitude_iteration`, the
+run-up's harmonic fixed point, :mod:`powertrain.solvers.equivalent_linear`). Every effect
+that changes the engine model predicts what its ``apply()`` runs, to round-off.
 """
 
 from __future__ import annotations
@@ -29,9 +20,7 @@ from powertrain.physics.mount_network import PackedNetworks
 from powertrain.solvers.equivalent_linear import fixed_point
 from powertrain.solvers.fast_harmonic import HarmonicModel
 
-#: Amplitude fixed point: relative change of every speed's amplitudes at convergence (the
-#: run-up's :func:`powertrain.solvers.equivalent_linear.fixed_point`, looser: the fit's
-#: residuals are compared at ~1e-3).
+#: Amplitude fixed point: relative change of every speed's amplitudes at convergence.
 TOLERANCE = 1e-6
 
 
@@ -46,10 +35,9 @@ class Prediction:
     iterations : int
         Fixed-point iterations of the nonlinear elements (0 if none).
     amplitudes : ndarray (n_r, n_net) or None
-        Relative-displacement amplitudes of the networks at convergence [m] (None: every
-        element linear).
+        Relative-displacement amplitudes of the networks [m] (None: all linear).
     elements : list or None
-        The networks' mount elements the prediction used (None: every element linear).
+        The networks' mount elements used (None: all linear).
     """
 
     velocity: np.ndarray
@@ -68,14 +56,13 @@ def _filled(hm, scenario):
 
 
 def _two_ports(sc, hm, abc):
-    """The networks' two-ports with every effect's change."""
     for eff, p in sc.values():
         abc = eff.two_port(hm, abc, p)
     return abc
 
 
 def _body(hm, sc):
-    """The modal body under the mounts with the effects' changes (None: no body)."""
+    """The modal body with the effects' changes (None: no body)."""
     body = getattr(hm, "body", None)
     if body is None:
         return None
@@ -85,7 +72,6 @@ def _body(hm, sc):
 
 
 def _load(hm, sc):
-    """The load harmonics with every effect's change."""
     load = hm.load
     for eff, p in sc.values():
         d = eff.load_delta(hm, p)
@@ -95,9 +81,7 @@ def _load(hm, sc):
 
 
 def _load_velocity(hm, sc):
-    """Channel velocities of the nominal model under the load with every effect's change:
-    the nominal load's velocities plus the effects' weighted load parts' (each part solved
-    once, :meth:`HarmonicModel.load_velocity`)."""
+    """Nominal model's channel velocities under the changed load (each load part solved once)."""
     v = hm.load_velocity("nominal load", hm.load[None])[0]
     for eff, p in sc.values():
         terms = eff.load_terms(hm, p)
@@ -107,10 +91,8 @@ def _load_velocity(hm, sc):
 
 
 def _elements(hm, sc, s_el):
-    """The networks' mount elements with the elastomer scales ``s_el`` (spring and damper
-    factors) and the effects' changes; None when every one is linear (the cached two-ports
-    serve). The scales keep every element's laws, so linearity is told before any element
-    is scaled."""
+    """The networks' mount elements with the elastomer scales ``s_el`` and the effects'
+    changes; None when every one is linear."""
     probe = list(hm.elements)
     for eff, p in sc.values():
         probe = eff.elements(hm, probe, p)
@@ -126,13 +108,9 @@ def _elements(hm, sc, s_el):
 
 
 def amplitude_iteration(hm, sc, els, load, body, *, tol=TOLERANCE, start=None):
-    """The nonlinear elements' fixed point at every speed at once
-    (:func:`powertrain.solvers.equivalent_linear.fixed_point`, the run-up's), ``g`` the
-    amplitudes of :meth:`HarmonicModel.relative_amplitude`.
-
-    Returns ``(two-ports with the effects, rigid-body amplitudes q, A (n_r, n_net),
-    iterations)``; raises ``AmplitudeNotConverged`` (a ``FloatingPointError``) naming the
-    mount direction and speed when it does not converge."""
+    """The nonlinear elements' amplitude fixed point at every speed at once, from ``start``
+    [m]: ``(two-ports, rigid-body amplitudes q, A (n_r, n_net) [m], iterations)``; raises
+    ``AmplitudeNotConverged`` (a ``FloatingPointError``) without convergence."""
     nl = np.array([el.nonlinear for el in els])
     base = np.zeros((hm.rpm.size, len(els)))
     if start is not None and np.shape(start) == base.shape:
@@ -156,9 +134,7 @@ def amplitude_iteration(hm, sc, els, load, body, *, tol=TOLERANCE, start=None):
 
 
 def _linear_velocity(hm, abc, load, body, orders):
-    """Channel velocities (n_r, n_ch, 16) of the linear model with the two-ports ``abc``,
-    the load ``load`` and the body ``body``, solved at the ``orders`` only (zero at the
-    others; None: all)."""
+    """Channel velocities (n_r, n_ch, 16) of the linear model, solved at ``orders`` only."""
     h = slice(1, None) if orders is None else np.asarray(orders, int) + 1
     if (body is not None and body is not hm.body and abc is hm.two_ports()
             and load is hm.load and body.adds_one_mode_to(hm.body)):
@@ -185,14 +161,10 @@ def predict(hm: HarmonicModel, scenario: dict, *, tol=TOLERANCE,
     tol : float
         Convergence of the nonlinear elements' amplitudes (relative).
     warm_amplitudes : ndarray (n_r, n_net), optional
-        Start of the amplitude fixed point (a nearby scenario's converged ``amplitudes``: a
-        fit's finite-difference steps then converge in a few iterations instead of ten to
-        twenty); the result agrees with a cold start to ``tol``.
+        Start of the amplitude fixed point [m]; the result agrees with a cold start to ``tol``.
     orders : array_like of int, optional
-        Indices (0..15, orders 0.5..8) of the velocities wanted: where every element is
-        linear, only their harmonics are solved (the other velocities are zero; a fit that
-        scores some orders solves only those). None: all. The nonlinear elements' fixed
-        point needs every harmonic (the amplitudes sum over them) and solves them all.
+        Indices (0..15, orders 0.5..8) wanted; with linear elements only those are solved
+        (the others zero). None: all.
     """
     sc = _filled(hm, scenario)
     s_el = None

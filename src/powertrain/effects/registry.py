@@ -1,6 +1,5 @@
-"""The one registry of effects: the CLI (``--effect``, ``--effects``), ``synth``, ``whatif`` and
-the diagnosis all read :data:`EFFECTS`. Adding an effect: a module with its class, and one
-entry in :data:`EFFECT_CLASSES` (docs/extending.md, "How to add an effect")."""
+"""The registry of effects read by the CLI, ``synth``, ``whatif`` and the diagnosis; adding an
+effect is one entry in :data:`EFFECT_CLASSES` (docs/extending.md)."""
 
 from __future__ import annotations
 
@@ -25,13 +24,9 @@ RESPONSE_EFFECTS = tuple(n for n, e in EFFECTS.items() if not e.engine_change)
 
 
 def check_scenario(scenario: dict, engine=None) -> dict:
-    """Validate ``{effect: {parameter: value}}``: known names, values inside the bounds.
-
-    Parameters are those the effect generates for ``engine`` (default layout without one).
-    Returns the scenario with every parameter filled in (defaults); raises ``KeyError``
-    (unknown effect or parameter) or ``ValueError`` (value outside its bounds, not finite)
-    with a one-line message.
-    """
+    """Validate ``{effect: {parameter: value}}`` (SI) against the parameters the effects
+    generate for ``engine`` and fill in the defaults; raises ``KeyError`` (unknown effect or
+    parameter) or ``ValueError`` (value outside its bounds or not finite)."""
     out = {}
     for name, params in scenario.items():
         if name not in EFFECTS:

@@ -2,13 +2,10 @@ r"""``sensor_error``: each channel's sensor reads a gain error, each triad a sma
 and cross-axis sensitivity.
 
 Channel c of triad m reads :math:`10^{G_c/20}\,[(\mathbf R(\boldsymbol\varphi_m) +
-\mathbf S_m)\mathbf v_m]_c`: the triad's axes are rotated by :math:`\boldsymbol\varphi_m`
-(Rodrigues) from the engine axes, :math:`\mathbf S_m` is a symmetric matrix with zero
-diagonal (transverse sensitivity: an accelerometer axis also feels the other two axes, a
-few percent by datasheet, typically ≤ 5 %), then each axis has its own gain. Rotation
-(antisymmetric) and cross-axis (symmetric) together make any small off-diagonal triad
-matrix. One gain ``g<c>`` per channel, a rotation ``r<m><axis>`` and three cross-axis terms
-``s<m>xy``, ``s<m>xz``, ``s<m>yz`` per mount triad, generated from the engine's mounts.
+\mathbf S_m)\mathbf v_m]_c`: the triad rotated by :math:`\boldsymbol\varphi_m` (Rodrigues),
+:math:`\mathbf S_m` symmetric with zero diagonal (transverse sensitivity, typically ≤ 5 % by
+datasheet). Parameters: a gain ``g<c>`` per channel, a rotation ``r<m><axis>`` and cross-axis
+terms ``s<m>xy``, ``s<m>xz``, ``s<m>yz`` per mount triad.
 """
 
 from __future__ import annotations
@@ -19,11 +16,9 @@ from powertrain.effects.base import Effect, Parameter, mount_labels
 
 #: Pairs of triad axes with a cross-axis sensitivity parameter.
 CROSS_AXES = ("xy", "xz", "yz")
-#: Bound of a cross-axis sensitivity [1]: accelerometer datasheets give ≤ 5 % transverse
-#: sensitivity; 8 % leaves room for the mounting.
+#: Bound of a cross-axis sensitivity [1] (datasheets ≤ 5 %, plus the mounting).
 CROSS_AXIS_MAX = 0.08
-#: Prior standard deviations (maximum a posteriori fit): a triad glued by hand is within a
-#: few degrees [rad]; transverse sensitivity is typically 1–3 % [1].
+#: Prior standard deviations of a rotation [rad] and of a cross-axis term [1].
 ROTATION_PRIOR = 0.1
 #: Rotation of the block-wise multi-start's extra starts [rad] (about 6°).
 ROTATION_START = 0.1
@@ -66,9 +61,6 @@ def sensor_reading(velocity, gain_db, rotation, cross_axis=None):
         Rotation vector of each triad [rad].
     cross_axis : ndarray (..., n_m, 3), optional
         Cross-axis sensitivities (xy, xz, yz) of each triad [1] (default none).
-
-    Leading axes (``...``, e.g. a Jacobian's columns) broadcast: each reading is the same
-    as that of its parameters alone.
     """
     v = np.asarray(velocity)
     gain_db = np.asarray(gain_db, float)
@@ -87,8 +79,7 @@ def sensor_reading(velocity, gain_db, rotation, cross_axis=None):
 
 
 def _sensor_arrays(params: dict, n_ch: int):
-    """``(gains (3 n_m,), rotations (n_m, 3), cross-axis (n_m, 3))`` of a parameter dict
-    (missing ones 0)."""
+    """``(gains (3 n_m,), rotations (n_m, 3), cross-axis (n_m, 3))``, missing ones 0."""
     gains = np.array([params.get(f"g{c + 1}", 0.0) for c in range(n_ch)])
     rot = np.array([[params.get(f"r{m + 1}{ax}", 0.0) for ax in "xyz"]
                     for m in range(n_ch // 3)])
@@ -128,11 +119,8 @@ class SensorError(Effect):
         return gains + rots + cross
 
     def separable_groups(self, engine=None):
-        """One block per triad (its 3 gains, rotation and cross-axis terms act on its 3
-        channels only), started at no rotation and at :data:`ROTATION_START` about each
-        of the 6 axis and 8 diagonal directions (until one fits within the scatter): a gain
-        error and a rotation that leaks a strong axis into a weak one look
-        alike locally, so a start at zero rotation alone can settle on a large false gain."""
+        """One block per triad, started at no rotation and at :data:`ROTATION_START` about 6
+        axis and 8 diagonal directions (a gain error and a leaking rotation look alike)."""
         out = []
         for m, _ in enumerate(mount_labels(engine)):
             names = ([f"g{3 * m + a + 1}" for a in range(3)]

@@ -1,11 +1,9 @@
 r"""The vehicle body (chassis) the mounts stand on: rigid, modal or measured receptances.
 
-``rigid`` (the mounts' body side does not move, the thesis's set-up), ``modal`` (body modes
-shared by the attachment points, each a single-DOF oscillator in its modal coordinate;
-receptance :math:`\mathbf H_{PQ}(\omega) = \sum_k \boldsymbol\psi_k(P)\boldsymbol\psi_k(Q)^T /
+``rigid`` (body side still), ``modal`` (body modes, receptance
+:math:`\mathbf H_{PQ}(\omega) = \sum_k \boldsymbol\psi_k(P)\boldsymbol\psi_k(Q)^T /
 \big(m_k(\omega_k^2 - \omega^2 + 2i\zeta_k\omega_k\omega)\big)`) or ``frf`` (measured
-receptances, coupled by admittance); ``docs/guide/chassis.md`` describes them. Body points of
-interest (``[chassis.points.NAME]``: seat rail, steering wheel) carry no load.
+receptances, coupled by admittance); ``docs/guide/chassis.md``. Body points carry no load.
 """
 
 from __future__ import annotations
@@ -34,11 +32,8 @@ class BodyMode:
 
 @dataclass(frozen=True, eq=False)
 class MeasuredReceptance:
-    """Measured receptances [m/N] on a frequency grid [Hz].
-
-    ``values[(resp, rdir, exc, edir)]`` is a complex array over ``frequency_hz``; names are
-    mounts (their body-side attachment points) or body points, directions engine x/y/z.
-    """
+    """Measured receptances [m/N]: ``values[(resp, rdir, exc, edir)]`` complex over
+    ``frequency_hz`` [Hz]; names are mounts or body points, directions engine x/y/z."""
 
     frequency_hz: np.ndarray
     values: dict
@@ -64,14 +59,13 @@ class MeasuredReceptance:
 
 @dataclass(frozen=True, eq=False)
 class Chassis:
-    """The body under the mounts; ``Chassis(model=...)`` makes the class of that model
-    (:class:`RigidChassis`, :class:`ModalChassis`, :class:`MeasuredChassis`), which owns the
-    body's assembly rows, its coupling to the mounts and its receptances.
+    """The body under the mounts; ``Chassis(model=...)`` makes :class:`RigidChassis`,
+    :class:`ModalChassis` or :class:`MeasuredChassis`.
 
     Attributes
     ----------
     model : str
-        ``rigid``, ``modal`` or ``frf`` (the file's name of the class).
+        ``rigid``, ``modal`` or ``frf``.
     modes : tuple of BodyMode
         ``modal`` only.
     points : tuple of str
@@ -87,9 +81,8 @@ class Chassis:
     file: str = ""
     notes: dict = field(default_factory=dict)
 
-    #: the mounts' body side does not move
     is_rigid = False
-    #: coupled to the powertrain by its receptances in the frequency domain only
+    #: coupled by its receptances in the frequency domain only
     coupled_by_admittance = False
 
     def __new__(cls, model="rigid", *args, **kwargs):
@@ -116,8 +109,7 @@ class Chassis:
         """Raise InputError when the body cannot be integrated in time."""
 
     def receptances(self, omegas, responses, excitations) -> np.ndarray:
-        """Receptance matrices (n_omega, 3 n_resp, 3 n_exc) [m/N] at every ``omegas``
-        [rad/s]."""
+        """Receptance matrices (n_omega, 3 n_resp, 3 n_exc) [m/N] at ``omegas`` [rad/s]."""
         omegas = np.asarray(omegas, float).ravel()
         return np.array([self.receptance_at(w, responses, excitations) for w in omegas])
 
@@ -127,14 +119,13 @@ class Chassis:
 
 
 class RigidChassis(Chassis):
-    """The mounts stand on the rigid ground (the thesis's set-up)."""
+    """The mounts stand on rigid ground."""
 
     is_rigid = True
 
 
 class ModalChassis(Chassis):
-    """Body modes shared by the mount attachment points; they become coordinates of the
-    assembled model."""
+    """Body modes, coordinates of the assembled model."""
 
     @property
     def body_modes(self) -> tuple:
@@ -159,8 +150,7 @@ class ModalChassis(Chassis):
 
 
 class MeasuredChassis(Chassis):
-    """Measured receptances between the attachment points (and to the body points), coupled
-    by admittance in the frequency domain."""
+    """Measured receptances, coupled by admittance in the frequency domain."""
 
     coupled_by_admittance = True
 

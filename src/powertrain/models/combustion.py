@@ -1,8 +1,7 @@
 """Combustion models of an engine: the single-zone pressure model and measured traces.
 
-Each model gives the pressure of every cylinder over an engine cycle at a speed
-(``cycle_pressures``) and the speeds it covers (``speed_range``); thin objects over
-:mod:`powertrain.physics.combustion` (SI).
+Each gives every cylinder's pressure over a cycle at a speed (``cycle_pressures``) and its
+speed range (``speed_range``), over :mod:`powertrain.physics.combustion` (SI).
 """
 
 from __future__ import annotations
@@ -40,10 +39,8 @@ class FullLoadCurve:
     fmep: np.ndarray
 
     def imep(self, omega: float, displacement: float, load: float = 1.0) -> float:
-        r"""Net IMEP [Pa] at ``omega`` [rad/s] for ``load`` × full-load torque.
-
-        .. math:: \mathrm{IMEP} = \frac{4\pi\,T_b}{V_D} + \mathrm{FMEP}
-        """
+        r"""Net IMEP :math:`4\pi T_b/V_D + \mathrm{FMEP}` [Pa] at ``omega`` [rad/s] for ``load``
+        × full-load torque."""
         tb = load * np.interp(omega, self.speed, self.torque)
         return float(4.0 * np.pi * tb / displacement + self.fmep_at(omega))
 
@@ -78,9 +75,7 @@ class SingleZoneCombustion:
     intake_temperature: float
     grid_points: int = 5760
     model: str = "single-zone"
-    #: the cycle grid and pressure basis of the last crank train (:meth:`cycle_basis`)
     _memo: Memo = field(default_factory=Memo, init=False, repr=False, compare=False)
-    #: engine-file key of the speed range (named in an out-of-range error)
     speed_key = "combustion.full_load.speed"
 
     def with_cylinder_factors(self, factors) -> SingleZoneCombustion:
@@ -120,9 +115,7 @@ class SingleZoneCombustion:
                                  "p_exhaust": p_ex}
 
     def motored_pressures(self, crank: CrankTrain, omega: float, intake_pressure=None):
-        """Pressure of every cylinder on the cycle grid without burn: compression and
-        expansion from ``intake_pressure`` [Pa] (default the ambient pressure: an unthrottled
-        crank), as :meth:`cycle_pressures` with the heat 0."""
+        """:meth:`cycle_pressures` without burn, from ``intake_pressure`` [Pa] (default ambient)."""
         theta, _, _, (b_in, b_ex, _) = self.cycle_basis(crank)
         p_in = self.ambient_pressure if intake_pressure is None else float(intake_pressure)
         p_ex = max(self.ambient_pressure, self.exhaust_pressure_ratio * p_in)
@@ -133,10 +126,8 @@ class SingleZoneCombustion:
                                  "p_exhaust": p_ex}
 
     def cycle_basis(self, crank: CrankTrain):
-        """The cycle grid ``theta`` [rad], volume ``V`` [m³], ``dV/dtheta`` [m³/rad] and
-        pressure basis (:func:`powertrain.physics.combustion.pressure_basis`) of ``crank``,
-        which do not depend on the speed: kept in the model's memo with the crank train
-        they belong to (read-only arrays, shared by every call)."""
+        """Speed-independent cycle grid ``theta`` [rad], ``V`` [m³], ``dV/dtheta`` [m³/rad] and
+        :func:`~powertrain.physics.combustion.pressure_basis` of ``crank`` (memoised, read-only)."""
         kept = self._memo.get("cycle basis")
         if kept is not None and kept[0] is crank:
             return kept[1]
@@ -184,10 +175,7 @@ class MeasuredPressure:
     speed_key = "combustion.traces"
 
     def cycle_pressures(self, crank: CrankTrain, omega: float, load: float = 1.0):
-        """Pressure of every cylinder on the grid, linearly interpolated in speed.
-
-        ``load`` must be 1 (traces are what they are).
-        """
+        """Pressure of every cylinder on the grid, linear in speed; ``load`` must be 1."""
         if load != 1.0:
             raise InputError("measured pressure traces cannot be scaled to another load",
                              file=self.file, key="load")
@@ -209,7 +197,7 @@ class MeasuredPressure:
                                "p_intake": float("nan"), "p_exhaust": float("nan")}
 
     def friction_mean_effective_pressure(self, omega: float) -> float:
-        """0: measured traces give no FMEP (their brake torque is the indicated one)."""
+        """0: measured traces give no FMEP."""
         return 0.0
 
     def speed_range(self):
@@ -217,8 +205,7 @@ class MeasuredPressure:
 
 
 class _OnBase:
-    """A combustion model run another way: its kind, speed key and speed range are its
-    base model's."""
+    """A combustion model run another way, with its base model's kind, speed key and range."""
 
     @property
     def model(self):
@@ -234,8 +221,7 @@ class _OnBase:
 
 @dataclass(frozen=True, eq=False)
 class LoadedCombustion(_OnBase):
-    """A combustion model run at ``load`` times its nominal load (the IMEP scale of the model:
-    for the single-zone model the fraction of full-load torque; a plan's part-load run)."""
+    """A combustion model run at ``load`` times its nominal load (IMEP scale)."""
 
     base: object
     load: float
@@ -259,9 +245,7 @@ class LoadedCombustion(_OnBase):
 
 @dataclass(frozen=True, eq=False)
 class MotoredCombustion(_OnBase):
-    """The cycle of a combustion model without burn (a crank turned by the starter or
-    coasting with the fuel cut) from the intake pressure ``intake_pressure`` [Pa] (None:
-    the model's default): its ``motored_pressures``, its friction."""
+    """A combustion model's cycle without burn from ``intake_pressure`` [Pa] (None: default)."""
 
     base: object
     intake_pressure: float | None = None

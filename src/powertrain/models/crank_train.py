@@ -1,8 +1,5 @@
-"""The crank train and the balancer shafts of an engine (SI, engine axes).
-
-Thin objects over :mod:`powertrain.physics.slider_crank`; see :mod:`powertrain.models.engine`
-for the axes and the load they put on the powertrain.
-"""
+"""The crank train and the balancer shafts of an engine (SI, engine axes;
+:mod:`powertrain.models.engine`)."""
 
 from __future__ import annotations
 
@@ -25,17 +22,16 @@ class CrankTrain:
     compression_ratio : float
         Geometric compression ratio [-].
     cylinder_x : ndarray
-        Position of each cylinder along the crank axis (engine X) [m], cylinder 1 first.
+        Each cylinder's position along the crank axis (engine X) [m], cylinder 1 first.
     cylinder_axis : ndarray, shape (3,)
-        Unit vector :math:`\\mathbf u` of the cylinder axis (crank axis to head), engine axes.
+        Unit vector :math:`\\mathbf u` of the cylinder axis (crank axis to head).
     rotation_sign : int
         +1: the crank turns positively about +X, −1: about −X.
-    crank_pin_angles : ndarray
-        Cylinder-1 crank angle at which each cylinder is at a top dead centre [rad].
+    crank_pin_angles, firing_angles : ndarray
+        Cylinder-1 crank angle at each cylinder's TDC, and at its firing TDC on ``[0, 4π)``
+        [rad].
     firing_order : tuple of int
         Cylinder numbers (1-based), starting with 1.
-    firing_angles : ndarray
-        Cylinder-1 crank angle of each cylinder's firing TDC on ``[0, 4π)`` [rad].
     reciprocating_mass, rotating_mass : float
         Per cylinder [kg].
     counterweight_fraction : float
@@ -59,7 +55,6 @@ class CrankTrain:
     rotating_mass: float
     counterweight_fraction: float
     crankcase_pressure: float
-    #: the last crank-angle grid's volumes (:meth:`volume`)
     _memo: Memo = field(default_factory=Memo, init=False, repr=False, compare=False)
 
     @property
@@ -68,9 +63,8 @@ class CrankTrain:
 
     @property
     def firing_interval(self) -> float:
-        """Crank angle over which the gas torque repeats [rad]: the least 4π / k whose
-        shift maps the firing angles onto themselves (4π / n with n cylinders firing at
-        even intervals; 240° for a V6 firing at 90° and 150°; else the cycle's 4π)."""
+        """Crank angle over which the gas torque repeats [rad]: the least 4π / k whose shift
+        maps the firing angles onto themselves (4π if none)."""
         angles = np.sort(np.mod(self.firing_angles, 4 * np.pi))
         for k in range(self.n_cylinders, 1, -1):
             if self.n_cylinders % k == 0:
@@ -107,10 +101,7 @@ class CrankTrain:
         return self.rotation_sign * np.cross([1.0, 0.0, 0.0], self.cylinder_axis)
 
     def volume(self, theta):
-        """Cylinder volume [m³] and dV/dθ [m³/rad] at crank angle ``theta`` [rad].
-
-        The last grid's result is kept in the crank train's memo (read-only arrays): the
-        combustion models ask for the same cycle grid at every speed and cylinder."""
+        """Cylinder volume [m³] and dV/dθ [m³/rad] at ``theta`` [rad] (last grid memoised)."""
         return self._memo.last_grid("volume", theta, lambda th: sc.cylinder_volume(
             th, self.bore, self.crank_radius, self.rod_length, self.pin_offset,
             self.compression_ratio))
@@ -128,8 +119,7 @@ class BalancerShaft:
     position : ndarray, shape (3,)
         A point of the shaft axis at the unbalance's plane, engine axes [m].
     phase : float
-        Angle of the unbalance at cylinder-1 TDC from :math:`\\mathbf u` towards
-        :math:`\\mathbf s` [rad].
+        Unbalance angle at cylinder-1 TDC from :math:`\\mathbf u` towards :math:`\\mathbf s` [rad].
     sense : int
         +1 turns with the crank, −1 against it.
     """

@@ -1,20 +1,12 @@
 r"""The engine model: crank train, rigid powertrain body, mounts, balancer shafts, combustion.
 
-Thin objects over :mod:`powertrain.physics.slider_crank`, :mod:`~powertrain.physics.combustion`
-and :mod:`~powertrain.physics.balancer`. Everything is SI, in engine axes (Kovarik 2016,
-sec. 4.1): origin at the centre of the 3rd main bearing, X along the crank axis (opposite to
-the vehicle's ISO 8855 X, i.e. rearwards for the longitudinal engine), Y opposite to the
-vehicle's Y (to the right), Z up.
-
-**Load on the powertrain** (:meth:`Engine.generalized_load`, ``docs/guide/excitation.md``):
-the powertrain is one rigid body containing the moving parts. Per cylinder, at its own
-position along X, the forces of :func:`powertrain.physics.slider_crank.crank_forces` on the
-block (gas on the head, side thrust with the pin-offset couple, main-bearing reaction: their
-sum is the shaking force plus the torque reaction :math:`-T`, its mean included), plus the residual
-rotating-mass force :math:`(1-k_{cw})\,m_{rot}\,r\omega^2(\cos\theta_i\,\mathbf u
-+ \sin\theta_i\,\mathbf s)` on the crank axis (the counterweights balance the fraction
-:math:`k_{cw}` of each throw's own rotating mass, default 1), and the balancer-shaft forces
-at the shaft positions. Moments are taken about the powertrain's centre of gravity.
+Everything is SI, in engine axes (Kovarik 2016, sec. 4.1): origin at the centre of the 3rd
+main bearing, X along the crank axis (opposite to the vehicle's ISO 8855 X), Y to the right,
+Z up. The load on the rigid powertrain (:meth:`Engine.generalized_load`,
+``docs/guide/excitation.md``) is, per cylinder at its X, the block forces of
+:func:`powertrain.physics.slider_crank.crank_forces`, the residual rotating-mass force
+:math:`(1-k_{cw})\,m_{rot}\,r\omega^2(\cos\theta_i\,\mathbf u + \sin\theta_i\,\mathbf s)`
+on the crank axis, and the balancer-shaft forces, with moments about the CG.
 """
 
 from __future__ import annotations
@@ -48,8 +40,7 @@ class RigidBody:
     cg : ndarray, shape (3,)
         Centre of gravity in engine axes [m].
     inertia : ndarray, shape (3, 3)
-        Inertia tensor about the CG in engine axes [kg·m²]; off-diagonal entries are the
-        tensor entries :math:`I_{xy} = -\\int xy\\,dm`.
+        Inertia tensor about the CG in engine axes [kg·m²] (:math:`I_{xy} = -\\int xy\\,dm`).
     """
 
     mass: float
@@ -63,13 +54,13 @@ class MountSpec:
     Attributes
     ----------
     name : str
-        Any name (e.g. ``left``, ``right``, ``gearbox``, ``torque_rod``).
+        Any name (e.g. ``left``, ``torque_rod``).
     position : ndarray, shape (3,)
         Engine-side mount point (measurement point) in engine axes [m].
     rotation : ndarray, shape (3, 3)
-        Columns are the mount's local x, y, z axes expressed in engine axes.
+        Columns are the mount's local x, y, z axes in engine axes.
     directions : dict of str to MountModel
-        ``{"x": ..., "y": ..., "z": ...}``: the mount model along each local axis.
+        The mount model along each local axis ``x``, ``y``, ``z``.
     files : dict of str to str
         Mount file of each direction.
     """
@@ -116,9 +107,8 @@ class Excitation:
     info: dict
 
     def order_spectrum(self, max_order: float = 8.0):
-        """Orders and complex amplitudes of the load over one engine cycle.
-
-        Requires the crank angles to be an equally spaced sampling of ``[0, 4π)``.
+        """Orders and complex amplitudes of the load; the crank angles must sample
+        ``[0, 4π)`` equally spaced.
 
         Returns
         -------
@@ -140,21 +130,20 @@ class Engine:
     ----------
     name : str
     crank : CrankTrain or None
-        None: the engine file has no ``[crank_train]`` (no excitation; ``modes`` only).
+        None without ``[crank_train]`` (no excitation).
     body : RigidBody
     mounts : list of MountSpec
         Any number (>= 3) of mounts, in file order.
     balancer : Balancer
     combustion : SingleZoneCombustion or MeasuredPressure or None
-        None: the engine file has no ``[combustion]`` (no excitation).
+        None without ``[combustion]`` (no excitation).
     file : str
         Engine file it was read from ("" if built in code).
     chassis : Chassis or None
         The body under the mounts (:mod:`powertrain.models.chassis`); None = rigid.
     gear_ratio : float
-        Gear ratio :math:`i` of the run (``[drive] gear_ratio``; 1 = the engine alone): it
-        multiplies the mean drive-torque reaction of the operating point
-        (:mod:`powertrain.solvers.operating_point`), not the order excitation.
+        Gear ratio of the run (``[drive] gear_ratio``) on the mean drive-torque reaction of
+        the operating point, not on the order excitation [-].
     """
 
     name: str
@@ -166,17 +155,15 @@ class Engine:
     file: str = ""
     chassis: object = None
     gear_ratio: float = 1.0
-    #: cycle pressures per speed and load, the last crank-angle grid's load patterns
     _cache: Memo = field(default_factory=Memo, init=False, repr=False, compare=False)
 
-    # ------------------------------------------------------------------ copies
     def replace(self, **changes) -> Engine:
         """A copy with fields replaced (``dataclasses.replace``; its memo starts empty)."""
         return dataclasses.replace(self, **changes)
 
     def with_balancers(self, enabled: bool = True, mass_radius: float | None = None) -> Engine:
-        """A copy with the balancer shafts switched on or off (and optionally every shaft's
-        unbalance set to ``mass_radius`` [kg·m])."""
+        """A copy with the balancer shafts on or off (and every shaft's unbalance
+        ``mass_radius`` [kg·m] when given)."""
         shafts = self.balancer.shafts
         if mass_radius is not None:
             shafts = tuple(dataclasses.replace(s, mass_radius=float(mass_radius)) for s in shafts)
@@ -192,16 +179,14 @@ class Engine:
                                                            imep_factors=factors))
 
     def at_load(self, load: float) -> Engine:
-        """A copy whose combustion runs at ``load`` times its nominal load (IMEP scale;
-        :class:`~powertrain.models.combustion.LoadedCombustion`). Load 1 returns ``self``."""
+        """A copy at ``load`` times the nominal load (IMEP scale); load 1 returns ``self``."""
         if float(load) == 1.0:
             return self
         return self.replace(combustion=LoadedCombustion(self.combustion, float(load)))
 
     def motored(self, intake_pressure=None) -> Engine:
-        """A copy whose cylinders run without burn from ``intake_pressure`` [Pa] (None: the
-        combustion model's default; :class:`MotoredCombustion`), kept in this one's memo;
-        its own starts with this one's load patterns (they depend on the geometry only)."""
+        """A copy (memoised) whose cylinders run without burn from ``intake_pressure`` [Pa]
+        (None: the model's default); it shares this one's geometry-only load patterns."""
         if (key := ("motored", intake_pressure)) not in self._cache:
             out = self.replace(combustion=MotoredCombustion(self.combustion, intake_pressure))
             if "load patterns" in self._cache:
@@ -221,9 +206,8 @@ class Engine:
         raise KeyError(name)
 
     def mount_section(self, element: str):
-        """``(file, key)`` of the mount direction ``element`` (``"left.y"``): its mount file
-        and the section of its amplitude law (``amplitude``) or else its friction element
-        (``friction``); the engine file and ``engine`` where unknown (an effect's)."""
+        """``(file, key)`` of the mount direction ``element`` (``"left.y"``): its mount file and
+        ``amplitude`` or ``friction``; the engine file and ``engine`` where unknown."""
         name, _, direction = element.rpartition(".")
         try:
             mount = self.mount(name)
@@ -234,10 +218,8 @@ class Engine:
         key = "amplitude" if law is not None and not law.constant else "friction"
         return mount.files.get(direction, self.file), key
 
-    # ------------------------------------------------------------------ pressure
     def require_excitation(self):
-        """Raise :class:`~powertrain.errors.InputError` naming the missing section when the
-        engine file describes no excitation."""
+        """Raise :class:`~powertrain.errors.InputError` when the excitation is missing."""
         for section, value in (("crank_train", self.crank), ("combustion", self.combustion)):
             if value is None:
                 raise InputError(f"missing section [{section}]: this command needs the "
@@ -270,9 +252,8 @@ class Engine:
         return kept[key]
 
     def cylinder_pressure(self, rpm: float, crank_angle_rad, load: float = 1.0) -> np.ndarray:
-        """Absolute pressure [Pa] of every cylinder, shape ``(n, n_cyl)``, at cylinder-1
-        crank angles ``crank_angle_rad`` [rad] (periodic over 4π, linear between the cycle
-        grid's points)."""
+        """Absolute pressure [Pa] of every cylinder, ``(n, n_cyl)``, at cylinder-1 crank angles
+        [rad] (periodic over 4π, linear between grid points)."""
         return self.cylinder_pressures([rpm], crank_angle_rad, load)[0]
 
     def cylinder_pressures(self, speeds_rpm, crank_angle_rad, load: float = 1.0) -> np.ndarray:
@@ -280,9 +261,8 @@ class Engine:
         return self.pressure_tables(speeds_rpm, crank_angle_rad, [load])[0]
 
     def pressure_tables(self, speeds_rpm, crank_angle_rad, loads) -> np.ndarray:
-        """:meth:`cylinder_pressure` at every load [-] and speed [rpm], shape
-        ``(n_loads, n_speeds, n, n_cyl)``: one periodic linear interpolation, its weights
-        found once when the cycle grids agree."""
+        """:meth:`cylinder_pressure` at every load [-] and speed [rpm],
+        ``(n_loads, n_speeds, n, n_cyl)``."""
         local = self.local_angles(crank_angle_rad)
         speeds = np.atleast_1d(speeds_rpm)
         cycles = [[self.cycle_pressures(n, load) for n in speeds] for load in loads]
@@ -303,7 +283,6 @@ class Engine:
         local = th[:, None] - self.crank.firing_angles[None, :]
         return np.mod(local + np.pi, 4.0 * np.pi) - np.pi
 
-    # ------------------------------------------------------------------ loads
     def excitation(self, rpm: float, crank_angle_rad=None, load: float = 1.0,
                    n_points: int = 1440) -> Excitation:
         """Pressures, per-cylinder forces and torques and the total load at one speed.
@@ -313,10 +292,11 @@ class Engine:
         rpm : float
             Engine speed [rpm] (constant).
         crank_angle_rad : array_like, optional
-            Cylinder-1 crank angles [rad]; default ``n_points`` equally spaced on
-            ``[0, 4π)``.
+            Cylinder-1 crank angles [rad]; default ``n_points`` equally spaced on ``[0, 4π)``.
         load : float
-            Fraction of the full-load torque [-] (single-zone model).
+            Fraction of the full-load torque [-].
+        n_points : int
+            Number of default crank angles.
         """
         if crank_angle_rad is None:
             crank_angle_rad = 4.0 * np.pi * np.arange(n_points) / n_points
@@ -339,44 +319,31 @@ class Engine:
                           load=total, imep=imep, info=dict(info))
 
     def _load_patterns(self, th):
-        """``(G, I)`` of :meth:`load_table`: the block load of a unit gas force in each
-        cylinder (list of (n, 6)) and of a unit omega^2 (n, 6) at the angles ``th`` [rad]."""
+        """Block loads of a unit gas force per cylinder (list of (n, 6)) and of a unit omega^2."""
         unit = np.eye(self.crank.n_cylinders)
         gas = [self._block_load(th, 0.0, np.broadcast_to(u, (th.size, unit.shape[0])))[0]
                for u in unit]
         return gas, self._block_load(th, 1.0, np.zeros((th.size, unit.shape[0])))[0]
 
     def motion_patterns(self, crank_angle_rad):
-        """Generalized loads (n, 6) of a unit omega^2 and of a unit crank acceleration at
-        the angles [rad], no gas force (:meth:`_block_load` is linear in both); kept for the
-        last grid, as the load patterns (they depend on the geometry only)."""
+        """Generalized loads (n, 6) of a unit omega^2 and of a unit crank acceleration at the
+        angles [rad], without gas force (cached for the last grid)."""
         th = np.atleast_1d(np.asarray(crank_angle_rad, dtype=float))
         inertia = self._cache.last_grid("load patterns", th, self._load_patterns)[1]
         return inertia, self._cache.last_grid("acceleration pattern", th,
                                               self._acceleration_pattern)
 
     def _acceleration_pattern(self, th):
-        """The block load (n, 6) of a unit crank acceleration at the angles ``th`` [rad]."""
         return self._block_load(th, 0.0, np.zeros((th.size, self.crank.n_cylinders)), 1.0)[0]
 
     def _block_load(self, th, omega, fg, alpha=0.0):
-        r"""Generalized load (n, 6) on the block at angles ``th`` [rad], speed ``omega``
-        [rad/s], crank acceleration ``alpha`` [rad/s^2] (not on the balancer shafts) and gas
-        forces ``fg`` (n, n_cyl) [N], and the per-cylinder forces of
-        :func:`~powertrain.physics.slider_crank.crank_forces` (dict of (n, n_cyl)). Linear in
-        the gas forces, in omega^2 and in alpha (:meth:`load_table` relies on it).
-
-        Cylinder :math:`c` at :math:`x_c\mathbf e_x` loads the block with the gas force
-        :math:`F_g\mathbf u` on the head (at :math:`y\mathbf u` from the crank axis), the side
-        thrust :math:`-N\mathbf s` at the pin (:math:`e\mathbf s + y\mathbf u`), the main
-        bearing's :math:`F_r(\sin\beta\,\mathbf s - \cos\beta\,\mathbf u)` (with
-        :math:`N = F_r\sin\beta`) and the unbalanced rotating mass's inertia on the crank
-        axis, and the pin offset's couple :math:`e F_g\,\mathbf s\times\mathbf u`. Summed,
-        the force is :math:`\sum_c (a_c\mathbf u + b_c\mathbf s)` and the moment about the CG
-        :math:`\sum_c (x_c\mathbf e_x - \mathbf r_G)\times(a_c\mathbf u + b_c\mathbf s)
-        + \sum_c (y N + e F_g)\,\mathbf s\times\mathbf u`, with
-        :math:`a_c = F_g - F_r\cos\beta + m_r r(\omega^2\cos\theta_c + \alpha\sin\theta_c)`
-        and :math:`b_c = m_r r(\omega^2\sin\theta_c - \alpha\cos\theta_c)`."""
+        r"""Generalized load (n, 6) on the block and the per-cylinder forces of
+        :func:`~powertrain.physics.slider_crank.crank_forces`; linear in the gas forces ``fg``,
+        in omega^2 and in alpha (the latter not on the balancer shafts). The force is
+        :math:`\sum_c (a_c\mathbf u + b_c\mathbf s)`, the moment about the CG adds the side
+        thrust's and the pin offset's couple :math:`(y N + e F_g)\,\mathbf s\times\mathbf u`,
+        with :math:`a_c = F_g - F_r\cos\beta + m_r r(\omega^2\cos\theta_c + \alpha\sin\theta_c)`,
+        :math:`b_c = m_r r(\omega^2\sin\theta_c - \alpha\cos\theta_c)`."""
         ct = self.crank
         u, s = ct.cylinder_axis, ct.lateral_axis
         theta = th[:, None] - np.asarray(ct.crank_pin_angles, float)[None, :]
@@ -414,10 +381,8 @@ class Engine:
         return comb.indicated_work(np.atleast_2d(p_g), self._cache[key], dtheta)
 
     def mean_brake_torque(self, rpm: float, load: float = 1.0) -> float:
-        r"""Mean brake torque at ``rpm`` [N·m]: the cycle mean of the indicated torque of the
-        cylinder pressures, :math:`\sum_i W_i/(4\pi)`, less
-        :math:`\mathrm{FMEP}\,V_D/(4\pi)` where the combustion model gives an FMEP (the
-        single-zone model's full-load curve at that speed; measured traces: none)."""
+        r"""Mean brake torque [N·m]: :math:`(\sum_i W_i - \mathrm{FMEP}\,V_D)/(4\pi)` (FMEP
+        from the combustion model, zero for measured traces)."""
         fmep = self.combustion.friction_mean_effective_pressure(self._check_speed(rpm) * RPM)
         work = float(np.sum(self.indicated_work(rpm, load)))
         return (work - fmep * self.crank.displacement) / (4.0 * np.pi)
@@ -442,11 +407,8 @@ class Engine:
         return self._evaluate(rpm, crank_angle_rad, load, detail=False)
 
     def load_table(self, speeds_rpm, crank_angle_rad, load: float = 1.0) -> np.ndarray:
-        """Generalized load (n_speeds, n, 6) at every speed [rpm] and angle [rad]: the
-        :meth:`generalized_load` of each speed to round-off, from patterns evaluated once: the
-        block load is linear in the gas forces and in omega^2 (:meth:`_block_load`), so it is
-        sum_i F_g,i G_i + omega^2 I with G_i the load of a unit gas force in cylinder i and I
-        that of a unit omega^2."""
+        """:meth:`generalized_load` (n_speeds, n, 6) at every speed [rpm] and angle [rad], to
+        round-off, as sum_i F_g,i G_i + omega^2 I from load patterns evaluated once."""
         return self.load_tables(speeds_rpm, crank_angle_rad, [load])[0]
 
     def load_tables(self, speeds_rpm, crank_angle_rad, loads) -> np.ndarray:
@@ -462,33 +424,29 @@ class Engine:
         return table
 
     def assemble(self, static_factors=None, *, rigid_ground=False):
-        """The assembled linear model of body, mounts and chassis: the one way to the system
-        every solver, the what-if and the diagnosis work on (:func:`powertrain.assembly.assemble`).
+        """The assembled linear model of body, mounts and chassis
+        (:func:`powertrain.assembly.assemble`).
 
         Parameters
         ----------
         static_factors : array_like (3 n_mounts,), optional
-            Each network's static factor at an operating point
-            (:mod:`powertrain.solvers.operating_point`); None: unscaled.
+            Each network's static factor at an operating point; None: unscaled.
         rigid_ground : bool
-            Mounts on rigid ground whatever the chassis: the static support and the modes at
-            static stiffness are properties of the powertrain on its mounts alone.
+            Mounts on rigid ground whatever the chassis.
         """
         b = self.body
         chassis = None if rigid_ground else self.chassis
         return assemble(b.mass, b.cg, b.inertia, self.mounts, chassis, static_factors)
 
     def rigid_body_modes(self):
-        """Natural frequencies [Hz] and mode shapes of the powertrain on its mounts' static
-        stiffness (undamped, rigid chassis); see
-        :meth:`powertrain.assembly.AssembledSystem.rigid_body_modes`."""
+        """Natural frequencies [Hz] and mode shapes on the mounts' static stiffness (undamped,
+        rigid chassis)."""
         return self.assemble(rigid_ground=True).rigid_body_modes()
 
 
 def _periodic_interpolation(x, xp, period):
-    """Indices ``i0``, ``i1`` into ``xp`` and weights ``w`` (shapes of ``x``) of the linear
-    interpolation of a ``period``-periodic function sampled at ``xp``, as ``np.interp(x, xp,
-    fp, period=period)``: ``fp[i0] (1 - w) + fp[i1] w``."""
+    """``(i0, i1, w)`` with ``fp[i0] (1 - w) + fp[i1] w`` equal to
+    ``np.interp(x, xp, fp, period=period)``."""
     xp_m = np.mod(xp, period)
     order = np.argsort(xp_m, kind="stable")
     xs = np.concatenate([[xp_m[order[-1]] - period], xp_m[order], [xp_m[order[0]] + period]])

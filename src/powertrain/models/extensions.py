@@ -1,11 +1,7 @@
 r"""Model extensions: new mount models built from existing ones, leaving those unchanged.
 
-:func:`with_base_compliance` puts a flexible chassis under a mount: the network's ground
-(``G``) becomes a base node of mass :math:`m_b` tied to the rigid ground by a spring
-:math:`c_b` and a damper :math:`d_b`. The thesis names a rigid chassis as one reason for its
-simulation-measurement gaps (Kovarik 2016, sec. 4.5: "chassis is considered as rigid, but in
-reality chassis has some compliance"). With a base the force "to ground" of the assembled
-model is the force in the base spring and damper.
+:func:`with_base_compliance` puts a base node of mass :math:`m_b` under a mount's network,
+tied to ground by :math:`c_b` and :math:`d_b` (a compliant chassis; Kovarik 2016, sec. 4.5).
 """
 
 from __future__ import annotations
@@ -20,12 +16,8 @@ BASE_DAMPING = "d_base"
 
 def with_base_compliance(mount_model: MountModel, mass: float, stiffness: float,
                          damping: float) -> MountModel:
-    r"""A copy of a mount model standing on a compliant base instead of the rigid ground.
-
-    Every element of the network that ends at ``G`` ends at a new internal node ``n{k+1}``
-    (``k`` = internal nodes of the original) instead; that node carries ``mass`` and is joined
-    to ``G`` by a Kelvin-Voigt element (``stiffness``, ``damping``). As the base stiffness
-    tends to infinity the original model is recovered. The original model is not modified.
+    r"""A copy of a mount model on a compliant base: elements ending at ``G`` end at a new node
+    carrying ``mass``, joined to ``G`` by ``stiffness`` and ``damping``.
 
     Parameters
     ----------
@@ -41,8 +33,7 @@ def with_base_compliance(mount_model: MountModel, mass: float, stiffness: float,
     Returns
     -------
     MountModel
-        Topology ``"<name>+base"`` with the extra parameters ``m_base``, ``c_base``,
-        ``d_base``.
+        Topology ``"<name>+base"`` with ``m_base``, ``c_base``, ``d_base``.
     """
     if not (mass > 0 and stiffness > 0 and damping >= 0):
         raise ValueError("need base mass > 0, stiffness > 0, damping >= 0")

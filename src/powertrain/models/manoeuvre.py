@@ -1,15 +1,9 @@
 r"""A transient manoeuvre: the crank speed and the engine load over time.
 
-The crank speed is a table of time and speed, linear between the rows, so the crank's
-angular acceleration :math:`\alpha` is constant on each interval and the crank angle is
-exact (a quadratic in time per interval):
-
-.. math:: \theta(t) = \Theta_i + \omega_i (t - t_i) + \tfrac12\alpha_i (t - t_i)^2,
-   \qquad \alpha_i = \frac{\omega_{i+1} - \omega_i}{t_{i+1} - t_i}.
-
-The load is a second table, linear between its rows: the IMEP scale of the engine's
-combustion model or the mean torque into the driveline (:class:`Manoeuvre`; the file reader
-is :mod:`powertrain.iotools.manoeuvre_file`, the guide ``docs/guide/transient.md``). SI.
+The crank speed is a table linear between rows, so :math:`\alpha_i` is constant per interval
+and :math:`\theta(t) = \Theta_i + \omega_i (t - t_i) + \tfrac12\alpha_i (t - t_i)^2` exactly.
+The load (IMEP scale or mean driveline torque) is a second table, linear between rows
+(``docs/guide/transient.md``). SI.
 """
 
 from __future__ import annotations
@@ -22,8 +16,7 @@ from powertrain.errors import InputError
 
 #: Load kinds a manoeuvre's load table may hold.
 LOAD_KINDS = ("imep_scale", "mean_torque")
-#: Longest manoeuvre [s]; longest interval between two rows of a table over which the value
-#: changes [s] (a hold may be longer).
+#: Longest manoeuvre [s]; longest interval between rows over which the value changes [s].
 MAX_DURATION = 60.0
 MAX_GAP = 5.0
 #: Largest crank speed [rpm] and IMEP scale [-].
@@ -35,15 +28,14 @@ MAX_GEAR_RATIO = 50.0
 MAX_CRANK_INERTIA = 20.0
 #: Intake pressure of the cycle without burn [Pa], least and most.
 MOTORED_INTAKE_PRESSURE = (0.05e5, 4e5)
-#: A starter's ratio [-] and the largest distance of its reaction point from the engine
-#: origin [m].
+#: A starter's ratio range [-] and its reaction point's largest distance from the origin [m].
 STARTER_RATIO = (0.1, 100.0)
 MAX_REACH = 3.0
 
 
 @dataclass(frozen=True, eq=False)
 class Starter:
-    """A starter (or integrated starter-generator) that drives the crank.
+    """A starter (or starter-generator) that drives the crank.
 
     Attributes
     ----------
@@ -75,7 +67,7 @@ class Starter:
 
 @dataclass(frozen=True, eq=False)
 class Manoeuvre:
-    """Crank speed and load tables of a transient (module docstring).
+    """Crank speed and load tables of a transient.
 
     Attributes
     ----------
@@ -94,15 +86,12 @@ class Manoeuvre:
     starter : Starter or None
     reversal : bool
         The crank may turn backwards (speed < 0).
-    file : str
-        The file it was read from.
-    notes : str
+    file, notes : str
+        The file it was read from; notes.
     motored_intake_pressure : float or None
-        Intake pressure of the cycle without burn (IMEP scale 0) [Pa]; None: the
-        combustion model's default (its ambient pressure: an unthrottled crank).
+        Intake pressure of the cycle without burn [Pa]; None: the model's ambient pressure.
     trigger_time : float
-        The time of the manoeuvre [s] at which a recording's trigger channel rises (a tip-in's
-        pedal switch; default 0, the start), before its end.
+        Time [s] at which a recording's trigger channel rises (before the end).
     """
 
     name: str
@@ -168,8 +157,7 @@ class Manoeuvre:
         return float(np.max(np.abs(self.speed)))
 
     def crank_motion(self, t):
-        """Crank angle [rad], speed [rad/s] and angular acceleration [rad/s²] at the times
-        ``t`` [s] (arrays of the shape of ``t``; constant beyond the table's ends)."""
+        """Crank angle [rad], speed [rad/s] and acceleration [rad/s²] at the times ``t`` [s]."""
         t = np.clip(np.asarray(t, float), self.time[0], self.time[-1])
         dt = np.diff(self.time)
         accel = np.diff(self.speed) / dt
@@ -192,7 +180,7 @@ class Manoeuvre:
 
 
 def _numbers(values, file, key) -> np.ndarray:
-    """``values`` as an array of floats (one line naming ``key`` where they are not)."""
+    """``values`` as floats, else an :class:`InputError` naming ``key``."""
     try:
         return np.asarray(values, float)
     except (TypeError, ValueError):
@@ -210,9 +198,7 @@ def _require(ok, message, file, key):
 
 
 def _times(time, value, file, table, column="speed"):
-    """A table's time and value columns (n,) checked: finite, from 0, strictly increasing,
-    at most :data:`MAX_DURATION` long, rows at most :data:`MAX_GAP` apart where the value
-    changes between them."""
+    """A table's time and value columns, checked (finite, from 0, increasing, bounded)."""
     key = f"{table}.time"
     t, v = _numbers(time, file, key), _numbers(value, file, f"{table}.{column}")
     _require(t.ndim == 1 and t.size >= 2, "at least two rows", file, key)

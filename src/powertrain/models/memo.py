@@ -1,12 +1,7 @@
 """The memo a frozen model keeps of values computed from its own fields.
 
-A frozen model (:class:`~powertrain.models.engine.Engine`,
-:class:`~powertrain.models.crank_train.CrankTrain`,
-:class:`~powertrain.models.combustion.SingleZoneCombustion`) holds one :class:`Memo` as a
-field (``init=False``: every new or replaced model starts with an empty one). The memo is
-not part of the model's value: it is never compared nor printed, and a copy
-(``copy.copy``, ``copy.deepcopy``, ``pickle``: a model sent to another process) starts
-empty and fills again where it is used.
+A frozen model holds one :class:`Memo` as an ``init=False`` field; it is not part of the
+model's value (never compared nor printed) and any copy or pickle starts empty.
 """
 
 from __future__ import annotations
@@ -24,8 +19,7 @@ def _read_only(value):
 
 
 class Memo(dict):
-    """Values computed from the fields of the model that holds it, by key; a copy is
-    empty."""
+    """Values computed from the holding model's fields, by key; a copy is empty."""
 
     def __reduce__(self):
         return (Memo, ())
@@ -40,9 +34,8 @@ class Memo(dict):
         return f"Memo({len(self)} entries)"
 
     def last_grid(self, key: str, theta, compute):
-        """``compute(theta)`` for the crank-angle grid ``theta`` [rad], kept under ``key``
-        for the last grid asked (a run-up asks for the same cycle grid at every speed); its
-        arrays are made read-only, as every caller shares them."""
+        """``compute(theta)`` for the grid ``theta`` [rad], kept read-only under ``key`` for the
+        last grid asked."""
         theta = np.asarray(theta, float)
         kept = self.get(key)
         if kept is not None and kept[0].shape == theta.shape and np.array_equal(kept[0], theta):

@@ -1,14 +1,9 @@
 r"""Mount model objects: a topology from thesis Table 2 plus its parameter values.
 
-A :class:`Topology` names the point masses and the Kelvin–Voigt elements of a lumped mount
-network (nodes ``E`` = engine side, ``G`` = ground/chassis side, and named masses). A
-:class:`MountModel` adds parameter values in SI and exposes the frequency-domain quantities
-(:meth:`MountModel.cross_point_stiffness`, :meth:`MountModel.input_point_stiffness`) and the
-time-domain matrices (:meth:`MountModel.matrices`).
-
-Topologies of Kovarik (2016), Table 2 (the thesis figures are missing from the reference
-text, so where Table 2 gives only a name and a parameter count the topology below is the
-project's documented choice that matches the count; element lists read ``node–node (c, d)``):
+A :class:`Topology` names the point masses and Kelvin–Voigt elements of a lumped network
+(nodes ``E`` engine side, ``G`` ground, named masses); a :class:`MountModel` adds SI values.
+Topologies of Kovarik (2016), Table 2 (where the table gives only a name and a parameter
+count, the project's documented choice matching the count), as ``node–node (c, d)``:
 
 =====================  ===  ==========================================================
 preset                 n    elements
@@ -57,10 +52,10 @@ class Topology:
     parameters : tuple of str
         Parameter names in datasheet order (c*, d* and m*).
     masses : tuple of str or None
-        Parameter name of each internal mass, in node order; ``None`` = massless node.
+        Parameter name of each internal mass in node order; ``None``: massless node.
     elements : tuple of (str, str, str or None, str or None)
-        ``(node_a, node_b, c_name, d_name)``; nodes are ``"E"``, ``"G"`` or a mass node
-        label ``"n1"``, ``"n2"``...; ``None`` = that part of the element is absent.
+        ``(node_a, node_b, c_name, d_name)``, nodes ``"E"``, ``"G"``, ``"n1"``...; ``None``:
+        that part absent.
     """
 
     name: str
@@ -149,15 +144,12 @@ class MountModel:
     name, source, notes : str
         Metadata carried from the mount file.
     port_law : object, optional
-        A nonlinear force in parallel with the network between its engine-side and base
-        nodes (:mod:`powertrain.physics.mount_elements`), e.g. the ``[friction]`` section's
-        :class:`~powertrain.physics.mount_laws.BergFriction`; None: the linear network.
+        Nonlinear force in parallel with the network (``[friction]``,
+        :class:`~powertrain.physics.mount_laws.BergFriction`); None: linear.
     amplitude_law : object, optional
-        The ``[amplitude]`` section (:class:`~powertrain.physics.mount_laws.PowerLaw` or
-        ``TableLaw``); None: amplitude independent.
+        The ``[amplitude]`` section (``PowerLaw`` or ``TableLaw``); None: amplitude independent.
     static_curve : StaticCurve, optional
-        The ``[static]`` section (:class:`~powertrain.physics.mount_laws.StaticCurve`);
-        None: the network's static stiffness acts at any deflection.
+        The ``[static]`` section; None: the static stiffness acts at any deflection.
     """
 
     topology: Topology
@@ -187,9 +179,7 @@ class MountModel:
         return np.array([self.params[p] for p in self.topology.parameters], dtype=float)
 
     def network(self):
-        """``(masses, elem_nodes, c, d)`` arrays for :mod:`powertrain.physics.mount_network`
-        (read-only, made once per model: the model is frozen and the amplitude fixed point
-        asks for them at every iteration)."""
+        """``(masses, elem_nodes, c, d)`` arrays (read-only, made once per model)."""
         return self._network
 
     @functools.cached_property
@@ -229,8 +219,7 @@ class MountModel:
                                                *self.network(), engine_mass, force)
 
     def matrices(self, include_ground=False):
-        """``(M, C, K)`` of the network, engine-side node first (see
-        :func:`powertrain.physics.mount_network.network_matrices`)."""
+        """``(M, C, K)`` of the network, engine-side node first."""
         return net.network_matrices(*self.network(), include_ground=include_ground)
 
     def static_stiffness(self) -> float:
@@ -242,20 +231,11 @@ class MountModel:
         return replace(self, params={**self.params, **changes})
 
     def scaled(self, stiffness: float = 1.0, damping: float = 1.0) -> MountModel:
-        """A copy with every spring scaled by ``stiffness`` and every damper by ``damping``.
-
-        Scaling all springs (and masses unchanged) scales K_CP's real part only at low
-        frequency; scaling springs and dampers together by ``s`` and masses by ``s`` scales
-        K_CP(ω) exactly by ``s`` (see :meth:`scaled_dynamic_stiffness`).
-        """
+        """A copy with every spring times ``stiffness`` and every damper times ``damping``."""
         new = {p: v * (stiffness if p[0] == "c" else damping if p[0] == "d" else 1.0)
                for p, v in self.params.items()}
         return replace(self, params=new)
 
     def scaled_dynamic_stiffness(self, factor: float) -> MountModel:
-        """A copy whose K_CP(ω) is exactly ``factor`` times this one at every frequency.
-
-        Every c, d and m scaled by the same factor: D(ω) scales by it, the internal motion
-        per unit engine-side motion is unchanged, so F_T scales by it.
-        """
+        """A copy whose K_CP(ω) is ``factor`` times this one's (every c, d and m scaled)."""
         return replace(self, params={p: v * factor for p, v in self.params.items()})

@@ -1,9 +1,7 @@
 """A raw run-up recording: time histories of mount-point channels plus speed or tacho.
 
-Every reader of raw time data (:mod:`powertrain.iotools.raw`) returns a
-:class:`RawRecording`; values are SI (m/s^2, m/s, m, N), time in s, speed in rpm, the tacho
-in V. A channel names where it was measured: mount, side (``active`` = engine side,
-``passive`` = body side), direction (x/y/z, engine axes) and quantity.
+Values are SI (m/s^2, m/s, m, N), time in s, speed in rpm, tacho in V; a channel names its
+mount, side (``active`` engine, ``passive`` body), direction (engine axes) and quantity.
 """
 
 from __future__ import annotations
@@ -15,8 +13,7 @@ import numpy as np
 from powertrain.analysis.channel import DIRECTIONS, SIDES, ChannelFields
 from powertrain.errors import InputError
 
-#: Largest sample magnitude accepted (in the channel's unit): far above any recorded
-#: vibration, far below where squares and spectra overflow.
+#: Largest sample magnitude accepted (far below where squares and spectra overflow).
 MAX_SAMPLE = 1e15
 
 #: Measured quantity -> its SI unit.
@@ -29,7 +26,7 @@ QUANTITIES = {
 #: Dimension of :mod:`powertrain.units` -> quantity (``length`` is a displacement).
 QUANTITY_OF_DIMENSION = {"acceleration": "acceleration", "velocity": "velocity",
                          "length": "displacement", "force": "force"}
-#: Relative tolerance on the sampling interval: a recording must be uniformly sampled.
+#: Relative tolerance on the (uniform) sampling interval.
 UNIFORM_TOLERANCE = 1e-3
 
 
@@ -42,8 +39,7 @@ class RawChannel(ChannelFields):
     name : str
         Channel name in the file.
     mount, side, direction, quantity : str
-        Where and what (``side`` is ``active`` or ``passive``; ``quantity`` a key of
-        :data:`QUANTITIES`).
+        Where and what (``quantity`` a key of :data:`QUANTITIES`).
     values : ndarray
         Samples in SI [m/s^2, m/s, m or N].
     unit : str
@@ -77,10 +73,9 @@ class RawRecording:
     comments : list of str
         Notes from the file (e.g. a SYNTHETIC label).
     cycle_reference : ndarray (n,) or None
-        Once-per-engine-cycle pulse train [V] (cam or injection signal), which fixes the
-        720° crank angle of the order phases (:mod:`powertrain.analysis.phase`).
+        Once-per-engine-cycle pulse train [V] fixing the 720° phase of the orders.
     trigger : ndarray (n,) or None
-        Trigger channel [V] (the start of an event, :mod:`powertrain.analysis.alignment`).
+        Trigger channel [V] (the start of an event).
     """
 
     time: np.ndarray
@@ -102,11 +97,8 @@ class RawRecording:
         return any("synthetic" in c.lower() for c in self.comments)
 
     def channel_matrix(self, channels=None) -> np.ndarray:
-        """Samples of ``channels`` (default all) as one (n_ch, n) array [SI].
-
-        When the channels are the rows, in order, of one array (as the readers build them)
-        that array is returned without copying.
-        """
+        """Samples of ``channels`` (default all) as one (n_ch, n) array [SI], without copying
+        when they are the rows of one array."""
         vals = [c.values for c in (self.channels if channels is None else channels)]
         base = vals[0].base
         if (isinstance(base, np.ndarray) and base.ndim == 2 and base.shape[0] == len(vals)
@@ -125,13 +117,8 @@ class RawRecording:
         return list(block)
 
     def validate(self, time_key="time") -> RawRecording:
-        """Check shapes, finiteness and uniform increasing time; return self.
-
-        Raises
-        ------
-        InputError
-            Naming the file and the channel.
-        """
+        """Check shapes, finiteness and uniform increasing time; return self (raises
+        :class:`InputError` naming the file and channel)."""
         t = np.asarray(self.time, float)
         self.time = t
         if t.ndim != 1 or t.size < 16:

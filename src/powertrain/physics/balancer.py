@@ -1,21 +1,11 @@
 r"""Balancer shafts (Lanchester balancer): rotating unbalance at a multiple of crank speed.
 
-A shaft turning at :math:`\rho\,\omega` (:math:`\rho = 2` for the second order of an
-inline-4) with unbalance :math:`m_b r_b` [kg·m] has its mass-centre direction at the angle
-
-.. math:: \alpha = \sigma_b\,\rho\,\theta + \phi_b
-
-measured from the cylinder axis :math:`u` towards :math:`s` (the crank-angle convention of
-:mod:`powertrain.physics.slider_crank`); :math:`\sigma_b = +1` turns with the crank,
-:math:`-1` against it. Its force on its bearings (and so on the block) is the centrifugal
-force
-
-.. math:: \mathbf F_b = m_b r_b\,(\rho\omega)^2\,(\cos\alpha\,\mathbf u + \sin\alpha\,\mathbf s)
-
-(Taylor 1985, vol. 2, ch. 8). A counter-rotating pair with :math:`\phi_b = \pi` and
-:math:`m_b r_b = \tfrac12 m\,r\,A_2` cancels the second-order vertical shaking force
-:math:`4 m r\omega^2 A_2\cos 2\theta` of a flat-crank inline-4 while its lateral components
-cancel each other (:func:`matching_mass_radius`).
+A shaft at :math:`\rho\,\omega` with unbalance :math:`m_b r_b` [kg·m] has its mass centre at
+:math:`\alpha = \sigma_b\,\rho\,\theta + \phi_b` from the cylinder axis :math:`u` towards
+:math:`s` (:mod:`powertrain.physics.slider_crank`; :math:`\sigma_b = \pm 1` with/against the
+crank) and loads the block with
+:math:`\mathbf F_b = m_b r_b(\rho\omega)^2(\cos\alpha\,\mathbf u + \sin\alpha\,\mathbf s)`
+(Taylor 1985, vol. 2, ch. 8).
 """
 
 from __future__ import annotations
@@ -52,10 +42,8 @@ def shaft_force(theta, omega, mass_radius, phase, sense=1, ratio=2.0):
 
 
 def matching_mass_radius(m_rec, r, a2, n_cylinders=4, n_shafts=2, ratio=2.0):
-    r"""Unbalance per shaft [kg·m] that cancels the second-order shaking force.
-
-    .. math:: n_{sh}\,m_b r_b\,(\rho\omega)^2 = n_{cyl}\, m\,r\,\omega^2 A_2
-              \;\Rightarrow\; m_b r_b = \frac{n_{cyl}\,m\,r\,A_2}{n_{sh}\,\rho^2}
+    r"""Unbalance per shaft [kg·m] that cancels the second-order shaking force:
+    :math:`m_b r_b = n_{cyl}\,m\,r\,A_2/(n_{sh}\,\rho^2)`.
 
     Parameters
     ----------
@@ -64,14 +52,13 @@ def matching_mass_radius(m_rec, r, a2, n_cylinders=4, n_shafts=2, ratio=2.0):
     r : float
         Crank radius [m].
     a2 : float
-        Second-order coefficient :math:`A_2` of the piston acceleration [-]
-        (≈ λ at leading order; see
-        :func:`powertrain.physics.slider_crank.second_order_coefficient`).
+        Second-order coefficient :math:`A_2` [-]
+        (:func:`powertrain.physics.slider_crank.second_order_coefficient`).
     n_cylinders : int
-        Number of cylinders of the inline engine [-].
+        Cylinders of the inline engine [-].
     n_shafts : int
-        Number of balancer shafts sharing the force [-].
+        Balancer shafts sharing the force [-].
     ratio : float
-        Shaft speed over crank speed ρ [-] (2 for second-order balancing).
+        Shaft speed over crank speed ρ [-].
     """
     return n_cylinders * m_rec * r * a2 / (n_shafts * ratio**2)

@@ -1,23 +1,15 @@
-r"""The one condensation of the assembled model: its mount networks' internal coordinates
-eliminated through their two-ports, at any Laplace variable :math:`s`.
+r"""Condensation of the assembled model: the mount networks' internal coordinates eliminated
+through their two-ports, at any Laplace variable :math:`s`.
 
-The retained coordinates R are the rigid body and, under a modal chassis, the body modes.
-Their frame (the rigid-body mass, the body modes' oscillators) has
+The retained coordinates R (rigid body, body modes) have
 :math:`\mathbf D_0(s) = \mathbf K_0 + s\mathbf C_0 + s^2\mathbf M_0`; network n joins its
-engine-side node (motion :math:`\mathbf p_{E,n}\cdot\mathbf q_R`) to its base node (motion
-:math:`\mathbf p_{B,n}\cdot\mathbf q_R`, zero on a rigid ground) and, its internal masses
-eliminated (:func:`powertrain.physics.mount_network.laplace_two_port`), acts through the
-two-port :math:`\mathbf T_n = [[a_n, b_n]; [b_n, c_n]]`:
+engine-side motion :math:`\mathbf p_{E,n}\cdot\mathbf q_R` to its base motion
+:math:`\mathbf p_{B,n}\cdot\mathbf q_R` through the two-port
+:math:`\mathbf T_n = [[a_n, b_n]; [b_n, c_n]]`
+(:func:`powertrain.physics.mount_network.laplace_two_port`), so exactly
 
 .. math:: \mathbf D_R(s) = \mathbf D_0(s) + \sum_n \mathbf P_n^T\mathbf T_n(s)\mathbf P_n,
-          \qquad \mathbf P_n = [\mathbf p_{E,n}; \mathbf p_{B,n}],
-
-exact: the Schur complement of :math:`\mathbf K + s\mathbf C + s^2\mathbf M` on R
-(tests/test_two_port.py against a dense solve). :func:`condense` keeps any subset of R (the
-rest of R condensed densely, e.g. the body modes for the 6×6 static stiffness); the static
-stiffness (:math:`s = 0`), the modes (complex :math:`s`), the harmonic steady state
-(:math:`s = i\omega`, :func:`harmonic_solve`, for the run-up and the cached diagnosis model
-alike) all go through :func:`condensed_matrix`.
+          \qquad \mathbf P_n = [\mathbf p_{E,n}; \mathbf p_{B,n}].
 """
 
 from __future__ import annotations
@@ -47,8 +39,7 @@ class NetworkPorts:
     internal : list of (start, n_internal)
         Each network's internal coordinates in the full numbering.
     elements : list
-        Each network's :class:`~powertrain.physics.mount_elements.MountElement` (its
-        ``two_port(s, amplitude, internal)``).
+        Each network's :class:`~powertrain.physics.mount_elements.MountElement`.
     """
 
     retained: np.ndarray
@@ -64,12 +55,10 @@ class NetworkPorts:
 
 
 def two_ports(ports: NetworkPorts, s, internal=False, amplitudes=None, linear=None):
-    """``(a, b, c)`` each ``s.shape + (n_net,)`` of every network at ``s`` (and the list of
-    internal motions per network when ``internal``): each element's equivalent-linear
-    two-port at its relative-displacement amplitude (``amplitudes`` (n_net,) [m]; None:
-    zero, which a linear element ignores). ``linear``: the networks' linear two-ports at
-    ``s`` (:func:`linear_two_ports`), reused: only the port laws' describing stiffnesses
-    are added (one amplitude per network)."""
+    """Equivalent-linear two-ports ``(a, b, c)``, each ``s.shape + (n_net,)`` [N/m], of every
+    network at ``s`` [1/s] and its ``amplitudes`` (n_net,) [m] (None: zero); also the internal
+    motions when ``internal``. ``linear`` (:func:`linear_two_ports`): reused, only the port
+    laws' describing stiffnesses added."""
     s = np.asarray(s, complex)
     amplitudes = np.zeros(len(ports.elements)) if amplitudes is None else amplitudes
     if linear is not None:
@@ -89,9 +78,8 @@ def two_ports(ports: NetworkPorts, s, internal=False, amplitudes=None, linear=No
 
 @dataclass(frozen=True)
 class LinearTwoPorts:
-    """The networks' linear two-ports at some ``s`` (:func:`linear_two_ports`): ``abc``
-    each ``s.shape + (n_net,)``, ``shapes`` their internal motions (one array per network,
-    :func:`~powertrain.physics.mount_network.laplace_two_port`)."""
+    """The networks' linear two-ports ``abc`` (each ``s.shape + (n_net,)``) and internal
+    motions ``shapes`` at some ``s``."""
 
     abc: tuple
     shapes: list
@@ -102,10 +90,8 @@ class LinearTwoPorts:
 
 
 def linear_two_ports(ports: NetworkPorts, s) -> LinearTwoPorts | None:
-    """Each network's linear two-port and internal motions at ``s``
-    (:meth:`MountElement.linear_two_port`), for :func:`two_ports` at many amplitudes (the
-    equivalent-linear fixed point); None when an amplitude law makes one depend on the
-    amplitude."""
+    """Each network's linear two-port and internal motions at ``s`` [1/s]; None when an
+    amplitude law makes one depend on the amplitude."""
     s = np.asarray(s, complex)
     res = [element.linear_two_port(s, internal=True) for element in ports.elements]
     if any(r is None for r in res):
@@ -115,9 +101,7 @@ def linear_two_ports(ports: NetworkPorts, s) -> LinearTwoPorts | None:
 
 
 def _with_port_laws(ports, s, internal, amplitudes, linear):
-    """:func:`two_ports` from the linear two-ports ``linear``: each port law's describing
-    stiffness at its amplitude added (at every ``s != 0``), as
-    :meth:`MountElement.two_port` adds it."""
+    """:func:`two_ports` from ``linear`` plus the port laws' describing stiffnesses at s != 0."""
     kd = np.zeros(len(ports.elements), complex)
     for k, d in enumerate(describing_stiffnesses(ports.elements, amplitudes)):
         if d is not None:
@@ -129,9 +113,8 @@ def _with_port_laws(ports, s, internal, amplitudes, linear):
 
 
 def condensed_matrix(frame, engine_rows, base_rows, abc, s):
-    r""":math:`\mathbf D_R(s)` of the module docstring, shape ``s.shape + (n_R, n_R)``, for
-    given two-port values ``abc`` (each ``s.shape + (n_net,)``); ``base_rows`` None: every
-    base grounded (``b``, ``c`` unused)."""
+    r""":math:`\mathbf D_R(s)`, shape ``s.shape + (n_R, n_R)``, for two-port values ``abc``
+    (each ``s.shape + (n_net,)``); ``base_rows`` None: every base grounded."""
     s = np.asarray(s, complex)
     M0, C0, K0 = (kernel_input(x) for x in frame)
     n, n_net = M0.shape[0], engine_rows.shape[0]
@@ -145,11 +128,9 @@ def condensed_matrix(frame, engine_rows, base_rows, abc, s):
 
 
 def condense(system, keep, s):
-    r"""Dynamic stiffness :math:`\mathbf K + s\mathbf C + s^2\mathbf M` of ``system`` on the
-    coordinates ``keep`` with all others eliminated exactly, every mount network as measured
-    (:meth:`~powertrain.physics.mount_elements.MountElement.as_measured`: amplitude laws at
-    factor 1, no friction; a linear network as it is): the linear view of the static
-    stiffness and the modes, independent of any response amplitude.
+    r"""Dynamic stiffness :math:`\mathbf K + s\mathbf C + s^2\mathbf M` of ``system`` on
+    ``keep``, all other coordinates eliminated exactly, every network as measured
+    (:meth:`~powertrain.physics.mount_elements.MountElement.as_measured`).
 
     Parameters
     ----------
@@ -166,7 +147,8 @@ def condense(system, keep, s):
     ports = system.ports()
     ports = replace(ports, elements=[element.as_measured() for element in ports.elements])
     s = np.asarray(s, complex)
-    D = _retained_matrix(ports, two_ports(ports, s), s)
+    D = condensed_matrix(ports.frame, ports.engine_rows,
+                         None if ports.grounded else ports.base_rows, two_ports(ports, s), s)
     pos = {int(j): i for i, j in enumerate(ports.retained)}
     if any(int(j) not in pos for j in keep):
         raise ValueError("condense keeps only retained coordinates (rigid body, body modes)")
@@ -180,16 +162,9 @@ def condense(system, keep, s):
     return Dk
 
 
-def _retained_matrix(ports, abc, s):
-    return condensed_matrix(ports.frame, ports.engine_rows,
-                            None if ports.grounded else ports.base_rows, abc, s)
-
-
 def harmonic_solve(frame, engine_rows, base_rows, abc, s, load):
-    r"""The one harmonic steady-state solve: :math:`\mathbf D_R(s)\hat{\mathbf q}_R =
-    \hat{\mathbf f}` on the retained coordinates, the load on the rigid body's six, for
-    every ``s`` at once (the run-up's harmonic stepper, the cached diagnosis model with or
-    without a modal body, the what-if).
+    r"""Harmonic steady state :math:`\mathbf D_R(s)\hat{\mathbf q}_R = \hat{\mathbf f}`,
+    the load on the rigid body's six coordinates, for every ``s`` at once.
 
     Parameters
     ----------
@@ -210,10 +185,8 @@ def harmonic_solve(frame, engine_rows, base_rows, abc, s, load):
 
 
 def batched_solve(D, b):
-    """Solutions ``x`` (shape of ``b``, ``(..., n)``) of ``D x = b`` for a stack ``D``
-    ``(..., n, n)``: :func:`powertrain.kernels.small_solve.batched_solve_kernel` on
-    contiguous complex copies. Raises ``numpy.linalg.LinAlgError`` on a singular matrix, as
-    ``numpy.linalg.solve``."""
+    """Solutions ``x`` (..., n) of ``D x = b`` for a stack ``D`` (..., n, n); raises
+    ``numpy.linalg.LinAlgError`` on a singular matrix."""
     D = np.asarray(D)
     b = np.asarray(b)
     n = D.shape[-1]

@@ -1,18 +1,13 @@
 r"""Mount elements: one mount direction as the assembled model and its solvers see it.
 
 A :class:`MountElement` is a linear network (:mod:`powertrain.physics.mount_network`) and,
-optionally, a *port law* in parallel with it between the engine-side and base nodes, acting
-on their relative displacement :math:`u = x_E - x_B` (``docs/extending.md``, "Adding a mount
-element"). In the frequency domain it is an equivalent-linear two-port
-(:meth:`MountElement.two_port`: the law's describing function :math:`k_{eq}(A)` added at
-every :math:`s \ne 0`; a port law carries no mean force), in the time domain the law's
-kernel arrays (:class:`PortForces`, :func:`powertrain.kernels.port_forces.newmark_port_kernel`).
-A port law has ``kind``, ``parameters()``, ``initial_state(u0, f0)``,
-``describing_stiffness(amplitude)`` and ``steady_state(amplitude, centre=0)``: the memory on
-its steady loop at the lower tip, moving up, where a displacement-driven test
-(:func:`powertrain.solvers.mount_time_domain.time_cross_point_stiffness`) starts it.
-:class:`JenkinsFriction` is the simplest; :class:`~powertrain.physics.mount_laws.BergFriction`
-is the mount files' ``[friction]``.
+optionally, a *port law* in parallel on the relative displacement :math:`u = x_E - x_B`
+(``docs/extending.md``). In the frequency domain it is an equivalent-linear two-port (the
+law's describing function :math:`k_{eq}(A)` added at every :math:`s \ne 0`; no mean force),
+in the time domain the law's kernel arrays (:class:`PortForces`). A port law has ``kind``,
+``parameters()``, ``initial_state(u0, f0)``, ``describing_stiffness(amplitude)`` and
+``steady_state(amplitude, centre=0)`` (its memory at the lower tip of the steady loop,
+moving up).
 """
 
 from __future__ import annotations
@@ -35,13 +30,11 @@ class JenkinsFriction:
     r"""A spring :math:`k` in series with a Coulomb slider of slip force :math:`F_s`:
     :math:`f = k(u - z)`, :math:`|f| \le F_s`, the slider position :math:`z` its memory.
 
-    Describing function (Caughey 1960) for :math:`u = A\sin\omega t`, with
-    :math:`\delta = F_s/(kA)`: :math:`k_{eq} = k` for :math:`\delta \ge 1`, otherwise
+    Describing function (Caughey 1960), :math:`\delta = F_s/(kA)`: :math:`k_{eq} = k` for
+    :math:`\delta \ge 1`, otherwise
 
     .. math:: k_{eq} = \frac{k}{\pi}\left(\varphi - \tfrac12\sin 2\varphi\right)
-              + i\,\frac{4k}{\pi}\,\delta(1 - \delta), \qquad \cos\varphi = 1 - 2\delta,
-
-    the imaginary part being the loop area :math:`4F_s(A - F_s/k)` over :math:`\pi A^2`.
+              + i\,\frac{4k}{\pi}\,\delta(1 - \delta), \qquad \cos\varphi = 1 - 2\delta.
 
     Parameters
     ----------
@@ -65,9 +58,7 @@ class JenkinsFriction:
         return np.array([u0 - np.clip(f0, -self.slip_force, self.slip_force) / self.stiffness])
 
     def steady_state(self, amplitude: float, centre: float = 0.0) -> np.ndarray:
-        """Slider at the lower tip of the steady loop of amplitude ``amplitude`` [m] about
-        ``centre`` [m], where the motion turns up (the tip force: k A while it sticks, else
-        F_s)."""
+        """Slider at the lower tip of the steady loop of ``amplitude`` [m] about ``centre`` [m]."""
         return np.array([centre - amplitude + min(self.stiffness * amplitude, self.slip_force)
                          / self.stiffness])
 
@@ -84,9 +75,8 @@ class JenkinsFriction:
 
 
 def describing_stiffnesses(elements, amplitudes) -> list:
-    """Each element's port-law describing stiffness at its amplitude (scalars [m]; None
-    for an element without a port law), one vectorised call per distinct law (the
-    equivalent-linear fixed point asks for every element at every iteration)."""
+    """Each element's port-law describing stiffness at its amplitude [m] (None without a port
+    law), one vectorised call per distinct law."""
     out = [None] * len(elements)
     for law, index in _by_law(elements, "port_law").items():
         values = law.describing_stiffness(np.array([amplitudes[k] for k in index], float))
@@ -105,12 +95,9 @@ def _by_law(elements, kind) -> dict:
 
 
 def element_two_ports(elements, s, amplitudes, packed=None):
-    r""":meth:`MountElement.two_port` of several elements, each ``s.shape + (n_el,)``:
-    element k at the amplitudes ``amplitudes[..., k]`` [m] (broadcast to ``s``), the
-    networks condensed in one kernel call (:func:`laplace_two_ports`; ``packed``: the
-    elements' networks packed once by the caller,
-    :class:`~powertrain.physics.mount_network.PackedNetworks`), the port laws'
-    describing stiffnesses added at every :math:`s \ne 0`."""
+    r""":meth:`MountElement.two_port` of several elements, each ``s.shape + (n_el,)``: element
+    k at ``amplitudes[..., k]`` [m], the networks condensed in one kernel call (``packed``:
+    the networks packed once by the caller, :class:`PackedNetworks`)."""
     lam = np.asarray(s, complex)
     A = np.asarray(amplitudes, float)
     scales = np.ones((2,) + A.shape)
@@ -139,19 +126,17 @@ class MountElement:
     Parameters
     ----------
     lumped : tuple
-        The linear network as its mount file gives it, ``(masses, elem_nodes, c, d)``
-        (:mod:`powertrain.physics.mount_network`; :meth:`MountModel.element
-        <powertrain.models.mount.MountModel.element>` makes it).
+        The linear network ``(masses, elem_nodes, c, d)``
+        (:mod:`powertrain.physics.mount_network`).
     port_law : object, optional
-        Nonlinear force between the engine-side and base nodes (module docstring), e.g.
+        Nonlinear force between the engine-side and base nodes, e.g.
         :class:`powertrain.physics.mount_laws.BergFriction`.
     amplitude_law : object, optional
-        ``scales(A) -> (stiffness factor, damping factor)`` on every spring and damper of
-        the network at the relative-displacement amplitude A [m]
-        (:class:`~powertrain.physics.mount_laws.PowerLaw`, ``TableLaw``); masses unscaled.
+        ``scales(A) -> (stiffness factor, damping factor)`` on every spring and damper at the
+        relative-displacement amplitude A [m] (:class:`~powertrain.physics.mount_laws.PowerLaw`,
+        ``TableLaw``); masses unscaled.
     static_factor : float
-        Factor on every spring and damper from the static curve at the operating point
-        (tangent stiffness there over that at the reference deflection); 1 without one.
+        Factor on every spring and damper from the static curve at the operating point [-].
     """
 
     lumped: tuple
@@ -173,8 +158,7 @@ class MountElement:
         return self.static_factor * float(ks), self.static_factor * float(ds)
 
     def scale_arrays(self, amplitude):
-        """:meth:`scales` at an array of amplitudes [m] (the static factor may be an array
-        too, one per speed): ``(stiffness factors, damping factors)`` broadcast together."""
+        """:meth:`scales` at an array of amplitudes [m] (the static factor may be an array)."""
         if self.amplitude_law is None:
             return self.static_factor * 1.0, self.static_factor * 1.0
         ks, ds = self.amplitude_law.scales(amplitude)
@@ -185,15 +169,12 @@ class MountElement:
         return MountElement(self.lumped, self.port_law, self.amplitude_law, float(static_factor))
 
     def as_measured(self) -> MountElement:
-        """The network as its mount file gives it, at the static factor: the amplitude law
-        at factor 1 (its reference amplitude, where the network was measured) and no port
-        law. What the linear analyses of the assembly take (static stiffness, modes:
-        :func:`powertrain.physics.condensation.condense`)."""
+        """The network at the static factor, without amplitude law or port law (the linear
+        view of :func:`powertrain.physics.condensation.condense`)."""
         return MountElement(self.lumped, static_factor=self.static_factor)
 
     def scaled(self, stiffness: float, damping: float) -> MountElement:
-        """A copy whose network has every spring times ``stiffness`` and every damper times
-        ``damping`` (masses kept), its laws and static factor as they are."""
+        """A copy with every spring times ``stiffness`` and every damper times ``damping``."""
         masses, nodes, c, d = self.lumped
         return MountElement((masses, nodes, c * stiffness, d * damping), self.port_law,
                             self.amplitude_law, self.static_factor)
@@ -207,18 +188,13 @@ class MountElement:
         return masses, nodes, c * ks, d * ds
 
     def matrices(self, include_ground=False, amplitude=0.0):
-        """``(M, C, K)`` of the linear network at the amplitude (the port law is not in
-        them)."""
+        """``(M, C, K)`` of the linear network at the amplitude (without the port law)."""
         return network_matrices(*self.network(amplitude), include_ground=include_ground)
 
     def two_port(self, s, amplitude=0.0, internal=False, describing=None):
-        """Equivalent-linear two-port ``(a, b, c)`` at the Laplace variable ``s`` and the
-        relative-displacement amplitude [m] (and the internal motions when ``internal``, see
-        :func:`powertrain.physics.mount_network.laplace_two_port`; a port law moves no
-        internal node). ``amplitude`` may be an array that broadcasts to ``s`` (one
-        amplitude per speed of a run-up, :mod:`powertrain.solvers.fast_harmonic`).
-        ``describing``: the port law's describing stiffness at the amplitude when the caller
-        has it (:func:`describing_stiffnesses`)."""
+        """Equivalent-linear two-port ``(a, b, c)`` at ``s`` [1/s] and the amplitude [m]
+        (scalar or broadcasting to ``s``); the internal motions too when ``internal``.
+        ``describing``: the port law's describing stiffness, when the caller has it."""
         lam = np.asarray(s, complex)
         if np.ndim(amplitude) == 0:
             res = laplace_two_port(lam, *self.network(amplitude), internal=internal)
@@ -234,16 +210,14 @@ class MountElement:
         return (res[0] + k, res[1] - k, res[2] + k) + res[3:]
 
     def linear_two_port(self, s, internal=False):
-        """The linear network's two-port at ``s`` (:meth:`two_port` without the port law)
-        when it does not depend on the amplitude (no amplitude law), else None."""
+        """The network's two-port at ``s`` without the port law; None with an amplitude law."""
         if self.amplitude_law is not None:
             return None
         return laplace_two_port(np.asarray(s, complex), *self.network(0.0), internal=internal)
 
     def cross_point_stiffness(self, frequency_hz, amplitude=0.0) -> np.ndarray:
-        """Equivalent-linear cross-point dynamic stiffness K*(f, A) [N/m]: the base force
-        per engine-side displacement under a sine of amplitude ``amplitude`` [m] at
-        ``frequency_hz`` [Hz], base grounded (minus the two-port's ``b``)."""
+        """Equivalent-linear cross-point dynamic stiffness K*(f, A) [N/m] at ``frequency_hz``
+        [Hz] and ``amplitude`` [m], base grounded."""
         s = 2j * np.pi * np.asarray(frequency_hz, float)
         return -self.two_port(s, amplitude)[1]
 
@@ -254,17 +228,16 @@ class PortForces:
     Attributes
     ----------
     rows : ndarray (m, n)
-        Relative displacement across each port law per unit coordinate (engine-side row
-        minus base row).
+        Relative displacement across each port law per unit coordinate.
     kinds : ndarray int64 (m,); parameters : ndarray (m, n_par)
     laws : list
-        The port-law objects (for their initial state).
+        The port-law objects.
     force_map : ndarray (n_ch, m)
         Transmitted-force channels per unit port force (engine axes).
     names : list of str
         ``mount.direction`` of each port law.
     index : ndarray int (m,)
-        Each port law's network (the element's place among the assembled networks).
+        Each port law's network among the assembled networks.
     n_networks : int
         Networks in the model.
     """
@@ -279,32 +252,31 @@ class PortForces:
     n_networks: int = 0
 
     def network_amplitudes(self, amplitudes) -> np.ndarray:
-        """Amplitudes of every network (n_networks,) [m]: the port laws' ``amplitudes``
-        (m,) at their networks, zero at the linear ones (which ignore it)."""
+        """Amplitudes of every network (n_networks,) [m], zero at the linear ones."""
         out = np.zeros(self.n_networks)
         out[self.index] = amplitudes
         return out
 
     def describing_forces(self, amplitudes, relative) -> np.ndarray:
         """Equivalent-linear port forces (n_h, m) [N] of the relative-motion harmonics
-        ``relative`` (n_h, m) at the ``amplitudes`` (m,)."""
+        ``relative`` (n_h, m) at the ``amplitudes`` (m,) [m]."""
         k = np.array([0j if law is None else law.describing_stiffness(a)
                       for law, a in zip(self.laws, amplitudes)])
         z = relative * k[None, :]
-        z[0] = 0.0                                    # the mean: unloaded (module docstring)
+        z[0] = 0.0                                    # a port law carries no mean force
         return z
 
     def initial_state(self, x0, f0=None) -> np.ndarray:
-        """State rows (m, n_state) of every law at the initial coordinates ``x0``, expected
-        to carry the forces ``f0`` (m,) [N] (default: unloaded)."""
+        """State rows (m, n_state) at the coordinates ``x0`` carrying the forces ``f0`` (m,) [N]
+        (default: unloaded)."""
         u0 = self.rows @ np.asarray(x0, float)
         f0 = np.zeros(u0.size) if f0 is None else f0
         return _state_rows([np.zeros(1) if law is None else law.initial_state(u, f)
                             for law, u, f in zip(self.laws, u0, f0)])
 
     def steady_states(self, amplitudes, centres) -> np.ndarray:
-        """State rows (m, n_state) of every law at the lower tip of its steady loop of
-        ``amplitudes`` (m,) [m] about ``centres`` (m,) [m] (``law.steady_state``)."""
+        """State rows (m, n_state) at the lower tip of each steady loop of ``amplitudes`` [m]
+        about ``centres`` [m]."""
         return _state_rows([np.zeros(1) if law is None else law.steady_state(a, c)
                             for law, a, c in zip(self.laws, amplitudes, centres)])
 
@@ -340,7 +312,7 @@ def port_forces(elements, rows, force_map, names) -> PortForces | None:
 
 
 def _state_rows(states) -> np.ndarray:
-    """1-D arrays of any length (the laws' states or parameters) as zero-padded rows (m, n)."""
+    """1-D arrays of any length as zero-padded rows (m, n)."""
     states = [np.atleast_1d(st) for st in states]
     out = np.zeros((len(states), max(st.size for st in states)))
     for e, st in enumerate(states):

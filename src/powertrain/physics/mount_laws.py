@@ -1,13 +1,11 @@
 r"""Amplitude, preload and friction laws of a mount direction (SI).
 
-The thesis (Kovarik 2016, sec. 6) names amplitude dependence as its model's main limitation.
-A mount file's ``[amplitude]``, ``[friction]`` and ``[static]`` sections
-(:mod:`powertrain.iotools.mount_file`; ``docs/guide/amplitude-and-preload.md``) become
-:class:`PowerLaw` or :class:`TableLaw` (every spring and damper of the network times a factor
-of the amplitude :math:`A` across the mount, masses never scaled), :class:`BergFriction`
-(Berg 1998, *A non-linear rubber spring model for rail vehicle dynamics analysis*, Vehicle
-System Dynamics 30) and :class:`StaticCurve`;
-:class:`~powertrain.physics.mount_elements.MountElement` applies them.
+A mount file's ``[amplitude]``, ``[friction]`` and ``[static]`` sections become
+:class:`PowerLaw` or :class:`TableLaw` (every spring and damper times a factor of the
+amplitude :math:`A` across the mount, masses never scaled), :class:`BergFriction` (Berg 1998,
+*A non-linear rubber spring model for rail vehicle dynamics analysis*, Vehicle System
+Dynamics 30) and :class:`StaticCurve`; the thesis (Kovarik 2016, sec. 6) names amplitude
+dependence as its model's main limitation.
 """
 
 from __future__ import annotations
@@ -20,8 +18,8 @@ from scipy.interpolate import PPoly
 from powertrain.kernels.port_forces import BERG
 from powertrain.kernels.transient import POWER_LAW, TABLE_LAW
 
-#: Gauss–Legendre nodes per loop branch of Berg's describing function: the branch is smooth
-#: (a rational function of sin θ), so 48 nodes give the first harmonic to round-off.
+#: Gauss–Legendre nodes per loop branch of Berg's describing function (the branch is smooth:
+#: 48 nodes give the first harmonic to round-off).
 _GAUSS_NODES = 48
 
 
@@ -31,20 +29,17 @@ def _read_only(*arrays):
     return arrays
 
 
-#: The Gauss–Legendre rule of :data:`_GAUSS_NODES` nodes on [-1, 1]: nodes, weights
-#: (constants, read-only).
+#: Gauss–Legendre nodes and weights on [-1, 1] (read-only).
 _GAUSS_LEGENDRE = _read_only(*np.polynomial.legendre.leggauss(_GAUSS_NODES))
 
 
 def _berg_rule():
-    """The rule on θ in [-π/2, π/2] as Berg's describing function takes it: 1 + sin θ at
-    the nodes, and the weights times sin θ and cos θ (read-only)."""
+    """1 + sin θ at the nodes on [-π/2, π/2] and the weights times sin θ and cos θ."""
     t, w = _GAUSS_LEGENDRE
     theta, wq = 0.5 * np.pi * t, 0.5 * np.pi * w
     return _read_only(1.0 + np.sin(theta), wq * np.sin(theta), wq * np.cos(theta))
 
 
-#: :func:`_berg_rule` (constants).
 _BERG_RULE = _berg_rule()
 
 
@@ -62,8 +57,7 @@ class PowerLaw:
     limits : tuple of float
         ``(lo, hi)``, 0 < lo <= 1 <= hi.
     damping_exponent : float
-        :math:`\gamma` (1, the default: dampers like springs, a constant loss factor; 0:
-        dampers unchanged, the loss factor rising as the rubber softens).
+        :math:`\gamma` (1: constant loss factor; 0: dampers unchanged).
     """
 
     reference: float
@@ -132,15 +126,14 @@ class TableLaw:
 
 @dataclass(frozen=True)
 class StaticCurve:
-    """A static force–deflection curve: deflection [m] -> force [N] (both increasing), the
-    monotone cubic through its points (PCHIP), straight beyond them with the end slopes; the
-    network scales with its tangent stiffness at the operating point over that at
+    """A static force–deflection curve: the monotone cubic (PCHIP) through its points, straight
+    beyond them; the network scales with its tangent stiffness relative to that at
     ``reference_deflection``.
 
     Parameters
     ----------
     deflection, force : tuple of float
-        The datasheet points, deflection strictly increasing, force strictly increasing.
+        Datasheet points [m], [N], both strictly increasing.
     reference_deflection : float
         Where the dynamic data were measured [m].
     """
@@ -164,16 +157,9 @@ class StaticCurve:
 
 def pchip_cubic(x, y):
     """``(breaks, coefficients (n - 1, 4))`` of the monotone piecewise cubic Hermite
-    interpolant (PCHIP) through the points ``(x, y)`` (x increasing, n ≥ 2), each segment's
-    polynomial about its left end, highest power first (:class:`scipy.interpolate.PPoly`'s
-    layout). Slopes: at an interior point the weighted harmonic mean of the secants on each
-    side, weights ``2 h_k + h_k-1`` and ``h_k + 2 h_k-1``, zero where they differ in sign or
-    one is zero (Fritsch & Butland 1984, *A method for constructing local monotone
-    piecewise cubic interpolants*, SIAM J. Sci. Stat. Comput. 5); at an end the one-sided
-    three-point estimate, zero where its sign is not the end secant's and three times that
-    secant where the secants change sign and it is larger (Moler 2004, *Numerical Computing
-    with MATLAB*, §3.6); two points: the line. The interpolant of
-    :class:`scipy.interpolate.PchipInterpolator`, the same operations (tested bit for bit)."""
+    interpolant through ``(x, y)`` in :class:`scipy.interpolate.PPoly`'s layout; the same
+    operations as :class:`scipy.interpolate.PchipInterpolator` (Fritsch & Butland 1984, SIAM
+    J. Sci. Stat. Comput. 5; end slopes: Moler 2004, *Numerical Computing with MATLAB*, §3.6)."""
     x, y = np.asarray(x, float), np.asarray(y, float)
     h = x[1:] - x[:-1]
     m = (y[1:] - y[:-1]) / h
@@ -192,8 +178,7 @@ def pchip_cubic(x, y):
 
 
 def _pchip_end(h0, h1, m0, m1):
-    """:func:`pchip_cubic`'s slope at an end: ``h0``, ``m0`` its segment, ``h1``, ``m1`` the
-    next."""
+    """Slope at an end from its segment ``h0``, ``m0`` and the next ``h1``, ``m1``."""
     d = ((2 * h0 + h1) * m0 - h0 * m1) / (h0 + h1)
     if np.sign(d) != np.sign(m0):
         return 0.0
@@ -203,15 +188,13 @@ def _pchip_end(h0, h1, m0, m1):
 
 
 def curve_pchip(curve) -> PPoly:
-    """The PCHIP (:func:`pchip_cubic`, no extrapolation) through a :class:`StaticCurve`'s
-    points: force [N] of deflection [m]."""
+    """The PCHIP (no extrapolation) force [N] of deflection [m] of a :class:`StaticCurve`."""
     x, c = pchip_cubic(curve.deflection, curve.force)
     return PPoly(c.T, x, extrapolate=False)
 
 
 class CurveReader:
-    """A :class:`StaticCurve` read many times: its PCHIP (no extrapolation), the PCHIP's
-    derivative and the curve's ends built once; straight beyond its points."""
+    """A :class:`StaticCurve` read many times: its PCHIP, derivative and ends built once."""
 
     def __init__(self, curve):
         x = np.asarray(curve.deflection, float)
@@ -242,22 +225,18 @@ class CurveReader:
 
 @dataclass(frozen=True)
 class BergFriction:
-    r"""Berg's friction element, in parallel with the whole network; a port law of
-    :mod:`powertrain.physics.mount_elements`. From the last reversal point
-    :math:`(x_s, F_s)`, with :math:`\alpha = F_s/F_{max}` and :math:`y = x - x_s`,
+    r"""Berg's friction element in parallel with the network (a port law). From the last
+    reversal point :math:`(x_s, F_s)`, with :math:`\alpha = F_s/F_{max}`, :math:`y = x - x_s`,
 
     .. math:: F = F_s + \frac{y}{x_2(1-\alpha) + y}(F_{max} - F_s)\ (y \ge 0),\qquad
               F = F_s + \frac{y}{x_2(1+\alpha) - y}(F_{max} + F_s)\ (y \le 0),
-
-    so that from the unloaded state :math:`F = F_{max}/2` at :math:`y = x_2`.
 
     Parameters
     ----------
     max_force : float
         :math:`F_{max}` [N] (>= 0; 0: no friction).
     half_displacement : float
-        :math:`x_2` [m] (> 0): displacement from the unloaded state at which half of
-        ``max_force`` is reached.
+        :math:`x_2` [m] (> 0): displacement from the unloaded state to half of ``max_force``.
     """
 
     max_force: float
@@ -268,8 +247,8 @@ class BergFriction:
         return np.array([self.max_force, self.half_displacement], float)
 
     def initial_state(self, u0: float, f0: float = 0.0) -> np.ndarray:
-        """Unloaded at ``u0`` when ``f0`` is 0; otherwise on the virgin curve carrying ``f0``
-        (clipped inside ±max_force): state ``[x_s, F_s, direction, u_last, F_last]``."""
+        """State ``[x_s, F_s, direction, u_last, F_last]`` at ``u0`` on the virgin curve
+        carrying ``f0`` (clipped inside ±max_force)."""
         fm = self.max_force
         f = float(np.clip(f0, -0.999 * fm, 0.999 * fm)) if fm > 0 else 0.0
         if f == 0.0:
@@ -280,9 +259,8 @@ class BergFriction:
         return np.array([u0 - y, 0.0, np.sign(f), u0, f])
 
     def steady_state(self, amplitude: float, centre: float = 0.0) -> np.ndarray:
-        """State on the symmetric steady loop of amplitude ``amplitude`` [m] about
-        ``centre`` [m], just reversed at its lower tip :math:`(c - A, -F_r)` and moving up
-        (a displacement-driven test started here is periodic from its first cycle)."""
+        """State just reversed at the lower tip of the steady loop of ``amplitude`` [m] about
+        ``centre`` [m], moving up."""
         fr = float(self.loop_amplitude_force(amplitude))
         low = centre - amplitude
         return np.array([low, -fr, 1.0, low, -fr])
@@ -303,11 +281,9 @@ class BergFriction:
         return 2 * A * fm / (b + np.sqrt(b * b + 4 * x2 * A))
 
     def describing_stiffness(self, amplitude) -> np.ndarray:
-        r"""Equivalent complex stiffness [N/m] at the displacement amplitude [m]: the first
-        harmonic of the steady loop under :math:`u = A\sin\theta`,
+        r"""Equivalent complex stiffness [N/m] at the amplitude [m]: the first harmonic
         :math:`k_{eq} = \frac{2}{\pi A}\int_{-\pi/2}^{\pi/2} F_\uparrow(\theta)
-        (\sin\theta + i\cos\theta)\,d\theta` (the descending branch mirrors the ascending
-        one); its imaginary part is the loop area over :math:`\pi A^2`."""
+        (\sin\theta + i\cos\theta)\,d\theta` of the steady loop."""
         A = np.atleast_1d(np.asarray(amplitude, float))
         out = np.full(A.shape, self.initial_stiffness + 0j if self.max_force > 0 else 0j)
         big = A > 1e-12 * self.half_displacement

@@ -1,61 +1,23 @@
 r"""Exact slider-crank kinematics and the forces of one cylinder on the engine block.
 
-Plane of one cylinder
----------------------
-The crank rotates at constant angular speed :math:`\omega` [rad/s]. In the plane of the
-cylinder, :math:`u` is the cylinder axis (pointing from the crank axis to the head) and
-:math:`s` the lateral direction into which the crank pin moves just after top dead centre.
-The crank angle :math:`\theta` [rad] is measured from the cylinder axis in the sense of
-rotation. The piston pin moves on the line :math:`s = e` (piston-pin offset :math:`e` [m],
-positive towards :math:`+s`. In the power stroke the rod pushes the piston towards
-:math:`-s`, so :math:`-s` is the major thrust side and the usual offset towards it is
-:math:`e < 0`).
-
-With crank radius :math:`r` [m], connecting-rod length :math:`l` [m] and the rod angle
-:math:`\beta` (no series expansion anywhere):
+In the cylinder plane :math:`u` is the cylinder axis (crank axis to head) and :math:`s` the
+lateral direction the crank pin moves into just after TDC; the crank angle :math:`\theta`
+[rad] is measured from :math:`u` in the sense of rotation. The piston pin moves on
+:math:`s = e` (pin offset [m]; the usual offset towards the major thrust side is
+:math:`e < 0`). With crank radius :math:`r`, rod length :math:`l` and rod angle
+:math:`\sin\beta = (r\sin\theta - e)/l`, exactly (no series expansion):
 
 .. math::
 
-    \sin\beta = \frac{r\sin\theta - e}{l}, \qquad
-    y = r\cos\theta + l\cos\beta,
-
+    y = r\cos\theta + l\cos\beta, \qquad
     \frac{dy}{d\theta} = -\frac{r\sin(\theta+\beta)}{\cos\beta}, \qquad
-    \frac{d^2y}{d\theta^2} = -r\cos\theta - l\cos\beta\,\beta'^2 - l\sin\beta\,\beta'',
+    \frac{d^2y}{d\theta^2} = -r\cos\theta - l\cos\beta\,\beta'^2 - l\sin\beta\,\beta''
 
-    \beta' = \frac{r\cos\theta}{l\cos\beta}, \qquad
-    \beta'' = \frac{l\sin\beta\,\beta'^2 - r\sin\theta}{l\cos\beta},
-
-and the piston acceleration is :math:`a = \omega^2\, d^2y/d\theta^2` [m/s²] along :math:`u`
-(Heywood 1988, sec. 2.2; Taylor 1985, vol. 2, ch. 8 for the forces). For :math:`e = 0` its
-Fourier series is :math:`a = -r\omega^2(\cos\theta + A_2\cos 2\theta - A_4\cos 4\theta
-+ \dots)` with :math:`A_2 = \lambda + \lambda^3/4 + 15\lambda^5/128 + \dots`,
-:math:`\lambda = r/l` (see :func:`second_order_coefficient`).
-
-Forces (the connecting rod's mass is split into a reciprocating part lumped at the piston pin
-and a rotating part at the crank pin; its moment-of-inertia correction is neglected)
-------------------------------------------------------------------------------------
-With gas force :math:`F_g = (p - p_{cc})A` [N] on the piston crown (towards the crank) and
-reciprocating mass :math:`m` [kg], the piston's equilibrium gives the rod force (compression
-positive) and the wall force on the piston
-
-.. math::
-
-    F_r = \frac{F_g + m a}{\cos\beta}, \qquad N = F_r \sin\beta ,
-
-and the crank torque in the sense of rotation
-
-.. math::
-
-    T = F_r\, r \sin(\theta + \beta) = -(F_g + m a)\,\frac{dy}{d\theta}.
-
-Forces on the block (the crank is assumed to turn at constant speed, the torque :math:`T`
-leaves through the crankshaft): gas on the head :math:`+F_g\,u` on the cylinder axis,
-piston side thrust :math:`-N\,s` at the piston pin together with the couple
-:math:`e F_g` (in the :math:`s\times u` sense) that the pin offset puts into the wall
-contact, and the main-bearing reaction :math:`F_r(\sin\beta\,s - \cos\beta\,u)` on the crank
-axis. Their sum is the shaking force :math:`-m a\,u` on the pin line plus the torque
-reaction :math:`-T` about the axis of rotation; :func:`block_forces` returns them separately
-so that each can be placed at its own point.
+(Heywood 1988, sec. 2.2). Forces (Taylor 1985, vol. 2, ch. 8; rod mass split into
+reciprocating and rotating parts): with gas force :math:`F_g` and reciprocating mass
+:math:`m`, rod force :math:`F_r = (F_g + m a)/\cos\beta`, side thrust
+:math:`N = F_r\sin\beta`, crank torque :math:`T = -(F_g + m a)\,dy/d\theta`. On the block
+they sum to the shaking force :math:`-m a\,u` plus the torque reaction :math:`-T`.
 """
 
 from __future__ import annotations
@@ -70,24 +32,14 @@ def piston_kinematics(theta, r, l, e=0.0):
     ----------
     theta : array_like
         Crank angle from the cylinder axis [rad].
-    r : float
-        Crank radius [m].
-    l : float
-        Connecting-rod length [m].
-    e : float, optional
-        Piston-pin offset [m].
+    r, l, e : float
+        Crank radius, connecting-rod length, piston-pin offset [m].
 
     Returns
     -------
-    y : ndarray
-        Piston-pin distance from the crank axis along the cylinder axis [m].
-    dy : ndarray
-        :math:`dy/d\theta` [m/rad].
-    d2y : ndarray
-        :math:`d^2y/d\theta^2` [m/rad²]; the acceleration at constant speed is
-        :math:`\omega^2\,d^2y/d\theta^2` [m/s²].
-    beta : ndarray
-        Rod angle [rad], :math:`\sin\beta = (r\sin\theta - e)/l`.
+    y, dy, d2y, beta : ndarray
+        Piston-pin distance from the crank axis [m], :math:`dy/d\theta` [m/rad],
+        :math:`d^2y/d\theta^2` [m/rad²] and the rod angle [rad].
     """
     theta = np.asarray(theta, dtype=float)
     beta = np.arcsin((r * np.sin(theta) - e) / l)
@@ -101,16 +53,9 @@ def piston_kinematics(theta, r, l, e=0.0):
 
 
 def stroke_limits(r, l, e=0.0):
-    r"""Piston-pin positions at top and bottom dead centre [m] and their crank angles [rad].
-
-    .. math:: y_{TDC} = \sqrt{(l+r)^2 - e^2}, \quad y_{BDC} = \sqrt{(l-r)^2 - e^2},
-              \quad \sin\theta_{TDC} = \frac{e}{l+r}, \quad
-              \sin(\theta_{BDC}-\pi) = -\frac{e}{l-r}
-
-    Returns
-    -------
-    y_tdc, y_bdc, theta_tdc, theta_bdc : float
-    """
+    r"""Piston-pin positions at TDC and BDC [m] and their crank angles [rad]:
+    ``(y_tdc, y_bdc, theta_tdc, theta_bdc)``, :math:`y_{TDC} = \sqrt{(l+r)^2 - e^2}`,
+    :math:`\sin\theta_{TDC} = e/(l+r)`."""
     y_tdc = float(np.sqrt((l + r) ** 2 - e**2))
     y_bdc = float(np.sqrt((l - r) ** 2 - e**2))
     theta_tdc = float(np.arcsin(e / (l + r)))
@@ -119,10 +64,8 @@ def stroke_limits(r, l, e=0.0):
 
 
 def cylinder_volume(theta, bore, r, l, e, compression_ratio):
-    r"""Cylinder volume [m³] from the exact kinematics.
-
-    .. math:: V = V_c + A\,(y_{TDC} - y), \qquad V_c = \frac{V_d}{\varepsilon - 1},
-              \qquad V_d = A\,(y_{TDC} - y_{BDC}), \qquad A = \pi B^2/4
+    r"""Cylinder volume :math:`V = V_c + A\,(y_{TDC} - y)`, :math:`V_c = V_d/(\varepsilon - 1)`
+    [m³], from the exact kinematics.
 
     Parameters
     ----------
@@ -137,10 +80,8 @@ def cylinder_volume(theta, bore, r, l, e, compression_ratio):
 
     Returns
     -------
-    V : ndarray
-        Volume [m³].
-    dV : ndarray
-        :math:`dV/d\theta` [m³/rad].
+    V, dV : ndarray
+        Volume [m³] and :math:`dV/d\theta` [m³/rad].
     """
     area = np.pi * bore**2 / 4.0
     y_tdc, y_bdc, _, _ = stroke_limits(r, l, e)
@@ -172,8 +113,7 @@ def crank_forces(theta, omega, gas_force, r, l, e, m_rec, alpha=0.0):
     m_rec : float
         Reciprocating mass (piston group plus the rod's small-end share) [kg].
     alpha : float or array_like
-        Crank angular acceleration [rad/s²] (0: constant speed); the piston acceleration
-        is :math:`\omega^2 y'' + \alpha y'`.
+        Crank angular acceleration [rad/s²]: piston acceleration :math:`\omega^2 y'' + \alpha y'`.
 
     Returns
     -------
@@ -197,13 +137,8 @@ def crank_forces(theta, omega, gas_force, r, l, e, m_rec, alpha=0.0):
 
 
 def second_order_coefficient(lam, terms=3):
-    r"""Coefficient :math:`A_2` of :math:`\cos 2\theta` in :math:`-a/(r\omega^2)` for
-    :math:`e = 0`.
-
-    .. math:: A_2 = \lambda + \tfrac14\lambda^3 + \tfrac{15}{128}\lambda^5 + \dots
-
-    (binomial expansion of :math:`\sqrt{1-\lambda^2\sin^2\theta}`; Taylor 1985, vol. 2,
-    ch. 8). The first omitted term is of order :math:`\lambda^7` (about 35/512 λ⁷).
+    r"""Coefficient :math:`A_2 = \lambda + \lambda^3/4 + 15\lambda^5/128 + \dots` of
+    :math:`\cos 2\theta` in :math:`-a/(r\omega^2)` for :math:`e = 0` (Taylor 1985, vol. 2, ch. 8).
 
     Parameters
     ----------
