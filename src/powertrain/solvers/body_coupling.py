@@ -170,8 +170,7 @@ def coupled_solve(M, omega, rows, shapes, abc, kip, body, load, rows_on=None):
     ndarray (n_r, n_h, 6 + K) complex: :math:`\hat{\mathbf q}` then :math:`\hat{\boldsymbol\eta}`.
     """
     frame, E, B = coupled_frame(M, rows, shapes, body, rows_on)
-    return harmonic_solve(frame, E, B, (kip, abc[1], abc[2]), 1j * np.asarray(omega, float),
-                          load)
+    return harmonic_solve(frame, E, B, (kip, abc[1], abc[2]), 1j * np.asarray(omega, float), load)
 
 
 def coupled_frame(M, rows, shapes, body, rows_on=None):
@@ -185,8 +184,7 @@ def coupled_rows(rows, shapes):
     """The networks' engine and base rows ``(E, B)``, each (n_net, 6 + K), from the network
     ``rows`` (n_net, 6) and body ``shapes`` (n_net, K)."""
     K = shapes.shape[1]
-    return (np.hstack([rows, np.zeros((rows.shape[0], K))]),
-            np.hstack([np.zeros_like(rows), shapes]))
+    return (np.hstack([rows, np.zeros((rows.shape[0], K))]), np.hstack([np.zeros_like(rows), shapes]))
 
 
 def coupled_matrix(M, omega, rows, shapes, abc, kip, body):
@@ -209,8 +207,7 @@ def one_more_mode_basis(M, omega, rows, shapes, abc, kip, body, load):
     f[..., :6, 0] = load
     X = np.linalg.solve(D, np.concatenate([f, U], axis=-1))
     x0, W = X[..., 0], X[..., 1:]
-    return (x0, W, np.einsum("...in,...i->...n", U, x0), np.einsum("...in,...im->...nm", U, W),
-            abc[2])
+    return (x0, W, np.einsum("...in,...i->...n", U, x0), np.einsum("...in,...im->...nm", U, W), abc[2])
 
 
 def one_more_mode(basis, shape, impedance):

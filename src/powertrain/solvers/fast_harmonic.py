@@ -270,8 +270,7 @@ class HarmonicModel:
         if self.static_scale is not None:
             els = [dataclasses.replace(el, static_factor=self.static_scale[:, k:k + 1])
                    for k, el in enumerate(els)]
-        return element_two_ports(els, 1j * self.omega, np.asarray(amplitudes, float)[:, None],
-                                 packed)
+        return element_two_ports(els, 1j * self.omega, np.asarray(amplitudes, float)[:, None], packed)
 
     def two_ports_on_base(self, abc, mass, stiffness, zeta):
         r"""The two-ports ``abc`` (each (n_r, 17, n_net)) on a base of ``mass`` [kg],
@@ -292,8 +291,7 @@ class HarmonicModel:
         return self.static_scale[:, None, list(index)]
 
     # ------------------------------------------------------------------ solves
-    def solve(self, kip, load=None, harmonics=slice(1, N_HARMONICS), abc=None,
-              body=None) -> np.ndarray:
+    def solve(self, kip, load=None, harmonics=slice(1, N_HARMONICS), abc=None, body=None) -> np.ndarray:
         r"""Amplitudes :math:`\hat{\mathbf q}` (n_r, n_h, 6 [+ K], body modes last) at the
         input-point stiffnesses ``kip`` (n_r, 17, n_net) [N/m] under ``load`` (default
         nominal) at the ``harmonics``; a modal body (``body``, default :attr:`body`) couples
@@ -312,8 +310,7 @@ class HarmonicModel:
                                  tuple(x[:, harmonics] for x in abc), K, body,
                                  load[:, harmonics], rows_on)
         frame = (self.M, np.zeros((6, 6)), np.zeros((6, 6)))
-        return harmonic_solve(frame, self.rows, None, (K, None, None), 1j * w,
-                              load[:, harmonics])
+        return harmonic_solve(frame, self.rows, None, (K, None, None), 1j * w, load[:, harmonics])
 
     def solve_one_more_mode(self, body, harmonics=slice(1, N_HARMONICS)) -> np.ndarray:
         """:meth:`solve`'s amplitudes (n_r, n_h, 6 + K + 1) of the nominal model at the
@@ -332,8 +329,7 @@ class HarmonicModel:
         j = np.arange(N_HARMONICS)[harmonics] - 1
         last = self._one_more_mode_at
         if last is None or not np.array_equal(last[0], j):     # the fit's orders: once
-            last = self._one_more_mode_at = (j, tuple(self._extra[k][0][:, j]
-                                                      for k in _ONE_MORE_MODE))
+            last = self._one_more_mode_at = (j, tuple(self._extra[k][0][:, j] for k in _ONE_MORE_MODE))
         basis = last[1]
         shape = body.network_shapes(self.networks, self.mount_axes)[:, -1]
         w = self.omega[:, harmonics]
@@ -392,8 +388,7 @@ class HarmonicModel:
     def _of_shapes(self, name, body, make):
         """``make()``, kept under ``name`` while ``body`` has the same shape arrays."""
         kept = self._body_memo.get(name)
-        if (kept is None or kept[0] is not body.mount_shapes
-                or kept[1] is not body.point_shapes):
+        if (kept is None or kept[0] is not body.mount_shapes or kept[1] is not body.point_shapes):
             kept = self._body_memo[name] = (body.mount_shapes, body.point_shapes, make())
         return kept[2]
 

@@ -336,8 +336,7 @@ def _start(engine, manoeuvre, system, load, ports, model):
     omega = abs(float(load.omega[0]))
     if omega < REST_RPM * RPM:  # at rest where the driveline holds the block (none: at zero)
         held = driveline_reaction(engine, manoeuvre, load.driveline_torque[0])
-        x0 = (_static_state(system, scaling, curves, held, manoeuvre.file) if held.any()
-              else np.zeros(n))
+        x0 = (_static_state(system, scaling, curves, held, manoeuvre.file) if held.any() else np.zeros(n))
         state = laws.initial_state(x0) if laws.kinds.size else None
         return x0, np.zeros(n), None, state, np.zeros(ports.kinds.size)
     grid = Cycles(N_THETA, 720.0 / N_THETA, 1, 1)
@@ -429,8 +428,7 @@ class _Curves:
 
     def kernel_tuple(self):
         """``(d0, f0, breaks, coefficients, count, reference tangent, has)``."""
-        return (self.d0, self.f0, *self.support.cubics, self.support.reference_tangent,
-                self.has)
+        return (self.d0, self.f0, *self.support.cubics, self.support.reference_tangent, self.has)
 
     def factors(self, x):
         """Static factor of every network at the state ``x`` (1 without a curve)."""

@@ -133,8 +133,7 @@ def driveline_reaction(engine, manoeuvre, driveline):
 def driveline_moment(engine, manoeuvre, driveline):
     """The moment (...) [N·m] about the engine's x axis of :func:`driveline_reaction`
     (same arguments)."""
-    return -manoeuvre.gear_ratio * np.asarray(driveline, float) * float(
-        engine.crank.rotation_sign)
+    return -manoeuvre.gear_ratio * np.asarray(driveline, float) * float(engine.crank.rotation_sign)
 
 
 class _GasTable:
@@ -210,8 +209,7 @@ class _GasTable:
     def _scale_index(self, scale):
         s = self.scales
         if s.size == 1:
-            return np.zeros(scale.size, np.int64), np.zeros(scale.size, np.int64), \
-                np.zeros(scale.size)
+            return np.zeros(scale.size, np.int64), np.zeros(scale.size, np.int64), np.zeros(scale.size)
         j = np.clip(np.searchsorted(s, scale, side="right") - 1, 0, s.size - 2)
         w = np.clip((scale - s[j]) / (s[j + 1] - s[j]), 0.0, 1.0)
         return j, j + 1, w
@@ -250,8 +248,7 @@ def _levels(manoeuvre, zero):
     if manoeuvre.load_kind == "mean_torque":
         return np.r_[[-1.0] if np.any(manoeuvre.load < 0) else [], TORQUE_SCALES]
     s_max = float(np.max(manoeuvre.load))
-    top = np.ceil(max(np.max((s_max - zero) / (1.0 - zero)), 0.0) / LEVEL_STEP - 1e-9) \
-        * LEVEL_STEP
+    top = np.ceil(max(np.max((s_max - zero) / (1.0 - zero)), 0.0) / LEVEL_STEP - 1e-9) * LEVEL_STEP
     fired = np.arange(0.0, top + LEVEL_STEP / 2, LEVEL_STEP)
     low = [-1.0] if np.min(manoeuvre.load) < np.max(zero) else []
     return np.r_[low, fired if fired.size > 1 or low else [0.0, LEVEL_STEP]]
