@@ -119,8 +119,7 @@ class CycleIntegrator:
         the networks scaled at ``amplitudes`` [m] and static ``factors``, or by ``scales``
         (n_net, 2) if given."""
         s = self.scaling
-        if scales is None:
-            scales = s.scales(self.ports.network_amplitudes(amplitudes), factors)
+        scales = s.scales(self.ports.network_amplitudes(amplitudes), factors) if scales is None else scales
         C, K, Fk, Fd = s.matrices(scales)
         self._first = self._first or (K, Fk)
         shifted = K is not self._first[0]

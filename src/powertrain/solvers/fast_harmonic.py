@@ -1,21 +1,15 @@
 r"""Cached frequency-domain model for many cheap re-solves (diagnosis, truth generation).
 
 :class:`HarmonicModel` caches the load harmonics :math:`\hat{\mathbf f}_{r,h}` (speed r,
-harmonic h = 0..16, orders 0..8 in steps of 0.5) [N, N·m] and each network's two-port
-between its engine-side node E and base node B, internal masses condensed,
-:math:`[F_E; F_B] = [[a, b]; [b, c]]\,[x_E; x_B]` (:math:`a = K_{IP}`, :math:`b = -K_{CP}` on
-a rigid ground). A base of mass :math:`m_b`, stiffness :math:`c_b`, damping :math:`d_b`
-gives exactly :math:`K_{IP}' = a - b^2/(c + c_b + i\omega d_b - \omega^2 m_b)`
-(:func:`powertrain.models.extensions.with_base_compliance`); scaling a network's springs,
-dampers and masses by :math:`s` scales :math:`(a, b, c)` by :math:`s`.
-:meth:`HarmonicModel.solve` solves for all speeds and harmonics at once
+harmonic h = 0..16: orders 0..8) [N, N·m] and each network's two-port :math:`(a, b, c)`,
+internal masses condensed (:math:`a = K_{IP}`, :math:`b = -K_{CP}` on a rigid ground; scaling
+springs, dampers and masses by :math:`s` scales it by :math:`s`), and solves at once
 
 .. math:: \Big(-\omega_h^2\mathbf M_{rb} + \sum_n K_{IP,n}(\omega_h)\,
           \mathbf r_n\mathbf r_n^T\Big)\hat{\mathbf q}_{r,h} = \hat{\mathbf f}_{r,h},
 
-and the channel velocities are :math:`\hat{\mathbf v} = i\omega_h\mathbf C\hat{\mathbf q}`
-(the numbers of :func:`powertrain.workflows.runup.run_runup` with ``solver="harmonic"``,
-tests/test_diagnose.py).
+channel velocities :math:`\hat{\mathbf v} = i\omega_h\mathbf C\hat{\mathbf q}` (the numbers of
+:func:`powertrain.workflows.runup.run_runup` with ``solver="harmonic"``, tests/test_diagnose.py).
 """
 
 from __future__ import annotations
@@ -94,9 +88,8 @@ class HarmonicModel:
         Rigid-body coordinates to mount-point motion in engine X/Y/Z.
     networks : list of (mount index, axis name, MountModel)
     elements : list of MountElement
-        One per network; nonlinear ones act through :meth:`two_ports_at`.
+        One per network (nonlinear ones: :meth:`two_ports_at`).
     packed : PackedNetworks
-        The networks packed once for the two-port kernel.
     """
 
     def __init__(self, engine, rpm, n_angle=N_ANGLE, system=None):
@@ -149,7 +142,6 @@ class HarmonicModel:
         self.output = np.array([self.channels.index(tuple(c)) for c in channels], int)
         self._extra = {k: v for k, v in self._extra.items() if not k.startswith(_VELOCITY_OF)}
 
-    # ------------------------------------------------------------------ cached parts
     def load_of(self, engine) -> np.ndarray:
         """Load harmonics (n_r, 17, 6) complex [N, N·m] of ``engine`` at the model's speeds
         (:meth:`Engine.load_table <powertrain.models.engine.Engine.load_table>`)."""
@@ -290,7 +282,6 @@ class HarmonicModel:
             return 1.0
         return self.static_scale[:, None, list(index)]
 
-    # ------------------------------------------------------------------ solves
     def solve(self, kip, load=None, harmonics=slice(1, N_HARMONICS), abc=None, body=None) -> np.ndarray:
         r"""Amplitudes :math:`\hat{\mathbf q}` (n_r, n_h, 6 [+ K], body modes last) at the
         input-point stiffnesses ``kip`` (n_r, 17, n_net) [N/m] under ``load`` (default

@@ -102,8 +102,7 @@ def newmark_ports(M, C, K, F, h, ports, x0=None, v0=None, a0=None, z0=None, stat
     P = np.ascontiguousarray(ports.rows, float)
     x0 = np.zeros(P.shape[1]) if x0 is None else x0
     v0 = np.zeros(P.shape[1]) if v0 is None else v0
-    if state is None:
-        state = ports.initial_state(x0, z0)
+    state = ports.initial_state(x0, z0) if state is None else state
     z0 = ports.forces(P @ x0, P @ v0, state)
     Fs, x0, v0, a0 = _start(M, C, K, F, Sinv, x0, v0, a0, P.T @ z0)
     W = np.ascontiguousarray(Sinv @ P.T)

@@ -101,8 +101,7 @@ def simulate_sweep(engine, rpm_from, rpm_to, rate_rpm_per_s, sample_rate=8192.0,
     _check(engine, rpm_from, rpm_to, rate_rpm_per_s, sample_rate)
     m, n_steps = sweep_steps(rpm_from, rpm_to, rate_rpm_per_s, sample_rate)
     h = 1.0 / (m * sample_rate)
-    if system is None:
-        system = engine.assemble()
+    system = engine.assemble() if system is None else system
     if system.chassis is not None:
         system.chassis.require_time_domain()
     load = _load_table(engine, rpm_from, rpm_to)
