@@ -215,7 +215,8 @@ def one_more_mode(basis, shape, impedance):
     with one more mode of shape ``shape`` (n_net,) along the networks and modal dynamic
     stiffness ``impedance`` (...) [N/m], exactly by the Schur complement: with
     :math:`z = Z + \sum_n c_n s_n'^2`, :math:`\eta = -\mathbf s'\cdot\mathbf P/(z -
-    \mathbf s'^T\mathbf G\mathbf s')`, :math:`\mathbf x = \mathbf x_0 - \eta\,\mathbf W\mathbf s'`."""
+    \mathbf s'^T\mathbf G\mathbf s')`, :math:`\mathbf x = \mathbf x_0 - \eta\,\mathbf W\mathbf s'`
+    (tests/test_missing_body_mode.py)."""
     x0, W, P, G, c = basis
     s = np.asarray(shape, float)
     z = impedance + (c * s ** 2).sum(axis=-1) - np.einsum("n,...nm,m->...", s, G, s)

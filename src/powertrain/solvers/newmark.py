@@ -162,7 +162,7 @@ class ModalNewmark:
     \end{bmatrix}`, whose propagator shares the eigenvectors of :math:`\mathbf A`: one
     eigendecomposition makes every step a diagonal recurrence
     (:func:`~powertrain.kernels.newmark.modal_trapezoid_kernel`) equal to :func:`newmark` to
-    round-off. Needs a regular mass matrix.
+    round-off (tests/test_runup.py). Needs a regular mass matrix.
 
     Parameters
     ----------
@@ -313,9 +313,9 @@ class ModalNewmark:
 class ModalPortNewmark:
     r""":func:`newmark_ports` in modal coordinates for fixed matrices
     (:func:`powertrain.kernels.port_forces.modal_port_kernel`; equal to :func:`newmark_ports`
-    to round-off and the Newton tolerance). The port motions are read on the reduced
-    coordinates the load and the port rows touch. Outputs ``y = Wx x + Wv v + Wa a + Wz z``
-    (None: no such term).
+    to round-off and the Newton tolerance, tests/test_time_domain_laws.py), the port motions
+    read on the coordinates the load and the port rows touch. Outputs ``y = Wx x + Wv v +
+    Wa a + Wz z`` (None: no such term).
 
     Parameters
     ----------

@@ -1,16 +1,11 @@
 r"""The run-up's per-speed solvers behind one protocol, chosen once per run.
 
 A :class:`Stepper` turns one speed's load over an engine cycle into the order amplitudes of
-every channel (:class:`SpeedOrders`): :class:`HarmonicStepper` (frequency-domain steady state,
-:func:`powertrain.solvers.harmonic.harmonic_response`), :class:`AdmittanceStepper` (the same
-with a measured-receptance body, :func:`powertrain.solvers.admittance.frf_response`),
-:class:`ModalNewmarkStepper` (Newmark average acceleration diagonalised once per model,
-:class:`powertrain.solvers.newmark.ModalNewmark`), :class:`DenseNewmarkStepper` (the same
-recurrence in physical coordinates) and :class:`ModalPortStepper` (the modal recurrence with
-the port laws, :class:`powertrain.solvers.newmark.ModalPortNewmark`). :func:`choose_stepper`
-picks one. With nonlinear mount elements (``system.port_forces()``) the Newmark steppers
-integrate the port laws by Newton per step, the linear modal one refuses them, and the
-frequency-domain steppers solve the equivalent-linear model
+every channel (:class:`SpeedOrders`), in the frequency domain (:class:`HarmonicStepper`,
+:class:`AdmittanceStepper`) or by Newmark average acceleration (:class:`ModalNewmarkStepper`,
+:class:`DenseNewmarkStepper`, :class:`ModalPortStepper`); :func:`choose_stepper` picks one.
+Nonlinear mount elements: the Newmark steppers integrate the port laws by Newton per step,
+the frequency-domain ones solve the equivalent-linear model
 (:mod:`powertrain.solvers.equivalent_linear`).
 """
 
@@ -158,7 +153,8 @@ class Stepper:
 
 
 class HarmonicStepper(Stepper):
-    """Frequency-domain steady state per order (rigid or modal body)."""
+    """Frequency-domain steady state per order (rigid or modal body,
+    :func:`powertrain.solvers.harmonic.harmonic_response`)."""
 
     solver = "harmonic"
 
@@ -183,7 +179,8 @@ class HarmonicStepper(Stepper):
 
 
 class AdmittanceStepper(Stepper):
-    """Frequency-domain steady state per order with a measured-receptance body."""
+    """Frequency-domain steady state per order with a measured-receptance body
+    (:func:`powertrain.solvers.admittance.frf_response`)."""
 
     solver = "harmonic"
 
@@ -235,8 +232,9 @@ class _NewmarkStepper(Stepper):
 
 
 class ModalNewmarkStepper(_NewmarkStepper):
-    """Newmark recurrence diagonalised once per model; needs a regular mass matrix and at
-    least two processed cycles."""
+    """Newmark recurrence diagonalised once per model
+    (:class:`powertrain.solvers.newmark.ModalNewmark`); linear models with a regular mass
+    matrix and two processed cycles."""
 
     implementation = "modal (diagonalised recurrence)"
 
