@@ -230,8 +230,7 @@ def rigid_body_modes(system, inertia, *, static=False, crank_axis=(1.0, 0.0, 0.0
 
 
 def _mode_fields(MR, s, phi, omegas, static_shapes, tra, static) -> list:
-    """The fields of a :class:`powertrain.results.modes.Mode` for each root ``s`` (k,) and
-    shape ``phi`` (n_R, k)."""
+    """Fields of a :class:`powertrain.results.modes.Mode` per root ``s`` and shape ``phi``."""
     pairs = _pair_with_static(MR, phi, static_shapes)
     phi = _normalise(MR, phi)
     e = (np.conj(phi) * (MR @ phi)).real
@@ -254,8 +253,7 @@ def _mode_fields(MR, s, phi, omegas, static_shapes, tra, static) -> list:
 
 
 def _as_measured(system):
-    """``(system, note)``: a nonlinear model with every network as measured
-    (:meth:`NetworkScaling.as_measured`) and its method note; a linear model as it is."""
+    """``(system, note)``: a nonlinear model with its networks as measured, and its note."""
     if system.port_forces() is None:
         return system, ""
     return NetworkScaling(system).as_measured(), "; " + AS_MEASURED

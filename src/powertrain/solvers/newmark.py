@@ -369,8 +369,7 @@ class ModalPortNewmark:
         self.port_arrays = (T, load_at, np.ascontiguousarray(0.25 * h * h * (T @ S @ T.T)))
 
     def _output_arrays(self, Wx=None, Wv=None, Wa=None, Wz=None):
-        """``((Wyz, y_cols, z_cols), w_rows, W, Wd)`` of :func:`modal_port_kernel` for the
-        output rows: rows ``w_rows`` also read ``Re(W eta) + Wd p`` off the modal state."""
+        """``((Wyz, y_cols, z_cols), w_rows, W, Wd)`` of :func:`modal_port_kernel` for the outputs."""
         modal, n, r = self.modal, self.modal.n, self.reduced
         off = np.setdiff1d(np.arange(n), r)
         rows = next(w.shape[0] for w in (Wx, Wv, Wa, Wz) if w is not None)

@@ -106,8 +106,7 @@ class StaticSupport:
 
 
 def _padded(pieces):
-    """The networks' ``(breaks, coefficients)`` stacked: breaks padded with their last,
-    coefficients with zeros, and the counts."""
+    """The networks' ``(breaks, coefficients)`` padded to one size, and their counts."""
     size = max(b.size for b, _ in pieces)
     breaks, coefficients = np.empty((len(pieces), size)), np.zeros((len(pieces), size - 1, 4))
     for i, (b, c) in enumerate(pieces):
@@ -117,8 +116,7 @@ def _padded(pieces):
 
 
 def _cubic(curve, stiffness):
-    """``(breaks, coefficients)`` of a network's force: its ``curve``'s PCHIP, or the line
-    ``stiffness`` × deflection."""
+    """``(breaks, coefficients)`` of the ``curve``'s PCHIP, or of the line ``stiffness`` × δ."""
     if curve is None:
         return np.array([0.0, 1.0]), np.array([[0.0, 0.0, stiffness, 0.0]])
     return pchip_cubic(curve.deflection, curve.force)

@@ -134,9 +134,7 @@ def crank_pulses(time, rpm_from, rate_rpm_per_s):
 
 
 def _pulse_train(theta, period, edge):
-    """Pulses [V] at ``theta`` [rad], one per ``period``, high for half of it; the linear
-    flank crosses the tracker's trigger level (:data:`~powertrain.analysis.speed.TRIGGER_HIGH`)
-    at ``edge`` modulo ``period``."""
+    """Pulses [V] at ``theta`` [rad], one per ``period``, crossing the trigger level at ``edge``."""
     flank = np.radians(PULSE_FLANK_DEG)
     phi = np.mod(theta - edge + TRIGGER_HIGH * flank, period)
     rise = phi / flank
@@ -150,8 +148,7 @@ def _pulse_train(theta, period, edge):
 
 
 def _channel_dofs(channel_matrix):
-    """The coordinates the channels read and the map (n_ch, n_read) from them to the channels
-    (applied after the decimation: fewer signals than channels)."""
+    """The coordinates the channels read and the map (n_ch, n_read) from them to the channels."""
     dofs = np.flatnonzero(np.any(channel_matrix != 0, axis=0))
     return dofs, np.ascontiguousarray(channel_matrix[:, dofs])
 
@@ -166,9 +163,7 @@ def _integrate_ramp(engine, system, load, ramp, dofs, decimator, progress, stati
 
 
 def _integrate(modal, dofs, load, ramp, eta, decimator, progress):
-    """Decimated accelerations (n_out, n_read) of ``dofs`` over the ramp ``(rpm_from, rate
-    [rpm/s], h [s], steps)`` from the modal state ``eta``, chunk by chunk
-    (:func:`powertrain.kernels.speed_ramp.modal_ramp_kernel`)."""
+    """Decimated accelerations (n_out, n_read) of ``dofs`` over the ramp from the modal state ``eta``."""
     rpm_from, rate_rpm_per_s, h, n_steps = ramp
     speeds, table, _ = load
     read = np.eye(modal.n)[dofs]
@@ -207,9 +202,7 @@ def _cycle_bounds(rpm_from, rate, h, n_steps):
 
 
 def _integrate_nonlinear(engine, system, load, ramp, dofs, decimator, static_factors):
-    """Decimated accelerations of ``dofs`` with nonlinear mount elements and the method's
-    name: :func:`_integrate_ports` for networks of constant scale, else dense Newmark cycle by
-    cycle (:class:`~powertrain.solvers.cycle_newmark.CycleIntegrator`)."""
+    """Decimated accelerations of ``dofs`` with nonlinear mount elements and the method's name."""
     rpm_from, rate, h, n_steps = ramp
     x, state, amplitudes, stepper = _nonlinear_start(engine, system, rpm_from, static_factors)
     integrator = CycleIntegrator(stepper.scaling, stepper.ports, h, x[3])
@@ -230,9 +223,7 @@ def _integrate_nonlinear(engine, system, load, ramp, dofs, decimator, static_fac
 
 
 def _integrate_ports(integrator, load, ramp, start, dofs, decimator):
-    """Decimated accelerations of ``dofs`` by modal Newmark with the port laws
-    (:class:`~powertrain.solvers.newmark.ModalPortNewmark`) from ``start`` = ((x0, v0, a0,
-    mean), port-law states, amplitudes)."""
+    """Decimated accelerations of ``dofs`` by modal Newmark with the port laws from ``start``."""
     _, _, h, n_steps = ramp
     (x0, v0, *_), state, amplitudes = start
     s, laws = integrator.scaling, integrator.laws
@@ -287,9 +278,7 @@ class _Rows:
 
 
 class _Decimator:
-    """Zero-phase polyphase decimation by ``m`` of ``n_ch`` signals arriving in chunks
-    (multiples of m): a centred FIR of 2 L + 1 taps (L = FIR_HALF m, Kaiser beta 8), output j
-    the filtered input at j m; the last 2 L input rows wait for the next chunk."""
+    """Zero-phase decimation by ``m`` (centred Kaiser FIR) of ``n_ch`` signals in chunks of k m."""
 
     def __init__(self, m, n_ch):
         self.m = m

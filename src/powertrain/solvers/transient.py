@@ -255,8 +255,7 @@ def _method(scaling, ports, curves, every, sub):
 
 
 def _run(system, scaling, ports, curves, F, h, start, steps, histories):
-    """Fill the kernel's ``histories`` under the body load ``F`` (n_t, 6), the amplitude law
-    updated every ``steps[0]`` steps, the curves every ``steps[1]``."""
+    """Fill the kernel's ``histories`` under the body load ``F`` (n_t, 6)."""
     every, sub = steps
     x, v, a, state, amplitudes = start
     laws = ports.select(ports.kinds != NONE)
@@ -287,8 +286,7 @@ def _run(system, scaling, ports, curves, F, h, start, steps, histories):
 
 
 def _channel_outputs(system, scaling, histories, laws_map):
-    """Fill the ``histories``' channel displacement, velocity, force and network deflection
-    from the states, port-law forces, network scales and curve loads."""
+    """Fill the ``histories``' channel outputs and network deflection from the states."""
     h = histories
     Cm = system.channel_matrix
     n_t, n_ch, n_net = h.X.shape[0], Cm.shape[0], system.port_rows.shape[0]
@@ -307,8 +305,7 @@ def _channel_outputs(system, scaling, histories, laws_map):
 
 
 def _time_histories(n_t, *shapes):
-    r"""Zeroed C-contiguous arrays (n_t, \*shape) for each of ``shapes`` in one buffer (fewer
-    page faults than several)."""
+    r"""Zeroed C-contiguous arrays (n_t, \*shape) for each of ``shapes``, in one buffer."""
     sizes = [n_t * math.prod(shape) for shape in shapes]
     buffer = np.zeros(sum(sizes))
     edges = np.cumsum([0, *sizes])
@@ -328,8 +325,7 @@ def _kernel_curves(system, scaling, curves):
 
 
 def _start(engine, manoeuvre, system, load, ports, model):
-    """``(x0, v0, a0, port-law states, amplitudes)``: at rest from standstill, else the
-    periodic steady state at the first speed and load; ``model = (scaling, curves)``."""
+    """``(x0, v0, a0, port-law states, amplitudes)`` at the start (module docstring)."""
     scaling, curves = model
     laws = ports.select(ports.kinds != NONE)
     n = system.n_dof
@@ -414,8 +410,7 @@ def _cycle_load(engine, manoeuvre, theta):
 
 
 class _Curves:
-    """The networks' static curves about the zero-torque static point, as the support's
-    piecewise cubics (:attr:`StaticSupport.cubics`)."""
+    """The networks' static curves about the zero-torque static point."""
 
     def __init__(self, engine, system):
         self.support = support = StaticSupport.of(engine)

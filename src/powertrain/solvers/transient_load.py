@@ -137,8 +137,7 @@ def driveline_moment(engine, manoeuvre, driveline):
 
 
 class _GasTable:
-    """Gas load per load level, speed and crank angle (roll mean removed), inertia and
-    acceleration patterns, and mean brake torque per level and speed (module docstring)."""
+    """Gas load and mean brake torque per load level and speed, and the motion patterns."""
 
     def __init__(self, engine, manoeuvre):
         lo, hi = engine.speed_range_rpm()

@@ -35,8 +35,7 @@ def kernel_model(M, C, K, C_parts, K_parts, assembled, pivoting=False):
 
 
 def _elimination_order(*matrices):
-    """Coordinates ordered by fewest nonzeros in any of ``matrices`` (networks' internal ones
-    first: no fill-in but the body's rows)."""
+    """Coordinates ordered by fewest nonzeros in any of ``matrices`` (least fill-in)."""
     pattern = sum((np.abs(m).reshape(-1, *m.shape[-2:]).sum(0) != 0) for m in matrices)
     return np.argsort((pattern != 0).sum(1), kind="stable").astype(np.int64)
 
@@ -47,8 +46,7 @@ def _mask(A, parts):
 
 
 def _with_parts(A, parts, mask):
-    """``(starts, columns, values, (network, position, value))``: ``A`` compressed on the
-    pattern ``mask``, and each of ``parts``' nonzero entries with its position among the values."""
+    """``A`` compressed on ``mask``, and each of ``parts``' nonzeros with its value position."""
     starts, columns = csr_pattern(mask)
     rows = np.repeat(np.arange(A.shape[0]), np.diff(starts))
     position = np.full(A.shape, -1, np.int64)
