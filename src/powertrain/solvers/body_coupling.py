@@ -103,12 +103,6 @@ class ModalBody:
                 and np.array_equal(self.point_shapes[..., :k], base.point_shapes)
                 and not np.any(self.point_shapes[..., k]))
 
-    def impedance(self, omega) -> np.ndarray:
-        r"""Modal dynamic stiffness :math:`Z_k` (omega.shape + (K,)) [N/m] at ``omega`` [rad/s]."""
-        w = np.asarray(omega, float)[..., None]
-        wk = 2 * np.pi * self.frequency_hz
-        return self.modal_mass * (wk ** 2 - w ** 2 + 2j * self.damping_ratio * wk * w)
-
     def network_shapes(self, networks, axes) -> np.ndarray:
         r""":math:`\mathbf s_n = \boldsymbol\Psi_{m(n)}^T\mathbf e_n`, (n_net, K), for the
         ``networks`` ``[(mount index, axis name, model)]`` and mount rotations ``axes``."""

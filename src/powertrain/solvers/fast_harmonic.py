@@ -129,7 +129,6 @@ class HarmonicModel:
         self._body_memo = {}
         #: indices of the channels :meth:`velocity` returns (None: all of ``channels``)
         self.output = None
-        self.active_channels = list(self.channels)
         if self.body is None:
             return
         self.mount_axes = list(self.system.mount_axes)
