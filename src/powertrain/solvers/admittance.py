@@ -1,22 +1,19 @@
 r"""Frequency-domain coupling of the powertrain to a body given by measured receptances.
 
-Each mount network is condensed to a two-port between its engine-side node E (moving with
-the powertrain along :math:`\mathbf r`) and its base node G (moving with the body's
-attachment point along the mount's local axis :math:`\mathbf e`):
-:math:`[F_E; F_G] = [[k_{11}, k_{12}]; [k_{21}, k_{22}]]\,[x_E; x_G]` (forces applied to the
-nodes). The body answers the forces the mounts put on it, :math:`\mathbf f_B = -(k_{21}x_E +
-k_{22}x_G)\mathbf e` summed per attachment point, through its receptance
-:math:`\mathbf x_A = \mathbf G_{AA}(\omega)\,\mathbf f_B` (admittance coupling; no inversion
-of the measured matrix):
+Each network is a two-port between its engine-side node E (along :math:`\mathbf r`) and its
+base node G (the body's attachment point along the mount axis :math:`\mathbf e`),
+:math:`[F_E; F_G] = [[k_{11}, k_{12}]; [k_{21}, k_{22}]]\,[x_E; x_G]`. The body answers the
+mount forces :math:`\mathbf f_B = -(k_{21}x_E + k_{22}x_G)\mathbf e` through its receptance,
+:math:`\mathbf x_A = \mathbf G_{AA}(\omega)\,\mathbf f_B` (no inversion of the measured matrix):
 
 .. math:: \begin{bmatrix}\mathbf D_{rr} & \mathbf D_{ra}\\ \mathbf G\mathbf D_{ar} &
           \mathbf I + \mathbf G\mathbf D_{aa}\end{bmatrix}
           \begin{bmatrix}\hat{\mathbf q}\\ \hat{\mathbf x}_A\end{bmatrix} =
           \begin{bmatrix}\hat{\mathbf f}\\ 0\end{bmatrix},
 
-:math:`\mathbf D_{rr} = -\omega^2\mathbf M_6 + \sum k_{11}\mathbf r\mathbf r^T`, and body
-points follow as :math:`\mathbf x_P = \mathbf G_{PA}\mathbf f_B`. With receptances taken from
-a modal body this reproduces the modal assembly exactly (tests/test_chassis.py).
+:math:`\mathbf D_{rr} = -\omega^2\mathbf M_6 + \sum k_{11}\mathbf r\mathbf r^T`; body points
+follow as :math:`\mathbf x_P = \mathbf G_{PA}\mathbf f_B` (exact against the modal assembly,
+tests/test_chassis.py).
 """
 
 from __future__ import annotations
@@ -29,8 +26,7 @@ DIRECTIONS = ("x", "y", "z")
 
 
 def _attachment_ports(system):
-    """Frame and port rows on the coordinates [q (6), x_A (3 per mount)]: each network's
-    engine side on q, its base on its mount's attachment point along the local axis."""
+    """Frame and engine/base port rows on the coordinates [q (6), x_A (3 per mount)]."""
     n_a = system.n_mount_channels
     n = 6 + n_a
     frame = (np.zeros((n, n)), np.zeros((n, n)), np.zeros((n, n)))
@@ -45,9 +41,9 @@ def _attachment_ports(system):
 
 
 def frf_response(system, load_harmonics, omegas, amplitudes=None):
-    """Harmonic response with a measured-receptance body (nonlinear elements at their
-    equivalent-linear two-port at ``amplitudes`` (n_net,) [m], as
-    :func:`powertrain.physics.condensation.harmonic_solve`).
+    """Harmonic response of ``system`` on its measured-receptance body to ``load_harmonics``
+    (n_h, 6) [N, N·m] at ``omegas`` [rad/s]; nonlinear elements at their equivalent-linear
+    two-port at ``amplitudes`` (n_net,) [m].
 
     Returns
     -------
@@ -86,8 +82,8 @@ def frf_response(system, load_harmonics, omegas, amplitudes=None):
 
 
 def relative_motion(system, index, q, body):
-    """Relative displacement engine side minus body side across the networks ``index``
-    (n_h, len(index)) of an :func:`frf_response` solution ``q``, ``body``."""
+    """Relative displacement (n_h, len(index)), engine side minus body side, across the
+    networks ``index`` of ``system`` in an :func:`frf_response` solution ``q``, ``body``."""
     axes = np.array([system.mount_axes[k // 3][:, k % 3] for k in index])
     rows = np.array([system.networks[k][0] for k in index])
     attach = np.stack([body[:, 3 * (k // 3):3 * (k // 3) + 3] for k in index], axis=1)

@@ -1,17 +1,10 @@
 r"""A modal body under the mounts on the fast cached path (:mod:`.fast_harmonic`).
 
-The rigid powertrain (6 coordinates :math:`\mathbf q`) stands on its mount networks; every
-network n joins its engine-side node (motion :math:`\mathbf r_n\cdot\mathbf q`) to its base
-node, which moves with the body at the mount's attachment point along the network's local
-axis :math:`\mathbf e_n`: :math:`x_{B,n} = \mathbf s_n\cdot\boldsymbol\eta`,
-:math:`\mathbf s_n = \boldsymbol\Psi_{m(n)}^T\mathbf e_n`, with :math:`\boldsymbol\Psi_m`
-(3 × K) the shapes of the K body modes at mount m (:class:`~powertrain.models.chassis.Chassis`,
-``model = "modal"``). Each network is the one two-port condensation
-(:func:`powertrain.physics.mount_network.two_port`, :math:`F_E = a x_E + b x_B`,
-:math:`F_B = b x_E + c x_B`), assembled by the one condensation
-(:func:`powertrain.physics.condensation.condensed_matrix`); each body mode
-:math:`Z_k(\omega) = m_k(\omega_k^2 - \omega^2 + 2i\zeta_k\omega_k\omega)`; per speed and
-harmonic the (6 + K) complex system
+Network n joins its engine-side node (:math:`\mathbf r_n\cdot\mathbf q`) to its base node on
+the body, :math:`x_{B,n} = \mathbf s_n\cdot\boldsymbol\eta`, :math:`\mathbf s_n =
+\boldsymbol\Psi_{m(n)}^T\mathbf e_n` (:math:`\boldsymbol\Psi_m` (3 × K) the mode shapes at
+mount m), through its two-port :math:`F_E = a x_E + b x_B`, :math:`F_B = b x_E + c x_B`;
+with :math:`Z_k = m_k(\omega_k^2 - \omega^2 + 2i\zeta_k\omega_k\omega)` the (6 + K) system
 
 .. math:: \begin{bmatrix} -\omega^2\mathbf M + \sum_n a_n\mathbf r_n\mathbf r_n^T &
           \sum_n b_n\mathbf r_n\mathbf s_n^T \\ \sum_n b_n\mathbf s_n\mathbf r_n^T &
@@ -19,10 +12,8 @@ harmonic the (6 + K) complex system
           \begin{bmatrix}\hat{\mathbf q}\\ \hat{\boldsymbol\eta}\end{bmatrix} =
           \begin{bmatrix}\hat{\mathbf f}\\ \mathbf 0\end{bmatrix}
 
-is solved. The body side of mount m moves by :math:`\boldsymbol\Psi_m\hat{\boldsymbol\eta}`
-(channels ``m/passive``), a body point P by :math:`\boldsymbol\Psi_P\hat{\boldsymbol\eta}`.
-This is the assembled modal model of :func:`powertrain.assembly.assemble` with the networks'
-internal masses condensed exactly (tests/test_body_coupling.py checks both solvers).
+is solved per speed and harmonic: the modal model of :func:`powertrain.assembly.assemble`
+with the networks' internal masses condensed exactly (tests/test_body_coupling.py).
 """
 
 from __future__ import annotations
@@ -59,9 +50,7 @@ class ModalBody:
 
     @classmethod
     def of(cls, engine):
-        """The modal body of ``engine`` (None for a rigid, absent or measured-receptance
-        chassis: the fast path predicts body-side motion only for a modal body; a modal
-        chassis without modes is a body side held still, K = 0)."""
+        """The modal body of ``engine``; None for a rigid, absent or measured-receptance chassis."""
         ch = getattr(engine, "chassis", None)
         if ch is None or ch.is_rigid or ch.coupled_by_admittance:
             return None
@@ -78,7 +67,8 @@ class ModalBody:
         return self.frequency_hz.size
 
     def with_modes(self, frequency_hz=None, modal_mass=None, damping_ratio=None) -> ModalBody:
-        """The same shapes with other modal parameters (None: kept)."""
+        """The same shapes with other ``frequency_hz`` [Hz], ``modal_mass`` [kg] and
+        ``damping_ratio`` [1] (None: kept)."""
         return replace(self,
                        frequency_hz=self.frequency_hz if frequency_hz is None
                        else np.asarray(frequency_hz, float),
@@ -88,8 +78,9 @@ class ModalBody:
                        else np.asarray(damping_ratio, float))
 
     def with_extra_mode(self, frequency_hz, modal_mass, damping_ratio, mount_shape) -> ModalBody:
-        """The body with one more mode (last): ``mount_shape`` (n_mounts, 3) its shape at
-        the mount attachment points, zero at the body points."""
+        """The body with one more mode (last) of ``frequency_hz`` [Hz], ``modal_mass`` [kg],
+        ``damping_ratio`` [1] and shape ``mount_shape`` (n_mounts, 3) at the mounts, zero at
+        the body points."""
         shape = np.asarray(mount_shape, float).reshape(self.mount_shapes.shape[0], 3, 1)
         return replace(self,
                        frequency_hz=np.append(self.frequency_hz, float(frequency_hz)),
@@ -101,8 +92,8 @@ class ModalBody:
                            axis=2))
 
     def adds_one_mode_to(self, base) -> bool:
-        """True when this body is ``base`` with one more mode (last) that is zero at the
-        body points (:meth:`with_extra_mode`): its response is :func:`one_more_mode`'s."""
+        """True when this body is the body ``base`` with one more mode (last), zero at the
+        body points (:meth:`with_extra_mode`)."""
         k = base.n_modes
         return (self.n_modes == k + 1 and self.points == base.points
                 and np.array_equal(self.frequency_hz[:k], base.frequency_hz)
@@ -112,15 +103,9 @@ class ModalBody:
                 and np.array_equal(self.point_shapes[..., :k], base.point_shapes)
                 and not np.any(self.point_shapes[..., k]))
 
-    def impedance(self, omega) -> np.ndarray:
-        r"""Modal dynamic stiffness :math:`Z_k(\omega)` (omega.shape + (K,)) [N/m]."""
-        w = np.asarray(omega, float)[..., None]
-        wk = 2 * np.pi * self.frequency_hz
-        return self.modal_mass * (wk ** 2 - w ** 2 + 2j * self.damping_ratio * wk * w)
-
     def network_shapes(self, networks, axes) -> np.ndarray:
         r""":math:`\mathbf s_n = \boldsymbol\Psi_{m(n)}^T\mathbf e_n`, (n_net, K), for the
-        networks ``[(mount index, axis name, model)]`` and mount rotations ``axes``."""
+        ``networks`` ``[(mount index, axis name, model)]`` and mount rotations ``axes``."""
         return np.array([self.mount_shapes[mi].T @ np.asarray(axes[mi], float)[:, DIRECTIONS.index(ax)]
                          for mi, ax, _ in networks])
 
@@ -131,17 +116,16 @@ class ModalBody:
 
 
 def body_channels(mount_names, body: ModalBody) -> list:
-    """Channel names of the body side: ``(NAME/passive, x|y|z)`` per mount, then the body
-    points ``(POINT, x|y|z)``."""
+    """Body-side channel names: ``(NAME/passive, x|y|z)`` for each of ``mount_names``, then
+    ``(POINT, x|y|z)`` for the points of ``body``."""
     return ([(passive_name(m), a) for m in mount_names for a in DIRECTIONS]
             + [(p, a) for p in body.points for a in DIRECTIONS])
 
 
 def modal_frame(M, frequency_hz, modal_mass, damping_ratio):
-    r"""Frame of the rigid powertrain (mass ``M`` (6, 6)) and K body modes as single-DOF
-    oscillators: :math:`(\mathbf M_0, \mathbf C_0, \mathbf K_0)`, each (6 + K, 6 + K), so
-    that :math:`\mathbf K_0 + i\omega\mathbf C_0 - \omega^2\mathbf M_0` holds
-    :math:`Z_k(\omega)` on the body modes."""
+    r"""Frame :math:`(\mathbf M_0, \mathbf C_0, \mathbf K_0)`, each (6 + K, 6 + K), of the rigid
+    powertrain (mass ``M`` (6, 6)) and K body modes (``frequency_hz`` [Hz], ``modal_mass``
+    [kg], ``damping_ratio`` [1]) as single-DOF oscillators."""
     wk = 2 * np.pi * np.asarray(frequency_hz, float)
     mk = np.asarray(modal_mass, float)
     n = 6 + wk.size
@@ -155,68 +139,61 @@ def modal_frame(M, frequency_hz, modal_mass, damping_ratio):
 
 
 def coupled_solve(M, omega, rows, shapes, abc, kip, body, load, rows_on=None):
-    r"""Solve the (6 + K) system of the module docstring for all speeds and harmonics by the
-    one harmonic solve (:func:`powertrain.physics.condensation.harmonic_solve`).
+    r"""Solve the (6 + K) system of the module docstring for all speeds and harmonics
+    (:func:`powertrain.physics.condensation.harmonic_solve`).
 
     Parameters
     ----------
     M : ndarray (6, 6)
+        Rigid-body mass matrix [kg, kg·m²].
     omega : ndarray (n_r, n_h) [rad/s]
     rows, shapes : ndarray (n_net, 6), (n_net, K)
-        Network rows :math:`\mathbf r_n` and body shapes :math:`\mathbf s_n`
-        (:meth:`ModalBody.network_shapes`).
+        Network rows :math:`\mathbf r_n` and body shapes :math:`\mathbf s_n`.
     abc : tuple of ndarray (n_r, n_h, n_net)
         The networks' two-ports (only ``b`` and ``c`` are read).
     kip : ndarray (n_r, n_h, n_net)
-        Engine-side term ``a`` (with the effects' input-point changes).
+        Engine-side term ``a`` [N/m].
     body : ModalBody
         Or anything with ``frequency_hz``, ``modal_mass``, ``damping_ratio``.
     load : ndarray (n_r, n_h, 6)
     rows_on : tuple, optional
-        :func:`coupled_rows` of ``rows``, ``shapes``, if at hand.
+        :func:`coupled_rows` of ``rows``, ``shapes``.
 
     Returns
     -------
     ndarray (n_r, n_h, 6 + K) complex: :math:`\hat{\mathbf q}` then :math:`\hat{\boldsymbol\eta}`.
     """
     frame, E, B = coupled_frame(M, rows, shapes, body, rows_on)
-    return harmonic_solve(frame, E, B, (kip, abc[1], abc[2]), 1j * np.asarray(omega, float),
-                          load)
+    return harmonic_solve(frame, E, B, (kip, abc[1], abc[2]), 1j * np.asarray(omega, float), load)
 
 
 def coupled_frame(M, rows, shapes, body, rows_on=None):
-    """The retained coordinates' frame (rigid body, body modes) and the networks' engine and
-    base rows on them, ``(frame, E, B)`` (arguments as :func:`coupled_solve`)."""
+    """``(frame, E, B)``: the retained coordinates' frame and the networks' engine and base
+    rows on them (arguments as :func:`coupled_solve`)."""
     E, B = coupled_rows(rows, shapes) if rows_on is None else rows_on
     return modal_frame(M, body.frequency_hz, body.modal_mass, body.damping_ratio), E, B
 
 
 def coupled_rows(rows, shapes):
-    """The networks' engine and base rows ``(E, B)`` on the retained coordinates (rigid
-    body, body modes), each (n_net, 6 + K), from the network rows ``rows`` (n_net, 6) and
-    body shapes ``shapes`` (n_net, K)."""
+    """The networks' engine and base rows ``(E, B)``, each (n_net, 6 + K), from the network
+    ``rows`` (n_net, 6) and body ``shapes`` (n_net, K)."""
     K = shapes.shape[1]
-    return (np.hstack([rows, np.zeros((rows.shape[0], K))]),
-            np.hstack([np.zeros_like(rows), shapes]))
+    return (np.hstack([rows, np.zeros((rows.shape[0], K))]), np.hstack([np.zeros_like(rows), shapes]))
 
 
 def coupled_matrix(M, omega, rows, shapes, abc, kip, body):
-    """The (6 + K) matrix of the module docstring per speed and harmonic, (..., 6 + K,
-    6 + K), through the one condensation (arguments as :func:`coupled_solve`)."""
+    """The (6 + K) matrix of the module docstring, (..., 6 + K, 6 + K) (arguments as
+    :func:`coupled_solve`)."""
     frame, E, B = coupled_frame(M, rows, shapes, body)
     return condensed_matrix(frame, E, B, (kip, abc[1], abc[2]), 1j * np.asarray(omega, float))
 
 
 def one_more_mode_basis(M, omega, rows, shapes, abc, kip, body, load):
-    r"""What :func:`one_more_mode` needs of the (6 + K) system of :func:`coupled_solve`
-    (its matrix :math:`\mathbf D`, load :math:`\mathbf f`), solved once: one more body mode
-    couples to it through :math:`\mathbf u = \mathbf U\mathbf s'`, :math:`\mathbf s'`
-    (n_net,) the new mode's shape along each network and :math:`\mathbf U` the columns
-    :math:`[b_n\mathbf r_n; c_n\mathbf s_n]`. Returns ``(x0, W, P, G, c)``:
-    :math:`\mathbf x_0 = \mathbf D^{-1}\mathbf f`, :math:`\mathbf W = \mathbf D^{-1}\mathbf U`,
-    :math:`\mathbf P = \mathbf U^T\mathbf x_0`, :math:`\mathbf G = \mathbf U^T\mathbf W`
-    and the networks' base terms ``c``, per speed and harmonic (arguments as
-    :func:`coupled_solve`)."""
+    r"""``(x0, W, P, G, c)`` of the (6 + K) system (arguments as :func:`coupled_solve`) for
+    :func:`one_more_mode`: with :math:`\mathbf U` the columns :math:`[b_n\mathbf r_n;
+    c_n\mathbf s_n]`, :math:`\mathbf x_0 = \mathbf D^{-1}\mathbf f`, :math:`\mathbf W =
+    \mathbf D^{-1}\mathbf U`, :math:`\mathbf P = \mathbf U^T\mathbf x_0`, :math:`\mathbf G =
+    \mathbf U^T\mathbf W`, and the base terms ``c``."""
     D = coupled_matrix(M, omega, rows, shapes, abc, kip, body)
     U = np.concatenate([abc[1][..., None, :] * rows.T, abc[2][..., None, :] * shapes.T],
                        axis=-2)                                    # (..., 6 + K, n_net)
@@ -224,20 +201,16 @@ def one_more_mode_basis(M, omega, rows, shapes, abc, kip, body, load):
     f[..., :6, 0] = load
     X = np.linalg.solve(D, np.concatenate([f, U], axis=-1))
     x0, W = X[..., 0], X[..., 1:]
-    return (x0, W, np.einsum("...in,...i->...n", U, x0), np.einsum("...in,...im->...nm", U, W),
-            abc[2])
+    return (x0, W, np.einsum("...in,...i->...n", U, x0), np.einsum("...in,...im->...nm", U, W), abc[2])
 
 
 def one_more_mode(basis, shape, impedance):
-    r"""Amplitudes (..., 6 + K + 1) of the system of :func:`one_more_mode_basis` with one
-    more body mode, its shape along each network ``shape`` (n_net,) and its modal dynamic
-    stiffness ``impedance`` (...): the bordered system :math:`[[\mathbf D, \mathbf u];
-    [\mathbf u^T, z]]` with :math:`z = Z + \sum_n c_n s_n'^2` solved by its Schur
-    complement, :math:`\eta = -\mathbf s'\cdot\mathbf P/(z - \mathbf s'^T\mathbf G
-    \mathbf s')`, :math:`\mathbf x = \mathbf x_0 - \eta\,\mathbf W\mathbf s'` — exact,
-    the same as :func:`coupled_solve` on the body with the mode
-    (tests/test_missing_body_mode.py)
-    at a few products per speed and harmonic instead of a solve."""
+    r"""Amplitudes (..., 6 + K + 1) of the system of ``basis`` (:func:`one_more_mode_basis`)
+    with one more mode of shape ``shape`` (n_net,) along the networks and modal dynamic
+    stiffness ``impedance`` (...) [N/m], exactly by the Schur complement: with
+    :math:`z = Z + \sum_n c_n s_n'^2`, :math:`\eta = -\mathbf s'\cdot\mathbf P/(z -
+    \mathbf s'^T\mathbf G\mathbf s')`, :math:`\mathbf x = \mathbf x_0 - \eta\,\mathbf W\mathbf s'`
+    (tests/test_missing_body_mode.py)."""
     x0, W, P, G, c = basis
     s = np.asarray(shape, float)
     z = impedance + (c * s ** 2).sum(axis=-1) - np.einsum("n,...nm,m->...", s, G, s)

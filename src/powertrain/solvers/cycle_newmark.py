@@ -1,24 +1,13 @@
 r"""Time-domain run of a model with nonlinear mount elements, one engine cycle at a time.
 
-The dense Newmark stepper and the continuous sweep integrate the same elements
-(:mod:`powertrain.physics.mount_elements`) this way:
-
-* **port laws** (Berg's friction, the Jenkins element) exactly, Newton per step inside the
-  kernel (:func:`powertrain.kernels.port_forces.newmark_port_kernel`), each law's memory
-  (reversal point) carried from step to step and from cycle to cycle;
-* the **amplitude law** once per engine cycle: after each cycle the amplitude of every
-  nonlinear element, :math:`A = \sqrt 2\,` RMS over that cycle of the relative displacement
-  across it (mean removed), rescales its network's springs and dampers for the next cycle
-  (:class:`powertrain.assembly.NetworkScaling`: the global matrices are the assembled ones plus each network's
-  unit contribution times its change of scale, so a rebuild is a few array additions);
-* the **static factor** of every network (the static curve at the operating point, hook
-  ``static_factors``: one factor per network, default each element's own ``static_factor``)
-  multiplies its scale (:meth:`MountElement.at_operating_point`).
-
-A run starts from the harmonic fixed point (:meth:`Stepper.harmonic_state`): the state at
-t = 0 of the equivalent-linear solution and its amplitudes, and the port laws on their
-steady loop along the harmonic relative motion (:func:`steady_loop_state`): Berg's loop,
-started unloaded, approaches its steady state only slowly (16 cycles at A = 0.4 x2).
+Port laws (Berg's friction, the Jenkins element) are integrated exactly, Newton per step
+(:func:`powertrain.kernels.port_forces.newmark_port_kernel`), their memory carried across
+steps and cycles. After each engine cycle the amplitude of every nonlinear element,
+:math:`A = \sqrt 2\,` RMS of its relative displacement over the cycle, rescales its network
+for the next (:class:`powertrain.assembly.NetworkScaling`), times its static factor
+(:meth:`MountElement.at_operating_point`). A run starts from the harmonic fixed point
+(:meth:`Stepper.harmonic_state`) with the port laws on their steady loop
+(:func:`steady_loop_state`; Berg's loop started unloaded settles only slowly).
 """
 
 from __future__ import annotations
@@ -31,14 +20,13 @@ from powertrain.kernels.port_forces import NONE, port_force_loop
 from powertrain.physics.mount_elements import PortForces
 from powertrain.solvers.newmark import newmark, newmark_ports
 
-#: Engine cycles of prescribed harmonic motion that settle the port laws' minor loops
-#: before t = 0 (after a start at the tip of the steady loop of the cycle's range).
+#: Engine cycles of prescribed harmonic motion that settle the port laws' minor loops.
 LOOP_CYCLES = 2
 
 
 def cycle_signal(harmonics, n_cycle) -> np.ndarray:
-    """Samples (n_cycle, m) over one engine cycle of the harmonics (n_h, m) (index j =
-    order j/2, ``Re sum_j c_j exp(i j theta / 2)``)."""
+    """Samples (n_cycle, m) over one engine cycle of the ``harmonics`` (n_h, m), index j =
+    order j/2: ``Re sum_j c_j exp(i j theta / 2)``."""
     n_h = harmonics.shape[0]
     if 2 * n_h > n_cycle:                 # up to the Nyquist harmonic: the full transform
         spectrum = np.zeros((n_cycle,) + harmonics.shape[1:], complex)
@@ -56,13 +44,10 @@ def cycle_amplitudes(u) -> np.ndarray:
 
 
 def steady_loop_state(ports, relative, n_cycle, cycles=LOOP_CYCLES) -> np.ndarray:
-    """States (m, n_state) of the port laws at t = 0 on their steady loop along the harmonic
-    relative motion ``relative`` (n_h, m): each law starts at the lowest point of the cycle
-    at the lower tip of its steady loop centred on the mean motion (``law.steady_state`` of
-    the lowest point's distance below the mean: no mean force, as in the harmonic solution,
-    where a loop is not unique, e.g. a friction element that sticks), then follows
-    the motion for ``cycles`` engine cycles and on to t = 0
-    (:func:`powertrain.kernels.port_forces.port_force_loop`)."""
+    """States (m, n_state) at t = 0 of the ``ports``' laws on their steady loop along the
+    harmonic relative motion ``relative`` (n_h, m), ``n_cycle`` samples per cycle: each starts
+    at the lower tip of its loop centred on the mean (no mean force) and follows the motion
+    for ``cycles`` cycles (:func:`powertrain.kernels.port_forces.port_force_loop`)."""
     u = cycle_signal(relative, n_cycle)
     low = np.argmin(u, axis=0)
     m = u.shape[1]
@@ -77,16 +62,15 @@ def steady_loop_state(ports, relative, n_cycle, cycles=LOOP_CYCLES) -> np.ndarra
 
 
 def no_ports(system):
-    """A :class:`PortForces` holding no element (a linear model run cycle by cycle, e.g.
-    for its static factors)."""
+    """A :class:`PortForces` of ``system`` holding no element."""
     n_net = len(system.networks)
     return PortForces(np.zeros((0, system.n_dof)), np.zeros(0, np.int64), np.zeros((0, 1)),
                       [], np.zeros((len(system.channels), 0)), [], np.zeros(0, int), n_net)
 
 
 def start_state(ports, qh, n_cycle):
-    """The port laws' states at t = 0 on their steady loop along the harmonic response
-    ``qh`` (n_h, n) (:func:`steady_loop_state`); None when no element has a port law."""
+    """The ``ports``' law states at t = 0 along the harmonic response ``qh`` (n_h, n), with
+    ``n_cycle`` samples per cycle (:func:`steady_loop_state`); None without port laws."""
     laws = ports.select(ports.kinds != NONE)
     return steady_loop_state(laws, qh @ laws.rows.T, n_cycle) if laws.kinds.size else None
 
@@ -106,14 +90,10 @@ class CycleRun:
 
 
 class CycleIntegrator:
-    """Integrates the nonlinear model one stretch (an engine cycle) at a time at the network
-    scales of the amplitudes of the stretch before (:func:`run_cycles`, the sweep).
-
-    The amplitude law scales the networks about the static deflection ``mean`` (n,) [m] of
-    the start: a stretch whose stiffness differs by dK from the first one's is loaded by dK
-    times it, so the static equilibrium stays where the harmonic fixed point put it and a
-    change of scale does not move it (which would be a step load of the size of the motion
-    itself).
+    """Integrates the nonlinear model one stretch (engine cycle) at a time at the network
+    scales of the stretch before's amplitudes. The networks scale about the static deflection
+    ``mean``: a stretch whose stiffness differs by dK is loaded by dK times it, so a change of
+    scale does not move the static equilibrium.
 
     Parameters
     ----------
@@ -124,6 +104,7 @@ class CycleIntegrator:
     h : float
         Time step [s].
     mean : ndarray (n,)
+        Static deflection [m].
     """
 
     def __init__(self, scaling, ports, h, mean):
@@ -133,44 +114,39 @@ class CycleIntegrator:
         self._first = None
 
     def run(self, F, start, amplitudes, state, factors=None, scales=None):
-        """States ``(X, V, A, Z)`` over the load rows ``F`` (k + 1, n) [N] from ``start``
-        = (x, v, a) (row 0), the port-law ``state`` updated in place, and the stretch's
-        force rows ``(Fk, Fd, offset)`` (:class:`CycleRun`); ``scales`` (n_net, 2), where
-        given, are the networks' scales at ``amplitudes`` and ``factors``."""
+        """States ``(X, V, A, Z)`` over the loads ``F`` (k + 1, n) [N] from ``start`` = (x, v,
+        a), the port-law ``state`` updated in place, and the force rows ``(Fk, Fd, offset)``;
+        the networks scaled at ``amplitudes`` [m] and static ``factors``, or by ``scales``
+        (n_net, 2) if given."""
         s = self.scaling
-        if scales is None:
-            scales = s.scales(self.ports.network_amplitudes(amplitudes), factors)
+        scales = s.scales(self.ports.network_amplitudes(amplitudes), factors) if scales is None else scales
         C, K, Fk, Fd = s.matrices(scales)
         self._first = self._first or (K, Fk)
         shifted = K is not self._first[0]
         load = F + (K - self._first[0]) @ self.mean if shifted else F
         if self.laws.kinds.size:
-            X, V, A, Z = newmark_ports(s.system.M, C, K, load, self.h, self.laws, *start,
-                                       state=state)
+            X, V, A, Z = newmark_ports(s.system.M, C, K, load, self.h, self.laws, *start, state=state)
         else:
             (X, V, A), Z = newmark(s.system.M, C, K, load, self.h, *start), None
         return (X, V, A, Z), (Fk, Fd, (Fk - self._first[1]) @ self.mean if shifted else None)
 
 
 def run_cycles(scaling, ports, F, h, n_cycle, start, amplitudes, factors=None) -> CycleRun:
-    """Integrate the nonlinear model under the load ``F`` (n_t, n) [N] with step ``h`` [s]
-    from ``start`` = (x0, v0, a0, port-law states or None, static deflection (n,) [m]),
-    the amplitude law updated once per ``n_cycle`` steps from the amplitudes (m,) [m] of the
-    first cycle (``ports``: the nonlinear elements; :class:`CycleIntegrator`)."""
+    """Integrate the model of ``scaling`` with the nonlinear elements ``ports`` under ``F``
+    (n_t, n) [N] at step ``h`` [s] from ``start`` = (x0, v0, a0, port-law states, static
+    deflection [m]), the amplitude law updated every ``n_cycle`` steps from ``amplitudes``
+    (m,) [m], static ``factors`` applied."""
     x0, v0, a0, state, mean = start
     integrator = CycleIntegrator(scaling, ports, h, mean)
     n_t = F.shape[0]
-    bounds = list(range(0, n_t - 1, n_cycle)) + [n_t - 1] if integrator.varying \
-        else [0, n_t - 1]
+    bounds = list(range(0, n_t - 1, n_cycle)) + [n_t - 1] if integrator.varying else [0, n_t - 1]
     out = [np.empty((n_t, F.shape[1])) for _ in range(3)]
-    out.append(np.empty((n_t, integrator.laws.kinds.size)) if integrator.laws.kinds.size
-               else None)
+    out.append(np.empty((n_t, integrator.laws.kinds.size)) if integrator.laws.kinds.size else None)
     out[0][0], out[1][0], out[2][0] = x0, v0, a0
     segments = []
     for lo, hi in zip(bounds[:-1], bounds[1:]):
         rows = slice(lo, hi + 1)
-        states, forces = integrator.run(F[rows], [o[lo] for o in out[:3]], amplitudes, state,
-                                        factors)
+        states, forces = integrator.run(F[rows], [o[lo] for o in out[:3]], amplitudes, state, factors)
         for o, value in zip(out, states):
             if o is not None:
                 o[rows] = value

@@ -1,20 +1,13 @@
 r"""Equivalent-linear steady state of a model with nonlinear mount elements.
 
-In the frequency domain a nonlinear element (:mod:`powertrain.physics.mount_elements`)
-acts through its describing function at the amplitude :math:`A` of the relative
-displacement across it, :math:`A = \sqrt 2\,` RMS over the engine cycle of orders 0.5 to 8,
-i.e. :math:`A = (\sum_j |\hat u_j|^2)^{1/2}` over those harmonics. The amplitudes and the
-response depend on each other: :func:`fixed_point` solves
-:math:`A = g(A)`, :math:`g` the amplitudes of the response at :math:`A`, by Anderson
-acceleration (Walker & Ni 2011) in log amplitudes: each step combines the last
-:data:`DEPTH` iterates so that the linearised residual :math:`\ln g(A) - \ln A` vanishes (a
-steep law converges in a few steps where plain iteration creeps, and amplitudes stay
-positive). Where the residual grows the history is dropped and a damped step
-:math:`\ln A \leftarrow \ln A + \rho\,(\ln g(A) - \ln A)` follows (relaxation :math:`\rho`
-halved each time, down to 1/64). Converged when the change is below
-:data:`TOLERANCE` of the largest amplitude; a fixed point that does not converge is an
-:class:`AmplitudeNotConverged` naming the element whose amplitude changes most relative to
-itself, and the speed. A linear model needs none of this: the steppers solve it once.
+A nonlinear element (:mod:`powertrain.physics.mount_elements`) acts through its describing
+function at the amplitude of the relative displacement across it, :math:`A = \sqrt 2\,` RMS
+over orders 0.5 to 8, :math:`A = (\sum_j |\hat u_j|^2)^{1/2}`. :func:`fixed_point` solves
+:math:`A = g(A)` (:math:`g` the amplitudes of the response at :math:`A`) by Anderson
+acceleration (Walker & Ni 2011) over the last :data:`DEPTH` iterates in log amplitudes;
+where the residual :math:`\ln g(A) - \ln A` grows the history is dropped and the step damped
+(relaxation halved, down to 1/64). Converged when the change is below :data:`TOLERANCE` of
+the largest amplitude, else :class:`AmplitudeNotConverged`.
 """
 
 from __future__ import annotations
@@ -34,7 +27,8 @@ AMPLITUDE_FLOOR = 1e-6
 
 class AmplitudeNotConverged(FloatingPointError):
     """The equivalent-linear amplitudes did not converge: ``element`` (``mount.direction``)
-    changed most relative to its own amplitude, at ``rpm``."""
+    changed most relative to itself, by ``change`` per iteration after ``iterations``, at
+    ``rpm``."""
 
     def __init__(self, element: str, rpm: float, change: float, iterations: int):
         self.element, self.rpm, self.change = element, float(rpm), float(change)
@@ -44,14 +38,12 @@ class AmplitudeNotConverged(FloatingPointError):
 
 
 def amplitudes_of(relative) -> np.ndarray:
-    """Amplitudes (m,) [m] of the relative-motion harmonics ``relative`` (n_h, m), index j
-    = order j/2."""
+    """Amplitudes (m,) [m] of the relative-motion harmonics ``relative`` (n_h, m), j = order j/2."""
     return np.sqrt(np.sum(np.abs(relative[AMPLITUDE_HARMONICS]) ** 2, axis=0))
 
 
 def amplitude_fixed_point(solve, relative_motion, ports, rpm, start=None, tolerance=TOLERANCE):
-    """The equivalent-linear steady state at one speed (:func:`fixed_point` of the ports'
-    amplitudes).
+    """The equivalent-linear steady state at one speed (:func:`fixed_point`).
 
     Parameters
     ----------
@@ -68,8 +60,7 @@ def amplitude_fixed_point(solve, relative_motion, ports, rpm, start=None, tolera
     start : ndarray (m,), optional
         First guess (e.g. the previous speed's amplitudes); default: zero.
     tolerance : float
-        Relative change of the amplitudes at convergence (a time-domain run, which goes on
-        to its own steady state, starts from a looser fixed point).
+        Relative change of the amplitudes at convergence.
 
     Returns
     -------
@@ -83,9 +74,8 @@ def amplitude_fixed_point(solve, relative_motion, ports, rpm, start=None, tolera
 
 
 def fixed_point(solve, amplitudes, names, rpm, start, tolerance=TOLERANCE):
-    """The fixed point :math:`A = g(A)` of the module docstring, at one speed (``start``
-    (m,)) or at several at once (``start`` (n_r, m), each row converged on its own largest
-    amplitude; the run-up's stepper and the diagnosis's cached model alike).
+    """The fixed point :math:`A = g(A)` at one speed (``start`` (m,)) or several (``start``
+    (n_r, m), each row converged on its own largest amplitude).
 
     Parameters
     ----------
@@ -132,8 +122,8 @@ def fixed_point(solve, amplitudes, names, rpm, start, tolerance=TOLERANCE):
 
 
 class AndersonSteps:
-    """Anderson acceleration of ``ln A = ln g(A)``, with a damped step as the fallback where
-    the residual grows (module docstring)."""
+    """Anderson acceleration of ``ln A = ln g(A)`` over ``depth`` iterates, damped where the
+    residual grows."""
 
     def __init__(self, depth):
         self.depth, self.relax, self.last = depth, 1.0, np.inf

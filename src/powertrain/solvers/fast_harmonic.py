@@ -1,37 +1,15 @@
 r"""Cached frequency-domain model for many cheap re-solves (diagnosis, truth generation).
 
-The harmonic solver (:mod:`powertrain.solvers.harmonic`) condenses every mount network to its
-input-point stiffness and solves a 6×6 system per order. When only the mounts, the chassis
-under them or the sensors change, the load harmonics per speed stay the same; when the
-balancer or the cylinders change, only a few harmonics change, linearly in the unbalance or
-(to first order) in the cylinder IMEP. :class:`HarmonicModel` caches:
-
-* the load harmonics :math:`\hat{\mathbf f}_{r,h}` (speed r, harmonic h = 0..16, i.e.
-  orders 0…8 in steps of 0.5) [N, N·m];
-* each network's *two-port* dynamic stiffness between its engine-side node E and its ground
-  node B with the internal masses condensed,
-
-  .. math:: \begin{pmatrix} F_E \\ F_B \end{pmatrix} =
-            \begin{pmatrix} a & b \\ b & c \end{pmatrix}
-            \begin{pmatrix} x_E \\ x_B \end{pmatrix},
-            \qquad a = K_{IP},\; b = -K_{CP}\ \text{(rigid ground)},
-
-  so that a base of mass :math:`m_b`, stiffness :math:`c_b` and damping :math:`d_b` under the
-  network (:func:`powertrain.models.extensions.with_base_compliance`) gives, exactly,
-
-  .. math:: K_{IP}' = a - \frac{b^2}{c + c_b + i\omega d_b - \omega^2 m_b},
-
-  and a network whose springs, dampers and masses are all scaled by :math:`s` has
-  :math:`(a, b, c)` scaled by :math:`s`.
-
-:meth:`HarmonicModel.solve` then solves, for all speeds and harmonics at once,
+:class:`HarmonicModel` caches the load harmonics :math:`\hat{\mathbf f}_{r,h}` (speed r,
+harmonic h = 0..16: orders 0..8) [N, N·m] and each network's two-port :math:`(a, b, c)`,
+internal masses condensed (:math:`a = K_{IP}`, :math:`b = -K_{CP}` on a rigid ground; scaling
+springs, dampers and masses by :math:`s` scales it by :math:`s`), and solves at once
 
 .. math:: \Big(-\omega_h^2\mathbf M_{rb} + \sum_n K_{IP,n}(\omega_h)\,
           \mathbf r_n\mathbf r_n^T\Big)\hat{\mathbf q}_{r,h} = \hat{\mathbf f}_{r,h},
 
-and the channel velocities are :math:`\hat{\mathbf v} = i\omega_h\mathbf C\hat{\mathbf q}`
-(the same numbers as :func:`powertrain.workflows.runup.run_runup` with ``solver="harmonic"``, see
-tests/test_diagnose.py).
+channel velocities :math:`\hat{\mathbf v} = i\omega_h\mathbf C\hat{\mathbf q}` (the numbers of
+:func:`powertrain.workflows.runup.run_runup` with ``solver="harmonic"``, tests/test_diagnose.py).
 """
 
 from __future__ import annotations
@@ -62,19 +40,16 @@ N_ANGLE = 720
 
 
 def static_factor_table(engine, rpm):
-    """Static factors (n_r, n_net) of every network at each speed's operating point, or
-    None when no mount direction has a static curve."""
+    """Static factors (n_r, n_net) of every network of ``engine`` at the speeds ``rpm``
+    [rpm], or None when no mount direction has a static curve."""
     if not has_static_curves(engine):
         return None
     return np.array([static_factors(engine, r) for r in np.atleast_1d(rpm)])
 
 
 def shaft_load(engine, shaft, rpm, theta):
-    r"""Generalized load of one balancer shaft [N, N·m], shape ``(n, 6)``, about the CG.
-
-    The shaft's centrifugal force (:func:`powertrain.physics.balancer.shaft_force`) at its
-    position; independent of whether the engine's balancer is enabled.
-    """
+    """Generalized load (n, 6) [N, N·m] about the CG of the balancer ``shaft``'s centrifugal
+    force at ``rpm`` [rpm] and crank angles ``theta`` (n,) [rad], balancer enabled or not."""
     ct = engine.crank
     omega = rpm * 2 * np.pi / 60.0
     f_u, f_s = bal.shaft_force(theta, omega, shaft.mass_radius, shaft.phase, shaft.sense,
@@ -101,8 +76,7 @@ class HarmonicModel:
     n_angle : int
         Samples per engine cycle for the load harmonics.
     system : AssembledSystem, optional
-        The system this is a frequency view of; default ``engine.assemble()``. Its
-        retained coordinates, network rows, elements and output rows are used as they are.
+        The system this is a frequency view of; default ``engine.assemble()``.
 
     Attributes
     ----------
@@ -114,13 +88,8 @@ class HarmonicModel:
         Rigid-body coordinates to mount-point motion in engine X/Y/Z.
     networks : list of (mount index, axis name, MountModel)
     elements : list of MountElement
-        One per network; nonlinear ones act through :meth:`two_ports_at`.
+        One per network (nonlinear ones: :meth:`two_ports_at`).
     packed : PackedNetworks
-        The networks packed once for the two-port kernel.
-
-    What the model computes it keeps while it lives (the load harmonics, the two-ports, the
-    scaled ones, the effects' defaults, :meth:`load_velocity`'s parts, what the last other
-    modal body's shapes give); nothing is kept outside it.
     """
 
     def __init__(self, engine, rpm, n_angle=N_ANGLE, system=None):
@@ -130,20 +99,15 @@ class HarmonicModel:
         self.theta = 4 * np.pi * np.arange(self.n_angle) / self.n_angle
         Omega = self.rpm * 2 * np.pi / 60.0
         self.omega = 0.5 * Omega[:, None] * np.arange(N_HARMONICS)[None, :]
-        #: the assembled system this view is of (:meth:`Engine.assemble
-        #: <powertrain.models.engine.Engine.assemble>`)
         self.system = engine.assemble() if system is None else system
         ports = self.system.ports()
         self.M = ports.frame[0][:6, :6]
         self.rows = ports.engine_rows[:, :6]
         self.networks = [(mi, axis, m.directions[axis]) for mi, m in enumerate(engine.mounts)
                          for axis in DIRECTIONS]
-        #: each network's mount element (:class:`~powertrain.physics.mount_elements.MountElement`:
-        #: its amplitude law and port law with it)
         self.elements = list(ports.elements)
         self.packed = PackedNetworks.of([el.lumped for el in self.elements])
-        #: every network's static factor per speed (n_r, n_net) at the operating point of
-        #: the static curves (:mod:`powertrain.solvers.operating_point`); None without any
+        #: static factor (n_r, n_net) of every network per speed; None without curves
         self.static_scale = static_factor_table(engine, self.rpm)
         n_a = self.system.n_mount_channels
         self.channel_matrix = self.system.channel_matrix[:n_a, :6]
@@ -160,14 +124,11 @@ class HarmonicModel:
         self._body_setup(engine, ports)
 
     def _body_setup(self, engine, ports):
-        """A modal body under the mounts (:mod:`powertrain.solvers.body_coupling`): its
-        passive-side and body-point channels follow the engine-side ones, read from the
-        assembled system's output rows on the retained coordinates."""
+        """The modal body under the mounts and its passive-side and body-point channels."""
         self.body = ModalBody.of(engine)
         self._body_memo = {}
         #: indices of the channels :meth:`velocity` returns (None: all of ``channels``)
         self.output = None
-        self.active_channels = list(self.channels)
         if self.body is None:
             return
         self.mount_axes = list(self.system.mount_axes)
@@ -176,15 +137,13 @@ class HarmonicModel:
         self.output_matrix = self.system.channel_matrix[:, ports.retained]
 
     def use_channels(self, channels):
-        """Let :meth:`velocity` return ``channels`` only (names as :attr:`channels`)."""
+        """Let :meth:`velocity` return ``channels`` (names as :attr:`channels`) only."""
         self.output = np.array([self.channels.index(tuple(c)) for c in channels], int)
         self._extra = {k: v for k, v in self._extra.items() if not k.startswith(_VELOCITY_OF)}
 
-    # ------------------------------------------------------------------ cached parts
     def load_of(self, engine) -> np.ndarray:
-        """Load harmonics of ``engine`` at the model's speeds, (n_r, 17, 6) complex: from
-        :meth:`Engine.load_table <powertrain.models.engine.Engine.load_table>` (the
-        ``generalized_load`` of every speed to round-off, its patterns evaluated once)."""
+        """Load harmonics (n_r, 17, 6) complex [N, N·m] of ``engine`` at the model's speeds
+        (:meth:`Engine.load_table <powertrain.models.engine.Engine.load_table>`)."""
         table = np.asarray(engine.load_table(self.rpm, self.theta), float)
         return harmonic_amplitudes(table, axis=1)[:, :N_HARMONICS]
 
@@ -196,9 +155,8 @@ class HarmonicModel:
         return self._load
 
     def effect_defaults(self, effect) -> dict:
-        """``effect.defaults(engine)`` for the model's engine (an
-        :class:`~powertrain.effects.base.Effect`), kept per effect: every prediction fills
-        its scenario with them."""
+        """``effect.defaults(engine)`` of the :class:`~powertrain.effects.base.Effect`
+        ``effect`` for the model's engine, kept per effect."""
         kept = self._effect_defaults.get(effect.name)
         if kept is None:
             kept = self._effect_defaults[effect.name] = effect.defaults(self.engine)
@@ -217,11 +175,8 @@ class HarmonicModel:
         return self._extra["shafts"]
 
     def two_ports(self, models=None):
-        """``(a, b, c)`` of every network at every speed and harmonic, each (n_r, 17, n_net).
-
-        ``models`` (list of MountModel, one per network) defaults to the engine's own
-        networks (cached).
-        """
+        """``(a, b, c)`` of every network at every speed and harmonic, each (n_r, 17, n_net);
+        ``models`` (MountModel per network) default the engine's own (cached)."""
         if models is None and self._abc is not None:
             return self._abc
         mods = [n[2] for n in self.networks] if models is None else models
@@ -233,17 +188,12 @@ class HarmonicModel:
         return abc
 
     def two_ports_scaled(self, scale, damper_scale=None, harmonics=None):
-        r"""``(a, b, c)`` of every network with its elastomer scaled, each (n_r, 17, n_net).
-
-        Every spring of network n at speed r and harmonic h times ``scale[r, h, n]`` and
-        every damper times ``damper_scale[r, h, n]`` (default ``scale``; any shapes that
-        broadcast to (n_r, 17, n_net)), its masses kept — :math:`s\,\mathbf K + i\omega
-        d\,\mathbf C - \omega^2\mathbf M` condensed by the one two-port condensation
-        (:func:`powertrain.physics.mount_network.laplace_two_ports`). With ``scale = 1`` the
-        same as :meth:`two_ports`. ``harmonics`` (indices 0..16, optional): with one factor
-        pair per network, only these harmonics are condensed, the others are zero (a linear
-        solve of some orders reads no more).
-        """
+        r"""``(a, b, c)`` of every network with its elastomer scaled, each (n_r, 17, n_net):
+        :math:`s\,\mathbf K + i\omega d\,\mathbf C - \omega^2\mathbf M` condensed
+        (:func:`powertrain.physics.mount_network.laplace_two_ports`), ``s = scale`` and
+        ``d = damper_scale`` (default ``scale``) broadcast to (n_r, 17, n_net). With one
+        factor pair per network only the ``harmonics`` (indices 0..16, optional) are
+        condensed, the others zero."""
         n_net = len(self.networks)
         scale = np.asarray(scale, float)
         damper = scale if damper_scale is None else np.asarray(damper_scale, float)
@@ -256,11 +206,7 @@ class HarmonicModel:
                                  np.broadcast_to(damper, shape) * statics)
 
     def _scaled_networks(self, factors, harmonics=None):
-        """Every network's two-port with its springs and dampers times ``factors[k]``
-        (a (spring, damper) pair) at every speed (at the ``harmonics`` only, the others zero;
-        None: all); the last two pairs per network are kept (a finite-difference Jacobian
-        column changes the factors of one mount only: the others' are reused), the missing
-        ones condensed in one call."""
+        """Two-ports with (spring, damper) ``factors`` per network; the last two per network kept."""
         h = None if harmonics is None else tuple(int(i) for i in harmonics)
         keys = [(float(k), float(d), h) for k, d in factors]
         kept = [self._scaled.setdefault(k, {}) for k in range(len(keys))]
@@ -287,9 +233,7 @@ class HarmonicModel:
         return self._assembled(keys, kept)
 
     def _assembled(self, keys, kept):
-        """The two-ports (each (n_r, 17, n_net), read-only) of the networks' ``keys`` from
-        their ``kept`` ones: the last result with the networks whose key changed replaced
-        (a Jacobian column changes one mount's)."""
+        """Read-only two-ports of ``keys``: the last result with the changed networks replaced."""
         last = self._scaled_last
         if last is None or len(last[0]) != len(keys):
             out = tuple(np.empty(self.omega.shape + (len(keys),), complex) for _ in range(3))
@@ -306,31 +250,25 @@ class HarmonicModel:
         return out
 
     def two_ports_at(self, amplitudes, elements=None, packed=None):
-        r"""``(a, b, c)`` of every network's element at its relative-displacement amplitude,
-        each (n_r, 17, n_net): :meth:`MountElement.two_port
-        <powertrain.physics.mount_elements.MountElement.two_port>` at :math:`s = i\omega`
-        with one amplitude per speed, ``amplitudes`` (n_r, n_net) [m]; ``elements``
-        default :attr:`elements` (the amplitude law scales springs and dampers, the port
-        law adds its describing function), ``packed`` their networks packed
-        (:class:`~powertrain.physics.mount_network.PackedNetworks`; default: packed here,
-        :attr:`packed` for :attr:`elements`)."""
+        r"""``(a, b, c)`` of every network's element, each (n_r, 17, n_net), at the
+        relative-displacement ``amplitudes`` (n_r, n_net) [m]: :meth:`MountElement.two_port
+        <powertrain.physics.mount_elements.MountElement.two_port>` at :math:`s = i\omega`.
+        ``elements`` default :attr:`elements`; ``packed`` their networks packed (default:
+        packed here, :attr:`packed` for :attr:`elements`)."""
         els = self.elements if elements is None else elements
         if elements is None:
             packed = self.packed
         if self.static_scale is not None:
             els = [dataclasses.replace(el, static_factor=self.static_scale[:, k:k + 1])
                    for k, el in enumerate(els)]
-        return element_two_ports(els, 1j * self.omega, np.asarray(amplitudes, float)[:, None],
-                                 packed)
+        return element_two_ports(els, 1j * self.omega, np.asarray(amplitudes, float)[:, None], packed)
 
     def two_ports_on_base(self, abc, mass, stiffness, zeta):
-        r"""The two-ports ``abc`` (each (n_r, 17, n_net)) with a base of ``mass`` [kg] on
-        ``stiffness`` [N/m] and damping ratio ``zeta`` [1] under every network, the base node
-        condensed exactly: with :math:`k_b = c_b + i\omega\,2\zeta\sqrt{c_b m_b}` and
-        :math:`z = c + k_b - \omega^2 m_b`, :math:`a' = a - b^2/z`, :math:`b' = b\,k_b/z`,
-        :math:`c' = k_b - k_b^2/z` (:math:`a'` the input-point stiffness on a rigid ground;
-        :math:`b', c'` couple a modal body) — the same network as
-        :func:`powertrain.models.extensions.with_base_compliance` gives."""
+        r"""The two-ports ``abc`` (each (n_r, 17, n_net)) on a base of ``mass`` [kg],
+        ``stiffness`` [N/m] and damping ratio ``zeta`` [1], condensed exactly: with
+        :math:`k_b = c_b + i\omega\,2\zeta\sqrt{c_b m_b}`, :math:`z = c + k_b - \omega^2 m_b`,
+        :math:`a' = a - b^2/z`, :math:`b' = b\,k_b/z`, :math:`c' = k_b - k_b^2/z`
+        (as :func:`powertrain.models.extensions.with_base_compliance`)."""
         a, b, c = abc
         w = self.omega[..., None]
         kb = stiffness + 1j * w * 2 * zeta * np.sqrt(stiffness * mass)
@@ -338,22 +276,17 @@ class HarmonicModel:
         return a - b ** 2 / z, b * kb / z, kb - kb ** 2 / z
 
     def _statics(self, index):
-        """The static factors of the networks ``index`` per speed, (n_r, 1, len(index))
-        (1.0 without curves)."""
+        """Static factors (n_r, 1, len(index)) of the networks ``index`` (1.0 without curves)."""
         if self.static_scale is None:
             return 1.0
         return self.static_scale[:, None, list(index)]
 
-    # ------------------------------------------------------------------ solves
-    def solve(self, kip, load=None, harmonics=slice(1, N_HARMONICS), abc=None,
-              body=None) -> np.ndarray:
-        r"""Rigid-body amplitudes :math:`\hat{\mathbf q}` (n_r, n_h, 6) for the given input-point
-        stiffnesses ``kip`` (n_r, 17, n_net) [N/m] and load (default nominal).
-
-        With a modal body (:attr:`body`) the amplitudes are (n_r, n_h, 6 + K), the body
-        modes last, coupled through the networks' two-ports ``abc`` (default nominal) to the
-        body ``body`` (default :attr:`body`; it may have other modes, e.g. one more) by
-        :func:`powertrain.solvers.body_coupling.coupled_solve`."""
+    def solve(self, kip, load=None, harmonics=slice(1, N_HARMONICS), abc=None, body=None) -> np.ndarray:
+        r"""Amplitudes :math:`\hat{\mathbf q}` (n_r, n_h, 6 [+ K], body modes last) at the
+        input-point stiffnesses ``kip`` (n_r, 17, n_net) [N/m] under ``load`` (default
+        nominal) at the ``harmonics``; a modal body (``body``, default :attr:`body`) couples
+        through the two-ports ``abc`` (default nominal,
+        :func:`powertrain.solvers.body_coupling.coupled_solve`)."""
         load = self.load if load is None else load
         w = self.omega[:, harmonics]
         K = kip[:, harmonics]
@@ -367,18 +300,15 @@ class HarmonicModel:
                                  tuple(x[:, harmonics] for x in abc), K, body,
                                  load[:, harmonics], rows_on)
         frame = (self.M, np.zeros((6, 6)), np.zeros((6, 6)))
-        return harmonic_solve(frame, self.rows, None, (K, None, None), 1j * w,
-                              load[:, harmonics])
+        return harmonic_solve(frame, self.rows, None, (K, None, None), 1j * w, load[:, harmonics])
 
     def solve_one_more_mode(self, body, harmonics=slice(1, N_HARMONICS)) -> np.ndarray:
-        r""":meth:`solve`'s amplitudes (n_r, n_h, 6 + K + 1) of the nominal model (its own
-        two-ports and load) on ``body``, the model's body with one more mode
+        """:meth:`solve`'s amplitudes (n_r, n_h, 6 + K + 1) of the nominal model at the
+        ``harmonics`` on ``body``, the model's body with one more mode
         (:meth:`ModalBody.adds_one_mode_to
         <powertrain.solvers.body_coupling.ModalBody.adds_one_mode_to>`): the nominal system
-        is solved once for the load and a unit coupling per network (cached,
-        :func:`~powertrain.solvers.body_coupling.one_more_mode_basis`), every mode after that
-        by :func:`~powertrain.solvers.body_coupling.one_more_mode` — the same as
-        :meth:`solve` to round-off."""
+        solved once (cached, :func:`~powertrain.solvers.body_coupling.one_more_mode_basis`),
+        each mode by :func:`~powertrain.solvers.body_coupling.one_more_mode`."""
         if _ONE_MORE_MODE[0] not in self._extra:
             abc = self.two_ports()
             h = slice(1, N_HARMONICS)
@@ -389,8 +319,7 @@ class HarmonicModel:
         j = np.arange(N_HARMONICS)[harmonics] - 1
         last = self._one_more_mode_at
         if last is None or not np.array_equal(last[0], j):     # the fit's orders: once
-            last = self._one_more_mode_at = (j, tuple(self._extra[k][0][:, j]
-                                                      for k in _ONE_MORE_MODE))
+            last = self._one_more_mode_at = (j, tuple(self._extra[k][0][:, j] for k in _ONE_MORE_MODE))
         basis = last[1]
         shape = body.network_shapes(self.networks, self.mount_axes)[:, -1]
         w = self.omega[:, harmonics]
@@ -398,12 +327,8 @@ class HarmonicModel:
         return one_more_mode(basis, shape, m * (wk ** 2 - w ** 2 + 2j * z * wk * w))
 
     def load_response(self, load) -> np.ndarray:
-        r""":meth:`solve`'s amplitudes (n_r, 16, 6 [+ K]) of the nominal model (its own
-        two-ports and body) for the load ``load`` (n_r, 17, 6), without a solve: they are
-        linear in the load, so the response to each unit load component is solved once
-        (cached, :attr:`_extra` ``"load_transfer"``, (6, n_r, 16, n_q)) and combined —
-        the same as :meth:`solve` to round-off. For the effects that change the load only
-        (a balancer error, a cylinder imbalance)."""
+        """:meth:`solve`'s amplitudes (n_r, 16, 6 [+ K]) of the nominal model for the load
+        harmonics ``load`` (n_r, 17, 6): the unit responses solved once (cached), combined."""
         if "load_transfer" not in self._extra:
             abc = self.two_ports()
             unit = np.zeros(self.omega.shape + (6,), complex)
@@ -416,19 +341,17 @@ class HarmonicModel:
         return np.einsum("jrhq,rhj->rhq", self._extra["load_transfer"], load[:, 1:])
 
     def load_velocity(self, name, loads) -> np.ndarray:
-        """Channel velocities (n_b, n_r, n_ch, 16) of the nominal model (its own two-ports
-        and body) under each of the loads ``loads`` (n_b, n_r, 17, 6), solved once and kept
-        under ``name``: :meth:`velocity` of :meth:`load_response`, linear in the load, so
-        that a load made of these parts is a weighted sum of their velocities (equal to
-        solving the summed load to round-off)."""
+        """Channel velocities (n_b, n_r, n_ch, 16) [m/s] of the nominal model under each of
+        ``loads`` (n_b, n_r, 17, 6), kept under ``name``: linear in the load, so a load of
+        these parts has the weighted sum of their velocities."""
         key = _VELOCITY_OF + name
         if key not in self._extra:
             self._extra[key] = np.stack([self.velocity(self.load_response(x)) for x in loads])
         return self._extra[key]
 
     def velocity(self, q, harmonics=slice(1, N_HARMONICS), body=None) -> np.ndarray:
-        """Complex peak channel velocities (n_r, n_ch, n_h) [m/s] from :meth:`solve`'s q
-        (solved with the modal body ``body``, default :attr:`body`)."""
+        """Complex peak channel velocities (n_r, n_ch, n_h) [m/s] of :meth:`solve`'s ``q`` at
+        the ``harmonics``, solved with ``body`` (default :attr:`body`)."""
         w = self.omega[:, harmonics]
         C = self.channel_matrix if self.body is None else self.output_matrix
         if body is not None and body is not self.body:     # its modes' output rows
@@ -440,39 +363,30 @@ class HarmonicModel:
         return np.swapaxes(q @ C.T, -1, -2) * (1j * w)[:, None, :]
 
     def network_amplitude(self, q) -> np.ndarray:
-        r"""Engine-side peak displacement of each network :math:`a_n =
-        \sqrt{\sum_h |\mathbf r_n\cdot\hat{\mathbf q}_h|^2}` [m] (= √2 × RMS sum), (n_r, n_net)."""
+        r"""Engine-side peak displacement (n_r, n_net) [m] of each network for :meth:`solve`'s
+        ``q``, :math:`a_n = \sqrt{\sum_h |\mathbf r_n\cdot\hat{\mathbf q}_h|^2}`."""
         x = q[..., :6] @ self.rows.T
         return np.sqrt(np.sum(np.abs(x) ** 2, axis=1))
 
     def _network_shapes(self, body):
-        """Mode shapes of ``body`` along each network's direction (n_net, K): the model's own
-        body's, or those of the last other body's mode shapes (kept while a fit changes the
-        modal parameters of the same shapes)."""
+        """Mode shapes (n_net, K) of ``body`` along each network's direction."""
         if body is self.body:
             return self.body_shapes
         return self._of_shapes("network shapes", body, lambda: body.network_shapes(
             self.networks, self.mount_axes))
 
     def _of_shapes(self, name, body, make):
-        """``make()``, a value that depends on ``body``'s mode shapes only, kept under
-        ``name`` with the shape arrays it was made of (the last body's: a fit's modal bodies
-        share their shape arrays, :meth:`ModalBody.with_modes
-        <powertrain.solvers.body_coupling.ModalBody.with_modes>`)."""
+        """``make()``, kept under ``name`` while ``body`` has the same shape arrays."""
         kept = self._body_memo.get(name)
-        if (kept is None or kept[0] is not body.mount_shapes
-                or kept[1] is not body.point_shapes):
+        if (kept is None or kept[0] is not body.mount_shapes or kept[1] is not body.point_shapes):
             kept = self._body_memo[name] = (body.mount_shapes, body.point_shapes, make())
         return kept[2]
 
     def relative_amplitude(self, q, body=None) -> np.ndarray:
-        r"""Amplitude of the relative displacement across each network (engine-side point
-        minus base, along its direction), :math:`A_n = \sqrt{\sum_h |\mathbf r_n\cdot
-        \hat{\mathbf q}_h - \mathbf s_n\cdot\hat{\boldsymbol\eta}_h|^2}` [m] over
-        :meth:`solve`'s harmonics (√2 × RMS, as
-        :func:`powertrain.solvers.equivalent_linear.amplitudes_of`), (n_r, n_net); the base
-        term only with a modal body (``body``: the one ``q`` was solved with, default
-        :attr:`body`)."""
+        r"""Relative-displacement amplitude (n_r, n_net) [m] across each network of
+        :meth:`solve`'s ``q`` (solved with ``body``, default :attr:`body`),
+        :math:`A_n = \sqrt{\sum_h |\mathbf r_n\cdot\hat{\mathbf q}_h - \mathbf s_n\cdot
+        \hat{\boldsymbol\eta}_h|^2}`; the base term only with a modal body."""
         x = q[..., :6] @ self.rows.T
         if self.body is not None:
             shapes = self._network_shapes(self.body if body is None else body)

@@ -1,23 +1,16 @@
 r"""Frequency-domain steady state of the assembled model, order by order.
 
-A load periodic over the engine cycle (two crank revolutions) has orders
-:math:`k/2`, :math:`k = 0, 1, 2, \dots` of the crank speed :math:`\Omega`. For each order the
-steady-state amplitude solves
+A load periodic over the engine cycle has orders :math:`k/2` of the crank speed
+:math:`\Omega`; each order's steady-state amplitude solves
 
 .. math:: \left(\mathbf K + i\omega_k\mathbf C - \omega_k^2\mathbf M\right)\hat{\mathbf q}_k
           = \mathbf B\hat{\mathbf f}_k, \qquad \omega_k = \tfrac{k}{2}\Omega,
 
-and :math:`\mathbf q(t) = \mathrm{Re}\sum_k \hat{\mathbf q}_k e^{i\omega_k t}`. Exact for the
-linear model; the time-domain Newmark stepper must agree with it.
-
-:func:`harmonic_response` solves it by the one harmonic solve
-(:func:`powertrain.physics.condensation.harmonic_solve`): the internal masses of each mount
-network are eliminated exactly through its two-port, so the retained coordinates (rigid body,
-body modes) feel each network through :math:`\mathbf P_n^T\mathbf T_n(i\omega)\mathbf P_n`
-(for a rigid ground, its input-point dynamic stiffness :math:`K_{IP}(\omega)` along the row
-:math:`\mathbf r_n`), a small solve per order; the internal amplitudes follow from the
-networks' own condensation. tests/test_runup.py checks it against a dense solve of the
-assembled matrices.
+and :math:`\mathbf q(t) = \mathrm{Re}\sum_k \hat{\mathbf q}_k e^{i\omega_k t}`, exact for the
+linear model. Each network's internal masses are eliminated exactly through its two-port
+(:func:`powertrain.physics.condensation.harmonic_solve`): the retained coordinates feel it as
+:math:`\mathbf P_n^T\mathbf T_n(i\omega)\mathbf P_n` (on a rigid ground :math:`K_{IP}(\omega)`
+along :math:`\mathbf r_n`); tests/test_runup.py checks it against a dense solve.
 """
 
 from __future__ import annotations
@@ -27,11 +20,8 @@ import numpy as np
 from powertrain.physics.condensation import harmonic_solve, two_ports
 
 
-def harmonic_response(system, load_harmonics, omegas, amplitudes=None, linear=None,
-                      internal=True):
-    """Complex amplitudes of every coordinate for each load harmonic: the retained ones by
-    the one harmonic solve (:func:`powertrain.physics.condensation.harmonic_solve`), each
-    network's internal motion from its engine-side and base motion.
+def harmonic_response(system, load_harmonics, omegas, amplitudes=None, linear=None, internal=True):
+    """Complex amplitudes of every coordinate for each load harmonic (module docstring).
 
     Parameters
     ----------
@@ -47,8 +37,7 @@ def harmonic_response(system, load_harmonics, omegas, amplitudes=None, linear=No
         The networks' linear two-ports at ``1j * omegas`` with their internal motions
         (:func:`~powertrain.physics.condensation.linear_two_ports`), reused.
     internal : bool
-        False: the networks' internal coordinates are left zero (only the retained ones are
-        solved).
+        False: the networks' internal coordinates are left zero.
 
     Returns
     -------

@@ -1,38 +1,23 @@
 r"""Rigid-body modes of the powertrain on its mounts: frequencies, damping, energy, torque roll.
 
-Two methods:
+``static``: the six undamped modes on the mounts' static stiffness, internal nodes condensed,
+:math:`\mathbf K_{6}\boldsymbol\varphi = \omega^2\mathbf M_{6}\boldsymbol\varphi`.
+``dynamic`` (default): the eigenvalues :math:`s` of the full assembled model in first-order
+form (:func:`state_space_eigenvalues`, networks' internal DOFs and body modes included), exact
+for lumped networks (a root of :math:`(s^2\mathbf M_R + \mathbf K_R(s))\boldsymbol\varphi = 0`,
+:func:`powertrain.physics.condensation.condense`); each static mode takes the root nearest in
+natural frequency and shape, one to one (:func:`_damped_roots`). Natural frequency
+:math:`|s|/2\pi`, damping ratio :math:`-\mathrm{Re}\,s/|s|`, damped frequency
+:math:`\mathrm{Im}\,s/2\pi`.
 
-* ``static`` — the six undamped modes of the body on the mounts' static (0 Hz) cross-point
-  stiffness, the networks' internal nodes condensed statically:
-  :math:`\mathbf K_{6}\boldsymbol\varphi = \omega^2\mathbf M_{6}\boldsymbol\varphi`.
-* ``dynamic`` (default) — each mode with the mount networks' dynamic stiffness at its own
-  (complex) frequency: the eigenvalues :math:`s` of the assembled model
-  :math:`\mathbf M\ddot{\mathbf q} + \mathbf C\dot{\mathbf q} + \mathbf K\mathbf q = 0` with
-  the networks' internal degrees of freedom (and the body modes of a modal chassis), in
-  first-order form, all found by one eigensolve (:func:`state_space_eigenvalues`), with the
-  shapes of those near the static modes (:func:`root_shapes`). Lumped networks
-  make this exact: a root is a root of the condensed problem
-  :math:`\big(s^2\mathbf M_R + \mathbf K_R(s)\big)\boldsymbol\varphi = 0` on the retained
-  coordinates (rigid body, body modes; every network through its two-port at :math:`s`,
-  :func:`powertrain.physics.condensation.condense`) and the retained part of its eigenvector
-  is :math:`\boldsymbol\varphi`. The full model has more roots than modes (the networks' own
-  modes); each static mode takes the root nearest to it in natural frequency and shape, one
-  to one (:func:`_damped_roots`). Natural frequency :math:`|s|/2\pi`, damping ratio
-  :math:`-\mathrm{Re}\,s/|s|`, damped frequency :math:`\mathrm{Im}\,s/2\pi`.
+Kinetic-energy shares over ``x, y, z, rx, ry, rz`` (at the CG, engine axes):
+:math:`E_j = \mathrm{Re}(\bar\varphi_j(\mathbf M\boldsymbol\varphi)_j) /
+\mathrm{Re}(\boldsymbol\varphi^H\mathbf M\boldsymbol\varphi)` [%], signed (products of
+inertia and complex shapes give slightly negative shares).
 
-Kinetic-energy distribution of mode :math:`\boldsymbol\varphi` over the coordinates
-``x, y, z, rx, ry, rz`` (CG translations and rotations about axes through the CG parallel to
-the engine axes): :math:`E_j = \mathrm{Re}\big(\bar\varphi_j(\mathbf M\boldsymbol\varphi)_j\big)
-/ \mathrm{Re}\big(\boldsymbol\varphi^H\mathbf M\boldsymbol\varphi\big)`, in percent (sums to
-100). The shares are signed: the products of inertia couple rx, ry and rz in
-:math:`\mathbf M`, and a damped mode's shape is complex, so a coordinate moving against the
-energy flow of its coupled partner has a slightly negative share (a few tenths of a percent);
-the text output says so whenever one is printed.
-
-Torque-roll axis: the axis about which the free body turns under a torque about the crank axis
-(engine X), :math:`\mathbf d = \mathbf I^{-1}\mathbf e_x/|\mathbf I^{-1}\mathbf e_x|` through
-the CG (Jeong & Singh, J. Sound Vib. 234(1), 2000, sec. 2). Each mode's rotation axis is the
-direction of its rotational part; the angle between the two axes is reported in 0..90°.
+Torque-roll axis: :math:`\mathbf d = \mathbf I^{-1}\mathbf e_x/|\mathbf I^{-1}\mathbf e_x|`
+through the CG (Jeong & Singh, J. Sound Vib. 234(1), 2000, sec. 2); each mode's rotation axis
+is the direction of its rotational part, the angle between them reported in 0..90°.
 """
 
 from __future__ import annotations
@@ -51,45 +36,41 @@ AS_MEASURED = ("mounts as measured (networks as in their mount files: amplitude 
 COORDINATES = ("x", "y", "z", "rx", "ry", "rz")
 #: Damping ratio below -UNSTABLE of a damped root: not a root of the passive model.
 UNSTABLE = 1e-8
-#: Share of a mode's kinetic energy in the powertrain's coordinates below which the mode does
-#: not move the powertrain (round-off): its energy distribution and axis are undefined (NaN).
+#: Share of a mode's kinetic energy in the powertrain's coordinates below which its energy
+#: distribution and axis are undefined (NaN).
 STILL = 1e-20
 
 
-# ---------------------------------------------------------------------------- physics
 def torque_roll_axis(inertia, crank_axis=(1.0, 0.0, 0.0)) -> np.ndarray:
-    """Unit direction of the torque-roll axis, :math:`\\mathbf I^{-1}\\mathbf e` normalised."""
+    """Unit direction of the torque-roll axis, :math:`\\mathbf I^{-1}\\mathbf e` normalised, of
+    the ``inertia`` (3, 3) [kg·m²] and the ``crank_axis`` (3,)."""
     d = np.linalg.solve(np.asarray(inertia, float), np.asarray(crank_axis, float))
     d = d / np.linalg.norm(d)
     return d if d @ np.asarray(crank_axis, float) >= 0 else -d
 
 
 def kinetic_energy_percent(M6, phi) -> np.ndarray:
-    """:math:`100\\,\\mathrm{Re}(\\bar\\varphi_j(\\mathbf M\\varphi)_j)/\\mathrm{Re}(\\varphi^H
-    \\mathbf M\\varphi)` per coordinate [%] of the mode ``phi`` (n,), or of each column of
-    ``phi`` (n, k)."""
+    """Kinetic-energy share [%] per coordinate of the mode ``phi`` (n,) or each column of
+    ``phi`` (n, k), mass matrix ``M6``."""
     phi = np.asarray(phi, complex)
     e = (np.conj(phi) * (M6 @ phi)).real
     return 100.0 * e / e.sum(axis=0)
 
 
 def number_or_null(value):
-    """``value`` as a float, or None (JSON null) where it is undefined (NaN: the rotation
-    axis of a mode without rotation)."""
+    """``value`` as a float, or None (JSON null) where it is NaN."""
     return float(value) if np.isfinite(value) else None
 
 
 def _axis_angles_deg(A, b) -> np.ndarray:
-    """Angle [deg, 0..90] between the axis of each column of ``A`` (3, k) and the axis ``b``;
-    NaN where either is zero."""
+    """Angle [deg, 0..90] between each column of ``A`` (3, k) and ``b``; NaN where one is zero."""
     norms = np.sqrt((A * A).sum(axis=0)) * np.sqrt(b @ b)
     cosine = np.divide(np.abs(b @ A), norms, out=np.zeros(norms.shape), where=norms > 0)
     return np.where(norms > 0, np.degrees(np.arccos(np.clip(cosine, 0.0, 1.0))), np.nan)
 
 
 def _normalise(M, phi):
-    """Each column of ``phi`` with unit modal mass, its phase such that its largest-energy
-    entry is real positive."""
+    """Each column of ``phi`` with unit modal mass, its largest-energy entry real positive."""
     phi = np.asarray(phi, complex)
     j = np.argmax((np.conj(phi) * (M @ phi)).real, axis=0)
     phi = phi * np.exp(-1j * np.angle(phi[j, np.arange(phi.shape[1])]))
@@ -97,9 +78,7 @@ def _normalise(M, phi):
 
 
 def _mac_matrix(P, Q, M) -> np.ndarray:
-    r"""Modal assurance criterion of every column of ``P`` with every column of ``Q``,
-    :math:`|\mathbf p^H\mathbf M\mathbf q|^2 / (\mathbf p^H\mathbf M\mathbf p\;
-    \mathbf q^H\mathbf M\mathbf q)`, shape (P columns, Q columns)."""
+    """Mass-weighted MAC of every column of ``P`` with every column of ``Q``."""
     MQ = M @ Q
     num = np.abs(np.conj(P).T @ MQ) ** 2
     return num / np.outer(np.einsum("ij,ij->j", np.conj(P), M @ P).real,
@@ -107,15 +86,9 @@ def _mac_matrix(P, Q, M) -> np.ndarray:
 
 
 def state_space_eigenvalues(system) -> np.ndarray:
-    r"""Eigenvalues of the assembled model's equations of motion
-    :math:`\mathbf M\ddot{\mathbf q} + \mathbf C\dot{\mathbf q} + \mathbf K\mathbf q = 0`
-    in first-order form, every coordinate included (rigid body, the networks' internal
-    degrees of freedom, body modes).
-
-    With :math:`\mathbf M` invertible the standard eigenproblem of
-    :math:`\begin{bmatrix}\mathbf 0 & \mathbf I\\ -\mathbf M^{-1}\mathbf K &
-    -\mathbf M^{-1}\mathbf C\end{bmatrix}`; otherwise (a massless node) the generalized
-    one with :math:`\mathrm{diag}(\mathbf I, \mathbf M)`, its infinite eigenvalues dropped.
+    r"""Eigenvalues of :math:`\mathbf M\ddot{\mathbf q} + \mathbf C\dot{\mathbf q} + \mathbf
+    K\mathbf q = 0` in first-order form, every coordinate included; with a singular
+    :math:`\mathbf M` the generalized problem, infinite eigenvalues dropped.
 
     Parameters
     ----------
@@ -142,11 +115,9 @@ def state_space_eigenvalues(system) -> np.ndarray:
 
 
 def root_shapes(system, roots) -> np.ndarray:
-    r"""The shape of the assembled model at each of its eigenvalues ``roots`` (k,) [1/s]: the
-    null vector of :math:`\mathbf K + s\mathbf C + s^2\mathbf M`, by one step of inverse
-    iteration from a generic start vector of its own for each root (so that a repeated root
-    gets independent shapes). For a root accurate to round-off the error of its shape is
-    round-off over the relative distance to the next root.
+    r"""The shape of ``system`` at each of its eigenvalues ``roots`` (k,) [1/s]: the null
+    vector of :math:`\mathbf K + s\mathbf C + s^2\mathbf M` by one inverse iteration from a
+    distinct start vector per root (a repeated root gets independent shapes).
 
     Returns
     -------
@@ -172,24 +143,14 @@ def _dynamic_stiffness(system, s):
 
 
 def _damped_roots(system, MR, omegas, vec):
-    r"""The damped mode of each static mode: ``(s, phi)``, the roots (k,) and their shapes on
-    the retained coordinates (n_R, k) in the order of ``omegas`` [rad/s], from the eigenvalues
-    of the full model (:func:`state_space_eigenvalues`) and their shapes
-    (:func:`root_shapes`).
+    r"""``(s, phi)``: the damped root (k,) of each static mode at ``omegas`` [rad/s] and its
+    shape on the retained coordinates (n_R, k).
 
-    Candidates are the eigenvalues with positive imaginary part and a modulus below three
-    times the highest static angular frequency (if these are fewer than the modes: every
-    eigenvalue with imaginary part >= 0, overdamped ones included), without those that leave
-    the retained coordinates still (a network's own mode, decoupled from the body). Each
-    static mode i gets its own candidate (:func:`scipy.optimize.linear_sum_assignment`) at
-    the least total cost :math:`|\ln(\omega_i/|s|)| + 1 - \mathrm{MAC}(\boldsymbol\varphi_i,
-    \boldsymbol\varphi_s)`: nearest in natural frequency and in shape.
-
-    Raises
-    ------
-    ValueError
-        Fewer candidates than modes, or a picked root with a damping ratio below
-        -:data:`UNSTABLE` (matrices beyond what the eigensolve resolves in floating point).
+    Candidates: eigenvalues with positive imaginary part below three times the highest static
+    frequency (else all with imaginary part >= 0) that move the retained coordinates. Each
+    static mode gets one (:func:`scipy.optimize.linear_sum_assignment`) at least total cost
+    :math:`|\ln(\omega_i/|s|)| + 1 - \mathrm{MAC}`. ValueError for fewer candidates than
+    modes or a root with damping ratio below -:data:`UNSTABLE`.
     """
     lam = state_space_eigenvalues(system)
     top = 3.0 * max(omegas.max(), 1e-9)
@@ -215,8 +176,7 @@ def _damped_roots(system, MR, omegas, vec):
 
 
 def _pair_with_static(M, shapes, static_shapes) -> list:
-    """``(index of the static mode, MAC)`` for each column of ``shapes``: the one-to-one
-    pairing of largest total MAC (:func:`scipy.optimize.linear_sum_assignment`)."""
+    """``(static mode index, MAC)`` per column of ``shapes``, paired one to one by largest MAC."""
     mac = _mac_matrix(shapes, static_shapes.astype(complex), M)
     rows, cols = linear_sum_assignment(-mac)
     pair = dict(zip(rows, cols))
@@ -231,10 +191,7 @@ def _static_condensed(system, keep) -> np.ndarray:
 
 def rigid_body_modes(system, inertia, *, static=False, crank_axis=(1.0, 0.0, 0.0)) -> dict:
     """The six rigid-body modes of an assembled powertrain, plus the body modes of a modal
-    chassis (coupled through the mounts).
-
-    Kinetic-energy shares are over the powertrain's six coordinates; a mode whose kinetic
-    energy lies mostly in the body modes is of kind ``chassis``.
+    chassis (kind ``chassis`` where most kinetic energy is in the body modes).
 
     Parameters
     ----------
@@ -256,8 +213,7 @@ def rigid_body_modes(system, inertia, *, static=False, crank_axis=(1.0, 0.0, 0.0
     w2, vec = sla.eigh(_static_condensed(system, keep), MR)
     tra = torque_roll_axis(inertia, crank_axis)
     omegas = np.sqrt(np.clip(w2, 0.0, None))
-    s, phi = (1j * omegas, vec.astype(complex)) if static else \
-        _damped_roots(system, MR, omegas, vec)
+    s, phi = (1j * omegas, vec.astype(complex)) if static else _damped_roots(system, MR, omegas, vec)
     modes = _mode_fields(MR, s, phi, omegas, vec, tra, static)
     modes.sort(key=lambda m: m["frequency_hz"])
     crank = np.asarray(crank_axis, float)
@@ -274,8 +230,7 @@ def rigid_body_modes(system, inertia, *, static=False, crank_axis=(1.0, 0.0, 0.0
 
 
 def _mode_fields(MR, s, phi, omegas, static_shapes, tra, static) -> list:
-    """The fields of a :class:`powertrain.results.modes.Mode` for each root ``s`` (k,) with
-    its shape ``phi`` (n_R, k) on the retained coordinates (any scale), in that order."""
+    """Fields of a :class:`powertrain.results.modes.Mode` per root ``s`` and shape ``phi``."""
     pairs = _pair_with_static(MR, phi, static_shapes)
     phi = _normalise(MR, phi)
     e = (np.conj(phi) * (MR @ phi)).real
@@ -298,10 +253,7 @@ def _mode_fields(MR, s, phi, omegas, static_shapes, tra, static) -> list:
 
 
 def _as_measured(system):
-    """``(system, note)``: a model with amplitude laws or friction with every network as
-    measured (:meth:`NetworkScaling.as_measured`, the view of
-    :func:`~powertrain.physics.condensation.condense`) and the note its method gets; a
-    linear model as it is."""
+    """``(system, note)``: a nonlinear model with its networks as measured, and its note."""
     if system.port_forces() is None:
         return system, ""
     return NetworkScaling(system).as_measured(), "; " + AS_MEASURED

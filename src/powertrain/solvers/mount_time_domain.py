@@ -1,19 +1,11 @@
 r"""Time-domain verification of a mount model: Newmark integration processed by FFT.
 
-The thesis verified its triple mass oscillator in AVL Excite by integrating the model in time
-under a harmonic load and processing the result into the frequency domain with an FFT
-(Kovarik 2016, sec. 3.2). These functions do the same with our Newmark kernel, starting from
-the exactly periodic state of the discrete recurrence (:func:`~powertrain.solvers.newmark.periodic_state`)
-so that no transient contaminates the window, and report the cycle-to-cycle periodicity.
-
-Two set-ups:
-
-* :func:`time_cross_point_stiffness` — the rate-machine test (sec. 1.8, Fig. 13): the
-  engine-side node follows :math:`x_1 = X\sin\omega t` with the base grounded, the force transmitted to
-  ground is recorded, :math:`K_{CP} = \hat F_T/X`.
-* :func:`time_forced_response` — the verification set-up (sec. 3.2, Appendix A): a force
-  :math:`F\cos\omega t` on an engine mass carried by the mount; records :math:`\hat X_1` and
-  :math:`\hat F_T`.
+As the thesis's verification in AVL Excite (Kovarik 2016, sec. 3.2), from the exactly periodic
+state of the discrete recurrence (:func:`~powertrain.solvers.newmark.periodic_state`), with
+the cycle-to-cycle periodicity reported. :func:`time_cross_point_stiffness` is the
+rate-machine test (sec. 1.8, Fig. 13: :math:`x_1 = X\sin\omega t`, base grounded,
+:math:`K_{CP} = \hat F_T/X`); :func:`time_forced_response` the verification set-up (sec. 3.2,
+Appendix A: :math:`F\cos\omega t` on an engine mass on the mount).
 """
 
 from __future__ import annotations
@@ -57,18 +49,13 @@ def _periodicity(sig, N):
 
 def time_cross_point_stiffness(model, frequency_hz, amplitude=1e-4,
                                steps_per_period=STEPS_PER_PERIOD) -> TimeDomainResult:
-    r"""Cross-point stiffness by imposing :math:`x_1 = X\sin\omega t` on the engine-side node
-    (base grounded) and integrating the internal masses: the first harmonic of the base force
-    over that of :math:`x_1` (the sinusoidal displacement test, Kovarik 2016 Fig. 13).
+    r"""Cross-point stiffness: first harmonic of the base force over that of the imposed
+    :math:`x_1 = X\sin\omega t` (base grounded; Kovarik 2016 Fig. 13).
 
-    A mount element acts as in a time-domain run-up: its network scaled by its amplitude law
-    at :math:`A = \sqrt2\,\mathrm{RMS}` of the last cycle of :math:`x_1` (:math:`X` for the
-    pure sine), its port law integrated along the prescribed motion
-    (:func:`powertrain.kernels.port_forces.port_force_loop`) from its steady loop
-    (``steady_state``) and added to the base force. The network starts in the exactly
-    periodic state of the Newmark recurrence, so two periods are integrated and the second
-    one is transformed; ``periodicity`` is the steady-state check, max |F(t+T) - F(t)| over
-    max |F|.
+    A mount element's network is scaled by its amplitude law at :math:`A = X`, its port law
+    integrated along the motion from its steady loop
+    (:func:`powertrain.kernels.port_forces.port_force_loop`). The second of two periods is
+    transformed; ``periodicity`` is max |F(t+T) - F(t)| over max |F|.
 
     Parameters
     ----------
@@ -76,9 +63,9 @@ def time_cross_point_stiffness(model, frequency_hz, amplitude=1e-4,
     frequency_hz : array_like
         [Hz], > 0.
     amplitude : float
-        Engine-side displacement amplitude X [m] (default 0.1 mm, the thesis's test amplitude;
-        a linear model cancels it).
+        Engine-side displacement amplitude X [m] (default 0.1 mm, the thesis's).
     steps_per_period : int
+        Newmark steps per period.
     """
     element = model.element() if hasattr(model, "element") else model
     freqs = np.atleast_1d(np.asarray(frequency_hz, float))
@@ -106,20 +93,17 @@ def time_cross_point_stiffness(model, frequency_hz, amplitude=1e-4,
 
 
 def _driven(M, C, K, x1, v1, h, N):
-    """Motion ``(X, V)`` of the network with the engine-side node prescribed (``x1``,
-    ``v1`` over two periods) and the internal masses integrated from their periodic state."""
+    """Motion ``(X, V)`` of the network, engine-side node prescribed (``x1``, ``v1``)."""
     if M.shape[0] == 1:
         return x1[:, None], v1[:, None]
     Mi, Ci, Ki = M[1:, 1:], C[1:, 1:], K[1:, 1:]
-    # load on the internal masses from the prescribed engine-side motion
     Fi = -(np.outer(x1[:N + 1], K[1:, 0]) + np.outer(v1[:N + 1], C[1:, 0]))
     Xi, Vi, _ = _run_periodic(Mi, Ci, Ki, Fi, h)
     return np.column_stack([x1, Xi]), np.column_stack([v1, Vi])
 
 
 def _port_force(law, x1, v1, amplitude):
-    """Force [N] of the port law ``law`` (None: zero) on the base along the prescribed
-    relative motion ``x1``, ``v1``, from its steady loop at ``amplitude``."""
+    """Force [N] of the port ``law`` (None: zero) along ``x1``, ``v1`` from its steady loop."""
     if law is None:
         return 0.0
     U = np.ascontiguousarray(x1[:, None])
@@ -132,7 +116,9 @@ def _port_force(law, x1, v1, amplitude):
 
 def time_forced_response(model, frequency_hz, engine_mass, force,
                          steps_per_period=STEPS_PER_PERIOD) -> TimeDomainResult:
-    """Engine mass [kg] on the mount under F cos(ωt) [N]: Newmark + FFT (thesis sec. 3.2)."""
+    """An ``engine_mass`` [kg] on the mount ``model`` under ``force`` cos(ωt) [N] at
+    ``frequency_hz`` [Hz], ``steps_per_period`` Newmark steps per period, by FFT (thesis
+    sec. 3.2)."""
     freqs = np.atleast_1d(np.asarray(frequency_hz, float))
     if np.any(freqs <= 0):
         raise ValueError("time-domain method needs frequencies > 0 Hz")

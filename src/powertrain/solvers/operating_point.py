@@ -1,29 +1,20 @@
 r"""The static operating point of the powertrain on its mounts, per engine speed.
 
-The six-DOF body (:math:`\mathbf q = (\mathbf u, \boldsymbol\theta)` at the centre of
-gravity, engine axes) carries its weight, :math:`-mg\,\mathbf e_z` at the CG
-(:math:`g` = 9.80665 m/s²), and the mean drive-torque reaction, the couple
-:math:`-i\,T_{mean}\,\mathbf n`: :math:`\mathbf n = \pm\mathbf e_x` the crank's rotation
-sense (``[crank_train] rotation``), :math:`T_{mean}` the mean brake torque at the speed
-(:meth:`powertrain.models.engine.Engine.mean_brake_torque`) and :math:`i` the gear ratio of the
-run (``[drive] gear_ratio``). Small displacements: a mount point :math:`\mathbf p` moves by
-:math:`\mathbf u + \boldsymbol\theta\times(\mathbf p - \mathbf c_g)`, mount axes and loads
-stay fixed, the base does not move. Along each local axis :math:`\mathbf e` of a mount the
-deflection is :math:`\delta = \mathbf r^T\mathbf q` (engine-side point minus base,
-:func:`powertrain.physics.rigid_body.direction_row`), the mount's force :math:`F(\delta)` is
-its static curve's (:class:`~powertrain.physics.mount_laws.StaticCurve`), or
-:math:`k_0\delta` with the network's static stiffness :math:`k_0` where the direction has no
-curve, and the mount pushes the engine with :math:`-F\,\mathbf r`. Equilibrium
+The six-DOF body (:math:`\mathbf q = (\mathbf u, \boldsymbol\theta)` at the CG, engine axes)
+carries its weight :math:`-mg\,\mathbf e_z` (:math:`g` = 9.80665 m/s²) and the mean
+drive-torque reaction :math:`-i\,T_{mean}\,\mathbf n` (:math:`\mathbf n = \pm\mathbf e_x` the
+crank's rotation sense, :math:`T_{mean}` the mean brake torque, :math:`i` the gear ratio).
+With small displacements each mount direction deflects by :math:`\delta = \mathbf r^T\mathbf q`
+(engine side minus base, :func:`powertrain.physics.rigid_body.direction_row`) and pushes the
+engine with :math:`-F(\delta)\,\mathbf r`, :math:`F` its static curve
+(:class:`~powertrain.physics.mount_laws.StaticCurve`) or :math:`k_0\delta`. Equilibrium
 
 .. math:: \mathbf R(\mathbf q) = \mathbf W - \sum F(\mathbf r^T\mathbf q)\,\mathbf r = 0
 
-is solved by Newton's method with the tangent stiffness
-:math:`\sum F'(\delta)\,\mathbf r\mathbf r^T` and a halving line search, until the force
-residual is at most :data:`TOLERANCE` of the weight and the moment residual at most
-:data:`TOLERANCE` of the weight × 1 m. Each network's *static factor* is its curve's tangent
-stiffness there over that at its reference deflection (1 without a curve): the factor the
-run-up scales the network's springs and dampers by
-(:meth:`~powertrain.physics.mount_elements.MountElement.at_operating_point`).
+is solved by Newton with the tangent stiffness :math:`\sum F'(\delta)\,\mathbf r\mathbf r^T`
+and a halving line search to :data:`TOLERANCE`. A network's *static factor*, its curve's
+tangent there over that at its reference deflection (1 without a curve), scales its springs
+and dampers (:meth:`~powertrain.physics.mount_elements.MountElement.at_operating_point`).
 """
 
 from __future__ import annotations
@@ -51,8 +42,8 @@ DIRECTIONS = ("x", "y", "z")
 
 @dataclass(frozen=True, eq=False)
 class StaticSupport:
-    """The mounts as the static equilibrium sees them, one entry per network (mount ×
-    local direction, mount order then x, y, z).
+    """The mounts as the static equilibrium sees them, one entry per network (mount order,
+    then local x, y, z).
 
     Attributes
     ----------
@@ -64,14 +55,10 @@ class StaticSupport:
         Static stiffness of the networks [N/m] (used where there is no curve).
     cubics : tuple
         ``(breaks (n_net, n_b), coefficients (n_net, n_b - 1, 4), count (n_net,))``: each
-        network's force as a piecewise cubic, its curve's PCHIP
-        (:func:`~powertrain.physics.mount_laws.pchip_cubic`) or the straight line of its
-        static stiffness, read by :func:`~powertrain.kernels.static_curve.curve_values`
-        (straight with the end slopes beyond the points, as
-        :class:`~powertrain.physics.mount_laws.CurveReader`).
+        network's force as a piecewise cubic (its curve's PCHIP or its static stiffness's
+        line, :func:`~powertrain.kernels.static_curve.curve_values`).
     reference_tangent : ndarray (n_net,)
-        Each curve's tangent stiffness at its reference deflection, the static stiffness
-        where there is none [N/m].
+        Tangent stiffness at each curve's reference deflection, else the static one [N/m].
     """
 
     rows: np.ndarray
@@ -82,7 +69,7 @@ class StaticSupport:
 
     @classmethod
     def of(cls, engine) -> StaticSupport:
-        """The support of ``engine``'s mounts."""
+        """The support of the mounts of ``engine``."""
         cg = np.asarray(engine.body.cg, float)
         rows, curves, k0 = [], [], []
         for mount in engine.mounts:
@@ -93,37 +80,33 @@ class StaticSupport:
                 rows.append(direction_row(r, R[:, a]))
                 curves.append(model.static_curve)
                 k0.append(model.static_stiffness())
-        cubics = tuple(kernel_input(a, a.dtype) for a in _padded(
-            [_cubic(c, k) for c, k in zip(curves, k0)]))
+        cubics = tuple(kernel_input(a, a.dtype) for a in _padded([_cubic(c, k) for c, k in zip(curves, k0)]))
         reference = np.array([0.0 if c is None else c.reference_deflection for c in curves])
         tangent = np.empty(len(curves))
         curve_values(*cubics, kernel_input(reference), np.empty(len(curves)), tangent)
         return cls(np.array(rows), curves, np.array(k0), cubics, tangent)
 
     def read(self, deflection):
-        """``(force [N], tangent stiffness [N/m])`` of every network at its deflection
-        (n_net,) [m]."""
+        """``(force [N], tangent stiffness [N/m])`` of every network at its ``deflection`` [m]."""
         force, tangent = np.empty(len(self.curves)), np.empty(len(self.curves))
         curve_values(*self.cubics, kernel_input(deflection), force, tangent)
         return force, tangent
 
     def forces(self, deflection) -> np.ndarray:
-        """Force of every network [N] at its deflection [m]."""
+        """Force of every network [N] at its ``deflection`` [m]."""
         return self.read(deflection)[0]
 
     def tangents(self, deflection) -> np.ndarray:
-        """Tangent stiffness of every network [N/m] at its deflection [m]."""
+        """Tangent stiffness of every network [N/m] at its ``deflection`` [m]."""
         return self.read(deflection)[1]
 
     def factors(self, deflection) -> np.ndarray:
-        """Static factor of every network at its deflection (1 without a curve)."""
+        """Static factor of every network at its ``deflection`` [m] (1 without a curve)."""
         return self.read(deflection)[1] / self.reference_tangent
 
 
 def _padded(pieces):
-    """``(breaks (n, size), coefficients (n, size - 1, 4), counts (n,))`` of the networks'
-    ``(breaks, coefficients)``: the breaks padded with their last, the coefficients with
-    zeros."""
+    """The networks' ``(breaks, coefficients)`` padded to one size, and their counts."""
     size = max(b.size for b, _ in pieces)
     breaks, coefficients = np.empty((len(pieces), size)), np.zeros((len(pieces), size - 1, 4))
     for i, (b, c) in enumerate(pieces):
@@ -133,9 +116,7 @@ def _padded(pieces):
 
 
 def _cubic(curve, stiffness):
-    """``(breaks, coefficients (segments, 4))`` of a network's force: its static
-    ``curve``'s PCHIP, or without one the line ``stiffness`` × deflection (about 0, so
-    exact at any small deflection)."""
+    """``(breaks, coefficients)`` of the ``curve``'s PCHIP, or of the line ``stiffness`` × δ."""
     if curve is None:
         return np.array([0.0, 1.0]), np.array([[0.0, 0.0, stiffness, 0.0]])
     return pchip_cubic(curve.deflection, curve.force)
@@ -152,9 +133,8 @@ class OperatingPoint:
     body : ndarray (6,)
         Displacement [m] and small rotation [rad] of the body at the CG, engine axes.
     deflection, force, tangent_stiffness : ndarray (n_mounts, 3)
-        Per mount and local direction x, y, z: engine-side point minus base [m], the
-        curve's force there [N] (the mount pushes the engine with minus it), its tangent
-        stiffness [N/m].
+        Per mount and local direction: engine side minus base [m], the curve's force [N]
+        (pushing the engine with minus it), its tangent stiffness [N/m].
     static_factor : ndarray (n_mounts * 3,)
         Each network's static factor.
     iterations : int
@@ -182,8 +162,8 @@ def has_static_curves(engine) -> bool:
 
 
 def static_load(engine, mean_torque: float) -> np.ndarray:
-    """Generalized load on the body about its CG [N, N·m]: the weight and the mean
-    drive-torque reaction :math:`-i\\,T_{mean}\\,\\mathbf n`."""
+    """Generalized load (6,) [N, N·m] on the body about its CG: the weight and the reaction
+    :math:`-i\\,T_{mean}\\,\\mathbf n` of the ``mean_torque`` [N·m] of ``engine``."""
     n = np.array([float(engine.crank.rotation_sign), 0.0, 0.0])
     load = np.zeros(6)
     load[2] = -engine.body.mass * STANDARD_GRAVITY
@@ -193,13 +173,24 @@ def static_load(engine, mean_torque: float) -> np.ndarray:
 
 def operating_point(engine, rpm: float, support: StaticSupport | None = None,
                     start=None, mean_torque: float | None = None) -> OperatingPoint:
-    """The static operating point of ``engine`` at ``rpm`` (module docstring), under the
-    mean brake torque at that speed or else ``mean_torque`` [N·m].
+    """The static operating point of ``engine`` at ``rpm`` (module docstring).
+
+    Parameters
+    ----------
+    engine : Engine
+    rpm : float
+        Speed [rpm].
+    support : StaticSupport, optional
+        The mounts (default built from ``engine``).
+    start : ndarray (6,), optional
+        Newton's first guess [m, rad] (default zero).
+    mean_torque : float, optional
+        Mean brake torque [N·m]; default the engine's at ``rpm``.
 
     Raises
     ------
     InputError
-        Naming the engine file and the speed when Newton's method does not converge.
+        When Newton's method does not converge.
     """
     engine.require_excitation()
     support = support or StaticSupport.of(engine)
@@ -220,7 +211,7 @@ def operating_point(engine, rpm: float, support: StaticSupport | None = None,
 
 
 def operating_points(engine, rpm) -> list:
-    """:func:`operating_point` at every speed of ``rpm``, each started from the last."""
+    """:func:`operating_point` of ``engine`` at every speed of ``rpm``, each started from the last."""
     support = StaticSupport.of(engine)
     out, start = [], None
     for n in np.atleast_1d(np.asarray(rpm, float)):
@@ -230,9 +221,8 @@ def operating_points(engine, rpm) -> list:
 
 
 def static_factors(engine, rpm) -> np.ndarray:
-    """Static factor of every network (mount order, then local x, y, z) at the operating
-    point of ``rpm`` [rpm], shape ``(n_networks,)``; all 1 when no mount direction has a
-    static curve (then nothing is solved)."""
+    """Static factor (n_networks,) of every network of ``engine`` at the operating point of
+    ``rpm`` [rpm]; all 1 without static curves."""
     if not has_static_curves(engine):
         return np.ones(3 * len(engine.mounts))
     return operating_point(engine, rpm).static_factor
@@ -245,8 +235,7 @@ def _residual(support, load, weight, q):
 
 
 def _equilibrium(support, load, weight, start):
-    """Newton with a halving line search: ``(q, iterations, residual)``; q None when not
-    converged."""
+    """Newton with a halving line search: ``(q, iterations, residual)``, q None if not converged."""
     q = np.zeros(6) if start is None else np.asarray(start, float).copy()
     r, size = _residual(support, load, weight, q)
     for it in range(MAX_ITERATIONS + 1):

@@ -1,20 +1,15 @@
 r"""Continuous run-up simulation: one linear speed ramp, integrated in time.
 
 The speed rises linearly, :math:`n(t) = n_0 + \dot n\,t`, so the crank angle is
-:math:`\theta(t) = \tfrac{2\pi}{60}(n_0 t + \tfrac12\dot n t^2)`. The load at every step is
-the engine's generalized load at that speed and angle, interpolated bilinearly in a table
-sampled every :data:`LOAD_RPM_STEP` rpm and :data:`LOAD_ANGLE_STEP_DEG` degrees of the
-cycle (speed-dependent inertia and gas forces; :meth:`Engine.load_table` evaluates the engine
-model's speed-independent patterns once). The same assembled model as the stepped
-run-up is integrated by Newmark average acceleration in modal form
-(:class:`~powertrain.solvers.newmark.ModalNewmark`, the same recurrence as the run-up's
-stepper) at ``oversample`` times the output rate (at least one step per crank degree at the
-top speed), starting from the periodic steady state at the first speed. The mount-point
-accelerations are decimated to ``sample_rate`` with a zero-phase polyphase FIR (Kaiser,
-beta 8) and returned as a :class:`~powertrain.models.recording.RawRecording` (synthetic,
-labelled so) with the speed channel, a once-per-revolution tacho whose rising edges are
-cylinder-1 firing TDC and a once-per-cycle reference (:func:`crank_pulses`, from the exact
-crank angle), ready for the tracker, phases included.
+:math:`\theta(t) = \tfrac{2\pi}{60}(n_0 t + \tfrac12\dot n t^2)`. The load is read
+bilinearly from a table every :data:`LOAD_RPM_STEP` rpm and :data:`LOAD_ANGLE_STEP_DEG`° of
+the cycle (:meth:`Engine.load_table`). The run-up's assembled model is integrated by Newmark
+average acceleration (modal, :class:`~powertrain.solvers.newmark.ModalNewmark`, for a linear
+model) at a multiple of the output rate (at least :data:`STEPS_PER_DEGREE` step per crank
+degree at the top speed) from the periodic steady state at the first speed. Mount-point
+accelerations are decimated to ``sample_rate`` by a zero-phase polyphase FIR (Kaiser, beta 8)
+into a synthetic :class:`~powertrain.models.recording.RawRecording` with the speed, a tacho
+and a cycle reference (:func:`crank_pulses`).
 """
 
 from __future__ import annotations
@@ -44,8 +39,7 @@ STEPS_PER_DEGREE = 1.0
 CHUNK_OUT = 8192
 #: Half-length of the decimation FIR in output samples.
 FIR_HALF = 10
-#: Bounds of a sweep, checked before any work: output samples (time data for the tracker;
-#: 2**22 is 512 s at 8192 Hz) and internal integration steps (2**24: about three minutes).
+#: Bounds of a sweep, checked before any work: output samples and internal steps.
 MIN_SWEEP_SAMPLES = 1024
 MAX_SWEEP_SAMPLES = 2 ** 22
 MAX_SWEEP_STEPS = 2 ** 24
@@ -69,9 +63,7 @@ def _load_table(engine, rpm_from, rpm_to):
 
 
 def _ramp_rows(load, ramp, lo, rows):
-    """Loads (rows, 6) [N] of the ramp ``(rpm_from, rate, h, steps)`` at steps ``lo ..
-    lo + rows - 1``, bilinear in the load table
-    (:func:`powertrain.kernels.speed_ramp.ramp_loads`)."""
+    """Loads (rows, 6) [N] of the ramp ``(rpm_from, rate, h, steps)`` at steps ``lo`` on."""
     speeds, table, _ = load
     rpm_from, rate, h, _ = ramp
     F = np.empty((rows, 6))
@@ -84,9 +76,6 @@ def simulate_sweep(engine, rpm_from, rpm_to, rate_rpm_per_s, sample_rate=8192.0,
                    system=None, progress=False, static_factors=None) -> RawRecording:
     """Simulate a continuous run-up; mount-point accelerations as raw time data.
 
-    A linear model is integrated in modal form; one with nonlinear mount elements in
-    physical coordinates one engine cycle at a time (:func:`_integrate_nonlinear`).
-
     Parameters
     ----------
     engine : Engine
@@ -97,25 +86,22 @@ def simulate_sweep(engine, rpm_from, rpm_to, rate_rpm_per_s, sample_rate=8192.0,
     sample_rate : float
         Output sampling rate [Hz].
     system : AssembledSystem, optional
+        Default ``engine.assemble()``.
     progress : bool
         tqdm bar on stderr (hidden when not a terminal).
     static_factors : callable, optional
-        Hook of the operating point: ``static_factors(rpm) -> (n_net,)`` every network's
-        static-curve factor at a speed, applied per engine cycle (default: each element's
-        own ``static_factor``).
+        ``static_factors(rpm) -> (n_net,)``, applied per engine cycle.
 
     Returns
     -------
     RawRecording
-        Three acceleration channels [m/s^2] per mount (engine side; a modal body under the
-        mounts moves with them), the speed [rpm], the tacho and the cycle reference [V]
-        (:func:`crank_pulses`).
+        Three engine-side acceleration channels [m/s^2] per mount, the speed [rpm], the
+        tacho and the cycle reference [V].
     """
     _check(engine, rpm_from, rpm_to, rate_rpm_per_s, sample_rate)
     m, n_steps = sweep_steps(rpm_from, rpm_to, rate_rpm_per_s, sample_rate)
     h = 1.0 / (m * sample_rate)
-    if system is None:
-        system = engine.assemble()
+    system = engine.assemble() if system is None else system
     if system.chassis is not None:
         system.chassis.require_time_domain()
     load = _load_table(engine, rpm_from, rpm_to)
@@ -124,8 +110,7 @@ def simulate_sweep(engine, rpm_from, rpm_to, rate_rpm_per_s, sample_rate=8192.0,
     decimator = _Decimator(m, dofs.size)
     ramp = (rpm_from, rate_rpm_per_s, h, n_steps)
     with single_blas_thread():
-        y, method = _integrate_ramp(engine, system, load, ramp, dofs, decimator, progress,
-                                    static_factors)
+        y, method = _integrate_ramp(engine, system, load, ramp, dofs, decimator, progress, static_factors)
         block = to_channels @ y.T                           # (n_ch, n_out), contiguous
     t_out = (decimator.first_output_index + np.arange(y.shape[0])) / sample_rate
     rpm_out = rpm_from + rate_rpm_per_s * t_out
@@ -136,28 +121,20 @@ def simulate_sweep(engine, rpm_from, rpm_to, rate_rpm_per_s, sample_rate=8192.0,
             f"acceleration, {method}, {m * sample_rate:g} Hz internal, decimated to "
             f"{sample_rate:g} Hz)")
     tacho, cycle = crank_pulses(t_out, rpm_from, rate_rpm_per_s)
-    return RawRecording(t_out, chans, rpm_out, tacho, "simulated sweep", [note],
-                        cycle).validate()
+    return RawRecording(t_out, chans, rpm_out, tacho, "simulated sweep", [note], cycle).validate()
 
 
 def crank_pulses(time, rpm_from, rate_rpm_per_s):
-    r"""The sweep's tacho and cycle reference [V] at ``time`` [s], from its exact crank angle
-    (module docstring): one pulse per revolution whose rising edge is cylinder-1 firing TDC
-    (:math:`\theta = 0` mod :math:`2\pi`), and one per cycle whose edge is
-    :data:`CYCLE_LEAD_DEG` before the TDC at :math:`\theta = 0` mod :math:`4\pi` (as a cam
-    signal: the first tacho reference after it is that TDC,
-    :func:`~powertrain.analysis.phase.cycle_origin`)."""
+    r"""Tacho and cycle reference [V] at ``time`` [s] of the ramp from ``rpm_from`` [rpm] at
+    ``rate_rpm_per_s``: one pulse per revolution rising at cylinder-1 firing TDC
+    (:math:`\theta = 0` mod :math:`2\pi`), one per cycle rising :data:`CYCLE_LEAD_DEG` before
+    the TDC at :math:`\theta = 0` mod :math:`4\pi` (:func:`~powertrain.analysis.phase.cycle_origin`)."""
     theta = (2 * np.pi / 60.0) * (rpm_from * time + 0.5 * rate_rpm_per_s * time ** 2)
-    return (_pulse_train(theta, 2 * np.pi, 0.0),
-            _pulse_train(theta, 4 * np.pi, -np.radians(CYCLE_LEAD_DEG)))
+    return (_pulse_train(theta, 2 * np.pi, 0.0), _pulse_train(theta, 4 * np.pi, -np.radians(CYCLE_LEAD_DEG)))
 
 
 def _pulse_train(theta, period, edge):
-    """Pulses [V] at the crank angles ``theta`` [rad], one per ``period``, high for half of
-    it: the rising flank, linear in angle over :data:`PULSE_FLANK_DEG`, crosses the
-    tracker's trigger level (:data:`~powertrain.analysis.speed.TRIGGER_HIGH` of the swing)
-    at ``edge`` modulo ``period``, so that the edge time interpolated between samples is
-    exact but for the speed's change over one sample."""
+    """Pulses [V] at ``theta`` [rad], one per ``period``, crossing the trigger level at ``edge``."""
     flank = np.radians(PULSE_FLANK_DEG)
     phi = np.mod(theta - edge + TRIGGER_HIGH * flank, period)
     rise = phi / flank
@@ -171,17 +148,13 @@ def _pulse_train(theta, period, edge):
 
 
 def _channel_dofs(channel_matrix):
-    """The coordinates the channels read (columns of ``channel_matrix`` not all zero: the
-    body's six) and the map (n_ch, n_read) from their accelerations to the channels. The
-    sweep integrates and decimates those and maps them after the decimation (both linear, so
-    equal to round-off, and fewer signals than channels)."""
+    """The coordinates the channels read and the map (n_ch, n_read) from them to the channels."""
     dofs = np.flatnonzero(np.any(channel_matrix != 0, axis=0))
     return dofs, np.ascontiguousarray(channel_matrix[:, dofs])
 
 
 def _integrate_ramp(engine, system, load, ramp, dofs, decimator, progress, static_factors):
-    """Decimated accelerations of the coordinates ``dofs`` over the ramp and the method's
-    name: modal for a linear model, else dense engine cycle by engine cycle."""
+    """Decimated accelerations of the coordinates ``dofs`` over the ramp and the method's name."""
     if system.port_forces() is None and static_factors is None:
         modal = ModalNewmark(system.M, system.C, system.K, load_dofs=6)
         return _integrate(modal, dofs, load, ramp, _initial_state(engine, modal, ramp[0]),
@@ -190,10 +163,7 @@ def _integrate_ramp(engine, system, load, ramp, dofs, decimator, progress, stati
 
 
 def _integrate(modal, dofs, load, ramp, eta, decimator, progress):
-    """Decimated accelerations (n_out, n_read) of the coordinates ``dofs`` over the ramp
-    ``(rpm_from, rate [rpm/s], step h [s], steps)`` from the modal state ``eta``, chunk by
-    chunk (one Numba kernel:
-    load, recurrence and outputs, :func:`powertrain.kernels.speed_ramp.modal_ramp_kernel`)."""
+    """Decimated accelerations (n_out, n_read) of ``dofs`` over the ramp from the modal state ``eta``."""
     rpm_from, rate_rpm_per_s, h, n_steps = ramp
     speeds, table, _ = load
     read = np.eye(modal.n)[dofs]
@@ -222,8 +192,7 @@ def _integrate(modal, dofs, load, ramp, eta, decimator, progress):
 
 
 def _cycle_bounds(rpm_from, rate, h, n_steps):
-    """Step indices (n_c + 1,) where the engine cycles of the ramp begin (and the last
-    step): the crank angle passes a multiple of 4 pi."""
+    """Step indices (n_c + 1,) where the ramp's engine cycles begin, and the last step."""
     t_end = n_steps * h
     cycles = (np.pi / 30.0) * (rpm_from * t_end + 0.5 * rate * t_end ** 2) / (4 * np.pi)
     angle = 4 * np.pi * np.arange(1, int(np.ceil(cycles)))
@@ -233,13 +202,7 @@ def _cycle_bounds(rpm_from, rate, h, n_steps):
 
 
 def _integrate_nonlinear(engine, system, load, ramp, dofs, decimator, static_factors):
-    """Decimated accelerations of the coordinates ``dofs`` over the ramp with nonlinear
-    mount elements and the method's name: modal with the port forces when the networks keep
-    their scale (:func:`_integrate_ports`; it starts with the acceleration of the equation
-    of motion), else dense Newmark engine cycle by engine cycle
-    (:class:`~powertrain.solvers.cycle_newmark.CycleIntegrator`), from the harmonic fixed
-    point at the first speed with the port laws on their steady loop, the amplitude law and
-    the static factors updated per cycle."""
+    """Decimated accelerations of ``dofs`` with nonlinear mount elements and the method's name."""
     rpm_from, rate, h, n_steps = ramp
     x, state, amplitudes, stepper = _nonlinear_start(engine, system, rpm_from, static_factors)
     integrator = CycleIntegrator(stepper.scaling, stepper.ports, h, x[3])
@@ -260,17 +223,12 @@ def _integrate_nonlinear(engine, system, load, ramp, dofs, decimator, static_fac
 
 
 def _integrate_ports(integrator, load, ramp, start, dofs, decimator):
-    """Decimated accelerations of the coordinates ``dofs`` over the ramp of a model whose
-    networks keep their scale (port laws only, no amplitude law or static hook): modal
-    Newmark with the port forces, Newton per step, chunk by chunk
-    (:class:`~powertrain.solvers.newmark.ModalPortNewmark`), from ``start`` = (state
-    ``(x0, v0, a0, mean)``, port-law states, amplitudes)."""
+    """Decimated accelerations of ``dofs`` by modal Newmark with the port laws from ``start``."""
     _, _, h, n_steps = ramp
     (x0, v0, *_), state, amplitudes = start
     s, laws = integrator.scaling, integrator.laws
     C, K, _, _ = s.matrices(s.scales(integrator.ports.network_amplitudes(amplitudes)))
-    run = ModalPortNewmark(ModalNewmark(s.system.M, C, K, load_dofs=6), laws, h,
-                           Wa=np.eye(C.shape[0])[dofs])
+    run = ModalPortNewmark(ModalNewmark(s.system.M, C, K, load_dofs=6), laws, h, Wa=np.eye(C.shape[0])[dofs])
     eta = run.modal_state(x0, v0)
     z = laws.forces(laws.rows @ x0, laws.rows @ v0, state)
     chunk = CHUNK_OUT * decimator.m         # a multiple of m keeps the decimation aligned
@@ -282,17 +240,14 @@ def _integrate_ports(integrator, load, ramp, start, dofs, decimator):
 
 
 def _nonlinear_start(engine, system, rpm, static_factors):
-    """State ``(x0, v0, a0, static deflection)``, port-law states and amplitudes of the
-    harmonic fixed point at ``rpm`` and the stepper that solved it."""
+    """State, port-law states and amplitudes of the harmonic fixed point at ``rpm``, and its stepper."""
     grid = Cycles(1440, 0.5, 1, 1)
     stepper = DenseNewmarkStepper(system, grid)
     stepper.static_factors = static_factors
     omega = rpm * np.pi / 30.0
     theta = np.arange(grid.n_cycle) * (4 * np.pi / grid.n_cycle)
-    fh, omegas = stepper.harmonics(np.asarray(engine.generalized_load(rpm, theta), float),
-                                   omega, 40.0)
-    qh, A = stepper.harmonic_state(fh, omegas, omega,
-                                   stepper.system_at(stepper.factors_at(omega)))
+    fh, omegas = stepper.harmonics(np.asarray(engine.generalized_load(rpm, theta), float), omega, 40.0)
+    qh, A = stepper.harmonic_state(fh, omegas, omega, stepper.system_at(stepper.factors_at(omega)))
     x = (qh.real.sum(0), (1j * omegas[:, None] * qh).real.sum(0),
          (-(omegas ** 2)[:, None] * qh).real.sum(0), qh[0].real)
     if stepper.ports is None:                 # linear, static factors only
@@ -323,25 +278,17 @@ class _Rows:
 
 
 class _Decimator:
-    """Zero-phase polyphase decimation by ``m`` of a signal arriving in chunks.
-
-    The FIR (2 L + 1 taps, L = FIR_HALF m, Kaiser beta 8, cut-off at the output Nyquist) is
-    centred, so output j is the filtered input at index j m; outputs whose support is not yet
-    complete wait for the next chunk (the last 2 L input rows are kept). Chunk lengths must
-    be multiples of m. With m = 1 (output rate >= the internal rate) the filter is the
-    identity.
-    """
+    """Zero-phase decimation by ``m`` (centred Kaiser FIR) of ``n_ch`` signals in chunks of k m."""
 
     def __init__(self, m, n_ch):
         self.m = m
         self.L = FIR_HALF * m if m > 1 else 0          # m = 1: nothing to decimate
-        self.fir = firwin(2 * self.L + 1, 1.0 / m, window=("kaiser", 8.0)) if m > 1 \
-            else np.ones(1)
+        self.fir = firwin(2 * self.L + 1, 1.0 / m, window=("kaiser", 8.0)) if m > 1 else np.ones(1)
         self.tail = np.zeros((n_ch, 0))          # the last input rows, transposed
 
     @property
     def first_output_index(self) -> int:
-        """Output sample index of the first row returned (time = index / output rate)."""
+        """Output sample index of the first row returned."""
         return (-(-(2 * self.L) // self.m) * self.m - self.L) // self.m
 
     def push(self, rows):
@@ -370,9 +317,9 @@ def _check(engine, rpm_from, rpm_to, rate, sample_rate):
 
 
 def sweep_steps(rpm_from, rpm_to, rate, sample_rate) -> tuple[int, int]:
-    """(internal steps per output sample, internal steps) of a sweep, bounded before any
-    work: at least :data:`MIN_SWEEP_SAMPLES` output samples, at most
-    :data:`MAX_SWEEP_SAMPLES` output samples and :data:`MAX_SWEEP_STEPS` internal steps."""
+    """(internal steps per output sample, internal steps) of a sweep from ``rpm_from`` to
+    ``rpm_to`` [rpm] at ``rate`` [rpm/s] and ``sample_rate`` [Hz], within
+    :data:`MIN_SWEEP_SAMPLES`, :data:`MAX_SWEEP_SAMPLES` and :data:`MAX_SWEEP_STEPS`."""
     rpm_from, rpm_to, rate = float(rpm_from), float(rpm_to), float(rate)   # no NumPy scalars:
     m = max(1, math.ceil(6.0 * rpm_to * STEPS_PER_DEGREE / sample_rate))  # inf, not a warning
     duration = (rpm_to - rpm_from) / rate
@@ -390,7 +337,7 @@ def sweep_steps(rpm_from, rpm_to, rate, sample_rate) -> tuple[int, int]:
 
 
 def _initial_state(engine, modal, rpm):
-    """Modal state of the periodic steady state at ``rpm`` (orders up to 40) at t = 0."""
+    """Modal state at t = 0 of the periodic steady state at ``rpm`` (orders up to 40)."""
     n = 1440
     theta = np.arange(n) * (4 * np.pi / n)
     fh = harmonic_amplitudes(np.asarray(engine.generalized_load(rpm, theta), float))[:81]

@@ -1,26 +1,12 @@
 r"""The run-up's per-speed solvers behind one protocol, chosen once per run.
 
 A :class:`Stepper` turns one speed's load over an engine cycle into the order amplitudes of
-every channel (:class:`SpeedOrders`). Five implement it:
-
-* :class:`HarmonicStepper` — the frequency-domain steady state order by order through the one
-  condensation (:func:`powertrain.solvers.harmonic.harmonic_response`);
-* :class:`AdmittanceStepper` — the same with a measured-receptance body, coupled by
-  admittance (:func:`powertrain.solvers.admittance.frf_response`);
-* :class:`ModalNewmarkStepper` — Newmark average acceleration, the recurrence diagonalised
-  once per model (:class:`powertrain.solvers.newmark.ModalNewmark`);
-* :class:`DenseNewmarkStepper` — the same recurrence in physical coordinates (Numba kernel);
-* :class:`ModalPortStepper` — the modal recurrence with the port laws, Newton per step
-  (:class:`powertrain.solvers.newmark.ModalPortNewmark`), for networks of constant scale.
-
-:func:`choose_stepper` picks one from the solver and stepper names and the chassis (which
-says whether it can be integrated in time). A time stepper sees the assembled model through
-``system.M``, ``C``, ``K``, its output rows and, when some mount element is nonlinear, the
-elements' port laws (``system.port_forces()``, :mod:`powertrain.physics.mount_elements`):
-the Newmark steppers with port laws integrate them (Newton per step in the kernel), the
-linear modal one refuses them, and the frequency-domain steppers solve the equivalent-linear model at the
-elements' amplitudes (:mod:`powertrain.solvers.equivalent_linear`). No stepper asks which
-element it holds.
+every channel (:class:`SpeedOrders`), in the frequency domain (:class:`HarmonicStepper`,
+:class:`AdmittanceStepper`) or by Newmark average acceleration (:class:`ModalNewmarkStepper`,
+:class:`DenseNewmarkStepper`, :class:`ModalPortStepper`); :func:`choose_stepper` picks one.
+Nonlinear mount elements: the Newmark steppers integrate the port laws by Newton per step,
+the frequency-domain ones solve the equivalent-linear model
+(:mod:`powertrain.solvers.equivalent_linear`).
 """
 
 from __future__ import annotations
@@ -44,12 +30,10 @@ from powertrain.solvers.harmonic import harmonic_response
 from powertrain.solvers.newmark import ModalNewmark, ModalPortNewmark, newmark
 
 #: Relative tolerance of the equivalent-linear fixed point a nonlinear Newmark run starts
-#: from (its amplitudes differ from the time domain's own by more: the harmonics above
-#: order 8, the friction's exact loop).
+#: from (the time domain's own amplitudes differ by more).
 START_TOLERANCE = 1e-4
-#: Highest order in the frequency-domain initial-state estimate of the Newmark run (the
-#: stepper itself sees the full sampled load): load harmonics above order 40 are < 2e-5 of
-#: the 2nd order for the default engine, and their response is smaller still.
+#: Highest order in the frequency-domain initial state of a Newmark run (harmonics above
+#: order 40 are < 2e-5 of the 2nd order for the default engine).
 INITIAL_STATE_MAX_ORDER = 40.0
 
 
@@ -70,9 +54,9 @@ class Cycles:
 
 @dataclass
 class SpeedOrders:
-    """One speed's result: complex order amplitudes (n_ch, n_orders) of displacement,
-    velocity, acceleration and transmitted force, the mean force (n_ch,), the cycle-to-cycle
-    periodicity of the processed window (0 in the frequency domain) and the solver time [s]."""
+    """One speed's complex order amplitudes (n_ch, n_orders) of displacement [m], velocity
+    [m/s], acceleration [m/s²] and force [N], the mean force (n_ch,) [N], the processed
+    window's cycle-to-cycle periodicity (0 in the frequency domain) and the solver time [s]."""
 
     displacement: np.ndarray
     velocity: np.ndarray
@@ -89,9 +73,8 @@ class Stepper:
 
     solver = ""
     setup_seconds = 0.0
-    #: Hook of the operating point: ``static_factors(rpm) -> (n_net,)``, every network's
-    #: static-curve factor at that speed (:meth:`MountElement.at_operating_point`); None:
-    #: each element's own ``static_factor``.
+    #: Hook ``static_factors(rpm) -> (n_net,)``: every network's static-curve factor at a
+    #: speed; None: each element's own ``static_factor``.
     static_factors = None
     #: Relative change of the amplitudes at which the equivalent-linear fixed point stops.
     fixed_point_tolerance = TOLERANCE
@@ -112,8 +95,7 @@ class Stepper:
         return self._scaling
 
     def factors_at(self, omega):
-        """The static factors (n_net,) at the speed ``omega`` [rad/s] from the hook, or
-        None."""
+        """The hook's static factors (n_net,) at the speed ``omega`` [rad/s], or None."""
         return None if self.static_factors is None else \
             np.asarray(self.static_factors(omega * 30.0 / np.pi), float)
 
@@ -122,16 +104,15 @@ class Stepper:
         return self.system if factors is None else self.scaling.at_operating_point(factors)
 
     def on_system(self, system) -> Stepper:
-        """A stepper of this kind on another assembly of the same model (the networks
-        scaled at an operating point), warm-started from this one's amplitudes."""
+        """A stepper of this kind on ``system``, warm-started from this one's amplitudes."""
         new = type(self)(system, self.grid)
         new.amplitudes = self.amplitudes
         return new
 
     def equivalent_linear(self, solve, relative_motion, omega):
-        """``(amplitudes, solve(amplitudes))``: the nonlinear elements' equivalent-linear
-        fixed point (:func:`amplitude_fixed_point`), warm-started from the last speed;
-        a linear model is solved once (amplitudes None)."""
+        """``(amplitudes, solve(amplitudes))`` at the equivalent-linear fixed point
+        (:func:`amplitude_fixed_point` of ``relative_motion``) at ``omega`` [rad/s],
+        warm-started from the last speed; a linear model is solved once (amplitudes None)."""
         if self.ports is None:
             return None, solve(None)
         A, solution = amplitude_fixed_point(solve, relative_motion, self.ports,
@@ -141,17 +122,15 @@ class Stepper:
         return A, solution
 
     def harmonic_state(self, fh, omegas, omega, system=None):
-        """Harmonic response (n_h, n_dof) of the (equivalent-linear) model (``system``,
-        default the stepper's) and the nonlinear elements' amplitudes (None: linear model).
-        The fixed point iterates on the harmonics that make the amplitudes only; one solve of
-        all follows. The networks' linear two-ports are condensed once for all."""
+        """Harmonic response (n_h, n_dof) of the equivalent-linear ``system`` (default the
+        stepper's) to the load harmonics ``fh`` at ``omegas`` [rad/s], and the nonlinear
+        elements' amplitudes (None: linear), at the speed ``omega`` [rad/s]."""
         s = self.system if system is None else system
         if self.ports is None:
             return harmonic_response(s, fh, omegas), None
         k = AMPLITUDE_HARMONICS.stop
         linear = linear_two_ports(s.ports(), 1j * np.asarray(omegas, float))
         first = None if linear is None else linear.first(k)
-        # the port rows read the retained coordinates only: no internal motion needed
         internal = bool(np.any(np.delete(self.ports.rows, s.ports().retained, axis=1)))
         A = self.equivalent_linear(lambda a: harmonic_response(s, fh[:k], omegas[:k], a,
                                                                first, internal),
@@ -159,7 +138,8 @@ class Stepper:
         return harmonic_response(s, fh, omegas, self.ports.network_amplitudes(A), linear), A
 
     def harmonics(self, load, omega, max_order=None):
-        """Load harmonics of the cycle (index j is order j/2) and their frequencies."""
+        """Harmonics of the cycle's ``load`` (index j is order j/2, up to ``max_order``) and
+        their frequencies [rad/s] at ``omega`` [rad/s]."""
         n_h = self.grid.n_cycle // 2
         if max_order is not None:
             n_h = min(n_h, int(2 * max_order) + 1)
@@ -173,7 +153,8 @@ class Stepper:
 
 
 class HarmonicStepper(Stepper):
-    """Frequency-domain steady state per order (rigid or modal body)."""
+    """Frequency-domain steady state per order (rigid or modal body,
+    :func:`powertrain.solvers.harmonic.harmonic_response`)."""
 
     solver = "harmonic"
 
@@ -187,20 +168,19 @@ class HarmonicStepper(Stepper):
         s = self.system
         Fk, Fd = s.force_matrix_k, s.force_matrix_d
         if A is not None:        # the force rows of the networks at their amplitudes
-            Fk, Fd = self.scaling.matrices(self.scaling.scales(
-                self.ports.network_amplitudes(A)))[2:]
+            Fk, Fd = self.scaling.matrices(self.scaling.scales(self.ports.network_amplitudes(A)))[2:]
         x = (q_o @ s.channel_matrix.T).T
         force = ((q_o @ Fk.T) + 1j * w * (q_o @ Fd.T)).T
         mean = Fk @ qh[0].real
         if A is not None:
             z = self.ports.describing_forces(A, qh @ self.ports.rows.T) @ self.ports.force_map.T
             force, mean = force + z[j].T, mean + z[0].real
-        return SpeedOrders(x, 1j * w.T * x, -(w.T ** 2) * x, force, mean, 0.0,
-                           time.perf_counter() - t0)
+        return SpeedOrders(x, 1j * w.T * x, -(w.T ** 2) * x, force, mean, 0.0, time.perf_counter() - t0)
 
 
 class AdmittanceStepper(Stepper):
-    """Frequency-domain steady state per order with a measured-receptance body."""
+    """Frequency-domain steady state per order with a measured-receptance body
+    (:func:`powertrain.solvers.admittance.frf_response`)."""
 
     solver = "harmonic"
 
@@ -241,8 +221,7 @@ class _NewmarkStepper(Stepper):
                 f"(orders <= {INITIAL_STATE_MAX_ORDER:g})"}
 
     def window_orders(self, d_c, v_c, a_c, f_c, v_prev, seconds) -> SpeedOrders:
-        """Orders of the processed window's channel signals and its periodicity against
-        the cycle before its last (``v_prev``)."""
+        """Orders of the window's channel signals, periodicity against ``v_prev``."""
         revs = 2 * self.grid.processed_cycles
         last = v_c[-self.grid.n_cycle:]
         scale = np.max(np.abs(last)) or 1.0
@@ -253,8 +232,9 @@ class _NewmarkStepper(Stepper):
 
 
 class ModalNewmarkStepper(_NewmarkStepper):
-    """Newmark recurrence diagonalised once per model; needs a regular mass matrix and at
-    least two processed cycles."""
+    """Newmark recurrence diagonalised once per model
+    (:class:`powertrain.solvers.newmark.ModalNewmark`); linear models with a regular mass
+    matrix and two processed cycles."""
 
     implementation = "modal (diagonalised recurrence)"
 
@@ -301,7 +281,6 @@ class DenseNewmarkStepper(_NewmarkStepper):
         s = self.system_at(factors)
         fh, omegas = self.harmonics(load, omega, INITIAL_STATE_MAX_ORDER)
         qh, amplitudes = self.harmonic_state(fh, omegas, omega, s)
-        # periodic steady-state estimate at t = 0: static preload + harmonic solution
         x0 = qh.real.sum(axis=0)
         v0 = (1j * omegas[:, None] * qh).real.sum(axis=0)
         a0 = (-(omegas ** 2)[:, None] * qh).real.sum(axis=0)
@@ -311,10 +290,9 @@ class DenseNewmarkStepper(_NewmarkStepper):
         return self.window_orders(*out, seconds)
 
     def channels(self, s, load, h, start, amplitudes, factors):
-        """Channel displacement, velocity, acceleration and transmitted force over the
-        processed window and the velocity of the cycle before its last: the model ``s``
-        (at the static ``factors``) from ``start`` = (x0, v0, a0, harmonic response),
-        nonlinear elements cycle by cycle from the ``amplitudes``."""
+        """Channel signals over the processed window and the velocity of the cycle before
+        its last: model ``s`` at step ``h`` [s] from ``start`` = (x0, v0, a0, harmonic
+        response), nonlinear elements cycle by cycle from the ``amplitudes``."""
         g = self.grid
         x0, v0, a0, qh = start
         F = np.zeros((g.cycles * g.n_cycle + 1, s.n_dof))
@@ -324,17 +302,14 @@ class DenseNewmarkStepper(_NewmarkStepper):
                            [(slice(0, F.shape[0]), s.force_matrix_k, s.force_matrix_d, None)])
         else:
             begin = (x0, v0, a0, start_state(self.ports, qh, g.n_cycle), qh[0].real)
-            run = run_cycles(self.scaling, self.ports, F, h, g.n_cycle, begin, amplitudes,
-                             factors)
+            run = run_cycles(self.scaling, self.ports, F, h, g.n_cycle, begin, amplitudes, factors)
         n = g.n_cycle
         d_c, v_c, a_c, f_c = self._outputs(run, slice(g.start, g.start + g.processed_cycles * n))
-        v_prev = v_c[:n] if g.processed_cycles >= 2 else \
-            self._outputs(run, slice(g.start - n, g.start))[1]
+        v_prev = v_c[:n] if g.processed_cycles >= 2 else self._outputs(run, slice(g.start - n, g.start))[1]
         return d_c, v_c, a_c, f_c, v_prev
 
     def _outputs(self, run, win):
-        """Channel displacement, velocity, acceleration and transmitted force over ``win``
-        (each part of it with the force rows of its cycle, the port laws' forces added)."""
+        """Channel displacement, velocity, acceleration and force of ``run`` over ``win``."""
         Cm = self.system.channel_matrix
         q, v, a = run.X[win], run.V[win], run.A[win]
         force = [run.X[lo:hi] @ Fk.T + run.V[lo:hi] @ Fd.T - (0.0 if off is None else off)
@@ -348,11 +323,9 @@ class DenseNewmarkStepper(_NewmarkStepper):
 
 
 class ModalPortStepper(DenseNewmarkStepper):
-    """A nonlinear model whose networks keep their scale (port laws, no amplitude law
-    that varies): the modal recurrence of the assembled model with the port laws, Newton
-    per step (:class:`~powertrain.solvers.newmark.ModalPortNewmark`), from the same harmonic
-    start as the dense stepper; outputs only over the processed window. Needs a regular mass
-    matrix, at least two processed cycles and no static-factor hook."""
+    """Modal recurrence with the port laws, Newton per step
+    (:class:`~powertrain.solvers.newmark.ModalPortNewmark`), for networks of constant scale.
+    Needs a regular mass matrix, two processed cycles and no static-factor hook."""
 
     implementation = "modal with the port laws (Newton per step)"
 
@@ -380,12 +353,10 @@ class ModalPortStepper(DenseNewmarkStepper):
         self.setup_seconds = time.perf_counter() - t0
 
     def harmonic_state(self, fh, omegas, omega, system=None):
-        """:meth:`Stepper.harmonic_state` through the modes of the model the stepper
-        integrates, when ``system`` is that model and no network has an amplitude law: per
-        harmonic the linear response to the load and to forces along the port rows
-        (:meth:`ModalNewmark.port_harmonics`), the port laws' describing stiffnesses fed
-        back along them (zero at the mean, as in the condensation), the same fixed point
-        on the amplitudes; the condensation otherwise."""
+        """:meth:`Stepper.harmonic_state` through the stepper's modes: the port laws'
+        describing stiffnesses fed back along the port rows
+        (:meth:`ModalNewmark.port_harmonics`); the condensation for another ``system`` or
+        an amplitude law."""
         s = self.system if system is None else system
         elements = s.ports().elements
         if s is not self.system or len(elements) != self.ports.n_networks or any(
@@ -395,8 +366,7 @@ class ModalPortStepper(DenseNewmarkStepper):
         eye = np.eye(self.ports.kinds.size)
 
         def relative(amplitudes, n_h=AMPLITUDE_HARMONICS.stop):
-            """Relative motions (n_h, m) along the port rows with the laws fed back at the
-            network amplitudes, and the laws' describing stiffnesses (n_h, m)."""
+            """Relative motions (n_h, m) along the port rows and describing stiffnesses."""
             a, kd = amplitudes[self.ports.index], np.zeros(eye.shape[0], complex)
             for law, index in self.law_groups:      # one call per distinct law
                 kd[index] = law.describing_stiffness(a[index])
@@ -413,8 +383,7 @@ class ModalPortStepper(DenseNewmarkStepper):
         return eta @ self.modal.Psi[:self.modal.n].T, A
 
     def runner(self, h) -> ModalPortNewmark:
-        """The modal recurrence with the port laws at the step ``h`` [s] (its outputs'
-        arrays built once per model)."""
+        """The modal recurrence with the port laws at the step ``h`` [s]."""
         if self._runner is None:
             self._runner = ModalPortNewmark(self.modal, self.laws, h, *self.rows)
         return self._runner.at_step(h)
@@ -449,8 +418,7 @@ def _auto_newmark(system, grid):
 
 
 #: Newmark implementations by their ``--stepper`` name.
-NEWMARK_STEPPERS = {"auto": _auto_newmark, "modal": ModalNewmarkStepper,
-                    "dense": DenseNewmarkStepper}
+NEWMARK_STEPPERS = {"auto": _auto_newmark, "modal": ModalNewmarkStepper, "dense": DenseNewmarkStepper}
 
 
 def _newmark(system, grid, stepper):
@@ -476,8 +444,8 @@ SOLVERS = {"newmark": _newmark, "harmonic": _harmonic}
 
 
 def choose_stepper(system, solver, stepper, grid: Cycles) -> Stepper:
-    """The stepper of a run-up: ``solver`` (``newmark`` or ``harmonic``), the Newmark
-    implementation ``stepper`` (``auto``, ``modal``, ``dense``) and the chassis decide."""
+    """The stepper for ``system`` on the time ``grid``: ``solver`` (``newmark`` or
+    ``harmonic``), ``stepper`` (``auto``, ``modal``, ``dense``) and the chassis decide."""
     if solver not in SOLVERS:
         raise ValueError(f"unknown solver {solver!r}")
     return SOLVERS[solver](system, grid, stepper)

@@ -1,49 +1,38 @@
 r"""A transient manoeuvre integrated in time by the run-up's nonlinear stepper.
 
-The load of :mod:`powertrain.solvers.transient_load` at every step drives the model of
-:meth:`Engine.assemble` (rigid ground, modal body, base compliance) through the Newmark step
-of the run-up's dense stepper and the continuous sweep (average acceleration; the port
-laws by Newton per step, :func:`~powertrain.kernels.port_forces.newmark_port_kernel`; the
-Newmark matrix factored sparsely, :mod:`powertrain.kernels.sparse_lu`), in one kernel
-call (:func:`~powertrain.kernels.transient.transient_kernel`: a stretch at a time, the
-amplitude law once per stretch, the curves' updates inside it). Stretches are
-:data:`STRETCH` long (a linear model without static curves is one stretch); the static
-curves are updated every :data:`CURVE_STEP`. Where the laws change (a new stretch or
-curve update) the integration restarts from the position and velocity, the acceleration
-solved from the new laws (carried over, the trapezoidal rule would keep the jump as an
-undamped alternating error).
+The load of :mod:`powertrain.solvers.transient_load` drives the model of
+:meth:`Engine.assemble` by Newmark average acceleration (port laws by Newton per step, the
+Newmark matrix factored sparsely, :mod:`powertrain.kernels.sparse_lu`) in one kernel call
+(:func:`~powertrain.kernels.transient.transient_kernel`). The amplitude law and the
+networks' centres are updated every :data:`STRETCH` (a linear model without static curves
+is one stretch), the static curves every :data:`CURVE_STEP`. Where the laws change the
+integration restarts from position and velocity with the acceleration solved from the new
+laws (carried over, the trapezoidal rule would keep the jump as an undamped alternating
+error).
 
-**Static curves, large deflection.** Coordinates are measured from the static operating
-point at zero mean torque (weight only, :func:`~powertrain.solvers.operating_point.operating_point`),
-whose network deflections are :math:`\delta_0`. At every curve update, at the state
-predicted for the middle of the piece it starts, :math:`\mathbf x_c = \mathbf x +
-\tfrac T2\dot{\mathbf x}` (:math:`T` the piece's length; network deflection
-:math:`u_c = \mathbf r^T\mathbf x_c`, :math:`\delta_c = \delta_0 + u_c`: read at the
-piece's start instead, the tangent lags the motion by half a piece, an error of first
-order in :math:`T` that the middle cancels), each network with a static curve :math:`F(\delta)` is
-scaled by :math:`\kappa = f\,s`: its static factor :math:`f` at :math:`\delta_c`
-(:meth:`MountElement.at_operating_point`: the curve's tangent is :math:`f k_0`, :math:`k_0`
-the network's static stiffness) times its amplitude law's scale :math:`s`; and it is
-loaded by
+**Static curves.** Coordinates are measured from the static operating point at zero mean
+torque (:func:`~powertrain.solvers.operating_point.operating_point`), network deflections
+:math:`\delta_0`. At each curve update, at the state predicted for the middle of the piece,
+:math:`\mathbf x_c = \mathbf x + \tfrac T2\dot{\mathbf x}` (:math:`T` the piece's length,
+:math:`u_c = \mathbf r^T\mathbf x_c`, :math:`\delta_c = \delta_0 + u_c`; the middle cancels
+the first-order lag of the tangent), each network with a static curve :math:`F(\delta)` is
+scaled by :math:`\kappa = f\,s` (static factor :math:`f` at :math:`\delta_c`, tangent
+:math:`f k_0`; :math:`s` the amplitude law's scale) and loaded by
 
 .. math:: c = F(\delta_c) - F(\delta_0) - f k_0\,(u_c - \bar u) - \kappa k_0\,\bar u ,
 
-where :math:`\bar u` is the network's centre, its mean deflection over the stretch before
-(over the first stretch, the deflection where it starts). Until the next update the static
-force is then
+where :math:`\bar u`, the network's centre, is its mean deflection over the stretch before
+(at first, the starting deflection). Until the next update the static force is
 
 .. math:: F(\delta_c) - F(\delta_0) + f k_0\,(u - u_c) + (\kappa - f)\,k_0\,(u - \bar u):
 
-the curve's tangent at :math:`\delta_c`, and the amplitude law's change of stiffness on the
-motion about the centre only. The body moves along the curves (small rotations) wherever it
-moves slowly, the amplitude law acts on the vibration about the mean deflection, and the
-dynamic network and friction are on top. As the updates get more frequent the curve part
-tends to the curve itself at every instant (tests/transient_oracle.py, ``continuous=True``).
-Mount forces are changes from the zero-torque static point.
+the curve's tangent at :math:`\delta_c`, the amplitude law acting on the motion about the
+centre only; as updates get more frequent it tends to the curve itself
+(tests/transient_oracle.py, ``continuous=True``). Mount forces are changes from the
+zero-torque static point.
 
-**Start.** At rest when the manoeuvre starts at standstill; else from the periodic steady
-state at its first speed and load (the equivalent-linear harmonic fixed point, port laws
-on their steady loop: :meth:`Stepper.harmonic_state`), as the run-up and the sweep start.
+**Start.** At rest from standstill; else the periodic steady state at the first speed and
+load (:meth:`Stepper.harmonic_state`), as the run-up and the sweep start.
 """
 
 from __future__ import annotations
@@ -82,24 +71,20 @@ from powertrain.solvers.transient_model import motion_model, stretch_kernel_mode
 
 class StretchRuleWarning(PowertrainWarning):
     """A mount direction has a static curve and an amplitude law: in a transient the law acts
-    per stretch on the motion about the mean deflection, its amplitude each stretch's, a
-    model choice (docs/guide/transient.md)."""
+    per stretch on the motion about the mean deflection (docs/guide/transient.md)."""
 
 
 #: Length of a stretch [s]: the amplitude law's scales and the networks' centres are updated
 #: this often (a rigid-body mode of 12 Hz is 8 stretches per period).
 STRETCH = 0.01
-#: Interval [s] at which the static curves' tangents and load are updated (a whole number
-#: per stretch): the curves are linearised over it, first order in it. Against the curve at
-#: every instant on a 0.12 s flare of a 6-DOF body with curve, power law and friction on one
-#: direction: 1.0 % of the peak force at 10 ms, 0.13 % at 2 ms, 0.05 % at 1 ms.
+#: Interval [s] of the static curves' updates (a whole number per stretch); the error is first
+#: order in it (about 0.13 % of the peak force at 2 ms on a 0.12 s flare).
 CURVE_STEP = 0.002
 #: Most integration steps of a manoeuvre (checked before any work).
 MAX_STEPS = 2 ** 21
 #: Most memory of a run's time histories [B] (checked before any work).
 MAX_BYTES = 2e9
-#: A manoeuvre starting below this speed [rpm] starts at rest (a recorded speed's creep at
-#: standstill: a cycle would last minutes, and the gas load is faded out there).
+#: A manoeuvre starting below this speed [rpm] starts at rest (the gas load is faded out).
 REST_RPM = 5.0
 #: Speed below which the step is set as at this speed [rpm]: standstill needs a step too.
 FLOOR_RPM = 600.0
@@ -112,31 +97,25 @@ class TransientRun:
     Attributes
     ----------
     load : TransientLoad
-        Times, crank motion, torques and the load.
     body : ndarray (n_t, 6)
-        Body displacement [m] and rotation [rad] at the CG from the zero-torque static point
-        (the first six of ``coordinates``).
+        Body displacement [m] and rotation [rad] at the CG from the zero-torque static point.
     displacement, velocity, acceleration, force : ndarray (n_t, n_ch)
-        Channel motion [m, m/s, m/s²] (engine side, then body side and body points) and
-        transmitted force [N].
+        Channel motion [m, m/s, m/s²] and transmitted force [N].
     deflection : ndarray (n_t, n_net)
         Network deflection (engine side minus base) from the zero-torque static point [m].
     channels : list of (str, str)
     networks : list of str
     method : str
     coordinates, coordinate_velocity : ndarray (n_t, n)
-        Every coordinate of the model (body, then the networks' internal ones and any
-        others) [m, rad] and its velocity.
+        Every coordinate of the model [m, rad] and its velocity.
     port_law_force : ndarray (n_t, m) or None
-        Force of each port law (friction) [N], in ``system.port_forces()`` order.
+        Force of each port law [N], in ``system.port_forces()`` order.
     network_scales : ndarray (n_t, n_net, 2)
-        Stiffness and damping scale of every network at each step (amplitude law times
-        static factor).
+        Stiffness and damping scale of every network (amplitude law times static factor).
     curve_load : ndarray (n_t, n_net)
-        The static curves' load ``c`` at each step [N] (module docstring; 0 without one).
+        The static curves' load ``c`` [N] (module docstring; 0 without one).
     stretch_steps, curve_steps : int
-        Steps per stretch (amplitude law and centres) and per update of the static curves'
-        tangents and load (a divisor of ``stretch_steps``).
+        Steps per stretch and per static-curve update (a divisor of ``stretch_steps``).
     """
 
     load: object
@@ -159,8 +138,8 @@ class TransientRun:
 
 
 def transient_steps(manoeuvre, angle_step_deg) -> int:
-    """Integration steps: ``angle_step_deg`` of crank angle at the top speed (at least
-    :data:`FLOOR_RPM`), bounded by :data:`MAX_STEPS` before any work."""
+    """Integration steps of ``manoeuvre``: ``angle_step_deg`` [deg] of crank angle at the top
+    speed (at least :data:`FLOOR_RPM`), at most :data:`MAX_STEPS`."""
     if not (math.isfinite(angle_step_deg) and 0.01 <= angle_step_deg <= 10.0):
         raise InputError("must be 0.01..10 [deg]", key="--angle-step")
     top = max(manoeuvre.max_speed, FLOOR_RPM * RPM)
@@ -182,10 +161,6 @@ def simulate_transient(engine, manoeuvre, *, system=None, angle_step_deg=1.0) ->
         The model (default ``engine.assemble()``).
     angle_step_deg : float
         Crank angle per step at the top speed [deg].
-
-    Returns
-    -------
-    TransientRun
     """
     top = engine.speed_range_rpm()[1]
     if manoeuvre.max_speed / RPM > top + 1e-6:
@@ -217,8 +192,7 @@ def simulate_transient(engine, manoeuvre, *, system=None, angle_step_deg=1.0) ->
 
 
 class _Histories(NamedTuple):
-    """A run's time histories (:func:`_history_shapes`), filled by :func:`_run` (the
-    kernel's) and :func:`_channel_outputs`."""
+    """A run's time histories, filled by :func:`_run` and :func:`_channel_outputs`."""
 
     X: np.ndarray
     V: np.ndarray
@@ -251,8 +225,7 @@ def _check_size(n_steps, system, manoeuvre):
 
 
 def _stretch_steps(h, n_steps, varying, curves):
-    """``(steps per stretch, steps per curve update)`` at the step ``h`` [s]: a whole number
-    of curve updates per stretch where there are curves; one stretch for a linear model."""
+    """``(steps per stretch, steps per curve update)`` at the step ``h`` [s]."""
     if curves:
         sub = max(1, round(CURVE_STEP / h))
         return sub * round(STRETCH / CURVE_STEP), sub
@@ -282,11 +255,7 @@ def _method(scaling, ports, curves, every, sub):
 
 
 def _run(system, scaling, ports, curves, F, h, start, steps, histories):
-    """Fill the ``histories``' states X, V (n_t, n), the channels' acceleration (n_t, n_ch),
-    the port-law forces, network scales and curve loads at every step under the load ``F``
-    (n_t, 6) on the body: ``steps = (every, sub)``, the amplitude law and the centres
-    updated every ``every`` steps (a stretch), the curves' tangents and load every ``sub``,
-    in one kernel call (:func:`~powertrain.kernels.transient.transient_kernel`)."""
+    """Fill the kernel's ``histories`` under the body load ``F`` (n_t, 6)."""
     every, sub = steps
     x, v, a, state, amplitudes = start
     laws = ports.select(ports.kinds != NONE)
@@ -317,10 +286,7 @@ def _run(system, scaling, ports, curves, F, h, start, steps, histories):
 
 
 def _channel_outputs(system, scaling, histories, laws_map):
-    """Fill the ``histories``' channel displacement, velocity, transmitted force
-    (n_t, n_ch) and network deflection (n_t, n_net) from their states, port-law forces,
-    network scales and curve loads: the force rows of
-    :meth:`~powertrain.assembly.NetworkScaling.matrices` at every step's scales."""
+    """Fill the ``histories``' channel outputs and network deflection from the states."""
     h = histories
     Cm = system.channel_matrix
     n_t, n_ch, n_net = h.X.shape[0], Cm.shape[0], system.port_rows.shape[0]
@@ -339,10 +305,7 @@ def _channel_outputs(system, scaling, histories, laws_map):
 
 
 def _time_histories(n_t, *shapes):
-    r"""Zeroed arrays (n_t, \*shape) for each of ``shapes``, each C-contiguous, all in one
-    buffer: a run's time histories are megabytes each, and the operating system maps one
-    buffer in far fewer page faults than several (in huge pages where it grants them:
-    NumPy asks for them from 4 MB)."""
+    r"""Zeroed C-contiguous arrays (n_t, \*shape) for each of ``shapes``, in one buffer."""
     sizes = [n_t * math.prod(shape) for shape in shapes]
     buffer = np.zeros(sum(sizes))
     edges = np.cumsum([0, *sizes])
@@ -350,8 +313,7 @@ def _time_histories(n_t, *shapes):
 
 
 def _kernel_curves(system, scaling, curves):
-    """The kernel's ``curves`` tuple (:func:`~powertrain.kernels.transient.curve_state`);
-    without static curves every network keeps its assembled factor."""
+    """The kernel's ``curves`` tuple (:func:`~powertrain.kernels.transient.curve_state`)."""
     rows = np.array(system.port_rows, float)
     n_net = rows.shape[0]
     if curves is None:
@@ -363,18 +325,14 @@ def _kernel_curves(system, scaling, curves):
 
 
 def _start(engine, manoeuvre, system, load, ports, model):
-    """``(x0, v0, a0, port-law states, amplitudes)``: at standstill at rest, where the
-    driveline's torque holds the block; else the periodic steady state at the first speed
-    and load, on static curves about the static point of its mean (:func:`_static_state`).
-    ``model = (scaling, curves)``."""
+    """``(x0, v0, a0, port-law states, amplitudes)`` at the start (module docstring)."""
     scaling, curves = model
     laws = ports.select(ports.kinds != NONE)
     n = system.n_dof
     omega = abs(float(load.omega[0]))
     if omega < REST_RPM * RPM:  # at rest where the driveline holds the block (none: at zero)
         held = driveline_reaction(engine, manoeuvre, load.driveline_torque[0])
-        x0 = (_static_state(system, scaling, curves, held, manoeuvre.file) if held.any()
-              else np.zeros(n))
+        x0 = (_static_state(system, scaling, curves, held, manoeuvre.file) if held.any() else np.zeros(n))
         state = laws.initial_state(x0) if laws.kinds.size else None
         return x0, np.zeros(n), None, state, np.zeros(ports.kinds.size)
     grid = Cycles(N_THETA, 720.0 / N_THETA, 1, 1)
@@ -395,22 +353,16 @@ def _start(engine, manoeuvre, system, load, ports, model):
     return x0, v0, a0, state, (np.zeros(ports.kinds.size) if A is None else A)
 
 
-#: Newton on the static point of the curves (:func:`_static_state`): most iterations and
-#: the step, relative to the state or to :data:`STATIC_SCALE` [m] where the state is
-#: smaller (near the zero-torque point, which the curves are about), at which it has
-#: converged.
+#: Newton on the curves' static point: most iterations, and the converged step relative to
+#: the state or to :data:`STATIC_SCALE` [m] where the state is smaller.
 STATIC_MAX_ITER, STATIC_TOL, STATIC_SCALE = 100, 1e-12, 1e-3
 
 
 def _static_state(system, scaling, curves, load, file=None):
     r"""State (n,) at rest under the body load ``load`` (6,) [N, N m] on the static curves:
-    :math:`\mathbf K(f)\,\mathbf x + \mathbf R^T \mathbf c = \mathbf F` with the
-    static factors :math:`f` and curve loads :math:`c` of
-    :func:`~powertrain.kernels.transient.curve_state` at :math:`\mathbf x` (the amplitude
-    law's scale 1: the static force of each network is its curve's), by Newton on the
-    tangent stiffness :math:`\mathbf K(f)`. Port laws carry no mean force (as in the
-    harmonic steady state). No static point (a load beyond what the curves carry): one
-    line naming the manoeuvre ``file`` and its load."""
+    :math:`\mathbf K(f)\,\mathbf x + \mathbf R^T \mathbf c = \mathbf F` by Newton on the
+    tangent stiffness (:func:`~powertrain.kernels.transient.curve_state`; port laws carry no
+    mean force); an InputError naming ``file`` where there is none."""
     kc = _kernel_curves(system, scaling, curves)
     rows, n_net = kc[0], kc[0].shape[0]
     F = np.zeros(system.n_dof)
@@ -431,9 +383,7 @@ def _static_state(system, scaling, curves, load, file=None):
 
 
 def _check_within_curves(curves, u, names, file):
-    """Refuse a static point farther beyond a static curve's points than they span: the
-    datasheet says nothing of such a deflection (its straight continuation would carry any
-    load)."""
+    """Refuse a static point farther beyond a static curve's points than they span."""
     for r in np.flatnonzero(curves.has):
         breaks, _, count = curves.support.cubics
         lo, hi = breaks[r, 0], breaks[r, count[r] - 1]
@@ -447,8 +397,7 @@ def _check_within_curves(curves, u, names, file):
 
 
 def _cycle_load(engine, manoeuvre, theta):
-    """The load (N_THETA, 6) over one cycle from the angles ``theta`` [rad] of the
-    manoeuvre held at its first speed and load (no acceleration)."""
+    """Load (N_THETA, 6) at ``theta`` [rad] of the manoeuvre held at its first speed and load."""
     w0 = float(manoeuvre.speed[0])
     T = 4 * np.pi / abs(w0)
     held = dataclasses.replace(manoeuvre, time=np.array([0.0, T]), speed=np.full(2, w0),
@@ -461,10 +410,7 @@ def _cycle_load(engine, manoeuvre, theta):
 
 
 class _Curves:
-    """The networks' static curves about the zero-torque static point (module docstring):
-    the support's piecewise cubics (:attr:`StaticSupport.cubics`), read exactly in the
-    kernel (:func:`~powertrain.kernels.static_curve.curve_point`; a network without a
-    curve: zero force, factor 1)."""
+    """The networks' static curves about the zero-torque static point."""
 
     def __init__(self, engine, system):
         self.support = support = StaticSupport.of(engine)
@@ -476,10 +422,8 @@ class _Curves:
         self.f0 = support.forces(self.d0)
 
     def kernel_tuple(self):
-        """``(d0, f0, breaks, coefficients, count, reference tangent, has)`` for
-        :func:`~powertrain.kernels.transient.curve_state`."""
-        return (self.d0, self.f0, *self.support.cubics, self.support.reference_tangent,
-                self.has)
+        """``(d0, f0, breaks, coefficients, count, reference tangent, has)``."""
+        return (self.d0, self.f0, *self.support.cubics, self.support.reference_tangent, self.has)
 
     def factors(self, x):
         """Static factor of every network at the state ``x`` (1 without a curve)."""

@@ -1,39 +1,31 @@
 r"""The load on the powertrain over a transient manoeuvre, at every time step.
 
-At crank angle :math:`\theta`, speed :math:`\omega` and angular acceleration
-:math:`\alpha` (:meth:`~powertrain.models.manoeuvre.Manoeuvre.crank_motion`) the block load
-is the run-up's excitation extended to any speed (:meth:`Engine.load_table`, linear in the
-gas forces and in :math:`\omega^2`) plus the moving masses' tangential accelerations
-(:meth:`Engine.motion_patterns`, linear in :math:`\alpha`):
+At crank angle :math:`\theta`, speed :math:`\omega` and acceleration :math:`\alpha`
+(:meth:`~powertrain.models.manoeuvre.Manoeuvre.crank_motion`) the block load is the run-up's
+excitation at any speed (:meth:`Engine.load_table`) plus the moving masses' tangential
+accelerations (:meth:`Engine.motion_patterns`):
 
 .. math:: \mathbf f(t) = \tilde{\mathbf G}(\theta, |\omega|, s)
    + \omega^2\,\mathbf I(\theta) + \alpha\,\tilde{\mathbf A}(\theta)
    - \big(J\alpha + i\,T_d\big)\,\mathbf n .
 
-:math:`\tilde{\mathbf G}` is the gas part with the cycle mean of its roll moment about the
-crank sense :math:`\mathbf n` removed (likewise :math:`\tilde{\mathbf A}`): the mean roll
-reaction is written out by the last term, from the powertrain's angular momentum: the crank
-train and flywheel (:math:`J`, ``crank_inertia``) accelerating at :math:`\alpha` push the
-housing back with :math:`-J\alpha\,\mathbf n`, and the driveline torque :math:`T_d` reacts
-with the gear ratio :math:`i` (0 in neutral). The starter's drive and its reaction on the
-block are both inside the powertrain, so they cancel in the net load on the rigid body; its
-torque :math:`T_s = J\alpha + T_d - T_e` (while engaged) is reported. The fluctuation of the
-gas and inertia torque about its cycle mean reaches the block as in the run-up.
+:math:`\tilde{\mathbf G}`, :math:`\tilde{\mathbf A}` have the cycle mean of their roll moment
+about the crank sense :math:`\mathbf n` removed; the mean roll reaction is the last term:
+the crank train and flywheel (:math:`J`) accelerating push the housing back with
+:math:`-J\alpha\,\mathbf n`, the driveline torque :math:`T_d` reacts through the gear ratio
+:math:`i` (0 in neutral). The starter acts inside the powertrain (no net load); its torque
+:math:`T_s = J\alpha + T_d - T_e` is reported.
 
-The gas load is tabulated over the crank angle (0.5°), the speed (25 rpm, clamped to the
-combustion model's range: below it the pressure of its lowest speed) and the load level
-:math:`\lambda`, and read trilinearly; below :data:`FADE_RPM` it fades out linearly to none
-at rest. The IMEP scale :math:`s` (the cycle's IMEP over the full-load one) is 0 for the
-cycle without burn (:meth:`Engine.motored`, from the manoeuvre's intake pressure), 1 at
-full load; :math:`s_0(\omega) = W(0)/W(1)`, the indicated work of the fired cycle of zero
-brake torque over the full-load one. From :math:`s_0` up the level is the combustion
-model's load, :math:`\lambda = (s - s_0)/(1 - s_0)` (fraction of full-load brake torque,
-steps of :data:`LEVEL_STEP`); below, :math:`\lambda = s/s_0 - 1`, the mix of the motored
-cycle (:math:`\lambda = -1`) and the zero-torque one. A mean torque :math:`T_d` is the
-level :math:`T_d / T_{full}(\omega)`, or where negative (engine braking)
-:math:`T_d / |T_{motored}(\omega)|`. :math:`T_e` is the model's mean brake torque at
-:math:`(\omega, \lambda)`; in the IMEP form :math:`T_d = T_e - J\alpha` when a gear is
-engaged.
+The gas load is tabulated over crank angle (0.5°), speed (25 rpm, clamped to the combustion
+model's range) and load level :math:`\lambda`, read trilinearly, and fades out linearly
+below :data:`FADE_RPM`. The IMEP scale :math:`s` is 0 without burn (:meth:`Engine.motored`),
+1 at full load; :math:`s_0(\omega) = W(0)/W(1)` is the indicated work of the zero-torque
+fired cycle over the full-load one. From :math:`s_0` up :math:`\lambda = (s - s_0)/(1 -
+s_0)` (fraction of full-load brake torque, steps of :data:`LEVEL_STEP`); below,
+:math:`\lambda = s/s_0 - 1` mixes the motored cycle (:math:`\lambda = -1`) and the
+zero-torque one. A mean torque :math:`T_d` is the level :math:`T_d / T_{full}(\omega)`, or
+when negative :math:`T_d / |T_{motored}(\omega)|`. :math:`T_e` is the model's mean brake
+torque at :math:`(\omega, \lambda)`; in the IMEP form :math:`T_d = T_e - J\alpha` in gear.
 """
 
 from __future__ import annotations
@@ -54,9 +46,8 @@ RPM_STEP = 25.0
 #: Load levels of the table of a mean-torque manoeuvre, and the step of an IMEP table's.
 TORQUE_SCALES = np.linspace(0.0, 1.0, 11)
 LEVEL_STEP = 0.1
-#: Below this speed [rpm] the gas load fades out linearly to none at rest: a crank at rest
-#: holds its cylinders' gas torque inside the engine (it stops where the compression torques
-#: balance); the run-up's excitation holds from here up.
+#: Below this speed [rpm] the gas load fades out linearly to none at rest (a crank at rest
+#: holds its cylinders' gas torque inside the engine).
 FADE_RPM = 50.0
 RPM = UNITS["rpm"][1]
 
@@ -79,7 +70,15 @@ class TransientLoad:
 
 
 def transient_load(engine, manoeuvre, t) -> TransientLoad:
-    """The load of ``manoeuvre`` on ``engine`` at the times ``t`` [s] (module docstring)."""
+    """The load of ``manoeuvre`` on ``engine`` at the times ``t`` [s] (module docstring).
+
+    Parameters
+    ----------
+    engine : Engine
+    manoeuvre : Manoeuvre
+    t : ndarray (n_t,)
+        Times [s].
+    """
     theta, omega, alpha = manoeuvre.crank_motion(t)
     n = np.array([float(engine.crank.rotation_sign), 0.0, 0.0])
     table = _GasTable(engine, manoeuvre)
@@ -108,8 +107,7 @@ def transient_load(engine, manoeuvre, t) -> TransientLoad:
 
 
 def _warn_beyond(driveline, engine_torque, t):
-    """Warn where a mean torque is beyond what the engine gives (more than its full load,
-    or more braking than its motored drag): the gas load is then the table's end."""
+    """Warn where a mean torque is beyond the engine's full load or motored drag."""
     off = np.abs(driveline - engine_torque) > 1e-6 * np.maximum(np.abs(driveline), 1.0)
     if off.any():
         i = int(np.argmax(np.abs(driveline - engine_torque)))
@@ -125,27 +123,21 @@ class TorqueLimitWarning(PowertrainWarning):
 
 
 def driveline_reaction(engine, manoeuvre, driveline):
-    r"""The driveline torque's reaction on the block (..., 6) [N, N·m] about the CG:
-    :math:`-i\,T_d\,\mathbf n` for the driveline torque ``driveline`` (...) [N·m], the
-    crank axis :math:`\mathbf n` the engine's x (:func:`driveline_moment`)."""
+    r"""The reaction (..., 6) [N, N·m] about the CG, :math:`-i\,T_d\,\mathbf n`, of the
+    driveline torque ``driveline`` (...) [N·m] of ``manoeuvre`` on ``engine``."""
     out = np.zeros(np.shape(driveline) + (6,))
     out[..., 3] = driveline_moment(engine, manoeuvre, driveline)
     return out
 
 
 def driveline_moment(engine, manoeuvre, driveline):
-    """The reaction's moment about the engine's x axis (...) [N·m] of
-    :func:`driveline_reaction`."""
-    return -manoeuvre.gear_ratio * np.asarray(driveline, float) * float(
-        engine.crank.rotation_sign)
+    """The moment (...) [N·m] about the engine's x axis of :func:`driveline_reaction`
+    (same arguments)."""
+    return -manoeuvre.gear_ratio * np.asarray(driveline, float) * float(engine.crank.rotation_sign)
 
 
 class _GasTable:
-    r"""The gas load per load level, speed and crank angle, the cycle mean of its roll
-    removed; the inertia and acceleration patterns; the mean brake torque per level and
-    speed. A level :math:`\lambda \ge 0` is the combustion model's load (fraction of
-    full-load brake torque), :math:`\lambda = -1` its cycle without burn, between them
-    linear (module docstring)."""
+    """Gas load and mean brake torque per load level and speed, and the motion patterns."""
 
     def __init__(self, engine, manoeuvre):
         lo, hi = engine.speed_range_rpm()
@@ -176,23 +168,21 @@ class _GasTable:
         self.full = np.array([engine.mean_brake_torque(n, 1.0) for n in self.speeds])
 
     def level_of_scale(self, spin, scale):
-        """Load level at the speeds [rad/s] of the IMEP scales: :math:`s_0` (the fired
-        cycle of zero torque) and above on the model's loads, below it towards no burn."""
+        """Load level of the IMEP ``scale`` at the speeds ``spin`` [rad/s]."""
         if self.zero is None:
             return np.asarray(scale, float)
         s0 = self._by_speed(self.zero, spin)
         return np.where(scale >= s0, (scale - s0) / (1.0 - s0), scale / s0 - 1.0)
 
     def scale_of_level(self, spin, level):
-        """IMEP scale [-] of the load levels at the speeds [rad/s]."""
+        """IMEP scale [-] of the load ``level`` at the speeds ``spin`` [rad/s]."""
         if self.zero is None:
             return np.asarray(level, float)
         s0 = self._by_speed(self.zero, spin)
         return np.where(level >= 0, s0 + level * (1.0 - s0), (1.0 + level) * s0)
 
     def level_of_torque(self, spin, torque):
-        """Load level of the mean brake torques [N·m]: a fraction of full load, below 0 of
-        the torque without burn (engine braking), bounded to the table."""
+        """Load level of the mean brake ``torque`` [N·m] at ``spin`` [rad/s], within the table."""
         full = np.maximum(self._by_speed(self.full, spin), 1e-9)
         level = np.where(torque >= 0, torque / full, 0.0)
         if self.scales[0] < 0:
@@ -205,9 +195,7 @@ class _GasTable:
         return values[v0] * (1 - fv) + values[v1] * fv
 
     def _no_mean_roll(self, load):
-        """``load`` (..., n_theta + 1, 6) with the cycle mean of its roll moment (over all
-        but the last angle, the wrap's) removed, in place: the moment about the crank axis,
-        the engine's x (``self.n``)."""
+        """``load`` (..., n_theta + 1, 6) with the cycle mean of its roll moment removed, in place."""
         s = self.n[0]
         load[..., 3] -= np.mean(load[..., :-1, 3] * s, axis=-1)[..., None] * s
         return load
@@ -220,17 +208,14 @@ class _GasTable:
     def _scale_index(self, scale):
         s = self.scales
         if s.size == 1:
-            return np.zeros(scale.size, np.int64), np.zeros(scale.size, np.int64), \
-                np.zeros(scale.size)
+            return np.zeros(scale.size, np.int64), np.zeros(scale.size, np.int64), np.zeros(scale.size)
         j = np.clip(np.searchsorted(s, scale, side="right") - 1, 0, s.size - 2)
         w = np.clip((scale - s[j]) / (s[j + 1] - s[j]), 0.0, 1.0)
         return j, j + 1, w
 
     def load(self, theta, omega, alpha, level):
-        """Load (n_t, 6) at the crank angles [rad], speeds [rad/s], accelerations
-        [rad/s²] and load levels: the gas table trilinear, faded out below
-        :data:`FADE_RPM`, plus the inertia and acceleration patterns
-        (:func:`~powertrain.kernels.load_table.table_load`)."""
+        """Load (n_t, 6) at crank angles ``theta`` [rad], speeds ``omega`` [rad/s],
+        accelerations ``alpha`` [rad/s²] and load ``level``."""
         spin = np.abs(omega)
         s0, _, fs = self._scale_index(level)
         v0, _, fv = self._speed_index(spin)
@@ -242,7 +227,7 @@ class _GasTable:
         return out
 
     def torque(self, spin, scale):
-        """Mean brake torque [N·m] at the speeds [rad/s] and scales, bilinear."""
+        """Mean brake torque [N·m] at the speeds ``spin`` [rad/s] and levels ``scale``, bilinear."""
         s0, s1, fs = self._scale_index(scale)
         v0, v1, fv = self._speed_index(spin)
         T = self.torques
@@ -251,21 +236,18 @@ class _GasTable:
 
 
 def _full_only(manoeuvre):
-    """An IMEP table at the model's own load throughout (measured traces allow no other)."""
+    """An IMEP manoeuvre at the model's own load throughout."""
     return manoeuvre.load_kind == "imep_scale" and bool(np.all(manoeuvre.load == 1.0))
 
 
 def _levels(manoeuvre, zero):
-    """Load levels of the gas table (:class:`_GasTable`): -1 (no burn) where the table
-    reaches below the fired cycle of zero torque, then the model's loads in steps of
-    :data:`LEVEL_STEP` up to the table's largest."""
+    """Load levels of the gas table: -1 (no burn) where needed, then steps of :data:`LEVEL_STEP`."""
     if zero is None:
         return np.array([1.0])
     if manoeuvre.load_kind == "mean_torque":
         return np.r_[[-1.0] if np.any(manoeuvre.load < 0) else [], TORQUE_SCALES]
     s_max = float(np.max(manoeuvre.load))
-    top = np.ceil(max(np.max((s_max - zero) / (1.0 - zero)), 0.0) / LEVEL_STEP - 1e-9) \
-        * LEVEL_STEP
+    top = np.ceil(max(np.max((s_max - zero) / (1.0 - zero)), 0.0) / LEVEL_STEP - 1e-9) * LEVEL_STEP
     fired = np.arange(0.0, top + LEVEL_STEP / 2, LEVEL_STEP)
     low = [-1.0] if np.min(manoeuvre.load) < np.max(zero) else []
     return np.r_[low, fired if fired.size > 1 or low else [0.0, LEVEL_STEP]]

@@ -1,10 +1,6 @@
-"""The transient kernel's model
-(:func:`~powertrain.kernels.transient.transient_kernel`) from the assembled system:
-the matrices compressed on the pattern of them and their networks' parts, the elimination
-order and the pattern of the Newmark matrix's LU factors there
-(:mod:`powertrain.kernels.sparse_lu`), found once per run; the amplitude laws and the rows
-the stretches' amplitudes and centres are read on
-(:func:`~powertrain.kernels.transient.transient_kernel`)."""
+"""The transient kernel's model (:func:`~powertrain.kernels.transient.transient_kernel`) from
+the assembled system: compressed matrices, elimination order and LU pattern
+(:mod:`powertrain.kernels.sparse_lu`), amplitude laws and the rows amplitudes are read on."""
 
 import numpy as np
 
@@ -13,17 +9,17 @@ from powertrain.kernels.transient import NO_LAW
 
 
 def stretch_kernel_model(system, scaling, pivoting=False):
-    """The kernel's ``model`` tuple (:func:`~powertrain.kernels.transient.transient_stretch_kernel`)."""
+    """The kernel's ``model`` tuple of ``system`` and its ``scaling`` (:func:`kernel_model`)."""
     return kernel_model(*(np.array(A, float) for A in (system.M, system.C, system.K)),
                         scaling.C_parts, scaling.K_parts, np.array(scaling.assembled, float),
                         pivoting)
 
 
 def kernel_model(M, C, K, C_parts, K_parts, assembled, pivoting=False):
-    """The kernel's ``model`` tuple of the assembled M, C, K (n, n), each network's parts
-    (n_net, n, n) and the scales (n_net, 2) the assembled matrices hold; with ``pivoting``
-    the kernel swaps rows where a pivot needs it, without it the code is not compiled and
-    the kernel returns :data:`~powertrain.kernels.transient.NEEDS_PIVOTING` there."""
+    """The kernel's ``model`` tuple of the assembled ``M``, ``C``, ``K`` (n, n), the networks'
+    ``C_parts``, ``K_parts`` (n_net, n, n) and the ``assembled`` scales (n_net, 2); without
+    ``pivoting`` the kernel returns :data:`~powertrain.kernels.transient.NEEDS_PIVOTING`
+    where a pivot needs a row swap."""
     try:
         M_inv = np.linalg.inv(M)
     except np.linalg.LinAlgError:          # massless nodes: the start acceleration is 0
@@ -39,10 +35,7 @@ def kernel_model(M, C, K, C_parts, K_parts, assembled, pivoting=False):
 
 
 def _elimination_order(*matrices):
-    """Coordinates in the order of fewest nonzeros in any of ``matrices`` (or their stacked
-    parts) first: each network's internal ones before the body's, so that the sparse
-    factors of S have no fill-in but the body's rows
-    (:mod:`powertrain.kernels.sparse_lu`)."""
+    """Coordinates ordered by fewest nonzeros in any of ``matrices`` (least fill-in)."""
     pattern = sum((np.abs(m).reshape(-1, *m.shape[-2:]).sum(0) != 0) for m in matrices)
     return np.argsort((pattern != 0).sum(1), kind="stable").astype(np.int64)
 
@@ -53,11 +46,7 @@ def _mask(A, parts):
 
 
 def _with_parts(A, parts, mask):
-    """``(starts, columns, values, (network, position, value))``: ``A`` compressed on the
-    pattern ``mask`` (that of C, K and their networks' ``parts``, :func:`_mask`: one pattern
-    for both, :func:`~powertrain.kernels.sparse_lu.subtract_products`), and each part's
-    nonzero entry with its position among the values
-    (:func:`~powertrain.kernels.transient._scaled`)."""
+    """``A`` compressed on ``mask``, and each of ``parts``' nonzeros with its value position."""
     starts, columns = csr_pattern(mask)
     rows = np.repeat(np.arange(A.shape[0]), np.diff(starts))
     position = np.full(A.shape, -1, np.int64)
@@ -68,18 +57,16 @@ def _with_parts(A, parts, mask):
 
 
 def motion_model(system, scaling, ports):
-    """The kernel's ``motion`` tuple (:func:`~powertrain.kernels.transient.transient_kernel`):
-    the networks' amplitude laws (:func:`amplitude_laws`), the ports' and the networks' rows
-    compressed, each port's network and whether a law varies with amplitude."""
+    """The kernel's ``motion`` tuple of ``system``, ``scaling`` and ``ports``: amplitude laws,
+    compressed port and network rows, each port's network and whether a law varies."""
     rows = (compressed(np.array(ports.rows, float), True, True),
             compressed(np.array(system.port_rows, float), True, True))
-    return (amplitude_laws(scaling.elements), rows, np.array(ports.index, np.int64),
-            bool(scaling.varying))
+    return (amplitude_laws(scaling.elements), rows, np.array(ports.index, np.int64), bool(scaling.varying))
 
 
 def amplitude_laws(elements):
     """``(kind, power, table, count)`` of :func:`~powertrain.kernels.transient.amplitude_scales`
-    from each network element's amplitude law (its ``kernel_law``)."""
+    from the amplitude laws of ``elements``."""
     rows = [(NO_LAW, (0.0,) * 5, ()) if el.amplitude_law is None else
             el.amplitude_law.kernel_law() for el in elements]
     size = max([len(table[0]) for *_, table in rows if table], default=1)
