@@ -63,8 +63,7 @@ def _one_line(default):
 
 def quiet_option(func):
     """The ``--quiet`` flag of every command (:data:`QUIET_HELP`)."""
-    return click.option("--quiet", is_flag=True, help=QUIET_HELP,
-                        callback=_silence_warnings)(func)
+    return click.option("--quiet", is_flag=True, help=QUIET_HELP, callback=_silence_warnings)(func)
 
 
 def say(text: str, quiet: bool, **kwargs) -> None:
@@ -88,8 +87,7 @@ def check_outputs(**targets) -> None:
             check_writable(path, key=key)
             same = seen.setdefault(Path(path).resolve(), key)
             if same != key:
-                raise InputError(f"{path} is also the {same} file (one file per output)",
-                                 key=key)
+                raise InputError(f"{path} is also the {same} file (one file per output)", key=key)
 
 
 def write_json(path, text: str, provenance: dict, key: str = "--json") -> None:

@@ -18,8 +18,7 @@ from powertrain.provenance import recording_command
 COMMANDS = {"compare": "compare", "diagnose": "diagnose", "examples": "examples",
             "excitation": "excitation", "fit-mount": "fit_mount", "modes": "modes",
             "report": "report", "runup": "runup", "static": "static", "stiffness": "stiffness",
-            "synth": "diagnose", "track": "track", "transient": "transient",
-            "whatif": "whatif"}
+            "synth": "diagnose", "track": "track", "transient": "transient", "whatif": "whatif"}
 
 
 class _Group(click.Group):

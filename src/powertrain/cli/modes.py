@@ -25,8 +25,7 @@ from powertrain.workflows.modes import modes as solve_modes
 @click.option("--static", is_flag=True,
               help="Static (0 Hz) mount stiffness, undamped (default: each mode with the "
                    "networks' dynamic stiffness at its own frequency, damped).")
-@click.option("--json", "json_file", type=click.Path(dir_okay=False),
-              help="Write the modes as JSON.")
+@click.option("--json", "json_file", type=click.Path(dir_okay=False), help="Write the modes as JSON.")
 @click.option("--plot", type=click.Path(dir_okay=False),
               help="Write the kinetic-energy distribution per mode (PNG).")
 @quiet_option

@@ -65,8 +65,7 @@ def quantity_of_unit(unit: str, file=None, key=None) -> str:
     if dim not in QUANTITY_OF_DIMENSION:
         what = "unknown unit" if dim is None else f"unit of {dim}"
         raise InputError(f"{what} {unit!r}: a channel needs a unit of acceleration (m/s^2, "
-                         "g), velocity (m/s, mm/s), displacement (m, mm) or force (N)",
-                         file=file, key=key)
+                         "g), velocity (m/s, mm/s), displacement (m, mm) or force (N)", file=file, key=key)
     return QUANTITY_OF_DIMENSION[dim]
 
 
@@ -76,8 +75,7 @@ def read_channel_map(path) -> ChannelMap:
     data = read_toml(path)
     for key in data:
         if key not in ("time", "rpm", "tacho", "channels"):
-            raise InputError("unknown key (expected time, rpm, tacho, [channels])",
-                             file=path, key=key)
+            raise InputError("unknown key (expected time, rpm, tacho, [channels])", file=path, key=key)
     cmap = ChannelMap(source=path)
     for key in ("time", "rpm", "tacho"):
         setattr(cmap, key, get(data, key, path, default=None, types=(str, type(None))))

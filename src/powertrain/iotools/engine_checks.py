@@ -28,8 +28,7 @@ _G = 9.80665
 def check_engine(engine, path) -> None:
     """Raise :class:`InputError` if ``engine`` (read from ``path``) is physically absurd."""
     check_support(engine, path)
-    if getattr(engine, "crank", None) is not None and getattr(engine, "combustion", None) \
-            is not None:
+    if getattr(engine, "crank", None) is not None and getattr(engine, "combustion", None) is not None:
         check_excitation(engine, path)
 
 

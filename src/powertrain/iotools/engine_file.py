@@ -72,8 +72,7 @@ def engine_or_default(engine=None) -> em.Engine:
     if engine is None or isinstance(engine, (str, os.PathLike)):
         return read_engine(DEFAULT_ENGINE_PATH if engine is None else engine)
     if not isinstance(engine, em.Engine):
-        raise InputError(f"expected an Engine or an engine file, got {type(engine).__name__}",
-                         key="--engine")
+        raise InputError(f"expected an Engine or an engine file, got {type(engine).__name__}", key="--engine")
     return engine
 
 
@@ -103,8 +102,7 @@ def read_engine(path=DEFAULT_ENGINE_PATH) -> em.Engine:
         crank = _read_crank(subtable(doc, "crank_train", path), path)
     if "combustion" in doc:
         if crank is None:
-            raise InputError("[combustion] needs a [crank_train] section", file=path,
-                             key="crank_train")
+            raise InputError("[combustion] needs a [crank_train] section", file=path, key="crank_train")
         combustion = read_combustion(subtable(doc, "combustion", path), path, crank)
     balancer = Balancer(enabled=False, ratio=2.0, shafts=())
     if "balancer" in doc:
@@ -114,8 +112,7 @@ def read_engine(path=DEFAULT_ENGINE_PATH) -> em.Engine:
         chassis = _read_chassis(subtable(doc, "chassis", path), path, [m.name for m in mounts])
     gear_ratio = _read_drive(doc, path)
     engine = em.Engine(name=name, crank=crank, body=body, mounts=mounts, balancer=balancer,
-                       combustion=combustion, file=path, chassis=chassis,
-                       gear_ratio=gear_ratio)
+                       combustion=combustion, file=path, chassis=chassis, gear_ratio=gear_ratio)
     check_engine(engine, path)
     return engine
 
@@ -137,8 +134,7 @@ def _read_chassis(t, path, mount_names):
     check_keys(t, _ALLOWED[p], path, p)
     model = get(t, "model", path, p, types=str)
     if model not in MODELS:
-        raise InputError(f"unknown model {model!r} (known: {', '.join(MODELS)})", file=path,
-                         key=f"{p}.model")
+        raise InputError(f"unknown model {model!r} (known: {', '.join(MODELS)})", file=path, key=f"{p}.model")
     points_raw = get(t, "points", path, p, default={}, types=dict)
     for name, pt in points_raw.items():
         key = f"{p}.points.{name}"
@@ -182,8 +178,7 @@ def _read_body_mode(m, path, p, mount_names, points):
     for name in list(mount_names) + list(points):
         v = get(shape_raw, name, path, sp, types=list)
         if len(v) != 3:
-            raise InputError(f"expected [sx, sy, sz], got {v!r}"[:200], file=path,
-                             key=f"{sp}.{name}")
+            raise InputError(f"expected [sx, sy, sz], got {v!r}"[:200], file=path, key=f"{sp}.{name}")
         shapes[name] = np.array([number(x, path, f"{sp}.{name}") for x in v])
     return BodyMode(frequency=f, damping_ratio=zeta, modal_mass=mass, shapes=shapes)
 
@@ -193,8 +188,7 @@ def _read_crank(t, path) -> CrankTrain:
     check_keys(t, _ALLOWED[p], path, p)
     n = get(t, "cylinders", path, p, types=int)
     if isinstance(n, bool) or n < 1:
-        raise InputError(f"must be a positive integer, got {n!r}", file=path,
-                         key=f"{p}.cylinders")
+        raise InputError(f"must be a positive integer, got {n!r}", file=path, key=f"{p}.cylinders")
     bore = scalar_quantity(t, "bore", "length", path, p, positive=True)
     stroke = scalar_quantity(t, "stroke", "length", path, p, positive=True)
     rod = scalar_quantity(t, "rod_length", "length", path, p, positive=True)
@@ -212,8 +206,7 @@ def _read_crank(t, path) -> CrankTrain:
                          file=path, key=f"{p}.cylinder_axis")
     rot = get(t, "rotation", path, p, types=str)
     if rot not in ("+X", "-X"):
-        raise InputError(f"expected \"+X\" or \"-X\", got {rot!r}", file=path,
-                         key=f"{p}.rotation")
+        raise InputError(f"expected \"+X\" or \"-X\", got {rot!r}", file=path, key=f"{p}.rotation")
     pins = array_quantity(t, "crank_pin_angles", "angle", path, p, (n,))
     pins = pins - pins[0]      # re cylinder 1: θ = 0 is its firing TDC, for forces and gas
     order_raw = get(t, "firing_order", path, p, types=list)
@@ -233,8 +226,7 @@ def _read_crank(t, path) -> CrankTrain:
                          compression_ratio=eps, cylinder_x=xs, cylinder_axis=axis,
                          rotation_sign=1 if rot == "+X" else -1, crank_pin_angles=pins,
                          firing_order=order, firing_angles=firing, reciprocating_mass=m_rec,
-                         rotating_mass=m_rot, counterweight_fraction=cw,
-                         crankcase_pressure=pcc)
+                         rotating_mass=m_rot, counterweight_fraction=cw, crankcase_pressure=pcc)
 
 
 def _firing_angles(pins, order, path, key):
@@ -285,8 +277,7 @@ _NAME_RE = re.compile(r"^[A-Za-z_][A-Za-z0-9_-]*$")
 def _read_mounts(t, path) -> list:
     """Every ``[mounts.NAME]`` table, in file order (at least :data:`MIN_MOUNTS`)."""
     if len(t) < MIN_MOUNTS:
-        raise InputError(f"need at least {MIN_MOUNTS} mounts, got {len(t)}", file=path,
-                         key="mounts")
+        raise InputError(f"need at least {MIN_MOUNTS} mounts, got {len(t)}", file=path, key="mounts")
     mounts = []
     for name in t:
         if not is_mount_name(name):
@@ -306,8 +297,7 @@ def _read_mounts(t, path) -> list:
 def euler_rotation(a, b, c) -> np.ndarray:
     """Local→engine rotation R = Rz(c)·Ry(b)·Rx(a) [angles in rad]: rotations about engine X
     by ``a``, then engine Y by ``b``, then engine Z by ``c`` (columns = local axes)."""
-    ca, sa, cb, sb, cc, sc = (math.cos(a), math.sin(a), math.cos(b), math.sin(b),
-                              math.cos(c), math.sin(c))
+    ca, sa, cb, sb, cc, sc = (math.cos(a), math.sin(a), math.cos(b), math.sin(b), math.cos(c), math.sin(c))
     rx = np.array([[1.0, 0.0, 0.0], [0.0, ca, -sa], [0.0, sa, ca]])
     ry = np.array([[cb, 0.0, sb], [0.0, 1.0, 0.0], [-sb, 0.0, cb]])
     rz = np.array([[cc, -sc, 0.0], [sc, cc, 0.0], [0.0, 0.0, 1.0]])
@@ -328,8 +318,7 @@ def _read_orientation(m, path, p) -> np.ndarray:
     lx = unit_vector(m, "local_x", path, p)
     lz = unit_vector(m, "local_z", path, p)
     if abs(float(lx @ lz)) > 1e-6:
-        raise InputError("local_x and local_z must be perpendicular", file=path,
-                         key=f"{p}.local_z")
+        raise InputError("local_x and local_z must be perpendicular", file=path, key=f"{p}.local_z")
     return np.column_stack([lx, np.cross(lz, lx), lz])
 
 
@@ -348,21 +337,17 @@ def _read_mount_directions(m, path, p):
             rel = get(files, d, path, f"{p}.files", types=str)
             full = base / rel
             if not full.is_file():
-                raise InputError(f"mount file not found: {full}", file=path,
-                                 key=f"{p}.files.{d}")
+                raise InputError(f"mount file not found: {full}", file=path, key=f"{p}.files.{d}")
             directions[d] = read_mount(full)
             paths[d] = str(full)
         return directions, paths
     if "stiffness" not in m:
-        raise InputError("missing key (give files or an inline stiffness)", file=path,
-                         key=f"{p}.stiffness")
+        raise InputError("missing key (give files or an inline stiffness)", file=path, key=f"{p}.stiffness")
     k = array_quantity(m, "stiffness", "stiffness", path, p, (3,), nonneg=True)
     c = (array_quantity(m, "damping", "damping", path, p, (3,), nonneg=True) if "damping" in m
          else np.zeros(3))
-    directions = {d: MountModel.from_values("kelvin-voigt", [k[i], c[i]],
-                                            name=f"inline spring-damper {d}",
-                                            source=f"{path}: {p}")
-                  for i, d in enumerate(DIRECTIONS)}
+    directions = {d: MountModel.from_values("kelvin-voigt", [k[i], c[i]], name=f"inline spring-damper {d}",
+                                            source=f"{path}: {p}") for i, d in enumerate(DIRECTIONS)}
     return directions, {}
 
 

@@ -72,8 +72,7 @@ def normalise_quantity(text: str) -> str:
             order = float("nan")
         if math.isfinite(order) and order > 0:
             return order_label(order)
-    raise ValueError(f"unknown quantity {text!r} (expected 'synthesis' or 'order_<n>', "
-                     "e.g. order_2)")
+    raise ValueError(f"unknown quantity {text!r} (expected 'synthesis' or 'order_<n>', e.g. order_2)")
 
 
 @dataclass
@@ -287,15 +286,12 @@ def _csv_layout(header, path, lineno) -> _Layout:
         if name not in known:
             raise InputError(
                 f"unknown column {name!r} (expected {', '.join(KEY_COLUMNS)} and one "
-                f"level column: {', '.join(LEVEL_COLUMNS)})",
-                file=path, line=lineno, key=name or "(empty)")
+                f"level column: {', '.join(LEVEL_COLUMNS)})", file=path, line=lineno, key=name or "(empty)")
         if header.count(name) > 1:
-            raise InputError(f"column {name!r} appears twice", file=path,
-                             line=lineno, key=name)
+            raise InputError(f"column {name!r} appears twice", file=path, line=lineno, key=name)
     for name in KEY_COLUMNS:
         if name not in header:
-            raise InputError(f"header lacks column {name!r}", file=path, line=lineno,
-                             key=name)
+            raise InputError(f"header lacks column {name!r}", file=path, line=lineno, key=name)
     levels = [n for n in header if n in LEVEL_COLUMNS]
     velocity_levels = [n for n in levels if n.startswith("velocity_")]
     if len(levels) > 1 and len(velocity_levels) == 1:
@@ -303,10 +299,8 @@ def _csv_layout(header, path, lineno) -> _Layout:
         levels = velocity_levels
     if len(levels) != 1:
         raise InputError(
-            "header needs exactly one level column with its unit "
-            f"({', '.join(LEVEL_COLUMNS)}); found "
-            f"{', '.join(levels) if levels else 'none'}",
-            file=path, line=lineno, key="header")
+            f"header needs exactly one level column with its unit ({', '.join(LEVEL_COLUMNS)}); found "
+            f"{', '.join(levels) if levels else 'none'}", file=path, line=lineno, key="header")
     return _Layout({n: i for i, n in enumerate(header)}, levels[0])
 
 
@@ -339,11 +333,9 @@ def _csv_row(fields, layout, path, lineno, mounts, points):
                          file=path, line=lineno, key="rpm")
     level = parse_number(fields[col[level_col]], path, lineno, level_col)
     if level < 0:
-        raise InputError(f"negative level {level:g}", file=path, line=lineno,
-                         key=level_col)
+        raise InputError(f"negative level {level:g}", file=path, line=lineno, key=level_col)
     _check_level(level * layout.scale, path, lineno, level_col)
-    return node, direction, quantity, rpm, level, _row_phase(fields, col, quantity, path,
-                                                             lineno)
+    return node, direction, quantity, rpm, level, _row_phase(fields, col, quantity, path, lineno)
 
 
 def _row_phase(fields, col, quantity, path, lineno) -> float:
@@ -366,8 +358,7 @@ def _csv_node(mount, side, path, lineno, mounts, points) -> str:
         return mount                                  # a body point of interest
     if not mount or (mounts is not None and mount not in mounts):
         known_txt = f" (known: {', '.join(mounts)})" if mounts is not None else ""
-        raise InputError(f"unknown mount {mount!r}{known_txt}", file=path, line=lineno,
-                         key="mount")
+        raise InputError(f"unknown mount {mount!r}{known_txt}", file=path, line=lineno, key="mount")
     return mount
 
 
@@ -379,8 +370,7 @@ def _add_row(rows, order, row, path, lineno) -> None:
         order.append(key)
     if rpm in rows[key]:
         raise InputError(f"duplicate row: {node},{direction},{quantity} at {rpm:g} rpm "
-                         f"already on line {rows[key][rpm][1]}", file=path, line=lineno,
-                         key="rpm")
+                         f"already on line {rows[key][rpm][1]}", file=path, line=lineno, key="rpm")
     rows[key][rpm] = (level, lineno, phase)
 
 
@@ -408,8 +398,7 @@ def _measured_runup(rows, order, layout, path, comments) -> MeasuredRunup:
         notes.append(f"levels read from peak column {level_col!r} and converted to RMS by "
                      "1/sqrt(2) (exact for a sinusoidal order; synthesis read as the "
                      "root-sum-square of the order peaks)")
-    return MeasuredRunup(curves, source=path, notes=notes, comments=comments, signal=signal,
-                         phases=phases)
+    return MeasuredRunup(curves, source=path, notes=notes, comments=comments, signal=signal, phases=phases)
 
 
 def to_velocity(curves, kind, notes):
@@ -422,8 +411,7 @@ def to_velocity(curves, kind, notes):
     out, dropped = {}, []
     channels = {(m, d) for m, d, _ in curves}
     for m, d in sorted(channels):
-        orders = {q: v for (mm, dd, q), v in curves.items()
-                  if (mm, dd) == (m, d) and q != "synthesis"}
+        orders = {q: v for (mm, dd, q), v in curves.items() if (mm, dd) == (m, d) and q != "synthesis"}
         for q, (rpm, level) in orders.items():
             w = 2 * math.pi * float(q.split("_", 1)[1]) * rpm / 60.0
             out[(m, d, q)] = (rpm, level / w if kind == "acceleration" else level * w)

@@ -48,8 +48,7 @@ def read_mount(path) -> MountModel:
     params_raw = get(doc, "parameters", path, types=dict)
     unknown = sorted(set(params_raw) - set(topo.parameters))
     if unknown:
-        raise InputError(f"unknown parameter for model {model!r} "
-                         f"(expected {', '.join(topo.parameters)})",
+        raise InputError(f"unknown parameter for model {model!r} (expected {', '.join(topo.parameters)})",
                          file=path, key=f"parameters.{unknown[0]}")
     params = {}
     for p in topo.parameters:
@@ -57,8 +56,7 @@ def read_mount(path) -> MountModel:
         unit = get(units, family, path, "units", types=str)
         raw = get(params_raw, p, path, "parameters")
         value = number(raw, path, f"parameters.{p}", nonneg=True)
-        params[p] = float(to_si(value, unit, _DIMENSION[family], file=path,
-                                key=f"units.{family}"))
+        params[p] = float(to_si(value, unit, _DIMENSION[family], file=path, key=f"units.{family}"))
         if params[p] > MAX_SI[family]:
             raise InputError(f"{value:g} {unit} above the plausible "
                              f"{from_si(MAX_SI[family], unit):g} {unit} (unit error?)",
@@ -66,8 +64,7 @@ def read_mount(path) -> MountModel:
     laws = {field: reader(get(doc, section, path, types=dict), _Units(units, path))
             for section, (field, reader) in _SECTIONS.items() if section in doc}
     model = MountModel(topo, params, name=str(mount.get("name", Path(path).stem)),
-                       source=str(mount.get("source", "")), notes=str(mount.get("notes", "")),
-                       **laws)
+                       source=str(mount.get("source", "")), notes=str(mount.get("notes", "")), **laws)
     check_network(model, path)
     return model
 
@@ -120,8 +117,7 @@ def _loose_nodes(model: MountModel) -> list:
             if (a in held) != (b in held):
                 held |= {a, b}
                 grown = True
-    return [topo.masses[k - 1] or f"node {k}" for k in range(1, topo.n_internal + 1)
-            if f"n{k}" not in held]
+    return [topo.masses[k - 1] or f"node {k}" for k in range(1, topo.n_internal + 1) if f"n{k}" not in held]
 
 
 class _Units:
@@ -154,8 +150,7 @@ def _numbers(t: dict, key: str, path: str, prefix: str, *, positive=False, nonne
 
 def _same_length(values: np.ndarray, like: np.ndarray, like_key: str, path, key) -> None:
     if len(values) != len(like):
-        raise InputError(f"has {len(values)} values, {like_key} has {len(like)}",
-                         file=path, key=key)
+        raise InputError(f"has {len(values)} values, {like_key} has {len(like)}", file=path, key=key)
 
 
 def _read_amplitude(t: dict, units: _Units):
@@ -163,10 +158,8 @@ def _read_amplitude(t: dict, units: _Units):
     path = units.path
     law = get(t, "law", path, "amplitude", types=str)
     if law == "power":
-        _no_unknown_keys(t, {"law", "reference", "exponent", "limits", "damping_exponent"},
-                         path, "amplitude")
-        reference = number(get(t, "reference", path, "amplitude"), path,
-                           "amplitude.reference", positive=True)
+        _no_unknown_keys(t, {"law", "reference", "exponent", "limits", "damping_exponent"}, path, "amplitude")
+        reference = number(get(t, "reference", path, "amplitude"), path, "amplitude.reference", positive=True)
         exponent = number(get(t, "exponent", path, "amplitude"), path, "amplitude.exponent")
         limits = tuple(_numbers(t, "limits", path, "amplitude", positive=True).tolist()) \
             if "limits" in t else DEFAULT_LIMITS
@@ -176,8 +169,7 @@ def _read_amplitude(t: dict, units: _Units):
         gamma = number(t.get("damping_exponent", 1.0), path, "amplitude.damping_exponent")
         return PowerLaw(float(units.si(reference, "x")), exponent, limits, gamma)
     if law == "table":
-        _no_unknown_keys(t, {"law", "amplitudes", "stiffness_scale", "damping_scale"}, path,
-                         "amplitude")
+        _no_unknown_keys(t, {"law", "amplitudes", "stiffness_scale", "damping_scale"}, path, "amplitude")
         amps = _numbers(t, "amplitudes", path, "amplitude", positive=True, increasing=True)
         scales = {}
         for key in ("stiffness_scale", "damping_scale"):
@@ -185,19 +177,16 @@ def _read_amplitude(t: dict, units: _Units):
                 scales[key] = _numbers(t, key, path, "amplitude", positive=True)
                 _same_length(scales[key], amps, "amplitudes", path, f"amplitude.{key}")
         damping = scales.get("damping_scale")
-        return TableLaw(tuple(units.si(amps, "x").tolist()),
-                        tuple(scales["stiffness_scale"].tolist()),
+        return TableLaw(tuple(units.si(amps, "x").tolist()), tuple(scales["stiffness_scale"].tolist()),
                         None if damping is None else tuple(damping.tolist()))
-    raise InputError(f"unknown law {law!r} (expected power or table)", file=path,
-                     key="amplitude.law")
+    raise InputError(f"unknown law {law!r} (expected power or table)", file=path, key="amplitude.law")
 
 
 def _read_friction(t: dict, units: _Units) -> BergFriction:
     """``[friction]`` -> :class:`BergFriction` (SI)."""
     path = units.path
     _no_unknown_keys(t, {"max_force", "half_displacement"}, path, "friction")
-    fmax = number(get(t, "max_force", path, "friction"), path, "friction.max_force",
-                  nonneg=True)
+    fmax = number(get(t, "max_force", path, "friction"), path, "friction.max_force", nonneg=True)
     x2 = number(get(t, "half_displacement", path, "friction"), path,
                 "friction.half_displacement", positive=True)
     return BergFriction(float(units.si(fmax, "F")), float(units.si(x2, "x")))
@@ -212,16 +201,14 @@ def _read_static(t: dict, units: _Units) -> StaticCurve:
     f = _numbers(t, "force", path, "static", increasing=True)
     _same_length(f, x, "deflection", path, "static.force")
     if len(x) < 2:
-        raise InputError("a static curve needs at least 2 points", file=path,
-                         key="static.deflection")
+        raise InputError("a static curve needs at least 2 points", file=path, key="static.deflection")
     ref = number(get(t, "reference_deflection", path, "static", default=0.0), path,
                  "static.reference_deflection")
     curve = StaticCurve(tuple(units.si(x, "x").tolist()), tuple(units.si(f, "F").tolist()),
                         float(units.si(ref, "x")))
     ends = curve.tangent_at([curve.deflection[0], curve.deflection[-1]])
     if not curve.tangent_at(curve.reference_deflection) > 0:
-        raise InputError("the curve's tangent there is zero", file=path,
-                         key="static.reference_deflection")
+        raise InputError("the curve's tangent there is zero", file=path, key="static.reference_deflection")
     if not np.all(ends > 0):
         raise InputError("the curve's end slope (PCHIP's end-point derivative) is zero; "
                          "add a point beyond", file=path, key="static.force")
@@ -229,8 +216,7 @@ def _read_static(t: dict, units: _Units) -> StaticCurve:
 
 
 #: Section -> (MountModel field, reader).
-_SECTIONS = {"amplitude": ("amplitude_law", _read_amplitude),
-             "friction": ("port_law", _read_friction),
+_SECTIONS = {"amplitude": ("amplitude_law", _read_amplitude), "friction": ("port_law", _read_friction),
              "static": ("static_curve", _read_static)}
 
 
@@ -239,8 +225,7 @@ def _no_unknown_keys(table: dict, known: set, path: str, prefix: str) -> None:
     unknown = sorted(set(table) - known)
     if unknown:
         key = f"{prefix}.{unknown[0]}" if prefix else unknown[0]
-        raise InputError(f"unknown key (expected {', '.join(sorted(known))})",
-                         file=path, key=key)
+        raise InputError(f"unknown key (expected {', '.join(sorted(known))})", file=path, key=key)
 
 
 def format_mount(model: MountModel, *, comment: str = "") -> str:
@@ -296,8 +281,7 @@ def _section_lines(model: MountModel) -> list:
                   f"half_displacement = {x(model.port_law.half_displacement)}"]
     curve = model.static_curve
     if curve is not None:
-        lines += ["", "[static]", f"deflection = {xs(curve.deflection)}",
-                  f"force = {forces(curve.force)}",
+        lines += ["", "[static]", f"deflection = {xs(curve.deflection)}", f"force = {forces(curve.force)}",
                   f"reference_deflection = {x(curve.reference_deflection)}"]
     return lines
 

@@ -77,8 +77,7 @@ def read_plan(path, engine) -> Plan:
     data = read_toml(path)
     extra = sorted(set(data) - {"runs"})
     if extra:
-        raise InputError(f"unknown key (a plan has [[runs]] only): {extra[0]}", file=path,
-                         key=extra[0])
+        raise InputError(f"unknown key (a plan has [[runs]] only): {extra[0]}", file=path, key=extra[0])
     runs = get(data, "runs", path, types=list)
     if not runs or not all(isinstance(r, dict) for r in runs):
         raise InputError("expected one or more [[runs]] tables", file=path, key="runs")
@@ -95,18 +94,15 @@ def _run_keys(run, path, key, engine, base):
     """``(load, traces path, measured path)`` of one run, checked."""
     unknown = sorted(set(run) - set(RUN_KEYS))
     if unknown:
-        raise InputError(f"unknown key (known: {', '.join(RUN_KEYS)})", file=path,
-                         key=f"{key}.{unknown[0]}")
+        raise InputError(f"unknown key (known: {', '.join(RUN_KEYS)})", file=path, key=f"{key}.{unknown[0]}")
     file = str(base / get(run, "file", path, key, types=str))
-    load = number(get(run, "load", path, key, default=1.0), path, f"{key}.load",
-                  positive=True)
+    load = number(get(run, "load", path, key, default=1.0), path, f"{key}.load", positive=True)
     traces = get(run, "traces", path, key, default=None, types=str)
     if traces is not None and "load" in run:
         raise InputError("give either load or traces, not both", file=path, key=f"{key}.load")
     if "load" in run and getattr(engine.combustion, "model", "") == "measured":
         raise InputError("load applies to engines with a combustion model; this engine has "
-                         "measured pressure traces (give traces = ... instead)", file=path,
-                         key=f"{key}.load")
+                         "measured pressure traces (give traces = ... instead)", file=path, key=f"{key}.load")
     if traces is not None:
         traces = str(base / traces)
     return load, traces, file

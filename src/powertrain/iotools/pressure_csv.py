@@ -95,11 +95,9 @@ def _row(n, text, path, n_cylinders) -> tuple:
         raise InputError(f"expected 4 values, got {len(cells)}", file=path, line=n)
     vals = [parse_number(c, path, n, name) for (name, _), c in zip(_COLUMNS, cells)]
     if vals[1] != int(vals[1]) or not 1 <= vals[1] <= n_cylinders:
-        raise InputError(f"cylinder must be 1..{n_cylinders}", file=path, line=n,
-                         key="cylinder")
+        raise InputError(f"cylinder must be 1..{n_cylinders}", file=path, line=n, key="cylinder")
     if vals[3] < 0:
-        raise InputError("absolute pressure must not be negative", file=path, line=n,
-                         key="pressure")
+        raise InputError("absolute pressure must not be negative", file=path, line=n, key="pressure")
     return (n, *vals)
 
 
@@ -112,8 +110,7 @@ def _check_ranges(speed, pressure, line_no, path) -> None:
                          line=int(line_no[np.argmax(bad_speed)]))
     if np.any(pressure > MAX_PRESSURE_PA):
         raise InputError(f"pressure above the plausible {MAX_PRESSURE_PA / 1e5:g} bar",
-                         file=path, key="pressure",
-                         line=int(line_no[np.argmax(pressure > MAX_PRESSURE_PA)]))
+                         file=path, key="pressure", line=int(line_no[np.argmax(pressure > MAX_PRESSURE_PA)]))
 
 
 def _check_trace(a, ln, c, w, path) -> None:
@@ -129,6 +126,5 @@ def _check_trace(a, ln, c, w, path) -> None:
     gaps = np.append(np.diff(a), a[0] + 4 * np.pi - a[-1])
     if gaps.max() > math.radians(MAX_GAP_DEG) + 1e-12:
         raise InputError(f"trace has a gap over {MAX_GAP_DEG:g}° (cylinder {c}, "
-                         f"{w * 60 / (2 * np.pi):.6g} rpm)", file=path,
-                         line=int(ln[0]), key="crank_angle")
+                         f"{w * 60 / (2 * np.pi):.6g} rpm)", file=path, line=int(ln[0]), key="crank_angle")
 

@@ -147,8 +147,7 @@ def _pick_speed(found: FileSignals, cmap, rpm, tacho, cycle_reference=None, trig
         values = np.asarray(values, float).ravel()
         if kind == "rpm":
             unit = unit or "rpm"
-            values = to_si(values, unit, "angular_speed", file=found.source, key=name) \
-                * 60.0 / (2.0 * np.pi)
+            values = to_si(values, unit, "angular_speed", file=found.source, key=name) * 60.0 / (2.0 * np.pi)
         elif unit:
             values = to_si(values, unit, "voltage", file=found.source, key=name)
         out[kind] = (name, values)
@@ -156,8 +155,7 @@ def _pick_speed(found: FileSignals, cmap, rpm, tacho, cycle_reference=None, trig
 
 
 def _same_time(a, b) -> bool:
-    return a.shape == b.shape and (b.size == 0 or np.allclose(
-        a, b, rtol=0, atol=1e-9 * max(abs(b[-1]), 1.0)))
+    return a.shape == b.shape and (b.size == 0 or np.allclose(a, b, rtol=0, atol=1e-9 * max(abs(b[-1]), 1.0)))
 
 
 def _vibration_time(found: FileSignals, signals):
@@ -169,8 +167,7 @@ def _vibration_time(found: FileSignals, signals):
     for name, _, _ in signals[1:]:
         if not _same_time(np.asarray(found.times.get(name, found.time)), np.asarray(time)):
             raise InputError(f"time base differs from channel {first!r}'s (only the speed or "
-                             "tacho channel may have its own; it is resampled)",
-                             file=found.source, key=name)
+                             "tacho channel may have its own; it is resampled)", file=found.source, key=name)
     return time
 
 
@@ -211,8 +208,7 @@ def _onto_time(found: FileSignals, speed, time):
 
 
 def assemble(found: FileSignals, cmap: ChannelMap | None = None, *, rpm=None,
-             tacho=None, cycle_reference=None, trigger=None,
-             map_option="--channels") -> RawRecording:
+             tacho=None, cycle_reference=None, trigger=None, map_option="--channels") -> RawRecording:
     """Map the signals of a file to mount channels in SI (see :func:`read_raw`)."""
     src = found.source
     speed, signals = _pick_speed(found, cmap, rpm, tacho, cycle_reference, trigger)
@@ -245,8 +241,7 @@ def assemble(found: FileSignals, cmap: ChannelMap | None = None, *, rpm=None,
                              f"{spec.quantity}", file=src, key=name)
         dimension = "length" if quantity == "displacement" else quantity
         si = to_si(np.asarray(values, float)[keep], unit, dimension, file=src, key=name)
-        channels.append(RawChannel(name, spec.mount, spec.side, spec.direction, quantity,
-                                   si, unit))
+        channels.append(RawChannel(name, spec.mount, spec.side, spec.direction, quantity, si, unit))
     if cmap is not None:
         for name in cmap.channels:
             if name not in used:

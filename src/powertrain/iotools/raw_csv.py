@@ -41,8 +41,7 @@ def read_csv_signals(path, channel_map=None) -> FileSignals:
             or h == time_name]
     if not tcol:
         raise InputError(f"header lacks a '{time_name} [s]' column (is this a wide raw CSV? "
-                         "order curves go to 'compare', not 'track')", file=path, line=start,
-                         key="time")
+                         "order curves go to 'compare', not 'track')", file=path, line=start, key="time")
     data = _numbers(lines, start, len(header), path)
     tname = header[tcol[0]]
     tunit = split_unit(tname)[1] or "s"
@@ -66,8 +65,7 @@ def _numbers(lines, start, n_cols, path):
                 continue
             fields = s.split(",")
             if len(fields) != n_cols:
-                raise InputError(f"{len(fields)} fields, header has {n_cols}", file=path,
-                                 line=lineno)
+                raise InputError(f"{len(fields)} fields, header has {n_cols}", file=path, line=lineno)
             for k, f in enumerate(fields):
                 try:
                     float(f)
@@ -83,8 +81,7 @@ def write_raw_csv(path, recording, *, comment: str = "") -> None:
     significant digits: uniform to the reader's tolerance however late it starts, the
     values to 9)."""
     signals = written_signals(recording)
-    names = ["time [s]"] + [f"{name} [{'1/min' if name == 'rpm' else unit}]"
-                            for name, _, unit, _ in signals]
+    names = ["time [s]"] + [f"{name} [{'1/min' if name == 'rpm' else unit}]" for name, _, unit, _ in signals]
     with atomic_write(path) as fh:
         for line in (comment.splitlines() if comment else []):
             fh.write(f"# {line}\n")

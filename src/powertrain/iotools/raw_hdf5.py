@@ -30,8 +30,7 @@ def _unit(ds):
     return u.decode() if isinstance(u, bytes) else str(u)
 
 
-def read_hdf5_signals(path, channel_map=None, *, map_option="--channels",
-                      extra=()) -> FileSignals:
+def read_hdf5_signals(path, channel_map=None, *, map_option="--channels", extra=()) -> FileSignals:
     """Signals of a raw HDF5 file (docs/reference/raw-data.md); ``map_option`` is the
     option named in the hint of a file that needs a channel map; ``extra``: names of more
     datasets read where the file has them (a trigger or cycle reference named by an
@@ -80,8 +79,7 @@ class _Budget:
 def _dataset(h5, name, path, budget):
     obj = h5.get(name)
     if obj is None or not hasattr(obj, "shape") or not hasattr(obj, "dtype"):
-        raise InputError("dataset not found (or a group, or a broken link)", file=path,
-                         key=name)
+        raise InputError("dataset not found (or a group, or a broken link)", file=path, key=name)
     if len(obj.shape or ()) != 1 or obj.dtype.kind not in "iuf":
         raise InputError("expected a 1-D numeric dataset", file=path, key=name)
     if obj.shape[0] > budget.left:
@@ -107,11 +105,9 @@ def _flag_attr(h5, name, path) -> bool:
     value = h5.attrs.get(name, False)
     if isinstance(value, np.ndarray) and value.shape == ():
         value = value[()]
-    if isinstance(value, (bool, np.bool_)) or (isinstance(value, (int, np.integer))
-                                               and value in (0, 1)):
+    if isinstance(value, (bool, np.bool_)) or (isinstance(value, (int, np.integer)) and value in (0, 1)):
         return bool(value)
-    raise InputError("expected a boolean attribute (true or false)", file=path,
-                     key=f"/@{name}")
+    raise InputError("expected a boolean attribute (true or false)", file=path, key=f"/@{name}")
 
 
 def _time(h5, name, path, budget):
@@ -140,8 +136,7 @@ def _read_own(h5, path, extra=()):
         key = f"channels/{name}"
         signals.append((name, _dataset(h5, key, path, budget), _unit(h5[key])))
     comments = _comments(h5, path)
-    if _flag_attr(h5, "synthetic", path) and \
-            not any("synthetic" in c.lower() for c in comments):
+    if _flag_attr(h5, "synthetic", path) and not any("synthetic" in c.lower() for c in comments):
         comments.append("SYNTHETIC")
     return FileSignals(time, signals, str(path), "time", comments, times)
 
@@ -152,8 +147,7 @@ def _own_time(h5, name, path, times, budget):
     if ref is None:
         return
     ref = ref.decode() if isinstance(ref, bytes) else str(ref)
-    times[name] = to_si(_dataset(h5, ref, path, budget), _unit(h5[ref]) or "s", "time", file=path,
-                        key=ref)
+    times[name] = to_si(_dataset(h5, ref, path, budget), _unit(h5[ref]) or "s", "time", file=path, key=ref)
 
 
 def _read_mapped(h5, path, cmap, extra=()):

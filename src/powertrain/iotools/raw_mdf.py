@@ -50,8 +50,7 @@ def read_mdf_signals(path, channel_map=None) -> FileSignals:
                 t = np.asarray(sig.timestamps, float)
                 if t.size < 2 or np.size(sig.samples) != t.size:
                     raise InputError(f"channel has {np.size(sig.samples)} samples at "
-                                     f"{t.size} times; a signal needs at least 2",
-                                     file=path, key=sig.name)
+                                     f"{t.size} times; a signal needs at least 2", file=path, key=sig.name)
                 if time is None:
                     time = t
                 elif t.shape != time.shape or not np.allclose(t, time, rtol=0,
@@ -77,8 +76,7 @@ def _check_declared_size(mdf, path) -> None:
     total = 0
     for g, group in enumerate(mdf.groups):
         cg = group.channel_group
-        record = int(getattr(cg, "samples_byte_nr", 0)) + \
-            int(getattr(cg, "invalidation_bytes_nr", 0))
+        record = int(getattr(cg, "samples_byte_nr", 0)) + int(getattr(cg, "invalidation_bytes_nr", 0))
         total += int(getattr(cg, "cycles_nr", 0)) * record
         if total > MAX_SAMPLE_BYTES:
             raise InputError(f"channel group {g + 1} declares {total:.3g} bytes of samples; "

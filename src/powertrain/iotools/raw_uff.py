@@ -43,8 +43,7 @@ def read_uff_signals(path, channel_map=None) -> FileSignals:
     check_complete(path, len(sets))
     sets = [s for s in sets if s.get("type") == 58]
     if not sets:
-        raise InputError("no dataset 58 (function at nodal DOF) in the universal file",
-                         file=path)
+        raise InputError("no dataset 58 (function at nodal DOF) in the universal file", file=path)
     _check_count(path, sets)
     time = None
     signals = []
@@ -78,8 +77,7 @@ def check_complete(path, n_read: int) -> None:
     with open(path, "rb") as fh:
         data = fh.read()
     if not data.rstrip().endswith(b"-1") or not data.rstrip()[:-2].endswith((b"\n", b" ")):
-        raise InputError("file does not end with the '-1' delimiter line: truncated?",
-                         file=path)
+        raise InputError("file does not end with the '-1' delimiter line: truncated?", file=path)
     started = len(_DATASET_START.findall(data))
     if started > n_read:
         raise InputError(f"{started} datasets start in the file but only {n_read} could be "

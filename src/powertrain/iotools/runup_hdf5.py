@@ -101,8 +101,7 @@ def _h5_paths(h5, path, n):
     key = "path_contribution/velocity"
     data = _h5_array(h5, key, path, "c", 4)
     if data.shape[0] != n[0] or data.shape[3] != n[2] or data.shape[1] % 3 or data.shape[2] % 3:
-        raise InputError(f"shape {data.shape} does not fit the speeds and orders", file=path,
-                         key=key)
+        raise InputError(f"shape {data.shape} does not fit the speeds and orders", file=path, key=key)
     return data
 
 

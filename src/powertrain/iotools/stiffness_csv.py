@@ -53,8 +53,7 @@ class MeasuredStiffness:
         if fmax is not None:
             keep &= self.frequency_hz <= fmax
         amp = None if self.amplitude_m is None else self.amplitude_m[keep]
-        return MeasuredStiffness(self.frequency_hz[keep], self.kcp[keep], self.source, amp,
-                                 self.synthetic)
+        return MeasuredStiffness(self.frequency_hz[keep], self.kcp[keep], self.source, amp, self.synthetic)
 
     @property
     def amplitudes(self) -> np.ndarray:
@@ -173,8 +172,7 @@ def _values(rows, header, cols, path) -> dict:
                 blocks.check(value, raw, lineno)
             limit = LIMITS.get(name)
             if limit is not None and abs(value) > limit:
-                raise InputError(f"|{raw}| above the plausible {limit:g}", file=path,
-                                 key=name, line=lineno)
+                raise InputError(f"|{raw}| above the plausible {limit:g}", file=path, key=name, line=lineno)
             data[name].append(value)
     if not data[FREQUENCY]:
         raise InputError("no data rows", file=path, key=FREQUENCY)
@@ -196,8 +194,7 @@ class _Blocks:
             return
         if amplitude in self.seen:
             raise InputError(f"amplitude {amplitude:g} mm again after other amplitudes "
-                             "(one block of rows per amplitude)", file=self.path,
-                             key=AMPLITUDE, line=lineno)
+                             "(one block of rows per amplitude)", file=self.path, key=AMPLITUDE, line=lineno)
         self.seen.append(amplitude)
         self.last = None
 

@@ -104,12 +104,9 @@ def parse_number(text, path, line, column, *, nonneg: bool = False) -> float:
     try:
         value = float(text)
     except (TypeError, ValueError):
-        raise InputError(f"not a number: {str(text).strip()!r}", file=path, line=line,
-                         key=column) from None
+        raise InputError(f"not a number: {str(text).strip()!r}", file=path, line=line, key=column) from None
     if not math.isfinite(value):
-        raise InputError(f"not a finite number ({str(text).strip()})", file=path, line=line,
-                         key=column)
+        raise InputError(f"not a finite number ({str(text).strip()})", file=path, line=line, key=column)
     if nonneg and value < 0:
-        raise InputError(f"must not be negative, got {str(text).strip()}", file=path,
-                         line=line, key=column)
+        raise InputError(f"must not be negative, got {str(text).strip()}", file=path, line=line, key=column)
     return value

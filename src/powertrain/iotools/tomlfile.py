@@ -37,8 +37,7 @@ def get(table: dict, key: str, path, prefix: str = "", *, default=..., types=Non
         return default
     value = table[key]
     if types is not None and not isinstance(value, types):
-        raise InputError(f"expected {_type_name(types)}, got {type(value).__name__}",
-                         file=path, key=full)
+        raise InputError(f"expected {_type_name(types)}, got {type(value).__name__}", file=path, key=full)
     return value
 
 
@@ -92,8 +91,7 @@ def check_keys(table, allowed, path, prefix):
     unknown = sorted(set(table) - set(allowed))
     if unknown:
         key = f"{prefix}.{unknown[0]}" if prefix else unknown[0]
-        raise InputError(f"unknown key (expected one of: {', '.join(sorted(allowed))})",
-                         file=path, key=key)
+        raise InputError(f"unknown key (expected one of: {', '.join(sorted(allowed))})", file=path, key=key)
 
 
 def subtable(doc, key, path, prefix=""):
@@ -138,8 +136,7 @@ def array_quantity(table, key, dimension, path, prefix, shape, *, nonneg=False, 
     if got is None or got == () or (want_len is not None and got != want_len):
         raise InputError(f"expected a list of shape {shape}, got {value!r}"[:200],
                          file=path, key=f"{full}.value")
-    vals = [number(v, path, f"{full}.value", nonneg=nonneg, positive=positive)
-            for v in flat(value)]
+    vals = [number(v, path, f"{full}.value", nonneg=nonneg, positive=positive) for v in flat(value)]
     return np.asarray(to_si(np.array(vals, dtype=float), unit, dimension, file=path,
                             key=f"{full}.unit"), dtype=float).reshape(got)
 
@@ -154,8 +151,7 @@ def unit_vector(table, key, path, prefix):
     v = vector3(table, key, "dimensionless", path, prefix)
     n = float(np.linalg.norm(v))
     if n < 1e-12:
-        raise InputError("direction vector must not be zero", file=path,
-                         key=f"{prefix}.{key}")
+        raise InputError("direction vector must not be zero", file=path, key=f"{prefix}.{key}")
     return v / n
 
 
