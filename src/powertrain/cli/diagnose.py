@@ -102,7 +102,6 @@ def diagnose(measured, plan_file, engine_file, report_dir, json_file, noise_floo
       powertrain diagnose case.csv --report out/diag --json out/diag.json
       powertrain diagnose --plan plan.toml --json out/plan.json
     """
-
     measured = _measured_or_plan(measured, plan_file)
     noise_floor = _noise_floor(noise_floor)
     names = [e.strip() for e in effects.split(",") if e.strip()] or None
@@ -172,7 +171,6 @@ def synth(effect_names, seed, out, truth_file, engine_file, quiet):
       powertrain synth --effect mount_temperature --seed 1 --out m.csv --truth t.json
       powertrain synth --effect none --out clean.csv
     """
-
     names = [] if effect_names.strip() == "none" else [
         e.strip() for e in effect_names.split(",") if e.strip()]
     check_outputs(out=out, truth=truth_file)

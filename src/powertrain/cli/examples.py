@@ -36,7 +36,6 @@ def examples(folder, quiet):
       powertrain examples .
       powertrain examples ~/powertrain-tour && cd ~/powertrain-tour
     """
-
     root = Path(folder)
     if root.exists() and not root.is_dir():
         raise InputError("exists and is not a folder; nothing copied", file=root, key="FOLDER")

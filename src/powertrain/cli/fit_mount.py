@@ -71,7 +71,6 @@ def fit_mount(measured, model, out, plot, form, freq_axis, starts, seed, fmin, f
       powertrain stiffness fitted.toml --freq 5,10,20,50,100,200,400
       powertrain fit-mount multi-amplitude.csv --friction --out fitted.toml
     """
-
     check_outputs(out=out, plot=plot)
     ref = _reference(reference)
     with activity(f"fit-mount ({model}, {starts} starts)", enabled=not quiet):

@@ -40,7 +40,6 @@ def modes(engine_file, static, json_file, plot, quiet):
       powertrain modes --engine engines/default-torque-rod.toml --json modes.json
       powertrain modes --static --plot modes.png
     """
-
     check_outputs(json=json_file, plot=plot)
     engine = engine_or_default(engine_file)
     result = solve_modes(engine, static=static)

@@ -77,7 +77,6 @@ def runup(rpm_from, rpm_to, rpm_step, engine_file, solver, stepper, angle_step, 
       powertrain runup --engine engines/default-modal-body.toml --path-plot paths.png
       powertrain runup --from 2000 --to 3000 --sweep 200 --raw sweep.h5 --csv sweep.csv
     """
-
     rpm = speed_steps(rpm_from, rpm_to, rpm_step)
     check_outputs(out=out, csv=csv_file, plot=plot, path_plot=path_plot, raw=raw_file)
     engine = engine_or_default(engine_file)

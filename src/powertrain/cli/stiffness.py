@@ -63,7 +63,6 @@ def stiffness(mount_file, engine_file, mount_dir, freq, method, fmt, plot, form,
       powertrain stiffness mounts/hydraulic-engine-mount-z.toml --amplitude 0.05,0.1,0.5 \\
           --method time --freq 1:100:1 --plot k.png
     """
-
     check_outputs(plot=plot)
     mount = _mount(mount_file, engine_file, mount_dir)
     result = run(mount, engine=engine_file, freq=freq, method=method,

@@ -1,9 +1,6 @@
-"""The ``[combustion]`` section of an engine file: the single-zone model or measured traces.
-
-``model = "single-zone"`` with its parameters and ``[combustion.full_load]`` (speed, torque,
-fmep), or ``model = "measured"`` with ``traces = "file.csv"``
-(:mod:`powertrain.iotools.pressure_csv`, relative to the engine file); see
-:mod:`powertrain.iotools.engine_file`. Values are converted to SI here.
+"""The ``[combustion]`` section of an engine file, in SI: ``model = "single-zone"`` with its
+parameters and ``[combustion.full_load]``, or ``model = "measured"`` with ``traces`` (a
+pressure-trace CSV relative to the engine file, :mod:`powertrain.iotools.pressure_csv`).
 """
 
 from __future__ import annotations
@@ -15,14 +12,7 @@ import numpy as np
 
 from powertrain.errors import InputError
 from powertrain.iotools.pressure_csv import read_pressure_traces
-from powertrain.iotools.tomlfile import (
-    array_quantity,
-    check_keys,
-    get,
-    quantity,
-    scalar_quantity,
-    subtable,
-)
+from powertrain.iotools.tomlfile import array_quantity, check_keys, get, quantity, scalar_quantity, subtable
 from powertrain.models.combustion import FullLoadCurve, SingleZoneCombustion
 
 #: ``[combustion]`` single-zone key -> (model field, dimension, check of the number).
@@ -63,10 +53,8 @@ def read_combustion(t: dict, path, crank):
     check_keys(t, KEYS["single-zone"], path, P)
     factors = array_quantity(t, "imep_factors", "dimensionless", path, P, (crank.n_cylinders,), nonneg=True)
     full_load = _read_full_load(subtable(t, "full_load", path, P), path)
-    values = {}
-    for key, (name, dim, check) in _SINGLE_ZONE.items():
-        kw = {check: True} if check else {}
-        values[name] = scalar_quantity(t, key, dim, path, P, **kw)
+    values = {name: scalar_quantity(t, key, dim, path, P, **({check: True} if check else {}))
+              for key, (name, dim, check) in _SINGLE_ZONE.items()}
     c = SingleZoneCombustion(full_load=full_load, imep_factors=factors, **values)
     _check_single_zone(c, path)
     return c

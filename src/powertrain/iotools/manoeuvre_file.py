@@ -1,10 +1,6 @@
-"""Reading a manoeuvre file (TOML): crank speed and load tables of a transient.
-
-Sections ``[manoeuvre]`` (name, gear_ratio, crank_inertia, reversal, trigger_time),
-``[speed]`` and
-``[load]`` (time tables), optional ``[starter]``: docs/guide/transient.md. The keys, units
-and table sizes (:data:`MAX_ROWS`) are checked here, the values by the model
-(:class:`~powertrain.models.manoeuvre.Manoeuvre`, which names this file), before any work.
+"""Manoeuvre files (TOML, docs/guide/transient.md): the crank speed and load tables of a
+transient. Keys, units and table sizes are checked here, the values by
+:class:`~powertrain.models.manoeuvre.Manoeuvre`.
 """
 
 from __future__ import annotations
@@ -33,10 +29,8 @@ def read_manoeuvre(path) -> Manoeuvre:
     Raises
     ------
     InputError
-        One line naming the file and the key: a missing or unknown key, a wrong unit, a
-        table of more than :data:`MAX_ROWS` rows, and every check of
-        :class:`~powertrain.models.manoeuvre.Manoeuvre` (times from 0 and increasing, a gap,
-        a negative speed where no reversal is allowed, a profile too long, bounds).
+        Naming the file and the key of the first problem (a table over :data:`MAX_ROWS`
+        rows, any check of :class:`~powertrain.models.manoeuvre.Manoeuvre`).
     """
     path = str(path)
     doc = read_toml(path)

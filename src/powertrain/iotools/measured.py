@@ -1,13 +1,10 @@
-r"""Measured run-up order curves: the long-format CSV or the run-up HDF5 layout.
+r"""Measured run-up order curves from the long-format CSV or the run-up HDF5 layout, in SI.
 
-The CSV (``runup --csv``, ``track --csv``, ``synth``; columns, level columns, ``side`` and
-``phase_deg``: docs/reference/csv-formats.md and raw-data.md) has one row per channel, quantity
-and speed. ``passive`` rows of mount ``left`` become channel ``left/passive``; a passive name
-that is not a mount is a body point. Peak levels become RMS by :math:`1/\sqrt2`; acceleration
-and displacement orders become velocity order by order (:func:`to_velocity`); force curves are
-compared with the simulated mount forces. HDF5 files are read with
-:func:`powertrain.iotools.runup_hdf5.read_runup_hdf5`. Levels are returned in SI (m/s RMS);
-every problem is an :class:`~powertrain.errors.InputError` naming file, line and column.
+CSV layout: docs/reference/csv-formats.md and raw-data.md. ``passive`` rows of mount ``left``
+become channel ``left/passive`` (another passive name is a body point); peak levels become RMS
+by :math:`1/\sqrt2`; acceleration and displacement become velocity order by order
+(:func:`to_velocity`). Every problem is an :class:`~powertrain.errors.InputError` naming file,
+line and column.
 """
 
 from __future__ import annotations
@@ -36,12 +33,9 @@ LEVEL_COLUMNS = {
     "force_rms_n": (1.0, "rms"),
 }
 KEY_COLUMNS = ("mount", "direction", "quantity", "rpm")
-#: Optional columns: the side of the mount (``active`` = engine side, default; ``passive`` =
-#: body side, or a body point of interest named in ``mount``) and further value columns
-#: (read and checked; the comparison uses the velocity level column).
+#: Optional columns: ``side`` (``active`` engine side, default; ``passive`` body side or a
+#: body point) and further value columns (checked, not compared).
 OPTIONAL_COLUMNS = ("side", "acceleration_rms_m_per_s2", "force_rms_n", "phase_deg")
-
-
 #: Highest plausible order level [m/s RMS]: above 1 km/s it is a unit or export error.
 MAX_LEVEL_M_PER_S = 1e3
 #: Highest plausible engine speed [rpm].
@@ -91,14 +85,11 @@ class MeasuredRunup:
     comments : list of str
         Comment lines of the file (without the leading ``#``).
     signal : str
-        ``velocity`` (levels in m/s, also for converted acceleration and displacement
-        curves) or ``mount_force`` (force curves, levels in N).
+        ``velocity`` (levels in m/s) or ``mount_force`` (levels in N).
     phases : dict
-        ``(mount, direction, quantity) -> phase [deg]`` aligned with that curve's speeds,
-        NaN where undefined; only order curves with at least one phase given (a
-        ``phase_deg`` column, or a simulated result). The order-k component is
-        √2·RMS·cos(kθ + φ), θ the crank angle from cylinder-1 firing TDC
-        (:mod:`powertrain.analysis.phase`).
+        ``(mount, direction, quantity) -> phase [deg]`` at that curve's speeds (NaN where
+        undefined), order curves with a phase only. Order k is √2·RMS·cos(kθ + φ), θ the
+        crank angle from cylinder-1 firing TDC (:mod:`powertrain.analysis.phase`).
     """
 
     curves: dict
@@ -111,11 +102,7 @@ class MeasuredRunup:
     @property
     def channels(self) -> list:
         """(mount, direction) pairs present, in order of first appearance."""
-        seen = []
-        for m, d, _ in self.curves:
-            if (m, d) not in seen:
-                seen.append((m, d))
-        return seen
+        return list(dict.fromkeys((m, d) for m, d, _ in self.curves))
 
     @property
     def quantities(self) -> list:
@@ -139,10 +126,8 @@ class MeasuredRunup:
 
     @classmethod
     def from_result(cls, result, source: str = "", signal: str = "velocity") -> MeasuredRunup:
-        """RMS curves (synthesis and every order) of a
-        :class:`~powertrain.results.runup.RunupResult`: velocity, or ``mount_force``; the
-        phases of its complex amplitudes (the simulation's crank angle is counted from
-        cylinder-1 firing TDC)."""
+        """RMS curves and phases of a :class:`~powertrain.results.runup.RunupResult`'s
+        ``signal`` (``velocity`` or ``mount_force``), synthesis and every order."""
         rpm = np.asarray(result.rpm, float)
         order_idx = np.argsort(rpm)
         rms = result.order_rms(signal)[order_idx]
@@ -190,8 +175,7 @@ def read_measured(path, mounts=None, points=None) -> MeasuredRunup:
 
 
 def _names(names, key):
-    """``mounts`` or ``points`` of :func:`read_measured` as a list of str (one str: that
-    name), None as it is."""
+    """``mounts`` or ``points`` of :func:`read_measured` as a list of str (None stays)."""
     if names is None:
         return None
     items = [names] if isinstance(names, str) else names
@@ -234,7 +218,7 @@ def _read_hdf5(path, mounts):
 
 
 def _is_point(result, name) -> bool:
-    """True if ``name`` is a body point of interest of a result (meta ``points``)."""
+    """True if ``name`` is a body point of a result (meta ``points``)."""
     return name in result.meta.get("points", [])
 
 
@@ -305,9 +289,8 @@ def _csv_layout(header, path, lineno) -> _Layout:
 
 
 def _csv_row(fields, layout, path, lineno, mounts, points):
-    """``(node, direction, quantity, rpm, level, phase)`` of a data row (level in the
-    column's unit, phase [deg] or NaN), or None for a row not modelled (quantity
-    ``overall``)."""
+    """``(node, direction, quantity, rpm, level, phase)`` of a data row (level in the column's
+    unit, phase [deg] or NaN); None for an ``overall`` row."""
     col, level_col = layout.col, layout.level_col
     side = fields[col["side"]].lower() if "side" in col else "active"
     if side not in SIDES:
@@ -350,8 +333,7 @@ def _row_phase(fields, col, quantity, path, lineno) -> float:
 
 
 def _csv_node(mount, side, path, lineno, mounts, points) -> str:
-    """Node of a row's ``mount`` and ``side``: ``left``, ``left/passive`` (body side of a
-    mount) or a body point of interest."""
+    """Node of a row: ``left``, ``left/passive`` (body side of a mount) or a body point."""
     if side == "passive" and mount and (mounts is None or mount in mounts):
         return passive_name(mount)                    # body side of that mount
     if side == "passive" and mount and (points is None or mount in points):
@@ -383,9 +365,7 @@ def _measured_runup(rows, order, layout, path, comments) -> MeasuredRunup:
         phase = np.array([rows[key][r][2] for r in speeds])
         if np.any(np.isfinite(phase)):
             phases[key] = phase
-    notes = []
-    signal = "velocity"
-    level_col = layout.level_col
+    notes, signal, level_col = [], "velocity", layout.level_col
     kind = level_col.split("_", 1)[0]
     if kind in ("acceleration", "displacement"):
         curves = to_velocity(curves, kind, notes)
@@ -405,8 +385,7 @@ def to_velocity(curves, kind, notes):
     r"""Convert acceleration or displacement order curves to velocity, order by order.
 
     :math:`v_o = a_o/\omega_o` or :math:`v_o = \omega_o x_o`, :math:`\omega_o = 2\pi o n/60`;
-    each channel's synthesis is recomputed as the RMS sum of its converted orders at the
-    speeds where every order of the channel is present (elsewhere it is dropped).
+    a channel's synthesis becomes the RMS sum of its converted orders where all are present.
     """
     out, dropped = {}, []
     channels = {(m, d) for m, d, _ in curves}
@@ -428,9 +407,8 @@ def to_velocity(curves, kind, notes):
                 rpm, level = out[(m, d, q)]
                 total += np.interp(speeds, rpm, level) ** 2
             out[(m, d, "synthesis")] = (speeds, np.sqrt(total))
-    notes.append(f"{kind} order curves converted to velocity order by order (divided by "
-                 "omega_o)" if kind == "acceleration" else
-                 f"{kind} order curves converted to velocity order by order (times omega_o)")
+    how = "divided by omega_o" if kind == "acceleration" else "times omega_o"
+    notes.append(f"{kind} order curves converted to velocity order by order ({how})")
     notes.append("synthesis recomputed as the RMS sum of the converted orders")
     if dropped:
         notes.append("synthesis dropped (no order curves to convert): " + ", ".join(dropped))

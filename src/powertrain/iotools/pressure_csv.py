@@ -1,9 +1,6 @@
-"""Measured cylinder-pressure traces (``[combustion] model = "measured"``): a CSV with units.
-
-Format (``speed [rpm],cylinder,crank_angle [deg],pressure [bar]``, each trace one 720° cycle,
-gaps at most :data:`MAX_GAP_DEG`): docs/reference/csv-formats.md. Traces are resampled onto a
-common grid of cycle angles on [-π, 3π) by periodic linear interpolation. Errors name the
-file, line and column.
+"""Measured cylinder-pressure traces (``[combustion] model = "measured"``): a CSV with units
+(docs/reference/csv-formats.md), each trace one 720° cycle resampled by periodic linear
+interpolation onto a common grid on [-π, 3π). Errors name the file, line and column.
 """
 
 from __future__ import annotations
@@ -114,8 +111,7 @@ def _check_ranges(speed, pressure, line_no, path) -> None:
 
 
 def _check_trace(a, ln, c, w, path) -> None:
-    """One cylinder's trace at speed ``w``: angles ``a`` [rad] increasing, within one cycle,
-    no gap over :data:`MAX_GAP_DEG`; ``ln`` the file lines."""
+    """Trace angles ``a`` [rad] increasing within one cycle, gaps <= :data:`MAX_GAP_DEG`."""
     bad = np.nonzero(np.diff(a) <= 0)[0]
     if bad.size:
         raise InputError("crank angles must increase within a trace", file=path,

@@ -31,10 +31,8 @@ def _unit(ds):
 
 
 def read_hdf5_signals(path, channel_map=None, *, map_option="--channels", extra=()) -> FileSignals:
-    """Signals of a raw HDF5 file (docs/reference/raw-data.md); ``map_option`` is the
-    option named in the hint of a file that needs a channel map; ``extra``: names of more
-    datasets read where the file has them (a trigger or cycle reference named by an
-    option)."""
+    """Signals of a raw HDF5 file (docs/reference/raw-data.md): ``map_option`` is named in the
+    hint when a channel map is needed; ``extra`` names more datasets read if present."""
     import h5py  # deferred: heavy package, loaded only when this format is used
     try:
         h5 = h5py.File(path, "r")
@@ -43,8 +41,7 @@ def read_hdf5_signals(path, channel_map=None, *, map_option="--channels", extra=
     with h5:
         try:
             return _read(h5, path, channel_map, map_option, tuple(n for n in extra if n))
-        except (KeyError, OSError, RuntimeError, TypeError) as exc:
-            # h5py's errors for broken links and unreadable objects
+        except (KeyError, OSError, RuntimeError, TypeError) as exc:   # broken links, unreadable objects
             raise InputError(f"unreadable HDF5 object ({str(exc)[:80]})", file=path) from None
 
 
@@ -142,7 +139,7 @@ def _read_own(h5, path, extra=()):
 
 
 def _own_time(h5, name, path, times, budget):
-    """Record the own time base [s] of dataset ``name`` if its ``time`` attribute names one."""
+    """Record the own time base [s] of dataset ``name`` its ``time`` attribute names, if any."""
     ref = h5[name].attrs.get("time")
     if ref is None:
         return
@@ -166,10 +163,9 @@ def _read_mapped(h5, path, cmap, extra=()):
 
 
 def write_raw_hdf5(path, recording, *, description: str = "", synthetic: bool = False) -> None:
-    """Write a :class:`RawRecording` in the ``powertrain-raw`` layout (docs/reference/raw-data.md;
-    values in each channel's unit)."""
+    """Write a :class:`RawRecording` in the ``powertrain-raw`` layout, values in each channel's
+    unit."""
     import h5py  # deferred: heavy package, loaded only when this format is used
-
     with atomic_path(path) as tmp:
         with h5py.File(tmp, "w") as h5:
             a = h5.attrs

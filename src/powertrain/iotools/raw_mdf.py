@@ -1,10 +1,6 @@
-"""Raw run-up time data in ASAM MDF4 (read and written by asammdf).
-
-Every channel of the file except the masters is a signal (name and unit as stored). The
-vibration channels must share one time base (a test-lab export of one group does); the
-speed or tacho channel may have its own, e.g. CAN engine speed at 100 Hz in its own group,
-and is resampled onto the vibration channels' (:func:`powertrain.iotools.raw.assemble`).
-Names follow the ``MOUNT.DIRECTION`` convention or a channel map.
+"""Raw run-up time data in ASAM MDF4 (asammdf): every channel but the masters is a signal.
+The vibration channels share one time base; a speed or tacho channel may have its own (e.g.
+CAN speed at 100 Hz), resampled by :func:`powertrain.iotools.raw.assemble`.
 """
 
 from __future__ import annotations
@@ -106,7 +102,6 @@ def _quiet_collect():
 def write_raw_mdf(path, recording) -> None:
     """Write a :class:`RawRecording` as MDF 4.10, one group, one channel per signal."""
     from asammdf import MDF, Signal  # deferred: heavy package, loaded only when this format is used
-
     t = np.asarray(recording.time, float)
     sigs = [Signal(np.asarray(values, float), t, name=name, unit=unit)
             for name, values, unit, _ in written_signals(recording, cycle=False)]

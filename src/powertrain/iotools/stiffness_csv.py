@@ -25,17 +25,8 @@ ABS, PHASE = "k_abs_n_per_mm", "phase_deg"
 
 @dataclass(frozen=True)
 class MeasuredStiffness:
-    """A measured cross-point dynamic stiffness curve.
-
-    Attributes
-    ----------
-    frequency_hz : ndarray
-        [Hz], strictly increasing.
-    kcp : ndarray of complex
-        Cross-point dynamic stiffness [N/m].
-    source : str
-        File it was read from.
-    """
+    """A measured cross-point dynamic stiffness curve: ``frequency_hz`` [Hz], strictly
+    increasing; ``kcp`` the complex stiffness [N/m]; ``source`` the file read."""
 
     frequency_hz: np.ndarray
     kcp: np.ndarray
@@ -73,8 +64,7 @@ LIMITS = {FREQUENCY: 1e5, REAL: 1e9, IMAG: 1e9, ABS: 1e9, PHASE: 360.0, AMPLITUD
 
 
 def _open_rows(path):
-    """The data rows (line number, fields) of a CSV file, and whether a comment line says
-    the data are synthetic."""
+    """The data rows (line number, fields) and whether a comment says "synthetic"."""
     text = read_text(path, "CSV")
     rows, synthetic = [], False
     try:
@@ -107,9 +97,7 @@ def read_stiffness_csv(path) -> MeasuredStiffness:
     Raises
     ------
     InputError
-        Unreadable file, missing or duplicated column, wrong number of fields, a value that
-        is not a finite number, negative frequency or magnitude, frequencies not strictly
-        increasing, no data rows.
+        Naming file, column and line of the first problem.
     """
     path = str(path)
     rows, synthetic = _open_rows(path)
@@ -119,9 +107,7 @@ def read_stiffness_csv(path) -> MeasuredStiffness:
     pair, polar = _columns(header, header_line, path)
     amp = [AMPLITUDE] if AMPLITUDE in header else []
     data = _values(rows[1:], header, [*amp, FREQUENCY, *pair], path)
-    f = np.array(data[FREQUENCY])
-    a = np.array(data[pair[0]])
-    b = np.array(data[pair[1]])
+    f, a, b = (np.array(data[name]) for name in (FREQUENCY, *pair))
     if polar:
         mag = to_si(a, "N/mm", "stiffness")
         kcp = mag * np.exp(1j * to_si(b, "deg", "angle"))
@@ -132,8 +118,7 @@ def read_stiffness_csv(path) -> MeasuredStiffness:
 
 
 def _columns(header, header_line, path):
-    """``(pair, polar)``: the two stiffness columns of the header and whether they are
-    magnitude and phase."""
+    """``(pair, polar)``: the two stiffness columns and whether they are magnitude, phase."""
     seen = set()
     for name in header:
         if name in seen:
@@ -180,8 +165,7 @@ def _values(rows, header, cols, path) -> dict:
 
 
 class _Blocks:
-    """The frequency order of a table: strictly increasing within each amplitude block,
-    each amplitude (> 0) one block (one block without an amplitude column)."""
+    """Frequencies strictly increasing within each block of one amplitude (> 0)."""
 
     def __init__(self, path):
         self.path, self.seen, self.last = path, [], None
