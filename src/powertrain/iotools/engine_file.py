@@ -1,9 +1,7 @@
 """Engine files (``engines/*.toml``) into an :class:`~powertrain.models.engine.Engine` in SI.
 
-Layout, keys and units: docs/reference/engine-file.md (``engines/default.toml`` is a complete,
-commented example). Every quantity is ``key = {value = ..., unit = "..."}``, converted to SI
-here once through :mod:`powertrain.units`; every problem is an
-:class:`~powertrain.errors.InputError` naming the file and the key.
+Layout: docs/reference/engine-file.md. Every quantity is ``key = {value = ..., unit = "..."}``;
+every problem is an :class:`~powertrain.errors.InputError` naming the file and the key.
 """
 
 from __future__ import annotations
@@ -46,8 +44,7 @@ MIN_MOUNTS = 3
 DIRECTIONS = ("x", "y", "z")
 
 _ALLOWED = {
-    "": {"engine", "crank_train", "body", "mounts", "balancer", "combustion", "chassis",
-         "drive"},
+    "": {"engine", "crank_train", "body", "mounts", "balancer", "combustion", "chassis", "drive"},
     "drive": {"gear_ratio"},
     "chassis": {"model", "modes", "points", "frf"},
     "chassis_mode": {"frequency", "damping_ratio", "modal_mass", "shape"},
@@ -58,17 +55,15 @@ _ALLOWED = {
                     "crank_pin_angles", "firing_order", "reciprocating_mass", "rotating_mass",
                     "counterweight_fraction", "crankcase_pressure"},
     "body": {"mass", "cg", "inertia"},
-    "mount": {"position", "local_x", "local_z", "orientation", "files", "stiffness",
-              "damping"},
+    "mount": {"position", "local_x", "local_z", "orientation", "files", "stiffness", "damping"},
     "balancer": {"enabled", "speed_ratio", "shafts"},
     "shaft": {"name", "mass_radius", "position", "phase", "sense"},
 }
 
 
 def engine_or_default(engine=None) -> em.Engine:
-    """``engine`` as an :class:`~powertrain.models.engine.Engine`: one given stays as it is,
-    a path is read (:func:`read_engine`), None reads the shipped default engine; anything
-    else is an :class:`~powertrain.errors.InputError` naming ``--engine``."""
+    """``engine`` as an :class:`~powertrain.models.engine.Engine`: an Engine as it is, a path
+    read (:func:`read_engine`), None the shipped default engine."""
     if engine is None or isinstance(engine, (str, os.PathLike)):
         return read_engine(DEFAULT_ENGINE_PATH if engine is None else engine)
     if not isinstance(engine, em.Engine):
@@ -104,15 +99,12 @@ def read_engine(path=DEFAULT_ENGINE_PATH) -> em.Engine:
         if crank is None:
             raise InputError("[combustion] needs a [crank_train] section", file=path, key="crank_train")
         combustion = read_combustion(subtable(doc, "combustion", path), path, crank)
-    balancer = Balancer(enabled=False, ratio=2.0, shafts=())
-    if "balancer" in doc:
-        balancer = _read_balancer(subtable(doc, "balancer", path), path)
-    chassis = None
-    if "chassis" in doc:
-        chassis = _read_chassis(subtable(doc, "chassis", path), path, [m.name for m in mounts])
-    gear_ratio = _read_drive(doc, path)
+    balancer = (_read_balancer(subtable(doc, "balancer", path), path) if "balancer" in doc
+                else Balancer(enabled=False, ratio=2.0, shafts=()))
+    chassis = (_read_chassis(subtable(doc, "chassis", path), path, [m.name for m in mounts])
+               if "chassis" in doc else None)
     engine = em.Engine(name=name, crank=crank, body=body, mounts=mounts, balancer=balancer,
-                       combustion=combustion, file=path, chassis=chassis, gear_ratio=gear_ratio)
+                       combustion=combustion, file=path, chassis=chassis, gear_ratio=_read_drive(doc, path))
     check_engine(engine, path)
     return engine
 
@@ -222,20 +214,16 @@ def _read_crank(t, path) -> CrankTrain:
     m_rot = scalar_quantity(t, "rotating_mass", "mass", path, p, nonneg=True)
     cw = scalar_quantity(t, "counterweight_fraction", "dimensionless", path, p, nonneg=True)
     pcc = scalar_quantity(t, "crankcase_pressure", "pressure", path, p, nonneg=True)
-    return CrankTrain(bore=bore, stroke=stroke, rod_length=rod, pin_offset=offset,
-                         compression_ratio=eps, cylinder_x=xs, cylinder_axis=axis,
-                         rotation_sign=1 if rot == "+X" else -1, crank_pin_angles=pins,
-                         firing_order=order, firing_angles=firing, reciprocating_mass=m_rec,
-                         rotating_mass=m_rot, counterweight_fraction=cw, crankcase_pressure=pcc)
+    return CrankTrain(bore=bore, stroke=stroke, rod_length=rod, pin_offset=offset, compression_ratio=eps,
+                      cylinder_x=xs, cylinder_axis=axis, rotation_sign=1 if rot == "+X" else -1,
+                      crank_pin_angles=pins, firing_order=order, firing_angles=firing,
+                      reciprocating_mass=m_rec, rotating_mass=m_rot, counterweight_fraction=cw,
+                      crankcase_pressure=pcc)
 
 
 def _firing_angles(pins, order, path, key):
-    """Cylinder-1 crank angle of each cylinder's firing TDC on [0, 4π) (``pins`` re
-    cylinder 1).
-
-    Walk the firing order from cylinder 1 (fired at 0): each next cylinder fires at the first
-    of its TDC angles (``pin + 2πk``) after the previous firing.
-    """
+    """Cylinder-1 crank angle of each cylinder's firing TDC on [0, 4π): along the firing order
+    from cylinder 1 (at 0), each fires at its first TDC (``pin + 2πk``) after the previous."""
     two_pi = 2.0 * np.pi
     pins = np.mod(pins, two_pi)
     firing = np.zeros(len(pins))

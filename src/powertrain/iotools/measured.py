@@ -49,13 +49,7 @@ def _check_level(level_si: float, path, line, key) -> None:
 
 
 def normalise_quantity(text: str) -> str:
-    """``synthesis`` or ``order_<n>`` with n > 0 written without trailing zeros.
-
-    Raises
-    ------
-    ValueError
-        If ``text`` is neither.
-    """
+    """``synthesis`` or ``order_<n>`` with n > 0 written without trailing zeros (else ValueError)."""
     text = text.strip()
     if text == "synthesis":
         return text
@@ -120,9 +114,8 @@ class MeasuredRunup:
 
     def rpm_range(self):
         """Lowest and highest speed of all curves [rpm]."""
-        lo = min(float(r[0]) for r, _ in self.curves.values())
-        hi = max(float(r[-1]) for r, _ in self.curves.values())
-        return lo, hi
+        return (min(float(r[0]) for r, _ in self.curves.values()),
+                max(float(r[-1]) for r, _ in self.curves.values()))
 
     @classmethod
     def from_result(cls, result, source: str = "", signal: str = "velocity") -> MeasuredRunup:

@@ -1,9 +1,6 @@
-"""Mount files (``mounts/*.toml``, datasheet units) into a
-:class:`~powertrain.models.mount.MountModel` in SI, and back (:func:`write_mount`).
-
-Layout, the optional ``[amplitude]``, ``[friction]`` and ``[static]`` sections and the checks:
-docs/reference/mount-file.md. The sections become :mod:`powertrain.physics.mount_laws`
-objects; every problem is an :class:`~powertrain.errors.InputError` naming file and key.
+"""Mount files (``mounts/*.toml``, datasheet units; docs/reference/mount-file.md) into a
+:class:`~powertrain.models.mount.MountModel` in SI and back (:func:`write_mount`); the optional
+``[amplitude]``, ``[friction]``, ``[static]`` sections become :mod:`powertrain.physics.mount_laws`.
 """
 
 from __future__ import annotations
@@ -70,8 +67,7 @@ def read_mount(path) -> MountModel:
 
 
 def check_plausible(model: MountModel, path) -> None:
-    """Refuse a parameter above :data:`MAX_SI` or not finite, as a mount file's (a value
-    set or scaled from the command line: ``whatif --set``, ``--scale``)."""
+    """Refuse a parameter above :data:`MAX_SI` or not finite (one set from the command line)."""
     for p, value in model.params.items():
         top = MAX_SI[p[0]]
         if not value <= top:
@@ -81,16 +77,8 @@ def check_plausible(model: MountModel, path) -> None:
 
 
 def check_network(model: MountModel, path) -> None:
-    """Refuse a network that is singular at 0 Hz: an internal node held by no spring to
-    the engine side or the ground (e.g. every spring and damper 0), so that its static
-    deflection is undetermined. Every solver condenses the network at 0 Hz (static
-    stiffness, rigid-body modes), where it would fail.
-
-    Raises
-    ------
-    InputError
-        Naming ``path``, key ``parameters``, and the loose internal masses.
-    """
+    """Refuse a network singular at 0 Hz (an internal node held by no spring to the engine
+    side or the ground), where every solver condenses it; the error names the loose nodes."""
     try:
         with np.errstate(all="ignore"):
             model.static_stiffness()
@@ -105,8 +93,7 @@ def check_network(model: MountModel, path) -> None:
 
 
 def _loose_nodes(model: MountModel) -> list:
-    """Labels of the internal nodes (their mass parameter, or ``node k``) joined to
-    neither the engine side nor the ground by a chain of nonzero springs."""
+    """Labels of the internal nodes joined to neither engine side nor ground by nonzero springs."""
     topo = model.topology
     held = {"E", "G"}
     springs = [(a, b) for a, b, c, _ in topo.elements if c and model.params[c] > 0]
@@ -121,8 +108,7 @@ def _loose_nodes(model: MountModel) -> list:
 
 
 class _Units:
-    """The ``[units]`` table of one file: converts a section's numbers to SI, naming
-    ``units.x`` / ``units.F`` when the unit a section needs is missing or wrong."""
+    """The ``[units]`` table of one file: a section's numbers to SI (errors name ``units.x``)."""
 
     def __init__(self, units: dict, path: str):
         self.units, self.path = units, path
@@ -134,8 +120,7 @@ class _Units:
 
 def _numbers(t: dict, key: str, path: str, prefix: str, *, positive=False, nonneg=False,
              increasing=False) -> np.ndarray:
-    """A non-empty list of finite numbers ``t[key]`` (optionally > 0 and strictly
-    increasing)."""
+    """A non-empty list of finite numbers ``t[key]`` (optionally > 0, strictly increasing)."""
     raw = get(t, key, path, prefix, types=list)
     full = f"{prefix}.{key}"
     if not raw:
@@ -193,8 +178,7 @@ def _read_friction(t: dict, units: _Units) -> BergFriction:
 
 
 def _read_static(t: dict, units: _Units) -> StaticCurve:
-    """``[static]`` -> :class:`StaticCurve` (SI), increasing with a positive tangent at the
-    reference deflection and a positive slope beyond its end points."""
+    """``[static]`` -> :class:`StaticCurve` (SI), increasing, with positive tangents."""
     path = units.path
     _no_unknown_keys(t, {"deflection", "force", "reference_deflection"}, path, "static")
     x = _numbers(t, "deflection", path, "static", increasing=True)
@@ -232,9 +216,7 @@ def format_mount(model: MountModel, *, comment: str = "") -> str:
     """The TOML text of a mount file in datasheet units."""
     def q(s):
         return '"' + str(s).replace("\\", "\\\\").replace('"', '\\"') + '"'
-    lines = []
-    for line in comment.splitlines():
-        lines.append(f"# {line}".rstrip())
+    lines = [f"# {line}".rstrip() for line in comment.splitlines()]
     lines += ["[mount]", f"name = {q(model.name or model.topology.description)}",
               f"model = {q(model.topology.name)}"]
     if model.source:
@@ -250,8 +232,7 @@ def format_mount(model: MountModel, *, comment: str = "") -> str:
 
 
 def _section_lines(model: MountModel) -> list:
-    """The ``[amplitude]``, ``[friction]`` and ``[static]`` lines of ``model`` (x in mm,
-    F in N)."""
+    """The ``[amplitude]``, ``[friction]`` and ``[static]`` lines of ``model`` (mm, N)."""
     def x(v):
         return _toml_number(from_si(v, SECTION_UNITS["x"]))
 

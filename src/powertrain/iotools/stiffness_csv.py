@@ -1,9 +1,6 @@
-"""Measured dynamic stiffness tables K*(f) (``fit-mount`` input): CSV in datasheet units.
-
-Columns ``frequency_hz`` and ``k_real_n_per_mm,k_imag_n_per_mm`` or ``k_abs_n_per_mm,
-phase_deg``, optionally ``amplitude_mm`` first (one block of rows per test amplitude, Kovarik
-2016 Fig. 14): docs/reference/csv-formats.md. Converted to SI here; every problem is an
-:class:`~powertrain.errors.InputError` naming the file, the column and (for values) the line.
+"""Measured dynamic stiffness tables K*(f) (``fit-mount`` input, docs/reference/csv-formats.md):
+CSV in datasheet units into SI, optionally one block of rows per test amplitude (Kovarik 2016
+Fig. 14).
 """
 
 from __future__ import annotations

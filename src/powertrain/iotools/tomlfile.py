@@ -42,9 +42,7 @@ def get(table: dict, key: str, path, prefix: str = "", *, default=..., types=Non
 
 
 def _type_name(types):
-    if isinstance(types, tuple):
-        return " or ".join(t.__name__ for t in types)
-    return types.__name__
+    return " or ".join(t.__name__ for t in types) if isinstance(types, tuple) else types.__name__
 
 
 def number(value, path, key, *, nonneg=False, positive=False) -> float:
@@ -63,22 +61,18 @@ def number(value, path, key, *, nonneg=False, positive=False) -> float:
 
 def quantity(table: dict, key: str, dimension: str, path, prefix: str = "", *,
              default=..., nonneg=False, positive=False):
-    """Read ``key = {value = ..., unit = "..."}`` (or ``[value, "unit"]``) and convert to SI.
-
-    Every physical quantity in engine files declares its unit this way.
-    """
+    """Read ``key = {value = ..., unit = "..."}`` and convert to SI (a list value: a list)."""
     full = f"{prefix}.{key}" if prefix else key
     raw = get(table, key, path, prefix, default=default)
     if raw is default and default is not ...:
         return default
-    if isinstance(raw, dict):
-        if "value" not in raw:
-            raise InputError("missing key", file=path, key=f"{full}.value")
-        if "unit" not in raw:
-            raise InputError("missing unit", file=path, key=f"{full}.unit")
-        value, unit = raw["value"], raw["unit"]
-    else:
+    if not isinstance(raw, dict):
         raise InputError("expected {value = ..., unit = \"...\"}", file=path, key=full)
+    if "value" not in raw:
+        raise InputError("missing key", file=path, key=f"{full}.value")
+    if "unit" not in raw:
+        raise InputError("missing unit", file=path, key=f"{full}.unit")
+    value, unit = raw["value"], raw["unit"]
     if isinstance(value, list):
         vals = [number(v, path, f"{full}.value", nonneg=nonneg, positive=positive) for v in value]
         return [to_si(v, unit, dimension, file=path, key=f"{full}.unit") for v in vals]
