@@ -53,7 +53,7 @@ def _library_names() -> str:
 
 def _truth_names() -> str:
     old = ", ".join(f"{a} (= {n})" for a, n in TRUTH_ALIASES.items())
-    return (f"Known: {', '.join(TRUTH_EFFECTS)}; or 'none'. Former names still accepted: {old}.")
+    return f"Known: {', '.join(TRUTH_EFFECTS)}; or 'none'. Former names still accepted: {old}."
 
 
 @main.command()
@@ -110,7 +110,7 @@ def diagnose(measured, plan_file, engine_file, report_dir, json_file, noise_floo
     _check_report(report_dir)
     with activity("diagnose (fitting the effect library)", enabled=not quiet):
         res = run_diagnosis(measured, engine_file, noise_floor=noise_floor, effects=names,
-                  pairs=not no_pairs, scheduler=scheduler, progress=False)
+                            pairs=not no_pairs, scheduler=scheduler, progress=False)
     say(res.to_text(), quiet)
     if json_file:
         _write_json(res, json_file, engine_file)

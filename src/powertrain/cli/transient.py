@@ -120,8 +120,9 @@ def _say(result, comparison, written, quiet) -> None:
     say(result.to_text(), quiet)
     if comparison is not None:
         say(comparison.to_text(), quiet)
-    say(f"solver time: {result.solver_seconds:.3f} s; " + (wrote(*written) if written
-           else "no file written (ask with --out, --csv, --json or --plot)"), quiet)
+    say(f"solver time: {result.solver_seconds:.3f} s; "
+        + (wrote(*written) if written else "no file written (ask with --out, --csv, --json or --plot)"),
+        quiet)
 
 
 def _check_options(files, raw_file, speed_from, reading, speed_average) -> None:

@@ -97,6 +97,6 @@ def _check_single_zone(c: SingleZoneCombustion, path) -> None:
             ("valve_overlap", c.valve_overlap < math.pi / 2, "must be below 90 deg"),
             ("intake_pressure_max", c.intake_pressure_max >= c.intake_pressure_min,
              "must not be below intake_pressure_min"),
-            ("indicated_efficiency", c.indicated_efficiency < 1, "must be below 1"),):
+            ("indicated_efficiency", c.indicated_efficiency < 1, "must be below 1")):
         if not ok:
             raise InputError(why, file=path, key=f"{P}.{key}")
