@@ -70,14 +70,9 @@ class MeasuredRunup:
     Attributes
     ----------
     curves : dict
-        ``(mount, direction, quantity) -> (rpm [rpm], level [m/s RMS])``, each a 1-D array,
-        speeds strictly increasing.
-    source : str
-        File read.
-    notes : list of str
-        Conversions applied (e.g. peak to RMS).
-    comments : list of str
-        Comment lines of the file (without the leading ``#``).
+        ``(mount, direction, quantity) -> (rpm [rpm], level [m/s RMS])``, speeds increasing.
+    source, notes, comments : str, list of str, list of str
+        File read, conversions applied, the file's comment lines (without ``#``).
     signal : str
         ``velocity`` (levels in m/s) or ``mount_force`` (levels in N).
     phases : dict
@@ -152,12 +147,7 @@ def read_measured(path, mounts=None, points=None) -> MeasuredRunup:
     Returns
     -------
     MeasuredRunup
-        Levels in m/s RMS.
-
-    Raises
-    ------
-    InputError
-        One line naming file, line and column.
+        Levels in m/s RMS (:class:`InputError` naming file, line and column on a problem).
     """
     check_regular_file(path)
     path = str(path)

@@ -1,11 +1,8 @@
-r"""Measured body receptances for ``[chassis] model = "frf"``: CSV or UFF 58.
-
-CSV columns ``frequency_hz,response,excitation,receptance_real_m_per_n,
-receptance_imag_m_per_n`` with ``response``/``excitation`` = ``NAME.DIR`` (a mount's body-side
-point or a body point); UFF 58: one receptance FRF (function type 4, m/N) per pair, the point
-named by ``rsp_ent_name``/``ref_ent_name``, directions 1/2/3 = x/y/z (negative = reversed).
-Needed: every pair of attachment-point directions (reciprocity fills H_ab from H_ba) and each
-body point's response to them, on one frequency grid (docs/guide/chassis.md).
+r"""Measured body receptances for ``[chassis] model = "frf"`` (docs/guide/chassis.md): a CSV of
+:data:`COLUMNS` with ``response``/``excitation`` = ``NAME.DIR``, or UFF 58 (function type 4,
+m/N; points ``rsp_ent_name``/``ref_ent_name``, directions 1/2/3 = x/y/z, negative reversed).
+Needed on one grid: every pair of mount directions (reciprocity fills H_ab from H_ba) and each
+body point's response to them.
 """
 
 from __future__ import annotations
@@ -41,8 +38,8 @@ def _channel(text, names, path, line, column):
 
 
 def read_receptance(path, mounts, points, defined_in="") -> MeasuredReceptance:
-    """Read a receptance file (``.uff``/``.unv`` as UFF 58, else CSV) and check coverage.
-    ``defined_in``: the engine file that names the mounts and points (for messages)."""
+    """Read a receptance file (``.uff``/``.unv`` as UFF 58, else CSV) and check coverage
+    (``defined_in``: the engine file naming the mounts and points, for messages)."""
     path = str(path)
     names = _Names(list(mounts) + list(points), defined_in)
     if path.lower().endswith((".uff", ".unv")):
