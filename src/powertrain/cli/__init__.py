@@ -1,7 +1,5 @@
-"""Command line: ``powertrain <command>``. Thin: parses, calls the library, prints.
-
-Each command lives in its own module.
-Exit codes: 0 success, 1 bad input (one line on stderr naming file and key), 2 usage error.
+"""Command line ``powertrain <command>``, one module per command: parses, calls the library,
+prints. Exit codes: 0 success, 1 bad input (one line on stderr naming file and key), 2 usage.
 """
 
 from __future__ import annotations

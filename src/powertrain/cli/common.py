@@ -39,9 +39,8 @@ QUIET_HELP = "Print nothing but errors (on stderr): no progress, no table, no wa
 
 
 def _silence_warnings(ctx, param, quiet):
-    """While the command runs: with ``--quiet`` Python warnings are ignored; without it the
-    package's own (:class:`~powertrain.errors.PowertrainWarning`) print as one line
-    ``warning: ...``, any other as Python prints it."""
+    """While the command runs: ``--quiet`` ignores warnings; else the package's own print as
+    one line ``warning: ...``."""
     ctx.with_resource(warnings.catch_warnings())
     if quiet:
         warnings.simplefilter("ignore")
@@ -63,8 +62,7 @@ def _one_line(default):
 
 def quiet_option(func):
     """The ``--quiet`` flag of every command (:data:`QUIET_HELP`)."""
-    return click.option("--quiet", is_flag=True, help=QUIET_HELP,
-                        callback=_silence_warnings)(func)
+    return click.option("--quiet", is_flag=True, help=QUIET_HELP, callback=_silence_warnings)(func)
 
 
 def say(text: str, quiet: bool, **kwargs) -> None:
@@ -79,8 +77,8 @@ def wrote(*paths) -> str:
 
 
 def check_outputs(**targets) -> None:
-    """Refuse, before any work, output paths that cannot be written (``--name=path``) and
-    two options naming the same file (the second would overwrite the first)."""
+    """Refuse, before any work, unwritable output paths (``--name=path``) and two options naming
+    the same file."""
     seen = {}
     for name, path in targets.items():
         if path:
@@ -88,13 +86,11 @@ def check_outputs(**targets) -> None:
             check_writable(path, key=key)
             same = seen.setdefault(Path(path).resolve(), key)
             if same != key:
-                raise InputError(f"{path} is also the {same} file (one file per output)",
-                                 key=key)
+                raise InputError(f"{path} is also the {same} file (one file per output)", key=key)
 
 
 def write_json(path, text: str, provenance: dict, key: str = "--json") -> None:
-    """Write a result's JSON ``text`` with a ``provenance`` key added, atomically; a result
-    with a non-finite number is refused (no NaN in an output file)."""
+    """Write a result's JSON ``text`` with a ``provenance`` key added, atomically (NaN refused)."""
     doc = json.loads(text)
     doc["provenance"] = provenance
     json_text(doc, path, key=key)
@@ -102,15 +98,13 @@ def write_json(path, text: str, provenance: dict, key: str = "--json") -> None:
 
 # ------------------------------------------------------------------ figures
 def use_agg() -> None:
-    """Select matplotlib's file-only Agg backend: the CLI draws no windows. Only the CLI
-    does this; the library never switches the backend."""
+    """Select matplotlib's file-only Agg backend (the CLI only; the library never switches it)."""
     import matplotlib  # deferred: heavy package, loaded only when a figure is drawn
     matplotlib.use("Agg")
 
 
 def cli_provenance(engine: str = ""):
-    """:class:`~powertrain.provenance.Provenance` of this command: the command line as given,
-    ``engine`` (what ran), version and time."""
+    """:class:`~powertrain.provenance.Provenance` of this command line and ``engine`` (what ran)."""
     return Provenance.now(command=command_line(), engine=engine)
 
 
@@ -130,9 +124,8 @@ def engine_description(engine, path, *, no_balancers=False, effects=()) -> str:
 
 
 def write_plot(draw, path) -> list:
-    """Draw a figure with ``draw(path)`` (a result's ``plot``) under the Agg backend, then
-    release it; returns the files written: ``path``, and the further pages of a figure
-    drawn on several (its ``pages``)."""
+    """Draw a figure with ``draw(path)`` under the Agg backend and release it; returns the files
+    written (``path`` and any further ``pages``)."""
     use_agg()
     fig = draw(path)
     close_figure(fig)
@@ -155,9 +148,8 @@ def plot_form_options(func):
 
 @contextlib.contextmanager
 def terminate_as_exit():
-    """Turn SIGTERM (``kill PID``) into ``SystemExit(143)`` while a command runs, so that its
-    staged outputs and temporary files are removed as on any other failure (main thread
-    only; other signals keep their handlers)."""
+    """Turn SIGTERM into ``SystemExit(143)`` while a command runs (main thread only), so that
+    its staged outputs are removed as on any other failure."""
     if threading.current_thread() is not threading.main_thread():
         yield
         return

@@ -44,8 +44,7 @@ from powertrain.workflows.comparison import compare as run_compare
                    "and interpolate it to the measured speeds. Default: simulate at every "
                    "measured speed (within the engine's range), no interpolation.")
 @quiet_option
-def compare(measured, sim_file, engine_file, plot, json_file, noise_floor, solver, rpm_step,
-            quiet):
+def compare(measured, sim_file, engine_file, plot, json_file, noise_floor, solver, rpm_step, quiet):
     """Compare a simulated run-up with a measured one.
 
     For each mount, direction and quantity (synthesis, 2nd, 4th and any other measured

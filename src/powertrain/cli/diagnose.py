@@ -53,8 +53,7 @@ def _library_names() -> str:
 
 def _truth_names() -> str:
     old = ", ".join(f"{a} (= {n})" for a, n in TRUTH_ALIASES.items())
-    return (f"Known: {', '.join(TRUTH_EFFECTS)}; or 'none'. Former names still accepted: "
-            f"{old}.")
+    return f"Known: {', '.join(TRUTH_EFFECTS)}; or 'none'. Former names still accepted: {old}."
 
 
 @main.command()
@@ -103,7 +102,6 @@ def diagnose(measured, plan_file, engine_file, report_dir, json_file, noise_floo
       powertrain diagnose case.csv --report out/diag --json out/diag.json
       powertrain diagnose --plan plan.toml --json out/plan.json
     """
-
     measured = _measured_or_plan(measured, plan_file)
     noise_floor = _noise_floor(noise_floor)
     names = [e.strip() for e in effects.split(",") if e.strip()] or None
@@ -112,7 +110,7 @@ def diagnose(measured, plan_file, engine_file, report_dir, json_file, noise_floo
     _check_report(report_dir)
     with activity("diagnose (fitting the effect library)", enabled=not quiet):
         res = run_diagnosis(measured, engine_file, noise_floor=noise_floor, effects=names,
-                  pairs=not no_pairs, scheduler=scheduler, progress=False)
+                            pairs=not no_pairs, scheduler=scheduler, progress=False)
     say(res.to_text(), quiet)
     if json_file:
         _write_json(res, json_file, engine_file)
@@ -124,16 +122,14 @@ def diagnose(measured, plan_file, engine_file, report_dir, json_file, noise_floo
 
 def _write_report(res, report_dir) -> list:
     use_agg()
-    return res.report(report_dir, provenance=cli_provenance(
-        engine_description(res.engine, res.engine.file)))
+    return res.report(report_dir, provenance=cli_provenance(engine_description(res.engine, res.engine.file)))
 
 
 def _measured_or_plan(measured, plan_file):
     """MEASURED or ``--plan``, exactly one of them."""
     if (measured is None) == (plan_file is None):
         raise InputError("give either a MEASURED file or --plan PLAN.toml (not both)"
-                         if measured else "missing MEASURED file or --plan PLAN.toml",
-                         key="--plan")
+                         if measured else "missing MEASURED file or --plan PLAN.toml", key="--plan")
     if plan_file is not None and not plan_file.lower().endswith(".toml"):
         raise InputError("a plan is a TOML file (PLAN.toml)", file=plan_file, key="--plan")
     return measured or plan_file
@@ -158,14 +154,12 @@ def _write_json(res, json_file, engine_file) -> None:
 
 @main.command()
 @click.option("--effect", "effect_names", default="none", show_default=True,
-              cls=_ListedOption, names=_truth_names,
-              help="Hidden truth effect(s), comma-separated.")
+              cls=_ListedOption, names=_truth_names, help="Hidden truth effect(s), comma-separated.")
 @click.option("--seed", type=int, default=0, show_default=True)
 @click.option("--out", required=True, type=click.Path(dir_okay=False),
               help="CSV written (long format; the hidden effect is not written).")
 @click.option("--truth", "truth_file", type=click.Path(dir_okay=False),
-              help="JSON with the hidden effect and its parameters (keep it away from the "
-                   "diagnosis).")
+              help="JSON with the hidden effect and its parameters (keep it away from the diagnosis).")
 @click.option("--engine", "engine_file", type=click.Path(dir_okay=False),
               help="Baseline engine file (default: engines/default.toml).")
 @quiet_option
@@ -177,7 +171,6 @@ def synth(effect_names, seed, out, truth_file, engine_file, quiet):
       powertrain synth --effect mount_temperature --seed 1 --out m.csv --truth t.json
       powertrain synth --effect none --out clean.csv
     """
-
     names = [] if effect_names.strip() == "none" else [
         e.strip() for e in effect_names.split(",") if e.strip()]
     check_outputs(out=out, truth=truth_file)

@@ -36,7 +36,6 @@ def examples(folder, quiet):
       powertrain examples .
       powertrain examples ~/powertrain-tour && cd ~/powertrain-tour
     """
-
     root = Path(folder)
     if root.exists() and not root.is_dir():
         raise InputError("exists and is not a folder; nothing copied", file=root, key="FOLDER")
@@ -61,5 +60,4 @@ def _check_free(src: Path, dest: Path, error) -> None:
         raise error("exists and is not a file; nothing copied", file=dest, key="FOLDER")
     if dest.exists() and not filecmp.cmp(src, dest, shallow=False):
         raise error("exists and differs from the shipped file; powertrain examples never "
-                    "overwrites (move it or choose another folder); nothing copied",
-                    file=dest, key="FOLDER")
+                    "overwrites (move it or choose another folder); nothing copied", file=dest, key="FOLDER")

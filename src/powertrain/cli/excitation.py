@@ -51,7 +51,6 @@ def excitation(rpm, engine_file, load, no_balancers, step, csv_path, plot, quiet
       powertrain excitation --rpm 3000 --csv out/load-3000.csv --plot out/load-3000.png
       powertrain excitation --rpm 2000 --engine engines/default.toml --no-balancers
     """
-
     check_outputs(csv=csv_path, plot=plot)
     result = run(engine_file, rpm, load=load, balancers=not no_balancers, angle_step_deg=step)
     if csv_path:

@@ -26,8 +26,7 @@ _MODELS = tuple(TOPOLOGIES)
 
 @main.command("fit-mount")
 @click.argument("measured")
-@click.option("--model", default="triple-parallel", show_default=True,
-              metavar="[" + "|".join(_MODELS) + "]",
+@click.option("--model", default="triple-parallel", show_default=True, metavar="[" + "|".join(_MODELS) + "]",
               help="Mount model preset (thesis Table 2).")
 @click.option("--out", required=True, type=click.Path(dir_okay=False),
               help="Fitted mount file to write (TOML, datasheet units).")
@@ -72,13 +71,11 @@ def fit_mount(measured, model, out, plot, form, freq_axis, starts, seed, fmin, f
       powertrain stiffness fitted.toml --freq 5,10,20,50,100,200,400
       powertrain fit-mount multi-amplitude.csv --friction --out fitted.toml
     """
-
     check_outputs(out=out, plot=plot)
     ref = _reference(reference)
     with activity(f"fit-mount ({model}, {starts} starts)", enabled=not quiet):
         result = fit_mount_csv(measured, model, friction=friction, reference=ref,
-                               starts=starts, seed=seed, max_mass=max_mass, fmin=fmin,
-                               fmax=fmax)
+                               starts=starts, seed=seed, max_mass=max_mass, fmin=fmin, fmax=fmax)
     write_mount(result.model, out, comment=result.file_comment())
     _plot(result, plot, form, freq_axis)
     say(result.to_text(), quiet)
@@ -91,8 +88,7 @@ def _plot(result, plot, form, freq_axis) -> None:
     """The measured-vs-fitted figure, when asked."""
     if plot:
         prov = cli_provenance()
-        write_plot(lambda p: result.plot(path=p, form=form, freq_axis=freq_axis,
-                                         provenance=prov), plot)
+        write_plot(lambda p: result.plot(path=p, form=form, freq_axis=freq_axis, provenance=prov), plot)
 
 
 def _reference(reference_mm):

@@ -18,14 +18,13 @@ from powertrain.provenance import recording_command
 COMMANDS = {"compare": "compare", "diagnose": "diagnose", "examples": "examples",
             "excitation": "excitation", "fit-mount": "fit_mount", "modes": "modes",
             "report": "report", "runup": "runup", "static": "static", "stiffness": "stiffness",
-            "synth": "diagnose", "track": "track", "transient": "transient",
-            "whatif": "whatif"}
+            "synth": "diagnose", "track": "track", "transient": "transient", "whatif": "whatif"}
 
 
 class _Group(click.Group):
-    """Runs every command in one :class:`~powertrain.outputs.OutputTransaction`, turns
-    :class:`~powertrain.errors.InputError` into one line on stderr and exit code 1, and
-    loads a command's module only when the command is asked for (:data:`COMMANDS`)."""
+    """Runs every command in one :class:`~powertrain.outputs.OutputTransaction`, an
+    :class:`~powertrain.errors.InputError` as one line on stderr and exit code 1; loads a
+    command's module only when it is asked for (:data:`COMMANDS`)."""
 
     def list_commands(self, ctx):
         return sorted(COMMANDS)

@@ -25,8 +25,7 @@ from powertrain.workflows.modes import modes as solve_modes
 @click.option("--static", is_flag=True,
               help="Static (0 Hz) mount stiffness, undamped (default: each mode with the "
                    "networks' dynamic stiffness at its own frequency, damped).")
-@click.option("--json", "json_file", type=click.Path(dir_okay=False),
-              help="Write the modes as JSON.")
+@click.option("--json", "json_file", type=click.Path(dir_okay=False), help="Write the modes as JSON.")
 @click.option("--plot", type=click.Path(dir_okay=False),
               help="Write the kinetic-energy distribution per mode (PNG).")
 @quiet_option
@@ -41,7 +40,6 @@ def modes(engine_file, static, json_file, plot, quiet):
       powertrain modes --engine engines/default-torque-rod.toml --json modes.json
       powertrain modes --static --plot modes.png
     """
-
     check_outputs(json=json_file, plot=plot)
     engine = engine_or_default(engine_file)
     result = solve_modes(engine, static=static)

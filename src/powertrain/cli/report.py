@@ -31,7 +31,6 @@ def report(study, out, quiet):
       powertrain examples .
       powertrain report examples/study.toml --out report.html
     """
-
     use_agg()
     with activity("report (running the study's steps)", enabled=not quiet):
         res = run_report(study, out)

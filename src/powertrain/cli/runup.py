@@ -26,12 +26,10 @@ from powertrain.workflows.runup import check_path_plot
 @speed_options
 @click.option("--engine", "engine_file", type=click.Path(dir_okay=False),
               help="Engine file (default: the shipped engines/default.toml).")
-@click.option("--solver", type=click.Choice(["newmark", "harmonic"]), default="newmark",
-              show_default=True,
+@click.option("--solver", type=click.Choice(["newmark", "harmonic"]), default="newmark", show_default=True,
               help="newmark: time integration, 6 cycles, last 2 processed; harmonic: "
                    "frequency-domain steady state order by order.")
-@click.option("--stepper", type=click.Choice(["auto", "modal", "dense"]), default="auto",
-              show_default=True,
+@click.option("--stepper", type=click.Choice(["auto", "modal", "dense"]), default="auto", show_default=True,
               help="Newmark implementation: modal (diagonalised recurrence), dense "
                    "(physical coordinates); auto = modal when the mass matrix is regular.")
 @click.option("--angle-step", type=float, default=1.0, show_default=True,
@@ -42,8 +40,7 @@ from powertrain.workflows.runup import check_path_plot
 @click.option("--csv", "csv_file", type=click.Path(dir_okay=False),
               help="Write the long-format CSV (columns mount, direction, quantity, rpm, "
                    "velocity_rms_mm_per_s).")
-@click.option("--plot", type=click.Path(dir_okay=False),
-              help="Thesis figure set (Figs 45-71) as PNG.")
+@click.option("--plot", type=click.Path(dir_okay=False), help="Thesis figure set (Figs 45-71) as PNG.")
 @click.option("--path-plot", type=click.Path(dir_okay=False),
               help="Path contributions at the body points of a modal or measured chassis "
                    "(PNG), at --path-order.")
@@ -80,7 +77,6 @@ def runup(rpm_from, rpm_to, rpm_step, engine_file, solver, stepper, angle_step, 
       powertrain runup --engine engines/default-modal-body.toml --path-plot paths.png
       powertrain runup --from 2000 --to 3000 --sweep 200 --raw sweep.h5 --csv sweep.csv
     """
-
     rpm = speed_steps(rpm_from, rpm_to, rpm_step)
     check_outputs(out=out, csv=csv_file, plot=plot, path_plot=path_plot, raw=raw_file)
     engine = engine_or_default(engine_file)
@@ -116,13 +112,10 @@ def _write_runup(result, files, engine, path_order) -> list:
         result.to_csv(files["csv"], result.synthetic_comments(prov))
     plots = {}
     if files["plot"]:
-        plots["plot"] = write_plot(lambda p: result.plot(path=p, provenance=prov),
-                                   files["plot"])
+        plots["plot"] = write_plot(lambda p: result.plot(path=p, provenance=prov), files["plot"])
     if files["path_plot"]:
-        write_plot(lambda p: result.plot_paths(path=p, order=path_order, provenance=prov),
-                   files["path_plot"])
-    return [f for k in ("out", "csv", "plot", "path_plot") if files[k]
-            for f in plots.get(k, [files[k]])]
+        write_plot(lambda p: result.plot_paths(path=p, order=path_order, provenance=prov), files["path_plot"])
+    return [f for k in ("out", "csv", "plot", "path_plot") if files[k] for f in plots.get(k, [files[k]])]
 
 
 def _write_sweep(result, files, engine) -> list:

@@ -35,7 +35,6 @@ def static(engine_file, rpm_list, json_file, quiet):
       powertrain static
       powertrain static --rpm 1000,3000,6000 --json static.json
     """
-
     rpm = speeds(rpm_list)
     check_outputs(json=json_file)
     engine = engine_or_default(engine_file)

@@ -27,11 +27,9 @@ from powertrain.workflows.stiffness import stiffness as run
                    "inline spring-damper).")
 @click.option("--freq", default="1:400:1", show_default=True,
               help="Frequencies [Hz]: list 5,10,20 and/or range start:stop:step.")
-@click.option("--method", type=click.Choice(["frequency", "time"]), default="frequency",
-              show_default=True,
+@click.option("--method", type=click.Choice(["frequency", "time"]), default="frequency", show_default=True,
               help="frequency: condensed network (eq. 39); time: Newmark integration + FFT.")
-@click.option("--format", "fmt", type=click.Choice(["table", "csv"]), default="table",
-              show_default=True,
+@click.option("--format", "fmt", type=click.Choice(["table", "csv"]), default="table", show_default=True,
               help="Printed output: the table of every frequency, or CSV (with --plot and "
                    "no --format: a short summary instead).")
 @click.option("--plot", type=click.Path(dir_okay=False),
@@ -65,7 +63,6 @@ def stiffness(mount_file, engine_file, mount_dir, freq, method, fmt, plot, form,
       powertrain stiffness mounts/hydraulic-engine-mount-z.toml --amplitude 0.05,0.1,0.5 \\
           --method time --freq 1:100:1 --plot k.png
     """
-
     check_outputs(plot=plot)
     mount = _mount(mount_file, engine_file, mount_dir)
     result = run(mount, engine=engine_file, freq=freq, method=method,
@@ -77,8 +74,7 @@ def _report(result, fmt, plot, form, freq_axis, quiet):
     """Write the plot (when asked); print the table, the CSV or the plot's summary."""
     if plot:
         prov = cli_provenance()
-        write_plot(lambda p: result.plot(path=p, form=form, freq_axis=freq_axis,
-                                         provenance=prov), plot)
+        write_plot(lambda p: result.plot(path=p, form=form, freq_axis=freq_axis, provenance=prov), plot)
     explicit = click.get_current_context().get_parameter_source("fmt").name != "DEFAULT"
     if plot and not explicit:
         say(result.summary(), quiet)

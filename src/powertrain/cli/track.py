@@ -30,8 +30,7 @@ from powertrain.workflows.tracking import track as run_track
               help="Vold-Kalman -3 dB half-bandwidth [Hz] (default: per order and speed, "
                    "1.5 x sqrt(order sweep rate [Hz/s]), at most a quarter of the order "
                    "spacing; 0.5 rejects a crossing fixed tone but flattens fast resonances).")
-@click.option("--quantity", type=click.Choice(["acceleration", "velocity", "displacement",
-                                                "force"]),
+@click.option("--quantity", type=click.Choice(["acceleration", "velocity", "displacement", "force"]),
               help="Track only channels of this quantity.")
 @click.option("--as", "as_quantity", type=click.Choice(["velocity"]),
               help="Convert order by order to velocity (divide by j*omega of the order).")

@@ -39,13 +39,11 @@ from powertrain.workflows import transient_recording as recording
               help="With --speed-from: the recorded speed's mean over each firing interval "
                    "of crank angle (a speed resolved within the cycle, an encoder's: its "
                    "firing orders' fluctuation is in the gas and inertia torques already).")
-@click.option("--seat", help="Body point for the ISO 2631-1 values (default: a body point "
-                             "named seat...).")
+@click.option("--seat", help="Body point for the ISO 2631-1 values (default: a body point named seat...).")
 @click.option("--channels", help="Channels of the figure, comma separated (e.g. "
                                  "left.z,right.z; default: the seat's, else each mount's z).")
 @click.option("--quantity", type=click.Choice(["acceleration", "displacement", "force"]),
-              default="acceleration", show_default=True, help="What the figure's channel "
-                                                              "panels show.")
+              default="acceleration", show_default=True, help="What the figure's channel panels show.")
 @click.option("--out", type=click.Path(dir_okay=False), help="Write the HDF5 time histories.")
 @click.option("--csv", "csv_file", type=click.Path(dir_okay=False),
               help="Write the time histories as CSV, one row per step.")
@@ -71,8 +69,7 @@ from powertrain.workflows import transient_recording as recording
                    "(default: lined up on the crank speed).")
 @click.option("--channel-map", type=click.Path(dir_okay=False),
               help="Channel map TOML of the --compare/--speed-from recording (the format of "
-                   "'powertrain track --channels'): file channel name -> mount, side, "
-                   "direction, quantity.")
+                   "'powertrain track --channels'): file channel name -> mount, side, direction, quantity.")
 @click.option("--trigger-edge", type=click.Choice(["rising", "falling"]), default="rising",
               show_default=True, help="The edge the --trigger channel marks (falling: an "
                                       "active-low trigger).")
@@ -101,8 +98,7 @@ def transient(manoeuvre_file, engine_file, angle_step, speed_from, speed_average
       powertrain transient examples/start.toml --speed-from rec.mf4 --pulses-per-rev 60 \\
           --speed-average
     """
-    files = dict(out=out, csv=csv_file, json=json_file, plot=plot, raw=raw_out,
-                 compare_plot=compare_plot)
+    files = dict(out=out, csv=csv_file, json=json_file, plot=plot, raw=raw_out, compare_plot=compare_plot)
     reading = dict(trigger=trigger, channel_map=channel_map, pulses_per_rev=pulses_per_rev,
                    trigger_edge=trigger_edge)
     _check_options(files, raw_file, speed_from, reading, speed_average)
@@ -112,8 +108,7 @@ def transient(manoeuvre_file, engine_file, angle_step, speed_from, speed_average
     firing = engine.crank.firing_interval if speed_average else None
     recorded = _recordings(raw_file, speed_from, reading, system, manoeuvre, firing)
     result = workflow.transient(manoeuvre, engine, angle_step_deg=angle_step, seat=seat,
-                                system=system, speed_from=recorded.get("speed"),
-                                speed_average=speed_average)
+                                system=system, speed_from=recorded.get("speed"), speed_average=speed_average)
     comparison = recording.compare_transient(result, recorded["compare"]) if raw_file else None
     written = _write(result, comparison, files, cli_provenance(engine_description(
         engine, engine.file)), figure, quantity)
@@ -126,8 +121,8 @@ def _say(result, comparison, written, quiet) -> None:
     if comparison is not None:
         say(comparison.to_text(), quiet)
     say(f"solver time: {result.solver_seconds:.3f} s; "
-        + (wrote(*written) if written
-           else "no file written (ask with --out, --csv, --json or --plot)"), quiet)
+        + (wrote(*written) if written else "no file written (ask with --out, --csv, --json or --plot)"),
+        quiet)
 
 
 def _check_options(files, raw_file, speed_from, reading, speed_average) -> None:

@@ -27,8 +27,7 @@ from powertrain.workflows.whatif import whatif as run_whatif
 @click.option("--engine", "engine_file", type=click.Path(dir_okay=False),
               help="Engine file (default: the shipped engines/default.toml).")
 @speed_options
-@click.option("--solver", type=click.Choice(["harmonic", "newmark"]), default="harmonic",
-              show_default=True,
+@click.option("--solver", type=click.Choice(["harmonic", "newmark"]), default="harmonic", show_default=True,
               help="harmonic: exact steady state of the linear model, fast; newmark: time "
                    "integration as in `runup`.")
 @click.option("--scale", multiple=True, metavar="MOUNT.DIR.KIND=FACTOR",
@@ -68,16 +67,13 @@ from powertrain.workflows.whatif import whatif as run_whatif
 @click.option("--delta-plot", type=click.Path(dir_okay=False),
               help="PNG of each variant's change against the baseline, 20 log10(v/v0) [dB]; "
                    "with --manoeuvre the change of its peaks [%].")
-@click.option("--json", "json_file", type=click.Path(dir_okay=False),
-              help="Write the changes as JSON.")
+@click.option("--json", "json_file", type=click.Path(dir_okay=False), help="Write the changes as JSON.")
 @click.option("--signal", type=click.Choice(["velocity", "mount_force"]), default="velocity",
-              show_default=True,
-              help="Compared signal: mount-point velocity or force transmitted to ground.")
+              show_default=True, help="Compared signal: mount-point velocity or force transmitted to ground.")
 @click.option("--objective", metavar="CHANNEL.DIR:QUANTITY:FROM-TO",
               help="Response to minimise, e.g. seat_rail.z:order_2:1500-3000 (a body point), "
                    "left.passive.z:synthesis:1000-6000 (body side of a mount; left/passive.z "
-                   "is read too) or left.z:...; "
-                   "ranks the variants by the mean change over the band [rpm].")
+                   "is read too) or left.z:...; ranks the variants by the mean change over the band [rpm].")
 @click.option("--workers", type=int, default=None,
               help="Processes for the variants (default: all local cores; 1 = serial).")
 @click.option("--scheduler", default=None, metavar="local|tcp://HOST:PORT",
@@ -154,8 +150,7 @@ def _baseline(engine_file, rpm_from, rpm_to, rpm_step):
     return read_engine(engine_file or DEFAULT_ENGINE_PATH), rpm
 
 
-def _write(result, fit, engine, engine_file, target_out, target_plot, json_file, plot,
-           delta_plot) -> None:
+def _write(result, fit, engine, engine_file, target_out, target_plot, json_file, plot, delta_plot) -> None:
     """Write the files asked for, each atomically."""
     prov = cli_provenance(engine_description(engine, engine.file))
     if target_out:

@@ -1,9 +1,6 @@
-"""Channel names of raw time data -> mount, side, direction, quantity.
-
-Either the name convention ``MOUNT[.SIDE].DIRECTION [UNIT]`` (``left.z [m/s^2]``; the unit
-decides the quantity) or a channel map (TOML, ``--channels MAP.toml``: optional ``time``,
-``rpm``, ``tacho`` and a ``[channels]`` table ``"FILE NAME" = {mount, side, direction,
-quantity, unit}``); both in docs/reference/raw-data.md.
+"""Channel names of raw time data -> mount, side, direction, quantity: the convention
+``MOUNT[.SIDE].DIRECTION [UNIT]`` (the unit decides the quantity) or a channel map (TOML);
+both in docs/reference/raw-data.md.
 """
 
 from __future__ import annotations
@@ -65,8 +62,7 @@ def quantity_of_unit(unit: str, file=None, key=None) -> str:
     if dim not in QUANTITY_OF_DIMENSION:
         what = "unknown unit" if dim is None else f"unit of {dim}"
         raise InputError(f"{what} {unit!r}: a channel needs a unit of acceleration (m/s^2, "
-                         "g), velocity (m/s, mm/s), displacement (m, mm) or force (N)",
-                         file=file, key=key)
+                         "g), velocity (m/s, mm/s), displacement (m, mm) or force (N)", file=file, key=key)
     return QUANTITY_OF_DIMENSION[dim]
 
 
@@ -76,8 +72,7 @@ def read_channel_map(path) -> ChannelMap:
     data = read_toml(path)
     for key in data:
         if key not in ("time", "rpm", "tacho", "channels"):
-            raise InputError("unknown key (expected time, rpm, tacho, [channels])",
-                             file=path, key=key)
+            raise InputError("unknown key (expected time, rpm, tacho, [channels])", file=path, key=key)
     cmap = ChannelMap(source=path)
     for key in ("time", "rpm", "tacho"):
         setattr(cmap, key, get(data, key, path, default=None, types=(str, type(None))))
@@ -89,10 +84,10 @@ def read_channel_map(path) -> ChannelMap:
         if not isinstance(entry, dict):
             raise InputError("expected a table {mount=..., direction=..., quantity=...}",
                              file=path, key=prefix)
-        for k in entry:
-            if k not in ENTRY_KEYS:
-                raise InputError(f"unknown key (expected {', '.join(ENTRY_KEYS)})",
-                                 file=path, key=f"{prefix}.{k}")
+        unknown = [k for k in entry if k not in ENTRY_KEYS]
+        if unknown:
+            raise InputError(f"unknown key (expected {', '.join(ENTRY_KEYS)})", file=path,
+                             key=f"{prefix}.{unknown[0]}")
         mount = get(entry, "mount", path, prefix, types=str)
         side = get(entry, "side", path, prefix, default="active", types=str).lower()
         direction = get(entry, "direction", path, prefix, types=str).lower()

@@ -1,9 +1,6 @@
-"""The ``[combustion]`` section of an engine file: the single-zone model or measured traces.
-
-``model = "single-zone"`` with its parameters and ``[combustion.full_load]`` (speed, torque,
-fmep), or ``model = "measured"`` with ``traces = "file.csv"``
-(:mod:`powertrain.iotools.pressure_csv`, relative to the engine file); see
-:mod:`powertrain.iotools.engine_file`. Values are converted to SI here.
+"""The ``[combustion]`` section of an engine file, in SI: ``model = "single-zone"`` with its
+parameters and ``[combustion.full_load]``, or ``model = "measured"`` with ``traces`` (a
+pressure-trace CSV relative to the engine file, :mod:`powertrain.iotools.pressure_csv`).
 """
 
 from __future__ import annotations
@@ -15,14 +12,7 @@ import numpy as np
 
 from powertrain.errors import InputError
 from powertrain.iotools.pressure_csv import read_pressure_traces
-from powertrain.iotools.tomlfile import (
-    array_quantity,
-    check_keys,
-    get,
-    quantity,
-    scalar_quantity,
-    subtable,
-)
+from powertrain.iotools.tomlfile import array_quantity, check_keys, get, quantity, scalar_quantity, subtable
 from powertrain.models.combustion import FullLoadCurve, SingleZoneCombustion
 
 #: ``[combustion]`` single-zone key -> (model field, dimension, check of the number).
@@ -47,8 +37,7 @@ _SINGLE_ZONE = {
     "intake_temperature": ("intake_temperature", "temperature", "positive"),
 }
 #: Keys of each combustion model's table.
-KEYS = {"single-zone": {"model", "imep_factors", "full_load", *_SINGLE_ZONE},
-        "measured": {"model", "traces"},
+KEYS = {"single-zone": {"model", "imep_factors", "full_load", *_SINGLE_ZONE}, "measured": {"model", "traces"},
         "full_load": {"speed", "torque", "fmep"}}
 P = "combustion"
 
@@ -62,13 +51,10 @@ def read_combustion(t: dict, path, crank):
         raise InputError(f"unknown model {model!r} (known: single-zone, measured)",
                          file=path, key=f"{P}.model")
     check_keys(t, KEYS["single-zone"], path, P)
-    factors = array_quantity(t, "imep_factors", "dimensionless", path, P,
-                             (crank.n_cylinders,), nonneg=True)
+    factors = array_quantity(t, "imep_factors", "dimensionless", path, P, (crank.n_cylinders,), nonneg=True)
     full_load = _read_full_load(subtable(t, "full_load", path, P), path)
-    values = {}
-    for key, (name, dim, check) in _SINGLE_ZONE.items():
-        kw = {check: True} if check else {}
-        values[name] = scalar_quantity(t, key, dim, path, P, **kw)
+    values = {name: scalar_quantity(t, key, dim, path, P, **({check: True} if check else {}))
+              for key, (name, dim, check) in _SINGLE_ZONE.items()}
     c = SingleZoneCombustion(full_load=full_load, imep_factors=factors, **values)
     _check_single_zone(c, path)
     return c
@@ -78,8 +64,7 @@ def _read_measured(t, path, crank):
     check_keys(t, KEYS["measured"], path, P)
     full = Path(path).parent / get(t, "traces", path, P, types=str)
     if not full.is_file():
-        raise InputError(f"pressure-trace file not found: {full}", file=path,
-                         key=f"{P}.traces")
+        raise InputError(f"pressure-trace file not found: {full}", file=path, key=f"{P}.traces")
     return read_pressure_traces(full, crank.n_cylinders)
 
 
@@ -88,14 +73,12 @@ def _read_full_load(fl, path) -> FullLoadCurve:
     check_keys(fl, KEYS["full_load"], path, fp)
     speed = np.asarray(quantity(fl, "speed", "angular_speed", path, fp, positive=True), float)
     if speed.ndim != 1 or speed.size < 2 or np.any(np.diff(speed) <= 0):
-        raise InputError("expected at least two strictly increasing speeds", file=path,
-                         key=f"{fp}.speed")
+        raise InputError("expected at least two strictly increasing speeds", file=path, key=f"{fp}.speed")
     torque = np.asarray(quantity(fl, "torque", "torque", path, fp, nonneg=True), float)
     fmep = np.asarray(quantity(fl, "fmep", "pressure", path, fp, nonneg=True), float)
     for key, arr in (("torque", torque), ("fmep", fmep)):
         if arr.shape != speed.shape:
-            raise InputError(f"expected {speed.size} values (one per speed)", file=path,
-                             key=f"{fp}.{key}")
+            raise InputError(f"expected {speed.size} values (one per speed)", file=path, key=f"{fp}.{key}")
     return FullLoadCurve(speed=speed, torque=torque, fmep=fmep)
 
 
@@ -114,7 +97,6 @@ def _check_single_zone(c: SingleZoneCombustion, path) -> None:
             ("valve_overlap", c.valve_overlap < math.pi / 2, "must be below 90 deg"),
             ("intake_pressure_max", c.intake_pressure_max >= c.intake_pressure_min,
              "must not be below intake_pressure_min"),
-            ("indicated_efficiency", c.indicated_efficiency < 1, "must be below 1"),
-    ):
+            ("indicated_efficiency", c.indicated_efficiency < 1, "must be below 1")):
         if not ok:
             raise InputError(why, file=path, key=f"{P}.{key}")

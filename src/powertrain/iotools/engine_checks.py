@@ -1,8 +1,6 @@
-"""Physical plausibility of an engine, checked once when its file is loaded (on the model
-in SI), so that a well-formed but absurd file fails at the input, naming the file, the section
-and the reason, instead of deep in a solver: the mounts must carry the body (rigid-body modes
-finite, :data:`MIN_MODE_HZ` to :data:`MAX_MODE_HZ`) and the excitation must be finite and below
-:data:`MAX_FORCE_N` at both ends of the speed range.
+"""Physical plausibility of an engine read from a file, so that an absurd file fails at the
+input, not in a solver: the mounts carry the body (rigid-body modes :data:`MIN_MODE_HZ` to
+:data:`MAX_MODE_HZ`) and the excitation is finite and below :data:`MAX_FORCE_N`.
 """
 
 from __future__ import annotations
@@ -28,8 +26,7 @@ _G = 9.80665
 def check_engine(engine, path) -> None:
     """Raise :class:`InputError` if ``engine`` (read from ``path``) is physically absurd."""
     check_support(engine, path)
-    if getattr(engine, "crank", None) is not None and getattr(engine, "combustion", None) \
-            is not None:
+    if getattr(engine, "crank", None) is not None and getattr(engine, "combustion", None) is not None:
         check_excitation(engine, path)
 
 
@@ -81,7 +78,7 @@ def _check_static_stiffness(system, mounts, path) -> None:
 
 def extreme_mount(mounts, pick=min) -> str:
     """``mount.direction (file, static stiffness)`` of the softest (``pick=min``) or stiffest
-    (``pick=max``) mount direction, to point at the file to look at."""
+    (``pick=max``) mount direction."""
     entries = []
     for m in mounts:
         for d, mdl in m.directions.items():

@@ -1,9 +1,7 @@
 """Engine files (``engines/*.toml``) into an :class:`~powertrain.models.engine.Engine` in SI.
 
-Layout, keys and units: docs/reference/engine-file.md (``engines/default.toml`` is a complete,
-commented example). Every quantity is ``key = {value = ..., unit = "..."}``, converted to SI
-here once through :mod:`powertrain.units`; every problem is an
-:class:`~powertrain.errors.InputError` naming the file and the key.
+Layout: docs/reference/engine-file.md. Every quantity is ``key = {value = ..., unit = "..."}``;
+every problem is an :class:`~powertrain.errors.InputError` naming the file and the key.
 """
 
 from __future__ import annotations
@@ -46,8 +44,7 @@ MIN_MOUNTS = 3
 DIRECTIONS = ("x", "y", "z")
 
 _ALLOWED = {
-    "": {"engine", "crank_train", "body", "mounts", "balancer", "combustion", "chassis",
-         "drive"},
+    "": {"engine", "crank_train", "body", "mounts", "balancer", "combustion", "chassis", "drive"},
     "drive": {"gear_ratio"},
     "chassis": {"model", "modes", "points", "frf"},
     "chassis_mode": {"frequency", "damping_ratio", "modal_mass", "shape"},
@@ -58,22 +55,19 @@ _ALLOWED = {
                     "crank_pin_angles", "firing_order", "reciprocating_mass", "rotating_mass",
                     "counterweight_fraction", "crankcase_pressure"},
     "body": {"mass", "cg", "inertia"},
-    "mount": {"position", "local_x", "local_z", "orientation", "files", "stiffness",
-              "damping"},
+    "mount": {"position", "local_x", "local_z", "orientation", "files", "stiffness", "damping"},
     "balancer": {"enabled", "speed_ratio", "shafts"},
     "shaft": {"name", "mass_radius", "position", "phase", "sense"},
 }
 
 
 def engine_or_default(engine=None) -> em.Engine:
-    """``engine`` as an :class:`~powertrain.models.engine.Engine`: one given stays as it is,
-    a path is read (:func:`read_engine`), None reads the shipped default engine; anything
-    else is an :class:`~powertrain.errors.InputError` naming ``--engine``."""
+    """``engine`` as an :class:`~powertrain.models.engine.Engine`: an Engine as it is, a path
+    read (:func:`read_engine`), None the shipped default engine."""
     if engine is None or isinstance(engine, (str, os.PathLike)):
         return read_engine(DEFAULT_ENGINE_PATH if engine is None else engine)
     if not isinstance(engine, em.Engine):
-        raise InputError(f"expected an Engine or an engine file, got {type(engine).__name__}",
-                         key="--engine")
+        raise InputError(f"expected an Engine or an engine file, got {type(engine).__name__}", key="--engine")
     return engine
 
 
@@ -103,19 +97,14 @@ def read_engine(path=DEFAULT_ENGINE_PATH) -> em.Engine:
         crank = _read_crank(subtable(doc, "crank_train", path), path)
     if "combustion" in doc:
         if crank is None:
-            raise InputError("[combustion] needs a [crank_train] section", file=path,
-                             key="crank_train")
+            raise InputError("[combustion] needs a [crank_train] section", file=path, key="crank_train")
         combustion = read_combustion(subtable(doc, "combustion", path), path, crank)
-    balancer = Balancer(enabled=False, ratio=2.0, shafts=())
-    if "balancer" in doc:
-        balancer = _read_balancer(subtable(doc, "balancer", path), path)
-    chassis = None
-    if "chassis" in doc:
-        chassis = _read_chassis(subtable(doc, "chassis", path), path, [m.name for m in mounts])
-    gear_ratio = _read_drive(doc, path)
+    balancer = (_read_balancer(subtable(doc, "balancer", path), path) if "balancer" in doc
+                else Balancer(enabled=False, ratio=2.0, shafts=()))
+    chassis = (_read_chassis(subtable(doc, "chassis", path), path, [m.name for m in mounts])
+               if "chassis" in doc else None)
     engine = em.Engine(name=name, crank=crank, body=body, mounts=mounts, balancer=balancer,
-                       combustion=combustion, file=path, chassis=chassis,
-                       gear_ratio=gear_ratio)
+                       combustion=combustion, file=path, chassis=chassis, gear_ratio=_read_drive(doc, path))
     check_engine(engine, path)
     return engine
 
@@ -137,8 +126,7 @@ def _read_chassis(t, path, mount_names):
     check_keys(t, _ALLOWED[p], path, p)
     model = get(t, "model", path, p, types=str)
     if model not in MODELS:
-        raise InputError(f"unknown model {model!r} (known: {', '.join(MODELS)})", file=path,
-                         key=f"{p}.model")
+        raise InputError(f"unknown model {model!r} (known: {', '.join(MODELS)})", file=path, key=f"{p}.model")
     points_raw = get(t, "points", path, p, default={}, types=dict)
     for name, pt in points_raw.items():
         key = f"{p}.points.{name}"
@@ -182,8 +170,7 @@ def _read_body_mode(m, path, p, mount_names, points):
     for name in list(mount_names) + list(points):
         v = get(shape_raw, name, path, sp, types=list)
         if len(v) != 3:
-            raise InputError(f"expected [sx, sy, sz], got {v!r}"[:200], file=path,
-                             key=f"{sp}.{name}")
+            raise InputError(f"expected [sx, sy, sz], got {v!r}"[:200], file=path, key=f"{sp}.{name}")
         shapes[name] = np.array([number(x, path, f"{sp}.{name}") for x in v])
     return BodyMode(frequency=f, damping_ratio=zeta, modal_mass=mass, shapes=shapes)
 
@@ -193,8 +180,7 @@ def _read_crank(t, path) -> CrankTrain:
     check_keys(t, _ALLOWED[p], path, p)
     n = get(t, "cylinders", path, p, types=int)
     if isinstance(n, bool) or n < 1:
-        raise InputError(f"must be a positive integer, got {n!r}", file=path,
-                         key=f"{p}.cylinders")
+        raise InputError(f"must be a positive integer, got {n!r}", file=path, key=f"{p}.cylinders")
     bore = scalar_quantity(t, "bore", "length", path, p, positive=True)
     stroke = scalar_quantity(t, "stroke", "length", path, p, positive=True)
     rod = scalar_quantity(t, "rod_length", "length", path, p, positive=True)
@@ -212,8 +198,7 @@ def _read_crank(t, path) -> CrankTrain:
                          file=path, key=f"{p}.cylinder_axis")
     rot = get(t, "rotation", path, p, types=str)
     if rot not in ("+X", "-X"):
-        raise InputError(f"expected \"+X\" or \"-X\", got {rot!r}", file=path,
-                         key=f"{p}.rotation")
+        raise InputError(f"expected \"+X\" or \"-X\", got {rot!r}", file=path, key=f"{p}.rotation")
     pins = array_quantity(t, "crank_pin_angles", "angle", path, p, (n,))
     pins = pins - pins[0]      # re cylinder 1: θ = 0 is its firing TDC, for forces and gas
     order_raw = get(t, "firing_order", path, p, types=list)
@@ -229,21 +214,16 @@ def _read_crank(t, path) -> CrankTrain:
     m_rot = scalar_quantity(t, "rotating_mass", "mass", path, p, nonneg=True)
     cw = scalar_quantity(t, "counterweight_fraction", "dimensionless", path, p, nonneg=True)
     pcc = scalar_quantity(t, "crankcase_pressure", "pressure", path, p, nonneg=True)
-    return CrankTrain(bore=bore, stroke=stroke, rod_length=rod, pin_offset=offset,
-                         compression_ratio=eps, cylinder_x=xs, cylinder_axis=axis,
-                         rotation_sign=1 if rot == "+X" else -1, crank_pin_angles=pins,
-                         firing_order=order, firing_angles=firing, reciprocating_mass=m_rec,
-                         rotating_mass=m_rot, counterweight_fraction=cw,
-                         crankcase_pressure=pcc)
+    return CrankTrain(bore=bore, stroke=stroke, rod_length=rod, pin_offset=offset, compression_ratio=eps,
+                      cylinder_x=xs, cylinder_axis=axis, rotation_sign=1 if rot == "+X" else -1,
+                      crank_pin_angles=pins, firing_order=order, firing_angles=firing,
+                      reciprocating_mass=m_rec, rotating_mass=m_rot, counterweight_fraction=cw,
+                      crankcase_pressure=pcc)
 
 
 def _firing_angles(pins, order, path, key):
-    """Cylinder-1 crank angle of each cylinder's firing TDC on [0, 4π) (``pins`` re
-    cylinder 1).
-
-    Walk the firing order from cylinder 1 (fired at 0): each next cylinder fires at the first
-    of its TDC angles (``pin + 2πk``) after the previous firing.
-    """
+    """Cylinder-1 crank angle of each cylinder's firing TDC on [0, 4π): along the firing order
+    from cylinder 1 (at 0), each fires at its first TDC (``pin + 2πk``) after the previous."""
     two_pi = 2.0 * np.pi
     pins = np.mod(pins, two_pi)
     firing = np.zeros(len(pins))
@@ -285,8 +265,7 @@ _NAME_RE = re.compile(r"^[A-Za-z_][A-Za-z0-9_-]*$")
 def _read_mounts(t, path) -> list:
     """Every ``[mounts.NAME]`` table, in file order (at least :data:`MIN_MOUNTS`)."""
     if len(t) < MIN_MOUNTS:
-        raise InputError(f"need at least {MIN_MOUNTS} mounts, got {len(t)}", file=path,
-                         key="mounts")
+        raise InputError(f"need at least {MIN_MOUNTS} mounts, got {len(t)}", file=path, key="mounts")
     mounts = []
     for name in t:
         if not is_mount_name(name):
@@ -306,8 +285,7 @@ def _read_mounts(t, path) -> list:
 def euler_rotation(a, b, c) -> np.ndarray:
     """Local→engine rotation R = Rz(c)·Ry(b)·Rx(a) [angles in rad]: rotations about engine X
     by ``a``, then engine Y by ``b``, then engine Z by ``c`` (columns = local axes)."""
-    ca, sa, cb, sb, cc, sc = (math.cos(a), math.sin(a), math.cos(b), math.sin(b),
-                              math.cos(c), math.sin(c))
+    ca, sa, cb, sb, cc, sc = (math.cos(a), math.sin(a), math.cos(b), math.sin(b), math.cos(c), math.sin(c))
     rx = np.array([[1.0, 0.0, 0.0], [0.0, ca, -sa], [0.0, sa, ca]])
     ry = np.array([[cb, 0.0, sb], [0.0, 1.0, 0.0], [-sb, 0.0, cb]])
     rz = np.array([[cc, -sc, 0.0], [sc, cc, 0.0], [0.0, 0.0, 1.0]])
@@ -328,8 +306,7 @@ def _read_orientation(m, path, p) -> np.ndarray:
     lx = unit_vector(m, "local_x", path, p)
     lz = unit_vector(m, "local_z", path, p)
     if abs(float(lx @ lz)) > 1e-6:
-        raise InputError("local_x and local_z must be perpendicular", file=path,
-                         key=f"{p}.local_z")
+        raise InputError("local_x and local_z must be perpendicular", file=path, key=f"{p}.local_z")
     return np.column_stack([lx, np.cross(lz, lx), lz])
 
 
@@ -348,21 +325,17 @@ def _read_mount_directions(m, path, p):
             rel = get(files, d, path, f"{p}.files", types=str)
             full = base / rel
             if not full.is_file():
-                raise InputError(f"mount file not found: {full}", file=path,
-                                 key=f"{p}.files.{d}")
+                raise InputError(f"mount file not found: {full}", file=path, key=f"{p}.files.{d}")
             directions[d] = read_mount(full)
             paths[d] = str(full)
         return directions, paths
     if "stiffness" not in m:
-        raise InputError("missing key (give files or an inline stiffness)", file=path,
-                         key=f"{p}.stiffness")
+        raise InputError("missing key (give files or an inline stiffness)", file=path, key=f"{p}.stiffness")
     k = array_quantity(m, "stiffness", "stiffness", path, p, (3,), nonneg=True)
     c = (array_quantity(m, "damping", "damping", path, p, (3,), nonneg=True) if "damping" in m
          else np.zeros(3))
-    directions = {d: MountModel.from_values("kelvin-voigt", [k[i], c[i]],
-                                            name=f"inline spring-damper {d}",
-                                            source=f"{path}: {p}")
-                  for i, d in enumerate(DIRECTIONS)}
+    directions = {d: MountModel.from_values("kelvin-voigt", [k[i], c[i]], name=f"inline spring-damper {d}",
+                                            source=f"{path}: {p}") for i, d in enumerate(DIRECTIONS)}
     return directions, {}
 
 

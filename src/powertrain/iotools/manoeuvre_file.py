@@ -1,10 +1,6 @@
-"""Reading a manoeuvre file (TOML): crank speed and load tables of a transient.
-
-Sections ``[manoeuvre]`` (name, gear_ratio, crank_inertia, reversal, trigger_time),
-``[speed]`` and
-``[load]`` (time tables), optional ``[starter]``: docs/guide/transient.md. The keys, units
-and table sizes (:data:`MAX_ROWS`) are checked here, the values by the model
-(:class:`~powertrain.models.manoeuvre.Manoeuvre`, which names this file), before any work.
+"""Manoeuvre files (TOML, docs/guide/transient.md): the crank speed and load tables of a
+transient. Keys, units and table sizes are checked here, the values by
+:class:`~powertrain.models.manoeuvre.Manoeuvre`.
 """
 
 from __future__ import annotations
@@ -33,10 +29,8 @@ def read_manoeuvre(path) -> Manoeuvre:
     Raises
     ------
     InputError
-        One line naming the file and the key: a missing or unknown key, a wrong unit, a
-        table of more than :data:`MAX_ROWS` rows, and every check of
-        :class:`~powertrain.models.manoeuvre.Manoeuvre` (times from 0 and increasing, a gap,
-        a negative speed where no reversal is allowed, a profile too long, bounds).
+        Naming the file and the key of the first problem (a table over :data:`MAX_ROWS`
+        rows, any check of :class:`~powertrain.models.manoeuvre.Manoeuvre`).
     """
     path = str(path)
     doc = read_toml(path)
@@ -45,22 +39,16 @@ def read_manoeuvre(path) -> Manoeuvre:
     check_keys(head, ("name", "notes", "gear_ratio", "crank_inertia", "reversal",
                       "trigger_time"), path, "manoeuvre")
     reversal = get(head, "reversal", path, "manoeuvre", default=False, types=bool)
-    time, speed = _columns(subtable(doc, "speed", path), ("speed",), "angular_speed", path,
-                           "speed")[:2]
+    time, speed = _columns(subtable(doc, "speed", path), ("speed",), "angular_speed", path, "speed")[:2]
     load_section = subtable(doc, "load", path)
     load_time, load, kind = _load_table(load_section, path)
     motored = (scalar_quantity(load_section, "motored_intake_pressure", "pressure", path,
-                               "load", positive=True)
-               if "motored_intake_pressure" in load_section else None)
-    gear = scalar_quantity(head, "gear_ratio", "dimensionless", path, "manoeuvre",
-                           default=0.0, nonneg=True)
-    inertia = scalar_quantity(head, "crank_inertia", "inertia", path, "manoeuvre",
-                              default=0.0, nonneg=True)
-    trigger = scalar_quantity(head, "trigger_time", "time", path, "manoeuvre", default=0.0,
-                              nonneg=True)
+                               "load", positive=True) if "motored_intake_pressure" in load_section else None)
+    gear = scalar_quantity(head, "gear_ratio", "dimensionless", path, "manoeuvre", default=0.0, nonneg=True)
+    inertia = scalar_quantity(head, "crank_inertia", "inertia", path, "manoeuvre", default=0.0, nonneg=True)
+    trigger = scalar_quantity(head, "trigger_time", "time", path, "manoeuvre", default=0.0, nonneg=True)
     starter = _starter(doc["starter"], path) if "starter" in doc else None
-    return Manoeuvre(str(get(head, "name", path, "manoeuvre", default="manoeuvre",
-                             types=str)),
+    return Manoeuvre(str(get(head, "name", path, "manoeuvre", default="manoeuvre", types=str)),
                      time, speed, load_time, load, kind, gear, inertia, starter, reversal,
                      path, str(get(head, "notes", path, "manoeuvre", default="", types=str)),
                      motored, trigger)
@@ -68,15 +56,12 @@ def read_manoeuvre(path) -> Manoeuvre:
 
 def _table(section, key, dimension, path, prefix):
     """One column of a table in SI, bounded in length."""
-    if not isinstance(section.get(key), dict) or not isinstance(section[key].get("value"),
-                                                                 list):
+    if not isinstance(section.get(key), dict) or not isinstance(section[key].get("value"), list):
         get(section, key, path, prefix)                 # missing: named
-        raise InputError('expected {value = [...], unit = "..."}', file=path,
-                         key=f"{prefix}.{key}")
+        raise InputError('expected {value = [...], unit = "..."}', file=path, key=f"{prefix}.{key}")
     n = len(section[key]["value"])
     if not 2 <= n <= MAX_ROWS:
-        raise InputError(f"{n} rows; 2..{MAX_ROWS} allowed", file=path,
-                         key=f"{prefix}.{key}.value")
+        raise InputError(f"{n} rows; 2..{MAX_ROWS} allowed", file=path, key=f"{prefix}.{key}.value")
     return array_quantity(section, key, dimension, path, prefix, (n,))
 
 
@@ -87,17 +72,14 @@ def _columns(section, names, dimension, path, prefix):
                                              if prefix == "load" else ()), path, prefix)
     present = [k for k in names if k in section]
     if len(present) > 1:
-        raise InputError(f"two load columns (one of {', '.join(names)})", file=path,
-                         key=prefix)
+        raise InputError(f"two load columns (one of {', '.join(names)})", file=path, key=prefix)
     name = present[0] if present else names[0]
     if not present and len(names) > 1:
         raise InputError(f"missing (one of {', '.join(names)})", file=path, key=prefix)
-    value = _table(section, name, dimension if isinstance(dimension, str)
-                   else dimension[name], path, prefix)
+    value = _table(section, name, dimension if isinstance(dimension, str) else dimension[name], path, prefix)
     time = _table(section, "time", "time", path, prefix)
     if time.size != value.size:
-        raise InputError(f"{time.size} times for {value.size} values", file=path,
-                         key=f"{prefix}.time")
+        raise InputError(f"{time.size} times for {value.size} values", file=path, key=f"{prefix}.time")
     return time, value, name
 
 

@@ -1,13 +1,10 @@
-r"""Measured run-up order curves: the long-format CSV or the run-up HDF5 layout.
+r"""Measured run-up order curves from the long-format CSV or the run-up HDF5 layout, in SI.
 
-The CSV (``runup --csv``, ``track --csv``, ``synth``; columns, level columns, ``side`` and
-``phase_deg``: docs/reference/csv-formats.md and raw-data.md) has one row per channel, quantity
-and speed. ``passive`` rows of mount ``left`` become channel ``left/passive``; a passive name
-that is not a mount is a body point. Peak levels become RMS by :math:`1/\sqrt2`; acceleration
-and displacement orders become velocity order by order (:func:`to_velocity`); force curves are
-compared with the simulated mount forces. HDF5 files are read with
-:func:`powertrain.iotools.runup_hdf5.read_runup_hdf5`. Levels are returned in SI (m/s RMS);
-every problem is an :class:`~powertrain.errors.InputError` naming file, line and column.
+CSV layout: docs/reference/csv-formats.md and raw-data.md. ``passive`` rows of mount ``left``
+become channel ``left/passive`` (another passive name is a body point); peak levels become RMS
+by :math:`1/\sqrt2`; acceleration and displacement become velocity order by order
+(:func:`to_velocity`). Every problem is an :class:`~powertrain.errors.InputError` naming file,
+line and column.
 """
 
 from __future__ import annotations
@@ -36,12 +33,9 @@ LEVEL_COLUMNS = {
     "force_rms_n": (1.0, "rms"),
 }
 KEY_COLUMNS = ("mount", "direction", "quantity", "rpm")
-#: Optional columns: the side of the mount (``active`` = engine side, default; ``passive`` =
-#: body side, or a body point of interest named in ``mount``) and further value columns
-#: (read and checked; the comparison uses the velocity level column).
+#: Optional columns: ``side`` (``active`` engine side, default; ``passive`` body side or a
+#: body point) and further value columns (checked, not compared).
 OPTIONAL_COLUMNS = ("side", "acceleration_rms_m_per_s2", "force_rms_n", "phase_deg")
-
-
 #: Highest plausible order level [m/s RMS]: above 1 km/s it is a unit or export error.
 MAX_LEVEL_M_PER_S = 1e3
 #: Highest plausible engine speed [rpm].
@@ -55,13 +49,7 @@ def _check_level(level_si: float, path, line, key) -> None:
 
 
 def normalise_quantity(text: str) -> str:
-    """``synthesis`` or ``order_<n>`` with n > 0 written without trailing zeros.
-
-    Raises
-    ------
-    ValueError
-        If ``text`` is neither.
-    """
+    """``synthesis`` or ``order_<n>`` with n > 0 written without trailing zeros (else ValueError)."""
     text = text.strip()
     if text == "synthesis":
         return text
@@ -72,8 +60,7 @@ def normalise_quantity(text: str) -> str:
             order = float("nan")
         if math.isfinite(order) and order > 0:
             return order_label(order)
-    raise ValueError(f"unknown quantity {text!r} (expected 'synthesis' or 'order_<n>', "
-                     "e.g. order_2)")
+    raise ValueError(f"unknown quantity {text!r} (expected 'synthesis' or 'order_<n>', e.g. order_2)")
 
 
 @dataclass
@@ -83,23 +70,15 @@ class MeasuredRunup:
     Attributes
     ----------
     curves : dict
-        ``(mount, direction, quantity) -> (rpm [rpm], level [m/s RMS])``, each a 1-D array,
-        speeds strictly increasing.
-    source : str
-        File read.
-    notes : list of str
-        Conversions applied (e.g. peak to RMS).
-    comments : list of str
-        Comment lines of the file (without the leading ``#``).
+        ``(mount, direction, quantity) -> (rpm [rpm], level [m/s RMS])``, speeds increasing.
+    source, notes, comments : str, list of str, list of str
+        File read, conversions applied, the file's comment lines (without ``#``).
     signal : str
-        ``velocity`` (levels in m/s, also for converted acceleration and displacement
-        curves) or ``mount_force`` (force curves, levels in N).
+        ``velocity`` (levels in m/s) or ``mount_force`` (levels in N).
     phases : dict
-        ``(mount, direction, quantity) -> phase [deg]`` aligned with that curve's speeds,
-        NaN where undefined; only order curves with at least one phase given (a
-        ``phase_deg`` column, or a simulated result). The order-k component is
-        √2·RMS·cos(kθ + φ), θ the crank angle from cylinder-1 firing TDC
-        (:mod:`powertrain.analysis.phase`).
+        ``(mount, direction, quantity) -> phase [deg]`` at that curve's speeds (NaN where
+        undefined), order curves with a phase only. Order k is √2·RMS·cos(kθ + φ), θ the
+        crank angle from cylinder-1 firing TDC (:mod:`powertrain.analysis.phase`).
     """
 
     curves: dict
@@ -112,11 +91,7 @@ class MeasuredRunup:
     @property
     def channels(self) -> list:
         """(mount, direction) pairs present, in order of first appearance."""
-        seen = []
-        for m, d, _ in self.curves:
-            if (m, d) not in seen:
-                seen.append((m, d))
-        return seen
+        return list(dict.fromkeys((m, d) for m, d, _ in self.curves))
 
     @property
     def quantities(self) -> list:
@@ -134,16 +109,13 @@ class MeasuredRunup:
 
     def rpm_range(self):
         """Lowest and highest speed of all curves [rpm]."""
-        lo = min(float(r[0]) for r, _ in self.curves.values())
-        hi = max(float(r[-1]) for r, _ in self.curves.values())
-        return lo, hi
+        return (min(float(r[0]) for r, _ in self.curves.values()),
+                max(float(r[-1]) for r, _ in self.curves.values()))
 
     @classmethod
     def from_result(cls, result, source: str = "", signal: str = "velocity") -> MeasuredRunup:
-        """RMS curves (synthesis and every order) of a
-        :class:`~powertrain.results.runup.RunupResult`: velocity, or ``mount_force``; the
-        phases of its complex amplitudes (the simulation's crank angle is counted from
-        cylinder-1 firing TDC)."""
+        """RMS curves and phases of a :class:`~powertrain.results.runup.RunupResult`'s
+        ``signal`` (``velocity`` or ``mount_force``), synthesis and every order."""
         rpm = np.asarray(result.rpm, float)
         order_idx = np.argsort(rpm)
         rms = result.order_rms(signal)[order_idx]
@@ -175,12 +147,7 @@ def read_measured(path, mounts=None, points=None) -> MeasuredRunup:
     Returns
     -------
     MeasuredRunup
-        Levels in m/s RMS.
-
-    Raises
-    ------
-    InputError
-        One line naming file, line and column.
+        Levels in m/s RMS (:class:`InputError` naming file, line and column on a problem).
     """
     check_regular_file(path)
     path = str(path)
@@ -191,8 +158,7 @@ def read_measured(path, mounts=None, points=None) -> MeasuredRunup:
 
 
 def _names(names, key):
-    """``mounts`` or ``points`` of :func:`read_measured` as a list of str (one str: that
-    name), None as it is."""
+    """``mounts`` or ``points`` of :func:`read_measured` as a list of str (None stays)."""
     if names is None:
         return None
     items = [names] if isinstance(names, str) else names
@@ -235,7 +201,7 @@ def _read_hdf5(path, mounts):
 
 
 def _is_point(result, name) -> bool:
-    """True if ``name`` is a body point of interest of a result (meta ``points``)."""
+    """True if ``name`` is a body point of a result (meta ``points``)."""
     return name in result.meta.get("points", [])
 
 
@@ -287,15 +253,12 @@ def _csv_layout(header, path, lineno) -> _Layout:
         if name not in known:
             raise InputError(
                 f"unknown column {name!r} (expected {', '.join(KEY_COLUMNS)} and one "
-                f"level column: {', '.join(LEVEL_COLUMNS)})",
-                file=path, line=lineno, key=name or "(empty)")
+                f"level column: {', '.join(LEVEL_COLUMNS)})", file=path, line=lineno, key=name or "(empty)")
         if header.count(name) > 1:
-            raise InputError(f"column {name!r} appears twice", file=path,
-                             line=lineno, key=name)
+            raise InputError(f"column {name!r} appears twice", file=path, line=lineno, key=name)
     for name in KEY_COLUMNS:
         if name not in header:
-            raise InputError(f"header lacks column {name!r}", file=path, line=lineno,
-                             key=name)
+            raise InputError(f"header lacks column {name!r}", file=path, line=lineno, key=name)
     levels = [n for n in header if n in LEVEL_COLUMNS]
     velocity_levels = [n for n in levels if n.startswith("velocity_")]
     if len(levels) > 1 and len(velocity_levels) == 1:
@@ -303,17 +266,14 @@ def _csv_layout(header, path, lineno) -> _Layout:
         levels = velocity_levels
     if len(levels) != 1:
         raise InputError(
-            "header needs exactly one level column with its unit "
-            f"({', '.join(LEVEL_COLUMNS)}); found "
-            f"{', '.join(levels) if levels else 'none'}",
-            file=path, line=lineno, key="header")
+            f"header needs exactly one level column with its unit ({', '.join(LEVEL_COLUMNS)}); found "
+            f"{', '.join(levels) if levels else 'none'}", file=path, line=lineno, key="header")
     return _Layout({n: i for i, n in enumerate(header)}, levels[0])
 
 
 def _csv_row(fields, layout, path, lineno, mounts, points):
-    """``(node, direction, quantity, rpm, level, phase)`` of a data row (level in the
-    column's unit, phase [deg] or NaN), or None for a row not modelled (quantity
-    ``overall``)."""
+    """``(node, direction, quantity, rpm, level, phase)`` of a data row (level in the column's
+    unit, phase [deg] or NaN); None for an ``overall`` row."""
     col, level_col = layout.col, layout.level_col
     side = fields[col["side"]].lower() if "side" in col else "active"
     if side not in SIDES:
@@ -339,11 +299,9 @@ def _csv_row(fields, layout, path, lineno, mounts, points):
                          file=path, line=lineno, key="rpm")
     level = parse_number(fields[col[level_col]], path, lineno, level_col)
     if level < 0:
-        raise InputError(f"negative level {level:g}", file=path, line=lineno,
-                         key=level_col)
+        raise InputError(f"negative level {level:g}", file=path, line=lineno, key=level_col)
     _check_level(level * layout.scale, path, lineno, level_col)
-    return node, direction, quantity, rpm, level, _row_phase(fields, col, quantity, path,
-                                                             lineno)
+    return node, direction, quantity, rpm, level, _row_phase(fields, col, quantity, path, lineno)
 
 
 def _row_phase(fields, col, quantity, path, lineno) -> float:
@@ -358,16 +316,14 @@ def _row_phase(fields, col, quantity, path, lineno) -> float:
 
 
 def _csv_node(mount, side, path, lineno, mounts, points) -> str:
-    """Node of a row's ``mount`` and ``side``: ``left``, ``left/passive`` (body side of a
-    mount) or a body point of interest."""
+    """Node of a row: ``left``, ``left/passive`` (body side of a mount) or a body point."""
     if side == "passive" and mount and (mounts is None or mount in mounts):
         return passive_name(mount)                    # body side of that mount
     if side == "passive" and mount and (points is None or mount in points):
         return mount                                  # a body point of interest
     if not mount or (mounts is not None and mount not in mounts):
         known_txt = f" (known: {', '.join(mounts)})" if mounts is not None else ""
-        raise InputError(f"unknown mount {mount!r}{known_txt}", file=path, line=lineno,
-                         key="mount")
+        raise InputError(f"unknown mount {mount!r}{known_txt}", file=path, line=lineno, key="mount")
     return mount
 
 
@@ -379,8 +335,7 @@ def _add_row(rows, order, row, path, lineno) -> None:
         order.append(key)
     if rpm in rows[key]:
         raise InputError(f"duplicate row: {node},{direction},{quantity} at {rpm:g} rpm "
-                         f"already on line {rows[key][rpm][1]}", file=path, line=lineno,
-                         key="rpm")
+                         f"already on line {rows[key][rpm][1]}", file=path, line=lineno, key="rpm")
     rows[key][rpm] = (level, lineno, phase)
 
 
@@ -393,9 +348,7 @@ def _measured_runup(rows, order, layout, path, comments) -> MeasuredRunup:
         phase = np.array([rows[key][r][2] for r in speeds])
         if np.any(np.isfinite(phase)):
             phases[key] = phase
-    notes = []
-    signal = "velocity"
-    level_col = layout.level_col
+    notes, signal, level_col = [], "velocity", layout.level_col
     kind = level_col.split("_", 1)[0]
     if kind in ("acceleration", "displacement"):
         curves = to_velocity(curves, kind, notes)
@@ -408,22 +361,19 @@ def _measured_runup(rows, order, layout, path, comments) -> MeasuredRunup:
         notes.append(f"levels read from peak column {level_col!r} and converted to RMS by "
                      "1/sqrt(2) (exact for a sinusoidal order; synthesis read as the "
                      "root-sum-square of the order peaks)")
-    return MeasuredRunup(curves, source=path, notes=notes, comments=comments, signal=signal,
-                         phases=phases)
+    return MeasuredRunup(curves, source=path, notes=notes, comments=comments, signal=signal, phases=phases)
 
 
 def to_velocity(curves, kind, notes):
     r"""Convert acceleration or displacement order curves to velocity, order by order.
 
     :math:`v_o = a_o/\omega_o` or :math:`v_o = \omega_o x_o`, :math:`\omega_o = 2\pi o n/60`;
-    each channel's synthesis is recomputed as the RMS sum of its converted orders at the
-    speeds where every order of the channel is present (elsewhere it is dropped).
+    a channel's synthesis becomes the RMS sum of its converted orders where all are present.
     """
     out, dropped = {}, []
     channels = {(m, d) for m, d, _ in curves}
     for m, d in sorted(channels):
-        orders = {q: v for (mm, dd, q), v in curves.items()
-                  if (mm, dd) == (m, d) and q != "synthesis"}
+        orders = {q: v for (mm, dd, q), v in curves.items() if (mm, dd) == (m, d) and q != "synthesis"}
         for q, (rpm, level) in orders.items():
             w = 2 * math.pi * float(q.split("_", 1)[1]) * rpm / 60.0
             out[(m, d, q)] = (rpm, level / w if kind == "acceleration" else level * w)
@@ -440,9 +390,8 @@ def to_velocity(curves, kind, notes):
                 rpm, level = out[(m, d, q)]
                 total += np.interp(speeds, rpm, level) ** 2
             out[(m, d, "synthesis")] = (speeds, np.sqrt(total))
-    notes.append(f"{kind} order curves converted to velocity order by order (divided by "
-                 "omega_o)" if kind == "acceleration" else
-                 f"{kind} order curves converted to velocity order by order (times omega_o)")
+    how = "divided by omega_o" if kind == "acceleration" else "times omega_o"
+    notes.append(f"{kind} order curves converted to velocity order by order ({how})")
     notes.append("synthesis recomputed as the RMS sum of the converted orders")
     if dropped:
         notes.append("synthesis dropped (no order curves to convert): " + ", ".join(dropped))

@@ -1,9 +1,6 @@
-"""Mount files (``mounts/*.toml``, datasheet units) into a
-:class:`~powertrain.models.mount.MountModel` in SI, and back (:func:`write_mount`).
-
-Layout, the optional ``[amplitude]``, ``[friction]`` and ``[static]`` sections and the checks:
-docs/reference/mount-file.md. The sections become :mod:`powertrain.physics.mount_laws`
-objects; every problem is an :class:`~powertrain.errors.InputError` naming file and key.
+"""Mount files (``mounts/*.toml``, datasheet units; docs/reference/mount-file.md) into a
+:class:`~powertrain.models.mount.MountModel` in SI and back (:func:`write_mount`); the optional
+``[amplitude]``, ``[friction]``, ``[static]`` sections become :mod:`powertrain.physics.mount_laws`.
 """
 
 from __future__ import annotations
@@ -48,8 +45,7 @@ def read_mount(path) -> MountModel:
     params_raw = get(doc, "parameters", path, types=dict)
     unknown = sorted(set(params_raw) - set(topo.parameters))
     if unknown:
-        raise InputError(f"unknown parameter for model {model!r} "
-                         f"(expected {', '.join(topo.parameters)})",
+        raise InputError(f"unknown parameter for model {model!r} (expected {', '.join(topo.parameters)})",
                          file=path, key=f"parameters.{unknown[0]}")
     params = {}
     for p in topo.parameters:
@@ -57,8 +53,7 @@ def read_mount(path) -> MountModel:
         unit = get(units, family, path, "units", types=str)
         raw = get(params_raw, p, path, "parameters")
         value = number(raw, path, f"parameters.{p}", nonneg=True)
-        params[p] = float(to_si(value, unit, _DIMENSION[family], file=path,
-                                key=f"units.{family}"))
+        params[p] = float(to_si(value, unit, _DIMENSION[family], file=path, key=f"units.{family}"))
         if params[p] > MAX_SI[family]:
             raise InputError(f"{value:g} {unit} above the plausible "
                              f"{from_si(MAX_SI[family], unit):g} {unit} (unit error?)",
@@ -66,15 +61,13 @@ def read_mount(path) -> MountModel:
     laws = {field: reader(get(doc, section, path, types=dict), _Units(units, path))
             for section, (field, reader) in _SECTIONS.items() if section in doc}
     model = MountModel(topo, params, name=str(mount.get("name", Path(path).stem)),
-                       source=str(mount.get("source", "")), notes=str(mount.get("notes", "")),
-                       **laws)
+                       source=str(mount.get("source", "")), notes=str(mount.get("notes", "")), **laws)
     check_network(model, path)
     return model
 
 
 def check_plausible(model: MountModel, path) -> None:
-    """Refuse a parameter above :data:`MAX_SI` or not finite, as a mount file's (a value
-    set or scaled from the command line: ``whatif --set``, ``--scale``)."""
+    """Refuse a parameter above :data:`MAX_SI` or not finite (one set from the command line)."""
     for p, value in model.params.items():
         top = MAX_SI[p[0]]
         if not value <= top:
@@ -84,16 +77,8 @@ def check_plausible(model: MountModel, path) -> None:
 
 
 def check_network(model: MountModel, path) -> None:
-    """Refuse a network that is singular at 0 Hz: an internal node held by no spring to
-    the engine side or the ground (e.g. every spring and damper 0), so that its static
-    deflection is undetermined. Every solver condenses the network at 0 Hz (static
-    stiffness, rigid-body modes), where it would fail.
-
-    Raises
-    ------
-    InputError
-        Naming ``path``, key ``parameters``, and the loose internal masses.
-    """
+    """Refuse a network singular at 0 Hz (an internal node held by no spring to the engine
+    side or the ground), where every solver condenses it; the error names the loose nodes."""
     try:
         with np.errstate(all="ignore"):
             model.static_stiffness()
@@ -108,8 +93,7 @@ def check_network(model: MountModel, path) -> None:
 
 
 def _loose_nodes(model: MountModel) -> list:
-    """Labels of the internal nodes (their mass parameter, or ``node k``) joined to
-    neither the engine side nor the ground by a chain of nonzero springs."""
+    """Labels of the internal nodes joined to neither engine side nor ground by nonzero springs."""
     topo = model.topology
     held = {"E", "G"}
     springs = [(a, b) for a, b, c, _ in topo.elements if c and model.params[c] > 0]
@@ -120,13 +104,11 @@ def _loose_nodes(model: MountModel) -> list:
             if (a in held) != (b in held):
                 held |= {a, b}
                 grown = True
-    return [topo.masses[k - 1] or f"node {k}" for k in range(1, topo.n_internal + 1)
-            if f"n{k}" not in held]
+    return [topo.masses[k - 1] or f"node {k}" for k in range(1, topo.n_internal + 1) if f"n{k}" not in held]
 
 
 class _Units:
-    """The ``[units]`` table of one file: converts a section's numbers to SI, naming
-    ``units.x`` / ``units.F`` when the unit a section needs is missing or wrong."""
+    """The ``[units]`` table of one file: a section's numbers to SI (errors name ``units.x``)."""
 
     def __init__(self, units: dict, path: str):
         self.units, self.path = units, path
@@ -138,8 +120,7 @@ class _Units:
 
 def _numbers(t: dict, key: str, path: str, prefix: str, *, positive=False, nonneg=False,
              increasing=False) -> np.ndarray:
-    """A non-empty list of finite numbers ``t[key]`` (optionally > 0 and strictly
-    increasing)."""
+    """A non-empty list of finite numbers ``t[key]`` (optionally > 0, strictly increasing)."""
     raw = get(t, key, path, prefix, types=list)
     full = f"{prefix}.{key}"
     if not raw:
@@ -154,8 +135,7 @@ def _numbers(t: dict, key: str, path: str, prefix: str, *, positive=False, nonne
 
 def _same_length(values: np.ndarray, like: np.ndarray, like_key: str, path, key) -> None:
     if len(values) != len(like):
-        raise InputError(f"has {len(values)} values, {like_key} has {len(like)}",
-                         file=path, key=key)
+        raise InputError(f"has {len(values)} values, {like_key} has {len(like)}", file=path, key=key)
 
 
 def _read_amplitude(t: dict, units: _Units):
@@ -163,10 +143,8 @@ def _read_amplitude(t: dict, units: _Units):
     path = units.path
     law = get(t, "law", path, "amplitude", types=str)
     if law == "power":
-        _no_unknown_keys(t, {"law", "reference", "exponent", "limits", "damping_exponent"},
-                         path, "amplitude")
-        reference = number(get(t, "reference", path, "amplitude"), path,
-                           "amplitude.reference", positive=True)
+        _no_unknown_keys(t, {"law", "reference", "exponent", "limits", "damping_exponent"}, path, "amplitude")
+        reference = number(get(t, "reference", path, "amplitude"), path, "amplitude.reference", positive=True)
         exponent = number(get(t, "exponent", path, "amplitude"), path, "amplitude.exponent")
         limits = tuple(_numbers(t, "limits", path, "amplitude", positive=True).tolist()) \
             if "limits" in t else DEFAULT_LIMITS
@@ -176,8 +154,7 @@ def _read_amplitude(t: dict, units: _Units):
         gamma = number(t.get("damping_exponent", 1.0), path, "amplitude.damping_exponent")
         return PowerLaw(float(units.si(reference, "x")), exponent, limits, gamma)
     if law == "table":
-        _no_unknown_keys(t, {"law", "amplitudes", "stiffness_scale", "damping_scale"}, path,
-                         "amplitude")
+        _no_unknown_keys(t, {"law", "amplitudes", "stiffness_scale", "damping_scale"}, path, "amplitude")
         amps = _numbers(t, "amplitudes", path, "amplitude", positive=True, increasing=True)
         scales = {}
         for key in ("stiffness_scale", "damping_scale"):
@@ -185,43 +162,37 @@ def _read_amplitude(t: dict, units: _Units):
                 scales[key] = _numbers(t, key, path, "amplitude", positive=True)
                 _same_length(scales[key], amps, "amplitudes", path, f"amplitude.{key}")
         damping = scales.get("damping_scale")
-        return TableLaw(tuple(units.si(amps, "x").tolist()),
-                        tuple(scales["stiffness_scale"].tolist()),
+        return TableLaw(tuple(units.si(amps, "x").tolist()), tuple(scales["stiffness_scale"].tolist()),
                         None if damping is None else tuple(damping.tolist()))
-    raise InputError(f"unknown law {law!r} (expected power or table)", file=path,
-                     key="amplitude.law")
+    raise InputError(f"unknown law {law!r} (expected power or table)", file=path, key="amplitude.law")
 
 
 def _read_friction(t: dict, units: _Units) -> BergFriction:
     """``[friction]`` -> :class:`BergFriction` (SI)."""
     path = units.path
     _no_unknown_keys(t, {"max_force", "half_displacement"}, path, "friction")
-    fmax = number(get(t, "max_force", path, "friction"), path, "friction.max_force",
-                  nonneg=True)
+    fmax = number(get(t, "max_force", path, "friction"), path, "friction.max_force", nonneg=True)
     x2 = number(get(t, "half_displacement", path, "friction"), path,
                 "friction.half_displacement", positive=True)
     return BergFriction(float(units.si(fmax, "F")), float(units.si(x2, "x")))
 
 
 def _read_static(t: dict, units: _Units) -> StaticCurve:
-    """``[static]`` -> :class:`StaticCurve` (SI), increasing with a positive tangent at the
-    reference deflection and a positive slope beyond its end points."""
+    """``[static]`` -> :class:`StaticCurve` (SI), increasing, with positive tangents."""
     path = units.path
     _no_unknown_keys(t, {"deflection", "force", "reference_deflection"}, path, "static")
     x = _numbers(t, "deflection", path, "static", increasing=True)
     f = _numbers(t, "force", path, "static", increasing=True)
     _same_length(f, x, "deflection", path, "static.force")
     if len(x) < 2:
-        raise InputError("a static curve needs at least 2 points", file=path,
-                         key="static.deflection")
+        raise InputError("a static curve needs at least 2 points", file=path, key="static.deflection")
     ref = number(get(t, "reference_deflection", path, "static", default=0.0), path,
                  "static.reference_deflection")
     curve = StaticCurve(tuple(units.si(x, "x").tolist()), tuple(units.si(f, "F").tolist()),
                         float(units.si(ref, "x")))
     ends = curve.tangent_at([curve.deflection[0], curve.deflection[-1]])
     if not curve.tangent_at(curve.reference_deflection) > 0:
-        raise InputError("the curve's tangent there is zero", file=path,
-                         key="static.reference_deflection")
+        raise InputError("the curve's tangent there is zero", file=path, key="static.reference_deflection")
     if not np.all(ends > 0):
         raise InputError("the curve's end slope (PCHIP's end-point derivative) is zero; "
                          "add a point beyond", file=path, key="static.force")
@@ -229,8 +200,7 @@ def _read_static(t: dict, units: _Units) -> StaticCurve:
 
 
 #: Section -> (MountModel field, reader).
-_SECTIONS = {"amplitude": ("amplitude_law", _read_amplitude),
-             "friction": ("port_law", _read_friction),
+_SECTIONS = {"amplitude": ("amplitude_law", _read_amplitude), "friction": ("port_law", _read_friction),
              "static": ("static_curve", _read_static)}
 
 
@@ -239,17 +209,14 @@ def _no_unknown_keys(table: dict, known: set, path: str, prefix: str) -> None:
     unknown = sorted(set(table) - known)
     if unknown:
         key = f"{prefix}.{unknown[0]}" if prefix else unknown[0]
-        raise InputError(f"unknown key (expected {', '.join(sorted(known))})",
-                         file=path, key=key)
+        raise InputError(f"unknown key (expected {', '.join(sorted(known))})", file=path, key=key)
 
 
 def format_mount(model: MountModel, *, comment: str = "") -> str:
     """The TOML text of a mount file in datasheet units."""
     def q(s):
         return '"' + str(s).replace("\\", "\\\\").replace('"', '\\"') + '"'
-    lines = []
-    for line in comment.splitlines():
-        lines.append(f"# {line}".rstrip())
+    lines = [f"# {line}".rstrip() for line in comment.splitlines()]
     lines += ["[mount]", f"name = {q(model.name or model.topology.description)}",
               f"model = {q(model.topology.name)}"]
     if model.source:
@@ -265,8 +232,7 @@ def format_mount(model: MountModel, *, comment: str = "") -> str:
 
 
 def _section_lines(model: MountModel) -> list:
-    """The ``[amplitude]``, ``[friction]`` and ``[static]`` lines of ``model`` (x in mm,
-    F in N)."""
+    """The ``[amplitude]``, ``[friction]`` and ``[static]`` lines of ``model`` (mm, N)."""
     def x(v):
         return _toml_number(from_si(v, SECTION_UNITS["x"]))
 
@@ -296,8 +262,7 @@ def _section_lines(model: MountModel) -> list:
                   f"half_displacement = {x(model.port_law.half_displacement)}"]
     curve = model.static_curve
     if curve is not None:
-        lines += ["", "[static]", f"deflection = {xs(curve.deflection)}",
-                  f"force = {forces(curve.force)}",
+        lines += ["", "[static]", f"deflection = {xs(curve.deflection)}", f"force = {forces(curve.force)}",
                   f"reference_deflection = {x(curve.reference_deflection)}"]
     return lines
 

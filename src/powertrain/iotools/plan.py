@@ -1,8 +1,6 @@
-"""Test plans: several measured run-ups of one car (load cases) diagnosed together.
-
-A plan file (TOML, docs/guide/diagnose.md) lists ``[[runs]]`` with ``file`` and either
-``load`` (IMEP scale of the combustion model) or ``traces`` (a pressure-trace CSV); paths are
-relative to the plan file; neither: the engine as it is.
+"""Test plans (TOML, docs/guide/diagnose.md): several measured run-ups of one car diagnosed
+together, each ``[[runs]]`` with ``file`` and optionally ``load`` (IMEP scale) or ``traces``
+(a pressure-trace CSV), paths relative to the plan.
 """
 
 from __future__ import annotations
@@ -21,16 +19,8 @@ RUN_KEYS = ("file", "load", "traces")
 
 @dataclass
 class PlanRun:
-    """One run of a plan: its measured order curves and the engine's operating state.
-
-    Attributes
-    ----------
-    measured : MeasuredRunup
-    load : float
-        IMEP scale of the combustion model (1: as in the engine file).
-    traces : str or None
-        Pressure-trace CSV replacing the engine's combustion for this run.
-    """
+    """One run of a plan: its ``measured`` order curves, the combustion model's IMEP scale
+    ``load`` (1: as in the engine file) or the pressure-trace CSV ``traces`` replacing it."""
 
     measured: object
     load: float = 1.0
@@ -43,8 +33,7 @@ class PlanRun:
     def engine(self, engine):
         """``engine`` in this run's operating state."""
         if self.traces is not None:
-            comb = read_pressure_traces(self.traces, engine.crank.n_cylinders)
-            engine = engine.replace(combustion=comb)
+            engine = engine.replace(combustion=read_pressure_traces(self.traces, engine.crank.n_cylinders))
         return engine.at_load(self.load)
 
     def to_dict(self) -> dict:
@@ -77,16 +66,13 @@ def read_plan(path, engine) -> Plan:
     data = read_toml(path)
     extra = sorted(set(data) - {"runs"})
     if extra:
-        raise InputError(f"unknown key (a plan has [[runs]] only): {extra[0]}", file=path,
-                         key=extra[0])
+        raise InputError(f"unknown key (a plan has [[runs]] only): {extra[0]}", file=path, key=extra[0])
     runs = get(data, "runs", path, types=list)
     if not runs or not all(isinstance(r, dict) for r in runs):
         raise InputError("expected one or more [[runs]] tables", file=path, key="runs")
-    base = Path(path).parent
-    out = []
+    base, out = Path(path).parent, []
     for i, run in enumerate(runs, start=1):
-        key = f"runs[{i}]"
-        load, traces, file = _run_keys(run, path, key, engine, base)
+        load, traces, file = _run_keys(run, path, f"runs[{i}]", engine, base)
         out.append(PlanRun(read_measured(file, mounts=engine.mount_names), load, traces))
     return Plan(out, source=path)
 
@@ -95,18 +81,15 @@ def _run_keys(run, path, key, engine, base):
     """``(load, traces path, measured path)`` of one run, checked."""
     unknown = sorted(set(run) - set(RUN_KEYS))
     if unknown:
-        raise InputError(f"unknown key (known: {', '.join(RUN_KEYS)})", file=path,
-                         key=f"{key}.{unknown[0]}")
+        raise InputError(f"unknown key (known: {', '.join(RUN_KEYS)})", file=path, key=f"{key}.{unknown[0]}")
     file = str(base / get(run, "file", path, key, types=str))
-    load = number(get(run, "load", path, key, default=1.0), path, f"{key}.load",
-                  positive=True)
+    load = number(get(run, "load", path, key, default=1.0), path, f"{key}.load", positive=True)
     traces = get(run, "traces", path, key, default=None, types=str)
     if traces is not None and "load" in run:
         raise InputError("give either load or traces, not both", file=path, key=f"{key}.load")
     if "load" in run and getattr(engine.combustion, "model", "") == "measured":
         raise InputError("load applies to engines with a combustion model; this engine has "
-                         "measured pressure traces (give traces = ... instead)", file=path,
-                         key=f"{key}.load")
+                         "measured pressure traces (give traces = ... instead)", file=path, key=f"{key}.load")
     if traces is not None:
         traces = str(base / traces)
     return load, traces, file

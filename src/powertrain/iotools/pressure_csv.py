@@ -1,9 +1,6 @@
-"""Measured cylinder-pressure traces (``[combustion] model = "measured"``): a CSV with units.
-
-Format (``speed [rpm],cylinder,crank_angle [deg],pressure [bar]``, each trace one 720° cycle,
-gaps at most :data:`MAX_GAP_DEG`): docs/reference/csv-formats.md. Traces are resampled onto a
-common grid of cycle angles on [-π, 3π) by periodic linear interpolation. Errors name the
-file, line and column.
+"""Measured cylinder-pressure traces (``[combustion] model = "measured"``): a CSV with units
+(docs/reference/csv-formats.md), each trace one 720° cycle resampled by periodic linear
+interpolation onto a common grid on [-π, 3π). Errors name the file, line and column.
 """
 
 from __future__ import annotations
@@ -95,11 +92,9 @@ def _row(n, text, path, n_cylinders) -> tuple:
         raise InputError(f"expected 4 values, got {len(cells)}", file=path, line=n)
     vals = [parse_number(c, path, n, name) for (name, _), c in zip(_COLUMNS, cells)]
     if vals[1] != int(vals[1]) or not 1 <= vals[1] <= n_cylinders:
-        raise InputError(f"cylinder must be 1..{n_cylinders}", file=path, line=n,
-                         key="cylinder")
+        raise InputError(f"cylinder must be 1..{n_cylinders}", file=path, line=n, key="cylinder")
     if vals[3] < 0:
-        raise InputError("absolute pressure must not be negative", file=path, line=n,
-                         key="pressure")
+        raise InputError("absolute pressure must not be negative", file=path, line=n, key="pressure")
     return (n, *vals)
 
 
@@ -112,13 +107,11 @@ def _check_ranges(speed, pressure, line_no, path) -> None:
                          line=int(line_no[np.argmax(bad_speed)]))
     if np.any(pressure > MAX_PRESSURE_PA):
         raise InputError(f"pressure above the plausible {MAX_PRESSURE_PA / 1e5:g} bar",
-                         file=path, key="pressure",
-                         line=int(line_no[np.argmax(pressure > MAX_PRESSURE_PA)]))
+                         file=path, key="pressure", line=int(line_no[np.argmax(pressure > MAX_PRESSURE_PA)]))
 
 
 def _check_trace(a, ln, c, w, path) -> None:
-    """One cylinder's trace at speed ``w``: angles ``a`` [rad] increasing, within one cycle,
-    no gap over :data:`MAX_GAP_DEG`; ``ln`` the file lines."""
+    """Trace angles ``a`` [rad] increasing within one cycle, gaps <= :data:`MAX_GAP_DEG`."""
     bad = np.nonzero(np.diff(a) <= 0)[0]
     if bad.size:
         raise InputError("crank angles must increase within a trace", file=path,
@@ -129,6 +122,5 @@ def _check_trace(a, ln, c, w, path) -> None:
     gaps = np.append(np.diff(a), a[0] + 4 * np.pi - a[-1])
     if gaps.max() > math.radians(MAX_GAP_DEG) + 1e-12:
         raise InputError(f"trace has a gap over {MAX_GAP_DEG:g}° (cylinder {c}, "
-                         f"{w * 60 / (2 * np.pi):.6g} rpm)", file=path,
-                         line=int(ln[0]), key="crank_angle")
+                         f"{w * 60 / (2 * np.pi):.6g} rpm)", file=path, line=int(ln[0]), key="crank_angle")
 

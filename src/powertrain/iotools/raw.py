@@ -1,11 +1,7 @@
-"""Raw run-up time data: one entry point for every format, one channel-mapping step.
-
-:func:`read_raw` recognises the format from the file's first bytes (HDF5 signature, the MDF
-identification block, a UFF ``-1`` delimiter line, otherwise a wide CSV), lets the format's
-reader list its signals ``(name, values, unit)`` and turns them into a
-:class:`~powertrain.models.recording.RawRecording` here, once: channel names through the
-name convention or a channel map (:mod:`powertrain.iotools.channel_map`), units to SI
-through :mod:`powertrain.units`.
+"""Raw run-up time data in any format (HDF5, MDF4, UFF, wide CSV, told by the first bytes)
+into a :class:`~powertrain.models.recording.RawRecording`: the format's reader lists the
+signals, mapped here to channels by name or channel map (:mod:`powertrain.iotools.channel_map`)
+and converted to SI.
 """
 
 from __future__ import annotations
@@ -38,9 +34,8 @@ _MDF = b"MDF     "
 
 
 def write_raw(path, recording, *, synthetic=True) -> None:
-    """Write a :class:`RawRecording` in the format its suffix names: ``.csv`` (wide CSV),
-    ``.uff``/``.unv`` (datasets 58), ``.mf4``/``.mdf`` (MDF4), else the raw HDF5 layout;
-    a ``synthetic`` one says so (its first comment heads the CSV and describes the HDF5)."""
+    """Write a :class:`RawRecording` as its suffix says: ``.csv``, ``.uff``/``.unv`` (dataset
+    58), ``.mf4``/``.mdf`` (MDF4), else raw HDF5 (marked ``synthetic`` if so)."""
     suffix = os.path.splitext(str(path))[1].lower()
     note = recording.comments[0] if recording.comments else ""
     if suffix == ".csv":
@@ -54,8 +49,7 @@ def write_raw(path, recording, *, synthetic=True) -> None:
 
 
 def detect_format(path) -> str:
-    """``hdf5``, ``mdf``, ``uff`` or ``csv`` from the first bytes of the file (a regular file:
-    a FIFO or device is refused before it is opened, so nothing blocks)."""
+    """``hdf5``, ``mdf``, ``uff`` or ``csv`` from the first bytes of a regular file."""
     check_regular_file(path)
     try:
         with open(path, "rb") as fh:
@@ -120,8 +114,8 @@ def read_raw(path, channel_map: ChannelMap | None = None, *, rpm: str | None = N
 
 
 def _find(signals, wanted):
-    """Index of the signal named ``wanted`` (full name or name without the unit bracket;
-    else the same ignoring case: ``RPM [1/min]``, ``Trigger [V]``)."""
+    """Index of the signal named ``wanted``, with or without its unit bracket, exactly, else
+    ignoring case."""
     for same in (str.__eq__, lambda a, b: a.casefold() == b.casefold()):
         for i, (name, _, _) in enumerate(signals):
             if same(name, wanted) or same(split_unit(name)[0], wanted):
@@ -147,8 +141,7 @@ def _pick_speed(found: FileSignals, cmap, rpm, tacho, cycle_reference=None, trig
         values = np.asarray(values, float).ravel()
         if kind == "rpm":
             unit = unit or "rpm"
-            values = to_si(values, unit, "angular_speed", file=found.source, key=name) \
-                * 60.0 / (2.0 * np.pi)
+            values = to_si(values, unit, "angular_speed", file=found.source, key=name) * 60.0 / (2.0 * np.pi)
         elif unit:
             values = to_si(values, unit, "voltage", file=found.source, key=name)
         out[kind] = (name, values)
@@ -156,8 +149,7 @@ def _pick_speed(found: FileSignals, cmap, rpm, tacho, cycle_reference=None, trig
 
 
 def _same_time(a, b) -> bool:
-    return a.shape == b.shape and (b.size == 0 or np.allclose(
-        a, b, rtol=0, atol=1e-9 * max(abs(b[-1]), 1.0)))
+    return a.shape == b.shape and (b.size == 0 or np.allclose(a, b, rtol=0, atol=1e-9 * max(abs(b[-1]), 1.0)))
 
 
 def _vibration_time(found: FileSignals, signals):
@@ -169,18 +161,13 @@ def _vibration_time(found: FileSignals, signals):
     for name, _, _ in signals[1:]:
         if not _same_time(np.asarray(found.times.get(name, found.time)), np.asarray(time)):
             raise InputError(f"time base differs from channel {first!r}'s (only the speed or "
-                             "tacho channel may have its own; it is resampled)",
-                             file=found.source, key=name)
+                             "tacho channel may have its own; it is resampled)", file=found.source, key=name)
     return time
 
 
 def _onto_time(found: FileSignals, speed, time):
-    """Speed/tacho channels on their own time base, linearly interpolated onto ``time``.
-
-    Returns ``(speed values, time, keep)``: where the speed's record is shorter, the
-    vibration samples outside it are dropped (``keep`` selects those kept) and a comment
-    says so.
-    """
+    """``(speed values, time, keep)``: speed/tacho channels with their own time base
+    interpolated onto ``time``; vibration samples outside their record dropped (``keep``)."""
     time = np.asarray(time, float)
     keep = slice(None)
     out = {}
@@ -211,14 +198,12 @@ def _onto_time(found: FileSignals, speed, time):
 
 
 def assemble(found: FileSignals, cmap: ChannelMap | None = None, *, rpm=None,
-             tacho=None, cycle_reference=None, trigger=None,
-             map_option="--channels") -> RawRecording:
+             tacho=None, cycle_reference=None, trigger=None, map_option="--channels") -> RawRecording:
     """Map the signals of a file to mount channels in SI (see :func:`read_raw`)."""
     src = found.source
     speed, signals = _pick_speed(found, cmap, rpm, tacho, cycle_reference, trigger)
     speed, time, keep = _onto_time(found, speed, _vibration_time(found, signals))
-    channels, ignored = [], []
-    used = set()
+    channels, ignored, used = [], [], set()
     for name, values, file_unit in signals:
         if cmap is not None and cmap.channels:
             spec = cmap.channels.get(name) or cmap.channels.get(split_unit(name)[0])
@@ -227,8 +212,7 @@ def assemble(found: FileSignals, cmap: ChannelMap | None = None, *, rpm=None,
                 if spec is None:
                     ignored.append(name)
                     continue
-            used.add(name)
-            used.add(split_unit(name)[0])
+            used |= {name, split_unit(name)[0]}
         else:
             spec = parse_channel_name(name)
             if spec is None:
@@ -245,8 +229,7 @@ def assemble(found: FileSignals, cmap: ChannelMap | None = None, *, rpm=None,
                              f"{spec.quantity}", file=src, key=name)
         dimension = "length" if quantity == "displacement" else quantity
         si = to_si(np.asarray(values, float)[keep], unit, dimension, file=src, key=name)
-        channels.append(RawChannel(name, spec.mount, spec.side, spec.direction, quantity,
-                                   si, unit))
+        channels.append(RawChannel(name, spec.mount, spec.side, spec.direction, quantity, si, unit))
     if cmap is not None:
         for name in cmap.channels:
             if name not in used:

@@ -41,12 +41,10 @@ def read_csv_signals(path, channel_map=None) -> FileSignals:
             or h == time_name]
     if not tcol:
         raise InputError(f"header lacks a '{time_name} [s]' column (is this a wide raw CSV? "
-                         "order curves go to 'compare', not 'track')", file=path, line=start,
-                         key="time")
+                         "order curves go to 'compare', not 'track')", file=path, line=start, key="time")
     data = _numbers(lines, start, len(header), path)
     tname = header[tcol[0]]
-    tunit = split_unit(tname)[1] or "s"
-    time = to_si(data[:, tcol[0]], tunit, "time", file=path, key=tname)
+    time = to_si(data[:, tcol[0]], split_unit(tname)[1] or "s", "time", file=path, key=tname)
     signals = [(h, data[:, k], split_unit(h)[1]) for k, h in enumerate(header) if k != tcol[0]]
     return FileSignals(time, signals, str(path), tname, comments)
 
@@ -66,8 +64,7 @@ def _numbers(lines, start, n_cols, path):
                 continue
             fields = s.split(",")
             if len(fields) != n_cols:
-                raise InputError(f"{len(fields)} fields, header has {n_cols}", file=path,
-                                 line=lineno)
+                raise InputError(f"{len(fields)} fields, header has {n_cols}", file=path, line=lineno)
             for k, f in enumerate(fields):
                 try:
                     float(f)
@@ -80,11 +77,9 @@ def _numbers(lines, start, n_cols, path):
 
 def write_raw_csv(path, recording, *, comment: str = "") -> None:
     """Write a :class:`RawRecording` as a wide CSV in its channels' file units (time to 15
-    significant digits: uniform to the reader's tolerance however late it starts, the
-    values to 9)."""
+    significant digits, to stay uniform however late it starts; values to 9)."""
     signals = written_signals(recording)
-    names = ["time [s]"] + [f"{name} [{'1/min' if name == 'rpm' else unit}]"
-                            for name, _, unit, _ in signals]
+    names = ["time [s]"] + [f"{name} [{'1/min' if name == 'rpm' else unit}]" for name, _, unit, _ in signals]
     with atomic_write(path) as fh:
         for line in (comment.splitlines() if comment else []):
             fh.write(f"# {line}\n")

@@ -30,12 +30,9 @@ def _unit(ds):
     return u.decode() if isinstance(u, bytes) else str(u)
 
 
-def read_hdf5_signals(path, channel_map=None, *, map_option="--channels",
-                      extra=()) -> FileSignals:
-    """Signals of a raw HDF5 file (docs/reference/raw-data.md); ``map_option`` is the
-    option named in the hint of a file that needs a channel map; ``extra``: names of more
-    datasets read where the file has them (a trigger or cycle reference named by an
-    option)."""
+def read_hdf5_signals(path, channel_map=None, *, map_option="--channels", extra=()) -> FileSignals:
+    """Signals of a raw HDF5 file (docs/reference/raw-data.md): ``map_option`` is named in the
+    hint when a channel map is needed; ``extra`` names more datasets read if present."""
     import h5py  # deferred: heavy package, loaded only when this format is used
     try:
         h5 = h5py.File(path, "r")
@@ -44,8 +41,7 @@ def read_hdf5_signals(path, channel_map=None, *, map_option="--channels",
     with h5:
         try:
             return _read(h5, path, channel_map, map_option, tuple(n for n in extra if n))
-        except (KeyError, OSError, RuntimeError, TypeError) as exc:
-            # h5py's errors for broken links and unreadable objects
+        except (KeyError, OSError, RuntimeError, TypeError) as exc:   # broken links, unreadable objects
             raise InputError(f"unreadable HDF5 object ({str(exc)[:80]})", file=path) from None
 
 
@@ -80,8 +76,7 @@ class _Budget:
 def _dataset(h5, name, path, budget):
     obj = h5.get(name)
     if obj is None or not hasattr(obj, "shape") or not hasattr(obj, "dtype"):
-        raise InputError("dataset not found (or a group, or a broken link)", file=path,
-                         key=name)
+        raise InputError("dataset not found (or a group, or a broken link)", file=path, key=name)
     if len(obj.shape or ()) != 1 or obj.dtype.kind not in "iuf":
         raise InputError("expected a 1-D numeric dataset", file=path, key=name)
     if obj.shape[0] > budget.left:
@@ -107,11 +102,9 @@ def _flag_attr(h5, name, path) -> bool:
     value = h5.attrs.get(name, False)
     if isinstance(value, np.ndarray) and value.shape == ():
         value = value[()]
-    if isinstance(value, (bool, np.bool_)) or (isinstance(value, (int, np.integer))
-                                               and value in (0, 1)):
+    if isinstance(value, (bool, np.bool_)) or (isinstance(value, (int, np.integer)) and value in (0, 1)):
         return bool(value)
-    raise InputError("expected a boolean attribute (true or false)", file=path,
-                     key=f"/@{name}")
+    raise InputError("expected a boolean attribute (true or false)", file=path, key=f"/@{name}")
 
 
 def _time(h5, name, path, budget):
@@ -140,20 +133,18 @@ def _read_own(h5, path, extra=()):
         key = f"channels/{name}"
         signals.append((name, _dataset(h5, key, path, budget), _unit(h5[key])))
     comments = _comments(h5, path)
-    if _flag_attr(h5, "synthetic", path) and \
-            not any("synthetic" in c.lower() for c in comments):
+    if _flag_attr(h5, "synthetic", path) and not any("synthetic" in c.lower() for c in comments):
         comments.append("SYNTHETIC")
     return FileSignals(time, signals, str(path), "time", comments, times)
 
 
 def _own_time(h5, name, path, times, budget):
-    """Record the own time base [s] of dataset ``name`` if its ``time`` attribute names one."""
+    """Record the own time base [s] of dataset ``name`` its ``time`` attribute names, if any."""
     ref = h5[name].attrs.get("time")
     if ref is None:
         return
     ref = ref.decode() if isinstance(ref, bytes) else str(ref)
-    times[name] = to_si(_dataset(h5, ref, path, budget), _unit(h5[ref]) or "s", "time", file=path,
-                        key=ref)
+    times[name] = to_si(_dataset(h5, ref, path, budget), _unit(h5[ref]) or "s", "time", file=path, key=ref)
 
 
 def _read_mapped(h5, path, cmap, extra=()):
@@ -172,10 +163,9 @@ def _read_mapped(h5, path, cmap, extra=()):
 
 
 def write_raw_hdf5(path, recording, *, description: str = "", synthetic: bool = False) -> None:
-    """Write a :class:`RawRecording` in the ``powertrain-raw`` layout (docs/reference/raw-data.md;
-    values in each channel's unit)."""
+    """Write a :class:`RawRecording` in the ``powertrain-raw`` layout, values in each channel's
+    unit."""
     import h5py  # deferred: heavy package, loaded only when this format is used
-
     with atomic_path(path) as tmp:
         with h5py.File(tmp, "w") as h5:
             a = h5.attrs

@@ -1,10 +1,6 @@
-"""Raw run-up time data in ASAM MDF4 (read and written by asammdf).
-
-Every channel of the file except the masters is a signal (name and unit as stored). The
-vibration channels must share one time base (a test-lab export of one group does); the
-speed or tacho channel may have its own, e.g. CAN engine speed at 100 Hz in its own group,
-and is resampled onto the vibration channels' (:func:`powertrain.iotools.raw.assemble`).
-Names follow the ``MOUNT.DIRECTION`` convention or a channel map.
+"""Raw run-up time data in ASAM MDF4 (asammdf): every channel but the masters is a signal.
+The vibration channels share one time base; a speed or tacho channel may have its own (e.g.
+CAN speed at 100 Hz), resampled by :func:`powertrain.iotools.raw.assemble`.
 """
 
 from __future__ import annotations
@@ -50,8 +46,7 @@ def read_mdf_signals(path, channel_map=None) -> FileSignals:
                 t = np.asarray(sig.timestamps, float)
                 if t.size < 2 or np.size(sig.samples) != t.size:
                     raise InputError(f"channel has {np.size(sig.samples)} samples at "
-                                     f"{t.size} times; a signal needs at least 2",
-                                     file=path, key=sig.name)
+                                     f"{t.size} times; a signal needs at least 2", file=path, key=sig.name)
                 if time is None:
                     time = t
                 elif t.shape != time.shape or not np.allclose(t, time, rtol=0,
@@ -77,8 +72,7 @@ def _check_declared_size(mdf, path) -> None:
     total = 0
     for g, group in enumerate(mdf.groups):
         cg = group.channel_group
-        record = int(getattr(cg, "samples_byte_nr", 0)) + \
-            int(getattr(cg, "invalidation_bytes_nr", 0))
+        record = int(getattr(cg, "samples_byte_nr", 0)) + int(getattr(cg, "invalidation_bytes_nr", 0))
         total += int(getattr(cg, "cycles_nr", 0)) * record
         if total > MAX_SAMPLE_BYTES:
             raise InputError(f"channel group {g + 1} declares {total:.3g} bytes of samples; "
@@ -108,7 +102,6 @@ def _quiet_collect():
 def write_raw_mdf(path, recording) -> None:
     """Write a :class:`RawRecording` as MDF 4.10, one group, one channel per signal."""
     from asammdf import MDF, Signal  # deferred: heavy package, loaded only when this format is used
-
     t = np.asarray(recording.time, float)
     sigs = [Signal(np.asarray(values, float), t, name=name, unit=unit)
             for name, values, unit, _ in written_signals(recording, cycle=False)]

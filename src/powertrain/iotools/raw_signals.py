@@ -1,9 +1,6 @@
 """A raw recording as the format modules see it: :class:`FileSignals` (what a reader found,
-before :func:`powertrain.iotools.raw.read_raw` maps channels and converts units) and
-:func:`written_signals` (what a writer stores).
-
-Its own module so that the format readers (``raw_csv``, ``raw_hdf5``, ``raw_mdf``,
-``raw_uff``) and the entry point (``raw``) import it without importing each other in a circle.
+in file units) and :func:`written_signals` (what a writer stores); shared by the readers and
+:mod:`powertrain.iotools.raw` without an import cycle.
 """
 
 from __future__ import annotations
@@ -28,9 +25,8 @@ class FileSignals:
 
 
 def written_signals(recording, *, cycle: bool = True) -> list:
-    """``(name, values, unit, channel)`` a writer stores: ``rpm`` [rpm], ``tacho``, (with
-    ``cycle``) ``cycle`` and ``trigger`` [V] where ``recording`` has them (``channel``
-    None), then every
+    """``(name, values, unit, channel)`` a writer stores: ``rpm`` [rpm], ``tacho``, ``cycle``
+    (if ``cycle``) and ``trigger`` [V] where present (``channel`` None), then every
     :class:`RawChannel` in its file unit."""
     out = [(name, values, unit, None) for name, values, unit in (
         ("rpm", recording.rpm, "rpm"), ("tacho", recording.tacho, "V"),

@@ -1,10 +1,7 @@
-"""Raw run-up time data in the universal file format, dataset 58 (read and written by pyuff).
-
-One dataset 58 per channel: name = ID line 1, unit = the ordinate units label; all channels
-share one time base (docs/reference/raw-data.md). A truncated file is refused: it must end
-with the ``-1`` delimiter, every dataset started must be complete, and the datasets written
-here are numbered (ID line 4 ``powertrain dataset K of N``) so that a file cut at a dataset
-boundary is found too.
+"""Raw run-up time data in the universal file format (pyuff): one dataset 58 per channel, name
+= ID line 1, unit = ordinate units label, one time base (docs/reference/raw-data.md). A
+truncated file is refused; datasets written here are numbered (ID line 4 ``powertrain dataset
+K of N``) so that a file cut at a dataset boundary is found too.
 """
 
 from __future__ import annotations
@@ -38,16 +35,13 @@ def read_uff_signals(path, channel_map=None) -> FileSignals:
         gc.collect()
     if problem is not None:
         raise InputError(f"not a readable universal file ({problem})", file=path)
-    if isinstance(sets, dict):
-        sets = [sets]
+    sets = [sets] if isinstance(sets, dict) else sets
     check_complete(path, len(sets))
     sets = [s for s in sets if s.get("type") == 58]
     if not sets:
-        raise InputError("no dataset 58 (function at nodal DOF) in the universal file",
-                         file=path)
+        raise InputError("no dataset 58 (function at nodal DOF) in the universal file", file=path)
     _check_count(path, sets)
-    time = None
-    signals = []
+    time, signals = None, []
     for k, s in enumerate(sets):
         name = str(s.get("id1", "")).strip() or f"dataset {k + 1}"
         x = np.asarray(s["x"], float)
@@ -66,9 +60,8 @@ def read_uff_signals(path, channel_map=None) -> FileSignals:
     return FileSignals(time, signals, str(path), "abscissa")
 
 
-#: Start of a dataset: the ``-1`` delimiter line, then the dataset number (``58`` or
-#: ``58b`` for binary).
 _COUNT = re.compile(r"powertrain dataset (\d+) of (\d+)")
+#: Start of a dataset: the ``-1`` delimiter line, then the dataset number (``58``, ``58b``).
 _DATASET_START = re.compile(rb"(?:^|\n)[ ]*-1[ ]*\r?\n[ ]*(\d+)b?[ \r\n]")
 
 
@@ -78,8 +71,7 @@ def check_complete(path, n_read: int) -> None:
     with open(path, "rb") as fh:
         data = fh.read()
     if not data.rstrip().endswith(b"-1") or not data.rstrip()[:-2].endswith((b"\n", b" ")):
-        raise InputError("file does not end with the '-1' delimiter line: truncated?",
-                         file=path)
+        raise InputError("file does not end with the '-1' delimiter line: truncated?", file=path)
     started = len(_DATASET_START.findall(data))
     if started > n_read:
         raise InputError(f"{started} datasets start in the file but only {n_read} could be "
@@ -87,8 +79,7 @@ def check_complete(path, n_read: int) -> None:
 
 
 def _check_count(path, sets) -> None:
-    """Files written here number their datasets (ID line 4, ``powertrain dataset K of N``);
-    a file cut at a dataset boundary then misses some of 1..N."""
+    """Refuse numbered datasets (ID line 4, ``powertrain dataset K of N``) missing some of 1..N."""
     marks = [_COUNT.fullmatch(str(s.get("id4", "")).strip()) for s in sets]
     totals = {int(m.group(2)) for m in marks if m}
     if not totals:
@@ -102,7 +93,6 @@ def _check_count(path, sets) -> None:
 def write_raw_uff(path, recording) -> None:
     """Write a :class:`RawRecording` as datasets 58 (binary, double precision)."""
     import pyuff  # deferred: heavy package, loaded only when this format is used
-
     rows = written_signals(recording, cycle=False)
     sets = []
     for node, (name, values, unit, ch) in enumerate(rows, start=1):

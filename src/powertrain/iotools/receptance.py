@@ -1,11 +1,8 @@
-r"""Measured body receptances for ``[chassis] model = "frf"``: CSV or UFF 58.
-
-CSV columns ``frequency_hz,response,excitation,receptance_real_m_per_n,
-receptance_imag_m_per_n`` with ``response``/``excitation`` = ``NAME.DIR`` (a mount's body-side
-point or a body point); UFF 58: one receptance FRF (function type 4, m/N) per pair, the point
-named by ``rsp_ent_name``/``ref_ent_name``, directions 1/2/3 = x/y/z (negative = reversed).
-Needed: every pair of attachment-point directions (reciprocity fills H_ab from H_ba) and each
-body point's response to them, on one frequency grid (docs/guide/chassis.md).
+r"""Measured body receptances for ``[chassis] model = "frf"`` (docs/guide/chassis.md): a CSV of
+:data:`COLUMNS` with ``response``/``excitation`` = ``NAME.DIR``, or UFF 58 (function type 4,
+m/N; points ``rsp_ent_name``/``ref_ent_name``, directions 1/2/3 = x/y/z, negative reversed).
+Needed on one grid: every pair of mount directions (reciprocity fills H_ab from H_ba) and each
+body point's response to them.
 """
 
 from __future__ import annotations
@@ -19,8 +16,7 @@ from powertrain.iotools.raw_uff import check_complete
 from powertrain.iotools.textfile import check_regular_file, parse_number, read_text
 from powertrain.models.chassis import MeasuredReceptance
 
-COLUMNS = ("frequency_hz", "response", "excitation", "receptance_real_m_per_n",
-           "receptance_imag_m_per_n")
+COLUMNS = ("frequency_hz", "response", "excitation", "receptance_real_m_per_n", "receptance_imag_m_per_n")
 
 
 class _Names(tuple):
@@ -42,8 +38,8 @@ def _channel(text, names, path, line, column):
 
 
 def read_receptance(path, mounts, points, defined_in="") -> MeasuredReceptance:
-    """Read a receptance file (``.uff``/``.unv`` as UFF 58, else CSV) and check coverage.
-    ``defined_in``: the engine file that names the mounts and points (for messages)."""
+    """Read a receptance file (``.uff``/``.unv`` as UFF 58, else CSV) and check coverage
+    (``defined_in``: the engine file naming the mounts and points, for messages)."""
     path = str(path)
     names = _Names(list(mounts) + list(points), defined_in)
     if path.lower().endswith((".uff", ".unv")):
@@ -83,8 +79,7 @@ def _to_grid(data, path):
         f = np.array([r[0] for r in rows])
         if np.any(np.diff(f) <= 0):
             raise InputError(f"frequencies of {key[0]}.{key[1]} / {key[2]}.{key[3]} must be "
-                             "strictly increasing", file=path, line=rows[0][2],
-                             key="frequency_hz")
+                             "strictly increasing", file=path, line=rows[0][2], key="frequency_hz")
         if grid is None:
             grid = f
         elif f.shape != grid.shape or not np.allclose(f, grid, rtol=1e-9):
@@ -150,17 +145,14 @@ def _uff_record(s, names, path, key):
     if f.ndim != 1 or f.shape != h.shape:
         raise InputError(f"{h.size} values at {f.size} frequencies", file=path, key=key)
     if not (np.all(np.isfinite(f)) and np.all(f >= 0) and np.all(np.isfinite(h))):
-        raise InputError("frequencies and receptances must be finite (frequencies >= 0)",
-                         file=path, key=key)
+        raise InputError("frequencies and receptances must be finite (frequencies >= 0)", file=path, key=key)
     return r, e, f, h
 
 
 def _check_coverage(values, mounts, points, path):
     for a, b, ad, bd in product(mounts, mounts, "xyz", "xyz"):
         if (a, ad, b, bd) not in values and (b, bd, a, ad) not in values:
-            raise InputError(f"missing receptance {a}.{ad} / {b}.{bd}", file=path,
-                             key="response")
+            raise InputError(f"missing receptance {a}.{ad} / {b}.{bd}", file=path, key="response")
     for p, b, pd, bd in product(points, mounts, "xyz", "xyz"):
         if (p, pd, b, bd) not in values:
-            raise InputError(f"missing receptance {p}.{pd} / {b}.{bd}", file=path,
-                             key="response")
+            raise InputError(f"missing receptance {p}.{pd} / {b}.{bd}", file=path, key="response")

@@ -15,9 +15,8 @@ from powertrain.solvers.operating_point import OperatingPoint
 
 
 def read_runup_hdf5(path) -> RunupResult:
-    """Read a run-up HDF5 file (the layout of :mod:`powertrain.results.runup`, written by
-    :meth:`RunupResult.to_hdf5`); every dataset's type and shape is checked (errors name the
-    file and the dataset or attribute)."""
+    """Read a run-up HDF5 file (layout: :mod:`powertrain.results.runup`), every dataset's type
+    and shape checked."""
     import h5py  # deferred: heavy package, loaded only when this format is used
     check_regular_file(path)
     try:
@@ -90,8 +89,7 @@ def _h5_array(h5, key, path, kinds, ndim, shape=None):
     if obj.ndim != ndim or (shape is not None and obj.shape != tuple(shape)):
         want = shape if shape is not None else f"{ndim} dimensions"
         raise InputError(f"shape {obj.shape}, expected {want}", file=path, key=key)
-    data = obj[()]
-    return np.asarray(data, dtype=complex if kind == "c" else float)
+    return np.asarray(obj[()], dtype=complex if kind == "c" else float)
 
 
 def _h5_paths(h5, path, n):
@@ -101,8 +99,7 @@ def _h5_paths(h5, path, n):
     key = "path_contribution/velocity"
     data = _h5_array(h5, key, path, "c", 4)
     if data.shape[0] != n[0] or data.shape[3] != n[2] or data.shape[1] % 3 or data.shape[2] % 3:
-        raise InputError(f"shape {data.shape} does not fit the speeds and orders", file=path,
-                         key=key)
+        raise InputError(f"shape {data.shape} does not fit the speeds and orders", file=path, key=key)
     return data
 
 

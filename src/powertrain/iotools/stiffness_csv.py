@@ -1,9 +1,6 @@
-"""Measured dynamic stiffness tables K*(f) (``fit-mount`` input): CSV in datasheet units.
-
-Columns ``frequency_hz`` and ``k_real_n_per_mm,k_imag_n_per_mm`` or ``k_abs_n_per_mm,
-phase_deg``, optionally ``amplitude_mm`` first (one block of rows per test amplitude, Kovarik
-2016 Fig. 14): docs/reference/csv-formats.md. Converted to SI here; every problem is an
-:class:`~powertrain.errors.InputError` naming the file, the column and (for values) the line.
+"""Measured dynamic stiffness tables K*(f) (``fit-mount`` input, docs/reference/csv-formats.md):
+CSV in datasheet units into SI, optionally one block of rows per test amplitude (Kovarik 2016
+Fig. 14).
 """
 
 from __future__ import annotations
@@ -25,17 +22,8 @@ ABS, PHASE = "k_abs_n_per_mm", "phase_deg"
 
 @dataclass(frozen=True)
 class MeasuredStiffness:
-    """A measured cross-point dynamic stiffness curve.
-
-    Attributes
-    ----------
-    frequency_hz : ndarray
-        [Hz], strictly increasing.
-    kcp : ndarray of complex
-        Cross-point dynamic stiffness [N/m].
-    source : str
-        File it was read from.
-    """
+    """A measured cross-point dynamic stiffness curve: ``frequency_hz`` [Hz], strictly
+    increasing; ``kcp`` the complex stiffness [N/m]; ``source`` the file read."""
 
     frequency_hz: np.ndarray
     kcp: np.ndarray
@@ -53,8 +41,7 @@ class MeasuredStiffness:
         if fmax is not None:
             keep &= self.frequency_hz <= fmax
         amp = None if self.amplitude_m is None else self.amplitude_m[keep]
-        return MeasuredStiffness(self.frequency_hz[keep], self.kcp[keep], self.source, amp,
-                                 self.synthetic)
+        return MeasuredStiffness(self.frequency_hz[keep], self.kcp[keep], self.source, amp, self.synthetic)
 
     @property
     def amplitudes(self) -> np.ndarray:
@@ -74,8 +61,7 @@ LIMITS = {FREQUENCY: 1e5, REAL: 1e9, IMAG: 1e9, ABS: 1e9, PHASE: 360.0, AMPLITUD
 
 
 def _open_rows(path):
-    """The data rows (line number, fields) of a CSV file, and whether a comment line says
-    the data are synthetic."""
+    """The data rows (line number, fields) and whether a comment says "synthetic"."""
     text = read_text(path, "CSV")
     rows, synthetic = [], False
     try:
@@ -108,9 +94,7 @@ def read_stiffness_csv(path) -> MeasuredStiffness:
     Raises
     ------
     InputError
-        Unreadable file, missing or duplicated column, wrong number of fields, a value that
-        is not a finite number, negative frequency or magnitude, frequencies not strictly
-        increasing, no data rows.
+        Naming file, column and line of the first problem.
     """
     path = str(path)
     rows, synthetic = _open_rows(path)
@@ -120,9 +104,7 @@ def read_stiffness_csv(path) -> MeasuredStiffness:
     pair, polar = _columns(header, header_line, path)
     amp = [AMPLITUDE] if AMPLITUDE in header else []
     data = _values(rows[1:], header, [*amp, FREQUENCY, *pair], path)
-    f = np.array(data[FREQUENCY])
-    a = np.array(data[pair[0]])
-    b = np.array(data[pair[1]])
+    f, a, b = (np.array(data[name]) for name in (FREQUENCY, *pair))
     if polar:
         mag = to_si(a, "N/mm", "stiffness")
         kcp = mag * np.exp(1j * to_si(b, "deg", "angle"))
@@ -133,8 +115,7 @@ def read_stiffness_csv(path) -> MeasuredStiffness:
 
 
 def _columns(header, header_line, path):
-    """``(pair, polar)``: the two stiffness columns of the header and whether they are
-    magnitude and phase."""
+    """``(pair, polar)``: the two stiffness columns and whether they are magnitude, phase."""
     seen = set()
     for name in header:
         if name in seen:
@@ -173,8 +154,7 @@ def _values(rows, header, cols, path) -> dict:
                 blocks.check(value, raw, lineno)
             limit = LIMITS.get(name)
             if limit is not None and abs(value) > limit:
-                raise InputError(f"|{raw}| above the plausible {limit:g}", file=path,
-                                 key=name, line=lineno)
+                raise InputError(f"|{raw}| above the plausible {limit:g}", file=path, key=name, line=lineno)
             data[name].append(value)
     if not data[FREQUENCY]:
         raise InputError("no data rows", file=path, key=FREQUENCY)
@@ -182,8 +162,7 @@ def _values(rows, header, cols, path) -> dict:
 
 
 class _Blocks:
-    """The frequency order of a table: strictly increasing within each amplitude block,
-    each amplitude (> 0) one block (one block without an amplitude column)."""
+    """Frequencies strictly increasing within each block of one amplitude (> 0)."""
 
     def __init__(self, path):
         self.path, self.seen, self.last = path, [], None
@@ -196,8 +175,7 @@ class _Blocks:
             return
         if amplitude in self.seen:
             raise InputError(f"amplitude {amplitude:g} mm again after other amplitudes "
-                             "(one block of rows per amplitude)", file=self.path,
-                             key=AMPLITUDE, line=lineno)
+                             "(one block of rows per amplitude)", file=self.path, key=AMPLITUDE, line=lineno)
         self.seen.append(amplitude)
         self.last = None
 

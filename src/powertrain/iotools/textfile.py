@@ -13,9 +13,8 @@ MAX_FILE_BYTES = 512 * 2 ** 20
 
 
 def check_regular_file(path) -> None:
-    """Refuse, without opening it, anything but an existing regular file of at most
-    :data:`MAX_FILE_BYTES` (a FIFO or device would block or never end), and anything but a
-    path (an int would name an open file descriptor)."""
+    """Refuse, without opening it, anything but a path to a regular file of at most
+    :data:`MAX_FILE_BYTES` (a FIFO or device would block; an int is a file descriptor)."""
     if not isinstance(path, (str, os.PathLike)):
         raise InputError(f"expected a file path, got {type(path).__name__} {str(path)[:40]!r}")
     try:
@@ -34,18 +33,14 @@ def check_regular_file(path) -> None:
 
 
 def read_text(path, kind: str = "text") -> str:
-    """Whole content of a UTF-8 text file.
+    """Whole content of a UTF-8 text file (:class:`InputError` naming the file if unreadable).
 
     Parameters
     ----------
     path : str or Path
+        The file.
     kind : str
         What the file should be (``"CSV"``, ``"TOML"``), for the error message.
-
-    Raises
-    ------
-    InputError
-        Missing, unreadable, a directory, or not UTF-8 — one line naming the file.
     """
     check_regular_file(path)
     try:
@@ -87,29 +82,17 @@ def parse_number(text, path, line, column, *, nonneg: bool = False) -> float:
     ----------
     text : str
         Cell content.
-    path : str
-        File, for the error message.
-    line : int
-        1-based line number, for the error message.
-    column : str
-        Column name, for the error message.
+    path, line, column : str, int, str
+        File, 1-based line number and column name, named by the error.
     nonneg : bool
         Reject negative values.
-
-    Raises
-    ------
-    InputError
-        Not a number, NaN/infinite, or negative when ``nonneg``.
     """
     try:
         value = float(text)
     except (TypeError, ValueError):
-        raise InputError(f"not a number: {str(text).strip()!r}", file=path, line=line,
-                         key=column) from None
+        raise InputError(f"not a number: {str(text).strip()!r}", file=path, line=line, key=column) from None
     if not math.isfinite(value):
-        raise InputError(f"not a finite number ({str(text).strip()})", file=path, line=line,
-                         key=column)
+        raise InputError(f"not a finite number ({str(text).strip()})", file=path, line=line, key=column)
     if nonneg and value < 0:
-        raise InputError(f"must not be negative, got {str(text).strip()}", file=path,
-                         line=line, key=column)
+        raise InputError(f"must not be negative, got {str(text).strip()}", file=path, line=line, key=column)
     return value

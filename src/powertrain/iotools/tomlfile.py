@@ -37,15 +37,12 @@ def get(table: dict, key: str, path, prefix: str = "", *, default=..., types=Non
         return default
     value = table[key]
     if types is not None and not isinstance(value, types):
-        raise InputError(f"expected {_type_name(types)}, got {type(value).__name__}",
-                         file=path, key=full)
+        raise InputError(f"expected {_type_name(types)}, got {type(value).__name__}", file=path, key=full)
     return value
 
 
 def _type_name(types):
-    if isinstance(types, tuple):
-        return " or ".join(t.__name__ for t in types)
-    return types.__name__
+    return " or ".join(t.__name__ for t in types) if isinstance(types, tuple) else types.__name__
 
 
 def number(value, path, key, *, nonneg=False, positive=False) -> float:
@@ -64,22 +61,18 @@ def number(value, path, key, *, nonneg=False, positive=False) -> float:
 
 def quantity(table: dict, key: str, dimension: str, path, prefix: str = "", *,
              default=..., nonneg=False, positive=False):
-    """Read ``key = {value = ..., unit = "..."}`` (or ``[value, "unit"]``) and convert to SI.
-
-    Every physical quantity in engine files declares its unit this way.
-    """
+    """Read ``key = {value = ..., unit = "..."}`` and convert to SI (a list value: a list)."""
     full = f"{prefix}.{key}" if prefix else key
     raw = get(table, key, path, prefix, default=default)
     if raw is default and default is not ...:
         return default
-    if isinstance(raw, dict):
-        if "value" not in raw:
-            raise InputError("missing key", file=path, key=f"{full}.value")
-        if "unit" not in raw:
-            raise InputError("missing unit", file=path, key=f"{full}.unit")
-        value, unit = raw["value"], raw["unit"]
-    else:
+    if not isinstance(raw, dict):
         raise InputError("expected {value = ..., unit = \"...\"}", file=path, key=full)
+    if "value" not in raw:
+        raise InputError("missing key", file=path, key=f"{full}.value")
+    if "unit" not in raw:
+        raise InputError("missing unit", file=path, key=f"{full}.unit")
+    value, unit = raw["value"], raw["unit"]
     if isinstance(value, list):
         vals = [number(v, path, f"{full}.value", nonneg=nonneg, positive=positive) for v in value]
         return [to_si(v, unit, dimension, file=path, key=f"{full}.unit") for v in vals]
@@ -92,8 +85,7 @@ def check_keys(table, allowed, path, prefix):
     unknown = sorted(set(table) - set(allowed))
     if unknown:
         key = f"{prefix}.{unknown[0]}" if prefix else unknown[0]
-        raise InputError(f"unknown key (expected one of: {', '.join(sorted(allowed))})",
-                         file=path, key=key)
+        raise InputError(f"unknown key (expected one of: {', '.join(sorted(allowed))})", file=path, key=key)
 
 
 def subtable(doc, key, path, prefix=""):
@@ -138,8 +130,7 @@ def array_quantity(table, key, dimension, path, prefix, shape, *, nonneg=False, 
     if got is None or got == () or (want_len is not None and got != want_len):
         raise InputError(f"expected a list of shape {shape}, got {value!r}"[:200],
                          file=path, key=f"{full}.value")
-    vals = [number(v, path, f"{full}.value", nonneg=nonneg, positive=positive)
-            for v in flat(value)]
+    vals = [number(v, path, f"{full}.value", nonneg=nonneg, positive=positive) for v in flat(value)]
     return np.asarray(to_si(np.array(vals, dtype=float), unit, dimension, file=path,
                             key=f"{full}.unit"), dtype=float).reshape(got)
 
@@ -154,8 +145,7 @@ def unit_vector(table, key, path, prefix):
     v = vector3(table, key, "dimensionless", path, prefix)
     n = float(np.linalg.norm(v))
     if n < 1e-12:
-        raise InputError("direction vector must not be zero", file=path,
-                         key=f"{prefix}.{key}")
+        raise InputError("direction vector must not be zero", file=path, key=f"{prefix}.{key}")
     return v / n
 
 
