@@ -63,32 +63,27 @@ def diagnose(measured, engine=None, *, noise_floor=DEFAULT_NOISE_FLOOR, effects=
     Parameters
     ----------
     measured : MeasuredRunup, Plan, str or path
-        Measured order curves [m/s RMS], or the file to read them from (CSV or run-up
-        HDF5, :func:`powertrain.iotools.measured.read_measured`); or a test plan of several
-        run-ups (:class:`powertrain.iotools.plan.Plan`, or its ``.toml`` file,
-        :func:`powertrain.iotools.plan.read_plan`): one set of effect parameters fitted to
-        all runs (:mod:`powertrain.diagnosis.plan`).
+        Measured order curves [m/s RMS] or their file (CSV or run-up HDF5); or a test plan
+        (:class:`powertrain.iotools.plan.Plan` or its ``.toml``): one parameter set for all runs.
     engine : Engine, str or path, optional
-        Baseline model, or its file (default: the shipped ``engines/default.toml``).
+        Baseline model or its file (default: the shipped ``engines/default.toml``).
     noise_floor : float
         RMS noise floor of the measured order curves [m/s].
     effects : sequence of str, optional
-        Candidates (default: all of the effect registry that apply to ``engine``).
+        Candidates (default: every registry effect that applies to ``engine``).
     pairs : bool
-        Also fit the pairs of the three best single candidates.
+        Also fit pairs of the best single candidates.
     band_check : bool
         Refit the chosen effect on speed bands (confounding check).
     rule : DecisionRule, optional
-        Decision constants (default :class:`DecisionRule`).
+        Decision constants.
     scheduler : str
-        Where the candidate fits run (:func:`powertrain.parallel.executor`): ``serial``
-        (default, also for None: it starts fastest), ``processes``, ``local`` (dask
-        LocalCluster) or ``tcp://HOST:PORT``.
-        The result is the same on every scheduler.
+        Where the fits run (:func:`powertrain.parallel.executor`): ``serial`` (default),
+        ``processes``, ``local`` or ``tcp://HOST:PORT``; the result is the same on each.
     progress : bool
         Progress bar on stderr (only on a terminal).
     budget : int
-        Residual evaluations per fit (:data:`powertrain.diagnosis.fit.EVAL_BUDGET`).
+        Residual evaluations per fit.
 
     Returns
     -------
@@ -111,9 +106,7 @@ def diagnose(measured, engine=None, *, noise_floor=DEFAULT_NOISE_FLOOR, effects=
 
 
 def _inputs(measured, engine, effects):
-    """``(engine, measured)`` read from their files when given as paths; the effect names
-    checked against the registry."""
-
+    """``(engine, measured)``, read from files if paths; effect names checked."""
     for e in effects or []:
         if e not in EFFECTS:
             raise InputError(f"unknown effect {e!r} (known: {', '.join(EFFECTS)})",
@@ -146,7 +139,7 @@ class _Setup:
         self.test_idx = even(self.test_all, N_TEST_RPM)
         self.effects = cand.applicable(engine, effects)
         self.hm = HarmonicModel(engine, data.rpm)
-        if data.channels != self.hm.channels:       # body-side channels measured (or not)
+        if data.channels != self.hm.channels:
             self.hm.use_channels(data.channels)
         cand.warm_caches(self.hm, self.effects)     # once, on every speed: subsets share it
         need = np.union1d(self.train_all, self.test_idx)
@@ -159,8 +152,7 @@ class _Setup:
         return self.hm_need.subset([self.pos[int(i)] for i in idx])
 
     def fold_problems(self) -> list:
-        """``[(Problem, baseline outcome)]`` of speed folds 1, 2 (:func:`split_rpm`; fold 0
-        is ``problem``), built on first use."""
+        """``[(Problem, baseline outcome)]`` of speed folds 1, 2, built on first use."""
         if getattr(self, "_folds", None) is None:
             self._folds = []
             for k in range(1, N_FOLDS):
@@ -219,8 +211,7 @@ def _fit_job(job):
 
 
 def _fit_all(s: _Setup, pairs, scheduler, progress, budget, e_n, rule, baseline, sigma):
-    """Singles, then pairs (:func:`pair_candidates`); in the order of submission, each with
-    its structured residual."""
+    """Fit singles, then pairs (:func:`pair_candidates`), each with its structured residual."""
     desc = "diagnose: candidate fits" if progress else None
     jobs = [(s.problem, (e,), None, budget) for e in s.effects]
     singles = run_map(_fit_job, jobs, scheduler, progress=desc)
@@ -237,11 +228,16 @@ def _fit_all(s: _Setup, pairs, scheduler, progress, budget, e_n, rule, baseline,
 
 
 def pair_candidates(singles, e_n, rule) -> list:
-    """Pairs worth fitting: none when the best single leaves a held-out excess RMS gap over
-    noise below ``rule.excess_min_db`` and a structured residual within
-    ``rule.struct_abs_db`` (nothing left that a second effect could be shown to explain);
-    else the best single with each other effect (forward selection: the second effect is
-    whatever explains most of the rest) and the second with the third best."""
+    """Pairs worth fitting: the best single with each other and the second with the third;
+    none when the best leaves an excess below ``rule.excess_min_db`` and no structure.
+
+    Parameters
+    ----------
+    singles : list of FitOutcome
+    e_n : float
+        Noise mean squared gap [dB²].
+    rule : DecisionRule
+    """
     ranked = sorted(singles, key=lambda o: o.heldout_mse)
     if not ranked:
         return []
@@ -280,9 +276,7 @@ def _decide(s, baseline, outcomes, sigma, rule, where_phrase, budget):
                 by_label[label].crossfit = crossfit(folds, by_label[label], budget=budget)
             continue
         o = by_label[verdict.needs_cells_check]
-        # over all speed folds when its support itself needed them (held-out t short), or
-        # asked again after a check at the held-out speeds fell short (rule.xv_t_screen)
-        # (a retry reuses the held-out speeds' refits of the first check)
+        # all speed folds when held-out t was short, or on a retry (reusing the first refits)
         all_folds = (not verdict.assessments[o.label].t_stat > rule.t_min
                      or o.cells_check is not None)
         first = o.cells_check["parts"][0] if o.cells_check is not None else None
@@ -305,7 +299,7 @@ def _diagnose(measured, engine, noise_floor, effects, pairs, do_bands, rule, sch
         s = PlanSetup(measured, engine, noise_floor, effects, _Setup)
     else:
         s = _Setup(measured, engine, noise_floor, effects)
-    w = getattr(s, "first", s)                 # step 1 and the figures: a plan's first run
+    w = getattr(s, "first", s)                 # where and the figures: a plan's first run
     gap_map, parts, rigid, found, sim0 = _where(w)
     s.effects = cand.at_location(s.effects, parts.get("sides"))
     sigma = noise_sigma_db(s.data)
@@ -357,9 +351,8 @@ def _diagnose(measured, engine, noise_floor, effects, pairs, do_bands, rule, sch
 
 
 def _gap_after(w, sc):
-    """The gap map with the answer's effects on every measured speed and the model levels
-    [m/s RMS] it compares; ``(None, None)`` where the answer's amplitude fixed point has no
-    steady state at a speed it was not fitted on."""
+    """Gap map and model levels [m/s RMS] with the answer's effects ``sc``; ``(None, None)``
+    without a steady state."""
     try:
         vel = predict(w.hm, sc).velocity
     except FloatingPointError:
@@ -370,8 +363,7 @@ def _gap_after(w, sc):
 
 
 def phase_kind(data) -> str:
-    """Measured phase: ``"all"`` (half orders too), ``"whole"`` (whole orders only) or
-    ``"none"``."""
+    """Measured phase of ``data``: ``"all"`` (half orders too), ``"whole"`` or ``"none"``."""
     return "all" if data.has_half_order_phase else "whole" if data.has_phase else "none"
 
 
@@ -384,8 +376,7 @@ def _finding(s, chosen):
 
 
 def _phase_dict(s, chosen) -> dict:
-    """The ``phase`` entry of the JSON: what phase was measured, the crank-angle offset
-    estimated with the chosen answer (baseline if none) [deg]."""
+    """The JSON's ``phase``: what was measured, the crank-angle offsets [deg] with the answer."""
     sc = {} if chosen is None else {e: chosen.params[e] for e in chosen.effects}
     offsets = [None if o is None else math.degrees(o) for o in s.problem.crank_offsets(sc)]
     return {"measured": phase_kind(s.data), "crank_offset_deg": offsets[0],
