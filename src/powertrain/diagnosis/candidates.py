@@ -55,10 +55,8 @@ def restatements(outcome, engine, band=None) -> tuple:
 def _refit(setup, e, params, budget):
     """The chosen effect refitted from an alternative start (a few evaluations)."""
     pack = Packing.of((e,), setup.problem.engine)
-    x = np.array([math.log(params[pn]) if lg else params[pn]
-                  for (_, pn), lg in zip(pack.names, pack.log)])
-    return fit_candidate(setup.problem, (e,), starts=[x], grid=False, budget=budget,
-                         defaults=False)
+    x = np.array([math.log(params[pn]) if lg else params[pn] for (_, pn), lg in zip(pack.names, pack.log)])
+    return fit_candidate(setup.problem, (e,), starts=[x], grid=False, budget=budget, defaults=False)
 
 
 def _same(a, b, tol=0.01):

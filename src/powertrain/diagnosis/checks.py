@@ -168,8 +168,7 @@ def heldout_cells_check(problem: Problem, o: FitOutcome, baseline: FitOutcome, s
     parts = [first or _cells_fold(problem, o, baseline, cells, sigma, kw)]
     parts += [_cells_fold(p, o, b, cells, sigma, kw) for p, b in folds]
     n = sum(q["n"] for q in parts)
-    e0, ec, e_n = (sum(q[k] * q["n"] for q in parts) / n if n else float("nan")
-                   for k in ("e0", "ec", "e_n"))
+    e0, ec, e_n = (sum(q[k] * q["n"] for q in parts) / n if n else float("nan") for k in ("e0", "ec", "e_n"))
     per_0, per_c = (np.concatenate([q[k] for q in parts]) for k in ("per_0", "per_c"))
     excess = max(e0 - e_n, 0.0)
     return {"kind": kind, "explained": (e0 - ec) / excess if excess > 0 else float("nan"),

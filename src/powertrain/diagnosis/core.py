@@ -109,8 +109,7 @@ def _inputs(measured, engine, effects):
     """``(engine, measured)``, read from files if paths; effect names checked."""
     for e in effects or []:
         if e not in EFFECTS:
-            raise InputError(f"unknown effect {e!r} (known: {', '.join(EFFECTS)})",
-                             key="--effects")
+            raise InputError(f"unknown effect {e!r} (known: {', '.join(EFFECTS)})", key="--effects")
     engine = engine_or_default(engine)
     if isinstance(measured, (str, os.PathLike)) and str(measured).lower().endswith(".toml"):
         measured = read_plan(measured, engine)
@@ -206,8 +205,7 @@ def _where(s: _Setup):
 def _fit_job(job):
     problem, effects, starts, budget = job
     with single_blas_thread():
-        return fit_candidate(problem, effects, starts=starts, budget=budget,
-                             defaults=starts is None)
+        return fit_candidate(problem, effects, starts=starts, budget=budget, defaults=starts is None)
 
 
 def _fit_all(s: _Setup, pairs, scheduler, progress, budget, e_n, rule, baseline, sigma):
@@ -263,8 +261,7 @@ def _decide(s, baseline, outcomes, sigma, rule, where_phrase, budget):
     e_n = noise_mse(s.problem, sigma)
     by_label = {o.label: o for o in outcomes}
     while True:
-        ev = Evidence(_evidence(baseline), [_evidence(o) for o in outcomes], e_n, sigma,
-                      where_phrase)
+        ev = Evidence(_evidence(baseline), [_evidence(o) for o in outcomes], e_n, sigma, where_phrase)
         verdict = decide(ev, rule)
         if verdict.kind is not VerdictKind.PENDING:
             return verdict, e_n
@@ -292,8 +289,7 @@ def _structure(s, baseline, outcomes, sigma):
         o.struct_db, o.chi2_ratio = structured_residual(o.heldout_gaps, cens_t, groups, sigma)
 
 
-def _diagnose(measured, engine, noise_floor, effects, pairs, do_bands, rule, scheduler,
-              progress, budget):
+def _diagnose(measured, engine, noise_floor, effects, pairs, do_bands, rule, scheduler, progress, budget):
     t0 = time.perf_counter()
     if hasattr(measured, "runs"):
         s = PlanSetup(measured, engine, noise_floor, effects, _Setup)

@@ -167,8 +167,7 @@ def gap_data(measured, engine, noise_floor=DEFAULT_NOISE_FLOOR) -> GapData:
     measured_channels = {(m, d) for m, d, _ in measured.curves}
     channels += [c for c in model_channels(engine)[len(channels):] if c in measured_channels]
     quantities = _half_order_quantities(measured)
-    harmonic = np.array([-1 if q == "synthesis" else int(round(2 * float(q[6:]))) - 1
-                         for q in quantities])
+    harmonic = np.array([-1 if q == "synthesis" else int(round(2 * float(q[6:]))) - 1 for q in quantities])
     level = np.full((rpm.size, len(channels), len(quantities)), np.nan)
     phases = getattr(measured, "phases", None) or {}
     phase = np.full(level.shape, np.nan) if phases else None

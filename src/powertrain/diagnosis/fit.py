@@ -117,8 +117,7 @@ class Problem:
             if cells is not None:
                 self.valid[part] = self.valid[part] & np.asarray(cells, bool)[None]
         self._level_at = {k: self._flat(on) for k, on in self.valid.items()}
-        self._scored = {k: ScoredLevels(self.meas[k][on], data.floor)
-                        for k, on in self.valid.items()}
+        self._scored = {k: ScoredLevels(self.meas[k][on], data.floor) for k, on in self.valid.items()}
         self._phase_setup()
 
     def _flat(self, on):
@@ -128,8 +127,7 @@ class Problem:
 
     def clusters(self) -> np.ndarray:
         """(channel, order) cell of each training residual of :meth:`vector`."""
-        return cluster_ids(self.valid["train"],
-                           None if self.phase_w is None else self.phase_on["train"])
+        return cluster_ids(self.valid["train"], None if self.phase_w is None else self.phase_on["train"])
 
     def _phase_setup(self):
         """Measured phases and their weights per part; ``phase_w`` None without phase."""
@@ -144,11 +142,9 @@ class Problem:
         self.phase_on = {k: np.isfinite(w) for k, w in self.phase_w.items()}
         self._phase_rad = {k: np.deg2rad(v[self.phase_on[k]]) for k, v in self.phase.items()}
         self._phase_at = {k: self._flat(on) for k, on in self.phase_on.items()}
-        self._order_on = {k: np.broadcast_to(self.order, on.shape)[on]
-                          for k, on in self.phase_on.items()}
+        self._order_on = {k: np.broadcast_to(self.order, on.shape)[on] for k, on in self.phase_on.items()}
         self._w_on = {k: self.phase_w[k][on] for k, on in self.phase_on.items()}
-        self._offset = ph.OffsetProfile(self._order_on["train"], self._w_on["train"],
-                                        self.sigma_db)
+        self._offset = ph.OffsetProfile(self._order_on["train"], self._w_on["train"], self.sigma_db)
 
     def reset_warm(self):
         """Forget cached velocities and amplitude starts (a fit must not depend on the last)."""
@@ -218,8 +214,7 @@ class Problem:
         vel = self.velocity(scenario)
         meas = self.meas["train"] * np.exp(1j * (np.deg2rad(self.phase["train"]) + self.order
                                                  * self.crank_offset(scenario, vel)))
-        return np.where(self.phase_on["train"],
-                        meas - vel[..., self.sub.harmonic] / math.sqrt(2.0), np.nan)
+        return np.where(self.phase_on["train"], meas - vel[..., self.sub.harmonic] / math.sqrt(2.0), np.nan)
 
     def vector(self, scenario, part="train"):
         """Residuals of ``part`` [dB]: ``gaps[valid]``, then any phase gaps and offset prior."""
@@ -318,8 +313,7 @@ def second_minimum(fun, pack, effects, x, sigma_db) -> list:
     j = pack.names.index((effects[0], name))
     val = (lambda v: math.exp(v[j])) if pack.log[j] else (lambda v: v[j])
     c0 = min([c for c, _ in fun.minima] + [float(fun.best[0])])
-    far = [(c, v) for c, v in fun.minima
-           if abs(math.log(val(v) / val(x))) >= math.log(BASIN_RATIO)]
+    far = [(c, v) for c, v in fun.minima if abs(math.log(val(v) / val(x))) >= math.log(BASIN_RATIO)]
     if not far:
         return []
     c, v = min(far, key=lambda t: t[0])
@@ -334,8 +328,7 @@ def score(problem, effects, sc, params, sigma, rss, n, p, nfev, seconds, x=None)
     (infinite where it has no steady state at a held-out speed)."""
     try:
         g = problem.gaps(sc, "test")
-        both = g if problem.phase_w is None else np.concatenate(
-            [g, problem.phase_gaps(sc, "test")], axis=-1)
+        both = g if problem.phase_w is None else np.concatenate([g, problem.phase_gaps(sc, "test")], axis=-1)
     except FloatingPointError:
         g = np.full(problem.valid["test"].shape, np.nan)
         per_rpm, mse, ch = np.full(g.shape[0], np.inf), math.inf, [math.nan] * g.shape[1]
@@ -348,8 +341,7 @@ def score(problem, effects, sc, params, sigma, rss, n, p, nfev, seconds, x=None)
 
 def per_speed_mse(g, ok):
     """Mean of ``g[i][ok[i]] ** 2`` for every speed i (NaN where none is ``ok``)."""
-    return np.array([np.mean(g[i][ok[i]] ** 2) if ok[i].any() else np.nan
-                     for i in range(g.shape[0])])
+    return np.array([np.mean(g[i][ok[i]] ** 2) if ok[i].any() else np.nan for i in range(g.shape[0])])
 
 
 def _heldout_means(g, both):

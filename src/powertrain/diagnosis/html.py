@@ -30,8 +30,7 @@ def diagnosis_html(r) -> str:
                                                for k, run in enumerate(r.runs, start=1))
                           + " (one set of effect parameters; where and the figures "
                             "describe run 1)")
-    return (paragraph(f"VERDICT: {r.verdict_text}", "verdict") + head + _where(r)
-            + _which(r) + _how_far(r))
+    return (paragraph(f"VERDICT: {r.verdict_text}", "verdict") + head + _where(r) + _which(r) + _how_far(r))
 
 
 def _run(k, run) -> str:
@@ -66,8 +65,7 @@ def _where(r) -> str:
 
 def _which(r) -> str:
     b = r.baseline
-    rows = [["(baseline)", 0, number(b.heldout_rms_db), "-", "-", "-",
-             number(b.struct_db), ""]]
+    rows = [["(baseline)", 0, number(b.heldout_rms_db), "-", "-", "-", number(b.struct_db), ""]]
     for o in r.outcomes:
         rows.append([o.label, o.n_params, number(o.heldout_rms_db), number(o.t_stat, ".1f"),
                      number(o.bic_gain, ".1f"), number(100 * o.explained, ".0f") + " %"
@@ -83,8 +81,7 @@ def _which(r) -> str:
             txt = ", ".join(f"{k} = {v:.4g} ± {r.chosen.sigma[e][k]:.2g} {unit.get(k, '')}"
                             for k, v in ps.items())
             said = EFFECTS[e].summary(ps)
-            items.append(f"<li>{esc(e)}: {esc(txt)}" + (f" = {esc(said)}" if said else "")
-                         + "</li>")
+            items.append(f"<li>{esc(e)}: {esc(txt)}" + (f" = {esc(said)}" if said else "") + "</li>")
         out += "<p>Parameters (1 sigma, cell-clustered):</p><ul>" + "".join(items) \
             + "</ul>"
     out += "".join(paragraph(f"Equivalent explanation: {eq['text']}") for eq in r.equivalents)

@@ -56,22 +56,19 @@ class JointProblem:
         self.sigma_db = sig if np.isfinite(sig) and sig > 0 else 1.0
         self.phase_w = None
         if any(p.phase_w is not None for p in self.runs):
-            self.phase_w = {k: np.concatenate([self._phase_w(p, k) for p in self.runs])
-                            for k in self.idx}
+            self.phase_w = {k: np.concatenate([self._phase_w(p, k) for p in self.runs]) for k in self.idx}
             self.phase_on = {k: np.isfinite(w) for k, w in self.phase_w.items()}
 
     @staticmethod
     def _phase_w(p, part):
-        return p.phase_w[part] if p.phase_w is not None else np.full(p.meas[part].shape,
-                                                                      np.nan)
+        return p.phase_w[part] if p.phase_w is not None else np.full(p.meas[part].shape, np.nan)
 
     def reset_warm(self):
         for p in self.runs:
             p.reset_warm()
 
     def restricted(self, train_cells=None, test_cells=None) -> JointProblem:
-        return JointProblem([p.restricted(train_cells, test_cells) for p in self.runs],
-                            self.data)
+        return JointProblem([p.restricted(train_cells, test_cells) for p in self.runs], self.data)
 
     def gaps(self, scenario, part="train"):
         return np.concatenate([p.gaps(scenario, part) for p in self.runs])

@@ -73,8 +73,7 @@ def _which(r) -> list:
                      f"{o.t_stat:>6.1f} {o.bic_gain:>8.1f} {expl} "
                      f"{o.struct_db:>9.2f}  {o.status}")
     if r.chosen is not None:
-        lines.append("  parameters (1 sigma and 95 % interval, cell-clustered: "
-                     "docs/guide/diagnose.md):")
+        lines.append("  parameters (1 sigma and 95 % interval, cell-clustered: docs/guide/diagnose.md):")
         for e, ps in r.chosen.params.items():
             unit = r.chosen.units.get(e, {})
             txt = ", ".join(f"{k} = {v:.4g} +- {r.chosen.sigma[e][k]:.2g}"
@@ -124,8 +123,7 @@ def fit_notes(chosen, outcomes, bands, budget) -> list:
         eff = EFFECTS[chosen.effects[0]]
         ps = chosen.params[chosen.effects[0]]
         for alt in chosen.alternatives:
-            out.append(eff.alternative_text(ps, alt["parameters"][chosen.effects[0]],
-                                            alt["delta_chi2"]))
+            out.append(eff.alternative_text(ps, alt["parameters"][chosen.effects[0]], alt["delta_chi2"]))
         said = eff.interval_text(chosen.interval.get(chosen.effects[0], {}))
         out += ([said] if said else []) + eff.bound_warnings(ps)
     if chosen is not None and chosen.budget_hit:
@@ -179,8 +177,7 @@ def write_report(r, directory, provenance=None) -> list:
         fh.write(r.to_text() + "\n")
     r.to_json(out / "diagnosis.json")
     files = [out / "summary.txt", out / "diagnosis.json"]
-    for name, fn in zip(REPORT_FILES[2:], (plot_gap_map, plot_gap_frequency,
-                                           plot_diagnosis_overlay)):
+    for name, fn in zip(REPORT_FILES[2:], (plot_gap_map, plot_gap_frequency, plot_diagnosis_overlay)):
         close_figure(fn(r, out / name, provenance=provenance))
         files.append(out / name)
     return files

@@ -185,8 +185,7 @@ class DiagnosisResult(Result):
     def to_json(self, path=None) -> str:
         """``diagnosis.json``: :meth:`to_dict`, non-finite numbers as null; written
         atomically to ``path`` if given."""
-        text = json.dumps(_finite_or_null(self.to_dict()), indent=1, allow_nan=False,
-                          default=_jsonable)
+        text = json.dumps(_finite_or_null(self.to_dict()), indent=1, allow_nan=False, default=_jsonable)
         if path is not None:
             with atomic_write(path) as fh:
                 fh.write(text)
@@ -208,8 +207,7 @@ class DiagnosisResult(Result):
         SubFigure, or one Axes when one quantity is shown or chosen (``quantity``); else an
         InputError saying to pass a Figure."""
         ax, path = target_and_path(ax, path)
-        return plot_gap_map(self, path, ax=ax, quantity=quantity,
-                            provenance=provenance)
+        return plot_gap_map(self, path, ax=ax, quantity=quantity, provenance=provenance)
 
     def report(self, directory, provenance=None) -> list:
         """Write ``summary.txt``, ``diagnosis.json`` and the figures into ``directory``."""

@@ -115,8 +115,7 @@ def _assess(ev: Evidence, rule: DecisionRule) -> dict:
             out[c.label].text = f"not better than {best_m.label} alone"
             if (t > rule.t_screen and dbic > rule.bic_margin and gain >= rule.pair_gain_min
                     and (c.crossfit is None or best_m.crossfit is None)):
-                out[c.label].crossfit_labels = tuple(x.label for x in (c, best_m)
-                                                     if x.crossfit is None)
+                out[c.label].crossfit_labels = tuple(x.label for x in (c, best_m) if x.crossfit is None)
     return out
 
 
@@ -160,8 +159,7 @@ def _big(a, rule):
 def _choose(ev, rule, ranked, ass):
     """``(chosen, None)``, or ``(None, label)`` whose cells check is missing."""
     smax = _struct_max(ev, rule)
-    big = [c for c in ranked if ass[c.label].status is Status.SUPPORTED
-           and _big(ass[c.label], rule)]
+    big = [c for c in ranked if ass[c.label].status is Status.SUPPORTED and _big(ass[c.label], rule)]
     for c in big[:rule.n_checked]:
         a = ass[c.label]
         r = next((r for r in big if r is not c and _restated(c, r)
@@ -182,8 +180,7 @@ def _choose(ev, rule, ranked, ass):
                     and xv["t"] > rule.xv_t_screen):
                 return None, c.label             # again, over every speed fold
             a.status = Status.FAILS_HELDOUT_CELLS
-            a.text = (f"fails held-out {xv['kind']} (explains {xv['explained']:.0%}, "
-                      f"t {xv['t']:.1f})")
+            a.text = (f"fails held-out {xv['kind']} (explains {xv['explained']:.0%}, t {xv['t']:.1f})")
             continue
         return c, None
     return None, None
@@ -237,8 +234,7 @@ def decide(evidence: Evidence, rule: DecisionRule = DecisionRule()) -> Verdict:
         return _no_answer(ev, rule, ass, order, ranked)
     chosen, pending = _choose(ev, rule, ranked, ass)
     if pending is not None:
-        return Verdict(VerdictKind.PENDING, "pending", "", ass, order,
-                       needs_cells_check=pending)
+        return Verdict(VerdictKind.PENDING, "pending", "", ass, order, needs_cells_check=pending)
     rivals, cross = _rivals(ev, rule, ranked, ass, chosen) if chosen is not None else ([], [])
     if cross:
         return Verdict(VerdictKind.PENDING, "pending", "", ass, order, needs_crossfit=cross)

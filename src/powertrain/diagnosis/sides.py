@@ -110,8 +110,7 @@ def _location(ea, da, ep, dp, a_mount):
 
 def _per_mount(gap, sig, cols_of, om):
     """``{mount: (excess, resolution)}`` of each mount's channels ``cols_of[mount]``."""
-    return {m: excess(gap[:, cols][:, :, om], sig[:, cols][:, :, om])
-            for m, cols in cols_of.items()}
+    return {m: excess(gap[:, cols][:, :, om], sig[:, cols][:, :, om]) for m, cols in cols_of.items()}
 
 
 def side_attribution(gap, data, sigma_db=None) -> dict | None:
@@ -221,8 +220,7 @@ def _shape_phrase(fs) -> str:
     """'body mode 2 of the engine file near 45 Hz, shared by the bases of left, ...'."""
     on = [m for m, v in fs["bases"].items() if v >= SHAPE_SHARED]
     quoted = ", ".join(f"{m} {v:.1f}" for m, v in fs["bases"].items())
-    where = (f"shared by the bases of {', '.join(on)}" if fs["shared"] else
-             f"local to the base of {on[0]}")
+    where = (f"shared by the bases of {', '.join(on)}" if fs["shared"] else f"local to the base of {on[0]}")
     return (f"{fs['mode']} near {fs['frequency_hz']:.0f} Hz, {where} (its {fs['shape']}, "
             f"largest component at each base: {quoted})")
 

@@ -62,8 +62,7 @@ def start_points(problem, pack, effects, starts, grid, fun, defaults=True):
     if grid and len(effects) == 1:
         # read from the data: fitted first (a default that is "no effect" starts nowhere)
         inner = DATA_START_MARGIN * span
-        cands = _data_starts(problem, pack, effects[0], fun, pack.lower + inner,
-                             pack.upper - inner) + cands
+        cands = _data_starts(problem, pack, effects[0], fun, pack.lower + inner, pack.upper - inner) + cands
         xb = _block_start(fun, pack, effects[0])
         if xb is not None:
             cands.append(np.clip(xb, lo, hi))

@@ -229,8 +229,7 @@ def regions(gap, data: GapData, parts):
             for i, j in _runs(np.isfinite(g) & (np.abs(g) > REGION_DB)):
                 seg = g[i:j + 1]
                 h = data.harmonic[k]
-                kind = "synthesis (see orders)" if h < 0 else _region_kind(
-                    parts, slice(i, j + 1), c, k)
+                kind = "synthesis (see orders)" if h < 0 else _region_kind(parts, slice(i, j + 1), c, k)
                 worst = i + int(np.nanargmax(np.abs(seg)))
                 found.append({"mount": mount, "direction": direction, "quantity": q,
                               "rpm_from": float(data.rpm[i]), "rpm_to": float(data.rpm[j]),
@@ -245,8 +244,7 @@ def regions(gap, data: GapData, parts):
 
 
 def _region_kind(parts, sl, c, k):
-    ss = {label: float(np.nansum(parts[name][sl, c, k] ** 2))
-          for name, label in KIND_LABEL.items()}
+    ss = {label: float(np.nansum(parts[name][sl, c, k] ** 2)) for name, label in KIND_LABEL.items()}
     return max(ss, key=ss.get)
 
 
