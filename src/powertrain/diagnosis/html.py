@@ -1,13 +1,11 @@
-"""The diagnosis in HTML (its ``_repr_html_`` and its section of the study report): the
-verdict, then where, which and how far as tables, worst first (the numbers of
-``summary.txt``, :mod:`powertrain.diagnosis.report`)."""
+"""The diagnosis in HTML (``_repr_html_``, the study report's section): the verdict, then
+where, which and how far as tables, worst first."""
 
 from __future__ import annotations
 
-from pathlib import Path
-
 import numpy as np
 
+from powertrain.diagnosis.report import run_text
 from powertrain.diagnosis.sides import side_text
 from powertrain.diagnosis.where import REGION_DB, attribution_text
 from powertrain.effects import EFFECTS
@@ -26,17 +24,11 @@ def diagnosis_html(r) -> str:
             f"{esc(', '.join(d.quantities))}; noise estimate {r.noise_db:.2f} dB (1 sigma)<br>"
             f"split: {esc(r.split['description'])}</p>")
     if r.runs:
-        head += paragraph("plan: " + "; ".join(_run(k, run)
+        head += paragraph("plan: " + "; ".join(run_text(k, run)
                                                for k, run in enumerate(r.runs, start=1))
                           + " (one set of effect parameters; where and the figures "
                             "describe run 1)")
     return (paragraph(f"VERDICT: {r.verdict_text}", "verdict") + head + _where(r) + _which(r) + _how_far(r))
-
-
-def _run(k, run) -> str:
-    """``run 2 part.csv (load 0.4)`` or ``(traces wot-p.csv)``."""
-    how = f"traces {Path(run['traces']).name}" if run.get("traces") else f"load {run['load']:g}"
-    return f"run {k} {Path(run['file']).name} ({how})"
 
 
 def _where(r) -> str:

@@ -28,7 +28,7 @@ def _header(r) -> list:
     if r.runs:
         lines.append(f"plan: {len(r.runs)} runs diagnosed together (one set of effect "
                      f"parameters; speeds held out within each run): " + "; ".join(
-                         _run_text(k, run) for k, run in enumerate(r.runs, start=1))
+                         run_text(k, run) for k, run in enumerate(r.runs, start=1))
                      + "; WHERE and the figures describe run 1, data and split above too")
     ph = r.phase or {}
     if ph.get("measured", "none") != "none":
@@ -100,24 +100,21 @@ def _interval_text(iv) -> str:
     return f" (95 % {iv[0]:.4g}..{iv[1]:.4g})"
 
 
-def _run_text(k, run) -> str:
-    """``run 2 part.csv (load 0.4)`` or ``(traces wot-p.csv)``."""
+def run_text(k, run) -> str:
+    """Plan run ``k``'s entry ``run`` in words: ``run 2 part.csv (load 0.4)``."""
     how = f"traces {Path(run['traces']).name}" if run.get("traces") else f"load {run['load']:g}"
     return f"run {k} {Path(run['file']).name} ({how})"
 
 
 def _db(value) -> str:
-    """A channel's held-out RMS [dB], or "-" where it has no held-out point (a channel
-    measured on part of the speeds only)."""
+    """A channel's held-out RMS [dB], or "-" without a held-out point."""
     return f"{value:.2f}" if np.isfinite(value) else "-"
 
 
 def fit_notes(chosen, outcomes, bands, budget) -> list:
-    """Sentences of the verdict on how far the fits can be trusted: a second minimum of the
-    answer that explains the data alike (``FitOutcome.alternatives``), parameters of the
-    answer at a bound (``Effect.bound_warnings``), and, said once, the fits that stopped at
-    their evaluation budget with what that means for the answer; the answer's 95 %
-    intervals where its effect states them (``Effect.interval_text``)."""
+    """Sentences on how far the fits can be trusted: the answer ``chosen``'s second minimum,
+    intervals and parameters at a bound; the ``outcomes`` and band refits ``bands`` stopped
+    at their ``budget``."""
     out = []
     if chosen is not None and len(chosen.effects) == 1:
         eff = EFFECTS[chosen.effects[0]]
@@ -144,7 +141,7 @@ def fit_notes(chosen, outcomes, bands, budget) -> list:
 
 
 def summary(r) -> str:
-    """The plain-text report: where, which, how far, verdict."""
+    """The plain-text report of result ``r``: where, which, how far, verdict."""
     b, d = r.baseline, r.data
     lines = _header(r) + _which(r)
     lines += ["", "3. HOW FAR (held-out speeds)"]
@@ -169,9 +166,8 @@ REPORT_FILES = ("summary.txt", "diagnosis.json", "gap_map.png", "gap_vs_frequenc
 
 
 def write_report(r, directory, provenance=None) -> list:
-    """Write ``summary.txt``, ``diagnosis.json`` and the figures (:data:`REPORT_FILES`) into
-    ``directory`` (created with its missing parents)."""
-
+    """Write result ``r``'s :data:`REPORT_FILES` into ``directory`` (created if missing);
+    ``provenance`` stamps the figures. Returns the paths."""
     out = Path(directory)
     with atomic_write(out / "summary.txt") as fh:
         fh.write(r.to_text() + "\n")

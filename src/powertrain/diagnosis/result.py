@@ -1,8 +1,5 @@
-"""Step 5 of the diagnosis: the result object and its JSON form (``diagnosis.json``).
-
-The JSON keys are an interface (scripts/blind_diagnosis.py and users' tools read them):
-keep every key; add freely.
-"""
+"""Step 5 of the diagnosis: the result object and its JSON (``diagnosis.json``, whose keys
+are an interface: keep every key)."""
 
 from __future__ import annotations
 
@@ -54,32 +51,28 @@ class DiagnosisResult(Result):
     notes: list = field(default_factory=list)
     #: E_n: held-out mean squared gap a perfect model would leave [dB²].
     noise_mse_heldout: float = 0.0
-    #: Labels of candidates that pass the decision rule but cannot be told apart.
+    #: Labels that pass the rule but cannot be told apart.
     ambiguous: list = field(default_factory=list)
-    #: With an answer: its pairs the held-out speeds cannot tell apart (a second effect
-    #: supported but not identified).
+    #: The answer's pairs not told apart (second effect not identified).
     second_effect_between: list = field(default_factory=list)
     rule: DecisionRule = field(default_factory=DecisionRule)
     verdict_kind: VerdictKind | None = None
     #: Parameter sets that explain the data equally well within the noise.
     equivalents: list = field(default_factory=list)
-    #: Fits stopped by their evaluation budget (labels).
+    #: Labels of fits stopped by their evaluation budget.
     budget_hits: list = field(default_factory=list)
-    #: Model levels [m/s RMS] like ``data.level`` (noise floor added in power): the
-    #: baseline, and with the chosen effect (None without one); the overlays draw them.
+    #: Model levels [m/s RMS] like ``data.level``: baseline and with the answer.
     sim_levels: np.ndarray | None = field(default=None, repr=False, compare=False)
     sim_after: np.ndarray | None = field(default=None, repr=False, compare=False)
-    #: The baseline engine diagnosed (:class:`~powertrain.models.engine.Engine`).
+    #: The baseline engine diagnosed.
     engine: object = field(default=None, repr=False, compare=False)
-    #: What the chosen effect names (``Effect.finding``: e.g. which cylinder), or None.
+    #: What the chosen effect names (``Effect.finding``), or None.
     finding: dict | None = None
-    #: Phase used: ``measured`` ("all", "whole", "none"), ``crank_offset_deg``,
-    #: ``scored_points``.
+    #: Phase used: ``measured``, ``crank_offset_deg``, ``scored_points``.
     phase: dict = field(default_factory=dict)
-    #: Per-run entries of a plan diagnosis (empty for a single run-up).
+    #: Per-run entries of a plan diagnosis.
     runs: list = field(default_factory=list)
 
-    # ------------------------------------------------------------------ dicts
     def _per_channel(self):
         d, chans = self.data, []
         for c, (m, di) in enumerate(d.channels):
@@ -94,6 +87,7 @@ class DiagnosisResult(Result):
         return chans
 
     def where(self) -> dict:
+        """The JSON's ``where`` entry (step 1)."""
         d, p = self.data, self.parts
         rg = self.rigid_gap[np.isfinite(self.rigid_gap)]
         return {
@@ -191,21 +185,28 @@ class DiagnosisResult(Result):
                 fh.write(text)
         return text
 
-    # ------------------------------------------------------------------ text, figures
     def to_text(self) -> str:
-        """Plain-text report: where, which, how far, verdict (what ``powertrain diagnose``
-        prints and ``summary.txt`` holds; :func:`powertrain.diagnosis.report.summary`)."""
+        """Plain-text report (``summary.txt``, what ``powertrain diagnose`` prints)."""
         return summary(self)
 
     def _repr_html_(self) -> str:
-        """HTML of the verdict, where, which and how far (Jupyter shows it)."""
+        """HTML of the verdict, where, which and how far."""
         return fragment(diagnosis_html(self))
 
     def plot(self, ax=None, *, path=None, quantity=None, provenance=None):
-        """Gap map figure, one panel per quantity; returns it (see
-        :func:`powertrain.plotting.plot_gap_map`). ``ax``: None (a new figure), a Figure or
-        SubFigure, or one Axes when one quantity is shown or chosen (``quantity``); else an
-        InputError saying to pass a Figure."""
+        """Gap map figure, one panel per quantity (:func:`powertrain.plotting.plot_gap_map`).
+
+        Parameters
+        ----------
+        ax : Figure, SubFigure or Axes, optional
+            Where to draw (one Axes only for one ``quantity``); None: a new figure.
+        path : str or path, optional
+            File to save it to.
+        quantity : str, optional
+            The one quantity shown.
+        provenance : dict, optional
+            Stamp of the figure.
+        """
         ax, path = target_and_path(ax, path)
         return plot_gap_map(self, path, ax=ax, quantity=quantity, provenance=provenance)
 
@@ -215,8 +216,7 @@ class DiagnosisResult(Result):
 
 
 def _finite_or_null(x):
-    """``x`` with every non-finite float (a quantity that is undefined here, e.g. the explained
-    fraction when the baseline leaves no excess over noise) replaced by ``None`` (JSON null)."""
+    """``x`` with every non-finite float replaced by ``None`` (JSON null)."""
     if isinstance(x, dict):
         return {k: _finite_or_null(v) for k, v in x.items()}
     if isinstance(x, (list, tuple)):
