@@ -252,8 +252,7 @@ def pair_candidates(singles, e_n, rule) -> list:
 
 def _evidence(o, struct=None):
     return CandidateEvidence(o.label, o.effects, o.heldout_mse, o.heldout_per_rpm, o.bic,
-                             o.struct_db if struct is None else struct, o.cells_check,
-                             o.crossfit, o.restates)
+                             o.struct_db if struct is None else struct, o.cells_check, o.crossfit, o.restates)
 
 
 def _decide(s, baseline, outcomes, sigma, rule, where_phrase, budget):
@@ -274,8 +273,7 @@ def _decide(s, baseline, outcomes, sigma, rule, where_phrase, budget):
             continue
         o = by_label[verdict.needs_cells_check]
         # all speed folds when held-out t was short, or on a retry (reusing the first refits)
-        all_folds = (not verdict.assessments[o.label].t_stat > rule.t_min
-                     or o.cells_check is not None)
+        all_folds = not verdict.assessments[o.label].t_stat > rule.t_min or o.cells_check is not None
         first = o.cells_check["parts"][0] if o.cells_check is not None else None
         o.cells_check = heldout_cells_check(
             s.problem, o, baseline, sigma, budget=budget,
@@ -339,8 +337,7 @@ def _diagnose(measured, engine, noise_floor, effects, pairs, do_bands, rule, sch
         sigma, w.split_dict(), baseline, outcomes, chosen, verdict.label, text, bands,
         time.perf_counter() - t0, synthetic=bool(getattr(measured, "synthetic", False)),
         noise_mse_heldout=e_n, ambiguous=verdict.ambiguous, rule=rule,
-        second_effect_between=verdict.second_effect_between,
-        verdict_kind=verdict.kind, equivalents=eq,
+        second_effect_between=verdict.second_effect_between, verdict_kind=verdict.kind, equivalents=eq,
         budget_hits=[o.label for o in outcomes if o.budget_hit], finding=finding,
         phase=_phase_dict(s, chosen), runs=s.run_entries(chosen) if w is not s else [],
         engine=engine, sim_levels=sim0, sim_after=sim_after)
@@ -376,6 +373,5 @@ def _phase_dict(s, chosen) -> dict:
     sc = {} if chosen is None else {e: chosen.params[e] for e in chosen.effects}
     offsets = [None if o is None else math.degrees(o) for o in s.problem.crank_offsets(sc)]
     return {"measured": phase_kind(s.data), "crank_offset_deg": offsets[0],
-            "crank_offset_deg_per_run": offsets,
-            "scored_points": 0 if s.problem.phase_w is None
+            "crank_offset_deg_per_run": offsets, "scored_points": 0 if s.problem.phase_w is None
             else int(s.problem.phase_on["train"].sum() + s.problem.phase_on["test"].sum())}

@@ -116,8 +116,7 @@ class GapData:
         """The same data on the engine-side channels only."""
         n = self.n_active
         return GapData(self.rpm, self.channels[:n], self.quantities, self.harmonic,
-                       self.level[:, :n], self.floor,
-                       phase=None if self.phase is None else self.phase[:, :n])
+                       self.level[:, :n], self.floor, phase=None if self.phase is None else self.phase[:, :n])
 
     def orders_only(self) -> GapData:
         """The same data without the synthesis."""

@@ -24,10 +24,8 @@ def diagnosis_html(r) -> str:
             f"{esc(', '.join(d.quantities))}; noise estimate {r.noise_db:.2f} dB (1 sigma)<br>"
             f"split: {esc(r.split['description'])}</p>")
     if r.runs:
-        head += paragraph("plan: " + "; ".join(run_text(k, run)
-                                               for k, run in enumerate(r.runs, start=1))
-                          + " (one set of effect parameters; where and the figures "
-                            "describe run 1)")
+        head += paragraph("plan: " + "; ".join(run_text(k, run) for k, run in enumerate(r.runs, start=1))
+                          + " (one set of effect parameters; where and the figures describe run 1)")
     return (paragraph(f"VERDICT: {r.verdict_text}", "verdict") + head + _where(r) + _which(r) + _how_far(r))
 
 
@@ -91,8 +89,7 @@ def _how_far(r) -> str:
                     f"{run['heldout_rms_db_after']:.2f} dB" for k, run in enumerate(r.runs, 1))
     return ("<h4>3. How far (held-out speeds)</h4>" + paragraph(text + ".")
             + table(["mount", "dir", "before [dB]", "after [dB]"], rows,
-                    "Held-out RMS gap per channel before and after the chosen effect, worst "
-                    "first"))
+                    "Held-out RMS gap per channel before and after the chosen effect, worst first"))
 
 
 def _value(text: str) -> float:

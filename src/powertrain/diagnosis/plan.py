@@ -23,8 +23,7 @@ def stacked(datas) -> GapData:
         phase = np.concatenate([d.phase if d.phase is not None else np.full(d.level.shape, np.nan)
                                 for d in datas])
     return GapData(np.concatenate([d.rpm for d in datas]), d0.channels, d0.quantities,
-                   d0.harmonic, np.concatenate([d.level for d in datas]), d0.floor,
-                   d0.n_engine_side, phase)
+                   d0.harmonic, np.concatenate([d.level for d in datas]), d0.floor, d0.n_engine_side, phase)
 
 
 def _offsets(sizes):

@@ -19,12 +19,10 @@ _PHASE_WORDS = {"all": "order phases measured, half orders too",
 
 def _header(r) -> list:
     d, p = r.data, r.parts
-    lines = [f"measured: {r.source}{' [SYNTHETIC]' if r.synthetic else ''}",
-             f"engine: {r.engine_name}",
+    lines = [f"measured: {r.source}{' [SYNTHETIC]' if r.synthetic else ''}", f"engine: {r.engine_name}",
              f"data: {d.rpm.size} speeds {d.rpm[0]:g}..{d.rpm[-1]:g} rpm, "
              f"{len(d.channels)} channels, quantities {', '.join(d.quantities)}; "
-             f"noise estimate {r.noise_db:.2f} dB (1 sigma)",
-             f"split: {r.split['description']}"]
+             f"noise estimate {r.noise_db:.2f} dB (1 sigma)", f"split: {r.split['description']}"]
     if r.runs:
         lines.append(f"plan: {len(r.runs)} runs diagnosed together (one set of effect "
                      f"parameters; speeds held out within each run): " + "; ".join(
@@ -34,10 +32,8 @@ def _header(r) -> list:
     if ph.get("measured", "none") != "none":
         offs = ", ".join(f"{o:+.2f}" for o in ph["crank_offset_deg_per_run"] if o is not None)
         lines.append(f"phase: {_PHASE_WORDS[ph['measured']]}; {ph['scored_points']} phase "
-                     f"points scored as complex residuals; crank-angle offset estimated "
-                     f"{offs} deg")
-    lines += ["", "1. WHERE",
-             f"  decomposition of the order gaps (share of sum of squares, each part "
+                     f"points scored as complex residuals; crank-angle offset estimated {offs} deg")
+    lines += ["", "1. WHERE", f"  decomposition of the order gaps (share of sum of squares, each part "
              f"alone): structure/frequency {p['share_alone']['structure']:.0%}, "
              f"excitation/order {p['share_alone']['excitation']:.0%}, "
              f"channel constant {p['share_alone']['const']:.0%}; all together "
@@ -70,8 +66,7 @@ def _which(r) -> list:
     for o in r.outcomes:
         expl = f"{o.explained:>6.0%}" if np.isfinite(o.explained) else f"{'-':>6}"
         lines.append(f"  {o.label:<40} {o.n_params:>2} {o.heldout_rms_db:>11.2f} "
-                     f"{o.t_stat:>6.1f} {o.bic_gain:>8.1f} {expl} "
-                     f"{o.struct_db:>9.2f}  {o.status}")
+                     f"{o.t_stat:>6.1f} {o.bic_gain:>8.1f} {expl} {o.struct_db:>9.2f}  {o.status}")
     if r.chosen is not None:
         lines.append("  parameters (1 sigma and 95 % interval, cell-clustered: docs/guide/diagnose.md):")
         for e, ps in r.chosen.params.items():
@@ -161,8 +156,7 @@ def summary(r) -> str:
 
 
 #: The files of a report folder (:func:`write_report`), in the order written.
-REPORT_FILES = ("summary.txt", "diagnosis.json", "gap_map.png", "gap_vs_frequency.png",
-                "overlay.png")
+REPORT_FILES = ("summary.txt", "diagnosis.json", "gap_map.png", "gap_vs_frequency.png", "overlay.png")
 
 
 def write_report(r, directory, provenance=None) -> list:

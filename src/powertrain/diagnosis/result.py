@@ -92,26 +92,21 @@ class DiagnosisResult(Result):
         rg = self.rigid_gap[np.isfinite(self.rigid_gap)]
         return {
             "gap_definition": "20 log10(sim/measured) dB, + = simulation higher; noise floor "
-                              f"added to the model in power; censored below "
-                              f"{NOISE_FLOOR_MARGIN:g}x floor",
-            "rpm": d.rpm.tolist(),
-            "channels": [list(c) for c in d.channels],
+                              f"added to the model in power; censored below {NOISE_FLOOR_MARGIN:g}x floor",
+            "rpm": d.rpm.tolist(), "channels": [list(c) for c in d.channels],
             "quantities": list(d.quantities),
             "gap_db": [[[None if not np.isfinite(x) else round(float(x), 3) for x in row]
                         for row in mat] for mat in self.gap],
             "gap_db_after": None if self.gap_after is None else
             [[[None if not np.isfinite(x) else round(float(x), 3) for x in row]
               for row in mat] for mat in self.gap_after],
-            "per_channel": self._per_channel(),
-            "regions_beyond_3db": self.regions,
+            "per_channel": self._per_channel(), "regions_beyond_3db": self.regions,
             "decomposition": {
                 "model": "gap = g_channel + dH_channel(f = order*rpm/60) + dF_order(rpm)",
                 "share_alone": p["share_alone"], "r2_alone": p["r2_alone"],
                 "r2_full": p["r2_full"], "residual_rms_db": p["residual_rms_db"],
-                "channel_const_db": p["channel_const_db"],
-                "structure_curves": p["structure_curves"],
-                "excitation_curves": p["excitation_curves"],
-                "attribution": p["attribution"]},
+                "channel_const_db": p["channel_const_db"], "structure_curves": p["structure_curves"],
+                "excitation_curves": p["excitation_curves"], "attribution": p["attribution"]},
             "sides": p.get("sides"),
             "outside_rigid_span_rms_db": {
                 "median": float(np.median(rg)) if rg.size else None,
@@ -121,28 +116,23 @@ class DiagnosisResult(Result):
 
     def _outcome_dict(self, o: FitOutcome) -> dict:
         return {"effect": o.label, "effects": list(o.effects), "parameters": o.params,
-                "summary": "; ".join(t for t in (EFFECTS[e].summary(o.params[e])
-                                                 for e in o.effects) if t),
-                "parameter_sigma": o.sigma, "parameter_interval_95": o.interval,
-                "n_parameters": o.n_params,
+                "summary": "; ".join(t for t in (EFFECTS[e].summary(o.params[e]) for e in o.effects) if t),
+                "parameter_sigma": o.sigma, "parameter_interval_95": o.interval, "n_parameters": o.n_params,
                 "heldout_rms_db_before": self.baseline.heldout_rms_db,
                 "heldout_rms_db_after": o.heldout_rms_db,
                 "heldout_channel_rms_db_before": self.baseline.heldout_channel_rms,
                 "heldout_channel_rms_db_after": o.heldout_channel_rms,
-                "train_bic_gain": o.bic_gain, "heldout_t": o.t_stat,
-                "crossfit_t": o.t_crossfit,
+                "train_bic_gain": o.bic_gain, "heldout_t": o.t_stat, "crossfit_t": o.t_crossfit,
                 "explained_fraction_of_excess": o.explained, "verdict": o.status,
                 "status": None if o.status_code is None else o.status_code.name.lower(),
-                "heldout_structured_residual_db": o.struct_db,
-                "heldout_block_chi2_ratio": o.chi2_ratio,
+                "heldout_structured_residual_db": o.struct_db, "heldout_block_chi2_ratio": o.chi2_ratio,
                 "heldout_cells_check": None if o.cells_check is None else {
                     k: v for k, v in o.cells_check.items() if k != "parts"},
                 "nfev": o.nfev, "n_eval": o.n_eval, "budget_hit": o.budget_hit, "seconds": o.seconds,
                 "alternatives": o.alternatives}
 
     def _decision_rule_dict(self):
-        return {**self.rule.to_dict(),
-                "CHANNEL_FOLDS": channel_folds(len(self.data.channels) // 3),
+        return {**self.rule.to_dict(), "CHANNEL_FOLDS": channel_folds(len(self.data.channels) // 3),
                 "ORDER_SPLIT": ORDER_SPLIT, "ORDER_FOLDS": ORDER_FOLDS}
 
     def to_dict(self) -> dict:
@@ -150,23 +140,16 @@ class DiagnosisResult(Result):
         excess = math.sqrt(max(b.heldout_mse - self.noise_mse_heldout, 0.0))
         return {
             "source": self.source, "synthetic": self.synthetic, "engine": self.engine_name,
-            "where": self.where(),
-            "ranking": [self._outcome_dict(o) for o in self.outcomes],
+            "where": self.where(), "ranking": [self._outcome_dict(o) for o in self.outcomes],
             "verdict": self.verdict, "verdict_text": self.verdict_text,
             "verdict_kind": None if self.verdict_kind is None else self.verdict_kind.value,
             "chosen": None if self.chosen is None else self._outcome_dict(self.chosen),
             "heldout_rms_db_before": b.heldout_rms_db,
-            "heldout_rms_db_after": (self.chosen or b).heldout_rms_db,
-            "heldout_excess_rms_db_before": excess,
-            "heldout_noise_mse_db2": self.noise_mse_heldout,
-            "ambiguous_between": self.ambiguous,
-            "second_effect_between": self.second_effect_between,
-            "equivalent_explanations": self.equivalents,
-            "budget_hits": self.budget_hits,
-            "split": self.split,
-            "confounding_check": self.band_check,
-            "decision_rule": self._decision_rule_dict(),
-            "baseline_heldout_structured_db": b.struct_db,
+            "heldout_rms_db_after": (self.chosen or b).heldout_rms_db, "heldout_excess_rms_db_before": excess,
+            "heldout_noise_mse_db2": self.noise_mse_heldout, "ambiguous_between": self.ambiguous,
+            "second_effect_between": self.second_effect_between, "equivalent_explanations": self.equivalents,
+            "budget_hits": self.budget_hits, "split": self.split, "confounding_check": self.band_check,
+            "decision_rule": self._decision_rule_dict(), "baseline_heldout_structured_db": b.struct_db,
             "effects_library": [e.to_dict() for e in EFFECTS.values()],
             "seconds": self.seconds, "notes": self.notes,
             "finding": self.finding, "phase": self.phase, "runs": self.runs,

@@ -312,8 +312,7 @@ def _no_answer(ev, rule, ass, order, ranked):
                  f"{abs(e0 ** 0.5 - supported[0].heldout_mse ** 0.5):.2f} dB only"
                  if supported else " and no candidate improves it significantly")
         text = (f"no effect: the held-out gap ({e0 ** 0.5:.2f} dB RMS) is within noise "
-                f"({ev.sigma_db:.2f} dB; excess {excess_db:.2f} dB < {rule.excess_min_db:g} "
-                f"dB){extra}")
+                f"({ev.sigma_db:.2f} dB; excess {excess_db:.2f} dB < {rule.excess_min_db:g} dB){extra}")
         return Verdict(VerdictKind.NO_EFFECT, "no effect", text, ass, order)
     if supported:
         best = ass[supported[0].label]

@@ -170,8 +170,7 @@ class Differences:
         last_x, f0 = self.fun.last
         if last_x is None or not np.array_equal(last_x, x):
             f0 = self.fun(x)               # as "2-point" without f0: evaluated first
-        return approx_derivative(self.fun, x, method="2-point", rel_step=DIFF_STEP, f0=f0,
-                                 bounds=self.bounds,
+        return approx_derivative(self.fun, x, method="2-point", rel_step=DIFF_STEP, f0=f0, bounds=self.bounds,
                                  workers=lambda _, xs: self.fun.columns(x, list(xs)))
 
 

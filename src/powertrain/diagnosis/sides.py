@@ -154,8 +154,7 @@ def side_attribution(gap, data, sigma_db=None) -> dict | None:
             "engine_side_resolution_db": da, "body_side_resolution_db": dp,
             "largest_mount_engine_side_db": a_mount,
             "mounts_off_body_side": off, "shared": len(off) >= MIN_SHARED_MOUNTS,
-            "noise_sigma_db": float(np.nanmedian(sig)) if np.isfinite(sig).any() else
-            float("nan"),
+            "noise_sigma_db": float(np.nanmedian(sig)) if np.isfinite(sig).any() else float("nan"),
             "band_hz": _band(gap, sig, data, cols) if (where == "body" and cols) else None}
 
 

@@ -184,5 +184,4 @@ def _refine_block(fun, sub, pack, x, idx, xs):
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         return least_squares(f, xs, jac=Differences.or_two_point(f, lower, upper),
-                             bounds=(lower, upper), method="trf", max_nfev=10 * idx.size,
-                             diff_step=DIFF_STEP)
+                             bounds=(lower, upper), method="trf", max_nfev=10 * idx.size, diff_step=DIFF_STEP)

@@ -29,10 +29,8 @@ N_RPM_KNOTS = 8
 LAM_SMOOTH, LAM_RIDGE = 3.0, 0.3
 #: Share of their part's largest RMS the orders (band, channels) named must carry.
 NAME_FRACTION = 0.5
-KIND_LABEL = {"structure": "structural (tied to frequency)",
-              "excitation": "excitation (tied to order/speed)",
-              "const": "sensor gain (constant per channel)",
-              "residual": "local/unexplained by smooth parts"}
+KIND_LABEL = {"structure": "structural (tied to frequency)", "excitation": "excitation (tied to order/speed)",
+              "const": "sensor gain (constant per channel)", "residual": "local/unexplained by smooth parts"}
 
 
 def _hat_basis(x, knots):
@@ -233,8 +231,7 @@ def regions(gap, data: GapData, parts):
                 worst = i + int(np.nanargmax(np.abs(seg)))
                 found.append({"mount": mount, "direction": direction, "quantity": q,
                               "rpm_from": float(data.rpm[i]), "rpm_to": float(data.rpm[j]),
-                              "n_points": int(j - i + 1),
-                              "max_abs_db": float(np.nanmax(np.abs(seg))),
+                              "n_points": int(j - i + 1), "max_abs_db": float(np.nanmax(np.abs(seg))),
                               "gap_at_max_db": float(g[worst]),
                               "frequency_hz_at_max": float(data.rpm[worst] * (h + 1) / 120.0)
                               if h >= 0 else None,
