@@ -1,28 +1,14 @@
 r"""Step 4 of the diagnosis: the decision rule, a pure function of the evidence.
 
-:func:`decide` (evidence, rule) → :class:`Verdict`; it never fits. With :math:`E_0, E_c, E_n`
-the held-out mean squared gaps [dB²] of the baseline, a candidate and a perfect model (noise):
-
-* **supported**: training BIC lower by more than ``bic_margin`` and per-speed held-out
-  improvement t (:func:`improvement_t`) above ``t_min`` (cross-fitted when t lies between
-  ``t_screen`` and ``t_min``);
-* a pair beats its better member only if supported against it the same way and explains at
-  least ``pair_gain_min`` of what the member leaves, never when the member alone leaves an
-  excess below ``excess_min_db`` with an unstructured residual;
-* the **answer**: the best supported candidate among the first ``n_checked`` that explain at
-  least ``explained_min`` of :math:`E_0 - E_n`, keep a structured residual within
-  :math:`\max(` ``struct_abs_db``, ``struct_rel`` × the baseline's) and predict withheld
-  (channel, order) cells (``xv_explained_min``, ``xv_t_min``);
-* an admissible rival of another family not told apart (t ≤ ``t_min``) makes it
-  **ambiguous**, unless all are pairs sharing one big supported effect (then that effect,
-  the second one not identified); a candidate that restates another (``Effect.restates``)
-  or names more effects while worse on held-out and BIC is no rival;
-* **no effect** when the baseline's excess RMS over noise is below ``excess_min_db``, else
-  **unexplained** (the best supported candidate named as partial).
-
-A candidate whose cells check is missing yields a ``PENDING`` verdict with
-``needs_cells_check``; the driver computes it and decides again. Details and rationale:
-docs/guide/diagnose.md, "Decision rule".
+:func:`decide` (evidence, rule) → :class:`Verdict`; it never fits. A candidate is
+**supported** when it lowers the training BIC by more than ``bic_margin`` and its per-speed
+held-out improvement t (:func:`improvement_t`) exceeds ``t_min``; a pair must also beat its
+better member. The **answer** is the best supported candidate among the first ``n_checked``
+that explains ``explained_min`` of the excess :math:`E_0 - E_n` [dB²], leaves no structured
+residual and predicts withheld (channel, order) cells; a rival of another family it cannot
+be told from makes it **ambiguous**. Else **no effect** (excess below ``excess_min_db``) or
+**unexplained**. A missing check or cross-fit yields a ``PENDING`` verdict that names it;
+the driver computes it and decides again. Details: docs/guide/diagnose.md, "Decision rule".
 """
 
 from __future__ import annotations
@@ -157,7 +143,7 @@ def _big(a, rule):
 
 
 def _choose(ev, rule, ranked, ass):
-    """``(chosen, None)``, or ``(None, label)`` whose cells check is missing."""
+    """``(chosen, None)``, ``(None, label)`` whose cells check is missing, or ``(None, None)``."""
     smax = _struct_max(ev, rule)
     big = [c for c in ranked if ass[c.label].status is Status.SUPPORTED and _big(ass[c.label], rule)]
     for c in big[:rule.n_checked]:

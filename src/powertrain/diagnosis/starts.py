@@ -34,7 +34,8 @@ DATA_START_MARGIN = 0.01
 def start_points(problem, pack, effects, starts, grid, fun, defaults=True):
     """Start vectors of a fit of ``effects`` (``pack``'s coordinates): data starts, defaults
     (unless ``defaults`` is False with ``starts``), ``starts``, the two best points of the
-    coarse grid and the block start (the last three with ``grid``); ``fun`` charges them."""
+    coarse grid and the block start (data, grid and block starts only with ``grid`` and a
+    single effect); ``fun`` charges the evaluations of ``problem``."""
     span = pack.upper - pack.lower
     lo, hi = pack.lower + 1e-9 * span, pack.upper - 1e-9 * span
     cands = [np.clip(s, lo, hi) for s in starts or []]
