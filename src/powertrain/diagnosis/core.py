@@ -169,10 +169,9 @@ class _Setup:
         d = self.data
         return {"description": f"{N_BLOCKS} contiguous speed blocks, blocks "
                                f"{', '.join(str(b + 1) for b in HELDOUT_BLOCKS)} held out: "
-                               f"{self.test_all.size} held-out speeds ({self.test_idx.size} "
-                               f"scored), {self.train_all.size} training speeds "
-                               f"({self.train_idx.size} fitted); all channels and measured "
-                               f"orders; synthesis not fitted",
+                               f"{self.test_all.size} held-out speeds ({self.test_idx.size} scored), "
+                               f"{self.train_all.size} training speeds ({self.train_idx.size} fitted); all "
+                               f"channels and measured orders; synthesis not fitted",
                 "train_rpm": d.rpm[self.train_idx].tolist(),
                 "heldout_rpm": d.rpm[self.test_idx].tolist()}
 

@@ -18,11 +18,10 @@ MAX_REGIONS = 12
 def diagnosis_html(r) -> str:
     """A :class:`~powertrain.diagnosis.result.DiagnosisResult` as HTML."""
     d = r.data
-    head = (f"<p>measured: <code>{esc(r.source)}</code>{synthetic_mark(r.synthetic)}<br>"
-            f"engine: {esc(r.engine_name)}<br>data: {d.rpm.size} speeds {d.rpm[0]:g}..."
-            f"{d.rpm[-1]:g} rpm, {len(d.channels)} channels, quantities "
-            f"{esc(', '.join(d.quantities))}; noise estimate {r.noise_db:.2f} dB (1 sigma)<br>"
-            f"split: {esc(r.split['description'])}</p>")
+    head = (f"<p>measured: <code>{esc(r.source)}</code>{synthetic_mark(r.synthetic)}<br>engine: "
+            f"{esc(r.engine_name)}<br>data: {d.rpm.size} speeds {d.rpm[0]:g}...{d.rpm[-1]:g} rpm, "
+            f"{len(d.channels)} channels, quantities {esc(', '.join(d.quantities))}; noise estimate "
+            f"{r.noise_db:.2f} dB (1 sigma)<br>split: {esc(r.split['description'])}</p>")
     if r.runs:
         head += paragraph("plan: " + "; ".join(run_text(k, run) for k, run in enumerate(r.runs, start=1))
                           + " (one set of effect parameters; where and the figures describe run 1)")
@@ -33,10 +32,9 @@ def _where(r) -> str:
     p = r.parts
     share = p["share_alone"]
     text = (f"Decomposition of the order gaps (share of the sum of squares, each part alone): "
-            f"structure/frequency {share['structure']:.0%}, excitation/order "
-            f"{share['excitation']:.0%}, channel constant {share['const']:.0%}; all together "
-            f"{p['r2_full']:.0%}, residual {p['residual_rms_db']:.2f} dB RMS. Attribution: "
-            f"{attribution_text(p['attribution'])}.")
+            f"structure/frequency {share['structure']:.0%}, excitation/order {share['excitation']:.0%}, "
+            f"channel constant {share['const']:.0%}; all together {p['r2_full']:.0%}, residual "
+            f"{p['residual_rms_db']:.2f} dB RMS. Attribution: {attribution_text(p['attribution'])}.")
     if p.get("sides"):
         text += f" Sides: {side_text(p['sides'])}."
     regions = sorted(r.regions, key=lambda g: -abs(g["gap_at_max_db"]))

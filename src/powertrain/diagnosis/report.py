@@ -34,10 +34,9 @@ def _header(r) -> list:
         lines.append(f"phase: {_PHASE_WORDS[ph['measured']]}; {ph['scored_points']} phase "
                      f"points scored as complex residuals; crank-angle offset estimated {offs} deg")
     lines += ["", "1. WHERE", f"  decomposition of the order gaps (share of sum of squares, each part "
-             f"alone): structure/frequency {p['share_alone']['structure']:.0%}, "
-             f"excitation/order {p['share_alone']['excitation']:.0%}, "
-             f"channel constant {p['share_alone']['const']:.0%}; all together "
-             f"{p['r2_full']:.0%}, residual {p['residual_rms_db']:.2f} dB RMS",
+             f"alone): structure/frequency {p['share_alone']['structure']:.0%}, excitation/order "
+             f"{p['share_alone']['excitation']:.0%}, channel constant {p['share_alone']['const']:.0%}; all "
+             f"together {p['r2_full']:.0%}, residual {p['residual_rms_db']:.2f} dB RMS",
              f"  attribution (each part fitted alone): {attribution_text(p['attribution'])}"]
     if p.get("sides"):
         lines.append(f"  sides: {side_text(p['sides'])}")
@@ -124,9 +123,8 @@ def fit_notes(chosen, outcomes, bands, budget) -> list:
                    f"verdict rests on that point's held-out scores)")
     others = [o.label for o in outcomes if o.budget_hit and o is not chosen]
     if others:
-        out.append(f"{len(others)} other fit(s) stopped at their evaluation budget "
-                   f"({', '.join(others)}): scored at their best point so far, they may fit "
-                   f"better than ranked")
+        out.append(f"{len(others)} other fit(s) stopped at their evaluation budget ({', '.join(others)}): "
+                   f"scored at their best point so far, they may fit better than ranked")
     n_band = sum(bool(b.get("budget_hit")) for b in bands)
     if n_band:
         out.append(f"{n_band} of {len(bands)} speed-band refits stopped at their budget: "

@@ -269,10 +269,9 @@ def _member_answer(ev, ass, order, m, pairs):
         ass[c.label].text = "second effect not identified: " + " or ".join(seconds)
     a = ass[m.label]
     a.status, a.text = Status.CHOSEN, Status.CHOSEN.value
-    text = (f"{m.label}: explains {a.explained:.0%} of the held-out excess gap over noise; "
-            f"held-out RMS gap {ev.baseline.heldout_mse ** 0.5:.2f} -> "
-            f"{m.heldout_mse ** 0.5:.2f} dB; with it a second effect is supported, but the "
-            f"held-out speeds cannot tell {' from '.join(seconds)}")
+    text = (f"{m.label}: explains {a.explained:.0%} of the held-out excess gap over noise; held-out RMS gap "
+            f"{ev.baseline.heldout_mse ** 0.5:.2f} -> {m.heldout_mse ** 0.5:.2f} dB; with it a second effect "
+            f"is supported, but the held-out speeds cannot tell {' from '.join(seconds)}")
     return Verdict(VerdictKind.EFFECT, m.label, text, ass, order, chosen=m.label,
                    second_effect_between=[c.label for c in pairs])
 
@@ -280,10 +279,9 @@ def _member_answer(ev, ass, order, m, pairs):
 def _chosen(ev, ass, order, c):
     a = ass[c.label]
     a.status, a.text = Status.CHOSEN, Status.CHOSEN.value
-    text = (f"{c.label}: explains {a.explained:.0%} of the held-out excess gap over noise; "
-            f"held-out RMS gap {ev.baseline.heldout_mse ** 0.5:.2f} -> "
-            f"{c.heldout_mse ** 0.5:.2f} dB; structured residual {c.struct_db:.2f} dB "
-            f"(baseline {ev.baseline.struct_db:.2f} dB); withheld {c.cells['kind']}: "
+    text = (f"{c.label}: explains {a.explained:.0%} of the held-out excess gap over noise; held-out RMS gap "
+            f"{ev.baseline.heldout_mse ** 0.5:.2f} -> {c.heldout_mse ** 0.5:.2f} dB; structured residual "
+            f"{c.struct_db:.2f} dB (baseline {ev.baseline.struct_db:.2f} dB); withheld {c.cells['kind']}: "
             f"explains {c.cells['explained']:.0%}")
     return Verdict(VerdictKind.EFFECT, c.label, text, ass, order, chosen=c.label)
 
