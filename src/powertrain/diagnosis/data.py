@@ -191,12 +191,10 @@ def _below_dynamic_range(level, phase, orders, floor):
     with np.errstate(invalid="ignore"):
         top = np.max(np.where(np.isfinite(lv), lv, -np.inf), axis=(1, 2), keepdims=True)
         cut = (lv < top * 10 ** (-DYNAMIC_RANGE_DB / 20)) & above_floor(lv, floor)
-    lv[cut] = np.nan
-    level[:, :, orders] = lv
-    if phase is not None:
-        ph = phase[:, :, orders]
-        ph[cut] = np.nan
-        phase[:, :, orders] = ph
+    for a in [level] + ([] if phase is None else [phase]):
+        sub = a[:, :, orders]
+        sub[cut] = np.nan
+        a[:, :, orders] = sub
 
 
 def order_levels(velocity, floor):
@@ -277,11 +275,7 @@ def even(idx, n_max):
 
 def speed_groups(test_idx, size=4):
     """Runs of adjacent held-out speeds, cut into groups of about ``size`` speeds."""
-    runs, start = [], 0
-    for i in range(1, test_idx.size + 1):
-        if i == test_idx.size or test_idx[i] != test_idx[i - 1] + 1:
-            runs.append(np.arange(start, i))
-            start = i
+    runs = np.split(np.arange(test_idx.size), np.flatnonzero(np.diff(test_idx) != 1) + 1)
     groups = []
     for r in runs:
         k = max(1, int(round(r.size / size)))
