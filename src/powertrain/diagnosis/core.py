@@ -343,8 +343,7 @@ def _diagnose(measured, engine, noise_floor, effects, pairs, do_bands, rule, sch
 
 
 def _gap_after(w, sc):
-    """Gap map and model levels [m/s RMS] with the answer's effects ``sc``; ``(None, None)``
-    without a steady state."""
+    """Gap map and model levels [m/s RMS] with effects ``sc`` (None, None: no steady state)."""
     try:
         vel = predict(w.hm, sc).velocity
     except FloatingPointError:

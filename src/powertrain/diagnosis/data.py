@@ -185,8 +185,7 @@ def gap_data(measured, engine, noise_floor=DEFAULT_NOISE_FLOOR) -> GapData:
 
 
 def _below_dynamic_range(level, phase, orders, floor):
-    """NaN (in place) for order levels and phases above the censoring level but more than
-    :data:`DYNAMIC_RANGE_DB` below the strongest order at their speed."""
+    """NaN (in place) where an order is :data:`DYNAMIC_RANGE_DB` below its speed's strongest."""
     lv = level[:, :, orders]
     with np.errstate(invalid="ignore"):
         top = np.max(np.where(np.isfinite(lv), lv, -np.inf), axis=(1, 2), keepdims=True)
@@ -229,8 +228,7 @@ class ScoredLevels:
 
 
 def censored_reference_db(meas, floor):
-    """``(censored, reference [dB])`` of measured levels: below the censoring level, that
-    level is the reference."""
+    """``(censored, reference [dB])`` of ``meas``: the censoring level where below it."""
     cl = censoring_level(floor)
     censored = meas < cl
     with np.errstate(divide="ignore", invalid="ignore"):

@@ -30,8 +30,7 @@ def second_differences(level_db):
 
 
 def mad_sigma(d2) -> float:
-    r"""1σ of independent scatter from second differences ``d2``:
-    :math:`1.4826\,\mathrm{MAD}/\sqrt6`."""
+    """1σ of independent scatter from second differences ``d2``: 1.4826 MAD/√6."""
     return float(1.4826 * np.median(np.abs(d2 - np.median(d2))) / math.sqrt(6.0))
 
 

@@ -120,16 +120,14 @@ def _support(ev, rule, c, e0, excess0) -> Assessment:
 
 
 def _member_suffices(ev, rule, m, a) -> bool:
-    """A supported member leaving an excess below ``excess_min_db`` and an unstructured
-    residual: nothing left for a second effect."""
+    """Member ``m`` is supported and leaves no excess or structure for a second effect."""
     left = math.sqrt(max(m.heldout_mse - ev.noise_mse, 0.0))
     return (a.status is Status.SUPPORTED and left < rule.excess_min_db
             and m.struct_db <= _struct_max(ev, rule))
 
 
 def _within_noise(ev, rule) -> bool:
-    """The baseline's excess is below ``excess_min_db`` and its structure within
-    ``struct_abs_db``: nothing for a candidate to explain."""
+    """The baseline leaves no excess or structure for a candidate to explain."""
     left = math.sqrt(max(ev.baseline.heldout_mse - ev.noise_mse, 0.0))
     return left < rule.excess_min_db and ev.baseline.struct_db <= rule.struct_abs_db
 

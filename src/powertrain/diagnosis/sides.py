@@ -70,8 +70,7 @@ def _pairs(channels):
 
 
 def _band(gap, sig, data, cols, n_bins=24):
-    """Frequency band [Hz] of the body-side gap: the bins around the largest mean squared gap
-    beyond noise (σ² off, else near-floor points dominate) with at least half its value."""
+    """Band [Hz] of the bins around the largest mean squared gap beyond noise, ≥ half of it."""
     f = np.broadcast_to(data.order_hz[:, None, :], gap.shape)
     g = gap[:, cols][:, :, data.order_mask]
     v = sig[:, cols][:, :, data.order_mask] ** 2
@@ -94,8 +93,7 @@ def _band(gap, sig, data, cols, n_bins=24):
 
 
 def _location(ea, da, ep, dp, a_mount):
-    """``(side, R)`` from the excesses, their resolutions and the largest mount's engine-side
-    excess ``a_mount``."""
+    """``(side, R)`` from the excesses, resolutions and largest mount excess ``a_mount``."""
     a_on = np.isfinite(ea) and ea > da
     p_on = np.isfinite(ep) and ep > dp
     if not (a_on or p_on):

@@ -158,8 +158,7 @@ def _projected(fun, sub, pack, effect, x, idx, start, chans):
 
 
 class _BlockResiduals:
-    """Residuals on ``sub``'s channels as a function of the block ``idx`` (others at ``x``),
-    charged to ``fun``."""
+    """Residuals on ``sub`` of the block ``idx`` (others at ``x``), charged to ``fun``."""
 
     def __init__(self, fun, sub, x, idx):
         self.fun, self.sub, self.x, self.idx = fun, sub, x, idx
