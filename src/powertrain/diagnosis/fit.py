@@ -19,13 +19,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from powertrain.diagnosis import phase as ph
-from powertrain.diagnosis.data import (
-    GapData,
-    ScoredLevels,
-    model_levels,
-    noise_sigma_db,
-    residuals_db,
-)
+from powertrain.diagnosis.data import GapData, ScoredLevels, model_levels, noise_sigma_db, residuals_db
 from powertrain.diagnosis.packing import Packing
 from powertrain.diagnosis.search import Counted, Exhausted, jacobian, trust_region
 from powertrain.diagnosis.starts import BASIN_RATIO, start_points
