@@ -1,28 +1,12 @@
 r"""Diagnosis of the sim-to-real gap: where it lies, which unmodelled effect causes it, how far
 it shrinks.
 
-Input: a measured run-up (:class:`~powertrain.iotools.measured.MeasuredRunup`, order curves
-per mount channel) and the baseline engine model. Levels are compared as the gap
-:math:`\Delta L = 20\log_{10}(s/m)` [dB] (+ = simulation higher).
-
-The modules are the steps, in order:
-
-==================== =====================================================================
-:mod:`.data`         measured data on the speed grid, noise floor (censoring), noise
-                     estimate, the training / held-out speed split
-:mod:`.where`        gap map, regions, decomposition into sensor / structure / excitation
-                     parts and the attribution (which orders, which band)
-:mod:`.candidates`   the registry's effects that apply to the engine; equivalent
-                     explanations
-:mod:`.fit`          bounded least squares per candidate on training speeds (evaluation
-                     budget), held-out scores
-:mod:`.checks`       residual structure, held-out (channel, order) cells, noise level,
-                     speed-band confounding check
-:mod:`.rule`         :class:`DecisionRule` and the pure :func:`decide` → :class:`Verdict`
-:mod:`.result`       :class:`DiagnosisResult` and its JSON
-:mod:`.report`       summary text and report folder
-:mod:`.core`         :func:`diagnose`, the driver
-==================== =====================================================================
+A measured run-up (order curves per mount channel) is compared with the baseline engine
+model as the gap :math:`\Delta L = 20\log_{10}(s/m)` [dB] (+ = simulation higher). The steps,
+in order: :mod:`.data` (speed grid, censoring, noise, split), :mod:`.where` (gap map,
+regions, decomposition), :mod:`.candidates`, :mod:`.fit`, :mod:`.checks`, :mod:`.rule`
+(:func:`decide` → :class:`Verdict`), :mod:`.result`, :mod:`.report`; :func:`diagnose`
+(:mod:`.core`) drives them.
 """
 
 from powertrain.diagnosis.checks import heldout_cells_check, noise_mse, structured_residual

@@ -1,9 +1,6 @@
-"""Step 2 of the diagnosis: the candidate effects for this engine, and what the data cannot
-tell apart among their parameters.
-
-Candidates come from the effect registry (:data:`powertrain.effects.EFFECTS`); an effect
-is a candidate when it applies to the engine (``applicable(engine)``).
-"""
+"""Step 2 of the diagnosis: the registry's effects that apply to the engine
+(:data:`powertrain.effects.EFFECTS`), and what the data cannot tell apart among their
+parameters."""
 
 from __future__ import annotations
 
@@ -23,15 +20,13 @@ def applicable(engine, names=None) -> list:
 
 
 def at_location(names, sides) -> list:
-    """The candidates among ``names`` at the side attribution ``sides`` (None: no body side
-    measured): an effect with ``locations`` only where the gap lies there."""
+    """The candidates among ``names`` whose ``locations`` admit ``sides``' location."""
     where = None if not sides else sides.get("location")
     return [e for e in names if EFFECTS[e].locations is None or where in EFFECTS[e].locations]
 
 
 def warm_caches(hm, effects):
-    """Fill the cached model's parts the candidates need (two-ports, loads, derivatives)
-    once, before any subset is taken."""
+    """Fill the parts of cached model ``hm`` that ``effects`` need, before any subset."""
     hm.two_ports()
     _ = hm.load
     for e in effects:
@@ -39,10 +34,8 @@ def warm_caches(hm, effects):
 
 
 def restatements(outcome, engine, band=None) -> tuple:
-    """``((effects, reason), ...)``: the candidates (effect tuples, sorted) whose finding
-    ``outcome``'s fit restates (``Effect.restates``; e.g. a missing body mode shaped like one
-    of the file's modes restates ``chassis_modes``; in a pair, the pair with that member
-    replaced). ``band``: the measured order frequencies' span [Hz] (``GapData.band_hz``)."""
+    """``((effects, reason), ...)``: candidates whose finding ``outcome``'s fit restates
+    (``Effect.restates`` on ``engine``; ``band`` the measured frequency span [Hz])."""
     out = []
     for e in outcome.effects:
         r = EFFECTS[e].restates(outcome.params[e], engine, band)
@@ -53,12 +46,10 @@ def restatements(outcome, engine, band=None) -> tuple:
 
 
 def _refit(setup, e, params, budget):
-    """The chosen effect refitted from an alternative start (a few evaluations)."""
+    """Effect ``e`` refitted from ``params``."""
     pack = Packing.of((e,), setup.problem.engine)
-    x = np.array([math.log(params[pn]) if lg else params[pn]
-                  for (_, pn), lg in zip(pack.names, pack.log)])
-    return fit_candidate(setup.problem, (e,), starts=[x], grid=False, budget=budget,
-                         defaults=False)
+    x = np.array([math.log(params[pn]) if lg else params[pn] for (_, pn), lg in zip(pack.names, pack.log)])
+    return fit_candidate(setup.problem, (e,), starts=[x], grid=False, budget=budget, defaults=False)
 
 
 def _same(a, b, tol=0.01):
@@ -66,16 +57,11 @@ def _same(a, b, tol=0.01):
 
 
 def equivalents(setup, chosen, rule, budget=400, noise_mse=0.0) -> list:
-    r"""Parameter sets that explain the data as well as the chosen answer, within the noise.
+    """Parameter sets that explain the data as well as the answer ``chosen``, within noise.
 
-    The chosen effect is refitted from each alternative start it offers
-    (``Effect.alternatives``: another cylinder weak or strong, another reference cylinder,
-    swapped mirror-image mounts...). A refit that lands elsewhere is *equivalent* when the
-    held-out speeds do not prefer the answer significantly (per-speed t ≤ ``rule.t_min``, as
-    between rival candidates) and its training BIC is not worse by more than
-    ``rule.bic_margin``; the report lists them instead of picking one silently. Where order
-    phases are measured the refits score them too (:mod:`powertrain.diagnosis.phase`), so an
-    alternative is listed only while it stays equivalent with phase.
+    The answer is refitted (``budget`` evaluations) from each of ``Effect.alternatives``; a
+    refit that lands elsewhere is equivalent when held-out t ≤ ``rule.t_min`` (``noise_mse``
+    [dB²]) and its training BIC is within ``rule.bic_margin``. ``setup``: the diagnosis'.
     """
     if chosen is None or len(chosen.effects) != 1:
         return []

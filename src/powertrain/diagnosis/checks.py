@@ -1,27 +1,17 @@
-r"""Evidence beyond the held-out speeds: residual structure, held-out (channel, order) cells,
-the noise a perfect model would leave, and the speed-band confounding check.
+r"""Evidence beyond the held-out speeds (step 3 of the diagnosis).
 
-* :func:`structured_residual`: the held-out residual averaged per channel and order over
-  groups of about 4 adjacent held-out speeds (noise averages out, structure does not);
+* :func:`structured_residual`: held-out residual averaged per (channel, order) over groups
+  of about 4 adjacent speeds (noise averages out, structure does not);
 * :func:`heldout_cells_check`: the candidate refitted without some (channel, order) cells
-  must predict them at the held-out speeds. Physical effects withhold channels (folds
-  generated from the mounts, :func:`channel_folds`: one channel of every mount triad each —
-  the rigid body carries the effect to a channel it was not fitted on); candidates with
-  sensor errors or per-channel parameters (``Effect.withhold_orders``: a missing body
-  mode's shape at each base) withhold orders per channel (:func:`order_folds`: each channel's
-  *informative* orders, with points above the noise floor, dealt into :data:`ORDER_FOLDS`
-  staggered folds so that every refit still sees an informative order of every channel).
-  A gain or a triad rotation is the same on every order of its channels, a frequency-tied
-  gap is not, so free gains cannot absorb a structural gap;
+  must predict them at the held-out speeds. Physical effects withhold channels (one of
+  every mount triad, :func:`channel_folds`); sensor-like candidates withhold each channel's
+  informative orders (:func:`order_folds`): a gain is the same on every order, a
+  frequency-tied gap is not;
 * :func:`noise_mse`: :math:`E_n = \hat\sigma^2 u`, the held-out mean squared gap a perfect
-  model would leave, :math:`u` the fraction of scored held-out points that are not censored;
-* :func:`crossfit`: the candidate refitted with each other third of the speed blocks held
-  out, so that every speed is scored once by a fit that did not see it (for candidates
-  whose held-out t on one third of the speeds is short of the rule's);
-* :func:`band_check`: the chosen effect refitted on four speed bands, each started from its
-  whole-range optimum (no start grid: the trend of one answer is asked for, not another
-  basin): a parameter believed constant that trends with speed points to a different
-  effect.
+  model leaves, :math:`u` the uncensored fraction of scored points;
+* :func:`crossfit`: refits with each other third of the speeds held out;
+* :func:`band_check`: the chosen effect refitted on four speed bands from its optimum: a
+  parameter that trends with speed points to another effect.
 """
 
 from __future__ import annotations
@@ -32,12 +22,11 @@ import time
 import numpy as np
 
 from powertrain.analysis.noise_floor import above_floor
-from powertrain.diagnosis.fit import FitOutcome, Problem, fit_candidate
+from powertrain.diagnosis.fit import FitOutcome, Problem, fit_candidate, per_speed_mse
 from powertrain.diagnosis.significance import log_ratio_t
 from powertrain.effects import EFFECTS
 
-#: Fallback order split when fewer than two orders are informative: orders up to this one
-#: form the "low" fold [order].
+#: Fallback order split with fewer than two informative orders [order].
 ORDER_SPLIT = 2.0
 #: Folds of the (channel, informative order) cells for response-only candidates.
 ORDER_FOLDS = 3
@@ -46,22 +35,18 @@ MIN_ORDER_POINTS = 10
 
 
 def channel_folds(n_mounts: int) -> tuple:
-    """Channel folds: fold j withholds channel (j + m) mod 3 of mount m's triad, for every
-    mount (three mounts: (0, 4, 8), (1, 5, 6), (2, 3, 7))."""
+    """Fold j withholds channel (j + m) mod 3 of every mount m's triad."""
     return tuple(tuple(3 * m + (j + m) % 3 for m in range(n_mounts)) for j in range(3))
 
 
 def structured_residual(g, censored, groups, sigma, cells=None):
     r"""Structured part of held-out residuals [dB RMS beyond noise] and its χ² ratio.
 
-    For every group of adjacent held-out speeds and every (channel, order) the mean
-    residual :math:`\bar g` of the :math:`n` uncensored points is formed; pure noise of
-    scatter :math:`\sigma` gives :math:`E[\bar g^2] = \sigma^2/n`. Returned:
-    :math:`\sqrt{\max(0,\ \overline{\bar g^2 - \sigma^2/n})}` and the ratio
-    :math:`\overline{n\bar g^2/\sigma^2}` (≈ 1 for noise). Without a cell of two scored
-    points: infinite when no held-out gap is finite (a fit without a steady state at the
-    held-out speeds predicts nothing there), else 0 (all censored: nothing left to see) and
-    a NaN ratio.
+    Per group and (channel, order), the mean :math:`\bar g` of :math:`n` uncensored
+    residuals (noise gives :math:`E[\bar g^2] = \sigma^2/n`): returns
+    :math:`\sqrt{\max(0,\ \overline{\bar g^2 - \sigma^2/n})}` and
+    :math:`\overline{n\bar g^2/\sigma^2}` (≈ 1 for noise); without a scored cell, inf if
+    no gap is finite, else (0, NaN).
 
     Parameters
     ----------
@@ -69,6 +54,7 @@ def structured_residual(g, censored, groups, sigma, cells=None):
         Held-out residuals [dB] (NaN where not scored).
     censored : ndarray bool, same shape
     groups : list of index arrays into the first axis
+        Groups of adjacent speeds.
     sigma : float
         Noise [dB, 1σ].
     cells : ndarray bool (n_ch, n_o), optional
@@ -88,7 +74,7 @@ def structured_residual(g, censored, groups, sigma, cells=None):
         if s2 > 0:
             chi.append(n[use] * m ** 2 / s2)
     z = np.concatenate(z) if z else np.empty(0)
-    if not z.size:      # no cell with two scored points: nothing predicted, or nothing left
+    if not z.size:
         return (float("inf"), float("inf")) if not np.isfinite(g).any() else (0.0, float("nan"))
     chi_r = float(np.mean(np.concatenate(chi))) if chi else float("nan")
     return float(math.sqrt(max(float(np.mean(z)), 0.0))), chi_r
@@ -98,17 +84,12 @@ def cells_mse(o: FitOutcome, cells):
     """Held-out mean squared gap of ``o`` on the (channel, order) ``cells``; and per speed."""
     g = o.heldout_gaps
     ok = np.isfinite(g) & np.asarray(cells, bool)[None]
-    per = np.array([np.mean(g[i][ok[i]] ** 2) if ok[i].any() else np.nan
-                    for i in range(g.shape[0])])
-    return float(np.mean(g[ok] ** 2)) if ok.any() else float("nan"), per
+    return float(np.mean(g[ok] ** 2)) if ok.any() else float("nan"), per_speed_mse(g, ok)
 
 
 def noise_mse(problem: Problem, sigma, cells=None) -> float:
     r"""Expected held-out mean squared gap of a perfect model [dB²]: :math:`\hat\sigma^2`
-    times the fraction of scored held-out points that are not censored (a censored point's
-    residual, :math:`\max(0, 20\log_{10}(s'/\kappa f))`, is 0 for a model below the
-    censoring level, whatever the noise); a scored phase gap (:mod:`powertrain.diagnosis.phase`,
-    all cells only) counts as one uncensored point."""
+    times the uncensored fraction of scored points (phase gaps count as uncensored)."""
     if not (np.isfinite(sigma) and sigma > 0):
         return 0.0
     valid = problem.valid["test"]
@@ -116,22 +97,20 @@ def noise_mse(problem: Problem, sigma, cells=None) -> float:
         valid = valid & np.asarray(cells, bool)[None]
     unc = int((valid & above_floor(problem.meas["test"], problem.data.floor)).sum())
     n = int(valid.sum())
-    if cells is None and problem.phase_w is not None:   # phase gaps: uncensored, 1σ each
+    if cells is None and problem.phase_w is not None:
         n_phase = int(problem.phase_on["test"].sum())
         unc, n = unc + n_phase, n + n_phase
     return float(sigma ** 2 * unc / n) if n else 0.0
 
 
 def order_folds(problem: Problem) -> list:
-    """Withheld-cell masks (n_ch, n_o) over each channel's informative orders (at least
-    :data:`MIN_ORDER_POINTS` training points of that channel above the floor): the i-th
-    informative order of channel c is withheld in fold (c + i) mod :data:`ORDER_FOLDS`, so
-    every order keeps some of its channels; a channel with a single informative order never
-    has it withheld (its gain would have nothing left to be fitted on). With fewer than two
-    informative orders overall, orders ≤ :data:`ORDER_SPLIT` vs the others."""
+    """Withheld-cell masks (n_ch, n_o): channel c's i-th informative order (at least
+    :data:`MIN_ORDER_POINTS` training points above the floor) in fold (c + i) mod
+    :data:`ORDER_FOLDS`; a channel's only informative order is never withheld (its gain
+    needs it). Fewer than two informative orders: orders ≤ :data:`ORDER_SPLIT` vs the rest."""
     n_ch, n_o = problem.valid["train"].shape[1:]
     usable = above_floor(problem.meas["train"], problem.data.floor) & problem.valid["train"]
-    informative = usable.sum(axis=0) >= MIN_ORDER_POINTS              # (n_ch, n_o)
+    informative = usable.sum(axis=0) >= MIN_ORDER_POINTS
     if informative.any(axis=0).sum() < 2:
         order = (problem.sub.harmonic + 1) / 2.0
         low = np.broadcast_to(order <= ORDER_SPLIT + 1e-9, (n_ch, n_o))
@@ -160,20 +139,28 @@ def _folds(problem: Problem, effects):
 
 def heldout_cells_check(problem: Problem, o: FitOutcome, baseline: FitOutcome, sigma,
                         budget=None, folds=(), first=None):
-    """Refit ``o``'s effects without some (channel, order) cells and score the withheld
-    cells at the held-out speeds (cross-validation over cells as well as speeds). With
-    ``folds`` (``[(Problem, its baseline FitOutcome)]`` of the other speed folds: a
-    candidate judged on cross-fitted speeds, :func:`crossfit`) the withheld cells are scored
-    at the held-out speeds of every speed fold; ``first``: the held-out speeds' part of an
-    earlier check of ``o`` (its ``parts[0]``), reused instead of refitted.
+    """Refit ``o``'s effects without some (channel, order) cells; score those held out.
+
+    Parameters
+    ----------
+    problem : Problem
+    o, baseline : FitOutcome
+        The candidate and the baseline.
+    sigma : float
+        Noise [dB, 1σ].
+    budget : int, optional
+        Evaluations per refit.
+    folds : sequence of (Problem, FitOutcome)
+        Other speed folds and their baselines: also score the cells there.
+    first : dict, optional
+        An earlier check's ``parts[0]``, reused instead of refitted.
 
     Returns
     -------
     dict
-        ``kind``, ``explained`` (fraction of the withheld cells' held-out excess over noise
-        removed), ``t`` (per-speed significance), ``baseline_excess_db``,
-        ``heldout_rms_db``, ``speed_folds`` and ``seconds``; and ``parts``, each speed
-        fold's sums (not written to the JSON).
+        ``kind``, ``explained`` (fraction of the cells' excess over noise removed), ``t``,
+        ``baseline_excess_db``, ``heldout_rms_db``, ``speed_folds``, ``seconds``; ``parts``
+        (per speed fold, not in the JSON).
     """
     t0 = time.perf_counter()
     kind, cells = _folds(problem, o.effects)
@@ -181,8 +168,7 @@ def heldout_cells_check(problem: Problem, o: FitOutcome, baseline: FitOutcome, s
     parts = [first or _cells_fold(problem, o, baseline, cells, sigma, kw)]
     parts += [_cells_fold(p, o, b, cells, sigma, kw) for p, b in folds]
     n = sum(q["n"] for q in parts)
-    e0, ec, e_n = (sum(q[k] * q["n"] for q in parts) / n if n else float("nan")
-                   for k in ("e0", "ec", "e_n"))
+    e0, ec, e_n = (sum(q[k] * q["n"] for q in parts) / n if n else float("nan") for k in ("e0", "ec", "e_n"))
     per_0, per_c = (np.concatenate([q[k] for q in parts]) for k in ("per_0", "per_c"))
     excess = max(e0 - e_n, 0.0)
     return {"kind": kind, "explained": (e0 - ec) / excess if excess > 0 else float("nan"),
@@ -192,8 +178,7 @@ def heldout_cells_check(problem: Problem, o: FitOutcome, baseline: FitOutcome, s
 
 
 def _cells_fold(problem, o, baseline, cell_folds, sigma, kw) -> dict:
-    """One speed fold of :func:`heldout_cells_check`: the withheld cells' mean squared gaps
-    (baseline, refits, noise), per speed and over all scored points."""
+    """One speed fold of :func:`heldout_cells_check`: the withheld cells' mean squared gaps."""
     g_all = np.full(problem.valid["test"].shape, np.nan)
     for held in cell_folds:
         if not held.any() or held.all():
@@ -202,8 +187,7 @@ def _cells_fold(problem, o, baseline, cell_folds, sigma, kw) -> dict:
                            grid=False, defaults=False, **kw)
         g_all = np.where(np.isfinite(fo.heldout_gaps), fo.heldout_gaps, g_all)
     ok = np.isfinite(g_all)
-    per_c = np.array([np.mean(g_all[i][ok[i]] ** 2) if ok[i].any() else np.nan
-                      for i in range(g_all.shape[0])])
+    per_c = per_speed_mse(g_all, ok)
     cells = ok.any(axis=0)
     e0, per_0 = cells_mse(baseline, cells)
     ec = float(np.mean(g_all[ok] ** 2)) if ok.any() else float("nan")
@@ -212,17 +196,13 @@ def _cells_fold(problem, o, baseline, cell_folds, sigma, kw) -> dict:
 
 
 def crossfit(folds, o: FitOutcome, budget=None) -> np.ndarray:
-    """Mean squared gap per speed of ``o``'s effects over all speed folds: ``o``'s own
-    held-out scores (fold 0), then refits on each other fold's training speeds (started
-    from ``o``'s optimum) scored on the speeds that fold leaves out. ``folds`` are
-    ``[(Problem, its baseline FitOutcome)]`` of folds 1, 2, ...; the baseline's vector over
-    the same speeds is :func:`crossfit_baseline`."""
+    """Mean squared gap per speed of ``o``'s effects over all speed folds: its own held-out
+    scores, then refits from ``o.x`` on each of ``folds`` (``[(Problem, baseline)]``)."""
     kw = {} if budget is None else {"budget": budget}
     parts = [o.heldout_per_rpm]
     for p, _ in folds:
         parts.append(fit_candidate(p, o.effects, starts=[o.x], grid=False, defaults=False,
-                                   **kw)
-                     .heldout_per_rpm)
+                                   **kw).heldout_per_rpm)
     return np.concatenate(parts)
 
 
@@ -231,18 +211,14 @@ def crossfit_baseline(folds, baseline: FitOutcome) -> np.ndarray:
     return np.concatenate([baseline.heldout_per_rpm] + [b.heldout_per_rpm for _, b in folds])
 
 
-#: Evaluation budget of one band refit in trust-region steps' worth of evaluations (p + 1
-#: each, p fitted parameters): a refit from the whole-range optimum moves there in a few
-#: steps when the answer holds on the band; one that wanders (a body mode refitted on a band
-#: that does not see its resonance crawled to 1100 evaluations, a quarter of a diagnosis's
-#: time) is stopped and says so (``budget_hit``).
+#: Budget of one band refit [trust-region steps of p + 1 evaluations]: an answer that holds
+#: on the band needs a few; one that wanders is stopped (``budget_hit``).
 BAND_STEPS = 20
 
 
 def band_check(problem_factory, effect, data, train_idx, start, n_bands=4):
-    """Refit one effect on speed bands of the training data, from its whole-range optimum
-    ``start`` (fitted vector): parameter trend with speed. Each refit has a budget of
-    :data:`BAND_STEPS` steps."""
+    """Refit ``effect`` on ``n_bands`` speed bands of ``train_idx`` from ``start`` (its
+    whole-range optimum); ``problem_factory(idx)`` builds each band's problem."""
     out = []
     edges = np.linspace(0, train_idx.size, n_bands + 1).astype(int)
     for b in range(n_bands):

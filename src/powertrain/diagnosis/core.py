@@ -63,32 +63,27 @@ def diagnose(measured, engine=None, *, noise_floor=DEFAULT_NOISE_FLOOR, effects=
     Parameters
     ----------
     measured : MeasuredRunup, Plan, str or path
-        Measured order curves [m/s RMS], or the file to read them from (CSV or run-up
-        HDF5, :func:`powertrain.iotools.measured.read_measured`); or a test plan of several
-        run-ups (:class:`powertrain.iotools.plan.Plan`, or its ``.toml`` file,
-        :func:`powertrain.iotools.plan.read_plan`): one set of effect parameters fitted to
-        all runs (:mod:`powertrain.diagnosis.plan`).
+        Measured order curves [m/s RMS] or their file (CSV or run-up HDF5); or a test plan
+        (:class:`powertrain.iotools.plan.Plan` or its ``.toml``): one parameter set for all runs.
     engine : Engine, str or path, optional
-        Baseline model, or its file (default: the shipped ``engines/default.toml``).
+        Baseline model or its file (default: the shipped ``engines/default.toml``).
     noise_floor : float
         RMS noise floor of the measured order curves [m/s].
     effects : sequence of str, optional
-        Candidates (default: all of the effect registry that apply to ``engine``).
+        Candidates (default: every registry effect that applies to ``engine``).
     pairs : bool
-        Also fit the pairs of the three best single candidates.
+        Also fit pairs of the best single candidates.
     band_check : bool
         Refit the chosen effect on speed bands (confounding check).
     rule : DecisionRule, optional
-        Decision constants (default :class:`DecisionRule`).
+        Decision constants.
     scheduler : str
-        Where the candidate fits run (:func:`powertrain.parallel.executor`): ``serial``
-        (default, also for None: it starts fastest), ``processes``, ``local`` (dask
-        LocalCluster) or ``tcp://HOST:PORT``.
-        The result is the same on every scheduler.
+        Where the fits run (:func:`powertrain.parallel.executor`): ``serial`` (default),
+        ``processes``, ``local`` or ``tcp://HOST:PORT``; the result is the same on each.
     progress : bool
         Progress bar on stderr (only on a terminal).
     budget : int
-        Residual evaluations per fit (:data:`powertrain.diagnosis.fit.EVAL_BUDGET`).
+        Residual evaluations per fit.
 
     Returns
     -------
@@ -111,13 +106,10 @@ def diagnose(measured, engine=None, *, noise_floor=DEFAULT_NOISE_FLOOR, effects=
 
 
 def _inputs(measured, engine, effects):
-    """``(engine, measured)`` read from their files when given as paths; the effect names
-    checked against the registry."""
-
+    """``(engine, measured)``, read from files if paths; effect names checked."""
     for e in effects or []:
         if e not in EFFECTS:
-            raise InputError(f"unknown effect {e!r} (known: {', '.join(EFFECTS)})",
-                             key="--effects")
+            raise InputError(f"unknown effect {e!r} (known: {', '.join(EFFECTS)})", key="--effects")
     engine = engine_or_default(engine)
     if isinstance(measured, (str, os.PathLike)) and str(measured).lower().endswith(".toml"):
         measured = read_plan(measured, engine)
@@ -146,7 +138,7 @@ class _Setup:
         self.test_idx = even(self.test_all, N_TEST_RPM)
         self.effects = cand.applicable(engine, effects)
         self.hm = HarmonicModel(engine, data.rpm)
-        if data.channels != self.hm.channels:       # body-side channels measured (or not)
+        if data.channels != self.hm.channels:
             self.hm.use_channels(data.channels)
         cand.warm_caches(self.hm, self.effects)     # once, on every speed: subsets share it
         need = np.union1d(self.train_all, self.test_idx)
@@ -159,8 +151,7 @@ class _Setup:
         return self.hm_need.subset([self.pos[int(i)] for i in idx])
 
     def fold_problems(self) -> list:
-        """``[(Problem, baseline outcome)]`` of speed folds 1, 2 (:func:`split_rpm`; fold 0
-        is ``problem``), built on first use."""
+        """``[(Problem, baseline outcome)]`` of speed folds 1, 2, built on first use."""
         if getattr(self, "_folds", None) is None:
             self._folds = []
             for k in range(1, N_FOLDS):
@@ -178,10 +169,9 @@ class _Setup:
         d = self.data
         return {"description": f"{N_BLOCKS} contiguous speed blocks, blocks "
                                f"{', '.join(str(b + 1) for b in HELDOUT_BLOCKS)} held out: "
-                               f"{self.test_all.size} held-out speeds ({self.test_idx.size} "
-                               f"scored), {self.train_all.size} training speeds "
-                               f"({self.train_idx.size} fitted); all channels and measured "
-                               f"orders; synthesis not fitted",
+                               f"{self.test_all.size} held-out speeds ({self.test_idx.size} scored), "
+                               f"{self.train_all.size} training speeds ({self.train_idx.size} fitted); all "
+                               f"channels and measured orders; synthesis not fitted",
                 "train_rpm": d.rpm[self.train_idx].tolist(),
                 "heldout_rpm": d.rpm[self.test_idx].tolist()}
 
@@ -214,13 +204,11 @@ def _where(s: _Setup):
 def _fit_job(job):
     problem, effects, starts, budget = job
     with single_blas_thread():
-        return fit_candidate(problem, effects, starts=starts, budget=budget,
-                             defaults=starts is None)
+        return fit_candidate(problem, effects, starts=starts, budget=budget, defaults=starts is None)
 
 
 def _fit_all(s: _Setup, pairs, scheduler, progress, budget, e_n, rule, baseline, sigma):
-    """Singles, then pairs (:func:`pair_candidates`); in the order of submission, each with
-    its structured residual."""
+    """Fit singles, then pairs (:func:`pair_candidates`), each with its structured residual."""
     desc = "diagnose: candidate fits" if progress else None
     jobs = [(s.problem, (e,), None, budget) for e in s.effects]
     singles = run_map(_fit_job, jobs, scheduler, progress=desc)
@@ -237,11 +225,16 @@ def _fit_all(s: _Setup, pairs, scheduler, progress, budget, e_n, rule, baseline,
 
 
 def pair_candidates(singles, e_n, rule) -> list:
-    """Pairs worth fitting: none when the best single leaves a held-out excess RMS gap over
-    noise below ``rule.excess_min_db`` and a structured residual within
-    ``rule.struct_abs_db`` (nothing left that a second effect could be shown to explain);
-    else the best single with each other effect (forward selection: the second effect is
-    whatever explains most of the rest) and the second with the third best."""
+    """Pairs worth fitting: the best single with each other and the second with the third;
+    none when the best leaves an excess below ``rule.excess_min_db`` and no structure.
+
+    Parameters
+    ----------
+    singles : list of FitOutcome
+    e_n : float
+        Noise mean squared gap [dB²].
+    rule : DecisionRule
+    """
     ranked = sorted(singles, key=lambda o: o.heldout_mse)
     if not ranked:
         return []
@@ -258,8 +251,7 @@ def pair_candidates(singles, e_n, rule) -> list:
 
 def _evidence(o, struct=None):
     return CandidateEvidence(o.label, o.effects, o.heldout_mse, o.heldout_per_rpm, o.bic,
-                             o.struct_db if struct is None else struct, o.cells_check,
-                             o.crossfit, o.restates)
+                             o.struct_db if struct is None else struct, o.cells_check, o.crossfit, o.restates)
 
 
 def _decide(s, baseline, outcomes, sigma, rule, where_phrase, budget):
@@ -267,8 +259,7 @@ def _decide(s, baseline, outcomes, sigma, rule, where_phrase, budget):
     e_n = noise_mse(s.problem, sigma)
     by_label = {o.label: o for o in outcomes}
     while True:
-        ev = Evidence(_evidence(baseline), [_evidence(o) for o in outcomes], e_n, sigma,
-                      where_phrase)
+        ev = Evidence(_evidence(baseline), [_evidence(o) for o in outcomes], e_n, sigma, where_phrase)
         verdict = decide(ev, rule)
         if verdict.kind is not VerdictKind.PENDING:
             return verdict, e_n
@@ -280,11 +271,8 @@ def _decide(s, baseline, outcomes, sigma, rule, where_phrase, budget):
                 by_label[label].crossfit = crossfit(folds, by_label[label], budget=budget)
             continue
         o = by_label[verdict.needs_cells_check]
-        # over all speed folds when its support itself needed them (held-out t short), or
-        # asked again after a check at the held-out speeds fell short (rule.xv_t_screen)
-        # (a retry reuses the held-out speeds' refits of the first check)
-        all_folds = (not verdict.assessments[o.label].t_stat > rule.t_min
-                     or o.cells_check is not None)
+        # all speed folds when held-out t was short, or on a retry (reusing the first refits)
+        all_folds = not verdict.assessments[o.label].t_stat > rule.t_min or o.cells_check is not None
         first = o.cells_check["parts"][0] if o.cells_check is not None else None
         o.cells_check = heldout_cells_check(
             s.problem, o, baseline, sigma, budget=budget,
@@ -298,14 +286,13 @@ def _structure(s, baseline, outcomes, sigma):
         o.struct_db, o.chi2_ratio = structured_residual(o.heldout_gaps, cens_t, groups, sigma)
 
 
-def _diagnose(measured, engine, noise_floor, effects, pairs, do_bands, rule, scheduler,
-              progress, budget):
+def _diagnose(measured, engine, noise_floor, effects, pairs, do_bands, rule, scheduler, progress, budget):
     t0 = time.perf_counter()
     if hasattr(measured, "runs"):
         s = PlanSetup(measured, engine, noise_floor, effects, _Setup)
     else:
         s = _Setup(measured, engine, noise_floor, effects)
-    w = getattr(s, "first", s)                 # step 1 and the figures: a plan's first run
+    w = getattr(s, "first", s)                 # where and the figures: a plan's first run
     gap_map, parts, rigid, found, sim0 = _where(w)
     s.effects = cand.at_location(s.effects, parts.get("sides"))
     sigma = noise_sigma_db(s.data)
@@ -349,17 +336,14 @@ def _diagnose(measured, engine, noise_floor, effects, pairs, do_bands, rule, sch
         sigma, w.split_dict(), baseline, outcomes, chosen, verdict.label, text, bands,
         time.perf_counter() - t0, synthetic=bool(getattr(measured, "synthetic", False)),
         noise_mse_heldout=e_n, ambiguous=verdict.ambiguous, rule=rule,
-        second_effect_between=verdict.second_effect_between,
-        verdict_kind=verdict.kind, equivalents=eq,
+        second_effect_between=verdict.second_effect_between, verdict_kind=verdict.kind, equivalents=eq,
         budget_hits=[o.label for o in outcomes if o.budget_hit], finding=finding,
         phase=_phase_dict(s, chosen), runs=s.run_entries(chosen) if w is not s else [],
         engine=engine, sim_levels=sim0, sim_after=sim_after)
 
 
 def _gap_after(w, sc):
-    """The gap map with the answer's effects on every measured speed and the model levels
-    [m/s RMS] it compares; ``(None, None)`` where the answer's amplitude fixed point has no
-    steady state at a speed it was not fitted on."""
+    """Gap map and model levels [m/s RMS] with effects ``sc`` (None, None: no steady state)."""
     try:
         vel = predict(w.hm, sc).velocity
     except FloatingPointError:
@@ -370,8 +354,7 @@ def _gap_after(w, sc):
 
 
 def phase_kind(data) -> str:
-    """Measured phase: ``"all"`` (half orders too), ``"whole"`` (whole orders only) or
-    ``"none"``."""
+    """Measured phase of ``data``: ``"all"`` (half orders too), ``"whole"`` or ``"none"``."""
     return "all" if data.has_half_order_phase else "whole" if data.has_phase else "none"
 
 
@@ -384,11 +367,9 @@ def _finding(s, chosen):
 
 
 def _phase_dict(s, chosen) -> dict:
-    """The ``phase`` entry of the JSON: what phase was measured, the crank-angle offset
-    estimated with the chosen answer (baseline if none) [deg]."""
+    """The JSON's ``phase``: what was measured, the crank-angle offsets [deg] with the answer."""
     sc = {} if chosen is None else {e: chosen.params[e] for e in chosen.effects}
     offsets = [None if o is None else math.degrees(o) for o in s.problem.crank_offsets(sc)]
     return {"measured": phase_kind(s.data), "crank_offset_deg": offsets[0],
-            "crank_offset_deg_per_run": offsets,
-            "scored_points": 0 if s.problem.phase_w is None
+            "crank_offset_deg_per_run": offsets, "scored_points": 0 if s.problem.phase_w is None
             else int(s.problem.phase_on["train"].sum() + s.problem.phase_on["test"].sum())}

@@ -1,23 +1,20 @@
 r"""Step 0 of the diagnosis: measured data on a speed grid, the noise floor, the speed split.
 
-The simulation is the harmonic steady state at every measured speed inside the engine's
-range. The measured noise floor :math:`f` (RMS per order) is added to the model in power,
-:math:`s' = \sqrt{s^2 + f^2}` (for the synthesis :math:`\sqrt{s^2 + 16 f^2}`). A measured
-point below the censoring level :math:`\kappa f` of the one noise-floor rule
-(:mod:`powertrain.analysis.noise_floor`, :math:`\kappa = 3`) is *censored*: it only says the
-level is below :math:`\kappa f`, so its residual is
-:math:`\max(0, 20\log_{10}(s'/\kappa f))` — a model predicting an order where none was
-measured is penalised, noise is never scored as a gap.
+The model is the harmonic steady state at every measured speed in the engine's range, with
+the noise floor :math:`f` (RMS per order) added in power, :math:`s' = \sqrt{s^2 + f^2}`
+(synthesis: :math:`\sqrt{s^2 + 16 f^2}`). A point below the censoring level :math:`\kappa f`
+(:mod:`powertrain.analysis.noise_floor`, :math:`\kappa = 3`) is *censored*: its residual is
+:math:`\max(0, 20\log_{10}(s'/\kappa f))`, so noise is never scored as a gap.
 """
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 
 import numpy as np
 
 from powertrain.analysis.noise_floor import above_floor, at_floor, censoring_level
+from powertrain.diagnosis.noise_model import mad_sigma, second_differences
 from powertrain.iotools.measured import quantity_sort_key
 from powertrain.solvers.body_coupling import ModalBody, body_channels
 
@@ -35,12 +32,8 @@ N_FOLDS = 3
 #: Smallest data set that can be split: speeds in total.
 MIN_RPM = 12
 #: Dynamic range of measured order levels [dB]: a point more than this below the strongest
-#: order of any channel at its speed is below what a simulator's time-domain solve and order
-#: extraction resolve (the project's Newmark run-up, default and modal-body engine, leaves
-#: the orders that are zero in the harmonic solve 100 dB and more below it, and the tinier
-#: body-side orders buried in that error) and far below what a test lab's order tracking
-#: resolves (60-80 dB); it is numerical error, not data, and is left out like an absent
-#: point (levels below 3x the noise floor stay censored).
+#: order at its speed is numerical error (a lab's order tracking resolves 60-80 dB) and is
+#: left out like an absent point (levels below 3x the floor stay censored).
 DYNAMIC_RANGE_DB = 90.0
 
 
@@ -51,6 +44,7 @@ class GapData:
     Attributes
     ----------
     rpm : ndarray (n_r,)
+        Speeds [rpm].
     channels : list of (mount, direction)
     quantities : list of str
         Orders (``order_2``...) then ``synthesis`` if measured.
@@ -85,22 +79,19 @@ class GapData:
 
     @property
     def order_hz(self):
-        """Frequency [Hz] of every speed and quantity, (n_r, n_q): order × rpm / 60 (0 for
-        the synthesis)."""
+        """Frequency [Hz] (n_r, n_q): order × rpm / 60 (0 for the synthesis)."""
         return self.rpm[:, None] * ((self.harmonic + 1) / 2.0)[None, :] / 60.0
 
     def band_hz(self) -> tuple | None:
-        """``(lowest, highest)`` order frequency [Hz] measured above the floor on any channel
-        (None without such a point): where a resonance can show in these data."""
+        """``(lowest, highest)`` order frequency [Hz] measured above the floor (or None)."""
         ok = self.usable & self.order_mask[None, None, :]
         f = np.broadcast_to(self.order_hz[:, None, :], ok.shape)[ok]
         return (float(f.min()), float(f.max())) if f.size else None
 
-    #: Engine-side channels (the first ones; body-side channels and body points follow);
-    #: None: all.
+    #: Engine-side channels (the first ones); None: all.
     n_engine_side: int | None = None
-    #: Measured order phase [deg] like ``level`` (NaN where not given; None: no phase at all).
-    #: The order-k component is √2·RMS·cos(kθ + φ), θ from cylinder-1 firing TDC.
+    #: Measured order phase φ [deg] like ``level`` (None: no phase): the order-k component
+    #: is √2·RMS·cos(kθ + φ), θ from cylinder-1 firing TDC.
     phase: np.ndarray | None = None
 
     @property
@@ -110,7 +101,7 @@ class GapData:
 
     @property
     def has_half_order_phase(self) -> bool:
-        """Some half-order (0.5, 1.5, ...) phase is measured (a cycle reference was used)."""
+        """Some half-order phase is measured (a cycle reference was used)."""
         if not self.has_phase:
             return False
         half = (self.harmonic >= 0) & (self.harmonic % 2 == 0)
@@ -125,8 +116,7 @@ class GapData:
         """The same data on the engine-side channels only."""
         n = self.n_active
         return GapData(self.rpm, self.channels[:n], self.quantities, self.harmonic,
-                       self.level[:, :n], self.floor,
-                       phase=None if self.phase is None else self.phase[:, :n])
+                       self.level[:, :n], self.floor, phase=None if self.phase is None else self.phase[:, :n])
 
     def orders_only(self) -> GapData:
         """The same data without the synthesis."""
@@ -137,9 +127,8 @@ class GapData:
 
 
 def model_channels(engine) -> list:
-    """Channels the fast model predicts for ``engine``: every mount's engine side, and with
-    a modal body (:mod:`powertrain.solvers.body_coupling`) every mount's body side
-    (``NAME/passive``) and the body points of interest."""
+    """Channels the fast model predicts for ``engine``: mounts' engine sides, and with a modal
+    body their body sides (``NAME/passive``) and the body points."""
     active = [(m.name, a) for m in engine.mounts for a in ("x", "y", "z")]
     body = ModalBody.of(engine)
     if body is None:
@@ -161,7 +150,15 @@ def _half_order_quantities(measured):
 
 
 def gap_data(measured, engine, noise_floor=DEFAULT_NOISE_FLOOR) -> GapData:
-    """Arrange a :class:`MeasuredRunup` on the union of its speeds inside the engine range."""
+    """Arrange a :class:`MeasuredRunup` on the union of its speeds inside the engine range.
+
+    Parameters
+    ----------
+    measured : MeasuredRunup
+    engine : Engine
+    noise_floor : float
+        RMS noise floor [m/s].
+    """
     lo, hi = engine.speed_range_rpm()
     rpm = np.unique(np.concatenate([r for r, _ in measured.curves.values()]))
     rpm = rpm[(rpm >= lo - 1e-9) & (rpm <= hi + 1e-9)]
@@ -169,8 +166,7 @@ def gap_data(measured, engine, noise_floor=DEFAULT_NOISE_FLOOR) -> GapData:
     measured_channels = {(m, d) for m, d, _ in measured.curves}
     channels += [c for c in model_channels(engine)[len(channels):] if c in measured_channels]
     quantities = _half_order_quantities(measured)
-    harmonic = np.array([-1 if q == "synthesis" else int(round(2 * float(q[6:]))) - 1
-                         for q in quantities])
+    harmonic = np.array([-1 if q == "synthesis" else int(round(2 * float(q[6:]))) - 1 for q in quantities])
     level = np.full((rpm.size, len(channels), len(quantities)), np.nan)
     phases = getattr(measured, "phases", None) or {}
     phase = np.full(level.shape, np.nan) if phases else None
@@ -189,24 +185,19 @@ def gap_data(measured, engine, noise_floor=DEFAULT_NOISE_FLOOR) -> GapData:
 
 
 def _below_dynamic_range(level, phase, orders, floor):
-    """Set to NaN (in place) the order levels above the censoring level but more than
-    :data:`DYNAMIC_RANGE_DB` below the strongest order of any channel at their speed, and
-    their phases: the measurement's (or the simulator's) numerical error, not a level."""
+    """NaN (in place) where an order is :data:`DYNAMIC_RANGE_DB` below its speed's strongest."""
     lv = level[:, :, orders]
     with np.errstate(invalid="ignore"):
         top = np.max(np.where(np.isfinite(lv), lv, -np.inf), axis=(1, 2), keepdims=True)
         cut = (lv < top * 10 ** (-DYNAMIC_RANGE_DB / 20)) & above_floor(lv, floor)
-    lv[cut] = np.nan
-    level[:, :, orders] = lv
-    if phase is not None:
-        ph = phase[:, :, orders]
-        ph[cut] = np.nan
-        phase[:, :, orders] = ph
+    for a in [level] + ([] if phase is None else [phase]):
+        sub = a[:, :, orders]
+        sub[cut] = np.nan
+        a[:, :, orders] = sub
 
 
 def order_levels(velocity, floor):
-    """Model RMS levels [m/s] of complex order velocities (peak, any shape) with the noise
-    floor ``floor`` added in power."""
+    """Model RMS levels [m/s] of complex peak velocities, ``floor`` [m/s] added in power."""
     return np.sqrt((np.abs(velocity) / np.sqrt(2.0)) ** 2 + floor ** 2)
 
 
@@ -216,15 +207,14 @@ def model_levels(velocity, data: GapData):
     order = data.harmonic >= 0
     out[..., order] = order_levels(velocity[..., data.harmonic[order]], data.floor)
     if not order.all():                                        # the synthesis
-        rms = np.abs(velocity) / np.sqrt(2.0)                  # (n_r, n_ch, 16)
+        rms = np.abs(velocity) / np.sqrt(2.0)
         out[..., ~order] = np.sqrt(np.sum(rms ** 2, axis=-1) + 16 * data.floor ** 2)[..., None]
     return out
 
 
 class ScoredLevels:
-    """:func:`residuals_db` of :func:`order_levels` at fixed scored points, the measured side
-    (censoring, its dB) formed once: a fit scores thousands of model evaluations against the
-    same points. ``meas`` (1-D) the measured RMS levels there [m/s], all finite."""
+    """:func:`residuals_db` of :func:`order_levels` at fixed points, the measured side formed
+    once; ``meas`` (1-D, finite) the measured RMS levels [m/s], ``floor`` [m/s]."""
 
     def __init__(self, meas, floor):
         self.censored, self.ref_db = censored_reference_db(meas, floor)
@@ -238,9 +228,7 @@ class ScoredLevels:
 
 
 def censored_reference_db(meas, floor):
-    """The noise-floor rule on measured levels: ``(censored, reference [dB])``, censored where
-    a level is below the censoring level, whose dB is then the reference (a model gap
-    there counts only where the model is above it)."""
+    """``(censored, reference [dB])`` of ``meas``: the censoring level where below it."""
     cl = censoring_level(floor)
     censored = meas < cl
     with np.errstate(divide="ignore", invalid="ignore"):
@@ -248,8 +236,7 @@ def censored_reference_db(meas, floor):
 
 
 def residuals_db(sim, meas, floor):
-    """Gap [dB] with censoring at the noise-floor rule's level; NaN where nothing was
-    measured."""
+    """Gap [dB] of ``sim`` over ``meas`` with censoring; NaN where nothing was measured."""
     cens, ref_db = censored_reference_db(meas, floor)
     with np.errstate(divide="ignore", invalid="ignore"):
         gap = 20.0 * np.log10(sim) - ref_db
@@ -258,27 +245,19 @@ def residuals_db(sim, meas, floor):
 
 
 def noise_sigma_db(data: GapData) -> float:
-    r"""Measurement scatter [dB, 1σ] from the measured order curves: second differences of
-    the dB level along speed, :math:`\hat\sigma = 1.4826\,\mathrm{MAD}/\sqrt6` (exact for
-    independent scatter on a locally linear curve).
-
-    On a grid coarser than the curves' features the second differences also carry the
-    curvature; the estimate is then an upper bound (the diagnosis stays conservative)."""
+    r"""Measurement scatter [dB, 1σ] from second differences of the dB levels along speed,
+    :math:`\hat\sigma = 1.4826\,\mathrm{MAD}/\sqrt6` (an upper bound on a coarse grid)."""
     lv = data.level[:, :, data.order_mask]
     ok = above_floor(lv, data.floor)
     with np.errstate(divide="ignore", invalid="ignore"):
         L = np.where(ok, 20 * np.log10(lv), np.nan)
-    d2 = L[2:] - 2 * L[1:-1] + L[:-2]
-    d2 = d2[np.isfinite(d2)]
-    if d2.size < 10:
-        return float("nan")
-    return float(1.4826 * np.median(np.abs(d2 - np.median(d2))) / math.sqrt(6.0))
+    d2 = second_differences(L)
+    return mad_sigma(d2) if d2.size >= 10 else float("nan")
 
 
 def split_rpm(rpm, fold=0):
-    """Training and held-out speed indices (12 contiguous blocks, blocks 2, 5, 8, 11 held
-    out); ``fold`` k = 1, 2 holds out the blocks k places further on (cross-fitting: the
-    three folds hold out every block once)."""
+    """Training and held-out indices of ``rpm`` (12 blocks, 2, 5, 8, 11 held out); ``fold`` k
+    holds out the blocks k places further on."""
     n = rpm.size
     block = np.minimum((np.arange(n) * N_BLOCKS) // n, N_BLOCKS - 1)
     test = np.isin(block, [(b + fold) % N_BLOCKS for b in HELDOUT_BLOCKS])
@@ -294,11 +273,7 @@ def even(idx, n_max):
 
 def speed_groups(test_idx, size=4):
     """Runs of adjacent held-out speeds, cut into groups of about ``size`` speeds."""
-    runs, start = [], 0
-    for i in range(1, test_idx.size + 1):
-        if i == test_idx.size or test_idx[i] != test_idx[i - 1] + 1:
-            runs.append(np.arange(start, i))
-            start = i
+    runs = np.split(np.arange(test_idx.size), np.flatnonzero(np.diff(test_idx) != 1) + 1)
     groups = []
     for r in runs:
         k = max(1, int(round(r.size / size)))

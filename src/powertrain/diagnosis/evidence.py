@@ -1,5 +1,4 @@
-"""The evidence the decision rule reads and the verdict it returns (step 4 of the diagnosis,
-:mod:`powertrain.diagnosis.rule`): what the fits measured per candidate, and the answer."""
+"""The evidence the decision rule (:mod:`powertrain.diagnosis.rule`) reads and its verdict."""
 
 from __future__ import annotations
 
@@ -30,7 +29,7 @@ class VerdictKind(Enum):
     NO_EFFECT = "no effect"
     UNEXPLAINED = "unexplained"
     AMBIGUOUS = "ambiguous"
-    PENDING = "pending"          # a held-out cells check is needed first
+    PENDING = "pending"          # a check is needed first
 
 
 @dataclass
@@ -44,11 +43,9 @@ class CandidateEvidence:
     bic: float
     struct_db: float = float("nan")
     cells: dict | None = None
-    #: mean squared gap per speed over all three speed folds (each fold's refit scored on
-    #: the speeds it left out; the baseline's over the same speeds); None until cross-fitted
+    #: mean squared gap per speed over all speed folds; None until cross-fitted
     crossfit: np.ndarray | None = None
-    #: ((effects, reason), ...): candidates (sorted effect tuples) whose finding this fit
-    #: restates (:func:`powertrain.diagnosis.candidates.restatements`)
+    #: ((effects, reason), ...) this fit restates
     restates: tuple = ()
 
 
@@ -73,14 +70,12 @@ class Assessment:
     status: Status
     text: str
     t_crossfit: float = float("nan")
-    #: labels to cross-fit before this candidate can be judged (itself, a pair's member)
     crossfit_labels: tuple = ()
 
 
 @dataclass
 class Verdict:
-    """The answer: kind, the JSON ``verdict`` label, text, per-candidate assessments (in
-    held-out order), the chosen label and the labels that cannot be told apart."""
+    """The answer: kind, JSON label, text, assessments, chosen and ambiguous labels."""
 
     kind: VerdictKind
     label: str
@@ -89,7 +84,6 @@ class Verdict:
     order: list = field(default_factory=list)
     chosen: str | None = None
     ambiguous: list = field(default_factory=list)
-    #: with an answer: its pairs that cannot be told apart (second effect not identified)
     second_effect_between: list = field(default_factory=list)
     needs_cells_check: str | None = None
     needs_crossfit: list = field(default_factory=list)

@@ -1,26 +1,13 @@
 r"""Step 3 of the diagnosis: fit candidate effects on the training speeds, score them on the
 held-out ones.
 
-Each candidate (one effect of the registry, or a pair) is fitted on the training speeds by
-bounded least squares in dB (``scipy.optimize.least_squares``, trust region reflective,
-multi-start: the defaults, given starts and, for single effects that declare one, the two
-best points of a coarse grid) and scored on the held-out speeds. Every fit has an
-evaluation budget (:data:`EVAL_BUDGET` residual evaluations, Jacobian columns included,
-each counted once whether its velocities were solved or read from the cache): when it is hit
-the best point so far is kept and the outcome says so (``budget_hit``).
-
-Parameters with a prior (``Parameter.prior_sd``) add the residual
-:math:`\hat\sigma\,(x - x_0)/s_p` per parameter (:math:`\hat\sigma` the measured scatter in
-dB): a maximum a posteriori fit, so that directions the magnitudes do not identify stay at
-the prior's centre; the BIC and the held-out scores use the data residuals only.
-
-Parameter uncertainties (1σ and a 95 % interval) are the larger of the Gauss–Newton and the
-cluster-robust covariance, clusters the (channel, order) cells, with a relative
-model-discrepancy floor where the effect names one (:mod:`powertrain.diagnosis.uncertainty`).
-A trial parameter set
-without a steady state (the amplitude fixed point diverges) is a point far worse than any
-fit (:data:`powertrain.diagnosis.search.NO_STEADY_STATE_RESIDUAL`): the search turns back,
-the diagnosis goes on.
+Each candidate (one effect or a pair) is fitted by bounded least squares in dB (trust region
+reflective, multi-start: :mod:`.starts`, :mod:`.search`) within :data:`EVAL_BUDGET` residual
+evaluations (reached: the best point so far, ``budget_hit``). A parameter with a prior
+(``Parameter.prior_sd``) adds the residual :math:`\hat\sigma\,(x - x_0)/s_p` (a MAP fit); the
+BIC and held-out scores use the data residuals only. Uncertainties: :mod:`.uncertainty`. A
+trial point without a steady state scores
+:data:`~powertrain.diagnosis.search.NO_STEADY_STATE_RESIDUAL`.
 """
 
 from __future__ import annotations
@@ -32,13 +19,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from powertrain.diagnosis import phase as ph
-from powertrain.diagnosis.data import (
-    GapData,
-    ScoredLevels,
-    model_levels,
-    noise_sigma_db,
-    residuals_db,
-)
+from powertrain.diagnosis.data import GapData, ScoredLevels, model_levels, noise_sigma_db, residuals_db
 from powertrain.diagnosis.packing import Packing
 from powertrain.diagnosis.search import Counted, Exhausted, jacobian, trust_region
 from powertrain.diagnosis.starts import BASIN_RATIO, start_points
@@ -50,11 +31,8 @@ from powertrain.solvers.fast_harmonic import N_HARMONICS
 #: Orders 0.5..8 of the model velocities (harmonics 1..16).
 N_ORDERS = N_HARMONICS - 1
 
-#: Evaluation budget per fit, in residual evaluations (all starts, grid and Jacobian
-#: columns included; every point counts 1, whether its velocities were solved or read from
-#: the cache and however many iterations its amplitude fixed point took, so that where a
-#: fit stops depends on its points only); reached, the fit stops with the best point so far
-#: (``budget_hit``).
+#: Evaluation budget per fit [residual evaluations]: every point of every start, grid and
+#: Jacobian column counts 1, cached or solved, so where a fit stops depends on its points only.
 EVAL_BUDGET = 2500
 
 
@@ -82,7 +60,7 @@ class FitOutcome:
     struct_db: float = float("nan")
     chi2_ratio: float = float("nan")
     cells_check: dict | None = None
-    #: mean squared gap per speed over all speed folds (:func:`checks.crossfit`), if run
+    #: mean squared gap per speed over all speed folds (:func:`checks.crossfit`)
     crossfit: np.ndarray | None = field(default=None, repr=False)
     t_crossfit: float = float("nan")
     budget_hit: bool = False
@@ -90,14 +68,12 @@ class FitOutcome:
     heldout_gaps: np.ndarray | None = field(default=None, repr=False)
     status_code: object = None
     units: dict = field(default_factory=dict)
-    #: Residual evaluations spent (the budget's unit).
     n_eval: int = 0
     #: candidates whose finding this fit restates (:func:`candidates.restatements`)
     restates: tuple = ()
-    #: a second minimum in another basin of ``Effect.basin_parameter`` that explains the
-    #: training data alike (:func:`second_minimum`): ``[{"parameters", "delta_chi2"}]``
+    #: second minimum explaining the data alike (:func:`second_minimum`)
     alternatives: list = field(default_factory=list)
-    #: 95 % interval ``{effect: {parameter: [lo, hi]}}`` (SI, :mod:`powertrain.diagnosis.uncertainty`)
+    #: 95 % interval ``{effect: {parameter: [lo, hi]}}`` (SI)
     interval: dict = field(default_factory=dict)
 
     @property
@@ -106,60 +82,49 @@ class FitOutcome:
 
 
 def _physical(scenario) -> tuple:
-    """``(physical part, its key)`` of a scenario: the effects that are not response-only
-    (solved once per distinct value, :meth:`Problem.velocity`)."""
+    """``(physical part, its key)`` of a scenario: its effects that are not response-only."""
     phys = {k: v for k, v in scenario.items() if not EFFECTS[k].response_only}
     return phys, tuple(sorted((k, tuple(sorted(v.items()))) for k, v in phys.items()))
 
 
 class Problem:
-    """Residual functions on the training and held-out speeds.
+    """Residual functions on the training and held-out speeds; ``train_cells`` /
+    ``test_cells`` (bool (n_ch, n_orders)) restrict the cells fitted / scored."""
 
-    ``train_cells`` / ``test_cells`` (bool (n_ch, n_orders)) restrict the (channel, order)
-    cells fitted / scored (held-out channels or orders).
-    """
-
-    def __init__(self, hm_train, hm_test, data: GapData, train_idx, test_idx, train_cells=None,
-                 test_cells=None):
+    def __init__(self, hm_train, hm_test, data: GapData, train_idx, test_idx,
+                 train_cells=None, test_cells=None):
         self.hm = {"train": hm_train, "test": hm_test}
-        self.engine = hm_train.engine       # for the effects' parameters (layout only)
+        self.engine = hm_train.engine
         self.data = data
         self.idx = {"train": train_idx, "test": test_idx}
         om = data.order_mask
         self.meas = {k: data.level[v][:, :, om] for k, v in self.idx.items()}
         self.sub = data.orders_only()
-        #: the velocity indices scored (a linear scenario solves only these; None: all,
-        #: the synthesis needs every order)
+        #: velocity indices scored (None: all, for the synthesis)
         self.orders = np.unique(self.sub.harmonic) if np.all(self.sub.harmonic >= 0) else None
         self.valid = {k: np.isfinite(v) for k, v in self.meas.items()}
         sig = noise_sigma_db(data)
-        #: measured scatter [dB, 1σ] (weight of the parameter priors; 1 dB if unknown)
+        #: measured scatter [dB, 1σ] weighting the priors (1 dB if unknown)
         self.sigma_db = sig if np.isfinite(sig) and sig > 0 else 1.0
         self.reset_warm()
         for part, cells in (("train", train_cells), ("test", test_cells)):
             if cells is not None:
                 self.valid[part] = self.valid[part] & np.asarray(cells, bool)[None]
-        # the scored level points as flat indices into the velocities (n_r, n_ch, N_ORDERS)
         self._level_at = {k: self._flat(on) for k, on in self.valid.items()}
-        self._scored = {k: ScoredLevels(self.meas[k][on], data.floor)
-                        for k, on in self.valid.items()}
+        self._scored = {k: ScoredLevels(self.meas[k][on], data.floor) for k, on in self.valid.items()}
         self._phase_setup()
 
     def _flat(self, on):
-        """Flat indices into the velocities (n_r, n_ch, N_ORDERS) of the cells ``on``
-        (n_r, n_ch, n_q), in the order of ``array[on]``."""
+        """Flat indices into the velocities (n_r, n_ch, N_ORDERS) of ``array[on]``."""
         r, c, q = np.nonzero(on)
         return (r * on.shape[1] + c) * N_ORDERS + self.sub.harmonic[q]
 
     def clusters(self) -> np.ndarray:
-        """Cluster of each residual of :meth:`vector` on the training speeds: its (channel,
-        order) cell (:func:`~powertrain.diagnosis.uncertainty.cluster_ids`)."""
-        return cluster_ids(self.valid["train"],
-                           None if self.phase_w is None else self.phase_on["train"])
+        """(channel, order) cell of each training residual of :meth:`vector`."""
+        return cluster_ids(self.valid["train"], None if self.phase_w is None else self.phase_on["train"])
 
     def _phase_setup(self):
-        """Measured phases and their weights per part (:mod:`powertrain.diagnosis.phase`);
-        ``phase_w`` None without phase."""
+        """Measured phases and their weights per part; ``phase_w`` None without phase."""
         self.order = (self.sub.harmonic + 1) / 2.0
         self.phase_w = None
         if not self.data.has_phase:
@@ -171,18 +136,13 @@ class Problem:
         self.phase_on = {k: np.isfinite(w) for k, w in self.phase_w.items()}
         self._phase_rad = {k: np.deg2rad(v[self.phase_on[k]]) for k, v in self.phase.items()}
         self._phase_at = {k: self._flat(on) for k, on in self.phase_on.items()}
-        self._order_on = {k: np.broadcast_to(self.order, on.shape)[on]
-                          for k, on in self.phase_on.items()}
+        self._order_on = {k: np.broadcast_to(self.order, on.shape)[on] for k, on in self.phase_on.items()}
         self._w_on = {k: self.phase_w[k][on] for k, on in self.phase_on.items()}
-        self._offset = ph.OffsetProfile(self._order_on["train"], self._w_on["train"],
-                                        self.sigma_db)
+        self._offset = ph.OffsetProfile(self._order_on["train"], self._w_on["train"], self.sigma_db)
 
     def reset_warm(self):
-        """Forget the cached velocities and the amplitude fixed point's start
-        (:class:`~powertrain.diagnosis.warm_start.AmplitudeStart`) (at the start of every
-        fit, so that a fit's result does not depend on what ran before it)."""
-        self._last = {}
-        self._warm = {}
+        """Forget cached velocities and amplitude starts (a fit must not depend on the last)."""
+        self._last, self._warm = {}, {}
 
     def restricted(self, train_cells=None, test_cells=None) -> Problem:
         """The same problem with (channel, order) cells withheld from fitting / scoring."""
@@ -191,8 +151,7 @@ class Problem:
 
     def velocity(self, scenario, part="train"):
         """Complex model velocities of the measured orders (n_r, n_ch, 16) [m/s peak]."""
-        # the physical part of the scenario is solved once per distinct value: a sensor
-        # error only re-reads the same velocities (cheap finite-difference columns)
+        # a sensor error only re-reads the physical part's velocities
         phys, key = _physical(scenario)
         last = self._last.get(part)
         if last is not None and last[0] == key:
@@ -200,8 +159,7 @@ class Problem:
         else:
             warm = self._warm.setdefault(part, AmplitudeStart())
             v = scenario_vector(phys)
-            pred = predict(self.hm[part], phys, warm_amplitudes=warm.start(v),
-                           orders=self.orders)
+            pred = predict(self.hm[part], phys, warm_amplitudes=warm.start(v), orders=self.orders)
             vel = pred.velocity
             if pred.amplitudes is not None:
                 warm.record(v, pred.amplitudes)
@@ -212,15 +170,13 @@ class Problem:
         return vel
 
     def gaps(self, scenario, part="train", vel=None):
-        """Level gaps [dB] (n_r, n_ch, n_q), NaN where not scored (``vel``: the scenario's
-        velocities if already at hand)."""
+        """Level gaps [dB] (n_r, n_ch, n_q), NaN where not scored."""
         vel = self.velocity(scenario, part) if vel is None else vel
         g = residuals_db(model_levels(vel, self.sub), self.meas[part], self.data.floor)
         return np.where(self.valid[part], g, np.nan)
 
     def crank_offset(self, scenario, vel=None) -> float:
-        """The run's crank-angle offset [rad] profiled on the training speeds (``vel``: the
-        scenario's training velocities if already at hand)."""
+        """The run's crank-angle offset [rad] profiled on the training speeds."""
         vel = self.velocity(scenario, "train") if vel is None else vel
         return self._offset(self._phase_diff(vel, "train"))
 
@@ -236,41 +192,34 @@ class Problem:
         return self.velocity(scenario, part)[..., self.sub.harmonic]
 
     def phase_gaps(self, scenario, part="train", delta=None):
-        """Phase residuals [dB] (n_r, n_ch, n_q), NaN where no phase is scored; None without
-        phase. ``delta``: the crank offset [rad] (default: profiled on the training
-        speeds)."""
+        """Phase residuals [dB] (n_r, n_ch, n_q), NaN where not scored; None without phase.
+        ``delta``: crank offset [rad] (default: profiled on the training speeds)."""
         if self.phase_w is None:
             return None
         delta = self.crank_offset(scenario) if delta is None else delta
         return ph.phase_gaps(self._order_velocity(scenario, part), self.phase[part],
-                          self.phase_w[part], self.order, delta)
+                             self.phase_w[part], self.order, delta)
 
     def complex_excess(self, scenario):
-        r"""Measured minus model complex order amplitude [m/s RMS] on the training speeds,
-        (n_r, n_ch, n_o), NaN where no phase is scored; None without phase. The measured
-        amplitude is :math:`L\,e^{i(\varphi + k\delta)}` with the profiled crank offset δ."""
+        r"""Measured (:math:`L\,e^{i(\varphi + k\delta)}`) minus model complex order amplitude
+        [m/s RMS] on the training speeds; NaN where no phase is scored, None without phase."""
         if self.phase_w is None:
             return None
         vel = self.velocity(scenario)
         meas = self.meas["train"] * np.exp(1j * (np.deg2rad(self.phase["train"]) + self.order
                                                  * self.crank_offset(scenario, vel)))
-        return np.where(self.phase_on["train"],
-                        meas - vel[..., self.sub.harmonic] / math.sqrt(2.0), np.nan)
+        return np.where(self.phase_on["train"], meas - vel[..., self.sub.harmonic] / math.sqrt(2.0), np.nan)
 
     def vector(self, scenario, part="train"):
-        """The residuals of ``part`` [dB]: the level gaps of the scored cells (as
-        :meth:`gaps`, in the order of ``gaps[valid]``), then with phase the phase gaps and
-        the crank offset's prior."""
+        """Residuals of ``part`` [dB]: ``gaps[valid]``, then any phase gaps and offset prior."""
         vel = self.velocity(scenario, part)
         g = self._scored[part](np.take(vel, self._level_at[part]))
         return g if self.phase_w is None else self._with_phase(g, vel, scenario, part)
 
     def read_vectors(self, scenarios) -> list | None:
-        """:meth:`vector` on the training speeds of each of ``scenarios``, which differ
-        from one another in response-only effects only (a Jacobian's sensor columns): the
-        cached velocities of their physical part read at once (:meth:`Effect.readings
-        <powertrain.effects.base.Effect.readings>`); the same values, no solve. None when the
-        cache holds another physical part (:meth:`vector` then solves it)."""
+        """:meth:`vector` on the training speeds of ``scenarios`` differing in response-only
+        effects only, read at once from the cached velocities; None when the cache holds
+        another physical part."""
         last = self._last.get("train")
         if last is None or last[0] != _physical(scenarios[0])[1]:
             return None
@@ -287,7 +236,7 @@ class Problem:
                                   self._w_on["train"], self.sigma_db)
 
     def _with_phase(self, g, vel, scenario, part):
-        """The level gaps ``g`` followed by the phase gaps and the crank offset's prior."""
+        """``g`` followed by the phase gaps and the crank offset's prior."""
         d = self._phase_diff(vel, part)
         delta = self._offset(d) if part == "train" else self.crank_offset(scenario)
         gp = self._w_on[part] * ph.wrap(d - self._order_on[part] * delta)
@@ -298,9 +247,19 @@ def fit_candidate(problem: Problem, effects, starts=None, grid=True,
                   budget=EVAL_BUDGET, defaults=True) -> FitOutcome:
     """Fit one effect or a combination on the training speeds, score on the held-out ones.
 
-    ``starts``: start vectors (fitted coordinates) besides the defaults, the start grid and
-    the data starts (``grid``); ``defaults=False`` with ``starts`` skips the defaults' start
-    (a refit from a known optimum: the checks, the band check, the pairs)."""
+    Parameters
+    ----------
+    problem : Problem or JointProblem
+    effects : tuple of str
+    starts : list of ndarray, optional
+        Extra start vectors (fitted coordinates).
+    grid : bool
+        Also the start grid and the data starts.
+    budget : int
+        Residual evaluations.
+    defaults : bool
+        False with ``starts``: skip the defaults' start (a refit from a known optimum).
+    """
     t0 = time.perf_counter()
     problem.reset_warm()
     pack = Packing.of(effects, problem.engine)
@@ -333,25 +292,22 @@ def fit_candidate(problem: Problem, effects, starts=None, grid=True,
     return out
 
 
-#: Training χ² (residuals over the scatter squared) within which a second minimum explains
-#: the data alike: the decision rule's BIC margin, "very strong" evidence (Kass & Raftery).
+#: Training Δχ² within which a second minimum explains the data alike (the rule's BIC margin,
+#: Kass & Raftery).
 ALIKE_CHI2 = 10.0
 
 
 def second_minimum(fun, pack, effects, x, sigma_db) -> list:
     """``[{"parameters", "delta_chi2"}]`` of the best finished start whose
-    ``Effect.basin_parameter`` lies a factor :data:`~powertrain.diagnosis.starts.BASIN_RATIO`
-    or more from the fit's at ``x`` and whose training χ² exceeds the fit's by less than
-    :data:`ALIKE_CHI2` (two minima that explain the data alike: both are reported, never
-    more); [] for pairs, effects without such a parameter, or no such minimum."""
+    ``Effect.basin_parameter`` lies :data:`~powertrain.diagnosis.starts.BASIN_RATIO` or more
+    from the fit's at ``x`` within Δχ² < :data:`ALIKE_CHI2`; else []."""
     name = EFFECTS[effects[0]].basin_parameter if len(effects) == 1 else None
     if name is None or not fun.minima:
         return []
     j = pack.names.index((effects[0], name))
     val = (lambda v: math.exp(v[j])) if pack.log[j] else (lambda v: v[j])
     c0 = min([c for c, _ in fun.minima] + [float(fun.best[0])])
-    far = [(c, v) for c, v in fun.minima
-           if abs(math.log(val(v) / val(x))) >= math.log(BASIN_RATIO)]
+    far = [(c, v) for c, v in fun.minima if abs(math.log(val(v) / val(x))) >= math.log(BASIN_RATIO)]
     if not far:
         return []
     c, v = min(far, key=lambda t: t[0])
@@ -362,14 +318,11 @@ def second_minimum(fun, pack, effects, x, sigma_db) -> list:
 
 
 def score(problem, effects, sc, params, sigma, rss, n, p, nfev, seconds, x=None) -> FitOutcome:
-    """Held-out scores of a scenario: mean squared gap per speed, overall, per channel. A
-    scenario without a steady state at a held-out speed (an amplitude fixed point that does
-    not converge there, though it did at the training speeds) predicts nothing there: its
-    held-out gap is infinite (the rule finds it unsupported; JSON null)."""
+    """Held-out scores of scenario ``sc``: mean squared gap per speed, overall, per channel
+    (infinite where it has no steady state at a held-out speed)."""
     try:
         g = problem.gaps(sc, "test")
-        both = g if problem.phase_w is None else np.concatenate(
-            [g, problem.phase_gaps(sc, "test")], axis=-1)    # level and phase gaps
+        both = g if problem.phase_w is None else np.concatenate([g, problem.phase_gaps(sc, "test")], axis=-1)
     except FloatingPointError:
         g = np.full(problem.valid["test"].shape, np.nan)
         per_rpm, mse, ch = np.full(g.shape[0], np.inf), math.inf, [math.nan] * g.shape[1]
@@ -380,17 +333,19 @@ def score(problem, effects, sc, params, sigma, rss, n, p, nfev, seconds, x=None)
                       per_rpm, ch, nfev, seconds, x=x, heldout_gaps=g)
 
 
+def per_speed_mse(g, ok):
+    """Mean of ``g[i][ok[i]] ** 2`` for every speed i (NaN where none is ``ok``)."""
+    return np.array([np.mean(g[i][ok[i]] ** 2) if ok[i].any() else np.nan for i in range(g.shape[0])])
+
+
 def _heldout_means(g, both):
-    """Mean squared held-out gap per speed and overall (levels and phases), RMS per channel
-    (levels)."""
+    """Mean squared gap per speed and overall (``both``), RMS per channel (``g``)."""
     valid, ok = np.isfinite(g), np.isfinite(both)
-    per_rpm = np.array([np.mean(both[i][ok[i]] ** 2) if ok[i].any() else np.nan
-                        for i in range(g.shape[0])])
     ch = []
     for c in range(g.shape[1]):
         v = g[:, c][valid[:, c]]
         ch.append(float(np.sqrt(np.mean(v ** 2))) if v.size else float("nan"))
-    return per_rpm, float(np.mean(both[ok] ** 2)), ch
+    return per_speed_mse(both, ok), float(np.mean(both[ok] ** 2)), ch
 
 
 def baseline_outcome(problem: Problem) -> FitOutcome:

@@ -1,13 +1,11 @@
-"""The diagnosis in HTML (its ``_repr_html_`` and its section of the study report): the
-verdict, then where, which and how far as tables, worst first (the numbers of
-``summary.txt``, :mod:`powertrain.diagnosis.report`)."""
+"""The diagnosis in HTML (``_repr_html_``, the study report's section): the verdict, then
+where, which and how far as tables, worst first."""
 
 from __future__ import annotations
 
-from pathlib import Path
-
 import numpy as np
 
+from powertrain.diagnosis.report import run_text
 from powertrain.diagnosis.sides import side_text
 from powertrain.diagnosis.where import REGION_DB, attribution_text
 from powertrain.effects import EFFECTS
@@ -20,34 +18,23 @@ MAX_REGIONS = 12
 def diagnosis_html(r) -> str:
     """A :class:`~powertrain.diagnosis.result.DiagnosisResult` as HTML."""
     d = r.data
-    head = (f"<p>measured: <code>{esc(r.source)}</code>{synthetic_mark(r.synthetic)}<br>"
-            f"engine: {esc(r.engine_name)}<br>data: {d.rpm.size} speeds {d.rpm[0]:g}..."
-            f"{d.rpm[-1]:g} rpm, {len(d.channels)} channels, quantities "
-            f"{esc(', '.join(d.quantities))}; noise estimate {r.noise_db:.2f} dB (1 sigma)<br>"
-            f"split: {esc(r.split['description'])}</p>")
+    head = (f"<p>measured: <code>{esc(r.source)}</code>{synthetic_mark(r.synthetic)}<br>engine: "
+            f"{esc(r.engine_name)}<br>data: {d.rpm.size} speeds {d.rpm[0]:g}...{d.rpm[-1]:g} rpm, "
+            f"{len(d.channels)} channels, quantities {esc(', '.join(d.quantities))}; noise estimate "
+            f"{r.noise_db:.2f} dB (1 sigma)<br>split: {esc(r.split['description'])}</p>")
     if r.runs:
-        head += paragraph("plan: " + "; ".join(_run(k, run)
-                                               for k, run in enumerate(r.runs, start=1))
-                          + " (one set of effect parameters; where and the figures "
-                            "describe run 1)")
-    return (paragraph(f"VERDICT: {r.verdict_text}", "verdict") + head + _where(r)
-            + _which(r) + _how_far(r))
-
-
-def _run(k, run) -> str:
-    """``run 2 part.csv (load 0.4)`` or ``(traces wot-p.csv)``."""
-    how = f"traces {Path(run['traces']).name}" if run.get("traces") else f"load {run['load']:g}"
-    return f"run {k} {Path(run['file']).name} ({how})"
+        head += paragraph("plan: " + "; ".join(run_text(k, run) for k, run in enumerate(r.runs, start=1))
+                          + " (one set of effect parameters; where and the figures describe run 1)")
+    return (paragraph(f"VERDICT: {r.verdict_text}", "verdict") + head + _where(r) + _which(r) + _how_far(r))
 
 
 def _where(r) -> str:
     p = r.parts
     share = p["share_alone"]
     text = (f"Decomposition of the order gaps (share of the sum of squares, each part alone): "
-            f"structure/frequency {share['structure']:.0%}, excitation/order "
-            f"{share['excitation']:.0%}, channel constant {share['const']:.0%}; all together "
-            f"{p['r2_full']:.0%}, residual {p['residual_rms_db']:.2f} dB RMS. Attribution: "
-            f"{attribution_text(p['attribution'])}.")
+            f"structure/frequency {share['structure']:.0%}, excitation/order {share['excitation']:.0%}, "
+            f"channel constant {share['const']:.0%}; all together {p['r2_full']:.0%}, residual "
+            f"{p['residual_rms_db']:.2f} dB RMS. Attribution: {attribution_text(p['attribution'])}.")
     if p.get("sides"):
         text += f" Sides: {side_text(p['sides'])}."
     regions = sorted(r.regions, key=lambda g: -abs(g["gap_at_max_db"]))
@@ -66,8 +53,7 @@ def _where(r) -> str:
 
 def _which(r) -> str:
     b = r.baseline
-    rows = [["(baseline)", 0, number(b.heldout_rms_db), "-", "-", "-",
-             number(b.struct_db), ""]]
+    rows = [["(baseline)", 0, number(b.heldout_rms_db), "-", "-", "-", number(b.struct_db), ""]]
     for o in r.outcomes:
         rows.append([o.label, o.n_params, number(o.heldout_rms_db), number(o.t_stat, ".1f"),
                      number(o.bic_gain, ".1f"), number(100 * o.explained, ".0f") + " %"
@@ -83,8 +69,7 @@ def _which(r) -> str:
             txt = ", ".join(f"{k} = {v:.4g} ± {r.chosen.sigma[e][k]:.2g} {unit.get(k, '')}"
                             for k, v in ps.items())
             said = EFFECTS[e].summary(ps)
-            items.append(f"<li>{esc(e)}: {esc(txt)}" + (f" = {esc(said)}" if said else "")
-                         + "</li>")
+            items.append(f"<li>{esc(e)}: {esc(txt)}" + (f" = {esc(said)}" if said else "") + "</li>")
         out += "<p>Parameters (1 sigma, cell-clustered):</p><ul>" + "".join(items) \
             + "</ul>"
     out += "".join(paragraph(f"Equivalent explanation: {eq['text']}") for eq in r.equivalents)
@@ -102,8 +87,7 @@ def _how_far(r) -> str:
                     f"{run['heldout_rms_db_after']:.2f} dB" for k, run in enumerate(r.runs, 1))
     return ("<h4>3. How far (held-out speeds)</h4>" + paragraph(text + ".")
             + table(["mount", "dir", "before [dB]", "after [dB]"], rows,
-                    "Held-out RMS gap per channel before and after the chosen effect, worst "
-                    "first"))
+                    "Held-out RMS gap per channel before and after the chosen effect, worst first"))
 
 
 def _value(text: str) -> float:

@@ -1,18 +1,10 @@
 r"""Noise model of the measured order levels, per channel and level.
 
-A measured order level scatters by the test's own repeatability (log-normal, σ_c per
-channel: sensors, mountings and cable runs differ) and by the noise floor, which adds a
-scatter that grows as the level nears the floor
-(:func:`powertrain.analysis.noise_floor.floor_scatter_db`: 2.0 dB at the censoring level
-3f, 0.6 dB at 10f). One σ for every channel and level under-states the scatter near the
-floor and over-states it high above; the point's own
-
-.. math:: \sigma(c, m) = \sqrt{\sigma_c^2 + \sigma_f(m)^2}
-
-is used instead. :math:`\sigma_c` comes from the second differences of the channel's dB
-level along speed at the points at least :data:`CLEAN_MULTIPLE` × the floor (there the
-floor adds ≤ 0.2 dB), :math:`\hat\sigma = 1.4826\,\mathrm{MAD}/\sqrt6`; a channel with fewer
-than :data:`MIN_DIFFS` such differences takes the estimate pooled over all channels.
+A point's scatter is :math:`\sigma(c, m) = \sqrt{\sigma_c^2 + \sigma_f(m)^2}`: the channel's
+repeatability :math:`\sigma_c` (log-normal; from second differences of its dB levels at least
+:data:`CLEAN_MULTIPLE` × the floor, :math:`1.4826\,\mathrm{MAD}/\sqrt6`, pooled over channels
+below :data:`MIN_DIFFS` differences) and the floor's
+(:func:`powertrain.analysis.noise_floor.floor_scatter_db`: 2.0 dB at 3f, 0.6 dB at 10f).
 """
 
 from __future__ import annotations
@@ -27,37 +19,35 @@ from powertrain.analysis.noise_floor import floor_scatter_db
 CLEAN_MULTIPLE = 30.0
 #: Fewest second differences for a channel's own estimate.
 MIN_DIFFS = 10
-#: Scatter assumed when no channel has enough clean points [dB, 1σ] (the middle of the
-#: 0.5-1 dB a test lab's order levels scatter by).
+#: Scatter when no channel has enough clean points [dB, 1σ] (a lab's 0.5-1 dB).
 FALLBACK_DB = 0.7
 
 
-def _second_differences(level_db):
-    """Second differences along speed (axis 0) of dB levels, finite ones, flattened."""
+def second_differences(level_db):
+    """Finite second differences along speed (axis 0) of dB levels ``level_db``, flattened."""
     d2 = level_db[2:] - 2 * level_db[1:-1] + level_db[:-2]
     return d2[np.isfinite(d2)]
 
 
-def _mad_sigma(d2) -> float:
+def mad_sigma(d2) -> float:
+    """1σ of independent scatter from second differences ``d2``: 1.4826 MAD/√6."""
     return float(1.4826 * np.median(np.abs(d2 - np.median(d2))) / math.sqrt(6.0))
 
 
 def channel_scatter_db(data) -> np.ndarray:
-    """Repeatability scatter σ_c [dB, 1σ] of every channel, (n_ch,) (module docstring)."""
+    """Repeatability scatter σ_c [dB, 1σ] of every channel of ``data`` (GapData), (n_ch,)."""
     lv = data.level[:, :, data.order_mask]
     with np.errstate(divide="ignore", invalid="ignore"):
         clean = np.where(lv >= CLEAN_MULTIPLE * data.floor, 20 * np.log10(lv), np.nan)
-    per = [_second_differences(clean[:, c]) for c in range(lv.shape[1])]
+    per = [second_differences(clean[:, c]) for c in range(lv.shape[1])]
     pooled = np.concatenate(per) if per else np.empty(0)
-    common = _mad_sigma(pooled) if pooled.size >= MIN_DIFFS else FALLBACK_DB
-    return np.array([_mad_sigma(d) if d.size >= MIN_DIFFS else common for d in per])
+    common = mad_sigma(pooled) if pooled.size >= MIN_DIFFS else FALLBACK_DB
+    return np.array([mad_sigma(d) if d.size >= MIN_DIFFS else common for d in per])
 
 
 def point_sigma_db(data, scatter_db=None) -> np.ndarray:
-    r"""σ(c, m) [dB, 1σ] of every measured point, like ``data.level`` (NaN where absent).
-
-    ``scatter_db``: the channels' σ_c (default :func:`channel_scatter_db`), or one number
-    for all."""
+    """σ(c, m) [dB, 1σ] of every point of ``data``, like ``data.level``; ``scatter_db``: the
+    channels' σ_c (default :func:`channel_scatter_db`) or one number."""
     sc = channel_scatter_db(data) if scatter_db is None else scatter_db
     sc = np.broadcast_to(np.asarray(sc, float), (len(data.channels),))
     fl = floor_scatter_db(data.level, data.floor)

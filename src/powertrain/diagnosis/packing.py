@@ -1,6 +1,4 @@
-"""The parameters of a candidate fit as one vector (step 3 of the diagnosis,
-:mod:`powertrain.diagnosis.fit`): bounds, log scale for scale-like parameters, start and
-priors, and back to effect scenarios and parameter tables."""
+"""A candidate's parameters as one fitted vector: bounds, log scale, start, priors, and back."""
 
 from __future__ import annotations
 
@@ -21,7 +19,6 @@ class Packing:
     upper: np.ndarray
     log: np.ndarray
     x0: np.ndarray
-
     units: dict = None
     prior_sd: np.ndarray = None
 
@@ -31,6 +28,7 @@ class Packing:
 
     @classmethod
     def of(cls, effects, engine=None):
+        """The packing of ``effects``' parameters (for ``engine``)."""
         names, lo, hi, logs, x0, units, prior = [], [], [], [], [], {}, []
         for e in effects:
             for p in EFFECTS[e].parameters(engine):
@@ -45,13 +43,14 @@ class Packing:
                    np.array(prior, float))
 
     def scenario(self, x):
+        """``{effect: {parameter: value}}`` (SI) at vector ``x``."""
         sc = {}
         for (e, p), lg, v in zip(self.names, self.log.tolist(), np.asarray(x, float).tolist()):
             sc.setdefault(e, {})[p] = math.exp(v) if lg else v
         return sc
 
     def values(self, x, sd):
-        """``params``, ``sigma`` dicts (SI) from the vector and its 1σ."""
+        """``params``, ``sigma`` dicts (SI) from vector ``x`` and its 1σ ``sd``."""
         params, sigma = {}, {}
         for (e, pn), lg, v, s in zip(self.names, self.log, x, sd):
             val = math.exp(v) if lg else v

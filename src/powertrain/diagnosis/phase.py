@@ -1,24 +1,16 @@
 r"""Order phase in the diagnosis: complex residuals with a level-dependent noise model and the
 run's crank-angle offset as a nuisance parameter.
 
-Where a measured point carries its order phase :math:`\varphi` (the order-k component is
-:math:`\sqrt2\,\mathrm{RMS}\cos(k\theta + \varphi)`, θ from cylinder-1 firing TDC) and its
-level :math:`L` is above the censoring level, the fit scores the phase gap
-:math:`\Delta = \mathrm{wrap}(\arg\hat v - k\delta - \varphi)` besides the level gap in dB.
-The level gap of a complex log-normal scatter of σ dB has a phase twin of
-:math:`\sigma_r = \sigma\ln 10/20` rad; the complex noise floor :math:`f` adds
-:math:`f/L` rad, so that
+Where a point carries its order phase :math:`\varphi` (order-k component
+:math:`\sqrt2\,\mathrm{RMS}\cos(k\theta + \varphi)`, θ from cylinder-1 firing TDC) above the
+censoring level, the phase gap :math:`\Delta = \mathrm{wrap}(\arg\hat v - k\delta - \varphi)`
+is scored besides the level gap, as a residual with a level gap's 1σ:
 
-.. math:: \sigma_\varphi = \sqrt{\sigma_r^2 + (f/L)^2},\qquad
-          r_\varphi = \frac{\sigma}{\sigma_\varphi}\,\Delta \quad[\mathrm{dB}],
+.. math:: \sigma_\varphi = \sqrt{(\sigma\ln 10/20)^2 + (f/L)^2},\qquad
+          r_\varphi = \frac{\sigma}{\sigma_\varphi}\,\Delta \quad[\mathrm{dB}].
 
-a residual with the same 1σ as a level gap: near the floor the phase weighs little, far
-above it a phase gap of 1 rad weighs as 8.7 dB. Magnitudes alone where no phase is given.
-
-A lab knows its TDC to about :data:`CRANK_OFFSET_SD_DEG` crank: an error δ shifts order k's
-phase by −kδ. δ is profiled out per run (weighted least squares over the run's phase
-residuals, with the prior :math:`\sigma\,\delta/\sigma_\delta` as one more residual); the
-held-out speeds use the training speeds' δ.
+The crank offset δ (prior :data:`CRANK_OFFSET_SD_DEG`) shifts order k's phase by −kδ; it is
+profiled out per run on the training speeds and reused on the held-out ones.
 """
 
 from __future__ import annotations
@@ -34,13 +26,13 @@ CRANK_OFFSET_SD_DEG = 1.0
 
 
 def wrap(x):
-    """Angle wrapped to [−π, π) [rad]."""
+    """Angle ``x`` wrapped to [−π, π) [rad]."""
     return np.mod(np.asarray(x) + np.pi, 2 * np.pi) - np.pi
 
 
 def phase_weights(level, phase_deg, floor, sigma_db):
-    r"""Weights :math:`\sigma/\sigma_\varphi` [dB/rad] of the phase gaps (module docstring);
-    NaN where no phase is given or the level is not above the censoring level."""
+    """Weights σ/σ_φ [dB/rad] of the phase gaps at RMS ``level`` and ``floor`` [m/s] for scatter
+    ``sigma_db``; NaN where ``phase_deg`` is missing or the level is censored."""
     sigma_r = sigma_db * math.log(10.0) / 20.0
     with np.errstate(divide="ignore", invalid="ignore"):
         s_phi = np.sqrt(sigma_r ** 2 + (floor / level) ** 2)
@@ -50,11 +42,9 @@ def phase_weights(level, phase_deg, floor, sigma_db):
 
 
 class OffsetProfile:
-    r"""The crank-angle offset δ [rad] of one run profiled from its phase gaps: minimises
+    r"""A run's crank-angle offset δ [rad] minimising
     :math:`\sum w^2\,\mathrm{wrap}(d - k\delta)^2 + (\sigma\delta/\sigma_\delta)^2` by two
-    re-wrapped weighted least-squares steps, for the orders ``order`` k and weights ``w`` of
-    the scored phase points (1-D; their sums are formed once: a fit profiles δ at every
-    evaluation)."""
+    re-wrapped weighted least-squares steps; ``order`` k and ``w`` of the scored points."""
 
     def __init__(self, order, w, sigma_db):
         k, w2 = order, w ** 2
@@ -72,7 +62,7 @@ class OffsetProfile:
         return float(np.sum(self.w2k * r) / self.denominator)
 
     def rows(self, d) -> np.ndarray:
-        """δ [rad] of each row of ``d`` (n_b, n_points), as calling this on each row."""
+        """δ [rad] of each row of ``d`` (n_b, n_points)."""
         if d.shape[1] == 0:
             return np.zeros(d.shape[0])
         k = self.order
@@ -82,24 +72,21 @@ class OffsetProfile:
 
 
 def crank_offset(d, order, w, sigma_db) -> float:
-    """Profiled crank-angle offset δ [rad] of one run (:class:`OffsetProfile`; ``d`` model
-    minus measured phase [rad], ``order`` k and ``w`` the weights at the scored phase
-    points, 1-D)."""
+    """Profiled crank-angle offset δ [rad] (:class:`OffsetProfile`) of model minus measured
+    phases ``d`` [rad] at orders ``order``, weights ``w``, scatter ``sigma_db``."""
     return OffsetProfile(order, w, sigma_db)(d)
 
 
 def phase_gaps(velocity, phase_deg, w, order, delta):
-    """Phase residuals [dB] (like ``w``; NaN where no phase counts) of the model's complex
-    velocities ``velocity`` (same cells) at the crank offset ``delta`` [rad]."""
+    """Phase residuals [dB] like ``w`` of complex ``velocity`` against ``phase_deg`` at
+    orders ``order`` and crank offset ``delta`` [rad]."""
     d = wrap(np.angle(velocity) - order * delta - np.deg2rad(phase_deg))
     return w * d
 
 
 def rows_with_phase(g, d, profile, w, sigma_db) -> list:
-    """Each row of the level gaps ``g`` (n_b, n) followed by its phase gaps and its crank
-    offset's prior: ``d`` (n_b, n_p) the model minus measured phases [rad] at the scored
-    phase points, ``w`` their weights, ``profile`` the run's :class:`OffsetProfile` (the
-    offset profiled per row, as one row at a time)."""
+    """Each row of level gaps ``g`` (n_b, n) followed by its phase gaps (``d`` (n_b, n_p)
+    model minus measured phases [rad], weights ``w``) and offset prior (``profile``)."""
     delta = profile.rows(d)
     gp = w * wrap(d - profile.order * delta[:, None])
     return [np.concatenate([gi, gpi, [offset_prior(float(di), sigma_db)]])
@@ -107,5 +94,5 @@ def rows_with_phase(g, d, profile, w, sigma_db) -> list:
 
 
 def offset_prior(delta, sigma_db) -> float:
-    """The crank offset's prior residual [dB]."""
+    """The crank offset ``delta``'s prior residual [dB]."""
     return sigma_db * delta / math.radians(CRANK_OFFSET_SD_DEG)

@@ -1,15 +1,9 @@
 """Several run-ups of one car in one diagnosis (a test plan, :mod:`powertrain.iotools.plan`).
 
-Every run keeps its own data, speed split, noise estimate and cached model — the engine in
-that run's operating state (its load, or its pressure traces) — and its own crank-angle
-offset (:mod:`powertrain.diagnosis.phase`). :class:`JointProblem` stacks the runs' residuals
-so that **one set of effect parameters** is fitted to all runs (an amplitude law must serve
-every run's amplitudes); speeds are held out within each run, and the held-out scores,
-checks and the decision see the runs' held-out speeds side by side (the speed axis of the
-stacked arrays is run 1's speeds, then run 2's, ...).
-
-Step 1 (where) and the figures describe the plan's first run; the per-run held-out gaps are
-in the result's ``runs``.
+Every run keeps its own data, split, noise estimate, cached model (the engine at that run's
+load or pressure traces) and crank-angle offset. :class:`JointProblem` stacks the runs'
+residuals (speed axis: run 1's speeds, then run 2's, ...) so that **one set of effect
+parameters** is fitted to all runs. Step 1 and the figures describe the first run.
 """
 
 from __future__ import annotations
@@ -22,16 +16,14 @@ from powertrain.errors import InputError
 
 
 def stacked(datas) -> GapData:
-    """The runs' :class:`GapData` one after the other along the speed axis."""
+    """The runs' :class:`GapData` ``datas`` one after the other along the speed axis."""
     d0 = datas[0]
     phase = None
     if any(d.phase is not None for d in datas):
-        phase = np.concatenate([d.phase if d.phase is not None else np.full(d.level.shape,
-                                                                            np.nan)
+        phase = np.concatenate([d.phase if d.phase is not None else np.full(d.level.shape, np.nan)
                                 for d in datas])
     return GapData(np.concatenate([d.rpm for d in datas]), d0.channels, d0.quantities,
-                   d0.harmonic, np.concatenate([d.level for d in datas]), d0.floor,
-                   d0.n_engine_side, phase)
+                   d0.harmonic, np.concatenate([d.level for d in datas]), d0.floor, d0.n_engine_side, phase)
 
 
 def _offsets(sizes):
@@ -39,8 +31,8 @@ def _offsets(sizes):
 
 
 class JointProblem:
-    """The runs' :class:`~powertrain.diagnosis.fit.Problem` fitted as one: residuals
-    concatenated, gaps stacked along the speed axis."""
+    """The ``runs``' :class:`~powertrain.diagnosis.fit.Problem` fitted as one on the stacked
+    ``data``: residuals concatenated, gaps stacked along the speed axis."""
 
     def __init__(self, runs, data: GapData):
         self.runs = list(runs)
@@ -56,29 +48,25 @@ class JointProblem:
         self.sigma_db = sig if np.isfinite(sig) and sig > 0 else 1.0
         self.phase_w = None
         if any(p.phase_w is not None for p in self.runs):
-            self.phase_w = {k: np.concatenate([self._phase_w(p, k) for p in self.runs])
-                            for k in self.idx}
+            self.phase_w = {k: np.concatenate([self._phase_w(p, k) for p in self.runs]) for k in self.idx}
             self.phase_on = {k: np.isfinite(w) for k, w in self.phase_w.items()}
 
     @staticmethod
     def _phase_w(p, part):
-        return p.phase_w[part] if p.phase_w is not None else np.full(p.meas[part].shape,
-                                                                      np.nan)
+        return p.phase_w[part] if p.phase_w is not None else np.full(p.meas[part].shape, np.nan)
 
     def reset_warm(self):
         for p in self.runs:
             p.reset_warm()
 
     def restricted(self, train_cells=None, test_cells=None) -> JointProblem:
-        return JointProblem([p.restricted(train_cells, test_cells) for p in self.runs],
-                            self.data)
+        return JointProblem([p.restricted(train_cells, test_cells) for p in self.runs], self.data)
 
     def gaps(self, scenario, part="train"):
         return np.concatenate([p.gaps(scenario, part) for p in self.runs])
 
     def complex_excess(self, scenario):
-        """The runs' :meth:`Problem.complex_excess` stacked (NaN for a run without phase);
-        None when no run has phase."""
+        """The runs' :meth:`Problem.complex_excess` stacked (None when no run has phase)."""
         parts = [p.complex_excess(scenario) for p in self.runs]
         if all(e is None for e in parts):
             return None
@@ -95,14 +83,12 @@ class JointProblem:
         return np.concatenate([p.vector(scenario, part) for p in self.runs])
 
     def clusters(self) -> np.ndarray:
-        """The runs' :meth:`Problem.clusters` joined: a (channel, order) cell is one cluster
-        over all runs, each run's crank offset prior one of its own."""
+        """The runs' :meth:`Problem.clusters` joined; each run's offset prior its own cluster."""
         return np.concatenate([np.where(c < 0, c - k, c)
                                for k, c in enumerate(p.clusters() for p in self.runs)])
 
     def read_vectors(self, scenarios) -> list | None:
-        """The runs' :meth:`Problem.read_vectors` joined (None if a run's cache holds
-        another physical part)."""
+        """The runs' :meth:`Problem.read_vectors` joined (None if one is None)."""
         parts = [p.read_vectors(scenarios) for p in self.runs]
         if any(v is None for v in parts):
             return None
@@ -114,8 +100,8 @@ class JointProblem:
 
 
 class PlanSetup:
-    """The setup of a plan diagnosis: one :class:`~powertrain.diagnosis.core._Setup` per run
-    (``runs``), joined; ``first`` is run 1's (step 1 and the figures)."""
+    """The setup of a plan diagnosis: one ``setup_class`` per run of ``plan`` (``runs``),
+    joined; ``first`` is run 1's."""
 
     def __init__(self, plan, engine, noise_floor, effects, setup_class):
         self.plan, self.runs = plan, []
@@ -146,8 +132,8 @@ class PlanSetup:
         return self._folds
 
     def run_entries(self, chosen) -> list:
-        """The ``runs`` entries of the JSON: each run's file, load, held-out RMS gap before
-        and after the chosen answer [dB] and crank-angle offset [deg]."""
+        """The JSON's ``runs``: each run's file, load, held-out RMS gap before and after
+        ``chosen`` [dB] and crank-angle offset [deg]."""
         sc = {} if chosen is None else {e: chosen.params[e] for e in chosen.effects}
         out = []
         for run, s in zip(self.plan.runs, self.runs):

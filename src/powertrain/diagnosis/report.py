@@ -19,29 +19,24 @@ _PHASE_WORDS = {"all": "order phases measured, half orders too",
 
 def _header(r) -> list:
     d, p = r.data, r.parts
-    lines = [f"measured: {r.source}{' [SYNTHETIC]' if r.synthetic else ''}",
-             f"engine: {r.engine_name}",
+    lines = [f"measured: {r.source}{' [SYNTHETIC]' if r.synthetic else ''}", f"engine: {r.engine_name}",
              f"data: {d.rpm.size} speeds {d.rpm[0]:g}..{d.rpm[-1]:g} rpm, "
              f"{len(d.channels)} channels, quantities {', '.join(d.quantities)}; "
-             f"noise estimate {r.noise_db:.2f} dB (1 sigma)",
-             f"split: {r.split['description']}"]
+             f"noise estimate {r.noise_db:.2f} dB (1 sigma)", f"split: {r.split['description']}"]
     if r.runs:
         lines.append(f"plan: {len(r.runs)} runs diagnosed together (one set of effect "
                      f"parameters; speeds held out within each run): " + "; ".join(
-                         _run_text(k, run) for k, run in enumerate(r.runs, start=1))
+                         run_text(k, run) for k, run in enumerate(r.runs, start=1))
                      + "; WHERE and the figures describe run 1, data and split above too")
     ph = r.phase or {}
     if ph.get("measured", "none") != "none":
         offs = ", ".join(f"{o:+.2f}" for o in ph["crank_offset_deg_per_run"] if o is not None)
         lines.append(f"phase: {_PHASE_WORDS[ph['measured']]}; {ph['scored_points']} phase "
-                     f"points scored as complex residuals; crank-angle offset estimated "
-                     f"{offs} deg")
-    lines += ["", "1. WHERE",
-             f"  decomposition of the order gaps (share of sum of squares, each part "
-             f"alone): structure/frequency {p['share_alone']['structure']:.0%}, "
-             f"excitation/order {p['share_alone']['excitation']:.0%}, "
-             f"channel constant {p['share_alone']['const']:.0%}; all together "
-             f"{p['r2_full']:.0%}, residual {p['residual_rms_db']:.2f} dB RMS",
+                     f"points scored as complex residuals; crank-angle offset estimated {offs} deg")
+    lines += ["", "1. WHERE", f"  decomposition of the order gaps (share of sum of squares, each part "
+             f"alone): structure/frequency {p['share_alone']['structure']:.0%}, excitation/order "
+             f"{p['share_alone']['excitation']:.0%}, channel constant {p['share_alone']['const']:.0%}; all "
+             f"together {p['r2_full']:.0%}, residual {p['residual_rms_db']:.2f} dB RMS",
              f"  attribution (each part fitted alone): {attribution_text(p['attribution'])}"]
     if p.get("sides"):
         lines.append(f"  sides: {side_text(p['sides'])}")
@@ -70,11 +65,9 @@ def _which(r) -> list:
     for o in r.outcomes:
         expl = f"{o.explained:>6.0%}" if np.isfinite(o.explained) else f"{'-':>6}"
         lines.append(f"  {o.label:<40} {o.n_params:>2} {o.heldout_rms_db:>11.2f} "
-                     f"{o.t_stat:>6.1f} {o.bic_gain:>8.1f} {expl} "
-                     f"{o.struct_db:>9.2f}  {o.status}")
+                     f"{o.t_stat:>6.1f} {o.bic_gain:>8.1f} {expl} {o.struct_db:>9.2f}  {o.status}")
     if r.chosen is not None:
-        lines.append("  parameters (1 sigma and 95 % interval, cell-clustered: "
-                     "docs/guide/diagnose.md):")
+        lines.append("  parameters (1 sigma and 95 % interval, cell-clustered: docs/guide/diagnose.md):")
         for e, ps in r.chosen.params.items():
             unit = r.chosen.units.get(e, {})
             txt = ", ".join(f"{k} = {v:.4g} +- {r.chosen.sigma[e][k]:.2g}"
@@ -101,31 +94,27 @@ def _interval_text(iv) -> str:
     return f" (95 % {iv[0]:.4g}..{iv[1]:.4g})"
 
 
-def _run_text(k, run) -> str:
-    """``run 2 part.csv (load 0.4)`` or ``(traces wot-p.csv)``."""
+def run_text(k, run) -> str:
+    """Plan run ``k``'s entry ``run`` in words: ``run 2 part.csv (load 0.4)``."""
     how = f"traces {Path(run['traces']).name}" if run.get("traces") else f"load {run['load']:g}"
     return f"run {k} {Path(run['file']).name} ({how})"
 
 
 def _db(value) -> str:
-    """A channel's held-out RMS [dB], or "-" where it has no held-out point (a channel
-    measured on part of the speeds only)."""
+    """A channel's held-out RMS [dB], or "-" without a held-out point."""
     return f"{value:.2f}" if np.isfinite(value) else "-"
 
 
 def fit_notes(chosen, outcomes, bands, budget) -> list:
-    """Sentences of the verdict on how far the fits can be trusted: a second minimum of the
-    answer that explains the data alike (``FitOutcome.alternatives``), parameters of the
-    answer at a bound (``Effect.bound_warnings``), and, said once, the fits that stopped at
-    their evaluation budget with what that means for the answer; the answer's 95 %
-    intervals where its effect states them (``Effect.interval_text``)."""
+    """Sentences on how far the fits can be trusted: the answer ``chosen``'s second minimum,
+    intervals and parameters at a bound; the ``outcomes`` and band refits ``bands`` stopped
+    at their ``budget``."""
     out = []
     if chosen is not None and len(chosen.effects) == 1:
         eff = EFFECTS[chosen.effects[0]]
         ps = chosen.params[chosen.effects[0]]
         for alt in chosen.alternatives:
-            out.append(eff.alternative_text(ps, alt["parameters"][chosen.effects[0]],
-                                            alt["delta_chi2"]))
+            out.append(eff.alternative_text(ps, alt["parameters"][chosen.effects[0]], alt["delta_chi2"]))
         said = eff.interval_text(chosen.interval.get(chosen.effects[0], {}))
         out += ([said] if said else []) + eff.bound_warnings(ps)
     if chosen is not None and chosen.budget_hit:
@@ -134,9 +123,8 @@ def fit_notes(chosen, outcomes, bands, budget) -> list:
                    f"verdict rests on that point's held-out scores)")
     others = [o.label for o in outcomes if o.budget_hit and o is not chosen]
     if others:
-        out.append(f"{len(others)} other fit(s) stopped at their evaluation budget "
-                   f"({', '.join(others)}): scored at their best point so far, they may fit "
-                   f"better than ranked")
+        out.append(f"{len(others)} other fit(s) stopped at their evaluation budget ({', '.join(others)}): "
+                   f"scored at their best point so far, they may fit better than ranked")
     n_band = sum(bool(b.get("budget_hit")) for b in bands)
     if n_band:
         out.append(f"{n_band} of {len(bands)} speed-band refits stopped at their budget: "
@@ -146,7 +134,7 @@ def fit_notes(chosen, outcomes, bands, budget) -> list:
 
 
 def summary(r) -> str:
-    """The plain-text report: where, which, how far, verdict."""
+    """The plain-text report of result ``r``: where, which, how far, verdict."""
     b, d = r.baseline, r.data
     lines = _header(r) + _which(r)
     lines += ["", "3. HOW FAR (held-out speeds)"]
@@ -166,21 +154,18 @@ def summary(r) -> str:
 
 
 #: The files of a report folder (:func:`write_report`), in the order written.
-REPORT_FILES = ("summary.txt", "diagnosis.json", "gap_map.png", "gap_vs_frequency.png",
-                "overlay.png")
+REPORT_FILES = ("summary.txt", "diagnosis.json", "gap_map.png", "gap_vs_frequency.png", "overlay.png")
 
 
 def write_report(r, directory, provenance=None) -> list:
-    """Write ``summary.txt``, ``diagnosis.json`` and the figures (:data:`REPORT_FILES`) into
-    ``directory`` (created with its missing parents)."""
-
+    """Write result ``r``'s :data:`REPORT_FILES` into ``directory`` (created if missing);
+    ``provenance`` stamps the figures. Returns the paths."""
     out = Path(directory)
     with atomic_write(out / "summary.txt") as fh:
         fh.write(r.to_text() + "\n")
     r.to_json(out / "diagnosis.json")
     files = [out / "summary.txt", out / "diagnosis.json"]
-    for name, fn in zip(REPORT_FILES[2:], (plot_gap_map, plot_gap_frequency,
-                                           plot_diagnosis_overlay)):
+    for name, fn in zip(REPORT_FILES[2:], (plot_gap_map, plot_gap_frequency, plot_diagnosis_overlay)):
         close_figure(fn(r, out / name, provenance=provenance))
         files.append(out / name)
     return files

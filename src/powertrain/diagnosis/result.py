@@ -1,8 +1,5 @@
-"""Step 5 of the diagnosis: the result object and its JSON form (``diagnosis.json``).
-
-The JSON keys are an interface (scripts/blind_diagnosis.py and users' tools read them):
-keep every key; add freely.
-"""
+"""Step 5 of the diagnosis: the result object and its JSON (``diagnosis.json``, whose keys
+are an interface: keep every key)."""
 
 from __future__ import annotations
 
@@ -54,32 +51,28 @@ class DiagnosisResult(Result):
     notes: list = field(default_factory=list)
     #: E_n: held-out mean squared gap a perfect model would leave [dB²].
     noise_mse_heldout: float = 0.0
-    #: Labels of candidates that pass the decision rule but cannot be told apart.
+    #: Labels that pass the rule but cannot be told apart.
     ambiguous: list = field(default_factory=list)
-    #: With an answer: its pairs the held-out speeds cannot tell apart (a second effect
-    #: supported but not identified).
+    #: The answer's pairs not told apart (second effect not identified).
     second_effect_between: list = field(default_factory=list)
     rule: DecisionRule = field(default_factory=DecisionRule)
     verdict_kind: VerdictKind | None = None
     #: Parameter sets that explain the data equally well within the noise.
     equivalents: list = field(default_factory=list)
-    #: Fits stopped by their evaluation budget (labels).
+    #: Labels of fits stopped by their evaluation budget.
     budget_hits: list = field(default_factory=list)
-    #: Model levels [m/s RMS] like ``data.level`` (noise floor added in power): the
-    #: baseline, and with the chosen effect (None without one); the overlays draw them.
+    #: Model levels [m/s RMS] like ``data.level``: baseline and with the answer.
     sim_levels: np.ndarray | None = field(default=None, repr=False, compare=False)
     sim_after: np.ndarray | None = field(default=None, repr=False, compare=False)
-    #: The baseline engine diagnosed (:class:`~powertrain.models.engine.Engine`).
+    #: The baseline engine diagnosed.
     engine: object = field(default=None, repr=False, compare=False)
-    #: What the chosen effect names (``Effect.finding``: e.g. which cylinder), or None.
+    #: What the chosen effect names (``Effect.finding``), or None.
     finding: dict | None = None
-    #: Phase used: ``measured`` ("all", "whole", "none"), ``crank_offset_deg``,
-    #: ``scored_points``.
+    #: Phase used: ``measured``, ``crank_offset_deg``, ``scored_points``.
     phase: dict = field(default_factory=dict)
-    #: Per-run entries of a plan diagnosis (empty for a single run-up).
+    #: Per-run entries of a plan diagnosis.
     runs: list = field(default_factory=list)
 
-    # ------------------------------------------------------------------ dicts
     def _per_channel(self):
         d, chans = self.data, []
         for c, (m, di) in enumerate(d.channels):
@@ -94,30 +87,26 @@ class DiagnosisResult(Result):
         return chans
 
     def where(self) -> dict:
+        """The JSON's ``where`` entry (step 1)."""
         d, p = self.data, self.parts
         rg = self.rigid_gap[np.isfinite(self.rigid_gap)]
         return {
             "gap_definition": "20 log10(sim/measured) dB, + = simulation higher; noise floor "
-                              f"added to the model in power; censored below "
-                              f"{NOISE_FLOOR_MARGIN:g}x floor",
-            "rpm": d.rpm.tolist(),
-            "channels": [list(c) for c in d.channels],
+                              f"added to the model in power; censored below {NOISE_FLOOR_MARGIN:g}x floor",
+            "rpm": d.rpm.tolist(), "channels": [list(c) for c in d.channels],
             "quantities": list(d.quantities),
             "gap_db": [[[None if not np.isfinite(x) else round(float(x), 3) for x in row]
                         for row in mat] for mat in self.gap],
             "gap_db_after": None if self.gap_after is None else
             [[[None if not np.isfinite(x) else round(float(x), 3) for x in row]
               for row in mat] for mat in self.gap_after],
-            "per_channel": self._per_channel(),
-            "regions_beyond_3db": self.regions,
+            "per_channel": self._per_channel(), "regions_beyond_3db": self.regions,
             "decomposition": {
                 "model": "gap = g_channel + dH_channel(f = order*rpm/60) + dF_order(rpm)",
                 "share_alone": p["share_alone"], "r2_alone": p["r2_alone"],
                 "r2_full": p["r2_full"], "residual_rms_db": p["residual_rms_db"],
-                "channel_const_db": p["channel_const_db"],
-                "structure_curves": p["structure_curves"],
-                "excitation_curves": p["excitation_curves"],
-                "attribution": p["attribution"]},
+                "channel_const_db": p["channel_const_db"], "structure_curves": p["structure_curves"],
+                "excitation_curves": p["excitation_curves"], "attribution": p["attribution"]},
             "sides": p.get("sides"),
             "outside_rigid_span_rms_db": {
                 "median": float(np.median(rg)) if rg.size else None,
@@ -127,28 +116,23 @@ class DiagnosisResult(Result):
 
     def _outcome_dict(self, o: FitOutcome) -> dict:
         return {"effect": o.label, "effects": list(o.effects), "parameters": o.params,
-                "summary": "; ".join(t for t in (EFFECTS[e].summary(o.params[e])
-                                                 for e in o.effects) if t),
-                "parameter_sigma": o.sigma, "parameter_interval_95": o.interval,
-                "n_parameters": o.n_params,
+                "summary": "; ".join(t for t in (EFFECTS[e].summary(o.params[e]) for e in o.effects) if t),
+                "parameter_sigma": o.sigma, "parameter_interval_95": o.interval, "n_parameters": o.n_params,
                 "heldout_rms_db_before": self.baseline.heldout_rms_db,
                 "heldout_rms_db_after": o.heldout_rms_db,
                 "heldout_channel_rms_db_before": self.baseline.heldout_channel_rms,
                 "heldout_channel_rms_db_after": o.heldout_channel_rms,
-                "train_bic_gain": o.bic_gain, "heldout_t": o.t_stat,
-                "crossfit_t": o.t_crossfit,
+                "train_bic_gain": o.bic_gain, "heldout_t": o.t_stat, "crossfit_t": o.t_crossfit,
                 "explained_fraction_of_excess": o.explained, "verdict": o.status,
                 "status": None if o.status_code is None else o.status_code.name.lower(),
-                "heldout_structured_residual_db": o.struct_db,
-                "heldout_block_chi2_ratio": o.chi2_ratio,
+                "heldout_structured_residual_db": o.struct_db, "heldout_block_chi2_ratio": o.chi2_ratio,
                 "heldout_cells_check": None if o.cells_check is None else {
                     k: v for k, v in o.cells_check.items() if k != "parts"},
                 "nfev": o.nfev, "n_eval": o.n_eval, "budget_hit": o.budget_hit, "seconds": o.seconds,
                 "alternatives": o.alternatives}
 
     def _decision_rule_dict(self):
-        return {**self.rule.to_dict(),
-                "CHANNEL_FOLDS": channel_folds(len(self.data.channels) // 3),
+        return {**self.rule.to_dict(), "CHANNEL_FOLDS": channel_folds(len(self.data.channels) // 3),
                 "ORDER_SPLIT": ORDER_SPLIT, "ORDER_FOLDS": ORDER_FOLDS}
 
     def to_dict(self) -> dict:
@@ -156,23 +140,16 @@ class DiagnosisResult(Result):
         excess = math.sqrt(max(b.heldout_mse - self.noise_mse_heldout, 0.0))
         return {
             "source": self.source, "synthetic": self.synthetic, "engine": self.engine_name,
-            "where": self.where(),
-            "ranking": [self._outcome_dict(o) for o in self.outcomes],
+            "where": self.where(), "ranking": [self._outcome_dict(o) for o in self.outcomes],
             "verdict": self.verdict, "verdict_text": self.verdict_text,
             "verdict_kind": None if self.verdict_kind is None else self.verdict_kind.value,
             "chosen": None if self.chosen is None else self._outcome_dict(self.chosen),
             "heldout_rms_db_before": b.heldout_rms_db,
-            "heldout_rms_db_after": (self.chosen or b).heldout_rms_db,
-            "heldout_excess_rms_db_before": excess,
-            "heldout_noise_mse_db2": self.noise_mse_heldout,
-            "ambiguous_between": self.ambiguous,
-            "second_effect_between": self.second_effect_between,
-            "equivalent_explanations": self.equivalents,
-            "budget_hits": self.budget_hits,
-            "split": self.split,
-            "confounding_check": self.band_check,
-            "decision_rule": self._decision_rule_dict(),
-            "baseline_heldout_structured_db": b.struct_db,
+            "heldout_rms_db_after": (self.chosen or b).heldout_rms_db, "heldout_excess_rms_db_before": excess,
+            "heldout_noise_mse_db2": self.noise_mse_heldout, "ambiguous_between": self.ambiguous,
+            "second_effect_between": self.second_effect_between, "equivalent_explanations": self.equivalents,
+            "budget_hits": self.budget_hits, "split": self.split, "confounding_check": self.band_check,
+            "decision_rule": self._decision_rule_dict(), "baseline_heldout_structured_db": b.struct_db,
             "effects_library": [e.to_dict() for e in EFFECTS.values()],
             "seconds": self.seconds, "notes": self.notes,
             "finding": self.finding, "phase": self.phase, "runs": self.runs,
@@ -185,31 +162,36 @@ class DiagnosisResult(Result):
     def to_json(self, path=None) -> str:
         """``diagnosis.json``: :meth:`to_dict`, non-finite numbers as null; written
         atomically to ``path`` if given."""
-        text = json.dumps(_finite_or_null(self.to_dict()), indent=1, allow_nan=False,
-                          default=_jsonable)
+        text = json.dumps(_finite_or_null(self.to_dict()), indent=1, allow_nan=False, default=_jsonable)
         if path is not None:
             with atomic_write(path) as fh:
                 fh.write(text)
         return text
 
-    # ------------------------------------------------------------------ text, figures
     def to_text(self) -> str:
-        """Plain-text report: where, which, how far, verdict (what ``powertrain diagnose``
-        prints and ``summary.txt`` holds; :func:`powertrain.diagnosis.report.summary`)."""
+        """Plain-text report (``summary.txt``, what ``powertrain diagnose`` prints)."""
         return summary(self)
 
     def _repr_html_(self) -> str:
-        """HTML of the verdict, where, which and how far (Jupyter shows it)."""
+        """HTML of the verdict, where, which and how far."""
         return fragment(diagnosis_html(self))
 
     def plot(self, ax=None, *, path=None, quantity=None, provenance=None):
-        """Gap map figure, one panel per quantity; returns it (see
-        :func:`powertrain.plotting.plot_gap_map`). ``ax``: None (a new figure), a Figure or
-        SubFigure, or one Axes when one quantity is shown or chosen (``quantity``); else an
-        InputError saying to pass a Figure."""
+        """Gap map figure, one panel per quantity (:func:`powertrain.plotting.plot_gap_map`).
+
+        Parameters
+        ----------
+        ax : Figure, SubFigure or Axes, optional
+            Where to draw (one Axes only for one ``quantity``); None: a new figure.
+        path : str or path, optional
+            File to save it to.
+        quantity : str, optional
+            The one quantity shown.
+        provenance : dict, optional
+            Stamp of the figure.
+        """
         ax, path = target_and_path(ax, path)
-        return plot_gap_map(self, path, ax=ax, quantity=quantity,
-                            provenance=provenance)
+        return plot_gap_map(self, path, ax=ax, quantity=quantity, provenance=provenance)
 
     def report(self, directory, provenance=None) -> list:
         """Write ``summary.txt``, ``diagnosis.json`` and the figures into ``directory``."""
@@ -217,8 +199,7 @@ class DiagnosisResult(Result):
 
 
 def _finite_or_null(x):
-    """``x`` with every non-finite float (a quantity that is undefined here, e.g. the explained
-    fraction when the baseline leaves no excess over noise) replaced by ``None`` (JSON null)."""
+    """``x`` with every non-finite float replaced by ``None`` (JSON null)."""
     if isinstance(x, dict):
         return {k: _finite_or_null(v) for k, v in x.items()}
     if isinstance(x, (list, tuple)):

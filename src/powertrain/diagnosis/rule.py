@@ -1,46 +1,14 @@
 r"""Step 4 of the diagnosis: the decision rule, a pure function of the evidence.
 
-:func:`decide` (evidence, rule) → :class:`Verdict`. With :math:`E_0, E_c` the held-out mean
-squared gaps (dB²) of the baseline and a candidate and :math:`E_n` the one a perfect model
-would leave (noise):
-
-* a candidate is **supported** when it lowers the training BIC by more than ``bic_margin``
-  and its held-out improvement is significant: the per-speed improvements :math:`d_r`
-  (log ratios of the mean squared gaps plus noise, :func:`improvement_t`) have
-  :math:`\bar d/(s_d/\sqrt{n_r}) >` ``t_min`` and :math:`\bar d > 0`;
-* a pair is preferred to its better member only if it is supported against that member in
-  the same way (cross-fitting both when that t lies between ``t_screen`` and ``t_min``) and
-  explains at least ``pair_gain_min`` of the excess that member leaves — and never when
-  that member is supported and leaves an excess over noise below ``excess_min_db`` with a
-  residual within the structure limit (nothing left beyond the lab's repeatability);
-* the **answer** is the best (lowest held-out gap) supported candidate, among the first
-  ``n_checked`` that explain at least ``explained_min`` of :math:`E_0 - E_n`, whose
-  held-out residual keeps a structured RMS beyond noise of at most
-  :math:`\max(` ``struct_abs_db``, ``struct_rel`` × the baseline's) and that predicts
-  withheld (channel, order) cells (explains ≥ ``xv_explained_min`` of their excess with
-  t > ``xv_t_min``; skipped when their excess is below ``excess_min_db``);
-* an admissible rival of another effect family that the held-out speeds cannot tell apart
-  from the answer (t ≤ ``t_min``) makes the verdict **ambiguous** — unless the answer and
-  its rivals are pairs that share one effect which is itself big and supported: then that
-  effect is the answer and the second effect is reported as not identified;
-* a candidate whose fit **restates** another supported one (``Effect.restates``: a "missing"
-  body mode whose shape pairs with one of the file's modes says "that mode is elsewhere") is
-  neither the answer nor a rival while the held-out speeds cannot tell it from the one it
-  restates (t ≤ ``t_min``): the more constrained statement is the answer; nor is a rival
-  that names more effects than the answer while it is worse on the held-out speeds and in
-  training BIC (by more than ``bic_margin``);
-* **no effect**, before any candidate is chosen, when the baseline's excess RMS gap over
-  noise is below ``excess_min_db`` and its structured residual within ``struct_abs_db``
-  (with or without order phase): a candidate that fits what is left "significantly" fits
-  round-off or the model's own numerical error;
-* otherwise **no effect** when the excess RMS gap :math:`\sqrt{\max(E_0 - E_n, 0)}` is
-  below ``excess_min_db`` (even if a candidate fits what is left "significantly": a model
-  that agrees to round-off leaves round-off for candidates to fit), else **unexplained**
-  (the best supported candidate named as partial, with the rule it failed).
-
-:func:`decide` never fits anything. When it reaches a candidate whose held-out cells check
-is not in the evidence yet, it returns a verdict with ``needs_cells_check`` set; the driver
-computes that check and decides again (:func:`powertrain.diagnosis.core.diagnose`).
+:func:`decide` (evidence, rule) → :class:`Verdict`; it never fits. A candidate is
+**supported** when it lowers the training BIC by more than ``bic_margin`` and its per-speed
+held-out improvement t (:func:`improvement_t`) exceeds ``t_min``; a pair must also beat its
+better member. The **answer** is the best supported candidate among the first ``n_checked``
+that explains ``explained_min`` of the excess :math:`E_0 - E_n` [dB²], leaves no structured
+residual and predicts withheld (channel, order) cells; a rival of another family it cannot
+be told from makes it **ambiguous**. Else **no effect** (excess below ``excess_min_db``) or
+**unexplained**. A missing check or cross-fit yields a ``PENDING`` verdict that names it;
+the driver computes it and decides again. Details: docs/guide/diagnose.md, "Decision rule".
 """
 
 from __future__ import annotations
@@ -51,68 +19,46 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from powertrain.diagnosis.evidence import (
-    Assessment,
-    Evidence,
-    Status,
-    Verdict,
-    VerdictKind,
-)
+from powertrain.diagnosis.evidence import Assessment, Evidence, Status, Verdict, VerdictKind
 from powertrain.diagnosis.significance import crossfit_t, improvement_t
 
 
 @dataclass(frozen=True)
 class DecisionRule:
-    """Constants of the decision rule (each with its rationale; tests/test_decision_rule.py
-    checks a case on each side of every threshold).
+    """Constants of the decision rule (tests/test_decision_rule.py checks each threshold).
 
     Attributes
     ----------
     t_min : float
-        Held-out significance: 4 standard errors of the per-speed improvement; a chance
-        improvement that large has p ≈ 3e-5 per candidate, < 1e-3 over ~25 candidates.
+        Held-out significance: 4 standard errors (chance p ≈ 3e-5 per candidate, < 1e-3
+        over ~25 candidates).
     bic_margin : float
-        Training BIC gain: 10 is "very strong" evidence (Kass & Raftery 1995; likelihood
-        ratio e^5 ≈ 150 after the parameter penalty).
+        Training BIC gain: 10 is "very strong" evidence (Kass & Raftery 1995).
     explained_min : float
-        Fraction of the held-out excess over noise the answer must explain: more than half
-        plus a margin, so that the answer is the gap's main cause, not a side effect.
+        Fraction of the held-out excess over noise the answer must explain (its main cause).
     pair_gain_min : float
-        Fraction of what the better member leaves that a pair must remove: a second effect
-        must earn its parameters on at least half the rest, else it fits residue.
+        Fraction of what the better member leaves that a pair must remove.
     excess_min_db : float
-        Excess RMS gap over noise below which the model agrees [dB]: 0.5 dB is a test lab's
+        Excess RMS gap over noise below which the model agrees [dB]: a test lab's
         run-to-run repeatability of order levels.
     struct_abs_db : float
-        Structured held-out residual beyond noise the answer may keep [dB]: about the lab's
-        repeatability, below which structure cannot be told from run-to-run variation.
+        Structured held-out residual beyond noise the answer may keep [dB].
     struct_rel : float
-        ... or this fraction of the baseline's structured gap: the answer must remove about
-        two thirds of the structure, not just the noise-like part.
+        ... or this fraction of the baseline's structured gap.
     xv_explained_min : float
-        Fraction of the withheld cells' excess the refitted answer must predict: a physical
-        effect transfers to cells it was not fitted on, free parameters do not.
+        Fraction of the withheld cells' excess the refitted answer must predict.
     xv_t_min : float
-        Significance of that prediction: 3 standard errors (one-sided p ≈ 0.004 with ~17
-        held-out speeds). Lower than ``t_min`` because it confirms one candidate that has
-        already passed the held-out speeds (no search over ~25 candidates to correct for),
-        on a third of the cells.
+        Significance of that prediction (one-sided p ≈ 0.004 with ~17 held-out speeds);
+        below ``t_min``: it confirms one candidate, no search to correct for.
     n_checked : int
-        Supported candidates (best first) put through the structure and held-out-cell
-        checks: the fourth best explains clearly less and each check costs 2–3 refits.
+        Supported candidates (best first) put through the structure and cells checks.
     t_screen : float
-        Held-out t above which a candidate that passes BIC and explains at least
-        ``explained_min`` but misses ``t_min`` is cross-fitted (refitted with the other two
-        thirds of the speeds held out, so every speed is scored once) and judged on all
-        speeds against the same ``t_min``: a gap that sits at a few resonance crossings
-        leaves one third of the speeds too few informative ones; three times the speeds
-        raise t by about √3, so below 2 (2√3 ≈ 3.5 < 4) cross-fitting cannot succeed. The
-        same holds between rivals: a rival whose held-out t against the answer lies between
-        ``t_screen`` and ``t_min`` is judged on the cross-fitted speeds of both.
+        Held-out t above which a candidate (or rival) short of ``t_min`` is cross-fitted and
+        judged on all speeds: three times the speeds raise t by about √3, so below 2
+        cross-fitting cannot reach 4.
     xv_t_screen : float
-        Held-out cells check: a candidate whose withheld cells were scored at the held-out
-        speeds only, explain at least ``xv_explained_min`` but miss ``xv_t_min`` with t above
-        this is scored again over every speed fold (the same √3 argument: 3/√3 ≈ 1.7).
+        Cells-check t above which a check at the held-out speeds only that misses
+        ``xv_t_min`` is repeated over every speed fold (3/√3 ≈ 1.7).
     """
 
     t_min: float = 4.0
@@ -125,7 +71,6 @@ class DecisionRule:
     xv_explained_min: float = 0.5
     xv_t_min: float = 3.0
     n_checked: int = 3
-
     t_screen: float = 2.0
     xv_t_screen: float = 1.7
 
@@ -137,9 +82,7 @@ class DecisionRule:
 def _assess(ev: Evidence, rule: DecisionRule) -> dict:
     e0 = ev.baseline.heldout_mse
     excess0 = max(e0 - ev.noise_mse, 0.0)
-    out = {}
-    for c in ev.candidates:
-        out[c.label] = _support(ev, rule, c, e0, excess0)
+    out = {c.label: _support(ev, rule, c, e0, excess0) for c in ev.candidates}
     by_label = {c.label: c for c in ev.candidates}
     for c in ev.candidates:
         if len(c.effects) != 2 or out[c.label].status is not Status.SUPPORTED:
@@ -158,15 +101,12 @@ def _assess(ev: Evidence, rule: DecisionRule) -> dict:
             out[c.label].text = f"not better than {best_m.label} alone"
             if (t > rule.t_screen and dbic > rule.bic_margin and gain >= rule.pair_gain_min
                     and (c.crossfit is None or best_m.crossfit is None)):
-                # judge pair vs member on all speeds
-                out[c.label].crossfit_labels = tuple(x.label for x in (c, best_m)
-                                                     if x.crossfit is None)
+                out[c.label].crossfit_labels = tuple(x.label for x in (c, best_m) if x.crossfit is None)
     return out
 
 
 def _support(ev, rule, c, e0, excess0) -> Assessment:
-    """Support of one candidate against the baseline; cross-fitted when held-out t falls
-    between ``t_screen`` and ``t_min`` for a candidate that is otherwise admissible."""
+    """Support of one candidate against the baseline (cross-fit asked for when t is short)."""
     t, dbic = improvement_t(ev.baseline, c, ev.noise_mse), ev.baseline.bic - c.bic
     explained = (e0 - c.heldout_mse) / excess0 if excess0 > 0 else float("nan")
     base_ok = dbic > rule.bic_margin and c.heldout_mse < e0
@@ -180,19 +120,14 @@ def _support(ev, rule, c, e0, excess0) -> Assessment:
 
 
 def _member_suffices(ev, rule, m, a) -> bool:
-    """A supported member that leaves a held-out excess over noise below ``excess_min_db``
-    (the lab's repeatability: below it the model agrees) and a residual within the structure
-    limit leaves a second effect nothing it could be shown to explain."""
+    """Member ``m`` is supported and leaves no excess or structure for a second effect."""
     left = math.sqrt(max(m.heldout_mse - ev.noise_mse, 0.0))
     return (a.status is Status.SUPPORTED and left < rule.excess_min_db
             and m.struct_db <= _struct_max(ev, rule))
 
 
 def _within_noise(ev, rule) -> bool:
-    """The baseline leaves a held-out excess over noise below ``excess_min_db`` and a
-    structured residual within ``struct_abs_db``: nothing beyond the lab's repeatability that
-    a candidate could be shown to explain (the same guard with and without order phase: the
-    phase gaps enter the excess as dB-equivalent residuals)."""
+    """The baseline leaves no excess or structure for a candidate to explain."""
     left = math.sqrt(max(ev.baseline.heldout_mse - ev.noise_mse, 0.0))
     return left < rule.excess_min_db and ev.baseline.struct_db <= rule.struct_abs_db
 
@@ -206,11 +141,9 @@ def _big(a, rule):
 
 
 def _choose(ev, rule, ranked, ass):
-    """First of the big supported candidates that passes structure and cells; or a label
-    whose cells check is missing (pending)."""
+    """``(chosen, None)``, ``(None, label)`` whose cells check is missing, or ``(None, None)``."""
     smax = _struct_max(ev, rule)
-    big = [c for c in ranked if ass[c.label].status is Status.SUPPORTED
-           and _big(ass[c.label], rule)]
+    big = [c for c in ranked if ass[c.label].status is Status.SUPPORTED and _big(ass[c.label], rule)]
     for c in big[:rule.n_checked]:
         a = ass[c.label]
         r = next((r for r in big if r is not c and _restated(c, r)
@@ -231,16 +164,14 @@ def _choose(ev, rule, ranked, ass):
                     and xv["t"] > rule.xv_t_screen):
                 return None, c.label             # again, over every speed fold
             a.status = Status.FAILS_HELDOUT_CELLS
-            a.text = (f"fails held-out {xv['kind']} (explains {xv['explained']:.0%}, "
-                      f"t {xv['t']:.1f})")
+            a.text = (f"fails held-out {xv['kind']} (explains {xv['explained']:.0%}, t {xv['t']:.1f})")
             continue
         return c, None
     return None, None
 
 
 def _rivals(ev, rule, ranked, ass, chosen):
-    """Admissible candidates of another family the held-out speeds cannot tell apart, and
-    the labels to cross-fit before that is final (t between ``t_screen`` and ``t_min``)."""
+    """Rivals the held-out speeds cannot tell from ``chosen``, and labels to cross-fit."""
     mine, smax, out, need = set(chosen.effects), _struct_max(ev, rule), [], []
     for c in ranked:
         theirs, a = set(c.effects), ass[c.label]
@@ -263,9 +194,7 @@ def _rivals(ev, rule, ranked, ass, chosen):
 
 
 def _needs_more_causes(rule, c, chosen) -> bool:
-    """Rival ``c`` names more effects than the answer yet is worse on the held-out speeds
-    and in training BIC (by more than ``bic_margin``): not an equal explanation, as a pair
-    must beat its own member."""
+    """Rival ``c`` names more effects than the answer yet is worse held-out and in BIC."""
     return (len(c.effects) > len(chosen.effects) and c.heldout_mse > chosen.heldout_mse
             and c.bic - chosen.bic > rule.bic_margin)
 
@@ -289,8 +218,7 @@ def decide(evidence: Evidence, rule: DecisionRule = DecisionRule()) -> Verdict:
         return _no_answer(ev, rule, ass, order, ranked)
     chosen, pending = _choose(ev, rule, ranked, ass)
     if pending is not None:
-        return Verdict(VerdictKind.PENDING, "pending", "", ass, order,
-                       needs_cells_check=pending)
+        return Verdict(VerdictKind.PENDING, "pending", "", ass, order, needs_cells_check=pending)
     rivals, cross = _rivals(ev, rule, ranked, ass, chosen) if chosen is not None else ([], [])
     if cross:
         return Verdict(VerdictKind.PENDING, "pending", "", ass, order, needs_crossfit=cross)
@@ -322,9 +250,7 @@ def _ambiguous(ev, rule, ass, order, chosen, rivals):
 
 
 def _shared_member(rule, ranked, ass, pairs):
-    """The one effect every indistinguishable pair shares, when it is a big supported
-    candidate on its own (each pair beat it: a second effect is present, but which one the
-    data do not say); else None."""
+    """The one effect all indistinguishable pairs share, if big and supported alone."""
     if any(len(c.effects) != 2 for c in pairs):
         return None
     shared = set.intersection(*(set(c.effects) for c in pairs))
@@ -341,10 +267,9 @@ def _member_answer(ev, ass, order, m, pairs):
         ass[c.label].text = "second effect not identified: " + " or ".join(seconds)
     a = ass[m.label]
     a.status, a.text = Status.CHOSEN, Status.CHOSEN.value
-    text = (f"{m.label}: explains {a.explained:.0%} of the held-out excess gap over noise; "
-            f"held-out RMS gap {ev.baseline.heldout_mse ** 0.5:.2f} -> "
-            f"{m.heldout_mse ** 0.5:.2f} dB; with it a second effect is supported, but the "
-            f"held-out speeds cannot tell {' from '.join(seconds)}")
+    text = (f"{m.label}: explains {a.explained:.0%} of the held-out excess gap over noise; held-out RMS gap "
+            f"{ev.baseline.heldout_mse ** 0.5:.2f} -> {m.heldout_mse ** 0.5:.2f} dB; with it a second effect "
+            f"is supported, but the held-out speeds cannot tell {' from '.join(seconds)}")
     return Verdict(VerdictKind.EFFECT, m.label, text, ass, order, chosen=m.label,
                    second_effect_between=[c.label for c in pairs])
 
@@ -352,10 +277,9 @@ def _member_answer(ev, ass, order, m, pairs):
 def _chosen(ev, ass, order, c):
     a = ass[c.label]
     a.status, a.text = Status.CHOSEN, Status.CHOSEN.value
-    text = (f"{c.label}: explains {a.explained:.0%} of the held-out excess gap over noise; "
-            f"held-out RMS gap {ev.baseline.heldout_mse ** 0.5:.2f} -> "
-            f"{c.heldout_mse ** 0.5:.2f} dB; structured residual {c.struct_db:.2f} dB "
-            f"(baseline {ev.baseline.struct_db:.2f} dB); withheld {c.cells['kind']}: "
+    text = (f"{c.label}: explains {a.explained:.0%} of the held-out excess gap over noise; held-out RMS gap "
+            f"{ev.baseline.heldout_mse ** 0.5:.2f} -> {c.heldout_mse ** 0.5:.2f} dB; structured residual "
+            f"{c.struct_db:.2f} dB (baseline {ev.baseline.struct_db:.2f} dB); withheld {c.cells['kind']}: "
             f"explains {c.cells['explained']:.0%}")
     return Verdict(VerdictKind.EFFECT, c.label, text, ass, order, chosen=c.label)
 
@@ -366,14 +290,11 @@ def _no_answer(ev, rule, ass, order, ranked):
     supported = [c for c in ranked if ass[c.label].status is not Status.NOT_SUPPORTED
                  and ass[c.label].status is not Status.NOT_BETTER_THAN_MEMBER]
     if excess_db < rule.excess_min_db:
-        # within noise: nothing to explain, whatever a candidate fits (a model that agrees
-        # to round-off still has candidates that fit the round-off "significantly")
         extra = (f"; the best supported candidate, {supported[0].label}, would change it by "
                  f"{abs(e0 ** 0.5 - supported[0].heldout_mse ** 0.5):.2f} dB only"
                  if supported else " and no candidate improves it significantly")
         text = (f"no effect: the held-out gap ({e0 ** 0.5:.2f} dB RMS) is within noise "
-                f"({ev.sigma_db:.2f} dB; excess {excess_db:.2f} dB < {rule.excess_min_db:g} "
-                f"dB){extra}")
+                f"({ev.sigma_db:.2f} dB; excess {excess_db:.2f} dB < {rule.excess_min_db:g} dB){extra}")
         return Verdict(VerdictKind.NO_EFFECT, "no effect", text, ass, order)
     if supported:
         best = ass[supported[0].label]

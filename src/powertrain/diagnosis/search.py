@@ -1,8 +1,6 @@
-"""The trust-region search of a candidate fit (:func:`powertrain.diagnosis.fit.fit_candidate`):
-the residual function with its evaluation count, budget, best point and stall watch, the
-forward-difference Jacobian the search asks for (SciPy's, its sensor columns read at once),
-the multi-start over the start points, and the Jacobian of a point the search did not finish.
-"""
+"""The trust-region search of a candidate fit: the counted residual function (budget, best
+point, stall watch), SciPy's forward-difference Jacobian with sensor columns read at once,
+and the multi-start."""
 
 from __future__ import annotations
 
@@ -17,11 +15,9 @@ from powertrain.effects import EFFECTS
 
 #: Residual of every point where a trial parameter set has no steady state.
 NO_STEADY_STATE_RESIDUAL = 1e3
-#: A start stops when its best cost has fallen by less than ``STALL_REL`` (relative) over
-#: ``STALL_STEPS`` trust-region steps' worth of evaluations (p + 1 each, p parameters): the
-#: trust region crawling along an active bound (a cylinder-imbalance factor at its limit)
-#: otherwise spends the whole budget on cost changes of 1e-5 per step. 2e-4 of the cost
-#: moves the BIC by about 0.2 per 1000 residuals, far below the decision's margin of 10.
+#: A start stops when its best cost falls by less than ``STALL_REL`` (relative) over
+#: ``STALL_STEPS`` steps of p + 1 evaluations (a crawl along an active bound); 2e-4 of the
+#: cost moves the BIC by about 0.2 per 1000 residuals, far below the rule's margin of 10.
 STALL_REL = 2e-4
 STALL_STEPS = 20
 #: Relative step of the forward-difference Jacobian columns.
@@ -29,22 +25,20 @@ DIFF_STEP = 1e-4
 
 
 class Exhausted(Exception):
-    """Raised inside the residual function when the fit's evaluation budget is spent."""
+    """The fit's evaluation budget is spent."""
 
 
 class _Stalled(Exception):
-    """Raised inside the residual function when a start has stalled (:data:`STALL_REL`)."""
+    """A start has stalled (:data:`STALL_REL`)."""
 
 
 class Counted:
-    """Residual function with an evaluation count, a budget, the best point seen and, while
-    a start runs (:meth:`watch`), its stall watch."""
+    """Residual function of ``problem`` over ``pack``'s vector with an evaluation count
+    (``budget`` at most), the best point seen and a stall watch (:meth:`watch`)."""
 
     def __init__(self, problem, pack, budget):
         self.problem, self.pack, self.budget = problem, pack, budget
-        #: residual evaluations charged so far: one per point, whether its velocities were
-        #: solved or read from the problem's cache and however many iterations its
-        #: amplitude fixed point took
+        #: residual evaluations charged (one per point, cached or solved)
         self.n = 0
         self.best = (np.inf, None, None)
         #: ``(cost, x)`` of every start the trust region finished (:func:`trust_region`)
@@ -58,35 +52,31 @@ class Counted:
             self.prior_w = problem.sigma_db / pack.prior_sd[self.prior_on]
 
     def prior(self, x):
-        """Prior residuals (empty without priors)."""
+        """Prior residuals at ``x`` (empty without priors)."""
         if not self.has_prior:
             return np.empty(0)
         return self.prior_w * (np.asarray(x) - self.pack.x0)[self.prior_on]
 
     def _data_size(self, problem, x):
-        """Number of data residuals: the best point's, or before any point the defaults'
-        (a refit started at a point without a steady state; raises if the defaults have
-        none either)."""
+        """Number of data residuals: the best point's, else the defaults'."""
         if self.best[2] is not None:
             return self.best[2].size - self.prior(x).size
         return problem.vector(self.pack.scenario(self.pack.x0)).size
 
     def evaluate(self, problem, x):
-        """Residuals of ``problem`` at ``x`` with the prior's, charged one evaluation to the
-        budget (raises when it is spent)."""
+        """Residuals of ``problem`` at ``x`` with the prior's, charged (raises when spent)."""
         self._check_budget()
         r = self.residuals(problem, x)
         self.n += 1
         return r
 
     def _check_budget(self):
-        """Raise :class:`Exhausted` when the budget is spent (before an evaluation)."""
         if self.n >= self.budget:
             raise Exhausted
 
     def residuals(self, problem, x):
-        """Residuals of ``problem`` at ``x`` with the prior's, uncharged; a point without a
-        steady state is worse than any fit (:data:`NO_STEADY_STATE_RESIDUAL`)."""
+        """Residuals of ``problem`` at ``x`` with the prior's, uncharged (no steady state:
+        :data:`NO_STEADY_STATE_RESIDUAL`)."""
         try:
             v = problem.vector(self.pack.scenario(x))
         except FloatingPointError:
@@ -94,11 +84,10 @@ class Counted:
         return self._with_prior(v, x)
 
     def _with_prior(self, v, x):
-        """The data residuals ``v`` at ``x`` followed by the prior's."""
         return np.concatenate([v, self.prior(x)])
 
     def watch(self, n_params):
-        """Watch the next start for a stall (None: stop watching)."""
+        """Watch the next start of ``n_params`` parameters for a stall (None: stop)."""
         self._stall = None if n_params is None else [STALL_STEPS * (n_params + 1), 0, np.inf]
 
     def _check_stall(self, c):
@@ -116,8 +105,7 @@ class Counted:
         return self._seen(x, self.evaluate(self.problem, x))
 
     def _seen(self, x, r):
-        """Keep ``r`` (the residuals at ``x``) as the best point if it is, watch the stall,
-        remember it as the last point (the Jacobian's ``f0``)."""
+        """Note residuals ``r`` at ``x``: best point, stall watch, last point (Jacobian f0)."""
         c = 0.5 * float(np.sum(r ** 2))
         if c < self.best[0]:
             self.best = (c, np.array(x, float), r)
@@ -126,13 +114,9 @@ class Counted:
         return r
 
     def columns(self, x0, xs, problem=None) -> list:
-        """The residuals at each of ``xs`` (the points of a forward-difference Jacobian at
-        ``x0``, in order), charged, kept and watched as by calling this one point after
-        another; runs of points that move response-only parameters of ``x0`` only are read
-        at once (:meth:`Problem.read_vectors
-        <powertrain.diagnosis.fit.Problem.read_vectors>`: the same values). ``problem``:
-        another than the fit's (a block start's channels), its points only charged, as by
-        :meth:`evaluate`."""
+        """Residuals at each of ``xs`` (a Jacobian's points at ``x0``) as by calling this on
+        each in turn; points moving only response-only parameters are read at once.
+        ``problem``: another than the fit's (points only charged)."""
         keep = problem is None
         problem = self.problem if keep else problem
         out, run = [], []
@@ -151,9 +135,7 @@ class Counted:
         return self._seen(x, r) if keep else r
 
     def _read(self, problem, run, keep) -> list:
-        """The residuals of the points ``run`` (see :meth:`columns`), read at once from the
-        cached velocities of their physical part; while the cache holds another, the next
-        point is evaluated alone (it solves that part)."""
+        """Residuals of the points ``run``, read at once from the cache (else one evaluated)."""
         out, scenarios = [], [self.pack.scenario(x) for x in run]
         while run:
             vs = problem.read_vectors(scenarios)
@@ -163,7 +145,7 @@ class Counted:
                 continue
             for x, v in zip(run, vs):
                 self._check_budget()
-                self.n += 1                # one evaluation, as by :meth:`evaluate`
+                self.n += 1
                 r = self._with_prior(v, x)
                 out.append(self._seen(x, r) if keep else r)
             break
@@ -171,20 +153,15 @@ class Counted:
 
 
 class Differences:
-    """The Jacobian a trust region asks for: SciPy's own forward differences (its steps,
-    ``rel_step`` :data:`DIFF_STEP`, one-sided within the bounds ``lower``, ``upper``;
-    ``f0`` the residuals the search has just computed at that point, ``fun.last``) with the
-    points evaluated by ``fun.columns`` (:meth:`Counted.columns`), so that a fit's sensor
-    columns are read at once. The same Jacobian, evaluation count, best point and stall as
-    ``jac="2-point"``."""
+    """SciPy's forward-difference Jacobian (``jac="2-point"``, bounds ``lower``, ``upper``)
+    with its points evaluated by ``fun.columns``: the same Jacobian and count."""
 
     def __init__(self, fun, lower, upper):
         self.fun, self.bounds = fun, (lower, upper)
 
     @classmethod
     def or_two_point(cls, fun, lower, upper):
-        """A :class:`Differences`, or ``"2-point"`` where SciPy's forward differences take
-        no map (``workers``, SciPy < 1.16): the same Jacobian, point by point."""
+        """A :class:`Differences`, or ``"2-point"`` on SciPy < 1.16 (no ``workers``)."""
         if "workers" not in inspect.signature(approx_derivative).parameters:
             return "2-point"
         return cls(fun, lower, upper)
@@ -193,15 +170,14 @@ class Differences:
         last_x, f0 = self.fun.last
         if last_x is None or not np.array_equal(last_x, x):
             f0 = self.fun(x)               # as "2-point" without f0: evaluated first
-        return approx_derivative(self.fun, x, method="2-point", rel_step=DIFF_STEP, f0=f0,
-                                 bounds=self.bounds,
+        return approx_derivative(self.fun, x, method="2-point", rel_step=DIFF_STEP, f0=f0, bounds=self.bounds,
                                  workers=lambda _, xs: self.fun.columns(x, list(xs)))
 
 
 def trust_region(fun, pack, cands):
-    """Best trust-region fit over the start points; (result-like, nfev, budget hit). The
-    result is None when the best point is a stalled start's or the budget was spent: the
-    caller takes ``fun.best``."""
+    """Best trust-region fit of ``fun`` over the starts ``cands`` within ``pack``'s bounds:
+    (result, nfev, budget hit); result None when a stalled start or the budget ends it
+    (then ``fun.best``)."""
     span = pack.upper - pack.lower
     best, nfev, stalled = None, 0, False
     jac = Differences.or_two_point(fun, pack.lower, pack.upper)
@@ -215,7 +191,7 @@ def trust_region(fun, pack, cands):
                                     max_nfev=60 * len(x_start), diff_step=DIFF_STEP)
         except Exhausted:
             return None, nfev, True
-        except _Stalled:                   # its best point is in fun.best if best of all
+        except _Stalled:
             stalled = True
             continue
         finally:
@@ -225,13 +201,12 @@ def trust_region(fun, pack, cands):
         if best is None or res.cost < best.cost:
             best = res
     if stalled and (best is None or fun.best[0] < best.cost):
-        return None, nfev, False           # the stalled start's best point (fun.best)
+        return None, nfev, False
     return best, nfev, False
 
 
 def jacobian(fun, x, pack):
-    """Forward-difference Jacobian at ``x`` (used when the budget or a stall stopped the
-    fit)."""
+    """Residuals and forward-difference Jacobian of ``fun`` at ``x`` within ``pack``'s bounds."""
     def full(x):
         return fun.residuals(fun.problem, x)
     r0 = full(x)

@@ -1,42 +1,18 @@
 r"""Part of step 1 (where): does the gap live in the body, in the mounts or in the excitation?
 
-Used when the measured file carries body-side (passive) channels the model predicts (a
-modal body under the mounts, or a rigid chassis whose body side the model holds still).
-With the gap :math:`\Delta L` [dB] (+ = simulation higher) on the engine side (a) and the
-body side (p) of every mount direction measured on both sides, each point carrying its own
-scatter σ (:func:`powertrain.diagnosis.noise_model.point_sigma_db`: per channel and level),
-the **excess over noise** of a set of points is
+Used when body-side (``NAME/passive``) channels are measured. With each point's scatter σ
+(:func:`powertrain.diagnosis.noise_model.point_sigma_db`), the **excess over noise** of a set
+of gaps :math:`\Delta L` [dB] is
 
 .. math:: E^2 = \frac{\sum_i w_i(\Delta L_i^2 - \sigma_i^2)}{\sum_i w_i},\quad
           w_i = \sigma_i^{-2},
 
-(0 when negative) and its resolution :math:`\delta^2 = Z\sqrt{2n}/\sum_i w_i` (Z =
-:data:`Z_RESOLUTION` standard errors of :math:`E^2` under noise alone). The side is read
-from the **ratio of the body-side to the engine-side excess**,
-:math:`R = E_p/\max(E_a, \delta_a)`:
-
-* a changed **excitation** (balancer, combustion) moves both sides alike through the same
-  transfer: R about 1 (0.65-0.91 for balancer errors);
-* a changed **mount** moves the engine side directly and the body side more, through the
-  changed isolation: R 3.1-6.8 (mount stiffness and amplitude-dependent mounts);
-* a changed or missing **body** mode reaches the engine side only through the bases'
-  motion (0.06-0.3 dB for several dB on the body side): R ≥ 15, unbounded.
-
-A ratio of several times does not yet tell body from mounts: with the noise left, the
-engine-side excess of a mount change often stays below its resolution, as a body change's
-does. What tells them apart is the engine side of **one mount**: a changed mount moves its
-own engine-side channels (0.7-1.5 dB in development draws of the two-sided plan), a body
-change moves none of them by more than about 0.55 dB. So: **engine side or excitation**
-when either side's excess is resolved and R < :data:`MOUNT_RATIO`; with R ≥
-:data:`MOUNT_RATIO` (body side resolved), **mounts** when the largest engine-side excess of
-one mount, A, reaches :data:`MOUNT_ENGINE_DB` (and its resolution), **body** when it does
-not and :math:`E_p` ≥ :data:`BODY_MIN_DB`, or whenever R ≥ :data:`BODY_RATIO` with A below
-:data:`MOUNT_ENGINE_DB`; **mounts** otherwise; **none** when neither side is resolved. A
-body-side gap is *shared* by several bases when the excess at :data:`MIN_SHARED_MOUNTS` or
-more mount bases reaches :data:`MOUNT_OFF_DB` and its resolution (its band: the
-frequencies where the body-side gap is largest). The isolation change
-:math:`\Delta L_a - \Delta L_p` is reported (its excess, with :math:`\sigma_a^2 +
-\sigma_p^2`).
+(0 when negative), resolved above :math:`\delta^2 = Z\sqrt{2n}/\sum_i w_i`
+(:data:`Z_RESOLUTION`). The ratio :math:`R = E_p/\max(E_a, \delta_a)` of body side to engine
+side is about 1 for an excitation change, 3-7 for a mount change and ≥ 15 for a body mode;
+a mount change also moves its own engine-side channels (:data:`MOUNT_ENGINE_DB`), a body
+change does not. Thresholds: :func:`_location`; rationale: docs/guide/diagnose.md, "Both
+sides of the mounts".
 """
 
 from __future__ import annotations
@@ -50,31 +26,26 @@ from powertrain.effects import predict
 from powertrain.effects.missing_body_mode import body_side_engine, mode_arrays
 from powertrain.solvers.fast_harmonic import HarmonicModel
 
-#: Body when the body-side excess is at least this multiple of the engine side's [1]: the
-#: geometric middle between mount changes (≤ 6.8) and body modes (≥ 15).
+#: Body when R reaches this [1]: between mount changes (≤ 6.8) and body modes (≥ 15).
 BODY_RATIO = 10.0
-#: Mounts when the ratio is at least this [1]: the geometric middle between excitation
-#: changes (≤ 0.91) and mount changes (≥ 3.1).
+#: Mounts when R reaches this [1]: between excitation (≤ 0.91) and mount changes (≥ 3.1).
 MOUNT_RATIO = 1.7
-#: A mount's own engine-side excess that points at the mounts [dB]: between the largest
-#: of body changes (about 0.55) and the smallest of one-mount stiffness changes (about 0.7)
-#: in development draws of the two-sided plan.
+#: A mount's own engine-side excess that points at the mounts [dB]: between body changes
+#: (≤ 0.55) and one-mount stiffness changes (≥ 0.7).
 MOUNT_ENGINE_DB = 0.65
-#: ... and the body side carries at least this much [dB] for a body answer (twice the
-#: 0.5 dB by which a model may miss).
+#: Body-side excess for a body answer [dB] (twice the 0.5 dB a model may miss by).
 BODY_MIN_DB = 1.0
-#: A mount base counts as off when its body-side excess reaches this [dB] (a test lab's
-#: run-to-run repeatability of order levels) and its resolution.
+#: Body-side excess of an off mount base [dB] (a lab's run-to-run repeatability).
 MOUNT_OFF_DB = 0.5
 #: Mount bases that must be off for a shared (body) resonance [1].
 MIN_SHARED_MOUNTS = 2
-#: Standard errors of the squared excess under noise alone that resolve an excess [1].
+#: Standard errors of the squared excess under noise that resolve an excess [1].
 Z_RESOLUTION = 3.0
 
 
 def excess(gap, sigma) -> tuple:
-    r"""``(E, δ)`` [dB]: the excess RMS over noise of the finite gaps and its resolution
-    (module docstring); ``(nan, nan)`` without points. ``sigma`` broadcasts to ``gap``."""
+    """``(E, δ)`` [dB]: excess RMS over noise of the finite ``gap`` and its resolution;
+    ``sigma`` [dB] broadcasts to ``gap``."""
     g = np.asarray(gap, float)
     s = np.broadcast_to(np.asarray(sigma, float), g.shape)
     ok = np.isfinite(g) & np.isfinite(s)
@@ -88,8 +59,7 @@ def excess(gap, sigma) -> tuple:
 
 
 def _pairs(channels):
-    """(engine-side index, body-side index, mount) of every mount direction measured on
-    both sides."""
+    """(engine-side index, body-side index, mount) of every direction measured on both sides."""
     index = {c: i for i, c in enumerate(channels)}
     out = []
     for i, (m, d) in enumerate(channels):
@@ -100,11 +70,7 @@ def _pairs(channels):
 
 
 def _band(gap, sig, data, cols, n_bins=24):
-    """Frequency band [Hz] of the passive gap: mean squared gap *beyond the noise* (each
-    point's σ² from the noise model taken off: points near the floor scatter most, and a
-    plain mean squared gap peaks where they lie, not at the resonance) in log-spaced
-    frequency bins (f = order × rpm / 60), the run of bins around the largest with at least
-    half its value."""
+    """Band [Hz] of the bins around the largest mean squared gap beyond noise, ≥ half of it."""
     f = np.broadcast_to(data.order_hz[:, None, :], gap.shape)
     g = gap[:, cols][:, :, data.order_mask]
     v = sig[:, cols][:, :, data.order_mask] ** 2
@@ -127,8 +93,7 @@ def _band(gap, sig, data, cols, n_bins=24):
 
 
 def _location(ea, da, ep, dp, a_mount):
-    """The side from the two excesses, their resolutions and the largest resolved
-    engine-side excess of one mount ``a_mount`` (module docstring)."""
+    """``(side, R)`` from the excesses, resolutions and largest mount excess ``a_mount``."""
     a_on = np.isfinite(ea) and ea > da
     p_on = np.isfinite(ep) and ep > dp
     if not (a_on or p_on):
@@ -143,12 +108,11 @@ def _location(ea, da, ep, dp, a_mount):
 
 def _per_mount(gap, sig, cols_of, om):
     """``{mount: (excess, resolution)}`` of each mount's channels ``cols_of[mount]``."""
-    return {m: excess(gap[:, cols][:, :, om], sig[:, cols][:, :, om])
-            for m, cols in cols_of.items()}
+    return {m: excess(gap[:, cols][:, :, om], sig[:, cols][:, :, om]) for m, cols in cols_of.items()}
 
 
 def side_attribution(gap, data, sigma_db=None) -> dict | None:
-    """Which side carries the order gap (module docstring); None without body-side pairs.
+    """Which side carries the order gap; None without body-side pairs.
 
     Parameters
     ----------
@@ -156,8 +120,7 @@ def side_attribution(gap, data, sigma_db=None) -> dict | None:
         Gap map [dB], NaN where censored or not measured.
     data : GapData
     sigma_db : float or ndarray, optional
-        Scatter [dB, 1σ]: one number for every point, or per point like ``gap`` (default:
-        the noise model per channel and level, :mod:`powertrain.diagnosis.noise_model`).
+        Scatter [dB, 1σ], one or per point (default: :mod:`.noise_model`).
     """
     pairs = _pairs(data.channels)
     if not pairs:
@@ -189,14 +152,13 @@ def side_attribution(gap, data, sigma_db=None) -> dict | None:
             "engine_side_resolution_db": da, "body_side_resolution_db": dp,
             "largest_mount_engine_side_db": a_mount,
             "mounts_off_body_side": off, "shared": len(off) >= MIN_SHARED_MOUNTS,
-            "noise_sigma_db": float(np.nanmedian(sig)) if np.isfinite(sig).any() else
-            float("nan"),
+            "noise_sigma_db": float(np.nanmedian(sig)) if np.isfinite(sig).any() else float("nan"),
             "band_hz": _band(gap, sig, data, cols) if (where == "body" and cols) else None}
 
 
 def measured_sides(measured, engine, noise_floor) -> dict | None:
-    """The side attribution of a measured run-up alone: the diagnosis' "where" step on the
-    gap against the model without effects, no fit (cheap; the validation's side rate)."""
+    """:func:`side_attribution` of ``measured`` against ``engine`` without effects (no fit);
+    ``noise_floor`` [m/s]."""
     engine = with_measured_body_side(engine, measured)
     d = gap_data(measured, engine, noise_floor)
     hm = HarmonicModel(engine, d.rpm)
@@ -206,10 +168,8 @@ def measured_sides(measured, engine, noise_floor) -> dict | None:
 
 
 def with_measured_body_side(engine, measured):
-    """``engine`` as the diagnosis models it: a rigid chassis whose body side is measured
-    (channels ``NAME/passive`` of its mounts) is a modal body without modes — the body side
-    predicted still, so that a missing body mode can give it motion
-    (:func:`powertrain.effects.missing_body_mode.body_side_engine`); else unchanged."""
+    """``engine``, with a rigid chassis whose body side is in ``measured`` made a modal body
+    without modes (so a missing body mode can move it)."""
     ch = getattr(engine, "chassis", None)
     if ch is not None and not ch.is_rigid:
         return engine
@@ -220,18 +180,14 @@ def with_measured_body_side(engine, measured):
     return engine
 
 
-#: A base takes part in a fitted body mode when its largest shape component reaches this
-#: share of the mode's largest [1] (half: the base moves at least half as much).
+#: Share of the mode's largest shape component a base needs to take part [1].
 SHAPE_SHARED = 0.5
 
 
 def fitted_shape(effect, params, engine) -> dict | None:
-    """The body mode an answer names, by its shape over the mount bases: ``{"effect",
-    "mode", "frequency_hz", "bases": {mount: largest |shape component| at its base,
-    normalised to the mode's largest}, "shape": where the shape comes from, "shared": two or
-    more bases at least :data:`SHAPE_SHARED`}``; None for other answers.
-    ``missing_body_mode``: its fitted shape; ``chassis_modes``: the file mode changed most
-    (frequency and modal mass, in log), with its shape from the engine file."""
+    """The body mode answer ``effect`` (``params``) names, by its shape over the mount bases:
+    ``{"effect", "mode", "frequency_hz", "bases", "shape", "shared"}``; None for other
+    answers. ``chassis_modes``: the file mode changed most, its shape from ``engine``."""
     names = [m.name for m in engine.mounts]
     if effect == "missing_body_mode":
         mode = mode_arrays(params, len(names))
@@ -258,19 +214,16 @@ def fitted_shape(effect, params, engine) -> dict | None:
 
 
 def _shape_phrase(fs) -> str:
-    """'body mode 2 of the engine file near 45 Hz, shared by the bases of left, gearbox
-    (its shape (engine file), largest component at each base: left 0.6, right 0.2, gearbox
-    1.0)'."""
+    """'body mode 2 of the engine file near 45 Hz, shared by the bases of left, ...'."""
     on = [m for m, v in fs["bases"].items() if v >= SHAPE_SHARED]
     quoted = ", ".join(f"{m} {v:.1f}" for m, v in fs["bases"].items())
-    where = (f"shared by the bases of {', '.join(on)}" if fs["shared"] else
-             f"local to the base of {on[0]}")
+    where = (f"shared by the bases of {', '.join(on)}" if fs["shared"] else f"local to the base of {on[0]}")
     return (f"{fs['mode']} near {fs['frequency_hz']:.0f} Hz, {where} (its {fs['shape']}, "
             f"largest component at each base: {quoted})")
 
 
 def side_text(s) -> str:
-    """One phrase for the where step ('' without body-side channels)."""
+    """One phrase for side attribution ``s`` ('' without body-side channels)."""
     if not s:
         return ""
     nums = (f"excess over noise: body side {s['body_side_rms_db']:.1f} dB RMS vs engine side "

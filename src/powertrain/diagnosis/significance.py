@@ -1,6 +1,4 @@
-r"""Significance of a held-out improvement (the decision rule's t statistics,
-:mod:`powertrain.diagnosis.rule`): per-speed log ratios of the mean squared gaps. ``base``
-and ``cand`` are :class:`~powertrain.diagnosis.rule.CandidateEvidence`."""
+"""Significance of a held-out improvement: t of the per-speed log ratios of mean squared gaps."""
 
 from __future__ import annotations
 
@@ -12,29 +10,22 @@ import numpy as np
 def improvement_t(base, cand, noise_mse=0.0):
     r"""t statistic of the held-out improvement per speed of ``cand`` over ``base``.
 
-    The per-speed improvement is the log ratio
-    :math:`d_r = \ln\frac{E_{0,r} + E_n}{E_{c,r} + E_n}` of the mean squared gaps with the
-    noise's :math:`E_n` added: a relative improvement, about equally large at the speeds
-    where the gap is large (near a resonance) and where it is moderate, so that its scatter
-    over speeds measures chance rather than how the gap varies along the run-up (a
-    difference :math:`E_{0,r} - E_{c,r}` is dominated by the few speeds near a resonance
-    and its t stays small however certain the improvement); speeds within noise count as
-    no change. t = :math:`\bar d/(s_d/\sqrt{n_r})`.
+    :math:`d_r = \ln\frac{E_{0,r} + E_n}{E_{c,r} + E_n}` (``noise_mse`` :math:`E_n` [dB²]), a
+    relative improvement whose scatter over speeds measures chance (a difference would be
+    dominated by the speeds near a resonance); t = :math:`\bar d/(s_d/\sqrt{n_r})`.
     """
     return log_ratio_t(base.heldout_per_rpm, cand.heldout_per_rpm, noise_mse)
 
 
 def crossfit_t(base, cand, noise_mse=0.0):
-    """:func:`improvement_t` over every speed when both carry cross-fitted per-speed gaps
-    (``crossfit``), else over the held-out speeds."""
+    """:func:`improvement_t` over every speed when both carry ``crossfit``, else held-out."""
     if base.crossfit is None or cand.crossfit is None:
         return improvement_t(base, cand, noise_mse)
     return log_ratio_t(base.crossfit, cand.crossfit, noise_mse)
 
 
 def log_ratio_t(per_0, per_c, noise_mse=0.0):
-    """t of the per-speed log ratios ln((per_0 + E_n)/(per_c + E_n)) (NaN entries dropped);
-    the statistic of :func:`improvement_t`."""
+    """t of the per-speed ln((per_0 + E_n)/(per_c + E_n)), ``noise_mse`` E_n (NaN dropped)."""
     en = max(float(noise_mse), 1e-12)
     with np.errstate(divide="ignore", invalid="ignore"):
         d = np.log((np.asarray(per_0, float) + en) / (np.asarray(per_c, float) + en))

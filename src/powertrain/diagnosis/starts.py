@@ -1,12 +1,7 @@
-"""Start points of the candidate fits (:mod:`powertrain.diagnosis.fit`): the defaults, given
-starts, the effects' coarse start grids, starts read from the data (``Effect.data_starts``:
-a missing body mode from the body-side gap's peak), and a block-wise multi-start for
-effects whose parameters act on disjoint channels (``Effect.separable_groups``: a sensor
-triad's gains, rotation and cross-axis terms).
-
-Every evaluation made here is charged to the fit's budget through ``fun`` (the fit's
-counted residual function).
-"""
+"""Start points of the candidate fits: the defaults, given starts, the effects' coarse start
+grids, starts read from the data (``Effect.data_starts``) and a block-wise multi-start for
+parameters acting on disjoint channels (``Effect.separable_groups``). Every evaluation is
+charged to the fit's budget through ``fun``."""
 
 from __future__ import annotations
 
@@ -27,31 +22,26 @@ BLOCK_SHARE = 0.4
 #: Starts read from the data kept after screening.
 DATA_KEPT = 2
 #: Ratio of ``Effect.basin_parameter`` beyond which a start lies in another basin (a body
-#: mode at 2-6 % damping is 4-12 % wide; two minima a quarter apart are separate resonances).
+#: mode at 2-6 % damping is 4-12 % wide).
 BASIN_RATIO = 1.25
-#: Starts kept besides the cheapest, each in a basin of its own (a cost nearly flat in a
-#: missing mode's frequency, as from magnitudes alone, ranks the grid's starts by noise).
+#: Starts kept besides the cheapest, each in a basin of its own.
 OTHER_BASINS = 2
-#: Distance of a start read from the data from its bounds [share of the bounds' span]. A
-#: start *on* a bound (a missing mode's shape normalised to its largest entry, which is the
-#: bound 1) stops the trust-region fit at once: scipy's ``trf`` truncates a step that crosses
-#: a bound at the bound, so the first step is ~1e-9 long and ``xtol`` ends the fit there
-#: (2 of 18 fresh draws of a 60 Hz mode stayed at their grid starts, 56.6 and 57.3 Hz).
+#: Distance of a data start from its bounds [share of the span]: on a bound, ``trf``'s first
+#: step is truncated to ~1e-9 and ``xtol`` ends the fit there.
 DATA_START_MARGIN = 0.01
 
 
 def start_points(problem, pack, effects, starts, grid, fun, defaults=True):
-    """Start vectors of a fit: the starts read from the data (first), the defaults (unless
-    ``defaults`` is False and ``starts`` are given: a refit from a known optimum), the
-    given ``starts``, the two best points of the effect's coarse start grid and the
-    block-wise multi-start's optimum."""
+    """Start vectors of a fit of ``effects`` (``pack``'s coordinates): data starts, defaults
+    (unless ``defaults`` is False with ``starts``), ``starts``, the two best points of the
+    coarse grid and the block start (data, grid and block starts only with ``grid`` and a
+    single effect); ``fun`` charges the evaluations of ``problem``."""
     span = pack.upper - pack.lower
     lo, hi = pack.lower + 1e-9 * span, pack.upper - 1e-9 * span
     cands = [np.clip(s, lo, hi) for s in starts or []]
     if defaults or not cands:
         cands = [np.clip(pack.x0, lo, hi)] + cands
-    # coarse grid of start points for effects that declare one (the cylinder IMEP factors
-    # need one: at e = 0 the half orders vanish and the gradient of their level with them)
+    # a grid where a default has no gradient (at e = 0 the half orders vanish)
     sg = EFFECTS[effects[0]].start_grid(problem.engine) if grid and len(effects) == 1 else ()
     if sg:
         mesh = np.meshgrid(*sg, indexing="ij")
@@ -60,10 +50,8 @@ def start_points(problem, pack, effects, starts, grid, fun, defaults=True):
         costs = [np.sum(fun(p) ** 2) for p in pts]
         cands += [np.clip(pts[i], lo, hi) for i in np.argsort(costs)[:2]]
     if grid and len(effects) == 1:
-        # read from the data: fitted first (a default that is "no effect" starts nowhere)
         inner = DATA_START_MARGIN * span
-        cands = _data_starts(problem, pack, effects[0], fun, pack.lower + inner,
-                             pack.upper - inner) + cands
+        cands = _data_starts(problem, pack, effects[0], fun, pack.lower + inner, pack.upper - inner) + cands
         xb = _block_start(fun, pack, effects[0])
         if xb is not None:
             cands.append(np.clip(xb, lo, hi))
@@ -71,9 +59,7 @@ def start_points(problem, pack, effects, starts, grid, fun, defaults=True):
 
 
 def _data_starts(problem, pack, effect, fun, lo, hi):
-    """The :data:`DATA_KEPT` cheapest of the effect's starts read from the training gaps
-    against the model without it (``Effect.data_starts``), the signs of its ``signed``
-    parameters then chosen (:func:`_signs`); every evaluation charged."""
+    """The :data:`DATA_KEPT` cheapest data starts (plus other basins), signs chosen."""
     d = problem.data
     fun.evaluate(problem, pack.x0)
     sc = pack.scenario(pack.x0)
@@ -94,9 +80,7 @@ def _data_starts(problem, pack, effect, fun, lo, hi):
 
 
 def _other_basin(pack, effect, pts, order, kept):
-    """The cheapest start whose ``Effect.basin_parameter`` lies at least a factor
-    :data:`BASIN_RATIO` from every kept start's (a second minimum, searched globally before
-    the local fits); None when the effect declares no such parameter or none does."""
+    """The cheapest start at least :data:`BASIN_RATIO` from every kept one (or None)."""
     name = EFFECTS[effect].basin_parameter
     if name is None:
         return None
@@ -109,8 +93,7 @@ def _other_basin(pack, effect, pts, order, kept):
 
 
 def _signs(fun, x, signed, passes=2):
-    """Signs of the ``signed`` parameters of a start (magnitudes read from the data carry
-    none): each flipped in turn, largest first, and kept when it lowers the cost."""
+    """Signs of the ``signed`` parameters: each flipped, largest first, kept if cheaper."""
     best = float(np.sum(fun(x) ** 2))
     for _ in range(passes):
         changed = False
@@ -128,12 +111,9 @@ def _signs(fun, x, signed, passes=2):
 
 
 def _block_start(fun, pack, effect):
-    """Block-wise multi-start (``Effect.separable_groups``): for each block (parameters that
-    act on their own channels only) every start is screened with the gains set to the mean
-    gap of their channels (:func:`_projected`), the best :data:`BLOCK_REFINED` are refined
-    on the block's channels alone, and the blocks' optima are joined into one start for the
-    joint fit. None when the effect declares no blocks. The screening and refits are
-    charged to the fit's budget and stop at :data:`BLOCK_SHARE` of it."""
+    """Block-wise multi-start: each block's starts screened (:func:`_projected`), the best
+    :data:`BLOCK_REFINED` refined on its channels (within :data:`BLOCK_SHARE` of the budget),
+    the optima joined; None without blocks."""
     groups = EFFECTS[effect].separable_groups(fun.problem.engine)
     if not groups:
         return None
@@ -158,8 +138,7 @@ def _block_start(fun, pack, effect):
 
 
 def _projected(fun, sub, pack, effect, x, idx, start, chans):
-    """(cost, block vector) of a start with each channel's gain set to minus its mean gap
-    over the points above the floor (the least-squares gain, censoring aside)."""
+    """(cost, block vector) of a start, each channel's gain set to minus its mean gap."""
     names = [pack.names[i][1] for i in idx]
     xs = np.array([start.get(n, pack.x0[i]) for n, i in zip(names, idx)])
     xx = x.copy()
@@ -179,10 +158,7 @@ def _projected(fun, sub, pack, effect, x, idx, start, chans):
 
 
 class _BlockResiduals:
-    """The residuals of a block start's channels ``sub`` as a function of the block's
-    parameters ``idx`` (the others at ``x``), charged to the fit's budget (``fun``,
-    :class:`~powertrain.diagnosis.search.Counted`); ``last`` and :meth:`columns` for the
-    Jacobian (:class:`~powertrain.diagnosis.search.Differences`)."""
+    """Residuals on ``sub`` of the block ``idx`` (others at ``x``), charged to ``fun``."""
 
     def __init__(self, fun, sub, x, idx):
         self.fun, self.sub, self.x, self.idx = fun, sub, x, idx
@@ -208,5 +184,4 @@ def _refine_block(fun, sub, pack, x, idx, xs):
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         return least_squares(f, xs, jac=Differences.or_two_point(f, lower, upper),
-                             bounds=(lower, upper), method="trf", max_nfev=10 * idx.size,
-                             diff_step=DIFF_STEP)
+                             bounds=(lower, upper), method="trf", max_nfev=10 * idx.size, diff_step=DIFF_STEP)

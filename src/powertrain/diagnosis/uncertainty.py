@@ -1,40 +1,21 @@
 r"""Uncertainty of the fitted parameters (:func:`powertrain.diagnosis.fit.fit_candidate`).
 
-Two covariances of the fitted coordinates :math:`x` (log space for scale-like parameters)
-are formed at the optimum from the residuals :math:`r` [dB] and their Jacobian :math:`J`
-(data rows, then the parameter priors' rows :math:`J_p`):
+From the residuals :math:`r` [dB] and Jacobian :math:`J` at the optimum (fitted coordinates,
+data rows then the priors' rows :math:`J_p`), :math:`A = J^TJ`:
 
-* Gauss–Newton, :math:`C_{GN} = \hat s^2 A^{+}`, :math:`A = J^TJ`, :math:`\hat s^2 =
-  \mathrm{RSS}/(n - p)` (at least the measured scatter squared when priors enter);
-  it takes the residuals as independent, which they are not when the model differs from
-  the data's source a little: the difference is smooth along speed in every (channel,
-  order) cell, so the residuals of a cell are correlated at all lags and pull the
-  parameters together;
+* Gauss–Newton, :math:`C_{GN} = \hat s^2 A^{+}`, :math:`\hat s^2 = \mathrm{RSS}/(n - p)`
+  (residuals taken as independent);
 * cluster-robust (sandwich; Liang & Zeger 1986, Biometrika 73; Cameron & Miller 2015,
-  "A practitioner's guide to cluster-robust inference", J. Human Resources 50),
-  clusters the (channel, order) cells (level and phase residuals of a cell over all
-  training speeds, and over all runs of a plan; the crank offset's prior row a cluster of
-  its own):
+  J. Human Resources 50), clusters the (channel, order) cells, whose residuals are
+  correlated along speed when the model differs smoothly from the data:
 
   .. math:: C_{CR} = \frac{G}{G-1}\,A^{+}\Big(\sum_g J_g^T r_g\, r_g^T J_g\Big)A^{+}
-            + \hat s^2 A^{+} J_p^T J_p A^{+},
+            + \hat s^2 A^{+} J_p^T J_p A^{+}.
 
-  :math:`G` the number of clusters, :math:`J_g, r_g` a cluster's rows (the prior rows, pseudo
-  data of known scatter, enter with their model variance). It measures the scatter of the
-  pull each cell exerts on the parameters: cells that disagree on the frequency of a mode
-  (one pulls it up, another down) widen it, whatever the size of the residuals.
-
-The reported 1σ is the larger of the two per parameter, and for the parameters an effect
-names in ``Effect.model_floor`` (a missing body mode's frequency and modal mass) a
-model-discrepancy term is added in quadrature, the relative floor :data:`MODEL_FLOOR`
-(a systematic standard uncertainty combined with the statistical one, JCGM 100:2008
-§5.1.2): :math:`\sigma^2 = \max(\sigma_{GN}^2, \sigma_{CR}^2) + (\epsilon\,\theta)^2`
-(:math:`\epsilon^2` in log coordinates). Neither covariance sees a difference between the
-model and the data's source that every cell shares (a mode's resonance placed a little
-higher by the model on all channels and orders alike): the data cannot measure it, so it is
-a stated constant. The 95 % interval is
-:math:`x \pm z\,\sigma_x` in fitted coordinates (:data:`Z_95`), mapped back (asymmetric for
-log-scale parameters) and clipped to the parameter's bounds.
+The 1σ is the larger of the two; for the parameters in ``Effect.model_floor`` the relative
+model-discrepancy floor :data:`MODEL_FLOOR` is added in quadrature (JCGM 100:2008 §5.1.2),
+:math:`\sigma^2 = \max(\sigma_{GN}^2, \sigma_{CR}^2) + (\epsilon\,\theta)^2`. The 95 % interval
+is :math:`x \pm z\,\sigma_x` (:data:`Z_95`) mapped back and clipped to the bounds.
 """
 
 from __future__ import annotations
@@ -45,21 +26,16 @@ import numpy as np
 
 from powertrain.effects import EFFECTS
 
-#: Relative model-discrepancy floor of the parameters named in ``Effect.model_floor`` [1]
-#: (chosen on a calibration set of draws kept apart from those the coverage is measured on:
-#: docs/validation/diagnosis.md, issue 37).
+#: Relative model-discrepancy floor of the parameters in ``Effect.model_floor`` [1]
+#: (calibrated on draws kept apart from the coverage's: docs/validation/diagnosis.md).
 MODEL_FLOOR = 0.025
 #: Two-sided 95 % normal quantile [1].
 Z_95 = 1.959964
 
 
 def cluster_ids(valid, phase_on=None) -> np.ndarray:
-    """Cluster of each residual of :meth:`Problem.vector <powertrain.diagnosis.fit.Problem.
-    vector>` on the training speeds: the level points (``valid`` (n_r, n_ch, n_o), in the
-    order of ``array[valid]``) and the phase points (``phase_on``, same shape) by their
-    (channel, order) cell, then with phase the crank offset's prior row (a cluster of its
-    own, -1 - its run; :meth:`JointProblem.clusters <powertrain.diagnosis.plan.JointProblem.
-    clusters>` numbers runs)."""
+    """Cluster of each training residual: the level points ``valid`` (n_r, n_ch, n_o) and
+    phase points ``phase_on`` by (channel, order) cell, then the offset prior's row (-1)."""
     n_o = valid.shape[2]
     cells = [np.nonzero(valid)[1] * n_o + np.nonzero(valid)[2]]
     if phase_on is not None:
@@ -69,8 +45,7 @@ def cluster_ids(valid, phase_on=None) -> np.ndarray:
 
 
 def parameter_sd(J, r, n_data, clusters, s2) -> np.ndarray:
-    """1σ of the fitted coordinates: the larger of the Gauss–Newton and the cluster-robust
-    value (module docstring).
+    """1σ of the fitted coordinates: the larger of the Gauss–Newton and cluster-robust values.
 
     Parameters
     ----------
@@ -109,9 +84,8 @@ def parameter_sd(J, r, n_data, clusters, s2) -> np.ndarray:
 
 
 def with_model_floor(pack, x, sd, floor=None) -> np.ndarray:
-    """``sd`` (fitted coordinates) with the relative model-discrepancy floor (:data:`
-    MODEL_FLOOR` unless ``floor``) added in quadrature for the parameters of ``pack`` that
-    their effect names in ``Effect.model_floor``."""
+    """``sd`` at ``x`` (``pack``'s coordinates) with the relative floor (:data:`MODEL_FLOOR`
+    unless ``floor``) added in quadrature for the parameters in ``Effect.model_floor``."""
     eps = MODEL_FLOOR if floor is None else floor
     out = np.array(sd, float)
     for j, (e, name) in enumerate(pack.names):
@@ -122,9 +96,8 @@ def with_model_floor(pack, x, sd, floor=None) -> np.ndarray:
 
 
 def intervals(pack, x, sd, z=Z_95) -> dict:
-    """``{effect: {parameter: [lo, hi]}}`` (SI): :math:`x \\pm z\\sigma_x` in the fitted
-    coordinates of ``pack`` (a :class:`~powertrain.diagnosis.packing.Packing`), mapped back
-    and clipped to the bounds; ``[None, None]`` where σ is not finite."""
+    """``{effect: {parameter: [lo, hi]}}`` (SI): ``x ± z sd`` in ``pack``'s coordinates,
+    mapped back and clipped to the bounds; ``[None, None]`` where ``sd`` is not finite."""
     out = {}
     lo = np.clip(x - z * sd, pack.lower, pack.upper)
     hi = np.clip(x + z * sd, pack.lower, pack.upper)

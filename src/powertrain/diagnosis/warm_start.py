@@ -1,35 +1,27 @@
 r"""Start of the amplitude fixed point for a fit's next evaluation (:mod:`powertrain.diagnosis.fit`).
 
-A trust-region fit evaluates a trial point, then its finite-difference columns (the trial
-point with one parameter moved by a small step), then the next trial point. With
-amplitude-dependent mounts each evaluation solves the fixed point :math:`A = g(A)`
-(:func:`powertrain.effects.predict.amplitude_iteration`) from a start; the converged
-amplitudes of the last *base* point (a point that is not a column of the one before) and
-the slopes :math:`\partial\ln A/\partial v_j` measured by the last column of each
-parameter predict the next start to first order:
+The converged amplitudes of the last *base* point and the slopes
+:math:`\partial\ln A/\partial v_j` of the last finite-difference column of each parameter
+predict the next start to first order,
 
-.. math:: \ln A_0 = \ln A_{base} + \sum_j \frac{\partial\ln A}{\partial v_j}\,(v_j - v_{base,j}).
+.. math:: \ln A_0 = \ln A_{base} + \sum_j \frac{\partial\ln A}{\partial v_j}\,(v_j - v_{base,j});
 
-A column then starts within the step's second-order term of its fixed point (one or two
-iterations instead of three), a trial point along the step. Only the start changes: every
-evaluation still iterates to the fixed point's tolerance.
+only the start changes, every evaluation still iterates to tolerance.
 """
 
 from __future__ import annotations
 
 import numpy as np
 
-#: A point that differs from the base in one parameter by at most this (relative to
-#: max(1, |v|)) is a finite-difference column of it (the fits' steps are 1e-4).
+#: A point differing from the base in one parameter by at most this (relative to
+#: max(1, |v|)) is a finite-difference column (the fits' steps are 1e-4).
 COLUMN_STEP = 1e-3
-#: Largest predicted change of ln A from the base: a long trial step extrapolated along
-#: the slopes may overshoot; within a factor e of the base's amplitudes the fixed point
-#: converges as it did from the base itself.
+#: Largest predicted change of ln A from the base (a long step may overshoot).
 MAX_LOG_CHANGE = 1.0
 
 
 def scenario_vector(scenario) -> np.ndarray:
-    """The scenario's parameter values in a fixed order (effect, then parameter name)."""
+    """``scenario``'s parameter values in a fixed order (effect, then parameter name)."""
     return np.array([float(v) for e in sorted(scenario) for _, v in sorted(scenario[e].items())])
 
 

@@ -1,24 +1,14 @@
 r"""Step 1 of the diagnosis: where the gap lies, and what kind of error it looks like.
 
-The gap map per mount, direction, quantity and speed; the regions beyond ±3 dB; and a
-decomposition of all order gaps (not the synthesis) into smooth parts,
+The gap map, its regions beyond ±3 dB, and a decomposition of the order gaps into smooth
+parts fitted by penalised least squares (hat bases: 32 knots in log f, 8 in rpm),
 
 .. math:: \Delta L_{c,o}(n) \approx g_c + \Delta H_c\!\big(f = o\,n/60\big)
           + \Delta F_o(n),
 
-fitted by penalised least squares (piecewise-linear bases: ΔH on 32 knots in log f, ΔF on
-8 knots in rpm, second-difference smoothing and a small ridge): :math:`g_c` a constant per
-channel (sensor gain), :math:`\Delta H_c` tied to a fixed *frequency* (transfer path,
-structure), :math:`\Delta F_o` tied to a fixed *order and speed* (excitation).
-
-Attribution (:func:`attribute`): each part is also fitted *alone* to the gap; the part whose
-own fit explains most of the gap's sum of squares (:math:`R^2` alone) names the kind of
-error, and its fitted curves say where: the orders whose excitation curve carries the gap
-(excitation), the frequency band where the structure curves are large (structure), the
-channels with the largest constants (sensor). A gap in the half orders of one cylinder
-is thus attributed to excitation at orders 0.5, 1, 1.5, not to a channel constant.
-
-Finally the gap outside the span of rigid-body motion (:func:`rigid_span_gap`).
+a channel constant (sensor gain), a frequency-tied part (structure) and an order-tied part
+(excitation). :func:`attribute` names the part that explains most when fitted alone, and
+where (orders, band or channels); :func:`rigid_span_gap` is the gap outside rigid-body motion.
 """
 
 from __future__ import annotations
@@ -37,13 +27,10 @@ N_FREQ_KNOTS = 32
 N_RPM_KNOTS = 8
 #: Second-difference smoothing and ridge weights of the decomposition.
 LAM_SMOOTH, LAM_RIDGE = 3.0, 0.3
-#: Orders (or the band) named in the attribution carry at least this fraction of the
-#: largest per-order (per-frequency) RMS of their part.
+#: Share of their part's largest RMS the orders (band, channels) named must carry.
 NAME_FRACTION = 0.5
-KIND_LABEL = {"structure": "structural (tied to frequency)",
-              "excitation": "excitation (tied to order/speed)",
-              "const": "sensor gain (constant per channel)",
-              "residual": "local/unexplained by smooth parts"}
+KIND_LABEL = {"structure": "structural (tied to frequency)", "excitation": "excitation (tied to order/speed)",
+              "const": "sensor gain (constant per channel)", "residual": "local/unexplained by smooth parts"}
 
 
 def _hat_basis(x, knots):
@@ -58,7 +45,7 @@ def _hat_basis(x, knots):
 
 
 def _design(data: GapData, mask, n_ch, n_q):
-    """Design matrix of the three parts and the column blocks of each."""
+    """Design matrix of the three parts, their column blocks and knots."""
     r_i, c_i, q_i = np.nonzero(mask)
     f = data.order_hz[r_i, q_i]
     fk = np.geomspace(max(f.min(), 1.0), f.max() * 1.0001, N_FREQ_KNOTS)
@@ -97,12 +84,7 @@ def _penalties(blocks, n_ch, n_q, nf, nr, n_col):
 
 
 def _solve(X, P, y, cols):
-    """Penalised least squares on the columns ``cols`` only; coefficients (full length).
-
-    The minimum-norm solution (as ``numpy.linalg.lstsq``): columns without an entry (a
-    channel or knot with no data and no penalty) get zero, the others solve the normal
-    equations as a sparse system (a data row touches five columns and the ridge makes
-    every penalised column regular)."""
+    """Penalised least squares on the columns ``cols`` (others and empty columns zero)."""
     cols = np.asarray(cols)
     A = sparse.csc_matrix(np.vstack([X[:, cols], P[:, cols]]))
     used = np.flatnonzero(np.diff(A.indptr))
@@ -119,15 +101,17 @@ def decompose_gap(gap, data: GapData, mask):
     Parameters
     ----------
     gap : ndarray (n_r, n_ch, n_q)
+        Gap map [dB].
+    data : GapData
     mask : ndarray bool, same shape
         Points used (finite, not censored, orders only).
 
     Returns
     -------
-    dict with the fitted parts at every point (``const``, ``structure``, ``excitation``,
-    ``residual``; arrays like ``gap``, NaN outside ``mask``), the share of the sum of squares
-    each part of the joint fit carries (``share_alone``), the R² of each part fitted alone
-    (``r2_alone``), the full-model R², the residual RMS [dB] and the fitted curves.
+    dict
+        Parts at every point (``const``, ``structure``, ``excitation``, ``residual``), each
+        part's share (``share_alone``) and R² alone (``r2_alone``), ``r2_full``,
+        ``residual_rms_db``, the fitted curves and the ``attribution``.
     """
     y = gap[mask]
     n_ch, n_q = gap.shape[1], gap.shape[2]
@@ -137,22 +121,17 @@ def decompose_gap(gap, data: GapData, mask):
     parts = {k: X[:, s] @ beta[s] for k, s in blocks.items()}
     fit = sum(parts.values())
     ss = float(np.sum(y ** 2)) or 1.0
-    out = {}
+    out = {k: _on(mask, v) for k, v in parts.items()}
+    out["residual"] = _on(mask, y - fit)
+    share, alone, alone_fit, b_alone = {}, {}, {}, {}
     for k, v in parts.items():
-        out[k] = np.full(gap.shape, np.nan)
-        out[k][mask] = v
-    out["residual"] = np.full(gap.shape, np.nan)
-    out["residual"][mask] = y - fit
-    share, alone, alone_fit = {}, {}, {}
-    for k, v in parts.items():
-        den = float(np.sum(v ** 2)) or 1.0       # best scale of the joint fit's part alone
+        den = float(np.sum(v ** 2)) or 1.0
         s = float(np.dot(v, y)) / den
         share[k] = max(0.0, 1.0 - float(np.sum((y - s * v) ** 2)) / ss)
-        cols = np.arange(X.shape[1])[blocks[k]]
-        b_k = _solve(X, P, y, cols)
-        alone[k] = max(0.0, 1.0 - float(np.sum((y - X @ b_k) ** 2)) / ss)
-        alone_fit[k] = np.full(gap.shape, np.nan)
-        alone_fit[k][mask] = X @ b_k
+        b_alone[k] = _solve(X, P, y, np.arange(X.shape[1])[blocks[k]])
+        xb = X @ b_alone[k]
+        alone[k] = max(0.0, 1.0 - float(np.sum((y - xb) ** 2)) / ss)
+        alone_fit[k] = _on(mask, xb)
     out.update(share_alone=share, r2_alone=alone, r2_full=1.0 - float(np.sum((y - fit) ** 2)) / ss,
                residual_rms_db=float(np.sqrt(np.mean((y - fit) ** 2))))
     out["structure_curves"] = {"frequency_hz": fk.tolist(),
@@ -161,15 +140,21 @@ def decompose_gap(gap, data: GapData, mask):
                                 "by_quantity": beta[blocks["excitation"]].reshape(n_q, -1).tolist()}
     out["channel_const_db"] = beta[blocks["const"]].tolist()
     out["attribution"] = attribute(out, alone_fit, data, gap.shape[2], fk,
-                                   beta_alone=_solve(X, P, y, np.arange(X.shape[1])[
-                                       blocks["structure"]])[blocks["structure"]])
+                                   beta_alone=b_alone["structure"][blocks["structure"]])
     return out
 
 
+def _on(mask, v):
+    """``v`` at the points ``mask``, NaN elsewhere."""
+    a = np.full(mask.shape, np.nan)
+    a[mask] = v
+    return a
+
+
 def attribute(parts, alone_fit, data: GapData, n_q, fk, beta_alone):
-    """Kind of the gap (the part with the largest R² alone) and where it lives, read from
-    that part's own fit: the orders (excitation), the frequency band (structure) or the
-    channels (sensor) carrying at least :data:`NAME_FRACTION` of its largest RMS."""
+    """Kind of the gap (largest R² alone in ``parts``) and where it lives in that part's own
+    fit ``alone_fit`` (n_q quantities): orders, band (``beta_alone`` on the knots ``fk``
+    [Hz]) or channels carrying :data:`NAME_FRACTION` of its largest RMS."""
     alone = parts["r2_alone"]
     kind = max(("structure", "excitation", "const"), key=lambda k: alone[k])
     out = {"kind": kind, "label": KIND_LABEL[kind], "r2_alone": alone[kind]}
@@ -192,7 +177,7 @@ def attribute(parts, alone_fit, data: GapData, n_q, fk, beta_alone):
 
 
 def attribution_text(att) -> str:
-    """One phrase: the kind of gap and where it lives."""
+    """One phrase for attribution ``att``: the kind of gap and where it lives."""
     txt = f"the gap looks mostly like {att['label']} error ({att['r2_alone']:.0%} of it)"
     if att.get("orders"):
         txt += " at orders " + ", ".join(f"{o:g}" for o in att["orders"])
@@ -206,10 +191,9 @@ def attribution_text(att) -> str:
 def rigid_span_gap(velocity, data: GapData, channel_matrix):
     r"""Gap left outside the rigid-body span [dB], (n_r, n_q_orders) RMS over channels.
 
-    Measured magnitudes with the simulated phases,
-    :math:`\tilde v_c = m_c\,e^{i\angle s_c}`, projected (least squares) on the span of the
-    channel matrix :math:`\mathbf C` (n_ch×6); the RMS over channels of
-    :math:`20\log_{10}(|P\tilde v|_c/m_c)` is returned where all channels are measured.
+    Measured magnitudes with simulated phases ``velocity``, :math:`\tilde v_c = m_c\,e^{i\angle
+    s_c}`, projected on the span of ``channel_matrix`` (n_ch×6); RMS over channels of
+    :math:`20\log_{10}(|P\tilde v|_c/m_c)` where all channels are measured.
     """
     qs = np.flatnonzero(data.order_mask)
     out = np.full((data.rpm.size, qs.size), np.nan)
@@ -229,21 +213,13 @@ def rigid_span_gap(velocity, data: GapData, channel_matrix):
 
 def _runs(over):
     """(start, stop) of the runs of True in a bool vector (stop inclusive)."""
-    out, i = [], 0
-    while i < over.size:
-        if not over[i]:
-            i += 1
-            continue
-        j = i
-        while j + 1 < over.size and over[j + 1]:
-            j += 1
-        out.append((i, j))
-        i = j + 1
-    return out
+    d = np.diff(np.concatenate([[0], over.astype(int), [0]]))
+    return [(int(a), int(b) - 1) for a, b in zip(np.flatnonzero(d == 1), np.flatnonzero(d == -1))]
 
 
 def regions(gap, data: GapData, parts):
-    """Contiguous speed ranges with |gap| > REGION_DB per channel and quantity."""
+    """Contiguous speed ranges with |``gap``| > REGION_DB per channel and quantity, kinds
+    from the decomposition ``parts``; largest first."""
     found = []
     for c, (mount, direction) in enumerate(data.channels):
         for k, q in enumerate(data.quantities):
@@ -251,13 +227,11 @@ def regions(gap, data: GapData, parts):
             for i, j in _runs(np.isfinite(g) & (np.abs(g) > REGION_DB)):
                 seg = g[i:j + 1]
                 h = data.harmonic[k]
-                kind = "synthesis (see orders)" if h < 0 else _region_kind(
-                    parts, slice(i, j + 1), c, k)
+                kind = "synthesis (see orders)" if h < 0 else _region_kind(parts, slice(i, j + 1), c, k)
                 worst = i + int(np.nanargmax(np.abs(seg)))
                 found.append({"mount": mount, "direction": direction, "quantity": q,
                               "rpm_from": float(data.rpm[i]), "rpm_to": float(data.rpm[j]),
-                              "n_points": int(j - i + 1),
-                              "max_abs_db": float(np.nanmax(np.abs(seg))),
+                              "n_points": int(j - i + 1), "max_abs_db": float(np.nanmax(np.abs(seg))),
                               "gap_at_max_db": float(g[worst]),
                               "frequency_hz_at_max": float(data.rpm[worst] * (h + 1) / 120.0)
                               if h >= 0 else None,
@@ -267,13 +241,12 @@ def regions(gap, data: GapData, parts):
 
 
 def _region_kind(parts, sl, c, k):
-    ss = {label: float(np.nansum(parts[name][sl, c, k] ** 2))
-          for name, label in KIND_LABEL.items()}
+    ss = {label: float(np.nansum(parts[name][sl, c, k] ** 2)) for name, label in KIND_LABEL.items()}
     return max(ss, key=ss.get)
 
 
 def where_text(found, parts):
-    """The 'where' phrase of an unexplained verdict."""
+    """The 'where' phrase of an unexplained verdict from regions ``found`` and ``parts``."""
     txt = attribution_text(parts["attribution"])
     if parts.get("sides"):
         txt += "; " + side_text(parts["sides"])
