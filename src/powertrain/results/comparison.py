@@ -113,12 +113,7 @@ class ChannelComparison:
 
 
 def json_number(x):
-    """``float(x)``, or None if not finite (JSON has no NaN).
-
-    Parameters
-    ----------
-    x : float
-    """
+    """``float(x)``, or None if not finite (JSON has no NaN)."""
     x = float(x)
     return x if np.isfinite(x) else None
 
@@ -361,13 +356,7 @@ def _quantity_line(pq) -> str:
 
 def missing_lines(missing) -> list:
     """``MOUNT DIRS: QUANTITIES: reason`` lines; directions with the same quantities and
-    reason share a line.
-
-    Parameters
-    ----------
-    missing : list of dict
-        ``{"mount", "direction", "quantity", "reason"}`` entries.
-    """
+    reason share a line (``missing``: ``{"mount", "direction", "quantity", "reason"}``)."""
     groups = {}                                     # (mount, reason, direction) -> quantities
     for m in missing:
         groups.setdefault((m["mount"], m["reason"], m["direction"]), []).append(m["quantity"])

@@ -123,13 +123,7 @@ class FitResult(Result):
 
 
 def parameter_lines(model) -> list:
-    """``  c1 = 12.5 N/mm`` lines: the model's parameters in datasheet units.
-
-    Parameters
-    ----------
-    model : MountModel
-        Model with SI ``params``.
-    """
+    """``  c1 = 12.5 N/mm`` lines: the ``model``'s parameters in datasheet units."""
     lines = []
     for p in model.topology.parameters:
         unit = PARAMETER_UNITS[p[0]]

@@ -327,13 +327,7 @@ OPERATING_POINT = {"mean_torque": "N*m", "body": "m, m, m, rad, rad, rad",
 
 
 def write_operating_point(g, static) -> None:
-    """Write the operating point per speed into the HDF5 group ``g`` (:data:`OPERATING_POINT`).
-
-    Parameters
-    ----------
-    g : h5py.Group
-    static : StaticResult
-    """
+    """Write the ``static`` operating point per speed into the HDF5 group ``g``."""
     g.attrs["gear_ratio"] = float(static.points[0].gear_ratio) if static.points else 1.0
     g.create_dataset("mounts", data=np.array(static.mounts, dtype="S"))
     for name, unit in OPERATING_POINT.items():
