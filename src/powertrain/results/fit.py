@@ -34,16 +34,13 @@ class FitResult(Result):
         Thesis objective :math:`f_{obj}` (eq. 19) of the fitted model [N].
     rel_rms : float
         Relative RMS error :math:`\\varepsilon` of the fitted model [1].
-    n_starts : int
-        Starting points screened.
-    n_polished : int
-        Screened starts run to convergence.
+    n_starts, n_polished : int
+        Starting points screened, and those run to convergence.
     success : bool
         The best polishing run converged (did not hit the evaluation limit).
-    polish_success : tuple of bool
-        Convergence flag of each polishing run.
-    polish_rel_rms : tuple of float
-        :math:`\\varepsilon` of each polishing run (spread = multi-modality).
+    polish_success, polish_rel_rms : tuple
+        Convergence flag and :math:`\\varepsilon` of each polishing run (spread =
+        multi-modality).
     n_hops, hops_accepted : int
         Perturbations of the incumbent tried, and those that improved the fit.
     time_s : float

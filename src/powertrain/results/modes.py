@@ -21,12 +21,8 @@ class Mode:
 
     Attributes
     ----------
-    frequency_hz : float
-        Natural frequency |s|/2π [Hz].
-    damping_ratio : float
-        −Re s/|s| [-] (0 for the static method).
-    damped_frequency_hz : float
-        Im s/2π [Hz].
+    frequency_hz, damping_ratio, damped_frequency_hz : float
+        |s|/2π [Hz], −Re s/|s| [-] (0 for the static method), Im s/2π [Hz].
     shape : ndarray complex (6,)
         ``[x, y, z, rx, ry, rz]`` at the CG [m, rad], largest-energy entry real positive,
         unit modal mass.
@@ -37,8 +33,7 @@ class Mode:
     kind : str
         ``rigid-body`` or ``chassis``.
     iterations : int
-        0: every mode comes from one eigensolve
-        (:func:`powertrain.solvers.modes.state_space_eigenvalues`).
+        0: all modes come from one eigensolve.
     body_energy_percent : float
         Share of the kinetic energy in the body modes of a modal chassis [%].
     static_frequency_hz : float
