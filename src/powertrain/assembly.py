@@ -228,9 +228,7 @@ def assemble(mass, cg, inertia, mounts, chassis=None, static_factors=None) -> As
 
 
 def _add_networks(matrices, blocks, mounts, shapes, body0):
-    """Add every network to M, C, K and its transmitted force to ``Fk``, ``Fd`` (in place);
-    returns the networks, their (node map, base row), port rows (engine side minus base) and
-    force map."""
+    """Add every network to M, C, K and its transmitted force to ``Fk``, ``Fd`` (in place)."""
     M, C, K, Fk, Fd = matrices
     n = M.shape[0]
     start, networks, maps = 6, [], []
@@ -266,8 +264,7 @@ def _force_row(g, L, base):
 
 
 def _network_blocks(mounts, cg, with_ground, static_factors=None):
-    """Per network: (engine-side row, M, C, K, ground-force rows kg, dg, mount index, axis
-    index, element at its static factor)."""
+    """Per network: (engine-side row, M, C, K, kg, dg, mount index, axis index, element)."""
     blocks = []
     for mi, mount in enumerate(mounts):
         r = np.asarray(mount.position, float) - cg

@@ -171,8 +171,7 @@ class ReportResult(Result):
         return sorted(rows, key=lambda g: -g["rms_db"])[:n]
 
     def to_text(self) -> str:
-        """What ``powertrain report`` prints: study, engine, measurement, verdict, top gaps,
-        steps."""
+        """What ``powertrain report`` prints."""
         s = self.study
         lines = [f"study: {shown(s.path)}: {s.title}",
                  f"engine: {s.engine.name} ({shown(s.engine.file)})"]
@@ -212,8 +211,7 @@ class ReportResult(Result):
 
 
 def _record(role: str, path: str, synthetic=frozenset()) -> FileRecord:
-    """Hash, size and first comment lines of a file (SYNTHETIC if its real path is in
-    ``synthetic``)."""
+    """Hash, size and first comment lines of a file."""
     digest = hashlib.sha256()
     try:
         with open(path, "rb") as fh:

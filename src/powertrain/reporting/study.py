@@ -128,8 +128,7 @@ def _noise_floor(doc, where) -> float:
 
 
 def _with_files(study: Study, where) -> Study:
-    """``study`` with ``files``: study, engine and mount files, measurement (plan, runs,
-    pressure traces), what-if files and manoeuvres."""
+    """``study`` with ``files``: ``(role, path)`` of every file it reads."""
     files = [("study", study.path), ("engine", study.engine.file)]
     for m in study.engine.mounts:
         files += [(f"mount {m.name}.{d}", os.path.normpath(f)) for d, f in m.files.items()]

@@ -85,8 +85,7 @@ class AmplitudeFitResult(Result):
         return "\n".join(lines)
 
     def to_text(self) -> str:
-        """What ``powertrain fit-mount`` prints: :meth:`summary` and the fitted values in
-        datasheet units."""
+        """What ``powertrain fit-mount`` prints: summary and values in datasheet units."""
         m = self.model
         lines = [self.summary(), "parameters:", *parameter_lines(m)]
         law = m.amplitude_law
@@ -108,8 +107,7 @@ class AmplitudeFitResult(Result):
 
     def plot(self, ax=None, path=None, *, form="magnitude-phase", freq_axis="log",
              provenance=None):
-        """Measured (dots) and fitted (lines) K*(f), one colour per amplitude
-        (:func:`powertrain.plotting.stiffness.plot_amplitude_fit`)."""
+        """Measured (dots) and fitted (lines) K*(f), one colour per amplitude."""
         ax, path = target_and_path(ax, path)
         curves = []
         for i, (a, c) in enumerate(zip(self.amplitude_m, self.curves)):

@@ -148,8 +148,7 @@ class ComparisonResult(JsonResult):
     EXPECTED_QUANTITIES: ClassVar[tuple] = EXPECTED_QUANTITIES
 
     def requested_quantities(self) -> list:
-        """The default three and every measured or compared quantity, synthesis first, then
-        orders ascending."""
+        """The default three and every measured or compared quantity, in file order."""
         qs = set(EXPECTED_QUANTITIES) | set(self.measured.quantities)
         qs |= {c.quantity for c in self.channels}
         return sorted(qs, key=quantity_sort_key)
@@ -229,23 +228,17 @@ class ComparisonResult(JsonResult):
             "overall_rms_db": json_number(self.overall_rms_db),
             "compared": {
                 "n_channel_quantities": len(self.channels),
-                "quantities": sorted({c.quantity for c in self.channels},
-                                     key=quantity_sort_key),
+                "quantities": sorted({c.quantity for c in self.channels}, key=quantity_sort_key),
                 "n_points_measured": int(n_total),
                 **{f"n_points_{key}": int(sum(getattr(c, flag).sum() for c in self.channels))
                    for key, flag in (("compared", "scored"), ("excluded_noise_floor", "at_floor"),
                                      ("outside_simulated_range", "outside"),
                                      ("simulation_zero", "sim_zero"))},
                 "n_points_measured_not_modelled": self.n_not_modelled,
-                "n_points_interpolated": self.n_interpolated,
-            },
-            "missing": list(self.missing),
-            "measured_not_modelled": list(self.not_modelled),
-            "per_quantity": self.per_quantity(),
-            "channels": [c.to_dict() for c in self.channels],
-            "per_rpm": list(self.per_rpm),
-            "definitions": dict(DEFINITIONS),
-        }
+                "n_points_interpolated": self.n_interpolated},
+            "missing": list(self.missing), "measured_not_modelled": list(self.not_modelled),
+            "per_quantity": self.per_quantity(), "channels": [c.to_dict() for c in self.channels],
+            "per_rpm": list(self.per_rpm), "definitions": dict(DEFINITIONS)}
 
     def worst_first(self) -> list:
         """The compared channels and quantities by RMS gap, largest first."""
@@ -275,8 +268,7 @@ class ComparisonResult(JsonResult):
                 f"{len(self.missing)} missing; {self.run.get('seconds', 0.0):.2f} s")
 
     def to_text(self, written=()) -> str:
-        """What ``powertrain compare`` prints: sources, rules, per-channel table (worst
-        first), per-quantity lines, what was not compared, summary, the files ``written``."""
+        """What ``powertrain compare`` prints, naming the files ``written``."""
         lines = self._sources() + ["", "per channel, worst first:", self.table(), "",
                                    "per quantity (CSAC/CSF across the channels at each "
                                    "speed, RMS magnitudes):"]

@@ -33,8 +33,7 @@ class ExcitationResult(Result):
     engine: object
 
     def to_text(self) -> str:
-        """What ``powertrain excitation`` prints: per-cylinder peak pressure and IMEP, mean
-        torque, load orders."""
+        """What ``powertrain excitation`` prints: peak pressures, IMEP, torque, load orders."""
         exc, engine = self.excitation, self.engine
         lines = [f"engine: {engine.name}",
                  f"speed {exc.rpm:g} rpm, balancer shafts "

@@ -89,8 +89,7 @@ class FitResult(Result):
                 f"{self.nfev} evaluations, {self.time_s:.2f} s")
 
     def to_text(self) -> str:
-        """What ``powertrain fit-mount`` prints: :meth:`summary` and the fitted parameters in
-        datasheet units."""
+        """What ``powertrain fit-mount`` prints: summary and parameters in datasheet units."""
         return "\n".join([self.summary(), "parameters:", *parameter_lines(self.model)])
 
     def file_comment(self) -> str:

@@ -247,8 +247,7 @@ class RunupResult(Result):
                 write_operating_point(h5.create_group("operating_point"), self.operating_point)
 
     def _run_record(self, snapshot, mounts, description, provenance):
-        """Engine text, mount snapshots, description and provenance: as given, else from
-        :attr:`engine`."""
+        """The HDF5 file's run record: as given, else from :attr:`engine`."""
         e = self.engine
         if e is None:
             return snapshot or "", mounts, description or "", provenance
@@ -293,8 +292,7 @@ class RunupResult(Result):
         return out
 
     def plot_paths(self, ax=None, *, path=None, order=2.0, provenance=None):
-        """Path contributions at the body points
-        (:func:`powertrain.plotting.body.plot_path_contributions`)."""
+        """Path contributions at the body points; returns the figure."""
         ax, path = target_and_path(ax, path)
         return plot_path_contributions(self, path, order, ax=ax, provenance=provenance)
 
@@ -363,8 +361,7 @@ class SweepRunup(Result):
     engine: object = field(default=None, repr=False, compare=False)
 
     def to_text(self) -> str:
-        """What ``powertrain runup --sweep`` prints: the tracked synthesis RMS velocity at
-        about 12 speeds [mm/s]."""
+        """What ``powertrain runup --sweep`` prints (about 12 speeds)."""
         tracked = self.tracked
         syn = tracked.synthesis_rms() * 1e3
         labels = [f"{c.mount}.{c.direction}" for c in tracked.channels]

@@ -138,8 +138,7 @@ class TrackedOrders(Result):
                        settings={**self.settings, "converted_to": "velocity"})
 
     def _csv_head(self, title: str, columns: list) -> tuple:
-        """``(lines, level factor, key per channel)``: title, comments and header of a CSV
-        (``side`` column when a channel is passive)."""
+        """``(head lines, level factor, key per channel)`` of a CSV."""
         col, factor = LEVEL_COLUMNS[self.quantity]
         with_side = any(c.side != "active" for c in self.channels)
         lines = [f"# {title}"] + [f"# {c}" for c in self.comments]
@@ -250,8 +249,7 @@ class TrackedOrders(Result):
         return self.order_rms()[:, c, int(np.argmin(np.abs(self.orders - o)))]
 
     def to_text(self, written=()) -> str:
-        """What ``powertrain track`` prints: recording, speed grid, Vold-Kalman settings,
-        tracked RMS table, the files ``written``."""
+        """What ``powertrain track`` prints, naming the files ``written``."""
         r, s = self.recording, self.settings
         lines = [f"raw: {self.source}{' [SYNTHETIC]' if r.get('synthetic') else ''}: "
                  f"{r.get('n_channels')} channel(s), {r.get('sample_rate_hz'):g} Hz, "
@@ -309,8 +307,7 @@ class TrackedOrders(Result):
         write_csv(path, self.spectra.spectrum_csv_text())
 
     def plot_maps(self, ax=None, *, path=None, provenance=None):
-        """The Campbell and rpm-frequency maps (:attr:`maps`); returns the figure
-        (:func:`powertrain.plotting.orders.plot_maps`)."""
+        """The Campbell and rpm-frequency maps (:attr:`maps`); returns the figure."""
         ax, path = target_and_path(ax, path)
         return plot_maps(**self.maps, path=path, ax=ax, provenance=provenance)
 

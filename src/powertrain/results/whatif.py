@@ -87,8 +87,7 @@ class WhatIfResult(JsonResult):
     JSON_INDENT = 2
 
     def to_text(self, written=()) -> str:
-        """What ``powertrain whatif`` prints: baseline, target fits, each variant's changes,
-        objective ranking, the files ``written``."""
+        """What ``powertrain whatif`` prints, naming the files ``written``."""
         d, rpm = self.description, self.baseline.rpm
         modes = ", ".join(f"{f:.2f}" for f in self.baseline.rigid_body_modes_hz)
         step = "" if self.rpm_step is None else f" step {self.rpm_step:g}"
