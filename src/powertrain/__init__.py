@@ -1,14 +1,12 @@
 """powertrain: powertrain mount vibration (NVH) simulator.
 
-The functions a study calls are importable from here (``import powertrain as pt``), imported
-on first use so ``import powertrain`` stays light::
+The study functions are importable from here, loaded on first use::
 
     run = pt.runup(pt.read_engine(), rpm="1000:6000:500")
     print(run.to_text())
 
-Each checks its arguments as the command line does and returns a result object with
-``to_text()``, ``plot(ax=None)`` and ``save(path)``; docs/guide/python-api.md walks a whole
-study, docs/architecture.md the data flow (everything inside the package is SI).
+Each checks its arguments as the command line does and returns a result with ``to_text()``,
+``plot(ax=None)`` and ``save(path)`` (docs/guide/python-api.md; SI inside).
 """
 
 from importlib import import_module as _import_module

@@ -1,16 +1,13 @@
 r"""Assembly of the powertrain model: a 6-DOF rigid body on its mounts' networks (three per mount).
 
-Each mount has a position (its engine-side point, which is also the measurement point) and a
-rotation whose columns are the mount's local x, y, z axes in engine axes. In each local
-direction a lumped network (e.g. the triple mass oscillator) joins the engine-side point to
-the rigid ground. The engine-side node of the network moves with the body along that
-direction, :math:`x_E = \mathbf e\cdot(\mathbf u + \boldsymbol\theta\times\mathbf r)`, and its
-internal masses are extra degrees of freedom (27 for the default engine's nine triple mass
-oscillators). With the map :math:`\mathbf L` from global coordinates to network nodes, every network adds
-:math:`\mathbf L^T\mathbf K_n\mathbf L` (and likewise C, M) to the global matrices.
-
-Outputs are linear maps of the state: the velocity of each mount point in engine X/Y/Z (three
-channels per mount) and the force each mount transmits to ground, in engine axes.
+Each mount has a position (its engine-side point, also the measurement point) and a rotation
+whose columns are its local x, y, z axes in engine axes. In each local direction a lumped
+network (e.g. the triple mass oscillator) joins the engine-side point to the ground; its
+engine-side node moves with the body, :math:`x_E = \mathbf e\cdot(\mathbf u +
+\boldsymbol\theta\times\mathbf r)`, its internal masses are extra degrees of freedom. With
+the map :math:`\mathbf L` from global coordinates to network nodes, each network adds
+:math:`\mathbf L^T\mathbf K_n\mathbf L` (likewise C, M) to the global matrices. Outputs are
+linear maps of the state: each mount point's motion and transmitted force, in engine axes.
 """
 
 from __future__ import annotations
@@ -41,9 +38,8 @@ class AssembledSystem:
     channel_matrix : ndarray (3 n_mounts, n)
         Maps q (or q', q'') to the motion of the mount points in engine X/Y/Z.
     force_matrix_k, force_matrix_d : ndarray (3 n_mounts, n)
-        Force transmitted by each mount to ground in engine axes:
-        F = force_matrix_k @ q + force_matrix_d @ q' (+ ``port_force_map`` @ the port
-        laws' forces, :meth:`port_forces`).
+        Force transmitted to ground in engine axes: F = force_matrix_k @ q +
+        force_matrix_d @ q' (+ ``port_force_map`` @ the port laws' forces).
     """
 
     M: np.ndarray
@@ -85,8 +81,8 @@ class AssembledSystem:
         return 3 * len(self.mount_names)
 
     def add_body_side(self, chassis, mount_names, body0):
-        """Append the body-side channels of every mount (``NAME/passive``) and of the body
-        points of interest; their force rows are the mount's transmitted force (points: 0)."""
+        """Append the body-side channels of every mount (``NAME/passive``, force rows: the
+        mount's transmitted force) and of the body points (force rows 0)."""
         self.chassis = chassis
         self.body_start = body0
         self.mount_names = list(mount_names)
@@ -126,20 +122,17 @@ class AssembledSystem:
         return [f"{m}.{a}" for m in self.mount_names for a in DIRECTIONS]
 
     def port_forces(self) -> PortForces | None:
-        """The nonlinear elements' port laws as kernel arrays; None: the model is linear
-        (:mod:`powertrain.physics.mount_elements`)."""
+        """The nonlinear elements' port laws as kernel arrays; None for a linear model."""
         if self.port_rows is None:
             return None
         return port_forces([el for *_, el in self.networks], self.port_rows,
                            self.port_force_map, self.network_names)
 
     def network_parts(self):
-        r"""Each network's contribution at unit scale (its model's springs and dampers as
-        given, no amplitude law or static factor): ``(C_k, K_k, gk_k, gd_k)`` stacked over
-        the networks, :math:`\mathbf L^T\mathbf C_n\mathbf L` (n_net, n, n), likewise K, and
-        the transmitted-force rows (n_net, n) that ``port_force_map`` spreads on the
-        channels; a network scaled by ``(ks, ds)`` adds ``ds C_k``, ``ks K_k``, ``ks gk_k``,
-        ``ds gd_k``."""
+        r"""Each network's contribution at unit scale, stacked: ``(C_k, K_k, gk_k, gd_k)``,
+        :math:`\mathbf L^T\mathbf C_n\mathbf L` (n_net, n, n), likewise K, and the
+        transmitted-force rows (n_net, n); a network scaled by ``(ks, ds)`` adds ``ds C_k``,
+        ``ks K_k``, ``ks gk_k``, ``ds gd_k``."""
         parts = [[], [], [], []]
         for (*_, element), (L, base) in zip(self.networks, self.network_maps):
             network = element.lumped
@@ -153,7 +146,7 @@ class AssembledSystem:
 
     def ports(self) -> NetworkPorts:
         """The networks on the retained coordinates (:mod:`powertrain.physics.condensation`);
-        a model assembled without them keeps every coordinate."""
+        without them every coordinate is kept."""
         if self.network_ports is not None:
             return self.network_ports
         n = self.n_dof
@@ -166,8 +159,7 @@ class AssembledSystem:
         return self.ports().retained
 
     def static_stiffness_6(self) -> np.ndarray:
-        """6×6 static stiffness of the body on its mounts, every other coordinate condensed
-        statically [N/m, N, N·m/rad]."""
+        """6×6 static stiffness of the body on its mounts, the rest condensed [N/m, N, N·m/rad]."""
         return condense(self, np.arange(6), 0.0).real
 
     def rigid_body_modes(self):
@@ -192,17 +184,14 @@ def assemble(mass, cg, inertia, mounts, chassis=None, static_factors=None) -> As
         Objects with ``name``, ``position`` (3,) [m, engine axes], ``rotation`` (3, 3)
         (columns = local x, y, z in engine axes) and ``directions`` {"x"|"y"|"z": MountModel}.
     chassis : Chassis, optional
-        ``modal``: the body modes become the last coordinates; each network's base node moves
-        with the body at its mount's attachment point. ``frf`` is coupled in the harmonic
-        solver only (:mod:`powertrain.solvers.harmonic`); ``rigid`` or None: fixed base.
+        ``modal``: body modes appended as coordinates, each network's base node moving with
+        the body; ``frf``: coupled in the harmonic solver only; ``rigid`` or None: fixed base.
     static_factors : array_like (3 n_mounts,), optional
-        Each network's static factor at an operating point
-        (:mod:`powertrain.solvers.operating_point`): its springs and dampers scaled by it
-        (:meth:`~powertrain.physics.mount_elements.MountElement.at_operating_point`);
-        None: unscaled.
+        Each network's static factor at an operating point, scaling its springs and dampers
+        (None: unscaled).
 
-    Outputs: the channels of every mount's engine-side point; with a non-rigid chassis also
-    its body side (``NAME/passive``) and the body points of interest.
+    Outputs: every mount's engine-side point; with a non-rigid chassis also its body side
+    (``NAME/passive``) and the body points.
     """
     cg = np.asarray(cg, float)
     body_modes = chassis.body_modes if chassis is not None else ()
@@ -239,10 +228,7 @@ def assemble(mass, cg, inertia, mounts, chassis=None, static_factors=None) -> As
 
 
 def _add_networks(matrices, blocks, mounts, shapes, body0):
-    """Add every network to the global M, C, K and its transmitted force to the force rows
-    ``Fk``, ``Fd`` (in place); returns the network list, each network's node map and base
-    row (the body motion under its base node; zero on the ground), its port row (engine side
-    minus base) and its force-map column (the mount axis on the mount's force rows)."""
+    """Add every network to M, C, K and its transmitted force to ``Fk``, ``Fd`` (in place)."""
     M, C, K, Fk, Fd = matrices
     n = M.shape[0]
     start, networks, maps = 6, [], []
@@ -272,15 +258,13 @@ def _add_networks(matrices, blocks, mounts, shapes, body0):
 
 
 def _force_row(g, L, base):
-    """Force on a network's base along its axis per unit q, from the network's ground-force
-    row ``g`` over its engine-side and internal nodes (:func:`ground_force_rows`)."""
+    """Force on a network's base along its axis per unit q, from its ground-force row ``g``."""
     ni = g.size - 1
     return g @ L[:ni + 1] - g.sum() * base
 
 
 def _network_blocks(mounts, cg, with_ground, static_factors=None):
-    """Per network: (engine-side row, its M, C, K, ground-force rows kg, dg, mount index,
-    axis index, element, at its static factor if given)."""
+    """Per network: (engine-side row, M, C, K, kg, dg, mount index, axis index, element)."""
     blocks = []
     for mi, mount in enumerate(mounts):
         r = np.asarray(mount.position, float) - cg
@@ -297,8 +281,8 @@ def _network_blocks(mounts, cg, with_ground, static_factors=None):
 
 
 def _frame(mass, inertia, body_modes):
-    """M, C, K of the retained coordinates without the networks: the rigid-body mass and
-    each body mode's single-DOF oscillator."""
+    """M, C, K of the retained coordinates without networks: rigid-body mass and each body
+    mode's single-DOF oscillator."""
     n = 6 + len(body_modes)
     M0, C0, K0 = (np.zeros((n, n)) for _ in range(3))
     M0[:6, :6] = rigid_body_mass_matrix(mass, inertia)
@@ -311,10 +295,8 @@ def _frame(mass, inertia, body_modes):
 
 
 class NetworkScaling:
-    """The assembled model's damping, stiffness and force rows with rescaled networks: the
-    one view of the system at other network scales (an amplitude law's factors per cycle in
-    the time domain, the static curves' operating point for the harmonic start, the
-    networks as measured for the modes).
+    """The assembled model's damping, stiffness and force rows at other network scales
+    (amplitude laws, static operating point, networks as measured).
 
     Parameters
     ----------
@@ -339,9 +321,8 @@ class NetworkScaling:
                            for el in self.elements)
 
     def scales(self, amplitudes, factors=None) -> np.ndarray:
-        """``(stiffness, damping)`` factor (n_net, 2) of every network at its amplitude
-        (n_net,) [m] and static factor (:meth:`MountElement.scales`; one call per distinct
-        amplitude law)."""
+        """``(stiffness, damping)`` factor (n_net, 2) of every network at its ``amplitudes``
+        (n_net,) [m] and static ``factors`` (default: as assembled)."""
         out = np.ones((len(self.elements), 2))
         a = np.asarray(amplitudes, float)
         for law, index in self._laws.items():
@@ -351,7 +332,7 @@ class NetworkScaling:
 
     def matrices(self, scales):
         """``(C, K, force_matrix_k, force_matrix_d)`` at the network ``scales`` (n_net, 2);
-        the assembled arrays themselves where no scale changed (bit-identical)."""
+        the assembled arrays themselves if no scale changed."""
         s = self.system
         dk, dd = (np.asarray(scales, float) - self.assembled).T
         if not (dk.any() or dd.any()):
@@ -362,20 +343,17 @@ class NetworkScaling:
                 s.force_matrix_d + (fmap * dd) @ self.gd)
 
     def at_operating_point(self, factors):
-        """The assembled model with its elements at the static ``factors`` (n_net,): the
-        same model, its elements, C, K and force rows replaced (for the harmonic start)."""
+        """The model with its elements at the static ``factors`` (n_net,)."""
         return self.with_elements([el.at_operating_point(f)
                                    for el, f in zip(self.elements, factors)])
 
     def as_measured(self):
-        """The assembled model with every network as measured
-        (:meth:`~powertrain.physics.mount_elements.MountElement.as_measured`): the linear
-        view the modes take."""
+        """The model with every network as measured (the linear view of the modes)."""
         return self.with_elements([el.as_measured() for el in self.elements])
 
     def with_elements(self, elements):
-        """The assembled model with ``elements`` (one per network, at amplitude 0): its
-        elements, C, K and force rows replaced."""
+        """The model with ``elements`` (one per network, at amplitude 0): elements, C, K and
+        force rows replaced."""
         s = self.system
         C, K, Fk, Fd = self.matrices(np.array([el.scales(0.0) for el in elements],
                                               float).reshape(-1, 2))

@@ -1,8 +1,5 @@
-"""Errors raised for bad user input.
-
-Every loader raises :class:`InputError` naming the file and the key (and, for tables,
-line and column), so that the command line can print one line and exit non-zero.
-"""
+"""Errors raised for bad user input: :class:`InputError` names the file, key and line, so the
+command line prints one line and exits non-zero."""
 
 from __future__ import annotations
 
@@ -48,9 +45,8 @@ class InputError(ValueError):
 
 
 def solved(solve, file, key):
-    """``solve()``, with a model that cannot be solved (singular, overflow) reported as bad
-    input naming ``file`` and ``key`` (the last guard: the checks at load catch the known
-    causes first)."""
+    """``solve()``, a model that cannot be solved (singular, overflow) reported as an
+    InputError naming ``file`` and ``key``."""
     import numpy as np  # deferred: keeps `import powertrain` (which loads InputError) free of numpy
     try:
         with np.errstate(all="ignore"):
@@ -72,6 +68,5 @@ def require_finite(values: dict, file, key) -> None:
 
 
 class PowertrainWarning(UserWarning):
-    """A result to be read with care (a model choice, a loose convergence): the package's
-    warnings derive from it, and the command line prints them as one line
-    ``warning: ...``."""
+    """Base of the package's warnings (a result to read with care); the command line prints
+    each as ``warning: ...``."""

@@ -1,12 +1,9 @@
-"""Safe file output: every file is written to a temporary file beside its target and renamed
-onto the target only when complete; a command's outputs are committed together.
-
-:func:`atomic_path` / :func:`atomic_write` write one file; :class:`OutputTransaction` (the
-CLI's, around every command) stages every file written inside it and renames them onto their
-targets together when the block succeeds, under a lock of each target folder; a failure
-removes the staged files and the folders the run created. Temporary files are named
-``.NAME.pt<PID>-<random>.tmp``; finished files get ``0666 & ~umask``. The guarantees and
-their tests: docs/reference/outputs.md.
+"""Safe file output: each file is written to a temporary file beside its target and renamed
+onto it when complete (:func:`atomic_path`, :func:`atomic_write`). :class:`OutputTransaction`
+(around every CLI command) stages the files written inside it and renames them together on
+success, each target folder locked; a failure removes the staged files and the folders
+created. Temporary files are ``.NAME.pt<PID>-<random>.tmp``; finished files get
+``0666 & ~umask``. Guarantees: docs/reference/outputs.md.
 """
 
 from __future__ import annotations
@@ -22,8 +19,8 @@ from pathlib import Path
 
 from powertrain.errors import InputError
 
-#: Longest file name [bytes] we write: the file system's limit (255 on Linux and macOS)
-#: minus room for the temporary name's prefix and suffix.
+#: Longest file name written [bytes]: the file-system limit (255) minus room for the
+#: temporary name's prefix and suffix.
 MAX_NAME_BYTES = 255 - 40
 _TEMP = re.compile(r"^\..+\.pt(\d+)-[A-Za-z0-9_]+\.tmp$")
 #: The transaction in progress in this context (the innermost ``with``), or None.
@@ -69,8 +66,8 @@ def sweep_stale_temps(folder) -> list[Path]:
 
 
 def check_writable(target, key: str | None = None) -> Path:
-    """Fail early, before any work, if ``target`` cannot be written (folder or path clash,
-    a name too long for the file system)."""
+    """Raise InputError before any work if ``target`` cannot be written (folder or path
+    clash, name too long; ``key``: the option named); returns it as a Path."""
     target = Path(target)
     if len(target.name.encode("utf-8", "surrogateescape")) > MAX_NAME_BYTES or \
             any(len(p.encode("utf-8", "surrogateescape")) > 255 for p in target.parts):
@@ -119,14 +116,14 @@ def _replace(tmp, target) -> None:
 
 
 class OutputTransaction:
-    """Stage every file written inside the ``with`` block; commit all of them when the
-    block succeeds, remove them (and the folders created for them) when it fails."""
+    """Stage every file written inside the ``with`` block; commit all of them on success,
+    remove them (and the folders created for them) on failure."""
 
     def __init__(self):
         self.staged: dict = {}              # target -> temporary file
         self.created: list = []             # folders created for the outputs
         self.committed: list = []
-        self._token = None                  # the context variable's value before ``with``
+        self._token = None
 
     def __enter__(self):
         self._token = _CURRENT.set(self)
@@ -149,10 +146,9 @@ class OutputTransaction:
         self.staged[target] = tmp
 
     def commit(self) -> list[Path]:
-        """Rename every staged file onto its target, each target folder locked meanwhile:
-        all of them or none. Every target is checked first (a folder in the way fails
-        before any file is replaced); a rename that fails all the same puts back the files
-        replaced before it (kept as hard links until the end)."""
+        """Rename every staged file onto its target under folder locks, all or none: targets
+        are checked first; a failing rename puts back the files replaced before it (kept as
+        hard links until the end)."""
         folders = sorted({str(t.parent.resolve()) for t in self.staged})
         with contextlib.ExitStack() as locks:
             for folder in folders:
@@ -199,8 +195,7 @@ def _check_target(target: Path) -> None:
 
 
 def _backup(target: Path) -> Path | None:
-    """A hard link to ``target``'s current file under a temporary name (None: no file, or
-    the file system has no hard links)."""
+    """A hard link to ``target``'s file under a temporary name (None: no file or no links)."""
     if not target.is_file():
         return None
     name = f".{target.name}.pt{os.getpid()}-{os.urandom(4).hex()}.tmp"
@@ -213,8 +208,7 @@ def _backup(target: Path) -> Path | None:
 
 
 def _restore(backups) -> None:
-    """Put the old files back onto the targets replaced so far; remove those that did not
-    exist before (a file replaced without a hard link stays replaced)."""
+    """Put the old files back onto the targets replaced so far; remove new ones."""
     for target, backup, existed in reversed(backups):
         with contextlib.suppress(OSError):
             if backup is not None:
@@ -253,8 +247,8 @@ def _folder_lock(folder):
 
 @contextlib.contextmanager
 def atomic_path(target):
-    """Yield a temporary path in the target's folder; on success it replaces ``target``
-    (at once, or at the commit of the :class:`OutputTransaction` in progress)."""
+    """Yield a temporary path beside ``target`` that replaces it on success (at once, or at
+    the commit of the :class:`OutputTransaction` in progress)."""
     target = Path(target)
     txn = _CURRENT.get()
     created = txn.created if txn is not None else []
@@ -284,11 +278,10 @@ def atomic_path(target):
 
 @contextlib.contextmanager
 def atomic_write(target, mode="w", **kwargs):
-    """Open a temporary file for writing; it replaces ``target`` only if the block succeeds
-    (see :func:`atomic_path`)."""
-    with atomic_path(target) as tmp:
-        with open(tmp, mode, **kwargs) as fh:
-            yield fh
+    """Open (``mode``, ``kwargs`` as :func:`open`) a temporary file that replaces ``target``
+    if the block succeeds (:func:`atomic_path`)."""
+    with atomic_path(target) as tmp, open(tmp, mode, **kwargs) as fh:
+        yield fh
 
 
 _NONFINITE_CELL = re.compile(r"^(?!#)(?:[^\n]*,)?[ \t]*[-+]?(?:nan|inf|infinity)[ \t]*(?:,|$)",
@@ -296,8 +289,8 @@ _NONFINITE_CELL = re.compile(r"^(?!#)(?:[^\n]*,)?[ \t]*[-+]?(?:nan|inf|infinity)
 
 
 def json_text(data, path=None, indent=1, key=None) -> str:
-    """``data`` as the indented JSON text of the result files; written atomically to ``path``
-    when given (``key``: the option an error names).
+    """``data`` as indented JSON text, written atomically to ``path`` if given (``key``: the
+    option an error names).
 
     Raises
     ------
@@ -316,8 +309,8 @@ def json_text(data, path=None, indent=1, key=None) -> str:
 
 
 def write_csv(path, text: str) -> None:
-    """Write the CSV ``text`` atomically to ``path``; an empty cell stands for a missing
-    value, and ``#`` lines are comments.
+    """Write the CSV ``text`` atomically to ``path`` (empty cell: missing value; ``#`` lines:
+    comments).
 
     Raises
     ------

@@ -1,11 +1,7 @@
-"""One place to choose where independent jobs run: serially, in local processes, or on a
-dask.distributed cluster.
-
-:func:`executor` is the one executor factory (``concurrent.futures`` interface) for a
-``scheduler``: None/``"auto"``, ``"serial"``, ``"processes"``, ``"local"`` (a dask
-``LocalCluster``), ``"tcp://HOST:PORT"`` or an executor (left running); the table:
-docs/guide/parallel.md. Results do not depend on the choice: :func:`run_map` returns them in
-submission order (tests/test_parallel.py).
+"""Where independent jobs run: serially, in local processes, or on a dask.distributed
+cluster. :func:`executor` gives a ``concurrent.futures`` executor for a ``scheduler``
+(docs/guide/parallel.md); :func:`run_map` returns results in submission order whatever the
+choice.
 """
 
 from __future__ import annotations
@@ -29,9 +25,8 @@ def _threadpools():
 
 
 def single_blas_thread():
-    """Context manager limiting BLAS to one thread: the models' matrices are small (~33×33),
-    and BLAS threads cost more than they give on them. The thread pools are found once per
-    process."""
+    """Context manager limiting BLAS to one thread: on the models' small (~33×33) matrices
+    BLAS threads cost more than they give."""
     return _threadpools().limit(limits=1, user_api="blas")
 
 
@@ -62,9 +57,8 @@ def cpu_count() -> int:
 
 
 def check_scheduler(scheduler, *, reach: bool = False) -> str:
-    """Normalised scheduler name; ``InputError`` (key ``--scheduler``) if not understood
-    (``tcp://HOST:PORT`` needs a host and a port 1..65535). ``reach``: also check, before
-    any work, that a dask scheduler answers there (:func:`probe_scheduler`)."""
+    """Normalised scheduler name; InputError (key ``--scheduler``) if not understood.
+    ``reach``: also check that a dask scheduler answers (:func:`probe_scheduler`)."""
     s = "auto" if scheduler in (None, "") else str(scheduler).strip()
     if s in ("auto", "serial", "processes", "local"):
         return s
@@ -93,11 +87,9 @@ CONNECT_TIMEOUT_S = 10.0
 
 
 def probe_scheduler(address: str, timeout: float = CONNECT_TIMEOUT_S) -> None:
-    """Refuse an address where no dask scheduler answers: nothing listens, something else
-    listens (an HTTP server waits for a request, sends nothing), or it never answers.
-
-    A dask scheduler greets every new connection first: a frame header (total length, then
-    the number of frames, both unsigned 64-bit little-endian) and its handshake."""
+    """Raise InputError unless a dask scheduler answers at ``address`` within ``timeout``
+    [s]: a dask scheduler greets every connection first with a frame header (total length,
+    number of frames: unsigned 64-bit little-endian)."""
     host, port = scheduler_host_port(address)
     try:
         with socket.create_connection((host, port), timeout=timeout) as sock:
@@ -122,8 +114,8 @@ def probe_scheduler(address: str, timeout: float = CONNECT_TIMEOUT_S) -> None:
 
 @contextmanager
 def executor(scheduler=None, *, workers=None, n_jobs=None):
-    """The executor for ``scheduler`` (docs/guide/parallel.md); one this function opens is shut
-    down on exit, pending jobs cancelled if the block raised.
+    """The executor for ``scheduler``; one opened here is shut down on exit, pending jobs
+    cancelled if the block raised.
 
     Parameters
     ----------
@@ -131,16 +123,14 @@ def executor(scheduler=None, *, workers=None, n_jobs=None):
         ``None``/``"auto"``, ``"serial"``, ``"processes"``, ``"local"``,
         ``"tcp://HOST:PORT"``, or an object with ``submit`` (yielded as it is).
     workers : int, optional
-        Local processes (default: the usable cores, :func:`cpu_count`; never more than
-        ``n_jobs``).
+        Local processes (default :func:`cpu_count`, at most ``n_jobs``).
     n_jobs : int, optional
-        Number of jobs about to be submitted (``auto`` runs one job serially).
+        Jobs about to be submitted (``auto`` runs one job serially).
 
     Raises
     ------
     InputError
-        ``scheduler`` not understood (key ``--scheduler``), or ``workers`` < 1 (key
-        ``--workers``).
+        ``scheduler`` not understood, or ``workers`` < 1.
     """
     if hasattr(scheduler, "submit"):
         yield scheduler
@@ -191,12 +181,9 @@ def _dask_client(address, n):
 
 
 def run_map(fn, items, scheduler=None, *, workers=None, progress=None, unit="job"):
-    """``[fn(x) for x in items]`` on the executor of ``scheduler`` (:func:`executor`: a
-    scheduler name or address, or an executor), results in the order of ``items``.
-
-    ``progress``: a description for a tqdm bar on stderr (shown only on a terminal), counting
-    ``unit``.
-    """
+    """``[fn(x) for x in items]`` on the executor of ``scheduler`` (:func:`executor`), in the
+    order of ``items``; ``progress``: description of a tqdm bar on stderr (terminal only)
+    counting ``unit``."""
     items = list(items)
     with executor(scheduler, workers=workers, n_jobs=len(items)) as ex:
         futures = [ex.submit(fn, x) for x in items]

@@ -1,8 +1,5 @@
-"""Progress bars on stderr (tqdm), silent when stderr is not a terminal or when asked.
-
-Every command that can run longer than about two seconds shows one; ``--quiet`` switches it
-off, and so does a redirected stderr (tqdm's ``disable=None``), so logs and pipes stay clean.
-"""
+"""Progress bars on stderr (tqdm) for commands longer than about two seconds; silent with
+``--quiet`` or a redirected stderr (tqdm's ``disable=None``)."""
 
 from __future__ import annotations
 
@@ -21,11 +18,8 @@ def progress_bar(iterable=None, *, enabled: bool = True, **kwargs):
 
 @contextlib.contextmanager
 def activity(desc: str, *, enabled: bool = True, interval: float = 0.25):
-    """Elapsed-time bar for a step whose length is not known in advance.
-
-    Yields the bar; a background thread refreshes it every ``interval`` seconds so that the
-    elapsed time keeps moving while the library works.
-    """
+    """Yield an elapsed-time bar for a step of unknown length, refreshed every ``interval``
+    [s] by a background thread."""
     bar = progress_bar(None, enabled=enabled, desc=desc, total=None,
                        bar_format="{desc}: {elapsed} elapsed{postfix}")
     if bar.disable:

@@ -1,9 +1,8 @@
 """Provenance of a result: what ran, how it was asked for, with which version and when.
 
-:func:`provenance` is the record written into every HDF5 (attribute ``provenance``) and JSON
-(key ``provenance``) output (its keys: docs/reference/outputs.md); :class:`Provenance` is its
-short form, printed as one line at the foot of every figure
-(:func:`powertrain.plotting.style.add_provenance`).
+:func:`provenance` is the record in every HDF5 and JSON output (``provenance``; keys in
+docs/reference/outputs.md); :class:`Provenance` its short form, one line at the foot of every
+figure.
 """
 
 from __future__ import annotations
@@ -22,7 +21,6 @@ from powertrain import __version__
 
 #: Arrays longer than this are summarised (shape, min, max) instead of listed.
 MAX_LISTED = 64
-
 #: The command line of the running CLI command (:func:`recording_command`), or None.
 _COMMAND_LINE: contextvars.ContextVar[tuple | None] = contextvars.ContextVar(
     "powertrain_command_line", default=None)
@@ -30,8 +28,7 @@ _COMMAND_LINE: contextvars.ContextVar[tuple | None] = contextvars.ContextVar(
 
 @contextlib.contextmanager
 def recording_command(argv):
-    """Within the block, :func:`command_line` is ``argv`` (the CLI's arguments as typed,
-    program name first)."""
+    """Within the block, :func:`command_line` is ``argv`` (as typed, program name first)."""
     token = _COMMAND_LINE.set(tuple(str(a) for a in argv))
     try:
         yield
@@ -40,8 +37,8 @@ def recording_command(argv):
 
 
 def stamp_hdf5(attrs, file_format: str) -> None:
-    """The header every HDF5 file of the project carries: ``format``, ``format_version`` (1),
-    ``powertrain_version`` and ``created`` (UTC, ISO 8601) on the root attributes."""
+    """Set the root ``attrs`` of every HDF5 file: ``format`` (``file_format``),
+    ``format_version`` (1), ``powertrain_version``, ``created`` (UTC, ISO 8601)."""
     attrs["format"] = file_format
     attrs["format_version"] = 1
     attrs["powertrain_version"] = __version__
@@ -49,8 +46,7 @@ def stamp_hdf5(attrs, file_format: str) -> None:
 
 
 def command_line() -> str:
-    """The command as typed: the CLI's record (:func:`recording_command`), else
-    ``sys.argv``."""
+    """The command as typed (:func:`recording_command`, else ``sys.argv``)."""
     argv = _COMMAND_LINE.get() or ["powertrain", *sys.argv[1:]]
     return shlex.join(str(a) for a in argv)
 
@@ -87,17 +83,17 @@ def engine_as_run(engine) -> dict:
     doc = jsonable(engine)
     doc["mounts"] = [{"name": m.name, "position_m": jsonable(m.position),
                       "rotation": jsonable(m.rotation), "files": dict(m.files),
-                      "directions": {d: {"model": mdl.topology.name, "params_si": jsonable(mdl.params),
-                                         "source": mdl.source}
+                      "directions": {d: {"model": mdl.topology.name,
+                                         "params_si": jsonable(mdl.params), "source": mdl.source}
                                      for d, mdl in m.directions.items()}}
                      for m in engine.mounts]
     return doc
 
 
 def provenance(engine=None, *, engine_file=None, modifications=(), effects=None) -> dict:
-    """The provenance record of a result: ``command_line``, ``powertrain_version``,
-    ``created`` (UTC, ISO 8601) and, with ``engine``, ``engine_file``, ``engine_name``,
-    ``modifications``, ``effects`` and ``engine_as_run`` (SI)."""
+    """The provenance record: ``command_line``, ``powertrain_version``, ``created`` and, with
+    ``engine``, ``engine_file``, ``engine_name``, ``modifications``, ``effects`` and
+    ``engine_as_run`` (SI)."""
     doc = {"command_line": command_line(), "powertrain_version": __version__,
            "created": datetime.now(timezone.utc).isoformat(timespec="seconds")}
     if engine is not None:
@@ -116,16 +112,14 @@ class Provenance:
     Attributes
     ----------
     command : str
-        The command line as typed (``powertrain runup --from 1000 ...``), or a description of
-        the library call; empty when unknown.
+        The command line as typed, or a description of the library call ("" if unknown).
     engine : str
-        The engine that ran: name and file, and what was changed on the command line
-        (e.g. ``"EA888-like (engines/default.toml), balancers off"``); empty when the result
-        has no engine (a mount stiffness).
+        Name, file and changes (``"EA888-like (engines/default.toml), balancers off"``);
+        "" without an engine.
     version : str
         ``powertrain`` version.
     date : str
-        UTC date and time, ISO 8601 to the second (``2026-11-23T18:30:00Z``).
+        UTC, ISO 8601 to the second (``2026-11-23T18:30:00Z``).
     """
 
     command: str = ""
@@ -141,7 +135,7 @@ class Provenance:
 
     @classmethod
     def from_record(cls, record: dict) -> Provenance:
-        """The short form of a provenance record of :func:`provenance` (HDF5/JSON)."""
+        """The short form of a :func:`provenance` record."""
         engine = record.get("engine_name", "")
         if record.get("engine_file"):
             engine += f" ({record['engine_file']})"

@@ -1,8 +1,7 @@
-"""The one table of units accepted in data files, and conversion to SI.
+"""The table of units accepted in data files, and conversion to SI.
 
-Data files may use the datasheet units of the field (N/mm, N·s/mm, kg, bar, mm, rpm, deg);
-every quantity declares its unit and the loaders convert it once, here. Inside the package
-everything is SI: m, kg, s, N, Pa, rad.
+Data files may use datasheet units (N/mm, N·s/mm, kg, bar, mm, rpm, deg); every quantity
+declares its unit and the loaders convert it once, here. Inside the package all is SI.
 """
 
 from __future__ import annotations
@@ -13,84 +12,33 @@ from powertrain.errors import InputError
 
 #: unit string -> (dimension, factor to SI). Aliases spell the same unit differently.
 UNITS: dict[str, tuple[str, float]] = {
-    # stiffness
-    "N/m": ("stiffness", 1.0),
-    "N/mm": ("stiffness", 1e3),
-    "kN/mm": ("stiffness", 1e6),
-    # damping
-    "N*s/m": ("damping", 1.0),
-    "Ns/m": ("damping", 1.0),
-    "N·s/m": ("damping", 1.0),
-    "N*s/mm": ("damping", 1e3),
-    "Ns/mm": ("damping", 1e3),
-    "N·s/mm": ("damping", 1e3),
-    # mass
-    "kg": ("mass", 1.0),
-    "g": ("mass", 1e-3),
-    "t": ("mass", 1e3),
-    # length
-    "m": ("length", 1.0),
-    "mm": ("length", 1e-3),
-    "cm": ("length", 1e-2),
-    # volume
-    "m^3": ("volume", 1.0),
-    "cm^3": ("volume", 1e-6),
-    "L": ("volume", 1e-3),
-    # pressure
-    "Pa": ("pressure", 1.0),
-    "kPa": ("pressure", 1e3),
-    "MPa": ("pressure", 1e6),
+    "N/m": ("stiffness", 1.0), "N/mm": ("stiffness", 1e3), "kN/mm": ("stiffness", 1e6),
+    "N*s/m": ("damping", 1.0), "Ns/m": ("damping", 1.0), "N·s/m": ("damping", 1.0),
+    "N*s/mm": ("damping", 1e3), "Ns/mm": ("damping", 1e3), "N·s/mm": ("damping", 1e3),
+    "kg": ("mass", 1.0), "g": ("mass", 1e-3), "t": ("mass", 1e3),
+    "m": ("length", 1.0), "mm": ("length", 1e-3), "cm": ("length", 1e-2),
+    "m^3": ("volume", 1.0), "cm^3": ("volume", 1e-6), "L": ("volume", 1e-3),
+    "Pa": ("pressure", 1.0), "kPa": ("pressure", 1e3), "MPa": ("pressure", 1e6),
     "bar": ("pressure", 1e5),
-    # angle
-    "rad": ("angle", 1.0),
-    "deg": ("angle", math.pi / 180.0),
-    # rotational speed
-    "rad/s": ("angular_speed", 1.0),
-    "rpm": ("angular_speed", 2.0 * math.pi / 60.0),
+    "rad": ("angle", 1.0), "deg": ("angle", math.pi / 180.0),
+    "rad/s": ("angular_speed", 1.0), "rpm": ("angular_speed", 2.0 * math.pi / 60.0),
     "1/min": ("angular_speed", 2.0 * math.pi / 60.0),
     "U/min": ("angular_speed", 2.0 * math.pi / 60.0),        # Umdrehungen pro Minute
-    # moment of inertia
-    "kg*m^2": ("inertia", 1.0),
-    "kg*mm^2": ("inertia", 1e-6),
-    # mass times radius (unbalance)
-    "kg*m": ("unbalance", 1.0),
-    "kg*mm": ("unbalance", 1e-3),
-    "g*mm": ("unbalance", 1e-6),
-    # torque / moment
-    "N*m": ("torque", 1.0),
-    "Nm": ("torque", 1.0),
-    # velocity, acceleration (vibration transducers)
-    "m/s": ("velocity", 1.0),
-    "mm/s": ("velocity", 1e-3),
-    "m/s^2": ("acceleration", 1.0),
-    "m/s2": ("acceleration", 1.0),
-    "m/s²": ("acceleration", 1.0),
-    "mm/s^2": ("acceleration", 1e-3),
-    "mm/s2": ("acceleration", 1e-3),
-    "mm/s²": ("acceleration", 1e-3),
-    # displacement also accepts micrometres
-    "um": ("length", 1e-6),
-    "µm": ("length", 1e-6),
-    # electric potential (tacho pulse trains)
-    "V": ("voltage", 1.0),
-    "mV": ("voltage", 1e-3),
-    # force
-    "N": ("force", 1.0),
-    "kN": ("force", 1e3),
-    # frequency
+    "kg*m^2": ("inertia", 1.0), "kg*mm^2": ("inertia", 1e-6),
+    "kg*m": ("unbalance", 1.0), "kg*mm": ("unbalance", 1e-3), "g*mm": ("unbalance", 1e-6),
+    "N*m": ("torque", 1.0), "Nm": ("torque", 1.0),
+    "m/s": ("velocity", 1.0), "mm/s": ("velocity", 1e-3),
+    "m/s^2": ("acceleration", 1.0), "m/s2": ("acceleration", 1.0),
+    "m/s²": ("acceleration", 1.0), "mm/s^2": ("acceleration", 1e-3),
+    "mm/s2": ("acceleration", 1e-3), "mm/s²": ("acceleration", 1e-3),
+    "um": ("length", 1e-6), "µm": ("length", 1e-6),
+    "V": ("voltage", 1.0), "mV": ("voltage", 1e-3),
+    "N": ("force", 1.0), "kN": ("force", 1e3),
     "Hz": ("frequency", 1.0),
-    # time
-    "s": ("time", 1.0),
-    "ms": ("time", 1e-3),
-    # energy per mass (fuel heating value)
-    "J/kg": ("specific_energy", 1.0),
-    "MJ/kg": ("specific_energy", 1e6),
-    # temperature (absolute only)
-    "K": ("temperature", 1.0),
-    # dimensionless
-    "1": ("dimensionless", 1.0),
-    "-": ("dimensionless", 1.0),
-    "%": ("dimensionless", 1e-2),
+    "s": ("time", 1.0), "ms": ("time", 1e-3),
+    "J/kg": ("specific_energy", 1.0), "MJ/kg": ("specific_energy", 1e6),
+    "K": ("temperature", 1.0),                                # absolute only
+    "1": ("dimensionless", 1.0), "-": ("dimensionless", 1.0), "%": ("dimensionless", 1e-2),
 }
 
 #: Standard gravity [m/s^2] (CGPM 1901), the ``g`` of accelerometer data.
@@ -98,16 +46,12 @@ STANDARD_GRAVITY = 9.80665
 
 #: Symbols whose meaning depends on the dimension expected: ``g`` is a gram where a mass is
 #: expected and standard gravity where an acceleration is expected.
-UNITS_BY_DIMENSION: dict[tuple[str, str], float] = {
-    ("g", "acceleration"): STANDARD_GRAVITY,
-}
+UNITS_BY_DIMENSION: dict[tuple[str, str], float] = {("g", "acceleration"): STANDARD_GRAVITY}
 
 
 def dimension_of(unit: str, candidates=None):
-    """Dimension of ``unit``, preferring one of ``candidates`` for ambiguous symbols (``g``).
-
-    Returns None for an unknown unit.
-    """
+    """Dimension of ``unit`` (None if unknown), preferring one of ``candidates`` for
+    ambiguous symbols (``g``)."""
     for cand in candidates or ():
         if (unit, cand) in UNITS_BY_DIMENSION or UNITS.get(unit, ("",))[0] == cand:
             return cand

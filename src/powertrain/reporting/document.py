@@ -1,24 +1,14 @@
-"""The report as one self-contained HTML document: the summary first (engine, files with
-provenance and SHA-256, verdict, top gaps), then one section per step with its tables and
-figures, then the commands and versions that reproduce it.
-
-Nothing is fetched (figures are PNG data URIs, the style sheet is inline, the content
-security policy forbids every other source) and no script is needed or allowed; the print
-rules of :data:`powertrain.results.html.STYLE` give A4 pages on which no figure is cut.
+"""The report as one self-contained HTML document: the summary (engine, files with provenance
+and SHA-256, verdict, top gaps), a section per step with its tables and figures, and the
+commands and versions that reproduce it. Nothing is fetched (data-URI figures, inline style,
+a content security policy forbidding every other source), no script runs; the print rules of
+:data:`powertrain.results.html.STYLE` give A4 pages.
 """
 
 from __future__ import annotations
 
 from powertrain.reporting.steps import STEPS, shown
-from powertrain.results.html import (
-    STYLE,
-    esc,
-    figure_html,
-    number,
-    paragraph,
-    synthetic_mark,
-    table,
-)
+from powertrain.results.html import STYLE, esc, figure_html, number, paragraph, synthetic_mark, table
 
 #: Sources the document may use: inline style, images from data URIs; nothing else.
 CSP = "default-src 'none'; img-src data:; style-src 'unsafe-inline'"
@@ -35,7 +25,7 @@ def document(title: str, body: str) -> str:
 
 
 def body(rep, provenance) -> str:
-    """The report's content: header, summary, the steps' sections (figures drawn with
+    """The content of report ``rep``: header, summary, the steps' sections (figures with
     ``provenance`` at their foot), reproduction."""
     parts = [f"<h1>{esc(rep.study.title)}</h1>",
              paragraph(f"Correlation report of study {shown(rep.study.path)}; powertrain "

@@ -1,6 +1,6 @@
-"""Values of a study file checked one key at a time: every error is one line naming the study
-file and the key (``compare.solver``), and an error of a library function that names only an
-option (``--scale``) is re-raised naming the study file and the step's key instead."""
+"""Values of a study file checked one key at a time: each error is one line naming the study
+file and the key (``compare.solver``); a library error naming only an option (``--scale``)
+is re-raised naming the study file and the step's key."""
 
 from __future__ import annotations
 
@@ -14,8 +14,8 @@ from powertrain.errors import InputError
 
 @dataclass(frozen=True)
 class Where:
-    """The study file being read: its path, its folder (paths in it are relative to that)
-    and the engine it names (for checks that need the model)."""
+    """The study file being read: its path, its folder (base of its relative paths) and its
+    engine."""
 
     path: str
     base: Path
@@ -103,9 +103,8 @@ def existing(name: str, where: Where, key: str) -> str:
 
 
 def restated(exc: InputError, where: Where, step: str) -> InputError:
-    """An error of a library function, naming the study file and ``step``'s key where it
-    named only an option (``--scale`` -> ``whatif.scale``); errors naming a file of their
-    own (a measured file, a variants file) stay as they are."""
+    """``exc`` naming the study file and ``step``'s key where it named only an option
+    (``--scale`` -> ``whatif.scale``); an error naming its own file stays as it is."""
     if exc.file is not None:
         return exc
     option = (exc.key or "").lstrip("-").replace("-", "_")

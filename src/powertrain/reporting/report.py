@@ -1,6 +1,5 @@
-"""``pt.report`` / ``powertrain report``: run a study file's steps through the library's
-functions and write them as one self-contained HTML report
-(:mod:`powertrain.reporting.document`)."""
+"""``pt.report`` / ``powertrain report``: run a study file's steps through the library and
+write one self-contained HTML report."""
 
 from __future__ import annotations
 
@@ -55,25 +54,22 @@ def report(study, out=None, *, progress: bool = False) -> ReportResult:
     Parameters
     ----------
     study : str or Path
-        Study file (TOML; docs/reference/study-file.md): the engine, the measured run-up or a
-        plan, and the steps (``[compare]``, ``[diagnose]``, ``[whatif]``, ``[modes]``,
-        ``[transient]``).
+        Study file (TOML, docs/reference/study-file.md): engine, measured run-up or plan, and
+        the steps (``[compare]``, ``[diagnose]``, ``[whatif]``, ``[modes]``, ``[transient]``).
     out : str or Path, optional
-        HTML file written (atomically) when given.
+        HTML file written atomically.
     progress : bool
-        Progress bars of the steps that show one.
+        Show the steps' progress bars.
 
     Returns
     -------
     ReportResult
-        ``to_text()`` is the summary the command prints; ``to_html()`` the document;
-        ``save(path)`` writes ``.html`` (or the first step's figure as ``.png``).
 
     Raises
     ------
     InputError
-        A bad study file (one line naming it and the key), a file it names that cannot be
-        read, an output path that cannot be written; no file is written then.
+        A bad study file (naming the key), an unreadable file it names, an unwritable output;
+        nothing is written then.
     """
     t0 = time.perf_counter()
     path = check_study_path(study)
@@ -93,10 +89,9 @@ def report(study, out=None, *, progress: bool = False) -> ReportResult:
                                                     for role, f in s.files],
                        versions=_versions(), created=_now(), out=str(out or ""),
                        seconds=time.perf_counter() - t0)
-    prov = Provenance.now(command=rep.command(), engine=f"{s.engine.name} "
-                                                         f"({shown(s.engine.file)})")
-    html = document.body(rep, prov)
-    rep = replace(rep, body=html, seconds=time.perf_counter() - t0)
+    prov = Provenance.now(command=rep.command(),
+                          engine=f"{s.engine.name} ({shown(s.engine.file)})")
+    rep = replace(rep, body=document.body(rep, prov), seconds=time.perf_counter() - t0)
     if out is not None:
         rep.to_html(out)
     return rep
@@ -112,26 +107,25 @@ def _check_out(out) -> None:
 
 @dataclass(frozen=True)
 class ReportResult(Result):
-    """A study's report: the study, each step's results, the files read with their hashes,
-    the versions, and the HTML body.
+    """A study's report: the study, each step's results, the files read, the versions and
+    the HTML body.
 
     Attributes
     ----------
     study : Study
     parts : dict
-        Step name -> ``[(label, result)]`` (one part per measured run where the step
-        compares with measurements).
+        Step name -> ``[(label, result)]`` (one per measured run for comparing steps).
     files : list of FileRecord
     versions : dict
         Package -> version (also Python and the platform).
     created : str
-        UTC date and time, ISO 8601.
+        UTC, ISO 8601.
     out : str
-        The file the report was written to ("" when none was given).
+        The report file ("" if none).
     body : str
-        The HTML content (a ``.pt-report`` block; :meth:`to_html` wraps it).
+        The HTML content (a ``.pt-report`` block).
     seconds : float
-        Wall-clock time of the study and the document [s].
+        Wall-clock time [s].
     """
 
     study: Study
@@ -163,10 +157,9 @@ class ReportResult(Result):
         return "No measurement compared in this study."
 
     def top_gaps(self, n: int = TOP_GAPS) -> list:
-        """The ``n`` channel-quantities with the largest RMS gap [dB], largest first: from
-        the comparison (every run), else from the diagnosis's gap map; each a dict with
-        ``run``, ``mount``, ``direction``, ``quantity``, ``rms_db``, ``bias_db``,
-        ``max_abs_db`` (and ``rpm_at_max_abs_db`` from a comparison) and ``from``."""
+        """The ``n`` channel-quantities with the largest RMS gap [dB] from the comparison
+        (else the diagnosis), largest first, as dicts (``run``, ``mount``, ``direction``,
+        ``quantity``, ``rms_db``, ``bias_db``, ``max_abs_db``, ``from``...)."""
         rows = []
         for label, r in self.parts.get("compare", []):
             rows += [{"run": label or "-", "mount": c.mount, "direction": c.direction,
@@ -178,8 +171,7 @@ class ReportResult(Result):
         return sorted(rows, key=lambda g: -g["rms_db"])[:n]
 
     def to_text(self) -> str:
-        """The summary ``powertrain report`` prints: study, engine, measurement, verdict,
-        top gaps, steps."""
+        """What ``powertrain report`` prints."""
         s = self.study
         lines = [f"study: {shown(s.path)}: {s.title}",
                  f"engine: {s.engine.name} ({shown(s.engine.file)})"]
@@ -203,16 +195,14 @@ class ReportResult(Result):
         return text
 
     def _repr_html_(self) -> str:
-        """The report's content (Jupyter shows it)."""
         return styled(self.body)
 
     def writers(self) -> dict:
-        """``.html`` (:meth:`to_html`), ``.htm``, ``.png`` (the first step's figure)."""
+        """``.html``, ``.htm``, ``.png`` (the first step's figure)."""
         return {".html": self.to_html, ".htm": self.to_html, **super().writers()}
 
     def plot(self, ax=None, *, path=None, step=None, provenance=None):
-        """The figure of one step's result (default the first step of the report; the first
-        run of a plan): its own ``plot`` with ``ax``, ``path`` and ``provenance``."""
+        """The figure of ``step``'s (default: the first step's) first result."""
         name = next(iter(self.parts)) if step is None else step
         if name not in self.parts:
             raise InputError(f"no step {name!r} in this report (steps: "
@@ -221,8 +211,7 @@ class ReportResult(Result):
 
 
 def _record(role: str, path: str, synthetic=frozenset()) -> FileRecord:
-    """The hash, size and first comment lines of one file (SYNTHETIC when its real path is
-    in ``synthetic``: a measurement that says it is synthetic)."""
+    """Hash, size and first comment lines of a file."""
     digest = hashlib.sha256()
     try:
         with open(path, "rb") as fh:
@@ -239,8 +228,7 @@ def _record(role: str, path: str, synthetic=frozenset()) -> FileRecord:
 
 
 def _first_comment(text: str) -> str:
-    """The first block of ``#`` comment lines of a text, joined, cut to
-    :data:`MAX_COMMENT` characters ("" when it has none)."""
+    """The first block of ``#`` comment lines, joined, cut to :data:`MAX_COMMENT` characters."""
     block = []
     for line in text.splitlines():
         if line.startswith("#"):

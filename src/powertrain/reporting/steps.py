@@ -1,7 +1,6 @@
 """The steps a study may include (``[compare]``, ``[diagnose]``, ``[whatif]``, ``[modes]``,
-``[transient]``), each run through the library's own function and shown as a section of the
-report. A kind of step is one :class:`Step` entry in :data:`STEPS`; the study reader, the
-summary and the document take every entry as it is.
+``[transient]``), each run through the library's own function and shown as a report section;
+each kind is one :class:`Step` in :data:`STEPS`.
 """
 
 from __future__ import annotations
@@ -38,21 +37,20 @@ class Step:
     title : str
         Section heading.
     options : callable
-        ``options(table, where)``: the step's table checked (:mod:`powertrain.reporting.keys`),
-        as the keyword arguments ``run`` and ``commands`` take.
+        ``options(table, where)``: the step's table checked, as ``run`` and ``commands`` take.
     run : callable
-        ``run(study, options, progress)``: ``[(label, result)]``, one part per measured run
-        where the step compares with measurements, else one part with an empty label.
+        ``run(study, options, progress)``: ``[(label, result)]``, one per measured run for a
+        comparing step, else one with an empty label.
     figures : callable
         ``figures(result, provenance)``: ``[(caption, draw)]``, ``draw()`` returning a figure.
     html : callable
-        ``html(result)``: the result's tables (what its ``_repr_html_`` shows).
+        ``html(result)``: the result's tables.
     commands : callable
-        ``commands(study, options)``: command lines (or Python lines) that repeat the step.
+        ``commands(study, options)``: command (or Python) lines that repeat the step.
     needs_measured : bool
-        The step compares with a measurement (the study must name one).
+        The step needs a measurement.
     cost : int
-        Run order, cheapest first (a bad key of a quick step fails before a long one runs).
+        Run order, cheapest first.
     """
 
     title: str
@@ -66,7 +64,7 @@ class Step:
 
 
 def shown(path) -> str:
-    """A path as the commands name it: relative to the current folder when inside it."""
+    """``path`` as the commands name it: relative to the current folder when inside it."""
     try:
         rel = os.path.relpath(path)
     except ValueError:                  # another drive (Windows)
@@ -92,7 +90,6 @@ def _noise_words(study) -> list:
     return [] if study.noise_floor == default else ["--noise-floor", f"{study.noise_floor * 1e3:g}"]
 
 
-# ------------------------------------------------------------------ compare
 def _compare_options(table, where) -> dict:
     k.check_keys(table, ("solver", "step"), where, "compare")
     return {"solver": k.choice(table, "solver", where, "compare", tuple(SOLVERS), "newmark"),
@@ -120,7 +117,6 @@ def _compare_commands(study, opts) -> list:
     return lines
 
 
-# ------------------------------------------------------------------ diagnose
 def _diagnose_options(table, where) -> dict:
     k.check_keys(table, ("effects", "pairs"), where, "diagnose")
     effects = [e.strip() for item in k.strings(table, "effects", where, "diagnose")
@@ -129,8 +125,8 @@ def _diagnose_options(table, where) -> dict:
         if e not in EFFECTS:
             raise where.error(f"unknown effect {e!r} (known: {', '.join(EFFECTS)})",
                               "diagnose.effects")
-    return {"effects": effects or None, "pairs": k.boolean(table, "pairs", where, "diagnose",
-                                                             True)}
+    return {"effects": effects or None,
+            "pairs": k.boolean(table, "pairs", where, "diagnose", True)}
 
 
 def _diagnose_run(study, opts, progress) -> list:
@@ -159,7 +155,6 @@ def _diagnose_commands(study, opts) -> list:
                    *_noise_words(study)])]
 
 
-# ------------------------------------------------------------------ what-if
 def _whatif_options(table, where) -> dict:
     allowed = ("variants", *WHATIF_OPERATIONS, "target", "from", "to", "step", "solver",
                "workers", "measured")
@@ -225,7 +220,6 @@ def _shown_swap(spec: str) -> str:
     return f"{node}={shown(path)}"
 
 
-# ------------------------------------------------------------------ modes
 def _modes_options(table, where) -> dict:
     k.check_keys(table, ("static",), where, "modes")
     return {"static": k.boolean(table, "static", where, "modes", False)}
@@ -240,7 +234,6 @@ def _modes_commands(study, opts) -> list:
                    *(["--static"] if opts["static"] else [])])]
 
 
-# ------------------------------------------------------------------ transient
 def _transient_options(table, where) -> dict:
     k.check_keys(table, ("manoeuvres", "seat"), where, "transient")
     files = k.strings(table, "manoeuvres", where, "transient")

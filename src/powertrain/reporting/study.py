@@ -1,8 +1,6 @@
-"""Reading a study file (TOML; every key in docs/reference/study-file.md): the engine, the
-measured run-up or a plan, the noise floor and one table per step. Paths are relative to the
-study file, as in a plan. A step is included when its table is there (an empty table: its
-defaults). Everything is checked, and every file read, before any step runs; a bad study file
-is one line naming it and the key.
+"""Reading a study file (TOML, docs/reference/study-file.md): engine, measured run-up or plan,
+noise floor and one table per step (present table: step included, empty: its defaults).
+Paths are relative to the study file. All is checked and read before any step runs.
 """
 
 from __future__ import annotations
@@ -21,13 +19,13 @@ from powertrain.reporting.steps import STEPS
 
 #: Keys of the top level of a study file besides the steps' tables.
 TOP_KEYS = ("title", "engine", "measured", "plan", "noise_floor")
-#: Default RMS noise floor of the measured order curves [m/s] (that of compare and diagnose).
+#: Default RMS noise floor of the measured order curves [m/s] (as compare and diagnose).
 DEFAULT_NOISE_FLOOR = 1e-6
 
 
 @dataclass(frozen=True)
 class Study:
-    """A study file as read: the engine, the measurement, the steps and their options.
+    """A study file as read: engine, measurement, steps and their options.
 
     Attributes
     ----------
@@ -36,18 +34,16 @@ class Study:
     title : str
     engine : Engine
     engine_file : str or None
-        The engine file the study names (None: the shipped default).
+        The engine file named (None: the shipped default).
     measured : MeasuredRunup or None
-        One measured run-up (``measured``).
     plan : Plan or None
-        A test plan of several run-ups (``plan``).
+        A test plan of several run-ups.
     noise_floor : float
         RMS noise floor of the measured order curves [m/s].
     steps : dict
-        Step name -> its checked options, in the order of the report
-        (:data:`~powertrain.reporting.steps.STEPS`).
+        Step name -> its checked options, in report order.
     files : list of (str, str)
-        ``(role, path)`` of every file the study reads.
+        ``(role, path)`` of every file read.
     """
 
     path: str
@@ -61,8 +57,8 @@ class Study:
     files: list = field(default_factory=list)
 
     def runs(self) -> list:
-        """``(label, measured, engine, plan run or None)`` of every measured run-up: the one
-        measured file, or each run of the plan with the engine in its operating state."""
+        """``(label, measured, engine, plan run or None)`` of every measured run-up (each plan
+        run with the engine in its operating state)."""
         if self.plan is None:
             return [] if self.measured is None else [("", self.measured, self.engine, None)]
         out = []
@@ -74,13 +70,12 @@ class Study:
 
 
 def read_study(path) -> Study:
-    """Read and check a study file; read the engine, the measurement and the plan it names.
+    """Read and check the study file ``path`` and the engine, measurement and plan it names.
 
     Raises
     ------
     InputError
-        One line naming the study file and the key (or a file it names, and that file's
-        key or line).
+        Naming the study file (or a file it names) and the key.
     """
     path = str(path)
     doc = read_toml(path)
@@ -133,8 +128,7 @@ def _noise_floor(doc, where) -> float:
 
 
 def _with_files(study: Study, where) -> Study:
-    """``study`` with ``files``: the study file, the engine and its mount files, the
-    measurement (plan, runs, pressure traces), the what-if files and the manoeuvres."""
+    """``study`` with ``files``: ``(role, path)`` of every file it reads."""
     files = [("study", study.path), ("engine", study.engine.file)]
     for m in study.engine.mounts:
         files += [(f"mount {m.name}.{d}", os.path.normpath(f)) for d, f in m.files.items()]
@@ -168,7 +162,7 @@ def _roles(roles: list) -> str:
 
 
 def check_study_path(study) -> str:
-    """``study`` as a path of a TOML file, else an :class:`InputError` naming ``STUDY``."""
+    """``study`` as the path of a TOML file, else an InputError naming ``STUDY``."""
     if not isinstance(study, (str, os.PathLike)):
         raise InputError(f"expected a study file (TOML), got {type(study).__name__}",
                          key="STUDY")

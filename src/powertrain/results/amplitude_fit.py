@@ -1,6 +1,5 @@
-"""Outcome of a multi-amplitude mount fit
-(:func:`powertrain.workflows.amplitude_fit.fit_amplitudes`): the fitted mount with its
-amplitude law and friction, and the residual per amplitude."""
+"""Outcome of a multi-amplitude mount fit: the fitted mount with its amplitude law and
+friction, and the residual per amplitude."""
 
 from __future__ import annotations
 
@@ -11,8 +10,7 @@ import numpy as np
 from powertrain.plotting.stiffness import fit_frequencies, plot_amplitude_fit
 from powertrain.plotting.style import target_and_path
 from powertrain.results.base import Result
-from powertrain.results.fit import PARAMETER_UNITS, FitResult
-from powertrain.units import from_si
+from powertrain.results.fit import FitResult, parameter_lines
 
 
 @dataclass(frozen=True)
@@ -31,13 +29,13 @@ class AmplitudeFitResult(Result):
     curves : list of MeasuredStiffness
         The data at each amplitude.
     rel_rms : tuple of float
-        Relative RMS error of the fitted model at each amplitude [1].
+        Relative RMS error at each amplitude [1].
     network_fit : FitResult
         Stage 1: the network alone at the reference amplitude.
     friction : bool
         Berg's friction element was fitted.
     success : bool
-        The best joint least-squares run met its tolerance (not the evaluation limit).
+        The best joint least-squares run converged (did not hit the evaluation limit).
     n_joint_starts, nfev : int
         Joint runs and their residual evaluations.
     time_s : float
@@ -61,14 +59,13 @@ class AmplitudeFitResult(Result):
     data_name: str = ""
 
     def kcp_fitted(self, index: int, frequency_hz=None) -> np.ndarray:
-        """K*(f) [N/m] of the fitted mount at amplitude ``index``, at its data frequencies
-        (or at ``frequency_hz`` [Hz])."""
+        """K*(f) [N/m] at amplitude ``index``, at its data frequencies or ``frequency_hz``."""
         f = self.curves[index].frequency_hz if frequency_hz is None else frequency_hz
         return self.model.element().cross_point_stiffness(f, self.amplitude_m[index])
 
     @property
     def synthetic(self) -> bool:
-        """The data file says its data are synthetic (the figure marks them SYNTHETIC)."""
+        """The data are marked synthetic (so is the figure)."""
         return any(getattr(c, "synthetic", False) for c in self.curves)
 
     def summary(self) -> str:
@@ -88,13 +85,9 @@ class AmplitudeFitResult(Result):
         return "\n".join(lines)
 
     def to_text(self) -> str:
-        """:meth:`summary` and the fitted values in datasheet units (what ``powertrain
-        fit-mount`` prints)."""
+        """What ``powertrain fit-mount`` prints: summary and values in datasheet units."""
         m = self.model
-        lines = [self.summary(), "parameters:"]
-        for p in m.topology.parameters:
-            unit = PARAMETER_UNITS[p[0]]
-            lines.append(f"  {p:>3s} = {from_si(m.params[p], unit):.6g} {unit}")
+        lines = [self.summary(), "parameters:", *parameter_lines(m)]
         law = m.amplitude_law
         lines += ["amplitude law:", f"  reference = {law.reference * 1e3:.6g} mm",
                   f"  exponent = {law.exponent:.6g}"]
@@ -114,9 +107,7 @@ class AmplitudeFitResult(Result):
 
     def plot(self, ax=None, path=None, *, form="magnitude-phase", freq_axis="log",
              provenance=None):
-        """Measured (dots) and fitted (lines) K*(f), one colour per amplitude (see
-        :func:`powertrain.plotting.stiffness.plot_amplitude_fit`; ``ax`` as for
-        :meth:`powertrain.results.stiffness.StiffnessResult.plot`)."""
+        """Measured (dots) and fitted (lines) K*(f), one colour per amplitude."""
         ax, path = target_and_path(ax, path)
         curves = []
         for i, (a, c) in enumerate(zip(self.amplitude_m, self.curves)):

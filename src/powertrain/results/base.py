@@ -1,6 +1,6 @@
-"""The protocol every result follows: ``to_text()`` (what its command prints),
-``plot(ax=None)`` (into a new figure, a Figure or SubFigure, or one Axes where the figure
-has one panel) and ``save(path)``, the writer chosen by the file's suffix."""
+"""The protocol of every result: ``to_text()`` (what its command prints), ``plot(ax=None)``
+(a new figure, a Figure or SubFigure, or one Axes for a one-panel figure) and ``save(path)``
+(writer chosen by suffix)."""
 
 from __future__ import annotations
 
@@ -15,16 +15,16 @@ HDF5_SUFFIXES = (".h5", ".hdf5")
 
 
 class Result:
-    """Base of the result classes: :meth:`save` picks the writer of a path's suffix among
-    :meth:`writers`; a subclass adds its own to the figure (``.png``)."""
+    """Base of the results: :meth:`save` picks the writer of the path's suffix among
+    :meth:`writers` (a subclass adds its own to ``.png``)."""
 
     def writers(self) -> dict:
         """File suffix (``".csv"``) -> method writing this result to a path."""
         return {".png": self.save_figure}
 
     def save(self, path) -> Path:
-        """Write the result to ``path`` in the format its suffix names (:meth:`writers`:
-        e.g. ``.csv``, ``.json``, ``.h5``, ``.png``), atomically; returns the path.
+        """Write the result to ``path`` atomically in the format of its suffix; returns
+        the path.
 
         Raises
         ------
@@ -46,8 +46,7 @@ class Result:
 
 
 class JsonResult(Result):
-    """A result with a JSON document (its ``to_dict()``): :meth:`to_json`, and ``.json``
-    among its :meth:`writers`."""
+    """A result with a JSON document (``to_dict()``), written by :meth:`to_json`."""
 
     #: Indentation of the JSON text (:func:`powertrain.outputs.json_text`).
     JSON_INDENT = 1
@@ -57,5 +56,5 @@ class JsonResult(Result):
         return json_text(self.to_dict(), path, indent=self.JSON_INDENT)
 
     def writers(self) -> dict:
-        """``.json`` (:meth:`to_json`), ``.png``."""
+        """``.json``, ``.png``."""
         return {".json": self.to_json, **super().writers()}

@@ -1,7 +1,5 @@
-r"""Result of ``powertrain compare``: per-channel level gaps and correlation metrics of a simulated
-run-up against a measured one (computed by :func:`powertrain.workflows.comparison.compare`),
-its text report, JSON and figure.
-"""
+"""Result of ``powertrain compare``: per-channel level gaps and correlation metrics of a
+simulated run-up against a measured one, as text, JSON and figure."""
 
 from __future__ import annotations
 
@@ -20,13 +18,11 @@ from powertrain.results.base import JsonResult
 from powertrain.results.html import fragment
 from powertrain.results.html_tables import comparison_html
 
-#: Quantities always expected (the thesis's comparison, sec. 4.4); any other measured order is
-#: compared too.
+#: Quantities always expected (thesis sec. 4.4); any other measured order is compared too.
 EXPECTED_QUANTITIES = ("synthesis", "order_2", "order_4")
-
 #: CSAC and CSF are computed at a speed only if at least this many channels are compared there.
 MIN_CHANNELS_CSAC = 3
-
+#: The JSON's ``definitions`` (with the metrics' sources).
 DEFINITIONS = {
     "gap_db": "20*log10(v_sim/v_meas) at each compared measured speed; positive = "
               "simulation higher",
@@ -72,13 +68,12 @@ DEFINITIONS = {
 }
 
 
-
 @dataclass(frozen=True)
 class ChannelComparison:
     """Comparison of one channel (mount, direction) and quantity.
 
-    Arrays cover all measured speeds of the channel; ``scored`` marks the compared ones.
-    Levels in m/s RMS, speeds in rpm, gaps in dB.
+    Arrays cover all measured speeds of the channel, ``scored`` marks the compared ones;
+    levels [m/s RMS], speeds [rpm], gaps [dB].
     """
 
     mount: str
@@ -103,18 +98,15 @@ class ChannelComparison:
         r = self.rpm[self.scored]
         d = {"mount": self.mount, "direction": self.direction, "quantity": self.quantity}
         d.update({k: json_number(v) for k, v in self.stats.items()})
-        d.update({
-            "n_measured": int(self.rpm.size),
-            "n_compared": int(self.scored.sum()),
-            "n_excluded_noise_floor": int(self.at_floor.sum()),
-            "n_outside_simulated_range": int(self.outside.sum()),
-            "n_simulation_zero": int(self.sim_zero.sum()),
-            "n_measured_not_modelled": int(self.not_modelled.sum()),
-            "rpm_compared": [json_number(x) for x in r],
-            "measured_m_per_s": [json_number(x) for x in self.measured[self.scored]],
-            "simulated_m_per_s": [json_number(x) for x in self.simulated[self.scored]],
-            "gap_db": [json_number(x) for x in self.gap_db],
-        })
+        d.update({"n_measured": int(self.rpm.size), "n_compared": int(self.scored.sum()),
+                  "n_excluded_noise_floor": int(self.at_floor.sum()),
+                  "n_outside_simulated_range": int(self.outside.sum()),
+                  "n_simulation_zero": int(self.sim_zero.sum()),
+                  "n_measured_not_modelled": int(self.not_modelled.sum()),
+                  "rpm_compared": [json_number(x) for x in r],
+                  "measured_m_per_s": [json_number(x) for x in self.measured[self.scored]],
+                  "simulated_m_per_s": [json_number(x) for x in self.simulated[self.scored]],
+                  "gap_db": [json_number(x) for x in self.gap_db]})
         if self.phase_gap_deg is not None:
             d["phase_gap_deg"] = [json_number(x) for x in self.phase_gap_deg]
         return d
@@ -147,18 +139,19 @@ class ComparisonResult(JsonResult):
     not_modelled : list of dict
         Measured-not-modelled points per channel and quantity: ``{"mount", "direction",
         "quantity", "rpm", "measured_m_per_s", "simulated_m_per_s"}``.
+    run : dict
+        What ran: ``engine``, ``engine_file``, ``solver``, ``simulation_file``,
+        ``simulation_seconds``, ``seconds`` (wall clock).
     """
 
     #: Quantities every comparison reports (plots draw them even when none was measured).
     EXPECTED_QUANTITIES: ClassVar[tuple] = EXPECTED_QUANTITIES
 
     def requested_quantities(self) -> list:
-        """Every quantity requested: the default three and all measured or compared ones,
-        in the measured-file order (synthesis first, then orders ascending)."""
+        """The default three and every measured or compared quantity, in file order."""
         qs = set(EXPECTED_QUANTITIES) | set(self.measured.quantities)
         qs |= {c.quantity for c in self.channels}
         return sorted(qs, key=quantity_sort_key)
-
 
     channels: list
     per_rpm: list
@@ -170,15 +163,12 @@ class ComparisonResult(JsonResult):
     sigma_db: float = cm.FRFSM_SIGMA_DB
     info: dict = field(default_factory=dict)
     not_modelled: list = field(default_factory=list)
-    #: What ran (set by :func:`~powertrain.workflows.comparison.compare`): ``engine``
-    #: (Engine or None), ``engine_file``, ``solver``, ``simulation_file`` (with a given
-    #: simulation), ``simulation_seconds`` and ``seconds`` (wall clock).
     run: dict = field(default_factory=dict)
 
     @property
     def exclusion_limit(self) -> float:
-        """Measured levels below this are excluded [m/s]: the one noise-floor rule,
-        :func:`~powertrain.analysis.noise_floor.censoring_level` of the floor."""
+        """Measured levels below this are excluded [m/s]
+        (:func:`~powertrain.analysis.noise_floor.censoring_level`)."""
         return censoring_level(self.noise_floor)
 
     @property
@@ -226,44 +216,32 @@ class ComparisonResult(JsonResult):
     def to_dict(self) -> dict:
         n_total = sum(c.rpm.size for c in self.channels)
         return {
-            "format": "powertrain-compare",
-            "format_version": 1,
-            "measured": self.measured.source,
-            "measured_synthetic": self.measured.synthetic,
+            "format": "powertrain-compare", "format_version": 1,
+            "measured": self.measured.source, "measured_synthetic": self.measured.synthetic,
             "measured_comments": list(self.measured.comments),
-            "simulated": self.simulated.source,
-            "simulated_rpm": [float(r) for r in self.sim_rpm],
+            "simulated": self.simulated.source, "simulated_rpm": [float(r) for r in self.sim_rpm],
             "notes": list(self.measured.notes) + list(self.info.get("notes", [])),
-            "noise_floor_m_per_s": self.noise_floor,
-            "noise_floor_margin": NOISE_FLOOR_MARGIN,
+            "noise_floor_m_per_s": self.noise_floor, "noise_floor_margin": NOISE_FLOOR_MARGIN,
             "noise_floor_exclusion_m_per_s": self.exclusion_limit,
             "simulated_at_measured_speeds": self.n_interpolated == 0,
-            "frfsm_sigma_db": self.sigma_db,
-            "min_channels_csac": MIN_CHANNELS_CSAC,
+            "frfsm_sigma_db": self.sigma_db, "min_channels_csac": MIN_CHANNELS_CSAC,
             "overall_rms_db": json_number(self.overall_rms_db),
             "compared": {
                 "n_channel_quantities": len(self.channels),
-                "quantities": sorted({c.quantity for c in self.channels},
-                                     key=quantity_sort_key),
+                "quantities": sorted({c.quantity for c in self.channels}, key=quantity_sort_key),
                 "n_points_measured": int(n_total),
                 **{f"n_points_{key}": int(sum(getattr(c, flag).sum() for c in self.channels))
                    for key, flag in (("compared", "scored"), ("excluded_noise_floor", "at_floor"),
                                      ("outside_simulated_range", "outside"),
                                      ("simulation_zero", "sim_zero"))},
                 "n_points_measured_not_modelled": self.n_not_modelled,
-                "n_points_interpolated": self.n_interpolated,
-            },
-            "missing": list(self.missing),
-            "measured_not_modelled": list(self.not_modelled),
-            "per_quantity": self.per_quantity(),
-            "channels": [c.to_dict() for c in self.channels],
-            "per_rpm": list(self.per_rpm),
-            "definitions": dict(DEFINITIONS),
-        }
+                "n_points_interpolated": self.n_interpolated},
+            "missing": list(self.missing), "measured_not_modelled": list(self.not_modelled),
+            "per_quantity": self.per_quantity(), "channels": [c.to_dict() for c in self.channels],
+            "per_rpm": list(self.per_rpm), "definitions": dict(DEFINITIONS)}
 
     def worst_first(self) -> list:
-        """The compared channels and quantities (:class:`ChannelComparison`) sorted by RMS
-        gap, largest first (:attr:`channels` keeps the files' order)."""
+        """The compared channels and quantities by RMS gap, largest first."""
         return sorted(self.channels, key=lambda c: -c.stats["rms_db"])
 
     def table(self) -> str:
@@ -290,9 +268,7 @@ class ComparisonResult(JsonResult):
                 f"{len(self.missing)} missing; {self.run.get('seconds', 0.0):.2f} s")
 
     def to_text(self, written=()) -> str:
-        """The report ``powertrain compare`` prints: sources, rules, the per-channel table
-        (worst first), per-quantity lines, what was not compared, the summary line; the
-        files in ``written`` are named at its end."""
+        """What ``powertrain compare`` prints, naming the files ``written``."""
         lines = self._sources() + ["", "per channel, worst first:", self.table(), "",
                                    "per quantity (CSAC/CSF across the channels at each "
                                    "speed, RMS magnitudes):"]
@@ -307,7 +283,6 @@ class ComparisonResult(JsonResult):
         return "\n".join(lines)
 
     def _repr_html_(self) -> str:
-        """HTML tables of this result (Jupyter shows them; :mod:`powertrain.results.html`)."""
         return fragment(comparison_html(self))
 
     def _sources(self) -> list:
@@ -324,8 +299,7 @@ class ComparisonResult(JsonResult):
         return lines
 
     def _phase_lines(self) -> list:
-        """The phase and complex gaps of the channels with phase on both sides (no lines
-        without)."""
+        """The phase and complex gaps of the channels with phase on both sides."""
         phased = [c for c in self.worst_first() if c.stats.get("n_phase_compared")]
         if not phased:
             return []
@@ -339,7 +313,7 @@ class ComparisonResult(JsonResult):
                                "complex dB", "complex °"], rows)]
 
     def _not_modelled_lines(self) -> list:
-        """The measured-not-modelled points, per channel and quantity (not in any dB gap)."""
+        """The measured-not-modelled points, per channel and quantity."""
         if not self.not_modelled:
             return []
         lines = ["", f"measured, not modelled (simulation below the {self.noise_floor * 1e3:g} "
@@ -352,24 +326,18 @@ class ComparisonResult(JsonResult):
 
     def plot(self, ax=None, *, path=None, quantities=None, channel=None, quantity=None,
              provenance=None, phase=True):
-        """Measured vs simulated curves, gap shaded (thesis layout, Figs 45-71), a row per
-        channel and a column per quantity (every measured one unless ``quantities`` says
-        otherwise), the order phase under the channels with phase on both sides
-        (``phase``). Returns the figure.
-
-        ``ax``: None (a new figure), a Figure or SubFigure, or one Axes where ``channel``
-        ((mount, direction)) and ``quantity`` leave one panel and no phase panel is drawn
-        under it (``phase=False``); else an InputError saying to pass a Figure. See
-        :func:`powertrain.plotting.plot_comparison`.
-        """
+        """Measured vs simulated curves, gap shaded (thesis Figs 45-71), a row per channel, a
+        column per quantity (default: every measured one), the phase below where both sides
+        give it (``phase``); returns the figure (:func:`powertrain.plotting.plot_comparison`).
+        ``ax``: None, a Figure or SubFigure, or one Axes where ``channel`` and ``quantity``
+        leave one panel and ``phase=False``."""
         ax, path = target_and_path(ax, path)
         return plot_comparison(self, path, quantities, ax=ax, channel=channel,
-                               quantity=quantity, phase=phase,
-                               provenance=provenance)
+                               quantity=quantity, phase=phase, provenance=provenance)
 
 
 def _quantity_line(pq) -> str:
-    """One line of the per-quantity summary of :meth:`ComparisonResult.to_text`."""
+    """One line of the per-quantity summary."""
     line = f"  {pq['quantity']:<10} rms {pq['rms_db']:.2f} dB, bias {pq['bias_db']:+.2f} dB"
     if pq["n_rpm_with_csac"]:
         return line + (f"; CSAC mean {pq['csac_mean']:.3f} (min {pq['csac_min']:.3f} at "
@@ -379,8 +347,8 @@ def _quantity_line(pq) -> str:
 
 
 def missing_lines(missing) -> list:
-    """``MOUNT DIRS: QUANTITIES: reason``, one line per mount and reason: the directions with
-    the same quantities and reason share a line (every entry stays in the JSON)."""
+    """``MOUNT DIRS: QUANTITIES: reason`` lines; directions with the same quantities and
+    reason share a line (``missing``: ``{"mount", "direction", "quantity", "reason"}``)."""
     groups = {}                                     # (mount, reason, direction) -> quantities
     for m in missing:
         groups.setdefault((m["mount"], m["reason"], m["direction"]), []).append(m["quantity"])

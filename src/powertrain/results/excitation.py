@@ -1,6 +1,5 @@
 """What drives the powertrain at one speed (``powertrain excitation``): the
-:class:`~powertrain.models.engine.Excitation` over one engine cycle with the engine it came
-from, its text summary, CSV and figure."""
+:class:`~powertrain.models.engine.Excitation` over one engine cycle, as text, CSV and figure."""
 
 from __future__ import annotations
 
@@ -34,8 +33,7 @@ class ExcitationResult(Result):
     engine: object
 
     def to_text(self) -> str:
-        """Per-cylinder peak pressure and IMEP, mean torque, load orders (what ``powertrain
-        excitation`` prints)."""
+        """What ``powertrain excitation`` prints: peak pressures, IMEP, torque, load orders."""
         exc, engine = self.excitation, self.engine
         lines = [f"engine: {engine.name}",
                  f"speed {exc.rpm:g} rpm, balancer shafts "
@@ -79,16 +77,15 @@ class ExcitationResult(Result):
         return "\n".join([",".join(header)] + rows) + "\n"
 
     def to_csv(self, path) -> None:
-        """Write :meth:`csv_text` atomically (:func:`powertrain.outputs.write_csv`)."""
+        """Write :meth:`csv_text` atomically."""
         write_csv(path, self.csv_text())
 
     def writers(self) -> dict:
-        """``.csv`` (:meth:`to_csv`), ``.png``."""
+        """``.csv``, ``.png``."""
         return {".csv": self.to_csv, **super().writers()}
 
     def plot(self, ax=None, *, path=None, provenance=None):
-        """Summary figure of six panels (see :func:`powertrain.plotting.plot_excitation`);
-        ``ax``: None (a new figure), a Figure or SubFigure (one Axes: an InputError saying to
-        pass a Figure); returns the figure."""
+        """Six-panel summary figure (:func:`powertrain.plotting.plot_excitation`); ``ax``:
+        None, a Figure or SubFigure; returns the figure."""
         ax, path = target_and_path(ax, path)
         return plot_excitation(self.excitation, path, ax=ax, provenance=provenance)

@@ -1,5 +1,5 @@
-"""Outcome of a mount parameter identification
-(:func:`powertrain.workflows.fitting.fit_mount`): the fitted model, its error and the effort."""
+"""Outcome of a mount parameter identification (:func:`powertrain.workflows.fitting.fit_mount`):
+the fitted model, its error and the effort."""
 
 from __future__ import annotations
 
@@ -34,30 +34,25 @@ class FitResult(Result):
         Thesis objective :math:`f_{obj}` (eq. 19) of the fitted model [N].
     rel_rms : float
         Relative RMS error :math:`\\varepsilon` of the fitted model [1].
-    n_starts : int
-        Starting points screened.
-    n_polished : int
-        Screened starts run to convergence.
+    n_starts, n_polished : int
+        Starting points screened, and those run to convergence.
     success : bool
-        The best polishing run met a convergence tolerance (not the evaluation limit).
-    polish_success : tuple of bool
-        Convergence flag of each polishing run.
-    polish_rel_rms : tuple of float
-        :math:`\\varepsilon` reached by each polishing run (spread = multi-modality).
-    n_hops : int
-        Perturbations of the incumbent tried.
-    hops_accepted : int
-        Perturbations that improved the fit.
+        The best polishing run converged (did not hit the evaluation limit).
+    polish_success, polish_rel_rms : tuple
+        Convergence flag and :math:`\\varepsilon` of each polishing run (spread =
+        multi-modality).
+    n_hops, hops_accepted : int
+        Perturbations of the incumbent tried, and those that improved the fit.
     time_s : float
-        Wall-clock time of the fit [s].
+        Wall-clock time [s].
     nfev : int
         Model evaluations (K_CP and Jacobian together).
     seed : int or None
         Seed of the starting points.
     data_name : str
-        Name of the file the data came from ("" for arrays).
+        The data's file ("" for arrays).
     synthetic : bool
-        The data file says its data are synthetic (the figure marks them SYNTHETIC).
+        The data are marked synthetic (so is the figure).
     """
 
     model: MountModel
@@ -91,17 +86,11 @@ class FitResult(Result):
                 f"{self.n_starts} starts screened, {self.n_polished} polished, "
                 f"{self.hops_accepted} of {self.n_hops} hops accepted, "
                 f"{'converged' if self.success else 'evaluation limit reached'}, "
-                f"{self.nfev} evaluations, "
-                f"{self.time_s:.2f} s")
+                f"{self.nfev} evaluations, {self.time_s:.2f} s")
 
     def to_text(self) -> str:
-        """:meth:`summary` and the fitted parameters in datasheet units (what
-        ``powertrain fit-mount`` prints)."""
-        lines = [self.summary(), "parameters:"]
-        for p in self.model.topology.parameters:
-            unit = PARAMETER_UNITS[p[0]]
-            lines.append(f"  {p:>3s} = {from_si(self.model.params[p], unit):.6g} {unit}")
-        return "\n".join(lines)
+        """What ``powertrain fit-mount`` prints: summary and parameters in datasheet units."""
+        return "\n".join([self.summary(), "parameters:", *parameter_lines(self.model)])
 
     def file_comment(self) -> str:
         """The comment of the fitted mount file: data, error, starts and seed."""
@@ -115,11 +104,8 @@ class FitResult(Result):
     def plot(self, ax=None, path=None, *, form="magnitude-phase", freq_axis="log",
              provenance=None):
         """Measured and fitted K*(f) [N/mm]: |K*| and loss angle (datasheets, ISO 10846) or
-        real and imaginary part (``form="real-imag"``, the thesis), over ``log`` or
-        ``linear`` frequency; returns the figure (see
-        :func:`powertrain.plotting.plot_mount_fit`). ``ax`` as for
-        :meth:`powertrain.results.stiffness.StiffnessResult.plot`; ``save(path)`` writes the
-        figure (``.png``)."""
+        real and imaginary part (``form="real-imag"``, the thesis) over ``log`` or ``linear``
+        frequency; returns the figure (:func:`powertrain.plotting.plot_mount_fit`)."""
         ax, path = target_and_path(ax, path)
         f = fit_frequencies(self.frequency_hz, freq_axis)
         return plot_mount_fit(self.frequency_hz, self.kcp_measured,
@@ -132,3 +118,10 @@ class FitResult(Result):
                               provenance=provenance, synthetic=self.synthetic)
 
 
+def parameter_lines(model) -> list:
+    """``  c1 = 12.5 N/mm`` lines: the ``model``'s parameters in datasheet units."""
+    lines = []
+    for p in model.topology.parameters:
+        unit = PARAMETER_UNITS[p[0]]
+        lines.append(f"  {p:>3s} = {from_si(model.params[p], unit):.6g} {unit}")
+    return lines

@@ -1,10 +1,9 @@
-"""HTML pieces of the results: tables, embedded figures and the style sheet shared by the
-results' ``_repr_html_`` (Jupyter) and the study report (``powertrain report``).
+"""HTML pieces shared by the results' ``_repr_html_`` (Jupyter) and ``powertrain report``:
+tables, embedded figures and the style sheet.
 
-Everything is self-contained: figures are PNG data URIs, the style sheet is inline, nothing
-is fetched and no script runs. The style is scoped to ``.pt-report`` so that a result shown
-in a notebook does not restyle the notebook; its print rules (A4, no figure or table row
-cut by a page break) apply when the report is printed to PDF.
+Self-contained: figures are PNG data URIs, the style sheet is inline, nothing is fetched, no
+script runs. The style is scoped to ``.pt-report`` (a notebook is not restyled); its print
+rules (A4, no figure or table row cut by a page break) apply when printed to PDF.
 """
 
 from __future__ import annotations
@@ -17,8 +16,7 @@ import re
 
 from powertrain.plotting.style import MAX_HEIGHT_IN, close_figure
 
-#: Resolution of the embedded figures [dots per inch]: sharp on screen and paper, and a
-#: report of a dozen figures stays at a few MB.
+#: Resolution of the embedded figures [dpi]: sharp, and a dozen figures stay a few MB.
 EMBED_DPI = 150
 #: CSS pixels per inch (fixed by CSS).
 CSS_PX_PER_IN = 96
@@ -71,8 +69,8 @@ def esc(value) -> str:
 
 
 def number(value, fmt: str = ".2f") -> str:
-    """A number formatted, ``-`` where it is None or not finite (never ``nan``; a value that
-    rounds to zero has no minus sign: ``0.00``, ``+0.00`` with a ``+`` format)."""
+    """``value`` formatted with ``fmt``; ``-`` where None or not finite, no minus sign on a
+    value that rounds to zero."""
     if value is None:
         return "-"
     try:
@@ -92,8 +90,7 @@ def _is_zero(text: str) -> bool:
 
 
 def table(header, rows, caption: str = "") -> str:
-    """An HTML table: ``header`` (strings) and ``rows`` (lists of cells; a cell that reads as
-    a number is right-aligned); cells are escaped."""
+    """An HTML table of escaped cells (``rows``: lists of cells), numbers right-aligned."""
     head = "".join(f"<th>{esc(h)}</th>" for h in header)
     body = []
     for row in rows:
@@ -117,9 +114,9 @@ def synthetic_mark(synthetic: bool) -> str:
 
 
 def figure_html(fig, caption: str, dpi: int = EMBED_DPI) -> str:
-    """A matplotlib figure as ``<figure>`` with the PNG embedded (data URI) and its caption;
-    the figure is closed. Shown at its drawn size (16 cm wide), scaled down to the tallest
-    figure an A4 page holds (:data:`~powertrain.plotting.style.MAX_HEIGHT_IN`)."""
+    """A matplotlib figure as ``<figure>``, PNG embedded, with its caption (figure closed);
+    at its drawn size, scaled down to fit an A4 page
+    (:data:`~powertrain.plotting.style.MAX_HEIGHT_IN`)."""
     w_in, h_in = (float(v) for v in fig.get_size_inches())
     buf = io.BytesIO()
     try:
@@ -136,8 +133,8 @@ def figure_html(fig, caption: str, dpi: int = EMBED_DPI) -> str:
 
 
 def fragment(inner: str) -> str:
-    """``inner`` in a ``.pt-report`` block with the style sheet: what ``_repr_html_`` returns
-    (Jupyter shows it as it is)."""
+    """``inner`` in a ``.pt-report`` block with the style sheet (what ``_repr_html_``
+    returns)."""
     return styled(f'<div class="pt-report">{inner}</div>')
 
 

@@ -1,6 +1,5 @@
-"""The HTML tables of the comparison, what-if and modes results (their ``_repr_html_`` and
-their sections of the study report): the numbers of ``to_text()``, per channel worst
-first."""
+"""HTML tables of the comparison, what-if, modes and transient results (``_repr_html_`` and
+the study report): the numbers of ``to_text()``, worst first."""
 
 from __future__ import annotations
 
@@ -11,11 +10,9 @@ from powertrain.results.html import esc, number, paragraph, synthetic_mark, tabl
 from powertrain.solvers.modes import COORDINATES
 
 
-# ------------------------------------------------------------------ compare
 def comparison_html(r) -> str:
-    """A :class:`~powertrain.results.comparison.ComparisonResult`: sources, the summary line,
-    the per-channel gaps worst first, the per-quantity metrics, phases, what was not
-    compared."""
+    """A :class:`~powertrain.results.comparison.ComparisonResult`: sources, summary,
+    per-channel gaps worst first, per-quantity metrics, phases, what was not compared."""
     meas = r.measured
     parts = [f"<p>measured: <code>{esc(meas.source)}</code>{synthetic_mark(meas.synthetic)}"
              f"<br>simulated: <code>{esc(r.simulated.source)}</code></p>",
@@ -74,11 +71,9 @@ def _missing(missing) -> list:
             for (mount, direction, reason), qs in groups.items()]
 
 
-# ------------------------------------------------------------------ what-if
 def whatif_html(r) -> str:
-    """A :class:`~powertrain.results.whatif.WhatIfResult`: the baseline, one row per variant
-    (operations, modes, overall change), then the change of every channel and quantity in
-    each variant, the channel-quantity with the largest change first."""
+    """A :class:`~powertrain.results.whatif.WhatIfResult`: baseline, one row per variant, then
+    every channel-quantity's change per variant, largest first."""
     d, rpm = r.description, r.baseline.rpm
     modes = ", ".join(f"{f:.2f}" for f in r.baseline.rigid_body_modes_hz)
     parts = [paragraph(f"baseline: {d.get('engine')} ({d.get('engine_file')}), solver "
@@ -141,10 +136,9 @@ def _mean_abs(values) -> float | None:
     return float(np.mean(ok)) if ok else None
 
 
-# ------------------------------------------------------------------ modes
 def modes_html(r) -> str:
-    """A :class:`~powertrain.results.modes.ModesResult`: the modes by frequency with their
-    damping and kinetic-energy distribution, and the torque-roll axis."""
+    """A :class:`~powertrain.results.modes.ModesResult`: modes by frequency with damping and
+    kinetic-energy distribution, and the torque-roll axis."""
     static = r.is_static()
     header = ["mode", "f [Hz]", "ζ"] + ([] if static else ["static f [Hz]", "MAC"]) \
         + ["dominant"] + [f"{c} [%]" for c in COORDINATES] + ["TRA angle [°]", "kind"]
@@ -162,11 +156,9 @@ def modes_html(r) -> str:
                         f"{t['angle_to_crank_axis_deg']:.2f}° from the crank axis"))
 
 
-# ------------------------------------------------------------------ transient
 def transient_html(r) -> str:
-    """A :class:`~powertrain.results.transient.TransientResult`: per channel the peak-to-peak
-    displacement, peak force and maximum acceleration (largest acceleration first), the
-    mounts' deflections, and the seat's ISO 2631-1 values."""
+    """A :class:`~powertrain.results.transient.TransientResult`: per-channel peaks (largest
+    acceleration first) and the seat's ISO 2631-1 values."""
     p = r.peaks()
     order = np.argsort(-p["max_acceleration"], kind="stable")
     rows = [[r.channels[k], number(p["max_acceleration"][k], ".2f"),
@@ -177,8 +169,7 @@ def transient_html(r) -> str:
     head = paragraph(f"manoeuvre {r.name} ({r.file}): {r.time[-1]:g} s, {r.time.size - 1} "
                      f"steps ({r.method}); peak crank speed {np.max(r.rpm):.0f} rpm")
     out = head + table(["channel", "max accel. [m/s²]", "at [s]", "p-p displ. [mm]",
-                        "peak force [N]"], rows,
-                       "Per channel, largest acceleration first")
+                        "peak force [N]"], rows, "Per channel, largest acceleration first")
     if r.seat is not None:
         s = r.seat
         out += table(["seat axis", "weighted RMS [m/s²]", "VDV [m/s^1.75]", "weighting"],

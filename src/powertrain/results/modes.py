@@ -1,6 +1,5 @@
-"""Rigid-body (and chassis) modes of the powertrain on its mounts: the result of
-:func:`powertrain.workflows.modes.modes` (the physics: :mod:`powertrain.solvers.modes`), with
-its text, JSON and kinetic-energy figure."""
+"""Rigid-body (and chassis) modes of the powertrain on its mounts (computed by
+:mod:`powertrain.solvers.modes`), as text, JSON and kinetic-energy figure."""
 
 from __future__ import annotations
 
@@ -22,12 +21,8 @@ class Mode:
 
     Attributes
     ----------
-    frequency_hz : float
-        Natural frequency |s|/2π [Hz].
-    damping_ratio : float
-        −Re s/|s| [-] (0 for the static method).
-    damped_frequency_hz : float
-        Im s/2π [Hz].
+    frequency_hz, damping_ratio, damped_frequency_hz : float
+        |s|/2π [Hz], −Re s/|s| [-] (0 for the static method), Im s/2π [Hz].
     shape : ndarray complex (6,)
         ``[x, y, z, rx, ry, rz]`` at the CG [m, rad], largest-energy entry real positive,
         unit modal mass.
@@ -38,16 +33,14 @@ class Mode:
     kind : str
         ``rigid-body`` or ``chassis``.
     iterations : int
-        Iterations taken to find the mode: 0, every mode comes from one eigensolve
-        (:func:`powertrain.solvers.modes.state_space_eigenvalues`).
+        0: all modes come from one eigensolve.
     body_energy_percent : float
-        Share of the mode's kinetic energy in the body modes of a modal chassis [%].
+        Share of the kinetic energy in the body modes of a modal chassis [%].
     static_frequency_hz : float
-        Frequency of the undamped static-stiffness mode of the most similar shape (paired
-        one to one by the modal assurance criterion; the frequency itself for the static
-        method) [Hz].
+        Frequency of the undamped static-stiffness mode paired to this one by the modal
+        assurance criterion (its own for the static method) [Hz].
     static_mac : float
-        Modal assurance criterion between this mode's shape and that static mode's [-].
+        MAC between this mode's shape and that static mode's [-].
     """
 
     frequency_hz: float
@@ -69,14 +62,12 @@ class Mode:
     def to_dict(self) -> dict:
         shape = self.shape.real
         return {"frequency_hz": float(self.frequency_hz),
-                "damping_ratio": float(self.damping_ratio),
-                "dominant": self.dominant,
+                "damping_ratio": float(self.damping_ratio), "dominant": self.dominant,
                 "ked_percent": {c: float(v) for c, v in zip(COORDINATES, self.ked_percent)},
                 "damped_frequency_hz": float(self.damped_frequency_hz),
                 "angle_to_torque_roll_axis_deg": number_or_null(
                     self.angle_to_torque_roll_axis_deg),
-                "shape": {c: float(v) for c, v in zip(COORDINATES, shape)},
-                "kind": self.kind,
+                "shape": {c: float(v) for c, v in zip(COORDINATES, shape)}, "kind": self.kind,
                 "body_energy_percent": float(self.body_energy_percent),
                 "static_frequency_hz": float(self.static_frequency_hz),
                 "static_mac": float(self.static_mac)}
@@ -95,9 +86,9 @@ class ModesResult(JsonResult):
     engine : str
         The engine's name.
     cg_m : list of float, optional
-        Centre of gravity of the powertrain [m, engine axes] (JSON key ``cg_m``).
+        Centre of gravity [m, engine axes].
     mounts : list of str, optional
-        The engine's mount names (JSON key ``mounts``).
+        The engine's mount names.
     """
 
     modes: list
@@ -112,15 +103,14 @@ class ModesResult(JsonResult):
     @classmethod
     def from_solution(cls, solution: dict, engine: str = "", *, cg_m=None,
                       mounts=None) -> ModesResult:
-        """The result of :func:`powertrain.solvers.modes.rigid_body_modes` (``engine``: the
-        engine's name, for reports and plots; ``cg_m``, ``mounts``: as the attributes)."""
+        """The result of :func:`powertrain.solvers.modes.rigid_body_modes`; the keywords
+        are the attributes."""
         return cls(modes=[Mode(**m) for m in solution["modes"]],
                    torque_roll_axis=solution["torque_roll_axis"], method=solution["method"],
                    engine=engine, cg_m=cg_m, mounts=mounts)
 
     def to_dict(self) -> dict:
-        """The JSON document: modes, torque-roll axis, method, engine, then ``cg_m`` and
-        ``mounts`` where known."""
+        """The JSON document (``cg_m`` and ``mounts`` where known)."""
         extra = {k: v for k, v in (("cg_m", self.cg_m), ("mounts", self.mounts))
                  if v is not None}
         return {"modes": [m.to_dict() for m in self.modes],
@@ -176,13 +166,10 @@ class ModesResult(JsonResult):
         return "\n".join(lines)
 
     def _repr_html_(self) -> str:
-        """HTML tables of this result (Jupyter shows them; :mod:`powertrain.results.html`)."""
         return fragment(modes_html(self))
 
     def plot(self, ax=None, *, path=None, provenance=None):
-        """Stacked kinetic-energy distribution per mode, one panel (PNG when ``path`` is
-        given); returns the figure. ``ax``: None (a new figure), an Axes, a Figure or
-        SubFigure."""
+        """Stacked kinetic-energy distribution per mode in one panel; returns the figure.
+        ``ax``: None, an Axes, a Figure or SubFigure."""
         ax, path = target_and_path(ax, path)
-        return plot_modes(self, path, ax=ax,
-                          provenance=provenance)
+        return plot_modes(self, path, ax=ax, provenance=provenance)

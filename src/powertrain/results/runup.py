@@ -1,10 +1,10 @@
 """Run-up results: order spectra of the mount channels (three per mount) against speed.
 
 Channels: every mount's engine side (``left``), with a modal or measured chassis also its
-body side (``left/passive``) and the body points of interest (``seat_rail``). Files: the HDF5
-layout (``runup --out``, all arrays SI with a ``unit`` attribute; docs/reference/outputs.md,
-the body-side datasets in docs/guide/chassis.md) and the long-format CSV (``runup --csv``,
-:data:`CSV_HEADER`; also the measured-data format, :mod:`powertrain.iotools.measured`).
+body side (``left/passive``) and the body points of interest (``seat_rail``). Files: HDF5
+(``runup --out``, SI with a ``unit`` attribute per dataset; docs/reference/outputs.md,
+docs/guide/chassis.md) and long-format CSV (``runup --csv``, :data:`CSV_HEADER`, also the
+measured-data format of :mod:`powertrain.iotools.measured`).
 """
 
 from __future__ import annotations
@@ -28,15 +28,11 @@ from powertrain.provenance import stamp_hdf5
 from powertrain.results.base import HDF5_SUFFIXES, Result
 from powertrain.solvers.modes import AS_MEASURED
 
-QUANTITIES = {
-    "displacement": "m",
-    "velocity": "m/s",
-    "acceleration": "m/s^2",
-    "mount_force": "N",
-}
+QUANTITIES = {"displacement": "m", "velocity": "m/s", "acceleration": "m/s^2",
+              "mount_force": "N"}
 #: What the run-up's rigid-body mode frequencies are (printed by ``runup`` and ``whatif``).
 RIGID_BODY_MODES_LABEL = "rigid-body modes, undamped, mounts at their static stiffness [Hz]"
-#: The same modes of an engine with amplitude laws or friction, saying which stiffness that is
+#: The same for an engine with amplitude laws or friction
 #: (:func:`powertrain.physics.condensation.condense`).
 RIGID_BODY_MODES_LABEL_AS_MEASURED = \
     f"rigid-body modes, undamped, {AS_MEASURED} at their static stiffness [Hz]"
@@ -49,9 +45,8 @@ CSV_HEADER = ("mount,direction,quantity,rpm,side,velocity_rms_mm_per_s,"
 class RunupResult(Result):
     """Order spectra of a run-up (complex peak amplitudes, SI).
 
-    Arrays ``displacement``, ``velocity``, ``acceleration``, ``mount_force`` have shape
+    ``displacement``, ``velocity``, ``acceleration``, ``mount_force`` have shape
     (n_rpm, n_channels, n_orders); ``channels`` lists (mount, direction) in engine axes.
-    Built once (a changed run-up is a new result, :func:`dataclasses.replace`);
     ``save(path)`` writes ``.csv``, ``.h5`` or ``.png``.
     """
 
@@ -68,21 +63,17 @@ class RunupResult(Result):
     solver_seconds: float = 0.0
     rigid_body_modes_hz: np.ndarray = field(default_factory=lambda: np.zeros(0))
     meta: dict = field(default_factory=dict)
-    #: complex velocity at every body-point channel per mount path (mount × local
-    #: direction), shape (n_rpm, 3 n_points, 3 n_mounts, n_orders) [m/s]; None without
-    #: body points (see :func:`powertrain.workflows.runup.path_contributions`)
+    #: velocity at every body-point channel per path (mount × local direction), shape
+    #: (n_rpm, 3 n_points, 3 n_mounts, n_orders) [m/s]; None without body points
     path_contribution: np.ndarray | None = None
     #: the static operating point per speed (:class:`~powertrain.results.static.StaticResult`)
-    #: the networks were scaled at; None when not computed
     operating_point: object = None
-    #: the engine that ran (balancers as run, before effects), when
-    #: :func:`powertrain.workflows.runup.runup` made the result; its file and mounts go into
+    #: the engine that ran (balancers as run, before effects); its file and mounts go into
     #: the HDF5 file
     engine: object = field(default=None, repr=False, compare=False)
-    #: what was changed on the engine (``balancer shafts switched off``), for the provenance
+    #: changes made to the engine (``balancer shafts switched off``), for the provenance
     modifications: list = field(default_factory=list)
 
-    # ----------------------------------------------------------------- both sides
     @property
     def mounts(self) -> list:
         """Mount names (engine-side channels), in order."""
@@ -100,8 +91,7 @@ class RunupResult(Result):
         return "passive" if name in self.points else split_side(name)[1]
 
     def isolation_db(self, mount, direction, quantity="synthesis") -> np.ndarray:
-        """Isolation of a mount: 20 log10(engine-side / body-side RMS velocity) [dB]
-        per speed (needs a non-rigid chassis)."""
+        """20 log10(engine-side / body-side RMS velocity) of a mount per speed [dB]."""
         a = self.curve(mount, direction, quantity)
         b = self.curve(passive_name(mount), direction, quantity)
         tiny = np.finfo(float).tiny
@@ -113,14 +103,13 @@ class RunupResult(Result):
         return [(m, d) for m in self.mounts for d in ("x", "y", "z")]
 
     def path_contributions(self, point, direction, order) -> np.ndarray:
-        """Complex velocity at body point ``point`` along engine ``direction`` carried by each
-        path, for ``order``: shape (n_rpm, n_paths) [m/s]; sums to the point's velocity."""
+        """Velocity at body ``point`` along engine ``direction`` carried by each path for
+        ``order``, (n_rpm, n_paths) [m/s]; sums to the point's velocity."""
         if self.path_contribution is None:
             raise KeyError("no path contributions (no body points in the chassis)")
         row = self.points.index(point) * 3 + "xyz".index(direction)
         return self.path_contribution[:, row, :, self.order_index(order)]
 
-    # ----------------------------------------------------------------- accessors
     def order_rms(self, quantity="velocity") -> np.ndarray:
         """RMS value per rpm, channel and order [SI]."""
         return order_rms(getattr(self, quantity))
@@ -146,11 +135,9 @@ class RunupResult(Result):
         order = float(quantity.split("_", 1)[1])
         return self.order_rms(signal)[:, c, self.order_index(order)]
 
-    # ----------------------------------------------------------------- text
     def to_text(self) -> str:
-        """The engine, the rigid-body modes, the effects, the synthesis RMS velocity per speed
-        and channel [mm/s] and, for a time integration, the periodicity (what ``powertrain
-        runup`` prints)."""
+        """What ``powertrain runup`` prints: engine, rigid-body modes, effects, synthesis RMS
+        velocity per speed and channel [mm/s], periodicity of a time integration."""
         name, file = self.meta.get("engine", ""), self.meta.get("engine_file", "")
         lines = [f"engine: {name} ({file})" if file else f"engine: {name}",
                  f"{self.modes_label}: {self._labelled_modes()} (damped, at the "
@@ -169,8 +156,7 @@ class RunupResult(Result):
 
     @property
     def modes_label(self) -> str:
-        """What the printed rigid-body modes are (``meta["nonlinear_mounts"]``: the engine
-        has amplitude laws or friction)."""
+        """What the printed rigid-body modes are (as measured for nonlinear mounts)."""
         return RIGID_BODY_MODES_LABEL_AS_MEASURED if self.meta.get("nonlinear_mounts") \
             else RIGID_BODY_MODES_LABEL
 
@@ -182,22 +168,18 @@ class RunupResult(Result):
                          for f, c in zip(self.rigid_body_modes_hz, coords))
 
     def synthetic_comments(self, provenance=None) -> list:
-        """``#`` lines of a CSV of a run-up with added effects (a stand-in for a measurement,
-        as ``synth`` writes): the SYNTHETIC label and the ``provenance`` line; none without
-        effects."""
+        """``#`` lines of a CSV of a run-up with added effects: the SYNTHETIC label and the
+        ``provenance`` line; none without effects."""
         effects = self.settings.get("effects")
         if not effects:
             return []
         return [f"SYNTHETIC: simulated run-up with added effects {effects_text(effects)}; "
                 "not measured"] + ([f"provenance: {provenance.line()}"] if provenance else [])
 
-    # ----------------------------------------------------------------- writers
     def csv_text(self, comments=()) -> str:
-        """Long-format CSV text: RMS velocity [mm/s], acceleration [m/s²], the force the
-        mount transmits to the body [N] and the velocity's phase [deg] per channel, side,
-        order and speed (body points have no force, synthesis rows no phase: empty cells).
-        ``comments`` become ``#`` lines above the header (a SYNTHETIC label, the
-        provenance)."""
+        """Long-format CSV: RMS velocity [mm/s], acceleration [m/s²], transmitted force [N]
+        and velocity phase [deg] per channel, side, order and speed (body points: no force,
+        synthesis rows: no phase). ``comments`` become ``#`` lines above the header."""
         phase = phase_deg(self.velocity)
         lines = [f"# {' '.join(str(c).split())}" for c in comments] + [CSV_HEADER]
         values = [(self.order_rms("velocity") * 1e3, self.synthesis_rms("velocity") * 1e3),
@@ -221,63 +203,54 @@ class RunupResult(Result):
         return "\n".join(lines) + "\n"
 
     def to_csv(self, path, comments=()) -> None:
-        """Write :meth:`csv_text` atomically (:func:`powertrain.outputs.write_csv`)."""
+        """Write :meth:`csv_text` atomically."""
         write_csv(path, self.csv_text(comments))
 
     def writers(self) -> dict:
-        """``.csv`` (:meth:`to_csv`), ``.h5``/``.hdf5`` (:meth:`to_hdf5`), ``.png``."""
+        """``.csv``, ``.h5``/``.hdf5``, ``.png``."""
         return {".csv": self.to_csv, **dict.fromkeys(HDF5_SUFFIXES, self.to_hdf5),
                 **super().writers()}
 
     def to_hdf5(self, path, *, engine_snapshot: str | None = None,
                 mount_snapshots: dict | None = None, synthetic: bool = False,
                 description: str | None = None, provenance: dict | None = None) -> None:
-        """Write the documented HDF5 layout atomically.
-
-        ``engine_snapshot`` is the engine file as read, ``mount_snapshots`` the mount models
-        as run; ``provenance`` (:func:`powertrain.provenance.provenance`) records the engine
-        as it ran (e.g. the balancers off), the effects applied, the command line, the
-        version and the time. With :attr:`engine` set, all three (and the description)
-        default to that engine's.
-        """
+        """Write the HDF5 layout atomically: ``engine_snapshot`` (engine file as read),
+        ``mount_snapshots`` (mount models as run) and ``provenance``
+        (:func:`powertrain.provenance.provenance`) default to :attr:`engine`'s."""
         import h5py  # deferred: heavy optional package
 
         snapshot, mount_snapshots, description, provenance = self._run_record(
             engine_snapshot, mount_snapshots, description, provenance)
-        with atomic_path(path) as tmp:
-            with h5py.File(tmp, "w") as h5:
-                a = h5.attrs
-                stamp_hdf5(a, "powertrain-runup")
-                a["settings"] = json.dumps(self.settings)
-                a["meta"] = json.dumps(self.meta)
-                a["engine_snapshot"] = snapshot
-                a["mount_snapshots"] = json.dumps(mount_snapshots or {})
-                a["synthetic"] = bool(synthetic)
-                a["description"] = description
-                if provenance:
-                    a["provenance"] = json.dumps(provenance, allow_nan=False)
-                    a["command_line"] = provenance.get("command_line", "")
-                    a["engine_as_run"] = json.dumps(provenance.get("engine_as_run", {}),
-                                                    allow_nan=False)
-                for key, data, unit in self._datasets():
-                    h5.create_dataset(key, data=data).attrs["unit"] = unit
-                for key, names in self._names().items():
-                    h5.create_dataset(key, data=np.array(names, dtype="S"))
-                h5["channels"].attrs["axes"] = "engine coordinate system (Kovarik 2016, sec. 4.1)"
-                if self.path_contribution is not None:
-                    h5["path_contribution/velocity"].attrs["axes"] = \
-                        "rpm, point channel, path (mount x local direction), order"
-                if self.operating_point is not None:
-                    write_operating_point(h5.create_group("operating_point"),
-                                          self.operating_point)
+        with atomic_path(path) as tmp, h5py.File(tmp, "w") as h5:
+            a = h5.attrs
+            stamp_hdf5(a, "powertrain-runup")
+            a["settings"] = json.dumps(self.settings)
+            a["meta"] = json.dumps(self.meta)
+            a["engine_snapshot"] = snapshot
+            a["mount_snapshots"] = json.dumps(mount_snapshots or {})
+            a["synthetic"] = bool(synthetic)
+            a["description"] = description
+            if provenance:
+                a["provenance"] = json.dumps(provenance, allow_nan=False)
+                a["command_line"] = provenance.get("command_line", "")
+                a["engine_as_run"] = json.dumps(provenance.get("engine_as_run", {}),
+                                                allow_nan=False)
+            for key, data, unit in self._datasets():
+                h5.create_dataset(key, data=data).attrs["unit"] = unit
+            for key, names in self._names().items():
+                h5.create_dataset(key, data=np.array(names, dtype="S"))
+            h5["channels"].attrs["axes"] = "engine coordinate system (Kovarik 2016, sec. 4.1)"
+            if self.path_contribution is not None:
+                h5["path_contribution/velocity"].attrs["axes"] = \
+                    "rpm, point channel, path (mount x local direction), order"
+            if self.operating_point is not None:
+                write_operating_point(h5.create_group("operating_point"), self.operating_point)
 
     def _run_record(self, snapshot, mounts, description, provenance):
-        """Engine file text, mount snapshots, description and provenance of the HDF5 file:
-        as given, else from :attr:`engine`."""
+        """The HDF5 file's run record: as given, else from :attr:`engine`."""
         e = self.engine
         if e is None:
             return snapshot or "", mounts, description or "", provenance
-
         if snapshot is None:
             snapshot = Path(e.file).read_text(encoding="utf-8") if e.file else ""
         if mounts is None:
@@ -293,8 +266,7 @@ class RunupResult(Result):
         return snapshot, mounts, description, provenance
 
     def _datasets(self) -> list:
-        """``(path, array, unit)`` of every numeric dataset of the HDF5 layout but the
-        operating point's."""
+        """``(path, array, unit)`` of every numeric HDF5 dataset but the operating point's."""
         out = [("rpm", self.rpm, "rpm"), ("orders", self.orders, "1")]
         for name, unit in QUANTITIES.items():
             arr = getattr(self, name)
@@ -309,8 +281,7 @@ class RunupResult(Result):
         return out
 
     def _names(self) -> dict:
-        """Path -> names of the string datasets: the channels and, with body points, the
-        points and paths of the path contributions."""
+        """Path -> names of the string datasets (channels; points and paths)."""
         out = {"channels/mount": [m for m, _ in self.channels],
                "channels/direction": [d for _, d in self.channels],
                "channels/side": [self.side(m) for m, _ in self.channels],
@@ -320,27 +291,22 @@ class RunupResult(Result):
             out["path_contribution/paths"] = [f"{m}.{d}" for m, d in self.paths]
         return out
 
-    # ----------------------------------------------------------------- plots
     def plot_paths(self, ax=None, *, path=None, order=2.0, provenance=None):
-        """Path contributions at the body points (see
-        :func:`powertrain.plotting.body.plot_path_contributions`)."""
+        """Path contributions at the body points; returns the figure."""
         ax, path = target_and_path(ax, path)
-        return plot_path_contributions(self, path, order, ax=ax,
-                                       provenance=provenance)
+        return plot_path_contributions(self, path, order, ax=ax, provenance=provenance)
 
     def plot(self, ax=None, *, path=None, quantities=("synthesis", "order_2", "order_4"),
              signal="velocity", others=None, channel=None, quantity=None, provenance=None):
-        """The thesis's figure set (Figs 45–71): one row per mount and direction, one column
-        per quantity (every one of ``quantities`` is drawn), RMS ``signal`` against rpm.
+        """The thesis's figure set (Figs 45–71): a row per mount and direction, a column per
+        one of ``quantities``, RMS ``signal`` against rpm; returns the figure
+        (:func:`powertrain.plotting.plot_runup`).
 
-        ``ax``: None (a new figure), a Figure or SubFigure (the grid is drawn in it), or one
-        Axes where ``channel`` ((mount, direction)) and ``quantity`` leave one panel (else
-        an InputError saying to pass a Figure); ``channel`` and ``quantity`` narrow the grid
-        on any target. ``others``: optional list of (label, RunupResult) overlaid;
-        ``provenance``: foot line of a new figure. Returns the figure; see
-        :func:`powertrain.plotting.plot_runup`. With a body model (body-side channels), no
-        ``others`` and no panel chosen: both sides of each mount in one panel, and the body
-        points (:func:`powertrain.plotting.body.plot_runup_both_sides`).
+        ``ax``: None, a Figure or SubFigure, or one Axes where ``channel`` ((mount,
+        direction)) and ``quantity`` leave one panel. ``others``: (label, RunupResult)
+        overlaid. With body-side channels, no ``others`` and no panel chosen: both sides of
+        each mount and the body points
+        (:func:`powertrain.plotting.body.plot_runup_both_sides`).
         """
         ax, path = target_and_path(ax, path)
         if (not others and not is_axes(ax) and channel is None and quantity is None
@@ -359,8 +325,7 @@ OPERATING_POINT = {"mean_torque": "N*m", "body": "m, m, m, rad, rad, rad",
 
 
 def write_operating_point(g, static) -> None:
-    """The operating point per speed into the HDF5 group ``g`` (layout in the module
-    docstring)."""
+    """Write the ``static`` operating point per speed into the HDF5 group ``g``."""
     g.attrs["gear_ratio"] = float(static.points[0].gear_ratio) if static.points else 1.0
     g.create_dataset("mounts", data=np.array(static.mounts, dtype="S"))
     for name, unit in OPERATING_POINT.items():
@@ -375,20 +340,19 @@ def effects_text(scenario) -> str:
 
 @dataclass(frozen=True)
 class SweepRunup(Result):
-    """A continuous run-up (one speed ramp, time-integrated): the raw recording, as a
-    measurement would give it, and its tracked order curves.
+    """A continuous run-up (one time-integrated speed ramp): the raw recording and its
+    tracked order curves.
 
     Attributes
     ----------
     recording : Recording
-        Mount-point accelerations against time, with speed (SYNTHETIC; the raw HDF5 layout
-        of :func:`powertrain.iotools.raw_hdf5.write_raw_hdf5`).
+        Mount-point accelerations and speed against time (SYNTHETIC; raw HDF5 layout of
+        :func:`powertrain.iotools.raw_hdf5.write_raw_hdf5`).
     tracked : TrackedOrders
-        Order curves tracked from it as a measurement is (COT, orders 0.5..8, velocity).
+        Order curves tracked from it (COT, orders 0.5..8, velocity).
     rate_rpm_per_s : float
         Speed ramp [rpm/s].
     engine : Engine, optional
-        The engine that ran.
     """
 
     recording: object
@@ -397,8 +361,7 @@ class SweepRunup(Result):
     engine: object = field(default=None, repr=False, compare=False)
 
     def to_text(self) -> str:
-        """What was simulated and the tracked synthesis RMS velocity at about 12 speeds
-        [mm/s] (what ``powertrain runup --sweep`` prints)."""
+        """What ``powertrain runup --sweep`` prints (about 12 speeds)."""
         tracked = self.tracked
         syn = tracked.synthesis_rms() * 1e3
         labels = [f"{c.mount}.{c.direction}" for c in tracked.channels]
@@ -410,7 +373,7 @@ class SweepRunup(Result):
                           format_table(["rpm"] + labels, rows, "{:.3f}")])
 
     def plot(self, ax=None, *, path=None, provenance=None):
-        """The tracked order curves (see :meth:`TrackedOrders.plot`); returns the figure."""
+        """The tracked order curves (:meth:`TrackedOrders.plot`); returns the figure."""
         return self.tracked.plot(ax, path=path, provenance=provenance)
 
     def to_csv(self, path) -> None:

@@ -1,7 +1,5 @@
-"""The static operating point per speed (``powertrain static``): the result of
-:func:`powertrain.workflows.static.static` (the physics:
-:mod:`powertrain.solvers.operating_point`), with its text and JSON (keys and units:
-docs/reference/json.md)."""
+"""The static operating point per speed (``powertrain static``; physics in
+:mod:`powertrain.solvers.operating_point`), as text, JSON (docs/reference/json.md) and figure."""
 
 from __future__ import annotations
 
@@ -19,8 +17,7 @@ from powertrain.units import from_si
 @dataclass(frozen=True)
 class StaticResult(JsonResult):
     """Operating points (:class:`~powertrain.solvers.operating_point.OperatingPoint`, one
-    per speed) of an engine's mounts ``mounts`` (names, in order); ``to_text()``,
-    ``to_json()``, ``plot(ax=None)``, ``save(path)`` (``.json``, ``.png``)."""
+    per speed) of the engine's ``mounts`` (names, in order)."""
 
     points: list
     mounts: list
@@ -53,16 +50,14 @@ class StaticResult(JsonResult):
                 "mounts": mounts}
 
     def plot(self, ax=None, *, path=None, provenance=None):
-        """The static deflection [mm] of every mount direction against speed, one panel;
-        returns the figure (see :func:`powertrain.plotting.body.plot_static`). ``ax``: None
-        (a new figure), an Axes, a Figure or SubFigure."""
+        """Static deflection [mm] of every mount direction against speed in one panel;
+        returns the figure (:func:`powertrain.plotting.body.plot_static`)."""
         ax, path = target_and_path(ax, path)
         return plot_static(self, path, ax=ax, provenance=provenance)
 
     def to_text(self) -> str:
-        """Per speed: the body's displacement [mm] and rotation [deg] at the CG, then each
-        mount's deflection [mm], force [N] and tangent stiffness [N/mm] per local
-        direction."""
+        """Per speed: body displacement [mm] and rotation [deg] at the CG, then each mount's
+        deflection [mm], force [N] and tangent stiffness [N/mm] per local direction."""
         blocks = [f"static operating point{f' of {self.engine}' if self.engine else ''}: "
                   "weight and mean drive-torque reaction on the mounts' static curves"]
         for p in self.points:

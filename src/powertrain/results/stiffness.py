@@ -1,5 +1,4 @@
-"""Dynamic stiffness K*(f) of a mount model in datasheet units, from either solution method
-(:func:`powertrain.workflows.stiffness.stiffness`)."""
+"""Dynamic stiffness K*(f) of a mount model in datasheet units, from either solution method."""
 
 from __future__ import annotations
 
@@ -18,8 +17,8 @@ class _Columns(Result):
     """A result of datasheet-unit columns (``columns()``) computed by ``method``."""
 
     def to_csv(self, path=None) -> str:
-        """The CSV text (datasheet units, 10 significant digits); written atomically to
-        ``path`` when given."""
+        """The CSV text (datasheet units, 10 significant digits), written atomically to
+        ``path`` if given."""
         cols = self.columns()
         rows = zip(*cols.values())
         text = "\n".join([",".join(cols)] + [",".join(f"{v:.10g}" for v in r) for r in rows])
@@ -28,7 +27,7 @@ class _Columns(Result):
         return text + "\n"
 
     def writers(self) -> dict:
-        """``.csv`` (:meth:`to_csv`), ``.png``."""
+        """``.csv``, ``.png``."""
         return {".csv": self.to_csv, **super().writers()}
 
     def to_text(self) -> str:
@@ -40,12 +39,8 @@ class _Columns(Result):
 
 @dataclass(frozen=True)
 class StiffnessResult(_Columns):
-    """K*(f) of a mount model, plus x1 and F_T for the verification set-up.
-
-    Attributes are SI; :meth:`columns` gives the datasheet-unit columns written out;
-    :meth:`to_text` the table, :meth:`summary` the short form printed with a plot,
-    :meth:`to_csv` the CSV, :meth:`plot` the figure, :meth:`save` either by suffix.
-    """
+    """K*(f) of a mount model, plus x1 and F_T for the verification set-up (SI;
+    :meth:`columns` in datasheet units)."""
 
     frequency_hz: np.ndarray
     kcp: np.ndarray                      #: cross-point stiffness [N/m]
@@ -59,13 +54,9 @@ class StiffnessResult(_Columns):
 
     def columns(self) -> dict[str, np.ndarray]:
         k = self.kcp / 1e3
-        cols = {
-            "frequency_hz": self.frequency_hz,
-            "k_real_n_per_mm": k.real,
-            "k_imag_n_per_mm": k.imag,
-            "k_abs_n_per_mm": np.abs(k),
-            "loss_angle_deg": np.degrees(np.angle(k)),
-        }
+        cols = {"frequency_hz": self.frequency_hz, "k_real_n_per_mm": k.real,
+                "k_imag_n_per_mm": k.imag, "k_abs_n_per_mm": np.abs(k),
+                "loss_angle_deg": np.degrees(np.angle(k))}
         if self.x1 is not None:
             cols["x1_real_mm"] = (self.x1 * 1e3).real
             cols["x1_imag_mm"] = (self.x1 * 1e3).imag
@@ -74,25 +65,22 @@ class StiffnessResult(_Columns):
         return cols
 
     def summary(self) -> str:
-        """What a plot reader checks first: |K*| range and the loss-angle peak, in N/mm, deg
-        (``powertrain stiffness --plot`` without ``--format``)."""
+        """|K*| range [N/mm] and loss-angle peak [deg] (``stiffness --plot`` without
+        ``--format``)."""
         f = self.frequency_hz
         return (f"# method: {self.method}; {f.size} frequencies {f[0]:g}..{f[-1]:g} Hz "
                 "(every value: --format table or csv)\n" + _ranges(self.columns()))
 
     def plot(self, ax=None, *, path=None, label=None, form="magnitude-phase", freq_axis="log",
              measured=None, provenance=None):
-        """K*(f) as |K*| and loss angle in two panels (datasheets, ISO 10846; default) or
-        real and imaginary part in one (``form="real-imag"``, the thesis), over ``log`` or
-        ``linear`` frequency; returns the figure (see
-        :func:`powertrain.plotting.plot_stiffness`). ``ax``: None (a new figure), a Figure or
-        SubFigure, a pair of Axes (magnitude-phase), or one Axes for ``real-imag`` (one Axes
-        for the two panels of magnitude-phase: an InputError saying to pass a Figure)."""
+        """K*(f) as |K*| and loss angle (datasheets, ISO 10846; default) or real and
+        imaginary part (``form="real-imag"``, the thesis) over ``log`` or ``linear``
+        frequency; returns the figure (:func:`powertrain.plotting.plot_stiffness`). ``ax``:
+        None, a Figure or SubFigure, a pair of Axes (magnitude-phase) or one (real-imag)."""
         ax, path = target_and_path(ax, path)
         name = label or self.label or "model"
         return plot_stiffness([(name, self)], path, measured=measured, ax=ax, form=form,
-                              freq_axis=freq_axis,
-                              provenance=provenance)
+                              freq_axis=freq_axis, provenance=provenance)
 
 
 def _ranges(cols) -> str:
@@ -107,11 +95,8 @@ def _ranges(cols) -> str:
 @dataclass(frozen=True)
 class AmplitudeStiffnessResult(_Columns):
     """K*(f, X) of the sinusoidal displacement test at several amplitudes X (``powertrain
-    stiffness --amplitude``): one :class:`StiffnessResult` per amplitude.
-
-    :meth:`columns` are those of :class:`StiffnessResult` after a first column
-    ``amplitude_mm``, the amplitudes one block after the other (a valid ``fit-mount`` input).
-    """
+    stiffness --amplitude``), one :class:`StiffnessResult` per amplitude; :meth:`columns`
+    prepends ``amplitude_mm``, one block per amplitude (a valid ``fit-mount`` input)."""
 
     amplitude_m: np.ndarray               #: test amplitudes X [m]
     curves: list                          #: StiffnessResult per amplitude
@@ -139,8 +124,7 @@ class AmplitudeStiffnessResult(_Columns):
 
     def plot(self, ax=None, *, path=None, form="magnitude-phase", freq_axis="log",
              provenance=None):
-        """One K*(f) curve per amplitude (see :meth:`StiffnessResult.plot`, also for
-        ``ax``)."""
+        """One K*(f) curve per amplitude (as :meth:`StiffnessResult.plot`)."""
         ax, path = target_and_path(ax, path)
         curves = [(f"X = {a * 1e3:g} mm", c) for a, c in zip(self.amplitude_m, self.curves)]
         return plot_stiffness(curves, path, ax=ax, form=form, freq_axis=freq_axis,

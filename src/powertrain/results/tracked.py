@@ -1,11 +1,10 @@
 """Order-tracked run-up: complex order amplitudes per speed and channel, and their files.
 
-The long-format CSV (read by ``compare`` and ``diagnose``; the level column by quantity:
-:data:`LEVEL_COLUMNS`), the order-spectrum CSV (``track --spectrum-at``) and the HDF5 layout
-(``format = "powertrain-tracked"``) are in docs/reference/raw-data.md and csv-formats.md.
-``synthesis`` is the RMS sum over the orders tracked; ``overall`` rows (``track --overall``)
-the RMS of the raw signal in a band (:mod:`powertrain.analysis.overall`); ``phase_deg`` the
-order's phase re cylinder-1 firing TDC (:mod:`powertrain.analysis.phase`).
+Long-format CSV (level column per quantity: :data:`LEVEL_COLUMNS`), order-spectrum CSV
+(``track --spectrum-at``) and HDF5 (``format = "powertrain-tracked"``): see
+docs/reference/raw-data.md and csv-formats.md. ``synthesis`` is the RMS sum over the orders,
+``overall`` the band RMS of the raw signal (:mod:`powertrain.analysis.overall`),
+``phase_deg`` the phase re cylinder-1 firing TDC (:mod:`powertrain.analysis.phase`).
 """
 
 from __future__ import annotations
@@ -28,17 +27,13 @@ from powertrain.provenance import stamp_hdf5
 from powertrain.results.base import HDF5_SUFFIXES, Result
 
 #: quantity -> (level column, factor from SI to the column's unit).
-LEVEL_COLUMNS = {
-    "acceleration": ("acceleration_rms_m_per_s2", 1.0),
-    "velocity": ("velocity_rms_mm_per_s", 1e3),
-    "displacement": ("displacement_rms_mm", 1e3),
-    "force": ("force_rms_n", 1.0),
-}
+LEVEL_COLUMNS = {"acceleration": ("acceleration_rms_m_per_s2", 1.0),
+                 "velocity": ("velocity_rms_mm_per_s", 1e3),
+                 "displacement": ("displacement_rms_mm", 1e3), "force": ("force_rms_n", 1.0)}
 
 
 def _phase_cell(phase, index) -> list:
-    """The ``phase_deg`` cell of an order row: none without the column, empty where
-    undefined."""
+    """The ``phase_deg`` cell of an order row: none without the column, empty if undefined."""
     if phase is None:
         return []
     value = phase[index]
@@ -74,8 +69,7 @@ class TrackedOrders(Result):
     settings : dict
     comments : list of str
     overall : ndarray (k, n_ch) or None
-        Overall RMS of the raw signal per speed [SI], in the band of
-        ``settings["overall_band_hz"]``.
+        Raw-signal RMS per speed in ``settings["overall_band_hz"]`` [SI].
     """
 
     rpm: np.ndarray
@@ -103,9 +97,8 @@ class TrackedOrders(Result):
         return np.sqrt(np.sum(self.order_rms() ** 2, axis=-1))
 
     def phase_deg(self) -> np.ndarray | None:
-        """Phase per speed, channel and order re cylinder-1 firing TDC [deg], NaN for orders
-        whose phase is undefined (``settings["phase"]["orders"]``); None when the phase was
-        not measured."""
+        """Phase per speed, channel and order re cylinder-1 firing TDC [deg]; NaN where
+        undefined, None when not measured."""
         ref = self.settings.get("phase")
         if not ref:
             return None
@@ -144,10 +137,8 @@ class TrackedOrders(Result):
         return replace(self, channels=chans, amplitude=amp,
                        settings={**self.settings, "converted_to": "velocity"})
 
-    # ------------------------------------------------------------------ writers
     def _csv_head(self, title: str, columns: list) -> tuple:
-        """``(lines, level factor, key of each channel)`` of a CSV: ``# title``, the comments,
-        the header (``side`` after ``mount`` when a channel is passive)."""
+        """``(head lines, level factor, key per channel)`` of a CSV."""
         col, factor = LEVEL_COLUMNS[self.quantity]
         with_side = any(c.side != "active" for c in self.channels)
         lines = [f"# {title}"] + [f"# {c}" for c in self.comments]
@@ -163,7 +154,7 @@ class TrackedOrders(Result):
     def csv_text(self) -> str:
         """Long-format CSV text (docs/reference/raw-data.md)."""
         phase = self.phase_deg()
-        tail = [] if phase is None else [""]            # empty phase_deg cell
+        tail = [] if phase is None else [""]
         lines, factor, keys = self._csv_head(
             f"tracked by powertrain track ({self.method}) from {self.source}{self._tag()}",
             ["quantity", "rpm", "LEVEL"] + ([] if phase is None else ["phase_deg"]))
@@ -184,7 +175,7 @@ class TrackedOrders(Result):
         return "\n".join(lines) + "\n"
 
     def spectrum_csv_text(self) -> str:
-        """Order spectrum CSV text (docs/reference/csv-formats.md): RMS against order per speed."""
+        """Order spectrum CSV text: RMS against order per speed (docs/reference/csv-formats.md)."""
         s = self.settings
         lines, factor, keys = self._csv_head(
             f"order spectrum by powertrain track from {self.source}{self._tag()}: COT block of "
@@ -197,11 +188,11 @@ class TrackedOrders(Result):
         return "\n".join(lines) + "\n"
 
     def to_csv(self, path) -> None:
-        """Write :meth:`csv_text` atomically (:func:`powertrain.outputs.write_csv`)."""
+        """Write :meth:`csv_text` atomically."""
         write_csv(path, self.csv_text())
 
     def writers(self) -> dict:
-        """``.csv`` (:meth:`to_csv`), ``.h5``/``.hdf5`` (:meth:`to_hdf5`), ``.png``."""
+        """``.csv``, ``.h5``/``.hdf5``, ``.png``."""
         return {".csv": self.to_csv, **dict.fromkeys(HDF5_SUFFIXES, self.to_hdf5),
                 **super().writers()}
 
@@ -209,29 +200,28 @@ class TrackedOrders(Result):
         """Write the HDF5 layout (docs/reference/raw-data.md) atomically."""
         import h5py  # deferred: heavy optional package
 
-        with atomic_path(path) as tmp:
-            with h5py.File(tmp, "w") as h5:
-                a = h5.attrs
-                stamp_hdf5(a, "powertrain-tracked")
-                a["source"] = self.source
-                a["method"] = self.method
-                a["settings"] = json.dumps(self.settings)
-                a["comments"] = json.dumps(self.comments)
-                h5.create_dataset("rpm", data=self.rpm).attrs["unit"] = "rpm"
-                h5.create_dataset("orders", data=self.orders).attrs["unit"] = "1"
-                g = h5.create_group("channels")
-                for key in ("name", "mount", "side", "direction", "quantity"):
-                    g.create_dataset(key, data=np.array([getattr(c, key) for c in self.channels],
-                                                        dtype="S"))
-                g.create_dataset("unit", data=np.array([QUANTITIES[c.quantity]
-                                                        for c in self.channels], dtype="S"))
-                h5.create_dataset("amplitude", data=self.amplitude)
-                h5.create_dataset("order_rms", data=self.order_rms())
-                h5.create_dataset("synthesis_rms", data=self.synthesis_rms())
-                if self.overall is not None:
-                    h5.create_dataset("overall_rms", data=self.overall)
-                if self.phase_deg() is not None:
-                    h5.create_dataset("phase_deg", data=self.phase_deg()).attrs["unit"] = "deg"
+        with atomic_path(path) as tmp, h5py.File(tmp, "w") as h5:
+            a = h5.attrs
+            stamp_hdf5(a, "powertrain-tracked")
+            a["source"] = self.source
+            a["method"] = self.method
+            a["settings"] = json.dumps(self.settings)
+            a["comments"] = json.dumps(self.comments)
+            h5.create_dataset("rpm", data=self.rpm).attrs["unit"] = "rpm"
+            h5.create_dataset("orders", data=self.orders).attrs["unit"] = "1"
+            g = h5.create_group("channels")
+            for key in ("name", "mount", "side", "direction", "quantity"):
+                g.create_dataset(key, data=np.array([getattr(c, key) for c in self.channels],
+                                                    dtype="S"))
+            g.create_dataset("unit", data=np.array([QUANTITIES[c.quantity]
+                                                    for c in self.channels], dtype="S"))
+            h5.create_dataset("amplitude", data=self.amplitude)
+            h5.create_dataset("order_rms", data=self.order_rms())
+            h5.create_dataset("synthesis_rms", data=self.synthesis_rms())
+            if self.overall is not None:
+                h5.create_dataset("overall_rms", data=self.overall)
+            if self.phase_deg() is not None:
+                h5.create_dataset("phase_deg", data=self.phase_deg()).attrs["unit"] = "deg"
 
     @classmethod
     def from_hdf5(cls, path) -> TrackedOrders:
@@ -259,8 +249,7 @@ class TrackedOrders(Result):
         return self.order_rms()[:, c, int(np.argmin(np.abs(self.orders - o)))]
 
     def to_text(self, written=()) -> str:
-        """The report ``powertrain track`` prints: the recording, the speed grid, the
-        Vold-Kalman settings, the tracked RMS table; the files in ``written`` at its end."""
+        """What ``powertrain track`` prints, naming the files ``written``."""
         r, s = self.recording, self.settings
         lines = [f"raw: {self.source}{' [SYNTHETIC]' if r.get('synthetic') else ''}: "
                  f"{r.get('n_channels')} channel(s), {r.get('sample_rate_hz'):g} Hz, "
@@ -284,8 +273,7 @@ class TrackedOrders(Result):
         return "\n".join(lines)
 
     def _phase_lines(self) -> list:
-        """What the phases refer to and, without a cycle reference, why half orders have
-        none (no lines when the phase was not measured)."""
+        """What the phases refer to and why half orders have none without a cycle reference."""
         ref = self.settings.get("phase")
         if not ref:
             return []
@@ -319,16 +307,12 @@ class TrackedOrders(Result):
         write_csv(path, self.spectra.spectrum_csv_text())
 
     def plot_maps(self, ax=None, *, path=None, provenance=None):
-        """The Campbell and rpm-frequency maps (:attr:`maps`); returns the figure (see
-        :func:`powertrain.plotting.orders.plot_maps`)."""
+        """The Campbell and rpm-frequency maps (:attr:`maps`); returns the figure."""
         ax, path = target_and_path(ax, path)
         return plot_maps(**self.maps, path=path, ax=ax, provenance=provenance)
 
     def plot(self, ax=None, *, path=None, quantities=None, provenance=None):
-        """Order curves (RMS against rpm), one panel per channel; returns the figure.
-        ``ax``: None (a new figure), a Figure or SubFigure, or one Axes when there is one
-        channel (else an InputError saying to pass a Figure)."""
+        """Order curves (RMS against rpm), one panel per channel; returns the figure. ``ax``:
+        None, a Figure or SubFigure, or one Axes for one channel."""
         ax, path = target_and_path(ax, path)
-        return plot_tracked(self, path, quantities, ax=ax,
-                            provenance=provenance)
-
+        return plot_tracked(self, path, quantities, ax=ax, provenance=provenance)

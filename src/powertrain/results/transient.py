@@ -1,15 +1,14 @@
 """A transient manoeuvre's result (``powertrain transient``): time histories, per-channel
-peaks and the seat's ISO 2631-1 values, with its text, CSV, JSON (docs/reference/json.md),
-HDF5 and figure.
+peaks and the seat's ISO 2631-1 values, as text, CSV, JSON (docs/reference/json.md), HDF5
+and figure.
 
 CSV: one row per time step; columns ``time_s``, ``rpm``, ``engine_torque_nm``,
 ``starter_torque_nm``, ``driveline_torque_nm``, ``body_x_mm`` .. ``body_rz_deg``, per
 channel ``CH_displacement_mm``, ``CH_velocity_mm_per_s``, ``CH_acceleration_m_per_s2``,
 ``CH_force_n``, per mount direction ``NET_deflection_mm``. Displacements, deflections and
-forces are changes from the static operating point at zero mean torque. A body point (a
-channel that is neither a mount's engine side nor its body side, e.g. ``seat_rail.z``)
-transmits no force: its peak force is NaN in :meth:`TransientResult.peaks`, ``n/a`` in the
-text, null in the JSON and its ``CH_force_n`` cells are empty.
+forces are changes from the static operating point at zero mean torque. A body point (neither
+side of a mount, e.g. ``seat_rail.z``) transmits no force: peak force NaN, ``n/a`` in the
+text, null in the JSON, empty ``CH_force_n`` cells.
 """
 
 from __future__ import annotations
@@ -47,15 +46,15 @@ class TransientResult(JsonResult):
     Attributes
     ----------
     name, file, engine : str
-        Manoeuvre name, its file, the engine that ran.
+        Manoeuvre, its file, the engine that ran.
     time, rpm : ndarray (n,)
-        [s], crank speed [rpm].
+        Time [s], crank speed [rpm].
     torques : dict of str -> ndarray (n,)
         ``engine``, ``starter``, ``driveline`` torque [N·m].
     body : ndarray (n, 6)
-        Body displacement [m] and rotation [rad] at the CG.
+        Displacement [m] and rotation [rad] at the CG.
     channels : list of str
-        ``mount.direction`` labels (engine side, then body side and body points).
+        ``mount.direction`` (engine side, then body side and body points).
     displacement, velocity, acceleration, force : ndarray (n, n_ch)
     networks : list of str
     deflection : ndarray (n, n_net) [m]
@@ -65,11 +64,9 @@ class TransientResult(JsonResult):
     solver_seconds : float
     notes : list of str
     speed_source : str
-        Where a recorded crank speed came from and how it was lined up ("" for the
-        manoeuvre's own speed table).
+        Origin and alignment of a recorded crank speed ("" for the manoeuvre's own).
     trigger_time : float
-        The manoeuvre's time at which a recording's trigger channel rises [s]
-        (:class:`~powertrain.models.manoeuvre.Manoeuvre`).
+        Manoeuvre time at which a recording's trigger rises [s].
     """
 
     name: str
@@ -98,15 +95,14 @@ class TransientResult(JsonResult):
         return self.channels.index(label)
 
     def transmits_force(self) -> np.ndarray:
-        """Per channel: True for a mount's engine side (``left.z``) or body side
-        (``left/passive.z``), False for a body point (``seat_rail.z``: no force)."""
+        """Per channel: True for either side of a mount, False for a body point."""
         mounts = {n.rpartition(".")[0] for n in self.networks}
         return np.array([c.rpartition(".")[0].split("/")[0] in mounts for c in self.channels],
                         bool)
 
     def peaks(self) -> dict:
-        """Per channel: peak-to-peak displacement [m], peak force [N] (NaN at a body point,
-        :meth:`transmits_force`), maximum acceleration [m/s²] and its time [s]."""
+        """Per channel: peak-to-peak displacement [m], peak force [N] (NaN at a body point),
+        maximum acceleration [m/s²] and its time [s]."""
         a = np.abs(self.acceleration)
         i = np.argmax(a, axis=0)
         force = np.max(np.abs(self.force), axis=0)
@@ -116,9 +112,8 @@ class TransientResult(JsonResult):
                 "time_of_max_acceleration": self.time[i]}
 
     def recording(self) -> RawRecording:
-        """Every channel's acceleration [m/s²] (the mounts' engine and body sides, the body
-        points) and the crank speed [rpm] as raw time data (labelled SYNTHETIC), for the raw
-        writers and readers."""
+        """Every channel's acceleration [m/s²] and the crank speed [rpm] as a raw recording
+        (labelled SYNTHETIC)."""
         chans = []
         for k, label in enumerate(self.channels):
             node, _, d = label.rpartition(".")
@@ -130,10 +125,9 @@ class TransientResult(JsonResult):
                             trigger=self.trigger_signal()).validate()
 
     def trigger_signal(self) -> np.ndarray | None:
-        """A trigger channel [V], 0 V before :attr:`trigger_time` and 5 V after, with one
-        sample between whose level puts the rise's crossing of 2.5 V (linear between
-        samples) at :attr:`trigger_time` exactly (None where the trigger is at the first
-        sample: no rise to record)."""
+        """Trigger channel [V]: 0 V before :attr:`trigger_time`, 5 V after, one sample
+        between placing the linear 2.5 V crossing at :attr:`trigger_time` exactly; None
+        when the trigger is at the first sample."""
         t, when = self.time, float(self.trigger_time)
         if when <= t[0]:
             return None
@@ -183,8 +177,7 @@ class TransientResult(JsonResult):
         return cols
 
     def to_csv(self, path) -> None:
-        """The time histories, one row per step (module docstring; a body point's force
-        cells empty), atomically."""
+        """Write the time histories as CSV, atomically (module docstring)."""
         cols = self.columns()
         names = list(cols)
         blank = [names.index(f"{c}_force_n") for c, f in
@@ -200,9 +193,8 @@ class TransientResult(JsonResult):
             writer.writerows(rows)
 
     def to_hdf5(self, path) -> None:
-        """The time histories (SI, each dataset's ``unit`` attribute) and the summary JSON as
-        an attribute, atomically; attribute ``transmits_force`` per channel
-        (:meth:`transmits_force`: a body point's ``force`` column is 0)."""
+        """Write the time histories (SI, ``unit`` attribute per dataset), the summary JSON and
+        per-channel ``transmits_force`` as attributes, atomically."""
         import h5py  # deferred: heavy optional package
         with atomic_path(path) as tmp, h5py.File(tmp, "w") as h5:
             h5.attrs["summary"] = self.to_json()
@@ -221,23 +213,20 @@ class TransientResult(JsonResult):
 
     def plot(self, ax=None, *, path=None, channels=None, quantity="acceleration",
              provenance=None):
-        """Crank speed and torque over time above the ``quantity`` (``acceleration``,
-        ``displacement``, ``force``) of ``channels`` (default: the seat's, else every mount's
-        z), peaks marked; returns the figure
-        (:func:`powertrain.plotting.transient.plot_transient`). ``ax``: None (a new figure),
-        a Figure or SubFigure, or a path (then ``path``); one Axes raises an InputError
-        saying to pass a Figure: the speed panel always stands above the channels."""
+        """Crank speed and torque above the ``quantity`` (``acceleration``, ``displacement``,
+        ``force``) of ``channels`` (default :meth:`default_channels`), peaks marked; returns
+        the figure (:func:`powertrain.plotting.transient.plot_transient`). ``ax``: None, a
+        Figure or SubFigure (not one Axes), or a path."""
         ax, path = target_and_path(ax, path)
         return plot_transient(self, channels or self.default_channels(), path, ax=ax,
                               provenance=provenance, quantity=quantity)
 
     def _repr_html_(self) -> str:
-        """HTML tables of this result (Jupyter shows them; :mod:`powertrain.results.html`)."""
         return fragment(transient_html(self))
 
     def default_channels(self) -> list:
-        """The seat's axes that move (a modal body whose modes have no component along an
-        axis at the seat leaves it at rest), else the engine-side z of every mount."""
+        """The seat's moving axes (all three if none moves), else up to three engine-side z
+        channels."""
         if self.seat is not None:
             axes = [f"{self.seat['point']}.{a}" for a in "xyz"]
             moving = [c for c in axes if np.any(self.acceleration[:, self.channel(c)])]
@@ -268,7 +257,7 @@ class TransientResult(JsonResult):
 
 
 def _finite(value):
-    """``value`` as a float, None where it is NaN (a JSON null)."""
+    """``value`` as a float, None (JSON null) where NaN."""
     return None if np.isnan(value) else float(value)
 
 
@@ -279,15 +268,15 @@ def _relative(part, whole):
 
 
 def _percent(value, spec):
-    """A percentage for a table: ``n/a`` where NaN."""
+    """A percentage for a table, ``n/a`` where NaN."""
     return "n/a" if np.isnan(value) else format(float(value), spec)
 
 
 @dataclass(frozen=True)
 class TransientRanking(JsonResult):
-    """Baseline and variants of the mount system over one manoeuvre (``powertrain whatif
-    --manoeuvre``), ranked by the peak acceleration at the seat (the largest magnitude of
-    its three axes) where the chassis has a seat point, else by the peak mount deflection.
+    """Baseline and variants over one manoeuvre (``powertrain whatif --manoeuvre``), ranked
+    by the peak seat acceleration (largest of its three axes) where there is a seat point,
+    else by the peak mount deflection.
 
     Attributes
     ----------
@@ -309,7 +298,7 @@ class TransientRanking(JsonResult):
                              for c in r.default_channels()) for r in self.runs])
 
     def peak_deflection(self):
-        """Largest mount deflection magnitude [m] per run and the mount direction."""
+        """Largest mount deflection magnitude [m] per run and its mount direction."""
         k = [int(np.argmax(np.max(np.abs(r.deflection), axis=0))) for r in self.runs]
         return (np.array([float(np.max(np.abs(r.deflection[:, j])))
                           for r, j in zip(self.runs, k)]),
@@ -317,8 +306,7 @@ class TransientRanking(JsonResult):
 
     def ranked_by(self) -> str:
         """``peak_seat_acceleration`` (with a seat) or ``peak_mount_deflection``."""
-        return "peak_mount_deflection" if self.peak_seat() is None else \
-            "peak_seat_acceleration"
+        return "peak_mount_deflection" if self.peak_seat() is None else "peak_seat_acceleration"
 
     def ranking(self) -> list:
         """Indices of the runs, best (smallest) first."""
@@ -342,12 +330,10 @@ class TransientRanking(JsonResult):
                          "--manoeuvre", key=key)
 
     def plot(self, ax=None, *, path=None, provenance=None, view="levels"):
-        """Bars in rank order, each with its value: ``view="levels"`` the peak seat
-        acceleration [m/s²] (if any) and the peak mount deflection [mm] per run,
-        ``view="delta"`` each variant's change of them against the baseline [%]
-        (:func:`powertrain.plotting.transient.plot_ranking`); returns the figure. ``ax``:
-        None (a new figure), a Figure or SubFigure, or one Axes when there is one panel (no
-        seat); else an InputError saying to pass a Figure."""
+        """Bars in rank order: ``view="levels"`` peak seat acceleration [m/s²] (if any) and
+        peak mount deflection [mm], ``"delta"`` each variant's change against the baseline
+        [%]; returns the figure (:func:`powertrain.plotting.transient.plot_ranking`). ``ax``:
+        None, a Figure or SubFigure, or one Axes when there is no seat."""
         ax, path = target_and_path(ax, path)
         return plot_ranking(self, path, ax=ax, provenance=provenance, view=view)
 
@@ -370,7 +356,7 @@ class TransientRanking(JsonResult):
 
 @dataclass(frozen=True)
 class TransientComparison(JsonResult):
-    """A simulated manoeuvre against a recording of it (``powertrain transient --compare``).
+    """A simulated manoeuvre against its recording (``powertrain transient --compare``).
 
     Attributes
     ----------
@@ -379,19 +365,18 @@ class TransientComparison(JsonResult):
     shift : float
         Time of the simulation's start in the recording [s].
     time : ndarray (n,)
-        Simulated times [s] compared: those the recording covers.
+        Simulated times the recording covers [s].
     channels : list of str
     measured, simulated : ndarray (n, k)
-        Accelerations [m/s²] at the simulated times.
+        Accelerations at those times [m/s²].
     aligned_on : str
-        How the shift was found: ``crank speed`` or ``trigger 'NAME'``.
+        ``crank speed`` or ``trigger 'NAME'``.
     event : tuple of float
         First and last time of the simulated event [s] (default: those compared).
     not_compared : dict of str -> str
         The recording's other channels and why each was not compared.
     shift_error : float
-        Standard error of ``shift`` [s] (:func:`~powertrain.analysis.alignment.align_speed`,
-        :func:`~powertrain.analysis.alignment.align_tacho`,
+        Standard error of ``shift`` [s] (:mod:`powertrain.analysis.alignment`,
         :func:`~powertrain.analysis.trigger.trigger_crossing`).
     """
 
@@ -413,9 +398,8 @@ class TransientComparison(JsonResult):
         return (first, last) + (tuple(self.event) if self.event else (first, last))
 
     def errors(self) -> dict:
-        """Per channel: the peaks [m/s²], the peak's error [%] and the RMS of the difference
-        over the event [m/s²] and relative to the measured RMS [%]; the relative ones NaN
-        where the measured channel is zero throughout (nothing to be relative to)."""
+        """Per channel: peaks [m/s²], peak error [%], RMS of the difference [m/s²] and
+        relative to the measured RMS [%] (relative ones NaN where the measurement is 0)."""
         pm, ps = np.max(np.abs(self.measured), 0), np.max(np.abs(self.simulated), 0)
         rms = np.sqrt(np.mean((self.simulated - self.measured) ** 2, axis=0))
         base = np.sqrt(np.mean(self.measured ** 2, axis=0))
@@ -436,10 +420,9 @@ class TransientComparison(JsonResult):
                 "not_compared": dict(self.not_compared)}
 
     def plot(self, ax=None, *, path=None, provenance=None):
-        """Measured and simulated acceleration per channel, overlaid, each panel headed by its
-        errors; returns the figure (:func:`powertrain.plotting.transient.plot_overlay`).
-        ``ax``: None (a new figure), a Figure or SubFigure, or one Axes when one channel is
-        compared (else an InputError saying to pass a Figure)."""
+        """Measured and simulated acceleration per channel, overlaid, headed by the errors;
+        returns the figure (:func:`powertrain.plotting.transient.plot_overlay`). ``ax``:
+        None, a Figure or SubFigure, or one Axes for one channel."""
         ax, path = target_and_path(ax, path)
         return plot_overlay(self, path, ax=ax, provenance=provenance)
 

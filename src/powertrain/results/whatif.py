@@ -1,9 +1,8 @@
-"""Result of ``powertrain whatif``: baseline and variant run-ups and their changes in dB
-(computed by :func:`powertrain.workflows.whatif.whatif`; docs/guide/whatif.md): the change
-20 log10(v_variant / v_baseline) of the RMS velocity (or another ``signal``) per channel and
-quantity at each speed step, its mean (``mean_delta_db``) and largest magnitude
-(``max_abs_delta_db``). Speed steps where both levels are below :data:`FLOOR_REL` of the
-baseline curve's maximum (a cancelled order) are left out.
+"""Result of ``powertrain whatif`` (docs/guide/whatif.md): baseline and variant run-ups and
+the change 20 log10(v_variant / v_baseline) of the RMS velocity (or another ``signal``) per
+channel, quantity and speed, its mean (``mean_delta_db``) and largest magnitude
+(``max_abs_delta_db``). Speeds where both levels are below :data:`FLOOR_REL` of the
+baseline maximum (a cancelled order) are left out.
 """
 
 from __future__ import annotations
@@ -70,8 +69,7 @@ class WhatIfResult(JsonResult):
         Overlaid measurement.
     target_fits : list of TargetFit
     signal : str
-        Compared signal: ``velocity`` (default; the measured quantity), ``mount_force``
-        (force transmitted to ground), ``displacement`` or ``acceleration``.
+        ``velocity`` (default), ``mount_force``, ``displacement`` or ``acceleration``.
     """
 
     baseline: object
@@ -89,9 +87,7 @@ class WhatIfResult(JsonResult):
     JSON_INDENT = 2
 
     def to_text(self, written=()) -> str:
-        """The report ``powertrain whatif`` prints: the baseline, the target fits, each
-        variant's table of changes, the objective ranking; the files in ``written`` are
-        named at its end."""
+        """What ``powertrain whatif`` prints, naming the files ``written``."""
         d, rpm = self.description, self.baseline.rpm
         modes = ", ".join(f"{f:.2f}" for f in self.baseline.rigid_body_modes_hz)
         step = "" if self.rpm_step is None else f" step {self.rpm_step:g}"
@@ -109,22 +105,19 @@ class WhatIfResult(JsonResult):
         return "\n".join(lines)
 
     def _repr_html_(self) -> str:
-        """HTML tables of this result (Jupyter shows them; :mod:`powertrain.results.html`)."""
         return fragment(whatif_html(self))
 
     def target_fit(self, key: str = "target"):
-        """The one retune of this what-if (:class:`~powertrain.workflows.retune.TargetFit`);
-        an InputError naming ``key`` unless exactly one target was given."""
+        """The one retune (:class:`~powertrain.workflows.retune.TargetFit`); InputError naming
+        ``key`` unless exactly one target was given."""
         if len(self.target_fits) != 1:
             raise InputError(f"needs exactly one target, {len(self.target_fits)} given",
                              key=key)
         return self.target_fits[0]
 
-
     def objective_changes(self) -> list:
-        """Variants ranked by the mean change of the objective response over its speed band
-        [dB], best (most negative) first: ``name``, ``mean_delta_db``,
-        ``baseline_rms_si`` and ``variant_rms_si`` (mean levels over the band, SI)."""
+        """Variants by mean change of the objective over its band [dB], best first: ``name``,
+        ``mean_delta_db``, ``baseline_rms_si``, ``variant_rms_si`` (band means, SI)."""
         if self.objective is None:
             return []
         name, d, q, lo, hi = self.objective
@@ -155,7 +148,6 @@ class WhatIfResult(JsonResult):
             lines.append(f"  {val:>10}  {r['name']}")
         return "\n".join(lines)
 
-    # ------------------------------------------------------------------ numbers
     def variant(self, name: str) -> VariantRun:
         for v in self.variants:
             if v.name == name:
@@ -192,8 +184,7 @@ class WhatIfResult(JsonResult):
         return out
 
     def baseline_gaps(self) -> list:
-        """Mean gap baseline vs measurement per channel and quantity [dB] (empty without
-        a measurement)."""
+        """Mean gap baseline vs measurement per channel and quantity [dB] (or empty)."""
         if self.measured is None or self.signal != "velocity":
             return []
         return [{"mount": m, "direction": d, "quantity": q,
@@ -201,7 +192,6 @@ class WhatIfResult(JsonResult):
                                                              m, d, q)}
                 for m, d in self.baseline.channels for q in self.quantities]
 
-    # ------------------------------------------------------------------ output
     def to_dict(self) -> dict:
         base = dict(self.description)
         base.setdefault("rpm", [float(r) for r in self.baseline.rpm])
@@ -211,14 +201,12 @@ class WhatIfResult(JsonResult):
                                 "synthetic": bool(self.measured.synthetic),
                                 "channels": self.baseline_gaps()}
         return {"format": "powertrain-whatif", "format_version": 1,
-                "powertrain_version": __version__,
-                "signal": self.signal,
+                "powertrain_version": __version__, "signal": self.signal,
                 "definition": f"delta_db = 20 log10(v_variant / v_baseline), v = RMS "
                               f"{self.signal}; "
                               "mean_delta_db = mean over the speed steps; max_abs_delta_db = "
                               "largest |delta_db|",
-                "quantities": list(self.quantities),
-                "baseline": base,
+                "quantities": list(self.quantities), "baseline": base,
                 "targets": [tf.to_dict() for tf in self.target_fits],
                 "objective": None if self.objective is None else {
                     "channel": self.objective[0], "direction": self.objective[1],
@@ -249,15 +237,13 @@ class WhatIfResult(JsonResult):
 
     def plot(self, ax=None, *, path=None, channel=None, quantity=None, provenance=None,
              view="levels"):
-        """Baseline, variants and measurement (``view="levels"``) or each variant's change
-        Δ dB against the baseline (``view="delta"``); returns the figure (see
-        :func:`powertrain.plotting.plot_whatif`). ``ax``: None (a new figure), a Figure or
-        SubFigure, or one Axes where ``channel`` ((mount, direction)) and ``quantity`` leave
-        one panel (else an InputError saying to pass a Figure)."""
+        """Levels of baseline, variants and measurement (``view="levels"``) or each variant's
+        Δ dB (``"delta"``); returns the figure (:func:`powertrain.plotting.plot_whatif`).
+        ``ax``: None, a Figure or SubFigure, or one Axes where ``channel`` and ``quantity``
+        leave one panel."""
         ax, path = target_and_path(ax, path)
         return plot_whatif(self, path, ax=ax, channel=channel, quantity=quantity,
-                           provenance=provenance,
-                           view=view)
+                           provenance=provenance, view=view)
 
 
 def _format_table(header, rows) -> str:
@@ -273,8 +259,8 @@ def _format_table(header, rows) -> str:
 
 
 def _gap_to_measured(result, measured, mount, direction, quantity):
-    """Mean of 20 log10(sim/measured) [dB] at the measured speeds inside the simulated range
-    (simulation interpolated linearly in log level); None if not available."""
+    """Mean 20 log10(sim/measured) [dB] at the measured speeds in the simulated range (log
+    level interpolated linearly); None if not available."""
     try:
         rpm_m, lev_m = measured.curve(mount, direction, quantity)
     except KeyError:
