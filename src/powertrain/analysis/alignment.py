@@ -152,16 +152,14 @@ def align_speed(t_sim, rpm_sim, t_rec, rpm_rec, *, file=None, key="rpm",
     t_rec, rpm_rec = unheld_speed(t_rec, np.asarray(rpm_rec, float))
     t, target = _fine(t_sim, rpm_sim)
     costs = _costs(t, target, t_rec, rpm_rec)
-    shifts, coarse, shift = _search(costs, _shift_range(t_sim, (t_rec[0], t_rec[-1]),
-                                                        partial), event)
+    shifts, coarse, shift = _search(costs, _shift_range(t_sim, (t_rec[0], t_rec[-1]), partial), event)
     best = int(np.argmin(coarse))
     other = _second_match(coarse, best, sigma ** 2)
     if other is not None:
         raise InputError(f"the crank speed matches the event's at two places of the recording "
                          f"(the event starting at {shift:.4f} s or at {shifts[other]:.4f} s); "
                          f"give {trigger}", file=file, key=key)
-    _check_match(float(np.sqrt(costs(np.array([shift]))[0])), sigma, target, (file, key),
-                 trigger)
+    _check_match(float(np.sqrt(costs(np.array([shift]))[0])), sigma, target, (file, key), trigger)
     white, error = _shift_error(t, target, t_rec, rpm_rec, shift, sigma)
     top = max(float(np.max(np.abs(target))), SPEED_FLOOR_RPM)
     allowed = ALIGN_TOLERANCE_DEG / (6.0 * top)
@@ -214,8 +212,7 @@ def align_tacho(t_sim, rpm_sim, span, edges, *, counts=None, pulses_per_rev=1, f
                          "revolution); give --pulses-per-rev N for a wheel of N teeth, or "
                          f"{trigger}", file=file, key=key)
     best = int(np.argmin(coarse))
-    sigma = max(float(np.sqrt(_phase_cost(shift, t_sim, rev, edges, revs, span))),
-                PHASE_FLOOR_REV)
+    sigma = max(float(np.sqrt(_phase_cost(shift, t_sim, rev, edges, revs, span))), PHASE_FLOOR_REV)
     if sigma > MISMATCH_REV:
         raise InputError(f"the tacho's pulses do not follow the event's crank angle at any "
                          f"shift ({sigma:.2g} rev RMS at the best, read as {pulses_per_rev} "
@@ -264,8 +261,7 @@ def _phase_error(shift, t_sim, rev, speed, edges, revs, span, sigma) -> tuple:
     lags = round(CORRELATION_REV * np.median(np.diff(revs)) ** -1)
     design = rate - np.mean(rate)
     white = sigma / np.sqrt(float(design @ design)) if np.any(design) else np.inf
-    return white, max(white, _correlated_error(design, phase - np.mean(phase),
-                                               PHASE_FLOOR_REV, lags))
+    return white, max(white, _correlated_error(design, phase - np.mean(phase), PHASE_FLOOR_REV, lags))
 
 
 def _phase_cost(shift, t_sim, rev, edges, revs, span) -> float:
@@ -288,8 +284,7 @@ def _search(costs, bounds, event) -> tuple:
     shifts = np.linspace(lo, hi, max(801, int(np.ceil((hi - lo) / (event / GRID))) + 1))
     coarse = costs(shifts)
     best = int(np.argmin(coarse))
-    fine = np.clip(shifts[best] + np.linspace(-2.0, 2.0, 401) * (shifts[1] - shifts[0]),
-                   lo, hi)
+    fine = np.clip(shifts[best] + np.linspace(-2.0, 2.0, 401) * (shifts[1] - shifts[0]), lo, hi)
     near = costs(fine)
     k = int(np.argmin(near))
     return shifts, coarse, _vertex(fine, near, k)
@@ -312,8 +307,7 @@ def _shift_range(t_sim, span, partial) -> tuple:
     """Shifts [s] searched: covering :data:`MIN_COVERAGE` of the event (``partial``), else all."""
     event = t_sim[-1] - t_sim[0]
     if partial:
-        return (span[0] - t_sim[-1] + MIN_COVERAGE * event,
-                span[1] - t_sim[0] - MIN_COVERAGE * event)
+        return (span[0] - t_sim[-1] + MIN_COVERAGE * event, span[1] - t_sim[0] - MIN_COVERAGE * event)
     return tuple(sorted((span[0] - t_sim[0], span[1] - t_sim[-1])))
 
 

@@ -110,8 +110,7 @@ def gap_statistics(rpm, gap_db):
     g = np.asarray(gap_db, float)
     r = np.asarray(rpm, float)
     if g.size == 0:
-        return {"rms_db": np.nan, "bias_db": np.nan, "max_abs_db": np.nan,
-                "rpm_at_max_abs_db": np.nan}
+        return {"rms_db": np.nan, "bias_db": np.nan, "max_abs_db": np.nan, "rpm_at_max_abs_db": np.nan}
     k = int(np.argmax(np.abs(g)))
     return {"rms_db": float(np.sqrt(np.mean(g ** 2))), "bias_db": float(np.mean(g)),
             "max_abs_db": float(abs(g[k])), "rpm_at_max_abs_db": float(r[k])}

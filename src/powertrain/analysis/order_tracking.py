@@ -63,8 +63,7 @@ def parse_orders(text: str, option: str = "--orders") -> np.ndarray:
         except InputError:
             raise
         except ValueError:
-            raise InputError(f"cannot read orders {part!r} (use 0.5:8:0.5 or 1,2,4)",
-                             key=option) from None
+            raise InputError(f"cannot read orders {part!r} (use 0.5:8:0.5 or 1,2,4)", key=option) from None
     arr = np.unique(np.round(np.array(values, float), 12))
     if arr.size == 0 or not np.all(np.isfinite(arr)) or np.any(arr <= 0):
         raise InputError("orders must be finite and > 0", key=option)
@@ -117,8 +116,7 @@ def speed_grid(profile, rpm_step, block_revs, *, margin_s=0.0, file=None, key="r
     m0, m1 = np.broadcast_to(np.asarray(margin_s, float), (2,))
     lo_ok = np.interp(th[0] + np.pi * block_revs, th, t) + m0
     hi_ok = np.interp(th[-1] - np.pi * block_revs, th, t) - m1
-    grid = rpm_step * np.arange(math.ceil(n.min() / rpm_step), math.floor(n.max() / rpm_step)
-                                + 1)
+    grid = rpm_step * np.arange(math.ceil(n.min() / rpm_step), math.floor(n.max() / rpm_step) + 1)
     if grid.size == 0:
         raise InputError(f"no multiple of {rpm_step:g} rpm between the record's speeds "
                          f"{n.min():.0f}..{n.max():.0f} rpm (a smaller step)", file=file,

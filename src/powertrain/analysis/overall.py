@@ -20,8 +20,7 @@ def parse_band(text: str, option: str = "--overall-band"):
     try:
         lo, hi = (float(v) for v in str(text).split(":"))
     except ValueError:
-        raise InputError(f"cannot read band {text!r} (use LO:HI in Hz, e.g. 5:1000)",
-                         key=option) from None
+        raise InputError(f"cannot read band {text!r} (use LO:HI in Hz, e.g. 5:1000)", key=option) from None
     if not (np.isfinite(lo) and np.isfinite(hi) and 0 <= lo < hi):
         raise InputError("band must be LO:HI with 0 <= LO < HI [Hz]", key=option)
     return lo, hi

@@ -98,8 +98,7 @@ def speed_from_rpm(time, rpm, *, smooth_s=0.1, file=None, key="rpm") -> SpeedPro
         smooth = np.interp(time, t_means, sm)
         lo, hi = time < t_means[0], time > t_means[-1]
         smooth[lo] = sm[0] + (sm[1] - sm[0]) / (t_means[1] - t_means[0]) * (time[lo] - t_means[0])
-        smooth[hi] = sm[-1] + (sm[-1] - sm[-2]) / (t_means[-1] - t_means[-2]) * (
-            time[hi] - t_means[-1])
+        smooth[hi] = sm[-1] + (sm[-1] - sm[-2]) / (t_means[-1] - t_means[-2]) * (time[hi] - t_means[-1])
     else:
         smooth = savgol_filter(rpm, window, 3, mode="interp") if window > 4 else rpm
     if np.any(smooth <= 0):
@@ -126,8 +125,7 @@ def mean_speed(time, rpm, interval) -> np.ndarray:
     angle = np.r_[0.0, np.cumsum(0.5 * (n[1:] + n[:-1]) * np.diff(t))]
     out = n
     for _ in range(2):
-        window = np.minimum(interval / np.maximum(np.abs(out) * np.pi / 30.0, 1e-12),
-                            MEAN_SPEED_WINDOW_S)
+        window = np.minimum(interval / np.maximum(np.abs(out) * np.pi / 30.0, 1e-12), MEAN_SPEED_WINDOW_S)
         window = np.minimum(window, t[-1] - t[0])
         lo = np.clip(t - 0.5 * window, t[0], t[-1] - window)
         out = (np.interp(lo + window, t, angle) - np.interp(lo, t, angle)) / window
@@ -173,8 +171,7 @@ def drop_spikes(edge_times) -> tuple:
         if not short.size:
             break
         before = np.where(short > 0, d[np.maximum(short - 1, 0)] + d[short], np.inf)
-        after = np.where(short + 1 < d.size, d[short] + d[np.minimum(short + 1, d.size - 1)],
-                         np.inf)
+        after = np.where(short + 1 < d.size, d[short] + d[np.minimum(short + 1, d.size - 1)], np.inf)
         first = np.abs(before - med[short]) < np.abs(after - med[short])
         t = np.delete(t, np.unique(np.where(first, short, short + 1)))
         notes.append(f"{short.size} tacho spike(s) dropped")
@@ -230,8 +227,7 @@ def checked_pulses_per_rev(pulses_per_rev) -> int:
     return int(pulses_per_rev)
 
 
-def speed_from_tacho(time, tacho, pulses_per_rev, *, smooth_s=0.1, file=None,
-                     key="tacho") -> SpeedProfile:
+def speed_from_tacho(time, tacho, pulses_per_rev, *, smooth_s=0.1, file=None, key="tacho") -> SpeedProfile:
     """Speed profile from the pulse train ``tacho`` at ``time`` [s] of ``pulses_per_rev``
     pulses per revolution, knots ``smooth_s`` [s] apart (module docstring)."""
     time = np.asarray(time, float)

@@ -58,8 +58,7 @@ def trigger_time(time, signal, *, edge="rising", file=None, key="--trigger") -> 
     return trigger_crossing(time, signal, edge=edge, file=file, key=key).time
 
 
-def trigger_crossing(time, signal, *, edge="rising", file=None,
-                     key="--trigger") -> TriggerCrossing:
+def trigger_crossing(time, signal, *, edge="rising", file=None, key="--trigger") -> TriggerCrossing:
     """Time [s] of a trigger channel's step and its standard error [s] (module docstring).
 
     Parameters
@@ -79,8 +78,7 @@ def trigger_crossing(time, signal, *, edge="rising", file=None,
         A channel that is not finite, does not step, or never rises to stay.
     """
     if edge not in TRIGGER_EDGES:
-        raise InputError(f"expected one of {', '.join(TRIGGER_EDGES)}, got {edge!r}",
-                         key="--trigger-edge")
+        raise InputError(f"expected one of {', '.join(TRIGGER_EDGES)}, got {edge!r}", key="--trigger-edge")
     time = np.asarray(time, float)
     x = np.asarray(signal, float) * (1.0 if edge == "rising" else -1.0)
     if not np.all(np.isfinite(x)):
@@ -176,8 +174,7 @@ def _rise(x, lo, hi, i) -> tuple:
     """Last sample at most 10 % of the step up to ``i``, first at least 90 % after it."""
     before = np.flatnonzero(x[:i + 1] <= lo + 0.1 * (hi - lo))
     after = np.flatnonzero(x[i + 1:] >= lo + 0.9 * (hi - lo))
-    return (int(before[-1]) if before.size else 0,
-            int(i + 1 + after[0]) if after.size else x.size - 1)
+    return (int(before[-1]) if before.size else 0, int(i + 1 + after[0]) if after.size else x.size - 1)
 
 
 def _rise_time(time, x, start, end, step) -> float:
@@ -189,6 +186,5 @@ def _rise_time(time, x, start, end, step) -> float:
         return max(update, span / (end - start))
     if end - start <= 2:
         return span / (end - start)
-    straight = end - start >= 3 and np.max(np.abs(np.diff(x[start:end + 1], 2))) <= \
-        1e-6 * step
+    straight = end - start >= 3 and np.max(np.abs(np.diff(x[start:end + 1], 2))) <= 1e-6 * step
     return step / (x[end] - x[start]) * span if straight else 0.0      # the whole step's
