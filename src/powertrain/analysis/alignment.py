@@ -146,8 +146,7 @@ def align_speed(t_sim, rpm_sim, t_rec, rpm_rec, *, file=None, key="rpm",
     length, event = t_rec[-1] - t_rec[0], t_sim[-1] - t_sim[0]
     if length < MIN_COVERAGE * event:
         raise InputError(f"the recording is {length:.4g} s long, less than "
-                         f"{MIN_COVERAGE:.0%} of the {event:.4g} s event", file=file,
-                         key="time")
+                         f"{MIN_COVERAGE:.0%} of the {event:.4g} s event", file=file, key="time")
     sigma = _scatter(t_rec, rpm_rec)
     t_rec, rpm_rec = unheld_speed(t_rec, np.asarray(rpm_rec, float))
     t, target = _fine(t_sim, rpm_sim)
@@ -329,8 +328,7 @@ def _check_match(residual, sigma, target, where, trigger):
         raise InputError(f"the recorded crank speed does not match the event's at any shift "
                          f"(RMS difference {residual:.3g} rpm at the best, over "
                          f"{MISMATCH_SHARE:.0%} of its {span:.4g} rpm range); give {trigger}, or "
-                         "drive the simulation with --speed-from", file=file,
-                         key=key)
+                         "drive the simulation with --speed-from", file=file, key=key)
 
 
 def _fine(t_sim, rpm_sim):
@@ -401,8 +399,7 @@ def _costs(t, target, t_rec, rpm_rec):
 def _second_match(costs, best, margin):
     """Index of the best shift outside ``best``'s valley costing within ``margin``, else None."""
     above = np.flatnonzero(costs >= costs[best] + margin)
-    left = above[above < best]
-    right = above[above > best]
+    left, right = above[above < best], above[above > best]
     outside = np.zeros(costs.size, bool)
     if left.size:
         outside[:left[-1]] = True

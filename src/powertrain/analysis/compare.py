@@ -75,18 +75,14 @@ def interpolate_log(rpm, level, rpm_new):
 def level_gap_db(simulated, measured):
     r"""Level gap :math:`20\log_{10}(v_\mathrm{sim}/v_\mathrm{meas})` [dB].
 
+    Positive where the simulation is higher.
+
     Parameters
     ----------
     simulated, measured : array_like
         Positive RMS levels [same unit].
-
-    Returns
-    -------
-    ndarray
-        Gap [dB]; positive where the simulation is higher.
     """
-    s = np.asarray(simulated, float)
-    m = np.asarray(measured, float)
+    s, m = np.asarray(simulated, float), np.asarray(measured, float)
     if np.any(s <= 0) or np.any(m <= 0):
         raise ValueError("levels must be > 0 for a gap in dB")
     return 20.0 * np.log10(s / m)
@@ -107,8 +103,7 @@ def gap_statistics(rpm, gap_db):
     dict
         ``rms_db``, ``bias_db``, ``max_abs_db``, ``rpm_at_max_abs_db`` [dB, rpm]; NaN if empty.
     """
-    g = np.asarray(gap_db, float)
-    r = np.asarray(rpm, float)
+    g, r = np.asarray(gap_db, float), np.asarray(rpm, float)
     if g.size == 0:
         return {"rms_db": np.nan, "bias_db": np.nan, "max_abs_db": np.nan, "rpm_at_max_abs_db": np.nan}
     k = int(np.argmax(np.abs(g)))
@@ -122,15 +117,12 @@ def frac(simulated, measured):
     :math:`(\sum_n s_n m_n)^2 / (\sum_n s_n^2 \sum_n m_n^2)`: the curve's shape, blind to a
     common level error.
 
+    In [0, 1]; 1 for a scaled copy; NaN if either curve is all zero or empty.
+
     Parameters
     ----------
     simulated, measured : array_like, shape (n,)
         RMS levels at the same speeds [same unit].
-
-    Returns
-    -------
-    float
-        In [0, 1]; 1 for a scaled copy; NaN if either curve is all zero or ``n = 0``.
     """
     return float(csac(simulated, measured, axis=-1))
 
@@ -153,12 +145,8 @@ def csac(simulated, measured, axis=-1):
     ndarray or float
         In [0, 1]; 1 for identical (or proportional) channel vectors.
     """
-    s = np.asarray(simulated, float)
-    m = np.asarray(measured, float)
-    num = np.sum(s * m, axis=axis) ** 2
-    den = np.sum(s ** 2, axis=axis) * np.sum(m ** 2, axis=axis)
-    with np.errstate(invalid="ignore", divide="ignore"):
-        return np.where(den > 0, num / np.where(den > 0, den, 1.0), np.nan)
+    s, m = np.asarray(simulated, float), np.asarray(measured, float)
+    return _ratio(np.sum(s * m, axis=axis) ** 2, np.sum(s ** 2, axis=axis) * np.sum(m ** 2, axis=axis))
 
 
 def csf(simulated, measured, axis=-1):
@@ -178,10 +166,13 @@ def csf(simulated, measured, axis=-1):
     ndarray or float
         In [0, 1]; 1 only for identical vectors; 2a/(1+a²) for a vector scaled by a.
     """
-    s = np.asarray(simulated, float)
-    m = np.asarray(measured, float)
-    num = 2.0 * np.abs(np.sum(s * m, axis=axis))
-    den = np.sum(s ** 2, axis=axis) + np.sum(m ** 2, axis=axis)
+    s, m = np.asarray(simulated, float), np.asarray(measured, float)
+    return _ratio(2.0 * np.abs(np.sum(s * m, axis=axis)),
+                  np.sum(s ** 2, axis=axis) + np.sum(m ** 2, axis=axis))
+
+
+def _ratio(num, den):
+    """``num / den`` where ``den > 0``, else NaN."""
     with np.errstate(invalid="ignore", divide="ignore"):
         return np.where(den > 0, num / np.where(den > 0, den, 1.0), np.nan)
 

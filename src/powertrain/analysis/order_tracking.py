@@ -119,8 +119,7 @@ def speed_grid(profile, rpm_step, block_revs, *, margin_s=0.0, file=None, key="r
     grid = rpm_step * np.arange(math.ceil(n.min() / rpm_step), math.floor(n.max() / rpm_step) + 1)
     if grid.size == 0:
         raise InputError(f"no multiple of {rpm_step:g} rpm between the record's speeds "
-                         f"{n.min():.0f}..{n.max():.0f} rpm (a smaller step)", file=file,
-                         key="--rpm-step")
+                         f"{n.min():.0f}..{n.max():.0f} rpm (a smaller step)", file=file, key="--rpm-step")
     tc, thc = first_passing(t, n, grid, th)
     keep = (tc >= lo_ok) & (tc <= hi_ok)
     rpm, centre = list(grid[keep]), thc[keep]
@@ -128,8 +127,7 @@ def speed_grid(profile, rpm_step, block_revs, *, margin_s=0.0, file=None, key="r
         raise InputError(f"speed never passes a multiple of {rpm_step:g} rpm with "
                          f"{block_revs / 2:g} revolutions (+ {max(m0, m1):.3g} s) of data either "
                          "side (speed "
-                         f"{n.min():.0f}..{n.max():.0f} rpm over {t[-1] - t[0]:.3g} s)",
-                         file=file, key=key)
+                         f"{n.min():.0f}..{n.max():.0f} rpm over {t[-1] - t[0]:.3g} s)", file=file, key=key)
     return np.array(rpm, float), np.array(centre, float)
 
 
@@ -137,9 +135,7 @@ def first_passing(t, rpm, targets, *others):
     """Time [s] at which ``rpm`` over ``t`` first reaches each of ``targets`` [rpm] (and
     ``others`` interpolated there); NaN where it never does. Bisection in the running
     maximum (from below) or minimum (from above)."""
-    t = np.asarray(t, float)
-    rpm = np.asarray(rpm, float)
-    targets = np.asarray(targets, float)
+    t, rpm, targets = np.asarray(t, float), np.asarray(rpm, float), np.asarray(targets, float)
     up = np.searchsorted(np.maximum.accumulate(rpm), targets, side="left")
     down = np.searchsorted(-np.minimum.accumulate(rpm), -targets, side="left")
     idx = np.where(rpm[0] < targets, up, down)
@@ -175,10 +171,8 @@ def cot_amplitudes(X, profile, orders, rpm_centre, angle_centre, block_revs=None
     ndarray complex (k, n_ch, n_o)
         Peak complex amplitudes [SI], phase relative to crank angle 0.
     """
-    X = np.ascontiguousarray(X, float)
-    orders = np.asarray(orders, float)
-    B = block_revs or block_revolutions(orders)
-    S = samples_per_rev(orders)
+    X, orders = np.ascontiguousarray(X, float), np.asarray(orders, float)
+    B, S = block_revs or block_revolutions(orders), samples_per_rev(orders)
     N = B * S
     fs = (profile.time.size - 1) / (profile.time[-1] - profile.time[0])
     j = np.arange(N)

@@ -109,6 +109,5 @@ def cycle_origin(profile, edge_times, *, file=None, key="--cycle-reference"):
     votes = np.bincount(revolution, minlength=2)
     if votes.max() < CYCLE_AGREEMENT * revolution.size:
         raise InputError("the cycle-reference edges fall on either revolution (the signal "
-                         "sits on the tacho reference pulse, or is not once per cycle)",
-                         file=file, key=key)
+                         "sits on the tacho reference pulse, or is not once per cycle)", file=file, key=key)
     return profile.reference + two_pi * int(np.argmax(votes))

@@ -40,20 +40,15 @@ class SpeedProfile:
 
     Attributes
     ----------
-    time : ndarray (n,)
-        [s]
-    rpm : ndarray (n,)
-        Smoothed speed [rpm].
-    angle : ndarray (n,)
-        Crank angle from the first sample (tacho: from the first edge) [rad].
+    time, rpm, angle : ndarray (n,)
+        Times [s], smoothed speed [rpm], crank angle from the first sample or edge [rad].
     valid : tuple of int
         First and last sample index where speed and angle are measured, not extrapolated.
     source : str
         ``rpm channel`` or ``tacho (N pulses/rev)``.
     notes : list of str
     reference : float or None
-        Angle [rad] (on :attr:`angle`'s scale) of a once-per-revolution reference pulse,
-        known modulo 2π; None when the speed source has none (module docstring).
+        Angle [rad] of a once-per-revolution reference pulse (modulo 2π), or None.
     """
 
     time: np.ndarray
@@ -85,8 +80,7 @@ def speed_from_rpm(time, rpm, *, smooth_s=0.1, file=None, key="rpm") -> SpeedPro
     file, key : str, optional
         Named in error messages.
     """
-    time = np.asarray(time, float)
-    rpm = np.asarray(rpm, float)
+    time, rpm = np.asarray(time, float), np.asarray(rpm, float)
     window = _savgol_window(time, smooth_s)
     # long windows: filter means of k samples, interpolate back, extrapolate the end slopes
     k = max(1, window // 64)
@@ -120,8 +114,7 @@ def mean_speed(time, rpm, interval) -> np.ndarray:
     :data:`MEAN_SPEED_WINDOW_S`: :math:`\bar n = (\Theta(t + T/2) - \Theta(t - T/2)) / T`,
     :math:`\Theta` the speed's integral, :math:`T = \Phi/|\omega|` from the once-averaged
     speed."""
-    t = np.asarray(time, float)
-    n = np.asarray(rpm, float)
+    t, n = np.asarray(time, float), np.asarray(rpm, float)
     angle = np.r_[0.0, np.cumsum(0.5 * (n[1:] + n[:-1]) * np.diff(t))]
     out = n
     for _ in range(2):
@@ -140,8 +133,7 @@ def tacho_edges(time, tacho, *, file=None, key="tacho", what="tacho"):
     swing = hi - lo
     if not swing > 1e-12 * max(abs(hi), abs(lo), 1.0):
         raise InputError(f"{what} has no edges (constant signal)", file=file, key=key)
-    up = lo + TRIGGER_HIGH * swing
-    down = lo + TRIGGER_LOW * swing
+    up, down = lo + TRIGGER_HIGH * swing, lo + TRIGGER_LOW * swing
     # 1 above `up`, 0 below `down`, else the last state (forward fill)
     marker = np.where(x > up, 1, np.where(x < down, 0, -1))
     idx = np.where(marker >= 0, np.arange(x.size), 0)
@@ -205,8 +197,9 @@ def count_teeth(edge_times, *, file=None, key="tacho"):
 
 
 def reference_count(counts, pulses_per_rev):
-    """Count (of :func:`count_teeth`'s ``counts``) of the reference pulse, or None: 0 at one
-    of ``pulses_per_rev``, else the first after a gap if every gap is on the same tooth."""
+    """Count (of :func:`count_teeth`'s ``counts``) of the reference pulse, or None: 0 for one
+    pulse per revolution (``pulses_per_rev``), else the first after a gap if every gap is on
+    the same tooth."""
     if pulses_per_rev == 1:
         return 0.0
     after_gap = counts[1:][np.diff(counts) > 1]
@@ -244,8 +237,7 @@ def speed_from_tacho(time, tacho, pulses_per_rev, *, smooth_s=0.1, file=None, ke
     spline = make_lsq_spline(t_e, theta_e, knots, k=3)
     valid = (int(np.searchsorted(time, t_e[0])), int(np.searchsorted(time, t_e[-1]) - 1))
     tc = np.clip(time, t_e[0], t_e[-1])
-    angle = spline(tc)
-    omega = spline.derivative()(tc)
+    angle, omega = spline(tc), spline.derivative()(tc)
     angle = angle + omega * (time - tc)          # linear outside the edges (`valid`)
     if np.any(omega[valid[0]:valid[1] + 1] <= 0):
         raise InputError("speed from the tacho is not > 0 throughout", file=file, key=key)

@@ -155,8 +155,7 @@ def trigger_levels(x, file=None, key="--trigger") -> tuple:
     noise = np.sqrt(np.mean(np.diff(x, 2) ** 2) / 6.0) if x.size > 2 else 0.0
     if hi - lo < TRIGGER_STEP_NOISE * noise:
         raise InputError(f"the trigger channel does not step (its step {hi - lo:.3g} is "
-                         f"less than {TRIGGER_STEP_NOISE:g} times its noise {noise:.3g})",
-                         file=file, key=key)
+                         f"less than {TRIGGER_STEP_NOISE:g} times its noise {noise:.3g})", file=file, key=key)
     return lo, hi
 
 

@@ -39,8 +39,7 @@ def plot_modes(result, path=None, ax=None, provenance=None):
     fig, axes, own = subplots(ax, figsize=(PRINT_WIDTH_IN, 4.6))
     ax = axes[0, 0]
     n = len(result.modes)
-    x = np.arange(n)
-    bottom = np.zeros(n)
+    x, bottom = np.arange(n), np.zeros(n)
     ked = np.array([np.clip(m.ked_percent, 0, None) for m in result.modes]).reshape(n, 6)
     for j, c in enumerate(COORDINATES):
         ax.bar(x, ked[:, j], bottom=bottom, color=_COLOURS[c], label=c, width=0.7)

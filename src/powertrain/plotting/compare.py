@@ -119,8 +119,7 @@ def plot_comparison(comparison, path=None, quantities=None, *, ax=None, channel=
     rows = list(comparison.simulated.channels)
     rows += [c for c in comparison.measured.channels if c not in rows]
     rows, quantities = select_panels(rows, list(quantities or
-                                                comparison.requested_quantities()),
-                                     channel, quantity)
+                                                comparison.requested_quantities()), channel, quantity)
     phased = {k: c for k, c in phased_channels(comparison).items()
               if k[:2] in rows and k[2] in quantities} if phase else {}
     if is_axes(ax) and phased:
@@ -178,8 +177,7 @@ def _grid(ax, rows, quantities, channel, quantity, phased):
     axes_in = [height - LEVEL_DECORATION_IN if kind == "level" else PHASE_AXES_IN for _, kind in kinds]
     fig, all_axes, own = subplots(ax, len(kinds), len(quantities), sharex=True,
                                   figsize=(PRINT_WIDTH_IN, sum(rows_in) + FRAME_HEIGHT_IN
-                                           + PHASE_NOTE_HEIGHT_IN),
-                                  gridspec_kw={"height_ratios": axes_in})
+                                           + PHASE_NOTE_HEIGHT_IN), gridspec_kw={"height_ratios": axes_in})
     if own:
         fig.get_layout_engine().set(h_pad=PHASE_FIGURE_PAD_IN)
     level = [i for i, (_, kind) in enumerate(kinds) if kind == "level"]

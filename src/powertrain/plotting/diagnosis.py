@@ -129,8 +129,7 @@ def _gap_panels(axes, diagnosis, qs, cens, valid, scale=GAP_SCALE_DB):
     im = None
     for a, q in zip(axes.flat, qs):
         k = d.quantities.index(q)
-        g = diagnosis.gap[:, rows, k].T
-        ok = valid[:, rows, k].T
+        g, ok = diagnosis.gap[:, rows, k].T, valid[:, rows, k].T
         a.set_title(quantity_label(q), fontsize=TITLE_SIZE)
         a.set_yticks(y, [f"{d.channels[c][0]} {d.channels[c][1].upper()}" for c in rows])
         a.tick_params(labelsize=TICK_SIZE)
@@ -178,8 +177,7 @@ def plot_gap_frequency(diagnosis, path=None, *, ax=None, provenance=None):
     ax : None, Figure or SubFigure
     provenance : Provenance, optional
     """
-    d = diagnosis.data
-    p = diagnosis.parts
+    d, p = diagnosis.data, diagnosis.parts
     with_data = [k for k in np.flatnonzero(d.order_mask) if np.isfinite(diagnosis.gap[:, :, k]).any()]
     chans = [c for c in range(len(d.channels)) if np.isfinite(diagnosis.gap[:, c, with_data]).any()]
     many = len(chans) > MAX_CHANNELS_ONE_AXIS
@@ -303,9 +301,7 @@ def plot_diagnosis_overlay(diagnosis, path=None, n_panels=6, *, ax=None, provena
     ax : None, Figure or SubFigure
     provenance : Provenance, optional
     """
-    d = diagnosis.data
-    g = diagnosis.gap
-    cens = _censored(diagnosis)
+    d, g, cens = diagnosis.data, diagnosis.gap, _censored(diagnosis)
     score = []
     for c in range(len(d.channels)):
         for k in np.flatnonzero(d.order_mask):
@@ -334,8 +330,7 @@ def plot_diagnosis_overlay(diagnosis, path=None, n_panels=6, *, ax=None, provena
 
 def _overlay_panel(ax, diagnosis, c, k, held, rms, cens):
     d = diagnosis.data
-    m = d.level[:, c, k] * 1e3
-    cl = NOISE_FLOOR_MARGIN * d.floor * 1e3
+    m, cl = d.level[:, c, k] * 1e3, NOISE_FLOOR_MARGIN * d.floor * 1e3
     up = np.isfinite(m) & ~cens
     ax.plot(d.rpm[up], m[up], "k.", ms=2.5, label="measured")
     if cens.any():

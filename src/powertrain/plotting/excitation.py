@@ -39,10 +39,6 @@ def plot_excitation(exc, path=None, *, ax=None, provenance=None):
         Where to draw the six panels.
     provenance : Provenance, optional
         Foot line of a new figure.
-
-    Returns
-    -------
-    matplotlib Figure (or SubFigure)
     """
     deg = np.degrees(exc.crank_angle)
     fig, axes, own = subplots(ax, 3, 2, figsize=(PRINT_WIDTH_IN, 8.6))

@@ -48,8 +48,7 @@ def grid(ax, rows, quantities, channel=None, quantity=None, panel_height=None, f
     if is_axes(ax):
         if len(rows) * len(quantities) != 1:
             raise InputError(panels_error(len(rows) * len(quantities), ", or choose one "
-                                          "panel with channel=(MOUNT, DIR) and quantity="),
-                             key="ax")
+                                          "panel with channel=(MOUNT, DIR) and quantity="), key="ax")
         return ax.figure, {(*rows[0], quantities[0]): ax}, False, np.array([[ax]])
     nr, nq = len(rows), len(quantities)
     if panel_height is None:
@@ -226,8 +225,7 @@ def plot_whatif(whatif, path=None, *, ax=None, channel=None, quantity=None, prov
 
 def _levels_panel(a, whatif, key, overall):
     mount, direction, q = key
-    base = whatif.baseline
-    signal = getattr(whatif, "signal", "velocity")
+    base, signal = whatif.baseline, getattr(whatif, "signal", "velocity")
     scale = SIGNAL_UNITS[signal][0]
     values = []
     if whatif.measured is not None and signal == "velocity" and key in whatif.measured.curves:

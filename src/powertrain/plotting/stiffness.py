@@ -47,8 +47,7 @@ def draw_stiffness(axes, f, kcp, form, *, label, style="-", color=None, marker=N
                    freq_axis=DEFAULT_FREQ_AXIS):
     """Draw ``kcp`` [N/m] at ``f`` [Hz] into ``axes`` in ``form``: data as ``marker``, models
     as lines (``style``; imaginary dashed), on ``freq_axis``, with ``label``, ``color``."""
-    f = np.asarray(f, dtype=float)
-    k = np.asarray(kcp) / 1e3
+    f, k = np.asarray(f, dtype=float), np.asarray(kcp) / 1e3
     if freq_axis == "log":
         ok = f > 0
         f, k = f[ok], k[ok]
@@ -93,8 +92,7 @@ def style_stiffness(axes, form, freq_axis, band=None, own=False):
 
 
 def plot_stiffness(curves, path=None, measured=None, ax=None, *, form=DEFAULT_FORM,
-                   freq_axis=DEFAULT_FREQ_AXIS, title=None, provenance=None,
-                   measured_label="measured"):
+                   freq_axis=DEFAULT_FREQ_AXIS, title=None, provenance=None, measured_label="measured"):
     """Cross-point dynamic stiffness K*(f) of one or more mount models (and a measurement).
 
     Parameters
@@ -112,10 +110,6 @@ def plot_stiffness(curves, path=None, measured=None, ax=None, *, form=DEFAULT_FO
         Foot line of a new figure.
     measured_label : str
         Legend label of ``measured``.
-
-    Returns
-    -------
-    matplotlib Figure (or SubFigure)
     """
     fig, axes, own = stiffness_axes(ax, form)
     if measured is not None:
@@ -167,10 +161,6 @@ def plot_mount_fit(frequency_hz, kcp_measured, kcp_fitted, *, label="fit", title
         As for :func:`plot_stiffness`.
     synthetic : bool
         Label the data and title ``SYNTHETIC``.
-
-    Returns
-    -------
-    matplotlib Figure (or SubFigure)
     """
     f_fit, k_fit = kcp_fitted if isinstance(kcp_fitted, tuple) else (frequency_hz, kcp_fitted)
     if synthetic:
@@ -197,8 +187,7 @@ def plot_retune(target_fit, path=None, *, ax=None, form=DEFAULT_FORM,
     fig, axes, own = stiffness_axes(ax, form)
     for k, style, label, color in ((tf.kcp_baseline, "-", "baseline", "k"),
                                    (tf.kcp_target, "--", "requested", colour(1)),
-                                   (tf.kcp_fitted, "-", f"fitted {tf.model.topology.name}",
-                                    colour(0))):
+                                   (tf.kcp_fitted, "-", f"fitted {tf.model.topology.name}", colour(0))):
         draw_stiffness(axes, tf.frequency_hz, k, form, label=label, style=style, color=color,
                        freq_axis=freq_axis)
     style_stiffness(axes, form, freq_axis, band=(tf.target.f_lo, tf.target.f_hi), own=own)
@@ -208,8 +197,7 @@ def plot_retune(target_fit, path=None, *, ax=None, form=DEFAULT_FORM,
 
 
 def plot_amplitude_fit(curves, path=None, *, ax=None, form=DEFAULT_FORM,
-                       freq_axis=DEFAULT_FREQ_AXIS, title=None, provenance=None,
-                       synthetic=False):
+                       freq_axis=DEFAULT_FREQ_AXIS, title=None, provenance=None, synthetic=False):
     """Measured (dots) and fitted (lines) K*(f) per test amplitude (Kovarik 2016, Fig. 14).
 
     Parameters

@@ -193,8 +193,8 @@ def finish(fig, own, path=None, provenance=None, title=None):
 
 
 def keep_inside(fig, tries=3) -> bool:
-    """Shrink a figure's constrained-layout area by any text overhang at its edges (layout
-    ignores it beside the provenance strip); True when nothing overhangs."""
+    """Shrink a figure's constrained-layout area by any text overhang at its edges (the
+    layout contains overhangs only when its area is the whole figure); True when none."""
     engine = fig.get_layout_engine()
     if engine is None or "rect" not in engine.get():
         return False
@@ -239,8 +239,8 @@ def add_provenance(fig, provenance):
 
 
 def foot_text(provenance, width_in) -> str:
-    """The provenance line in lines of ``width_in`` at :data:`FOOT_SIZE`: the command on lines
-    of its own, broken between arguments with shell continuations, runnable as printed.
+    """The provenance line in lines of ``width_in`` at :data:`FOOT_SIZE`: one when it fits,
+    else the command on lines of its own broken with shell continuations, runnable as printed.
 
     Parameters
     ----------
@@ -378,8 +378,7 @@ def log_axis(ax, axis="x", max_ticks=8, minor=True):
             if axis != "y" or not (vmin > 0 and vmax > 0):
                 return 0.0
             a = self.axis.axes
-            height_pt = a.bbox.height * 72 / a.figure.dpi
-            span = abs(math.log10(vmax / vmin))
+            height_pt, span = a.bbox.height * 72 / a.figure.dpi, abs(math.log10(vmax / vmin))
             return 1.25 * TICK_SIZE * span / height_pt if height_pt > 0 else 0.0
 
     target = ax.xaxis if axis == "x" else ax.yaxis

@@ -189,8 +189,7 @@ def plot_overlay(comparison, path=None, ax=None, provenance=None):
     rows, cols, shown = overlay_grid(n)
     height = min(1.7 + 1.6 * rows, MAX_HEIGHT_IN)
     fig, axes, own = subplots(ax, rows, cols, figsize=(PRINT_WIDTH_IN, height), sharex=True)
-    e = comparison.errors()
-    t = comparison.time
+    e, t = comparison.errors(), comparison.time
     drawn = overlay_channels(comparison.channels, e["rms_difference_percent"], shown)
     for k, a in enumerate(axes.ravel()):
         if k >= shown:
@@ -203,8 +202,7 @@ def plot_overlay(comparison, path=None, ax=None, provenance=None):
         a.set_title(f"{comparison.channels[j]}: peak "
                     f"{'n/a' if np.isnan(peak) else signed(peak) + ' %'}\n"
                     f"RMS diff. {e['rms_difference'][j]:.3g} m/s²"
-                    + ("" if np.isnan(share) else f" ({share:.0f} %)"), fontsize=TICK_SIZE,
-                    pad=3)
+                    + ("" if np.isnan(share) else f" ({share:.0f} %)"), fontsize=TICK_SIZE, pad=3)
         a.margins(x=X_MARGIN, y=Y_MARGIN)
         a.tick_params(labelsize=TICK_SIZE)
         a.grid(True, lw=0.3)
