@@ -1,45 +1,20 @@
-r"""A recorded manoeuvre lined up with a simulated one: the crank speed of a tacho through
-standstill, the time shift that best matches two speed profiles or a tacho's pulses, and
-whether that shift is determined at all (a trigger channel's time:
+r"""A recorded manoeuvre lined up with a simulated one (a trigger channel's time:
 :mod:`powertrain.analysis.trigger`).
 
 **Tacho speed** (:func:`tacho_rpm`): each interval between rising edges gives its mean speed
-:math:`60\,\Delta c/(N\Delta t)` [rpm], :math:`\Delta c` the pulses it spans (1, or a
-missing-tooth wheel's gap counted, :func:`tacho_counts`) of :math:`N` per revolution,
-placed at the interval's midpoint, linear between midpoints.
-Before the first edge :math:`e_0`, with :math:`d_1` the first interval: where the recording
-starts more than :math:`d_1` before :math:`e_0`, the crank cannot have turned at the first
-interval's speed over that time (it would have passed the pulse once more inside the
-record), so it is taken at rest until one first interval before the first edge
-(:math:`e_0 - d_1`, where the pulse before would have been) and rising linearly from 0 there
-to the first interval's speed at its midpoint; otherwise it was already turning and the
-first interval's speed is held back to the first sample. After the last edge likewise: the
-speed falls linearly to 0 at one last interval after it where the record goes on longer
-than that, else the last interval's speed is held.
+:math:`60\,\Delta c/(N\Delta t)` [rpm] at its midpoint, linear between; at rest before the
+first edge (after the last) where the record extends more than one interval beyond it.
 
-**Alignment on the speed** (:func:`align_speed`): the shift :math:`s` minimising the mean of
+**Speed alignment** (:func:`align_speed`): the shift :math:`s` minimising the mean of
 :math:`(n_\mathrm{rec}(t) - n_\mathrm{sim}(t - s))^2` over the recorded samples inside the
-event (at most :data:`COST_SAMPLES`; an unsigned speed channel against the event's
-magnitude; a channel held between updates read at its updates, :func:`unheld_speed`),
-among the shifts where the recording covers :data:`MIN_COVERAGE` of the event at either end
-(or, not ``partial``, all of it; a grid, then refined 100 times finer about the best). At
-the best shift the speeds may differ by :data:`MISMATCH_SHARE` of the event's speed range
-(RMS), else no shift matches. Its standard error is
-:math:`\sigma / \sqrt{\sum \dot n_\mathrm{sim}^2}` over the recorded samples (least
-squares on one parameter), :math:`\sigma` the recorded speed's scatter (the second
-differences' RMS over :math:`\sqrt 6`, at least :data:`SPEED_FLOOR_RPM`); where
-:data:`ALIGN_SIGMAS` standard errors exceed the time the crank takes to turn
-:data:`ALIGN_TOLERANCE_DEG` at the event's top speed, the speed varies too little to align
-on and the recording is refused (a trigger channel is then needed). It is refused too where
-the speed matches as well elsewhere: a shift outside the valley of the best one (beyond
-where the cost first rises by :math:`\sigma^2` on either side) whose cost is within
-:math:`\sigma^2` of the best (a recording of two starts).
+event; standard error :math:`\sigma / \sqrt{\sum \dot n_\mathrm{sim}^2}`, :math:`\sigma` the
+recorded speed's scatter (second differences' RMS over :math:`\sqrt 6`). Refused where
+:data:`ALIGN_SIGMAS` standard errors exceed the time the crank turns
+:data:`ALIGN_TOLERANCE_DEG` at top speed, or where a shift outside the best one's valley
+costs within :math:`\sigma^2` of the best (two starts).
 
-**Alignment on a tacho's pulses** (:func:`align_tacho`): the event's crank angle at the
-rising edges less :math:`1/N` revolution per pulse counted is constant at the true shift
-(the pulses' phase unknown): the shift minimising its variance, among the shifts where the edges inside the
-event are as many as the revolutions it turns there (within one); its standard error the
-phase's scatter over :math:`\sqrt{\sum \dot\theta^2}` at the edges; refused as above.
+**Tacho alignment** (:func:`align_tacho`): the shift minimising the variance of the event's
+crank angle at the edges less :math:`1/N` revolution per pulse counted.
 """
 
 from __future__ import annotations
@@ -53,52 +28,44 @@ from powertrain.errors import InputError, PowertrainWarning
 
 #: Times of the event at which the speeds are matched.
 GRID = 400
-#: Smallest scatter assumed of a recorded speed [rpm] (the resolution of an rpm channel).
+#: Smallest scatter assumed of a recorded speed [rpm] (an rpm channel's resolution).
 SPEED_FLOOR_RPM = 1.0
-#: An alignment on the speed is accepted when ALIGN_SIGMAS standard errors of its shift are
-#: at most the time the crank takes to turn ALIGN_TOLERANCE_DEG [deg] at the event's top
-#: speed (2 deg: 4 deg of phase on the 2nd order, about 7 % RMS of an identical waveform).
+#: Accepted when ALIGN_SIGMAS standard errors are at most the time the crank turns
+#: ALIGN_TOLERANCE_DEG [deg] at top speed (2 deg: 4 deg of 2nd-order phase, ~7 % RMS).
 ALIGN_SIGMAS = 3.0
 ALIGN_TOLERANCE_DEG = 2.0
 #: Least part of the event a recording must cover after alignment.
 MIN_COVERAGE = 0.5
-#: A speed channel whose samples change at fewer than this share of them is held between
-#: updates (:func:`unheld_speed`).
+#: A speed channel changing at fewer than this share of its samples is held between updates.
 HELD_SHARE = 0.5
-#: The speeds at the best shift may differ by at most this share of the event's speed range
-#: (RMS; else the recording does not match the event anywhere).
+#: Largest RMS speed difference at the best shift, as a share of the event's speed range.
 MISMATCH_SHARE = 0.1
-#: A tacho's alignment: least pulses inside the event, the phase's scatter assumed at least
-#: [rev] (a sample of jitter), and the most [rev] at the best shift (else no match).
+#: Tacho alignment: least pulses inside the event, least phase scatter [rev], and the most
+#: [rev] at the best shift.
 MIN_EDGES = 4
 PHASE_FLOOR_REV = 1e-4
 MISMATCH_REV = 0.05
-#: Longest correlation of a speed residual [s] and of a tacho's phase residual [rev]
-#: the shift's standard error takes in (:func:`_correlated_error`: two periods of the 2nd
-#: order at 250 rpm; eight revolutions: the slow drift of a sampled tacho's edges).
+#: Longest correlation of a speed residual [s] (two periods of the 2nd order at 250 rpm)
+#: and of a tacho's phase residual [rev] (a sampled tacho's slow drift).
 CORRELATION_S = 0.25
 CORRELATION_REV = 8.0
-#: What an alignment's error offers instead: the trigger channel's option.
+#: The option an alignment's error offers instead.
 TRIGGER = "--trigger CHANNEL"
-#: Times at which an event's speed table is read for its angle and slope, and the most
-#: recorded samples a speed alignment's cost reads.
+#: Times the event's speed table is read at, and most recorded samples a speed cost reads.
 FINE = 20001
 COST_SAMPLES = 20000
 
 
 class AlignmentWarning(PowertrainWarning):
-    """A recording lined up on its crank speed or tacho whose shift is uncertain by more
-    than :data:`ALIGN_TOLERANCE_DEG` (:data:`ALIGN_SIGMAS` standard errors) because the
-    recorded speed differs from the event's (a correlated residual: another profile, a
-    fluctuation at the firing orders), not because it varies too little."""
+    """A shift uncertain by more than :data:`ALIGN_TOLERANCE_DEG` (:data:`ALIGN_SIGMAS`
+    standard errors) because the recorded speed differs from the event's (a correlated
+    residual), not because it varies too little."""
 
 
 def tacho_counts(edges, pulses_per_rev=1, *, file=None, key="tacho") -> tuple:
-    """``(edges, counts)``: a tacho's rising edges [s], spikes dropped, and the pulses
-    counted at each from the first: one per edge with one pulse per revolution (a start's
-    intervals change too fast to tell a gap), else
-    :func:`~powertrain.analysis.speed.count_teeth`'s (a missing-tooth wheel's gap
-    counted)."""
+    """``(edges, counts)``: a tacho's rising ``edges`` [s], spikes dropped, and the pulses
+    counted at each: one per edge at one pulse per revolution, else
+    :func:`~powertrain.analysis.speed.count_teeth`'s; ``file``, ``key`` name errors."""
     edges = np.asarray(edges, float)
     if pulses_per_rev == 1:
         edges = drop_spikes(edges)[0]
@@ -108,16 +75,14 @@ def tacho_counts(edges, pulses_per_rev=1, *, file=None, key="tacho") -> tuple:
 
 
 def tacho_rpm(time, edges, counts, pulses_per_rev=1) -> np.ndarray:
-    """Crank speed [rpm] at every sample from a tacho of ``pulses_per_rev`` pulses per
-    revolution (module docstring: interval means at their midpoints, standstill before the
-    first and after the last edge where the record is long enough to show it).
+    """Crank speed [rpm] at every sample from a tacho (module docstring).
 
     Parameters
     ----------
     time : ndarray (n,)
         [s]
     edges, counts : ndarray (m,)
-        The tacho's rising edges [s] and the pulses counted at each (:func:`tacho_counts`).
+        Rising edges [s] and pulses counted at each (:func:`tacho_counts`).
     pulses_per_rev : int
     """
     time = np.asarray(time, float)
@@ -132,11 +97,10 @@ def tacho_rpm(time, edges, counts, pulses_per_rev=1) -> np.ndarray:
 
 def trigger_shift(crossing, trigger_at, rpm_event, *, file=None, key="--trigger"):
     """The recording's time [s] of the event's time 0 from a trigger's ``crossing``
-    (:class:`~powertrain.analysis.trigger.TriggerCrossing`) that marks the event's time
-    ``trigger_at`` [s]; refused where it is known worse than the time the crank takes to
-    turn :data:`ALIGN_TOLERANCE_DEG` at the event's top speed (``rpm_event`` [rpm]): the
-    root sum of squares of :data:`ALIGN_SIGMAS` times its noise's standard error and half
-    its sampling interval (the worst of a step anywhere in it)."""
+    (:class:`~powertrain.analysis.trigger.TriggerCrossing`) marking the event's time
+    ``trigger_at`` [s]; refused where :data:`ALIGN_SIGMAS` noise errors and half a sampling
+    interval (root sum of squares) exceed the time the crank turns
+    :data:`ALIGN_TOLERANCE_DEG` at the top of ``rpm_event`` [rpm]."""
     top = max(float(np.max(np.abs(rpm_event))), SPEED_FLOOR_RPM)
     allowed = ALIGN_TOLERANCE_DEG / (6.0 * top)
     bound = float(np.hypot(ALIGN_SIGMAS * crossing.spread, 0.5 * crossing.sampling))
@@ -150,56 +114,51 @@ def trigger_shift(crossing, trigger_at, rpm_event, *, file=None, key="--trigger"
 
 
 def coverage(t0, t1, rec0, rec1, shift):
-    """Part of the event ``t0..t1`` [s] the recording ``rec0..rec1`` covers when the event's
-    time t is the recording's t + ``shift``: ``(first, last)`` event times [s]."""
+    """``(first, last)`` event times [s] of ``t0..t1`` the recording ``rec0..rec1`` covers,
+    the event's time t being the recording's t + ``shift`` [s]."""
     return max(t0, rec0 - shift), min(t1, rec1 - shift)
 
 
 def align_speed(t_sim, rpm_sim, t_rec, rpm_rec, *, file=None, key="rpm",
                 partial=True, trigger=TRIGGER) -> tuple:
-    """Time shift [s] of the recording against the event (the recording's time of the event's
-    time 0) and its standard error [s], from the speeds (module docstring).
+    """Shift [s] of the recording against the event, and its standard error [s], from the speeds.
 
     Parameters
     ----------
     t_sim, rpm_sim : ndarray
-        The event's times [s] and crank speed [rpm] (the manoeuvre's or the simulation's).
+        The event's times [s] and crank speed [rpm].
     t_rec, rpm_rec : ndarray
         The recording's sample times [s] and crank speed [rpm].
     file, key : str, optional
         Named in error messages.
     partial : bool
-        The recording may cover part of the event (at least :data:`MIN_COVERAGE`, at either
-        end); False: it holds all of it.
+        The recording may cover part of the event (at least :data:`MIN_COVERAGE`); False:
+        all of it.
     trigger : str
-        The option an error message offers instead (default :data:`TRIGGER`).
+        The option an error message offers instead.
 
     Raises
     ------
     InputError
-        The recording shorter than :data:`MIN_COVERAGE` of the event, the speed too flat
-        to align on, matching at two places, or not matching anywhere.
+        The recording too short, the speed too flat, matching at two places or nowhere.
     """
     t_sim, t_rec = np.asarray(t_sim, float), np.asarray(t_rec, float)
     length, event = t_rec[-1] - t_rec[0], t_sim[-1] - t_sim[0]
     if length < MIN_COVERAGE * event:
         raise InputError(f"the recording is {length:.4g} s long, less than "
-                         f"{MIN_COVERAGE:.0%} of the {event:.4g} s event", file=file,
-                         key="time")
+                         f"{MIN_COVERAGE:.0%} of the {event:.4g} s event", file=file, key="time")
     sigma = _scatter(t_rec, rpm_rec)
     t_rec, rpm_rec = unheld_speed(t_rec, np.asarray(rpm_rec, float))
     t, target = _fine(t_sim, rpm_sim)
     costs = _costs(t, target, t_rec, rpm_rec)
-    shifts, coarse, shift = _search(costs, _shift_range(t_sim, (t_rec[0], t_rec[-1]),
-                                                        partial), event)
+    shifts, coarse, shift = _search(costs, _shift_range(t_sim, (t_rec[0], t_rec[-1]), partial), event)
     best = int(np.argmin(coarse))
     other = _second_match(coarse, best, sigma ** 2)
     if other is not None:
         raise InputError(f"the crank speed matches the event's at two places of the recording "
                          f"(the event starting at {shift:.4f} s or at {shifts[other]:.4f} s); "
                          f"give {trigger}", file=file, key=key)
-    _check_match(float(np.sqrt(costs(np.array([shift]))[0])), sigma, target, (file, key),
-                 trigger)
+    _check_match(float(np.sqrt(costs(np.array([shift]))[0])), sigma, target, (file, key), trigger)
     white, error = _shift_error(t, target, t_rec, rpm_rec, shift, sigma)
     top = max(float(np.max(np.abs(target))), SPEED_FLOOR_RPM)
     allowed = ALIGN_TOLERANCE_DEG / (6.0 * top)
@@ -215,20 +174,26 @@ def align_speed(t_sim, rpm_sim, t_rec, rpm_rec, *, file=None, key="rpm",
 
 def align_tacho(t_sim, rpm_sim, span, edges, *, counts=None, pulses_per_rev=1, file=None,
                 key="tacho", partial=True, trigger=TRIGGER) -> tuple:
-    """Time shift [s] of the recording against the event and its standard error [s] from a
-    tacho's rising ``edges`` [s] with ``counts`` pulses counted at each (default one per
-    edge; :func:`tacho_counts`) of ``pulses_per_rev`` per revolution, the recording lasting
-    ``span = (first, last)`` [s]: the shift at which the event's crank angle at the edges,
-    less 1/``pulses_per_rev`` revolution per pulse counted, is most nearly constant (least
-    squares, the pulses' phase eliminated), among the shifts where the pulses inside the
-    event span as many revolutions as it turns there (module docstring); ``partial`` and
-    ``trigger`` as :func:`align_speed`'s.
+    """Shift [s] of the recording against the event, and its standard error [s], from a tacho.
+
+    Parameters
+    ----------
+    t_sim, rpm_sim : ndarray
+        The event's times [s] and crank speed [rpm].
+    span : (float, float)
+        The recording's first and last time [s].
+    edges : ndarray
+        The tacho's rising edges [s].
+    counts : ndarray, optional
+        Pulses counted at each edge (default one per edge; :func:`tacho_counts`).
+    pulses_per_rev : int
+    file, key, partial, trigger
+        As :func:`align_speed`'s.
 
     Raises
     ------
     InputError
-        Fewer than :data:`MIN_EDGES` edges in the event, no shift matching, two, or one not
-        determined to :data:`ALIGN_TOLERANCE_DEG`.
+        Fewer than :data:`MIN_EDGES` edges in the event, no match, two, or one not determined.
     """
     t_sim, rpm_sim = _fine(t_sim, rpm_sim)
     edges = np.asarray(edges, float)
@@ -246,8 +211,7 @@ def align_tacho(t_sim, rpm_sim, span, edges, *, counts=None, pulses_per_rev=1, f
                          "revolution); give --pulses-per-rev N for a wheel of N teeth, or "
                          f"{trigger}", file=file, key=key)
     best = int(np.argmin(coarse))
-    sigma = max(float(np.sqrt(_phase_cost(shift, t_sim, rev, edges, revs, span))),
-                PHASE_FLOOR_REV)
+    sigma = max(float(np.sqrt(_phase_cost(shift, t_sim, rev, edges, revs, span))), PHASE_FLOOR_REV)
     if sigma > MISMATCH_REV:
         raise InputError(f"the tacho's pulses do not follow the event's crank angle at any "
                          f"shift ({sigma:.2g} rev RMS at the best, read as {pulses_per_rev} "
@@ -270,8 +234,7 @@ def align_tacho(t_sim, rpm_sim, span, edges, *, counts=None, pulses_per_rev=1, f
 
 
 def _warn_uncertain(error, allowed, what, file) -> None:
-    """:class:`AlignmentWarning` where :data:`ALIGN_SIGMAS` standard errors ``error`` [s]
-    exceed ``allowed`` [s]."""
+    """:class:`AlignmentWarning` where ALIGN_SIGMAS times ``error`` [s] exceeds ``allowed`` [s]."""
     if ALIGN_SIGMAS * error > allowed:
         warnings.warn(AlignmentWarning(
             f"{file or 'the recording'}: lined up on the {what}, but the recorded speed "
@@ -281,31 +244,29 @@ def _warn_uncertain(error, allowed, what, file) -> None:
             "channel (--trigger) lines it up better"), stacklevel=3)
 
 
-def _phase_error(shift, t_sim, rev, speed, edges, revs, span, sigma) -> tuple:
-    """Standard errors [s] of the tacho's shift, least squares on the shift with the
-    pulses' phase eliminated (the speed at the edges less its mean): ``(white, error)``,
-    the first from the phase's white scatter ``sigma`` [rev], the second from the phase
-    residual correlated as it is over the edges (:func:`_correlated_error`), at least the
-    first."""
-    first, last = max(t_sim[0], span[0] - shift), min(t_sim[-1], span[1] - shift)
+def _edges_inside(shift, t_sim, span, edges) -> tuple:
+    """``(first, last, at, inside)``: the covered event span [s], edges in event time, mask."""
+    first, last = coverage(t_sim[0], t_sim[-1], span[0], span[1], shift)
     at = edges - shift
-    inside = (at >= first) & (at <= last)
+    return first, last, at, (at >= first) & (at <= last)
+
+
+def _phase_error(shift, t_sim, rev, speed, edges, revs, span, sigma) -> tuple:
+    """``(white, error)`` [s] of the tacho's shift: from the white phase scatter ``sigma``
+    [rev], and from the residual as correlated (:func:`_correlated_error`), at least white."""
+    _, _, at, inside = _edges_inside(shift, t_sim, span, edges)
     phase = np.interp(at[inside], t_sim, rev) - revs[inside]
     rate = np.interp(at[inside], t_sim, speed)
     lags = round(CORRELATION_REV * np.median(np.diff(revs)) ** -1)
     design = rate - np.mean(rate)
     white = sigma / np.sqrt(float(design @ design)) if np.any(design) else np.inf
-    return white, max(white, _correlated_error(design, phase - np.mean(phase),
-                                               PHASE_FLOOR_REV, lags))
+    return white, max(white, _correlated_error(design, phase - np.mean(phase), PHASE_FLOOR_REV, lags))
 
 
 def _phase_cost(shift, t_sim, rev, edges, revs, span) -> float:
-    """Variance [rev²] of the event's crank angle at the edges inside it less their
-    revolutions counted ``revs`` (inf where fewer than :data:`MIN_EDGES`, or where the edges
-    span other revolutions than the event turns over the recorded part, within one)."""
-    first, last = max(t_sim[0], span[0] - shift), min(t_sim[-1], span[1] - shift)
-    at = edges - shift
-    inside = (at >= first) & (at <= last)
+    """Variance [rev²] of the event's angle at the edges less ``revs``; inf where fewer than
+    :data:`MIN_EDGES` or the edges span other revolutions than the event turns (within one)."""
+    first, last, at, inside = _edges_inside(shift, t_sim, span, edges)
     at, counted = at[inside], revs[inside]
     if at.size < MIN_EDGES:
         return np.inf
@@ -316,24 +277,21 @@ def _phase_cost(shift, t_sim, rev, edges, revs, span) -> float:
 
 
 def _search(costs, bounds, event) -> tuple:
-    """``(shifts, their costs, best shift)``: ``costs`` (of an array of shifts) on a grid
-    over ``bounds`` at most ``event / GRID`` apart, then 100 times finer about its best,
-    then the vertex of the parabola through the finer grid's best and its neighbours."""
+    """``(shifts, their costs, best shift)``: a grid over ``bounds`` at most ``event / GRID``
+    apart, 100 times finer about its best, then the parabola vertex (:func:`_vertex`)."""
     lo, hi = bounds
     shifts = np.linspace(lo, hi, max(801, int(np.ceil((hi - lo) / (event / GRID))) + 1))
     coarse = costs(shifts)
     best = int(np.argmin(coarse))
-    fine = np.clip(shifts[best] + np.linspace(-2.0, 2.0, 401) * (shifts[1] - shifts[0]),
-                   lo, hi)
+    fine = np.clip(shifts[best] + np.linspace(-2.0, 2.0, 401) * (shifts[1] - shifts[0]), lo, hi)
     near = costs(fine)
     k = int(np.argmin(near))
     return shifts, coarse, _vertex(fine, near, k)
 
 
 def _vertex(shifts, costs, k) -> float:
-    """The shift of the least cost: the vertex of the parabola through ``k`` and its
-    neighbours on the uniform grid ``shifts``, where they are finite and curve upwards;
-    else ``shifts[k]``."""
+    """Vertex of the parabola through ``k`` and its neighbours where finite and convex, else
+    ``shifts[k]``."""
     if not 0 < k < shifts.size - 1 or not np.all(np.isfinite(costs[k - 1:k + 2])):
         return float(shifts[k])
     left, mid, right = costs[k - 1:k + 2]
@@ -345,20 +303,16 @@ def _vertex(shifts, costs, k) -> float:
 
 
 def _shift_range(t_sim, span, partial) -> tuple:
-    """The shifts [s] searched: the recording covering at least :data:`MIN_COVERAGE` of the
-    event at either end (``partial``), else holding all of it (a shorter one: lying
-    inside it)."""
+    """Shifts [s] searched: covering :data:`MIN_COVERAGE` of the event (``partial``), else all."""
     event = t_sim[-1] - t_sim[0]
     if partial:
-        return (span[0] - t_sim[-1] + MIN_COVERAGE * event,
-                span[1] - t_sim[0] - MIN_COVERAGE * event)
+        return (span[0] - t_sim[-1] + MIN_COVERAGE * event, span[1] - t_sim[0] - MIN_COVERAGE * event)
     return tuple(sorted((span[0] - t_sim[0], span[1] - t_sim[-1])))
 
 
 def unheld_speed(t_rec, rpm_rec):
-    """``(t_rec, rpm)``: a speed channel [rpm] held between updates (an ECU's or a bus's:
-    most samples repeat the one before) as its updates, linear between them; any other as
-    it is."""
+    """``(t_rec, rpm)``: a speed channel ``rpm_rec`` [rpm] held between updates (most samples
+    repeat the one before) as its updates, linear between them; any other as it is."""
     changed = np.r_[True, np.diff(rpm_rec) != 0]
     if np.mean(changed) >= HELD_SHARE or np.count_nonzero(changed) < 4:
         return t_rec, rpm_rec
@@ -367,36 +321,35 @@ def unheld_speed(t_rec, rpm_rec):
 
 
 def _check_match(residual, sigma, target, where, trigger):
-    """Refuse a best shift at which the speeds still differ by more than
-    :data:`MISMATCH_SHARE` of the event's speed range (and many times the scatter): the
-    recorded speed is not the event's anywhere."""
+    """Refuse a best shift whose RMS ``residual`` [rpm] exceeds :data:`MISMATCH_SHARE` of the
+    event's speed range and five times the scatter."""
     span, (file, key) = float(np.ptp(target)), where
     if residual > max(MISMATCH_SHARE * span, 5.0 * sigma):
         raise InputError(f"the recorded crank speed does not match the event's at any shift "
                          f"(RMS difference {residual:.3g} rpm at the best, over "
                          f"{MISMATCH_SHARE:.0%} of its {span:.4g} rpm range); give {trigger}, or "
-                         "drive the simulation with --speed-from", file=file,
-                         key=key)
+                         "drive the simulation with --speed-from", file=file, key=key)
 
 
 def _fine(t_sim, rpm_sim):
-    """The event's speed [rpm] on :data:`FINE` times (a speed table's rows are linear between
-    them: its angle is not)."""
+    """The event's speed [rpm] on :data:`FINE` times (its angle is not linear between rows)."""
     t_sim = np.asarray(t_sim, float)
     t = np.linspace(t_sim[0], t_sim[-1], FINE)
     return t, np.interp(t, t_sim, np.asarray(rpm_sim, float))
 
 
-def _shift_error(t, target, t_rec, rpm_rec, shift, sigma) -> tuple:
-    """Standard errors [s] of the shift against the event's speed ``target`` [rpm] at ``t``
-    (:func:`_fine`), least squares on one parameter over the recorded samples inside the
-    event (those the cost reads): ``(white, error)``, the first from the recorded speed's
-    white scatter ``sigma`` [rpm] (:func:`_scatter`: whether the speed varies enough), the
-    second from the residual at the shift, correlated as it is (:func:`_correlated_error`),
-    at least the first."""
+def _cost_samples(target, t_rec, rpm_rec) -> tuple:
+    """``(target, every)``: the event's magnitude against an unsigned channel, and the stride
+    keeping at most :data:`COST_SAMPLES` recorded samples."""
     if np.min(rpm_rec) >= 0:
         target = np.abs(target)
-    every = max(1, int(np.ceil(t_rec.size / COST_SAMPLES)))
+    return target, max(1, int(np.ceil(t_rec.size / COST_SAMPLES)))
+
+
+def _shift_error(t, target, t_rec, rpm_rec, shift, sigma) -> tuple:
+    """``(white, error)`` [s] of the speed shift: from the white scatter ``sigma`` [rpm], and
+    from the residual as correlated (:func:`_correlated_error`), at least white."""
+    target, every = _cost_samples(target, t_rec, rpm_rec)
     at, rr = t_rec[::every] - shift, rpm_rec[::every]
     inside = (at >= t[0]) & (at <= t[-1])
     slope = np.interp(at[inside], t, np.gradient(target, t))
@@ -407,14 +360,12 @@ def _shift_error(t, target, t_rec, rpm_rec, shift, sigma) -> tuple:
 
 
 def _correlated_error(design, residual, floor, lags) -> float:
-    r"""Standard error of a one-parameter least-squares fit of slope ``design`` whose
-    ``residual`` (both at evenly spaced points) may be correlated and of unequal scatter
-    (a fluctuation at the firing orders, filtered noise, a profile that differs, a tacho's
-    edges jittering by a time, not an angle): Newey and West's (1987)
-    :math:`\sqrt{\sum_{|k|\le L} w_k \sum_i u_i u_{i+k}} / \sum_i d_i^2`,
-    :math:`u_i = d_i r_i`, Bartlett weights :math:`w_k = 1 - |k|/(L+1)` over ``lags``
-    :math:`L` (at most a fifth of the points); at least ``floor`` over
-    :math:`\sqrt{\sum d_i^2}` (white scatter of that size)."""
+    r"""Standard error of a one-parameter least-squares fit with correlated residuals.
+
+    Newey and West (1987): :math:`\sqrt{\sum_{|k|\le L} w_k \sum_i u_i u_{i+k}} / \sum_i
+    d_i^2`, :math:`u_i = d_i r_i`, Bartlett weights :math:`w_k = 1 - |k|/(L+1)`, :math:`L`
+    = ``lags`` (at most a fifth of the points); at least ``floor`` over
+    :math:`\sqrt{\sum d_i^2}`."""
     d, r = np.asarray(design, float), np.asarray(residual, float)
     info = float(d @ d)
     if not info > 0:
@@ -430,12 +381,8 @@ def _correlated_error(design, residual, floor, lags) -> float:
 
 
 def _costs(t, target, t_rec, rpm_rec):
-    """Mean squared speed difference [rpm²] over the recorded samples (at most
-    :data:`COST_SAMPLES`, evenly taken) inside the event, as a function of an array of
-    shifts; an unsigned speed channel (never negative) against the event's magnitude."""
-    if np.min(rpm_rec) >= 0:
-        target = np.abs(target)
-    every = max(1, int(np.ceil(t_rec.size / COST_SAMPLES)))
+    """Mean squared speed difference [rpm²] inside the event as a function of shifts."""
+    target, every = _cost_samples(target, t_rec, rpm_rec)
     tr, rr = t_rec[::every], rpm_rec[::every]
 
     def costs(shifts):
@@ -450,11 +397,9 @@ def _costs(t, target, t_rec, rpm_rec):
 
 
 def _second_match(costs, best, margin):
-    """Index of the best shift outside the valley of ``best`` whose cost is within
-    ``margin`` of the best (as good a match elsewhere), else None."""
+    """Index of the best shift outside ``best``'s valley costing within ``margin``, else None."""
     above = np.flatnonzero(costs >= costs[best] + margin)
-    left = above[above < best]
-    right = above[above > best]
+    left, right = above[above < best], above[above > best]
     outside = np.zeros(costs.size, bool)
     if left.size:
         outside[:left[-1]] = True
@@ -465,8 +410,7 @@ def _second_match(costs, best, margin):
 
 
 def _scatter(t_rec, rpm_rec) -> float:
-    """The recorded speed's scatter [rpm]: the RMS of its second differences over sqrt(6)
-    (white noise), at least :data:`SPEED_FLOOR_RPM`."""
+    """Speed scatter [rpm]: second differences' RMS over sqrt(6), at least SPEED_FLOOR_RPM."""
     r = np.asarray(rpm_rec, float)
     scatter = np.sqrt(np.mean(np.diff(r, 2) ** 2) / 6.0) if r.size > 2 else 0.0
     return max(scatter, SPEED_FLOOR_RPM)

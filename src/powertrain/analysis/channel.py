@@ -1,12 +1,8 @@
 """Where a vibration channel sits: mount (or body point), side and direction.
 
-One value type, one spelling. The label of a channel is ``MOUNT.DIRECTION`` on the engine
-(active) side and ``MOUNT.passive.DIRECTION`` on the body (passive) side, e.g. ``left.z``,
-``left.passive.z``; it names the channels of raw recordings, tracked orders and their files.
-
-Results of a run-up key their curves by a *node* and a direction: ``left`` (engine side),
-``left/passive`` (body side, as in the run-up's files), a body point's own name;
-:meth:`Channel.of_node` and :attr:`Channel.node` translate to and from it.
+Labels are ``MOUNT.DIRECTION`` (engine side) and ``MOUNT.passive.DIRECTION`` (body side),
+e.g. ``left.z``, ``left.passive.z``. Run-up results key curves by a *node* (``left``,
+``left/passive``, a body point) and a direction: :meth:`Channel.of_node`, :attr:`Channel.node`.
 """
 
 from __future__ import annotations
@@ -20,15 +16,12 @@ DIRECTIONS = ("x", "y", "z")
 PASSIVE = "/passive"
 
 _TEXT = re.compile(r"^\s*([A-Za-z_][\w\-]*)(?:/(passive)|\.(active|passive))?\.([xyzXYZ])\s*$")
-
-
 _MOUNT = re.compile(r"^[A-Za-z_][\w\-]*$")
 
 
 def is_mount_name(name: str) -> bool:
-    """A mount name the channel spelling can carry: a letter or ``_`` first, then letters,
-    digits, ``_`` or ``-``, and not a word a CSV reader takes for a number (``nan``, ``inf``,
-    ``infinity``)."""
+    """True for a ``name`` the channel spelling can carry: a letter or ``_``, then letters,
+    digits, ``_``, ``-``; not ``nan``, ``inf``, ``infinity`` (a CSV reader's numbers)."""
     return bool(_MOUNT.match(name)) and name.lower() not in ("nan", "inf", "infinity")
 
 
@@ -64,8 +57,8 @@ class Channel:
 
     @classmethod
     def parse(cls, text: str) -> Channel:
-        """Channel of ``left.z``, ``left.active.z``, ``left.passive.z`` or
-        ``left/passive.z``; ValueError for anything else."""
+        """Channel of ``text``: ``left.z``, ``left.active.z``, ``left.passive.z`` or
+        ``left/passive.z``; ValueError otherwise."""
         m = _TEXT.match(text) if isinstance(text, str) else None
         if not m:
             raise ValueError(f"cannot read channel {text!r} (expected MOUNT.DIRECTION or "
@@ -75,7 +68,7 @@ class Channel:
 
     @classmethod
     def of_node(cls, node: str, direction: str) -> Channel:
-        """Channel of a result's ``(node, direction)`` pair (``("left/passive", "z")``)."""
+        """Channel of a result's ``node`` and ``direction`` (``"left/passive", "z"``)."""
         mount, side = split_side(node)
         return cls(mount, side, direction)
 
@@ -95,8 +88,8 @@ class Channel:
 
 
 class ChannelFields:
-    """Mixin of a record with ``mount``, ``side`` and ``direction`` fields (a raw channel, a
-    tracked channel): its :class:`Channel` and the one spelling of its label."""
+    """Mixin of a record with ``mount``, ``side`` and ``direction`` fields: its
+    :class:`Channel` and label."""
 
     @property
     def channel(self) -> Channel:

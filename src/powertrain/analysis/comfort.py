@@ -14,11 +14,10 @@ limiting (2nd-order Butterworth high pass at :math:`f_1` and low pass at :math:`
 with :math:`W_k` (vertical, z) :math:`f_3 = f_4 = 12.5` Hz, :math:`Q_4 = 0.63`,
 :math:`f_5 = 2.37` Hz, :math:`Q_5 = 0.91`, :math:`f_6 = 3.35` Hz, :math:`Q_6 = 0.91`, and
 :math:`W_d` (horizontal, x and y) :math:`f_3 = f_4 = 2` Hz, :math:`Q_4 = 0.63`, no step;
-:math:`f_1 = 0.4` Hz, :math:`f_2 = 100` Hz for both. The filter is made digital by the
-bilinear transform (:func:`scipy.signal.bilinear_zpk`; the sample rate of a manoeuvre is
-tens of times the 100 Hz band limit) and run forward from rest, in second-order sections.
-The weighted RMS is :math:`a_w = (\frac1T\int a_w^2 dt)^{1/2}` and
-the vibration dose value :math:`VDV = (\int a_w^4 dt)^{1/4}` [m/s^1.75] (eqs. 1 and 9).
+:math:`f_1 = 0.4` Hz, :math:`f_2 = 100` Hz for both; made digital by the bilinear transform
+and run from rest in second-order sections. Weighted RMS
+:math:`a_w = (\frac1T\int a_w^2 dt)^{1/2}`, vibration dose value
+:math:`VDV = (\int a_w^4 dt)^{1/4}` [m/s^1.75] (eqs. 1 and 9).
 
 .. [1] ISO 2631-1:1997, Mechanical vibration and shock — Evaluation of human exposure to
    whole-body vibration — Part 1: General requirements, Annex A.
@@ -41,8 +40,7 @@ _Q = 1.0 / np.sqrt(2.0)
 
 
 def weighting_analog(name):
-    """Numerator and denominator polynomials (descending powers of s) of the weighting
-    ``name`` (``"Wk"`` or ``"Wd"``)."""
+    """Numerator and denominator (descending powers of s) of the weighting ``name`` (Wk, Wd)."""
     f1, f2, f3, f4, q4, f5, q5, f6, q6 = WEIGHTINGS[name]
     w1, w2, w3, w4 = (2 * np.pi * f for f in (f1, f2, f3, f4))
     num = np.polymul([1.0, 0.0, 0.0], [w2 ** 2])
@@ -67,10 +65,10 @@ def weighted(acceleration, sample_rate, name) -> np.ndarray:
 
 
 def weighted_rms(aw, sample_rate) -> float:
-    """Weighted RMS acceleration [m/s²] of the weighted signal ``aw``."""
+    """Weighted RMS acceleration [m/s²] of the weighted signal ``aw`` (``sample_rate`` [Hz])."""
     return float(np.sqrt(np.mean(np.square(aw)))) if len(aw) else 0.0
 
 
 def vibration_dose_value(aw, sample_rate) -> float:
-    """Vibration dose value [m/s^1.75] of the weighted signal ``aw``."""
+    """Vibration dose value [m/s^1.75] of the weighted signal ``aw`` at ``sample_rate`` [Hz]."""
     return float(np.sum(np.asarray(aw) ** 4) / sample_rate) ** 0.25

@@ -1,8 +1,5 @@
-r"""Correlation of simulated and measured run-up order curves: pure functions on arrays.
-
-Levels are RMS magnitudes in one unit on both sides (the package passes m/s). The measures
-(level gap, FRAC, CSAC, CSF, FRFSM-like score, phase and complex gap) are defined in each
-function's docstring; ``docs/guide/compare.md`` tabulates them with what each is blind to.
+r"""Correlation of simulated and measured run-up order curves (RMS levels, one unit on both
+sides); ``docs/guide/compare.md`` tabulates the measures and what each is blind to.
 
 References
 ----------
@@ -28,11 +25,10 @@ FRFSM_SIGMA_DB = 6.0
 
 
 def interpolate_log(rpm, level, rpm_new):
-    r"""Interpolate a level curve linearly in speed and linearly in log level; no extrapolation.
+    r"""Interpolate a level curve linearly in speed and in log level; no extrapolation.
 
-    Between two simulated speeds :math:`n_a < n < n_b` with levels :math:`v_a, v_b > 0`:
-    :math:`\ln v = (1-t)\ln v_a + t\ln v_b`, :math:`t = (n-n_a)/(n_b-n_a)` (straight lines on
-    the log-scaled plots). Where either neighbour is zero, linear in level instead.
+    :math:`\ln v = (1-t)\ln v_a + t\ln v_b`, :math:`t = (n-n_a)/(n_b-n_a)`; linear in
+    level where either neighbour is zero.
 
     Parameters
     ----------
@@ -46,12 +42,11 @@ def interpolate_log(rpm, level, rpm_new):
     Returns
     -------
     values : ndarray, shape (k,)
-        Interpolated levels; NaN outside ``[rpm[0], rpm[-1]]`` [unit of ``level``].
+        Interpolated levels; NaN outside ``[rpm[0], rpm[-1]]``.
     inside : ndarray of bool, shape (k,)
-        True where ``rpm_new`` lies inside the curve's speed range (within 1e-9 rpm).
+        Where ``rpm_new`` is inside the curve's speed range (within 1e-9 rpm).
     """
-    x = np.asarray(rpm, float)
-    y = np.asarray(level, float)
+    x, y = np.asarray(rpm, float), np.asarray(level, float)
     xn = np.atleast_1d(np.asarray(rpm_new, float))
     if x.ndim != 1 or x.shape != y.shape or x.size == 0:
         raise ValueError("rpm and level must be 1-D arrays of the same non-zero length")
@@ -80,18 +75,14 @@ def interpolate_log(rpm, level, rpm_new):
 def level_gap_db(simulated, measured):
     r"""Level gap :math:`20\log_{10}(v_\mathrm{sim}/v_\mathrm{meas})` [dB].
 
+    Positive where the simulation is higher.
+
     Parameters
     ----------
     simulated, measured : array_like
         Positive RMS levels [same unit].
-
-    Returns
-    -------
-    ndarray
-        Gap [dB]; positive where the simulation is higher.
     """
-    s = np.asarray(simulated, float)
-    m = np.asarray(measured, float)
+    s, m = np.asarray(simulated, float), np.asarray(measured, float)
     if np.any(s <= 0) or np.any(m <= 0):
         raise ValueError("levels must be > 0 for a gap in dB")
     return 20.0 * np.log10(s / m)
@@ -110,15 +101,11 @@ def gap_statistics(rpm, gap_db):
     Returns
     -------
     dict
-        ``rms_db`` :math:`\sqrt{\overline{\Delta L^2}}`, ``bias_db`` :math:`\overline{\Delta L}`,
-        ``max_abs_db`` :math:`\max|\Delta L|` and ``rpm_at_max_abs_db`` [dB, rpm]; NaN when
-        ``n = 0``.
+        ``rms_db``, ``bias_db``, ``max_abs_db``, ``rpm_at_max_abs_db`` [dB, rpm]; NaN if empty.
     """
-    g = np.asarray(gap_db, float)
-    r = np.asarray(rpm, float)
+    g, r = np.asarray(gap_db, float), np.asarray(rpm, float)
     if g.size == 0:
-        return {"rms_db": np.nan, "bias_db": np.nan, "max_abs_db": np.nan,
-                "rpm_at_max_abs_db": np.nan}
+        return {"rms_db": np.nan, "bias_db": np.nan, "max_abs_db": np.nan, "rpm_at_max_abs_db": np.nan}
     k = int(np.argmax(np.abs(g)))
     return {"rms_db": float(np.sqrt(np.mean(g ** 2))), "bias_db": float(np.mean(g)),
             "max_abs_db": float(abs(g[k])), "rpm_at_max_abs_db": float(r[k])}
@@ -127,18 +114,15 @@ def gap_statistics(rpm, gap_db):
 def frac(simulated, measured):
     r"""Frequency response assurance criterion of two level curves over speed [1]_ [2]_.
 
-    :math:`(\sum_n s_n m_n)^2 / (\sum_n s_n^2 \sum_n m_n^2)`, summed over the compared speeds:
-    the shape of the curve, blind to a common level error (read it with the dB gap).
+    :math:`(\sum_n s_n m_n)^2 / (\sum_n s_n^2 \sum_n m_n^2)`: the curve's shape, blind to a
+    common level error.
+
+    In [0, 1]; 1 for a scaled copy; NaN if either curve is all zero or empty.
 
     Parameters
     ----------
     simulated, measured : array_like, shape (n,)
         RMS levels at the same speeds [same unit].
-
-    Returns
-    -------
-    float
-        In [0, 1]; 1 for a scaled copy; NaN if either curve is all zero or ``n = 0``.
     """
     return float(csac(simulated, measured, axis=-1))
 
@@ -146,8 +130,8 @@ def frac(simulated, measured):
 def csac(simulated, measured, axis=-1):
     r"""Cross-signature assurance criterion across channels [3]_.
 
-    :math:`(\sum_j s_j m_j)^2 / (\sum_j s_j^2 \sum_j m_j^2)`, summed along ``axis``
-    (the channels; one value per speed): the deflection shape across the mounts.
+    :math:`(\sum_j s_j m_j)^2 / (\sum_j s_j^2 \sum_j m_j^2)` along ``axis``: the deflection
+    shape across the mounts.
 
     Parameters
     ----------
@@ -161,19 +145,14 @@ def csac(simulated, measured, axis=-1):
     ndarray or float
         In [0, 1]; 1 for identical (or proportional) channel vectors.
     """
-    s = np.asarray(simulated, float)
-    m = np.asarray(measured, float)
-    num = np.sum(s * m, axis=axis) ** 2
-    den = np.sum(s ** 2, axis=axis) * np.sum(m ** 2, axis=axis)
-    with np.errstate(invalid="ignore", divide="ignore"):
-        return np.where(den > 0, num / np.where(den > 0, den, 1.0), np.nan)
+    s, m = np.asarray(simulated, float), np.asarray(measured, float)
+    return _ratio(np.sum(s * m, axis=axis) ** 2, np.sum(s ** 2, axis=axis) * np.sum(m ** 2, axis=axis))
 
 
 def csf(simulated, measured, axis=-1):
-    r"""Cross-signature scale factor across channels [3]_.
+    r"""Cross-signature scale factor across channels [3]_: shape and level.
 
-    :math:`2|\sum_j s_j m_j| / (\sum_j s_j^2 + \sum_j m_j^2)`, summed along ``axis``: shape
-    and level.
+    :math:`2|\sum_j s_j m_j| / (\sum_j s_j^2 + \sum_j m_j^2)` along ``axis``.
 
     Parameters
     ----------
@@ -187,10 +166,13 @@ def csf(simulated, measured, axis=-1):
     ndarray or float
         In [0, 1]; 1 only for identical vectors; 2a/(1+a²) for a vector scaled by a.
     """
-    s = np.asarray(simulated, float)
-    m = np.asarray(measured, float)
-    num = 2.0 * np.abs(np.sum(s * m, axis=axis))
-    den = np.sum(s ** 2, axis=axis) + np.sum(m ** 2, axis=axis)
+    s, m = np.asarray(simulated, float), np.asarray(measured, float)
+    return _ratio(2.0 * np.abs(np.sum(s * m, axis=axis)),
+                  np.sum(s ** 2, axis=axis) + np.sum(m ** 2, axis=axis))
+
+
+def _ratio(num, den):
+    """``num / den`` where ``den > 0``, else NaN."""
     with np.errstate(invalid="ignore", divide="ignore"):
         return np.where(den > 0, num / np.where(den > 0, den, 1.0), np.nan)
 
@@ -198,9 +180,8 @@ def csf(simulated, measured, axis=-1):
 def frfsm_score(gap_db, sigma_db=FRFSM_SIGMA_DB):
     r"""FRFSM-like similarity: mean over points of :math:`\exp(-\Delta L^2/(2\sigma^2))`.
 
-    Follows the idea of the FRF similarity metric of Lee, Ahn & Kim [4]_ (the likelihood of
-    the level difference under a normal distribution, normalised to 0..1); our own simplified
-    definition, not their formula: a uniform 6 dB gap scores 0.61, 3 dB 0.88, 12 dB 0.14.
+    After the idea of Lee, Ahn & Kim's FRF similarity metric [4]_, not their formula: a
+    uniform 6 dB gap scores 0.61, 3 dB 0.88, 12 dB 0.14.
 
     Parameters
     ----------
@@ -221,8 +202,8 @@ def frfsm_score(gap_db, sigma_db=FRFSM_SIGMA_DB):
 
 
 def interpolate_phase(rpm, phase_deg, rpm_new):
-    """Phase [deg] at ``rpm_new``: linear in rpm on the unwrapped phase between the speeds
-    where it is given; NaN outside them (no extrapolation), wrapped to (-180°, 180°]."""
+    """Phase [deg] at ``rpm_new`` [rpm] from ``phase_deg`` at ``rpm``: linear in rpm on the
+    unwrapped phase, wrapped to (-180°, 180°]; NaN outside the given speeds."""
     rpm, phase = np.asarray(rpm, float), np.asarray(phase_deg, float)
     ok = np.isfinite(phase)
     rpm_new = np.asarray(rpm_new, float)
@@ -235,13 +216,12 @@ def interpolate_phase(rpm, phase_deg, rpm_new):
 
 
 def phase_statistics(simulated, measured, sim_phase_deg, meas_phase_deg) -> dict:
-    r"""Phase gap :math:`\varphi_\mathrm{sim} - \varphi_\mathrm{meas}` [deg], wrapped to
-    (-180°, 180°], per point and its summary over the points where both phases are finite:
-    ``phase_gap_deg`` (NaN elsewhere), ``n_phase_compared``, ``phase_rms_deg``,
-    ``phase_bias_deg`` (angle of the mean phasor), and the complex gap
-    ``complex_gap_db``, ``complex_gap_deg``: :math:`20\log_{10}|a|` and :math:`\arg a` of the
-    least-squares ratio :math:`a = \sum_n S_n \bar M_n / \sum_n |M_n|^2` of the complex
-    amplitudes (phase scatter lowers :math:`|a|` below the magnitude gap)."""
+    r"""Phase gap :math:`\varphi_\mathrm{sim} - \varphi_\mathrm{meas}` [deg] of the levels
+    ``simulated``, ``measured`` at phases ``sim_phase_deg``, ``meas_phase_deg`` [deg]:
+    ``phase_gap_deg`` (wrapped; NaN where a phase is), ``n_phase_compared``,
+    ``phase_rms_deg``, ``phase_bias_deg`` (angle of the mean phasor), and ``complex_gap_db``,
+    ``complex_gap_deg``: :math:`20\log_{10}|a|`, :math:`\arg a` of the least-squares ratio
+    :math:`a = \sum_n S_n \bar M_n / \sum_n |M_n|^2`."""
     gap = wrap_deg(np.asarray(sim_phase_deg, float) - np.asarray(meas_phase_deg, float))
     ok = np.isfinite(gap)
     out = {"phase_gap_deg": gap, "n_phase_compared": int(ok.sum())}

@@ -1,10 +1,8 @@
 r"""Fourier coefficients of sampled periodic signals.
 
-For samples :math:`s_k = s(k T/N)`, :math:`k = 0..N-1` over an integer number of periods,
-the complex amplitude of harmonic :math:`j` (so that :math:`s(t) \approx \mathrm{Re}\,
-\sum_j \hat S_j e^{i j \Omega t}`) is :math:`\hat S_j = \frac{2}{N}\sum_k s_k e^{-2\pi i jk/N}`
-for :math:`j \ge 1` and :math:`\hat S_0 = \frac1N\sum_k s_k`. The RMS value of harmonic j
-is :math:`|\hat S_j|/\sqrt2`.
+For :math:`N` samples over whole periods, :math:`s(t) \approx \mathrm{Re}\sum_j \hat S_j
+e^{i j \Omega t}` with :math:`\hat S_j = \frac{2}{N}\sum_k s_k e^{-2\pi i jk/N}`
+(:math:`j \ge 1`), :math:`\hat S_0 = \frac1N\sum_k s_k`; RMS :math:`|\hat S_j|/\sqrt2`.
 """
 
 from __future__ import annotations
@@ -18,8 +16,7 @@ def harmonic_amplitudes(samples, axis=0):
     Parameters
     ----------
     samples : ndarray
-        Equally spaced samples covering the window exactly once (do not repeat the end
-        point), along ``axis``.
+        Equally spaced samples over the window, end point excluded, along ``axis``.
     axis : int
         Time axis of ``samples``.
 

@@ -1,17 +1,15 @@
 r"""Computed order tracking (COT) of run-up time data (``docs/guide/track.md``, step 3).
 
-For each speed of the output grid one block of ``B`` revolutions centred on the instant the
-speed is passed is resampled to ``S`` samples per revolution (low-pass interpolation at
-:data:`ANTI_ALIAS_FRACTION` of the local angular Nyquist frequency :math:`S\,n/120` [Hz],
-:mod:`powertrain.kernels.order_tracking`), and its spectrum is evaluated at exactly the
-orders asked for, Hann window over the block (no picket-fence error):
+For each grid speed, a block of ``B`` revolutions centred where the speed is passed is
+resampled to ``S`` samples per revolution (low-pass at the local angular Nyquist frequency
+:math:`S\,n/120` [Hz], :mod:`powertrain.kernels.order_tracking`) and its Hann-windowed
+spectrum evaluated at exactly the orders asked for:
 
 .. math:: \hat S_o = \frac{2}{\sum_j w_j}\sum_j w_j\,x(\theta_j)\,e^{-i o \theta_j},
           \qquad \mathrm{RMS}_o = |\hat S_o|/\sqrt2.
 
-The block length (:func:`block_revolutions`, at least 4 bins between neighbouring orders)
-keeps the Hann side lobes of one order below -50 dB at the next. Vold–Kalman filtering
-(:mod:`powertrain.analysis.vold_kalman`) is the second method.
+At least 4 bins between neighbouring orders (:func:`block_revolutions`) keep one order's
+Hann side lobes below -50 dB at the next.
 """
 
 from __future__ import annotations
@@ -25,14 +23,11 @@ from powertrain.kernels.order_tracking import sinc_resample_kernel
 
 #: Angle samples per revolution: at least this many per unit of the highest order.
 SAMPLES_PER_ORDER = 6
-#: Anti-alias cut-off as a fraction of the angular Nyquist frequency S/2 [orders]. Only
-#: content that folds onto the tracked orders (<= S/6) matters, i.e. content above
-#: 5S/6; the kernel's transition band (about S/2 +- 0.3 S/2) ends below that, while the
-#: tracked orders stay in the flat passband.
+#: Anti-alias cut-off as a fraction of the angular Nyquist frequency S/2: only content above
+#: 5S/6 folds onto the tracked orders (<= S/6), beyond the kernel's transition band.
 ANTI_ALIAS_FRACTION = 1.0
-#: Zero crossings per side and Kaiser beta of the resampling kernel: with 8 and 7 the
-#: tracked RMS of a 16-order sweep buried under 5x stronger orders 8.25..200 is within
-#: 0.004 dB (16 and 8: 0.0005 dB at twice the cost); tests/test_order_tracking.py.
+#: Zero crossings per side and Kaiser beta of the resampling kernel (0.004 dB on a sweep
+#: under 5x stronger orders 8.25..200, tests/test_order_tracking.py).
 KERNEL_ZERO_CROSSINGS = 8
 KERNEL_BETA = 7.0
 #: Block length bounds [revolutions].
@@ -40,16 +35,14 @@ MIN_BLOCK_REVS = 8
 MAX_BLOCK_REVS = 64
 #: Most speeds of a tracked speed grid (1 rpm steps over 20 000 rpm).
 MAX_GRID_SPEEDS = 20_000
-
-
-#: Most orders one ``--orders`` may ask for, and the highest order (order 200 of 6000 rpm is
-#: 20 kHz; the limits keep a typo from asking for terabytes).
+#: Most orders one ``--orders`` may ask for, and the highest order (200 at 6000 rpm: 20 kHz).
 MAX_ORDERS = 2000
 MAX_ORDER = 200.0
 
 
 def parse_orders(text: str, option: str = "--orders") -> np.ndarray:
-    """``0.5:8:0.5`` (start:stop:step, inclusive), a list ``1,0.5,1.41421356``, or a mix."""
+    """Orders from ``text``: ``0.5:8:0.5`` (start:stop:step, inclusive), a list
+    ``1,0.5,1.41421356``, or a mix; ``option`` names errors."""
     values = []
     for part in str(text).split(","):
         part = part.strip()
@@ -70,8 +63,7 @@ def parse_orders(text: str, option: str = "--orders") -> np.ndarray:
         except InputError:
             raise
         except ValueError:
-            raise InputError(f"cannot read orders {part!r} (use 0.5:8:0.5 or 1,2,4)",
-                             key=option) from None
+            raise InputError(f"cannot read orders {part!r} (use 0.5:8:0.5 or 1,2,4)", key=option) from None
     arr = np.unique(np.round(np.array(values, float), 12))
     if arr.size == 0 or not np.all(np.isfinite(arr)) or np.any(arr <= 0):
         raise InputError("orders must be finite and > 0", key=option)
@@ -82,28 +74,29 @@ def parse_orders(text: str, option: str = "--orders") -> np.ndarray:
 
 
 def block_revolutions(orders) -> int:
-    """Block length [rev]: at least 4 Hann bins between neighbouring orders (and from 0)."""
+    """Block length [rev]: at least 4 Hann bins between neighbouring ``orders`` and from 0."""
     o = np.sort(np.asarray(orders, float))
     spacing = min(o[0], np.min(np.diff(o)) if o.size > 1 else o[0])
     return int(min(MAX_BLOCK_REVS, max(MIN_BLOCK_REVS, math.ceil(4.0 / spacing - 1e-9))))
 
 
 def samples_per_rev(orders) -> int:
-    """Angle samples per revolution: power of two >= SAMPLES_PER_ORDER * highest order."""
+    """Angle samples per revolution: power of two >= SAMPLES_PER_ORDER * max(``orders``)."""
     need = max(16.0, SAMPLES_PER_ORDER * float(np.max(orders)))
     return int(2 ** math.ceil(math.log2(need)))
 
 
 def kernel_table(K, beta, n_tab=16385):
-    """Kaiser-windowed sinc with K zero crossings per side, on v = -1 ... 1."""
+    """Kaiser-windowed (``beta``) sinc with ``K`` zero crossings per side, ``n_tab`` points on
+    v = -1 ... 1."""
     v = np.linspace(-1.0, 1.0, n_tab)
     return np.sinc(K * v) * np.kaiser(n_tab, beta)
 
 
 def speed_grid(profile, rpm_step, block_revs, *, margin_s=0.0, file=None, key="rpm"):
-    """Grid speeds [rpm] the shaft passes with a whole block inside the measured range.
-
-    ``margin_s`` [s] is kept free beyond the block at both ends, or ``(start, end)``.
+    """Grid speeds [rpm], multiples of ``rpm_step``, that ``profile`` passes with a block of
+    ``block_revs`` [rev] and ``margin_s`` [s] (or ``(start, end)``) inside the measured range;
+    ``file``, ``key`` name errors.
 
     Returns
     -------
@@ -123,12 +116,10 @@ def speed_grid(profile, rpm_step, block_revs, *, margin_s=0.0, file=None, key="r
     m0, m1 = np.broadcast_to(np.asarray(margin_s, float), (2,))
     lo_ok = np.interp(th[0] + np.pi * block_revs, th, t) + m0
     hi_ok = np.interp(th[-1] - np.pi * block_revs, th, t) - m1
-    grid = rpm_step * np.arange(math.ceil(n.min() / rpm_step), math.floor(n.max() / rpm_step)
-                                + 1)
+    grid = rpm_step * np.arange(math.ceil(n.min() / rpm_step), math.floor(n.max() / rpm_step) + 1)
     if grid.size == 0:
         raise InputError(f"no multiple of {rpm_step:g} rpm between the record's speeds "
-                         f"{n.min():.0f}..{n.max():.0f} rpm (a smaller step)", file=file,
-                         key="--rpm-step")
+                         f"{n.min():.0f}..{n.max():.0f} rpm (a smaller step)", file=file, key="--rpm-step")
     tc, thc = first_passing(t, n, grid, th)
     keep = (tc >= lo_ok) & (tc <= hi_ok)
     rpm, centre = list(grid[keep]), thc[keep]
@@ -136,21 +127,15 @@ def speed_grid(profile, rpm_step, block_revs, *, margin_s=0.0, file=None, key="r
         raise InputError(f"speed never passes a multiple of {rpm_step:g} rpm with "
                          f"{block_revs / 2:g} revolutions (+ {max(m0, m1):.3g} s) of data either "
                          "side (speed "
-                         f"{n.min():.0f}..{n.max():.0f} rpm over {t[-1] - t[0]:.3g} s)",
-                         file=file, key=key)
+                         f"{n.min():.0f}..{n.max():.0f} rpm over {t[-1] - t[0]:.3g} s)", file=file, key=key)
     return np.array(rpm, float), np.array(centre, float)
 
 
 def first_passing(t, rpm, targets, *others):
-    """Time (and the values of ``others`` interpolated there) at which the speed first
-    reaches each target [s]; NaN where it never does.
-
-    From below (``rpm[0] < target``) the first sample at or above the target is found by
-    bisection in the running maximum, from above in the running minimum.
-    """
-    t = np.asarray(t, float)
-    rpm = np.asarray(rpm, float)
-    targets = np.asarray(targets, float)
+    """Time [s] at which ``rpm`` over ``t`` first reaches each of ``targets`` [rpm] (and
+    ``others`` interpolated there); NaN where it never does. Bisection in the running
+    maximum (from below) or minimum (from above)."""
+    t, rpm, targets = np.asarray(t, float), np.asarray(rpm, float), np.asarray(targets, float)
     up = np.searchsorted(np.maximum.accumulate(rpm), targets, side="left")
     down = np.searchsorted(-np.minimum.accumulate(rpm), -targets, side="left")
     idx = np.where(rpm[0] < targets, up, down)
@@ -186,14 +171,12 @@ def cot_amplitudes(X, profile, orders, rpm_centre, angle_centre, block_revs=None
     ndarray complex (k, n_ch, n_o)
         Peak complex amplitudes [SI], phase relative to crank angle 0.
     """
-    X = np.ascontiguousarray(X, float)
-    orders = np.asarray(orders, float)
-    B = block_revs or block_revolutions(orders)
-    S = samples_per_rev(orders)
+    X, orders = np.ascontiguousarray(X, float), np.asarray(orders, float)
+    B, S = block_revs or block_revolutions(orders), samples_per_rev(orders)
     N = B * S
     fs = (profile.time.size - 1) / (profile.time[-1] - profile.time[0])
     j = np.arange(N)
-    theta = angle_centre[:, None] + (j[None, :] - N / 2) * (2 * np.pi / S)   # (k, N)
+    theta = angle_centre[:, None] + (j[None, :] - N / 2) * (2 * np.pi / S)
     idx = np.arange(profile.time.size, dtype=float)
     pos = np.interp(theta.ravel(), profile.angle, idx)
     rpm_at = np.interp(pos, idx, profile.rpm)

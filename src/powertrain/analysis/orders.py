@@ -1,10 +1,9 @@
 r"""Order analysis of engine-synchronous signals.
 
-Signals sampled at a constant crank-angle increment over the processed window (an integer
-number of engine cycles, the thesis uses the last two) are Fourier analysed; harmonic j of a
-window of W crank revolutions is order j/W. Orders 0.5 to 8 in steps of 0.5 are reported as
-RMS values :math:`|\hat S|/\sqrt 2`, and the synthesis is the RMS sum of all of them,
-:math:`\sqrt{\sum_o S_{o,\mathrm{rms}}^2}` (Kovarik 2016, sec. 4.4: "sum of all orders up to 8").
+Signals at a constant crank-angle increment over W revolutions (whole engine cycles) are
+Fourier analysed: harmonic j is order j/W. Orders 0.5..8 are reported as RMS
+:math:`|\hat S|/\sqrt 2`; the synthesis is :math:`\sqrt{\sum_o S_{o,\mathrm{rms}}^2}`
+(Kovarik 2016, sec. 4.4).
 """
 
 from __future__ import annotations
@@ -18,19 +17,19 @@ ORDERS = np.arange(1, 17) * 0.5
 
 
 def order_label(order: float) -> str:
-    """``order_0.5``, ``order_1``, ``order_1.5`` ... (no trailing ``.0``)."""
+    """Label of ``order``: ``order_0.5``, ``order_1`` ... (no trailing ``.0``)."""
     return f"order_{order:g}"
 
 
 def quantity_sort_key(quantity: str):
-    """Sort key of a quantity label: ``synthesis`` first, then orders ascending."""
+    """Sort key of a ``quantity`` label: ``synthesis`` first, then orders ascending."""
     if quantity == "synthesis":
         return (0, 0.0)
     return (1, float(quantity.split("_", 1)[1]))
 
 
 def order_spectrum(samples, revolutions, orders=ORDERS, axis=0):
-    """Complex amplitudes of the given orders.
+    """Complex amplitudes of the given orders [unit of ``samples``].
 
     Parameters
     ----------
@@ -59,10 +58,10 @@ def order_spectrum(samples, revolutions, orders=ORDERS, axis=0):
 
 
 def order_rms(amplitudes):
-    """RMS value of each order from complex amplitudes."""
+    """RMS value of each order from complex ``amplitudes``."""
     return np.abs(amplitudes) / np.sqrt(2.0)
 
 
 def synthesis_rms(amplitudes, axis=-1):
-    """RMS sum over orders: sqrt(sum of order RMS^2) along ``axis``."""
+    """RMS sum of ``amplitudes`` over orders, sqrt(sum of order RMS^2), along ``axis``."""
     return np.sqrt(np.sum(order_rms(amplitudes) ** 2, axis=axis))

@@ -1,15 +1,9 @@
 r"""Overall level of the raw signal per speed (``powertrain track --overall``).
 
-At each speed of the tracking grid the overall level of a channel is the RMS of the channel
-**band-limited** to :math:`[f_\mathrm{lo}, f_\mathrm{hi}]` by an ideal filter (FFT of the
-whole record, bins outside the band set to zero), over the same span as the COT block:
-``B`` revolutions centred on the instant the speed is passed, Hann-weighted,
-
-.. math:: L = \sqrt{\sum_j w_j\,x_j^2 \Big/ \sum_j w_j}.
-
-On a signal made only of the tracked orders (at least two Hann bins apart over the block,
-so the cross terms average out) :math:`L` equals the synthesis, and
-:math:`L^2 - \mathrm{synthesis}^2` is the in-band power of what is not a tracked order.
+At each grid speed: the Hann-weighted RMS of the channel band-limited to
+:math:`[f_\mathrm{lo}, f_\mathrm{hi}]` (ideal FFT filter over the whole record) over the COT
+block, :math:`L = \sqrt{\sum_j w_j\,x_j^2 / \sum_j w_j}`. On tracked orders alone it equals
+the synthesis; :math:`L^2 - \mathrm{synthesis}^2` is the in-band power of the rest.
 """
 
 from __future__ import annotations
@@ -22,28 +16,24 @@ from powertrain.errors import InputError
 
 
 def parse_band(text: str, option: str = "--overall-band"):
-    """``LO:HI`` [Hz] -> (lo, hi) with 0 <= lo < hi."""
+    """``text`` ``LO:HI`` [Hz] -> (lo, hi) with 0 <= lo < hi; ``option`` names errors."""
     try:
         lo, hi = (float(v) for v in str(text).split(":"))
     except ValueError:
-        raise InputError(f"cannot read band {text!r} (use LO:HI in Hz, e.g. 5:1000)",
-                         key=option) from None
+        raise InputError(f"cannot read band {text!r} (use LO:HI in Hz, e.g. 5:1000)", key=option) from None
     if not (np.isfinite(lo) and np.isfinite(hi) and 0 <= lo < hi):
         raise InputError("band must be LO:HI with 0 <= LO < HI [Hz]", key=option)
     return lo, hi
 
 
 def band_limited(x, fs, band, derivative=None):
-    r"""Channels ``x`` (n_ch, n) with every FFT bin outside ``band`` [Hz] set to zero.
-
-    ``derivative`` (n_ch,) of -1, 0, 1 per channel integrates (divides by :math:`i\omega`)
-    or differentiates in the same pass: acceleration or displacement to velocity.
-    """
+    r"""Channels ``x`` (n_ch, n) at ``fs`` [Hz] with every FFT bin outside ``band`` [Hz]
+    zeroed; ``derivative`` (n_ch,) -1/0/1 integrates (:math:`/i\omega`) or differentiates."""
     n = x.shape[-1]
     m = next_fast_len(n, real=True)
     f = rfftfreq(m, 1.0 / fs)
     out = np.empty_like(x, dtype=float)
-    for c in range(x.shape[0]):                        # one channel at a time: bounded memory
+    for c in range(x.shape[0]):                        # one at a time: bounded memory
         spec = rfft(x[c], m)
         spec[(f < band[0]) | (f > band[1]) | (f == 0)] = 0.0
         if derivative is not None and derivative[c]:

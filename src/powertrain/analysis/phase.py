@@ -4,19 +4,14 @@ r"""Order phase: the one convention, and the crank-angle origin of measured phas
 
 .. math:: x_o(\theta) = \sqrt2\,\mathrm{RMS}_o\cos(o\,\theta + \varphi_o),
 
-:math:`\theta` the crank angle [rad] from cylinder-1 firing TDC (in the sense of rotation),
-:math:`\varphi_o` the phase [deg], wrapped to (-180°, 180°]. The complex amplitudes of the
-package (:mod:`powertrain.analysis.fourier`, :mod:`powertrain.analysis.orders`, computed
-order tracking and Vold–Kalman filtering) all satisfy
-:math:`x_o = \mathrm{Re}\,(\hat S_o e^{i o\theta})`, so :math:`\varphi_o = \arg\hat S_o` once
-:math:`\theta` is counted from that TDC. The simulation's crank angle is (cylinder 1 at its
-firing TDC at :math:`\theta = 0`, :mod:`powertrain.models.engine`); a tracked recording's angle
-is counted from its first tacho edge, and :func:`to_tdc` moves the origin.
+:math:`\theta` the crank angle [rad] from cylinder-1 firing TDC, :math:`\varphi_o` the phase
+[deg] wrapped to (-180°, 180°]. Every complex amplitude of the package satisfies
+:math:`x_o = \mathrm{Re}\,(\hat S_o e^{i o\theta})`, so :math:`\varphi_o = \arg\hat S_o`; a
+tracked recording's angle counts from its first tacho edge and :func:`to_tdc` moves it.
 
-**Measured origin** (``docs/guide/track.md``, order phase): the tacho's reference pulse
-fixes the angle modulo 360°, ``--tdc-offset`` places cylinder-1 firing TDC after it
-(:func:`tdc_origin`); half orders stay ambiguous by 180° unless a once-per-cycle signal
-(``--cycle-reference``) picks the revolution (:func:`cycle_origin`).
+**Measured origin** (``docs/guide/track.md``): the tacho's reference pulse fixes the angle
+modulo 360°, ``--tdc-offset`` places TDC after it (:func:`tdc_origin`); half orders need a
+once-per-cycle signal (``--cycle-reference``, :func:`cycle_origin`).
 """
 
 from __future__ import annotations
@@ -25,8 +20,7 @@ import numpy as np
 
 from powertrain.errors import InputError
 
-#: An order below this fraction of the largest order of its channel at that speed is
-#: round-off (e.g. an order the load does not excite): its phase is undefined (NaN).
+#: An order below this fraction of its channel's largest is round-off: phase NaN.
 PHASE_FLOOR = 1e-9
 #: Spacing of successive cycle-reference edges accepted as "once per cycle": 720° ± this.
 CYCLE_TOLERANCE_DEG = 36.0
@@ -36,14 +30,14 @@ CYCLE_AGREEMENT = 0.9
 
 
 def wrap_deg(angle_deg):
-    """Angle(s) wrapped to (-180°, 180°] [deg]."""
+    """``angle_deg`` [deg] wrapped to (-180°, 180°]."""
     wrapped = 180.0 - np.mod(180.0 - np.asarray(angle_deg, float), 360.0)
     return wrapped + 0.0
 
 
 def phase_deg(amplitudes, axis=-1):
-    """Phase [deg] of complex order amplitudes (module docstring), NaN where the order is
-    round-off (below :data:`PHASE_FLOOR` x the largest along ``axis``, the orders axis)."""
+    """Phase [deg] of complex order ``amplitudes``; NaN below :data:`PHASE_FLOOR` times the
+    largest along ``axis`` (the orders)."""
     a = np.asarray(amplitudes, complex)
     mag = np.abs(a)
     top = np.max(mag, axis=axis, keepdims=True) if a.size else mag
@@ -52,9 +46,8 @@ def phase_deg(amplitudes, axis=-1):
 
 
 def to_tdc(amplitudes, orders, origin):
-    r"""Complex amplitudes re an angle origin moved to ``origin`` [rad] (the old angle of
-    cylinder-1 firing TDC): :math:`\hat S_o e^{i o\,\mathrm{origin}}`; orders on the last
-    axis."""
+    r"""``amplitudes`` of ``orders`` (last axis) re the angle ``origin`` [rad]:
+    :math:`\hat S_o e^{i o\,\mathrm{origin}}`."""
     return np.asarray(amplitudes, complex) * np.exp(1j * np.asarray(orders, float) * origin)
 
 
@@ -71,7 +64,7 @@ def tdc_origin(profile, tdc_offset_deg, cycle_edges=None, *, file=None, key="--t
     cycle_edges : ndarray, optional
         Times [s] of the cycle reference's rising edges.
     file, key : str, optional
-        Named in an :class:`~powertrain.errors.InputError` (the recording and the option).
+        Named in error messages.
 
     Returns
     -------
@@ -95,8 +88,9 @@ def tdc_origin(profile, tdc_offset_deg, cycle_edges=None, *, file=None, key="--t
 
 
 def cycle_origin(profile, edge_times, *, file=None, key="--cycle-reference"):
-    """Profile angle [rad] of the first tacho reference pulse after a cycle-reference edge
-    (the same for every edge modulo 4π, else InputError)."""
+    """Angle [rad] of ``profile``'s first reference pulse after a cycle-reference edge
+    (``edge_times`` [s]; the same modulo 4π for all, else InputError naming ``file``,
+    ``key``)."""
     i0, i1 = profile.valid
     t0, t1 = profile.time[i0], profile.time[i1]
     edges = np.asarray(edge_times, float)
@@ -115,6 +109,5 @@ def cycle_origin(profile, edge_times, *, file=None, key="--cycle-reference"):
     votes = np.bincount(revolution, minlength=2)
     if votes.max() < CYCLE_AGREEMENT * revolution.size:
         raise InputError("the cycle-reference edges fall on either revolution (the signal "
-                         "sits on the tacho reference pulse, or is not once per cycle)",
-                         file=file, key=key)
+                         "sits on the tacho reference pulse, or is not once per cycle)", file=file, key=key)
     return profile.reference + two_pi * int(np.argmax(votes))

@@ -1,19 +1,15 @@
 r"""Shaft speed and crank angle of a run-up, from an rpm channel or a tacho pulse train.
 
-From an **rpm channel**: the samples are smoothed (Savitzky–Golay, cubic, over
-``smooth_s`` seconds: a straight or parabolic ramp passes unchanged) and the angle is their
-integral, :math:`\theta(t) = \int_0^t 2\pi n(\tau)/60\,d\tau` (trapezoidal rule).
+**rpm channel**: smoothed by a cubic Savitzky–Golay filter over ``smooth_s`` seconds (a
+parabolic ramp passes unchanged); the angle is its trapezoidal integral
+:math:`\theta(t) = \int_0^t 2\pi n/60\,d\tau`.
 
-From a **tacho** (``pulses_per_rev`` pulses per revolution): rising edges by a Schmitt
-trigger between the 2nd and 98th percentile levels (:data:`TRIGGER_HIGH`,
-:data:`TRIGGER_LOW`), missing teeth counted from the interval ratio to the local median and
-spikes dropped (:func:`count_teeth`); the angle at the edges, :math:`2\pi\,\mathrm{count}/N`,
-is fitted by a least-squares cubic spline with knots ``smooth_s`` apart (a linear sweep's
-quadratic angle is reproduced exactly), which gives angle and speed at every sample. The
-**reference pulse** (:attr:`SpeedProfile.reference`, the crank-angle origin of the order
-phases, :mod:`powertrain.analysis.phase`) is every pulse of a once-per-revolution tacho, or
-the first pulse after the missing-tooth gap of a wheel with ``N > 1`` teeth; an rpm channel,
-or a wheel without a gap, has none.
+**Tacho** (``N`` pulses per revolution): rising edges by a Schmitt trigger between the 2nd
+and 98th percentile levels, missing teeth counted and spikes dropped (:func:`count_teeth`);
+the edge angles :math:`2\pi\,\mathrm{count}/N` are fitted by a least-squares cubic spline
+with knots ``smooth_s`` apart. The **reference pulse** (the order phases' origin,
+:mod:`powertrain.analysis.phase`) is every pulse of a once-per-revolution tacho, or the first
+after a missing-tooth gap; an rpm channel has none.
 """
 
 from __future__ import annotations
@@ -30,12 +26,10 @@ from powertrain.errors import InputError
 #: Schmitt-trigger thresholds as fractions of the tacho swing.
 TRIGGER_HIGH = 0.6
 TRIGGER_LOW = 0.4
-#: Interval ratio tolerance for counting missing teeth, and the ratio below which an
-#: interval is a spike.
+#: Interval ratio tolerance for counting missing teeth; ratio below which it is a spike.
 MISSING_TOOTH_TOLERANCE = 0.3
 SPIKE_RATIO = 0.3
-#: Fewest tacho edges a speed profile is fitted to (a cubic spline with end conditions),
-#: and the most pulses per revolution accepted.
+#: Fewest tacho edges a speed profile is fitted to; most pulses per revolution accepted.
 MIN_TACHO_EDGES = 8
 MAX_PULSES_PER_REV = 100_000
 
@@ -46,20 +40,15 @@ class SpeedProfile:
 
     Attributes
     ----------
-    time : ndarray (n,)
-        [s]
-    rpm : ndarray (n,)
-        Smoothed speed [rpm].
-    angle : ndarray (n,)
-        Crank angle from the first sample (tacho: from the first edge) [rad].
+    time, rpm, angle : ndarray (n,)
+        Times [s], smoothed speed [rpm], crank angle from the first sample or edge [rad].
     valid : tuple of int
         First and last sample index where speed and angle are measured, not extrapolated.
     source : str
         ``rpm channel`` or ``tacho (N pulses/rev)``.
     notes : list of str
     reference : float or None
-        Angle [rad] (on :attr:`angle`'s scale) of a once-per-revolution reference pulse,
-        known modulo 2π; None when the speed source has none (module docstring).
+        Angle [rad] of a once-per-revolution reference pulse (modulo 2π), or None.
     """
 
     time: np.ndarray
@@ -78,24 +67,22 @@ def _savgol_window(time, smooth_s):
 
 
 def speed_from_rpm(time, rpm, *, smooth_s=0.1, file=None, key="rpm") -> SpeedProfile:
-    """Speed profile from an rpm channel (see module docstring).
+    """Speed profile from an rpm channel (module docstring).
 
     Parameters
     ----------
     time : ndarray (n,)
-        [s], uniform.
+        Uniform sample times [s].
     rpm : ndarray (n,)
         Measured speed [rpm].
     smooth_s : float
         Smoothing window [s].
     file, key : str, optional
-        File and channel named in error messages.
+        Named in error messages.
     """
-    time = np.asarray(time, float)
-    rpm = np.asarray(rpm, float)
+    time, rpm = np.asarray(time, float), np.asarray(rpm, float)
     window = _savgol_window(time, smooth_s)
-    # long windows: Savitzky-Golay on means of k samples, interpolated back (linear inside,
-    # the end slopes extrapolated outside the first and last block centres)
+    # long windows: filter means of k samples, interpolate back, extrapolate the end slopes
     k = max(1, window // 64)
     n_blocks = rpm.size // k
     if k > 1 and n_blocks >= 16:
@@ -105,8 +92,7 @@ def speed_from_rpm(time, rpm, *, smooth_s=0.1, file=None, key="rpm") -> SpeedPro
         smooth = np.interp(time, t_means, sm)
         lo, hi = time < t_means[0], time > t_means[-1]
         smooth[lo] = sm[0] + (sm[1] - sm[0]) / (t_means[1] - t_means[0]) * (time[lo] - t_means[0])
-        smooth[hi] = sm[-1] + (sm[-1] - sm[-2]) / (t_means[-1] - t_means[-2]) * (
-            time[hi] - t_means[-1])
+        smooth[hi] = sm[-1] + (sm[-1] - sm[-2]) / (t_means[-1] - t_means[-2]) * (time[hi] - t_means[-1])
     else:
         smooth = savgol_filter(rpm, window, 3, mode="interp") if window > 4 else rpm
     if np.any(smooth <= 0):
@@ -123,22 +109,16 @@ MEAN_SPEED_WINDOW_S = 0.2
 
 
 def mean_speed(time, rpm, interval) -> np.ndarray:
-    r"""Crank speed [rpm] at every sample ``time`` [s] averaged over the time the crank
-    takes to turn ``interval`` [rad] (the firing interval: its fluctuation at the firing
-    orders and their harmonics averages out), centred (moved inside the record at its
-    ends), at most :data:`MEAN_SPEED_WINDOW_S` long:
-    :math:`\bar n(t) = (\Theta(t + T/2) - \Theta(t - T/2)) / T`, :math:`\Theta` the
-    integral of the speed, :math:`T = \Phi/|\omega|`. The window is set by the speed
-    averaged once more (the fluctuation changes it by its own share). A centred mean
-    spreads a change of speed over the window: a crank at rest before a start reads the
-    mean of up to half a window of its run-off."""
-    t = np.asarray(time, float)
-    n = np.asarray(rpm, float)
+    r"""Crank speed ``rpm`` at every sample ``time`` [s] averaged over the time the crank
+    turns ``interval`` [rad] (the firing interval), centred, kept inside the record, at most
+    :data:`MEAN_SPEED_WINDOW_S`: :math:`\bar n = (\Theta(t + T/2) - \Theta(t - T/2)) / T`,
+    :math:`\Theta` the speed's integral, :math:`T = \Phi/|\omega|` from the once-averaged
+    speed."""
+    t, n = np.asarray(time, float), np.asarray(rpm, float)
     angle = np.r_[0.0, np.cumsum(0.5 * (n[1:] + n[:-1]) * np.diff(t))]
     out = n
     for _ in range(2):
-        window = np.minimum(interval / np.maximum(np.abs(out) * np.pi / 30.0, 1e-12),
-                            MEAN_SPEED_WINDOW_S)
+        window = np.minimum(interval / np.maximum(np.abs(out) * np.pi / 30.0, 1e-12), MEAN_SPEED_WINDOW_S)
         window = np.minimum(window, t[-1] - t[0])
         lo = np.clip(t - 0.5 * window, t[0], t[-1] - window)
         out = (np.interp(lo + window, t, angle) - np.interp(lo, t, angle)) / window
@@ -146,16 +126,15 @@ def mean_speed(time, rpm, interval) -> np.ndarray:
 
 
 def tacho_edges(time, tacho, *, file=None, key="tacho", what="tacho"):
-    """Times of the rising edges of a pulse train [s] (Schmitt trigger, interpolated);
-    ``what`` names the signal in error messages."""
+    """Rising-edge times [s] of the pulse train ``tacho`` at ``time`` (Schmitt trigger,
+    interpolated); ``file``, ``key``, ``what`` name it in error messages."""
     x = np.asarray(tacho, float)
     lo, hi = np.percentile(x, [2.0, 98.0])
     swing = hi - lo
     if not swing > 1e-12 * max(abs(hi), abs(lo), 1.0):
         raise InputError(f"{what} has no edges (constant signal)", file=file, key=key)
-    up = lo + TRIGGER_HIGH * swing
-    down = lo + TRIGGER_LOW * swing
-    # state: 1 above `up`, 0 below `down`, else the last state (forward fill)
+    up, down = lo + TRIGGER_HIGH * swing, lo + TRIGGER_LOW * swing
+    # 1 above `up`, 0 below `down`, else the last state (forward fill)
     marker = np.where(x > up, 1, np.where(x < down, 0, -1))
     idx = np.where(marker >= 0, np.arange(x.size), 0)
     np.maximum.accumulate(idx, out=idx)
@@ -165,8 +144,7 @@ def tacho_edges(time, tacho, *, file=None, key="tacho", what="tacho"):
     if rise.size < MIN_TACHO_EDGES:
         raise InputError(f"{what} has too few edges ({rise.size} rising edges found, at least "
                          f"{MIN_TACHO_EDGES} needed)", file=file, key=key)
-    # the sample at index `rise` is the first above `up`; interpolate the crossing of `up`
-    i1 = rise
+    i1 = rise                    # the first sample above `up`: interpolate the crossing
     i0 = np.maximum(rise - 1, 0)
     x0, x1 = x[i0], x[i1]
     frac = np.clip((up - x0) / np.where(x1 > x0, x1 - x0, 1.0), 0.0, 1.0)
@@ -174,9 +152,8 @@ def tacho_edges(time, tacho, *, file=None, key="tacho", what="tacho"):
 
 
 def drop_spikes(edge_times) -> tuple:
-    """Edge times [s] without the spikes' (of an interval shorter than :data:`SPIKE_RATIO`
-    of the running median, the edge whose removal leaves an interval nearer the median),
-    and notes saying how many."""
+    """``edge_times`` [s] without spikes (an interval under :data:`SPIKE_RATIO` of the running
+    median: the edge whose removal leaves one nearer the median), and notes."""
     t = np.asarray(edge_times, float)
     notes = []
     for _ in range(3):                       # drop spikes, then re-evaluate the median
@@ -186,8 +163,7 @@ def drop_spikes(edge_times) -> tuple:
         if not short.size:
             break
         before = np.where(short > 0, d[np.maximum(short - 1, 0)] + d[short], np.inf)
-        after = np.where(short + 1 < d.size, d[short] + d[np.minimum(short + 1, d.size - 1)],
-                         np.inf)
+        after = np.where(short + 1 < d.size, d[short] + d[np.minimum(short + 1, d.size - 1)], np.inf)
         first = np.abs(before - med[short]) < np.abs(after - med[short])
         t = np.delete(t, np.unique(np.where(first, short, short + 1)))
         notes.append(f"{short.size} tacho spike(s) dropped")
@@ -195,7 +171,8 @@ def drop_spikes(edge_times) -> tuple:
 
 
 def count_teeth(edge_times, *, file=None, key="tacho"):
-    """Pulse count at each edge, with missing teeth counted and spikes dropped.
+    """Pulse count at each of ``edge_times`` [s], missing teeth counted, spikes dropped;
+    ``file``, ``key`` name errors.
 
     Returns
     -------
@@ -220,11 +197,9 @@ def count_teeth(edge_times, *, file=None, key="tacho"):
 
 
 def reference_count(counts, pulses_per_rev):
-    """Pulse count (on the scale of :func:`count_teeth`) of the reference pulse, or None.
-
-    One pulse per revolution: every pulse (0). More: the first pulse after a gap, if every
-    gap falls on the same tooth of the revolution (a missing-tooth wheel); else None.
-    """
+    """Count (of :func:`count_teeth`'s ``counts``) of the reference pulse, or None: 0 for one
+    pulse per revolution (``pulses_per_rev``), else the first after a gap if every gap is on
+    the same tooth."""
     if pulses_per_rev == 1:
         return 0.0
     after_gap = counts[1:][np.diff(counts) > 1]
@@ -235,8 +210,7 @@ def reference_count(counts, pulses_per_rev):
 
 
 def checked_pulses_per_rev(pulses_per_rev) -> int:
-    """``pulses_per_rev`` as an int, a whole number 1..:data:`MAX_PULSES_PER_REV` (else an
-    InputError naming ``--pulses-per-rev``)."""
+    """``pulses_per_rev`` as an int 1..:data:`MAX_PULSES_PER_REV`, else an InputError."""
     if not (isinstance(pulses_per_rev, (int, float, np.integer, np.floating))
             and not isinstance(pulses_per_rev, bool)
             and 1 <= pulses_per_rev <= MAX_PULSES_PER_REV
@@ -246,9 +220,9 @@ def checked_pulses_per_rev(pulses_per_rev) -> int:
     return int(pulses_per_rev)
 
 
-def speed_from_tacho(time, tacho, pulses_per_rev, *, smooth_s=0.1, file=None,
-                     key="tacho") -> SpeedProfile:
-    """Speed profile from a tacho pulse train (see module docstring)."""
+def speed_from_tacho(time, tacho, pulses_per_rev, *, smooth_s=0.1, file=None, key="tacho") -> SpeedProfile:
+    """Speed profile from the pulse train ``tacho`` at ``time`` [s] of ``pulses_per_rev``
+    pulses per revolution, knots ``smooth_s`` [s] apart (module docstring)."""
     time = np.asarray(time, float)
     checked_pulses_per_rev(pulses_per_rev)
     edges = tacho_edges(time, tacho, file=file, key=key)
@@ -263,10 +237,8 @@ def speed_from_tacho(time, tacho, pulses_per_rev, *, smooth_s=0.1, file=None,
     spline = make_lsq_spline(t_e, theta_e, knots, k=3)
     valid = (int(np.searchsorted(time, t_e[0])), int(np.searchsorted(time, t_e[-1]) - 1))
     tc = np.clip(time, t_e[0], t_e[-1])
-    angle = spline(tc)
-    omega = spline.derivative()(tc)
-    # linear extrapolation outside the edges (outside `valid`)
-    angle = angle + omega * (time - tc)
+    angle, omega = spline(tc), spline.derivative()(tc)
+    angle = angle + omega * (time - tc)          # linear outside the edges (`valid`)
     if np.any(omega[valid[0]:valid[1] + 1] <= 0):
         raise InputError("speed from the tacho is not > 0 throughout", file=file, key=key)
     rpm = omega * (60.0 / (2.0 * np.pi))

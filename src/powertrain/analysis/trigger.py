@@ -1,31 +1,20 @@
 r"""The time of a trigger channel's step, and how well it is known.
 
-**Levels**: the channel's low and high levels are the medians of its samples below and
-above the middle of its 1st and 99th percentiles (a spike, an overshoot or a ringing does
-not move them); the trigger level is their mean.
+**Levels**: low and high are the medians of the samples below and above the middle of the
+1st and 99th percentiles; the trigger level is their mean.
 
-**Time** (:func:`trigger_crossing`; an active-low trigger, ``edge="falling"``, is read
-inverted): the first rising crossing of the trigger level (linear
-between samples; where three samples or more about it, one after the other, lie within
-25 % of the step of the level, the crossing of the least-squares line through them) after
-which the channel stays above it for :data:`TRIGGER_HOLD_S` (a
-glitch is no trigger); where the channel crossed the level (either way) less than
-:data:`TRIGGER_BOUNCE_S` before, those crossings are one bounce and the trigger is the
-bounce's first rising crossing (a switch's first contact). A channel above its level most
-of the time before it rises is read, with a :class:`TriggerWarning`, as it is: an
-active-low trigger's release. A channel whose step is under
-:data:`TRIGGER_STEP_NOISE` times its noise (the second differences' RMS over
-:math:`\sqrt 6`) does not step and is refused.
+**Time** (:func:`trigger_crossing`; ``edge="falling"`` reads the channel inverted): the
+first rising crossing of the level (linear between samples, or the least-squares line
+through three or more consecutive samples within 25 % of the step of it) after which the
+channel stays above for :data:`TRIGGER_HOLD_S`; crossings less than
+:data:`TRIGGER_BOUNCE_S` apart are one bounce, read at its first rising crossing. A step
+under :data:`TRIGGER_STEP_NOISE` times the noise (second differences' RMS over
+:math:`\sqrt 6`) is refused.
 
-**Standard error**: :math:`\sqrt{(\sigma/\dot x)^2 + t_r^2/12}`, the noise :math:`\sigma`
-over the slope at the crossing (of the line: its least-squares standard error) and the
-time :math:`t_r` the step may lie anywhere in,
-from the last sample below 10 % of the step to the first above 90 %: a channel held between
-updates (changing at ten samples or more but fewer than half of them, at intervals of more
-than a sample: a bus's), its update interval; a rise over one or two sample intervals, one;
-a straight rise over three or more (a channel resampled by linear interpolation from a
-slower one: the reader says so), the time that line takes over the whole step; else (a rise
-its samples resolve) 0.
+**Standard error**: :math:`\sqrt{(\sigma/\dot x)^2 + t_r^2/12}`, the noise over the slope
+and the time :math:`t_r` the step may lie anywhere in (from 10 % to 90 % of the step): a
+held channel's update interval; one sample interval for a rise over one or two; a straight
+rise's (linearly resampled) time over the whole step; else 0.
 """
 
 from __future__ import annotations
@@ -37,27 +26,25 @@ import numpy as np
 
 from powertrain.errors import InputError, PowertrainWarning
 
-#: A trigger channel steps by at least this many times its noise and stays above its level
-#: this long [s] after its rising crossing.
+#: Least step [noise RMS]; time [s] the channel stays above its level after the crossing.
 TRIGGER_STEP_NOISE = 10.0
 TRIGGER_HOLD_S = 0.002
 #: Crossings less than this apart [s] are one bounce (a switch's).
 TRIGGER_BOUNCE_S = 0.005
-#: A channel changing at fewer than this share of its samples, but at ten or more, is held
-#: between updates (a bus's): its step lies anywhere in an update interval.
+#: A channel changing at fewer than this share of its samples (ten or more) is held.
 HELD_SHARE = 0.5
 #: The edges a trigger may mark.
 TRIGGER_EDGES = ("rising", "falling")
 
 
 class TriggerWarning(PowertrainWarning):
-    """A trigger whose channel is above its level most of the time before it rises: an
-    active-low trigger read at its release (``--trigger-edge falling`` reads its press)."""
+    """A trigger channel above its level most of the time before it rises: an active-low
+    trigger read at its release."""
 
 
 class TriggerCrossing(NamedTuple):
-    """A trigger's step: ``time`` [s], its standard error ``error`` [s], from the noise
-    ``spread`` [s] and the ``sampling`` interval [s] the step may lie anywhere in."""
+    """A trigger's step ``time`` [s] and standard ``error`` [s], from the noise ``spread``
+    [s] and the ``sampling`` interval [s] the step may lie anywhere in."""
 
     time: float
     error: float
@@ -66,14 +53,13 @@ class TriggerCrossing(NamedTuple):
 
 
 def trigger_time(time, signal, *, edge="rising", file=None, key="--trigger") -> float:
-    """Time [s] of the trigger channel ``signal``'s step (module docstring;
-    :func:`trigger_crossing` with its standard error)."""
+    """Time [s] of the step of ``signal`` at ``time`` [s]: :func:`trigger_crossing`'s
+    (``edge``, ``file``, ``key`` as there) without its error."""
     return trigger_crossing(time, signal, edge=edge, file=file, key=key).time
 
 
-def trigger_crossing(time, signal, *, edge="rising", file=None,
-                     key="--trigger") -> TriggerCrossing:
-    """Time [s] of the trigger channel's step and its standard error [s] (module docstring).
+def trigger_crossing(time, signal, *, edge="rising", file=None, key="--trigger") -> TriggerCrossing:
+    """Time [s] of a trigger channel's step and its standard error [s] (module docstring).
 
     Parameters
     ----------
@@ -92,8 +78,7 @@ def trigger_crossing(time, signal, *, edge="rising", file=None,
         A channel that is not finite, does not step, or never rises to stay.
     """
     if edge not in TRIGGER_EDGES:
-        raise InputError(f"expected one of {', '.join(TRIGGER_EDGES)}, got {edge!r}",
-                         key="--trigger-edge")
+        raise InputError(f"expected one of {', '.join(TRIGGER_EDGES)}, got {edge!r}", key="--trigger-edge")
     time = np.asarray(time, float)
     x = np.asarray(signal, float) * (1.0 if edge == "rising" else -1.0)
     if not np.all(np.isfinite(x)):
@@ -123,9 +108,8 @@ def trigger_crossing(time, signal, *, edge="rising", file=None,
 
 
 def _crossing(time, x, level, width, i) -> tuple:
-    """Time [s] the channel crosses ``level`` after sample ``i`` and its standard error
-    [s] from the noise: of the least-squares line through three samples or more about it
-    within ``width`` of the level, else between the two samples."""
+    """Time [s] ``x`` crosses ``level`` after sample ``i`` and its noise error [s]: of the
+    least-squares line through 3+ samples within ``width`` of it, else between two samples."""
     noise = np.sqrt(np.mean(np.diff(x, 2) ** 2) / 6.0) if x.size > 2 else 0.0
     band = _band(x, level, width, i)
     if band.size >= 3:
@@ -135,8 +119,7 @@ def _crossing(time, x, level, width, i) -> tuple:
 
 
 def _band(x, level, width, i) -> np.ndarray:
-    """Indices of the samples one after the other within ``width`` of ``level`` about the
-    crossing between samples ``i`` and ``i + 1``."""
+    """Indices of consecutive samples within ``width`` of ``level`` about sample ``i + 1``."""
     inside = np.abs(x - level) <= width
     lo = hi = i + 1 if inside[i + 1] else i
     if not inside[lo]:
@@ -149,8 +132,7 @@ def _band(x, level, width, i) -> np.ndarray:
 
 
 def _fitted_crossing(t, x, level, noise) -> tuple:
-    """Where the least-squares line through a resolved rise crosses ``level`` [s], and the
-    standard error [s] of that time from the samples' ``noise``."""
+    """Crossing time [s] of ``level`` by the least-squares line, and its error [s] from ``noise``."""
     a, b = np.polyfit(t - t[0], x, 1)
     when = (level - b) / a
     spread = noise / a * np.sqrt(1.0 / t.size + (when - np.mean(t - t[0])) ** 2
@@ -159,8 +141,8 @@ def _fitted_crossing(t, x, level, noise) -> tuple:
 
 
 def trigger_levels(x, file=None, key="--trigger") -> tuple:
-    """Low and high level of a trigger channel (module docstring); refused where the step
-    is under :data:`TRIGGER_STEP_NOISE` times the noise."""
+    """Low and high level of the trigger channel ``x`` (module docstring); ``file``, ``key``
+    name the error where it does not step."""
     p1, p99 = np.percentile(x, [1.0, 99.0])
     split = 0.5 * (p1 + p99)
     below, over = x[x < split], x[x >= split]
@@ -173,14 +155,12 @@ def trigger_levels(x, file=None, key="--trigger") -> tuple:
     noise = np.sqrt(np.mean(np.diff(x, 2) ** 2) / 6.0) if x.size > 2 else 0.0
     if hi - lo < TRIGGER_STEP_NOISE * noise:
         raise InputError(f"the trigger channel does not step (its step {hi - lo:.3g} is "
-                         f"less than {TRIGGER_STEP_NOISE:g} times its noise {noise:.3g})",
-                         file=file, key=key)
+                         f"less than {TRIGGER_STEP_NOISE:g} times its noise {noise:.3g})", file=file, key=key)
     return lo, hi
 
 
 def _first_contact(time, above, i) -> int:
-    """The sample before the first rising crossing of the bounce that ends with the rising
-    crossing after sample ``i`` (crossings less than :data:`TRIGGER_BOUNCE_S` apart)."""
+    """Sample before the first rising crossing of the bounce ending after sample ``i``."""
     changes = np.flatnonzero(above[:-1] != above[1:])
     k = int(np.searchsorted(changes, i))
     while k > 0 and time[changes[k]] - time[changes[k - 1]] < TRIGGER_BOUNCE_S:
@@ -190,19 +170,14 @@ def _first_contact(time, above, i) -> int:
 
 
 def _rise(x, lo, hi, i) -> tuple:
-    """Indices of the last sample at most 10 % of the step before the crossing after
-    sample ``i`` and of the first at least 90 % after it."""
+    """Last sample at most 10 % of the step up to ``i``, first at least 90 % after it."""
     before = np.flatnonzero(x[:i + 1] <= lo + 0.1 * (hi - lo))
     after = np.flatnonzero(x[i + 1:] >= lo + 0.9 * (hi - lo))
-    return (int(before[-1]) if before.size else 0,
-            int(i + 1 + after[0]) if after.size else x.size - 1)
+    return (int(before[-1]) if before.size else 0, int(i + 1 + after[0]) if after.size else x.size - 1)
 
 
 def _rise_time(time, x, start, end, step) -> float:
-    """The time [s] the step may lie anywhere in (module docstring): a channel held between
-    updates, its update interval; a step over at most two sample intervals, one; a straight
-    rise over three intervals or more, the time that line takes over the whole step; else
-    0."""
+    """Time [s] the step may lie anywhere in (module docstring)."""
     span = float(time[end] - time[start])
     changes = np.flatnonzero(np.diff(x) != 0)
     update = float(np.median(np.diff(time[changes]))) if changes.size > 1 else 0.0
@@ -210,6 +185,5 @@ def _rise_time(time, x, start, end, step) -> float:
         return max(update, span / (end - start))
     if end - start <= 2:
         return span / (end - start)
-    straight = end - start >= 3 and np.max(np.abs(np.diff(x[start:end + 1], 2))) <= \
-        1e-6 * step
+    straight = end - start >= 3 and np.max(np.abs(np.diff(x[start:end + 1], 2))) <= 1e-6 * step
     return step / (x[end] - x[start]) * span if straight else 0.0      # the whole step's

@@ -7,22 +7,19 @@ with a two-pole structural equation [1]_:
 .. math:: \min_a \sum_k |x_k - a_k c_k|^2 + r^2 \sum_k |a_{k+1} - 2a_k + a_{k-1}|^2,
           \qquad c_k = e^{i o \theta_k},
 
-whose normal equations, since :math:`|c_k| = 1`, are
-:math:`(\mathbf I + r^2 \mathbf D^\mathsf T\mathbf D)\,\mathbf a = \bar{\mathbf c}\odot\mathbf x`
-with :math:`\mathbf D` the second-difference matrix: one real symmetric positive-definite
-pentadiagonal matrix for every order and channel, factored once (banded Cholesky). The
-filter's amplitude response to a component at :math:`f` Hz from the order is
-:math:`1/(1 + r^2 (2 - 2\cos 2\pi f\Delta t)^2)`; the weight is set from the -3 dB
-half-bandwidth :math:`f_b`: :math:`r = \sqrt{\sqrt2 - 1}/(2\pi f_b\Delta t)^2`.
+with normal equations (:math:`|c_k| = 1`)
+:math:`(\mathbf I + r^2 \mathbf D^\mathsf T\mathbf D)\,\mathbf a = \bar{\mathbf c}\odot\mathbf x`,
+:math:`\mathbf D` the second-difference matrix: one pentadiagonal SPD matrix per order,
+factored once (banded Cholesky). The amplitude response at :math:`f` Hz from the order is
+:math:`1/(1 + r^2 (2 - 2\cos 2\pi f\Delta t)^2)`, so the -3 dB half-bandwidth :math:`f_b`
+gives :math:`r = \sqrt{\sqrt2 - 1}/(2\pi f_b\Delta t)^2`.
 
-The default bandwidth (:func:`default_bandwidth`, per order and sample) is the narrowest of
-three rules, described with their verification in ``docs/guide/track.md``: *sweep*
-:math:`f_b = 1.5\sqrt{\dot f_o}` for an order sweeping at :math:`\dot f_o` [Hz/s] (the
-time-frequency limit of a linear chirp, A. Brandt, *Noise and Vibration Analysis*, Wiley 2011,
-ch. 12; ``scripts/verify_vkf_bandwidth.py``); *record* at least :math:`1.5/(0.05\,T)`; and,
-winning over both, *spacing* at most a quarter of the distance to the nearest other tracked
-order (or 0 Hz). Each order is filtered on its own; long records are first decimated
-(polyphase, Kaiser anti-alias) to about five times the highest tracked frequency.
+The default bandwidth (:func:`default_bandwidth`; ``docs/guide/track.md``) is the narrowest
+of: *sweep* :math:`f_b = 1.5\sqrt{\dot f_o}` [Hz/s] (a linear chirp's time-frequency limit,
+A. Brandt, *Noise and Vibration Analysis*, Wiley 2011, ch. 12); *record* at least
+:math:`1.5/(0.05\,T)`; capped by *spacing*, a quarter of the distance to the nearest other
+order. Long records are first decimated (polyphase, Kaiser) to about five times the highest
+tracked frequency.
 
 References
 ----------
@@ -44,16 +41,14 @@ from powertrain.errors import InputError
 
 #: Sweep rule: f_b = SWEEP_FACTOR * sqrt(order frequency rate [Hz/s]) (module docstring).
 SWEEP_FACTOR = 1.5
-#: Spacing rule: f_b <= (distance to the nearest other order [Hz]) / SPACING_RATIO, where
-#: the filter's response 1/(1 + (sqrt2 - 1) (f/f_b)^4) is -40.6 dB.
+#: Spacing rule: f_b <= distance to the nearest other order / SPACING_RATIO (-40.6 dB there).
 SPACING_RATIO = 4.0
 #: Record rule: at most this fraction of the record is dropped at each end.
 EDGE_FRACTION = 0.05
 #: Window [s] over which the speed's rate of change is averaged for the sweep rule.
 SWEEP_RATE_WINDOW_S = 0.5
-#: Speeds closer to the record ends than this many 1/bandwidth seconds are not reported:
-#: the smoother's end transient (time constant about 1/(2 pi f_b / sqrt 2)) has decayed
-#: below 0.01 dB there.
+#: Speeds within this many 1/bandwidth seconds of the record ends are not reported (the end
+#: transient has decayed below 0.01 dB beyond).
 EDGE_TIME_CONSTANTS = 1.5
 #: Decimate when the sampling rate exceeds this multiple of the highest tracked frequency.
 DECIMATE_ABOVE = 10.0
@@ -61,9 +56,8 @@ DECIMATED_RATE_FACTOR = 5.0
 
 
 def check_bandwidth(bandwidth_hz, duration_s, sample_rate):
-    """Refuse a bandwidth [Hz] that is not finite and > 0, above a quarter of the sampling
-    rate, or so narrow that the end transients (:data:`EDGE_TIME_CONSTANTS` / bandwidth at
-    each end) leave no data of the ``duration_s`` record."""
+    """Refuse a ``bandwidth_hz`` [Hz] not in (0, ``sample_rate``/4] [Hz], or whose end
+    transients (:data:`EDGE_TIME_CONSTANTS` / bandwidth) fill the ``duration_s`` [s] record."""
     if not 0 < bandwidth_hz <= 0.25 * sample_rate:
         raise InputError(f"must be > 0 and <= {0.25 * sample_rate:g} Hz (a quarter of the "
                          f"sampling rate), got {bandwidth_hz:g}", key="--bandwidth")
@@ -75,13 +69,14 @@ def check_bandwidth(bandwidth_hz, duration_s, sample_rate):
 
 
 def weight_from_bandwidth(bandwidth_hz, dt):
-    """Structural weight r for a -3 dB half-bandwidth [Hz] (scalar or per sample) at dt [s]."""
+    """Structural weight r for a -3 dB half-bandwidth ``bandwidth_hz`` [Hz] at ``dt`` [s]."""
     x = 2 * np.pi * np.asarray(bandwidth_hz, float) * dt
     return math.sqrt(math.sqrt(2.0) - 1.0) / x ** 2
 
 
 def default_bandwidth(profile, orders):
-    """Default -3 dB half-bandwidth per order and sample [Hz] (module docstring).
+    """Default -3 dB half-bandwidth [Hz] per ``orders`` and sample of ``profile`` (module
+    docstring).
 
     Returns
     -------
@@ -94,8 +89,8 @@ def default_bandwidth(profile, orders):
     rate = np.abs(np.gradient(rpm, dt))                                  # [rpm/s]
     rate = uniform_filter1d(rate, max(1, int(round(SWEEP_RATE_WINDOW_S / dt))), mode="nearest")
     o = np.sort(np.asarray(orders, float))
-    spacing = np.minimum(o, np.diff(o, prepend=-np.inf))   # to lower neighbour
-    spacing = np.minimum(spacing, np.diff(o, append=np.inf))             # and upper one
+    spacing = np.minimum(o, np.diff(o, prepend=-np.inf))
+    spacing = np.minimum(spacing, np.diff(o, append=np.inf))
     sweep = SWEEP_FACTOR * np.sqrt(o[:, None] * rate[None, :] / 60.0)
     record = EDGE_TIME_CONSTANTS / (EDGE_FRACTION * (t[i1] - t[i0]))
     speed = np.maximum(np.abs(rpm), np.min(rpm[i0:i1 + 1]))     # tacho: extrapolated ends
@@ -105,7 +100,7 @@ def default_bandwidth(profile, orders):
 
 
 def _factor(r):
-    """Banded Cholesky factor of I + D^T diag(r^2) D (upper form for scipy); r (n-2,)."""
+    """Banded Cholesky factor (upper) of I + D^T diag(r^2) D; r (n-2,)."""
     w = np.asarray(r, float) ** 2
     n = w.size + 2
     ab = np.zeros((3, n))
@@ -131,8 +126,7 @@ def vkf_amplitudes(X, profile, orders, rpm_centre, *, bandwidth_hz, progress=Fal
     rpm_centre : ndarray (k,)
         Grid speeds [rpm]; each is read at the first instant the speed passes it.
     bandwidth_hz : float or ndarray (n_o, n)
-        -3 dB half-bandwidth [Hz], one value or per order and sample
-        (:func:`default_bandwidth`).
+        -3 dB half-bandwidth [Hz] (per order and sample: :func:`default_bandwidth`).
     progress : bool
         tqdm bar over the orders (hidden when stderr is not a terminal).
 
@@ -162,8 +156,7 @@ def vkf_amplitudes(X, profile, orders, rpm_centre, *, bandwidth_hz, progress=Fal
         cb = _factor(weight_from_bandwidth(width[k, 1:-1], dt))
         c = np.exp(-1j * orders[k] * angle)
         rhs = (X * c[None, :]).T                                   # (n, n_ch)
-        env = cho_solve_banded((cb, False), rhs.real) + 1j * cho_solve_banded((cb, False),
-                                                                           rhs.imag)
+        env = cho_solve_banded((cb, False), rhs.real) + 1j * cho_solve_banded((cb, False), rhs.imag)
         for ch in range(X.shape[0]):
             out[:, ch, k] = 2.0 * (np.interp(times, t, env[:, ch].real)
                                    + 1j * np.interp(times, t, env[:, ch].imag))

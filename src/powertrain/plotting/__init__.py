@@ -1,10 +1,8 @@
-"""All figures. matplotlib is imported lazily in this package and nowhere else in the library.
+"""All figures; matplotlib is imported lazily here and nowhere else in the library.
 
-Every plot function takes ``ax=None`` (a new figure with constrained layout; or the user's
-Axes, Figure or SubFigure), returns the figure, writes a PNG atomically when given ``path``,
-and never switches the matplotlib backend (the CLI picks Agg). Shared helpers (provenance
-line, plain-number log axes, colour bars with ``extend``, one legend per figure) are in
-:mod:`powertrain.plotting.style`; the figures are described in ``docs/reference/figures.md``.
+Every plot function takes ``ax=None`` (a new figure, or the user's Axes, Figure or
+SubFigure), returns the figure, writes a PNG atomically when given ``path`` and never
+switches the backend (``docs/reference/figures.md``).
 """
 
 from powertrain.plotting.compare import plot_comparison

@@ -1,7 +1,4 @@
-"""Figures of the mounting system: modes, both sides of each mount, path contributions.
-
-matplotlib comes through :mod:`powertrain.plotting` (imported lazily there only).
-"""
+"""Figures of the mounting system: modes, both sides of each mount, path contributions."""
 
 from __future__ import annotations
 
@@ -36,14 +33,13 @@ _COLOURS = dict(zip(COORDINATES, (OKABE_ITO[c] for c in (
 
 
 def plot_modes(result, path=None, ax=None, provenance=None):
-    """Kinetic-energy distribution of each mode as stacked bars, labelled with frequency,
-    damping ratio and the angle of its rotation axis to the torque-roll axis; returns the
-    figure (``ax``: None, an Axes, Figure or SubFigure)."""
+    """Kinetic-energy distribution of each mode of ``result`` as stacked bars, labelled with
+    frequency, damping ratio and angle to the torque-roll axis; PNG to ``path``, into ``ax``
+    (None, Axes, Figure, SubFigure), ``provenance`` at the foot."""
     fig, axes, own = subplots(ax, figsize=(PRINT_WIDTH_IN, 4.6))
     ax = axes[0, 0]
     n = len(result.modes)
-    x = np.arange(n)
-    bottom = np.zeros(n)
+    x, bottom = np.arange(n), np.zeros(n)
     ked = np.array([np.clip(m.ked_percent, 0, None) for m in result.modes]).reshape(n, 6)
     for j, c in enumerate(COORDINATES):
         ax.bar(x, ked[:, j], bottom=bottom, color=_COLOURS[c], label=c, width=0.7)
@@ -66,10 +62,8 @@ def plot_modes(result, path=None, ax=None, provenance=None):
 
 
 def plot_static(result, path=None, ax=None, provenance=None):
-    """Static operating point against speed: the deflection [mm] of every mount's local
-    x, y, z direction (engine side relative to the base) under the weight and the mean
-    drive-torque reaction, one line each (markers at the speeds solved); returns the figure
-    (``ax``: None, an Axes, a Figure or SubFigure; one panel)."""
+    """Static deflection [mm] of every mount's local x, y, z against speed under the weight
+    and mean torque reaction; ``path``, ``ax``, ``provenance`` as :func:`plot_modes`'s."""
     fig, axes, own = subplots(ax, figsize=(PRINT_WIDTH_IN, 4.2))
     a = axes[0, 0]
     rpm, deflection = result.rpm, result.stack("deflection") * 1e3     # (n_rpm, n_m, 3)
@@ -96,10 +90,9 @@ def _positive(values):
 
 def plot_runup_both_sides(result, path=None, quantities=("synthesis", "order_2", "order_4"),
                           signal="velocity", ax=None, provenance=None):
-    """Run-up curves with a body model: one panel per mount and direction holding the
-    engine side (solid) and the body side (dashed), then one per body-point direction with
-    response; columns = ``quantities``; paged as :func:`~powertrain.plotting.runup.plot_runup`.
-    Returns the figure, the first page (``ax``: None, a Figure or SubFigure)."""
+    """Run-up curves of ``result`` with a body model: a panel per mount direction with both
+    sides, then per body-point direction, columns ``quantities`` of ``signal``; paged as
+    :func:`~powertrain.plotting.runup.plot_runup` (``path``, ``ax``, ``provenance``)."""
     rows = [(m, d, True) for m in result.mounts for d in "xyz"]
     points = [(p, d, False) for p in result.points for d in "xyz"]
     silent = [(p, d) for p, d, _ in points
@@ -120,13 +113,12 @@ def plot_runup_both_sides(result, path=None, quantities=("synthesis", "order_2",
                                   figsize=(PRINT_WIDTH_IN, height * len(chunk) + frame))
         _both_sides_grid(fig, axes, result, chunk, quantities, signal)
         legend(fig, axes, ax)
-        return finish(fig, own, file, provenance,
-                      title=title + note if not is_axes(ax) else None)
+        return finish(fig, own, file, provenance, title=title + note if not is_axes(ax) else None)
     return draw_pages(rows, frame, ax, path, page)
 
 
 def _both_sides_grid(fig, axes, result, rows, quantities, signal):
-    """The panels of one page of :func:`plot_runup_both_sides` and their axis labels."""
+    """Panels of one page of :func:`plot_runup_both_sides` and their axis labels."""
     factor, unit = SIGNAL_UNITS[signal][:2]
     for r, row in enumerate(rows):
         for q, quantity in enumerate(quantities):
@@ -156,23 +148,18 @@ def _both_sides_panel(a, result, row, quantity, signal, factor):
         no_data(a, "zero at every speed")
 
 
-def plot_path_contributions(result, path=None, order=2.0, n_paths=6, ax=None,
-                            provenance=None):
-    """Transfer-path view of every body-point direction at one order: the part of each
-    path's velocity in phase with the total, Re(v_path·conj(v)/|v|) [mm/s] (these add up to
-    |v|), for the ``n_paths`` largest paths, and the total |v| (black). Paths with the same
-    curve (a symmetric layout) share one line and one legend entry; a direction without
-    response is named in the title instead of drawn. Returns the figure."""
+def plot_path_contributions(result, path=None, order=2.0, n_paths=6, ax=None, provenance=None):
+    """Transfer paths of every body-point direction at ``order``: each path's velocity in
+    phase with the total, Re(v_path·conj(v)/|v|) [mm/s] (they add up to |v|), for the
+    ``n_paths`` largest, and |v|; ``path``, ``ax``, ``provenance`` as :func:`plot_modes`'s."""
     rows, silent = [], []
     for p in result.points:
         for d in "xyz":
-            pc = result.path_contributions(p, d, order) * 1e3          # (n_rpm, n_paths)
-            (rows if np.abs(pc.sum(axis=1)).max(initial=0.0) > 1e-9 else silent).append(
-                (p, d, pc))
-    if not rows:                 # nothing moves at all: one labelled empty panel
+            pc = result.path_contributions(p, d, order) * 1e3
+            (rows if np.abs(pc.sum(axis=1)).max(initial=0.0) > 1e-9 else silent).append((p, d, pc))
+    if not rows:
         rows, silent = silent[:1], silent[1:]
-    fig, axes, own = subplots(ax, len(rows), 1, sharex=True,
-                              figsize=(PRINT_WIDTH_IN, 2.4 * len(rows) + 2.0))
+    fig, axes, own = subplots(ax, len(rows), 1, sharex=True, figsize=(PRINT_WIDTH_IN, 2.4 * len(rows) + 2.0))
     labels = [f"{m} {d}" for m, d in result.paths]
     colours = {}
     for a, (p, d, pc) in zip(axes[:, 0], rows):
@@ -195,16 +182,15 @@ def plot_path_contributions(result, path=None, order=2.0, n_paths=6, ax=None,
 
 
 def _paths_panel(a, rpm, pc, labels, n_paths, colours):
-    """One body-point direction: the largest in-phase path parts (equal curves merged) and
-    the total; ``colours`` keeps one colour per legend label across panels."""
+    """Largest in-phase path parts (equal curves merged) and the total; ``colours`` keeps a
+    colour per label across panels."""
     total = pc.sum(axis=1)
     mag = np.abs(total)
     unit = np.where(mag > 0, np.conj(total) / np.where(mag > 0, mag, 1.0), 0.0)
     inphase = (pc * unit[:, None]).real
     groups = []
     for j in np.argsort(np.abs(inphase).max(axis=0))[::-1][:n_paths]:
-        same = [g for g in groups if np.allclose(inphase[:, g[0]], inphase[:, j],
-                                                 rtol=1e-6, atol=1e-9)]
+        same = [g for g in groups if np.allclose(inphase[:, g[0]], inphase[:, j], rtol=1e-6, atol=1e-9)]
         (same[0].append(j) if same else groups.append([j]))
     for g in groups:
         label = " = ".join(labels[j] for j in g)

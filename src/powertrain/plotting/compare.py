@@ -1,5 +1,5 @@
-"""Comparison figure: measured and simulated run-up order curves, level gap shaded; under
-each level panel with phase on both sides, the order phase."""
+"""Comparison figure: measured and simulated run-up order curves, level gap shaded, order
+phase under each level panel with phase on both sides."""
 
 from __future__ import annotations
 
@@ -38,50 +38,41 @@ from powertrain.plotting.style import (
 
 #: Display factor of the levels: m/s -> mm/s.
 MM = 1e3
-#: Height of one panel row [in]: at most the roomy one, at least what keeps three log ticks
-#: apart at 8 pt; in between, as much as fits :data:`MAX_HEIGHT_IN`.
+#: Height of one panel row [in]: between these, as much as fits :data:`MAX_HEIGHT_IN` (the
+#: lower keeps three log ticks apart at 8 pt).
 ROW_HEIGHT_IN = (0.62, 1.35)
-#: Figure height outside the panel rows [in]: title, legend, x label, provenance line (as
-#: :func:`powertrain.plotting.runup.grid` adds).
+#: Figure height outside the panel rows [in]: title, legend, x label, provenance line.
 FRAME_HEIGHT_IN = 1.6
-#: Most labelled ticks on a panel's level axis: 1-2-5 per decade would collide at 8 pt on a
-#: compact row; the 1-3 or decade ticks do not.
+#: Most labelled ticks on a level axis (1-2-5 per decade collide on a compact row).
 MAX_LEVEL_TICKS = 3
-#: Drawn height of a phase panel [in] and its labelled ticks [deg]: inside the ±180° range,
-#: so that no label reaches the level panel above; two 8-pt labels (9.3 pt boxes) 180° of
-#: the 400° axis apart need 0.29 in, and constrained layout trims a little.
+#: Drawn height of a phase panel [in] (two 8-pt labels 180° apart need 0.29 in) and its
+#: labelled ticks [deg], inside ±180° so none reaches the level panel above.
 PHASE_AXES_IN = 0.32
 PHASE_TICKS = (-90.0, 90.0)
-#: Phase axis limit [deg]: a little beyond ±180° so that points at the wrap stay visible.
+#: Phase axis limit [deg]: beyond ±180° so points at the wrap stay visible.
 PHASE_LIMIT_DEG = 200.0
-#: Vertical pad around each panel of a figure with phase rows [in] (constrained layout's
-#: default 3 pt halved: the phase panel sits close under its level panel), and what a level
-#: row holds besides its axes there: its one-line title and the pads [in].
+#: Vertical pad around each panel with phase rows [in] (half the default), and a level
+#: row's height besides its axes: its title and pads [in].
 PHASE_FIGURE_PAD_IN = 1.5 / 72
 LEVEL_DECORATION_IN = 0.2
-#: Said in the title of a figure with phase rows.
-#: Height of the two title lines :data:`PHASE_NOTE` adds [in].
+#: Said in the title of a figure with phase rows, and the height of its two lines [in].
 PHASE_NOTE_HEIGHT_IN = 0.3
 PHASE_NOTE = ("; under a level panel, where both sides give it: the order phase φ re "
               "cylinder-1 firing TDC (√2·RMS·cos(kθ + φ))")
-#: Simulated speeds are marked when there are at most this many (a coarse grid, joined by
-#: the lines of the log-level interpolation); a simulation at the measured speeds is a line.
+#: Simulated speeds are marked when there are at most this many (else a line).
 MAX_MARKED_SPEEDS = 30
 #: Marker of a measured-not-modelled point.
-NOT_MODELLED_STYLE = {"marker": "^", "ls": "none", "ms": 2.5, "mew": 0,
-                      "color": OKABE_ITO["reddish purple"]}
-#: Text of an empty panel per reason it was not compared (the reasons of
-#: :attr:`ComparisonResult.missing`), short enough for a compact panel.
+NOT_MODELLED_STYLE = {"marker": "^", "ls": "none", "ms": 2.5, "mew": 0, "color": OKABE_ITO["reddish purple"]}
+#: Text of an empty panel per reason it was not compared (:attr:`ComparisonResult.missing`).
 EMPTY_TEXT = {"not in the measured data": "not measured",
               "not in the simulation": "not simulated",
               "no comparable point": "every point below the limit"}
 
 
 def row_height(n_rows: int, n_phase_rows: int = 0) -> float:
-    """Level row height [in] that fits ``n_rows`` level rows and ``n_phase_rows`` phase rows
-    (:func:`phase_row_height` each) in :data:`MAX_HEIGHT_IN`: within :data:`ROW_HEIGHT_IN`,
-    except that a figure with phase rows goes below its lower bound rather than past the
-    page (the log ticks are thinned to the drawn height)."""
+    """Level row height [in] fitting ``n_rows`` level and ``n_phase_rows`` phase rows in
+    :data:`MAX_HEIGHT_IN`, within :data:`ROW_HEIGHT_IN` (with phase rows, below its lower
+    bound rather than past the page)."""
     lo, hi = ROW_HEIGHT_IN
     room = MAX_HEIGHT_IN - FRAME_HEIGHT_IN - n_phase_rows * phase_row_height() - \
         (PHASE_NOTE_HEIGHT_IN if n_phase_rows else 0.0)
@@ -95,8 +86,8 @@ def phase_row_height() -> float:
 
 
 def phased_channels(comparison) -> dict:
-    """``{(mount, direction, quantity): ChannelComparison}`` of the channel-quantities with
-    a phase gap (phase on both sides at a compared point; the report's phase table)."""
+    """``{(mount, direction, quantity): ChannelComparison}`` of ``comparison``'s
+    channel-quantities with a phase gap."""
     return {(c.mount, c.direction, c.quantity): c for c in comparison.channels
             if c.stats.get("n_phase_compared")}
 
@@ -105,10 +96,9 @@ def plot_comparison(comparison, path=None, quantities=None, *, ax=None, channel=
                     quantity=None, provenance=None, phase=True):
     """Measured and simulated RMS velocity against speed, level gap shaded.
 
-    The thesis's layout (Kovarik 2016, Figs 45-71): one row per mount and direction, one
-    column per quantity, log-scaled velocity [mm/s], rows as tall as fit one A4 page
-    (:func:`row_height`); phase panels under the channels with phase on both sides.
-    ``docs/reference/figures.md`` (``compare --plot``) lists every mark.
+    Kovarik 2016's layout (Figs 45-71): a row per mount and direction, a column per
+    quantity, log velocity [mm/s]; phase panels under channels with phase on both sides
+    (``docs/reference/figures.md``).
 
     Parameters
     ----------
@@ -116,11 +106,9 @@ def plot_comparison(comparison, path=None, quantities=None, *, ax=None, channel=
     path : str or Path, optional
         PNG file written atomically.
     quantities : sequence of str, optional
-        Columns; default ``comparison.requested_quantities()``: the default three and
-        every measured or compared one.
+        Columns; default ``comparison.requested_quantities()``.
     ax : None, Axes, Figure or SubFigure
-        Where to draw; an Axes takes one panel (``channel``, ``quantity`` and no phase
-        panel), else an InputError saying to pass a Figure.
+        Where to draw; an Axes takes one panel (``channel``, ``quantity``, no phase).
     channel, quantity : optional
         Only this channel ((mount, direction)) and quantity.
     provenance : Provenance, optional
@@ -131,13 +119,11 @@ def plot_comparison(comparison, path=None, quantities=None, *, ax=None, channel=
     rows = list(comparison.simulated.channels)
     rows += [c for c in comparison.measured.channels if c not in rows]
     rows, quantities = select_panels(rows, list(quantities or
-                                                comparison.requested_quantities()),
-                                     channel, quantity)
+                                                comparison.requested_quantities()), channel, quantity)
     phased = {k: c for k, c in phased_channels(comparison).items()
               if k[:2] in rows and k[2] in quantities} if phase else {}
     if is_axes(ax) and phased:
-        raise InputError(panels_error(2, ", or phase=False for the level panel alone"),
-                         key="ax")
+        raise InputError(panels_error(2, ", or phase=False for the level panel alone"), key="ax")
     fig, panels, phase_panels, own, axes = _grid(ax, rows, quantities, None, None, phased)
     limit, margin_titles = comparison.exclusion_limit * MM, not is_axes(ax)
     _level_panels(panels, comparison, rows[0], limit, margin_titles)
@@ -149,20 +135,17 @@ def plot_comparison(comparison, path=None, quantities=None, *, ax=None, channel=
             _no_phase(a, id(a) in bottom)
     if margin_titles:
         _margin_labels(axes, panels, rows, quantities[0])
-    label_grid(fig, axes, "RMS velocity [mm/s]" + (", under it phase φ [°]" if phased
-                                                   else ""))
+    label_grid(fig, axes, "RMS velocity [mm/s]" + (", under it phase φ [°]" if phased else ""))
     legend(fig, axes, ax)
     return finish(fig, own, path, provenance,
                   title=_title(comparison, bool(phased)) if not is_axes(ax) else None)
 
 
 def _level_panels(panels, comparison, top_channel, limit, margin_titles):
-    """Draw every level panel: compared or measured-not-modelled, else labelled empty."""
+    """Draw every level panel, or label it empty."""
     compared = {(c.mount, c.direction, c.quantity): c for c in comparison.channels}
-    unmodelled = {(e["mount"], e["direction"], e["quantity"]): e
-                  for e in comparison.not_modelled}
-    missing = {(m["mount"], m["direction"], m["quantity"]): m["reason"]
-               for m in comparison.missing}
+    unmodelled = {(e["mount"], e["direction"], e["quantity"]): e for e in comparison.not_modelled}
+    missing = {(m["mount"], m["direction"], m["quantity"]): m["reason"] for m in comparison.missing}
     for key, a in panels.items():
         head = _head(key, top_channel, margin_titles)
         if key in compared or key in unmodelled:
@@ -181,37 +164,31 @@ def _margin_labels(axes, panels, rows, first_quantity):
 
 
 def _grid(ax, rows, quantities, channel, quantity, phased):
-    """``(fig, {key: level Axes}, {key: phase Axes}, own, 2-D array of every panel)``: the
-    level panels as :func:`~powertrain.plotting.runup.grid`, and a phase row under each
-    channel row with some phase in ``phased``."""
+    """``(fig, {key: level Axes}, {key: phase Axes}, own, all panels)``: the level grid of
+    :func:`~powertrain.plotting.runup.grid`, a phase row under each row with phase."""
     with_phase = [ch for ch in rows if any(k[:2] == tuple(ch) for k in phased)]
     height = row_height(len(rows), len(with_phase))
     if not with_phase:
-        fig, panels, own, axes = grid(ax, rows, quantities, channel, quantity,
-                                      panel_height=height)
+        fig, panels, own, axes = grid(ax, rows, quantities, channel, quantity, panel_height=height)
         return fig, panels, {}, own, axes
     kinds = [(tuple(ch), kind) for ch in rows
              for kind in (("level", "phase") if ch in with_phase else ("level",))]
     rows_in = [height if kind == "level" else phase_row_height() for _, kind in kinds]
-    axes_in = [height - LEVEL_DECORATION_IN if kind == "level" else PHASE_AXES_IN
-               for _, kind in kinds]
+    axes_in = [height - LEVEL_DECORATION_IN if kind == "level" else PHASE_AXES_IN for _, kind in kinds]
     fig, all_axes, own = subplots(ax, len(kinds), len(quantities), sharex=True,
                                   figsize=(PRINT_WIDTH_IN, sum(rows_in) + FRAME_HEIGHT_IN
-                                           + PHASE_NOTE_HEIGHT_IN),
-                                  gridspec_kw={"height_ratios": axes_in})
+                                           + PHASE_NOTE_HEIGHT_IN), gridspec_kw={"height_ratios": axes_in})
     if own:
         fig.get_layout_engine().set(h_pad=PHASE_FIGURE_PAD_IN)
     level = [i for i, (_, kind) in enumerate(kinds) if kind == "level"]
-    panels = {(*rows[r], q): all_axes[i, j] for r, i in enumerate(level)
-              for j, q in enumerate(quantities)}
+    panels = {(*rows[r], q): all_axes[i, j] for r, i in enumerate(level) for j, q in enumerate(quantities)}
     phase_panels = {(*ch, q): all_axes[i, j] for i, (ch, kind) in enumerate(kinds)
                     if kind == "phase" for j, q in enumerate(quantities)}
     return fig, panels, phase_panels, own, all_axes
 
 
 def _no_phase(ax, bottom):
-    """A phase slot without phase: hidden, or on the bottom row only its speed axis (so that
-    every column's speed labels stay on one line)."""
+    """A phase slot without phase: hidden, or on the ``bottom`` row only its speed axis."""
     if not bottom:
         ax.set_visible(False)
         return
@@ -223,8 +200,8 @@ def _no_phase(ax, bottom):
 
 
 def _phase_panel(ax, comparison, c):
-    """Order phase [deg] of one channel-quantity, wrapped to ±180° (measured where not at
-    the noise floor, simulated where its level is not zero), a line broken at each wrap."""
+    """Order phase [deg] of one channel-quantity ``c``: measured off the floor, simulated
+    where its level is not zero."""
     key = (c.mount, c.direction, c.quantity)
     meas = np.asarray(comparison.measured.phases[key], float)
     _phase_line(ax, c.rpm, np.where(c.at_floor, np.nan, meas), "-", color="k", lw=0.7,
@@ -232,8 +209,7 @@ def _phase_panel(ax, comparison, c):
     rpm, level = comparison.simulated.curves[key]
     sim = np.where(level > 0, comparison.simulated.phases[key], np.nan)
     sparse = len(comparison.sim_rpm) <= MAX_MARKED_SPEEDS
-    _phase_line(ax, rpm, sim, "o-" if sparse else "-", color=colour(0), ms=2, lw=1.2,
-                label="simulated")
+    _phase_line(ax, rpm, sim, "o-" if sparse else "-", color=colour(0), ms=2, lw=1.2, label="simulated")
     ax.set_ylim(-PHASE_LIMIT_DEG, PHASE_LIMIT_DEG)
     ax.set_yticks(PHASE_TICKS)
     ax.set_yticks([-180.0, 0.0, 180.0], minor=True)
@@ -242,8 +218,7 @@ def _phase_panel(ax, comparison, c):
 
 
 def _phase_line(ax, rpm, phase_deg, fmt, **style):
-    """Draw a wrapped phase against speed, the line broken where it wraps (a step over
-    180°) instead of crossing the panel."""
+    """Draw a wrapped phase against speed, broken at each wrap (a step over 180°)."""
     rpm, phase = np.asarray(rpm, float), np.asarray(phase_deg, float)
     jump = np.abs(np.diff(phase)) > 180.0
     at = np.nonzero(jump)[0] + 1
@@ -251,8 +226,7 @@ def _phase_line(ax, rpm, phase_deg, fmt, **style):
 
 
 def _head(key, top_channel, margin_titles) -> str:
-    """First title line of a panel: the full ``left Z · order 2`` for a single panel; in a
-    grid the quantity on the top row (the channel is the row's y label), else nothing."""
+    """First title line: ``left Z · order 2`` alone; in a grid the quantity on the top row."""
     if not margin_titles:
         return panel_title(*key)
     return quantity_label(key[2]) if tuple(key[:2]) == tuple(top_channel) else ""
@@ -282,8 +256,7 @@ def _title(comparison, phased=False) -> str:
 
 
 def _panel(ax, key, comparison, c, unmodelled, limit, head):
-    """One channel-quantity: curves, shaded gap, excluded and measured-not-modelled points,
-    title with the gap."""
+    """One channel-quantity: curves, shaded gap, excluded and not-modelled points."""
     sparse = len(comparison.sim_rpm) <= MAX_MARKED_SPEEDS
     values = [_curve(ax, comparison.measured.curves, key, "-", color="k", lw=0.7,
                      label="measured", zorder=3),
@@ -315,7 +288,7 @@ def _panel(ax, key, comparison, c, unmodelled, limit, head):
 
 
 def _curve(ax, curves, key, fmt, **style):
-    """Draw the positive part of one curve [mm/s]; its drawn levels (empty if absent)."""
+    """Draw the positive part of one curve; its drawn levels [mm/s]."""
     if key not in curves:
         return np.array([])
     rpm, level = curves[key]

@@ -32,31 +32,26 @@ from powertrain.plotting.style import (
     wrap,
 )
 
-#: Smallest colour scale of the gap map [dB]; the scale is the data's largest gap rounded
-#: up to one of :data:`GAP_SCALES_DB` (cells beyond, none, would show as arrows).
+#: Smallest colour scale of the gap map [dB], and the scales the largest gap is rounded up to.
 GAP_SCALE_DB = 6.0
 GAP_SCALES_DB = (3.0, 6.0, 10.0, 20.0, 30.0, 40.0, 60.0, 80.0, 100.0)
-#: Channels beyond which the gap against frequency is drawn as small multiples, one panel
-#: per mount base (or body point) and direction.
+#: Channels beyond which the gap against frequency is small multiples (base and direction).
 MAX_CHANNELS_ONE_AXIS = 8
-#: Gap outlined on the map [dB] ...
+#: Gap outlined on the map [dB] where it holds over at least this many neighbouring speeds.
 GAP_OUTLINE_DB = 3.0
-#: ... where it holds over at least this many neighbouring speeds (a lone noisy cell is not
-#: outlined).
 GAP_OUTLINE_RUN = 3
 
 
 def _censored(diagnosis):
-    """Measured points at the noise floor (the one rule, :mod:`powertrain.analysis.noise_floor`)."""
+    """Measured points at the noise floor."""
     d = diagnosis.data
     return np.isfinite(d.level) & at_floor(d.level, d.floor)
 
 
 def plot_gap_map(diagnosis, path=None, *, ax=None, quantity=None, provenance=None):
-    """Gap map of a :class:`powertrain.diagnosis.DiagnosisResult`: one panel per quantity
-    with a point above the censoring limit, channels against speed, colour = gap
-    20 log10(sim/measured) [dB] on a scale from the data (:func:`gap_scale`), runs of at
-    least :data:`GAP_OUTLINE_RUN` speeds beyond ±3 dB outlined, censored cells grey
+    """Gap map: per quantity, channels against speed coloured by the gap [dB].
+
+    Runs of :data:`GAP_OUTLINE_RUN` speeds beyond ±3 dB outlined, censored cells grey
     (``docs/reference/figures.md``, ``gap_map.png``).
 
     Parameters
@@ -65,8 +60,7 @@ def plot_gap_map(diagnosis, path=None, *, ax=None, quantity=None, provenance=Non
     path : str, optional
         PNG written atomically.
     ax : None, Axes, Figure or SubFigure
-        An Axes takes one panel: the one quantity shown, or ``quantity``; else an
-        InputError saying to pass a Figure.
+        An Axes takes one panel (one quantity, or ``quantity``).
     quantity : str, optional
         Only this quantity.
     provenance : Provenance, optional
@@ -84,8 +78,7 @@ def plot_gap_map(diagnosis, path=None, *, ax=None, quantity=None, provenance=Non
         qs = [quantity]
     if is_axes(ax):
         if len(qs) != 1:
-            raise InputError(panels_error(len(qs), ", or choose one with quantity="),
-                             key="ax")
+            raise InputError(panels_error(len(qs), ", or choose one with quantity="), key="ax")
         fig, axes, own = subplots(ax)
     else:
         ncol = 1 if len(qs) == 1 else 2
@@ -112,15 +105,15 @@ def plot_gap_map(diagnosis, path=None, *, ax=None, quantity=None, provenance=Non
 
 
 def gap_scale(gaps) -> float:
-    """Colour scale [dB] of the gap map: the largest finite |gap| rounded up to one of
-    :data:`GAP_SCALES_DB` (at least :data:`GAP_SCALE_DB`)."""
+    """Colour scale [dB]: the largest finite |``gaps``| [dB] rounded up to one of
+    :data:`GAP_SCALES_DB`, at least :data:`GAP_SCALE_DB`."""
     g = np.abs(np.asarray(gaps, float))
     top = float(g[np.isfinite(g)].max()) if np.isfinite(g).any() else 0.0
     return next((v for v in GAP_SCALES_DB if v >= max(top, GAP_SCALE_DB)), GAP_SCALES_DB[-1])
 
 
 def _run_name(diagnosis) -> str:
-    """' of run 1 (FILE)' for a plan's figures (they show its first run), else ''."""
+    """' of run 1 (FILE) of N' for a plan's figures (its first run), else ''."""
     runs = getattr(diagnosis, "runs", None) or []
     if not runs:
         return ""
@@ -131,14 +124,12 @@ def _gap_panels(axes, diagnosis, qs, cens, valid, scale=GAP_SCALE_DB):
     """Draw the gap panels; returns the last colour mesh (None when nothing was drawn)."""
     from matplotlib.colors import ListedColormap  # deferred: heavy optional package
     d = diagnosis.data
-    rows = np.flatnonzero(valid.any(axis=(0, 2))) if valid.any() else \
-        np.arange(len(d.channels))                       # channels with a point to show
+    rows = np.flatnonzero(valid.any(axis=(0, 2))) if valid.any() else np.arange(len(d.channels))
     y = np.arange(rows.size)
     im = None
     for a, q in zip(axes.flat, qs):
         k = d.quantities.index(q)
-        g = diagnosis.gap[:, rows, k].T
-        ok = valid[:, rows, k].T
+        g, ok = diagnosis.gap[:, rows, k].T, valid[:, rows, k].T
         a.set_title(quantity_label(q), fontsize=TITLE_SIZE)
         a.set_yticks(y, [f"{d.channels[c][0]} {d.channels[c][1].upper()}" for c in rows])
         a.tick_params(labelsize=TICK_SIZE)
@@ -157,7 +148,7 @@ def _gap_panels(axes, diagnosis, qs, cens, valid, scale=GAP_SCALE_DB):
 
 
 def _n_rows(valid) -> int:
-    """Channels drawn in the gap map: those with a point above the censoring limit."""
+    """Channels drawn in the gap map: those with an uncensored point."""
     return max(1, int(valid.any(axis=(0, 2)).sum()))
 
 
@@ -173,11 +164,11 @@ def _runs_beyond(mask, run):
 
 
 def plot_gap_frequency(diagnosis, path=None, *, ax=None, provenance=None):
-    """Order gaps (a) against frequency f = order·rpm/60 [Hz] per channel, with its fitted
-    structure part (a structural cause lines up at one frequency), and (b), averaged over
-    the channels, against speed per order, with its fitted excitation part (dashed). Beyond
-    :data:`MAX_CHANNELS_ONE_AXIS` channels (a) is small multiples, one per mount base (or
-    body point) and direction (``docs/reference/figures.md``, ``gap_vs_frequency.png``).
+    """Order gaps (a) per channel against frequency with the fitted structure part, and
+    (b) per order, averaged over channels, against speed with the fitted excitation part.
+
+    Beyond :data:`MAX_CHANNELS_ONE_AXIS` channels (a) is small multiples per base and
+    direction (``docs/reference/figures.md``, ``gap_vs_frequency.png``).
 
     Parameters
     ----------
@@ -186,18 +177,14 @@ def plot_gap_frequency(diagnosis, path=None, *, ax=None, provenance=None):
     ax : None, Figure or SubFigure
     provenance : Provenance, optional
     """
-    d = diagnosis.data
-    p = diagnosis.parts
-    with_data = [k for k in np.flatnonzero(d.order_mask)
-                 if np.isfinite(diagnosis.gap[:, :, k]).any()]
-    chans = [c for c in range(len(d.channels))
-             if np.isfinite(diagnosis.gap[:, c, with_data]).any()]
+    d, p = diagnosis.data, diagnosis.parts
+    with_data = [k for k in np.flatnonzero(d.order_mask) if np.isfinite(diagnosis.gap[:, :, k]).any()]
+    chans = [c for c in range(len(d.channels)) if np.isfinite(diagnosis.gap[:, c, with_data]).any()]
     many = len(chans) > MAX_CHANNELS_ONE_AXIS
     fig, own, small, a2 = _frequency_layout(ax, diagnosis, with_data, chans, many)
     for a in small:
         log_axis(a, "x", max_ticks=4 if many else 9)
-        a.set_xlabel("frequency [Hz]" if many else "frequency = order × rpm / 60 [Hz]",
-                     fontsize=LABEL_SIZE)
+        a.set_xlabel("frequency [Hz]" if many else "frequency = order × rpm / 60 [Hz]", fontsize=LABEL_SIZE)
         a.set_ylabel("gap [dB]" if many else "gap per channel [dB]", fontsize=LABEL_SIZE)
     a2.set_xlabel("engine speed [rpm]", fontsize=LABEL_SIZE)
     a2.set_ylabel("gap, mean over channels [dB]", fontsize=LABEL_SIZE)
@@ -220,8 +207,7 @@ def plot_gap_frequency(diagnosis, path=None, *, ax=None, provenance=None):
 
 
 def _frequency_layout(ax, diagnosis, orders, chans, many):
-    """``(fig, own, panels of (a), panel (b))`` of :func:`plot_gap_frequency`, drawn: (a)
-    one panel, or with ``many`` small multiples in three columns; (b) below, full width."""
+    """``(fig, own, panels of (a), panel (b))`` of :func:`plot_gap_frequency`, drawn."""
     groups = _channel_groups(diagnosis.data.channels, chans)
     ncol = 3 if many else 1
     nrow = -(-len(groups) // ncol) if many else 1
@@ -243,8 +229,7 @@ def _frequency_layout(ax, diagnosis, orders, chans, many):
 
 
 def _channel_groups(channels, chans) -> dict:
-    """``{(base, direction): [channel indices]}`` of ``chans``: a mount's engine side and
-    body side (``NAME/passive``) share their base's panel; a body point has its own."""
+    """``{(base, direction): [channel indices]}`` of ``chans`` (both sides of a mount share)."""
     out = {}
     for c in chans:
         mount, direction = channels[c]
@@ -253,10 +238,8 @@ def _channel_groups(channels, chans) -> dict:
 
 
 def _gap_by_channel(ax, diagnosis, orders, chans, sides):
-    """Gap points and structure line of channels ``chans``: each its own series style, or
-    with ``sides`` (one base and direction per panel) the engine side blue solid with
-    circles, the body side orange dashed with squares, a body point green dotted with
-    triangles (markers: no order's line of panel (b) looks like them)."""
+    """Gap points and structure line of ``chans``: a series style each, or by ``sides``
+    (engine, body side, body point: marked so no order's line of panel (b) looks alike)."""
     d, p = diagnosis.data, diagnosis.parts
     sc = p["structure_curves"]
     for j, c in enumerate(chans):
@@ -272,8 +255,7 @@ def _gap_by_channel(ax, diagnosis, orders, chans, sides):
             label = f"{mount} {direction.upper()}"
         for k in orders:
             f = (d.harmonic[k] + 1) / 2.0 * d.rpm / 60.0
-            ax.plot(f, diagnosis.gap[:, c, k], "o", ms=1.6, color=style["color"],
-                    alpha=0.6, ls="none")
+            ax.plot(f, diagnosis.gap[:, c, k], "o", ms=1.6, color=style["color"], alpha=0.6, ls="none")
         ax.plot(sc["frequency_hz"], np.array(sc["by_channel"][c]) + p["channel_const_db"][c],
                 lw=1.2, label=label, **style)
 
@@ -288,15 +270,14 @@ def _gap_by_order(ax, diagnosis, orders):
         style = series_style(j)
         ax.plot(d.rpm, mean, lw=1.0, color=style["color"], ls=style["ls"],
                 label=quantity_label(d.quantities[k]))
-        ax.plot(ec["rpm"], ec["by_quantity"][k], lw=2.0, ls=(0, (4, 2)), color=style["color"],
-                alpha=0.7)
-    if orders:      # one entry for the dashed lines, each in its order's colour
+        ax.plot(ec["rpm"], ec["by_quantity"][k], lw=2.0, ls=(0, (4, 2)), color=style["color"], alpha=0.7)
+    if orders:
         ax.plot([], [], lw=2.0, ls=(0, (4, 2)), color="0.45",
                 label="fitted excitation part (dashed, the order's colour)")
 
 
 def _legend_above(ax, title):
-    """The panel's legend above it (outside the data), carrying the panel title."""
+    """The panel's legend above it, carrying ``title``."""
     n = len(ax.get_legend_handles_labels()[1])
     leg = ax.legend(loc="lower left", bbox_to_anchor=(0, 1.01, 1, 0), mode="expand",
                     ncol=max(1, min(n, 5)), fontsize=LEGEND_SIZE, frameon=False,
@@ -307,10 +288,9 @@ def _legend_above(ax, title):
 
 
 def plot_diagnosis_overlay(diagnosis, path=None, n_panels=6, *, ax=None, provenance=None):
-    """Measured vs baseline vs baseline + chosen effect for the channel-orders with the
-    largest baseline gaps; held-out speeds circled, censored measured points hollow at the
-    censoring level; the simulated curves at every measured speed (noise floor added in
-    power), or a note where one has no steady state. A plan's overlay shows its first run.
+    """Measured, baseline and baseline + chosen effect for the largest-gap channel-orders.
+
+    Held-out speeds circled, censored points hollow at the censoring level.
 
     Parameters
     ----------
@@ -321,9 +301,7 @@ def plot_diagnosis_overlay(diagnosis, path=None, n_panels=6, *, ax=None, provena
     ax : None, Figure or SubFigure
     provenance : Provenance, optional
     """
-    d = diagnosis.data
-    g = diagnosis.gap
-    cens = _censored(diagnosis)
+    d, g, cens = diagnosis.data, diagnosis.gap, _censored(diagnosis)
     score = []
     for c in range(len(d.channels)):
         for k in np.flatnonzero(d.order_mask):
@@ -352,15 +330,13 @@ def plot_diagnosis_overlay(diagnosis, path=None, n_panels=6, *, ax=None, provena
 
 def _overlay_panel(ax, diagnosis, c, k, held, rms, cens):
     d = diagnosis.data
-    m = d.level[:, c, k] * 1e3
-    cl = NOISE_FLOOR_MARGIN * d.floor * 1e3
+    m, cl = d.level[:, c, k] * 1e3, NOISE_FLOOR_MARGIN * d.floor * 1e3
     up = np.isfinite(m) & ~cens
     ax.plot(d.rpm[up], m[up], "k.", ms=2.5, label="measured")
     if cens.any():
         ax.plot(d.rpm[cens], np.full(int(cens.sum()), cl), "o", mfc="none", mec="k", ms=2.5,
                 mew=0.6, label=f"measured below {NOISE_FLOOR_MARGIN:g}× the floor (censored)")
-    ax.plot(d.rpm[held & up], m[held & up], "o", mfc="none", mec="0.6", ms=4,
-            label="held-out speeds")
+    ax.plot(d.rpm[held & up], m[held & up], "o", mfc="none", mec="0.6", ms=4, label="held-out speeds")
     values = [m[up], [cl] if cens.any() else []]
     sim0 = _sim_curve(diagnosis, diagnosis.sim_levels, diagnosis.gap, c, k, m)
     ax.plot(d.rpm, sim0, "-", color=OKABE_ITO["vermillion"], lw=1, label="baseline simulation")
@@ -380,8 +356,7 @@ def _overlay_panel(ax, diagnosis, c, k, held, rms, cens):
 
 
 def _sim_curve(diagnosis, levels, gap, c, k, measured_mm):
-    """A simulated curve [mm/s] at every measured speed: the model levels when the result
-    carries them, else measured × 10^(gap/20) (where the gap is scored); None without."""
+    """Simulated curve [mm/s]: ``levels``, else measured × 10^(gap/20); None without either."""
     if levels is not None:
         return levels[:, c, k] * 1e3
     if gap is None:

@@ -20,18 +20,15 @@ from powertrain.plotting.style import (
 
 #: Legend label of the x, y and z component (one colour each in every load panel).
 COMPONENTS = ("x: Fx, Mx", "y: Fy, My", "z: Fz, Mz")
-#: Colours of the components, apart from the cylinders' (palette colours 0-3).
+#: Colours of the components, apart from the cylinders'.
 _COMPONENT_COLOURS = (OKABE_ITO["reddish purple"], OKABE_ITO["sky blue"], "0.3")
 
 
 def plot_excitation(exc, path=None, *, ax=None, provenance=None):
     """Summary figure of an :class:`~powertrain.models.engine.Excitation` over one cycle.
 
-    Six panels: cylinder pressures [bar] and per-cylinder crank torque [N·m] against the
-    crank angle of cylinder 1 [deg] (one colour per cylinder in both); the total forces [N]
-    and moments [N·m] on the powertrain about its CG (engine axes), each on its own axis
-    (one colour per component x, y, z); and the order spectrum (0.5..8) of the forces and of
-    the moments. One legend above the panels, so none covers a curve.
+    Cylinder pressures [bar] and crank torques [N·m] against cylinder 1's crank angle
+    [deg]; forces [N] and moments [N·m] about the CG (engine axes); their order spectra.
 
     Parameters
     ----------
@@ -42,23 +39,17 @@ def plot_excitation(exc, path=None, *, ax=None, provenance=None):
         Where to draw the six panels.
     provenance : Provenance, optional
         Foot line of a new figure.
-
-    Returns
-    -------
-    matplotlib Figure (or SubFigure)
     """
     deg = np.degrees(exc.crank_angle)
     fig, axes, own = subplots(ax, 3, 2, figsize=(PRINT_WIDTH_IN, 8.6))
     for i in range(exc.pressure.shape[1]):
-        axes[0, 0].plot(deg, exc.pressure[:, i] / 1e5, color=colour(i), lw=1.1,
-                        label=f"cylinder {i + 1}")
+        axes[0, 0].plot(deg, exc.pressure[:, i] / 1e5, color=colour(i), lw=1.1, label=f"cylinder {i + 1}")
         axes[0, 1].plot(deg, exc.torque[:, i], color=colour(i), lw=0.8)
     axes[0, 1].plot(deg, exc.torque.sum(axis=1), "k", lw=1.4, label="sum of the cylinders")
     axes[0, 0].set_ylabel("cylinder pressure [bar]", fontsize=LABEL_SIZE)
     axes[0, 1].set_ylabel("crank torque [N·m]", fontsize=LABEL_SIZE)
     for j in range(3):
-        axes[1, 0].plot(deg, exc.load[:, j], color=_COMPONENT_COLOURS[j], lw=1.1,
-                        label=COMPONENTS[j])
+        axes[1, 0].plot(deg, exc.load[:, j], color=_COMPONENT_COLOURS[j], lw=1.1, label=COMPONENTS[j])
         axes[1, 1].plot(deg, exc.load[:, j + 3], color=_COMPONENT_COLOURS[j], lw=1.1)
     axes[1, 0].set_ylabel("force on the powertrain [N]", fontsize=LABEL_SIZE)
     axes[1, 1].set_ylabel("moment about the CG [N·m]", fontsize=LABEL_SIZE)
@@ -83,8 +74,7 @@ def _spectrum(axes, exc):
             v = np.abs(amp[1:, first + j])
             a.bar(orders[1:] + (j - 1) * width, np.where(v > 0, v, np.nan), width=width,
                   color=_COMPONENT_COLOURS[j])
-        a.set_title(f"order spectrum of the {'forces' if first == 0 else 'moments'}",
-                    fontsize=TITLE_SIZE)
+        a.set_title(f"order spectrum of the {'forces' if first == 0 else 'moments'}", fontsize=TITLE_SIZE)
         a.set_xlabel("engine order", fontsize=LABEL_SIZE)
         a.set_ylabel(f"amplitude [{unit}]", fontsize=LABEL_SIZE)
         a.set_xticks(np.arange(1, 8.01, 1.0))

@@ -1,5 +1,5 @@
 """Plots of order-tracked run-ups: order curves, Campbell (rpm-order) and rpm-frequency
-maps, slow vs fast sweep. matplotlib comes through :mod:`powertrain.plotting`."""
+maps, slow vs fast sweep."""
 
 from __future__ import annotations
 
@@ -32,28 +32,23 @@ from powertrain.plotting.style import (
 #: Display unit and factor per quantity.
 DISPLAY = {"acceleration": ("m/s²", 1.0), "velocity": ("mm/s", 1e3),
            "displacement": ("mm", 1e3), "force": ("N", 1.0)}
-
-
-#: Dynamic range of an order-curve panel [dB]: the axis reaches this far below the panel's
-#: largest level, so numerical noise far below (1e-5 of the signal) does not stretch it.
+#: Dynamic range of an order-curve panel [dB] below its largest level (noise does not
+#: stretch the axis).
 DYNAMIC_RANGE_DB = 60.0
 #: Campbell and waterfall maps reach this far above the highest tracked order.
 MAP_MARGIN = 1.25
 
 
 def tracked_quantities(tracked) -> list:
-    """What ``track --plot`` draws: the synthesis and every tracked order."""
+    """What ``track --plot`` draws: the synthesis and every order of ``tracked``."""
     return ["synthesis"] + [order_label(o) for o in tracked.orders]
 
 
 def plot_tracked(tracked, path=None, quantities=None, *, ax=None, provenance=None):
-    """Order RMS against rpm, one panel per channel: the synthesis (black) and every order
-    asked (default: every tracked order, :func:`tracked_quantities`), each in the colour and
-    line style it has in every figure (:func:`~powertrain.plotting.style.quantity_style`).
-
-    A curve wholly more than :data:`DYNAMIC_RANGE_DB` below the panel's largest level is not
-    drawn but named in the title. Returns the figure (``ax``: None, Figure or SubFigure, or
-    an Axes when there is one channel, else an InputError saying to pass a Figure)."""
+    """Order RMS of ``tracked`` against rpm, a panel per channel: ``quantities`` (default
+    :func:`tracked_quantities`); curves wholly :data:`DYNAMIC_RANGE_DB` below the panel's
+    largest are named in the title instead. PNG to ``path``; ``ax`` None, Figure, SubFigure
+    or (one channel) an Axes; ``provenance`` at the foot."""
     quantities = list(quantities or tracked_quantities(tracked))
     n = len(tracked.channels)
     cols = min(3, n)
@@ -79,11 +74,10 @@ def plot_tracked(tracked, path=None, quantities=None, *, ax=None, provenance=Non
 
 
 def _hidden_note(hidden, n_channels) -> str:
-    """The title's note on the orders not drawn, grouped by where."""
+    """The title's note on the orders not drawn, grouped by panel."""
     groups = {}
     for q, where in hidden.items():
-        groups.setdefault("any panel" if len(where) == n_channels else ", ".join(where),
-                          []).append(q)
+        groups.setdefault("any panel" if len(where) == n_channels else ", ".join(where), []).append(q)
     note = ""
     for where, qs in groups.items():
         names = ", ".join(q.replace("order_", "") for q in qs)
@@ -93,9 +87,8 @@ def _hidden_note(hidden, n_channels) -> str:
 
 
 def _draw_curves(a, tracked, label, quantities, factor):
-    """Draw the curves of one channel that reach within :data:`DYNAMIC_RANGE_DB` of its
-    largest level; returns (the drawn levels, clipped to that range, the quantities not
-    drawn)."""
+    """Draw a channel's curves reaching within :data:`DYNAMIC_RANGE_DB` of its largest;
+    ``(drawn levels clipped to that range, quantities not drawn)``."""
     curves = {}
     for q in quantities:
         v = tracked.curve(label, q) * factor
@@ -108,8 +101,7 @@ def _draw_curves(a, tracked, label, quantities, factor):
         if not v.size or v.max() < floor:
             left_out.append(q)
             continue
-        a.plot(r, v, label=quantity_label(q), lw=1.8 if q == "synthesis" else 1.1,
-               **quantity_style(q))
+        a.plot(r, v, label=quantity_label(q), lw=1.8 if q == "synthesis" else 1.1, **quantity_style(q))
         drawn.append(np.maximum(v, floor))
     return (np.concatenate(drawn) if drawn else np.array([])), left_out
 
@@ -117,16 +109,12 @@ def _draw_curves(a, tracked, label, quantities, factor):
 def plot_maps(rpm, orders, order_rms, times, freqs, rpm_t, psd, title="", path=None,
               unit="m/s²", *, factor=1.0, max_order=None, tracked_rpm=None, block_revs=None,
               window_s=None, ax=None, provenance=None):
-    """Campbell (rpm-order) above rpm-frequency colour map, levels in dB re the maximum on an
-    80 dB scale (colour-bar arrows where lower levels are clipped); the order axis and the
-    frequency axis end :data:`MAP_MARGIN` above ``max_order`` (default: the highest order of
-    the map). ``order_rms`` is SI, shown in ``unit`` = SI × ``factor``.
-
-    Both speed axes span ``tracked_rpm`` (the order curves' speed range; default the maps'
-    own): a map reaches less far, as its analysis blocks (``block_revs`` revolutions) or
-    windows (``window_s`` seconds) are centred inside the record, and each panel's title
-    says so; the speeds it does not reach are shaded grey. Returns the figure (``ax``:
-    None, Figure or SubFigure)."""
+    """Campbell map (``order_rms`` [SI] at ``rpm`` × ``orders``) above the rpm-frequency map
+    (``psd`` at ``rpm_t`` × ``freqs``; ``times`` unused), in dB re the maximum on an 80 dB
+    scale, shown in ``unit`` = SI × ``factor``; axes end :data:`MAP_MARGIN` above
+    ``max_order``. Both speed axes span ``tracked_rpm``; speeds a map does not reach (its
+    ``block_revs`` blocks or ``window_s`` windows centred in the record) shaded. ``title``,
+    ``path``, ``ax`` (None, Figure, SubFigure), ``provenance`` as usual."""
     fig, axes, own = subplots(ax, 2, 1, figsize=(PRINT_WIDTH_IN, 7.4), sharey=True)
     a1, a2 = axes[:, 0]
     top = MAP_MARGIN * float(max_order or np.max(orders))
@@ -154,8 +142,7 @@ def plot_maps(rpm, orders, order_rms, times, freqs, rpm_t, psd, title="", path=N
 
 
 def _speed_axis(a, name, first, last, limits, span):
-    """The speed axis ``limits`` [rpm] of one map whose data reach ``first``..``last``: the
-    speeds beyond shaded, the title saying why (``span``: its blocks or windows)."""
+    """Speed axis ``limits`` [rpm] of a map reaching ``first``..``last``, the rest shaded."""
     lo, hi = float(min(limits)), float(max(limits))
     step = (last - first) / 50 if last > first else 0.0
     title = name
@@ -173,10 +160,8 @@ def _speed_axis(a, name, first, last, limits, span):
 
 
 def plot_sweep_rates(curves, path=None, title="", *, ax=None, provenance=None):
-    """Order curves of several sweep rates over the stepped run-up; returns the figure.
-
-    ``curves``: list of (label, rpm, level [m/s]) drawn in that order.
-    """
+    """Order curves of several sweep rates over the stepped run-up: ``curves`` of (label,
+    rpm, level [m/s]); ``path``, ``title``, ``ax``, ``provenance`` as usual."""
     fig, axes, own = subplots(ax, figsize=(PRINT_WIDTH_IN, 4.2))
     a = axes[0, 0]
     for k, (label, rpm, level) in enumerate(curves):

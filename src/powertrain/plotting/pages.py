@@ -1,6 +1,5 @@
-"""Figures on pages: the rows of a grid split so that each page fits an A4 page
-(:data:`~powertrain.plotting.style.MAX_HEIGHT_IN`), the page files ``NAME.png``,
-``NAME_p2.png`` …, and the title note of each page."""
+"""Figures on pages: a grid's rows split to fit A4 pages, written to ``NAME.png``,
+``NAME_p2.png`` …, each page's title noting the others."""
 
 from __future__ import annotations
 
@@ -8,34 +7,31 @@ import os
 
 from powertrain.plotting.style import MAX_HEIGHT_IN, close_figure
 
-#: Row heights of a grid of panels [in]: the smallest that keeps a one-line panel title and
-#: two log ticks at 8 pt apart, and the roomy one; a grid whose rows at the smallest height
-#: exceed :data:`MAX_HEIGHT_IN` is drawn on several pages (:func:`page_rows`).
+#: Row heights of a grid [in]: the smallest keeping a title and two log ticks apart at 8 pt,
+#: and the roomy one.
 MIN_ROW_IN, ROOMY_ROW_IN = 0.62, 1.3
-#: Size of an A4 page at :data:`~powertrain.plotting.style.DPI` [px], portrait: no saved figure is larger.
+#: Size of an A4 page at :data:`~powertrain.plotting.style.DPI` [px]: no saved figure is larger.
 A4_PX = (2480, 3508)
 
 
 def page_rows(rows, frame_in, roomy=ROOMY_ROW_IN):
-    """``rows`` of a grid split into pages that each fit :data:`MAX_HEIGHT_IN`, and the row
-    height.
+    """``rows`` of a grid split into pages that each fit :data:`MAX_HEIGHT_IN`, and the row height.
 
     Parameters
     ----------
     rows : list
         The grid's rows, in order.
     frame_in : float
-        Height of a page outside its rows [in] (title, legend, x labels, provenance line).
+        Height of a page outside its rows [in].
     roomy : float
         Row height when there is room [in].
 
     Returns
     -------
     pages : list of lists
-        Consecutive rows per page, as even as can be (one page when all fit at
-        :data:`MIN_ROW_IN`).
+        Consecutive rows per page, as even as can be.
     row_in : float
-        Height of a row [in]: ``roomy``, or less (not below :data:`MIN_ROW_IN`) to fit.
+        Height of a row [in]: ``roomy``, or less (down to :data:`MIN_ROW_IN`) to fit.
     """
     room = MAX_HEIGHT_IN - frame_in
     per_page = max(1, int(room // MIN_ROW_IN))
@@ -46,8 +42,7 @@ def page_rows(rows, frame_in, roomy=ROOMY_ROW_IN):
 
 
 def page_path(path, k: int):
-    """File of page ``k`` (from 0) of a figure written to ``path``: ``path`` itself, then
-    ``NAME_p2.png``, ``NAME_p3.png`` … beside it."""
+    """File of page ``k`` (from 0) of a figure written to ``path``: ``path``, ``NAME_p2.png`` …"""
     if k == 0 or path is None:
         return path
     base, ext = os.path.splitext(os.fspath(path))
@@ -55,17 +50,14 @@ def page_path(path, k: int):
 
 
 def draw_pages(rows, frame_in, ax, path, draw):
-    """A grid's ``rows`` drawn on as many pages as :func:`page_rows` needs (one page when
-    drawn into ``ax`` or not written): ``draw(rows, row height [in], file, title note)``
-    makes a page's figure. Returns the first page (what a plot function returns; the others,
-    written, are released), its ``pages`` attribute listing every file written when there
-    are several."""
+    """A grid's ``rows`` drawn on the pages :func:`page_rows` needs with ``frame_in`` (one
+    into ``ax`` or unwritten) by ``draw(rows, row height [in], file, title note)``; the
+    first page returned, ``pages`` listing the files written to ``path``, the rest closed."""
     pages, height = page_rows(rows, frame_in)
     if ax is not None or not path:
         pages = [rows]
     paths = [page_path(path, k) for k in range(len(pages))]
-    figures = [draw(chunk, height, paths[k], page_note(k, pages, path))
-               for k, chunk in enumerate(pages)]
+    figures = [draw(chunk, height, paths[k], page_note(k, pages, path)) for k, chunk in enumerate(pages)]
     for fig in figures[1:]:
         close_figure(fig)
     if len(figures) > 1:
@@ -74,10 +66,9 @@ def draw_pages(rows, frame_in, ax, path, draw):
 
 
 def page_note(k: int, pages, path) -> str:
-    """Title note of page ``k`` of a figure drawn on several pages (empty for one page)."""
+    """Title note of page ``k`` of ``pages`` written to ``path`` (empty for one page)."""
     if len(pages) < 2:
         return ""
     names = [os.path.basename(os.fspath(page_path(path, j))) for j in range(len(pages))]
     rest = ", ".join(n for j, n in enumerate(names) if j != k)
-    return f" — page {k + 1} of {len(pages)} (also {rest})" if path else \
-        f" — part {k + 1} of {len(pages)}"
+    return f" — page {k + 1} of {len(pages)} (also {rest})" if path else f" — part {k + 1} of {len(pages)}"

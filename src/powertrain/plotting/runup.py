@@ -1,6 +1,5 @@
-"""Run-up figures: order curves against speed, one panel per channel (mount × direction) and
-quantity (synthesis, orders) — the thesis's layout (Kovarik 2016, Figs 45–71) — for a run-up,
-a comparison with a measurement and a what-if study."""
+"""Run-up figures: order curves against speed, a panel per channel and quantity (Kovarik
+2016, Figs 45–71), for a run-up and a what-if study; the grid shared with the comparison."""
 
 from __future__ import annotations
 
@@ -30,25 +29,16 @@ from powertrain.plotting.style import (
 RPM_LABEL = "engine speed [rpm]"
 #: Said once in a figure's title instead of in every panel.
 SYNTHESIS_NOTE = " (synthesis = RMS sum of the orders ≤ 8)"
-
-
 #: Height of a grid figure outside its panel rows [in]: title, legend, x labels, foot line.
 GRID_FRAME_IN = 1.6
 
 
-def grid(ax, rows, quantities, channel=None, quantity=None, panel_height=None,
-         frame_in=GRID_FRAME_IN):
-    """Panels of a channel × quantity figure: every row of ``rows`` and column of
-    ``quantities``, or only the row ``channel`` ((mount, direction)) and the column
-    ``quantity`` where given.
+def grid(ax, rows, quantities, channel=None, quantity=None, panel_height=None, frame_in=GRID_FRAME_IN):
+    """Panels of a channel × quantity figure: ``rows`` × ``quantities``, or only the row
+    ``channel`` and column ``quantity`` where given; an Axes ``ax`` takes one panel.
 
-    ``ax`` None, Figure or SubFigure: those panels; an Axes: the one panel they leave
-    (:class:`~powertrain.errors.InputError`, saying to pass a Figure, when they leave
-    several).
-
-    ``panel_height``: of a row [in]; default as tall as fit one page
-    (:func:`~powertrain.plotting.style.page_rows`) with ``frame_in`` [in] for the title,
-    legend, x labels and foot line.
+    ``panel_height`` [in]: of a row, default as tall as fit one page with ``frame_in`` [in]
+    for title, legend, x labels and foot line.
 
     Returns
     -------
@@ -58,15 +48,12 @@ def grid(ax, rows, quantities, channel=None, quantity=None, panel_height=None,
     if is_axes(ax):
         if len(rows) * len(quantities) != 1:
             raise InputError(panels_error(len(rows) * len(quantities), ", or choose one "
-                                          "panel with channel=(MOUNT, DIR) and quantity="),
-                             key="ax")
+                                          "panel with channel=(MOUNT, DIR) and quantity="), key="ax")
         return ax.figure, {(*rows[0], quantities[0]): ax}, False, np.array([[ax]])
     nr, nq = len(rows), len(quantities)
     if panel_height is None:
         panel_height = page_rows(rows, frame_in)[1]
-    fig, axes, own = subplots(ax, nr, nq,
-                              figsize=(PRINT_WIDTH_IN, panel_height * nr + frame_in),
-                              sharex=True)
+    fig, axes, own = subplots(ax, nr, nq, figsize=(PRINT_WIDTH_IN, panel_height * nr + frame_in), sharex=True)
     panels = {(*rows[r], quantities[q]): axes[r, q] for r in range(nr) for q in range(nq)}
     return fig, panels, own, axes
 
@@ -92,31 +79,26 @@ def panel_title(mount, direction, quantity) -> str:
     return f"{mount} {direction.upper()} · {quantity_label(quantity)}"
 
 
-#: Most columns that each get their own x label (more: one under the middle column, as a
-#: label per column would run into its neighbours).
+#: Most columns that each get their own x label (more: one under the middle column).
 MAX_LABELLED_COLUMNS = 4
 
 
 def label_grid(fig, axes, ylabel):
-    """Shared axis labels: an x label under each column (only under the middle one beyond
-    :data:`MAX_LABELLED_COLUMNS`) and one y label beside it, or the labels of a single
-    axes."""
+    """An x label under each column of ``axes`` (the middle one beyond
+    :data:`MAX_LABELLED_COLUMNS`) and one ``ylabel`` beside them."""
     if axes.size == 1:
         axes.flat[0].set_xlabel(RPM_LABEL, fontsize=LABEL_SIZE)
         axes.flat[0].set_ylabel(ylabel, fontsize=LABEL_SIZE)
         return
-    columns = axes[-1] if axes.shape[1] <= MAX_LABELLED_COLUMNS else \
-        [axes[-1, axes.shape[1] // 2]]
+    columns = axes[-1] if axes.shape[1] <= MAX_LABELLED_COLUMNS else [axes[-1, axes.shape[1] // 2]]
     for ax in columns:
         ax.set_xlabel(RPM_LABEL, fontsize=LABEL_SIZE)
     fig.supylabel(ylabel, fontsize=LABEL_SIZE + 0.5)
 
 
 def style_panel(ax, title, values, dynamic_range_db=None, max_ticks=4):
-    """Title, log y axis with at most ``max_ticks`` plain-number ticks and limits spanning at
-    least a factor 4; with ``dynamic_range_db`` the axis reaches at most that far below the
-    largest value (numerical noise far below does not stretch it). False when there is
-    nothing to show."""
+    """``title`` and a log y axis for ``values`` (at most ``max_ticks`` ticks, a factor 4 at
+    least, at most ``dynamic_range_db`` below the largest); False with nothing to show."""
     ax.set_title(title, fontsize=TITLE_SIZE)
     ax.grid(True, which="major", alpha=0.35)
     ax.tick_params(which="both", labelsize=TICK_SIZE)
@@ -141,14 +123,11 @@ def _positive(rpm, values):
     return np.asarray(rpm)[ok], values[ok]
 
 
-# --------------------------------------------------------------------------- run-up
 def plot_runup(results, path=None, quantities=("synthesis", "order_2", "order_4"),
                signal="velocity", *, ax=None, channel=None, quantity=None, provenance=None):
     """RMS curves of one or more run-ups: rows = mount × direction, columns = ``quantities``.
 
-    The rows are made as tall as fit one A4 page (:func:`grid`); written to ``path``, a grid
-    whose rows do not fit one page at the smallest row height is written as pages:
-    ``path``, then ``NAME_p2.png`` … (:func:`~powertrain.plotting.style.page_path`).
+    Rows that do not fit one A4 page are written as pages ``path``, ``NAME_p2.png`` ….
 
     Parameters
     ----------
@@ -156,18 +135,19 @@ def plot_runup(results, path=None, quantities=("synthesis", "order_2", "order_4"
     path : str or Path, optional
         PNG written atomically (the first page).
     quantities : sequence of str
-        ``synthesis`` and/or ``order_<n>``; every one is drawn.
+        ``synthesis`` and/or ``order_<n>``.
     signal : {"velocity", "displacement", "acceleration", "mount_force"}
     ax : None, Axes, Figure or SubFigure
-        Where to draw (see :func:`grid`); an Axes gets the one panel ``channel``/``quantity``.
+        Where to draw (:func:`grid`).
+    channel, quantity : optional
+        Only this channel ((mount, direction)) and quantity.
     provenance : Provenance, optional
         Foot line of a new figure.
 
     Returns
     -------
     matplotlib Figure (or SubFigure)
-        The first page; its ``pages`` attribute lists the files written when there are
-        several.
+        The first page; its ``pages`` attribute lists the files written.
     """
     rows, picked = select_panels(results[0][1].channels, list(quantities), channel, quantity)
     if is_axes(ax):
@@ -199,15 +179,11 @@ def _runup_page(results, rows, quantities, signal, ax, provenance, path, note):
                   f"{note}" if not is_axes(ax) else None)
 
 
-# --------------------------------------------------------------------------- what-if
-def plot_whatif(whatif, path=None, *, ax=None, channel=None, quantity=None, provenance=None,
-                view="levels"):
-    """A what-if study against speed: absolute levels (``view="levels"``) or the change of
-    each variant against the baseline, Δ = 20 log10(v/v0) [dB] (``view="delta"``).
+def plot_whatif(whatif, path=None, *, ax=None, channel=None, quantity=None, provenance=None, view="levels"):
+    """A what-if study against speed: levels, or each variant's change Δ = 20 log10(v/v0) [dB].
 
-    Every channel-quantity, one panel each, paged as :func:`plot_runup`; the legend gives
-    each variant's mean change over all channels, quantities and speeds
-    (``docs/reference/figures.md``, ``whatif --plot`` and ``--delta-plot``).
+    Paged as :func:`plot_runup`; the legend gives each variant's mean change
+    (``docs/reference/figures.md``).
 
     Parameters
     ----------
@@ -221,8 +197,7 @@ def plot_whatif(whatif, path=None, *, ax=None, channel=None, quantity=None, prov
     Returns
     -------
     matplotlib Figure (or SubFigure)
-        The first page; its ``pages`` attribute lists the files written when there are
-        several.
+        The first page; its ``pages`` attribute lists the files written.
     """
     if view not in ("levels", "delta"):
         raise InputError(f"{view!r} is not one of 'levels', 'delta'", key="view")
@@ -231,8 +206,7 @@ def plot_whatif(whatif, path=None, *, ax=None, channel=None, quantity=None, prov
     signal = getattr(whatif, "signal", "velocity")
     title = _whatif_title(view, signal)
     entries = len(whatif.variants) + 1 + (whatif.measured is not None and view == "levels")
-    frame = GRID_FRAME_IN + 0.16 * (wrap(title, PRINT_WIDTH_IN * 0.95, 9).count("\n") + 1
-                                    + entries)
+    frame = GRID_FRAME_IN + 0.16 * (wrap(title, PRINT_WIDTH_IN * 0.95, 9).count("\n") + 1 + entries)
     overall = {v.name: _mean_change(whatif, v.name, base.channels, list(whatif.quantities))
                for v in whatif.variants}
 
@@ -245,15 +219,13 @@ def plot_whatif(whatif, path=None, *, ax=None, channel=None, quantity=None, prov
         label_grid(fig, axes, "Δ = 20 log10(v/v0) [dB]" if view == "delta" else
                    f"RMS {signal.replace('_', ' ')} [{SIGNAL_UNITS[signal][1]}]")
         legend(fig, axes, ax)
-        return finish(fig, own, file, provenance,
-                      title=title + note if not is_axes(ax) else None)
+        return finish(fig, own, file, provenance, title=title + note if not is_axes(ax) else None)
     return draw_pages(rows, frame, ax, path, page)
 
 
 def _levels_panel(a, whatif, key, overall):
     mount, direction, q = key
-    base = whatif.baseline
-    signal = getattr(whatif, "signal", "velocity")
+    base, signal = whatif.baseline, getattr(whatif, "signal", "velocity")
     scale = SIGNAL_UNITS[signal][0]
     values = []
     if whatif.measured is not None and signal == "velocity" and key in whatif.measured.curves:
@@ -285,7 +257,7 @@ def _delta_panel(a, whatif, key, overall):
 
 
 def _share_delta_axis(axes):
-    """One symmetric Δ range for every panel (at least ±1 dB), so panels compare."""
+    """One symmetric Δ range for every panel, at least ±1 dB."""
     top = 1.0
     for a in axes:
         for line in a.get_lines():
@@ -305,7 +277,7 @@ def _whatif_title(view, signal) -> str:
 
 
 def _mean_change(whatif, name, channels, quantities) -> float:
-    """Mean change [dB] of variant ``name`` over the given channels, quantities and speeds."""
+    """Mean change [dB] of variant ``name`` over ``channels``, ``quantities`` and speeds."""
     d = [whatif.delta_db(name, m, di, q) for m, di in channels for q in quantities]
     d = np.concatenate([np.atleast_1d(x) for x in d]) if d else np.array([])
     d = d[np.isfinite(d)]

@@ -1,8 +1,7 @@
 """Dynamic-stiffness figures K*(f): mount models, measured-vs-fitted, retune targets.
 
-Two forms: ``real-imag`` — real and imaginary part [N/mm] in one panel (the thesis's form,
-Kovarik 2016 Figs 15–29); ``magnitude-phase`` — |K*| [N/mm] above the loss angle [deg] (the
-datasheet form, ISO 10846). Frequency axis ``log`` (plain-number ticks) or ``linear``.
+Forms: ``real-imag``, real and imaginary part [N/mm] in one panel (Kovarik 2016 Figs
+15–29); ``magnitude-phase``, |K*| [N/mm] above the loss angle [deg] (ISO 10846).
 """
 
 from __future__ import annotations
@@ -31,9 +30,8 @@ DEFAULT_FORM, DEFAULT_FREQ_AXIS = "magnitude-phase", "log"
 
 
 def stiffness_axes(ax, form, figsize=(PRINT_WIDTH_IN, 5.2)):
-    """Figure and axes of a stiffness plot: one Axes for ``real-imag``, two (|K*|, loss
-    angle) for ``magnitude-phase``; ``ax`` as for :func:`powertrain.plotting.style.subplots`
-    (one Axes only for ``real-imag``), or a pair of Axes for ``magnitude-phase``."""
+    """Figure and axes of a stiffness plot of ``form`` and ``figsize`` [in]: one Axes
+    (``real-imag``) or two (``magnitude-phase``; ``ax`` may be a pair)."""
     if form not in FORMS:
         raise InputError(f"{form!r} is not one of {', '.join(map(repr, FORMS))}", key="--form")
     if form == "magnitude-phase" and isinstance(ax, (list, tuple)) and len(ax) == 2:
@@ -41,17 +39,15 @@ def stiffness_axes(ax, form, figsize=(PRINT_WIDTH_IN, 5.2)):
     if form == "real-imag":
         fig, axes, own = subplots(ax, 1, 1, figsize=(figsize[0], figsize[1] * 0.8))
         return fig, [axes[0, 0]], own
-    fig, axes, own = subplots(ax, 2, 1, figsize=figsize, sharex=True,
-                              gridspec_kw={"height_ratios": [3, 2]})
+    fig, axes, own = subplots(ax, 2, 1, figsize=figsize, sharex=True, gridspec_kw={"height_ratios": [3, 2]})
     return fig, list(axes[:, 0]), own
 
 
 def draw_stiffness(axes, f, kcp, form, *, label, style="-", color=None, marker=None,
                    freq_axis=DEFAULT_FREQ_AXIS):
-    """Draw one K*(f) [N/m] curve into ``axes`` (from :func:`stiffness_axes`); measured data
-    as markers (``marker``), models as lines (real solid, imaginary dashed)."""
-    f = np.asarray(f, dtype=float)
-    k = np.asarray(kcp) / 1e3
+    """Draw ``kcp`` [N/m] at ``f`` [Hz] into ``axes`` in ``form``: data as ``marker``, models
+    as lines (``style``; imaginary dashed), on ``freq_axis``, with ``label``, ``color``."""
+    f, k = np.asarray(f, dtype=float), np.asarray(kcp) / 1e3
     if freq_axis == "log":
         ok = f > 0
         f, k = f[ok], k[ok]
@@ -68,11 +64,10 @@ def draw_stiffness(axes, f, kcp, form, *, label, style="-", color=None, marker=N
 
 
 def style_stiffness(axes, form, freq_axis, band=None, own=False):
-    """Labels, grid, frequency axis (log with plain numbers, or linear), optional shaded
-    band (f_lo, f_hi) [Hz]."""
+    """Labels, grid, ``freq_axis``, shaded ``band`` (f_lo, f_hi) [Hz]; the legend above the
+    panels when ``own``."""
     if freq_axis not in FREQ_AXES:
-        raise InputError(f"{freq_axis!r} is not one of {', '.join(map(repr, FREQ_AXES))}",
-                         key="--freq-axis")
+        raise InputError(f"{freq_axis!r} is not one of {', '.join(map(repr, FREQ_AXES))}", key="--freq-axis")
     if form == "real-imag":
         axes[0].set_ylabel("dynamic stiffness K* [N/mm]", fontsize=LABEL_SIZE)
     else:
@@ -89,7 +84,7 @@ def style_stiffness(axes, form, freq_axis, band=None, own=False):
         a.tick_params(which="both", labelsize=TICK_SIZE)
     if form == "magnitude-phase":
         axes[0].tick_params(labelbottom=False)
-    if own:       # a figure of its own: the legend above the panels, off the curves
+    if own:
         axes[0].figure.legend(*axes[0].get_legend_handles_labels(), loc="outside upper center",
                    fontsize=LEGEND_SIZE, frameon=False, ncol=2)
     else:
@@ -97,8 +92,7 @@ def style_stiffness(axes, form, freq_axis, band=None, own=False):
 
 
 def plot_stiffness(curves, path=None, measured=None, ax=None, *, form=DEFAULT_FORM,
-                   freq_axis=DEFAULT_FREQ_AXIS, title=None, provenance=None,
-                   measured_label="measured"):
+                   freq_axis=DEFAULT_FREQ_AXIS, title=None, provenance=None, measured_label="measured"):
     """Cross-point dynamic stiffness K*(f) of one or more mount models (and a measurement).
 
     Parameters
@@ -110,31 +104,23 @@ def plot_stiffness(curves, path=None, measured=None, ax=None, *, form=DEFAULT_FO
         Drawn as dots.
     ax : None, Axes, Figure, SubFigure, or (Axes, Axes) for ``magnitude-phase``
     form : {"magnitude-phase", "real-imag"}
-        |K*| and loss angle (datasheets, ISO 10846) or real and imaginary part (thesis).
     freq_axis : {"log", "linear"}
     title : str, optional
     provenance : Provenance, optional
         Foot line of a new figure.
     measured_label : str
         Legend label of ``measured``.
-
-    Returns
-    -------
-    matplotlib Figure (or SubFigure)
     """
     fig, axes, own = stiffness_axes(ax, form)
     if measured is not None:
         draw_stiffness(axes, measured[0], measured[1], form, label=measured_label, color="k",
                        marker=".", freq_axis=freq_axis)
     for k, item in enumerate(curves):
-        label, f, kcp = (item[0], item[1].frequency_hz, item[1].kcp) if len(item) == 2 \
-            else item
-        draw_stiffness(axes, f, kcp, form, label=label, color=colour(k),
-                       freq_axis=freq_axis)
+        label, f, kcp = (item[0], item[1].frequency_hz, item[1].kcp) if len(item) == 2 else item
+        draw_stiffness(axes, f, kcp, form, label=label, color=colour(k), freq_axis=freq_axis)
     style_stiffness(axes, form, freq_axis, own=own)
     if title:
-        axes[0].set_title(wrap(title, root_size(axes[0].figure)[0] * 0.95, TITLE_SIZE),
-                          fontsize=TITLE_SIZE)
+        axes[0].set_title(wrap(title, root_size(axes[0].figure)[0] * 0.95, TITLE_SIZE), fontsize=TITLE_SIZE)
     return finish(fig, own, path, provenance)
 
 
@@ -143,9 +129,7 @@ FIT_POINTS = 400
 
 
 def fit_frequencies(frequency_hz, freq_axis=DEFAULT_FREQ_AXIS) -> np.ndarray:
-    """Frequencies [Hz] at which a fitted model is drawn as a continuous curve:
-    :data:`FIT_POINTS` spanning the data's ``frequency_hz`` range, evenly on the
-    ``freq_axis`` (log: from the lowest positive frequency)."""
+    """:data:`FIT_POINTS` frequencies [Hz] spanning ``frequency_hz``, even on ``freq_axis``."""
     f = np.asarray(frequency_hz, dtype=float)
     if freq_axis == "log" and (f > 0).any():
         return np.geomspace(f[f > 0].min(), f.max(), FIT_POINTS)
@@ -153,17 +137,14 @@ def fit_frequencies(frequency_hz, freq_axis=DEFAULT_FREQ_AXIS) -> np.ndarray:
 
 
 def data_label(synthetic: bool) -> str:
-    """Legend word of data points: ``SYNTHETIC data`` when the file says so, else
-    ``measured``."""
+    """Legend word of data points: ``SYNTHETIC data`` if ``synthetic``, else ``measured``."""
     return "SYNTHETIC data" if synthetic else "measured"
 
 
 def plot_mount_fit(frequency_hz, kcp_measured, kcp_fitted, *, label="fit", title=None,
                    ax=None, path=None, form=DEFAULT_FORM, freq_axis=DEFAULT_FREQ_AXIS,
                    provenance=None, synthetic=False):
-    """Measured (dots) and fitted (lines) K*(f) of a mount fit, in either form (see
-    :func:`plot_stiffness`; the thesis shows real and imaginary parts, Kovarik 2016,
-    Figs. 15–29 and 37–42).
+    """Measured (dots) and fitted (lines) K*(f) of a mount fit (Kovarik 2016, Figs. 15–29).
 
     Parameters
     ----------
@@ -172,20 +153,14 @@ def plot_mount_fit(frequency_hz, kcp_measured, kcp_fitted, *, label="fit", title
     kcp_measured : ndarray of complex
         Cross-point dynamic stiffness [N/m] at ``frequency_hz``.
     kcp_fitted : ndarray of complex, or (frequencies [Hz], ndarray of complex)
-        The fitted model's [N/m]: at ``frequency_hz``, or as a continuous curve at its own
-        frequencies (:func:`fit_frequencies`).
+        The fitted model's [N/m], at ``frequency_hz`` or its own (:func:`fit_frequencies`).
     label : str
         Legend label of the fitted curves.
     title : str, optional
     ax, path, form, freq_axis, provenance
         As for :func:`plot_stiffness`.
     synthetic : bool
-        The data are synthetic: labelled ``SYNTHETIC data``, the title starts with
-        ``SYNTHETIC``.
-
-    Returns
-    -------
-    matplotlib Figure (or SubFigure)
+        Label the data and title ``SYNTHETIC``.
     """
     f_fit, k_fit = kcp_fitted if isinstance(kcp_fitted, tuple) else (frequency_hz, kcp_fitted)
     if synthetic:
@@ -212,8 +187,7 @@ def plot_retune(target_fit, path=None, *, ax=None, form=DEFAULT_FORM,
     fig, axes, own = stiffness_axes(ax, form)
     for k, style, label, color in ((tf.kcp_baseline, "-", "baseline", "k"),
                                    (tf.kcp_target, "--", "requested", colour(1)),
-                                   (tf.kcp_fitted, "-", f"fitted {tf.model.topology.name}",
-                                    colour(0))):
+                                   (tf.kcp_fitted, "-", f"fitted {tf.model.topology.name}", colour(0))):
         draw_stiffness(axes, tf.frequency_hz, k, form, label=label, style=style, color=color,
                        freq_axis=freq_axis)
     style_stiffness(axes, form, freq_axis, band=(tf.target.f_lo, tf.target.f_hi), own=own)
@@ -223,21 +197,17 @@ def plot_retune(target_fit, path=None, *, ax=None, form=DEFAULT_FORM,
 
 
 def plot_amplitude_fit(curves, path=None, *, ax=None, form=DEFAULT_FORM,
-                       freq_axis=DEFAULT_FREQ_AXIS, title=None, provenance=None,
-                       synthetic=False):
-    """Measured (dots) and fitted (continuous lines) K*(f) at several test amplitudes, one
-    colour per amplitude (Kovarik 2016, Fig. 14 with the fit over it).
+                       freq_axis=DEFAULT_FREQ_AXIS, title=None, provenance=None, synthetic=False):
+    """Measured (dots) and fitted (lines) K*(f) per test amplitude (Kovarik 2016, Fig. 14).
 
     Parameters
     ----------
     curves : list of (label, frequency_hz, kcp_measured, kcp_fitted)
-        Per amplitude; stiffness [N/m]; ``kcp_fitted`` at ``frequency_hz`` or as its own
-        (frequencies [Hz], K*) pair (:func:`fit_frequencies`).
+        Per amplitude [Hz, N/m]; ``kcp_fitted`` may be its own (frequencies, K*) pair.
     path, ax, form, freq_axis, title, provenance
         As for :func:`plot_stiffness`.
     synthetic : bool
-        The data are synthetic: labelled ``SYNTHETIC data``, the title starts with
-        ``SYNTHETIC``.
+        Label the data and title ``SYNTHETIC``.
     """
     fig, axes, own = stiffness_axes(ax, form)
     for k, (label, f, measured, fitted) in enumerate(curves):
@@ -250,6 +220,5 @@ def plot_amplitude_fit(curves, path=None, *, ax=None, form=DEFAULT_FORM,
     if synthetic:
         title = "SYNTHETIC data" + (f" · {title}" if title else "")
     if title:
-        axes[0].set_title(wrap(title, root_size(axes[0].figure)[0] * 0.95, TITLE_SIZE),
-                          fontsize=TITLE_SIZE)
+        axes[0].set_title(wrap(title, root_size(axes[0].figure)[0] * 0.95, TITLE_SIZE), fontsize=TITLE_SIZE)
     return finish(fig, own, path, provenance)

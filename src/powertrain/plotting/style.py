@@ -1,9 +1,7 @@
 """Shared figure helpers: figure set-up, provenance line, plain-number log axes, colour bars
 with ``extend``, one legend per figure, empty-panel labels, atomic saving.
 
-Every figure of the package is made with these, so they look alike and pass the text-overlap
-test (``tests/test_figures.py``). matplotlib is imported lazily; nothing here switches the
-backend (the CLI picks Agg, :func:`powertrain.cli.common.use_agg`).
+matplotlib is imported lazily; nothing here switches the backend (the CLI picks Agg).
 """
 
 from __future__ import annotations
@@ -24,50 +22,42 @@ from powertrain.provenance import Provenance
 SIGNAL_UNITS = {"velocity": (1e3, "mm/s"), "displacement": (1e6, "µm"),
                 "acceleration": (1.0, "m/s²"), "mount_force": (1.0, "N")}
 
-#: Intended print width of every figure [in]: the text width of an A4 report page, 16 cm.
-#: Figures are drawn at this width, so a font size in points is the printed size.
+#: Print width of every figure [in]: an A4 page's text width, 16 cm (font sizes print as is).
 PRINT_WIDTH_IN = 16 / 2.54
-#: Tallest figure [in]: the text height of an A4 page (29.7 cm less 2.5 cm margins, 24.7 cm)
-#: less room for a three-line caption, 22 cm. Grids with many rows are compacted to fit it.
+#: Tallest figure [in]: an A4 page's text height less a three-line caption, 22 cm.
 MAX_HEIGHT_IN = 22 / 2.54
 #: Smallest printed text [pt] (titles, labels, ticks, legends, provenance line).
 MIN_PRINT_PT = 8.0
-#: Resolution of saved PNGs [dots per inch]: 300 dpi at 16 cm is about 1900 px wide.
+#: Resolution of saved PNGs [dots per inch].
 DPI = 300
 #: Font sizes [pt]: panel titles, axis labels, tick labels, legends, provenance line.
 TITLE_SIZE, LABEL_SIZE, TICK_SIZE, LEGEND_SIZE, FOOT_SIZE = 8.5, 8.5, 8, 8, 8
 
-#: Colour-blind-safe palette (Okabe & Ito 2008, "Color Universal Design"), without its black
-#: (reserved for baselines and totals) and its yellow (too light for lines on white). Lines
-#: beyond the seventh repeat the colours with another line style (:func:`series_style`).
+#: Colour-blind-safe palette (Okabe & Ito 2008, "Color Universal Design"); PALETTE omits
+#: black (baselines, totals) and yellow (too light on white).
 OKABE_ITO = {"blue": "#0072B2", "orange": "#E69F00", "bluish green": "#009E73",
              "vermillion": "#D55E00", "reddish purple": "#CC79A7", "sky blue": "#56B4E9",
              "yellow": "#F0E442", "black": "#000000"}
 PALETTE = tuple(OKABE_ITO[n] for n in ("blue", "orange", "bluish green", "vermillion",
                                        "reddish purple", "sky blue"))
-#: Gap shading: simulation above the measurement, simulation below it (orange / sky blue:
-#: told apart with every colour-vision deficiency, unlike red / green).
+#: Gap shading: simulation above, below the measurement (told apart by every deficiency).
 GAP_ABOVE, GAP_BELOW = OKABE_ITO["orange"], OKABE_ITO["sky blue"]
 _LINE_STYLES = ("-", "--", ":", "-.")
-#: Average glyph width as a fraction of the font size (DejaVu Sans), for text-width estimates.
+#: Average glyph width as a fraction of the font size (DejaVu Sans).
 _GLYPH = 0.6
 
 
-# ------------------------------------------------------------------ figure and axes
 def subplots(target, nrows=1, ncols=1, figsize=(PRINT_WIDTH_IN, 3.6), **kwargs):
     """Figure and a 2-D array of axes for a plot function's ``ax`` argument.
 
     Parameters
     ----------
     target : None, matplotlib Axes, Figure or SubFigure
-        None: a new pyplot figure with constrained layout (the current backend; never
-        switched). Figure or SubFigure: the panels are made in it. Axes: used as is, allowed
-        only for a single panel (else :class:`~powertrain.errors.InputError` saying to pass
-        a Figure).
+        None: a new pyplot figure, constrained layout. Figure or SubFigure: panels made in
+        it. Axes: used as is, for a single panel only (else InputError).
     nrows, ncols : int
     figsize : (float, float)
-        Size of a new figure [in]; its width is the print width :data:`PRINT_WIDTH_IN`
-        (fonts are then printed at their nominal size).
+        Size of a new figure [in].
     kwargs
         Passed to ``subplots`` (sharex, sharey, gridspec_kw ...).
 
@@ -76,7 +66,7 @@ def subplots(target, nrows=1, ncols=1, figsize=(PRINT_WIDTH_IN, 3.6), **kwargs):
     fig : Figure or SubFigure
     axes : ndarray of Axes, shape (nrows, ncols)
     own : bool
-        True when the figure was made here (then the caller adds title, legend, provenance).
+        True when the figure was made here.
     """
     from matplotlib.axes import Axes  # deferred: heavy optional package
     from matplotlib.figure import FigureBase  # deferred: heavy optional package
@@ -85,8 +75,7 @@ def subplots(target, nrows=1, ncols=1, figsize=(PRINT_WIDTH_IN, 3.6), **kwargs):
         fig = plt.figure(figsize=figsize, layout="constrained")
         return fig, _use_palette(fig.subplots(nrows, ncols, squeeze=False, **kwargs)), True
     if isinstance(target, FigureBase):
-        return target, _use_palette(target.subplots(nrows, ncols, squeeze=False, **kwargs)), \
-            False
+        return target, _use_palette(target.subplots(nrows, ncols, squeeze=False, **kwargs)), False
     if isinstance(target, Axes):
         if nrows * ncols != 1:
             raise InputError(panels_error(nrows * ncols), key="ax")
@@ -96,16 +85,15 @@ def subplots(target, nrows=1, ncols=1, figsize=(PRINT_WIDTH_IN, 3.6), **kwargs):
 
 
 def panels_error(n: int, choose: str = "") -> str:
-    """The message for an Axes given to a figure of ``n`` panels (``choose``: how to ask
-    for one panel instead, if the figure can)."""
+    """Message for an Axes given to a figure of ``n`` panels (``choose``: how to pick one)."""
     return (f"this figure has {n} panels: pass a Figure or SubFigure (e.g. fig or "
             f"fig.subfigures()), not one Axes{choose}")
 
 
 def legend(fig, axes, target, extra=()):
-    """The legend of a plot: one for the figure above the panels
-    (:func:`figure_legend`), or inside the Axes when ``target`` is one Axes."""
-    if not is_axes(target):      # a whole figure: the legend above its panels
+    """Legend of a plot: above the panels of ``fig`` (:func:`figure_legend`, ``axes``,
+    ``extra``), or inside the Axes when ``target`` is one."""
+    if not is_axes(target):
         return figure_legend(fig, axes, extra)
     a = np.ravel(axes)[0]
     handles, labels = a.get_legend_handles_labels()
@@ -120,19 +108,16 @@ def colour(k: int) -> str:
 
 
 def series_style(k: int) -> dict:
-    """Colour and line style of the ``k``-th of many series: the palette's colours first
-    solid, then dashed, dotted, dash-dotted (24 distinct series)."""
+    """Colour and line style of the ``k``-th series: the palette solid, then dashed, dotted,
+    dash-dotted (24 distinct)."""
     return {"color": colour(k), "ls": _LINE_STYLES[(k // len(PALETTE)) % len(_LINE_STYLES)]}
 
 
 def order_style(order) -> dict:
     """Colour and line style of an engine order, the same in every figure.
 
-    Even orders (2, 4, 6, 8: the firing orders of a four-cylinder engine) are solid lines in
-    blue, orange, bluish green, vermillion; odd orders (1, 3, 5, 7) dashed in reddish purple,
-    sky blue, blue, orange; half orders 0.5 … 5.5 dotted and 6.5, 7.5 dash-dotted, coloured
-    by their integer part (the 16 orders 0.5 … 8 all differ); any other order dash-dot-dot.
-    The synthesis and totals are black (:func:`quantity_style`).
+    Orders 2, 4, 6, 8 solid; 1, 3, 5, 7 dashed; half orders dotted (6.5, 7.5 dash-dotted);
+    the 16 orders 0.5 … 8 all differ; any other order dash-dot-dot.
 
     Parameters
     ----------
@@ -157,8 +142,7 @@ def order_style(order) -> dict:
 
 
 def quantity_style(quantity: str) -> dict:
-    """Colour and line style of a run-up quantity: ``synthesis`` and ``overall`` black
-    (solid, dashed), an order as :func:`order_style`."""
+    """Style of a run-up ``quantity``: synthesis, overall black; an order :func:`order_style`."""
     totals = {"synthesis": "-", "overall": "--"}
     return {"color": "k", "ls": totals[quantity]} if quantity in totals else order_style(quantity)
 
@@ -170,7 +154,7 @@ def _use_palette(axes):
 
 
 def is_axes(target) -> bool:
-    """True for a single matplotlib Axes (then grid plots draw one chosen panel)."""
+    """True for a single matplotlib Axes ``target``."""
     if target is None:
         return False
     from matplotlib.axes import Axes  # deferred: heavy optional package
@@ -191,7 +175,7 @@ def root_size(fig):
 
 
 def finish(fig, own, path=None, provenance=None, title=None):
-    """Title, provenance line and saving of a figure made by a plot function."""
+    """Title, provenance line (when ``own``) and saving to ``path`` of a figure."""
     if title:
         text = wrap(title, root_size(fig)[0] * 0.95, 9)
         if fig.legends:   # the legend above the panels carries the title (no collision)
@@ -209,11 +193,8 @@ def finish(fig, own, path=None, provenance=None, title=None):
 
 
 def keep_inside(fig, tries=3) -> bool:
-    """Shrink the constrained-layout area of a top-level figure by as much as any text
-    (a tick label or a panel title wider than its panel in the last column) overhangs the
-    figure's edges: constrained layout keeps such overhangs inside the figure only when its
-    area is the whole figure, not with the provenance strip or a ``supylabel``. True when
-    the figure is laid out as last drawn here, nothing overhanging."""
+    """Shrink a figure's constrained-layout area by any text overhang at its edges (the
+    layout contains overhangs only when its area is the whole figure); True when none."""
     engine = fig.get_layout_engine()
     if engine is None or "rect" not in engine.get():
         return False
@@ -231,24 +212,20 @@ def keep_inside(fig, tries=3) -> bool:
     return False
 
 
-# ------------------------------------------------------------------ text
 def wrap(text, width_in, fontsize) -> str:
-    """Wrap ``text`` to lines that fit ``width_in`` inches at ``fontsize`` points."""
+    """``text`` wrapped to lines that fit ``width_in`` [in] at ``fontsize`` [pt]."""
     chars = max(20, int(width_in * 72 / (fontsize * _GLYPH) * 0.95))
-    return "\n".join(textwrap.wrap(text, chars, break_long_words=True,
-                                   break_on_hyphens=False)) or text
+    return "\n".join(textwrap.wrap(text, chars, break_long_words=True, break_on_hyphens=False)) or text
 
 
 def add_provenance(fig, provenance):
-    """Write the provenance line (wrapped) at the foot of a top-level figure, in a strip
-    reserved from the constrained layout so that it never overlaps the axes.
+    """Write the provenance line at the foot of ``fig``, in a strip kept from the layout.
 
     Parameters
     ----------
     fig : Figure
     provenance : powertrain.provenance.Provenance, dict or None
-        A :class:`~powertrain.provenance.Provenance`, or a record of
-        :func:`powertrain.provenance.provenance`; None: only the program version is shown.
+        A :class:`~powertrain.provenance.Provenance` or its record; None: the version only.
     """
     width, height = fig.get_figwidth(), fig.get_figheight()
     text = foot_text(provenance, width * 0.98)
@@ -262,10 +239,8 @@ def add_provenance(fig, provenance):
 
 
 def foot_text(provenance, width_in) -> str:
-    """The provenance line in lines of ``width_in`` inches at :data:`FOOT_SIZE`: on one line
-    when it fits; else version, date and engine wrapped, then the command on lines of its
-    own, broken only between arguments with a shell continuation (`` \\``), so that it can
-    be copied and run as printed.
+    """The provenance line in lines of ``width_in`` at :data:`FOOT_SIZE`: one when it fits,
+    else the command on lines of its own broken with shell continuations, runnable as printed.
 
     Parameters
     ----------
@@ -274,7 +249,7 @@ def foot_text(provenance, width_in) -> str:
     width_in : float
         Width of a line [in].
     """
-    if isinstance(provenance, dict):   # a record of powertrain.provenance.provenance()
+    if isinstance(provenance, dict):
         provenance = Provenance.from_record(provenance)
     if provenance is None:
         return f"powertrain {__version__}"
@@ -287,14 +262,11 @@ def foot_text(provenance, width_in) -> str:
 
 
 def shell_lines(command: str, chars: int) -> list:
-    """``command`` in lines of at most ``chars`` characters, broken between arguments, each
-    but the last ending in a shell continuation `` \\``, the following ones indented; an
-    option stays with its value, and an argument longer than a line stands on a line of its
-    own."""
+    """``command`` in lines of at most ``chars``, broken between arguments with shell
+    continuations, indented; an option stays with its value."""
     words = []
     for word in command.split(" "):
-        if words and words[-1].startswith("-") and not word.startswith("-") \
-                and " " not in words[-1]:
+        if words and words[-1].startswith("-") and not word.startswith("-") and " " not in words[-1]:
             words[-1] += " " + word
         else:
             words.append(word)
@@ -311,39 +283,33 @@ def shell_lines(command: str, chars: int) -> list:
 
 
 def quantity_label(quantity: str) -> str:
-    """``order_2`` -> ``order 2``; ``synthesis`` (the RMS sum of the orders ≤ 8, said once
-    in the figure's title) stays."""
+    """``quantity`` label: ``order_2`` -> ``order 2``; ``synthesis`` stays."""
     return quantity.replace("order_", "order ")
 
 
 def signed(value, decimals: int = 1) -> str:
-    """``value`` with its sign and ``decimals`` decimals (``+0.1``, ``-2.0``); a value that
-    rounds to zero is ``0.0``, never ``-0.0`` or ``+0.0``."""
+    """``value`` signed with ``decimals`` decimals (``+0.1``); zero is ``0.0``, never signed."""
     text = f"{value:+.{decimals}f}"
     return text[1:] if float(text) == 0 else text
 
 
 def no_data(ax, text="no data above the noise floor", width=42):
-    """Label an empty panel in its centre, wrapped to lines of ``width`` characters (and drop
-    its y tick labels)."""
+    """Label the empty panel ``ax`` with ``text`` wrapped to ``width`` characters."""
     ax.text(0.5, 0.5, "\n".join(textwrap.wrap(text, width)), transform=ax.transAxes,
             ha="center", va="center", fontsize=LABEL_SIZE, color="0.4")
     ax.tick_params(axis="y", labelleft=False)
 
 
-# ------------------------------------------------------------------ log axes
 def _plain(value, _pos=None) -> str:
-    """Tick label of a log axis as a plain number: 10, 20, 50, 0.05, 0.00001 (never 2×10¹
-    or 1e-5)."""
+    """Tick label of a log axis as a plain number (0.00001, never 1e-5)."""
     if value <= 0 or not math.isfinite(value):
         return ""
     return np.format_float_positional(float(f"{value:.6g}"), trim="-")
 
 
 def _log_ticks(vmin, vmax, max_ticks, min_gap=0.0):
-    """Ticks of a log axis inside [vmin, vmax]: 1-2-5 per decade, thinned to 1-3 or 1 (or
-    every n-th decade) when more than ``max_ticks`` or when two would be closer than
-    ``min_gap`` decades, refined to 1..9 when fewer than two."""
+    """Log ticks in [vmin, vmax]: 1-2-5 per decade, thinned beyond ``max_ticks`` or closer
+    than ``min_gap`` decades, refined to 1..9 when fewer than two."""
     if vmin > vmax:
         vmin, vmax = vmax, vmin
     if not (vmax > 0 and math.isfinite(vmax)):
@@ -363,7 +329,7 @@ def _log_ticks(vmin, vmax, max_ticks, min_gap=0.0):
             break
     if len(ticks) >= 2:
         return np.array(ticks)
-    for subs in ((1, 2, 5), range(1, 10)):   # thinned 1-2-5, then refined to 1..9
+    for subs in ((1, 2, 5), range(1, 10)):
         fine = _spaced(inside(subs), min_gap)
         if 2 <= len(fine) <= max_ticks:
             return np.array(fine)
@@ -373,8 +339,7 @@ def _log_ticks(vmin, vmax, max_ticks, min_gap=0.0):
 
 
 def _spaced(ticks, min_gap):
-    """The ascending ``ticks`` thinned so that neighbours are at least ``min_gap`` decades
-    apart (the first kept)."""
+    """Ascending ``ticks`` thinned to at least ``min_gap`` decades apart."""
     kept = []
     for t in ticks:
         if not kept or math.log10(t / kept[-1]) >= min_gap:
@@ -383,8 +348,7 @@ def _spaced(ticks, min_gap):
 
 
 def log_axis(ax, axis="x", max_ticks=8, minor=True):
-    """Make ``ax``'s x or y axis logarithmic with plain-number tick labels (10, 20, 50, 100 …)
-    and unlabelled minor ticks.
+    """Make ``ax``'s x or y axis logarithmic with plain-number tick labels.
 
     Parameters
     ----------
@@ -393,7 +357,7 @@ def log_axis(ax, axis="x", max_ticks=8, minor=True):
     max_ticks : int
         Most labelled ticks; the 1-2-5 sequence is thinned beyond it.
     minor : bool
-        Unlabelled minor ticks at 2..9 × 10^n (off in large grids: they cost drawing time).
+        Unlabelled minor ticks at 2..9 × 10^n.
     """
     from matplotlib.ticker import (  # deferred: heavy optional package
         FuncFormatter,
@@ -410,14 +374,11 @@ def log_axis(ax, axis="x", max_ticks=8, minor=True):
             return _log_ticks(vmin, vmax, max_ticks, self._min_gap(vmin, vmax))
 
         def _min_gap(self, vmin, vmax):
-            """Decades between two stacked y tick labels (1.25 font sizes: the label's
-            height and a gap) on this axes' drawn height; 0 on an x axis (its labels sit
-            side by side)."""
+            """Decades between two stacked y labels (1.25 font sizes); 0 on an x axis."""
             if axis != "y" or not (vmin > 0 and vmax > 0):
                 return 0.0
             a = self.axis.axes
-            height_pt = a.bbox.height * 72 / a.figure.dpi
-            span = abs(math.log10(vmax / vmin))
+            height_pt, span = a.bbox.height * 72 / a.figure.dpi, abs(math.log10(vmax / vmin))
             return 1.25 * TICK_SIZE * span / height_pt if height_pt > 0 else 0.0
 
     target = ax.xaxis if axis == "x" else ax.yaxis
@@ -432,10 +393,9 @@ def log_axis(ax, axis="x", max_ticks=8, minor=True):
     target.set_minor_formatter(NullFormatter())
 
 
-# ------------------------------------------------------------------ colour bar, legend
 def colorbar(fig, mappable, axes, data, vmin, vmax, label):
-    """Colour bar with ``extend`` arrows on the sides where ``data`` is clipped by the
-    ``[vmin, vmax]`` scale."""
+    """Colour bar of ``mappable`` on ``axes`` labelled ``label``, with ``extend`` arrows where
+    ``data`` is clipped by ``[vmin, vmax]``."""
     finite = np.asarray(data, dtype=float)
     finite = finite[np.isfinite(finite)]
     below = bool(finite.size and finite.min() < vmin)
@@ -448,9 +408,8 @@ def colorbar(fig, mappable, axes, data, vmin, vmax, label):
 
 
 def figure_legend(fig, axes, extra=(), fontsize=LEGEND_SIZE):
-    """One legend for the whole figure, above the panels: the distinct labels of all
-    ``axes`` (first occurrence wins) plus ``extra`` (handle, label) pairs; as many columns
-    as fit the figure width."""
+    """One legend above the panels: the distinct labels of ``axes`` and ``extra`` (handle,
+    label) pairs, in as many columns as fit at ``fontsize``."""
     handles, labels = [], []
     for ax in np.ravel(axes):
         for h, lab in zip(*ax.get_legend_handles_labels()):
@@ -469,10 +428,9 @@ def figure_legend(fig, axes, extra=(), fontsize=LEGEND_SIZE):
                       fontsize=fontsize, frameon=False, markerscale=1.5)
 
 
-# ------------------------------------------------------------------ output
 def save_figure(fig, path, laid_out=False):
-    """Save a figure as PNG atomically (no half-written file on failure); ``laid_out``: in
-    the layout :func:`keep_inside` has just made, its engine held off while saving."""
+    """Save ``fig`` as PNG to ``path`` atomically; ``laid_out``: keep :func:`keep_inside`'s
+    layout (engine held off while saving)."""
     root = root_figure(fig)
     engine = root.get_layout_engine() if laid_out else None
     with atomic_path(path) as tmp:
@@ -486,14 +444,13 @@ def save_figure(fig, path, laid_out=False):
 
 
 def target_and_path(ax, path):
-    """``(ax, path)``, with a str or path given as ``ax`` taken as the output file
-    (``result.plot("file.png")``)."""
+    """``(ax, path)``, a path given as ``ax`` taken as the output file."""
     if isinstance(ax, (str, os.PathLike)):
         return None, ax
     return ax, path
 
 
 def close_figure(fig):
-    """Release a pyplot figure (after saving it, when nobody will show it)."""
+    """Release the pyplot figure ``fig``."""
     import matplotlib.pyplot as plt  # deferred: heavy optional package
     plt.close(fig)

@@ -1,8 +1,5 @@
-"""The figures of a transient manoeuvre: crank speed and torque over time above the chosen
-channels (each channel's peak marked, its value and time above the panel), the what-if
-ranking over a manoeuvre (bars in rank order, or each variant's change against the
-baseline), and a simulated manoeuvre overlaid on its recording (a grid that fits a page,
-each panel headed by its peak error and RMS of the difference)."""
+"""Figures of a transient manoeuvre: speed and torque over the chosen channels, the what-if
+ranking over a manoeuvre, and a simulated manoeuvre overlaid on its recording."""
 
 from __future__ import annotations
 
@@ -29,19 +26,15 @@ from powertrain.plotting.style import (
 QUANTITIES = {"acceleration": ("acceleration", 1.0, "m/s²"),
               "displacement": ("displacement", 1e3, "mm"),
               "force": ("force", 1.0, "N")}
-#: The crank speed is black (no channel or torque line shares it); the torques (twin axis
-#: of the top panel) and the channels take distinct colours of the palette, a channel
-#: beyond the third its colour again with another line style.
+#: Crank speed black; torques (twin axis) and channels in distinct palette colours.
 SPEED_COLOUR = OKABE_ITO["black"]
 TORQUE_STYLES = {"engine": (OKABE_ITO["orange"], "-"),
                  "starter": (OKABE_ITO["sky blue"], "--"),
                  "driveline": (OKABE_ITO["vermillion"], ":")}
 CHANNEL_COLOURS = (OKABE_ITO["blue"], OKABE_ITO["bluish green"], OKABE_ITO["reddish purple"])
-#: Margins of the data inside a channel panel (fractions of the data range): a peak at the
-#: first or last step, or at the top or bottom, keeps its marker clear of the frame.
+#: Data margins inside a channel panel (fractions of its range): a peak marker clear of the frame.
 X_MARGIN, Y_MARGIN = 0.05, 0.12
-#: Height of a panel of a transient figure [in], and the most panel rows of an overlay on
-#: one page (more channels are left out and named in the title).
+#: Height of a panel [in], and the most panel rows of an overlay (the rest named in the title).
 ROW_IN, MAX_OVERLAY_ROWS = 1.45, 5
 
 
@@ -51,16 +44,12 @@ def channel_style(k: int) -> dict:
     return {"color": CHANNEL_COLOURS[k % n], "ls": ("-", "--", ":", "-.")[(k // n) % 4]}
 
 
-def plot_transient(result, channels, path=None, ax=None, provenance=None,
-                   quantity="acceleration"):
-    """Speed [rpm] and the torques [N·m] in the top panel, below it one panel per channel of
-    ``channels`` (labels ``mount.direction``) with its ``quantity`` (:data:`QUANTITIES`);
-    each channel's largest magnitude is marked (▲/▼) and its value and time stand above the
-    panel's frame. Returns the figure; ``ax``: None (a new figure), a Figure or SubFigure
-    (one Axes is refused: the figure has several panels)."""
+def plot_transient(result, channels, path=None, ax=None, provenance=None, quantity="acceleration"):
+    """Speed [rpm] and torques [N·m] of ``result`` above a panel per channel of ``channels``
+    (``mount.direction``) with its ``quantity`` (:data:`QUANTITIES`), its peak marked; PNG
+    to ``path``, into ``ax`` (None, Figure, SubFigure), ``provenance`` at the foot."""
     if quantity not in QUANTITIES:
-        raise InputError(f"unknown quantity {quantity!r} (one of: {', '.join(QUANTITIES)})",
-                         key="--quantity")
+        raise InputError(f"unknown quantity {quantity!r} (one of: {', '.join(QUANTITIES)})", key="--quantity")
     attr, scale, unit = QUANTITIES[quantity]
     missing = [c for c in channels if c not in result.channels]
     if missing:
@@ -81,13 +70,11 @@ def plot_transient(result, channels, path=None, ax=None, provenance=None,
     legend(fig, axes, ax, extra=list(zip(handles, labels)))
     if not own:
         axes[0, 0].set_title(result.name, fontsize=TITLE_SIZE)
-    return finish(fig, own, path, provenance,
-                  title=f"{result.name} — {result.engine}" if own else None)
+    return finish(fig, own, path, provenance, title=f"{result.name} — {result.engine}" if own else None)
 
 
 def _speed_and_torque(top, result):
-    """The top panel: crank speed (black) and, on a twin axis, every torque that is not
-    zero throughout (:data:`TORQUE_STYLES`); returns the twin axes."""
+    """Top panel: speed, and on a returned twin axis every torque not zero throughout."""
     t = result.time
     top.plot(t, result.rpm, color=SPEED_COLOUR, lw=1.2, label="crank speed [rpm]")
     top.set_ylabel("speed [rpm]", fontsize=LABEL_SIZE)
@@ -103,8 +90,7 @@ def _speed_and_torque(top, result):
 
 
 def _channel_panel(a, t, y, label, unit, style):
-    """One channel's trace, its peak marked on the curve and written above the frame (the
-    panel's right-hand title: free space, never on the trace)."""
+    """One channel's trace, its peak marked and written above the frame."""
     i = int(np.argmax(np.abs(y)))
     marker = "v" if y[i] < 0 else "^"
     a.plot(t, y, lw=0.7, label=label, **style)
@@ -115,13 +101,10 @@ def _channel_panel(a, t, y, label, unit, style):
     a.set_ylabel(f"{label}\n[{unit}]", fontsize=LABEL_SIZE)
 
 
-# ------------------------------------------------------------------ what-if ranking
 def plot_ranking(ranking, path=None, ax=None, provenance=None, view="levels"):
-    """The what-if over a manoeuvre as horizontal bars, best (smallest) first from the top
-    in the ranking's order: ``view="levels"`` the peak seat acceleration [m/s²] (with a
-    seat) and the peak mount deflection [mm] of every run (the mount direction named),
-    ``view="delta"`` each variant's change of them against the baseline [%]; every bar
-    carries its value. Returns the figure."""
+    """The what-if ``ranking`` over a manoeuvre as bars, best at the top: ``view="levels"``
+    peak seat acceleration [m/s²] and mount deflection [mm], ``"delta"`` their change [%];
+    ``path``, ``ax``, ``provenance`` as :func:`plot_transient`'s."""
     if view not in ("levels", "delta"):
         raise InputError(f"unknown view {view!r} (levels or delta)", key="view")
     panels = ranking_panels(ranking, delta=view == "delta")
@@ -138,8 +121,8 @@ def plot_ranking(ranking, path=None, ax=None, provenance=None, view="levels"):
 
 
 def ranking_panels(ranking, delta=False) -> list:
-    """``(title, names, values, notes, unit)`` per panel of :func:`plot_ranking`, the runs
-    in rank order (without the baseline for ``delta``: their change in %)."""
+    """``(title, names, values, notes, unit)`` per panel of :func:`plot_ranking` of
+    ``ranking``, runs in rank order (``delta``: changes [%], no baseline)."""
     order = ranking.ranking()
     if delta:
         order = [k for k in order if k != 0]
@@ -160,9 +143,8 @@ def ranking_panels(ranking, delta=False) -> list:
 
 
 def _bars(a, names, values, notes, unit, delta):
-    """Horizontal bars of ``values`` (first at the top), each bar's value (and ``notes``) in
-    a column right of the frame, on its bar's line; the baseline grey, the variants blue
-    (``delta``: a decrease blue, an increase vermillion, about a zero line)."""
+    """Horizontal bars, first at the top, values and ``notes`` right of the frame (``delta``:
+    a decrease blue, an increase vermillion)."""
     y = np.arange(len(names))
     if delta:
         colours = [OKABE_ITO["blue"] if v <= 0 else OKABE_ITO["vermillion"] for v in values]
@@ -180,58 +162,47 @@ def _bars(a, names, values, notes, unit, delta):
     values_axis = a.secondary_yaxis("right")
     values_axis.set_yticks(y, texts, fontsize=TICK_SIZE)
     values_axis.tick_params(length=0, pad=4)
-    a.set_xlabel(("change against the baseline" if delta else "peak") + f" [{unit}]",
-                 fontsize=LABEL_SIZE)
+    a.set_xlabel(("change against the baseline" if delta else "peak") + f" [{unit}]", fontsize=LABEL_SIZE)
     a.tick_params(labelsize=TICK_SIZE)
     a.grid(True, axis="x", lw=0.3)
 
 
 def _decimals(value) -> int:
-    """Decimals of a change [%]: one from 1 % on, below it two significant digits (at most
-    three decimals)."""
+    """Decimals of a change [%]: one from 1 %, else two significant digits (at most three)."""
     size = abs(float(value))
     return 1 if size == 0 or size >= 1 else min(3, 1 - math.floor(math.log10(size)))
 
 
-# ------------------------------------------------------------------ overlay on a recording
 def overlay_grid(n: int) -> tuple:
-    """``(rows, columns, shown)`` of an overlay of ``n`` channels: one column up to three
-    channels, else three (a mount's X, Y, Z side by side), at most
-    :data:`MAX_OVERLAY_ROWS` rows (``shown`` channels; the rest are left out)."""
+    """``(rows, columns, shown)`` of an overlay of ``n`` channels: one column up to three,
+    else three, at most :data:`MAX_OVERLAY_ROWS` rows."""
     cols = 1 if n <= 3 else 3
     rows = min(math.ceil(n / cols), MAX_OVERLAY_ROWS)
     return rows, cols, min(n, rows * cols)
 
 
 def plot_overlay(comparison, path=None, ax=None, provenance=None):
-    """Measured and simulated acceleration [m/s²] over time, one panel per channel in a grid
-    that fits a page (:func:`overlay_grid`; where not all fit, the seat's and those of the
-    largest relative RMS of the difference are drawn, in file order
-    (:func:`overlay_channels`), and the others named in the title), each
-    panel headed by the channel, the simulated peak's error [%] and the RMS of the
-    difference [m/s²] (and of the measured RMS [%]). Returns the figure."""
+    """Measured and simulated acceleration [m/s²] of ``comparison`` over time, a panel per
+    channel (:func:`overlay_channels`) headed by its peak error [%] and RMS difference
+    [m/s²]; ``path``, ``ax``, ``provenance`` as :func:`plot_transient`'s."""
     n = len(comparison.channels)
     rows, cols, shown = overlay_grid(n)
     height = min(1.7 + 1.6 * rows, MAX_HEIGHT_IN)
     fig, axes, own = subplots(ax, rows, cols, figsize=(PRINT_WIDTH_IN, height), sharex=True)
-    e = comparison.errors()
-    t = comparison.time
+    e, t = comparison.errors(), comparison.time
     drawn = overlay_channels(comparison.channels, e["rms_difference_percent"], shown)
     for k, a in enumerate(axes.ravel()):
         if k >= shown:
             _hide(axes, k, cols)
             continue
         j = drawn[k]
-        a.plot(t, comparison.measured[:, j], color=OKABE_ITO["blue"], lw=0.7,
-               label="measured")
-        a.plot(t, comparison.simulated[:, j], color=OKABE_ITO["orange"], lw=0.7, ls="--",
-               label="simulated")
+        a.plot(t, comparison.measured[:, j], color=OKABE_ITO["blue"], lw=0.7, label="measured")
+        a.plot(t, comparison.simulated[:, j], color=OKABE_ITO["orange"], lw=0.7, ls="--", label="simulated")
         peak, share = e["peak_error_percent"][j], e["rms_difference_percent"][j]
         a.set_title(f"{comparison.channels[j]}: peak "
                     f"{'n/a' if np.isnan(peak) else signed(peak) + ' %'}\n"
                     f"RMS diff. {e['rms_difference'][j]:.3g} m/s²"
-                    + ("" if np.isnan(share) else f" ({share:.0f} %)"), fontsize=TICK_SIZE,
-                    pad=3)
+                    + ("" if np.isnan(share) else f" ({share:.0f} %)"), fontsize=TICK_SIZE, pad=3)
         a.margins(x=X_MARGIN, y=Y_MARGIN)
         a.tick_params(labelsize=TICK_SIZE)
         a.grid(True, lw=0.3)
@@ -252,9 +223,8 @@ def plot_overlay(comparison, path=None, ax=None, provenance=None):
 
 
 def overlay_channels(channels, rms_difference_percent, shown) -> list:
-    """Indices of the ``shown`` channels drawn, in their order: the seat's axes (a body
-    point named ``seat...``) first, then those of the largest RMS of the difference
-    relative to the measured RMS [%] (a channel without one last)."""
+    """Indices of the ``shown`` of ``channels`` drawn, in order: the seat's first, then the
+    largest ``rms_difference_percent``."""
     share = np.nan_to_num(np.asarray(rms_difference_percent, float), nan=-np.inf)
     seat = np.array([c.startswith("seat") for c in channels])
     order = np.lexsort((-share, ~seat))
@@ -262,7 +232,7 @@ def overlay_channels(channels, rms_difference_percent, shown) -> list:
 
 
 def _hide(axes, j, cols):
-    """Hide the unused panel ``j`` of the grid; the panel above it keeps its time axis."""
+    """Hide unused panel ``j`` of ``axes``; the panel above keeps its time axis."""
     r, c = divmod(j, cols)
     axes[r, c].set_visible(False)
     if r > 0:
