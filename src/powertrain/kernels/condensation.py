@@ -1,14 +1,12 @@
-r"""The assembled system's dynamic stiffness with its mount networks condensed to two-ports,
-at many values of the Laplace variable:
+r"""The assembled dynamic stiffness with the mount networks condensed to two-ports
+(maths in :mod:`powertrain.physics.condensation`):
 
 .. math:: \mathbf D_w = s_w^2\mathbf M_0 + s_w\mathbf C_0 + \mathbf K_0
           + \sum_n a_{wn}\,\mathbf e_n\mathbf e_n^T
           + b_{wn}\,(\mathbf e_n\boldsymbol\beta_n^T + \boldsymbol\beta_n\mathbf e_n^T)
-          + c_{wn}\,\boldsymbol\beta_n\boldsymbol\beta_n^T
+          + c_{wn}\,\boldsymbol\beta_n\boldsymbol\beta_n^T,
 
-(:math:`\mathbf e_n`, :math:`\boldsymbol\beta_n` network n's engine-side and base rows; the
-maths in :mod:`powertrain.physics.condensation`). Each network's nonzero upper-triangle
-entries are listed once and summed in real arithmetic (real rows times complex two-ports).
+:math:`\mathbf e_n`, :math:`\boldsymbol\beta_n` network n's engine-side and base rows.
 """
 
 from __future__ import annotations

@@ -5,9 +5,7 @@ interpolation of the channels at a fractional input index :math:`p`,
                       {\sum_i h\!\left(\frac{i - p}{L}\right)},\qquad
           h(v) = \operatorname{sinc}(K v)\,w_\mathrm{Kaiser}(v),\quad |v| < 1,
 
-a Kaiser-windowed sinc with ``K`` zero crossings per side over ``L = K / c`` input samples:
-a low-pass at ``c`` times the input Nyquist frequency (``c < 1``: the anti-alias filter of a
-resampling to a lower rate). ``h`` is tabulated and interpolated linearly.
+with ``L = K / c``: a low-pass at ``c`` times the input Nyquist frequency.
 """
 
 import math

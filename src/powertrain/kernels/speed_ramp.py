@@ -1,11 +1,9 @@
-r"""The continuous sweep's per-sample loops (:mod:`powertrain.solvers.speed_ramp`): the
-ramp's load read from its table, the modal Newmark recurrence and the channel outputs, fused
-so that no array of all steps is built.
+r"""The continuous sweep's per-sample loops (:mod:`powertrain.solvers.speed_ramp`): the ramp's
+load read from its table, the modal Newmark recurrence and the channel outputs, fused.
 
 Ramp: :math:`n(t) = n_0 + \dot n t`, :math:`\theta(t) = \tfrac{2\pi}{60}(n_0 t +
-\tfrac12\dot n t^2)`, :math:`t_k = k h`. The table holds the generalized load (6 components)
-at ``n_speeds`` speeds from ``speed0`` every ``speed_step`` rpm and ``n_theta`` angles over
-the cycle (plus the periodic wrap), read bilinearly.
+\tfrac12\dot n t^2)`, :math:`t_k = k h`; the table holds the generalized load at speeds
+``speed0 + i speed_step`` [rpm] and ``n_theta`` angles over the cycle plus the periodic wrap.
 """
 
 import math
