@@ -56,8 +56,7 @@ def condensed_matrix_kernel(s, M0, C0, K0, E, B, a, b, c, D):
 
 @njit(cache=True, nogil=True)
 def _outer_terms(R, S, same):
-    """``(network, flat position i·n + j, i <= j, value)`` of the nonzero upper-triangle entries
-    of each network's ``r sᵀ`` (``same``: ``R`` is ``S``) or ``r sᵀ + s rᵀ``."""
+    """``(network, flat position i·n + j, value)`` of each network's nonzero upper-triangle terms."""
     n_net, n = R.shape
     net = np.empty(n_net * n * n, np.int64)
     pos = np.empty(n_net * n * n, np.int64)

@@ -25,8 +25,7 @@ BERG = 2
 
 @njit(cache=True, nogil=True, inline="always")
 def _berg_branch(u, state, e):
-    """``(direction, x_s, F_s)`` of the branch through ``u``: the committed one while the
-    direction holds, else one from the last committed point."""
+    """``(direction, x_s, F_s)`` of the branch through ``u`` from the committed ``state``."""
     du = u - state[e, 3]
     d = 1.0 if du > 0 else (-1.0 if du < 0 else state[e, 2])
     if d == state[e, 2]:
@@ -120,8 +119,7 @@ def _dot(a, b):
 
 @njit(cache=True, nogil=True)
 def _solve_in_place(J, r):
-    """Solve ``J x = r`` by Gaussian elimination with partial pivoting; ``x`` overwrites
-    ``r``, ``J`` is destroyed."""
+    """Solve ``J x = r`` in place (``x`` into ``r``) by elimination with partial pivoting."""
     m = r.shape[0]
     for c in range(m):
         p = c
@@ -205,10 +203,8 @@ def newmark_port_kernel(G, H, Fs, h, x0, v0, a0, W, P, Q, kinds, par, state, X, 
 
 @njit(cache=True, nogil=True)
 def _port_newton(kinds, par, state, ul, vl, Q, z, r, J, tol, max_iter):
-    """Newton on one step's port forces ``z`` (in place) of ``z_e = f_e(ul_e - (Qu z)_e,
-    vl_e - qv (Qu z)_e)``, ``Q = (Qu, qv, ...)``. True on success."""
-    Qu, qv = Q[0], Q[1]
-    m = z.shape[0]
+    """Newton on one step's port forces ``z`` (in place); True on success."""
+    Qu, qv, m = Q[0], Q[1], z.shape[0]
     for _ in range(max_iter):
         big, worst = 1.0, 0.0
         for e in range(m):
@@ -234,20 +230,17 @@ JACOBI_ITER = 8
 
 @njit(cache=True, nogil=True, inline="always")
 def port_forces_step(kinds, par, state, ul, vl, Q, z, last, r, J, tol, max_iter):
-    """One step's port forces ``z`` (in place, from the last step's) of ``z_e = f_e(ul_e -
-    (Qu z)_e, vl_e - qv (Qu z)_e)``, ``Q = (Qu, qv, row sums of |Qu|)`` (:func:`port_coupling`),
-    and the states committed. True on success.
+    """One step's port forces ``z`` (in place) of ``z_e = f_e(ul_e - (Qu z)_e, vl_e - qv (Qu
+    z)_e)``, ``Q = (Qu, qv, row sums of |Qu|)``, the states committed. True on success.
 
-    The ports couple only through the body's motion within a step (``Qu`` ~ h²/mass), so the
+    The ports couple only through the body's motion within a step (``Qu`` ~ h²/mass): the
     laws' forces ``f`` at the motion of ``z`` are the solution's to within ``rho |f - z|``,
-    ``rho = max_e (|k_t,e| + qv |c_t,e|) sum_j |Qu_ej|``. From a predictor along the laws'
-    tangents (:func:`_predict`; ``last`` (7, m) = ``(u, v, df/du, df/dv)``, the point before
-    and the coupling ``Qu z``), ``z = f`` is accepted when ``rho |f - z|`` is below ``tol``
-    times (1 + the largest force); else diagonal Newton for :data:`JACOBI_ITER` iterations,
-    then :func:`_port_newton` (``r``, ``J`` work space, ``max_iter``); ``kinds``, ``par``,
-    ``state`` as :func:`law_force`."""
-    Qu, qv = Q[0], Q[1]
-    m = z.shape[0]
+    ``rho = max_e (|k_t,e| + qv |c_t,e|) sum_j |Qu_ej|``. From a tangent predictor
+    (``last`` (7, m) = ``(u, v, df/du, df/dv)``, the point before, ``Qu z``), ``z = f`` is
+    accepted when ``rho |f - z|`` <= ``tol`` (1 + max |z|); else :data:`JACOBI_ITER`
+    diagonal Newton iterations, then full Newton (``r``, ``J`` work space, ``max_iter``);
+    ``kinds``, ``par``, ``state`` as :func:`law_force`."""
+    Qu, qv, m = Q[0], Q[1], z.shape[0]
     _predict(ul, vl, qv, last, z)
     for _ in range(JACOBI_ITER):
         big, worst, rho = _port_residual(kinds, par, state, ul, vl, Q, z, last, r)
@@ -268,17 +261,14 @@ def port_forces_step(kinds, par, state, ul, vl, Q, z, last, r, J, tol, max_iter)
 
 @njit(cache=True, nogil=True, inline="always")
 def _predict(ul, vl, qv, last, z):
-    """Move the last step's forces ``z`` along the laws' tangents to the motions at the last
-    coupling: ``k_t du + c_t dv``, ``k_t`` extrapolated to mid-step from the last two points
-    (rows 4, 5 of ``last``) while the direction holds."""
+    """Move the last step's forces ``z`` along the laws' tangents to this step's motions."""
     for e in range(z.shape[0]):
         du = ul[e] - last[6, e] - last[0, e]
         kt = last[2, e]
         if du * (last[0, e] - last[4, e]) > 0.0:
             kt += 0.5 * (kt - last[5, e])
         z[e] += kt * du + last[3, e] * (vl[e] - qv * last[6, e] - last[1, e])
-        last[4, e] = last[0, e]
-        last[5, e] = last[2, e]
+        last[4, e], last[5, e] = last[0, e], last[2, e]
 
 
 @njit(cache=True, nogil=True)
@@ -292,8 +282,7 @@ def port_coupling(Qu, qv):
 
 @njit(cache=True, nogil=True, inline="always")
 def _port_residual(kinds, par, state, ul, vl, Q, z, last, r):
-    """Residuals ``r = f(u, v) - z``, the points ``last`` (rows 0-3, 6); returns (1 + the
-    largest force, the largest residual, rho of :func:`port_forces_step`)."""
+    """Residuals ``r = f(u, v) - z`` into ``r`` and ``last``; ``(1 + max |z|, max |r|, rho)``."""
     Qu, qv, qa = Q
     big, worst, rho = 1.0, 0.0, 0.0
     for e in range(z.shape[0]):
@@ -333,8 +322,7 @@ def _load_less_ports(load_at, T, F, k, z, p):
 
 @njit(cache=True, nogil=True, fastmath=True, inline="always")
 def _write_outputs(outputs, x, y, p, z, out, k, g):
-    """Row ``k`` of ``out``: ``Wyz [y[y_cols], z[z_cols]]`` (gathered in ``g``), plus
-    ``Re(W eta) + Wd p`` on the rows ``w_rows``; ``x`` is eta in real form."""
+    """Row ``k`` of ``out``: ``Wyz [y[y_cols], z[z_cols]]`` plus ``Re(W eta) + Wd p`` on ``w_rows``."""
     (Wyz, y_cols, z_cols), w_rows, W, Wd = outputs
     ny = y_cols.shape[0]
     for d in range(ny):

@@ -15,7 +15,13 @@ Numba caches a kernel by its own file: after editing a kernel this one calls, to
 import numpy as np
 from numba import njit
 
-from powertrain.kernels.port_forces import law_force, port_coupling, port_forces_at, port_forces_step
+from powertrain.kernels.port_forces import (
+    _dot,
+    law_force,
+    port_coupling,
+    port_forces_at,
+    port_forces_step,
+)
 from powertrain.kernels.sparse_lu import (
     factor,
     factor_on_pattern,
@@ -125,12 +131,9 @@ def curve_state(x, curves, law, centres, factors, c):
     rows, d0, f0, breaks, coefficients, count, ref, has, base, stiffness = curves
     for r in range(rows.shape[0]):
         if not has[r]:
-            factors[r] = base[r]
-            c[r] = 0.0
+            factors[r], c[r] = base[r], 0.0
             continue
-        u = 0.0
-        for j in range(x.shape[0]):
-            u += rows[r, j] * x[j]
+        u = _dot(rows[r], x)
         force, tangent = curve_point(breaks, coefficients, count, r, d0[r] + u)
         f = tangent / ref[r]
         factors[r] = f
@@ -140,8 +143,7 @@ def curve_state(x, curves, law, centres, factors, c):
 
 @njit(cache=True, nogil=True)
 def _scaled(fixed, change):
-    """The compressed assembled matrix plus each network's ``change`` of scale times its part:
-    ``fixed = (starts, columns, assembled values, (network, position, value) of the parts)``."""
+    """The compressed assembled matrix plus each network's ``change`` of scale times its part."""
     starts, columns, base, (net, position, value) = fixed
     out = base.copy()
     for e in range(value.shape[0]):
@@ -196,10 +198,7 @@ def _start_acceleration(model, laws, C, K, f, x, v):
 
 @njit(cache=True, nogil=True)
 def _piece(model, laws, h, C, K, F, load, x, v, a, X, V, A, Z, tol, max_iter, work, pivoting):
-    """Newmark over the rows ``F`` less ``load`` from ``(x, v)`` into ``X``, ``V``, ``A``,
-    ``Z``; ``a`` the start acceleration, or empty: solved. S is factored on its pattern into
-    ``work = (B (n, n), factors)``, or with row swaps unless ``pivoting`` is None (then
-    :data:`NEEDS_PIVOTING` is returned). Returns the steps where Newton did not converge."""
+    """Newmark over one piece; the steps where Newton failed, or :data:`NEEDS_PIVOTING`."""
     M, Ms, perm, where, pattern = model[0], model[1], model[6], model[7], model[8]
     if a.shape[0] == 0:
         a = _start_acceleration(model, laws, C, K, _less(F, 0, load, np.empty(x.shape[0])), x, v)
@@ -220,9 +219,7 @@ def _piece(model, laws, h, C, K, F, load, x, v, a, X, V, A, Z, tol, max_iter, wo
 
 @njit(cache=True, nogil=True)
 def _port_setup(laws, lu, h, x, v, Z):
-    r"""``(W = S^-1 P^T, coupling, P compressed, z, work)`` for :func:`_sparse_steps`, ``z``
-    and ``Z[0]`` the forces at ``(x, v)``, the predictor's coupling (``laws[5]``) set to this
-    piece's :math:`\mathbf Q_u\mathbf z`; None without port laws."""
+    """``(W, coupling, P compressed, z, work)`` of the port laws; sets ``Z[0]`` and ``last``'s coupling."""
     if laws is None:
         return None
     P, kinds, par, state, (starts, columns, values), last = laws
@@ -234,17 +231,10 @@ def _port_setup(laws, lu, h, x, v, Z):
             for k in range(starts[i], starts[i + 1]):
                 Q[i, e] += hh * values[k] * W[columns[k], e]
     for e in range(m):
-        u, du = 0.0, 0.0
-        for j in range(n):
-            u += P[e, j] * x[j]
-            du += P[e, j] * v[j]
-        z[e] = law_force(kinds[e], u, du, par, state, e)[0]
+        z[e] = law_force(kinds[e], _dot(P[e], x), _dot(P[e], v), par, state, e)[0]
         Z[0, e] = z[e]
     for e in range(m):
-        c = 0.0
-        for j in range(m):
-            c += Q[e, j] * z[j]
-        last[6, e] = c
+        last[6, e] = _dot(Q[e], z)
     return (W, port_coupling(Q, 2.0 / h), laws[4], z,
             (np.empty(m), np.empty(m), np.empty(m), np.empty((m, m)), last))
 
@@ -266,10 +256,7 @@ def _port_step(laws, ports, h, xt, vt, a, z_out, tol, max_iter):
     for e in range(z.shape[0]):
         z_out[e] = z[e]
     for j in range(a.shape[0]):
-        s = 0.0
-        for e in range(z.shape[0]):
-            s += W[j, e] * z[e]
-        a[j] -= s
+        a[j] -= _dot(W[j], z)
     return ok
 
 
@@ -298,9 +285,7 @@ def _sparse_steps(lu, laws, h, C, K, F, load, x, v, a, X, V, A, Z, tol, max_iter
 
 @njit(cache=True, nogil=True)
 def _piece_curves(middle, curves, law, centres, assembled, work, scales, loads, load):
-    """:func:`curve_state` at ``middle``: the scales and curve loads into every row of
-    ``scales``, ``loads``, the change from ``assembled`` into ``work[2]`` and the loads on the
-    coordinates into ``load`` (n,)."""
+    """:func:`curve_state` at ``middle`` into the piece's ``scales``, ``loads``, ``load``."""
     rows, n_net = curves[0], law.shape[0]
     factors, c, change = work
     curve_state(middle, curves, law, centres, factors, c)
@@ -325,8 +310,8 @@ def transient_stretch_kernel(model, curves, laws, h, F, law, centres, lo, hi, su
     model : tuple
         ``(M, M compressed, inverse of M compressed (zero on massless nodes), C, K, assembled
         scales (n_net, 2), perm, where, pattern, pivoting)``: C and K as :func:`_scaled` takes
-        them, the elimination order, each coordinate's position in it and the factors'
-        pattern (:mod:`powertrain.kernels.sparse_lu`), ``pivoting`` as :func:`_piece`'s.
+        them, the elimination order, each coordinate's position in it, the factors' pattern
+        (:mod:`powertrain.kernels.sparse_lu`); ``pivoting`` None forbids row swaps.
     curves : tuple
         :func:`curve_state`'s.
     laws : tuple or None

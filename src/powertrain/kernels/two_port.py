@@ -217,8 +217,7 @@ def kcp_gradient_kernel(omega, B, masses, c, d, kcp, dk_dm, dk_dc, dk_dd):
 
 @njit(cache=True, nogil=True)
 def _incidence_nodal_matrix(lam, B, masses, c, d, D):
-    r"""Fill ``D`` with :math:`\mathbf B^T\operatorname{diag}(c + \lambda d)\mathbf B +
-    \lambda^2\operatorname{diag}(0, \mathbf m, 0)`."""
+    r"""``D`` = :math:`\mathbf B^T\operatorname{diag}(c + \lambda d)\mathbf B + \lambda^2\mathbf M`."""
     size = B.shape[1]
     D[:, :] = 0.0
     for k in range(masses.size):
