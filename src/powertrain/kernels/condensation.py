@@ -9,8 +9,6 @@ r"""The assembled dynamic stiffness with the mount networks condensed to two-por
 :math:`\mathbf e_n`, :math:`\boldsymbol\beta_n` network n's engine-side and base rows.
 """
 
-from __future__ import annotations
-
 import numpy as np
 from numba import njit
 

@@ -3,8 +3,6 @@ r"""Many small dense complex systems :math:`\mathbf D_k\mathbf x_k = \mathbf b_k
 with partial pivoting on the largest :math:`|\Re|+|\Im|` of the column, as LAPACK's ``zgesv``.
 """
 
-from __future__ import annotations
-
 import numpy as np
 from numba import njit
 
@@ -28,8 +26,7 @@ def batched_solve_kernel(D, b, x):
         0, or 1 when some matrix has an exactly zero pivot (its solution NaN).
     """
     m, n = b.shape
-    A = np.empty((n, n), np.complex128)
-    status = 0
+    A, status = np.empty((n, n), np.complex128), 0
     for k in range(m):
         for i in range(n):
             x[k, i] = b[k, i]

@@ -25,8 +25,7 @@ def factor(M, C, K, c, k, perm):
     the rows' order ``rows``: ``perm`` with a row swapped in where a pivot is below
     :data:`PIVOT_THRESHOLD` of its column's largest entry; ``ok`` False if S is singular."""
     n = M.shape[0]
-    B = np.empty((n, n))
-    rows = perm.copy()
+    B, rows = np.empty((n, n)), perm.copy()
     for i in range(n):
         for j in range(n):
             a, b = perm[i], perm[j]

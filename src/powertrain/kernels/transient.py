@@ -366,8 +366,7 @@ def transient_stretch_kernel(model, curves, laws, h, F, law, centres, lo, hi, su
             for i in range(out.shape[1]):
                 out[p + k, i] = row_product(out_rows, i, A[k])
         failed += got
-        # the next piece's laws differ: its acceleration is solved from them, or the
-        # trapezoidal rule would carry the jump on as an undamped alternating error
+        # solved from the next piece's laws, or the jump would persist as an undamped alternation
         a = np.empty(0)
     return failed
 

@@ -11,8 +11,6 @@ pivoting on the largest diagonal) to :math:`F_E = a x_E + b x_B`, :math:`F_B = b
 parameter derivatives (:func:`powertrain.physics.mount_network.cross_point_stiffness_gradient`).
 """
 
-from __future__ import annotations
-
 import numpy as np
 from numba import njit
 
@@ -96,9 +94,7 @@ def two_port_kernel(lam, spring_scale, damper_scale, masses, elem_nodes, c, d, o
         0, or 1 if singular at some entry (NaN there).
     """
     status, n, size = 0, masses.size, masses.size + 2
-    D = np.empty((size, size), np.complex128)
-    order = np.empty(n, np.int64)
-    gone = np.empty(size, np.bool_)
+    D, order, gone = np.empty((size, size), np.complex128), np.empty(n, np.int64), np.empty(size, np.bool_)
     X = np.empty((size if out_x.shape[0] else 0, 2), np.complex128)
     for w in range(lam.size):
         nodal_matrix(lam[w], spring_scale[w], damper_scale[w], masses, elem_nodes, c, d, D)
@@ -180,10 +176,8 @@ def kcp_gradient_kernel(omega, B, masses, c, d, kcp, dk_dm, dk_dc, dk_dd):
         0, or 1 if singular at some frequency (NaN there).
     """
     n_el, n, status = B.shape[0], B.shape[1] - 2, 0
-    D = np.empty((n + 2, n + 2), dtype=np.complex128)
-    XY = np.empty((n + 2, 2), dtype=np.complex128)
-    order = np.empty(n, np.int64)
-    gone = np.empty(n + 2, np.bool_)
+    D, XY = np.empty((n + 2, n + 2), dtype=np.complex128), np.empty((n + 2, 2), dtype=np.complex128)
+    order, gone = np.empty(n, np.int64), np.empty(n + 2, np.bool_)
     for f in range(omega.shape[0]):
         w = omega[f]
         _incidence_nodal_matrix(1j * w, B, masses, c, d, D)
