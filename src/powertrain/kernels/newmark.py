@@ -12,10 +12,8 @@ one step of size :math:`h` is
     \mathbf x_{n+1} = \tilde{\mathbf x} + \tfrac{h^2}{4}\ddot{\mathbf x}_{n+1},\quad
     \dot{\mathbf x}_{n+1} = \tilde{\mathbf v} + \tfrac{h}{2}\ddot{\mathbf x}_{n+1}.
 
-The caller passes :math:`\mathbf S^{-1}\mathbf C`, :math:`\mathbf S^{-1}\mathbf K` and
-:math:`\mathbf S^{-1}\mathbf f_n`. No inverse of :math:`\mathbf M` is needed, so massless
-nodes are allowed (S is regular when each has a spring or damper). Unconditionally stable,
-no numerical damping, period error :math:`(\omega h)^2/12`.
+No inverse of :math:`\mathbf M` is needed: massless nodes with a spring or damper are
+allowed. Unconditionally stable, no numerical damping, period error :math:`(\omega h)^2/12`.
 """
 
 import numpy as np

@@ -1,12 +1,9 @@
-r"""Port laws: nonlinear forces in parallel with a mount network, between its engine-side and
-base nodes, on the relative displacement :math:`u = x_E - x_B` and velocity :math:`\dot u`.
-
-Each law is a kind code, a row of parameters and a row of state, dispatched by code:
-:func:`law_force` gives the force :math:`f` (on the base; :math:`-f` on the engine side) and
-its tangents :math:`\partial f/\partial u`, :math:`\partial f/\partial\dot u` from the
-committed state, unchanged; :func:`commit_state` updates the state once a step has
-converged. A new law adds a code, a branch in each and its element type in
-:mod:`powertrain.physics.mount_elements`. The Newmark kernels with port laws are here too.
+r"""Port laws: nonlinear forces in parallel with a mount network on the relative motion
+:math:`u = x_E - x_B`, :math:`\dot u` of its engine-side and base nodes, and the Newmark
+kernels with them. A law is a kind code, a row of parameters and a row of state:
+:func:`law_force` gives the force (on the base; :math:`-f` on the engine side) and its
+tangents, :func:`commit_state` updates the state after a converged step. A new law adds a
+code, a branch in each and its element type in :mod:`powertrain.physics.mount_elements`.
 """
 
 import numpy as np

@@ -1,13 +1,9 @@
 r"""A transient manoeuvre stretch by stretch (:func:`transient_kernel`; formulas in
-:mod:`powertrain.solvers.transient`).
-
-Each stretch takes its amplitude-law scales from the last one's amplitudes and is cut into
-pieces of ``sub`` steps; at each piece's predicted middle :math:`\mathbf x + \tfrac
-T2\dot{\mathbf x}` the networks' static factors and curve loads are read from their curves
-(:func:`curve_state`) and C, K rescaled. A step solves :math:`\mathbf S\ddot{\mathbf x} =
-\mathbf f - \mathbf C\tilde{\mathbf v} - \mathbf K\tilde{\mathbf x}` by S's sparse LU factors
-(:mod:`powertrain.kernels.sparse_lu`), then the port laws by Newton
-(:func:`powertrain.kernels.port_forces.newmark_port_kernel`).
+:mod:`powertrain.solvers.transient`): each stretch's amplitude-law scales from the last one's
+amplitudes; per piece of ``sub`` steps the curves' static factors and loads at its predicted
+middle (:func:`curve_state`); per step a sparse LU solve of :math:`\mathbf S\ddot{\mathbf x} =
+\mathbf f - \mathbf C\tilde{\mathbf v} - \mathbf K\tilde{\mathbf x}`
+(:mod:`powertrain.kernels.sparse_lu`) and the port laws by Newton.
 
 Numba caches a kernel by its own file: after editing a kernel this one calls, touch this file.
 """

@@ -1,14 +1,11 @@
-r"""Two-port dynamic stiffness of a lumped mount network (internal point masses joined by
-Kelvin–Voigt elements to its engine-side node E, its ground node B and each other), wrapped
-by :func:`powertrain.physics.mount_network.two_port`.
+r"""Two-port dynamic stiffness of a lumped mount network (point masses joined by Kelvin–Voigt
+elements to its engine-side node E, ground node B and each other).
 
-At each Laplace variable :math:`\lambda_w` with spring and damper factors :math:`s_w`,
-:math:`t_w` the nodal matrix :math:`\mathbf D_w = s_w\mathbf K + \lambda_w t_w\mathbf C +
-\lambda_w^2\mathbf M` is condensed by Gaussian elimination of the internal nodes (symmetric
-pivoting on the largest diagonal) to :math:`F_E = a x_E + b x_B`, :math:`F_B = b x_E + c x_B`
-(:math:`a = K_{IP}`, :math:`b = -K_{CP}`), and optionally the internal motion per unit
-:math:`x_E`, :math:`x_B`. :func:`kcp_gradient_kernel` gives the cross-point stiffness's
-parameter derivatives (:func:`powertrain.physics.mount_network.cross_point_stiffness_gradient`).
+The nodal matrix :math:`\mathbf D_w = s_w\mathbf K + \lambda_w t_w\mathbf C + \lambda_w^2\mathbf M`
+is condensed by eliminating the internal nodes (symmetric pivoting on the largest diagonal)
+to :math:`F_E = a x_E + b x_B`, :math:`F_B = b x_E + c x_B` (:math:`a = K_{IP}`,
+:math:`b = -K_{CP}`); :func:`kcp_gradient_kernel` gives :math:`K_{CP}`'s parameter
+derivatives (:func:`powertrain.physics.mount_network.cross_point_stiffness_gradient`).
 """
 
 import numpy as np
