@@ -1,23 +1,13 @@
-r"""Compiled kernel: the assembled system's dynamic stiffness with its mount networks
-condensed to two-ports, at many values of the Laplace variable.
-
-For each :math:`s_w` it fills
+r"""The assembled dynamic stiffness with the mount networks condensed to two-ports
+(maths in :mod:`powertrain.physics.condensation`):
 
 .. math:: \mathbf D_w = s_w^2\mathbf M_0 + s_w\mathbf C_0 + \mathbf K_0
           + \sum_n a_{wn}\,\mathbf e_n\mathbf e_n^T
           + b_{wn}\,(\mathbf e_n\boldsymbol\beta_n^T + \boldsymbol\beta_n\mathbf e_n^T)
-          + c_{wn}\,\boldsymbol\beta_n\boldsymbol\beta_n^T
+          + c_{wn}\,\boldsymbol\beta_n\boldsymbol\beta_n^T,
 
-(:math:`\mathbf e_n` network n's engine-side row, :math:`\boldsymbol\beta_n` its base row;
-the maths is in :mod:`powertrain.physics.condensation`, whose
-:func:`~powertrain.physics.condensation.condensed_matrix` is the one caller). The networks'
-terms are symmetric and a row moves only some coordinates (the rigid body, or the body
-modes): the kernel lists each network's nonzero upper-triangle entries once and sums over
-them in real arithmetic (real rows times complex two-ports), with no temporary of the size
-of the result. Checked against the dense NumPy sum in tests/test_two_port.py.
+:math:`\mathbf e_n`, :math:`\boldsymbol\beta_n` network n's engine-side and base rows.
 """
-
-from __future__ import annotations
 
 import numpy as np
 from numba import njit
@@ -32,14 +22,13 @@ def condensed_matrix_kernel(s, M0, C0, K0, E, B, a, b, c, D):
     s : ndarray (n_w,) complex
         Laplace variable [1/s].
     M0, C0, K0 : ndarray (n, n) float
-        The frame's mass, damping and stiffness (the networks not in them).
+        The frame's mass, damping and stiffness, networks excluded.
     E, B : ndarray (n_net, n) float
-        Engine-side and base rows; ``B`` with no rows: every base grounded (``b``, ``c``
-        unused).
+        Engine-side and base rows; ``B`` with no rows: every base grounded.
     a, b, c : ndarray (n_w, n_net) complex
-        The networks' two-ports.
+        The networks' two-ports (``b``, ``c`` unused when ``B`` is empty).
     D : ndarray (n_w, n, n) complex
-        Filled.
+        Output.
     """
     n = M0.shape[0]
     terms = [_outer_terms(E, E, True)]
@@ -60,14 +49,12 @@ def condensed_matrix_kernel(s, M0, C0, K0, E, B, a, b, c, D):
         for i in range(n):
             for j in range(n):
                 u = min(i, j) * n + max(i, j)
-                D[w, i, j] = s2 * M0[i, j] + sw * C0[i, j] + K0[i, j] + (U[0, u]
-                                                                         + 1j * U[1, u])
+                D[w, i, j] = s2 * M0[i, j] + sw * C0[i, j] + K0[i, j] + (U[0, u] + 1j * U[1, u])
 
 
 @njit(cache=True, nogil=True)
 def _outer_terms(R, S, same):
-    """The nonzero upper-triangle entries of each network's ``r sᵀ`` (``same``: ``R`` is
-    ``S``) or ``r sᵀ + s rᵀ``: ``(network, flat position i·n + j with i <= j, value)``."""
+    """``(network, flat position i·n + j, value)`` of each network's nonzero upper-triangle terms."""
     n_net, n = R.shape
     net = np.empty(n_net * n * n, np.int64)
     pos = np.empty(n_net * n * n, np.int64)

@@ -1,15 +1,11 @@
-r"""The engine's load tables: built from the gas forces and the unit-load patterns
-(:func:`gas_table`, :meth:`powertrain.models.engine.Engine.load_tables`) from the cylinder
-pressures at the table's angles (:func:`cylinder_pressures`), and a transient
-manoeuvre's load read from them at every step (:func:`table_load`,
-:mod:`powertrain.solvers.transient_load`): the gas load trilinear in load level, speed and
-crank angle, the inertia and acceleration patterns linear in the angle,
+r"""The engine's load tables, built from the gas forces and unit-load patterns
+(:func:`gas_table`) at the cylinder pressures of the table's angles
+(:func:`cylinder_pressures`), and read at every step of a transient (:func:`table_load`): the
+gas load trilinear in load level, speed and crank angle, the inertia and acceleration
+patterns linear in the angle,
 
 .. math:: \mathbf f_k = \phi_k\,\tilde{\mathbf G}(\lambda_k, n_k, \theta_k)
    + \omega_k^2\,\mathbf I(\theta_k) + \alpha_k\,\tilde{\mathbf A}(\theta_k).
-
-Loops rather than NumPy expressions: each of those would build an array of the whole table
-or of all steps.
 """
 
 from numba import njit
@@ -26,8 +22,8 @@ def table_load(gas, inertia, acceleration, levels, speeds, angles, fade, omega2,
     """Fill ``out`` (n, 6) with the load at each step.
 
     ``gas`` (n_levels, n_speeds, n_theta + 1, 6), ``inertia`` and ``acceleration``
-    (n_theta + 1, 6) are periodic tables (the first angle repeated last). ``levels`` and
-    ``speeds`` (n, 2) hold each step's lower table index and its weight towards the next,
+    (n_theta + 1, 6) are periodic tables (first angle repeated last). ``levels`` and
+    ``speeds`` (n, 2) hold each step's lower table index and weight towards the next,
     ``angles`` (n,) the fractional angle index in ``[0, n_theta)``; ``fade`` (n,) scales the
     gas load, ``omega2`` (n,) [rad²/s²] and ``alpha`` (n,) [rad/s²] the patterns.
     """
@@ -50,12 +46,10 @@ def table_load(gas, inertia, acceleration, levels, speeds, angles, fade, omega2,
 
 @njit(cache=True, nogil=True)
 def gas_table(gas_force, patterns, inertia, omega2, out):
-    """Fill ``out`` (n_loads, n_speeds, n, 6) with the block load of the gas forces
-    ``gas_force`` (n_loads, n_speeds, n, n_cyl) [N] and of the speeds' ``omega2``
-    (n_speeds,) [rad²/s²]: ``omega2 I + sum over cylinders of F_g G`` with the load of a
-    unit gas force in each cylinder ``patterns`` (n_cyl, n, 6) and of a unit omega^2
-    ``inertia`` (n, 6) (:meth:`powertrain.models.engine.Engine.load_tables`), summed in that
-    order."""
+    """Fill ``out`` (n_loads, n_speeds, n, 6) with ``omega2 I + sum over cylinders of F_g G``:
+    gas forces ``gas_force`` (n_loads, n_speeds, n, n_cyl) [N], unit-gas-force loads
+    ``patterns`` (n_cyl, n, 6), unit-omega² load ``inertia`` (n, 6), ``omega2`` (n_speeds,)
+    [rad²/s²]."""
     n_load, n_speed, n, n_cyl = gas_force.shape
     for a in range(n_load):
         for s in range(n_speed):
@@ -69,10 +63,8 @@ def gas_table(gas_force, patterns, inertia, omega2, out):
 
 @njit(cache=True, nogil=True)
 def cylinder_pressures(cycle, i0, i1, w, out):
-    """Fill ``out`` (n, n_cyl) with each cylinder's pressure of ``cycle`` (n_cyl, n_grid)
-    [Pa] at the angles of the linear interpolation ``cycle[c, i0] (1 - w) + cycle[c, i1] w``
-    (``i0``, ``i1``, ``w`` (n, n_cyl):
-    :func:`powertrain.models.engine._periodic_interpolation`)."""
+    """Fill ``out`` (n, n_cyl) with ``cycle[c, i0] (1 - w) + cycle[c, i1] w``: each cylinder's
+    pressure of ``cycle`` (n_cyl, n_grid) [Pa] interpolated at ``i0``, ``i1``, ``w`` (n, n_cyl)."""
     for t in range(i0.shape[0]):
         for c in range(i0.shape[1]):
             out[t, c] = cycle[c, i0[t, c]] * (1.0 - w[t, c]) + cycle[c, i1[t, c]] * w[t, c]

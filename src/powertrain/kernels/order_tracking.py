@@ -1,18 +1,11 @@
-r"""Angle-domain resampling kernel of computed order tracking.
-
-Each output sample is a low-pass interpolation of the channels at a fractional input index
-:math:`p`:
+r"""Angle-domain resampling of computed order tracking: each output sample is a low-pass
+interpolation of the channels at a fractional input index :math:`p`,
 
 .. math:: y(p) = \frac{\sum_i h\!\left(\frac{i - p}{L}\right) x_i}
                       {\sum_i h\!\left(\frac{i - p}{L}\right)},\qquad
           h(v) = \operatorname{sinc}(K v)\,w_\mathrm{Kaiser}(v),\quad |v| < 1,
 
-a Kaiser-windowed sinc with ``K`` zero crossings per side stretched over ``L = K / c``
-input samples, i.e. a low-pass at ``c`` times the input Nyquist frequency (``c = 1``:
-plain band-limited interpolation; ``c < 1``: the anti-alias filter of a resampling to a
-lower rate, applied only where output samples are wanted). The kernel is tabulated
-(``table``, linear interpolation between entries); the weights are computed once per output
-sample and applied to every channel.
+with ``L = K / c``: a low-pass at ``c`` times the input Nyquist frequency.
 """
 
 import math
@@ -43,10 +36,8 @@ def sinc_resample_kernel(X, pos, cutoff, table, K, out):
     out : ndarray (n_ch, m)
         Output.
     """
-    n_ch = X.shape[0]
-    n = X.shape[1]
-    m = pos.shape[0]
-    n_tab = table.shape[0]
+    n_ch, n = X.shape
+    m, n_tab = pos.shape[0], table.shape[0]
     half_tab = 0.5 * (n_tab - 1)
     c_min = 1.0
     for j in range(m):
@@ -56,8 +47,7 @@ def sinc_resample_kernel(X, pos, cutoff, table, K, out):
     for b in prange(n_chunks):
         w = np.empty(max_width)
         for j in range(b * CHUNK, min(m, (b + 1) * CHUNK)):
-            p = pos[j]
-            L = K / cutoff[j]
+            p, L = pos[j], K / cutoff[j]
             i_lo = max(int(math.ceil(p - L)), 0)
             i_hi = min(int(math.floor(p + L)), n - 1)
             width = i_hi - i_lo + 1
@@ -65,8 +55,7 @@ def sinc_resample_kernel(X, pos, cutoff, table, K, out):
             for q in range(width):
                 u = ((i_lo + q - p) / L + 1.0) * half_tab
                 k = min(int(u), n_tab - 2)
-                f = u - k
-                c = table[k] + f * (table[k + 1] - table[k])
+                c = table[k] + (u - k) * (table[k + 1] - table[k])
                 w[q] = c
                 wsum += c
             for ch in range(n_ch):

@@ -1,41 +1,28 @@
-r"""Port laws: nonlinear forces across a mount network, evaluated from plain arrays.
-
-A port law acts in parallel with a mount network, between its engine-side node and its base
-node, on the relative displacement :math:`u = x_E - x_B` and velocity :math:`\dot u`. Numba
-cannot call Python objects fast, so every law is a kind code, a row of parameters and a row
-of state (its memory, e.g. the friction element's reversal point), dispatched here by code:
-
-* :func:`law_force` (:func:`port_force` for one law's rows) gives the trial force
-  :math:`f` (on the base; :math:`-f` on the engine side), the tangent stiffness
-  :math:`\partial f/\partial u` and the tangent damping
-  :math:`\partial f/\partial\dot u` at :math:`(u, \dot u)` from the committed state, without
-  changing it (Newton iterates on it);
-* :func:`commit_state` updates the state once the step has converged.
-
-A new law adds its code, one branch in each of the two functions and its Python element type
-(:mod:`powertrain.physics.mount_elements`); the Newmark kernel with port laws
-(:func:`newmark_port_kernel`, here because kernels import no other kernel) does not change.
+r"""Port laws: nonlinear forces in parallel with a mount network on the relative motion
+:math:`u = x_E - x_B`, :math:`\dot u` of its engine-side and base nodes, and the Newmark
+kernels with them. A law is a kind code, a row of parameters and a row of state:
+:func:`law_force` gives the force (on the base; :math:`-f` on the engine side) and its
+tangents, :func:`commit_state` updates the state after a converged step. A new law adds a
+code, a branch in each and its element type in :mod:`powertrain.physics.mount_elements`.
 """
 
 import numpy as np
 from numba import njit
 
-#: No force (a linear element has no port law; kept so that code 0 is harmless).
+#: No force (code 0 is harmless).
 NONE = 0
 #: Jenkins element: spring ``k = par[0]`` in series with a Coulomb slider of slip force
 #: ``F_s = par[1]``; state ``z = state[0]``, the slider's position.
 JENKINS = 1
 #: Berg's friction element: ``F_max = par[0]``, ``x2 = par[1]``; state ``[x_s, F_s,
-#: direction, u_last, F_last]``: the last reversal point, the direction of motion since it
-#: (+1, -1; 0 before any motion) and the last committed point (a reversal, when the next
-#: step turns back). Formula: :mod:`powertrain.physics.mount_laws`.
+#: direction, u_last, F_last]``: the last reversal point, the direction since it (+1, -1;
+#: 0 before any motion), the last committed point. Formula: :mod:`powertrain.physics.mount_laws`.
 BERG = 2
 
 
 @njit(cache=True, nogil=True, inline="always")
 def _berg_branch(u, state, e):
-    """``(direction, x_s, F_s)`` of the branch the point ``u`` lies on: the committed one
-    while the motion keeps its direction, else a new one from the last committed point."""
+    """``(direction, x_s, F_s)`` of the branch through ``u`` from the committed ``state``."""
     du = u - state[e, 3]
     d = 1.0 if du > 0 else (-1.0 if du < 0 else state[e, 2])
     if d == state[e, 2]:
@@ -46,8 +33,7 @@ def _berg_branch(u, state, e):
 @njit(cache=True, nogil=True, inline="always")
 def _berg(u, par, state, e):
     """Berg's force and tangent stiffness at ``u`` from the committed ``state``."""
-    fm = par[e, 0]
-    x2 = par[e, 1]
+    fm, x2 = par[e, 0], par[e, 1]
     if fm <= 0.0:
         return 0.0, 0.0
     d, xs, fs = _berg_branch(u, state, e)
@@ -64,12 +50,10 @@ def _berg(u, par, state, e):
 
 @njit(cache=True, nogil=True, inline="always")
 def law_force(kind, u, v, par, state, e):
-    """``(f, df/du, df/dv)`` of the port law ``kind`` at ``(u, v)`` from the committed
-    state, row ``e`` of ``par`` and ``state`` (unchanged) [N, N/m, N·s/m] (2-D arrays and a
-    row index: no array view per call in the kernels' loops)."""
+    """``(f, df/du, df/dv)`` [N, N/m, N·s/m] of the port law ``kind`` at ``(u, v)`` [m, m/s]
+    from row ``e`` of ``par`` and ``state`` (unchanged)."""
     if kind == JENKINS:
-        k = par[e, 0]
-        fs = par[e, 1]
+        k, fs = par[e, 0], par[e, 1]
         f = k * (u - state[e, 0])
         if f > fs:
             return fs, 0.0, 0.0
@@ -84,18 +68,16 @@ def law_force(kind, u, v, par, state, e):
 
 @njit(cache=True, nogil=True)
 def port_force(kind, u, v, par, state):
-    """:func:`law_force` of one law, its parameters ``par`` and ``state`` as rows."""
-    return law_force(kind, u, v, par.reshape((1, par.size)), state.reshape((1, state.size)),
-                     0)
+    """:func:`law_force` of one law ``kind`` at ``(u, v)``, ``par`` and ``state`` 1-D."""
+    return law_force(kind, u, v, par.reshape((1, par.size)), state.reshape((1, state.size)), 0)
 
 
 @njit(cache=True, nogil=True, inline="always")
 def commit_state(kind, u, v, par, state, e, f):
-    """Update row ``e`` of ``state`` in place after a converged step ending at ``(u, v)``,
-    where the law gives the force ``f`` (:func:`law_force`)."""
+    """Update row ``e`` of ``state`` after a converged step ending at ``(u, v)`` with force
+    ``f``; ``kind``, ``par`` as :func:`law_force`."""
     if kind == JENKINS:
-        k = par[e, 0]
-        fs = par[e, 1]
+        k, fs = par[e, 0], par[e, 1]
         f = k * (u - state[e, 0])
         if f > fs:
             state[e, 0] = u - fs / k
@@ -103,24 +85,20 @@ def commit_state(kind, u, v, par, state, e, f):
             state[e, 0] = u + fs / k
     elif kind == BERG:
         d, xs, fsr = _berg_branch(u, state, e)
-        state[e, 0] = xs
-        state[e, 1] = fsr
-        state[e, 2] = d
-        state[e, 3] = u
-        state[e, 4] = f
+        state[e, 0], state[e, 1], state[e, 2], state[e, 3], state[e, 4] = xs, fsr, d, u, f
 
 
 @njit(cache=True, nogil=True)
 def port_forces_at(kinds, par, state, u, v, out):
-    """Forces ``out`` (m,) of the laws at ``u``, ``v`` (m,) from ``state`` (unchanged)."""
+    """Forces ``out`` (m,) of the laws ``kinds``, ``par`` at ``u``, ``v`` (m,) from ``state``."""
     for e in range(kinds.shape[0]):
         out[e] = law_force(kinds[e], u[e], v[e], par, state, e)[0]
 
 
 @njit(cache=True, nogil=True)
 def port_force_loop(kinds, par, state, U, V, F):
-    """Forces ``F`` (n_t, m) of the port laws along prescribed motions ``U``, ``V``
-    (n_t, m), committing the state after every point (a displacement-driven test)."""
+    """Forces ``F`` (n_t, m) of the laws ``kinds``, ``par`` along the motions ``U``, ``V``
+    (n_t, m), ``state`` committed after every point."""
     for t in range(U.shape[0]):
         for e in range(kinds.shape[0]):
             F[t, e] = law_force(kinds[e], U[t, e], V[t, e], par, state, e)[0]
@@ -129,7 +107,7 @@ def port_force_loop(kinds, par, state, U, V, F):
 
 @njit(cache=True, nogil=True, inline="always")
 def _dot(a, b):
-    """Dot product of two short vectors (a loop: no BLAS call per step)."""
+    """Dot product of two short vectors (no BLAS call)."""
     s = 0.0
     for i in range(a.shape[0]):
         s += a[i] * b[i]
@@ -138,8 +116,7 @@ def _dot(a, b):
 
 @njit(cache=True, nogil=True)
 def _solve_in_place(J, r):
-    """Solve ``J x = r`` (small, dense) by Gaussian elimination with partial pivoting;
-    ``x`` overwrites ``r``, ``J`` is destroyed (no allocation per call)."""
+    """Solve ``J x = r`` in place (``x`` into ``r``) by elimination with partial pivoting."""
     m = r.shape[0]
     for c in range(m):
         p = c
@@ -165,44 +142,30 @@ def _solve_in_place(J, r):
 @njit(cache=True, nogil=True)
 def newmark_port_kernel(G, H, Fs, h, x0, v0, a0, W, P, Q, kinds, par, state, X, V, A, Z,
                         tol, max_iter):
-    r"""Newmark average acceleration with port laws in parallel with the linear model:
-    :math:`\mathbf M\ddot{\mathbf x} + \mathbf C\dot{\mathbf x} + \mathbf K\mathbf x
-    + \mathbf P^T\mathbf z = \mathbf f`, :math:`z_e = f_e(\mathbf p_e\cdot\mathbf x,
-    \mathbf p_e\cdot\dot{\mathbf x})` (:mod:`powertrain.kernels.port_forces`).
+    r"""Newmark average acceleration of :math:`\mathbf M\ddot{\mathbf x} + \mathbf
+    C\dot{\mathbf x} + \mathbf K\mathbf x + \mathbf P^T\mathbf z = \mathbf f`,
+    :math:`z_e = f_e(\mathbf p_e\cdot\mathbf x, \mathbf p_e\cdot\dot{\mathbf x})`.
 
-    The linear step gives :math:`\ddot{\mathbf x}_{lin}` as in
-    :func:`powertrain.kernels.newmark.newmark_kernel`; with
-    the port forces :math:`\ddot{\mathbf x} = \ddot{\mathbf x}_{lin} - \mathbf W\mathbf z`,
-    :math:`\mathbf W = \mathbf S^{-1}\mathbf P^T`, so the port motions are
-    :math:`\mathbf u = \mathbf u_{lin} - \tfrac{h^2}{4}\mathbf Q\mathbf z`,
-    :math:`\dot{\mathbf u} = \dot{\mathbf u}_{lin} - \tfrac h2\mathbf Q\mathbf z`,
-    :math:`\mathbf Q = \mathbf P\mathbf W`. Newton solves the m equations
-    :math:`z_e = f_e(u_e, \dot u_e)` per step (Jacobian
-    :math:`\mathbf I + \mathrm{diag}(\tfrac{h^2}{4}k_t + \tfrac h2 c_t)\mathbf Q`; its
-    diagonal first, :func:`port_forces_step`), from the tangent at the previous step; the
-    states are committed once it has converged.
+    With :math:`\ddot{\mathbf x} = \ddot{\mathbf x}_{lin} - \mathbf W\mathbf z` the port
+    motions are :math:`\mathbf u = \mathbf u_{lin} - \tfrac{h^2}{4}\mathbf Q\mathbf z`,
+    :math:`\dot{\mathbf u} = \dot{\mathbf u}_{lin} - \tfrac h2\mathbf Q\mathbf z`; Newton
+    solves :math:`z_e = f_e(u_e, \dot u_e)` per step (:func:`port_forces_step`), then the
+    states are committed.
 
-    Arguments: ``G, H, Fs, h, x0, v0, a0, X, V, A`` as :func:`newmark_kernel`; ``W`` (n, m)
-    = S^-1 P^T; ``P`` (m, n) the port rows (relative displacement across each port law per
-    unit coordinate); ``Q`` (m, m) = P S^-1 P^T; ``kinds`` (m,) int64 the port-law codes,
-    ``par`` (m, n_par) their parameters, ``state`` (m, n_state) their state (updated in
-    place to the state after the last step); output ``Z`` (n_steps + 1, m) the port forces
-    at every time point [N]; Newton stops when every residual is below ``tol`` times (1 +
-    the largest force), or after ``max_iter`` iterations. Returns the number of steps at
-    which Newton did not converge (0 on success).
+    ``G, H, Fs, h, x0, v0, a0, X, V, A`` as :func:`powertrain.kernels.newmark.newmark_kernel`;
+    ``W`` (n, m) = S^-1 P^T; ``P`` (m, n) the port rows; ``Q`` (m, m) = P S^-1 P^T; ``kinds``
+    (m,) int64 the law codes, ``par`` (m, n_par) their parameters, ``state`` (m, n_state)
+    their state (updated in place); output ``Z`` (n_steps + 1, m) the port forces [N]; Newton
+    stops when every residual is below ``tol`` times (1 + the largest force), or after
+    ``max_iter`` iterations. Returns the number of steps where Newton did not converge.
     """
-    n, m, ns = x0.shape[0], kinds.shape[0], Fs.shape[0]
-    hh = 0.25 * h * h
-    hv = 0.5 * h
+    n, m, ns, hh, hv = x0.shape[0], kinds.shape[0], Fs.shape[0], 0.25 * h * h, 0.5 * h
     xt, vt = np.empty(n), np.empty(n)
     ul, vl, z, r = np.empty(m), np.empty(m), np.empty(m), np.empty(m)
     J, last = np.empty((m, m)), np.zeros((7, m))
-    coupled = port_coupling(hh * Q, hv / hh)
-    failed = 0
+    coupled, failed = port_coupling(hh * Q, hv / hh), 0
     for j in range(n):
-        X[0, j] = x0[j]
-        V[0, j] = v0[j]
-        A[0, j] = a0[j]
+        X[0, j], V[0, j], A[0, j] = x0[j], v0[j], a0[j]
     for e in range(m):
         z[e] = law_force(kinds[e], _dot(P[e], x0), _dot(P[e], v0), par, state, e)[0]
         Z[0, e] = z[e]
@@ -213,22 +176,18 @@ def newmark_port_kernel(G, H, Fs, h, x0, v0, a0, W, P, Q, kinds, par, state, X, 
         Ak = A[k]
         for i in range(n):
             s = Fs[k, i]
-            Gi = G[i]            # row views: 2-D indexing in the inner loop is slower
-            Hi = H[i]
+            Gi, Hi = G[i], H[i]            # row views: 2-D indexing in the inner loop is slower
             for j in range(n):
                 s -= Gi[j] * vt[j] + Hi[j] * xt[j]
             Ak[i] = s
         for e in range(m):
             Pe = P[e]
-            su = 0.0
-            sv = 0.0
+            su, sv = 0.0, 0.0
             for j in range(n):
                 su += Pe[j] * (xt[j] + hh * Ak[j])
                 sv += Pe[j] * (vt[j] + hv * Ak[j])
-            ul[e] = su
-            vl[e] = sv
-        if not port_forces_step(kinds, par, state, ul, vl, coupled, z, last, r, J, tol,
-                                 max_iter):
+            ul[e], vl[e] = su, sv
+        if not port_forces_step(kinds, par, state, ul, vl, coupled, z, last, r, J, tol, max_iter):
             failed += 1
         for e in range(m):
             Z[k, e] = z[e]
@@ -241,10 +200,8 @@ def newmark_port_kernel(G, H, Fs, h, x0, v0, a0, W, P, Q, kinds, par, state, X, 
 
 @njit(cache=True, nogil=True)
 def _port_newton(kinds, par, state, ul, vl, Q, z, r, J, tol, max_iter):
-    """Newton on the port forces ``z`` (in place) of one step: ``z_e = f_e(ul_e - (Qu z)_e,
-    vl_e - qv (Qu z)_e)``, ``Q = (Qu, qv, ...)``, from the given ``z``. True on success."""
-    Qu, qv = Q[0], Q[1]
-    m = z.shape[0]
+    """Newton on one step's port forces ``z`` (in place); True on success."""
+    Qu, qv, m = Q[0], Q[1], z.shape[0]
     for _ in range(max_iter):
         big, worst = 1.0, 0.0
         for e in range(m):
@@ -264,31 +221,23 @@ def _port_newton(kinds, par, state, ul, vl, Q, z, r, J, tol, max_iter):
     return False
 
 
-#: Iterations of the diagonal Newton before full Newton takes over (:func:`port_forces_step`).
+#: Iterations of the diagonal Newton before full Newton (:func:`port_forces_step`).
 JACOBI_ITER = 8
 
 
 @njit(cache=True, nogil=True, inline="always")
 def port_forces_step(kinds, par, state, ul, vl, Q, z, last, r, J, tol, max_iter):
-    """The port forces ``z`` (in place, from the last step's) of one step, ``z_e =
-    f_e(ul_e - (Qu z)_e, vl_e - qv (Qu z)_e)``, ``Q = (Qu, qv, row sums of |Qu|)``
-    (:func:`port_coupling`; the velocities' coupling is ``qv = 2 / h`` times the displacements'
-    in Newmark's average acceleration), and the states committed. True on success.
+    """One step's port forces ``z`` (in place) of ``z_e = f_e(ul_e - (Qu z)_e, vl_e - qv (Qu
+    z)_e)``, ``Q = (Qu, qv, row sums of |Qu|)``, the states committed. True on success.
 
-    The ports are coupled only through the body's motion within one step (``Qu`` of the
-    order h^2/mass: ``|k_t Qu|`` ~ 1e-5 for the default engine's friction at 40 kHz): the
-    forces ``f`` the laws give at the motion of forces ``z`` are those of the solution to
-    within ``rho |f - z|``, ``rho = max_e (|k_t,e| + qv |c_t,e|) sum_j |Qu_ej|`` (first
-    order). So from a predictor on the laws' curves through the last committed points
-    (:func:`_predict`, at the motions without this step's change of the coupling), ``last``
-    (7, m) = ``(u, v, df/du, df/dv)``, the point before and the coupling ``Qu z`` (updated
-    here; zeros: from ``z``), one evaluation mostly suffices:
-    ``z = f`` is accepted when ``rho |f - z|`` is below ``tol`` times (1 + the largest
-    force) (the tolerance of :func:`_port_newton`, which takes over after
-    :data:`JACOBI_ITER` iterations of Newton with the Jacobian's diagonal), and the states
-    are committed at that evaluation."""
-    Qu, qv = Q[0], Q[1]
-    m = z.shape[0]
+    The ports couple only through the body's motion within a step (``Qu`` ~ h²/mass): the
+    laws' forces ``f`` at the motion of ``z`` are the solution's to within ``rho |f - z|``,
+    ``rho = max_e (|k_t,e| + qv |c_t,e|) sum_j |Qu_ej|``. From a tangent predictor
+    (``last`` (7, m) = ``(u, v, df/du, df/dv)``, the point before, ``Qu z``), ``z = f`` is
+    accepted when ``rho |f - z|`` <= ``tol`` (1 + max |z|); else :data:`JACOBI_ITER`
+    diagonal Newton iterations, then full Newton (``r``, ``J`` work space, ``max_iter``);
+    ``kinds``, ``par``, ``state`` as :func:`law_force`."""
+    Qu, qv, m = Q[0], Q[1], z.shape[0]
     _predict(ul, vl, qv, last, z)
     for _ in range(JACOBI_ITER):
         big, worst, rho = _port_residual(kinds, par, state, ul, vl, Q, z, last, r)
@@ -309,24 +258,19 @@ def port_forces_step(kinds, par, state, ul, vl, Q, z, last, r, J, tol, max_iter)
 
 @njit(cache=True, nogil=True, inline="always")
 def _predict(ul, vl, qv, last, z):
-    """The port forces ``z`` (in place, the last step's) moved along the laws' curves to the
-    motions with the last coupling (row 6 of ``last``): ``k_t du + c_t dv``, the tangent
-    stiffness, while the motion keeps its direction, extrapolated to the middle of the step
-    from the last two committed points (rows 4, 5: the point before, moved on here; a step
-    as long as the last: the curvature to second order in du, no division)."""
+    """Move the last step's forces ``z`` along the laws' tangents to this step's motions."""
     for e in range(z.shape[0]):
         du = ul[e] - last[6, e] - last[0, e]
         kt = last[2, e]
         if du * (last[0, e] - last[4, e]) > 0.0:
             kt += 0.5 * (kt - last[5, e])
         z[e] += kt * du + last[3, e] * (vl[e] - qv * last[6, e] - last[1, e])
-        last[4, e] = last[0, e]
-        last[5, e] = last[2, e]
+        last[4, e], last[5, e] = last[0, e], last[2, e]
 
 
 @njit(cache=True, nogil=True)
 def port_coupling(Qu, qv):
-    """``(Qu, qv, qa)``, ``qa`` the row sums of |Qu| (looped: NumPy's costs a compile)."""
+    """``(Qu, qv, qa)``, ``qa`` the row sums of |Qu|."""
     qa = np.zeros(Qu.shape[0])
     for i, j in np.ndindex(Qu.shape):
         qa[i] += abs(Qu[i, j])
@@ -335,9 +279,7 @@ def port_coupling(Qu, qv):
 
 @njit(cache=True, nogil=True, inline="always")
 def _port_residual(kinds, par, state, ul, vl, Q, z, last, r):
-    """Residuals ``r = f(u, v) - z`` of the port forces ``z`` and the points ``last`` (rows
-    0-3) = ``(u, v, df/du, df/dv)``, the coupling ``Qu z`` in row 6; returns (1 + the largest
-    force, the largest residual, the coupling bound rho of :func:`port_forces_step`)."""
+    """Residuals ``r = f(u, v) - z`` into ``r`` and ``last``; ``(1 + max |z|, max |r|, rho)``."""
     Qu, qv, qa = Q
     big, worst, rho = 1.0, 0.0, 0.0
     for e in range(z.shape[0]):
@@ -357,15 +299,14 @@ def _port_residual(kinds, par, state, ul, vl, Q, z, last, r):
 
 @njit(cache=True, nogil=True, inline="always")
 def _commit(kinds, par, state, last, f):
-    """Commit the states at the points ``last`` where the laws give the forces ``f``."""
+    """Commit the states at the points ``last`` with the forces ``f``."""
     for e in range(f.shape[0]):
         commit_state(kinds[e], last[0, e], last[1, e], par, state, e, f[e])
 
 
 @njit(cache=True, nogil=True, fastmath=True, inline="always")
 def _load_less_ports(load_at, T, F, k, z, p):
-    """Generalized force ``p`` (q,) on the reduced coordinates: the load ``F[k]`` placed at
-    ``load_at`` minus the port forces ``T^T z``."""
+    """``p`` (q,) = the load ``F[k]`` placed at ``load_at`` minus ``T^T z``."""
     for c in range(p.shape[0]):
         p[c] = 0.0
     for c in range(F.shape[1]):
@@ -378,10 +319,7 @@ def _load_less_ports(load_at, T, F, k, z, p):
 
 @njit(cache=True, nogil=True, fastmath=True, inline="always")
 def _write_outputs(outputs, x, y, p, z, out, k, g):
-    """Row ``k`` of the outputs ``out``: ``Wyz [y[y_cols], z[z_cols]]`` (gathered into the
-    work space ``g`` first), plus ``Re(W eta) + Wd p`` on the rows ``w_rows`` (those reading
-    coordinates off the reduced ones). Rows of 2-D arrays are indexed in place: a row view
-    per product costs more than the product at these sizes."""
+    """Row ``k`` of ``out``: ``Wyz [y[y_cols], z[z_cols]]`` plus ``Re(W eta) + Wd p`` on ``w_rows``."""
     (Wyz, y_cols, z_cols), w_rows, W, Wd = outputs
     ny = y_cols.shape[0]
     for d in range(ny):
@@ -404,38 +342,27 @@ def _write_outputs(outputs, x, y, p, z, out, k, g):
 
 @njit(cache=True, nogil=True, fastmath=True, error_model="numpy")
 def modal_port_kernel(modal, outputs, ports, laws, F, x, y, z, out, tol, max_iter):
-    r"""Newmark average acceleration with port laws in modal coordinates: the trapezoidal
-    modal recurrence of the linear model (:class:`~powertrain.solvers.newmark.ModalNewmark`)
-    :math:`\eta_{k+1} = \lambda_d\eta_k + \mathbf G(\mathbf p_k + \mathbf p_{k+1})`, the
-    generalized force :math:`\mathbf p` on the q reduced coordinates :math:`\mathbf y` (those
-    the load or a port row touches: the body's six) being the load minus the port forces,
-    :math:`\mathbf p = \mathbf E\mathbf f - \mathbf T^T\mathbf z` (port rows
-    :math:`\mathbf P = \mathbf T\,\partial\mathbf y/\partial\mathbf x`), and
-    :math:`\mathbf G = \mathrm{diag}\gamma\,\Psi^{-1}[0; \mathbf M^{-1}]` on them.
+    r"""Newmark average acceleration with port laws in modal coordinates: the recurrence
+    :math:`\eta_{k+1} = \lambda_d\eta_k + \mathbf G(\mathbf p_k + \mathbf p_{k+1})`
+    (:class:`~powertrain.solvers.newmark.ModalNewmark`), :math:`\mathbf p = \mathbf E\mathbf f
+    - \mathbf T^T\mathbf z` the load less the port forces on the q reduced coordinates
+    :math:`\mathbf y` (those the load or a port row touches).
 
-    One modal read per step, the reduced accelerations of the next step,
-    :math:`\ddot{\mathbf y}_{k+1} = \mathrm{Re}(\Psi_a\lambda_d\eta_k) + \mathbf D_a\mathbf
-    p_k + \mathbf S\mathbf p_{k+1}` (:math:`\Psi_a = \Psi_{\dot y}\Lambda`, :math:`\mathbf
-    D_a = \mathrm{Re}(\Psi_a\mathbf G)`, :math:`\mathbf S = \mathbf D_a + \mathbf M^{-1}_{yy}`);
-    displacements and velocities follow by Newmark's kinematics, which the recurrence
-    satisfies exactly, :math:`\mathbf y_{k+1} = \mathbf y_k + h\dot{\mathbf y}_k +
-    \tfrac{h^2}4(\ddot{\mathbf y}_k + \ddot{\mathbf y}_{k+1})`. So the port motions are
-    :math:`\mathbf u = \mathbf u_{lin} - \mathbf Q_u\mathbf z`, :math:`\mathbf Q_u =
-    \tfrac{h^2}4\mathbf T\mathbf S\mathbf T^T` (the :math:`\tfrac{h^2}{4}\mathbf P\mathbf
-    S^{-1}\mathbf P^T` of :func:`newmark_port_kernel`), solved for :math:`\mathbf z`
-    (:func:`port_forces_step`); then the recurrence.
+    Each step reads the next reduced accelerations :math:`\ddot{\mathbf y}_{k+1} =
+    \mathrm{Re}(\Psi_a\lambda_d\eta_k) + \mathbf D_a\mathbf p_k + \mathbf S\mathbf p_{k+1}`;
+    displacements and velocities follow by Newmark's kinematics, which the recurrence satisfies
+    exactly. The port motions :math:`\mathbf u = \mathbf u_{lin} - \mathbf Q_u\mathbf z`,
+    :math:`\mathbf Q_u = \tfrac{h^2}4\mathbf T\mathbf S\mathbf T^T`, are solved for
+    :math:`\mathbf z` (:func:`port_forces_step`).
 
-    Arguments (modal arrays in real form, n_x columns: the real parts of the n modes, then
-    the imaginary parts of the n_c complex ones, which come first): ``modal = (lam_d, G, Ra,
-    (Da, S), h)``, ``lam_d`` = (real parts (n,), imaginary parts (n_c,)), ``G`` (q, n_x)
-    (the map's columns as rows), ``Ra`` (q, n_x) reading
-    :math:`\mathrm{Re}(\Psi_a\lambda_d\eta)`; ``out`` (n_rows, n_out) gets
-    the ``outputs`` (:func:`_write_outputs`) at steps 0 .. n_rows - 1 of the loads ``F``
-    (n_rows + 1, n_load); ``ports = (T, load_at, Qu)``, ``laws = (kinds, par, state)``. The
-    modal state ``x`` (n_x,), the reduced state ``y`` (3 q,) (displacements, velocities,
-    accelerations) and the port forces ``z`` (m,) are the state at step 0 on entry and at
-    step n_rows on return, ``state`` is updated in place. Returns the number of steps at
-    which Newton did not converge.
+    Modal arrays in real form (n_x columns: the real parts of the n modes, then the imaginary
+    parts of the n_c complex ones, which come first): ``modal = (lam_d, G, Ra, (Da, S), h)``,
+    ``lam_d = (real parts (n,), imaginary parts (n_c,))``, ``G``, ``Ra`` (q, n_x). ``out``
+    (n_rows, n_out) gets the ``outputs`` (:func:`_write_outputs`) at steps 0 .. n_rows - 1 of
+    the loads ``F`` (n_rows + 1, n_load); ``ports = (T, load_at, Qu)``, ``laws = (kinds, par,
+    state)``; ``tol``, ``max_iter`` as :func:`newmark_port_kernel`. ``x`` (n_x,), ``y`` (3 q,)
+    (displacements, velocities, accelerations) and ``z`` (m,) are the state at step 0 on entry,
+    at step n_rows on return; ``state`` is updated. Returns the steps where Newton failed.
     """
     (lr, li), G, Ra, (Da, S), h = modal
     T, load_at, Qu = ports
@@ -470,8 +397,7 @@ def modal_port_kernel(modal, outputs, ports, laws, F, x, y, z, out, tol, max_ite
                 su += T[e, c] * wu[c]
                 sv += T[e, c] * wv[c]
             ul[e], vl[e] = su, sv
-        if not port_forces_step(kinds, par, state, ul, vl, coupled, z, last, r, J, tol,
-                                 max_iter):
+        if not port_forces_step(kinds, par, state, ul, vl, coupled, z, last, r, J, tol, max_iter):
             failed += 1
         _load_less_ports(load_at, T, F, k + 1, z, p_next)
         for c in range(q):

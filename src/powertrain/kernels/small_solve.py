@@ -1,14 +1,7 @@
-r"""Compiled kernel: many small dense complex systems :math:`\mathbf D_k\mathbf x_k =
-\mathbf b_k` at once (the cached harmonic model's 6×6 rigid-body systems, one per speed and
-harmonic, and the modal body's coupled ones).
-
-Gaussian elimination with partial pivoting (the largest :math:`|\Re|+|\Im|` of the column,
-as LAPACK's ``zgesv``), per system in place on a copy. For a few hundred systems of size
-6–12 a hand-written loop is faster than the batched ``numpy.linalg.solve`` (whose
-per-matrix overhead dominates); the results agree to round-off.
+r"""Many small dense complex systems :math:`\mathbf D_k\mathbf x_k = \mathbf b_k` at once
+(e.g. the harmonic model's 6×6 systems, one per speed and harmonic), by Gaussian elimination
+with partial pivoting on the largest :math:`|\Re|+|\Im|` of the column, as LAPACK's ``zgesv``.
 """
-
-from __future__ import annotations
 
 import numpy as np
 from numba import njit
@@ -21,7 +14,7 @@ def batched_solve_kernel(D, b, x):
     Parameters
     ----------
     D : ndarray (m, n, n) complex
-        The matrices (not changed).
+        The matrices (unchanged).
     b : ndarray (m, n) complex
         The right-hand sides.
     x : ndarray (m, n) complex
@@ -33,8 +26,7 @@ def batched_solve_kernel(D, b, x):
         0, or 1 when some matrix has an exactly zero pivot (its solution NaN).
     """
     m, n = b.shape
-    A = np.empty((n, n), np.complex128)
-    status = 0
+    A, status = np.empty((n, n), np.complex128), 0
     for k in range(m):
         for i in range(n):
             x[k, i] = b[k, i]
@@ -47,19 +39,14 @@ def batched_solve_kernel(D, b, x):
             for i in range(col + 1, n):
                 v = abs(A[i, col].real) + abs(A[i, col].imag)
                 if v > best:
-                    best = v
-                    p = i
+                    best, p = v, i
             if best == 0.0:
                 singular = True
                 break
             if p != col:
                 for j in range(n):
-                    t = A[col, j]
-                    A[col, j] = A[p, j]
-                    A[p, j] = t
-                t = x[k, col]
-                x[k, col] = x[k, p]
-                x[k, p] = t
+                    A[col, j], A[p, j] = A[p, j], A[col, j]
+                x[k, col], x[k, p] = x[k, p], x[k, col]
             inv = 1.0 / A[col, col]
             for i in range(col + 1, n):
                 f = A[i, col] * inv

@@ -1,26 +1,14 @@
-r"""Compiled kernel: the LU factors of a small sparse matrix in a fixed elimination order,
-kept sparse, and their solve; and a sparse matrix–vector product.
+r"""Sparse LU factors of a small matrix in a fixed elimination order, their solve, and sparse
+matrix–vector products.
 
 The Newmark matrix :math:`\mathbf S = \mathbf M + \tfrac h2\mathbf C + \tfrac{h^2}{4}\mathbf K`
-of a body on mount networks is an arrow: each network's internal coordinates couple only
-to each other and to the body's. Eliminated networks first and the body last (the order
-of fewest nonzeros first, :mod:`powertrain.solvers.transient_model` computes it once), its
-factors have no fill-in but the body's rows, so a solve costs about the number of nonzeros
-of S instead of :math:`n^2`, and a factorization a few of the networks' small blocks
-instead of :math:`n^3`.
-
-S is symmetric positive definite for passive mounts (every massless node held by a spring
-or damper), where elimination needs no pivoting (Golub & Van Loan, *Matrix Computations*,
-4th ed., 2013, §4.2). :func:`factor` swaps a row in only where a pivot is small against
-its column (threshold pivoting, ibid. §3.4 and Duff, Erisman & Reid, *Direct Methods for
-Sparse Matrices*, 2nd ed., 2017, §5.4): never for such an S, so its factors stay sparse;
-any other regular S is still solved, with fill-in.
-
-S's pattern is the same at every factorization of a run (only the values of C and K
-change), so :func:`lu_pattern` finds its factors' pattern once (symbolic factorization,
-Duff, Erisman & Reid §10.2) and :func:`factor_on_pattern` computes the values on it: work
-about the factors' nonzeros. Where a pivot would need a swap it says so, and the caller
-falls back to :func:`factor`.
+of a body on mount networks is an arrow; with the networks eliminated first its factors fill
+in only the body's rows. For passive mounts S is symmetric positive definite and needs no
+pivoting (Golub & Van Loan, *Matrix Computations*, 4th ed., 2013, §4.2); :func:`factor`
+swaps rows only where a pivot is small against its column (threshold pivoting, ibid. §3.4;
+Duff, Erisman & Reid, *Direct Methods for Sparse Matrices*, 2nd ed., 2017, §5.4).
+:func:`lu_pattern` finds the factors' pattern once (symbolic factorization, ibid. §10.2),
+:func:`factor_on_pattern` computes the values on it.
 """
 
 import numpy as np
@@ -32,15 +20,12 @@ PIVOT_THRESHOLD = 0.01
 
 @njit(cache=True, nogil=True)
 def factor(M, C, K, c, k, perm):
-    """``(ok, B, rows)``: the LU factors of S = ``M + c C + k K`` (n, n) with its columns
-    in the order ``perm`` (int64, n) in one array ``B`` (L strictly below the diagonal with
-    a unit diagonal, U on and above) and the order of its rows ``rows``: ``perm`` but where
-    a pivot is below :data:`PIVOT_THRESHOLD` of its column's largest entry, whose row is
-    swapped in (threshold pivoting: none for a positive definite S, whose factors keep its
-    sparsity); ``ok`` False where a column has no nonzero entry left (S singular)."""
+    """``(ok, B, rows)``: the LU factors of S = ``M + c C + k K`` (n, n), columns in the order
+    ``perm`` (int64, n), in ``B`` (unit-diagonal L below the diagonal, U on and above), and
+    the rows' order ``rows``: ``perm`` with a row swapped in where a pivot is below
+    :data:`PIVOT_THRESHOLD` of its column's largest entry; ``ok`` False if S is singular."""
     n = M.shape[0]
-    B = np.empty((n, n))
-    rows = perm.copy()
+    B, rows = np.empty((n, n)), perm.copy()
     for i in range(n):
         for j in range(n):
             a, b = perm[i], perm[j]
@@ -74,8 +59,7 @@ def factor(M, C, K, c, k, perm):
 
 
 def csr_pattern(mask):
-    """``(starts, columns)`` (int64) of the rows of the boolean ``mask`` (m, n): its
-    ``True`` entries row by row, columns ascending (:func:`compressed`'s layout)."""
+    """``(starts, columns)`` (int64, :func:`compressed`'s layout) of the boolean ``mask`` (m, n)."""
     rows, columns = np.nonzero(mask)
     starts = np.zeros(mask.shape[0] + 1, np.int64)
     np.cumsum(np.bincount(rows, minlength=mask.shape[0]), out=starts[1:])
@@ -83,10 +67,9 @@ def csr_pattern(mask):
 
 
 def lu_pattern(mask):
-    """``(L rows, L columns, U rows)``, each ``(starts, indices)`` (:func:`csr_pattern`):
-    the entries of the LU factors, without row swaps, of a matrix whose nonzeros are
-    ``mask`` (n, n), already in its elimination order: its own and the fill-in
-    (symbolic elimination)."""
+    """``(L rows, L columns, U rows)``, each ``(starts, indices)`` (:func:`csr_pattern`): the
+    entries, fill-in included, of the LU factors without row swaps of a matrix whose nonzeros
+    are ``mask`` (n, n), in elimination order."""
     P = np.array(mask, bool)
     _fill_in(P)
     lower = np.tril(P, -1)
@@ -95,9 +78,7 @@ def lu_pattern(mask):
 
 @njit(cache=True, nogil=True)
 def _fill_in(P):
-    """Mark in the boolean ``P`` (n, n), in place, the entries elimination without row
-    swaps fills in: row ``i`` takes row ``col``'s pattern right of ``col`` wherever
-    ``P[i, col]``."""
+    """Mark in ``P`` (n, n) the entries elimination without row swaps fills in."""
     n = P.shape[0]
     for col in range(n):
         for i in range(col + 1, n):
@@ -109,13 +90,11 @@ def _fill_in(P):
 
 @njit(cache=True, nogil=True)
 def factor_on_pattern(terms, where, pattern, B, factors):
-    """The LU factors of S = Σ coefficient × A over ``terms`` (a tuple of ``(A compressed,
-    coefficient)``, :func:`compressed`) in the order whose position of each coordinate is
-    ``where`` (int64, n), into ``factors`` (:func:`sparse_factors`' layout on
-    :func:`lu_pattern`'s ``pattern``); ``B`` (n, n) work space. False, leaving ``factors``
-    unfinished, where a pivot is below :data:`PIVOT_THRESHOLD` of its column's largest
-    entry or a column is zero: :func:`factor` then decides (a row swap, or S singular).
-    Without a swap, the same arithmetic as :func:`factor`."""
+    """The LU factors of S = Σ coefficient × A over ``terms`` (``(A compressed, coefficient)``
+    pairs), coordinate i at position ``where[i]``, into ``factors`` (:func:`sparse_factors`'
+    layout on :func:`lu_pattern`'s ``pattern``); ``B`` (n, n) work space. False where a pivot
+    needs a swap or a column is zero (then :func:`factor` decides); else the same arithmetic
+    as :func:`factor`."""
     (lower_p, lower_i), (col_p, col_i), (upper_p, upper_i) = pattern
     (_, _, lower_x), (_, _, upper_x), inv_d = factors
     n = B.shape[0]
@@ -153,19 +132,16 @@ def factor_on_pattern(terms, where, pattern, B, factors):
 
 @njit(cache=True, nogil=True)
 def compressed(A, lower, upper):
-    """``(starts, columns, values)``: the rows of ``A`` (m, n) compressed (CSR), the
-    entries below the diagonal where ``lower``, above it where ``upper``, the diagonal where
-    both; zeros left out."""
+    """``(starts, columns, values)``: the nonzeros of ``A`` (m, n) in CSR, those below the
+    diagonal if ``lower``, above it if ``upper``, on it if both."""
     m, n = A.shape
-    starts, columns, values = np.zeros(m + 1, np.int64), np.empty(m * n, np.int64), \
-        np.empty(m * n)
+    starts, columns, values = np.zeros(m + 1, np.int64), np.empty(m * n, np.int64), np.empty(m * n)
     k = 0
     for i in range(m):
         for j in range(n):
             if A[i, j] != 0.0 and ((j < i and lower) or (j > i and upper)
                                    or (j == i and lower and upper)):
-                columns[k] = j
-                values[k] = A[i, j]
+                columns[k], values[k] = j, A[i, j]
                 k += 1
         starts[i + 1] = k
     return starts, columns[:k].copy(), values[:k].copy()
@@ -173,8 +149,7 @@ def compressed(A, lower, upper):
 
 @njit(cache=True, nogil=True)
 def sparse_factors(B):
-    """``(L, U, inverse diagonal)`` of :func:`factor`'s ``B``: the strict triangles
-    compressed (:func:`compressed`) and the reciprocals of U's diagonal."""
+    """``(L, U, 1 / diag U)`` of :func:`factor`'s ``B``, the strict triangles compressed."""
     inv_d = np.empty(B.shape[0])
     for i in range(B.shape[0]):
         inv_d[i] = 1.0 / B[i, i]
@@ -183,9 +158,8 @@ def sparse_factors(B):
 
 @njit(cache=True, nogil=True)
 def lu_solve(factors, rows, perm, b, y, out):
-    """``out`` = S^-1 ``b`` (n,) from :func:`sparse_factors`' ``factors`` of S, its rows in
-    the order ``rows`` and its columns in the order ``perm`` (:func:`factor`); ``y`` (n,)
-    is work space."""
+    """``out`` = S^-1 ``b`` (n,) from the ``factors`` (:func:`sparse_factors`), ``rows`` and
+    ``perm`` (:func:`factor`); ``y`` (n,) work space."""
     (Lp, Li, Lx), (Up, Ui, Ux), inv_d = factors
     n = b.shape[0]
     for i in range(n):
@@ -203,9 +177,8 @@ def lu_solve(factors, rows, perm, b, y, out):
 
 @njit(cache=True, nogil=True)
 def lu_solve_rows(factors, rows, perm, B, Y, out):
-    """``out[:, e]`` = S^-1 ``B[e]`` for every row of ``B`` (m, n) at once, as
-    :func:`lu_solve` does each (the same arithmetic, bit for bit), the factors read once;
-    ``Y`` (n, m) is work space and ``out`` (n, m)."""
+    """``out[:, e]`` = S^-1 ``B[e]`` for every row of ``B`` (m, n), bit for bit as
+    :func:`lu_solve` (``factors``, ``rows``, ``perm`` as there); ``Y`` (n, m) work space."""
     (Lp, Li, Lx), (Up, Ui, Ux), inv_d = factors
     n, m = B.shape[1], B.shape[0]
     for i in range(n):
@@ -251,9 +224,8 @@ def subtract_product(A, x, out):
 
 @njit(cache=True, nogil=True)
 def subtract_products(C, v, K, x, out):
-    """``out -= C v`` then ``-= K x`` row by row, ``C`` and ``K`` compressed on one pattern
-    (:func:`compressed`'s layout; the same sums as :func:`subtract_product` twice, in one
-    pass over the pattern)."""
+    """``out -= C v`` then ``-= K x`` row by row, ``C``, ``K`` compressed on one pattern (the
+    sums of :func:`subtract_product` twice)."""
     starts, columns, c = C
     k = K[2]
     for i in range(starts.shape[0] - 1):

@@ -1,11 +1,9 @@
-r"""The continuous sweep's per-sample loops over plain arrays: the load of the speed ramp
-interpolated in its table, the modal Newmark recurrence and the channel outputs, fused so that
-no array of all steps is ever built (:mod:`powertrain.solvers.speed_ramp`).
+r"""The continuous sweep's per-sample loops (:mod:`powertrain.solvers.speed_ramp`): the ramp's
+load read from its table, the modal Newmark recurrence and the channel outputs, fused.
 
 Ramp: :math:`n(t) = n_0 + \dot n t`, :math:`\theta(t) = \tfrac{2\pi}{60}(n_0 t +
-\tfrac12\dot n t^2)`, step :math:`t_k = k h`. The load table holds the generalized load
-(6 components) at ``n_speeds`` speeds from ``speed0`` every ``speed_step`` rpm and
-``n_theta`` angles over the cycle (plus the periodic wrap); it is read bilinearly.
+\tfrac12\dot n t^2)`, :math:`t_k = k h`; the table holds the generalized load at speeds
+``speed0 + i speed_step`` [rpm] and ``n_theta`` angles over the cycle plus the periodic wrap.
 """
 
 import math
@@ -16,10 +14,9 @@ from numba import njit
 
 @njit(cache=True, nogil=True)
 def ramp_load(table, speed0, speed_step, rpm_from, rate, h, k, out):
-    """Load ``out`` (6,) of the ramp at step ``k``, bilinear in the ``table``
-    (n_speeds, n_theta + 1, 6)."""
-    n_speeds = table.shape[0]
-    n_theta = table.shape[1] - 1
+    """Load ``out`` (6,) of the ramp ``rpm_from`` + ``rate`` t [rpm, rpm/s] at step ``k`` of
+    ``h`` [s], bilinear in ``table`` (n_speeds, n_theta + 1, 6) of ``speed0``, ``speed_step``."""
+    n_speeds, n_theta = table.shape[0], table.shape[1] - 1
     t = k * h
     rpm = rpm_from + rate * t
     theta = (2.0 * np.pi / 60.0) * (rpm_from * t + 0.5 * rate * t * t)
@@ -27,8 +24,7 @@ def ramp_load(table, speed0, speed_step, rpm_from, rate, h, k, out):
     u = (cycles - math.floor(cycles)) * n_theta       # floor: no fmod call per step
     i = min(int(u), n_theta - 1)
     fu = u - i
-    v = (rpm - speed0) / speed_step
-    v = min(max(v, 0.0), n_speeds - 1 - 1e-12)
+    v = min(max((rpm - speed0) / speed_step, 0.0), n_speeds - 1 - 1e-12)
     s = int(v)
     fv = v - s
     s1 = min(s + 1, n_speeds - 1)
@@ -48,17 +44,13 @@ def ramp_loads(table, speed0, speed_step, rpm_from, rate, h, k0, out):
 @njit(cache=True, nogil=True, fastmath=True)
 def modal_ramp_kernel(lam_d, load_map, w, w_load, table, speed0, speed_step, rpm_from, rate,
                       h, k0, x, out):
-    r"""Channel outputs ``out`` (n_rows, n_ch) at steps ``k0 .. k0 + n_rows - 1`` of the
-    modal recurrence :math:`\eta_{k+1} = \lambda_d\eta_k + g_k + g_{k+1}`,
-    :math:`g = ` ``load_map`` :math:`\cdot f` (the gain folded in:
-    :func:`modal_trapezoid_kernel` of :mod:`powertrain.kernels.newmark`), output
-    :math:`y = \mathrm{Re}(W\eta) + W_{load}f`. The modal state and arrays are in real
-    form: the real parts of the n modes, then the imaginary parts of the complex ones, which
-    come first (a real mode's is zero but for round-off), so that every loop over the modes
-    is one plain loop: ``x`` (n_x,), ``load_map`` (6, n_x), ``w`` (n_ch, n_x) (the rows
-    reading the real part), ``lam_d = (real parts (n,), imaginary parts (n_c,))``.
-
-    ``x`` is the state at step ``k0`` on entry and at ``k0 + n_rows`` on return.
+    r"""Channel outputs ``out`` (n_rows, n_ch) at steps ``k0 ..`` of the modal recurrence
+    :math:`\eta_{k+1} = \lambda_d\eta_k + g_k + g_{k+1}`, :math:`g = ` ``load_map``
+    :math:`\cdot f` (gain folded in), :math:`y = \mathrm{Re}(W\eta) + W_{load}f`
+    (``w``, ``w_load``), the load :func:`ramp_load`'s. Real form: the real parts of the n
+    modes, then the imaginary parts of the complex ones, which come first: ``x`` (n_x,),
+    ``load_map`` (6, n_x), ``w`` (n_ch, n_x), ``lam_d = (real parts (n,), imaginary parts
+    (n_c,))``. ``x`` is the state at step ``k0`` on entry, at ``k0 + n_rows`` on return.
     """
     lr, li = lam_d
     n = lr.shape[0]
@@ -90,9 +82,8 @@ def modal_ramp_kernel(lam_d, load_map, w, w_load, table, speed0, speed_step, rpm
 
 @njit(cache=True, nogil=True, fastmath=True)
 def fir_decimate(fir, buf_t, m, i_lo, out):
-    """Rows ``i_lo ..`` of the full convolution of the signals ``buf_t`` (n_ch, n) with
-    ``fir`` kept every ``m``-th (scipy's ``upfirdn(fir, buf_t.T, 1, m, axis=0)``), into
-    ``out`` (n_out, n_ch)."""
+    """Rows ``i_lo ..`` of ``upfirdn(fir, buf_t.T, 1, m, axis=0)`` (scipy) into ``out``
+    (n_out, n_ch), ``buf_t`` (n_ch, n)."""
     last = fir.shape[0] - 1
     rev = fir[::-1].copy()
     for r in range(out.shape[0]):

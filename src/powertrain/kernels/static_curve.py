@@ -1,7 +1,5 @@
-r"""Static curves read as their piecewise cubics (each network's PCHIP as
-:class:`scipy.interpolate.PPoly` holds it), straight with the end slopes beyond their
-points: the operating point (:mod:`powertrain.solvers.operating_point`) and the transient's
-pieces (:mod:`powertrain.kernels.transient`) read the curves here.
+r"""Static curves as piecewise cubics (each network's PCHIP in
+:class:`scipy.interpolate.PPoly` form), straight with the end slopes beyond their ends.
 """
 
 from numba import njit
@@ -9,11 +7,9 @@ from numba import njit
 
 @njit(cache=True, nogil=True)
 def curve_point(breaks, coefficients, count, r, d):
-    """``(force, tangent)`` [N, N/m] of network ``r``'s static curve at the deflection
-    ``d`` [m]: the piecewise cubic of ``count[r]`` breakpoints ``breaks[r]`` (n_net, n_b)
-    with the coefficients ``coefficients[r, j]`` (highest power first, as
-    :class:`scipy.interpolate.PPoly`'s) on each segment, straight with the end slopes
-    beyond its ends."""
+    """``(force, tangent)`` [N, N/m] of network ``r``'s curve at the deflection ``d`` [m]:
+    ``count[r]`` breakpoints ``breaks[r]`` (n_net, n_b), segment j's ``coefficients[r, j]``
+    highest power first."""
     last = count[r] - 1
     x0, x1 = breaks[r, 0], breaks[r, last]
     x = min(max(d, x0), x1)
@@ -29,7 +25,7 @@ def curve_point(breaks, coefficients, count, r, d):
 
 @njit(cache=True, nogil=True)
 def curve_values(breaks, coefficients, count, d, force, tangent):
-    """Each network's curve force and tangent at its deflection ``d`` (n_net,) [m] into
-    ``force``, ``tangent`` (:func:`curve_point`)."""
+    """:func:`curve_point` of every network at ``d`` (n_net,) [m] into ``force``, ``tangent``
+    (``breaks``, ``coefficients``, ``count`` as there)."""
     for r in range(d.shape[0]):
         force[r], tangent[r] = curve_point(breaks, coefficients, count, r, d[r])

@@ -1,33 +1,18 @@
-r"""A transient manoeuvre in one call, stretch by stretch (:func:`transient_kernel`: the
-amplitude laws' scales from the last stretch's amplitudes, :func:`amplitude_scales`), and
-one stretch: the static curves' updates and the Newmark steps between them
-(:mod:`powertrain.solvers.transient` holds the formulas,
-:mod:`powertrain.solvers.transient_model` builds the model).
+r"""A transient manoeuvre stretch by stretch (:func:`transient_kernel`; formulas in
+:mod:`powertrain.solvers.transient`): each stretch's amplitude-law scales from the last one's
+amplitudes; per piece of ``sub`` steps the curves' static factors and loads at its predicted
+middle (:func:`curve_state`); per step a sparse LU solve of :math:`\mathbf S\ddot{\mathbf x} =
+\mathbf f - \mathbf C\tilde{\mathbf v} - \mathbf K\tilde{\mathbf x}`
+(:mod:`powertrain.kernels.sparse_lu`) and the port laws by Newton.
 
-A stretch is cut into pieces of ``sub`` steps. At the start of every piece, at the state
-predicted for its middle, :math:`\mathbf x + \tfrac T2\dot{\mathbf x}` (:math:`T` its
-length), each network's static factor :math:`f` and curve load :math:`c` are read from its
-curve's piecewise cubic (:func:`curve_state`); the networks are scaled by the amplitude law's
-``law`` times :math:`f`; the damping and stiffness are the assembled ones plus each
-network's change of scale times its parts (sparse: the nonzero entries of every network's
-:math:`\mathbf L^T\mathbf C_n\mathbf L`, :math:`\mathbf L^T\mathbf K_n\mathbf L`); the piece
-is integrated from the position and velocity, its acceleration solved from the new laws.
-A step solves :math:`\mathbf S\ddot{\mathbf x} = \mathbf f - \mathbf C\tilde{\mathbf v}
-- \mathbf K\tilde{\mathbf x}` (:mod:`powertrain.kernels.newmark`) by S's LU factors kept
-sparse (:mod:`powertrain.kernels.sparse_lu`: a piece costs a factorization of the networks'
-small blocks on the factors' pattern, found once per run; a step about the nonzeros of S;
-C and K kept compressed on the pattern of them and their parts), then the port laws by Newton as
-:func:`powertrain.kernels.port_forces.newmark_port_kernel`. Loops rather than NumPy
-expressions: each expression costs a compilation on a first run.
-
-Numba caches a kernel by its own file: after editing the step kernels it calls, touch this
-file (or clear ``__pycache__``) so that its cached machine code is rebuilt.
+Numba caches a kernel by its own file: after editing a kernel this one calls, touch this file.
 """
 
 import numpy as np
 from numba import njit
 
 from powertrain.kernels.port_forces import (
+    _dot,
     law_force,
     port_coupling,
     port_forces_at,
@@ -48,10 +33,9 @@ from powertrain.kernels.static_curve import curve_point
 #: Amplitude-law kinds (:func:`amplitude_scales`): none, :class:`~powertrain.physics.mount_laws.PowerLaw`,
 #: :class:`~powertrain.physics.mount_laws.TableLaw`.
 NO_LAW, POWER_LAW, TABLE_LAW = 0, 1, 2
-#: What the kernels return where S needs a row swap and the model has no pivoting
-#: (:func:`_piece`).
+#: Returned where S needs a row swap and the model has no pivoting (:func:`_piece`).
 NEEDS_PIVOTING = -1
-#: The smallest amplitude a power law reads [m] (``np.finfo(float).tiny``, as it does).
+#: The smallest amplitude a power law reads [m].
 TINY = np.finfo(np.float64).tiny
 
 
@@ -70,12 +54,11 @@ def _interp(x, xp, fp, count):
 
 @njit(cache=True, nogil=True)
 def amplitude_scales(laws, amplitudes, law):
-    """The amplitude laws' ``(stiffness, damping)`` scales ``law`` (n_net, 2) of every
-    network at its amplitude ``amplitudes`` (n_net,) [m] (1 without a law), as the laws'
-    own ``scales``. ``laws = (kind (n_net,), power (n_net, 5) = (reference [m], exponent,
-    lowest, highest factor, damping exponent), table (n_net, 3, T) = (log amplitudes,
-    stiffness, damping factors), its points (n_net,))``: a table's first amplitude is
-    ``power[r, 0]``, below which it reads its first factors."""
+    """Fill ``law`` (n_net, 2) with each network's ``(stiffness, damping)`` scales at
+    ``amplitudes`` (n_net,) [m], 1 without a law. ``laws = (kind (n_net,), power (n_net, 5) =
+    (reference [m], exponent, lowest, highest factor, damping exponent), table (n_net, 3, T) =
+    (log amplitudes, stiffness, damping factors), its points (n_net,))``; a table reads its
+    first factors below ``power[r, 0]``."""
     kind, power, table, count = laws
     for r in range(kind.shape[0]):
         if kind[r] == POWER_LAW:
@@ -93,8 +76,7 @@ def amplitude_scales(laws, amplitudes, law):
 
 @njit(cache=True, nogil=True)
 def _row_motion(A, e, X, lo, hi, u):
-    """Row ``e`` of ``A`` (compressed) times the rows ``lo`` to ``hi`` - 1 of ``X`` into
-    ``u``; returns their mean."""
+    """Row ``e`` of ``A`` (compressed) times rows ``lo:hi`` of ``X`` into ``u``; returns the mean."""
     starts, columns, values = A
     mean = 0.0
     for k in range(lo, hi):
@@ -108,11 +90,9 @@ def _row_motion(A, e, X, lo, hi, u):
 
 @njit(cache=True, nogil=True)
 def stretch_motion(rows, network, X, lo, hi, amplitudes, centres):
-    """Over the rows ``lo`` to ``hi`` - 1 of ``X``: each port's amplitude, √2 times the
-    RMS about its mean of its motion (``rows[0]`` compressed, m ports), on its ``network``
-    (m,) into ``amplitudes`` (n_net,; zero where no port), where ``amplitudes`` has
-    entries; and each network's centre, the mean of its deflection (``rows[1]``), into
-    ``centres``."""
+    """Over rows ``lo:hi`` of ``X``: each port's amplitude, √2 times the RMS about the mean of
+    its motion (``rows[0]`` compressed), into ``amplitudes`` (n_net,) at its ``network`` (m,)
+    unless ``amplitudes`` is empty; each network's mean deflection (``rows[1]``) into ``centres``."""
     u = np.empty(hi - lo)
     if amplitudes.shape[0]:
         for e in range(rows[0][0].shape[0] - 1):
@@ -127,10 +107,9 @@ def stretch_motion(rows, network, X, lo, hi, amplitudes, centres):
 
 @njit(cache=True, nogil=True)
 def network_force_change(on_x, on_v, scales, assembled, loads):
-    """Each network's force less the one its assembled scales give, in place of ``on_x``
-    (n_t, n_net): ``on_x`` and ``on_v`` its unit-scale force of the displacements and of
-    the velocities, times the step's ``scales`` (n_t, n_net, 2) less ``assembled``
-    (n_net, 2), plus the curve ``loads`` (n_t, n_net) [N]."""
+    """Each network's force less that of its ``assembled`` (n_net, 2) scales, in place of
+    ``on_x`` (n_t, n_net): the unit-scale forces ``on_x``, ``on_v`` of the displacements and
+    velocities times ``scales`` (n_t, n_net, 2) less ``assembled``, plus ``loads`` [N]."""
     for t in range(on_x.shape[0]):
         for e in range(on_x.shape[1]):
             on_x[t, e] = (on_x[t, e] * (scales[t, e, 0] - assembled[e, 0])
@@ -140,21 +119,17 @@ def network_force_change(on_x, on_v, scales, assembled, loads):
 @njit(cache=True, nogil=True)
 def curve_state(x, curves, law, centres, factors, c):
     r"""Static factor ``factors`` and curve load ``c`` (n_net,) [N] of every network at the
-    state ``x`` (n,), its amplitude-law scales ``law`` (n_net, 2) and ``centres``
-    (n_net,) [m]: :math:`c = F(\delta) - F(\delta_0) - f k_0 (u - \bar u) - s f k_0\bar u`
-    with :math:`u` the network deflection, :math:`\delta = \delta_0 + u`,
-    :math:`f = F'(\delta)/F'(\delta_{ref})`; a network without a curve keeps its
-    assembled factor and no load. ``curves = (rows, d0, f0, breaks, coefficients, count,
-    reference tangent, has, base, stiffness)`` (:func:`curve_point`)."""
+    state ``x`` (n,), amplitude-law scales ``law`` (n_net, 2) and ``centres`` (n_net,) [m]:
+    :math:`c = F(\delta) - F(\delta_0) - f k_0 (u - \bar u) - s f k_0\bar u`, :math:`u` the
+    deflection, :math:`\delta = \delta_0 + u`, :math:`f = F'(\delta)/F'(\delta_{ref})`; no
+    curve: the assembled factor, no load. ``curves = (rows, d0, f0, breaks, coefficients,
+    count, reference tangent, has, base, stiffness)``."""
     rows, d0, f0, breaks, coefficients, count, ref, has, base, stiffness = curves
     for r in range(rows.shape[0]):
         if not has[r]:
-            factors[r] = base[r]
-            c[r] = 0.0
+            factors[r], c[r] = base[r], 0.0
             continue
-        u = 0.0
-        for j in range(x.shape[0]):
-            u += rows[r, j] * x[j]
+        u = _dot(rows[r], x)
         force, tangent = curve_point(breaks, coefficients, count, r, d0[r] + u)
         f = tangent / ref[r]
         factors[r] = f
@@ -164,10 +139,7 @@ def curve_state(x, curves, law, centres, factors, c):
 
 @njit(cache=True, nogil=True)
 def _scaled(fixed, change):
-    """The compressed matrix (:func:`~powertrain.kernels.sparse_lu.compressed`) of the
-    assembled one plus each network's change of scale times its part: ``fixed = (starts,
-    columns, assembled values, (network, position, value) of the parts' entries)``, the
-    pattern that of all of them."""
+    """The compressed assembled matrix plus each network's ``change`` of scale times its part."""
     starts, columns, base, (net, position, value) = fixed
     out = base.copy()
     for e in range(value.shape[0]):
@@ -188,8 +160,7 @@ def _dense(A, n):
 
 @njit(cache=True, nogil=True)
 def _less(F, k, load, out):
-    """Row ``k`` of the load ``F`` (on the first ``F.shape[1]`` coordinates, none on the
-    others) less ``load`` (n,), into ``out`` (n,), returned."""
+    """Row ``k`` of ``F`` (zero beyond its columns) less ``load`` (n,) into ``out``, returned."""
     nf = F.shape[1]
     for j in range(nf):
         out[j] = F[k, j] - load[j]
@@ -200,8 +171,7 @@ def _less(F, k, load, out):
 
 @njit(cache=True, nogil=True)
 def _start_acceleration(model, laws, C, K, f, x, v):
-    """The acceleration [m/s²] at ``(x, v)`` under the load ``f`` and the port laws, ``C``,
-    ``K`` compressed (0 on massless nodes: ``M_inv`` holds zeros there)."""
+    """The acceleration [m/s²] at ``(x, v)`` under ``f`` and the port laws (0 on massless nodes)."""
     r = f.copy()
     subtract_products(C, v, K, x, r)
     if laws is not None:
@@ -223,23 +193,13 @@ def _start_acceleration(model, laws, C, K, f, x, v):
 
 
 @njit(cache=True, nogil=True)
-def _piece(model, laws, h, C, K, F, load, x, v, a, X, V, A, Z, tol, max_iter, work,
-           pivoting):
-    """Newmark over the load rows ``F`` (k + 1, n_f ≤ n: :func:`_less`) less ``load`` (n,)
-    from ``(x, v)`` with ``C``, ``K`` (compressed) into the rows ``X``, ``V``, ``A``,
-    ``Z``; ``a`` the acceleration at the start, or solved from the laws where it has no
-    entry. S factored
-    in the model's order on its factors' pattern into ``work = (B (n, n), factors)``, or,
-    where a pivot needs a row swap, with swaps if ``pivoting`` is not None
-    (:mod:`powertrain.kernels.sparse_lu`; None: that code is left out of the compiled
-    kernel and the piece returns :data:`NEEDS_PIVOTING`). Returns the steps where Newton
-    did not converge."""
+def _piece(model, laws, h, C, K, F, load, x, v, a, X, V, A, Z, tol, max_iter, work, pivoting):
+    """Newmark over one piece; the steps where Newton failed, or :data:`NEEDS_PIVOTING`."""
     M, Ms, perm, where, pattern = model[0], model[1], model[6], model[7], model[8]
     if a.shape[0] == 0:
         a = _start_acceleration(model, laws, C, K, _less(F, 0, load, np.empty(x.shape[0])), x, v)
     B, factors = work
-    if factor_on_pattern(((Ms, 1.0), (C, 0.5 * h), (K, 0.25 * h * h)), where, pattern, B,
-                         factors):
+    if factor_on_pattern(((Ms, 1.0), (C, 0.5 * h), (K, 0.25 * h * h)), where, pattern, B, factors):
         lu = (factors, perm, perm)
     elif pivoting is None:
         return NEEDS_PIVOTING
@@ -255,76 +215,55 @@ def _piece(model, laws, h, C, K, F, load, x, v, a, X, V, A, Z, tol, max_iter, wo
 
 @njit(cache=True, nogil=True)
 def _port_setup(laws, lu, h, x, v, Z):
-    r"""``(W, coupling, P compressed, z, work)`` of the port laws for
-    :func:`_sparse_steps` (W = S^-1 P^T, :func:`~powertrain.kernels.port_forces.newmark_port_kernel`),
-    ``z`` and row 0 of ``Z`` the forces at ``(x, v)``; None without port laws. The
-    predictor's points (``laws[5]``, :func:`~powertrain.kernels.port_forces.port_forces_step`'s
-    ``last``) go on from the last piece: their coupling is set to this piece's,
-    :math:`\mathbf Q_u\mathbf z`, so that the laws' tangents predict the first step too."""
+    """``(W, coupling, P compressed, z, work)`` of the port laws; sets ``Z[0]`` and ``last``'s coupling."""
     if laws is None:
         return None
     P, kinds, par, state, (starts, columns, values), last = laws
-    n, m = x.shape[0], kinds.shape[0]
+    n, m, hh = x.shape[0], kinds.shape[0], 0.25 * h * h
     W, Q, z = np.empty((n, m)), np.zeros((m, m)), np.empty(m)
-    hh = 0.25 * h * h
     lu_solve_rows(lu[0], lu[1], lu[2], P, np.empty((n, m)), W)
-    for e in range(m):              # loops: each NumPy expression costs a compile
+    for e in range(m):
         for i in range(m):
             for k in range(starts[i], starts[i + 1]):
                 Q[i, e] += hh * values[k] * W[columns[k], e]
     for e in range(m):
-        u, du = 0.0, 0.0
-        for j in range(n):
-            u += P[e, j] * x[j]
-            du += P[e, j] * v[j]
-        z[e] = law_force(kinds[e], u, du, par, state, e)[0]
+        z[e] = law_force(kinds[e], _dot(P[e], x), _dot(P[e], v), par, state, e)[0]
         Z[0, e] = z[e]
     for e in range(m):
-        c = 0.0
-        for j in range(m):
-            c += Q[e, j] * z[j]
-        last[6, e] = c
+        last[6, e] = _dot(Q[e], z)
     return (W, port_coupling(Q, 2.0 / h), laws[4], z,
             (np.empty(m), np.empty(m), np.empty(m), np.empty((m, m)), last))
 
 
 @njit(cache=True, nogil=True)
 def _port_step(laws, ports, h, xt, vt, a, z_out, tol, max_iter):
-    """The port forces of one step (:func:`~powertrain.kernels.port_forces.newmark_port_kernel`)
-    into ``z_out``, taken off the linear acceleration ``a`` in place. True on success."""
+    """One step's port forces into ``z_out``, taken off the linear acceleration ``a``. True on success."""
     _, kinds, par, state, _, _ = laws
     W, coupled, (starts, columns, values), z, (ul, vl, r, J, last) = ports
     hh, hv = 0.25 * h * h, 0.5 * h
     for e in range(z.shape[0]):
-        su = 0.0
-        sv = 0.0
+        su, sv = 0.0, 0.0
         for k in range(starts[e], starts[e + 1]):
             j = columns[k]
             su += values[k] * (xt[j] + hh * a[j])
             sv += values[k] * (vt[j] + hv * a[j])
-        ul[e] = su
-        vl[e] = sv
+        ul[e], vl[e] = su, sv
     ok = port_forces_step(kinds, par, state, ul, vl, coupled, z, last, r, J, tol, max_iter)
     for e in range(z.shape[0]):
         z_out[e] = z[e]
     for j in range(a.shape[0]):
-        s = 0.0
-        for e in range(z.shape[0]):
-            s += W[j, e] * z[e]
-        a[j] -= s
+        a[j] -= _dot(W[j], z)
     return ok
 
 
 @njit(cache=True, nogil=True)
 def _sparse_steps(lu, laws, h, C, K, F, load, x, v, a, X, V, A, Z, tol, max_iter):
-    """:func:`_piece` by the factors ``lu = (factors, rows, perm)`` of S: a step is the
-    residual by the compressed C and K, one sparse solve and the port laws."""
+    """:func:`_piece`'s steps by S's factors ``lu = (factors, rows, perm)``."""
     n, hh, hv = x.shape[0], 0.25 * h * h, 0.5 * h
     xt, vt, r, y = np.empty(n), np.empty(n), np.empty(n), np.empty(n)
     for j in range(n):
         X[0, j], V[0, j], A[0, j] = x[j], v[j], a[j]
-    ports = _port_setup(laws, lu, h, x, v, Z)
-    failed = 0
+    ports, failed = _port_setup(laws, lu, h, x, v, Z), 0
     for k in range(1, F.shape[0]):
         for j in range(n):
             xt[j] = X[k - 1, j] + h * V[k - 1, j] + hh * A[k - 1, j]
@@ -332,8 +271,7 @@ def _sparse_steps(lu, laws, h, C, K, F, load, x, v, a, X, V, A, Z, tol, max_iter
         _less(F, k, load, r)
         subtract_products(C, vt, K, xt, r)
         lu_solve(lu[0], lu[1], lu[2], r, y, A[k])
-        if laws is not None and not _port_step(laws, ports, h, xt, vt, A[k], Z[k], tol,
-                                               max_iter):
+        if laws is not None and not _port_step(laws, ports, h, xt, vt, A[k], Z[k], tol, max_iter):
             failed += 1
         for j in range(n):
             X[k, j] = xt[j] + hh * A[k, j]
@@ -343,13 +281,8 @@ def _sparse_steps(lu, laws, h, C, K, F, load, x, v, a, X, V, A, Z, tol, max_iter
 
 @njit(cache=True, nogil=True)
 def _piece_curves(middle, curves, law, centres, assembled, work, scales, loads, load):
-    """A piece's curves at its predicted ``middle`` (:func:`curve_state`): every network's
-    scales (law times static factor) and curve load on each of the piece's rows of
-    ``scales`` and ``loads``, their change from the ``assembled`` scales into ``change``
-    (n_net, 2) and the curve loads on the coordinates into ``load`` (n,); ``work =
-    (factors, c, change)``, the first two (n_net,) work space."""
-    rows = curves[0]
-    n_net = law.shape[0]
+    """:func:`curve_state` at ``middle`` into the piece's ``scales``, ``loads``, ``load``."""
+    rows, n_net = curves[0], law.shape[0]
     factors, c, change = work
     curve_state(middle, curves, law, centres, factors, c)
     for r in range(n_net):
@@ -366,46 +299,39 @@ def _piece_curves(middle, curves, law, centres, assembled, work, scales, loads, 
 @njit(cache=True, nogil=True)
 def transient_stretch_kernel(model, curves, laws, h, F, law, centres, lo, hi, sub, a0, X, V,
                              acceleration, Z, scales, loads, tol, max_iter):
-    """Integrate steps ``lo`` to ``hi`` (module docstring), pieces of ``sub`` steps.
+    """Integrate steps ``lo`` to ``hi`` (module docstring).
 
     Parameters
     ----------
     model : tuple
-        ``(M, M compressed, inverse of M compressed, C, K, assembled, perm, where,
-        pattern, pivoting)``: the mass matrix (n, n) and it and its inverse compressed
-        (:func:`~powertrain.kernels.sparse_lu.compressed`; the inverse zero where M is
-        singular: massless nodes, a start acceleration of 0); C and K as :func:`_scaled`
-        takes them; the scales (n_net, 2) the assembled matrices hold; the coordinates'
-        elimination order (int64, n), each coordinate's position in it and S's factors'
-        pattern there (:mod:`powertrain.kernels.sparse_lu`); then ``pivoting`` (None, or
-        an empty array where a row swap is allowed, :func:`_piece`).
+        ``(M, M compressed, inverse of M compressed (zero on massless nodes), C, K, assembled
+        scales (n_net, 2), perm, where, pattern, pivoting)``: C and K as :func:`_scaled` takes
+        them, the elimination order, each coordinate's position in it, the factors' pattern
+        (:mod:`powertrain.kernels.sparse_lu`); ``pivoting`` None forbids row swaps.
     curves : tuple
         :func:`curve_state`'s.
     laws : tuple or None
-        ``(P, kinds, par, state, P compressed, last)`` of the port laws (m rows),
-        ``state`` and the predictor's points ``last`` (7, m) (zeros at the start) updated
-        in place; None without port laws.
+        ``(P, kinds, par, state, P compressed, last)`` of the m port laws, ``state`` and the
+        predictor's ``last`` (7, m) updated in place; None without port laws.
     h : float
         Time step [s].
     F : ndarray (n_t, n_f)
-        Load at every step on the first n_f ≤ n coordinates (the body's), none on the
-        others [N].
+        Load on the first n_f ≤ n coordinates [N].
     law : ndarray (n_net, 2)
-        The amplitude law's stiffness and damping scales over the stretch.
+        The amplitude laws' stiffness and damping scales.
     centres : ndarray (n_net,)
         The networks' centres [m].
     lo, hi, sub : int
+        First and last step, steps per piece.
     a0 : ndarray (n,) or (0,)
-        Acceleration at ``lo`` [m/s²], or empty: solved from the laws.
+        Acceleration at ``lo`` [m/s²], or empty: solved.
     X, V, Z, scales, loads : ndarray
         Outputs over every step, row ``lo`` the start (X, V read from it).
     acceleration : tuple
-        ``(A, rows compressed, out)``: a piece's accelerations (sub + 1, n) (work space)
-        and the rows (:func:`~powertrain.kernels.sparse_lu.compressed`) whose product with
-        them fills ``out`` (n_t, n_rows) at every step.
+        ``(A, rows compressed, out)``: work space (sub + 1, n) and the rows whose product with
+        the accelerations fills ``out`` (n_t, n_rows).
     tol, max_iter : float, int
-        Newton's tolerance and iteration limit
-        (:func:`~powertrain.kernels.port_forces.newmark_port_kernel`).
+        Newton's tolerance and iteration limit.
 
     Returns
     -------
@@ -415,13 +341,11 @@ def transient_stretch_kernel(model, curves, laws, h, F, law, centres, lo, hi, su
     C0, K0, assembled = model[3], model[4], model[5]
     n_net, n = law.shape[0], X.shape[1]
     (lp, li), _, (up, ui) = model[8]           # _piece's work space: S, its factors
-    work = np.empty((n, n)), ((lp, li, np.empty(li.shape[0])), (up, ui, np.empty(ui.shape[0])),
-                              np.empty(n))
+    work = np.empty((n, n)), ((lp, li, np.empty(li.shape[0])), (up, ui, np.empty(ui.shape[0])), np.empty(n))
     middle, load, change = np.empty(n), np.empty(n), np.empty((n_net, 2))
     curve_work = np.empty(n_net), np.empty(n_net), change
     A, out_rows, out = acceleration
-    failed = 0
-    a = a0
+    failed, a = 0, a0
     for p in range(lo, hi, sub):
         q = min(p + sub, hi)
         x, v = X[p].copy(), V[p].copy()
@@ -438,8 +362,7 @@ def transient_stretch_kernel(model, curves, laws, h, F, law, centres, lo, hi, su
             for i in range(out.shape[1]):
                 out[p + k, i] = row_product(out_rows, i, A[k])
         failed += got
-        # the next piece's laws differ: its acceleration is solved from them, or the
-        # trapezoidal rule would carry the jump on as an undamped alternating error
+        # solved from the next piece's laws, or the jump would persist as an undamped alternation
         a = np.empty(0)
     return failed
 
@@ -447,20 +370,16 @@ def transient_stretch_kernel(model, curves, laws, h, F, law, centres, lo, hi, su
 @njit(cache=True, nogil=True)
 def transient_kernel(model, curves, laws, motion, h, F, steps, a0, amplitudes, centres, X, V,
                      acceleration, Z, scales, loads, tol, max_iter):
-    """Integrate the whole manoeuvre, stretch by stretch (:func:`transient_stretch_kernel`;
-    ``steps = (every, sub)``, steps per stretch and per piece): each stretch's amplitude-law
-    scales from the amplitudes of the one before (:func:`amplitude_scales`), its centres
-    their mean deflections (:func:`stretch_motion`). ``motion = (amplitude laws, (port
-    rows, network rows) compressed, each port's network, varying)``: without a varying
-    law the amplitudes stay. ``amplitudes`` (n_net,) [m] and ``centres`` (n_net,) [m] are
-    the start's, updated in place; the rest as :func:`transient_stretch_kernel`. Returns
-    the steps at which Newton did not converge, or :data:`NEEDS_PIVOTING` where S needs a
-    row swap and the model allows none (its rows then unfinished)."""
+    """Integrate the whole manoeuvre by :func:`transient_stretch_kernel`, ``steps = (every,
+    sub)`` steps per stretch and per piece, each stretch's scales from the last one's
+    amplitudes and its centres their mean deflections (:func:`stretch_motion`). ``motion =
+    (amplitude laws, (port rows, network rows) compressed, each port's network, varying)``;
+    ``amplitudes``, ``centres`` (n_net,) [m] the start's, updated in place; the rest as
+    :func:`transient_stretch_kernel`. Returns the steps where Newton did not converge, or
+    :data:`NEEDS_PIVOTING`."""
     amplitude_laws, rows, network, varying = motion
     every, sub = steps
-    n_t = F.shape[0]
-    law = np.empty((amplitudes.shape[0], 2))
-    none = np.empty(0)
+    n_t, law, none = F.shape[0], np.empty((amplitudes.shape[0], 2)), np.empty(0)
     failed, a = 0, a0
     for lo in range(0, n_t - 1, every):
         hi = min(lo + every, n_t - 1)
@@ -472,6 +391,5 @@ def transient_kernel(model, curves, laws, motion, h, F, steps, a0, amplitudes, c
         failed += got
         a = none
         if hi < n_t - 1:
-            stretch_motion(rows, network, X, lo, hi, amplitudes if varying else none,
-                           centres)
+            stretch_motion(rows, network, X, lo, hi, amplitudes if varying else none, centres)
     return failed

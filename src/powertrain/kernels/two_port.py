@@ -1,35 +1,12 @@
-r"""Compiled kernel: two-port dynamic stiffness of a mount network with a scaled elastomer.
+r"""Two-port dynamic stiffness of a lumped mount network (point masses joined by Kelvin–Voigt
+elements to its engine-side node E, ground node B and each other).
 
-The one implementation of the mount two-port condensation (wrapped by
-:func:`powertrain.physics.mount_network.two_port`, used by the cached harmonic model and the
-truth generator). For one lumped network (internal point masses joined by Kelvin–Voigt
-elements to its engine-side node E, its ground node B and each other) and a list of
-values of the Laplace variable :math:`\lambda_w` (:math:`i\omega_w` for a harmonic
-motion, complex for a damped mode, 0 for the static case) with a spring factor :math:`s_w` and
-a damper factor :math:`t_w` each, the kernel forms the nodal dynamic stiffness
-
-.. math:: \mathbf D_w = s_w\mathbf K + \lambda_w t_w\mathbf C + \lambda_w^2\mathbf M
-
-(springs and dampers scaled, the masses kept: :meth:`MountModel.scaled`) and condenses the
-internal nodes by Gaussian elimination (symmetric pivoting on the largest remaining
-diagonal; the pivot is checked: below :data:`PIVOT_RTOL` times the largest entry the
-network is singular at that frequency, the outputs are NaN and the status is 1), leaving the
-2×2 two-port
-
-.. math:: \begin{pmatrix} F_E \\ F_B \end{pmatrix} =
-          \begin{pmatrix} a & b \\ b & c \end{pmatrix}
-          \begin{pmatrix} x_E \\ x_B \end{pmatrix}
-
-(:math:`a = K_{IP}` with the ground fixed, :math:`b = -K_{CP}`), and, on request, the
-internal motion per unit :math:`x_E` (ground held) and per unit :math:`x_B` (engine side
-held) by back substitution. The same elimination (:func:`condense_nodes`) gives the
-cross-point stiffness and its parameter derivatives (:func:`kcp_gradient_kernel`; the maths
-in :func:`powertrain.physics.mount_network.cross_point_stiffness_gradient`). The networks are
-small, so a hand-written elimination per frequency is much faster than batched LAPACK calls
-(parameter identification evaluates the Jacobian thousands of times).
+The nodal matrix :math:`\mathbf D_w = s_w\mathbf K + \lambda_w t_w\mathbf C + \lambda_w^2\mathbf M`
+is condensed by eliminating the internal nodes (symmetric pivoting on the largest diagonal)
+to :math:`F_E = a x_E + b x_B`, :math:`F_B = b x_E + c x_B` (:math:`a = K_{IP}`,
+:math:`b = -K_{CP}`); :func:`kcp_gradient_kernel` gives :math:`K_{CP}`'s parameter
+derivatives (:func:`powertrain.physics.mount_network.cross_point_stiffness_gradient`).
 """
-
-from __future__ import annotations
 
 import numpy as np
 from numba import njit
@@ -40,14 +17,10 @@ PIVOT_RTOL = 1e-13
 
 @njit(cache=True, nogil=True)
 def condense_nodes(D, n, order, X, gone):
-    """Eliminate the internal nodes 1..n of the nodal matrix ``D`` (n + 2, n + 2) in place.
-
-    Symmetric pivoting on the largest remaining diagonal; afterwards ``D[0, 0]``,
-    ``D[0, n + 1]``, ``D[n + 1, n + 1]`` are the two-port and, when ``X`` has n + 2 rows,
-    ``X[:, 0]`` / ``X[:, 1]`` the nodal motion per unit engine-side / ground-node motion.
-    ``order`` (n,) int and ``gone`` (n + 2,) bool are work space. Returns False when a
-    pivot is below :data:`PIVOT_RTOL` times the largest entry (singular network).
-    """
+    """Eliminate the internal nodes 1..n of ``D`` (n + 2, n + 2) in place, leaving the two-port
+    in ``D[0, 0]``, ``D[0, n + 1]``, ``D[n + 1, n + 1]`` and, if ``X`` has n + 2 rows, the
+    nodal motion per unit engine-side / ground motion in its columns. ``order`` (n,) and
+    ``gone`` (n + 2,) are work space. False if the network is singular."""
     size = n + 2
     big2 = 0.0                    # the largest entry by its squared modulus (no hypot)
     for i in range(size):
@@ -57,13 +30,11 @@ def condense_nodes(D, n, order, X, gone):
                 big2 = m2
     gone[:] = False
     for step in range(n):             # boundary nodes 0 and n + 1 are never eliminated
-        k = -1
-        best2 = -1.0                  # squared moduli: the same pivot as by modulus
+        k, best2 = -1, -1.0           # squared moduli: the same pivot as by modulus
         for i in range(1, n + 1):
             m2 = D[i, i].real * D[i, i].real + D[i, i].imag * D[i, i].imag
             if not gone[i] and m2 > best2:
-                best2 = m2
-                k = i
+                best2, k = m2, i
         if best2 <= PIVOT_RTOL * PIVOT_RTOL * big2:
             return False
         gone[k] = True
@@ -100,9 +71,9 @@ def two_port_kernel(lam, spring_scale, damper_scale, masses, elem_nodes, c, d, o
     Parameters
     ----------
     lam : ndarray (n_w,) complex
-        Laplace variable of each entry (:math:`i\\omega` for a harmonic) [1/s].
+        Laplace variable (:math:`i\\omega` for a harmonic) [1/s].
     spring_scale, damper_scale : ndarray (n_w,) float
-        Spring and damper factors [1] of each entry.
+        Spring and damper factors [1].
     masses : ndarray (n,) float
         Internal masses [kg] (zero allowed).
     elem_nodes : ndarray (n_el, 2) int
@@ -110,54 +81,40 @@ def two_port_kernel(lam, spring_scale, damper_scale, masses, elem_nodes, c, d, o
     c, d : ndarray (n_el,) float
         Element stiffness [N/m] and damping [N·s/m].
     out_a, out_b, out_c : ndarray (n_w,) complex
-        Filled with :math:`a = K_{IP}`, the coupling :math:`b` and the ground-side
-        :math:`c` [N/m].
+        Output :math:`a = K_{IP}`, :math:`b`, :math:`c` [N/m].
     out_x : ndarray (n_w, n, 2) complex or (0, n, 2)
-        Filled (when it has n_w rows) with the internal motion per unit engine-side and per
-        unit ground-node motion.
+        Output if not empty: internal motion per unit engine-side and ground motion.
 
     Returns
     -------
     int
-        0, or 1 if a pivot was below :data:`PIVOT_RTOL` at some entry (NaN there).
+        0, or 1 if singular at some entry (NaN there).
     """
-    status = 0
-    n = masses.size
-    size = n + 2
-    D = np.empty((size, size), np.complex128)
-    order = np.empty(n, np.int64)
-    gone = np.empty(size, np.bool_)
+    status, n, size = 0, masses.size, masses.size + 2
+    D, order, gone = np.empty((size, size), np.complex128), np.empty(n, np.int64), np.empty(size, np.bool_)
     X = np.empty((size if out_x.shape[0] else 0, 2), np.complex128)
     for w in range(lam.size):
         nodal_matrix(lam[w], spring_scale[w], damper_scale[w], masses, elem_nodes, c, d, D)
         if not condense_nodes(D, n, order, X, gone):
             status = 1
-            out_a[w] = np.nan
-            out_b[w] = np.nan
-            out_c[w] = np.nan
+            out_a[w] = out_b[w] = out_c[w] = np.nan
             continue
-        out_a[w] = D[0, 0]
-        out_b[w] = D[0, n + 1]
-        out_c[w] = D[n + 1, n + 1]
+        out_a[w], out_b[w], out_c[w] = D[0, 0], D[0, n + 1], D[n + 1, n + 1]
         if out_x.shape[0]:
             for i in range(n):
-                out_x[w, i, 0] = X[i + 1, 0]
-                out_x[w, i, 1] = X[i + 1, 1]
+                out_x[w, i, 0], out_x[w, i, 1] = X[i + 1, 0], X[i + 1, 1]
     return status
 
 
 @njit(cache=True, nogil=True)
 def two_ports_kernel(lam, spring_scale, damper_scale, mass_ptr, masses, el_ptr, elem_nodes, c,
                      d, out_a, out_b, out_c):
-    """:func:`two_port_kernel` of several networks in one call (the equivalent-linear fixed
-    point asks for every network at every iteration): network k has the masses
+    """:func:`two_port_kernel` of several networks at ``lam``: network k has the masses
     ``masses[mass_ptr[k]:mass_ptr[k + 1]]`` and the elements ``el_ptr[k]:el_ptr[k + 1]`` of
     ``elem_nodes``, ``c``, ``d``; its factors and outputs are row k of ``spring_scale``,
-    ``damper_scale`` and ``out_a``, ``out_b``, ``out_c`` (n_net, n_w; rows, so that
-    :func:`two_port_kernel` gets contiguous arrays and compiles once). Returns 0, or 1 when
-    some network was singular somewhere (NaN there)."""
-    no_x = np.empty((0, 0, 2), np.complex128)
-    status = 0
+    ``damper_scale``, ``out_a``, ``out_b``, ``out_c`` (n_net, n_w). Returns 0, or 1 if some
+    network was singular somewhere (NaN there)."""
+    no_x, status = np.empty((0, 0, 2), np.complex128), 0
     for k in range(out_a.shape[0]):
         m0, m1, e0, e1 = mass_ptr[k], mass_ptr[k + 1], el_ptr[k], el_ptr[k + 1]
         status |= two_port_kernel(lam, spring_scale[k], damper_scale[k], masses[m0:m1],
@@ -169,17 +126,14 @@ def two_ports_kernel(lam, spring_scale, damper_scale, mass_ptr, masses, el_ptr, 
 @njit(cache=True, nogil=True)
 def nodal_matrix(lam, s, t, masses, elem_nodes, c, d, D):
     """Fill ``D`` (n + 2, n + 2) with :math:`s\\mathbf K + \\lambda t\\mathbf C +
-    \\lambda^2\\mathbf M` over the nodes engine side (0), internal (1..n), ground (n + 1)."""
+    \\lambda^2\\mathbf M` over the nodes engine side (0), internal (1..n), ground (n + 1)
+    (``lam``, ``s``, ``t``; ``masses``, ``elem_nodes``, ``c``, ``d`` as :func:`two_port_kernel`)."""
     n = masses.size
-    size = n + 2
-    for i in range(size):
-        for j in range(size):
-            D[i, j] = 0.0
+    D[:, :] = 0.0
     for k in range(n):
         D[k + 1, k + 1] = lam * lam * masses[k]
     for e in range(c.size):
-        ia = elem_nodes[e, 0]
-        ib = elem_nodes[e, 1]
+        ia, ib = elem_nodes[e, 0], elem_nodes[e, 1]
         if ia < 0:
             ia = n + 1
         if ib < 0:
@@ -196,7 +150,7 @@ def nodal_matrix(lam, s, t, masses, elem_nodes, c, d, D):
 
 @njit(cache=True, nogil=True)
 def kcp_gradient_kernel(omega, B, masses, c, d, kcp, dk_dm, dk_dc, dk_dd):
-    """Fill ``kcp``, ``dk_dm``, ``dk_dc``, ``dk_dd`` (complex) for every frequency.
+    """Fill the cross-point stiffness and its parameter derivatives at every frequency.
 
     Parameters
     ----------
@@ -205,9 +159,9 @@ def kcp_gradient_kernel(omega, B, masses, c, d, kcp, dk_dm, dk_dc, dk_dd):
     B : ndarray (n_el, n + 2)
         Incidence over engine side (0), internal nodes (1..n), ground (n + 1).
     masses : ndarray (n,)
-        [kg]
+        Internal masses [kg].
     c, d : ndarray (n_el,)
-        [N/m], [N·s/m]
+        Element stiffness [N/m] and damping [N·s/m].
     kcp : ndarray complex (n_freq,)
         Output, cross-point stiffness [N/m].
     dk_dm, dk_dc, dk_dd : ndarray complex (n_freq, n), (n_freq, n_el), (n_freq, n_el)
@@ -216,16 +170,11 @@ def kcp_gradient_kernel(omega, B, masses, c, d, kcp, dk_dm, dk_dc, dk_dd):
     Returns
     -------
     int
-        0 on success, 1 if the internal block was singular at some frequency (the outputs
-        of that frequency are then NaN).
+        0, or 1 if singular at some frequency (NaN there).
     """
-    n_el = B.shape[0]
-    n = B.shape[1] - 2
-    status = 0
-    D = np.empty((n + 2, n + 2), dtype=np.complex128)
-    XY = np.empty((n + 2, 2), dtype=np.complex128)
-    order = np.empty(n, np.int64)
-    gone = np.empty(n + 2, np.bool_)
+    n_el, n, status = B.shape[0], B.shape[1] - 2, 0
+    D, XY = np.empty((n + 2, n + 2), dtype=np.complex128), np.empty((n + 2, 2), dtype=np.complex128)
+    order, gone = np.empty(n, np.int64), np.empty(n + 2, np.bool_)
     for f in range(omega.shape[0]):
         w = omega[f]
         _incidence_nodal_matrix(1j * w, B, masses, c, d, D)
@@ -235,8 +184,7 @@ def kcp_gradient_kernel(omega, B, masses, c, d, kcp, dk_dm, dk_dc, dk_dd):
             for j in range(n):
                 dk_dm[f, j] = np.nan
             for e in range(n_el):
-                dk_dc[f, e] = np.nan
-                dk_dd[f, e] = np.nan
+                dk_dc[f, e] = dk_dd[f, e] = np.nan
             continue
         total = 0.0 + 0.0j
         for j in range(n):
@@ -244,8 +192,7 @@ def kcp_gradient_kernel(omega, B, masses, c, d, kcp, dk_dm, dk_dc, dk_dd):
             dk_dm[f, j] = g
             total += g * masses[j]
         for e in range(n_el):
-            u = 0.0 + 0.0j
-            v = 0.0 + 0.0j
+            u, v = 0.0 + 0.0j, 0.0 + 0.0j
             for a in range(n + 2):
                 be = B[e, a]
                 if be != 0.0:
@@ -261,12 +208,9 @@ def kcp_gradient_kernel(omega, B, masses, c, d, kcp, dk_dm, dk_dc, dk_dd):
 
 @njit(cache=True, nogil=True)
 def _incidence_nodal_matrix(lam, B, masses, c, d, D):
-    r"""Fill ``D`` with :math:`\mathbf B^T\operatorname{diag}(c + \lambda d)\mathbf B +
-    \lambda^2\operatorname{diag}(0, \mathbf m, 0)`."""
+    r"""``D`` = :math:`\mathbf B^T\operatorname{diag}(c + \lambda d)\mathbf B + \lambda^2\mathbf M`."""
     size = B.shape[1]
-    for i in range(size):
-        for j in range(size):
-            D[i, j] = 0.0
+    D[:, :] = 0.0
     for k in range(masses.size):
         D[k + 1, k + 1] = lam * lam * masses[k]
     for e in range(B.shape[0]):
