@@ -225,6 +225,7 @@ def test_the_cli_strings_give_what_the_command_computes(default_engine):
     np.testing.assert_array_equal(run.rpm, np.arange(1000.0, 6001.0, 500.0))
 
 
+@pytest.mark.slow
 def test_fit_mount_fits_what_the_command_fits(tmp_path):
     """``pt.fit_mount(file)`` on data at several amplitudes is the command's joint fit."""
     fit = pt.fit_mount(AMPLITUDES)

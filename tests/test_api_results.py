@@ -100,6 +100,7 @@ def drawn(fig) -> dict:
             "legends": len(fig.legends) + sum(a.get_legend() is not None for a in axes)}
 
 
+@pytest.mark.slow
 def test_every_result_class_follows_the_protocol(results):
     for name, r in results.items():
         assert type(r).__name__ == name
@@ -110,6 +111,7 @@ def test_every_result_class_follows_the_protocol(results):
         assert ".png" in r.writers(), name
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("name", sorted(MAKERS))
 def test_a_result_is_built_once(name, results):
     r = results[name]
@@ -119,6 +121,7 @@ def test_a_result_is_built_once(name, results):
         setattr(r, field, None)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("name", NAMES_BY_COST)
 def test_plot_into_a_figure_draws_what_it_draws_alone(name, results):
     r = results[name]
@@ -131,6 +134,7 @@ def test_plot_into_a_figure_draws_what_it_draws_alone(name, results):
     assert drawn(sub) == alone, name
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("name", sorted(MAKERS))
 def test_plot_into_one_axes_draws_the_one_panel_or_asks_for_a_figure(name, results):
     r = results[name]
@@ -163,6 +167,7 @@ def test_the_comparison_panel_in_an_axes_has_its_legend(results):
     assert ax.get_title().startswith("right X · order 6")
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("name", NAMES_BY_COST)
 def test_save_writes_every_suffix_it_names(name, results, tmp_path):
     r = results[name]

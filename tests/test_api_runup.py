@@ -10,6 +10,7 @@ import sys
 import h5py
 import matplotlib
 import numpy as np
+import pytest
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
@@ -32,6 +33,7 @@ def _printed(*args) -> str:
     return r.stdout
 
 
+@pytest.mark.slow
 def test_runup_text_is_what_the_command_prints_and_plot_draws_into_given_axes():
     result = runup(None, [1000.0, 2000.0], solver="harmonic", balancers=False,
                    effects=["sensor_error:g1=1"])

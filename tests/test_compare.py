@@ -291,6 +291,7 @@ def test_hdf5_measured_file_against_itself(tmp_path):
 
 
 # ----------------------------------------------------------------------- command line
+@pytest.mark.slow
 def test_cli_with_sim_file_writes_json_and_plot(tmp_path, sim_csv):
     rows = measured_rows(np.arange(1000.0, 6001.0, 100.0), scale={("left", "x", "order_2"): 2},
                          drop={("gearbox", "z")})

@@ -74,6 +74,7 @@ def _title_lines(fig) -> int:
     return t.count("\n") + 1
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("name", ["plot_gap_map", "plot_gap_frequency",
                                   "plot_diagnosis_overlay"])
 def test_twenty_channel_figures_are_clean(figures, name):

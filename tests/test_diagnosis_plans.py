@@ -82,6 +82,7 @@ def _cli(cwd, *args):
                           text=True, timeout=120)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("args, words", [
     ([], "missing MEASURED file or --plan"),
     (["x.csv", "--plan", "p.toml"], "not both"),

@@ -290,6 +290,7 @@ def test_diagnose_report_figures(tmp_path, monkeypatch, saved):
     _assert_clean(saved, ["gap_vs_frequency.png"], "diagnose")
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("form,axis", [("magnitude-phase", "log"), ("real-imag", "linear"),
                                        ("real-imag", "log"), ("magnitude-phase", "linear")])
 def test_stiffness_and_fit_figures(tmp_path, monkeypatch, saved, form, axis):

@@ -120,6 +120,7 @@ def test_objective_is_thesis_eq19_in_newton():
 
 # --- recovery of known curves -----------------------------------------------------------
 
+@pytest.mark.slow
 def test_triple_parallel_recovers_hydraulic_mount_curve():
     true = read_mount(MOUNTS / "hydraulic-engine-mount-x.toml")
     k = true.cross_point_stiffness(F)
@@ -159,6 +160,7 @@ def test_fit_is_not_trivially_good():
     assert res.rel_rms > 0.2
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("seed", [0, 1])
 def test_mini_robustness_hydraulic_y(seed):
     """The hardest set of scripts/fit_robustness.py (sharp resonance near 200 Hz)."""
@@ -199,6 +201,7 @@ def invoke(*args):
     return CliRunner().invoke(main, [str(a) for a in args])
 
 
+@pytest.mark.slow
 def test_cli_end_to_end(tmp_path):
     src = MOUNTS / "hydraulic-engine-mount-z.toml"
     res = invoke("stiffness", src, "--freq", "1:400:1", "--format", "csv")

@@ -70,6 +70,7 @@ def test_sigkill_mid_write_leaves_no_temporary_file_after_the_next_run(worker, t
     assert outcome == "ok", detail
 
 
+@pytest.mark.slow
 def test_issue_39_last_bad_inputs(worker, tmp_path):
     """Issue 39's last bad inputs: a mount singular at 0 Hz refused at reading (also reached
     through ``whatif --set``), a raw HDF5 file with an empty /time or an array as its
@@ -116,6 +117,7 @@ def test_issue_38_transient_failures(worker, tmp_path):
      "HDF5: integer mount names", "HDF5: wrong-shaped velocity", "HDF5: soft-link loop",
      "HDF5: empty rpm array", "HDF5: flipped bytes #1", "HDF5: flipped bytes #2",
      "HDF5: flipped bytes #3", "HDF5: flipped bytes #4"]))
+@pytest.mark.slow
 def test_issue_10_failures(worker, tmp_path, name):
     """Each named failure of the issue's campaign is now a clean error (or a finite result,
     e.g. flipped bytes in an unused part of the HDF5 file)."""
@@ -125,6 +127,7 @@ def test_issue_10_failures(worker, tmp_path, name):
         f"{outcome}: {detail}"
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("kind", sorted(fh.KINDS))
 def test_mutated_inputs_fail_cleanly_or_give_finite_results(worker, tmp_path, kind):
     @settings(max_examples=EXAMPLES, deadline=None, database=None,

@@ -158,6 +158,7 @@ def test_runup_outputs_0644_with_provenance_and_balancers_off(tmp_path):
     assert {m["name"] for m in as_run["mounts"]} == {"left", "right", "gearbox"}
 
 
+@pytest.mark.slow
 def test_runup_effect_recorded(tmp_path):
     r = _cli(["runup", *QUICK, "--solver", "harmonic", "--quiet", "--out", "r.h5",
               "--effect", "base_compliance:c_base=400N/mm,m_base=8kg"], tmp_path)
@@ -211,6 +212,7 @@ def test_unwritable_output_refused_before_work(tmp_path):
       "--raw", "sub/../s.h5"], "--raw"),
     (["transient", "START", "--json", "t.out", "--plot", "t.out"], "--plot"),
 ])
+@pytest.mark.slow
 def test_two_outputs_naming_one_file_are_refused_before_work(tmp_path, args, key):
     """The second output would overwrite the first: one line naming both options."""
     (tmp_path / "sub").mkdir()
@@ -237,6 +239,7 @@ def test_failure_after_writing_removes_the_earlier_outputs(tmp_path, monkeypatch
     assert list(tmp_path.iterdir()) == []
 
 
+@pytest.mark.slow
 def test_progress_bar_quiet_when_not_a_terminal(tmp_path):
     r = _cli(["runup", *QUICK, "--solver", "harmonic"], tmp_path)
     assert r.returncode == 0 and r.stderr == ""

@@ -161,6 +161,7 @@ def _cli(args, cwd):
                           capture_output=True, text=True)
 
 
+@pytest.mark.slow
 def test_cli_runup_writes_hdf5_csv_and_plot(tmp_path):
     r = _cli(["runup", "--from", "1000", "--to", "2000", "--step", "500", "--out", "r.h5",
               "--csv", "r.csv", "--plot", "r.png", "--quiet"], tmp_path)
@@ -176,6 +177,7 @@ def test_cli_runup_writes_hdf5_csv_and_plot(tmp_path):
     (lambda s: s.replace("[body]", "[bodyx]", 1), "body"),
     (lambda s: s.replace('unit = "kg"', 'unit = "furlong"', 1), "unit"),
 ])
+@pytest.mark.slow
 def test_cli_runup_bad_engine_file_one_line_no_output(tmp_path, edit, key):
     src = DEFAULT_ENGINE_PATH.read_text() if hasattr(DEFAULT_ENGINE_PATH, "read_text") else \
         open(DEFAULT_ENGINE_PATH).read()

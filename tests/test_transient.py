@@ -441,6 +441,7 @@ def test_a_recorded_speed_drives_the_same_run(default_engine, tmp_path):
     assert np.allclose(b["peak_force"][:9], a["peak_force"][:9], rtol=0.01)
 
 
+@pytest.mark.slow
 @pytest.mark.filterwarnings("ignore::powertrain.solvers.transient.StretchRuleWarning")
 def test_solve_ivp_on_the_laws_written_out_agrees(tmp_path):
     """One mount direction with a static curve, an amplitude law and Berg's friction on a
@@ -456,6 +457,7 @@ def test_solve_ivp_on_the_laws_written_out_agrees(tmp_path):
     assert np.max(np.abs(run.force[:, ch] - force)) <= IVP_REL * np.max(np.abs(force))
 
 
+@pytest.mark.slow
 @pytest.mark.filterwarnings("ignore::powertrain.solvers.transient.StretchRuleWarning")
 def test_the_stretch_rule_tends_to_the_curve_itself_under_an_amplitude_law(tmp_path):
     """The same flare against the curve evaluated at every instant (``continuous=True``,

@@ -337,6 +337,7 @@ def test_a_trigger_must_step_and_hold():
     assert trigger_time(t, step) == pytest.approx(0.49995, abs=1e-4)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("fmt", ["h5", "csv", "uff", "mf4"])
 def test_the_manoeuvres_trigger_time_is_written_and_lines_its_recording_up(fmt, tmp_path):
     """A back-out, too flat to line up on its speed, written as raw data with the trigger
@@ -549,6 +550,7 @@ def test_the_firing_interval_is_the_gas_torques_period(default_engine, angles, i
     assert np.degrees(crank.firing_interval) == pytest.approx(interval)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("suffix, kind", [(".csv", "csv"), (".mf4", "mdf"), (".uff", "uff")])
 def test_raw_output_is_written_in_the_format_of_its_suffix(suffix, kind, tmp_path):
     """Review 4: --raw x.csv wrote HDF5; now the suffix chooses the writer, and the file

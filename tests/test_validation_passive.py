@@ -10,6 +10,7 @@ hand-counted rows for the scores.
 from __future__ import annotations
 
 import numpy as np
+import pytest
 from conftest import MODAL
 
 from benchmarks.cases import case_plan
@@ -149,6 +150,7 @@ def test_passive_scores_by_hand():
     assert "mount_temperature -> mounts 0.50 (1/2" in passive_where_line(rows)
 
 
+@pytest.mark.slow
 def test_a_mount_whose_loss_factor_falls_as_it_softens_is_named_mount_stiffness():
     """Case 27 of the passive rate test's seed 90210 (left mount 0.70, 0.60, 0.62 × in x, y,
     z; the generator's dampers × factor^0.7, not × factor): answered "unexplained" while
