@@ -8,7 +8,8 @@ Prints, for ``src/powertrain`` (or the checkout given as the first argument):
 * CLI command functions (decorated with ``@main.command``) over 40 lines;
 * comparisons of a chassis, solver or combustion model *name* with a string
   (``x.model == "modal"``, ``solver == "harmonic"``) outside the file readers (``iotools``);
-* modules loose at the top of the package (``__init__.py`` not counted).
+* modules loose at the top of the package (``__init__.py`` not counted);
+* the package's lines, each counted once as docstring, blank, comment or code.
 
 The last line is a one-line summary. ``tests/test_architecture.py`` holds the same limits.
 
@@ -93,6 +94,33 @@ def measure(package: Path) -> Metrics:
     return m
 
 
+def _docstring_lines(tree) -> set:
+    """Line numbers of the module's, classes' and functions' docstrings."""
+    out = set()
+    for node in ast.walk(tree):
+        if isinstance(node, (ast.Module, ast.ClassDef, ast.FunctionDef, ast.AsyncFunctionDef)):
+            first = node.body[0] if node.body else None
+            if (isinstance(first, ast.Expr) and isinstance(first.value, ast.Constant)
+                    and isinstance(first.value.value, str)):
+                out.update(range(first.lineno, first.end_lineno + 1))
+    return out
+
+
+def line_kinds(package: Path) -> dict:
+    """``{"total", "code", "docstrings", "blank", "comments"}`` over the package's modules:
+    a line inside a docstring counts as docstring, else blank, comment (``#`` first) or code."""
+    n = dict.fromkeys(("total", "code", "docstrings", "blank", "comments"), 0)
+    for path in sorted(package.rglob("*.py")):
+        text = path.read_text(encoding="utf-8")
+        doc = _docstring_lines(ast.parse(text))
+        for i, line in enumerate(text.splitlines(), 1):
+            kind = ("docstrings" if i in doc else "blank" if not line.strip()
+                    else "comments" if line.lstrip().startswith("#") else "code")
+            n[kind] += 1
+            n["total"] += 1
+    return n
+
+
 def main(argv: list[str]) -> None:
     root = Path(argv[1]) if len(argv) > 1 else Path(__file__).resolve().parents[1]
     m = measure(root / "src" / "powertrain")
@@ -105,6 +133,9 @@ def main(argv: list[str]) -> None:
     for rel, line, text in m.variant_comparisons:
         print(f"variant {rel}:{line} {text}")
     print("loose top-level modules: " + ", ".join(m.loose_modules))
+    n = line_kinds(root / "src" / "powertrain")
+    print(f"lines: {n['total']} (code {n['code']}, docstrings {n['docstrings']}, blank "
+          f"{n['blank']}, comments {n['comments']})")
     print(m.summary())
 
 

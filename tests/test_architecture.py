@@ -205,6 +205,17 @@ def test_the_size_checker_can_fail(tmp_path):
     assert len(m.variant_comparisons) == 1
 
 
+def test_the_line_count_tells_each_line_once(tmp_path):
+    """``code_metrics.line_kinds``: every line once, a docstring's blank line as docstring."""
+    cm, _ = _code_metrics()
+    pkg = tmp_path / "powertrain"
+    pkg.mkdir()
+    (pkg / "m.py").write_text('"""Doc.\n\nMore."""\n\n# note\nx = 1  # end\n\n\n'
+                              'def f():\n    """One."""\n    return x\n')
+    assert cm.line_kinds(pkg) == {"total": 11, "code": 3, "docstrings": 4, "blank": 3,
+                                  "comments": 1}
+
+
 # ------------------------------------------------- the benchmark's scaffolding (issue 36)
 #: Modules of the blind benchmark and the rate tests, which live in ``benchmarks/`` (not
 #: installed): the truth generator, its truth effects, case plans, scoring and rate sizing.
