@@ -106,7 +106,7 @@ def port_force_loop(kinds, par, state, U, V, F):
 
 
 @njit(cache=True, nogil=True, inline="always")
-def _dot(a, b):
+def short_dot(a, b):
     """Dot product of two short vectors (no BLAS call)."""
     s = 0.0
     for i in range(a.shape[0]):
@@ -167,7 +167,7 @@ def newmark_port_kernel(G, H, Fs, h, x0, v0, a0, W, P, Q, kinds, par, state, X, 
     for j in range(n):
         X[0, j], V[0, j], A[0, j] = x0[j], v0[j], a0[j]
     for e in range(m):
-        z[e] = law_force(kinds[e], _dot(P[e], x0), _dot(P[e], v0), par, state, e)[0]
+        z[e] = law_force(kinds[e], short_dot(P[e], x0), short_dot(P[e], v0), par, state, e)[0]
         Z[0, e] = z[e]
     for k in range(1, ns):
         for j in range(n):
@@ -192,7 +192,7 @@ def newmark_port_kernel(G, H, Fs, h, x0, v0, a0, W, P, Q, kinds, par, state, X, 
         for e in range(m):
             Z[k, e] = z[e]
         for j in range(n):
-            A[k, j] -= _dot(W[j], z)
+            A[k, j] -= short_dot(W[j], z)
             X[k, j] = xt[j] + hh * A[k, j]
             V[k, j] = vt[j] + hv * A[k, j]
     return failed
@@ -205,7 +205,7 @@ def _port_newton(kinds, par, state, ul, vl, Q, z, r, J, tol, max_iter):
     for _ in range(max_iter):
         big, worst = 1.0, 0.0
         for e in range(m):
-            c = _dot(Qu[e], z)
+            c = short_dot(Qu[e], z)
             f, kt, ct = law_force(kinds[e], ul[e] - c, vl[e] - qv * c, par, state, e)
             r[e] = f - z[e]
             big = max(big, abs(z[e]))

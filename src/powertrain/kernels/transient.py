@@ -12,11 +12,11 @@ import numpy as np
 from numba import njit
 
 from powertrain.kernels.port_forces import (
-    _dot,
     law_force,
     port_coupling,
     port_forces_at,
     port_forces_step,
+    short_dot,
 )
 from powertrain.kernels.sparse_lu import (
     factor,
@@ -129,7 +129,7 @@ def curve_state(x, curves, law, centres, factors, c):
         if not has[r]:
             factors[r], c[r] = base[r], 0.0
             continue
-        u = _dot(rows[r], x)
+        u = short_dot(rows[r], x)
         force, tangent = curve_point(breaks, coefficients, count, r, d0[r] + u)
         f = tangent / ref[r]
         factors[r] = f
@@ -227,10 +227,10 @@ def _port_setup(laws, lu, h, x, v, Z):
             for k in range(starts[i], starts[i + 1]):
                 Q[i, e] += hh * values[k] * W[columns[k], e]
     for e in range(m):
-        z[e] = law_force(kinds[e], _dot(P[e], x), _dot(P[e], v), par, state, e)[0]
+        z[e] = law_force(kinds[e], short_dot(P[e], x), short_dot(P[e], v), par, state, e)[0]
         Z[0, e] = z[e]
     for e in range(m):
-        last[6, e] = _dot(Q[e], z)
+        last[6, e] = short_dot(Q[e], z)
     return (W, port_coupling(Q, 2.0 / h), laws[4], z,
             (np.empty(m), np.empty(m), np.empty(m), np.empty((m, m)), last))
 
@@ -252,7 +252,7 @@ def _port_step(laws, ports, h, xt, vt, a, z_out, tol, max_iter):
     for e in range(z.shape[0]):
         z_out[e] = z[e]
     for j in range(a.shape[0]):
-        a[j] -= _dot(W[j], z)
+        a[j] -= short_dot(W[j], z)
     return ok
 
 
